@@ -1,0 +1,51 @@
+"""``run-study SCENE.yaml [--out DIR]``: run a scene, write ``DIR/<name>.nc`` and the comparison report."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from .scene import SceneError, find_scene, load_scene
+from .study import run_study, write_dataset
+
+EXIT_BAD_INPUT = 2
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The command-line interface of ``run-study``."""
+    parser = argparse.ArgumentParser(
+        prog="run-study",
+        description="Run a vibroimpact scene (YAML) and write its netCDF dataset and comparison report.",
+    )
+    parser.add_argument("scene", help="scene file; a bare name is also looked up in ./studies/ and the shipped studies")
+    parser.add_argument("--out", type=Path, default=None, help="output folder (default: results/<scene name>/)")
+    parser.add_argument("--no-report", action="store_true", help="write the dataset only")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point; returns the process exit code (2 for a bad scene or arguments)."""
+    args = build_parser().parse_args(argv)
+    try:
+        scene = load_scene(find_scene(args.scene))
+    except (SceneError, FileNotFoundError, IsADirectoryError) as error:
+        print(f"run-study: error: {error}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    out_dir = args.out if args.out is not None else Path("results") / scene.name
+    started = time.perf_counter()
+    dataset = run_study(scene)
+    path = write_dataset(dataset, out_dir / f"{scene.name}.nc")
+    print(f"wrote {path}")
+    if scene.report and not args.no_report:
+        from .report import write_report  # matplotlib is imported only when a report is made
+
+        report = write_report(dataset, out_dir)
+        print(f"wrote {report}")
+    print(f"done in {time.perf_counter() - started:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

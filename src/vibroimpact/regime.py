@@ -1,0 +1,67 @@
+"""The ``regime`` flag of the output datasets: which kind of steady motion a value describes.
+
+Stored as an integer variable with CF ``flag_values`` / ``flag_meanings`` attributes.
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = ["Regime", "classify", "regime_attributes"]
+
+
+class Regime(IntEnum):
+    """Regime of the steady-state motion at one point of a study."""
+
+    #: No contact: the linear response stays inside the clearance and no one-impact solution exists.
+    LINEAR = 0
+    #: Admissible one-impact-per-period motion; the linear response would cross the stop.
+    ONE_IMPACT = 1
+    #: Admissible one-impact motion although the linear response also fits: two regimes coexist (hysteresis);
+    #: the one-impact values are reported.
+    ONE_IMPACT_COEXISTING_LINEAR = 2
+    #: The linear response fits; a one-impact solution of eqs. 15-16 exists but penetrates the stop.
+    LINEAR_WITH_INADMISSIBLE_ONE_IMPACT = 3
+    #: The linear response crosses the stop and the only one-impact solution penetrates it: values are NaN.
+    NONE_INADMISSIBLE_ONE_IMPACT = 4
+    #: The linear response crosses the stop and no one-impact solution exists: values are NaN.
+    NONE = 5
+    #: Solution ``linear`` only: the response without a stop (Delta -> infinity) crosses the clearance.
+    LINEAR_EXCEEDS_CLEARANCE = 6
+
+
+def classify(linear_fits: ArrayLike, exists: ArrayLike, admissible: ArrayLike) -> NDArray[np.int8]:
+    """Regime flag from three boolean arrays (broadcast together).
+
+    Parameters
+    ----------
+    linear_fits : array_like of bool
+        The linear steady state stays inside the clearance, q |H12| <= Delta.
+    exists : array_like of bool
+        A one-impact solution of eqs. 15-16 exists (real root, J >= 0).
+    admissible : array_like of bool
+        That solution keeps X2(t) <= Delta over the whole period.
+    """
+    fits, found, ok = np.broadcast_arrays(
+        np.asarray(linear_fits, bool), np.asarray(exists, bool), np.asarray(admissible, bool) & np.asarray(exists, bool)
+    )
+    flag = np.full(fits.shape, Regime.NONE, dtype=np.int8)
+    flag[~fits & found & ~ok] = Regime.NONE_INADMISSIBLE_ONE_IMPACT
+    flag[~fits & ok] = Regime.ONE_IMPACT
+    flag[fits & ok] = Regime.ONE_IMPACT_COEXISTING_LINEAR
+    flag[fits & found & ~ok] = Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT
+    flag[fits & ~found] = Regime.LINEAR
+    return flag
+
+
+def regime_attributes() -> dict[str, object]:
+    """CF attributes of the ``regime`` variable."""
+    return {
+        "long_name": "steady-state regime",
+        "units": "1",
+        "flag_values": np.array([int(r) for r in Regime], dtype=np.int8),
+        "flag_meanings": " ".join(r.name.lower() for r in Regime),
+    }

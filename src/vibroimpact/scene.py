@@ -1,0 +1,334 @@
+"""YAML scenes: what system, stop and excitation to study, over which grids, by which solutions.
+
+A scene is read with ``yaml.safe_load`` and checked completely before any work starts: every unknown key, wrong
+type or out-of-range value is reported (all of them at once, each naming its key and the allowed range) in one
+:class:`SceneError`. Example (all values SI, frequencies in Hz)::
+
+    name: restitution
+    system: {m1: 1.0, m2: 0.1, k1: 25000, k2: 4300, b1: 0.8, b2: 0.08}
+    excitation: {amplitude: 10.0}
+    stop: {clearance: 0.003}
+    sweep:
+      restitution: [0.0, 0.2, 0.4, 0.6, 0.8]
+      frequency: {start: 15.0, stop: 45.0, step: 0.005}
+    solutions: [linear, pgf, pgf_paper]
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from .pgf import AdmissibilitySettings
+from .system import TwoDofSystem
+
+__all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "SOLUTIONS", "QUANTITIES", "SWEEPABLE"]
+
+#: Solutions a scene can ask for.
+SOLUTIONS = ("linear", "pgf", "pgf_paper")
+#: Quantities a scene can ask for (``regime`` is always written: it says what the others mean).
+QUANTITIES = ("x1_amplitude", "x2_amplitude", "force_amplitude", "suspension_force_amplitude", "impulse", "phase", "regime")
+#: Parameters that can be swept, with their units and allowed ranges (low, high, low inclusive).
+SWEEPABLE = {
+    "frequency": ("Hz", 0.0, math.inf, False),
+    "restitution": ("1", 0.0, 1.0, True),
+    "clearance": ("m", 0.0, math.inf, True),
+}
+MAX_GRID_POINTS = 1_000_000
+
+
+class SceneError(ValueError):
+    """A scene is invalid. ``problems`` lists every problem found, each naming its key."""
+
+    def __init__(self, problems: list[str], source: str = "scene") -> None:
+        self.problems = list(problems)
+        super().__init__(f"invalid {source}:\n" + "\n".join(f"  - {p}" for p in self.problems))
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A validated scene.
+
+    Attributes
+    ----------
+    name : str
+        Scene name; output goes to ``<out>/<name>.nc``.
+    description : str
+        Free text.
+    system : TwoDofSystem
+        The linear system.
+    amplitude : float
+        Excitation force amplitude q [N].
+    frequency : ndarray
+        Excitation frequencies [Hz], increasing.
+    restitution : ndarray
+        Restitution ratios R [-]; one value unless swept.
+    clearance : ndarray
+        Clearances Delta [m]; one value unless swept.
+    swept : tuple of str
+        Parameters that are dimensions of the output, in dimension order (``frequency`` last).
+    solutions : tuple of str
+        Solutions to compute.
+    quantities : tuple of str
+        Quantities to write.
+    admissibility : AdmissibilitySettings
+        Settings of the X2(t) <= Delta check.
+    report : bool
+        Whether ``run-study`` writes the comparison report.
+    text : str
+        The YAML source, stored in the output's attributes.
+    """
+
+    name: str
+    description: str
+    system: TwoDofSystem
+    amplitude: float
+    frequency: np.ndarray
+    restitution: np.ndarray
+    clearance: np.ndarray
+    swept: tuple[str, ...]
+    solutions: tuple[str, ...]
+    quantities: tuple[str, ...]
+    admissibility: AdmissibilitySettings = field(default_factory=AdmissibilitySettings)
+    report: bool = True
+    text: str = ""
+
+
+# ----------------------------------------------------------------------------- checking helpers
+class _Checker:
+    """Collects problems while walking a parsed YAML document."""
+
+    def __init__(self) -> None:
+        self.problems: list[str] = []
+
+    def fail(self, key: str, message: str) -> None:
+        self.problems.append(f"{key}: {message}")
+
+    def mapping(self, key: str, value: Any, allowed: set[str], required: set[str] = frozenset()) -> dict:
+        if not isinstance(value, dict):
+            self.fail(key, f"expected a mapping with keys {sorted(allowed)}, got {type(value).__name__}")
+            return {}
+        for unknown in sorted(set(map(str, value)) - allowed):
+            self.fail(f"{key}.{unknown}" if key else unknown, f"unknown key (allowed: {', '.join(sorted(allowed))})")
+        for missing in sorted(required - set(value)):
+            self.fail(f"{key}.{missing}" if key else missing, "required key is missing")
+        return value
+
+    def number(self, key: str, value: Any, low: float, high: float, low_inclusive: bool = True, high_inclusive: bool = True) -> float | None:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.fail(key, f"expected a number, got {value!r} ({type(value).__name__})")
+            return None
+        number = float(value)
+        ok_low = number >= low if low_inclusive else number > low
+        ok_high = number <= high if high_inclusive else number < high
+        if not (math.isfinite(number) and ok_low and ok_high):
+            interval = f"{'[' if low_inclusive else '('}{low:g}, {high:g}{']' if high_inclusive else ')'}"
+            self.fail(key, f"{value!r} is out of range: allowed {interval}")
+            return None
+        return number
+
+    def integer(self, key: str, value: Any, low: int, high: int) -> int | None:
+        if isinstance(value, bool) or not isinstance(value, int):
+            self.fail(key, f"expected an integer, got {value!r} ({type(value).__name__})")
+            return None
+        if not low <= value <= high:
+            self.fail(key, f"{value!r} is out of range: allowed [{low}, {high}]")
+            return None
+        return value
+
+    def choices(self, key: str, value: Any, allowed: tuple[str, ...]) -> tuple[str, ...]:
+        if not isinstance(value, list) or not value:
+            self.fail(key, f"expected a non-empty list of names from {list(allowed)}, got {value!r}")
+            return ()
+        chosen: list[str] = []
+        for i, item in enumerate(value):
+            if item not in allowed:
+                self.fail(f"{key}[{i}]", f"unknown name {item!r} (allowed: {', '.join(allowed)})")
+            elif item in chosen:
+                self.fail(f"{key}[{i}]", f"{item!r} is listed twice")
+            else:
+                chosen.append(item)
+        return tuple(chosen)
+
+    def grid(self, key: str, value: Any, low: float, high: float, low_inclusive: bool) -> np.ndarray | None:
+        """A list of values or {start, stop, step} / {start, stop, num}; returns sorted unique values."""
+        check = lambda k, v: self.number(k, v, low, high, low_inclusive)  # noqa: E731
+        if isinstance(value, list):
+            if not value:
+                self.fail(key, "empty grid: give at least one value")
+                return None
+            numbers = [check(f"{key}[{i}]", v) for i, v in enumerate(value)]
+            if any(n is None for n in numbers):
+                return None
+            values = np.array(numbers, dtype=float)
+            if np.unique(values).size != values.size:
+                self.fail(key, "repeated values in the grid")
+                return None
+            return np.sort(values)
+        if isinstance(value, dict):
+            spec = self.mapping(key, value, {"start", "stop", "step", "num"}, {"start", "stop"})
+            if "step" in spec and "num" in spec or ("step" not in spec and "num" not in spec):
+                self.fail(key, "give exactly one of 'step' or 'num' with 'start' and 'stop'")
+                return None
+            start = check(f"{key}.start", spec.get("start"))
+            stop = check(f"{key}.stop", spec.get("stop"))
+            if start is None or stop is None:
+                return None
+            if stop <= start:
+                self.fail(f"{key}.stop", f"{stop:g} must be greater than start = {start:g}")
+                return None
+            if "step" in spec:
+                step = self.number(f"{key}.step", spec["step"], 0.0, stop - start, low_inclusive=False)
+                if step is None:
+                    return None
+                count = int(math.floor((stop - start) / step * (1.0 + 1e-12))) + 1
+            else:
+                count = self.integer(f"{key}.num", spec["num"], 2, MAX_GRID_POINTS)
+                if count is None:
+                    return None
+                step = (stop - start) / (count - 1)
+            if count > MAX_GRID_POINTS:
+                self.fail(key, f"{count} points is too many: allowed at most {MAX_GRID_POINTS}")
+                return None
+            # integer multiples of the step keep grid values exact decimals where the step is one (0.005 Hz)
+            return np.round(start + step * np.arange(count), 12)
+        self.fail(key, f"expected a list of values or a mapping {{start, stop, step|num}}, got {type(value).__name__}")
+        return None
+
+
+# ----------------------------------------------------------------------------- the parser
+_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "sweep", "solutions", "quantities", "settings", "report"}
+_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+
+
+def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
+    """Validate a parsed YAML document and build the :class:`Scene`; raise :class:`SceneError` listing all problems."""
+    c = _Checker()
+    doc = c.mapping("", document, _TOP_KEYS, {"name", "system", "excitation", "sweep", "solutions"})
+    if not doc and not c.problems:
+        c.fail("scene", "empty document")
+
+    name = doc.get("name")
+    if "name" in doc and not (isinstance(name, str) and _NAME.match(name)):
+        c.fail("name", f"expected a file-name-safe string (letters, digits, '_', '-', '.'), got {name!r}")
+    description = doc.get("description", "")
+    if not isinstance(description, str):
+        c.fail("description", f"expected a string, got {type(description).__name__}")
+
+    system = _parse_system(c, doc.get("system")) if "system" in doc else None
+    amplitude = None
+    if "excitation" in doc:
+        excitation = c.mapping("excitation", doc["excitation"], {"amplitude"}, {"amplitude"})
+        if "amplitude" in excitation:
+            amplitude = c.number("excitation.amplitude", excitation["amplitude"], 0.0, math.inf, low_inclusive=False)
+
+    sweep = c.mapping("sweep", doc.get("sweep", {}), set(SWEEPABLE), {"frequency"}) if "sweep" in doc else {}
+    stop = c.mapping("stop", doc["stop"], {"clearance", "restitution"}) if "stop" in doc else {}
+    grids: dict[str, np.ndarray | None] = {}
+    for key, (_units, low, high, low_inclusive) in SWEEPABLE.items():
+        if key in sweep:
+            if key in stop:
+                c.fail(f"stop.{key}", f"also swept in sweep.{key}: give it in one place only")
+            grids[key] = c.grid(f"sweep.{key}", sweep[key], low, high, low_inclusive)
+        elif key in stop:
+            value = c.number(f"stop.{key}", stop[key], low, high, low_inclusive)
+            grids[key] = None if value is None else np.array([value])
+        elif key != "frequency":
+            c.fail(f"stop.{key}", f"required unless swept (sweep.{key}); allowed range {'[' if low_inclusive else '('}{low:g}, {high:g}]")
+
+    solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
+    quantities = c.choices("quantities", doc["quantities"], QUANTITIES) if "quantities" in doc else QUANTITIES
+    if "regime" not in quantities:
+        quantities = (*quantities, "regime")
+
+    admissibility = AdmissibilitySettings()
+    if "settings" in doc:
+        settings = c.mapping("settings", doc["settings"], {"admissibility"})
+        if "admissibility" in settings:
+            adm = c.mapping("settings.admissibility", settings["admissibility"], {"samples_per_period", "relative_tolerance"})
+            kwargs: dict[str, Any] = {}
+            if "samples_per_period" in adm:
+                kwargs["samples_per_period"] = c.integer("settings.admissibility.samples_per_period", adm["samples_per_period"], 16, 1_000_000)
+            if "relative_tolerance" in adm:
+                kwargs["relative_tolerance"] = c.number("settings.admissibility.relative_tolerance", adm["relative_tolerance"], 0.0, 1e-2)
+            if None not in kwargs.values():
+                admissibility = AdmissibilitySettings(**kwargs)
+
+    report = doc.get("report", True)
+    if not isinstance(report, bool):
+        c.fail("report", f"expected true or false, got {report!r}")
+
+    if c.problems:
+        raise SceneError(c.problems, source)
+    assert system is not None and amplitude is not None  # guaranteed when no problem was recorded
+    swept = tuple(k for k in ("restitution", "clearance") if k in sweep) + ("frequency",)
+    return Scene(
+        name=name,
+        description=description,
+        system=system,
+        amplitude=amplitude,
+        frequency=grids["frequency"],
+        restitution=grids["restitution"],
+        clearance=grids["clearance"],
+        swept=swept,
+        solutions=solutions,
+        quantities=quantities,
+        admissibility=admissibility,
+        report=report,
+        text=text,
+    )
+
+
+def _parse_system(c: _Checker, value: Any) -> TwoDofSystem | None:
+    spec = c.mapping("system", value, {"m1", "m2", "k1", "k2", "b1", "b2"}, {"m1", "m2", "k1", "k2"})
+    numbers: dict[str, float | None] = {}
+    for key in ("m1", "m2", "k1", "k2"):
+        if key in spec:
+            numbers[key] = c.number(f"system.{key}", spec[key], 0.0, math.inf, low_inclusive=False)
+    for key in ("b1", "b2"):
+        if key in spec:
+            numbers[key] = c.number(f"system.{key}", spec[key], 0.0, math.inf)
+    if len(numbers) < 4 or None in numbers.values():
+        return None
+    return TwoDofSystem(**numbers)
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a scene file; raise :class:`SceneError` (or ``OSError`` if unreadable)."""
+    path = Path(path)
+    text = path.read_text(encoding="utf-8")
+    try:
+        document = yaml.safe_load(text)
+    except yaml.YAMLError as error:
+        raise SceneError([f"not valid YAML: {error}"], str(path)) from None
+    return parse_scene(document, text=text, source=str(path))
+
+
+def find_scene(name: str | Path) -> Path:
+    """Locate a scene: the path as given, else ``studies/<name>`` in the working directory, else the shipped one.
+
+    Raises
+    ------
+    FileNotFoundError
+        Naming every place looked at.
+    """
+    given = Path(name)
+    candidates = [given]
+    if not given.is_absolute():
+        candidates.append(Path.cwd() / "studies" / given)
+        candidates.append(shipped_studies_dir() / given.name)
+    for candidate in candidates:
+        if candidate.is_file():
+            return candidate
+    raise FileNotFoundError("scene not found; looked at: " + ", ".join(str(p) for p in candidates))
+
+
+def shipped_studies_dir() -> Path:
+    """The ``studies/`` folder of the source checkout this package was installed from."""
+    return Path(__file__).resolve().parents[2] / "studies"

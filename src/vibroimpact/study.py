@@ -1,0 +1,184 @@
+"""Expand a scene into its grid, compute the solutions it asks for, and gather one labelled ``xarray.Dataset``.
+
+Output contract (read by other tools; keep these names): dimensions ``solution`` (strings), each swept parameter
+(``restitution`` [1], ``clearance`` [m]) and ``frequency`` [Hz]; variables ``x1_amplitude`` [m],
+``x2_amplitude`` [m], ``force_amplitude`` [N], ``suspension_force_amplitude`` [N], ``impulse`` [N s], ``phase``
+[rad] and ``regime`` (CF flags). Unswept stop parameters are scalar coordinates.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from dataclasses import asdict
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import xarray as xr
+
+from . import __version__
+from .linear import linear_response
+from .modal import fit_modal_parameters
+from .pgf import PgfVariant, green_models, solve_one_impact
+from .regime import Regime, classify, regime_attributes
+from .scene import Scene
+
+__all__ = ["run_study", "write_dataset", "VARIABLE_ATTRIBUTES"]
+
+VARIABLE_ATTRIBUTES: dict[str, dict[str, str]] = {
+    "x1_amplitude": {"units": "m", "long_name": "fundamental-harmonic amplitude of the primary-mass displacement X1"},
+    "x2_amplitude": {"units": "m", "long_name": "fundamental-harmonic amplitude of the absorber displacement X2"},
+    "force_amplitude": {"units": "N", "long_name": "fundamental-harmonic amplitude of the force transmitted to the base (suspension plus impacts, eq. 23)"},
+    "suspension_force_amplitude": {"units": "N", "long_name": "fundamental-harmonic amplitude of the force through the suspension alone (eq. 21)"},
+    "impulse": {"units": "N s", "long_name": "impact impulse per period (0 where the motion is linear)"},
+    "phase": {"units": "rad", "long_name": "phase of the impact relative to the linear absorber motion (varphi + psi12, eq. 15)"},
+}
+COORDINATE_ATTRIBUTES: dict[str, dict[str, str]] = {
+    "frequency": {"units": "Hz", "long_name": "excitation frequency"},
+    "restitution": {"units": "1", "long_name": "restitution ratio R"},
+    "clearance": {"units": "m", "long_name": "clearance Delta between absorber and stop"},
+    "solution": {"long_name": "solution method"},
+}
+_IMPACT_REGIMES = (Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR)
+_LINEAR_REGIMES = (Regime.LINEAR, Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT)
+
+Progress = Callable[[str], None]
+
+
+def _stderr_progress(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
+
+
+def run_study(scene: Scene, progress: Progress | None = _stderr_progress) -> xr.Dataset:
+    """Compute every solution of ``scene`` over its grid.
+
+    Parameters
+    ----------
+    scene : Scene
+        A validated scene.
+    progress : callable, optional
+        Receives one line per finished step; ``None`` for silence.
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions ``solution``, the swept parameters and ``frequency``.
+    """
+    report = progress or (lambda _message: None)
+    # full grid (restitution, clearance, frequency); unswept axes have length 1 and are squeezed at the end
+    r = scene.restitution[:, None, None]
+    delta = scene.clearance[None, :, None]
+    omega = 2.0 * np.pi * scene.frequency[None, None, :]
+    shape = np.broadcast_shapes(r.shape, delta.shape, omega.shape)
+    total = len(scene.solutions)
+    per_solution = []
+    for i, name in enumerate(scene.solutions, start=1):
+        values = _linear(scene, omega, delta, shape) if name == "linear" else _pgf(scene, PgfVariant(name), omega, delta, r, shape)
+        per_solution.append(values)
+        report(f"[{i}/{total}] {name}: {int(np.prod(shape))} points")
+
+    dims = ("solution", "restitution", "clearance", "frequency")
+    coords = {
+        "solution": np.array(scene.solutions, dtype=object),
+        "restitution": scene.restitution,
+        "clearance": scene.clearance,
+        "frequency": scene.frequency,
+    }
+    data_vars = {}
+    for quantity in scene.quantities:
+        stacked = np.stack([values[quantity] for values in per_solution])
+        attrs = regime_attributes() if quantity == "regime" else VARIABLE_ATTRIBUTES[quantity]
+        data_vars[quantity] = xr.Variable(dims, stacked, attrs)
+    dataset = xr.Dataset(data_vars, coords=coords)
+    for key in ("restitution", "clearance"):
+        if key not in scene.swept:
+            dataset = dataset.squeeze(key)
+    for key, attrs in COORDINATE_ATTRIBUTES.items():
+        dataset[key].attrs.update(attrs)
+    dataset.attrs.update(_metadata(scene))
+    return dataset
+
+
+def _linear(scene: Scene, omega: np.ndarray, delta: np.ndarray, shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+    response = linear_response(scene.system, omega, scene.amplitude)
+    fits = np.abs(response.x2) <= delta
+    values = {
+        "x1_amplitude": np.abs(response.x1),
+        "x2_amplitude": np.abs(response.x2),
+        "force_amplitude": np.abs(response.force),
+        "suspension_force_amplitude": np.abs(response.force),
+        "impulse": np.zeros(shape),
+        "phase": np.full(shape, np.nan),
+        "regime": np.where(fits, Regime.LINEAR, Regime.LINEAR_EXCEEDS_CLEARANCE).astype(np.int8),
+    }
+    return {k: np.broadcast_to(v, shape) for k, v in values.items() if k in scene.quantities}
+
+
+def _pgf(scene: Scene, variant: PgfVariant, omega: np.ndarray, delta: np.ndarray, r: np.ndarray, shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+    solution = solve_one_impact(scene.system, omega, delta, r, scene.amplitude, variant, green_models(scene.system, variant))
+    linear = linear_response(scene.system, np.broadcast_to(omega, shape), scene.amplitude)
+    fits = solution.linear_amplitude_x2 <= solution.clearance
+    regime = classify(fits, solution.exists, solution.admissible(scene.admissibility))
+    impact = np.isin(regime, _IMPACT_REGIMES)
+    free = np.isin(regime, _LINEAR_REGIMES)
+
+    def choose(impact_value: Callable[[], np.ndarray], linear_value: np.ndarray) -> np.ndarray:
+        return np.where(impact, impact_value(), np.where(free, linear_value, np.nan))
+
+    zeros = np.zeros(shape)
+    makers: dict[str, Callable[[], np.ndarray]] = {
+        "x1_amplitude": lambda: choose(lambda: np.abs(solution.x1_harmonic()), np.abs(linear.x1)),
+        "x2_amplitude": lambda: choose(lambda: np.abs(solution.x2_harmonic()), np.abs(linear.x2)),
+        "force_amplitude": lambda: choose(lambda: np.abs(solution.force_harmonic()), np.abs(linear.force)),
+        "suspension_force_amplitude": lambda: choose(lambda: np.abs(solution.suspension_force_harmonic()), np.abs(linear.force)),
+        "impulse": lambda: choose(lambda: solution.impulse, zeros),
+        "phase": lambda: np.where(impact, solution.phase, np.nan),
+        "regime": lambda: regime,
+    }
+    return {q: makers[q]() for q in scene.quantities}
+
+
+def _metadata(scene: Scene) -> dict[str, object]:
+    system = scene.system
+    fit = fit_modal_parameters(system) if "pgf_paper" in scene.solutions else None
+    attrs: dict[str, object] = {
+        "title": f"vibroimpact study '{scene.name}'",
+        "scene_name": scene.name,
+        "scene": scene.text,
+        "vibroimpact_version": __version__,
+        "Conventions": "CF-1.8",
+        "excitation_amplitude_N": scene.amplitude,
+        "natural_frequencies_Hz": np.array(system.natural_frequencies()) / (2.0 * np.pi),
+        "antiresonance_frequency_Hz": system.antiresonance_frequency() / (2.0 * np.pi),
+        "method_pgf": "exact poles and residues of H22; exact chi22'(0-) from the derivative of eq. 12; stable (+) root of corrected eq. 16",
+        "method_pgf_paper": "curve-fitted modal parameters of H22 (eq. 10, Omega fixed from eq. 11); chi22'(0-) = -1/(2 M2); stable (+) root of corrected eq. 16",
+    }
+    for key, value in system.as_dict().items():
+        attrs[f"system_{key}"] = value
+    for key, value in asdict(scene.admissibility).items():
+        attrs[f"admissibility_{key}"] = value
+    if fit is not None:
+        attrs["pgf_paper_form_factors_per_kg"] = np.real(fit.form_factor)
+        attrs["pgf_paper_loss_factors"] = fit.loss_factor
+    return attrs
+
+
+def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
+    """Write ``dataset`` to netCDF atomically: a temporary file in the same folder, then a rename.
+
+    A reader never sees a half-written file, and an interrupted run leaves the previous file intact.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    encoding = {name: {"zlib": True, "complevel": 4} for name in dataset.data_vars}
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(handle)
+    try:
+        dataset.to_netcdf(temporary, engine="netcdf4", format="NETCDF4", encoding=encoding)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+    return path
