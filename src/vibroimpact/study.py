@@ -177,6 +177,7 @@ def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
     os.close(handle)
     try:
         dataset.to_netcdf(temporary, engine="netcdf4", format="NETCDF4", encoding=encoding)
+        os.chmod(temporary, 0o644)
         os.replace(temporary, path)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
