@@ -33,7 +33,17 @@ __all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "SOLUTIONS", "QUA
 #: Solutions a scene can ask for.
 SOLUTIONS = ("linear", "pgf", "pgf_paper")
 #: Quantities a scene can ask for (``regime`` is always written: it says what the others mean).
-QUANTITIES = ("x1_amplitude", "x2_amplitude", "force_amplitude", "suspension_force_amplitude", "impulse", "phase", "regime")
+QUANTITIES = (
+    "x1_amplitude",
+    "x2_amplitude",
+    "force_amplitude",
+    "suspension_force_amplitude",
+    "impulse",
+    "phase",
+    "regime",
+    "stable",
+    "floquet_modulus",
+)
 #: Parameters that can be swept, with their units and allowed ranges (low, high, low inclusive).
 SWEEPABLE = {
     "frequency": ("Hz", 0.0, math.inf, False),

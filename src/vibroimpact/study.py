@@ -24,6 +24,7 @@ from .modal import fit_modal_parameters
 from .pgf import PgfVariant, green_models, solve_one_impact
 from .regime import Regime, classify, regime_attributes
 from .scene import Scene
+from .stability import floquet_multipliers
 
 __all__ = ["run_study", "write_dataset", "VARIABLE_ATTRIBUTES"]
 
@@ -34,6 +35,13 @@ VARIABLE_ATTRIBUTES: dict[str, dict[str, str]] = {
     "suspension_force_amplitude": {"units": "N", "long_name": "fundamental-harmonic amplitude of the force through the suspension alone (eq. 21)"},
     "impulse": {"units": "N s", "long_name": "impact impulse per period (0 where the motion is linear)"},
     "phase": {"units": "rad", "long_name": "phase of the impact relative to the linear absorber motion (varphi + psi12, eq. 15)"},
+    "floquet_modulus": {"units": "1", "long_name": "largest modulus of the Floquet multipliers of the one-impact orbit (< 1: stable); solution pgf only"},
+}
+STABLE_ATTRIBUTES = {
+    "long_name": "Floquet stability of the one-impact orbit (solution pgf only)",
+    "units": "1",
+    "flag_values": np.array([-1, 0, 1], dtype=np.int8),
+    "flag_meanings": "not_applicable unstable stable",
 }
 COORDINATE_ATTRIBUTES: dict[str, dict[str, str]] = {
     "frequency": {"units": "Hz", "long_name": "excitation frequency"},
@@ -89,7 +97,7 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress) -> xr.
     data_vars = {}
     for quantity in scene.quantities:
         stacked = np.stack([values[quantity] for values in per_solution])
-        attrs = regime_attributes() if quantity == "regime" else VARIABLE_ATTRIBUTES[quantity]
+        attrs = {"regime": regime_attributes(), "stable": STABLE_ATTRIBUTES}.get(quantity, VARIABLE_ATTRIBUTES.get(quantity))
         data_vars[quantity] = xr.Variable(dims, stacked, attrs)
     dataset = xr.Dataset(data_vars, coords=coords)
     for key in ("restitution", "clearance"):
@@ -112,6 +120,8 @@ def _linear(scene: Scene, omega: np.ndarray, delta: np.ndarray, shape: tuple[int
         "impulse": np.zeros(shape),
         "phase": np.full(shape, np.nan),
         "regime": np.where(fits, Regime.LINEAR, Regime.LINEAR_EXCEEDS_CLEARANCE).astype(np.int8),
+        "stable": np.full(shape, -1, dtype=np.int8),
+        "floquet_modulus": np.full(shape, np.nan),
     }
     return {k: np.broadcast_to(v, shape) for k, v in values.items() if k in scene.quantities}
 
@@ -123,21 +133,32 @@ def _pgf(scene: Scene, variant: PgfVariant, omega: np.ndarray, delta: np.ndarray
     regime = classify(fits, solution.exists, solution.admissible(scene.admissibility))
     impact = np.isin(regime, _IMPACT_REGIMES)
     free = np.isin(regime, _LINEAR_REGIMES)
+    wanted = set(scene.quantities)
 
-    def choose(impact_value: Callable[[], np.ndarray], linear_value: np.ndarray) -> np.ndarray:
-        return np.where(impact, impact_value(), np.where(free, linear_value, np.nan))
+    def choose(impact_value: np.ndarray, linear_value: np.ndarray) -> np.ndarray:
+        return np.where(impact, impact_value, np.where(free, linear_value, np.nan))
 
-    zeros = np.zeros(shape)
-    makers: dict[str, Callable[[], np.ndarray]] = {
-        "x1_amplitude": lambda: choose(lambda: np.abs(solution.x1_harmonic()), np.abs(linear.x1)),
-        "x2_amplitude": lambda: choose(lambda: np.abs(solution.x2_harmonic()), np.abs(linear.x2)),
-        "force_amplitude": lambda: choose(lambda: np.abs(solution.force_harmonic()), np.abs(linear.force)),
-        "suspension_force_amplitude": lambda: choose(lambda: np.abs(solution.suspension_force_harmonic()), np.abs(linear.force)),
-        "impulse": lambda: choose(lambda: solution.impulse, zeros),
-        "phase": lambda: np.where(impact, solution.phase, np.nan),
-        "regime": lambda: regime,
-    }
-    return {q: makers[q]() for q in scene.quantities}
+    values: dict[str, np.ndarray] = {"regime": regime}
+    if "x1_amplitude" in wanted:
+        values["x1_amplitude"] = choose(np.abs(solution.x1_harmonic()), np.abs(linear.x1))
+    if "x2_amplitude" in wanted:
+        values["x2_amplitude"] = choose(np.abs(solution.x2_harmonic()), np.abs(linear.x2))
+    if "force_amplitude" in wanted:
+        values["force_amplitude"] = choose(np.abs(solution.force_harmonic()), np.abs(linear.force))
+    if "suspension_force_amplitude" in wanted:
+        values["suspension_force_amplitude"] = choose(np.abs(solution.suspension_force_harmonic()), np.abs(linear.force))
+    if "impulse" in wanted:
+        values["impulse"] = choose(solution.impulse, np.zeros(shape))
+    if "phase" in wanted:
+        values["phase"] = np.where(impact, solution.phase, np.nan)
+    if wanted & {"stable", "floquet_modulus"}:
+        # Floquet analysis of the exact orbits only: the paper variant's orbits are not orbits of the real system
+        modulus = np.full(shape, np.nan)
+        if variant is PgfVariant.EXACT:
+            modulus = np.where(impact, np.max(np.abs(floquet_multipliers(solution)), axis=-1), np.nan)
+        values["floquet_modulus"] = modulus
+        values["stable"] = np.where(np.isnan(modulus), -1, modulus < 1.0).astype(np.int8)
+    return {q: values[q] for q in scene.quantities}
 
 
 def _metadata(scene: Scene) -> dict[str, object]:
