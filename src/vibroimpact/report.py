@@ -35,7 +35,9 @@ REDUCTION_FACTOR_DEFINITION = (
     "within that resonance's band). The bands split the frequency range at the anti-resonance sqrt(K2/M2): band 1 "
     "below it, band 2 above it. Points where the solution is undefined (NaN: no admissible one-impact regime and "
     "the linear motion would cross the stop) are left out and counted in the 'undefined' column; where there are "
-    "any, the factor is an upper bound."
+    "any, the factor is an upper bound. The 'unstable' column counts grid points of the band whose one-impact orbit "
+    "is unstable (pgf only): the factor is computed from those values too, as in the paper, but the real motion "
+    "there is another one (possibly larger), so treat such factors with care."
 )
 _PAPER_VALUES = {"x1_amplitude": {0.2: (28.0, 23.0)}, "force_amplitude": {0.2: (25.0, 30.0)}}
 _PEAK_QUANTITY = {"x1_amplitude": "x1", "x2_amplitude": "x2", "force_amplitude": "force", "suspension_force_amplitude": "force"}
@@ -69,6 +71,8 @@ def write_report(dataset: xr.Dataset, out_dir: str | Path) -> Path:
                 figures.append(_response_figure(part, quantity, out))
         if "regime" in part:
             figures.append(_regime_figure(part, out))
+        if "floquet_modulus" in part and "pgf" in part["solution"].values:
+            figures.append(_stability_figure(part, out))
     tables = _tables(dataset, scene)
     page = _html(dataset, scene, figures, tables)
     return _write_text_atomic(out / "report.html", page)
@@ -139,7 +143,11 @@ def _response_figure(part: xr.Dataset, quantity: str, out: Path) -> Figure:
             ax.plot(f, part[quantity].sel(solution="linear").broadcast_like(part["frequency"]).isel(**_first(part)).values, ":", color="k", lw=1.2, label="LIN")
         if solution != "linear":
             for i, (name, line) in enumerate(_lines(part)):
-                ax.plot(f, line[quantity].sel(solution=solution).values, color=f"C{i}", lw=1.0, label=name)
+                values = line[quantity].sel(solution=solution).values
+                unstable = line["stable"].sel(solution=solution).values == 0 if "stable" in line else np.zeros(values.shape, bool)
+                ax.plot(f, np.where(unstable, np.nan, values), color=f"C{i}", lw=1.0, label=name)
+                if unstable.any():
+                    ax.plot(f, np.where(unstable, values, np.nan), color=f"C{i}", lw=0.8, ls="--", alpha=0.45)
         ax.set(title=f"{solution}: {label} (Delta = {clearance_text})", xlabel="frequency [Hz]", ylabel=f"{label} [{units}]")
         if quantity != "impulse":
             ax.set_yscale("log")
@@ -148,6 +156,8 @@ def _response_figure(part: xr.Dataset, quantity: str, out: Path) -> Figure:
     caption = (
         f"{label} against frequency, Delta = {clearance_text}; one curve per restitution ratio, LIN = linear system. "
         "Gaps: no admissible one-impact regime while the linear motion would cross the stop. "
+        "Faint dashed: one-impact orbits that exist but are unstable (Floquet multiplier outside the unit circle; pgf only): "
+        "the real motion there is not this orbit. "
         "Left: exact poles/residues and exact chi22'(0-); right: the paper's fitted modes and constant chi22'(0-)."
     )
     return Figure(_save(fig, out / f"{quantity}{tag}.png"), caption)
@@ -178,13 +188,30 @@ def _regime_figure(part: xr.Dataset, out: Path) -> Figure:
     return Figure(_save(fig, out / f"regime{tag}.png"), caption)
 
 
+def _stability_figure(part: xr.Dataset, out: Path) -> Figure:
+    clearance_text, tag = _clearance_tag(part)
+    fig, ax = plt.subplots(figsize=(12, 4.2))
+    f = part["frequency"].values
+    for i, (name, line) in enumerate(_lines(part)):
+        ax.semilogy(f, line["floquet_modulus"].sel(solution="pgf").values, color=f"C{i}", lw=1.0, label=name)
+    ax.axhline(1.0, color="k", lw=1.0)
+    ax.set(xlabel="frequency [Hz]", ylabel="max |Floquet multiplier|", title=f"pgf: stability of the one-impact orbit (Delta = {clearance_text})")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    caption = (
+        "Largest Floquet multiplier modulus of the exact one-impact orbit (monodromy = impact saltation matrix x exact flow "
+        "over the period). Above 1 the orbit exists but is unstable: a simulation started on it leaves it."
+    )
+    return Figure(_save(fig, out / f"stability{tag}.png"), caption)
+
+
 # -------------------------------------------------------------------------------------------- tables
 def reduction_factors(dataset: xr.Dataset, scene: Scene, quantity: str, solution: str) -> list[dict[str, object]]:
     """Reduction factor of ``quantity`` at each linear resonance for each (clearance, R) of ``dataset``.
 
     See :data:`REDUCTION_FACTOR_DEFINITION`. Returns one row per (clearance, restitution) with keys
     ``clearance``, ``restitution``, ``linear_peak`` (list per mode), ``largest`` (list), ``factor`` (list) and
-    ``undefined`` (NaN points per band).
+    ``undefined`` (NaN points per band), ``unstable`` (points with an unstable one-impact orbit, per band).
     """
     peaks = resonance_peaks(scene.system, scene.amplitude, _PEAK_QUANTITY[quantity])
     split = scene.system.antiresonance_frequency() / (2.0 * np.pi)
@@ -198,9 +225,11 @@ def reduction_factors(dataset: xr.Dataset, scene: Scene, quantity: str, solution
             line = data.sel(**sel)
             largest = [float(line.where(b).max()) if bool(b.any()) else np.nan for b in bands]
             undefined = [int((line.isnull() & b).sum()) for b in bands]
+            stable = dataset["stable"].sel(solution=solution).sel(**sel) if "stable" in dataset else None
+            unstable = [int(((stable == 0) & b).sum()) if stable is not None else 0 for b in bands]
             factors = [p.value / v if v > 0 else np.nan for p, v in zip(peaks, largest)]
             rows.append(
-                {"clearance": float(delta), "restitution": float(r), "linear_peak": [p.value for p in peaks], "largest": largest, "factor": factors, "undefined": undefined}
+                {"clearance": float(delta), "restitution": float(r), "linear_peak": [p.value for p in peaks], "largest": largest, "factor": factors, "undefined": undefined, "unstable": unstable}
             )
     return rows
 
@@ -212,7 +241,7 @@ def _tables(dataset: xr.Dataset, scene: Scene) -> list[tuple[str, str]]:
         if quantity not in dataset or not solutions:
             continue
         label, units = _LABELS[quantity]
-        header = "<tr><th>solution</th><th>Delta [mm]</th><th>R</th><th>linear peak 1 / 2 [" + units + "]</th><th>largest in band 1 / 2</th><th>reduction factor 1</th><th>reduction factor 2</th><th>undefined points 1 / 2</th><th>paper (R = 0.2)</th></tr>"
+        header = "<tr><th>solution</th><th>Delta [mm]</th><th>R</th><th>linear peak 1 / 2 [" + units + "]</th><th>largest in band 1 / 2</th><th>reduction factor 1</th><th>reduction factor 2</th><th>undefined points 1 / 2</th><th>unstable points 1 / 2</th><th>paper (R = 0.2)</th></tr>"
         body = []
         for solution in solutions:
             for row in reduction_factors(dataset, scene, quantity, solution):
@@ -223,6 +252,7 @@ def _tables(dataset: xr.Dataset, scene: Scene) -> list[tuple[str, str]]:
                     f"<td>{row['largest'][0]:.4g} / {row['largest'][1]:.4g}</td>"
                     f"<td>{row['factor'][0]:.1f}</td><td>{row['factor'][1]:.1f}</td>"
                     f"<td>{row['undefined'][0]} / {row['undefined'][1]}</td>"
+                    f"<td>{row['unstable'][0]} / {row['unstable'][1]}</td>"
                     f"<td>{'' if paper is None else f'{paper[0]:g} / {paper[1]:g}'}</td></tr>"
                 )
         tables.append((f"Reduction factors: {label}", f"<table>{header}{''.join(body)}</table>"))
