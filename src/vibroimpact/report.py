@@ -27,7 +27,7 @@ from .modal import exact_modal_parameters, fit_modal_parameters  # noqa: E402
 from .regime import Regime  # noqa: E402
 from .scene import Scene, parse_scene  # noqa: E402
 
-__all__ = ["write_report", "reduction_factors", "REDUCTION_FACTOR_DEFINITION"]
+__all__ = ["REDUCTION_FACTOR_DEFINITION", "ReductionRow", "reduction_factors", "write_report"]
 
 REDUCTION_FACTOR_DEFINITION = (
     "Reduction factor of a quantity at linear resonance i = (peak of the linear response near natural frequency i, "
@@ -39,7 +39,7 @@ REDUCTION_FACTOR_DEFINITION = (
     "is unstable (pgf only): the factor is computed from those values too, as in the paper, but the real motion "
     "there is another one (possibly larger), so treat such factors with care."
 )
-_PAPER_VALUES = {"x1_amplitude": {0.2: (28.0, 23.0)}, "force_amplitude": {0.2: (25.0, 30.0)}}
+_PAPER_VALUES: dict[str, dict[float, tuple[float, float]]] = {"x1_amplitude": {0.2: (28.0, 23.0)}, "force_amplitude": {0.2: (25.0, 30.0)}}
 _PEAK_QUANTITY = {"x1_amplitude": "x1", "x2_amplitude": "x2", "force_amplitude": "force", "suspension_force_amplitude": "force"}
 _LABELS = {
     "x1_amplitude": ("|X1| fundamental", "m"),
@@ -140,7 +140,7 @@ def _response_figure(part: xr.Dataset, quantity: str, out: Path) -> Figure:
     f = part["frequency"].values
     for ax, solution in zip(axes[0], panels):
         if "linear" in part["solution"].values and quantity != "impulse":
-            ax.plot(f, part[quantity].sel(solution="linear").broadcast_like(part["frequency"]).isel(**_first(part)).values, ":", color="k", lw=1.2, label="LIN")
+            ax.plot(f, part[quantity].sel(solution="linear").isel(_first(part)).values, ":", color="k", lw=1.2, label="LIN")
         if solution != "linear":
             for i, (name, line) in enumerate(_lines(part)):
                 values = line[quantity].sel(solution=solution).values
@@ -206,30 +206,65 @@ def _stability_figure(part: xr.Dataset, out: Path) -> Figure:
 
 
 # -------------------------------------------------------------------------------------------- tables
-def reduction_factors(dataset: xr.Dataset, scene: Scene, quantity: str, solution: str) -> list[dict[str, object]]:
+@dataclass(frozen=True)
+class ReductionRow:
+    """Reduction factors of one quantity for one (clearance, R): one entry per linear resonance (mode 1, 2).
+
+    Attributes
+    ----------
+    clearance : float
+        Delta [m].
+    restitution : float
+        R [-].
+    linear_peak : tuple of float
+        Analytic linear peak near each natural frequency (units of the quantity).
+    largest : tuple of float
+        Largest vibro-impact value on the grid in each band.
+    factor : tuple of float
+        linear_peak / largest [-].
+    undefined : tuple of int
+        Grid points of the band with NaN (no admissible regime).
+    unstable : tuple of int
+        Grid points of the band whose one-impact orbit is unstable.
+    """
+
+    clearance: float
+    restitution: float
+    linear_peak: tuple[float, ...]
+    largest: tuple[float, ...]
+    factor: tuple[float, ...]
+    undefined: tuple[int, ...]
+    unstable: tuple[int, ...]
+
+
+def reduction_factors(dataset: xr.Dataset, scene: Scene, quantity: str, solution: str) -> list[ReductionRow]:
     """Reduction factor of ``quantity`` at each linear resonance for each (clearance, R) of ``dataset``.
 
-    See :data:`REDUCTION_FACTOR_DEFINITION`. Returns one row per (clearance, restitution) with keys
-    ``clearance``, ``restitution``, ``linear_peak`` (list per mode), ``largest`` (list), ``factor`` (list) and
-    ``undefined`` (NaN points per band), ``unstable`` (points with an unstable one-impact orbit, per band).
+    See :data:`REDUCTION_FACTOR_DEFINITION`.
     """
     peaks = resonance_peaks(scene.system, scene.amplitude, _PEAK_QUANTITY[quantity])
     split = scene.system.antiresonance_frequency() / (2.0 * np.pi)
     data = dataset[quantity].sel(solution=solution)
+    stable = dataset["stable"].sel(solution=solution) if "stable" in dataset else None
     f = data["frequency"]
     bands = [f < split, f >= split]
     rows = []
     for delta in np.atleast_1d(data["clearance"].values):
         for r in np.atleast_1d(data["restitution"].values):
             sel = {k: v for k, v in (("clearance", delta), ("restitution", r)) if k in data.dims}
-            line = data.sel(**sel)
-            largest = [float(line.where(b).max()) if bool(b.any()) else np.nan for b in bands]
-            undefined = [int((line.isnull() & b).sum()) for b in bands]
-            stable = dataset["stable"].sel(solution=solution).sel(**sel) if "stable" in dataset else None
-            unstable = [int(((stable == 0) & b).sum()) if stable is not None else 0 for b in bands]
-            factors = [p.value / v if v > 0 else np.nan for p, v in zip(peaks, largest)]
+            line = data.sel(sel)
+            largest = tuple(float(line.where(b).max()) if bool(b.any()) else np.nan for b in bands)
+            unstable_line = stable.sel(sel) == 0 if stable is not None else xr.zeros_like(line, dtype=bool)
             rows.append(
-                {"clearance": float(delta), "restitution": float(r), "linear_peak": [p.value for p in peaks], "largest": largest, "factor": factors, "undefined": undefined, "unstable": unstable}
+                ReductionRow(
+                    clearance=float(delta),
+                    restitution=float(r),
+                    linear_peak=tuple(p.value for p in peaks),
+                    largest=largest,
+                    factor=tuple(p.value / v if v > 0 else np.nan for p, v in zip(peaks, largest)),
+                    undefined=tuple(int((line.isnull() & b).sum()) for b in bands),
+                    unstable=tuple(int((unstable_line & b).sum()) for b in bands),
+                )
             )
     return rows
 
@@ -245,14 +280,14 @@ def _tables(dataset: xr.Dataset, scene: Scene) -> list[tuple[str, str]]:
         body = []
         for solution in solutions:
             for row in reduction_factors(dataset, scene, quantity, solution):
-                paper = _PAPER_VALUES.get(quantity, {}).get(row["restitution"]) if abs(row["clearance"] - 0.003) < 1e-12 else None
+                paper = _PAPER_VALUES.get(quantity, {}).get(row.restitution) if abs(row.clearance - 0.003) < 1e-12 else None
                 body.append(
-                    f"<tr><td>{solution}</td><td>{row['clearance'] * 1e3:g}</td><td>{row['restitution']:g}</td>"
-                    f"<td>{row['linear_peak'][0]:.4g} / {row['linear_peak'][1]:.4g}</td>"
-                    f"<td>{row['largest'][0]:.4g} / {row['largest'][1]:.4g}</td>"
-                    f"<td>{row['factor'][0]:.1f}</td><td>{row['factor'][1]:.1f}</td>"
-                    f"<td>{row['undefined'][0]} / {row['undefined'][1]}</td>"
-                    f"<td>{row['unstable'][0]} / {row['unstable'][1]}</td>"
+                    f"<tr><td>{solution}</td><td>{row.clearance * 1e3:g}</td><td>{row.restitution:g}</td>"
+                    f"<td>{row.linear_peak[0]:.4g} / {row.linear_peak[1]:.4g}</td>"
+                    f"<td>{row.largest[0]:.4g} / {row.largest[1]:.4g}</td>"
+                    f"<td>{row.factor[0]:.1f}</td><td>{row.factor[1]:.1f}</td>"
+                    f"<td>{row.undefined[0]} / {row.undefined[1]}</td>"
+                    f"<td>{row.unstable[0]} / {row.unstable[1]}</td>"
                     f"<td>{'' if paper is None else f'{paper[0]:g} / {paper[1]:g}'}</td></tr>"
                 )
         tables.append((f"Reduction factors: {label}", f"<table>{header}{''.join(body)}</table>"))

@@ -120,7 +120,7 @@ class _Checker:
     def fail(self, key: str, message: str) -> None:
         self.problems.append(f"{key}: {message}")
 
-    def mapping(self, key: str, value: Any, allowed: set[str], required: set[str] = frozenset()) -> dict:
+    def mapping(self, key: str, value: Any, allowed: set[str], required: frozenset[str] | set[str] = frozenset()) -> dict:
         if not isinstance(value, dict):
             self.fail(key, f"expected a mapping with keys {sorted(allowed)}, got {type(value).__name__}")
             return {}
@@ -168,7 +168,10 @@ class _Checker:
 
     def grid(self, key: str, value: Any, low: float, high: float, low_inclusive: bool) -> np.ndarray | None:
         """A list of values or {start, stop, step} / {start, stop, num}; returns sorted unique values."""
-        check = lambda k, v: self.number(k, v, low, high, low_inclusive)  # noqa: E731
+
+        def check(k: str, v: Any) -> float | None:
+            return self.number(k, v, low, high, low_inclusive)
+
         if isinstance(value, list):
             if not value:
                 self.fail(key, "empty grid: give at least one value")
@@ -197,12 +200,12 @@ class _Checker:
                 step = self.number(f"{key}.step", spec["step"], 0.0, stop - start, low_inclusive=False)
                 if step is None:
                     return None
-                count = int(math.floor((stop - start) / step * (1.0 + 1e-12))) + 1
+                count = math.floor((stop - start) / step * (1.0 + 1e-12)) + 1
             else:
-                count = self.integer(f"{key}.num", spec["num"], 2, MAX_GRID_POINTS)
-                if count is None:
+                num = self.integer(f"{key}.num", spec["num"], 2, MAX_GRID_POINTS)
+                if num is None:
                     return None
-                step = (stop - start) / (count - 1)
+                count, step = num, (stop - start) / (num - 1)
             if count > MAX_GRID_POINTS:
                 self.fail(key, f"{count} points is too many: allowed at most {MAX_GRID_POINTS}")
                 return None
@@ -276,16 +279,19 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
 
     if c.problems:
         raise SceneError(c.problems, source)
-    assert system is not None and amplitude is not None  # guaranteed when no problem was recorded
+    frequency, restitution, clearance = grids["frequency"], grids["restitution"], grids["clearance"]
+    # guaranteed when no problem was recorded
+    assert system is not None and amplitude is not None and isinstance(name, str)
+    assert frequency is not None and restitution is not None and clearance is not None
     swept = tuple(k for k in ("restitution", "clearance") if k in sweep) + ("frequency",)
     return Scene(
         name=name,
         description=description,
         system=system,
         amplitude=amplitude,
-        frequency=grids["frequency"],
-        restitution=grids["restitution"],
-        clearance=grids["clearance"],
+        frequency=frequency,
+        restitution=restitution,
+        clearance=clearance,
         swept=swept,
         solutions=solutions,
         quantities=quantities,
@@ -297,14 +303,13 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
 
 def _parse_system(c: _Checker, value: Any) -> TwoDofSystem | None:
     spec = c.mapping("system", value, {"m1", "m2", "k1", "k2", "b1", "b2"}, {"m1", "m2", "k1", "k2"})
-    numbers: dict[str, float | None] = {}
-    for key in ("m1", "m2", "k1", "k2"):
+    numbers: dict[str, float] = {}
+    for key in ("m1", "m2", "k1", "k2", "b1", "b2"):
         if key in spec:
-            numbers[key] = c.number(f"system.{key}", spec[key], 0.0, math.inf, low_inclusive=False)
-    for key in ("b1", "b2"):
-        if key in spec:
-            numbers[key] = c.number(f"system.{key}", spec[key], 0.0, math.inf)
-    if len(numbers) < 4 or None in numbers.values():
+            number = c.number(f"system.{key}", spec[key], 0.0, math.inf, low_inclusive=key.startswith("b"))
+            if number is not None:
+                numbers[key] = number
+    if not {"m1", "m2", "k1", "k2"} <= set(numbers) or len(numbers) < len(spec.keys() & {"m1", "m2", "k1", "k2", "b1", "b2"}):
         return None
     return TwoDofSystem(**numbers)
 
