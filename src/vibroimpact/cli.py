@@ -30,7 +30,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         scene = load_scene(find_scene(args.scene))
-    except (SceneError, FileNotFoundError, IsADirectoryError) as error:
+    except (SceneError, OSError) as error:  # OSError: missing, a directory, unreadable
         print(f"run-study: error: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
     out_dir = args.out if args.out is not None else Path("results") / scene.name

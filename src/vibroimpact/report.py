@@ -20,12 +20,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
-import yaml  # noqa: E402
 
 from .linear import linear_response, resonance_peaks  # noqa: E402
 from .modal import exact_modal_parameters, fit_modal_parameters  # noqa: E402
 from .regime import Regime  # noqa: E402
-from .scene import Scene, parse_scene  # noqa: E402
+from .scene import Scene, parse_scene, read_yaml  # noqa: E402
 
 __all__ = ["REDUCTION_FACTOR_DEFINITION", "ReductionRow", "reduction_factors", "write_report"]
 
@@ -62,7 +61,7 @@ def write_report(dataset: xr.Dataset, out_dir: str | Path) -> Path:
     """Write the PNG figures and ``report.html`` for ``dataset`` into ``out_dir``; return the HTML path."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    scene = parse_scene(yaml.safe_load(dataset.attrs["scene"]), text=dataset.attrs["scene"])
+    scene = parse_scene(read_yaml(dataset.attrs["scene"]), text=dataset.attrs["scene"])
     figures = [_linear_figure(scene, out)]
     for clearance_index in range(dataset.sizes.get("clearance", 1)):
         part = dataset.isel(clearance=clearance_index) if "clearance" in dataset.dims else dataset

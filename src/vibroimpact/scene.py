@@ -111,6 +111,29 @@ class Scene:
 
 
 # ----------------------------------------------------------------------------- checking helpers
+def _interval(low: float, high: float, low_inclusive: bool = True, high_inclusive: bool = True) -> str:
+    """Interval in mathematical notation; an infinite end is always open."""
+    opening = "[" if low_inclusive and math.isfinite(low) else "("
+    closing = "]" if high_inclusive and math.isfinite(high) else ")"
+    return f"{opening}{low:g}, {high:g}{closing}"
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` that refuses a key repeated in one mapping (PyYAML silently keeps the last one)."""
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+        seen: set[Any] = set()
+        for key_node, _value_node in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            if key in seen:
+                raise yaml.constructor.ConstructorError(None, None, f"key {key!r} is repeated", key_node.start_mark)
+            seen.add(key)
+        return super().construct_mapping(node, deep=deep)
+
+
+def read_yaml(text: str) -> Any:
+    """Parse YAML safely (no Python objects), rejecting repeated keys."""
+    return yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 - a SafeLoader subclass
 class _Checker:
     """Collects problems while walking a parsed YAML document."""
 
@@ -138,8 +161,7 @@ class _Checker:
         ok_low = number >= low if low_inclusive else number > low
         ok_high = number <= high if high_inclusive else number < high
         if not (math.isfinite(number) and ok_low and ok_high):
-            interval = f"{'[' if low_inclusive else '('}{low:g}, {high:g}{']' if high_inclusive else ')'}"
-            self.fail(key, f"{value!r} is out of range: allowed {interval}")
+            self.fail(key, f"{value!r} is out of range: allowed {_interval(low, high, low_inclusive, high_inclusive)}")
             return None
         return number
 
@@ -189,8 +211,10 @@ class _Checker:
             if "step" in spec and "num" in spec or ("step" not in spec and "num" not in spec):
                 self.fail(key, "give exactly one of 'step' or 'num' with 'start' and 'stop'")
                 return None
-            start = check(f"{key}.start", spec.get("start"))
-            stop = check(f"{key}.stop", spec.get("stop"))
+            if "start" not in spec or "stop" not in spec:
+                return None  # already reported as missing
+            start = check(f"{key}.start", spec["start"])
+            stop = check(f"{key}.stop", spec["stop"])
             if start is None or stop is None:
                 return None
             if stop <= start:
@@ -209,8 +233,14 @@ class _Checker:
             if count > MAX_GRID_POINTS:
                 self.fail(key, f"{count} points is too many: allowed at most {MAX_GRID_POINTS}")
                 return None
-            # integer multiples of the step keep grid values exact decimals where the step is one (0.005 Hz)
-            return np.round(start + step * np.arange(count), 12)
+            # integer multiples of the step, rounded to 12 significant digits of the grid's scale, keep values exact
+            # decimals where the step is one (0.005 Hz) without collapsing tiny clearances
+            decimals = 12 - math.floor(math.log10(max(abs(start), abs(stop))))
+            values = np.round(start + step * np.arange(count), decimals)
+            if np.unique(values).size != values.size:
+                self.fail(key, f"step {step:g} is below the grid's resolution")
+                return None
+            return values
         self.fail(key, f"expected a list of values or a mapping {{start, stop, step|num}}, got {type(value).__name__}")
         return None
 
@@ -223,9 +253,10 @@ _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
     """Validate a parsed YAML document and build the :class:`Scene`; raise :class:`SceneError` listing all problems."""
     c = _Checker()
+    if not isinstance(document, dict):
+        what = "an empty document" if document is None else f"a {type(document).__name__}"
+        raise SceneError([f"scene: expected a mapping with keys {sorted(_TOP_KEYS)}, got {what}"], source)
     doc = c.mapping("", document, _TOP_KEYS, {"name", "system", "excitation", "sweep", "solutions"})
-    if not doc and not c.problems:
-        c.fail("scene", "empty document")
 
     name = doc.get("name")
     if "name" in doc and not (isinstance(name, str) and _NAME.match(name)):
@@ -253,7 +284,7 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
             value = c.number(f"stop.{key}", stop[key], low, high, low_inclusive)
             grids[key] = None if value is None else np.array([value])
         elif key != "frequency":
-            c.fail(f"stop.{key}", f"required unless swept (sweep.{key}); allowed range {'[' if low_inclusive else '('}{low:g}, {high:g}]")
+            c.fail(f"stop.{key}", f"required unless swept (sweep.{key}); allowed range {_interval(low, high, low_inclusive)}")
 
     solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
     quantities = c.choices("quantities", doc["quantities"], QUANTITIES) if "quantities" in doc else QUANTITIES
@@ -315,11 +346,14 @@ def _parse_system(c: _Checker, value: Any) -> TwoDofSystem | None:
 
 
 def load_scene(path: str | Path) -> Scene:
-    """Read and validate a scene file; raise :class:`SceneError` (or ``OSError`` if unreadable)."""
+    """Read and validate a scene file; raise :class:`SceneError` (or ``OSError`` if it cannot be read)."""
     path = Path(path)
-    text = path.read_text(encoding="utf-8")
     try:
-        document = yaml.safe_load(text)
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as error:
+        raise SceneError([f"not UTF-8 text: {error}"], str(path)) from None
+    try:
+        document = read_yaml(text)
     except yaml.YAMLError as error:
         raise SceneError([f"not valid YAML: {error}"], str(path)) from None
     return parse_scene(document, text=text, source=str(path))
@@ -338,6 +372,8 @@ def find_scene(name: str | Path) -> Path:
     if not given.is_absolute():
         candidates.append(Path.cwd() / "studies" / given)
         candidates.append(shipped_studies_dir() / given.name)
+    if given.is_dir():
+        raise IsADirectoryError(f"scene {given} is a directory, not a YAML file")
     for candidate in candidates:
         if candidate.is_file():
             return candidate
