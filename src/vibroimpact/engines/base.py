@@ -1,0 +1,185 @@
+"""What every engine shares: the problem it solves, its settings, and the immutable trajectory it returns."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..system import TwoDofSystem
+from ..validation import require_in_range, require_non_negative, require_positive
+
+__all__ = ["ImpactProblem", "EngineSettings", "Trajectory", "Engine", "MODE_FREE", "MODE_STUCK"]
+
+#: Segment modes of a trajectory.
+MODE_FREE, MODE_STUCK = 0, 1
+
+
+@dataclass(frozen=True)
+class ImpactProblem:
+    """The system of eq. 1 with a rigid stop: force q cos(w t + phase) on the primary mass, stop at X2 = Delta.
+
+    Parameters
+    ----------
+    system : TwoDofSystem
+        Masses, springs and dashpots.
+    clearance : float
+        Delta [m], >= 0.
+    restitution : float
+        R [-], 0 <= R <= 1: the absorber's velocity after an impact is -R times the velocity before.
+    amplitude : float
+        q [N], >= 0.
+    frequency : float
+        Excitation frequency [Hz], > 0.
+    phase : float
+        Phase of the force at t = 0 [rad].
+    """
+
+    system: TwoDofSystem
+    clearance: float = field(metadata={"units": "m"})
+    restitution: float = field(metadata={"units": "1"})
+    amplitude: float = field(metadata={"units": "N"})
+    frequency: float = field(metadata={"units": "Hz"})
+    phase: float = field(default=0.0, metadata={"units": "rad"})
+
+    def __post_init__(self) -> None:
+        require_non_negative("clearance", self.clearance)
+        require_in_range("restitution", self.restitution, 0.0, 1.0)
+        require_non_negative("amplitude", self.amplitude)
+        require_positive("frequency", self.frequency)
+
+    @property
+    def omega(self) -> float:
+        """Angular frequency w [rad s-1]."""
+        return 2.0 * math.pi * self.frequency
+
+    @property
+    def period(self) -> float:
+        """T = 1 / f [s]."""
+        return 1.0 / self.frequency
+
+    def force(self, t: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
+        """External force on the primary mass [N]."""
+        return self.amplitude * np.cos(self.omega * t + self.phase)
+
+    def holding_force(self, x1: float | NDArray, v1: float | NDArray) -> float | NDArray:
+        """Force the stop must exert to hold the absorber at rest at X2 = Delta, B2 X1' + K2 (X1 - Delta) [N].
+
+        Positive: the absorber is pushed into the stop (it sticks); it leaves when this turns negative.
+        """
+        return self.system.b2 * v1 + self.system.k2 * (x1 - self.clearance)
+
+    def velocity_scale(self) -> float:
+        """A velocity typical of the motion, w (Delta + q |H12|) [m s-1], for relative thresholds."""
+        linear = self.amplitude * abs(self.system.receptances(self.omega).h12)
+        return self.omega * (self.clearance + linear) + 1e-300
+
+
+@dataclass(frozen=True)
+class EngineSettings:
+    """Numerical settings of a time-domain engine.
+
+    Parameters
+    ----------
+    rtol, atol : float
+        Relative and absolute tolerances of the integrator (ignored by ``exact``, which is exact to round-off).
+    method : {'adams', 'bdf'}
+        Linear multistep family of CVODE (``momentary``).
+    max_step : float
+        Largest step [s]; 0 means no limit.
+    sticking_velocity : float
+        Impacts slower than this fraction of :meth:`ImpactProblem.velocity_scale` while the stop pushes the absorber
+        end a chattering sequence: the absorber sticks [-].
+    max_impacts_per_period : int
+        Chattering safeguard: more impacts than this in one period force the sticking check.
+    """
+
+    rtol: float = 1e-8
+    atol: float = 1e-12
+    method: str = "adams"
+    max_step: float = 0.0
+    sticking_velocity: float = 1e-9
+    max_impacts_per_period: int = 10_000
+
+    def __post_init__(self) -> None:
+        require_in_range("rtol", self.rtol, 1e-15, 1e-1)
+        require_in_range("atol", self.atol, 1e-300, 1e-1)
+        if self.method not in ("adams", "bdf"):
+            raise ValueError(f"method = {self.method!r} is not allowed: use 'adams' or 'bdf'")
+        require_non_negative("max_step", self.max_step)
+        require_in_range("sticking_velocity", self.sticking_velocity, 0.0, 1e-2)
+        require_in_range("max_impacts_per_period", self.max_impacts_per_period, 10, 1e9)
+
+
+@dataclass(frozen=True, eq=False)
+class Trajectory:
+    """Immutable record of an integration over whole periods from ``t_start``.
+
+    Attributes
+    ----------
+    problem : ImpactProblem
+        What was integrated.
+    strobe_times : ndarray, shape (n + 1,)
+        t_start + k T [s], k = 0 ... n.
+    strobe_states : ndarray, shape (n + 1, 4)
+        (X1, X2, X1', X2') at the strobe times [m, m, m s-1, m s-1] (after any impact at that instant).
+    impact_times : ndarray
+        Times of the impacts [s].
+    impact_velocities : ndarray
+        Absorber velocity just before each impact, > 0 [m s-1].
+    impulses : ndarray
+        M2 (1 + R) X2'(t-) of each impact [N s].
+    segments : ndarray, shape (s, 3)
+        Rows (start [s], end [s], mode): ``MODE_FREE`` flight or ``MODE_STUCK`` (absorber held at the stop).
+    segment_states : ndarray, shape (s, 4)
+        State at the start of each segment (after the event that began it).
+    moments : ndarray of complex, shape (n, 5) or (0, 5)
+        Per period, when requested: integrals of X1 e^{-jwt}, X2 e^{-jwt} [m s], of the contact force e^{-jwt}
+        (impulses plus holding force while stuck) [N s], and of X1^2, X2^2 [m2 s] (real).
+    stats : dict
+        Engine counters (steps, rhs calls, events, grazing checks ...).
+    """
+
+    problem: ImpactProblem
+    strobe_times: NDArray[np.float64]
+    strobe_states: NDArray[np.float64]
+    impact_times: NDArray[np.float64]
+    impact_velocities: NDArray[np.float64]
+    impulses: NDArray[np.float64]
+    segments: NDArray[np.float64]
+    segment_states: NDArray[np.float64]
+    moments: NDArray[np.complex128]
+    stats: dict[str, int] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for name in ("strobe_times", "strobe_states", "impact_times", "impact_velocities", "impulses", "segments", "segment_states", "moments"):
+            getattr(self, name).setflags(write=False)
+
+    @property
+    def periods(self) -> int:
+        """Number of whole periods integrated."""
+        return self.strobe_times.size - 1
+
+    @property
+    def final_state(self) -> NDArray[np.float64]:
+        """State at the last strobe time."""
+        return self.strobe_states[-1]
+
+    @property
+    def stuck_time(self) -> float:
+        """Total time spent stuck at the stop [s]."""
+        stuck = self.segments[:, 2] == MODE_STUCK
+        return float(np.sum(self.segments[stuck, 1] - self.segments[stuck, 0]))
+
+
+class Engine(Protocol):
+    """A time-domain solver of an :class:`ImpactProblem`."""
+
+    name: str
+
+    def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
+        """Integrate ``periods`` whole periods from ``state`` at ``t_start``."""
+        ...

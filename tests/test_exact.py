@@ -1,0 +1,144 @@
+"""Engine ``exact``: closed-form propagation with guaranteed contact detection."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from vibroimpact.engines import MODE_STUCK, EngineSettings, ExactEngine, ImpactProblem
+from vibroimpact.linear import linear_response
+from vibroimpact.system import TwoDofSystem
+
+from .conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
+from .engine_cases import energy_budget, linear_state, mechanical_energy, pgf_start
+
+ENGINE = ExactEngine()
+
+
+@pytest.mark.parametrize(("frequency", "restitution"), [(25.0, 0.2), (24.0, 0.0), (40.0, 0.2), (26.0, 0.6)])
+def test_stays_on_stable_pgf_orbit(frequency: float, restitution: float) -> None:
+    """Started on a stable one-impact orbit, it impacts once per period at t = k T with the PGF impulse, to ~1e-12."""
+    problem, state, t0, orbit = pgf_start(frequency, restitution)
+    trajectory = ENGINE.integrate(problem, state, t0, 200)
+    assert trajectory.impulses.size == 200
+    np.testing.assert_allclose(trajectory.impulses, orbit.impulse[0], rtol=1e-10)
+    phases = (trajectory.impact_times * frequency + 0.5) % 1.0 - 0.5
+    np.testing.assert_allclose(phases, 0.0, atol=1e-10)
+    np.testing.assert_allclose(trajectory.strobe_states[-1], state, rtol=0, atol=1e-11 * np.abs(state).max())
+
+
+def test_leaves_unstable_pgf_orbit() -> None:
+    """At 38 Hz (R = 0.2) the orbit's Floquet modulus is 1.108: round-off grows until the motion is elsewhere."""
+    problem, state, t0, _orbit = pgf_start(38.0, 0.2)
+    trajectory = ENGINE.integrate(problem, state, t0, 1000)
+    assert np.abs(trajectory.strobe_states[-1] - state).max() > 1e-3 * np.abs(state).max()
+
+
+def test_far_clearance_is_the_linear_solution() -> None:
+    """No contact ever: the strobe states are the linear steady state's, to round-off."""
+    problem = ImpactProblem(TwoDofSystem(m1=1.0, m2=0.1, k1=25_000.0, k2=4_300.0, b1=0.8, b2=0.08), 1.0, 0.2, PAPER_AMPLITUDE, 23.0)
+    start = linear_state(problem)
+    trajectory = ENGINE.integrate(problem, start, 0.0, 100)
+    assert trajectory.impulses.size == 0 and trajectory.stats["events"] == 0
+    np.testing.assert_allclose(trajectory.strobe_states, np.broadcast_to(start, trajectory.strobe_states.shape), atol=1e-12 * np.abs(start).max())
+
+
+@pytest.mark.parametrize("margin", [-5e-10, 5e-10])
+def test_grazing_contact_is_never_missed(margin: float, system: TwoDofSystem) -> None:
+    """The linear orbit's maximum X2 lies 0.5 nm beyond (or short of) the stop: one impact (or none) per period."""
+    frequency = 30.0
+    amplitude_x2 = PAPER_AMPLITUDE * abs(linear_response(system, 2 * np.pi * frequency, 1.0).x2)
+    problem = ImpactProblem(system, amplitude_x2 + margin, 0.9, PAPER_AMPLITUDE, frequency)
+    started = time.perf_counter()
+    trajectory = ENGINE.integrate(problem, linear_state(problem), 0.0, 3)
+    assert time.perf_counter() - started < 5.0
+    if margin < 0:
+        assert trajectory.impulses.size >= 1
+        assert trajectory.impact_velocities[0] < 1e-3  # a near-tangent touch
+    else:
+        assert trajectory.impulses.size == 0
+
+
+@pytest.mark.parametrize(("frequency", "restitution"), [(25.0, 0.2), (38.0, 0.2), (22.0, 0.8)])
+def test_energy_balance(frequency: float, restitution: float) -> None:
+    """Energy change = input work - viscous dissipation - impact loss M2 (1 - R^2) v^2 / 2, over 20 periods."""
+    problem, state, t0, _orbit = pgf_start(frequency, restitution)
+    perturbed = state + np.array([1e-5, -1e-5, 0.0, 0.0])
+    budget = energy_budget(ENGINE.integrate(problem, perturbed, t0, 20))
+    assert budget["impact_loss"] > 0.01 * budget["work"]
+    balance = budget["work"] - budget["dissipation"] - budget["impact_loss"]
+    assert budget["change"] == pytest.approx(balance, abs=1e-9 * budget["work"])
+
+
+def test_elastic_impacts_without_damping_conserve_energy() -> None:
+    """R = 1, B1 = B2 = 0: energy changes only by the work of the force; impacts lose nothing."""
+    undamped = TwoDofSystem(m1=1.0, m2=0.1, k1=25_000.0, k2=4_300.0)
+    problem = ImpactProblem(undamped, 2e-3, 1.0, PAPER_AMPLITUDE, 25.0)
+    trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 30)
+    assert trajectory.impulses.size > 10
+    budget = energy_budget(trajectory)
+    assert budget["dissipation"] == 0.0 and budget["impact_loss"] == 0.0
+    assert budget["change"] == pytest.approx(budget["work"], abs=1e-10 * mechanical_energy(undamped, trajectory.strobe_states).max())
+
+
+@pytest.mark.parametrize("restitution", [0.0, 0.05, 0.3])
+def test_chattering_ends_in_sticking_and_release(restitution: float, system: TwoDofSystem) -> None:
+    """Quasi-static forcing (10 Hz) with Delta = 0.1 mm below the primary mass's 0.47 mm motion: the spring presses
+    the absorber on the stop, impacts accumulate (Zeno), it sticks and is released again every period; no hang;
+    the stop only pushes (holding force >= 0) while stuck and X2 never exceeds Delta."""
+    clearance = 1e-4
+    problem = ImpactProblem(system, clearance, restitution, PAPER_AMPLITUDE, 10.0)
+    started = time.perf_counter()
+    trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 30)
+    assert time.perf_counter() - started < 20.0
+    assert trajectory.stats["sticks"] >= 29 and trajectory.stats["releases"] >= 29
+    stuck = trajectory.segments[trajectory.segments[:, 2] == MODE_STUCK]
+    times = np.concatenate([np.linspace(a, b, 7) for a, b, _ in stuck])
+    y = ENGINE.dense(trajectory, times)
+    assert np.all(problem.holding_force(y[:, 0], y[:, 2]) >= -1e-9)
+    everywhere = ENGINE.dense(trajectory, np.linspace(trajectory.strobe_times[0], trajectory.strobe_times[-1], 20001))
+    assert everywhere[:, 1].max() <= clearance * (1 + 1e-12)
+
+
+def test_zero_clearance(system: TwoDofSystem) -> None:
+    """Delta = 0: the stop at the static equilibrium; impacts every period, X2 <= 0."""
+    problem = ImpactProblem(system, 0.0, 0.5, PAPER_AMPLITUDE, 25.0)
+    trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 40)
+    assert trajectory.impulses.size >= 30
+    y = ENGINE.dense(trajectory, np.linspace(0.0, trajectory.strobe_times[-1], 5001))
+    assert y[:, 1].max() <= 1e-15
+
+
+def test_restitution_law_at_every_impact(system: TwoDofSystem) -> None:
+    """Velocity just after each impact (from the next segment's start state) is -R times the velocity before."""
+    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.3, PAPER_AMPLITUDE, 26.0)
+    trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 40)
+    starts = trajectory.segments[:, 0]
+    after = trajectory.segment_states[np.searchsorted(starts, trajectory.impact_times)]
+    np.testing.assert_allclose(after[:, 3], -0.3 * trajectory.impact_velocities, rtol=1e-12)
+    np.testing.assert_allclose(trajectory.impulses, system.m2 * 1.3 * trajectory.impact_velocities, rtol=1e-14)
+
+
+def test_rejects_a_start_inside_the_stop(system: TwoDofSystem) -> None:
+    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.3, PAPER_AMPLITUDE, 26.0)
+    with pytest.raises(ValueError, match="penetrates the stop"):
+        ENGINE.integrate(problem, np.array([0.0, 0.004, 0.0, 0.0]), 0.0, 1)
+
+
+def test_problem_validation(system: TwoDofSystem) -> None:
+    with pytest.raises(ValueError, match=r"restitution = 1.5 is out of range: allowed \[0, 1\]"):
+        ImpactProblem(system, PAPER_CLEARANCE, 1.5, PAPER_AMPLITUDE, 26.0)
+    with pytest.raises(ValueError, match="method = 'rk4' is not allowed"):
+        EngineSettings(method="rk4")
+
+
+def test_energy_balance_with_sticking(system: TwoDofSystem) -> None:
+    """Sticking phases do no work (X2' = 0): the balance still closes, with chatter losses included."""
+    problem = ImpactProblem(system, 1e-4, 0.3, PAPER_AMPLITUDE, 10.0)
+    trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 10)
+    assert trajectory.stats["sticks"] > 5
+    budget = energy_budget(trajectory)
+    balance = budget["work"] - budget["dissipation"] - budget["impact_loss"]
+    assert budget["change"] == pytest.approx(balance, abs=1e-8 * abs(budget["work"]) + 1e-12)
