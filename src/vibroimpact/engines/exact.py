@@ -85,6 +85,7 @@ class _Run:
         self.tolerance = 1e-15 * self.length_scale
         self.force_tolerance = 1e-15 * (s.k2 + s.b2 * problem.omega) * self.length_scale
         self.sticking_velocity = settings.sticking_velocity * problem.velocity_scale()
+        self.resolution_velocity = 1e-14 * problem.velocity_scale()
 
     # ------------------------------------------------------------------ loop
     def go(self, y: NDArray[np.float64], t: float, periods: int) -> Trajectory:
@@ -92,7 +93,7 @@ class _Run:
         y = y.copy()
         if y[1] > p.clearance:
             raise ValueError(f"initial X2 = {y[1]!r} m penetrates the stop (clearance {p.clearance!r} m)")
-        stuck = y[1] == p.clearance and y[3] == 0.0 and p.holding_force(y[0], y[2]) > 0.0
+        stuck = bool(y[1] == p.clearance and y[3] == 0.0 and self._pushed(t, y))
         leaving = y[1] == p.clearance
         origin = t
         rec.strobe_times.append(t)
@@ -159,7 +160,7 @@ class _Run:
         p, rec = self.problem, self.rec
         rec.stats["events"] += 1
         y[1] = p.clearance
-        velocity = max(y[3], 0.0)
+        velocity = y[3] if y[3] > self.resolution_velocity else 0.0  # below round-off: a touch, not an impact
         chattering = velocity <= self.sticking_velocity or impacts_this_period > self.settings.max_impacts_per_period or p.restitution == 0.0
         if velocity > 0.0:
             impulse = p.system.m2 * (1.0 + p.restitution) * velocity

@@ -1,0 +1,246 @@
+"""Bookkeeping shared by the integrator-based engines: modes, contact map, sticking, strobes, harmonic moments.
+
+An engine subclasses :class:`EventLoopEngine` and implements only :meth:`EventLoopEngine._advance` (integrate from
+a state until the period boundary or the first event). The integrated state is (X1, u, X1', X2') with the gap
+u = X2 - Delta in place of X2, so that positions near the stop keep their absolute precision (with X2 itself, a
+gap of 1e-20 m vanishes in X2 - Delta and the event function looks identically zero); it is followed, when harmonic
+moments are wanted, by eight quadrature states: the integrals of X1 cos, X1 sin, X2 cos, X2 sin (of w t), of the
+holding force times cos and sin (non-zero only while stuck), and of X1^2 and X2^2.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+from enum import Enum
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .base import MODE_FREE, MODE_STUCK, EngineSettings, ImpactProblem, Trajectory
+
+__all__ = ["EventLoopEngine", "Stop", "Model"]
+
+QUADRATURES = 8
+
+
+class Stop(Enum):
+    """Why :meth:`EventLoopEngine._advance` returned."""
+
+    BOUNDARY = 0
+    CONTACT = 1
+    RELEASE = 2
+
+
+@dataclass
+class Model:
+    """Right-hand side and event functions of one problem, with a mutable mode flag (free or stuck)."""
+
+    problem: ImpactProblem
+    with_moments: bool
+    stuck: bool = False
+    apex_event: bool = True
+    rhs_calls: int = 0
+    size: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        s, p = self.problem.system, self.problem
+        self.size = 4 + (QUADRATURES if self.with_moments else 0)
+        self._coefficients = (s.m1, s.m2, s.k1, s.k2, s.b1, s.b2, p.amplitude, p.omega, p.phase, p.clearance)
+
+    def rhs(self, t: float, y: NDArray[np.float64], yp: NDArray[np.float64]) -> None:
+        """Write y' into ``yp`` (scikit-sundae convention)."""
+        self.rhs_calls += 1
+        m1, m2, k1, k2, b1, b2, q, w, phase, delta = self._coefficients
+        x1, gap, v1, v2 = y[0], y[1], y[2], y[3]
+        x2 = gap + delta
+        force = q * math.cos(w * t + phase)
+        yp[0] = v1
+        if self.stuck:
+            yp[1] = 0.0
+            yp[2] = (force - k1 * x1 - b1 * v1 - k2 * (x1 - delta) - b2 * v1) / m1
+            yp[3] = 0.0
+        else:
+            yp[1] = v2
+            yp[2] = (force - k1 * x1 - b1 * v1 - k2 * (x1 - x2) - b2 * (v1 - v2)) / m1
+            yp[3] = (k2 * (x1 - x2) + b2 * (v1 - v2)) / m2
+        if self.with_moments:
+            c, s = math.cos(w * t), math.sin(w * t)
+            holding = b2 * v1 + k2 * (x1 - delta) if self.stuck else 0.0
+            yp[4], yp[5], yp[6], yp[7] = x1 * c, x1 * s, x2 * c, x2 * s
+            yp[8], yp[9] = holding * c, holding * s
+            yp[10], yp[11] = x1 * x1, x2 * x2
+
+    def derivative(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        """y' as a new array."""
+        yp = np.empty(self.size)
+        self.rhs(t, y, yp)
+        return yp
+
+    #: Number of event functions and their crossing directions: gap rising, holding force falling, apex (X2' falling).
+    NUM_EVENTS = 3
+    DIRECTIONS = (1, -1, -1)
+
+    def events(self, t: float, y: NDArray[np.float64], out: NDArray[np.float64]) -> None:
+        """Event functions: gap X2 - Delta and apex X2' (free flight only), holding force (stuck only).
+
+        Inactive events return a constant, so they never cross zero.
+        """
+        if self.stuck:
+            out[0] = -1.0
+            out[1] = self.problem.holding_force(y[0], y[2])
+            out[2] = 1.0
+        else:
+            out[0] = y[1]
+            out[1] = 1.0
+            out[2] = y[3] if self.apex_event else 1.0
+
+
+class EventLoopEngine(ABC):
+    """Template: integrate period by period, apply the contact map and the sticking rules between calls."""
+
+    name = "event-loop"
+
+    def __init__(self, settings: EngineSettings = EngineSettings()) -> None:
+        self.settings = settings
+
+    @abstractmethod
+    def _begin(self, model: Model) -> None:
+        """Prepare the integrator for ``model`` (called once per :meth:`integrate`)."""
+
+    @abstractmethod
+    def _advance(self, model: Model, t: float, y: NDArray[np.float64], t_stop: float) -> tuple[Stop, float, NDArray[np.float64]]:
+        """Integrate from (t, y) to ``t_stop`` or to the first event of the current mode; return why, when, state."""
+
+    def _counters(self) -> dict[str, int]:
+        """Integrator counters to add to the trajectory's stats."""
+        return {}
+
+    def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
+        """Integrate ``periods`` whole periods from ``state`` (X1, X2, X1', X2') at ``t_start`` [s]."""
+        if periods < 0:
+            raise ValueError(f"periods = {periods} is out of range: allowed [0, inf)")
+        state = np.asarray(state, dtype=float)
+        if state[1] > problem.clearance:
+            raise ValueError(f"initial X2 = {state[1]!r} m penetrates the stop (clearance {problem.clearance!r} m)")
+        model = Model(problem, moments)
+        y = np.zeros(model.size)
+        y[:4] = state
+        y[1] -= problem.clearance  # integrate the gap u = X2 - Delta
+        model.stuck = bool(y[1] == 0.0 and y[3] == 0.0 and self._pushed(model, t_start, y))
+        self._begin(model)
+        rec = _Record(problem, moments)
+        rec.strobe(t_start, y)
+        rec.segment(t_start, y, model.stuck)
+        t = float(t_start)
+        sticking_velocity = self.settings.sticking_velocity * problem.velocity_scale()
+        for k in range(1, periods + 1):
+            boundary = t_start + k * problem.period
+            impacts = events = 0
+            while True:
+                stop, t, y = self._advance(model, t, y, boundary)
+                if stop is Stop.BOUNDARY:
+                    break
+                events += 1
+                if events > 10 * self.settings.max_impacts_per_period:
+                    raise RuntimeError(f"no progress at t = {t!r} s: {events} events in one period")
+                if stop is Stop.RELEASE:
+                    rec.stats["releases"] += 1
+                    model.stuck = False
+                else:
+                    impacts += 1
+                    y = y.copy()
+                    y[1] = 0.0
+                    velocity = max(y[3], 0.0)
+                    if velocity > 0.0:
+                        rec.impact(t, velocity)
+                    chattering = velocity <= sticking_velocity or impacts > self.settings.max_impacts_per_period or problem.restitution == 0.0
+                    if chattering and self._pushed(model, t, y):
+                        y[3] = 0.0
+                        model.stuck = True
+                        rec.stats["sticks"] += 1
+                    else:
+                        y[3] = -problem.restitution * velocity
+                rec.segment(t, y, model.stuck)
+            rec.strobe(t, y)
+        rec.stats.update(self._counters())
+        rec.stats["rhs_calls"] = model.rhs_calls
+        return rec.trajectory()
+
+    def _pushed(self, model: Model, t: float, y: NDArray[np.float64]) -> bool:
+        """The stop must push to hold the absorber: holding force > 0, or = 0 and rising."""
+        p = model.problem
+        force = p.holding_force(y[0], y[2])
+        scale = 1e-12 * (p.system.k2 * (p.clearance + abs(y[0])) + p.system.b2 * abs(y[2])) + 1e-300
+        if abs(force) > scale:
+            return force > 0.0
+        was = model.stuck
+        model.stuck = True
+        rate = model.derivative(t, y)
+        model.stuck = was
+        return p.system.b2 * rate[2] + p.system.k2 * rate[0] > 0.0
+
+
+@dataclass
+class _Record:
+    """Mutable accumulators of an event-loop integration."""
+
+    problem: ImpactProblem
+    moments: bool
+    strobe_times: list[float] = field(default_factory=list)
+    strobe_states: list[NDArray[np.float64]] = field(default_factory=list)
+    impact_times: list[float] = field(default_factory=list)
+    impact_velocities: list[float] = field(default_factory=list)
+    segments: list[tuple[float, int]] = field(default_factory=list)
+    segment_states: list[NDArray[np.float64]] = field(default_factory=list)
+    period_moments: list[NDArray[np.complex128]] = field(default_factory=list)
+    impulse_moment: complex = 0j
+    stats: dict[str, int] = field(default_factory=lambda: {"impacts": 0, "sticks": 0, "releases": 0})
+
+    def impact(self, t: float, velocity: float) -> None:
+        p = self.problem
+        self.impact_times.append(t)
+        self.impact_velocities.append(velocity)
+        self.stats["impacts"] += 1
+        self.impulse_moment += p.system.m2 * (1.0 + p.restitution) * velocity * complex(math.cos(p.omega * t), -math.sin(p.omega * t))
+
+    def _physical(self, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        """(X1, u, X1', X2', ...) -> (X1, X2, X1', X2', ...)."""
+        out = y.copy()
+        out[1] += self.problem.clearance
+        return out
+
+    def segment(self, t: float, y: NDArray[np.float64], stuck: bool) -> None:
+        self.segments.append((t, MODE_STUCK if stuck else MODE_FREE))
+        self.segment_states.append(self._physical(y[:4]))
+
+    def strobe(self, t: float, y: NDArray[np.float64]) -> None:
+        if self.strobe_states and self.moments:
+            q = y[4:] - self.strobe_states[-1][4:]
+            self.period_moments.append(
+                np.array([q[0] - 1j * q[1], q[2] - 1j * q[3], q[4] - 1j * q[5] + self.impulse_moment, q[6], q[7]])
+            )
+            self.impulse_moment = 0j
+        self.strobe_times.append(t)
+        self.strobe_states.append(self._physical(y))
+
+    def trajectory(self) -> Trajectory:
+        starts = np.array([s[0] for s in self.segments])
+        ends = np.append(starts[1:], self.strobe_times[-1])
+        keep = ends > starts
+        rows = np.column_stack([starts, ends, [s[1] for s in self.segments]])[keep]
+        velocities = np.array(self.impact_velocities)
+        p = self.problem
+        return Trajectory(
+            problem=p,
+            strobe_times=np.array(self.strobe_times),
+            strobe_states=np.array(self.strobe_states)[:, :4],
+            impact_times=np.array(self.impact_times),
+            impact_velocities=velocities,
+            impulses=p.system.m2 * (1.0 + p.restitution) * velocities,
+            segments=rows.reshape(-1, 3),
+            segment_states=np.array(self.segment_states).reshape(-1, 4)[keep],
+            moments=np.array(self.period_moments, dtype=complex).reshape(-1, 5),
+            stats=dict(self.stats),
+        )
