@@ -56,13 +56,20 @@ def test_values_follow_the_regime(golden_run: xr.Dataset) -> None:
     linear = golden_run.sel(solution="linear", drop=True)
     regime = pgf["regime"]
     impact = regime.isin([Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR])
-    free = regime.isin([Regime.LINEAR, Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT])
+    free = regime.isin([Regime.LINEAR, Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT, Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT])
     assert impact.any() and free.any()
     assert bool((pgf["impulse"].where(impact) > 0).sum() == impact.sum())
     xr.testing.assert_allclose(pgf["x1_amplitude"].where(free), linear["x1_amplitude"].where(free))
     assert bool(pgf["x1_amplitude"].where(~impact & ~free).isnull().all())
     # linear regime is only claimed where the linear motion really fits inside the clearance
     assert bool((linear["x2_amplitude"].where(free) <= golden_run["clearance"]).sum() == free.sum())
+    # an unstable one-impact orbit is never reported where the stable linear motion fits
+    coexisting = regime == Regime.ONE_IMPACT_COEXISTING_LINEAR
+    assert not bool(((pgf["stable"] == 0) & coexisting).any())
+    assert bool((regime == Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT).any())
+    # the raw one-impact values cover every point where a solution exists
+    exists = pgf["one_impact_impulse"].notnull()
+    assert bool((pgf["one_impact_x1_amplitude"].notnull() == exists).all()) and bool(exists.sum() >= impact.sum())
 
 
 def test_large_clearance_study_is_linear() -> None:

@@ -31,6 +31,9 @@ class Regime(IntEnum):
     NONE = 5
     #: Solution ``linear`` only: the response without a stop (Delta -> infinity) crosses the clearance.
     LINEAR_EXCEEDS_CLEARANCE = 6
+    #: The linear response fits and an admissible one-impact orbit exists but is unstable (Floquet, ``pgf``): the
+    #: motion that persists is the linear one, whose values are reported.
+    LINEAR_WITH_UNSTABLE_ONE_IMPACT = 7
 
 
 def classify(linear_fits: ArrayLike, exists: ArrayLike, admissible: ArrayLike) -> NDArray[np.int8]:

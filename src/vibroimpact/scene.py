@@ -43,6 +43,10 @@ QUANTITIES = (
     "regime",
     "stable",
     "floquet_modulus",
+    "one_impact_x1_amplitude",
+    "one_impact_x2_amplitude",
+    "one_impact_force_amplitude",
+    "one_impact_impulse",
 )
 #: Parameters that can be swept, with their units and allowed ranges (low, high, low inclusive).
 SWEEPABLE = {

@@ -35,13 +35,20 @@ VARIABLE_ATTRIBUTES: dict[str, dict[str, str]] = {
     "suspension_force_amplitude": {"units": "N", "long_name": "fundamental-harmonic amplitude of the force through the suspension alone (eq. 21)"},
     "impulse": {"units": "N s", "long_name": "impact impulse per period (0 where the motion is linear)"},
     "phase": {"units": "rad", "long_name": "phase of the impact relative to the linear absorber motion (varphi + psi12, eq. 15)"},
-    "floquet_modulus": {"units": "1", "long_name": "largest modulus of the Floquet multipliers of the one-impact orbit (< 1: stable); solution pgf only"},
+    "floquet_modulus": {"units": "1", "long_name": "largest modulus of the Floquet multipliers of the admissible one-impact orbit (< 1: stable); solution pgf only"},
+    "one_impact_x1_amplitude": {"units": "m", "long_name": "|X1| fundamental of the one-impact solution of eqs. 15-17 wherever it exists, unchecked (admissible or not, stable or not)"},
+    "one_impact_x2_amplitude": {"units": "m", "long_name": "|X2| fundamental of the one-impact solution of eqs. 15-18 wherever it exists, unchecked"},
+    "one_impact_force_amplitude": {"units": "N", "long_name": "force fundamental (eq. 23) of the one-impact solution wherever it exists, unchecked"},
+    "one_impact_impulse": {"units": "N s", "long_name": "impulse (eq. 16) of the one-impact solution wherever it exists, unchecked"},
 }
+#: |Floquet multiplier| within this distance of 1 is reported as marginal, not decided by round-off.
+MARGINAL_MODULUS = 1e-9
+STABLE_MARGINAL = 2
 STABLE_ATTRIBUTES = {
-    "long_name": "Floquet stability of the one-impact orbit (solution pgf only)",
+    "long_name": "Floquet stability of the reported one-impact orbit (solution pgf only)",
     "units": "1",
-    "flag_values": np.array([-1, 0, 1], dtype=np.int8),
-    "flag_meanings": "not_applicable unstable stable",
+    "flag_values": np.array([-1, 0, 1, STABLE_MARGINAL], dtype=np.int8),
+    "flag_meanings": "not_applicable unstable stable marginal",
 }
 COORDINATE_ATTRIBUTES: dict[str, dict[str, str]] = {
     "frequency": {"units": "Hz", "long_name": "excitation frequency"},
@@ -50,7 +57,7 @@ COORDINATE_ATTRIBUTES: dict[str, dict[str, str]] = {
     "solution": {"long_name": "solution method"},
 }
 _IMPACT_REGIMES = (Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR)
-_LINEAR_REGIMES = (Regime.LINEAR, Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT)
+_LINEAR_REGIMES = (Regime.LINEAR, Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT, Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT)
 
 Progress = Callable[[str], None]
 
@@ -122,6 +129,10 @@ def _linear(scene: Scene, omega: np.ndarray, delta: np.ndarray, shape: tuple[int
         "regime": np.where(fits, Regime.LINEAR, Regime.LINEAR_EXCEEDS_CLEARANCE).astype(np.int8),
         "stable": np.full(shape, -1, dtype=np.int8),
         "floquet_modulus": np.full(shape, np.nan),
+        "one_impact_x1_amplitude": np.full(shape, np.nan),
+        "one_impact_x2_amplitude": np.full(shape, np.nan),
+        "one_impact_force_amplitude": np.full(shape, np.nan),
+        "one_impact_impulse": np.full(shape, np.nan),
     }
     return {k: np.broadcast_to(v, shape) for k, v in values.items() if k in scene.quantities}
 
@@ -130,35 +141,42 @@ def _pgf(scene: Scene, variant: PgfVariant, omega: np.ndarray, delta: np.ndarray
     solution = solve_one_impact(scene.system, omega, delta, r, scene.amplitude, variant, green_models(scene.system, variant))
     linear = linear_response(scene.system, np.broadcast_to(omega, shape), scene.amplitude)
     fits = solution.linear_amplitude_x2 <= solution.clearance
-    regime = classify(fits, solution.exists, solution.admissible(scene.admissibility))
+    admissible = solution.admissible(scene.admissibility)
+    regime = classify(fits, solution.exists, admissible)
+    modulus = np.full(shape, np.nan)
+    if variant is PgfVariant.EXACT:
+        # Floquet analysis of the exact orbits only: the paper variant's orbits are not orbits of the real system
+        modulus = np.where(admissible, np.max(np.abs(floquet_multipliers(solution)), axis=-1), np.nan)
+        unstable = modulus > 1.0 + MARGINAL_MODULUS
+        regime[(regime == Regime.ONE_IMPACT_COEXISTING_LINEAR) & unstable] = Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT
     impact = np.isin(regime, _IMPACT_REGIMES)
     free = np.isin(regime, _LINEAR_REGIMES)
-    wanted = set(scene.quantities)
 
     def choose(impact_value: np.ndarray, linear_value: np.ndarray) -> np.ndarray:
         return np.where(impact, impact_value, np.where(free, linear_value, np.nan))
 
-    values: dict[str, np.ndarray] = {"regime": regime}
-    if "x1_amplitude" in wanted:
-        values["x1_amplitude"] = choose(np.abs(solution.x1_harmonic()), np.abs(linear.x1))
-    if "x2_amplitude" in wanted:
-        values["x2_amplitude"] = choose(np.abs(solution.x2_harmonic()), np.abs(linear.x2))
-    if "force_amplitude" in wanted:
-        values["force_amplitude"] = choose(np.abs(solution.force_harmonic()), np.abs(linear.force))
-    if "suspension_force_amplitude" in wanted:
-        values["suspension_force_amplitude"] = choose(np.abs(solution.suspension_force_harmonic()), np.abs(linear.force))
-    if "impulse" in wanted:
-        values["impulse"] = choose(solution.impulse, np.zeros(shape))
-    if "phase" in wanted:
-        values["phase"] = np.where(impact, solution.phase, np.nan)
-    if wanted & {"stable", "floquet_modulus"}:
-        # Floquet analysis of the exact orbits only: the paper variant's orbits are not orbits of the real system
-        modulus = np.full(shape, np.nan)
-        if variant is PgfVariant.EXACT:
-            modulus = np.where(impact, np.max(np.abs(floquet_multipliers(solution)), axis=-1), np.nan)
-        values["floquet_modulus"] = modulus
-        values["stable"] = np.where(np.isnan(modulus), -1, modulus < 1.0).astype(np.int8)
-    return {q: values[q] for q in scene.quantities}
+    def stable_flag() -> np.ndarray:
+        flag = np.where(np.abs(modulus - 1.0) <= MARGINAL_MODULUS, STABLE_MARGINAL, modulus < 1.0)
+        return np.where(impact & np.isfinite(modulus), flag, -1).astype(np.int8)
+
+    # each quantity is computed only if the scene asks for it
+    makers: dict[str, Callable[[], np.ndarray]] = {
+        "regime": lambda: regime,
+        "x1_amplitude": lambda: choose(np.abs(solution.x1_harmonic()), np.abs(linear.x1)),
+        "x2_amplitude": lambda: choose(np.abs(solution.x2_harmonic()), np.abs(linear.x2)),
+        "force_amplitude": lambda: choose(np.abs(solution.force_harmonic()), np.abs(linear.force)),
+        "suspension_force_amplitude": lambda: choose(np.abs(solution.suspension_force_harmonic()), np.abs(linear.force)),
+        "impulse": lambda: choose(solution.impulse, np.zeros(shape)),
+        "phase": lambda: np.where(impact, solution.phase, np.nan),
+        "floquet_modulus": lambda: modulus,
+        "stable": stable_flag,
+        # the raw one-impact solution of eqs. 15-18 wherever it exists, admissible or not (what the paper plots)
+        "one_impact_x1_amplitude": lambda: np.where(solution.exists, np.abs(solution.x1_harmonic()), np.nan),
+        "one_impact_x2_amplitude": lambda: np.where(solution.exists, np.abs(solution.x2_harmonic()), np.nan),
+        "one_impact_force_amplitude": lambda: np.where(solution.exists, np.abs(solution.force_harmonic()), np.nan),
+        "one_impact_impulse": lambda: solution.impulse,
+    }
+    return {q: makers[q]() for q in scene.quantities}
 
 
 def _metadata(scene: Scene) -> dict[str, object]:
