@@ -77,3 +77,10 @@ def test_modal_parameters_round_trip_to_pole_residue() -> None:
 def test_complex_form_factor_cannot_become_eq10_terms(system: TwoDofSystem) -> None:
     with pytest.raises(ValueError, match="form_factor must be real"):
         exact_modal_parameters(system).to_pole_residue()
+
+
+def test_fit_refuses_systems_without_two_underdamped_modes() -> None:
+    """An overdamped absorber has one oscillatory mode: eq. 10 with two modes does not describe it."""
+    overdamped = TwoDofSystem(m1=1.0, m2=0.1, k1=25_000.0, k2=4_300.0, b1=0.8, b2=200.0)
+    with pytest.raises(ValueError, match="needs two underdamped modes; this system has 1"):
+        fit_modal_parameters(overdamped)

@@ -520,3 +520,40 @@ def test_tiny_clearance_grid_keeps_its_values() -> None:
 
 def test_infinite_upper_bound_is_printed_open() -> None:
     assert problems_of(scene_with(_set("system", "m1", float("inf")))) == ["system.m1: inf is out of range: allowed (0, inf)"]
+
+
+def test_yaml_12_exponent_numbers_are_floats(tmp_path: Path) -> None:
+    """`3e-3` and `2.5e4` are numbers (YAML 1.2), not strings as PyYAML's YAML 1.1 default would have it."""
+    doc = yaml.safe_dump(base_scene()).replace("clearance: 0.003", "clearance: 3e-3").replace("k1: 25000.0", "k1: 2.5e4")
+    assert "3e-3" in doc and "2.5e4" in doc
+    path = tmp_path / "exp.yaml"
+    path.write_text(doc, encoding="utf-8")
+    scene = load_scene(path)
+    assert scene.clearance[0] == 0.003 and scene.system.k1 == 25000.0
+
+
+def test_total_grid_size_is_bounded() -> None:
+    doc = base_scene()
+    doc["stop"] = {}
+    doc["sweep"] = {"restitution": {"start": 0, "stop": 1, "num": 1000}, "clearance": {"start": 0, "stop": 1, "num": 1000}, "frequency": {"start": 1, "stop": 2, "num": 1000}}
+    assert problems_of(doc) == ["sweep: 1,000,000,000 points (restitution x clearance x frequency) is too many: allowed at most 10,000,000"]
+
+
+def test_bare_name_without_extension(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert find_scene("restitution") == shipped_studies_dir() / "restitution.yaml"
+
+
+def test_cli_out_is_an_existing_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = write_yaml(tmp_path / "tiny.yaml", base_scene())
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    assert cli.main([str(path), "--out", str(blocker)]) == 2
+    assert "--out" in capsys.readouterr().err
+
+
+def test_pgf_paper_needs_two_underdamped_modes() -> None:
+    doc = base_scene()
+    doc["system"]["b2"] = 200.0
+    doc["solutions"] = ["pgf", "pgf_paper"]
+    assert problems_of(doc) == ["solutions: pgf_paper needs two underdamped modes (the paper's eq. 10 fit); this system has 1"]

@@ -7,10 +7,13 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 from .scene import SceneError, find_scene, load_scene
 from .study import run_study, write_dataset
 
 EXIT_BAD_INPUT = 2
+EXIT_FAILURE = 1
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -19,7 +22,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="run-study",
         description="Run a vibroimpact scene (YAML) and write its netCDF dataset and comparison report.",
     )
-    parser.add_argument("scene", help="scene file; a bare name is also looked up in ./studies/ and the shipped studies")
+    parser.add_argument("scene", help="scene file; a bare name (with or without .yaml) is also looked up in ./studies/ and the shipped studies")
     parser.add_argument("--out", type=Path, default=None, help="output folder (default: results/<scene name>/)")
     parser.add_argument("--no-report", action="store_true", help="write the dataset only")
     return parser
@@ -34,15 +37,22 @@ def main(argv: list[str] | None = None) -> int:
         print(f"run-study: error: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
     out_dir = args.out if args.out is not None else Path("results") / scene.name
+    if out_dir.exists() and not out_dir.is_dir():
+        print(f"run-study: error: --out {out_dir} exists and is not a folder", file=sys.stderr)
+        return EXIT_BAD_INPUT
     started = time.perf_counter()
-    dataset = run_study(scene)
-    path = write_dataset(dataset, out_dir / f"{scene.name}.nc")
-    print(f"wrote {path}")
-    if scene.report and not args.no_report:
-        from .report import write_report  # matplotlib is imported only when a report is made
+    try:
+        dataset = run_study(scene)
+        path = write_dataset(dataset, out_dir / f"{scene.name}.nc")
+        print(f"wrote {path}")
+        if scene.report and not args.no_report:
+            from .report import write_report  # matplotlib is imported only when a report is made
 
-        report = write_report(dataset, out_dir)
-        print(f"wrote {report}")
+            report = write_report(dataset, out_dir)
+            print(f"wrote {report}")
+    except (OSError, ValueError, ArithmeticError, np.linalg.LinAlgError, RuntimeError) as error:
+        print(f"run-study: error while running {scene.name!r}: {type(error).__name__}: {error}", file=sys.stderr)
+        return EXIT_FAILURE
     print(f"done in {time.perf_counter() - started:.1f} s")
     return 0
 

@@ -13,6 +13,7 @@ Two representations of the same kind of object:
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -20,7 +21,7 @@ from scipy.optimize import least_squares
 
 from .system import TwoDofSystem
 
-__all__ = ["PoleResidueModel", "ModalParameters", "exact_pole_residue", "exact_modal_parameters", "fit_modal_parameters"]
+__all__ = ["ModalParameters", "PoleResidueModel", "exact_modal_parameters", "exact_pole_residue", "fit_modal_parameters", "underdamped_mode_count"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -139,24 +140,41 @@ def exact_modal_parameters(system: TwoDofSystem, output: int = 2, load: int = 2)
     return ModalParameters(omega=omega, loss_factor=-poles.real / omega, form_factor=2j * poles.imag * residues)
 
 
-def fit_modal_parameters(system: TwoDofSystem, omega_grid: ArrayLike | None = None) -> ModalParameters:
+def underdamped_mode_count(system: TwoDofSystem) -> int:
+    """Number of oscillatory (complex-pole) modes of the system: 2 for a lightly damped absorber."""
+    return int(np.sum(exact_pole_residue(system).poles.imag > 0))
+
+
+@lru_cache(maxsize=32)
+def fit_modal_parameters(system: TwoDofSystem, omega_grid: tuple[float, ...] | None = None) -> ModalParameters:
     """The paper's curve fit of |H22| by eq. 10 with Omega_i fixed at the undamped values of eq. 11.
 
     Fits the real form factors A_i and loss factors xi_i by least squares on ``log |H22|`` (relative error, so the
-    sharp peaks and the anti-resonance both count), from a neutral start (xi = 1 %, equal form factors).
+    sharp peaks and the anti-resonance both count), starting from the real parts of the exact modal values.
+    Cached per system (the fit is deterministic).
 
     Parameters
     ----------
     system : TwoDofSystem
         The linear system.
-    omega_grid : array_like, optional
+    omega_grid : tuple of float, optional
         Angular frequencies [rad s-1] to fit on. Default: 0.5 Omega_1 ... 1.5 Omega_2, densified around each peak.
 
     Returns
     -------
     ModalParameters
         Real form factors [kg-1] and loss factors [-]; ``omega`` are the undamped natural frequencies.
+
+    Raises
+    ------
+    ValueError
+        If the system does not have two underdamped modes (eq. 10 then does not describe it).
+    RuntimeError
+        If the least-squares fit does not converge.
     """
+    modes = underdamped_mode_count(system)
+    if modes != 2:
+        raise ValueError(f"the paper's modal fit (eq. 10) needs two underdamped modes; this system has {modes}")
     omega_n = np.array(system.natural_frequencies())
     if omega_grid is None:
         wide = np.linspace(0.5 * omega_n[0], 1.5 * omega_n[1], 2001)
@@ -169,8 +187,11 @@ def fit_modal_parameters(system: TwoDofSystem, omega_grid: ArrayLike | None = No
         model = ModalParameters(omega=omega_n, loss_factor=x[2:], form_factor=x[:2])
         return np.log(np.abs(model.receptance(w))) - target
 
-    start = np.array([0.5 / system.m2, 0.5 / system.m2, 0.01, 0.01])
-    lower = np.array([0.0, 0.0, 1e-9, 1e-9])
+    exact = exact_modal_parameters(system)
+    start = np.concatenate([np.abs(np.real(exact.form_factor)), np.clip(exact.loss_factor, 1e-9, 0.98)])
+    lower = np.array([0.0, 0.0, 1e-12, 1e-12])
     upper = np.array([np.inf, np.inf, 0.99, 0.99])
-    fit = least_squares(residual, start, bounds=(lower, upper), x_scale=np.abs(start), xtol=1e-14, ftol=1e-14, gtol=1e-14)
+    fit = least_squares(residual, start, bounds=(lower, upper), x_scale=np.abs(start) + 1e-300, xtol=1e-14, ftol=1e-14, gtol=1e-14)
+    if not fit.success:
+        raise RuntimeError(f"the modal curve fit did not converge: {fit.message}")
     return ModalParameters(omega=omega_n, loss_factor=fit.x[2:], form_factor=fit.x[:2])

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from .modal import underdamped_mode_count
 from .pgf import AdmissibilitySettings
 from .system import TwoDofSystem
 
@@ -55,6 +56,8 @@ SWEEPABLE = {
     "clearance": ("m", 0.0, math.inf, True),
 }
 MAX_GRID_POINTS = 1_000_000
+#: Largest study: restitution x clearance x frequency points (each solution holds a few arrays of this size).
+MAX_STUDY_POINTS = 10_000_000
 
 
 class SceneError(ValueError):
@@ -123,7 +126,8 @@ def _interval(low: float, high: float, low_inclusive: bool = True, high_inclusiv
 
 
 class _UniqueKeyLoader(yaml.SafeLoader):
-    """``yaml.SafeLoader`` that refuses a key repeated in one mapping (PyYAML silently keeps the last one)."""
+    """``yaml.SafeLoader`` that refuses a key repeated in one mapping (PyYAML silently keeps the last one) and reads
+    YAML 1.2 numbers such as ``3e-3`` as floats (YAML 1.1, PyYAML's default, reads them as strings)."""
 
     def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
         seen: set[Any] = set()
@@ -133,6 +137,13 @@ class _UniqueKeyLoader(yaml.SafeLoader):
                 raise yaml.constructor.ConstructorError(None, None, f"key {key!r} is repeated", key_node.start_mark)
             seen.add(key)
         return super().construct_mapping(node, deep=deep)
+
+
+_UniqueKeyLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+    list("-+0123456789"),
+)
 
 
 def read_yaml(text: str) -> Any:
@@ -290,7 +301,12 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
         elif key != "frequency":
             c.fail(f"stop.{key}", f"required unless swept (sweep.{key}); allowed range {_interval(low, high, low_inclusive)}")
 
+    sizes = [g.size for g in grids.values() if g is not None]
+    if len(sizes) == len(SWEEPABLE) and math.prod(sizes) > MAX_STUDY_POINTS:
+        c.fail("sweep", f"{math.prod(sizes):,} points (restitution x clearance x frequency) is too many: allowed at most {MAX_STUDY_POINTS:,}")
     solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
+    if "pgf_paper" in solutions and system is not None and (modes := underdamped_mode_count(system)) != 2:
+        c.fail("solutions", f"pgf_paper needs two underdamped modes (the paper's eq. 10 fit); this system has {modes}")
     quantities = c.choices("quantities", doc["quantities"], QUANTITIES) if "quantities" in doc else QUANTITIES
     if "regime" not in quantities:
         quantities = (*quantities, "regime")
@@ -376,6 +392,8 @@ def find_scene(name: str | Path) -> Path:
     if not given.is_absolute():
         candidates.append(Path.cwd() / "studies" / given)
         candidates.append(shipped_studies_dir() / given.name)
+    if given.suffix not in (".yaml", ".yml"):
+        candidates += [c.with_name(c.name + ".yaml") for c in list(candidates)]
     if given.is_dir():
         raise IsADirectoryError(f"scene {given} is a directory, not a YAML file")
     for candidate in candidates:
