@@ -90,7 +90,7 @@ def _simulate_from_orbit(system: TwoDofSystem, s: OneImpactSolution, impacts: in
 
 @pytest.mark.parametrize(("frequency", "restitution"), [(25.0, 0.2), (24.0, 0.0), (38.0, 0.2)])
 def test_direct_simulation_stays_on_the_orbit(system: TwoDofSystem, frequency: float, restitution: float) -> None:
-    """Independent check: time integration started on the PGF orbit repeats it, impact after impact, to ~1e-9."""
+    """Independent check: time integration started on the PGF orbit repeats it, impact after impact, to 1e-8."""
     s = solve(system, frequency, restitution)
     impacts = 30
     state0, state, t = _simulate_from_orbit(system, s, impacts)

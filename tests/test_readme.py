@@ -24,3 +24,22 @@ def test_readme_starts_with_two_setup_commands() -> None:
 def test_ci_runs_the_readme_test_command() -> None:
     ci = (ROOT / ".ci" / "run").read_text().splitlines()
     assert readme_commands()[1] in ci
+
+
+def test_readme_reduction_factors_are_what_the_study_gives() -> None:
+    """The README's results table is recomputed here: change both together."""
+    from vibroimpact.reduction import reduction_factors
+    from vibroimpact.scene import load_scene
+    from vibroimpact.study import run_study
+
+    scene = load_scene(ROOT / "studies" / "restitution.yaml")
+    dataset = run_study(scene, progress=None)
+    readme = (ROOT / "README.md").read_text()
+
+    def factors(quantity: str, solution: str) -> list[str]:
+        row = next(r for r in reduction_factors(dataset, scene, quantity, solution) if r.restitution == 0.2)
+        return [f"{x:.1f}" for x in row.factor]
+
+    for solution, label in (("pgf", "`pgf` (exact)"), ("pgf_paper", "`pgf_paper`")):
+        expected = factors("x1_amplitude", solution) + factors("force_amplitude", solution)
+        assert f"| {label} | {' | '.join(expected)} |" in readme

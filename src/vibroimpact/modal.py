@@ -179,8 +179,9 @@ def fit_modal_parameters(system: TwoDofSystem, omega_grid: tuple[float, ...] | N
     if omega_grid is None:
         wide = np.linspace(0.5 * omega_n[0], 1.5 * omega_n[1], 2001)
         peaks = [wn * (1.0 + np.linspace(-0.02, 0.02, 401)) for wn in omega_n]
-        omega_grid = np.unique(np.concatenate([wide, *peaks]))
-    w = np.asarray(omega_grid, dtype=float)
+        w = np.unique(np.concatenate([wide, *peaks]))
+    else:
+        w = np.asarray(omega_grid, dtype=float)
     target = np.log(np.abs(system.receptances(w).h22))
 
     def residual(x: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -24,8 +24,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import Enum
-from typing import Iterable
-
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -64,14 +62,6 @@ class AdmissibilitySettings:
     edge_samples: int = 24
     relative_tolerance: float = 1e-9
     chunk_points: int = 2048
-
-    def as_dict(self) -> dict[str, float]:
-        """Settings as plain attributes."""
-        return {
-            "admissibility_samples_per_period": self.samples_per_period,
-            "admissibility_edge_samples": self.edge_samples,
-            "admissibility_relative_tolerance": self.relative_tolerance,
-        }
 
 
 @dataclass(frozen=True, eq=False)
@@ -334,8 +324,3 @@ def solve_one_impact(
         green12=green12,
         system=system,
     )
-
-
-def available_variants() -> Iterable[str]:
-    """Names of the closed-form variants, as used in scenes."""
-    return [v.value for v in PgfVariant]

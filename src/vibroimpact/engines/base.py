@@ -65,7 +65,7 @@ class ImpactProblem:
         """External force on the primary mass [N]."""
         return self.amplitude * np.cos(self.omega * t + self.phase)
 
-    def holding_force(self, x1: float | NDArray, v1: float | NDArray) -> float | NDArray:
+    def holding_force(self, x1: float | NDArray[np.float64], v1: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
         """Force the stop must exert to hold the absorber at rest at X2 = Delta, B2 X1' + K2 (X1 - Delta) [N].
 
         Positive: the absorber is pushed into the stop (it sticks); it leaves when this turns negative.
@@ -74,7 +74,7 @@ class ImpactProblem:
 
     def velocity_scale(self) -> float:
         """A velocity typical of the motion, w (Delta + q |H12|) [m s-1], for relative thresholds."""
-        linear = self.amplitude * abs(self.system.receptances(self.omega).h12)
+        linear = self.amplitude * float(np.abs(self.system.receptances(self.omega).h12))
         return self.omega * (self.clearance + linear) + 1e-300
 
 

@@ -174,12 +174,12 @@ class EventLoopEngine(ABC):
         force = p.holding_force(y[0], y[2])
         scale = 1e-12 * (p.system.k2 * (p.clearance + abs(y[0])) + p.system.b2 * abs(y[2])) + 1e-300
         if abs(force) > scale:
-            return force > 0.0
+            return bool(force > 0.0)
         was = model.stuck
         model.stuck = True
         rate = model.derivative(t, y)
         model.stuck = was
-        return p.system.b2 * rate[2] + p.system.k2 * rate[0] > 0.0
+        return bool(p.system.b2 * rate[2] + p.system.k2 * rate[0] > 0.0)
 
 
 @dataclass

@@ -102,7 +102,7 @@ class _Run:
         while k <= periods:
             boundary = origin + k * p.period
             fresh = piece is None
-            if fresh:  # a new closed-form piece after each event
+            if piece is None:  # a new closed-form piece after each event
                 piece, watch = self._piece(t, y, stuck)
             rec.stats["steps"] += 1
             tolerance = self.force_tolerance if stuck else self.tolerance
@@ -206,7 +206,7 @@ class _Run:
             contact = np.zeros_like(x1)
         else:
             x1, x2 = states[:, 0], np.full(times.shape, p.clearance)
-            contact = p.holding_force(states[:, 0], states[:, 1])
+            contact = np.asarray(p.holding_force(states[:, 0], states[:, 1]))
         rec.current += np.array([w @ (x1 * phasor), w @ (x2 * phasor), w @ (contact * phasor), w @ x1**2, w @ x2**2])
 
     def _trajectory(self) -> Trajectory:

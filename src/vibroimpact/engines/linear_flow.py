@@ -55,7 +55,7 @@ class HarmonicLinearFlow:
 
     def start(self, t0: float, y0: NDArray[np.float64]) -> "Piece":
         """The solution through state ``y0`` at time ``t0``."""
-        modal = self.inverse_vectors @ (np.asarray(y0, dtype=float) - self.particular(t0))
+        modal = self.inverse_vectors @ (np.asarray(y0, dtype=float) - self.particular(t0)).astype(complex)
         return Piece(self, float(t0), modal)
 
 
