@@ -229,7 +229,7 @@ MISTAKES = [
     ("clearance-in-stop-and-sweep", _set("sweep", "clearance", [0.003]), ["stop.clearance: also swept in sweep.clearance: give it in one place only"]),
     ("unknown-solution", _top("solutions", ["linear", "fem"]), ["solutions[1]: unknown name 'fem'", "allowed: linear, pgf, pgf_paper"]),
     ("solution-twice", _top("solutions", ["pgf", "linear", "pgf"]), ["solutions[2]: 'pgf' is listed twice"]),
-    ("empty-solutions", _top("solutions", []), ["solutions: expected a non-empty list of names from ['linear', 'pgf', 'pgf_paper']"]),
+    ("empty-solutions", _top("solutions", []), ["solutions: expected a non-empty list of names from ['linear', 'pgf', 'pgf_paper', 'momentary', 'exact']"]),
     ("solutions-not-list", _top("solutions", "linear"), ["solutions: expected a non-empty list of names", "'linear'"]),
     ("unknown-quantity", _top("quantities", ["x2_amplitude", "velocity"]), ["quantities[1]: unknown name 'velocity'", "allowed: x1_amplitude", "floquet_modulus"]),
     ("quantity-twice", _top("quantities", ["impulse", "impulse"]), ["quantities[1]: 'impulse' is listed twice"]),

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import os
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -25,6 +27,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("scene", help="scene file; a bare name (with or without .yaml) is also looked up in ./studies/ and the shipped studies")
     parser.add_argument("--out", type=Path, default=None, help="output folder (default: results/<scene name>/)")
     parser.add_argument("--no-report", action="store_true", help="write the dataset only")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="processes for the simulations (default: all cores)")
     return parser
 
 
@@ -40,10 +43,15 @@ def main(argv: list[str] | None = None) -> int:
     if out_dir.exists() and not out_dir.is_dir():
         print(f"run-study: error: --out {out_dir} exists and is not a folder", file=sys.stderr)
         return EXIT_BAD_INPUT
+    if args.jobs < 1:
+        print(f"run-study: error: --jobs {args.jobs} is out of range: allowed [1, inf)", file=sys.stderr)
+        return EXIT_BAD_INPUT
     started = time.perf_counter()
+    cache = out_dir / ".cache"  # finished simulation cases: an interrupted run resumes from here
     try:
-        dataset = run_study(scene)
+        dataset = run_study(scene, jobs=args.jobs, cache_dir=cache)
         path = write_dataset(dataset, out_dir / f"{scene.name}.nc")
+        shutil.rmtree(cache, ignore_errors=True)
         print(f"wrote {path}")
         if scene.report and not args.no_report:
             from .report import write_report  # matplotlib is imported only when a report is made

@@ -34,6 +34,12 @@ class Regime(IntEnum):
     #: The linear response fits and an admissible one-impact orbit exists but is unstable (Floquet, ``pgf``): the
     #: motion that persists is the linear one, whose values are reported.
     LINEAR_WITH_UNSTABLE_ONE_IMPACT = 7
+    #: Time-domain solutions: a converged periodic motion other than one impact per period (several impacts,
+    #: sticking, or a period of several excitation periods).
+    PERIODIC_IMPACTS = 8
+    #: Time-domain solutions: no periodic steady state within the allowed periods (quasi-periodic or chaotic);
+    #: values are averages over the measured window.
+    IRREGULAR = 9
 
 
 def classify(linear_fits: ArrayLike, exists: ArrayLike, admissible: ArrayLike) -> NDArray[np.int8]:

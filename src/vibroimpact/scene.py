@@ -25,14 +25,20 @@ from typing import Any
 import numpy as np
 import yaml
 
+from .engines.base import EngineSettings
 from .modal import underdamped_mode_count
 from .pgf import AdmissibilitySettings
+from .steady import SteadySettings
 from .system import TwoDofSystem
 
 __all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "SOLUTIONS", "QUANTITIES", "SWEEPABLE"]
 
 #: Solutions a scene can ask for.
-SOLUTIONS = ("linear", "pgf", "pgf_paper")
+SOLUTIONS = ("linear", "pgf", "pgf_paper", "momentary", "exact")
+#: Solutions computed by time integration (they need the ``simulation`` section's settings).
+ENGINE_SOLUTIONS = ("momentary", "exact")
+#: How a simulation starts at each frequency.
+SIMULATION_STARTS = ("linear", "pgf", "rest", "sweep_up", "sweep_down")
 #: Quantities a scene can ask for (``regime`` is always written: it says what the others mean).
 QUANTITIES = (
     "x1_amplitude",
@@ -48,6 +54,10 @@ QUANTITIES = (
     "one_impact_x2_amplitude",
     "one_impact_force_amplitude",
     "one_impact_impulse",
+    "impacts_per_period",
+    "converged",
+    "x1_rms",
+    "x2_rms",
 )
 #: Parameters that can be swept, with their units and allowed ranges (low, high, low inclusive).
 SWEEPABLE = {
@@ -66,6 +76,28 @@ class SceneError(ValueError):
     def __init__(self, problems: list[str], source: str = "scene") -> None:
         self.problems = list(problems)
         super().__init__(f"invalid {source}:\n" + "\n".join(f"  - {p}" for p in self.problems))
+
+
+@dataclass(frozen=True, eq=False)
+class SimulationSettings:
+    """How the time-domain solutions (``momentary``, ``exact``) are run.
+
+    Attributes
+    ----------
+    frequency : ndarray
+        Frequencies simulated [Hz] (a coarser grid than the analytic one, merged into the dataset's axis).
+    start : str
+        One of :data:`SIMULATION_STARTS`.
+    engine : EngineSettings
+        Integrator tolerances and method.
+    steady : SteadySettings
+        Convergence and measurement of the steady state.
+    """
+
+    frequency: np.ndarray
+    start: str = "pgf"
+    engine: EngineSettings = field(default_factory=EngineSettings)
+    steady: SteadySettings = field(default_factory=SteadySettings)
 
 
 @dataclass(frozen=True, eq=False)
@@ -96,6 +128,8 @@ class Scene:
         Quantities to write.
     admissibility : AdmissibilitySettings
         Settings of the X2(t) <= Delta check.
+    simulation : SimulationSettings or None
+        Settings of the time-domain solutions, when the scene asks for any.
     report : bool
         Whether ``run-study`` writes the comparison report.
     text : str
@@ -113,8 +147,16 @@ class Scene:
     solutions: tuple[str, ...]
     quantities: tuple[str, ...]
     admissibility: AdmissibilitySettings = field(default_factory=AdmissibilitySettings)
+    simulation: SimulationSettings | None = None
     report: bool = True
     text: str = ""
+
+    @property
+    def all_frequencies(self) -> np.ndarray:
+        """The dataset's frequency axis: the analytic grid merged with the simulation grid [Hz]."""
+        if self.simulation is None:
+            return self.frequency
+        return np.union1d(self.frequency, self.simulation.frequency)
 
 
 # ----------------------------------------------------------------------------- checking helpers
@@ -261,7 +303,8 @@ class _Checker:
 
 
 # ----------------------------------------------------------------------------- the parser
-_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "sweep", "solutions", "quantities", "settings", "report"}
+_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "sweep", "solutions", "quantities", "settings", "simulation", "report"}
+_SIMULATION_KEYS = {"frequency", "start", "method", "rtol", "atol", "max_step", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods"}
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 
@@ -324,6 +367,16 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
             if None not in kwargs.values():
                 admissibility = AdmissibilitySettings(**kwargs)
 
+    simulation = None
+    engines = [name for name in solutions if name in ENGINE_SOLUTIONS]
+    if "simulation" in doc:
+        if not engines:
+            c.fail("simulation", f"given, but no time-domain solution ({', '.join(ENGINE_SOLUTIONS)}) is asked for")
+        elif grids.get("frequency") is not None:
+            simulation = _parse_simulation(c, doc["simulation"], grids["frequency"])
+    elif engines and grids.get("frequency") is not None:
+        simulation = SimulationSettings(frequency=grids["frequency"])
+
     report = doc.get("report", True)
     if not isinstance(report, bool):
         c.fail("report", f"expected true or false, got {report!r}")
@@ -347,9 +400,33 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
         solutions=solutions,
         quantities=quantities,
         admissibility=admissibility,
+        simulation=simulation,
         report=report,
         text=text,
     )
+
+
+def _parse_simulation(c: _Checker, value: Any, default_frequency: np.ndarray) -> SimulationSettings | None:
+    spec = c.mapping("simulation", value, _SIMULATION_KEYS)
+    frequency = c.grid("simulation.frequency", spec["frequency"], 0.0, math.inf, False) if "frequency" in spec else default_frequency
+    start = spec.get("start", "pgf")
+    if start not in SIMULATION_STARTS:
+        c.fail("simulation.start", f"{start!r} is not allowed: use one of {', '.join(SIMULATION_STARTS)}")
+    engine_kwargs = {k: spec[k] for k in ("method", "rtol", "atol", "max_step") if k in spec}
+    steady_kwargs = {k: spec[k] for k in ("tolerance", "max_periods", "measure_periods", "irregular_measure_periods") if k in spec}
+    settings = []
+    for kind, kwargs in ((EngineSettings, engine_kwargs), (SteadySettings, steady_kwargs)):
+        for key, item in kwargs.items():
+            if isinstance(item, bool) or not isinstance(item, (int, float, str)):
+                c.fail(f"simulation.{key}", f"expected a number or name, got {item!r}")
+        try:
+            settings.append(kind(**kwargs))
+        except (ValueError, TypeError) as error:
+            c.fail("simulation." + str(error).split(" ")[0], str(error))
+            settings.append(None)
+    if frequency is None or start not in SIMULATION_STARTS or None in settings:
+        return None
+    return SimulationSettings(frequency=frequency, start=start, engine=settings[0], steady=settings[1])
 
 
 def _parse_system(c: _Checker, value: Any) -> TwoDofSystem | None:

@@ -23,7 +23,11 @@ from .linear import linear_response
 from .modal import fit_modal_parameters
 from .pgf import PgfVariant, green_models, solve_one_impact
 from .regime import Regime, classify, regime_attributes
-from .scene import Scene
+from .scene import ENGINE_SOLUTIONS, Scene
+from .simulate import FIELDS, SWEEP_STARTS, SimulationCase, run_cases
+
+#: Frequencies per simulation case when points are independent (load balancing between processes).
+CASE_CHUNK = 16
 from .stability import floquet_multipliers
 
 __all__ = ["run_study", "write_dataset", "VARIABLE_ATTRIBUTES"]
@@ -40,6 +44,15 @@ VARIABLE_ATTRIBUTES: dict[str, dict[str, str]] = {
     "one_impact_x2_amplitude": {"units": "m", "long_name": "|X2| fundamental of the one-impact solution of eqs. 15-18 wherever it exists, unchecked"},
     "one_impact_force_amplitude": {"units": "N", "long_name": "force fundamental (eq. 23) of the one-impact solution wherever it exists, unchecked"},
     "one_impact_impulse": {"units": "N s", "long_name": "impulse (eq. 16) of the one-impact solution wherever it exists, unchecked"},
+    "impacts_per_period": {"units": "1", "long_name": "impacts per excitation period (simulations: measured over whole periods)"},
+    "x1_rms": {"units": "m", "long_name": "RMS of X1 (simulations: over the measured periods; linear regimes: |X1| / sqrt 2)"},
+    "x2_rms": {"units": "m", "long_name": "RMS of X2 (simulations: over the measured periods; linear regimes: |X2| / sqrt 2)"},
+}
+CONVERGED_ATTRIBUTES = {
+    "long_name": "the simulated stroboscopic state repeated to the steady-state tolerance",
+    "units": "1",
+    "flag_values": np.array([-1, 0, 1], dtype=np.int8),
+    "flag_meanings": "not_applicable not_converged converged",
 }
 #: |Floquet multiplier| within this distance of 1 is reported as marginal, not decided by round-off.
 MARGINAL_MODULUS = 1e-9
@@ -66,7 +79,7 @@ def _stderr_progress(message: str) -> None:
     print(message, file=sys.stderr, flush=True)
 
 
-def run_study(scene: Scene, progress: Progress | None = _stderr_progress) -> xr.Dataset:
+def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: int = 1, cache_dir: Path | None = None) -> xr.Dataset:
     """Compute every solution of ``scene`` over its grid.
 
     Parameters
@@ -74,7 +87,11 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress) -> xr.
     scene : Scene
         A validated scene.
     progress : callable, optional
-        Receives one line per finished step; ``None`` for silence.
+        Receives one line per finished step; ``None`` for silence (also silences the simulation progress bar).
+    jobs : int
+        Processes for the time-domain solutions.
+    cache_dir : Path, optional
+        Folder where finished simulation cases are kept, so that an interrupted study resumes.
 
     Returns
     -------
@@ -83,28 +100,34 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress) -> xr.
     """
     report = progress or (lambda _message: None)
     # full grid (restitution, clearance, frequency); unswept axes have length 1 and are squeezed at the end
+    frequency = scene.all_frequencies
     r = scene.restitution[:, None, None]
     delta = scene.clearance[None, :, None]
-    omega = 2.0 * np.pi * scene.frequency[None, None, :]
+    omega = 2.0 * np.pi * frequency[None, None, :]
     shape = np.broadcast_shapes(r.shape, delta.shape, omega.shape)
     total = len(scene.solutions)
     per_solution = []
     for i, name in enumerate(scene.solutions, start=1):
-        values = _linear(scene, omega, delta, shape) if name == "linear" else _pgf(scene, PgfVariant(name), omega, delta, r, shape)
+        if name == "linear":
+            values = _linear(scene, omega, delta, shape)
+        elif name in ENGINE_SOLUTIONS:
+            values = _simulated(scene, name, shape, jobs, cache_dir, progress is not None)
+        else:
+            values = _pgf(scene, PgfVariant(name), omega, delta, r, shape)
         per_solution.append(values)
-        report(f"[{i}/{total}] {name}: {int(np.prod(shape))} points")
+        report(f"[{i}/{total}] {name}: done")
 
     dims = ("solution", "restitution", "clearance", "frequency")
     coords = {
         "solution": np.array(scene.solutions, dtype=object),
         "restitution": scene.restitution,
         "clearance": scene.clearance,
-        "frequency": scene.frequency,
+        "frequency": frequency,
     }
     data_vars = {}
     for quantity in scene.quantities:
         stacked = np.stack([values[quantity] for values in per_solution])
-        attrs = {"regime": regime_attributes(), "stable": STABLE_ATTRIBUTES}.get(quantity, VARIABLE_ATTRIBUTES.get(quantity))
+        attrs = {"regime": regime_attributes(), "stable": STABLE_ATTRIBUTES, "converged": CONVERGED_ATTRIBUTES}.get(quantity, VARIABLE_ATTRIBUTES.get(quantity))
         data_vars[quantity] = xr.Variable(dims, stacked, attrs)
     dataset = xr.Dataset(data_vars, coords=coords)
     for key in ("restitution", "clearance"):
@@ -133,6 +156,10 @@ def _linear(scene: Scene, omega: np.ndarray, delta: np.ndarray, shape: tuple[int
         "one_impact_x2_amplitude": np.full(shape, np.nan),
         "one_impact_force_amplitude": np.full(shape, np.nan),
         "one_impact_impulse": np.full(shape, np.nan),
+        "impacts_per_period": np.zeros(shape),
+        "converged": np.full(shape, -1, dtype=np.int8),
+        "x1_rms": np.abs(response.x1) / np.sqrt(2.0) * np.ones(shape),
+        "x2_rms": np.abs(response.x2) / np.sqrt(2.0) * np.ones(shape),
     }
     return {k: np.broadcast_to(v, shape) for k, v in values.items() if k in scene.quantities}
 
@@ -175,8 +202,63 @@ def _pgf(scene: Scene, variant: PgfVariant, omega: np.ndarray, delta: np.ndarray
         "one_impact_x2_amplitude": lambda: np.where(solution.exists, np.abs(solution.x2_harmonic()), np.nan),
         "one_impact_force_amplitude": lambda: np.where(solution.exists, np.abs(solution.force_harmonic()), np.nan),
         "one_impact_impulse": lambda: solution.impulse,
+        "impacts_per_period": lambda: np.where(impact, 1.0, np.where(free, 0.0, np.nan)),
+        "converged": lambda: np.full(shape, -1, dtype=np.int8),
+        "x1_rms": lambda: np.where(free, np.abs(linear.x1) / np.sqrt(2.0), np.nan),
+        "x2_rms": lambda: np.where(free, np.abs(linear.x2) / np.sqrt(2.0), np.nan),
     }
     return {q: makers[q]() for q in scene.quantities}
+
+
+def _simulated(scene: Scene, engine: str, shape: tuple[int, ...], jobs: int, cache_dir: Path | None, progress: bool) -> dict[str, np.ndarray]:
+    """Steady states of a time-domain engine on the simulation grid; NaN at the other frequencies."""
+    assert scene.simulation is not None
+    sim = scene.simulation
+    all_frequencies = scene.all_frequencies
+    columns = np.searchsorted(all_frequencies, sim.frequency)
+    # a sweep is one chain; independent starts are split into chunks so that processes share the work evenly
+    chunk = sim.frequency.size if sim.start in SWEEP_STARTS else CASE_CHUNK
+    cases, places = [], []
+    for i, restitution in enumerate(scene.restitution):
+        for j, clearance in enumerate(scene.clearance):
+            for first in range(0, sim.frequency.size, chunk):
+                frequencies = tuple(float(f) for f in sim.frequency[first : first + chunk])
+                cases.append(SimulationCase(engine, scene.system, scene.amplitude, float(restitution), float(clearance), frequencies, sim.start, sim.engine, sim.steady))
+                places.append((i, j, columns[first : first + chunk]))
+    results = run_cases(cases, jobs=jobs, cache_dir=cache_dir, progress=progress)
+    fields = {name: np.full(shape, np.nan, dtype=complex if name in ("x1", "x2", "suspension_force", "contact_force") else float) for name in FIELDS}
+    for (i, j, where), result in zip(places, results):
+        for name in FIELDS:
+            fields[name][i, j, where] = result[name]
+    computed = ~np.isnan(fields["converged"])
+    converged = fields["converged"] == 1.0
+    impacts = fields["impacts_per_period"]
+    regime = np.full(shape, Regime.NONE, dtype=np.int8)
+    regime[computed & ~converged] = Regime.IRREGULAR
+    regime[computed & converged] = Regime.PERIODIC_IMPACTS
+    regime[computed & converged & (impacts == 0.0)] = Regime.LINEAR
+    regime[computed & converged & (fields["multiplicity"] == 1.0) & (impacts == 1.0)] = Regime.ONE_IMPACT
+    force = fields["suspension_force"] + fields["contact_force"]
+    values = {
+        "x1_amplitude": np.abs(fields["x1"]),
+        "x2_amplitude": np.abs(fields["x2"]),
+        "force_amplitude": np.abs(force),
+        "suspension_force_amplitude": np.abs(fields["suspension_force"]),
+        "impulse": fields["mean_impulse"],
+        "phase": np.full(shape, np.nan),
+        "regime": regime,
+        "stable": np.full(shape, -1, dtype=np.int8),
+        "floquet_modulus": np.full(shape, np.nan),
+        "one_impact_x1_amplitude": np.full(shape, np.nan),
+        "one_impact_x2_amplitude": np.full(shape, np.nan),
+        "one_impact_force_amplitude": np.full(shape, np.nan),
+        "one_impact_impulse": np.full(shape, np.nan),
+        "impacts_per_period": impacts,
+        "converged": np.where(computed, converged, -1).astype(np.int8),
+        "x1_rms": fields["x1_rms"],
+        "x2_rms": fields["x2_rms"],
+    }
+    return {q: values[q] for q in scene.quantities}
 
 
 def _metadata(scene: Scene) -> dict[str, object]:
@@ -198,6 +280,15 @@ def _metadata(scene: Scene) -> dict[str, object]:
         attrs[f"system_{key}"] = value
     for key, value in asdict(scene.admissibility).items():
         attrs[f"admissibility_{key}"] = value
+    if scene.simulation is not None:
+        attrs["simulation_frequency_Hz"] = scene.simulation.frequency
+        attrs["simulation_start"] = scene.simulation.start
+        for key, value in asdict(scene.simulation.engine).items():
+            attrs[f"simulation_engine_{key}"] = value
+        for key, value in asdict(scene.simulation.steady).items():
+            attrs[f"simulation_steady_{key}"] = value
+        attrs["method_exact"] = "piecewise-exact propagation (eigenvectors + harmonic particular solution), contacts by guaranteed Taylor-bound root bracketing"
+        attrs["method_momentary"] = "scikit-sundae CVODE with contact/release events and an apex event guarding grazing contacts"
     if fit is not None:
         attrs["pgf_paper_form_factors_per_kg"] = np.real(fit.form_factor)
         attrs["pgf_paper_loss_factors"] = fit.loss_factor
