@@ -9,6 +9,7 @@ from __future__ import annotations
 import base64
 import html
 import io
+import math
 import os
 import tempfile
 from dataclasses import dataclass
@@ -26,7 +27,7 @@ from .linear import linear_response  # noqa: E402
 from .modal import exact_modal_parameters, fit_modal_parameters, underdamped_mode_count  # noqa: E402
 from .reduction import DEFINITION, paper_reduction_factors, reduction_factors  # noqa: E402
 from .regime import Regime  # noqa: E402
-from .scene import Scene, parse_scene, read_yaml  # noqa: E402
+from .scene import ENGINE_SOLUTIONS, Scene, parse_scene, read_yaml  # noqa: E402
 from .system import PAPER_SYSTEM  # noqa: E402
 
 __all__ = ["write_report"]
@@ -64,6 +65,11 @@ def write_report(dataset: xr.Dataset, out_dir: str | Path) -> Path:
             figures.append(_regime_figure(part, out / f"regime{tag}.png"))
         if "floquet_modulus" in part and "pgf" in part["solution"].values:
             figures.append(_stability_figure(part, out / f"stability{tag}.png"))
+        engines = [name for name in part["solution"].values if name in ENGINE_SOLUTIONS]
+        if engines:
+            for quantity in ("x1_amplitude", "x2_amplitude", "force_amplitude", "impulse"):
+                if quantity in part:
+                    figures.append(_simulation_figure(part, quantity, engines, out / f"simulation_{quantity}{tag}.png"))
     tables = _tables(dataset, scene)
     page = _html(dataset, scene, figures, tables)
     return _write_text_atomic(out / "report.html", page)
@@ -221,6 +227,90 @@ def _stability_figure(part: xr.Dataset, path: Path) -> Figure:
     return Figure(_save(fig, path), caption)
 
 
+def _simulation_figure(part: xr.Dataset, quantity: str, engines: list[str], path: Path) -> Figure:
+    """Simulation against PGF, one panel per restitution ratio (like the paper's figures 21-24)."""
+    label, units = _LABELS[quantity]
+    lines = _lines(part)
+    columns = min(3, len(lines))
+    rows = math.ceil(len(lines) / columns)
+    fig, axes = plt.subplots(rows, columns, figsize=(6.2 * columns, 3.8 * rows), squeeze=False, sharex=True)
+    f = part["frequency"].values
+    simulated = np.isin(f, np.asarray(part.attrs.get("simulation_frequency_Hz", f)))
+    markers = {"momentary": ("o", 4.5), "exact": ("x", 4.0)}
+    for ax, (name, line) in zip(axes.flat, lines):
+        if "linear" in part["solution"].values and quantity != "impulse":
+            ax.plot(f, line[quantity].sel(solution="linear").values, ":", color="k", lw=1.0, label="LIN")
+        if "pgf" in part["solution"].values:
+            values = line[quantity].sel(solution="pgf").values
+            unstable = line["stable"].sel(solution="pgf").values == 0 if "stable" in line else np.zeros(values.shape, bool)
+            ax.plot(f, np.where(unstable, np.nan, values), color="C0", lw=1.1, label="pgf")
+            if unstable.any():
+                ax.plot(f, np.where(unstable, values, np.nan), color="C0", lw=0.8, ls="--", alpha=0.5, label="pgf, unstable orbit")
+        for k, engine in enumerate(engines):
+            values = line[quantity].sel(solution=engine).values[simulated]
+            converged = line["converged"].sel(solution=engine).values[simulated] == 1 if "converged" in line else np.ones(values.shape, bool)
+            marker, size = markers.get(engine, ("s", 4.0))
+            color = f"C{k + 1}"
+            ax.plot(f[simulated][converged], values[converged], marker, color=color, ms=size, mfc=color if marker == "o" else "none", ls="none", label=f"{engine}, periodic")
+            if (~converged).any():
+                ax.plot(f[simulated][~converged], values[~converged], marker, color=color, ms=size, mfc="none", ls="none", alpha=0.8, label=f"{engine}, irregular")
+        if quantity != "impulse":
+            ax.set_yscale("log")
+        ax.set(title=f"{name}", xlabel="frequency [Hz]", ylabel=f"{label} [{units}]")
+        ax.grid(True, which="both", alpha=0.3)
+    for ax in list(axes.flat)[len(lines) :]:
+        ax.set_visible(False)
+    handles, names = axes.flat[0].get_legend_handles_labels()
+    fig.legend(handles, names, loc="lower center", ncol=6, fontsize=8, bbox_to_anchor=(0.5, -0.02 - 0.02 * rows))
+    fig.suptitle(f"Simulation against PGF: {label} (Delta = {_clearance_text(part)})")
+    caption = (
+        f"{label}: steady states simulated at each marked frequency (filled: the stroboscopic state repeated; hollow: "
+        "irregular motion, averaged over the measured periods) against the PGF closed form (solid where its orbit is "
+        "stable, dashed where unstable). Impulse of a simulation: mean impulse per impact."
+    )
+    return Figure(_save(fig, path), caption)
+
+
+def _agreement_table(dataset: xr.Dataset, scene: Scene) -> str:
+    """Simulation against PGF by band: relative differences of |X1| where the PGF orbit is stable and where not."""
+    engines = [name for name in dataset["solution"].values if name in ENGINE_SOLUTIONS]
+    if not engines or "pgf" not in dataset["solution"].values or "x1_amplitude" not in dataset or scene.simulation is None:
+        return ""
+    split = scene.system.antiresonance_frequency() / (2.0 * np.pi)
+    sim_f = scene.simulation.frequency
+    data = dataset.sel(frequency=sim_f)
+    header = (
+        "<tr><th>engine</th><th>Delta [mm]</th><th>R</th><th>band</th><th>points</th><th>max rel. diff. |X1|, PGF stable or linear</th>"
+        "<th>median</th><th>PGF unstable: points</th><th>max rel. diff. there</th><th>simulation irregular</th><th>simulation with other than 1 or 0 impacts per period</th></tr>"
+    )
+    body = []
+    for engine in engines:
+        for delta in np.atleast_1d(data["clearance"].values):
+            for r in np.atleast_1d(data["restitution"].values):
+                sel = {k: v for k, v in (("clearance", delta), ("restitution", r)) if k in data.dims}
+                line = data.sel(sel)
+                sim = line["x1_amplitude"].sel(solution=engine).values
+                pgf = line["x1_amplitude"].sel(solution="pgf").values
+                unstable = line["stable"].sel(solution="pgf").values == 0 if "stable" in line else np.zeros(sim.shape, bool)
+                irregular = line["converged"].sel(solution=engine).values == 0 if "converged" in line else np.zeros(sim.shape, bool)
+                other = ~np.isin(line["impacts_per_period"].sel(solution=engine).values, (0.0, 1.0)) if "impacts_per_period" in line else np.zeros(sim.shape, bool)
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    difference = np.abs(sim - pgf) / np.abs(pgf)
+                for band, mask in (("1", sim_f < split), ("2", sim_f >= split)):
+                    good = mask & ~unstable & np.isfinite(difference)
+                    bad = mask & unstable & np.isfinite(difference)
+                    body.append(
+                        f"<tr><td>{engine}</td><td>{float(delta) * 1e3:g}</td><td>{float(r):g}</td><td>{band}</td><td>{int(mask.sum())}</td>"
+                        f"<td>{_fmt(difference[good].max(initial=np.nan))}</td><td>{_fmt(np.median(difference[good]) if good.any() else np.nan)}</td>"
+                        f"<td>{int(bad.sum())}</td><td>{_fmt(difference[bad].max(initial=np.nan))}</td><td>{int((irregular & mask).sum())}</td><td>{int((other & mask).sum())}</td></tr>"
+                    )
+    return f"<table>{header}{''.join(body)}</table>"
+
+
+def _fmt(value: float) -> str:
+    return "" if not np.isfinite(value) else f"{value:.1e}"
+
+
 # -------------------------------------------------------------------------------------------- tables
 def _tables(dataset: xr.Dataset, scene: Scene) -> list[tuple[str, str]]:
     tables = [("Modal parameters of H22", _modal_table(scene))]
@@ -246,6 +336,9 @@ def _tables(dataset: xr.Dataset, scene: Scene) -> list[tuple[str, str]]:
                     f"<td>{'' if paper is None else f'{paper[0]:g} / {paper[1]:g}'}</td></tr>"
                 )
         tables.append((f"Reduction factors: {label}", f"<table>{header}{''.join(body)}</table>"))
+    agreement = _agreement_table(dataset, scene)
+    if agreement:
+        tables.append(("Simulation against PGF by band (|X1| fundamental)", agreement))
     return tables
 
 

@@ -20,7 +20,7 @@ import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import yaml
@@ -65,6 +65,7 @@ SWEEPABLE = {
     "restitution": ("1", 0.0, 1.0, True),
     "clearance": ("m", 0.0, math.inf, True),
 }
+_T = TypeVar("_T")
 MAX_GRID_POINTS = 1_000_000
 #: Largest study: restitution x clearance x frequency points (each solution holds a few arrays of this size).
 MAX_STUDY_POINTS = 10_000_000
@@ -372,10 +373,10 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
     if "simulation" in doc:
         if not engines:
             c.fail("simulation", f"given, but no time-domain solution ({', '.join(ENGINE_SOLUTIONS)}) is asked for")
-        elif grids.get("frequency") is not None:
-            simulation = _parse_simulation(c, doc["simulation"], grids["frequency"])
-    elif engines and grids.get("frequency") is not None:
-        simulation = SimulationSettings(frequency=grids["frequency"])
+        elif (main_grid := grids.get("frequency")) is not None:
+            simulation = _parse_simulation(c, doc["simulation"], main_grid)
+    elif engines and (main_grid := grids.get("frequency")) is not None:
+        simulation = SimulationSettings(frequency=main_grid)
 
     report = doc.get("report", True)
     if not isinstance(report, bool):
@@ -408,25 +409,30 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
 
 def _parse_simulation(c: _Checker, value: Any, default_frequency: np.ndarray) -> SimulationSettings | None:
     spec = c.mapping("simulation", value, _SIMULATION_KEYS)
-    frequency = c.grid("simulation.frequency", spec["frequency"], 0.0, math.inf, False) if "frequency" in spec else default_frequency
+    frequency: np.ndarray | None = c.grid("simulation.frequency", spec["frequency"], 0.0, math.inf, False) if "frequency" in spec else default_frequency
     start = spec.get("start", "pgf")
     if start not in SIMULATION_STARTS:
         c.fail("simulation.start", f"{start!r} is not allowed: use one of {', '.join(SIMULATION_STARTS)}")
     engine_kwargs = {k: spec[k] for k in ("method", "rtol", "atol", "max_step") if k in spec}
     steady_kwargs = {k: spec[k] for k in ("tolerance", "max_periods", "measure_periods", "irregular_measure_periods") if k in spec}
-    settings = []
-    for kind, kwargs in ((EngineSettings, engine_kwargs), (SteadySettings, steady_kwargs)):
-        for key, item in kwargs.items():
-            if isinstance(item, bool) or not isinstance(item, (int, float, str)):
-                c.fail(f"simulation.{key}", f"expected a number or name, got {item!r}")
-        try:
-            settings.append(kind(**kwargs))
-        except (ValueError, TypeError) as error:
-            c.fail("simulation." + str(error).split(" ")[0], str(error))
-            settings.append(None)
-    if frequency is None or start not in SIMULATION_STARTS or None in settings:
+    engine = _settings(c, EngineSettings, engine_kwargs)
+    steady = _settings(c, SteadySettings, steady_kwargs)
+    if frequency is None or start not in SIMULATION_STARTS or engine is None or steady is None:
         return None
-    return SimulationSettings(frequency=frequency, start=start, engine=settings[0], steady=settings[1])
+    return SimulationSettings(frequency=frequency, start=start, engine=engine, steady=steady)
+
+
+def _settings(c: _Checker, kind: type[_T], kwargs: dict[str, Any]) -> _T | None:
+    """Build a settings dataclass, turning its validation errors into scene problems under ``simulation.``."""
+    for key, item in kwargs.items():
+        if isinstance(item, bool) or not isinstance(item, (int, float, str)):
+            c.fail(f"simulation.{key}", f"expected a number or name, got {item!r}")
+            return None
+    try:
+        return kind(**kwargs)
+    except (ValueError, TypeError) as error:
+        c.fail("simulation." + str(error).split(" ")[0], str(error))
+        return None
 
 
 def _parse_system(c: _Checker, value: Any) -> TwoDofSystem | None:

@@ -210,5 +210,5 @@ def _save(cache_dir: Path, case: SimulationCase, result: CaseResult) -> None:
     cache_dir.mkdir(parents=True, exist_ok=True)
     handle, temporary = tempfile.mkstemp(prefix=".case.", suffix=".npz", dir=cache_dir)
     os.close(handle)
-    np.savez(temporary, **result)
+    np.savez(temporary, **result)  # type: ignore[arg-type]
     os.replace(temporary, _cache_path(cache_dir, case))
