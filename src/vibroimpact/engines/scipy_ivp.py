@@ -1,0 +1,74 @@
+"""Comparison engines: ``scipy.integrate.solve_ivp`` (DOP853, LSODA, Radau, ...) with terminal events and restarts.
+
+The loop a user would write: integrate to the next contact (or release) with a terminal event, apply the map,
+restart. There is no grazing guard, on purpose: these are the baselines the ``momentary`` engine is measured against.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.integrate import solve_ivp
+
+from .base import EngineSettings
+from .event_loop import EventLoopEngine, Model, Stop
+
+__all__ = ["SolveIvpEngine", "SOLVE_IVP_METHODS"]
+
+SOLVE_IVP_METHODS = ("RK45", "DOP853", "LSODA", "Radau", "BDF")
+
+
+class SolveIvpEngine(EventLoopEngine):
+    """``solve_ivp`` with a terminal contact event (free flight) or release event (stuck).
+
+    Parameters
+    ----------
+    settings : EngineSettings
+        rtol, atol and max_step are used; ``method`` of the settings is ignored.
+    method : str
+        One of :data:`SOLVE_IVP_METHODS`.
+    """
+
+    def __init__(self, settings: EngineSettings = EngineSettings(), method: str = "DOP853") -> None:
+        if method not in SOLVE_IVP_METHODS:
+            raise ValueError(f"method = {method!r} is not allowed: use one of {', '.join(SOLVE_IVP_METHODS)}")
+        super().__init__(settings)
+        self.method = method
+        self.name = f"solve_ivp_{method}"
+
+    def _begin(self, model: Model) -> None:
+        def contact(t: float, y: NDArray[np.float64]) -> float:
+            return float(y[1])  # the gap X2 - Delta
+
+        def release(t: float, y: NDArray[np.float64]) -> float:
+            return float(model.problem.holding_force(y[0], y[2]))
+
+        contact.terminal, contact.direction = True, 1.0  # type: ignore[attr-defined]
+        release.terminal, release.direction = True, -1.0  # type: ignore[attr-defined]
+        self._contact, self._release = contact, release
+
+        def rhs(t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+            return model.derivative(t, y)
+
+        self._rhs = rhs
+        self._steps = self._events_found = self._nfev = 0
+
+    def _counters(self) -> dict[str, int]:
+        return {"steps": self._steps, "events": self._events_found, "solver_rhs_calls": self._nfev}
+
+    def _advance(self, model: Model, t: float, y: NDArray[np.float64], t_stop: float) -> tuple[Stop, float, NDArray[np.float64]]:
+        options: dict[str, Any] = {"method": self.method, "rtol": self.settings.rtol, "atol": self.settings.atol}
+        if self.settings.max_step > 0.0:
+            options["max_step"] = self.settings.max_step
+        event = self._release if model.stuck else self._contact
+        result = solve_ivp(self._rhs, (t, t_stop), y, events=[event], **options)
+        if result.status < 0:
+            raise RuntimeError(f"solve_ivp ({self.method}) failed at t = {result.t[-1]!r} s: {result.message}")
+        self._steps += result.t.size - 1
+        self._nfev += result.nfev
+        if result.status == 1:
+            self._events_found += 1
+            return (Stop.RELEASE if model.stuck else Stop.CONTACT), float(result.t_events[0][0]), np.array(result.y_events[0][0])
+        return Stop.BOUNDARY, float(result.t[-1]), np.array(result.y[:, -1])
