@@ -25,7 +25,8 @@ from typing import Any, TypeVar
 import numpy as np
 import yaml
 
-from .engines.base import EngineSettings
+from .benchmark import BENCHMARK_METHODS, BenchmarkCase, BenchmarkSettings
+from .engines.base import EngineSettings, ImpactProblem
 from .modal import underdamped_mode_count
 from .pgf import AdmissibilitySettings
 from .steady import SteadySettings
@@ -102,6 +103,14 @@ class SimulationSettings:
 
 
 @dataclass(frozen=True, eq=False)
+class BenchmarkScene:
+    """A benchmark scene's cases and settings (see :mod:`vibroimpact.benchmark`)."""
+
+    cases: tuple[BenchmarkCase, ...]
+    settings: BenchmarkSettings
+
+
+@dataclass(frozen=True, eq=False)
 class Scene:
     """A validated scene.
 
@@ -149,6 +158,7 @@ class Scene:
     quantities: tuple[str, ...]
     admissibility: AdmissibilitySettings = field(default_factory=AdmissibilitySettings)
     simulation: SimulationSettings | None = None
+    benchmark: BenchmarkScene | None = None
     report: bool = True
     text: str = ""
 
@@ -305,6 +315,8 @@ class _Checker:
 
 # ----------------------------------------------------------------------------- the parser
 _TOP_KEYS = {"name", "description", "system", "excitation", "stop", "sweep", "solutions", "quantities", "settings", "simulation", "report"}
+_BENCHMARK_KEYS = {"duration", "methods", "tolerances", "atol_ratio", "repeats", "max_seconds", "cases"}
+_BENCHMARK_CASE_KEYS = {"name", "frequency", "restitution", "clearance", "clearance_below_linear", "start"}
 _SIMULATION_KEYS = {"frequency", "start", "method", "rtol", "atol", "max_step", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods"}
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
@@ -315,6 +327,8 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
     if not isinstance(document, dict):
         what = "an empty document" if document is None else f"a {type(document).__name__}"
         raise SceneError([f"scene: expected a mapping with keys {sorted(_TOP_KEYS)}, got {what}"], source)
+    if "benchmark" in document:
+        return _parse_benchmark_scene(c, document, text, source)
     doc = c.mapping("", document, _TOP_KEYS, {"name", "system", "excitation", "sweep", "solutions"})
 
     name = doc.get("name")
@@ -403,6 +417,79 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
         admissibility=admissibility,
         simulation=simulation,
         report=report,
+        text=text,
+    )
+
+
+def _parse_benchmark_scene(c: _Checker, document: dict, text: str, source: str) -> Scene:
+    """A benchmark scene: system, excitation amplitude and ``benchmark`` (cases, methods, tolerances)."""
+    doc = c.mapping("", document, {"name", "description", "system", "excitation", "benchmark", "report"}, {"name", "system", "excitation", "benchmark"})
+    name = doc.get("name")
+    if not (isinstance(name, str) and _NAME.match(name)):
+        c.fail("name", f"expected a file-name-safe string (letters, digits, '_', '-', '.'), got {name!r}")
+    system = _parse_system(c, doc.get("system"))
+    excitation = c.mapping("excitation", doc.get("excitation"), {"amplitude"}, {"amplitude"})
+    amplitude = c.number("excitation.amplitude", excitation.get("amplitude"), 0.0, math.inf, low_inclusive=False) if "amplitude" in excitation else None
+    spec = c.mapping("benchmark", doc["benchmark"], _BENCHMARK_KEYS, {"duration", "methods", "tolerances", "cases"})
+    duration = c.number("benchmark.duration", spec.get("duration"), 0.0, 1e5, low_inclusive=False) if "duration" in spec else None
+    methods = c.choices("benchmark.methods", spec.get("methods"), tuple(BENCHMARK_METHODS)) if "methods" in spec else ()
+    tolerances = c.grid("benchmark.tolerances", spec.get("tolerances"), 1e-15, 1e-1, True) if "tolerances" in spec else None
+    options: dict[str, Any] = {}
+    if "atol_ratio" in spec:
+        options["atol_ratio"] = c.number("benchmark.atol_ratio", spec["atol_ratio"], 1e-12, 1.0)
+    if "repeats" in spec:
+        options["repeats"] = c.integer("benchmark.repeats", spec["repeats"], 1, 100)
+    if "max_seconds" in spec:
+        options["max_seconds"] = c.number("benchmark.max_seconds", spec["max_seconds"], 0.0, 1e5, low_inclusive=False)
+    cases = []
+    raw_cases = spec.get("cases", [])
+    if not isinstance(raw_cases, list) or not raw_cases:
+        c.fail("benchmark.cases", "expected a non-empty list of cases {name, frequency, restitution, clearance | clearance_below_linear, start}")
+        raw_cases = []
+    for i, raw in enumerate(raw_cases):
+        key = f"benchmark.cases[{i}]"
+        case = c.mapping(key, raw, _BENCHMARK_CASE_KEYS, {"name", "frequency", "restitution", "start"})
+        frequency = c.number(f"{key}.frequency", case.get("frequency"), 0.0, math.inf, low_inclusive=False) if "frequency" in case else None
+        restitution = c.number(f"{key}.restitution", case.get("restitution"), 0.0, 1.0) if "restitution" in case else None
+        if ("clearance" in case) == ("clearance_below_linear" in case):
+            c.fail(key, "give exactly one of 'clearance' [m] or 'clearance_below_linear' [m]")
+            continue
+        start = case.get("start")
+        if start not in ("rest", "linear"):
+            c.fail(f"{key}.start", f"{start!r} is not allowed: use rest or linear")
+        if None in (frequency, restitution, system, amplitude, duration) or start not in ("rest", "linear"):
+            continue
+        assert system is not None and frequency is not None and amplitude is not None and duration is not None and restitution is not None
+        if "clearance" in case:
+            clearance = c.number(f"{key}.clearance", case["clearance"], 0.0, math.inf)
+        else:
+            below = c.number(f"{key}.clearance_below_linear", case["clearance_below_linear"], -1.0, 1.0)
+            linear = amplitude * abs(complex(system.receptances(2.0 * math.pi * frequency).h12))
+            clearance = None if below is None else linear - below
+            if clearance is not None and clearance < 0:
+                c.fail(f"{key}.clearance_below_linear", f"{below:g} m exceeds the linear amplitude {linear:g} m")
+                clearance = None
+        if clearance is None:
+            continue
+        problem = ImpactProblem(system, clearance, restitution, amplitude, frequency)
+        cases.append(BenchmarkCase(str(case["name"]), problem, start, max(1, round(duration * frequency))))
+    if c.problems:
+        raise SceneError(c.problems, source)
+    assert tolerances is not None and isinstance(name, str) and system is not None and amplitude is not None
+    settings = BenchmarkSettings(methods=methods, tolerances=tuple(float(t) for t in tolerances[::-1]), **options)
+    return Scene(
+        name=name,
+        description=str(doc.get("description", "")),
+        system=system,
+        amplitude=amplitude,
+        frequency=np.array(sorted({case.problem.frequency for case in cases})),
+        restitution=np.array(sorted({case.problem.restitution for case in cases})),
+        clearance=np.array(sorted({case.problem.clearance for case in cases})),
+        swept=(),
+        solutions=(),
+        quantities=(),
+        benchmark=BenchmarkScene(tuple(cases), settings),
+        report=bool(doc.get("report", True)),
         text=text,
     )
 

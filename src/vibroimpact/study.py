@@ -19,6 +19,7 @@ import numpy as np
 import xarray as xr
 
 from . import __version__
+from .benchmark import run_benchmark
 from .linear import linear_response
 from .modal import fit_modal_parameters
 from .pgf import PgfVariant, green_models, solve_one_impact
@@ -98,6 +99,10 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
     xarray.Dataset
         Dimensions ``solution``, the swept parameters and ``frequency``.
     """
+    if scene.benchmark is not None:
+        dataset = run_benchmark(list(scene.benchmark.cases), scene.benchmark.settings, progress=progress is not None)
+        dataset.attrs.update({"title": f"vibroimpact benchmark '{scene.name}'", "scene_name": scene.name, "scene": scene.text, "vibroimpact_version": __version__})
+        return dataset
     report = progress or (lambda _message: None)
     # full grid (restitution, clearance, frequency); unswept axes have length 1 and are squeezed at the end
     frequency = scene.all_frequencies
