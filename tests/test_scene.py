@@ -557,3 +557,70 @@ def test_pgf_paper_needs_two_underdamped_modes() -> None:
     doc["system"]["b2"] = 200.0
     doc["solutions"] = ["pgf", "pgf_paper"]
     assert problems_of(doc) == ["solutions: pgf_paper needs two underdamped modes (the paper's eq. 10 fit); this system has 1"]
+
+
+# ----------------------------------------------------------------------------- simulation and benchmark sections
+def _with_engines(**simulation: Any) -> dict[str, Any]:
+    doc = base_scene()
+    doc["solutions"] = ["pgf", "momentary", "exact"]
+    if simulation:
+        doc["simulation"] = simulation
+    return doc
+
+
+def test_simulation_defaults_to_the_analytic_grid() -> None:
+    scene = parse_scene(_with_engines())
+    assert scene.simulation is not None and scene.simulation.start == "pgf"
+    np.testing.assert_array_equal(scene.simulation.frequency, scene.frequency)
+
+
+def test_simulation_grid_is_merged_into_the_frequency_axis() -> None:
+    scene = parse_scene(_with_engines(frequency=[20.25, 21.0], start="sweep_up", rtol=1e-7, max_periods=50))
+    assert 20.25 in scene.all_frequencies and scene.all_frequencies.size == scene.frequency.size + 1
+    assert scene.simulation is not None and scene.simulation.engine.rtol == 1e-7 and scene.simulation.steady.max_periods == 50
+
+
+@pytest.mark.parametrize(
+    ("simulation", "fragment"),
+    [
+        ({"start": "middle"}, "simulation.start: 'middle' is not allowed: use one of linear, pgf, rest, sweep_up, sweep_down"),
+        ({"rtol": 5.0}, "simulation.rtol: rtol = 5.0 is out of range: allowed [1e-15, 0.1]"),
+        ({"method": "rk4"}, "simulation.method: method = 'rk4' is not allowed"),
+        ({"max_periods": 0}, "simulation.max_periods: max_periods = 0 is out of range"),
+        ({"frequency": [-1.0]}, "simulation.frequency[0]: -1.0 is out of range"),
+        ({"colour": 1}, "simulation.colour: unknown key"),
+    ],
+)
+def test_bad_simulation_settings(simulation: dict[str, Any], fragment: str) -> None:
+    problems = problems_of(_with_engines(**simulation))
+    assert any(p.startswith(fragment) for p in problems), problems
+
+
+def test_simulation_without_engine_solutions_is_an_error() -> None:
+    doc = base_scene()
+    doc["simulation"] = {"start": "pgf"}
+    assert problems_of(doc) == ["simulation: given, but no time-domain solution (momentary, exact) is asked for"]
+
+
+def test_shipped_engine_cost_scene_parses() -> None:
+    scene = load_scene(shipped_studies_dir() / "engine_cost.yaml")
+    assert scene.benchmark is not None and len(scene.benchmark.cases) == 3
+    assert scene.benchmark.settings.tolerances[0] > scene.benchmark.settings.tolerances[-1]  # loose to tight
+
+
+@pytest.mark.parametrize(
+    ("change", "fragment"),
+    [
+        (lambda b: b.update(methods=["euler"]), "benchmark.methods[0]: unknown name 'euler'"),
+        (lambda b: b["cases"][0].pop("start"), "benchmark.cases[0].start: required key is missing"),
+        (lambda b: b["cases"][0].update(clearance=0.003), "benchmark.cases[0]: give exactly one of 'clearance' [m] or 'clearance_below_linear' [m]"),
+        (lambda b: b.update(cases=[]), "benchmark.cases: expected a non-empty list"),
+    ],
+)
+def test_bad_benchmark_scenes(change: Callable[[dict[str, Any]], Any], fragment: str) -> None:
+    doc = yaml.safe_load((shipped_studies_dir() / "engine_cost.yaml").read_text())
+    doc["benchmark"]["cases"] = doc["benchmark"]["cases"][2:]  # the grazing case: clearance_below_linear
+    change(doc["benchmark"])
+    with pytest.raises(SceneError) as caught:
+        parse_scene(doc)
+    assert any(p.startswith(fragment) for p in caught.value.problems), caught.value.problems

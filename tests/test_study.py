@@ -107,3 +107,34 @@ def test_failed_write_keeps_previous_file(golden_run: xr.Dataset, tmp_path: Path
         write_dataset(broken, target)
     assert target.read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["x.nc"]
+
+
+def test_simulated_solutions_join_the_dataset(tmp_path: Path) -> None:
+    """Engines on their own coarse grid: NaN elsewhere; on stable one-impact points they equal pgf; CLI --jobs 2."""
+    from vibroimpact import cli
+
+    doc = small_scene(
+        sweep={"frequency": {"start": 24.0, "stop": 26.0, "step": 0.25}},
+        stop={"clearance": 0.003, "restitution": 0.2},
+        solutions=["pgf", "exact", "momentary"],
+        simulation={"frequency": [24.5, 25.1, 30.0], "start": "pgf", "tolerance": 1e-9, "rtol": 1e-10, "atol": 1e-14},
+        report=False,
+    )
+    path = tmp_path / "sim.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    assert cli.main([str(path), "--out", str(tmp_path / "o"), "--jobs", "2"]) == 0
+    assert not (tmp_path / "o" / ".cache").exists()
+    with xr.open_dataset(tmp_path / "o" / "golden_small.nc") as ds:
+        assert 25.1 in ds["frequency"].values and 30.0 in ds["frequency"].values
+        for engine in ("exact", "momentary"):
+            values = ds["x1_amplitude"].sel(solution=engine)
+            assert int(values.notnull().sum()) == 3
+            for f in (24.5, 25.1):
+                point = ds.sel(solution=engine, frequency=f)
+                assert int(point["converged"]) == 1 and float(point["impacts_per_period"]) == 1.0
+                assert int(point["regime"]) == Regime.ONE_IMPACT
+                assert float(point["x1_amplitude"]) == pytest.approx(float(ds["x1_amplitude"].sel(solution="pgf", frequency=f)), rel=1e-6)
+                assert float(point["impulse"]) == pytest.approx(float(ds["impulse"].sel(solution="pgf", frequency=f)), rel=1e-6)
+            linear_point = ds.sel(solution=engine, frequency=30.0)
+            assert int(linear_point["regime"]) == Regime.LINEAR and float(linear_point["impacts_per_period"]) == 0.0
+        assert int(ds["converged"].sel(solution="pgf", frequency=25.1)) == -1
