@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 from .engines.base import Engine, ImpactProblem
 from .harmonics import HarmonicMeasures, measure
 from .linear import linear_response
-from .pgf import solve_one_impact
+from .pgf import OneImpactSolution, solve_one_impact
 from .validation import require_in_range
 
 __all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "START_MODES"]
@@ -104,7 +104,7 @@ def start_state(problem: ImpactProblem, mode: str) -> tuple[float, NDArray[np.fl
     if mode == "rest":
         return 0.0, np.zeros(4)
     if mode == "pgf":
-        orbit = solve_one_impact(problem.system, np.array([problem.omega]), problem.clearance, problem.restitution, problem.amplitude)
+        orbit = _orbit(problem)
         if orbit.exists[0] and orbit.admissible()[0]:
             # the orbit's time origin is its impact, where the force has phase (phi - psi12); in the problem's
             # time that is t_impact = (phi - psi12 - phase) / w; start half a period after it, away from the impact
@@ -119,6 +119,15 @@ def start_state(problem: ImpactProblem, mode: str) -> tuple[float, NDArray[np.fl
     if state[1] > problem.clearance:  # the linear state would start inside the stop: start at rest instead
         return 0.0, np.zeros(4)
     return 0.0, state
+
+
+def _orbit(problem: ImpactProblem) -> OneImpactSolution:
+    return solve_one_impact(problem.system, np.array([problem.omega]), problem.clearance, problem.restitution, problem.amplitude)
+
+
+def _has_orbit(problem: ImpactProblem) -> bool:
+    orbit = _orbit(problem)
+    return bool(orbit.exists[0] and orbit.admissible()[0])
 
 
 def linear_fits(problem: ImpactProblem) -> bool:
@@ -142,6 +151,8 @@ def steady_state(
     settings : SteadySettings
         Convergence and measurement settings.
     """
+    if start == "pgf" and not _has_orbit(problem):
+        start = "linear"  # where no admissible one-impact orbit exists, the pgf start is the linear one
     if start == "linear" and linear_fits(problem):
         return _linear_answer(problem)
     t, y = start_state(problem, start) if isinstance(start, str) else (float(start[0]), np.asarray(start[1], dtype=float))
