@@ -155,12 +155,7 @@ def _linear(scene: Scene, omega: np.ndarray, delta: np.ndarray, shape: tuple[int
         "impulse": np.zeros(shape),
         "phase": np.full(shape, np.nan),
         "regime": np.where(fits, Regime.LINEAR, Regime.LINEAR_EXCEEDS_CLEARANCE).astype(np.int8),
-        "stable": np.full(shape, -1, dtype=np.int8),
-        "floquet_modulus": np.full(shape, np.nan),
-        "one_impact_x1_amplitude": np.full(shape, np.nan),
-        "one_impact_x2_amplitude": np.full(shape, np.nan),
-        "one_impact_force_amplitude": np.full(shape, np.nan),
-        "one_impact_impulse": np.full(shape, np.nan),
+        **_no_one_impact_orbit(shape),
         "impacts_per_period": np.zeros(shape),
         "converged": np.full(shape, -1, dtype=np.int8),
         "x1_rms": np.abs(response.x1) / np.sqrt(2.0) * np.ones(shape),
@@ -215,6 +210,19 @@ def _pgf(scene: Scene, variant: PgfVariant, omega: np.ndarray, delta: np.ndarray
     return {q: makers[q]() for q in scene.quantities}
 
 
+def _no_one_impact_orbit(shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+    """Values of the variables that describe the PGF orbit, for solutions that have none."""
+    nan = np.full(shape, np.nan)
+    return {
+        "stable": np.full(shape, -1, dtype=np.int8),
+        "floquet_modulus": nan,
+        "one_impact_x1_amplitude": nan,
+        "one_impact_x2_amplitude": nan,
+        "one_impact_force_amplitude": nan,
+        "one_impact_impulse": nan,
+    }
+
+
 def _simulated(scene: Scene, engine: str, shape: tuple[int, ...], jobs: int, cache_dir: Path | None, progress: bool) -> dict[str, np.ndarray]:
     """Steady states of a time-domain engine on the simulation grid; NaN at the other frequencies."""
     assert scene.simulation is not None
@@ -252,12 +260,7 @@ def _simulated(scene: Scene, engine: str, shape: tuple[int, ...], jobs: int, cac
         "impulse": fields["mean_impulse"],
         "phase": np.full(shape, np.nan),
         "regime": regime,
-        "stable": np.full(shape, -1, dtype=np.int8),
-        "floquet_modulus": np.full(shape, np.nan),
-        "one_impact_x1_amplitude": np.full(shape, np.nan),
-        "one_impact_x2_amplitude": np.full(shape, np.nan),
-        "one_impact_force_amplitude": np.full(shape, np.nan),
-        "one_impact_impulse": np.full(shape, np.nan),
+        **_no_one_impact_orbit(shape),
         "impacts_per_period": impacts,
         "converged": np.where(computed, converged, -1).astype(np.int8),
         "x1_rms": fields["x1_rms"],
