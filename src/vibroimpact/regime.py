@@ -16,6 +16,9 @@ __all__ = ["Regime", "classify", "regime_attributes"]
 class Regime(IntEnum):
     """Regime of the steady-state motion at one point of a study."""
 
+    #: The solution was not computed at this point (time-domain solutions off their own frequency grid).
+    NOT_COMPUTED = -1
+
     #: No contact: the linear response stays inside the clearance and no one-impact solution exists.
     LINEAR = 0
     #: Admissible one-impact-per-period motion; the linear response would cross the stop.

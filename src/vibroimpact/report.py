@@ -197,18 +197,27 @@ def _regime_figure(part: xr.Dataset, path: Path) -> Figure:
     clearance_text = _clearance_text(part)
     lines = _lines(part)
     fig, axes = plt.subplots(len(solutions), 1, figsize=(15, 0.5 + 0.45 * len(lines) * len(solutions) + 0.6 * len(solutions)), sharex=True, squeeze=False)
-    cmap = plt.get_cmap("tab10", len(Regime))
+    flags = [r for r in Regime if r is not Regime.NOT_COMPUTED]
+    cmap = plt.get_cmap("tab10", len(flags))
     f = part["frequency"].values
     for ax, solution in zip(axes[:, 0], solutions):
         grid = np.array([line["regime"].sel(solution=solution).values for _, line in lines], dtype=float)
-        extent = (f[0], f[-1], len(lines) - 0.5, -0.5)
-        ax.imshow(grid, aspect="auto", interpolation="nearest", cmap=cmap, vmin=-0.5, vmax=len(Regime) - 0.5, extent=extent)
+        computed = np.any(grid != Regime.NOT_COMPUTED, axis=0)
+        columns = f[computed]
+        # each column spans halfway to its neighbours, so coarse simulation grids show as blocks, not hairlines
+        edges = np.concatenate([[f[0]], (columns[1:] + columns[:-1]) / 2.0, [f[-1]]]) if columns.size else np.array([f[0], f[-1]])
+        values = np.ma.masked_equal(grid[:, computed], Regime.NOT_COMPUTED) if columns.size else np.ma.masked_all((len(lines), 1))
+        ax.pcolormesh(edges, np.arange(len(lines) + 1) - 0.5, values, cmap=cmap, vmin=-0.5, vmax=len(flags) - 0.5, shading="flat")
+        ax.set_ylim(len(lines) - 0.5, -0.5)
         ax.set_yticks(range(len(lines)), [name for name, _ in lines])
         ax.set_title(f"{solution}: regime (Delta = {clearance_text})", fontsize=10)
     axes[-1, 0].set_xlabel("frequency [Hz]")
-    handles = [plt.Rectangle((0, 0), 1, 1, color=cmap(int(r))) for r in Regime]
-    fig.legend(handles, [r.name.lower() for r in Regime], loc="lower center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, -0.08))
-    caption = "Regime of each point (the dataset's 'regime' flag): where each value comes from and where the one-impact solution is missing or inadmissible."
+    handles = [plt.Rectangle((0, 0), 1, 1, color=cmap(int(r))) for r in flags]
+    fig.legend(handles, [r.name.lower() for r in flags], loc="lower center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, -0.02 - 0.12 / len(solutions)))
+    caption = (
+        "Regime of each point (the dataset's 'regime' flag): where each value comes from, where the one-impact solution "
+        "is missing, inadmissible or unstable, and what the simulations found (periodic or irregular impacting motion)."
+    )
     return Figure(_save(fig, path), caption)
 
 

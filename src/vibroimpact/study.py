@@ -246,7 +246,7 @@ def _simulated(scene: Scene, engine: str, shape: tuple[int, ...], jobs: int, cac
     computed = ~np.isnan(fields["converged"])
     converged = fields["converged"] == 1.0
     impacts = fields["impacts_per_period"]
-    regime = np.full(shape, Regime.NONE, dtype=np.int8)
+    regime = np.full(shape, Regime.NOT_COMPUTED, dtype=np.int8)
     regime[computed & ~converged] = Regime.IRREGULAR
     regime[computed & converged] = Regime.PERIODIC_IMPACTS
     regime[computed & converged & (impacts == 0.0)] = Regime.LINEAR
