@@ -55,6 +55,8 @@ def energy_budget(trajectory: Trajectory) -> dict[str, float]:
             w = (b - a) * weights
             work += w @ (p.force(times) * y[:, 2])
             dissipation += w @ (s.b1 * y[:, 2] ** 2 + s.b2 * (y[:, 2] - y[:, 3]) ** 2)
-    loss = float(np.sum(0.5 * s.m2 * (1 - p.restitution**2) * trajectory.impact_velocities**2))
+    before = trajectory.impact_velocities
+    after = before - trajectory.impulses / s.m2  # -R v, or 0 for an impact that ends in sticking
+    loss = float(np.sum(0.5 * s.m2 * (before**2 - after**2)))
     change = float(mechanical_energy(s, trajectory.strobe_states[-1]) - mechanical_energy(s, trajectory.strobe_states[0]))
     return {"change": change, "work": float(work), "dissipation": float(dissipation), "impact_loss": loss}

@@ -118,3 +118,19 @@ def test_processes_give_the_same_results(system: TwoDofSystem) -> None:
     parallel = run_cases(cases, jobs=2, progress=False)
     for a, b in zip(serial, parallel):
         np.testing.assert_array_equal(a["x1"], b["x1"])
+
+
+def test_a_failing_point_costs_only_itself(system: TwoDofSystem, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """An engine failure at one frequency leaves NaN there, flagged, and the other points of the case are kept."""
+    real = simulate.steady_state
+
+    def flaky(engine: object, problem: ImpactProblem, start: object, settings: SteadySettings) -> object:
+        if problem.frequency == 25.0:
+            raise RuntimeError("CVODE failed (simulated)")
+        return real(engine, problem, start, settings)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(simulate, "steady_state", flaky)
+    result = simulate.run_case(_case(system, "sweep_up"))
+    assert list(result["failed"]) == [0.0, 0.0, 1.0, 0.0]
+    assert np.isnan(result["x1"][2]) and np.all(np.isfinite(result["x1"][[0, 1, 3]]))
+    assert "f = 25 Hz failed: CVODE failed (simulated)" in capsys.readouterr().err

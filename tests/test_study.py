@@ -119,7 +119,7 @@ def test_simulated_solutions_join_the_dataset(tmp_path: Path) -> None:
         stop={"clearance": 0.003, "restitution": 0.2},
         solutions=["pgf", "exact", "momentary"],
         simulation={"frequency": [24.5, 25.1, 30.0], "start": "pgf", "tolerance": 1e-9, "rtol": 1e-10, "atol": 1e-14},
-        report=False,
+        report=True,
     )
     path = tmp_path / "sim.yaml"
     path.write_text(yaml.safe_dump(doc))
@@ -139,3 +139,5 @@ def test_simulated_solutions_join_the_dataset(tmp_path: Path) -> None:
             linear_point = ds.sel(solution=engine, frequency=30.0)
             assert int(linear_point["regime"]) == Regime.LINEAR and float(linear_point["impacts_per_period"]) == 0.0
         assert int(ds["converged"].sel(solution="pgf", frequency=25.1)) == -1
+    page = (tmp_path / "o" / "report.html").read_text()
+    assert "Simulation against PGF by band" in page and (tmp_path / "o" / "simulation_x1_amplitude.png").is_file()

@@ -35,7 +35,11 @@ class HarmonicMeasures:
     impacts_per_period : float
         Impacts per period [-].
     mean_impulse : float
-        Mean impulse per impact [N s]; 0 if there was none.
+        Mean impulse per impact [N s]; 0 if there was none. With chattering it depends on how many impacts were
+        resolved before sticking (``EngineSettings.sticking_velocity``): prefer ``impulse_per_period``.
+    impulse_per_period : float
+        Total impulse of the impacts per period [N s]: the impact impulse for one impact per period; with
+        chattering, the converged sum of the sequence (the unresolved rest is negligible).
     periods : int
         Whole periods measured.
     """
@@ -48,6 +52,7 @@ class HarmonicMeasures:
     x2_rms: float
     impacts_per_period: float
     mean_impulse: float
+    impulse_per_period: float
     periods: int
 
     @property
@@ -75,5 +80,6 @@ def measure(trajectory: Trajectory) -> HarmonicMeasures:
         x2_rms=math.sqrt(max(total[4].real, 0.0) / window),
         impacts_per_period=impacts / periods,
         mean_impulse=float(np.mean(trajectory.impulses)) if impacts else 0.0,
+        impulse_per_period=float(np.sum(trajectory.impulses)) / periods,
         periods=periods,
     )

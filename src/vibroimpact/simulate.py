@@ -36,7 +36,7 @@ __all__ = ["ENGINES", "SWEEP_STARTS", "SimulationCase", "CaseResult", "run_cases
 ENGINES: dict[str, Callable[[EngineSettings], Engine]] = {"exact": ExactEngine, "momentary": MomentaryEngine}
 SWEEP_STARTS = ("sweep_up", "sweep_down")
 #: Fields of a case result, one value per frequency.
-FIELDS = ("x1", "x2", "suspension_force", "contact_force", "x1_rms", "x2_rms", "impacts_per_period", "mean_impulse", "converged", "multiplicity", "periods_used", "wall_time")
+FIELDS = ("x1", "x2", "suspension_force", "contact_force", "x1_rms", "x2_rms", "impacts_per_period", "mean_impulse", "impulse_per_period", "converged", "multiplicity", "periods_used", "wall_time", "failed")
 
 
 def make_engine(name: str, settings: EngineSettings) -> Engine:
@@ -104,7 +104,14 @@ def run_case(case: SimulationCase) -> CaseResult:
                 problem = ImpactProblem(case.system, case.clearance, case.restitution, case.amplitude, frequency, phase=phase)
                 start = (0.0, result.end_state)
         started = time.perf_counter()
-        result = steady_state(engine, problem, start, case.steady_settings)
+        try:
+            result = steady_state(engine, problem, start, case.steady_settings)
+        except (RuntimeError, ValueError, ArithmeticError, np.linalg.LinAlgError) as error:
+            # one failing point must not cost the others: it stays NaN, flagged, and a sweep restarts after it
+            print(f"{case.engine}: R = {case.restitution:g}, Delta = {case.clearance:g} m, f = {frequency:g} Hz failed: {error}", file=sys.stderr)
+            out["failed"][i] = 1.0
+            previous = None
+            continue
         m = result.measures
         values = {
             "x1": m.x1,
@@ -115,10 +122,12 @@ def run_case(case: SimulationCase) -> CaseResult:
             "x2_rms": m.x2_rms,
             "impacts_per_period": m.impacts_per_period,
             "mean_impulse": m.mean_impulse,
+            "impulse_per_period": m.impulse_per_period,
             "converged": float(result.converged),
             "multiplicity": float(result.multiplicity),
             "periods_used": float(result.periods_used),
             "wall_time": time.perf_counter() - started,
+            "failed": 0.0,
         }
         for name, value in values.items():
             out[name][i] = value
@@ -156,7 +165,10 @@ def run_cases(cases: list[SimulationCase], jobs: int = 1, cache_dir: Path | None
             for future in as_completed(futures):
                 finish(futures[future], future.result())
     bar.close()
-    return [r for r in results if r is not None]
+    finished = [r for r in results if r is not None]
+    if len(finished) != len(cases):  # cannot happen: every case either came from the cache or was run
+        raise RuntimeError(f"{len(cases) - len(finished)} simulation cases have no result")
+    return finished
 
 
 class _Progress:
@@ -203,6 +215,8 @@ def _load(cache_dir: Path, case: SimulationCase) -> CaseResult | None:
     if not path.is_file():
         return None
     with np.load(path) as stored:
+        if not set(FIELDS) <= set(stored.files):
+            return None  # written by an older version: run the case again
         return {name: stored[name] for name in FIELDS}
 
 

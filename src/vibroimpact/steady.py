@@ -220,6 +220,7 @@ def _linear_answer(problem: ImpactProblem) -> SteadyResult:
         x2_rms=abs(x2) / math.sqrt(2.0),
         impacts_per_period=0.0,
         mean_impulse=0.0,
+        impulse_per_period=0.0,
         periods=0,
     )
     _t, state = start_state(problem, "linear")

@@ -133,7 +133,8 @@ class Trajectory:
     impact_velocities : ndarray
         Absorber velocity just before each impact, > 0 [m s-1].
     impulses : ndarray
-        M2 (1 + R) X2'(t-) of each impact [N s].
+        M2 (X2'(t-) - X2'(t+)) of each impact [N s]: M2 (1 + R) X2'(t-), or M2 X2'(t-) for the impact that ends a
+        chattering sequence in sticking.
     segments : ndarray, shape (s, 3)
         Rows (start [s], end [s], mode): ``MODE_FREE`` flight or ``MODE_STUCK`` (absorber held at the stop).
     segment_states : ndarray, shape (s, 4)

@@ -122,12 +122,13 @@ class EventLoopEngine(ABC):
         if periods < 0:
             raise ValueError(f"periods = {periods} is out of range: allowed [0, inf)")
         state = np.asarray(state, dtype=float)
-        if state[1] > problem.clearance:
+        length_scale = problem.clearance + problem.velocity_scale() / problem.omega
+        if state[1] > problem.clearance + 1e-12 * length_scale:
             raise ValueError(f"initial X2 = {state[1]!r} m penetrates the stop (clearance {problem.clearance!r} m)")
         model = Model(problem, moments)
         y = np.zeros(model.size)
         y[:4] = state
-        y[1] -= problem.clearance  # integrate the gap u = X2 - Delta
+        y[1] = min(y[1] - problem.clearance, 0.0)  # integrate the gap u = X2 - Delta; round-off above is the stop
         model.stuck = bool(y[1] == 0.0 and y[3] == 0.0 and self._pushed(model, t_start, y))
         self._begin(model)
         rec = _Record(problem, moments)
@@ -139,8 +140,17 @@ class EventLoopEngine(ABC):
             boundary = t_start + k * problem.period
             impacts = events = 0
             while True:
-                stop, t, y = self._advance(model, t, y, boundary)
+                if not model.stuck and y[1] >= 0.0 and y[3] > 0.0:
+                    # at the stop and moving into it (a start there, or an impact exactly on a period boundary):
+                    # integrators do not report a root at their initial time, so the contact is applied here
+                    stop = Stop.CONTACT
+                elif boundary - t <= 4.0 * math.ulp(boundary):
+                    stop, t = Stop.BOUNDARY, boundary  # nothing left of this period to integrate
+                else:
+                    stop, t, y = self._advance(model, t, y, boundary)
                 if stop is Stop.BOUNDARY:
+                    if not model.stuck and y[1] >= 0.0 and y[3] > 0.0:
+                        continue  # an impact exactly at the boundary is applied before the strobe
                     break
                 events += 1
                 if events > 10 * self.settings.max_impacts_per_period:
@@ -153,15 +163,13 @@ class EventLoopEngine(ABC):
                     y = y.copy()
                     y[1] = 0.0
                     velocity = max(y[3], 0.0)
-                    if velocity > 0.0:
-                        rec.impact(t, velocity)
                     chattering = velocity <= sticking_velocity or impacts > self.settings.max_impacts_per_period or problem.restitution == 0.0
-                    if chattering and self._pushed(model, t, y):
-                        y[3] = 0.0
-                        model.stuck = True
-                        rec.stats["sticks"] += 1
-                    else:
-                        y[3] = -problem.restitution * velocity
+                    model.stuck = chattering and self._pushed(model, t, y)
+                    after = 0.0 if model.stuck else -problem.restitution * velocity
+                    if velocity > 0.0:
+                        rec.impact(t, velocity, problem.system.m2 * (velocity - after))  # M2 (1 + R) v, or M2 v if it sticks
+                    y[3] = after
+                    rec.stats["sticks"] += int(model.stuck)
                 rec.segment(t, y, model.stuck)
             rec.strobe(t, y)
         rec.stats.update(self._counters())
@@ -192,18 +200,20 @@ class _Record:
     strobe_states: list[NDArray[np.float64]] = field(default_factory=list)
     impact_times: list[float] = field(default_factory=list)
     impact_velocities: list[float] = field(default_factory=list)
+    impulses: list[float] = field(default_factory=list)
     segments: list[tuple[float, int]] = field(default_factory=list)
     segment_states: list[NDArray[np.float64]] = field(default_factory=list)
     period_moments: list[NDArray[np.complex128]] = field(default_factory=list)
     impulse_moment: complex = 0j
     stats: dict[str, int] = field(default_factory=lambda: {"impacts": 0, "sticks": 0, "releases": 0})
 
-    def impact(self, t: float, velocity: float) -> None:
-        p = self.problem
+    def impact(self, t: float, velocity: float, impulse: float) -> None:
+        omega = self.problem.omega
         self.impact_times.append(t)
         self.impact_velocities.append(velocity)
+        self.impulses.append(impulse)
         self.stats["impacts"] += 1
-        self.impulse_moment += p.system.m2 * (1.0 + p.restitution) * velocity * complex(math.cos(p.omega * t), -math.sin(p.omega * t))
+        self.impulse_moment += impulse * complex(math.cos(omega * t), -math.sin(omega * t))
 
     def _physical(self, y: NDArray[np.float64]) -> NDArray[np.float64]:
         """(X1, u, X1', X2', ...) -> (X1, X2, X1', X2', ...)."""
@@ -230,15 +240,13 @@ class _Record:
         ends = np.append(starts[1:], self.strobe_times[-1])
         keep = ends > starts
         rows = np.column_stack([starts, ends, [s[1] for s in self.segments]])[keep]
-        velocities = np.array(self.impact_velocities)
-        p = self.problem
         return Trajectory(
-            problem=p,
+            problem=self.problem,
             strobe_times=np.array(self.strobe_times),
             strobe_states=np.array(self.strobe_states)[:, :4],
             impact_times=np.array(self.impact_times),
-            impact_velocities=velocities,
-            impulses=p.system.m2 * (1.0 + p.restitution) * velocities,
+            impact_velocities=np.array(self.impact_velocities),
+            impulses=np.array(self.impulses),
             segments=rows.reshape(-1, 3),
             segment_states=np.array(self.segment_states).reshape(-1, 4)[keep],
             moments=np.array(self.period_moments, dtype=complex).reshape(-1, 5),

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .base import MODE_FREE, MODE_STUCK, EngineSettings, ImpactProblem, Trajectory
-from .linear_flow import HarmonicLinearFlow, Observable, Piece, first_crossing, gauss_legendre
+from .linear_flow import HarmonicLinearFlow, Observable, Piece, escape_step, first_crossing, gauss_legendre
 
 __all__ = ["ExactEngine"]
 
@@ -91,14 +91,16 @@ class _Run:
     def go(self, y: NDArray[np.float64], t: float, periods: int) -> Trajectory:
         p, rec = self.problem, self.rec
         y = y.copy()
-        if y[1] > p.clearance:
+        if y[1] > p.clearance + 1e-12 * self.length_scale:
             raise ValueError(f"initial X2 = {y[1]!r} m penetrates the stop (clearance {p.clearance!r} m)")
+        y[1] = min(y[1], p.clearance)  # round-off above the stop is the stop
         stuck = bool(y[1] == p.clearance and y[3] == 0.0 and self._pushed(t, y))
         leaving = y[1] == p.clearance
         origin = t
         rec.strobe_times.append(t)
         rec.strobe_states.append(y.copy())
         k, piece, impacts_this_period, events_this_period = 1, None, 0, 0
+        events_at = t if leaving else math.nan  # time of the last event: a search starting there leaves the surface
         while k <= periods:
             boundary = origin + k * p.period
             fresh = piece is None
@@ -113,6 +115,8 @@ class _Run:
             self._moments(piece, t, t_end, MODE_STUCK if stuck else MODE_FREE)
             y, t = self._state(piece, t_end, stuck), t_end
             if t_event is None:  # period boundary: strobe, keep the piece
+                # a search cut short by the boundary right after an event there must still start by leaving the surface
+                leaving = t_end - events_at <= 1e-9 * p.period
                 rec.strobe_times.append(t)
                 rec.strobe_states.append(y.copy())
                 if rec.moments:
@@ -121,6 +125,7 @@ class _Run:
                 k, impacts_this_period, events_this_period = k + 1, 0, 0
                 continue
             events_this_period += 1
+            events_at = t
             if events_this_period > 10 * self.settings.max_impacts_per_period:
                 raise RuntimeError(f"no progress at t = {t!r} s: {events_this_period} events in one period")
             if stuck:
@@ -138,7 +143,7 @@ class _Run:
         value = release.derivatives(t, 1)[0]
         if abs(value) > self.force_tolerance:
             return value < 0.0
-        return first_crossing(release, t, math.inf, self.force_tolerance, leaving=True) != t
+        return escape_step(release, t) is not None
 
     def _piece(self, t: float, y: NDArray[np.float64], stuck: bool) -> tuple[Piece, Observable]:
         """Closed-form motion from (t, y) and the function whose first zero ends it (gap, or holding force)."""
@@ -153,7 +158,9 @@ class _Run:
         if stuck:
             x1, v1 = piece.state(t)
             return np.array([x1, self.problem.clearance, v1, 0.0])
-        return piece.state(t)
+        y = piece.state(t)
+        y[1] = min(y[1], self.problem.clearance)  # round-off above the stop is the stop
+        return y
 
     def _contact(self, t: float, y: NDArray[np.float64], impacts_this_period: int) -> bool:
         """Apply the contact at time t to ``y`` in place; return True if the absorber sticks."""
@@ -162,20 +169,19 @@ class _Run:
         y[1] = p.clearance
         velocity = y[3] if y[3] > self.resolution_velocity else 0.0  # below round-off: a touch, not an impact
         chattering = velocity <= self.sticking_velocity or impacts_this_period > self.settings.max_impacts_per_period or p.restitution == 0.0
+        sticks = chattering and self._pushed(t, y)
+        after = 0.0 if sticks else -p.restitution * velocity
         if velocity > 0.0:
-            impulse = p.system.m2 * (1.0 + p.restitution) * velocity
+            impulse = p.system.m2 * (velocity - after)  # M2 (1 + R) v, or M2 v when the absorber sticks
             rec.impact_times.append(t)
             rec.impact_velocities.append(velocity)
             rec.impulses.append(impulse)
             rec.stats["impacts"] += 1
             if rec.moments:
                 rec.current[2] += impulse * np.exp(-1j * p.omega * t)
-        if chattering and self._pushed(t, y):
-            y[3] = 0.0
-            rec.stats["sticks"] += 1
-            return True
-        y[3] = -p.restitution * velocity
-        return False
+        y[3] = after
+        rec.stats["sticks"] += int(sticks)
+        return sticks
 
     # --------------------------------------------------------------- moments
     def _segment(self, t0: float, t1: float, mode: int, y0: NDArray[np.float64], fresh: bool) -> None:

@@ -20,7 +20,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["HarmonicLinearFlow", "Piece", "Observable", "first_crossing", "gauss_legendre"]
+__all__ = ["HarmonicLinearFlow", "Piece", "Observable", "first_crossing", "escape_step", "gauss_legendre"]
 
 
 class HarmonicLinearFlow:
@@ -164,8 +164,10 @@ def first_crossing(h: Observable, t_from: float, t_to: float, tolerance: float, 
     tolerance = max(tolerance, 1e-15 * (sum(abs(a) for a in h.amplitudes) + abs(h.harmonic) + abs(h.constant)))
     t = t_from
     if leaving and h.derivatives(t, 1)[0] >= -tolerance:  # at the surface: the start must not count as a root
-        step = _escape_step(h, t)
+        step = escape_step(h, t)
         if step is None:
+            if h.bound(t, 0) <= tolerance:
+                return None  # h is zero from here on (at rest on the surface, no forcing): nothing crosses
             return t_from  # not leaving after all: the caller decides (contact or sticking)
         t += step
         if t >= t_to:
@@ -181,7 +183,8 @@ def first_crossing(h: Observable, t_from: float, t_to: float, tolerance: float, 
         trial = 2.0 * step
         step = max(step, min(_quadratic_step(h0, h1, max(h2 + jerk * trial / 3.0, 0.0)), trial))
         if t + step >= t_to:
-            return None
+            # h < 0 on [t, t_to); a root exactly at t_to (an impact on a period boundary) is still a root
+            return t_to if h.derivatives(t_to, 1)[0] >= -tolerance else None
         if t + step == t:  # converged to the resolution of the time axis
             return t
         t += step
@@ -194,7 +197,7 @@ def _quadratic_step(h0: float, h1: float, curvature: float) -> float:
     return 2.0 * -h0 / (h1 + math.sqrt(h1 * h1 - 2.0 * curvature * h0))
 
 
-def _escape_step(h: Observable, t: float) -> float | None:
+def escape_step(h: Observable, t: float) -> float | None:
     """A step over which h stays < 0 when h(t) = 0 and h leaves the surface; ``None`` if it does not leave.
 
     With derivatives h^(1) = ... = h^(k-1) = 0 and h^(k) < 0, ``h(t + s) <= h^(k) s^k / k! + M s^(k+1) / (k+1)!`` with
