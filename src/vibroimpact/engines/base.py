@@ -178,6 +178,68 @@ class Trajectory:
         return float(np.sum(self.segments[stuck, 1] - self.segments[stuck, 0]))
 
 
+class TrajectoryBuilder:
+    """Accumulates what an engine finds while it integrates; :meth:`build` freezes it into a :class:`Trajectory`.
+
+    Engines report physical states (X1, X2, X1', X2'), segment starts, impacts, moments of the running period and
+    strobes; segment ends are the next segment's start (or the last strobe), so zero-length segments vanish.
+    """
+
+    def __init__(self, problem: ImpactProblem, moments: bool) -> None:
+        self.problem, self.moments = problem, moments
+        self._strobe_times: list[float] = []
+        self._strobe_states: list[NDArray[np.float64]] = []
+        self._impacts: list[tuple[float, float, float]] = []
+        self._segments: list[tuple[float, int]] = []
+        self._segment_states: list[NDArray[np.float64]] = []
+        self._period_moments: list[NDArray[np.complex128]] = []
+        self._current = np.zeros(5, dtype=complex)
+        self.stats: dict[str, int] = {"impacts": 0, "sticks": 0, "releases": 0}
+
+    def impact(self, t: float, velocity: float, impulse: float) -> None:
+        """An impact at time t [s] with pre-impact velocity [m s-1] and impulse [N s] (its Fourier term included)."""
+        self._impacts.append((t, velocity, impulse))
+        self.stats["impacts"] += 1
+        if self.moments:
+            self._current[2] += impulse * complex(math.cos(self.problem.omega * t), -math.sin(self.problem.omega * t))
+
+    def segment(self, t: float, mode: int, state: NDArray[np.float64]) -> None:
+        """A new segment (``MODE_FREE`` or ``MODE_STUCK``) starts at time t [s] in ``state``."""
+        self._segments.append((t, mode))
+        self._segment_states.append(np.array(state[:4], dtype=float))
+
+    def add_moments(self, values: NDArray[np.complex128]) -> None:
+        """Add integrals (X1, X2, holding force times e^{-jwt}; X1^2, X2^2) to the running period."""
+        self._current += values
+
+    def strobe(self, t: float, state: NDArray[np.float64]) -> None:
+        """A period boundary at time t [s]: record the state and close the running period's moments."""
+        if self._strobe_times and self.moments:
+            self._period_moments.append(self._current)
+            self._current = np.zeros(5, dtype=complex)
+        self._strobe_times.append(t)
+        self._strobe_states.append(np.array(state[:4], dtype=float))
+
+    def build(self, stats: dict[str, int] | None = None) -> Trajectory:
+        """The immutable trajectory, with ``stats`` merged into the builder's counters."""
+        starts = np.array([s[0] for s in self._segments])
+        ends = np.append(starts[1:], self._strobe_times[-1]) if starts.size else starts
+        keep = ends > starts
+        impacts = np.array(self._impacts, dtype=float).reshape(-1, 3)
+        return Trajectory(
+            problem=self.problem,
+            strobe_times=np.array(self._strobe_times),
+            strobe_states=np.array(self._strobe_states).reshape(-1, 4),
+            impact_times=impacts[:, 0].copy(),
+            impact_velocities=impacts[:, 1].copy(),
+            impulses=impacts[:, 2].copy(),
+            segments=np.column_stack([starts, ends, [s[1] for s in self._segments]]).reshape(-1, 3)[keep],
+            segment_states=np.array(self._segment_states).reshape(-1, 4)[keep],
+            moments=np.array(self._period_moments, dtype=complex).reshape(-1, 5),
+            stats=self.stats | (stats or {}),
+        )
+
+
 class Engine(Protocol):
     """A time-domain solver of an :class:`ImpactProblem`."""
 

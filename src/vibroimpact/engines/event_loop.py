@@ -18,7 +18,7 @@ from enum import Enum
 import numpy as np
 from numpy.typing import NDArray
 
-from .base import MODE_FREE, MODE_STUCK, EngineSettings, ImpactProblem, Trajectory
+from .base import MODE_FREE, MODE_STUCK, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
 
 __all__ = ["EventLoopEngine", "Stop", "Model"]
 
@@ -131,9 +131,14 @@ class EventLoopEngine(ABC):
         y[1] = min(y[1] - problem.clearance, 0.0)  # integrate the gap u = X2 - Delta; round-off above is the stop
         model.stuck = bool(y[1] == 0.0 and y[3] == 0.0 and self._pushed(model, t_start, y))
         self._begin(model)
-        rec = _Record(problem, moments)
-        rec.strobe(t_start, y)
-        rec.segment(t_start, y, model.stuck)
+        rec = TrajectoryBuilder(problem, moments)
+
+        def physical(y: NDArray[np.float64]) -> NDArray[np.float64]:
+            return np.array([y[0], y[1] + problem.clearance, y[2], y[3]])  # the gap u back to X2
+
+        rec.strobe(t_start, physical(y))
+        rec.segment(t_start, MODE_STUCK if model.stuck else MODE_FREE, physical(y))
+        quadratures = y[4:].copy()
         t = float(t_start)
         sticking_velocity = self.settings.sticking_velocity * problem.velocity_scale()
         for k in range(1, periods + 1):
@@ -170,11 +175,13 @@ class EventLoopEngine(ABC):
                         rec.impact(t, velocity, problem.system.m2 * (velocity - after))  # M2 (1 + R) v, or M2 v if it sticks
                     y[3] = after
                     rec.stats["sticks"] += int(model.stuck)
-                rec.segment(t, y, model.stuck)
-            rec.strobe(t, y)
-        rec.stats.update(self._counters())
-        rec.stats["rhs_calls"] = model.rhs_calls
-        return rec.trajectory()
+                rec.segment(t, MODE_STUCK if model.stuck else MODE_FREE, physical(y))
+            if moments:
+                q = y[4:] - quadratures
+                quadratures = y[4:].copy()
+                rec.add_moments(np.array([q[0] - 1j * q[1], q[2] - 1j * q[3], q[4] - 1j * q[5], q[6], q[7]]))
+            rec.strobe(t, physical(y))
+        return rec.build(self._counters() | {"rhs_calls": model.rhs_calls})
 
     def _pushed(self, model: Model, t: float, y: NDArray[np.float64]) -> bool:
         """The stop must push to hold the absorber: holding force > 0, or = 0 and rising."""
@@ -188,67 +195,3 @@ class EventLoopEngine(ABC):
         rate = model.derivative(t, y)
         model.stuck = was
         return bool(p.system.b2 * rate[2] + p.system.k2 * rate[0] > 0.0)
-
-
-@dataclass
-class _Record:
-    """Mutable accumulators of an event-loop integration."""
-
-    problem: ImpactProblem
-    moments: bool
-    strobe_times: list[float] = field(default_factory=list)
-    strobe_states: list[NDArray[np.float64]] = field(default_factory=list)
-    impact_times: list[float] = field(default_factory=list)
-    impact_velocities: list[float] = field(default_factory=list)
-    impulses: list[float] = field(default_factory=list)
-    segments: list[tuple[float, int]] = field(default_factory=list)
-    segment_states: list[NDArray[np.float64]] = field(default_factory=list)
-    period_moments: list[NDArray[np.complex128]] = field(default_factory=list)
-    impulse_moment: complex = 0j
-    stats: dict[str, int] = field(default_factory=lambda: {"impacts": 0, "sticks": 0, "releases": 0})
-
-    def impact(self, t: float, velocity: float, impulse: float) -> None:
-        omega = self.problem.omega
-        self.impact_times.append(t)
-        self.impact_velocities.append(velocity)
-        self.impulses.append(impulse)
-        self.stats["impacts"] += 1
-        self.impulse_moment += impulse * complex(math.cos(omega * t), -math.sin(omega * t))
-
-    def _physical(self, y: NDArray[np.float64]) -> NDArray[np.float64]:
-        """(X1, u, X1', X2', ...) -> (X1, X2, X1', X2', ...)."""
-        out = y.copy()
-        out[1] += self.problem.clearance
-        return out
-
-    def segment(self, t: float, y: NDArray[np.float64], stuck: bool) -> None:
-        self.segments.append((t, MODE_STUCK if stuck else MODE_FREE))
-        self.segment_states.append(self._physical(y[:4]))
-
-    def strobe(self, t: float, y: NDArray[np.float64]) -> None:
-        if self.strobe_states and self.moments:
-            q = y[4:] - self.strobe_states[-1][4:]
-            self.period_moments.append(
-                np.array([q[0] - 1j * q[1], q[2] - 1j * q[3], q[4] - 1j * q[5] + self.impulse_moment, q[6], q[7]])
-            )
-            self.impulse_moment = 0j
-        self.strobe_times.append(t)
-        self.strobe_states.append(self._physical(y))
-
-    def trajectory(self) -> Trajectory:
-        starts = np.array([s[0] for s in self.segments])
-        ends = np.append(starts[1:], self.strobe_times[-1])
-        keep = ends > starts
-        rows = np.column_stack([starts, ends, [s[1] for s in self.segments]])[keep]
-        return Trajectory(
-            problem=self.problem,
-            strobe_times=np.array(self.strobe_times),
-            strobe_states=np.array(self.strobe_states)[:, :4],
-            impact_times=np.array(self.impact_times),
-            impact_velocities=np.array(self.impact_velocities),
-            impulses=np.array(self.impulses),
-            segments=rows.reshape(-1, 3),
-            segment_states=np.array(self.segment_states).reshape(-1, 4)[keep],
-            moments=np.array(self.period_moments, dtype=complex).reshape(-1, 5),
-            stats=dict(self.stats),
-        )

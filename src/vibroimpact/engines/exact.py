@@ -11,34 +11,15 @@ B2 X1' + K2 (X1 - Delta) turns negative (found by the same root search).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-
 import numpy as np
 from numpy.typing import NDArray
 
-from .base import MODE_FREE, MODE_STUCK, EngineSettings, ImpactProblem, Trajectory
+from .base import MODE_FREE, MODE_STUCK, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
 from .linear_flow import HarmonicLinearFlow, Observable, Piece, escape_step, first_crossing, gauss_legendre
 
 __all__ = ["ExactEngine"]
 
 _GAP = np.array([0.0, 1.0, 0.0, 0.0])
-
-
-@dataclass
-class _Recorder:
-    """Mutable accumulators while integrating; frozen into a :class:`Trajectory` at the end."""
-
-    moments: bool
-    strobe_times: list[float] = field(default_factory=list)
-    strobe_states: list[NDArray[np.float64]] = field(default_factory=list)
-    impact_times: list[float] = field(default_factory=list)
-    impact_velocities: list[float] = field(default_factory=list)
-    impulses: list[float] = field(default_factory=list)
-    segments: list[tuple[float, float, int]] = field(default_factory=list)
-    segment_states: list[NDArray[np.float64]] = field(default_factory=list)
-    period_moments: list[NDArray[np.complex128]] = field(default_factory=list)
-    current: NDArray[np.complex128] = field(default_factory=lambda: np.zeros(5, dtype=complex))
-    stats: dict[str, int] = field(default_factory=lambda: {"steps": 0, "events": 0, "impacts": 0, "sticks": 0, "releases": 0})
 
 
 class ExactEngine:
@@ -53,12 +34,12 @@ class ExactEngine:
         """Integrate ``periods`` whole periods from ``state`` (X1, X2, X1', X2') at ``t_start`` [s]."""
         if periods < 0:
             raise ValueError(f"periods = {periods} is out of range: allowed [0, inf)")
-        run = _Run(problem, self.settings, _Recorder(moments))
+        run = _Run(problem, self.settings, TrajectoryBuilder(problem, moments))
         return run.go(np.asarray(state, dtype=float), float(t_start), int(periods))
 
     def dense(self, trajectory: Trajectory, times: NDArray[np.float64]) -> NDArray[np.float64]:
         """States at arbitrary ``times`` inside a trajectory, shape (n, 4), exact (from its segments)."""
-        run = _Run(trajectory.problem, self.settings, _Recorder(False))
+        run = _Run(trajectory.problem, self.settings, TrajectoryBuilder(trajectory.problem, False))
         times = np.asarray(times, dtype=float)
         index = np.clip(np.searchsorted(trajectory.segments[:, 0], times, side="right") - 1, 0, len(trajectory.segments) - 1)
         out = np.empty((times.size, 4))
@@ -73,8 +54,9 @@ class ExactEngine:
 class _Run:
     """One integration: the event loop of the exact engine."""
 
-    def __init__(self, problem: ImpactProblem, settings: EngineSettings, recorder: _Recorder) -> None:
-        self.problem, self.settings, self.rec = problem, settings, recorder
+    def __init__(self, problem: ImpactProblem, settings: EngineSettings, builder: TrajectoryBuilder) -> None:
+        self.problem, self.settings, self.rec = problem, settings, builder
+        self.steps = self.events = 0
         s = problem.system
         self.free = HarmonicLinearFlow(s.state_matrix, np.array([0, 0, problem.amplitude * np.exp(1j * problem.phase) / s.m1, 0]), np.zeros(4), problem.omega)
         stuck_matrix = np.array([[0.0, 1.0], [-(s.k1 + s.k2) / s.m1, -(s.b1 + s.b2) / s.m1]])
@@ -97,8 +79,7 @@ class _Run:
         stuck = bool(y[1] == p.clearance and y[3] == 0.0 and self._pushed(t, y))
         leaving = y[1] == p.clearance
         origin = t
-        rec.strobe_times.append(t)
-        rec.strobe_states.append(y.copy())
+        rec.strobe(t, y)
         k, piece, impacts_this_period, events_this_period = 1, None, 0, 0
         events_at = t if leaving else math.nan  # time of the last event: a search starting there leaves the surface
         while k <= periods:
@@ -106,22 +87,19 @@ class _Run:
             fresh = piece is None
             if piece is None:  # a new closed-form piece after each event
                 piece, watch = self._piece(t, y, stuck)
-            rec.stats["steps"] += 1
+            self.steps += 1
             tolerance = self.force_tolerance if stuck else self.tolerance
             t_event = first_crossing(watch, t, boundary, tolerance, leaving=leaving)
             leaving = False
             t_end = boundary if t_event is None else t_event
-            self._segment(t, t_end, MODE_STUCK if stuck else MODE_FREE, y, fresh)
+            if fresh:
+                rec.segment(t, MODE_STUCK if stuck else MODE_FREE, y)
             self._moments(piece, t, t_end, MODE_STUCK if stuck else MODE_FREE)
             y, t = self._state(piece, t_end, stuck), t_end
             if t_event is None:  # period boundary: strobe, keep the piece
                 # a search cut short by the boundary right after an event there must still start by leaving the surface
                 leaving = t_end - events_at <= 1e-9 * p.period
-                rec.strobe_times.append(t)
-                rec.strobe_states.append(y.copy())
-                if rec.moments:
-                    rec.period_moments.append(rec.current)
-                    rec.current = np.zeros(5, dtype=complex)
+                rec.strobe(t, y)
                 k, impacts_this_period, events_this_period = k + 1, 0, 0
                 continue
             events_this_period += 1
@@ -135,7 +113,7 @@ class _Run:
                 impacts_this_period += 1
                 stuck = self._contact(t, y, impacts_this_period)
             piece, leaving = None, True  # leaving the stop, or the free flight into sticking
-        return self._trajectory()
+        return rec.build({"steps": self.steps, "events": self.events})
 
     def _pushed(self, t: float, y: NDArray[np.float64]) -> bool:
         """Would the stop have to push to hold the absorber at rest here (holding force > 0, or = 0 and rising)?"""
@@ -165,36 +143,19 @@ class _Run:
     def _contact(self, t: float, y: NDArray[np.float64], impacts_this_period: int) -> bool:
         """Apply the contact at time t to ``y`` in place; return True if the absorber sticks."""
         p, rec = self.problem, self.rec
-        rec.stats["events"] += 1
+        self.events += 1
         y[1] = p.clearance
         velocity = y[3] if y[3] > self.resolution_velocity else 0.0  # below round-off: a touch, not an impact
         chattering = velocity <= self.sticking_velocity or impacts_this_period > self.settings.max_impacts_per_period or p.restitution == 0.0
         sticks = chattering and self._pushed(t, y)
         after = 0.0 if sticks else -p.restitution * velocity
         if velocity > 0.0:
-            impulse = p.system.m2 * (velocity - after)  # M2 (1 + R) v, or M2 v when the absorber sticks
-            rec.impact_times.append(t)
-            rec.impact_velocities.append(velocity)
-            rec.impulses.append(impulse)
-            rec.stats["impacts"] += 1
-            if rec.moments:
-                rec.current[2] += impulse * np.exp(-1j * p.omega * t)
+            rec.impact(t, velocity, p.system.m2 * (velocity - after))  # M2 (1 + R) v, or M2 v when the absorber sticks
         y[3] = after
         rec.stats["sticks"] += int(sticks)
         return sticks
 
     # --------------------------------------------------------------- moments
-    def _segment(self, t0: float, t1: float, mode: int, y0: NDArray[np.float64], fresh: bool) -> None:
-        """Record [t0, t1] in ``mode``; a piece continued across a period boundary extends its segment."""
-        rec = self.rec
-        if t1 <= t0:
-            return
-        if not fresh and rec.segments:
-            rec.segments[-1] = (rec.segments[-1][0], t1, mode)
-        else:
-            rec.segments.append((t0, t1, mode))
-            rec.segment_states.append(y0.copy())
-
     def _moments(self, piece: Piece, t0: float, t1: float, mode: int) -> None:
         """Add the segment's Fourier and square integrals (Gauss-Legendre, exact for smooth pieces)."""
         rec = self.rec
@@ -213,19 +174,4 @@ class _Run:
         else:
             x1, x2 = states[:, 0], np.full(times.shape, p.clearance)
             contact = np.asarray(p.holding_force(states[:, 0], states[:, 1]))
-        rec.current += np.array([w @ (x1 * phasor), w @ (x2 * phasor), w @ (contact * phasor), w @ x1**2, w @ x2**2])
-
-    def _trajectory(self) -> Trajectory:
-        rec = self.rec
-        return Trajectory(
-            problem=self.problem,
-            strobe_times=np.array(rec.strobe_times),
-            strobe_states=np.array(rec.strobe_states),
-            impact_times=np.array(rec.impact_times),
-            impact_velocities=np.array(rec.impact_velocities),
-            impulses=np.array(rec.impulses),
-            segments=np.array(rec.segments, dtype=float).reshape(-1, 3),
-            segment_states=np.array(rec.segment_states, dtype=float).reshape(-1, 4),
-            moments=np.array(rec.period_moments, dtype=complex).reshape(-1, 5),
-            stats=dict(rec.stats),
-        )
+        rec.add_moments(np.array([w @ (x1 * phasor), w @ (x2 * phasor), w @ (contact * phasor), w @ x1**2, w @ x2**2]))
