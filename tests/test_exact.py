@@ -36,6 +36,7 @@ def test_leaves_unstable_pgf_orbit() -> None:
     assert np.abs(trajectory.strobe_states[-1] - state).max() > 1e-3 * np.abs(state).max()
 
 
+@pytest.mark.timeout(60)
 def test_far_clearance_is_the_linear_solution() -> None:
     """No contact ever: the strobe states are the linear steady state's, to round-off."""
     problem = ImpactProblem(TwoDofSystem(m1=1.0, m2=0.1, k1=25_000.0, k2=4_300.0, b1=0.8, b2=0.08), 1.0, 0.2, PAPER_AMPLITUDE, 23.0)
@@ -45,6 +46,7 @@ def test_far_clearance_is_the_linear_solution() -> None:
     np.testing.assert_allclose(trajectory.strobe_states, np.broadcast_to(start, trajectory.strobe_states.shape), atol=1e-12 * np.abs(start).max())
 
 
+@pytest.mark.timeout(60)
 @pytest.mark.parametrize("margin", [-5e-10, 5e-10])
 def test_grazing_contact_is_never_missed(margin: float, system: TwoDofSystem) -> None:
     """The linear orbit's maximum X2 lies 0.5 nm beyond (or short of) the stop: one impact (or none) per period."""
@@ -72,6 +74,7 @@ def test_energy_balance(frequency: float, restitution: float) -> None:
     assert budget["change"] == pytest.approx(balance, abs=1e-9 * budget["work"])
 
 
+@pytest.mark.timeout(60)
 def test_elastic_impacts_without_damping_conserve_energy() -> None:
     """R = 1, B1 = B2 = 0: energy changes only by the work of the force; impacts lose nothing."""
     undamped = TwoDofSystem(m1=1.0, m2=0.1, k1=25_000.0, k2=4_300.0)
@@ -83,6 +86,7 @@ def test_elastic_impacts_without_damping_conserve_energy() -> None:
     assert budget["change"] == pytest.approx(budget["work"], abs=1e-10 * mechanical_energy(undamped, trajectory.strobe_states).max())
 
 
+@pytest.mark.timeout(60)
 @pytest.mark.parametrize("restitution", [0.0, 0.05, 0.3])
 def test_chattering_ends_in_sticking_and_release(restitution: float, system: TwoDofSystem) -> None:
     """Quasi-static forcing (10 Hz) with Delta = 0.1 mm below the primary mass's 0.47 mm motion: the spring presses
@@ -102,6 +106,7 @@ def test_chattering_ends_in_sticking_and_release(restitution: float, system: Two
     assert everywhere[:, 1].max() <= clearance * (1 + 1e-12)
 
 
+@pytest.mark.timeout(60)
 def test_zero_clearance(system: TwoDofSystem) -> None:
     """Delta = 0: the stop at the static equilibrium; impacts every period, X2 <= 0."""
     problem = ImpactProblem(system, 0.0, 0.5, PAPER_AMPLITUDE, 25.0)
@@ -153,6 +158,7 @@ def _start_at_impact(frequency: float, restitution: float) -> tuple[ImpactProble
     return problem, np.array([orbit.x1(zero)[0, 0], orbit.x2(zero)[0, 0], orbit.x1(zero, 1)[0, 0], orbit.x2(zero, 1)[0, 0]])
 
 
+@pytest.mark.timeout(60)
 @pytest.mark.parametrize("engine", ["exact", "momentary"])
 def test_impacts_on_period_boundaries(engine: str) -> None:
     """One impact per period, each at a strobe time: counted once per period, strobes after the impact, no failure."""
@@ -175,6 +181,7 @@ def test_impacts_on_period_boundaries(engine: str) -> None:
         np.testing.assert_allclose(trajectory.impact_times * 25.0, np.arange(1, trajectory.impact_times.size + 1), atol=1e-6)
 
 
+@pytest.mark.timeout(60)
 def test_rest_on_the_stop_without_forcing_does_not_livelock(system: TwoDofSystem) -> None:
     problem = ImpactProblem(system, 0.0, 0.5, 0.0, 25.0)
     started = time.perf_counter()

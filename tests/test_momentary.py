@@ -18,6 +18,7 @@ from .engine_cases import energy_budget, linear_state
 TIGHT = EngineSettings(rtol=1e-10, atol=1e-14)
 
 
+@pytest.mark.timeout(60)
 @pytest.mark.parametrize("method", ["adams", "bdf"])
 @pytest.mark.parametrize(("frequency", "restitution"), [(25.0, 0.2), (38.0, 0.0)])
 def test_agrees_with_exact_over_20_seconds(system: TwoDofSystem, method: str, frequency: float, restitution: float) -> None:
@@ -56,6 +57,7 @@ def _grazing_problems(system: TwoDofSystem, margin: float) -> list[ImpactProblem
     return [ImpactProblem(system, amplitude_x2 + margin, 0.9, PAPER_AMPLITUDE, frequency, phase=phase) for phase in np.linspace(0, 2 * np.pi, 24, endpoint=False)]
 
 
+@pytest.mark.timeout(60)
 def test_grazing_contact_penetrating_half_a_nanometre_is_found(system: TwoDofSystem) -> None:
     """The linear orbit overshoots the stop by 5e-10 m: every phase of the step grid finds the touch (exact does)."""
     started = time.perf_counter()
@@ -79,6 +81,7 @@ def test_grazing_without_contact_gives_none(system: TwoDofSystem) -> None:
         assert MomentaryEngine().integrate(problem, linear_state(problem), 0.0, 2).impact_times.size == 0
 
 
+@pytest.mark.timeout(60)
 @pytest.mark.parametrize("restitution", [0.0, 0.05, 0.3])
 def test_chattering_sticks_and_releases_like_exact(system: TwoDofSystem, restitution: float) -> None:
     """Quasi-static case (10 Hz, Delta = 0.1 mm): stick and release every period; stuck time as the exact engine's."""
@@ -95,6 +98,7 @@ def test_chattering_sticks_and_releases_like_exact(system: TwoDofSystem, restitu
     assert np.all(trial.strobe_states[:, 1] <= problem.clearance)
 
 
+@pytest.mark.timeout(60)
 def test_elastic_undamped_conserves_energy() -> None:
     """R = 1 and no damping: the energy change equals the work of the force."""
     undamped = TwoDofSystem(m1=1.0, m2=0.1, k1=25_000.0, k2=4_300.0)
@@ -122,6 +126,7 @@ def test_restitution_law_at_every_impact(system: TwoDofSystem) -> None:
     np.testing.assert_array_equal(after[:, 1], problem.clearance)
 
 
+@pytest.mark.timeout(60)
 def test_zero_clearance(system: TwoDofSystem) -> None:
     problem = ImpactProblem(system, 0.0, 0.5, PAPER_AMPLITUDE, 25.0)
     trial = MomentaryEngine(TIGHT).integrate(problem, np.zeros(4), 0.0, 40)
@@ -130,6 +135,7 @@ def test_zero_clearance(system: TwoDofSystem) -> None:
     np.testing.assert_allclose(trial.impact_times, reference.impact_times, atol=1e-9)
 
 
+@pytest.mark.timeout(60)
 def test_far_clearance_is_the_linear_solution(system: TwoDofSystem) -> None:
     problem = ImpactProblem(system, 1.0, 0.2, PAPER_AMPLITUDE, 23.0)
     start = linear_state(problem)
@@ -138,6 +144,7 @@ def test_far_clearance_is_the_linear_solution(system: TwoDofSystem) -> None:
     np.testing.assert_allclose(trajectory.strobe_states, np.broadcast_to(start, trajectory.strobe_states.shape), atol=1e-8 * np.abs(start).max())
 
 
+@pytest.mark.timeout(60)
 def test_start_at_the_stop_moving_into_it(system: TwoDofSystem) -> None:
     """CVODE reports no root at its initial time: the engine applies the contact itself, like exact does."""
     problem = ImpactProblem(system, 1e-3, 0.5, PAPER_AMPLITUDE, 25.0)
@@ -148,6 +155,7 @@ def test_start_at_the_stop_moving_into_it(system: TwoDofSystem) -> None:
         assert np.all(trajectory.strobe_states[:, 1] <= problem.clearance)
 
 
+@pytest.mark.timeout(60)
 def test_rest_on_the_stop_without_forcing(system: TwoDofSystem) -> None:
     problem = ImpactProblem(system, 0.0, 0.5, 0.0, 25.0)
     assert MomentaryEngine().integrate(problem, np.zeros(4), 0.0, 3).impact_times.size == 0
