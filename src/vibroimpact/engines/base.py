@@ -142,6 +142,8 @@ class Trajectory:
     moments : ndarray of complex, shape (n, 5) or (0, 5)
         Per period, when requested: integrals of X1 e^{-jwt}, X2 e^{-jwt} [m s], of the contact force e^{-jwt}
         (impulses plus holding force while stuck) [N s], and of X1^2, X2^2 [m2 s] (real).
+    contact_peaks : ndarray, shape (c, 2)
+        Compliant contacts only: largest contact force [N] and largest absorber deceleration [m s-2] of each contact.
     stats : dict
         Engine counters (steps, rhs calls, events, grazing checks ...).
     """
@@ -155,10 +157,11 @@ class Trajectory:
     segments: NDArray[np.float64]
     segment_states: NDArray[np.float64]
     moments: NDArray[np.complex128]
+    contact_peaks: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 2)))
     stats: dict[str, int] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        for name in ("strobe_times", "strobe_states", "impact_times", "impact_velocities", "impulses", "segments", "segment_states", "moments"):
+        for name in ("strobe_times", "strobe_states", "impact_times", "impact_velocities", "impulses", "segments", "segment_states", "moments", "contact_peaks"):
             getattr(self, name).setflags(write=False)
 
     @property
@@ -193,15 +196,24 @@ class TrajectoryBuilder:
         self._segments: list[tuple[float, int]] = []
         self._segment_states: list[NDArray[np.float64]] = []
         self._period_moments: list[NDArray[np.complex128]] = []
+        self._peaks: list[tuple[float, float]] = []
         self._current = np.zeros(5, dtype=complex)
         self.stats: dict[str, int] = {"impacts": 0, "sticks": 0, "releases": 0}
 
-    def impact(self, t: float, velocity: float, impulse: float) -> None:
-        """An impact at time t [s] with pre-impact velocity [m s-1] and impulse [N s] (its Fourier term included)."""
+    def impact(self, t: float, velocity: float, impulse: float, in_moments: bool = True) -> None:
+        """An impact at time t [s] with pre-impact velocity [m s-1] and impulse [N s].
+
+        A momentary impulse's Fourier term is added to the contact-force moment; a compliant contact's force is
+        integrated continuously instead (``in_moments=False``).
+        """
         self._impacts.append((t, velocity, impulse))
         self.stats["impacts"] += 1
-        if self.moments:
+        if self.moments and in_moments:
             self._current[2] += impulse * complex(math.cos(self.problem.omega * t), -math.sin(self.problem.omega * t))
+
+    def contact_peaks(self, force: float, acceleration: float) -> None:
+        """Largest contact force [N] and absorber deceleration [m s-2] of the last compliant contact."""
+        self._peaks.append((force, acceleration))
 
     def segment(self, t: float, mode: int, state: NDArray[np.float64]) -> None:
         """A new segment (``MODE_FREE`` or ``MODE_STUCK``) starts at time t [s] in ``state``."""
@@ -236,6 +248,7 @@ class TrajectoryBuilder:
             segments=np.column_stack([starts, ends, [s[1] for s in self._segments]]).reshape(-1, 3)[keep],
             segment_states=np.array(self._segment_states).reshape(-1, 4)[keep],
             moments=np.array(self._period_moments, dtype=complex).reshape(-1, 5),
+            contact_peaks=np.array(self._peaks, dtype=float).reshape(-1, 2),
             stats=self.stats | (stats or {}),
         )
 

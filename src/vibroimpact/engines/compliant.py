@@ -1,0 +1,230 @@
+"""Engine ``compliant``: the Kelvin-Voigt bumper of eq. 25 through SUNDIALS IDA (scikit-sundae).
+
+The equations of motion are written as the residual ``y' - f(t, y)`` of the state (X1, u, X1', X2') with the gap
+u = X2 - Delta, then the running integral of the bumper force (impulses), then the harmonic-moment quadratures of
+:mod:`.event_loop` (whose contact-force channel integrates the bumper force itself). A contact-mode flag keeps the residual smooth: in contact the bumper force
+F = K u + B X2' acts on the absorber, outside it does not, and the switches are events:
+
+* onset, free flight: the gap rising through zero (an apex event, X2' falling through zero, guards grazing contacts
+  as in ``momentary``);
+* release, in contact: F falling through zero (eq. 25: the bumper never pulls);
+* peaks, in contact: dF/dt falling through zero (largest force) and the absorber's jerk rising through zero (largest
+  deceleration); they are recorded and integration goes on.
+
+Each mode switch re-initialises IDA with consistent y' = f(t, y). A Jacobian callback returns the mode's constant
+``cj I - df/dy``. Each contact is recorded as an impact (onset time, entry speed, impulse = integral of F) with its
+peak force and deceleration. The restitution of ``ImpactProblem`` is not used: the bumper's loss factor sets it
+(:func:`vibroimpact.contact.restitution_from_loss_factor`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from sksundae.ida import IDA
+
+from ..contact import KelvinVoigtBumper
+from .base import MODE_FREE, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
+from .event_loop import QUADRATURES
+
+__all__ = ["CompliantEngine"]
+
+MODE_CONTACT = 2  # segment mode: absorber on the bumper
+_STATUS_TSTOP, _STATUS_ROOT = 1, 2
+
+
+class _BumperModel:
+    """Right-hand side, residual, Jacobian and events of the system with a Kelvin-Voigt bumper."""
+
+    def __init__(self, problem: ImpactProblem, bumper: KelvinVoigtBumper, with_moments: bool) -> None:
+        s = problem.system
+        self.problem, self.with_moments = problem, with_moments
+        self.size = 5 + (QUADRATURES if with_moments else 0)  # (X1, u, X1', X2', integral of F) + moments
+        self.contact = False
+        self.rhs_calls = 0
+        self.k, self.b = bumper.stiffness(s.m2), bumper.damping(s.m2)
+        self._c = (s.m1, s.m2, s.k1, s.k2, s.b1, s.b2, problem.amplitude, problem.omega, problem.phase, problem.clearance)
+        base = np.zeros((self.size, self.size))
+        base[:4, :4] = s.state_matrix
+        self._jacobian = {False: base, True: base.copy()}
+        self._jacobian[True][3, 1] -= self.k / s.m2
+        self._jacobian[True][3, 3] -= self.b / s.m2
+        self._jacobian[True][4, 1] += self.k
+        self._jacobian[True][4, 3] += self.b
+
+    def force(self, y: NDArray[np.float64]) -> float:
+        """Bumper force on the absorber in contact mode, K u + B X2' [N] (may be negative: then it releases)."""
+        return self.k * y[1] + self.b * y[3]
+
+    def rhs(self, t: float, y: NDArray[np.float64], yp: NDArray[np.float64]) -> None:
+        self.rhs_calls += 1
+        m1, m2, k1, k2, b1, b2, q, w, phase, delta = self._c
+        x1, gap, v1, v2 = y[0], y[1], y[2], y[3]
+        spring = k2 * (x1 - gap - delta) + b2 * (v1 - v2)
+        bumper = self.k * gap + self.b * v2 if self.contact else 0.0
+        yp[0] = v1
+        yp[1] = v2
+        yp[2] = (q * math.cos(w * t + phase) - k1 * x1 - b1 * v1 - spring) / m1
+        yp[3] = (spring - bumper) / m2
+        yp[4] = bumper
+        if self.with_moments:
+            c, s = math.cos(w * t), math.sin(w * t)
+            x2 = gap + delta
+            yp[5], yp[6], yp[7], yp[8] = x1 * c, x1 * s, x2 * c, x2 * s
+            yp[9], yp[10] = bumper * c, bumper * s
+            yp[11], yp[12] = x1 * x1, x2 * x2
+
+    def derivative(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        yp = np.empty(self.size)
+        self.rhs(t, y, yp)
+        return yp
+
+    def residual(self, t: float, y: NDArray[np.float64], yp: NDArray[np.float64], res: NDArray[np.float64]) -> None:
+        f = np.empty(self.size)
+        self.rhs(t, y, f)
+        res[:] = yp - f
+
+    def jacobian(self, t: float, y: NDArray[np.float64], yp: NDArray[np.float64], res: NDArray[np.float64], cj: float, jj: NDArray[np.float64]) -> None:
+        """d(res)/dy + cj d(res)/dy' = cj I - df/dy (quadrature rows: their dependence on the state is left out,
+        which only slows Newton's convergence on those rows, never the solution)."""
+        jj[:, :] = -self._jacobian[self.contact]
+        jj[np.diag_indices(self.size)] += cj
+
+    def events(self, t: float, y: NDArray[np.float64], yp: NDArray[np.float64], out: NDArray[np.float64]) -> None:
+        """[gap (rising), force (falling), apex X2' (falling), dF/dt (falling), jerk of X2 (rising)]."""
+        if self.contact:
+            f = self.derivative(t, y)
+            force_rate = self.k * y[3] + self.b * f[3]
+            s = self.problem.system
+            jerk = (s.k2 * (y[2] - y[3]) + s.b2 * (f[2] - f[3]) - force_rate) / s.m2
+            out[0], out[1], out[2], out[3], out[4] = -1.0, self.force(y), 1.0, force_rate, jerk
+        else:
+            out[0], out[1], out[2], out[3], out[4] = y[1], 1.0, y[3], 1.0, -1.0
+
+
+class CompliantEngine:
+    """IDA with a Kelvin-Voigt bumper (see module docstring).
+
+    Parameters
+    ----------
+    bumper_frequency : float
+        Apparent natural frequency Omega_b / 2 pi [Hz], > 0.
+    bumper_loss_factor : float
+        xi_b [-], >= 0.
+    settings : EngineSettings
+        rtol, atol and max_step.
+    """
+
+    name = "compliant"
+
+    def __init__(self, bumper_frequency: float, bumper_loss_factor: float, settings: EngineSettings = EngineSettings()) -> None:
+        self.frequency, self.loss_factor, self.settings = bumper_frequency, bumper_loss_factor, settings
+        KelvinVoigtBumper(0.0, bumper_frequency, bumper_loss_factor)  # validates both
+
+    def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
+        """Integrate ``periods`` whole periods from ``state`` (X1, X2, X1', X2') at ``t_start`` [s]."""
+        if periods < 0:
+            raise ValueError(f"periods = {periods} is out of range: allowed [0, inf)")
+        bumper = KelvinVoigtBumper(problem.clearance, self.frequency, self.loss_factor)
+        model = _BumperModel(problem, bumper, moments)
+        y = np.zeros(model.size)
+        y[:4] = np.asarray(state, dtype=float)
+        y[1] -= problem.clearance
+        model.contact = bool(y[1] >= 0.0 and model.force(y) > 0.0)
+        solver = self._solver(model)
+        rec = TrajectoryBuilder(problem, moments)
+
+        def physical(y: NDArray[np.float64]) -> NDArray[np.float64]:
+            return np.array([y[0], y[1] + problem.clearance, y[2], y[3]])
+
+        def restart(t: float, y: NDArray[np.float64]) -> None:
+            _clear(self._events)
+            result = solver.init_step(t, y, model.derivative(t, y))
+            if result.status < 0:
+                raise RuntimeError(f"IDA could not start at t = {t!r} s: {result.message}")
+
+        t = float(t_start)
+        restart(t, y)
+        rec.strobe(t, physical(y))
+        rec.segment(t, MODE_CONTACT if model.contact else MODE_FREE, physical(y))
+        quadratures = y[5:].copy()
+        counts = {"events": 0, "contacts": 0, "steps": 0}
+
+        def begin_contact(t: float, y: NDArray[np.float64]) -> tuple[tuple[float, float, float], float, float]:
+            """Onset (time, entry speed, impulse integral) and the force and deceleration at first touch."""
+            counts["contacts"] += 1
+            return (t, float(y[3]), float(y[4])), model.force(y), max(-model.derivative(t, y)[3], 0.0)
+
+        onset, peak_force, peak_deceleration = begin_contact(t, y) if model.contact else ((t, 0.0, 0.0), 0.0, 0.0)
+        for k in range(1, periods + 1):
+            boundary = t_start + k * problem.period
+            while True:
+                result = solver.step(boundary, method="onestep", tstop=boundary)
+                counts["steps"] += 1
+                if result.status < 0:
+                    raise RuntimeError(f"IDA failed at t = {result.t!r} s: {result.message}")
+                t, y = float(result.t), np.array(result.y)
+                if result.status == _STATUS_TSTOP:
+                    break
+                if result.status != _STATUS_ROOT:
+                    continue
+                fired = np.asarray(result.i_events[-1])
+                _clear(self._events)
+                counts["events"] += 1
+                if model.contact and fired[1] != 0:  # release
+                    rec.contact_peaks(peak_force, peak_deceleration)
+                    impulse = float(y[4]) - onset[2]
+                    rec.impact(onset[0], onset[1], impulse, in_moments=False)
+                    model.contact = False
+                elif model.contact:  # a force or deceleration maximum: record it, integration goes on
+                    f = model.derivative(t, y)
+                    peak_force = max(peak_force, model.force(y))
+                    peak_deceleration = max(peak_deceleration, -f[3])
+                    continue
+                elif fired[0] != 0 or (fired[2] != 0 and y[1] >= 0.0):  # onset (or a tangent touch at an apex)
+                    model.contact = True
+                    y[1] = max(y[1], 0.0)
+                    onset, peak_force, peak_deceleration = begin_contact(t, y)
+                else:
+                    continue  # an apex short of the bumper
+                restart(t, y)
+                rec.segment(t, MODE_CONTACT if model.contact else MODE_FREE, physical(y))
+            if moments:
+                q = y[5:] - quadratures
+                quadratures = y[5:].copy()
+                rec.add_moments(np.array([q[0] - 1j * q[1], q[2] - 1j * q[3], q[4] - 1j * q[5], q[6], q[7]]))
+            rec.strobe(t, physical(y))
+        return rec.build(counts | {"rhs_calls": model.rhs_calls})
+
+    def _solver(self, model: _BumperModel) -> IDA:
+        def events(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], out: NDArray[np.float64]) -> None:
+            model.events(t, y, yp, out)
+
+        events.terminal = [True] * 5  # type: ignore[attr-defined]
+        events.direction = [1, -1, -1, -1, 1]  # type: ignore[attr-defined]
+        self._events = events
+        options: dict[str, Any] = {
+            "rtol": self.settings.rtol,
+            "atol": self.settings.atol,
+            "max_num_steps": 1_000_000,
+            "eventsfn": events,
+            "num_events": 5,
+            "jacfn": model.jacobian,
+        }
+        if self.settings.max_step > 0.0:
+            options["max_step"] = self.settings.max_step
+        return IDA(model.residual, **options)
+
+
+def _clear(events: Any) -> None:
+    """Forget the roots recorded on a scikit-sundae event function (they accumulate and slow every step)."""
+    for name in ("_i", "_t", "_y"):
+        records = getattr(events, name, None)
+        if records is not None:
+            records.clear()
+    counts = getattr(events, "_i_cnt", None)
+    if counts is not None:
+        counts[:] = 0
