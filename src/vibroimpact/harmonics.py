@@ -1,4 +1,4 @@
-"""Fundamental harmonics and RMS over whole periods, from a trajectory's per-period moments.
+"""Fundamental harmonics and RMS: over whole periods of a steady state, and running over a swept sine.
 
 Over N whole periods of length T the complex fundamental amplitude of a signal x(t) is
 ``(2 / (N T)) * integral x(t) exp(-j w t) dt`` (|.| is the amplitude of its cos(w t + phi) component), and its RMS is
@@ -14,8 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .engines.base import Trajectory
+from .excitation import SweptSine
 
-__all__ = ["HarmonicMeasures", "measure"]
+__all__ = ["HarmonicMeasures", "RunningEstimate", "measure", "running_fundamental"]
 
 
 @dataclass(frozen=True)
@@ -83,3 +84,64 @@ def measure(trajectory: Trajectory) -> HarmonicMeasures:
         impulse_per_period=float(np.sum(trajectory.impulses)) / periods,
         periods=periods,
     )
+
+
+@dataclass(frozen=True)
+class RunningEstimate:
+    """Running fundamental harmonic and RMS of a swept-sine response (the paper's "Statistics" blocks).
+
+    Attributes
+    ----------
+    time : ndarray
+        Sample times where a whole window is available [s].
+    frequency : ndarray
+        Instantaneous excitation frequency there [Hz]: the axis to plot against.
+    amplitude : ndarray
+        Fundamental-harmonic amplitude over the window [units of the signal].
+    rms : ndarray
+        RMS over the same window [units of the signal].
+    """
+
+    time: np.ndarray
+    frequency: np.ndarray
+    amplitude: np.ndarray
+    rms: np.ndarray
+
+
+def running_fundamental(t: np.ndarray, x: np.ndarray, sweep: SweptSine, cycles: int = 8) -> RunningEstimate:
+    """Demodulate ``x`` against the sweep's own sin and cos over a moving window of ``cycles`` whole cycles.
+
+    The window ends at each sample and spans the phase interval [theta(t) - 2 pi cycles, theta(t)]; the integrals
+    are taken in theta, so for x = A sin(theta + phi) the estimate is exactly A, however fast the sweep (sampling
+    error aside: trapezoidal sums, second order in the step), and harmonics and offsets cancel.
+
+    Parameters
+    ----------
+    t : ndarray
+        Increasing sample times [s].
+    x : ndarray
+        Signal at those times.
+    sweep : SweptSine
+        The excitation (its phase theta(t)).
+    cycles : int
+        Window length in excitation cycles, >= 1.
+    """
+    from scipy.integrate import cumulative_trapezoid
+
+    if cycles < 1:
+        raise ValueError(f"cycles = {cycles!r} is out of range: allowed [1, inf)")
+    t = np.asarray(t, dtype=float)
+    x = np.asarray(x, dtype=float)
+    theta = sweep.phase(t)
+    rate = 2.0 * np.pi * sweep.frequency(t)  # d theta / dt
+    in_phase = cumulative_trapezoid(x * np.sin(theta) * rate, t, initial=0.0)
+    quadrature = cumulative_trapezoid(x * np.cos(theta) * rate, t, initial=0.0)
+    squares = cumulative_trapezoid(x * x, t, initial=0.0)
+    start = theta - 2.0 * np.pi * cycles
+    ok = start >= theta[0]
+    span = np.pi * cycles
+    i = (in_phase[ok] - np.interp(start[ok], theta, in_phase)) / span
+    q = (quadrature[ok] - np.interp(start[ok], theta, quadrature)) / span
+    t_start = np.interp(start[ok], theta, t)
+    rms = np.sqrt((squares[ok] - np.interp(start[ok], theta, squares)) / (t[ok] - t_start))
+    return RunningEstimate(time=t[ok], frequency=sweep.frequency(t[ok]), amplitude=np.hypot(i, q), rms=rms)
