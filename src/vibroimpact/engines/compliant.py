@@ -128,76 +128,29 @@ class CompliantEngine:
         """Integrate ``periods`` whole periods from ``state`` (X1, X2, X1', X2') at ``t_start`` [s]."""
         if periods < 0:
             raise ValueError(f"periods = {periods} is out of range: allowed [0, inf)")
-        bumper = KelvinVoigtBumper(problem.clearance, self.frequency, self.loss_factor)
-        model = _BumperModel(problem, bumper, moments)
-        y = np.zeros(model.size)
-        y[:4] = np.asarray(state, dtype=float)
-        y[1] -= problem.clearance
-        model.contact = bool(y[1] >= 0.0 and model.force(y) > 0.0)
-        solver = self._solver(model)
+        model = _BumperModel(problem, KelvinVoigtBumper(problem.clearance, self.frequency, self.loss_factor), moments)
         rec = TrajectoryBuilder(problem, moments)
-
-        def physical(y: NDArray[np.float64]) -> NDArray[np.float64]:
-            return np.array([y[0], y[1] + problem.clearance, y[2], y[3]])
-
-        def restart(t: float, y: NDArray[np.float64]) -> None:
-            _clear(self._events)
-            result = solver.init_step(t, y, model.derivative(t, y))
-            if result.status < 0:
-                raise RuntimeError(f"IDA could not start at t = {t!r} s: {result.message}")
-
-        t = float(t_start)
-        restart(t, y)
-        rec.strobe(t, physical(y))
-        rec.segment(t, MODE_CONTACT if model.contact else MODE_FREE, physical(y))
-        quadratures = y[5:].copy()
-        counts = {"events": 0, "contacts": 0, "steps": 0}
-
-        def begin_contact(t: float, y: NDArray[np.float64]) -> tuple[tuple[float, float, float], float, float]:
-            """Onset (time, entry speed, impulse integral) and the force and deceleration at first touch."""
-            counts["contacts"] += 1
-            return (t, float(y[3]), float(y[4])), model.force(y), max(-model.derivative(t, y)[3], 0.0)
-
-        onset, peak_force, peak_deceleration = begin_contact(t, y) if model.contact else ((t, 0.0, 0.0), 0.0, 0.0)
+        run = _Run(self, model, rec, float(t_start), state)
+        rec.strobe(run.t, run.physical())
+        quadratures = run.y[5:].copy()
         for k in range(1, periods + 1):
             boundary = t_start + k * problem.period
             while True:
-                result = solver.step(boundary, method="onestep", tstop=boundary)
-                counts["steps"] += 1
+                result = run.solver.step(boundary, method="onestep", tstop=boundary)
+                run.counts["steps"] += 1
                 if result.status < 0:
                     raise RuntimeError(f"IDA failed at t = {result.t!r} s: {result.message}")
-                t, y = float(result.t), np.array(result.y)
+                run.t, run.y = float(result.t), np.array(result.y)
                 if result.status == _STATUS_TSTOP:
                     break
-                if result.status != _STATUS_ROOT:
-                    continue
-                fired = np.asarray(result.i_events[-1])
-                _clear(self._events)
-                counts["events"] += 1
-                if model.contact and fired[1] != 0:  # release
-                    rec.contact_peaks(peak_force, peak_deceleration)
-                    impulse = float(y[4]) - onset[2]
-                    rec.impact(onset[0], onset[1], impulse, in_moments=False)
-                    model.contact = False
-                elif model.contact:  # a force or deceleration maximum: record it, integration goes on
-                    f = model.derivative(t, y)
-                    peak_force = max(peak_force, model.force(y))
-                    peak_deceleration = max(peak_deceleration, -f[3])
-                    continue
-                elif fired[0] != 0 or (fired[2] != 0 and y[1] >= 0.0):  # onset (or a tangent touch at an apex)
-                    model.contact = True
-                    y[1] = max(y[1], 0.0)
-                    onset, peak_force, peak_deceleration = begin_contact(t, y)
-                else:
-                    continue  # an apex short of the bumper
-                restart(t, y)
-                rec.segment(t, MODE_CONTACT if model.contact else MODE_FREE, physical(y))
+                if result.status == _STATUS_ROOT:
+                    run.on_root(np.asarray(result.i_events[-1]))
             if moments:
-                q = y[5:] - quadratures
-                quadratures = y[5:].copy()
+                q = run.y[5:] - quadratures
+                quadratures = run.y[5:].copy()
                 rec.add_moments(np.array([q[0] - 1j * q[1], q[2] - 1j * q[3], q[4] - 1j * q[5], q[6], q[7]]))
-            rec.strobe(t, physical(y))
-        return rec.build(counts | {"rhs_calls": model.rhs_calls})
+            rec.strobe(run.t, run.physical())
+        return rec.build(run.counts | {"rhs_calls": model.rhs_calls})
 
     def _solver(self, model: _BumperModel) -> IDA:
         def events(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], out: NDArray[np.float64]) -> None:
@@ -217,6 +170,66 @@ class CompliantEngine:
         if self.settings.max_step > 0.0:
             options["max_step"] = self.settings.max_step
         return IDA(model.residual, **options)
+
+
+class _Run:
+    """One IDA integration: the state, the solver, and what happens at each event (onset, release, peaks)."""
+
+    def __init__(self, engine: CompliantEngine, model: _BumperModel, rec: TrajectoryBuilder, t: float, state: NDArray[np.float64]) -> None:
+        self.model, self.rec = model, rec
+        self.clearance = model.problem.clearance
+        self.t = t
+        self.y = np.zeros(model.size)
+        self.y[:4] = np.asarray(state, dtype=float)
+        self.y[1] -= self.clearance
+        model.contact = bool(self.y[1] >= 0.0 and model.force(self.y) > 0.0)
+        self.solver = engine._solver(model)
+        self._events = engine._events
+        self.counts = {"events": 0, "contacts": 0, "steps": 0}
+        self.onset, self.peak_force, self.peak_deceleration = (t, 0.0, 0.0), 0.0, 0.0
+        if model.contact:
+            self._begin_contact()
+        self.restart()
+
+    def physical(self) -> NDArray[np.float64]:
+        """(X1, X2, X1', X2') now."""
+        return np.array([self.y[0], self.y[1] + self.clearance, self.y[2], self.y[3]])
+
+    def restart(self) -> None:
+        """Re-initialise IDA at the current state with consistent y' = f(t, y), and open a segment."""
+        _clear(self._events)
+        result = self.solver.init_step(self.t, self.y, self.model.derivative(self.t, self.y))
+        if result.status < 0:
+            raise RuntimeError(f"IDA could not start at t = {self.t!r} s: {result.message}")
+        self.rec.segment(self.t, MODE_CONTACT if self.model.contact else MODE_FREE, self.physical())
+
+    def _begin_contact(self) -> None:
+        """Onset (time, entry speed, impulse integral) and the force and deceleration at first touch."""
+        self.counts["contacts"] += 1
+        self.onset = (self.t, float(self.y[3]), float(self.y[4]))
+        self.peak_force = self.model.force(self.y)
+        self.peak_deceleration = max(-self.model.derivative(self.t, self.y)[3], 0.0)
+
+    def on_root(self, fired: NDArray[np.int_]) -> None:
+        """Handle the events that stopped IDA at the current time; restart it if the mode changed."""
+        _clear(self._events)
+        self.counts["events"] += 1
+        model, y = self.model, self.y
+        if model.contact and fired[1] != 0:  # release: the bumper would pull
+            self.rec.contact_peaks(self.peak_force, self.peak_deceleration)
+            self.rec.impact(self.onset[0], self.onset[1], float(y[4]) - self.onset[2], in_moments=False)
+            model.contact = False
+        elif model.contact:  # a force or deceleration maximum: record it, integration goes on
+            self.peak_force = max(self.peak_force, model.force(y))
+            self.peak_deceleration = max(self.peak_deceleration, -model.derivative(self.t, y)[3])
+            return
+        elif fired[0] != 0 or (fired[2] != 0 and y[1] >= 0.0):  # onset (or a tangent touch at an apex)
+            model.contact = True
+            y[1] = max(y[1], 0.0)
+            self._begin_contact()
+        else:
+            return  # an apex short of the bumper
+        self.restart()
 
 
 def _clear(events: Any) -> None:
