@@ -108,3 +108,39 @@ def test_hard_bumpers(system: TwoDofSystem, frequency: float, xi: float) -> None
     assert np.all(np.isfinite(trajectory.strobe_states))
     assert np.all((trajectory.contact_peaks > 0.0) & np.isfinite(trajectory.contact_peaks))
     assert np.all(trajectory.impulses > 0.0)
+
+
+@pytest.mark.timeout(60)
+def test_slow_sweep_without_contact_follows_the_linear_response(system: TwoDofSystem) -> None:
+    """Swept sine 15 -> 17 Hz at 0.2 Hz/s, clearance far away, started on the linear steady state: the running
+    fundamental of X1 is |q H11| at the window's frequency to 1e-3 (sweep lag and sampling included)."""
+    from vibroimpact.excitation import SweptSine
+    from vibroimpact.harmonics import running_fundamental
+    from vibroimpact.linear import linear_response
+
+    sweep = SweptSine(PAPER_AMPLITUDE, 15.0, 17.0, 0.2)
+    h = linear_response(system, 2 * math.pi * 15.0, PAPER_AMPLITUDE)
+    x = np.array([h.x1, h.x2]) * -1j  # the response to q sin(theta) at theta = 0
+    state = np.concatenate([x.real, (2j * math.pi * 15.0 * x).real])
+    record = CompliantEngine(250.0, 0.73).sweep(system, 1.0, sweep, 2000.0, state)
+    assert record.trajectory.impact_times.size == 0 and np.all(record.contact_force == 0.0)
+    estimate = running_fundamental(record.time, record.x1, sweep, cycles=8)
+    linear = np.abs(linear_response(system, 2 * math.pi * estimate.frequency, PAPER_AMPLITUDE).x1)
+    np.testing.assert_allclose(estimate.amplitude, linear, rtol=1e-3)
+
+
+@pytest.mark.timeout(60)
+def test_slow_sweep_with_contact_follows_the_one_impact_orbit(system: TwoDofSystem) -> None:
+    """Swept sine 24 -> 25 Hz at 0.1 Hz/s through stable one-impact orbits (R = 0.2, stiff 4 kHz bumper), from rest:
+    after the 5 s transient the running fundamental of X1 is the PGF value to 1.5 % (0.6 % is the bumper's)."""
+    from vibroimpact.excitation import SweptSine
+    from vibroimpact.harmonics import running_fundamental
+    from vibroimpact.pgf import solve_one_impact
+
+    sweep = SweptSine(PAPER_AMPLITUDE, 24.0, 25.0, 0.1)
+    record = CompliantEngine(4000.0, loss_factor_from_restitution(0.2)).sweep(system, PAPER_CLEARANCE, sweep, 2000.0)
+    estimate = running_fundamental(record.time, record.x1, sweep, cycles=8)
+    settled = estimate.time > 5.0
+    orbit = solve_one_impact(system, 2 * math.pi * estimate.frequency[settled], PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE)
+    np.testing.assert_allclose(estimate.amplitude[settled], np.abs(orbit.x1_harmonic()), rtol=0.015)
+    assert record.trajectory.impact_times.size == pytest.approx(sweep.duration * 24.5, rel=0.02)  # one contact per period

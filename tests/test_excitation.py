@@ -55,13 +55,13 @@ def test_running_rms_of_a_chirp() -> None:
 
 
 def test_estimator_follows_a_changing_amplitude() -> None:
-    """A slowly growing amplitude is tracked with the lag of half a window."""
+    """A slowly growing amplitude is tracked: the estimate is the envelope near the window's centre (to 5e-4:
+    the average is weighted by phase, and the frequency changes across the window)."""
     sweep = SweptSine(amplitude=1.0, start_frequency=20.0, stop_frequency=30.0, rate=1.0)
     t = np.linspace(0.0, 10.0, 400001)
     envelope = 1.0 + 0.05 * t
     estimate = running_fundamental(t, envelope * np.sin(sweep.phase(t)), sweep, cycles=4)
-    half_window = 2.0 / sweep.frequency(estimate.time)  # 4 cycles / 2
-    np.testing.assert_allclose(estimate.amplitude, 1.0 + 0.05 * (estimate.time - half_window), rtol=5e-4)
+    np.testing.assert_allclose(estimate.amplitude, 1.0 + 0.05 * estimate.time, rtol=5e-4)
 
 
 def test_validation() -> None:

@@ -93,9 +93,9 @@ class RunningEstimate:
     Attributes
     ----------
     time : ndarray
-        Sample times where a whole window is available [s].
+        Centre of each window (in phase) [s]: one per sample where a whole window ends.
     frequency : ndarray
-        Instantaneous excitation frequency there [Hz]: the axis to plot against.
+        Instantaneous excitation frequency at that centre [Hz]: the axis to plot against.
     amplitude : ndarray
         Fundamental-harmonic amplitude over the window [units of the signal].
     rms : ndarray
@@ -144,4 +144,5 @@ def running_fundamental(t: np.ndarray, x: np.ndarray, sweep: SweptSine, cycles: 
     q = (quadrature[ok] - np.interp(start[ok], theta, quadrature)) / span
     t_start = np.interp(start[ok], theta, t)
     rms = np.sqrt((squares[ok] - np.interp(start[ok], theta, squares)) / (t[ok] - t_start))
-    return RunningEstimate(time=t[ok], frequency=sweep.frequency(t[ok]), amplitude=np.hypot(i, q), rms=rms)
+    centre = np.interp(theta[ok] - np.pi * cycles, theta, t)
+    return RunningEstimate(time=centre, frequency=sweep.frequency(centre), amplitude=np.hypot(i, q), rms=rms)

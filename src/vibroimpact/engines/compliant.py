@@ -20,6 +20,7 @@ peak force and deceleration. The restitution of ``ImpactProblem`` is not used: t
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -27,10 +28,13 @@ from numpy.typing import NDArray
 from sksundae.ida import IDA
 
 from ..contact import KelvinVoigtBumper
+from ..excitation import SweptSine
+from ..system import TwoDofSystem
 from .base import MODE_FREE, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
+from ..validation import require_positive
 from .event_loop import QUADRATURES
 
-__all__ = ["CompliantEngine"]
+__all__ = ["CompliantEngine", "SweepRecord"]
 
 MODE_CONTACT = 2  # segment mode: absorber on the bumper
 _STATUS_TSTOP, _STATUS_ROOT = 1, 2
@@ -39,9 +43,9 @@ _STATUS_TSTOP, _STATUS_ROOT = 1, 2
 class _BumperModel:
     """Right-hand side, residual, Jacobian and events of the system with a Kelvin-Voigt bumper."""
 
-    def __init__(self, problem: ImpactProblem, bumper: KelvinVoigtBumper, with_moments: bool) -> None:
+    def __init__(self, problem: ImpactProblem, bumper: KelvinVoigtBumper, with_moments: bool, sweep: SweptSine | None = None) -> None:
         s = problem.system
-        self.problem, self.with_moments = problem, with_moments
+        self.problem, self.with_moments, self.sweep = problem, with_moments, sweep
         self.size = 5 + (QUADRATURES if with_moments else 0)  # (X1, u, X1', X2', integral of F) + moments
         self.contact = False
         self.rhs_calls = 0
@@ -67,7 +71,8 @@ class _BumperModel:
         bumper = self.k * gap + self.b * v2 if self.contact else 0.0
         yp[0] = v1
         yp[1] = v2
-        yp[2] = (q * math.cos(w * t + phase) - k1 * x1 - b1 * v1 - spring) / m1
+        external = q * math.cos(w * t + phase) if self.sweep is None else self.sweep.amplitude * math.sin(self.sweep.phase(t))
+        yp[2] = (external - k1 * x1 - b1 * v1 - spring) / m1
         yp[3] = (spring - bumper) / m2
         yp[4] = bumper
         if self.with_moments:
@@ -103,6 +108,35 @@ class _BumperModel:
             out[0], out[1], out[2], out[3], out[4] = -1.0, self.force(y), 1.0, force_rate, jerk
         else:
             out[0], out[1], out[2], out[3], out[4] = y[1], 1.0, y[3], 1.0, -1.0
+
+
+@dataclass(frozen=True, eq=False)
+class SweepRecord:
+    """A swept-sine run, sampled uniformly in time.
+
+    Attributes
+    ----------
+    sweep : SweptSine
+        The excitation.
+    time : ndarray
+        Sample times [s].
+    x1, x2 : ndarray
+        Displacements [m].
+    base_force : ndarray
+        Force on the base: suspension K1 X1 + B1 X1' plus bumper [N].
+    contact_force : ndarray
+        Bumper force [N] (0 outside contact).
+    trajectory : Trajectory
+        Contacts (onset times, entry speeds, impulses, peaks) and segments.
+    """
+
+    sweep: SweptSine
+    time: NDArray[np.float64]
+    x1: NDArray[np.float64]
+    x2: NDArray[np.float64]
+    base_force: NDArray[np.float64]
+    contact_force: NDArray[np.float64]
+    trajectory: Trajectory
 
 
 class CompliantEngine:
@@ -151,6 +185,46 @@ class CompliantEngine:
                 rec.add_moments(np.array([q[0] - 1j * q[1], q[2] - 1j * q[3], q[4] - 1j * q[5], q[6], q[7]]))
             rec.strobe(run.t, run.physical())
         return rec.build(run.counts | {"rhs_calls": model.rhs_calls})
+
+    def sweep(self, system: TwoDofSystem, clearance: float, sweep: SweptSine, sample_rate: float, state: NDArray[np.float64] | None = None) -> SweepRecord:
+        """Swept-sine test (the paper's Simulink run): q sin(theta(t)) from t = 0 to the sweep's end, sampled.
+
+        Parameters
+        ----------
+        system : TwoDofSystem
+            The linear system.
+        clearance : float
+            Delta [m].
+        sweep : SweptSine
+            The excitation.
+        sample_rate : float
+            Output samples per second [Hz] (IDA interpolates; the step is set by the tolerances).
+        state : ndarray, optional
+            (X1, X2, X1', X2') at t = 0; rest by default.
+        """
+        require_positive("sample_rate", sample_rate)
+        problem = ImpactProblem(system, clearance, 0.5, sweep.amplitude, sweep.start_frequency)  # forcing from `sweep`
+        model = _BumperModel(problem, KelvinVoigtBumper(clearance, self.frequency, self.loss_factor), False, sweep)
+        rec = TrajectoryBuilder(problem, False)
+        run = _Run(self, model, rec, 0.0, np.zeros(4) if state is None else state)
+        times = np.arange(0.0, sweep.duration, 1.0 / sample_rate)
+        out = np.empty((times.size, 5))
+        for i, sample in enumerate(times):
+            while run.t < sample:
+                result = run.solver.step(float(sample))
+                run.counts["steps"] += 1
+                if result.status < 0:
+                    raise RuntimeError(f"IDA failed at t = {result.t!r} s: {result.message}")
+                run.t, run.y = float(result.t), np.array(result.y)
+                if result.status == _STATUS_ROOT:
+                    run.on_root(np.asarray(result.i_events[-1]))
+                    continue
+                break
+            bumper = model.force(run.y) if model.contact else 0.0
+            out[i] = [run.y[0], run.y[1] + clearance, run.y[2], run.y[3], bumper]
+        rec.strobe(run.t, run.physical())
+        base_force = system.k1 * out[:, 0] + system.b1 * out[:, 2] + out[:, 4]
+        return SweepRecord(sweep, times, out[:, 0], out[:, 1], base_force, out[:, 4], rec.build(run.counts | {"rhs_calls": model.rhs_calls}))
 
     def _solver(self, model: _BumperModel) -> IDA:
         def events(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], out: NDArray[np.float64]) -> None:
