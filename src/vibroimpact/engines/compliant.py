@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -50,6 +50,13 @@ class _BumperModel:
         self.contact = False
         self.rhs_calls = 0
         self.k, self.b = bumper.stiffness(s.m2), bumper.damping(s.m2)
+        self._buffer = np.empty(self.size)  # reused by the residual and the events: no allocation per call
+        if sweep is None:
+            q, w, phase = problem.amplitude, problem.omega, problem.phase
+            self._external: Callable[[float], float] = lambda t: q * math.cos(w * t + phase)
+        else:
+            q, f0, half_alpha = sweep.amplitude, sweep.start_frequency, 0.5 * sweep.alpha
+            self._external = lambda t: q * math.sin(2.0 * math.pi * t * (f0 + half_alpha * t))
         self._c = (s.m1, s.m2, s.k1, s.k2, s.b1, s.b2, problem.amplitude, problem.omega, problem.phase, problem.clearance)
         base = np.zeros((self.size, self.size))
         base[:4, :4] = s.state_matrix
@@ -71,8 +78,7 @@ class _BumperModel:
         bumper = self.k * gap + self.b * v2 if self.contact else 0.0
         yp[0] = v1
         yp[1] = v2
-        external = q * math.cos(w * t + phase) if self.sweep is None else self.sweep.amplitude * math.sin(self.sweep.phase(t))
-        yp[2] = (external - k1 * x1 - b1 * v1 - spring) / m1
+        yp[2] = (self._external(t) - k1 * x1 - b1 * v1 - spring) / m1
         yp[3] = (spring - bumper) / m2
         yp[4] = bumper
         if self.with_moments:
@@ -88,9 +94,8 @@ class _BumperModel:
         return yp
 
     def residual(self, t: float, y: NDArray[np.float64], yp: NDArray[np.float64], res: NDArray[np.float64]) -> None:
-        f = np.empty(self.size)
-        self.rhs(t, y, f)
-        res[:] = yp - f
+        self.rhs(t, y, self._buffer)
+        np.subtract(yp, self._buffer, out=res)
 
     def jacobian(self, t: float, y: NDArray[np.float64], yp: NDArray[np.float64], res: NDArray[np.float64], cj: float, jj: NDArray[np.float64]) -> None:
         """d(res)/dy + cj d(res)/dy' = cj I - df/dy (quadrature rows: their dependence on the state is left out,
@@ -101,7 +106,8 @@ class _BumperModel:
     def events(self, t: float, y: NDArray[np.float64], yp: NDArray[np.float64], out: NDArray[np.float64]) -> None:
         """[gap (rising), force (falling), apex X2' (falling), dF/dt (falling), jerk of X2 (rising)]."""
         if self.contact:
-            f = self.derivative(t, y)
+            f = self._buffer
+            self.rhs(t, y, f)
             force_rate = self.k * y[3] + self.b * f[3]
             s = self.problem.system
             jerk = (s.k2 * (y[2] - y[3]) + s.b2 * (f[2] - f[3]) - force_rate) / s.m2
