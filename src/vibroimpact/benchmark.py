@@ -24,7 +24,6 @@ from .engines.base import Engine
 from .engines.momentary import MomentaryEngine
 from .engines.scipy_ivp import SolveIvpEngine
 from .steady import start_state
-from .system import TwoDofSystem
 
 __all__ = ["BENCHMARK_METHODS", "BenchmarkCase", "BenchmarkSettings", "run_benchmark", "equal_error_speedup"]
 

@@ -32,6 +32,7 @@ from ..excitation import SweptSine
 from ..system import TwoDofSystem
 from .base import MODE_FREE, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
 from ..validation import require_positive
+from .sundae import clear_event_records
 from .event_loop import QUADRATURES
 
 __all__ = ["CompliantEngine", "SweepRecord"]
@@ -277,7 +278,7 @@ class _Run:
 
     def restart(self) -> None:
         """Re-initialise IDA at the current state with consistent y' = f(t, y), and open a segment."""
-        _clear(self._events)
+        clear_event_records(self._events)
         result = self.solver.init_step(self.t, self.y, self.model.derivative(self.t, self.y))
         if result.status < 0:
             raise RuntimeError(f"IDA could not start at t = {self.t!r} s: {result.message}")
@@ -292,7 +293,7 @@ class _Run:
 
     def on_root(self, fired: NDArray[np.int_]) -> None:
         """Handle the events that stopped IDA at the current time; restart it if the mode changed."""
-        _clear(self._events)
+        clear_event_records(self._events)
         self.counts["events"] += 1
         model, y = self.model, self.y
         if model.contact and fired[1] != 0:  # release: the bumper would pull
@@ -310,14 +311,3 @@ class _Run:
         else:
             return  # an apex short of the bumper
         self.restart()
-
-
-def _clear(events: Any) -> None:
-    """Forget the roots recorded on a scikit-sundae event function (they accumulate and slow every step)."""
-    for name in ("_i", "_t", "_y"):
-        records = getattr(events, name, None)
-        if records is not None:
-            records.clear()
-    counts = getattr(events, "_i_cnt", None)
-    if counts is not None:
-        counts[:] = 0

@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 from sksundae.cvode import CVODE
 
 from .base import EngineSettings
+from .sundae import clear_event_records
 from .event_loop import EventLoopEngine, Model, Stop
 
 __all__ = ["MomentaryEngine"]
@@ -80,7 +81,7 @@ class MomentaryEngine(EventLoopEngine):
         return {"events": self._events_found, "apex_checks": self._apexes, "tangent_touches": self._touches}
 
     def _restart(self, t: float, y: NDArray[np.float64]) -> None:
-        _clear_event_records(self._events)
+        clear_event_records(self._events)
         result = self._solver.init_step(t, y)
         if result.status < 0:
             raise RuntimeError(f"CVODE could not start at t = {t!r} s: {result.message}")
@@ -97,7 +98,7 @@ class MomentaryEngine(EventLoopEngine):
                 self._at = _Position(float(result.t), now)
                 return Stop.BOUNDARY, float(result.t), now
             fired = np.asarray(result.i_events[-1])
-            _clear_event_records(self._events)
+            clear_event_records(self._events)
             if fired[0] != 0 or fired[1] != 0:
                 return self._event(fired, result)
             self._apexes += 1
@@ -112,14 +113,3 @@ class MomentaryEngine(EventLoopEngine):
         self._events_found += 1
         self._at = _Position(np.nan, None)
         return (Stop.CONTACT if fired[0] != 0 else Stop.RELEASE), float(result.t), np.array(result.y)
-
-
-def _clear_event_records(events: Any) -> None:
-    """Forget the roots recorded on a scikit-sundae event function (they accumulate and slow every step)."""
-    for name in ("_i", "_t", "_y"):
-        records = getattr(events, name, None)
-        if records is not None:
-            records.clear()
-    counts = getattr(events, "_i_cnt", None)
-    if counts is not None:
-        counts[:] = 0
