@@ -33,7 +33,7 @@ from ..system import TwoDofSystem
 from .base import MODE_FREE, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
 from ..validation import require_positive
 from .sundae import clear_event_records
-from .event_loop import QUADRATURES
+from .event_loop import QUADRATURES, moment_row, write_quadratures
 
 __all__ = ["CompliantEngine", "SweepRecord"]
 
@@ -83,11 +83,7 @@ class _BumperModel:
         yp[3] = (spring - bumper) / m2
         yp[4] = bumper
         if self.with_moments:
-            c, s = math.cos(w * t), math.sin(w * t)
-            x2 = gap + delta
-            yp[5], yp[6], yp[7], yp[8] = x1 * c, x1 * s, x2 * c, x2 * s
-            yp[9], yp[10] = bumper * c, bumper * s
-            yp[11], yp[12] = x1 * x1, x2 * x2
+            write_quadratures(yp, 5, t, w, x1, gap + delta, bumper)
 
     def derivative(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         yp = np.empty(self.size)
@@ -189,7 +185,7 @@ class CompliantEngine:
             if moments:
                 q = run.y[5:] - quadratures
                 quadratures = run.y[5:].copy()
-                rec.add_moments(np.array([q[0] - 1j * q[1], q[2] - 1j * q[3], q[4] - 1j * q[5], q[6], q[7]]))
+                rec.add_moments(moment_row(q))
             rec.strobe(run.t, run.physical())
         return rec.build(run.counts | {"rhs_calls": model.rhs_calls})
 

@@ -25,6 +25,20 @@ __all__ = ["EventLoopEngine", "Stop", "Model"]
 QUADRATURES = 8
 
 
+def write_quadratures(yp: NDArray[np.float64], first: int, t: float, omega: float, x1: float, x2: float, contact: float) -> None:
+    """Write the eight moment integrands into ``yp[first:first + 8]``: X1, X2 and the contact force times cos and
+    sin of w t, then X1^2 and X2^2."""
+    c, s = math.cos(omega * t), math.sin(omega * t)
+    yp[first], yp[first + 1], yp[first + 2], yp[first + 3] = x1 * c, x1 * s, x2 * c, x2 * s
+    yp[first + 4], yp[first + 5] = contact * c, contact * s
+    yp[first + 6], yp[first + 7] = x1 * x1, x2 * x2
+
+
+def moment_row(q: NDArray[np.float64]) -> NDArray[np.complex128]:
+    """Integrals of the eight quadratures over a period -> the Trajectory's moment row (e^{-jwt} = cos - j sin)."""
+    return np.array([q[0] - 1j * q[1], q[2] - 1j * q[3], q[4] - 1j * q[5], q[6], q[7]])
+
+
 class Stop(Enum):
     """Why :meth:`EventLoopEngine._advance` returned."""
 
@@ -66,11 +80,8 @@ class Model:
             yp[2] = (force - k1 * x1 - b1 * v1 - k2 * (x1 - x2) - b2 * (v1 - v2)) / m1
             yp[3] = (k2 * (x1 - x2) + b2 * (v1 - v2)) / m2
         if self.with_moments:
-            c, s = math.cos(w * t), math.sin(w * t)
             holding = b2 * v1 + k2 * (x1 - delta) if self.stuck else 0.0
-            yp[4], yp[5], yp[6], yp[7] = x1 * c, x1 * s, x2 * c, x2 * s
-            yp[8], yp[9] = holding * c, holding * s
-            yp[10], yp[11] = x1 * x1, x2 * x2
+            write_quadratures(yp, 4, t, w, x1, x2, holding)
 
     def derivative(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         """y' as a new array."""
@@ -179,7 +190,7 @@ class EventLoopEngine(ABC):
             if moments:
                 q = y[4:] - quadratures
                 quadratures = y[4:].copy()
-                rec.add_moments(np.array([q[0] - 1j * q[1], q[2] - 1j * q[3], q[4] - 1j * q[5], q[6], q[7]]))
+                rec.add_moments(moment_row(q))
             rec.strobe(t, physical(y))
         return rec.build(self._counters() | {"rhs_calls": model.rhs_calls})
 
