@@ -624,3 +624,18 @@ def test_bad_benchmark_scenes(change: Callable[[dict[str, Any]], Any], fragment:
     with pytest.raises(SceneError) as caught:
         parse_scene(doc)
     assert any(p.startswith(fragment) for p in caught.value.problems), caught.value.problems
+
+
+def test_benchmark_scene_checks_the_common_header() -> None:
+    """Name, description, system, excitation and report are checked alike in benchmark scenes."""
+    doc = yaml.safe_load((shipped_studies_dir() / "engine_cost.yaml").read_text())
+    doc["report"] = "yes"
+    doc["description"] = 3
+    del doc["system"]
+    with pytest.raises(SceneError) as caught:
+        parse_scene(doc)
+    assert caught.value.problems == [
+        "system: required key is missing",
+        "description: expected a string, got int",
+        "report: expected true or false, got 'yes'",
+    ]

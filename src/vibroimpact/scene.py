@@ -331,19 +331,7 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
         return _parse_benchmark_scene(c, document, text, source)
     doc = c.mapping("", document, _TOP_KEYS, {"name", "system", "excitation", "sweep", "solutions"})
 
-    name = doc.get("name")
-    if "name" in doc and not (isinstance(name, str) and _NAME.match(name)):
-        c.fail("name", f"expected a file-name-safe string (letters, digits, '_', '-', '.'), got {name!r}")
-    description = doc.get("description", "")
-    if not isinstance(description, str):
-        c.fail("description", f"expected a string, got {type(description).__name__}")
-
-    system = _parse_system(c, doc.get("system")) if "system" in doc else None
-    amplitude = None
-    if "excitation" in doc:
-        excitation = c.mapping("excitation", doc["excitation"], {"amplitude"}, {"amplitude"})
-        if "amplitude" in excitation:
-            amplitude = c.number("excitation.amplitude", excitation["amplitude"], 0.0, math.inf, low_inclusive=False)
+    name, description, system, amplitude, report = _parse_header(c, doc)
 
     sweep = c.mapping("sweep", doc.get("sweep", {}), set(SWEEPABLE), {"frequency"}) if "sweep" in doc else {}
     stop = c.mapping("stop", doc["stop"], {"clearance", "restitution"}) if "stop" in doc else {}
@@ -392,10 +380,6 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
     elif engines and (main_grid := grids.get("frequency")) is not None:
         simulation = SimulationSettings(frequency=main_grid)
 
-    report = doc.get("report", True)
-    if not isinstance(report, bool):
-        c.fail("report", f"expected true or false, got {report!r}")
-
     if c.problems:
         raise SceneError(c.problems, source)
     frequency, restitution, clearance = grids["frequency"], grids["restitution"], grids["clearance"]
@@ -421,15 +405,30 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
     )
 
 
+def _parse_header(c: _Checker, doc: dict) -> tuple[Any, str, TwoDofSystem | None, float | None, bool]:
+    """What every scene has: name, description, system, excitation amplitude and the report switch."""
+    name = doc.get("name")
+    if "name" in doc and not (isinstance(name, str) and _NAME.match(name)):
+        c.fail("name", f"expected a file-name-safe string (letters, digits, '_', '-', '.'), got {name!r}")
+    description = doc.get("description", "")
+    if not isinstance(description, str):
+        c.fail("description", f"expected a string, got {type(description).__name__}")
+    system = _parse_system(c, doc.get("system")) if "system" in doc else None
+    amplitude = None
+    if "excitation" in doc:
+        excitation = c.mapping("excitation", doc["excitation"], {"amplitude"}, {"amplitude"})
+        if "amplitude" in excitation:
+            amplitude = c.number("excitation.amplitude", excitation["amplitude"], 0.0, math.inf, low_inclusive=False)
+    report = doc.get("report", True)
+    if not isinstance(report, bool):
+        c.fail("report", f"expected true or false, got {report!r}")
+    return name, description, system, amplitude, bool(report)
+
+
 def _parse_benchmark_scene(c: _Checker, document: dict, text: str, source: str) -> Scene:
     """A benchmark scene: system, excitation amplitude and ``benchmark`` (cases, methods, tolerances)."""
     doc = c.mapping("", document, {"name", "description", "system", "excitation", "benchmark", "report"}, {"name", "system", "excitation", "benchmark"})
-    name = doc.get("name")
-    if not (isinstance(name, str) and _NAME.match(name)):
-        c.fail("name", f"expected a file-name-safe string (letters, digits, '_', '-', '.'), got {name!r}")
-    system = _parse_system(c, doc.get("system"))
-    excitation = c.mapping("excitation", doc.get("excitation"), {"amplitude"}, {"amplitude"})
-    amplitude = c.number("excitation.amplitude", excitation.get("amplitude"), 0.0, math.inf, low_inclusive=False) if "amplitude" in excitation else None
+    name, description, system, amplitude, report = _parse_header(c, doc)
     spec = c.mapping("benchmark", doc["benchmark"], _BENCHMARK_KEYS, {"duration", "methods", "tolerances", "cases"})
     duration = c.number("benchmark.duration", spec.get("duration"), 0.0, 1e5, low_inclusive=False) if "duration" in spec else None
     methods = c.choices("benchmark.methods", spec.get("methods"), tuple(BENCHMARK_METHODS)) if "methods" in spec else ()
@@ -479,7 +478,7 @@ def _parse_benchmark_scene(c: _Checker, document: dict, text: str, source: str) 
     settings = BenchmarkSettings(methods=methods, tolerances=tuple(float(t) for t in tolerances[::-1]), **options)
     return Scene(
         name=name,
-        description=str(doc.get("description", "")),
+        description=description,
         system=system,
         amplitude=amplitude,
         frequency=np.array(sorted({case.problem.frequency for case in cases})),
@@ -489,7 +488,7 @@ def _parse_benchmark_scene(c: _Checker, document: dict, text: str, source: str) 
         solutions=(),
         quantities=(),
         benchmark=BenchmarkScene(tuple(cases), settings),
-        report=bool(doc.get("report", True)),
+        report=report,
         text=text,
     )
 
