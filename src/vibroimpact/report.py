@@ -10,8 +10,6 @@ import base64
 import html
 import io
 import math
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,6 +21,7 @@ from matplotlib.figure import Figure as Figure_  # noqa: E402
 import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
 
+from .atomic import atomic_path  # noqa: E402
 from .linear import linear_response  # noqa: E402
 from .modal import exact_modal_parameters, fit_modal_parameters, underdamped_mode_count  # noqa: E402
 from .reduction import DEFINITION, paper_reduction_factors, reduction_factors  # noqa: E402
@@ -82,11 +81,8 @@ def _save(fig: Figure_, path: Path) -> Path:
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=110, bbox_inches="tight")
     plt.close(fig)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    with os.fdopen(handle, "wb") as stream:
-        stream.write(buffer.getvalue())
-    os.chmod(temporary, 0o644)
-    os.replace(temporary, path)
+    with atomic_path(path) as temporary:
+        temporary.write_bytes(buffer.getvalue())
     return path
 
 
@@ -461,9 +457,6 @@ def _html(dataset: xr.Dataset, scene: Scene, figures: list[Figure], tables: list
 
 
 def _write_text_atomic(path: Path, text: str) -> Path:
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    with os.fdopen(handle, "w", encoding="utf-8") as stream:
-        stream.write(text)
-    os.chmod(temporary, 0o644)
-    os.replace(temporary, path)
+    with atomic_path(path) as temporary:
+        temporary.write_text(text, encoding="utf-8")
     return path

@@ -11,9 +11,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import os
 import sys
-import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
@@ -24,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import __version__
+from .atomic import atomic_path
 from .engines import EngineSettings, ExactEngine, ImpactProblem
 from .engines.base import Engine
 from .engines.momentary import MomentaryEngine
@@ -221,8 +220,5 @@ def _load(cache_dir: Path, case: SimulationCase) -> CaseResult | None:
 
 
 def _save(cache_dir: Path, case: SimulationCase, result: CaseResult) -> None:
-    cache_dir.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=".case.", suffix=".npz", dir=cache_dir)
-    os.close(handle)
-    np.savez(temporary, **result)  # type: ignore[arg-type]
-    os.replace(temporary, _cache_path(cache_dir, case))
+    with atomic_path(_cache_path(cache_dir, case), suffix=".npz") as temporary:
+        np.savez(temporary, **result)  # type: ignore[arg-type]

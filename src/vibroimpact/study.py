@@ -8,9 +8,7 @@ Output contract (read by other tools; keep these names): dimensions ``solution``
 
 from __future__ import annotations
 
-import os
 import sys
-import tempfile
 from dataclasses import asdict
 from pathlib import Path
 from typing import Callable
@@ -19,6 +17,7 @@ import numpy as np
 import xarray as xr
 
 from . import __version__
+from .atomic import atomic_path
 from .benchmark import run_benchmark
 from .linear import linear_response
 from .modal import fit_modal_parameters
@@ -309,15 +308,7 @@ def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
     A reader never sees a half-written file, and an interrupted run leaves the previous file intact.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     encoding = {name: {"zlib": True, "complevel": 4} for name in dataset.data_vars}
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(handle)
-    try:
+    with atomic_path(path) as temporary:
         dataset.to_netcdf(temporary, engine="netcdf4", format="NETCDF4", encoding=encoding)
-        os.chmod(temporary, 0o644)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
     return path
