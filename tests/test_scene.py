@@ -182,7 +182,7 @@ MISTAKES = [
     ("unknown-system-key", _set("system", "m3", 1.0), ["system.m3: unknown key", "allowed: b1, b2, k1, k2, m1, m2"]),
     ("unknown-excitation-key", _set("excitation", "phase", 0.0), ["excitation.phase: unknown key", "allowed: amplitude"]),
     ("unknown-stop-key", _set("stop", "stiffness", 1.0), ["stop.stiffness: unknown key", "allowed: clearance, restitution"]),
-    ("unknown-sweep-key", _set("sweep", "amplitude", [1.0]), ["sweep.amplitude: unknown key", "allowed: clearance, frequency, restitution"]),
+    ("unknown-sweep-key", _set("sweep", "amplitude", [1.0]), ["sweep.amplitude: unknown key", "allowed: bumper_frequency, bumper_loss_factor, clearance, frequency, restitution"]),
     ("string-mass", _set("system", "m1", "heavy"), ["system.m1: expected a number", "'heavy'", "(str)"]),
     ("bool-stiffness", _set("system", "k1", True), ["system.k1: expected a number", "True", "(bool)"]),
     ("list-amplitude", _set("excitation", "amplitude", [1.0, 2.0]), ["excitation.amplitude: expected a number", "(list)"]),
@@ -229,7 +229,7 @@ MISTAKES = [
     ("clearance-in-stop-and-sweep", _set("sweep", "clearance", [0.003]), ["stop.clearance: also swept in sweep.clearance: give it in one place only"]),
     ("unknown-solution", _top("solutions", ["linear", "fem"]), ["solutions[1]: unknown name 'fem'", "allowed: linear, pgf, pgf_paper"]),
     ("solution-twice", _top("solutions", ["pgf", "linear", "pgf"]), ["solutions[2]: 'pgf' is listed twice"]),
-    ("empty-solutions", _top("solutions", []), ["solutions: expected a non-empty list of names from ['linear', 'pgf', 'pgf_paper', 'momentary', 'exact']"]),
+    ("empty-solutions", _top("solutions", []), ["solutions: expected a non-empty list of names from ['linear', 'pgf', 'pgf_paper', 'momentary', 'exact', 'compliant']"]),
     ("solutions-not-list", _top("solutions", "linear"), ["solutions: expected a non-empty list of names", "'linear'"]),
     ("unknown-quantity", _top("quantities", ["x2_amplitude", "velocity"]), ["quantities[1]: unknown name 'velocity'", "allowed: x1_amplitude", "floquet_modulus"]),
     ("quantity-twice", _top("quantities", ["impulse", "impulse"]), ["quantities[1]: 'impulse' is listed twice"]),
@@ -536,7 +536,7 @@ def test_total_grid_size_is_bounded() -> None:
     doc = base_scene()
     doc["stop"] = {}
     doc["sweep"] = {"restitution": {"start": 0, "stop": 1, "num": 1000}, "clearance": {"start": 0, "stop": 1, "num": 1000}, "frequency": {"start": 1, "stop": 2, "num": 1000}}
-    assert problems_of(doc) == ["sweep: 1,000,000,000 points (restitution x clearance x frequency) is too many: allowed at most 10,000,000"]
+    assert problems_of(doc) == ["sweep: 1,000,000,000 points (product of the swept grids) is too many: allowed at most 10,000,000"]
 
 
 def test_bare_name_without_extension(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -599,7 +599,7 @@ def test_bad_simulation_settings(simulation: dict[str, Any], fragment: str) -> N
 def test_simulation_without_engine_solutions_is_an_error() -> None:
     doc = base_scene()
     doc["simulation"] = {"start": "pgf"}
-    assert problems_of(doc) == ["simulation: given, but no time-domain solution (momentary, exact) is asked for"]
+    assert problems_of(doc) == ["simulation: given, but no time-domain solution (momentary, exact, compliant) is asked for"]
 
 
 def test_shipped_engine_cost_scene_parses() -> None:

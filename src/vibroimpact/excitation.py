@@ -84,6 +84,16 @@ class SweptSine:
         tt = np.asarray(t, dtype=float)
         return 2.0 * math.pi * (self.start_frequency * tt + 0.5 * self.alpha * tt * tt)
 
+    def time_at_phase(self, theta: ArrayLike) -> NDArray[np.float64]:
+        """Inverse of :meth:`phase`: the time [s] at which theta(t) = ``theta`` [rad] (NaN past a sweep down's turn).
+
+        t = 2 p / (f0 + sqrt(f0^2 + 2 alpha p)) with p = theta / 2 pi: the root that is free of cancellation.
+        """
+        cycles = np.asarray(theta, dtype=float) / (2.0 * math.pi)
+        discriminant = self.start_frequency**2 + 2.0 * self.alpha * cycles
+        with np.errstate(invalid="ignore"):
+            return np.where(discriminant >= 0.0, 2.0 * cycles / (self.start_frequency + np.sqrt(np.maximum(discriminant, 0.0))), np.nan)
+
     def force(self, t: ArrayLike) -> NDArray[np.float64]:
         """q sin(theta(t)) [N]."""
         return self.amplitude * np.sin(self.phase(t))

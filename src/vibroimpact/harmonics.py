@@ -16,7 +16,7 @@ import numpy as np
 from .engines.base import Trajectory
 from .excitation import SweptSine
 
-__all__ = ["HarmonicMeasures", "RunningEstimate", "measure", "running_fundamental"]
+__all__ = ["HarmonicMeasures", "RunningEstimate", "measure", "running_fundamental", "running_at", "window_times"]
 
 
 @dataclass(frozen=True)
@@ -43,6 +43,11 @@ class HarmonicMeasures:
         chattering, the converged sum of the sequence (the unresolved rest is negligible).
     periods : int
         Whole periods measured.
+    peak_contact_force : float
+        Largest contact force over the measured contacts [N]: compliant bumpers only (NaN for a rigid stop, whose
+        force is an impulse; 0 without contact).
+    peak_acceleration : float
+        Largest deceleration of the absorber in contact [m s-2]: compliant bumpers only (NaN for a rigid stop).
     """
 
     x1: complex
@@ -55,6 +60,8 @@ class HarmonicMeasures:
     mean_impulse: float
     impulse_per_period: float
     periods: int
+    peak_contact_force: float = math.nan
+    peak_acceleration: float = math.nan
 
     @property
     def force(self) -> complex:
@@ -72,6 +79,13 @@ def measure(trajectory: Trajectory) -> HarmonicMeasures:
     total = trajectory.moments.sum(axis=0)
     x1 = complex(2.0 * total[0] / window)
     impacts = trajectory.impulses.size
+    peaks = trajectory.contact_peaks
+    if peaks.shape[0]:
+        peak_force, peak_acceleration = float(peaks[:, 0].max()), float(peaks[:, 1].max())
+    elif impacts:
+        peak_force = peak_acceleration = math.nan  # a rigid stop: impulses, no finite peak
+    else:
+        peak_force = peak_acceleration = 0.0
     return HarmonicMeasures(
         x1=x1,
         x2=complex(2.0 * total[1] / window),
@@ -83,6 +97,8 @@ def measure(trajectory: Trajectory) -> HarmonicMeasures:
         mean_impulse=float(np.mean(trajectory.impulses)) if impacts else 0.0,
         impulse_per_period=float(np.sum(trajectory.impulses)) / periods,
         periods=periods,
+        peak_contact_force=peak_force,
+        peak_acceleration=peak_acceleration,
     )
 
 
@@ -146,3 +162,28 @@ def running_fundamental(t: np.ndarray, x: np.ndarray, sweep: SweptSine, cycles: 
     rms = np.sqrt((squares[ok] - np.interp(start[ok], theta, squares)) / (t[ok] - t_start))
     centre = np.interp(theta[ok] - np.pi * cycles, theta, t)
     return RunningEstimate(time=centre, frequency=sweep.frequency(centre), amplitude=np.hypot(i, q), rms=rms)
+
+
+def window_times(sweep: SweptSine, centres: np.ndarray, cycles: int) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end [s] of the windows of ``cycles`` whole excitation cycles centred (in phase) on ``centres`` [s]."""
+    theta = sweep.phase(centres)
+    half = np.pi * cycles
+    return sweep.time_at_phase(theta - half), sweep.time_at_phase(theta + half)
+
+
+def running_at(t: np.ndarray, cumulative: np.ndarray, sweep: SweptSine, centres: np.ndarray, cycles: int) -> np.ndarray:
+    """Increase of a cumulative integral sampled at ``t`` over each window of :func:`window_times`.
+
+    ``cumulative`` may be complex (e.g. the integral of x exp(-j theta) theta' dt). NaN where a window leaves the
+    samples. Linear interpolation between samples: exact for integrals that are constant between them (impulses).
+    """
+    start, end = window_times(sweep, centres, cycles)
+    inside = (start >= t[0]) & (end <= t[-1])
+
+    def at(times: np.ndarray) -> np.ndarray:
+        if np.iscomplexobj(cumulative):
+            return np.interp(times, t, cumulative.real) + 1j * np.interp(times, t, cumulative.imag)
+        return np.interp(times, t, cumulative)
+
+    values = at(np.where(inside, end, t[0])) - at(np.where(inside, start, t[0]))
+    return np.where(inside, values, np.nan)

@@ -43,6 +43,9 @@ class Regime(IntEnum):
     #: Time-domain solutions: no periodic steady state within the allowed periods (quasi-periodic or chaotic);
     #: values are averages over the measured window.
     IRREGULAR = 9
+    #: Swept-sine tests: contacts occurred within the estimator's window. A sweep is a slow transient, not a steady
+    #: state: ``impacts_per_period`` says how many contacts per cycle.
+    SWEPT_CONTACT = 10
 
 
 def classify(linear_fits: ArrayLike, exists: ArrayLike, admissible: ArrayLike) -> NDArray[np.int8]:

@@ -27,17 +27,20 @@ import yaml
 
 from .benchmark import BENCHMARK_METHODS, BenchmarkCase, BenchmarkSettings
 from .engines.base import EngineSettings, ImpactProblem
+from .excitation import SweptSine
 from .modal import underdamped_mode_count
 from .pgf import AdmissibilitySettings
 from .steady import SteadySettings
 from .system import TwoDofSystem
 
-__all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "SOLUTIONS", "QUANTITIES", "SWEEPABLE"]
+__all__ = ["Scene", "SceneError", "SweptSineSettings", "load_scene", "parse_scene", "SOLUTIONS", "ENGINE_SOLUTIONS", "QUANTITIES", "SWEEPABLE", "GRID_DIMS"]
 
 #: Solutions a scene can ask for.
-SOLUTIONS = ("linear", "pgf", "pgf_paper", "momentary", "exact")
+SOLUTIONS = ("linear", "pgf", "pgf_paper", "momentary", "exact", "compliant")
 #: Solutions computed by time integration (they need the ``simulation`` section's settings).
-ENGINE_SOLUTIONS = ("momentary", "exact")
+ENGINE_SOLUTIONS = ("momentary", "exact", "compliant")
+#: Directions of a swept-sine test.
+SWEEP_DIRECTIONS = ("up", "down")
 #: How a simulation starts at each frequency.
 SIMULATION_STARTS = ("linear", "pgf", "rest", "sweep_up", "sweep_down")
 #: Quantities a scene can ask for (``regime`` is always written: it says what the others mean).
@@ -59,13 +62,22 @@ QUANTITIES = (
     "converged",
     "x1_rms",
     "x2_rms",
+    "peak_acceleration",
+    "peak_contact_force",
+    "wall_time",
 )
 #: Parameters that can be swept, with their units and allowed ranges (low, high, low inclusive).
 SWEEPABLE = {
     "frequency": ("Hz", 0.0, math.inf, False),
     "restitution": ("1", 0.0, 1.0, True),
     "clearance": ("m", 0.0, math.inf, True),
+    "bumper_frequency": ("Hz", 0.0, math.inf, False),
+    "bumper_loss_factor": ("1", 0.0, 1e6, True),
 }
+#: Where an unswept parameter is given instead (``frequency`` is always swept).
+_FIXED_PLACE = {"restitution": ("stop", "restitution"), "clearance": ("stop", "clearance"), "bumper_frequency": ("bumper", "frequency"), "bumper_loss_factor": ("bumper", "loss_factor")}
+#: Dimension order of a study's grid (unswept ones are squeezed out of the dataset).
+GRID_DIMS = ("restitution", "clearance", "bumper_frequency", "sweep", "frequency")
 _T = TypeVar("_T")
 MAX_GRID_POINTS = 1_000_000
 #: Largest study: restitution x clearance x frequency points (each solution holds a few arrays of this size).
@@ -100,6 +112,37 @@ class SimulationSettings:
     start: str = "pgf"
     engine: EngineSettings = field(default_factory=EngineSettings)
     steady: SteadySettings = field(default_factory=SteadySettings)
+
+
+@dataclass(frozen=True)
+class SweptSineSettings:
+    """A swept-sine test (the paper's Simulink run, section 5) instead of stepped steady states.
+
+    Attributes
+    ----------
+    start_frequency, stop_frequency : float
+        Ends of the sweep [Hz] (a sweep down runs from ``stop_frequency`` to ``start_frequency``).
+    rate : float
+        |alpha| [Hz s-1].
+    directions : tuple of str
+        Some of ``up``, ``down``.
+    sample_rate : float
+        Output samples per second of the simulated signals [Hz].
+    window_cycles : int
+        Cycles of the excitation in the running estimators' window.
+    """
+
+    start_frequency: float
+    stop_frequency: float
+    rate: float
+    directions: tuple[str, ...] = SWEEP_DIRECTIONS
+    sample_rate: float = 1000.0
+    window_cycles: int = 8
+
+    def sweep(self, amplitude: float, direction: str) -> SweptSine:
+        """The excitation of one direction."""
+        low, high = self.start_frequency, self.stop_frequency
+        return SweptSine(amplitude, low, high, self.rate) if direction == "up" else SweptSine(amplitude, high, low, self.rate)
 
 
 @dataclass(frozen=True, eq=False)
@@ -140,6 +183,13 @@ class Scene:
         Settings of the X2(t) <= Delta check.
     simulation : SimulationSettings or None
         Settings of the time-domain solutions, when the scene asks for any.
+    bumper_frequency : ndarray or None
+        Omega_b / 2 pi of the compliant bumper [Hz] (one value unless swept); None without a bumper.
+    bumper_loss_factor : ndarray or None
+        xi_b [-]: one value, or one per ``restitution`` when ``bumper_loss_factor`` is swept (``restitution`` then
+        holds R(xi_b), eq. 26 corrected); None: each restitution's own loss factor (the exact inverse of R(xi_b)).
+    swept_sine : SweptSineSettings or None
+        When given, the time-domain solutions are swept-sine tests, not stepped steady states.
     report : bool
         Whether ``run-study`` writes the comparison report.
     text : str
@@ -159,8 +209,24 @@ class Scene:
     admissibility: AdmissibilitySettings = field(default_factory=AdmissibilitySettings)
     simulation: SimulationSettings | None = None
     benchmark: BenchmarkScene | None = None
+    bumper_frequency: np.ndarray | None = None
+    bumper_loss_factor: np.ndarray | None = None
+    swept_sine: SweptSineSettings | None = None
     report: bool = True
     text: str = ""
+
+    def loss_factors(self) -> np.ndarray:
+        """The bumper's xi_b for each restitution of the grid [-] (NaN where none gives it, R = 0)."""
+        from .contact import loss_factor_from_restitution
+
+        if self.bumper_loss_factor is not None:
+            return np.broadcast_to(self.bumper_loss_factor, self.restitution.shape).astype(float)
+        return np.array([loss_factor_from_restitution(r) if r > 0.0 else np.nan for r in self.restitution])
+
+    @property
+    def sweep_directions(self) -> tuple[str, ...]:
+        """Directions of the swept-sine test; ``()`` for stepped steady states."""
+        return () if self.swept_sine is None else self.swept_sine.directions
 
     @property
     def all_frequencies(self) -> np.ndarray:
@@ -314,7 +380,9 @@ class _Checker:
 
 
 # ----------------------------------------------------------------------------- the parser
-_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "sweep", "solutions", "quantities", "settings", "simulation", "report"}
+_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "bumper", "sweep", "swept_sine", "solutions", "quantities", "settings", "simulation", "report"}
+#: Simulation keys that only stepped steady states use.
+_STEADY_ONLY_KEYS = {"frequency", "start", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods"}
 _BENCHMARK_KEYS = {"duration", "methods", "tolerances", "atol_ratio", "repeats", "max_seconds", "cases"}
 _BENCHMARK_CASE_KEYS = {"name", "frequency", "restitution", "clearance", "clearance_below_linear", "start"}
 _SIMULATION_KEYS = {"frequency", "start", "method", "rtol", "atol", "max_step", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods"}
@@ -334,23 +402,45 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
     name, description, system, amplitude, report = _parse_header(c, doc)
 
     sweep = c.mapping("sweep", doc.get("sweep", {}), set(SWEEPABLE), {"frequency"}) if "sweep" in doc else {}
-    stop = c.mapping("stop", doc["stop"], {"clearance", "restitution"}) if "stop" in doc else {}
+    fixed = {
+        "stop": c.mapping("stop", doc["stop"], {"clearance", "restitution"}) if "stop" in doc else {},
+        "bumper": c.mapping("bumper", doc["bumper"], {"frequency", "loss_factor"}) if "bumper" in doc else {},
+    }
+    solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
+    derived_restitution = "bumper_loss_factor" in sweep
     grids: dict[str, np.ndarray | None] = {}
     for key, (_units, low, high, low_inclusive) in SWEEPABLE.items():
+        section, field_name = _FIXED_PLACE.get(key, ("", ""))
+        place = f"{section}.{field_name}"
+        given_fixed = field_name in fixed.get(section, {})
         if key in sweep:
-            if key in stop:
-                c.fail(f"stop.{key}", f"also swept in sweep.{key}: give it in one place only")
+            if given_fixed:
+                c.fail(place, f"also swept in sweep.{key}: give it in one place only")
             grids[key] = c.grid(f"sweep.{key}", sweep[key], low, high, low_inclusive)
-        elif key in stop:
-            value = c.number(f"stop.{key}", stop[key], low, high, low_inclusive)
+        elif given_fixed:
+            value = c.number(place, fixed[section][field_name], low, high, low_inclusive)
             grids[key] = None if value is None else np.array([value])
-        elif key != "frequency":
-            c.fail(f"stop.{key}", f"required unless swept (sweep.{key}); allowed range {_interval(low, high, low_inclusive)}")
+        elif key == "restitution" and derived_restitution:
+            continue  # R(xi_b) of the swept loss factors
+        elif key == "restitution" or key == "clearance":
+            c.fail(place, f"required unless swept (sweep.{key}); allowed range {_interval(low, high, low_inclusive)}")
+    if derived_restitution and "restitution" in grids:
+        c.fail("sweep.bumper_loss_factor", "sweeping the bumper's loss factor sets the restitution R(xi_b): do not also give restitution")
+    if derived_restitution and (xi := grids.get("bumper_loss_factor")) is not None:
+        from .contact import restitution_from_loss_factor
+
+        grids["restitution"] = np.array([restitution_from_loss_factor(x) for x in xi])
+    needs_bumper = "compliant" in solutions or "swept_sine" in doc
+    if needs_bumper and "bumper_frequency" not in sweep and "bumper" not in doc:
+        c.fail("bumper", "required by the compliant solution and swept-sine tests: {frequency: Omega_b / 2 pi [Hz], loss_factor: xi_b (optional)}")
+    elif "bumper" in doc and "bumper_frequency" not in sweep and "frequency" not in fixed["bumper"]:
+        c.fail("bumper.frequency", "required unless swept (sweep.bumper_frequency): Omega_b / 2 pi [Hz] in (0, inf)")
+    if "compliant" in solutions and "bumper_loss_factor" not in grids and (r := grids.get("restitution")) is not None and np.any(r == 0.0):
+        c.fail("stop.restitution", "R = 0 needs an infinitely damped bumper for the compliant solution: give bumper.loss_factor, or sweep R > 0")
 
     sizes = [g.size for g in grids.values() if g is not None]
-    if len(sizes) == len(SWEEPABLE) and math.prod(sizes) > MAX_STUDY_POINTS:
-        c.fail("sweep", f"{math.prod(sizes):,} points (restitution x clearance x frequency) is too many: allowed at most {MAX_STUDY_POINTS:,}")
-    solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
+    if len(sizes) >= 3 and math.prod(sizes) > MAX_STUDY_POINTS:
+        c.fail("sweep", f"{math.prod(sizes):,} points (product of the swept grids) is too many: allowed at most {MAX_STUDY_POINTS:,}")
     if "pgf_paper" in solutions and system is not None and (modes := underdamped_mode_count(system)) != 2:
         c.fail("solutions", f"pgf_paper needs two underdamped modes (the paper's eq. 10 fit); this system has {modes}")
     quantities = c.choices("quantities", doc["quantities"], QUANTITIES) if "quantities" in doc else QUANTITIES
@@ -372,10 +462,14 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
 
     simulation = None
     engines = [name for name in solutions if name in ENGINE_SOLUTIONS]
+    swept_sine = _parse_swept_sine(c, doc["swept_sine"], engines) if "swept_sine" in doc else None
     if "simulation" in doc:
         if not engines:
             c.fail("simulation", f"given, but no time-domain solution ({', '.join(ENGINE_SOLUTIONS)}) is asked for")
         elif (main_grid := grids.get("frequency")) is not None:
+            if "swept_sine" in doc:
+                for key in sorted(set(doc["simulation"]) & _STEADY_ONLY_KEYS if isinstance(doc["simulation"], dict) else ()):
+                    c.fail(f"simulation.{key}", "not used by a swept-sine test (it sets stepped steady states): remove it")
             simulation = _parse_simulation(c, doc["simulation"], main_grid)
     elif engines and (main_grid := grids.get("frequency")) is not None:
         simulation = SimulationSettings(frequency=main_grid)
@@ -386,7 +480,8 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
     # guaranteed when no problem was recorded
     assert system is not None and amplitude is not None and isinstance(name, str)
     assert frequency is not None and restitution is not None and clearance is not None
-    swept = tuple(k for k in ("restitution", "clearance") if k in sweep) + ("frequency",)
+    order = ("bumper_loss_factor", "restitution", "clearance", "bumper_frequency")
+    swept = tuple(k for k in order if k in sweep) + ("frequency",)
     return Scene(
         name=name,
         description=description,
@@ -400,9 +495,35 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
         quantities=quantities,
         admissibility=admissibility,
         simulation=simulation,
+        bumper_frequency=grids.get("bumper_frequency"),
+        bumper_loss_factor=grids.get("bumper_loss_factor"),
+        swept_sine=swept_sine,
         report=report,
         text=text,
     )
+
+
+def _parse_swept_sine(c: _Checker, value: Any, engines: list[str]) -> SweptSineSettings | None:
+    """``swept_sine: {start, stop, rate, directions, sample_rate, window_cycles}`` (frequencies [Hz], rate [Hz s-1])."""
+    spec = c.mapping("swept_sine", value, {"start", "stop", "rate", "directions", "sample_rate", "window_cycles"}, {"start", "stop", "rate"})
+    if engines != ["compliant"]:
+        c.fail("solutions", f"a swept-sine test runs the compliant solution only (and needs it): got {engines or 'none'}")
+    start = c.number("swept_sine.start", spec["start"], 0.0, math.inf, low_inclusive=False) if "start" in spec else None
+    stop = c.number("swept_sine.stop", spec["stop"], 0.0, math.inf, low_inclusive=False) if "stop" in spec else None
+    rate = c.number("swept_sine.rate", spec["rate"], 0.0, math.inf, low_inclusive=False) if "rate" in spec else None
+    directions = c.choices("swept_sine.directions", spec["directions"], SWEEP_DIRECTIONS) if "directions" in spec else SWEEP_DIRECTIONS
+    sample_rate = c.number("swept_sine.sample_rate", spec.get("sample_rate", 1000.0), 0.0, 1e7, low_inclusive=False)
+    cycles = c.integer("swept_sine.window_cycles", spec.get("window_cycles", 8), 1, 10_000)
+    if start is not None and stop is not None and stop <= start:
+        c.fail("swept_sine.stop", f"{stop:g} must be greater than start = {start:g} (directions say which way it runs)")
+        return None
+    if None in (start, stop, rate, sample_rate, cycles) or not directions:
+        return None
+    assert start is not None and stop is not None and rate is not None and sample_rate is not None and cycles is not None
+    if sample_rate < 20.0 * stop:
+        c.fail("swept_sine.sample_rate", f"{sample_rate:g} Hz is too coarse for {stop:g} Hz: allowed [{20.0 * stop:g}, 1e+07] (20 samples per cycle)")
+        return None
+    return SweptSineSettings(start, stop, rate, directions, sample_rate, cycles)
 
 
 def _parse_header(c: _Checker, doc: dict) -> tuple[Any, str, TwoDofSystem | None, float | None, bool]:

@@ -16,7 +16,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Protocol, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,23 +25,43 @@ from . import __version__
 from .atomic import atomic_path
 from .engines import EngineSettings, ExactEngine, ImpactProblem
 from .engines.base import Engine
+from .engines.compliant import CompliantEngine
 from .engines.momentary import MomentaryEngine
 from .steady import SteadySettings, linear_fits, steady_state
 from .system import TwoDofSystem
 
-__all__ = ["ENGINES", "SWEEP_STARTS", "SimulationCase", "CaseResult", "run_cases", "make_engine"]
+__all__ = ["ENGINES", "SWEEP_STARTS", "Case", "SimulationCase", "CaseResult", "run_cases", "make_engine"]
 
-#: Time-domain solutions and their engines.
-ENGINES: dict[str, Callable[[EngineSettings], Engine]] = {"exact": ExactEngine, "momentary": MomentaryEngine}
+#: Time-domain solutions and their engines (the compliant one also needs its bumper, see :func:`make_engine`).
+ENGINES: dict[str, Callable[..., Engine]] = {"exact": ExactEngine, "momentary": MomentaryEngine, "compliant": CompliantEngine}
 SWEEP_STARTS = ("sweep_up", "sweep_down")
 #: Fields of a case result, one value per frequency.
-FIELDS = ("x1", "x2", "suspension_force", "contact_force", "x1_rms", "x2_rms", "impacts_per_period", "mean_impulse", "impulse_per_period", "converged", "multiplicity", "periods_used", "wall_time", "failed")
+FIELDS = (
+    "x1",
+    "x2",
+    "suspension_force",
+    "contact_force",
+    "x1_rms",
+    "x2_rms",
+    "impacts_per_period",
+    "mean_impulse",
+    "impulse_per_period",
+    "peak_contact_force",
+    "peak_acceleration",
+    "converged",
+    "multiplicity",
+    "periods_used",
+    "wall_time",
+    "failed",
+)
 
 
-def make_engine(name: str, settings: EngineSettings) -> Engine:
-    """The engine registered under ``name``."""
+def make_engine(name: str, settings: EngineSettings, bumper_frequency: float = math.nan, bumper_loss_factor: float = math.nan) -> Engine:
+    """The engine registered under ``name``; ``compliant`` takes Omega_b / 2 pi [Hz] and xi_b [-] of its bumper."""
     if name not in ENGINES:
         raise ValueError(f"engine {name!r} is unknown: use one of {', '.join(ENGINES)}")
+    if name == "compliant":
+        return CompliantEngine(bumper_frequency, bumper_loss_factor, settings)
     return ENGINES[name](settings)
 
 
@@ -58,6 +78,19 @@ class SimulationCase:
     start: str
     engine_settings: EngineSettings
     steady_settings: SteadySettings
+    bumper_frequency: float = math.nan
+    bumper_loss_factor: float = math.nan
+
+    fields = FIELDS
+
+    @property
+    def points(self) -> int:
+        """Frequency points in the case (progress is counted in points)."""
+        return len(self.frequencies)
+
+    def run(self) -> "CaseResult":
+        """Steady states of this case (see :func:`run_case`)."""
+        return run_case(self)
 
     def key(self) -> str:
         """A stable hash of everything that determines the result (and of the package version)."""
@@ -73,6 +106,7 @@ class SimulationCase:
                 "start": self.start,
                 "engine_settings": asdict(self.engine_settings),
                 "steady_settings": asdict(self.steady_settings),
+                "bumper": [self.bumper_frequency, self.bumper_loss_factor] if self.engine == "compliant" else None,
             },
             sort_keys=True,
         )
@@ -84,7 +118,7 @@ CaseResult = dict[str, NDArray[np.generic]]
 
 def run_case(case: SimulationCase) -> CaseResult:
     """Steady states of one case, in the order of ``case.frequencies``."""
-    engine = make_engine(case.engine, case.engine_settings)
+    engine = make_engine(case.engine, case.engine_settings, case.bumper_frequency, case.bumper_loss_factor)
     n = len(case.frequencies)
     out: dict[str, NDArray[np.generic]] = {name: np.full(n, np.nan, dtype=complex if name in ("x1", "x2", "suspension_force", "contact_force") else float) for name in FIELDS}
     order = range(n - 1, -1, -1) if case.start == "sweep_down" else range(n)
@@ -122,6 +156,8 @@ def run_case(case: SimulationCase) -> CaseResult:
             "impacts_per_period": m.impacts_per_period,
             "mean_impulse": m.mean_impulse,
             "impulse_per_period": m.impulse_per_period,
+            "peak_contact_force": m.peak_contact_force,
+            "peak_acceleration": m.peak_acceleration,
             "converged": float(result.converged),
             "multiplicity": float(result.multiplicity),
             "periods_used": float(result.periods_used),
@@ -134,7 +170,25 @@ def run_case(case: SimulationCase) -> CaseResult:
     return out
 
 
-def run_cases(cases: list[SimulationCase], jobs: int = 1, cache_dir: Path | None = None, progress: bool = True) -> list[CaseResult]:
+class Case(Protocol):
+    """What :func:`run_cases` runs: a picklable piece of work with a stable key and a weight for progress."""
+
+    engine: str
+    fields: tuple[str, ...]
+
+    @property
+    def points(self) -> int: ...
+
+    def key(self) -> str: ...
+
+    def run(self) -> CaseResult: ...
+
+
+def _run(case: Case) -> CaseResult:
+    return case.run()
+
+
+def run_cases(cases: Sequence[Case], jobs: int = 1, cache_dir: Path | None = None, progress: bool = True) -> list[CaseResult]:
     """Run cases serially (``jobs = 1``) or in ``jobs`` processes, reusing and filling ``cache_dir``.
 
     Progress (points done, elapsed, estimated remaining) goes to stderr.
@@ -147,20 +201,20 @@ def run_cases(cases: list[SimulationCase], jobs: int = 1, cache_dir: Path | None
             results[index] = cached
         else:
             pending.append(index)
-    bar = _Progress(sum(len(c.frequencies) for c in cases), sum(len(cases[i].frequencies) for i in range(len(cases)) if results[i] is not None), progress)
+    bar = _Progress(sum(c.points for c in cases), sum(cases[i].points for i in range(len(cases)) if results[i] is not None), progress)
 
     def finish(index: int, result: CaseResult) -> None:
         results[index] = result
         if cache_dir is not None:
             _save(cache_dir, cases[index], result)
-        bar.advance(len(cases[index].frequencies))
+        bar.advance(cases[index].points)
 
     if jobs <= 1 or len(pending) <= 1:
         for index in pending:
-            finish(index, run_case(cases[index]))
+            finish(index, cases[index].run())
     else:
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            futures = {pool.submit(run_case, cases[index]): index for index in pending}
+            futures = {pool.submit(_run, cases[index]): index for index in pending}
             for future in as_completed(futures):
                 finish(futures[future], future.result())
     bar.close()
@@ -205,20 +259,20 @@ class _Progress:
             print(file=sys.stderr, flush=True)
 
 
-def _cache_path(cache_dir: Path, case: SimulationCase) -> Path:
+def _cache_path(cache_dir: Path, case: Case) -> Path:
     return cache_dir / f"{case.engine}-{case.key()}.npz"
 
 
-def _load(cache_dir: Path, case: SimulationCase) -> CaseResult | None:
+def _load(cache_dir: Path, case: Case) -> CaseResult | None:
     path = _cache_path(cache_dir, case)
     if not path.is_file():
         return None
     with np.load(path) as stored:
-        if not set(FIELDS) <= set(stored.files):
+        if not set(case.fields) <= set(stored.files):
             return None  # written by an older version: run the case again
-        return {name: stored[name] for name in FIELDS}
+        return {name: stored[name] for name in case.fields}
 
 
-def _save(cache_dir: Path, case: SimulationCase, result: CaseResult) -> None:
+def _save(cache_dir: Path, case: Case, result: CaseResult) -> None:
     with atomic_path(_cache_path(cache_dir, case), suffix=".npz") as temporary:
         np.savez(temporary, **result)  # type: ignore[arg-type]

@@ -222,6 +222,8 @@ def _linear_answer(problem: ImpactProblem) -> SteadyResult:
         mean_impulse=0.0,
         impulse_per_period=0.0,
         periods=0,
+        peak_contact_force=0.0,
+        peak_acceleration=0.0,
     )
     _t, state = start_state(problem, "linear")
     return SteadyResult(measures=measures, converged=True, multiplicity=1, periods_used=0, end_time=0.0, end_state=state, integrated=False)

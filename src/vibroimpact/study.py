@@ -19,12 +19,14 @@ import xarray as xr
 from . import __version__
 from .atomic import atomic_path
 from .benchmark import run_benchmark
+from .contact import peak_acceleration_factor
 from .linear import linear_response
 from .modal import fit_modal_parameters
 from .pgf import PgfVariant, green_models, solve_one_impact
 from .regime import Regime, classify, regime_attributes
-from .scene import ENGINE_SOLUTIONS, Scene
+from .scene import ENGINE_SOLUTIONS, GRID_DIMS, Scene
 from .simulate import FIELDS, SWEEP_STARTS, SimulationCase, run_cases
+from .swept import SWEEP_QUANTITIES, SweepCase
 
 #: Frequencies per simulation case when points are independent (load balancing between processes).
 CASE_CHUNK = 16
@@ -47,6 +49,15 @@ VARIABLE_ATTRIBUTES: dict[str, dict[str, str]] = {
     "impacts_per_period": {"units": "1", "long_name": "impacts per excitation period (simulations: measured over whole periods)"},
     "x1_rms": {"units": "m", "long_name": "RMS of X1 (simulations: over the measured periods; linear regimes: |X1| / sqrt 2)"},
     "x2_rms": {"units": "m", "long_name": "RMS of X2 (simulations: over the measured periods; linear regimes: |X2| / sqrt 2)"},
+    "peak_acceleration": {"units": "m s-2", "long_name": "largest deceleration of the absorber on the bumper (compliant: measured; pgf: Gamma(xi_b) Omega_b J / (M2 (1 + R)); rigid engines: NaN; no contact: 0)"},
+    "peak_contact_force": {"units": "N", "long_name": "largest bumper force (compliant: measured; pgf: M2 times its peak-acceleration estimate; rigid engines: NaN; no contact: 0)"},
+    "wall_time": {"units": "s", "long_name": "wall time of the simulation at this point (one process; swept-sine tests: the whole sweep)"},
+}
+SWEEP_STAT_ATTRIBUTES: dict[str, dict[str, str]] = {
+    "sweep_wall_time": {"units": "s", "long_name": "wall time of the whole swept-sine run"},
+    "sweep_steps": {"units": "1", "long_name": "integrator steps of the swept-sine run"},
+    "sweep_contacts": {"units": "1", "long_name": "bumper contacts during the swept-sine run"},
+    "sweep_rhs_calls": {"units": "1", "long_name": "right-hand-side (residual) evaluations of the swept-sine run"},
 }
 CONVERGED_ATTRIBUTES = {
     "long_name": "the simulated stroboscopic state repeated to the steady-state tolerance",
@@ -68,6 +79,9 @@ COORDINATE_ATTRIBUTES: dict[str, dict[str, str]] = {
     "restitution": {"units": "1", "long_name": "restitution ratio R"},
     "clearance": {"units": "m", "long_name": "clearance Delta between absorber and stop"},
     "solution": {"long_name": "solution method"},
+    "bumper_frequency": {"units": "Hz", "long_name": "apparent natural frequency Omega_b / 2 pi of the compliant bumper"},
+    "bumper_loss_factor": {"units": "1", "long_name": "loss factor xi_b of the compliant bumper"},
+    "sweep": {"long_name": "direction of the swept-sine test"},
 }
 _IMPACT_REGIMES = (Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR)
 _LINEAR_REGIMES = (Regime.LINEAR, Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT, Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT)
@@ -96,51 +110,82 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
     Returns
     -------
     xarray.Dataset
-        Dimensions ``solution``, the swept parameters and ``frequency``.
+        Dimensions ``solution``, the swept parameters (``sweep`` for swept-sine tests) and ``frequency``.
     """
     if scene.benchmark is not None:
         dataset = run_benchmark(list(scene.benchmark.cases), scene.benchmark.settings, progress=progress is not None)
         dataset.attrs.update({"title": f"vibroimpact benchmark '{scene.name}'", "scene_name": scene.name, "scene": scene.text, "vibroimpact_version": __version__})
         return dataset
     report = progress or (lambda _message: None)
-    # full grid (restitution, clearance, frequency); unswept axes have length 1 and are squeezed at the end
+    # full grid (restitution, clearance, bumper_frequency, sweep, frequency): unswept axes have length 1 and are
+    # squeezed at the end; each solution computes only along the axes it depends on, then is broadcast
     frequency = scene.all_frequencies
-    r = scene.restitution[:, None, None]
-    delta = scene.clearance[None, :, None]
-    omega = 2.0 * np.pi * frequency[None, None, :]
-    shape = np.broadcast_shapes(r.shape, delta.shape, omega.shape)
+    bumper = scene.bumper_frequency if scene.bumper_frequency is not None else np.array([np.nan])
+    directions = scene.sweep_directions or ("",)
+    full = (scene.restitution.size, scene.clearance.size, bumper.size, len(directions), frequency.size)
+    r = scene.restitution[:, None, None, None, None]
+    delta = scene.clearance[None, :, None, None, None]
+    omega = 2.0 * np.pi * frequency[None, None, None, None, :]
+    base = np.broadcast_shapes(r.shape, delta.shape, omega.shape)
     total = len(scene.solutions)
     per_solution = []
+    running: dict[str, np.ndarray] = {}
+    sweep_axes: dict[str, np.ndarray] = {}
     for i, name in enumerate(scene.solutions, start=1):
         if name == "linear":
-            values = _linear(scene, omega, delta, shape)
+            values = _linear(scene, omega, delta, base)
+        elif name in ENGINE_SOLUTIONS and scene.swept_sine is not None:
+            values, running, sweep_axes = _swept(scene, full, jobs, cache_dir, progress is not None)
         elif name in ENGINE_SOLUTIONS:
-            values = _simulated(scene, name, shape, jobs, cache_dir, progress is not None)
+            values = _simulated(scene, name, full, jobs, cache_dir, progress is not None)
         else:
-            values = _pgf(scene, PgfVariant(name), omega, delta, r, shape)
+            values = _pgf(scene, PgfVariant(name), omega, delta, r, base)
         per_solution.append(values)
         report(f"[{i}/{total}] {name}: done")
 
-    dims = ("solution", "restitution", "clearance", "frequency")
-    coords = {
-        "solution": np.array(scene.solutions, dtype=object),
-        "restitution": scene.restitution,
-        "clearance": scene.clearance,
-        "frequency": frequency,
-    }
+    dims = ("solution", *GRID_DIMS)
+    coords: dict[str, object] = {"solution": np.array(scene.solutions, dtype=object), "restitution": scene.restitution, "clearance": scene.clearance, "frequency": frequency}
+    if scene.bumper_frequency is not None:
+        coords["bumper_frequency"] = scene.bumper_frequency
+    if scene.swept_sine is not None:
+        coords["sweep"] = np.array(directions, dtype=object)
     data_vars = {}
     for quantity in scene.quantities:
-        stacked = np.stack([values[quantity] for values in per_solution])
+        stacked = np.stack([np.broadcast_to(values[quantity], full) for values in per_solution])
         attrs = {"regime": regime_attributes(), "stable": STABLE_ATTRIBUTES, "converged": CONVERGED_ATTRIBUTES}.get(quantity, VARIABLE_ATTRIBUTES.get(quantity))
         data_vars[quantity] = xr.Variable(dims, stacked, attrs)
+    for name, values in running.items():
+        if name.startswith("sweep_"):  # one value per sweep run
+            data_vars[name] = xr.Variable(GRID_DIMS[:-1], values, SWEEP_STAT_ATTRIBUTES[name])
+        else:
+            data_vars[name] = xr.Variable((*GRID_DIMS[:-1], "time"), values, _running_attributes(name))
     dataset = xr.Dataset(data_vars, coords=coords)
-    for key in ("restitution", "clearance"):
-        if key not in scene.swept:
-            dataset = dataset.squeeze(key)
+    if running:
+        dataset = dataset.assign_coords(
+            time=("time", sweep_axes["time"], {"units": "s", "long_name": "time since the start of the sweep"}),
+            instantaneous_frequency=(("sweep", "time"), sweep_axes["instantaneous_frequency"], {"units": "Hz", "long_name": "instantaneous excitation frequency f0 + alpha t"}),
+        )
+    for key in ("restitution", "clearance", "bumper_frequency", "sweep"):
+        if key == "sweep" and scene.swept_sine is not None:
+            continue  # a swept-sine study keeps its sweep dimension even with one direction
+        if key not in scene.swept and key in dataset.dims:
+            dataset = dataset.squeeze(key, drop=key not in coords)
+    if scene.bumper_frequency is not None:
+        losses = scene.loss_factors()
+        dataset = dataset.assign_coords(bumper_loss_factor=("restitution", losses) if "restitution" in dataset.dims else float(losses[0]))
+        if "bumper_loss_factor" in scene.swept:
+            dataset = dataset.swap_dims({"restitution": "bumper_loss_factor"})
     for key, attrs in COORDINATE_ATTRIBUTES.items():
-        dataset[key].attrs.update(attrs)
+        if key in dataset.coords:
+            dataset[key].attrs.update(attrs)
     dataset.attrs.update(_metadata(scene))
     return dataset
+
+
+def _running_attributes(name: str) -> dict[str, str]:
+    quantity = name.removeprefix("running_")
+    base = VARIABLE_ATTRIBUTES.get(quantity, {})
+    return {"units": base.get("units", "1"), "long_name": f"running estimate over the sweep's window: {base.get('long_name', quantity)}"}
 
 
 def _linear(scene: Scene, omega: np.ndarray, delta: np.ndarray, shape: tuple[int, ...]) -> dict[str, np.ndarray]:
@@ -159,6 +204,9 @@ def _linear(scene: Scene, omega: np.ndarray, delta: np.ndarray, shape: tuple[int
         "converged": np.full(shape, -1, dtype=np.int8),
         "x1_rms": np.abs(response.x1) / np.sqrt(2.0) * np.ones(shape),
         "x2_rms": np.abs(response.x2) / np.sqrt(2.0) * np.ones(shape),
+        "peak_acceleration": np.where(fits, 0.0, np.nan),
+        "peak_contact_force": np.where(fits, 0.0, np.nan),
+        "wall_time": np.full(shape, np.nan),
     }
     return {k: np.broadcast_to(v, shape) for k, v in values.items() if k in scene.quantities}
 
@@ -205,8 +253,22 @@ def _pgf(scene: Scene, variant: PgfVariant, omega: np.ndarray, delta: np.ndarray
         "converged": lambda: np.full(shape, -1, dtype=np.int8),
         "x1_rms": lambda: np.where(free, np.abs(linear.x1) / np.sqrt(2.0), np.nan),
         "x2_rms": lambda: np.where(free, np.abs(linear.x2) / np.sqrt(2.0), np.nan),
+        "peak_acceleration": lambda: choose(_peak_acceleration_estimate(scene, solution.impulse, r), np.zeros(shape)),
+        "peak_contact_force": lambda: choose(scene.system.m2 * _peak_acceleration_estimate(scene, solution.impulse, r), np.zeros(shape)),
+        "wall_time": lambda: np.full(shape, np.nan),
     }
     return {q: makers[q]() for q in scene.quantities}
+
+
+def _peak_acceleration_estimate(scene: Scene, impulse: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """PGF-based peak contact deceleration (section 6.3, corrected): Gamma(xi_b) Omega_b v0 with the entry speed
+    v0 = J / (M2 (1 + R)) of the rigid-stop solution [m s-2]; the contact force peaks at M2 times it (the bumper
+    force is all that decelerates the absorber during the short contact). NaN without a bumper."""
+    if scene.bumper_frequency is None:
+        return np.full(np.broadcast_shapes(np.shape(impulse), r.shape), np.nan)
+    gamma = np.array([peak_acceleration_factor(xi) if np.isfinite(xi) else np.nan for xi in scene.loss_factors()])[:, None, None, None, None]
+    omega_b = 2.0 * np.pi * scene.bumper_frequency[None, None, :, None, None]
+    return gamma * omega_b * impulse / (scene.system.m2 * (1.0 + r))
 
 
 def _no_one_impact_orbit(shape: tuple[int, ...]) -> dict[str, np.ndarray]:
@@ -223,29 +285,36 @@ def _no_one_impact_orbit(shape: tuple[int, ...]) -> dict[str, np.ndarray]:
 
 
 def _simulated(scene: Scene, engine: str, shape: tuple[int, ...], jobs: int, cache_dir: Path | None, progress: bool) -> dict[str, np.ndarray]:
-    """Steady states of a time-domain engine on the simulation grid; NaN at the other frequencies."""
+    """Steady states of a time-domain engine on the simulation grid; NaN at the other frequencies.
+
+    Only ``compliant`` depends on the bumper: the rigid engines run once per (restitution, clearance).
+    """
     assert scene.simulation is not None
     sim = scene.simulation
-    all_frequencies = scene.all_frequencies
-    columns = np.searchsorted(all_frequencies, sim.frequency)
+    columns = np.searchsorted(scene.all_frequencies, sim.frequency)
+    bumpers = scene.bumper_frequency if engine == "compliant" and scene.bumper_frequency is not None else np.array([np.nan])
+    losses = scene.loss_factors() if engine == "compliant" else np.full(scene.restitution.shape, np.nan)
     # a sweep is one chain; independent starts are split into chunks so that processes share the work evenly
     chunk = sim.frequency.size if sim.start in SWEEP_STARTS else CASE_CHUNK
     cases, places = [], []
     for i, restitution in enumerate(scene.restitution):
         for j, clearance in enumerate(scene.clearance):
-            for first in range(0, sim.frequency.size, chunk):
-                frequencies = tuple(float(f) for f in sim.frequency[first : first + chunk])
-                cases.append(SimulationCase(engine, scene.system, scene.amplitude, float(restitution), float(clearance), frequencies, sim.start, sim.engine, sim.steady))
-                places.append((i, j, columns[first : first + chunk]))
+            for k, bumper in enumerate(bumpers):
+                for first in range(0, sim.frequency.size, chunk):
+                    frequencies = tuple(float(f) for f in sim.frequency[first : first + chunk])
+                    case = SimulationCase(engine, scene.system, scene.amplitude, float(restitution), float(clearance), frequencies, sim.start, sim.engine, sim.steady, float(bumper), float(losses[i]))
+                    cases.append(case)
+                    places.append((i, j, k, columns[first : first + chunk]))
     results = run_cases(cases, jobs=jobs, cache_dir=cache_dir, progress=progress)
-    fields = {name: np.full(shape, np.nan, dtype=complex if name in ("x1", "x2", "suspension_force", "contact_force") else float) for name in FIELDS}
-    for (i, j, where), result in zip(places, results):
+    grid = (shape[0], shape[1], bumpers.size, 1, shape[4])
+    fields = {name: np.full(grid, np.nan, dtype=complex if name in ("x1", "x2", "suspension_force", "contact_force") else float) for name in FIELDS}
+    for (i, j, k, where), result in zip(places, results):
         for name in FIELDS:
-            fields[name][i, j, where] = result[name]
+            fields[name][i, j, k, 0, where] = result[name]
     computed = ~np.isnan(fields["converged"])
     converged = fields["converged"] == 1.0
     impacts = fields["impacts_per_period"]
-    regime = np.full(shape, Regime.NOT_COMPUTED, dtype=np.int8)
+    regime = np.full(grid, Regime.NOT_COMPUTED, dtype=np.int8)
     regime[computed & ~converged] = Regime.IRREGULAR
     regime[computed & converged] = Regime.PERIODIC_IMPACTS
     regime[computed & converged & (impacts == 0.0)] = Regime.LINEAR
@@ -257,15 +326,60 @@ def _simulated(scene: Scene, engine: str, shape: tuple[int, ...], jobs: int, cac
         "force_amplitude": np.abs(force),
         "suspension_force_amplitude": np.abs(fields["suspension_force"]),
         "impulse": fields["impulse_per_period"],
-        "phase": np.full(shape, np.nan),
+        "phase": np.full(grid, np.nan),
         "regime": regime,
-        **_no_one_impact_orbit(shape),
+        **_no_one_impact_orbit(grid),
         "impacts_per_period": impacts,
         "converged": np.where(computed, converged, -1).astype(np.int8),
         "x1_rms": fields["x1_rms"],
         "x2_rms": fields["x2_rms"],
+        "peak_acceleration": fields["peak_acceleration"],
+        "peak_contact_force": fields["peak_contact_force"],
+        "wall_time": fields["wall_time"],
     }
     return {q: values[q] for q in scene.quantities}
+
+
+def _swept(scene: Scene, shape: tuple[int, ...], jobs: int, cache_dir: Path | None, progress: bool) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """Swept-sine tests of the compliant model: estimates on the frequency grid, running estimates against time, and
+    the time axes (``time``, ``instantaneous_frequency`` per direction)."""
+    assert scene.swept_sine is not None and scene.bumper_frequency is not None and scene.simulation is not None
+    losses = scene.loss_factors()
+    frequencies = tuple(float(f) for f in scene.all_frequencies)
+    cases, places = [], []
+    for i in range(scene.restitution.size):
+        for j, clearance in enumerate(scene.clearance):
+            for k, bumper in enumerate(scene.bumper_frequency):
+                for d, direction in enumerate(scene.swept_sine.directions):
+                    cases.append(SweepCase(scene.system, scene.amplitude, float(clearance), float(bumper), float(losses[i]), scene.swept_sine, direction, scene.simulation.engine, frequencies))
+                    places.append((i, j, k, d))
+    results = run_cases(cases, jobs=jobs, cache_dir=cache_dir, progress=progress)
+    times = results[0]["time"]
+    values = {name: np.full(shape, np.nan) for name in SWEEP_QUANTITIES}
+    running = {f"running_{name}": np.full((*shape[:-1], times.size), np.nan) for name in SWEEP_QUANTITIES}
+    stats = {name: np.full(shape[:-1], np.nan) for name in ("wall_time", "steps", "contacts", "rhs_calls")}
+    instantaneous = np.full((shape[3], times.size), np.nan)
+    for (i, j, k, d), result in zip(places, results):
+        for name in SWEEP_QUANTITIES:
+            values[name][i, j, k, d] = result[name]
+            running[f"running_{name}"][i, j, k, d] = result[f"running_{name}"]
+        for name in stats:
+            stats[name][i, j, k, d] = result[name]
+        instantaneous[d] = result["instantaneous_frequency"]
+    impacts = values["impacts_per_period"]
+    regime = np.full(shape, Regime.NOT_COMPUTED, dtype=np.int8)
+    regime[impacts == 0.0] = Regime.LINEAR
+    regime[impacts > 0.0] = Regime.SWEPT_CONTACT
+    values |= {
+        "phase": np.full(shape, np.nan),
+        "regime": regime,
+        **_no_one_impact_orbit(shape),
+        "converged": np.full(shape, -1, dtype=np.int8),
+        "wall_time": np.broadcast_to(stats["wall_time"][..., None], shape),
+    }
+    for name, value in stats.items():
+        running[f"sweep_{name}"] = value  # one value per sweep: the run's cost
+    return {q: values[q] for q in scene.quantities}, running, {"time": times, "instantaneous_frequency": instantaneous}
 
 
 def _metadata(scene: Scene) -> dict[str, object]:
