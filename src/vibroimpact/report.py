@@ -8,19 +8,16 @@ from __future__ import annotations
 
 import base64
 import html
-import io
 import math
-from dataclasses import dataclass
 from pathlib import Path
 
-import matplotlib
+from .report_common import Figure, save_figure  # sets the Agg backend before pyplot is imported
 
-matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.figure import Figure as Figure_  # noqa: E402
 import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
 
+from . import bumper_report  # noqa: E402
 from .atomic import atomic_path  # noqa: E402
 from .linear import linear_response  # noqa: E402
 from .modal import exact_modal_parameters, fit_modal_parameters, underdamped_mode_count  # noqa: E402
@@ -40,14 +37,6 @@ _LABELS = {
 }
 
 
-@dataclass(frozen=True)
-class Figure:
-    """A figure written to disk and its caption."""
-
-    path: Path
-    caption: str
-
-
 def write_report(dataset: xr.Dataset, out_dir: str | Path) -> Path:
     """Write the PNG figures and ``report.html`` for ``dataset`` into ``out_dir``; return the HTML path."""
     out = Path(out_dir)
@@ -56,6 +45,14 @@ def write_report(dataset: xr.Dataset, out_dir: str | Path) -> Path:
     if scene.benchmark is not None:
         return _write_text_atomic(out / "report.html", _html(dataset, scene, [_benchmark_figure(dataset, out / "work_precision.png")], _benchmark_tables(dataset)))
     figures = [_linear_figure(scene, out)]
+    if scene.swept_sine is not None:
+        figures += bumper_report.sweep_figures(dataset, scene, out)
+        tables = [("Modal parameters of H22", _modal_table(scene)), *bumper_report.sweep_tables(dataset, scene)]
+        return _write_text_atomic(out / "report.html", _html(dataset, scene, figures, tables))
+    if "bumper_frequency" in dataset.dims:
+        figures += bumper_report.stiffness_figures(dataset, scene, out)
+        tables = [("Modal parameters of H22", _modal_table(scene)), *bumper_report.stiffness_tables(dataset, scene)]
+        return _write_text_atomic(out / "report.html", _html(dataset, scene, figures, tables))
     for clearance_index in range(dataset.sizes.get("clearance", 1)):
         part = dataset.isel(clearance=clearance_index) if "clearance" in dataset.dims else dataset
         tag = f"_clearance{clearance_index}" if "clearance" in dataset.dims else ""
@@ -72,20 +69,18 @@ def write_report(dataset: xr.Dataset, out_dir: str | Path) -> Path:
                 if quantity in part:
                     figures.append(_simulation_figure(part, quantity, engines, out / f"simulation_{quantity}{tag}.png"))
     tables = _tables(dataset, scene)
+    engines_present = any(name in ENGINE_SOLUTIONS for name in dataset["solution"].values)
+    for parameter in ("restitution", "clearance"):
+        if parameter in dataset.dims and engines_present and "x1_amplitude" in dataset:
+            figures += bumper_report.peak_figures(dataset, scene, parameter, out)
+            tables += bumper_report.peak_tables(dataset, scene, parameter)
+    if "peak_acceleration" in dataset and "compliant" in dataset["solution"].values:
+        figures += bumper_report.peak_acceleration_figure(dataset, scene, out)
     page = _html(dataset, scene, figures, tables)
     return _write_text_atomic(out / "report.html", page)
 
 
 # ------------------------------------------------------------------------------------------- figures
-def _save(fig: Figure_, path: Path) -> Path:
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    with atomic_path(path) as temporary:
-        temporary.write_bytes(buffer.getvalue())
-    return path
-
-
 def _clearance_text(part: xr.Dataset) -> str:
     return f"{float(part['clearance']) * 1e3:.6g} mm"
 
@@ -126,7 +121,7 @@ def _linear_figure(scene: Scene, out: Path) -> Figure:
         f"Linear system (Delta -> infinity). Natural frequencies {', '.join(f'{x / (2 * np.pi):.3f}' for x in system.natural_frequencies())} Hz, "
         f"anti-resonance {system.antiresonance_frequency() / (2 * np.pi):.3f} Hz."
     )
-    return Figure(_save(fig, out / "linear.png"), caption)
+    return Figure(save_figure(fig, out / "linear.png"), caption)
 
 
 def _lines(part: xr.Dataset) -> list[tuple[str, xr.Dataset]]:
@@ -180,7 +175,7 @@ def _response_figure(part: xr.Dataset, quantity: str, path: Path) -> Figure:
         parts.append("Faint thin: the raw one-impact solution wherever eqs. 15-16 have a root, unchecked; this is what the paper plots, spikes included.")
     if len(panels) == 2:
         parts.append("Left: exact poles/residues and exact chi22'(0-); right: the paper's fitted modes and constant chi22'(0-).")
-    return Figure(_save(fig, path), " ".join(parts))
+    return Figure(save_figure(fig, path), " ".join(parts))
 
 
 def _first(part: xr.Dataset) -> dict[str, int]:
@@ -214,7 +209,7 @@ def _regime_figure(part: xr.Dataset, path: Path) -> Figure:
         "Regime of each point (the dataset's 'regime' flag): where each value comes from, where the one-impact solution "
         "is missing, inadmissible or unstable, and what the simulations found (periodic or irregular impacting motion)."
     )
-    return Figure(_save(fig, path), caption)
+    return Figure(save_figure(fig, path), caption)
 
 
 def _stability_figure(part: xr.Dataset, path: Path) -> Figure:
@@ -231,7 +226,7 @@ def _stability_figure(part: xr.Dataset, path: Path) -> Figure:
         "Largest Floquet multiplier modulus of the exact one-impact orbit (monodromy = impact saltation matrix x exact flow "
         "over the period). Above 1 the orbit exists but is unstable: a simulation started on it leaves it."
     )
-    return Figure(_save(fig, path), caption)
+    return Figure(save_figure(fig, path), caption)
 
 
 def _simulation_figure(part: xr.Dataset, quantity: str, engines: list[str], path: Path) -> Figure:
@@ -243,7 +238,7 @@ def _simulation_figure(part: xr.Dataset, quantity: str, engines: list[str], path
     fig, axes = plt.subplots(rows, columns, figsize=(6.2 * columns, 3.8 * rows), squeeze=False, sharex=True)
     f = part["frequency"].values
     simulated = np.isin(f, np.asarray(part.attrs.get("simulation_frequency_Hz", f)))
-    markers = {"momentary": ("o", 4.5), "exact": ("x", 4.0)}
+    markers = {"momentary": ("o", 4.5), "exact": ("x", 4.0), "compliant": ("s", 4.0)}
     for ax, (name, line) in zip(axes.flat, lines):
         if "linear" in part["solution"].values and quantity != "impulse":
             ax.plot(f, line[quantity].sel(solution="linear").values, ":", color="k", lw=1.0, label="LIN")
@@ -268,14 +263,14 @@ def _simulation_figure(part: xr.Dataset, quantity: str, engines: list[str], path
     for ax in list(axes.flat)[len(lines) :]:
         ax.set_visible(False)
     handles, names = axes.flat[0].get_legend_handles_labels()
-    fig.legend(handles, names, loc="lower center", ncol=6, fontsize=8, bbox_to_anchor=(0.5, -0.02 - 0.02 * rows))
-    fig.suptitle(f"Simulation against PGF: {label} (Delta = {_clearance_text(part)})")
+    fig.legend(handles, names, loc="upper center", ncol=6, fontsize=8, bbox_to_anchor=(0.5, 0.0))
+    fig.suptitle(f"Simulation against PGF: {label} (Delta = {_clearance_text(part)})", y=1.0 + 0.06 / rows)
     caption = (
         f"{label}: steady states simulated at each marked frequency (filled: the stroboscopic state repeated; hollow: "
         "irregular motion, averaged over the measured periods) against the PGF closed form (solid where its orbit is "
         "stable, dashed where unstable). Impulse of a simulation: mean impulse per impact."
     )
-    return Figure(_save(fig, path), caption)
+    return Figure(save_figure(fig, path), caption)
 
 
 def _agreement_table(dataset: xr.Dataset, scene: Scene) -> str:
@@ -337,7 +332,7 @@ def _benchmark_figure(dataset: xr.Dataset, path: Path) -> Figure:
         "Work-precision: one point per tolerance (rtol from loose to tight), error against the exact engine, wall time "
         "measured in one process run (read ratios, not seconds). Crosses: runs that missed impacts of the reference."
     )
-    return Figure(_save(fig, path), caption)
+    return Figure(save_figure(fig, path), caption)
 
 
 def _benchmark_tables(dataset: xr.Dataset) -> list[tuple[str, str]]:

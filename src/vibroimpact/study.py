@@ -168,7 +168,8 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
     for key in ("restitution", "clearance", "bumper_frequency", "sweep"):
         if key == "sweep" and scene.swept_sine is not None:
             continue  # a swept-sine study keeps its sweep dimension even with one direction
-        if key not in scene.swept and key in dataset.dims:
+        swept = key in scene.swept or (key == "restitution" and "bumper_loss_factor" in scene.swept)
+        if not swept and key in dataset.dims:
             dataset = dataset.squeeze(key, drop=key not in coords)
     if scene.bumper_frequency is not None:
         losses = scene.loss_factors()
