@@ -73,3 +73,25 @@ def test_validation() -> None:
         sweep = SweptSine(amplitude=1.0, start_frequency=15.0, stop_frequency=45.0, rate=0.1)
         running_fundamental(np.linspace(0, 1, 100), np.zeros(100), sweep, cycles=0)
     assert HarmonicForce(2.0, 10.0).force(0.0) == 2.0
+
+
+@pytest.mark.parametrize(("start", "stop"), [(15.0, 45.0), (45.0, 15.0)])
+def test_time_at_phase_inverts_the_phase(start: float, stop: float) -> None:
+    sweep = SweptSine(amplitude=1.0, start_frequency=start, stop_frequency=stop, rate=0.1)
+    t = np.linspace(0.0, sweep.duration, 1001)
+    np.testing.assert_allclose(sweep.time_at_phase(sweep.phase(t)), t, rtol=1e-12, atol=1e-12)
+
+
+def test_estimates_at_chosen_centres_are_exact_and_nan_outside() -> None:
+    """Windows centred where the instantaneous frequency is 20, 25, 30 Hz (as a study reports them): exact A for a
+    sine; NaN where the window would leave the record."""
+    sweep = SweptSine(amplitude=1.0, start_frequency=19.5, stop_frequency=30.5, rate=1.0)
+    t = np.linspace(0.0, sweep.duration, int(sweep.duration * 30.5 * 1200))
+    amplitude = 1.5e-3
+    x = amplitude * np.sin(sweep.phase(t) - 1.1)
+    centres = (np.array([19.51, 20.0, 25.0, 30.0, 30.49]) - 19.5) / sweep.alpha
+    estimate = running_fundamental(t, x, sweep, cycles=8, centres=centres)
+    assert np.all(np.isnan(estimate.amplitude[[0, -1]]))  # half a window does not fit at either end
+    np.testing.assert_allclose(estimate.amplitude[1:-1], amplitude, rtol=1e-6)
+    np.testing.assert_allclose(estimate.rms[1:-1], amplitude / math.sqrt(2.0), rtol=1e-3)
+    np.testing.assert_allclose(estimate.frequency[1:-1], [20.0, 25.0, 30.0])

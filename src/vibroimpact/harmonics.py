@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.integrate import cumulative_trapezoid
 
 from .engines.base import Trajectory
 from .excitation import SweptSine
@@ -124,12 +125,12 @@ class RunningEstimate:
     rms: np.ndarray
 
 
-def running_fundamental(t: np.ndarray, x: np.ndarray, sweep: SweptSine, cycles: int = 8) -> RunningEstimate:
+def running_fundamental(t: np.ndarray, x: np.ndarray, sweep: SweptSine, cycles: int = 8, centres: np.ndarray | None = None) -> RunningEstimate:
     """Demodulate ``x`` against the sweep's own sin and cos over a moving window of ``cycles`` whole cycles.
 
-    The window ends at each sample and spans the phase interval [theta(t) - 2 pi cycles, theta(t)]; the integrals
-    are taken in theta, so for x = A sin(theta + phi) the estimate is exactly A, however fast the sweep (sampling
-    error aside: trapezoidal sums, second order in the step), and harmonics and offsets cancel.
+    Each window spans ``cycles`` whole cycles of the excitation phase theta, centred (in phase) on its time; the
+    integrals are taken in theta, so for x = A sin(theta + phi) the estimate is exactly A, however fast the sweep
+    (sampling error aside: trapezoidal sums, second order in the step), and harmonics and offsets cancel.
 
     Parameters
     ----------
@@ -141,27 +142,24 @@ def running_fundamental(t: np.ndarray, x: np.ndarray, sweep: SweptSine, cycles: 
         The excitation (its phase theta(t)).
     cycles : int
         Window length in excitation cycles, >= 1.
+    centres : ndarray, optional
+        Window centres [s]; by default one window ending at each sample (where a whole window fits). NaN where a
+        window leaves the samples.
     """
-    from scipy.integrate import cumulative_trapezoid
-
     if cycles < 1:
         raise ValueError(f"cycles = {cycles!r} is out of range: allowed [1, inf)")
     t = np.asarray(t, dtype=float)
     x = np.asarray(x, dtype=float)
     theta = sweep.phase(t)
-    rate = 2.0 * np.pi * sweep.frequency(t)  # d theta / dt
-    in_phase = cumulative_trapezoid(x * np.sin(theta) * rate, t, initial=0.0)
-    quadrature = cumulative_trapezoid(x * np.cos(theta) * rate, t, initial=0.0)
-    squares = cumulative_trapezoid(x * x, t, initial=0.0)
-    start = theta - 2.0 * np.pi * cycles
-    ok = start >= theta[0]
-    span = np.pi * cycles
-    i = (in_phase[ok] - np.interp(start[ok], theta, in_phase)) / span
-    q = (quadrature[ok] - np.interp(start[ok], theta, quadrature)) / span
-    t_start = np.interp(start[ok], theta, t)
-    rms = np.sqrt((squares[ok] - np.interp(start[ok], theta, squares)) / (t[ok] - t_start))
-    centre = np.interp(theta[ok] - np.pi * cycles, theta, t)
-    return RunningEstimate(time=centre, frequency=sweep.frequency(centre), amplitude=np.hypot(i, q), rms=rms)
+    if centres is None:
+        ends = theta[theta - 2.0 * np.pi * cycles >= theta[0]]
+        centres = sweep.time_at_phase(ends - np.pi * cycles)
+    centres = np.asarray(centres, dtype=float)
+    rotor = np.exp(-1j * theta) * (2.0 * np.pi * sweep.frequency(t))  # exp(-j theta) d theta / dt
+    fourier = running_at(t, cumulative_trapezoid(x * rotor, t, initial=0.0), sweep, centres, cycles)
+    start, end = window_times(sweep, centres, cycles)
+    squares = running_at(t, cumulative_trapezoid(x * x, t, initial=0.0), sweep, centres, cycles)
+    return RunningEstimate(time=centres, frequency=sweep.frequency(centres), amplitude=np.abs(fourier) / (np.pi * cycles), rms=np.sqrt(squares / (end - start)))
 
 
 def window_times(sweep: SweptSine, centres: np.ndarray, cycles: int) -> tuple[np.ndarray, np.ndarray]:
@@ -178,7 +176,9 @@ def running_at(t: np.ndarray, cumulative: np.ndarray, sweep: SweptSine, centres:
     samples. Linear interpolation between samples: exact for integrals that are constant between them (impulses).
     """
     start, end = window_times(sweep, centres, cycles)
-    inside = (start >= t[0]) & (end <= t[-1])
+    slack = 1e-12 * (t[-1] - t[0])  # a window ending exactly at the last sample is inside despite round-off
+    with np.errstate(invalid="ignore"):
+        inside = (start >= t[0] - slack) & (end <= t[-1] + slack)
 
     def at(times: np.ndarray) -> np.ndarray:
         if np.iscomplexobj(cumulative):

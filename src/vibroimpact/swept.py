@@ -23,7 +23,7 @@ from . import __version__
 from .engines.base import EngineSettings
 from .engines.compliant import CompliantEngine, SweepRecord
 from .excitation import SweptSine
-from .harmonics import running_at, window_times
+from .harmonics import running_at, running_fundamental, window_times
 from .scene import SweptSineSettings
 from .system import TwoDofSystem
 
@@ -140,21 +140,14 @@ def running_quantities(record: SweepRecord, centres: NDArray[np.float64], cycles
     """
     sweep: SweptSine = record.sweep
     t = record.time
-    theta = sweep.phase(t)
-    rotor = np.exp(-1j * theta) * (2.0 * np.pi * sweep.frequency(t))  # exp(-j theta) d theta / dt
+    rotor = np.exp(-1j * sweep.phase(t)) * (2.0 * np.pi * sweep.frequency(t))  # exp(-j theta) d theta / dt
     suspension = record.base_force - record.contact_force
     span = np.pi * cycles
-
-    def fundamental(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        return np.abs(running_at(t, cumulative_trapezoid(x * rotor, t, initial=0.0), sweep, centres, cycles)) / span
-
-    def rms(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        return np.sqrt(running_at(t, cumulative_trapezoid(x * x, t, initial=0.0), sweep, centres, cycles) / duration)
-
+    x1 = running_fundamental(t, record.x1, sweep, cycles, centres)
+    x2 = running_fundamental(t, record.x2, sweep, cycles, centres)
     safe = np.nan_to_num(centres, nan=t[0])
     start, end = window_times(sweep, safe, cycles)
-    valid = np.isfinite(centres) & (start >= t[0]) & (end <= t[-1])
-    duration = np.where(valid, end - start, np.nan)
+    valid = np.isfinite(x1.amplitude)
     contact = running_at(t, record.contact_fourier, sweep, centres, cycles)
     suspension_fourier = running_at(t, cumulative_trapezoid(suspension * rotor, t, initial=0.0), sweep, centres, cycles)
     trajectory = record.trajectory
@@ -168,14 +161,14 @@ def running_quantities(record: SweepRecord, centres: NDArray[np.float64], cycles
         peak_force[i], peak_acceleration[i] = peaks[first[i] : last[i]].max(axis=0)
     nan = np.where(valid, 1.0, np.nan)
     return {
-        "x1_amplitude": fundamental(record.x1),
-        "x2_amplitude": fundamental(record.x2),
+        "x1_amplitude": x1.amplitude,
+        "x2_amplitude": x2.amplitude,
         "force_amplitude": np.abs(suspension_fourier + contact) / span,
         "suspension_force_amplitude": np.abs(suspension_fourier) / span,
         "impulse": (impulses[last] - impulses[first]) / cycles * nan,
         "impacts_per_period": (last - first) / cycles * nan,
-        "x1_rms": rms(record.x1),
-        "x2_rms": rms(record.x2),
+        "x1_rms": x1.rms,
+        "x2_rms": x2.rms,
         "peak_acceleration": peak_acceleration * nan,
         "peak_contact_force": peak_force * nan,
     }
