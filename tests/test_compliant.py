@@ -10,9 +10,10 @@ from scipy.integrate import solve_ivp
 
 from vibroimpact.contact import loss_factor_from_restitution, peak_acceleration_factor, restitution_from_loss_factor
 from vibroimpact.engines import EngineSettings, ExactEngine, ImpactProblem
-from vibroimpact.engines.compliant import MODE_CONTACT, CompliantEngine
+from vibroimpact.engines.compliant import MODE_CONTACT, CompliantEngine, SweepRecord
+from vibroimpact.excitation import SweptSine
 from vibroimpact.steady import SteadySettings, steady_state
-from vibroimpact.system import TwoDofSystem
+from vibroimpact.system import PAPER_SYSTEM, TwoDofSystem
 
 from .conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
 
@@ -144,3 +145,156 @@ def test_slow_sweep_with_contact_follows_the_one_impact_orbit(system: TwoDofSyst
     orbit = solve_one_impact(system, 2 * math.pi * estimate.frequency[settled], PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE)
     np.testing.assert_allclose(estimate.amplitude[settled], np.abs(orbit.x1_harmonic()), rtol=0.015)
     assert record.trajectory.impact_times.size == pytest.approx(sweep.duration * 24.5, rel=0.02)  # one contact per period
+
+
+def _paper_sweep_record(settings: EngineSettings, start: float, stop: float, sample_rate: float = 1000.0) -> tuple[SweptSine, SweepRecord]:
+    """The paper's swept-sine test (250 Hz bumper, R = 0.2) from ``start`` to ``stop`` Hz at 0.1 Hz/s."""
+    sweep = SweptSine(PAPER_AMPLITUDE, start, stop, 0.1)
+    return sweep, CompliantEngine(250.0, loss_factor_from_restitution(0.2), settings).sweep(PAPER_SYSTEM, PAPER_CLEARANCE, sweep, sample_rate)
+
+
+@pytest.mark.timeout(60)
+def test_sweep_settings_agree_with_a_tight_run() -> None:
+    """The paper's sweep settings (rtol 1e-6, atol 1e-10 m) against rtol 1e-9 over a contact-rich 10 s (24 -> 25 Hz,
+    one contact per period): same contacts, onsets to 1e-6 s, running X1 fundamental to 2e-5 of its largest value
+    (measured 4e-6), peak force and deceleration and impulses to 2e-4 (measured ~3e-5)."""
+    from vibroimpact.engines.compliant import SWEEP_SETTINGS
+    from vibroimpact.harmonics import running_fundamental
+
+    sweep, record = _paper_sweep_record(SWEEP_SETTINGS, 24.0, 25.0)
+    _, tight = _paper_sweep_record(EngineSettings(rtol=1e-9, atol=1e-13), 24.0, 25.0)
+    a, b = record.trajectory, tight.trajectory
+    assert a.impact_times.size == b.impact_times.size == a.stats["contacts"] == pytest.approx(sweep.duration * 24.5, rel=0.01)
+    np.testing.assert_allclose(a.impact_times, b.impact_times, atol=1e-6)
+    np.testing.assert_allclose(a.contact_peaks, b.contact_peaks, rtol=2e-4)
+    np.testing.assert_allclose(a.impulses, b.impulses, rtol=2e-4)
+    fundamental = running_fundamental(record.time, record.x1, sweep, cycles=8).amplitude
+    reference = running_fundamental(tight.time, tight.x1, sweep, cycles=8).amplitude
+    assert np.max(np.abs(fundamental - reference)) < 2e-5 * reference.max()
+    np.testing.assert_allclose(record.contact_fourier, tight.contact_fourier, atol=1e-4 * np.abs(tight.contact_fourier).max())
+
+
+@pytest.mark.timeout(60)
+def test_sweep_record_contacts_stats_and_force_quadrature() -> None:
+    """Per contact: onset, peak force and deceleration (one row each, positive); counters; samples of the bumper
+    force; and the Fourier integral of the force (integrated with the motion) against the trapezoidal rule on
+    100 kHz samples (1e-2: the force jumps at each onset, which the samples only resolve to one step)."""
+    from scipy.integrate import cumulative_trapezoid
+
+    sweep, record = _paper_sweep_record(EngineSettings(rtol=1e-8, atol=1e-12), 24.0, 24.3, sample_rate=100_000.0)
+    trajectory = record.trajectory
+    assert trajectory.impact_times.size >= 60 and trajectory.contact_peaks.shape == (trajectory.impact_times.size, 2)
+    assert np.all(trajectory.contact_peaks > 0.0) and np.all(np.diff(trajectory.impact_times) > 0.0)
+    assert trajectory.stats["contacts"] - trajectory.impact_times.size in (0, 1)
+    assert trajectory.stats["steps"] > 0 and trajectory.stats["rhs_calls"] >= trajectory.stats["steps"]
+    assert np.all(record.contact_force >= 0.0) and record.contact_force.max() <= trajectory.contact_peaks[:, 0].max() * (1 + 1e-6)
+    assert record.contact_force.max() > 0.9 * trajectory.contact_peaks[:, 0].max()
+    rotor = np.exp(-1j * sweep.phase(record.time)) * 2 * math.pi * sweep.frequency(record.time)
+    sampled = cumulative_trapezoid(record.contact_force * rotor, record.time, initial=0.0)
+    np.testing.assert_allclose(record.contact_fourier, sampled, atol=1e-2 * np.abs(sampled).max())
+
+
+def test_sweep_clears_the_event_records() -> None:
+    """scikit-sundae keeps every root on the event function (NOTES): the run must leave none behind, or each call
+    gets slower over a long sweep."""
+    from vibroimpact.contact import KelvinVoigtBumper
+    from vibroimpact.engines.base import TrajectoryBuilder
+    from vibroimpact.engines.compliant import _BumperModel, _Run
+
+    sweep = SweptSine(PAPER_AMPLITUDE, 24.0, 24.5, 0.1)
+    problem = ImpactProblem(PAPER_SYSTEM, PAPER_CLEARANCE, 0.5, PAPER_AMPLITUDE, 24.0)
+    model = _BumperModel(problem, KelvinVoigtBumper(PAPER_CLEARANCE, 250.0, 0.3), False, sweep)
+    engine = CompliantEngine(250.0, 0.3)
+    run = _Run(engine, model, TrajectoryBuilder(problem, False), 0.0, np.zeros(4), 2 * math.pi * 25.0)
+    run.run(np.arange(0.0, sweep.duration, 1e-3), lambda t, y, contact: None)
+    assert run.counts["contacts"] > 50
+    for _, events in run.solvers.values():
+        assert all(len(getattr(events, name)) == 0 for name in ("_i", "_t", "_y", "_yp"))
+
+
+def _first_apex(system: TwoDofSystem, state: np.ndarray) -> tuple[float, float]:
+    """Time and X2 of the first apex (X2' = 0) of the free motion from ``state`` (matrix exponential: exact)."""
+    from scipy.linalg import expm
+    from scipy.optimize import brentq
+
+    a = system.state_matrix
+    t = brentq(lambda t: (expm(a * t) @ state)[3], 1e-3, 0.012, xtol=1e-15)
+    return t, float((expm(a * t) @ state)[1])
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("settings", [EngineSettings(rtol=1e-6, atol=1e-10), EngineSettings(rtol=1e-8, atol=1e-9)])
+def test_near_tangent_touches(system: TwoDofSystem, settings: EngineSettings) -> None:
+    """Free motion from X2 = 0 whose first apex (exact) passes the bumper by 1e-8 ... 1e-7 m (beyond it for
+    3e-5 ... 1e-4 s): one contact each, starting before the apex; 1e-8 m short of it: none. (The gap is a state with
+    an absolute tolerance, so the steps shrink as it nears zero and the onset event sees these touches.)"""
+    state = np.array([0.0, 0.0, 0.0, 0.3])
+    apex_time, apex = _first_apex(system, state)
+    for overshoot in (1e-8, 3e-8, 1e-7, -1e-8, -1e-7):
+        problem = ImpactProblem(system, apex - overshoot, 0.5, 0.0, 1.0 / (4 * apex_time))  # one period: to the next apex
+        trajectory = CompliantEngine(250.0, 0.3, settings).integrate(problem, state, 0.0, 1)
+        expected = 1 if overshoot > 0 else 0
+        assert trajectory.stats["contacts"] == trajectory.impact_times.size == expected, overshoot
+        if expected:
+            assert apex_time - 2 * math.sqrt(2 * overshoot / 40.0) < trajectory.impact_times[0] < apex_time
+            assert 0.0 < trajectory.contact_peaks[0, 0] < 0.5  # ~100 N in a real contact
+
+
+@pytest.mark.timeout(60)
+def test_apex_check_catches_what_the_onset_event_misses(system: TwoDofSystem, monkeypatch: pytest.MonkeyPatch) -> None:
+    """With the onset event switched off, the apex check alone finds a touch 1e-8 m deep: the contact starts at the
+    apex (flagged as grazing), the outputs integrated past it are redone, and the period ends as with the onset
+    event but for the touch itself (it starts 14 us later, at rest instead of at 1 mm/s: the final states differ by
+    ~2e-5 of the largest state value)."""
+    from vibroimpact.engines import compliant
+
+    state = np.array([0.0, 0.0, 0.0, 0.3])
+    apex_time, apex = _first_apex(system, state)
+    problem = ImpactProblem(system, apex - 1e-8, 0.5, 0.0, 1.0 / (4 * apex_time))
+    engine = CompliantEngine(250.0, 0.3, EngineSettings(rtol=1e-8, atol=1e-12))
+    normal = engine.integrate(problem, state, 0.0, 2)
+    events = compliant._BumperModel.events
+
+    def without_onset(model: compliant._BumperModel, contact: bool):  # type: ignore[no-untyped-def]
+        function = events(model, contact)
+        if contact:
+            return function
+
+        def blind(t: float, y: np.ndarray, yp: np.ndarray, out: np.ndarray) -> None:
+            function(t, y, yp, out)
+            out[0] = -1.0
+
+        blind.terminal, blind.direction = function.terminal, function.direction  # type: ignore[attr-defined]
+        return blind
+
+    monkeypatch.setattr(compliant._BumperModel, "events", without_onset)
+    blind = engine.integrate(problem, state, 0.0, 2)
+    assert blind.stats["grazing"] == blind.stats["contacts"] == blind.impact_times.size == normal.impact_times.size == 1
+    assert blind.impact_times[0] == pytest.approx(apex_time, rel=1e-8)
+    np.testing.assert_allclose(blind.strobe_times, normal.strobe_times, rtol=1e-15)
+    np.testing.assert_allclose(blind.strobe_states, normal.strobe_states, atol=1e-4 * np.abs(normal.strobe_states).max())
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(600)
+def test_paper_sweep_is_fast_and_close_to_a_tight_run() -> None:
+    """The paper's 300 s sweep (15 -> 45 Hz) in well under a minute with :data:`SWEEP_SETTINGS` (~10 s measured;
+    it took ~155 s before), and over the contact-rich, reproducible 21 -> 24 Hz (60 - 90 s) the same contacts and
+    running X1 fundamental as rtol 1e-9 to 1e-4 of its largest value."""
+    import time
+
+    from vibroimpact.engines.compliant import SWEEP_SETTINGS
+    from vibroimpact.harmonics import running_fundamental
+
+    started = time.perf_counter()
+    sweep, record = _paper_sweep_record(SWEEP_SETTINGS, 15.0, 45.0)
+    wall = time.perf_counter() - started
+    assert wall < 60.0
+    _, tight = _paper_sweep_record(EngineSettings(rtol=1e-9, atol=1e-13), 15.0, 45.0)
+    onsets = [r.trajectory.impact_times[(r.trajectory.impact_times >= 60.0) & (r.trajectory.impact_times < 90.0)] for r in (record, tight)]
+    assert onsets[0].size == onsets[1].size > 600
+    np.testing.assert_allclose(onsets[0], onsets[1], atol=1e-5)
+    a = running_fundamental(record.time, record.x1, sweep, cycles=8)
+    b = running_fundamental(tight.time, tight.x1, sweep, cycles=8)
+    window = (a.time >= 60.0) & (a.time < 90.0)
+    assert np.max(np.abs(a.amplitude[window] - b.amplitude[window])) < 1e-4 * b.amplitude[window].max()

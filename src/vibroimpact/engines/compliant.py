@@ -1,27 +1,51 @@
 """Engine ``compliant``: the Kelvin-Voigt bumper of eq. 25 through SUNDIALS IDA (scikit-sundae).
 
 The equations of motion are written as the residual ``y' - f(t, y)`` of the state (X1, u, X1', X2') with the gap
-u = X2 - Delta, then the running integral of the bumper force (impulses), then the harmonic-moment quadratures of
-:mod:`.event_loop` (whose contact-force channel integrates the bumper force itself). A contact-mode flag keeps the residual smooth: in contact the bumper force
-F = K u + B X2' acts on the absorber, outside it does not, and the switches are events:
+u = X2 - Delta, then the running integral of the bumper force (impulses), then quadratures: for ``integrate``, the
+harmonic moments of :mod:`.event_loop` when asked (their contact-force channel integrates the bumper force itself);
+for ``sweep``, the Fourier integral of the bumper force against the sweep's own phase, integral of
+F exp(-j theta) theta' dt (the force is a pulse far shorter than the output sampling: it cannot be summed from
+samples). In contact the bumper force F = K u + B X2' acts on the absorber, outside it does not. Each mode has its
+own IDA solver, residual, Jacobian ``cj I - df/dy`` and events, so every residual is smooth; the switches are events:
 
-* onset, free flight: the gap rising through zero (an apex event, X2' falling through zero, guards grazing contacts
-  as in ``momentary``);
-* release, in contact: F falling through zero (eq. 25: the bumper never pulls);
-* peaks, in contact: dF/dt falling through zero (largest force) and the absorber's jerk rising through zero (largest
-  deceleration); they are recorded and integration goes on.
+* free flight: the gap rising through zero (onset, terminal) and the absorber's apex, X2' falling through zero
+  (recorded only): an apex at u >= 0 is a grazing contact whose two gap crossings fell inside one step; the run goes
+  back to that apex and the contact starts there;
+* contact: -F rising through zero (release, terminal: eq. 25, the bumper never pulls), dF/dt falling through zero
+  (largest force) and the absorber's jerk rising through zero (largest deceleration), both recorded only.
 
-Each mode switch re-initialises IDA with consistent y' = f(t, y). A Jacobian callback returns the mode's constant
-``cj I - df/dy``. Each contact is recorded as an impact (onset time, entry speed, impulse = integral of F) with its
-peak force and deceleration. The restitution of ``ImpactProblem`` is not used: the bumper's loss factor sets it
-(:func:`vibroimpact.contact.restitution_from_loss_factor`).
+How it runs, and why it is fast: between two mode switches the mode's solver runs in one ``IDA.solve`` call over
+the output times (sweep samples or period boundaries) in that stretch (at most :data:`_OUTPUTS_PER_CALL`), so
+SUNDIALS interpolates the outputs and locates the recorded roots without returning to Python; only the terminal
+events (two per contact) return. Each switch re-initialises the new mode's solver with consistent y' = f(t, y) and a
+first step sqrt(2 rtol) / (the mode's fastest angular frequency), a backward-Euler step of about the tolerance (the
+step then grows as usual; SUNDIALS' own guess would depend on the distance to the next output; 0.03 to 30 times
+this first step changed the step count by +-10 % without a trend: a restart costs ~15 steps of ramp-up to order 5
+either way, of ~170 per period at 25 Hz with one contact). The event records
+scikit-sundae keeps on an event function are cleared after every call, or each call would get slower (NOTES).
+Measured on the paper's 300 s swept-sine test (rtol 1e-6, 2858 contacts, one process): 10 s with
+:data:`SWEEP_SETTINGS`, 12 s with atol 1e-12; the earlier loop of one ``IDA.step`` per output and per root took
+16 s with every record cleared and ~155 s as it was, its steps slowing down as the ``_yp`` records piled up.
+Profiled, ~75 % of the time is inside ``IDA.solve`` outside the Python callbacks (SUNDIALS, and scikit-sundae
+wrapping the arrays of every callback), the rest in the residual and event functions; there are ~1.1 residual
+calls per step attempt (the model is linear and the Jacobian exact).
+
+Tolerances: ``settings.rtol`` is the relative tolerance; ``settings.atol`` is the absolute tolerance of the
+displacements [m], and the other components get the same tolerance in their own units (:func:`absolute_tolerances`).
+With ``atol`` a small fraction of the motion's amplitude the error test no longer asks for a relative accuracy of
+each component as it crosses zero. The paper's swept-sine test uses :data:`SWEEP_SETTINGS` (rtol 1e-6, atol 1e-10 m).
+
+Each contact is recorded as an impact (onset time, entry speed, impulse = integral of F) with its peak force and
+peak deceleration (``Trajectory.contact_peaks``). The restitution of ``ImpactProblem`` is not used: the bumper's
+loss factor sets it (:func:`vibroimpact.contact.restitution_from_loss_factor`).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -30,87 +54,223 @@ from sksundae.ida import IDA
 from ..contact import KelvinVoigtBumper
 from ..excitation import SweptSine
 from ..system import TwoDofSystem
-from .base import MODE_FREE, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
 from ..validation import require_positive
-from .sundae import clear_event_records
+from .base import MODE_FREE, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
 from .event_loop import QUADRATURES, moment_row, write_quadratures
+from .sundae import clear_event_records
 
-__all__ = ["CompliantEngine", "SweepRecord"]
+__all__ = ["SWEEP_SETTINGS", "CompliantEngine", "SweepRecord", "absolute_tolerances"]
 
 MODE_CONTACT = 2  # segment mode: absorber on the bumper
-_STATUS_TSTOP, _STATUS_ROOT = 1, 2
+_STATUS_ROOT = 2  # IDA_ROOT_RETURN
+#: Settings for the paper's swept-sine test. Against rtol 1e-9 runs of the 15 -> 45 Hz sweep, atol 1e-10 m is as
+#: close as 1e-12 m (the default) and ~15 % cheaper; 1e-9 m saves another ~5 % but drifts 5-10x farther after the
+#: regime change near 39.5 Hz (``vibroimpact.sweep_cost`` and tests/test_compliant.py measure both).
+SWEEP_SETTINGS = EngineSettings(rtol=1e-6, atol=1e-10)
+#: Largest number of output times handled by one ``IDA.solve`` call (bounds its output arrays).
+_OUTPUTS_PER_CALL = 2048
+#: Mode switches in a row without any progress in time before the run is declared stuck.
+_MAX_SWITCHES_IN_PLACE = 100
+
+
+def absolute_tolerances(atol: float, omega_ref: float, m2: float, quadratures: str = "none") -> NDArray[np.float64]:
+    """Per-component absolute tolerances of the compliant engine's state.
+
+    ``atol`` [m] applies to X1 and u; the velocities get ``atol * omega_ref`` [m s-1], the force integral
+    ``atol * omega_ref * m2`` [N s] (a momentum). Quadratures: the sweep's Fourier integrals of the force [N]
+    ``atol * omega_ref**2 * m2``; the harmonic moments of the displacements [m s] ``atol / omega_ref``, of the force
+    ``atol * m2`` [N s], of the squares [m2 s] ``1e-3 * atol / omega_ref`` (millimetre amplitudes).
+
+    Parameters
+    ----------
+    atol : float
+        Absolute tolerance of the displacements [m].
+    omega_ref : float
+        Angular frequency of the motion [rad s-1] (the excitation's, or the sweep's highest).
+    m2 : float
+        Absorber mass [kg].
+    quadratures : {'none', 'sweep', 'moments'}
+        The states after the force integral: none, the sweep's two Fourier integrals, or the eight moments.
+    """
+    v = atol * omega_ref
+    tolerances = [atol, atol, v, v, v * m2]
+    if quadratures == "sweep":
+        tolerances += [v * omega_ref * m2] * 2
+    elif quadratures == "moments":
+        d = atol / omega_ref
+        tolerances += [d, d, d, d, atol * m2, atol * m2, 1e-3 * d, 1e-3 * d]
+    elif quadratures != "none":
+        raise ValueError(f"quadratures = {quadratures!r} is not allowed: use 'none', 'sweep' or 'moments'")
+    return np.array(tolerances)
 
 
 class _BumperModel:
-    """Right-hand side, residual, Jacobian and events of the system with a Kelvin-Voigt bumper."""
+    """Residuals, Jacobians and events of each mode, and the right-hand side, of the system with a bumper."""
 
     def __init__(self, problem: ImpactProblem, bumper: KelvinVoigtBumper, with_moments: bool, sweep: SweptSine | None = None) -> None:
         s = problem.system
-        self.problem, self.with_moments, self.sweep = problem, with_moments, sweep
-        self.size = 5 + (QUADRATURES if with_moments else 0)  # (X1, u, X1', X2', integral of F) + moments
-        self.contact = False
-        self.rhs_calls = 0
+        if with_moments and sweep is not None:
+            raise ValueError("harmonic moments are for a harmonic force, not a sweep")
+        self.problem, self.sweep = problem, sweep
+        # (X1, u, X1', X2', integral of F), then 8 moments (integrate) or 2 Fourier integrals of F (sweep)
+        self.quadratures = "sweep" if sweep is not None else "moments" if with_moments else "none"
+        self.size = 5 + {"none": 0, "sweep": 2, "moments": QUADRATURES}[self.quadratures]
         self.k, self.b = bumper.stiffness(s.m2), bumper.damping(s.m2)
-        self._buffer = np.empty(self.size)  # reused by the residual and the events: no allocation per call
+        #: [residual calls, step attempts (distinct residual times), last residual time]
+        self.counter: list[float] = [0, 0, math.nan]
         if sweep is None:
-            q, w, phase = problem.amplitude, problem.omega, problem.phase
-            self._external: Callable[[float], float] = lambda t: q * math.cos(w * t + phase)
-        else:
-            q, f0, half_alpha = sweep.amplitude, sweep.start_frequency, 0.5 * sweep.alpha
-            self._external = lambda t: q * math.sin(2.0 * math.pi * t * (f0 + half_alpha * t))
-        self._c = (s.m1, s.m2, s.k1, s.k2, s.b1, s.b2, problem.amplitude, problem.omega, problem.phase, problem.clearance)
+            self._w0, self._half_alpha = problem.omega, 0.0
+        else:  # theta(t) = t (w0 + pi alpha t), theta'(t) = w0 + 2 pi alpha t
+            self._w0, self._half_alpha = 2.0 * math.pi * sweep.start_frequency, math.pi * sweep.alpha
         base = np.zeros((self.size, self.size))
         base[:4, :4] = s.state_matrix
-        self._jacobian = {False: base, True: base.copy()}
-        self._jacobian[True][3, 1] -= self.k / s.m2
-        self._jacobian[True][3, 3] -= self.b / s.m2
-        self._jacobian[True][4, 1] += self.k
-        self._jacobian[True][4, 3] += self.b
+        contact = base.copy()
+        contact[3, 1] -= self.k / s.m2
+        contact[3, 3] -= self.b / s.m2
+        contact[4, 1] += self.k
+        contact[4, 3] += self.b
+        self._minus_jacobian = {False: -base, True: -contact}
+        self._identity = np.eye(self.size)
+
+    @property
+    def rhs_calls(self) -> int:
+        return int(self.counter[0])
+
+    @property
+    def steps(self) -> int:
+        return int(self.counter[1])
+
+    def external(self, t: float) -> float:
+        """Force on the primary mass [N]."""
+        p = self.problem
+        if self.sweep is None:
+            return p.amplitude * math.cos(p.omega * t + p.phase)
+        return self.sweep.amplitude * math.sin(t * (self._w0 + self._half_alpha * t))
 
     def force(self, y: NDArray[np.float64]) -> float:
         """Bumper force on the absorber in contact mode, K u + B X2' [N] (may be negative: then it releases)."""
         return self.k * y[1] + self.b * y[3]
 
-    def rhs(self, t: float, y: NDArray[np.float64], yp: NDArray[np.float64]) -> None:
-        self.rhs_calls += 1
-        m1, m2, k1, k2, b1, b2, q, w, phase, delta = self._c
-        x1, gap, v1, v2 = y[0], y[1], y[2], y[3]
-        spring = k2 * (x1 - gap - delta) + b2 * (v1 - v2)
-        bumper = self.k * gap + self.b * v2 if self.contact else 0.0
-        yp[0] = v1
-        yp[1] = v2
-        yp[2] = (self._external(t) - k1 * x1 - b1 * v1 - spring) / m1
-        yp[3] = (spring - bumper) / m2
-        yp[4] = bumper
-        if self.with_moments:
-            write_quadratures(yp, 5, t, w, x1, gap + delta, bumper)
-
-    def derivative(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
-        yp = np.empty(self.size)
-        self.rhs(t, y, yp)
+    def derivative(self, t: float, y: NDArray[np.float64], contact: bool) -> NDArray[np.float64]:
+        """f(t, y) of the given mode (restarts, peaks, moments)."""
+        s, delta = self.problem.system, self.problem.clearance
+        x1, gap, v1, v2 = float(y[0]), float(y[1]), float(y[2]), float(y[3])
+        spring = s.k2 * (x1 - gap - delta) + s.b2 * (v1 - v2)
+        bumper = self.k * gap + self.b * v2 if contact else 0.0
+        yp = np.zeros(self.size)
+        yp[:5] = v1, v2, (self.external(t) - s.k1 * x1 - s.b1 * v1 - spring) / s.m1, (spring - bumper) / s.m2, bumper
+        if self.quadratures == "moments":
+            write_quadratures(yp, 5, t, self.problem.omega, x1, gap + delta, bumper)
+        elif self.sweep is not None and contact:
+            theta, rate = t * (self._w0 + self._half_alpha * t), self._w0 + 2.0 * self._half_alpha * t
+            yp[5], yp[6] = bumper * math.cos(theta) * rate, bumper * math.sin(theta) * rate
         return yp
 
-    def residual(self, t: float, y: NDArray[np.float64], yp: NDArray[np.float64], res: NDArray[np.float64]) -> None:
-        self.rhs(t, y, self._buffer)
-        np.subtract(yp, self._buffer, out=res)
+    def residual(self, contact: bool) -> Callable[..., None]:
+        """The residual y' - f(t, y) of one mode, written for speed (it is called millions of times)."""
+        s, delta, counter = self.problem.system, self.problem.clearance, self.counter
+        if self.quadratures == "moments":
 
-    def jacobian(self, t: float, y: NDArray[np.float64], yp: NDArray[np.float64], res: NDArray[np.float64], cj: float, jj: NDArray[np.float64]) -> None:
-        """d(res)/dy + cj d(res)/dy' = cj I - df/dy (quadrature rows: their dependence on the state is left out,
-        which only slows Newton's convergence on those rows, never the solution)."""
-        jj[:, :] = -self._jacobian[self.contact]
-        jj[np.diag_indices(self.size)] += cj
+            def general(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], res: NDArray[np.float64]) -> None:
+                counter[0] += 1
+                if t != counter[2]:
+                    counter[1] += 1
+                    counter[2] = t
+                np.subtract(yp, self.derivative(t, y, contact), out=res)
 
-    def events(self, t: float, y: NDArray[np.float64], yp: NDArray[np.float64], out: NDArray[np.float64]) -> None:
-        """[gap (rising), force (falling), apex X2' (falling), dF/dt (falling), jerk of X2 (rising)]."""
-        if self.contact:
-            f = self._buffer
-            self.rhs(t, y, f)
-            force_rate = self.k * y[3] + self.b * f[3]
-            s = self.problem.system
-            jerk = (s.k2 * (y[2] - y[3]) + s.b2 * (f[2] - f[3]) - force_rate) / s.m2
-            out[0], out[1], out[2], out[3], out[4] = -1.0, self.force(y), 1.0, force_rate, jerk
-        else:
-            out[0], out[1], out[2], out[3], out[4] = y[1], 1.0, y[3], 1.0, -1.0
+            return general
+        m1, m2, k1, k2, b1, b2, k, b = s.m1, s.m2, s.k1, s.k2, s.b1, s.b2, self.k, self.b
+        sin, cos, swept = math.sin, math.cos, self.sweep is not None
+        q = self.problem.amplitude if self.sweep is None else self.sweep.amplitude
+        w0, half_alpha, phase = self._w0, self._half_alpha, self.problem.phase
+
+        def residual(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], res: NDArray[np.float64]) -> None:
+            counter[0] += 1
+            if t != counter[2]:
+                counter[1] += 1
+                counter[2] = t
+            x1, u, v1, v2 = y[:4].tolist()
+            d = yp.tolist()
+            spring = k2 * (x1 - u - delta) + b2 * (v1 - v2)
+            if swept:
+                theta = t * (w0 + half_alpha * t)
+                sine = sin(theta)
+                external = q * sine
+            else:
+                external = q * cos(w0 * t + phase)
+            bumper = k * u + b * v2 if contact else 0.0
+            res[0] = d[0] - v1
+            res[1] = d[1] - v2
+            res[2] = d[2] - (external - k1 * x1 - b1 * v1 - spring) / m1
+            res[3] = d[3] - (spring - bumper) / m2
+            res[4] = d[4] - bumper
+            if swept:
+                if contact:
+                    rate = bumper * (w0 + 2.0 * half_alpha * t)
+                    res[5] = d[5] - rate * cos(theta)
+                    res[6] = d[6] - rate * sine
+                else:
+                    res[5] = d[5]
+                    res[6] = d[6]
+
+        return residual
+
+    def jacobian(self, contact: bool) -> Callable[..., None]:
+        """d(res)/dy + cj d(res)/dy' = cj I - df/dy; exact but for the moment rows (their dependence on the state is
+        left out, which only slows Newton's convergence on those rows, never the solution)."""
+        minus, identity = self._minus_jacobian[contact], self._identity
+        fourier = self.sweep is not None and contact
+        k, b, w0, half_alpha = self.k, self.b, self._w0, self._half_alpha
+
+        def jacobian(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], res: NDArray[np.float64], cj: float, jj: NDArray[np.float64]) -> None:
+            np.multiply(identity, cj, out=jj)
+            jj += minus
+            if fourier:  # rows of F cos(theta) theta' and F sin(theta) theta'
+                theta, rate = t * (w0 + half_alpha * t), w0 + 2.0 * half_alpha * t
+                c, s = math.cos(theta) * rate, math.sin(theta) * rate
+                jj[5, 1], jj[5, 3], jj[6, 1], jj[6, 3] = -k * c, -b * c, -k * s, -b * s
+
+        return jacobian
+
+    def events(self, contact: bool) -> Callable[..., None]:
+        """The event function of one mode, with its ``terminal`` and ``direction`` attributes.
+
+        Free: [u (rising, terminal: onset), X2' (falling: apex)]. Contact: [-F (rising, terminal: release), dF/dt
+        (falling: largest force), jerk of X2 (rising: largest deceleration)]. The rates use the y' that IDA passes
+        (its interpolant's derivative): a root of a rate is located to the solution's accuracy, and the peak values
+        are then evaluated from the state at the root, where an error in the time only enters to second order.
+        """
+        s = self.problem.system
+        k, b, k2, b2, m2 = self.k, self.b, s.k2, s.b2, s.m2
+        if contact:
+
+            def contact_events(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], out: NDArray[np.float64]) -> None:
+                u, v1, v2, a1, a2 = y[1], y[2], y[3], yp[2], yp[3]
+                rate = k * v2 + b * a2
+                out[0] = -(k * u + b * v2)
+                out[1] = rate
+                out[2] = (k2 * (v1 - v2) + b2 * (a1 - a2) - rate) / m2
+
+            contact_events.terminal = [True, False, False]  # type: ignore[attr-defined]
+            contact_events.direction = [1, -1, 1]  # type: ignore[attr-defined]
+            return contact_events
+
+        def free_events(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], out: NDArray[np.float64]) -> None:
+            out[0] = y[1]
+            out[1] = y[3]
+
+        free_events.terminal = [True, False]  # type: ignore[attr-defined]
+        free_events.direction = [1, -1]  # type: ignore[attr-defined]
+        return free_events
+
+
+def _clear(events: Any) -> None:
+    """Forget every record scikit-sundae 1.2.0 keeps on an event function, ``_yp`` included (which
+    :func:`.sundae.clear_event_records` leaves: it grows too, and every call converts all of it to an array)."""
+    clear_event_records(events)
+    records = getattr(events, "_yp", None)
+    if records is not None:
+        records.clear()
 
 
 @dataclass(frozen=True, eq=False)
@@ -130,7 +290,14 @@ class SweepRecord:
     contact_force : ndarray
         Bumper force [N] (0 outside contact).
     trajectory : Trajectory
-        Contacts (onset times, entry speeds, impulses, peaks) and segments.
+        Contacts: ``impact_times`` (onsets) [s], ``impact_velocities`` [m s-1], ``impulses`` [N s] and
+        ``contact_peaks`` (c, 2) = [peak force N, peak deceleration m s-2], one row per completed contact (a contact
+        still open at the end is counted in ``stats["contacts"]`` only); ``segments`` (free and contact); ``stats``:
+        ``steps`` (step attempts), ``rhs_calls`` (residual or right-hand-side evaluations), ``contacts``, ``events``
+        (roots handled), ``solver_calls``, ``grazing`` (contacts caught at an apex).
+    contact_fourier : ndarray of complex
+        Running integral of F exp(-j theta) theta' dt from t = 0 to each sample [N], integrated with the motion:
+        its increase over a window of whole cycles, divided by pi times the cycles, is the bumper force's fundamental.
     """
 
     sweep: SweptSine
@@ -140,6 +307,7 @@ class SweepRecord:
     base_force: NDArray[np.float64]
     contact_force: NDArray[np.float64]
     trajectory: Trajectory
+    contact_fourier: NDArray[np.complex128]
 
 
 class CompliantEngine:
@@ -152,7 +320,8 @@ class CompliantEngine:
     bumper_loss_factor : float
         xi_b [-], >= 0.
     settings : EngineSettings
-        rtol, atol and max_step.
+        rtol, atol (of the displacements [m]; scaled for the other components, see :func:`absolute_tolerances`) and
+        max_step. :data:`SWEEP_SETTINGS` suits the paper's swept-sine test.
     """
 
     name = "compliant"
@@ -167,27 +336,20 @@ class CompliantEngine:
             raise ValueError(f"periods = {periods} is out of range: allowed [0, inf)")
         model = _BumperModel(problem, KelvinVoigtBumper(problem.clearance, self.frequency, self.loss_factor), moments)
         rec = TrajectoryBuilder(problem, moments)
-        run = _Run(self, model, rec, float(t_start), state)
+        run = _Run(self, model, rec, float(t_start), state, problem.omega)
         rec.strobe(run.t, run.physical())
-        quadratures = run.y[5:].copy()
-        for k in range(1, periods + 1):
-            boundary = t_start + k * problem.period
-            while True:
-                result = run.solver.step(boundary, method="onestep", tstop=boundary)
-                run.counts["steps"] += 1
-                if result.status < 0:
-                    raise RuntimeError(f"IDA failed at t = {result.t!r} s: {result.message}")
-                run.t, run.y = float(result.t), np.array(result.y)
-                if result.status == _STATUS_TSTOP:
-                    break
-                if result.status == _STATUS_ROOT:
-                    run.on_root(np.asarray(result.i_events[-1]))
-            if moments:
-                q = run.y[5:] - quadratures
-                quadratures = run.y[5:].copy()
-                rec.add_moments(moment_row(q))
-            rec.strobe(run.t, run.physical())
-        return rec.build(run.counts | {"rhs_calls": model.rhs_calls})
+        previous = run.y[5:].copy()
+
+        def strobes(times: NDArray[np.float64], ys: NDArray[np.float64], contact: bool) -> None:
+            nonlocal previous
+            for t, y in zip(times, ys):
+                if moments:
+                    rec.add_moments(moment_row(y[5:] - previous))
+                    previous = y[5:].copy()
+                rec.strobe(float(t), np.array([y[0], y[1] + problem.clearance, y[2], y[3]]))
+
+        run.run(np.asarray(t_start + problem.period * np.arange(1, periods + 1), dtype=np.float64), strobes)
+        return rec.build(run.stats())
 
     def sweep(self, system: TwoDofSystem, clearance: float, sweep: SweptSine, sample_rate: float, state: NDArray[np.float64] | None = None) -> SweepRecord:
         """Swept-sine test (the paper's Simulink run): q sin(theta(t)) from t = 0 to the sweep's end, sampled.
@@ -209,101 +371,149 @@ class CompliantEngine:
         problem = ImpactProblem(system, clearance, 0.5, sweep.amplitude, sweep.start_frequency)  # forcing from `sweep`
         model = _BumperModel(problem, KelvinVoigtBumper(clearance, self.frequency, self.loss_factor), False, sweep)
         rec = TrajectoryBuilder(problem, False)
-        run = _Run(self, model, rec, 0.0, np.zeros(4) if state is None else state)
+        omega_ref = 2.0 * math.pi * max(sweep.start_frequency, sweep.stop_frequency)
+        run = _Run(self, model, rec, 0.0, np.zeros(4) if state is None else state, omega_ref)
         times = np.arange(0.0, sweep.duration, 1.0 / sample_rate)
-        out = np.empty((times.size, 5))
-        for i, sample in enumerate(times):
-            while run.t < sample:
-                result = run.solver.step(float(sample))
-                run.counts["steps"] += 1
-                if result.status < 0:
-                    raise RuntimeError(f"IDA failed at t = {result.t!r} s: {result.message}")
-                run.t, run.y = float(result.t), np.array(result.y)
-                if result.status == _STATUS_ROOT:
-                    run.on_root(np.asarray(result.i_events[-1]))
-                    continue
-                break
-            bumper = model.force(run.y) if model.contact else 0.0
-            out[i] = [run.y[0], run.y[1] + clearance, run.y[2], run.y[3], bumper]
+        out = np.empty((times.size, 7))  # X1, X2, X1', X2', F, Fourier integral (real, -imaginary)
+        filled = 0
+
+        def samples(t: NDArray[np.float64], ys: NDArray[np.float64], contact: bool) -> None:
+            nonlocal filled
+            block = out[filled : filled + t.size]
+            block[:, :4] = ys[:, :4]
+            block[:, 1] += clearance
+            block[:, 4] = model.k * ys[:, 1] + model.b * ys[:, 3] if contact else 0.0
+            block[:, 5:] = ys[:, 5:7]
+            filled += t.size
+
+        run.run(times, samples)
+        if filled != times.size:
+            raise RuntimeError(f"the sweep produced {filled} of {times.size} samples")
         rec.strobe(run.t, run.physical())
         base_force = system.k1 * out[:, 0] + system.b1 * out[:, 2] + out[:, 4]
-        return SweepRecord(sweep, times, out[:, 0], out[:, 1], base_force, out[:, 4], rec.build(run.counts | {"rhs_calls": model.rhs_calls}))
+        fourier = out[:, 5] - 1j * out[:, 6]
+        return SweepRecord(sweep, times, out[:, 0], out[:, 1], base_force, out[:, 4], rec.build(run.stats()), fourier)
 
-    def _solver(self, model: _BumperModel) -> IDA:
-        def events(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], out: NDArray[np.float64]) -> None:
-            model.events(t, y, yp, out)
-
-        events.terminal = [True] * 5  # type: ignore[attr-defined]
-        events.direction = [1, -1, -1, -1, 1]  # type: ignore[attr-defined]
-        self._events = events
+    def _solver(self, model: _BumperModel, contact: bool, omega_ref: float) -> tuple[IDA, Any]:
+        """The IDA solver of one mode and its event function."""
+        events = model.events(contact)
+        s = model.problem.system
+        natural = float(np.abs(np.linalg.eigvals(s.state_matrix)).max())
+        fastest = max(math.sqrt(natural**2 + (model.k / s.m2 if contact else 0.0)), omega_ref)
+        first = math.sqrt(2.0 * self.settings.rtol) / fastest  # backward Euler: h^2 |y''| / 2 ~ rtol |y|
         options: dict[str, Any] = {
             "rtol": self.settings.rtol,
-            "atol": self.settings.atol,
+            "atol": absolute_tolerances(self.settings.atol, omega_ref, s.m2, model.quadratures),
             "max_num_steps": 1_000_000,
             "eventsfn": events,
-            "num_events": 5,
-            "jacfn": model.jacobian,
+            "num_events": 3 if contact else 2,  # see events()
+            "jacfn": model.jacobian(contact),
+            "first_step": first,
         }
         if self.settings.max_step > 0.0:
             options["max_step"] = self.settings.max_step
-        return IDA(model.residual, **options)
+            options["first_step"] = min(first, self.settings.max_step)
+        return IDA(model.residual(contact), **options), events
 
 
 class _Run:
-    """One IDA integration: the state, the solver, and what happens at each event (onset, release, peaks)."""
+    """One integration: the state, one IDA solver per mode, and what happens at each switch and recorded root."""
 
-    def __init__(self, engine: CompliantEngine, model: _BumperModel, rec: TrajectoryBuilder, t: float, state: NDArray[np.float64]) -> None:
+    def __init__(self, engine: CompliantEngine, model: _BumperModel, rec: TrajectoryBuilder, t: float, state: NDArray[np.float64], omega_ref: float) -> None:
         self.model, self.rec = model, rec
         self.clearance = model.problem.clearance
         self.t = t
         self.y = np.zeros(model.size)
         self.y[:4] = np.asarray(state, dtype=float)
         self.y[1] -= self.clearance
-        model.contact = bool(self.y[1] >= 0.0 and model.force(self.y) > 0.0)
-        self.solver = engine._solver(model)
-        self._events = engine._events
-        self.counts = {"events": 0, "contacts": 0, "steps": 0}
+        self.contact = bool(self.y[1] >= 0.0 and model.force(self.y) > 0.0)
+        self.solvers = {mode: engine._solver(model, mode, omega_ref) for mode in (False, True)}
+        self.counts = {"events": 0, "contacts": 0, "solver_calls": 0, "grazing": 0}
         self.onset, self.peak_force, self.peak_deceleration = (t, 0.0, 0.0), 0.0, 0.0
-        if model.contact:
+        if self.contact:
             self._begin_contact()
-        self.restart()
+        self.rec.segment(self.t, MODE_CONTACT if self.contact else MODE_FREE, self.physical())
 
     def physical(self) -> NDArray[np.float64]:
         """(X1, X2, X1', X2') now."""
         return np.array([self.y[0], self.y[1] + self.clearance, self.y[2], self.y[3]])
 
-    def restart(self) -> None:
-        """Re-initialise IDA at the current state with consistent y' = f(t, y), and open a segment."""
-        clear_event_records(self._events)
-        result = self.solver.init_step(self.t, self.y, self.model.derivative(self.t, self.y))
-        if result.status < 0:
-            raise RuntimeError(f"IDA could not start at t = {self.t!r} s: {result.message}")
-        self.rec.segment(self.t, MODE_CONTACT if self.model.contact else MODE_FREE, self.physical())
+    def stats(self) -> dict[str, int]:
+        return self.counts | {"steps": self.model.steps, "rhs_calls": self.model.rhs_calls}
+
+    def run(self, outputs: NDArray[np.float64], emit: Callable[[NDArray[np.float64], NDArray[np.float64], bool], None]) -> None:
+        """Integrate to ``outputs[-1]``, handing the states at the increasing ``outputs`` (all after or at the
+        current time) to ``emit(times, states, contact)`` in order, in blocks of one mode."""
+        n, i, in_place, last_switch = outputs.size, 0, 0, math.nan
+        while i < n:
+            j, close = i, 16.0 * np.finfo(float).eps * max(1.0, abs(self.t))  # IDA refuses a first output closer than ~4 eps t
+            while j < n and outputs[j] <= self.t + close:  # outputs at the current time: the current state
+                j += 1
+            if j > i:
+                emit(outputs[i:j], np.broadcast_to(self.y, (j - i, self.y.size)), self.contact)
+                i = j
+                continue
+            j = min(n, i + _OUTPUTS_PER_CALL)
+            tspan = np.concatenate(([self.t], outputs[i:j]))
+            midpoint = tspan.size == 2  # IDA.solve interpolates at given times only with three or more
+            if midpoint:
+                tspan = np.array([self.t, 0.5 * (self.t + outputs[i]), outputs[i]])
+            solver, events = self.solvers[self.contact]
+            self.counts["solver_calls"] += 1
+            result = solver.solve(tspan, self.y, self.model.derivative(self.t, self.y, self.contact))
+            if result.status < 0:
+                raise RuntimeError(f"IDA failed at t = {float(result.t[-1])!r} s: {result.message}")
+            times, states = result.t[1:], result.y[1:]
+            stopped = result.status == _STATUS_ROOT  # on a terminal event: the last row is the root
+            rows, end_t, end_y = times.size - 1 if stopped else times.size, float(times[-1]), states[-1]
+            records = (result.i_events, result.t_events, result.y_events)
+            _clear(events)
+            if records[0] is not None:
+                rows, end_t, end_y, stopped = self._roots(records, times, rows, end_t, end_y, stopped)
+            first = 1 if midpoint else 0
+            if rows > first:
+                emit(times[first:rows], states[first:rows], self.contact)
+                i += rows - first
+            self.t, self.y = end_t, np.array(end_y)
+            if stopped:
+                in_place = in_place + 1 if self.t == last_switch else 0
+                if in_place > _MAX_SWITCHES_IN_PLACE:
+                    raise RuntimeError(f"the contact switches mode over and over at t = {self.t!r} s")
+                last_switch = self.t
+                self._switch()
+
+    def _roots(self, records: tuple[Any, Any, Any], times: NDArray[np.float64], rows: int, end_t: float, end_y: NDArray[np.float64], stopped: bool) -> tuple[int, float, NDArray[np.float64], bool]:
+        """Handle the roots recorded in one solver call; return the output rows to keep and where the run goes on
+        (a grazing contact cuts the call short at its apex)."""
+        model = self.model
+        for flags, t_root, y_root in zip(*records):
+            if stopped and t_root == end_t and flags[0] != 0:
+                break  # the terminal event: the caller switches mode
+            self.counts["events"] += 1
+            if self.contact:  # a largest force or deceleration
+                self.peak_force = max(self.peak_force, model.force(y_root))
+                self.peak_deceleration = max(self.peak_deceleration, -model.derivative(float(t_root), y_root, True)[3])
+            elif y_root[1] >= 0.0:  # an apex at or beyond the bumper: a grazing contact the onset event missed
+                self.counts["grazing"] += 1
+                return int(np.searchsorted(times[:rows], t_root, side="right")), float(t_root), y_root, True
+        return rows, end_t, end_y, stopped
 
     def _begin_contact(self) -> None:
         """Onset (time, entry speed, impulse integral) and the force and deceleration at first touch."""
         self.counts["contacts"] += 1
         self.onset = (self.t, float(self.y[3]), float(self.y[4]))
         self.peak_force = self.model.force(self.y)
-        self.peak_deceleration = max(-self.model.derivative(self.t, self.y)[3], 0.0)
+        self.peak_deceleration = max(-self.model.derivative(self.t, self.y, True)[3], 0.0)
 
-    def on_root(self, fired: NDArray[np.int_]) -> None:
-        """Handle the events that stopped IDA at the current time; restart it if the mode changed."""
-        clear_event_records(self._events)
+    def _switch(self) -> None:
+        """Onset (or grazing apex) in flight, release in contact: change mode at the current state."""
         self.counts["events"] += 1
-        model, y = self.model, self.y
-        if model.contact and fired[1] != 0:  # release: the bumper would pull
+        if self.contact:  # release: the bumper would pull
             self.rec.contact_peaks(self.peak_force, self.peak_deceleration)
-            self.rec.impact(self.onset[0], self.onset[1], float(y[4]) - self.onset[2], in_moments=False)
-            model.contact = False
-        elif model.contact:  # a force or deceleration maximum: record it, integration goes on
-            self.peak_force = max(self.peak_force, model.force(y))
-            self.peak_deceleration = max(self.peak_deceleration, -model.derivative(self.t, y)[3])
-            return
-        elif fired[0] != 0 or (fired[2] != 0 and y[1] >= 0.0):  # onset (or a tangent touch at an apex)
-            model.contact = True
-            y[1] = max(y[1], 0.0)
-            self._begin_contact()
+            self.rec.impact(self.onset[0], self.onset[1], float(self.y[4]) - self.onset[2], in_moments=False)
+            self.contact = False
         else:
-            return  # an apex short of the bumper
-        self.restart()
+            self.contact = True
+            self.y[1] = max(self.y[1], 0.0)
+            self._begin_contact()
+        self.rec.segment(self.t, MODE_CONTACT if self.contact else MODE_FREE, self.physical())
