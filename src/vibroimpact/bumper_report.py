@@ -216,8 +216,9 @@ def peak_tables(dataset: xr.Dataset, scene: Scene, parameter: str) -> list[tuple
 
 
 # -------------------------------------------------------------------------------------- peak acceleration
-def peak_acceleration_figure(dataset: xr.Dataset, scene: Scene, out: Path) -> list[Figure]:
-    """Peak contact deceleration and force against frequency: simulation against the PGF-based estimate (figure 28)."""
+def peak_acceleration_figure(dataset: xr.Dataset, scene: Scene, path: Path) -> list[Figure]:
+    """Peak contact deceleration and force against frequency at one clearance: simulation against the PGF-based
+    estimate (figure 28)."""
     f = dataset["frequency"].values
     fig, axes = plt.subplots(1, 2, figsize=(15, 4.6), squeeze=False)
     lines = [(f"R = {float(r):g}", dataset.sel(restitution=r)) for r in dataset["restitution"].values] if "restitution" in dataset.dims else [(f"R = {float(dataset['restitution']):g}", dataset)]
@@ -247,7 +248,7 @@ def peak_acceleration_figure(dataset: xr.Dataset, scene: Scene, out: Path) -> li
         "against the PGF-based estimate Gamma(xi_b) Omega_b J / (M2 (1 + R)) (section 6.3 with the corrected factor Gamma): "
         "the rigid-stop impulse J gives the entry speed, the one-collision solution of the bumper gives the peak."
     )
-    return [Figure(save_figure(fig, out / "peak_acceleration.png"), caption)]
+    return [Figure(save_figure(fig, path), caption + f" Delta = {float(dataset['clearance']) * 1e3:g} mm.")]
 
 
 # ------------------------------------------------------------------------------------------- stiffness

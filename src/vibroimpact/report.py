@@ -63,6 +63,8 @@ def write_report(dataset: xr.Dataset, out_dir: str | Path) -> Path:
             figures.append(_regime_figure(part, out / f"regime{tag}.png"))
         if "floquet_modulus" in part and "pgf" in part["solution"].values:
             figures.append(_stability_figure(part, out / f"stability{tag}.png"))
+        if "peak_acceleration" in part and "compliant" in part["solution"].values:
+            figures += bumper_report.peak_acceleration_figure(part, scene, out / f"peak_acceleration{tag}.png")
         engines = [name for name in part["solution"].values if name in ENGINE_SOLUTIONS]
         if engines:
             for quantity in ("x1_amplitude", "x2_amplitude", "force_amplitude", "impulse"):
@@ -74,8 +76,6 @@ def write_report(dataset: xr.Dataset, out_dir: str | Path) -> Path:
         if parameter in dataset.dims and engines_present and "x1_amplitude" in dataset:
             figures += bumper_report.peak_figures(dataset, scene, parameter, out)
             tables += bumper_report.peak_tables(dataset, scene, parameter)
-    if "peak_acceleration" in dataset and "compliant" in dataset["solution"].values:
-        figures += bumper_report.peak_acceleration_figure(dataset, scene, out)
     page = _html(dataset, scene, figures, tables)
     return _write_text_atomic(out / "report.html", page)
 

@@ -264,15 +264,6 @@ class _BumperModel:
         return free_events
 
 
-def _clear(events: Any) -> None:
-    """Forget every record scikit-sundae 1.2.0 keeps on an event function, ``_yp`` included (which
-    :func:`.sundae.clear_event_records` leaves: it grows too, and every call converts all of it to an array)."""
-    clear_event_records(events)
-    records = getattr(events, "_yp", None)
-    if records is not None:
-        records.clear()
-
-
 @dataclass(frozen=True, eq=False)
 class SweepRecord:
     """A swept-sine run, sampled uniformly in time.
@@ -467,7 +458,7 @@ class _Run:
             stopped = result.status == _STATUS_ROOT  # on a terminal event: the last row is the root
             rows, end_t, end_y = times.size - 1 if stopped else times.size, float(times[-1]), states[-1]
             records = (result.i_events, result.t_events, result.y_events)
-            _clear(events)
+            clear_event_records(events)
             if records[0] is not None:
                 rows, end_t, end_y, stopped = self._roots(records, times, rows, end_t, end_y, stopped)
             first = 1 if midpoint else 0
