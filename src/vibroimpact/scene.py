@@ -130,6 +130,9 @@ class SweptSineSettings:
         Output samples per second of the simulated signals [Hz].
     window_cycles : int
         Cycles of the excitation in the running estimators' window.
+    initial_state : str
+        ``linear``: each run starts on the linear steady state at its first frequency (where it fits inside the
+        clearance; else at rest), so no start-up transient shows; ``rest``: at rest, like a bench test.
     """
 
     start_frequency: float
@@ -138,6 +141,7 @@ class SweptSineSettings:
     directions: tuple[str, ...] = SWEEP_DIRECTIONS
     sample_rate: float = 1000.0
     window_cycles: int = 8
+    initial_state: str = "linear"
 
     def sweep(self, amplitude: float, direction: str) -> SweptSine:
         """The excitation of one direction."""
@@ -505,7 +509,7 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
 
 def _parse_swept_sine(c: _Checker, value: Any, engines: list[str]) -> SweptSineSettings | None:
     """``swept_sine: {start, stop, rate, directions, sample_rate, window_cycles}`` (frequencies [Hz], rate [Hz s-1])."""
-    spec = c.mapping("swept_sine", value, {"start", "stop", "rate", "directions", "sample_rate", "window_cycles"}, {"start", "stop", "rate"})
+    spec = c.mapping("swept_sine", value, {"start", "stop", "rate", "directions", "sample_rate", "window_cycles", "initial_state"}, {"start", "stop", "rate"})
     if engines != ["compliant"]:
         c.fail("solutions", f"a swept-sine test runs the compliant solution only (and needs it): got {engines or 'none'}")
     start = c.number("swept_sine.start", spec["start"], 0.0, math.inf, low_inclusive=False) if "start" in spec else None
@@ -514,6 +518,10 @@ def _parse_swept_sine(c: _Checker, value: Any, engines: list[str]) -> SweptSineS
     directions = c.choices("swept_sine.directions", spec["directions"], SWEEP_DIRECTIONS) if "directions" in spec else SWEEP_DIRECTIONS
     sample_rate = c.number("swept_sine.sample_rate", spec.get("sample_rate", 1000.0), 0.0, 1e7, low_inclusive=False)
     cycles = c.integer("swept_sine.window_cycles", spec.get("window_cycles", 8), 1, 10_000)
+    initial = spec.get("initial_state", "linear")
+    if initial not in ("linear", "rest"):
+        c.fail("swept_sine.initial_state", f"{initial!r} is not allowed: use linear or rest")
+        return None
     if start is not None and stop is not None and stop <= start:
         c.fail("swept_sine.stop", f"{stop:g} must be greater than start = {start:g} (directions say which way it runs)")
         return None
@@ -523,7 +531,7 @@ def _parse_swept_sine(c: _Checker, value: Any, engines: list[str]) -> SweptSineS
     if sample_rate < 20.0 * stop:
         c.fail("swept_sine.sample_rate", f"{sample_rate:g} Hz is too coarse for {stop:g} Hz: allowed [{20.0 * stop:g}, 1e+07] (20 samples per cycle)")
         return None
-    return SweptSineSettings(start, stop, rate, directions, sample_rate, cycles)
+    return SweptSineSettings(start, stop, rate, directions, sample_rate, cycles, initial)
 
 
 def _parse_header(c: _Checker, doc: dict) -> tuple[Any, str, TwoDofSystem | None, float | None, bool]:

@@ -27,7 +27,7 @@ from .harmonics import running_at, running_fundamental, window_times
 from .scene import SweptSineSettings
 from .system import TwoDofSystem
 
-__all__ = ["SweepCase", "SWEEP_QUANTITIES", "SWEEP_FIELDS", "run_sweep_case", "running_quantities"]
+__all__ = ["SweepCase", "SWEEP_QUANTITIES", "SWEEP_FIELDS", "run_sweep_case", "running_quantities", "sweep_start_state"]
 
 #: Quantities estimated per window, on the frequency grid and (prefixed ``running_``) on the time grid.
 SWEEP_QUANTITIES = (
@@ -109,7 +109,8 @@ def run_sweep_case(case: SweepCase) -> dict[str, NDArray[np.generic]]:
     sweep = case.settings.sweep(case.amplitude, case.direction)
     engine = CompliantEngine(case.bumper_frequency, case.bumper_loss_factor, case.engine_settings)
     started = time.perf_counter()
-    record = engine.sweep(case.system, case.clearance, sweep, case.settings.sample_rate)
+    state = sweep_start_state(case.system, sweep, case.clearance) if case.settings.initial_state == "linear" else None
+    record = engine.sweep(case.system, case.clearance, sweep, case.settings.sample_rate, state)
     wall_time = time.perf_counter() - started
     frequencies = np.asarray(case.frequencies, dtype=float)
     with np.errstate(invalid="ignore"):
@@ -129,6 +130,17 @@ def run_sweep_case(case: SweepCase) -> dict[str, NDArray[np.generic]]:
     for name in ("steps", "contacts", "rhs_calls"):
         out[name] = np.array(float(stats.get(name, np.nan)))
     return out
+
+
+def sweep_start_state(system: TwoDofSystem, sweep: SweptSine, clearance: float) -> NDArray[np.float64] | None:
+    """(X1, X2, X1', X2') of the linear steady response to q sin(2 pi f0 t) at t = 0, or None (rest) if its absorber
+    amplitude exceeds the clearance."""
+    omega = 2.0 * np.pi * sweep.start_frequency
+    h = system.receptances(omega)
+    x = sweep.amplitude * np.array([complex(h.h11), complex(h.h12)]) * -1j  # sin = cos delayed by a quarter period
+    if abs(x[1]) > clearance:
+        return None
+    return np.concatenate([x.real, (1j * omega * x).real])
 
 
 def running_quantities(record: SweepRecord, centres: NDArray[np.float64], cycles: int) -> dict[str, NDArray[np.float64]]:
