@@ -212,6 +212,28 @@ def test_sweep_clears_the_event_records() -> None:
         assert all(len(getattr(events, name)) == 0 for name in ("_i", "_t", "_y", "_yp"))
 
 
+@pytest.mark.timeout(120)
+def test_sweep_memory_stays_flat() -> None:
+    """Beyond its output, a sweep's memory grows only by its per-contact records: between a 5 s and a 20 s
+    contact-rich sweep (22 -> 22.5 / 24 Hz, ~110 / ~460 contacts) the peak traced allocation minus the samples grows
+    by less than 2 kB per added contact (measured ~1 kB: impact, peaks and two segment rows). Anything kept per
+    step (~170 steps per contact) would exceed it many times over."""
+    import tracemalloc
+
+    def extra_memory(stop: float) -> tuple[float, int]:
+        tracemalloc.start()
+        try:
+            _, record = _paper_sweep_record(EngineSettings(rtol=1e-6, atol=1e-10), 22.0, stop, sample_rate=500.0)
+            _, peak = tracemalloc.get_traced_memory()
+        finally:
+            tracemalloc.stop()
+        return peak - record.time.nbytes * 7, record.trajectory.impact_times.size
+
+    (short, few), (long, many) = extra_memory(22.5), extra_memory(24.0)
+    assert many > 3 * few > 300
+    assert (long - short) / (many - few) < 2048, (short, long, few, many)
+
+
 def _first_apex(system: TwoDofSystem, state: np.ndarray) -> tuple[float, float]:
     """Time and X2 of the first apex (X2' = 0) of the free motion from ``state`` (matrix exponential: exact)."""
     from scipy.linalg import expm
@@ -278,18 +300,14 @@ def test_apex_check_catches_what_the_onset_event_misses(system: TwoDofSystem, mo
 @pytest.mark.slow
 @pytest.mark.timeout(600)
 def test_paper_sweep_is_fast_and_close_to_a_tight_run() -> None:
-    """The paper's 300 s sweep (15 -> 45 Hz) in well under a minute with :data:`SWEEP_SETTINGS` (~10 s measured;
-    it took ~155 s before), and over the contact-rich, reproducible 21 -> 24 Hz (60 - 90 s) the same contacts and
+    """The paper's 300 s sweep (15 -> 45 Hz) with :data:`SWEEP_SETTINGS` (~10 s measured, see ``sweep_cost``; the
+    timeout catches a hang), and over the contact-rich, reproducible 21 -> 24 Hz (60 - 90 s) the same contacts and
     running X1 fundamental as rtol 1e-9 to 1e-4 of its largest value."""
-    import time
 
     from vibroimpact.engines.compliant import SWEEP_SETTINGS
     from vibroimpact.harmonics import running_fundamental
 
-    started = time.perf_counter()
-    sweep, record = _paper_sweep_record(SWEEP_SETTINGS, 15.0, 45.0)
-    wall = time.perf_counter() - started
-    assert wall < 60.0
+    sweep, record = _paper_sweep_record(SWEEP_SETTINGS, 15.0, 45.0)  # the timeout bounds it; speed is benchmarked
     _, tight = _paper_sweep_record(EngineSettings(rtol=1e-9, atol=1e-13), 15.0, 45.0)
     onsets = [r.trajectory.impact_times[(r.trajectory.impact_times >= 60.0) & (r.trajectory.impact_times < 90.0)] for r in (record, tight)]
     assert onsets[0].size == onsets[1].size > 600
