@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
 
-from . import bumper_report  # noqa: E402
+from . import accuracy_report, bumper_report  # noqa: E402
 from .atomic import atomic_path  # noqa: E402
 from .linear import linear_response  # noqa: E402
 from .modal import exact_modal_parameters, fit_modal_parameters, underdamped_mode_count  # noqa: E402
@@ -43,7 +43,7 @@ def write_report(dataset: xr.Dataset, out_dir: str | Path) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     scene = parse_scene(read_yaml(dataset.attrs["scene"]), text=dataset.attrs["scene"])
     if scene.benchmark is not None:
-        return _write_text_atomic(out / "report.html", _html(dataset, scene, [_benchmark_figure(dataset, out / "work_precision.png")], _benchmark_tables(dataset)))
+        return _write_text_atomic(out / "report.html", _html(dataset, scene, accuracy_report.accuracy_figures(dataset, out), accuracy_report.accuracy_tables(dataset)))
     figures = [_linear_figure(scene, out)]
     if scene.swept_sine is not None:
         figures += bumper_report.sweep_figures(dataset, scene, out)
@@ -310,62 +310,6 @@ def _agreement_table(dataset: xr.Dataset, scene: Scene) -> str:
                         f"<td>{int(bad.sum())}</td><td>{_fmt(_largest(difference[bad]))}</td><td>{int((irregular & mask).sum())}</td><td>{int((other & mask).sum())}</td></tr>"
                     )
     return f"<table>{header}{''.join(body)}</table>"
-
-
-def _benchmark_figure(dataset: xr.Dataset, path: Path) -> Figure:
-    cases = list(dataset["case"].values)
-    fig, axes = plt.subplots(1, len(cases), figsize=(6.2 * len(cases), 4.6), squeeze=False)
-    for ax, case in zip(axes[0], cases):
-        for k, method in enumerate(dataset["engine"].values):
-            line = dataset.sel(case=case, engine=method)
-            error = line["impact_time_error"].values
-            wall = line["wall_time"].values
-            missed = line["missed_impacts"].values > 0
-            ax.loglog(wall, np.where(missed, np.nan, error), "o-", color=f"C{k}", label=str(method), ms=4)
-            if missed.any():
-                ax.loglog(wall[missed], np.maximum(error[missed], 1e-16), "x", color=f"C{k}", ms=9, mew=2)
-        ax.axvline(float(dataset["exact_wall_time"].sel(case=case)), color="k", ls="--", lw=1.0, label="exact (error 0)")
-        ax.set(title=str(case), xlabel="wall time [s] (median)", ylabel="largest impact-time error [s]")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
-    caption = (
-        "Work-precision: one point per tolerance (rtol from loose to tight), error against the exact engine, wall time "
-        "measured in one process run (read ratios, not seconds). Crosses: runs that missed impacts of the reference."
-    )
-    return Figure(save_figure(fig, path), caption)
-
-
-def _benchmark_tables(dataset: xr.Dataset) -> list[tuple[str, str]]:
-    from .benchmark import equal_error_speedup
-
-    tables = []
-    ivp = [m for m in dataset["engine"].values if str(m).startswith("solve_ivp")]
-    summary = ["<tr><th>case</th><th>rtol</th><th>momentary_adams [s]</th><th>exact [s]</th><th>momentary / exact</th><th>best solve_ivp at equal error</th><th>its time / momentary's</th></tr>"]
-    for case in dataset["case"].values:
-        rows = ["<tr><th>method</th><th>rtol</th><th>wall [s]</th><th>rhs calls</th><th>impacts</th><th>missed</th><th>extra</th><th>impact-time error [s]</th><th>impulse error</th></tr>"]
-        for method in dataset["engine"].values:
-            for tolerance in dataset["rtol"].values:
-                p = dataset.sel(case=case, engine=method, rtol=tolerance)
-                if not np.isfinite(float(p["wall_time"])):
-                    continue
-                rows.append(
-                    f"<tr><td>{method}</td><td>{float(tolerance):g}</td><td>{float(p['wall_time']):.3f}</td><td>{float(p['rhs_calls']):.0f}</td>"
-                    f"<td>{float(p['impacts']):.0f}</td><td>{float(p['missed_impacts']):.0f}</td><td>{float(p['extra_impacts']):.0f}</td>"
-                    f"<td>{float(p['impact_time_error']):.2e}</td><td>{float(p['impulse_error']):.2e}</td></tr>"
-                )
-        exact = float(dataset["exact_wall_time"].sel(case=case))
-        rows.append(f"<tr><td>exact (reference)</td><td></td><td>{exact:.3f}</td><td></td><td>{float(dataset['reference_impacts'].sel(case=case)):.0f}</td><td>0</td><td>0</td><td>0</td><td>0</td></tr>")
-        tables.append((f"Engine cost: {case}", "<table>" + "".join(rows) + "</table>"))
-        if "momentary_adams" in dataset["engine"].values:
-            for tolerance in dataset["rtol"].values:
-                p = dataset.sel(case=case, engine="momentary_adams", rtol=tolerance)
-                ratio, other = equal_error_speedup(dataset, str(case), "momentary_adams", float(tolerance), [str(m) for m in ivp])
-                summary.append(
-                    f"<tr><td>{case}</td><td>{float(tolerance):g}</td><td>{float(p['wall_time']):.3f}</td><td>{exact:.4f}</td>"
-                    f"<td>{float(p['wall_time']) / exact:.1f}</td><td>{other}</td><td>{'' if not np.isfinite(ratio) else f'{ratio:.2f}'}</td></tr>"
-                )
-    tables.insert(0, ("Summary: momentary (Adams) against exact and against solve_ivp at equal impact-time error", "<table>" + "".join(summary) + "</table>"))
-    return tables
 
 
 def _largest(values: np.ndarray) -> float:

@@ -25,7 +25,7 @@ from typing import Any, TypeVar
 import numpy as np
 import yaml
 
-from .benchmark import BENCHMARK_METHODS, BenchmarkCase, BenchmarkSettings
+from .benchmark import BENCHMARK_METHODS, BenchmarkCase, BenchmarkSettings, LadderSettings
 from .engines.base import EngineSettings, ImpactProblem
 from .excitation import SweptSine
 from .modal import underdamped_mode_count
@@ -387,8 +387,8 @@ class _Checker:
 _TOP_KEYS = {"name", "description", "system", "excitation", "stop", "bumper", "sweep", "swept_sine", "solutions", "quantities", "settings", "simulation", "report"}
 #: Simulation keys that only stepped steady states use.
 _STEADY_ONLY_KEYS = {"frequency", "start", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods"}
-_BENCHMARK_KEYS = {"duration", "methods", "tolerances", "atol_ratio", "repeats", "max_seconds", "cases"}
-_BENCHMARK_CASE_KEYS = {"name", "frequency", "restitution", "clearance", "clearance_below_linear", "start"}
+_BENCHMARK_KEYS = {"duration", "methods", "tolerances", "atol_ratio", "repeats", "max_seconds", "cases", "ladder"}
+_BENCHMARK_CASE_KEYS = {"name", "frequency", "restitution", "clearance", "clearance_below_linear", "start", "bumper_frequency", "swept_sine"}
 _SIMULATION_KEYS = {"frequency", "start", "method", "rtol", "atol", "max_step", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods"}
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
@@ -569,25 +569,50 @@ def _parse_benchmark_scene(c: _Checker, document: dict, text: str, source: str) 
         options["repeats"] = c.integer("benchmark.repeats", spec["repeats"], 1, 100)
     if "max_seconds" in spec:
         options["max_seconds"] = c.number("benchmark.max_seconds", spec["max_seconds"], 0.0, 1e5, low_inclusive=False)
+    if "ladder" in spec:
+        options["ladder"] = _parse_ladder(c, spec["ladder"])
     cases = []
     raw_cases = spec.get("cases", [])
     if not isinstance(raw_cases, list) or not raw_cases:
-        c.fail("benchmark.cases", "expected a non-empty list of cases {name, frequency, restitution, clearance | clearance_below_linear, start}")
+        c.fail("benchmark.cases", "expected a non-empty list of cases {name, frequency, restitution, clearance | clearance_below_linear, start[, bumper_frequency] | swept_sine}")
         raw_cases = []
     for i, raw in enumerate(raw_cases):
         key = f"benchmark.cases[{i}]"
-        case = c.mapping(key, raw, _BENCHMARK_CASE_KEYS, {"name", "frequency", "restitution", "start"})
-        frequency = c.number(f"{key}.frequency", case.get("frequency"), 0.0, math.inf, low_inclusive=False) if "frequency" in case else None
+        case = c.mapping(key, raw, _BENCHMARK_CASE_KEYS, {"name", "restitution"})
+        swept = case.get("swept_sine")
+        if swept is not None:
+            spec_s = c.mapping(f"{key}.swept_sine", swept, {"start", "stop", "rate", "sample_rate"}, {"start", "stop", "rate"})
+            f_start = c.number(f"{key}.swept_sine.start", spec_s.get("start"), 0.0, math.inf, low_inclusive=False) if "start" in spec_s else None
+            f_stop = c.number(f"{key}.swept_sine.stop", spec_s.get("stop"), 0.0, math.inf, low_inclusive=False) if "stop" in spec_s else None
+            rate = c.number(f"{key}.swept_sine.rate", spec_s.get("rate"), 0.0, math.inf, low_inclusive=False) if "rate" in spec_s else None
+            sample_rate = c.number(f"{key}.swept_sine.sample_rate", spec_s.get("sample_rate", 2000.0), 0.0, 1e7, low_inclusive=False)
+            if "frequency" in case or "start" in case:
+                c.fail(key, "a swept_sine case sets its own frequencies and starts at rest: remove frequency and start")
+            if "bumper_frequency" not in case:
+                c.fail(f"{key}.bumper_frequency", "required by a swept_sine case (the compliant model): Omega_b / 2 pi [Hz] in (0, inf)")
+            if f_start is not None and f_stop is not None and f_start == f_stop:
+                c.fail(f"{key}.swept_sine.stop", "must differ from start")
+                f_start = None
+            frequency = f_start
+        else:
+            if "frequency" not in case:
+                c.fail(f"{key}.frequency", "required key is missing")
+            if "start" not in case:
+                c.fail(f"{key}.start", "required key is missing")
+            frequency = c.number(f"{key}.frequency", case.get("frequency"), 0.0, math.inf, low_inclusive=False) if "frequency" in case else None
         restitution = c.number(f"{key}.restitution", case.get("restitution"), 0.0, 1.0) if "restitution" in case else None
+        bumper = c.number(f"{key}.bumper_frequency", case["bumper_frequency"], 0.0, math.inf, low_inclusive=False) if "bumper_frequency" in case else math.nan
+        if bumper is not None and math.isfinite(bumper) and restitution == 0.0:
+            c.fail(f"{key}.restitution", "R = 0 needs an infinitely damped bumper: use R > 0 with bumper_frequency")
         if ("clearance" in case) == ("clearance_below_linear" in case):
             c.fail(key, "give exactly one of 'clearance' [m] or 'clearance_below_linear' [m]")
             continue
-        start = case.get("start")
-        if start not in ("rest", "linear"):
-            c.fail(f"{key}.start", f"{start!r} is not allowed: use rest or linear")
-        if None in (frequency, restitution, system, amplitude, duration) or start not in ("rest", "linear"):
+        start = case.get("start", "rest")
+        if start not in ("rest", "linear", "pgf"):
+            c.fail(f"{key}.start", f"{start!r} is not allowed: use rest, linear or pgf")
+        if None in (frequency, restitution, system, amplitude, duration, bumper) or start not in ("rest", "linear", "pgf"):
             continue
-        assert system is not None and frequency is not None and amplitude is not None and duration is not None and restitution is not None
+        assert system is not None and frequency is not None and amplitude is not None and duration is not None and restitution is not None and bumper is not None
         if "clearance" in case:
             clearance = c.number(f"{key}.clearance", case["clearance"], 0.0, math.inf)
         else:
@@ -600,7 +625,14 @@ def _parse_benchmark_scene(c: _Checker, document: dict, text: str, source: str) 
         if clearance is None:
             continue
         problem = ImpactProblem(system, clearance, restitution, amplitude, frequency)
-        cases.append(BenchmarkCase(str(case["name"]), problem, start, max(1, round(duration * frequency))))
+        if swept is not None:
+            if None in (f_start, f_stop, rate, sample_rate):
+                continue
+            assert f_start is not None and f_stop is not None and rate is not None and sample_rate is not None
+            sweep = SweptSine(amplitude, f_start, f_stop, rate)
+            cases.append(BenchmarkCase(str(case["name"]), problem, "rest", 0, bumper, sweep, sample_rate))
+        else:
+            cases.append(BenchmarkCase(str(case["name"]), problem, start, max(1, round(duration * frequency)), bumper))
     if c.problems:
         raise SceneError(c.problems, source)
     assert tolerances is not None and isinstance(name, str) and system is not None and amplitude is not None
@@ -620,6 +652,21 @@ def _parse_benchmark_scene(c: _Checker, document: dict, text: str, source: str) 
         report=report,
         text=text,
     )
+
+
+def _parse_ladder(c: _Checker, value: Any) -> LadderSettings | None:
+    """``ladder: {frequency, restitution, clearance, bumper_frequencies, rtol, repeats}``."""
+    spec = c.mapping("benchmark.ladder", value, {"frequency", "restitution", "clearance", "bumper_frequencies", "rtol", "repeats"}, {"frequency", "restitution", "clearance", "bumper_frequencies"})
+    frequency = c.number("benchmark.ladder.frequency", spec["frequency"], 0.0, math.inf, low_inclusive=False) if "frequency" in spec else None
+    restitution = c.number("benchmark.ladder.restitution", spec["restitution"], 0.0, 1.0, low_inclusive=False) if "restitution" in spec else None
+    clearance = c.number("benchmark.ladder.clearance", spec["clearance"], 0.0, math.inf) if "clearance" in spec else None
+    bumpers = c.grid("benchmark.ladder.bumper_frequencies", spec["bumper_frequencies"], 0.0, math.inf, False) if "bumper_frequencies" in spec else None
+    rtol = c.number("benchmark.ladder.rtol", spec.get("rtol", 1e-8), 1e-14, 1e-2)
+    repeats = c.integer("benchmark.ladder.repeats", spec.get("repeats", 3), 1, 100)
+    if None in (frequency, restitution, clearance, bumpers, rtol, repeats):
+        return None
+    assert frequency is not None and restitution is not None and clearance is not None and bumpers is not None and rtol is not None and repeats is not None
+    return LadderSettings(frequency, restitution, clearance, tuple(float(b) for b in bumpers), rtol, repeats)
 
 
 def _parse_simulation(c: _Checker, value: Any, default_frequency: np.ndarray) -> SimulationSettings | None:

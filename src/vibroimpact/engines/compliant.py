@@ -385,13 +385,23 @@ class CompliantEngine:
         fourier = out[:, 5] - 1j * out[:, 6]
         return SweepRecord(sweep, times, out[:, 0], out[:, 1], base_force, out[:, 4], rec.build(run.stats()), fourier)
 
+    def solve(self, solver: Any, tspan: NDArray[np.float64], y0: NDArray[np.float64], yp0: NDArray[np.float64]) -> Any:
+        """One solver call over ``tspan`` from a consistent (y0, y0')."""
+        return solver.solve(tspan, y0, yp0)
+
+    def first_step(self, model: _BumperModel, contact: bool, omega_ref: float) -> float:
+        """First step after a (re)start [s]: sqrt(2 rtol) / (the mode's fastest angular frequency), a backward-Euler
+        step of about the tolerance (h^2 |y''| / 2 ~ rtol |y|)."""
+        s = model.problem.system
+        natural = float(np.abs(np.linalg.eigvals(s.state_matrix)).max())
+        fastest = max(math.sqrt(natural**2 + (model.k / s.m2 if contact else 0.0)), omega_ref)
+        return math.sqrt(2.0 * self.settings.rtol) / fastest
+
     def _solver(self, model: _BumperModel, contact: bool, omega_ref: float) -> tuple[IDA, Any]:
         """The IDA solver of one mode and its event function."""
         events = model.events(contact)
         s = model.problem.system
-        natural = float(np.abs(np.linalg.eigvals(s.state_matrix)).max())
-        fastest = max(math.sqrt(natural**2 + (model.k / s.m2 if contact else 0.0)), omega_ref)
-        first = math.sqrt(2.0 * self.settings.rtol) / fastest  # backward Euler: h^2 |y''| / 2 ~ rtol |y|
+        first = self.first_step(model, contact, omega_ref)
         options: dict[str, Any] = {
             "rtol": self.settings.rtol,
             "atol": absolute_tolerances(self.settings.atol, omega_ref, s.m2, model.quadratures),
@@ -411,7 +421,7 @@ class _Run:
     """One integration: the state, one IDA solver per mode, and what happens at each switch and recorded root."""
 
     def __init__(self, engine: CompliantEngine, model: _BumperModel, rec: TrajectoryBuilder, t: float, state: NDArray[np.float64], omega_ref: float) -> None:
-        self.model, self.rec = model, rec
+        self.engine, self.model, self.rec = engine, model, rec
         self.clearance = model.problem.clearance
         self.t = t
         self.y = np.zeros(model.size)
@@ -451,7 +461,7 @@ class _Run:
                 tspan = np.array([self.t, 0.5 * (self.t + outputs[i]), outputs[i]])
             solver, events = self.solvers[self.contact]
             self.counts["solver_calls"] += 1
-            result = solver.solve(tspan, self.y, self.model.derivative(self.t, self.y, self.contact))
+            result = self.engine.solve(solver, tspan, self.y, self.model.derivative(self.t, self.y, self.contact))
             if result.status < 0:
                 raise RuntimeError(f"IDA failed at t = {float(result.t[-1])!r} s: {result.message}")
             times, states = result.t[1:], result.y[1:]
