@@ -54,7 +54,7 @@ def test_swept_loss_factor_sets_the_restitution() -> None:
         (lambda d: d.pop("bumper"), "bumper: required by the compliant solution"),
         (lambda d: d.update(bumper={"loss_factor": 0.5}), "bumper.frequency: required unless swept"),
         (lambda d: d.update(bumper={"frequency": -1.0}), "bumper.frequency: -1.0 is out of range: allowed (0, inf)"),
-        (lambda d: d.update(bumper={"frequency": 250.0, "loss_factor": -0.1}), "bumper.loss_factor: -0.1 is out of range: allowed [0, 1e+06]"),
+        (lambda d: d.update(bumper={"frequency": 250.0, "loss_factor": -0.1}), "bumper.loss_factor: -0.1 is out of range: allowed [0, 1000]"),
         (lambda d: d.update(bumper={"frequency": 250.0, "damping": 1.0}), "bumper.damping: unknown key (allowed: frequency, loss_factor)"),
         (lambda d: d["sweep"].update(bumper_frequency=[100.0, 200.0]), "bumper.frequency: also swept in sweep.bumper_frequency"),
         (lambda d: d["sweep"].update(bumper_loss_factor=[0.5, 1.0]), "sweep.bumper_loss_factor: sweeping the bumper's loss factor sets the restitution"),
@@ -91,6 +91,9 @@ def test_swept_sine_settings() -> None:
         ({"start": 20.0, "stop": 26.0, "rate": 0.1, "directions": ["sideways"]}, None, None, "swept_sine.directions[0]: unknown name 'sideways' (allowed: up, down)"),
         ({"start": 20.0, "stop": 26.0, "rate": 0.1}, ["pgf", "momentary"], None, "solutions: a swept-sine test runs the compliant solution only"),
         ({"start": 20.0, "stop": 26.0, "rate": 0.1}, None, {"max_periods": 10}, "simulation.max_periods: not used by a swept-sine test"),
+        ({"start": 20.0, "stop": 26.0, "rate": 1e-6}, None, None, "swept_sine.rate: 6e+06 s at 1000 samples/s is 6e+09 samples per run: allowed at most 1e+07"),
+        ({"start": 20.0, "stop": 26.0, "rate": 100.0}, None, None, "swept_sine.rate: the sweep lasts 0.06 s, shorter than two 8-cycle estimator windows at 20 Hz (0.8 s)"),
+        ({"start": 30.0, "stop": 31.0, "rate": 0.1}, None, None, "sweep.frequency: no frequency of the grid lies in the swept band [30, 31] Hz"),
     ],
 )
 def test_swept_sine_mistakes(spec: dict[str, Any], solutions: list[str] | None, simulation: dict[str, Any] | None, expected: str) -> None:
@@ -112,3 +115,9 @@ def test_shipped_bumper_studies_parse() -> None:
         assert np.all(np.isfinite(scene.loss_factors()) & (scene.loss_factors() > 0.0)), name
     sweep = load_scene(shipped_studies_dir() / "bumper_sweep.yaml")
     assert sweep.loss_factors()[0] == pytest.approx(loss_factor_from_restitution(0.2)) and math.isclose(sweep.loss_factors()[0], 0.7312, abs_tol=5e-5)
+
+
+def test_every_swept_sine_problem_is_reported_at_once() -> None:
+    problems = problems_of(compliant_scene(swept_sine={"start": 20.0, "stop": 26.0, "rate": 0.1, "initial_state": "bench", "sample_rate": 100.0}))
+    assert any("swept_sine.initial_state: 'bench' is not allowed" in p for p in problems), problems
+    assert any("swept_sine.sample_rate: 100 Hz is too coarse" in p for p in problems), problems

@@ -107,3 +107,16 @@ def test_report(sweep_run: xr.Dataset, tmp_path: Path) -> None:
     page = write_report(sweep_run, tmp_path).read_text()
     for name in ("sweep_displacements.png", "sweep_force_impulse.png", "sweep_time.png", "Cost of the swept-sine runs"):
         assert name in page, name
+
+
+@pytest.mark.timeout(120)
+def test_only_the_quantities_asked_for(tmp_path: Path) -> None:
+    """A swept scene that asks for |X1| only writes no running RMS and still gets its report."""
+    from vibroimpact.report import write_report
+
+    document = sweep_document(quantities=["x1_amplitude", "regime"], swept_sine={"start": 24.0, "stop": 24.5, "rate": 0.25, "sample_rate": 2000.0, "directions": ["up"]})
+    document["sweep"] = {"frequency": [24.2, 24.25]}
+    ds = run_study(parse_scene(document, text=yaml.safe_dump(document)), progress=None)
+    assert "running_x1_amplitude" in ds and "running_x1_rms" not in ds and "x1_rms" not in ds
+    assert np.all(np.isfinite(ds["x1_amplitude"].sel(solution="compliant").values))
+    assert "sweep_displacements.png" in write_report(ds, tmp_path).read_text()

@@ -290,6 +290,9 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
     dataset.attrs["atol_ratio_m"] = settings.atol_ratio
     dataset.attrs["repeats"] = settings.repeats
     dataset.attrs["reference_rtol_compliant"] = REFERENCE_RTOL
+    for case in cases:  # what a run simulates, for per-period and per-second costs (vibroimpact.estimate)
+        dataset.attrs[f"case_{case.name}_duration_s"] = case.sweep.duration if case.sweep is not None else case.periods / case.problem.frequency
+        dataset.attrs[f"case_{case.name}_frequency_Hz"] = case.problem.frequency
     if settings.ladder is not None and cases:
         if progress:
             print("benchmark: model cost ladder", file=sys.stderr, flush=True)

@@ -39,12 +39,17 @@ def sweep_figures(dataset: xr.Dataset, scene: Scene, out: Path) -> list[Figure]:
     panels = [("x1_amplitude", "x1_rms", "X1"), ("x2_amplitude", "x2_rms", "X2")]
     fig, axes = plt.subplots(1, 2, figsize=(15, 4.8), squeeze=False)
     for ax, (fundamental, rms, name) in zip(axes[0], panels):
+        if fundamental not in dataset and rms not in dataset:
+            ax.set_visible(False)
+            continue
         _steady_lines(ax, dataset, fundamental, f)
         for direction in sweeps:
             line = dataset.sel(solution="compliant", sweep=direction)
             colour = _SWEEP_COLOURS.get(direction, "C4")
-            ax.plot(f, line[fundamental].values, color=colour, lw=1.0, label=f"sweep {direction}: fundamental")
-            ax.plot(f, np.sqrt(2.0) * line[rms].values, color=colour, lw=0.8, ls="--", alpha=0.7, label=f"sweep {direction}: sqrt 2 x RMS")
+            if fundamental in line:
+                ax.plot(f, line[fundamental].values, color=colour, lw=1.0, label=f"sweep {direction}: fundamental")
+            if rms in line:
+                ax.plot(f, np.sqrt(2.0) * line[rms].values, color=colour, lw=0.8, ls="--", alpha=0.7, label=f"sweep {direction}: sqrt 2 x RMS")
         ax.set(yscale="log", xlabel="instantaneous frequency [Hz]", ylabel=f"{name} [m]", title=f"{name}: swept sine against steady states")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
@@ -60,6 +65,9 @@ def sweep_figures(dataset: xr.Dataset, scene: Scene, out: Path) -> list[Figure]:
     for ax, quantity, label, units, log in zip(
         axes[0], ("force_amplitude", "impulse", "impacts_per_period"), ("|F| fundamental on the base", "impulse per period", "contacts per period"), ("N", "N s", "1"), (True, False, False)
     ):
+        if quantity not in dataset:
+            ax.set_visible(False)
+            continue
         _steady_lines(ax, dataset, quantity, f, linear=quantity == "force_amplitude")
         for direction in sweeps:
             ax.plot(f, dataset[quantity].sel(solution="compliant", sweep=direction).values, color=_SWEEP_COLOURS.get(direction, "C4"), lw=0.9, label=f"sweep {direction}")
@@ -119,7 +127,7 @@ def sweep_tables(dataset: xr.Dataset, scene: Scene) -> list[tuple[str, str]]:
             f"<td>{float(line['sweep_contacts']):.0f}</td><td>{float(line['sweep_rhs_calls']):.0f}</td><td>{duration:g}</td></tr>"
         )
     tables = [("Cost of the swept-sine runs (one process each)", "<table>" + "".join(rows) + "</table>")]
-    if "pgf" in dataset["solution"].values:
+    if "pgf" in dataset["solution"].values and "x1_amplitude" in dataset:
         rows = ["<tr><th>sweep</th><th>band</th><th>points (PGF stable, contact)</th><th>median rel. diff. |X1|</th><th>90th percentile</th></tr>"]
         f = dataset["frequency"].values
         split = _split(scene)

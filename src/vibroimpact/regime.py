@@ -46,6 +46,8 @@ class Regime(IntEnum):
     #: Swept-sine tests: contacts occurred within the estimator's window. A sweep is a slow transient, not a steady
     #: state: ``impacts_per_period`` says how many contacts per cycle.
     SWEPT_CONTACT = 10
+    #: Time-domain solutions: the integrator failed at this point (the error went to stderr); values are NaN.
+    FAILED = 11
 
 
 def classify(linear_fits: ArrayLike, exists: ArrayLike, admissible: ArrayLike) -> NDArray[np.int8]:

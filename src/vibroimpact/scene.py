@@ -72,7 +72,7 @@ SWEEPABLE = {
     "restitution": ("1", 0.0, 1.0, True),
     "clearance": ("m", 0.0, math.inf, True),
     "bumper_frequency": ("Hz", 0.0, math.inf, False),
-    "bumper_loss_factor": ("1", 0.0, 1e6, True),
+    "bumper_loss_factor": ("1", 0.0, 1e3, True),
 }
 #: Where an unswept parameter is given instead (``frequency`` is always swept).
 _FIXED_PLACE = {"restitution": ("stop", "restitution"), "clearance": ("stop", "clearance"), "bumper_frequency": ("bumper", "frequency"), "bumper_loss_factor": ("bumper", "loss_factor")}
@@ -82,6 +82,8 @@ _T = TypeVar("_T")
 MAX_GRID_POINTS = 1_000_000
 #: Largest study: restitution x clearance x frequency points (each solution holds a few arrays of this size).
 MAX_STUDY_POINTS = 10_000_000
+#: Most output samples of one swept-sine run (7 floats each, plus the estimators' temporaries: ~1 GB).
+MAX_SWEEP_SAMPLES = 10_000_000
 
 
 class SceneError(ValueError):
@@ -466,7 +468,7 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
 
     simulation = None
     engines = [name for name in solutions if name in ENGINE_SOLUTIONS]
-    swept_sine = _parse_swept_sine(c, doc["swept_sine"], engines) if "swept_sine" in doc else None
+    swept_sine = _parse_swept_sine(c, doc["swept_sine"], engines, grids.get("frequency")) if "swept_sine" in doc else None
     if "simulation" in doc:
         if not engines:
             c.fail("simulation", f"given, but no time-domain solution ({', '.join(ENGINE_SOLUTIONS)}) is asked for")
@@ -507,8 +509,9 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
     )
 
 
-def _parse_swept_sine(c: _Checker, value: Any, engines: list[str]) -> SweptSineSettings | None:
-    """``swept_sine: {start, stop, rate, directions, sample_rate, window_cycles}`` (frequencies [Hz], rate [Hz s-1])."""
+def _parse_swept_sine(c: _Checker, value: Any, engines: list[str], grid: np.ndarray | None) -> SweptSineSettings | None:
+    """``swept_sine: {start, stop, rate, directions, sample_rate, window_cycles, initial_state}`` (frequencies [Hz],
+    rate [Hz s-1]); every problem is reported."""
     spec = c.mapping("swept_sine", value, {"start", "stop", "rate", "directions", "sample_rate", "window_cycles", "initial_state"}, {"start", "stop", "rate"})
     if engines != ["compliant"]:
         c.fail("solutions", f"a swept-sine test runs the compliant solution only (and needs it): got {engines or 'none'}")
@@ -521,15 +524,25 @@ def _parse_swept_sine(c: _Checker, value: Any, engines: list[str]) -> SweptSineS
     initial = spec.get("initial_state", "linear")
     if initial not in ("linear", "rest"):
         c.fail("swept_sine.initial_state", f"{initial!r} is not allowed: use linear or rest")
+    if start is None or stop is None:
         return None
-    if start is not None and stop is not None and stop <= start:
+    if stop <= start:
         c.fail("swept_sine.stop", f"{stop:g} must be greater than start = {start:g} (directions say which way it runs)")
         return None
-    if None in (start, stop, rate, sample_rate, cycles) or not directions:
-        return None
-    assert start is not None and stop is not None and rate is not None and sample_rate is not None and cycles is not None
-    if sample_rate < 20.0 * stop:
+    if sample_rate is not None and sample_rate < 20.0 * stop:
         c.fail("swept_sine.sample_rate", f"{sample_rate:g} Hz is too coarse for {stop:g} Hz: allowed [{20.0 * stop:g}, 1e+07] (20 samples per cycle)")
+        sample_rate = None
+    if rate is not None:
+        duration = (stop - start) / rate
+        if sample_rate is not None and duration * sample_rate > MAX_SWEEP_SAMPLES:
+            c.fail("swept_sine.rate", f"{duration:g} s at {sample_rate:g} samples/s is {duration * sample_rate:.3g} samples per run: allowed at most {MAX_SWEEP_SAMPLES:.0e} (raise the rate or lower swept_sine.sample_rate)")
+            rate = None
+        elif cycles is not None and 2.0 * cycles / start >= duration:
+            c.fail("swept_sine.rate", f"the sweep lasts {duration:g} s, shorter than two {cycles}-cycle estimator windows at {start:g} Hz ({2.0 * cycles / start:g} s): lower the rate or swept_sine.window_cycles")
+            rate = None
+    if grid is not None and not np.any((grid >= start) & (grid <= stop)):
+        c.fail("sweep.frequency", f"no frequency of the grid lies in the swept band [{start:g}, {stop:g}] Hz, where the running estimates are reported")
+    if rate is None or sample_rate is None or cycles is None or not directions or initial not in ("linear", "rest"):
         return None
     return SweptSineSettings(start, stop, rate, directions, sample_rate, cycles, initial)
 
@@ -663,7 +676,7 @@ def _parse_ladder(c: _Checker, value: Any) -> LadderSettings | None:
     bumpers = c.grid("benchmark.ladder.bumper_frequencies", spec["bumper_frequencies"], 0.0, math.inf, False) if "bumper_frequencies" in spec else None
     rtol = c.number("benchmark.ladder.rtol", spec.get("rtol", 1e-8), 1e-14, 1e-2)
     repeats = c.integer("benchmark.ladder.repeats", spec.get("repeats", 3), 1, 100)
-    if None in (frequency, restitution, clearance, bumpers, rtol, repeats):
+    if any(v is None for v in (frequency, restitution, clearance, bumpers, rtol, repeats)):
         return None
     assert frequency is not None and restitution is not None and clearance is not None and bumpers is not None and rtol is not None and repeats is not None
     return LadderSettings(frequency, restitution, clearance, tuple(float(b) for b in bumpers), rtol, repeats)

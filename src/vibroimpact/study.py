@@ -22,11 +22,11 @@ from .benchmark import run_benchmark
 from .contact import peak_acceleration_factor
 from .linear import linear_response
 from .modal import fit_modal_parameters
-from .pgf import PgfVariant, green_models, solve_one_impact
+from .pgf import OneImpactSolution, PgfVariant, green_models, solve_one_impact
 from .regime import Regime, classify, regime_attributes
 from .scene import ENGINE_SOLUTIONS, GRID_DIMS, Scene
 from .simulate import FIELDS, SWEEP_STARTS, SimulationCase, run_cases
-from .swept import SWEEP_QUANTITIES, SweepCase
+from .swept import SWEEP_QUANTITIES, SWEEP_STATS, SweepCase
 
 #: Frequencies per simulation case when points are independent (load balancing between processes).
 CASE_CHUNK = 16
@@ -49,8 +49,8 @@ VARIABLE_ATTRIBUTES: dict[str, dict[str, str]] = {
     "impacts_per_period": {"units": "1", "long_name": "impacts per excitation period (simulations: measured over whole periods)"},
     "x1_rms": {"units": "m", "long_name": "RMS of X1 (simulations: over the measured periods; linear regimes: |X1| / sqrt 2)"},
     "x2_rms": {"units": "m", "long_name": "RMS of X2 (simulations: over the measured periods; linear regimes: |X2| / sqrt 2)"},
-    "peak_acceleration": {"units": "m s-2", "long_name": "largest deceleration of the absorber on the bumper (compliant: measured; pgf: Gamma(xi_b) Omega_b J / (M2 (1 + R)); rigid engines: NaN; no contact: 0)"},
-    "peak_contact_force": {"units": "N", "long_name": "largest bumper force (compliant: measured; pgf: M2 times its peak-acceleration estimate; rigid engines: NaN; no contact: 0)"},
+    "peak_acceleration": {"units": "m s-2", "long_name": "largest deceleration of the absorber on the bumper, bumper force less absorber spring over M2 (compliant: measured; pgf: (M2 Gamma(xi_b) Omega_b J / (M2 (1 + R)) - absorber spring force at the impact) / M2; rigid engines: NaN; no contact: 0)"},
+    "peak_contact_force": {"units": "N", "long_name": "largest bumper force (compliant: measured; pgf: Gamma(xi_b) Omega_b J / (1 + R); rigid engines: NaN; no contact: 0)"},
     "wall_time": {"units": "s", "long_name": "wall time of the simulation at this point (one process; swept-sine tests: the whole sweep)"},
 }
 SWEEP_STAT_ATTRIBUTES: dict[str, dict[str, str]] = {
@@ -58,6 +58,8 @@ SWEEP_STAT_ATTRIBUTES: dict[str, dict[str, str]] = {
     "sweep_steps": {"units": "1", "long_name": "integrator steps of the swept-sine run"},
     "sweep_contacts": {"units": "1", "long_name": "bumper contacts during the swept-sine run"},
     "sweep_rhs_calls": {"units": "1", "long_name": "right-hand-side (residual) evaluations of the swept-sine run"},
+    "sweep_linear_start": {"units": "1", "long_name": "1: the run started on the linear steady state at its first frequency; 0: at rest (asked for, or the linear state would cross the stop)"},
+    "sweep_failed": {"units": "1", "long_name": "1: the integrator failed (values NaN, regime failed); 0: the run finished"},
 }
 CONVERGED_ATTRIBUTES = {
     "long_name": "the simulated stroboscopic state repeated to the steady-state tolerance",
@@ -254,22 +256,32 @@ def _pgf(scene: Scene, variant: PgfVariant, omega: np.ndarray, delta: np.ndarray
         "converged": lambda: np.full(shape, -1, dtype=np.int8),
         "x1_rms": lambda: np.where(free, np.abs(linear.x1) / np.sqrt(2.0), np.nan),
         "x2_rms": lambda: np.where(free, np.abs(linear.x2) / np.sqrt(2.0), np.nan),
-        "peak_acceleration": lambda: choose(_peak_acceleration_estimate(scene, solution.impulse, r), np.zeros(shape)),
-        "peak_contact_force": lambda: choose(scene.system.m2 * _peak_acceleration_estimate(scene, solution.impulse, r), np.zeros(shape)),
+        "peak_acceleration": lambda: choose(_peak_estimates(scene, solution, r)[0], np.zeros(shape)),
+        "peak_contact_force": lambda: choose(_peak_estimates(scene, solution, r)[1], np.zeros(shape)),
         "wall_time": lambda: np.full(shape, np.nan),
     }
     return {q: makers[q]() for q in scene.quantities}
 
 
-def _peak_acceleration_estimate(scene: Scene, impulse: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """PGF-based peak contact deceleration (section 6.3, corrected): Gamma(xi_b) Omega_b v0 with the entry speed
-    v0 = J / (M2 (1 + R)) of the rigid-stop solution [m s-2]; the contact force peaks at M2 times it (the bumper
-    force is all that decelerates the absorber during the short contact). NaN without a bumper."""
+def _peak_estimates(scene: Scene, solution: OneImpactSolution, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """PGF-based peak deceleration of the absorber [m s-2] and peak bumper force [N] (section 6.3, corrected).
+
+    The rigid-stop impulse J gives the entry speed v0 = J / (M2 (1 + R)); one collision with the bumper then peaks at
+    the force M2 Gamma(xi_b) Omega_b v0. The absorber's deceleration is that force less the absorber spring's pull
+    at the impact, K2 (X1 - Delta) + B2 (X1' - X2'(0-)), over M2 (the contact is too short for the spring to change).
+    NaN without a bumper.
+    """
     if scene.bumper_frequency is None:
-        return np.full(np.broadcast_shapes(np.shape(impulse), r.shape), np.nan)
+        nan = np.full(np.broadcast_shapes(np.shape(solution.impulse), r.shape), np.nan)
+        return nan, nan
+    s = scene.system
     gamma = np.array([peak_acceleration_factor(xi) if np.isfinite(xi) else np.nan for xi in scene.loss_factors()])[:, None, None, None, None]
     omega_b = 2.0 * np.pi * scene.bumper_frequency[None, None, :, None, None]
-    return gamma * omega_b * impulse / (scene.system.m2 * (1.0 + r))
+    force = gamma * omega_b * solution.impulse / (1.0 + r)
+    at_impact = np.zeros(1)
+    with np.errstate(invalid="ignore"):
+        spring = s.k2 * (solution.x1(at_impact)[..., 0] - solution.clearance) + s.b2 * (solution.x1(at_impact, 1)[..., 0] - solution.pre_impact_velocity)
+    return (force - spring) / s.m2, force
 
 
 def _no_one_impact_orbit(shape: tuple[int, ...]) -> dict[str, np.ndarray]:
@@ -320,6 +332,7 @@ def _simulated(scene: Scene, engine: str, shape: tuple[int, ...], jobs: int, cac
     regime[computed & converged] = Regime.PERIODIC_IMPACTS
     regime[computed & converged & (impacts == 0.0)] = Regime.LINEAR
     regime[computed & converged & (fields["multiplicity"] == 1.0) & (impacts == 1.0)] = Regime.ONE_IMPACT
+    regime[fields["failed"] == 1.0] = Regime.FAILED
     force = fields["suspension_force"] + fields["contact_force"]
     values = {
         "x1_amplitude": np.abs(fields["x1"]),
@@ -358,7 +371,7 @@ def _swept(scene: Scene, shape: tuple[int, ...], jobs: int, cache_dir: Path | No
     times = results[0]["time"]
     values = {name: np.full(shape, np.nan) for name in SWEEP_QUANTITIES}
     running = {f"running_{name}": np.full((*shape[:-1], times.size), np.nan) for name in SWEEP_QUANTITIES}
-    stats = {name: np.full(shape[:-1], np.nan) for name in ("wall_time", "steps", "contacts", "rhs_calls")}
+    stats = {name: np.full(shape[:-1], np.nan) for name in SWEEP_STATS}
     instantaneous = np.full((shape[3], times.size), np.nan)
     for (i, j, k, d), result in zip(places, results):
         for name in SWEEP_QUANTITIES:
@@ -371,6 +384,7 @@ def _swept(scene: Scene, shape: tuple[int, ...], jobs: int, cache_dir: Path | No
     regime = np.full(shape, Regime.NOT_COMPUTED, dtype=np.int8)
     regime[impacts == 0.0] = Regime.LINEAR
     regime[impacts > 0.0] = Regime.SWEPT_CONTACT
+    regime[np.broadcast_to(stats["failed"][..., None] == 1.0, shape)] = Regime.FAILED
     values |= {
         "phase": np.full(shape, np.nan),
         "regime": regime,
@@ -378,6 +392,7 @@ def _swept(scene: Scene, shape: tuple[int, ...], jobs: int, cache_dir: Path | No
         "converged": np.full(shape, -1, dtype=np.int8),
         "wall_time": np.broadcast_to(stats["wall_time"][..., None], shape),
     }
+    running = {name: value for name, value in running.items() if name.removeprefix("running_") in scene.quantities}
     for name, value in stats.items():
         running[f"sweep_{name}"] = value  # one value per sweep: the run's cost
     return {q: values[q] for q in scene.quantities}, running, {"time": times, "instantaneous_frequency": instantaneous}
@@ -402,7 +417,12 @@ def _metadata(scene: Scene) -> dict[str, object]:
         attrs[f"system_{key}"] = value
     for key, value in asdict(scene.admissibility).items():
         attrs[f"admissibility_{key}"] = value
-    if scene.simulation is not None:
+    if scene.simulation is not None and scene.swept_sine is not None:
+        for key, value in asdict(scene.swept_sine).items():
+            attrs[f"swept_sine_{key}"] = np.array(value, dtype=str) if key == "directions" else value
+        for key in ("rtol", "atol", "max_step"):
+            attrs[f"simulation_engine_{key}"] = getattr(scene.simulation.engine, key)
+    elif scene.simulation is not None:
         attrs["simulation_frequency_Hz"] = scene.simulation.frequency
         attrs["simulation_start"] = scene.simulation.start
         for key, value in asdict(scene.simulation.engine).items():
@@ -411,6 +431,7 @@ def _metadata(scene: Scene) -> dict[str, object]:
             attrs[f"simulation_steady_{key}"] = value
         attrs["method_exact"] = "piecewise-exact propagation (eigenvectors + harmonic particular solution), contacts by guaranteed Taylor-bound root bracketing"
         attrs["method_momentary"] = "scikit-sundae CVODE with contact/release events and an apex event guarding grazing contacts"
+        attrs["method_compliant"] = "Kelvin-Voigt bumper (eq. 25) through scikit-sundae IDA: one solver per contact mode, onset/release events, recorded force and deceleration peaks; atol of the displacements [m], other states scaled"
     if fit is not None:
         attrs["pgf_paper_form_factors_per_kg"] = np.real(fit.form_factor)
         attrs["pgf_paper_loss_factors"] = fit.loss_factor

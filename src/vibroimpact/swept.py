@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import sys
 import time
 from dataclasses import asdict, dataclass
 
@@ -43,7 +44,7 @@ SWEEP_QUANTITIES = (
     "peak_contact_force",
 )
 #: Whole-run statistics of a sweep.
-SWEEP_STATS = ("wall_time", "steps", "contacts", "rhs_calls")
+SWEEP_STATS = ("wall_time", "steps", "contacts", "rhs_calls", "linear_start", "failed")
 SWEEP_FIELDS = SWEEP_QUANTITIES + tuple(f"running_{q}" for q in SWEEP_QUANTITIES) + ("time", "instantaneous_frequency") + SWEEP_STATS
 
 
@@ -110,14 +111,25 @@ def run_sweep_case(case: SweepCase) -> dict[str, NDArray[np.generic]]:
     engine = CompliantEngine(case.bumper_frequency, case.bumper_loss_factor, case.engine_settings)
     started = time.perf_counter()
     state = sweep_start_state(case.system, sweep, case.clearance) if case.settings.initial_state == "linear" else None
-    record = engine.sweep(case.system, case.clearance, sweep, case.settings.sample_rate, state)
+    times = np.linspace(0.0, sweep.duration, case.time_points)
+    try:
+        record = engine.sweep(case.system, case.clearance, sweep, case.settings.sample_rate, state)
+    except (RuntimeError, ValueError, ArithmeticError) as error:
+        # a failing run must not cost the others: it stays NaN, flagged, and the study goes on
+        print(f"compliant sweep {case.direction}: Delta = {case.clearance:g} m, bumper {case.bumper_frequency:g} Hz, xi_b = {case.bumper_loss_factor:g} failed: {error}", file=sys.stderr)
+        failed: dict[str, NDArray[np.generic]] = {name: np.full(len(case.frequencies), np.nan) for name in SWEEP_QUANTITIES}
+        failed |= {f"running_{name}": np.full(times.size, np.nan) for name in SWEEP_QUANTITIES}
+        failed |= {"time": times, "instantaneous_frequency": sweep.frequency(times)}
+        failed |= {name: np.array(np.nan) for name in SWEEP_STATS}
+        failed["linear_start"] = np.array(float(state is not None))
+        failed["failed"] = np.array(1.0)
+        return failed
     wall_time = time.perf_counter() - started
     frequencies = np.asarray(case.frequencies, dtype=float)
     with np.errstate(invalid="ignore"):
         at_frequency = (frequencies - sweep.start_frequency) / sweep.alpha
     inside = (at_frequency >= 0.0) & (at_frequency <= sweep.duration)
     centres = np.where(inside, at_frequency, np.nan)
-    times = np.linspace(0.0, sweep.duration, case.time_points)
     cycles = case.settings.window_cycles
     on_grid = running_quantities(record, centres, cycles)
     on_times = running_quantities(record, times, cycles)
@@ -129,6 +141,8 @@ def run_sweep_case(case: SweepCase) -> dict[str, NDArray[np.generic]]:
     out["wall_time"] = np.array(wall_time)
     for name in ("steps", "contacts", "rhs_calls"):
         out[name] = np.array(float(stats.get(name, np.nan)))
+    out["linear_start"] = np.array(float(state is not None))  # the linear start falls back to rest where it would cross the stop
+    out["failed"] = np.array(0.0)
     return out
 
 
