@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import shutil
 import sys
 import time
@@ -28,6 +29,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--out", type=Path, default=None, help="output folder (default: results/<scene name>/)")
     parser.add_argument("--no-report", action="store_true", help="write the dataset only")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="processes for the simulations (default: all cores)")
+    parser.add_argument("--estimate", action="store_true", help="print the predicted wall time and memory of the scene, and run nothing")
     return parser
 
 
@@ -46,10 +48,19 @@ def main(argv: list[str] | None = None) -> int:
     if args.jobs < 1:
         print(f"run-study: error: --jobs {args.jobs} is out of range: allowed [1, inf)", file=sys.stderr)
         return EXIT_BAD_INPUT
+    if args.estimate:
+        from .estimate import estimate_scene
+
+        print(estimate_scene(scene, jobs=args.jobs).text())
+        return 0
     started = time.perf_counter()
     cache = out_dir / ".cache"  # finished simulation cases: an interrupted run resumes from here
     try:
         dataset = run_study(scene, jobs=args.jobs, cache_dir=cache)
+        # what this run cost, for comparing with ``--estimate`` (simulations: excluding cases taken from the cache)
+        dataset.attrs["run_wall_time_s"] = time.perf_counter() - started
+        dataset.attrs["run_jobs"] = args.jobs
+        dataset.attrs["run_peak_memory_bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
         path = write_dataset(dataset, out_dir / f"{scene.name}.nc")
         shutil.rmtree(cache, ignore_errors=True)
         print(f"wrote {path}")

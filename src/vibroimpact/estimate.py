@@ -1,0 +1,270 @@
+"""Predict a scene's wall time and memory before running it (``run-study SCENE --estimate``).
+
+The prediction multiplies what the scene asks for by costs measured on this machine kind
+(:mod:`vibroimpact.cost_table`, written by ``python -m vibroimpact.estimate --calibrate ACCURACY.nc`` from the
+``accuracy_cost`` study):
+
+* closed forms: seconds per grid point of each solution;
+* stepped steady states: seconds per simulated period of each engine at its tolerance (interpolated log-log between
+  the measured tolerances) times the periods each point will need, predicted from the closed form: none where the
+  answer is the linear state (no integration), a short transient plus the measured periods where a stable one-impact
+  orbit exists, and ``max_periods`` plus the irregular measurement elsewhere (motion that may never settle);
+* swept sines: seconds per simulated second of the compliant engine at its tolerance;
+* the work is spread over ``jobs`` processes; the report adds a fixed cost per figure.
+
+Memory: the dataset (every variable over the full grid, the running estimates of sweeps), the samples a sweep holds
+while it runs, and the measured footprint of one worker process. It is an estimate: the report of
+``accuracy_cost`` and ``tests/test_estimate.py`` compare it with measured runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import pprint
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .cost_table import COSTS
+from .scene import ENGINE_SOLUTIONS, Scene
+
+__all__ = ["Estimate", "estimate_scene", "per_period_cost", "calibrate"]
+
+#: Periods of a transient that settles on a stable orbit (two convergence chunks), before the measurement.
+SETTLING_PERIODS = 40
+#: Engine names of the cost table for each time-domain solution (momentary by its CVODE family).
+_ENGINE_KEYS = {"exact": "exact", "compliant": "compliant_ida"}
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """Predicted cost of a scene.
+
+    Attributes
+    ----------
+    wall_time : float
+        Predicted wall time of ``run-study`` [s].
+    memory : float
+        Predicted peak memory of the main process [bytes].
+    parts : dict
+        Wall time of each part (solution, report) [s], before dividing simulations over processes.
+    points : dict
+        Time-domain points (or sweeps) per solution, and how many are predicted to integrate.
+    """
+
+    wall_time: float
+    memory: float
+    parts: dict[str, float] = field(default_factory=dict)
+    points: dict[str, str] = field(default_factory=dict)
+
+    def text(self) -> str:
+        """The estimate as printed by ``run-study --estimate``."""
+        lines = [f"predicted wall time: {_duration(self.wall_time)}; peak memory: {self.memory / 2**20:.0f} MiB"]
+        for name, seconds in self.parts.items():
+            detail = f" ({self.points[name]})" if name in self.points else ""
+            lines.append(f"  {name}: {_duration(seconds)} of work{detail}")
+        lines.append("(costs measured by the accuracy_cost study on this machine kind; an estimate, typically within a factor of 2)")
+        return "\n".join(lines)
+
+
+def per_period_cost(engine: str, rtol: float) -> float:
+    """Measured wall time of one simulated period of a stepped run of ``engine`` at ``rtol`` [s]."""
+    table = COSTS["per_period"][engine]
+    if isinstance(table, float):
+        return table  # exact: no tolerance
+    return _interpolate(table, rtol)
+
+
+def per_sweep_second_cost(engine: str, rtol: float) -> float:
+    """Measured wall time per simulated second of a swept-sine run at ``rtol`` [s s-1]."""
+    return _interpolate(COSTS["per_sweep_second"][engine], rtol)
+
+
+def _interpolate(table: dict[float, float], rtol: float) -> float:
+    tolerances = np.array(sorted(table))
+    seconds = np.array([table[t] for t in tolerances])
+    return float(np.exp(np.interp(np.log(rtol), np.log(tolerances), np.log(seconds))))
+
+
+def estimate_scene(scene: Scene, jobs: int = 1) -> Estimate:
+    """Predict the wall time and peak memory of running ``scene`` with ``jobs`` processes."""
+    jobs = max(1, jobs)
+    if scene.benchmark is not None:
+        return _estimate_benchmark(scene)
+    parts: dict[str, float] = {}
+    points: dict[str, str] = {}
+    frequency = scene.all_frequencies
+    bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
+    directions = max(1, len(scene.sweep_directions))
+    grid = scene.restitution.size * scene.clearance.size * frequency.size
+    closed_form = 0.0
+    simulated = 0.0
+    biggest_case = 0.0
+    for name in scene.solutions:
+        if name not in ENGINE_SOLUTIONS:
+            seconds = COSTS["closed_form_per_point"][name] * grid * (bumpers if name == "pgf" and scene.bumper_frequency is not None else 1)
+            parts[name] = seconds
+            closed_form += seconds
+            continue
+        assert scene.simulation is not None
+        rtol = scene.simulation.engine.rtol
+        key = _ENGINE_KEYS.get(name, f"momentary_{scene.simulation.engine.method}")
+        if scene.swept_sine is not None:
+            s = scene.swept_sine
+            duration = abs(s.stop_frequency - s.start_frequency) / s.rate
+            one = per_sweep_second_cost(key, rtol) * duration
+            runs = scene.restitution.size * scene.clearance.size * bumpers * directions
+            parts[name] = one * runs
+            points[name] = f"{runs} sweeps of {duration:g} s"
+            biggest_case = max(biggest_case, one)
+        else:
+            periods = _periods(scene)
+            copies = bumpers if name == "compliant" else 1
+            seconds = per_period_cost(key, rtol) * float(periods.sum()) * copies
+            parts[name] = seconds
+            integrated = int(np.count_nonzero(periods)) * copies
+            points[name] = f"{periods.size * copies} points, {integrated} integrated, {float(periods.sum()) * copies:.0f} periods"
+        simulated += parts[name]
+    report = 0.0
+    if scene.report:
+        report = COSTS["report_base"] + COSTS["report_per_figure"] * _figures(scene)
+        parts["report"] = report
+    wall = COSTS["startup"] + closed_form + max(simulated / min(jobs, os_cpus()), biggest_case) + report
+    return Estimate(wall_time=wall, memory=_memory(scene), parts=parts, points=points)
+
+
+def os_cpus() -> int:
+    """Processes that really run at once (the machine's cores)."""
+    import os
+
+    return os.cpu_count() or 1
+
+
+def _periods(scene: Scene) -> np.ndarray:
+    """Periods each simulated (restitution, clearance, frequency) point is predicted to integrate."""
+    from .pgf import solve_one_impact
+    from .stability import floquet_multipliers
+
+    assert scene.simulation is not None
+    sim = scene.simulation
+    omega = 2.0 * np.pi * sim.frequency[None, None, :]
+    r = scene.restitution[:, None, None]
+    delta = scene.clearance[None, :, None]
+    orbit = solve_one_impact(scene.system, omega, delta, r, scene.amplitude)
+    admissible = orbit.admissible()
+    stable = np.zeros(admissible.shape, dtype=bool)
+    if admissible.any():
+        modulus = np.max(np.abs(floquet_multipliers(orbit)), axis=-1)
+        stable = admissible & (modulus < 1.0)
+    fits = orbit.linear_amplitude_x2 <= orbit.clearance
+    steady = sim.steady
+    settle = SETTLING_PERIODS + steady.measure_periods
+    wander = steady.max_periods + steady.irregular_measure_periods
+    if sim.start in ("pgf", "linear"):
+        no_integration = fits & ~admissible if sim.start == "pgf" else fits
+        return np.where(no_integration, 0, np.where(stable, settle, wander)).astype(float)
+    return np.where(stable | fits, settle, wander).astype(float)  # rest or stepped sweeps: every point integrates
+
+
+def _figures(scene: Scene) -> int:
+    if scene.swept_sine is not None:
+        return 4
+    per_clearance = 12 if any(s in ENGINE_SOLUTIONS for s in scene.solutions) else 7
+    return 1 + per_clearance * scene.clearance.size + (2 if len(scene.swept) > 1 else 0)
+
+
+def _memory(scene: Scene) -> float:
+    """Peak memory of the main process [bytes]: its footprint, the dataset (built, stacked, written: ~3 copies), and
+    the samples of one sweep held at once."""
+    frequency = scene.all_frequencies
+    bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
+    directions = max(1, len(scene.sweep_directions))
+    cells = scene.restitution.size * scene.clearance.size * bumpers * directions * frequency.size
+    dataset = 3.0 * 8.0 * len(scene.quantities) * len(scene.solutions) * cells
+    sweep = 0.0
+    if scene.swept_sine is not None:
+        s = scene.swept_sine
+        samples = abs(s.stop_frequency - s.start_frequency) / s.rate * s.sample_rate
+        sweep = samples * 8.0 * 16  # samples, cumulative integrals and temporaries of the estimators
+    return COSTS["process_memory"] + dataset + sweep
+
+
+def _estimate_benchmark(scene: Scene) -> Estimate:
+    """Benchmarks: every method at every tolerance (loose to tight), repeated unless a run is slow, and no tighter
+    tolerance after a run over the scene's time limit, as :func:`vibroimpact.benchmark.run_benchmark` does."""
+    from .benchmark import SLOW_RUN
+
+    assert scene.benchmark is not None
+    bench = scene.benchmark
+    total = 0.0
+    for case in bench.cases:
+        periods = case.periods if case.sweep is None else case.sweep.duration * case.sweep.start_frequency
+        total += per_period_cost("exact", 0.0) * periods * bench.settings.repeats
+        for method in bench.settings.methods:
+            if not case.runs(method):
+                continue
+            for rtol in bench.settings.tolerances:
+                if case.sweep is not None:
+                    key = method if method in COSTS["per_sweep_second"] else "compliant_ida"
+                    one = per_sweep_second_cost(key, rtol) * case.sweep.duration
+                else:
+                    key = method if method in COSTS["per_period"] else "momentary_adams"
+                    one = per_period_cost(key, rtol) * periods
+                total += one * (1 if one > SLOW_RUN else bench.settings.repeats)
+                if one > bench.settings.max_seconds:
+                    break
+    return Estimate(wall_time=COSTS["startup"] + total, memory=COSTS["process_memory"], parts={"benchmark": total})
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120.0:
+        return f"{seconds:.0f} s"
+    if seconds < 7200.0:
+        return f"{seconds / 60.0:.1f} min"
+    return f"{seconds / 3600.0:.1f} h"
+
+
+def calibrate(accuracy: Path) -> dict[str, object]:
+    """Costs from an ``accuracy_cost`` dataset: per period of the stepped one-impact case, per simulated second of
+    the swept case, for each method and tolerance; the fixed costs are kept from the current table."""
+    import xarray as xr
+
+    with xr.open_dataset(accuracy) as data:
+        stepped = next(str(c) for c in data["case"].values if "one_impact" in str(c))
+        swept = next(str(c) for c in data["case"].values if "swept" in str(c))
+        duration = float(data.attrs.get(f"case_{stepped}_duration_s", 2.0))
+        frequency = float(data.attrs.get(f"case_{stepped}_frequency_Hz", 25.0))
+        sweep_duration = float(data.attrs.get(f"case_{swept}_duration_s", 10.0))
+        periods = duration * frequency
+        per_period: dict[str, object] = {"exact": float(data["reference_wall_time"].sel(case=stepped, reference="exact")) / periods}
+        per_sweep: dict[str, object] = {}
+        for method in data["engine"].values:
+            for case, target, scale in ((stepped, per_period, periods), (swept, per_sweep, sweep_duration)):
+                line = data["wall_time"].sel(case=case, engine=method)
+                table = {float(t): float(w) / scale for t, w in zip(line["rtol"].values, line.values) if math.isfinite(float(w))}
+                if table:
+                    target[str(method)] = table
+    costs = dict(COSTS)
+    costs["per_period"] = per_period
+    costs["per_sweep_second"] = per_sweep
+    return costs
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m vibroimpact.estimate --calibrate ACCURACY.nc``: rewrite :mod:`vibroimpact.cost_table`."""
+    parser = argparse.ArgumentParser(prog="python -m vibroimpact.estimate", description=__doc__.split("\n")[0])
+    parser.add_argument("--calibrate", type=Path, required=True, help="dataset of the accuracy_cost study")
+    args = parser.parse_args(argv)
+    costs = calibrate(args.calibrate)
+    target = Path(__file__).with_name("cost_table.py")
+    header = '"""Measured costs for :mod:`vibroimpact.estimate` (written by ``python -m vibroimpact.estimate --calibrate``)."""\n\n'
+    target.write_text(header + "COSTS: dict = " + pprint.pformat(costs, width=120, sort_dicts=True) + "\n", encoding="utf-8")
+    print(f"wrote {target}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,70 @@
+"""``run-study --estimate``: what it predicts, checked against what a run does."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from vibroimpact import cli
+from vibroimpact.estimate import _periods, estimate_scene, per_period_cost
+from vibroimpact.scene import load_scene, parse_scene, shipped_studies_dir
+from vibroimpact.simulate import SimulationCase, run_case
+from vibroimpact.study import run_study
+
+from .test_scene import PAPER_SYSTEM_SPEC
+
+
+def small_scene() -> dict:
+    return {
+        "name": "small",
+        "system": dict(PAPER_SYSTEM_SPEC),
+        "excitation": {"amplitude": 10.0},
+        "stop": {"clearance": 0.003, "restitution": 0.2},
+        "sweep": {"frequency": {"start": 18.0, "stop": 30.0, "step": 1.0}},
+        "solutions": ["linear", "pgf", "momentary"],
+        "simulation": {"rtol": 1e-8, "atol": 1e-12, "max_periods": 100},
+        "report": False,
+    }
+
+
+def test_predicted_integration_matches_what_the_run_does() -> None:
+    """Points predicted to need no integration are exactly those the run answers without integrating."""
+    scene = parse_scene(small_scene())
+    assert scene.simulation is not None
+    predicted = _periods(scene)[0, 0]
+    case = SimulationCase("momentary", scene.system, scene.amplitude, 0.2, 0.003, tuple(scene.simulation.frequency), "pgf", scene.simulation.engine, scene.simulation.steady)
+    used = run_case(case)["periods_used"]
+    np.testing.assert_array_equal(predicted == 0, used == 0)
+    assert np.all(predicted[used > 0] >= 48)  # a settling transient plus the measurement, or the irregular budget
+
+
+def test_costs_grow_as_tolerances_tighten() -> None:
+    for engine in ("momentary_adams", "compliant_ida"):
+        assert per_period_cost(engine, 1e-12) > per_period_cost(engine, 1e-4)
+    assert per_period_cost("exact", 1e-3) == per_period_cost("exact", 1e-12)
+
+
+def test_memory_estimate_covers_the_dataset() -> None:
+    scene = parse_scene(small_scene())
+    estimate = estimate_scene(scene)
+    dataset = run_study(scene, progress=None)
+    assert estimate.memory > dataset.nbytes and estimate.wall_time > 0
+    assert "momentary" in estimate.parts and "integrated" in estimate.points["momentary"]
+
+
+def test_cli_estimate_runs_nothing(tmp_path: Path, capsys: object) -> None:
+    path = tmp_path / "small.yaml"
+    path.write_text(yaml.safe_dump(small_scene()))
+    out = tmp_path / "out"
+    assert cli.main([str(path), "--estimate", "--out", str(out)]) == 0
+    assert not out.exists()
+    text = capsys.readouterr().out  # type: ignore[attr-defined]
+    assert "predicted wall time" in text and "peak memory" in text
+
+
+def test_every_shipped_study_has_an_estimate() -> None:
+    for path in sorted(shipped_studies_dir().glob("*.yaml")):
+        estimate = estimate_scene(load_scene(path), jobs=2)
+        assert 1.0 < estimate.wall_time < 3600.0, path.name
