@@ -121,3 +121,16 @@ def test_every_swept_sine_problem_is_reported_at_once() -> None:
     problems = problems_of(compliant_scene(swept_sine={"start": 20.0, "stop": 26.0, "rate": 0.1, "initial_state": "bench", "sample_rate": 100.0}))
     assert any("swept_sine.initial_state: 'bench' is not allowed" in p for p in problems), problems
     assert any("swept_sine.sample_rate: 100 Hz is too coarse" in p for p in problems), problems
+
+
+def test_default_tolerances_follow_the_guidance() -> None:
+    """Without rtol/atol: stepped steady states 1e-8 / 1e-12 m, swept sines 1e-7 / 1e-11 m (README, tolerance
+    guidance); given values win."""
+    from vibroimpact.scene import DEFAULT_TOLERANCES
+
+    stepped = parse_scene(compliant_scene())
+    assert stepped.simulation is not None and (stepped.simulation.engine.rtol, stepped.simulation.engine.atol) == DEFAULT_TOLERANCES["stepped"] == (1e-8, 1e-12)
+    swept = parse_scene(sweep_scene())
+    assert swept.simulation is not None and (swept.simulation.engine.rtol, swept.simulation.engine.atol) == DEFAULT_TOLERANCES["swept"] == (1e-7, 1e-11)
+    given = parse_scene(sweep_scene() | {"simulation": {"rtol": 1e-6}})
+    assert given.simulation is not None and given.simulation.engine.rtol == 1e-6 and given.simulation.engine.atol == 1e-11
