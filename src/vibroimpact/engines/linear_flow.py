@@ -172,12 +172,27 @@ def first_crossing(h: Observable, t_from: float, t_to: float, tolerance: float, 
         t += step
         if t >= t_to:
             return None
+    departing = leaving
     while True:
         h0, h1, h2, curvature, jerk = h.step_data(t)
+        if departing and h0 >= -8.0 * tolerance:
+            # a slow departure from the surface stays within the round-off band of h for many escape steps (at rest
+            # on the stop, a holding force of -2e-6 N against a 49 N force took ~1e3 of them): while h still goes
+            # down it is not a root (returned as one, the caller applied a contact at zero speed and searched again,
+            # ~1e-11 s further on, until the period's event budget ran out); clear of the band, the search goes on
+            step = escape_step(h, t)
+            if step is not None:
+                if t + step >= t_to:
+                    return None
+                if t + step == t:
+                    return t
+                t += step
+                continue
         if h0 >= -tolerance:
             if h1 > 0.0:
                 t = max(t - h0 / h1, t_from)  # one Newton step: |h0| <= tolerance
             return t
+        departing = departing and h0 >= -8.0 * tolerance
         step = _quadratic_step(h0, h1, curvature)
         # a local bound is often much tighter: on [0, S], h'' <= h''(t) + S sup|h'''|; try S = twice the global step
         trial = 2.0 * step

@@ -6,6 +6,7 @@ restart. There is no grazing guard, on purpose: these are the baselines the ``mo
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -40,7 +41,15 @@ class SolveIvpEngine(EventLoopEngine):
 
     def _begin(self, model: Model) -> None:
         def contact(t: float, y: NDArray[np.float64]) -> float:
-            return float(y[1])  # the gap X2 - Delta
+            gap = float(y[1])  # X2 - Delta
+            # At the restart time, and wherever it is exactly 0, the gap counts as short of the stop. Every restart
+            # on the stop (after an impact, a touch or a release) has a gap of 0, and SciPy takes g = 0 at a step's
+            # start with g >= 0 at its end for a crossing at that start (brentq returns the end where g = 0): a fast
+            # return to the stop (chatter) was applied at the start itself, to the rebound's velocity, over and over,
+            # and at rest on the stop with no force (g = 0 throughout) every step reported one. Negative there, the
+            # root is the first crossing after the start. (By time as well as by value: brentq re-evaluates the start
+            # on the dense output, whose gap there may differ from 0 by round-off.)
+            return -1.0 if gap == 0.0 or (t == self._restart and gap > 0.0) else gap
 
         def release(t: float, y: NDArray[np.float64]) -> float:
             return float(model.problem.holding_force(y[0], y[2]))
@@ -54,6 +63,7 @@ class SolveIvpEngine(EventLoopEngine):
 
         self._rhs = rhs
         self._steps = self._events_found = self._nfev = 0
+        self._restart = math.nan
 
     def _counters(self) -> dict[str, int]:
         return {"steps": self._steps, "events": self._events_found, "solver_rhs_calls": self._nfev}
@@ -63,6 +73,7 @@ class SolveIvpEngine(EventLoopEngine):
         if self.settings.max_step > 0.0:
             options["max_step"] = self.settings.max_step
         event = self._release if model.stuck else self._contact
+        self._restart = t
         result = solve_ivp(self._rhs, (t, t_stop), y, events=[event], **options)
         if result.status < 0:
             raise RuntimeError(f"solve_ivp ({self.method}) failed at t = {result.t[-1]!r} s: {result.message}")
