@@ -452,7 +452,10 @@ def _cases() -> list[HardCase]:
     ))
     add(HardCase(
         "very-long-10000-periods", "400 s from rest, 10 000 impacts", problem, _rest(), 10_000,
-        per_engine(exact(), integrated(times=1e-7), integrated(times=1e-7), long_compliant, radau=NotRun(RADAU_COST)),
+        per_engine(
+            exact(penetration=1e-10, note="at t = 400 s the round-off of w t alone is ~1e-11 of the motion: its flow is checked to 1e-10 (passes at 1e-11, not at 1e-12)"),
+            integrated(times=1e-7), integrated(times=1e-7), long_compliant, radau=NotRun(RADAU_COST),
+        ),
         timeout=900, slow=True,
     ))
     chatter = ImpactProblem(PAPER_SYSTEM, 1e-4, 0.05, PAPER_AMPLITUDE, 10.0)
