@@ -237,3 +237,16 @@ def test_max_overshoot_is_the_supremum_over_the_period(system: TwoDofSystem) -> 
                 assert overshoot[index] == pytest.approx(brute, abs=1e-12 * scale)
             else:
                 assert -1e-8 * scale <= overshoot[index] <= 0.0
+
+
+def test_rms_of_the_orbit_matches_a_simulation(system: TwoDofSystem) -> None:
+    """RMS of the reconstructed X1, X2 of the stable 25 Hz orbit against the exact engine's steady-state RMS (exact
+    per-period moments) to 1e-5; a sine's RMS is |X| / sqrt 2, the clipped X2 is not."""
+    from vibroimpact.engines import ExactEngine, ImpactProblem
+    from vibroimpact.steady import SteadySettings, steady_state
+
+    orbit = solve_one_impact(system, np.array([2 * np.pi * 25.0]), 0.003, 0.2, 10.0)
+    x1_rms, x2_rms = orbit.rms()
+    measured = steady_state(ExactEngine(), ImpactProblem(system, 0.003, 0.2, 10.0, 25.0), "pgf", SteadySettings(tolerance=1e-10)).measures
+    assert x1_rms[0] == pytest.approx(measured.x1_rms, rel=1e-5) and x2_rms[0] == pytest.approx(measured.x2_rms, rel=1e-5)
+    assert x2_rms[0] * np.sqrt(2.0) / abs(orbit.x2_harmonic()[0]) > 1.01  # harmonics and a mean offset

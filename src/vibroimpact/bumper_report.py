@@ -43,6 +43,9 @@ def sweep_figures(dataset: xr.Dataset, scene: Scene, out: Path) -> list[Figure]:
             ax.set_visible(False)
             continue
         _steady_lines(ax, dataset, fundamental, f)
+        if rms in dataset and "pgf" in dataset["solution"].values:
+            first = {"sweep": 0} if "sweep" in dataset.dims else {}
+            ax.plot(f, np.sqrt(2.0) * dataset[rms].sel(solution="pgf").isel(first).values, color="C0", lw=0.8, ls="--", alpha=0.7, label="PGF: sqrt 2 x RMS")
         for direction in sweeps:
             line = dataset.sel(solution="compliant", sweep=direction)
             colour = _SWEEP_COLOURS.get(direction, "C4")

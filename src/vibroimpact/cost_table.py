@@ -1,6 +1,6 @@
 """Measured costs for :mod:`vibroimpact.estimate` (written by ``python -m vibroimpact.estimate --calibrate``)."""
 
-COSTS: dict = {'closed_form_per_point': {'linear': 3.6e-07, 'pgf': 0.000146, 'pgf_paper': 0.00011},
+COSTS: dict = {'closed_form_per_point': {'linear': 3.6e-07, 'pgf': 0.000161, 'pgf_paper': 0.000164},
  'per_period': {'compliant_cvode_adams': {1e-12: 0.003943530440010363,
                                           1e-11: 0.0037287501800165046,
                                           1e-10: 0.0032156069399934496,
