@@ -141,3 +141,56 @@ def test_accuracy_benchmark_with_compliant_and_swept_cases(system: TwoDofSystem)
     difference = data["ladder_x1_difference"]
     assert float(difference.sel(model="pgf")) < 1e-8 and float(difference.sel(model="momentary")) < 1e-6
     assert 1e-3 < float(difference.sel(model="compliant_1000Hz")) < 0.05  # the bumper's physics: ~2.4 % at 1 kHz
+
+
+def test_matching_is_one_to_one(system: TwoDofSystem) -> None:
+    """Two reference impacts close together cannot both match one trial impact, whichever side is the reference."""
+    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, 25.0)
+    reference = ExactEngine().integrate(problem, np.zeros(4), 0.0, 20)
+    t = reference.impact_times
+    pair = _with_impacts(reference, np.sort(np.append(t, t[4] + 1e-6)))
+    assert _compare(pair, reference)["missed_impacts"] == 1 and _compare(pair, reference)["extra_impacts"] == 0
+    assert _compare(reference, pair)["missed_impacts"] == 0 and _compare(reference, pair)["extra_impacts"] == 1
+
+
+def test_loosest_tolerance_needs_every_tighter_one() -> None:
+    """Synthetic line: errors meet 1e-3 at rtol 1e-8, 1e-6 and 1e-4, not at 1e-7 (a fluke): the answer is 1e-8; a
+    missed or an extra impact disqualifies a tolerance; tolerances not run are skipped."""
+    from vibroimpact.benchmark import loosest_tolerance
+
+    rtol = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
+    error = np.array([[[5e-3, 5e-4, 5e-4, 5e-5, 2e-3, 5e-6, np.nan]]])
+    zeros = np.zeros_like(error)
+    wall = np.array([[[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, np.nan]]])
+    data = xr.Dataset(
+        {"x1_error": (("case", "engine", "rtol"), error), "missed_impacts": (("case", "engine", "rtol"), zeros), "extra_impacts": (("case", "engine", "rtol"), zeros.copy()), "wall_time": (("case", "engine", "rtol"), wall)},
+        coords={"case": ["c"], "engine": ["m"], "rtol": rtol},
+    )
+    assert loosest_tolerance(data, "c", "m", 1e-3) == (1e-8, 6.0)
+    data["x1_error"][0, 0, 4] = 5e-4
+    assert loosest_tolerance(data, "c", "m", 1e-3) == (1e-4, 2.0)
+    data["extra_impacts"][0, 0, 3] = 1
+    assert loosest_tolerance(data, "c", "m", 1e-3) == (1e-7, 5.0)
+    data["missed_impacts"][0, 0, 5] = 1
+    assert np.isnan(loosest_tolerance(data, "c", "m", 1e-3)[0])
+
+
+@pytest.mark.parametrize(
+    ("change", "expected"),
+    [
+        (lambda cases: cases.append(dict(cases[0])), "benchmark.cases[1].name: 'a' is used by another case"),
+        (lambda cases: cases.append({"name": "s", "restitution": 0.2, "clearance": 0.003, "bumper_frequency": 250.0, "swept_sine": {"start": 24.0, "stop": 25.0, "rate": 10.0}}), "benchmark.cases[1].swept_sine.rate: the sweep lasts 0.1 s"),
+        (lambda cases: cases.append({"name": "s", "restitution": 0.2, "clearance": 0.003, "bumper_frequency": 250.0, "swept_sine": {"start": 24.0, "stop": 25.0, "rate": 0.1, "sample_rate": 30.0}}), "benchmark.cases[1].swept_sine.sample_rate: 30 Hz is too coarse"),
+        (lambda cases: cases.append({"name": "s", "restitution": 0.2, "clearance": 0.003, "swept_sine": None}), "benchmark.cases[1].swept_sine: expected a mapping"),
+        (lambda cases: cases[0].update(bumper_frequency=1e12), "benchmark.cases[0].bumper_frequency: 1000000000000.0 is out of range"),
+    ],
+)
+def test_benchmark_scene_mistakes(change: object, expected: str) -> None:
+    from vibroimpact.scene import SceneError, parse_scene
+
+    cases = [{"name": "a", "frequency": 25.0, "restitution": 0.2, "clearance": 0.003, "start": "pgf"}]
+    change(cases)  # type: ignore[operator]
+    document = {"name": "b", "system": {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0}, "excitation": {"amplitude": 10.0}, "benchmark": {"duration": 1.0, "methods": ["momentary_adams"], "tolerances": [1e-6], "cases": cases}}
+    with pytest.raises(SceneError) as caught:
+        parse_scene(document)
+    assert any(expected in p for p in caught.value.problems), caught.value.problems

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 import yaml
 
 from vibroimpact import cli
@@ -33,7 +34,9 @@ def test_predicted_integration_matches_what_the_run_does() -> None:
     """Points predicted to need no integration are exactly those the run answers without integrating."""
     scene = parse_scene(small_scene())
     assert scene.simulation is not None
-    predicted = _periods(scene)[0, 0]
+    periods, scale = _periods(scene)
+    assert scale == 1.0
+    predicted = periods[0, 0]
     case = SimulationCase("momentary", scene.system, scene.amplitude, 0.2, 0.003, tuple(scene.simulation.frequency), "pgf", scene.simulation.engine, scene.simulation.steady)
     used = run_case(case)["periods_used"]
     np.testing.assert_array_equal(predicted == 0, used == 0)
@@ -46,12 +49,40 @@ def test_costs_grow_as_tolerances_tighten() -> None:
     assert per_period_cost("exact", 1e-3) == per_period_cost("exact", 1e-12)
 
 
-def test_memory_estimate_covers_the_dataset() -> None:
+def test_memory_estimate_grows_with_the_dataset_and_the_workers() -> None:
+    from vibroimpact.cost_table import COSTS
+
     scene = parse_scene(small_scene())
-    estimate = estimate_scene(scene)
+    one = estimate_scene(scene, jobs=1)
     dataset = run_study(scene, progress=None)
-    assert estimate.memory > dataset.nbytes and estimate.wall_time > 0
-    assert "momentary" in estimate.parts and "integrated" in estimate.points["momentary"]
+    assert one.memory >= COSTS["main_process_memory"] + dataset.nbytes
+    assert estimate_scene(scene, jobs=2).memory == one.memory + COSTS["worker_process_memory"] * min(2, __import__("os").cpu_count() or 1) or (__import__("os").cpu_count() or 1) == 1
+    big = small_scene() | {"sweep": {"restitution": [0.1, 0.2, 0.3], "frequency": {"start": 18.0, "stop": 30.0, "step": 0.001}}}
+    big["stop"] = {"clearance": 0.003}
+    assert estimate_scene(parse_scene(big), jobs=1).memory > one.memory + 2 * dataset.nbytes
+    assert "momentary" in one.parts and "integrated" in one.points["momentary"]
+
+
+def test_start_modes_are_predicted_as_they_run() -> None:
+    """rest: every point integrates for the whole budget; stepped sweeps: linear-fitting points answered at once."""
+    document = small_scene()
+    document["simulation"] = {"rtol": 1e-8, "max_periods": 100, "start": "rest"}
+    rest, _ = _periods(parse_scene(document))
+    assert np.all(rest == 100 + 64)
+    document["simulation"]["start"] = "sweep_up"
+    scene = parse_scene(document)
+    swept, _ = _periods(scene)
+    case = SimulationCase("momentary", scene.system, scene.amplitude, 0.2, 0.003, tuple(scene.simulation.frequency), "sweep_up", scene.simulation.engine, scene.simulation.steady)  # type: ignore[union-attr]
+    used = run_case(case)["periods_used"]
+    np.testing.assert_array_equal(swept[0, 0] == 0, used == 0)
+
+
+def test_large_grids_are_subsampled() -> None:
+    document = small_scene()
+    document["sweep"] = {"frequency": {"start": 15.0, "stop": 45.0, "step": 0.0005}}
+    scene = parse_scene(document)
+    periods, scale = _periods(scene)
+    assert periods.shape[-1] <= 20_000 and scale * periods.shape[-1] == pytest.approx(scene.simulation.frequency.size)  # type: ignore[union-attr]
 
 
 def test_cli_estimate_runs_nothing(tmp_path: Path, capsys: object) -> None:

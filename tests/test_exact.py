@@ -198,3 +198,18 @@ def test_impact_ending_in_sticking_transfers_m2_v(system: TwoDofSystem) -> None:
     assert ending.sum() >= 4
     np.testing.assert_allclose(trajectory.impulses[ending], system.m2 * trajectory.impact_velocities[ending], rtol=1e-14)
     np.testing.assert_allclose(trajectory.impulses[~ending], 1.3 * system.m2 * trajectory.impact_velocities[~ending], rtol=1e-14)
+
+
+@pytest.mark.timeout(60)
+def test_resting_on_the_stop_with_round_off_holding_force_does_not_livelock() -> None:
+    """Found by the property tests: Delta = 0, R = 1, at rest on the stop, the force just starting to push. The holding
+    force evaluates to 5.6e-17 N of round-off; its sign once decided 'not pushed', and zero-speed elastic impacts
+    repeated at t = 0 until the event budget ran out. Round-off-sized forces now leave the decision to the
+    derivatives: the absorber is held, then released."""
+    from vibroimpact.engines import ImpactProblem
+
+    s = TwoDofSystem(m1=0.5, m2=0.34916140783976635, k1=10000.0, k2=10934.225385165902, b1=0.0, b2=0.13323645201253634)
+    problem = ImpactProblem(s, 0.0, 1.0, 0.5, 56.38618344739488, phase=0.0004942310000114958)
+    trajectory = ExactEngine().integrate(problem, np.zeros(4), 0.0, 3)
+    assert trajectory.stats["releases"] >= 1 and trajectory.stats["events"] < 100
+    assert np.all(trajectory.strobe_states[:, 1] <= 1e-15)

@@ -61,6 +61,7 @@ def main(argv: list[str] | None = None) -> int:
         dataset.attrs["run_wall_time_s"] = time.perf_counter() - started
         dataset.attrs["run_jobs"] = args.jobs
         dataset.attrs["run_peak_memory_bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+        dataset.attrs["run_peak_memory_worker_bytes"] = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * 1024  # largest worker
         path = write_dataset(dataset, out_dir / f"{scene.name}.nc")
         shutil.rmtree(cache, ignore_errors=True)
         print(f"wrote {path}")

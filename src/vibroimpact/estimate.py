@@ -121,19 +121,22 @@ def estimate_scene(scene: Scene, jobs: int = 1) -> Estimate:
             points[name] = f"{runs} sweeps of {duration:g} s"
             biggest_case = max(biggest_case, one)
         else:
-            periods = _periods(scene)
+            periods, scale = _periods(scene)
             copies = bumpers if name == "compliant" else 1
-            seconds = per_period_cost(key, rtol) * float(periods.sum()) * copies
+            total_periods = float(periods.sum()) * scale * copies
+            seconds = per_period_cost(key, rtol) * total_periods
             parts[name] = seconds
-            integrated = int(np.count_nonzero(periods)) * copies
-            points[name] = f"{periods.size * copies} points, {integrated} integrated, {float(periods.sum()) * copies:.0f} periods"
+            integrated = int(np.count_nonzero(periods) * scale) * copies
+            points[name] = f"{scene.restitution.size * scene.clearance.size * scene.simulation.frequency.size * copies} points, ~{integrated} integrated, ~{total_periods:.0f} periods"
+            if scene.simulation.start in ("sweep_up", "sweep_down"):  # one serial chain per (R, Delta, bumper)
+                biggest_case = max(biggest_case, seconds / (scene.restitution.size * scene.clearance.size * copies))
         simulated += parts[name]
     report = 0.0
     if scene.report:
         report = COSTS["report_base"] + COSTS["report_per_figure"] * _figures(scene)
         parts["report"] = report
     wall = COSTS["startup"] + closed_form + max(simulated / min(jobs, os_cpus()), biggest_case) + report
-    return Estimate(wall_time=wall, memory=_memory(scene), parts=parts, points=points)
+    return Estimate(wall_time=wall, memory=_memory(scene, jobs), parts=parts, points=points)
 
 
 def os_cpus() -> int:
@@ -143,30 +146,54 @@ def os_cpus() -> int:
     return os.cpu_count() or 1
 
 
-def _periods(scene: Scene) -> np.ndarray:
-    """Periods each simulated (restitution, clearance, frequency) point is predicted to integrate."""
+#: Largest number of simulated points whose closed form is solved for the estimate (a larger grid is subsampled).
+ESTIMATE_POINTS = 20_000
+
+
+def _periods(scene: Scene) -> tuple[np.ndarray, float]:
+    """Periods each simulated (restitution, clearance, frequency) point is predicted to integrate, on the grid or on
+    an evenly subsampled frequency grid, and the factor that scales its sum to the whole grid.
+
+    As :func:`vibroimpact.steady.steady_state` and :func:`vibroimpact.simulate.run_case` do: ``linear`` and stepped
+    sweeps answer a point whose linear motion fits without integrating; ``pgf`` also needs no admissible one-impact
+    orbit there; a stable orbit settles in a short transient; elsewhere the motion may never settle (``max_periods``
+    plus the irregular measurement). From ``rest`` every point integrates, and the lightly damped transient of the
+    linear modes (damping ratios ~1e-3) outlasts ``max_periods``.
+    """
     from .pgf import solve_one_impact
     from .stability import floquet_multipliers
 
     assert scene.simulation is not None
     sim = scene.simulation
-    omega = 2.0 * np.pi * sim.frequency[None, None, :]
-    r = scene.restitution[:, None, None]
-    delta = scene.clearance[None, :, None]
-    orbit = solve_one_impact(scene.system, omega, delta, r, scene.amplitude)
+    per_line = max(1, ESTIMATE_POINTS // (scene.restitution.size * scene.clearance.size))
+    frequencies = sim.frequency if sim.frequency.size <= per_line else sim.frequency[np.linspace(0, sim.frequency.size - 1, per_line).astype(int)]
+    scale = sim.frequency.size / frequencies.size
+    steady = sim.steady
+    wander = steady.max_periods + steady.irregular_measure_periods
+    shape = (scene.restitution.size, scene.clearance.size, frequencies.size)
+    if sim.start == "rest":
+        return np.full(shape, float(wander)), scale
+    omega = 2.0 * np.pi * frequencies[None, None, :]
+    orbit = solve_one_impact(scene.system, omega, scene.clearance[None, :, None], scene.restitution[:, None, None], scene.amplitude)
     admissible = orbit.admissible()
     stable = np.zeros(admissible.shape, dtype=bool)
     if admissible.any():
         modulus = np.max(np.abs(floquet_multipliers(orbit)), axis=-1)
         stable = admissible & (modulus < 1.0)
     fits = orbit.linear_amplitude_x2 <= orbit.clearance
-    steady = sim.steady
     settle = SETTLING_PERIODS + steady.measure_periods
-    wander = steady.max_periods + steady.irregular_measure_periods
-    if sim.start in ("pgf", "linear"):
+    if sim.start in ("sweep_up", "sweep_down"):
+        # a chain: a fitting point is answered linear unless the point before it impacted (then it integrates from
+        # there, and keeps impacting where a one-impact orbit coexists with the linear motion)
+        order = range(frequencies.size) if sim.start == "sweep_up" else range(frequencies.size - 1, -1, -1)
+        no_integration = np.zeros(shape, dtype=bool)
+        impacting = np.zeros(shape[:2], dtype=bool)
+        for k in order:
+            no_integration[..., k] = fits[..., k] & ~impacting
+            impacting = ~fits[..., k] | (impacting & admissible[..., k])
+    else:
         no_integration = fits & ~admissible if sim.start == "pgf" else fits
-        return np.where(no_integration, 0, np.where(stable, settle, wander)).astype(float)
-    return np.where(stable | fits, settle, wander).astype(float)  # rest or stepped sweeps: every point integrates
+    return np.where(no_integration, 0, np.where(stable, settle, wander)).astype(float), scale
 
 
 def _figures(scene: Scene) -> int:
@@ -176,20 +203,23 @@ def _figures(scene: Scene) -> int:
     return 1 + per_clearance * scene.clearance.size + (2 if len(scene.swept) > 1 else 0)
 
 
-def _memory(scene: Scene) -> float:
-    """Peak memory of the main process [bytes]: its footprint, the dataset (built, stacked, written: ~3 copies), and
-    the samples of one sweep held at once."""
+def _memory(scene: Scene, jobs: int) -> float:
+    """Peak memory of the run, main process and workers [bytes]: the main process's footprint and its dataset (built,
+    stacked, written: ~3 copies), one worker footprint per process simulating, and the samples of one sweep per
+    worker."""
     frequency = scene.all_frequencies
     bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
     directions = max(1, len(scene.sweep_directions))
     cells = scene.restitution.size * scene.clearance.size * bumpers * directions * frequency.size
     dataset = 3.0 * 8.0 * len(scene.quantities) * len(scene.solutions) * cells
+    simulating = any(name in ENGINE_SOLUTIONS for name in scene.solutions)
+    workers = min(jobs, os_cpus()) if simulating and jobs > 1 else 0
     sweep = 0.0
     if scene.swept_sine is not None:
         s = scene.swept_sine
         samples = abs(s.stop_frequency - s.start_frequency) / s.rate * s.sample_rate
-        sweep = samples * 8.0 * 16  # samples, cumulative integrals and temporaries of the estimators
-    return COSTS["process_memory"] + dataset + sweep
+        sweep = samples * 8.0 * 16 * max(1, workers)  # samples, cumulative integrals and temporaries of the estimators
+    return COSTS["main_process_memory"] + dataset + workers * COSTS["worker_process_memory"] + sweep
 
 
 def _estimate_benchmark(scene: Scene) -> Estimate:
@@ -216,7 +246,7 @@ def _estimate_benchmark(scene: Scene) -> Estimate:
                 total += one * (1 if one > SLOW_RUN else bench.settings.repeats)
                 if one > bench.settings.max_seconds:
                     break
-    return Estimate(wall_time=COSTS["startup"] + total, memory=COSTS["process_memory"], parts={"benchmark": total})
+    return Estimate(wall_time=COSTS["startup"] + total, memory=COSTS["main_process_memory"], parts={"benchmark": total})
 
 
 def _duration(seconds: float) -> str:

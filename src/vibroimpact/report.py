@@ -46,8 +46,13 @@ def write_report(dataset: xr.Dataset, out_dir: str | Path) -> Path:
         return _write_text_atomic(out / "report.html", _html(dataset, scene, accuracy_report.accuracy_figures(dataset, out), accuracy_report.accuracy_tables(dataset)))
     figures = [_linear_figure(scene, out)]
     if scene.swept_sine is not None:
-        figures += bumper_report.sweep_figures(dataset, scene, out)
-        tables = [("Modal parameters of H22", _modal_table(scene)), *bumper_report.sweep_tables(dataset, scene)]
+        # the pages show one (restitution, clearance, bumper) point: the first of each swept grid (the dataset has all)
+        first = {d: 0 for d in ("restitution", "bumper_loss_factor", "clearance", "bumper_frequency") if d in dataset.dims}
+        part = dataset.isel(first)
+        figures += bumper_report.sweep_figures(part, scene, out)
+        tables = [("Modal parameters of H22", _modal_table(scene)), *bumper_report.sweep_tables(part, scene)]
+        if first:
+            tables.append(("Grid", f"<p>Figures and tables show the first point of the swept grids ({', '.join(first)}); the dataset holds every point.</p>"))
         return _write_text_atomic(out / "report.html", _html(dataset, scene, figures, tables))
     if "bumper_frequency" in dataset.dims:
         figures += bumper_report.stiffness_figures(dataset, scene, out)

@@ -71,7 +71,7 @@ SWEEPABLE = {
     "frequency": ("Hz", 0.0, math.inf, False),
     "restitution": ("1", 0.0, 1.0, True),
     "clearance": ("m", 0.0, math.inf, True),
-    "bumper_frequency": ("Hz", 0.0, math.inf, False),
+    "bumper_frequency": ("Hz", 0.0, 1e6, False),
     "bumper_loss_factor": ("1", 0.0, 1e3, True),
 }
 #: Where an unswept parameter is given instead (``frequency`` is always swept).
@@ -84,6 +84,10 @@ MAX_GRID_POINTS = 1_000_000
 MAX_STUDY_POINTS = 10_000_000
 #: Most output samples of one swept-sine run (7 floats each, plus the estimators' temporaries: ~1 GB).
 MAX_SWEEP_SAMPLES = 10_000_000
+#: Stiffest bumper accepted [Hz] (tested to 100 kHz; contact then lasts microseconds).
+MAX_BUMPER_FREQUENCY = 1e6
+#: Most periods of one benchmark run.
+MAX_BENCHMARK_PERIODS = 1_000_000
 
 
 class SceneError(ValueError):
@@ -589,10 +593,20 @@ def _parse_benchmark_scene(c: _Checker, document: dict, text: str, source: str) 
     if not isinstance(raw_cases, list) or not raw_cases:
         c.fail("benchmark.cases", "expected a non-empty list of cases {name, frequency, restitution, clearance | clearance_below_linear, start[, bumper_frequency] | swept_sine}")
         raw_cases = []
+    names: list[str] = []
     for i, raw in enumerate(raw_cases):
         key = f"benchmark.cases[{i}]"
         case = c.mapping(key, raw, _BENCHMARK_CASE_KEYS, {"name", "restitution"})
+        if "name" in case:
+            if not (isinstance(case["name"], str) and _NAME.match(case["name"])):
+                c.fail(f"{key}.name", f"expected a name of letters, digits, '_', '-', '.', got {case['name']!r}")
+            elif case["name"] in names:
+                c.fail(f"{key}.name", f"{case['name']!r} is used by another case: names must be unique")
+            names.append(str(case["name"]))
         swept = case.get("swept_sine")
+        if "swept_sine" in case and not isinstance(swept, dict):
+            c.fail(f"{key}.swept_sine", f"expected a mapping {{start, stop, rate, sample_rate}}, got {swept!r}")
+            continue
         if swept is not None:
             spec_s = c.mapping(f"{key}.swept_sine", swept, {"start", "stop", "rate", "sample_rate"}, {"start", "stop", "rate"})
             f_start = c.number(f"{key}.swept_sine.start", spec_s.get("start"), 0.0, math.inf, low_inclusive=False) if "start" in spec_s else None
@@ -606,6 +620,17 @@ def _parse_benchmark_scene(c: _Checker, document: dict, text: str, source: str) 
             if f_start is not None and f_stop is not None and f_start == f_stop:
                 c.fail(f"{key}.swept_sine.stop", "must differ from start")
                 f_start = None
+            if f_start is not None and f_stop is not None and rate is not None and sample_rate is not None:
+                top, span = max(f_start, f_stop), abs(f_stop - f_start) / rate
+                if sample_rate < 20.0 * top:
+                    c.fail(f"{key}.swept_sine.sample_rate", f"{sample_rate:g} Hz is too coarse for {top:g} Hz: allowed [{20.0 * top:g}, 1e+07] (20 samples per cycle)")
+                    sample_rate = None
+                elif span * sample_rate > MAX_SWEEP_SAMPLES:
+                    c.fail(f"{key}.swept_sine.rate", f"{span * sample_rate:.3g} samples per run: allowed at most {MAX_SWEEP_SAMPLES:.0e}")
+                    rate = None
+                elif span <= 2.0 * 8 / min(f_start, f_stop):
+                    c.fail(f"{key}.swept_sine.rate", f"the sweep lasts {span:g} s, shorter than two 8-cycle windows of the running X1 fundamental")
+                    rate = None
             frequency = f_start
         else:
             if "frequency" not in case:
@@ -614,7 +639,7 @@ def _parse_benchmark_scene(c: _Checker, document: dict, text: str, source: str) 
                 c.fail(f"{key}.start", "required key is missing")
             frequency = c.number(f"{key}.frequency", case.get("frequency"), 0.0, math.inf, low_inclusive=False) if "frequency" in case else None
         restitution = c.number(f"{key}.restitution", case.get("restitution"), 0.0, 1.0) if "restitution" in case else None
-        bumper = c.number(f"{key}.bumper_frequency", case["bumper_frequency"], 0.0, math.inf, low_inclusive=False) if "bumper_frequency" in case else math.nan
+        bumper = c.number(f"{key}.bumper_frequency", case["bumper_frequency"], 0.0, MAX_BUMPER_FREQUENCY, low_inclusive=False) if "bumper_frequency" in case else math.nan
         if bumper is not None and math.isfinite(bumper) and restitution == 0.0:
             c.fail(f"{key}.restitution", "R = 0 needs an infinitely damped bumper: use R > 0 with bumper_frequency")
         if ("clearance" in case) == ("clearance_below_linear" in case):
@@ -645,7 +670,11 @@ def _parse_benchmark_scene(c: _Checker, document: dict, text: str, source: str) 
             sweep = SweptSine(amplitude, f_start, f_stop, rate)
             cases.append(BenchmarkCase(str(case["name"]), problem, "rest", 0, bumper, sweep, sample_rate))
         else:
-            cases.append(BenchmarkCase(str(case["name"]), problem, start, max(1, round(duration * frequency)), bumper))
+            periods = max(1, round(duration * frequency))
+            if periods > MAX_BENCHMARK_PERIODS:
+                c.fail(f"{key}.frequency", f"{periods:,} periods per run (duration x frequency) is too many: allowed at most {MAX_BENCHMARK_PERIODS:,}")
+                continue
+            cases.append(BenchmarkCase(str(case["name"]), problem, start, periods, bumper))
     if c.problems:
         raise SceneError(c.problems, source)
     assert tolerances is not None and isinstance(name, str) and system is not None and amplitude is not None
@@ -673,7 +702,7 @@ def _parse_ladder(c: _Checker, value: Any) -> LadderSettings | None:
     frequency = c.number("benchmark.ladder.frequency", spec["frequency"], 0.0, math.inf, low_inclusive=False) if "frequency" in spec else None
     restitution = c.number("benchmark.ladder.restitution", spec["restitution"], 0.0, 1.0, low_inclusive=False) if "restitution" in spec else None
     clearance = c.number("benchmark.ladder.clearance", spec["clearance"], 0.0, math.inf) if "clearance" in spec else None
-    bumpers = c.grid("benchmark.ladder.bumper_frequencies", spec["bumper_frequencies"], 0.0, math.inf, False) if "bumper_frequencies" in spec else None
+    bumpers = c.grid("benchmark.ladder.bumper_frequencies", spec["bumper_frequencies"], 0.0, MAX_BUMPER_FREQUENCY, False) if "bumper_frequencies" in spec else None
     rtol = c.number("benchmark.ladder.rtol", spec.get("rtol", 1e-8), 1e-14, 1e-2)
     repeats = c.integer("benchmark.ladder.repeats", spec.get("repeats", 3), 1, 100)
     if any(v is None for v in (frequency, restitution, clearance, bumpers, rtol, repeats)):
@@ -692,6 +721,8 @@ DEFAULT_TOLERANCES = {"stepped": (1e-8, 1e-12), "swept": (1e-7, 1e-11)}
 def _parse_simulation(c: _Checker, value: Any, default_frequency: np.ndarray, swept: bool = False) -> SimulationSettings | None:
     spec = dict(c.mapping("simulation", value, _SIMULATION_KEYS))
     rtol, atol = DEFAULT_TOLERANCES["swept" if swept else "stepped"]
+    if "rtol" in spec and "atol" not in spec and isinstance(spec["rtol"], (int, float)) and not isinstance(spec["rtol"], bool):
+        spec["atol"] = spec["rtol"] * (atol / rtol)  # the ratio the guidance was measured with: atol = rtol x 1e-4 m
     spec.setdefault("rtol", rtol)
     spec.setdefault("atol", atol)
     frequency: np.ndarray | None = c.grid("simulation.frequency", spec["frequency"], 0.0, math.inf, False) if "frequency" in spec else default_frequency
