@@ -533,22 +533,30 @@ def _parse_swept_sine(c: _Checker, value: Any, engines: list[str], grid: np.ndar
     if stop <= start:
         c.fail("swept_sine.stop", f"{stop:g} must be greater than start = {start:g} (directions say which way it runs)")
         return None
-    if sample_rate is not None and sample_rate < 20.0 * stop:
-        c.fail("swept_sine.sample_rate", f"{sample_rate:g} Hz is too coarse for {stop:g} Hz: allowed [{20.0 * stop:g}, 1e+07] (20 samples per cycle)")
-        sample_rate = None
-    if rate is not None:
-        duration = (stop - start) / rate
-        if sample_rate is not None and duration * sample_rate > MAX_SWEEP_SAMPLES:
-            c.fail("swept_sine.rate", f"{duration:g} s at {sample_rate:g} samples/s is {duration * sample_rate:.3g} samples per run: allowed at most {MAX_SWEEP_SAMPLES:.0e} (raise the rate or lower swept_sine.sample_rate)")
-            rate = None
-        elif cycles is not None and 2.0 * cycles / start >= duration:
-            c.fail("swept_sine.rate", f"the sweep lasts {duration:g} s, shorter than two {cycles}-cycle estimator windows at {start:g} Hz ({2.0 * cycles / start:g} s): lower the rate or swept_sine.window_cycles")
-            rate = None
+    rate, sample_rate = _check_sweep_run(c, "swept_sine", start, stop, rate, sample_rate, cycles, " or swept_sine.window_cycles")
     if grid is not None and not np.any((grid >= start) & (grid <= stop)):
         c.fail("sweep.frequency", f"no frequency of the grid lies in the swept band [{start:g}, {stop:g}] Hz, where the running estimates are reported")
     if rate is None or sample_rate is None or cycles is None or not directions or initial not in ("linear", "rest"):
         return None
     return SweptSineSettings(start, stop, rate, directions, sample_rate, cycles, initial)
+
+
+def _check_sweep_run(c: _Checker, key: str, low: float, high: float, rate: float | None, sample_rate: float | None, cycles: int | None, window_hint: str = "") -> tuple[float | None, float | None]:
+    """Limits of one swept-sine run between ``low`` and ``high`` [Hz], shared by scenes and benchmark cases: 20 output
+    samples per cycle at the top, at most :data:`MAX_SWEEP_SAMPLES` samples, and room for two estimator windows of
+    ``cycles`` cycles. Returns (rate, sample_rate), each None where it failed."""
+    if sample_rate is not None and sample_rate < 20.0 * high:
+        c.fail(f"{key}.sample_rate", f"{sample_rate:g} Hz is too coarse for {high:g} Hz: allowed [{20.0 * high:g}, 1e+07] (20 samples per cycle)")
+        sample_rate = None
+    if rate is not None:
+        duration = (high - low) / rate
+        if sample_rate is not None and duration * sample_rate > MAX_SWEEP_SAMPLES:
+            c.fail(f"{key}.rate", f"{duration:g} s at {sample_rate:g} samples/s is {duration * sample_rate:.3g} samples per run: allowed at most {MAX_SWEEP_SAMPLES:.0e} (raise the rate or lower {key}.sample_rate)")
+            rate = None
+        elif cycles is not None and 2.0 * cycles / low >= duration:
+            c.fail(f"{key}.rate", f"the sweep lasts {duration:g} s, shorter than two {cycles}-cycle estimator windows at {low:g} Hz ({2.0 * cycles / low:g} s): lower the rate{window_hint}")
+            rate = None
+    return rate, sample_rate
 
 
 def _parse_header(c: _Checker, doc: dict) -> tuple[Any, str, TwoDofSystem | None, float | None, bool]:
@@ -620,17 +628,8 @@ def _parse_benchmark_scene(c: _Checker, document: dict, text: str, source: str) 
             if f_start is not None and f_stop is not None and f_start == f_stop:
                 c.fail(f"{key}.swept_sine.stop", "must differ from start")
                 f_start = None
-            if f_start is not None and f_stop is not None and rate is not None and sample_rate is not None:
-                top, span = max(f_start, f_stop), abs(f_stop - f_start) / rate
-                if sample_rate < 20.0 * top:
-                    c.fail(f"{key}.swept_sine.sample_rate", f"{sample_rate:g} Hz is too coarse for {top:g} Hz: allowed [{20.0 * top:g}, 1e+07] (20 samples per cycle)")
-                    sample_rate = None
-                elif span * sample_rate > MAX_SWEEP_SAMPLES:
-                    c.fail(f"{key}.swept_sine.rate", f"{span * sample_rate:.3g} samples per run: allowed at most {MAX_SWEEP_SAMPLES:.0e}")
-                    rate = None
-                elif span <= 2.0 * 8 / min(f_start, f_stop):
-                    c.fail(f"{key}.swept_sine.rate", f"the sweep lasts {span:g} s, shorter than two 8-cycle windows of the running X1 fundamental")
-                    rate = None
+            if f_start is not None and f_stop is not None:  # the benchmark's running X1 fundamental uses 8-cycle windows
+                rate, sample_rate = _check_sweep_run(c, f"{key}.swept_sine", min(f_start, f_stop), max(f_start, f_stop), rate, sample_rate, 8)
             frequency = f_start
         else:
             if "frequency" not in case:
