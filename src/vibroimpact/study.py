@@ -8,6 +8,7 @@ Output contract (read by other tools; keep these names): dimensions ``solution``
 
 from __future__ import annotations
 
+import functools
 import sys
 from dataclasses import asdict
 from pathlib import Path
@@ -232,12 +233,9 @@ def _pgf(scene: Scene, variant: PgfVariant, omega: np.ndarray, delta: np.ndarray
     def choose(impact_value: np.ndarray, linear_value: np.ndarray) -> np.ndarray:
         return np.where(impact, impact_value, np.where(free, linear_value, np.nan))
 
-    cache: list[tuple[np.ndarray, np.ndarray]] = []
-
-    def rms() -> tuple[np.ndarray, np.ndarray]:
-        if not cache:
-            cache.append(solution.rms())
-        return cache[0]
+    # computed once each, and only if a quantity that needs them is asked for
+    rms = functools.cache(solution.rms)
+    peaks = functools.cache(lambda: _peak_estimates(scene, solution, r))
 
     def stable_flag() -> np.ndarray:
         flag = np.where(np.abs(modulus - 1.0) <= MARGINAL_MODULUS, STABLE_MARGINAL, modulus < 1.0)
@@ -263,8 +261,8 @@ def _pgf(scene: Scene, variant: PgfVariant, omega: np.ndarray, delta: np.ndarray
         "converged": lambda: np.full(shape, -1, dtype=np.int8),
         "x1_rms": lambda: choose(rms()[0], np.abs(linear.x1) / np.sqrt(2.0)),
         "x2_rms": lambda: choose(rms()[1], np.abs(linear.x2) / np.sqrt(2.0)),
-        "peak_acceleration": lambda: choose(_peak_estimates(scene, solution, r)[0], np.zeros(shape)),
-        "peak_contact_force": lambda: choose(_peak_estimates(scene, solution, r)[1], np.zeros(shape)),
+        "peak_acceleration": lambda: choose(peaks()[0], np.zeros(shape)),
+        "peak_contact_force": lambda: choose(peaks()[1], np.zeros(shape)),
         "wall_time": lambda: np.full(shape, np.nan),
     }
     return {q: makers[q]() for q in scene.quantities}
