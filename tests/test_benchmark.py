@@ -85,6 +85,7 @@ def test_benchmark_scene_end_to_end(tmp_path: Path) -> None:
     assert int(data["reference_impacts"].sel(case="graze", reference="exact")) >= 3
     assert int(data["impacts"].sel(case="graze", engine="solve_ivp_DOP853", rtol=1e-6)) < int(data["impacts"].sel(case="graze", engine="momentary_adams", rtol=1e-6))
     assert (tmp_path / "o" / "report.html").is_file() and (tmp_path / "o" / "work_precision.png").is_file()
+    assert "at equal impact-time error" in (tmp_path / "o" / "report.html").read_text()
 
 
 def test_compliant_cvode_is_an_independent_integrator_of_the_same_model(system: TwoDofSystem) -> None:

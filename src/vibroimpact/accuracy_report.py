@@ -14,7 +14,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
-from .benchmark import loosest_tolerance
+from .benchmark import equal_error_speedup, loosest_tolerance
 from .report_common import Figure, save_figure
 
 __all__ = ["accuracy_figures", "accuracy_tables", "TARGETS"]
@@ -64,6 +64,8 @@ def accuracy_figures(dataset: xr.Dataset, out: Path) -> list[Figure]:
 def accuracy_tables(dataset: xr.Dataset) -> list[tuple[str, str]]:
     """The answer (cheapest way to each target), tolerance guidance, the ladder, and every measured point."""
     tables = [("Cheapest way to the X1 fundamental within a target", _answer_table(dataset)), ("Tolerance guidance: loosest rtol meeting each target", _guidance_table(dataset))]
+    if "momentary_adams" in dataset["engine"].values:
+        tables.append(("momentary (Adams) against exact and against solve_ivp at equal impact-time error", _equal_error_table(dataset)))
     if "model" in dataset.dims:
         tables.append(("Model cost ladder: one steady state per model", _ladder_table(dataset)))
     tables.append(("run-study --estimate against measured runs of the shipped studies", _estimate_table()))
@@ -126,6 +128,27 @@ def _guidance_table(dataset: xr.Dataset) -> str:
                 rtol, wall = loosest_tolerance(dataset, str(case), str(method), target)
                 cells.append(f"<td>{_g(rtol)}{'' if not math.isfinite(wall) else f' ({wall:.3g} s)'}</td>")
         rows.append(f"<tr><td>{method}</td>{''.join(cells)}</tr>")
+    return "<table>" + "".join(rows) + "</table>"
+
+
+def _equal_error_table(dataset: xr.Dataset) -> str:
+    """Per rigid-stop case and tolerance: momentary's wall time, its ratio to exact's, and the fastest solve_ivp method's
+    wall time at the same impact-time error (interpolated, :func:`vibroimpact.benchmark.equal_error_speedup`)."""
+    ivp = [str(m) for m in dataset["engine"].values if str(m).startswith("solve_ivp")]
+    rows = ["<tr><th>case</th><th>rtol</th><th>momentary_adams [s]</th><th>exact [s]</th><th>momentary / exact</th><th>best solve_ivp at equal error</th><th>its time / momentary's</th></tr>"]
+    for case in dataset["case"].values:
+        exact = float(dataset["reference_wall_time"].sel(case=case, reference="exact"))
+        if not math.isfinite(exact):
+            continue
+        for tolerance in dataset["rtol"].values:
+            wall = float(dataset["wall_time"].sel(case=case, engine="momentary_adams", rtol=tolerance))
+            if not math.isfinite(wall):
+                continue
+            ratio, other = equal_error_speedup(dataset, str(case), "momentary_adams", float(tolerance), ivp)
+            rows.append(
+                f"<tr><td>{case}</td><td>{float(tolerance):g}</td><td>{wall:.4f}</td><td>{exact:.4f}</td><td>{wall / exact:.1f}</td>"
+                f"<td>{other}</td><td>{'' if not math.isfinite(ratio) else f'{ratio:.2f}'}</td></tr>"
+            )
     return "<table>" + "".join(rows) + "</table>"
 
 
