@@ -146,17 +146,27 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
         per_solution.append(values)
         report(f"[{i}/{total}] {name}: done")
 
-    dims = ("solution", *GRID_DIMS)
-    coords: dict[str, object] = {"solution": np.array(scene.solutions, dtype=object), "restitution": scene.restitution, "clearance": scene.clearance, "frequency": frequency}
+    # a swept-sine test depends on its direction, the steady-state solutions do not: they are not repeated along
+    # ``sweep``; the swept runs' estimates on the frequency grid are the ``swept_*`` variables (sweep, frequency)
+    steady_solutions = [name for name in scene.solutions if not (name in ENGINE_SOLUTIONS and scene.swept_sine is not None)]
+    steady_dims = tuple(d for d in GRID_DIMS if d != "sweep" or scene.swept_sine is None)
+    coords: dict[str, object] = {"solution": np.array(steady_solutions, dtype=object), "restitution": scene.restitution, "clearance": scene.clearance, "frequency": frequency}
     if scene.bumper_frequency is not None:
         coords["bumper_frequency"] = scene.bumper_frequency
     if scene.swept_sine is not None:
         coords["sweep"] = np.array(directions, dtype=object)
+    if not steady_solutions:
+        del coords["solution"]
     data_vars = {}
     for quantity in scene.quantities:
-        stacked = np.stack([np.broadcast_to(values[quantity], full) for values in per_solution])
-        attrs = {"regime": regime_attributes(), "stable": STABLE_ATTRIBUTES, "converged": CONVERGED_ATTRIBUTES}.get(quantity, VARIABLE_ATTRIBUTES.get(quantity))
-        data_vars[quantity] = xr.Variable(dims, stacked, attrs)
+        attrs = _quantity_attributes(quantity)
+        steady = [np.broadcast_to(values[quantity], full) for name, values in zip(scene.solutions, per_solution) if name in steady_solutions]
+        if steady:
+            stacked = np.stack(steady)
+            data_vars[quantity] = xr.Variable(("solution", *steady_dims), stacked if scene.swept_sine is None else stacked[:, :, :, :, 0, :], attrs)
+        for name, values in zip(scene.solutions, per_solution):
+            if name not in steady_solutions:
+                data_vars[f"swept_{quantity}"] = xr.Variable(GRID_DIMS, values[quantity], _swept_attributes(name, attrs))
     for name, values in running.items():
         if name.startswith("sweep_"):  # one value per sweep run
             data_vars[name] = xr.Variable(GRID_DIMS[:-1], values, SWEEP_STAT_ATTRIBUTES[name])
@@ -184,6 +194,17 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
             dataset[key].attrs.update(attrs)
     dataset.attrs.update(_metadata(scene))
     return dataset
+
+
+def _quantity_attributes(quantity: str) -> dict[str, object]:
+    """Units, long name and (for flags) CF flag attributes of a quantity."""
+    return dict({"regime": regime_attributes(), "stable": STABLE_ATTRIBUTES, "converged": CONVERGED_ATTRIBUTES}.get(quantity, VARIABLE_ATTRIBUTES.get(quantity, {})))
+
+
+def _swept_attributes(solution: str, attrs: dict[str, object]) -> dict[str, object]:
+    """Attributes of a swept-sine estimate on the frequency grid: the quantity's, with the run named."""
+    long_name = attrs.get("long_name", "")
+    return attrs | {"long_name": f"{solution} swept-sine running estimate centred at each frequency: {long_name}"}
 
 
 def _running_attributes(name: str) -> dict[str, str]:
