@@ -89,7 +89,7 @@ def sweep_figures(dataset: xr.Dataset, scene: Scene, out: Path) -> list[Figure]:
     if "running_x1_amplitude" in dataset:
         fig, ax = plt.subplots(figsize=(15, 4.2))
         for direction in sweeps:
-            ax.plot(dataset["time"].values, dataset["running_x1_amplitude"].sel(sweep=direction).values, color=_SWEEP_COLOURS.get(direction, "C4"), lw=0.9, label=f"sweep {direction}")
+            ax.plot(dataset["elapsed_time"].values, dataset["running_x1_amplitude"].sel(sweep=direction).values, color=_SWEEP_COLOURS.get(direction, "C4"), lw=0.9, label=f"sweep {direction}")
         ax.set(yscale="log", xlabel="time [s]", ylabel="|X1| running fundamental [m]", title="Running fundamental of X1 against time (the Simulink scope view)")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import functools
 import sys
 from dataclasses import asdict
+from datetime import datetime, timezone
 from pathlib import Path
 from typing import Callable
 
@@ -171,12 +172,14 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
         if name.startswith("sweep_"):  # one value per sweep run
             data_vars[name] = xr.Variable(GRID_DIMS[:-1], values, SWEEP_STAT_ATTRIBUTES[name])
         else:
-            data_vars[name] = xr.Variable((*GRID_DIMS[:-1], "time"), values, _running_attributes(name))
+            data_vars[name] = xr.Variable((*GRID_DIMS[:-1], "elapsed_time"), values, _running_attributes(name))
     dataset = xr.Dataset(data_vars, coords=coords)
     if running:
         dataset = dataset.assign_coords(
-            time=("time", sweep_axes["time"], {"units": "s", "long_name": "time since the start of the sweep"}),
-            instantaneous_frequency=(("sweep", "time"), sweep_axes["instantaneous_frequency"], {"units": "Hz", "long_name": "instantaneous excitation frequency f0 + alpha t"}),
+            # an elapsed duration, not a date: CF's standard_name ``time`` would need "seconds since <epoch>" units,
+            # which readers decode into calendar dates; so no standard_name, and not the reserved name ``time``
+            elapsed_time=("elapsed_time", sweep_axes["time"], {"units": "s", "long_name": "simulated time since the start of the sweep"}),
+            instantaneous_frequency=(("sweep", "elapsed_time"), sweep_axes["instantaneous_frequency"], {"units": "Hz", "long_name": "instantaneous excitation frequency f0 + alpha t"}),
         )
     for key in ("restitution", "clearance", "bumper_frequency", "sweep"):
         if key == "sweep" and scene.swept_sine is not None:
@@ -470,7 +473,12 @@ def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
     A reader never sees a half-written file, and an interrupted run leaves the previous file intact.
     """
     path = Path(path)
-    encoding = {name: {"zlib": True, "complevel": 4} for name in dataset.data_vars}
+    encoding: dict[str, dict[str, object]] = {name: {"zlib": True, "complevel": 4} for name in dataset.data_vars}
+    # CF 2.5.1: coordinate variables carry no _FillValue (xarray adds one to every float variable unless told not to)
+    encoding |= {name: {"_FillValue": None} for name in dataset.coords if dataset[name].dtype.kind == "f"}
+    if not dataset.attrs.get("history"):
+        stamp = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+        dataset = dataset.assign_attrs(history=f"{stamp} vibroimpact {__version__}: {dataset.attrs.get('title', 'dataset')} written")
     with atomic_path(path) as temporary:
         dataset.to_netcdf(temporary, engine="netcdf4", format="NETCDF4", encoding=encoding)
     return path
