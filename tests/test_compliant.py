@@ -212,7 +212,8 @@ def test_sweep_clears_the_event_records() -> None:
         assert all(len(getattr(events, name)) == 0 for name in ("_i", "_t", "_y", "_yp"))
 
 
-@pytest.mark.timeout(120)
+@pytest.mark.slow
+@pytest.mark.timeout(300)
 def test_sweep_memory_stays_flat() -> None:
     """Beyond its output, a sweep's memory grows only by its per-contact records: between a 5 s and a 20 s
     contact-rich sweep (22 -> 22.5 / 24 Hz, ~110 / ~460 contacts) the peak traced allocation minus the samples grows

@@ -151,7 +151,8 @@ def test_start_at_the_stop_moving_into_it(system: TwoDofSystem) -> None:
     state = np.array([0.0, 1e-3, 0.0, 0.1])
     for engine in (MomentaryEngine(), ExactEngine()):
         trajectory = engine.integrate(problem, state, 0.0, 2)
-        assert trajectory.impact_times[0] == 0.0 and trajectory.impact_velocities[0] == 0.1
+        assert trajectory.impact_times[0] == pytest.approx(0.0, abs=1e-15)
+        assert trajectory.impact_velocities[0] == pytest.approx(0.1, rel=1e-12)
         assert np.all(trajectory.strobe_states[:, 1] <= problem.clearance)
 
 

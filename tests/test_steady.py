@@ -12,7 +12,8 @@ from vibroimpact.engines import EngineSettings, ExactEngine, ImpactProblem
 from vibroimpact.engines.momentary import MomentaryEngine
 from vibroimpact.linear import linear_response
 from vibroimpact.pgf import solve_one_impact
-from vibroimpact.simulate import SimulationCase, run_cases
+from vibroimpact.runner import run_cases
+from vibroimpact.simulate import SimulationCase
 from vibroimpact.steady import SteadySettings, steady_state
 from vibroimpact.system import TwoDofSystem
 
@@ -101,7 +102,7 @@ def test_cache_resumes_without_recomputing(system: TwoDofSystem, tmp_path: Path,
     first = run_cases(cases, cache_dir=tmp_path, progress=False)
     assert len(list(tmp_path.glob("*.npz"))) == 2
 
-    def fail(case: SimulationCase) -> dict:
+    def fail(case: SimulationCase, report: object = None) -> dict:
         raise AssertionError("a cached case was recomputed")
 
     monkeypatch.setattr(simulate, "run_case", fail)

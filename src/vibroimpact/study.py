@@ -22,12 +22,14 @@ from . import __version__
 from .atomic import atomic_path
 from .benchmark import run_benchmark
 from .contact import peak_acceleration_factor
+from .fingerprint import source_hash
 from .linear import linear_response
 from .modal import fit_modal_parameters
 from .pgf import OneImpactSolution, PgfVariant, green_models, solve_one_impact
 from .regime import Regime, classify, regime_attributes
 from .scene import ENGINE_SOLUTIONS, GRID_DIMS, Scene
-from .simulate import FIELDS, SWEEP_STARTS, SimulationCase, run_cases
+from .runner import run_cases
+from .simulate import FIELDS, SWEEP_STARTS, SimulationCase
 from .swept import SWEEP_QUANTITIES, SWEEP_STATS, SweepCase
 
 #: Frequencies per simulation case when points are independent (load balancing between processes).
@@ -435,6 +437,7 @@ def _metadata(scene: Scene) -> dict[str, object]:
         "scene_name": scene.name,
         "scene": scene.text,
         "vibroimpact_version": __version__,
+        "vibroimpact_source_sha256": source_hash(),
         "Conventions": "CF-1.8",
         "excitation_amplitude_N": scene.amplitude,
         "natural_frequencies_Hz": np.array(system.natural_frequencies()) / (2.0 * np.pi),

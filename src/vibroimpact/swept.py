@@ -10,8 +10,6 @@ and peak force and deceleration are counted per window from the contacts themsel
 
 from __future__ import annotations
 
-import hashlib
-import json
 import sys
 import time
 from dataclasses import asdict, dataclass
@@ -20,11 +18,12 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import cumulative_trapezoid
 
-from . import __version__
 from .engines.base import EngineSettings
 from .engines.compliant import CompliantEngine, SweepRecord
 from .excitation import SweptSine
+from .fingerprint import case_key
 from .harmonics import running_at, running_fundamental, window_times
+from .runner import ProgressReport
 from .scene import SweptSineSettings
 from .system import TwoDofSystem
 
@@ -90,30 +89,33 @@ class SweepCase:
     engine = "compliant_sweep"
     fields = SWEEP_FIELDS
 
+    progress_unit = "s simulated"
+
     @property
-    def points(self) -> int:
-        """Progress weight: the frequency points this sweep reports."""
-        return len(self.frequencies)
+    def progress_total(self) -> float:
+        """The sweep's duration [s]: progress is counted in simulated time."""
+        return self.settings.sweep(self.amplitude, self.direction).duration
 
     def key(self) -> str:
-        """A stable hash of everything that determines the result."""
-        text = json.dumps({"version": __version__, "case": asdict(self)}, sort_keys=True, default=str)
-        return hashlib.sha256(text.encode()).hexdigest()[:24]
+        """A stable hash of everything that determines the result, the package version and its source code."""
+        return case_key(asdict(self))
 
-    def run(self) -> dict[str, NDArray[np.generic]]:
+    def run(self, report: ProgressReport | None = None) -> dict[str, NDArray[np.generic]]:
         """Simulate the sweep and estimate (see :func:`run_sweep_case`)."""
-        return run_sweep_case(self)
+        return run_sweep_case(self, report)
 
 
-def run_sweep_case(case: SweepCase) -> dict[str, NDArray[np.generic]]:
-    """Run one sweep; estimates on ``case.frequencies`` and on the time grid, and the run's cost."""
+def run_sweep_case(case: SweepCase, report: ProgressReport | None = None) -> dict[str, NDArray[np.generic]]:
+    """Run one sweep; estimates on ``case.frequencies`` and on the time grid, and the run's cost.
+
+    ``report`` receives the simulated time reached [s] as the run goes on."""
     sweep = case.settings.sweep(case.amplitude, case.direction)
     engine = CompliantEngine(case.bumper_frequency, case.bumper_loss_factor, case.engine_settings)
     started = time.perf_counter()
     state = sweep_start_state(case.system, sweep, case.clearance) if case.settings.initial_state == "linear" else None
     times = np.linspace(0.0, sweep.duration, case.time_points)
     try:
-        record = engine.sweep(case.system, case.clearance, sweep, case.settings.sample_rate, state)
+        record = engine.sweep(case.system, case.clearance, sweep, case.settings.sample_rate, state, report)
     except (RuntimeError, ValueError, ArithmeticError) as error:
         # a failing run must not cost the others: it stays NaN, flagged, and the study goes on
         print(f"compliant sweep {case.direction}: Delta = {case.clearance:g} m, bumper {case.bumper_frequency:g} Hz, xi_b = {case.bumper_loss_factor:g} failed: {error}", file=sys.stderr)

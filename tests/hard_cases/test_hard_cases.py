@@ -1,5 +1,8 @@
 """The table of hard cases (``cases.py``) run against every engine: each (case, engine) pair is one test.
 
+The default tier runs the reference ``exact`` and the default integrator (``momentary`` Adams) on every case; the
+other engines' rows are the ``hard`` tier (``pytest -m hard``), and the longest runs the ``slow`` tier.
+
 A pair whose engine does not apply is reported as skipped with the table's reason; nothing is left out silently
 (``test_every_case_names_every_engine``). A failure lists every requirement that did not hold, with the measured
 value and its bound, and all the measurements of the run.
@@ -15,6 +18,10 @@ from .cases import CASES, ENGINE_NAMES, RIGID, Expect, HardCase, NotRun
 from .runs import exact_run, measure, run_case
 
 
+#: Engines whose rows run in the default tier; the rest of the table is the ``hard`` tier (``pytest -m hard``).
+DEFAULT_TIER_ENGINES = ("exact", "adams")
+
+
 def _params() -> list:
     params = []
     for case in CASES:
@@ -23,6 +30,8 @@ def _params() -> list:
             marks = [pytest.mark.timeout(case.timeout)]
             if case.slow:
                 marks.append(pytest.mark.slow)
+            elif engine not in DEFAULT_TIER_ENGINES:
+                marks.append(pytest.mark.hard)
             if isinstance(expect, NotRun):
                 marks.append(pytest.mark.skip(reason=f"{engine} does not run {case.id}: {expect.reason}"))
             params.append(pytest.param(case, engine, id=f"{case.id}-{engine}", marks=marks))

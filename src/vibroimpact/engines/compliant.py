@@ -380,7 +380,15 @@ class CompliantEngine:
         run.run(np.asarray(t_start + problem.period * np.arange(1, periods + 1), dtype=np.float64), strobes)
         return rec.build(run.stats())
 
-    def sweep(self, system: TwoDofSystem, clearance: float, sweep: SweptSine, sample_rate: float, state: NDArray[np.float64] | None = None) -> SweepRecord:
+    def sweep(
+        self,
+        system: TwoDofSystem,
+        clearance: float,
+        sweep: SweptSine,
+        sample_rate: float,
+        state: NDArray[np.float64] | None = None,
+        progress: Callable[[float], None] | None = None,
+    ) -> SweepRecord:
         """Swept-sine test (the paper's Simulink run): q sin(theta(t)) from t = 0 to the sweep's end, sampled.
 
         Parameters
@@ -395,6 +403,8 @@ class CompliantEngine:
             Output samples per second [Hz] (IDA interpolates; the step is set by the tolerances).
         state : ndarray, optional
             (X1, X2, X1', X2') at t = 0; rest by default.
+        progress : callable, optional
+            Receives the simulated time reached [s] after each block of samples.
         """
         require_positive("sample_rate", sample_rate)
         problem = ImpactProblem(system, clearance, 0.5, sweep.amplitude, sweep.start_frequency)  # forcing from `sweep`
@@ -414,6 +424,8 @@ class CompliantEngine:
             block[:, 4] = model.k * ys[:, 1] + model.b * ys[:, 3] if contact else 0.0
             block[:, 5:] = ys[:, 5:7]
             filled += t.size
+            if progress is not None:
+                progress(float(t[-1]))
 
         run.run(times, samples)
         if filled != times.size:

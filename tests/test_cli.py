@@ -1,0 +1,181 @@
+"""``run-study`` as a user meets it: the shipped studies, bad output folders, YAML errors, Ctrl-C, an installed copy."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+from vibroimpact import cli, study
+from vibroimpact.scene import shipped_studies, shipped_studies_dir
+
+from .test_scene import base_scene, write_yaml
+
+REPOSITORY = Path(__file__).resolve().parents[1]
+
+
+def test_list_shows_every_shipped_study_with_its_description(capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.main(["--list"]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    names = sorted(path.stem for path in shipped_studies_dir().glob("*.yaml"))
+    assert "restitution" in names and len(printed) == len(names)
+    for line, name, (listed, description) in zip(printed, names, shipped_studies()):
+        assert line.split()[0] == name == listed and description and description in line
+
+
+def test_a_scene_is_required_without_list(capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.main([]) == 2
+    assert "a scene is required" in capsys.readouterr().err
+
+
+def test_unwritable_out_is_refused_before_any_work(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """--out under a regular file cannot be created: exit 2 naming the path, and nothing is computed."""
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a folder")
+    out = blocker / "results"
+
+    def never(*args: object, **kwargs: object) -> None:
+        raise AssertionError("work started although --out cannot be written")
+
+    monkeypatch.setattr(cli, "run_study", never)
+    assert cli.main([str(write_yaml(tmp_path / "tiny.yaml", base_scene())), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert f"--out {out} cannot be written" in err and "Traceback" not in err
+
+
+def test_yaml_syntax_error_names_the_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "broken.yaml"
+    path.write_text("name: broken\nsystem: {m1: 1.0\n  k1: [\n", encoding="utf-8")
+    assert cli.main([str(path), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert f'in "{path}", line 2' in err and "<unicode string>" not in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_each_searched_place_is_listed_once(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """In a checkout, ./studies is the shipped folder: it is named once, not twice."""
+    monkeypatch.chdir(shipped_studies_dir().parent)
+    assert cli.main(["no_such_scene.yaml"]) == 2
+    places = capsys.readouterr().err.split("looked at: ")[1].strip().split(", ")
+    assert len(places) == len({str(Path(place).resolve()) for place in places}) == 2
+
+
+def test_a_local_file_wins_over_the_shipped_scene(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from vibroimpact.scene import find_scene
+
+    monkeypatch.chdir(tmp_path)
+    local = write_yaml(tmp_path / "restitution.yaml", base_scene())
+    assert find_scene("restitution.yaml").resolve() == local.resolve()
+    assert find_scene("restitution").resolve() == local.resolve()
+
+
+def _slow_scene(folder: Path) -> Path:
+    """Enough simulation cases (momentary, 16 points each) that an interrupt lands between two of them."""
+    document = base_scene()
+    document.update(
+        name="interrupted",
+        stop={"clearance": 0.003, "restitution": 0.2},
+        sweep={"frequency": {"start": 33.0, "stop": 40.0, "step": 0.1}},
+        solutions=["linear", "momentary"],
+        simulation={"start": "pgf"},
+        report=False,
+    )
+    return write_yaml(folder / "interrupted.yaml", document)
+
+
+def _start(arguments: list[str], folder: Path) -> subprocess.Popen[str]:
+    # its own process group, as a terminal's foreground job; SIGINT handled as in an interactive shell
+    return subprocess.Popen(
+        [sys.executable, "-m", "vibroimpact.cli", *arguments],
+        cwd=folder,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+
+
+@pytest.mark.timeout(240)
+def test_ctrl_c_leaves_one_line_and_a_resumable_cache(tmp_path: Path) -> None:
+    """Ctrl-C (SIGINT to the whole process group, workers included): exit 130, one line saying what was kept, no
+    traceback; the same command then starts from the kept cases."""
+    scene = _slow_scene(tmp_path)
+    cache = tmp_path / "out" / ".cache"
+    arguments = [str(scene), "--out", "out", "--jobs", "2"]
+    run = _start(arguments, tmp_path)
+    deadline = time.monotonic() + 180.0
+    while not list(cache.glob("*.npz")) and run.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert run.poll() is None, "the study ended before it could be interrupted"
+    os.killpg(run.pid, signal.SIGINT)
+    _out, err = run.communicate(timeout=60)
+    kept = len(list(cache.glob("*.npz")))
+    assert run.returncode == 130, err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+    assert err.rstrip().splitlines()[-1] == f"interrupted: {kept} finished case{'s' if kept != 1 else ''} kept; run the same command to resume"
+    assert 1 <= kept < 5  # 71 points in 16-point cases: 5 cases
+    # the rerun begins with the kept cases done
+    rerun = _start(arguments, tmp_path)
+    assert rerun.stderr is not None
+    first_progress = next(line for line in rerun.stderr if line.startswith("simulating"))
+    os.killpg(rerun.pid, signal.SIGINT)
+    rerun.communicate(timeout=60)
+    done = int(first_progress.split("] ")[1].split("/")[0])
+    assert done >= 16 * kept - 16 and done > 0, first_progress
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(600)
+def test_installed_package_finds_its_studies(tmp_path: Path) -> None:
+    """A non-editable install (wheel) run from an empty folder lists and finds the shipped scenes."""
+    wheels, site, empty = tmp_path / "wheels", tmp_path / "site", tmp_path / "empty"
+    empty.mkdir()
+    pip = [sys.executable, "-m", "pip", "--disable-pip-version-check", "--no-cache-dir"]
+    subprocess.run([*pip, "wheel", "--no-deps", "-w", str(wheels), str(REPOSITORY)], check=True, capture_output=True)
+    wheel = next(wheels.glob("vibroimpact-*.whl"))
+    subprocess.run([*pip, "install", "--no-deps", "--target", str(site), str(wheel)], check=True, capture_output=True)
+    environment = os.environ | {"PYTHONPATH": str(site)}
+
+    def run(*arguments: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run([sys.executable, "-m", "vibroimpact.cli", *arguments], cwd=empty, env=environment, capture_output=True, text=True, timeout=300)
+
+    where = subprocess.run([sys.executable, "-c", "import vibroimpact; print(vibroimpact.__file__)"], cwd=empty, env=environment, capture_output=True, text=True, check=True)
+    assert where.stdout.startswith(str(site)), where.stdout
+    listed = run("--list")
+    assert listed.returncode == 0 and "restitution" in listed.stdout and "bumper_sweep" in listed.stdout
+    estimated = run("restitution.yaml", "--estimate")
+    assert estimated.returncode == 0, estimated.stderr
+    assert yaml.safe_load((site / "vibroimpact" / "studies" / "restitution.yaml").read_text())["name"] == "restitution"
+    assert list(empty.iterdir()) == []  # --list and --estimate write nothing
+
+
+def test_a_code_change_invalidates_the_resume_cache(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The cache key hashes the package's source: other code, other key (the version number alone would not do)."""
+    from vibroimpact import fingerprint
+    from vibroimpact.engines import EngineSettings
+    from vibroimpact.simulate import SimulationCase
+    from vibroimpact.steady import SteadySettings
+    from vibroimpact.system import PAPER_SYSTEM
+
+    case = SimulationCase("exact", PAPER_SYSTEM, 10.0, 0.2, 0.003, (25.0,), "pgf", EngineSettings(), SteadySettings())
+    before = case.key()
+    assert case.key() == before and len(fingerprint.source_hash()) == 64
+    monkeypatch.setattr(fingerprint, "source_hash", lambda: "0" * 64)
+    assert case.key() != before
+
+
+def test_datasets_record_the_source_they_came_from(tmp_path: Path) -> None:
+    from vibroimpact.fingerprint import source_hash
+    from vibroimpact.scene import load_scene
+
+    document = base_scene()
+    document.update(solutions=["linear"], sweep={"frequency": [20.0, 21.0]})
+    dataset = study.run_study(load_scene(write_yaml(tmp_path / "tiny.yaml", document)), progress=None)
+    assert dataset.attrs["vibroimpact_source_sha256"] == source_hash()
