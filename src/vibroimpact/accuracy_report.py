@@ -15,62 +15,67 @@ import numpy as np
 import xarray as xr
 
 from .benchmark import equal_error_speedup, loosest_tolerance
-from .report_common import Figure, save_figure
+from .report_common import DrawnFigure, Table
+from .report_style import figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour
 
 __all__ = ["accuracy_figures", "accuracy_tables", "TARGETS"]
 
 #: X1-fundamental accuracies the guidance is given for [-].
 TARGETS = (1e-3, 1e-6)
+_ERRORS = (("x1_error", "relative error of the X1 fundamental [1]"), ("impact_time_error", "largest impact-time error [s]"))
 
 
-def accuracy_figures(dataset: xr.Dataset, out: Path) -> list[Figure]:
-    """Work-precision diagrams: X1 error and impact-time error against wall time, one panel per case."""
+def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
+    """Work-precision diagrams: X1 error and impact-time error against wall time, one row of two panels per case."""
     cases = [str(c) for c in dataset["case"].values]
-    fig, axes = plt.subplots(2, len(cases), figsize=(6.4 * len(cases), 9.0), squeeze=False)
+    methods = [str(m) for m in dataset["engine"].values]
+    fig, axes = new_figure(2 * len(cases), panel_height=3.6, legend_rows=legend_rows(len(methods) + 4))
+    missed_any = False
     for j, case in enumerate(cases):
-        for row, (quantity, label) in enumerate((("x1_error", "relative error of the X1 fundamental"), ("impact_time_error", "largest impact-time error [s]"))):
-            ax = axes[row, j]
-            for k, method in enumerate(dataset["engine"].values):
+        for column, (quantity, label) in enumerate(_ERRORS):
+            ax = axes[2 * j + column]
+            for k, method in enumerate(methods):
                 line = dataset.sel(case=case, engine=method)
                 wall, error = line["wall_time"].values, line[quantity].values
                 if not np.isfinite(wall).any():
                     continue
                 missed = line["missed_impacts"].values > 0
                 floor = np.maximum(error, 1e-17)  # an exact zero still gets a point
-                style = "o-" if str(method).startswith(("momentary", "compliant")) else "s--"
-                ax.loglog(wall, np.where(missed, np.nan, floor), style, color=f"C{k % 10}", ms=4, lw=1.0, label=str(method))
+                style = "o-" if method.startswith(("momentary", "compliant")) else "s--"
+                ax.loglog(wall, np.where(missed, np.nan, floor), style, color=series_colour(k), ms=4, lw=1.2, label=method, gid=method)
                 if missed.any():
-                    ax.loglog(wall[missed], floor[missed], "x", color=f"C{k % 10}", ms=9, mew=2)
-            for reference, marker in (("exact", "k"), ("compliant_cvode_adams", "0.5")):
+                    ax.loglog(wall[missed], floor[missed], "x", color=series_colour(k), ms=9, mew=2, label="_nolegend_", gid=method)
+                    missed_any = True
+            for reference, colour in (("exact", "k"), ("compliant_cvode_adams", "0.5")):
                 value = float(dataset["reference_wall_time"].sel(case=case, reference=reference))
                 if math.isfinite(value):
-                    ax.axvline(value, color=marker, ls=":", lw=1.0, label=f"reference: {reference}" + (" (rtol 1e-13)" if reference != "exact" else ""))
+                    ax.axvline(value, color=colour, ls=":", lw=1.2, label=f"reference: {reference}" + (" (rtol 1e-13)" if reference != "exact" else ""))
             if quantity == "x1_error":
                 for target in TARGETS:
-                    ax.axhline(target, color="k", lw=0.5, alpha=0.4)
-            ax.set(title=case, xlabel="wall time [s] (median)", ylabel=label)
-            ax.grid(True, which="both", alpha=0.3)
-            if row == 0:
-                ax.legend(fontsize=7)
+                    ax.axhline(target, color="k", lw=0.6, alpha=0.5)
+            finish_axes(ax, "wall time [s] (median)", label, case)
+    figure_legend(fig, axes, columns=4)
     caption = (
-        "Work-precision: one point per tolerance (rtol 1e-3 ... 1e-12 from right to left), error against the reference "
-        "(rigid-stop methods: the exact engine; compliant model: CVODE Adams at rtol 1e-13), wall time the median of "
-        "repeated runs in one process (read ratios, not seconds). Solid: SUNDIALS engines; dashed: solve_ivp. Crosses: "
-        "runs that missed impacts of the reference. Thin lines: the 1e-3 and 1e-6 targets."
+        "Work-precision, one row per case: one point per tolerance (rtol 1e-3 ... 1e-12 from right to left), error against "
+        "the reference (rigid-stop methods: the exact engine; compliant model: CVODE Adams at rtol 1e-13), wall time the "
+        "median of repeated runs in one process (read ratios, not seconds). Solid with circles: SUNDIALS engines; dashed "
+        "with squares: solve_ivp; dotted verticals: the references' wall times."
+        + (" Crosses: runs that missed impacts of the reference." if missed_any else "")
+        + " Thin horizontal lines: the 1e-3 and 1e-6 targets."
     )
-    return [Figure(save_figure(fig, out / "work_precision.png"), caption)]
+    return [DrawnFigure(fig, "work_precision", "Work-precision diagrams", caption)]
 
 
-def accuracy_tables(dataset: xr.Dataset) -> list[tuple[str, str]]:
+def accuracy_tables(dataset: xr.Dataset) -> list[Table]:
     """The answer (cheapest way to each target), tolerance guidance, the ladder, and every measured point."""
-    tables = [("Cheapest way to the X1 fundamental within a target", _answer_table(dataset)), ("Tolerance guidance: loosest rtol meeting each target", _guidance_table(dataset))]
+    tables = [Table("Cheapest way to the X1 fundamental within a target", _answer_table(dataset)), Table("Tolerance guidance: loosest rtol meeting each target", _guidance_table(dataset))]
     if "momentary_adams" in dataset["engine"].values:
-        tables.append(("momentary (Adams) against exact and against solve_ivp at equal impact-time error", _equal_error_table(dataset)))
+        tables.append(Table("momentary (Adams) against exact and against solve_ivp at equal impact-time error", _equal_error_table(dataset)))
     if "model" in dataset.dims:
-        tables.append(("Model cost ladder: one steady state per model", _ladder_table(dataset)))
-    tables.append(("run-study --estimate against measured runs of the shipped studies", _estimate_table()))
+        tables.append(Table("Model cost ladder: one steady state per model", _ladder_table(dataset)))
+    tables.append(Table("run-study --estimate against measured runs of the shipped studies", _estimate_table()))
     for case in dataset["case"].values:
-        tables.append((f"Every point: {case}", _points_table(dataset, str(case))))
+        tables.append(Table(f"Every point: {case}", _points_table(dataset, str(case))))
     return tables
 
 
@@ -102,9 +107,9 @@ def _answer_table(dataset: xr.Dataset) -> str:
             other, other_rtol, other_wall = _cheapest(dataset, str(case), target, ivp)
             speedup = other_wall / wall if name and other else math.nan
             rows.append(
-                f"<tr><td>{case}</td><td>{target:g}</td><td>{name or 'none reaches it'}</td><td>{_g(rtol)}</td><td>{_f(wall)}</td>"
-                f"<td>{other or 'none reaches it'}</td><td>{_g(other_rtol)}</td><td>{_f(other_wall)}</td><td>{'' if not math.isfinite(speedup) else f'{speedup:.1f}x'}</td>"
-                f"<td>{_f(exact)}</td></tr>"
+                f"<tr><td>{case}</td><td>{target:g}</td><td>{name or 'none reaches it'}</td><td>{fmt(rtol, 'g')}</td><td>{fmt(wall)}</td>"
+                f"<td>{other or 'none reaches it'}</td><td>{fmt(other_rtol, 'g')}</td><td>{fmt(other_wall)}</td><td>{'' if not math.isfinite(speedup) else f'{speedup:.1f}x'}</td>"
+                f"<td>{fmt(exact)}</td></tr>"
             )
     note = (
         "<p>For each method the loosest tolerance whose X1 fundamental is within the target (and every tighter one run, "
@@ -126,7 +131,7 @@ def _guidance_table(dataset: xr.Dataset) -> str:
         for case in dataset["case"].values:
             for target in TARGETS:
                 rtol, wall = loosest_tolerance(dataset, str(case), str(method), target)
-                cells.append(f"<td>{_g(rtol)}{'' if not math.isfinite(wall) else f' ({wall:.3g} s)'}</td>")
+                cells.append(f"<td>{fmt(rtol, 'g')}{'' if not math.isfinite(wall) else f' ({wall:.3g} s)'}</td>")
         rows.append(f"<tr><td>{method}</td>{''.join(cells)}</tr>")
     return "<table>" + "".join(rows) + "</table>"
 
@@ -196,25 +201,12 @@ def _points_table(dataset: xr.Dataset, case: str) -> str:
             if not np.isfinite(float(p["wall_time"])):
                 continue
             rows.append(
-                f"<tr><td>{method}</td><td>{float(tolerance):g}</td><td>{float(p['wall_time']):.4f}</td><td>{_n(p['steps'])}</td><td>{_n(p['rhs_calls'])}</td>"
-                f"<td>{_n(p['impacts'])}</td><td>{_n(p['missed_impacts'])}</td><td>{_n(p['extra_impacts'])}</td><td>{float(p['x1_error']):.2e}</td>"
+                f"<tr><td>{method}</td><td>{float(tolerance):g}</td><td>{float(p['wall_time']):.4f}</td><td>{fmt(p['steps'], '.0f')}</td><td>{fmt(p['rhs_calls'], '.0f')}</td>"
+                f"<td>{fmt(p['impacts'], '.0f')}</td><td>{fmt(p['missed_impacts'], '.0f')}</td><td>{fmt(p['extra_impacts'], '.0f')}</td><td>{float(p['x1_error']):.2e}</td>"
                 f"<td>{float(p['impact_time_error']):.2e}</td><td>{float(p['impulse_error']):.2e}</td></tr>"
             )
     for reference in dataset["reference"].values:
         wall = float(dataset["reference_wall_time"].sel(case=case, reference=reference))
         if math.isfinite(wall):
-            rows.append(f"<tr><td>reference: {reference}</td><td></td><td>{wall:.4f}</td><td></td><td></td><td>{_n(dataset['reference_impacts'].sel(case=case, reference=reference))}</td><td>0</td><td>0</td><td>0</td><td>0</td><td>0</td></tr>")
+            rows.append(f"<tr><td>reference: {reference}</td><td></td><td>{wall:.4f}</td><td></td><td></td><td>{fmt(dataset['reference_impacts'].sel(case=case, reference=reference), '.0f')}</td><td>0</td><td>0</td><td>0</td><td>0</td><td>0</td></tr>")
     return "<table>" + "".join(rows) + "</table>"
-
-
-def _n(value: object) -> str:
-    number = float(value)  # type: ignore[arg-type]
-    return "" if not math.isfinite(number) else f"{number:.0f}"
-
-
-def _g(value: float) -> str:
-    return "" if not math.isfinite(value) else f"{value:g}"
-
-
-def _f(value: float) -> str:
-    return "" if not math.isfinite(value) else f"{value:.3g}"

@@ -1,0 +1,308 @@
+"""Figures of the frequency-response pages (paper figures 2-8 and 21-24): linear system, responses of every solution,
+regime maps, stability, and simulations against the closed form.
+
+Each builder returns a :class:`~vibroimpact.report_common.DrawnFigure` whose caption is put together from what was
+drawn. Closed forms are drawn as curves on the dataset's grid, simulations as markers on their own grid
+(:mod:`vibroimpact.report_style`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+from matplotlib.colors import BoundaryNorm, ListedColormap
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+
+from .linear import linear_response
+from .modal import fit_modal_parameters, underdamped_mode_count
+from .regime import Regime
+from .report_common import DrawnFigure
+from .report_style import (
+    ENGINE_MARKERS,
+    LINEAR_STYLE,
+    QUANTITIES,
+    RAW_STYLE,
+    REGIME_COLOURS,
+    SOLUTION_COLOURS,
+    SOLUTION_DESCRIPTIONS,
+    SOLUTION_TITLES,
+    Caption,
+    axis_label,
+    draw_curve,
+    draw_linear,
+    draw_points,
+    figure_legend,
+    finish_axes,
+    legend_rows,
+    new_figure,
+    regime_label,
+    series_colour,
+    solution_ref,
+    stability_keys,
+)
+from .scene import ENGINE_SOLUTIONS, Scene
+
+__all__ = ["linear_figure", "response_figure", "regime_figure", "regime_map", "stability_figure", "simulation_figure", "series_by_restitution", "clearance_text"]
+
+#: Fewer grid points than this: closed-form curves also get a marker per value.
+COARSE_GRID_POINTS = 30
+_FREQUENCY = "frequency [Hz]"
+
+
+def clearance_text(part: xr.Dataset) -> str:
+    """Delta of a dataset at one clearance, in mm."""
+    return f"Delta = {float(part['clearance']) * 1e3:.6g} mm"
+
+
+def series_by_restitution(part: xr.Dataset) -> list[tuple[str, xr.Dataset]]:
+    """(legend text, dataset) for each restitution ratio of ``part``."""
+    if "restitution" in part.dims:
+        return [(f"R = {float(r):g}", part.sel(restitution=r)) for r in part["restitution"].values]
+    return [(f"R = {float(part['restitution']):g}", part)]
+
+
+def _unstable(line: xr.Dataset, solution: str) -> np.ndarray | None:
+    """Points where ``solution``'s one-impact orbit exists but is unstable (None: stability not computed)."""
+    if "stable" not in line:
+        return None
+    return np.asarray(line["stable"].sel(solution=solution).values == 0)
+
+
+def _periodic(line: xr.Dataset, solution: str, shape: tuple[int, ...]) -> np.ndarray:
+    """Points where a simulation converged to a periodic steady state."""
+    if "converged" not in line:
+        return np.ones(shape, bool)
+    return np.asarray(line["converged"].sel(solution=solution).values == 1)
+
+
+def _simulation_phrase(drawn: dict[str, tuple[bool, bool]]) -> str:
+    """Caption phrase for the simulations drawn: (periodic drawn, irregular drawn) per solution."""
+    shapes = {"o": "circles", "D": "diamonds", "s": "squares"}
+    names = ", ".join(f"{solution_ref(s)} ({shapes.get(ENGINE_MARKERS.get(s, ('s', 0))[0], 'markers')})" for s in drawn)
+    kinds = []
+    if any(p for p, _ in drawn.values()):
+        kinds.append("filled: periodic steady state (the stroboscopic state repeated)")
+    if any(i for _, i in drawn.values()):
+        kinds.append("hollow: irregular motion, averaged over the measured periods")
+    return f"Simulations {names}: one marker per simulated frequency ({'; '.join(kinds)})."
+
+
+def _engine_keys(drawn: dict[str, tuple[bool, bool]]) -> list[Line2D]:
+    """Legend entries for simulation markers, in black (colours are per series)."""
+    keys = []
+    for solution, (periodic, irregular) in drawn.items():
+        marker, size = ENGINE_MARKERS.get(solution, ("s", 5.0))
+        if periodic:
+            keys.append(Line2D([], [], marker=marker, ls="none", color="k", ms=size, label=f"{solution_ref(solution)}, periodic"))
+        if irregular:
+            keys.append(Line2D([], [], marker=marker, ls="none", color="k", mfc="none", ms=size, label=f"{solution_ref(solution)}, irregular"))
+    return keys
+
+
+def linear_figure(scene: Scene) -> DrawnFigure:
+    """Linear responses, force on the base and the curve fit of H22 (paper figures 2-4)."""
+    system = scene.system
+    f = scene.frequency
+    w = 2.0 * np.pi * f
+    response = linear_response(system, w, scene.amplitude)
+    fit = fit_modal_parameters(system) if underdamped_mode_count(system) == 2 else None
+    fig, axes = new_figure(3, panel_height=3.6, legend_rows=2)
+    ax = axes[0]
+    ax.semilogy(f, np.abs(response.x1), label="|X1| primary", color="C0", lw=1.4)
+    ax.semilogy(f, np.abs(response.x2), label="|X2| absorber", color="C1", lw=1.4)
+    for delta in scene.clearance:
+        ax.axhline(delta, color="k", lw=0.9, ls="--")
+    finish_axes(ax, _FREQUENCY, "amplitude [m]", "Linear responses (paper fig. 2)")
+    ax = axes[1]
+    ax.semilogy(f, np.abs(response.force), color="C2", lw=1.4)
+    finish_axes(ax, _FREQUENCY, "|F| on the base [N]", "Linear force on the base (paper fig. 3)")
+    ax = axes[2]
+    ax.semilogy(f, np.abs(system.receptances(w).h22), label="|H22| exact (eq. 4)", lw=1.4)
+    if fit is not None:
+        step = max(1, f.size // 120)
+        ax.semilogy(f[::step], np.abs(fit.receptance(w[::step])), "o", mfc="none", ms=4, label="eq. 10, fitted modes")
+    finish_axes(ax, _FREQUENCY, "|H22| [m/N]", "Accuracy of the curve fit (paper fig. 4)")
+    figure_legend(fig, axes, [Line2D([], [], color="k", lw=0.9, ls="--", label="clearance Delta")])
+    natural = ", ".join(f"{x / (2 * np.pi):.3f}" for x in system.natural_frequencies())
+    caption = (
+        f"Linear system (Delta -> infinity): |X1| and |X2| (dashed: the clearance), the force on the base, and |H22| exact "
+        f"{'against the paper' + chr(39) + 's curve fit (circles)' if fit is not None else '(the paper' + chr(39) + 's fit needs two underdamped modes)'}. "
+        f"Natural frequencies {natural} Hz, anti-resonance {system.antiresonance_frequency() / (2 * np.pi):.3f} Hz."
+    )
+    return DrawnFigure(fig, "linear", "Linear responses, force on the base, fit of H22", caption)
+
+
+def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure | None:
+    """One panel per solution with values of ``quantity``: closed forms as curves, simulations as markers, one colour
+    per restitution ratio, the linear system dotted (paper figures 5-8). None if nothing has a finite value."""
+    q = QUANTITIES[quantity]
+    present = [str(s) for s in part["solution"].values]
+    candidates = [s for s in present if s != "linear"] or ["linear"]
+    panels = [s for s in candidates if np.isfinite(part[quantity].sel(solution=s).values).any()]
+    if not panels:
+        return None
+    lines = series_by_restitution(part)
+    f = part["frequency"].values
+    coarse = f.size < COARSE_GRID_POINTS
+    with_linear = "linear" in present and quantity != "impulse"
+    raw_name = f"one_impact_{quantity}"
+    caption = Caption(
+        f"{q.label} ({q.meaning}) against frequency, {clearance_text(part)}, one colour per restitution ratio; one panel "
+        f"per solution: {'; '.join(f'{solution_ref(s)}, {SOLUTION_DESCRIPTIONS.get(s, s)}' for s in panels)}."
+    )
+    fig, axes = new_figure(len(panels), panel_height=3.7, sharey=True, legend_rows=legend_rows(len(lines) + 6))
+    engines: dict[str, tuple[bool, bool]] = {}
+    any_unstable = gaps = raw = False
+    for ax, solution in zip(axes, panels):
+        if with_linear or solution == "linear":
+            draw_linear(ax, f, part[quantity].sel(solution="linear").isel(_first(part)).values, coarse)
+            caption.add("linear", "LIN (dotted black): the linear system (no stop).")
+        for i, (_, line) in enumerate(lines if solution != "linear" else []):
+            values = line[quantity].sel(solution=solution).values
+            if solution in ENGINE_SOLUTIONS:
+                periodic, irregular = draw_points(ax, f, values, periodic=_periodic(line, solution, values.shape), solution=solution, colour=series_colour(i), label=None)
+                old = engines.get(solution, (False, False))
+                engines[solution] = (old[0] or periodic, old[1] or irregular)
+                continue
+            _, unstable = draw_curve(ax, f, values, colour=series_colour(i), label=None, gid=solution, unstable=_unstable(line, solution), coarse=coarse)
+            any_unstable |= unstable
+            gaps |= bool(np.isnan(values).any())
+            if raw_name in line and solution != "linear":
+                raw_values = line[raw_name].sel(solution=solution).values
+                if np.isfinite(raw_values).any():
+                    ax.plot(f, raw_values, color=series_colour(i), label="_nolegend_", gid=f"raw:{solution}", **RAW_STYLE)
+                    raw = True
+        finish_axes(ax, _FREQUENCY, axis_label(quantity), f"{solution_ref(solution)}: {SOLUTION_TITLES.get(solution, solution)}", log=q.log)
+    if any_unstable:
+        caption.add("unstable", "Curves: solid where the one-impact orbit is stable (or the motion linear), dashed where it exists but is unstable (Floquet): the real motion there is another one.")
+    if gaps:
+        caption.add("gaps", "Gaps in a curve: no admissible one-impact regime while the linear motion would cross the stop.")
+    if raw:
+        caption.add("raw", "Faint thin lines: the raw one-impact solution wherever eqs. 15-16 have a root, unchecked (admissible or not, stable or not): what the paper plots, spikes included.")
+    if engines:
+        caption.add("engines", _simulation_phrase(engines))
+    finite = part[quantity].sel(solution=[*panels, *(["linear"] if with_linear else [])]).values
+    top = float(np.max(finite[np.isfinite(finite)], initial=0.0))
+    if top > 0.0:
+        axes[0].set_ylim(top=3.0 * top if q.log else 1.1 * top)
+    keys = [Patch(color=series_colour(i), label=text) for i, (text, _) in enumerate(lines)]
+    if with_linear:
+        keys.append(Line2D([], [], label="LIN (linear system)", **LINEAR_STYLE))
+    keys += stability_keys() if any_unstable else []
+    keys += [Line2D([], [], color="k", label="raw one-impact solution", **RAW_STYLE)] if raw else []
+    figure_legend(fig, [], keys + _engine_keys(engines))
+    missing = [s for s in candidates if s not in panels]
+    tail = f"No finite values, not drawn: {', '.join(solution_ref(s) for s in missing)}." if missing else ""
+    return DrawnFigure(fig, name, f"{q.label}, {clearance_text(part)}", caption.text(tail))
+
+
+def _first(part: xr.Dataset) -> dict[str, int]:
+    """Index the first restitution value (the linear response does not depend on it)."""
+    return {"restitution": 0} if "restitution" in part.dims else {}
+
+
+def regime_figure(part: xr.Dataset, name: str) -> DrawnFigure:
+    """Regime flag of every point: one panel per solution, one row per restitution ratio, one colour per flag."""
+    lines = series_by_restitution(part)
+    panels = [
+        (f"{solution_ref(str(s))}: regime, {clearance_text(part)}", [text for text, _ in lines], np.array([line["regime"].sel(solution=s).values for _, line in lines], dtype=int))
+        for s in part["solution"].values
+    ]
+    solutions = ", ".join(solution_ref(str(s)) for s in part["solution"].values)
+    return regime_map(panels, part["frequency"].values, name, f"Regime map, {clearance_text(part)}", f"Regime of each point of {solutions}")
+
+
+def regime_map(panels: list[tuple[str, list[str], np.ndarray]], f: np.ndarray, name: str, title: str, lead: str) -> DrawnFigure:
+    """Regime flags as coloured bands, one colour per flag, the legend below the panels.
+
+    Parameters
+    ----------
+    panels : list of (str, list of str, ndarray)
+        Per panel: its title, its row labels, and the flags, shape (rows, frequency).
+    f : ndarray
+        Frequency grid [Hz].
+    name, title : str
+        File name and heading of the figure.
+    lead : str
+        First sentence of the caption.
+    """
+    flags = sorted(REGIME_COLOURS)
+    cmap = ListedColormap([REGIME_COLOURS[r] for r in flags])
+    norm = BoundaryNorm(np.arange(len(flags) + 1) - 0.5, len(flags))
+    rows = max(len(labels) for _, labels, _ in panels)
+    fig, axes = new_figure(len(panels), panel_height=0.95 + 0.3 * rows, columns=1, sharex=True, legend_rows=legend_rows(len(flags), 3))
+    seen: set[int] = set()
+    for ax, (panel_title, labels, grid) in zip(axes, panels):
+        computed = np.any(grid != Regime.NOT_COMPUTED, axis=0)
+        columns = f[computed]
+        if columns.size:
+            # each column spans halfway to its neighbours: coarse simulation grids show as blocks, not hairlines
+            edges = np.concatenate([[f[0]], (columns[1:] + columns[:-1]) / 2.0, [f[-1]]]) if columns.size > 1 else np.array([columns[0] - 0.5, columns[0] + 0.5])
+            ax.pcolormesh(edges, np.arange(len(labels) + 1) - 0.5, np.searchsorted(flags, grid[:, computed]), cmap=cmap, norm=norm, shading="flat", gid=f"regime:{panel_title}")
+            seen.update(int(v) for v in np.unique(grid[:, computed]))
+        ax.set_ylim(len(labels) - 0.5, -0.5)
+        ax.set_yticks(range(len(labels)), labels)
+        ax.set_title(panel_title, fontsize=11)
+    axes[-1].set_xlabel(_FREQUENCY)
+    shown = [r for r in flags if int(r) in seen]
+    figure_legend(fig, [], [Patch(color=REGIME_COLOURS[r], label=regime_label(r)) for r in shown], columns=3)
+    caption = (
+        f"{lead} (the dataset's regime flag, its value in brackets), one colour per flag. Points of a coarser "
+        f"simulation grid span halfway to their neighbours. Present: {', '.join(r.name.lower() for r in shown)}."
+    )
+    return DrawnFigure(fig, name, title, caption)
+
+
+def stability_figure(part: xr.Dataset, name: str) -> DrawnFigure:
+    """Largest Floquet multiplier modulus of the pgf one-impact orbit against frequency."""
+    lines = series_by_restitution(part)
+    f = part["frequency"].values
+    fig, axes = new_figure(1, panel_height=3.8, legend_rows=legend_rows(len(lines) + 1, 6))
+    ax = axes[0]
+    for i, (text, line) in enumerate(lines):
+        draw_curve(ax, f, line["floquet_modulus"].sel(solution="pgf").values, colour=series_colour(i), label=text, gid="pgf", coarse=f.size < COARSE_GRID_POINTS)
+    ax.axhline(1.0, color="k", lw=1.0, label="stability limit 1")
+    finish_axes(ax, _FREQUENCY, axis_label("floquet_modulus"), f"{solution_ref('pgf')}: stability of the one-impact orbit, {clearance_text(part)}", log=True)
+    figure_legend(fig, axes, columns=6)
+    caption = (
+        f"{QUANTITIES['floquet_modulus'].label} of the exact one-impact orbit of {solution_ref('pgf')} (monodromy = impact "
+        "saltation matrix x exact flow over the period), one colour per restitution ratio. Above 1 the orbit exists but "
+        "is unstable: a simulation started on it leaves it."
+    )
+    return DrawnFigure(fig, name, f"Stability of the one-impact orbit, {clearance_text(part)}", caption)
+
+
+def simulation_figure(part: xr.Dataset, quantity: str, engines: list[str], name: str) -> DrawnFigure | None:
+    """Simulations against the closed form, one panel per restitution ratio (paper figures 21-24)."""
+    q = QUANTITIES[quantity]
+    lines = series_by_restitution(part)
+    present = [str(s) for s in part["solution"].values]
+    f = part["frequency"].values
+    drawn = [e for e in engines if np.isfinite(part[quantity].sel(solution=e).values).any()]
+    if not drawn:
+        return None
+    closed = "pgf" if "pgf" in present else None
+    caption = Caption(f"{q.label} ({q.meaning}) against frequency, {clearance_text(part)}: one panel per restitution ratio.")
+    fig, axes = new_figure(len(lines), panel_height=3.5, legend_rows=legend_rows(2 + 2 * len(drawn) + 2))
+    markers: dict[str, tuple[bool, bool]] = {}
+    any_unstable = False
+    for ax, (text, line) in zip(axes, lines):
+        if "linear" in present and quantity != "impulse":
+            draw_linear(ax, f, line[quantity].sel(solution="linear").values)
+            caption.add("linear", "LIN (dotted black): the linear system (no stop).")
+        if closed is not None:
+            _, unstable = draw_curve(ax, f, line[quantity].sel(solution=closed).values, colour=SOLUTION_COLOURS[closed], label=solution_ref(closed), gid=closed, unstable=_unstable(line, closed))
+            any_unstable |= unstable
+            caption.add("closed", f"{solution_ref(closed)} (blue line): the {SOLUTION_DESCRIPTIONS[closed]}.")
+        for engine in drawn:
+            values = line[quantity].sel(solution=engine).values
+            periodic, irregular = draw_points(ax, f, values, periodic=_periodic(line, engine, values.shape), solution=engine, colour=SOLUTION_COLOURS[engine], label=solution_ref(engine))
+            old = markers.get(engine, (False, False))
+            markers[engine] = (old[0] or periodic, old[1] or irregular)
+        finish_axes(ax, _FREQUENCY, axis_label(quantity), text, log=q.log)
+    if any_unstable:
+        caption.add("unstable", f"{solution_ref(closed)} dashed: the one-impact orbit exists but is unstable (Floquet).")
+    caption.add("engines", _simulation_phrase(markers))
+    figure_legend(fig, axes, stability_keys() if any_unstable else [])
+    return DrawnFigure(fig, name, f"Simulation against the closed form: {q.label}, {clearance_text(part)}", caption.text())
