@@ -67,7 +67,7 @@ def test_restitution_and_peak_acceleration_match_one_collision(xi: float) -> Non
 def test_restitution_limits_and_monotony() -> None:
     xi = np.linspace(0.0, 20.0, 4001)
     r = np.array([restitution_from_loss_factor(x) for x in xi])
-    assert r[0] == 1.0 and np.all(np.diff(r) < 0)
+    assert r[0] == 1.0 and np.all(np.diff(r) < 0)  # exact: R(0) = exp(0)
     assert restitution_from_loss_factor(1.0) == pytest.approx(math.exp(-2.0), rel=1e-15)
     # continuous through critical damping, from both sides
     assert restitution_from_loss_factor(1.0 - 1e-9) == pytest.approx(math.exp(-2.0), rel=1e-8)
@@ -94,9 +94,9 @@ def test_bumper_force_law() -> None:
     """Eq. 25: no force before contact, K x + B v while pushing, never pulling."""
     bumper = KelvinVoigtBumper(clearance=3e-3, frequency=250.0, loss_factor=0.5)
     m2 = 0.1
-    assert bumper.force(m2, 2.9e-3, 1.0) == 0.0
+    assert bumper.force(m2, 2.9e-3, 1.0) == 0.0  # exact: no contact: force set to 0
     assert bumper.force(m2, 3.1e-3, 0.2) == pytest.approx(bumper.stiffness(m2) * 1e-4 + bumper.damping(m2) * 0.2)
-    assert bumper.force(m2, 3.0001e-3, -5.0) == 0.0
+    assert bumper.force(m2, 3.0001e-3, -5.0) == 0.0  # exact: released: force set to 0
     assert bumper.stiffness(m2) == pytest.approx(m2 * (2 * math.pi * 250.0) ** 2)
 
 

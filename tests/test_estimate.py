@@ -35,7 +35,7 @@ def test_predicted_integration_matches_what_the_run_does() -> None:
     scene = parse_scene(small_scene())
     assert scene.simulation is not None
     periods, scale = _periods(scene)
-    assert scale == 1.0
+    assert scale == 1.0  # exact: no subsampling: factor set to 1
     predicted = periods[0, 0]
     case = SimulationCase("momentary", scene.system, scene.amplitude, 0.2, 0.003, tuple(scene.simulation.frequency), "pgf", scene.simulation.engine, scene.simulation.steady)
     used = run_case(case)["periods_used"]

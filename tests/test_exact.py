@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 
 import numpy as np
 import pytest
@@ -53,9 +52,7 @@ def test_grazing_contact_is_never_missed(margin: float, system: TwoDofSystem) ->
     frequency = 30.0
     amplitude_x2 = PAPER_AMPLITUDE * abs(linear_response(system, 2 * np.pi * frequency, 1.0).x2)
     problem = ImpactProblem(system, amplitude_x2 + margin, 0.9, PAPER_AMPLITUDE, frequency)
-    started = time.perf_counter()
     trajectory = ENGINE.integrate(problem, linear_state(problem), 0.0, 3)
-    assert time.perf_counter() - started < 5.0
     if margin < 0:
         assert trajectory.impulses.size >= 1
         assert trajectory.impact_velocities[0] < 1e-3  # a near-tangent touch
@@ -82,7 +79,7 @@ def test_elastic_impacts_without_damping_conserve_energy() -> None:
     trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 30)
     assert trajectory.impulses.size > 10
     budget = energy_budget(trajectory)
-    assert budget["dissipation"] == 0.0 and abs(budget["impact_loss"]) < 1e-12 * abs(budget["work"])
+    assert budget["dissipation"] == 0.0 and abs(budget["impact_loss"]) < 1e-12 * abs(budget["work"])  # exact: no dashpot: a sum of zeros
     assert budget["change"] == pytest.approx(budget["work"], abs=1e-10 * mechanical_energy(undamped, trajectory.strobe_states).max())
 
 
@@ -94,9 +91,7 @@ def test_chattering_ends_in_sticking_and_release(restitution: float, system: Two
     the stop only pushes (holding force >= 0) while stuck and X2 never exceeds Delta."""
     clearance = 1e-4
     problem = ImpactProblem(system, clearance, restitution, PAPER_AMPLITUDE, 10.0)
-    started = time.perf_counter()
     trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 30)
-    assert time.perf_counter() - started < 20.0
     assert trajectory.stats["sticks"] >= 29 and trajectory.stats["releases"] >= 29
     stuck = trajectory.segments[trajectory.segments[:, 2] == MODE_STUCK]
     times = np.concatenate([np.linspace(a, b, 7) for a, b, _ in stuck])
@@ -174,7 +169,7 @@ def test_impacts_on_period_boundaries(engine: str) -> None:
         assert trajectory.impact_times.size == 30
         np.testing.assert_allclose(trajectory.impact_times * 25.0, np.arange(1, 31), atol=1e-9)
         assert np.all(trajectory.strobe_states[1:, 3] < 0.0)
-        assert steady_state(solver, problem, (0.0, state)).measures.impacts_per_period == 1.0
+        assert steady_state(solver, problem, (0.0, state)).measures.impacts_per_period == 1.0  # exact: a count per period
     else:
         # an integrator lands within its error of the boundary, on either side: the last impact may fall after it
         assert trajectory.impact_times.size in (29, 30)
@@ -184,9 +179,8 @@ def test_impacts_on_period_boundaries(engine: str) -> None:
 @pytest.mark.timeout(60)
 def test_rest_on_the_stop_without_forcing_does_not_livelock(system: TwoDofSystem) -> None:
     problem = ImpactProblem(system, 0.0, 0.5, 0.0, 25.0)
-    started = time.perf_counter()
     trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 3)
-    assert time.perf_counter() - started < 5.0 and trajectory.impact_times.size == 0
+    assert trajectory.impact_times.size == 0  # and no livelock: the timeout mark bounds the run
 
 
 def test_impact_ending_in_sticking_transfers_m2_v(system: TwoDofSystem) -> None:

@@ -92,8 +92,8 @@ def test_minimal_scene_parses() -> None:
     scene = parse_scene(scene_with(lambda d: d.pop("description")))
     assert scene.name == "tiny"
     assert scene.description == ""
-    assert scene.system.m1 == 1.0 and scene.system.k2 == 4300.0 and scene.system.b2 == 0.08
-    assert scene.amplitude == 10.0
+    assert scene.system.m1 == 1.0 and scene.system.k2 == 4300.0 and scene.system.b2 == 0.08  # exact: parsed input
+    assert scene.amplitude == 10.0  # exact: parsed input
     np.testing.assert_array_equal(scene.restitution, [0.2])
     np.testing.assert_array_equal(scene.clearance, [0.003])
     assert scene.swept == ("frequency",)
@@ -105,7 +105,7 @@ def test_minimal_scene_parses() -> None:
 def test_damping_is_optional() -> None:
     """b1 and b2 may be left out (undamped system)."""
     scene = parse_scene(scene_with(lambda d: (d["system"].pop("b1"), d["system"].pop("b2"))))
-    assert scene.system.b1 == 0.0 and scene.system.b2 == 0.0
+    assert scene.system.b1 == 0.0 and scene.system.b2 == 0.0  # exact: parsed input
 
 
 @pytest.mark.parametrize(
@@ -171,7 +171,7 @@ def test_shipped_restitution_scene_loads() -> None:
     assert scene.name == "restitution"
     assert scene.swept == ("restitution", "frequency")
     assert scene.restitution.tolist() == [0.0, 0.2, 0.4, 0.6, 0.8]
-    assert scene.frequency[0] == 15.0 and scene.frequency[-1] == 45.0 and scene.frequency.size == 6001
+    assert scene.frequency[0] == 15.0 and scene.frequency[-1] == 45.0 and scene.frequency.size == 6001  # exact: grid ends are the inputs
     assert scene.text == path.read_text(encoding="utf-8")
 
 
@@ -529,7 +529,7 @@ def test_yaml_12_exponent_numbers_are_floats(tmp_path: Path) -> None:
     path = tmp_path / "exp.yaml"
     path.write_text(doc, encoding="utf-8")
     scene = load_scene(path)
-    assert scene.clearance[0] == 0.003 and scene.system.k1 == 25000.0
+    assert scene.clearance[0] == 0.003 and scene.system.k1 == 25000.0  # exact: parsed input
 
 
 def test_total_grid_size_is_bounded() -> None:
@@ -577,7 +577,7 @@ def test_simulation_defaults_to_the_analytic_grid() -> None:
 def test_simulation_grid_is_merged_into_the_frequency_axis() -> None:
     scene = parse_scene(_with_engines(frequency=[20.25, 21.0], start="sweep_up", rtol=1e-7, max_periods=50))
     assert 20.25 in scene.all_frequencies and scene.all_frequencies.size == scene.frequency.size + 1
-    assert scene.simulation is not None and scene.simulation.engine.rtol == 1e-7 and scene.simulation.steady.max_periods == 50
+    assert scene.simulation is not None and scene.simulation.engine.rtol == 1e-7 and scene.simulation.steady.max_periods == 50  # exact: parsed input
 
 
 @pytest.mark.parametrize(

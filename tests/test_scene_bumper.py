@@ -79,7 +79,7 @@ def test_swept_sine_settings() -> None:
     assert scene.swept_sine is not None and scene.sweep_directions == ("down",)
     sweep = scene.swept_sine.sweep(10.0, "down")
     assert (sweep.start_frequency, sweep.stop_frequency, sweep.alpha, sweep.duration) == (26.0, 20.0, -0.5, 12.0)
-    assert scene.swept_sine.window_cycles == 4 and scene.swept_sine.sample_rate == 1000.0
+    assert scene.swept_sine.window_cycles == 4 and scene.swept_sine.sample_rate == 1000.0  # exact: parsed input
 
 
 @pytest.mark.parametrize(
@@ -133,4 +133,4 @@ def test_default_tolerances_follow_the_guidance() -> None:
     swept = parse_scene(sweep_scene())
     assert swept.simulation is not None and (swept.simulation.engine.rtol, swept.simulation.engine.atol) == DEFAULT_TOLERANCES["swept"] == (1e-7, 1e-11)
     given = parse_scene(sweep_scene() | {"simulation": {"rtol": 1e-6}})  # atol follows: rtol x 1e-4 m, as measured
-    assert given.simulation is not None and given.simulation.engine.rtol == 1e-6 and given.simulation.engine.atol == pytest.approx(1e-10)
+    assert given.simulation is not None and given.simulation.engine.rtol == 1e-6 and given.simulation.engine.atol == pytest.approx(1e-10)  # exact: parsed input

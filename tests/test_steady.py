@@ -37,7 +37,7 @@ def test_exact_steady_state_equals_pgf(system: TwoDofSystem, frequency: float, r
     result = steady_state(ExactEngine(), problem, "pgf", SteadySettings(tolerance=1e-11, max_periods=3000))
     expected = pgf_values(system, frequency, restitution)
     m = result.measures
-    assert result.converged and result.multiplicity == 1 and m.impacts_per_period == 1.0
+    assert result.converged and result.multiplicity == 1 and m.impacts_per_period == 1.0  # exact: a count per period
     assert abs(m.x1) == pytest.approx(expected["x1"], rel=1e-9)
     assert abs(m.x2) == pytest.approx(expected["x2"], rel=1e-9)
     assert abs(m.force) == pytest.approx(expected["force"], rel=1e-9)
@@ -67,7 +67,7 @@ def test_measured_linear_motion_has_exact_harmonics_and_rms(system: TwoDofSystem
     state = np.array([response.x1.real, response.x2.real, (1j * problem.omega * response.x1).real, (1j * problem.omega * response.x2).real])
     result = steady_state(ExactEngine(), problem, (0.0, state), SteadySettings(tolerance=1e-10))
     m = result.measures
-    assert result.integrated and m.impacts_per_period == 0.0
+    assert result.integrated and m.impacts_per_period == 0.0  # exact: a count per period
     assert m.x1 == pytest.approx(complex(response.x1), rel=1e-11)
     assert m.x2_rms == pytest.approx(abs(response.x2) / np.sqrt(2), rel=1e-11)
     assert abs(m.force) == pytest.approx(abs(response.force), rel=1e-11)
@@ -93,7 +93,7 @@ def test_stepped_sweep_lands_on_the_stable_orbits(system: TwoDofSystem, start: s
     result = simulate.run_case(case)
     for i, frequency in enumerate(case.frequencies):
         expected = pgf_values(system, frequency, 0.2)
-        assert result["converged"][i] == 1.0 and result["impacts_per_period"][i] == 1.0
+        assert result["converged"][i] == 1.0 and result["impacts_per_period"][i] == 1.0  # exact: flags and counts
         assert abs(result["x1"][i]) == pytest.approx(expected["x1"], rel=1e-7)
 
 
@@ -126,7 +126,7 @@ def test_a_failing_point_costs_only_itself(system: TwoDofSystem, monkeypatch: py
     real = simulate.steady_state
 
     def flaky(engine: object, problem: ImpactProblem, start: object, settings: SteadySettings) -> object:
-        if problem.frequency == 25.0:
+        if problem.frequency == 25.0:  # exact: a grid value
             raise RuntimeError("CVODE failed (simulated)")
         return real(engine, problem, start, settings)  # type: ignore[arg-type]
 

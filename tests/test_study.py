@@ -88,7 +88,7 @@ def test_only_requested_quantities_and_unswept_parameters_as_scalars() -> None:
     ds = run_study(scene, progress=None)
     assert set(ds.data_vars) == {"impulse", "regime"}
     assert ds["impulse"].dims == ("solution", "frequency")
-    assert float(ds["clearance"]) == 0.003 and float(ds["restitution"]) == 0.2
+    assert float(ds["clearance"]) == 0.003 and float(ds["restitution"]) == 0.2  # exact: input coordinates
 
 
 def test_write_is_atomic_and_leaves_no_temporary(golden_run: xr.Dataset, tmp_path: Path) -> None:
@@ -132,12 +132,12 @@ def test_simulated_solutions_join_the_dataset(tmp_path: Path) -> None:
             assert int(values.notnull().sum()) == 3
             for f in (24.5, 25.1):
                 point = ds.sel(solution=engine, frequency=f)
-                assert int(point["converged"]) == 1 and float(point["impacts_per_period"]) == 1.0
+                assert int(point["converged"]) == 1 and float(point["impacts_per_period"]) == 1.0  # exact: a count per period
                 assert int(point["regime"]) == Regime.ONE_IMPACT
                 assert float(point["x1_amplitude"]) == pytest.approx(float(ds["x1_amplitude"].sel(solution="pgf", frequency=f)), rel=1e-6)
                 assert float(point["impulse"]) == pytest.approx(float(ds["impulse"].sel(solution="pgf", frequency=f)), rel=1e-6)
             linear_point = ds.sel(solution=engine, frequency=30.0)
-            assert int(linear_point["regime"]) == Regime.LINEAR and float(linear_point["impacts_per_period"]) == 0.0
+            assert int(linear_point["regime"]) == Regime.LINEAR and float(linear_point["impacts_per_period"]) == 0.0  # exact: a count per period
         assert int(ds["converged"].sel(solution="pgf", frequency=25.1)) == -1
     page = (tmp_path / "o" / "report.html").read_text()
     assert "Simulation against PGF by band" in page and (tmp_path / "o" / "simulation_x1_amplitude.png").is_file()

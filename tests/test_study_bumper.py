@@ -90,7 +90,7 @@ def test_compliant_peaks_and_amplitudes_approach_the_rigid_values(stiffness_run:
     for error in (x1, peak, force):
         ratio = (error.sel(bumper_frequency=500.0) / error.sel(bumper_frequency=4000.0)).values
         assert np.all((ratio > 6.0) & (ratio < 10.0)), ratio
-    assert np.all(ds["impacts_per_period"].sel(solution="compliant").values == 1.0)
+    assert np.all(ds["impacts_per_period"].sel(solution="compliant").values == 1.0)  # exact: a count per period
 
 
 def test_swept_loss_factor_becomes_the_dimension() -> None:

@@ -303,16 +303,16 @@ def _cases() -> list[HardCase]:
     )
     for restitution in (0.0, 0.05):
         problem = ImpactProblem(PAPER_SYSTEM, 1e-4, restitution, PAPER_AMPLITUDE, 10.0)
-        rigid_impacts = "same" if restitution == 0.0 else "free"
-        note = "" if restitution == 0.0 else chatter_note
-        times = 1e-7 if restitution == 0.0 else None
+        rigid_impacts = "same" if restitution == 0.0 else "free"  # exact: the table's input R
+        note = "" if restitution == 0.0 else chatter_note  # exact: the table's input R
+        times = 1e-7 if restitution == 0.0 else None  # exact: the table's input R
         add(HardCase(
             f"chatter-R{restitution:g}", "quasi-static forcing presses the absorber on the stop: Zeno chatter, sticking, release, every period", problem, _rest(), 30,
             per_engine(
                 exact(sticking=True),
                 integrated(impacts=rigid_impacts, times=times, sticking=True, note=note or "times to 1e-7 s (measured 2e-8 BDF, 4e-8 Radau)"),
                 integrated(impacts=rigid_impacts, times=times, sticking=True, note=note or "times to 1e-7 s (measured 4e-8 Radau)"),
-                NotRun("R = 0 needs an infinitely damped bumper") if restitution == 0.0 else Expect(
+                NotRun("R = 0 needs an infinitely damped bumper") if restitution == 0.0 else Expect(  # exact: the table's input R
                     impacts="free", x1=1e-4,
                     note="a bumper has no sticking: a few resolved bounces, then a long pressed contact (64 contacts against 194 impacts); |X1| to 1e-4 (measured 7e-6)",
                 ),

@@ -46,7 +46,7 @@ def _after_states(trajectory: Trajectory) -> tuple[np.ndarray, np.ndarray]:
         if i < starts.size and starts[i] == t:
             states[k], modes[k] = trajectory.segment_states[i], trajectory.segments[i, 2]
         elif t == trajectory.strobe_times[-1]:
-            states[k], modes[k] = trajectory.final_state, MODE_FREE if trajectory.final_state[3] != 0.0 else MODE_STUCK
+            states[k], modes[k] = trajectory.final_state, MODE_FREE if trajectory.final_state[3] != 0.0 else MODE_STUCK  # exact: a stuck absorber's velocity is set to 0
         else:
             raise AssertionError(f"impact at t = {t!r} s starts no segment")
     return states, modes

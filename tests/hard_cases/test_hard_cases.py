@@ -66,7 +66,7 @@ def judge(case: HardCase, engine: str, expect: Expect, m: dict[str, float]) -> l
 
     # always
     if engine in RIGID:
-        require(m["law_speed"] == 0.0, f"{m['law_speed']:g} impacts with a pre-impact speed <= 0")
+        require(m["law_speed"] == 0.0, f"{m['law_speed']:g} impacts with a pre-impact speed <= 0")  # exact: a count
         at_most("law_position", 0.0, "absorber not at the stop just after an impact [m]")
         at_most("law_velocity", 1e-12, "X2'+ = -R X2'- (or 0 when it sticks), relative error")
         at_most("law_impulse", 1e-12, "impulse M2 (1 + R) X2'- (or M2 X2'- when it sticks), relative error")
