@@ -11,7 +11,7 @@ import functools
 import io
 import itertools
 import struct
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 import xarray as xr
@@ -171,6 +171,86 @@ def benchmark_dataset() -> xr.Dataset:
     )
 
 
+@functools.cache
+def stiffness_dataset() -> xr.Dataset:
+    """A bumper-stiffness study's shape: pgf, exact and compliant at two frequencies and three bumpers (made up)."""
+    document: dict[str, Any] = {
+        "name": "tiny_stiffness",
+        "system": dict(PAPER_SYSTEM_SPEC),
+        "excitation": {"amplitude": 10.0},
+        "stop": {"clearance": 0.003, "restitution": 0.2},
+        "sweep": {"bumper_frequency": [250.0, 1000.0, 4000.0], "frequency": [24.0, 25.0]},
+        "solutions": ["pgf", "exact", "compliant"],
+        "quantities": ["x1_amplitude", "regime", "wall_time"],
+        "simulation": {"start": "pgf"},
+    }
+    bumper = np.array(document["sweep"]["bumper_frequency"])
+    rigid = np.array([2.0e-3, 2.5e-3])
+    x1 = np.empty((3, 3, 2))
+    x1[0], x1[1] = rigid, rigid * (1.0 + 1e-9)
+    x1[2] = rigid * (1.0 + 10.0 / bumper[:, None])
+    wall = np.broadcast_to(np.array([np.nan, 0.05, 0.0])[:, None, None], (3, 3, 2)).copy()
+    wall[2] = 0.001 * bumper[:, None] * np.ones(2)
+    dims = ("solution", "bumper_frequency", "frequency")
+    return xr.Dataset(
+        {"x1_amplitude": (dims, x1), "wall_time": (dims, wall), "regime": (dims, np.full((3, 3, 2), int(Regime.ONE_IMPACT), dtype=np.int8))},
+        coords={"solution": ["pgf", "exact", "compliant"], "bumper_frequency": bumper, "frequency": [24.0, 25.0], "restitution": 0.2, "clearance": 0.003},
+        attrs={"scene": yaml.safe_dump(document)},
+    )
+
+
+def scene_of(dataset: xr.Dataset) -> Any:
+    """The scene stored in ``dataset``."""
+    from vibroimpact.scene import read_yaml
+
+    return parse_scene(read_yaml(dataset.attrs["scene"]), text=dataset.attrs["scene"])
+
+
+def _one_regime_panel() -> xr.Dataset:
+    ds = steady_dataset(engines=(), restitution=(0.2,), step=0.5)
+    return ds.sel(solution=["pgf"])
+
+
+def _builders() -> dict[str, Callable[[], list[Any]]]:
+    """Every kind of report figure, each built from a tiny dataset: name -> () -> list of DrawnFigure."""
+    from vibroimpact.accuracy_report import accuracy_figures
+    from vibroimpact.bumper_report import peak_acceleration_figure, peak_figure, stiffness_figure
+    from vibroimpact.report_responses import linear_figure, regime_figure, response_figure, simulation_figure, stability_figure
+    from vibroimpact.scene import ENGINE_SOLUTIONS
+    from vibroimpact.sweep_report import sweep_figures
+
+    def steady() -> xr.Dataset:
+        return steady_dataset()
+
+    return {
+        "linear": lambda: [linear_figure(scene_of(steady()))],
+        "response_x1": lambda: [response_figure(steady(), "x1_amplitude", "x1")],
+        "response_force": lambda: [response_figure(steady(), "force_amplitude", "force")],
+        "response_impulse": lambda: [response_figure(steady(), "impulse", "impulse")],
+        "regime": lambda: [regime_figure(steady(), "regime")],
+        "regime_one_row": lambda: [regime_figure(_one_regime_panel(), "regime")],
+        "stability": lambda: [stability_figure(steady(), "stability")],
+        "simulation_x1": lambda: [simulation_figure(steady(), "x1_amplitude", list(ENGINE_SOLUTIONS), "sim")],
+        "simulation_impulse": lambda: [simulation_figure(steady(), "impulse", list(ENGINE_SOLUTIONS), "sim")],
+        "peak_acceleration": lambda: [peak_acceleration_figure(steady(), "peak")],
+        "peaks_vs_restitution": lambda: [peak_figure(steady(), scene_of(steady()), "restitution", "peaks")],
+        "sweep": lambda: sweep_figures(swept_dataset(), scene_of(swept_dataset())),
+        "stiffness": lambda: [stiffness_figure(stiffness_dataset(), scene_of(stiffness_dataset()), "stiffness")],
+        "work_precision": lambda: accuracy_figures(benchmark_dataset()),
+    }
+
+
+#: Names of :func:`build` figure kinds, for parametrised tests.
+FIGURE_KINDS = ("linear", "response_x1", "response_force", "response_impulse", "regime", "regime_one_row", "stability", "simulation_x1", "simulation_impulse", "peak_acceleration", "peaks_vs_restitution", "sweep", "stiffness", "work_precision")
+
+
+def build(kind: str) -> list[Any]:
+    """The drawn figures of ``kind`` (one of :data:`FIGURE_KINDS`); close them after use."""
+    figures = _builders()[kind]()
+    assert figures and all(f is not None for f in figures), kind
+    return figures
+
+
 # ------------------------------------------------------------------------------------------- inspectors
 def visible(line: Line2D) -> np.ndarray:
     """Which data points of ``line`` show: a marker at every finite point, or a line segment to a finite neighbour
@@ -299,3 +379,7 @@ def test_overlapping_titles_and_legends_on_panels_are_found() -> None:
     assert any("lies on the panel" in p for p in problems), problems
     assert any("6.0 pt" in p for p in problems), problems
     plt.close(fig)
+
+
+def test_every_figure_kind_is_listed() -> None:
+    assert set(FIGURE_KINDS) == set(_builders())

@@ -15,6 +15,7 @@ import numpy as np
 import xarray as xr
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
+from matplotlib.ticker import NullFormatter
 
 from .regime import Regime
 from .report_common import DrawnFigure, Table
@@ -221,6 +222,10 @@ def stiffness_figure(dataset: xr.Dataset, scene: Scene, name: str) -> DrawnFigur
         ax.axhline(rigid, color="k", ls=":", lw=1.2, label=f"{reference} (median)", gid=reference)
         finish_axes(ax, "bumper frequency Omega_b / 2 pi [Hz]", "wall time per steady state [s]", "Cost of the compliant model")
         caption.add("cost", f"Right: the wall time of each steady state of {solution_ref('compliant')} (transient plus measurement, one process); dotted: the median of {solution_ref(reference)}.")
+    for ax in axes:
+        # ticks at the bumpers computed: read off directly, and no crowded minor-tick labels on a short log axis
+        ax.set_xticks(bumper, [f"{b:g}" for b in bumper])
+        ax.xaxis.set_minor_formatter(NullFormatter())
     figure_legend(fig, axes, columns=6)
     return DrawnFigure(fig, name, "Compliant bumper against the rigid stop", caption.text())
 
