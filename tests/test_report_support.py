@@ -227,6 +227,7 @@ def _builders() -> dict[str, Callable[[], list[Any]]]:
         "response_x1": lambda: [response_figure(steady(), "x1_amplitude", "x1")],
         "response_force": lambda: [response_figure(steady(), "force_amplitude", "force")],
         "response_impulse": lambda: [response_figure(steady(), "impulse", "impulse")],
+        "response_pgf_compliant": lambda: [response_figure(steady().sel(solution=["linear", "pgf", "compliant"]), "x1_amplitude", "x1")],
         "regime": lambda: [regime_figure(steady(), "regime")],
         "regime_one_row": lambda: [regime_figure(_one_regime_panel(), "regime")],
         "stability": lambda: [stability_figure(steady(), "stability")],
@@ -241,7 +242,7 @@ def _builders() -> dict[str, Callable[[], list[Any]]]:
 
 
 #: Names of :func:`build` figure kinds, for parametrised tests.
-FIGURE_KINDS = ("linear", "response_x1", "response_force", "response_impulse", "regime", "regime_one_row", "stability", "simulation_x1", "simulation_impulse", "peak_acceleration", "peaks_vs_restitution", "sweep", "stiffness", "work_precision")
+FIGURE_KINDS = ("linear", "response_x1", "response_force", "response_impulse", "response_pgf_compliant", "regime", "regime_one_row", "stability", "simulation_x1", "simulation_impulse", "peak_acceleration", "peaks_vs_restitution", "sweep", "stiffness", "work_precision")
 
 
 def build(kind: str) -> list[Any]:

@@ -109,13 +109,13 @@ def linear_figure(scene: Scene) -> DrawnFigure:
     fit = fit_modal_parameters(system) if underdamped_mode_count(system) == 2 else None
     fig, axes = new_figure(3, panel_height=3.6, legend_rows=2)
     ax = axes[0]
-    ax.semilogy(f, np.abs(response.x1), label="|X1| primary", color="C0", lw=1.4)
-    ax.semilogy(f, np.abs(response.x2), label="|X2| absorber", color="C1", lw=1.4)
+    ax.semilogy(f, np.abs(response.x1), label="|X1| primary", color="C0", lw=1.4, gid="linear")
+    ax.semilogy(f, np.abs(response.x2), label="|X2| absorber", color="C1", lw=1.4, gid="linear")
     for delta in scene.clearance:
         ax.axhline(delta, color="k", lw=0.9, ls="--")
     finish_axes(ax, _FREQUENCY, "amplitude [m]", "Linear responses (paper fig. 2)")
     ax = axes[1]
-    ax.semilogy(f, np.abs(response.force), color="C2", lw=1.4)
+    ax.semilogy(f, np.abs(response.force), color="C2", lw=1.4, gid="linear")
     finish_axes(ax, _FREQUENCY, "|F| on the base [N]", "Linear force on the base (paper fig. 3)")
     ax = axes[2]
     ax.semilogy(f, np.abs(system.receptances(w).h22), label="|H22| exact (eq. 4)", lw=1.4)
