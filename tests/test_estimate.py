@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 from vibroimpact import cli
-from vibroimpact.estimate import _periods, estimate_scene, per_period_cost
+from vibroimpact.estimate import SPEED_FACTOR_RANGE, _periods, estimate_scene, per_period_cost, speed_factor
 from vibroimpact.scene import load_scene, parse_scene, shipped_studies_dir
 from vibroimpact.simulate import SimulationCase, run_case
 from vibroimpact.study import run_study
@@ -97,5 +97,15 @@ def test_cli_estimate_runs_nothing(tmp_path: Path, capsys: object) -> None:
 
 def test_every_shipped_study_has_an_estimate() -> None:
     for path in sorted(shipped_studies_dir().glob("*.yaml")):
-        estimate = estimate_scene(load_scene(path), jobs=2)
+        estimate = estimate_scene(load_scene(path), jobs=2, speed=1.0)
         assert 1.0 < estimate.wall_time < 3600.0, path.name
+
+
+def test_a_slower_machine_gets_a_longer_prediction() -> None:
+    """The prediction scales with the measured machine speed; the probe's own factor is a bounded positive number."""
+    scene = parse_scene(small_scene())
+    calibration, slower = estimate_scene(scene, jobs=1, speed=1.0), estimate_scene(scene, jobs=1, speed=2.5)
+    assert slower.wall_time == pytest.approx(2.5 * calibration.wall_time)
+    assert all(slower.parts[name] == pytest.approx(2.5 * seconds) for name, seconds in calibration.parts.items())
+    assert slower.memory == calibration.memory and "2.50 x" in slower.text()
+    assert SPEED_FACTOR_RANGE[0] <= speed_factor() <= SPEED_FACTOR_RANGE[1]

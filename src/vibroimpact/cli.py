@@ -44,8 +44,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.list:
-        for name, description in shipped_studies():
-            print(f"{name:<20} {description}")
+        print("\n".join(f"{name:<20} {description}" for name, description in shipped_studies()))
         return 0
     if args.scene is None:
         parser.print_usage(sys.stderr)

@@ -140,5 +140,6 @@ COSTS: dict = {'closed_form_per_point': {'linear': 3.6e-07, 'pgf': 0.000161, 'pg
                                           0.001: 0.09948044529992331}},
  'report_base': 1.0,
  'report_per_figure': 0.4,
+ 'speed_probe_seconds': 0.083,
  'startup': 2.3,
  'worker_process_memory': 100000000.0}

@@ -10,7 +10,10 @@ The prediction multiplies what the scene asks for by costs measured on this mach
   answer is the linear state (no integration), a short transient plus the measured periods where a stable one-impact
   orbit exists, and ``max_periods`` plus the irregular measurement elsewhere (motion that may never settle);
 * swept sines: seconds per simulated second of the compliant engine at its tolerance;
-* the work is spread over ``jobs`` processes; the report adds a fixed cost per figure.
+* the work is spread over ``jobs`` processes; the report adds a fixed cost per figure;
+* everything is scaled by this machine's speed against the calibration machine's: a probe of about 0.2 s (the same
+  short ``exact`` and ``momentary`` runs, timed at calibration too) measures it, so a slower or busier machine gets a
+  longer prediction.
 
 Memory: the dataset (every variable over the full grid, the running estimates of sweeps), the samples a sweep holds
 while it runs, and the measured footprint of one worker process. It is an estimate: the report of
@@ -35,6 +38,8 @@ __all__ = ["Estimate", "estimate_scene", "per_period_cost", "calibrate"]
 
 #: Periods of a transient that settles on a stable orbit (two convergence chunks), before the measurement.
 SETTLING_PERIODS = 40
+#: Bounds of the machine-speed factor: a probe outside them is a glitch rather than a machine.
+SPEED_FACTOR_RANGE = (0.2, 10.0)
 #: Engine names of the cost table for each time-domain solution (momentary by its CVODE family).
 _ENGINE_KEYS = {"exact": "exact", "compliant": "compliant_ida"}
 
@@ -46,19 +51,22 @@ class Estimate:
     Attributes
     ----------
     wall_time : float
-        Predicted wall time of ``run-study`` [s].
+        Predicted wall time of ``run-study`` [s] (on this machine: ``speed_factor`` included).
     memory : float
         Predicted peak memory of the main process [bytes].
     parts : dict
         Wall time of each part (solution, report) [s], before dividing simulations over processes.
     points : dict
         Time-domain points (or sweeps) per solution, and how many are predicted to integrate.
+    speed_factor : float
+        This machine's time for the speed probe over the calibration machine's [-] (> 1: slower).
     """
 
     wall_time: float
     memory: float
     parts: dict[str, float] = field(default_factory=dict)
     points: dict[str, str] = field(default_factory=dict)
+    speed_factor: float = 1.0
 
     def text(self) -> str:
         """The estimate as printed by ``run-study --estimate``."""
@@ -66,8 +74,37 @@ class Estimate:
         for name, seconds in self.parts.items():
             detail = f" ({self.points[name]})" if name in self.points else ""
             lines.append(f"  {name}: {_duration(seconds)} of work{detail}")
-        lines.append("(costs measured by the accuracy_cost study on this machine kind; an estimate, typically within a factor of 2)")
+        lines.append(
+            f"(costs measured by the accuracy_cost study, scaled by this machine's speed: a probe took {self.speed_factor:.2f} x "
+            "the calibration machine's time; an estimate, typically within a factor of 2)"
+        )
         return "\n".join(lines)
+
+
+def speed_probe(repeats: int = 3) -> float:
+    """Wall time of a fixed short workload, the best of ``repeats`` [s]: 100 periods of ``exact`` and 100 of
+    ``momentary`` (CVODE Adams, rtol 1e-8) at 25 Hz from rest, the kind of work the simulations spend their time on."""
+    import time
+
+    from .engines import EngineSettings, ExactEngine, ImpactProblem
+    from .engines.momentary import MomentaryEngine
+    from .system import PAPER_SYSTEM
+
+    problem = ImpactProblem(PAPER_SYSTEM, 3e-3, 0.2, 10.0, 25.0)
+    engines = (ExactEngine(), MomentaryEngine(EngineSettings(rtol=1e-8, atol=1e-12)))
+    best = math.inf
+    for _ in range(repeats):
+        started = time.perf_counter()
+        for engine in engines:
+            engine.integrate(problem, np.zeros(4), 0.0, 100)
+        best = min(best, time.perf_counter() - started)
+    return best
+
+
+def speed_factor() -> float:
+    """This machine's probe time over the calibration machine's [-], within :data:`SPEED_FACTOR_RANGE`."""
+    low, high = SPEED_FACTOR_RANGE
+    return min(max(speed_probe() / COSTS["speed_probe_seconds"], low), high)
 
 
 def per_period_cost(engine: str, rtol: float) -> float:
@@ -89,11 +126,25 @@ def _interpolate(table: dict[float, float], rtol: float) -> float:
     return float(np.exp(np.interp(np.log(rtol), np.log(tolerances), np.log(seconds))))
 
 
-def estimate_scene(scene: Scene, jobs: int = 1) -> Estimate:
-    """Predict the wall time and peak memory of running ``scene`` with ``jobs`` processes."""
+def estimate_scene(scene: Scene, jobs: int = 1, speed: float | None = None) -> Estimate:
+    """Predict the wall time and peak memory of running ``scene`` with ``jobs`` processes.
+
+    ``speed`` is the machine-speed factor (this machine's time over the calibration machine's); by default it is
+    measured with :func:`speed_factor`."""
     jobs = max(1, jobs)
-    if scene.benchmark is not None:
-        return _estimate_benchmark(scene)
+    speed = speed_factor() if speed is None else speed
+    unscaled = _estimate_benchmark(scene) if scene.benchmark is not None else _estimate_study(scene, jobs)
+    return Estimate(
+        wall_time=unscaled.wall_time * speed,
+        memory=unscaled.memory,
+        parts={name: seconds * speed for name, seconds in unscaled.parts.items()},
+        points=unscaled.points,
+        speed_factor=speed,
+    )
+
+
+def _estimate_study(scene: Scene, jobs: int) -> Estimate:
+    """The estimate of a regular (not benchmark) scene on the calibration machine."""
     parts: dict[str, float] = {}
     points: dict[str, str] = {}
     frequency = scene.all_frequencies
@@ -280,6 +331,7 @@ def calibrate(accuracy: Path) -> dict[str, object]:
     costs = dict(COSTS)
     costs["per_period"] = per_period
     costs["per_sweep_second"] = per_sweep
+    costs["speed_probe_seconds"] = speed_probe()  # on the machine that measured the costs
     return costs
 
 
