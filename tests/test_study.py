@@ -141,3 +141,6 @@ def test_simulated_solutions_join_the_dataset(tmp_path: Path) -> None:
         assert int(ds["converged"].sel(solution="pgf", frequency=25.1)) == -1
     page = (tmp_path / "o" / "report.html").read_text()
     assert "Simulation against PGF by band" in page and (tmp_path / "o" / "simulation_x1_amplitude.png").is_file()
+    # a table of contents, and the simulations' reduction factors counted on their own grid (3 points, all in band 1)
+    assert "<nav id='contents'>" in page and "Reduction factors" in page
+    assert "<td>3 / 0</td><td>0 / 0</td>" in page
