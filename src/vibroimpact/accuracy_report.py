@@ -16,12 +16,18 @@ import xarray as xr
 
 from .benchmark import equal_error_speedup, loosest_tolerance
 from .report_common import DrawnFigure, Table
-from .report_style import figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour
+from .report_style import Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour
 
 __all__ = ["accuracy_figures", "accuracy_tables", "TARGETS"]
 
 #: X1-fundamental accuracies the guidance is given for [-].
 TARGETS = (1e-3, 1e-6)
+#: What each reference is (rigid stop: the exact engine; compliant model: CVODE Adams at a far tighter tolerance).
+#: Per reference: legend text, caption text.
+_REFERENCES = {
+    "exact": ("reference: exact", "the exact engine (rigid-stop methods)"),
+    "compliant_cvode_adams": ("reference: CVODE Adams 1e-13", "CVODE Adams at rtol 1e-13 (compliant model)"),
+}
 _ERRORS = (("x1_error", "relative error of the X1 fundamental [1]"), ("impact_time_error", "largest impact-time error [s]"))
 
 
@@ -30,7 +36,11 @@ def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
     cases = [str(c) for c in dataset["case"].values]
     methods = [str(m) for m in dataset["engine"].values]
     fig, axes = new_figure(2 * len(cases), panel_height=3.6, legend_rows=legend_rows(len(methods) + 4))
-    missed_any = False
+    tolerances = np.sort(np.asarray(dataset["rtol"].values, dtype=float))[::-1]
+    caption = Caption(
+        f"Work-precision, one row per case: one point per tolerance (rtol {tolerances[0]:.0e} ... {tolerances[-1]:.0e} from right to "
+        "left), error against the reference, wall time the median of repeated runs in one process (read ratios, not seconds)."
+    )
     for j, case in enumerate(cases):
         for column, (quantity, label) in enumerate(_ERRORS):
             ax = axes[2 * j + column]
@@ -41,29 +51,25 @@ def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
                     continue
                 missed = line["missed_impacts"].values > 0
                 floor = np.maximum(error, 1e-17)  # an exact zero still gets a point
-                style = "o-" if method.startswith(("momentary", "compliant")) else "s--"
-                ax.loglog(wall, np.where(missed, np.nan, floor), style, color=series_colour(k), ms=4, lw=1.2, label=method, gid=method)
+                ivp = method.startswith("solve_ivp")
+                ax.loglog(wall, np.where(missed, np.nan, floor), "s--" if ivp else "o-", color=series_colour(k), ms=4, lw=1.2, label=method, gid=method)
+                caption.add("ivp" if ivp else "sundials", "Dashed with squares: scipy's solve_ivp." if ivp else "Solid with circles: SUNDIALS engines.")
                 if missed.any():
                     ax.loglog(wall[missed], floor[missed], "x", color=series_colour(k), ms=9, mew=2, label="_nolegend_", gid=method)
-                    missed_any = True
+                    caption.add("missed", "Crosses: runs that missed impacts of the reference (errors floored at 1e-17 where zero).")
             for reference, colour in (("exact", "k"), ("compliant_cvode_adams", "0.5")):
                 value = float(dataset["reference_wall_time"].sel(case=case, reference=reference))
                 if math.isfinite(value):
-                    ax.axvline(value, color=colour, ls=":", lw=1.2, label=f"reference: {reference}" + (" (rtol 1e-13)" if reference != "exact" else ""))
+                    legend, text = _REFERENCES[reference]
+                    ax.axvline(value, color=colour, ls=":", lw=1.3, label=legend)
+                    caption.add(f"reference {reference}", f"Dotted vertical{' (grey)' if colour != 'k' else ''}: the wall time of the reference, {text}.")
             if quantity == "x1_error":
                 for target in TARGETS:
                     ax.axhline(target, color="k", lw=0.6, alpha=0.5)
+                caption.add("targets", f"Thin horizontal lines: the {' and '.join(f'{t:.0e}' for t in TARGETS)} targets.")
             finish_axes(ax, "wall time [s] (median)", label, case)
     figure_legend(fig, axes, columns=4)
-    caption = (
-        "Work-precision, one row per case: one point per tolerance (rtol 1e-3 ... 1e-12 from right to left), error against "
-        "the reference (rigid-stop methods: the exact engine; compliant model: CVODE Adams at rtol 1e-13), wall time the "
-        "median of repeated runs in one process (read ratios, not seconds). Solid with circles: SUNDIALS engines; dashed "
-        "with squares: solve_ivp; dotted verticals: the references' wall times."
-        + (" Crosses: runs that missed impacts of the reference." if missed_any else "")
-        + " Thin horizontal lines: the 1e-3 and 1e-6 targets."
-    )
-    return [DrawnFigure(fig, "work_precision", "Work-precision diagrams", caption)]
+    return [DrawnFigure(fig, "work_precision", "Work-precision diagrams", caption.text())]
 
 
 def accuracy_tables(dataset: xr.Dataset) -> list[Table]:

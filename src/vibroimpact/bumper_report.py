@@ -22,6 +22,7 @@ from .report_common import DrawnFigure, Table
 from .report_responses import clearance_text, series_by_restitution
 from .report_style import (
     ENGINE_MARKERS,
+    OVER_MARKERS_ZORDER,
     QUANTITIES,
     SOLUTION_COLOURS,
     Caption,
@@ -89,7 +90,17 @@ def _peak_rows(dataset: xr.Dataset, scene: Scene, parameter: str) -> list[PeakRo
     return rows
 
 
-_PEAK_LINES = {"pgf": ("-", "C0"), "pgf, stable one-impact orbits only": ((0, (1, 1.5)), "C9"), "pgf on the simulation grid": ("-.", "C7"), "pgf_paper": ("-", "C4")}
+#: Variants of a closed-form peak curve (label suffix): line style, width, and what the caption says of them; wide
+#: solid lines under thinner ones, so that equal curves all show.
+_PEAK_VARIANTS = {
+    "": ("-", 3.0, "wide solid: the closed form on its fine grid, the largest realisable steady state (where the linear motion fits beside an unstable one-impact orbit, the linear one)"),
+    ", stable one-impact orbits only": (":", 1.8, "dotted: stable one-impact orbits only, the curve the paper draws"),
+    " on the simulation grid": ("-.", 1.4, "dash-dot: the closed form on the simulated frequencies only, a like-for-like comparison with the markers"),
+}
+
+
+def _variant(label: str, solution: str) -> str:
+    return label[len(solution) :]
 
 
 def peak_figure(dataset: xr.Dataset, scene: Scene, parameter: str, name: str) -> DrawnFigure:
@@ -98,7 +109,7 @@ def peak_figure(dataset: xr.Dataset, scene: Scene, parameter: str, name: str) ->
     scale, unit = (1e3, "mm") if parameter == "clearance" else (1.0, "-")
     labels = list(dict.fromkeys(r[0] for r in rows))
     fig, axes = new_figure(2, panel_height=3.9, legend_rows=legend_rows(len(labels) + 2, 3))
-    caption = Caption(f"Largest {QUANTITIES['x1_amplitude'].label} in each resonance band against the {parameter} (paper figures 25-26).")
+    caption = Caption(f"Largest {QUANTITIES['x1_amplitude'].label} in each resonance band against the {parameter} (paper figures 25-26); one colour per solution.")
     engines: dict[str, tuple[bool, bool]] = {}
     for band, ax in enumerate(axes):
         for label in labels:
@@ -106,22 +117,18 @@ def peak_figure(dataset: xr.Dataset, scene: Scene, parameter: str, name: str) ->
             solution = chosen[0][1]
             x = np.array([r[2] for r in chosen]) * scale
             y = np.array([r[3 + band][0] for r in chosen])
+            colour = SOLUTION_COLOURS.get(solution, "C5")
             if solution in ENGINE_SOLUTIONS:
-                colour = SOLUTION_COLOURS.get(solution, "C3")
                 ax.plot(x, y, color=colour, lw=0.8, label="_nolegend_", gid=solution)
                 drawn = draw_points(ax, x, y, periodic=np.array([r[5 + band] for r in chosen]), solution=solution, colour=colour, label=solution_ref(solution))
                 engines[solution] = (engines.get(solution, (False, False))[0] or drawn[0], engines.get(solution, (False, False))[1] or drawn[1])
-            else:
-                ls, colour = _PEAK_LINES.get(label, ("--", "C5"))
-                ax.plot(x, y, ls=ls, marker="o", ms=3.5, lw=1.5, color=colour, label=label.replace(solution, solution_ref(solution), 1), gid=solution)
-        finish_axes(ax, f"{parameter} [{unit}]", f"peak {axis_label('x1_amplitude')}", f"resonance band {band + 1} ({'below' if band == 0 else 'above'} the anti-resonance)")
+                continue
+            variant = _variant(label, solution)
+            ls, width, phrase = _PEAK_VARIANTS[variant]
+            ax.plot(x, y, ls=ls, lw=width, marker="o", ms=3.0 + width, color=colour, alpha=0.55 if not variant else 1.0, label=f"{solution_ref(solution)}{variant}", gid=solution)
+            caption.add(f"variant{variant}", f"Closed forms ({', '.join(solution_ref(s) for s in dict.fromkeys(r[1] for r in rows if r[1] not in ENGINE_SOLUTIONS))}), {phrase}." if not variant else f"{phrase[0].upper()}{phrase[1:]}.")
+        finish_axes(ax, f"{parameter} [{unit}]", f"peak {axis_label('x1_amplitude')}", f"Resonance band {band + 1} ({'below' if band == 0 else 'above'} the anti-resonance)")
     figure_legend(fig, axes, columns=3)
-    if "pgf" in labels:
-        caption.add("pgf", f"{solution_ref('pgf')}: the largest realisable steady state (where the linear motion fits beside an unstable one-impact orbit, the linear one).")
-    if "pgf, stable one-impact orbits only" in labels:
-        caption.add("stable", "Dotted: stable one-impact orbits only, the curve the paper draws.")
-    if "pgf on the simulation grid" in labels:
-        caption.add("grid", "Dash-dot: the closed form on the simulated frequencies only, a like-for-like comparison with the markers.")
     if engines:
         kinds = ["filled: the peak is a periodic steady state"] + (["hollow: an irregular motion's average"] if any(i for _, i in engines.values()) else [])
         caption.add("engines", f"Markers: simulations {', '.join(solution_ref(s) for s in engines)} ({'; '.join(kinds)}); where motions coexist, a simulation settles on one of them depending on where it starts (here: near the one-impact orbit).")
@@ -136,7 +143,7 @@ def peak_tables(dataset: xr.Dataset, scene: Scene, parameter: str) -> list[Table
         f"<tr><td>{label}</td><td>{value * scale:g}</td><td>{fmt(p1[0] * 1e3, '.4g')}</td><td>{fmt(p1[1], '.3f')}</td><td>{fmt(p2[0] * 1e3, '.4g')}</td><td>{fmt(p2[1], '.3f')}</td></tr>"
         for label, _, value, p1, p2, _, _ in _peak_rows(dataset, scene, parameter)
     ]
-    return [Table(f"Resonance peaks of |X1| against the {parameter}", f"<table>{header}{''.join(body)}</table>")]
+    return [Table(f"Resonance peaks of |X1| against the {parameter}: values", f"<table>{header}{''.join(body)}</table>")]
 
 
 # -------------------------------------------------------------------------------------- peak acceleration
@@ -158,7 +165,8 @@ def peak_acceleration_figure(part: xr.Dataset, name: str) -> DrawnFigure | None:
     for ax, quantity in zip(axes, quantities):
         for i, (_, line) in enumerate(lines):
             if "pgf" in present:
-                drawn, unstable = draw_curve(ax, f, line[quantity].sel(solution="pgf").values, colour=series_colour(i), label=None, gid="pgf", unstable=line["stable"].sel(solution="pgf").values == 0 if "stable" in line else None)
+                flags = line["stable"].sel(solution="pgf").values == 0 if "stable" in line else None
+                drawn, unstable = draw_curve(ax, f, line[quantity].sel(solution="pgf").values, colour=series_colour(i), label=None, gid="pgf", unstable=flags, zorder=OVER_MARKERS_ZORDER)
                 any_unstable |= unstable
                 if drawn:
                     caption.add("pgf", f"Lines: the estimate from {solution_ref('pgf')}, Gamma(xi_b) Omega_b J / (1 + R) for the force (section 6.3 with the corrected factor Gamma; the deceleration less the absorber spring's pull): the rigid-stop impulse J gives the entry speed, the one-collision solution of the bumper gives the peak.")

@@ -88,7 +88,7 @@ _STYLE = (
     "body{font-family:sans-serif;max-width:1360px;margin:1.5em auto;padding:0 12px;color:#222;line-height:1.4}"
     "table{border-collapse:collapse;margin:0.6em 0;display:block;overflow-x:auto;max-width:100%}"
     "td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}td{white-space:nowrap}"
-    "th{background:#f2f2f2}td:first-child{text-align:left}"
+    "th{background:#f2f2f2}td:first-child,th:first-child{text-align:left}"
     "img{max-width:100%;height:auto;display:block}pre{background:#f4f4f4;padding:1em;overflow:auto}"
     "figure{margin:1.2em 0 2em 0}figcaption{font-size:95%;color:#333;max-width:1320px}"
     "nav{background:#f7f7f7;border:1px solid #ddd;padding:0.4em 1.2em;margin:1em 0}nav ol{margin:0.2em 0}"

@@ -21,6 +21,7 @@ from .report_common import DrawnFigure
 from .report_style import (
     ENGINE_MARKERS,
     LINEAR_STYLE,
+    OVER_MARKERS_ZORDER,
     QUANTITIES,
     RAW_STYLE,
     REGIME_COLOURS,
@@ -118,10 +119,10 @@ def linear_figure(scene: Scene) -> DrawnFigure:
     ax.semilogy(f, np.abs(response.force), color="C2", lw=1.4, gid="linear")
     finish_axes(ax, _FREQUENCY, "|F| on the base [N]", "Linear force on the base (paper fig. 3)")
     ax = axes[2]
-    ax.semilogy(f, np.abs(system.receptances(w).h22), label="|H22| exact (eq. 4)", lw=1.4)
+    ax.semilogy(f, np.abs(system.receptances(w).h22), label="|H22| exact (eq. 4)", color="k", lw=1.4)
     if fit is not None:
         step = max(1, f.size // 120)
-        ax.semilogy(f[::step], np.abs(fit.receptance(w[::step])), "o", mfc="none", ms=4, label="eq. 10, fitted modes")
+        ax.semilogy(f[::step], np.abs(fit.receptance(w[::step])), "o", color="C3", mfc="none", ms=4.5, label="|H22| of eq. 10, the paper's fitted modes")
     finish_axes(ax, _FREQUENCY, "|H22| [m/N]", "Accuracy of the curve fit (paper fig. 4)")
     figure_legend(fig, axes, [Line2D([], [], color="k", lw=0.9, ls="--", label="clearance Delta")])
     natural = ", ".join(f"{x / (2 * np.pi):.3f}" for x in system.natural_frequencies())
@@ -194,7 +195,7 @@ def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure |
     figure_legend(fig, [], keys + _engine_keys(engines))
     missing = [s for s in candidates if s not in panels]
     tail = f"No finite values, not drawn: {', '.join(solution_ref(s) for s in missing)}." if missing else ""
-    return DrawnFigure(fig, name, f"{q.label}, {clearance_text(part)}", caption.text(tail))
+    return DrawnFigure(fig, name, f"{q.label[:1].upper()}{q.label[1:]}, {clearance_text(part)}", caption.text(tail))
 
 
 def _first(part: xr.Dataset) -> dict[str, int]:
@@ -292,7 +293,7 @@ def simulation_figure(part: xr.Dataset, quantity: str, engines: list[str], name:
             draw_linear(ax, f, line[quantity].sel(solution="linear").values)
             caption.add("linear", "LIN (dotted black): the linear system (no stop).")
         if closed is not None:
-            _, unstable = draw_curve(ax, f, line[quantity].sel(solution=closed).values, colour=SOLUTION_COLOURS[closed], label=solution_ref(closed), gid=closed, unstable=_unstable(line, closed))
+            _, unstable = draw_curve(ax, f, line[quantity].sel(solution=closed).values, colour=SOLUTION_COLOURS[closed], label=solution_ref(closed), gid=closed, unstable=_unstable(line, closed), zorder=OVER_MARKERS_ZORDER)
             any_unstable |= unstable
             caption.add("closed", f"{solution_ref(closed)} (blue line): the {SOLUTION_DESCRIPTIONS[closed]}.")
         for engine in drawn:

@@ -37,6 +37,7 @@ __all__ = [
     "DPI",
     "FIGURE_WIDTH",
     "MAX_COLUMNS",
+    "OVER_MARKERS_ZORDER",
     "MIN_FONT_SIZE",
     "QUANTITIES",
     "REGIME_COLOURS",
@@ -146,6 +147,10 @@ RAW_STYLE = {"ls": "-", "lw": 0.7, "alpha": 0.35, "zorder": 1}
 #: Simulation markers (fillable shapes: filled means periodic) and sizes [pt]; exact's larger diamonds show under
 #: momentary's circles where both agree.
 ENGINE_MARKERS: dict[str, tuple[str, float]] = {"momentary": ("o", 3.5), "exact": ("D", 5.0), "compliant": ("s", 4.0)}
+#: Drawing order of markers: smaller ones on top of larger ones [matplotlib zorder; lines are at 2].
+MARKER_ZORDER = 2.5
+#: Closed-form curves drawn over simulation markers, to compare the two [matplotlib zorder].
+OVER_MARKERS_ZORDER = 3.0
 #: Dot for an isolated closed-form value (no finite neighbour, so no line segment) [pt].
 ISOLATED_MARKER_SIZE = 3.0
 
@@ -209,7 +214,7 @@ class Caption:
 
 
 # ---------------------------------------------------------------------------------------------- drawing
-def draw_curve(ax: Axes, x: np.ndarray, y: np.ndarray, *, colour: str, label: str | None, gid: str, unstable: np.ndarray | None = None, coarse: bool = False, style: dict[str, object] | None = None) -> tuple[bool, bool]:
+def draw_curve(ax: Axes, x: np.ndarray, y: np.ndarray, *, colour: str, label: str | None, gid: str, unstable: np.ndarray | None = None, coarse: bool = False, style: dict[str, object] | None = None, zorder: float = 2.0) -> tuple[bool, bool]:
     """Draw closed-form values: solid where stable, dashed where ``unstable``, gaps at NaN, dots at isolated values.
 
     Parameters
@@ -230,6 +235,8 @@ def draw_curve(ax: Axes, x: np.ndarray, y: np.ndarray, *, colour: str, label: st
         Also mark every value (a grid too coarse for a line alone).
     style : dict, optional
         Line style of the stable stretches instead of :data:`STABLE_STYLE`.
+    zorder : float
+        Drawing order (:data:`OVER_MARKERS_ZORDER` to draw over simulation markers).
 
     Returns
     -------
@@ -244,21 +251,21 @@ def draw_curve(ax: Axes, x: np.ndarray, y: np.ndarray, *, colour: str, label: st
     marker = {"marker": "o", "ms": ISOLATED_MARKER_SIZE} if coarse else {}
     stable_y = np.where(flagged, np.nan, y)
     unstable_y = np.where(flagged, y, np.nan)
-    ax.plot(x, stable_y, color=colour, label=label or "_nolegend_", gid=gid, **(style or STABLE_STYLE), **marker)
+    ax.plot(x, stable_y, color=colour, label=label or "_nolegend_", gid=gid, zorder=zorder, **(style or STABLE_STYLE), **marker)
     if flagged.any():
-        ax.plot(x, unstable_y, color=colour, label="_nolegend_", gid=gid, **UNSTABLE_STYLE, **marker)
+        ax.plot(x, unstable_y, color=colour, label="_nolegend_", gid=gid, zorder=zorder, **UNSTABLE_STYLE, **marker)
     for values in (stable_y, unstable_y if flagged.any() else None):
         if values is not None and not coarse:
-            _mark_isolated(ax, x, values, colour, gid)
+            _mark_isolated(ax, x, values, colour, gid, zorder)
     return bool(finite.any()), bool(flagged.any())
 
 
-def _mark_isolated(ax: Axes, x: np.ndarray, y: np.ndarray, colour: str, gid: str) -> None:
+def _mark_isolated(ax: Axes, x: np.ndarray, y: np.ndarray, colour: str, gid: str, zorder: float = 2.0) -> None:
     """A dot at each finite value whose neighbours are both missing (a line draws nothing there)."""
     finite = np.isfinite(y)
     isolated = finite & ~np.r_[False, finite[:-1]] & ~np.r_[finite[1:], False]
     if isolated.any():
-        ax.plot(np.asarray(x)[isolated], y[isolated], "o", color=colour, ms=ISOLATED_MARKER_SIZE, label="_nolegend_", gid=gid)
+        ax.plot(np.asarray(x)[isolated], y[isolated], "o", color=colour, ms=ISOLATED_MARKER_SIZE, label="_nolegend_", gid=gid, zorder=zorder)
 
 
 def draw_linear(ax: Axes, x: np.ndarray, y: np.ndarray, coarse: bool = False) -> bool:
@@ -298,10 +305,11 @@ def draw_points(ax: Axes, x: np.ndarray, y: np.ndarray, *, periodic: np.ndarray,
     periodic = np.asarray(periodic, bool) & finite
     irregular = finite & ~periodic
     marker, size = ENGINE_MARKERS.get(solution, ("s", 5.0))
+    zorder = MARKER_ZORDER - size / 100.0
     if periodic.any():
-        ax.plot(x[periodic], y[periodic], marker, ls="none", color=colour, mfc=colour, ms=size, label=f"{label}, periodic" if label else "_nolegend_", gid=solution)
+        ax.plot(x[periodic], y[periodic], marker, ls="none", color=colour, mfc=colour, ms=size, zorder=zorder, label=f"{label}, periodic" if label else "_nolegend_", gid=solution)
     if irregular.any():
-        ax.plot(x[irregular], y[irregular], marker, ls="none", color=colour, mfc="none", mew=1.1, ms=size, label=f"{label}, irregular" if label else "_nolegend_", gid=solution)
+        ax.plot(x[irregular], y[irregular], marker, ls="none", color=colour, mfc="none", mew=1.1, ms=size, zorder=zorder, label=f"{label}, irregular" if label else "_nolegend_", gid=solution)
     return bool(periodic.any()), bool(irregular.any())
 
 
