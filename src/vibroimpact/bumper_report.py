@@ -140,7 +140,7 @@ def peak_tables(dataset: xr.Dataset, scene: Scene, parameter: str) -> list[Table
     unit, scale = ("mm", 1e3) if parameter == "clearance" else ("-", 1.0)
     header = f"<tr><th>solution</th><th>{parameter} [{unit}]</th><th>peak 1 [mm]</th><th>at [Hz]</th><th>peak 2 [mm]</th><th>at [Hz]</th></tr>"
     body = [
-        f"<tr><td>{label}</td><td>{value * scale:g}</td><td>{fmt(p1[0] * 1e3, '.4g')}</td><td>{fmt(p1[1], '.3f')}</td><td>{fmt(p2[0] * 1e3, '.4g')}</td><td>{fmt(p2[1], '.3f')}</td></tr>"
+        f"<tr><td>{label}</td><td>{value * scale:g}</td><td>{fmt(p1[0] * 1e3, '#.4g')}</td><td>{fmt(p1[1], '.3f')}</td><td>{fmt(p2[0] * 1e3, '#.4g')}</td><td>{fmt(p2[1], '.3f')}</td></tr>"
         for label, _, value, p1, p2, _, _ in _peak_rows(dataset, scene, parameter)
     ]
     return [Table(f"Resonance peaks of |X1| against the {parameter}: values", f"<table>{header}{''.join(body)}</table>")]

@@ -90,7 +90,7 @@ def reduction_tables(dataset: xr.Dataset, scene: Scene) -> list[Table]:
                 unstable = "n/a" if row.unstable is None else f"{row.unstable[0]} / {row.unstable[1]}"
                 body.append(
                     f"<tr><td>{solution}</td><td>{row.clearance * 1e3:g}</td><td>{row.restitution:g}</td>"
-                    f"<td>{fmt(row.linear_peak[0], '.4g')} / {fmt(row.linear_peak[1], '.4g')}</td><td>{fmt(row.largest[0], '.4g')} / {fmt(row.largest[1], '.4g')}</td>"
+                    f"<td>{fmt(row.linear_peak[0], '#.4g')} / {fmt(row.linear_peak[1], '#.4g')}</td><td>{fmt(row.largest[0], '#.4g')} / {fmt(row.largest[1], '#.4g')}</td>"
                     f"{factors}<td>{computed}</td><td>{row.undefined[0]} / {row.undefined[1]}</td><td>{unstable}</td>"
                     f"<td>{'' if paper is None else f'{paper[0]:g} / {paper[1]:g}'}</td></tr>"
                 )
