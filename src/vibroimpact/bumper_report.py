@@ -20,32 +20,11 @@ from matplotlib.ticker import NullFormatter
 from .regime import Regime
 from .report_common import DrawnFigure, Table
 from .report_responses import clearance_text, series_by_restitution
-from .report_style import (
-    ENGINE_MARKERS,
-    OVER_MARKERS_ZORDER,
-    QUANTITIES,
-    SOLUTION_COLOURS,
-    Caption,
-    axis_label,
-    draw_curve,
-    draw_points,
-    figure_legend,
-    finish_axes,
-    fmt,
-    legend_rows,
-    new_figure,
-    series_colour,
-    solution_ref,
-    stability_keys,
-)
+from .report_series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_points, periodic_points, split_frequency, stability_keys, unstable_points
+from .report_style import QUANTITIES, SOLUTION_COLOURS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref
 from .scene import ENGINE_SOLUTIONS, Scene
 
-__all__ = ["peak_figure", "peak_tables", "peak_acceleration_figure", "stiffness_figure", "stiffness_tables", "band_peaks", "split_frequency"]
-
-
-def split_frequency(scene: Scene) -> float:
-    """The anti-resonance frequency [Hz], which separates the two resonance bands."""
-    return scene.system.antiresonance_frequency() / (2.0 * np.pi)
+__all__ = ["peak_figure", "peak_tables", "peak_acceleration_figure", "stiffness_figure", "stiffness_tables", "band_peaks"]
 
 
 # ---------------------------------------------------------------------------------------------- peaks
@@ -74,7 +53,7 @@ def _peak_rows(dataset: xr.Dataset, scene: Scene, parameter: str) -> list[PeakRo
         for solution in (str(s) for s in dataset["solution"].values if s != "linear"):
             values = point["x1_amplitude"].sel(solution=solution).values
             if solution in ENGINE_SOLUTIONS:
-                converged = point["converged"].sel(solution=solution).values == 1 if "converged" in point else np.ones(values.shape, bool)
+                converged = periodic_points(point, solution)
                 peaks = band_peaks(values, f, split)
                 periodic = [bool(np.any(converged & np.isclose(f, at, rtol=0.0, atol=1e-9))) for _, at in peaks]
                 rows.append((solution, solution, float(value), *peaks, *periodic))
@@ -110,7 +89,7 @@ def peak_figure(dataset: xr.Dataset, scene: Scene, parameter: str, name: str) ->
     labels = list(dict.fromkeys(r[0] for r in rows))
     fig, axes = new_figure(2, panel_height=3.9, legend_rows=legend_rows(len(labels) + 2, 3))
     caption = Caption(f"Largest {QUANTITIES['x1_amplitude'].label} in each resonance band against the {parameter} (paper figures 25-26); one colour per solution.")
-    engines: dict[str, tuple[bool, bool]] = {}
+    engines = SimulationMarkers()
     for band, ax in enumerate(axes):
         for label in labels:
             chosen = [r for r in rows if r[0] == label]
@@ -120,8 +99,7 @@ def peak_figure(dataset: xr.Dataset, scene: Scene, parameter: str, name: str) ->
             colour = SOLUTION_COLOURS.get(solution, "C5")
             if solution in ENGINE_SOLUTIONS:
                 ax.plot(x, y, color=colour, lw=0.8, label="_nolegend_", gid=solution)
-                drawn = draw_points(ax, x, y, periodic=np.array([r[5 + band] for r in chosen]), solution=solution, colour=colour, label=solution_ref(solution))
-                engines[solution] = (engines.get(solution, (False, False))[0] or drawn[0], engines.get(solution, (False, False))[1] or drawn[1])
+                engines.add(solution, draw_points(ax, x, y, periodic=np.array([r[5 + band] for r in chosen]), solution=solution, colour=colour, label=solution_ref(solution)))
                 continue
             variant = _variant(label, solution)
             ls, width, phrase = _PEAK_VARIANTS[variant]
@@ -130,8 +108,8 @@ def peak_figure(dataset: xr.Dataset, scene: Scene, parameter: str, name: str) ->
         finish_axes(ax, f"{parameter} [{unit}]", f"peak {axis_label('x1_amplitude')}", f"Resonance band {band + 1} ({'below' if band == 0 else 'above'} the anti-resonance)")
     figure_legend(fig, axes, columns=3)
     if engines:
-        kinds = ["filled: the peak is a periodic steady state"] + (["hollow: an irregular motion's average"] if any(i for _, i in engines.values()) else [])
-        caption.add("engines", f"Markers: simulations {', '.join(solution_ref(s) for s in engines)} ({'; '.join(kinds)}); where motions coexist, a simulation settles on one of them depending on where it starts (here: near the one-impact orbit).")
+        caption.add("engines", engines.phrase("the peak is a periodic steady state", "the peak is an irregular motion's average", each="the largest value on the simulated frequencies"))
+        caption.add("coexist", "Where motions coexist, a simulation settles on one of them depending on where it starts (here: near the one-impact orbit).")
     return DrawnFigure(fig, name, f"Resonance peaks of |X1| against the {parameter}", caption.text())
 
 
@@ -161,35 +139,23 @@ def peak_acceleration_figure(part: xr.Dataset, name: str) -> DrawnFigure | None:
         f"{' and '.join(QUANTITIES[q].label for q in quantities)} per steady state against frequency, {clearance_text(part)}, one colour per restitution ratio."
     )
     any_unstable = False
-    engines: dict[str, tuple[bool, bool]] = {}
+    engines = SimulationMarkers()
     for ax, quantity in zip(axes, quantities):
         for i, (_, line) in enumerate(lines):
             if "pgf" in present:
-                flags = line["stable"].sel(solution="pgf").values == 0 if "stable" in line else None
-                drawn, unstable = draw_curve(ax, f, line[quantity].sel(solution="pgf").values, colour=series_colour(i), label=None, gid="pgf", unstable=flags, zorder=OVER_MARKERS_ZORDER)
+                drawn, unstable = draw_curve(ax, f, line[quantity].sel(solution="pgf").values, colour=series_colour(i), label=None, gid="pgf", unstable=unstable_points(line, "pgf"), zorder=OVER_MARKERS_ZORDER)
                 any_unstable |= unstable
                 if drawn:
                     caption.add("pgf", f"Lines: the estimate from {solution_ref('pgf')}, Gamma(xi_b) Omega_b J / (1 + R) for the force (section 6.3 with the corrected factor Gamma; the deceleration less the absorber spring's pull): the rigid-stop impulse J gives the entry speed, the one-collision solution of the bumper gives the peak.")
             if "compliant" in present:
-                values = line[quantity].sel(solution="compliant").values
-                periodic = line["converged"].sel(solution="compliant").values == 1 if "converged" in line else np.ones(values.shape, bool)
-                drawn_points = draw_points(ax, f, values, periodic=periodic, solution="compliant", colour=series_colour(i), label=None)
-                engines["compliant"] = (engines.get("compliant", (False, False))[0] or drawn_points[0], engines.get("compliant", (False, False))[1] or drawn_points[1])
+                engines.add("compliant", draw_points(ax, f, line[quantity].sel(solution="compliant").values, periodic=periodic_points(line, "compliant"), solution="compliant", colour=series_colour(i), label=None))
         finish_axes(ax, "frequency [Hz]", axis_label(quantity), QUANTITIES[quantity].label)
     if any_unstable:
         caption.add("unstable", "Dashed: the estimate on a one-impact orbit that exists but is unstable.")
+    if engines:
+        caption.add("compliant", engines.phrase(irregular="irregular motion, the largest over the measured window"))
     keys: list[Line2D | Patch] = [Patch(color=series_colour(i), label=text) for i, (text, _) in enumerate(lines)]
-    keys += stability_keys() if any_unstable else []
-    marker, size = ENGINE_MARKERS["compliant"]
-    periodic_drawn, irregular_drawn = engines.get("compliant", (False, False))
-    if periodic_drawn or irregular_drawn:
-        kinds = (["filled: periodic steady state"] if periodic_drawn else []) + (["hollow: irregular motion, the largest over the measured window"] if irregular_drawn else [])
-        caption.add("compliant", f"Squares: {solution_ref('compliant')} simulations, one per simulated frequency ({'; '.join(kinds)}).")
-    if periodic_drawn:
-        keys.append(Line2D([], [], marker=marker, ls="none", color="k", ms=size, label=f"{solution_ref('compliant')}, periodic"))
-    if irregular_drawn:
-        keys.append(Line2D([], [], marker=marker, ls="none", color="k", mfc="none", ms=size, label=f"{solution_ref('compliant')}, irregular"))
-    figure_legend(fig, [], keys)
+    figure_legend(fig, [], keys + (stability_keys() if any_unstable else []) + engines.keys())
     return DrawnFigure(fig, name, f"Peak contact deceleration and force, {clearance_text(part)}", caption.text())
 
 

@@ -18,10 +18,9 @@ from .linear import linear_response
 from .modal import fit_modal_parameters, underdamped_mode_count
 from .regime import Regime
 from .report_common import DrawnFigure
+from .report_series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_linear, draw_points, periodic_points, stability_keys, unstable_points
 from .report_style import (
-    ENGINE_MARKERS,
     LINEAR_STYLE,
-    OVER_MARKERS_ZORDER,
     QUANTITIES,
     RAW_STYLE,
     REGIME_COLOURS,
@@ -30,9 +29,6 @@ from .report_style import (
     SOLUTION_TITLES,
     Caption,
     axis_label,
-    draw_curve,
-    draw_linear,
-    draw_points,
     figure_legend,
     finish_axes,
     legend_rows,
@@ -40,7 +36,6 @@ from .report_style import (
     regime_label,
     series_colour,
     solution_ref,
-    stability_keys,
 )
 from .scene import ENGINE_SOLUTIONS, Scene
 
@@ -63,44 +58,6 @@ def series_by_restitution(part: xr.Dataset) -> list[tuple[str, xr.Dataset]]:
     if "restitution" in part.dims:
         return [(f"R = {float(r):g}", part.sel(restitution=r)) for r in part["restitution"].values]
     return [(f"R = {float(part['restitution']):g}", part)]
-
-
-def _unstable(line: xr.Dataset, solution: str) -> np.ndarray | None:
-    """Points where ``solution``'s one-impact orbit exists but is unstable (None: stability not computed)."""
-    if "stable" not in line:
-        return None
-    return np.asarray(line["stable"].sel(solution=solution).values == 0)
-
-
-def _periodic(line: xr.Dataset, solution: str, shape: tuple[int, ...]) -> np.ndarray:
-    """Points where a simulation converged to a periodic steady state."""
-    if "converged" not in line:
-        return np.ones(shape, bool)
-    return np.asarray(line["converged"].sel(solution=solution).values == 1)
-
-
-def _simulation_phrase(drawn: dict[str, tuple[bool, bool]]) -> str:
-    """Caption phrase for the simulations drawn: (periodic drawn, irregular drawn) per solution."""
-    shapes = {"o": "circles", "D": "diamonds", "s": "squares"}
-    names = ", ".join(f"{solution_ref(s)} ({shapes.get(ENGINE_MARKERS.get(s, ('s', 0))[0], 'markers')})" for s in drawn)
-    kinds = []
-    if any(p for p, _ in drawn.values()):
-        kinds.append("filled: periodic steady state (the stroboscopic state repeated)")
-    if any(i for _, i in drawn.values()):
-        kinds.append("hollow: irregular motion, averaged over the measured periods")
-    return f"Simulations {names}: one marker per simulated frequency ({'; '.join(kinds)})."
-
-
-def _engine_keys(drawn: dict[str, tuple[bool, bool]]) -> list[Line2D]:
-    """Legend entries for simulation markers, in black (colours are per series)."""
-    keys = []
-    for solution, (periodic, irregular) in drawn.items():
-        marker, size = ENGINE_MARKERS.get(solution, ("s", 5.0))
-        if periodic:
-            keys.append(Line2D([], [], marker=marker, ls="none", color="k", ms=size, label=f"{solution_ref(solution)}, periodic"))
-        if irregular:
-            keys.append(Line2D([], [], marker=marker, ls="none", color="k", mfc="none", ms=size, label=f"{solution_ref(solution)}, irregular"))
-    return keys
 
 
 def linear_figure(scene: Scene) -> DrawnFigure:
@@ -156,7 +113,7 @@ def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure |
         f"per solution: {'; '.join(f'{solution_ref(s)}, {SOLUTION_DESCRIPTIONS.get(s, s)}' for s in panels)}."
     )
     fig, axes = new_figure(len(panels), panel_height=3.7, sharey=True, legend_rows=legend_rows(len(lines) + 6))
-    engines: dict[str, tuple[bool, bool]] = {}
+    engines = SimulationMarkers()
     any_unstable = gaps = raw = False
     for ax, solution in zip(axes, panels):
         if with_linear or solution == "linear":
@@ -165,11 +122,9 @@ def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure |
         for i, (_, line) in enumerate(lines if solution != "linear" else []):
             values = line[quantity].sel(solution=solution).values
             if solution in ENGINE_SOLUTIONS:
-                periodic, irregular = draw_points(ax, f, values, periodic=_periodic(line, solution, values.shape), solution=solution, colour=series_colour(i), label=None)
-                old = engines.get(solution, (False, False))
-                engines[solution] = (old[0] or periodic, old[1] or irregular)
+                engines.add(solution, draw_points(ax, f, values, periodic=periodic_points(line, solution), solution=solution, colour=series_colour(i), label=None))
                 continue
-            _, unstable = draw_curve(ax, f, values, colour=series_colour(i), label=None, gid=solution, unstable=_unstable(line, solution), coarse=coarse)
+            _, unstable = draw_curve(ax, f, values, colour=series_colour(i), label=None, gid=solution, unstable=unstable_points(line, solution), coarse=coarse)
             any_unstable |= unstable
             gaps |= bool(np.isnan(values).any())
             if raw_name in line and solution != "linear":
@@ -185,7 +140,7 @@ def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure |
     if raw:
         caption.add("raw", "Faint thin lines: the raw one-impact solution wherever eqs. 15-16 have a root, unchecked (admissible or not, stable or not): what the paper plots, spikes included.")
     if engines:
-        caption.add("engines", _simulation_phrase(engines))
+        caption.add("engines", engines.phrase())
     finite = part[quantity].sel(solution=[*panels, *(["linear"] if with_linear else [])]).values
     top = float(np.max(finite[np.isfinite(finite)], initial=0.0))
     if top > 0.0:
@@ -195,7 +150,7 @@ def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure |
         keys.append(Line2D([], [], label="LIN (linear system)", **LINEAR_STYLE))
     keys += stability_keys() if any_unstable else []
     keys += [Line2D([], [], color="k", label="raw one-impact solution", **RAW_STYLE)] if raw else []
-    figure_legend(fig, [], keys + _engine_keys(engines))
+    figure_legend(fig, [], keys + engines.keys())
     missing = [s for s in candidates if s not in panels]
     tail = f"No finite values, not drawn: {', '.join(solution_ref(s) for s in missing)}." if missing else ""
     return DrawnFigure(fig, name, f"{q.label[:1].upper()}{q.label[1:]}, {clearance_text(part)}", caption.text(tail))
@@ -289,24 +244,22 @@ def simulation_figure(part: xr.Dataset, quantity: str, engines: list[str], name:
     closed = "pgf" if "pgf" in present else None
     caption = Caption(f"{q.label} ({q.meaning}) against frequency, {clearance_text(part)}: one panel per restitution ratio.")
     fig, axes = new_figure(len(lines), panel_height=3.5, legend_rows=legend_rows(2 + 2 * len(drawn) + 2))
-    markers: dict[str, tuple[bool, bool]] = {}
+    markers = SimulationMarkers()
     any_unstable = False
     for ax, (text, line) in zip(axes, lines):
         if "linear" in present and quantity != "impulse":
             draw_linear(ax, f, line[quantity].sel(solution="linear").values)
             caption.add("linear", "LIN (dotted black): the linear system (no stop).")
         if closed is not None:
-            _, unstable = draw_curve(ax, f, line[quantity].sel(solution=closed).values, colour=SOLUTION_COLOURS[closed], label=solution_ref(closed), gid=closed, unstable=_unstable(line, closed), zorder=OVER_MARKERS_ZORDER)
+            _, unstable = draw_curve(ax, f, line[quantity].sel(solution=closed).values, colour=SOLUTION_COLOURS[closed], label=solution_ref(closed), gid=closed, unstable=unstable_points(line, closed), zorder=OVER_MARKERS_ZORDER)
             any_unstable |= unstable
             caption.add("closed", f"{solution_ref(closed)} (blue line): the {SOLUTION_DESCRIPTIONS[closed]}.")
         for engine in drawn:
             values = line[quantity].sel(solution=engine).values
-            periodic, irregular = draw_points(ax, f, values, periodic=_periodic(line, engine, values.shape), solution=engine, colour=SOLUTION_COLOURS[engine], label=solution_ref(engine))
-            old = markers.get(engine, (False, False))
-            markers[engine] = (old[0] or periodic, old[1] or irregular)
+            markers.add(engine, draw_points(ax, f, values, periodic=periodic_points(line, engine), solution=engine, colour=SOLUTION_COLOURS[engine], label=solution_ref(engine)))
         finish_axes(ax, _FREQUENCY, axis_label(quantity), text, log=q.log)
     if any_unstable:
         caption.add("unstable", f"{solution_ref(closed)} dashed: the one-impact orbit exists but is unstable (Floquet).")
-    caption.add("engines", _simulation_phrase(markers))
+    caption.add("engines", markers.phrase())
     figure_legend(fig, axes, stability_keys() if any_unstable else [])
     return DrawnFigure(fig, name, f"Simulation against the closed form: {q.label}, {clearance_text(part)}", caption.text())

@@ -4,16 +4,7 @@ A report is read in a browser about 1400 px wide. Figures are at most :data:`FIG
 they are shown unscaled and their text (at least :data:`MIN_FONT_SIZE`) stays legible; panels come at most
 :data:`MAX_COLUMNS` to a row; legends sit below the panels (:func:`figure_legend`), never on the data.
 
-The drawing helpers make each kind of data look the same on every page and keep every finite value visible:
-
-* :func:`draw_curve` for closed-form solutions on the fine grid: solid where the orbit is stable, dashed (same colour,
-  same weight) where it is unstable, gaps where there is no value, and a dot for a value with no finite neighbour
-  (a line segment needs two points);
-* :func:`draw_points` for simulations on their own grid: one marker per computed point, filled for a periodic steady
-  state, hollow for irregular motion.
-
-Captions are put together by a :class:`Caption` from what the helpers actually drew. Solutions are named in
-captions as ``'name'`` (:func:`solution_ref`).
+How a solution's values are drawn (curves, markers, stability) is :mod:`vibroimpact.report_series`.
 """
 
 from __future__ import annotations
@@ -26,7 +17,6 @@ import matplotlib
 
 matplotlib.use("Agg")  # reports are drawn without a display
 import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
 from matplotlib.axes import Axes  # noqa: E402
 from matplotlib.figure import Figure as MatplotlibFigure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
@@ -37,20 +27,20 @@ __all__ = [
     "DPI",
     "FIGURE_WIDTH",
     "MAX_COLUMNS",
-    "OVER_MARKERS_ZORDER",
     "MIN_FONT_SIZE",
     "QUANTITIES",
     "REGIME_COLOURS",
     "SOLUTION_COLOURS",
     "SOLUTION_DESCRIPTIONS",
     "SOLUTION_TITLES",
+    "ENGINE_MARKERS",
+    "LINEAR_STYLE",
+    "RAW_STYLE",
     "STABLE_STYLE",
     "UNSTABLE_STYLE",
     "Caption",
     "Quantity",
     "axis_label",
-    "draw_curve",
-    "draw_points",
     "figure_legend",
     "fmt",
     "new_figure",
@@ -147,12 +137,6 @@ RAW_STYLE = {"ls": "-", "lw": 0.7, "alpha": 0.35, "zorder": 1}
 #: Simulation markers (fillable shapes: filled means periodic) and sizes [pt]; exact's larger diamonds show under
 #: momentary's circles where both agree.
 ENGINE_MARKERS: dict[str, tuple[str, float]] = {"momentary": ("o", 3.5), "exact": ("D", 5.0), "compliant": ("s", 4.0)}
-#: Drawing order of markers: smaller ones on top of larger ones [matplotlib zorder; lines are at 2].
-MARKER_ZORDER = 2.5
-#: Closed-form curves drawn over simulation markers, to compare the two [matplotlib zorder].
-OVER_MARKERS_ZORDER = 3.0
-#: Dot for an isolated closed-form value (no finite neighbour, so no line segment) [pt].
-ISOLATED_MARKER_SIZE = 3.0
 
 
 #: Colour of each solution where a figure distinguishes solutions (not restitution ratios).
@@ -211,111 +195,6 @@ class Caption:
         """The caption: lead, phrases, tail; its first letter a capital."""
         text = " ".join(part for part in (self.lead, *self._phrases.values(), tail) if part)
         return text[:1].upper() + text[1:]
-
-
-# ---------------------------------------------------------------------------------------------- drawing
-def draw_curve(ax: Axes, x: np.ndarray, y: np.ndarray, *, colour: str, label: str | None, gid: str, unstable: np.ndarray | None = None, coarse: bool = False, style: dict[str, object] | None = None, zorder: float = 2.0) -> tuple[bool, bool]:
-    """Draw closed-form values: solid where stable, dashed where ``unstable``, gaps at NaN, dots at isolated values.
-
-    Parameters
-    ----------
-    ax : Axes
-        Panel to draw on.
-    x, y : ndarray
-        Abscissa and values (NaN where there is no value).
-    colour : str
-        Line colour.
-    label : str or None
-        Legend entry of the line (None: none).
-    gid : str
-        Identifier of the drawn artists (the solution's name): tests find each solution's data by it.
-    unstable : ndarray of bool, optional
-        Points on an unstable orbit.
-    coarse : bool
-        Also mark every value (a grid too coarse for a line alone).
-    style : dict, optional
-        Line style of the stable stretches instead of :data:`STABLE_STYLE`.
-    zorder : float
-        Drawing order (:data:`OVER_MARKERS_ZORDER` to draw over simulation markers).
-
-    Returns
-    -------
-    (bool, bool)
-        Whether any value was drawn, and whether any unstable stretch was.
-    """
-    y = np.asarray(y, dtype=float)
-    finite = np.isfinite(y)
-    flagged = np.zeros(y.shape, bool) if unstable is None else (np.asarray(unstable, bool) & finite)
-    # solid and dashed stretches are not joined: where stability changes the value may jump to another branch, and a
-    # joining segment would draw a motion that does not exist (the hole is one grid step wide)
-    marker = {"marker": "o", "ms": ISOLATED_MARKER_SIZE} if coarse else {}
-    stable_y = np.where(flagged, np.nan, y)
-    unstable_y = np.where(flagged, y, np.nan)
-    ax.plot(x, stable_y, color=colour, label=label or "_nolegend_", gid=gid, zorder=zorder, **(style or STABLE_STYLE), **marker)
-    if flagged.any():
-        ax.plot(x, unstable_y, color=colour, label="_nolegend_", gid=gid, zorder=zorder, **UNSTABLE_STYLE, **marker)
-    for values in (stable_y, unstable_y if flagged.any() else None):
-        if values is not None and not coarse:
-            _mark_isolated(ax, x, values, colour, gid, zorder)
-    return bool(finite.any()), bool(flagged.any())
-
-
-def _mark_isolated(ax: Axes, x: np.ndarray, y: np.ndarray, colour: str, gid: str, zorder: float = 2.0) -> None:
-    """A dot at each finite value whose neighbours are both missing (a line draws nothing there)."""
-    finite = np.isfinite(y)
-    isolated = finite & ~np.r_[False, finite[:-1]] & ~np.r_[finite[1:], False]
-    if isolated.any():
-        ax.plot(np.asarray(x)[isolated], y[isolated], "o", color=colour, ms=ISOLATED_MARKER_SIZE, label="_nolegend_", gid=gid, zorder=zorder)
-
-
-def draw_linear(ax: Axes, x: np.ndarray, y: np.ndarray, coarse: bool = False) -> bool:
-    """The linear system's curve (dotted black, legend 'LIN'); returns whether anything was drawn."""
-    marker = {"marker": ".", "ms": 4} if coarse else {}
-    ax.plot(x, y, label="LIN", gid="linear", **LINEAR_STYLE, **marker)
-    _mark_isolated(ax, x, np.asarray(y, dtype=float), "k", "linear")
-    return bool(np.isfinite(y).any())
-
-
-def draw_points(ax: Axes, x: np.ndarray, y: np.ndarray, *, periodic: np.ndarray, solution: str, colour: str, label: str | None) -> tuple[bool, bool]:
-    """Draw a simulation's values on its own grid: one marker per finite value, filled if periodic, hollow if not.
-
-    Parameters
-    ----------
-    ax : Axes
-        Panel to draw on.
-    x, y : ndarray
-        Abscissa and values; NaN where the solution was not computed.
-    periodic : ndarray of bool
-        The simulated steady state was periodic (its stroboscopic state repeated).
-    solution : str
-        The simulation's name: its marker shape, and the artists' gid.
-    colour : str
-        Marker colour.
-    label : str or None
-        Legend entry (", periodic" and ", irregular" are appended; None: none).
-
-    Returns
-    -------
-    (bool, bool)
-        Whether periodic and whether irregular values were drawn.
-    """
-    y = np.asarray(y, dtype=float)
-    x = np.asarray(x)
-    finite = np.isfinite(y)
-    periodic = np.asarray(periodic, bool) & finite
-    irregular = finite & ~periodic
-    marker, size = ENGINE_MARKERS.get(solution, ("s", 5.0))
-    zorder = MARKER_ZORDER - size / 100.0
-    if periodic.any():
-        ax.plot(x[periodic], y[periodic], marker, ls="none", color=colour, mfc=colour, ms=size, zorder=zorder, label=f"{label}, periodic" if label else "_nolegend_", gid=solution)
-    if irregular.any():
-        ax.plot(x[irregular], y[irregular], marker, ls="none", color=colour, mfc="none", mew=1.1, ms=size, zorder=zorder, label=f"{label}, irregular" if label else "_nolegend_", gid=solution)
-    return bool(periodic.any()), bool(irregular.any())
-
-
-def stability_keys() -> list[Line2D]:
-    """Legend entries explaining solid and dashed closed-form curves (drawn in black, colours are per series)."""
-    return [Line2D([], [], color="k", label="stable orbit (solid)", **STABLE_STYLE), Line2D([], [], color="k", label="unstable orbit (dashed)", **UNSTABLE_STYLE)]
 
 
 # ---------------------------------------------------------------------------------------------- layout

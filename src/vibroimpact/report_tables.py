@@ -15,6 +15,7 @@ from .modal import exact_modal_parameters, fit_modal_parameters
 from .reduction import DEFINITION, paper_reduction_factors, reduction_factors
 from .regime import Regime
 from .report_common import Table
+from .report_series import split_frequency
 from .report_style import QUANTITIES, fmt
 from .scene import ENGINE_SOLUTIONS, Scene
 from .system import PAPER_SYSTEM
@@ -68,7 +69,7 @@ def reduction_intro() -> str:
 def reduction_tables(dataset: xr.Dataset, scene: Scene) -> list[Table]:
     """One table per quantity: reduction factors of every solution but ``linear`` at each (clearance, R)."""
     solutions = [str(s) for s in dataset["solution"].values if s != "linear"]
-    split = scene.system.antiresonance_frequency() / (2.0 * np.pi)
+    split = split_frequency(scene)
     tables = []
     for quantity in _REDUCTION_QUANTITIES:
         if quantity not in dataset or not solutions:
@@ -103,7 +104,7 @@ def agreement_table(dataset: xr.Dataset, scene: Scene) -> Table | None:
     engines = [str(name) for name in dataset["solution"].values if name in ENGINE_SOLUTIONS]
     if not engines or "pgf" not in dataset["solution"].values or "x1_amplitude" not in dataset:
         return None
-    split = scene.system.antiresonance_frequency() / (2.0 * np.pi)
+    split = split_frequency(scene)
     header = (
         "<tr><th>solution</th><th>Delta [mm]</th><th>R</th><th>band</th><th>computed points</th><th>max rel. diff. |X1|, pgf stable or linear</th>"
         "<th>median</th><th>pgf unstable: points</th><th>max rel. diff. there</th><th>simulation irregular</th><th>simulation with other than 1 or 0 impacts per period</th></tr>"

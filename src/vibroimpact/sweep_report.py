@@ -14,22 +14,8 @@ import xarray as xr
 from .regime import Regime
 from .report_common import DrawnFigure, Table
 from .report_responses import regime_map
-from .report_style import (
-    QUANTITIES,
-    SOLUTION_COLOURS,
-    SOLUTION_DESCRIPTIONS,
-    Caption,
-    axis_label,
-    draw_curve,
-    draw_linear,
-    figure_legend,
-    finish_axes,
-    fmt,
-    legend_rows,
-    new_figure,
-    solution_ref,
-    stability_keys,
-)
+from .report_series import draw_curve, draw_linear, split_frequency, stability_keys, unstable_points
+from .report_style import QUANTITIES, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref
 from .scene import ENGINE_SOLUTIONS, Scene
 
 __all__ = ["sweep_figures", "sweep_tables"]
@@ -74,8 +60,7 @@ def _draw_steady(ax: object, dataset: xr.Dataset, quantity: str, caption: Captio
         caption.add("linear", "LIN (dotted black): the linear system (no stop).")
     unstable = False
     if "pgf" in steady:
-        flags = dataset["stable"].sel(solution="pgf").values == 0 if "stable" in dataset else None
-        drawn, unstable = draw_curve(ax, f, dataset[quantity].sel(solution="pgf").values, colour=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')} steady state", gid="pgf", unstable=flags)
+        drawn, unstable = draw_curve(ax, f, dataset[quantity].sel(solution="pgf").values, colour=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')} steady state", gid="pgf", unstable=unstable_points(dataset, "pgf"))
         if drawn:
             caption.add("pgf", f"{solution_ref('pgf')}: the {SOLUTION_DESCRIPTIONS['pgf']} (solid where the orbit is stable{', dashed where unstable' if unstable else ''}).")
     return unstable
@@ -168,7 +153,7 @@ def sweep_tables(dataset: xr.Dataset, scene: Scene) -> list[Table]:
     if "pgf" in _steady_solutions(dataset) and "swept_x1_amplitude" in dataset:
         rows = ["<tr><th>sweep</th><th>band</th><th>points (pgf stable, sweep in contact)</th><th>median rel. diff. |X1|</th><th>90th percentile</th></tr>"]
         f = dataset["frequency"].values
-        split = scene.system.antiresonance_frequency() / (2.0 * np.pi)
+        split = split_frequency(scene)
         pgf = dataset["x1_amplitude"].sel(solution="pgf").values
         stable = dataset["stable"].sel(solution="pgf").values == 1 if "stable" in dataset else np.isfinite(pgf)
         for direction in _directions(dataset):
