@@ -189,9 +189,10 @@ def regime_map(panels: list[tuple[str, list[str], np.ndarray]], f: np.ndarray, n
     flags = sorted(REGIME_COLOURS)
     cmap = ListedColormap([REGIME_COLOURS[r] for r in flags])
     norm = BoundaryNorm(np.arange(len(flags) + 1) - 0.5, len(flags))
-    rows = max(len(labels) for _, labels, _ in panels)
-    fig, axes = new_figure(len(panels), panel_height=0.95 + 0.3 * rows, columns=1, sharex=True, legend_rows=legend_rows(len(flags), 3))
+    heights = [0.95 + 0.3 * len(labels) for _, labels, _ in panels]
+    fig, axes = new_figure(len(panels), columns=1, sharex=True, legend_rows=legend_rows(len(flags), 3), row_heights=heights)
     seen: set[int] = set()
+    coarse = False
     for ax, (panel_title, labels, grid) in zip(axes, panels):
         computed = np.any(grid != Regime.NOT_COMPUTED, axis=0)
         columns = f[computed]
@@ -200,16 +201,16 @@ def regime_map(panels: list[tuple[str, list[str], np.ndarray]], f: np.ndarray, n
             edges = np.concatenate([[f[0]], (columns[1:] + columns[:-1]) / 2.0, [f[-1]]]) if columns.size > 1 else np.array([columns[0] - 0.5, columns[0] + 0.5])
             ax.pcolormesh(edges, np.arange(len(labels) + 1) - 0.5, np.searchsorted(flags, grid[:, computed]), cmap=cmap, norm=norm, shading="flat", gid=f"regime:{panel_title}")
             seen.update(int(v) for v in np.unique(grid[:, computed]))
+            coarse |= bool(columns.size < f.size)
         ax.set_ylim(len(labels) - 0.5, -0.5)
         ax.set_yticks(range(len(labels)), labels)
         ax.set_title(panel_title, fontsize=11)
     axes[-1].set_xlabel(_FREQUENCY)
     shown = [r for r in flags if int(r) in seen]
     figure_legend(fig, [], [Patch(color=REGIME_COLOURS[r], label=regime_label(r)) for r in shown], columns=3)
-    caption = (
-        f"{lead} (the dataset's regime flag, its value in brackets), one colour per flag. Points of a coarser "
-        f"simulation grid span halfway to their neighbours. Present: {', '.join(r.name.lower() for r in shown)}."
-    )
+    caption = f"{lead} (the dataset's regime flag, its value in brackets), one colour per flag."
+    if coarse:
+        caption += " A solution computed on a coarser grid (simulations) shows each point as a block reaching halfway to its neighbours."
     return DrawnFigure(fig, name, title, caption)
 
 

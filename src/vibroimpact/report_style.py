@@ -198,7 +198,15 @@ class Caption:
 
 
 # ---------------------------------------------------------------------------------------------- layout
-def new_figure(panels: int, panel_height: float = 3.6, columns: int = MAX_COLUMNS, sharex: bool = False, sharey: bool = False, legend_rows: int = 0) -> tuple[MatplotlibFigure, list[Axes]]:
+def new_figure(
+    panels: int,
+    panel_height: float = 3.6,
+    columns: int = MAX_COLUMNS,
+    sharex: bool = False,
+    sharey: bool = False,
+    legend_rows: int = 0,
+    row_heights: Sequence[float] | None = None,
+) -> tuple[MatplotlibFigure, list[Axes]]:
     """A figure :data:`FIGURE_WIDTH` wide with ``panels`` panels, at most ``columns`` to a row, constrained layout.
 
     Parameters
@@ -213,6 +221,8 @@ def new_figure(panels: int, panel_height: float = 3.6, columns: int = MAX_COLUMN
         Share the axes between panels.
     legend_rows : int
         Rows of legend entries expected below the panels (adds height for them).
+    row_heights : sequence of float, optional
+        Height of each row [in] instead of ``panel_height`` for all.
 
     Returns
     -------
@@ -221,8 +231,11 @@ def new_figure(panels: int, panel_height: float = 3.6, columns: int = MAX_COLUMN
     """
     columns = max(1, min(columns, MAX_COLUMNS, panels))
     rows = math.ceil(panels / columns)
-    height = rows * panel_height + 0.25 * legend_rows + (0.2 if legend_rows else 0.0)
-    fig, grid = plt.subplots(rows, columns, figsize=(FIGURE_WIDTH, height), squeeze=False, sharex=sharex, sharey=sharey, layout="constrained")
+    heights = list(row_heights) if row_heights is not None else [panel_height] * rows
+    height = sum(heights) + 0.25 * legend_rows + (0.2 if legend_rows else 0.0)
+    fig, grid = plt.subplots(
+        rows, columns, figsize=(FIGURE_WIDTH, height), squeeze=False, sharex=sharex, sharey=sharey, layout="constrained", gridspec_kw={"height_ratios": heights}
+    )
     axes = list(grid.flat)
     for ax in axes[panels:]:
         ax.remove()

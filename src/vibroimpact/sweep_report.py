@@ -22,8 +22,10 @@ __all__ = ["sweep_figures", "sweep_tables"]
 
 #: Colour of each sweep direction.
 SWEEP_COLOURS = {"up": "C3", "down": "C2"}
+#: Running fundamental of a sweep: thinner than the steady states' curves, which show beneath.
+SWEPT_STYLE = {"ls": "-", "lw": 0.9}
 #: sqrt 2 x running RMS: thinner, dash-dot (dashed means an unstable orbit).
-RMS_STYLE = {"ls": "-.", "lw": 1.0}
+RMS_STYLE = {"ls": "-.", "lw": 0.9}
 _FREQUENCY = "instantaneous frequency [Hz]"
 
 
@@ -75,7 +77,7 @@ def _draw_swept(ax: object, dataset: xr.Dataset, quantity: str, solution: str, s
     drawn = False
     for direction in _directions(dataset):
         values = scale * dataset[name].sel(sweep=direction).values
-        drawn |= draw_curve(ax, f, values, colour=SWEEP_COLOURS.get(direction, "C4"), label=f"{solution_ref(solution)} sweep {direction}{suffix}", gid=solution, style=style)[0]
+        drawn |= draw_curve(ax, f, values, colour=SWEEP_COLOURS.get(direction, "C4"), label=f"{solution_ref(solution)} sweep {direction}{suffix}", gid=solution, style=style or SWEPT_STYLE)[0]
     return drawn
 
 
@@ -110,7 +112,7 @@ def _displacement_figure(dataset: xr.Dataset, scene: Scene, solution: str) -> Dr
         any_unstable |= _draw_steady(ax, dataset, quantity, caption)
         if rms in dataset and "pgf" in _steady_solutions(dataset):
             ax.plot(dataset["frequency"].values, np.sqrt(2.0) * dataset[rms].sel(solution="pgf").values, color=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')}: sqrt 2 x RMS", gid="pgf", **RMS_STYLE)
-            caption.add("pgf rms", f"Dash-dot: sqrt 2 x RMS (equal to the fundamental for a pure sine), of {solution_ref('pgf')}'s reconstructed orbit and of the sweeps.")
+            caption.add("pgf rms", f"Dash-dot: sqrt 2 x RMS (equal to the fundamental for a pure sine) of the orbit reconstructed by {solution_ref('pgf')} and of the sweeps.")
         if _draw_swept(ax, dataset, quantity, solution):
             caption.add("swept", "Red: sweep up, green: sweep down, running fundamental over the estimator window (solid).")
         _draw_swept(ax, dataset, rms, solution, scale=np.sqrt(2.0), style=RMS_STYLE, suffix=": sqrt 2 x RMS")
