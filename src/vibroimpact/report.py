@@ -69,18 +69,18 @@ def page_sections(dataset: xr.Dataset, scene: Scene, out: Path) -> list[Section]
     if "bumper_frequency" in dataset.dims:
         sections.append(Section("Compliant bumper against the rigid stop", figures=_saved([bumper_report.stiffness_figure(dataset, scene, "bumper_stiffness")], out), tables=bumper_report.stiffness_tables(dataset, scene)))
         return sections
-    sections += _response_sections(dataset, out)
+    # the summary (resonance peaks against the swept parameter) first, then the detail per clearance, then the tables
     engines = [str(s) for s in dataset["solution"].values if s in ENGINE_SOLUTIONS]
-    agreement = agreement_table(dataset, scene)
-    if agreement is not None:
-        sections.append(Section("Simulation against the closed form: agreement by band", tables=[agreement]))
-    solutions = [s for s in dataset["solution"].values if s != "linear"]
-    if solutions:
-        sections.append(Section("Reduction factors", intro=reduction_intro(), tables=reduction_tables(dataset, scene)))
     for parameter in ("restitution", "clearance"):
         if parameter in dataset.dims and engines and "x1_amplitude" in dataset:
             figure = bumper_report.peak_figure(dataset, scene, parameter, f"peaks_vs_{parameter}")
             sections.append(Section(f"Resonance peaks against the {parameter}", figures=_saved([figure], out), tables=bumper_report.peak_tables(dataset, scene, parameter)))
+    sections += _response_sections(dataset, out)
+    agreement = agreement_table(dataset, scene)
+    if agreement is not None:
+        sections.append(Section("Simulation against the closed form: agreement by band", tables=[agreement]))
+    if any(s != "linear" for s in dataset["solution"].values):
+        sections.append(Section("Reduction factors", intro=reduction_intro(), tables=reduction_tables(dataset, scene)))
     return sections
 
 

@@ -92,6 +92,8 @@ _STYLE = (
     "img{max-width:100%;height:auto;display:block}pre{background:#f4f4f4;padding:1em;overflow:auto}"
     "figure{margin:1.2em 0 2em 0}figcaption{font-size:95%;color:#333;max-width:1320px}"
     "nav{background:#f7f7f7;border:1px solid #ddd;padding:0.4em 1.2em;margin:1em 0}nav ol{margin:0.2em 0}"
+    "nav ol ol{list-style:none;padding-left:1.2em;margin:0 0 0.4em 0;font-size:95%}nav ol ol li{display:inline}"
+    "nav ol ol li+li:before{content:' \\00b7  ';color:#888}"
     "h3{margin-bottom:0.3em}.filename{color:#777}"
 )
 
@@ -106,6 +108,13 @@ def _anchor(text: str, used: set[str]) -> str:
     return anchor
 
 
+def _short(title: str, prefix: str, suffix: str | None) -> str:
+    """``title`` without the ``prefix`` and ``suffix`` its section's title already says, for the contents."""
+    if suffix and title.endswith(suffix) and len(title) > len(suffix):
+        title = title[: -len(suffix)]
+    return title[len(prefix) :] if title.startswith(prefix) and len(title) > len(prefix) else title
+
+
 def render_page(title: str, paragraphs: list[str], sections: list[Section], scene_text: str) -> str:
     """The HTML page: heading, ``paragraphs`` (plain text), contents, the sections, and the scene.
 
@@ -117,10 +126,13 @@ def render_page(title: str, paragraphs: list[str], sections: list[Section], scen
     for section in [*sections, Section("Scene")]:
         section_id = _anchor(section.title, used)
         entries = []
+        # the contents do not repeat what the section's title says ("Simulations ...: " before, ", Delta = 3 mm" after)
+        suffix = section.title[section.title.index(", ") :] if ", " in section.title else None
+        prefix = section.title.split(", ")[0] + ": "
         body.append(f"<section id='{section_id}'><h2>{html.escape(section.title)}</h2>{section.intro}")
         for figure in section.figures:
             figure_id = _anchor(figure.path.stem, used)
-            entries.append(f"<li><a href='#{figure_id}'>{html.escape(figure.title)}</a></li>")
+            entries.append(f"<li><a href='#{figure_id}'>{html.escape(_short(figure.title, prefix, suffix))}</a></li>")
             encoded = base64.b64encode(figure.path.read_bytes()).decode("ascii")
             body.append(
                 f"<figure id='{figure_id}'><h3>{html.escape(figure.title)}</h3><img alt='{html.escape(figure.title)}' "
@@ -129,7 +141,7 @@ def render_page(title: str, paragraphs: list[str], sections: list[Section], scen
             )
         for table in section.tables:
             table_id = _anchor(table.title, used)
-            entries.append(f"<li><a href='#{table_id}'>{html.escape(table.title)}</a></li>")
+            entries.append(f"<li><a href='#{table_id}'>{html.escape(_short(table.title, prefix, suffix))}</a></li>")
             body.append(f"<div id='{table_id}'><h3>{html.escape(table.title)}</h3>{table.html}</div>")
         if section.title == "Scene":
             body.append(f"<pre>{html.escape(scene_text)}</pre>")

@@ -197,8 +197,7 @@ def regime_map(panels: list[tuple[str, list[str], np.ndarray]], f: np.ndarray, n
         computed = np.any(grid != Regime.NOT_COMPUTED, axis=0)
         columns = f[computed]
         if columns.size:
-            # each column spans halfway to its neighbours: coarse simulation grids show as blocks, not hairlines
-            edges = np.concatenate([[f[0]], (columns[1:] + columns[:-1]) / 2.0, [f[-1]]]) if columns.size > 1 else np.array([columns[0] - 0.5, columns[0] + 0.5])
+            edges = _block_edges(columns, f)
             ax.pcolormesh(edges, np.arange(len(labels) + 1) - 0.5, np.searchsorted(flags, grid[:, computed]), cmap=cmap, norm=norm, shading="flat", gid=f"regime:{panel_title}")
             seen.update(int(v) for v in np.unique(grid[:, computed]))
             coarse |= bool(columns.size < f.size)
@@ -210,8 +209,22 @@ def regime_map(panels: list[tuple[str, list[str], np.ndarray]], f: np.ndarray, n
     figure_legend(fig, [], [Patch(color=REGIME_COLOURS[r], label=regime_label(r)) for r in shown], columns=3)
     caption = f"{lead} (the dataset's regime flag, its value in brackets), one colour per flag."
     if coarse:
-        caption += " A solution computed on a coarser grid (simulations) shows each point as a block reaching halfway to its neighbours."
+        caption += (
+            " A solution computed on a coarser grid (simulations) shows each point as a block reaching halfway to its"
+            " neighbours; blank: frequencies it was not asked to compute."
+        )
     return DrawnFigure(fig, name, title, caption)
+
+
+def _block_edges(columns: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """Edges of blocks around each computed frequency, halfway to its neighbours (coarse simulation grids show as
+    blocks, not hairlines), the end blocks as wide as their neighbours' half spacing, within the frequency axis."""
+    if columns.size == 1:
+        half = 0.5 * float(np.min(np.diff(f))) if f.size > 1 else 0.5
+        return np.array([columns[0] - half, columns[0] + half])
+    middle = (columns[1:] + columns[:-1]) / 2.0
+    first, last = columns[0] - (middle[0] - columns[0]), columns[-1] + (columns[-1] - middle[-1])
+    return np.concatenate([[max(first, f[0])], middle, [min(last, f[-1])]])
 
 
 def stability_figure(part: xr.Dataset, name: str) -> DrawnFigure:
@@ -263,4 +276,4 @@ def simulation_figure(part: xr.Dataset, quantity: str, engines: list[str], name:
         caption.add("unstable", f"{solution_ref(closed)} dashed: the one-impact orbit exists but is unstable (Floquet).")
     caption.add("engines", markers.phrase())
     figure_legend(fig, axes, stability_keys() if any_unstable else [])
-    return DrawnFigure(fig, name, f"Simulation against the closed form: {q.label}, {clearance_text(part)}", caption.text())
+    return DrawnFigure(fig, name, f"Simulations against the closed form: {q.label}, {clearance_text(part)}", caption.text())
