@@ -59,3 +59,12 @@ def test_drawn_map_gives_each_flag_one_colour_and_no_two_flags_the_same() -> Non
         assert entries[regime_label(Regime(flag))] == next(iter(colour))
         assert entries[regime_label(Regime(flag))] == tuple(np.round(to_rgba(REGIME_COLOURS[Regime(flag)]), 6))
     plt.close(drawn.figure)
+
+
+def test_coarse_grid_blocks_reach_halfway_to_their_neighbours_only() -> None:
+    """A simulation on 16-17 Hz (0.5 Hz steps) on a 15-20 Hz axis covers 15.75-17.25 Hz, not the whole axis."""
+    from vibroimpact.report_responses import _block_edges
+
+    f = np.linspace(15.0, 20.0, 101)
+    np.testing.assert_allclose(_block_edges(np.array([16.0, 16.5, 17.0]), f), [15.75, 16.25, 16.75, 17.25])
+    np.testing.assert_allclose(_block_edges(f, f)[[0, -1]], [15.0, 20.0])  # the fine grid fills the axis, no more
