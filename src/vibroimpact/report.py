@@ -91,7 +91,7 @@ def _response_sections(dataset: xr.Dataset, out: Path) -> list[Section]:
     for index in range(dataset.sizes.get("clearance", 1)):
         part = dataset.isel(clearance=index) if several else dataset
         tag = f"_clearance{index}" if several else ""
-        where = f", {clearance_text(part)}" if several else ""
+        where = f", {clearance_text(part)}"
         sections.append(Section(f"Frequency responses{where}", figures=_saved(_response_figures(part, tag), out)))
         engines = [str(name) for name in part["solution"].values if name in ENGINE_SOLUTIONS]
         if engines:

@@ -112,7 +112,10 @@ def _short(title: str, prefix: str, suffix: str | None) -> str:
     """``title`` without the ``prefix`` and ``suffix`` its section's title already says, for the contents."""
     if suffix and title.endswith(suffix) and len(title) > len(suffix):
         title = title[: -len(suffix)]
-    return title[len(prefix) :] if title.startswith(prefix) and len(title) > len(prefix) else title
+    if title.startswith(prefix) and len(title) > len(prefix):
+        title = title[len(prefix) :]
+        title = title[:1].upper() + title[1:]
+    return title
 
 
 def render_page(title: str, paragraphs: list[str], sections: list[Section], scene_text: str) -> str:

@@ -39,7 +39,7 @@ from .report_style import (
 )
 from .scene import ENGINE_SOLUTIONS, Scene
 
-__all__ = ["linear_figure", "response_figure", "regime_figure", "regime_map", "stability_figure", "simulation_figure", "series_by_restitution", "clearance_text"]
+__all__ = ["linear_figure", "response_figure", "regime_figure", "regime_map", "block_edges", "stability_figure", "simulation_figure", "series_by_restitution", "clearance_text"]
 
 #: Frequencies of the linear system's figure (0.0075 Hz over 15-45 Hz: the resonances are about 0.1 Hz wide).
 LINEAR_FIGURE_POINTS = 4001
@@ -197,7 +197,7 @@ def regime_map(panels: list[tuple[str, list[str], np.ndarray]], f: np.ndarray, n
         computed = np.any(grid != Regime.NOT_COMPUTED, axis=0)
         columns = f[computed]
         if columns.size:
-            edges = _block_edges(columns, f)
+            edges = block_edges(columns, f)
             ax.pcolormesh(edges, np.arange(len(labels) + 1) - 0.5, np.searchsorted(flags, grid[:, computed]), cmap=cmap, norm=norm, shading="flat", gid=f"regime:{panel_title}")
             seen.update(int(v) for v in np.unique(grid[:, computed]))
             coarse |= bool(columns.size < f.size)
@@ -216,7 +216,7 @@ def regime_map(panels: list[tuple[str, list[str], np.ndarray]], f: np.ndarray, n
     return DrawnFigure(fig, name, title, caption)
 
 
-def _block_edges(columns: np.ndarray, f: np.ndarray) -> np.ndarray:
+def block_edges(columns: np.ndarray, f: np.ndarray) -> np.ndarray:
     """Edges of blocks around each computed frequency, halfway to its neighbours (coarse simulation grids show as
     blocks, not hairlines), the end blocks as wide as their neighbours' half spacing, within the frequency axis."""
     if columns.size == 1:
