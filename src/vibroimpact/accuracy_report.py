@@ -95,6 +95,7 @@ def _cheapest(dataset: xr.Dataset, case: str, target: float, methods: list[str])
 
 
 def _answer_table(dataset: xr.Dataset) -> str:
+    """Per case and target: the cheapest of our integrators against the cheapest solve_ivp method (HTML)."""
     methods = [str(m) for m in dataset["engine"].values]
     ivp = [m for m in methods if m.startswith("solve_ivp")]
     rows = [
@@ -129,6 +130,7 @@ def _answer_table(dataset: xr.Dataset) -> str:
 
 
 def _guidance_table(dataset: xr.Dataset) -> str:
+    """Per method: the loosest rtol meeting each target in each case, and its wall time [s] (HTML)."""
     header = "<tr><th>engine</th>" + "".join(f"<th>{case}: rtol for {t:g}</th>" for case in dataset["case"].values for t in TARGETS) + "</tr>"
     rows = [header]
     for method in dataset["engine"].values:
@@ -163,6 +165,7 @@ def _equal_error_table(dataset: xr.Dataset) -> str:
 
 
 def _ladder_table(dataset: xr.Dataset) -> str:
+    """One steady state through each model: wall time [s], |X1| [m], difference from exact and relative cost (HTML)."""
     rows = ["<tr><th>model</th><th>wall time per frequency point [s]</th><th>|X1| [m]</th><th>relative difference from exact</th><th>cost / exact</th></tr>"]
     exact_wall = float(dataset["ladder_wall_time"].sel(model="exact"))
     for model in dataset["model"].values:
@@ -199,6 +202,7 @@ def _estimate_table(results: Path = Path("results")) -> str:
 
 
 def _points_table(dataset: xr.Dataset, case: str) -> str:
+    """Every measured point of ``case``: cost, impacts found and missed, errors (HTML)."""
     rows = ["<tr><th>method</th><th>rtol</th><th>wall [s]</th><th>steps</th><th>rhs calls</th><th>impacts</th><th>missed</th><th>extra</th><th>X1 error</th><th>impact-time error [s]</th><th>impulse error</th></tr>"]
     for method in dataset["engine"].values:
         for tolerance in dataset["rtol"].values:

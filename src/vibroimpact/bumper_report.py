@@ -79,6 +79,7 @@ _PEAK_VARIANTS = {
 
 
 def _variant(label: str, solution: str) -> str:
+    """The variant of a closed-form peak row: its label after the solution's name (a key of ``_PEAK_VARIANTS``)."""
     return label[len(solution) :]
 
 
@@ -161,6 +162,7 @@ def peak_acceleration_figure(part: xr.Dataset, name: str) -> DrawnFigure | None:
 
 # ------------------------------------------------------------------------------------------- stiffness
 def _stiffness_reference(dataset: xr.Dataset) -> str | None:
+    """The rigid-stop simulation the compliant one is compared with (exact if present), or None."""
     for name in ("exact", "momentary"):
         if name in dataset["solution"].values:
             return name

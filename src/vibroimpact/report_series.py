@@ -148,6 +148,7 @@ class SimulationMarkers:
         self.drawn[solution] = (old[0] or drawn[0], old[1] or drawn[1])
 
     def __bool__(self) -> bool:
+        """Whether any marker was drawn."""
         return any(p or i for p, i in self.drawn.values())
 
     def keys(self) -> list[Line2D]:

@@ -1,4 +1,4 @@
-"""The look every report page shares: figure size, colours, quantity labels, one number formatter, drawing helpers.
+"""The look every report page shares: figure size, colours, quantity labels, one number formatter, captions, layout.
 
 A report is read in a browser about 1400 px wide. Figures are at most :data:`FIGURE_WIDTH` wide at :data:`DPI`, so
 they are shown unscaled and their text (at least :data:`MIN_FONT_SIZE`) stays legible; panels come at most

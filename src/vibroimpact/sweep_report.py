@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import xarray as xr
+from matplotlib.axes import Axes
 
 from .regime import Regime
 from .report_common import DrawnFigure, Table
@@ -30,6 +31,7 @@ _FREQUENCY = "instantaneous frequency [Hz]"
 
 
 def _steady_solutions(dataset: xr.Dataset) -> list[str]:
+    """The steady-state solutions of a swept-sine dataset (none if it has no ``solution`` dimension)."""
     return [str(s) for s in dataset["solution"].values] if "solution" in dataset.coords else []
 
 
@@ -39,10 +41,12 @@ def _swept_solution(scene: Scene) -> str:
 
 
 def _directions(dataset: xr.Dataset) -> list[str]:
+    """The sweep directions of the dataset, in its order."""
     return [str(s) for s in dataset["sweep"].values]
 
 
 def _sweep_text(scene: Scene) -> str:
+    """The sweep's range [Hz], rate [Hz/s], bumper [Hz], loss factor [-] and window [cycles], for captions."""
     s = scene.swept_sine
     assert s is not None and scene.bumper_frequency is not None
     return (
@@ -51,7 +55,7 @@ def _sweep_text(scene: Scene) -> str:
     )
 
 
-def _draw_steady(ax: object, dataset: xr.Dataset, quantity: str, caption: Caption, with_linear: bool = True) -> bool:
+def _draw_steady(ax: Axes, dataset: xr.Dataset, quantity: str, caption: Caption, with_linear: bool = True) -> bool:
     """Linear system and pgf steady state of ``quantity``; returns whether an unstable stretch was drawn."""
     f = dataset["frequency"].values
     steady = _steady_solutions(dataset)
@@ -68,7 +72,7 @@ def _draw_steady(ax: object, dataset: xr.Dataset, quantity: str, caption: Captio
     return unstable
 
 
-def _draw_swept(ax: object, dataset: xr.Dataset, quantity: str, solution: str, scale: float = 1.0, style: dict[str, object] | None = None, suffix: str = "") -> bool:
+def _draw_swept(ax: Axes, dataset: xr.Dataset, quantity: str, solution: str, scale: float = 1.0, style: dict[str, object] | None = None, suffix: str = "") -> bool:
     """The running estimate of ``quantity`` of each sweep direction; returns whether anything was drawn."""
     name = f"swept_{quantity}"
     if name not in dataset:
@@ -105,6 +109,7 @@ def sweep_figures(dataset: xr.Dataset, scene: Scene) -> list[DrawnFigure]:
 
 
 def _displacement_figure(dataset: xr.Dataset, scene: Scene, solution: str) -> DrawnFigure:
+    """Running fundamental and sqrt 2 x RMS of X1 and X2 of each sweep against the steady states (figures 16-20)."""
     caption = Caption(f"Swept sine ({_sweep_text(scene)}): running estimates of {solution_ref(solution)} against the instantaneous frequency, like the paper's figures 16-20, against the steady states.")
     fig, axes = new_figure(2, panel_height=4.0, legend_rows=legend_rows(8))
     any_unstable = False
@@ -124,6 +129,7 @@ def _displacement_figure(dataset: xr.Dataset, scene: Scene, solution: str) -> Dr
 
 
 def _force_figure(dataset: xr.Dataset, solution: str) -> DrawnFigure | None:
+    """Force on the base, impulse and contacts per period of each sweep against the steady states (figures 21-24)."""
     quantities = [q for q in ("force_amplitude", "impulse", "impacts_per_period") if f"swept_{q}" in dataset]
     if not quantities:
         return None
