@@ -40,12 +40,8 @@ def write_report(dataset: xr.Dataset, out_dir: str | Path) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     scene = parse_scene(read_yaml(dataset.attrs["scene"]), text=dataset.attrs["scene"])
     sections = page_sections(dataset, scene, out)
-    if "solution" in dataset.coords:
-        contents = f"solutions: {', '.join(map(str, dataset['solution'].values))}"
-    elif "engine" in dataset.coords:
-        contents = f"methods: {', '.join(map(str, dataset['engine'].values))}"
-    else:
-        contents = f"solutions: {', '.join(scene.solutions)}"
+    # the scene's solutions: a swept-sine run is not along the dataset's ``solution`` dimension
+    contents = f"methods: {', '.join(map(str, dataset['engine'].values))}" if scene.benchmark is not None else f"solutions: {', '.join(scene.solutions)}"
     paragraphs = [scene.description, f"vibroimpact {dataset.attrs.get('vibroimpact_version', '?')}; {contents}."]
     return write_page(out / "report.html", render_page(f"Study '{scene.name}'", paragraphs, sections, scene.text))
 
