@@ -13,6 +13,7 @@ import pytest
 import yaml
 
 from vibroimpact import cli, study
+from vibroimpact.runner import cached_case_count
 from vibroimpact.scene import shipped_studies, shipped_studies_dir
 
 from .test_scene import base_scene, write_yaml
@@ -111,12 +112,12 @@ def test_ctrl_c_leaves_one_line_and_a_resumable_cache(tmp_path: Path) -> None:
     arguments = [str(scene), "--out", "out", "--jobs", "2"]
     run = _start(arguments, tmp_path)
     deadline = time.monotonic() + 180.0
-    while not list(cache.glob("*.npz")) and run.poll() is None and time.monotonic() < deadline:
+    while cached_case_count(cache) == 0 and run.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)
     assert run.poll() is None, "the study ended before it could be interrupted"
     os.killpg(run.pid, signal.SIGINT)
     _out, err = run.communicate(timeout=60)
-    kept = len(list(cache.glob("*.npz")))
+    kept = cached_case_count(cache)
     assert run.returncode == 130, err
     assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
     assert err.rstrip().splitlines()[-1] == f"interrupted: {kept} finished case{'s' if kept != 1 else ''} kept; run the same command to resume"

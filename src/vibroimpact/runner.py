@@ -88,8 +88,8 @@ def run_cases(cases: Sequence[Case], jobs: int = 1, cache_dir: Path | None = Non
 
 
 def cached_case_count(cache_dir: Path) -> int:
-    """Finished cases kept in ``cache_dir``."""
-    return len(list(cache_dir.glob("*.npz"))) if cache_dir.is_dir() else 0
+    """Finished cases kept in ``cache_dir`` (not counting a temporary file being written, whose name starts with a dot)."""
+    return sum(1 for path in cache_dir.glob("*.npz") if not path.name.startswith(".")) if cache_dir.is_dir() else 0
 
 
 def _run_in_processes(cases: Sequence[Case], pending: list[int], jobs: int, bar: "_Progress", finish: Callable[[int, CaseResult], None]) -> None:
