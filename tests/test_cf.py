@@ -64,6 +64,25 @@ def test_swept_sine_study_is_cf_clean(tmp_path: Path) -> None:
     assert cf_findings(path, tmp_path / "cf.json") == []
 
 
+@pytest.mark.timeout(120)
+def test_benchmark_study_is_cf_clean(tmp_path: Path) -> None:
+    """A benchmark scene's dataset (case, engine, rtol), as engine_cost and accuracy_cost write it."""
+    document = {
+        "name": "cf_benchmark",
+        "system": dict(PAPER_SYSTEM_SPEC),
+        "excitation": {"amplitude": 10.0},
+        "benchmark": {
+            "duration": 0.2,
+            "methods": ["momentary_adams"],
+            "tolerances": [1.0e-6],
+            "repeats": 1,
+            "cases": [{"name": "one_impact_25Hz", "frequency": 25.0, "restitution": 0.2, "clearance": 0.003, "start": "rest"}],
+        },
+    }
+    path = write(document, tmp_path)
+    assert cf_findings(path, tmp_path / "cf.json") == []
+
+
 def test_the_check_finds_what_it_should(tmp_path: Path) -> None:
     """The check is not blind: a coordinate with a _FillValue and a file without history are reported."""
     import xarray as xr

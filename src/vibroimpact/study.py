@@ -120,7 +120,7 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
     """
     if scene.benchmark is not None:
         dataset = run_benchmark(list(scene.benchmark.cases), scene.benchmark.settings, progress=progress is not None)
-        dataset.attrs.update({"title": f"vibroimpact benchmark '{scene.name}'", "scene_name": scene.name, "scene": scene.text, "vibroimpact_version": __version__})
+        dataset.attrs.update({"title": f"vibroimpact benchmark '{scene.name}'", "scene_name": scene.name, "scene": scene.text} | _provenance())
         return dataset
     report = progress or (lambda _message: None)
     # full grid (restitution, clearance, bumper_frequency, sweep, frequency): unswept axes have length 1 and are
@@ -429,6 +429,11 @@ def _swept(scene: Scene, shape: tuple[int, ...], jobs: int, cache_dir: Path | No
     return {q: values[q] for q in scene.quantities}, running, {"time": times, "instantaneous_frequency": instantaneous}
 
 
+def _provenance() -> dict[str, str]:
+    """What every dataset says about how it was made: the package version, its source and the conventions followed."""
+    return {"vibroimpact_version": __version__, "vibroimpact_source_sha256": source_hash(), "Conventions": "CF-1.8"}
+
+
 def _metadata(scene: Scene) -> dict[str, object]:
     system = scene.system
     fit = fit_modal_parameters(system) if "pgf_paper" in scene.solutions else None
@@ -436,9 +441,7 @@ def _metadata(scene: Scene) -> dict[str, object]:
         "title": f"vibroimpact study '{scene.name}'",
         "scene_name": scene.name,
         "scene": scene.text,
-        "vibroimpact_version": __version__,
-        "vibroimpact_source_sha256": source_hash(),
-        "Conventions": "CF-1.8",
+        **_provenance(),
         "excitation_amplitude_N": scene.amplitude,
         "natural_frequencies_Hz": np.array(system.natural_frequencies()) / (2.0 * np.pi),
         "antiresonance_frequency_Hz": system.antiresonance_frequency() / (2.0 * np.pi),
