@@ -3,7 +3,9 @@
 Output contract (read by other tools; keep these names): dimensions ``solution`` (strings), each swept parameter
 (``restitution`` [1], ``clearance`` [m]) and ``frequency`` [Hz]; variables ``x1_amplitude`` [m],
 ``x2_amplitude`` [m], ``force_amplitude`` [N], ``suspension_force_amplitude`` [N], ``impulse`` [N s], ``phase``
-[rad] and ``regime`` (CF flags). Unswept stop parameters are scalar coordinates.
+[rad] and ``regime`` (CF flags). Unswept stop parameters are scalar coordinates. Swept-sine scenes add dimension
+``sweep``: the swept runs' estimates are ``swept_<quantity>`` (sweep, frequency) and their running estimates
+``running_<quantity>`` (sweep, elapsed_time); the steady-state solutions are not repeated along ``sweep``.
 """
 
 from __future__ import annotations
