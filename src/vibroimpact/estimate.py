@@ -11,7 +11,7 @@ The prediction multiplies what the scene asks for by costs measured on this mach
   orbit exists, and ``max_periods`` plus the irregular measurement elsewhere (motion that may never settle);
 * swept sines: seconds per simulated second of the compliant engine at its tolerance;
 * the work is spread over ``jobs`` processes; the report adds a fixed cost per figure;
-* everything is scaled by this machine's speed against the calibration machine's: a probe of about 0.2 s (the same
+* everything is scaled by this machine's speed against the calibration machine's: a probe of about 0.25 s (the same
   short ``exact`` and ``momentary`` runs, timed at calibration too) measures it, so a slower or busier machine gets a
   longer prediction.
 
@@ -23,6 +23,7 @@ while it runs, and the measured footprint of one worker process. It is an estima
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 import pprint
 import sys
@@ -101,8 +102,10 @@ def speed_probe(repeats: int = 3) -> float:
     return best
 
 
+@functools.cache
 def speed_factor() -> float:
-    """This machine's probe time over the calibration machine's [-], within :data:`SPEED_FACTOR_RANGE`."""
+    """This machine's probe time over the calibration machine's [-], within :data:`SPEED_FACTOR_RANGE`; measured once
+    per process (the accuracy report estimates every shipped study)."""
     low, high = SPEED_FACTOR_RANGE
     return min(max(speed_probe() / COSTS["speed_probe_seconds"], low), high)
 
