@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from vibroimpact.system import PAPER_SYSTEM, TwoDofSystem
+from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
 
 #: Excitation amplitude q of the paper's example [N].
 PAPER_AMPLITUDE = 10.0

@@ -6,11 +6,11 @@ import numpy as np
 
 from vibroimpact.engines import ExactEngine, ImpactProblem, Trajectory
 from vibroimpact.engines.linear_flow import gauss_legendre
-from vibroimpact.linear import linear_response
-from vibroimpact.pgf import OneImpactSolution, solve_one_impact
-from vibroimpact.system import PAPER_SYSTEM, TwoDofSystem
+from vibroimpact.analysis.linear import linear_response
+from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
+from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
 
-from .conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
+from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
 
 
 def pgf_start(frequency: float, restitution: float, clearance: float = PAPER_CLEARANCE, system: TwoDofSystem = PAPER_SYSTEM) -> tuple[ImpactProblem, np.ndarray, float, OneImpactSolution]:

@@ -12,11 +12,12 @@ from pathlib import Path
 import pytest
 import yaml
 
-from vibroimpact import cli, study
-from vibroimpact.runner import cached_case_count
-from vibroimpact.scene import shipped_studies, shipped_studies_dir
+from vibroimpact import cli
+from vibroimpact.study import run as study
+from vibroimpact.study.runner import cached_case_count
+from vibroimpact.scene.core import shipped_studies, shipped_studies_dir
 
-from .test_scene import base_scene, write_yaml
+from tests.scene.test_scene import base_scene, write_yaml
 
 REPOSITORY = Path(__file__).resolve().parents[1]
 
@@ -68,7 +69,7 @@ def test_each_searched_place_is_listed_once(monkeypatch: pytest.MonkeyPatch, cap
 
 
 def test_a_local_file_wins_over_the_shipped_scene(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    from vibroimpact.scene import find_scene
+    from vibroimpact.scene.core import find_scene
 
     monkeypatch.chdir(tmp_path)
     local = write_yaml(tmp_path / "restitution.yaml", base_scene())
@@ -159,11 +160,11 @@ def test_installed_package_finds_its_studies(tmp_path: Path) -> None:
 
 def test_a_code_change_invalidates_the_resume_cache(monkeypatch: pytest.MonkeyPatch) -> None:
     """The cache key hashes the package's source: other code, other key (the version number alone would not do)."""
-    from vibroimpact import fingerprint
+    from vibroimpact.study import fingerprint
     from vibroimpact.engines import EngineSettings
-    from vibroimpact.simulate import SimulationCase
-    from vibroimpact.steady import SteadySettings
-    from vibroimpact.system import PAPER_SYSTEM
+    from vibroimpact.study.cases import SimulationCase
+    from vibroimpact.simulation.steady import SteadySettings
+    from vibroimpact.model.system import PAPER_SYSTEM
 
     case = SimulationCase("exact", PAPER_SYSTEM, 10.0, 0.2, 0.003, (25.0,), "pgf", EngineSettings(), SteadySettings())
     before = case.key()
@@ -173,8 +174,8 @@ def test_a_code_change_invalidates_the_resume_cache(monkeypatch: pytest.MonkeyPa
 
 
 def test_datasets_record_the_source_they_came_from(tmp_path: Path) -> None:
-    from vibroimpact.fingerprint import source_hash
-    from vibroimpact.scene import load_scene
+    from vibroimpact.study.fingerprint import source_hash
+    from vibroimpact.scene.core import load_scene
 
     document = base_scene()
     document.update(solutions=["linear"], sweep={"frequency": [20.0, 21.0]})

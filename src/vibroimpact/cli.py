@@ -14,9 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .runner import cached_case_count
-from .scene import Scene, SceneError, find_scene, load_scene, shipped_studies
-from .study import run_study, write_dataset
+from vibroimpact.study.runner import cached_case_count
+from vibroimpact.scene.core import Scene, SceneError, find_scene, load_scene, shipped_studies
+from vibroimpact.study.run import run_study, write_dataset
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILURE = 1
@@ -59,7 +59,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"run-study: error: --jobs {args.jobs} is out of range: allowed [1, inf)", file=sys.stderr)
         return EXIT_BAD_INPUT
     if args.estimate:
-        from .estimate import estimate_scene
+        from vibroimpact.study.estimate import estimate_scene
 
         print(estimate_scene(scene, jobs=args.jobs).text())
         return 0
@@ -103,7 +103,7 @@ def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, cache: Path) -> 
         shutil.rmtree(cache, ignore_errors=True)
         print(f"wrote {path}")
         if scene.report and not args.no_report:
-            from .report import write_report  # matplotlib is imported only when a report is made
+            from vibroimpact.reporting.report import write_report  # matplotlib is imported only when a report is made
 
             report = write_report(dataset, out_dir)
             print(f"wrote {report}")

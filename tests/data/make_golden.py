@@ -5,8 +5,8 @@ Say in the commit message why the numbers changed.
 
 from pathlib import Path
 
-from vibroimpact.scene import load_scene
-from vibroimpact.study import run_study, write_dataset
+from vibroimpact.scene.core import load_scene
+from vibroimpact.study.run import run_study, write_dataset
 
 HERE = Path(__file__).parent
 

@@ -31,16 +31,16 @@ from typing import Mapping
 
 import numpy as np
 
-from vibroimpact.contact import loss_factor_from_restitution, restitution_from_loss_factor
+from vibroimpact.model.contact import loss_factor_from_restitution, restitution_from_loss_factor
 from vibroimpact.engines import Engine, EngineSettings, ExactEngine, ImpactProblem
-from vibroimpact.engines.compliant import CompliantEngine
+from vibroimpact.engines.compliant.ida import CompliantEngine
 from vibroimpact.engines.momentary import MomentaryEngine
 from vibroimpact.engines.scipy_ivp import SolveIvpEngine
-from vibroimpact.linear import linear_response
-from vibroimpact.system import PAPER_SYSTEM, TwoDofSystem
+from vibroimpact.analysis.linear import linear_response
+from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
 
-from ..conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
-from ..engine_cases import linear_state, pgf_start
+from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
+from tests.engine_cases import linear_state, pgf_start
 
 __all__ = ["ENGINE_NAMES", "RIGID", "SOLVE_IVP", "Bumper", "Expect", "NotRun", "HardCase", "CASES", "build_engine"]
 

@@ -10,12 +10,12 @@ import math
 
 import numpy as np
 
-from vibroimpact.contact import restitution_from_loss_factor
+from vibroimpact.model.contact import restitution_from_loss_factor
 from vibroimpact.engines import MODE_FREE, MODE_STUCK, EngineSettings, ExactEngine, ImpactProblem, Trajectory
-from vibroimpact.engines.compliant import MODE_CONTACT
+from vibroimpact.engines.compliant.ida import MODE_CONTACT
 from vibroimpact.engines.linear_flow import HarmonicLinearFlow, first_crossing
 
-from ..engine_cases import energy_budget
+from tests.engine_cases import energy_budget
 
 __all__ = [
     "length_scale",

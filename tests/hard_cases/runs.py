@@ -10,9 +10,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from vibroimpact.engines import MODE_STUCK, Trajectory
-from vibroimpact.pgf import solve_one_impact
+from vibroimpact.analysis.pgf import solve_one_impact
 
-from ..engine_cases import linear_state
+from tests.engine_cases import linear_state
 from .cases import CASES, RIGID, Expect, HardCase, build_engine
 from .checks import (
     bumper_penetration_bound,

@@ -30,9 +30,9 @@ from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 from vibroimpact.engines import ImpactProblem
-from vibroimpact.system import TwoDofSystem
+from vibroimpact.model.system import TwoDofSystem
 
-from ..engine_cases import linear_state
+from tests.engine_cases import linear_state
 from .cases import RIGID, SOLVE_IVP, Bumper, build_engine
 from .checks import bumper_penetration_bound, compliant_contact_errors, contact_law_errors, flow_exceedances, length_scale, penetration
 

@@ -9,8 +9,8 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from ..system import TwoDofSystem
-from ..validation import require_in_range, require_non_negative, require_positive
+from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.model.validation import require_in_range, require_non_negative, require_positive
 
 __all__ = ["ImpactProblem", "EngineSettings", "Trajectory", "Engine", "MODE_FREE", "MODE_STUCK"]
 

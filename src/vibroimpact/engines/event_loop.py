@@ -18,7 +18,7 @@ from enum import Enum
 import numpy as np
 from numpy.typing import NDArray
 
-from .base import MODE_FREE, MODE_STUCK, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
+from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
 
 __all__ = ["EventLoopEngine", "Stop", "Model"]
 

@@ -14,8 +14,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from .base import MODE_FREE, MODE_STUCK, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
-from .linear_flow import HarmonicLinearFlow, Observable, Piece, escape_step, first_crossing, gauss_legendre
+from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
+from vibroimpact.engines.linear_flow import HarmonicLinearFlow, Observable, Piece, escape_step, first_crossing, gauss_legendre
 
 __all__ = ["ExactEngine"]
 

@@ -22,9 +22,9 @@ import numpy as np
 from numpy.typing import NDArray
 from sksundae.cvode import CVODE
 
-from .base import EngineSettings
-from .sundae import clear_event_records
-from .event_loop import EventLoopEngine, Model, Stop
+from vibroimpact.engines.base import EngineSettings
+from vibroimpact.engines.sundae import clear_event_records
+from vibroimpact.engines.event_loop import EventLoopEngine, Model, Stop
 
 __all__ = ["MomentaryEngine"]
 

@@ -13,8 +13,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
-from .base import EngineSettings
-from .event_loop import EventLoopEngine, Model, Stop
+from vibroimpact.engines.base import EngineSettings
+from vibroimpact.engines.event_loop import EventLoopEngine, Model, Stop
 
 __all__ = ["SolveIvpEngine", "SOLVE_IVP_METHODS"]
 

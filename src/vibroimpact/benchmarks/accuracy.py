@@ -1,0 +1,428 @@
+"""Accuracy and cost: the same run through every engine and tolerance, measured in one process against a reference.
+
+Each case is a stepped-sine run (frequency, restitution, clearance, start, periods), optionally with a bumper, or a
+swept-sine run of the compliant model. Rigid-stop methods (``momentary_*``, ``solve_ivp_*`` on stepped cases) are
+measured against the ``exact`` engine; compliant-model methods (``compliant_ida``, ``compliant_cvode_*``, and
+``solve_ivp_*`` on swept cases, through :func:`.engines.compliant_ivp.solve_ivp_sweep`) against the compliant model
+integrated by CVODE (Adams) at rtol 1e-13: another integrator, converged. Each impact of the reference is matched to
+the nearest impact of the method (within 1e-3 of a period); unmatched reference impacts are *missed*, unmatched
+method impacts *extra*; impact-time and impulse errors are over matched impacts. The quantity users care about most,
+the fundamental of X1, is compared over the whole run (stepped: from the exact per-period moments; swept: the running
+8-cycle fundamental, largest difference over the run relative to its largest value). Wall time is the median of
+``repeats`` runs (one run when a run takes more than 5 s). Timings on shared machines are noisy: read the ratios,
+measured in the same process run, not the absolute seconds.
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+import sys
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import xarray as xr
+
+from vibroimpact.model.contact import loss_factor_from_restitution
+from vibroimpact.engines import EngineSettings, ExactEngine, ImpactProblem, Trajectory
+from vibroimpact.engines.base import Engine
+from vibroimpact.engines.compliant.ida import CompliantEngine, SweepRecord
+from vibroimpact.engines.compliant.cvode import CompliantCvodeEngine
+from vibroimpact.engines.compliant.ivp import solve_ivp_sweep
+from vibroimpact.engines.momentary import MomentaryEngine
+from vibroimpact.engines.scipy_ivp import SolveIvpEngine
+from vibroimpact.model.excitation import SweptSine
+from vibroimpact.simulation.harmonics import measure, running_fundamental
+from vibroimpact.simulation.steady import start_state
+from vibroimpact.model.system import TwoDofSystem
+
+__all__ = ["BENCHMARK_METHODS", "BenchmarkCase", "BenchmarkSettings", "LadderSettings", "run_benchmark", "model_ladder", "equal_error_speedup", "loosest_tolerance", "REFERENCE_RTOL"]
+
+#: Rigid-stop methods (``exact`` is always run: it is their reference).
+RIGID_METHODS: dict[str, Callable[[EngineSettings], Engine]] = {
+    "momentary_adams": lambda s: MomentaryEngine(EngineSettings(rtol=s.rtol, atol=s.atol, method="adams")),
+    "momentary_bdf": lambda s: MomentaryEngine(EngineSettings(rtol=s.rtol, atol=s.atol, method="bdf")),
+    "solve_ivp_DOP853": lambda s: SolveIvpEngine(s, "DOP853"),
+    "solve_ivp_LSODA": lambda s: SolveIvpEngine(s, "LSODA"),
+    "solve_ivp_Radau": lambda s: SolveIvpEngine(s, "Radau"),
+    "solve_ivp_RK45": lambda s: SolveIvpEngine(s, "RK45"),
+}
+#: Compliant-model methods: (settings, bumper frequency [Hz], loss factor) -> engine.
+COMPLIANT_METHODS: dict[str, Callable[[EngineSettings, float, float], CompliantEngine]] = {
+    "compliant_ida": lambda s, f, xi: CompliantEngine(f, xi, s),
+    "compliant_cvode_adams": lambda s, f, xi: CompliantCvodeEngine(f, xi, EngineSettings(rtol=s.rtol, atol=s.atol, method="adams")),
+    "compliant_cvode_bdf": lambda s, f, xi: CompliantCvodeEngine(f, xi, EngineSettings(rtol=s.rtol, atol=s.atol, method="bdf")),
+}
+#: Every method name a benchmark scene may list.
+BENCHMARK_METHODS = tuple(RIGID_METHODS) + tuple(COMPLIANT_METHODS)
+#: Tolerance of the compliant model's reference (CVODE Adams); its atol is this times the scene's atol_ratio.
+REFERENCE_RTOL = 1e-13
+SLOW_RUN = 5.0  # [s] a run longer than this is not repeated
+
+
+@dataclass(frozen=True)
+class BenchmarkCase:
+    """One benchmark run: the problem, where it starts and how long it lasts.
+
+    Attributes
+    ----------
+    name : str
+        Label of the case.
+    problem : ImpactProblem
+        System, stop and excitation (a swept case uses its system, clearance and restitution).
+    start : str
+        ``rest``, ``linear`` or ``pgf`` (see :func:`vibroimpact.steady.start_state`); swept cases start at rest.
+    periods : int
+        Whole periods integrated (stepped cases).
+    bumper_frequency : float
+        Omega_b / 2 pi of the compliant model [Hz] (loss factor from the restitution); NaN: no compliant methods.
+    sweep : SweptSine or None
+        A swept-sine case of the compliant model.
+    sample_rate : float
+        Output samples per second of a swept case [Hz].
+    """
+
+    name: str
+    problem: ImpactProblem
+    start: str
+    periods: int
+    bumper_frequency: float = math.nan
+    sweep: SweptSine | None = None
+    sample_rate: float = 2000.0
+
+    @property
+    def loss_factor(self) -> float:
+        """xi_b matching the case's restitution [-]."""
+        return loss_factor_from_restitution(self.problem.restitution)
+
+    def runs(self, method: str) -> bool:
+        """Whether ``method`` applies to this case."""
+        if self.sweep is not None:
+            return method in COMPLIANT_METHODS or method.startswith("solve_ivp_")
+        return method in RIGID_METHODS or (method in COMPLIANT_METHODS and math.isfinite(self.bumper_frequency))
+
+
+@dataclass(frozen=True)
+class BenchmarkSettings:
+    """What to compare.
+
+    Attributes
+    ----------
+    methods : tuple of str
+        Keys of :data:`BENCHMARK_METHODS`.
+    tolerances : tuple of float
+        Relative tolerances; atol = rtol * ``atol_ratio`` [m, m s-1].
+    atol_ratio : float
+        Absolute tolerance per unit of relative tolerance [m].
+    repeats : int
+        Runs per point (median wall time).
+    max_seconds : float
+        The largest run time allowed: tighter tolerances of a method are skipped once a run took longer [s].
+    ladder : LadderSettings or None
+        The model-cost ladder to measure as well.
+    """
+
+    methods: tuple[str, ...]
+    tolerances: tuple[float, ...]
+    atol_ratio: float = 1e-4
+    repeats: int = 3
+    max_seconds: float = 60.0
+    ladder: "LadderSettings | None" = None
+
+
+def _compare(reference: Trajectory, trial: Trajectory) -> dict[str, float]:
+    """Missed and extra impacts, and errors over matched impacts, of ``trial`` against ``reference``.
+
+    Matching is one to one: candidate pairs (each reference impact with its nearest trial impacts on either side)
+    closer than the window are taken greedily from the closest, each impact used once; unmatched reference impacts
+    are missed, unmatched trial impacts extra.
+    """
+    window = 1e-3 * reference.problem.period
+    ref_t, trial_t = reference.impact_times, trial.impact_times
+    time_error = impulse_error = 0.0
+    pairs: list[tuple[float, int, int]] = []
+    if trial_t.size and ref_t.size:
+        right = np.searchsorted(trial_t, ref_t)
+        for i, r in enumerate(right):
+            for j in (r - 1, r, r + 1):
+                if 0 <= j < trial_t.size and abs(trial_t[j] - ref_t[i]) < window:
+                    pairs.append((abs(trial_t[j] - ref_t[i]), i, j))
+    pairs.sort()
+    used_ref, used_trial, matched = set(), set(), []
+    for gap, i, j in pairs:
+        if i not in used_ref and j not in used_trial:
+            used_ref.add(i)
+            used_trial.add(j)
+            matched.append((gap, i, j))
+    if matched:
+        gaps, ref_index, trial_index = (np.array(column) for column in zip(*matched))
+        time_error = float(gaps.max())
+        impulse_error = float(np.max(np.abs(trial.impulses[trial_index] - reference.impulses[ref_index]) / reference.impulses[ref_index]))
+    missed, extra = int(ref_t.size - len(matched)), int(trial_t.size - len(matched))
+    scale = np.abs(reference.strobe_states).max(axis=0) + 1e-300
+    state_error = float(np.max(np.abs(trial.final_state - reference.final_state) / scale))
+    return {"missed_impacts": missed, "extra_impacts": extra, "impact_time_error": time_error, "impulse_error": impulse_error, "final_state_error": state_error}
+
+
+class _Run:
+    """What one timed run returns: the trajectory, and for a sweep its running X1 fundamental."""
+
+    def __init__(self, trajectory: Trajectory, x1: np.ndarray) -> None:
+        self.trajectory, self.x1 = trajectory, x1
+
+
+def _x1_of(trajectory: Trajectory) -> np.ndarray:
+    return np.array([abs(measure(trajectory).x1)]) if trajectory.periods else np.array([np.nan])
+
+
+def _runner(case: BenchmarkCase, method: str, settings: EngineSettings) -> Callable[[], _Run]:
+    """A function doing one run of ``method`` on ``case``."""
+    problem = case.problem
+    if case.sweep is not None:
+        sweep = case.sweep
+
+        def from_record(record: SweepRecord) -> _Run:
+            return _Run(record.trajectory, running_fundamental(record.time, record.x1, sweep, cycles=8).amplitude)
+
+        if method in COMPLIANT_METHODS:
+            engine = COMPLIANT_METHODS[method](settings, case.bumper_frequency, case.loss_factor)
+            return lambda: from_record(engine.sweep(problem.system, problem.clearance, sweep, case.sample_rate))
+        ivp = method.removeprefix("solve_ivp_")
+        return lambda: from_record(solve_ivp_sweep(problem.system, problem.clearance, case.bumper_frequency, case.loss_factor, sweep, case.sample_rate, ivp, settings.rtol, settings.atol))
+    t0, y0 = start_state(problem, case.start)
+    stepped: Engine = COMPLIANT_METHODS[method](settings, case.bumper_frequency, case.loss_factor) if method in COMPLIANT_METHODS else RIGID_METHODS[method](settings)
+
+    def run() -> _Run:
+        trajectory = stepped.integrate(problem, y0, t0, case.periods, moments=True)
+        return _Run(trajectory, _x1_of(trajectory))
+
+    return run
+
+
+def _timed(run: Callable[[], _Run], repeats: int) -> tuple[_Run, float]:
+    times = []
+    result = None
+    for _ in range(repeats):
+        started = time.perf_counter()
+        result = run()
+        times.append(time.perf_counter() - started)
+        if times[-1] > SLOW_RUN:
+            break
+    assert result is not None
+    return result, statistics.median(times)
+
+
+def _references(case: BenchmarkCase, settings: BenchmarkSettings) -> dict[str, tuple[_Run, float]]:
+    """The references a case needs: ``exact`` (rigid methods), ``compliant`` (CVODE Adams at REFERENCE_RTOL)."""
+    references: dict[str, tuple[_Run, float]] = {}
+    if case.sweep is None:
+        t0, y0 = start_state(case.problem, case.start)
+
+        def exact() -> _Run:
+            trajectory = ExactEngine().integrate(case.problem, y0, t0, case.periods, moments=True)
+            return _Run(trajectory, _x1_of(trajectory))
+
+        references["rigid"] = _timed(exact, settings.repeats)
+    if any(case.runs(m) and (m in COMPLIANT_METHODS or case.sweep is not None) for m in settings.methods):
+        tight = EngineSettings(rtol=REFERENCE_RTOL, atol=REFERENCE_RTOL * settings.atol_ratio, method="adams")
+        references["compliant"] = _timed(_runner(case, "compliant_cvode_adams", tight), 1)
+    return references
+
+
+def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progress: bool = True) -> xr.Dataset:
+    """Every method at every tolerance on every case; returns a Dataset with dimensions (case, engine, rtol).
+
+    The dimensions are called ``engine`` and ``rtol``, not ``method`` and ``tolerance``, which clash with the
+    keyword arguments of ``Dataset.sel``. Methods that do not apply to a case (a compliant method without a bumper,
+    a rigid-stop engine on a swept case) are NaN there.
+    """
+    shape = (len(cases), len(settings.methods), len(settings.tolerances))
+    names = ("wall_time", "rhs_calls", "steps", "impacts", "missed_impacts", "extra_impacts", "impact_time_error", "impulse_error", "final_state_error", "x1_error")
+    data = {name: np.full(shape, np.nan) for name in names}
+    reference_time = np.full((len(cases), 2), np.nan)
+    reference_impacts = np.full((len(cases), 2), np.nan)
+    reference_x1 = np.full((len(cases), 2), np.nan)
+    for c, case in enumerate(cases):
+        references = _references(case, settings)
+        for r, kind in enumerate(("rigid", "compliant")):
+            if kind in references:
+                reference, reference_time[c, r] = references[kind]
+                reference_impacts[c, r] = reference.trajectory.impact_times.size
+                reference_x1[c, r] = float(np.nanmax(reference.x1))
+        for m, method in enumerate(settings.methods):
+            if not case.runs(method):
+                continue
+            kind = "compliant" if method in COMPLIANT_METHODS or case.sweep is not None else "rigid"
+            reference = references[kind][0]
+            for k, rtol in enumerate(settings.tolerances):
+                run, wall = _timed(_runner(case, method, EngineSettings(rtol=rtol, atol=rtol * settings.atol_ratio)), settings.repeats)
+                trajectory = run.trajectory
+                scale = float(np.nanmax(reference.x1))
+                values = _compare(reference.trajectory, trajectory) | {
+                    "wall_time": wall,
+                    "rhs_calls": trajectory.stats.get("rhs_calls", np.nan),
+                    "steps": trajectory.stats.get("steps", np.nan),
+                    "impacts": trajectory.impact_times.size,
+                    "x1_error": float(np.nanmax(np.abs(run.x1 - reference.x1))) / scale if run.x1.shape == reference.x1.shape else np.nan,
+                }
+                if case.sweep is not None:
+                    values["final_state_error"] = np.nan  # samples, not strobes: x1_error says it
+                for name in names:
+                    data[name][c, m, k] = values[name]
+                if progress:
+                    print(f"benchmark {case.name}: {method} rtol {rtol:g}: {wall:.3f} s, X1 error {values['x1_error']:.1e}, missed {values['missed_impacts']}", file=sys.stderr, flush=True)
+                if wall > settings.max_seconds:
+                    break  # tighter tolerances would only take longer
+    attrs = {
+        "wall_time": ("s", "median wall time of one run"),
+        "rhs_calls": ("1", "right-hand-side (or residual) evaluations"),
+        "steps": ("1", "integrator steps where the engine counts them (NaN otherwise)"),
+        "impacts": ("1", "impacts (contacts) found"),
+        "missed_impacts": ("1", "impacts of the reference not found within 1e-3 of a period"),
+        "extra_impacts": ("1", "impacts found that the reference does not have"),
+        "impact_time_error": ("s", "largest impact-time error over matched impacts"),
+        "impulse_error": ("1", "largest relative impulse error over matched impacts"),
+        "final_state_error": ("1", "error of the final state relative to the reference's largest values (stepped cases)"),
+        "x1_error": ("1", "error of the X1 fundamental relative to the reference (stepped: over the whole run; swept: largest difference of the running 8-cycle fundamental over its largest value)"),
+    }
+    dataset = xr.Dataset(
+        {name: (("case", "engine", "rtol"), data[name], {"units": attrs[name][0], "long_name": attrs[name][1]}) for name in names},
+        coords={"case": [c.name for c in cases], "engine": list(settings.methods), "rtol": list(settings.tolerances), "reference": ["exact", "compliant_cvode_adams"]},
+    )
+    dataset["reference_wall_time"] = (("case", "reference"), reference_time, {"units": "s", "long_name": "wall time of the reference run"})
+    dataset["reference_impacts"] = (("case", "reference"), reference_impacts, {"units": "1", "long_name": "impacts of the reference"})
+    dataset["reference_x1"] = (("case", "reference"), reference_x1, {"units": "m", "long_name": "X1 fundamental of the reference (swept: its largest running value)"})
+    dataset["exact_wall_time"] = dataset["reference_wall_time"].sel(reference="exact", drop=True).assign_attrs(long_name="median wall time of the exact reference")
+    dataset["rtol"].attrs.update({"units": "1", "long_name": "relative tolerance rtol (atol = rtol x atol_ratio)"})
+    dataset["reference"].attrs.update({"long_name": "reference of the rigid-stop methods (exact) and of the compliant model (CVODE Adams, rtol 1e-13)"})
+    dataset.attrs["atol_ratio_m"] = settings.atol_ratio
+    dataset.attrs["repeats"] = settings.repeats
+    dataset.attrs["reference_rtol_compliant"] = REFERENCE_RTOL
+    for case in cases:  # what a run simulates, for per-period and per-second costs (vibroimpact.estimate)
+        dataset.attrs[f"case_{case.name}_duration_s"] = case.sweep.duration if case.sweep is not None else case.periods / case.problem.frequency
+        dataset.attrs[f"case_{case.name}_frequency_Hz"] = case.problem.frequency
+    if settings.ladder is not None and cases:
+        if progress:
+            print("benchmark: model cost ladder", file=sys.stderr, flush=True)
+        ladder = model_ladder(cases[0].problem.system, cases[0].problem.amplitude, settings.ladder, settings.atol_ratio)
+        dataset = dataset.merge(ladder, combine_attrs="no_conflicts")
+    return dataset
+
+
+def loosest_tolerance(dataset: xr.Dataset, case: str, method: str, target: float) -> tuple[float, float]:
+    """The loosest rtol of ``method`` whose X1 error on ``case`` is within ``target`` (no missed or extra impact), with all
+    tighter ones that were run too (a method stops at its time limit); returns (rtol, wall time) or (nan, nan)."""
+    line = dataset.sel(case=case, engine=method)
+    error, missed, extra, wall = line["x1_error"].values, line["missed_impacts"].values, line["extra_impacts"].values, line["wall_time"].values
+    order = [i for i in np.argsort(line["rtol"].values) if np.isfinite(wall[i])]  # tight to loose, the tolerances run
+    best = (math.nan, math.nan)
+    for i in order:
+        if not (np.isfinite(error[i]) and error[i] <= target and missed[i] == 0 and extra[i] == 0):
+            break
+        best = (float(line["rtol"].values[i]), float(wall[i]))
+    return best
+
+
+def equal_error_speedup(dataset: xr.Dataset, case: str, method: str, tolerance: float, against: list[str]) -> tuple[float, str]:
+    """Speed-up of ``method`` at ``tolerance`` over the fastest of ``against`` at the same impact-time error.
+
+    Each competitor's wall time at that error is interpolated log-log between its tolerances; competitors that
+    missed impacts at the tolerances used are excluded. Returns (ratio, competitor) or (nan, '').
+    """
+    point = dataset.sel(case=case, engine=method, rtol=tolerance)
+    target = float(point["impact_time_error"])
+    if not (target > 0 and float(point["missed_impacts"]) == 0):
+        return math.nan, ""
+    best, best_name = math.inf, ""
+    for other in against:
+        line = dataset.sel(case=case, engine=other)
+        error = line["impact_time_error"].values
+        wall = line["wall_time"].values
+        ok = np.isfinite(error) & (error > 0) & (line["missed_impacts"].values == 0)
+        if ok.sum() < 2 or not (error[ok].min() <= target <= error[ok].max()):
+            continue
+        order = np.argsort(np.log(error[ok]))
+        needed = float(np.exp(np.interp(np.log(target), np.log(error[ok])[order], np.log(wall[ok])[order])))
+        if needed < best:
+            best, best_name = needed, other
+    if not best_name:
+        return math.nan, ""
+    return best / float(point["wall_time"]), best_name
+
+
+@dataclass(frozen=True)
+class LadderSettings:
+    """One frequency point through every model, from the closed form to ever stiffer bumpers.
+
+    Attributes
+    ----------
+    frequency : float
+        Excitation frequency [Hz].
+    restitution : float
+        R [-] (the bumpers get the loss factor that gives it).
+    clearance : float
+        Delta [m].
+    bumper_frequencies : tuple of float
+        Omega_b / 2 pi of the compliant models [Hz].
+    rtol : float
+        Tolerance of the integrators (atol = rtol x the scene's atol_ratio).
+    repeats : int
+        Runs per model (median wall time).
+    """
+
+    frequency: float
+    restitution: float
+    clearance: float
+    bumper_frequencies: tuple[float, ...]
+    rtol: float = 1e-8
+    repeats: int = 3
+
+
+def model_ladder(system: TwoDofSystem, amplitude: float, ladder: LadderSettings, atol_ratio: float) -> xr.Dataset:
+    """Wall time of one steady-state point and its |X1| for ``pgf``, ``exact``, ``momentary`` and ``compliant`` at
+    each bumper frequency, and the relative difference from ``exact``; dimension ``model``."""
+    from vibroimpact.analysis.pgf import solve_one_impact
+    from vibroimpact.simulation.steady import SteadySettings, steady_state
+
+    problem = ImpactProblem(system, ladder.clearance, ladder.restitution, amplitude, ladder.frequency)
+    settings = EngineSettings(rtol=ladder.rtol, atol=ladder.rtol * atol_ratio)
+    steady = SteadySettings(tolerance=max(10.0 * ladder.rtol, 1e-10))
+    omega = np.array([problem.omega])
+
+    def pgf() -> float:
+        return float(np.abs(solve_one_impact(system, omega, ladder.clearance, ladder.restitution, amplitude).x1_harmonic())[0])
+
+    models: dict[str, Callable[[], float]] = {"pgf": pgf}
+    engines: dict[str, Engine] = {"exact": ExactEngine(), "momentary": MomentaryEngine(settings)}
+    xi = loss_factor_from_restitution(ladder.restitution)
+    for frequency in ladder.bumper_frequencies:
+        engines[f"compliant_{frequency:g}Hz"] = CompliantEngine(frequency, xi, settings)
+    for name, engine in engines.items():
+        models[name] = lambda engine=engine: abs(steady_state(engine, problem, "pgf", steady).measures.x1)
+    wall, x1 = [], []
+    for name, model in models.items():
+        times = []
+        for _ in range(ladder.repeats):
+            started = time.perf_counter()
+            value = model()
+            times.append(time.perf_counter() - started)
+        wall.append(statistics.median(times))
+        x1.append(value)
+    exact = x1[list(models).index("exact")]
+    return xr.Dataset(
+        {
+            "ladder_wall_time": ("model", wall, {"units": "s", "long_name": "wall time of one steady-state point (pgf: one closed-form point), median"}),
+            "ladder_x1_amplitude": ("model", x1, {"units": "m", "long_name": "steady-state |X1| fundamental"}),
+            "ladder_x1_difference": ("model", np.abs(np.array(x1) - exact) / exact, {"units": "1", "long_name": "relative difference of |X1| from the exact engine"}),
+        },
+        coords={"model": list(models)},
+        attrs={
+            "ladder_description": (
+                f"{ladder.frequency:g} Hz, R = {ladder.restitution:g}, Delta = {ladder.clearance * 1e3:g} mm; steady states from the "
+                f"slightly perturbed one-impact orbit, integrators at rtol {ladder.rtol:g}, steady-state tolerance {steady.tolerance:g}; "
+                "bumpers with the loss factor that gives R. The compliant differences are the bumper's physics, not error."
+            )
+        },
+    )

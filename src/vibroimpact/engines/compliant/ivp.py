@@ -1,0 +1,257 @@
+"""The compliant-bumper swept-sine test through ``scipy.integrate.solve_ivp``: a cross-check of the IDA engine.
+
+Written independently of :mod:`.compliant` (its own right-hand side, in the physical coordinates X1, X2, X1', X2',
+its own events and restarts), so that agreement between the two means something. The model is the same: the
+Kelvin-Voigt bumper of eq. 25 pushes with F = K (X2 - Delta) + B X2' from the moment X2 reaches Delta until F falls
+to zero. The loop a user of SciPy would write:
+
+* free flight: ``solve_ivp`` with a terminal event on X2 - Delta (rising) and a recorded one on X2' (falling, the
+  apex); an apex at X2 >= Delta is a contact whose two crossings fell inside one step: the run restarts there;
+* contact: a terminal event on F (falling), recorded ones on dF/dt (falling, largest force) and on the jerk
+  (rising, largest deceleration);
+* each terminal event restarts ``solve_ivp`` in the other mode; the samples come from ``t_eval`` (each method's
+  dense output).
+
+The state carries the force integral and the Fourier integral of the force against the sweep's phase, so the record
+has the same impulses and ``contact_fourier`` as :meth:`.compliant.CompliantEngine.sweep`. Implicit methods get the
+mode's constant Jacobian (the Fourier rows excepted: they vary with time; solve_ivp's finite differences fill them
+when ``jac`` is omitted, so it is given without them).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.integrate import solve_ivp
+
+from vibroimpact.model.excitation import SweptSine
+from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.model.validation import require_non_negative, require_positive
+from vibroimpact.engines.base import MODE_FREE, ImpactProblem, TrajectoryBuilder
+from vibroimpact.engines.compliant.ida import MODE_CONTACT, SweepRecord
+
+__all__ = ["IVP_METHODS", "solve_ivp_sweep"]
+
+#: The methods of ``solve_ivp`` (all of them can run this model; the implicit ones get the Jacobian).
+IVP_METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
+_IMPLICIT = ("Radau", "BDF", "LSODA")
+#: Samples per ``solve_ivp`` call at most (a long free flight is cut into calls of this many samples).
+_SAMPLES_PER_CALL = 4096
+
+
+def solve_ivp_sweep(
+    system: TwoDofSystem,
+    clearance: float,
+    bumper_frequency: float,
+    bumper_loss_factor: float,
+    sweep: SweptSine,
+    sample_rate: float,
+    method: str = "LSODA",
+    rtol: float = 1e-6,
+    atol: float = 1e-10,
+    state: NDArray[np.float64] | None = None,
+) -> SweepRecord:
+    """The swept-sine test of :meth:`.compliant.CompliantEngine.sweep`, integrated with ``solve_ivp``.
+
+    Parameters
+    ----------
+    system : TwoDofSystem
+        The linear system.
+    clearance : float
+        Delta [m], >= 0.
+    bumper_frequency : float
+        Omega_b / 2 pi [Hz], > 0.
+    bumper_loss_factor : float
+        xi_b [-], >= 0.
+    sweep : SweptSine
+        The excitation.
+    sample_rate : float
+        Output samples per second [Hz]; the samples are those of the IDA engine, ``arange(0, duration, 1 / rate)``.
+    method : str
+        One of :data:`IVP_METHODS`.
+    rtol : float
+        Relative tolerance.
+    atol : float
+        Absolute tolerance of the displacements [m]; velocities get ``atol`` times the sweep's highest angular
+        frequency w, the force integral that times M2, its Fourier integral that times w again (as IDA's).
+    state : ndarray, optional
+        (X1, X2, X1', X2') at t = 0; rest by default.
+
+    Returns
+    -------
+    SweepRecord
+        Samples, contacts (onsets, entry speeds, impulses, peaks) and ``stats``: ``nfev``, ``njev``, ``nlu`` (summed
+        over the calls), ``solver_calls``, ``contacts``, ``events``, ``grazing``; ``rhs_calls`` = ``nfev``.
+    """
+    if method not in IVP_METHODS:
+        raise ValueError(f"method = {method!r} is not allowed: use one of {', '.join(IVP_METHODS)}")
+    require_non_negative("clearance", clearance)
+    require_positive("bumper_frequency", bumper_frequency)
+    require_non_negative("bumper_loss_factor", bumper_loss_factor)
+    require_positive("sample_rate", sample_rate)
+    run = _IvpRun(system, clearance, bumper_frequency, bumper_loss_factor, sweep, method, rtol, atol)
+    times = np.arange(0.0, sweep.duration, 1.0 / sample_rate)
+    start = np.zeros(4) if state is None else np.asarray(state, dtype=float)
+    samples = run.run(np.concatenate([start, np.zeros(3)]), times)
+    x1, x2, v1, force = samples[:, 0], samples[:, 1], samples[:, 2], samples[:, 7]
+    return SweepRecord(
+        sweep=sweep,
+        time=times,
+        x1=x1.copy(),
+        x2=x2.copy(),
+        base_force=system.k1 * x1 + system.b1 * v1 + force,
+        contact_force=force.copy(),
+        trajectory=run.rec.build(run.stats | {"rhs_calls": run.stats["nfev"]}),
+        contact_fourier=samples[:, 5] - 1j * samples[:, 6],
+    )
+
+
+class _IvpRun:
+    """State, events and restarts of one solve_ivp sweep. State: X1, X2, X1', X2', integral of F, and the integrals
+    of F cos(theta) theta' and F sin(theta) theta'."""
+
+    def __init__(self, system: TwoDofSystem, clearance: float, frequency: float, loss_factor: float, sweep: SweptSine, method: str, rtol: float, atol: float) -> None:
+        self.system, self.delta, self.sweep, self.method, self.rtol = system, clearance, sweep, method, rtol
+        omega_b = 2.0 * math.pi * frequency
+        self.k, self.b = system.m2 * omega_b**2, 2.0 * system.m2 * loss_factor * omega_b
+        w = 2.0 * math.pi * max(sweep.start_frequency, sweep.stop_frequency)
+        self.atol = np.array([atol, atol, atol * w, atol * w, atol * w * system.m2, atol * w * w * system.m2, atol * w * w * system.m2])
+        self.rec = TrajectoryBuilder(ImpactProblem(system, clearance, 0.5, sweep.amplitude, sweep.start_frequency), False)
+        self.stats = {"nfev": 0, "njev": 0, "nlu": 0, "solver_calls": 0, "contacts": 0, "events": 0, "grazing": 0}
+        s = system
+        free = np.zeros((7, 7))
+        free[0, 2] = free[1, 3] = 1.0
+        free[2, :4] = [-(s.k1 + s.k2) / s.m1, s.k2 / s.m1, -(s.b1 + s.b2) / s.m1, s.b2 / s.m1]
+        free[3, :4] = [s.k2 / s.m2, -s.k2 / s.m2, s.b2 / s.m2, -s.b2 / s.m2]
+        contact = free.copy()
+        contact[3, 1] -= self.k / s.m2
+        contact[3, 3] -= self.b / s.m2
+        contact[4, 1], contact[4, 3] = self.k, self.b
+        self.jacobians = {False: free, True: contact}
+
+    def rhs(self, contact: bool) -> Callable[[float, NDArray[np.float64]], NDArray[np.float64]]:
+        s, delta, k, b, q = self.system, self.delta, self.k, self.b, self.sweep.amplitude
+        f0, alpha = self.sweep.start_frequency, self.sweep.alpha
+
+        def f(t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+            x1, x2, v1, v2 = y[0], y[1], y[2], y[3]
+            theta = 2.0 * math.pi * (f0 * t + 0.5 * alpha * t * t)
+            coupling = s.k2 * (x2 - x1) + s.b2 * (v2 - v1)  # spring and dashpot pull on the primary mass
+            push = k * (x2 - delta) + b * v2 if contact else 0.0
+            speed = 2.0 * math.pi * (f0 + alpha * t)  # theta'
+            return np.array([
+                v1,
+                v2,
+                (q * math.sin(theta) - s.k1 * x1 - s.b1 * v1 + coupling) / s.m1,
+                (-coupling - push) / s.m2,
+                push,
+                push * math.cos(theta) * speed,
+                push * math.sin(theta) * speed,
+            ])
+
+        return f
+
+    def events(self, contact: bool, f: Callable[[float, NDArray[np.float64]], NDArray[np.float64]]) -> list[Callable[..., float]]:
+        """Terminal first, then the recorded ones (see the module docstring)."""
+        delta, k, b, s = self.delta, self.k, self.b, self.system
+
+        def onset(t: float, y: NDArray[np.float64]) -> float:
+            return float(y[1] - delta)
+
+        def apex(t: float, y: NDArray[np.float64]) -> float:
+            return float(y[3])
+
+        def release(t: float, y: NDArray[np.float64]) -> float:
+            return float(k * (y[1] - delta) + b * y[3])
+
+        def force_rate(t: float, y: NDArray[np.float64]) -> float:
+            return float(k * y[3] + b * f(t, y)[3])
+
+        def jerk(t: float, y: NDArray[np.float64]) -> float:
+            d = f(t, y)
+            return float(s.k2 * (y[2] - y[3]) + s.b2 * (d[2] - d[3]) - k * y[3] - b * d[3]) / s.m2
+
+        onset.terminal, onset.direction = True, 1.0  # type: ignore[attr-defined]
+        apex.terminal, apex.direction = False, -1.0  # type: ignore[attr-defined]
+        release.terminal, release.direction = True, -1.0  # type: ignore[attr-defined]
+        force_rate.terminal, force_rate.direction = False, -1.0  # type: ignore[attr-defined]
+        jerk.terminal, jerk.direction = False, 1.0  # type: ignore[attr-defined]
+        return [release, force_rate, jerk] if contact else [onset, apex]
+
+    def run(self, y: NDArray[np.float64], times: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Integrate over the samples ``times`` from ``y`` at t = 0; rows X1, X2, X1', X2', the three integrals, F."""
+        out = np.empty((times.size, 8))
+        t, n, i = 0.0, times.size, 0
+        contact = bool(y[1] >= self.delta and self.k * (y[1] - self.delta) + self.b * y[3] > 0.0)
+        functions = {mode: self.rhs(mode) for mode in (False, True)}
+        events = {mode: self.events(mode, functions[mode]) for mode in (False, True)}
+        jacobians = {mode: self._constant(self.jacobians[mode]) for mode in (False, True)}  # LSODA takes callables only
+        onset: dict[str, Any] = self._begin(t, y, functions[True]) if contact else {}
+        self.rec.segment(t, MODE_CONTACT if contact else MODE_FREE, y[:4])
+        while i < n:
+            while i < n and times[i] <= t:  # samples at the current time
+                out[i] = self._sample(y, contact)
+                i += 1
+            if i == n:
+                break
+            j = min(n, i + _SAMPLES_PER_CALL)
+            options: dict[str, Any] = {"jac": jacobians[contact]} if self.method in _IMPLICIT else {}
+            sol = solve_ivp(functions[contact], (t, times[j - 1]), y, method=self.method, t_eval=times[i:j], events=events[contact], rtol=self.rtol, atol=self.atol, **options)
+            if sol.status < 0:
+                raise RuntimeError(f"solve_ivp ({self.method}) failed after t = {t!r} s: {sol.message}")
+            self.stats["solver_calls"] += 1
+            for name in ("nfev", "njev", "nlu"):
+                self.stats[name] += int(getattr(sol, name))
+            kept, switch = len(sol.t), sol.status == 1  # (t is an empty list when no sample was reached)
+            if switch:
+                t, y = float(sol.t_events[0][-1]), sol.y_events[0][-1].copy()
+            else:
+                t, y = float(sol.t[-1]), sol.y[:, -1].copy()
+            if contact:  # largest force and deceleration: at the recorded roots, and at onset
+                for which, column in ((1, 0), (2, 1)):
+                    for tr, yr in zip(sol.t_events[which], sol.y_events[which]):
+                        self.stats["events"] += 1
+                        value = self.k * (yr[1] - self.delta) + self.b * yr[3] if column == 0 else -functions[True](tr, yr)[3]
+                        onset["peaks"][column] = max(onset["peaks"][column], value)
+            else:  # an apex at or past the bumper: a missed contact
+                self.stats["events"] += len(sol.t_events[1])
+                late = [(tr, yr) for tr, yr in zip(sol.t_events[1], sol.y_events[1]) if yr[1] >= self.delta]
+                if late:
+                    self.stats["grazing"] += 1
+                    t, y, switch = float(late[0][0]), late[0][1].copy(), True
+                    kept = int(np.searchsorted(sol.t, t, side="right"))
+            if kept:
+                block = out[i : i + kept]
+                block[:, :7] = sol.y[:, :kept].T
+                block[:, 7] = self.k * (block[:, 1] - self.delta) + self.b * block[:, 3] if contact else 0.0
+            i += kept
+            if switch:
+                self.stats["events"] += 1
+                if contact:
+                    self.rec.contact_peaks(*onset["peaks"])
+                    self.rec.impact(onset["t"], onset["v"], float(y[4]) - onset["impulse"], in_moments=False)
+                else:
+                    onset = self._begin(t, y, functions[True])
+                contact = not contact
+                self.rec.segment(t, MODE_CONTACT if contact else MODE_FREE, y[:4])
+        self.rec.strobe(t, y[:4])
+        return out
+
+    @staticmethod
+    def _constant(matrix: NDArray[np.float64]) -> Callable[[float, NDArray[np.float64]], NDArray[np.float64]]:
+        return lambda t, y: matrix
+
+    def _begin(self, t: float, y: NDArray[np.float64], contact_rhs: Callable[[float, NDArray[np.float64]], NDArray[np.float64]]) -> dict[str, Any]:
+        """A contact starts: its onset time, entry speed, force integral, and the force and deceleration now."""
+        self.stats["contacts"] += 1
+        y[1] = max(y[1], self.delta)
+        force = self.k * (y[1] - self.delta) + self.b * y[3]
+        return {"t": t, "v": float(y[3]), "impulse": float(y[4]), "peaks": [force, max(-contact_rhs(t, y)[3], 0.0)]}
+
+    def _sample(self, y: NDArray[np.float64], contact: bool) -> NDArray[np.float64]:
+        force = self.k * (y[1] - self.delta) + self.b * y[3] if contact else 0.0
+        return np.concatenate([y[:7], [force]])

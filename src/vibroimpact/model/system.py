@@ -1,0 +1,178 @@
+"""The linear two-degree-of-freedom system: primary mass on a suspension, absorber on the primary mass.
+
+Equations of motion (seed paper eq. 1, without the contact force)::
+
+    M1 X1'' + B1 X1' + B2 (X1' - X2') + K1 X1 + K2 (X1 - X2) = Q(t)
+    M2 X2'' + B2 (X2' - X1') + K2 (X2 - X1)                 = -Phi
+
+``X1`` and ``X2`` are absolute displacements [m]; the force ``Q`` acts on the primary mass, the contact force
+``Phi`` on the absorber.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from vibroimpact.model.validation import require_positive, require_non_negative
+
+__all__ = ["TwoDofSystem", "Receptances", "PAPER_SYSTEM"]
+
+
+@dataclass(frozen=True)
+class Receptances:
+    """Complex dynamic compliances H(j omega) of the system [m N-1], arrays over frequency.
+
+    Attributes
+    ----------
+    h11 : ndarray of complex
+        Displacement of the primary mass per unit force on the primary mass [m N-1].
+    h12 : ndarray of complex
+        Displacement of the absorber per unit force on the primary mass (and, by reciprocity, the other way
+        round) [m N-1].
+    h22 : ndarray of complex
+        Displacement of the absorber per unit force on the absorber [m N-1].
+    """
+
+    h11: NDArray[np.complex128]
+    h12: NDArray[np.complex128]
+    h22: NDArray[np.complex128]
+
+
+@dataclass(frozen=True)
+class TwoDofSystem:
+    """Masses, springs and dashpots of the vibration protection system (paper fig. 1).
+
+    Parameters
+    ----------
+    m1 : float
+        Primary mass M1 [kg], > 0.
+    m2 : float
+        Absorber mass M2 [kg], > 0.
+    k1 : float
+        Suspension stiffness K1 between base and primary mass [N m-1], > 0.
+    k2 : float
+        Absorber stiffness K2 between primary mass and absorber [N m-1], > 0.
+    b1 : float
+        Suspension damping B1 [N s m-1], >= 0.
+    b2 : float
+        Absorber damping B2 [N s m-1], >= 0.
+    """
+
+    m1: float = field(metadata={"units": "kg"})
+    m2: float = field(metadata={"units": "kg"})
+    k1: float = field(metadata={"units": "N m-1"})
+    k2: float = field(metadata={"units": "N m-1"})
+    b1: float = field(default=0.0, metadata={"units": "N s m-1"})
+    b2: float = field(default=0.0, metadata={"units": "N s m-1"})
+
+    def __post_init__(self) -> None:
+        for name in ("m1", "m2", "k1", "k2"):
+            require_positive(f"system.{name}", getattr(self, name))
+        for name in ("b1", "b2"):
+            require_non_negative(f"system.{name}", getattr(self, name))
+
+    # ------------------------------------------------------------------ matrices
+    @property
+    def mass_matrix(self) -> NDArray[np.float64]:
+        """Mass matrix M [kg]."""
+        return np.diag([self.m1, self.m2])
+
+    @property
+    def stiffness_matrix(self) -> NDArray[np.float64]:
+        """Stiffness matrix K [N m-1]."""
+        return np.array([[self.k1 + self.k2, -self.k2], [-self.k2, self.k2]])
+
+    @property
+    def damping_matrix(self) -> NDArray[np.float64]:
+        """Damping matrix B [N s m-1]."""
+        return np.array([[self.b1 + self.b2, -self.b2], [-self.b2, self.b2]])
+
+    @property
+    def state_matrix(self) -> NDArray[np.float64]:
+        """First-order state matrix A [s-1] for the state (X1, X2, X1', X2'): y' = A y + forcing."""
+        minv = np.linalg.inv(self.mass_matrix)
+        zero, eye = np.zeros((2, 2)), np.eye(2)
+        return np.block([[zero, eye], [-minv @ self.stiffness_matrix, -minv @ self.damping_matrix]])
+
+    # --------------------------------------------------------------- polynomials
+    def characteristic_polynomial(self) -> NDArray[np.float64]:
+        """Coefficients of D(s) (eq. 5 with s = j omega), highest power first [kg2, ..., N2 m-2]."""
+        p1 = np.array([self.m1, self.b1 + self.b2, self.k1 + self.k2])
+        p2 = np.array([self.m2, self.b2, self.k2])
+        coupling = np.array([self.b2, self.k2])
+        return np.polysub(np.polymul(p1, p2), np.polymul(coupling, coupling))
+
+    def numerator_polynomial(self, output: int, load: int) -> NDArray[np.float64]:
+        """Coefficients of the numerator of H_{output,load}(s) (eq. 4), highest power first.
+
+        Parameters
+        ----------
+        output, load : {1, 2}
+            Index of the displacement and of the loaded mass.
+        """
+        if {output, load} == {1, 2}:
+            return np.array([self.b2, self.k2])
+        if output == load == 1:
+            return np.array([self.m2, self.b2, self.k2])
+        if output == load == 2:
+            return np.array([self.m1, self.b1 + self.b2, self.k1 + self.k2])
+        raise ValueError(f"output and load must be 1 or 2, got output={output!r}, load={load!r}")
+
+    # ---------------------------------------------------------------- receptances
+    def receptances(self, omega: ArrayLike) -> Receptances:
+        """Receptances H11, H12, H22 at angular frequencies ``omega`` [rad s-1] (eqs. 4-5), vectorised.
+
+        Parameters
+        ----------
+        omega : array_like
+            Angular excitation frequency [rad s-1].
+
+        Returns
+        -------
+        Receptances
+            Arrays shaped like ``omega`` [m N-1].
+        """
+        w = np.asarray(omega, dtype=float)
+        jw = 1j * w
+        d11 = -self.m1 * w**2 + jw * (self.b1 + self.b2) + self.k1 + self.k2
+        d22 = -self.m2 * w**2 + jw * self.b2 + self.k2
+        coupling = jw * self.b2 + self.k2
+        det = d11 * d22 - coupling**2
+        return Receptances(h11=d22 / det, h12=coupling / det, h22=d11 / det)
+
+    # ---------------------------------------------------------------- frequencies
+    def natural_frequencies(self) -> tuple[float, float]:
+        """Undamped natural angular frequencies Omega_1 < Omega_2 [rad s-1] from the corrected eq. 11.
+
+        The printed eq. 11 has ``K1*M1 + K1*M2 + K2*M1`` as the first term; the roots of D(j omega) = 0 with
+        B = 0 need ``K1*M2 + K2*M1 + K2*M2`` (see the README's errata).
+        """
+        s = self.k1 * self.m2 + self.k2 * self.m1 + self.k2 * self.m2
+        root = math.sqrt(s * s - 4.0 * self.k1 * self.k2 * self.m1 * self.m2)
+        denominator = 2.0 * self.m1 * self.m2
+        # (s - root) loses digits when K1 K2 M1 M2 << s^2; the product of the two roots is exact.
+        omega2_high = (s + root) / denominator
+        omega2_low = self.k1 * self.k2 / (self.m1 * self.m2) / omega2_high
+        return math.sqrt(omega2_low), math.sqrt(omega2_high)
+
+    def natural_frequencies_eig(self) -> tuple[float, float]:
+        """Undamped natural angular frequencies [rad s-1] from the eigenvalues of M^-1 K (independent check)."""
+        eigenvalues = np.linalg.eigvals(np.linalg.solve(self.mass_matrix, self.stiffness_matrix)).real
+        low, high = np.sqrt(np.sort(eigenvalues))
+        return float(low), float(high)
+
+    def antiresonance_frequency(self) -> float:
+        """Undamped anti-resonance of the primary mass, sqrt(K2/M2) [rad s-1]: H11 = 0 there when B2 = 0."""
+        return math.sqrt(self.k2 / self.m2)
+
+    def as_dict(self) -> dict[str, float]:
+        """Plain dictionary of the parameters (SI units), for dataset attributes."""
+        return {name: float(getattr(self, name)) for name in ("m1", "m2", "k1", "k2", "b1", "b2")}
+
+
+#: The paper's numerical example (eq. 24).
+PAPER_SYSTEM = TwoDofSystem(m1=1.0, m2=0.1, k1=25_000.0, k2=4_300.0, b1=0.8, b2=0.08)

@@ -1,0 +1,1 @@
+"""HTML pages with figures and tables, drawn from a dataset alone."""

@@ -1,0 +1,221 @@
+"""Report pages of benchmark scenes: work-precision diagrams, tolerance guidance, and what accuracy costs.
+
+Every figure and table reads the dataset of :func:`vibroimpact.benchmark.run_benchmark` (dimensions case, engine,
+rtol), and the model-cost ladder when the scene asked for one. Wall times are medians of several runs, all measured
+in one process run: read ratios, not seconds.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from vibroimpact.benchmarks.accuracy import equal_error_speedup, loosest_tolerance
+from vibroimpact.reporting.page import DrawnFigure, Table
+from vibroimpact.reporting.style import Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour
+
+__all__ = ["accuracy_figures", "accuracy_tables", "TARGETS"]
+
+#: X1-fundamental accuracies the guidance is given for [-].
+TARGETS = (1e-3, 1e-6)
+#: What each reference is (rigid stop: the exact engine; compliant model: CVODE Adams at a far tighter tolerance).
+#: Per reference: legend text, caption text.
+_REFERENCES = {
+    "exact": ("reference: exact", "the exact engine (rigid-stop methods)"),
+    "compliant_cvode_adams": ("reference: CVODE Adams 1e-13", "CVODE Adams at rtol 1e-13 (compliant model)"),
+}
+_ERRORS = (("x1_error", "relative error of the X1 fundamental [1]"), ("impact_time_error", "largest impact-time error [s]"))
+
+
+def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
+    """Work-precision diagrams: X1 error and impact-time error against wall time, one row of two panels per case."""
+    cases = [str(c) for c in dataset["case"].values]
+    methods = [str(m) for m in dataset["engine"].values]
+    fig, axes = new_figure(2 * len(cases), panel_height=3.6, legend_rows=legend_rows(len(methods) + 4))
+    tolerances = np.sort(np.asarray(dataset["rtol"].values, dtype=float))[::-1]
+    caption = Caption(
+        f"Work-precision, one row per case: one point per tolerance (rtol {tolerances[0]:.0e} ... {tolerances[-1]:.0e} from right to "
+        "left), error against the reference, wall time the median of repeated runs in one process (read ratios, not seconds)."
+    )
+    for j, case in enumerate(cases):
+        for column, (quantity, label) in enumerate(_ERRORS):
+            ax = axes[2 * j + column]
+            for k, method in enumerate(methods):
+                line = dataset.sel(case=case, engine=method)
+                wall, error = line["wall_time"].values, line[quantity].values
+                if not np.isfinite(wall).any():
+                    continue
+                missed = line["missed_impacts"].values > 0
+                floor = np.maximum(error, 1e-17)  # an exact zero still gets a point
+                ivp = method.startswith("solve_ivp")
+                ax.loglog(wall, np.where(missed, np.nan, floor), "s--" if ivp else "o-", color=series_colour(k), ms=4, lw=1.2, label=method, gid=method)
+                caption.add("ivp" if ivp else "sundials", "Dashed with squares: scipy's solve_ivp." if ivp else "Solid with circles: SUNDIALS engines.")
+                if missed.any():
+                    ax.loglog(wall[missed], floor[missed], "x", color=series_colour(k), ms=9, mew=2, label="_nolegend_", gid=method)
+                    caption.add("missed", "Crosses: runs that missed impacts of the reference (errors floored at 1e-17 where zero).")
+            for reference, colour in (("exact", "k"), ("compliant_cvode_adams", "0.5")):
+                value = float(dataset["reference_wall_time"].sel(case=case, reference=reference))
+                if math.isfinite(value):
+                    legend, text = _REFERENCES[reference]
+                    ax.axvline(value, color=colour, ls=":", lw=1.3, label=legend)
+                    caption.add(f"reference {reference}", f"Dotted vertical{' (grey)' if colour != 'k' else ''}: the wall time of the reference, {text}.")
+            if quantity == "x1_error":
+                for target in TARGETS:
+                    ax.axhline(target, color="k", lw=0.6, alpha=0.5)
+                caption.add("targets", f"Thin horizontal lines: the {' and '.join(f'{t:.0e}' for t in TARGETS)} targets.")
+            finish_axes(ax, "wall time [s] (median)", label, case)
+    figure_legend(fig, axes, columns=4)
+    return [DrawnFigure(fig, "work_precision", "Work-precision diagrams", caption.text())]
+
+
+def accuracy_tables(dataset: xr.Dataset) -> list[Table]:
+    """The answer (cheapest way to each target), tolerance guidance, the ladder, and every measured point."""
+    tables = [Table("Cheapest way to the X1 fundamental within a target", _answer_table(dataset)), Table("Tolerance guidance: loosest rtol meeting each target", _guidance_table(dataset))]
+    if "momentary_adams" in dataset["engine"].values:
+        tables.append(Table("momentary (Adams) against exact and against solve_ivp at equal impact-time error", _equal_error_table(dataset)))
+    if "model" in dataset.dims:
+        tables.append(Table("Model cost ladder: one steady state per model", _ladder_table(dataset)))
+    tables.append(Table("run-study --estimate against measured runs of the shipped studies", _estimate_table()))
+    for case in dataset["case"].values:
+        tables.append(Table(f"Every point: {case}", _points_table(dataset, str(case))))
+    return tables
+
+
+def _cheapest(dataset: xr.Dataset, case: str, target: float, methods: list[str]) -> tuple[str, float, float]:
+    """(method, rtol, wall) of the fastest method meeting ``target`` at its loosest sufficient tolerance."""
+    best = ("", math.nan, math.inf)
+    for method in methods:
+        rtol, wall = loosest_tolerance(dataset, case, method, target)
+        if math.isfinite(wall) and wall < best[2]:
+            best = (method, rtol, wall)
+    return best
+
+
+def _answer_table(dataset: xr.Dataset) -> str:
+    """Per case and target: the cheapest of our integrators against the cheapest solve_ivp method (HTML)."""
+    methods = [str(m) for m in dataset["engine"].values]
+    ivp = [m for m in methods if m.startswith("solve_ivp")]
+    rows = [
+        "<tr><th>case</th><th>target</th><th>cheapest integrator</th><th>its rtol</th><th>wall [s]</th><th>fastest solve_ivp</th><th>its rtol</th>"
+        "<th>wall [s]</th><th>speed-up</th><th>exact engine (rigid stop, error 0) [s]</th></tr>"
+    ]
+    for case in dataset["case"].values:
+        exact = float(dataset["reference_wall_time"].sel(case=case, reference="exact"))
+        # one model per comparison: the rigid stop on stepped cases (compliant runs answer another question), the
+        # compliant model on swept ones
+        swept = math.isnan(exact)
+        ours = [m for m in methods if m.startswith("compliant") == swept and not m.startswith("solve_ivp")]
+        for target in TARGETS:
+            name, rtol, wall = _cheapest(dataset, str(case), target, ours)
+            other, other_rtol, other_wall = _cheapest(dataset, str(case), target, ivp)
+            speedup = other_wall / wall if name and other else math.nan
+            rows.append(
+                f"<tr><td>{case}</td><td>{target:g}</td><td>{name or 'none reaches it'}</td><td>{fmt(rtol, 'g')}</td><td>{fmt(wall)}</td>"
+                f"<td>{other or 'none reaches it'}</td><td>{fmt(other_rtol, 'g')}</td><td>{fmt(other_wall)}</td><td>{'' if not math.isfinite(speedup) else f'{speedup:.1f}x'}</td>"
+                f"<td>{fmt(exact)}</td></tr>"
+            )
+    note = (
+        "<p>For each method the loosest tolerance whose X1 fundamental is within the target (and every tighter one run, "
+        "without a missed impact), and the wall time of a run at it; the cheapest of our integrators against the cheapest "
+        "solve_ivp method, within one model: the rigid stop on stepped cases, the compliant model on the swept one (whose "
+        "reference is CVODE Adams at rtol 1e-13: CVODE Adams there is measured against its own integrator at a far tighter "
+        "tolerance). For the rigid stop the exact engine needs no tolerance and is cheaper still. Irregular motion "
+        "has no converged trajectory: its errors grow with the run's length (trajectories diverge), so its figures hold for "
+        "runs of the length measured here only.</p>"
+    )
+    return "<table>" + "".join(rows) + "</table>" + note
+
+
+def _guidance_table(dataset: xr.Dataset) -> str:
+    """Per method: the loosest rtol meeting each target in each case, and its wall time [s] (HTML)."""
+    header = "<tr><th>engine</th>" + "".join(f"<th>{case}: rtol for {t:g}</th>" for case in dataset["case"].values for t in TARGETS) + "</tr>"
+    rows = [header]
+    for method in dataset["engine"].values:
+        cells = []
+        for case in dataset["case"].values:
+            for target in TARGETS:
+                rtol, wall = loosest_tolerance(dataset, str(case), str(method), target)
+                cells.append(f"<td>{fmt(rtol, 'g')}{'' if not math.isfinite(wall) else f' ({wall:.3g} s)'}</td>")
+        rows.append(f"<tr><td>{method}</td>{''.join(cells)}</tr>")
+    return "<table>" + "".join(rows) + "</table>"
+
+
+def _equal_error_table(dataset: xr.Dataset) -> str:
+    """Per rigid-stop case and tolerance: momentary's wall time, its ratio to exact's, and the fastest solve_ivp method's
+    wall time at the same impact-time error (interpolated, :func:`vibroimpact.benchmark.equal_error_speedup`)."""
+    ivp = [str(m) for m in dataset["engine"].values if str(m).startswith("solve_ivp")]
+    rows = ["<tr><th>case</th><th>rtol</th><th>momentary_adams [s]</th><th>exact [s]</th><th>momentary / exact</th><th>best solve_ivp at equal error</th><th>its time / momentary's</th></tr>"]
+    for case in dataset["case"].values:
+        exact = float(dataset["reference_wall_time"].sel(case=case, reference="exact"))
+        if not math.isfinite(exact):
+            continue
+        for tolerance in dataset["rtol"].values:
+            wall = float(dataset["wall_time"].sel(case=case, engine="momentary_adams", rtol=tolerance))
+            if not math.isfinite(wall):
+                continue
+            ratio, other = equal_error_speedup(dataset, str(case), "momentary_adams", float(tolerance), ivp)
+            rows.append(
+                f"<tr><td>{case}</td><td>{float(tolerance):g}</td><td>{wall:.4f}</td><td>{exact:.4f}</td><td>{wall / exact:.1f}</td>"
+                f"<td>{other}</td><td>{'' if not math.isfinite(ratio) else f'{ratio:.2f}'}</td></tr>"
+            )
+    return "<table>" + "".join(rows) + "</table>"
+
+
+def _ladder_table(dataset: xr.Dataset) -> str:
+    """One steady state through each model: wall time [s], |X1| [m], difference from exact and relative cost (HTML)."""
+    rows = ["<tr><th>model</th><th>wall time per frequency point [s]</th><th>|X1| [m]</th><th>relative difference from exact</th><th>cost / exact</th></tr>"]
+    exact_wall = float(dataset["ladder_wall_time"].sel(model="exact"))
+    for model in dataset["model"].values:
+        point = dataset.sel(model=model)
+        wall = float(point["ladder_wall_time"])
+        rows.append(
+            f"<tr><td>{model}</td><td>{wall:.3g}</td><td>{float(point['ladder_x1_amplitude']):.6e}</td>"
+            f"<td>{float(point['ladder_x1_difference']):.2e}</td><td>{wall / exact_wall:.3g}</td></tr>"
+        )
+    return "<table>" + "".join(rows) + "</table>" + f"<p>{dataset.attrs.get('ladder_description', '')}</p>"
+
+
+def _estimate_table(results: Path = Path("results")) -> str:
+    """Predicted wall time (without the report) of each shipped study against its last run in ``results/``."""
+    from vibroimpact.study.estimate import estimate_scene
+    from vibroimpact.scene.core import load_scene, shipped_studies_dir
+
+    rows = ["<tr><th>study</th><th>predicted [s]</th><th>measured [s]</th><th>measured / predicted</th><th>processes</th></tr>"]
+    for path in sorted(shipped_studies_dir().glob("*.yaml")):
+        scene = load_scene(path)
+        output = results / scene.name / f"{scene.name}.nc"
+        measured, jobs = math.nan, 0
+        if output.is_file():
+            with xr.open_dataset(output) as done:
+                measured, jobs = float(done.attrs.get("run_wall_time_s", math.nan)), int(done.attrs.get("run_jobs", 0))
+        if not jobs:
+            rows.append(f"<tr><td>{scene.name}</td><td></td><td>not run with this version</td><td></td><td></td></tr>")
+            continue
+        estimate = estimate_scene(scene, jobs=jobs)
+        predicted = estimate.wall_time - estimate.parts.get("report", 0.0)
+        rows.append(f"<tr><td>{scene.name}</td><td>{predicted:.0f}</td><td>{measured:.0f}</td><td>{measured / predicted:.2f}</td><td>{jobs}</td></tr>")
+    note = "<p>Measured: the run_wall_time_s of results/NAME/NAME.nc (dataset written, report excluded) from this machine's last run of each study.</p>"
+    return "<table>" + "".join(rows) + "</table>" + note
+
+
+def _points_table(dataset: xr.Dataset, case: str) -> str:
+    """Every measured point of ``case``: cost, impacts found and missed, errors (HTML)."""
+    rows = ["<tr><th>method</th><th>rtol</th><th>wall [s]</th><th>steps</th><th>rhs calls</th><th>impacts</th><th>missed</th><th>extra</th><th>X1 error</th><th>impact-time error [s]</th><th>impulse error</th></tr>"]
+    for method in dataset["engine"].values:
+        for tolerance in dataset["rtol"].values:
+            p = dataset.sel(case=case, engine=method, rtol=tolerance)
+            if not np.isfinite(float(p["wall_time"])):
+                continue
+            rows.append(
+                f"<tr><td>{method}</td><td>{float(tolerance):g}</td><td>{float(p['wall_time']):.4f}</td><td>{fmt(p['steps'], '.0f')}</td><td>{fmt(p['rhs_calls'], '.0f')}</td>"
+                f"<td>{fmt(p['impacts'], '.0f')}</td><td>{fmt(p['missed_impacts'], '.0f')}</td><td>{fmt(p['extra_impacts'], '.0f')}</td><td>{float(p['x1_error']):.2e}</td>"
+                f"<td>{float(p['impact_time_error']):.2e}</td><td>{float(p['impulse_error']):.2e}</td></tr>"
+            )
+    for reference in dataset["reference"].values:
+        wall = float(dataset["reference_wall_time"].sel(case=case, reference=reference))
+        if math.isfinite(wall):
+            rows.append(f"<tr><td>reference: {reference}</td><td></td><td>{wall:.4f}</td><td></td><td></td><td>{fmt(dataset['reference_impacts'].sel(case=case, reference=reference), '.0f')}</td><td>0</td><td>0</td><td>0</td><td>0</td><td>0</td></tr>")
+    return "<table>" + "".join(rows) + "</table>"

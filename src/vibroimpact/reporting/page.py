@@ -1,0 +1,166 @@
+"""What every report page shares: figure and table records, the PNG writer, and the HTML page with its contents.
+
+Figure builders return a :class:`DrawnFigure` (the matplotlib figure still open, so that tests can inspect what was
+drawn); :func:`save_figure` writes it and closes it. A page is a list of :class:`Section`; :func:`render_page` writes
+the HTML with a table of contents linking every section, figure and table.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from vibroimpact.reporting.style import DPI  # first: selects the Agg backend before pyplot is imported
+
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.figure import Figure as MatplotlibFigure  # noqa: E402
+
+from vibroimpact.study.io import atomic_path  # noqa: E402
+
+__all__ = ["DrawnFigure", "Figure", "Table", "Section", "save_figure", "render_page", "write_page"]
+
+
+@dataclass(frozen=True)
+class DrawnFigure:
+    """A drawn matplotlib figure, not yet written.
+
+    Attributes
+    ----------
+    figure : matplotlib.figure.Figure
+        The open figure.
+    name : str
+        File name without extension (unique within a page).
+    title : str
+        Heading of the figure on the page and in its contents.
+    caption : str
+        What the figure shows, generated from what was drawn.
+    """
+
+    figure: MatplotlibFigure
+    name: str
+    title: str
+    caption: str
+
+
+@dataclass(frozen=True)
+class Figure:
+    """A figure written to disk, its heading and caption."""
+
+    path: Path
+    title: str
+    caption: str
+
+
+@dataclass(frozen=True)
+class Table:
+    """An HTML table (or any HTML block) with its heading."""
+
+    title: str
+    html: str
+
+
+@dataclass
+class Section:
+    """A part of a page: a heading, an optional introduction (HTML), then figures and tables in that order."""
+
+    title: str
+    intro: str = ""
+    figures: list[Figure] = field(default_factory=list)
+    tables: list[Table] = field(default_factory=list)
+
+
+def save_figure(drawn: DrawnFigure, out_dir: Path) -> Figure:
+    """Write ``drawn`` as ``out_dir/<name>.png`` atomically, close it, and return its record."""
+    buffer = io.BytesIO()
+    drawn.figure.savefig(buffer, format="png", dpi=DPI, bbox_inches="tight", pad_inches=0.08)
+    plt.close(drawn.figure)
+    path = Path(out_dir) / f"{drawn.name}.png"
+    with atomic_path(path) as temporary:
+        temporary.write_bytes(buffer.getvalue())
+    return Figure(path, drawn.title, drawn.caption)
+
+
+_STYLE = (
+    "body{font-family:sans-serif;max-width:1360px;margin:1.5em auto;padding:0 12px;color:#222;line-height:1.4}"
+    "table{border-collapse:collapse;margin:0.6em 0;display:block;overflow-x:auto;max-width:100%}"
+    "td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}td{white-space:nowrap}"
+    "th{background:#f2f2f2}td:first-child,th:first-child{text-align:left}"
+    "img{max-width:100%;height:auto;display:block}pre{background:#f4f4f4;padding:1em;overflow:auto}"
+    "figure{margin:1.2em 0 2em 0}figcaption{font-size:95%;color:#333;max-width:1320px}"
+    "nav{background:#f7f7f7;border:1px solid #ddd;padding:0.4em 1.2em;margin:1em 0}nav ol{margin:0.2em 0}"
+    "nav ol ol{list-style:none;padding-left:1.2em;margin:0 0 0.4em 0;font-size:95%}nav ol ol li{display:inline}"
+    "nav ol ol li+li:before{content:' \\00b7  ';color:#888}"
+    "h3{margin-bottom:0.3em}.filename{color:#777}"
+)
+
+
+def _anchor(text: str, used: set[str]) -> str:
+    """A unique HTML id made of ``text``."""
+    base = re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-") or "item"
+    anchor, n = base, 2
+    while anchor in used:
+        anchor, n = f"{base}-{n}", n + 1
+    used.add(anchor)
+    return anchor
+
+
+def _short(title: str, prefix: str, suffix: str | None) -> str:
+    """``title`` without the ``prefix`` and ``suffix`` its section's title already says, for the contents."""
+    if suffix and title.endswith(suffix) and len(title) > len(suffix):
+        title = title[: -len(suffix)]
+    if title.startswith(prefix) and len(title) > len(prefix):
+        title = title[len(prefix) :]
+        title = title[:1].upper() + title[1:]
+    return title
+
+
+def render_page(title: str, paragraphs: list[str], sections: list[Section], scene_text: str) -> str:
+    """The HTML page: heading, ``paragraphs`` (plain text), contents, the sections, and the scene.
+
+    Every section, figure and table gets an anchor and an entry in the contents; figures are embedded (base64).
+    """
+    used: set[str] = set()
+    contents: list[str] = []
+    body: list[str] = []
+    for section in [*sections, Section("Scene")]:
+        section_id = _anchor(section.title, used)
+        entries = []
+        # the contents do not repeat what the section's title says ("Simulations ...: " before, ", Delta = 3 mm" after)
+        suffix = section.title[section.title.index(", ") :] if ", " in section.title else None
+        prefix = section.title.split(", ")[0] + ": "
+        body.append(f"<section id='{section_id}'><h2>{html.escape(section.title)}</h2>{section.intro}")
+        for figure in section.figures:
+            figure_id = _anchor(figure.path.stem, used)
+            entries.append(f"<li><a href='#{figure_id}'>{html.escape(_short(figure.title, prefix, suffix))}</a></li>")
+            encoded = base64.b64encode(figure.path.read_bytes()).decode("ascii")
+            body.append(
+                f"<figure id='{figure_id}'><h3>{html.escape(figure.title)}</h3><img alt='{html.escape(figure.title)}' "
+                f"src='data:image/png;base64,{encoded}'><figcaption>{html.escape(figure.caption)} "
+                f"<span class='filename'>({html.escape(figure.path.name)})</span></figcaption></figure>"
+            )
+        for table in section.tables:
+            table_id = _anchor(table.title, used)
+            entries.append(f"<li><a href='#{table_id}'>{html.escape(_short(table.title, prefix, suffix))}</a></li>")
+            body.append(f"<div id='{table_id}'><h3>{html.escape(table.title)}</h3>{table.html}</div>")
+        if section.title == "Scene":
+            body.append(f"<pre>{html.escape(scene_text)}</pre>")
+        body.append("</section>")
+        sub = f"<ol>{''.join(entries)}</ol>" if entries else ""
+        contents.append(f"<li><a href='#{section_id}'>{html.escape(section.title)}</a>{sub}</li>")
+    head = (
+        f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title><style>{_STYLE}</style></head><body>"
+        f"<h1>{html.escape(title)}</h1>" + "".join(f"<p>{html.escape(p)}</p>" for p in paragraphs)
+    )
+    nav = f"<nav id='contents'><h2>Contents</h2><ol>{''.join(contents)}</ol></nav>"
+    return "\n".join([head, nav, *body, "</body></html>"])
+
+
+def write_page(path: Path, text: str) -> Path:
+    """Write ``text`` to ``path`` atomically; return the path."""
+    with atomic_path(path) as temporary:
+        temporary.write_text(text, encoding="utf-8")
+    return path

@@ -1,0 +1,272 @@
+"""The look every report page shares: figure size, colours, quantity labels, one number formatter, captions, layout.
+
+A report is read in a browser about 1400 px wide. Figures are at most :data:`FIGURE_WIDTH` wide at :data:`DPI`, so
+they are shown unscaled and their text (at least :data:`MIN_FONT_SIZE`) stays legible; panels come at most
+:data:`MAX_COLUMNS` to a row; legends sit below the panels (:func:`figure_legend`), never on the data.
+
+How a solution's values are drawn (curves, markers, stability) is :mod:`vibroimpact.report_series`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Iterable, Sequence, SupportsFloat
+
+import matplotlib
+
+matplotlib.use("Agg")  # reports are drawn without a display
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.axes import Axes  # noqa: E402
+from matplotlib.figure import Figure as MatplotlibFigure  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+
+from vibroimpact.analysis.regime import Regime  # noqa: E402
+
+__all__ = [
+    "DPI",
+    "FIGURE_WIDTH",
+    "MAX_COLUMNS",
+    "MIN_FONT_SIZE",
+    "QUANTITIES",
+    "REGIME_COLOURS",
+    "SOLUTION_COLOURS",
+    "SOLUTION_DESCRIPTIONS",
+    "SOLUTION_TITLES",
+    "ENGINE_MARKERS",
+    "LINEAR_STYLE",
+    "RAW_STYLE",
+    "STABLE_STYLE",
+    "UNSTABLE_STYLE",
+    "Caption",
+    "Quantity",
+    "axis_label",
+    "figure_legend",
+    "fmt",
+    "new_figure",
+    "regime_label",
+    "series_colour",
+    "solution_ref",
+]
+
+#: Resolution of the PNG figures [dots per inch].
+DPI = 110
+#: Width of every figure [in]: 1320 px at :data:`DPI`, shown unscaled in a 1400 px browser window.
+FIGURE_WIDTH = 12.0
+#: Smallest font of any text in a figure [pt] (14 px at :data:`DPI`).
+MIN_FONT_SIZE = 9.0
+#: Panels per row at most.
+MAX_COLUMNS = 2
+
+
+@dataclass(frozen=True)
+class Quantity:
+    """How a dataset quantity is named on an axis and in a caption.
+
+    Attributes
+    ----------
+    label : str
+        Short name on the axis and in captions; no label is part of another.
+    units : str
+        Units as in the dataset's ``units`` attribute.
+    meaning : str
+        What the value is, for captions.
+    log : bool
+        Drawn on a logarithmic axis.
+    """
+
+    label: str
+    units: str
+    meaning: str
+    log: bool
+
+
+QUANTITIES: dict[str, Quantity] = {
+    "x1_amplitude": Quantity("|X1| fundamental", "m", "fundamental-harmonic amplitude of the primary mass's displacement", True),
+    "x2_amplitude": Quantity("|X2| fundamental", "m", "fundamental-harmonic amplitude of the absorber's displacement", True),
+    "force_amplitude": Quantity("|F| on the base", "N", "fundamental of the force on the base through suspension and impacts (eq. 23)", True),
+    "suspension_force_amplitude": Quantity("|F| through the suspension", "N", "fundamental of the force through the suspension alone (eq. 21)", True),
+    "impulse": Quantity("impulse per period", "N s", "total impulse of the impacts in one excitation period", False),
+    "impacts_per_period": Quantity("contacts per period", "1", "contacts per excitation period", False),
+    "peak_acceleration": Quantity("peak contact deceleration", "m s-2", "largest deceleration of the absorber on the bumper", False),
+    "peak_contact_force": Quantity("peak contact force", "N", "largest bumper force", False),
+    "floquet_modulus": Quantity("largest |Floquet multiplier|", "1", "largest modulus of the Floquet multipliers of the one-impact orbit", True),
+}
+
+
+def axis_label(quantity: str) -> str:
+    """Axis label of ``quantity``: its short name and units in brackets."""
+    q = QUANTITIES[quantity]
+    return f"{q.label} [{q.units}]"
+
+
+# ----------------------------------------------------------------------------------------------- regimes
+#: One colour per regime flag, all distinct: blues for the one-impact motion, greens for the linear motion, reds where
+#: no steady state is known, oranges and browns for what simulations found, grey where nothing was computed.
+REGIME_COLOURS: dict[Regime, str] = {
+    Regime.NOT_COMPUTED: "#d9d9d9",
+    Regime.LINEAR: "#b2df8a",
+    Regime.ONE_IMPACT: "#1f78b4",
+    Regime.ONE_IMPACT_COEXISTING_LINEAR: "#a6cee3",
+    Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT: "#33a02c",
+    Regime.NONE_INADMISSIBLE_ONE_IMPACT: "#fb9a99",
+    Regime.NONE: "#e31a1c",
+    Regime.LINEAR_EXCEEDS_CLEARANCE: "#fdbf6f",
+    Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT: "#6a3d9a",
+    Regime.PERIODIC_IMPACTS: "#ff7f00",
+    Regime.IRREGULAR: "#b15928",
+    Regime.SWEPT_CONTACT: "#cab2d6",
+    Regime.FAILED: "#000000",
+}
+
+
+def regime_label(regime: Regime) -> str:
+    """Legend text of a regime flag: its CF flag meaning and value, as in the dataset."""
+    return f"{regime.name.lower()} ({int(regime)})"
+
+
+# ------------------------------------------------------------------------------------------ line styles
+#: Closed-form values on a stable (or linear) orbit.
+STABLE_STYLE = {"ls": "-", "lw": 1.4}
+#: Closed-form values on an orbit that exists but is unstable: same colour and weight as stable, dashed.
+UNSTABLE_STYLE = {"ls": (0, (5, 2.5)), "lw": 1.4}
+#: The linear system (no stop).
+LINEAR_STYLE = {"ls": ":", "lw": 1.3, "color": "k"}
+#: Raw one-impact solution wherever eqs. 15-16 have a root, unchecked: thin and faint, behind everything.
+RAW_STYLE = {"ls": "-", "lw": 0.7, "alpha": 0.35, "zorder": 1}
+#: Simulation markers (fillable shapes: filled means periodic) and sizes [pt]; exact's larger diamonds show under
+#: momentary's circles where both agree.
+ENGINE_MARKERS: dict[str, tuple[str, float]] = {"momentary": ("o", 3.5), "exact": ("D", 5.0), "compliant": ("s", 4.0)}
+
+
+#: Colour of each solution where a figure distinguishes solutions (not restitution ratios).
+SOLUTION_COLOURS: dict[str, str] = {"linear": "k", "pgf": "C0", "pgf_paper": "C4", "momentary": "C1", "exact": "C2", "compliant": "C3"}
+#: Short name of each solution for panel titles (half a figure wide).
+SOLUTION_TITLES: dict[str, str] = {
+    "linear": "linear system",
+    "pgf": "closed form, exact modes",
+    "pgf_paper": "closed form, paper's fitted modes",
+    "exact": "exact engine, rigid stop",
+    "momentary": "CVODE, rigid stop",
+    "compliant": "IDA, compliant bumper",
+}
+#: What each solution is, for captions.
+SOLUTION_DESCRIPTIONS: dict[str, str] = {
+    "linear": "linear system, no stop",
+    "pgf": "one-impact closed form, exact poles/residues and exact chi22'(0-)",
+    "pgf_paper": "one-impact closed form, the paper's fitted modes and constant chi22'(0-)",
+    "exact": "piecewise-exact simulation, rigid stop",
+    "momentary": "CVODE simulation, rigid stop",
+    "compliant": "IDA simulation, Kelvin-Voigt bumper (eq. 25)",
+}
+
+
+def series_colour(index: int) -> str:
+    """Colour of the ``index``-th series of a figure (matplotlib's default cycle, ten colours)."""
+    return f"C{index % 10}"
+
+
+def solution_ref(solution: str) -> str:
+    """How a caption names a solution."""
+    return f"'{solution}'"
+
+
+def fmt(value: SupportsFloat | None, spec: str = ".3g") -> str:
+    """``value`` formatted with ``spec``; empty for NaN, infinity or None (a table cell with nothing to show)."""
+    if value is None:
+        return ""
+    number = float(value)
+    return "" if not math.isfinite(number) else format(number, spec)
+
+
+# ---------------------------------------------------------------------------------------------- captions
+class Caption:
+    """Caption phrases collected while drawing, each once, in drawing order."""
+
+    def __init__(self, lead: str) -> None:
+        self.lead = lead
+        self._phrases: dict[str, str] = {}
+
+    def add(self, key: str, phrase: str) -> None:
+        """Add ``phrase`` under ``key`` unless that key has one already."""
+        self._phrases.setdefault(key, phrase)
+
+    def text(self, tail: str = "") -> str:
+        """The caption: lead, phrases, tail; its first letter a capital."""
+        text = " ".join(part for part in (self.lead, *self._phrases.values(), tail) if part)
+        return text[:1].upper() + text[1:]
+
+
+# ---------------------------------------------------------------------------------------------- layout
+def new_figure(
+    panels: int,
+    panel_height: float = 3.6,
+    columns: int = MAX_COLUMNS,
+    sharex: bool = False,
+    sharey: bool = False,
+    legend_rows: int = 0,
+    row_heights: Sequence[float] | None = None,
+) -> tuple[MatplotlibFigure, list[Axes]]:
+    """A figure :data:`FIGURE_WIDTH` wide with ``panels`` panels, at most ``columns`` to a row, constrained layout.
+
+    Parameters
+    ----------
+    panels : int
+        Number of panels; unused cells of the last row are removed.
+    panel_height : float
+        Height of one row of panels [in].
+    columns : int
+        Panels per row at most (capped at :data:`MAX_COLUMNS`).
+    sharex, sharey : bool
+        Share the axes between panels.
+    legend_rows : int
+        Rows of legend entries expected below the panels (adds height for them).
+    row_heights : sequence of float, optional
+        Height of each row [in] instead of ``panel_height`` for all.
+
+    Returns
+    -------
+    (Figure, list of Axes)
+        The figure and its panels in reading order.
+    """
+    columns = max(1, min(columns, MAX_COLUMNS, panels))
+    rows = math.ceil(panels / columns)
+    heights = list(row_heights) if row_heights is not None else [panel_height] * rows
+    height = sum(heights) + 0.25 * legend_rows + (0.2 if legend_rows else 0.0)
+    fig, grid = plt.subplots(
+        rows, columns, figsize=(FIGURE_WIDTH, height), squeeze=False, sharex=sharex, sharey=sharey, layout="constrained", gridspec_kw={"height_ratios": heights}
+    )
+    axes = list(grid.flat)
+    for ax in axes[panels:]:
+        ax.remove()
+    return fig, axes[:panels]
+
+
+def figure_legend(fig: MatplotlibFigure, axes: Sequence[Axes], extra: Iterable[Line2D] = (), columns: int = 4) -> None:
+    """One legend for the whole figure, below the panels (outside every axes, so it covers no data).
+
+    Entries are the labelled artists of ``axes`` (each label once, in drawing order) followed by ``extra``.
+    """
+    entries: dict[str, object] = {}
+    for ax in axes:
+        for handle, label in zip(*ax.get_legend_handles_labels()):
+            entries.setdefault(label, handle)
+    for handle in extra:
+        entries.setdefault(handle.get_label(), handle)
+    if entries:
+        fig.legend(list(entries.values()), list(entries.keys()), loc="outside lower center", ncols=min(columns, len(entries)), fontsize=MIN_FONT_SIZE + 1)
+
+
+def legend_rows(entries: int, columns: int = 4) -> int:
+    """Rows a :func:`figure_legend` of ``entries`` entries takes."""
+    return math.ceil(entries / columns) if entries else 0
+
+
+def finish_axes(ax: Axes, xlabel: str, ylabel: str, title: str, log: bool = False) -> None:
+    """Labels, title, grid and scale of a panel."""
+    if log:
+        ax.set_yscale("log")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=MIN_FONT_SIZE + 2)
+    ax.grid(True, which="both", alpha=0.3)

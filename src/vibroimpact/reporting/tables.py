@@ -1,0 +1,142 @@
+"""Tables of the frequency-response pages: modal parameters, reduction factors, simulation against the closed form.
+
+A solution is judged only on the points it was asked to compute: time-domain solutions run on their own, coarser
+grid and are flagged ``not_computed`` elsewhere; those points are neither failures nor undefined values.
+"""
+
+from __future__ import annotations
+
+import html
+
+import numpy as np
+import xarray as xr
+
+from vibroimpact.model.modal import exact_modal_parameters, fit_modal_parameters
+from vibroimpact.reporting.reduction import DEFINITION, paper_reduction_factors, reduction_factors
+from vibroimpact.analysis.regime import Regime
+from vibroimpact.reporting.page import Table
+from vibroimpact.reporting.series import split_frequency
+from vibroimpact.reporting.style import QUANTITIES, fmt
+from vibroimpact.scene.core import ENGINE_SOLUTIONS, Scene
+from vibroimpact.model.system import PAPER_SYSTEM
+
+__all__ = ["modal_table", "reduction_tables", "reduction_intro", "agreement_table", "computed_part"]
+
+_REDUCTION_QUANTITIES = ("x1_amplitude", "force_amplitude", "suspension_force_amplitude", "x2_amplitude")
+
+
+def computed_part(dataset: xr.Dataset, solution: str) -> xr.Dataset:
+    """``dataset`` on the frequencies where ``solution`` was computed (its regime is not ``not_computed`` at some
+    point of the other dimensions); all of it if there is no regime."""
+    if "regime" not in dataset:
+        return dataset
+    regime = dataset["regime"].sel(solution=solution)
+    computed = regime != Regime.NOT_COMPUTED
+    others = [d for d in regime.dims if d != "frequency"]
+    if others:
+        computed = computed.any(others)
+    return dataset.isel(frequency=np.flatnonzero(computed.values))
+
+
+def modal_table(scene: Scene) -> Table:
+    """Exact and fitted modal parameters of H22."""
+    exact = exact_modal_parameters(scene.system)
+    fit = fit_modal_parameters(scene.system) if exact.omega.size == 2 else None
+    rows = ["<tr><th>mode</th><th>Omega/2pi [Hz]</th><th>xi exact</th><th>xi fitted</th><th>A exact (complex) [1/kg]</th><th>A fitted [1/kg]</th></tr>"]
+    for i in range(exact.omega.size):
+        a = exact.form_factor[i]
+        fitted = ("", "") if fit is None else (fmt(fit.loss_factor[i], ".5f"), fmt(np.real(fit.form_factor[i]), ".4f"))
+        rows.append(
+            f"<tr><td>{i + 1}</td><td>{fmt(exact.omega[i] / (2 * np.pi), '.4f')}</td><td>{fmt(exact.loss_factor[i], '.5f')}</td><td>{fitted[0]}</td>"
+            f"<td>{a.real:.4f} {a.imag:+.4f}j</td><td>{fitted[1]}</td></tr>"
+        )
+    note = "The paper prints A = 2.75, 7.25 and xi = 0.0022, 0.0023 for its system (eq. 24)." if scene.system == PAPER_SYSTEM else ""
+    if fit is None:
+        note += " The system has fewer than two underdamped modes: the paper's fit does not apply."
+    return Table("Modal parameters of H22", "<table>" + "".join(rows) + f"</table><p>{note}</p>")
+
+
+def reduction_intro() -> str:
+    """The definition of the reduction factors and the notes on the tables' columns (HTML)."""
+    return (
+        f"<p>{html.escape(DEFINITION[:1].upper() + DEFINITION[1:])}</p><p>Each solution is counted on the points it was asked to compute only "
+        "(simulations: their own frequency grid): <i>computed</i> is their number per band, <i>undefined</i> those "
+        "without a value (no steady state known, or the simulation failed). &dagger;: the grid step in that band exceeds "
+        "a quarter of the linear peak's half-power width; a narrow maximum may be missed.</p>"
+    )
+
+
+def reduction_tables(dataset: xr.Dataset, scene: Scene) -> list[Table]:
+    """One table per quantity: reduction factors of every solution but ``linear`` at each (clearance, R)."""
+    solutions = [str(s) for s in dataset["solution"].values if s != "linear"]
+    split = split_frequency(scene)
+    tables = []
+    for quantity in _REDUCTION_QUANTITIES:
+        if quantity not in dataset or not solutions:
+            continue
+        units = QUANTITIES[quantity].units
+        header = (
+            f"<tr><th>solution</th><th>Delta [mm]</th><th>R</th><th>linear peak 1 / 2 [{units}]</th><th>largest realisable in band 1 / 2</th>"
+            "<th>reduction factor 1</th><th>reduction factor 2</th><th>computed points 1 / 2</th><th>undefined points 1 / 2</th>"
+            "<th>unstable points 1 / 2</th><th>paper</th></tr>"
+        )
+        body = []
+        for solution in solutions:
+            part = computed_part(dataset, solution)
+            f = part["frequency"].values
+            computed = f"{int(np.sum(f < split))} / {int(np.sum(f >= split))}"
+            for row in reduction_factors(part, scene, quantity, solution):
+                paper = paper_reduction_factors(scene, quantity, row.restitution, row.clearance)
+                factors = "".join(f"<td>{fmt(factor, '.1f')}{' &dagger;' if coarse else ''}</td>" for factor, coarse in zip(row.factor, row.coarse))
+                unstable = "n/a" if row.unstable is None else f"{row.unstable[0]} / {row.unstable[1]}"
+                body.append(
+                    f"<tr><td>{solution}</td><td>{row.clearance * 1e3:g}</td><td>{row.restitution:g}</td>"
+                    f"<td>{fmt(row.linear_peak[0], '#.4g')} / {fmt(row.linear_peak[1], '#.4g')}</td><td>{fmt(row.largest[0], '#.4g')} / {fmt(row.largest[1], '#.4g')}</td>"
+                    f"{factors}<td>{computed}</td><td>{row.undefined[0]} / {row.undefined[1]}</td><td>{unstable}</td>"
+                    f"<td>{'' if paper is None else f'{paper[0]:g} / {paper[1]:g}'}</td></tr>"
+                )
+        tables.append(Table(f"Reduction factors: {QUANTITIES[quantity].label}", f"<table>{header}{''.join(body)}</table>"))
+    return tables
+
+
+def agreement_table(dataset: xr.Dataset, scene: Scene) -> Table | None:
+    """Simulation against pgf by band: relative differences of |X1| where the pgf orbit is stable and where not."""
+    engines = [str(name) for name in dataset["solution"].values if name in ENGINE_SOLUTIONS]
+    if not engines or "pgf" not in dataset["solution"].values or "x1_amplitude" not in dataset:
+        return None
+    split = split_frequency(scene)
+    header = (
+        "<tr><th>solution</th><th>Delta [mm]</th><th>R</th><th>band</th><th>computed points</th><th>max rel. diff. |X1|, pgf stable or linear</th>"
+        "<th>median</th><th>pgf unstable: points</th><th>max rel. diff. there</th><th>simulation irregular</th><th>simulation with other than 1 or 0 impacts per period</th></tr>"
+    )
+    body = []
+    for engine in engines:
+        data = computed_part(dataset, engine)
+        sim_f = data["frequency"].values
+        for delta in np.atleast_1d(data["clearance"].values):
+            for r in np.atleast_1d(data["restitution"].values):
+                line = data.sel({k: v for k, v in (("clearance", delta), ("restitution", r)) if k in data.dims})
+                sim = line["x1_amplitude"].sel(solution=engine).values
+                pgf = line["x1_amplitude"].sel(solution="pgf").values
+                # the one-impact orbit is unstable where flagged so, and where pgf reports the linear motion instead (regime 7)
+                unstable = line["regime"].sel(solution="pgf").values == Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT
+                if "stable" in line:
+                    unstable = unstable | (line["stable"].sel(solution="pgf").values == 0)
+                irregular = line["converged"].sel(solution=engine).values == 0 if "converged" in line else np.zeros(sim.shape, bool)
+                other = ~np.isin(line["impacts_per_period"].sel(solution=engine).values, (0.0, 1.0)) if "impacts_per_period" in line else np.zeros(sim.shape, bool)
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    difference = np.abs(sim - pgf) / np.abs(pgf)
+                for band, mask in (("1", sim_f < split), ("2", sim_f >= split)):
+                    good = mask & ~unstable & np.isfinite(difference)
+                    bad = mask & unstable & np.isfinite(difference)
+                    body.append(
+                        f"<tr><td>{engine}</td><td>{float(delta) * 1e3:g}</td><td>{float(r):g}</td><td>{band}</td><td>{int(mask.sum())}</td>"
+                        f"<td>{fmt(_largest(difference[good]), '.1e')}</td><td>{fmt(np.median(difference[good]) if good.any() else np.nan, '.1e')}</td>"
+                        f"<td>{int(bad.sum())}</td><td>{fmt(_largest(difference[bad]), '.1e')}</td><td>{int((irregular & mask).sum())}</td><td>{int((other & mask).sum())}</td></tr>"
+                    )
+    return Table("Simulation against PGF by band (|X1| fundamental)", f"<table>{header}{''.join(body)}</table>")
+
+
+def _largest(values: np.ndarray) -> float:
+    """Largest of ``values``; NaN if there are none."""
+    return float(np.max(values)) if values.size else float("nan")

@@ -1,0 +1,1 @@
+"""Time-domain results built on the engines: steady states at one frequency, harmonic measures, swept-sine runs."""

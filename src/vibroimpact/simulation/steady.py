@@ -1,0 +1,229 @@
+"""Steady state at a fixed frequency: integrate until the stroboscopic state repeats, then measure whole periods.
+
+Starts: ``linear`` (the linear steady state; answered without integrating when it stays inside the clearance, since
+it is then an exact steady state), ``pgf`` (the exact one-impact orbit, where it exists), ``rest``, or an explicit
+state (a frequency sweep passes the previous frequency's end state).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from vibroimpact.engines.base import Engine, ImpactProblem
+from vibroimpact.simulation.harmonics import HarmonicMeasures, measure
+from vibroimpact.analysis.linear import linear_response
+from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
+from vibroimpact.model.validation import require_in_range
+
+__all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "START_MODES"]
+
+START_MODES = ("linear", "pgf", "rest")
+
+
+@dataclass(frozen=True)
+class SteadySettings:
+    """How a steady state is sought.
+
+    Parameters
+    ----------
+    tolerance : float
+        The stroboscopic state repeats when successive states (p periods apart) differ by less than this fraction of
+        the motion's scale (positions: Delta + q |H12|; velocities: w times that) [-].
+    max_periods : int
+        Give up (``converged = False``) after this many periods, and measure anyway.
+    chunk_periods : int
+        Periods integrated between convergence checks.
+    measure_periods : int
+        Whole periods measured after convergence (rounded up to a multiple of the detected period).
+    irregular_measure_periods : int
+        Whole periods measured when the motion did not converge (averages of irregular motion need longer).
+    max_multiplicity : int
+        Longest period (in excitation periods) recognised as periodic motion.
+    start_perturbation : float
+        Relative displacement of the ``pgf`` start from the orbit [-], so that the simulation tests the orbit's
+        stability rather than sitting on an unstable orbit until round-off grows.
+    """
+
+    tolerance: float = 1e-7
+    max_periods: int = 1000
+    chunk_periods: int = 20
+    measure_periods: int = 8
+    irregular_measure_periods: int = 64
+    max_multiplicity: int = 4
+    start_perturbation: float = 1e-6
+
+    def __post_init__(self) -> None:
+        require_in_range("tolerance", self.tolerance, 1e-14, 1e-1)
+        require_in_range("max_periods", self.max_periods, 1, 1e8)
+        require_in_range("chunk_periods", self.chunk_periods, 2, 1e6)
+        require_in_range("measure_periods", self.measure_periods, 1, 1e6)
+        require_in_range("irregular_measure_periods", self.irregular_measure_periods, 1, 1e6)
+        require_in_range("max_multiplicity", self.max_multiplicity, 1, 64)
+        require_in_range("start_perturbation", self.start_perturbation, 0.0, 1e-2)
+
+
+@dataclass(frozen=True)
+class SteadyResult:
+    """Outcome of :func:`steady_state`.
+
+    Attributes
+    ----------
+    measures : HarmonicMeasures
+        Harmonics, RMS and impact statistics of the measured periods.
+    converged : bool
+        The stroboscopic state repeated to the tolerance.
+    multiplicity : int
+        Period of the steady motion in excitation periods (1 for period-one motion; 0 if not converged).
+    periods_used : int
+        Periods integrated in all, transient plus measurement (0: answered without integrating).
+    end_time : float
+        Time of the final state [s].
+    end_state : ndarray, shape (4,)
+        Final (X1, X2, X1', X2'), for the next point of a sweep.
+    integrated : bool
+        False when the answer is the linear steady state, given without integrating.
+    """
+
+    measures: HarmonicMeasures
+    converged: bool
+    multiplicity: int
+    periods_used: int
+    end_time: float
+    end_state: NDArray[np.float64] = field(repr=False)
+    integrated: bool = True
+
+
+def start_state(problem: ImpactProblem, mode: str) -> tuple[float, NDArray[np.float64]]:
+    """Initial (time, state) for a start mode; ``pgf`` falls back to ``linear`` where no one-impact orbit exists."""
+    if mode not in START_MODES:
+        raise ValueError(f"start = {mode!r} is not allowed: use one of {', '.join(START_MODES)}")
+    if mode == "rest":
+        return 0.0, np.zeros(4)
+    if mode == "pgf":
+        orbit = _orbit(problem)
+        if orbit.exists[0] and orbit.admissible()[0]:
+            # the orbit's time origin is its impact, where the force has phase (phi - psi12); in the problem's
+            # time that is t_impact = (phi - psi12 - phase) / w; start half a period after it, away from the impact
+            forcing_phase = float(orbit.phase[0] - np.angle(orbit.receptances.h12[0]))
+            t_impact = ((forcing_phase - problem.phase) / problem.omega) % problem.period
+            half = np.array([[0.5 * problem.period]])
+            state = np.array([orbit.x1(half)[0, 0], orbit.x2(half)[0, 0], orbit.x1(half, 1)[0, 0], orbit.x2(half, 1)[0, 0]])
+            return t_impact + 0.5 * problem.period, state
+    response = linear_response(problem.system, problem.omega, problem.amplitude)
+    x = np.array([response.x1, response.x2]) * np.exp(1j * problem.phase)
+    state = np.concatenate([x.real, (1j * problem.omega * x).real])
+    if state[1] > problem.clearance:  # the linear state would start inside the stop: start at rest instead
+        return 0.0, np.zeros(4)
+    return 0.0, state
+
+
+def _orbit(problem: ImpactProblem) -> OneImpactSolution:
+    return solve_one_impact(problem.system, np.array([problem.omega]), problem.clearance, problem.restitution, problem.amplitude)
+
+
+def _has_orbit(problem: ImpactProblem) -> bool:
+    orbit = _orbit(problem)
+    return bool(orbit.exists[0] and orbit.admissible()[0])
+
+
+def linear_fits(problem: ImpactProblem) -> bool:
+    """The linear steady state stays inside the clearance, q |H12| <= Delta."""
+    return bool(problem.amplitude * abs(complex(problem.system.receptances(problem.omega).h12)) <= problem.clearance)
+
+
+def steady_state(
+    engine: Engine, problem: ImpactProblem, start: str | tuple[float, NDArray[np.float64]] = "linear", settings: SteadySettings = SteadySettings()
+) -> SteadyResult:
+    """Integrate to the steady state and measure it.
+
+    Parameters
+    ----------
+    engine : Engine
+        Time-domain engine.
+    problem : ImpactProblem
+        System, stop and excitation.
+    start : {'linear', 'pgf', 'rest'} or (time [s], state)
+        Where to start.
+    settings : SteadySettings
+        Convergence and measurement settings.
+    """
+    if start == "pgf" and not _has_orbit(problem):
+        start = "linear"  # where no admissible one-impact orbit exists, the pgf start is the linear one
+    if start == "linear" and linear_fits(problem):
+        return _linear_answer(problem)
+    t, y = start_state(problem, start) if isinstance(start, str) else (float(start[0]), np.asarray(start[1], dtype=float))
+    scale = np.array([1.0, 1.0, problem.omega, problem.omega]) * (problem.clearance + problem.amplitude * abs(complex(problem.system.receptances(problem.omega).h12)))
+    if start == "pgf":
+        y = y + settings.start_perturbation * scale * np.array([1.0, 0.0, 0.0, 0.0])
+    strobes = [y]
+    used = 0
+    multiplicity = 0
+    while used < settings.max_periods:
+        chunk = min(settings.chunk_periods, settings.max_periods - used)
+        trajectory = engine.integrate(problem, y, t, chunk)
+        used += chunk
+        strobes.extend(trajectory.strobe_states[1:])
+        t, y = float(trajectory.strobe_times[-1]), trajectory.final_state
+        recent = np.array(strobes[-3 * settings.max_multiplicity - 1 :])
+        multiplicity = _repeat(recent, scale, settings)
+        if multiplicity:
+            break
+    if multiplicity:
+        periods = multiplicity * math.ceil(settings.measure_periods / multiplicity)
+    else:
+        periods = settings.irregular_measure_periods
+    final = engine.integrate(problem, y, t, periods, moments=True)
+    return SteadyResult(
+        measures=measure(final),
+        converged=multiplicity > 0,
+        multiplicity=multiplicity,
+        periods_used=used + periods,
+        end_time=float(final.strobe_times[-1]),
+        end_state=final.final_state.copy(),
+    )
+
+
+def _repeat(strobes: NDArray[np.float64], scale: NDArray[np.float64], settings: SteadySettings) -> int:
+    """Smallest p <= max_multiplicity such that the last 2 p + 1 strobes repeat with period p; 0 if none.
+
+    A transient decaying with complex Floquet multipliers of angle near 2 pi / p repeats better after p periods than
+    after one; a genuine period-p motion has macroscopically distinct strobe points. So p > 1 is accepted only when
+    successive strobe states differ by more than 1000 times the tolerance.
+    """
+    step = float(np.max(np.abs(strobes[-1] - strobes[-2]) / scale)) if strobes.shape[0] >= 2 else 0.0
+    for p in range(1, settings.max_multiplicity + 1):
+        if p > 1 and step < 1e3 * settings.tolerance:
+            break
+        if strobes.shape[0] < 2 * p + 1:
+            break
+        recent = strobes[-(p + 1) :]
+        earlier = strobes[-(2 * p + 1) : -p]
+        if np.all(np.abs(recent - earlier) <= settings.tolerance * scale):
+            return p
+    return 0
+
+
+def _linear_answer(problem: ImpactProblem) -> SteadyResult:
+    response = linear_response(problem.system, problem.omega, problem.amplitude)
+    rotation = np.exp(1j * problem.phase)
+    x1, x2 = complex(response.x1) * rotation, complex(response.x2) * rotation
+    measures = HarmonicMeasures(
+        x1=x1,
+        x2=x2,
+        suspension_force=complex(response.force) * rotation,
+        contact_force=0j,
+        x1_rms=abs(x1) / math.sqrt(2.0),
+        x2_rms=abs(x2) / math.sqrt(2.0),
+        impacts_per_period=0.0,
+        mean_impulse=0.0,
+        impulse_per_period=0.0,
+        periods=0,
+        peak_contact_force=0.0,
+        peak_acceleration=0.0,
+    )
+    _t, state = start_state(problem, "linear")
+    return SteadyResult(measures=measures, converged=True, multiplicity=1, periods_used=0, end_time=0.0, end_state=state, integrated=False)

@@ -1,0 +1,163 @@
+"""Steady states of the time-domain engines over a study's grid, as cases for :func:`vibroimpact.runner.run_cases`.
+
+A *case* is one engine at one (restitution, clearance) over its frequencies: independent points for the ``linear``,
+``pgf`` and ``rest`` starts, a chain for the stepped sweeps (``sweep_up``, ``sweep_down``: each point starts from the
+previous one's end state, with the force phase kept continuous).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from dataclasses import asdict, dataclass
+from typing import Callable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from vibroimpact.engines import EngineSettings, ExactEngine, ImpactProblem
+from vibroimpact.engines.base import Engine
+from vibroimpact.engines.compliant.ida import CompliantEngine
+from vibroimpact.engines.momentary import MomentaryEngine
+from vibroimpact.study.fingerprint import case_key
+from vibroimpact.study.runner import CaseResult, ProgressReport
+from vibroimpact.simulation.steady import SteadySettings, linear_fits, steady_state
+from vibroimpact.model.system import TwoDofSystem
+
+__all__ = ["ENGINES", "SWEEP_STARTS", "SimulationCase", "run_case", "make_engine"]
+
+#: Time-domain solutions and their engines (the compliant one also needs its bumper, see :func:`make_engine`).
+ENGINES: dict[str, Callable[..., Engine]] = {"exact": ExactEngine, "momentary": MomentaryEngine, "compliant": CompliantEngine}
+SWEEP_STARTS = ("sweep_up", "sweep_down")
+#: Fields of a case result, one value per frequency.
+FIELDS = (
+    "x1",
+    "x2",
+    "suspension_force",
+    "contact_force",
+    "x1_rms",
+    "x2_rms",
+    "impacts_per_period",
+    "mean_impulse",
+    "impulse_per_period",
+    "peak_contact_force",
+    "peak_acceleration",
+    "converged",
+    "multiplicity",
+    "periods_used",
+    "wall_time",
+    "failed",
+)
+
+
+def make_engine(name: str, settings: EngineSettings, bumper_frequency: float = math.nan, bumper_loss_factor: float = math.nan) -> Engine:
+    """The engine registered under ``name``; ``compliant`` takes Omega_b / 2 pi [Hz] and xi_b [-] of its bumper."""
+    if name not in ENGINES:
+        raise ValueError(f"engine {name!r} is unknown: use one of {', '.join(ENGINES)}")
+    if name == "compliant":
+        return CompliantEngine(bumper_frequency, bumper_loss_factor, settings)
+    return ENGINES[name](settings)
+
+
+@dataclass(frozen=True)
+class SimulationCase:
+    """One engine at one (restitution, clearance) over its frequencies."""
+
+    engine: str
+    system: TwoDofSystem
+    amplitude: float
+    restitution: float
+    clearance: float
+    frequencies: tuple[float, ...]
+    start: str
+    engine_settings: EngineSettings
+    steady_settings: SteadySettings
+    bumper_frequency: float = math.nan
+    bumper_loss_factor: float = math.nan
+
+    fields = FIELDS
+
+    progress_unit = "points"
+
+    @property
+    def progress_total(self) -> float:
+        """Frequency points in the case (progress is counted in points)."""
+        return float(len(self.frequencies))
+
+    def run(self, report: ProgressReport | None = None) -> CaseResult:
+        """Steady states of this case (see :func:`run_case`)."""
+        return run_case(self, report)
+
+    def key(self) -> str:
+        """A stable hash of everything that determines the result, the package version and its source code."""
+        return case_key(
+            {
+                "engine": self.engine,
+                "system": asdict(self.system),
+                "amplitude": self.amplitude,
+                "restitution": self.restitution,
+                "clearance": self.clearance,
+                "frequencies": list(self.frequencies),
+                "start": self.start,
+                "engine_settings": asdict(self.engine_settings),
+                "steady_settings": asdict(self.steady_settings),
+                "bumper": [self.bumper_frequency, self.bumper_loss_factor] if self.engine == "compliant" else None,
+            }
+        )
+
+
+def run_case(case: SimulationCase, report: ProgressReport | None = None) -> CaseResult:
+    """Steady states of one case, in the order of ``case.frequencies``; ``report`` receives the points done."""
+    engine = make_engine(case.engine, case.engine_settings, case.bumper_frequency, case.bumper_loss_factor)
+    n = len(case.frequencies)
+    out: dict[str, NDArray[np.generic]] = {name: np.full(n, np.nan, dtype=complex if name in ("x1", "x2", "suspension_force", "contact_force") else float) for name in FIELDS}
+    order = range(n - 1, -1, -1) if case.start == "sweep_down" else range(n)
+    previous = None
+    for i in order:
+        frequency = case.frequencies[i]
+        problem = ImpactProblem(case.system, case.clearance, case.restitution, case.amplitude, frequency, phase=0.0)
+        start: str | tuple[float, NDArray[np.float64]] = case.start
+        if case.start in SWEEP_STARTS:
+            if previous is None or (previous[2] == 0.0 and linear_fits(problem)):
+                start = "linear"  # a slow sweep without impacts follows the linear steady state
+            else:
+                old_problem, result, _impacts = previous
+                # keep the force continuous: the new force at t = 0 continues the old one at its end time
+                phase = (old_problem.omega * result.end_time + old_problem.phase) % (2.0 * math.pi)
+                problem = ImpactProblem(case.system, case.clearance, case.restitution, case.amplitude, frequency, phase=phase)
+                start = (0.0, result.end_state)
+        started = time.perf_counter()
+        try:
+            result = steady_state(engine, problem, start, case.steady_settings)
+        except (RuntimeError, ValueError, ArithmeticError, np.linalg.LinAlgError) as error:
+            # one failing point must not cost the others: it stays NaN, flagged, and a sweep restarts after it
+            print(f"{case.engine}: R = {case.restitution:g}, Delta = {case.clearance:g} m, f = {frequency:g} Hz failed: {error}", file=sys.stderr)
+            out["failed"][i] = 1.0
+            previous = None
+            continue
+        m = result.measures
+        values = {
+            "x1": m.x1,
+            "x2": m.x2,
+            "suspension_force": m.suspension_force,
+            "contact_force": m.contact_force,
+            "x1_rms": m.x1_rms,
+            "x2_rms": m.x2_rms,
+            "impacts_per_period": m.impacts_per_period,
+            "mean_impulse": m.mean_impulse,
+            "impulse_per_period": m.impulse_per_period,
+            "peak_contact_force": m.peak_contact_force,
+            "peak_acceleration": m.peak_acceleration,
+            "converged": float(result.converged),
+            "multiplicity": float(result.multiplicity),
+            "periods_used": float(result.periods_used),
+            "wall_time": time.perf_counter() - started,
+            "failed": 0.0,
+        }
+        for name, value in values.items():
+            out[name][i] = value
+        previous = (problem, result, m.impacts_per_period)
+        if report is not None:
+            report(float(n - i if case.start == "sweep_down" else i + 1))
+    return out

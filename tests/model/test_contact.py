@@ -1,0 +1,117 @@
+"""Kelvin-Voigt bumper (eq. 25): restitution and peak acceleration against one-collision simulations."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.optimize import minimize_scalar
+
+from vibroimpact.model.contact import (
+    KelvinVoigtBumper,
+    RigidStop,
+    loss_factor_from_restitution,
+    paper_restitution,
+    peak_acceleration_factor,
+    restitution_from_loss_factor,
+)
+
+OMEGA = 2 * math.pi * 250.0  # the paper's bumper, Omega_b / 2 pi = 250 Hz [rad s-1]
+V0 = 0.5  # entry speed [m s-1]
+LOSS_FACTORS = [1e-4, 0.05, 0.2, 0.4, 0.45, 0.49, 0.5, 0.65, 0.8, 0.999, 1.0, 1.001, 1.5, 3.0, 10.0]
+
+
+def collide(xi: float) -> tuple[float, float]:
+    """One collision simulated: (restitution, peak |acceleration| / (Omega v0)).
+
+    x'' = -2 xi Omega x' - Omega^2 x from x = 0, x' = v0, until the force M2 (Omega^2 x + 2 xi Omega x') falls to 0.
+    """
+
+    def rhs(t: float, y: np.ndarray) -> list[float]:
+        return [y[1], -2 * xi * OMEGA * y[1] - OMEGA**2 * y[0]]
+
+    def force(t: float, y: np.ndarray) -> float:
+        return OMEGA**2 * y[0] + 2 * xi * OMEGA * y[1]
+
+    force.terminal, force.direction = True, -1.0
+    horizon = 20.0 / OMEGA * max(1.0, xi)
+    run = solve_ivp(rhs, (0.0, horizon), [0.0, V0], method="DOP853", rtol=1e-13, atol=1e-16, events=force, dense_output=True, first_step=1e-9 / OMEGA)
+    assert run.status == 1, "the bumper must release"
+    release = run.t_events[0][0]
+    restitution = -run.y_events[0][0][1] / V0
+
+    def acceleration(t: float) -> float:
+        x, v = run.sol(t)
+        return abs(-2 * xi * OMEGA * v - OMEGA**2 * x)
+
+    times = np.linspace(0.0, release, 4001)
+    values = np.array([acceleration(t) for t in times])
+    k = int(np.argmax(values))
+    best = values[k]
+    if 0 < k < times.size - 1:
+        refined = minimize_scalar(lambda t: -acceleration(t), bounds=(times[k - 1], times[k + 1]), method="bounded", options={"xatol": 1e-15})
+        best = max(best, -refined.fun)
+    return restitution, best / (OMEGA * V0)
+
+
+@pytest.mark.parametrize("xi", LOSS_FACTORS)
+def test_restitution_and_peak_acceleration_match_one_collision(xi: float) -> None:
+    """Closed forms against a simulated collision, to 1e-8, under-, critically and over-damped."""
+    restitution, peak = collide(xi)
+    assert restitution_from_loss_factor(xi) == pytest.approx(restitution, rel=1e-8)
+    assert peak_acceleration_factor(xi) == pytest.approx(peak, rel=1e-8)
+
+
+def test_restitution_limits_and_monotony() -> None:
+    xi = np.linspace(0.0, 20.0, 4001)
+    r = np.array([restitution_from_loss_factor(x) for x in xi])
+    assert r[0] == 1.0 and np.all(np.diff(r) < 0)  # exact: R(0) = exp(0)
+    assert restitution_from_loss_factor(1.0) == pytest.approx(math.exp(-2.0), rel=1e-15)
+    # continuous through critical damping, from both sides
+    assert restitution_from_loss_factor(1.0 - 1e-9) == pytest.approx(math.exp(-2.0), rel=1e-8)
+    assert restitution_from_loss_factor(1.0 + 1e-9) == pytest.approx(math.exp(-2.0), rel=1e-8)
+    # a very damped bumper: R ~ 1 / (4 xi^2)
+    assert restitution_from_loss_factor(1e4) * 4e8 == pytest.approx(1.0, rel=1e-2)
+
+
+@pytest.mark.parametrize("restitution", [0.9, 0.6, 0.2, math.exp(-2.0), 0.05, 1e-4])
+def test_inverse(restitution: float) -> None:
+    xi = loss_factor_from_restitution(restitution)
+    assert restitution_from_loss_factor(xi) == pytest.approx(restitution, rel=1e-12)
+
+
+def test_paper_loss_factor_does_not_give_r_02() -> None:
+    """Erratum evidence: R = 0.2 needs xi_b = 0.731 (not the paper's 0.65, which gives 0.228); eq. 26 as printed is
+    not a restitution at all there (3.3)."""
+    assert loss_factor_from_restitution(0.2) == pytest.approx(0.7312, abs=1e-4)
+    assert restitution_from_loss_factor(0.65) == pytest.approx(0.2284, abs=1e-4)
+    assert paper_restitution(0.65) > 1.0
+
+
+def test_bumper_force_law() -> None:
+    """Eq. 25: no force before contact, K x + B v while pushing, never pulling."""
+    bumper = KelvinVoigtBumper(clearance=3e-3, frequency=250.0, loss_factor=0.5)
+    m2 = 0.1
+    assert bumper.force(m2, 2.9e-3, 1.0) == 0.0  # exact: no contact: force set to 0
+    assert bumper.force(m2, 3.1e-3, 0.2) == pytest.approx(bumper.stiffness(m2) * 1e-4 + bumper.damping(m2) * 0.2)
+    assert bumper.force(m2, 3.0001e-3, -5.0) == 0.0  # exact: released: force set to 0
+    assert bumper.stiffness(m2) == pytest.approx(m2 * (2 * math.pi * 250.0) ** 2)
+
+
+@pytest.mark.parametrize(
+    ("make", "fragment"),
+    [
+        (lambda: KelvinVoigtBumper(clearance=-1e-3, frequency=250.0, loss_factor=0.5), "clearance = -0.001 is out of range"),
+        (lambda: KelvinVoigtBumper(clearance=1e-3, frequency=0.0, loss_factor=0.5), "frequency = 0.0 is out of range"),
+        (lambda: KelvinVoigtBumper(clearance=1e-3, frequency=250.0, loss_factor=-0.1), "loss_factor = -0.1 is out of range"),
+        (lambda: RigidStop(clearance=1e-3, restitution=1.2), "restitution = 1.2 is out of range: allowed [0, 1]"),
+        (lambda: loss_factor_from_restitution(0.0), "restitution = 0 needs an infinitely damped bumper"),
+    ],
+)
+def test_validation(make: object, fragment: str) -> None:
+    import re
+
+    with pytest.raises(ValueError, match=re.escape(fragment)):
+        make()  # type: ignore[operator]

@@ -1,0 +1,82 @@
+"""Captions say what is drawn: every solution, quantity and description they name is in the figure, filled and
+hollow markers mean what the caption says, and the impulse is called what the data hold."""
+
+from __future__ import annotations
+
+import re
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+
+from vibroimpact.reporting.style import QUANTITIES, SOLUTION_DESCRIPTIONS, SOLUTION_TITLES
+from vibroimpact.scene.core import ENGINE_SOLUTIONS, SOLUTIONS
+from vibroimpact.study.run import VARIABLE_ATTRIBUTES
+
+from tests.reporting.test_report_support import FIGURE_KINDS, build, drawn_gids, steady_dataset, visible
+
+#: Words by which a caption names a solution without its name.
+IMPLICIT_NAMES = {"pgf_paper": ("fitted modes",)}
+
+
+def _drawn_solutions(fig: plt.Figure) -> set[str]:
+    """Solutions with visible data in ``fig``: artists' gids, and the solutions regime-map panels are titled with."""
+    drawn = set()
+    for gid in drawn_gids(fig):
+        drawn.update(re.findall(r"'(\w+)'", gid) if gid.startswith("regime:") else [gid])
+    return drawn
+
+
+def _axis_texts(fig: plt.Figure) -> str:
+    return " ".join(t for ax in fig.axes for t in (ax.get_ylabel(), ax.get_xlabel(), ax.get_title()))
+
+
+@pytest.mark.parametrize("kind", FIGURE_KINDS)
+def test_caption_names_only_what_is_drawn(kind: str) -> None:
+    for drawn in build(kind):
+        fig, caption = drawn.figure, drawn.caption
+        solutions = _drawn_solutions(fig)
+        named = {name for name in re.findall(r"'(\w+)'", caption) if name in SOLUTIONS}
+        assert named <= solutions, f"{drawn.name}: caption names {named - solutions}, not drawn"
+        # compared in lower case: a caption starts with a capital
+        words = caption.lower()
+        titles = " ".join(ax.get_title() for ax in fig.axes).lower()
+        for solution in SOLUTIONS:
+            for text in (SOLUTION_DESCRIPTIONS[solution].lower(), SOLUTION_TITLES[solution].lower(), *IMPLICIT_NAMES.get(solution, ())):
+                if text in words or text in titles:
+                    assert solution in solutions, f"{drawn.name}: describes {solution} ({text!r}), which it does not draw"
+        axes_text = _axis_texts(fig).lower()
+        for quantity in QUANTITIES.values():
+            if quantity.label.lower() in words:
+                assert quantity.label.lower() in axes_text, f"{drawn.name}: caption names {quantity.label!r}, no panel shows it"
+        plt.close(fig)
+
+
+def test_filled_markers_are_periodic_and_hollow_ones_irregular() -> None:
+    ds = steady_dataset()
+    (drawn,) = build("simulation_x1")
+    f = ds["frequency"].values
+    kinds = set()
+    for ax, r in zip(drawn.figure.axes, ds["restitution"].values):
+        for line in ax.get_lines():
+            if line.get_gid() not in ENGINE_SOLUTIONS or line.get_linestyle() != "None":
+                continue
+            converged = ds["converged"].sel(solution=line.get_gid(), restitution=r).values
+            at = np.searchsorted(f, np.asarray(line.get_xdata())[visible(line)])
+            filled = line.get_markerfacecolor() != "none"
+            kinds.add(filled)
+            assert np.all(converged[at] == (1 if filled else 0)), (line.get_gid(), r, filled)
+    assert kinds == {True, False}
+    assert "filled: periodic" in drawn.caption and "hollow: irregular" in drawn.caption
+    plt.close(drawn.figure)
+
+
+@pytest.mark.parametrize("kind", ["response_impulse", "simulation_impulse"])
+def test_impulse_is_called_what_the_data_hold(kind: str) -> None:
+    """The dataset's impulse is the total per excitation period (simulations too), not a mean per impact."""
+    assert "per period" in VARIABLE_ATTRIBUTES["impulse"]["long_name"] and "per period" in QUANTITIES["impulse"].label
+    for drawn in build(kind):
+        assert QUANTITIES["impulse"].label in drawn.caption.lower()
+        assert "per impact" not in drawn.caption
+        assert all("impulse per period" in ax.get_ylabel() for ax in drawn.figure.axes)
+        plt.close(drawn.figure)

@@ -1,0 +1,123 @@
+"""Swept-sine studies end to end: the dataset contract, agreement with the steady states, and the report."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from vibroimpact.analysis.regime import Regime
+from vibroimpact.scene.core import parse_scene
+from vibroimpact.study.run import run_study, write_dataset
+from vibroimpact.study.swept_cases import sweep_start_state
+from vibroimpact.model.system import PAPER_SYSTEM
+
+from tests.scene.test_scene import PAPER_SYSTEM_SPEC
+
+
+def sweep_document(**changes: Any) -> dict[str, Any]:
+    """24 -> 26 Hz at 0.25 Hz/s (8 s) through stable one-impact orbits, R = 0.2, a stiff 4 kHz bumper."""
+    document: dict[str, Any] = {
+        "name": "short_sweep",
+        "system": dict(PAPER_SYSTEM_SPEC),
+        "excitation": {"amplitude": 10.0},
+        "stop": {"clearance": 0.003, "restitution": 0.2},
+        "bumper": {"frequency": 4000.0},
+        "sweep": {"frequency": {"start": 23.0, "stop": 27.0, "step": 0.05}},
+        "swept_sine": {"start": 24.0, "stop": 26.0, "rate": 0.25, "sample_rate": 2000.0, "window_cycles": 8},
+        "solutions": ["linear", "pgf", "compliant"],
+        "simulation": {"rtol": 1e-7, "atol": 1e-11},
+    }
+    document.update(changes)
+    return document
+
+
+@pytest.fixture(scope="module")
+def sweep_run() -> xr.Dataset:
+    document = sweep_document()
+    return run_study(parse_scene(document, text=yaml.safe_dump(document)), progress=None, jobs=2)
+
+
+@pytest.mark.timeout(120)
+def test_contract(sweep_run: xr.Dataset, tmp_path: Path) -> None:
+    ds = sweep_run
+    # the steady states do not depend on the sweep direction and are not repeated along it
+    assert ds["x1_amplitude"].dims == ("solution", "frequency") and list(ds["solution"].values) == ["linear", "pgf"]
+    assert ds["swept_x1_amplitude"].dims == ("sweep", "frequency") and ds["swept_x1_amplitude"].attrs["units"] == "m"
+    assert list(ds["sweep"].values) == ["up", "down"]
+    assert ds["running_x1_amplitude"].dims == ("sweep", "elapsed_time") and ds["elapsed_time"].attrs["units"] == "s"
+    assert ds["instantaneous_frequency"].dims == ("sweep", "elapsed_time") and ds["instantaneous_frequency"].attrs["units"] == "Hz"
+    np.testing.assert_allclose(ds["instantaneous_frequency"].sel(sweep="up").values, 24.0 + 0.25 * ds["elapsed_time"].values)
+    np.testing.assert_allclose(ds["instantaneous_frequency"].sel(sweep="down").values, 26.0 - 0.25 * ds["elapsed_time"].values)
+    for name in ("swept_x1_rms", "swept_x2_rms", "swept_peak_acceleration", "swept_peak_contact_force", "sweep_wall_time", "sweep_contacts"):
+        assert name in ds and ds[name].attrs["units"], name
+    # outside the swept band (and within half a window of its ends) there is no estimate
+    assert np.all(np.isnan(ds["swept_x1_amplitude"].sel(frequency=[23.0, 23.9, 26.1, 27.0]).values))
+    assert np.all(ds["swept_regime"].sel(frequency=25.0).values == Regime.SWEPT_CONTACT)
+    assert ds["swept_regime"].attrs["flag_meanings"] == ds["regime"].attrs["flag_meanings"]
+    assert np.all(ds["sweep_contacts"].values > 0.95 * 8 * 25.0)
+    write_dataset(ds, tmp_path / "sweep.nc")
+    with xr.open_dataset(tmp_path / "sweep.nc") as back:
+        loaded = back.load()
+    assert "vibroimpact" in loaded.attrs.pop("history")  # CF: the file says what wrote it
+    xr.testing.assert_identical(loaded, ds)
+
+
+@pytest.mark.timeout(120)
+def test_slow_sweep_follows_the_steady_states(sweep_run: xr.Dataset) -> None:
+    """A slow sweep through stable one-impact orbits stays on them, one contact per cycle: |X1| and the force on the
+    base within 1.2 % of the PGF values (measured 0.6 % up, 0.8 % down: the 4 kHz bumper alone accounts for 0.6 %,
+    the sweep's lag for the rest), impulse per period within 1 % (0.24 / 0.50 %), peak deceleration within 1.5 %
+    (0.67 / 1.13 %)."""
+    ds = sweep_run.sel(frequency=slice(24.6, 25.4))
+    for direction in ("up", "down"):
+        line = ds.sel(sweep=direction)
+        for quantity, tolerance in (("x1_amplitude", 0.012), ("impulse", 0.01), ("force_amplitude", 0.012), ("peak_acceleration", 0.015)):
+            sim = line[f"swept_{quantity}"].values
+            pgf = line[quantity].sel(solution="pgf").values
+            np.testing.assert_allclose(sim, pgf, rtol=tolerance, err_msg=f"{direction} {quantity}")
+        np.testing.assert_allclose(line["swept_impacts_per_period"].values, 1.0, atol=1.0 / 8)
+        # the RMS of a nearly sinusoidal X1 is close to |X1| / sqrt 2 (harmonics add a little)
+        ratio = line["swept_x1_rms"].values * np.sqrt(2.0) / line["swept_x1_amplitude"].values
+        assert np.all((ratio > 0.99) & (ratio < 1.1)), ratio
+
+
+def test_linear_start_state_is_the_steady_response_to_the_sine() -> None:
+    from vibroimpact.model.excitation import SweptSine
+
+    sweep = SweptSine(10.0, 15.0, 45.0, 0.1)
+    state = sweep_start_state(PAPER_SYSTEM, sweep, 0.003)
+    # independently: (K - w^2 M + j w B) X = F with F = q exp(-j pi / 2) on the primary mass (q sin = Re(-j q e^{jwt}))
+    s = PAPER_SYSTEM
+    w = 2 * np.pi * 15.0
+    dynamic = np.array([[s.k1 + s.k2, -s.k2], [-s.k2, s.k2]]) - w**2 * np.diag([s.m1, s.m2]) + 1j * w * np.array([[s.b1 + s.b2, -s.b2], [-s.b2, s.b2]])
+    x = np.linalg.solve(dynamic, np.array([-10.0j, 0.0]))
+    assert state is not None
+    np.testing.assert_allclose(state, np.concatenate([x.real, (1j * w * x).real]), rtol=1e-12, atol=1e-15)
+    assert sweep_start_state(PAPER_SYSTEM, SweptSine(10.0, 23.0, 45.0, 0.1), 0.003) is None  # at resonance it would cross the stop
+
+
+@pytest.mark.timeout(120)
+def test_report(sweep_run: xr.Dataset, tmp_path: Path) -> None:
+    from vibroimpact.reporting.report import write_report
+
+    page = write_report(sweep_run, tmp_path).read_text()
+    for name in ("sweep_displacements.png", "sweep_force_impulse.png", "sweep_time.png", "Cost of the swept-sine runs"):
+        assert name in page, name
+
+
+@pytest.mark.timeout(120)
+def test_only_the_quantities_asked_for(tmp_path: Path) -> None:
+    """A swept scene that asks for |X1| only writes no running RMS and still gets its report."""
+    from vibroimpact.reporting.report import write_report
+
+    document = sweep_document(quantities=["x1_amplitude", "regime"], swept_sine={"start": 24.0, "stop": 24.5, "rate": 0.25, "sample_rate": 2000.0, "directions": ["up"]})
+    document["sweep"] = {"frequency": [24.2, 24.25]}
+    ds = run_study(parse_scene(document, text=yaml.safe_dump(document)), progress=None)
+    assert "running_x1_amplitude" in ds and "running_x1_rms" not in ds and "swept_x1_rms" not in ds
+    assert np.all(np.isfinite(ds["swept_x1_amplitude"].values))
+    assert "sweep_displacements.png" in write_report(ds, tmp_path).read_text()
