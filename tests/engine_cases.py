@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from vibroimpact.engines import ExactEngine, ImpactProblem, Trajectory
+from vibroimpact.engines.exact import ExactEngine
+
+from vibroimpact.engines.base import ImpactProblem, Trajectory
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact

@@ -161,9 +161,9 @@ def test_installed_package_finds_its_studies(tmp_path: Path) -> None:
 def test_a_code_change_invalidates_the_resume_cache(monkeypatch: pytest.MonkeyPatch) -> None:
     """The cache key hashes the package's source: other code, other key (the version number alone would not do)."""
     from vibroimpact.study import fingerprint
-    from vibroimpact.engines import EngineSettings
+    from vibroimpact.engines.settings import EngineSettings
     from vibroimpact.study.cases import SimulationCase
-    from vibroimpact.simulation.steady import SteadySettings
+    from vibroimpact.simulation.settings import SteadySettings
     from vibroimpact.model.system import PAPER_SYSTEM
 
     case = SimulationCase("exact", PAPER_SYSTEM, 10.0, 0.2, 0.003, (25.0,), "pgf", EngineSettings(), SteadySettings())

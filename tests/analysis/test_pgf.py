@@ -242,8 +242,10 @@ def test_max_overshoot_is_the_supremum_over_the_period(system: TwoDofSystem) -> 
 def test_rms_of_the_orbit_matches_a_simulation(system: TwoDofSystem) -> None:
     """RMS of the reconstructed X1, X2 of the stable 25 Hz orbit against the exact engine's steady-state RMS (exact
     per-period moments) to 1e-5; a sine's RMS is |X| / sqrt 2, the clipped X2 is not."""
-    from vibroimpact.engines import ExactEngine, ImpactProblem
-    from vibroimpact.simulation.steady import SteadySettings, steady_state
+    from vibroimpact.engines.exact import ExactEngine
+    from vibroimpact.engines.base import ImpactProblem
+    from vibroimpact.simulation.steady import steady_state
+    from vibroimpact.simulation.settings import SteadySettings
 
     orbit = solve_one_impact(system, np.array([2 * np.pi * 25.0]), 0.003, 0.2, 10.0)
     x1_rms, x2_rms = orbit.rms()

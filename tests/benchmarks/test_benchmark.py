@@ -11,7 +11,8 @@ import yaml
 
 from vibroimpact import cli
 from vibroimpact.benchmarks.accuracy import BenchmarkCase, BenchmarkSettings, _compare, equal_error_speedup, run_benchmark
-from vibroimpact.engines import ExactEngine, ImpactProblem, Trajectory
+from vibroimpact.engines.exact import ExactEngine
+from vibroimpact.engines.base import ImpactProblem, Trajectory
 from vibroimpact.model.system import TwoDofSystem
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
@@ -94,7 +95,7 @@ def test_compliant_cvode_is_an_independent_integrator_of_the_same_model(system: 
     import math
 
     from vibroimpact.model.contact import loss_factor_from_restitution, restitution_from_loss_factor
-    from vibroimpact.engines import EngineSettings
+    from vibroimpact.engines.settings import EngineSettings
     from vibroimpact.engines.compliant.ida import CompliantEngine
     from vibroimpact.engines.compliant.cvode import CompliantCvodeEngine
 

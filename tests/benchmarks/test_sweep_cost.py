@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from vibroimpact.model.contact import loss_factor_from_restitution
-from vibroimpact.engines.compliant.ida import SWEEP_SETTINGS, CompliantEngine
+from vibroimpact.engines.compliant.ida import CompliantEngine
+from vibroimpact.engines.settings import SWEEP_SETTINGS
 from vibroimpact.engines.compliant.ivp import solve_ivp_sweep
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.simulation.harmonics import running_fundamental

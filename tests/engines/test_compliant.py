@@ -9,10 +9,13 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from vibroimpact.model.contact import loss_factor_from_restitution, peak_acceleration_factor, restitution_from_loss_factor
-from vibroimpact.engines import EngineSettings, ExactEngine, ImpactProblem
+from vibroimpact.engines.exact import ExactEngine
+from vibroimpact.engines.base import ImpactProblem
+from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.compliant.ida import MODE_CONTACT, CompliantEngine, SweepRecord
 from vibroimpact.model.excitation import SweptSine
-from vibroimpact.simulation.steady import SteadySettings, steady_state
+from vibroimpact.simulation.steady import steady_state
+from vibroimpact.simulation.settings import SteadySettings
 from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
@@ -158,7 +161,7 @@ def test_sweep_settings_agree_with_a_tight_run() -> None:
     """The paper's sweep settings (rtol 1e-6, atol 1e-10 m) against rtol 1e-9 over a contact-rich 10 s (24 -> 25 Hz,
     one contact per period): same contacts, onsets to 1e-6 s, running X1 fundamental to 2e-5 of its largest value
     (measured 4e-6), peak force and deceleration and impulses to 2e-4 (measured ~3e-5)."""
-    from vibroimpact.engines.compliant.ida import SWEEP_SETTINGS
+    from vibroimpact.engines.settings import SWEEP_SETTINGS
     from vibroimpact.simulation.harmonics import running_fundamental
 
     sweep, record = _paper_sweep_record(SWEEP_SETTINGS, 24.0, 25.0)
@@ -305,7 +308,7 @@ def test_paper_sweep_is_fast_and_close_to_a_tight_run() -> None:
     timeout catches a hang), and over the contact-rich, reproducible 21 -> 24 Hz (60 - 90 s) the same contacts and
     running X1 fundamental as rtol 1e-9 to 1e-4 of its largest value."""
 
-    from vibroimpact.engines.compliant.ida import SWEEP_SETTINGS
+    from vibroimpact.engines.settings import SWEEP_SETTINGS
     from vibroimpact.simulation.harmonics import running_fundamental
 
     sweep, record = _paper_sweep_record(SWEEP_SETTINGS, 15.0, 45.0)  # the timeout bounds it; speed is benchmarked

@@ -6,7 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vibroimpact.engines import MODE_STUCK, EngineSettings, ExactEngine, ImpactProblem
+from vibroimpact.engines.base import MODE_STUCK, ImpactProblem
+
+from vibroimpact.engines.exact import ExactEngine
+
+from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.model.system import TwoDofSystem
 
@@ -200,7 +204,7 @@ def test_resting_on_the_stop_with_round_off_holding_force_does_not_livelock() ->
     force evaluates to 5.6e-17 N of round-off; its sign once decided 'not pushed', and zero-speed elastic impacts
     repeated at t = 0 until the event budget ran out. Round-off-sized forces now leave the decision to the
     derivatives: the absorber is held, then released."""
-    from vibroimpact.engines import ImpactProblem
+    from vibroimpact.engines.base import ImpactProblem
 
     s = TwoDofSystem(m1=0.5, m2=0.34916140783976635, k1=10000.0, k2=10934.225385165902, b1=0.0, b2=0.13323645201253634)
     problem = ImpactProblem(s, 0.0, 1.0, 0.5, 56.38618344739488, phase=0.0004942310000114958)

@@ -6,7 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vibroimpact.engines import MODE_STUCK, EngineSettings, ExactEngine, ImpactProblem
+from vibroimpact.engines.base import MODE_STUCK, ImpactProblem
+
+from vibroimpact.engines.exact import ExactEngine
+
+from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.momentary import MomentaryEngine
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.model.system import TwoDofSystem

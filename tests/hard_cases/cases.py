@@ -32,7 +32,9 @@ from typing import Mapping
 import numpy as np
 
 from vibroimpact.model.contact import loss_factor_from_restitution, restitution_from_loss_factor
-from vibroimpact.engines import Engine, EngineSettings, ExactEngine, ImpactProblem
+from vibroimpact.engines.base import Engine, ImpactProblem
+from vibroimpact.engines.exact import ExactEngine
+from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.compliant.ida import CompliantEngine
 from vibroimpact.engines.momentary import MomentaryEngine
 from vibroimpact.engines.scipy_ivp import SolveIvpEngine

@@ -29,7 +29,7 @@ import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
-from vibroimpact.engines import ImpactProblem
+from vibroimpact.engines.base import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
 
 from tests.engine_cases import linear_state

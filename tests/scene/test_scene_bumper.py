@@ -126,11 +126,11 @@ def test_every_swept_sine_problem_is_reported_at_once() -> None:
 def test_default_tolerances_follow_the_guidance() -> None:
     """Without rtol/atol: stepped steady states 1e-8 / 1e-12 m, swept sines 1e-7 / 1e-11 m (README, tolerance
     guidance); given values win, and an rtol alone brings atol = rtol x 1e-4 m."""
-    from vibroimpact.scene.core import DEFAULT_TOLERANCES
+    from vibroimpact.engines.settings import STEPPED_TOLERANCES, SWEPT_TOLERANCES
 
     stepped = parse_scene(compliant_scene())
-    assert stepped.simulation is not None and (stepped.simulation.engine.rtol, stepped.simulation.engine.atol) == DEFAULT_TOLERANCES["stepped"] == (1e-8, 1e-12)
+    assert stepped.simulation is not None and (stepped.simulation.engine.rtol, stepped.simulation.engine.atol) == STEPPED_TOLERANCES == (1e-8, 1e-12)
     swept = parse_scene(sweep_scene())
-    assert swept.simulation is not None and (swept.simulation.engine.rtol, swept.simulation.engine.atol) == DEFAULT_TOLERANCES["swept"] == (1e-7, 1e-11)
+    assert swept.simulation is not None and (swept.simulation.engine.rtol, swept.simulation.engine.atol) == SWEPT_TOLERANCES == (1e-7, 1e-11)
     given = parse_scene(sweep_scene() | {"simulation": {"rtol": 1e-6}})  # atol follows: rtol x 1e-4 m, as measured
     assert given.simulation is not None and given.simulation.engine.rtol == 1e-6 and given.simulation.engine.atol == pytest.approx(1e-10)  # exact: parsed input

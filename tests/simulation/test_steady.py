@@ -8,13 +8,16 @@ import numpy as np
 import pytest
 
 from vibroimpact.study import cases as simulate
-from vibroimpact.engines import EngineSettings, ExactEngine, ImpactProblem
+from vibroimpact.engines.exact import ExactEngine
+from vibroimpact.engines.base import ImpactProblem
+from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.momentary import MomentaryEngine
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import solve_one_impact
 from vibroimpact.study.runner import run_cases
 from vibroimpact.study.cases import SimulationCase
-from vibroimpact.simulation.steady import SteadySettings, steady_state
+from vibroimpact.simulation.steady import steady_state
+from vibroimpact.simulation.settings import SteadySettings
 from vibroimpact.model.system import TwoDofSystem
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE

@@ -54,7 +54,7 @@ def test_pgf_peak_estimates(stiffness_run: xr.Dataset) -> None:
     """Force: Gamma(xi_b) Omega_b J / (1 + R). Deceleration: that force less the absorber spring's pull at the impact,
     over M2; the spring force here comes from an independent exact-engine run of the orbit (state just before an
     impact)."""
-    from vibroimpact.engines import ExactEngine
+    from vibroimpact.engines.exact import ExactEngine
 
     from tests.engine_cases import pgf_start
 

@@ -26,7 +26,9 @@ import numpy as np
 import xarray as xr
 
 from vibroimpact.model.contact import loss_factor_from_restitution
-from vibroimpact.engines import EngineSettings, ExactEngine, ImpactProblem, Trajectory
+from vibroimpact.engines.exact import ExactEngine
+from vibroimpact.engines.base import ImpactProblem, Trajectory
+from vibroimpact.engines.settings import ATOL_RATIO, REFERENCE_RTOL, EngineSettings
 from vibroimpact.engines.base import Engine
 from vibroimpact.engines.compliant.ida import CompliantEngine, SweepRecord
 from vibroimpact.engines.compliant.cvode import CompliantCvodeEngine
@@ -57,8 +59,7 @@ COMPLIANT_METHODS: dict[str, Callable[[EngineSettings, float, float], CompliantE
 }
 #: Every method name a benchmark scene may list.
 BENCHMARK_METHODS = tuple(RIGID_METHODS) + tuple(COMPLIANT_METHODS)
-#: Tolerance of the compliant model's reference (CVODE Adams); its atol is this times the scene's atol_ratio.
-REFERENCE_RTOL = 1e-13
+
 SLOW_RUN = 5.0  # [s] a run longer than this is not repeated
 
 
@@ -126,7 +127,7 @@ class BenchmarkSettings:
 
     methods: tuple[str, ...]
     tolerances: tuple[float, ...]
-    atol_ratio: float = 1e-4
+    atol_ratio: float = ATOL_RATIO
     repeats: int = 3
     max_seconds: float = 60.0
     ladder: "LadderSettings | None" = None
@@ -384,7 +385,8 @@ def model_ladder(system: TwoDofSystem, amplitude: float, ladder: LadderSettings,
     """Wall time of one steady-state point and its |X1| for ``pgf``, ``exact``, ``momentary`` and ``compliant`` at
     each bumper frequency, and the relative difference from ``exact``; dimension ``model``."""
     from vibroimpact.analysis.pgf import solve_one_impact
-    from vibroimpact.simulation.steady import SteadySettings, steady_state
+    from vibroimpact.simulation.steady import steady_state
+    from vibroimpact.simulation.settings import SteadySettings
 
     problem = ImpactProblem(system, ladder.clearance, ladder.restitution, amplitude, ladder.frequency)
     settings = EngineSettings(rtol=ladder.rtol, atol=ladder.rtol * atol_ratio)

@@ -30,8 +30,9 @@ import numpy as np
 import xarray as xr
 
 from vibroimpact.model.contact import loss_factor_from_restitution
-from vibroimpact.engines import EngineSettings
-from vibroimpact.engines.compliant.ida import SWEEP_SETTINGS, CompliantEngine, SweepRecord
+from vibroimpact.engines.settings import EngineSettings
+from vibroimpact.engines.compliant.ida import CompliantEngine, SweepRecord
+from vibroimpact.engines.settings import SWEEP_SETTINGS
 from vibroimpact.engines.compliant.ivp import IVP_METHODS, solve_ivp_sweep
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.simulation.harmonics import running_fundamental

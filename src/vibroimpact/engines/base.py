@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.model.validation import require_in_range, require_non_negative, require_positive
 
-__all__ = ["ImpactProblem", "EngineSettings", "Trajectory", "Engine", "MODE_FREE", "MODE_STUCK"]
+__all__ = ["ImpactProblem", "Trajectory", "Engine", "MODE_FREE", "MODE_STUCK"]
 
 #: Segment modes of a trajectory.
 MODE_FREE, MODE_STUCK = 0, 1
@@ -76,44 +76,6 @@ class ImpactProblem:
         """A velocity typical of the motion, w (Delta + q |H12|) [m s-1], for relative thresholds."""
         linear = self.amplitude * float(np.abs(self.system.receptances(self.omega).h12))
         return self.omega * (self.clearance + linear) + 1e-300
-
-
-@dataclass(frozen=True)
-class EngineSettings:
-    """Numerical settings of a time-domain engine.
-
-    Parameters
-    ----------
-    rtol, atol : float
-        Relative and absolute tolerances of the integrator (ignored by ``exact``, which is exact to round-off).
-    method : {'adams', 'bdf'}
-        Linear multistep family of CVODE (``momentary``).
-    max_step : float
-        Largest step [s]; 0 means no limit.
-    sticking_velocity : float
-        Impacts slower than this fraction of :meth:`ImpactProblem.velocity_scale` while the stop pushes the absorber
-        end a chattering sequence: the absorber sticks [-]. Rebounds much slower than the default would rise less
-        than a few hundred round-off units of the gap, where no integrator resolves them; the chatter left out
-        lasts about 2 R v / ((1 - R) a), of the order of 1e-9 s.
-    max_impacts_per_period : int
-        Chattering safeguard: more impacts than this in one period force the sticking check.
-    """
-
-    rtol: float = 1e-8
-    atol: float = 1e-12
-    method: str = "adams"
-    max_step: float = 0.0
-    sticking_velocity: float = 1e-6
-    max_impacts_per_period: int = 10_000
-
-    def __post_init__(self) -> None:
-        require_in_range("rtol", self.rtol, 1e-15, 1e-1)
-        require_in_range("atol", self.atol, 1e-300, 1e-1)
-        if self.method not in ("adams", "bdf"):
-            raise ValueError(f"method = {self.method!r} is not allowed: use 'adams' or 'bdf'")
-        require_non_negative("max_step", self.max_step)
-        require_in_range("sticking_velocity", self.sticking_velocity, 0.0, 1e-2)
-        require_in_range("max_impacts_per_period", self.max_impacts_per_period, 10, 1e9)
 
 
 @dataclass(frozen=True, eq=False)

@@ -18,7 +18,9 @@ from enum import Enum
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
+from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, ImpactProblem, Trajectory, TrajectoryBuilder
+
+from vibroimpact.engines.settings import EngineSettings
 
 __all__ = ["EventLoopEngine", "Stop", "Model"]
 

@@ -14,7 +14,9 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
+from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, ImpactProblem, Trajectory, TrajectoryBuilder
+
+from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.linear_flow import HarmonicLinearFlow, Observable, Piece, escape_step, first_crossing, gauss_legendre
 
 __all__ = ["ExactEngine"]

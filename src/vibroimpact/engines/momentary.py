@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 from sksundae.cvode import CVODE
 
-from vibroimpact.engines.base import EngineSettings
+from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.sundae import clear_event_records
 from vibroimpact.engines.event_loop import EventLoopEngine, Model, Stop
 

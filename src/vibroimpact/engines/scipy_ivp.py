@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
-from vibroimpact.engines.base import EngineSettings
+from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.event_loop import EventLoopEngine, Model, Stop
 
 __all__ = ["SolveIvpEngine", "SOLVE_IVP_METHODS"]

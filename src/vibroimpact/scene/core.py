@@ -27,11 +27,12 @@ import numpy as np
 import yaml
 
 from vibroimpact.benchmarks.accuracy import BENCHMARK_METHODS, BenchmarkCase, BenchmarkSettings, LadderSettings
-from vibroimpact.engines.base import EngineSettings, ImpactProblem
+from vibroimpact.engines.base import ImpactProblem
+from vibroimpact.engines.settings import STEPPED_TOLERANCES, SWEPT_TOLERANCES, EngineSettings
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.modal import underdamped_mode_count
 from vibroimpact.analysis.pgf import AdmissibilitySettings
-from vibroimpact.simulation.steady import SteadySettings
+from vibroimpact.simulation.settings import SteadySettings
 from vibroimpact.model.system import TwoDofSystem
 
 __all__ = ["Scene", "SceneError", "SweptSineSettings", "load_scene", "parse_scene", "SOLUTIONS", "ENGINE_SOLUTIONS", "QUANTITIES", "SWEEPABLE", "GRID_DIMS"]
@@ -711,16 +712,11 @@ def _parse_ladder(c: _Checker, value: Any) -> LadderSettings | None:
     return LadderSettings(frequency, restitution, clearance, tuple(float(b) for b in bumpers), rtol, repeats)
 
 
-#: Default integrator tolerances (rtol, atol [m]), from the accuracy_cost study (README, tolerance guidance): stepped
-#: steady states need rtol 1e-8 so that the integrator's noise stays below the stroboscopic tolerance 1e-7 (at rtol
-#: 1e-6 points near the ends of the one-impact branches never pass the repeat test); swept sines have no such test
-#: and rtol 1e-7 keeps the running X1 fundamental within 1e-6.
-DEFAULT_TOLERANCES = {"stepped": (1e-8, 1e-12), "swept": (1e-7, 1e-11)}
 
 
 def _parse_simulation(c: _Checker, value: Any, default_frequency: np.ndarray, swept: bool = False) -> SimulationSettings | None:
     spec = dict(c.mapping("simulation", value, _SIMULATION_KEYS))
-    rtol, atol = DEFAULT_TOLERANCES["swept" if swept else "stepped"]
+    rtol, atol = SWEPT_TOLERANCES if swept else STEPPED_TOLERANCES
     if "rtol" in spec and "atol" not in spec and isinstance(spec["rtol"], (int, float)) and not isinstance(spec["rtol"], bool):
         spec["atol"] = spec["rtol"] * (atol / rtol)  # the ratio the guidance was measured with: atol = rtol x 1e-4 m
     spec.setdefault("rtol", rtol)

@@ -17,53 +17,11 @@ from vibroimpact.engines.base import Engine, ImpactProblem
 from vibroimpact.simulation.harmonics import HarmonicMeasures, measure
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
-from vibroimpact.model.validation import require_in_range
+from vibroimpact.simulation.settings import SteadySettings
 
 __all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "START_MODES"]
 
 START_MODES = ("linear", "pgf", "rest")
-
-
-@dataclass(frozen=True)
-class SteadySettings:
-    """How a steady state is sought.
-
-    Parameters
-    ----------
-    tolerance : float
-        The stroboscopic state repeats when successive states (p periods apart) differ by less than this fraction of
-        the motion's scale (positions: Delta + q |H12|; velocities: w times that) [-].
-    max_periods : int
-        Give up (``converged = False``) after this many periods, and measure anyway.
-    chunk_periods : int
-        Periods integrated between convergence checks.
-    measure_periods : int
-        Whole periods measured after convergence (rounded up to a multiple of the detected period).
-    irregular_measure_periods : int
-        Whole periods measured when the motion did not converge (averages of irregular motion need longer).
-    max_multiplicity : int
-        Longest period (in excitation periods) recognised as periodic motion.
-    start_perturbation : float
-        Relative displacement of the ``pgf`` start from the orbit [-], so that the simulation tests the orbit's
-        stability rather than sitting on an unstable orbit until round-off grows.
-    """
-
-    tolerance: float = 1e-7
-    max_periods: int = 1000
-    chunk_periods: int = 20
-    measure_periods: int = 8
-    irregular_measure_periods: int = 64
-    max_multiplicity: int = 4
-    start_perturbation: float = 1e-6
-
-    def __post_init__(self) -> None:
-        require_in_range("tolerance", self.tolerance, 1e-14, 1e-1)
-        require_in_range("max_periods", self.max_periods, 1, 1e8)
-        require_in_range("chunk_periods", self.chunk_periods, 2, 1e6)
-        require_in_range("measure_periods", self.measure_periods, 1, 1e6)
-        require_in_range("irregular_measure_periods", self.irregular_measure_periods, 1, 1e6)
-        require_in_range("max_multiplicity", self.max_multiplicity, 1, 64)
-        require_in_range("start_perturbation", self.start_perturbation, 0.0, 1e-2)
 
 
 @dataclass(frozen=True)

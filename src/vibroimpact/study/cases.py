@@ -16,13 +16,18 @@ from typing import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.engines import EngineSettings, ExactEngine, ImpactProblem
+from vibroimpact.engines.exact import ExactEngine
+
+from vibroimpact.engines.base import ImpactProblem
+
+from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.base import Engine
 from vibroimpact.engines.compliant.ida import CompliantEngine
 from vibroimpact.engines.momentary import MomentaryEngine
 from vibroimpact.study.fingerprint import case_key
 from vibroimpact.study.runner import CaseResult, ProgressReport
-from vibroimpact.simulation.steady import SteadySettings, linear_fits, steady_state
+from vibroimpact.simulation.steady import linear_fits, steady_state
+from vibroimpact.simulation.settings import SteadySettings
 from vibroimpact.model.system import TwoDofSystem
 
 __all__ = ["ENGINES", "SWEEP_STARTS", "SimulationCase", "run_case", "make_engine"]

@@ -87,7 +87,11 @@ def speed_probe(repeats: int = 3) -> float:
     ``momentary`` (CVODE Adams, rtol 1e-8) at 25 Hz from rest, the kind of work the simulations spend their time on."""
     import time
 
-    from vibroimpact.engines import EngineSettings, ExactEngine, ImpactProblem
+    from vibroimpact.engines.exact import ExactEngine
+
+    from vibroimpact.engines.base import ImpactProblem
+
+    from vibroimpact.engines.settings import EngineSettings
     from vibroimpact.engines.momentary import MomentaryEngine
     from vibroimpact.model.system import PAPER_SYSTEM
 

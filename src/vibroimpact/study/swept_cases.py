@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import cumulative_trapezoid
 
-from vibroimpact.engines.base import EngineSettings
+from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.compliant.ida import CompliantEngine, SweepRecord
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.study.fingerprint import case_key

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 from sksundae.cvode import CVODE
 
-from vibroimpact.engines.base import EngineSettings
+from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.compliant.ida import CompliantEngine, _BumperModel, absolute_tolerances
 
 __all__ = ["CompliantCvodeEngine"]

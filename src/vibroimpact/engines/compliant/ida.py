@@ -56,7 +56,8 @@ from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.model.validation import require_positive
-from vibroimpact.engines.base import MODE_FREE, EngineSettings, ImpactProblem, Trajectory, TrajectoryBuilder
+from vibroimpact.engines.base import MODE_FREE, ImpactProblem, Trajectory, TrajectoryBuilder
+from vibroimpact.engines.settings import SWEEP_SETTINGS, EngineSettings
 from vibroimpact.engines.event_loop import QUADRATURES, moment_row, write_quadratures
 from vibroimpact.engines.sundae import clear_event_records
 
@@ -68,7 +69,7 @@ _STATUS_ILL_INPUT = -22  # IDA_ILL_INPUT (CV_ILL_INPUT): among others, "Root fou
 #: Settings for the paper's swept-sine test. Against rtol 1e-9 runs of the 15 -> 45 Hz sweep, atol 1e-10 m is as
 #: close as 1e-12 m (the default) and ~15 % cheaper; 1e-9 m saves another ~5 % but drifts 5-10x farther after the
 #: regime change near 39.5 Hz (``vibroimpact.sweep_cost`` and tests/test_compliant.py measure both).
-SWEEP_SETTINGS = EngineSettings(rtol=1e-6, atol=1e-10)
+
 #: Largest number of output times handled by one ``IDA.solve`` call (bounds its output arrays).
 _OUTPUTS_PER_CALL = 2048
 #: Mode switches in a row without any progress in time before the run is declared stuck.

@@ -1,0 +1,97 @@
+"""Every engine by name: the one vocabulary of scenes, studies, benchmarks, the cost estimate and the tests.
+
+An entry names the class that implements the engine (imported on first use, so that a scene can check engine names
+without loading a solver library), the contact law it solves, and the options it is built with. Adding an engine
+is one module plus one line here::
+
+    "my_engine": EngineSpec("vibroimpact.engines.my_engine:MyEngine", RIGID, "what it is"),
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any, Mapping
+
+from vibroimpact.engines.settings import EngineSettings
+
+__all__ = ["RIGID", "BUMPER", "EngineSpec", "ENGINES", "engine_names", "engine_spec", "make_engine"]
+
+#: Contact laws an engine can solve: the momentary-impact stop and the Kelvin-Voigt bumper.
+RIGID, BUMPER = "rigid", "bumper"
+
+
+@dataclass(frozen=True)
+class EngineSpec:
+    """One registered engine.
+
+    Attributes
+    ----------
+    target : str
+        ``module:class`` of the engine; the class is called as ``cls(settings, **options)``.
+    contact : str
+        :data:`RIGID` or :data:`BUMPER`: the contact law of the problems it integrates.
+    description : str
+        One line for listings.
+    options : mapping
+        Fixed keyword arguments of the class (a solver family, a method).
+    settings_method : str or None
+        When set, the CVODE method (``adams`` or ``bdf``) the engine always uses, whatever the settings say.
+    """
+
+    target: str
+    contact: str
+    description: str
+    options: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
+    settings_method: str | None = None
+
+    def build(self, settings: EngineSettings) -> Any:
+        """The engine with ``settings`` (its method replaced by :attr:`settings_method` when that is set)."""
+        module_name, _, class_name = self.target.partition(":")
+        engine_class = getattr(importlib.import_module(module_name), class_name)
+        if self.settings_method is not None and settings.method != self.settings_method:
+            settings = EngineSettings(**{**settings.__dict__, "method": self.settings_method})
+        return engine_class(settings, **self.options)
+
+
+def _solve_ivp(method: str) -> EngineSpec:
+    return EngineSpec("vibroimpact.engines.scipy_ivp:SolveIvpEngine", RIGID, f"scipy solve_ivp ({method}) with terminal events and restarts: a comparison baseline", MappingProxyType({"method": method}))
+
+
+#: name -> engine. ``momentary`` uses the method of its settings; the suffixed names fix it.
+ENGINES: Mapping[str, EngineSpec] = MappingProxyType(
+    {
+        "exact": EngineSpec("vibroimpact.engines.exact:ExactEngine", RIGID, "piecewise-exact closed-form flow with guaranteed contact search: the reference"),
+        "momentary": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", RIGID, "SUNDIALS CVODE with contact events and a grazing guard (method from the settings)"),
+        "momentary_adams": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", RIGID, "SUNDIALS CVODE, Adams, with contact events and a grazing guard", settings_method="adams"),
+        "momentary_bdf": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", RIGID, "SUNDIALS CVODE, BDF, with contact events and a grazing guard", settings_method="bdf"),
+        "solve_ivp_RK45": _solve_ivp("RK45"),
+        "solve_ivp_DOP853": _solve_ivp("DOP853"),
+        "solve_ivp_LSODA": _solve_ivp("LSODA"),
+        "solve_ivp_Radau": _solve_ivp("Radau"),
+        "solve_ivp_BDF": _solve_ivp("BDF"),
+        "compliant": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", BUMPER, "Kelvin-Voigt bumper through SUNDIALS IDA, one solver per contact mode"),
+        "compliant_ida": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", BUMPER, "the engine compliant, under the name benchmark scenes use"),
+        "compliant_cvode_adams": EngineSpec("vibroimpact.engines.compliant.cvode:CompliantCvodeEngine", BUMPER, "Kelvin-Voigt bumper through SUNDIALS CVODE (Adams)", settings_method="adams"),
+        "compliant_cvode_bdf": EngineSpec("vibroimpact.engines.compliant.cvode:CompliantCvodeEngine", BUMPER, "Kelvin-Voigt bumper through SUNDIALS CVODE (BDF)", settings_method="bdf"),
+    }
+)
+
+
+def engine_names(contact: str | None = None) -> tuple[str, ...]:
+    """Registered names, in registry order; only those solving ``contact`` (:data:`RIGID`, :data:`BUMPER`) if given."""
+    return tuple(name for name, spec in ENGINES.items() if contact is None or spec.contact == contact)
+
+
+def engine_spec(name: str) -> EngineSpec:
+    """The entry of ``name``; ``ValueError`` naming the registered engines if there is none."""
+    try:
+        return ENGINES[name]
+    except KeyError:
+        raise ValueError(f"engine {name!r} is unknown: use one of {', '.join(ENGINES)}") from None
+
+
+def make_engine(name: str, settings: EngineSettings = EngineSettings()) -> Any:
+    """The engine registered under ``name``, built with ``settings``."""
+    return engine_spec(name).build(settings)
