@@ -236,6 +236,16 @@ class Scene:
         return np.array([loss_factor_from_restitution(r) if r > 0.0 else np.nan for r in self.restitution])
 
     @property
+    def kind(self) -> str:
+        """What kind of study the scene is: ``benchmark``, ``swept`` (swept-sine tests) or ``stepped`` (steady states).
+
+        The one place that decides it; everything else dispatches on this name.
+        """
+        if self.benchmark is not None:
+            return "benchmark"
+        return "stepped" if self.swept_sine is None else "swept"
+
+    @property
     def sweep_directions(self) -> tuple[str, ...]:
         """Directions of the swept-sine test; ``()`` for stepped steady states."""
         return () if self.swept_sine is None else self.swept_sine.directions
