@@ -15,7 +15,7 @@ import yaml
 from vibroimpact import cli
 from vibroimpact.study import run as study
 from vibroimpact.study.runner import cached_case_count
-from vibroimpact.scene.core import shipped_studies, shipped_studies_dir
+from vibroimpact.scene import load_scene, shipped_studies, shipped_studies_dir
 
 from tests.scene.test_scene import base_scene, write_yaml
 
@@ -69,7 +69,7 @@ def test_each_searched_place_is_listed_once(monkeypatch: pytest.MonkeyPatch, cap
 
 
 def test_a_local_file_wins_over_the_shipped_scene(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    from vibroimpact.scene.core import find_scene
+    from vibroimpact.scene import find_scene
 
     monkeypatch.chdir(tmp_path)
     local = write_yaml(tmp_path / "restitution.yaml", base_scene())
@@ -162,11 +162,12 @@ def test_a_code_change_invalidates_the_resume_cache(monkeypatch: pytest.MonkeyPa
     """The cache key hashes the package's source: other code, other key (the version number alone would not do)."""
     from vibroimpact.study import fingerprint
     from vibroimpact.engines.settings import EngineSettings
+    from vibroimpact.model.contact import RigidStop
     from vibroimpact.study.cases import SimulationCase
     from vibroimpact.simulation.settings import SteadySettings
     from vibroimpact.model.system import PAPER_SYSTEM
 
-    case = SimulationCase("exact", PAPER_SYSTEM, 10.0, 0.2, 0.003, (25.0,), "pgf", EngineSettings(), SteadySettings())
+    case = SimulationCase("exact", PAPER_SYSTEM, 10.0, RigidStop(0.003, 0.2), (25.0,), "pgf", EngineSettings(), SteadySettings())
     before = case.key()
     assert case.key() == before and len(fingerprint.source_hash()) == 64
     monkeypatch.setattr(fingerprint, "source_hash", lambda: "0" * 64)
@@ -175,9 +176,132 @@ def test_a_code_change_invalidates_the_resume_cache(monkeypatch: pytest.MonkeyPa
 
 def test_datasets_record_the_source_they_came_from(tmp_path: Path) -> None:
     from vibroimpact.study.fingerprint import source_hash
-    from vibroimpact.scene.core import load_scene
+    from vibroimpact.scene import load_scene
 
     document = base_scene()
     document.update(solutions=["linear"], sweep={"frequency": [20.0, 21.0]})
     dataset = study.run_study(load_scene(write_yaml(tmp_path / "tiny.yaml", document)), progress=None)
     assert dataset.attrs["vibroimpact_source_sha256"] == source_hash()
+
+
+# ----------------------------------------------------------------------------- subcommands: calibrate, sweep-cost
+
+#: Wall time per simulated period of the tiny accuracy dataset's momentary_adams runs [s] (far from the shipped costs).
+TINY_PER_PERIOD = 2.0
+
+
+def tiny_accuracy_dataset(path: Path) -> Path:
+    """An accuracy_cost-shaped dataset: a stepped one-impact case (2 s at 25 Hz: 50 periods) and a swept case (10 s)."""
+    import numpy as np
+    import xarray as xr
+
+    cases, engines, tolerances = ["one_impact_25Hz", "swept_compliant"], ["momentary_adams", "compliant_ida"], [1e-6, 1e-8]
+    wall = np.empty((2, 2, 2))
+    wall[0] = [[50 * TINY_PER_PERIOD, 50 * TINY_PER_PERIOD], [10.0, 20.0]]  # stepped: 50 periods
+    wall[1] = [[np.nan, np.nan], [5.0, 9.0]]  # swept: the compliant engine only
+    dataset = xr.Dataset(
+        {"wall_time": (("case", "engine", "rtol"), wall), "reference_wall_time": (("case", "reference"), [[0.5, 1.0], [np.nan, 30.0]])},
+        coords={"case": cases, "engine": engines, "rtol": tolerances, "reference": ["exact", "compliant_cvode_adams"]},
+        attrs={"case_one_impact_25Hz_duration_s": 2.0, "case_one_impact_25Hz_frequency_Hz": 25.0, "case_swept_compliant_duration_s": 10.0},
+    )
+    dataset.to_netcdf(path)
+    return path
+
+
+def test_help_lists_the_subcommands(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["--help"])
+    assert exit_info.value.code == 0
+    text = capsys.readouterr().out
+    assert "run-study calibrate ACCURACY.nc [--out FILE]" in text and "run-study sweep-cost [options]" in text
+
+
+def test_calibrate_writes_a_cost_file_that_estimate_reads(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """calibrate -> the cost file (measured tables replaced, the rest kept) -> ``--estimate --costs`` predicts from it."""
+    from vibroimpact.study.cost_model import Costs, default_costs
+    from vibroimpact.study.estimate import estimate_scene
+
+    out = tmp_path / "costs" / "costs.json"
+    assert cli.main(["calibrate", str(tiny_accuracy_dataset(tmp_path / "accuracy.nc")), "--out", str(out)]) == 0
+    assert str(out) in capsys.readouterr().err
+    costs = Costs.load(out)
+    assert costs.per_period_cost("momentary_adams", 1e-7) == pytest.approx(TINY_PER_PERIOD)
+    assert costs.per_period_cost("exact", 1e-7) == pytest.approx(0.5 / 50)
+    assert costs.per_sweep_second_cost("compliant_ida", 1e-6) == pytest.approx(0.5) and costs.per_sweep_second_cost("compliant_ida", 1e-8) == pytest.approx(0.9)
+    assert "compliant_cvode_adams" not in costs.per_period  # only what the dataset measured
+    shipped = default_costs()
+    assert costs.closed_form_per_point == shipped.closed_form_per_point and costs.startup == shipped.startup
+    assert costs.speed_probe_seconds > 0.0 and costs.to_json() == out.read_text()
+    # the estimate reads it: every predicted period of momentary costs TINY_PER_PERIOD seconds
+    document = base_scene()
+    document.update(solutions=["linear", "momentary"], sweep={"frequency": [24.0, 25.0]}, simulation={"rtol": 1e-7, "start": "rest", "max_periods": 100}, report=False)
+    scene_path = write_yaml(tmp_path / "tiny.yaml", document)
+    scene = load_scene(scene_path)
+    assert scene.simulation is not None
+    ours = estimate_scene(scene, speed=1.0, costs=costs).parts["momentary"]
+    periods = (scene.simulation.steady.max_periods + scene.simulation.steady.irregular_measure_periods) * 2  # from rest: every point, the whole budget
+    assert ours == pytest.approx(TINY_PER_PERIOD * periods)
+    assert estimate_scene(scene, speed=1.0).parts["momentary"] < ours / 100  # the shipped costs predict far less
+    assert cli.main([str(scene_path), "--estimate", "--costs", str(out)]) == 0
+    assert "momentary: " in capsys.readouterr().out
+
+
+def test_calibrate_writes_the_package_file_by_default_or_says_why_not(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    from vibroimpact.study import estimate
+
+    package_file = tmp_path / "package" / "costs.json"
+    package_file.parent.mkdir()
+    package_file.write_text("{}")
+    monkeypatch.setattr(estimate, "COSTS_FILE", package_file)
+    accuracy = tiny_accuracy_dataset(tmp_path / "accuracy.nc")
+    assert cli.main(["calibrate", str(accuracy)]) == 0
+    assert "momentary_adams" in package_file.read_text()
+    written = package_file.read_text()
+    monkeypatch.setattr(estimate.os, "access", lambda *_args: False)  # an installed, read-only package
+    assert cli.main(["calibrate", str(accuracy)]) == 2
+    error = capsys.readouterr().err
+    assert "not writable" in error and "--out FILE" in error
+    assert package_file.read_text() == written
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["calibrate", "missing.nc"], "No such file"),
+        (["calibrate", "not_accuracy.nc"], "not an accuracy_cost dataset"),
+        (["calibrate", "no_swept.nc"], "no swept case"),
+        (["sweep-cost", "--methods", "Euler"], "not allowed"),
+    ],
+)
+def test_subcommands_refuse_bad_input(arguments: list[str], message: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    import xarray as xr
+
+    monkeypatch.chdir(tmp_path)
+    xr.Dataset({"x": ("frequency", [1.0])}).to_netcdf(tmp_path / "not_accuracy.nc")
+    with xr.open_dataset(tiny_accuracy_dataset(tmp_path / "accuracy.nc")) as accuracy:
+        accuracy.sel(case=["one_impact_25Hz"]).to_netcdf(tmp_path / "no_swept.nc")
+    assert cli.main(arguments) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_estimate_refuses_a_bad_cost_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    document = base_scene()
+    document.update(solutions=["linear"], sweep={"frequency": [20.0, 21.0]})
+    scene = write_yaml(tmp_path / "tiny.yaml", document)
+    (tmp_path / "bad.json").write_text('{"per_period": {"euler": 1.0}}')
+    assert cli.main([str(scene), "--estimate", "--costs", str(tmp_path / "bad.json")]) == 2
+    assert "--costs" in capsys.readouterr().err
+    assert cli.main([str(scene), "--estimate", "--costs", str(tmp_path / "missing.json")]) == 2
+
+
+def test_sweep_cost_options_make_its_settings() -> None:
+    import argparse
+
+    from vibroimpact.benchmarks.sweep_cost import add_arguments, settings_from_arguments
+
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    settings = settings_from_arguments(parser.parse_args(["--methods", "DOP853", "--down", "--no-reference", "--rtol", "1e-7", "--budget", "5"]))
+    assert settings.methods == ("DOP853",) and settings.reference_rtol is None
+    assert settings.sweep.start_frequency > settings.sweep.stop_frequency  # down: 45 -> 15 Hz
+    assert settings.engine_settings.rtol == pytest.approx(1e-7) and settings.budget == pytest.approx(5.0)

@@ -1,5 +1,9 @@
-"""``run-study SCENE.yaml [--out DIR] [--jobs N] [--no-report] [--estimate]``, ``run-study --list``: run a scene, write
-``DIR/<name>.nc`` and the comparison report."""
+"""``run-study SCENE.yaml [--out DIR] [--jobs N] [--no-report] [--estimate [--costs FILE]]``, ``run-study --list``: run a
+scene, write ``DIR/<name>.nc`` and the comparison report; ``run-study calibrate ACCURACY.nc [--out FILE]`` and
+``run-study sweep-cost [options]``: the companions that measure costs.
+
+A first argument that names a subcommand runs it (a scene file of that name is still reached as ``./calibrate.yaml``).
+"""
 
 from __future__ import annotations
 
@@ -11,17 +15,24 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
 from vibroimpact.study.runner import cached_case_count
-from vibroimpact.scene.core import Scene, SceneError, find_scene, load_scene, shipped_studies
-from vibroimpact.study.run import run_study, write_dataset
+from vibroimpact.scene import Scene, SceneError, find_scene, load_scene, shipped_studies
+from vibroimpact.study.io import write_dataset
+from vibroimpact.study.run import run_study
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILURE = 1
 #: 128 + SIGINT, what a shell reports for a program ended by Ctrl-C.
 EXIT_INTERRUPTED = 130
+#: Subcommands and what they do (``run-study --help`` lists them).
+SUBCOMMANDS = {
+    "calibrate": "calibrate ACCURACY.nc [--out FILE]: measure the costs of --estimate from an accuracy_cost dataset and write the cost file",
+    "sweep-cost": "sweep-cost [options]: time the paper's swept-sine test through IDA and solve_ivp (a markdown table)",
+}
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -29,18 +40,24 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="run-study",
         description="Run a vibroimpact scene (YAML) and write its netCDF dataset and comparison report.",
+        epilog="subcommands (run-study SUBCOMMAND --help for their options):\n" + "\n".join(f"  run-study {text}" for text in SUBCOMMANDS.values()),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("scene", nargs="?", help="scene file; a bare name (with or without .yaml) is also looked up in ./studies/ and the shipped studies (a local file wins)")
     parser.add_argument("--out", type=Path, default=None, help="output folder (default: results/<scene name>/)")
     parser.add_argument("--no-report", action="store_true", help="write the dataset only")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="processes for the simulations (default: all cores)")
     parser.add_argument("--estimate", action="store_true", help="print the predicted wall time and memory of the scene, and run nothing")
+    parser.add_argument("--costs", type=Path, default=None, help="cost file of --estimate (default: the package's calibrated costs, see run-study calibrate)")
     parser.add_argument("--list", action="store_true", help="list the shipped studies with their descriptions, and run nothing")
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the process exit code (2 for a bad scene or arguments, 130 when interrupted)."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv and argv[0] in _COMMANDS:
+        return _COMMANDS[argv[0]](argv[1:])
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.list:
@@ -59,10 +76,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"run-study: error: --jobs {args.jobs} is out of range: allowed [1, inf)", file=sys.stderr)
         return EXIT_BAD_INPUT
     if args.estimate:
-        from vibroimpact.study.estimate import estimate_scene
-
-        print(estimate_scene(scene, jobs=args.jobs).text())
-        return 0
+        return _estimate(scene, args.jobs, args.costs)
     out_dir = args.out if args.out is not None else Path("results") / scene.name
     problem = unwritable(out_dir)
     if problem is not None:
@@ -75,6 +89,60 @@ def main(argv: list[str] | None = None) -> int:
         kept = cached_case_count(cache)
         print(f"\ninterrupted: {kept} finished case{'s' if kept != 1 else ''} kept; run the same command to resume", file=sys.stderr)
         return EXIT_INTERRUPTED
+
+
+def _estimate(scene: Scene, jobs: int, costs_file: Path | None) -> int:
+    """Print the predicted cost of ``scene`` (with the costs of ``costs_file``, by default the package's)."""
+    from vibroimpact.study.cost_model import Costs
+    from vibroimpact.study.estimate import estimate_scene
+
+    try:
+        costs = Costs.load(costs_file) if costs_file is not None else None
+        print(estimate_scene(scene, jobs=jobs, costs=costs).text())
+    except (OSError, ValueError) as error:
+        print(f"run-study: error: --costs {costs_file}: {error}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyError as error:  # a cost file without the engine the scene runs
+        print(f"run-study: error: the cost file {costs_file} has no cost for {error}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    return 0
+
+
+def calibrate_command(argv: list[str]) -> int:
+    """``run-study calibrate ACCURACY.nc [--out FILE]``: write the costs measured by an ``accuracy_cost`` run."""
+    parser = argparse.ArgumentParser(prog="run-study calibrate", description="Measure the costs of run-study --estimate from a dataset of the accuracy_cost study (and this machine's speed probe) and write the cost file.")
+    parser.add_argument("accuracy", type=Path, help="dataset of the accuracy_cost study, e.g. results/accuracy_cost/accuracy_cost.nc")
+    parser.add_argument("--out", type=Path, default=None, help="cost file to write (default: the package's own costs.json, where the package is writable)")
+    args = parser.parse_args(argv)
+    from vibroimpact.study.estimate import calibrate, write_costs
+
+    try:
+        path = write_costs(calibrate(args.accuracy), args.out)
+    except (OSError, ValueError, KeyError) as error:  # unreadable, not an accuracy_cost dataset, read-only package
+        print(f"run-study calibrate: error: {error}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    print(f"wrote {path}", file=sys.stderr)
+    return 0
+
+
+def sweep_cost_command(argv: list[str]) -> int:
+    """``run-study sweep-cost [options]``: the swept-sine cost table (:mod:`vibroimpact.benchmarks.sweep_cost`)."""
+    from vibroimpact.benchmarks import sweep_cost
+
+    parser = argparse.ArgumentParser(prog="run-study sweep-cost", description=(sweep_cost.__doc__ or "").split("\n\n")[0])
+    sweep_cost.add_arguments(parser)
+    args = parser.parse_args(argv)
+    try:
+        settings = sweep_cost.settings_from_arguments(args)
+    except ValueError as error:
+        print(f"run-study sweep-cost: error: {error}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    try:
+        print(sweep_cost.markdown_table(sweep_cost.run_sweep_cost(settings, log=lambda line: print(line, flush=True))))
+    except KeyboardInterrupt:
+        print("\ninterrupted: the cost table is not complete", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    return 0
 
 
 def unwritable(out_dir: Path) -> str | None:
@@ -112,6 +180,10 @@ def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, cache: Path) -> 
         return EXIT_FAILURE
     print(f"done in {time.perf_counter() - started:.1f} s")
     return 0
+
+
+#: The subcommands of :data:`SUBCOMMANDS` and what runs them.
+_COMMANDS: dict[str, Callable[[list[str]], int]] = {"calibrate": calibrate_command, "sweep-cost": sweep_cost_command}
 
 
 if __name__ == "__main__":

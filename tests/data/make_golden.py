@@ -5,8 +5,9 @@ Say in the commit message why the numbers changed.
 
 from pathlib import Path
 
-from vibroimpact.scene.core import load_scene
-from vibroimpact.study.run import run_study, write_dataset
+from vibroimpact.scene import load_scene
+from vibroimpact.study.io import write_dataset
+from vibroimpact.study.run import run_study
 
 HERE = Path(__file__).parent
 

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from vibroimpact.reporting.style import QUANTITIES, SOLUTION_DESCRIPTIONS, SOLUTION_TITLES
-from vibroimpact.scene.core import ENGINE_SOLUTIONS, SOLUTIONS
-from vibroimpact.study.run import VARIABLE_ATTRIBUTES
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS, SOLUTIONS
+from vibroimpact.scene.variables import VARIABLE_ATTRIBUTES
 
 from tests.reporting.test_report_support import FIGURE_KINDS, build, drawn_gids, steady_dataset, visible
 

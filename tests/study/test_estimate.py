@@ -9,8 +9,11 @@ import pytest
 import yaml
 
 from vibroimpact import cli
-from vibroimpact.study.estimate import SPEED_FACTOR_RANGE, _periods, estimate_scene, per_period_cost, speed_factor
-from vibroimpact.scene.core import load_scene, parse_scene, shipped_studies_dir
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.study.cost_model import default_costs
+from vibroimpact.study.estimate import SPEED_FACTOR_RANGE, estimate_scene, speed_factor
+from vibroimpact.study.stepped import expected_periods
+from vibroimpact.scene import load_scene, parse_scene, shipped_studies_dir
 from vibroimpact.study.cases import SimulationCase, run_case
 from vibroimpact.study.run import run_study
 
@@ -34,29 +37,29 @@ def test_predicted_integration_matches_what_the_run_does() -> None:
     """Points predicted to need no integration are exactly those the run answers without integrating."""
     scene = parse_scene(small_scene())
     assert scene.simulation is not None
-    periods, scale = _periods(scene)
+    periods, scale = expected_periods(scene)
     assert scale == 1.0  # exact: no subsampling: factor set to 1
     predicted = periods[0, 0]
-    case = SimulationCase("momentary", scene.system, scene.amplitude, 0.2, 0.003, tuple(scene.simulation.frequency), "pgf", scene.simulation.engine, scene.simulation.steady)
+    case = SimulationCase("momentary", scene.system, scene.amplitude, RigidStop(0.003, 0.2), tuple(scene.simulation.frequency), "pgf", scene.simulation.engine, scene.simulation.steady)
     used = run_case(case)["periods_used"]
     np.testing.assert_array_equal(predicted == 0, used == 0)
     assert np.all(predicted[used > 0] >= 48)  # a settling transient plus the measurement, or the irregular budget
 
 
 def test_costs_grow_as_tolerances_tighten() -> None:
+    costs = default_costs()
     for engine in ("momentary_adams", "compliant_ida"):
-        assert per_period_cost(engine, 1e-12) > per_period_cost(engine, 1e-4)
-    assert per_period_cost("exact", 1e-3) == per_period_cost("exact", 1e-12)
+        assert costs.per_period_cost(engine, 1e-12) > costs.per_period_cost(engine, 1e-4)
+    assert costs.per_period_cost("exact", 1e-3) == costs.per_period_cost("exact", 1e-12)
 
 
 def test_memory_estimate_grows_with_the_dataset_and_the_workers() -> None:
-    from vibroimpact.study.cost_table import COSTS
-
+    costs = default_costs()
     scene = parse_scene(small_scene())
     one = estimate_scene(scene, jobs=1)
     dataset = run_study(scene, progress=None)
-    assert one.memory >= COSTS["main_process_memory"] + dataset.nbytes
-    assert estimate_scene(scene, jobs=2).memory == one.memory + COSTS["worker_process_memory"] * min(2, __import__("os").cpu_count() or 1) or (__import__("os").cpu_count() or 1) == 1
+    assert one.memory >= costs.main_process_memory + dataset.nbytes
+    assert estimate_scene(scene, jobs=2).memory == one.memory + costs.worker_process_memory * min(2, __import__("os").cpu_count() or 1) or (__import__("os").cpu_count() or 1) == 1
     big = small_scene() | {"sweep": {"restitution": [0.1, 0.2, 0.3], "frequency": {"start": 18.0, "stop": 30.0, "step": 0.001}}}
     big["stop"] = {"clearance": 0.003}
     assert estimate_scene(parse_scene(big), jobs=1).memory > one.memory + 2 * dataset.nbytes
@@ -67,12 +70,12 @@ def test_start_modes_are_predicted_as_they_run() -> None:
     """rest: every point integrates for the whole budget; stepped sweeps: linear-fitting points answered at once."""
     document = small_scene()
     document["simulation"] = {"rtol": 1e-8, "max_periods": 100, "start": "rest"}
-    rest, _ = _periods(parse_scene(document))
+    rest, _ = expected_periods(parse_scene(document))
     assert np.all(rest == 100 + 64)
     document["simulation"]["start"] = "sweep_up"
     scene = parse_scene(document)
-    swept, _ = _periods(scene)
-    case = SimulationCase("momentary", scene.system, scene.amplitude, 0.2, 0.003, tuple(scene.simulation.frequency), "sweep_up", scene.simulation.engine, scene.simulation.steady)  # type: ignore[union-attr]
+    swept, _ = expected_periods(scene)
+    case = SimulationCase("momentary", scene.system, scene.amplitude, RigidStop(0.003, 0.2), tuple(scene.simulation.frequency), "sweep_up", scene.simulation.engine, scene.simulation.steady)  # type: ignore[union-attr]
     used = run_case(case)["periods_used"]
     np.testing.assert_array_equal(swept[0, 0] == 0, used == 0)
 
@@ -81,7 +84,7 @@ def test_large_grids_are_subsampled() -> None:
     document = small_scene()
     document["sweep"] = {"frequency": {"start": 15.0, "stop": 45.0, "step": 0.0005}}
     scene = parse_scene(document)
-    periods, scale = _periods(scene)
+    periods, scale = expected_periods(scene)
     assert periods.shape[-1] <= 20_000 and scale * periods.shape[-1] == pytest.approx(scene.simulation.frequency.size)  # type: ignore[union-attr]
 
 

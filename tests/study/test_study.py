@@ -10,8 +10,9 @@ import xarray as xr
 import yaml
 
 from vibroimpact.analysis.regime import Regime
-from vibroimpact.scene.core import load_scene, parse_scene
-from vibroimpact.study.run import run_study, write_dataset
+from vibroimpact.scene import load_scene, parse_scene
+from vibroimpact.study.io import write_dataset
+from vibroimpact.study.run import run_study
 
 DATA = Path(__file__).parents[1] / "data"
 

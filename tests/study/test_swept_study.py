@@ -11,8 +11,9 @@ import xarray as xr
 import yaml
 
 from vibroimpact.analysis.regime import Regime
-from vibroimpact.scene.core import parse_scene
-from vibroimpact.study.run import run_study, write_dataset
+from vibroimpact.scene import parse_scene
+from vibroimpact.study.io import write_dataset
+from vibroimpact.study.run import run_study
 from vibroimpact.study.swept_cases import sweep_start_state
 from vibroimpact.model.system import PAPER_SYSTEM
 

@@ -39,6 +39,7 @@ from vibroimpact.model.excitation import SweptSine
 from vibroimpact.simulation.harmonics import measure, running_fundamental
 from vibroimpact.simulation.steady import start_state
 from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.scene.variables import BENCHMARK_ATTRIBUTES, LADDER_ATTRIBUTES
 
 __all__ = ["BENCHMARK_METHODS", "BenchmarkCase", "BenchmarkSettings", "LadderSettings", "run_benchmark", "model_ladder", "equal_error_speedup", "loosest_tolerance", "REFERENCE_RTOL"]
 
@@ -276,28 +277,16 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
                     print(f"benchmark {case.name}: {method} rtol {rtol:g}: {wall:.3f} s, X1 error {values['x1_error']:.1e}, missed {values['missed_impacts']}", file=sys.stderr, flush=True)
                 if wall > settings.max_seconds:
                     break  # tighter tolerances would only take longer
-    attrs = {
-        "wall_time": ("s", "median wall time of one run"),
-        "rhs_calls": ("1", "right-hand-side (or residual) evaluations"),
-        "steps": ("1", "integrator steps where the engine counts them (NaN otherwise)"),
-        "impacts": ("1", "impacts (contacts) found"),
-        "missed_impacts": ("1", "impacts of the reference not found within 1e-3 of a period"),
-        "extra_impacts": ("1", "impacts found that the reference does not have"),
-        "impact_time_error": ("s", "largest impact-time error over matched impacts"),
-        "impulse_error": ("1", "largest relative impulse error over matched impacts"),
-        "final_state_error": ("1", "error of the final state relative to the reference's largest values (stepped cases)"),
-        "x1_error": ("1", "error of the X1 fundamental relative to the reference (stepped: over the whole run; swept: largest difference of the running 8-cycle fundamental over its largest value)"),
-    }
     dataset = xr.Dataset(
-        {name: (("case", "engine", "rtol"), data[name], {"units": attrs[name][0], "long_name": attrs[name][1]}) for name in names},
+        {name: (("case", "engine", "rtol"), data[name], dict(BENCHMARK_ATTRIBUTES[name])) for name in names},
         coords={"case": [c.name for c in cases], "engine": list(settings.methods), "rtol": list(settings.tolerances), "reference": ["exact", "compliant_cvode_adams"]},
     )
-    dataset["reference_wall_time"] = (("case", "reference"), reference_time, {"units": "s", "long_name": "wall time of the reference run"})
-    dataset["reference_impacts"] = (("case", "reference"), reference_impacts, {"units": "1", "long_name": "impacts of the reference"})
-    dataset["reference_x1"] = (("case", "reference"), reference_x1, {"units": "m", "long_name": "X1 fundamental of the reference (swept: its largest running value)"})
-    dataset["exact_wall_time"] = dataset["reference_wall_time"].sel(reference="exact", drop=True).assign_attrs(long_name="median wall time of the exact reference")
-    dataset["rtol"].attrs.update({"units": "1", "long_name": "relative tolerance rtol (atol = rtol x atol_ratio)"})
-    dataset["reference"].attrs.update({"long_name": "reference of the rigid-stop methods (exact) and of the compliant model (CVODE Adams, rtol 1e-13)"})
+    dataset["reference_wall_time"] = (("case", "reference"), reference_time, dict(BENCHMARK_ATTRIBUTES["reference_wall_time"]))
+    dataset["reference_impacts"] = (("case", "reference"), reference_impacts, dict(BENCHMARK_ATTRIBUTES["reference_impacts"]))
+    dataset["reference_x1"] = (("case", "reference"), reference_x1, dict(BENCHMARK_ATTRIBUTES["reference_x1"]))
+    dataset["exact_wall_time"] = dataset["reference_wall_time"].sel(reference="exact", drop=True).assign_attrs(BENCHMARK_ATTRIBUTES["exact_wall_time"])
+    for coordinate in ("rtol", "reference"):
+        dataset[coordinate].attrs.update(BENCHMARK_ATTRIBUTES[coordinate])
     dataset.attrs["atol_ratio_m"] = settings.atol_ratio
     dataset.attrs["repeats"] = settings.repeats
     dataset.attrs["reference_rtol_compliant"] = REFERENCE_RTOL
@@ -415,9 +404,9 @@ def model_ladder(system: TwoDofSystem, amplitude: float, ladder: LadderSettings,
     exact = x1[list(models).index("exact")]
     return xr.Dataset(
         {
-            "ladder_wall_time": ("model", wall, {"units": "s", "long_name": "wall time of one steady-state point (pgf: one closed-form point), median"}),
-            "ladder_x1_amplitude": ("model", x1, {"units": "m", "long_name": "steady-state |X1| fundamental"}),
-            "ladder_x1_difference": ("model", np.abs(np.array(x1) - exact) / exact, {"units": "1", "long_name": "relative difference of |X1| from the exact engine"}),
+            "ladder_wall_time": ("model", wall, dict(LADDER_ATTRIBUTES["ladder_wall_time"])),
+            "ladder_x1_amplitude": ("model", x1, dict(LADDER_ATTRIBUTES["ladder_x1_amplitude"])),
+            "ladder_x1_difference": ("model", np.abs(np.array(x1) - exact) / exact, dict(LADDER_ATTRIBUTES["ladder_x1_difference"])),
         },
         coords={"model": list(models)},
         attrs={

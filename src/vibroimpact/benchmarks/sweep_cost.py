@@ -37,29 +37,9 @@ from vibroimpact.engines.compliant.ivp import IVP_METHODS, solve_ivp_sweep
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.simulation.harmonics import running_fundamental
 from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
+from vibroimpact.scene.variables import SWEEP_COST_ATTRIBUTES
 
-__all__ = ["SweepCostSettings", "markdown_table", "run_sweep_cost"]
-
-_FIELDS = {
-    "span": {"long_name": "simulated sweep (full, or the slice run from rest)"},
-    "simulated_time": {"units": "s", "long_name": "simulated time"},
-    "wall_time": {"units": "s", "long_name": "wall time of the run"},
-    "wall_per_simulated_second": {"units": "s s-1", "long_name": "wall time per simulated second"},
-    "cost_ratio": {"units": "1", "long_name": "wall time per simulated second over IDA's on the same span (IDA at the default tolerances)"},
-    "projected_full_time": {"units": "s", "long_name": "wall time the full sweep would take at this run's cost ratio to IDA"},
-    "rhs_calls": {"units": "1", "long_name": "residual (IDA) or right-hand-side (solve_ivp nfev) evaluations"},
-    "steps": {"units": "1", "long_name": "IDA step attempts (not reported by solve_ivp: NaN)"},
-    "jacobians": {"units": "1", "long_name": "Jacobian evaluations (solve_ivp njev; NaN for IDA)"},
-    "contacts": {"units": "1", "long_name": "contacts begun"},
-    "ida_contacts": {"units": "1", "long_name": "contacts of IDA over the same span"},
-    "x1_fundamental_max_diff": {"units": "m", "long_name": "largest |difference| of the running X1 fundamental from IDA's on the same span"},
-    "x1_fundamental_rel_diff": {"units": "1", "long_name": "the same, over the largest running X1 fundamental of IDA"},
-    "x1_fundamental_diff_at": {"units": "Hz", "long_name": "instantaneous frequency where the largest difference occurs"},
-    "band_rel_diff": {"units": "1", "long_name": "largest |difference| of the running X1 fundamental from IDA's within the slice's frequency band, over IDA's largest value there"},
-    "band_contacts": {"units": "1", "long_name": "contacts begun within the slice's frequency band"},
-    "band_ida_contacts": {"units": "1", "long_name": "contacts of IDA within the slice's frequency band on the same span"},
-}
-
+__all__ = ["SweepCostSettings", "markdown_table", "run_sweep_cost", "add_arguments", "settings_from_arguments"]
 
 @dataclass(frozen=True)
 class SweepCostSettings:
@@ -197,7 +177,7 @@ def run_sweep_cost(settings: SweepCostSettings = SweepCostSettings(), log: Calla
             baselines[_span(sweep)] = ida(sweep)
             add(f"{label} (slice)", sweep, *baselines[_span(sweep)])
         add(f"solve_ivp {method} rtol {tolerances.rtol:g}", sweep, *ivp(sweep, method))
-    data = {name: ("run", np.array([row[name] for row in rows]), attrs) for name, attrs in _FIELDS.items()}
+    data = {name: ("run", np.array([row[name] for row in rows]), dict(attrs)) for name, attrs in SWEEP_COST_ATTRIBUTES.items()}
     return xr.Dataset(
         data,
         coords={"run": [str(row["run"]) for row in rows]},
@@ -245,25 +225,29 @@ def markdown_table(table: xr.Dataset) -> str:
     return "\n".join(lines)
 
 
-def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(prog="python -m vibroimpact.sweep_cost", description=__doc__.split("\n\n")[0])
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options of ``run-study sweep-cost``."""
     parser.add_argument("--methods", default="LSODA,Radau", help="solve_ivp methods, comma-separated (default: LSODA,Radau)")
     parser.add_argument("--budget", type=float, default=120.0, help="largest projected full-sweep time of a method [s]; beyond: the slice")
     parser.add_argument("--rtol", type=float, default=SWEEP_SETTINGS.rtol)
     parser.add_argument("--atol", type=float, default=SWEEP_SETTINGS.atol, help="absolute tolerance of the displacements [m]")
     parser.add_argument("--down", action="store_true", help="sweep down (45 -> 15 Hz) instead of up")
     parser.add_argument("--no-reference", action="store_true", help="leave out the tighter IDA reference run")
-    args = parser.parse_args(argv)
+
+
+def settings_from_arguments(args: argparse.Namespace) -> SweepCostSettings:
+    """What ``run-study sweep-cost`` runs, from the options of :func:`add_arguments`.
+
+    Raises
+    ------
+    ValueError
+        For an unknown method, a budget or tolerance out of range.
+    """
     sweep = SweptSine(10.0, 45.0, 15.0, 0.1) if args.down else SweptSine(10.0, 15.0, 45.0, 0.1)
-    settings = SweepCostSettings(
+    return SweepCostSettings(
         sweep=sweep,
         engine_settings=EngineSettings(rtol=args.rtol, atol=args.atol),
         methods=tuple(m for m in args.methods.split(",") if m),
         budget=args.budget,
         reference_rtol=None if args.no_reference else 1e-9,
     )
-    print(markdown_table(run_sweep_cost(settings, log=lambda line: print(line, flush=True))))
-
-
-if __name__ == "__main__":
-    main()

@@ -1,0 +1,151 @@
+"""Units, long names and CF flag attributes of every variable and coordinate the package writes: one table.
+
+Studies (:mod:`vibroimpact.study`), the accuracy benchmark and the sweep-cost table take their attributes from here,
+and reports read them back from the datasets. A new quantity gets its line here (and its place in
+:data:`vibroimpact.scene.core.QUANTITIES` if a scene may ask for it).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vibroimpact.analysis.regime import regime_attributes
+
+__all__ = [
+    "VARIABLE_ATTRIBUTES",
+    "SWEEP_STAT_ATTRIBUTES",
+    "CONVERGED_ATTRIBUTES",
+    "STABLE_MARGINAL",
+    "STABLE_ATTRIBUTES",
+    "COORDINATE_ATTRIBUTES",
+    "SWEEP_TIME_ATTRIBUTES",
+    "BENCHMARK_ATTRIBUTES",
+    "LADDER_ATTRIBUTES",
+    "SWEEP_COST_ATTRIBUTES",
+    "quantity_attributes",
+    "swept_attributes",
+    "running_attributes",
+]
+
+#: Quantities of a study (solution, grid...).
+VARIABLE_ATTRIBUTES: dict[str, dict[str, str]] = {
+    "x1_amplitude": {"units": "m", "long_name": "fundamental-harmonic amplitude of the primary-mass displacement X1"},
+    "x2_amplitude": {"units": "m", "long_name": "fundamental-harmonic amplitude of the absorber displacement X2"},
+    "force_amplitude": {"units": "N", "long_name": "fundamental-harmonic amplitude of the force transmitted to the base (suspension plus impacts, eq. 23)"},
+    "suspension_force_amplitude": {"units": "N", "long_name": "fundamental-harmonic amplitude of the force through the suspension alone (eq. 21)"},
+    "impulse": {"units": "N s", "long_name": "impact impulse per period (0 where the motion is linear; simulations: total impulse of the impacts per period)"},
+    "phase": {"units": "rad", "long_name": "phase of the impact relative to the linear absorber motion (varphi + psi12, eq. 15)"},
+    "floquet_modulus": {"units": "1", "long_name": "largest modulus of the Floquet multipliers of the admissible one-impact orbit (< 1: stable); solution pgf only"},
+    "one_impact_x1_amplitude": {"units": "m", "long_name": "|X1| fundamental of the one-impact solution of eqs. 15-17 wherever it exists, unchecked (admissible or not, stable or not)"},
+    "one_impact_x2_amplitude": {"units": "m", "long_name": "|X2| fundamental of the one-impact solution of eqs. 15-18 wherever it exists, unchecked"},
+    "one_impact_force_amplitude": {"units": "N", "long_name": "force fundamental (eq. 23) of the one-impact solution wherever it exists, unchecked"},
+    "one_impact_impulse": {"units": "N s", "long_name": "impulse (eq. 16) of the one-impact solution wherever it exists, unchecked"},
+    "impacts_per_period": {"units": "1", "long_name": "impacts per excitation period (simulations: measured over whole periods)"},
+    "x1_rms": {"units": "m", "long_name": "RMS of X1 (simulations: over the measured periods; pgf: of the reconstructed orbit, 512 samples per period; linear regimes: |X1| / sqrt 2)"},
+    "x2_rms": {"units": "m", "long_name": "RMS of X2 (simulations: over the measured periods; pgf: of the reconstructed orbit, 512 samples per period; linear regimes: |X2| / sqrt 2)"},
+    "peak_acceleration": {"units": "m s-2", "long_name": "largest deceleration of the absorber on the bumper, bumper force less absorber spring over M2 (compliant: measured; pgf: (M2 Gamma(xi_b) Omega_b J / (M2 (1 + R)) - absorber spring force at the impact) / M2; rigid engines: NaN; no contact: 0)"},
+    "peak_contact_force": {"units": "N", "long_name": "largest bumper force (compliant: measured; pgf: Gamma(xi_b) Omega_b J / (1 + R); rigid engines: NaN; no contact: 0)"},
+    "wall_time": {"units": "s", "long_name": "wall time of the simulation at this point (one process; swept-sine tests: the whole sweep)"},
+}
+#: Whole-run statistics of a swept-sine run (sweep...).
+SWEEP_STAT_ATTRIBUTES: dict[str, dict[str, str]] = {
+    "sweep_wall_time": {"units": "s", "long_name": "wall time of the whole swept-sine run"},
+    "sweep_steps": {"units": "1", "long_name": "integrator steps of the swept-sine run"},
+    "sweep_contacts": {"units": "1", "long_name": "bumper contacts during the swept-sine run"},
+    "sweep_rhs_calls": {"units": "1", "long_name": "right-hand-side (residual) evaluations of the swept-sine run"},
+    "sweep_linear_start": {"units": "1", "long_name": "1: the run started on the linear steady state at its first frequency; 0: at rest (asked for, or the linear state would cross the stop)"},
+    "sweep_failed": {"units": "1", "long_name": "1: the integrator failed (values NaN, regime failed); 0: the run finished"},
+}
+CONVERGED_ATTRIBUTES = {
+    "long_name": "the simulated stroboscopic state repeated to the steady-state tolerance",
+    "units": "1",
+    "flag_values": np.array([-1, 0, 1], dtype=np.int8),
+    "flag_meanings": "not_applicable not_converged converged",
+}
+#: The ``stable`` flag of an orbit whose largest |Floquet multiplier| is 1 within round-off.
+STABLE_MARGINAL = 2
+STABLE_ATTRIBUTES = {
+    "long_name": "Floquet stability of the reported one-impact orbit (solution pgf only)",
+    "units": "1",
+    "flag_values": np.array([-1, 0, 1, STABLE_MARGINAL], dtype=np.int8),
+    "flag_meanings": "not_applicable unstable stable marginal",
+}
+COORDINATE_ATTRIBUTES: dict[str, dict[str, str]] = {
+    "frequency": {"units": "Hz", "long_name": "excitation frequency"},
+    "restitution": {"units": "1", "long_name": "restitution ratio R"},
+    "clearance": {"units": "m", "long_name": "clearance Delta between absorber and stop"},
+    "solution": {"long_name": "solution method"},
+    "bumper_frequency": {"units": "Hz", "long_name": "apparent natural frequency Omega_b / 2 pi of the compliant bumper"},
+    "bumper_loss_factor": {"units": "1", "long_name": "loss factor xi_b of the compliant bumper"},
+    "sweep": {"long_name": "direction of the swept-sine test"},
+}
+#: The time axes of a swept-sine study's running estimates. ``elapsed_time`` is an elapsed duration, not a date: CF's
+#: standard_name ``time`` would need "seconds since <epoch>" units, which readers decode into calendar dates; so no
+#: standard_name, and not the reserved name ``time``.
+SWEEP_TIME_ATTRIBUTES: dict[str, dict[str, str]] = {
+    "elapsed_time": {"units": "s", "long_name": "simulated time since the start of the sweep"},
+    "instantaneous_frequency": {"units": "Hz", "long_name": "instantaneous excitation frequency f0 + alpha t"},
+}
+#: The accuracy benchmark (case, engine, rtol; case, reference).
+BENCHMARK_ATTRIBUTES: dict[str, dict[str, str]] = {
+    "wall_time": {"units": "s", "long_name": "median wall time of one run"},
+    "rhs_calls": {"units": "1", "long_name": "right-hand-side (or residual) evaluations"},
+    "steps": {"units": "1", "long_name": "integrator steps where the engine counts them (NaN otherwise)"},
+    "impacts": {"units": "1", "long_name": "impacts (contacts) found"},
+    "missed_impacts": {"units": "1", "long_name": "impacts of the reference not found within 1e-3 of a period"},
+    "extra_impacts": {"units": "1", "long_name": "impacts found that the reference does not have"},
+    "impact_time_error": {"units": "s", "long_name": "largest impact-time error over matched impacts"},
+    "impulse_error": {"units": "1", "long_name": "largest relative impulse error over matched impacts"},
+    "final_state_error": {"units": "1", "long_name": "error of the final state relative to the reference's largest values (stepped cases)"},
+    "x1_error": {"units": "1", "long_name": "error of the X1 fundamental relative to the reference (stepped: over the whole run; swept: largest difference of the running 8-cycle fundamental over its largest value)"},
+    "reference_wall_time": {"units": "s", "long_name": "wall time of the reference run"},
+    "reference_impacts": {"units": "1", "long_name": "impacts of the reference"},
+    "reference_x1": {"units": "m", "long_name": "X1 fundamental of the reference (swept: its largest running value)"},
+    "exact_wall_time": {"units": "s", "long_name": "median wall time of the exact reference"},
+    "rtol": {"units": "1", "long_name": "relative tolerance rtol (atol = rtol x atol_ratio)"},
+    "reference": {"long_name": "reference of the rigid-stop methods (exact) and of the compliant model (CVODE Adams, rtol 1e-13)"},
+}
+#: The benchmark's model-cost ladder (model).
+LADDER_ATTRIBUTES: dict[str, dict[str, str]] = {
+    "ladder_wall_time": {"units": "s", "long_name": "wall time of one steady-state point (pgf: one closed-form point), median"},
+    "ladder_x1_amplitude": {"units": "m", "long_name": "steady-state |X1| fundamental"},
+    "ladder_x1_difference": {"units": "1", "long_name": "relative difference of |X1| from the exact engine"},
+}
+#: The swept-sine cost table of ``run-study sweep-cost`` (run).
+SWEEP_COST_ATTRIBUTES: dict[str, dict[str, str]] = {
+    "span": {"long_name": "simulated sweep (full, or the slice run from rest)"},
+    "simulated_time": {"units": "s", "long_name": "simulated time"},
+    "wall_time": {"units": "s", "long_name": "wall time of the run"},
+    "wall_per_simulated_second": {"units": "s s-1", "long_name": "wall time per simulated second"},
+    "cost_ratio": {"units": "1", "long_name": "wall time per simulated second over IDA's on the same span (IDA at the default tolerances)"},
+    "projected_full_time": {"units": "s", "long_name": "wall time the full sweep would take at this run's cost ratio to IDA"},
+    "rhs_calls": {"units": "1", "long_name": "residual (IDA) or right-hand-side (solve_ivp nfev) evaluations"},
+    "steps": {"units": "1", "long_name": "IDA step attempts (not reported by solve_ivp: NaN)"},
+    "jacobians": {"units": "1", "long_name": "Jacobian evaluations (solve_ivp njev; NaN for IDA)"},
+    "contacts": {"units": "1", "long_name": "contacts begun"},
+    "ida_contacts": {"units": "1", "long_name": "contacts of IDA over the same span"},
+    "x1_fundamental_max_diff": {"units": "m", "long_name": "largest |difference| of the running X1 fundamental from IDA's on the same span"},
+    "x1_fundamental_rel_diff": {"units": "1", "long_name": "the same, over the largest running X1 fundamental of IDA"},
+    "x1_fundamental_diff_at": {"units": "Hz", "long_name": "instantaneous frequency where the largest difference occurs"},
+    "band_rel_diff": {"units": "1", "long_name": "largest |difference| of the running X1 fundamental from IDA's within the slice's frequency band, over IDA's largest value there"},
+    "band_contacts": {"units": "1", "long_name": "contacts begun within the slice's frequency band"},
+    "band_ida_contacts": {"units": "1", "long_name": "contacts of IDA within the slice's frequency band on the same span"},
+}
+
+
+def quantity_attributes(quantity: str) -> dict[str, object]:
+    """Units, long name and (for flags) CF flag attributes of a quantity."""
+    return dict({"regime": regime_attributes(), "stable": STABLE_ATTRIBUTES, "converged": CONVERGED_ATTRIBUTES}.get(quantity, VARIABLE_ATTRIBUTES.get(quantity, {})))
+
+
+def swept_attributes(solution: str, attrs: dict[str, object]) -> dict[str, object]:
+    """Attributes of a swept-sine estimate on the frequency grid: the quantity's, with the run named."""
+    long_name = attrs.get("long_name", "")
+    return attrs | {"long_name": f"{solution} swept-sine running estimate centred at each frequency: {long_name}"}
+
+
+def running_attributes(name: str) -> dict[str, str]:
+    """Attributes of a running estimate against the sweep's elapsed time (``running_<quantity>``)."""
+    quantity = name.removeprefix("running_")
+    base = VARIABLE_ATTRIBUTES.get(quantity, {})
+    return {"units": base.get("units", "1"), "long_name": f"running estimate over the sweep's window: {base.get('long_name', quantity)}"}

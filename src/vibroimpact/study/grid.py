@@ -1,0 +1,148 @@
+"""What stepped and swept studies share: the full grid, the loop over solutions, and the dataset around the values.
+
+The full grid is (restitution, clearance, bumper_frequency, sweep, frequency): unswept axes have length 1 and are
+squeezed at the end; each solution computes only along the axes it depends on, then is broadcast.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Callable
+
+import numpy as np
+import xarray as xr
+
+from vibroimpact.analysis.pgf import PgfVariant
+from vibroimpact.model.modal import fit_modal_parameters
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS, Scene
+from vibroimpact.scene.variables import COORDINATE_ATTRIBUTES
+from vibroimpact.study.io import provenance
+from vibroimpact.study.solutions import linear_values, pgf_values
+
+__all__ = ["Progress", "StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset"]
+
+Progress = Callable[[str], None]
+#: The values of one solution, quantity -> array over (part of) the full grid.
+Values = dict[str, np.ndarray]
+
+
+@dataclass(frozen=True, eq=False)
+class StudyGrid:
+    """The full grid of a study and its axes, shaped for broadcasting.
+
+    Attributes
+    ----------
+    frequency : ndarray
+        Every frequency of the dataset [Hz].
+    bumper : ndarray
+        Omega_b / 2 pi [Hz]; ``[nan]`` without a bumper.
+    directions : tuple of str
+        Sweep directions; ``("",)`` for stepped studies.
+    full : tuple of int
+        Shape of the full grid.
+    r, delta, omega : ndarray
+        Restitution [-], clearance [m] and angular frequency [rad s-1] on their axes of the full grid.
+    base : tuple of int
+        Shape of the closed forms' grid (restitution, clearance, frequency).
+    """
+
+    frequency: np.ndarray
+    bumper: np.ndarray
+    directions: tuple[str, ...]
+    full: tuple[int, ...]
+    r: np.ndarray
+    delta: np.ndarray
+    omega: np.ndarray
+    base: tuple[int, ...]
+
+    @classmethod
+    def of(cls, scene: Scene) -> "StudyGrid":
+        """The grid of ``scene``."""
+        frequency = scene.all_frequencies
+        bumper = scene.bumper_frequency if scene.bumper_frequency is not None else np.array([np.nan])
+        directions = scene.sweep_directions or ("",)
+        full = (scene.restitution.size, scene.clearance.size, bumper.size, len(directions), frequency.size)
+        r = scene.restitution[:, None, None, None, None]
+        delta = scene.clearance[None, :, None, None, None]
+        omega = 2.0 * np.pi * frequency[None, None, None, None, :]
+        base = np.broadcast_shapes(r.shape, delta.shape, omega.shape)
+        return cls(frequency, bumper, directions, full, r, delta, omega, base)
+
+
+def solve_each(scene: Scene, grid: StudyGrid, simulate: Callable[[str], Values], progress: Progress | None) -> list[Values]:
+    """The values of every solution of ``scene``, in its order; ``simulate(name)`` computes a time-domain one."""
+    report = progress or (lambda _message: None)
+    total = len(scene.solutions)
+    per_solution = []
+    for i, name in enumerate(scene.solutions, start=1):
+        if name == "linear":
+            values = linear_values(scene, grid.omega, grid.delta, grid.base)
+        elif name in ENGINE_SOLUTIONS:
+            values = simulate(name)
+        else:
+            values = pgf_values(scene, PgfVariant(name), grid.omega, grid.delta, grid.r, grid.base)
+        per_solution.append(values)
+        report(f"[{i}/{total}] {name}: done")
+    return per_solution
+
+
+def grid_coordinates(scene: Scene, grid: StudyGrid, solutions: list[str]) -> dict[str, object]:
+    """Coordinates of the dataset before squeezing: ``solution`` (if any), the parameters and ``frequency``."""
+    coords: dict[str, object] = {"solution": np.array(solutions, dtype=object), "restitution": scene.restitution, "clearance": scene.clearance, "frequency": grid.frequency}
+    if scene.bumper_frequency is not None:
+        coords["bumper_frequency"] = scene.bumper_frequency
+    if not solutions:
+        del coords["solution"]
+    return coords
+
+
+def steady_variable(quantity: str, scene: Scene, grid: StudyGrid, per_solution: list[Values], solutions: list[str]) -> np.ndarray | None:
+    """``quantity`` of the named solutions stacked along a leading ``solution`` axis over the full grid; None if none."""
+    steady = [np.broadcast_to(values[quantity], grid.full) for name, values in zip(scene.solutions, per_solution) if name in solutions]
+    return np.stack(steady) if steady else None
+
+
+def finish_dataset(dataset: xr.Dataset, scene: Scene, coords: dict[str, object], simulation_attributes: dict[str, object], keep: tuple[str, ...] = ()) -> xr.Dataset:
+    """Squeeze the unswept axes (not those in ``keep``), add the bumper's loss factor, the coordinates' attributes and
+    the dataset's metadata (``simulation_attributes``: what the study kind says of its simulations)."""
+    for key in ("restitution", "clearance", "bumper_frequency", "sweep"):
+        if key in keep:
+            continue
+        swept = key in scene.swept or (key == "restitution" and "bumper_loss_factor" in scene.swept)
+        if not swept and key in dataset.dims:
+            dataset = dataset.squeeze(key, drop=key not in coords)
+    if scene.bumper_frequency is not None:
+        losses = scene.loss_factors()
+        dataset = dataset.assign_coords(bumper_loss_factor=("restitution", losses) if "restitution" in dataset.dims else float(losses[0]))
+        if "bumper_loss_factor" in scene.swept:
+            dataset = dataset.swap_dims({"restitution": "bumper_loss_factor"})
+    for key, attrs in COORDINATE_ATTRIBUTES.items():
+        if key in dataset.coords:
+            dataset[key].attrs.update(attrs)
+    dataset.attrs.update(_metadata(scene, simulation_attributes))
+    return dataset
+
+
+def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[str, object]:
+    system = scene.system
+    fit = fit_modal_parameters(system) if "pgf_paper" in scene.solutions else None
+    attrs: dict[str, object] = {
+        "title": f"vibroimpact study '{scene.name}'",
+        "scene_name": scene.name,
+        "scene": scene.text,
+        **provenance(),
+        "excitation_amplitude_N": scene.amplitude,
+        "natural_frequencies_Hz": np.array(system.natural_frequencies()) / (2.0 * np.pi),
+        "antiresonance_frequency_Hz": system.antiresonance_frequency() / (2.0 * np.pi),
+        "method_pgf": "exact poles and residues of H22; exact chi22'(0-) from the derivative of eq. 12; stable (+) root of corrected eq. 16",
+        "method_pgf_paper": "curve-fitted modal parameters of H22 (eq. 10, Omega fixed from eq. 11); chi22'(0-) = -1/(2 M2); stable (+) root of corrected eq. 16",
+    }
+    for key, value in system.as_dict().items():
+        attrs[f"system_{key}"] = value
+    for key, value in asdict(scene.admissibility).items():
+        attrs[f"admissibility_{key}"] = value
+    attrs.update(simulation_attributes)
+    if fit is not None:
+        attrs["pgf_paper_form_factors_per_kg"] = np.real(fit.form_factor)
+        attrs["pgf_paper_loss_factors"] = fit.loss_factor
+    return attrs

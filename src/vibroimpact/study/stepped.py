@@ -1,0 +1,129 @@
+"""Stepped studies: steady states (closed forms and time-domain engines) at each point of the grid."""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from vibroimpact.analysis.pgf import solve_one_impact
+from vibroimpact.analysis.stability import floquet_multipliers
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, Scene
+from vibroimpact.scene.variables import quantity_attributes
+from vibroimpact.study.cost_model import Costs, EnginePart, Estimate, grid_estimate
+from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates, solve_each, steady_variable
+from vibroimpact.study.solutions import simulated_values
+
+__all__ = ["SteppedStudy", "expected_periods", "SETTLING_PERIODS", "ESTIMATE_POINTS"]
+
+#: Periods of a transient that settles on a stable orbit (two convergence chunks), before the measurement.
+SETTLING_PERIODS = 40
+#: Largest number of simulated points whose closed form is solved for the estimate (a larger grid is subsampled).
+ESTIMATE_POINTS = 20_000
+
+
+class SteppedStudy:
+    """Steady states over (restitution, clearance, bumper, frequency): dimension ``solution`` for every solution."""
+
+    name = "stepped"
+
+    def run(self, scene: Scene, progress: Progress | None, jobs: int, cache_dir: Path | None) -> xr.Dataset:
+        """Every solution of ``scene`` over its grid (see :func:`vibroimpact.study.run.run_study`)."""
+        grid = StudyGrid.of(scene)
+        per_solution = solve_each(scene, grid, lambda name: simulated_values(scene, name, grid.full, jobs, cache_dir, progress is not None), progress)
+        solutions = list(scene.solutions)
+        coords = grid_coordinates(scene, grid, solutions)
+        data_vars = {}
+        for quantity in scene.quantities:
+            stacked = steady_variable(quantity, scene, grid, per_solution, solutions)
+            if stacked is not None:
+                data_vars[quantity] = xr.Variable(("solution", *GRID_DIMS), stacked, quantity_attributes(quantity))
+        dataset = xr.Dataset(data_vars, coords=coords)
+        return finish_dataset(dataset, scene, coords, self.simulation_attributes(scene))
+
+    @staticmethod
+    def simulation_attributes(scene: Scene) -> dict[str, object]:
+        """What the dataset records of the time-domain solutions' settings and methods."""
+        attrs: dict[str, object] = {}
+        if scene.simulation is not None:
+            attrs["simulation_frequency_Hz"] = scene.simulation.frequency
+            attrs["simulation_start"] = scene.simulation.start
+            for key, value in asdict(scene.simulation.engine).items():
+                attrs[f"simulation_engine_{key}"] = value
+            for key, value in asdict(scene.simulation.steady).items():
+                attrs[f"simulation_steady_{key}"] = value
+            attrs["method_exact"] = "piecewise-exact propagation (eigenvectors + harmonic particular solution), contacts by guaranteed Taylor-bound root bracketing"
+            attrs["method_momentary"] = "scikit-sundae CVODE with contact/release events and an apex event guarding grazing contacts"
+            attrs["method_compliant"] = "Kelvin-Voigt bumper (eq. 25) through scikit-sundae IDA: one solver per contact mode, onset/release events, recorded force and deceleration peaks; atol of the displacements [m], other states scaled"
+        return attrs
+
+    def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:
+        """Seconds per simulated period of each engine at its tolerance times the periods each point is predicted to
+        integrate (:func:`expected_periods`), on the calibration machine."""
+        bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
+
+        def engine_part(name: str, engine: str) -> EnginePart:
+            assert scene.simulation is not None
+            periods, scale = expected_periods(scene)
+            copies = bumpers if name == "compliant" else 1
+            total_periods = float(periods.sum()) * scale * copies
+            seconds = costs.per_period_cost(engine, scene.simulation.engine.rtol) * total_periods
+            integrated = int(np.count_nonzero(periods) * scale) * copies
+            points = f"{scene.restitution.size * scene.clearance.size * scene.simulation.frequency.size * copies} points, ~{integrated} integrated, ~{total_periods:.0f} periods"
+            serial = 0.0
+            if scene.simulation.start in ("sweep_up", "sweep_down"):  # one serial chain per (R, Delta, bumper)
+                serial = seconds / (scene.restitution.size * scene.clearance.size * copies)
+            return seconds, points, serial
+
+        return grid_estimate(scene, jobs, costs, engine_part, report_figures(scene))
+
+
+def report_figures(scene: Scene) -> int:
+    """Figures of the study's report page."""
+    per_clearance = 12 if any(s in ENGINE_SOLUTIONS for s in scene.solutions) else 7
+    return 1 + per_clearance * scene.clearance.size + (2 if len(scene.swept) > 1 else 0)
+
+
+def expected_periods(scene: Scene) -> tuple[np.ndarray, float]:
+    """Periods each simulated (restitution, clearance, frequency) point is predicted to integrate, on the grid or on
+    an evenly subsampled frequency grid, and the factor that scales its sum to the whole grid.
+
+    As :func:`vibroimpact.simulation.steady.steady_state` and :func:`vibroimpact.study.cases.run_case` do: ``linear`` and stepped
+    sweeps answer a point whose linear motion fits without integrating; ``pgf`` also needs no admissible one-impact
+    orbit there; a stable orbit settles in a short transient; elsewhere the motion may never settle (``max_periods``
+    plus the irregular measurement). From ``rest`` every point integrates, and the lightly damped transient of the
+    linear modes (damping ratios ~1e-3) outlasts ``max_periods``.
+    """
+    assert scene.simulation is not None
+    sim = scene.simulation
+    per_line = max(1, ESTIMATE_POINTS // (scene.restitution.size * scene.clearance.size))
+    frequencies = sim.frequency if sim.frequency.size <= per_line else sim.frequency[np.linspace(0, sim.frequency.size - 1, per_line).astype(int)]
+    scale = sim.frequency.size / frequencies.size
+    steady = sim.steady
+    wander = steady.max_periods + steady.irregular_measure_periods
+    shape = (scene.restitution.size, scene.clearance.size, frequencies.size)
+    if sim.start == "rest":
+        return np.full(shape, float(wander)), scale
+    omega = 2.0 * np.pi * frequencies[None, None, :]
+    orbit = solve_one_impact(scene.system, omega, scene.clearance[None, :, None], scene.restitution[:, None, None], scene.amplitude)
+    admissible = orbit.admissible()
+    stable = np.zeros(admissible.shape, dtype=bool)
+    if admissible.any():
+        modulus = np.max(np.abs(floquet_multipliers(orbit)), axis=-1)
+        stable = admissible & (modulus < 1.0)
+    fits = orbit.linear_amplitude_x2 <= orbit.clearance
+    settle = SETTLING_PERIODS + steady.measure_periods
+    if sim.start in ("sweep_up", "sweep_down"):
+        # a chain: a fitting point is answered linear unless the point before it impacted (then it integrates from
+        # there, and keeps impacting where a one-impact orbit coexists with the linear motion)
+        order = range(frequencies.size) if sim.start == "sweep_up" else range(frequencies.size - 1, -1, -1)
+        no_integration = np.zeros(shape, dtype=bool)
+        impacting = np.zeros(shape[:2], dtype=bool)
+        for k in order:
+            no_integration[..., k] = fits[..., k] & ~impacting
+            impacting = ~fits[..., k] | (impacting & admissible[..., k])
+    else:
+        no_integration = fits & ~admissible if sim.start == "pgf" else fits
+    return np.where(no_integration, 0, np.where(stable, settle, wander)).astype(float), scale
