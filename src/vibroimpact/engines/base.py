@@ -1,81 +1,23 @@
-"""What every engine shares: the problem it solves, its settings, and the immutable trajectory it returns."""
+"""What every engine shares: the records it returns (trajectory, swept-sine record), the protocols of the stepping
+and the sweeping engines, and the checks every run starts with."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.model.validation import require_in_range, require_non_negative, require_positive
+from vibroimpact.model.excitation import SweptSine
+from vibroimpact.model.problem import Contact, ImpactProblem
 
-__all__ = ["ImpactProblem", "Trajectory", "Engine", "MODE_FREE", "MODE_STUCK"]
+__all__ = ["Trajectory", "TrajectoryBuilder", "SweepRecord", "Engine", "SweepingEngine", "check_run", "MODE_FREE", "MODE_STUCK"]
 
 #: Segment modes of a trajectory.
 MODE_FREE, MODE_STUCK = 0, 1
-
-
-@dataclass(frozen=True)
-class ImpactProblem:
-    """The system of eq. 1 with a rigid stop: force q cos(w t + phase) on the primary mass, stop at X2 = Delta.
-
-    Parameters
-    ----------
-    system : TwoDofSystem
-        Masses, springs and dashpots.
-    clearance : float
-        Delta [m], >= 0.
-    restitution : float
-        R [-], 0 <= R <= 1: the absorber's velocity after an impact is -R times the velocity before.
-    amplitude : float
-        q [N], >= 0.
-    frequency : float
-        Excitation frequency [Hz], > 0.
-    phase : float
-        Phase of the force at t = 0 [rad].
-    """
-
-    system: TwoDofSystem
-    clearance: float = field(metadata={"units": "m"})
-    restitution: float = field(metadata={"units": "1"})
-    amplitude: float = field(metadata={"units": "N"})
-    frequency: float = field(metadata={"units": "Hz"})
-    phase: float = field(default=0.0, metadata={"units": "rad"})
-
-    def __post_init__(self) -> None:
-        require_non_negative("clearance", self.clearance)
-        require_in_range("restitution", self.restitution, 0.0, 1.0)
-        require_non_negative("amplitude", self.amplitude)
-        require_positive("frequency", self.frequency)
-
-    @property
-    def omega(self) -> float:
-        """Angular frequency w [rad s-1]."""
-        return 2.0 * math.pi * self.frequency
-
-    @property
-    def period(self) -> float:
-        """T = 1 / f [s]."""
-        return 1.0 / self.frequency
-
-    def force(self, t: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
-        """External force on the primary mass [N]."""
-        return self.amplitude * np.cos(self.omega * t + self.phase)
-
-    def holding_force(self, x1: float | NDArray[np.float64], v1: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
-        """Force the stop must exert to hold the absorber at rest at X2 = Delta, B2 X1' + K2 (X1 - Delta) [N].
-
-        Positive: the absorber is pushed into the stop (it sticks); it leaves when this turns negative.
-        """
-        return self.system.b2 * v1 + self.system.k2 * (x1 - self.clearance)
-
-    def velocity_scale(self) -> float:
-        """A velocity typical of the motion, w (Delta + q |H12|) [m s-1], for relative thresholds."""
-        linear = self.amplitude * float(np.abs(self.system.receptances(self.omega).h12))
-        return self.omega * (self.clearance + linear) + 1e-300
 
 
 @dataclass(frozen=True, eq=False)
@@ -215,11 +157,81 @@ class TrajectoryBuilder:
         )
 
 
+@dataclass(frozen=True, eq=False)
+class SweepRecord:
+    """A swept-sine run, sampled uniformly in time.
+
+    Attributes
+    ----------
+    sweep : SweptSine
+        The excitation.
+    time : ndarray
+        Sample times [s].
+    x1, x2 : ndarray
+        Displacements [m].
+    base_force : ndarray
+        Force on the base: suspension K1 X1 + B1 X1' plus bumper [N].
+    contact_force : ndarray
+        Bumper force [N] (0 outside contact).
+    trajectory : Trajectory
+        Contacts: ``impact_times`` (onsets) [s], ``impact_velocities`` [m s-1], ``impulses`` [N s] and
+        ``contact_peaks`` (c, 2) = [peak force N, peak deceleration m s-2], one row per completed contact (a contact
+        still open at the end is counted in ``stats["contacts"]`` only); ``segments`` (free and contact); ``stats``:
+        ``steps`` (step attempts), ``rhs_calls`` (residual or right-hand-side evaluations), ``contacts``, ``events``
+        (roots handled), ``solver_calls``, ``grazing`` (contacts caught at an apex).
+    contact_fourier : ndarray of complex
+        Running integral of F exp(-j theta) theta' dt from t = 0 to each sample [N], integrated with the motion:
+        its increase over a window of whole cycles, divided by pi times the cycles, is the bumper force's fundamental.
+    """
+
+    sweep: SweptSine
+    time: NDArray[np.float64]
+    x1: NDArray[np.float64]
+    x2: NDArray[np.float64]
+    base_force: NDArray[np.float64]
+    contact_force: NDArray[np.float64]
+    trajectory: Trajectory
+    contact_fourier: NDArray[np.complex128]
+
+
 class Engine(Protocol):
-    """A time-domain solver of an :class:`ImpactProblem`."""
+    """A time-domain solver of an :class:`ImpactProblem` with a harmonic force, period by period."""
 
     name: str
 
     def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
         """Integrate ``periods`` whole periods from ``state`` at ``t_start``."""
         ...
+
+
+class SweepingEngine(Protocol):
+    """A time-domain solver of an :class:`ImpactProblem` with a :class:`SweptSine` excitation, start to end."""
+
+    name: str
+
+    def sweep(
+        self, problem: ImpactProblem, sample_rate: float, state: NDArray[np.float64] | None = None, progress: Callable[[float], None] | None = None
+    ) -> SweepRecord:
+        """Run the whole sweep from ``state`` (rest by default) at t = 0, sampled at ``sample_rate`` [Hz];
+        ``progress`` receives the simulated time reached [s]."""
+        ...
+
+
+def check_run(engine: str, problem: ImpactProblem, contact: type[Contact], periods: int = 0) -> None:
+    """What every run checks first: a whole number of periods >= 0, and a contact law the engine solves.
+
+    Parameters
+    ----------
+    engine : str
+        Name of the engine, for the message.
+    problem : ImpactProblem
+        The problem to run.
+    contact : type
+        :class:`RigidStop` or :class:`KelvinVoigtBumper`: the contact law of the engine.
+    periods : int
+        Periods to integrate.
+    """
+    if periods < 0:
+        raise ValueError(f"periods = {periods} is out of range: allowed [0, inf)")
+    if not isinstance(problem.contact, contact):
+        raise TypeError(f"engine {engine!r} solves a {contact.__name__}, not problem.contact = {problem.contact!r}")

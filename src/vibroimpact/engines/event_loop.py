@@ -18,9 +18,10 @@ from enum import Enum
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, ImpactProblem, Trajectory, TrajectoryBuilder
-
+from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory, TrajectoryBuilder
+from vibroimpact.engines.rigid_contact import RigidContact
 from vibroimpact.engines.settings import EngineSettings
+from vibroimpact.model.problem import ImpactProblem
 
 __all__ = ["EventLoopEngine", "Stop", "Model"]
 
@@ -132,12 +133,9 @@ class EventLoopEngine(ABC):
 
     def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
         """Integrate ``periods`` whole periods from ``state`` (X1, X2, X1', X2') at ``t_start`` [s]."""
-        if periods < 0:
-            raise ValueError(f"periods = {periods} is out of range: allowed [0, inf)")
+        law = RigidContact(self.name, problem, self.settings, periods)
         state = np.asarray(state, dtype=float)
-        length_scale = problem.clearance + problem.velocity_scale() / problem.omega
-        if state[1] > problem.clearance + 1e-12 * length_scale:
-            raise ValueError(f"initial X2 = {state[1]!r} m penetrates the stop (clearance {problem.clearance!r} m)")
+        law.check_start(state)
         model = Model(problem, moments)
         y = np.zeros(model.size)
         y[:4] = state
@@ -153,7 +151,6 @@ class EventLoopEngine(ABC):
         rec.segment(t_start, MODE_STUCK if model.stuck else MODE_FREE, physical(y))
         quadratures = y[4:].copy()
         t = float(t_start)
-        sticking_velocity = self.settings.sticking_velocity * problem.velocity_scale()
         for k in range(1, periods + 1):
             boundary = t_start + k * problem.period
             impacts = events = 0
@@ -171,7 +168,7 @@ class EventLoopEngine(ABC):
                         continue  # an impact exactly at the boundary is applied before the strobe
                     break
                 events += 1
-                if events > 10 * self.settings.max_impacts_per_period:
+                if events > 10 * law.max_impacts:
                     raise RuntimeError(f"no progress at t = {t!r} s: {events} events in one period")
                 if stop is Stop.RELEASE:
                     rec.stats["releases"] += 1
@@ -180,14 +177,9 @@ class EventLoopEngine(ABC):
                     impacts += 1
                     y = y.copy()
                     y[1] = 0.0
-                    velocity = max(y[3], 0.0)
-                    chattering = velocity <= sticking_velocity or impacts > self.settings.max_impacts_per_period or problem.restitution == 0.0
-                    model.stuck = chattering and self._pushed(model, t, y)
-                    after = 0.0 if model.stuck else -problem.restitution * velocity
-                    if velocity > 0.0:
-                        rec.impact(t, velocity, problem.system.m2 * (velocity - after))  # M2 (1 + R) v, or M2 v if it sticks
-                    y[3] = after
-                    rec.stats["sticks"] += int(model.stuck)
+                    impact = law.collide(rec, t, max(y[3], 0.0), impacts, lambda: self._pushed(model, t, y))
+                    model.stuck = impact.sticks
+                    y[3] = impact.after
                 rec.segment(t, MODE_STUCK if model.stuck else MODE_FREE, physical(y))
             if moments:
                 q = y[4:] - quadratures

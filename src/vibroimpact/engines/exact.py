@@ -14,10 +14,11 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, ImpactProblem, Trajectory, TrajectoryBuilder
-
-from vibroimpact.engines.settings import EngineSettings
+from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory, TrajectoryBuilder
 from vibroimpact.engines.linear_flow import HarmonicLinearFlow, Observable, Piece, escape_step, first_crossing, gauss_legendre
+from vibroimpact.engines.rigid_contact import RigidContact
+from vibroimpact.engines.settings import EngineSettings
+from vibroimpact.model.problem import ImpactProblem
 
 __all__ = ["ExactEngine"]
 
@@ -34,14 +35,12 @@ class ExactEngine:
 
     def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
         """Integrate ``periods`` whole periods from ``state`` (X1, X2, X1', X2') at ``t_start`` [s]."""
-        if periods < 0:
-            raise ValueError(f"periods = {periods} is out of range: allowed [0, inf)")
-        run = _Run(problem, self.settings, TrajectoryBuilder(problem, moments))
+        run = _Run(RigidContact(self.name, problem, self.settings, periods), problem, TrajectoryBuilder(problem, moments))
         return run.go(np.asarray(state, dtype=float), float(t_start), int(periods))
 
     def dense(self, trajectory: Trajectory, times: NDArray[np.float64]) -> NDArray[np.float64]:
         """States at arbitrary ``times`` inside a trajectory, shape (n, 4), exact (from its segments)."""
-        run = _Run(trajectory.problem, self.settings, TrajectoryBuilder(trajectory.problem, False))
+        run = _Run(RigidContact(self.name, trajectory.problem, self.settings, 0), trajectory.problem, TrajectoryBuilder(trajectory.problem, False))
         times = np.asarray(times, dtype=float)
         index = np.clip(np.searchsorted(trajectory.segments[:, 0], times, side="right") - 1, 0, len(trajectory.segments) - 1)
         out = np.empty((times.size, 4))
@@ -56,8 +55,8 @@ class ExactEngine:
 class _Run:
     """One integration: the event loop of the exact engine."""
 
-    def __init__(self, problem: ImpactProblem, settings: EngineSettings, builder: TrajectoryBuilder) -> None:
-        self.problem, self.settings, self.rec = problem, settings, builder
+    def __init__(self, law: RigidContact, problem: ImpactProblem, builder: TrajectoryBuilder) -> None:
+        self.law, self.problem, self.rec = law, problem, builder
         self.steps = self.events = 0
         s = problem.system
         self.free = HarmonicLinearFlow(s.state_matrix, np.array([0, 0, problem.amplitude * np.exp(1j * problem.phase) / s.m1, 0]), np.zeros(4), problem.omega)
@@ -65,18 +64,16 @@ class _Run:
         self.stuck = HarmonicLinearFlow(
             stuck_matrix, np.array([0, problem.amplitude * np.exp(1j * problem.phase) / s.m1]), np.array([0.0, s.k2 * problem.clearance / s.m1]), problem.omega
         )
-        self.length_scale = problem.clearance + problem.velocity_scale() / problem.omega
+        self.length_scale = law.length_scale
         self.tolerance = 1e-15 * self.length_scale
         self.force_tolerance = 1e-15 * (s.k2 + s.b2 * problem.omega) * self.length_scale
-        self.sticking_velocity = settings.sticking_velocity * problem.velocity_scale()
         self.resolution_velocity = 1e-14 * problem.velocity_scale()
 
     # ------------------------------------------------------------------ loop
     def go(self, y: NDArray[np.float64], t: float, periods: int) -> Trajectory:
         p, rec = self.problem, self.rec
         y = y.copy()
-        if y[1] > p.clearance + 1e-12 * self.length_scale:
-            raise ValueError(f"initial X2 = {y[1]!r} m penetrates the stop (clearance {p.clearance!r} m)")
+        self.law.check_start(y)
         y[1] = min(y[1], p.clearance)  # round-off above the stop is the stop
         stuck = bool(y[1] == p.clearance and y[3] == 0.0 and self._pushed(t, y))
         leaving = y[1] == p.clearance
@@ -106,7 +103,7 @@ class _Run:
                 continue
             events_this_period += 1
             events_at = t
-            if events_this_period > 10 * self.settings.max_impacts_per_period:
+            if events_this_period > 10 * self.law.max_impacts:
                 raise RuntimeError(f"no progress at t = {t!r} s: {events_this_period} events in one period")
             if stuck:
                 rec.stats["releases"] += 1
@@ -146,18 +143,12 @@ class _Run:
 
     def _contact(self, t: float, y: NDArray[np.float64], impacts_this_period: int) -> bool:
         """Apply the contact at time t to ``y`` in place; return True if the absorber sticks."""
-        p, rec = self.problem, self.rec
         self.events += 1
-        y[1] = p.clearance
+        y[1] = self.problem.clearance
         velocity = y[3] if y[3] > self.resolution_velocity else 0.0  # below round-off: a touch, not an impact
-        chattering = velocity <= self.sticking_velocity or impacts_this_period > self.settings.max_impacts_per_period or p.restitution == 0.0
-        sticks = chattering and self._pushed(t, y)
-        after = 0.0 if sticks else -p.restitution * velocity
-        if velocity > 0.0:
-            rec.impact(t, velocity, p.system.m2 * (velocity - after))  # M2 (1 + R) v, or M2 v when the absorber sticks
-        y[3] = after
-        rec.stats["sticks"] += int(sticks)
-        return sticks
+        impact = self.law.collide(self.rec, t, velocity, impacts_this_period, lambda: self._pushed(t, y))
+        y[3] = impact.after
+        return impact.sticks
 
     # --------------------------------------------------------------- moments
     def _moments(self, piece: Piece, t0: float, t1: float, mode: int) -> None:

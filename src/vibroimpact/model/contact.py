@@ -23,13 +23,22 @@ from __future__ import annotations
 
 import cmath
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from scipy.optimize import brentq
 
 from vibroimpact.model.validation import require_in_range, require_non_negative, require_positive
 
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import NDArray
+
+    from vibroimpact.model.system import TwoDofSystem
+
 __all__ = [
+    "Impact",
     "KelvinVoigtBumper",
     "RigidStop",
     "loss_factor_from_restitution",
@@ -41,8 +50,40 @@ __all__ = [
 
 
 @dataclass(frozen=True)
+class Impact:
+    """What one impact on a rigid stop does to the absorber.
+
+    Attributes
+    ----------
+    velocity : float
+        Approach speed X2'(t-) >= 0 [m s-1] (0: a touch, nothing is recorded).
+    after : float
+        X2'(t+) [m s-1]: -R X2'(t-), or 0 when the absorber sticks.
+    sticks : bool
+        The impact ends a chattering sequence: the absorber stays on the stop.
+    impulse : float
+        M2 (X2'(t-) - X2'(t+)) [N s]: M2 (1 + R) v, or M2 v when it sticks.
+    """
+
+    velocity: float
+    after: float
+    sticks: bool
+    impulse: float
+
+
+@dataclass(frozen=True)
 class RigidStop:
-    """Momentary-impact stop: clearance Delta [m] >= 0 and restitution ratio R [-] in [0, 1]."""
+    """Momentary-impact stop: clearance Delta [m] >= 0 and restitution ratio R [-] in [0, 1].
+
+    The stop bounds the absorber's displacement from above, X2 <= Delta. Its law, applied by every rigid-stop engine
+    (the engines only find when the absorber reaches it and whether it pushes there):
+
+    * an impact at approach speed v maps X2' to -R v, with impulse M2 (1 + R) v;
+    * impacts slower than the sticking velocity, more of them than allowed in one period, or any impact with
+      R = 0, are chattering: if the stop then pushes the absorber (holding force > 0), the absorber sticks, X2' = 0,
+      impulse M2 v;
+    * a stuck absorber is held by B2 X1' + K2 (X1 - Delta) and leaves when that force turns negative.
+    """
 
     clearance: float = field(metadata={"units": "m"})
     restitution: float = field(metadata={"units": "1"})
@@ -50,6 +91,31 @@ class RigidStop:
     def __post_init__(self) -> None:
         require_non_negative("clearance", self.clearance)
         require_in_range("restitution", self.restitution, 0.0, 1.0)
+
+    def holding_force(self, system: TwoDofSystem, x1: float | NDArray[np.float64], v1: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
+        """Force the stop must exert to hold the absorber at rest at X2 = Delta, B2 X1' + K2 (X1 - Delta) [N].
+
+        Positive: the absorber is pushed into the stop (it sticks); it leaves when this turns negative.
+        """
+        return system.b2 * v1 + system.k2 * (x1 - self.clearance)
+
+    def chatters(self, velocity: float, impacts: int, sticking_velocity: float, max_impacts: int) -> bool:
+        """Is an impact at ``velocity`` [m s-1], the ``impacts``-th of its period, part of a chattering sequence?
+
+        Slower than ``sticking_velocity`` [m s-1], more than ``max_impacts`` in the period, or R = 0.
+        """
+        return velocity <= sticking_velocity or impacts > max_impacts or self.restitution == 0.0
+
+    def impact(self, mass: float, velocity: float, chattering: bool, pushed: Callable[[], bool]) -> Impact:
+        """The impact of an absorber of ``mass`` M2 [kg] arriving at ``velocity`` >= 0 [m s-1].
+
+        ``pushed()`` answers whether the stop must push to hold the absorber at rest here (the engine's own test:
+        a root search on the exact flow, or the derivatives of the holding force); it is asked only when the impact
+        is ``chattering`` (see :meth:`chatters`).
+        """
+        sticks = chattering and pushed()
+        after = 0.0 if sticks else -self.restitution * velocity
+        return Impact(velocity, after, sticks, mass * (velocity - after))
 
 
 @dataclass(frozen=True)

@@ -31,9 +31,19 @@ class HarmonicForce:
         require_non_negative("amplitude", self.amplitude)
         require_positive("frequency", self.frequency)
 
+    @property
+    def omega(self) -> float:
+        """Angular frequency w = 2 pi f [rad s-1]."""
+        return 2.0 * math.pi * self.frequency
+
+    @property
+    def period(self) -> float:
+        """T = 1 / f [s]."""
+        return 1.0 / self.frequency
+
     def force(self, t: ArrayLike) -> NDArray[np.float64]:
         """Force at time(s) t [s] -> [N]."""
-        return self.amplitude * np.cos(2.0 * math.pi * self.frequency * np.asarray(t, dtype=float) + self.phase)
+        return self.amplitude * np.cos(self.omega * np.asarray(t, dtype=float) + self.phase)
 
 
 @dataclass(frozen=True)

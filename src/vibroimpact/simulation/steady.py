@@ -1,8 +1,9 @@
 """Steady state at a fixed frequency: integrate until the stroboscopic state repeats, then measure whole periods.
 
 Starts: ``linear`` (the linear steady state; answered without integrating when it stays inside the clearance, since
-it is then an exact steady state), ``pgf`` (the exact one-impact orbit, where it exists), ``rest``, or an explicit
-state (a frequency sweep passes the previous frequency's end state).
+it is then an exact steady state), ``pgf`` (the exact one-impact orbit of a rigid stop, where it exists: the
+problem's own stop, or for a bumper the stop a caller names), ``rest``, or an explicit state (a frequency sweep passes
+the previous frequency's end state).
 """
 
 from __future__ import annotations
@@ -13,13 +14,15 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.engines.base import Engine, ImpactProblem
+from vibroimpact.engines.base import Engine
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.simulation.harmonics import HarmonicMeasures, measure
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
 from vibroimpact.simulation.settings import SteadySettings
 
-__all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "START_MODES"]
+__all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "orbit_stop_of", "START_MODES"]
 
 START_MODES = ("linear", "pgf", "rest")
 
@@ -55,14 +58,17 @@ class SteadyResult:
     integrated: bool = True
 
 
-def start_state(problem: ImpactProblem, mode: str) -> tuple[float, NDArray[np.float64]]:
-    """Initial (time, state) for a start mode; ``pgf`` falls back to ``linear`` where no one-impact orbit exists."""
+def start_state(problem: ImpactProblem, mode: str, orbit_stop: RigidStop | None = None) -> tuple[float, NDArray[np.float64]]:
+    """Initial (time, state) for a start mode; ``pgf`` falls back to ``linear`` where no one-impact orbit exists.
+
+    ``orbit_stop`` is the rigid stop whose one-impact orbit a ``pgf`` start follows (see :func:`orbit_stop_of`).
+    """
     if mode not in START_MODES:
         raise ValueError(f"start = {mode!r} is not allowed: use one of {', '.join(START_MODES)}")
     if mode == "rest":
         return 0.0, np.zeros(4)
     if mode == "pgf":
-        orbit = _orbit(problem)
+        orbit = _orbit(problem, orbit_stop)
         if orbit.exists[0] and orbit.admissible()[0]:
             # the orbit's time origin is its impact, where the force has phase (phi - psi12); in the problem's
             # time that is t_impact = (phi - psi12 - phase) / w; start half a period after it, away from the impact
@@ -79,12 +85,23 @@ def start_state(problem: ImpactProblem, mode: str) -> tuple[float, NDArray[np.fl
     return 0.0, state
 
 
-def _orbit(problem: ImpactProblem) -> OneImpactSolution:
-    return solve_one_impact(problem.system, np.array([problem.omega]), problem.clearance, problem.restitution, problem.amplitude)
+def orbit_stop_of(problem: ImpactProblem, orbit_stop: RigidStop | None = None) -> RigidStop:
+    """The rigid stop whose one-impact orbit starts a ``pgf`` run: ``orbit_stop`` if given, else the problem's own
+    rigid stop, else (a bumper) the rigid stop of the bumper's clearance and one-collision restitution."""
+    if orbit_stop is not None:
+        return orbit_stop
+    if isinstance(problem.contact, RigidStop):
+        return problem.contact
+    return RigidStop(problem.clearance, problem.contact.restitution)
 
 
-def _has_orbit(problem: ImpactProblem) -> bool:
-    orbit = _orbit(problem)
+def _orbit(problem: ImpactProblem, orbit_stop: RigidStop | None) -> OneImpactSolution:
+    stop = orbit_stop_of(problem, orbit_stop)
+    return solve_one_impact(problem.system, np.array([problem.omega]), stop.clearance, stop.restitution, problem.amplitude)
+
+
+def _has_orbit(problem: ImpactProblem, orbit_stop: RigidStop | None) -> bool:
+    orbit = _orbit(problem, orbit_stop)
     return bool(orbit.exists[0] and orbit.admissible()[0])
 
 
@@ -94,7 +111,11 @@ def linear_fits(problem: ImpactProblem) -> bool:
 
 
 def steady_state(
-    engine: Engine, problem: ImpactProblem, start: str | tuple[float, NDArray[np.float64]] = "linear", settings: SteadySettings = SteadySettings()
+    engine: Engine,
+    problem: ImpactProblem,
+    start: str | tuple[float, NDArray[np.float64]] = "linear",
+    settings: SteadySettings = SteadySettings(),
+    orbit_stop: RigidStop | None = None,
 ) -> SteadyResult:
     """Integrate to the steady state and measure it.
 
@@ -108,12 +129,14 @@ def steady_state(
         Where to start.
     settings : SteadySettings
         Convergence and measurement settings.
+    orbit_stop : RigidStop, optional
+        The rigid stop whose one-impact orbit a ``pgf`` start follows (see :func:`orbit_stop_of`).
     """
-    if start == "pgf" and not _has_orbit(problem):
+    if start == "pgf" and not _has_orbit(problem, orbit_stop):
         start = "linear"  # where no admissible one-impact orbit exists, the pgf start is the linear one
     if start == "linear" and linear_fits(problem):
         return _linear_answer(problem)
-    t, y = start_state(problem, start) if isinstance(start, str) else (float(start[0]), np.asarray(start[1], dtype=float))
+    t, y = start_state(problem, start, orbit_stop) if isinstance(start, str) else (float(start[0]), np.asarray(start[1], dtype=float))
     scale = np.array([1.0, 1.0, problem.omega, problem.omega]) * (problem.clearance + problem.amplitude * abs(complex(problem.system.receptances(problem.omega).h12)))
     if start == "pgf":
         y = y + settings.start_perturbation * scale * np.array([1.0, 0.0, 0.0, 0.0])

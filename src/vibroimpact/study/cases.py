@@ -1,6 +1,6 @@
 """Steady states of the time-domain engines over a study's grid, as cases for :func:`vibroimpact.runner.run_cases`.
 
-A *case* is one engine at one (restitution, clearance) over its frequencies: independent points for the ``linear``,
+A *case* is one engine at one contact (a rigid stop, or a bumper) over its frequencies: independent points for the ``linear``,
 ``pgf`` and ``rest`` starts, a chain for the stepped sweeps (``sweep_up``, ``sweep_down``: each point starts from the
 previous one's end state, with the force phase kept continuous).
 """
@@ -11,29 +11,23 @@ import math
 import sys
 import time
 from dataclasses import asdict, dataclass
-from typing import Callable
 
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.engines.exact import ExactEngine
-
-from vibroimpact.engines.base import ImpactProblem
-
+from vibroimpact.engines.registry import make_engine
 from vibroimpact.engines.settings import EngineSettings
-from vibroimpact.engines.base import Engine
-from vibroimpact.engines.compliant.ida import CompliantEngine
-from vibroimpact.engines.momentary import MomentaryEngine
+from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.study.fingerprint import case_key
 from vibroimpact.study.runner import CaseResult, ProgressReport
 from vibroimpact.simulation.steady import linear_fits, steady_state
 from vibroimpact.simulation.settings import SteadySettings
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["ENGINES", "SWEEP_STARTS", "SimulationCase", "run_case", "make_engine"]
+__all__ = ["SWEEP_STARTS", "SimulationCase", "run_case"]
 
-#: Time-domain solutions and their engines (the compliant one also needs its bumper, see :func:`make_engine`).
-ENGINES: dict[str, Callable[..., Engine]] = {"exact": ExactEngine, "momentary": MomentaryEngine, "compliant": CompliantEngine}
 SWEEP_STARTS = ("sweep_up", "sweep_down")
 #: Fields of a case result, one value per frequency.
 FIELDS = (
@@ -56,30 +50,40 @@ FIELDS = (
 )
 
 
-def make_engine(name: str, settings: EngineSettings, bumper_frequency: float = math.nan, bumper_loss_factor: float = math.nan) -> Engine:
-    """The engine registered under ``name``; ``compliant`` takes Omega_b / 2 pi [Hz] and xi_b [-] of its bumper."""
-    if name not in ENGINES:
-        raise ValueError(f"engine {name!r} is unknown: use one of {', '.join(ENGINES)}")
-    if name == "compliant":
-        return CompliantEngine(bumper_frequency, bumper_loss_factor, settings)
-    return ENGINES[name](settings)
-
-
 @dataclass(frozen=True)
 class SimulationCase:
-    """One engine at one (restitution, clearance) over its frequencies."""
+    """One engine (a name of :mod:`vibroimpact.engines.registry`) at one contact over its frequencies.
+
+    Attributes
+    ----------
+    engine : str
+        Registered engine name.
+    system : TwoDofSystem
+        The linear system.
+    amplitude : float
+        q [N].
+    contact : RigidStop or KelvinVoigtBumper
+        The contact law the engine solves.
+    frequencies : tuple of float
+        Excitation frequencies [Hz].
+    start : str
+        A start of :data:`vibroimpact.simulation.steady.START_MODES` or of :data:`SWEEP_STARTS`.
+    engine_settings, steady_settings
+        Numerical settings.
+    orbit_stop : RigidStop or None
+        The rigid stop whose one-impact orbit a ``pgf`` start follows (a bumper's study grid point); None: the
+        contact's own (:func:`vibroimpact.simulation.steady.orbit_stop_of`).
+    """
 
     engine: str
     system: TwoDofSystem
     amplitude: float
-    restitution: float
-    clearance: float
+    contact: RigidStop | KelvinVoigtBumper
     frequencies: tuple[float, ...]
     start: str
     engine_settings: EngineSettings
     steady_settings: SteadySettings
-    bumper_frequency: float = math.nan
-    bumper_loss_factor: float = math.nan
+    orbit_stop: RigidStop | None = None
 
     fields = FIELDS
 
@@ -101,27 +105,26 @@ class SimulationCase:
                 "engine": self.engine,
                 "system": asdict(self.system),
                 "amplitude": self.amplitude,
-                "restitution": self.restitution,
-                "clearance": self.clearance,
+                "contact": {"law": type(self.contact).__name__, **asdict(self.contact)},
+                "orbit_stop": None if self.orbit_stop is None else asdict(self.orbit_stop),
                 "frequencies": list(self.frequencies),
                 "start": self.start,
                 "engine_settings": asdict(self.engine_settings),
                 "steady_settings": asdict(self.steady_settings),
-                "bumper": [self.bumper_frequency, self.bumper_loss_factor] if self.engine == "compliant" else None,
             }
         )
 
 
 def run_case(case: SimulationCase, report: ProgressReport | None = None) -> CaseResult:
     """Steady states of one case, in the order of ``case.frequencies``; ``report`` receives the points done."""
-    engine = make_engine(case.engine, case.engine_settings, case.bumper_frequency, case.bumper_loss_factor)
+    engine = make_engine(case.engine, case.engine_settings)
     n = len(case.frequencies)
     out: dict[str, NDArray[np.generic]] = {name: np.full(n, np.nan, dtype=complex if name in ("x1", "x2", "suspension_force", "contact_force") else float) for name in FIELDS}
     order = range(n - 1, -1, -1) if case.start == "sweep_down" else range(n)
     previous = None
     for i in order:
         frequency = case.frequencies[i]
-        problem = ImpactProblem(case.system, case.clearance, case.restitution, case.amplitude, frequency, phase=0.0)
+        problem = ImpactProblem(case.system, case.contact, HarmonicForce(case.amplitude, frequency, phase=0.0))
         start: str | tuple[float, NDArray[np.float64]] = case.start
         if case.start in SWEEP_STARTS:
             if previous is None or (previous[2] == 0.0 and linear_fits(problem)):
@@ -130,14 +133,14 @@ def run_case(case: SimulationCase, report: ProgressReport | None = None) -> Case
                 old_problem, result, _impacts = previous
                 # keep the force continuous: the new force at t = 0 continues the old one at its end time
                 phase = (old_problem.omega * result.end_time + old_problem.phase) % (2.0 * math.pi)
-                problem = ImpactProblem(case.system, case.clearance, case.restitution, case.amplitude, frequency, phase=phase)
+                problem = ImpactProblem(case.system, case.contact, HarmonicForce(case.amplitude, frequency, phase=phase))
                 start = (0.0, result.end_state)
         started = time.perf_counter()
         try:
-            result = steady_state(engine, problem, start, case.steady_settings)
+            result = steady_state(engine, problem, start, case.steady_settings, case.orbit_stop)
         except (RuntimeError, ValueError, ArithmeticError, np.linalg.LinAlgError) as error:
             # one failing point must not cost the others: it stays NaN, flagged, and a sweep restarts after it
-            print(f"{case.engine}: R = {case.restitution:g}, Delta = {case.clearance:g} m, f = {frequency:g} Hz failed: {error}", file=sys.stderr)
+            print(f"{case.engine}: {case.contact}, f = {frequency:g} Hz failed: {error}", file=sys.stderr)
             out["failed"][i] = 1.0
             previous = None
             continue

@@ -15,8 +15,9 @@ import numpy as np
 from numpy.typing import NDArray
 from sksundae.cvode import CVODE
 
+from vibroimpact.engines.compliant.ida import CompliantEngine
+from vibroimpact.engines.compliant.model import BumperModel, absolute_tolerances
 from vibroimpact.engines.settings import EngineSettings
-from vibroimpact.engines.compliant.ida import CompliantEngine, _BumperModel, absolute_tolerances
 
 __all__ = ["CompliantCvodeEngine"]
 
@@ -24,15 +25,15 @@ __all__ = ["CompliantCvodeEngine"]
 class CompliantCvodeEngine(CompliantEngine):
     """The Kelvin-Voigt bumper through CVODE (``settings.method``: ``adams`` or ``bdf``); see :class:`CompliantEngine`."""
 
-    def __init__(self, bumper_frequency: float, bumper_loss_factor: float, settings: EngineSettings = EngineSettings()) -> None:
-        super().__init__(bumper_frequency, bumper_loss_factor, settings)
+    def __init__(self, settings: EngineSettings = EngineSettings()) -> None:
+        super().__init__(settings)
         self.name = f"compliant_cvode_{settings.method}"
 
     def solve(self, solver: Any, tspan: NDArray[np.float64], y0: NDArray[np.float64], yp0: NDArray[np.float64]) -> Any:
         """One CVODE call over ``tspan`` (an ODE solver needs no y0')."""
         return solver.solve(tspan, y0)
 
-    def _solver(self, model: _BumperModel, contact: bool, omega_ref: float) -> tuple[Any, Any]:
+    def _solver(self, model: BumperModel, contact: bool, omega_ref: float) -> tuple[Any, Any]:
         residual = model.residual(contact)
         zero = np.zeros(model.size)
 

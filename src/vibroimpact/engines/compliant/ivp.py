@@ -28,11 +28,11 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
-from vibroimpact.model.excitation import SweptSine
-from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.model.validation import require_non_negative, require_positive
-from vibroimpact.engines.base import MODE_FREE, ImpactProblem, TrajectoryBuilder
-from vibroimpact.engines.compliant.ida import MODE_CONTACT, SweepRecord
+from vibroimpact.engines.base import MODE_FREE, SweepRecord, TrajectoryBuilder, check_run
+from vibroimpact.engines.compliant.model import MODE_CONTACT
+from vibroimpact.model.contact import KelvinVoigtBumper
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.validation import require_positive
 
 __all__ = ["IVP_METHODS", "solve_ivp_sweep"]
 
@@ -44,11 +44,7 @@ _SAMPLES_PER_CALL = 4096
 
 
 def solve_ivp_sweep(
-    system: TwoDofSystem,
-    clearance: float,
-    bumper_frequency: float,
-    bumper_loss_factor: float,
-    sweep: SweptSine,
+    problem: ImpactProblem,
     sample_rate: float,
     method: str = "LSODA",
     rtol: float = 1e-6,
@@ -59,16 +55,9 @@ def solve_ivp_sweep(
 
     Parameters
     ----------
-    system : TwoDofSystem
-        The linear system.
-    clearance : float
-        Delta [m], >= 0.
-    bumper_frequency : float
-        Omega_b / 2 pi [Hz], > 0.
-    bumper_loss_factor : float
-        xi_b [-], >= 0.
-    sweep : SweptSine
-        The excitation.
+    problem : ImpactProblem
+        System, :class:`~vibroimpact.model.contact.KelvinVoigtBumper` and
+        :class:`~vibroimpact.model.excitation.SweptSine` excitation.
     sample_rate : float
         Output samples per second [Hz]; the samples are those of the IDA engine, ``arange(0, duration, 1 / rate)``.
     method : str
@@ -89,11 +78,10 @@ def solve_ivp_sweep(
     """
     if method not in IVP_METHODS:
         raise ValueError(f"method = {method!r} is not allowed: use one of {', '.join(IVP_METHODS)}")
-    require_non_negative("clearance", clearance)
-    require_positive("bumper_frequency", bumper_frequency)
-    require_non_negative("bumper_loss_factor", bumper_loss_factor)
+    check_run(f"solve_ivp_{method}", problem, KelvinVoigtBumper)
+    system, sweep = problem.system, problem.sweep
     require_positive("sample_rate", sample_rate)
-    run = _IvpRun(system, clearance, bumper_frequency, bumper_loss_factor, sweep, method, rtol, atol)
+    run = _IvpRun(problem, method, rtol, atol)
     times = np.arange(0.0, sweep.duration, 1.0 / sample_rate)
     start = np.zeros(4) if state is None else np.asarray(state, dtype=float)
     samples = run.run(np.concatenate([start, np.zeros(3)]), times)
@@ -114,13 +102,13 @@ class _IvpRun:
     """State, events and restarts of one solve_ivp sweep. State: X1, X2, X1', X2', integral of F, and the integrals
     of F cos(theta) theta' and F sin(theta) theta'."""
 
-    def __init__(self, system: TwoDofSystem, clearance: float, frequency: float, loss_factor: float, sweep: SweptSine, method: str, rtol: float, atol: float) -> None:
-        self.system, self.delta, self.sweep, self.method, self.rtol = system, clearance, sweep, method, rtol
-        omega_b = 2.0 * math.pi * frequency
-        self.k, self.b = system.m2 * omega_b**2, 2.0 * system.m2 * loss_factor * omega_b
+    def __init__(self, problem: ImpactProblem, method: str, rtol: float, atol: float) -> None:
+        system, bumper, sweep = problem.system, problem.bumper, problem.sweep
+        self.system, self.delta, self.sweep, self.method, self.rtol = system, problem.clearance, sweep, method, rtol
+        self.k, self.b = bumper.stiffness(system.m2), bumper.damping(system.m2)
         w = 2.0 * math.pi * max(sweep.start_frequency, sweep.stop_frequency)
         self.atol = np.array([atol, atol, atol * w, atol * w, atol * w * system.m2, atol * w * w * system.m2, atol * w * w * system.m2])
-        self.rec = TrajectoryBuilder(ImpactProblem(system, clearance, 0.5, sweep.amplitude, sweep.start_frequency), False)
+        self.rec = TrajectoryBuilder(problem, False)
         self.stats = {"nfev": 0, "njev": 0, "nlu": 0, "solver_calls": 0, "contacts": 0, "events": 0, "grazing": 0}
         s = system
         free = np.zeros((7, 7))
