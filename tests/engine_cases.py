@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.engines.exact import ExactEngine
 
-from vibroimpact.engines.base import ImpactProblem, Trajectory
+from vibroimpact.engines.base import Trajectory
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
@@ -20,7 +23,7 @@ def pgf_start(frequency: float, restitution: float, clearance: float = PAPER_CLE
     orbit = solve_one_impact(system, np.array([2 * np.pi * frequency]), clearance, restitution, PAPER_AMPLITUDE)
     assert orbit.exists[0]
     phase = float(orbit.phase[0] - np.angle(orbit.receptances.h12[0]))
-    problem = ImpactProblem(system, clearance, restitution, PAPER_AMPLITUDE, frequency, phase=phase)
+    problem = ImpactProblem(system, RigidStop(clearance, restitution), HarmonicForce(PAPER_AMPLITUDE, frequency, phase=phase))
     half = np.array([[0.5 / frequency]])
     state = np.array([orbit.x1(half)[0, 0], orbit.x2(half)[0, 0], orbit.x1(half, 1)[0, 0], orbit.x2(half, 1)[0, 0]])
     return problem, state, 0.5 / frequency, orbit

@@ -6,6 +6,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import OneImpactSolution, PgfVariant, solve_one_impact, stable_impulse_root
 from vibroimpact.model.system import TwoDofSystem
@@ -243,12 +246,12 @@ def test_rms_of_the_orbit_matches_a_simulation(system: TwoDofSystem) -> None:
     """RMS of the reconstructed X1, X2 of the stable 25 Hz orbit against the exact engine's steady-state RMS (exact
     per-period moments) to 1e-5; a sine's RMS is |X| / sqrt 2, the clipped X2 is not."""
     from vibroimpact.engines.exact import ExactEngine
-    from vibroimpact.engines.base import ImpactProblem
+    
     from vibroimpact.simulation.steady import steady_state
     from vibroimpact.simulation.settings import SteadySettings
 
     orbit = solve_one_impact(system, np.array([2 * np.pi * 25.0]), 0.003, 0.2, 10.0)
     x1_rms, x2_rms = orbit.rms()
-    measured = steady_state(ExactEngine(), ImpactProblem(system, 0.003, 0.2, 10.0, 25.0), "pgf", SteadySettings(tolerance=1e-10)).measures
+    measured = steady_state(ExactEngine(), ImpactProblem(system, RigidStop(0.003, 0.2), HarmonicForce(10.0, 25.0)), "pgf", SteadySettings(tolerance=1e-10)).measures
     assert x1_rms[0] == pytest.approx(measured.x1_rms, rel=1e-5) and x2_rms[0] == pytest.approx(measured.x2_rms, rel=1e-5)
     assert x2_rms[0] * np.sqrt(2.0) / abs(orbit.x2_harmonic()[0]) > 1.01  # harmonics and a mean offset

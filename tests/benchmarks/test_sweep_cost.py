@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from vibroimpact.model.contact import loss_factor_from_restitution
+from vibroimpact.model.contact import KelvinVoigtBumper, loss_factor_from_restitution
+from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.engines.compliant.ida import CompliantEngine
 from vibroimpact.engines.settings import SWEEP_SETTINGS
 from vibroimpact.engines.compliant.ivp import solve_ivp_sweep
@@ -31,8 +32,9 @@ def test_solve_ivp_sweep_agrees_with_ida(system: TwoDofSystem, bumper: float, me
     both codes: the same contacts, onsets to 1e-6 s, running X1 fundamental to 2e-5 of its largest value (measured
     ~2e-6), peaks and impulses to 5e-4 (~5e-5), samples of X2 and the Fourier integral of the force to 1e-4."""
     sweep = SweptSine(PAPER_AMPLITUDE, 24.0, stop, 0.1)
-    ida = CompliantEngine(bumper, XI, SWEEP_SETTINGS).sweep(system, PAPER_CLEARANCE, sweep, 1000.0)
-    ivp = solve_ivp_sweep(system, PAPER_CLEARANCE, bumper, XI, sweep, 1000.0, method, SWEEP_SETTINGS.rtol, SWEEP_SETTINGS.atol)
+    problem = ImpactProblem(system, KelvinVoigtBumper(PAPER_CLEARANCE, bumper, XI), sweep)
+    ida = CompliantEngine(SWEEP_SETTINGS).sweep(problem, 1000.0)
+    ivp = solve_ivp_sweep(problem, 1000.0, method, SWEEP_SETTINGS.rtol, SWEEP_SETTINGS.atol)
     a, b = ivp.trajectory, ida.trajectory
     assert a.impact_times.size == b.impact_times.size == a.stats["contacts"] >= 0.9 * 24.0 * sweep.duration
     np.testing.assert_allclose(a.impact_times, b.impact_times, atol=1e-6)
@@ -50,7 +52,7 @@ def test_solve_ivp_sweep_agrees_with_ida(system: TwoDofSystem, bumper: float, me
 
 def test_solve_ivp_sweep_rejects_an_unknown_method(system: TwoDofSystem) -> None:
     with pytest.raises(ValueError, match="method"):
-        solve_ivp_sweep(system, PAPER_CLEARANCE, 250.0, XI, SweptSine(10.0, 24.0, 25.0, 0.1), 1000.0, "Euler")
+        solve_ivp_sweep(ImpactProblem(system, KelvinVoigtBumper(PAPER_CLEARANCE, 250.0, XI), SweptSine(10.0, 24.0, 25.0, 0.1)), 1000.0, "Euler")
 
 
 def _small_cost_settings(methods: tuple[str, ...], budget: float) -> SweepCostSettings:

@@ -3,16 +3,21 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from vibroimpact.model.contact import loss_factor_from_restitution, peak_acceleration_factor, restitution_from_loss_factor
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution, peak_acceleration_factor, restitution_from_loss_factor
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.engines.base import SweepRecord
 from vibroimpact.engines.exact import ExactEngine
-from vibroimpact.engines.base import ImpactProblem
+
 from vibroimpact.engines.settings import EngineSettings
-from vibroimpact.engines.compliant.ida import MODE_CONTACT, CompliantEngine, SweepRecord
+from vibroimpact.engines.compliant.ida import CompliantEngine
+from vibroimpact.engines.compliant.model import MODE_CONTACT
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.simulation.steady import steady_state
 from vibroimpact.simulation.settings import SteadySettings
@@ -29,9 +34,9 @@ FREE_ABSORBER = TwoDofSystem(m1=1.0, m2=0.1, k1=1.0, k2=1e-12)
 @pytest.mark.parametrize("xi", [1e-4, 0.05, 0.3, 0.49, 0.7, 1.0, 1.5, 4.0])
 def test_one_collision_restitution_impulse_and_peak(xi: float) -> None:
     """IDA reproduces R(xi), the impulse M2 v0 (1 + R) and the peak deceleration Gamma(xi) Omega v0 to 1e-8."""
-    problem = ImpactProblem(FREE_ABSORBER, 1e-3, 0.5, 0.0, 1.0)
+    problem = ImpactProblem(FREE_ABSORBER, KelvinVoigtBumper(1e-3, 250.0, xi), HarmonicForce(0.0, 1.0))
     v0, omega_b = 0.5, 2 * math.pi * 250.0
-    trajectory = CompliantEngine(250.0, xi, TIGHT).integrate(problem, np.array([0.0, 1e-3, 0.0, v0]), 0.0, 1)
+    trajectory = CompliantEngine(TIGHT).integrate(problem, np.array([0.0, 1e-3, 0.0, v0]), 0.0, 1)
     restitution = restitution_from_loss_factor(xi)
     assert trajectory.impulses.size == 1
     assert -trajectory.strobe_states[-1, 3] / v0 == pytest.approx(restitution, rel=1e-8)
@@ -73,9 +78,9 @@ def _reference(problem: ImpactProblem, frequency: float, xi: float, duration: fl
 @pytest.mark.timeout(120)
 def test_agrees_with_an_independent_integration(system: TwoDofSystem) -> None:
     """IDA against DOP853 on the same compliant model, 0.6 s from rest at 25 Hz: contact onsets and final state."""
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, 25.0)
     xi = loss_factor_from_restitution(0.2)
-    trajectory = CompliantEngine(250.0, xi, TIGHT).integrate(problem, np.zeros(4), 0.0, 15)
+    problem = ImpactProblem(system, KelvinVoigtBumper(PAPER_CLEARANCE, 250.0, xi), HarmonicForce(PAPER_AMPLITUDE, 25.0))
+    trajectory = CompliantEngine(TIGHT).integrate(problem, np.zeros(4), 0.0, 15)
     onsets, final = _reference(problem, 250.0, xi, 15 / 25.0)
     assert trajectory.impact_times.size == onsets.size >= 10
     np.testing.assert_allclose(trajectory.impact_times, onsets, atol=1e-9)
@@ -87,12 +92,13 @@ def test_agrees_with_an_independent_integration(system: TwoDofSystem) -> None:
 def test_stiffening_bumper_converges_to_momentary_impact(system: TwoDofSystem) -> None:
     """Stated rate: the steady-state |X1| approaches the momentary-impact value (same R) like 1 / Omega_b: each 4x
     stiffer bumper divides the error by about 4 (9.4 %, 2.4 %, 0.6 % at 250, 1000, 4000 Hz at 25 Hz, R = 0.2)."""
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, 25.0)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.2), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     reference = steady_state(ExactEngine(), problem, "pgf", SteadySettings(tolerance=1e-10)).measures
     xi = loss_factor_from_restitution(0.2)
     errors = []
     for frequency in (250.0, 1000.0, 4000.0):
-        result = steady_state(CompliantEngine(frequency, xi, EngineSettings(rtol=1e-9, atol=1e-13)), problem, "pgf", SteadySettings(tolerance=1e-9))
+        bumper = replace(problem, contact=KelvinVoigtBumper(PAPER_CLEARANCE, frequency, xi))
+        result = steady_state(CompliantEngine(EngineSettings(rtol=1e-9, atol=1e-13)), bumper, "pgf", SteadySettings(tolerance=1e-9), problem.rigid_stop)
         assert result.converged and result.measures.impacts_per_period == 1.0  # exact: a count per period
         errors.append(abs(abs(result.measures.x1) - abs(reference.x1)) / abs(reference.x1))
     ratios = np.array(errors[:-1]) / np.array(errors[1:])
@@ -105,8 +111,8 @@ def test_stiffening_bumper_converges_to_momentary_impact(system: TwoDofSystem) -
 def test_hard_bumpers(system: TwoDofSystem, frequency: float, xi: float) -> None:
     """Very stiff, nearly elastic and overdamped bumpers: no failure; every contact that began also released (an
     impact is recorded at release), with a finite positive peak force and impulse."""
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, 25.0)
-    trajectory = CompliantEngine(frequency, xi).integrate(problem, np.zeros(4), 0.0, 20)
+    problem = ImpactProblem(system, KelvinVoigtBumper(PAPER_CLEARANCE, frequency, xi), HarmonicForce(PAPER_AMPLITUDE, 25.0))
+    trajectory = CompliantEngine().integrate(problem, np.zeros(4), 0.0, 20)
     assert trajectory.impact_times.size >= 10
     assert trajectory.stats["contacts"] - trajectory.impact_times.size in (0, 1)
     assert np.all(np.isfinite(trajectory.strobe_states))
@@ -126,7 +132,7 @@ def test_slow_sweep_without_contact_follows_the_linear_response(system: TwoDofSy
     h = linear_response(system, 2 * math.pi * 15.0, PAPER_AMPLITUDE)
     x = np.array([h.x1, h.x2]) * -1j  # the response to q sin(theta) at theta = 0
     state = np.concatenate([x.real, (2j * math.pi * 15.0 * x).real])
-    record = CompliantEngine(250.0, 0.73).sweep(system, 1.0, sweep, 2000.0, state)
+    record = CompliantEngine().sweep(ImpactProblem(system, KelvinVoigtBumper(1.0, 250.0, 0.73), sweep), 2000.0, state)
     assert record.trajectory.impact_times.size == 0 and np.all(record.contact_force == 0.0)  # exact: no contact: force set to 0
     estimate = running_fundamental(record.time, record.x1, sweep, cycles=8)
     linear = np.abs(linear_response(system, 2 * math.pi * estimate.frequency, PAPER_AMPLITUDE).x1)
@@ -142,7 +148,7 @@ def test_slow_sweep_with_contact_follows_the_one_impact_orbit(system: TwoDofSyst
     from vibroimpact.analysis.pgf import solve_one_impact
 
     sweep = SweptSine(PAPER_AMPLITUDE, 24.0, 25.0, 0.1)
-    record = CompliantEngine(4000.0, loss_factor_from_restitution(0.2)).sweep(system, PAPER_CLEARANCE, sweep, 2000.0)
+    record = CompliantEngine().sweep(ImpactProblem(system, KelvinVoigtBumper(PAPER_CLEARANCE, 4000.0, loss_factor_from_restitution(0.2)), sweep), 2000.0)
     estimate = running_fundamental(record.time, record.x1, sweep, cycles=8)
     settled = estimate.time > 5.0
     orbit = solve_one_impact(system, 2 * math.pi * estimate.frequency[settled], PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE)
@@ -153,7 +159,8 @@ def test_slow_sweep_with_contact_follows_the_one_impact_orbit(system: TwoDofSyst
 def _paper_sweep_record(settings: EngineSettings, start: float, stop: float, sample_rate: float = 1000.0) -> tuple[SweptSine, SweepRecord]:
     """The paper's swept-sine test (250 Hz bumper, R = 0.2) from ``start`` to ``stop`` Hz at 0.1 Hz/s."""
     sweep = SweptSine(PAPER_AMPLITUDE, start, stop, 0.1)
-    return sweep, CompliantEngine(250.0, loss_factor_from_restitution(0.2), settings).sweep(PAPER_SYSTEM, PAPER_CLEARANCE, sweep, sample_rate)
+    bumper = KelvinVoigtBumper(PAPER_CLEARANCE, 250.0, loss_factor_from_restitution(0.2))
+    return sweep, CompliantEngine(settings).sweep(ImpactProblem(PAPER_SYSTEM, bumper, sweep), sample_rate)
 
 
 @pytest.mark.timeout(60)
@@ -200,14 +207,14 @@ def test_sweep_record_contacts_stats_and_force_quadrature() -> None:
 def test_sweep_clears_the_event_records() -> None:
     """scikit-sundae keeps every root on the event function (NOTES): the run must leave none behind, or each call
     gets slower over a long sweep."""
-    from vibroimpact.model.contact import KelvinVoigtBumper
     from vibroimpact.engines.base import TrajectoryBuilder
-    from vibroimpact.engines.compliant.ida import _BumperModel, _Run
+    from vibroimpact.engines.compliant.ida import _Run
+    from vibroimpact.engines.compliant.model import BumperModel
 
     sweep = SweptSine(PAPER_AMPLITUDE, 24.0, 24.5, 0.1)
-    problem = ImpactProblem(PAPER_SYSTEM, PAPER_CLEARANCE, 0.5, PAPER_AMPLITUDE, 24.0)
-    model = _BumperModel(problem, KelvinVoigtBumper(PAPER_CLEARANCE, 250.0, 0.3), False, sweep)
-    engine = CompliantEngine(250.0, 0.3)
+    problem = ImpactProblem(PAPER_SYSTEM, KelvinVoigtBumper(PAPER_CLEARANCE, 250.0, 0.3), sweep)
+    model = BumperModel(problem, False)
+    engine = CompliantEngine()
     run = _Run(engine, model, TrajectoryBuilder(problem, False), 0.0, np.zeros(4), 2 * math.pi * 25.0)
     run.run(np.arange(0.0, sweep.duration, 1e-3), lambda t, y, contact: None)
     assert run.counts["contacts"] > 50
@@ -257,8 +264,8 @@ def test_near_tangent_touches(system: TwoDofSystem, settings: EngineSettings) ->
     state = np.array([0.0, 0.0, 0.0, 0.3])
     apex_time, apex = _first_apex(system, state)
     for overshoot in (1e-8, 3e-8, 1e-7, -1e-8, -1e-7):
-        problem = ImpactProblem(system, apex - overshoot, 0.5, 0.0, 1.0 / (4 * apex_time))  # one period: to the next apex
-        trajectory = CompliantEngine(250.0, 0.3, settings).integrate(problem, state, 0.0, 1)
+        problem = ImpactProblem(system, KelvinVoigtBumper(apex - overshoot, 250.0, 0.3), HarmonicForce(0.0, 1.0 / (4 * apex_time)))  # one period: to the next apex
+        trajectory = CompliantEngine(settings).integrate(problem, state, 0.0, 1)
         expected = 1 if overshoot > 0 else 0
         assert trajectory.stats["contacts"] == trajectory.impact_times.size == expected, overshoot
         if expected:
@@ -272,16 +279,16 @@ def test_apex_check_catches_what_the_onset_event_misses(system: TwoDofSystem, mo
     apex (flagged as grazing), the outputs integrated past it are redone, and the period ends as with the onset
     event but for the touch itself (it starts 14 us later, at rest instead of at 1 mm/s: the final states differ by
     ~2e-5 of the largest state value)."""
-    from vibroimpact.engines.compliant import ida as compliant
+    from vibroimpact.engines.compliant import model as compliant
 
     state = np.array([0.0, 0.0, 0.0, 0.3])
     apex_time, apex = _first_apex(system, state)
-    problem = ImpactProblem(system, apex - 1e-8, 0.5, 0.0, 1.0 / (4 * apex_time))
-    engine = CompliantEngine(250.0, 0.3, EngineSettings(rtol=1e-8, atol=1e-12))
+    problem = ImpactProblem(system, KelvinVoigtBumper(apex - 1e-8, 250.0, 0.3), HarmonicForce(0.0, 1.0 / (4 * apex_time)))
+    engine = CompliantEngine(EngineSettings(rtol=1e-8, atol=1e-12))
     normal = engine.integrate(problem, state, 0.0, 2)
-    events = compliant._BumperModel.events
+    events = compliant.BumperModel.events
 
-    def without_onset(model: compliant._BumperModel, contact: bool):  # type: ignore[no-untyped-def]
+    def without_onset(model: compliant.BumperModel, contact: bool):  # type: ignore[no-untyped-def]
         function = events(model, contact)
         if contact:
             return function
@@ -293,7 +300,7 @@ def test_apex_check_catches_what_the_onset_event_misses(system: TwoDofSystem, mo
         blind.terminal, blind.direction = function.terminal, function.direction  # type: ignore[attr-defined]
         return blind
 
-    monkeypatch.setattr(compliant._BumperModel, "events", without_onset)
+    monkeypatch.setattr(compliant.BumperModel, "events", without_onset)
     blind = engine.integrate(problem, state, 0.0, 2)
     assert blind.stats["grazing"] == blind.stats["contacts"] == blind.impact_times.size == normal.impact_times.size == 1
     assert blind.impact_times[0] == pytest.approx(apex_time, rel=1e-8)

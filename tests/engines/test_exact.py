@@ -6,7 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vibroimpact.engines.base import MODE_STUCK, ImpactProblem
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.engines.base import MODE_STUCK
 
 from vibroimpact.engines.exact import ExactEngine
 
@@ -42,7 +45,7 @@ def test_leaves_unstable_pgf_orbit() -> None:
 @pytest.mark.timeout(60)
 def test_far_clearance_is_the_linear_solution() -> None:
     """No contact ever: the strobe states are the linear steady state's, to round-off."""
-    problem = ImpactProblem(TwoDofSystem(m1=1.0, m2=0.1, k1=25_000.0, k2=4_300.0, b1=0.8, b2=0.08), 1.0, 0.2, PAPER_AMPLITUDE, 23.0)
+    problem = ImpactProblem(TwoDofSystem(m1=1.0, m2=0.1, k1=25_000.0, k2=4_300.0, b1=0.8, b2=0.08), RigidStop(1.0, 0.2), HarmonicForce(PAPER_AMPLITUDE, 23.0))
     start = linear_state(problem)
     trajectory = ENGINE.integrate(problem, start, 0.0, 100)
     assert trajectory.impulses.size == 0 and trajectory.stats["events"] == 0
@@ -55,7 +58,7 @@ def test_grazing_contact_is_never_missed(margin: float, system: TwoDofSystem) ->
     """The linear orbit's maximum X2 lies 0.5 nm beyond (or short of) the stop: one impact (or none) per period."""
     frequency = 30.0
     amplitude_x2 = PAPER_AMPLITUDE * abs(linear_response(system, 2 * np.pi * frequency, 1.0).x2)
-    problem = ImpactProblem(system, amplitude_x2 + margin, 0.9, PAPER_AMPLITUDE, frequency)
+    problem = ImpactProblem(system, RigidStop(amplitude_x2 + margin, 0.9), HarmonicForce(PAPER_AMPLITUDE, frequency))
     trajectory = ENGINE.integrate(problem, linear_state(problem), 0.0, 3)
     if margin < 0:
         assert trajectory.impulses.size >= 1
@@ -79,7 +82,7 @@ def test_energy_balance(frequency: float, restitution: float) -> None:
 def test_elastic_impacts_without_damping_conserve_energy() -> None:
     """R = 1, B1 = B2 = 0: energy changes only by the work of the force; impacts lose nothing."""
     undamped = TwoDofSystem(m1=1.0, m2=0.1, k1=25_000.0, k2=4_300.0)
-    problem = ImpactProblem(undamped, 2e-3, 1.0, PAPER_AMPLITUDE, 25.0)
+    problem = ImpactProblem(undamped, RigidStop(2e-3, 1.0), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 30)
     assert trajectory.impulses.size > 10
     budget = energy_budget(trajectory)
@@ -94,7 +97,7 @@ def test_chattering_ends_in_sticking_and_release(restitution: float, system: Two
     the absorber on the stop, impacts accumulate (Zeno), it sticks and is released again every period; no hang;
     the stop only pushes (holding force >= 0) while stuck and X2 never exceeds Delta."""
     clearance = 1e-4
-    problem = ImpactProblem(system, clearance, restitution, PAPER_AMPLITUDE, 10.0)
+    problem = ImpactProblem(system, RigidStop(clearance, restitution), HarmonicForce(PAPER_AMPLITUDE, 10.0))
     trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 30)
     assert trajectory.stats["sticks"] >= 29 and trajectory.stats["releases"] >= 29
     stuck = trajectory.segments[trajectory.segments[:, 2] == MODE_STUCK]
@@ -108,7 +111,7 @@ def test_chattering_ends_in_sticking_and_release(restitution: float, system: Two
 @pytest.mark.timeout(60)
 def test_zero_clearance(system: TwoDofSystem) -> None:
     """Delta = 0: the stop at the static equilibrium; impacts every period, X2 <= 0."""
-    problem = ImpactProblem(system, 0.0, 0.5, PAPER_AMPLITUDE, 25.0)
+    problem = ImpactProblem(system, RigidStop(0.0, 0.5), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 40)
     assert trajectory.impulses.size >= 30
     y = ENGINE.dense(trajectory, np.linspace(0.0, trajectory.strobe_times[-1], 5001))
@@ -117,7 +120,7 @@ def test_zero_clearance(system: TwoDofSystem) -> None:
 
 def test_restitution_law_at_every_impact(system: TwoDofSystem) -> None:
     """Velocity just after each impact (from the next segment's start state) is -R times the velocity before."""
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.3, PAPER_AMPLITUDE, 26.0)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.3), HarmonicForce(PAPER_AMPLITUDE, 26.0))
     trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 40)
     starts = trajectory.segments[:, 0]
     after = trajectory.segment_states[np.searchsorted(starts, trajectory.impact_times)]
@@ -126,21 +129,21 @@ def test_restitution_law_at_every_impact(system: TwoDofSystem) -> None:
 
 
 def test_rejects_a_start_inside_the_stop(system: TwoDofSystem) -> None:
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.3, PAPER_AMPLITUDE, 26.0)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.3), HarmonicForce(PAPER_AMPLITUDE, 26.0))
     with pytest.raises(ValueError, match="penetrates the stop"):
         ENGINE.integrate(problem, np.array([0.0, 0.004, 0.0, 0.0]), 0.0, 1)
 
 
 def test_problem_validation(system: TwoDofSystem) -> None:
     with pytest.raises(ValueError, match=r"restitution = 1.5 is out of range: allowed \[0, 1\]"):
-        ImpactProblem(system, PAPER_CLEARANCE, 1.5, PAPER_AMPLITUDE, 26.0)
+        ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 1.5), HarmonicForce(PAPER_AMPLITUDE, 26.0))
     with pytest.raises(ValueError, match="method = 'rk4' is not allowed"):
         EngineSettings(method="rk4")
 
 
 def test_energy_balance_with_sticking(system: TwoDofSystem) -> None:
     """Sticking phases do no work (X2' = 0): the balance still closes, with chatter losses included."""
-    problem = ImpactProblem(system, 1e-4, 0.3, PAPER_AMPLITUDE, 10.0)
+    problem = ImpactProblem(system, RigidStop(1e-4, 0.3), HarmonicForce(PAPER_AMPLITUDE, 10.0))
     trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 10)
     assert trajectory.stats["sticks"] > 5
     budget = energy_budget(trajectory)
@@ -182,14 +185,14 @@ def test_impacts_on_period_boundaries(engine: str) -> None:
 
 @pytest.mark.timeout(60)
 def test_rest_on_the_stop_without_forcing_does_not_livelock(system: TwoDofSystem) -> None:
-    problem = ImpactProblem(system, 0.0, 0.5, 0.0, 25.0)
+    problem = ImpactProblem(system, RigidStop(0.0, 0.5), HarmonicForce(0.0, 25.0))
     trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 3)
     assert trajectory.impact_times.size == 0  # and no livelock: the timeout mark bounds the run
 
 
 def test_impact_ending_in_sticking_transfers_m2_v(system: TwoDofSystem) -> None:
     """The absorber stops dead: the impulse is M2 v (not M2 (1 + R) v) and the balance still closes."""
-    problem = ImpactProblem(system, 1e-4, 0.3, PAPER_AMPLITUDE, 10.0)
+    problem = ImpactProblem(system, RigidStop(1e-4, 0.3), HarmonicForce(PAPER_AMPLITUDE, 10.0))
     trajectory = ENGINE.integrate(problem, np.zeros(4), 0.0, 5)
     stuck_starts = trajectory.segments[trajectory.segments[:, 2] == MODE_STUCK, 0]
     ending = np.isin(trajectory.impact_times, stuck_starts)
@@ -204,10 +207,10 @@ def test_resting_on_the_stop_with_round_off_holding_force_does_not_livelock() ->
     force evaluates to 5.6e-17 N of round-off; its sign once decided 'not pushed', and zero-speed elastic impacts
     repeated at t = 0 until the event budget ran out. Round-off-sized forces now leave the decision to the
     derivatives: the absorber is held, then released."""
-    from vibroimpact.engines.base import ImpactProblem
+    
 
     s = TwoDofSystem(m1=0.5, m2=0.34916140783976635, k1=10000.0, k2=10934.225385165902, b1=0.0, b2=0.13323645201253634)
-    problem = ImpactProblem(s, 0.0, 1.0, 0.5, 56.38618344739488, phase=0.0004942310000114958)
+    problem = ImpactProblem(s, RigidStop(0.0, 1.0), HarmonicForce(0.5, 56.38618344739488, phase=0.0004942310000114958))
     trajectory = ExactEngine().integrate(problem, np.zeros(4), 0.0, 3)
     assert trajectory.stats["releases"] >= 1 and trajectory.stats["events"] < 100
     assert np.all(trajectory.strobe_states[:, 1] <= 1e-15)

@@ -6,7 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vibroimpact.engines.base import MODE_STUCK, ImpactProblem
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.engines.base import MODE_STUCK
 
 from vibroimpact.engines.exact import ExactEngine
 
@@ -29,7 +32,7 @@ def test_agrees_with_exact_over_20_seconds(system: TwoDofSystem, method: str, fr
 
     (At 38 Hz with R = 0.2 the one-impact orbit is unstable and the motion sensitive to round-off: any two
     integrators part after a hundred impacts, so R = 0, whose orbit is stable, is used there.)"""
-    problem = ImpactProblem(system, PAPER_CLEARANCE, restitution, PAPER_AMPLITUDE, frequency)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, restitution), HarmonicForce(PAPER_AMPLITUDE, frequency))
     periods = int(20 * frequency)
     reference = ExactEngine().integrate(problem, np.zeros(4), 0.0, periods)
     trial = MomentaryEngine(EngineSettings(rtol=1e-10, atol=1e-14, method=method)).integrate(problem, np.zeros(4), 0.0, periods)
@@ -42,7 +45,7 @@ def test_agrees_with_exact_over_20_seconds(system: TwoDofSystem, method: str, fr
 
 def test_error_follows_the_tolerance(system: TwoDofSystem) -> None:
     """Tighter rtol, smaller error against exact: impact-time error drops by > 30x from rtol 1e-6 to 1e-9."""
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, 25.0)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.2), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     reference = ExactEngine().integrate(problem, np.zeros(4), 0.0, 100)
     errors = []
     for rtol in (1e-6, 1e-9):
@@ -55,7 +58,7 @@ def test_error_follows_the_tolerance(system: TwoDofSystem) -> None:
 def _grazing_problems(system: TwoDofSystem, margin: float) -> list[ImpactProblem]:
     frequency = 30.0
     amplitude_x2 = PAPER_AMPLITUDE * abs(linear_response(system, 2 * np.pi * frequency, 1.0).x2)
-    return [ImpactProblem(system, amplitude_x2 + margin, 0.9, PAPER_AMPLITUDE, frequency, phase=phase) for phase in np.linspace(0, 2 * np.pi, 24, endpoint=False)]
+    return [ImpactProblem(system, RigidStop(amplitude_x2 + margin, 0.9), HarmonicForce(PAPER_AMPLITUDE, frequency, phase=phase)) for phase in np.linspace(0, 2 * np.pi, 24, endpoint=False)]
 
 
 @pytest.mark.timeout(60)
@@ -84,7 +87,7 @@ def test_grazing_without_contact_gives_none(system: TwoDofSystem) -> None:
 @pytest.mark.parametrize("restitution", [0.0, 0.05, 0.3])
 def test_chattering_sticks_and_releases_like_exact(system: TwoDofSystem, restitution: float) -> None:
     """Quasi-static case (10 Hz, Delta = 0.1 mm): stick and release every period; stuck time as the exact engine's."""
-    problem = ImpactProblem(system, 1e-4, restitution, PAPER_AMPLITUDE, 10.0)
+    problem = ImpactProblem(system, RigidStop(1e-4, restitution), HarmonicForce(PAPER_AMPLITUDE, 10.0))
     trial = MomentaryEngine(TIGHT).integrate(problem, np.zeros(4), 0.0, 30)
     reference = ExactEngine().integrate(problem, np.zeros(4), 0.0, 30)
     assert trial.stats["sticks"] == reference.stats["sticks"] >= 29
@@ -99,7 +102,7 @@ def test_chattering_sticks_and_releases_like_exact(system: TwoDofSystem, restitu
 def test_elastic_undamped_conserves_energy() -> None:
     """R = 1 and no damping: the energy change equals the work of the force."""
     undamped = TwoDofSystem(m1=1.0, m2=0.1, k1=25_000.0, k2=4_300.0)
-    problem = ImpactProblem(undamped, 2e-3, 1.0, PAPER_AMPLITUDE, 25.0)
+    problem = ImpactProblem(undamped, RigidStop(2e-3, 1.0), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     trajectory = MomentaryEngine(TIGHT).integrate(problem, np.zeros(4), 0.0, 30)
     assert trajectory.impulses.size > 10
     budget = energy_budget(trajectory)
@@ -108,7 +111,7 @@ def test_elastic_undamped_conserves_energy() -> None:
 
 
 def test_energy_balance_damped(system: TwoDofSystem) -> None:
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.4, PAPER_AMPLITUDE, 26.0)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.4), HarmonicForce(PAPER_AMPLITUDE, 26.0))
     budget = energy_budget(MomentaryEngine(TIGHT).integrate(problem, np.zeros(4), 0.0, 20))
     balance = budget["work"] - budget["dissipation"] - budget["impact_loss"]
     assert budget["impact_loss"] > 0.01 * budget["work"]
@@ -116,7 +119,7 @@ def test_energy_balance_damped(system: TwoDofSystem) -> None:
 
 
 def test_restitution_law_at_every_impact(system: TwoDofSystem) -> None:
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.3, PAPER_AMPLITUDE, 26.0)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.3), HarmonicForce(PAPER_AMPLITUDE, 26.0))
     trajectory = MomentaryEngine().integrate(problem, np.zeros(4), 0.0, 40)
     after = trajectory.segment_states[np.searchsorted(trajectory.segments[:, 0], trajectory.impact_times)]
     np.testing.assert_allclose(after[:, 3], -0.3 * trajectory.impact_velocities, rtol=1e-14)
@@ -125,7 +128,7 @@ def test_restitution_law_at_every_impact(system: TwoDofSystem) -> None:
 
 @pytest.mark.timeout(60)
 def test_zero_clearance(system: TwoDofSystem) -> None:
-    problem = ImpactProblem(system, 0.0, 0.5, PAPER_AMPLITUDE, 25.0)
+    problem = ImpactProblem(system, RigidStop(0.0, 0.5), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     trial = MomentaryEngine(TIGHT).integrate(problem, np.zeros(4), 0.0, 40)
     reference = ExactEngine().integrate(problem, np.zeros(4), 0.0, 40)
     assert trial.impact_times.size == reference.impact_times.size >= 30
@@ -134,7 +137,7 @@ def test_zero_clearance(system: TwoDofSystem) -> None:
 
 @pytest.mark.timeout(60)
 def test_far_clearance_is_the_linear_solution(system: TwoDofSystem) -> None:
-    problem = ImpactProblem(system, 1.0, 0.2, PAPER_AMPLITUDE, 23.0)
+    problem = ImpactProblem(system, RigidStop(1.0, 0.2), HarmonicForce(PAPER_AMPLITUDE, 23.0))
     start = linear_state(problem)
     trajectory = MomentaryEngine(TIGHT).integrate(problem, start, 0.0, 50)
     assert trajectory.impact_times.size == 0
@@ -144,7 +147,7 @@ def test_far_clearance_is_the_linear_solution(system: TwoDofSystem) -> None:
 @pytest.mark.timeout(60)
 def test_start_at_the_stop_moving_into_it(system: TwoDofSystem) -> None:
     """CVODE reports no root at its initial time: the engine applies the contact itself, like exact does."""
-    problem = ImpactProblem(system, 1e-3, 0.5, PAPER_AMPLITUDE, 25.0)
+    problem = ImpactProblem(system, RigidStop(1e-3, 0.5), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     state = np.array([0.0, 1e-3, 0.0, 0.1])
     for engine in (MomentaryEngine(), ExactEngine()):
         trajectory = engine.integrate(problem, state, 0.0, 2)
@@ -155,5 +158,5 @@ def test_start_at_the_stop_moving_into_it(system: TwoDofSystem) -> None:
 
 @pytest.mark.timeout(60)
 def test_rest_on_the_stop_without_forcing(system: TwoDofSystem) -> None:
-    problem = ImpactProblem(system, 0.0, 0.5, 0.0, 25.0)
+    problem = ImpactProblem(system, RigidStop(0.0, 0.5), HarmonicForce(0.0, 25.0))
     assert MomentaryEngine().integrate(problem, np.zeros(4), 0.0, 3).impact_times.size == 0

@@ -10,8 +10,9 @@ import math
 
 import numpy as np
 
+from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.contact import restitution_from_loss_factor
-from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, ImpactProblem, Trajectory
+from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory
 from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.compliant.ida import MODE_CONTACT

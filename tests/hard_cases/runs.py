@@ -42,10 +42,10 @@ class Run:
 
 
 def run_case(case: HardCase, engine: str) -> Run:
-    solver = build_engine(engine, case)
+    solver = build_engine(engine)
     t0, state = case.start
     started = time.perf_counter()
-    trajectory = solver.integrate(case.problem, state, t0, case.periods, moments=True)
+    trajectory = solver.integrate(case.problem_for(engine), state, t0, case.periods, moments=True)
     return Run(case, engine, trajectory, time.perf_counter() - started)
 
 

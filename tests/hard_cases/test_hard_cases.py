@@ -1,6 +1,6 @@
 """The table of hard cases (``cases.py``) run against every engine: each (case, engine) pair is one test.
 
-The default tier runs the reference ``exact`` and the default integrator (``momentary`` Adams) on every case; the
+The default tier runs the reference ``exact`` and the default integrator (``momentary_adams``) on every case; the
 other engines' rows are the ``hard`` tier (``pytest -m hard``), and the longest runs the ``slow`` tier.
 
 A pair whose engine does not apply is reported as skipped with the table's reason; nothing is left out silently
@@ -19,7 +19,7 @@ from .runs import exact_run, measure, run_case
 
 
 #: Engines whose rows run in the default tier; the rest of the table is the ``hard`` tier (``pytest -m hard``).
-DEFAULT_TIER_ENGINES = ("exact", "adams")
+DEFAULT_TIER_ENGINES = ("exact", "momentary_adams")
 
 
 def _params() -> list:

@@ -7,9 +7,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.study import cases as simulate
 from vibroimpact.engines.exact import ExactEngine
-from vibroimpact.engines.base import ImpactProblem
+
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.momentary import MomentaryEngine
 from vibroimpact.analysis.linear import linear_response
@@ -36,7 +39,7 @@ def pgf_values(system: TwoDofSystem, frequency: float, restitution: float) -> di
 @pytest.mark.parametrize(("frequency", "restitution"), [(25.0, 0.2), (26.0, 0.6), (40.0, 0.2), (22.0, 0.0)])
 def test_exact_steady_state_equals_pgf(system: TwoDofSystem, frequency: float, restitution: float) -> None:
     """At stable points the exact engine's measured steady state is the closed-form solution to ~1e-9."""
-    problem = ImpactProblem(system, PAPER_CLEARANCE, restitution, PAPER_AMPLITUDE, frequency)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, restitution), HarmonicForce(PAPER_AMPLITUDE, frequency))
     result = steady_state(ExactEngine(), problem, "pgf", SteadySettings(tolerance=1e-11, max_periods=3000))
     expected = pgf_values(system, frequency, restitution)
     m = result.measures
@@ -48,7 +51,7 @@ def test_exact_steady_state_equals_pgf(system: TwoDofSystem, frequency: float, r
 
 
 def test_momentary_steady_state_equals_pgf_to_its_tolerance(system: TwoDofSystem) -> None:
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, 25.0)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.2), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     result = steady_state(MomentaryEngine(EngineSettings(rtol=1e-10, atol=1e-14)), problem, "pgf", SteadySettings(tolerance=1e-9))
     expected = pgf_values(system, 25.0, 0.2)
     assert result.converged
@@ -57,7 +60,7 @@ def test_momentary_steady_state_equals_pgf_to_its_tolerance(system: TwoDofSystem
 
 
 def test_linear_point_is_answered_without_integrating(system: TwoDofSystem) -> None:
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, 30.0)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.2), HarmonicForce(PAPER_AMPLITUDE, 30.0))
     result = steady_state(ExactEngine(), problem, "linear")
     assert not result.integrated and result.periods_used == 0
     assert abs(result.measures.x1) == pytest.approx(abs(linear_response(system, problem.omega, PAPER_AMPLITUDE).x1), rel=1e-15)
@@ -65,7 +68,7 @@ def test_linear_point_is_answered_without_integrating(system: TwoDofSystem) -> N
 
 def test_measured_linear_motion_has_exact_harmonics_and_rms(system: TwoDofSystem) -> None:
     """Integrating the linear steady state (no contact) measures its amplitude and RMS = amplitude / sqrt 2 exactly."""
-    problem = ImpactProblem(system, 1.0, 0.2, PAPER_AMPLITUDE, 30.0)
+    problem = ImpactProblem(system, RigidStop(1.0, 0.2), HarmonicForce(PAPER_AMPLITUDE, 30.0))
     response = linear_response(system, problem.omega, PAPER_AMPLITUDE)
     state = np.array([response.x1.real, response.x2.real, (1j * problem.omega * response.x1).real, (1j * problem.omega * response.x2).real])
     result = steady_state(ExactEngine(), problem, (0.0, state), SteadySettings(tolerance=1e-10))
@@ -79,14 +82,14 @@ def test_measured_linear_motion_has_exact_harmonics_and_rms(system: TwoDofSystem
 @pytest.mark.parametrize("engine", [ExactEngine(), MomentaryEngine()])
 def test_unstable_pgf_orbit_is_left(system: TwoDofSystem, engine: object) -> None:
     """At 38 Hz (R = 0.2, Floquet modulus 1.108) a start next to the orbit does not stay on it."""
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, 38.0)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.2), HarmonicForce(PAPER_AMPLITUDE, 38.0))
     result = steady_state(engine, problem, "pgf", SteadySettings(max_periods=300))  # type: ignore[arg-type]
     expected = pgf_values(system, 38.0, 0.2)
     assert not (result.converged and abs(abs(result.measures.x1) - expected["x1"]) < 1e-3 * expected["x1"])
 
 
 def _case(system: TwoDofSystem, start: str, engine: str = "exact", frequencies: tuple[float, ...] = (24.0, 24.5, 25.0, 25.5)) -> SimulationCase:
-    return SimulationCase(engine, system, PAPER_AMPLITUDE, 0.2, PAPER_CLEARANCE, frequencies, start, EngineSettings(), SteadySettings(tolerance=1e-9, max_periods=2000))
+    return SimulationCase(engine, system, PAPER_AMPLITUDE, RigidStop(PAPER_CLEARANCE, 0.2), frequencies, start, EngineSettings(), SteadySettings(tolerance=1e-9, max_periods=2000))
 
 
 @pytest.mark.parametrize("start", ["sweep_up", "sweep_down"])
@@ -128,10 +131,10 @@ def test_a_failing_point_costs_only_itself(system: TwoDofSystem, monkeypatch: py
     """An engine failure at one frequency leaves NaN there, flagged, and the other points of the case are kept."""
     real = simulate.steady_state
 
-    def flaky(engine: object, problem: ImpactProblem, start: object, settings: SteadySettings) -> object:
+    def flaky(engine: object, problem: ImpactProblem, start: object, settings: SteadySettings, orbit_stop: object = None) -> object:
         if problem.frequency == 25.0:  # exact: a grid value
             raise RuntimeError("CVODE failed (simulated)")
-        return real(engine, problem, start, settings)  # type: ignore[arg-type]
+        return real(engine, problem, start, settings, orbit_stop)  # type: ignore[arg-type]
 
     monkeypatch.setattr(simulate, "steady_state", flaky)
     result = simulate.run_case(_case(system, "sweep_up"))

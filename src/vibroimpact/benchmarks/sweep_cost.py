@@ -29,10 +29,11 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from vibroimpact.model.contact import loss_factor_from_restitution
-from vibroimpact.engines.settings import EngineSettings
-from vibroimpact.engines.compliant.ida import CompliantEngine, SweepRecord
-from vibroimpact.engines.settings import SWEEP_SETTINGS
+from vibroimpact.model.contact import KelvinVoigtBumper, loss_factor_from_restitution
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.engines.base import SweepRecord
+from vibroimpact.engines.registry import make_engine
+from vibroimpact.engines.settings import SWEEP_SETTINGS, EngineSettings
 from vibroimpact.engines.compliant.ivp import IVP_METHODS, solve_ivp_sweep
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.simulation.harmonics import running_fundamental
@@ -109,17 +110,17 @@ def run_sweep_cost(settings: SweepCostSettings = SweepCostSettings(), log: Calla
         Receives a line of progress per run.
     """
     s = settings
-    xi = loss_factor_from_restitution(s.restitution)
+    bumper = KelvinVoigtBumper(s.clearance, s.bumper_frequency, loss_factor_from_restitution(s.restitution))
     tolerances = s.engine_settings
 
     def ida(sweep: SweptSine, engine_settings: EngineSettings = tolerances) -> tuple[SweepRecord, float]:
         started = time.perf_counter()
-        record = CompliantEngine(s.bumper_frequency, xi, engine_settings).sweep(s.system, s.clearance, sweep, s.sample_rate)
+        record = make_engine("compliant", engine_settings).sweep(ImpactProblem(s.system, bumper, sweep), s.sample_rate)
         return record, time.perf_counter() - started
 
     def ivp(sweep: SweptSine, method: str) -> tuple[SweepRecord, float]:
         started = time.perf_counter()
-        record = solve_ivp_sweep(s.system, s.clearance, s.bumper_frequency, xi, sweep, s.sample_rate, method, tolerances.rtol, tolerances.atol)
+        record = solve_ivp_sweep(ImpactProblem(s.system, bumper, sweep), s.sample_rate, method, tolerances.rtol, tolerances.atol)
         return record, time.perf_counter() - started
 
     rows: list[dict[str, object]] = []
