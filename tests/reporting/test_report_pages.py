@@ -13,12 +13,12 @@ import pytest
 
 from vibroimpact.reporting.reduction import DEFINITION
 from vibroimpact.analysis.regime import Regime
-from vibroimpact.reporting import report
-from vibroimpact.reporting.report import page_sections
+from vibroimpact.reporting import page as page_module
+from vibroimpact.reporting.report import page_for
 from vibroimpact.reporting.page import DrawnFigure, Figure, Section, Table, render_page, save_figure
 from vibroimpact.reporting.tables import reduction_tables
 
-from tests.reporting.test_report_support import scene_of, steady_dataset, swept_dataset
+from tests.reporting.test_report_support import setting_of, steady_dataset, swept_dataset
 
 
 def _rows(table_html: str) -> list[list[str]]:
@@ -34,10 +34,10 @@ def _pair(cell: str) -> tuple[int, int]:
 def test_undefined_points_are_computed_points_without_a_value() -> None:
     """Points a simulation never ran (regime not_computed, 90 % here) are not counted as undefined."""
     ds = steady_dataset()
-    scene = scene_of(ds)
-    split = scene.system.antiresonance_frequency() / (2.0 * np.pi)
+    setting = setting_of(ds)
+    split = setting.system.antiresonance_frequency() / (2.0 * np.pi)
     bands = (ds["frequency"].values < split, ds["frequency"].values >= split)
-    table = next(t for t in reduction_tables(ds, scene) if "|X1|" in t.title)
+    table = next(t for t in reduction_tables(ds, setting) if "|X1|" in t.title)
     header, *rows = _rows(table.html)
     column = {name: i for i, name in enumerate(header)}
     checked = 0
@@ -68,7 +68,7 @@ def test_contents_link_every_section_figure_and_table(tmp_path: Path) -> None:
     assert len(links) == 2 + 1 + 2 + 1  # two sections, a figure, two tables, the scene
 
 
-def _quick_save(drawn: DrawnFigure, out_dir: Path) -> Figure:
+def quick_save(drawn: DrawnFigure, out_dir: Path) -> Figure:
     """Stands in for the PNG writer where only the page's composition is tested (rendering PNGs takes seconds)."""
     plt.close(drawn.figure)
     path = Path(out_dir) / f"{drawn.name}.png"
@@ -77,11 +77,10 @@ def _quick_save(drawn: DrawnFigure, out_dir: Path) -> Figure:
 
 
 def test_sweep_page_has_contents_and_explains_only_what_it_shows(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(report, "save_figure", _quick_save)
+    monkeypatch.setattr(page_module, "save_figure", quick_save)
     ds = swept_dataset()
-    scene = scene_of(ds)
-    sections = page_sections(ds, scene, tmp_path)
-    page = render_page("sweep", [], sections, scene.text)
+    sections = page_for(ds).sections(tmp_path)
+    page = render_page("sweep", [], sections, ds.attrs["scene"])
     titles = [s.title for s in sections]
     assert titles == ["Linear system", "Swept sine against the steady states"]
     assert "<nav id='contents'>" in page

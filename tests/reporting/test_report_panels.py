@@ -13,8 +13,9 @@ import xarray as xr
 
 from vibroimpact.reporting.bumper_page import peak_acceleration_figure
 from vibroimpact.reporting.responses import response_figure, simulation_figure
-from vibroimpact.scene.core import ENGINE_SOLUTIONS, parse_scene, read_yaml
-from vibroimpact.reporting.sweep_page import sweep_figures
+from vibroimpact.reporting.record import study_setting
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS
+from vibroimpact.reporting.sweep_page import sweep_figures, swept_sine_run
 
 from tests.reporting.test_report_support import shown_points, steady_dataset, swept_dataset
 
@@ -77,8 +78,7 @@ def test_peak_contact_panels_show_the_simulation_and_the_estimate() -> None:
 
 def test_sweep_panels_show_both_sweeps_and_the_steady_states() -> None:
     ds = swept_dataset()
-    scene = parse_scene(read_yaml(ds.attrs["scene"]), text=ds.attrs["scene"])
-    figures = {drawn.name: drawn for drawn in sweep_figures(ds, scene)}
+    figures = {drawn.name: drawn for drawn in sweep_figures(ds, swept_sine_run(ds, study_setting(ds)))}
     assert {"sweep_displacements", "sweep_force_impulse", "sweep_regime", "sweep_time"} <= set(figures)
     f = ds["frequency"].values
     panels = {"sweep_displacements": ("x1_amplitude", "x2_amplitude"), "sweep_force_impulse": ("force_amplitude", "impulse", "impacts_per_period")}

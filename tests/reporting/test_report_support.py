@@ -22,10 +22,11 @@ from matplotlib.lines import Line2D
 from matplotlib.text import Text
 
 from vibroimpact.analysis.regime import Regime, regime_attributes
+from vibroimpact.reporting.record import StudySetting, study_setting
 from vibroimpact.reporting.style import DPI, FIGURE_WIDTH
-from vibroimpact.scene.core import parse_scene
+from vibroimpact.scene import parse_scene
 from vibroimpact.study.run import run_study
-from vibroimpact.study.swept_cases import SWEEP_QUANTITIES
+from vibroimpact.simulation.swept import SWEEP_QUANTITIES
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
 
@@ -145,13 +146,16 @@ def swept_dataset() -> xr.Dataset:
     dataset["running_x1_amplitude"] = (("sweep", "elapsed_time"), np.vstack([np.full(time.size, 2e-3), np.full(time.size, 1.5e-3)]))
     for stat, value in (("wall_time", 3.0), ("steps", 1e4), ("contacts", 200.0), ("rhs_calls", 2e4), ("linear_start", 1.0), ("failed", 0.0)):
         dataset[f"sweep_{stat}"] = ("sweep", [value, value])
-    dataset.attrs = dict(closed.attrs, scene=yaml.safe_dump(document))
+    sweep = document["swept_sine"]
+    # what a swept-sine study stores of its sweep (the closed forms alone were run without it)
+    stored = {"start_frequency": sweep["start"], "stop_frequency": sweep["stop"], "rate": sweep["rate"], "directions": np.array(["up", "down"]), "sample_rate": sweep["sample_rate"], "window_cycles": 8, "initial_state": "linear"}
+    dataset.attrs = dict(closed.attrs, scene=yaml.safe_dump(document), study_kind="swept", **{f"swept_sine_{key}": value for key, value in stored.items()})
     return dataset
 
 
 @functools.cache
 def benchmark_dataset() -> xr.Dataset:
-    """Just what the work-precision figure reads: two cases, three methods, four tolerances."""
+    """What the benchmark page reads (made up): two cases, three methods, four tolerances."""
     cases, engines, rtol = ["one_impact", "irregular"], ["momentary_adams", "compliant_ida", "solve_ivp_DOP853"], [1e-4, 1e-6, 1e-8, 1e-10]
     shape = (len(cases), len(engines), len(rtol))
     wall = np.broadcast_to(np.array([0.1, 0.2, 0.4, 0.8]), shape) * np.array([1.0, 2.0, 3.0])[None, :, None]
@@ -165,9 +169,16 @@ def benchmark_dataset() -> xr.Dataset:
             "x1_error": (dims, error),
             "impact_time_error": (dims, error * 1e-3),
             "missed_impacts": (dims, missed),
+            "extra_impacts": (dims, np.zeros(shape)),
+            "impacts": (dims, np.full(shape, 40.0)),
+            "steps": (dims, np.full(shape, 1000.0)),
+            "rhs_calls": (dims, np.full(shape, 3000.0)),
+            "impulse_error": (dims, error * 10.0),
             "reference_wall_time": (("case", "reference"), np.array([[0.05, np.nan], [0.05, 1.0]])),
+            "reference_impacts": (("case", "reference"), np.array([[40.0, np.nan], [40.0, 40.0]])),
         },
         coords={"case": cases, "engine": engines, "rtol": rtol, "reference": ["exact", "compliant_cvode_adams"]},
+        attrs={"scene_name": "tiny_benchmark", "scene": "name: tiny_benchmark\ndescription: made up\n", "vibroimpact_version": "0.1.0"},
     )
 
 
@@ -195,15 +206,13 @@ def stiffness_dataset() -> xr.Dataset:
     return xr.Dataset(
         {"x1_amplitude": (dims, x1), "wall_time": (dims, wall), "regime": (dims, np.full((3, 3, 2), int(Regime.ONE_IMPACT), dtype=np.int8))},
         coords={"solution": ["pgf", "exact", "compliant"], "bumper_frequency": bumper, "frequency": [24.0, 25.0], "restitution": 0.2, "clearance": 0.003},
-        attrs={"scene": yaml.safe_dump(document)},
+        attrs={"scene_name": document["name"], "scene": yaml.safe_dump(document), "excitation_amplitude_N": 10.0, **{f"system_{key}": value for key, value in PAPER_SYSTEM_SPEC.items()}},
     )
 
 
-def scene_of(dataset: xr.Dataset) -> Any:
-    """The scene stored in ``dataset``."""
-    from vibroimpact.scene.core import read_yaml
-
-    return parse_scene(read_yaml(dataset.attrs["scene"]), text=dataset.attrs["scene"])
+def setting_of(dataset: xr.Dataset) -> StudySetting:
+    """What ``dataset`` says of its system, excitation and grids."""
+    return study_setting(dataset)
 
 
 def _one_regime_panel() -> xr.Dataset:
@@ -216,14 +225,14 @@ def _builders() -> dict[str, Callable[[], list[Any]]]:
     from vibroimpact.reporting.accuracy_page import accuracy_figures
     from vibroimpact.reporting.bumper_page import peak_acceleration_figure, peak_figure, stiffness_figure
     from vibroimpact.reporting.responses import linear_figure, regime_figure, response_figure, simulation_figure, stability_figure
-    from vibroimpact.scene.core import ENGINE_SOLUTIONS
-    from vibroimpact.reporting.sweep_page import sweep_figures
+    from vibroimpact.scene.schema import ENGINE_SOLUTIONS
+    from vibroimpact.reporting.sweep_page import sweep_figures, swept_sine_run
 
     def steady() -> xr.Dataset:
         return steady_dataset()
 
     return {
-        "linear": lambda: [linear_figure(scene_of(steady()))],
+        "linear": lambda: [linear_figure(setting_of(steady()))],
         "response_x1": lambda: [response_figure(steady(), "x1_amplitude", "x1")],
         "response_force": lambda: [response_figure(steady(), "force_amplitude", "force")],
         "response_impulse": lambda: [response_figure(steady(), "impulse", "impulse")],
@@ -234,9 +243,9 @@ def _builders() -> dict[str, Callable[[], list[Any]]]:
         "simulation_x1": lambda: [simulation_figure(steady(), "x1_amplitude", list(ENGINE_SOLUTIONS), "sim")],
         "simulation_impulse": lambda: [simulation_figure(steady(), "impulse", list(ENGINE_SOLUTIONS), "sim")],
         "peak_acceleration": lambda: [peak_acceleration_figure(steady(), "peak")],
-        "peaks_vs_restitution": lambda: [peak_figure(steady(), scene_of(steady()), "restitution", "peaks")],
-        "sweep": lambda: sweep_figures(swept_dataset(), scene_of(swept_dataset())),
-        "stiffness": lambda: [stiffness_figure(stiffness_dataset(), scene_of(stiffness_dataset()), "stiffness")],
+        "peaks_vs_restitution": lambda: [peak_figure(steady(), setting_of(steady()), "restitution", "peaks")],
+        "sweep": lambda: sweep_figures(swept_dataset(), swept_sine_run(swept_dataset(), setting_of(swept_dataset()))),
+        "stiffness": lambda: [stiffness_figure(stiffness_dataset(), setting_of(stiffness_dataset()), "stiffness")],
         "work_precision": lambda: accuracy_figures(benchmark_dataset()),
     }
 

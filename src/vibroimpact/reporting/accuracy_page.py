@@ -14,10 +14,10 @@ import numpy as np
 import xarray as xr
 
 from vibroimpact.benchmarks.accuracy import equal_error_speedup, loosest_tolerance
-from vibroimpact.reporting.page import DrawnFigure, Table
+from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.reporting.style import Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour
 
-__all__ = ["accuracy_figures", "accuracy_tables", "TARGETS"]
+__all__ = ["AccuracyPage", "accuracy_figures", "accuracy_tables", "TARGETS"]
 
 #: X1-fundamental accuracies the guidance is given for [-].
 TARGETS = (1e-3, 1e-6)
@@ -30,6 +30,27 @@ _REFERENCES = {
 _ERRORS = (("x1_error", "relative error of the X1 fundamental [1]"), ("impact_time_error", "largest impact-time error [s]"))
 
 
+class AccuracyPage:
+    """The page of a benchmark study: work-precision diagrams, tolerance guidance, the ladder and every point.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        The benchmark's dataset (dimensions ``case``, ``engine``, ``rtol``).
+    """
+
+    def __init__(self, dataset: xr.Dataset) -> None:
+        self.dataset = dataset
+
+    def summary(self) -> str:
+        """The methods measured."""
+        return f"methods: {', '.join(map(str, self.dataset['engine'].values))}"
+
+    def sections(self, out: Path) -> list[Section]:
+        """One section: the work-precision diagrams and every table."""
+        return [Section("Work-precision", figures=saved(accuracy_figures(self.dataset), out), tables=accuracy_tables(self.dataset))]
+
+
 def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
     """Work-precision diagrams: X1 error and impact-time error against wall time, one row of two panels per case."""
     cases = [str(c) for c in dataset["case"].values]
@@ -37,7 +58,7 @@ def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
     fig, axes = new_figure(2 * len(cases), panel_height=3.6, legend_rows=legend_rows(len(methods) + 4))
     tolerances = np.sort(np.asarray(dataset["rtol"].values, dtype=float))[::-1]
     caption = Caption(
-        f"Work-precision, one row per case: one point per tolerance (rtol {tolerances[0]:.0e} ... {tolerances[-1]:.0e} from right to "
+        f"Work-precision, one row per case: one point per tolerance (rtol {fmt(tolerances[0], '.0e')} ... {fmt(tolerances[-1], '.0e')} from right to "
         "left), error against the reference, wall time the median of repeated runs in one process (read ratios, not seconds)."
     )
     for j, case in enumerate(cases):
@@ -65,7 +86,7 @@ def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
             if quantity == "x1_error":
                 for target in TARGETS:
                     ax.axhline(target, color="k", lw=0.6, alpha=0.5)
-                caption.add("targets", f"Thin horizontal lines: the {' and '.join(f'{t:.0e}' for t in TARGETS)} targets.")
+                caption.add("targets", f"Thin horizontal lines: the {' and '.join(fmt(t, '.0e') for t in TARGETS)} targets.")
             finish_axes(ax, "wall time [s] (median)", label, case)
     figure_legend(fig, axes, columns=4)
     return [DrawnFigure(fig, "work_precision", "Work-precision diagrams", caption.text())]
@@ -113,8 +134,8 @@ def _answer_table(dataset: xr.Dataset) -> str:
             other, other_rtol, other_wall = _cheapest(dataset, str(case), target, ivp)
             speedup = other_wall / wall if name and other else math.nan
             rows.append(
-                f"<tr><td>{case}</td><td>{target:g}</td><td>{name or 'none reaches it'}</td><td>{fmt(rtol, 'g')}</td><td>{fmt(wall)}</td>"
-                f"<td>{other or 'none reaches it'}</td><td>{fmt(other_rtol, 'g')}</td><td>{fmt(other_wall)}</td><td>{'' if not math.isfinite(speedup) else f'{speedup:.1f}x'}</td>"
+                f"<tr><td>{case}</td><td>{fmt(target, 'g')}</td><td>{name or 'none reaches it'}</td><td>{fmt(rtol, 'g')}</td><td>{fmt(wall)}</td>"
+                f"<td>{other or 'none reaches it'}</td><td>{fmt(other_rtol, 'g')}</td><td>{fmt(other_wall)}</td><td>{fmt(speedup, '.1f', '{}x')}</td>"
                 f"<td>{fmt(exact)}</td></tr>"
             )
     note = (
@@ -131,14 +152,14 @@ def _answer_table(dataset: xr.Dataset) -> str:
 
 def _guidance_table(dataset: xr.Dataset) -> str:
     """Per method: the loosest rtol meeting each target in each case, and its wall time [s] (HTML)."""
-    header = "<tr><th>engine</th>" + "".join(f"<th>{case}: rtol for {t:g}</th>" for case in dataset["case"].values for t in TARGETS) + "</tr>"
+    header = "<tr><th>engine</th>" + "".join(f"<th>{case}: rtol for {fmt(t, 'g')}</th>" for case in dataset["case"].values for t in TARGETS) + "</tr>"
     rows = [header]
     for method in dataset["engine"].values:
         cells = []
         for case in dataset["case"].values:
             for target in TARGETS:
                 rtol, wall = loosest_tolerance(dataset, str(case), str(method), target)
-                cells.append(f"<td>{fmt(rtol, 'g')}{'' if not math.isfinite(wall) else f' ({wall:.3g} s)'}</td>")
+                cells.append(f"<td>{fmt(rtol, 'g')}{fmt(wall, '.3g', ' ({} s)')}</td>")
         rows.append(f"<tr><td>{method}</td>{''.join(cells)}</tr>")
     return "<table>" + "".join(rows) + "</table>"
 
@@ -158,8 +179,8 @@ def _equal_error_table(dataset: xr.Dataset) -> str:
                 continue
             ratio, other = equal_error_speedup(dataset, str(case), "momentary_adams", float(tolerance), ivp)
             rows.append(
-                f"<tr><td>{case}</td><td>{float(tolerance):g}</td><td>{wall:.4f}</td><td>{exact:.4f}</td><td>{wall / exact:.1f}</td>"
-                f"<td>{other}</td><td>{'' if not math.isfinite(ratio) else f'{ratio:.2f}'}</td></tr>"
+                f"<tr><td>{case}</td><td>{fmt(tolerance, 'g')}</td><td>{fmt(wall, '.4f')}</td><td>{fmt(exact, '.4f')}</td><td>{fmt(wall / exact, '.1f')}</td>"
+                f"<td>{other}</td><td>{fmt(ratio, '.2f')}</td></tr>"
             )
     return "<table>" + "".join(rows) + "</table>"
 
@@ -172,8 +193,8 @@ def _ladder_table(dataset: xr.Dataset) -> str:
         point = dataset.sel(model=model)
         wall = float(point["ladder_wall_time"])
         rows.append(
-            f"<tr><td>{model}</td><td>{wall:.3g}</td><td>{float(point['ladder_x1_amplitude']):.6e}</td>"
-            f"<td>{float(point['ladder_x1_difference']):.2e}</td><td>{wall / exact_wall:.3g}</td></tr>"
+            f"<tr><td>{model}</td><td>{fmt(wall)}</td><td>{fmt(point['ladder_x1_amplitude'], '.6e')}</td>"
+            f"<td>{fmt(point['ladder_x1_difference'], '.2e')}</td><td>{fmt(wall / exact_wall)}</td></tr>"
         )
     return "<table>" + "".join(rows) + "</table>" + f"<p>{dataset.attrs.get('ladder_description', '')}</p>"
 
@@ -181,7 +202,7 @@ def _ladder_table(dataset: xr.Dataset) -> str:
 def _estimate_table(results: Path = Path("results")) -> str:
     """Predicted wall time (without the report) of each shipped study against its last run in ``results/``."""
     from vibroimpact.study.estimate import estimate_scene
-    from vibroimpact.scene.core import load_scene, shipped_studies_dir
+    from vibroimpact.scene import load_scene, shipped_studies_dir
 
     rows = ["<tr><th>study</th><th>predicted [s]</th><th>measured [s]</th><th>measured / predicted</th><th>processes</th></tr>"]
     for path in sorted(shipped_studies_dir().glob("*.yaml")):
@@ -196,7 +217,7 @@ def _estimate_table(results: Path = Path("results")) -> str:
             continue
         estimate = estimate_scene(scene, jobs=jobs)
         predicted = estimate.wall_time - estimate.parts.get("report", 0.0)
-        rows.append(f"<tr><td>{scene.name}</td><td>{predicted:.0f}</td><td>{measured:.0f}</td><td>{measured / predicted:.2f}</td><td>{jobs}</td></tr>")
+        rows.append(f"<tr><td>{scene.name}</td><td>{fmt(predicted, '.0f')}</td><td>{fmt(measured, '.0f')}</td><td>{fmt(measured / predicted, '.2f')}</td><td>{jobs}</td></tr>")
     note = "<p>Measured: the run_wall_time_s of results/NAME/NAME.nc (dataset written, report excluded) from this machine's last run of each study.</p>"
     return "<table>" + "".join(rows) + "</table>" + note
 
@@ -210,12 +231,12 @@ def _points_table(dataset: xr.Dataset, case: str) -> str:
             if not np.isfinite(float(p["wall_time"])):
                 continue
             rows.append(
-                f"<tr><td>{method}</td><td>{float(tolerance):g}</td><td>{float(p['wall_time']):.4f}</td><td>{fmt(p['steps'], '.0f')}</td><td>{fmt(p['rhs_calls'], '.0f')}</td>"
-                f"<td>{fmt(p['impacts'], '.0f')}</td><td>{fmt(p['missed_impacts'], '.0f')}</td><td>{fmt(p['extra_impacts'], '.0f')}</td><td>{float(p['x1_error']):.2e}</td>"
-                f"<td>{float(p['impact_time_error']):.2e}</td><td>{float(p['impulse_error']):.2e}</td></tr>"
+                f"<tr><td>{method}</td><td>{fmt(tolerance, 'g')}</td><td>{fmt(p['wall_time'], '.4f')}</td><td>{fmt(p['steps'], '.0f')}</td><td>{fmt(p['rhs_calls'], '.0f')}</td>"
+                f"<td>{fmt(p['impacts'], '.0f')}</td><td>{fmt(p['missed_impacts'], '.0f')}</td><td>{fmt(p['extra_impacts'], '.0f')}</td><td>{fmt(p['x1_error'], '.2e')}</td>"
+                f"<td>{fmt(p['impact_time_error'], '.2e')}</td><td>{fmt(p['impulse_error'], '.2e')}</td></tr>"
             )
     for reference in dataset["reference"].values:
         wall = float(dataset["reference_wall_time"].sel(case=case, reference=reference))
         if math.isfinite(wall):
-            rows.append(f"<tr><td>reference: {reference}</td><td></td><td>{wall:.4f}</td><td></td><td></td><td>{fmt(dataset['reference_impacts'].sel(case=case, reference=reference), '.0f')}</td><td>0</td><td>0</td><td>0</td><td>0</td><td>0</td></tr>")
+            rows.append(f"<tr><td>reference: {reference}</td><td></td><td>{fmt(wall, '.4f')}</td><td></td><td></td><td>{fmt(dataset['reference_impacts'].sel(case=case, reference=reference), '.0f')}</td><td>0</td><td>0</td><td>0</td><td>0</td><td>0</td></tr>")
     return "<table>" + "".join(rows) + "</table>"

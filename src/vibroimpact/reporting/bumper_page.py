@@ -4,12 +4,15 @@
 * peak contact deceleration and force against frequency, simulation against the PGF-based estimate (figure 28);
 * convergence of the compliant model to the rigid-stop one as the bumper stiffens, and what it costs.
 
-The swept-sine page is :mod:`vibroimpact.sweep_report`.
+The peak figures are part of the frequency-response page (:mod:`vibroimpact.reporting.stepped_page`); a study along
+the bumper frequency has a page of its own, :class:`BumperStiffnessPage`. The swept-sine page is
+:mod:`vibroimpact.reporting.sweep_page`.
 """
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import xarray as xr
@@ -18,13 +21,14 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import NullFormatter
 
 from vibroimpact.analysis.regime import Regime
-from vibroimpact.reporting.page import DrawnFigure, Table
-from vibroimpact.reporting.responses import clearance_text, series_by_restitution
-from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_points, periodic_points, split_frequency, stability_keys, unstable_points
+from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
+from vibroimpact.reporting.record import StudySetting
+from vibroimpact.reporting.responses import SolutionsPage, clearance_text, linear_section, series_by_restitution
+from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_points, periodic_points, stability_keys, unstable_points
 from vibroimpact.reporting.style import QUANTITIES, SOLUTION_COLOURS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref
-from vibroimpact.scene.core import ENGINE_SOLUTIONS, Scene
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 
-__all__ = ["peak_figure", "peak_tables", "peak_acceleration_figure", "stiffness_figure", "stiffness_tables", "band_peaks"]
+__all__ = ["BumperStiffnessPage", "peak_figure", "peak_tables", "peak_acceleration_figure", "stiffness_figure", "stiffness_tables", "band_peaks"]
 
 
 # ---------------------------------------------------------------------------------------------- peaks
@@ -42,11 +46,11 @@ def band_peaks(values: np.ndarray, f: np.ndarray, split: float) -> tuple[tuple[f
 PeakRow = tuple[str, str, float, tuple[float, float], tuple[float, float], bool, bool]
 
 
-def _peak_rows(dataset: xr.Dataset, scene: Scene, parameter: str) -> list[PeakRow]:
+def _peak_rows(dataset: xr.Dataset, setting: StudySetting, parameter: str) -> list[PeakRow]:
     """Peaks of |X1| per solution and ``parameter`` value; pgf also with stable orbits only and on the simulation grid."""
     f = dataset["frequency"].values
-    split = split_frequency(scene)
-    sim_f = scene.simulation.frequency if scene.simulation is not None else None
+    split = setting.split_frequency
+    sim_f = setting.simulation_frequency
     rows: list[PeakRow] = []
     for value in dataset[parameter].values:
         point = dataset.sel({parameter: value})
@@ -63,7 +67,7 @@ def _peak_rows(dataset: xr.Dataset, scene: Scene, parameter: str) -> list[PeakRo
                 impact = np.isin(point["regime"].sel(solution=solution).values, (Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR))
                 stable = impact & (point["stable"].sel(solution=solution).values == 1)
                 rows.append(("pgf, stable one-impact orbits only", solution, float(value), *band_peaks(np.where(stable, values, np.nan), f, split), True, True))
-            if sim_f is not None:
+            if sim_f.size:
                 on = np.isin(f, sim_f)
                 rows.append((f"{solution} on the simulation grid", solution, float(value), *band_peaks(values[on], f[on], split), True, True))
     return rows
@@ -83,9 +87,9 @@ def _variant(label: str, solution: str) -> str:
     return label[len(solution) :]
 
 
-def peak_figure(dataset: xr.Dataset, scene: Scene, parameter: str, name: str) -> DrawnFigure:
+def peak_figure(dataset: xr.Dataset, setting: StudySetting, parameter: str, name: str) -> DrawnFigure:
     """Peak |X1| of each resonance band against ``parameter`` (``restitution`` or ``clearance``): figures 25-26."""
-    rows = _peak_rows(dataset, scene, parameter)
+    rows = _peak_rows(dataset, setting, parameter)
     scale, unit = (1e3, "mm") if parameter == "clearance" else (1.0, "-")
     labels = list(dict.fromkeys(r[0] for r in rows))
     fig, axes = new_figure(2, panel_height=3.9, legend_rows=legend_rows(len(labels) + 2, 3))
@@ -114,13 +118,13 @@ def peak_figure(dataset: xr.Dataset, scene: Scene, parameter: str, name: str) ->
     return DrawnFigure(fig, name, f"Resonance peaks of |X1| against the {parameter}", caption.text())
 
 
-def peak_tables(dataset: xr.Dataset, scene: Scene, parameter: str) -> list[Table]:
+def peak_tables(dataset: xr.Dataset, setting: StudySetting, parameter: str) -> list[Table]:
     """The values of :func:`peak_figure`."""
     unit, scale = ("mm", 1e3) if parameter == "clearance" else ("-", 1.0)
     header = f"<tr><th>solution</th><th>{parameter} [{unit}]</th><th>peak 1 [mm]</th><th>at [Hz]</th><th>peak 2 [mm]</th><th>at [Hz]</th></tr>"
     body = [
-        f"<tr><td>{label}</td><td>{value * scale:g}</td><td>{fmt(p1[0] * 1e3, '#.4g')}</td><td>{fmt(p1[1], '.3f')}</td><td>{fmt(p2[0] * 1e3, '#.4g')}</td><td>{fmt(p2[1], '.3f')}</td></tr>"
-        for label, _, value, p1, p2, _, _ in _peak_rows(dataset, scene, parameter)
+        f"<tr><td>{label}</td><td>{fmt(value * scale, 'g')}</td><td>{fmt(p1[0] * 1e3, '#.4g')}</td><td>{fmt(p1[1], '.3f')}</td><td>{fmt(p2[0] * 1e3, '#.4g')}</td><td>{fmt(p2[1], '.3f')}</td></tr>"
+        for label, _, value, p1, p2, _, _ in _peak_rows(dataset, setting, parameter)
     ]
     return [Table(f"Resonance peaks of |X1| against the {parameter}: values", f"<table>{header}{''.join(body)}</table>")]
 
@@ -161,6 +165,17 @@ def peak_acceleration_figure(part: xr.Dataset, name: str) -> DrawnFigure | None:
 
 
 # ------------------------------------------------------------------------------------------- stiffness
+class BumperStiffnessPage(SolutionsPage):
+    """The page of a stepped study along the bumper frequency (dimensions ``solution``, ``bumper_frequency``,
+    ``frequency``): the compliant bumper against the rigid stop."""
+
+    def sections(self, out: Path) -> list[Section]:
+        """Linear system, then the convergence of the compliant bumper and its cost."""
+        figure = stiffness_figure(self.dataset, self.setting, "bumper_stiffness")
+        convergence = Section("Compliant bumper against the rigid stop", figures=saved([figure], out), tables=stiffness_tables(self.dataset, self.setting))
+        return [linear_section(self.setting, out), convergence]
+
+
 def _stiffness_reference(dataset: xr.Dataset) -> str | None:
     """The rigid-stop simulation the compliant one is compared with (exact if present), or None."""
     for name in ("exact", "momentary"):
@@ -169,13 +184,13 @@ def _stiffness_reference(dataset: xr.Dataset) -> str | None:
     return None
 
 
-def stiffness_figure(dataset: xr.Dataset, scene: Scene, name: str) -> DrawnFigure | None:
+def stiffness_figure(dataset: xr.Dataset, setting: StudySetting, name: str) -> DrawnFigure | None:
     """Difference of the compliant |X1| from the rigid-stop one against Omega_b, and the wall time per point."""
     reference = _stiffness_reference(dataset)
     if reference is None or "compliant" not in dataset["solution"].values:
         return None
     bumper = dataset["bumper_frequency"].values
-    f = scene.simulation.frequency if scene.simulation is not None else dataset["frequency"].values
+    f = setting.simulation_frequency if setting.simulation_frequency.size else dataset["frequency"].values
     panels = 2 if "wall_time" in dataset else 1
     fig, axes = new_figure(panels, panel_height=4.0, legend_rows=legend_rows(f.size + 2, 6))
     ax = axes[0]
@@ -183,7 +198,7 @@ def stiffness_figure(dataset: xr.Dataset, scene: Scene, name: str) -> DrawnFigur
         point = dataset.sel(frequency=frequency)
         sim = point["x1_amplitude"].sel(solution="compliant").values
         ref = point["x1_amplitude"].sel(solution=reference).values
-        ax.loglog(bumper, np.abs(sim - ref) / ref, "o-", color=series_colour(k), ms=4, label=f"{frequency:g} Hz", gid="compliant")
+        ax.loglog(bumper, np.abs(sim - ref) / ref, "o-", color=series_colour(k), ms=4, label=f"{fmt(frequency, 'g')} Hz", gid="compliant")
     ax.loglog(bumper, 0.1 * bumper[0] / bumper, "k--", lw=0.9, label="slope -1")
     finish_axes(ax, "bumper frequency Omega_b / 2 pi [Hz]", f"relative difference of {QUANTITIES['x1_amplitude'].label} [1]", "Convergence to the rigid stop")
     caption = Caption(
@@ -193,26 +208,26 @@ def stiffness_figure(dataset: xr.Dataset, scene: Scene, name: str) -> DrawnFigur
     if panels == 2:
         ax = axes[1]
         for k, frequency in enumerate(f):
-            ax.loglog(bumper, dataset["wall_time"].sel(solution="compliant", frequency=frequency).values, "o-", color=series_colour(k), ms=4, label=f"{frequency:g} Hz", gid="compliant")
+            ax.loglog(bumper, dataset["wall_time"].sel(solution="compliant", frequency=frequency).values, "o-", color=series_colour(k), ms=4, label=f"{fmt(frequency, 'g')} Hz", gid="compliant")
         rigid = float(np.nanmedian(dataset["wall_time"].sel(solution=reference).values))
         ax.axhline(rigid, color="k", ls=":", lw=1.2, label=f"{reference} (median)", gid=reference)
         finish_axes(ax, "bumper frequency Omega_b / 2 pi [Hz]", "wall time per steady state [s]", "Cost of the compliant model")
         caption.add("cost", f"Right: the wall time of each steady state of {solution_ref('compliant')} (transient plus measurement, one process); dotted: the median of {solution_ref(reference)}.")
     for ax in axes:
         # ticks at the bumpers computed: read off directly, and no crowded minor-tick labels on a short log axis
-        ax.set_xticks(bumper, [f"{b:g}" for b in bumper])
+        ax.set_xticks(bumper, [fmt(b, "g") for b in bumper])
         ax.xaxis.set_minor_formatter(NullFormatter())
     figure_legend(fig, axes, columns=6)
     return DrawnFigure(fig, name, "Compliant bumper against the rigid stop", caption.text())
 
 
-def stiffness_tables(dataset: xr.Dataset, scene: Scene) -> list[Table]:
+def stiffness_tables(dataset: xr.Dataset, setting: StudySetting) -> list[Table]:
     """Per bumper frequency: median and largest difference from the rigid stop, fitted order, median wall time."""
     reference = _stiffness_reference(dataset)
-    if reference is None or "compliant" not in dataset["solution"].values or scene.simulation is None:
+    if reference is None or "compliant" not in dataset["solution"].values or not setting.simulation_frequency.size:
         return []
     bumper = dataset["bumper_frequency"].values
-    data = dataset.sel(frequency=scene.simulation.frequency)
+    data = dataset.sel(frequency=setting.simulation_frequency)
     sim = data["x1_amplitude"].sel(solution="compliant").transpose("bumper_frequency", "frequency").values
     ref = data["x1_amplitude"].sel(solution=reference).values
     difference = np.abs(sim - ref) / ref
@@ -225,5 +240,5 @@ def stiffness_tables(dataset: xr.Dataset, scene: Scene) -> list[Table]:
                 orders = np.log(difference[i - 1] / difference[i]) / np.log(b / bumper[i - 1])
             if np.isfinite(orders).any():
                 order = float(np.nanmedian(orders))
-        rows.append(f"<tr><td>{b:g}</td><td>{fmt(np.nanmedian(difference[i]), '.2e')}</td><td>{fmt(np.nanmax(difference[i]), '.2e')}</td><td>{fmt(order, '.2f')}</td><td>{fmt(np.nanmedian(wall[i]), '.3f')}</td></tr>")
+        rows.append(f"<tr><td>{fmt(b, 'g')}</td><td>{fmt(np.nanmedian(difference[i]), '.2e')}</td><td>{fmt(np.nanmax(difference[i]), '.2e')}</td><td>{fmt(order, '.2f')}</td><td>{fmt(np.nanmedian(wall[i]), '.3f')}</td></tr>")
     return [Table(f"compliant against {reference}: convergence and cost", "<table>" + "".join(rows) + "</table>")]

@@ -2,7 +2,8 @@
 
 Figure builders return a :class:`DrawnFigure` (the matplotlib figure still open, so that tests can inspect what was
 drawn); :func:`save_figure` writes it and closes it. A page is a list of :class:`Section`; :func:`render_page` writes
-the HTML with a table of contents linking every section, figure and table.
+the HTML with a table of contents linking every section, figure and table. Each kind of study has a page type
+(:class:`StudyPage`) that gives the line naming what was computed and the sections, both read from the dataset.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import io
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Iterable, Protocol
 
 from vibroimpact.reporting.style import DPI  # first: selects the Agg backend before pyplot is imported
 
@@ -21,7 +23,7 @@ from matplotlib.figure import Figure as MatplotlibFigure  # noqa: E402
 
 from vibroimpact.study.io import atomic_path  # noqa: E402
 
-__all__ = ["DrawnFigure", "Figure", "Table", "Section", "save_figure", "render_page", "write_page"]
+__all__ = ["DrawnFigure", "Figure", "Table", "Section", "StudyPage", "save_figure", "saved", "render_page", "write_page"]
 
 
 @dataclass(frozen=True)
@@ -73,6 +75,18 @@ class Section:
     tables: list[Table] = field(default_factory=list)
 
 
+class StudyPage(Protocol):
+    """The page of one kind of study (:func:`vibroimpact.reporting.report.page_for` chooses it)."""
+
+    def summary(self) -> str:
+        """What was computed, for the page's heading: ``solutions: ...`` or ``methods: ...``."""
+        ...
+
+    def sections(self, out: Path) -> list[Section]:
+        """The page's sections, their figures written into ``out``."""
+        ...
+
+
 def save_figure(drawn: DrawnFigure, out_dir: Path) -> Figure:
     """Write ``drawn`` as ``out_dir/<name>.png`` atomically, close it, and return its record."""
     buffer = io.BytesIO()
@@ -82,6 +96,11 @@ def save_figure(drawn: DrawnFigure, out_dir: Path) -> Figure:
     with atomic_path(path) as temporary:
         temporary.write_bytes(buffer.getvalue())
     return Figure(path, drawn.title, drawn.caption)
+
+
+def saved(drawn: Iterable[DrawnFigure | None], out: Path) -> list[Figure]:
+    """Write each drawn figure (skipping None) as soon as it comes, so that few are open at once."""
+    return [save_figure(figure, out) for figure in drawn if figure is not None]
 
 
 _STYLE = (

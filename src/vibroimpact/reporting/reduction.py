@@ -20,8 +20,7 @@ import xarray as xr
 
 from vibroimpact.analysis.linear import linear_response, resonance_peaks
 from vibroimpact.model.modal import exact_modal_parameters
-from vibroimpact.scene.core import Scene
-from vibroimpact.model.system import PAPER_SYSTEM
+from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
 
 __all__ = ["DEFINITION", "ReductionRow", "reduction_factors", "paper_reduction_factors"]
 
@@ -67,20 +66,33 @@ class ReductionRow:
     coarse: tuple[bool, ...]
 
 
-def reduction_factors(dataset: xr.Dataset, scene: Scene, quantity: str, solution: str) -> list[ReductionRow]:
-    """Reduction factors of ``quantity`` for ``solution`` at each (clearance, R) of ``dataset`` (see module doc)."""
+def reduction_factors(dataset: xr.Dataset, system: TwoDofSystem, amplitude: float, quantity: str, solution: str) -> list[ReductionRow]:
+    """Reduction factors of ``quantity`` for ``solution`` at each (clearance, R) of ``dataset`` (see module doc).
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        A stepped study's dataset (or part of it) holding ``quantity`` along ``solution`` and ``frequency``.
+    system : TwoDofSystem
+        The system the dataset was computed for.
+    amplitude : float
+        Excitation amplitude q [N].
+    quantity : str
+        ``x1_amplitude``, ``x2_amplitude``, ``force_amplitude`` or ``suspension_force_amplitude``.
+    solution : str
+        The solution whose factors are wanted.
+    """
     if quantity not in _PEAK_QUANTITY:
         raise ValueError(f"quantity must be one of {sorted(_PEAK_QUANTITY)}, got {quantity!r}")
-    system = scene.system
-    peaks = resonance_peaks(system, scene.amplitude, _PEAK_QUANTITY[quantity])
+    peaks = resonance_peaks(system, amplitude, _PEAK_QUANTITY[quantity])
     split = system.antiresonance_frequency() / (2.0 * np.pi)
     data = dataset[quantity].sel(solution=solution)
     stable = dataset["stable"].sel(solution=solution) if "stable" in dataset and solution == "pgf" else None
     f = data["frequency"].values
     bands = [f < split, f >= split]
-    response = linear_response(system, 2.0 * np.pi * f, scene.amplitude)
+    response = linear_response(system, 2.0 * np.pi * f, amplitude)
     linear_value = {"x1": np.abs(response.x1), "x2": np.abs(response.x2), "force": np.abs(response.force)}[_PEAK_QUANTITY[quantity]]
-    widths = [2.0 * zeta * peak.frequency for zeta, peak in zip(_loss_factors(scene), peaks)]
+    widths = [2.0 * zeta * peak.frequency for zeta, peak in zip(_loss_factors(system), peaks)]
     coarse = tuple(bool(np.sum(band) < 2 or np.max(np.diff(f[band]), initial=0.0) > width / 4.0) for band, width in zip(bands, widths))
     rows = []
     for delta in np.atleast_1d(data["clearance"].values):
@@ -106,14 +118,14 @@ def reduction_factors(dataset: xr.Dataset, scene: Scene, quantity: str, solution
     return rows
 
 
-def paper_reduction_factors(scene: Scene, quantity: str, restitution: float, clearance: float) -> tuple[float, float] | None:
+def paper_reduction_factors(system: TwoDofSystem, amplitude: float, quantity: str, restitution: float, clearance: float) -> tuple[float, float] | None:
     """The factors the paper quotes, for its own example only (system of eq. 24, q = 10 N, Delta = 3 mm, R = 0.2)."""
-    if scene.system == PAPER_SYSTEM and scene.amplitude == 10.0 and abs(clearance - 3e-3) < 1e-12 and abs(restitution - 0.2) < 1e-12:
+    if system == PAPER_SYSTEM and amplitude == 10.0 and abs(clearance - 3e-3) < 1e-12 and abs(restitution - 0.2) < 1e-12:
         return _PAPER.get(quantity)
     return None
 
 
-def _loss_factors(scene: Scene) -> list[float]:
+def _loss_factors(system: TwoDofSystem) -> list[float]:
     """Modal loss factors for the half-power widths (exact decomposition of H22; padded if fewer than 2 modes)."""
-    zeta = list(exact_modal_parameters(scene.system).loss_factor)
+    zeta = list(exact_modal_parameters(system).loss_factor)
     return (zeta + [zeta[-1] if zeta else 1.0] * 2)[:2]

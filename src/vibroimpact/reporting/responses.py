@@ -1,12 +1,15 @@
 """Figures of the frequency-response pages (paper figures 2-8 and 21-24): linear system, responses of every solution,
-regime maps, stability, and simulations against the closed form.
+regime maps, stability, and simulations against the closed form; the linear-system section every stepped and swept
+page opens with, and what those pages share (:class:`SolutionsPage`).
 
-Each builder returns a :class:`~vibroimpact.report_common.DrawnFigure` whose caption is put together from what was
+Each builder returns a :class:`~vibroimpact.reporting.page.DrawnFigure` whose caption is put together from what was
 drawn. Closed forms are drawn as curves on the dataset's grid, simulations as markers on their own grid
-(:mod:`vibroimpact.report_style`).
+(:mod:`vibroimpact.reporting.series`).
 """
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 import xarray as xr
@@ -17,7 +20,8 @@ from matplotlib.patches import Patch
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.model.modal import fit_modal_parameters, underdamped_mode_count
 from vibroimpact.analysis.regime import Regime
-from vibroimpact.reporting.page import DrawnFigure
+from vibroimpact.reporting.page import DrawnFigure, Section, saved
+from vibroimpact.reporting.record import StudySetting
 from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_linear, draw_points, periodic_points, stability_keys, unstable_points
 from vibroimpact.reporting.style import (
     LINEAR_STYLE,
@@ -31,15 +35,17 @@ from vibroimpact.reporting.style import (
     axis_label,
     figure_legend,
     finish_axes,
+    fmt,
     legend_rows,
     new_figure,
     regime_label,
     series_colour,
     solution_ref,
 )
-from vibroimpact.scene.core import ENGINE_SOLUTIONS, Scene
+from vibroimpact.reporting.tables import modal_table
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 
-__all__ = ["linear_figure", "response_figure", "regime_figure", "regime_map", "block_edges", "stability_figure", "simulation_figure", "series_by_restitution", "clearance_text"]
+__all__ = ["SolutionsPage", "linear_section", "linear_figure", "response_figure", "regime_figure", "regime_map", "block_edges", "stability_figure", "simulation_figure", "series_by_restitution", "clearance_text"]
 
 #: Frequencies of the linear system's figure (0.0075 Hz over 15-45 Hz: the resonances are about 0.1 Hz wide).
 LINEAR_FIGURE_POINTS = 4001
@@ -50,29 +56,55 @@ _FREQUENCY = "frequency [Hz]"
 
 def clearance_text(part: xr.Dataset) -> str:
     """Delta of a dataset at one clearance, in mm."""
-    return f"Delta = {float(part['clearance']) * 1e3:.6g} mm"
+    return f"Delta = {fmt(float(part['clearance']) * 1e3, '.6g')} mm"
 
 
 def series_by_restitution(part: xr.Dataset) -> list[tuple[str, xr.Dataset]]:
     """(legend text, dataset) for each restitution ratio of ``part``."""
     if "restitution" in part.dims:
-        return [(f"R = {float(r):g}", part.sel(restitution=r)) for r in part["restitution"].values]
-    return [(f"R = {float(part['restitution']):g}", part)]
+        return [(f"R = {fmt(r, 'g')}", part.sel(restitution=r)) for r in part["restitution"].values]
+    return [(f"R = {fmt(part['restitution'], 'g')}", part)]
 
 
-def linear_figure(scene: Scene) -> DrawnFigure:
+class SolutionsPage:
+    """What the pages of stepped and swept studies share: the dataset, what it says of its study, and the summary
+    naming the solutions; each page gives its own sections.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        The study's dataset.
+    setting : StudySetting
+        What the dataset says of its system, excitation and grids.
+    """
+
+    def __init__(self, dataset: xr.Dataset, setting: StudySetting) -> None:
+        self.dataset = dataset
+        self.setting = setting
+
+    def summary(self) -> str:
+        """The solutions of the study."""
+        return f"solutions: {', '.join(self.setting.solutions)}"
+
+
+def linear_section(setting: StudySetting, out: Path) -> Section:
+    """The section every stepped and swept page opens with: the linear system and the modal parameters of H22."""
+    return Section("Linear system", figures=saved([linear_figure(setting)], out), tables=[modal_table(setting.system)])
+
+
+def linear_figure(setting: StudySetting) -> DrawnFigure:
     """Linear responses, force on the base and the curve fit of H22 (paper figures 2-4)."""
-    system = scene.system
-    # the closed form is cheap: a fine grid over the scene's range (its own grid may be a handful of points)
-    f = np.union1d(scene.frequency, np.linspace(scene.frequency.min(), scene.frequency.max(), LINEAR_FIGURE_POINTS))
+    system = setting.system
+    # the closed form is cheap: a fine grid over the study's range (its own grid may be a handful of points)
+    f = np.union1d(setting.frequency, np.linspace(setting.frequency.min(), setting.frequency.max(), LINEAR_FIGURE_POINTS))
     w = 2.0 * np.pi * f
-    response = linear_response(system, w, scene.amplitude)
+    response = linear_response(system, w, setting.amplitude)
     fit = fit_modal_parameters(system) if underdamped_mode_count(system) == 2 else None
     fig, axes = new_figure(3, panel_height=3.6, legend_rows=2)
     ax = axes[0]
     ax.semilogy(f, np.abs(response.x1), label="|X1| primary", color="C0", lw=1.4, gid="linear")
     ax.semilogy(f, np.abs(response.x2), label="|X2| absorber", color="C1", lw=1.4, gid="linear")
-    for delta in scene.clearance:
+    for delta in setting.clearance:
         ax.axhline(delta, color="k", lw=0.9, ls="--")
     finish_axes(ax, _FREQUENCY, "amplitude [m]", "Linear responses (paper fig. 2)")
     ax = axes[1]
@@ -85,11 +117,11 @@ def linear_figure(scene: Scene) -> DrawnFigure:
         ax.semilogy(f[::step], np.abs(fit.receptance(w[::step])), "o", color="C3", mfc="none", ms=4.5, label="|H22| of eq. 10, the paper's fitted modes")
     finish_axes(ax, _FREQUENCY, "|H22| [m/N]", "Accuracy of the curve fit (paper fig. 4)")
     figure_legend(fig, axes, [Line2D([], [], color="k", lw=0.9, ls="--", label="clearance Delta")])
-    natural = ", ".join(f"{x / (2 * np.pi):.3f}" for x in system.natural_frequencies())
+    natural = ", ".join(fmt(x / (2 * np.pi), ".3f") for x in system.natural_frequencies())
     caption = (
         f"Linear system (Delta -> infinity): |X1| and |X2| (dashed: the clearance), the force on the base, and |H22| exact "
         f"{'against the paper' + chr(39) + 's curve fit (circles)' if fit is not None else '(the paper' + chr(39) + 's fit needs two underdamped modes)'}. "
-        f"Natural frequencies {natural} Hz, anti-resonance {system.antiresonance_frequency() / (2 * np.pi):.3f} Hz."
+        f"Natural frequencies {natural} Hz, anti-resonance {fmt(system.antiresonance_frequency() / (2 * np.pi), '.3f')} Hz."
     )
     return DrawnFigure(fig, "linear", "Linear responses, force on the base, fit of H22", caption)
 

@@ -6,7 +6,7 @@
 * :func:`draw_points` for simulations on their own grid: one marker per computed point, filled for a periodic steady
   state, hollow for irregular motion; a :class:`SimulationMarkers` records which were drawn, for the legend and the
   caption;
-* the dataset lookups the pages share: where an orbit is unstable, where a simulation is periodic, the band split.
+* the dataset lookups the pages share: where an orbit is unstable, where a simulation is periodic.
 
 Every drawn artist carries the solution's name as its ``gid``: tests find each solution's data by it.
 """
@@ -19,9 +19,8 @@ from matplotlib.axes import Axes
 from matplotlib.lines import Line2D
 
 from vibroimpact.reporting.style import ENGINE_MARKERS, LINEAR_STYLE, STABLE_STYLE, UNSTABLE_STYLE, solution_ref
-from vibroimpact.scene.core import Scene
 
-__all__ = ["draw_curve", "draw_linear", "draw_points", "stability_keys", "SimulationMarkers", "unstable_points", "periodic_points", "split_frequency", "OVER_MARKERS_ZORDER"]
+__all__ = ["draw_curve", "draw_linear", "draw_points", "stability_keys", "SimulationMarkers", "unstable_points", "periodic_points", "OVER_MARKERS_ZORDER"]
 
 #: Drawing order of markers: smaller ones on top of larger ones [matplotlib zorder; lines are at 2].
 MARKER_ZORDER = 2.5
@@ -189,8 +188,3 @@ def periodic_points(data: xr.Dataset, solution: str) -> np.ndarray:
     if "converged" not in data:
         return np.ones(data[next(iter(data.data_vars))].sel(solution=solution).shape, bool)
     return np.asarray(data["converged"].sel(solution=solution).values == 1)
-
-
-def split_frequency(scene: Scene) -> float:
-    """The anti-resonance frequency [Hz], which separates the two resonance bands."""
-    return scene.system.antiresonance_frequency() / (2.0 * np.pi)

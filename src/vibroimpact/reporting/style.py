@@ -171,12 +171,13 @@ def solution_ref(solution: str) -> str:
     return f"'{solution}'"
 
 
-def fmt(value: SupportsFloat | None, spec: str = ".3g") -> str:
-    """``value`` formatted with ``spec``; empty for NaN, infinity or None (a table cell with nothing to show)."""
+def fmt(value: SupportsFloat | None, spec: str = ".3g", pattern: str = "{}") -> str:
+    """The one number formatter of every report: ``value`` formatted with ``spec`` and put into ``pattern`` (its
+    ``{}``, e.g. ``"{}x"`` or ``" ({} s)"``); empty for NaN, infinity or None (a table cell with nothing to show)."""
     if value is None:
         return ""
     number = float(value)
-    return "" if not math.isfinite(number) else format(number, spec)
+    return "" if not math.isfinite(number) else pattern.format(format(number, spec))
 
 
 # ---------------------------------------------------------------------------------------------- captions

@@ -3,23 +3,27 @@
 Dataset layout read here: the steady-state solutions (``linear``, ``pgf``, ...) as ``<quantity>(solution, frequency)``
 without a ``sweep`` dimension; the swept runs' running estimates on the frequency grid as
 ``swept_<quantity>(sweep, frequency)``; ``running_<quantity>(sweep, elapsed_time)`` against time; ``sweep_<stat>(sweep)``
-per run. The page shows one point of any other swept dimension (the caller selects it).
+per run. The page shows the first point of any other swept dimension. The sweep's settings are the dataset's
+``swept_sine_*`` attributes.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import xarray as xr
 from matplotlib.axes import Axes
 
 from vibroimpact.analysis.regime import Regime
-from vibroimpact.reporting.page import DrawnFigure, Table
-from vibroimpact.reporting.responses import regime_map
-from vibroimpact.reporting.series import draw_curve, draw_linear, split_frequency, stability_keys, unstable_points
+from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
+from vibroimpact.reporting.record import SWEPT_SOLUTION, StudySetting
+from vibroimpact.reporting.responses import SolutionsPage, linear_section, regime_map
+from vibroimpact.reporting.series import draw_curve, draw_linear, stability_keys, unstable_points
 from vibroimpact.reporting.style import QUANTITIES, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref
-from vibroimpact.scene.core import ENGINE_SOLUTIONS, Scene
 
-__all__ = ["sweep_figures", "sweep_tables"]
+__all__ = ["SweptSinePage", "SweptSineRun", "swept_sine_run", "sweep_figures", "sweep_tables"]
 
 #: Colour of each sweep direction.
 SWEEP_COLOURS = {"up": "C3", "down": "C2"}
@@ -28,6 +32,77 @@ SWEPT_STYLE = {"ls": "-", "lw": 0.9}
 #: sqrt 2 x running RMS: thinner, dash-dot (dashed means an unstable orbit).
 RMS_STYLE = {"ls": "-.", "lw": 0.9}
 _FREQUENCY = "instantaneous frequency [Hz]"
+#: Grid dimensions of which the page shows the first point.
+PAGE_POINT_DIMS = ("restitution", "bumper_loss_factor", "clearance", "bumper_frequency")
+
+
+@dataclass(frozen=True)
+class SweptSineRun:
+    """How the swept-sine runs of a dataset were made, as its ``swept_sine_*`` attributes say.
+
+    Attributes
+    ----------
+    start_frequency, stop_frequency : float
+        Frequency range of the sweep [Hz].
+    rate : float
+        Sweep rate [Hz/s].
+    window_cycles : int
+        Excitation cycles in the running estimators' window.
+    bumper_frequency : float
+        Omega_b / 2 pi of the (first) bumper [Hz].
+    bumper_loss_factor : float
+        xi_b of the (first) bumper [-].
+    """
+
+    start_frequency: float
+    stop_frequency: float
+    rate: float
+    window_cycles: int
+    bumper_frequency: float
+    bumper_loss_factor: float
+
+    def __post_init__(self) -> None:
+        if not (0.0 < self.start_frequency and 0.0 < self.stop_frequency and 0.0 < self.rate):
+            raise ValueError(f"a sweep has positive frequencies [Hz] and rate [Hz/s], got {self}")
+
+    @property
+    def duration(self) -> float:
+        """Simulated time of one sweep [s]."""
+        return (self.stop_frequency - self.start_frequency) / self.rate
+
+    def text(self) -> str:
+        """The sweep's range [Hz], rate [Hz/s], bumper [Hz], loss factor [-] and window [cycles], for captions."""
+        return (
+            f"{fmt(self.start_frequency, 'g')} <-> {fmt(self.stop_frequency, 'g')} Hz at {fmt(self.rate, 'g')} Hz/s, bumper {fmt(self.bumper_frequency, 'g')} Hz, "
+            f"xi_b = {fmt(self.bumper_loss_factor, '.4f')}, estimator window {self.window_cycles} cycles"
+        )
+
+
+def swept_sine_run(dataset: xr.Dataset, setting: StudySetting) -> SweptSineRun:
+    """The :class:`SweptSineRun` of a swept-sine study's ``dataset``."""
+    attrs = dataset.attrs
+    return SweptSineRun(
+        start_frequency=float(attrs["swept_sine_start_frequency"]),
+        stop_frequency=float(attrs["swept_sine_stop_frequency"]),
+        rate=float(attrs["swept_sine_rate"]),
+        window_cycles=int(attrs["swept_sine_window_cycles"]),
+        bumper_frequency=float(setting.bumper_frequency[0]),
+        bumper_loss_factor=float(setting.bumper_loss_factor[0]),
+    )
+
+
+class SweptSinePage(SolutionsPage):
+    """The page of a swept-sine study (dimensions ``solution``, ``sweep``, ``frequency``, ``elapsed_time``): the linear
+    system, then the sweeps against the steady states; the swept solution is the last of the summary's."""
+
+    def sections(self, out: Path) -> list[Section]:
+        """Linear system, then the sweeps at the first point of the other swept grids."""
+        run = swept_sine_run(self.dataset, self.setting)
+        first = {d: 0 for d in PAGE_POINT_DIMS if d in self.dataset.dims}
+        part = self.dataset.isel(first)
+        intro = f"<p>Figures and tables show the first point of the swept grids ({', '.join(first)}); the dataset holds every point.</p>" if first else ""
+        sweeps = Section("Swept sine against the steady states", intro=intro, figures=saved(sweep_figures(part, run), out), tables=sweep_tables(part, run, self.setting))
+        return [linear_section(self.setting, out), sweeps]
 
 
 def _steady_solutions(dataset: xr.Dataset) -> list[str]:
@@ -35,24 +110,9 @@ def _steady_solutions(dataset: xr.Dataset) -> list[str]:
     return [str(s) for s in dataset["solution"].values] if "solution" in dataset.coords else []
 
 
-def _swept_solution(scene: Scene) -> str:
-    """The solution that was run as a swept sine."""
-    return next((s for s in scene.solutions if s in ENGINE_SOLUTIONS), "compliant")
-
-
 def _directions(dataset: xr.Dataset) -> list[str]:
     """The sweep directions of the dataset, in its order."""
     return [str(s) for s in dataset["sweep"].values]
-
-
-def _sweep_text(scene: Scene) -> str:
-    """The sweep's range [Hz], rate [Hz/s], bumper [Hz], loss factor [-] and window [cycles], for captions."""
-    s = scene.swept_sine
-    assert s is not None and scene.bumper_frequency is not None
-    return (
-        f"{s.start_frequency:g} <-> {s.stop_frequency:g} Hz at {s.rate:g} Hz/s, bumper {scene.bumper_frequency[0]:g} Hz, "
-        f"xi_b = {scene.loss_factors()[0]:.4f}, estimator window {s.window_cycles} cycles"
-    )
 
 
 def _draw_steady(ax: Axes, dataset: xr.Dataset, quantity: str, caption: Caption, with_linear: bool = True) -> bool:
@@ -85,10 +145,10 @@ def _draw_swept(ax: Axes, dataset: xr.Dataset, quantity: str, solution: str, sca
     return drawn
 
 
-def sweep_figures(dataset: xr.Dataset, scene: Scene) -> list[DrawnFigure]:
+def sweep_figures(dataset: xr.Dataset, run: SweptSineRun) -> list[DrawnFigure]:
     """Running estimates of each swept-sine run against the steady states, the regimes, and X1 against time."""
-    solution = _swept_solution(scene)
-    figures = [_displacement_figure(dataset, scene, solution)]
+    solution = SWEPT_SOLUTION
+    figures = [_displacement_figure(dataset, run, solution)]
     force = _force_figure(dataset, solution)
     if force is not None:
         figures.append(force)
@@ -103,14 +163,14 @@ def sweep_figures(dataset: xr.Dataset, scene: Scene) -> list[DrawnFigure]:
             draw_curve(axes[0], dataset["elapsed_time"].values, values, colour=SWEEP_COLOURS.get(direction, "C4"), label=f"{solution_ref(solution)} sweep {direction}", gid=solution)
         finish_axes(axes[0], "time since the start of the sweep [s]", f"running {axis_label('x1_amplitude')}", "Running fundamental of X1 against time (the Simulink scope view)", log=True)
         figure_legend(fig, axes)
-        caption = f"The running {QUANTITIES['x1_amplitude'].label} of each {solution_ref(solution)} sweep against the time since its start ({_sweep_text(scene)})."
+        caption = f"The running {QUANTITIES['x1_amplitude'].label} of each {solution_ref(solution)} sweep against the time since its start ({run.text()})."
         figures.append(DrawnFigure(fig, "sweep_time", "Running |X1| against time", caption))
     return figures
 
 
-def _displacement_figure(dataset: xr.Dataset, scene: Scene, solution: str) -> DrawnFigure:
+def _displacement_figure(dataset: xr.Dataset, run: SweptSineRun, solution: str) -> DrawnFigure:
     """Running fundamental and sqrt 2 x RMS of X1 and X2 of each sweep against the steady states (figures 16-20)."""
-    caption = Caption(f"Swept sine ({_sweep_text(scene)}): running estimates of {solution_ref(solution)} against the instantaneous frequency, like the paper's figures 16-20, against the steady states.")
+    caption = Caption(f"Swept sine ({run.text()}): running estimates of {solution_ref(solution)} against the instantaneous frequency, like the paper's figures 16-20, against the steady states.")
     fig, axes = new_figure(2, panel_height=4.0, legend_rows=legend_rows(8))
     any_unstable = False
     for ax, (quantity, rms, name) in zip(axes, (("x1_amplitude", "x1_rms", "X1"), ("x2_amplitude", "x2_rms", "X2"))):
@@ -146,22 +206,19 @@ def _force_figure(dataset: xr.Dataset, solution: str) -> DrawnFigure | None:
     return DrawnFigure(fig, "sweep_force_impulse", "Swept sine: force, impulse and contacts", caption.text())
 
 
-def sweep_tables(dataset: xr.Dataset, scene: Scene) -> list[Table]:
+def sweep_tables(dataset: xr.Dataset, run: SweptSineRun, setting: StudySetting) -> list[Table]:
     """Cost of each run, and the sweep against the pgf steady state where that is stable."""
-    s = scene.swept_sine
-    assert s is not None
-    duration = (s.stop_frequency - s.start_frequency) / s.rate
     rows = ["<tr><th>sweep</th><th>wall time [s]</th><th>steps</th><th>contacts</th><th>residual calls</th><th>simulated [s]</th><th>failed</th></tr>"]
     for direction in _directions(dataset):
         line = dataset.sel(sweep=direction)
         cells = [fmt(float(line[f"sweep_{stat}"]), spec) if f"sweep_{stat}" in line else "" for stat, spec in (("wall_time", ".1f"), ("steps", ".0f"), ("contacts", ".0f"), ("rhs_calls", ".0f"))]
         failed = "yes" if "sweep_failed" in line and float(line["sweep_failed"]) == 1.0 else "no"
-        rows.append(f"<tr><td>{direction}</td>{''.join(f'<td>{c}</td>' for c in cells)}<td>{duration:g}</td><td>{failed}</td></tr>")
+        rows.append(f"<tr><td>{direction}</td>{''.join(f'<td>{c}</td>' for c in cells)}<td>{fmt(run.duration, 'g')}</td><td>{failed}</td></tr>")
     tables = [Table("Cost of the swept-sine runs (one process each)", "<table>" + "".join(rows) + "</table>")]
     if "pgf" in _steady_solutions(dataset) and "swept_x1_amplitude" in dataset:
         rows = ["<tr><th>sweep</th><th>band</th><th>points (pgf stable, sweep in contact)</th><th>median rel. diff. |X1|</th><th>90th percentile</th></tr>"]
         f = dataset["frequency"].values
-        split = split_frequency(scene)
+        split = setting.split_frequency
         pgf = dataset["x1_amplitude"].sel(solution="pgf").values
         stable = dataset["stable"].sel(solution="pgf").values == 1 if "stable" in dataset else np.isfinite(pgf)
         for direction in _directions(dataset):

@@ -15,10 +15,10 @@ from vibroimpact.model.modal import exact_modal_parameters, fit_modal_parameters
 from vibroimpact.reporting.reduction import DEFINITION, paper_reduction_factors, reduction_factors
 from vibroimpact.analysis.regime import Regime
 from vibroimpact.reporting.page import Table
-from vibroimpact.reporting.series import split_frequency
+from vibroimpact.reporting.record import StudySetting
 from vibroimpact.reporting.style import QUANTITIES, fmt
-from vibroimpact.scene.core import ENGINE_SOLUTIONS, Scene
-from vibroimpact.model.system import PAPER_SYSTEM
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS
+from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
 
 __all__ = ["modal_table", "reduction_tables", "reduction_intro", "agreement_table", "computed_part"]
 
@@ -38,19 +38,19 @@ def computed_part(dataset: xr.Dataset, solution: str) -> xr.Dataset:
     return dataset.isel(frequency=np.flatnonzero(computed.values))
 
 
-def modal_table(scene: Scene) -> Table:
-    """Exact and fitted modal parameters of H22."""
-    exact = exact_modal_parameters(scene.system)
-    fit = fit_modal_parameters(scene.system) if exact.omega.size == 2 else None
+def modal_table(system: TwoDofSystem) -> Table:
+    """Exact and fitted modal parameters of H22 of ``system``."""
+    exact = exact_modal_parameters(system)
+    fit = fit_modal_parameters(system) if exact.omega.size == 2 else None
     rows = ["<tr><th>mode</th><th>Omega/2pi [Hz]</th><th>xi exact</th><th>xi fitted</th><th>A exact (complex) [1/kg]</th><th>A fitted [1/kg]</th></tr>"]
     for i in range(exact.omega.size):
         a = exact.form_factor[i]
         fitted = ("", "") if fit is None else (fmt(fit.loss_factor[i], ".5f"), fmt(np.real(fit.form_factor[i]), ".4f"))
         rows.append(
             f"<tr><td>{i + 1}</td><td>{fmt(exact.omega[i] / (2 * np.pi), '.4f')}</td><td>{fmt(exact.loss_factor[i], '.5f')}</td><td>{fitted[0]}</td>"
-            f"<td>{a.real:.4f} {a.imag:+.4f}j</td><td>{fitted[1]}</td></tr>"
+            f"<td>{fmt(a.real, '.4f')} {fmt(a.imag, '+.4f')}j</td><td>{fitted[1]}</td></tr>"
         )
-    note = "The paper prints A = 2.75, 7.25 and xi = 0.0022, 0.0023 for its system (eq. 24)." if scene.system == PAPER_SYSTEM else ""
+    note = "The paper prints A = 2.75, 7.25 and xi = 0.0022, 0.0023 for its system (eq. 24)." if system == PAPER_SYSTEM else ""
     if fit is None:
         note += " The system has fewer than two underdamped modes: the paper's fit does not apply."
     return Table("Modal parameters of H22", "<table>" + "".join(rows) + f"</table><p>{note}</p>")
@@ -66,48 +66,47 @@ def reduction_intro() -> str:
     )
 
 
-def reduction_tables(dataset: xr.Dataset, scene: Scene) -> list[Table]:
+def reduction_tables(dataset: xr.Dataset, setting: StudySetting) -> list[Table]:
     """One table per quantity: reduction factors of every solution but ``linear`` at each (clearance, R)."""
     solutions = [str(s) for s in dataset["solution"].values if s != "linear"]
-    split = split_frequency(scene)
+    split = setting.split_frequency
     tables = []
     for quantity in _REDUCTION_QUANTITIES:
         if quantity not in dataset or not solutions:
             continue
         units = QUANTITIES[quantity].units
-        header = (
-            f"<tr><th>solution</th><th>Delta [mm]</th><th>R</th><th>linear peak 1 / 2 [{units}]</th><th>largest realisable in band 1 / 2</th>"
-            "<th>reduction factor 1</th><th>reduction factor 2</th><th>computed points 1 / 2</th><th>undefined points 1 / 2</th>"
-            "<th>unstable points 1 / 2</th><th>paper</th></tr>"
+        header = _header(
+            f"linear peak 1 / 2 [{units}]", "largest realisable in band 1 / 2", "reduction factor 1", "reduction factor 2", "computed points 1 / 2",
+            "undefined points 1 / 2", "unstable points 1 / 2", "paper",
         )
         body = []
         for solution in solutions:
             part = computed_part(dataset, solution)
             f = part["frequency"].values
             computed = f"{int(np.sum(f < split))} / {int(np.sum(f >= split))}"
-            for row in reduction_factors(part, scene, quantity, solution):
-                paper = paper_reduction_factors(scene, quantity, row.restitution, row.clearance)
+            for row in reduction_factors(part, setting.system, setting.amplitude, quantity, solution):
+                paper = paper_reduction_factors(setting.system, setting.amplitude, quantity, row.restitution, row.clearance)
                 factors = "".join(f"<td>{fmt(factor, '.1f')}{' &dagger;' if coarse else ''}</td>" for factor, coarse in zip(row.factor, row.coarse))
                 unstable = "n/a" if row.unstable is None else f"{row.unstable[0]} / {row.unstable[1]}"
                 body.append(
-                    f"<tr><td>{solution}</td><td>{row.clearance * 1e3:g}</td><td>{row.restitution:g}</td>"
+                    f"<tr><td>{solution}</td><td>{fmt(row.clearance * 1e3, 'g')}</td><td>{fmt(row.restitution, 'g')}</td>"
                     f"<td>{fmt(row.linear_peak[0], '#.4g')} / {fmt(row.linear_peak[1], '#.4g')}</td><td>{fmt(row.largest[0], '#.4g')} / {fmt(row.largest[1], '#.4g')}</td>"
                     f"{factors}<td>{computed}</td><td>{row.undefined[0]} / {row.undefined[1]}</td><td>{unstable}</td>"
-                    f"<td>{'' if paper is None else f'{paper[0]:g} / {paper[1]:g}'}</td></tr>"
+                    f"<td>{'' if paper is None else fmt(paper[0], 'g') + ' / ' + fmt(paper[1], 'g')}</td></tr>"
                 )
         tables.append(Table(f"Reduction factors: {QUANTITIES[quantity].label}", f"<table>{header}{''.join(body)}</table>"))
     return tables
 
 
-def agreement_table(dataset: xr.Dataset, scene: Scene) -> Table | None:
+def agreement_table(dataset: xr.Dataset, setting: StudySetting) -> Table | None:
     """Simulation against pgf by band: relative differences of |X1| where the pgf orbit is stable and where not."""
     engines = [str(name) for name in dataset["solution"].values if name in ENGINE_SOLUTIONS]
     if not engines or "pgf" not in dataset["solution"].values or "x1_amplitude" not in dataset:
         return None
-    split = split_frequency(scene)
-    header = (
-        "<tr><th>solution</th><th>Delta [mm]</th><th>R</th><th>band</th><th>computed points</th><th>max rel. diff. |X1|, pgf stable or linear</th>"
-        "<th>median</th><th>pgf unstable: points</th><th>max rel. diff. there</th><th>simulation irregular</th><th>simulation with other than 1 or 0 impacts per period</th></tr>"
+    split = setting.split_frequency
+    header = _header(
+        "band", "computed points", "max rel. diff. |X1|, pgf stable or linear", "median", "pgf unstable: points", "max rel. diff. there",
+        "simulation irregular", "simulation with other than 1 or 0 impacts per period",
     )
     body = []
     for engine in engines:
@@ -130,11 +129,16 @@ def agreement_table(dataset: xr.Dataset, scene: Scene) -> Table | None:
                     good = mask & ~unstable & np.isfinite(difference)
                     bad = mask & unstable & np.isfinite(difference)
                     body.append(
-                        f"<tr><td>{engine}</td><td>{float(delta) * 1e3:g}</td><td>{float(r):g}</td><td>{band}</td><td>{int(mask.sum())}</td>"
+                        f"<tr><td>{engine}</td><td>{fmt(float(delta) * 1e3, 'g')}</td><td>{fmt(r, 'g')}</td><td>{band}</td><td>{int(mask.sum())}</td>"
                         f"<td>{fmt(_largest(difference[good]), '.1e')}</td><td>{fmt(np.median(difference[good]) if good.any() else np.nan, '.1e')}</td>"
                         f"<td>{int(bad.sum())}</td><td>{fmt(_largest(difference[bad]), '.1e')}</td><td>{int((irregular & mask).sum())}</td><td>{int((other & mask).sum())}</td></tr>"
                     )
     return Table("Simulation against PGF by band (|X1| fundamental)", f"<table>{header}{''.join(body)}</table>")
+
+
+def _header(*columns: str) -> str:
+    """Header row of a table over the (clearance, R) grid: solution, Delta [mm], R, then ``columns`` (HTML)."""
+    return "<tr>" + "".join(f"<th>{column}</th>" for column in ("solution", "Delta [mm]", "R", *columns)) + "</tr>"
 
 
 def _largest(values: np.ndarray) -> float:

@@ -1,0 +1,150 @@
+"""One page type per kind of study, chosen from the dataset alone; what a page knows of its study comes from the
+dataset (coordinates, variables, attributes), never from a re-validated scene."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from vibroimpact.reporting import page as page_module
+from vibroimpact.reporting.accuracy_page import AccuracyPage
+from vibroimpact.reporting.bumper_page import BumperStiffnessPage
+from vibroimpact.reporting.record import StudyRecord, stored_description, study_kind, study_record, study_setting
+from vibroimpact.reporting.report import page_for, write_report
+from vibroimpact.reporting.stepped_page import FrequencyResponsePage
+from vibroimpact.reporting.sweep_page import SweptSinePage, swept_sine_run
+
+from tests.reporting.test_report_pages import quick_save
+from tests.reporting.test_report_support import benchmark_dataset, steady_dataset, stiffness_dataset, swept_dataset
+
+
+@pytest.fixture(autouse=True)
+def _no_png(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Pages are composed without rendering PNGs (seconds each); the figures themselves are tested elsewhere."""
+    monkeypatch.setattr(page_module, "save_figure", quick_save)
+
+
+def _names(section: page_module.Section) -> tuple[list[str], list[str]]:
+    """File names of a section's figures and titles of its tables."""
+    return [f.path.stem for f in section.figures], [t.title for t in section.tables]
+
+
+def test_stepped_page_has_responses_simulations_peaks_agreement_and_reduction_factors(tmp_path: Path) -> None:
+    ds = steady_dataset()
+    page = page_for(ds)
+    assert isinstance(page, FrequencyResponsePage)
+    assert page.summary() == "solutions: linear, pgf, pgf_paper, momentary, exact, compliant"
+    sections = {s.title: s for s in page.sections(tmp_path)}
+    assert list(sections) == [
+        "Linear system",
+        "Resonance peaks against the restitution",
+        "Frequency responses, Delta = 3 mm",
+        "Simulations against the closed form, Delta = 3 mm",
+        "Simulation against the closed form: agreement by band",
+        "Reduction factors",
+    ]
+    assert _names(sections["Linear system"]) == (["linear"], ["Modal parameters of H22"])
+    assert _names(sections["Resonance peaks against the restitution"]) == (["peaks_vs_restitution"], ["Resonance peaks of |X1| against the restitution: values"])
+    figures, _ = _names(sections["Frequency responses, Delta = 3 mm"])
+    assert figures == ["x2_amplitude", "x1_amplitude", "force_amplitude", "suspension_force_amplitude", "impulse", "regime", "stability", "peak_acceleration"]
+    assert _names(sections["Simulations against the closed form, Delta = 3 mm"])[0] == [f"simulation_{q}" for q in ("x1_amplitude", "x2_amplitude", "force_amplitude", "impulse")]
+    assert [t.title for t in sections["Reduction factors"].tables] == [f"Reduction factors: {q}" for q in ("|X1| fundamental", "|F| on the base", "|F| through the suspension", "|X2| fundamental")]
+
+
+def test_bumper_stiffness_page_shows_convergence_and_cost(tmp_path: Path) -> None:
+    ds = stiffness_dataset()
+    page = page_for(ds)
+    assert isinstance(page, BumperStiffnessPage)
+    assert page.summary() == "solutions: pgf, exact, compliant"
+    sections = page.sections(tmp_path)
+    assert [s.title for s in sections] == ["Linear system", "Compliant bumper against the rigid stop"]
+    assert _names(sections[1]) == (["bumper_stiffness"], ["compliant against exact: convergence and cost"])
+    # the simulated frequencies come from the data: the dataset has no simulation_frequency_Hz attribute
+    np.testing.assert_array_equal(study_setting(ds).simulation_frequency, [24.0, 25.0])
+
+
+def test_swept_sine_page_shows_the_sweeps_against_the_steady_states(tmp_path: Path) -> None:
+    ds = swept_dataset()
+    page = page_for(ds)
+    assert isinstance(page, SweptSinePage)
+    assert page.summary() == "solutions: linear, pgf, compliant", "the swept solution is not along the solution dimension"
+    sections = page.sections(tmp_path)
+    assert [s.title for s in sections] == ["Linear system", "Swept sine against the steady states"]
+    figures, tables = _names(sections[1])
+    assert figures == ["sweep_displacements", "sweep_force_impulse", "sweep_regime", "sweep_time"]
+    assert tables == ["Cost of the swept-sine runs (one process each)", "Swept sine against the stable pgf steady state (|X1| fundamental)"]
+    run = swept_sine_run(ds, study_setting(ds))
+    assert run.text() == "21 <-> 29 Hz at 1 Hz/s, bumper 250 Hz, xi_b = 0.7312, estimator window 8 cycles"
+    assert run.duration == pytest.approx(8.0, rel=1e-15)
+
+
+def test_benchmark_page_shows_work_precision_and_every_point(tmp_path: Path) -> None:
+    ds = benchmark_dataset()
+    page = page_for(ds)
+    assert isinstance(page, AccuracyPage)
+    assert page.summary() == "methods: momentary_adams, compliant_ida, solve_ivp_DOP853"
+    sections = page.sections(tmp_path)
+    assert [s.title for s in sections] == ["Work-precision"]
+    figures, tables = _names(sections[0])
+    assert figures == ["work_precision"]
+    assert tables[:3] == ["Cheapest way to the X1 fundamental within a target", "Tolerance guidance: loosest rtol meeting each target", "momentary (Adams) against exact and against solve_ivp at equal impact-time error"]
+    assert tables[-2:] == ["Every point: one_impact", "Every point: irregular"]
+
+
+@pytest.mark.parametrize(
+    ("dataset", "kind"),
+    [(steady_dataset, "stepped"), (stiffness_dataset, "stepped"), (swept_dataset, "swept"), (benchmark_dataset, "benchmark")],
+)
+def test_kind_comes_from_the_attribute_else_from_the_dimensions(dataset: object, kind: str) -> None:
+    ds = dataset()  # type: ignore[operator]
+    assert study_kind(ds) == kind
+    without = ds.copy()
+    without.attrs = {k: v for k, v in ds.attrs.items() if k != "study_kind"}
+    assert study_kind(without) == kind
+
+
+def test_the_study_kind_attribute_decides_and_is_checked() -> None:
+    ds = steady_dataset().copy()
+    ds.attrs = dict(ds.attrs, study_kind="benchmark")
+    assert study_kind(ds) == "benchmark"
+    ds.attrs["study_kind"] = "continuation"
+    with pytest.raises(ValueError, match="study_kind must be one of stepped, swept, benchmark"):
+        study_kind(ds)
+    with pytest.raises(ValueError, match="kind must be one of"):
+        StudyRecord(kind="other", name="x", description="", scene_text="", version="0")
+
+
+def test_a_dataset_whose_scene_no_longer_validates_is_still_reported(tmp_path: Path) -> None:
+    """The stored scene has a key today's parser refuses; the page is made from the dataset all the same, the scene
+    text shown verbatim, the description read from it as plain YAML."""
+    ds = steady_dataset(engines=("exact",), restitution=(0.2,), step=0.5).copy()
+    scene = "name: old_study\ndescription: written by an older version\nobsolete_key: {anything: 1}\nsystem: not a mapping\n"
+    ds.attrs = dict(ds.attrs, scene=scene, scene_name="old_study")
+    path = write_report(ds, tmp_path)
+    text = path.read_text()
+    assert "<h1>Study &#x27;old_study&#x27;</h1>" in text
+    assert "<p>written by an older version</p>" in text
+    assert "obsolete_key: {anything: 1}" in text
+    assert "Reduction factors" in text
+    assert study_record(ds).description == "written by an older version"
+
+
+@pytest.mark.parametrize("text", ["", "- a list\n- not a mapping\n", "description: [not, text]\n", "name: [unclosed\n"])
+def test_a_missing_or_unreadable_description_is_empty(text: str) -> None:
+    assert stored_description(text) == ""
+
+
+def test_the_setting_is_what_the_dataset_stores() -> None:
+    ds = steady_dataset()
+    setting = study_setting(ds)
+    assert setting.system.as_dict() == {key: float(ds.attrs[f"system_{key}"]) for key in ("m1", "m2", "k1", "k2", "b1", "b2")}
+    assert setting.amplitude == pytest.approx(10.0, rel=0.0)
+    np.testing.assert_array_equal(setting.frequency, ds["frequency"].values)
+    np.testing.assert_array_equal(setting.clearance, [0.003])
+    np.testing.assert_allclose(setting.simulation_frequency, np.arange(15.0, 45.0 + 1e-9, 0.5), rtol=0.0, atol=1e-9)
+    np.testing.assert_array_equal(setting.bumper_frequency, [250.0])
+    stored = xr.Dataset(ds.data_vars, coords=ds.coords, attrs=dict(ds.attrs, simulation_frequency_Hz=np.array([20.0, 30.0])))
+    np.testing.assert_array_equal(study_setting(stored).simulation_frequency, [20.0, 30.0])
