@@ -115,3 +115,47 @@ def test_validation(make: object, fragment: str) -> None:
 
     with pytest.raises(ValueError, match=re.escape(fragment)):
         make()  # type: ignore[operator]
+
+
+# ----------------------------------------------------------------------------------------------- the rigid law
+def test_rigid_impact_map_and_impulse() -> None:
+    """An impact that does not chatter: X2' -> -R v, impulse M2 (1 + R) v; the sticking test is not even asked."""
+    from vibroimpact.model.contact import RigidStop
+
+    def never() -> bool:
+        raise AssertionError("asked whether the stop pushes on an impact that does not chatter")
+
+    impact = RigidStop(0.003, 0.4).impact(0.1, 2.0, False, never)
+    assert not impact.sticks and impact.velocity == 2.0  # exact: passed through
+    assert impact.after == pytest.approx(-0.8, rel=1e-15)
+    assert impact.impulse == pytest.approx(0.1 * 2.0 * 1.4, rel=1e-15)
+
+
+@pytest.mark.parametrize("pushed", [True, False])
+def test_rigid_chattering_sticks_only_where_the_stop_pushes(pushed: bool) -> None:
+    from vibroimpact.model.contact import RigidStop
+
+    impact = RigidStop(0.003, 0.4).impact(0.1, 1e-9, True, lambda: pushed)
+    assert impact.sticks is pushed
+    assert impact.after == (0.0 if pushed else pytest.approx(-0.4e-9, rel=1e-15))
+    assert impact.impulse == pytest.approx(0.1 * 1e-9 * (1.0 if pushed else 1.4), rel=1e-15)
+
+
+def test_rigid_chattering_test() -> None:
+    """Slow, too many in a period, or R = 0 chatter; anything else does not."""
+    from vibroimpact.model.contact import RigidStop
+
+    stop = RigidStop(0.003, 0.4)
+    assert stop.chatters(1e-6, 1, 1e-6, 10)
+    assert stop.chatters(1.0, 11, 1e-6, 10)
+    assert not stop.chatters(1.0, 10, 1e-6, 10)
+    assert RigidStop(0.003, 0.0).chatters(1.0, 1, 1e-6, 10)
+
+
+def test_rigid_holding_force() -> None:
+    from vibroimpact.model.contact import RigidStop
+    from vibroimpact.model.system import PAPER_SYSTEM
+
+    stop = RigidStop(0.003, 0.4)
+    assert stop.holding_force(PAPER_SYSTEM, 0.005, -0.2) == pytest.approx(PAPER_SYSTEM.b2 * -0.2 + PAPER_SYSTEM.k2 * 0.002, rel=1e-15)
+    np.testing.assert_allclose(stop.holding_force(PAPER_SYSTEM, np.array([0.003, 0.0]), np.zeros(2)), [0.0, -PAPER_SYSTEM.k2 * 0.003], atol=1e-15)
