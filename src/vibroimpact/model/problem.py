@@ -9,7 +9,7 @@ with another stop (another coordinate, a second side) changes the contact and th
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Union
+from typing import TypeVar, Union
 
 import numpy as np
 from numpy.typing import NDArray
@@ -24,6 +24,16 @@ __all__ = ["Contact", "Excitation", "ImpactProblem"]
 Contact = Union[RigidStop, KelvinVoigtBumper]
 #: The excitations a problem may have.
 Excitation = Union[HarmonicForce, SweptSine]
+
+_Kind = TypeVar("_Kind")
+
+
+def _part_of_kind(name: str, value: object, kind: type[_Kind], why: str) -> _Kind:
+    """``value`` if it is a ``kind``, else ``TypeError`` naming the part and saying ``why`` it must be one."""
+    if not isinstance(value, kind):
+        raise TypeError(f"{name} = {value!r} is not a {kind.__name__}: {why}")
+    return value
+
 
 _PARTS = {"system": (TwoDofSystem,), "contact": (RigidStop, KelvinVoigtBumper), "excitation": (HarmonicForce, SweptSine)}
 
@@ -62,16 +72,12 @@ class ImpactProblem:
     @property
     def rigid_stop(self) -> RigidStop:
         """The contact, which must be a :class:`RigidStop` (``TypeError`` naming the contact otherwise)."""
-        if not isinstance(self.contact, RigidStop):
-            raise TypeError(f"contact = {self.contact!r} is not a RigidStop: a momentary-impact engine solves a rigid stop only")
-        return self.contact
+        return _part_of_kind("contact", self.contact, RigidStop, "a momentary-impact engine solves a rigid stop only")
 
     @property
     def bumper(self) -> KelvinVoigtBumper:
         """The contact, which must be a :class:`KelvinVoigtBumper` (``TypeError`` naming the contact otherwise)."""
-        if not isinstance(self.contact, KelvinVoigtBumper):
-            raise TypeError(f"contact = {self.contact!r} is not a KelvinVoigtBumper: a compliant engine solves a bumper only")
-        return self.contact
+        return _part_of_kind("contact", self.contact, KelvinVoigtBumper, "a compliant engine solves a bumper only")
 
     @property
     def restitution(self) -> float:
@@ -86,16 +92,12 @@ class ImpactProblem:
     @property
     def harmonic(self) -> HarmonicForce:
         """The excitation, which must be a :class:`HarmonicForce` (``TypeError`` naming it otherwise)."""
-        if not isinstance(self.excitation, HarmonicForce):
-            raise TypeError(f"excitation = {self.excitation!r} is not a HarmonicForce: a frequency, phase or period needs a harmonic force")
-        return self.excitation
+        return _part_of_kind("excitation", self.excitation, HarmonicForce, "a frequency, phase or period needs a harmonic force")
 
     @property
     def sweep(self) -> SweptSine:
         """The excitation, which must be a :class:`SweptSine` (``TypeError`` naming it otherwise)."""
-        if not isinstance(self.excitation, SweptSine):
-            raise TypeError(f"excitation = {self.excitation!r} is not a SweptSine: a sweeping engine runs a swept sine only")
-        return self.excitation
+        return _part_of_kind("excitation", self.excitation, SweptSine, "a sweeping engine runs a swept sine only")
 
     @property
     def amplitude(self) -> float:
