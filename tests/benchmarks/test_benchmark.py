@@ -9,13 +9,20 @@ import pytest
 import xarray as xr
 import yaml
 
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
+from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact import cli
-from vibroimpact.benchmarks.accuracy import BenchmarkCase, BenchmarkSettings, _compare, equal_error_speedup, run_benchmark
+from vibroimpact.benchmarks.accuracy import _compare, equal_error_speedup, run_benchmark
+from vibroimpact.scene.schema import BenchmarkCase, BenchmarkSettings
 from vibroimpact.engines.exact import ExactEngine
-from vibroimpact.engines.base import ImpactProblem, Trajectory
+from vibroimpact.engines.base import Trajectory
 from vibroimpact.model.system import TwoDofSystem
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
+
+#: Period of the 25 Hz problems whose impacts are matched [s].
+PERIOD = 1.0 / 25.0
 
 
 def _with_impacts(reference: Trajectory, times: np.ndarray) -> Trajectory:
@@ -25,18 +32,18 @@ def _with_impacts(reference: Trajectory, times: np.ndarray) -> Trajectory:
 
 
 def test_impact_matching_counts_missed_and_extra(system: TwoDofSystem) -> None:
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, 25.0)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.2), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     reference = ExactEngine().integrate(problem, np.zeros(4), 0.0, 20)
     times = reference.impact_times
-    assert _compare(reference, reference)["missed_impacts"] == 0
+    assert _compare(reference, reference, PERIOD)["missed_impacts"] == 0
     shifted = _with_impacts(reference, times + 1e-9)
-    result = _compare(reference, shifted)
+    result = _compare(reference, shifted, PERIOD)
     assert result["missed_impacts"] == 0 and result["extra_impacts"] == 0 and result["impact_time_error"] == pytest.approx(1e-9, rel=1e-3)
     fewer = _with_impacts(reference, np.delete(times, [3, 7]))
-    assert _compare(reference, fewer)["missed_impacts"] == 2
+    assert _compare(reference, fewer, PERIOD)["missed_impacts"] == 2
     more = _with_impacts(reference, np.sort(np.append(times, times[5] + 0.3 / problem.frequency)))
-    assert _compare(reference, more)["extra_impacts"] == 1
-    assert _compare(reference, _with_impacts(reference, np.array([])))["missed_impacts"] == times.size
+    assert _compare(reference, more, PERIOD)["extra_impacts"] == 1
+    assert _compare(reference, _with_impacts(reference, np.array([])), PERIOD)["missed_impacts"] == times.size
 
 
 def test_equal_error_speedup_interpolates_log_log() -> None:
@@ -55,7 +62,7 @@ def test_equal_error_speedup_interpolates_log_log() -> None:
 
 
 def test_small_benchmark_runs_every_method(system: TwoDofSystem) -> None:
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, 25.0)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.2), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     cases = [BenchmarkCase("c", problem, "rest", 20)]
     settings = BenchmarkSettings(methods=("momentary_adams", "solve_ivp_DOP853"), tolerances=(1e-6, 1e-9), repeats=1)
     data = run_benchmark(cases, settings, progress=False)
@@ -94,21 +101,21 @@ def test_compliant_cvode_is_an_independent_integrator_of_the_same_model(system: 
     steady run to the tolerance: the reference of the compliant model is another integrator, not the same code."""
     import math
 
-    from vibroimpact.model.contact import loss_factor_from_restitution, restitution_from_loss_factor
+    from vibroimpact.model.contact import KelvinVoigtBumper, loss_factor_from_restitution, restitution_from_loss_factor
     from vibroimpact.engines.settings import EngineSettings
     from vibroimpact.engines.compliant.ida import CompliantEngine
     from vibroimpact.engines.compliant.cvode import CompliantCvodeEngine
 
     free = TwoDofSystem(m1=1.0, m2=0.1, k1=1.0, k2=1e-12)
-    problem = ImpactProblem(free, 1e-3, 0.5, 0.0, 1.0)
+    problem = ImpactProblem(free, KelvinVoigtBumper(1e-3, 250.0, 0.3), HarmonicForce(0.0, 1.0))
     for method in ("adams", "bdf"):
-        trajectory = CompliantCvodeEngine(250.0, 0.3, EngineSettings(rtol=1e-11, atol=1e-15, method=method)).integrate(problem, np.array([0.0, 1e-3, 0.0, 0.5]), 0.0, 1)
+        trajectory = CompliantCvodeEngine(EngineSettings(rtol=1e-11, atol=1e-15, method=method)).integrate(problem, np.array([0.0, 1e-3, 0.0, 0.5]), 0.0, 1)
         assert -trajectory.strobe_states[-1, 3] / 0.5 == pytest.approx(restitution_from_loss_factor(0.3), rel=1e-8)
-    forced = ImpactProblem(system, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, 25.0)
     xi = loss_factor_from_restitution(0.2)
+    forced = ImpactProblem(system, KelvinVoigtBumper(PAPER_CLEARANCE, 1000.0, xi), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     tight = EngineSettings(rtol=1e-11, atol=1e-15)
-    a = CompliantEngine(1000.0, xi, tight).integrate(forced, np.zeros(4), 0.0, 20)
-    b = CompliantCvodeEngine(1000.0, xi, tight).integrate(forced, np.zeros(4), 0.0, 20)
+    a = CompliantEngine(tight).integrate(forced, np.zeros(4), 0.0, 20)
+    b = CompliantCvodeEngine(tight).integrate(forced, np.zeros(4), 0.0, 20)
     assert a.impact_times.size == b.impact_times.size >= 15
     np.testing.assert_allclose(a.impact_times, b.impact_times, atol=1e-9)
     np.testing.assert_allclose(a.final_state, b.final_state, atol=1e-7 * np.abs(a.final_state).max())
@@ -119,13 +126,14 @@ def test_compliant_cvode_is_an_independent_integrator_of_the_same_model(system: 
 def test_accuracy_benchmark_with_compliant_and_swept_cases(system: TwoDofSystem) -> None:
     """Compliant methods are measured against CVODE Adams at rtol 1e-13, rigid ones against exact; X1 errors shrink
     with the tolerance; a swept case runs only the compliant model; the ladder ranks the models."""
-    from vibroimpact.benchmarks.accuracy import LadderSettings, loosest_tolerance
+    from vibroimpact.benchmarks.accuracy import loosest_tolerance
+    from vibroimpact.scene.schema import LadderSettings
     from vibroimpact.model.excitation import SweptSine
 
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, 25.0)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.2), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     cases = [
-        BenchmarkCase("stepped", problem, "pgf", 10, bumper_frequency=1000.0),
-        BenchmarkCase("swept", problem, "rest", 0, bumper_frequency=250.0, sweep=SweptSine(PAPER_AMPLITUDE, 24.0, 24.3, 0.1), sample_rate=1000.0),
+        BenchmarkCase("stepped", problem, "pgf", 10, bumper=KelvinVoigtBumper(PAPER_CLEARANCE, 1000.0, loss_factor_from_restitution(0.2))),
+        BenchmarkCase("swept", problem, "rest", 0, bumper=KelvinVoigtBumper(PAPER_CLEARANCE, 250.0, loss_factor_from_restitution(0.2)), sweep=SweptSine(PAPER_AMPLITUDE, 24.0, 24.3, 0.1), sample_rate=1000.0),
     ]
     ladder = LadderSettings(25.0, 0.2, PAPER_CLEARANCE, (1000.0,), 1e-8, 1)
     settings = BenchmarkSettings(methods=("momentary_adams", "compliant_ida", "solve_ivp_DOP853"), tolerances=(1e-4, 1e-7, 1e-10), repeats=1, ladder=ladder)
@@ -147,12 +155,12 @@ def test_accuracy_benchmark_with_compliant_and_swept_cases(system: TwoDofSystem)
 
 def test_matching_is_one_to_one(system: TwoDofSystem) -> None:
     """Two reference impacts close together cannot both match one trial impact, whichever side is the reference."""
-    problem = ImpactProblem(system, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, 25.0)
+    problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.2), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     reference = ExactEngine().integrate(problem, np.zeros(4), 0.0, 20)
     t = reference.impact_times
     pair = _with_impacts(reference, np.sort(np.append(t, t[4] + 1e-6)))
-    assert _compare(pair, reference)["missed_impacts"] == 1 and _compare(pair, reference)["extra_impacts"] == 0
-    assert _compare(reference, pair)["missed_impacts"] == 0 and _compare(reference, pair)["extra_impacts"] == 1
+    assert _compare(pair, reference, PERIOD)["missed_impacts"] == 1 and _compare(pair, reference, PERIOD)["extra_impacts"] == 0
+    assert _compare(reference, pair, PERIOD)["missed_impacts"] == 0 and _compare(reference, pair, PERIOD)["extra_impacts"] == 1
 
 
 def test_loosest_tolerance_needs_every_tighter_one() -> None:
@@ -188,7 +196,7 @@ def test_loosest_tolerance_needs_every_tighter_one() -> None:
     ],
 )
 def test_benchmark_scene_mistakes(change: object, expected: str) -> None:
-    from vibroimpact.scene.core import SceneError, parse_scene
+    from vibroimpact.scene import SceneError, parse_scene
 
     cases = [{"name": "a", "frequency": 25.0, "restitution": 0.2, "clearance": 0.003, "start": "pgf"}]
     change(cases)  # type: ignore[operator]

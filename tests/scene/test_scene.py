@@ -12,15 +12,8 @@ import pytest
 import yaml
 
 from vibroimpact import cli
-from vibroimpact.scene.core import (
-    MAX_GRID_POINTS,
-    QUANTITIES,
-    SceneError,
-    find_scene,
-    load_scene,
-    parse_scene,
-    shipped_studies_dir,
-)
+from vibroimpact.scene import SceneError, find_scene, load_scene, parse_scene, shipped_studies_dir
+from vibroimpact.scene.schema import MAX_GRID_POINTS, QUANTITIES
 
 #: The paper's system (eq. 24), as in studies/restitution.yaml.
 PAPER_SYSTEM_SPEC = {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0, "b1": 0.8, "b2": 0.08}

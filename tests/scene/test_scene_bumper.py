@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from vibroimpact.model.contact import loss_factor_from_restitution, restitution_from_loss_factor
-from vibroimpact.scene.core import parse_scene
+from vibroimpact.scene import parse_scene
 
 from tests.scene.test_scene import problems_of, scene_with
 
@@ -107,7 +107,7 @@ def test_swept_sine_mistakes(spec: dict[str, Any], solutions: list[str] | None, 
 
 
 def test_shipped_bumper_studies_parse() -> None:
-    from vibroimpact.scene.core import load_scene, shipped_studies_dir
+    from vibroimpact.scene import load_scene, shipped_studies_dir
 
     for name in ("bumper_sweep", "bumper_stiffness", "restitution_peaks", "clearance_peaks", "peak_acceleration"):
         scene = load_scene(shipped_studies_dir() / f"{name}.yaml")

@@ -10,7 +10,7 @@ import pytest
 import xarray as xr
 
 from vibroimpact.model.contact import peak_acceleration_factor, restitution_from_loss_factor
-from vibroimpact.scene.core import parse_scene
+from vibroimpact.scene import parse_scene
 from vibroimpact.study.run import run_study
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC

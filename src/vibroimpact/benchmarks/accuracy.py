@@ -19,129 +19,38 @@ import math
 import statistics
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import replace
 from typing import Callable
 
 import numpy as np
 import xarray as xr
 
-from vibroimpact.model.contact import loss_factor_from_restitution
-from vibroimpact.engines.exact import ExactEngine
-from vibroimpact.engines.base import ImpactProblem, Trajectory
-from vibroimpact.engines.settings import ATOL_RATIO, REFERENCE_RTOL, EngineSettings
-from vibroimpact.engines.base import Engine
-from vibroimpact.engines.compliant.ida import CompliantEngine, SweepRecord
-from vibroimpact.engines.compliant.cvode import CompliantCvodeEngine
+from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.engines.base import Engine, SweepRecord, Trajectory
+from vibroimpact.engines.registry import BUMPER, engine_spec, make_engine
+from vibroimpact.engines.settings import REFERENCE_RTOL, EngineSettings
 from vibroimpact.engines.compliant.ivp import solve_ivp_sweep
-from vibroimpact.engines.momentary import MomentaryEngine
-from vibroimpact.engines.scipy_ivp import SolveIvpEngine
-from vibroimpact.model.excitation import SweptSine
 from vibroimpact.simulation.harmonics import measure, running_fundamental
 from vibroimpact.simulation.steady import start_state
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.variables import BENCHMARK_ATTRIBUTES, LADDER_ATTRIBUTES
+from vibroimpact.scene.schema import BenchmarkCase, BenchmarkSettings, LadderSettings
 
-__all__ = ["BENCHMARK_METHODS", "BenchmarkCase", "BenchmarkSettings", "LadderSettings", "run_benchmark", "model_ladder", "equal_error_speedup", "loosest_tolerance", "REFERENCE_RTOL"]
-
-#: Rigid-stop methods (``exact`` is always run: it is their reference).
-RIGID_METHODS: dict[str, Callable[[EngineSettings], Engine]] = {
-    "momentary_adams": lambda s: MomentaryEngine(EngineSettings(rtol=s.rtol, atol=s.atol, method="adams")),
-    "momentary_bdf": lambda s: MomentaryEngine(EngineSettings(rtol=s.rtol, atol=s.atol, method="bdf")),
-    "solve_ivp_DOP853": lambda s: SolveIvpEngine(s, "DOP853"),
-    "solve_ivp_LSODA": lambda s: SolveIvpEngine(s, "LSODA"),
-    "solve_ivp_Radau": lambda s: SolveIvpEngine(s, "Radau"),
-    "solve_ivp_RK45": lambda s: SolveIvpEngine(s, "RK45"),
-}
-#: Compliant-model methods: (settings, bumper frequency [Hz], loss factor) -> engine.
-COMPLIANT_METHODS: dict[str, Callable[[EngineSettings, float, float], CompliantEngine]] = {
-    "compliant_ida": lambda s, f, xi: CompliantEngine(f, xi, s),
-    "compliant_cvode_adams": lambda s, f, xi: CompliantCvodeEngine(f, xi, EngineSettings(rtol=s.rtol, atol=s.atol, method="adams")),
-    "compliant_cvode_bdf": lambda s, f, xi: CompliantCvodeEngine(f, xi, EngineSettings(rtol=s.rtol, atol=s.atol, method="bdf")),
-}
-#: Every method name a benchmark scene may list.
-BENCHMARK_METHODS = tuple(RIGID_METHODS) + tuple(COMPLIANT_METHODS)
+__all__ = ["run_benchmark", "model_ladder", "equal_error_speedup", "loosest_tolerance", "REFERENCE_RTOL"]
 
 SLOW_RUN = 5.0  # [s] a run longer than this is not repeated
 
 
-@dataclass(frozen=True)
-class BenchmarkCase:
-    """One benchmark run: the problem, where it starts and how long it lasts.
-
-    Attributes
-    ----------
-    name : str
-        Label of the case.
-    problem : ImpactProblem
-        System, stop and excitation (a swept case uses its system, clearance and restitution).
-    start : str
-        ``rest``, ``linear`` or ``pgf`` (see :func:`vibroimpact.steady.start_state`); swept cases start at rest.
-    periods : int
-        Whole periods integrated (stepped cases).
-    bumper_frequency : float
-        Omega_b / 2 pi of the compliant model [Hz] (loss factor from the restitution); NaN: no compliant methods.
-    sweep : SweptSine or None
-        A swept-sine case of the compliant model.
-    sample_rate : float
-        Output samples per second of a swept case [Hz].
-    """
-
-    name: str
-    problem: ImpactProblem
-    start: str
-    periods: int
-    bumper_frequency: float = math.nan
-    sweep: SweptSine | None = None
-    sample_rate: float = 2000.0
-
-    @property
-    def loss_factor(self) -> float:
-        """xi_b matching the case's restitution [-]."""
-        return loss_factor_from_restitution(self.problem.restitution)
-
-    def runs(self, method: str) -> bool:
-        """Whether ``method`` applies to this case."""
-        if self.sweep is not None:
-            return method in COMPLIANT_METHODS or method.startswith("solve_ivp_")
-        return method in RIGID_METHODS or (method in COMPLIANT_METHODS and math.isfinite(self.bumper_frequency))
-
-
-@dataclass(frozen=True)
-class BenchmarkSettings:
-    """What to compare.
-
-    Attributes
-    ----------
-    methods : tuple of str
-        Keys of :data:`BENCHMARK_METHODS`.
-    tolerances : tuple of float
-        Relative tolerances; atol = rtol * ``atol_ratio`` [m, m s-1].
-    atol_ratio : float
-        Absolute tolerance per unit of relative tolerance [m].
-    repeats : int
-        Runs per point (median wall time).
-    max_seconds : float
-        The largest run time allowed: tighter tolerances of a method are skipped once a run took longer [s].
-    ladder : LadderSettings or None
-        The model-cost ladder to measure as well.
-    """
-
-    methods: tuple[str, ...]
-    tolerances: tuple[float, ...]
-    atol_ratio: float = ATOL_RATIO
-    repeats: int = 3
-    max_seconds: float = 60.0
-    ladder: "LadderSettings | None" = None
-
-
-def _compare(reference: Trajectory, trial: Trajectory) -> dict[str, float]:
+def _compare(reference: Trajectory, trial: Trajectory, period: float) -> dict[str, float]:
     """Missed and extra impacts, and errors over matched impacts, of ``trial`` against ``reference``.
 
     Matching is one to one: candidate pairs (each reference impact with its nearest trial impacts on either side)
-    closer than the window are taken greedily from the closest, each impact used once; unmatched reference impacts
-    are missed, unmatched trial impacts extra.
+    closer than the window, 1e-3 of the case's ``period`` [s], are taken greedily from the closest, each impact used
+    once; unmatched reference impacts are missed, unmatched trial impacts extra.
     """
-    window = 1e-3 * reference.problem.period
+    window = 1e-3 * period
     ref_t, trial_t = reference.impact_times, trial.impact_times
     time_error = impulse_error = 0.0
     pairs: list[tuple[float, int, int]] = []
@@ -188,13 +97,18 @@ def _runner(case: BenchmarkCase, method: str, settings: EngineSettings) -> Calla
         def from_record(record: SweepRecord) -> _Run:
             return _Run(record.trajectory, running_fundamental(record.time, record.x1, sweep, cycles=8).amplitude)
 
-        if method in COMPLIANT_METHODS:
-            engine = COMPLIANT_METHODS[method](settings, case.bumper_frequency, case.loss_factor)
-            return lambda: from_record(engine.sweep(problem.system, problem.clearance, sweep, case.sample_rate))
+        assert case.bumper is not None
+        swept = ImpactProblem(problem.system, case.bumper, sweep)
+        if engine_spec(method).contact == BUMPER:
+            engine = make_engine(method, settings)
+            return lambda: from_record(engine.sweep(swept, case.sample_rate))
         ivp = method.removeprefix("solve_ivp_")
-        return lambda: from_record(solve_ivp_sweep(problem.system, problem.clearance, case.bumper_frequency, case.loss_factor, sweep, case.sample_rate, ivp, settings.rtol, settings.atol))
-    t0, y0 = start_state(problem, case.start)
-    stepped: Engine = COMPLIANT_METHODS[method](settings, case.bumper_frequency, case.loss_factor) if method in COMPLIANT_METHODS else RIGID_METHODS[method](settings)
+        return lambda: from_record(solve_ivp_sweep(swept, case.sample_rate, ivp, settings.rtol, settings.atol))
+    t0, y0 = start_state(problem, case.start)  # the rigid stop's start, for the compliant model too
+    stepped: Engine = make_engine(method, settings)
+    if engine_spec(method).contact == BUMPER:
+        assert case.bumper is not None
+        problem = replace(problem, contact=case.bumper)
 
     def run() -> _Run:
         trajectory = stepped.integrate(problem, y0, t0, case.periods, moments=True)
@@ -223,11 +137,11 @@ def _references(case: BenchmarkCase, settings: BenchmarkSettings) -> dict[str, t
         t0, y0 = start_state(case.problem, case.start)
 
         def exact() -> _Run:
-            trajectory = ExactEngine().integrate(case.problem, y0, t0, case.periods, moments=True)
+            trajectory = make_engine("exact").integrate(case.problem, y0, t0, case.periods, moments=True)
             return _Run(trajectory, _x1_of(trajectory))
 
         references["rigid"] = _timed(exact, settings.repeats)
-    if any(case.runs(m) and (m in COMPLIANT_METHODS or case.sweep is not None) for m in settings.methods):
+    if any(case.runs(m) and (engine_spec(m).contact == BUMPER or case.sweep is not None) for m in settings.methods):
         tight = EngineSettings(rtol=REFERENCE_RTOL, atol=REFERENCE_RTOL * settings.atol_ratio, method="adams")
         references["compliant"] = _timed(_runner(case, "compliant_cvode_adams", tight), 1)
     return references
@@ -256,13 +170,13 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
         for m, method in enumerate(settings.methods):
             if not case.runs(method):
                 continue
-            kind = "compliant" if method in COMPLIANT_METHODS or case.sweep is not None else "rigid"
+            kind = "compliant" if engine_spec(method).contact == BUMPER or case.sweep is not None else "rigid"
             reference = references[kind][0]
             for k, rtol in enumerate(settings.tolerances):
                 run, wall = _timed(_runner(case, method, EngineSettings(rtol=rtol, atol=rtol * settings.atol_ratio)), settings.repeats)
                 trajectory = run.trajectory
                 scale = float(np.nanmax(reference.x1))
-                values = _compare(reference.trajectory, trajectory) | {
+                values = _compare(reference.trajectory, trajectory, case.problem.period) | {
                     "wall_time": wall,
                     "rhs_calls": trajectory.stats.get("rhs_calls", np.nan),
                     "steps": trajectory.stats.get("steps", np.nan),
@@ -342,34 +256,6 @@ def equal_error_speedup(dataset: xr.Dataset, case: str, method: str, tolerance: 
     return best / float(point["wall_time"]), best_name
 
 
-@dataclass(frozen=True)
-class LadderSettings:
-    """One frequency point through every model, from the closed form to ever stiffer bumpers.
-
-    Attributes
-    ----------
-    frequency : float
-        Excitation frequency [Hz].
-    restitution : float
-        R [-] (the bumpers get the loss factor that gives it).
-    clearance : float
-        Delta [m].
-    bumper_frequencies : tuple of float
-        Omega_b / 2 pi of the compliant models [Hz].
-    rtol : float
-        Tolerance of the integrators (atol = rtol x the scene's atol_ratio).
-    repeats : int
-        Runs per model (median wall time).
-    """
-
-    frequency: float
-    restitution: float
-    clearance: float
-    bumper_frequencies: tuple[float, ...]
-    rtol: float = 1e-8
-    repeats: int = 3
-
-
 def model_ladder(system: TwoDofSystem, amplitude: float, ladder: LadderSettings, atol_ratio: float) -> xr.Dataset:
     """Wall time of one steady-state point and its |X1| for ``pgf``, ``exact``, ``momentary`` and ``compliant`` at
     each bumper frequency, and the relative difference from ``exact``; dimension ``model``."""
@@ -377,7 +263,8 @@ def model_ladder(system: TwoDofSystem, amplitude: float, ladder: LadderSettings,
     from vibroimpact.simulation.steady import steady_state
     from vibroimpact.simulation.settings import SteadySettings
 
-    problem = ImpactProblem(system, ladder.clearance, ladder.restitution, amplitude, ladder.frequency)
+    stop = RigidStop(ladder.clearance, ladder.restitution)
+    problem = ImpactProblem(system, stop, HarmonicForce(amplitude, ladder.frequency))
     settings = EngineSettings(rtol=ladder.rtol, atol=ladder.rtol * atol_ratio)
     steady = SteadySettings(tolerance=max(10.0 * ladder.rtol, 1e-10))
     omega = np.array([problem.omega])
@@ -386,12 +273,13 @@ def model_ladder(system: TwoDofSystem, amplitude: float, ladder: LadderSettings,
         return float(np.abs(solve_one_impact(system, omega, ladder.clearance, ladder.restitution, amplitude).x1_harmonic())[0])
 
     models: dict[str, Callable[[], float]] = {"pgf": pgf}
-    engines: dict[str, Engine] = {"exact": ExactEngine(), "momentary": MomentaryEngine(settings)}
+    engines: dict[str, tuple[Engine, ImpactProblem]] = {"exact": (make_engine("exact"), problem), "momentary": (make_engine("momentary", settings), problem)}
     xi = loss_factor_from_restitution(ladder.restitution)
     for frequency in ladder.bumper_frequencies:
-        engines[f"compliant_{frequency:g}Hz"] = CompliantEngine(frequency, xi, settings)
-    for name, engine in engines.items():
-        models[name] = lambda engine=engine: abs(steady_state(engine, problem, "pgf", steady).measures.x1)
+        engines[f"compliant_{frequency:g}Hz"] = (make_engine("compliant", settings), replace(problem, contact=KelvinVoigtBumper(ladder.clearance, frequency, xi)))
+    for name, (engine, run_problem) in engines.items():
+        # every model starts from the rigid stop's one-impact orbit (a bumper's own R(xi_b) differs in the last digits)
+        models[name] = lambda engine=engine, run_problem=run_problem: abs(steady_state(engine, run_problem, "pgf", steady, stop).measures.x1)
     wall, x1 = [], []
     for name, model in models.items():
         times = []

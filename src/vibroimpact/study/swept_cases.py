@@ -24,7 +24,7 @@ from vibroimpact.model.excitation import SweptSine
 from vibroimpact.study.fingerprint import case_key
 from vibroimpact.simulation.harmonics import running_at, running_fundamental, window_times
 from vibroimpact.study.runner import ProgressReport
-from vibroimpact.scene.core import SweptSineSettings
+from vibroimpact.scene.schema import SweptSineSettings
 from vibroimpact.model.system import TwoDofSystem
 
 __all__ = ["SweepCase", "SWEEP_QUANTITIES", "SWEEP_FIELDS", "run_sweep_case", "running_quantities", "sweep_start_state"]

@@ -1,0 +1,349 @@
+"""What a scene says: the frozen :class:`Scene` and its parts, and the vocabulary and limits of the scene format.
+
+Nothing here reads YAML or checks a document (see :mod:`vibroimpact.scene.sections` and
+:mod:`vibroimpact.scene.benchmark`); a :class:`Scene` is built only from checked values. Engine names come from
+:mod:`vibroimpact.engines.registry`, which names every engine without importing one.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from vibroimpact.analysis.pgf import AdmissibilitySettings
+from vibroimpact.engines.registry import BUMPER, RIGID, engine_names, engine_spec
+from vibroimpact.engines.settings import ATOL_RATIO, EngineSettings
+from vibroimpact.model.contact import KelvinVoigtBumper, loss_factor_from_restitution
+from vibroimpact.model.excitation import SweptSine
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.simulation.settings import SteadySettings
+
+__all__ = [
+    "Scene",
+    "SimulationSettings",
+    "SweptSineSettings",
+    "BenchmarkScene",
+    "BenchmarkCase",
+    "BenchmarkSettings",
+    "LadderSettings",
+    "SOLUTIONS",
+    "ENGINE_SOLUTIONS",
+    "ENGINE_CONTACT",
+    "BENCHMARK_REFERENCE",
+    "BENCHMARK_METHODS",
+    "QUANTITIES",
+    "SWEEPABLE",
+    "GRID_DIMS",
+]
+
+#: Solutions a scene can ask for.
+SOLUTIONS = ("linear", "pgf", "pgf_paper", "momentary", "exact", "compliant")
+#: Solutions computed by time integration (they need the ``simulation`` section's settings).
+ENGINE_SOLUTIONS = ("momentary", "exact", "compliant")
+#: The contact law of each engine solution (from the engine registry, which must name every one of them).
+ENGINE_CONTACT = {name: engine_spec(name).contact for name in ENGINE_SOLUTIONS}
+#: The engine every rigid-stop benchmark method is measured against; a benchmark always runs it.
+BENCHMARK_REFERENCE = "exact"
+#: Engines a benchmark scene may compare: every registered engine but the reference.
+BENCHMARK_METHODS = tuple(name for name in engine_names() if name != BENCHMARK_REFERENCE)
+#: Directions of a swept-sine test.
+SWEEP_DIRECTIONS = ("up", "down")
+#: How a simulation starts at each frequency.
+SIMULATION_STARTS = ("linear", "pgf", "rest", "sweep_up", "sweep_down")
+#: Quantities a scene can ask for (``regime`` is always written: it says what the others mean).
+QUANTITIES = (
+    "x1_amplitude",
+    "x2_amplitude",
+    "force_amplitude",
+    "suspension_force_amplitude",
+    "impulse",
+    "phase",
+    "regime",
+    "stable",
+    "floquet_modulus",
+    "one_impact_x1_amplitude",
+    "one_impact_x2_amplitude",
+    "one_impact_force_amplitude",
+    "one_impact_impulse",
+    "impacts_per_period",
+    "converged",
+    "x1_rms",
+    "x2_rms",
+    "peak_acceleration",
+    "peak_contact_force",
+    "wall_time",
+)
+#: Parameters that can be swept, with their units and allowed ranges (low, high, low inclusive).
+SWEEPABLE = {
+    "frequency": ("Hz", 0.0, math.inf, False),
+    "restitution": ("1", 0.0, 1.0, True),
+    "clearance": ("m", 0.0, math.inf, True),
+    "bumper_frequency": ("Hz", 0.0, 1e6, False),
+    "bumper_loss_factor": ("1", 0.0, 1e3, True),
+}
+#: Dimension order of a study's grid (unswept ones are squeezed out of the dataset).
+GRID_DIMS = ("restitution", "clearance", "bumper_frequency", "sweep", "frequency")
+#: Most points of one grid.
+MAX_GRID_POINTS = 1_000_000
+#: Largest study: restitution x clearance x frequency points (each solution holds a few arrays of this size).
+MAX_STUDY_POINTS = 10_000_000
+#: Most output samples of one swept-sine run (7 floats each, plus the estimators' temporaries: ~1 GB).
+MAX_SWEEP_SAMPLES = 10_000_000
+#: Stiffest bumper accepted [Hz] (tested to 100 kHz; contact then lasts microseconds).
+MAX_BUMPER_FREQUENCY = 1e6
+#: Most periods of one benchmark run.
+MAX_BENCHMARK_PERIODS = 1_000_000
+
+
+@dataclass(frozen=True, eq=False)
+class SimulationSettings:
+    """How the time-domain solutions (``momentary``, ``exact``) are run.
+
+    Attributes
+    ----------
+    frequency : ndarray
+        Frequencies simulated [Hz] (a coarser grid than the analytic one, merged into the dataset's axis).
+    start : str
+        One of :data:`SIMULATION_STARTS`.
+    engine : EngineSettings
+        Integrator tolerances and method.
+    steady : SteadySettings
+        Convergence and measurement of the steady state.
+    """
+
+    frequency: np.ndarray
+    start: str = "pgf"
+    engine: EngineSettings = field(default_factory=EngineSettings)
+    steady: SteadySettings = field(default_factory=SteadySettings)
+
+
+@dataclass(frozen=True)
+class SweptSineSettings:
+    """A swept-sine test (the paper's Simulink run, section 5) instead of stepped steady states.
+
+    Attributes
+    ----------
+    start_frequency, stop_frequency : float
+        Ends of the sweep [Hz] (a sweep down runs from ``stop_frequency`` to ``start_frequency``).
+    rate : float
+        |alpha| [Hz s-1].
+    directions : tuple of str
+        Some of ``up``, ``down``.
+    sample_rate : float
+        Output samples per second of the simulated signals [Hz].
+    window_cycles : int
+        Cycles of the excitation in the running estimators' window.
+    initial_state : str
+        ``linear``: each run starts on the linear steady state at its first frequency (where it fits inside the
+        clearance; else at rest), so no start-up transient shows; ``rest``: at rest, like a bench test.
+    """
+
+    start_frequency: float
+    stop_frequency: float
+    rate: float
+    directions: tuple[str, ...] = SWEEP_DIRECTIONS
+    sample_rate: float = 1000.0
+    window_cycles: int = 8
+    initial_state: str = "linear"
+
+    def sweep(self, amplitude: float, direction: str) -> SweptSine:
+        """The excitation of one direction."""
+        low, high = self.start_frequency, self.stop_frequency
+        return SweptSine(amplitude, low, high, self.rate) if direction == "up" else SweptSine(amplitude, high, low, self.rate)
+
+
+@dataclass(frozen=True)
+class LadderSettings:
+    """One frequency point through every model, from the closed form to ever stiffer bumpers.
+
+    Attributes
+    ----------
+    frequency : float
+        Excitation frequency [Hz].
+    restitution : float
+        R [-] (the bumpers get the loss factor that gives it).
+    clearance : float
+        Delta [m].
+    bumper_frequencies : tuple of float
+        Omega_b / 2 pi of the compliant models [Hz].
+    rtol : float
+        Tolerance of the integrators (atol = rtol x the scene's atol_ratio).
+    repeats : int
+        Runs per model (median wall time).
+    """
+
+    frequency: float
+    restitution: float
+    clearance: float
+    bumper_frequencies: tuple[float, ...]
+    rtol: float = 1e-8
+    repeats: int = 3
+
+
+@dataclass(frozen=True)
+class BenchmarkCase:
+    """One benchmark run: the problem, where it starts and how long it lasts.
+
+    Attributes
+    ----------
+    name : str
+        Label of the case.
+    problem : ImpactProblem
+        System, rigid stop and harmonic force (a swept case: its start frequency), for the rigid-stop methods and
+        the start of every stepped run.
+    start : str
+        ``rest``, ``linear`` or ``pgf`` (see :func:`vibroimpact.simulation.steady.start_state`); swept cases start at rest.
+    periods : int
+        Whole periods integrated (stepped cases).
+    bumper : KelvinVoigtBumper or None
+        The compliant model's contact (its loss factor gives the stop's restitution); None: no compliant methods.
+    sweep : SweptSine or None
+        A swept-sine case of the compliant model.
+    sample_rate : float
+        Output samples per second of a swept case [Hz].
+    """
+
+    name: str
+    problem: ImpactProblem
+    start: str
+    periods: int
+    bumper: KelvinVoigtBumper | None = None
+    sweep: SweptSine | None = None
+    sample_rate: float = 2000.0
+
+    def runs(self, method: str) -> bool:
+        """Whether ``method`` applies to this case."""
+        contact = engine_spec(method).contact
+        if self.sweep is not None:
+            return contact == BUMPER or method.startswith("solve_ivp_")
+        return contact == RIGID or (contact == BUMPER and self.bumper is not None)
+
+
+@dataclass(frozen=True)
+class BenchmarkSettings:
+    """What to compare.
+
+    Attributes
+    ----------
+    methods : tuple of str
+        Names of :data:`BENCHMARK_METHODS`.
+    tolerances : tuple of float
+        Relative tolerances; atol = rtol * ``atol_ratio`` [m, m s-1].
+    atol_ratio : float
+        Absolute tolerance per unit of relative tolerance [m].
+    repeats : int
+        Runs per point (median wall time).
+    max_seconds : float
+        The largest run time allowed: tighter tolerances of a method are skipped once a run took longer [s].
+    ladder : LadderSettings or None
+        The model-cost ladder to measure as well.
+    """
+
+    methods: tuple[str, ...]
+    tolerances: tuple[float, ...]
+    atol_ratio: float = ATOL_RATIO
+    repeats: int = 3
+    max_seconds: float = 60.0
+    ladder: LadderSettings | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class BenchmarkScene:
+    """A benchmark scene's cases and settings (run by :mod:`vibroimpact.benchmarks.accuracy`)."""
+
+    cases: tuple[BenchmarkCase, ...]
+    settings: BenchmarkSettings
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A validated scene.
+
+    Attributes
+    ----------
+    name : str
+        Scene name; output goes to ``<out>/<name>.nc``.
+    description : str
+        Free text.
+    system : TwoDofSystem
+        The linear system.
+    amplitude : float
+        Excitation force amplitude q [N].
+    frequency : ndarray
+        Excitation frequencies [Hz], increasing.
+    restitution : ndarray
+        Restitution ratios R [-]; one value unless swept.
+    clearance : ndarray
+        Clearances Delta [m]; one value unless swept.
+    swept : tuple of str
+        Parameters that are dimensions of the output, in dimension order (``frequency`` last).
+    solutions : tuple of str
+        Solutions to compute.
+    quantities : tuple of str
+        Quantities to write.
+    admissibility : AdmissibilitySettings
+        Settings of the X2(t) <= Delta check.
+    simulation : SimulationSettings or None
+        Settings of the time-domain solutions, when the scene asks for any.
+    bumper_frequency : ndarray or None
+        Omega_b / 2 pi of the compliant bumper [Hz] (one value unless swept); None without a bumper.
+    bumper_loss_factor : ndarray or None
+        xi_b [-]: one value, or one per ``restitution`` when ``bumper_loss_factor`` is swept (``restitution`` then
+        holds R(xi_b), eq. 26 corrected); None: each restitution's own loss factor (the exact inverse of R(xi_b)).
+    swept_sine : SweptSineSettings or None
+        When given, the time-domain solutions are swept-sine tests, not stepped steady states.
+    report : bool
+        Whether ``run-study`` writes the comparison report.
+    text : str
+        The YAML source, stored in the output's attributes.
+    """
+
+    name: str
+    description: str
+    system: TwoDofSystem
+    amplitude: float
+    frequency: np.ndarray
+    restitution: np.ndarray
+    clearance: np.ndarray
+    swept: tuple[str, ...]
+    solutions: tuple[str, ...]
+    quantities: tuple[str, ...]
+    admissibility: AdmissibilitySettings = field(default_factory=AdmissibilitySettings)
+    simulation: SimulationSettings | None = None
+    benchmark: BenchmarkScene | None = None
+    bumper_frequency: np.ndarray | None = None
+    bumper_loss_factor: np.ndarray | None = None
+    swept_sine: SweptSineSettings | None = None
+    report: bool = True
+    text: str = ""
+
+    def loss_factors(self) -> np.ndarray:
+        """The bumper's xi_b for each restitution of the grid [-] (NaN where none gives it, R = 0)."""
+        if self.bumper_loss_factor is not None:
+            return np.broadcast_to(self.bumper_loss_factor, self.restitution.shape).astype(float)
+        return np.array([loss_factor_from_restitution(r) if r > 0.0 else np.nan for r in self.restitution])
+
+    @property
+    def kind(self) -> str:
+        """What kind of study the scene is: ``benchmark``, ``swept`` (swept-sine tests) or ``stepped`` (steady states).
+
+        The one place that decides it; everything else dispatches on this name.
+        """
+        if self.benchmark is not None:
+            return "benchmark"
+        return "stepped" if self.swept_sine is None else "swept"
+
+    @property
+    def sweep_directions(self) -> tuple[str, ...]:
+        """Directions of the swept-sine test; ``()`` for stepped steady states."""
+        return () if self.swept_sine is None else self.swept_sine.directions
+
+    @property
+    def all_frequencies(self) -> np.ndarray:
+        """The dataset's frequency axis: the analytic grid merged with the simulation grid [Hz]."""
+        if self.simulation is None:
+            return self.frequency
+        return np.union1d(self.frequency, self.simulation.frequency)

@@ -1,0 +1,64 @@
+"""The scene layer knows no solver: reading every shipped scene loads no engine, solver library, xarray or plotting."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+#: Modules (and everything under them) that reading a scene must not load.
+FORBIDDEN = (
+    "sksundae",
+    "scipy.integrate",
+    "xarray",
+    "matplotlib",
+    "netCDF4",
+    "vibroimpact.simulation.steady",
+    "vibroimpact.simulation.harmonics",
+    "vibroimpact.benchmarks",
+    "vibroimpact.study",
+    "vibroimpact.reporting",
+)
+#: What the scene may use of the engines package: the settings and the registry of names (no engine module).
+ENGINE_MODULES_ALLOWED = ("vibroimpact.engines", "vibroimpact.engines.settings", "vibroimpact.engines.registry")
+
+#: Run in a fresh interpreter: import the scene, parse every shipped scene, print the loaded modules.
+_PROGRAM = """
+import json, sys
+import vibroimpact.scene as scene
+for path in sorted(scene.shipped_studies_dir().glob("*.yaml")):
+    scene.load_scene(path)
+print(json.dumps(sorted(sys.modules)))
+"""
+
+
+def loaded_modules(program: str) -> list[str]:
+    """The names in ``sys.modules`` after ``program`` (which prints them as JSON) ran in a fresh interpreter."""
+    done = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True, check=True, timeout=120)
+    return json.loads(done.stdout.splitlines()[-1])
+
+
+def forbidden_among(modules: list[str]) -> list[str]:
+    """The modules of ``modules`` that the scene layer must not load."""
+    def under(name: str, package: str) -> bool:
+        return name == package or name.startswith(package + ".")
+
+    return [
+        name
+        for name in modules
+        if any(under(name, package) for package in FORBIDDEN) or (under(name, "vibroimpact.engines") and name not in ENGINE_MODULES_ALLOWED)
+    ]
+
+
+def test_reading_every_shipped_scene_loads_no_engine_solver_or_xarray() -> None:
+    modules = loaded_modules(_PROGRAM)
+    assert "vibroimpact.scene.reader" in modules  # the program did read scenes
+    assert forbidden_among(modules) == []
+
+
+def test_the_check_sees_an_engine_module() -> None:
+    """The same check on a program that also imports an engine names it (and its solver library)."""
+    modules = loaded_modules("import vibroimpact.engines.momentary\n" + _PROGRAM)
+    found = forbidden_among(modules)
+    assert "vibroimpact.engines.momentary" in found
+    assert any(name.startswith("sksundae") for name in found)
