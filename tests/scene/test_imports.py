@@ -6,6 +6,8 @@ import json
 import subprocess
 import sys
 
+import pytest
+
 #: Modules (and everything under them) that reading a scene must not load.
 FORBIDDEN = (
     "sksundae",
@@ -62,3 +64,19 @@ def test_the_check_sees_an_engine_module() -> None:
     found = forbidden_among(modules)
     assert "vibroimpact.engines.momentary" in found
     assert any(name.startswith("sksundae") for name in found)
+
+
+def test_engine_names_come_from_the_registry() -> None:
+    """Solutions integrated by an engine and benchmark methods are registered engines; the reference is no method."""
+    from vibroimpact.engines.registry import engine_names
+    from vibroimpact.scene import SceneError, load_scene, parse_scene, shipped_studies_dir
+    from vibroimpact.scene.schema import ENGINE_SOLUTIONS
+
+    assert set(ENGINE_SOLUTIONS) <= set(engine_names())
+    shipped = load_scene(shipped_studies_dir() / "accuracy_cost.yaml").benchmark
+    assert shipped is not None and set(shipped.settings.methods) <= set(engine_names())
+    case = {"name": "a", "frequency": 25.0, "restitution": 0.2, "clearance": 0.003, "start": "pgf"}
+    document = {"name": "b", "system": {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0}, "excitation": {"amplitude": 10.0}, "benchmark": {"duration": 1.0, "methods": ["solve_ivp_BDF", "exact"], "tolerances": [1e-6], "cases": [case]}}
+    with pytest.raises(SceneError) as caught:
+        parse_scene(document)
+    assert len(caught.value.problems) == 1 and caught.value.problems[0].startswith("benchmark.methods[1]: unknown name 'exact'")
