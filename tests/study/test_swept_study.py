@@ -14,7 +14,6 @@ from vibroimpact.analysis.regime import Regime
 from vibroimpact.scene import parse_scene
 from vibroimpact.study.io import write_dataset
 from vibroimpact.study.run import run_study
-from vibroimpact.study.swept_cases import sweep_start_state
 from vibroimpact.model.system import PAPER_SYSTEM
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
@@ -85,21 +84,6 @@ def test_slow_sweep_follows_the_steady_states(sweep_run: xr.Dataset) -> None:
         # the RMS of a nearly sinusoidal X1 is close to |X1| / sqrt 2 (harmonics add a little)
         ratio = line["swept_x1_rms"].values * np.sqrt(2.0) / line["swept_x1_amplitude"].values
         assert np.all((ratio > 0.99) & (ratio < 1.1)), ratio
-
-
-def test_linear_start_state_is_the_steady_response_to_the_sine() -> None:
-    from vibroimpact.model.excitation import SweptSine
-
-    sweep = SweptSine(10.0, 15.0, 45.0, 0.1)
-    state = sweep_start_state(PAPER_SYSTEM, sweep, 0.003)
-    # independently: (K - w^2 M + j w B) X = F with F = q exp(-j pi / 2) on the primary mass (q sin = Re(-j q e^{jwt}))
-    s = PAPER_SYSTEM
-    w = 2 * np.pi * 15.0
-    dynamic = np.array([[s.k1 + s.k2, -s.k2], [-s.k2, s.k2]]) - w**2 * np.diag([s.m1, s.m2]) + 1j * w * np.array([[s.b1 + s.b2, -s.b2], [-s.b2, s.b2]])
-    x = np.linalg.solve(dynamic, np.array([-10.0j, 0.0]))
-    assert state is not None
-    np.testing.assert_allclose(state, np.concatenate([x.real, (1j * w * x).real]), rtol=1e-12, atol=1e-15)
-    assert sweep_start_state(PAPER_SYSTEM, SweptSine(10.0, 23.0, 45.0, 0.1), 0.003) is None  # at resonance it would cross the stop
 
 
 @pytest.mark.timeout(120)

@@ -21,7 +21,8 @@ from vibroimpact.study.cost_model import Costs, EnginePart, Estimate, grid_estim
 from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates, solve_each, steady_variable
 from vibroimpact.study.runner import run_cases
 from vibroimpact.study.solutions import no_one_impact_orbit
-from vibroimpact.study.swept_cases import SWEEP_QUANTITIES, SWEEP_STATS, SweepCase
+from vibroimpact.simulation.swept import SWEEP_QUANTITIES
+from vibroimpact.study.swept_cases import SWEEP_STATS, SweepCase
 
 __all__ = ["SweptStudy", "swept_values", "REPORT_FIGURES"]
 
