@@ -1,14 +1,61 @@
 """vibroimpact: vibration protection by a tuned dynamic absorber whose motion is limited by a stop on the base.
 
 Linear two-degree-of-freedom model, closed-form periodic-Green-function (PGF) solution of the one-impact regime,
-and studies that put them side by side (seed paper: the absorber with a stop mounted on the base).
+time-domain engines, and studies that put them side by side (seed paper: the absorber with a stop mounted on the
+base). The names users import are available here and load their layer on first use, so ``import vibroimpact``
+stays light::
+
+    from vibroimpact import load_scene, run_study, write_dataset
+    dataset = run_study(load_scene("studies/restitution.yaml"), jobs=2)
 """
 
+from __future__ import annotations
+
+import importlib
 from importlib.metadata import PackageNotFoundError, version
+from typing import Any
 
 try:
     __version__ = version("vibroimpact")
 except PackageNotFoundError:  # running from a source tree without installation
     __version__ = "0+unknown"
 
-__all__ = ["__version__"]
+#: Public name -> the module that defines it (README, "Architecture").
+_PUBLIC = {
+    "TwoDofSystem": "vibroimpact.model.system",
+    "PAPER_SYSTEM": "vibroimpact.model.system",
+    "RigidStop": "vibroimpact.model.contact",
+    "KelvinVoigtBumper": "vibroimpact.model.contact",
+    "HarmonicForce": "vibroimpact.model.excitation",
+    "SweptSine": "vibroimpact.model.excitation",
+    "ImpactProblem": "vibroimpact.model.problem",
+    "solve_one_impact": "vibroimpact.analysis.pgf",
+    "linear_response": "vibroimpact.analysis.linear",
+    "EngineSettings": "vibroimpact.engines.settings",
+    "ENGINES": "vibroimpact.engines.registry",
+    "make_engine": "vibroimpact.engines.registry",
+    "steady_state": "vibroimpact.simulation.steady",
+    "Scene": "vibroimpact.scene",
+    "SceneError": "vibroimpact.scene",
+    "load_scene": "vibroimpact.scene",
+    "parse_scene": "vibroimpact.scene",
+    "find_scene": "vibroimpact.scene",
+    "run_study": "vibroimpact.study.run",
+    "write_dataset": "vibroimpact.study.io",
+    "write_report": "vibroimpact.reporting.report",
+}
+
+__all__ = ["__version__", *_PUBLIC]
+
+
+def __getattr__(name: str) -> Any:
+    """Load a public name's module on first use (PEP 562)."""
+    if name not in _PUBLIC:
+        raise AttributeError(f"module 'vibroimpact' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_PUBLIC[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

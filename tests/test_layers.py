@@ -1,0 +1,97 @@
+"""The package's layers import downward only, and the lower layers know nothing of YAML, xarray or plotting.
+
+Read from the source (every ``import`` statement, including those inside functions), so a new upward import fails
+here however rarely it runs.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "src" / "vibroimpact"
+#: Lowest first: a module may import from its own layer and those before it (README, "Architecture").
+LAYERS = ("model", "analysis", "engines", "simulation", "scene", "benchmarks", "study", "reporting", "cli")
+#: Third-party libraries a layer must not import (lower layers are physics and numerics only).
+FORBIDDEN_LIBRARIES = {
+    "model": ("yaml", "xarray", "matplotlib", "netCDF4", "sksundae"),
+    "analysis": ("yaml", "xarray", "matplotlib", "netCDF4", "sksundae"),
+    "engines": ("yaml", "xarray", "matplotlib", "netCDF4"),
+    "simulation": ("yaml", "xarray", "matplotlib", "netCDF4"),
+    "scene": ("xarray", "matplotlib", "netCDF4", "sksundae", "scipy.integrate"),
+}
+
+
+def layer_of(module: str) -> str | None:
+    """The layer of ``vibroimpact.<layer>...`` (``cli`` and the package itself are the top), None outside."""
+    parts = module.split(".")
+    if parts[0] != "vibroimpact" or module in ("vibroimpact", "vibroimpact.__version__"):
+        return None  # outside, or the package's version: metadata every layer may read
+    if len(parts) == 1:
+        return "cli"  # the package's __init__: lazy public names, the top
+    return parts[1] if parts[1] in LAYERS else "cli"
+
+
+def module_name(path: Path) -> str:
+    relative = path.relative_to(PACKAGE.parent).with_suffix("")
+    parts = list(relative.parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def imports(path: Path) -> list[tuple[int, str]]:
+    """(line, absolute module) of every import in ``path``, relative imports resolved."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [(node.lineno, alias.name) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                package = module_name(path).split(".")[: None if path.name == "__init__.py" else -1]
+                base = package[: len(package) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            found.append((node.lineno, target))
+            # ``from vibroimpact.x import y`` may name a module y: check it too
+            found += [(node.lineno, f"{target}.{alias.name}") for alias in node.names]
+    return found
+
+
+SOURCES = sorted(PACKAGE.rglob("*.py"))
+
+
+def test_every_subpackage_is_a_known_layer() -> None:
+    subpackages = {p.parent.relative_to(PACKAGE).parts[0] for p in SOURCES if p.parent != PACKAGE}
+    assert subpackages <= set(LAYERS) | {"studies"}, f"a subpackage that is no layer: {sorted(subpackages - set(LAYERS))}"
+
+
+@pytest.mark.parametrize("path", SOURCES, ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_imports_go_downward_only(path: Path) -> None:
+    own = layer_of(module_name(path)) or "cli"  # the package's own __init__ is the top
+    upward = []
+    for line, target in imports(path):
+        layer = layer_of(target)
+        if layer is not None and LAYERS.index(layer) > LAYERS.index(own):
+            upward.append(f"line {line}: {target} ({layer} is above {own})")
+    assert not upward, "upward imports:\n" + "\n".join(upward)
+
+
+@pytest.mark.parametrize("path", [p for p in SOURCES if layer_of(module_name(p)) in FORBIDDEN_LIBRARIES], ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_lower_layers_import_no_io_or_plotting(path: Path) -> None:
+    forbidden = FORBIDDEN_LIBRARIES[layer_of(module_name(path))]  # type: ignore[index]
+    bad = [f"line {line}: {target}" for line, target in imports(path) if any(target == name or target.startswith(name + ".") for name in forbidden)]
+    assert not bad, "forbidden imports:\n" + "\n".join(bad)
+
+
+def test_the_checks_see_an_upward_import(tmp_path: Path) -> None:
+    """The scan is not blind: an import of the study layer from a model module, even inside a function, is found."""
+    module = tmp_path / "probe.py"
+    module.write_text("def f():\n    from vibroimpact.study.run import run_study\n    import xarray\n")
+    found = [target for _line, target in imports(module)]
+    assert "vibroimpact.study.run" in found and "xarray" in found
+    assert LAYERS.index(layer_of("vibroimpact.study.run")) > LAYERS.index("model")  # type: ignore[arg-type]
