@@ -80,8 +80,9 @@ class SweptStudy:
     @staticmethod
     def simulation_attributes(scene: Scene) -> dict[str, object]:
         """What the dataset records of the sweep and of the compliant engine's tolerances."""
+        assert scene.swept_sine is not None
         attrs: dict[str, object] = {}
-        if scene.simulation is not None and scene.swept_sine is not None:
+        if scene.simulation is not None:
             for key, value in asdict(scene.swept_sine).items():
                 attrs[f"swept_sine_{key}"] = np.array(value, dtype=str) if key == "directions" else value
             for key in ("rtol", "atol", "max_step"):
