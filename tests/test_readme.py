@@ -48,3 +48,18 @@ def test_readme_reduction_factors_are_what_the_study_gives() -> None:
     for solution, label in (("pgf", "`pgf` (exact)"), ("pgf_paper", "`pgf_paper`")):
         expected = factors("x1_amplitude", solution) + factors("force_amplitude", solution)
         assert f"| {label} | {' | '.join(expected)} |" in readme
+
+
+def test_every_file_and_test_the_readme_names_exists() -> None:
+    """A path the README names (`simulation/steady.py`, `tests/model/test_system.py::test_x`) is there, and so is the
+    test: after a move, the README cannot send a reader to a file that is gone."""
+    text = (ROOT / "README.md").read_text()
+    missing = []
+    for path, test in re.findall(r"`([\w./-]+\.py)(?:::(\w+))?`", text):
+        places = [ROOT / path] if path.startswith(("src/", "tests/")) else [ROOT / "src" / "vibroimpact" / path, ROOT / "tests" / path, ROOT / "tests" / "hard_cases" / path]
+        found = next((place for place in places if place.is_file()), None)
+        if found is None:
+            missing.append(path)
+        elif test and not re.search(rf"def {test}\(", found.read_text()):
+            missing.append(f"{path}::{test}")
+    assert not missing, f"the README names what is not there: {missing}"
