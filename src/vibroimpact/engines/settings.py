@@ -31,7 +31,8 @@ class EngineSettings:
     Parameters
     ----------
     rtol, atol : float
-        Relative and absolute tolerances of the integrator (ignored by ``exact``, which is exact to round-off).
+        Relative and absolute [m] tolerances of the integrator (ignored by ``exact``, which is exact to round-off);
+        default :data:`STEPPED_TOLERANCES`.
     method : {'adams', 'bdf'}
         Linear multistep family of CVODE (``momentary``).
     max_step : float
@@ -45,8 +46,8 @@ class EngineSettings:
         Chattering safeguard: more impacts than this in one period force the sticking check.
     """
 
-    rtol: float = 1e-8
-    atol: float = 1e-12
+    rtol: float = STEPPED_TOLERANCES[0]
+    atol: float = STEPPED_TOLERANCES[1]
     method: str = "adams"
     max_step: float = 0.0
     sticking_velocity: float = 1e-6

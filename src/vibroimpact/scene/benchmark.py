@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from vibroimpact.engines.settings import STEPPED_TOLERANCES
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
 from vibroimpact.model.excitation import HarmonicForce, SweptSine
 from vibroimpact.model.problem import ImpactProblem
@@ -173,7 +174,7 @@ def _parse_ladder(c: Checker, value: Any) -> LadderSettings | None:
     restitution = c.number("benchmark.ladder.restitution", spec["restitution"], 0.0, 1.0, low_inclusive=False) if "restitution" in spec else None
     clearance = c.number("benchmark.ladder.clearance", spec["clearance"], 0.0, math.inf) if "clearance" in spec else None
     bumpers = c.grid("benchmark.ladder.bumper_frequencies", spec["bumper_frequencies"], 0.0, MAX_BUMPER_FREQUENCY, False) if "bumper_frequencies" in spec else None
-    rtol = c.number("benchmark.ladder.rtol", spec.get("rtol", 1e-8), 1e-14, 1e-2)
+    rtol = c.number("benchmark.ladder.rtol", spec.get("rtol", STEPPED_TOLERANCES[0]), 1e-14, 1e-2)
     repeats = c.integer("benchmark.ladder.repeats", spec.get("repeats", 3), 1, 100)
     if any(v is None for v in (frequency, restitution, clearance, bumpers, rtol, repeats)):
         return None

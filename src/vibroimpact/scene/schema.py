@@ -14,7 +14,7 @@ import numpy as np
 
 from vibroimpact.analysis.pgf import AdmissibilitySettings
 from vibroimpact.engines.registry import BUMPER, RIGID, engine_names, engine_spec
-from vibroimpact.engines.settings import ATOL_RATIO, EngineSettings
+from vibroimpact.engines.settings import ATOL_RATIO, STEPPED_TOLERANCES, EngineSettings
 from vibroimpact.model.contact import KelvinVoigtBumper, loss_factor_from_restitution
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem
@@ -170,7 +170,7 @@ class LadderSettings:
     bumper_frequencies : tuple of float
         Omega_b / 2 pi of the compliant models [Hz].
     rtol : float
-        Tolerance of the integrators (atol = rtol x the scene's atol_ratio).
+        Tolerance of the integrators (atol = rtol x the scene's atol_ratio); default: that of stepped steady states.
     repeats : int
         Runs per model (median wall time).
     """
@@ -179,7 +179,7 @@ class LadderSettings:
     restitution: float
     clearance: float
     bumper_frequencies: tuple[float, ...]
-    rtol: float = 1e-8
+    rtol: float = STEPPED_TOLERANCES[0]
     repeats: int = 3
 
 

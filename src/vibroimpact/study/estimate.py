@@ -50,14 +50,14 @@ def speed_probe(repeats: int = 3) -> float:
     import time
 
     from vibroimpact.engines.registry import make_engine
-    from vibroimpact.engines.settings import EngineSettings
+    from vibroimpact.engines.settings import STEPPED_TOLERANCES, EngineSettings
     from vibroimpact.model.contact import RigidStop
     from vibroimpact.model.excitation import HarmonicForce
     from vibroimpact.model.problem import ImpactProblem
     from vibroimpact.model.system import PAPER_SYSTEM
 
     problem = ImpactProblem(PAPER_SYSTEM, RigidStop(3e-3, 0.2), HarmonicForce(10.0, 25.0))
-    engines = (make_engine("exact"), make_engine("momentary", EngineSettings(rtol=1e-8, atol=1e-12)))
+    engines = (make_engine("exact"), make_engine("momentary", EngineSettings(*STEPPED_TOLERANCES)))
     best = math.inf
     for _ in range(repeats):
         started = time.perf_counter()

@@ -30,6 +30,7 @@ from scipy.integrate import solve_ivp
 
 from vibroimpact.engines.base import MODE_FREE, SweepRecord, TrajectoryBuilder, check_run
 from vibroimpact.engines.compliant.model import MODE_CONTACT
+from vibroimpact.engines.settings import SWEEP_SETTINGS
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.validation import require_positive
@@ -47,8 +48,8 @@ def solve_ivp_sweep(
     problem: ImpactProblem,
     sample_rate: float,
     method: str = "LSODA",
-    rtol: float = 1e-6,
-    atol: float = 1e-10,
+    rtol: float = SWEEP_SETTINGS.rtol,
+    atol: float = SWEEP_SETTINGS.atol,
     state: NDArray[np.float64] | None = None,
 ) -> SweepRecord:
     """The swept-sine test of :meth:`.compliant.CompliantEngine.sweep`, integrated with ``solve_ivp``.
