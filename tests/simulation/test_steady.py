@@ -2,23 +2,18 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce
-from vibroimpact.study import cases as simulate
 from vibroimpact.engines.exact import ExactEngine
 
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.momentary import MomentaryEngine
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import solve_one_impact
-from vibroimpact.study.runner import run_cases
-from vibroimpact.study.cases import SimulationCase
 from vibroimpact.simulation.steady import steady_state
 from vibroimpact.simulation.settings import SteadySettings
 from vibroimpact.model.system import TwoDofSystem
@@ -86,58 +81,3 @@ def test_unstable_pgf_orbit_is_left(system: TwoDofSystem, engine: object) -> Non
     result = steady_state(engine, problem, "pgf", SteadySettings(max_periods=300))  # type: ignore[arg-type]
     expected = pgf_values(system, 38.0, 0.2)
     assert not (result.converged and abs(abs(result.measures.x1) - expected["x1"]) < 1e-3 * expected["x1"])
-
-
-def _case(system: TwoDofSystem, start: str, engine: str = "exact", frequencies: tuple[float, ...] = (24.0, 24.5, 25.0, 25.5)) -> SimulationCase:
-    return SimulationCase(engine, system, PAPER_AMPLITUDE, RigidStop(PAPER_CLEARANCE, 0.2), frequencies, start, EngineSettings(), SteadySettings(tolerance=1e-9, max_periods=2000))
-
-
-@pytest.mark.parametrize("start", ["sweep_up", "sweep_down"])
-def test_stepped_sweep_lands_on_the_stable_orbits(system: TwoDofSystem, start: str) -> None:
-    """A stepped sweep through a band of stable one-impact orbits ends on each of them."""
-    case = _case(system, start)
-    result = simulate.run_case(case)
-    for i, frequency in enumerate(case.frequencies):
-        expected = pgf_values(system, frequency, 0.2)
-        assert result["converged"][i] == 1.0 and result["impacts_per_period"][i] == 1.0  # exact: flags and counts
-        assert abs(result["x1"][i]) == pytest.approx(expected["x1"], rel=1e-7)
-
-
-def test_cache_resumes_without_recomputing(system: TwoDofSystem, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    cases = [_case(system, "pgf", frequencies=(25.0,)), _case(system, "linear", frequencies=(30.0, 31.0))]
-    first = run_cases(cases, cache_dir=tmp_path, progress=False)
-    assert len(list(tmp_path.glob("*.npz"))) == 2
-
-    def fail(case: SimulationCase, report: object = None) -> dict:
-        raise AssertionError("a cached case was recomputed")
-
-    monkeypatch.setattr(simulate, "run_case", fail)
-    second = run_cases(cases, cache_dir=tmp_path, progress=False)
-    for a, b in zip(first, second):
-        for name in simulate.FIELDS:
-            if name != "wall_time":
-                np.testing.assert_array_equal(a[name], b[name])
-
-
-def test_processes_give_the_same_results(system: TwoDofSystem) -> None:
-    cases = [_case(system, "pgf", frequencies=(25.0, 26.0)), _case(system, "pgf", engine="momentary", frequencies=(25.0,))]
-    serial = run_cases(cases, jobs=1, progress=False)
-    parallel = run_cases(cases, jobs=2, progress=False)
-    for a, b in zip(serial, parallel):
-        np.testing.assert_array_equal(a["x1"], b["x1"])
-
-
-def test_a_failing_point_costs_only_itself(system: TwoDofSystem, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
-    """An engine failure at one frequency leaves NaN there, flagged, and the other points of the case are kept."""
-    real = simulate.steady_state
-
-    def flaky(engine: object, problem: ImpactProblem, start: object, settings: SteadySettings, orbit_stop: object = None) -> object:
-        if problem.frequency == 25.0:  # exact: a grid value
-            raise RuntimeError("CVODE failed (simulated)")
-        return real(engine, problem, start, settings, orbit_stop)  # type: ignore[arg-type]
-
-    monkeypatch.setattr(simulate, "steady_state", flaky)
-    result = simulate.run_case(_case(system, "sweep_up"))
-    assert list(result["failed"]) == [0.0, 0.0, 1.0, 0.0]
-    assert np.isnan(result["x1"][2]) and np.all(np.isfinite(result["x1"][[0, 1, 3]]))
-    assert "f = 25 Hz failed: CVODE failed (simulated)" in capsys.readouterr().err

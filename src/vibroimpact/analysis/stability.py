@@ -35,7 +35,7 @@ def floquet_multipliers(solution: OneImpactSolution) -> NDArray[np.complex128]:
     Parameters
     ----------
     solution : OneImpactSolution
-        Solutions from :func:`vibroimpact.pgf.solve_one_impact`.
+        Solutions from :func:`vibroimpact.analysis.pgf.solve_one_impact`.
     """
     system = solution.system
     shape = solution.omega.shape

@@ -3,7 +3,7 @@
 Each case is a stepped-sine run (frequency, restitution, clearance, start, periods), optionally with a bumper, or a
 swept-sine run of the compliant model. Rigid-stop methods (``momentary_*``, ``solve_ivp_*`` on stepped cases) are
 measured against the ``exact`` engine; compliant-model methods (``compliant_ida``, ``compliant_cvode_*``, and
-``solve_ivp_*`` on swept cases, through :func:`.engines.compliant_ivp.solve_ivp_sweep`) against the compliant model
+``solve_ivp_*`` on swept cases, through :func:`vibroimpact.engines.compliant.ivp.solve_ivp_sweep`) against the compliant model
 integrated by CVODE (Adams) at rtol 1e-13: another integrator, converged. Each impact of the reference is matched to
 the nearest impact of the method (within 1e-3 of a period); unmatched reference impacts are *missed*, unmatched
 method impacts *extra*; impact-time and impulse errors are over matched impacts. The quantity users care about most,
@@ -204,7 +204,7 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
     dataset.attrs["atol_ratio_m"] = settings.atol_ratio
     dataset.attrs["repeats"] = settings.repeats
     dataset.attrs["reference_rtol_compliant"] = REFERENCE_RTOL
-    for case in cases:  # what a run simulates, for per-period and per-second costs (vibroimpact.estimate)
+    for case in cases:  # what a run simulates, for per-period and per-second costs (vibroimpact.study.estimate.calibrate)
         dataset.attrs[f"case_{case.name}_duration_s"] = case.sweep.duration if case.sweep is not None else case.periods / case.problem.frequency
         dataset.attrs[f"case_{case.name}_frequency_Hz"] = case.problem.frequency
     if settings.ladder is not None and cases:

@@ -1,14 +1,14 @@
 """Cost of the paper's swept-sine test: the IDA engine against ``solve_ivp`` (LSODA, Radau, ...), in one process.
 
 The sweep (15 -> 45 Hz at 0.1 Hz/s, q = 10 N, Delta = 3 mm, 250 Hz bumper with R = 0.2, 1 kHz output) is run by
-:meth:`vibroimpact.engines.compliant.CompliantEngine.sweep` and by :func:`vibroimpact.engines.compliant_ivp.solve_ivp_sweep`
+:meth:`vibroimpact.engines.compliant.ida.CompliantEngine.sweep` and by :func:`vibroimpact.engines.compliant.ivp.solve_ivp_sweep`
 (independent code, same model) at the same tolerances. A method whose full run would exceed ``budget`` seconds
 (projected from the ratio of its wall time to IDA's on a 2 s contact-rich probe, 24 -> 24.2 Hz from rest) runs a
 stated slice instead: the contact-rich sweep 21 -> 24 Hz from rest (30 s, ~670 contacts), which IDA also runs, so
 that every ratio compares the same simulated span. Ratios are of wall time per simulated second.
 
 Each row also gives the largest difference of the running fundamental of X1 (8-cycle windows,
-:func:`vibroimpact.harmonics.running_fundamental`) from IDA's on the same span, and where it occurs, then the same
+:func:`vibroimpact.simulation.harmonics.running_fundamental`) from IDA's on the same span, and where it occurs, then the same
 within the slice's frequency band (21-24 Hz: contact-rich and reproducible) with the contacts counted there. Read
 them with the reference row (IDA at a tighter rtol): over the whole sweep the largest differences sit in the 33-39 Hz
 band and at the ends of the impact regimes (near 26.6 and 39.5 Hz), where the motion amplifies any perturbation:
@@ -55,7 +55,7 @@ class SweepCostSettings:
     bumper_frequency : float
         Omega_b / 2 pi [Hz].
     restitution : float
-        R [-]: the bumper's loss factor follows (:func:`vibroimpact.contact.loss_factor_from_restitution`).
+        R [-]: the bumper's loss factor follows (:func:`vibroimpact.model.contact.loss_factor_from_restitution`).
     sweep : SweptSine
         The full sweep.
     sample_rate : float

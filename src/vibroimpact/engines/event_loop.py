@@ -1,6 +1,7 @@
 """Bookkeeping shared by the integrator-based engines: modes, contact map, sticking, strobes, harmonic moments.
 
-An engine subclasses :class:`EventLoopEngine` and implements only :meth:`EventLoopEngine._advance` (integrate from
+An engine subclasses :class:`EventLoopEngine` and implements only :meth:`EventLoopEngine._begin` (set up its
+integrator) and :meth:`EventLoopEngine._advance` (integrate from
 a state until the period boundary or the first event). The integrated state is (X1, u, X1', X2') with the gap
 u = X2 - Delta in place of X2, so that positions near the stop keep their absolute precision (with X2 itself, a
 gap of 1e-20 m vanishes in X2 - Delta and the event function looks identically zero); it is followed, when harmonic

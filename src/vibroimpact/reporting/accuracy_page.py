@@ -1,6 +1,6 @@
 """Report pages of benchmark scenes: work-precision diagrams, tolerance guidance, and what accuracy costs.
 
-Every figure and table reads the dataset of :func:`vibroimpact.benchmark.run_benchmark` (dimensions case, engine,
+Every figure and table reads the dataset of :func:`vibroimpact.benchmarks.accuracy.run_benchmark` (dimensions case, engine,
 rtol), and the model-cost ladder when the scene asked for one. Wall times are medians of several runs, all measured
 in one process run: read ratios, not seconds.
 """
@@ -166,7 +166,7 @@ def _guidance_table(dataset: xr.Dataset) -> str:
 
 def _equal_error_table(dataset: xr.Dataset) -> str:
     """Per rigid-stop case and tolerance: momentary's wall time, its ratio to exact's, and the fastest solve_ivp method's
-    wall time at the same impact-time error (interpolated, :func:`vibroimpact.benchmark.equal_error_speedup`)."""
+    wall time at the same impact-time error (interpolated, :func:`vibroimpact.benchmarks.accuracy.equal_error_speedup`)."""
     ivp = [str(m) for m in dataset["engine"].values if str(m).startswith("solve_ivp")]
     rows = ["<tr><th>case</th><th>rtol</th><th>momentary_adams [s]</th><th>exact [s]</th><th>momentary / exact</th><th>best solve_ivp at equal error</th><th>its time / momentary's</th></tr>"]
     for case in dataset["case"].values:

@@ -4,7 +4,7 @@ A report is read in a browser about 1400 px wide. Figures are at most :data:`FIG
 they are shown unscaled and their text (at least :data:`MIN_FONT_SIZE`) stays legible; panels come at most
 :data:`MAX_COLUMNS` to a row; legends sit below the panels (:func:`figure_legend`), never on the data.
 
-How a solution's values are drawn (curves, markers, stability) is :mod:`vibroimpact.report_series`.
+How a solution's values are drawn (curves, markers, stability) is :mod:`vibroimpact.reporting.series`.
 """
 
 from __future__ import annotations

@@ -39,10 +39,10 @@ __all__ = [
     "GRID_DIMS",
 ]
 
-#: Solutions a scene can ask for.
-SOLUTIONS = ("linear", "pgf", "pgf_paper", "momentary", "exact", "compliant")
-#: Solutions computed by time integration (they need the ``simulation`` section's settings).
+#: Solutions computed by time integration (they need the ``simulation`` section's settings): registered engines.
 ENGINE_SOLUTIONS = ("momentary", "exact", "compliant")
+#: Solutions a scene can ask for: the closed forms, then the engines.
+SOLUTIONS = ("linear", "pgf", "pgf_paper", *ENGINE_SOLUTIONS)
 #: The contact law of each engine solution (from the engine registry, which must name every one of them).
 ENGINE_CONTACT = {name: engine_spec(name).contact for name in ENGINE_SOLUTIONS}
 #: The engine every rigid-stop benchmark method is measured against; a benchmark always runs it.

@@ -2,7 +2,7 @@
 
 Studies (:mod:`vibroimpact.study`), the accuracy benchmark and the sweep-cost table take their attributes from here,
 and reports read them back from the datasets. A new quantity gets its line here (and its place in
-:data:`vibroimpact.scene.core.QUANTITIES` if a scene may ask for it).
+:data:`vibroimpact.scene.schema.QUANTITIES` if a scene may ask for it).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Steady states of the time-domain engines over a study's grid, as cases for :func:`vibroimpact.runner.run_cases`.
+"""Steady states of the time-domain engines over a study's grid, as cases for :func:`vibroimpact.study.runner.run_cases`.
 
 A *case* is one engine at one contact (a rigid stop, or a bumper) over its frequencies: independent points for the ``linear``,
 ``pgf`` and ``rest`` starts, a chain for the stepped sweeps (``sweep_up``, ``sweep_down``: each point starts from the

@@ -14,6 +14,7 @@ from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import OneImpactSolution, PgfVariant, green_models, solve_one_impact
 from vibroimpact.analysis.regime import Regime, classify
 from vibroimpact.analysis.stability import floquet_multipliers
+from vibroimpact.engines.registry import BUMPER, engine_spec
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, peak_acceleration_factor
 from vibroimpact.scene.schema import Scene
 from vibroimpact.scene.variables import STABLE_MARGINAL
@@ -148,13 +149,14 @@ def no_one_impact_orbit(shape: tuple[int, ...]) -> dict[str, np.ndarray]:
 def simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], jobs: int, cache_dir: Path | None, progress: bool) -> dict[str, np.ndarray]:
     """Steady states of a time-domain engine on the simulation grid; NaN at the other frequencies.
 
-    Only ``compliant`` depends on the bumper: the rigid engines run once per (restitution, clearance).
+    Only a bumper engine (``compliant``) depends on the bumper: the rigid engines run once per (restitution, clearance).
     """
     assert scene.simulation is not None
     sim = scene.simulation
     columns = np.searchsorted(scene.all_frequencies, sim.frequency)
-    bumpers = scene.bumper_frequency if engine == "compliant" and scene.bumper_frequency is not None else np.array([np.nan])
-    losses = scene.loss_factors() if engine == "compliant" else np.full(scene.restitution.shape, np.nan)
+    on_bumper = engine_spec(engine).contact == BUMPER  # the registry says which contact law the engine solves
+    bumpers = scene.bumper_frequency if on_bumper and scene.bumper_frequency is not None else np.array([np.nan])
+    losses = scene.loss_factors() if on_bumper else np.full(scene.restitution.shape, np.nan)
     # a sweep is one chain; independent starts are split into chunks so that processes share the work evenly
     chunk = sim.frequency.size if sim.start in SWEEP_STARTS else CASE_CHUNK
     cases, places = [], []
@@ -164,7 +166,7 @@ def simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], jobs: in
                 for first in range(0, sim.frequency.size, chunk):
                     frequencies = tuple(float(f) for f in sim.frequency[first : first + chunk])
                     stop = RigidStop(float(clearance), float(restitution))  # the compliant engine's pgf start follows its orbit
-                    contact = KelvinVoigtBumper(float(clearance), float(bumper), float(losses[i])) if engine == "compliant" else stop
+                    contact = KelvinVoigtBumper(float(clearance), float(bumper), float(losses[i])) if on_bumper else stop
                     case = SimulationCase(engine, scene.system, scene.amplitude, contact, frequencies, sim.start, sim.engine, sim.steady, None if contact is stop else stop)
                     cases.append(case)
                     places.append((i, j, k, columns[first : first + chunk]))

@@ -1,4 +1,4 @@
-"""The compliant-bumper model of :mod:`.compliant` through SUNDIALS CVODE instead of IDA.
+"""The compliant-bumper model of :mod:`.model` (engine :mod:`.ida`) through SUNDIALS CVODE instead of IDA.
 
 Same model, events and bookkeeping (contact-mode flag, onset and release, recorded force and deceleration peaks,
 grazing apex check); only the integrator differs: the residual y' - f(t, y) of each mode is turned into the

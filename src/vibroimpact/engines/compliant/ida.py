@@ -10,7 +10,7 @@ this first step changed the step count by +-10 % without a trend: a restart cost
 either way, of ~170 per period at 25 Hz with one contact). The event records
 scikit-sundae keeps on an event function are cleared after every call, or each call would get slower (NOTES).
 Measured on the paper's 300 s swept-sine test (rtol 1e-6, 2858 contacts, one process): 10 s with
-:data:`SWEEP_SETTINGS`, 12 s with atol 1e-12; the earlier loop of one ``IDA.step`` per output and per root took
+:data:`~vibroimpact.engines.settings.SWEEP_SETTINGS`, 12 s with atol 1e-12; the earlier loop of one ``IDA.step`` per output and per root took
 16 s with every record cleared and ~155 s as it was, its steps slowing down as the ``_yp`` records piled up.
 Profiled, ~75 % of the time is inside ``IDA.solve`` outside the Python callbacks (SUNDIALS, and scikit-sundae
 wrapping the arrays of every callback), the rest in the residual and event functions; there are ~1.1 residual
@@ -19,7 +19,7 @@ calls per step attempt (the model is linear and the Jacobian exact).
 Tolerances: ``settings.rtol`` is the relative tolerance; ``settings.atol`` is the absolute tolerance of the
 displacements [m], and the other components get the same tolerance in their own units (:func:`absolute_tolerances`).
 With ``atol`` a small fraction of the motion's amplitude the error test no longer asks for a relative accuracy of
-each component as it crosses zero. The paper's swept-sine test uses :data:`SWEEP_SETTINGS` (rtol 1e-6, atol 1e-10 m).
+each component as it crosses zero. The paper's swept-sine test uses :data:`~vibroimpact.engines.settings.SWEEP_SETTINGS` (rtol 1e-6, atol 1e-10 m).
 
 Each contact is recorded as an impact (onset time, entry speed, impulse = integral of F) with its peak force and
 peak deceleration (``Trajectory.contact_peaks``). The bumper is the problem's contact (a

@@ -1,6 +1,6 @@
 """The compliant-bumper swept-sine test through ``scipy.integrate.solve_ivp``: a cross-check of the IDA engine.
 
-Written independently of :mod:`.compliant` (its own right-hand side, in the physical coordinates X1, X2, X1', X2',
+Written independently of :mod:`.ida` and :mod:`.model` (its own right-hand side, in the physical coordinates X1, X2, X1', X2',
 its own events and restarts), so that agreement between the two means something. The model is the same: the
 Kelvin-Voigt bumper of eq. 25 pushes with F = K (X2 - Delta) + B X2' from the moment X2 reaches Delta until F falls
 to zero. The loop a user of SciPy would write:
@@ -13,7 +13,7 @@ to zero. The loop a user of SciPy would write:
   dense output).
 
 The state carries the force integral and the Fourier integral of the force against the sweep's phase, so the record
-has the same impulses and ``contact_fourier`` as :meth:`.compliant.CompliantEngine.sweep`. Implicit methods get the
+has the same impulses and ``contact_fourier`` as :meth:`.ida.CompliantEngine.sweep`. Implicit methods get the
 mode's constant Jacobian (the Fourier rows excepted: they vary with time; solve_ivp's finite differences fill them
 when ``jac`` is omitted, so it is given without them).
 """
@@ -52,7 +52,7 @@ def solve_ivp_sweep(
     atol: float = SWEEP_SETTINGS.atol,
     state: NDArray[np.float64] | None = None,
 ) -> SweepRecord:
-    """The swept-sine test of :meth:`.compliant.CompliantEngine.sweep`, integrated with ``solve_ivp``.
+    """The swept-sine test of :meth:`.ida.CompliantEngine.sweep`, integrated with ``solve_ivp``.
 
     Parameters
     ----------

@@ -2,7 +2,7 @@
 
 The equations of motion are written as the residual ``y' - f(t, y)`` of the state (X1, u, X1', X2') with the gap
 u = X2 - Delta, then the running integral of the bumper force (impulses), then quadratures: for ``integrate``, the
-harmonic moments of :mod:`.event_loop` when asked (their contact-force channel integrates the bumper force itself);
+harmonic moments of :mod:`vibroimpact.engines.event_loop` when asked (their contact-force channel integrates the bumper force itself);
 for ``sweep``, the Fourier integral of the bumper force against the sweep's own phase, integral of
 F exp(-j theta) theta' dt (the force is a pulse far shorter than the output sampling: it cannot be summed from
 samples). In contact the bumper force F = K u + B X2' acts on the absorber, outside it does not. Each mode has its
