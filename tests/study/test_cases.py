@@ -13,7 +13,7 @@ from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.simulation.settings import SteadySettings
-from vibroimpact.study import cases
+from vibroimpact.study import cases as study_cases
 from vibroimpact.study.cases import SimulationCase
 from vibroimpact.study.runner import run_cases
 
@@ -29,7 +29,7 @@ def _case(system: TwoDofSystem, start: str, engine: str = "exact", frequencies: 
 def test_stepped_sweep_lands_on_the_stable_orbits(system: TwoDofSystem, start: str) -> None:
     """A stepped sweep through a band of stable one-impact orbits ends on each of them."""
     case = _case(system, start)
-    result = cases.run_case(case)
+    result = study_cases.run_case(case)
     for i, frequency in enumerate(case.frequencies):
         expected = pgf_values(system, frequency, 0.2)
         assert result["converged"][i] == 1.0 and result["impacts_per_period"][i] == 1.0  # exact: flags and counts
@@ -44,10 +44,10 @@ def test_cache_resumes_without_recomputing(system: TwoDofSystem, tmp_path: Path,
     def fail(case: SimulationCase, report: object = None) -> dict:
         raise AssertionError("a cached case was recomputed")
 
-    monkeypatch.setattr(cases, "run_case", fail)
+    monkeypatch.setattr(study_cases, "run_case", fail)
     second = run_cases(cases, cache_dir=tmp_path, progress=False)
     for a, b in zip(first, second):
-        for name in cases.FIELDS:
+        for name in study_cases.FIELDS:
             if name != "wall_time":
                 np.testing.assert_array_equal(a[name], b[name])
 
@@ -62,15 +62,15 @@ def test_processes_give_the_same_results(system: TwoDofSystem) -> None:
 
 def test_a_failing_point_costs_only_itself(system: TwoDofSystem, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
     """An engine failure at one frequency leaves NaN there, flagged, and the other points of the case are kept."""
-    real = cases.steady_state
+    real = study_cases.steady_state
 
     def flaky(engine: object, problem: ImpactProblem, start: object, settings: SteadySettings, orbit_stop: object = None) -> object:
         if problem.frequency == 25.0:  # exact: a grid value
             raise RuntimeError("CVODE failed (simulated)")
         return real(engine, problem, start, settings, orbit_stop)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(cases, "steady_state", flaky)
-    result = cases.run_case(_case(system, "sweep_up"))
+    monkeypatch.setattr(study_cases, "steady_state", flaky)
+    result = study_cases.run_case(_case(system, "sweep_up"))
     assert list(result["failed"]) == [0.0, 0.0, 1.0, 0.0]
     assert np.isnan(result["x1"][2]) and np.all(np.isfinite(result["x1"][[0, 1, 3]]))
     assert "f = 25 Hz failed: CVODE failed (simulated)" in capsys.readouterr().err
