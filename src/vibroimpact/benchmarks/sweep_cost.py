@@ -33,7 +33,7 @@ from vibroimpact.model.contact import KelvinVoigtBumper, loss_factor_from_restit
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.engines.base import SweepRecord
 from vibroimpact.engines.registry import make_engine
-from vibroimpact.engines.settings import SWEEP_SETTINGS, EngineSettings
+from vibroimpact.engines.settings import SWEEP_REFERENCE_RTOL, SWEEP_SETTINGS, EngineSettings
 from vibroimpact.engines.compliant.ivp import IVP_METHODS, solve_ivp_sweep
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.simulation.harmonics import running_fundamental
@@ -85,7 +85,7 @@ class SweepCostSettings:
     budget: float = 120.0
     slice_sweep: SweptSine = SweptSine(10.0, 21.0, 24.0, 0.1)
     probe_sweep: SweptSine = SweptSine(10.0, 24.0, 24.2, 0.1)
-    reference_rtol: float | None = 1e-9
+    reference_rtol: float | None = SWEEP_REFERENCE_RTOL
 
     def __post_init__(self) -> None:
         unknown = [m for m in self.methods if m not in IVP_METHODS]
@@ -250,5 +250,5 @@ def settings_from_arguments(args: argparse.Namespace) -> SweepCostSettings:
         engine_settings=EngineSettings(rtol=args.rtol, atol=args.atol),
         methods=tuple(m for m in args.methods.split(",") if m),
         budget=args.budget,
-        reference_rtol=None if args.no_reference else 1e-9,
+        reference_rtol=None if args.no_reference else SWEEP_REFERENCE_RTOL,
     )

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 from vibroimpact.model.validation import require_in_range, require_non_negative
 
-__all__ = ["EngineSettings", "STEPPED_TOLERANCES", "SWEPT_TOLERANCES", "SWEEP_SETTINGS", "REFERENCE_RTOL", "ATOL_RATIO"]
+__all__ = ["EngineSettings", "STEPPED_TOLERANCES", "SWEPT_TOLERANCES", "SWEEP_SETTINGS", "SWEEP_REFERENCE_RTOL", "REFERENCE_RTOL", "ATOL_RATIO"]
 
 #: (rtol, atol [m]) of a scene's stepped steady states when the scene sets none.
 STEPPED_TOLERANCES = (1e-8, 1e-12)
@@ -68,3 +68,5 @@ class EngineSettings:
 #: ~5 % but drifts 5-10x farther after the regime change near 39.5 Hz (``benchmarks.sweep_cost`` and
 #: tests/engines/test_compliant.py measure both).
 SWEEP_SETTINGS = EngineSettings(rtol=1e-6, atol=1e-10)
+#: Relative tolerance of the tighter IDA run that ``run-study sweep-cost`` measures the others against.
+SWEEP_REFERENCE_RTOL = 1e-9
