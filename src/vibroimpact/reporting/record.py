@@ -21,12 +21,10 @@ import yaml
 
 from vibroimpact.analysis.regime import Regime
 from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.scene.schema import ENGINE_SOLUTIONS
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS, STUDY_KINDS
 
-__all__ = ["STUDY_KINDS", "SWEPT_SOLUTION", "StudyRecord", "StudySetting", "study_kind", "study_record", "study_setting", "stored_description"]
+__all__ = ["SWEPT_SOLUTION", "StudyRecord", "StudySetting", "study_kind", "study_record", "study_setting", "stored_description"]
 
-#: Kinds of study, each with a page type of its own (:func:`vibroimpact.reporting.report.page_for`).
-STUDY_KINDS = ("stepped", "swept", "benchmark")
 #: The solution a swept-sine test runs: the compliant bumper (scenes allow no other); its estimates are the
 #: ``swept_<quantity>`` variables, not a value of the ``solution`` coordinate.
 SWEPT_SOLUTION = "compliant"

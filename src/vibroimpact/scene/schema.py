@@ -39,6 +39,8 @@ __all__ = [
     "GRID_DIMS",
 ]
 
+#: Kinds of study a scene can be (:attr:`Scene.kind`); each has its run and estimate (``study/kinds.py``) and its page.
+STUDY_KINDS = ("stepped", "swept", "benchmark")
 #: Solutions computed by time integration (they need the ``simulation`` section's settings): registered engines.
 ENGINE_SOLUTIONS = ("momentary", "exact", "compliant")
 #: Solutions a scene can ask for: the closed forms, then the engines.
