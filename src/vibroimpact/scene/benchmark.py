@@ -38,6 +38,7 @@ from vibroimpact.scene.schema import (
     Scene,
 )
 from vibroimpact.scene.sections import NAME, check_sweep_run, parse_header
+from vibroimpact.simulation.settings import START_MODES
 
 __all__ = ["BENCHMARK_TOP_KEYS", "parse_benchmark_scene"]
 
@@ -115,9 +116,9 @@ def parse_benchmark_scene(document: dict, text: str = "", source: str = "scene")
             c.fail(key, "give exactly one of 'clearance' [m] or 'clearance_below_linear' [m]")
             continue
         start = case.get("start", "rest")
-        if start not in ("rest", "linear", "pgf"):
+        if start not in START_MODES:
             c.fail(f"{key}.start", f"{start!r} is not allowed: use rest, linear or pgf")
-        if None in (frequency, restitution, system, amplitude, duration, bumper) or start not in ("rest", "linear", "pgf"):
+        if None in (frequency, restitution, system, amplitude, duration, bumper) or start not in START_MODES:
             continue
         assert system is not None and frequency is not None and amplitude is not None and duration is not None and restitution is not None and bumper is not None
         if "clearance" in case:

@@ -19,7 +19,7 @@ from vibroimpact.model.contact import KelvinVoigtBumper, loss_factor_from_restit
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.simulation.settings import SteadySettings
+from vibroimpact.simulation.settings import START_MODES, SWEEP_STARTS, SteadySettings
 
 __all__ = [
     "Scene",
@@ -54,7 +54,7 @@ BENCHMARK_METHODS = tuple(name for name in engine_names() if name != BENCHMARK_R
 #: Directions of a swept-sine test.
 SWEEP_DIRECTIONS = ("up", "down")
 #: How a simulation starts at each frequency.
-SIMULATION_STARTS = ("linear", "pgf", "rest", "sweep_up", "sweep_down")
+SIMULATION_STARTS = START_MODES + SWEEP_STARTS
 #: Quantities a scene can ask for (``regime`` is always written: it says what the others mean).
 QUANTITIES = (
     "x1_amplitude",

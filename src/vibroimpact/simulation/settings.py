@@ -6,7 +6,12 @@ from dataclasses import dataclass
 
 from vibroimpact.model.validation import require_in_range
 
-__all__ = ["SteadySettings"]
+__all__ = ["SteadySettings", "START_MODES", "SWEEP_STARTS"]
+
+#: Where a steady state at one frequency starts: the linear steady state, the one-impact (PGF) orbit, or rest.
+START_MODES = ("linear", "pgf", "rest")
+#: Stepped sweeps over a frequency grid: each point starts from the previous one's end state (up or down in frequency).
+SWEEP_STARTS = ("sweep_up", "sweep_down")
 
 
 @dataclass(frozen=True)

@@ -20,11 +20,10 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.simulation.harmonics import HarmonicMeasures, measure
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
-from vibroimpact.simulation.settings import SteadySettings
+from vibroimpact.simulation.settings import START_MODES, SteadySettings
 
 __all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "orbit_stop_of", "START_MODES"]
 
-START_MODES = ("linear", "pgf", "rest")
 
 
 @dataclass(frozen=True)

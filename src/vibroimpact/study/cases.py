@@ -23,12 +23,11 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.study.fingerprint import case_key
 from vibroimpact.study.runner import CaseResult, ProgressReport
 from vibroimpact.simulation.steady import linear_fits, steady_state
-from vibroimpact.simulation.settings import SteadySettings
+from vibroimpact.simulation.settings import SWEEP_STARTS, SteadySettings
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["SWEEP_STARTS", "SimulationCase", "run_case"]
+__all__ = ["SimulationCase", "run_case"]
 
-SWEEP_STARTS = ("sweep_up", "sweep_down")
 #: Fields of a case result, one value per frequency.
 FIELDS = (
     "x1",
@@ -67,7 +66,7 @@ class SimulationCase:
     frequencies : tuple of float
         Excitation frequencies [Hz].
     start : str
-        A start of :data:`vibroimpact.simulation.steady.START_MODES` or of :data:`SWEEP_STARTS`.
+        A start of :data:`~vibroimpact.simulation.settings.START_MODES` or of :data:`~vibroimpact.simulation.settings.SWEEP_STARTS`.
     engine_settings, steady_settings
         Numerical settings.
     orbit_stop : RigidStop or None

@@ -18,7 +18,8 @@ from vibroimpact.engines.registry import BUMPER, engine_spec
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, peak_acceleration_factor
 from vibroimpact.scene.schema import Scene
 from vibroimpact.scene.variables import STABLE_MARGINAL
-from vibroimpact.study.cases import FIELDS, SWEEP_STARTS, SimulationCase
+from vibroimpact.simulation.settings import SWEEP_STARTS
+from vibroimpact.study.cases import FIELDS, SimulationCase
 from vibroimpact.study.runner import run_cases
 
 __all__ = ["linear_values", "pgf_values", "peak_estimates", "no_one_impact_orbit", "simulated_values", "MARGINAL_MODULUS", "CASE_CHUNK"]

@@ -10,8 +10,10 @@ import xarray as xr
 
 from vibroimpact.analysis.pgf import solve_one_impact
 from vibroimpact.analysis.stability import floquet_multipliers
+from vibroimpact.engines.registry import BUMPER, engine_spec
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, Scene
 from vibroimpact.scene.variables import quantity_attributes
+from vibroimpact.simulation.settings import SWEEP_STARTS
 from vibroimpact.study.cost_model import Costs, EnginePart, Estimate, grid_estimate
 from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates, solve_each, steady_variable
 from vibroimpact.study.solutions import simulated_values
@@ -63,17 +65,18 @@ class SteppedStudy:
         """Seconds per simulated period of each engine at its tolerance times the periods each point is predicted to
         integrate (:func:`expected_periods`), on the calibration machine."""
         bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
+        # the same for every engine: solved once (the closed form over up to ESTIMATE_POINTS points)
+        periods, scale = expected_periods(scene) if scene.simulation is not None else (np.zeros(0), 1.0)
 
         def engine_part(name: str, engine: str) -> EnginePart:
             assert scene.simulation is not None
-            periods, scale = expected_periods(scene)
-            copies = bumpers if name == "compliant" else 1
+            copies = bumpers if engine_spec(name).contact == BUMPER else 1  # a bumper engine runs once per bumper
             total_periods = float(periods.sum()) * scale * copies
             seconds = costs.per_period_cost(engine, scene.simulation.engine.rtol) * total_periods
             integrated = int(np.count_nonzero(periods) * scale) * copies
             points = f"{scene.restitution.size * scene.clearance.size * scene.simulation.frequency.size * copies} points, ~{integrated} integrated, ~{total_periods:.0f} periods"
             serial = 0.0
-            if scene.simulation.start in ("sweep_up", "sweep_down"):  # one serial chain per (R, Delta, bumper)
+            if scene.simulation.start in SWEEP_STARTS:  # one serial chain per (R, Delta, bumper)
                 serial = seconds / (scene.restitution.size * scene.clearance.size * copies)
             return seconds, points, serial
 
@@ -115,7 +118,7 @@ def expected_periods(scene: Scene) -> tuple[np.ndarray, float]:
         stable = admissible & (modulus < 1.0)
     fits = orbit.linear_amplitude_x2 <= orbit.clearance
     settle = SETTLING_PERIODS + steady.measure_periods
-    if sim.start in ("sweep_up", "sweep_down"):
+    if sim.start in SWEEP_STARTS:
         # a chain: a fitting point is answered linear unless the point before it impacted (then it integrates from
         # there, and keeps impacting where a one-impact orbit coexists with the linear motion)
         order = range(frequencies.size) if sim.start == "sweep_up" else range(frequencies.size - 1, -1, -1)
