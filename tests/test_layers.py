@@ -13,12 +13,13 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "vibroimpact"
 #: Lowest first: a module may import from its own layer and those before it (README, "Architecture").
-LAYERS = ("model", "analysis", "engines", "simulation", "scene", "benchmarks", "study", "reporting", "cli")
+LAYERS = ("model", "analysis", "engines", "orbits", "simulation", "scene", "benchmarks", "study", "reporting", "cli")
 #: Third-party libraries a layer must not import (lower layers are physics and numerics only).
 FORBIDDEN_LIBRARIES = {
     "model": ("yaml", "xarray", "matplotlib", "netCDF4", "sksundae"),
     "analysis": ("yaml", "xarray", "matplotlib", "netCDF4", "sksundae"),
     "engines": ("yaml", "xarray", "matplotlib", "netCDF4"),
+    "orbits": ("yaml", "xarray", "matplotlib", "netCDF4", "sksundae"),
     "simulation": ("yaml", "xarray", "matplotlib", "netCDF4"),
     "scene": ("xarray", "matplotlib", "netCDF4", "sksundae", "scipy.integrate"),
 }
