@@ -1,0 +1,208 @@
+"""Test functions of the special points of a branch, their location, and branch switching at a period doubling.
+
+Test functions (each changes sign at its point):
+
+* fold: the continued parameter's component of the branch tangent (the branch turns back);
+* period doubling: ``det(J + I)`` (a real multiplier crosses -1);
+* Neimark-Sacker: ``det(J(2) - I)`` with ``J(2)`` the second compound (bialternate) matrix of the monodromy, whose
+  eigenvalues are the products mu_i mu_j (i < j): it vanishes when a complex pair crosses the unit circle, and also
+  at a neutral saddle (a real pair with mu_i mu_j = 1), which the location rejects;
+* grazing (hybrid maps): the margin to grazing, ``min(-closest_approach / L, min_impact_velocity / V)`` with the
+  sign of the side: positive with the impact count of the branch's start, negative with another count (or where
+  no orbit is found). It reaches 0 where a free flight touches the stop (a new impact is born) or an impact's
+  velocity goes to zero.
+
+Location: the branch between two points a and b is parametrised by the arclength sigma along a's tangent; at each
+trial sigma the corrector puts the point back on the branch and the test function is evaluated there; sigma is
+found by regula falsi with the Illinois modification (bisection when a trial fails), to a tolerance that gives the
+parameter to better than 1e-8 relative.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from itertools import combinations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from vibroimpact.orbits.arclength import ArclengthSystem, Point
+from vibroimpact.orbits.branch import HybridInfo, Iterated, MapEvaluation, ParametrisedMap, PeriodicOrbit, SpecialPoint
+
+__all__ = [
+    "second_compound",
+    "fold_test",
+    "period_doubling_test",
+    "neimark_sacker_test",
+    "grazing_margin",
+    "locate",
+    "classify",
+    "switch_period_doubling",
+]
+
+
+def second_compound(matrix: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Second compound matrix (2x2 minors, rows and columns indexed by pairs i < j); eigenvalues mu_i mu_j."""
+    pairs = list(combinations(range(matrix.shape[0]), 2))
+    out = np.empty((len(pairs), len(pairs)))
+    for a, (i, j) in enumerate(pairs):
+        for b, (k, l) in enumerate(pairs):
+            out[a, b] = matrix[i, k] * matrix[j, l] - matrix[i, l] * matrix[j, k]
+    return out
+
+
+def fold_test(point: Point, index: int) -> float:
+    """The tangent's component along the continued parameter (unknown ``index`` of z)."""
+    return float(point.tangent[index])
+
+
+def period_doubling_test(out: MapEvaluation) -> float:
+    """det(J + I) of the monodromy."""
+    return float(np.linalg.det(out.jacobian + np.eye(out.jacobian.shape[0])))
+
+
+def neimark_sacker_test(out: MapEvaluation) -> float:
+    """det(J(2) - I) of the monodromy's second compound (0 when mu_i mu_j = 1 for a pair); 0 for a 1-D map."""
+    if out.jacobian.shape[0] < 2:
+        return 1.0
+    compound = second_compound(out.jacobian)
+    return float(np.linalg.det(compound - np.eye(compound.shape[0])))
+
+
+def grazing_margin(info: HybridInfo) -> float:
+    """Dimensionless distance to grazing, >= 0: min(-closest_approach / L, min_impact_velocity / V)."""
+    return float(min(-info.closest_approach / info.length_scale, info.min_impact_velocity / info.velocity_scale))
+
+
+def locate(
+    arc: ArclengthSystem,
+    start: Point,
+    end_sigma: float,
+    test: Callable[[Point | None], float | None],
+    tolerance: float,
+    corrector_tolerance: float,
+    max_iterations: int = 80,
+) -> tuple[Point, Point | None, float]:
+    """The point between ``start`` (sigma = 0) and sigma = ``end_sigma`` where ``test`` changes sign.
+
+    Parameters
+    ----------
+    arc : ArclengthSystem
+        The continuation problem.
+    start : Point
+        Point a, with its tangent.
+    end_sigma : float
+        Arclength (along a's tangent) of point b, where the test has the other sign.
+    test : callable
+        Test value of a corrected point (``None`` is passed when the corrector fails; the test may return ``None``
+        for "the far side, no value": then the bracket is bisected).
+    tolerance : float
+        Bracket width in sigma at which to stop.
+    corrector_tolerance : float
+        Scaled residual of the corrector.
+
+    Returns
+    -------
+    (Point, Point or None, float)
+        The last point with a's sign, the last point with b's sign (None if none was found there) and the final
+        bracket width.
+    """
+    f_lo = test(start)
+    lo, hi, f_hi = 0.0, float(end_sigma), None
+    lo_point, hi_point = start, None
+    sign = np.sign(f_lo) if f_lo else 1.0
+    side = 0
+    for _ in range(max_iterations):
+        if hi - lo <= tolerance:
+            break
+        if f_hi is None or f_lo is None:
+            sigma = 0.5 * (lo + hi)
+        else:
+            sigma = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
+            if not lo < sigma < hi:
+                sigma = 0.5 * (lo + hi)
+        trial = arc.correct(start.z + sigma * start.tangent, start.tangent, corrector_tolerance, 12)
+        value = test(trial)
+        if value is not None and np.sign(value) == sign:
+            lo, f_lo, lo_point = sigma, value, trial
+            if side == 1 and f_hi is not None:
+                f_hi *= 0.5  # Illinois: the retained end's value is halved when the same end moves twice
+            side = 1
+        else:
+            hi, f_hi, hi_point = sigma, value, trial if value is not None else hi_point
+            if side == -1 and f_lo is not None:
+                f_lo *= 0.5
+            side = -1
+        if value is not None and value == 0.0:  # exact: the test vanishes at a trial point
+            return trial, trial, 0.0
+    return lo_point, hi_point, hi - lo
+
+
+def _closest(multipliers: NDArray[np.complex128], target: complex) -> complex:
+    return complex(multipliers[np.argmin(np.abs(multipliers - target))])
+
+
+def classify(kind: str, orbit: PeriodicOrbit, parameter: str, test_value: float) -> SpecialPoint | None:
+    """The special point of ``kind`` at ``orbit``, or None when its multipliers deny it (a neutral saddle)."""
+    mu = orbit.multipliers
+    if kind == "neimark_sacker":
+        pair = mu[np.abs(mu.imag) > 1e-9 * np.maximum(np.abs(mu), 1e-300)]
+        if pair.size == 0 or np.min(np.abs(np.abs(pair) - 1.0)) > 1e-5:
+            return None
+        critical = pair[np.argmin(np.abs(np.abs(pair) - 1.0))]
+        note = f"complex pair crosses the unit circle at angle {abs(np.angle(critical)):.6g} rad"
+        return SpecialPoint(kind, orbit, parameter, orbit.parameter(parameter), test_value, note)
+    if kind == "period_doubling":
+        eigenvalues, vectors = np.linalg.eig(orbit.monodromy)
+        k = int(np.argmin(np.abs(eigenvalues + 1.0)))
+        vector = np.real(vectors[:, k])
+        note = f"multiplier {_closest(mu, -1.0).real:.10g} crosses -1"
+        return SpecialPoint(kind, orbit, parameter, orbit.parameter(parameter), test_value, note, eigenvector=vector / np.linalg.norm(vector))
+    if kind == "fold":
+        note = f"the branch turns back; multiplier {_closest(mu, 1.0).real:.10g}"
+        return SpecialPoint(kind, orbit, parameter, orbit.parameter(parameter), test_value, note)
+    raise ValueError(f"kind = {kind!r}: classify handles fold, period_doubling and neimark_sacker")
+
+
+def switch_period_doubling(system: ParametrisedMap, point: SpecialPoint, amplitude: float = 1e-3, tolerance: float = 1e-11) -> PeriodicOrbit:
+    """The period-2k orbit born at a period doubling, from the guess y* +- eps v (v: the -1 eigenvector).
+
+    At the period doubling the fixed points of P^{2k} have a pitchfork: the period-k branch and the period-2k one,
+    whose tangent there is (v, 0). The guess y* + eps v is corrected by Newton's method on P^{2k}(y) - y = 0 with the
+    parameter free and the step kept orthogonal to v (a pseudo-arclength step of length eps along v), so the new
+    orbit is found on whichever side of the bifurcation it exists. Both signs of eps are tried.
+
+    Parameters
+    ----------
+    system : ParametrisedMap
+        The map P whose period-k orbit doubles (k is taken from the special point's orbit).
+    point : SpecialPoint
+        A ``period_doubling`` point.
+    amplitude : float
+        eps, relative to the map's state scale [-].
+    tolerance : float
+        Scaled residual of the corrector.
+
+    Returns
+    -------
+    PeriodicOrbit
+        A period-2k orbit (``period`` = 2k) whose two halves differ.
+    """
+    if point.kind != "period_doubling" or point.eigenvector is None:
+        raise ValueError(f"switch_period_doubling needs a period_doubling point, got {point.kind!r}")
+    orbit = point.orbit
+    k = orbit.period
+    doubled = Iterated(system, 2 * k)
+    index = orbit.parameter_names.index(point.parameter)
+    arc = ArclengthSystem(doubled, orbit.parameters, (index,))
+    direction = np.concatenate([point.eigenvector / arc.sy, [0.0]])
+    direction /= np.linalg.norm(direction)
+    start = arc.to_z(orbit.state, orbit.parameters)
+    for sign in (1.0, -1.0):
+        found = arc.correct(start + sign * amplitude * direction, direction, tolerance, 30)
+        if found is None:
+            continue
+        half = Iterated(system, k).evaluate(found.y, found.p).image
+        if np.max(np.abs(half - found.y) / arc.sy) > 0.1 * amplitude:
+            return found.orbit(doubled)
+    raise RuntimeError(f"no period-{2 * k} orbit found next to the period doubling at {point.parameter} = {orbit.parameter(point.parameter)!r}")

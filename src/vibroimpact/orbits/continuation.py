@@ -1,0 +1,293 @@
+"""Pseudo-arclength continuation of periodic orbits in one parameter, with the detection of special points.
+
+From a periodic orbit the branch is followed by predictor (a step h along the unit tangent in scaled variables) and
+corrector (Newton's method on ``P^k(y) - y = 0`` plus the arclength condition), so it goes around folds and through
+unstable parts alike. The step grows after an easy correction and shrinks after a hard or failed one, or when the
+tangent turns by more than ``max_turn``. Between consecutive points the test functions of
+:mod:`.bifurcations` are compared and every sign change is located and stored with its multipliers.
+
+The continuation stops at a bound of the parameter (the last point lies on the bound), after ``max_steps`` steps,
+when the branch closes on itself (an isola), when the step falls below ``min_step``, or at a grazing point when
+``stop_at_grazing``. At a grazing point the impact count changes (or no orbit is found beyond); the point is
+located, and the orbit beyond it, if Newton's method finds one, tells whether the branch continues with the new
+impact count (``SpecialPoint.continues``, ``impacts_after``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from vibroimpact.model.validation import require_in_range, require_positive
+from vibroimpact.orbits.arclength import ArclengthSystem, Point
+from vibroimpact.orbits.bifurcations import classify, grazing_margin, locate, neimark_sacker_test, period_doubling_test
+from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Branch, Iterated, ParametrisedMap, PeriodicOrbit, SpecialPoint
+
+__all__ = ["ContinuationSettings", "continue_branch"]
+
+
+@dataclass(frozen=True)
+class ContinuationSettings:
+    """How a branch is followed.
+
+    Parameters
+    ----------
+    step : float
+        First arclength step, in scaled variables (state / state_scale, parameter / parameter_scale) [-].
+    min_step, max_step : float
+        Limits of the adapted step [-].
+    max_steps : int
+        Most points on the branch (per direction).
+    lower, upper : float
+        Bounds of the continued parameter (its own unit, e.g. Hz).
+    tolerance : float
+        Scaled residual at which the corrector stops [-].
+    max_corrector_iterations : int
+        Newton iterations per corrector.
+    max_turn : float
+        Largest angle between consecutive tangents [rad]; a larger turn halves the step.
+    locate_tolerance : float
+        Relative precision of a located special point's parameter [-].
+    detect : tuple of str
+        Special points to detect (subset of ``SPECIAL_POINT_KINDS``).
+    stop_at_grazing : bool
+        End the branch at a grazing point (True), or carry on with the new impact count when an orbit exists there.
+    grazing_margin : float
+        A failed step from a point whose grazing margin is below this is searched for a grazing point [-].
+    """
+
+    step: float = 0.05
+    min_step: float = 1e-7
+    max_step: float = 0.5
+    max_steps: int = 2000
+    lower: float = -math.inf
+    upper: float = math.inf
+    tolerance: float = 1e-11
+    max_corrector_iterations: int = 8
+    max_turn: float = 0.35
+    locate_tolerance: float = 1e-10
+    detect: tuple[str, ...] = SPECIAL_POINT_KINDS
+    stop_at_grazing: bool = True
+    grazing_margin: float = 0.05
+
+    def __post_init__(self) -> None:
+        for name in ("step", "min_step", "max_step", "tolerance", "locate_tolerance", "grazing_margin"):
+            require_positive(name, getattr(self, name))
+        require_in_range("max_steps", self.max_steps, 1, 10**7)
+        require_in_range("max_turn", self.max_turn, 1e-3, math.pi / 2)
+        if not self.lower < self.upper:
+            raise ValueError(f"lower = {self.lower!r} must be below upper = {self.upper!r}")
+        unknown = set(self.detect) - set(SPECIAL_POINT_KINDS)
+        if unknown:
+            raise ValueError(f"detect: unknown kinds {sorted(unknown)}; allowed {SPECIAL_POINT_KINDS}")
+
+
+def _signature(point: Point) -> tuple[int, int] | None:
+    return point.out.hybrid.signature if point.out.hybrid is not None else None
+
+
+class _Walker:
+    """One direction of one branch."""
+
+    def __init__(self, system: ParametrisedMap, orbit: PeriodicOrbit, index: int, settings: ContinuationSettings) -> None:
+        self.system, self.index, self.settings = system, index, settings
+        self.name = system.parameter_names[index]
+        self.arc = ArclengthSystem(system, orbit.parameters, (index,))
+        self.n = system.dimension
+        self.specials: list[tuple[float, SpecialPoint]] = []
+
+    def tolerance(self, point: Point) -> float:
+        """Arclength bracket that gives the parameter to locate_tolerance relative."""
+        return self.settings.locate_tolerance * max(abs(point.z[self.n]), 1e-3)
+
+    def tests(self, point: Point) -> dict[str, float]:
+        kinds = self.settings.detect
+        values = {}
+        if "fold" in kinds:
+            values["fold"] = float(point.tangent[self.n])
+        if "period_doubling" in kinds:
+            values["period_doubling"] = period_doubling_test(point.out)
+        if "neimark_sacker" in kinds:
+            values["neimark_sacker"] = neimark_sacker_test(point.out)
+        return values
+
+    def special(self, kind: str, a: Point, sigma: float, arclength: float) -> None:
+        """Locate a sign change of ``kind``'s test between a and sigma along a's tangent, and keep it if real."""
+
+        def test(point: Point | None) -> float | None:
+            return None if point is None else self.tests(point)[kind]
+
+        tol = self.settings.tolerance
+        lo, hi, _width = locate(self.arc, a, sigma, test, self.tolerance(a), tol)
+        best = lo if hi is None or abs(test(lo) or 0.0) <= abs(test(hi) or 0.0) else hi
+        found = classify(kind, best.orbit(self.system), self.name, float(test(best) or 0.0))
+        if found is not None and kind == "fold" and self._collapsed(best):
+            self.parent = best  # not a fold: the period-2k branch meets the period-k orbit it was born from
+            return
+        if found is not None:
+            self.specials.append((arclength + float(a.tangent @ (best.z - a.z)), found))
+
+    def _collapsed(self, point: Point) -> bool:
+        """Is this fixed point of P^k (k even) a fixed point of P^(k/2): the period-doubling point of its parent?"""
+        if not isinstance(self.system, Iterated) or self.system.times % 2:
+            return False
+        half = Iterated(self.system.base, self.system.times // 2).evaluate(point.y, point.p).image
+        return bool(np.max(np.abs(half - point.y) / self.arc.sy) < 1e-3)  # amplitude ~ sqrt(parameter distance)
+
+    def grazing(self, a: Point, sigma: float, arclength: float) -> object:
+        """Locate a grazing point between a and sigma; return the point beyond it (None: the branch ends there)."""
+        reference = _signature(a)
+
+        def test(point: Point | None) -> float | None:
+            if point is None:
+                return None
+            margin = grazing_margin(point.out.hybrid)
+            return margin if _signature(point) == reference else -margin
+
+        lo, hi, _width = locate(self.arc, a, sigma, test, self.tolerance(a), self.settings.tolerance)
+        if hi is None and grazing_margin(lo.out.hybrid) > 1e-6:
+            return _NOT_GRAZING  # a plain corrector failure, not a grazing
+        before = lo.out.hybrid
+        if hi is not None:
+            after = hi.out.hybrid
+            what = "a new impact is born (a free flight touches the stop)" if after.impacts > before.impacts else "an impact's velocity goes to zero"
+            if after.impacts == before.impacts:
+                what = f"the number of sticking phases changes ({before.sticks} -> {after.sticks})"
+            note = f"{what}; the branch continues with {after.impacts} impacts per period"
+        else:
+            what = "a free flight touches the stop" if -before.closest_approach / before.length_scale <= before.min_impact_velocity / before.velocity_scale else "an impact's velocity goes to zero"
+            note = f"{what}; no periodic orbit beyond: the branch ends"
+        found = SpecialPoint(
+            "grazing",
+            lo.orbit(self.system),
+            self.name,
+            float(lo.p[self.index]),
+            grazing_margin(before),
+            note,
+            continues=hi is not None,
+            impacts_after=None if hi is None else hi.out.hybrid.impacts,
+        )
+        self.specials.append((arclength + float(a.tangent @ (lo.z - a.z)), found))
+        self.last_before = lo
+        return hi
+
+    def bound(self, a: Point, sigma: float, value: float) -> Point:
+        """The point between a and sigma where the parameter equals ``value``."""
+
+        def test(point: Point | None) -> float | None:
+            return None if point is None else float(point.p[self.index] - value)
+
+        lo, hi, _width = locate(self.arc, a, sigma, test, self.tolerance(a), self.settings.tolerance)
+        return hi if hi is not None else lo
+
+    def run(self, start: Point) -> tuple[list[Point], str]:
+        s, n = self.settings, self.n
+        a, points, h, arclength = start, [start], s.step, 0.0
+        values_a = self.tests(a)
+        turn = math.cos(s.max_turn)
+        for _ in range(s.max_steps):
+            b = self.arc.correct(a.z + h * a.tangent, a.tangent, s.tolerance, s.max_corrector_iterations)
+            if b is not None and b.tangent @ a.tangent < turn and h > s.min_step:
+                b = None  # the tangent turned too much: a smaller step
+            hybrid = a.out.hybrid is not None and "grazing" in s.detect
+            changed = b is not None and _signature(b) != _signature(a)
+            if hybrid and (changed or (b is None and grazing_margin(a.out.hybrid) < s.grazing_margin)):
+                beyond = self.grazing(a, h, arclength)
+                if beyond is not _NOT_GRAZING:
+                    points.append(self.last_before)
+                    if beyond is None or s.stop_at_grazing:
+                        return points, "grazing"
+                    arclength += float(a.tangent @ (beyond.z - a.z))
+                    a, values_a = beyond, self.tests(beyond)
+                    points.append(a)
+                    continue
+                b = None
+            elif changed:
+                b = None
+            if b is None:
+                h *= 0.5
+                if h < s.min_step:
+                    return points, "step_too_small"
+                continue
+            sigma = float(a.tangent @ (b.z - a.z))
+            value = float(b.p[self.index])
+            if not s.lower <= value <= s.upper:
+                points.append(self.bound(a, sigma, s.lower if value < s.lower else s.upper))
+                return points, "bound"
+            values_b = self.tests(b)
+            self.parent = None
+            for kind, before in values_a.items():
+                if np.sign(before) * np.sign(values_b[kind]) < 0:
+                    self.special(kind, a, sigma, arclength)
+            if self.parent is not None:
+                points.append(self.parent)
+                return points, "parent"
+            arclength += sigma
+            if len(points) > 3:
+                offset_a, offset_b = a.z - start.z, b.z - start.z
+                if start.tangent @ offset_a < 0.0 <= start.tangent @ offset_b and np.linalg.norm(offset_b) < 2.0 * h:
+                    points.append(b)
+                    return points, "closed"
+            points.append(b)
+            a, values_a = b, values_b
+            h = min(h * 1.5, s.max_step) if b.iterations <= 2 else (max(h / 1.5, s.min_step) if b.iterations >= 5 else h)
+        return points, "max_steps"
+
+
+_NOT_GRAZING = object()
+
+
+def continue_branch(system: ParametrisedMap, orbit: PeriodicOrbit, parameter: str, settings: ContinuationSettings = ContinuationSettings(), direction: int = 0) -> Branch:
+    """Follow the branch of periodic orbits through ``orbit`` as ``parameter`` varies.
+
+    Parameters
+    ----------
+    system : ParametrisedMap
+        The map P^k whose fixed points are continued (``Iterated(map, k)`` for a period-k orbit).
+    orbit : PeriodicOrbit
+        A converged orbit (:func:`vibroimpact.orbits.shooting.shoot`).
+    parameter : str
+        Name of the continued parameter (one of ``system.parameter_names``).
+    settings : ContinuationSettings
+        Steps, bounds, tolerances and what to detect.
+    direction : {1, -1, 0}
+        Increasing parameter first, decreasing, or both ways (the branch then runs from its lower-direction end to
+        its upper-direction end).
+
+    Returns
+    -------
+    Branch
+        The points in arclength order with the located special points. ``end`` says why the continuation stopped;
+        both ways, it is ``"<first end>, <last end>"``.
+    """
+    index = list(system.parameter_names).index(parameter)
+    if direction not in (1, -1, 0):
+        raise ValueError(f"direction = {direction!r}: allowed 1, -1, 0")
+    walker = _Walker(system, orbit, index, settings)
+    start = walker.arc.point(walker.arc.to_z(orbit.state, orbit.parameters), None)
+    n = system.dimension
+
+    def oriented(sign: float) -> Point:
+        t = start.tangent if start.tangent[n] * sign >= 0.0 else -start.tangent
+        return Point(start.z, start.y, start.p, start.out, start.residual, start.jacobian, t, 0, orbit.residual_history)
+
+    runs = []
+    for sign in ((1.0, -1.0) if direction == 0 else (float(direction),)):
+        walker.specials = []
+        points, end = walker.run(oriented(sign))
+        runs.append((points, end, sorted(walker.specials, key=lambda item: item[0])))
+        if end == "closed":
+            break
+    if direction != 0:
+        points, end, specials = runs[0]
+        return Branch(parameter, tuple(p.orbit(system) for p in points), tuple(s for _, s in specials), end)
+    if runs[-1][1] == "closed":  # an isola: the run went all the way round
+        points, _end, specials = runs[-1]
+        return Branch(parameter, tuple(p.orbit(system) for p in points), tuple(s for _, s in specials), "closed")
+    (up, up_end, up_specials), (down, down_end, down_specials) = runs
+    points = list(reversed(down)) + up[1:]
+    specials = [s for _, s in reversed(down_specials)] + [s for _, s in up_specials]
+    return Branch(parameter, tuple(p.orbit(system) for p in points), tuple(specials), f"{down_end}, {up_end}")
