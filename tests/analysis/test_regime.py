@@ -129,3 +129,10 @@ def test_paper_impact_free_band_is_linear_throughout() -> None:
     assert bool(np.all(flags == Regime.LINEAR))
     flags, _fits = paper_regimes(np.arange(21.0, 26.01, 0.25))
     assert bool(np.all(flags == Regime.ONE_IMPACT))
+
+
+def test_the_kinds_of_non_periodic_motion_are_appended_without_renumbering() -> None:
+    """Datasets written before keep their meaning: irregular stays 9, failed 11; the new kinds are 12 and 13."""
+    assert (Regime.IRREGULAR, Regime.FAILED, Regime.QUASI_PERIODIC, Regime.CHAOTIC) == (9, 11, 12, 13)
+    meanings = regime_attributes()["flag_meanings"].split(" ")
+    assert meanings[-2:] == ["quasi_periodic", "chaotic"]

@@ -40,14 +40,22 @@ class Regime(IntEnum):
     #: Time-domain solutions: a converged periodic motion other than one impact per period (several impacts,
     #: sticking, or a period of several excitation periods).
     PERIODIC_IMPACTS = 8
-    #: Time-domain solutions: no periodic steady state within the allowed periods (quasi-periodic or chaotic);
-    #: values are averages over the measured window.
+    #: Time-domain solutions: no periodic steady state within the allowed periods, and the evidence (Lyapunov exponent,
+    #: strobe spectrum, rotation number) does not decide between quasi-periodic and chaotic motion; values are
+    #: averages over the measured window.
     IRREGULAR = 9
     #: Swept-sine tests: contacts occurred within the estimator's window. A sweep is a slow transient, not a steady
     #: state: ``impacts_per_period`` says how many contacts per cycle.
     SWEPT_CONTACT = 10
     #: Time-domain solutions: the integrator failed at this point (the error went to stderr); values are NaN.
     FAILED = 11
+    #: Time-domain solutions: no periodic steady state, and the motion is quasi-periodic: its largest Lyapunov exponent
+    #: (``lyapunov_exponent`` [1/period]) is 0 within its error and the strobes lie on a closed curve (line spectrum,
+    #: regular rotation number); values are averages over the measured window.
+    QUASI_PERIODIC = 12
+    #: Time-domain solutions: no periodic steady state, and the motion is chaotic: its largest Lyapunov exponent is
+    #: positive beyond its error; values are averages over the measured window.
+    CHAOTIC = 13
 
 
 def classify(linear_fits: ArrayLike, exists: ArrayLike, admissible: ArrayLike) -> NDArray[np.int8]:
