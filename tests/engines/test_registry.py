@@ -48,5 +48,5 @@ def test_a_fixed_method_overrides_the_settings() -> None:
 
 
 def test_an_unknown_name_lists_the_registered_ones() -> None:
-    with pytest.raises(ValueError, match="engine 'adams' is unknown: use one of exact, momentary"):
+    with pytest.raises(ValueError, match="engine 'adams' is unknown: use one of exact, exact_python, momentary"):
         make_engine("adams")

@@ -50,6 +50,8 @@ class Trajectory:
         Compliant contacts only: largest contact force [N] and largest absorber deceleration [m s-2] of each contact.
     stats : dict
         Engine counters (steps, rhs calls, events, grazing checks ...).
+    strobe_jacobians : ndarray, shape (n, 4, 4) or (0, 4, 4)
+        ``exact`` engine on request: entry k is the exact Jacobian of period k's stroboscopic map, d y_{k+1} / d y_k.
     """
 
     problem: ImpactProblem
@@ -63,9 +65,13 @@ class Trajectory:
     moments: NDArray[np.complex128]
     contact_peaks: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 2)))
     stats: dict[str, int] = field(default_factory=dict)
+    strobe_jacobians: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 4, 4)))
 
     def __post_init__(self) -> None:
-        for name in ("strobe_times", "strobe_states", "impact_times", "impact_velocities", "impulses", "segments", "segment_states", "moments", "contact_peaks"):
+        for name in (
+            "strobe_times", "strobe_states", "impact_times", "impact_velocities", "impulses", "segments", "segment_states", "moments",
+            "contact_peaks", "strobe_jacobians",
+        ):  # fmt: skip
             getattr(self, name).setflags(write=False)
 
     @property

@@ -1,172 +1,183 @@
 """Engine ``exact``: piecewise-exact propagation, the reference every integrator is measured against.
 
 Between events the motion is linear with harmonic forcing, so it is propagated in closed form (eigenvectors of the
-state matrix plus the harmonic particular solution, :mod:`.linear_flow`). Contacts are found by guaranteed root
-bracketing (:func:`.linear_flow.first_crossing`): no contact is missed however tangent, and contact times are exact
+state matrix plus the harmonic particular solution). Contacts are found by guaranteed root bracketing (Taylor bounds
+of the gap, :func:`.linear_flow.first_crossing`): no contact is missed however tangent, and contact times are exact
 to round-off. At a contact X2' -> -R X2'. When impacts accumulate (chattering, small R) and the stop pushes the
 absorber, it sticks: X2 = Delta, X2' = 0, only the primary mass moves, until the holding force
 B2 X1' + K2 (X1 - Delta) turns negative (found by the same root search).
+
+The event loop runs compiled (:mod:`.exact_core`, numba); this module is its thin Python face. It also returns the
+exact Jacobian of the stroboscopic map (state-transition matrices times the saltation matrices of impacts, sticking
+and release), for shooting, continuation and Lyapunov exponents (:mod:`vibroimpact.orbits`).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
+from functools import lru_cache
+
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory, TrajectoryBuilder
-from vibroimpact.engines.linear_flow import HarmonicLinearFlow, Observable, Piece, escape_step, first_crossing, gauss_legendre
+from vibroimpact.engines import exact_core
+from vibroimpact.engines.base import MODE_STUCK, Trajectory
+from vibroimpact.engines.exact_python import PythonExactEngine
 from vibroimpact.engines.rigid_contact import RigidContact
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["ExactEngine"]
+__all__ = ["ExactEngine", "StrobeMap"]
 
-_GAP = np.array([0.0, 1.0, 0.0, 0.0])
+
+@dataclass(frozen=True, eq=False)
+class StrobeMap:
+    """The stroboscopic map over ``periods`` periods from one state, with its exact Jacobian.
+
+    Attributes
+    ----------
+    state : ndarray, shape (4,)
+        Image (X1, X2, X1', X2') after the periods [m, m, m s-1, m s-1].
+    jacobian : ndarray, shape (4, 4)
+        d state / d start [-, s-1 or s]: NaN where the map is not differentiable (a grazing touch at zero speed).
+    impact_times : ndarray
+        Times of the impacts [s].
+    impact_velocities : ndarray
+        Speed of the absorber just before each impact, > 0 [m s-1].
+    sticks, releases : int
+        Impacts that ended in sticking, and releases from the stop.
+    closest_approach : float
+        Largest X2 - Delta at an interior local maximum of a free flight [m] (<= 0; -inf if none): a new impact
+        is born (grazing) where it reaches 0.
+    closest_approach_time : float
+        When it happens [s] (NaN if none).
+    """
+
+    state: NDArray[np.float64]
+    jacobian: NDArray[np.float64]
+    impact_times: NDArray[np.float64]
+    impact_velocities: NDArray[np.float64]
+    sticks: int
+    releases: int
+    closest_approach: float
+    closest_approach_time: float
+    stats: dict[str, int] = field(default_factory=dict)
+
+
+@lru_cache(maxsize=32)
+def _eigen(matrix: tuple[tuple[float, ...], ...]) -> tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128]]:
+    """Eigenvalues, eigenvectors and their inverse of a state matrix: once per system (cached)."""
+    a = np.array(matrix, dtype=complex)
+    lam, vec = np.linalg.eig(a)
+    return lam, np.ascontiguousarray(vec), np.ascontiguousarray(np.linalg.inv(vec))
+
+
+@lru_cache(maxsize=32)
+def _matrices(system: TwoDofSystem) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The free state matrix A (4 x 4) and the stuck one of (X1, X1') (2 x 2)."""
+    s = system
+    stuck = np.array([[0.0, 1.0], [-(s.k1 + s.k2) / s.m1, -(s.b1 + s.b2) / s.m1]])
+    return np.ascontiguousarray(s.state_matrix, dtype=float), stuck
+
+
+class _Flows:
+    """The arrays the compiled loop needs for one problem (eigen-decompositions shared per system)."""
+
+    def __init__(self, problem: ImpactProblem) -> None:
+        s, p = problem.system, problem
+        a, stuck = _matrices(s)
+        self.a = a
+        self.lam, self.vec, self.inv = _eigen(tuple(map(tuple, a)))
+        self.slam, self.svec, self.sinv = _eigen(tuple(map(tuple, stuck)))
+        forcing = p.amplitude * np.exp(1j * p.phase) / s.m1
+        jw = 1j * p.omega
+        self.hrm = np.linalg.solve(jw * np.eye(4) - a, np.array([0, 0, forcing, 0], dtype=complex))
+        self.cst = np.zeros(4)
+        self.shrm = np.linalg.solve(jw * np.eye(2) - stuck, np.array([0, forcing], dtype=complex))
+        self.scst = -np.linalg.solve(stuck, np.array([0.0, s.k2 * p.clearance / s.m1]))
 
 
 class ExactEngine:
-    """Exact piecewise-linear reference engine (see module docstring)."""
+    """Exact piecewise-linear reference engine, compiled (see module docstring)."""
 
     name = "exact"
 
     def __init__(self, settings: EngineSettings = EngineSettings()) -> None:
         self.settings = settings
 
-    def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
-        """Integrate ``periods`` whole periods from ``state`` (X1, X2, X1', X2') at ``t_start`` [s]."""
-        run = _Run(RigidContact(self.name, problem, self.settings, periods), problem, TrajectoryBuilder(problem, moments))
-        return run.go(np.asarray(state, dtype=float), float(t_start), int(periods))
+    def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, jacobians: bool, approach: bool) -> tuple:
+        law = RigidContact(self.name, problem, self.settings, periods)
+        state = np.ascontiguousarray(state, dtype=float)
+        law.check_start(state)
+        f, p, s = _Flows(problem), problem, problem.system
+        length = law.length_scale
+        out = exact_core.run_periods(
+            f.lam, f.vec, f.inv, f.hrm, f.cst, f.slam, f.svec, f.sinv, f.shrm, f.scst,
+            f.a, p.amplitude / s.m1, p.phase, p.omega, p.period,
+            p.clearance, p.restitution, s.m2, s.k2, s.b2,
+            law.sticking_velocity, law.max_impacts, 1e-15 * length, 1e-15 * (s.k2 + s.b2 * p.omega) * length,
+            1e-14 * p.velocity_scale(),
+            state, float(t_start), int(periods), moments, jacobians, approach,
+            exact_core.GL_NODES, exact_core.GL_WEIGHTS,
+        )  # fmt: skip
+        if out[0] != exact_core.STATUS_OK:
+            raise RuntimeError(f"no progress at t = {out[1]!r} s: more than {10 * law.max_impacts} events in one period")
+        return out
+
+    def integrate(
+        self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False, jacobians: bool = False
+    ) -> Trajectory:
+        """Integrate ``periods`` whole periods from ``state`` (X1, X2, X1', X2') at ``t_start`` [s].
+
+        With ``jacobians``, ``strobe_jacobians[k]`` is the exact Jacobian of period k's stroboscopic map.
+        """
+        _status, _t, strobes, jac, impacts, segments, segment_states, period_moments, counters, _approach = self._run(
+            problem, state, t_start, periods, moments, jacobians, False
+        )
+        times = float(t_start) + np.arange(periods + 1) * problem.period  # the loop's boundaries, bit for bit
+        starts = segments[:, 0]
+        ends = np.append(starts[1:], times[-1]) if starts.size else starts
+        keep = ends > starts
+        return Trajectory(
+            problem=problem,
+            strobe_times=times,
+            strobe_states=strobes,
+            impact_times=impacts[:, 0].copy(),
+            impact_velocities=impacts[:, 1].copy(),
+            impulses=impacts[:, 2].copy(),
+            segments=np.column_stack([starts, ends, segments[:, 1]])[keep],
+            segment_states=segment_states[keep],
+            moments=period_moments if moments else np.zeros((0, 5), dtype=complex),
+            stats=_stats(counters, impacts.shape[0]),
+            strobe_jacobians=jac if jacobians else np.zeros((0, 4, 4)),
+        )
+
+    def strobe_map(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float = 0.0, periods: int = 1) -> StrobeMap:
+        """The stroboscopic map over ``periods`` periods from ``state`` at ``t_start`` [s], with its exact Jacobian
+        and what a continuation watches (impact speeds, closest approach of the gap)."""
+        _status, _t, strobes, jac, impacts, _segments, _states, _moments, counters, approach = self._run(problem, state, t_start, periods, False, True, True)
+        product = np.eye(4)
+        for factor in jac:
+            product = factor @ product
+        return StrobeMap(
+            state=strobes[-1].copy(),
+            jacobian=product,
+            impact_times=impacts[:, 0].copy(),
+            impact_velocities=impacts[:, 1].copy(),
+            sticks=int(counters[2]),
+            releases=int(counters[3]),
+            closest_approach=float(approach[0]),
+            closest_approach_time=float(approach[1]),
+            stats=_stats(counters, impacts.shape[0]),
+        )
 
     def dense(self, trajectory: Trajectory, times: NDArray[np.float64]) -> NDArray[np.float64]:
         """States at arbitrary ``times`` inside a trajectory, shape (n, 4), exact (from its segments)."""
-        run = _Run(RigidContact(self.name, trajectory.problem, self.settings, 0), trajectory.problem, TrajectoryBuilder(trajectory.problem, False))
-        times = np.asarray(times, dtype=float)
-        index = np.clip(np.searchsorted(trajectory.segments[:, 0], times, side="right") - 1, 0, len(trajectory.segments) - 1)
-        out = np.empty((times.size, 4))
-        for i in np.unique(index):
-            start, _end, mode = trajectory.segments[i]
-            piece, _watch = run._piece(start, trajectory.segment_states[i], mode == MODE_STUCK)
-            chosen = index == i
-            out[chosen] = [run._state(piece, t, mode == MODE_STUCK) for t in times[chosen]]
-        return out
+        return PythonExactEngine(self.settings).dense(trajectory, times)
 
 
-class _Run:
-    """One integration: the event loop of the exact engine."""
-
-    def __init__(self, law: RigidContact, problem: ImpactProblem, builder: TrajectoryBuilder) -> None:
-        self.law, self.problem, self.rec = law, problem, builder
-        self.steps = self.events = 0
-        s = problem.system
-        self.free = HarmonicLinearFlow(s.state_matrix, np.array([0, 0, problem.amplitude * np.exp(1j * problem.phase) / s.m1, 0]), np.zeros(4), problem.omega)
-        stuck_matrix = np.array([[0.0, 1.0], [-(s.k1 + s.k2) / s.m1, -(s.b1 + s.b2) / s.m1]])
-        self.stuck = HarmonicLinearFlow(
-            stuck_matrix, np.array([0, problem.amplitude * np.exp(1j * problem.phase) / s.m1]), np.array([0.0, s.k2 * problem.clearance / s.m1]), problem.omega
-        )
-        self.length_scale = law.length_scale
-        self.tolerance = 1e-15 * self.length_scale
-        self.force_tolerance = 1e-15 * (s.k2 + s.b2 * problem.omega) * self.length_scale
-        self.resolution_velocity = 1e-14 * problem.velocity_scale()
-
-    # ------------------------------------------------------------------ loop
-    def go(self, y: NDArray[np.float64], t: float, periods: int) -> Trajectory:
-        p, rec = self.problem, self.rec
-        y = y.copy()
-        self.law.check_start(y)
-        y[1] = min(y[1], p.clearance)  # round-off above the stop is the stop
-        stuck = bool(y[1] == p.clearance and y[3] == 0.0 and self._pushed(t, y))
-        leaving = y[1] == p.clearance
-        origin = t
-        rec.strobe(t, y)
-        k, piece, impacts_this_period, events_this_period = 1, None, 0, 0
-        events_at = t if leaving else math.nan  # time of the last event: a search starting there leaves the surface
-        while k <= periods:
-            boundary = origin + k * p.period
-            fresh = piece is None
-            if piece is None:  # a new closed-form piece after each event
-                piece, watch = self._piece(t, y, stuck)
-            self.steps += 1
-            tolerance = self.force_tolerance if stuck else self.tolerance
-            t_event = first_crossing(watch, t, boundary, tolerance, leaving=leaving)
-            leaving = False
-            t_end = boundary if t_event is None else t_event
-            if fresh:
-                rec.segment(t, MODE_STUCK if stuck else MODE_FREE, y)
-            self._moments(piece, t, t_end, MODE_STUCK if stuck else MODE_FREE)
-            y, t = self._state(piece, t_end, stuck), t_end
-            if t_event is None:  # period boundary: strobe, keep the piece
-                # a search cut short by the boundary right after an event there must still start by leaving the surface
-                leaving = t_end - events_at <= 1e-9 * p.period
-                rec.strobe(t, y)
-                k, impacts_this_period, events_this_period = k + 1, 0, 0
-                continue
-            events_this_period += 1
-            events_at = t
-            if events_this_period > 10 * self.law.max_impacts:
-                raise RuntimeError(f"no progress at t = {t!r} s: {events_this_period} events in one period")
-            if stuck:
-                rec.stats["releases"] += 1
-                stuck = False
-            else:
-                impacts_this_period += 1
-                stuck = self._contact(t, y, impacts_this_period)
-            piece, leaving = None, True  # leaving the stop, or the free flight into sticking
-        return rec.build({"steps": self.steps, "events": self.events})
-
-    def _pushed(self, t: float, y: NDArray[np.float64]) -> bool:
-        """Would the stop have to push to hold the absorber at rest here (holding force > 0, or = 0 and rising)?"""
-        _piece, release = self._piece(t, y, stuck=True)  # release = -holding force
-        value = release.derivatives(t, 1)[0]
-        # a holding force of a few round-off units is zero: its sign is noise (the flow's particular solution can be
-        # larger than the length scale when Delta = 0, so allow 64 units), and the derivatives decide
-        if abs(value) > 64.0 * self.force_tolerance:
-            return value < 0.0
-        return escape_step(release, t) is not None
-
-    def _piece(self, t: float, y: NDArray[np.float64], stuck: bool) -> tuple[Piece, Observable]:
-        """Closed-form motion from (t, y) and the function whose first zero ends it (gap, or holding force)."""
-        p = self.problem
-        if stuck:
-            piece = self.stuck.start(t, y[[0, 2]])
-            return piece, piece.observable(np.array([-p.system.k2, -p.system.b2]), p.system.k2 * p.clearance)
-        piece = self.free.start(t, y)
-        return piece, piece.observable(_GAP, -p.clearance)
-
-    def _state(self, piece: Piece, t: float, stuck: bool) -> NDArray[np.float64]:
-        if stuck:
-            x1, v1 = piece.state(t)
-            return np.array([x1, self.problem.clearance, v1, 0.0])
-        y = piece.state(t)
-        y[1] = min(y[1], self.problem.clearance)  # round-off above the stop is the stop
-        return y
-
-    def _contact(self, t: float, y: NDArray[np.float64], impacts_this_period: int) -> bool:
-        """Apply the contact at time t to ``y`` in place; return True if the absorber sticks."""
-        self.events += 1
-        y[1] = self.problem.clearance
-        velocity = y[3] if y[3] > self.resolution_velocity else 0.0  # below round-off: a touch, not an impact
-        impact = self.law.collide(self.rec, t, velocity, impacts_this_period, lambda: self._pushed(t, y))
-        y[3] = impact.after
-        return impact.sticks
-
-    # --------------------------------------------------------------- moments
-    def _moments(self, piece: Piece, t0: float, t1: float, mode: int) -> None:
-        """Add the segment's Fourier and square integrals (Gauss-Legendre, exact for smooth pieces)."""
-        rec = self.rec
-        if not rec.moments or t1 <= t0:
-            return
-        p = self.problem
-        fastest = max(abs(x) for x in piece.flow.eigenvalues) + p.omega
-        nodes, weights = gauss_legendre(int(min(400, 16 + math.ceil(0.8 * fastest * (t1 - t0)))))
-        times = t0 + (t1 - t0) * nodes
-        w = (t1 - t0) * weights
-        phasor = np.exp(-1j * p.omega * times)
-        states = piece.state(times)
-        if mode == MODE_FREE:
-            x1, x2 = states[:, 0], states[:, 1]
-            contact = np.zeros_like(x1)
-        else:
-            x1, x2 = states[:, 0], np.full(times.shape, p.clearance)
-            contact = np.asarray(p.holding_force(states[:, 0], states[:, 1]))
-        rec.add_moments(np.array([w @ (x1 * phasor), w @ (x2 * phasor), w @ (contact * phasor), w @ x1**2, w @ x2**2]))
+def _stats(counters: NDArray[np.int64], impacts: int) -> dict[str, int]:
+    steps, events, sticks, releases, touches = (int(c) for c in counters)
+    return {"impacts": impacts, "sticks": sticks, "releases": releases, "steps": steps, "events": events, "touches": touches}

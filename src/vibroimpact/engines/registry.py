@@ -62,7 +62,8 @@ def _solve_ivp(method: str) -> EngineSpec:
 #: name -> engine. ``momentary`` uses the method of its settings; the suffixed names fix it.
 ENGINES: Mapping[str, EngineSpec] = MappingProxyType(
     {
-        "exact": EngineSpec("vibroimpact.engines.exact:ExactEngine", RIGID, "piecewise-exact closed-form flow with guaranteed contact search: the reference"),
+        "exact": EngineSpec("vibroimpact.engines.exact:ExactEngine", RIGID, "piecewise-exact closed-form flow with guaranteed contact search, compiled: the reference"),
+        "exact_python": EngineSpec("vibroimpact.engines.exact_python:PythonExactEngine", RIGID, "the exact engine's algorithm in pure Python: its cross-check and speed baseline"),
         "momentary": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", RIGID, "SUNDIALS CVODE with contact events and a grazing guard (method from the settings)"),
         "momentary_adams": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", RIGID, "SUNDIALS CVODE, Adams, with contact events and a grazing guard", settings_method="adams"),
         "momentary_bdf": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", RIGID, "SUNDIALS CVODE, BDF, with contact events and a grazing guard", settings_method="bdf"),

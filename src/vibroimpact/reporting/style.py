@@ -117,6 +117,8 @@ REGIME_COLOURS: dict[Regime, str] = {
     Regime.IRREGULAR: "#b15928",
     Regime.SWEPT_CONTACT: "#cab2d6",
     Regime.FAILED: "#000000",
+    Regime.QUASI_PERIODIC: "#ffff99",
+    Regime.CHAOTIC: "#f0027f",
 }
 
 

@@ -1,0 +1,334 @@
+"""The compiled core of the ``exact`` engine: its whole event loop in one numba function, with the exact Jacobian
+(the flow and root-search kernels are in :mod:`.flow_kernels`).
+
+The algorithm is :mod:`.exact_python`'s (closed-form flow, guaranteed first-root search by Taylor bounds, impact map,
+sticking and release, strobes, Fourier moments), compiled with ``@njit(cache=True)``: the interpreter overhead of the
+pure-Python loop was ~99 % of its cost (README, "The compiled exact core"). Flows are passed as arrays:
+
+* ``lam`` (n,) eigenvalues, ``vec`` (n, n) eigenvectors, ``inv`` (n, n) their inverse, ``hrm`` (n,) the complex
+  amplitude Y of the harmonic particular solution Re(Y e^{jwt}), ``cst`` (n,) the constant particular solution;
+  the free flow has n = 4 (X1, X2, X1', X2'), the stuck flow n = 2 (X1, X1') with X2 = Delta, X2' = 0.
+* an observable h = w . y + offset of a piece from (t0, y0) is ``amp`` (n,) complex (per eigenvalue), ``har``
+  (complex), ``con`` (float): h(t) = Re(sum amp_i e^{lam_i (t - t0)} + har e^{jwt}) + con.
+
+The Jacobian of the stroboscopic map is the product, over the pieces of a period, of the state-transition matrices
+Re(V diag(e^{lam dt}) V^-1) and of the saltation matrix of each event (Leine & Nijmeijer; di Bernardo et al.):
+an impact y+ = D y- with D = diag(1, 1, 1, -R) (or diag(1, 1, 1, 0) when it sticks) gives
+S = D + (f(y+) - D f(y-)) e2^T / X2'(t-); a release is continuous in y and in the vector field (the absorber leaves
+at rest with zero holding force), so its saltation matrix is the identity. While stuck, X2 and X2' are held, so the
+transition matrix has zero rows for them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from vibroimpact.engines.flow_kernels import derivatives as _derivatives
+from vibroimpact.engines.flow_kernels import escape_step
+from vibroimpact.engines.flow_kernels import first_crossing as _first_crossing
+from vibroimpact.engines.flow_kernels import modal as _modal
+from vibroimpact.engines.flow_kernels import observable as _observable
+from vibroimpact.engines.flow_kernels import state as _state
+from vibroimpact.engines.flow_kernels import value as _value
+
+__all__ = ["run_periods", "STATUS_OK", "STATUS_NO_PROGRESS", "GL_NODES", "GL_WEIGHTS"]
+
+STATUS_OK, STATUS_NO_PROGRESS = 0, 1
+_x, _w = np.polynomial.legendre.leggauss(16)
+#: 16-point Gauss-Legendre rule on [0, 1]: moments are integrated over chunks of at most 4 radians of the fastest
+#: rate, where its error is below 1e-25 relative (the integrands are exponentials).
+GL_NODES, GL_WEIGHTS = (_x + 1.0) / 2.0, _w / 2.0
+
+
+@njit(cache=True)
+def _transition(lam, vec, inv, dt):
+    n = lam.size
+    scaled = np.empty((n, n), dtype=np.complex128)
+    for i in range(n):
+        g = np.exp(lam[i] * dt)
+        for j in range(n):
+            scaled[i, j] = g * inv[i, j]
+    return np.ascontiguousarray((vec @ scaled).real)
+
+
+@njit(cache=True)
+def _left_multiply(factor, jac, work):
+    """jac <- factor @ jac (4 x 4), through ``work``."""
+    for r in range(4):
+        for c in range(4):
+            acc = 0.0
+            for m in range(4):
+                acc += factor[r, m] * jac[m, c]
+            work[r, c] = acc
+    jac[:, :] = work
+
+
+@njit(cache=True)
+def _free_field(a_matrix, force_over_m1, omega, phase, t, y):
+    f = a_matrix @ y
+    f[2] += force_over_m1 * math.cos(omega * t + phase)
+    return f
+
+
+@njit(cache=True)
+def _grow(array, rows):
+    bigger = np.empty((max(2 * array.shape[0], rows),) + array.shape[1:], dtype=array.dtype)
+    bigger[: array.shape[0]] = array
+    return bigger
+
+
+@njit(cache=True)
+def _closest_approach(lam, amp, har, con, omega, t0, ta, tb, fastest, best):
+    """Largest interior local maximum of h on (ta, tb) (h' from + to -), if above best[0]: stored in best."""
+    chunks = max(2, int(math.ceil(fastest * (tb - ta) / 0.5)))
+    d = np.empty(3)
+    h_prev = ta
+    _derivatives(lam, amp, har, con, omega, t0, ta, d)
+    slope_prev = d[1]
+    for c in range(1, chunks + 1):
+        t = ta + (tb - ta) * c / chunks
+        _derivatives(lam, amp, har, con, omega, t0, t, d)
+        if slope_prev > 0.0 and d[1] < 0.0 and c < chunks + 1:
+            lo, hi = h_prev, t
+            for _ in range(200):  # bisection on h' (sign + at lo, - at hi)
+                mid = 0.5 * (lo + hi)
+                if mid <= lo or mid >= hi:
+                    break
+                _derivatives(lam, amp, har, con, omega, t0, mid, d)
+                if d[1] > 0.0:
+                    lo = mid
+                else:
+                    hi = mid
+            _derivatives(lam, amp, har, con, omega, t0, lo, d)
+            if lo > ta and lo < tb and d[0] > best[0]:
+                best[0], best[1] = d[0], lo
+            _derivatives(lam, amp, har, con, omega, t0, t, d)
+        slope_prev, h_prev = d[1], t
+
+
+@njit(cache=True)
+def run_periods(
+    lam, vec, inv, hrm, cst,  # free flow
+    slam, svec, sinv, shrm, scst,  # stuck flow of (X1, X1')
+    a_matrix, force_over_m1, phase, omega, period,
+    clearance, restitution, m2, k2, b2,
+    sticking_velocity, max_impacts, tolerance, force_tolerance, resolution_velocity,
+    y_start, t_start, periods, want_moments, want_jacobians, want_approach,
+    gl_nodes, gl_weights,
+):  # fmt: skip
+    """Integrate ``periods`` periods from (t_start, y_start); see :class:`vibroimpact.engines.exact.ExactEngine`.
+
+    Returns (status, t_fail, strobes, jacobians, impacts (m, 3): time, speed, impulse, segments (s, 2): start, mode,
+    segment_states (s, 4), moments (periods, 5), counters [steps, events, sticks, releases, touches],
+    approach [value, time]).
+    """
+    n_strobes = periods + 1
+    strobes = np.empty((n_strobes, 4))
+    jacobians = np.empty((periods if want_jacobians else 0, 4, 4))
+    moments = np.zeros((periods if want_moments else 0, 5), dtype=np.complex128)
+    impacts = np.empty((max(4, 2 * periods), 3))
+    segments = np.empty((max(4, 2 * periods), 2))
+    segment_states = np.empty((max(4, 2 * periods), 4))
+    counters = np.zeros(5, dtype=np.int64)
+    approach = np.array([-math.inf, math.nan])
+    n_impacts = 0
+    n_segments = 0
+    gap_w = np.array([0.0, 1.0, 0.0, 0.0])
+    hold_w = np.array([-k2, -b2])
+    fastest = omega
+    for i in range(lam.size):
+        fastest = max(fastest, abs(lam[i]) + omega)
+    y = y_start.copy()
+    y[1] = min(y[1], clearance)
+    t = t_start
+    jac = np.eye(4)
+    # is the start stuck (at rest on the stop and pushed)?
+    stuck = False
+    if y[1] == clearance and y[3] == 0.0:
+        stuck = _pushed(slam, svec, sinv, shrm, scst, omega, hold_w, k2 * clearance, force_tolerance, t, y)
+    # at the stop to round-off (a strobe just after an impact may land a few 1e-19 m below it): the first search
+    # starts by leaving the surface, or finds the contact at once if the absorber moves into the stop
+    leaving = y[1] >= clearance - tolerance
+    origin = t
+    strobes[0] = y
+    k = 1
+    fresh = True
+    impacts_period = 0
+    events_period = 0
+    events_at = t if leaving else math.nan
+    modal = np.empty(4, dtype=np.complex128)
+    amp = np.empty(4, dtype=np.complex128)
+    smodal = np.empty(2, dtype=np.complex128)
+    samp = np.empty(2, dtype=np.complex128)
+    work = np.empty((4, 4))
+    har = 0j
+    con = 0.0
+    t_piece = t
+    ynew = np.empty(4)
+    y2 = np.empty(2)
+    while k <= periods:
+        boundary = origin + k * period
+        if fresh:
+            t_piece = t
+            if stuck:
+                y2[0], y2[1] = y[0], y[2]
+                _modal(slam, svec, sinv, shrm, scst, omega, t, y2, smodal)
+                har, con = _observable(hold_w, k2 * clearance, svec, shrm, scst, smodal, samp)
+            else:
+                _modal(lam, vec, inv, hrm, cst, omega, t, y, modal)
+                har, con = _observable(gap_w, -clearance, vec, hrm, cst, modal, amp)
+            if n_segments == segments.shape[0]:
+                segments = _grow(segments, n_segments + 1)
+                segment_states = _grow(segment_states, n_segments + 1)
+            segments[n_segments, 0], segments[n_segments, 1] = t, 1.0 if stuck else 0.0
+            segment_states[n_segments] = y
+            n_segments += 1
+            fresh = False  # the piece lasts until the next event, across period boundaries
+        counters[0] += 1
+        if stuck:
+            t_event = _first_crossing(slam, samp, har, con, omega, t_piece, t, boundary, force_tolerance, leaving)
+        else:
+            t_event = _first_crossing(lam, amp, har, con, omega, t_piece, t, boundary, tolerance, leaving)
+        leaving = False
+        t_end = boundary if math.isnan(t_event) else t_event
+        # moments, closest approach and the transition matrix of [t, t_end]
+        if t_end > t:
+            if want_moments:
+                _add_moments(
+                    moments, k - 1, stuck, lam, vec, hrm, cst, slam, svec, shrm, scst, omega, t_piece, smodal if stuck else modal,
+                    t, t_end, fastest, clearance, k2, b2, gl_nodes, gl_weights,
+                )  # fmt: skip
+            if want_approach and not stuck:
+                _closest_approach(lam, amp, har, con, omega, t_piece, t, t_end, fastest, approach)
+            if want_jacobians:
+                if stuck:
+                    phi2 = _transition(slam, svec, sinv, t_end - t)
+                    phi = np.zeros((4, 4))
+                    phi[0, 0], phi[0, 2], phi[2, 0], phi[2, 2] = phi2[0, 0], phi2[0, 1], phi2[1, 0], phi2[1, 1]
+                else:
+                    phi = _transition(lam, vec, inv, t_end - t)
+                _left_multiply(phi, jac, work)
+        if stuck:
+            _state(slam, svec, shrm, scst, omega, t_piece, smodal, t_end, y2)
+            ynew[0], ynew[1], ynew[2], ynew[3] = y2[0], clearance, y2[1], 0.0
+        else:
+            _state(lam, vec, hrm, cst, omega, t_piece, modal, t_end, ynew)
+            ynew[1] = min(ynew[1], clearance)
+        y[:] = ynew
+        t = t_end
+        if math.isnan(t_event):
+            leaving = t_end - events_at <= 1e-9 * period
+            strobes[k] = y
+            if want_jacobians:
+                jacobians[k - 1] = jac
+                jac[:, :] = 0.0
+                for r in range(4):
+                    jac[r, r] = 1.0
+            k += 1
+            impacts_period = 0
+            events_period = 0
+            continue
+        events_period += 1
+        events_at = t
+        if events_period > 10 * max_impacts:
+            return STATUS_NO_PROGRESS, t, strobes, jacobians, impacts[:n_impacts], segments[:n_segments], segment_states[:n_segments], moments, counters, approach
+        if stuck:
+            counters[3] += 1
+            stuck = False  # release: continuous state and vector field, saltation = identity
+        else:
+            impacts_period += 1
+            counters[1] += 1
+            y[1] = clearance
+            velocity = y[3] if y[3] > resolution_velocity else 0.0
+            chatters = velocity <= sticking_velocity or impacts_period > max_impacts or restitution == 0.0
+            sticks = False
+            if chatters:
+                sticks = _pushed(slam, svec, sinv, shrm, scst, omega, hold_w, k2 * clearance, force_tolerance, t, y)
+            after = 0.0 if sticks else -restitution * velocity
+            if want_jacobians:
+                _left_multiply(_saltation(a_matrix, force_over_m1, phase, omega, t, y, after, restitution, sticks, velocity), jac, work)
+            impulse = m2 * (velocity - after)
+            if velocity > 0.0:
+                if n_impacts == impacts.shape[0]:
+                    impacts = _grow(impacts, n_impacts + 1)
+                impacts[n_impacts, 0], impacts[n_impacts, 1], impacts[n_impacts, 2] = t, velocity, impulse
+                n_impacts += 1
+                if want_moments:
+                    moments[k - 1, 2] += impulse * complex(math.cos(omega * t), -math.sin(omega * t))
+            else:
+                counters[4] += 1
+            counters[2] += 1 if sticks else 0
+            y[3] = after
+            stuck = sticks
+        fresh = True
+        leaving = True
+        continue
+    return STATUS_OK, t, strobes, jacobians, impacts[:n_impacts], segments[:n_segments], segment_states[:n_segments], moments, counters, approach
+
+
+@njit(cache=True)
+def _pushed(slam, svec, sinv, shrm, scst, omega, hold_w, hold_offset, force_tolerance, t, y):
+    """Would the stop have to push to hold the absorber at rest at (t, y) (holding force > 0, or = 0 and rising)?"""
+    y2 = np.array([y[0], y[2]])
+    modal = np.empty(2, dtype=np.complex128)
+    amp = np.empty(2, dtype=np.complex128)
+    _modal(slam, svec, sinv, shrm, scst, omega, t, y2, modal)
+    har, con = _observable(hold_w, hold_offset, svec, shrm, scst, modal, amp)
+    value = _value(slam, amp, har, con, omega, t, t)
+    if abs(value) > 64.0 * force_tolerance:
+        return value < 0.0
+    return escape_step(slam, amp, har, con, omega, t, t) >= 0.0
+
+
+@njit(cache=True)
+def _saltation(a_matrix, force_over_m1, phase, omega, t, y_contact, after, restitution, sticks, velocity):
+    """Saltation matrix of an impact at time t, at ``y_contact`` (X2 = Delta), from X2' = velocity to ``after``."""
+    salt = np.eye(4)
+    salt[3, 3] = 0.0 if sticks else -restitution
+    if velocity <= 0.0:
+        if not sticks:
+            salt[:, :] = math.nan  # a grazing touch: the map is not differentiable here
+        else:
+            salt[1, 1] = 0.0  # touch and stick: X2 and X2' are held from here on
+        return salt
+    before = y_contact.copy()
+    before[3] = velocity
+    y_after = y_contact.copy()
+    y_after[3] = after
+    f_before = _free_field(a_matrix, force_over_m1, omega, phase, t, before)
+    f_after = _free_field(a_matrix, force_over_m1, omega, phase, t, y_after)
+    if sticks:
+        f_after[3] = 0.0  # the stuck field: X2' stays 0
+    for r in range(4):  # S = D + (f+ - D f-) e2^T / X2'(t-), D = diag(salt) before this loop changes column 1
+        salt[r, 1] += (f_after[r] - salt[r, r] * f_before[r]) / f_before[1]
+    return salt
+
+
+@njit(cache=True)
+def _add_moments(moments, row, stuck, lam, vec, hrm, cst, slam, svec, shrm, scst, omega, t_piece, modal, ta, tb, fastest, clearance, k2, b2, gl_nodes, gl_weights):
+    chunks = max(1, int(math.ceil(fastest * (tb - ta) / 4.0)))
+    width = (tb - ta) / chunks
+    y = np.empty(4)
+    y2 = np.empty(2)
+    for c in range(chunks):
+        start = ta + c * width
+        for i in range(gl_nodes.size):
+            t = start + width * gl_nodes[i]
+            w = width * gl_weights[i]
+            phasor = complex(math.cos(omega * t), -math.sin(omega * t))
+            if stuck:
+                _state(slam, svec, shrm, scst, omega, t_piece, modal, t, y2)
+                x1, x2 = y2[0], clearance
+                contact = b2 * y2[1] + k2 * (y2[0] - clearance)
+            else:
+                _state(lam, vec, hrm, cst, omega, t_piece, modal, t, y)
+                x1, x2 = y[0], y[1]
+                contact = 0.0
+            moments[row, 0] += w * x1 * phasor
+            moments[row, 1] += w * x2 * phasor
+            moments[row, 2] += w * contact * phasor
+            moments[row, 3] += w * x1 * x1
+            moments[row, 4] += w * x2 * x2
