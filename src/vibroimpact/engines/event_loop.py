@@ -15,6 +15,7 @@ import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from enum import Enum
+from typing import Callable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -53,39 +54,128 @@ class Stop(Enum):
 
 @dataclass
 class Model:
-    """Right-hand side and event functions of one problem, with a mutable mode flag (free or stuck)."""
+    """Right-hand side, Jacobian and event functions of one problem, with a mutable mode flag (free or stuck).
+
+    Between impacts the flow is linear: y' = A y + c + e q cos(w t + phase), with one constant matrix A per mode.
+    :attr:`rhs`, :attr:`jacobian` and :attr:`events` are closures over those coefficients as Python floats (built once
+    per model): a solver calls them at every step, where numpy scalars and attribute lookups cost more than the
+    arithmetic.
+    """
 
     problem: ImpactProblem
     with_moments: bool
     stuck: bool = False
     apex_event: bool = True
-    rhs_calls: int = 0
     size: int = field(init=False)
+    #: y' into ``yp`` (scikit-sundae convention ``rhs(t, y, yp)``).
+    rhs: Callable[[float, NDArray[np.float64], NDArray[np.float64]], None] = field(init=False, repr=False)
+    #: d y' / d y into ``jac`` (scikit-sundae convention ``jacobian(t, y, yp, jac)``), exact: the flow is linear.
+    jacobian: Callable[[float, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]], None] = field(init=False, repr=False)
+    #: The three event functions into ``out`` (``events(t, y, out)``), see :data:`NUM_EVENTS`.
+    events: Callable[[float, NDArray[np.float64], NDArray[np.float64]], None] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        s, p = self.problem.system, self.problem
         self.size = 4 + (QUADRATURES if self.with_moments else 0)
-        self._coefficients = (s.m1, s.m2, s.k1, s.k2, s.b1, s.b2, p.amplitude, p.omega, p.phase, p.clearance)
+        self._calls = [0]
+        self.rhs = self._make_rhs()
+        self.jacobian = self._make_jacobian()
+        self.events = self._make_events()
 
-    def rhs(self, t: float, y: NDArray[np.float64], yp: NDArray[np.float64]) -> None:
-        """Write y' into ``yp`` (scikit-sundae convention)."""
-        self.rhs_calls += 1
-        m1, m2, k1, k2, b1, b2, q, w, phase, delta = self._coefficients
-        x1, gap, v1, v2 = y[0], y[1], y[2], y[3]
-        x2 = gap + delta
-        force = q * math.cos(w * t + phase)
-        yp[0] = v1
-        if self.stuck:
-            yp[1] = 0.0
-            yp[2] = (force - k1 * x1 - b1 * v1 - k2 * (x1 - delta) - b2 * v1) / m1
-            yp[3] = 0.0
-        else:
-            yp[1] = v2
-            yp[2] = (force - k1 * x1 - b1 * v1 - k2 * (x1 - x2) - b2 * (v1 - v2)) / m1
-            yp[3] = (k2 * (x1 - x2) + b2 * (v1 - v2)) / m2
-        if self.with_moments:
-            holding = b2 * v1 + k2 * (x1 - delta) if self.stuck else 0.0
-            write_quadratures(yp, 4, t, w, x1, x2, holding)
+    @property
+    def rhs_calls(self) -> int:
+        """Right-hand-side evaluations so far."""
+        return self._calls[0]
+
+    def matrix(self, stuck: bool) -> NDArray[np.float64]:
+        """The constant matrix A (4, 4) of the flow of (X1, u, X1', X2') in one mode [SI]."""
+        s = self.problem.system
+        a = np.zeros((4, 4))
+        a[0, 2] = 1.0
+        a[2, 0], a[2, 2] = -(s.k1 + s.k2) / s.m1, -(s.b1 + s.b2) / s.m1
+        if not stuck:
+            a[1, 3] = 1.0
+            a[2, 1], a[2, 3] = s.k2 / s.m1, s.b2 / s.m1
+            a[3] = [s.k2 / s.m2, -s.k2 / s.m2, s.b2 / s.m2, -s.b2 / s.m2]
+        return a
+
+    def coefficients(self) -> tuple[float, ...]:
+        """The flow's numbers as Python floats: rows 2 and 3 of the free-flight :meth:`matrix` (a20 ... a33), the
+        constant accelerations c2 = K2 Delta / M1 and c3 = -K2 Delta / M2 [m s-2], q / M1 [m s-2], w [rad s-1],
+        phase [rad], Delta [m], K2 [N m-1], B2 [N s m-1]. X1'' = a20 X1 + a21 u + a22 X1' + a23 X2' + c2 + (q / M1)
+        cos(w t + phase), X2'' = a30 X1 + ... + c3; stuck, a21 and a23 drop out (u = X2' = 0) and X2'' = 0."""
+        s, p = self.problem.system, self.problem
+        rows = [float(v) for v in self.matrix(False)[2:].ravel()]
+        k2, delta = float(s.k2), float(p.clearance)
+        return (*rows, k2 * delta / s.m1, -k2 * delta / s.m2, p.amplitude / s.m1, float(p.omega), float(p.phase), delta, k2, float(s.b2))
+
+    def _make_rhs(self) -> Callable[[float, NDArray[np.float64], NDArray[np.float64]], None]:
+        model, calls = self, self._calls
+        a20, a21, a22, a23, a30, a31, a32, a33, c2, c3, f2, w, phase, delta, k2, b2 = self.coefficients()
+        cos, sin = math.cos, math.sin
+
+        def rhs(t: float, y: NDArray[np.float64], yp: NDArray[np.float64]) -> None:
+            calls[0] += 1
+            x1, u, v1, v2 = y.tolist()  # Python floats: their arithmetic is several times cheaper than numpy's
+            yp[0] = v1
+            if model.stuck:
+                yp[1] = 0.0
+                yp[2] = a20 * x1 + a22 * v1 + c2 + f2 * cos(w * t + phase)
+                yp[3] = 0.0
+            else:
+                yp[1] = v2
+                yp[2] = a20 * x1 + a21 * u + a22 * v1 + a23 * v2 + c2 + f2 * cos(w * t + phase)
+                yp[3] = a30 * x1 + a31 * u + a32 * v1 + a33 * v2 + c3
+
+        def rhs_with_moments(t: float, y: NDArray[np.float64], yp: NDArray[np.float64]) -> None:
+            calls[0] += 1
+            x1, u, v1, v2 = y[:4].tolist()
+            forcing = c2 + f2 * cos(w * t + phase)
+            if model.stuck:
+                holding = b2 * v1 + k2 * (x1 - delta)
+                a2, a3 = a20 * x1 + a22 * v1 + forcing, 0.0
+            else:
+                holding = 0.0
+                a2 = a20 * x1 + a21 * u + a22 * v1 + a23 * v2 + forcing
+                a3 = a30 * x1 + a31 * u + a32 * v1 + a33 * v2 + c3
+            x2, c, sn = u + delta, cos(w * t), sin(w * t)
+            yp[:] = (v1, 0.0 if model.stuck else v2, a2, a3, x1 * c, x1 * sn, x2 * c, x2 * sn, holding * c, holding * sn, x1 * x1, x2 * x2)
+
+        return rhs_with_moments if self.with_moments else rhs
+
+    def _make_jacobian(self) -> Callable[[float, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]], None]:
+        free, stuck = self.matrix(False), self.matrix(True)
+        p, s, model, with_moments = self.problem, self.problem.system, self, self.with_moments
+        delta, w = float(p.clearance), float(p.omega)
+
+        def jacobian(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], jac: NDArray[np.float64]) -> None:
+            jac[:4, :4] = stuck if model.stuck else free
+            if with_moments:
+                # the quadratures' rows: d/dy of X1 cos, X1 sin, X2 cos, X2 sin, H cos, H sin, X1^2, X2^2 (X2 = u + Delta)
+                c, sn = math.cos(w * t), math.sin(w * t)
+                x1, x2 = float(y[0]), float(y[1]) + delta
+                jac[4:, :] = 0.0
+                jac[4, 0], jac[5, 0], jac[6, 1], jac[7, 1] = c, sn, c, sn
+                if model.stuck:
+                    jac[8, 0], jac[8, 2], jac[9, 0], jac[9, 2] = s.k2 * c, s.b2 * c, s.k2 * sn, s.b2 * sn
+                jac[10, 0], jac[11, 1] = 2.0 * x1, 2.0 * x2
+
+        return jacobian
+
+    def _make_events(self) -> Callable[[float, NDArray[np.float64], NDArray[np.float64]], None]:
+        p, model = self.problem, self
+        delta, k2, b2 = float(p.clearance), float(p.system.k2), float(p.system.b2)
+
+        def events(t: float, y: NDArray[np.float64], out: NDArray[np.float64]) -> None:
+            if model.stuck:
+                out[0] = -1.0
+                out[1] = b2 * float(y[2]) + k2 * (float(y[0]) - delta)  # the holding force
+                out[2] = 1.0
+            else:
+                out[0] = y[1]
+                out[1] = 1.0
+                out[2] = y[3] if model.apex_event else 1.0
+
+        return events
 
     def derivative(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         """y' as a new array."""
@@ -94,22 +184,10 @@ class Model:
         return yp
 
     #: Number of event functions and their crossing directions: gap rising, holding force falling, apex (X2' falling).
+    #: Inactive events return a constant, so they never cross zero: free flight has the gap X2 - Delta and the apex
+    #: X2', the stuck mode the holding force.
     NUM_EVENTS = 3
     DIRECTIONS = (1, -1, -1)
-
-    def events(self, t: float, y: NDArray[np.float64], out: NDArray[np.float64]) -> None:
-        """Event functions: gap X2 - Delta and apex X2' (free flight only), holding force (stuck only).
-
-        Inactive events return a constant, so they never cross zero.
-        """
-        if self.stuck:
-            out[0] = -1.0
-            out[1] = self.problem.holding_force(y[0], y[2])
-            out[2] = 1.0
-        else:
-            out[0] = y[1]
-            out[1] = 1.0
-            out[2] = y[3] if self.apex_event else 1.0
 
 
 class EventLoopEngine(ABC):
@@ -132,6 +210,13 @@ class EventLoopEngine(ABC):
         """Integrator counters to add to the trajectory's stats."""
         return {}
 
+    def _compiled_rhs_calls(self) -> int:
+        """Right-hand-side evaluations made outside :attr:`Model.rhs` (by compiled callbacks)."""
+        return 0
+
+    def _end(self) -> None:
+        """Release what :meth:`_begin` set up (called once per :meth:`integrate`, also after an error)."""
+
     def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
         """Integrate ``periods`` whole periods from ``state`` (X1, X2, X1', X2') at ``t_start`` [s]."""
         law = RigidContact(self.name, problem, self.settings, periods)
@@ -143,51 +228,54 @@ class EventLoopEngine(ABC):
         y[1] = min(y[1] - problem.clearance, 0.0)  # integrate the gap u = X2 - Delta; round-off above is the stop
         model.stuck = bool(y[1] == 0.0 and y[3] == 0.0 and self._pushed(model, t_start, y))
         self._begin(model)
-        rec = TrajectoryBuilder(problem, moments)
+        try:
+            rec = TrajectoryBuilder(problem, moments)
 
-        def physical(y: NDArray[np.float64]) -> NDArray[np.float64]:
-            return np.array([y[0], y[1] + problem.clearance, y[2], y[3]])  # the gap u back to X2
+            def physical(y: NDArray[np.float64]) -> NDArray[np.float64]:
+                return np.array([y[0], y[1] + problem.clearance, y[2], y[3]])  # the gap u back to X2
 
-        rec.strobe(t_start, physical(y))
-        rec.segment(t_start, MODE_STUCK if model.stuck else MODE_FREE, physical(y))
-        quadratures = y[4:].copy()
-        t = float(t_start)
-        for k in range(1, periods + 1):
-            boundary = t_start + k * problem.period
-            impacts = events = 0
-            while True:
-                if not model.stuck and y[1] >= 0.0 and y[3] > 0.0:
-                    # at the stop and moving into it (a start there, or an impact exactly on a period boundary):
-                    # integrators do not report a root at their initial time, so the contact is applied here
-                    stop = Stop.CONTACT
-                elif boundary - t <= 4.0 * math.ulp(boundary):
-                    stop, t = Stop.BOUNDARY, boundary  # nothing left of this period to integrate
-                else:
-                    stop, t, y = self._advance(model, t, y, boundary)
-                if stop is Stop.BOUNDARY:
+            rec.strobe(t_start, physical(y))
+            rec.segment(t_start, MODE_STUCK if model.stuck else MODE_FREE, physical(y))
+            quadratures = y[4:].copy()
+            t = float(t_start)
+            for k in range(1, periods + 1):
+                boundary = t_start + k * problem.period
+                impacts = events = 0
+                while True:
                     if not model.stuck and y[1] >= 0.0 and y[3] > 0.0:
-                        continue  # an impact exactly at the boundary is applied before the strobe
-                    break
-                events += 1
-                if events > 10 * law.max_impacts:
-                    raise RuntimeError(f"no progress at t = {t!r} s: {events} events in one period")
-                if stop is Stop.RELEASE:
-                    rec.stats["releases"] += 1
-                    model.stuck = False
-                else:
-                    impacts += 1
-                    y = y.copy()
-                    y[1] = 0.0
-                    impact = law.collide(rec, t, max(y[3], 0.0), impacts, lambda: self._pushed(model, t, y))
-                    model.stuck = impact.sticks
-                    y[3] = impact.after
-                rec.segment(t, MODE_STUCK if model.stuck else MODE_FREE, physical(y))
-            if moments:
-                q = y[4:] - quadratures
-                quadratures = y[4:].copy()
-                rec.add_moments(moment_row(q))
-            rec.strobe(t, physical(y))
-        return rec.build(self._counters() | {"rhs_calls": model.rhs_calls})
+                        # at the stop and moving into it (a start there, or an impact exactly on a period boundary):
+                        # integrators do not report a root at their initial time, so the contact is applied here
+                        stop = Stop.CONTACT
+                    elif boundary - t <= 4.0 * math.ulp(boundary):
+                        stop, t = Stop.BOUNDARY, boundary  # nothing left of this period to integrate
+                    else:
+                        stop, t, y = self._advance(model, t, y, boundary)
+                    if stop is Stop.BOUNDARY:
+                        if not model.stuck and y[1] >= 0.0 and y[3] > 0.0:
+                            continue  # an impact exactly at the boundary is applied before the strobe
+                        break
+                    events += 1
+                    if events > 10 * law.max_impacts:
+                        raise RuntimeError(f"no progress at t = {t!r} s: {events} events in one period")
+                    if stop is Stop.RELEASE:
+                        rec.stats["releases"] += 1
+                        model.stuck = False
+                    else:
+                        impacts += 1
+                        y = y.copy()
+                        y[1] = 0.0
+                        impact = law.collide(rec, t, max(y[3], 0.0), impacts, lambda: self._pushed(model, t, y))
+                        model.stuck = impact.sticks
+                        y[3] = impact.after
+                    rec.segment(t, MODE_STUCK if model.stuck else MODE_FREE, physical(y))
+                if moments:
+                    q = y[4:] - quadratures
+                    quadratures = y[4:].copy()
+                    rec.add_moments(moment_row(q))
+                rec.strobe(t, physical(y))
+        finally:
+            self._end()
+        return rec.build(self._counters() | {"rhs_calls": model.rhs_calls + self._compiled_rhs_calls()})
 
     def _pushed(self, model: Model, t: float, y: NDArray[np.float64]) -> bool:
         """The stop must push to hold the absorber: holding force > 0, or = 0 and rising."""
