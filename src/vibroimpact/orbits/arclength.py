@@ -124,16 +124,37 @@ class ArclengthSystem:
         y, p = self.from_z(z)
         return Point(z, y, p, out, residual, jac, self.tangent(jac, previous_tangent), 0, (float(np.max(np.abs(residual))),))
 
-    def correct(self, predicted: NDArray[np.float64], direction: NDArray[np.float64], tolerance: float, max_iterations: int) -> Point | None:
+    def correct(
+        self,
+        predicted: NDArray[np.float64],
+        direction: NDArray[np.float64],
+        tolerance: float,
+        max_iterations: int,
+        signature: tuple[int, int] | None = None,
+        anchor: NDArray[np.float64] | None = None,
+    ) -> Point | None:
         """Newton's method on [F(z) = 0, direction . (z - predicted) = 0]; None when it does not converge.
 
         Converged when max |F| <= ``tolerance`` and the last Newton step was below ``100 * tolerance`` (scaled).
+        With a hybrid ``signature`` (impacts, sticks), every iterate is kept on the side of the grazing manifold where
+        the map has that signature, by halving the step (from ``anchor``, a point on that side, for the first one):
+        next to a grazing point the map's Jacobian grows like one over the slowest impact's speed and a full Newton
+        step would jump to the other side, where the map is another function.
         """
         z = np.array(predicted, dtype=float)
         history: list[float] = []
         last_step = np.inf
+        previous = anchor
         for iteration in range(max_iterations + 1):
             residual, jac, out = self.equations(z)
+            if signature is not None and previous is not None:
+                for _ in range(40):
+                    if out.hybrid is not None and out.hybrid.signature == signature:
+                        break
+                    z = previous + 0.5 * (z - previous)
+                    residual, jac, out = self.equations(z)
+                else:
+                    return None
             size = float(np.max(np.abs(residual))) if residual.size else 0.0
             history.append(size)
             if not np.isfinite(size) or not np.all(np.isfinite(jac)):
@@ -150,5 +171,6 @@ class ArclengthSystem:
             except np.linalg.LinAlgError:
                 return None
             last_step = float(np.max(np.abs(step)))
+            previous = z
             z = z + step
         return None

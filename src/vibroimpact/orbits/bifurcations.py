@@ -20,6 +20,7 @@ parameter to better than 1e-8 relative.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from itertools import combinations
 
@@ -36,6 +37,7 @@ __all__ = [
     "neimark_sacker_test",
     "grazing_margin",
     "locate",
+    "locate_grazing",
     "classify",
     "switch_period_doubling",
 ]
@@ -136,6 +138,131 @@ def locate(
         if value is not None and value == 0.0:  # exact: the test vanishes at a trial point
             return trial, trial, 0.0
     return lo_point, hi_point, hi - lo
+
+
+def locate_grazing(
+    arc: ArclengthSystem, start: Point, end_sigma: float, tolerance: float, corrector_tolerance: float
+) -> tuple[Point, Point | None, Point | None, float]:
+    """The grazing point between ``start`` (sigma = 0) and sigma = ``end_sigma``.
+
+    Beyond a grazing point the map changes (an impact appears or disappears). On the side with the impact its
+    Jacobian grows like one over the slowest impact's speed, so Newton's method converges only ever closer to the
+    point; on the side without it the map is smooth up to the point. The margin (:func:`grazing_margin`) crosses zero
+    linearly on either side (the closest approach, or the speed of the vanishing impact, is proportional to the
+    distance to the point), so the inverse interpolation of sigma in the margin through the side points nearest the
+    boundary predicts where it vanishes. The point is first approached from ``start``'s side; if an orbit with fewer
+    impacts is found beyond it, the approach is repeated from there, where Newton's method works to the end.
+
+    Returns
+    -------
+    (Point, Point or None, Point or None, float)
+        The point of ``start``'s side nearest the grazing point; the orbit at the grazing point from the side with
+        fewer impacts (None when none was found: then the branch ends there); a point beyond, with another impact
+        count (None if none); and the parameter value of the grazing point (NaN when the margin does not vanish within
+        the step: a failed step, not a grazing point).
+    """
+    n = arc.n
+    side, estimate, beyond, rough = _approach(arc, start, end_sigma, tolerance, corrector_tolerance)
+    reference = start.out.hybrid.signature
+    if beyond is None and math.isfinite(rough) and 0.0 < rough < 8.0 * end_sigma:
+        beyond = _jump(arc, start, side, rough, reference, corrector_tolerance)
+    if beyond is not None and beyond.out.hybrid.impacts < start.out.hybrid.impacts:
+        # approach again from the smooth side, towards the parameter where start's side extrapolates the point
+        # (the other branch may leave the point in either direction: a nonsmooth fold when the linear orbit turns back)
+        target = float(start.z[n] + rough * start.tangent[n]) if math.isfinite(rough) else float(side.z[n])
+        tangent = beyond.tangent if beyond.tangent[n] * (target - beyond.z[n]) >= 0.0 else -beyond.tangent
+        back = Point(beyond.z, beyond.y, beyond.p, beyond.out, beyond.residual, beyond.jacobian, tangent, 0, beyond.history)
+        reach = 2.0 * abs(target - float(beyond.z[n])) / max(abs(float(tangent[n])), 1e-3) + 10.0 * tolerance
+        other, other_estimate, _, _ = _approach(arc, back, reach, tolerance, corrector_tolerance)
+        if math.isfinite(other_estimate):
+            value = float(other.z[n] + (other_estimate - float(back.tangent @ (other.z - back.z))) * other.tangent[n] / float(back.tangent @ other.tangent))
+            return side, other, beyond, value * float(arc.sp[0])
+    if not math.isfinite(estimate):
+        return side, None, None, math.nan
+    value = float(side.z[n] + (estimate - float(start.tangent @ (side.z - start.z))) * side.tangent[n] / float(start.tangent @ side.tangent))
+    return side, side, beyond, value * float(arc.sp[0])
+
+
+def _jump(arc: ArclengthSystem, start: Point, side: Point, rough: float, reference: tuple[int, int], tolerance: float) -> Point | None:
+    """An orbit with another impact count just across the grazing point (Newton fails next to it on the impacting
+    side): along the branch's tangent beyond the extrapolated point, then at fixed parameter on either side of it
+    (where the branch meets the other orbits at an angle, e.g. the linear orbit turning back)."""
+    for factor in (1.25, 1.6, 2.5, 4.0):
+        trial = arc.correct(start.z + factor * rough * start.tangent, start.tangent, tolerance, 12)
+        if trial is not None and trial.out.hybrid is not None and trial.out.hybrid.signature != reference:
+            return trial
+    n = arc.n
+    fixed = np.zeros(n + 1)
+    fixed[n] = 1.0
+    distance = float(start.tangent @ (side.z - start.z))
+    for factor in (1.25, 2.0, -0.25, -1.0, 4.0):
+        shift = (rough - distance) * factor
+        predicted = side.z.copy()
+        predicted[n] += shift * side.tangent[n]
+        trial = arc.correct(predicted, fixed, tolerance, 12)
+        if trial is not None and trial.out.hybrid is not None and trial.out.hybrid.signature != reference:
+            tangent = trial.tangent if trial.tangent @ (side.z - trial.z) < 0.0 else -trial.tangent
+            return Point(trial.z, trial.y, trial.p, trial.out, trial.residual, trial.jacobian, tangent, trial.iterations, trial.history)
+    return None
+
+
+def _approach(
+    arc: ArclengthSystem, start: Point, end_sigma: float, tolerance: float, corrector_tolerance: float, max_iterations: int = 60
+) -> tuple[Point, float, Point | None, float]:
+    """Approach the grazing point from ``start``'s side.
+
+    Returns (nearest side point, sigma of the point or NaN, a point beyond or None, the last extrapolated sigma).
+    """
+    reference = start.out.hybrid.signature
+    samples = [(0.0, grazing_margin(start.out.hybrid), start)]
+    lo, hi, beyond = 0.0, float(end_sigma), None
+    estimate = math.nan
+    for _ in range(max_iterations):
+        if len(samples) >= 2:
+            estimate = _extrapolate_zero(samples[-3:])
+        if hi - lo <= tolerance or (len(samples) >= 2 and abs(estimate - samples[-1][0]) <= tolerance):
+            break
+        if len(samples) >= 3 and not estimate < 1.5 * end_sigma:
+            return samples[-1][2], math.nan, beyond, estimate  # the margin does not vanish within the step
+        sigma = estimate if lo < estimate < hi else 0.5 * (lo + hi)
+        near = samples[-1][2]  # predict from the side point nearest the boundary, along its own tangent
+        predicted = near.z + (sigma - samples[-1][0]) / float(start.tangent @ near.tangent) * near.tangent
+        trial = arc.correct(predicted, start.tangent, corrector_tolerance, 12)
+        if trial is not None and trial.out.hybrid is not None and trial.out.hybrid.signature == reference:
+            lo = sigma
+            samples.append((sigma, grazing_margin(trial.out.hybrid), trial))
+        else:
+            hi = sigma
+            if trial is not None and trial.out.hybrid is not None:
+                beyond = trial
+    side = samples[-1][2]
+    # the margin must approach zero inside the step; Newton may fail right next to the point (hi < estimate)
+    if not (len(samples) >= 2 and samples[-1][1] < 1e-3 and math.isfinite(estimate) and lo - tolerance <= estimate <= end_sigma + tolerance):
+        return side, math.nan, beyond, estimate
+    if beyond is None:  # look once just beyond the grazing point for an orbit with another impact count
+        for offset in (1e-6, 1e-4, 1e-2):
+            sigma = estimate + offset * max(1.0, abs(float(start.z[-1])))
+            trial = arc.correct(start.z + sigma * start.tangent, start.tangent, corrector_tolerance, 12)
+            if trial is not None and trial.out.hybrid is not None and trial.out.hybrid.signature != reference:
+                beyond = trial
+                break
+    return side, float(estimate), beyond, estimate
+
+
+def _extrapolate_zero(samples: list[tuple[float, float, Point]]) -> float:
+    """sigma where the margin vanishes: the inverse interpolation (sigma as a polynomial in the margin) at 0."""
+    sigmas = [item[0] for item in samples]
+    margins = [item[1] for item in samples]
+    if len(set(margins)) < len(margins):
+        return math.nan
+    total = 0.0
+    for i, (si, mi) in enumerate(zip(sigmas, margins)):
+        weight = 1.0
+        for j, mj in enumerate(margins):
+            if j != i:
+                weight *= (0.0 - mj) / (mi - mj)
+        total += weight * si
+    return total
 
 
 def _closest(multipliers: NDArray[np.complex128], target: complex) -> complex:

@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.model.validation import require_in_range, require_positive
 from vibroimpact.orbits.arclength import ArclengthSystem, Point
-from vibroimpact.orbits.bifurcations import classify, grazing_margin, locate, neimark_sacker_test, period_doubling_test
+from vibroimpact.orbits.bifurcations import classify, grazing_margin, locate, locate_grazing, neimark_sacker_test, period_doubling_test
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Branch, Iterated, ParametrisedMap, PeriodicOrbit, SpecialPoint
 
 __all__ = ["ContinuationSettings", "continue_branch"]
@@ -139,40 +139,47 @@ class _Walker:
 
     def grazing(self, a: Point, sigma: float, arclength: float) -> object:
         """Locate a grazing point between a and sigma; return the point beyond it (None: the branch ends there)."""
-        reference = _signature(a)
-
-        def test(point: Point | None) -> float | None:
-            if point is None:
-                return None
-            margin = grazing_margin(point.out.hybrid)
-            return margin if _signature(point) == reference else -margin
-
-        lo, hi, _width = locate(self.arc, a, sigma, test, self.tolerance(a), self.settings.tolerance)
-        if hi is None and grazing_margin(lo.out.hybrid) > 1e-6:
+        side, grazing, beyond, value = locate_grazing(self.arc, a, sigma, self.tolerance(a), self.settings.tolerance)
+        if not math.isfinite(value):
             return _NOT_GRAZING  # a plain corrector failure, not a grazing
-        before = lo.out.hybrid
-        if hi is not None:
-            after = hi.out.hybrid
-            what = "a new impact is born (a free flight touches the stop)" if after.impacts > before.impacts else "an impact's velocity goes to zero"
+        before = side.out.hybrid
+        tangency = -before.closest_approach / before.length_scale <= before.min_impact_velocity / before.velocity_scale
+        what = "a free flight touches the stop" if tangency else "an impact's velocity goes to zero"
+        if beyond is not None:
+            after = beyond.out.hybrid
             if after.impacts == before.impacts:
-                what = f"the number of sticking phases changes ({before.sticks} -> {after.sticks})"
+                what = f"{what} (the sticking phases change, {before.sticks} -> {after.sticks})"
             note = f"{what}; the branch continues with {after.impacts} impacts per period"
         else:
-            what = "a free flight touches the stop" if -before.closest_approach / before.length_scale <= before.min_impact_velocity / before.velocity_scale else "an impact's velocity goes to zero"
             note = f"{what}; no periodic orbit beyond: the branch ends"
+        at = grazing if grazing is not None else side
         found = SpecialPoint(
             "grazing",
-            lo.orbit(self.system),
+            at.orbit(self.system),
             self.name,
-            float(lo.p[self.index]),
-            grazing_margin(before),
+            value,
+            grazing_margin(at.out.hybrid),
             note,
-            continues=hi is not None,
-            impacts_after=None if hi is None else hi.out.hybrid.impacts,
+            continues=beyond is not None,
+            impacts_after=None if beyond is None else beyond.out.hybrid.impacts,
         )
-        self.specials.append((arclength + float(a.tangent @ (lo.z - a.z)), found))
-        self.last_before = lo
-        return hi
+        self.specials.append((arclength + float(a.tangent @ (side.z - a.z)), found))
+        self.last_before = side
+        return beyond
+
+    def _grazing_distance(self, a: Point) -> float:
+        """Arclength to the grazing point extrapolated from the margin's slope (inf when it is not approaching)."""
+        if a.out.hybrid is None or self.slope is None or self.slope >= 0.0:
+            return math.inf
+        margin = grazing_margin(a.out.hybrid)
+        return -margin / self.slope if margin < self.settings.grazing_margin else math.inf
+
+    def _grazing_ahead(self, a: Point, h: float) -> bool:
+        """After a failed step: is a grazing point likely within h (the margin, extrapolated, reaches zero)?"""
+        margin = grazing_margin(a.out.hybrid)
+        if margin >= self.settings.grazing_margin:
+            return False
+        return self.slope is None or margin + 4.0 * h * min(self.slope, 0.0) <= 0.0
 
     def bound(self, a: Point, sigma: float, value: float) -> Point:
         """The point between a and sigma where the parameter equals ``value``."""
@@ -184,7 +191,9 @@ class _Walker:
         return hi if hi is not None else lo
 
     def run(self, start: Point) -> tuple[list[Point], str]:
-        s, n = self.settings, self.n
+        s = self.settings
+        self.slope: float | None = None
+        self.retry_margin = 2e-3  # margin below which a grazing point is sought ahead whatever the step
         a, points, h, arclength = start, [start], s.step, 0.0
         values_a = self.tests(a)
         turn = math.cos(s.max_turn)
@@ -194,8 +203,14 @@ class _Walker:
                 b = None  # the tangent turned too much: a smaller step
             hybrid = a.out.hybrid is not None and "grazing" in s.detect
             changed = b is not None and _signature(b) != _signature(a)
-            if hybrid and (changed or (b is None and grazing_margin(a.out.hybrid) < s.grazing_margin)):
-                beyond = self.grazing(a, h, arclength)
+            ahead = self._grazing_distance(a)
+            close = ahead < 0.5 * h or (math.isfinite(ahead) and grazing_margin(a.out.hybrid) < self.retry_margin)
+            if close:
+                self.retry_margin = 0.5 * grazing_margin(a.out.hybrid)  # if it is no grazing point, retry when halved
+            if hybrid and (changed or (b is None and self._grazing_ahead(a, h)) or close):
+                # a grazing point within the step: the impact count changed, or Newton failed next to it, or the
+                # margin extrapolates to zero (Newton's region shrinks near it, the steps would creep)
+                beyond = self.grazing(a, h if changed or b is None else 1.5 * ahead, arclength)
                 if beyond is not _NOT_GRAZING:
                     points.append(self.last_before)
                     if beyond is None or s.stop_at_grazing:
@@ -232,6 +247,7 @@ class _Walker:
                     points.append(b)
                     return points, "closed"
             points.append(b)
+            self.slope = (grazing_margin(b.out.hybrid) - grazing_margin(a.out.hybrid)) / sigma if b.out.hybrid is not None else 0.0
             a, values_a = b, values_b
             h = min(h * 1.5, s.max_step) if b.iterations <= 2 else (max(h / 1.5, s.min_step) if b.iterations >= 5 else h)
         return points, "max_steps"

@@ -72,15 +72,30 @@ def scaled_residual(out: MapEvaluation, y: NDArray[np.float64], scale: NDArray[n
 def parameter_derivative(system: ParametrisedMap, y: NDArray[np.float64], p: NDArray[np.float64], index: int, out: MapEvaluation | None = None) -> NDArray[np.float64]:
     """dP/dp_index at (y, p): the map's own derivative if it gives one, else a central difference.
 
-    The step is ``FD_RELATIVE_STEP * max(|p_i|, parameter_scale_i)`` (see :data:`FD_RELATIVE_STEP`).
+    The step is ``FD_RELATIVE_STEP * max(|p_i|, parameter_scale_i)`` (see :data:`FD_RELATIVE_STEP`). Next to a grazing
+    point one side of the difference can have another impact count (the map is not differentiable across): then the
+    one-sided difference on the side of ``out``'s impact count is used, halving the step until one side agrees.
     """
     if out is not None and out.parameter_jacobian is not None:
         return np.asarray(out.parameter_jacobian)[:, index]
     step = FD_RELATIVE_STEP * max(abs(float(p[index])), float(system.parameter_scale[index]))
-    up, down = p.copy(), p.copy()
-    up[index] += step
-    down[index] -= step
-    return (system.evaluate(y, up).image - system.evaluate(y, down).image) / (up[index] - down[index])
+    signature = out.hybrid.signature if out is not None and out.hybrid is not None else None
+    for _ in range(30):
+        up, down = p.copy(), p.copy()
+        up[index] += step
+        down[index] -= step
+        above, below = system.evaluate(y, up), system.evaluate(y, down)
+        if signature is None or above.hybrid is None:
+            return (above.image - below.image) / (up[index] - down[index])
+        same_above, same_below = above.hybrid.signature == signature, below.hybrid is not None and below.hybrid.signature == signature
+        if same_above and same_below:
+            return (above.image - below.image) / (up[index] - down[index])
+        if same_above and out is not None:
+            return (above.image - out.image) / (up[index] - p[index])
+        if same_below and out is not None:
+            return (out.image - below.image) / (p[index] - down[index])
+        step *= 0.5
+    return (above.image - below.image) / (up[index] - down[index])
 
 
 def make_orbit(system: ParametrisedMap, y: NDArray[np.float64], p: NDArray[np.float64], out: MapEvaluation, history: tuple[float, ...] = ()) -> PeriodicOrbit:
