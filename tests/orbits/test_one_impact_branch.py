@@ -1,0 +1,181 @@
+"""The one-impact branch of the paper's system by continuation, against the closed form (issue 11, item 7).
+
+PAPER_SYSTEM, Delta = 3 mm, q = 10 N, R = 0.2, 15-45 Hz: each band's branch is continued both ways from the closed-form
+orbit, around the fold at the band's end and down the unstable root of eq. 16 to the grazing points at both ends,
+where the impact velocity vanishes (q |H12| = Delta). Every point must be the closed-form orbit (eqs. 15-18, either
+root), its multipliers those of :mod:`vibroimpact.analysis.stability`, the folds the zeros of the discriminant of
+eq. 16, the Neimark-Sacker points the crossings of the Floquet modulus through 1.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from vibroimpact.analysis.pgf import solve_one_impact
+from vibroimpact.analysis.stability import floquet_multipliers
+from vibroimpact.engines.exact import ExactEngine
+from vibroimpact.engines.registry import make_engine
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import PAPER_SYSTEM
+from vibroimpact.orbits.bifurcations import switch_period_doubling
+from vibroimpact.orbits.branch import Iterated
+from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
+from vibroimpact.orbits.maps import ImpactMap, one_impact_state, orbit_measures, section_phase, with_impulse
+from vibroimpact.orbits.shooting import shoot
+
+pytestmark = pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")
+
+DELTA, Q, R = 3e-3, 10.0, 0.2
+BANDS = {"low": ((19.0, 29.0), 24.0), "high": ((33.0, 45.0), 37.0)}
+
+
+def _problem(frequency: float, band: tuple[float, float], delta: float = DELTA, restitution: float = R) -> ImpactProblem:
+    base = ImpactProblem(PAPER_SYSTEM, RigidStop(delta, restitution), HarmonicForce(Q, frequency))
+    phase = section_phase(base, np.linspace(*band, 400))  # the strobe away from every impact of the band
+    return ImpactProblem(PAPER_SYSTEM, RigidStop(delta, restitution), HarmonicForce(Q, frequency, phase))
+
+
+def _roots(f: float | np.ndarray, delta: float = DELTA, restitution: float = R):
+    """Both roots of eq. 16 (corrected) and its discriminant at frequency f [Hz]."""
+    sol = solve_one_impact(PAPER_SYSTEM, 2.0 * np.pi * np.asarray(f, dtype=float), delta, restitution, Q)
+    c = (1.0 / (PAPER_SYSTEM.m2 * (1.0 + restitution)) + sol.chi_rate_before) / sol.omega
+    a = Q * np.abs(sol.receptances.h12)
+    quad_a, quad_b = c**2 + sol.chi0**2, delta * sol.chi0
+    disc = quad_a * a**2 - (c * delta) ** 2
+    root = np.sqrt(np.maximum(disc, 0.0))
+    return sol, (-quad_b + root) / quad_a, (-quad_b - root) / quad_a, disc
+
+
+@pytest.fixture(scope="module")
+def branches():
+    out = {}
+    for name, (band, f0) in BANDS.items():
+        problem = _problem(f0, band)
+        system = ImpactMap(problem)
+        orbit = shoot(system, one_impact_state(problem), system.parameters)
+        out[name] = (system, continue_branch(system, orbit, "frequency", ContinuationSettings(lower=15.0, upper=45.0)))
+    return out
+
+
+def test_each_band_runs_from_grazing_around_the_fold_to_grazing(branches) -> None:
+    for system, branch in branches.values():
+        assert branch.end == "grazing, grazing"
+        assert set(branch.impacts) == {1}
+        kinds = [s.kind for s in branch.special_points]
+        assert kinds[0] == "grazing" and kinds[-1] == "grazing" and kinds.count("fold") == 1
+        assert branch.stable.any() and (~branch.stable).any()
+
+
+def test_every_point_is_the_closed_form_orbit(branches) -> None:
+    for system, branch in branches.values():
+        impulses = []
+        for orbit in branch.orbits:
+            f = orbit.parameter("frequency")
+            measures = orbit_measures(system, orbit)
+            assert measures.impulses.size == 1
+            impulse = measures.impulses[0]
+            sol, plus, minus, _disc = _roots(f)
+            closed = with_impulse(sol, float(plus if abs(plus - impulse) < abs(minus - impulse) else minus))
+            impulses.append((impulse, float(closed.impulse)))
+            scale = abs(float(closed.impulse)) + 1e-2 * abs(float(plus))
+            assert impulse == pytest.approx(float(closed.impulse), rel=1e-9, abs=1e-9 * scale)
+            assert measures.x1_amplitude == pytest.approx(abs(closed.x1_harmonic()), rel=1e-9)
+            assert measures.x2_amplitude == pytest.approx(abs(closed.x2_harmonic()), rel=1e-9)
+            state = one_impact_state(system.problem_at(orbit.parameters), closed)
+            assert np.max(np.abs(orbit.state - state) / system.state_scale) < 1e-9
+            expected = np.sort_complex(floquet_multipliers(closed).ravel())
+            got = np.sort_complex(orbit.multipliers)
+            # next to a grazing point the multipliers grow like 1 / J and both computations lose digits with them
+            tolerance = 1e-9 * max(1.0, float(np.max(np.abs(got)))) * max(1.0, 1e-2 * abs(float(plus)) / impulse)
+            assert np.max(np.abs(got - expected)) < tolerance
+        impulses = np.array(impulses)
+        assert np.max(np.abs(impulses[:, 0] - impulses[:, 1])) < 1e-9 * np.max(impulses[:, 1])
+
+
+def test_folds_are_the_zeros_of_the_discriminant(branches) -> None:
+    for system, branch in branches.values():
+        (fold,) = branch.special("fold")
+        exact = brentq(lambda f: float(_roots(f)[3]), fold.value - 0.05, fold.value + 0.05, xtol=1e-14, rtol=1e-15)
+        assert fold.value == pytest.approx(exact, rel=1e-8)
+        assert np.min(np.abs(fold.orbit.multipliers - 1.0)) < 1e-6
+
+
+def test_grazing_points_are_where_the_linear_amplitude_reaches_the_clearance(branches) -> None:
+    def gap(f: float) -> float:
+        return Q * abs(complex(PAPER_SYSTEM.receptances(2.0 * np.pi * f).h12)) - DELTA
+
+    for system, branch in branches.values():
+        for point in branch.special("grazing"):
+            exact = brentq(gap, point.value - 0.05, point.value + 0.05, xtol=1e-14, rtol=1e-15)
+            assert point.value == pytest.approx(exact, rel=1e-8)
+            assert point.continues and point.impacts_after == 0  # the linear orbit carries on
+
+
+def _complex_pair_crossings(low: float, high: float, root: int) -> list[float]:
+    """Frequencies in [low, high] where a complex pair of one root's Floquet multipliers crosses the unit circle."""
+
+    def excess(f: float | np.ndarray) -> np.ndarray:
+        sol, plus, minus, _ = _roots(f)
+        mu = np.atleast_2d(floquet_multipliers(with_impulse(sol, (plus, minus)[root])))
+        pair = np.where(np.abs(mu.imag) > 1e-9, np.abs(mu), -np.inf)
+        return np.max(pair, axis=-1) - 1.0
+
+    grid = np.arange(low, high, 1e-3)
+    values = excess(grid)
+    crossings = []
+    for k in np.flatnonzero(np.isfinite(values[:-1]) & np.isfinite(values[1:]) & (np.sign(values[:-1]) * np.sign(values[1:]) < 0)):
+        crossings.append(brentq(lambda f: float(excess(f)[0]), grid[k], grid[k + 1], xtol=1e-14, rtol=1e-15))
+    return crossings
+
+
+def test_neimark_sacker_points_are_the_crossings_of_the_floquet_modulus(branches) -> None:
+    lost = []
+    for system, branch in branches.values():
+        fold = branch.special("fold")[0].value
+        graze = sorted(p.value for p in branch.special("grazing"))
+        on_branch = _complex_pair_crossings(graze[0] + 1e-6, fold - 1e-6, 0) + _complex_pair_crossings(graze[-1] + 1e-6, fold - 1e-6, 1)
+        torus = [p.value for p in branch.special("neimark_sacker")]
+        assert len(torus) == len(on_branch)
+        for value in on_branch:
+            assert min(abs(t - value) for t in torus) < 1e-8 * value
+        lost += [p.value for p in branch.special("neimark_sacker") if np.sum(np.abs(p.orbit.multipliers) > 1.0 - 1e-6) == 2]
+        # where the stable orbit is lost, the largest Floquet modulus of the closed form crosses 1 (fine grid)
+        grid = np.arange(graze[0] + 1e-6, fold - 1e-6, 1e-3)
+        sol, plus, _minus, _ = _roots(grid)
+        modulus = np.max(np.abs(floquet_multipliers(with_impulse(sol, plus))), axis=-1)
+        crossing = grid[np.flatnonzero(np.diff(np.sign(modulus - 1.0)))]
+        for value in crossing:
+            assert min(abs(t - value) for t in torus) < 2e-3
+    # the stable orbit loses stability near 21.2 and 39.0 Hz through a torus bifurcation
+    assert sorted(round(v, 1) for v in lost) == [21.2, 39.0]
+
+
+def test_period_doubling_and_its_period_two_branch_confirmed_by_momentary() -> None:
+    # Delta = 1 mm, R = 0.2: the one-impact orbit doubles its period near 17.58 Hz
+    band = (15.5, 19.0)
+    problem = _problem(17.8, band, delta=1e-3)
+    system = ImpactMap(problem)
+    branch = continue_branch(system, shoot(system, one_impact_state(problem), system.parameters), "frequency", ContinuationSettings(lower=15.0, upper=20.0))
+    (doubling,) = branch.special("period_doubling")
+    assert np.min(np.abs(doubling.orbit.multipliers + 1.0)) < 1e-7
+    two = switch_period_doubling(system, doubling)
+    second = continue_branch(Iterated(system, 2), two, "frequency", ContinuationSettings(lower=15.0, upper=20.0, max_steps=400))
+    assert all(o.period == 2 for o in second.orbits)
+    # supercritical: the stable period-two orbit lives between its fold and the period doubling, below 17.576 Hz
+    stable = [o for o in second.orbits if o.stable and o.impacts == 2]
+    assert stable, "a stable period-two orbit with two impacts"
+    orbit = min(stable, key=lambda o: o.floquet_modulus)
+    assert orbit.parameter("frequency") < doubling.value
+    # time simulation with an independent engine from next to the orbit: it settles on the same period-two orbit
+    momentary = make_engine("momentary")
+    start = orbit.state + 1e-5 * system.state_scale
+    run = momentary.integrate(system.problem_at(orbit.parameters), start, 0.0, 200)
+    strobes = run.strobe_states[-20:]
+    assert np.max(np.abs(strobes[2:] - strobes[:-2]) / system.state_scale) < 1e-6  # period two
+    assert np.min(np.max(np.abs(strobes[1:] - strobes[:-1]) / system.state_scale, axis=1)) > 1e-2  # not period one
+    other = Iterated(system, 1).evaluate(orbit.state, orbit.parameters).image
+    assert min(np.max(np.abs(strobes[-1] - orbit.state) / system.state_scale), np.max(np.abs(strobes[-1] - other) / system.state_scale)) < 1e-6
