@@ -35,6 +35,7 @@ __all__ = [
     "BENCHMARK_REFERENCE",
     "BENCHMARK_METHODS",
     "QUANTITIES",
+    "MOTION_QUANTITIES",
     "SWEEPABLE",
     "GRID_DIMS",
 ]
@@ -77,7 +78,13 @@ QUANTITIES = (
     "peak_acceleration",
     "peak_contact_force",
     "wall_time",
+    "lyapunov_exponent",
+    "lyapunov_error",
+    "rotation_number",
+    "spectral_line_fraction",
 )
+#: The evidence of what a non-periodic simulated motion is (NaN where the motion is periodic, and for closed forms).
+MOTION_QUANTITIES = ("lyapunov_exponent", "lyapunov_error", "rotation_number", "spectral_line_fraction")
 #: Parameters that can be swept, with their units and allowed ranges (low, high, low inclusive).
 SWEEPABLE = {
     "frequency": ("Hz", 0.0, math.inf, False),

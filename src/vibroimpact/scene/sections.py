@@ -43,8 +43,8 @@ TOP_KEYS = {"name", "description", "system", "excitation", "stop", "bumper", "sw
 #: A scene's or a case's name: safe as a file name.
 NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 #: Simulation keys that only stepped steady states use.
-_STEADY_ONLY_KEYS = {"frequency", "start", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods"}
-_SIMULATION_KEYS = {"frequency", "start", "method", "rtol", "atol", "max_step", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods"}
+_STEADY_ONLY_KEYS = {"frequency", "start", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods"}
+_SIMULATION_KEYS = {"frequency", "start", "method", "rtol", "atol", "max_step", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods"}
 #: Where an unswept parameter is given instead (``frequency`` is always swept).
 _FIXED_PLACE = {"restitution": ("stop", "restitution"), "clearance": ("stop", "clearance"), "bumper_frequency": ("bumper", "frequency"), "bumper_loss_factor": ("bumper", "loss_factor")}
 _T = TypeVar("_T")
@@ -225,7 +225,7 @@ def _parse_simulation(c: Checker, value: Any, default_frequency: np.ndarray, swe
     if start not in SIMULATION_STARTS:
         c.fail("simulation.start", f"{start!r} is not allowed: use one of {', '.join(SIMULATION_STARTS)}")
     engine_kwargs = {k: spec[k] for k in ("method", "rtol", "atol", "max_step") if k in spec}
-    steady_kwargs = {k: spec[k] for k in ("tolerance", "max_periods", "measure_periods", "irregular_measure_periods") if k in spec}
+    steady_kwargs = {k: spec[k] for k in ("tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods") if k in spec}
     engine = _settings(c, EngineSettings, engine_kwargs)
     steady = _settings(c, SteadySettings, steady_kwargs)
     if frequency is None or start not in SIMULATION_STARTS or engine is None or steady is None:

@@ -46,6 +46,10 @@ VARIABLE_ATTRIBUTES: dict[str, dict[str, str]] = {
     "peak_acceleration": {"units": "m s-2", "long_name": "largest deceleration of the absorber on the bumper, bumper force less absorber spring over M2 (compliant: measured; pgf: (M2 Gamma(xi_b) Omega_b J / (M2 (1 + R)) - absorber spring force at the impact) / M2; rigid engines: NaN; no contact: 0)"},
     "peak_contact_force": {"units": "N", "long_name": "largest bumper force (compliant: measured; pgf: Gamma(xi_b) Omega_b J / (1 + R); rigid engines: NaN; no contact: 0)"},
     "wall_time": {"units": "s", "long_name": "wall time of the simulation at this point (one process; swept-sine tests: the whole sweep)"},
+    "lyapunov_exponent": {"units": "1", "long_name": "largest Lyapunov exponent of the stroboscopic map per excitation period where the simulated motion is not periodic (exact: from its exact Jacobians; other engines: from a perturbed copy of their own run)"},
+    "lyapunov_error": {"units": "1", "long_name": "standard error of lyapunov_exponent per excitation period (spread of block averages)"},
+    "rotation_number": {"units": "1", "long_name": "rotation number of the strobe points around their centre, cycles per excitation period, where they lie on a closed curve (quasi-periodic motion)"},
+    "spectral_line_fraction": {"units": "1", "long_name": "fraction of the power of the X1 strobe sequence in its 5 largest spectral lines (near 1: a line spectrum, quasi-periodic; low: broadband, chaotic)"},
 }
 #: Whole-run statistics of a swept-sine run (sweep...).
 SWEEP_STAT_ATTRIBUTES: dict[str, dict[str, str]] = {

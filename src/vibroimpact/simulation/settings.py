@@ -8,8 +8,9 @@ from vibroimpact.model.validation import require_in_range
 
 __all__ = ["SteadySettings", "START_MODES", "SWEEP_STARTS"]
 
-#: Where a steady state at one frequency starts: the linear steady state, the one-impact (PGF) orbit, or rest.
-START_MODES = ("linear", "pgf", "rest")
+#: Where a steady state at one frequency starts: the linear steady state, the one-impact (PGF) orbit, rest, or the
+#: periodic orbit found by shooting from the PGF orbit (:mod:`vibroimpact.simulation.periodic`).
+START_MODES = ("linear", "pgf", "rest", "shooting")
 #: Stepped sweeps over a frequency grid: each point starts from the previous one's end state (up or down in frequency).
 SWEEP_STARTS = ("sweep_up", "sweep_down")
 
@@ -36,6 +37,11 @@ class SteadySettings:
     start_perturbation : float
         Relative displacement of the ``pgf`` start from the orbit [-], so that the simulation tests the orbit's
         stability rather than sitting on an unstable orbit until round-off grows.
+    lyapunov_periods : int
+        Where the motion does not become periodic, its largest Lyapunov exponent is estimated over this many periods
+        on the attractor: the measured run is extended to this length; ``exact`` takes the exponent from its exact
+        Jacobians (nearly free), other engines from a perturbed copy of the run (as many periods again). 0: measure
+        ``irregular_measure_periods`` only and classify nothing (``irregular``).
     """
 
     tolerance: float = 1e-7
@@ -45,6 +51,7 @@ class SteadySettings:
     irregular_measure_periods: int = 64
     max_multiplicity: int = 4
     start_perturbation: float = 1e-6
+    lyapunov_periods: int = 1024
 
     def __post_init__(self) -> None:
         require_in_range("tolerance", self.tolerance, 1e-14, 1e-1)
@@ -54,3 +61,4 @@ class SteadySettings:
         require_in_range("irregular_measure_periods", self.irregular_measure_periods, 1, 1e6)
         require_in_range("max_multiplicity", self.max_multiplicity, 1, 64)
         require_in_range("start_perturbation", self.start_perturbation, 0.0, 1e-2)
+        require_in_range("lyapunov_periods", self.lyapunov_periods, 0, 1e7)

@@ -2,8 +2,12 @@
 
 Starts: ``linear`` (the linear steady state; answered without integrating when it stays inside the clearance, since
 it is then an exact steady state), ``pgf`` (the exact one-impact orbit of a rigid stop, where it exists: the
-problem's own stop, or for a bumper the stop a caller names), ``rest``, or an explicit state (a frequency sweep passes
-the previous frequency's end state).
+problem's own stop, or for a bumper the stop a caller names), ``shooting`` (the periodic orbit that Newton's method
+finds from the ``pgf`` orbit on the exact stroboscopic map: where it is stable, the run starts on it; else as
+``pgf``), ``rest``, or an explicit state (a frequency sweep passes the previous frequency's end state).
+
+Where the motion does not become periodic, the measured run says what it is (``motion``: quasi-periodic, chaotic or
+undecided, with its Lyapunov exponent; :func:`vibroimpact.simulation.periodic.motion_evidence`).
 """
 
 from __future__ import annotations
@@ -20,7 +24,9 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.simulation.harmonics import HarmonicMeasures, measure
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
+from vibroimpact.simulation.periodic import motion_evidence, shoot_orbit
 from vibroimpact.simulation.settings import START_MODES, SteadySettings
+from vibroimpact.orbits.motion import MotionEvidence
 
 __all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "orbit_stop_of", "START_MODES"]
 
@@ -46,6 +52,10 @@ class SteadyResult:
         Final (X1, X2, X1', X2'), for the next point of a sweep.
     integrated : bool
         False when the answer is the linear steady state, given without integrating.
+    motion : MotionEvidence or None
+        Where the motion did not converge (and ``lyapunov_periods`` > 0): what it is, with the evidence.
+    search_periods : int
+        Periods spent finding the steady state (shooting's map evaluations, or marching), before measuring it.
     """
 
     measures: HarmonicMeasures
@@ -55,6 +65,8 @@ class SteadyResult:
     end_time: float
     end_state: NDArray[np.float64] = field(repr=False)
     integrated: bool = True
+    motion: MotionEvidence | None = None
+    search_periods: int = 0
 
 
 def start_state(problem: ImpactProblem, mode: str, orbit_stop: RigidStop | None = None) -> tuple[float, NDArray[np.float64]]:
@@ -66,7 +78,7 @@ def start_state(problem: ImpactProblem, mode: str, orbit_stop: RigidStop | None 
         raise ValueError(f"start = {mode!r} is not allowed: use one of {', '.join(START_MODES)}")
     if mode == "rest":
         return 0.0, np.zeros(4)
-    if mode == "pgf":
+    if mode in ("pgf", "shooting"):
         orbit = _orbit(problem, orbit_stop)
         if orbit.exists[0] and orbit.admissible()[0]:
             # the orbit's time origin is its impact, where the force has phase (phi - psi12); in the problem's
@@ -124,26 +136,38 @@ def steady_state(
         Time-domain engine.
     problem : ImpactProblem
         System, stop and excitation.
-    start : {'linear', 'pgf', 'rest'} or (time [s], state)
+    start : {'linear', 'pgf', 'rest', 'shooting'} or (time [s], state)
         Where to start.
     settings : SteadySettings
         Convergence and measurement settings.
     orbit_stop : RigidStop, optional
         The rigid stop whose one-impact orbit a ``pgf`` start follows (see :func:`orbit_stop_of`).
     """
-    if start == "pgf" and not _has_orbit(problem, orbit_stop):
+    if start in ("pgf", "shooting") and not _has_orbit(problem, orbit_stop):
         start = "linear"  # where no admissible one-impact orbit exists, the pgf start is the linear one
     if start == "linear" and linear_fits(problem):
         return _linear_answer(problem)
     t, y = start_state(problem, start, orbit_stop) if isinstance(start, str) else (float(start[0]), np.asarray(start[1], dtype=float))
     scale = np.array([1.0, 1.0, problem.omega, problem.omega]) * (problem.clearance + problem.amplitude * abs(complex(problem.system.receptances(problem.omega).h12)))
+    used = 0
+    first_chunk = settings.chunk_periods
+    if start == "shooting":
+        shot = shoot_orbit(problem if isinstance(problem.contact, RigidStop) else _rigid(problem, orbit_stop), t, y)
+        used = shot.periods if shot is not None else 0
+        if shot is not None and shot.stable:
+            t, y = shot.time, shot.state
+            if engine.name == "exact":  # the orbit is the steady state: measure it
+                return _measure(engine, problem, t, y, 1, used, settings)
+            first_chunk = 3  # an integrator starts on the orbit: it needs only to confirm that its state repeats
+        else:
+            start = "pgf"  # no stable orbit near the closed form: march from it, perturbed
     if start == "pgf":
         y = y + settings.start_perturbation * scale * np.array([1.0, 0.0, 0.0, 0.0])
     strobes = [y]
-    used = 0
+    searched = used
     multiplicity = 0
-    while used < settings.max_periods:
-        chunk = min(settings.chunk_periods, settings.max_periods - used)
+    while used - searched < settings.max_periods:
+        chunk = min(first_chunk if used == searched else settings.chunk_periods, settings.max_periods - (used - searched))
         trajectory = engine.integrate(problem, y, t, chunk)
         used += chunk
         strobes.extend(trajectory.strobe_states[1:])
@@ -152,19 +176,41 @@ def steady_state(
         multiplicity = _repeat(recent, scale, settings)
         if multiplicity:
             break
+    return _measure(engine, problem, t, y, multiplicity, used, settings)
+
+
+def _measure(engine: Engine, problem: ImpactProblem, t: float, y: NDArray[np.float64], multiplicity: int, searched: int, settings: SteadySettings) -> SteadyResult:
+    """Measure whole periods from (t, y): a periodic motion over a multiple of its period; a motion that did not
+    converge over ``irregular_measure_periods``, or ``lyapunov_periods`` to say what it is."""
+    motion = None
     if multiplicity:
         periods = multiplicity * math.ceil(settings.measure_periods / multiplicity)
+        final = engine.integrate(problem, y, t, periods, moments=True)
+    elif settings.lyapunov_periods:
+        periods = max(settings.irregular_measure_periods, settings.lyapunov_periods)
+        exact = engine.name == "exact"
+        final = engine.integrate(problem, y, t, periods, moments=True, jacobians=True) if exact else engine.integrate(problem, y, t, periods, moments=True)
+        motion = motion_evidence(engine, problem, final)
+        if not exact:
+            periods *= 2  # the perturbed copy of the run
     else:
         periods = settings.irregular_measure_periods
-    final = engine.integrate(problem, y, t, periods, moments=True)
+        final = engine.integrate(problem, y, t, periods, moments=True)
     return SteadyResult(
         measures=measure(final),
         converged=multiplicity > 0,
         multiplicity=multiplicity,
-        periods_used=used + periods,
+        periods_used=searched + periods,
         end_time=float(final.strobe_times[-1]),
         end_state=final.final_state.copy(),
+        motion=motion,
+        search_periods=searched,
     )
+
+
+def _rigid(problem: ImpactProblem, orbit_stop: RigidStop | None) -> ImpactProblem:
+    """The problem with the rigid stop a ``pgf`` start follows in place of its bumper (shooting needs a rigid stop)."""
+    return ImpactProblem(problem.system, orbit_stop_of(problem, orbit_stop), problem.excitation)
 
 
 def _repeat(strobes: NDArray[np.float64], scale: NDArray[np.float64], settings: SteadySettings) -> int:

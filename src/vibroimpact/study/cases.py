@@ -46,6 +46,11 @@ FIELDS = (
     "periods_used",
     "wall_time",
     "failed",
+    "motion_regime",
+    "lyapunov_exponent",
+    "lyapunov_error",
+    "rotation_number",
+    "spectral_line_fraction",
 )
 
 
@@ -144,6 +149,7 @@ def run_case(case: SimulationCase, report: ProgressReport | None = None) -> Case
             previous = None
             continue
         m = result.measures
+        motion = result.motion
         values = {
             "x1": m.x1,
             "x2": m.x2,
@@ -161,6 +167,11 @@ def run_case(case: SimulationCase, report: ProgressReport | None = None) -> Case
             "periods_used": float(result.periods_used),
             "wall_time": time.perf_counter() - started,
             "failed": 0.0,
+            "motion_regime": float(motion.regime) if motion is not None else math.nan,
+            "lyapunov_exponent": motion.lyapunov_exponent if motion is not None else math.nan,
+            "lyapunov_error": motion.lyapunov_error if motion is not None else math.nan,
+            "rotation_number": motion.rotation_number if motion is not None and motion.rotation_regular else math.nan,
+            "spectral_line_fraction": motion.spectral_line_fraction if motion is not None else math.nan,
         }
         for name, value in values.items():
             out[name][i] = value

@@ -16,7 +16,7 @@ from vibroimpact.analysis.regime import Regime, classify
 from vibroimpact.analysis.stability import floquet_multipliers
 from vibroimpact.engines.registry import BUMPER, engine_spec
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, peak_acceleration_factor
-from vibroimpact.scene.schema import Scene
+from vibroimpact.scene.schema import MOTION_QUANTITIES, Scene
 from vibroimpact.scene.variables import STABLE_MARGINAL
 from vibroimpact.simulation.settings import SWEEP_STARTS
 from vibroimpact.study.cases import FIELDS, SimulationCase
@@ -53,6 +53,7 @@ def linear_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, shape: tup
         "peak_acceleration": np.where(fits, 0.0, np.nan),
         "peak_contact_force": np.where(fits, 0.0, np.nan),
         "wall_time": np.full(shape, np.nan),
+        **{name: np.full(shape, np.nan) for name in MOTION_QUANTITIES},
     }
     return {k: np.broadcast_to(v, shape) for k, v in values.items() if k in scene.quantities}
 
@@ -109,6 +110,7 @@ def pgf_values(scene: Scene, variant: PgfVariant, omega: np.ndarray, delta: np.n
         "peak_acceleration": lambda: choose(peaks()[0], np.zeros(shape)),
         "peak_contact_force": lambda: choose(peaks()[1], np.zeros(shape)),
         "wall_time": lambda: np.full(shape, np.nan),
+        **{name: (lambda: np.full(shape, np.nan)) for name in MOTION_QUANTITIES},
     }
     return {q: makers[q]() for q in scene.quantities}
 
@@ -182,6 +184,8 @@ def simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], jobs: in
     impacts = fields["impacts_per_period"]
     regime = np.full(grid, Regime.NOT_COMPUTED, dtype=np.int8)
     regime[computed & ~converged] = Regime.IRREGULAR
+    classified = computed & ~converged & ~np.isnan(fields["motion_regime"])
+    regime[classified] = fields["motion_regime"][classified].astype(np.int8)  # quasi_periodic, chaotic or irregular
     regime[computed & converged] = Regime.PERIODIC_IMPACTS
     regime[computed & converged & (impacts == 0.0)] = Regime.LINEAR
     regime[computed & converged & (fields["multiplicity"] == 1.0) & (impacts == 1.0)] = Regime.ONE_IMPACT
@@ -203,5 +207,9 @@ def simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], jobs: in
         "peak_acceleration": fields["peak_acceleration"],
         "peak_contact_force": fields["peak_contact_force"],
         "wall_time": fields["wall_time"],
+        "lyapunov_exponent": fields["lyapunov_exponent"],
+        "lyapunov_error": fields["lyapunov_error"],
+        "rotation_number": fields["rotation_number"],
+        "spectral_line_fraction": fields["spectral_line_fraction"],
     }
     return {q: values[q] for q in scene.quantities}

@@ -15,7 +15,7 @@ import xarray as xr
 
 from vibroimpact.analysis.regime import Regime
 from vibroimpact.model.contact import KelvinVoigtBumper
-from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, Scene
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, MOTION_QUANTITIES, Scene
 from vibroimpact.scene.variables import SWEEP_STAT_ATTRIBUTES, SWEEP_TIME_ATTRIBUTES, quantity_attributes, running_attributes, swept_attributes
 from vibroimpact.study.cost_model import Costs, EnginePart, Estimate, grid_estimate
 from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates, solve_each, steady_variable
@@ -61,7 +61,7 @@ class SweptStudy:
             if stacked is not None:
                 data_vars[quantity] = xr.Variable(("solution", *steady_dims), stacked[:, :, :, :, 0, :], attrs)
             for name, values in zip(scene.solutions, per_solution):
-                if name not in steady_solutions:
+                if name not in steady_solutions and quantity not in MOTION_QUANTITIES:
                     data_vars[f"swept_{quantity}"] = xr.Variable(GRID_DIMS, values[quantity], swept_attributes(name, attrs))
         for name, values in running.items():
             if name.startswith("sweep_"):  # one value per sweep run
@@ -145,6 +145,7 @@ def swept_values(scene: Scene, shape: tuple[int, ...], jobs: int, cache_dir: Pat
         **no_one_impact_orbit(shape),
         "converged": np.full(shape, -1, dtype=np.int8),
         "wall_time": np.broadcast_to(stats["wall_time"][..., None], shape),
+        **{name: np.full(shape, np.nan) for name in MOTION_QUANTITIES},  # a sweep is a transient: no attractor to classify
     }
     running = {name: value for name, value in running.items() if name.removeprefix("running_") in scene.quantities}
     for name, value in stats.items():
