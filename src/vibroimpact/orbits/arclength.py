@@ -82,15 +82,20 @@ class ArclengthSystem:
     def _extra_values(self, out: MapEvaluation, y: NDArray[np.float64], p: NDArray[np.float64]) -> list[float]:
         return [float(g(out, y, p)) for g in self.extra]
 
-    def equations(self, z: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64], MapEvaluation]:
-        """F(z), dF/dz (shape (n + f - 1, n + f)) and the map's evaluation at z."""
+    def equations(self, z: NDArray[np.float64], columns: NDArray[np.float64] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64], MapEvaluation]:
+        """F(z), dF/dz (shape (n + f - 1, n + f)) and the map's evaluation at z.
+
+        ``columns`` (n, f): the scaled dP/dp columns to reuse (a chord step) instead of differencing them again.
+        """
         y, p = self.from_z(z)
         out = self.system.evaluate(y, p)
         residual = np.concatenate([(out.image - y) / self.sy, self._extra_values(out, y, p)])
         jac = np.empty((residual.size, z.size))
         jac[: self.n, : self.n] = (out.jacobian - np.eye(self.n)) * self.sy[None, :] / self.sy[:, None]
-        for j, index in enumerate(self.free):
-            jac[: self.n, self.n + j] = parameter_derivative(self.system, y, p, index, out) * self.sp[j] / self.sy
+        if columns is not None:
+            jac[: self.n, self.n :] = columns
+        elif np.all(np.isfinite(out.image)):
+            self.fresh_columns(jac, y, p, out)
         if self.extra:
             base = residual[self.n :]
             for i in range(z.size):  # forward differences of the test functions: sqrt(eps) relative steps
@@ -100,6 +105,11 @@ class ArclengthSystem:
                 yy, pp = self.from_z(zz)
                 jac[self.n :, i] = (np.array(self._extra_values(self.system.evaluate(yy, pp), yy, pp)) - base) / step
         return residual, jac, out
+
+    def fresh_columns(self, jac: NDArray[np.float64], y: NDArray[np.float64], p: NDArray[np.float64], out: MapEvaluation) -> None:
+        """Write the scaled dP/dp columns at (y, p) into ``jac``."""
+        for j, index in enumerate(self.free):
+            jac[: self.n, self.n + j] = parameter_derivative(self.system, y, p, index, out) * self.sp[j] / self.sy
 
     @staticmethod
     def tangent(jacobian: NDArray[np.float64], previous: NDArray[np.float64] | None) -> NDArray[np.float64]:
@@ -135,7 +145,9 @@ class ArclengthSystem:
     ) -> Point | None:
         """Newton's method on [F(z) = 0, direction . (z - predicted) = 0]; None when it does not converge.
 
-        Converged when max |F| <= ``tolerance`` and the last Newton step was below ``100 * tolerance`` (scaled).
+        Converged when max |F| <= ``tolerance`` and the last Newton step was below ``100 * tolerance`` (scaled): the
+        last step polishes the point to round-off, which matters next to a fold where the error in the state is the
+        residual divided by the distance of a multiplier from 1.
         With a hybrid ``signature`` (impacts, sticks), every iterate is kept on the side of the grazing manifold where
         the map has that signature, by halving the step (from ``anchor``, a point on that side, for the first one):
         next to a grazing point the map's Jacobian grows like one over the slowest impact's speed and a full Newton
@@ -145,14 +157,15 @@ class ArclengthSystem:
         history: list[float] = []
         last_step = np.inf
         previous = anchor
+        columns = None  # dP/dp is differenced at the first iterate and at the solution only (chord steps between)
         for iteration in range(max_iterations + 1):
-            residual, jac, out = self.equations(z)
+            residual, jac, out = self.equations(z, columns)
             if signature is not None and previous is not None:
                 for _ in range(40):
                     if out.hybrid is not None and out.hybrid.signature == signature:
                         break
                     z = previous + 0.5 * (z - previous)
-                    residual, jac, out = self.equations(z)
+                    residual, jac, out = self.equations(z, columns)
                 else:
                     return None
             size = float(np.max(np.abs(residual))) if residual.size else 0.0
@@ -161,7 +174,10 @@ class ArclengthSystem:
                 return None
             if size <= tolerance and last_step <= 100.0 * tolerance:
                 y, p = self.from_z(z)
+                if columns is not None:
+                    self.fresh_columns(jac, y, p, out)
                 return Point(z, y, p, out, residual, jac, self.tangent(jac, direction), iteration, tuple(history))
+            columns = jac[: self.n, self.n :].copy()
             if iteration == max_iterations or (iteration >= 3 and size > 2.0 * history[-2]):
                 return None
             square = np.vstack([jac, direction])

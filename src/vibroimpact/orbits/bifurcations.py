@@ -141,7 +141,7 @@ def locate(
 
 
 def locate_grazing(
-    arc: ArclengthSystem, start: Point, end_sigma: float, tolerance: float, corrector_tolerance: float
+    arc: ArclengthSystem, start: Point, end_sigma: float, tolerance: float, corrector_tolerance: float, hint: Point | None = None
 ) -> tuple[Point, Point | None, Point | None, float]:
     """The grazing point between ``start`` (sigma = 0) and sigma = ``end_sigma``.
 
@@ -151,7 +151,8 @@ def locate_grazing(
     linearly on either side (the closest approach, or the speed of the vanishing impact, is proportional to the
     distance to the point), so the inverse interpolation of sigma in the margin through the side points nearest the
     boundary predicts where it vanishes. The point is first approached from ``start``'s side; if an orbit with fewer
-    impacts is found beyond it, the approach is repeated from there, where Newton's method works to the end.
+    impacts is found beyond it (or given as ``hint``), the approach is repeated from there, where Newton's method
+    works to the end.
 
     Returns
     -------
@@ -162,8 +163,10 @@ def locate_grazing(
         the step: a failed step, not a grazing point).
     """
     n = arc.n
-    side, estimate, beyond, rough = _approach(arc, start, end_sigma, tolerance, corrector_tolerance)
     reference = start.out.hybrid.signature
+    side, estimate, beyond, rough = _approach(arc, start, end_sigma, tolerance, corrector_tolerance)
+    if beyond is None and hint is not None and hint.out.hybrid is not None and hint.out.hybrid.signature != reference:
+        beyond = hint
     if beyond is None and math.isfinite(rough) and 0.0 < rough < 8.0 * end_sigma:
         beyond = _jump(arc, start, side, rough, reference, corrector_tolerance)
     if beyond is not None and beyond.out.hybrid.impacts < start.out.hybrid.impacts:
@@ -217,6 +220,7 @@ def _approach(
     samples = [(0.0, grazing_margin(start.out.hybrid), start)]
     lo, hi, beyond = 0.0, float(end_sigma), None
     estimate = math.nan
+    failures = 0
     for _ in range(max_iterations):
         if len(samples) >= 2:
             estimate = _extrapolate_zero(samples[-3:])
@@ -227,16 +231,24 @@ def _approach(
         sigma = estimate if lo < estimate < hi else 0.5 * (lo + hi)
         near = samples[-1][2]  # predict from the side point nearest the boundary, along its own tangent
         predicted = near.z + (sigma - samples[-1][0]) / float(start.tangent @ near.tangent) * near.tangent
-        trial = arc.correct(predicted, start.tangent, corrector_tolerance, 12)
+        trial = arc.correct(predicted, start.tangent, corrector_tolerance, 8, reference if len(samples) < 3 else None, near.z)
         if trial is not None and trial.out.hybrid is not None and trial.out.hybrid.signature == reference:
             lo = sigma
             samples.append((sigma, grazing_margin(trial.out.hybrid), trial))
+            failures = 0
         else:
             hi = sigma
+            failures += 1
             if trial is not None and trial.out.hybrid is not None:
                 beyond = trial
+                if beyond.out.hybrid.impacts < reference[0] and len(samples) >= 2 and samples[-1][1] < 1e-3:
+                    break  # the side without the impact is smooth: the caller approaches from there
+            if failures >= 4 and len(samples) >= 2 and samples[-1][1] < 1e-3:
+                break  # Newton's region shrinks next to the point on the impacting side: extrapolate from here
     side = samples[-1][2]
     # the margin must approach zero inside the step; Newton may fail right next to the point (hi < estimate)
+    if len(samples) >= 2:
+        estimate = _extrapolate_zero(samples[-3:])
     if not (len(samples) >= 2 and samples[-1][1] < 1e-3 and math.isfinite(estimate) and lo - tolerance <= estimate <= end_sigma + tolerance):
         return side, math.nan, beyond, estimate
     if beyond is None:  # look once just beyond the grazing point for an orbit with another impact count

@@ -61,7 +61,7 @@ class ContinuationSettings:
 
     step: float = 0.05
     min_step: float = 1e-7
-    max_step: float = 0.5
+    max_step: float = 0.3
     max_steps: int = 2000
     lower: float = -math.inf
     upper: float = math.inf
@@ -137,9 +137,9 @@ class _Walker:
         half = Iterated(self.system.base, self.system.times // 2).evaluate(point.y, point.p).image
         return bool(np.max(np.abs(half - point.y) / self.arc.sy) < 1e-3)  # amplitude ~ sqrt(parameter distance)
 
-    def grazing(self, a: Point, sigma: float, arclength: float) -> object:
+    def grazing(self, a: Point, sigma: float, arclength: float, hint: Point | None = None) -> object:
         """Locate a grazing point between a and sigma; return the point beyond it (None: the branch ends there)."""
-        side, grazing, beyond, value = locate_grazing(self.arc, a, sigma, self.tolerance(a), self.settings.tolerance)
+        side, grazing, beyond, value = locate_grazing(self.arc, a, sigma, self.tolerance(a), self.settings.tolerance, hint)
         if not math.isfinite(value):
             return _NOT_GRAZING  # a plain corrector failure, not a grazing
         before = side.out.hybrid
@@ -166,6 +166,13 @@ class _Walker:
         self.specials.append((arclength + float(a.tangent @ (side.z - a.z)), found))
         self.last_before = side
         return beyond
+
+    def detect(self, a: Point, values_a: dict[str, float], b: Point, values_b: dict[str, float], sigma: float, arclength: float) -> None:
+        """Locate every test function that changes sign between a and b (sigma along a's tangent)."""
+        self.parent = None
+        for kind, before in values_a.items():
+            if np.sign(before) * np.sign(values_b[kind]) < 0:
+                self.special(kind, a, sigma, arclength)
 
     def _grazing_distance(self, a: Point) -> float:
         """Arclength to the grazing point extrapolated from the margin's slope (inf when it is not approaching)."""
@@ -203,6 +210,9 @@ class _Walker:
                 b = None  # the tangent turned too much: a smaller step
             hybrid = a.out.hybrid is not None and "grazing" in s.detect
             changed = b is not None and _signature(b) != _signature(a)
+            if changed and h > 1e-3:
+                h *= 0.5  # walk up to the grazing point with ordinary steps, so that no other test is skipped
+                continue
             ahead = self._grazing_distance(a)
             close = ahead < 0.5 * h or (math.isfinite(ahead) and grazing_margin(a.out.hybrid) < self.retry_margin)
             if close:
@@ -210,9 +220,11 @@ class _Walker:
             if hybrid and (changed or (b is None and self._grazing_ahead(a, h)) or close):
                 # a grazing point within the step: the impact count changed, or Newton failed next to it, or the
                 # margin extrapolates to zero (Newton's region shrinks near it, the steps would creep)
-                beyond = self.grazing(a, h if changed or b is None else 1.5 * ahead, arclength)
+                beyond = self.grazing(a, h if changed or b is None else 1.5 * ahead, arclength, b if changed else None)
                 if beyond is not _NOT_GRAZING:
-                    points.append(self.last_before)
+                    last = self.last_before
+                    self.detect(a, values_a, last, self.tests(last), float(a.tangent @ (last.z - a.z)), arclength)
+                    points.append(last)
                     if beyond is None or s.stop_at_grazing:
                         return points, "grazing"
                     arclength += float(a.tangent @ (beyond.z - a.z))
@@ -233,10 +245,7 @@ class _Walker:
                 points.append(self.bound(a, sigma, s.lower if value < s.lower else s.upper))
                 return points, "bound"
             values_b = self.tests(b)
-            self.parent = None
-            for kind, before in values_a.items():
-                if np.sign(before) * np.sign(values_b[kind]) < 0:
-                    self.special(kind, a, sigma, arclength)
+            self.detect(a, values_a, b, values_b, sigma, arclength)
             if self.parent is not None:
                 points.append(self.parent)
                 return points, "parent"
@@ -249,7 +258,7 @@ class _Walker:
             points.append(b)
             self.slope = (grazing_margin(b.out.hybrid) - grazing_margin(a.out.hybrid)) / sigma if b.out.hybrid is not None else 0.0
             a, values_a = b, values_b
-            h = min(h * 1.5, s.max_step) if b.iterations <= 2 else (max(h / 1.5, s.min_step) if b.iterations >= 5 else h)
+            h = min(h * 1.5, s.max_step) if b.iterations <= 3 else (max(h / 1.5, s.min_step) if b.iterations >= 6 else h)
         return points, "max_steps"
 
 

@@ -23,9 +23,11 @@ from vibroimpact.orbits.branch import Iterated, MapEvaluation, ParametrisedMap, 
 
 __all__ = ["ShootingSettings", "ShootingError", "shoot", "make_orbit", "parameter_derivative", "scaled_residual"]
 
-#: Finite-difference step for dP/dp, relative to max(|p|, parameter_scale): eps^(1/3) balances the O(h^2) truncation
-#: of a central difference against its O(eps / h) round-off, leaving ~eps^(2/3) ~ 4e-11 relative error.
-FD_RELATIVE_STEP = float(np.finfo(float).eps ** (1.0 / 3.0))
+#: Finite-difference step for dP/dp, relative to max(|p|, parameter_scale): sqrt(eps) balances the O(h) truncation of
+#: a one-sided difference against its O(eps / h) round-off, leaving ~sqrt(eps) ~ 1.5e-8 relative error. dP/dp only
+#: steers Newton's corrector and the predictor (the points themselves are exact zeros of P(y) - y), and a one-sided
+#: difference costs one map evaluation instead of two and can stay on one side of a grazing point.
+FD_RELATIVE_STEP = float(np.sqrt(np.finfo(float).eps))
 
 
 @dataclass(frozen=True)
@@ -70,32 +72,27 @@ def scaled_residual(out: MapEvaluation, y: NDArray[np.float64], scale: NDArray[n
 
 
 def parameter_derivative(system: ParametrisedMap, y: NDArray[np.float64], p: NDArray[np.float64], index: int, out: MapEvaluation | None = None) -> NDArray[np.float64]:
-    """dP/dp_index at (y, p): the map's own derivative if it gives one, else a central difference.
+    """dP/dp_index at (y, p): the map's own derivative if it gives one, else a one-sided difference.
 
     The step is ``FD_RELATIVE_STEP * max(|p_i|, parameter_scale_i)`` (see :data:`FD_RELATIVE_STEP`). Next to a grazing
-    point one side of the difference can have another impact count (the map is not differentiable across): then the
-    one-sided difference on the side of ``out``'s impact count is used, halving the step until one side agrees.
+    point the perturbed map can have another impact count (it is not differentiable across): then the difference is
+    taken on the other side, halving the step until one side has ``out``'s impact count.
     """
     if out is not None and out.parameter_jacobian is not None:
         return np.asarray(out.parameter_jacobian)[:, index]
+    if out is None:
+        out = system.evaluate(y, p)
     step = FD_RELATIVE_STEP * max(abs(float(p[index])), float(system.parameter_scale[index]))
-    signature = out.hybrid.signature if out is not None and out.hybrid is not None else None
+    signature = out.hybrid.signature if out.hybrid is not None else None
     for _ in range(30):
-        up, down = p.copy(), p.copy()
-        up[index] += step
-        down[index] -= step
-        above, below = system.evaluate(y, up), system.evaluate(y, down)
-        if signature is None or above.hybrid is None:
-            return (above.image - below.image) / (up[index] - down[index])
-        same_above, same_below = above.hybrid.signature == signature, below.hybrid is not None and below.hybrid.signature == signature
-        if same_above and same_below:
-            return (above.image - below.image) / (up[index] - down[index])
-        if same_above and out is not None:
-            return (above.image - out.image) / (up[index] - p[index])
-        if same_below and out is not None:
-            return (out.image - below.image) / (p[index] - down[index])
+        for sign in (1.0, -1.0):
+            moved = p.copy()
+            moved[index] += sign * step
+            other = system.evaluate(y, moved)
+            if signature is None or (other.hybrid is not None and other.hybrid.signature == signature):
+                return (other.image - out.image) / (moved[index] - p[index])
         step *= 0.5
-    return (above.image - below.image) / (up[index] - down[index])
+    return (other.image - out.image) / (moved[index] - p[index])
 
 
 def make_orbit(system: ParametrisedMap, y: NDArray[np.float64], p: NDArray[np.float64], out: MapEvaluation, history: tuple[float, ...] = ()) -> PeriodicOrbit:

@@ -172,5 +172,5 @@ def _walk(arc: ArclengthSystem, start: Point, s: ContinuationSettings, limits: d
                 return points, "closed"
         points.append(b)
         a = b
-        h = min(h * 1.5, s.max_step) if b.iterations <= 2 else (max(h / 1.5, s.min_step) if b.iterations >= 5 else h)
+        h = min(h * 1.5, s.max_step) if b.iterations <= 3 else (max(h / 1.5, s.min_step) if b.iterations >= 6 else h)
     return points, "max_steps"
