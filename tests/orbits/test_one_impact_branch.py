@@ -181,3 +181,24 @@ def test_period_doubling_and_its_period_two_branch_confirmed_by_momentary() -> N
     assert np.min(np.max(np.abs(strobes[1:] - strobes[:-1]) / system.state_scale, axis=1)) > 1e-2  # not period one
     other = Iterated(system, 1).evaluate(orbit.state, orbit.parameters).image
     assert min(np.max(np.abs(strobes[-1] - orbit.state) / system.state_scale), np.max(np.abs(strobes[-1] - other) / system.state_scale)) < 1e-6
+
+
+def test_fold_and_torus_curves_in_frequency_and_clearance(branches) -> None:
+    from vibroimpact.orbits.two_parameter import continue_special_point
+
+    system, branch = branches["low"]
+    settings = ContinuationSettings(step=0.05, max_steps=40)
+    fold = continue_special_point(system, branch.special("fold")[0], "clearance", settings, bounds={"clearance": (2e-3, 4e-3)})
+    assert fold.values("clearance").max() == pytest.approx(4e-3) and fold.values("clearance").min() < 2.5e-3
+    for orbit in fold.orbits:  # on the fold curve the discriminant of eq. 16 vanishes at each clearance
+        f, delta = orbit.parameter("frequency"), orbit.parameter("clearance")
+        sol, plus, _minus, disc = _roots(f, delta=delta)
+        c = (1.0 / (PAPER_SYSTEM.m2 * (1.0 + R)) + sol.chi_rate_before) / sol.omega
+        assert abs(float(disc)) < 1e-9 * float((c**2 + sol.chi0**2) * (Q * np.abs(sol.receptances.h12)) ** 2)
+        assert np.min(np.abs(orbit.multipliers - 1.0)) < 1e-8
+    torus = continue_special_point(system, branch.special("neimark_sacker")[0], "clearance", settings, bounds={"clearance": (2e-3, 4e-3)})
+    assert len(torus.orbits) > 10
+    for orbit in torus.orbits:  # a complex pair on the unit circle all along
+        mu = orbit.multipliers
+        pair = mu[np.abs(mu.imag) > 1e-9]
+        assert pair.size == 2 and np.abs(pair) == pytest.approx([1.0, 1.0], abs=1e-8)

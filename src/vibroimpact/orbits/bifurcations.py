@@ -59,7 +59,9 @@ def fold_test(point: Point, index: int) -> float:
 
 
 def period_doubling_test(out: MapEvaluation) -> float:
-    """det(J + I) of the monodromy."""
+    """det(J + I) of the monodromy (NaN where the map has no value)."""
+    if not np.all(np.isfinite(out.jacobian)):
+        return math.nan
     return float(np.linalg.det(out.jacobian + np.eye(out.jacobian.shape[0])))
 
 
@@ -67,6 +69,8 @@ def neimark_sacker_test(out: MapEvaluation) -> float:
     """det(J(2) - I) of the monodromy's second compound (0 when mu_i mu_j = 1 for a pair); 0 for a 1-D map."""
     if out.jacobian.shape[0] < 2:
         return 1.0
+    if not np.all(np.isfinite(out.jacobian)):
+        return math.nan
     compound = second_compound(out.jacobian)
     return float(np.linalg.det(compound - np.eye(compound.shape[0])))
 

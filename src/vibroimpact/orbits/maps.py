@@ -79,11 +79,14 @@ class ImpactMap:
     def evaluate(self, y: NDArray[np.float64], p: NDArray[np.float64]) -> MapEvaluation:
         """The state k periods after ``y`` at t = 0, its Jacobian and the hybrid information.
 
-        A state inside the stop (X2 > Delta, e.g. a Newton iterate) has no image: NaN, which Newton's method and the
-        corrector treat as a failed step.
+        A state inside the stop (X2 > Delta) or invalid parameters (e.g. a Newton iterate) have no image: NaN, which
+        Newton's method and the corrector treat as a failed step.
         """
-        problem = self.problem_at(p)
-        if not y[1] <= problem.clearance:  # a Newton iterate inside the stop: no flight starts there
+        try:
+            problem = self.problem_at(p)
+        except ValueError:  # a Newton iterate outside the parameters' ranges (negative clearance, R > 1, ...)
+            problem = None
+        if problem is None or not y[1] <= problem.clearance:  # or inside the stop: no flight starts there
             nan = np.full(4, np.nan)
             return MapEvaluation(nan, np.full((4, 4), np.nan), None, None)
         strobe = self.engine.strobe_map(problem, np.asarray(y, dtype=float), 0.0, self.periods)

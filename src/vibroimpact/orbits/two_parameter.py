@@ -66,6 +66,8 @@ def defining_function(kind: str, reference: tuple[int, int] | None = None) -> Te
 
     def fold(out: MapEvaluation, y: NDArray[np.float64], p: NDArray[np.float64]) -> float:
         n = out.jacobian.shape[0]
+        if not np.all(np.isfinite(out.jacobian)):
+            return math.nan
         identity = identity_cache.setdefault(n, np.eye(n))
         return float(np.linalg.det(out.jacobian - identity))
 
