@@ -6,6 +6,8 @@ itself (:mod:`vibroimpact.reporting.record`), never from a re-validated scene. :
 the kind of study, in this one place:
 
 * benchmark studies: work-precision diagrams and tolerance guidance (:class:`~vibroimpact.reporting.accuracy_page.AccuracyPage`);
+* bifurcation studies: diagrams with brute force and continued branches, special points, multipliers and the chart
+  (:class:`~vibroimpact.reporting.bifurcation_page.BifurcationPage`);
 * swept-sine tests: running estimates against the steady states (:class:`~vibroimpact.reporting.sweep_page.SweptSinePage`);
 * stepped studies with a swept bumper frequency: convergence of the compliant bumper to the rigid stop
   (:class:`~vibroimpact.reporting.bumper_page.BumperStiffnessPage`);
@@ -21,6 +23,7 @@ import xarray as xr
 
 from vibroimpact.reporting.page import StudyPage, render_page, write_page  # selects the Agg backend
 from vibroimpact.reporting.accuracy_page import AccuracyPage  # noqa: E402
+from vibroimpact.reporting.bifurcation_page import BifurcationPage  # noqa: E402
 from vibroimpact.reporting.bumper_page import BumperStiffnessPage  # noqa: E402
 from vibroimpact.reporting.record import study_kind, study_record, study_setting  # noqa: E402
 from vibroimpact.reporting.stepped_page import FrequencyResponsePage  # noqa: E402
@@ -45,6 +48,8 @@ def page_for(dataset: xr.Dataset) -> StudyPage:
     kind = study_kind(dataset)
     if kind == "benchmark":
         return AccuracyPage(dataset)
+    if kind == "bifurcation":
+        return BifurcationPage(dataset)
     setting = study_setting(dataset)
     if kind == "swept":
         return SweptSinePage(dataset, setting)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -20,6 +21,9 @@ from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.simulation.settings import START_MODES, SWEEP_STARTS, SteadySettings
+
+if TYPE_CHECKING:
+    from vibroimpact.scene.bifurcation import BifurcationSettings
 
 __all__ = [
     "Scene",
@@ -41,7 +45,7 @@ __all__ = [
 ]
 
 #: Kinds of study a scene can be (:attr:`Scene.kind`); each has its run and estimate (``study/kinds.py``) and its page.
-STUDY_KINDS = ("stepped", "swept", "benchmark")
+STUDY_KINDS = ("stepped", "swept", "benchmark", "bifurcation")
 #: Solutions computed by time integration (they need the ``simulation`` section's settings): registered engines.
 ENGINE_SOLUTIONS = ("momentary", "exact", "compliant")
 #: Solutions a scene can ask for: the closed forms, then the engines.
@@ -304,6 +308,8 @@ class Scene:
         holds R(xi_b), eq. 26 corrected); None: each restitution's own loss factor (the exact inverse of R(xi_b)).
     swept_sine : SweptSineSettings or None
         When given, the time-domain solutions are swept-sine tests, not stepped steady states.
+    bifurcation : BifurcationSettings or None
+        When given, a bifurcation study (:mod:`vibroimpact.scene.bifurcation`): brute force, branches, chart.
     report : bool
         Whether ``run-study`` writes the comparison report.
     text : str
@@ -326,6 +332,7 @@ class Scene:
     bumper_frequency: np.ndarray | None = None
     bumper_loss_factor: np.ndarray | None = None
     swept_sine: SweptSineSettings | None = None
+    bifurcation: "BifurcationSettings | None" = None
     report: bool = True
     text: str = ""
 
@@ -337,12 +344,15 @@ class Scene:
 
     @property
     def kind(self) -> str:
-        """What kind of study the scene is: ``benchmark``, ``swept`` (swept-sine tests) or ``stepped`` (steady states).
+        """What kind of study the scene is: ``benchmark``, ``bifurcation``, ``swept`` (swept-sine tests) or ``stepped``
+        (steady states).
 
         The one place that decides it; everything else dispatches on this name.
         """
         if self.benchmark is not None:
             return "benchmark"
+        if self.bifurcation is not None:
+            return "bifurcation"
         return "stepped" if self.swept_sine is None else "swept"
 
     @property

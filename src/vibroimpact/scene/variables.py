@@ -22,6 +22,8 @@ __all__ = [
     "BENCHMARK_ATTRIBUTES",
     "LADDER_ATTRIBUTES",
     "SWEEP_COST_ATTRIBUTES",
+    "BIFURCATION_ATTRIBUTES",
+    "flag_attributes",
     "quantity_attributes",
     "swept_attributes",
     "running_attributes",
@@ -135,6 +137,52 @@ SWEEP_COST_ATTRIBUTES: dict[str, dict[str, str]] = {
     "band_contacts": {"units": "1", "long_name": "contacts begun within the slice's frequency band"},
     "band_ida_contacts": {"units": "1", "long_name": "contacts of IDA within the slice's frequency band on the same span"},
 }
+
+#: A bifurcation study (branch_point, special_point, brute force over (restitution, sweep, frequency, ...), chart).
+BIFURCATION_ATTRIBUTES: dict[str, dict[str, str]] = {
+    "branch": {"units": "1", "long_name": "label of the continued branch the point belongs to"},
+    "branch_frequency": {"units": "Hz", "long_name": "excitation frequency of the branch point"},
+    "branch_restitution": {"units": "1", "long_name": "restitution ratio R of the branch point"},
+    "x1_amplitude": {"units": "m", "long_name": "fundamental-harmonic amplitude of X1 over the orbit's period"},
+    "x2_amplitude": {"units": "m", "long_name": "fundamental-harmonic amplitude of X2 over the orbit's period"},
+    "impulse": {"units": "N s", "long_name": "total impact impulse of the orbit per excitation period"},
+    "floquet_modulus": {"units": "1", "long_name": "largest modulus of the orbit's Floquet multipliers (< 1: stable)"},
+    "impacts_per_period": {"units": "1", "long_name": "impacts per excitation period of the orbit (impacts per orbit period / period_multiplicity)"},
+    "period_multiplicity": {"units": "1", "long_name": "the orbit's period in excitation periods (1: period one, 2: born at a period doubling ...)"},
+    "floquet_multiplier_real": {"units": "1", "long_name": "real part of the Floquet multipliers (eigenvalues of the monodromy), by decreasing modulus"},
+    "floquet_multiplier_imag": {"units": "1", "long_name": "imaginary part of the Floquet multipliers, by decreasing modulus"},
+    "impact_velocity": {"units": "m s-1", "long_name": "approach velocity of each impact over the orbit's period (NaN-padded)"},
+    "special_point_frequency": {"units": "Hz", "long_name": "excitation frequency of the special point"},
+    "special_point_restitution": {"units": "1", "long_name": "restitution ratio R of the special point"},
+    "special_point_branch": {"units": "1", "long_name": "label of the branch on which the special point was located"},
+    "special_point_x1_amplitude": {"units": "m", "long_name": "fundamental-harmonic amplitude of X1 of the orbit at the special point"},
+    "special_point_impulse": {"units": "N s", "long_name": "impact impulse per excitation period of the orbit at the special point"},
+    "special_point_floquet_modulus": {"units": "1", "long_name": "largest |Floquet multiplier| at the special point"},
+    "special_point_impacts_per_period": {"units": "1", "long_name": "impacts per excitation period of the orbit at the special point"},
+    "special_point_period_multiplicity": {"units": "1", "long_name": "period of the orbit at the special point, in excitation periods"},
+    "special_point_multiplier_real": {"units": "1", "long_name": "real part of the Floquet multipliers at the special point"},
+    "special_point_multiplier_imag": {"units": "1", "long_name": "imaginary part of the Floquet multipliers at the special point"},
+    "special_point_note": {"long_name": "what happens at the special point"},
+    "brute_x1": {"units": "m", "long_name": "brute force: X1 at each kept strobe t = k T (force q cos(w t))"},
+    "brute_x1_amplitude": {"units": "m", "long_name": "brute force: fundamental-harmonic amplitude of X1 over each kept period"},
+    "brute_impact_velocity": {"units": "m s-1", "long_name": "brute force: approach velocity of the impacts over the kept periods (the last ones; NaN-padded)"},
+    "brute_impacts_per_period": {"units": "1", "long_name": "brute force: impacts per excitation period over the kept periods"},
+    "brute_period": {"units": "1", "long_name": "brute force: period of the strobes in excitation periods (0: none found up to 8)"},
+    "brute_lyapunov_exponent": {"units": "1", "long_name": "brute force: largest Lyapunov exponent per excitation period where the strobes do not repeat (exact Jacobians)"},
+    "chart_curve": {"units": "1", "long_name": "label of the curve of special points in (frequency, clearance)"},
+    "chart_frequency": {"units": "Hz", "long_name": "excitation frequency of the chart's curve point"},
+    "chart_clearance": {"units": "m", "long_name": "clearance Delta of the chart's curve point"},
+    "map_frequency": {"units": "Hz", "long_name": "excitation frequency of the regime map"},
+    "map_clearance": {"units": "m", "long_name": "clearance Delta of the regime map"},
+    "chart_impacts_per_period": {"units": "1", "long_name": "regime map: impacts per excitation period over the kept periods"},
+    "chart_period": {"units": "1", "long_name": "regime map: period of the strobes in excitation periods (0: none found up to 8)"},
+    "strobe": {"units": "1", "long_name": "index of the kept strobe (excitation period) at each frequency"},
+}
+
+
+def flag_attributes(long_name: str, meanings: tuple[str, ...], dtype: type = np.int8) -> dict[str, object]:
+    """CF flag attributes of an integer variable whose values 0, 1, ... mean ``meanings``."""
+    return {"long_name": long_name, "units": "1", "flag_values": np.arange(len(meanings), dtype=dtype), "flag_meanings": " ".join(meanings)}
 
 
 def quantity_attributes(quantity: str) -> dict[str, object]:

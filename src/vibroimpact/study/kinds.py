@@ -16,6 +16,7 @@ import xarray as xr
 
 from vibroimpact.scene.schema import Scene
 from vibroimpact.study.benchmark import BenchmarkStudy
+from vibroimpact.study.bifurcation import BifurcationStudy
 from vibroimpact.study.cost_model import Costs, Estimate
 from vibroimpact.study.grid import Progress
 from vibroimpact.study.stepped import SteppedStudy
@@ -42,7 +43,7 @@ class StudyKind(Protocol):
 
 
 #: Every kind of study by name.
-KINDS: Mapping[str, StudyKind] = MappingProxyType({kind.name: kind for kind in (SteppedStudy(), SweptStudy(), BenchmarkStudy())})
+KINDS: Mapping[str, StudyKind] = MappingProxyType({kind.name: kind for kind in (SteppedStudy(), SweptStudy(), BenchmarkStudy(), BifurcationStudy())})
 
 
 def study_kind(scene: Scene) -> StudyKind:

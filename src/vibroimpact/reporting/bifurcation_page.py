@@ -1,0 +1,235 @@
+"""Report page of bifurcation studies: bifurcation diagrams with brute force and continued branches, the special
+points, the Floquet multipliers along the branches, and the two-parameter chart with its regime map.
+
+Dataset layout read here: see :mod:`vibroimpact.study.bifurcation` (``branch_point``, ``special_point``, the
+``brute_*`` variables over (restitution, sweep, frequency, ...), ``chart_point`` and ``chart_regime``).
+"""
+
+from __future__ import annotations
+
+import html
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from matplotlib.axes import Axes
+from matplotlib.colors import BoundaryNorm, ListedColormap
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+
+from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
+from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure
+
+__all__ = ["BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class"]
+
+#: Brute-force dots of each sweep direction.
+SWEEP_COLOURS = {"up": "C3", "down": "C2"}
+#: Marker of each kind of special point.
+SPECIAL_MARKERS = {"fold": "o", "period_doubling": "s", "neimark_sacker": "D", "grazing": "^"}
+#: Colour of an orbit by (impacts per orbit period, period multiplicity); others: grey.
+ORBIT_COLOURS = {(0, 1): "k", (1, 1): "C0", (2, 2): "C1", (1, 2): "C4", (2, 1): "C5", (3, 3): "C6", (4, 4): "C8"}
+#: Colours of the regime map's classes (failed, linear, one_impact, other_periodic, quasi_periodic, chaotic, irregular).
+REGIME_COLOURS = ("#ffffff", "#d9d9d9", "#9ecae1", "#a1d99b", "#fdae6b", "#e6550d", "#bcbddc")
+_FREQUENCY = "excitation frequency [Hz]"
+#: Top of the multiplier figure's axis [-].
+MODULUS_TOP = 20.0
+
+
+def orbit_class(impacts_per_period: float, period: int) -> tuple[int, int]:
+    """(impacts per orbit period, period multiplicity) of an orbit."""
+    return int(round(impacts_per_period * period)), int(period)
+
+
+def _orbit_label(key: tuple[int, int]) -> str:
+    impacts, period = key
+    if impacts == 0:
+        return "linear orbit (no impact)"
+    return f"{impacts} impact{'s' if impacts > 1 else ''} per {'period' if period == 1 else f'{period} periods'}"
+
+
+def _flags(variable: xr.DataArray) -> list[str]:
+    return str(variable.attrs.get("flag_meanings", "")).split()
+
+
+def _branches(dataset: xr.Dataset, restitution: float) -> Iterator[tuple[int, xr.Dataset]]:
+    """Each branch of one restitution, its points in arclength order."""
+    mask = np.isclose(dataset["branch_restitution"].values, restitution)
+    part = dataset[["x1_amplitude", "floquet_modulus", "stable", "impacts_per_period", "period_multiplicity", "impact_velocity"]].isel(branch_point=np.flatnonzero(mask))
+    for label in np.unique(part["branch"].values):
+        yield int(label), part.isel(branch_point=np.flatnonzero(part["branch"].values == label))
+
+
+def _draw_branch(ax: Axes, frequency: np.ndarray, values: np.ndarray, stable: np.ndarray, colour: str, label: str) -> None:
+    """A branch line, solid where stable, dashed where unstable; each change of stability drawn on both sides."""
+    change = np.flatnonzero(np.diff(stable.astype(int))) + 1
+    for piece in np.split(np.arange(frequency.size), change):
+        if piece.size == 0:
+            continue
+        run = np.append(piece, piece[-1] + 1) if piece[-1] + 1 < frequency.size else piece
+        style = STABLE_STYLE if stable[piece[0]] else UNSTABLE_STYLE
+        ax.plot(frequency[run], values[run], color=colour, label=label, **style)
+        label = "_"
+
+
+def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> DrawnFigure:
+    """The bifurcation diagram of one restitution: X1 amplitude and impact velocities against frequency."""
+    fig, (top, bottom) = new_figure(2, panel_height=4.2, columns=1, sharex=True, legend_rows=4)
+    classes: set[tuple[int, int]] = set()
+    r_index = int(np.argmin(np.abs(dataset["restitution"].values - restitution)))
+    for direction in dataset["sweep"].values:
+        brute = dataset.isel(restitution=r_index).sel(sweep=direction)
+        f = brute["frequency"].values
+        amp = brute["brute_x1_amplitude"].values
+        top.scatter(np.repeat(f, amp.shape[1]), amp.ravel() * 1e3, s=1.5, color=SWEEP_COLOURS.get(str(direction), "C7"), alpha=0.6, lw=0, zorder=1)
+        vel = brute["brute_impact_velocity"].values
+        bottom.scatter(np.repeat(f, vel.shape[1]), vel.ravel(), s=1.5, color=SWEEP_COLOURS.get(str(direction), "C7"), alpha=0.6, lw=0, zorder=1)
+    for _label, branch in _branches(dataset, restitution):
+        f = branch["branch_frequency"].values
+        key = orbit_class(float(branch["impacts_per_period"].values[0]), int(branch["period_multiplicity"].values[0]))
+        colour = ORBIT_COLOURS.get(key, "0.5")
+        name = _orbit_label(key) if key not in classes else "_"
+        classes.add(key)
+        stable = branch["stable"].values == 1
+        _draw_branch(top, f, branch["x1_amplitude"].values * 1e3, stable, colour, name)
+        velocities = branch["impact_velocity"].values
+        for k in range(velocities.shape[1]):
+            if np.isfinite(velocities[:, k]).any():
+                _draw_branch(bottom, f, velocities[:, k], stable, colour, "_")
+    specials = _specials(dataset, restitution)
+    kinds = _flags(dataset["special_point_kind"])
+    for code, kind in enumerate(kinds):
+        chosen = specials.isel(special_point=np.flatnonzero(specials["special_point_kind"].values == code))
+        if chosen.sizes["special_point"]:
+            top.scatter(chosen["special_point_frequency"], chosen["special_point_x1_amplitude"] * 1e3, marker=SPECIAL_MARKERS.get(kind, "x"), s=42,
+                        facecolor="none", edgecolor="k", lw=1.2, zorder=5, label=kind.replace("_", "-"))  # fmt: skip
+    finish_axes(top, "", "|X1| fundamental [mm]", f"R = {fmt(restitution, 'g')}: X1 amplitude")
+    finish_axes(bottom, _FREQUENCY, "impact velocity [m/s]", f"R = {fmt(restitution, 'g')}: impact velocities")
+    dots = [Line2D([], [], ls="", marker="o", ms=5, color=SWEEP_COLOURS.get(str(d), "C7"), label=f"brute force, sweep {d}") for d in dataset["sweep"].values]
+    extra = [*dots, Line2D([], [], color="k", **STABLE_STYLE, label="stable"), Line2D([], [], color="k", **UNSTABLE_STYLE, label="unstable")]
+    figure_legend(fig, [top, bottom], extra, columns=5)
+    caption = (
+        f"Bifurcation diagram at R = {fmt(restitution, 'g')}, Delta = {fmt(float(dataset['clearance']) * 1e3, 'g')} mm. Dots: brute-force "
+        f"time simulation (compiled exact engine) sweeping up (red) and down (green), the end state carried to the next frequency; "
+        f"top: the X1 fundamental over each of the {dataset.sizes['strobe']} kept periods; bottom: the velocity of every impact in them. "
+        "Lines: every continued branch (solid stable, dashed unstable; colour: impacts per orbit period and period), the linear orbit "
+        "where it fits inside the clearance in black; markers: the located special points (table below)."
+    )
+    return DrawnFigure(fig, f"bifurcation_R{index}", f"Bifurcation diagram, R = {fmt(restitution, 'g')}", caption)
+
+
+def _specials(dataset: xr.Dataset, restitution: float) -> xr.Dataset:
+    mask = np.isclose(dataset["special_point_restitution"].values, restitution)
+    return dataset[["special_point_x1_amplitude", "special_point_floquet_modulus"]].isel(special_point=np.flatnonzero(mask))
+
+
+def multiplier_figure(dataset: xr.Dataset, restitution: float, index: int) -> DrawnFigure:
+    """The largest Floquet multiplier modulus along every branch of one restitution (log scale)."""
+    fig, (ax,) = new_figure(1, panel_height=4.0, columns=1, legend_rows=2)
+    seen: set[tuple[int, int]] = set()
+    for _label, branch in _branches(dataset, restitution):
+        key = orbit_class(float(branch["impacts_per_period"].values[0]), int(branch["period_multiplicity"].values[0]))
+        if key[0] == 0:
+            continue
+        name = _orbit_label(key) if key not in seen else "_"
+        seen.add(key)
+        _draw_branch(ax, branch["branch_frequency"].values, branch["floquet_modulus"].values, branch["stable"].values == 1, ORBIT_COLOURS.get(key, "0.5"), name)
+    ax.axhline(1.0, color="k", lw=0.8)
+    specials = _specials(dataset, restitution)
+    ax.scatter(specials["special_point_frequency"], specials["special_point_floquet_modulus"], s=30, facecolor="none", edgecolor="k", zorder=5, label="special points")
+    finish_axes(ax, _FREQUENCY, "largest |Floquet multiplier|", f"R = {fmt(restitution, 'g')}: stability along the branches", log=True)
+    ax.set_ylim(0.2, MODULUS_TOP)
+    figure_legend(fig, [ax], columns=5)
+    caption = (f"Largest modulus of the Floquet multipliers along every impacting branch at R = {fmt(restitution, 'g')} (log scale, "
+               f"clipped at {fmt(MODULUS_TOP, 'g')}: next to a grazing point the multipliers grow without bound): an orbit is stable below 1 (the horizontal line); solid stable, dashed unstable; circles: the special points.")  # fmt: skip
+    return DrawnFigure(fig, f"multipliers_R{index}", f"Floquet multipliers, R = {fmt(restitution, 'g')}", caption)
+
+
+def chart_figure(dataset: xr.Dataset) -> DrawnFigure:
+    """The regime map of each sweep direction with the curves of special points in (frequency, clearance)."""
+    directions = [str(d) for d in dataset["sweep"].values]
+    fig, axes = new_figure(len(directions), panel_height=4.6, columns=len(directions), sharey=True, legend_rows=3)
+    meanings = _flags(dataset["chart_regime"])
+    cmap = ListedColormap(REGIME_COLOURS[: len(meanings)])
+    norm = BoundaryNorm(np.arange(-1.5, len(meanings) - 1), cmap.N)
+    kinds = _flags(dataset["chart_kind"])
+    curve_colours = {"fold": "C0", "period_doubling": "C1", "neimark_sacker": "C3", "grazing": "k"}
+    for ax, direction in zip(axes, directions):
+        regime = dataset["chart_regime"].sel(sweep=direction)
+        ax.pcolormesh(dataset["map_frequency"], dataset["map_clearance"] * 1e3, regime.values, cmap=cmap, norm=norm, shading="nearest", rasterized=True)
+        for label in np.unique(dataset["chart_curve"].values):
+            points = np.flatnonzero(dataset["chart_curve"].values == label)
+            kind = kinds[int(dataset["chart_kind"].values[points[0]])]
+            ax.plot(dataset["chart_frequency"].values[points], dataset["chart_clearance"].values[points] * 1e3, color=curve_colours.get(kind, "0.3"),
+                    lw=1.6, ls="--" if kind == "grazing" else "-", label=f"{kind.replace('_', '-')} curve")  # fmt: skip
+        ax.axhline(float(dataset["clearance"]) * 1e3, color="0.3", lw=0.8, ls=":")
+        ax.set_ylim(float(dataset["map_clearance"].min()) * 1e3, float(dataset["map_clearance"].max()) * 1e3)
+        ax.set_xlim(float(dataset["map_frequency"].min()), float(dataset["map_frequency"].max()))
+        finish_axes(ax, _FREQUENCY, "clearance Delta [mm]" if ax is axes[0] else "", f"brute force sweeping {direction}")
+    patches = [Patch(facecolor=REGIME_COLOURS[k], edgecolor="0.5", label=meaning.replace("_", " ")) for k, meaning in enumerate(meanings) if meaning != "failed"]
+    figure_legend(fig, axes, patches, columns=5)
+    r = dataset.attrs.get("chart_restitution", float("nan"))
+    caption = (
+        f"Chart of frequency x clearance at R = {fmt(r, 'g')}. Colours: what the brute-force simulation settles on at each point of a "
+        f"{dataset.sizes['map_frequency']} x {dataset.sizes['map_clearance']} grid (sweeping in frequency at each clearance, the end state "
+        "carried over): linear motion, one impact per period, another periodic motion, or non-periodic motion (quasi-periodic, chaotic, or "
+        "undecided: irregular) from the exact Lyapunov exponent. Lines: the fold, period-doubling and Neimark-Sacker points of the "
+        "one-impact branches continued in (frequency, clearance), and (dashed) the grazing curve q |H12| = Delta where the one-impact "
+        "orbit's impact velocity vanishes and the linear motion touches the stop; dotted: the clearance of the diagrams."
+    )
+    return DrawnFigure(fig, "chart", f"Two-parameter chart, R = {fmt(r, 'g')}", caption)
+
+
+def bifurcation_figures(dataset: xr.Dataset) -> Iterator[DrawnFigure]:
+    """Every figure of the page, in order."""
+    for index, r in enumerate(dataset["restitution"].values):
+        yield diagram_figure(dataset, float(r), index)
+        yield multiplier_figure(dataset, float(r), index)
+    if "chart_regime" in dataset:
+        yield chart_figure(dataset)
+
+
+def special_point_table(dataset: xr.Dataset) -> Table:
+    """Every located special point: kind, frequency, R, the orbit, its multipliers and what happens there."""
+    kinds = _flags(dataset["special_point_kind"])
+    rows = []
+    order = np.lexsort((dataset["special_point_frequency"].values, dataset["special_point_restitution"].values))
+    for k in order:
+        point = dataset.isel(special_point=int(k))
+        mu = point["special_point_multiplier_real"].values + 1j * point["special_point_multiplier_imag"].values
+        multipliers = ", ".join(f"{m.real:.4f}{m.imag:+.4f}j" if abs(m.imag) > 1e-9 else f"{m.real:.4f}" for m in mu)
+        key = orbit_class(float(point["special_point_impacts_per_period"]), int(point["special_point_period_multiplicity"]))
+        cells = [
+            kinds[int(point["special_point_kind"])].replace("_", "-"), fmt(float(point["special_point_frequency"]), ".5f"),
+            fmt(float(point["special_point_restitution"]), "g"), str(int(point["special_point_branch"])), _orbit_label(key),
+            html.escape(multipliers), fmt(float(point["special_point_floquet_modulus"]), ".4f"), html.escape(str(point["special_point_note"].values)),
+        ]  # fmt: skip
+        rows.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
+    header = "".join(f"<th>{h}</th>" for h in ("kind", "frequency [Hz]", "R", "branch", "orbit", "Floquet multipliers", "max |mu|", "what happens there"))
+    return Table("Special points", f"<table><tr>{header}</tr>{''.join(rows)}</table>")
+
+
+class BifurcationPage:
+    """The page of a bifurcation study's dataset."""
+
+    def __init__(self, dataset: xr.Dataset) -> None:
+        self.dataset = dataset
+
+    def summary(self) -> str:
+        """What was computed."""
+        d = self.dataset
+        return (f"{int(np.unique(d['branch'].values).size)} branches, {d.sizes['special_point']} special points, brute force at "
+                f"{d.sizes['frequency']} frequencies x {d.sizes['sweep']} directions for R = {', '.join(fmt(r, 'g') for r in d['restitution'].values)}")  # fmt: skip
+
+    def sections(self, out: Path) -> list[Section]:
+        """Diagrams and multipliers per restitution with the special points' table, then the chart."""
+        figures = saved(bifurcation_figures(self.dataset), out)
+        notes = str(self.dataset.attrs.get("continuation_notes", ""))
+        intro = ("<p>Every branch of periodic orbits found by continuation (how it was started and where it ends):</p>"
+                 f"<pre>{html.escape(notes)}</pre>") if notes else ""  # fmt: skip
+        chart = [f for f in figures if f.path.stem == "chart"]
+        sections = [Section("Bifurcation diagrams", intro, [f for f in figures if f not in chart], [special_point_table(self.dataset)])]
+        if chart:
+            chart_notes = str(self.dataset.attrs.get("chart_notes", ""))
+            sections.append(Section("Two-parameter chart", f"<pre>{html.escape(chart_notes)}</pre>" if chart_notes else "", chart))
+        return sections

@@ -1,0 +1,321 @@
+"""Bifurcation scenes: the header of every scene, the stop's clearance and ``bifurcation`` (brute force, continued
+branches and the two-parameter chart).
+
+Example (the shipped ``bifurcation``, shortened)::
+
+    name: bifurcation
+    system: {m1: 1.0, m2: 0.1, k1: 25000, k2: 4300, b1: 0.8, b2: 0.08}
+    excitation: {amplitude: 10.0}
+    stop: {clearance: 0.003}
+    bifurcation:
+      frequency: {start: 15.0, stop: 45.0}          # the band [Hz]
+      restitution: [0.2, 0.8]
+      brute_force: {step: 0.05, transient_periods: 300, strobes: 64, directions: [up, down]}
+      continuation: {one_impact: true, period_doubling: true, grazing: true, linear: true, max_steps: 2000}
+      chart: {restitution: 0.2, clearance: {start: 0.001, stop: 0.006}, kinds: [fold, neimark_sacker, grazing]}
+
+Every key is checked (unknown keys, wrong types and out-of-range values are reported together, each naming its key).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from vibroimpact.model.validation import require_in_range, require_positive
+from vibroimpact.scene.checker import Checker, SceneError
+from vibroimpact.scene.schema import SWEEP_DIRECTIONS, Scene
+from vibroimpact.scene.sections import parse_header
+
+__all__ = [
+    "BIFURCATION_TOP_KEYS",
+    "CHART_KINDS",
+    "BruteForceSettings",
+    "BranchSettings",
+    "ChartSettings",
+    "BifurcationSettings",
+    "parse_bifurcation_scene",
+]
+
+#: Top-level keys of a bifurcation scene.
+BIFURCATION_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "bifurcation", "report"}
+#: Special points whose curves the two-parameter chart can follow (the order of the CF flags of ``special_point_kind``).
+CHART_KINDS = ("fold", "period_doubling", "neimark_sacker", "grazing")
+_KEYS = {"frequency", "restitution", "brute_force", "continuation", "chart"}
+_BRUTE_KEYS = {"step", "transient_periods", "strobes", "directions"}
+_BRANCH_KEYS = {"one_impact", "period_doubling", "grazing", "linear", "max_steps", "max_step"}
+_CHART_KEYS = {"restitution", "clearance", "kinds", "max_steps", "frequency_step", "clearance_num", "transient_periods", "strobes"}
+#: Most brute-force periods of one scene (frequencies x restitutions x directions x periods per point).
+MAX_BRUTE_PERIODS = 50_000_000
+
+
+@dataclass(frozen=True)
+class BruteForceSettings:
+    """Stepped sweeps of the time simulation (``exact``), the end state carried to the next frequency.
+
+    Attributes
+    ----------
+    step : float
+        Frequency step [Hz].
+    transient_periods : int
+        Periods integrated and dropped at each frequency.
+    strobes : int
+        Strobes (whole periods) kept at each frequency.
+    directions : tuple of str
+        ``up`` and/or ``down``.
+    """
+
+    step: float = 0.05
+    transient_periods: int = 300
+    strobes: int = 64
+    directions: tuple[str, ...] = SWEEP_DIRECTIONS
+
+    def __post_init__(self) -> None:
+        require_positive("step", self.step)
+        require_in_range("transient_periods", self.transient_periods, 0, 1_000_000)
+        require_in_range("strobes", self.strobes, 1, 100_000)
+
+
+@dataclass(frozen=True)
+class BranchSettings:
+    """Which branches are continued in frequency, and how far.
+
+    Attributes
+    ----------
+    one_impact : bool
+        The one-impact branches, started from the closed form (PGF) at both roots of eq. 16.
+    period_doubling : bool
+        Period-2 branches switched at every period doubling of a period-1 branch.
+    grazing : bool
+        Branches born at grazing points where an orbit with another (non-zero) impact count continues.
+    linear : bool
+        The impactless (linear) orbit wherever it fits inside the clearance (closed form).
+    max_steps : int
+        Most continuation steps per direction of a branch.
+    max_step : float
+        Largest arclength step, in the continuation's scaled variables [-].
+    """
+
+    one_impact: bool = True
+    period_doubling: bool = True
+    grazing: bool = True
+    linear: bool = True
+    max_steps: int = 2000
+    max_step: float = 0.1
+
+    def __post_init__(self) -> None:
+        require_in_range("max_steps", self.max_steps, 1, 100_000)
+        require_in_range("max_step", self.max_step, 1e-4, 1.0)
+
+
+@dataclass(frozen=True)
+class ChartSettings:
+    """The two-parameter chart (frequency x clearance at one restitution).
+
+    Attributes
+    ----------
+    restitution : float
+        R of the chart [-].
+    clearance : (float, float)
+        Clearance range [m].
+    kinds : tuple of str
+        Special points followed in (frequency, clearance), from :data:`CHART_KINDS`.
+    max_steps : int
+        Most continuation steps per direction of a curve.
+    frequency_step : float
+        Frequency step of the regime map's brute-force sweeps [Hz].
+    clearance_num : int
+        Clearances of the regime map (evenly spaced over the range).
+    transient_periods, strobes : int
+        Periods dropped, and kept for the classification, at each point of the regime map.
+    """
+
+    restitution: float = 0.2
+    clearance: tuple[float, float] = (1e-3, 6e-3)
+    kinds: tuple[str, ...] = CHART_KINDS
+    max_steps: int = 300
+    frequency_step: float = 0.25
+    clearance_num: int = 12
+    transient_periods: int = 300
+    strobes: int = 128
+
+    def __post_init__(self) -> None:
+        require_in_range("restitution", self.restitution, 0.0, 1.0)
+        if not 0.0 < self.clearance[0] < self.clearance[1]:
+            raise ValueError(f"clearance = {self.clearance!r}: expected 0 < start < stop [m]")
+        require_in_range("max_steps", self.max_steps, 1, 100_000)
+        require_positive("frequency_step", self.frequency_step)
+        require_in_range("clearance_num", self.clearance_num, 2, 1000)
+        require_in_range("transient_periods", self.transient_periods, 0, 1_000_000)
+        require_in_range("strobes", self.strobes, 64, 100_000)
+
+    @property
+    def clearances(self) -> np.ndarray:
+        """The regime map's clearances [m]."""
+        return np.linspace(self.clearance[0], self.clearance[1], self.clearance_num)
+
+
+@dataclass(frozen=True, eq=False)
+class BifurcationSettings:
+    """What a bifurcation study computes.
+
+    Attributes
+    ----------
+    low, high : float
+        The frequency band [Hz].
+    restitution : tuple of float
+        R of each bifurcation diagram [-].
+    brute_force : BruteForceSettings
+        Stepped sweeps up and down.
+    branches : BranchSettings
+        Continued branches.
+    chart : ChartSettings or None
+        The two-parameter chart (None: none).
+    """
+
+    low: float
+    high: float
+    restitution: tuple[float, ...]
+    brute_force: BruteForceSettings = BruteForceSettings()
+    branches: BranchSettings = BranchSettings()
+    chart: ChartSettings | None = None
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.low < self.high:
+            raise ValueError(f"frequency band ({self.low!r}, {self.high!r}): expected 0 < start < stop [Hz]")
+
+    @property
+    def frequency(self) -> np.ndarray:
+        """The brute-force frequency grid [Hz], increasing."""
+        count = math.floor((self.high - self.low) / self.brute_force.step * (1.0 + 1e-12)) + 1
+        return np.round(self.low + self.brute_force.step * np.arange(count), 10)
+
+    @property
+    def chart_frequency(self) -> np.ndarray:
+        """The regime map's frequency grid [Hz] (empty without a chart)."""
+        if self.chart is None:
+            return np.zeros(0)
+        count = math.floor((self.high - self.low) / self.chart.frequency_step * (1.0 + 1e-12)) + 1
+        return np.round(self.low + self.chart.frequency_step * np.arange(count), 10)
+
+
+def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
+    """Validate a bifurcation scene's document (a mapping with ``bifurcation``) and build the :class:`Scene`; raise
+    :class:`SceneError` listing all problems."""
+    c = Checker()
+    doc = c.mapping("", document, BIFURCATION_TOP_KEYS, {"name", "system", "excitation", "stop", "bifurcation"})
+    name, description, system, amplitude, report = parse_header(c, doc)
+    stop = c.mapping("stop", doc["stop"], {"clearance"}, {"clearance"}) if "stop" in doc else {}
+    clearance = c.number("stop.clearance", stop["clearance"], 0.0, math.inf, low_inclusive=False) if "clearance" in stop else None
+    spec = c.mapping("bifurcation", doc.get("bifurcation"), _KEYS, {"frequency", "restitution"}) if "bifurcation" in doc else {}
+    low = high = None
+    if "frequency" in spec:
+        band = c.mapping("bifurcation.frequency", spec["frequency"], {"start", "stop"}, {"start", "stop"})
+        low = c.number("bifurcation.frequency.start", band["start"], 0.0, math.inf, low_inclusive=False) if "start" in band else None
+        high = c.number("bifurcation.frequency.stop", band["stop"], 0.0, math.inf, low_inclusive=False) if "stop" in band else None
+        if low is not None and high is not None and high <= low:
+            c.fail("bifurcation.frequency.stop", f"{high:g} must be greater than start = {low:g}")
+            high = None
+    restitution = c.grid("bifurcation.restitution", spec["restitution"], 0.0, 1.0, True) if "restitution" in spec else None
+    brute = _settings(c, "bifurcation.brute_force", spec.get("brute_force", {}), _BRUTE_KEYS, _brute_values)
+    branches = _settings(c, "bifurcation.continuation", spec.get("continuation", {}), _BRANCH_KEYS, _branch_values)
+    chart = _settings(c, "bifurcation.chart", spec["chart"], _CHART_KEYS, _chart_values) if "chart" in spec else None
+    if brute is not None and low is not None and high is not None and restitution is not None:
+        if brute.step > high - low:
+            c.fail("bifurcation.brute_force.step", f"{brute.step:g} Hz is out of range: allowed (0, {high - low:g}] (the band's width)")
+        else:
+            periods = (high - low) / brute.step * restitution.size * len(brute.directions) * (brute.transient_periods + brute.strobes)
+            if periods > MAX_BRUTE_PERIODS:
+                c.fail("bifurcation.brute_force", f"{periods:.3g} simulated periods is too many: allowed at most {MAX_BRUTE_PERIODS:.0e} (raise step, or fewer periods)")
+    if chart is not None and low is not None and high is not None and chart.frequency_step > high - low:
+        c.fail("bifurcation.chart.frequency_step", f"{chart.frequency_step:g} Hz is out of range: allowed (0, {high - low:g}] (the band's width)")
+    if c.problems:
+        raise SceneError(c.problems, source)
+    assert system is not None and amplitude is not None and isinstance(name, str) and clearance is not None
+    assert low is not None and high is not None and restitution is not None and brute is not None and branches is not None
+    settings = BifurcationSettings(low, high, tuple(float(r) for r in restitution), brute, branches, chart)
+    return Scene(
+        name=name,
+        description=description,
+        system=system,
+        amplitude=amplitude,
+        frequency=settings.frequency,
+        restitution=np.asarray(restitution, dtype=float),
+        clearance=np.array([clearance]),
+        swept=("restitution", "frequency"),
+        solutions=(),
+        quantities=(),
+        bifurcation=settings,
+        report=report,
+        text=text,
+    )
+
+
+def _settings(c: Checker, key: str, value: Any, allowed: set[str], values: Any) -> Any:
+    """A settings dataclass from the mapping ``value`` under ``key``: ``values(c, key, spec)`` checks each entry and
+    returns (class, keyword arguments) or None; a failure of the class's own validation names the key."""
+    spec = c.mapping(key, value, allowed)
+    if set(map(str, spec)) - allowed:
+        return None
+    built = values(c, key, spec)
+    if built is None:
+        return None
+    kind, kwargs = built
+    try:
+        return kind(**kwargs)
+    except (ValueError, TypeError) as error:
+        c.fail(f"{key}.{str(error).split(' ')[0]}", str(error))
+        return None
+
+
+def _brute_values(c: Checker, key: str, spec: dict) -> tuple[type, dict] | None:
+    kwargs: dict[str, Any] = {}
+    if "step" in spec:
+        kwargs["step"] = c.number(f"{key}.step", spec["step"], 0.0, math.inf, low_inclusive=False)
+    if "transient_periods" in spec:
+        kwargs["transient_periods"] = c.integer(f"{key}.transient_periods", spec["transient_periods"], 0, 1_000_000)
+    if "strobes" in spec:
+        kwargs["strobes"] = c.integer(f"{key}.strobes", spec["strobes"], 1, 100_000)
+    if "directions" in spec:
+        kwargs["directions"] = c.choices(f"{key}.directions", spec["directions"], SWEEP_DIRECTIONS) or None
+    return None if None in kwargs.values() else (BruteForceSettings, kwargs)
+
+
+def _branch_values(c: Checker, key: str, spec: dict) -> tuple[type, dict] | None:
+    kwargs: dict[str, Any] = {}
+    for flag in ("one_impact", "period_doubling", "grazing", "linear"):
+        if flag in spec:
+            if not isinstance(spec[flag], bool):
+                c.fail(f"{key}.{flag}", f"expected true or false, got {spec[flag]!r}")
+                kwargs[flag] = None
+            else:
+                kwargs[flag] = spec[flag]
+    if "max_steps" in spec:
+        kwargs["max_steps"] = c.integer(f"{key}.max_steps", spec["max_steps"], 1, 100_000)
+    if "max_step" in spec:
+        kwargs["max_step"] = c.number(f"{key}.max_step", spec["max_step"], 1e-4, 1.0)
+    return None if None in kwargs.values() else (BranchSettings, kwargs)
+
+
+def _chart_values(c: Checker, key: str, spec: dict) -> tuple[type, dict] | None:
+    kwargs: dict[str, Any] = {}
+    if "restitution" in spec:
+        kwargs["restitution"] = c.number(f"{key}.restitution", spec["restitution"], 0.0, 1.0)
+    if "clearance" in spec:
+        band = c.mapping(f"{key}.clearance", spec["clearance"], {"start", "stop"}, {"start", "stop"})
+        start = c.number(f"{key}.clearance.start", band["start"], 0.0, 1.0, low_inclusive=False) if "start" in band else None
+        stop = c.number(f"{key}.clearance.stop", band["stop"], 0.0, 1.0, low_inclusive=False) if "stop" in band else None
+        if start is not None and stop is not None and stop <= start:
+            c.fail(f"{key}.clearance.stop", f"{stop:g} must be greater than start = {start:g}")
+        kwargs["clearance"] = (start, stop) if start is not None and stop is not None and stop > start else None
+    if "kinds" in spec:
+        kwargs["kinds"] = c.choices(f"{key}.kinds", spec["kinds"], CHART_KINDS) or None
+    for name, low, high in (("max_steps", 1, 100_000), ("clearance_num", 2, 1000), ("transient_periods", 0, 1_000_000), ("strobes", 64, 100_000)):
+        if name in spec:
+            kwargs[name] = c.integer(f"{key}.{name}", spec[name], low, high)
+    if "frequency_step" in spec:
+        kwargs["frequency_step"] = c.number(f"{key}.frequency_step", spec["frequency_step"], 0.0, math.inf, low_inclusive=False)
+    return None if None in kwargs.values() else (ChartSettings, kwargs)

@@ -1,0 +1,310 @@
+"""Every periodic orbit of one restitution over a frequency band: branches continued from the closed form, at period
+doublings and at grazing points, the linear orbit, and their special points, as flat arrays for a dataset.
+
+:func:`find_branches` starts a branch at the middle of every frequency segment where a root of eq. 16 (corrected)
+gives an admissible one-impact orbit, unless an earlier branch already passes through that orbit (same impulse at
+that frequency); each branch gets its own stroboscopic section, away from the impacts of its band
+(:func:`vibroimpact.orbits.maps.section_phase`). Period doublings of period-1 branches switch to the period-2 branch;
+grazing points where an orbit with another, non-zero impact count continues start a branch there. The linear orbit
+comes from the closed form wherever q |H12| <= Delta. Failures of a continuation are recorded, never fatal.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import brentq
+
+from vibroimpact.analysis.pgf import solve_one_impact
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.orbits.bifurcations import switch_period_doubling
+from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Branch, Iterated, MapEvaluation, PeriodicOrbit, SpecialPoint
+from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
+from vibroimpact.orbits.maps import ImpactMap, one_impact_state, orbit_measures, section_phase, with_impulse
+from vibroimpact.orbits.shooting import shoot
+
+__all__ = ["ORIGINS", "MAX_ORBIT_IMPACTS", "GuardedMap", "OrbitSet", "find_branches", "one_impact_roots", "linear_segments"]
+
+#: How a branch was found (CF flags of ``branch_origin``).
+ORIGINS = ("linear", "one_impact", "period_doubling", "grazing")
+#: Impact velocities kept per orbit (the rest are dropped; ``impacts_per_period`` counts them all).
+MAX_ORBIT_IMPACTS = 8
+#: Frequency step of the closed-form scan for one-impact starts [Hz].
+SCAN_STEP = 0.01
+#: Largest relative impulse difference of an orbit from a branch it is taken to lie on [-].
+SAME_ORBIT = 0.02
+#: Most branches born at grazing points per restitution (each may have its own grazing points).
+MAX_GRAZING_BRANCHES = 8
+
+
+class GuardedMap:
+    """An :class:`ImpactMap` that answers NaN (a failed step) outside a box of parameters instead of raising.
+
+    Continuation and location may try a parameter far outside the physical range (a negative frequency or clearance);
+    the map then has no image, which the corrector treats as a failed step.
+    """
+
+    def __init__(self, base: ImpactMap, bounds: dict[str, tuple[float, float]]) -> None:
+        self.base = base
+        self.dimension, self.parameter_names = base.dimension, base.parameter_names
+        self.state_scale, self.parameter_scale = base.state_scale, base.parameter_scale
+        self.problem, self.periods, self.engine, self.parameters = base.problem, base.periods, base.engine, base.parameters
+        self.bounds = [(base.parameter_names.index(name), low, high) for name, (low, high) in bounds.items()]
+
+    def problem_at(self, p: NDArray[np.float64]) -> ImpactProblem:
+        """The problem with parameter vector ``p``."""
+        return self.base.problem_at(p)
+
+    def evaluate(self, y: NDArray[np.float64], p: NDArray[np.float64]) -> MapEvaluation:
+        """The base map's evaluation, or NaN outside the bounds."""
+        if all(low <= p[index] <= high for index, low, high in self.bounds) and np.all(np.isfinite(y)):
+            try:
+                return self.base.evaluate(y, p)
+            except RuntimeError:  # the engine made no progress (endless chattering): no image
+                pass
+        return MapEvaluation(np.full(self.dimension, np.nan), np.full((self.dimension, self.dimension), np.nan), None, None)
+
+
+@dataclass
+class OrbitSet:
+    """Branches and special points of one restitution, as lists of per-point records (see :meth:`add_branch`), and
+    the continued branches with their maps (``maps``: (GuardedMap, Branch) pairs)."""
+
+    points: list[dict] = field(default_factory=list)
+    specials: list[dict] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    count: int = 0
+    maps: list = field(default_factory=list)
+
+    def add_branch(self, system: GuardedMap, branch: Branch, origin: str) -> int:
+        """Measure every orbit of ``branch`` and keep it with its special points; return its label."""
+        label = self.count
+        self.count += 1
+        for orbit in branch.orbits:
+            self.points.append(_record(system, orbit) | {"branch": label, "origin": ORIGINS.index(origin)})
+        for point in branch.special_points:
+            self.specials.append(_record(system, point.orbit) | {"branch": label, "kind": SPECIAL_POINT_KINDS.index(point.kind), "frequency": point.value, "note": point.note})
+        self.notes.append(f"branch {label} ({origin}): {len(branch.orbits)} points, {branch.values.min():.4f}-{branch.values.max():.4f} Hz, ends: {branch.end}")
+        return label
+
+    def add_linear(self, system: TwoDofSystem, amplitude: float, clearance: float, frequency: NDArray[np.float64]) -> None:
+        """The impactless orbit on one segment of frequencies where it fits inside the clearance."""
+        label = self.count
+        self.count += 1
+        multipliers = _linear_multipliers(system, frequency)
+        h = system.receptances(2.0 * np.pi * frequency)
+        for k, f in enumerate(frequency):
+            modulus = float(np.max(np.abs(multipliers[k])))
+            self.points.append({
+                "branch": label, "origin": 0, "frequency": float(f), "x1_amplitude": amplitude * abs(complex(h.h11[k])),
+                "x2_amplitude": amplitude * abs(complex(h.h12[k])), "impulse": 0.0, "floquet_modulus": modulus,
+                "stable": int(modulus < 1.0), "impacts": 0, "period": 1, "multipliers": multipliers[k], "velocities": np.zeros(0),
+            })  # fmt: skip
+        self.notes.append(f"branch {label} (linear): {frequency.size} points, {frequency[0]:.4f}-{frequency[-1]:.4f} Hz")
+
+    def impulse_at(self, frequency: float, period: int, impacts: int) -> list[float]:
+        """Impulses per excitation period of the known branches with this period and impact count at ``frequency``."""
+        found = []
+        for a, b in zip(self.points[:-1], self.points[1:]):
+            if a["branch"] != b["branch"] or a["period"] != period or a["impacts"] != impacts or b["impacts"] != impacts:
+                continue
+            low, high = sorted((a["frequency"], b["frequency"]))
+            if low <= frequency <= high:
+                t = 0.0 if high == low else (frequency - a["frequency"]) / (b["frequency"] - a["frequency"])
+                found.append(a["impulse"] + t * (b["impulse"] - a["impulse"]))
+        return found
+
+    def known(self, frequency: float, period: int, impacts: int, impulse: float) -> bool:
+        """Does a known branch pass through an orbit of this period, impact count and impulse at ``frequency``?"""
+        return any(abs(j - impulse) <= SAME_ORBIT * max(abs(impulse), 1e-12) for j in self.impulse_at(frequency, period, impacts))
+
+
+def _record(system: GuardedMap, orbit: PeriodicOrbit) -> dict:
+    measures = orbit_measures(system.base, orbit)
+    multipliers = np.zeros(4, dtype=complex)
+    multipliers[: orbit.multipliers.size] = orbit.multipliers
+    modulus = orbit.floquet_modulus
+    return {
+        "frequency": orbit.parameter("frequency"),
+        "x1_amplitude": measures.x1_amplitude,
+        "x2_amplitude": measures.x2_amplitude,
+        "impulse": float(measures.impulses.sum()) / orbit.period,
+        "floquet_modulus": modulus,
+        "stable": 2 if abs(modulus - 1.0) <= 1e-9 else int(modulus < 1.0),
+        "impacts": int(measures.impulses.size),
+        "period": orbit.period,
+        "multipliers": multipliers,
+        "velocities": measures.impact_velocities[:MAX_ORBIT_IMPACTS],
+    }
+
+
+def _linear_multipliers(system: TwoDofSystem, frequency: NDArray[np.float64]) -> NDArray[np.complex128]:
+    """exp(lambda T) of the free system's eigenvalues at each frequency, by decreasing modulus."""
+    eigenvalues = np.linalg.eigvals(system.state_matrix)
+    mu = np.exp(eigenvalues[None, :] / np.asarray(frequency)[:, None])
+    order = np.argsort(-np.abs(mu), axis=1, kind="stable")
+    return np.take_along_axis(mu, order, axis=1)
+
+
+def one_impact_roots(system: TwoDofSystem, frequency: NDArray[np.float64], clearance: float, restitution: float, amplitude: float) -> tuple:
+    """The closed-form solution at ``frequency`` [Hz] and both roots of eq. 16 (corrected) [N s], NaN where none."""
+    sol = solve_one_impact(system, 2.0 * np.pi * frequency, clearance, restitution, amplitude)
+    c = (1.0 / (system.m2 * (1.0 + restitution)) + sol.chi_rate_before) / sol.omega
+    a = amplitude * np.abs(sol.receptances.h12)
+    quad_a, quad_b = c**2 + sol.chi0**2, clearance * sol.chi0
+    disc = quad_a * a**2 - (c * clearance) ** 2
+    root = np.sqrt(np.where(disc >= 0.0, disc, np.nan))
+    roots = [(-quad_b + sign * root) / quad_a for sign in (1.0, -1.0)]
+    return sol, [np.where(j >= 0.0, j, np.nan) for j in roots]
+
+
+def linear_segments(system: TwoDofSystem, amplitude: float, clearance: float, low: float, high: float, step: float = 0.02) -> list[NDArray[np.float64]]:
+    """Frequency segments [Hz] where the linear orbit fits inside the clearance, with their exact grazing ends."""
+    frequency = np.arange(low, high + 0.5 * step, step)
+
+    def gap(f: float) -> float:
+        return clearance - amplitude * abs(complex(system.receptances(2.0 * np.pi * f).h12))
+
+    fits = np.array([gap(f) >= 0.0 for f in frequency])
+    segments = []
+    for run in np.split(np.flatnonzero(fits), np.flatnonzero(np.diff(np.flatnonzero(fits)) > 1) + 1):
+        if run.size == 0:
+            continue
+        inner = list(frequency[run])
+        if run[0] > 0:
+            inner.insert(0, brentq(gap, frequency[run[0] - 1], frequency[run[0]], xtol=1e-12))
+        if run[-1] < frequency.size - 1:
+            inner.append(brentq(gap, frequency[run[-1]], frequency[run[-1] + 1], xtol=1e-12))
+        segments.append(np.array(inner))
+    return segments
+
+
+def find_branches(
+    system: TwoDofSystem, amplitude: float, clearance: float, restitution: float, low: float, high: float,
+    one_impact: bool = True, period_doubling: bool = True, grazing: bool = True, linear: bool = True,
+    max_steps: int = 2000, max_step: float = 0.1, progress=None,
+) -> OrbitSet:  # fmt: skip
+    """Every branch of one restitution over [low, high] Hz (module docstring); ``progress`` gets a line per branch."""
+    found = OrbitSet()
+    settings = ContinuationSettings(lower=low, upper=high, max_steps=max_steps, max_step=max_step)
+    bounds = {"frequency": (0.5 * low, 2.0 * high), "clearance": (0.0, math.inf), "restitution": (0.0, 1.0)}
+
+    def say(message: str) -> None:
+        if progress is not None:
+            progress(f"R = {restitution:g}: {message}")
+
+    def guarded(frequency: float, phase: float) -> GuardedMap:
+        problem = ImpactProblem(system, RigidStop(clearance, restitution), HarmonicForce(amplitude, frequency, phase))
+        return GuardedMap(ImpactMap(problem), bounds)
+
+    def attempt(what: str, run) -> None:
+        try:
+            run()
+        except Exception as error:  # noqa: BLE001 - a failed branch is recorded, the others go on
+            found.notes.append(f"{what} failed: {type(error).__name__}: {str(error)[:200]}")
+            say(f"{what} failed ({type(error).__name__})")
+
+    maps: list[tuple[GuardedMap, Branch]] = []
+    if linear:
+        for segment in linear_segments(system, amplitude, clearance, low, high):
+            found.add_linear(system, amplitude, clearance, segment)
+    if one_impact:
+        frequency = np.arange(low, high + 0.5 * SCAN_STEP, SCAN_STEP)
+        sol, roots = one_impact_roots(system, frequency, clearance, restitution, amplitude)
+        exists = np.isfinite(roots[0]) | np.isfinite(roots[1])
+        for root in roots:
+            ok = np.isfinite(root)
+            candidate = with_impulse(sol, np.where(ok, root, 0.0))
+            admissible = ok & candidate.admissible()
+            runs = np.split(np.flatnonzero(admissible), np.flatnonzero(np.diff(np.flatnonzero(admissible)) > 1) + 1)
+            for run in (r for r in runs if r.size):
+                k = int(run[run.size // 2])
+                f0, j0 = float(frequency[k]), float(root[k])
+                if found.known(f0, 1, 1, j0):
+                    continue
+                band = _segment(exists, k)
+                base = ImpactProblem(system, RigidStop(clearance, restitution), HarmonicForce(amplitude, f0))
+                phase = section_phase(base, frequency[band[0] : band[1] + 1])
+                mapping = guarded(f0, phase)
+
+                def start(mapping: GuardedMap = mapping, f0: float = f0, j0: float = j0) -> None:
+                    single = with_impulse(solve_one_impact(system, 2.0 * np.pi * f0, clearance, restitution, amplitude), j0)
+                    orbit = shoot(mapping, one_impact_state(mapping.problem, single), mapping.parameters)
+                    branch = continue_branch(mapping, orbit, "frequency", settings)
+                    label = found.add_branch(mapping, branch, "one_impact")
+                    maps.append((mapping, branch))
+                    say(f"one-impact branch {label} from {f0:.2f} Hz: {len(branch.orbits)} points, {len(branch.special_points)} special points")
+
+                attempt(f"one-impact branch from {f0:.2f} Hz", start)
+    if period_doubling:
+        for mapping, branch in list(maps):
+            for point in branch.special("period_doubling"):
+                if point.orbit.period != 1:
+                    continue
+
+                def doubled(mapping: GuardedMap = mapping, point: SpecialPoint = point) -> None:
+                    orbit = switch_period_doubling(mapping, point)
+                    child = continue_branch(Iterated(mapping, 2), orbit, "frequency", settings)
+                    label = found.add_branch(mapping, child, "period_doubling")
+                    maps.append((mapping, child))
+                    say(f"period-2 branch {label} from the period doubling at {point.value:.3f} Hz: {len(child.orbits)} points")
+
+                attempt(f"period-2 branch at {point.value:.3f} Hz", doubled)
+    if grazing:
+        born = 0
+        for mapping, branch in maps:  # grows while it runs: a born branch's own grazing points are visited too
+            for point in branch.special("grazing"):
+                if not point.continues or not point.impacts_after or point.impacts_after in set(branch.impacts.tolist()) or born >= MAX_GRAZING_BRANCHES:
+                    continue
+
+                def beyond(mapping: GuardedMap = mapping, point: SpecialPoint = point) -> None:
+                    orbit = _orbit_beyond(mapping, point)
+                    if orbit is None:
+                        found.notes.append(f"no orbit with {point.impacts_after} impacts found next to the grazing point at {point.value:.4f} Hz")
+                        return
+                    measures = orbit_measures(mapping.base, orbit)
+                    if found.known(orbit.parameter("frequency"), orbit.period, orbit.impacts, float(measures.impulses.sum()) / orbit.period):
+                        return
+                    child = continue_branch(Iterated(mapping, orbit.period) if orbit.period > 1 else mapping, orbit, "frequency", settings)
+                    label = found.add_branch(mapping, child, "grazing")
+                    maps.append((mapping, child))
+                    say(f"branch {label} born at the grazing point at {point.value:.3f} Hz: {len(child.orbits)} points")
+
+                born += 1
+                attempt(f"branch born at {point.value:.4f} Hz", beyond)
+    found.maps = maps
+    return found
+
+
+def _segment(mask: NDArray[np.bool_], k: int) -> tuple[int, int]:
+    """First and last index of the run of True in ``mask`` that contains index ``k``."""
+    first, last = k, k
+    while first > 0 and mask[first - 1]:
+        first -= 1
+    while last < mask.size - 1 and mask[last + 1]:
+        last += 1
+    return first, last
+
+
+def _orbit_beyond(mapping: GuardedMap, point: SpecialPoint) -> PeriodicOrbit | None:
+    """The orbit with ``point.impacts_after`` impacts next to a grazing point: shooting from the grazing orbit on
+    either side of it, ever farther."""
+    orbit = point.orbit
+    index = orbit.parameter_names.index("frequency")
+    for offset in (1e-4, 1e-3, 1e-2, 5e-2):
+        for sign in (1.0, -1.0):
+            p = orbit.parameters.copy()
+            p[index] = point.value + sign * offset
+            try:
+                found = shoot(mapping, orbit.state, p, orbit.period)
+            except Exception:  # noqa: BLE001 - no orbit there: try the next guess
+                continue
+            if found.impacts == point.impacts_after:
+                return found
+    return None

@@ -1,0 +1,276 @@
+"""The work of a bifurcation study as runner cases (:mod:`vibroimpact.study.runner`): brute-force sweeps, the branches
+of one restitution, and the two-parameter chart's curves.
+
+* :class:`SweepCase`: a stepped sweep of the ``exact`` engine over frequencies (up or down), the end state carried to
+  the next frequency; at each frequency a transient is dropped, then the strobes, the per-period X1 fundamental and the
+  impact velocities are kept and the motion is classified (:data:`MOTION_CLASSES`): linear, one impact per period,
+  another periodic motion, or, where the strobes do not repeat, quasi-periodic, chaotic or irregular from the exact
+  Jacobians (:func:`vibroimpact.orbits.motion.classify_motion`). A strictly negative Lyapunov exponent means a periodic
+  orbit approached slowly: the motion is classified by the period that repeats best.
+* :class:`BranchCase`: :func:`vibroimpact.study.bifurcation_branches.find_branches` of one restitution.
+* :class:`ChartCase`: the special points of the chart's restitution followed in (frequency, clearance); grazing curves
+  of the one-impact orbit (its impact velocity vanishes where q |H12| = Delta) from the closed form.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from vibroimpact.engines.exact import ExactEngine
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Iterated
+from vibroimpact.orbits.continuation import ContinuationSettings
+from vibroimpact.orbits.motion import classify_motion
+from vibroimpact.orbits.two_parameter import continue_special_point
+from vibroimpact.study.bifurcation_branches import MAX_ORBIT_IMPACTS, OrbitSet, find_branches
+from vibroimpact.study.fingerprint import case_key
+from vibroimpact.study.runner import CaseResult, ProgressReport
+
+__all__ = ["MOTION_CLASSES", "MAX_KEPT_IMPACTS", "SweepCase", "BranchCase", "ChartCase", "branch_arrays"]
+
+#: What the motion at a brute-force point is (CF flags of ``brute_regime`` and ``chart_regime``, values 0...).
+MOTION_CLASSES = ("linear", "one_impact", "other_periodic", "quasi_periodic", "chaotic", "irregular")
+#: Impact velocities kept per brute-force point (NaN-padded).
+MAX_KEPT_IMPACTS = 64
+#: Longest period looked for in the strobes [periods].
+MAX_PERIOD = 8
+#: Strobes repeat when they differ by less than this, relative to Delta + q |H12| (velocities: times w) [-].
+REPEAT_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True, eq=False)
+class SweepCase:
+    """A stepped brute-force sweep of one (restitution, clearance, direction) over ``frequencies`` [Hz]."""
+
+    system: TwoDofSystem
+    amplitude: float
+    clearance: float
+    restitution: float
+    direction: str
+    frequencies: tuple[float, ...]
+    transient: int
+    strobes: int
+    engine: str = "exact"
+    fields: tuple[str, ...] = ("x1", "x1_amplitude", "velocity", "impacts", "regime", "period", "lyapunov")
+    progress_unit: str = "frequency points"
+
+    @property
+    def progress_total(self) -> float:
+        """Frequency points."""
+        return float(len(self.frequencies))
+
+    def key(self) -> str:
+        """Hash of everything that determines the result."""
+        return case_key({"kind": "bifurcation_sweep", **{k: v for k, v in asdict(self).items() if k != "system"}, "system": asdict(self.system)})
+
+    def run(self, report: ProgressReport | None = None) -> CaseResult:
+        """Arrays over the frequencies in increasing order (whatever the direction)."""
+        engine = ExactEngine()
+        f = np.array(self.frequencies)
+        order = np.argsort(f) if self.direction == "up" else np.argsort(f)[::-1]
+        n, s = f.size, self.strobes
+        out = {
+            "x1": np.full((n, s), np.nan), "x1_amplitude": np.full((n, s), np.nan), "velocity": np.full((n, MAX_KEPT_IMPACTS), np.nan),
+            "impacts": np.zeros(n), "regime": np.full(n, -1, dtype=np.int8), "period": np.zeros(n, dtype=np.int16), "lyapunov": np.full(n, np.nan),
+        }  # fmt: skip
+        state = None
+        for done, k in enumerate(order):
+            problem = ImpactProblem(self.system, RigidStop(self.clearance, self.restitution), HarmonicForce(self.amplitude, float(f[k])))
+            state = _linear_start(problem) if state is None else state
+            try:
+                state = _measure(engine, problem, state, self.transient, s, out, k)
+            except RuntimeError:  # the engine made no progress (endless chattering): start the next point at rest
+                state = np.zeros(4)
+            if report is not None:
+                report(done + 1)
+        return out
+
+
+def _linear_start(problem: ImpactProblem) -> NDArray[np.float64]:
+    """The linear steady state at t = 0 if it fits inside the clearance, else rest."""
+    h = problem.system.receptances(problem.omega)
+    x1, x2 = problem.amplitude * complex(h.h11), problem.amplitude * complex(h.h12)
+    if abs(x2) > problem.clearance:
+        return np.zeros(4)
+    w = problem.omega
+    return np.array([x1.real, x2.real, (1j * w * x1).real, (1j * w * x2).real])
+
+
+def _measure(engine: ExactEngine, problem: ImpactProblem, state: NDArray[np.float64], transient: int, strobes: int, out: dict, k: int) -> NDArray[np.float64]:
+    """Drop the transient, keep ``strobes`` periods at row ``k`` of ``out``; return the end state."""
+    if transient:
+        state = engine.integrate(problem, state, 0.0, transient).final_state
+    run = engine.integrate(problem, state, 0.0, strobes, moments=True, jacobians=True)
+    s = run.strobe_states
+    out["x1"][k] = s[1:, 0]
+    out["x1_amplitude"][k] = np.abs(run.moments[:, 0]) * 2.0 / problem.period
+    velocities = run.impact_velocities
+    out["velocity"][k, : min(velocities.size, MAX_KEPT_IMPACTS)] = velocities[-MAX_KEPT_IMPACTS:]
+    out["impacts"][k] = velocities.size / strobes
+    length = problem.clearance + problem.amplitude * abs(complex(problem.system.receptances(problem.omega).h12))
+    scale = np.array([length, length, problem.omega * length, problem.omega * length])
+    mismatch = [float(np.max(np.abs(s[p:] - s[:-p]) / scale)) if s.shape[0] > 2 * p else math.inf for p in range(1, MAX_PERIOD + 1)]
+    period = next((p for p, m in enumerate(mismatch, start=1) if m < REPEAT_TOLERANCE), 0)
+    if velocities.size == 0:
+        out["regime"][k], out["period"][k] = 0, 1
+        return run.final_state
+    if not period:
+        evidence = classify_motion(run.strobe_jacobians, s[1:])
+        out["lyapunov"][k] = evidence.lyapunov_exponent
+        if evidence.lyapunov_exponent < -0.005:  # contracting: a periodic orbit approached slowly
+            period = int(np.argmin(mismatch)) + 1
+        else:
+            out["regime"][k] = MOTION_CLASSES.index(evidence.kind)
+            return run.final_state
+    out["period"][k] = period
+    tail = (strobes // period) * period
+    impacts = np.count_nonzero(run.impact_times >= run.strobe_times[strobes - tail])
+    out["regime"][k] = 1 if period == 1 and impacts == tail else 2
+    return run.final_state
+
+
+#: Fields of :func:`branch_arrays`.
+BRANCH_FIELDS = (
+    "branch", "origin", "frequency", "x1_amplitude", "x2_amplitude", "impulse", "floquet_modulus", "stable", "impacts", "period",
+    "multipliers_real", "multipliers_imag", "velocities",
+    "sp_branch", "sp_kind", "sp_frequency", "sp_x1_amplitude", "sp_impulse", "sp_floquet_modulus", "sp_impacts", "sp_period",
+    "sp_multipliers_real", "sp_multipliers_imag", "sp_note", "notes",
+)  # fmt: skip
+
+
+@dataclass(frozen=True, eq=False)
+class BranchCase:
+    """Every branch of one restitution (:func:`find_branches`); arrays from :func:`branch_arrays`."""
+
+    system: TwoDofSystem
+    amplitude: float
+    clearance: float
+    restitution: float
+    low: float
+    high: float
+    options: tuple[tuple[str, object], ...]
+    engine: str = "exact"
+    fields: tuple[str, ...] = BRANCH_FIELDS
+    progress_unit: str = "frequency points"
+
+    @property
+    def progress_total(self) -> float:
+        """One unit per branch set."""
+        return 1.0
+
+    def key(self) -> str:
+        """Hash of everything that determines the result."""
+        return case_key({"kind": "bifurcation_branches", "system": asdict(self.system), "amplitude": self.amplitude, "clearance": self.clearance,
+                         "restitution": self.restitution, "band": [self.low, self.high], "options": dict(self.options)})  # fmt: skip
+
+    def run(self, report: ProgressReport | None = None) -> CaseResult:
+        """The branches' and special points' arrays."""
+        found = find_branches(self.system, self.amplitude, self.clearance, self.restitution, self.low, self.high, **dict(self.options))
+        return branch_arrays(found)
+
+
+
+
+def branch_arrays(found: OrbitSet) -> CaseResult:
+    """Flat arrays of an :class:`OrbitSet` (one row per branch point, one per special point)."""
+
+    def column(rows: list[dict], name: str, dtype: type = float) -> np.ndarray:
+        return np.array([row[name] for row in rows], dtype=dtype)
+
+    def velocities(rows: list[dict]) -> np.ndarray:
+        out = np.full((len(rows), MAX_ORBIT_IMPACTS), np.nan)
+        for i, row in enumerate(rows):
+            out[i, : row["velocities"].size] = row["velocities"]
+        return out
+
+    points, specials = found.points, found.specials
+    pm = np.array([row["multipliers"] for row in points]).reshape(-1, 4)
+    sm = np.array([row["multipliers"] for row in specials]).reshape(-1, 4)
+    return {
+        "branch": column(points, "branch", int), "origin": column(points, "origin", int), "frequency": column(points, "frequency"),
+        "x1_amplitude": column(points, "x1_amplitude"), "x2_amplitude": column(points, "x2_amplitude"), "impulse": column(points, "impulse"),
+        "floquet_modulus": column(points, "floquet_modulus"), "stable": column(points, "stable", int), "impacts": column(points, "impacts", int),
+        "period": column(points, "period", int), "multipliers_real": pm.real, "multipliers_imag": pm.imag, "velocities": velocities(points),
+        "sp_branch": column(specials, "branch", int), "sp_kind": column(specials, "kind", int), "sp_frequency": column(specials, "frequency"),
+        "sp_x1_amplitude": column(specials, "x1_amplitude"), "sp_impulse": column(specials, "impulse"),
+        "sp_floquet_modulus": column(specials, "floquet_modulus"), "sp_impacts": column(specials, "impacts", int),
+        "sp_period": column(specials, "period", int), "sp_multipliers_real": sm.real, "sp_multipliers_imag": sm.imag,
+        "sp_note": np.array([row["note"] for row in specials], dtype=str), "notes": np.array(found.notes, dtype=str),
+    }  # fmt: skip
+
+
+@dataclass(frozen=True, eq=False)
+class ChartCase:
+    """Curves of special points in (frequency, clearance) at one restitution, from the branches at ``clearance``."""
+
+    system: TwoDofSystem
+    amplitude: float
+    clearance: float
+    restitution: float
+    low: float
+    high: float
+    clearance_range: tuple[float, float]
+    kinds: tuple[str, ...]
+    max_steps: int
+    engine: str = "exact"
+    fields: tuple[str, ...] = ("curve", "kind", "frequency", "clearance", "notes")
+    progress_unit: str = "frequency points"
+
+    @property
+    def progress_total(self) -> float:
+        """One unit."""
+        return 1.0
+
+    def key(self) -> str:
+        """Hash of everything that determines the result."""
+        return case_key({"kind": "bifurcation_chart", **{k: v for k, v in asdict(self).items() if k != "system"}, "system": asdict(self.system)})
+
+    def run(self, report: ProgressReport | None = None) -> CaseResult:
+        """The curves as flat arrays (one row per curve point)."""
+        found = find_branches(self.system, self.amplitude, self.clearance, self.restitution, self.low, self.high, grazing=False, linear=False)
+        low_c, high_c = self.clearance_range
+        bounds = {"clearance": (low_c, high_c), "frequency": (self.low, self.high)}
+        settings = ContinuationSettings(max_steps=self.max_steps, max_step=0.2)
+        rows: list[tuple[int, int, float, float]] = []
+        notes = list(found.notes)
+        curve = 0
+        if "grazing" in self.kinds:
+            for f, d in _grazing_curves(self.system, self.amplitude, self.low, self.high, low_c, high_c):
+                rows += [(curve, SPECIAL_POINT_KINDS.index("grazing"), fi, di) for fi, di in zip(f, d)]
+                curve += 1
+        for mapping, branch in found.maps:
+            system = Iterated(mapping, branch.orbits[0].period) if branch.orbits[0].period > 1 else mapping
+            for point in branch.special_points:
+                kind = SPECIAL_POINT_KINDS.index(point.kind)
+                if point.kind not in self.kinds or (point.kind == "grazing" and "velocity" in point.note):
+                    continue  # the one-impact orbit's vanishing impact: the closed-form curve above
+                if any(k == kind and abs(f - point.value) < 1e-3 and abs(d - self.clearance) < 1e-6 for _c, k, f, d in rows):
+                    continue  # on a curve already followed
+                try:
+                    special = continue_special_point(system, point, "clearance", settings, bounds=bounds)
+                except Exception as error:  # noqa: BLE001 - a curve that cannot be followed is recorded, not fatal
+                    notes.append(f"{point.kind} curve from {point.value:.4f} Hz failed: {type(error).__name__}: {str(error)[:160]}")
+                    continue
+                f, d = special.values("frequency"), special.values("clearance")
+                notes.append(f"{point.kind} curve {curve} from {point.value:.4f} Hz: {f.size} points, ends: {special.end}")
+                rows += [(curve, kind, fi, di) for fi, di in zip(f, d)]
+                curve += 1
+        table = np.array(rows, dtype=float).reshape(-1, 4)
+        return {"curve": table[:, 0].astype(int), "kind": table[:, 1].astype(int), "frequency": table[:, 2], "clearance": table[:, 3], "notes": np.array(notes, dtype=str)}
+
+
+def _grazing_curves(system: TwoDofSystem, amplitude: float, low: float, high: float, low_c: float, high_c: float, step: float = 0.01) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Delta = q |H12(f)| over the band, split where it leaves [low_c, high_c]: where the one-impact orbit's impact
+    velocity vanishes and the linear orbit touches the stop."""
+    f = np.arange(low, high + 0.5 * step, step)
+    d = amplitude * np.abs(system.receptances(2.0 * np.pi * f).h12)
+    inside = (d >= low_c) & (d <= high_c)
+    runs = np.split(np.flatnonzero(inside), np.flatnonzero(np.diff(np.flatnonzero(inside)) > 1) + 1)
+    return [(f[r], d[r]) for r in runs if r.size > 1]
