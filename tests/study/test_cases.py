@@ -64,10 +64,10 @@ def test_a_failing_point_costs_only_itself(system: TwoDofSystem, monkeypatch: py
     """An engine failure at one frequency leaves NaN there, flagged, and the other points of the case are kept."""
     real = study_cases.steady_state
 
-    def flaky(engine: object, problem: ImpactProblem, start: object, settings: SteadySettings, orbit_stop: object = None) -> object:
+    def flaky(engine: object, problem: ImpactProblem, start: object, settings: SteadySettings, orbit_stop: object = None, guess: object = "compute") -> object:
         if problem.frequency == 25.0:  # exact: a grid value
             raise RuntimeError("CVODE failed (simulated)")
-        return real(engine, problem, start, settings, orbit_stop)  # type: ignore[arg-type]
+        return real(engine, problem, start, settings, orbit_stop, guess)  # type: ignore[arg-type]
 
     monkeypatch.setattr(study_cases, "steady_state", flaky)
     result = study_cases.run_case(_case(system, "sweep_up"))

@@ -1,5 +1,8 @@
-"""The compiled core of the ``exact`` engine: its whole event loop in one numba function, with the exact Jacobian
-(the flow and root-search kernels are in :mod:`.flow_kernels`).
+"""The compiled core of the ``exact`` engine: its whole event loop in one numba function, with the exact Jacobian.
+
+Everything the loop calls lives in this one module on purpose: numba's on-disk cache is keyed by the source file of
+each cached function only, so a change in a function called from another file would not recompile its callers
+(numba PR #8396, unmerged); a kernel module beside this one served stale machine code after an edit.
 
 The algorithm is :mod:`.exact_python`'s (closed-form flow, guaranteed first-root search by Taylor bounds, impact map,
 sticking and release, strobes, Fourier moments), compiled with ``@njit(cache=True)``: the interpreter overhead of the
@@ -26,14 +29,6 @@ import math
 import numpy as np
 from numba import njit
 
-from vibroimpact.engines.flow_kernels import derivatives as _derivatives
-from vibroimpact.engines.flow_kernels import escape_step
-from vibroimpact.engines.flow_kernels import first_crossing as _first_crossing
-from vibroimpact.engines.flow_kernels import modal as _modal
-from vibroimpact.engines.flow_kernels import observable as _observable
-from vibroimpact.engines.flow_kernels import state as _state
-from vibroimpact.engines.flow_kernels import value as _value
-
 __all__ = ["run_periods", "STATUS_OK", "STATUS_NO_PROGRESS", "GL_NODES", "GL_WEIGHTS"]
 
 STATUS_OK, STATUS_NO_PROGRESS = 0, 1
@@ -41,6 +36,182 @@ _x, _w = np.polynomial.legendre.leggauss(16)
 #: 16-point Gauss-Legendre rule on [0, 1]: moments are integrated over chunks of at most 4 radians of the fastest
 #: rate, where its error is below 1e-25 relative (the integrands are exponentials).
 GL_NODES, GL_WEIGHTS = (_x + 1.0) / 2.0, _w / 2.0
+
+
+@njit(cache=True)
+def _modal(lam, vec, inv, hrm, cst, omega, t0, y0, out):
+    """Modal coordinates of the homogeneous part through y0 at t0, into ``out``."""
+    n = lam.size
+    phasor = complex(math.cos(omega * t0), math.sin(omega * t0))
+    for r in range(n):
+        out[r] = 0j
+    for i in range(n):
+        rel = y0[i] - ((hrm[i] * phasor).real + cst[i])
+        for r in range(n):
+            out[r] += inv[r, i] * rel
+
+
+@njit(cache=True)
+def _state(lam, vec, hrm, cst, omega, t0, modal, t, out):
+    n = lam.size
+    phasor = complex(math.cos(omega * t), math.sin(omega * t))
+    for r in range(n):
+        out[r] = (hrm[r] * phasor).real + cst[r]
+    for i in range(n):
+        growth = np.exp(lam[i] * (t - t0)) * modal[i]
+        for r in range(n):
+            out[r] += (vec[r, i] * growth).real
+
+
+@njit(cache=True)
+def _observable(weights, offset, vec, hrm, cst, modal, amp):
+    """h = weights . y + offset of the piece with ``modal`` coordinates: amplitudes into ``amp``; (har, con)."""
+    n = modal.size
+    har = 0j
+    con = offset
+    for i in range(n):
+        acc = 0j
+        for r in range(n):
+            acc += weights[r] * vec[r, i]
+        amp[i] = acc * modal[i]
+        har += weights[i] * hrm[i]
+        con += weights[i] * cst[i]
+    return har, con
+
+
+@njit(cache=True)
+def _value(lam, amp, har, con, omega, t0, t):
+    """h(t)."""
+    total = har * complex(math.cos(omega * t), math.sin(omega * t))
+    for i in range(lam.size):
+        total += amp[i] * np.exp(lam[i] * (t - t0))
+    return total.real + con
+
+
+@njit(cache=True)
+def _derivatives(lam, amp, har, con, omega, t0, t, out):
+    """h, h', ..., h^(len(out) - 1) at t."""
+    forced = har * complex(math.cos(omega * t), math.sin(omega * t))
+    jw = 1j * omega
+    power = 1.0 + 0j
+    for k in range(out.size):
+        out[k] = (forced * power).real + (con if k == 0 else 0.0)
+        power *= jw
+    for i in range(lam.size):
+        term = amp[i] * np.exp(lam[i] * (t - t0))
+        for k in range(out.size):
+            out[k] += term.real
+            term *= lam[i]
+
+
+@njit(cache=True)
+def _bound(lam, amp, har, omega, t0, t, order):
+    """An upper bound of |h^(order)| over [t, inf) (all Re(lam) <= 0)."""
+    total = abs(har) * omega**order
+    for i in range(lam.size):
+        total += abs(amp[i]) * abs(lam[i]) ** order * math.exp(lam[i].real * (t - t0))
+    return total
+
+
+@njit(cache=True)
+def _step_data(lam, amp, har, con, omega, t0, t):
+    h0 = 0j
+    h1 = 0j
+    h2 = 0j
+    magnitude = abs(har)
+    bound2 = magnitude * omega * omega
+    bound3 = bound2 * omega
+    for i in range(lam.size):
+        term = amp[i] * np.exp(lam[i] * (t - t0))
+        l = lam[i]
+        h0 += term
+        h1 += term * l
+        h2 += term * l * l
+        size = abs(term) * (l.real * l.real + l.imag * l.imag)
+        bound2 += size
+        bound3 += size * abs(l)
+    forced = har * complex(math.cos(omega * t), math.sin(omega * t))
+    return (h0 + forced).real + con, (h1 + forced * 1j * omega).real, (h2 - forced * omega * omega).real, bound2, bound3
+
+
+@njit(cache=True)
+def _escape_step(lam, amp, har, con, omega, t0, t):
+    """A step over which h stays < 0 from h(t) = 0 when h leaves the surface; -1.0 if it does not leave (orders up to
+    4, see linear_flow.escape_step)."""
+    values = np.empty(5)
+    _derivatives(lam, amp, har, con, omega, t0, t, values)
+    for k in range(1, 5):
+        scale = _bound(lam, amp, har, omega, t0, t, k)
+        if values[k] < -1e-9 * scale:
+            return -(k + 1) * values[k] / _bound(lam, amp, har, omega, t0, t, k + 1)
+        if values[k] > 1e-9 * scale:
+            return -1.0
+    return -1.0
+
+
+@njit(cache=True)
+def _quadratic_step(h0, h1, curvature):
+    if curvature <= 0.0 and h1 <= 0.0:
+        return math.inf
+    return 2.0 * -h0 / (h1 + math.sqrt(h1 * h1 - 2.0 * curvature * h0))
+
+
+@njit(cache=True)
+def _polish(h0, h1, h2):
+    """The step onto the root of the local quadratic model (see linear_flow.polish_step)."""
+    newton = -h0 / h1
+    if h0 < 0.0 and h2 > 0.0:
+        return min(newton, _quadratic_step(h0, h1, h2))
+    return newton
+
+
+@njit(cache=True)
+def _first_crossing(lam, amp, har, con, omega, t0, t_from, t_to, tolerance, leaving):
+    """First time in (t_from, t_to] at which h reaches 0 from below; NaN if none (see linear_flow.first_crossing)."""
+    size = abs(har) + abs(con)
+    for i in range(amp.size):
+        size += abs(amp[i])
+    tolerance = max(tolerance, 1e-15 * size)
+    pair = np.empty(2)
+    t = t_from
+    if leaving:
+        if _value(lam, amp, har, con, omega, t0, t) >= -tolerance:
+            step = _escape_step(lam, amp, har, con, omega, t0, t)
+            if step < 0.0:
+                if _bound(lam, amp, har, omega, t0, t, 0) <= tolerance:
+                    return math.nan
+                return t_from
+            t += step
+            if t >= t_to:
+                return math.nan
+    departing = leaving
+    while True:
+        h0, h1, h2, curvature, jerk = _step_data(lam, amp, har, con, omega, t0, t)
+        if departing and h0 >= -8.0 * tolerance:
+            step = _escape_step(lam, amp, har, con, omega, t0, t)
+            if step >= 0.0:
+                if t + step >= t_to:
+                    return math.nan
+                if t + step == t:
+                    return t
+                t += step
+                continue
+        if h0 >= -tolerance:
+            if h1 > 0.0:
+                t = max(t + _polish(h0, h1, h2), t_from)
+            return t
+        departing = departing and h0 >= -8.0 * tolerance
+        step = _quadratic_step(h0, h1, curvature)
+        trial = 2.0 * step
+        step = max(step, min(_quadratic_step(h0, h1, max(h2 + jerk * trial / 3.0, 0.0)), trial))
+        if t + step >= t_to:
+            # h < 0 on [t, t_to); a root at t_to (an impact on a period boundary) is still a root, and so is one
+            # within a few round-off units of it, arriving: it is applied before the strobe, not after it
+            _derivatives(lam, amp, har, con, omega, t0, t_to, pair)
+            return t_to if pair[0] >= -tolerance or (pair[0] >= -8.0 * tolerance and pair[1] > 0.0) else math.nan
+        if t + step == t:
+            return t
+        t += step
 
 
 @njit(cache=True)
@@ -280,7 +451,7 @@ def _pushed(slam, svec, sinv, shrm, scst, omega, hold_w, hold_offset, force_tole
     value = _value(slam, amp, har, con, omega, t, t)
     if abs(value) > 64.0 * force_tolerance:
         return value < 0.0
-    return escape_step(slam, amp, har, con, omega, t, t) >= 0.0
+    return _escape_step(slam, amp, har, con, omega, t, t) >= 0.0
 
 
 @njit(cache=True)

@@ -229,10 +229,13 @@ def escape_step(h: Observable, t: float) -> float | None:
     """A step over which h stays < 0 when h(t) = 0 and h leaves the surface; ``None`` if it does not leave.
 
     With derivatives h^(1) = ... = h^(k-1) = 0 and h^(k) < 0, ``h(t + s) <= h^(k) s^k / k! + M s^(k+1) / (k+1)!`` with
-    M = sup |h^(k+1)|, negative for s < -(k + 1) h^(k) / M.
+    M = sup |h^(k+1)|, negative for s < -(k + 1) h^(k) / M. Orders up to 4: an absorber at rest on the stop with zero
+    holding force and an undamped spring (B2 = 0) leaves at the fourth order (h^(2) = H / M2 = 0, h^(3) = B2 X1^(2)
+    / M2 = 0, h^(4) = K2 X1^(2) / M2); with three orders that start was neither leaving nor a contact, and the loop
+    applied a touch at the same instant until its event budget ran out.
     """
-    values = h.derivatives(t, 4)
-    for k in range(1, 4):
+    values = h.derivatives(t, 5)
+    for k in range(1, 5):
         scale = h.bound(t, k)
         if values[k] < -1e-9 * scale:
             return -(k + 1) * values[k] / h.bound(t, k + 1)

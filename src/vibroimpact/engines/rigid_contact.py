@@ -37,6 +37,8 @@ class RigidContact:
 
     Attributes
     ----------
+    velocity_scale : float
+        The problem's velocity scale w (Delta + q |H12|) [m s-1].
     length_scale : float
         Delta + velocity_scale / w [m]: the size of the motion, for round-off thresholds.
     sticking_velocity : float
@@ -46,8 +48,9 @@ class RigidContact:
     def __init__(self, engine: str, problem: ImpactProblem, settings: EngineSettings, periods: int) -> None:
         check_run(engine, problem, RigidStop, periods)
         self.stop, self.mass = problem.rigid_stop, problem.system.m2
-        self.length_scale = problem.clearance + problem.velocity_scale() / problem.omega
-        self.sticking_velocity = settings.sticking_velocity * problem.velocity_scale()
+        self.velocity_scale = problem.velocity_scale()
+        self.length_scale = problem.clearance + self.velocity_scale / problem.omega
+        self.sticking_velocity = settings.sticking_velocity * self.velocity_scale
         self.max_impacts = settings.max_impacts_per_period
 
     def check_start(self, state: NDArray[np.float64]) -> None:

@@ -109,7 +109,7 @@ def shoot_orbit(problem: ImpactProblem, time: float, guess: NDArray[np.float64],
     return ShotOrbit(float(time), orbit.state, orbit.floquet_modulus, section.evaluations)
 
 
-def motion_evidence(engine: Engine, problem: ImpactProblem, run: Trajectory, every: int = 4) -> MotionEvidence:
+def motion_evidence(engine: Engine, problem: ImpactProblem, run: Trajectory, every: int = 8) -> MotionEvidence:
     """What a motion that did not become periodic is, from a run on its attractor.
 
     Parameters

@@ -13,6 +13,7 @@ undecided, with its Lyapunov exponent; :func:`vibroimpact.simulation.periodic.mo
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,7 +29,7 @@ from vibroimpact.simulation.periodic import motion_evidence, shoot_orbit
 from vibroimpact.simulation.settings import START_MODES, SteadySettings
 from vibroimpact.orbits.motion import MotionEvidence
 
-__all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "orbit_stop_of", "START_MODES"]
+__all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "pgf_guesses", "orbit_stop_of", "START_MODES"]
 
 
 
@@ -79,15 +80,9 @@ def start_state(problem: ImpactProblem, mode: str, orbit_stop: RigidStop | None 
     if mode == "rest":
         return 0.0, np.zeros(4)
     if mode in ("pgf", "shooting"):
-        orbit = _orbit(problem, orbit_stop)
-        if orbit.exists[0] and orbit.admissible()[0]:
-            # the orbit's time origin is its impact, where the force has phase (phi - psi12); in the problem's
-            # time that is t_impact = (phi - psi12 - phase) / w; start half a period after it, away from the impact
-            forcing_phase = float(orbit.phase[0] - np.angle(orbit.receptances.h12[0]))
-            t_impact = ((forcing_phase - problem.phase) / problem.omega) % problem.period
-            half = np.array([[0.5 * problem.period]])
-            state = np.array([orbit.x1(half)[0, 0], orbit.x2(half)[0, 0], orbit.x1(half, 1)[0, 0], orbit.x2(half, 1)[0, 0]])
-            return t_impact + 0.5 * problem.period, state
+        guess = pgf_guesses(problem, [problem.frequency], orbit_stop)[0]
+        if guess is not None:
+            return guess
     response = linear_response(problem.system, problem.omega, problem.amplitude)
     x = np.array([response.x1, response.x2]) * np.exp(1j * problem.phase)
     state = np.concatenate([x.real, (1j * problem.omega * x).real])
@@ -106,14 +101,26 @@ def orbit_stop_of(problem: ImpactProblem, orbit_stop: RigidStop | None = None) -
     return RigidStop(problem.clearance, problem.contact.restitution)
 
 
-def _orbit(problem: ImpactProblem, orbit_stop: RigidStop | None) -> OneImpactSolution:
+def pgf_guesses(problem: ImpactProblem, frequencies: Sequence[float], orbit_stop: RigidStop | None = None) -> list[tuple[float, NDArray[np.float64]] | None]:
+    """The ``pgf`` start (time [s], state) at each of ``frequencies`` [Hz], from one vectorised closed-form solution;
+    None where no admissible one-impact orbit exists.
+
+    The orbit's time origin is its impact, where the force has phase (phi - psi12); in the problem's time (force
+    q cos(w t + phase)) that is t_impact = (phi - psi12 - phase) / w. The start is half a period after it, away from
+    the impact. ``problem`` gives the system, the force's amplitude and phase, and (with ``orbit_stop``, see
+    :func:`orbit_stop_of`) the stop.
+    """
     stop = orbit_stop_of(problem, orbit_stop)
-    return solve_one_impact(problem.system, np.array([problem.omega]), stop.clearance, stop.restitution, problem.amplitude)
-
-
-def _has_orbit(problem: ImpactProblem, orbit_stop: RigidStop | None) -> bool:
-    orbit = _orbit(problem, orbit_stop)
-    return bool(orbit.exists[0] and orbit.admissible()[0])
+    omega = 2.0 * np.pi * np.asarray(frequencies, dtype=float)
+    orbit = solve_one_impact(problem.system, omega, stop.clearance, stop.restitution, problem.amplitude)
+    ok = orbit.exists & orbit.admissible()
+    period = 2.0 * np.pi / omega
+    half = 0.5 * period[:, None]
+    with np.errstate(invalid="ignore"):
+        states = np.stack([orbit.x1(half)[:, 0], orbit.x2(half)[:, 0], orbit.x1(half, 1)[:, 0], orbit.x2(half, 1)[:, 0]], axis=-1)
+        forcing_phase = orbit.phase - np.angle(orbit.receptances.h12)
+        t_impact = np.mod((forcing_phase - problem.phase) / omega, period)
+    return [(float(t_impact[i] + half[i, 0]), states[i]) if ok[i] else None for i in range(omega.size)]
 
 
 def linear_fits(problem: ImpactProblem) -> bool:
@@ -127,6 +134,7 @@ def steady_state(
     start: str | tuple[float, NDArray[np.float64]] = "linear",
     settings: SteadySettings = SteadySettings(),
     orbit_stop: RigidStop | None = None,
+    guess: tuple[float, NDArray[np.float64]] | None | str = "compute",
 ) -> SteadyResult:
     """Integrate to the steady state and measure it.
 
@@ -142,12 +150,21 @@ def steady_state(
         Convergence and measurement settings.
     orbit_stop : RigidStop, optional
         The rigid stop whose one-impact orbit a ``pgf`` start follows (see :func:`orbit_stop_of`).
+    guess : (time [s], state) or None, optional
+        The ``pgf`` start, precomputed for a whole grid by :func:`pgf_guesses` (None: no admissible one-impact
+        orbit); by default computed here.
     """
-    if start in ("pgf", "shooting") and not _has_orbit(problem, orbit_stop):
-        start = "linear"  # where no admissible one-impact orbit exists, the pgf start is the linear one
+    if start in ("pgf", "shooting"):
+        if isinstance(guess, str):
+            guess = pgf_guesses(problem, [problem.frequency], orbit_stop)[0]
+        if guess is None:
+            start = "linear"  # where no admissible one-impact orbit exists, the pgf start is the linear one
     if start == "linear" and linear_fits(problem):
         return _linear_answer(problem)
-    t, y = start_state(problem, start, orbit_stop) if isinstance(start, str) else (float(start[0]), np.asarray(start[1], dtype=float))
+    if start in ("pgf", "shooting"):
+        t, y = guess[0], np.array(guess[1], dtype=float)  # type: ignore[index]
+    else:
+        t, y = start_state(problem, start, orbit_stop) if isinstance(start, str) else (float(start[0]), np.asarray(start[1], dtype=float))
     scale = np.array([1.0, 1.0, problem.omega, problem.omega]) * (problem.clearance + problem.amplitude * abs(complex(problem.system.receptances(problem.omega).h12)))
     used = 0
     first_chunk = settings.chunk_periods
@@ -187,12 +204,17 @@ def _measure(engine: Engine, problem: ImpactProblem, t: float, y: NDArray[np.flo
         periods = multiplicity * math.ceil(settings.measure_periods / multiplicity)
         final = engine.integrate(problem, y, t, periods, moments=True)
     elif settings.lyapunov_periods:
-        periods = max(settings.irregular_measure_periods, settings.lyapunov_periods)
-        exact = engine.name == "exact"
-        final = engine.integrate(problem, y, t, periods, moments=True, jacobians=True) if exact else engine.integrate(problem, y, t, periods, moments=True)
-        motion = motion_evidence(engine, problem, final)
-        if not exact:
-            periods *= 2  # the perturbed copy of the run
+        # the averages over irregular_measure_periods, then the run that says what the motion is (Jacobians of exact,
+        # or a perturbed copy of an integrator's own run: as many periods again)
+        final = engine.integrate(problem, y, t, settings.irregular_measure_periods, moments=True)
+        after = (float(final.strobe_times[-1]), final.final_state)
+        if engine.name == "exact":
+            run = engine.integrate(problem, after[1], after[0], settings.lyapunov_periods, jacobians=True)
+            periods = settings.irregular_measure_periods + settings.lyapunov_periods
+        else:
+            run = engine.integrate(problem, after[1], after[0], settings.lyapunov_periods)
+            periods = settings.irregular_measure_periods + 2 * settings.lyapunov_periods
+        motion = motion_evidence(engine, problem, run)
     else:
         periods = settings.irregular_measure_periods
         final = engine.integrate(problem, y, t, periods, moments=True)

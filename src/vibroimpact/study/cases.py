@@ -22,7 +22,7 @@ from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.study.fingerprint import case_key
 from vibroimpact.study.runner import CaseResult, ProgressReport
-from vibroimpact.simulation.steady import linear_fits, steady_state
+from vibroimpact.simulation.steady import linear_fits, pgf_guesses, steady_state
 from vibroimpact.simulation.settings import SWEEP_STARTS, SteadySettings
 from vibroimpact.model.system import TwoDofSystem
 
@@ -126,6 +126,10 @@ def run_case(case: SimulationCase, report: ProgressReport | None = None) -> Case
     out: dict[str, NDArray[np.generic]] = {name: np.full(n, np.nan, dtype=complex if name in ("x1", "x2", "suspension_force", "contact_force") else float) for name in FIELDS}
     order = range(n - 1, -1, -1) if case.start == "sweep_down" else range(n)
     previous = None
+    guesses: list[tuple[float, NDArray[np.float64]] | None] | None = None
+    if case.start in ("pgf", "shooting"):  # the closed-form orbits of the whole case in one vectorised solution
+        first = ImpactProblem(case.system, case.contact, HarmonicForce(case.amplitude, case.frequencies[0], phase=0.0))
+        guesses = pgf_guesses(first, case.frequencies, case.orbit_stop)
     for i in order:
         frequency = case.frequencies[i]
         problem = ImpactProblem(case.system, case.contact, HarmonicForce(case.amplitude, frequency, phase=0.0))
@@ -141,7 +145,8 @@ def run_case(case: SimulationCase, report: ProgressReport | None = None) -> Case
                 start = (0.0, result.end_state)
         started = time.perf_counter()
         try:
-            result = steady_state(engine, problem, start, case.steady_settings, case.orbit_stop)
+            guess = guesses[i] if guesses is not None else "compute"
+            result = steady_state(engine, problem, start, case.steady_settings, case.orbit_stop, guess)
         except (RuntimeError, ValueError, ArithmeticError, np.linalg.LinAlgError) as error:
             # one failing point must not cost the others: it stays NaN, flagged, and a sweep restarts after it
             print(f"{case.engine}: {case.contact}, f = {frequency:g} Hz failed: {error}", file=sys.stderr)
