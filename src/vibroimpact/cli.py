@@ -173,7 +173,7 @@ def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, cache: Path) -> 
         if scene.report and not args.no_report:
             from vibroimpact.reporting.report import write_report  # matplotlib is imported only when a report is made
 
-            report = write_report(dataset, out_dir)
+            report = write_report(dataset, out_dir, jobs=args.jobs)
             print(f"wrote {report}")
     except (OSError, ValueError, ArithmeticError, np.linalg.LinAlgError, RuntimeError) as error:
         print(f"run-study: error while running {scene.name!r}: {type(error).__name__}: {error}", file=sys.stderr)

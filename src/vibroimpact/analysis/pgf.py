@@ -218,23 +218,25 @@ class OneImpactSolution:
         sticking = (self.restitution == 0.0) & (self.x2(np.zeros((rows.size, 1)), 2)[:, 0] > 0.0)
         return np.where(sticking, np.inf, best)
 
-    def rms(self, samples: int = 512, chunk_points: int = 2048) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def rms(self, nodes: int = 64, chunk_points: int = 2048) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """RMS of the reconstructed X1(t) and X2(t) over the period [m]; NaN where no solution exists.
 
-        The mean of ``samples`` uniform samples of x^2 over the period: the trapezoidal rule of a periodic function,
-        second order in the step at the velocity kink of the impact (relative error ~1e-6 with 512 samples).
+        Gauss-Legendre quadrature of x^2 over the open period: the orbit is smooth on [0, T] (its only kink, the
+        impact, is at the ends), so ``nodes`` = 64 is exact to round-off (it agrees with 128 nodes to 1e-15, where the
+        512-sample trapezoidal rule used before was second order at the kink, ~1e-6, and ~8x dearer).
         """
         shape = self.omega.shape
         x1_rms, x2_rms = np.full(shape, np.nan), np.full(shape, np.nan)
         flat_index = np.flatnonzero(self.exists)
-        fractions = np.arange(samples) / samples
+        points, weights = np.polynomial.legendre.leggauss(nodes)
+        fractions, weights = (points + 1.0) / 2.0, weights / 2.0
         out1, out2 = x1_rms.reshape(-1), x2_rms.reshape(-1)
         for start in range(0, flat_index.size, chunk_points):
             idx = flat_index[start : start + chunk_points]
             part = self._subset(idx)
             t = fractions * part.period[..., None]
-            out1[idx] = np.sqrt(np.mean(part.x1(t) ** 2, axis=-1))
-            out2[idx] = np.sqrt(np.mean(part.x2(t) ** 2, axis=-1))
+            out1[idx] = np.sqrt(part.x1(t) ** 2 @ weights)
+            out2[idx] = np.sqrt(part.x2(t) ** 2 @ weights)
         return x1_rms, x2_rms
 
     def _subset(self, flat_index: NDArray[np.intp]) -> "OneImpactSolution":

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import xarray as xr
 
-from vibroimpact.reporting.page import StudyPage, render_page, write_page  # selects the Agg backend
+from vibroimpact.reporting.page import StudyPage, render_page, rendering, write_page  # selects the Agg backend
 from vibroimpact.reporting.accuracy_page import AccuracyPage  # noqa: E402
 from vibroimpact.reporting.bifurcation_page import BifurcationPage  # noqa: E402
 from vibroimpact.reporting.bumper_page import BumperStiffnessPage  # noqa: E402
@@ -32,13 +32,15 @@ from vibroimpact.reporting.sweep_page import SweptSinePage  # noqa: E402
 __all__ = ["write_report", "page_for"]
 
 
-def write_report(dataset: xr.Dataset, out_dir: str | Path) -> Path:
-    """Write the PNG figures and ``report.html`` for ``dataset`` into ``out_dir``; return the HTML path."""
+def write_report(dataset: xr.Dataset, out_dir: str | Path, jobs: int = 1) -> Path:
+    """Write the PNG figures and ``report.html`` for ``dataset`` into ``out_dir``, rendering the figures in ``jobs``
+    processes; return the HTML path."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     record = study_record(dataset)
     page = page_for(dataset)
-    sections = page.sections(out)
+    with rendering(jobs):
+        sections = page.sections(out)
     paragraphs = [record.description, f"vibroimpact {record.version}; {page.summary()}."]
     return write_page(out / "report.html", render_page(f"Study '{record.name}'", paragraphs, sections, record.scene_text))
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,6 +27,7 @@ from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
 from vibroimpact.simulation.periodic import motion_evidence, shoot_orbit
 from vibroimpact.simulation.settings import START_MODES, SteadySettings
+from vibroimpact.orbits.lyapunov import state_scales
 from vibroimpact.orbits.motion import MotionEvidence
 
 __all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "pgf_guesses", "orbit_stop_of", "START_MODES"]
@@ -196,37 +197,45 @@ def steady_state(
     return _measure(engine, problem, t, y, multiplicity, used, settings)
 
 
+#: Longest period [excitation periods] recognised in the strobes of the long run of a motion that marching did not
+#: see repeat: stable orbits of period 4-10 on the paper's system converge too slowly for the marching window.
+LONG_MULTIPLICITY = 32
+
+
 def _measure(engine: Engine, problem: ImpactProblem, t: float, y: NDArray[np.float64], multiplicity: int, searched: int, settings: SteadySettings) -> SteadyResult:
-    """Measure whole periods from (t, y): a periodic motion over a multiple of its period; a motion that did not
-    converge over ``irregular_measure_periods``, or ``lyapunov_periods`` to say what it is."""
+    """Measure whole periods from (t, y): a periodic motion over a multiple of its period.
+
+    A motion that did not converge first runs ``lyapunov_periods`` more (with the exact Jacobians for ``exact``):
+    if its strobes then repeat with a period up to :data:`LONG_MULTIPLICITY`, it is that periodic orbit, reached
+    late; otherwise that run says what the motion is (:func:`motion_evidence`), and ``irregular_measure_periods``
+    are measured after it.
+    """
     motion = None
+    periods = 0
+    if not multiplicity and settings.lyapunov_periods:
+        exact = engine.name == "exact"
+        run = engine.integrate(problem, y, t, settings.lyapunov_periods, jacobians=True) if exact else engine.integrate(problem, y, t, settings.lyapunov_periods)
+        periods = settings.lyapunov_periods
+        t, y = float(run.strobe_times[-1]), run.final_state
+        scale = state_scales(problem)
+        multiplicity = _repeat(run.strobe_states[-(3 * LONG_MULTIPLICITY + 1) :], scale, replace(settings, max_multiplicity=LONG_MULTIPLICITY))
+        if not multiplicity:
+            motion = motion_evidence(engine, problem, run)
+            periods += 0 if exact else settings.lyapunov_periods  # the perturbed copy of an integrator's run
     if multiplicity:
-        periods = multiplicity * math.ceil(settings.measure_periods / multiplicity)
-        final = engine.integrate(problem, y, t, periods, moments=True)
-    elif settings.lyapunov_periods:
-        # the averages over irregular_measure_periods, then the run that says what the motion is (Jacobians of exact,
-        # or a perturbed copy of an integrator's own run: as many periods again)
-        final = engine.integrate(problem, y, t, settings.irregular_measure_periods, moments=True)
-        after = (float(final.strobe_times[-1]), final.final_state)
-        if engine.name == "exact":
-            run = engine.integrate(problem, after[1], after[0], settings.lyapunov_periods, jacobians=True)
-            periods = settings.irregular_measure_periods + settings.lyapunov_periods
-        else:
-            run = engine.integrate(problem, after[1], after[0], settings.lyapunov_periods)
-            periods = settings.irregular_measure_periods + 2 * settings.lyapunov_periods
-        motion = motion_evidence(engine, problem, run)
+        measured = multiplicity * math.ceil(settings.measure_periods / multiplicity)
     else:
-        periods = settings.irregular_measure_periods
-        final = engine.integrate(problem, y, t, periods, moments=True)
+        measured = settings.irregular_measure_periods
+    final = engine.integrate(problem, y, t, measured, moments=True)
     return SteadyResult(
         measures=measure(final),
         converged=multiplicity > 0,
         multiplicity=multiplicity,
-        periods_used=searched + periods,
+        periods_used=searched + periods + measured,
         end_time=float(final.strobe_times[-1]),
         end_state=final.final_state.copy(),
         motion=motion,
-        search_periods=searched,
+        search_periods=searched + (periods if multiplicity else 0),
     )
 
 
