@@ -38,7 +38,7 @@ _x, _w = np.polynomial.legendre.leggauss(16)
 GL_NODES, GL_WEIGHTS = (_x + 1.0) / 2.0, _w / 2.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _modal(lam, vec, inv, hrm, cst, omega, t0, y0, out):
     """Modal coordinates of the homogeneous part through y0 at t0, into ``out``."""
     n = lam.size
@@ -51,19 +51,21 @@ def _modal(lam, vec, inv, hrm, cst, omega, t0, y0, out):
             out[r] += inv[r, i] * rel
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _state(lam, vec, hrm, cst, omega, t0, modal, t, out):
     n = lam.size
     phasor = complex(math.cos(omega * t), math.sin(omega * t))
     for r in range(n):
         out[r] = (hrm[r] * phasor).real + cst[r]
     for i in range(n):
-        growth = np.exp(lam[i] * (t - t0)) * modal[i]
+        if lam[i].imag < 0.0:
+            continue  # its conjugate's term, doubled, stands for both (the state is real)
+        growth = np.exp(lam[i] * (t - t0)) * modal[i] * (2.0 if lam[i].imag > 0.0 else 1.0)
         for r in range(n):
             out[r] += (vec[r, i] * growth).real
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _observable(weights, offset, vec, hrm, cst, modal, amp):
     """h = weights . y + offset of the piece with ``modal`` coordinates: amplitudes into ``amp``; (har, con)."""
     n = modal.size
@@ -79,7 +81,37 @@ def _observable(weights, offset, vec, hrm, cst, modal, amp):
     return har, con
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
+def _half_rates(lam):
+    """The eigenvalues a real observable needs: one of each complex-conjugate pair (Im > 0) and the real ones."""
+    count = 0
+    for i in range(lam.size):
+        if lam[i].imag >= 0.0:
+            count += 1
+    out = np.empty(count, dtype=np.complex128)
+    count = 0
+    for i in range(lam.size):
+        if lam[i].imag >= 0.0:
+            out[count] = lam[i]
+            count += 1
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def _halve(lam, amp, out):
+    """Amplitudes on :func:`_half_rates`: Re(a e^{lt}) + Re(conj) = Re(2 a e^{lt}), so each pair is kept once,
+    doubled (every evaluation of the observable then costs half)."""
+    count = 0
+    for i in range(lam.size):
+        if lam[i].imag > 0.0:
+            out[count] = 2.0 * amp[i]
+            count += 1
+        elif lam[i].imag == 0.0:
+            out[count] = amp[i]
+            count += 1
+
+
+@njit(cache=True, error_model="numpy")
 def _value(lam, amp, har, con, omega, t0, t):
     """h(t)."""
     total = har * complex(math.cos(omega * t), math.sin(omega * t))
@@ -88,7 +120,7 @@ def _value(lam, amp, har, con, omega, t0, t):
     return total.real + con
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _derivatives(lam, amp, har, con, omega, t0, t, out):
     """h, h', ..., h^(len(out) - 1) at t."""
     forced = har * complex(math.cos(omega * t), math.sin(omega * t))
@@ -104,7 +136,7 @@ def _derivatives(lam, amp, har, con, omega, t0, t, out):
             term *= lam[i]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _bound(lam, amp, har, omega, t0, t, order):
     """An upper bound of |h^(order)| over [t, inf) (all Re(lam) <= 0)."""
     total = abs(har) * omega**order
@@ -113,7 +145,7 @@ def _bound(lam, amp, har, omega, t0, t, order):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _step_data(lam, amp, har, con, omega, t0, t):
     h0 = 0j
     h1 = 0j
@@ -134,7 +166,7 @@ def _step_data(lam, amp, har, con, omega, t0, t):
     return (h0 + forced).real + con, (h1 + forced * 1j * omega).real, (h2 - forced * omega * omega).real, bound2, bound3
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _escape_step(lam, amp, har, con, omega, t0, t):
     """A step over which h stays < 0 from h(t) = 0 when h leaves the surface; -1.0 if it does not leave (orders up to
     4, see linear_flow.escape_step)."""
@@ -149,14 +181,14 @@ def _escape_step(lam, amp, har, con, omega, t0, t):
     return -1.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _quadratic_step(h0, h1, curvature):
     if curvature <= 0.0 and h1 <= 0.0:
         return math.inf
     return 2.0 * -h0 / (h1 + math.sqrt(h1 * h1 - 2.0 * curvature * h0))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _polish(h0, h1, h2):
     """The step onto the root of the local quadratic model (see linear_flow.polish_step)."""
     newton = -h0 / h1
@@ -165,7 +197,7 @@ def _polish(h0, h1, h2):
     return newton
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _first_crossing(lam, amp, har, con, omega, t0, t_from, t_to, tolerance, leaving):
     """First time in (t_from, t_to] at which h reaches 0 from below; NaN if none (see linear_flow.first_crossing)."""
     size = abs(har) + abs(con)
@@ -214,7 +246,7 @@ def _first_crossing(lam, amp, har, con, omega, t0, t_from, t_to, tolerance, leav
         t += step
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _transition(lam, vec, inv, dt):
     n = lam.size
     scaled = np.empty((n, n), dtype=np.complex128)
@@ -225,7 +257,7 @@ def _transition(lam, vec, inv, dt):
     return np.ascontiguousarray((vec @ scaled).real)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _left_multiply(factor, jac, work):
     """jac <- factor @ jac (4 x 4), through ``work``."""
     for r in range(4):
@@ -237,21 +269,21 @@ def _left_multiply(factor, jac, work):
     jac[:, :] = work
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _free_field(a_matrix, force_over_m1, omega, phase, t, y):
     f = a_matrix @ y
     f[2] += force_over_m1 * math.cos(omega * t + phase)
     return f
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _grow(array, rows):
     bigger = np.empty((max(2 * array.shape[0], rows),) + array.shape[1:], dtype=array.dtype)
     bigger[: array.shape[0]] = array
     return bigger
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _closest_approach(lam, amp, har, con, omega, t0, ta, tb, fastest, best):
     """Largest interior local maximum of h on (ta, tb) (h' from + to -), if above best[0]: stored in best."""
     chunks = max(2, int(math.ceil(fastest * (tb - ta) / 0.5)))
@@ -280,7 +312,7 @@ def _closest_approach(lam, amp, har, con, omega, t0, ta, tb, fastest, best):
         slope_prev, h_prev = d[1], t
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run_periods(
     lam, vec, inv, hrm, cst,  # free flow
     slam, svec, sinv, shrm, scst,  # stuck flow of (X1, X1')
@@ -334,6 +366,8 @@ def run_periods(
     amp = np.empty(4, dtype=np.complex128)
     smodal = np.empty(2, dtype=np.complex128)
     samp = np.empty(2, dtype=np.complex128)
+    hlam, hslam = _half_rates(lam), _half_rates(slam)  # the observables' rates: one of each conjugate pair
+    hamp, hsamp = np.empty(hlam.size, dtype=np.complex128), np.empty(hslam.size, dtype=np.complex128)
     work = np.empty((4, 4))
     har = 0j
     con = 0.0
@@ -348,9 +382,11 @@ def run_periods(
                 y2[0], y2[1] = y[0], y[2]
                 _modal(slam, svec, sinv, shrm, scst, omega, t, y2, smodal)
                 har, con = _observable(hold_w, k2 * clearance, svec, shrm, scst, smodal, samp)
+                _halve(slam, samp, hsamp)
             else:
                 _modal(lam, vec, inv, hrm, cst, omega, t, y, modal)
                 har, con = _observable(gap_w, -clearance, vec, hrm, cst, modal, amp)
+                _halve(lam, amp, hamp)
             if n_segments == segments.shape[0]:
                 segments = _grow(segments, n_segments + 1)
                 segment_states = _grow(segment_states, n_segments + 1)
@@ -360,9 +396,9 @@ def run_periods(
             fresh = False  # the piece lasts until the next event, across period boundaries
         counters[0] += 1
         if stuck:
-            t_event = _first_crossing(slam, samp, har, con, omega, t_piece, t, boundary, force_tolerance, leaving)
+            t_event = _first_crossing(hslam, hsamp, har, con, omega, t_piece, t, boundary, force_tolerance, leaving)
         else:
-            t_event = _first_crossing(lam, amp, har, con, omega, t_piece, t, boundary, tolerance, leaving)
+            t_event = _first_crossing(hlam, hamp, har, con, omega, t_piece, t, boundary, tolerance, leaving)
         leaving = False
         t_end = boundary if math.isnan(t_event) else t_event
         # moments, closest approach and the transition matrix of [t, t_end]
@@ -373,7 +409,7 @@ def run_periods(
                     t, t_end, fastest, clearance, k2, b2, gl_nodes, gl_weights,
                 )  # fmt: skip
             if want_approach and not stuck:
-                _closest_approach(lam, amp, har, con, omega, t_piece, t, t_end, fastest, approach)
+                _closest_approach(hlam, hamp, har, con, omega, t_piece, t, t_end, fastest, approach)
             if want_jacobians:
                 if stuck:
                     phi2 = _transition(slam, svec, sinv, t_end - t)
@@ -440,7 +476,7 @@ def run_periods(
     return STATUS_OK, t, strobes, jacobians, impacts[:n_impacts], segments[:n_segments], segment_states[:n_segments], moments, counters, approach
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _pushed(slam, svec, sinv, shrm, scst, omega, hold_w, hold_offset, force_tolerance, t, y):
     """Would the stop have to push to hold the absorber at rest at (t, y) (holding force > 0, or = 0 and rising)?"""
     y2 = np.array([y[0], y[2]])
@@ -454,7 +490,7 @@ def _pushed(slam, svec, sinv, shrm, scst, omega, hold_w, hold_offset, force_tole
     return _escape_step(slam, amp, har, con, omega, t, t) >= 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _saltation(a_matrix, force_over_m1, phase, omega, t, y_contact, after, restitution, sticks, velocity):
     """Saltation matrix of an impact at time t, at ``y_contact`` (X2 = Delta), from X2' = velocity to ``after``."""
     salt = np.eye(4)
@@ -478,7 +514,7 @@ def _saltation(a_matrix, force_over_m1, phase, omega, t, y_contact, after, resti
     return salt
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _add_moments(moments, row, stuck, lam, vec, hrm, cst, slam, svec, shrm, scst, omega, t_piece, modal, ta, tb, fastest, clearance, k2, b2, gl_nodes, gl_weights):
     chunks = max(1, int(math.ceil(fastest * (tb - ta) / 4.0)))
     width = (tb - ta) / chunks

@@ -18,10 +18,13 @@ from vibroimpact.study.cost_model import Costs, EnginePart, Estimate, grid_estim
 from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates, solve_each, steady_variable
 from vibroimpact.study.solutions import simulated_values
 
-__all__ = ["SteppedStudy", "expected_periods", "SETTLING_PERIODS", "ESTIMATE_POINTS"]
+__all__ = ["SteppedStudy", "expected_periods", "SETTLING_PERIODS", "SHOOTING_PERIODS", "ESTIMATE_POINTS"]
 
 #: Periods of a transient that settles on a stable orbit (two convergence chunks), before the measurement.
 SETTLING_PERIODS = 40
+#: Periods a ``shooting`` start integrates before measuring a stable orbit: 1-2 map evaluations and the 3-period check
+#: of an integrator (measured on the restitution study: 1-4).
+SHOOTING_PERIODS = 5
 #: Largest number of simulated points whose closed form is solved for the estimate (a larger grid is subsampled).
 ESTIMATE_POINTS = 20_000
 
@@ -71,7 +74,10 @@ class SteppedStudy:
         def engine_part(name: str, engine: str) -> EnginePart:
             assert scene.simulation is not None
             copies = bumpers if engine_spec(name).contact == BUMPER else 1  # a bumper engine runs once per bumper
-            total_periods = float(periods.sum()) * scale * copies
+            steady = scene.simulation.steady
+            # where the motion may never settle, an integrator also runs a perturbed copy of its Lyapunov run
+            wandering = np.count_nonzero(periods >= steady.max_periods + steady.lyapunov_periods) if name != "exact" else 0
+            total_periods = (float(periods.sum()) + wandering * steady.lyapunov_periods) * scale * copies
             seconds = costs.per_period_cost(engine, scene.simulation.engine.rtol) * total_periods
             integrated = int(np.count_nonzero(periods) * scale) * copies
             points = f"{scene.restitution.size * scene.clearance.size * scene.simulation.frequency.size * copies} points, ~{integrated} integrated, ~{total_periods:.0f} periods"
@@ -105,7 +111,7 @@ def expected_periods(scene: Scene) -> tuple[np.ndarray, float]:
     frequencies = sim.frequency if sim.frequency.size <= per_line else sim.frequency[np.linspace(0, sim.frequency.size - 1, per_line).astype(int)]
     scale = sim.frequency.size / frequencies.size
     steady = sim.steady
-    wander = steady.max_periods + steady.irregular_measure_periods
+    wander = steady.max_periods + steady.lyapunov_periods + steady.irregular_measure_periods
     shape = (scene.restitution.size, scene.clearance.size, frequencies.size)
     if sim.start == "rest":
         return np.full(shape, float(wander)), scale
@@ -117,7 +123,7 @@ def expected_periods(scene: Scene) -> tuple[np.ndarray, float]:
         modulus = np.max(np.abs(floquet_multipliers(orbit)), axis=-1)
         stable = admissible & (modulus < 1.0)
     fits = orbit.linear_amplitude_x2 <= orbit.clearance
-    settle = SETTLING_PERIODS + steady.measure_periods
+    settle = (SHOOTING_PERIODS if sim.start == "shooting" else SETTLING_PERIODS) + steady.measure_periods
     if sim.start in SWEEP_STARTS:
         # a chain: a fitting point is answered linear unless the point before it impacted (then it integrates from
         # there, and keeps impacting where a one-impact orbit coexists with the linear motion)
@@ -128,5 +134,5 @@ def expected_periods(scene: Scene) -> tuple[np.ndarray, float]:
             no_integration[..., k] = fits[..., k] & ~impacting
             impacting = ~fits[..., k] | (impacting & admissible[..., k])
     else:
-        no_integration = fits & ~admissible if sim.start == "pgf" else fits
+        no_integration = fits & ~admissible if sim.start in ("pgf", "shooting") else fits
     return np.where(no_integration, 0, np.where(stable, settle, wander)).astype(float), scale
