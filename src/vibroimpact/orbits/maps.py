@@ -45,6 +45,10 @@ class ImpactMap:
         k >= 1: excitation periods per map iteration.
     engine : ExactEngine, optional
         The engine that computes the map (default settings when omitted).
+    bounds : dict, optional
+        Parameter name -> (lower, upper): outside this box the map has no image (NaN, a failed step), e.g. to keep a
+        continuation's trials at physical frequencies. Parameters outside their own ranges (a negative clearance or
+        frequency, R > 1) never have one.
 
     Attributes
     ----------
@@ -59,7 +63,7 @@ class ImpactMap:
     parameter_names = tuple(PARAMETERS)
     dimension = 4
 
-    def __init__(self, problem: ImpactProblem, periods: int = 1, engine: ExactEngine | None = None) -> None:
+    def __init__(self, problem: ImpactProblem, periods: int = 1, engine: ExactEngine | None = None, bounds: dict[str, tuple[float, float]] | None = None) -> None:
         _checked = (problem.rigid_stop, problem.harmonic)  # TypeError naming the part unless a rigid stop and a harmonic force
         if int(periods) < 1:
             raise ValueError(f"periods = {periods!r} is out of range: allowed [1, inf)")
@@ -69,6 +73,15 @@ class ImpactMap:
         length = problem.clearance + problem.amplitude * float(np.abs(problem.system.receptances(problem.omega).h12))
         self.state_scale = np.array([length, length, problem.omega * length, problem.omega * length])
         self.parameter_scale = np.array([1.0, 0.1, 1e-3, 1.0])
+        self.bounds = dict(bounds or {})
+        unknown = set(self.bounds) - set(PARAMETERS)
+        if unknown:
+            raise ValueError(f"bounds: unknown parameters {sorted(unknown)}; allowed {list(PARAMETERS)}")
+        self._box = [(self.parameter_names.index(name), float(low), float(high)) for name, (low, high) in self.bounds.items()]
+
+    def with_periods(self, periods: int) -> "ImpactMap":
+        """The same map over ``periods`` excitation periods (one compiled call per evaluation, unlike ``Iterated``)."""
+        return ImpactMap(self.problem, periods, self.engine, self.bounds)
 
     def problem_at(self, p: NDArray[np.float64]) -> ImpactProblem:
         """The problem with parameter vector ``p``."""
@@ -79,17 +92,24 @@ class ImpactMap:
     def evaluate(self, y: NDArray[np.float64], p: NDArray[np.float64]) -> MapEvaluation:
         """The state k periods after ``y`` at t = 0, its Jacobian and the hybrid information.
 
-        A state inside the stop (X2 > Delta) or invalid parameters (e.g. a Newton iterate) have no image: NaN, which
-        Newton's method and the corrector treat as a failed step.
+        A state inside the stop (X2 > Delta), a non-finite state, invalid parameters (e.g. a Newton iterate at a
+        negative frequency or clearance), parameters outside ``bounds`` and a flight on which the engine makes no
+        progress (endless chattering) have no image: NaN, which Newton's method and the corrector treat as a failed step.
         """
-        try:
-            problem = self.problem_at(p)
-        except ValueError:  # a Newton iterate outside the parameters' ranges (negative clearance, R > 1, ...)
-            problem = None
-        if problem is None or not y[1] <= problem.clearance:  # or inside the stop: no flight starts there
-            nan = np.full(4, np.nan)
-            return MapEvaluation(nan, np.full((4, 4), np.nan), None, None)
-        strobe = self.engine.strobe_map(problem, np.asarray(y, dtype=float), 0.0, self.periods)
+        problem = None
+        if all(low <= p[i] <= high for i, low, high in self._box) and np.all(np.isfinite(y)):
+            try:
+                problem = self.problem_at(p)
+            except ValueError:  # a Newton iterate outside the parameters' ranges (negative clearance, R > 1, ...)
+                problem = None
+        strobe = None
+        if problem is not None and y[1] <= problem.clearance:  # inside the stop, no flight starts
+            try:
+                strobe = self.engine.strobe_map(problem, np.asarray(y, dtype=float), 0.0, self.periods)
+            except RuntimeError:  # the engine made no progress (endless chattering)
+                strobe = None
+        if strobe is None:
+            return MapEvaluation(np.full(4, np.nan), np.full((4, 4), np.nan), None, None)
         velocities = strobe.impact_velocities
         length = self.state_scale[0]
         hybrid = HybridInfo(

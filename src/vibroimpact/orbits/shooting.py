@@ -150,6 +150,8 @@ def shoot(system: ParametrisedMap, guess: ArrayLike, parameters: ArrayLike, peri
     for _ in range(settings.max_iterations):
         if not np.all(np.isfinite(r)):
             raise ShootingError("the map returned a non-finite state", tuple(history))
+        if not np.all(np.isfinite(out.jacobian)):  # e.g. an impact at zero speed: its saltation matrix is singular
+            raise ShootingError("the map's Jacobian is not finite (an impact at zero speed?)", tuple(history))
         if history[-1] <= settings.tolerance:
             if out.hybrid is not None and out.hybrid.sticks and not settings.allow_sticking:
                 raise ShootingError(
