@@ -9,6 +9,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
+from vibroimpact.analysis.regime import Regime
 from vibroimpact.reporting.style import QUANTITIES, SOLUTION_DESCRIPTIONS, SOLUTION_TITLES
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, SOLUTIONS
 from vibroimpact.scene.variables import VARIABLE_ATTRIBUTES
@@ -67,7 +68,7 @@ def test_filled_markers_are_periodic_and_hollow_ones_irregular() -> None:
             kinds.add(filled)
             assert np.all(converged[at] == (1 if filled else 0)), (line.get_gid(), r, filled)
     assert kinds == {True, False}
-    assert "filled: periodic" in drawn.caption and "hollow: irregular" in drawn.caption
+    assert "filled: periodic" in drawn.caption and "hollow: not periodic" in drawn.caption
     plt.close(drawn.figure)
 
 
@@ -79,4 +80,32 @@ def test_impulse_is_called_what_the_data_hold(kind: str) -> None:
         assert QUANTITIES["impulse"].label in drawn.caption.lower()
         assert "per impact" not in drawn.caption
         assert all("impulse per period" in ax.get_ylabel() for ax in drawn.figure.axes)
+        plt.close(drawn.figure)
+
+
+def test_lyapunov_figure_draws_every_non_periodic_point_in_the_colour_of_its_kind() -> None:
+    """Each engine's chaotic and quasi-periodic points, one marker each, coloured as on the regime map; the caption
+    says how the exponent was estimated and what the thresholds are."""
+    from matplotlib.colors import to_hex
+
+    from vibroimpact.reporting.motion_figure import lyapunov_figure
+    from vibroimpact.reporting.style import REGIME_COLOURS
+
+
+    dataset = steady_dataset()
+    drawn = lyapunov_figure(dataset, ["momentary", "exact"], "lyapunov")
+    assert drawn is not None
+    try:
+        for ax, restitution in zip(drawn.figure.axes, dataset["restitution"].values):
+            for engine in ("momentary", "exact"):
+                regime = dataset["regime"].sel(solution=engine, restitution=restitution).values
+                for kind in (Regime.CHAOTIC, Regime.QUASI_PERIODIC):
+                    points = [
+                        len(line.get_xdata())
+                        for line in ax.get_lines()
+                        if line.get_gid() == engine and line.get_marker() not in (None, "None", "") and to_hex(line.get_color()) == REGIME_COLOURS[kind]
+                    ]
+                    assert sum(points) == int(np.sum(regime == int(kind))) > 0
+        assert "exact Jacobians" in drawn.caption and "perturbed" in drawn.caption and "0.01" in drawn.caption
+    finally:
         plt.close(drawn.figure)

@@ -50,7 +50,7 @@ def test_stepped_page_has_responses_simulations_peaks_agreement_and_reduction_fa
     assert _names(sections["Resonance peaks against the restitution"]) == (["peaks_vs_restitution"], ["Resonance peaks of |X1| against the restitution: values"])
     figures, _ = _names(sections["Frequency responses, Delta = 3 mm"])
     assert figures == ["x2_amplitude", "x1_amplitude", "force_amplitude", "suspension_force_amplitude", "impulse", "regime", "stability", "peak_acceleration"]
-    assert _names(sections["Simulations against the closed form, Delta = 3 mm"])[0] == [f"simulation_{q}" for q in ("x1_amplitude", "x2_amplitude", "force_amplitude", "impulse")]
+    assert _names(sections["Simulations against the closed form, Delta = 3 mm"])[0] == [f"simulation_{q}" for q in ("x1_amplitude", "x2_amplitude", "force_amplitude", "impulse")] + ["lyapunov"]
     assert [t.title for t in sections["Reduction factors"].tables] == [f"Reduction factors: {q}" for q in ("|X1| fundamental", "|F| on the base", "|F| through the suspension", "|X2| fundamental")]
 
 

@@ -86,8 +86,12 @@ def _fake_simulation(closed: xr.Dataset, engine: str, offset: float) -> xr.Datas
         part[name] = values.where(on & ~failed)
     impact = part["impulse"] > 0.0
     regime = xr.where(impact, int(Regime.ONE_IMPACT), int(Regime.LINEAR))
-    regime = xr.where(irregular, int(Regime.IRREGULAR), regime)
+    chaotic = irregular & mask(f < 36.0)  # 34-36 Hz chaotic, 36-38 Hz quasi-periodic (their evidence below)
+    regime = xr.where(irregular, int(Regime.QUASI_PERIODIC), regime)
+    regime = xr.where(chaotic, int(Regime.CHAOTIC), regime)
     regime = xr.where(failed, int(Regime.FAILED), regime)
+    part["lyapunov_exponent"] = xr.where(irregular, xr.where(chaotic, 0.08, 0.001), np.nan)
+    part["lyapunov_error"] = xr.where(irregular, xr.where(chaotic, 0.005, 0.002), np.nan)
     part["regime"] = xr.where(on, regime, int(Regime.NOT_COMPUTED)).astype(np.int8).assign_attrs(regime_attributes())
     part["converged"] = xr.where(on, xr.where(irregular, 0, 1), -1).astype(np.int8)
     part["impacts_per_period"] = xr.where(on & ~failed, xr.where(impact, 1.0, 0.0), np.nan)
@@ -224,6 +228,7 @@ def _builders() -> dict[str, Callable[[], list[Any]]]:
     """Every kind of report figure, each built from a tiny dataset: name -> () -> list of DrawnFigure."""
     from vibroimpact.reporting.accuracy_page import accuracy_figures
     from vibroimpact.reporting.bumper_page import peak_acceleration_figure, peak_figure, stiffness_figure
+    from vibroimpact.reporting.motion_figure import lyapunov_figure
     from vibroimpact.reporting.responses import linear_figure, regime_figure, response_figure, simulation_figure, stability_figure
     from vibroimpact.scene.schema import ENGINE_SOLUTIONS
     from vibroimpact.reporting.sweep_page import sweep_figures, swept_sine_run
@@ -247,11 +252,12 @@ def _builders() -> dict[str, Callable[[], list[Any]]]:
         "sweep": lambda: sweep_figures(swept_dataset(), swept_sine_run(swept_dataset(), setting_of(swept_dataset()))),
         "stiffness": lambda: [stiffness_figure(stiffness_dataset(), setting_of(stiffness_dataset()), "stiffness")],
         "work_precision": lambda: accuracy_figures(benchmark_dataset()),
+        "lyapunov": lambda: [lyapunov_figure(steady(), ["momentary", "exact"], "lyapunov")],
     }
 
 
 #: Names of :func:`build` figure kinds, for parametrised tests.
-FIGURE_KINDS = ("linear", "response_x1", "response_force", "response_impulse", "response_pgf_compliant", "regime", "regime_one_row", "stability", "simulation_x1", "simulation_impulse", "peak_acceleration", "peaks_vs_restitution", "sweep", "stiffness", "work_precision")
+FIGURE_KINDS = ("linear", "response_x1", "response_force", "response_impulse", "response_pgf_compliant", "regime", "regime_one_row", "stability", "simulation_x1", "simulation_impulse", "peak_acceleration", "peaks_vs_restitution", "sweep", "stiffness", "work_precision", "lyapunov")
 
 
 def build(kind: str) -> list[Any]:

@@ -2,7 +2,8 @@
 
 Every figure and table reads the dataset of :func:`vibroimpact.benchmarks.accuracy.run_benchmark` (dimensions case, engine,
 rtol), and the model-cost ladder when the scene asked for one. Wall times are medians of several runs, all measured
-in one process run: read ratios, not seconds.
+in one process run: read ratios, not seconds. Engines without a tolerance (the dataset's ``tolerance_free_engines``)
+were run once per case and are shown once.
 """
 
 from __future__ import annotations
@@ -14,10 +15,11 @@ import numpy as np
 import xarray as xr
 
 from vibroimpact.benchmarks.accuracy import equal_error_speedup, loosest_tolerance
+from vibroimpact.engines.settings import STEPPED_TOLERANCES
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.reporting.style import Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour
 
-__all__ = ["AccuracyPage", "accuracy_figures", "accuracy_tables", "TARGETS"]
+__all__ = ["AccuracyPage", "accuracy_figures", "accuracy_tables", "per_period_table", "TARGETS"]
 
 #: X1-fundamental accuracies the guidance is given for [-].
 TARGETS = (1e-3, 1e-6)
@@ -28,6 +30,13 @@ _REFERENCES = {
     "compliant_cvode_adams": ("reference: CVODE Adams 1e-13", "CVODE Adams at rtol 1e-13 (compliant model)"),
 }
 _ERRORS = (("x1_error", "relative error of the X1 fundamental [1]"), ("impact_time_error", "largest impact-time error [s]"))
+#: The integrator shown in the per-period table, at the default rtol of stepped steady states.
+_INTEGRATOR = "momentary_adams"
+
+
+def _tolerance_free(dataset: xr.Dataset) -> set[str]:
+    """Methods run once per case (no tolerance), their one run stored at every rtol."""
+    return set(str(dataset.attrs.get("tolerance_free_engines", "")).split())
 
 
 class AccuracyPage:
@@ -66,6 +75,9 @@ def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
             ax = axes[2 * j + column]
             for k, method in enumerate(methods):
                 line = dataset.sel(case=case, engine=method)
+                if method in _tolerance_free(dataset):
+                    line = line.isel(rtol=[0])
+                    caption.add("free", f"{', '.join(sorted(_tolerance_free(dataset)))}: no tolerance, one run (one point).")
                 wall, error = line["wall_time"].values, line[quantity].values
                 if not np.isfinite(wall).any():
                     continue
@@ -95,6 +107,8 @@ def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
 def accuracy_tables(dataset: xr.Dataset) -> list[Table]:
     """The answer (cheapest way to each target), tolerance guidance, the ladder, and every measured point."""
     tables = [Table("Cheapest way to the X1 fundamental within a target", _answer_table(dataset)), Table("Tolerance guidance: loosest rtol meeting each target", _guidance_table(dataset))]
+    if "floor_time_per_period" in dataset:
+        tables.insert(0, Table("Cost per period: the exact engine against its floor, the pure-Python loop and momentary", per_period_table(dataset)))
     if "momentary_adams" in dataset["engine"].values:
         tables.append(Table("momentary (Adams) against exact and against solve_ivp at equal impact-time error", _equal_error_table(dataset)))
     if "model" in dataset.dims:
@@ -128,7 +142,7 @@ def _answer_table(dataset: xr.Dataset) -> str:
         # one model per comparison: the rigid stop on stepped cases (compliant runs answer another question), the
         # compliant model on swept ones
         swept = math.isnan(exact)
-        ours = [m for m in methods if m.startswith("compliant") == swept and not m.startswith("solve_ivp")]
+        ours = [m for m in methods if m.startswith("compliant") == swept and not m.startswith("solve_ivp") and m not in _tolerance_free(dataset)]
         for target in TARGETS:
             name, rtol, wall = _cheapest(dataset, str(case), target, ours)
             other, other_rtol, other_wall = _cheapest(dataset, str(case), target, ivp)
@@ -154,12 +168,14 @@ def _guidance_table(dataset: xr.Dataset) -> str:
     """Per method: the loosest rtol meeting each target in each case, and its wall time [s] (HTML)."""
     header = "<tr><th>engine</th>" + "".join(f"<th>{case}: rtol for {fmt(t, 'g')}</th>" for case in dataset["case"].values for t in TARGETS) + "</tr>"
     rows = [header]
+    free = _tolerance_free(dataset)
     for method in dataset["engine"].values:
         cells = []
         for case in dataset["case"].values:
             for target in TARGETS:
                 rtol, wall = loosest_tolerance(dataset, str(case), str(method), target)
-                cells.append(f"<td>{fmt(rtol, 'g')}{fmt(wall, '.3g', ' ({} s)')}</td>")
+                text = ("none needed" if math.isfinite(rtol) else "") if method in free else fmt(rtol, "g")
+                cells.append(f"<td>{text}{fmt(wall, '.3g', ' ({} s)')}</td>")
         rows.append(f"<tr><td>{method}</td>{''.join(cells)}</tr>")
     return "<table>" + "".join(rows) + "</table>"
 
@@ -225,13 +241,14 @@ def _estimate_table(results: Path = Path("results")) -> str:
 def _points_table(dataset: xr.Dataset, case: str) -> str:
     """Every measured point of ``case``: cost, impacts found and missed, errors (HTML)."""
     rows = ["<tr><th>method</th><th>rtol</th><th>wall [s]</th><th>steps</th><th>rhs calls</th><th>impacts</th><th>missed</th><th>extra</th><th>X1 error</th><th>impact-time error [s]</th><th>impulse error</th></tr>"]
+    free = _tolerance_free(dataset)
     for method in dataset["engine"].values:
-        for tolerance in dataset["rtol"].values:
+        for tolerance in dataset["rtol"].values[:1] if method in free else dataset["rtol"].values:
             p = dataset.sel(case=case, engine=method, rtol=tolerance)
             if not np.isfinite(float(p["wall_time"])):
                 continue
             rows.append(
-                f"<tr><td>{method}</td><td>{fmt(tolerance, 'g')}</td><td>{fmt(p['wall_time'], '.4f')}</td><td>{fmt(p['steps'], '.0f')}</td><td>{fmt(p['rhs_calls'], '.0f')}</td>"
+                f"<tr><td>{method}</td><td>{'none' if method in free else fmt(tolerance, 'g')}</td><td>{fmt(p['wall_time'], '.4f')}</td><td>{fmt(p['steps'], '.0f')}</td><td>{fmt(p['rhs_calls'], '.0f')}</td>"
                 f"<td>{fmt(p['impacts'], '.0f')}</td><td>{fmt(p['missed_impacts'], '.0f')}</td><td>{fmt(p['extra_impacts'], '.0f')}</td><td>{fmt(p['x1_error'], '.2e')}</td>"
                 f"<td>{fmt(p['impact_time_error'], '.2e')}</td><td>{fmt(p['impulse_error'], '.2e')}</td></tr>"
             )
@@ -240,3 +257,44 @@ def _points_table(dataset: xr.Dataset, case: str) -> str:
         if math.isfinite(wall):
             rows.append(f"<tr><td>reference: {reference}</td><td></td><td>{fmt(wall, '.4f')}</td><td></td><td></td><td>{fmt(dataset['reference_impacts'].sel(case=case, reference=reference), '.0f')}</td><td>0</td><td>0</td><td>0</td><td>0</td><td>0</td></tr>")
     return "<table>" + "".join(rows) + "</table>"
+
+
+def per_period_table(dataset: xr.Dataset) -> str:
+    """Per stepped case: microseconds per excitation period of the exact engine, of its floor (the compiled kernel
+    alone, with and without the moments), of ``exact_python`` and of ``momentary_adams`` at the default rtol, and the
+    ratios exact_python / exact and exact / floor (HTML)."""
+    rtol = STEPPED_TOLERANCES[0]
+    rows = [
+        "<tr><th>case</th><th>frequency [Hz]</th><th>periods</th><th>exact (compiled) [us/period]</th><th>floor: its kernel alone [us/period]</th>"
+        "<th>kernel without moments [us/period]</th><th>exact_python [us/period]</th>"
+        f"<th>{_INTEGRATOR} at rtol {fmt(rtol, 'g')} [us/period]</th><th>exact_python / exact</th><th>exact / floor</th></tr>"
+    ]
+    engines = [str(m) for m in dataset["engine"].values]
+
+    def engine_cost(case: str, method: str) -> float:
+        if method not in engines or not any(np.isclose(float(r), rtol, rtol=1e-9, atol=0.0) for r in dataset["rtol"].values):
+            return math.nan
+        return 1e6 * float(dataset["time_per_period"].sel(case=case, engine=method).sel(rtol=rtol, method="nearest"))
+
+    for case in dataset["case"].values:
+        exact, floor = 1e6 * float(dataset["reference_time_per_period"].sel(case=case)), 1e6 * float(dataset["floor_time_per_period"].sel(case=case))
+        if not math.isfinite(exact):
+            continue  # a swept case: no exact reference
+        bare = 1e6 * float(dataset["floor_no_moments_time_per_period"].sel(case=case)) if "floor_no_moments_time_per_period" in dataset else math.nan
+        python, integrator = engine_cost(str(case), "exact_python"), engine_cost(str(case), _INTEGRATOR)
+        frequency = dataset.attrs.get(f"case_{case}_frequency_Hz", math.nan)
+        rows.append(
+            f"<tr><td>{case}</td><td>{fmt(frequency, 'g')}</td><td>{fmt(dataset['periods'].sel(case=case), '.0f')}</td><td>{fmt(exact, '.2f')}</td>"
+            f"<td>{fmt(floor, '.2f')}</td><td>{fmt(bare, '.2f')}</td><td>{fmt(python, '.1f')}</td><td>{fmt(integrator, '.1f')}</td>"
+            f"<td>{fmt(python / exact, '.0f', '{}x')}</td><td>{fmt(exact / floor, '.2f', '{}x')}</td></tr>"
+        )
+    note = (
+        "<p>Wall time of one run of the case divided by its periods, in microseconds; every number, and so every ratio, "
+        "measured in one process run (median of the repeated runs; shared machines are noisy: read the ratios, not the "
+        "microseconds). exact: the compiled engine as studies call it (its Python face included), with the per-period "
+        "Fourier moments the benchmark's X1 needs. Floor: its compiled kernel (exact_core.run_periods) alone on the same "
+        "run with the arguments the engine prepares, prepared once and untimed; exact / floor is what the Python face adds. "
+        "Without moments: the kernel computing strobes, impacts and segments only. exact_python: the same algorithm in "
+        "pure Python (it has no tolerance: one run).</p>"
+    )
+    return "<table>" + "".join(rows) + "</table>" + note

@@ -109,7 +109,7 @@ def draw_points(ax: Axes, x: np.ndarray, y: np.ndarray, *, periodic: np.ndarray,
     colour : str
         Marker colour.
     label : str or None
-        Legend entry (", periodic" and ", irregular" are appended; None: none).
+        Legend entry (", periodic" and ", not periodic" are appended; None: none).
 
     Returns
     -------
@@ -126,7 +126,7 @@ def draw_points(ax: Axes, x: np.ndarray, y: np.ndarray, *, periodic: np.ndarray,
     if periodic.any():
         ax.plot(x[periodic], y[periodic], marker, ls="none", color=colour, mfc=colour, ms=size, zorder=zorder, label=f"{label}, periodic" if label else "_nolegend_", gid=solution)
     if irregular.any():
-        ax.plot(x[irregular], y[irregular], marker, ls="none", color=colour, mfc="none", mew=1.1, ms=size, zorder=zorder, label=f"{label}, irregular" if label else "_nolegend_", gid=solution)
+        ax.plot(x[irregular], y[irregular], marker, ls="none", color=colour, mfc="none", mew=1.1, ms=size, zorder=zorder, label=f"{label}, not periodic" if label else "_nolegend_", gid=solution)
     return bool(periodic.any()), bool(irregular.any())
 
 
@@ -158,13 +158,13 @@ class SimulationMarkers:
             if periodic:
                 keys.append(Line2D([], [], marker=marker, ls="none", color="k", ms=size, label=f"{solution_ref(solution)}, periodic"))
             if irregular:
-                keys.append(Line2D([], [], marker=marker, ls="none", color="k", mfc="none", ms=size, label=f"{solution_ref(solution)}, irregular"))
+                keys.append(Line2D([], [], marker=marker, ls="none", color="k", mfc="none", ms=size, label=f"{solution_ref(solution)}, not periodic"))
         return keys
 
     def phrase(
         self,
         periodic: str = "periodic steady state (the stroboscopic state repeated)",
-        irregular: str = "irregular motion, averaged over the measured periods",
+        irregular: str = "not periodic (quasi-periodic, chaotic or undecided: the regime map says which), averaged over the measured periods",
         each: str = "one marker per simulated frequency",
     ) -> str:
         """Caption sentence: the simulations drawn, their shapes, what each marker is, and what filled and hollow mean

@@ -13,6 +13,7 @@ from typing import Iterator
 import xarray as xr
 
 from vibroimpact.reporting.bumper_page import peak_acceleration_figure, peak_figure, peak_tables
+from vibroimpact.reporting.motion_figure import lyapunov_figure
 from vibroimpact.reporting.page import DrawnFigure, Section, saved
 from vibroimpact.reporting.responses import SolutionsPage, clearance_text, linear_section, regime_figure, response_figure, simulation_figure, stability_figure
 from vibroimpact.reporting.tables import agreement_table, reduction_intro, reduction_tables
@@ -61,8 +62,8 @@ def _response_sections(dataset: xr.Dataset, out: Path) -> list[Section]:
         sections.append(Section(f"Frequency responses{where}", figures=saved(_response_figures(part, tag), out)))
         engines = [str(name) for name in part["solution"].values if name in ENGINE_SOLUTIONS]
         if engines:
-            simulations = (simulation_figure(part, quantity, engines, f"simulation_{quantity}{tag}") for quantity in SIMULATION_QUANTITIES if quantity in part)
-            sections.append(Section(f"Simulations against the closed form{where}", figures=saved(simulations, out)))
+            simulations = [simulation_figure(part, quantity, engines, f"simulation_{quantity}{tag}") for quantity in SIMULATION_QUANTITIES if quantity in part]
+            sections.append(Section(f"Simulations against the closed form{where}", figures=saved(simulations + [lyapunov_figure(part, engines, f"lyapunov{tag}")], out)))
     return sections
 
 

@@ -91,6 +91,7 @@ QUANTITIES: dict[str, Quantity] = {
     "peak_acceleration": Quantity("peak contact deceleration", "m s-2", "largest deceleration of the absorber on the bumper", False),
     "peak_contact_force": Quantity("peak contact force", "N", "largest bumper force", False),
     "floquet_modulus": Quantity("largest |Floquet multiplier|", "1", "largest modulus of the Floquet multipliers of the one-impact orbit", True),
+    "lyapunov_exponent": Quantity("largest Lyapunov exponent", "1/period", "largest Lyapunov exponent of the stroboscopic map, per excitation period", False),
 }
 
 
