@@ -109,3 +109,26 @@ def test_lyapunov_figure_draws_every_non_periodic_point_in_the_colour_of_its_kin
         assert "exact Jacobians" in drawn.caption and "perturbed" in drawn.caption and "0.01" in drawn.caption
     finally:
         plt.close(drawn.figure)
+
+
+def test_agreement_table_counts_each_kind_of_non_periodic_motion() -> None:
+    """The fake simulations are chaotic over 34-36 Hz and quasi-periodic over 36-38 Hz (band 2): the table counts them."""
+    import html as html_module
+
+    from vibroimpact.reporting.record import study_setting
+    from vibroimpact.reporting.tables import agreement_table
+
+    dataset = steady_dataset()
+    split = study_setting(dataset).split_frequency
+    table = agreement_table(dataset, study_setting(dataset))
+    assert table is not None
+    rows = [[html_module.unescape(re.sub("<[^>]+>", "", c)).strip() for c in re.findall(r"<t[dh][^>]*>(.*?)</t[dh]>", r, re.S)] for r in re.findall(r"<tr>(.*?)</tr>", table.html, re.S)]
+    header, body = rows[0], rows[1:]
+    quasi, chaotic = header.index("simulation quasi-periodic"), header.index("chaotic")
+    for row in body:
+        engine, r, band = row[0], float(row[2]), row[3]
+        regime = dataset["regime"].sel(solution=engine, restitution=r).values
+        in_band = (dataset["frequency"].values >= split) if band == "2" else (dataset["frequency"].values < split)
+        assert int(row[quasi]) == int(np.sum((regime == int(Regime.QUASI_PERIODIC)) & in_band))
+        assert int(row[chaotic]) == int(np.sum((regime == int(Regime.CHAOTIC)) & in_band))
+    assert any(int(row[chaotic]) > 0 for row in body) and any(int(row[quasi]) > 0 for row in body)

@@ -106,7 +106,7 @@ def agreement_table(dataset: xr.Dataset, setting: StudySetting) -> Table | None:
     split = setting.split_frequency
     header = _header(
         "band", "computed points", "max rel. diff. |X1|, pgf stable or linear", "median", "pgf unstable: points", "max rel. diff. there",
-        "simulation irregular", "simulation with other than 1 or 0 impacts per period",
+        "simulation quasi-periodic", "chaotic", "not periodic, undecided", "simulation with other than 1 or 0 impacts per period",
     )
     body = []
     for engine in engines:
@@ -121,7 +121,8 @@ def agreement_table(dataset: xr.Dataset, setting: StudySetting) -> Table | None:
                 unstable = line["regime"].sel(solution="pgf").values == Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT
                 if "stable" in line:
                     unstable = unstable | (line["stable"].sel(solution="pgf").values == 0)
-                irregular = line["converged"].sel(solution=engine).values == 0 if "converged" in line else np.zeros(sim.shape, bool)
+                regime = line["regime"].sel(solution=engine).values
+                kinds = [regime == int(kind) for kind in (Regime.QUASI_PERIODIC, Regime.CHAOTIC, Regime.IRREGULAR)]
                 other = ~np.isin(line["impacts_per_period"].sel(solution=engine).values, (0.0, 1.0)) if "impacts_per_period" in line else np.zeros(sim.shape, bool)
                 with np.errstate(invalid="ignore", divide="ignore"):
                     difference = np.abs(sim - pgf) / np.abs(pgf)
@@ -131,7 +132,9 @@ def agreement_table(dataset: xr.Dataset, setting: StudySetting) -> Table | None:
                     body.append(
                         f"<tr><td>{engine}</td><td>{fmt(float(delta) * 1e3, 'g')}</td><td>{fmt(r, 'g')}</td><td>{band}</td><td>{int(mask.sum())}</td>"
                         f"<td>{fmt(_largest(difference[good]), '.1e')}</td><td>{fmt(np.median(difference[good]) if good.any() else np.nan, '.1e')}</td>"
-                        f"<td>{int(bad.sum())}</td><td>{fmt(_largest(difference[bad]), '.1e')}</td><td>{int((irregular & mask).sum())}</td><td>{int((other & mask).sum())}</td></tr>"
+                        f"<td>{int(bad.sum())}</td><td>{fmt(_largest(difference[bad]), '.1e')}</td>"
+                        + "".join(f"<td>{int((kind & mask).sum())}</td>" for kind in kinds)
+                        + f"<td>{int((other & mask).sum())}</td></tr>"
                     )
     return Table("Simulation against PGF by band (|X1| fundamental)", f"<table>{header}{''.join(body)}</table>")
 
