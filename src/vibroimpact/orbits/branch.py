@@ -24,6 +24,7 @@ __all__ = [
     "SpecialPoint",
     "Branch",
     "SPECIAL_POINT_KINDS",
+    "lower_period_maps",
 ]
 
 #: Kinds of special points, in the order of the CF flags of the output contract.
@@ -160,6 +161,27 @@ class Iterated:
         return MapEvaluation(out.image, jacobian, dp, hybrid)
 
 
+def lower_period_maps(system: ParametrisedMap) -> list[tuple[int, ParametrisedMap]]:
+    """The maps over each proper divisor d of ``system``'s period, largest d first: (d, P^d).
+
+    ``system`` is a map of K underlying periods: ``Iterated(P, t)`` (K = t, or t times P's own ``periods`` when P
+    has a ``with_periods`` method, as :class:`vibroimpact.orbits.maps.ImpactMap`), or such a map P itself. A fixed
+    point of P^K that is also one of P^d has the smaller period d. Empty when K = 1.
+    """
+    base, times = (system.base, system.times) if isinstance(system, Iterated) else (system, 1)
+    unit = int(getattr(base, "periods", 1)) if hasattr(base, "with_periods") else 1
+    total = times * unit
+    out: list[tuple[int, ParametrisedMap]] = []
+    for d in range(total // 2, 0, -1):
+        if total % d:
+            continue
+        if hasattr(base, "with_periods"):
+            out.append((d, base.with_periods(d)))
+        elif d % unit == 0:
+            out.append((d, Iterated(base, d // unit) if d // unit > 1 else base))
+    return out
+
+
 @dataclass(frozen=True, eq=False)
 class PeriodicOrbit:
     """A fixed point of ``P^k``: a period-k orbit of the underlying system.
@@ -267,7 +289,8 @@ class Branch:
         Located folds, period doublings, Neimark-Sacker and grazing points, in order of arclength.
     end : str
         Why the continuation stopped: 'bound', 'grazing', 'max_steps', 'closed' (the branch returned to its start),
-        'step_too_small', 'parent' (a period-2k branch reached the period doubling of its period-k parent).
+        'step_too_small', 'parent' (a period-K branch reached the lower-period orbit it was born from: the period
+        doubling of its period-K/2 parent, or a K/d-tupling of a period-d orbit).
     """
 
     parameter: str

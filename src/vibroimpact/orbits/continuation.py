@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from vibroimpact.model.validation import require_in_range, require_positive
 from vibroimpact.orbits.arclength import ArclengthSystem, Point
 from vibroimpact.orbits.bifurcations import classify, grazing_margin, locate, locate_grazing, neimark_sacker_test, period_doubling_test
-from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Branch, Iterated, ParametrisedMap, PeriodicOrbit, SpecialPoint
+from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Branch, ParametrisedMap, PeriodicOrbit, SpecialPoint, lower_period_maps
 
 __all__ = ["ContinuationSettings", "continue_branch"]
 
@@ -98,6 +98,7 @@ class _Walker:
         self.arc = ArclengthSystem(system, orbit.parameters, (index,))
         self.n = system.dimension
         self.specials: list[tuple[float, SpecialPoint]] = []
+        self.lower = lower_period_maps(system)
 
     def tolerance(self, point: Point) -> float:
         """Arclength bracket that gives the parameter to locate_tolerance relative."""
@@ -131,11 +132,13 @@ class _Walker:
             self.specials.append((arclength + float(a.tangent @ (best.z - a.z)), found))
 
     def _collapsed(self, point: Point) -> bool:
-        """Is this fixed point of P^k (k even) a fixed point of P^(k/2): the period-doubling point of its parent?"""
-        if not isinstance(self.system, Iterated) or self.system.times % 2:
-            return False
-        half = Iterated(self.system.base, self.system.times // 2).evaluate(point.y, point.p).image
-        return bool(np.max(np.abs(half - point.y) / self.arc.sy) < 1e-3)  # amplitude ~ sqrt(parameter distance)
+        """Is this fixed point of P^K also one of P^d for a proper divisor d of K: the branch meets the lower-period
+        orbit it was born from (a period doubling, or a k-tupling where a multiplier is a k-th root of unity)?"""
+        for _d, lower in self.lower:
+            image = lower.evaluate(point.y, point.p).image
+            if np.max(np.abs(image - point.y) / self.arc.sy) < 1e-3:  # amplitude ~ sqrt(parameter distance)
+                return True
+        return False
 
     def grazing(self, a: Point, sigma: float, arclength: float, hint: Point | None = None) -> object:
         """Locate a grazing point between a and sigma; return the point beyond it (None: the branch ends there)."""
@@ -248,6 +251,9 @@ class _Walker:
             self.detect(a, values_a, b, values_b, sigma, arclength)
             if self.parent is not None:
                 points.append(self.parent)
+                return points, "parent"
+            if self.lower and self._collapsed(b):  # on the lower-period orbit without a fold (a k-tupling): stop
+                points.append(b)
                 return points, "parent"
             arclength += sigma
             if len(points) > 3:

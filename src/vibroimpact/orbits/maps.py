@@ -28,7 +28,7 @@ from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import HybridInfo, MapEvaluation, PeriodicOrbit
 
-__all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "one_impact_state", "with_impulse", "section_phase", "PARAMETERS"]
+__all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "one_impact_state", "with_impulse", "section_phase", "resection", "PARAMETERS"]
 
 #: The parameters of an :class:`ImpactMap`, in order, with their units.
 PARAMETERS = {"frequency": "Hz", "restitution": "1", "clearance": "m", "amplitude": "N"}
@@ -210,3 +210,31 @@ def section_phase(problem: ImpactProblem, frequencies: NDArray[np.float64]) -> f
     gaps = np.diff(np.concatenate([points, [points[0] + 1.0]]))
     k = int(np.argmax(gaps))
     return float(2.0 * np.pi * ((points[k] + 0.5 * gaps[k]) % 1.0))
+
+
+def resection(problem: ImpactProblem, state: NDArray[np.float64], periods: int, engine: ExactEngine | None = None) -> tuple[ImpactProblem, NDArray[np.float64]]:
+    """The same motion seen through a strobe away from its impacts.
+
+    ``state`` is the state at t = 0 of ``problem`` on (or near) an orbit of ``periods`` excitation periods, e.g. the
+    end of a brute-force run. The motion is integrated over ``periods`` periods; the impact instants modulo T leave
+    gaps, and the new strobe goes in the middle of the widest: at tau = g T, i.e. the problem with force phase
+    phase + 2 pi g, whose t = 0 is the old t = tau. An :class:`ImpactMap` of that problem has the orbit as a fixed
+    point of a map that is smooth near it (no impact crosses its strobe).
+
+    Returns
+    -------
+    (ImpactProblem, ndarray)
+        The problem with the new force phase [rad], and the state (X1, X2, X1', X2') at its t = 0.
+    """
+    engine = engine if engine is not None else ExactEngine()
+    run = engine.integrate(problem, np.asarray(state, dtype=float), 0.0, int(periods))
+    fractions = np.sort((run.impact_times / problem.period) % 1.0)
+    if fractions.size == 0:
+        return problem, np.asarray(state, dtype=float).copy()
+    gaps = np.diff(np.concatenate([fractions, [fractions[0] + 1.0]]))
+    k = int(np.argmax(gaps))
+    g = float((fractions[k] + 0.5 * gaps[k]) % 1.0)
+    moved = engine.dense(run, np.array([g * problem.period]))[0]
+    phase = float((problem.phase + 2.0 * np.pi * g) % (2.0 * np.pi))
+    base = problem
+    return ImpactProblem(base.system, base.contact, HarmonicForce(base.amplitude, base.frequency, phase)), np.asarray(moved, dtype=float)

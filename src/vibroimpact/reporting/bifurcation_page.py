@@ -21,14 +21,18 @@ from matplotlib.patches import Patch
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure
 
-__all__ = ["BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class"]
+__all__ = ["BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class", "orbit_colours"]
 
 #: Brute-force dots of each sweep direction.
 SWEEP_COLOURS = {"up": "C3", "down": "C2"}
 #: Marker of each kind of special point.
 SPECIAL_MARKERS = {"fold": "o", "period_doubling": "s", "neimark_sacker": "D", "grazing": "^"}
-#: Colour of an orbit by (impacts per orbit period, period multiplicity); others: grey.
+#: Colour of an orbit by (impacts per orbit period, period multiplicity); other classes take :data:`EXTRA_COLOURS`.
 ORBIT_COLOURS = {(0, 1): "k", (1, 1): "C0", (2, 2): "C1", (1, 2): "C4", (2, 1): "C5", (3, 3): "C6", (4, 4): "C8"}
+#: Colours of the other classes of orbits (seeded from the brute force: periods up to 32), in order of period; none is
+#: a colour of :data:`ORBIT_COLOURS` or of the brute-force dots.
+EXTRA_COLOURS = ("#17becf", "#bcbd22", "#393b79", "#637939", "#8c6d31", "#843c39", "#7b4173", "#636363", "#e7ba52", "#5254a3",
+                 "#a55194", "#b5cf6b", "#6b6ecf", "#bd9e39", "#de9ed6", "#9c9ede")  # fmt: skip
 #: Colours of the regime map's classes (failed, linear, one_impact, other_periodic, quasi_periodic, chaotic, irregular).
 REGIME_COLOURS = ("#ffffff", "#d9d9d9", "#9ecae1", "#a1d99b", "#fdae6b", "#e6550d", "#bcbddc")
 _FREQUENCY = "excitation frequency [Hz]"
@@ -39,6 +43,22 @@ MODULUS_TOP = 20.0
 def orbit_class(impacts_per_period: float, period: int) -> tuple[int, int]:
     """(impacts per orbit period, period multiplicity) of an orbit."""
     return int(round(impacts_per_period * period)), int(period)
+
+
+def orbit_colours(dataset: xr.Dataset) -> dict[tuple[int, int], str]:
+    """A colour for every class of orbit in ``dataset`` (the same in every figure): :data:`ORBIT_COLOURS`, then the
+    other classes in order of period and impacts from :data:`EXTRA_COLOURS` (cycling)."""
+    classes = sorted({orbit_class(float(i), int(p)) for i, p in zip(dataset["impacts_per_period"].values, dataset["period_multiplicity"].values)}, key=lambda k: (k[1], k[0]))
+    colours = dict(ORBIT_COLOURS)
+    extra = [k for k in classes if k not in colours]
+    for n, key in enumerate(extra):
+        colours[key] = EXTRA_COLOURS[n % len(EXTRA_COLOURS)]
+    return colours
+
+
+def _class_legend(colours: dict[tuple[int, int], str], classes: set[tuple[int, int]]) -> list[Line2D]:
+    """A solid line per class drawn, in order of period and impacts (stability is told by the line style)."""
+    return [Line2D([], [], color=colours[k], lw=1.6, label=_orbit_label(k)) for k in sorted(classes, key=lambda k: (k[1], k[0]))]
 
 
 def _orbit_label(key: tuple[int, int]) -> str:
@@ -60,6 +80,13 @@ def _branches(dataset: xr.Dataset, restitution: float) -> Iterator[tuple[int, xr
         yield int(label), part.isel(branch_point=np.flatnonzero(part["branch"].values == label))
 
 
+def _classes(dataset: xr.Dataset, restitution: float) -> list[tuple[int, int]]:
+    """The classes of orbit of one restitution's branches."""
+    mask = np.isclose(dataset["branch_restitution"].values, restitution)
+    pairs = zip(dataset["impacts_per_period"].values[mask], dataset["period_multiplicity"].values[mask])
+    return sorted({orbit_class(float(i), int(p)) for i, p in pairs})
+
+
 def _draw_branch(ax: Axes, frequency: np.ndarray, values: np.ndarray, stable: np.ndarray, colour: str, label: str) -> None:
     """A branch line, solid where stable, dashed where unstable; each change of stability drawn on both sides."""
     change = np.flatnonzero(np.diff(stable.astype(int))) + 1
@@ -74,7 +101,8 @@ def _draw_branch(ax: Axes, frequency: np.ndarray, values: np.ndarray, stable: np
 
 def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> DrawnFigure:
     """The bifurcation diagram of one restitution: X1 amplitude and impact velocities against frequency."""
-    fig, (top, bottom) = new_figure(2, panel_height=4.2, columns=1, sharex=True, legend_rows=4)
+    keys = _classes(dataset, restitution)
+    fig, (top, bottom) = new_figure(2, panel_height=4.2, columns=1, sharex=True, legend_rows=legend_rows(len(keys) + 8, 5))
     classes: set[tuple[int, int]] = set()
     r_index = int(np.argmin(np.abs(dataset["restitution"].values - restitution)))
     for direction in dataset["sweep"].values:
@@ -84,14 +112,14 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
         top.scatter(np.repeat(f, amp.shape[1]), amp.ravel() * 1e3, s=1.5, color=SWEEP_COLOURS.get(str(direction), "C7"), alpha=0.6, lw=0, zorder=1)
         vel = brute["brute_impact_velocity"].values
         bottom.scatter(np.repeat(f, vel.shape[1]), vel.ravel(), s=1.5, color=SWEEP_COLOURS.get(str(direction), "C7"), alpha=0.6, lw=0, zorder=1)
+    colours = orbit_colours(dataset)
     for _label, branch in _branches(dataset, restitution):
         f = branch["branch_frequency"].values
         key = orbit_class(float(branch["impacts_per_period"].values[0]), int(branch["period_multiplicity"].values[0]))
-        colour = ORBIT_COLOURS.get(key, "0.5")
-        name = _orbit_label(key) if key not in classes else "_"
+        colour = colours.get(key, "0.5")
         classes.add(key)
         stable = branch["stable"].values == 1
-        _draw_branch(top, f, branch["x1_amplitude"].values * 1e3, stable, colour, name)
+        _draw_branch(top, f, branch["x1_amplitude"].values * 1e3, stable, colour, "_")
         velocities = branch["impact_velocity"].values
         for k in range(velocities.shape[1]):
             if np.isfinite(velocities[:, k]).any():
@@ -107,7 +135,7 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
     finish_axes(bottom, _FREQUENCY, "impact velocity [m/s]", f"R = {fmt(restitution, 'g')}: impact velocities")
     dots = [Line2D([], [], ls="", marker="o", ms=5, color=SWEEP_COLOURS.get(str(d), "C7"), label=f"brute force, sweep {d}") for d in dataset["sweep"].values]
     extra = [*dots, Line2D([], [], color="k", **STABLE_STYLE, label="stable"), Line2D([], [], color="k", **UNSTABLE_STYLE, label="unstable")]
-    figure_legend(fig, [top, bottom], extra, columns=5)
+    figure_legend(fig, [top, bottom], [*_class_legend(colours, classes), *extra], columns=5)
     caption = (
         f"Bifurcation diagram at R = {fmt(restitution, 'g')}, Delta = {fmt(float(dataset['clearance']) * 1e3, 'g')} mm. Dots: brute-force "
         f"time simulation (compiled exact engine) sweeping up (red) and down (green), the end state carried to the next frequency; "
@@ -125,21 +153,22 @@ def _specials(dataset: xr.Dataset, restitution: float) -> xr.Dataset:
 
 def multiplier_figure(dataset: xr.Dataset, restitution: float, index: int) -> DrawnFigure:
     """The largest Floquet multiplier modulus along every branch of one restitution (log scale)."""
-    fig, (ax,) = new_figure(1, panel_height=4.0, columns=1, legend_rows=2)
+    keys = [k for k in _classes(dataset, restitution) if k[0]]
+    fig, (ax,) = new_figure(1, panel_height=4.0, columns=1, legend_rows=legend_rows(len(keys) + 1, 5))
     seen: set[tuple[int, int]] = set()
+    colours = orbit_colours(dataset)
     for _label, branch in _branches(dataset, restitution):
         key = orbit_class(float(branch["impacts_per_period"].values[0]), int(branch["period_multiplicity"].values[0]))
         if key[0] == 0:
             continue
-        name = _orbit_label(key) if key not in seen else "_"
         seen.add(key)
-        _draw_branch(ax, branch["branch_frequency"].values, branch["floquet_modulus"].values, branch["stable"].values == 1, ORBIT_COLOURS.get(key, "0.5"), name)
+        _draw_branch(ax, branch["branch_frequency"].values, branch["floquet_modulus"].values, branch["stable"].values == 1, colours.get(key, "0.5"), "_")
     ax.axhline(1.0, color="k", lw=0.8)
     specials = _specials(dataset, restitution)
     ax.scatter(specials["special_point_frequency"], specials["special_point_floquet_modulus"], s=30, facecolor="none", edgecolor="k", zorder=5, label="special points")
     finish_axes(ax, _FREQUENCY, "largest |Floquet multiplier|", f"R = {fmt(restitution, 'g')}: stability along the branches", log=True)
     ax.set_ylim(0.2, MODULUS_TOP)
-    figure_legend(fig, [ax], columns=5)
+    figure_legend(fig, [ax], _class_legend(colours, seen), columns=5)
     caption = (f"Largest modulus of the Floquet multipliers along every impacting branch at R = {fmt(restitution, 'g')} (log scale, "
                f"clipped at {fmt(MODULUS_TOP, 'g')}: next to a grazing point the multipliers grow without bound): an orbit is stable below 1 (the horizontal line); solid stable, dashed unstable; circles: the special points.")  # fmt: skip
     return DrawnFigure(fig, f"multipliers_R{index}", f"Floquet multipliers, R = {fmt(restitution, 'g')}", caption)
@@ -174,8 +203,9 @@ def chart_figure(dataset: xr.Dataset) -> DrawnFigure:
         f"{dataset.sizes['map_frequency']} x {dataset.sizes['map_clearance']} grid (sweeping in frequency at each clearance, the end state "
         "carried over): linear motion, one impact per period, another periodic motion, or non-periodic motion (quasi-periodic, chaotic, or "
         "undecided: irregular) from the exact Lyapunov exponent. Lines: the fold, period-doubling and Neimark-Sacker points of the "
-        "one-impact branches continued in (frequency, clearance), and (dashed) the grazing curve q |H12| = Delta where the one-impact "
-        "orbit's impact velocity vanishes and the linear motion touches the stop; dotted: the clearance of the diagrams."
+        "one-impact branches continued in (frequency, clearance); dashed, the grazing curves: q |H12| = Delta where the one-impact "
+        "orbit's impact velocity vanishes and the linear motion touches the stop, and the points where a free flight of the one-impact "
+        "orbit touches the stop (located again at each clearance); dotted: the clearance of the diagrams."
     )
     return DrawnFigure(fig, "chart", f"Two-parameter chart, R = {fmt(r, 'g')}", caption)
 

@@ -11,7 +11,7 @@ Example (the shipped ``bifurcation``, shortened)::
       frequency: {start: 15.0, stop: 45.0}          # the band [Hz]
       restitution: [0.2, 0.8]
       brute_force: {step: 0.05, transient_periods: 300, strobes: 64, directions: [up, down]}
-      continuation: {one_impact: true, period_doubling: true, grazing: true, linear: true, max_steps: 2000}
+      continuation: {one_impact: true, period_doubling: true, grazing: true, linear: true, brute_force: true, max_steps: 2000}
       chart: {restitution: 0.2, clearance: {start: 0.001, stop: 0.006}, kinds: [fold, neimark_sacker, grazing]}
 
 Every key is checked (unknown keys, wrong types and out-of-range values are reported together, each naming its key).
@@ -46,7 +46,7 @@ BIFURCATION_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "
 CHART_KINDS = ("fold", "period_doubling", "neimark_sacker", "grazing")
 _KEYS = {"frequency", "restitution", "brute_force", "continuation", "chart"}
 _BRUTE_KEYS = {"step", "transient_periods", "strobes", "directions"}
-_BRANCH_KEYS = {"one_impact", "period_doubling", "grazing", "linear", "max_steps", "max_step"}
+_BRANCH_KEYS = {"one_impact", "period_doubling", "grazing", "linear", "brute_force", "max_steps", "max_step"}
 _CHART_KEYS = {"restitution", "clearance", "kinds", "max_steps", "frequency_step", "clearance_num", "transient_periods", "strobes"}
 #: Most brute-force periods of one scene (frequencies x restitutions x directions x periods per point).
 MAX_BRUTE_PERIODS = 50_000_000
@@ -93,6 +93,9 @@ class BranchSettings:
         Branches born at grazing points where an orbit with another (non-zero) impact count continues.
     linear : bool
         The impactless (linear) orbit wherever it fits inside the clearance (closed form).
+    brute_force : bool
+        Branches seeded from the brute force: where a sweep's strobes repeat with a period k on an orbit no other
+        branch passes through, that orbit continued as a fixed point of the k-period map.
     max_steps : int
         Most continuation steps per direction of a branch.
     max_step : float
@@ -103,6 +106,7 @@ class BranchSettings:
     period_doubling: bool = True
     grazing: bool = True
     linear: bool = True
+    brute_force: bool = True
     max_steps: int = 2000
     max_step: float = 0.1
 
@@ -286,7 +290,7 @@ def _brute_values(c: Checker, key: str, spec: dict) -> tuple[type, dict] | None:
 
 def _branch_values(c: Checker, key: str, spec: dict) -> tuple[type, dict] | None:
     kwargs: dict[str, Any] = {}
-    for flag in ("one_impact", "period_doubling", "grazing", "linear"):
+    for flag in ("one_impact", "period_doubling", "grazing", "linear", "brute_force"):
         if flag in spec:
             if not isinstance(spec[flag], bool):
                 c.fail(f"{key}.{flag}", f"expected true or false, got {spec[flag]!r}")

@@ -34,16 +34,19 @@ from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS
 from vibroimpact.scene.schema import Scene
 from vibroimpact.scene.variables import BIFURCATION_ATTRIBUTES, COORDINATE_ATTRIBUTES, STABLE_ATTRIBUTES, flag_attributes
 from vibroimpact.study.bifurcation_branches import MAX_ORBIT_IMPACTS, ORIGINS
-from vibroimpact.study.bifurcation_cases import MAX_KEPT_IMPACTS, MOTION_CLASSES, BranchCase, ChartCase, SweepCase
+from vibroimpact.study.bifurcation_cases import MAX_KEPT_IMPACTS, MAX_PERIOD, MOTION_CLASSES, BranchCase, ChartCase, SweepCase
+from vibroimpact.study.bifurcation_seeds import Seed, sweep_seeds
 from vibroimpact.study.cost_model import Costs, Estimate
 from vibroimpact.study.grid import Progress
 from vibroimpact.study.io import provenance
 from vibroimpact.study.runner import CaseResult, run_cases
 
-__all__ = ["BifurcationStudy", "CONTINUATION_SECONDS", "CHART_SECONDS", "REPORT_FIGURES"]
+__all__ = ["BifurcationStudy", "CONTINUATION_SECONDS", "CLOSED_FORM_SECONDS", "CHART_SECONDS", "REPORT_FIGURES"]
 
-#: Wall time of the continuation of one restitution's branches on the calibration machine [s] (measured: 1.8-2.3 s).
-CONTINUATION_SECONDS = 3.0
+#: Wall time of the continuation of one restitution's branches on the calibration machine [s], with the branches
+#: seeded from the brute force (measured: 11-15 s for R = 0.2 and 0.8 at load ~2), and without (1.8-2.3 s).
+CONTINUATION_SECONDS = 13.0
+CLOSED_FORM_SECONDS = 3.0
 #: Wall time of the chart's curves on the calibration machine [s] (measured: ~15 s).
 CHART_SECONDS = 20.0
 #: Figures of the report: per restitution a diagram and the multipliers; the chart.
@@ -64,22 +67,36 @@ class BifurcationStudy:
         say = progress if progress is not None else (lambda message: None)
         system, q, delta = scene.system, scene.amplitude, float(scene.clearance[0])
         options = tuple(sorted(vars(settings.branches).items()))
-        continuation: list = [BranchCase(system, q, delta, r, settings.low, settings.high, options) for r in settings.restitution]
-        chart = settings.chart
-        if chart is not None:
-            continuation.append(ChartCase(system, q, delta, chart.restitution, settings.low, settings.high, chart.clearance, chart.kinds, chart.max_steps))
-        say(f"continuing the branches of R = {', '.join(f'{r:g}' for r in settings.restitution)}" + (f" and the chart's curves (R = {chart.restitution:g})" if chart else ""))
-        results = run_cases(continuation, jobs, cache_dir, progress is not None)
-        for case, result in zip(continuation, results):
-            for note in result["notes"]:
-                say(f"  {'chart' if isinstance(case, ChartCase) else 'R ='} {case.restitution:g}: {note}")
         brute = settings.brute_force
+        chart = settings.chart
         sweeps = [SweepCase(system, q, delta, r, d, tuple(scene.frequency), brute.transient_periods, brute.strobes) for r in settings.restitution for d in brute.directions]
         maps = []
         if chart is not None:
             maps = [SweepCase(system, q, float(c), chart.restitution, d, tuple(settings.chart_frequency), chart.transient_periods, chart.strobes) for c in chart.clearances for d in brute.directions]
-        say(f"brute force: {len(sweeps)} sweeps of {scene.frequency.size} frequencies" + (f", regime map: {len(maps)} sweeps of {settings.chart_frequency.size}" if maps else ""))
-        swept = run_cases(sweeps + maps, jobs, cache_dir, progress is not None)
+        # the chart's curves (the longest case) first, alongside the sweeps; then the branches, seeded from the sweeps
+        charted = [ChartCase(system, q, delta, chart.restitution, settings.low, settings.high, chart.clearance, chart.kinds, chart.max_steps)] if chart else []
+        say(f"brute force: {len(sweeps)} sweeps of {scene.frequency.size} frequencies" + (f", regime map: {len(maps)} sweeps of {settings.chart_frequency.size}" if maps else "")
+            + (f"; the chart's curves (R = {chart.restitution:g})" if chart else ""))  # fmt: skip
+        first = run_cases(charted + sweeps + maps, jobs, cache_dir, progress is not None)
+        chart_result, swept = (first[0], first[1:]) if chart else (None, first)
+        if chart_result is not None:
+            for note in chart_result["notes"]:
+                say(f"  chart {chart.restitution:g}: {note}")
+        continuation = []
+        for i, r in enumerate(settings.restitution):
+            seeds: list[Seed] = []
+            if settings.branches.brute_force:
+                for j, _direction in enumerate(brute.directions):
+                    result = swept[i * len(brute.directions) + j]
+                    seeds += sweep_seeds(scene.frequency, result["period"], result["impacts"], result["state"], j)
+            continuation.append(BranchCase(system, q, delta, r, settings.low, settings.high, options, tuple(seeds)))
+        say(f"continuing the branches of R = {', '.join(f'{r:g}' for r in settings.restitution)}")
+        results = run_cases(continuation, jobs, cache_dir, progress is not None)
+        for case, result in zip(continuation, results):
+            for note in result["notes"]:
+                say(f"  R = {case.restitution:g}: {note}")
+        if chart_result is not None:
+            results = [*results, chart_result]
         data = _branches(results[: len(settings.restitution)], settings.restitution)
         data = data.merge(_brute(swept[: len(sweeps)], scene, brute.directions, brute.strobes))
         if chart is not None:
@@ -98,17 +115,19 @@ class BifurcationStudy:
         brute = settings.brute_force
         per_period = costs.per_period_cost("exact", 0.0) * BRUTE_FACTOR
         periods = scene.frequency.size * len(settings.restitution) * len(brute.directions) * (brute.transient_periods + brute.strobes)
-        continuation = [CONTINUATION_SECONDS] * len(settings.restitution)
+        continuation = [CONTINUATION_SECONDS if settings.branches.brute_force else CLOSED_FORM_SECONDS] * len(settings.restitution)
+        chart_seconds = 0.0
         if settings.chart is not None:
             chart = settings.chart
             periods += settings.chart_frequency.size * chart.clearance_num * len(brute.directions) * (chart.transient_periods + chart.strobes)
-            continuation.append(CHART_SECONDS)
+            chart_seconds = CHART_SECONDS
         sweeps = periods * per_period
         jobs = max(1, jobs)
-        branches = max(max(continuation), sum(continuation) / jobs)
+        first = max(chart_seconds, (chart_seconds + sweeps) / jobs)  # the chart's curves run alongside the sweeps
+        branches = max(max(continuation), sum(continuation) / jobs)  # then the branches, seeded from the sweeps
         report = costs.report_base + REPORT_FIGURES * len(settings.restitution) * costs.report_per_figure
-        wall = costs.startup + branches + sweeps / jobs + report
-        parts = {"continuation": branches, "brute force": sweeps / jobs, "report": report}
+        wall = costs.startup + first + branches + report
+        parts = {"brute force and chart": first, "continuation": branches, "report": report}
         memory = costs.main_process_memory + (jobs - 1) * costs.worker_process_memory
         return Estimate(wall_time=wall, memory=memory, parts=parts, points={"brute force": f"{periods:,} periods", "continuation": f"{len(continuation)} continuations"})
 
@@ -240,8 +259,8 @@ def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult])
         "frequency_band_Hz": np.array([settings.low, settings.high]),
         "brute_force_transient_periods": settings.brute_force.transient_periods,
         "continuation_notes": "\n".join(f"R = {r:g}: {note}" for r, result in zip(settings.restitution, results) for note in result["notes"]),
-        "method_branches": "pseudo-arclength continuation of fixed points of the exact stroboscopic map (compiled exact engine, exact Jacobians), started from the closed-form one-impact orbit at both roots of eq. 16",
-        "method_brute_force": "compiled exact engine, stepped sweeps carrying the end state; strobes compared over periods 1-8, else the Lyapunov exponent from the exact Jacobians",
+        "method_branches": "pseudo-arclength continuation of fixed points of the exact stroboscopic map (compiled exact engine, exact Jacobians), started from the closed-form one-impact orbit at both roots of eq. 16, at period doublings, at grazing points and from every periodic brute-force attractor no other branch passes through",
+        "method_brute_force": f"compiled exact engine, stepped sweeps carrying the end state; strobes compared over periods 1-{MAX_PERIOD}, else the Lyapunov exponent from the exact Jacobians",
     }
     if settings.chart is not None:
         attrs["chart_restitution"] = settings.chart.restitution

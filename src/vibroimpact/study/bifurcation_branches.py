@@ -11,7 +11,6 @@ comes from the closed form wherever q |H12| <= Delta. Failures of a continuation
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -29,10 +28,10 @@ from vibroimpact.orbits.continuation import ContinuationSettings, continue_branc
 from vibroimpact.orbits.maps import ImpactMap, one_impact_state, orbit_measures, section_phase, with_impulse
 from vibroimpact.orbits.shooting import shoot
 
-__all__ = ["ORIGINS", "MAX_ORBIT_IMPACTS", "GuardedMap", "OrbitSet", "find_branches", "one_impact_roots", "linear_segments"]
+__all__ = ["ORIGINS", "MAX_ORBIT_IMPACTS", "map_bounds", "OrbitSet", "find_branches", "one_impact_roots", "linear_segments"]
 
 #: How a branch was found (CF flags of ``branch_origin``).
-ORIGINS = ("linear", "one_impact", "period_doubling", "grazing")
+ORIGINS = ("linear", "one_impact", "period_doubling", "grazing", "brute_force")
 #: Impact velocities kept per orbit (the rest are dropped; ``impacts_per_period`` counts them all).
 MAX_ORBIT_IMPACTS = 8
 #: Frequency step of the closed-form scan for one-impact starts [Hz].
@@ -43,46 +42,19 @@ SAME_ORBIT = 0.02
 MAX_GRAZING_BRANCHES = 8
 
 
-class GuardedMap:
-    """An :class:`ImpactMap` that answers NaN (a failed step) outside a box of parameters instead of raising.
-
-    Continuation and location may try a parameter far outside the physical range (a negative frequency or clearance);
-    the map then has no image, which the corrector treats as a failed step.
-    """
-
-    def __init__(self, base: ImpactMap, bounds: dict[str, tuple[float, float]]) -> None:
-        self.base = base
-        self.dimension, self.parameter_names = base.dimension, base.parameter_names
-        self.state_scale, self.parameter_scale = base.state_scale, base.parameter_scale
-        self.problem, self.periods, self.engine, self.parameters = base.problem, base.periods, base.engine, base.parameters
-        self.bounds = [(base.parameter_names.index(name), low, high) for name, (low, high) in bounds.items()]
-
-    def problem_at(self, p: NDArray[np.float64]) -> ImpactProblem:
-        """The problem with parameter vector ``p``."""
-        return self.base.problem_at(p)
-
-    def evaluate(self, y: NDArray[np.float64], p: NDArray[np.float64]) -> MapEvaluation:
-        """The base map's evaluation, or NaN outside the bounds."""
-        if all(low <= p[index] <= high for index, low, high in self.bounds) and np.all(np.isfinite(y)):
-            try:
-                return self.base.evaluate(y, p)
-            except RuntimeError:  # the engine made no progress (endless chattering): no image
-                pass
-        return MapEvaluation(np.full(self.dimension, np.nan), np.full((self.dimension, self.dimension), np.nan), None, None)
-
-
 @dataclass
 class OrbitSet:
     """Branches and special points of one restitution, as lists of per-point records (see :meth:`add_branch`), and
-    the continued branches with their maps (``maps``: (GuardedMap, Branch) pairs)."""
+    the continued branches with their maps (``maps``: (ImpactMap, Branch) pairs)."""
 
     points: list[dict] = field(default_factory=list)
     specials: list[dict] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     count: int = 0
     maps: list = field(default_factory=list)
+    _index: tuple | None = None
 
-    def add_branch(self, system: GuardedMap, branch: Branch, origin: str) -> int:
+    def add_branch(self, system: ImpactMap, branch: Branch, origin: str) -> int:
         """Measure every orbit of ``branch`` and keep it with its special points; return its label."""
         label = self.count
         self.count += 1
@@ -110,23 +82,42 @@ class OrbitSet:
 
     def impulse_at(self, frequency: float, period: int, impacts: int) -> list[float]:
         """Impulses per excitation period of the known branches with this period and impact count at ``frequency``."""
-        found = []
-        for a, b in zip(self.points[:-1], self.points[1:]):
-            if a["branch"] != b["branch"] or a["period"] != period or a["impacts"] != impacts or b["impacts"] != impacts:
-                continue
-            low, high = sorted((a["frequency"], b["frequency"]))
-            if low <= frequency <= high:
-                t = 0.0 if high == low else (frequency - a["frequency"]) / (b["frequency"] - a["frequency"])
-                found.append(a["impulse"] + t * (b["impulse"] - a["impulse"]))
-        return found
+        if self._index is None or self._index[0] != len(self.points):
+            self._index = (len(self.points), _segments(self.points))
+        segments = self._index[1].get((period, impacts))
+        if segments is None:
+            return []
+        fa, fb, ja, jb = segments
+        inside = (np.minimum(fa, fb) <= frequency) & (frequency <= np.maximum(fa, fb))
+        span = np.where(fb[inside] == fa[inside], 1.0, fb[inside] - fa[inside])
+        t = np.where(fb[inside] == fa[inside], 0.0, (frequency - fa[inside]) / span)
+        return list(ja[inside] + t * (jb[inside] - ja[inside]))
 
-    def known(self, frequency: float, period: int, impacts: int, impulse: float) -> bool:
-        """Does a known branch pass through an orbit of this period, impact count and impulse at ``frequency``?"""
-        return any(abs(j - impulse) <= SAME_ORBIT * max(abs(impulse), 1e-12) for j in self.impulse_at(frequency, period, impacts))
+    def known(self, frequency: float, period: int, impacts: int, impulse: float, tolerance: float = 0.0) -> bool:
+        """Does a known branch pass through an orbit of this period, impact count and impulse at ``frequency``
+        (within :data:`SAME_ORBIT`, or ``tolerance`` when larger)?"""
+        limit = max(SAME_ORBIT, tolerance) * max(abs(impulse), 1e-12)
+        return any(abs(j - impulse) <= limit for j in self.impulse_at(frequency, period, impacts))
 
 
-def _record(system: GuardedMap, orbit: PeriodicOrbit) -> dict:
-    measures = orbit_measures(system.base, orbit)
+def _segments(points: list[dict]) -> dict[tuple[int, int], tuple[np.ndarray, ...]]:
+    """(period, impacts per orbit period) -> (f_a, f_b, J_a, J_b) of each pair of consecutive points of one branch."""
+    groups: dict[tuple[int, int], list[tuple[float, float, float, float]]] = {}
+    for a, b in zip(points[:-1], points[1:]):
+        if a["branch"] == b["branch"] and a["period"] == b["period"] and a["impacts"] == b["impacts"]:
+            groups.setdefault((a["period"], a["impacts"]), []).append((a["frequency"], b["frequency"], a["impulse"], b["impulse"]))
+    return {key: tuple(np.array(column) for column in zip(*rows)) for key, rows in groups.items()}
+
+
+def map_bounds(low: float, high: float) -> dict[str, tuple[float, float]]:
+    """The parameter box of the study's maps: frequencies within a factor 2 of the band [Hz] (a continuation's trials
+    stay physical; outside, the map has no image)."""
+    return {"frequency": (0.5 * low, 2.0 * high)}
+
+
+def _record(system: ImpactMap, orbit: PeriodicOrbit) -> dict:
+    measures = orbit_measures(system, orbit)
+    periods = orbit.period * system.periods  # excitation periods per orbit period
     multipliers = np.zeros(4, dtype=complex)
     multipliers[: orbit.multipliers.size] = orbit.multipliers
     modulus = orbit.floquet_modulus
@@ -134,11 +125,11 @@ def _record(system: GuardedMap, orbit: PeriodicOrbit) -> dict:
         "frequency": orbit.parameter("frequency"),
         "x1_amplitude": measures.x1_amplitude,
         "x2_amplitude": measures.x2_amplitude,
-        "impulse": float(measures.impulses.sum()) / orbit.period,
+        "impulse": float(measures.impulses.sum()) / periods,
         "floquet_modulus": modulus,
         "stable": 2 if abs(modulus - 1.0) <= 1e-9 else int(modulus < 1.0),
         "impacts": int(measures.impulses.size),
-        "period": orbit.period,
+        "period": periods,
         "multipliers": multipliers,
         "velocities": measures.impact_velocities[:MAX_ORBIT_IMPACTS],
     }
@@ -193,15 +184,15 @@ def find_branches(
     """Every branch of one restitution over [low, high] Hz (module docstring); ``progress`` gets a line per branch."""
     found = OrbitSet()
     settings = ContinuationSettings(lower=low, upper=high, max_steps=max_steps, max_step=max_step)
-    bounds = {"frequency": (0.5 * low, 2.0 * high), "clearance": (0.0, math.inf), "restitution": (0.0, 1.0)}
+    bounds = map_bounds(low, high)
 
     def say(message: str) -> None:
         if progress is not None:
             progress(f"R = {restitution:g}: {message}")
 
-    def guarded(frequency: float, phase: float) -> GuardedMap:
+    def guarded(frequency: float, phase: float) -> ImpactMap:
         problem = ImpactProblem(system, RigidStop(clearance, restitution), HarmonicForce(amplitude, frequency, phase))
-        return GuardedMap(ImpactMap(problem), bounds)
+        return ImpactMap(problem, bounds=bounds)
 
     def attempt(what: str, run) -> None:
         try:
@@ -210,7 +201,7 @@ def find_branches(
             found.notes.append(f"{what} failed: {type(error).__name__}: {str(error)[:200]}")
             say(f"{what} failed ({type(error).__name__})")
 
-    maps: list[tuple[GuardedMap, Branch]] = []
+    maps: list[tuple[ImpactMap, Branch]] = []
     if linear:
         for segment in linear_segments(system, amplitude, clearance, low, high):
             found.add_linear(system, amplitude, clearance, segment)
@@ -233,7 +224,7 @@ def find_branches(
                 phase = section_phase(base, frequency[band[0] : band[1] + 1])
                 mapping = guarded(f0, phase)
 
-                def start(mapping: GuardedMap = mapping, f0: float = f0, j0: float = j0) -> None:
+                def start(mapping: ImpactMap = mapping, f0: float = f0, j0: float = j0) -> None:
                     single = with_impulse(solve_one_impact(system, 2.0 * np.pi * f0, clearance, restitution, amplitude), j0)
                     orbit = shoot(mapping, one_impact_state(mapping.problem, single), mapping.parameters)
                     branch = continue_branch(mapping, orbit, "frequency", settings)
@@ -248,7 +239,7 @@ def find_branches(
                 if point.orbit.period != 1:
                     continue
 
-                def doubled(mapping: GuardedMap = mapping, point: SpecialPoint = point) -> None:
+                def doubled(mapping: ImpactMap = mapping, point: SpecialPoint = point) -> None:
                     orbit = switch_period_doubling(mapping, point)
                     child = continue_branch(Iterated(mapping, 2), orbit, "frequency", settings)
                     label = found.add_branch(mapping, child, "period_doubling")
@@ -263,12 +254,12 @@ def find_branches(
                 if not point.continues or not point.impacts_after or point.impacts_after in set(branch.impacts.tolist()) or born >= MAX_GRAZING_BRANCHES:
                     continue
 
-                def beyond(mapping: GuardedMap = mapping, point: SpecialPoint = point) -> None:
+                def beyond(mapping: ImpactMap = mapping, point: SpecialPoint = point) -> None:
                     orbit = _orbit_beyond(mapping, point)
                     if orbit is None:
                         found.notes.append(f"no orbit with {point.impacts_after} impacts found next to the grazing point at {point.value:.4f} Hz")
                         return
-                    measures = orbit_measures(mapping.base, orbit)
+                    measures = orbit_measures(mapping, orbit)
                     if found.known(orbit.parameter("frequency"), orbit.period, orbit.impacts, float(measures.impulses.sum()) / orbit.period):
                         return
                     child = continue_branch(Iterated(mapping, orbit.period) if orbit.period > 1 else mapping, orbit, "frequency", settings)
@@ -292,7 +283,7 @@ def _segment(mask: NDArray[np.bool_], k: int) -> tuple[int, int]:
     return first, last
 
 
-def _orbit_beyond(mapping: GuardedMap, point: SpecialPoint) -> PeriodicOrbit | None:
+def _orbit_beyond(mapping: ImpactMap, point: SpecialPoint) -> PeriodicOrbit | None:
     """The orbit with ``point.impacts_after`` impacts next to a grazing point: shooting from the grazing orbit on
     either side of it, ever farther."""
     orbit = point.orbit

@@ -8,8 +8,11 @@ of one restitution, and the two-parameter chart's curves.
   Jacobians (:func:`vibroimpact.orbits.motion.classify_motion`). A strictly negative Lyapunov exponent means a periodic
   orbit approached slowly: the motion is classified by the period that repeats best.
 * :class:`BranchCase`: :func:`vibroimpact.study.bifurcation_branches.find_branches` of one restitution.
-* :class:`ChartCase`: the special points of the chart's restitution followed in (frequency, clearance); grazing curves
-  of the one-impact orbit (its impact velocity vanishes where q |H12| = Delta) from the closed form.
+* :class:`ChartCase`: the special points of the chart's restitution followed in (frequency, clearance): folds, period
+  doublings and Neimark-Sacker points continued (:func:`vibroimpact.orbits.two_parameter.continue_special_point`), the
+  points where a free flight of an orbit touches the stop traced by repeated location
+  (:func:`vibroimpact.orbits.grazing_curve.trace_grazing`), and the one-impact orbit's vanishing impact velocity
+  (where q |H12| = Delta, the linear orbit's grazing) from the closed form.
 """
 
 from __future__ import annotations
@@ -27,9 +30,11 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Iterated
 from vibroimpact.orbits.continuation import ContinuationSettings
+from vibroimpact.orbits.grazing_curve import trace_grazing
 from vibroimpact.orbits.motion import classify_motion
 from vibroimpact.orbits.two_parameter import continue_special_point
 from vibroimpact.study.bifurcation_branches import MAX_ORBIT_IMPACTS, OrbitSet, find_branches
+from vibroimpact.study.bifurcation_seeds import Seed, seed_branches
 from vibroimpact.study.fingerprint import case_key
 from vibroimpact.study.runner import CaseResult, ProgressReport
 
@@ -39,8 +44,8 @@ __all__ = ["MOTION_CLASSES", "MAX_KEPT_IMPACTS", "SweepCase", "BranchCase", "Cha
 MOTION_CLASSES = ("linear", "one_impact", "other_periodic", "quasi_periodic", "chaotic", "irregular")
 #: Impact velocities kept per brute-force point (NaN-padded).
 MAX_KEPT_IMPACTS = 64
-#: Longest period looked for in the strobes [periods].
-MAX_PERIOD = 8
+#: Longest period looked for in the strobes [periods] (the strobes kept must cover it twice).
+MAX_PERIOD = 32
 #: Strobes repeat when they differ by less than this, relative to Delta + q |H12| (velocities: times w) [-].
 REPEAT_TOLERANCE = 1e-6
 
@@ -58,7 +63,7 @@ class SweepCase:
     transient: int
     strobes: int
     engine: str = "exact"
-    fields: tuple[str, ...] = ("x1", "x1_amplitude", "velocity", "impacts", "regime", "period", "lyapunov")
+    fields: tuple[str, ...] = ("x1", "x1_amplitude", "velocity", "impacts", "regime", "period", "lyapunov", "state")
     progress_unit: str = "frequency points"
 
     @property
@@ -79,6 +84,7 @@ class SweepCase:
         out = {
             "x1": np.full((n, s), np.nan), "x1_amplitude": np.full((n, s), np.nan), "velocity": np.full((n, MAX_KEPT_IMPACTS), np.nan),
             "impacts": np.zeros(n), "regime": np.full(n, -1, dtype=np.int8), "period": np.zeros(n, dtype=np.int16), "lyapunov": np.full(n, np.nan),
+            "state": np.full((n, 4), np.nan),
         }  # fmt: skip
         state = None
         for done, k in enumerate(order):
@@ -109,6 +115,7 @@ def _measure(engine: ExactEngine, problem: ImpactProblem, state: NDArray[np.floa
         state = engine.integrate(problem, state, 0.0, transient).final_state
     run = engine.integrate(problem, state, 0.0, strobes, moments=True, jacobians=True)
     s = run.strobe_states
+    out["state"][k] = run.final_state
     out["x1"][k] = s[1:, 0]
     out["x1_amplitude"][k] = np.abs(run.moments[:, 0]) * 2.0 / problem.period
     velocities = run.impact_velocities
@@ -156,6 +163,7 @@ class BranchCase:
     low: float
     high: float
     options: tuple[tuple[str, object], ...]
+    seeds: tuple[Seed, ...] = ()
     engine: str = "exact"
     fields: tuple[str, ...] = BRANCH_FIELDS
     progress_unit: str = "frequency points"
@@ -168,14 +176,18 @@ class BranchCase:
     def key(self) -> str:
         """Hash of everything that determines the result."""
         return case_key({"kind": "bifurcation_branches", "system": asdict(self.system), "amplitude": self.amplitude, "clearance": self.clearance,
-                         "restitution": self.restitution, "band": [self.low, self.high], "options": dict(self.options)})  # fmt: skip
+                         "restitution": self.restitution, "band": [self.low, self.high], "options": dict(self.options),
+                         "seeds": [asdict(seed) for seed in self.seeds]})  # fmt: skip
 
     def run(self, report: ProgressReport | None = None) -> CaseResult:
         """The branches' and special points' arrays."""
-        found = find_branches(self.system, self.amplitude, self.clearance, self.restitution, self.low, self.high, **dict(self.options))
+        options = dict(self.options)
+        brute_force = bool(options.pop("brute_force", True))
+        found = find_branches(self.system, self.amplitude, self.clearance, self.restitution, self.low, self.high, **options)
+        if brute_force and self.seeds:
+            settings = ContinuationSettings(lower=self.low, upper=self.high, max_steps=int(options.get("max_steps", 2000)), max_step=float(options.get("max_step", 0.1)))
+            seed_branches(found, self.system, self.amplitude, self.clearance, self.restitution, self.low, self.high, self.seeds, settings)
         return branch_arrays(found)
-
-
 
 
 def branch_arrays(found: OrbitSet) -> CaseResult:
@@ -254,12 +266,17 @@ class ChartCase:
                 if any(k == kind and abs(f - point.value) < 1e-3 and abs(d - self.clearance) < 1e-6 for _c, k, f, d in rows):
                     continue  # on a curve already followed
                 try:
-                    special = continue_special_point(system, point, "clearance", settings, bounds=bounds)
+                    if point.kind == "grazing":  # not differentiable there: located again at each clearance
+                        special = trace_grazing(system, point, "clearance", bounds)
+                        how = f"traced by location ({special.measure})"
+                    else:
+                        special = continue_special_point(system, point, "clearance", settings, bounds=bounds)
+                        how = "continued"
                 except Exception as error:  # noqa: BLE001 - a curve that cannot be followed is recorded, not fatal
                     notes.append(f"{point.kind} curve from {point.value:.4f} Hz failed: {type(error).__name__}: {str(error)[:160]}")
                     continue
                 f, d = special.values("frequency"), special.values("clearance")
-                notes.append(f"{point.kind} curve {curve} from {point.value:.4f} Hz: {f.size} points, ends: {special.end}")
+                notes.append(f"{point.kind} curve {curve} from {point.value:.4f} Hz {how}: {f.size} points, {d.min() * 1e3:.3f}-{d.max() * 1e3:.3f} mm, ends: {special.end}")
                 rows += [(curve, kind, fi, di) for fi, di in zip(f, d)]
                 curve += 1
         table = np.array(rows, dtype=float).reshape(-1, 4)
