@@ -597,7 +597,7 @@ def test_simulation_without_engine_solutions_is_an_error() -> None:
 
 def test_shipped_engine_cost_scene_parses() -> None:
     scene = load_scene(shipped_studies_dir() / "engine_cost.yaml")
-    assert scene.benchmark is not None and len(scene.benchmark.cases) == 3
+    assert scene.benchmark is not None and len(scene.benchmark.cases) == 4
     assert scene.benchmark.settings.tolerances[0] > scene.benchmark.settings.tolerances[-1]  # loose to tight
 
 

@@ -11,6 +11,13 @@ the fundamental of X1, is compared over the whole run (stepped: from the exact p
 8-cycle fundamental, largest difference over the run relative to its largest value). Wall time is the median of
 ``repeats`` runs (one run when a run takes more than 5 s). Timings on shared machines are noisy: read the ratios,
 measured in the same process run, not the absolute seconds.
+
+Engines that have no tolerance (:data:`TOLERANCE_FREE`, e.g. ``exact_python``, the exact engine's algorithm in pure
+Python) run once per case; that measurement is stored at every tolerance. Per stepped case the costs per excitation
+period are stored too: of every method, of the ``exact`` reference, and of its *floor*, the compiled kernel
+(:func:`vibroimpact.engines.exact_core.run_periods`) alone on the same run with the arguments the engine prepares,
+timed the same way, its runs interleaved with the reference's (:func:`exact_kernel`): the difference from the
+reference is what the engine's Python face adds.
 """
 
 from __future__ import annotations
@@ -20,7 +27,7 @@ import statistics
 import sys
 import time
 from dataclasses import replace
-from typing import Callable
+from typing import Any, Callable, TypeVar, cast
 
 import numpy as np
 import xarray as xr
@@ -38,9 +45,13 @@ from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.variables import BENCHMARK_ATTRIBUTES, LADDER_ATTRIBUTES
 from vibroimpact.scene.schema import BenchmarkCase, BenchmarkSettings, LadderSettings
 
-__all__ = ["run_benchmark", "model_ladder", "equal_error_speedup", "loosest_tolerance", "REFERENCE_RTOL"]
+__all__ = ["run_benchmark", "model_ladder", "equal_error_speedup", "loosest_tolerance", "exact_kernel", "REFERENCE_RTOL", "TOLERANCE_FREE"]
 
 SLOW_RUN = 5.0  # [s] a run longer than this is not repeated
+#: Engines whose runs ignore rtol and atol: measured once per case, stored at every tolerance.
+TOLERANCE_FREE = frozenset({"exact", "exact_python"})
+
+_T = TypeVar("_T")
 
 
 def _compare(reference: Trajectory, trial: Trajectory, period: float) -> dict[str, float]:
@@ -117,22 +128,56 @@ def _runner(case: BenchmarkCase, method: str, settings: EngineSettings) -> Calla
     return run
 
 
-def _timed(run: Callable[[], _Run], repeats: int) -> tuple[_Run, float]:
-    times = []
-    result = None
-    for _ in range(repeats):
-        started = time.perf_counter()
-        result = run()
-        times.append(time.perf_counter() - started)
-        if times[-1] > SLOW_RUN:
-            break
-    assert result is not None
-    return result, statistics.median(times)
+def _timed(run: Callable[[], _T], repeats: int) -> tuple[_T, float]:
+    """The last result of ``run`` and the median wall time [s] of up to ``repeats`` calls (one after a slow run)."""
+    ((result, wall),) = _timed_together([run], repeats)
+    return cast(_T, result), wall
 
 
-def _references(case: BenchmarkCase, settings: BenchmarkSettings) -> dict[str, tuple[_Run, float]]:
-    """The references a case needs: ``exact`` (rigid methods), ``compliant`` (CVODE Adams at REFERENCE_RTOL)."""
+def _timed_together(runs: list[Callable[[], Any]], repeats: int) -> list[tuple[Any, float]]:
+    """Each of ``runs`` called in turn, ``repeats`` rounds (one round more only while no run took over 5 s), so that a
+    change of the machine's load falls on all of them alike: the last result of each and its median wall time [s]."""
+    times: list[list[float]] = [[] for _ in runs]
+    results: list[Any] = []
+    while not times[0] or (len(times[0]) < repeats and max(t[-1] for t in times) <= SLOW_RUN):
+        results = []
+        for run, record in zip(runs, times):
+            started = time.perf_counter()
+            results.append(run())
+            record.append(time.perf_counter() - started)
+    return [(result, statistics.median(record)) for result, record in zip(results, times)]
+
+
+def exact_kernel(case: BenchmarkCase, moments: bool = True) -> Callable[[], int]:
+    """A function running the exact engine's compiled kernel alone on ``case``'s stepped run; it returns the status.
+
+    :func:`vibroimpact.engines.exact_core.run_periods` is called with the arguments the engine prepares for the
+    problem (prepared here, once) and the run's start and periods, ``moments`` as the reference run asks for them
+    (True) or not: no engine object, no checks, no :class:`Trajectory`. What the reference costs beyond this is the
+    engine's Python face: this is its floor.
+    """
+    from vibroimpact.engines import exact_core
+    from vibroimpact.engines.exact import _setup  # the engine's own per-problem preparation
+
+    t0, y0 = start_state(case.problem, case.start)
+    arguments = _setup(case.problem, EngineSettings()).arguments
+    state = np.ascontiguousarray(y0, dtype=float)
+
+    def kernel() -> int:
+        status = exact_core.run_periods(*arguments, state, float(t0), int(case.periods), moments, False, False, exact_core.GL_NODES, exact_core.GL_WEIGHTS)[0]
+        if status != exact_core.STATUS_OK:
+            raise RuntimeError(f"benchmark case {case.name}: the exact kernel made no progress")
+        return int(status)
+
+    return kernel
+
+
+def _references(case: BenchmarkCase, settings: BenchmarkSettings) -> tuple[dict[str, tuple[_Run, float]], list[float]]:
+    """The references a case needs: ``exact`` (rigid methods), ``compliant`` (CVODE Adams at REFERENCE_RTOL); and
+    the wall times [s] of the exact kernel alone with the moments and without (stepped cases; NaN otherwise),
+    timed in turn with the exact reference."""
     references: dict[str, tuple[_Run, float]] = {}
+    floors = [math.nan, math.nan]
     if case.sweep is None:
         t0, y0 = start_state(case.problem, case.start)
 
@@ -140,11 +185,15 @@ def _references(case: BenchmarkCase, settings: BenchmarkSettings) -> dict[str, t
             trajectory = make_engine("exact").integrate(case.problem, y0, t0, case.periods, moments=True)
             return _Run(trajectory, _x1_of(trajectory))
 
-        references["rigid"] = _timed(exact, settings.repeats)
+        make_engine("exact").integrate(case.problem, y0, t0, 1, moments=True)  # untimed: loads the compiled kernel
+        kernels = [exact_kernel(case, moments) for moments in (True, False)]
+        timed = _timed_together([exact, *kernels], settings.repeats)
+        references["rigid"] = timed[0]
+        floors = [wall for _, wall in timed[1:]]
     if any(case.runs(m) and (engine_spec(m).contact == BUMPER or case.sweep is not None) for m in settings.methods):
         tight = EngineSettings(rtol=REFERENCE_RTOL, atol=REFERENCE_RTOL * settings.atol_ratio, method="adams")
         references["compliant"] = _timed(_runner(case, "compliant_cvode_adams", tight), 1)
-    return references
+    return references, floors
 
 
 def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progress: bool = True) -> xr.Dataset:
@@ -160,8 +209,19 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
     reference_time = np.full((len(cases), 2), np.nan)
     reference_impacts = np.full((len(cases), 2), np.nan)
     reference_x1 = np.full((len(cases), 2), np.nan)
+    periods = np.array([np.nan if case.sweep is not None else float(case.periods) for case in cases])
+    floors = np.full((len(cases), 2), np.nan)  # [s] the exact kernel alone: with the moments, without
     for c, case in enumerate(cases):
-        references = _references(case, settings)
+        references, floors[c] = _references(case, settings)
+        if case.sweep is None:
+            if progress:
+                per_period = 1e6 / case.periods
+                print(
+                    f"benchmark {case.name}: exact {references['rigid'][1] * per_period:.2f} us/period, its compiled kernel alone "
+                    f"{floors[c, 0] * per_period:.2f} (without moments {floors[c, 1] * per_period:.2f})",
+                    file=sys.stderr,
+                    flush=True,
+                )
         for r, kind in enumerate(("rigid", "compliant")):
             if kind in references:
                 reference, reference_time[c, r] = references[kind]
@@ -173,6 +233,10 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
             kind = "compliant" if engine_spec(method).contact == BUMPER or case.sweep is not None else "rigid"
             reference = references[kind][0]
             for k, rtol in enumerate(settings.tolerances):
+                if method in TOLERANCE_FREE and k:  # the same run at every tolerance: measured once
+                    for name in names:
+                        data[name][c, m, k] = data[name][c, m, 0]
+                    continue
                 run, wall = _timed(_runner(case, method, EngineSettings(rtol=rtol, atol=rtol * settings.atol_ratio)), settings.repeats)
                 trajectory = run.trajectory
                 scale = float(np.nanmax(reference.x1))
@@ -188,8 +252,8 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
                 for name in names:
                     data[name][c, m, k] = values[name]
                 if progress:
-                    print(f"benchmark {case.name}: {method} rtol {rtol:g}: {wall:.3f} s, X1 error {values['x1_error']:.1e}, missed {values['missed_impacts']}", file=sys.stderr, flush=True)
-                if wall > settings.max_seconds:
+                    print(f"benchmark {case.name}: {method} rtol {'(none)' if method in TOLERANCE_FREE else format(rtol, 'g')}: {wall:.3f} s, X1 error {values['x1_error']:.1e}, missed {values['missed_impacts']}", file=sys.stderr, flush=True)
+                if wall > settings.max_seconds and method not in TOLERANCE_FREE:
                     break  # tighter tolerances would only take longer
     dataset = xr.Dataset(
         {name: (("case", "engine", "rtol"), data[name], dict(BENCHMARK_ATTRIBUTES[name])) for name in names},
@@ -199,11 +263,17 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
     dataset["reference_impacts"] = (("case", "reference"), reference_impacts, dict(BENCHMARK_ATTRIBUTES["reference_impacts"]))
     dataset["reference_x1"] = (("case", "reference"), reference_x1, dict(BENCHMARK_ATTRIBUTES["reference_x1"]))
     dataset["exact_wall_time"] = dataset["reference_wall_time"].sel(reference="exact", drop=True).assign_attrs(BENCHMARK_ATTRIBUTES["exact_wall_time"])
+    dataset["periods"] = ("case", periods, dict(BENCHMARK_ATTRIBUTES["periods"]))
+    dataset["time_per_period"] = (dataset["wall_time"] / dataset["periods"]).assign_attrs(BENCHMARK_ATTRIBUTES["time_per_period"])
+    dataset["reference_time_per_period"] = (dataset["exact_wall_time"] / dataset["periods"]).assign_attrs(BENCHMARK_ATTRIBUTES["reference_time_per_period"])
+    dataset["floor_time_per_period"] = ("case", floors[:, 0] / periods, dict(BENCHMARK_ATTRIBUTES["floor_time_per_period"]))
+    dataset["floor_no_moments_time_per_period"] = ("case", floors[:, 1] / periods, dict(BENCHMARK_ATTRIBUTES["floor_no_moments_time_per_period"]))
     for coordinate in ("rtol", "reference"):
         dataset[coordinate].attrs.update(BENCHMARK_ATTRIBUTES[coordinate])
     dataset.attrs["atol_ratio_m"] = settings.atol_ratio
     dataset.attrs["repeats"] = settings.repeats
     dataset.attrs["reference_rtol_compliant"] = REFERENCE_RTOL
+    dataset.attrs["tolerance_free_engines"] = " ".join(m for m in settings.methods if m in TOLERANCE_FREE)
     for case in cases:  # what a run simulates, for per-period and per-second costs (vibroimpact.study.estimate.calibrate)
         dataset.attrs[f"case_{case.name}_duration_s"] = case.sweep.duration if case.sweep is not None else case.periods / case.problem.frequency
         dataset.attrs[f"case_{case.name}_frequency_Hz"] = case.problem.frequency

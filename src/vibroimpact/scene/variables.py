@@ -108,6 +108,11 @@ BENCHMARK_ATTRIBUTES: dict[str, dict[str, str]] = {
     "reference_impacts": {"units": "1", "long_name": "impacts of the reference"},
     "reference_x1": {"units": "m", "long_name": "X1 fundamental of the reference (swept: its largest running value)"},
     "exact_wall_time": {"units": "s", "long_name": "median wall time of the exact reference"},
+    "periods": {"units": "1", "long_name": "whole excitation periods of a stepped run (NaN: swept case)"},
+    "time_per_period": {"units": "s", "long_name": "wall time per excitation period, wall_time / periods (stepped cases; an engine without tolerances: one run, stored at every rtol)"},
+    "reference_time_per_period": {"units": "s", "long_name": "wall time per excitation period of the exact reference (compiled engine with its Python face, moments included)"},
+    "floor_time_per_period": {"units": "s", "long_name": "wall time per excitation period of the exact engine's compiled kernel alone (exact_core.run_periods, arguments prepared untimed) on the same run, moments included: the exact reference's floor"},
+    "floor_no_moments_time_per_period": {"units": "s", "long_name": "as floor_time_per_period without the per-period Fourier moments (strobes, impacts and segments only)"},
     "rtol": {"units": "1", "long_name": "relative tolerance rtol (atol = rtol x atol_ratio)"},
     "reference": {"long_name": "reference of the rigid-stop methods (exact) and of the compliant model (CVODE Adams, rtol 1e-13)"},
 }
