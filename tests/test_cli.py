@@ -239,7 +239,9 @@ def test_calibrate_writes_a_cost_file_that_estimate_reads(tmp_path: Path, capsys
     scene = load_scene(scene_path)
     assert scene.simulation is not None
     ours = estimate_scene(scene, speed=1.0, costs=costs).parts["momentary"]
-    periods = (scene.simulation.steady.max_periods + scene.simulation.steady.irregular_measure_periods) * 2  # from rest: every point, the whole budget
+    steady = scene.simulation.steady
+    # from rest: every point, the whole budget: marching, the Lyapunov run and its perturbed copy, the measurement
+    periods = (steady.max_periods + 2 * steady.lyapunov_periods + steady.irregular_measure_periods) * 2
     assert ours == pytest.approx(TINY_PER_PERIOD * periods)
     assert estimate_scene(scene, speed=1.0).parts["momentary"] < ours / 100  # the shipped costs predict far less
     assert cli.main([str(scene_path), "--estimate", "--costs", str(out)]) == 0
