@@ -142,7 +142,7 @@ class ExactEngine:
         setup = _setup(problem, self.settings)
         state = np.ascontiguousarray(state, dtype=float)
         setup.law.check_start(state)
-        out = exact_core.run_periods(*setup.arguments, state, float(t_start), int(periods), moments, jacobians, approach, exact_core.GL_NODES, exact_core.GL_WEIGHTS)
+        out = exact_core.run_periods(*setup.arguments, state, float(t_start), int(periods), moments, jacobians, approach)
         if out[0] != exact_core.STATUS_OK:
             raise RuntimeError(f"no progress at t = {out[1]!r} s: more than {10 * setup.law.max_impacts} events in one period")
         return out

@@ -29,13 +29,9 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["run_periods", "STATUS_OK", "STATUS_NO_PROGRESS", "GL_NODES", "GL_WEIGHTS"]
+__all__ = ["run_periods", "STATUS_OK", "STATUS_NO_PROGRESS"]
 
 STATUS_OK, STATUS_NO_PROGRESS = 0, 1
-_x, _w = np.polynomial.legendre.leggauss(16)
-#: 16-point Gauss-Legendre rule on [0, 1]: moments are integrated over chunks of at most 4 radians of the fastest
-#: rate, where its error is below 1e-25 relative (the integrands are exponentials).
-GL_NODES, GL_WEIGHTS = (_x + 1.0) / 2.0, _w / 2.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -320,7 +316,6 @@ def run_periods(
     clearance, restitution, m2, k2, b2,
     sticking_velocity, max_impacts, tolerance, force_tolerance, resolution_velocity,
     y_start, t_start, periods, want_moments, want_jacobians, want_approach,
-    gl_nodes, gl_weights,
 ):  # fmt: skip
     """Integrate ``periods`` periods from (t_start, y_start); see :class:`vibroimpact.engines.exact.ExactEngine`.
 
@@ -368,6 +363,10 @@ def run_periods(
     samp = np.empty(2, dtype=np.complex128)
     hlam, hslam = _half_rates(lam), _half_rates(slam)  # the observables' rates: one of each conjugate pair
     hamp, hsamp = np.empty(hlam.size, dtype=np.complex128), np.empty(hslam.size, dtype=np.complex128)
+    free_rates, stuck_rates = _moment_rates(lam, omega), _moment_rates(slam, omega)  # the closed-form moments' exponents
+    m = lam.size + 2
+    buffers = (np.empty(m, dtype=np.complex128), np.empty((m, m), dtype=np.complex128), np.empty(m, dtype=np.complex128), np.empty(m + 1, dtype=np.complex128), np.empty(m, dtype=np.complex128), np.empty(m, dtype=np.complex128))
+    weights = (np.array([1.0, 0.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0, 0.0]), np.array([1.0, 0.0]), np.array([k2, b2]))  # X1, X2; stuck X1, holding force
     work = np.empty((4, 4))
     har = 0j
     con = 0.0
@@ -406,7 +405,7 @@ def run_periods(
             if want_moments:
                 _add_moments(
                     moments, k - 1, stuck, lam, vec, hrm, cst, slam, svec, shrm, scst, omega, t_piece, smodal if stuck else modal,
-                    t, t_end, fastest, clearance, k2, b2, gl_nodes, gl_weights,
+                    t, t_end, clearance, k2, b2, free_rates, stuck_rates, buffers, weights,
                 )  # fmt: skip
             if want_approach and not stuck:
                 _closest_approach(hlam, hamp, har, con, omega, t_piece, t, t_end, fastest, approach)
@@ -515,27 +514,115 @@ def _saltation(a_matrix, force_over_m1, phase, omega, t, y_contact, after, resti
 
 
 @njit(cache=True, error_model="numpy")
-def _add_moments(moments, row, stuck, lam, vec, hrm, cst, slam, svec, shrm, scst, omega, t_piece, modal, ta, tb, fastest, clearance, k2, b2, gl_nodes, gl_weights):
-    chunks = max(1, int(math.ceil(fastest * (tb - ta) / 4.0)))
-    width = (tb - ta) / chunks
-    y = np.empty(4)
-    y2 = np.empty(2)
-    for c in range(chunks):
-        start = ta + c * width
-        for i in range(gl_nodes.size):
-            t = start + width * gl_nodes[i]
-            w = width * gl_weights[i]
-            phasor = complex(math.cos(omega * t), -math.sin(omega * t))
-            if stuck:
-                _state(slam, svec, shrm, scst, omega, t_piece, modal, t, y2)
-                x1, x2 = y2[0], clearance
-                contact = b2 * y2[1] + k2 * (y2[0] - clearance)
+def _series(z):
+    """(e^z - 1) / z for small z, without cancellation: e^(x+iy) - 1 = expm1(x) cos y - 2 sin^2(y/2) + i e^x sin y."""
+    if z == 0.0:  # exact: the constant term of a real harmonic pair, e^{jwt} e^{-jwt}
+        return 1.0 + 0j
+    x, y = z.real, z.imag
+    half = math.sin(0.5 * y)
+    return complex(math.expm1(x) * math.cos(y) - 2.0 * half * half, math.exp(x) * math.sin(y)) / z
+
+
+@njit(cache=True, error_model="numpy")
+def _moment_rates(lam, omega):
+    """The exponents of a piece's components (the eigenvalues, then +-jw for the two halves of the harmonic term) and
+    the reciprocals the closed-form integrals divide by: of each rate, of each pairwise sum, of each rate - jw (0 where
+    the sum vanishes: that integral is then taken by its series)."""
+    m = lam.size + 2
+    rates = np.empty(m, dtype=np.complex128)
+    rates[: lam.size] = lam
+    rates[lam.size], rates[lam.size + 1] = complex(0.0, omega), complex(0.0, -omega)
+    inverse = np.zeros((m + 1, m), dtype=np.complex128)  # rows 0..m-1: 1 / (r_k + r_l); row m: 1 / (r_k - jw)
+    for k in range(m):
+        for l in range(m):
+            s = rates[k] + rates[l]
+            inverse[k, l] = 1.0 / s if abs(s) > 0.0 else 0.0
+        s = rates[k] - complex(0.0, omega)
+        inverse[m, k] = 1.0 / s if abs(s) > 0.0 else 0.0
+    return rates, inverse
+
+
+@njit(cache=True, error_model="numpy")
+def _amplitudes(lam, vec, hrm, modal, omega, t0, weights, amps):
+    """weights . y of the piece as sum_k amps_k e^{rates_k (t - t0)} plus a constant: the modal terms (their sum is
+    real) and the harmonic Re(Y e^{jwt}) as two conjugate halves."""
+    n = lam.size
+    harmonic = 0j
+    for i in range(n):
+        acc = 0j
+        for r in range(n):
+            acc += weights[r] * vec[r, i]
+        amps[i] = acc * modal[i]
+        harmonic += weights[i] * hrm[i]
+    harmonic *= complex(math.cos(omega * t0), math.sin(omega * t0))
+    amps[n], amps[n + 1] = 0.5 * harmonic, 0.5 * np.conj(harmonic)
+
+
+@njit(cache=True, error_model="numpy")
+def _piece_factors(rates, inverse, omega, a, length, pair, single, fourier, ea, el):
+    """E(s) = int_a^{a+L} e^{s u} du = e^{s a} (e^{s L} - 1) / s for every sum of two rates (``pair``), every rate
+    (``single``) and every rate - jw (``fourier``; the last entry: the constant's, s = -jw); near s L = 0 by the series.
+    Every exponential is a product of the m exponentials e^{r_k a}, e^{r_k L} of this piece."""
+    m = rates.size
+    for k in range(m):
+        ea[k] = np.exp(rates[k] * a)
+        el[k] = np.exp(rates[k] * length)
+    wa = complex(math.cos(omega * a), -math.sin(omega * a))
+    wl = complex(math.cos(omega * length), -math.sin(omega * length))
+    for k in range(m):
+        for l in range(k, m):
+            s = rates[k] + rates[l]
+            growth = ea[k] * ea[l]
+            if abs(s) * length >= 0.5:
+                pair[k, l] = growth * (el[k] * el[l] - 1.0) * inverse[k, l]
             else:
-                _state(lam, vec, hrm, cst, omega, t_piece, modal, t, y)
-                x1, x2 = y[0], y[1]
-                contact = 0.0
-            moments[row, 0] += w * x1 * phasor
-            moments[row, 1] += w * x2 * phasor
-            moments[row, 2] += w * contact * phasor
-            moments[row, 3] += w * x1 * x1
-            moments[row, 4] += w * x2 * x2
+                pair[k, l] = growth * length * _series(s * length)
+        s = rates[k]
+        single[k] = ea[k] * ((el[k] - 1.0) / s if abs(s) * length >= 0.5 else length * _series(s * length))
+        s = rates[k] - complex(0.0, omega)
+        fourier[k] = ea[k] * wa * ((el[k] * wl - 1.0) * inverse[m, k] if abs(s) * length >= 0.5 else length * _series(s * length))
+    s = complex(0.0, -omega)
+    fourier[m] = wa * ((wl - 1.0) / s if abs(s) * length >= 0.5 else length * _series(s * length))
+
+
+@njit(cache=True, error_model="numpy")
+def _integrals(amps, constant, length, pair, single, fourier, phasor, out, slot_fourier, slot_square):
+    """Add int x e^{-jwt} dt (``phasor`` = e^{-jw t0}) to out[slot_fourier] and int x^2 dt to out[slot_square]
+    (if >= 0) for x = sum_k amps_k e^{rates_k u} + constant, from the piece's factors."""
+    m = amps.size
+    total = constant * fourier[m]
+    for k in range(m):
+        total += amps[k] * fourier[k]
+    out[slot_fourier] += total * phasor
+    if slot_square < 0:
+        return
+    square = constant * constant * length + 0j
+    for k in range(m):
+        square += amps[k] * (2.0 * constant * single[k] + amps[k] * pair[k, k])
+        for l in range(k + 1, m):
+            square += 2.0 * amps[k] * amps[l] * pair[k, l]
+    out[slot_square] += square.real
+
+
+@njit(cache=True, error_model="numpy")
+def _add_moments(moments, row, stuck, lam, vec, hrm, cst, slam, svec, shrm, scst, omega, t_piece, modal, ta, tb, clearance, k2, b2, free_rates, stuck_rates, buffers, weights):
+    """Add the piece's Fourier and square integrals over [ta, tb] to ``moments[row]``, in closed form (the motion is
+    a sum of exponentials): X1 and X2 times e^{-jwt}, the holding force times e^{-jwt} while stuck, X1^2 and X2^2."""
+    rates, inverse = stuck_rates if stuck else free_rates
+    m = rates.size
+    amps, pair, single, fourier = buffers[0][:m], buffers[1][:m, :m], buffers[2][:m], buffers[3][: m + 1]
+    a, length = ta - t_piece, tb - ta
+    _piece_factors(rates, inverse, omega, a, length, pair, single, fourier, buffers[4][:m], buffers[5][:m])
+    phasor = complex(math.cos(omega * t_piece), -math.sin(omega * t_piece))
+    out = moments[row]
+    if stuck:
+        _amplitudes(slam, svec, shrm, modal, omega, t_piece, weights[2], amps)
+        _integrals(amps, scst[0], length, pair, single, fourier, phasor, out, 0, 3)
+        _integrals(amps[:0], clearance, length, pair, single, fourier[m:], phasor, out, 1, 4)  # X2 = Delta
+        _amplitudes(slam, svec, shrm, modal, omega, t_piece, weights[3], amps)
+        _integrals(amps, k2 * (scst[0] - clearance) + b2 * scst[1], length, pair, single, fourier, phasor, out, 2, -1)
+        return
+    _amplitudes(lam, vec, hrm, modal, omega, t_piece, weights[0], amps)
+    _integrals(amps, cst[0], length, pair, single, fourier, phasor, out, 0, 3)
+    _amplitudes(lam, vec, hrm, modal, omega, t_piece, weights[1], amps)
+    _integrals(amps, cst[1], length, pair, single, fourier, phasor, out, 1, 4)
