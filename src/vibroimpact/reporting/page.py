@@ -148,7 +148,8 @@ def saved(drawn: Iterable[DrawnFigure | None], out: Path) -> list[Figure]:
             continue
         try:
             data = pickle.dumps(figure.figure)
-        except (pickle.PicklingError, TypeError, AttributeError):
+        except Exception:  # noqa: BLE001 - any figure that does not pickle (a lambda formatter; pandas caches filled
+            # while being pickled: "dictionary changed size during iteration", seen on clearance_peaks) is drawn here
             pending.append((figure, _png(figure.figure)))
             continue
         plt.close(figure.figure)
