@@ -23,7 +23,7 @@ from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.simulation.settings import START_MODES, SWEEP_STARTS, SteadySettings
 
 if TYPE_CHECKING:
-    from vibroimpact.scene.bifurcation import BifurcationSettings
+    from vibroimpact.scene.bifurcation_settings import BifurcationSettings
 
 __all__ = [
     "Scene",
