@@ -249,3 +249,26 @@ def test_exact_jacobians_give_the_floquet_exponent_on_the_one_impact_orbit(frequ
     spectrum = lyapunov_spectrum(trajectory.strobe_jacobians)
     assert spectrum.spectrum[0] == pytest.approx(truth[0], abs=3.0 * spectrum.error + 0.02)
     assert spectrum.spectrum.sum() == pytest.approx(truth.sum(), abs=1e-6)
+
+
+def test_exponent_along_a_run_of_a_linear_motion_is_its_slowest_decay() -> None:
+    """Far from the stop the map is the flow exp(A T): every separation decays like the slowest mode, so the exponent
+    is max Re(lambda) T per period (to 1 % over 320 periods: the separation turns in that mode's plane, and the mean
+    converges like 1 / n), and the run used as its own reference gives what two separate trajectories give."""
+    from vibroimpact.orbits.lyapunov import lyapunov_two_trajectories
+
+    from vibroimpact.engines.exact import ExactEngine
+    from vibroimpact.model.contact import RigidStop
+    from vibroimpact.model.excitation import HarmonicForce
+    from vibroimpact.model.problem import ImpactProblem
+    from vibroimpact.model.system import PAPER_SYSTEM
+    from vibroimpact.orbits.lyapunov import lyapunov_along_run
+
+    problem = ImpactProblem(PAPER_SYSTEM, RigidStop(1.0, 0.5), HarmonicForce(10.0, 25.0))
+    run = ExactEngine().integrate(problem, np.zeros(4), 0.0, 320)
+    estimate = lyapunov_along_run(ExactEngine(), problem, run, every=8)
+    slowest = float(np.max(np.linalg.eigvals(PAPER_SYSTEM.state_matrix).real)) * problem.period
+    assert estimate.exponent == pytest.approx(slowest, rel=1e-2)
+    separate = lyapunov_two_trajectories(ExactEngine(), problem, np.zeros(4), 0.0, 320, renormalise_every=8)
+    assert estimate.exponent == pytest.approx(separate.exponent, rel=1e-6)
+    assert estimate.periods == 288  # exact: 40 intervals of 8 periods, the first 4 discarded

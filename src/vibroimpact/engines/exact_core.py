@@ -6,13 +6,15 @@ each cached function only, so a change in a function called from another file wo
 
 The algorithm is :mod:`.exact_python`'s (closed-form flow, guaranteed first-root search by Taylor bounds, impact map,
 sticking and release, strobes, Fourier moments), compiled with ``@njit(cache=True)``: the interpreter overhead of the
-pure-Python loop was ~99 % of its cost (README, "The compiled exact core"). Flows are passed as arrays:
+pure-Python loop was ~97 % of its cost (README, "Speed: before and after the compiled core"). Flows are passed as
+arrays:
 
 * ``lam`` (n,) eigenvalues, ``vec`` (n, n) eigenvectors, ``inv`` (n, n) their inverse, ``hrm`` (n,) the complex
   amplitude Y of the harmonic particular solution Re(Y e^{jwt}), ``cst`` (n,) the constant particular solution;
   the free flow has n = 4 (X1, X2, X1', X2'), the stuck flow n = 2 (X1, X1') with X2 = Delta, X2' = 0.
-* an observable h = w . y + offset of a piece from (t0, y0) is ``amp`` (n,) complex (per eigenvalue), ``har``
-  (complex), ``con`` (float): h(t) = Re(sum amp_i e^{lam_i (t - t0)} + har e^{jwt}) + con.
+* an observable h = w . y + offset of a piece from (t0, y0) is ``amp`` complex (one per eigenvalue; the root search
+  keeps one of each conjugate pair, doubled), ``har`` (complex), ``con`` (float):
+  h(t) = Re(sum amp_i e^{lam_i (t - t0)} + har e^{jwt}) + con.
 
 The Jacobian of the stroboscopic map is the product, over the pieces of a period, of the state-transition matrices
 Re(V diag(e^{lam dt}) V^-1) and of the saltation matrix of each event (Leine & Nijmeijer; di Bernardo et al.):
@@ -284,14 +286,14 @@ def _closest_approach(lam, amp, har, con, omega, t0, ta, tb, fastest, best):
     """Largest interior local maximum of h on (ta, tb) (h' from + to -), if above best[0]: stored in best."""
     chunks = max(2, int(math.ceil(fastest * (tb - ta) / 0.5)))
     d = np.empty(3)
-    h_prev = ta
+    t_prev = ta
     _derivatives(lam, amp, har, con, omega, t0, ta, d)
     slope_prev = d[1]
     for c in range(1, chunks + 1):
         t = ta + (tb - ta) * c / chunks
         _derivatives(lam, amp, har, con, omega, t0, t, d)
-        if slope_prev > 0.0 and d[1] < 0.0 and c < chunks + 1:
-            lo, hi = h_prev, t
+        if slope_prev > 0.0 and d[1] < 0.0:
+            lo, hi = t_prev, t
             for _ in range(200):  # bisection on h' (sign + at lo, - at hi)
                 mid = 0.5 * (lo + hi)
                 if mid <= lo or mid >= hi:
@@ -305,7 +307,7 @@ def _closest_approach(lam, amp, har, con, omega, t0, ta, tb, fastest, best):
             if lo > ta and lo < tb and d[0] > best[0]:
                 best[0], best[1] = d[0], lo
             _derivatives(lam, amp, har, con, omega, t0, t, d)
-        slope_prev, h_prev = d[1], t
+        slope_prev, t_prev = d[1], t
 
 
 @njit(cache=True, error_model="numpy")

@@ -23,10 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from vibroimpact.engines.base import Engine
+from vibroimpact.engines.base import Engine, Trajectory
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["LyapunovEstimate", "lyapunov_from_jacobians", "lyapunov_spectrum", "lyapunov_two_trajectories", "block_estimate", "state_scales"]
+__all__ = ["LyapunovEstimate", "lyapunov_from_jacobians", "lyapunov_spectrum", "lyapunov_two_trajectories", "lyapunov_along_run", "block_estimate", "state_scales"]
 
 #: A generic start direction: no component zero, no simple relation between components (so that it has a component
 #: along every Oseledets direction, with probability one).
@@ -288,6 +288,48 @@ def lyapunov_two_trajectories(
         t = float(reference.strobe_times[-1])
     kept = growth[transient:]
     exponent, error = block_estimate(kept, blocks)
+    return LyapunovEstimate(exponent, error, kept.size * every, kept, np.array([exponent]), np.array([error]))
+
+
+def lyapunov_along_run(engine: Engine, problem: ImpactProblem, run: Trajectory, every: int, relative_size: float = 1e-6) -> LyapunovEstimate:
+    """Largest Lyapunov exponent [1/period] of any engine along a run it made: a copy perturbed by ``relative_size``
+    (of :func:`state_scales`) restarts from the run's strobe every ``every`` periods and its separation from the run's
+    next strobe is measured and renormalised (Benettin), as :func:`lyapunov_two_trajectories` does, but with the run
+    itself as the reference trajectory, so the estimate costs one more run of the same length instead of two.
+
+    Parameters
+    ----------
+    engine : Engine
+        The engine that made ``run``.
+    problem : ImpactProblem
+        The problem.
+    run : Trajectory
+        The reference, on the attractor, over at least ``every`` periods.
+    every : int
+        Periods between renormalisations (>= 1).
+    relative_size : float
+        delta, the separation (see :func:`lyapunov_two_trajectories` for the choice).
+
+    Returns
+    -------
+    LyapunovEstimate
+        The first tenth of the intervals is discarded while the separation aligns; the error is the spread of 10
+        block averages.
+    """
+    intervals = run.periods // every
+    scale = state_scales(problem)
+    direction = _GENERIC[:4] / np.linalg.norm(_GENERIC[:4])
+    growth = np.empty(intervals)
+    for i in range(intervals):
+        start = run.strobe_states[i * every]
+        d = _inside(problem, start, direction * relative_size, scale)
+        copy = engine.integrate(problem, start + d * scale, float(run.strobe_times[i * every]), every)
+        separation = (copy.final_state - run.strobe_states[(i + 1) * every]) / scale
+        length = float(np.linalg.norm(separation))
+        growth[i] = np.log(max(length, 1e-300) / relative_size) / every
+        direction = separation / length if length > 0.0 else direction
+    kept = growth[intervals // 10 :]
+    exponent, error = block_estimate(kept, 10)
     return LyapunovEstimate(exponent, error, kept.size * every, kept, np.array([exponent]), np.array([error]))
 
 

@@ -23,7 +23,7 @@ from vibroimpact.engines.base import Engine, Trajectory
 from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import HybridInfo, MapEvaluation
-from vibroimpact.orbits.lyapunov import LyapunovEstimate, block_estimate, state_scales
+from vibroimpact.orbits.lyapunov import lyapunov_along_run, state_scales
 from vibroimpact.orbits.motion import MotionEvidence, classify_motion, classify_strobes
 from vibroimpact.orbits.shooting import ShootingError, ShootingSettings, shoot
 
@@ -120,11 +120,10 @@ def motion_evidence(engine: Engine, problem: ImpactProblem, run: Trajectory, eve
         The problem.
     run : Trajectory
         A run on the attractor. With ``strobe_jacobians`` (``exact``) the exact exponent and the strobes decide;
-        otherwise the strobes and an exponent of the engine's own: a copy perturbed by 1e-6 of the motion's scale
-        (see :func:`vibroimpact.orbits.lyapunov.lyapunov_two_trajectories` for that size) restarts from the run's
-        strobes every ``every`` periods, and the growth of its separation from the run is averaged (Benettin). The
-        run is the reference trajectory, so the estimate costs one more run of the same length (following only the
-        run's second half left 61 of the restitution study's 1505 points undecided instead of 32).
+        otherwise the strobes and an exponent of the engine's own (:func:`vibroimpact.orbits.lyapunov.lyapunov_along_run`:
+        a copy perturbed by 1e-6 of the motion's scale restarts from the run's strobes; one more run of the same
+        length; following only the run's second half left 61 of the restitution study's 1505 points undecided
+        instead of 32).
     every : int, optional
         Periods between renormalisations of the separation (>= 1); by default a 32nd of the run, at most 32. Each is
         a new engine call; over 32 periods a separation of 1e-6 grows to at most ~1e-3 on the paper's chaotic
@@ -133,30 +132,7 @@ def motion_evidence(engine: Engine, problem: ImpactProblem, run: Trajectory, eve
     if run.strobe_jacobians.shape[0]:
         return classify_motion(run.strobe_jacobians, run.strobe_states)
     every = min(32, max(1, run.periods // 32)) if every is None else every
-    first = 0
-    intervals = run.periods // every
-    if intervals < 10:
+    if run.periods // every < 10:
         return classify_strobes(run.strobe_states)
-    return classify_strobes(run.strobe_states, _exponent_along(engine, problem, run, every, first, intervals))
+    return classify_strobes(run.strobe_states, lyapunov_along_run(engine, problem, run, every))
 
-
-def _exponent_along(engine: Engine, problem: ImpactProblem, run: Trajectory, every: int, first: int, intervals: int, size: float = 1e-6) -> LyapunovEstimate:
-    """Largest Lyapunov exponent [1/period] from copies of ``run`` perturbed by ``size`` at its strobes ``first``,
-    ``first + 1``, ... (in intervals of ``every`` periods)."""
-    scale = state_scales(problem)
-    direction = np.array([0.5406, -0.3212, 0.7188, 0.3005])
-    direction /= np.linalg.norm(direction)
-    growth = np.empty(intervals)
-    for i in range(first, first + intervals):
-        start = run.strobe_states[i * every]
-        d = direction * size
-        if start[1] + d[1] * scale[1] > problem.clearance:
-            d[1] = -abs(d[1])  # never start the copy inside the stop
-        copy = engine.integrate(problem, start + d * scale, float(run.strobe_times[i * every]), every)
-        separation = (copy.final_state - run.strobe_states[(i + 1) * every]) / scale
-        length = float(np.linalg.norm(separation))
-        growth[i - first] = np.log(max(length, 1e-300) / size) / every
-        direction = separation / length if length > 0.0 else direction
-    kept = growth[intervals // 10 :]
-    exponent, error = block_estimate(kept, 10)
-    return LyapunovEstimate(exponent, error, kept.size * every, kept, np.array([exponent]), np.array([error]))
