@@ -27,7 +27,6 @@ from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
 from vibroimpact.simulation.periodic import motion_evidence, shoot_orbit
 from vibroimpact.simulation.settings import START_MODES, SteadySettings
-from vibroimpact.orbits.lyapunov import state_scales
 from vibroimpact.orbits.motion import MotionEvidence
 
 __all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "pgf_guesses", "orbit_stop_of", "START_MODES"]
@@ -175,7 +174,7 @@ def steady_state(
         if shot is not None and shot.stable:
             t, y = shot.time, shot.state
             if engine.name == "exact":  # the orbit is the steady state: measure it
-                return _measure(engine, problem, t, y, 1, used, settings)
+                return _measure(engine, problem, t, y, 1, used, settings, scale)
             first_chunk = 3  # an integrator starts on the orbit: it needs only to confirm that its state repeats
         else:
             start = "pgf"  # no stable orbit near the closed form: march from it, perturbed
@@ -194,7 +193,7 @@ def steady_state(
         multiplicity = _repeat(recent, scale, settings)
         if multiplicity:
             break
-    return _measure(engine, problem, t, y, multiplicity, used, settings)
+    return _measure(engine, problem, t, y, multiplicity, used, settings, scale)
 
 
 #: Longest period [excitation periods] recognised in the strobes of the long run of a motion that marching did not
@@ -202,13 +201,15 @@ def steady_state(
 LONG_MULTIPLICITY = 32
 
 
-def _measure(engine: Engine, problem: ImpactProblem, t: float, y: NDArray[np.float64], multiplicity: int, searched: int, settings: SteadySettings) -> SteadyResult:
+def _measure(
+    engine: Engine, problem: ImpactProblem, t: float, y: NDArray[np.float64], multiplicity: int, searched: int, settings: SteadySettings, scale: NDArray[np.float64]
+) -> SteadyResult:
     """Measure whole periods from (t, y): a periodic motion over a multiple of its period.
 
     A motion that did not converge first runs ``lyapunov_periods`` more (with the exact Jacobians for ``exact``):
     if its strobes then repeat with a period up to :data:`LONG_MULTIPLICITY`, it is that periodic orbit, reached
-    late; otherwise that run says what the motion is (:func:`motion_evidence`), and ``irregular_measure_periods``
-    are measured after it.
+    late (the same repeat test as marching's, on the same ``scale`` of the motion); otherwise that run says what the
+    motion is (:func:`motion_evidence`), and ``irregular_measure_periods`` are measured after it.
     """
     motion = None
     periods = 0
@@ -217,7 +218,6 @@ def _measure(engine: Engine, problem: ImpactProblem, t: float, y: NDArray[np.flo
         run = engine.integrate(problem, y, t, settings.lyapunov_periods, jacobians=True) if exact else engine.integrate(problem, y, t, settings.lyapunov_periods)
         periods = settings.lyapunov_periods
         t, y = float(run.strobe_times[-1]), run.final_state
-        scale = state_scales(problem)
         multiplicity = _repeat(run.strobe_states[-(3 * LONG_MULTIPLICITY + 1) :], scale, replace(settings, max_multiplicity=LONG_MULTIPLICITY))
         if not multiplicity:
             motion = motion_evidence(engine, problem, run)
