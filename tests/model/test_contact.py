@@ -103,7 +103,7 @@ def test_bumper_force_law() -> None:
 @pytest.mark.parametrize(
     ("make", "fragment"),
     [
-        (lambda: KelvinVoigtBumper(clearance=-1e-3, frequency=250.0, loss_factor=0.5), "clearance = -0.001 is out of range"),
+        (lambda: KelvinVoigtBumper(clearance=float("nan"), frequency=250.0, loss_factor=0.5), "clearance: expected a finite number"),
         (lambda: KelvinVoigtBumper(clearance=1e-3, frequency=0.0, loss_factor=0.5), "frequency = 0.0 is out of range"),
         (lambda: KelvinVoigtBumper(clearance=1e-3, frequency=250.0, loss_factor=-0.1), "loss_factor = -0.1 is out of range"),
         (lambda: RigidStop(clearance=1e-3, restitution=1.2), "restitution = 1.2 is out of range: allowed [0, 1]"),

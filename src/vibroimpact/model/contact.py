@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING
 
 from scipy.optimize import brentq
 
-from vibroimpact.model.validation import require_in_range, require_non_negative, require_positive
+from vibroimpact.model.validation import require_finite, require_in_range, require_non_negative, require_positive
 
 if TYPE_CHECKING:
     import numpy as np
@@ -73,7 +73,7 @@ class Impact:
 
 @dataclass(frozen=True)
 class RigidStop:
-    """Momentary-impact stop: clearance Delta [m] >= 0 and restitution ratio R [-] in [0, 1].
+    """Momentary-impact stop: clearance Delta [m] (negative: a preloading stop) and restitution ratio R [-] in [0, 1].
 
     The stop bounds the absorber's displacement from above, X2 <= Delta. Its law, applied by every rigid-stop engine
     (the engines only find when the absorber reaches it and whether it pushes there):
@@ -89,7 +89,7 @@ class RigidStop:
     restitution: float = field(metadata={"units": "1"})
 
     def __post_init__(self) -> None:
-        require_non_negative("clearance", self.clearance)
+        require_finite("clearance", self.clearance)
         require_in_range("restitution", self.restitution, 0.0, 1.0)
 
     def holding_force(self, system: TwoDofSystem, x1: float | NDArray[np.float64], v1: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
@@ -137,7 +137,7 @@ class KelvinVoigtBumper:
     loss_factor: float = field(metadata={"units": "1"})
 
     def __post_init__(self) -> None:
-        require_non_negative("clearance", self.clearance)
+        require_finite("clearance", self.clearance)
         require_positive("frequency", self.frequency)
         require_non_negative("loss_factor", self.loss_factor)
 

@@ -16,20 +16,89 @@ from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.model.validation import require_non_negative, require_positive
 
-__all__ = ["HarmonicForce", "SweptSine"]
+__all__ = ["HarmonicForce", "SweptSine", "load_weights", "static_load"]
+
+
+def _vector(name: str, value: object) -> tuple[float, ...] | None:
+    if value is None:
+        return None
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"{name}: expected a list of numbers (one per coordinate), got {value!r}") from error
+    if array.ndim != 1 or array.size == 0 or not np.all(np.isfinite(array)):
+        raise ValueError(f"{name}: expected a list of finite numbers (one per coordinate), got {value!r}")
+    return tuple(float(v) for v in array)
+
+
+def load_weights(weights: tuple[float, ...] | None, size: int, key: str = "excitation.on") -> NDArray[np.float64]:
+    """The harmonic load's distribution over ``size`` coordinates: ``weights``, or e_1 (the primary mass) if None."""
+    if weights is None:
+        out = np.zeros(size)
+        out[0] = 1.0
+        return out
+    if len(weights) != size:
+        raise ValueError(f"{key}: expected {size} weights (one per coordinate), got {len(weights)}")
+    return np.array(weights, dtype=float)
+
+
+def static_load(static: tuple[float, ...] | None, size: int, key: str = "excitation.static") -> NDArray[np.float64]:
+    """The constant force per coordinate [N] (zeros if None)."""
+    if static is None:
+        return np.zeros(size)
+    if len(static) != size:
+        raise ValueError(f"{key}: expected {size} forces (one per coordinate), got {len(static)}")
+    return np.array(static, dtype=float)
 
 
 @dataclass(frozen=True)
 class HarmonicForce:
-    """q cos(2 pi f t + phase) [N] on the primary mass."""
+    """A harmonic load q cos(2 pi f t + phase), distributed over the coordinates, plus an optional constant force.
+
+    Parameters
+    ----------
+    amplitude : float
+        q [N] (or, for ``base_motion``, the base displacement amplitude Y [m]), >= 0.
+    frequency : float
+        f [Hz], > 0.
+    phase : float
+        Phase at t = 0 [rad].
+    weights : tuple of float, optional
+        Distribution of the load over the coordinates (force per coordinate per unit q [-]); None: all of it on the
+        first coordinate (the paper's primary mass).
+    static : tuple of float, optional
+        Constant force on each coordinate [N] (e.g. gravity, -m g); None: none.
+    base_motion : bool
+        The base moves as Y cos(2 pi f t + phase) and the coordinates are measured relative to it: the load is the
+        inertial force M 1 Y w^2 cos(w t + phase) [N] (every coordinate is carried by the base).
+    """
 
     amplitude: float = field(metadata={"units": "N"})
     frequency: float = field(metadata={"units": "Hz"})
     phase: float = field(default=0.0, metadata={"units": "rad"})
+    weights: tuple[float, ...] | None = None
+    static: tuple[float, ...] | None = field(default=None, metadata={"units": "N"})
+    base_motion: bool = False
 
     def __post_init__(self) -> None:
         require_non_negative("amplitude", self.amplitude)
         require_positive("frequency", self.frequency)
+        object.__setattr__(self, "weights", _vector("excitation.on", self.weights))
+        object.__setattr__(self, "static", _vector("excitation.static", self.static))
+        if self.base_motion and self.weights is not None:
+            raise ValueError("excitation: a base motion loads every coordinate through its mass; give no 'on' weights with it")
+
+    def load_vector(self, mass_matrix: NDArray[np.float64]) -> NDArray[np.complex128]:
+        """Complex amplitude of the harmonic load per coordinate [N]: the load is Re(F e^{jwt})."""
+        size = mass_matrix.shape[0]
+        phasor = complex(math.cos(self.phase), math.sin(self.phase))
+        if self.base_motion:
+            return mass_matrix @ np.ones(size) * self.amplitude * self.omega**2 * phasor
+        return load_weights(self.weights, size) * self.amplitude * phasor
+
+    def static_vector(self, size: int) -> NDArray[np.float64]:
+        """Constant force per coordinate [N]."""
+        return static_load(self.static, size)
 
     @property
     def omega(self) -> float:
@@ -60,14 +129,22 @@ class SweptSine:
         Frequency at the end [Hz], > 0 (below ``start_frequency`` for a sweep down).
     rate : float
         |alpha| [Hz s-1], > 0; the sign follows the direction of the sweep.
+    weights : tuple of float, optional
+        Distribution of the force over the coordinates (see :class:`HarmonicForce`); None: the first coordinate.
+    static : tuple of float, optional
+        Constant force per coordinate [N].
     """
 
     amplitude: float = field(metadata={"units": "N"})
     start_frequency: float = field(metadata={"units": "Hz"})
     stop_frequency: float = field(metadata={"units": "Hz"})
     rate: float = field(metadata={"units": "Hz s-1"})
+    weights: tuple[float, ...] | None = None
+    static: tuple[float, ...] | None = field(default=None, metadata={"units": "N"})
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "weights", _vector("excitation.on", self.weights))
+        object.__setattr__(self, "static", _vector("excitation.static", self.static))
         require_non_negative("amplitude", self.amplitude)
         require_positive("start_frequency", self.start_frequency)
         require_positive("stop_frequency", self.stop_frequency)

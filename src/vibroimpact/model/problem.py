@@ -16,12 +16,16 @@ from numpy.typing import NDArray
 
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
 from vibroimpact.model.excitation import HarmonicForce, SweptSine
+from vibroimpact.model.stops import Stop
+from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["Contact", "Excitation", "ImpactProblem"]
+__all__ = ["Contact", "Excitation", "ImpactProblem", "Structure"]
 
 #: The contact laws a problem may have.
 Contact = Union[RigidStop, KelvinVoigtBumper]
+#: The structures a problem may have.
+Structure = Union[TwoDofSystem, LinearStructure]
 #: The excitations a problem may have.
 Excitation = Union[HarmonicForce, SweptSine]
 
@@ -35,25 +39,26 @@ def _part_of_kind(name: str, value: object, kind: type[_Kind], why: str) -> _Kin
     return value
 
 
-_PARTS = {"system": (TwoDofSystem,), "contact": (RigidStop, KelvinVoigtBumper), "excitation": (HarmonicForce, SweptSine)}
+_PARTS = {"system": (TwoDofSystem, LinearStructure), "contact": (RigidStop, KelvinVoigtBumper, tuple), "excitation": (HarmonicForce, SweptSine)}
 
 
 @dataclass(frozen=True)
 class ImpactProblem:
-    """The system of eq. 1 with a contact on the absorber and a force on the primary mass.
+    """A linear structure with stops and a harmonic (or swept) load.
 
     Parameters
     ----------
-    system : TwoDofSystem
-        Masses, springs and dashpots.
-    contact : RigidStop or KelvinVoigtBumper
-        The momentary-impact stop (clearance, restitution) or the compliant bumper (clearance, frequency, loss factor).
+    system : TwoDofSystem or LinearStructure
+        Masses, springs and dashpots: the paper's named two-mass system, or any N-dof structure.
+    contact : RigidStop, KelvinVoigtBumper or tuple of Stop
+        A single contact law means the paper's stop: an upper stop of the absorber (coordinate 2) against the base.
+        A tuple of :class:`Stop` gives any layout (any number, absolute or relative, upper or lower).
     excitation : HarmonicForce or SweptSine
-        q cos(w t + phase), or the linear swept sine of the paper's Simulink test.
+        q cos(w t + phase) distributed over the coordinates (plus a constant force), or the linear swept sine.
     """
 
-    system: TwoDofSystem
-    contact: Contact
+    system: Structure
+    contact: Contact | tuple[Stop, ...]
     excitation: Excitation
 
     def __post_init__(self) -> None:
@@ -62,22 +67,123 @@ class ImpactProblem:
             if not isinstance(value, kinds):
                 allowed = " or ".join(kind.__name__ for kind in kinds)
                 raise TypeError(f"{name} = {value!r} is not allowed: expected a {allowed}")
+        if isinstance(self.contact, tuple):
+            for stop in self.contact:
+                if not isinstance(stop, Stop):
+                    raise TypeError(f"contact: {stop!r} is not a Stop")
+                stop.check_size(self.system.size)
+        elif self.system.size < 2:
+            raise ValueError("contact: a single contact law means the paper's stop on coordinate 2; give a tuple of Stop instead")
+        size = self.system.size
+        for key, vector in (("excitation.on", self.excitation.weights), ("excitation.static", self.excitation.static)):
+            if vector is not None and len(vector) != size:
+                raise ValueError(f"{key}: expected {size} values (one per coordinate), got {len(vector)}")
+
+    # ----------------------------------------------------------------- structure
+    @property
+    def structure(self) -> LinearStructure:
+        """The system as a :class:`LinearStructure` (matrices and coordinate names)."""
+        return self.system.structure
+
+    @property
+    def size(self) -> int:
+        """N, the number of degrees of freedom (the state has 2 N entries: displacements, then velocities)."""
+        return self.system.size
+
+    @property
+    def stops(self) -> tuple[Stop, ...]:
+        """Every stop of the problem (one upper stop on the absorber for a single contact law)."""
+        if isinstance(self.contact, tuple):
+            return self.contact
+        return (Stop(self.contact, coordinate=1, other=None, side="upper"),)
+
+    @property
+    def paper_layout(self) -> bool:
+        """The paper's layout: two masses, one upper absolute stop on the absorber, force on the primary mass only."""
+        stops = self.stops
+        excitation = self.excitation
+        weights_ok = excitation.weights is None or tuple(excitation.weights) == (1.0, 0.0)
+        static_ok = excitation.static is None or not any(excitation.static)
+        base = isinstance(excitation, HarmonicForce) and excitation.base_motion
+        return (self.size == 2 and len(stops) == 1 and stops[0].coordinate == 1 and stops[0].other is None and stops[0].side == "upper"
+                and weights_ok and static_ok and not base)  # fmt: skip
+
+    def normals(self) -> NDArray[np.float64]:
+        """n of every stop, shape (K, N): gap_k = Delta_k - n_k . x."""
+        return np.array([stop.normal(self.size) for stop in self.stops]).reshape(-1, self.size)
+
+    def clearances(self) -> NDArray[np.float64]:
+        """Delta of every stop [m], shape (K,)."""
+        return np.array([stop.clearance for stop in self.stops])
+
+    def load(self) -> tuple[NDArray[np.complex128], NDArray[np.float64]]:
+        """(F, F0): the harmonic load Re(F e^{jwt}) and the constant load, per coordinate [N].
+
+        For a swept sine, F is the distribution of q (the sweep's own signal multiplies it).
+        """
+        size = self.size
+        excitation = self.excitation
+        if isinstance(excitation, HarmonicForce):
+            return excitation.load_vector(self.structure.mass_matrix), excitation.static_vector(size)
+        from vibroimpact.model.excitation import load_weights, static_load
+
+        return load_weights(excitation.weights, size).astype(complex) * excitation.amplitude, static_load(excitation.static, size)
+
+    def first_order(self) -> tuple[NDArray[np.float64], NDArray[np.complex128], NDArray[np.float64]]:
+        """(A, b, b0): the free flight as y' = A y + Re(b e^{jwt}) + b0 with y = (x, x') [SI]."""
+        structure = self.structure
+        size = self.size
+        harmonic, static = self.load()
+        minv = np.linalg.inv(structure.mass_matrix)
+        b = np.concatenate([np.zeros(size, dtype=complex), minv @ harmonic])
+        b0 = np.concatenate([np.zeros(size), minv @ static])
+        return structure.state_matrix, b, b0
+
+    def gap_amplitude(self, stop: int = 0) -> float:
+        """|n . H(jw) F|: the amplitude of stop ``stop``'s coordinate in the linear motion without stops [m]."""
+        harmonic, _ = self.load()
+        n = self.stops[stop].normal(self.size)
+        h = self.structure.receptance_matrix(self.omega)
+        return float(abs(n @ h @ harmonic))
+
+    def contact_holding(self, stop: int, state: NDArray[np.float64], t: float) -> float:
+        """Force lambda [N] that stop ``stop`` must exert to hold its gap closed (g = 0, g' = 0) in ``state`` at t.
+
+        lambda = n . M^-1 (f(t) - C x' - K x) / (n . M^-1 n); positive: the structure is pushed into the stop (it
+        sticks); it leaves when lambda turns negative. Equals :meth:`RigidStop.holding_force` on the paper's layout.
+        """
+        structure = self.structure
+        size = self.size
+        harmonic, static = self.load()
+        force = static + (harmonic * complex(np.cos(self.omega * t), np.sin(self.omega * t))).real
+        x, v = np.asarray(state[:size], dtype=float), np.asarray(state[size : 2 * size], dtype=float)
+        n = self.stops[stop].normal(size)
+        minv_n = np.linalg.solve(structure.mass_matrix, n)
+        return float(minv_n @ (force - structure.damping_matrix @ v - structure.stiffness_matrix @ x) / (n @ minv_n))
 
     # ------------------------------------------------------------------ contact
     @property
+    def law(self) -> Contact:
+        """The contact law of the problem's only stop (``ValueError`` if it has several: ask :attr:`stops`)."""
+        stops = self.stops
+        if len(stops) != 1:
+            raise ValueError(f"contact: the problem has {len(stops)} stops; a single-stop quantity needs exactly one")
+        return stops[0].law
+
+    @property
     def clearance(self) -> float:
-        """Delta [m]: where the contact begins."""
-        return self.contact.clearance
+        """Delta [m] of the only stop: where the contact begins."""
+        return self.law.clearance
 
     @property
     def rigid_stop(self) -> RigidStop:
-        """The contact, which must be a :class:`RigidStop` (``TypeError`` naming the contact otherwise)."""
-        return _part_of_kind("contact", self.contact, RigidStop, "a momentary-impact engine solves a rigid stop only")
+        """The only stop's law, which must be a :class:`RigidStop` (``TypeError`` naming the contact otherwise)."""
+        return _part_of_kind("contact", self.law, RigidStop, "a momentary-impact engine solves a rigid stop only")
 
     @property
     def bumper(self) -> KelvinVoigtBumper:
-        """The contact, which must be a :class:`KelvinVoigtBumper` (``TypeError`` naming the contact otherwise)."""
-        return _part_of_kind("contact", self.contact, KelvinVoigtBumper, "a compliant engine solves a bumper only")
+        """The only stop's law, which must be a :class:`KelvinVoigtBumper` (``TypeError`` naming the contact otherwise)."""
+        return _part_of_kind("contact", self.law, KelvinVoigtBumper, "a compliant engine solves a bumper only")
 
     @property
     def restitution(self) -> float:
@@ -129,6 +235,10 @@ class ImpactProblem:
         return self.excitation.force(t)
 
     def velocity_scale(self) -> float:
-        """A velocity typical of the harmonic motion, w (Delta + q |H12|) [m s-1], for relative thresholds."""
-        linear = self.amplitude * float(np.abs(self.system.receptances(self.omega).h12))
-        return self.omega * (self.clearance + linear) + 1e-300
+        """A velocity typical of the harmonic motion [m s-1], for relative thresholds: w (Delta + q |H12|) on the
+        paper's layout, and in general w times the largest |Delta_k| + |n_k . H F| over the stops."""
+        _, static = self.load()
+        minv_static = np.linalg.solve(self.structure.mass_matrix, static)
+        # a static load's length: how far it moves a stop's coordinate in 1/w [s] (gravity on a free mass)
+        sizes = [abs(stop.clearance) + self.gap_amplitude(k) + abs(stop.normal(self.size) @ minv_static) / self.omega**2 for k, stop in enumerate(self.stops)]
+        return self.omega * max(sizes) + 1e-300

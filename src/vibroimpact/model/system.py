@@ -13,10 +13,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.validation import require_positive, require_non_negative
 
 __all__ = ["TwoDofSystem", "Receptances", "PAPER_SYSTEM"]
@@ -97,6 +99,37 @@ class TwoDofSystem:
         minv = np.linalg.inv(self.mass_matrix)
         zero, eye = np.zeros((2, 2)), np.eye(2)
         return np.block([[zero, eye], [-minv @ self.stiffness_matrix, -minv @ self.damping_matrix]])
+
+    @cached_property
+    def structure(self) -> LinearStructure:
+        """The same system as a :class:`LinearStructure` with coordinates ``x1`` (primary) and ``x2`` (absorber)."""
+        return LinearStructure(self.mass_matrix, self.stiffness_matrix, self.damping_matrix, ("x1", "x2"))
+
+    @property
+    def size(self) -> int:
+        """N = 2 degrees of freedom."""
+        return 2
+
+    @property
+    def coordinates(self) -> tuple[str, str]:
+        """Names of the coordinates: ``x1`` (primary mass), ``x2`` (absorber)."""
+        return ("x1", "x2")
+
+    def index(self, name: str, key: str = "coordinate") -> int:
+        """Index of the coordinate called ``name`` (``x1`` or ``x2``)."""
+        return self.structure.index(name, key)
+
+    def receptance_matrix(self, omega: ArrayLike) -> NDArray[np.complex128]:
+        """H(j w) [m N-1], shape omega.shape + (2, 2) (see :meth:`LinearStructure.receptance_matrix`)."""
+        return self.structure.receptance_matrix(omega)
+
+    def receptance(self, omega: ArrayLike, output: ArrayLike, load: ArrayLike) -> NDArray[np.complex128]:
+        """output^T H(j w) load [m N-1] (see :meth:`LinearStructure.receptance`)."""
+        return self.structure.receptance(omega, output, load)
+
+    def rigid_body_modes(self) -> int:
+        """0: both springs are positive."""
+        return 0
 
     # --------------------------------------------------------------- polynomials
     def characteristic_polynomial(self) -> NDArray[np.float64]:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["require_positive", "require_non_negative", "require_in_range"]
+__all__ = ["require_finite", "require_positive", "require_non_negative", "require_in_range"]
 
 
 def _number(name: str, value: object) -> float:
@@ -14,6 +14,11 @@ def _number(name: str, value: object) -> float:
     if not math.isfinite(number):
         raise ValueError(f"{name}: expected a finite number, got {value!r}")
     return number
+
+
+def require_finite(name: str, value: object) -> float:
+    """Return ``value`` as float if it is a finite number, else raise ``ValueError`` naming ``name``."""
+    return _number(name, value)
 
 
 def require_positive(name: str, value: object) -> float:

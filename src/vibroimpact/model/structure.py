@@ -1,0 +1,204 @@
+"""A linear structure of N degrees of freedom: mass, stiffness and damping matrices and the names of its coordinates.
+
+Equations of motion, without contact forces::
+
+    M x'' + C x' + K x = f(t)
+
+``M`` must be symmetric positive definite, ``K`` and ``C`` symmetric positive semi-definite (a zero stiffness is a
+free mass: a rigid-body mode). The paper's two-mass system (:class:`~vibroimpact.model.system.TwoDofSystem`) is one
+such structure, whose :attr:`~vibroimpact.model.system.TwoDofSystem.structure` gives the same matrices.
+
+Coordinates are displacements [m] measured from the position of the unloaded springs (relative to the base when the
+excitation is a base motion, see :mod:`.excitation`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = ["LinearStructure", "as_matrix_rows"]
+
+#: Relative tolerance of the symmetry and definiteness checks.
+_TOLERANCE = 1e-12
+
+
+def as_matrix_rows(name: str, value: object, size: int | None = None) -> tuple[tuple[float, ...], ...]:
+    """``value`` as a square matrix of finite floats, in rows of tuples; ``ValueError`` naming ``name`` otherwise.
+
+    Parameters
+    ----------
+    name : str
+        Key of the matrix, for the message (e.g. ``system.mass``).
+    value : array_like
+        The matrix.
+    size : int, optional
+        The required number of rows and columns.
+    """
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"{name}: expected a square matrix of numbers (a list of rows), got {value!r}") from error
+    if array.ndim != 2 or array.shape[0] != array.shape[1] or array.shape[0] == 0:
+        raise ValueError(f"{name}: expected a square matrix (a list of N rows of N numbers), got shape {array.shape}")
+    if size is not None and array.shape[0] != size:
+        raise ValueError(f"{name}: expected {size} x {size} like system.mass, got {array.shape[0]} x {array.shape[1]}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name}: every entry must be a finite number, got {value!r}")
+    return tuple(tuple(float(entry) for entry in row) for row in array)
+
+
+def _check_symmetric_definite(name: str, matrix: NDArray[np.float64], positive: bool) -> None:
+    scale = float(np.max(np.abs(matrix))) if matrix.size else 0.0
+    asymmetry = float(np.max(np.abs(matrix - matrix.T))) if matrix.size else 0.0
+    if asymmetry > _TOLERANCE * scale:
+        raise ValueError(f"{name}: must be symmetric, but differs from its transpose by up to {asymmetry:.3g}")
+    eigenvalues = np.linalg.eigvalsh(0.5 * (matrix + matrix.T))
+    smallest = float(eigenvalues[0])
+    if positive and smallest <= _TOLERANCE * scale:
+        raise ValueError(f"{name}: must be positive definite (every mass > 0), but its smallest eigenvalue is {smallest:.6g}")
+    if not positive and smallest < -_TOLERANCE * scale:
+        raise ValueError(f"{name}: must be positive semi-definite (no negative spring or dashpot), but it has the eigenvalue {smallest:.6g}")
+
+
+@dataclass(frozen=True)
+class LinearStructure:
+    """Masses, springs and dashpots of a linear structure of N degrees of freedom.
+
+    Parameters
+    ----------
+    mass : array_like, shape (N, N)
+        M [kg], symmetric positive definite.
+    stiffness : array_like, shape (N, N)
+        K [N m-1], symmetric positive semi-definite (zero rows: free masses).
+    damping : array_like, shape (N, N), optional
+        C [N s m-1], symmetric positive semi-definite; zero by default.
+    coordinates : sequence of str, optional
+        Names of the coordinates, unique; ``x1, x2, ...`` by default.
+
+    Raises
+    ------
+    ValueError
+        Naming the key (``system.mass``, ``system.stiffness``, ``system.damping``, ``system.coordinates``) and what is
+        wrong: shape, symmetry, definiteness, finiteness, names.
+    """
+
+    mass: tuple[tuple[float, ...], ...] = field(metadata={"units": "kg"})
+    stiffness: tuple[tuple[float, ...], ...] = field(metadata={"units": "N m-1"})
+    damping: tuple[tuple[float, ...], ...] = field(default=(), metadata={"units": "N s m-1"})
+    coordinates: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        mass = as_matrix_rows("system.mass", self.mass)
+        size = len(mass)
+        stiffness = as_matrix_rows("system.stiffness", self.stiffness, size)
+        if isinstance(self.damping, tuple) and len(self.damping) == 0:
+            damping = tuple(tuple(0.0 for _ in range(size)) for _ in range(size))
+        else:
+            damping = as_matrix_rows("system.damping", self.damping, size)
+        _check_symmetric_definite("system.mass", np.array(mass), positive=True)
+        _check_symmetric_definite("system.stiffness", np.array(stiffness), positive=False)
+        _check_symmetric_definite("system.damping", np.array(damping), positive=False)
+        names = tuple(self.coordinates) if len(self.coordinates) else tuple(f"x{i + 1}" for i in range(size))
+        if len(names) != size:
+            raise ValueError(f"system.coordinates: expected {size} names (one per row of system.mass), got {len(names)}: {list(names)}")
+        for name in names:
+            if not isinstance(name, str) or not name.isidentifier():
+                raise ValueError(f"system.coordinates: {name!r} is not a valid name (letters, digits and _, not starting with a digit)")
+        if len(set(names)) != size:
+            raise ValueError(f"system.coordinates: names must be unique, got {list(names)}")
+        object.__setattr__(self, "mass", mass)
+        object.__setattr__(self, "stiffness", stiffness)
+        object.__setattr__(self, "damping", damping)
+        object.__setattr__(self, "coordinates", names)
+
+    # ------------------------------------------------------------------ matrices
+    @property
+    def size(self) -> int:
+        """N, the number of degrees of freedom."""
+        return len(self.mass)
+
+    @property
+    def mass_matrix(self) -> NDArray[np.float64]:
+        """M [kg]."""
+        return np.array(self.mass, dtype=float)
+
+    @property
+    def stiffness_matrix(self) -> NDArray[np.float64]:
+        """K [N m-1]."""
+        return np.array(self.stiffness, dtype=float)
+
+    @property
+    def damping_matrix(self) -> NDArray[np.float64]:
+        """C [N s m-1]."""
+        return np.array(self.damping, dtype=float)
+
+    @property
+    def state_matrix(self) -> NDArray[np.float64]:
+        """First-order state matrix A [s-1] for the state (x, x'): y' = A y + (0, M^-1 f)."""
+        n = self.size
+        minv = np.linalg.inv(self.mass_matrix)
+        return np.block([[np.zeros((n, n)), np.eye(n)], [-minv @ self.stiffness_matrix, -minv @ self.damping_matrix]])
+
+    @property
+    def structure(self) -> LinearStructure:
+        """Itself (the paper's :class:`TwoDofSystem` answers the same with its matrices)."""
+        return self
+
+    def index(self, name: str, key: str = "coordinate") -> int:
+        """Index of the coordinate called ``name``; ``ValueError`` naming ``key`` and the allowed names otherwise."""
+        if name not in self.coordinates:
+            raise ValueError(f"{key} = {name!r} is not a coordinate of the system: allowed {list(self.coordinates)}")
+        return self.coordinates.index(name)
+
+    # ---------------------------------------------------------------- receptances
+    def receptance_matrix(self, omega: ArrayLike) -> NDArray[np.complex128]:
+        """H(j w) = (K - w^2 M + j w C)^-1 [m N-1], shape omega.shape + (N, N), vectorised.
+
+        Infinite (NaN) where the undamped structure resonates exactly, or at w = 0 for a free mass.
+        """
+        w = np.asarray(omega, dtype=float)[..., None, None]
+        dynamic = self.stiffness_matrix - w**2 * self.mass_matrix + 1j * w * self.damping_matrix
+        with np.errstate(all="ignore"):
+            try:
+                return np.linalg.inv(dynamic)
+            except np.linalg.LinAlgError:
+                out = np.full(dynamic.shape, np.nan + 0j)
+                flat, fout = dynamic.reshape(-1, self.size, self.size), out.reshape(-1, self.size, self.size)
+                for i, block in enumerate(flat):
+                    if np.linalg.cond(block) < 1e15:
+                        fout[i] = np.linalg.inv(block)
+                return out
+
+    def receptance(self, omega: ArrayLike, output: ArrayLike, load: ArrayLike) -> NDArray[np.complex128]:
+        """output^T H(j w) load [m N-1]: the response of the coordinate combination ``output`` (e.g. e2 - e1, a
+        relative displacement) to a unit harmonic load distributed as ``load`` (weights per coordinate)."""
+        h = self.receptance_matrix(omega)
+        return np.einsum("i,...ij,j->...", np.asarray(output, dtype=float), h, np.asarray(load, dtype=float))
+
+    # ---------------------------------------------------------------- modes
+    def rigid_body_modes(self) -> int:
+        """Number of rigid-body modes: the dimension of the null space of K (free masses, floating structures)."""
+        stiffness = self.stiffness_matrix
+        scale = float(np.max(np.abs(stiffness))) if np.any(stiffness) else 0.0
+        if scale == 0.0:
+            return self.size
+        return int(np.sum(np.linalg.eigvalsh(stiffness) <= 1e-10 * scale))
+
+    def natural_frequencies(self) -> NDArray[np.float64]:
+        """Undamped natural angular frequencies, ascending [rad s-1] (0 for each rigid-body mode)."""
+        chol = np.linalg.cholesky(self.mass_matrix)
+        inv = np.linalg.inv(chol)
+        eigenvalues = np.linalg.eigvalsh(inv @ self.stiffness_matrix @ inv.T)
+        return np.sqrt(np.maximum(eigenvalues, 0.0))
+
+    def as_dict(self) -> dict[str, object]:
+        """Plain dictionary of the matrices (SI units) and names, for dataset attributes."""
+        return {"mass": [list(r) for r in self.mass], "stiffness": [list(r) for r in self.stiffness],
+                "damping": [list(r) for r in self.damping], "coordinates": list(self.coordinates)}  # fmt: skip
+
+    def __repr__(self) -> str:
+        return f"LinearStructure(N={self.size}, coordinates={list(self.coordinates)}, natural frequencies {np.round(self.natural_frequencies() / (2 * math.pi), 4).tolist()} Hz)"
