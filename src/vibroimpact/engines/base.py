@@ -30,28 +30,38 @@ class Trajectory:
         What was integrated.
     strobe_times : ndarray, shape (n + 1,)
         t_start + k T [s], k = 0 ... n.
-    strobe_states : ndarray, shape (n + 1, 4)
-        (X1, X2, X1', X2') at the strobe times [m, m, m s-1, m s-1] (after any impact at that instant).
+    strobe_states : ndarray, shape (n + 1, 2 N)
+        (x_1 ... x_N, x_1' ... x_N') at the strobe times [m, m s-1] (after any impact at that instant); for the paper's
+        system (X1, X2, X1', X2').
     impact_times : ndarray
         Times of the impacts [s].
     impact_velocities : ndarray
-        Absorber velocity just before each impact, > 0 [m s-1].
+        Approach speed of the stop's coordinate just before each impact, n . x'(t-) > 0 [m s-1] (the absorber's
+        velocity for the paper's stop).
     impulses : ndarray
-        M2 (X2'(t-) - X2'(t+)) of each impact [N s]: M2 (1 + R) X2'(t-), or M2 X2'(t-) for the impact that ends a
-        chattering sequence in sticking.
+        Impulse of each impact [N s]: m_eff (1 + R) v, or m_eff v for the impact that ends a chattering sequence in
+        sticking (m_eff = M2 for the paper's stop, see :class:`~vibroimpact.model.stops.Stop`).
     segments : ndarray, shape (s, 3)
-        Rows (start [s], end [s], mode): ``MODE_FREE`` flight or ``MODE_STUCK`` (absorber held at the stop).
-    segment_states : ndarray, shape (s, 4)
+        Rows (start [s], end [s], mode): ``MODE_FREE`` flight or ``MODE_STUCK`` (a stop held closed).
+    segment_states : ndarray, shape (s, 2 N)
         State at the start of each segment (after the event that began it).
-    moments : ndarray of complex, shape (n, 5) or (0, 5)
-        Per period, when requested: integrals of X1 e^{-jwt}, X2 e^{-jwt} [m s], of the contact force e^{-jwt}
-        (impulses plus holding force while stuck) [N s], and of X1^2, X2^2 [m2 s] (real).
+    moments : ndarray of complex, shape (n, 2 N + K) or (0, 2 N + K)
+        Per period, when requested: integrals of x_i e^{-jwt} for each coordinate [m s], of each stop's contact force
+        e^{-jwt} (impulses plus holding force while stuck) [N s], and of x_i^2 [m2 s] (real); for the paper's system
+        (X1, X2, F, X1^2, X2^2).
     contact_peaks : ndarray, shape (c, 2)
         Compliant contacts only: largest contact force [N] and largest absorber deceleration [m s-2] of each contact.
     stats : dict
         Engine counters (steps, rhs calls, events, grazing checks ...).
-    strobe_jacobians : ndarray, shape (n, 4, 4) or (0, 4, 4)
+    strobe_jacobians : ndarray, shape (n, 2 N, 2 N) or (0, 2 N, 2 N)
         ``exact`` engine on request: entry k is the exact Jacobian of period k's stroboscopic map, d y_{k+1} / d y_k.
+    impact_stops : ndarray of int
+        Index (into ``problem.stops``) of the stop of each impact.
+    segment_stops : ndarray of int, shape (s,)
+        Index of the stop held closed in each ``MODE_STUCK`` segment (or in contact, for a compliant engine), -1 in
+        free flight.
+    contact_peak_stops : ndarray of int, shape (c,)
+        Index of the stop of each row of ``contact_peaks``.
     """
 
     problem: ImpactProblem
@@ -66,11 +76,22 @@ class Trajectory:
     contact_peaks: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 2)))
     stats: dict[str, int] = field(default_factory=dict)
     strobe_jacobians: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 4, 4)))
+    impact_stops: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    segment_stops: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    contact_peak_stops: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
     def __post_init__(self) -> None:
+        # engines that know one stop only leave the stop indices empty: every impact, stuck segment and peak is stop 0
+        if self.impact_stops.size != self.impact_times.size:
+            object.__setattr__(self, "impact_stops", np.zeros(self.impact_times.size, dtype=np.int64))
+        if self.segment_stops.size != self.segments.shape[0]:
+            stuck = self.segments[:, 2] == MODE_STUCK if self.segments.size else np.zeros(0, dtype=bool)
+            object.__setattr__(self, "segment_stops", np.where(stuck, 0, -1).astype(np.int64))
+        if self.contact_peak_stops.size != self.contact_peaks.shape[0]:
+            object.__setattr__(self, "contact_peak_stops", np.zeros(self.contact_peaks.shape[0], dtype=np.int64))
         for name in (
             "strobe_times", "strobe_states", "impact_times", "impact_velocities", "impulses", "segments", "segment_states", "moments",
-            "contact_peaks", "strobe_jacobians",
+            "contact_peaks", "strobe_jacobians", "impact_stops", "segment_stops", "contact_peak_stops",
         ):  # fmt: skip
             getattr(self, name).setflags(write=False)
 
@@ -94,53 +115,63 @@ class Trajectory:
 class TrajectoryBuilder:
     """Accumulates what an engine finds while it integrates; :meth:`build` freezes it into a :class:`Trajectory`.
 
-    Engines report physical states (X1, X2, X1', X2'), segment starts, impacts, moments of the running period and
-    strobes; segment ends are the next segment's start (or the last strobe), so zero-length segments vanish.
+    Engines report physical states (x, x'), segment starts, impacts, moments of the running period and strobes;
+    segment ends are the next segment's start (or the last strobe), so zero-length segments vanish.
     """
 
     def __init__(self, problem: ImpactProblem, moments: bool) -> None:
         self.problem, self.moments = problem, moments
+        self.size, self.stop_count = problem.size, len(problem.stops)
+        #: columns of a period's moments: coordinates, contact forces per stop, squares of the coordinates
+        self.width = 2 * self.size + self.stop_count
         self._strobe_times: list[float] = []
         self._strobe_states: list[NDArray[np.float64]] = []
         self._impacts: list[tuple[float, float, float]] = []
+        self._impact_stops: list[int] = []
         self._segments: list[tuple[float, int]] = []
+        self._segment_stops: list[int] = []
         self._segment_states: list[NDArray[np.float64]] = []
         self._period_moments: list[NDArray[np.complex128]] = []
         self._peaks: list[tuple[float, float]] = []
-        self._current = np.zeros(5, dtype=complex)
+        self._peak_stops: list[int] = []
+        self._current = np.zeros(self.width, dtype=complex)
         self.stats: dict[str, int] = {"impacts": 0, "sticks": 0, "releases": 0}
 
-    def impact(self, t: float, velocity: float, impulse: float, in_moments: bool = True) -> None:
-        """An impact at time t [s] with pre-impact velocity [m s-1] and impulse [N s].
+    def impact(self, t: float, velocity: float, impulse: float, in_moments: bool = True, stop: int = 0) -> None:
+        """An impact on stop ``stop`` at time t [s] with approach velocity [m s-1] and impulse [N s].
 
-        A momentary impulse's Fourier term is added to the contact-force moment; a compliant contact's force is
-        integrated continuously instead (``in_moments=False``).
+        A momentary impulse's Fourier term is added to the stop's contact-force moment; a compliant contact's force
+        is integrated continuously instead (``in_moments=False``).
         """
         self._impacts.append((t, velocity, impulse))
+        self._impact_stops.append(stop)
         self.stats["impacts"] += 1
         if self.moments and in_moments:
-            self._current[2] += impulse * complex(math.cos(self.problem.omega * t), -math.sin(self.problem.omega * t))
+            self._current[self.size + stop] += impulse * complex(math.cos(self.problem.omega * t), -math.sin(self.problem.omega * t))
 
-    def contact_peaks(self, force: float, acceleration: float) -> None:
-        """Largest contact force [N] and absorber deceleration [m s-2] of the last compliant contact."""
+    def contact_peaks(self, force: float, acceleration: float, stop: int = 0) -> None:
+        """Largest contact force [N] and deceleration of the stopped coordinate [m s-2] of the last compliant contact."""
         self._peaks.append((force, acceleration))
+        self._peak_stops.append(stop)
 
-    def segment(self, t: float, mode: int, state: NDArray[np.float64]) -> None:
-        """A new segment (``MODE_FREE`` or ``MODE_STUCK``) starts at time t [s] in ``state``."""
+    def segment(self, t: float, mode: int, state: NDArray[np.float64], stop: int = -1) -> None:
+        """A new segment (``MODE_FREE``, or ``MODE_STUCK`` on stop ``stop``) starts at time t [s] in ``state``."""
         self._segments.append((t, mode))
-        self._segment_states.append(np.array(state[:4], dtype=float))
+        self._segment_stops.append(stop if mode == MODE_STUCK and stop >= 0 else (0 if mode == MODE_STUCK else -1))
+        self._segment_states.append(np.array(state[: 2 * self.size], dtype=float))
 
     def add_moments(self, values: NDArray[np.complex128]) -> None:
-        """Add integrals (X1, X2, holding force times e^{-jwt}; X1^2, X2^2) to the running period."""
+        """Add integrals (coordinates and contact forces times e^{-jwt}; squares of the coordinates) to the running
+        period, shape (2 N + K,)."""
         self._current += values
 
     def strobe(self, t: float, state: NDArray[np.float64]) -> None:
         """A period boundary at time t [s]: record the state and close the running period's moments."""
         if self._strobe_times and self.moments:
             self._period_moments.append(self._current)
-            self._current = np.zeros(5, dtype=complex)
+            self._current = np.zeros(self.width, dtype=complex)
         self._strobe_times.append(t)
-        self._strobe_states.append(np.array(state[:4], dtype=float))
+        self._strobe_states.append(np.array(state[: 2 * self.size], dtype=float))
 
     def build(self, stats: dict[str, int] | None = None) -> Trajectory:
         """The immutable trajectory, with ``stats`` merged into the builder's counters."""
@@ -148,18 +179,22 @@ class TrajectoryBuilder:
         ends = np.append(starts[1:], self._strobe_times[-1]) if starts.size else starts
         keep = ends > starts
         impacts = np.array(self._impacts, dtype=float).reshape(-1, 3)
+        states = 2 * self.size
         return Trajectory(
             problem=self.problem,
             strobe_times=np.array(self._strobe_times),
-            strobe_states=np.array(self._strobe_states).reshape(-1, 4),
+            strobe_states=np.array(self._strobe_states).reshape(-1, states),
             impact_times=impacts[:, 0].copy(),
             impact_velocities=impacts[:, 1].copy(),
             impulses=impacts[:, 2].copy(),
             segments=np.column_stack([starts, ends, [s[1] for s in self._segments]]).reshape(-1, 3)[keep],
-            segment_states=np.array(self._segment_states).reshape(-1, 4)[keep],
-            moments=np.array(self._period_moments, dtype=complex).reshape(-1, 5),
+            segment_states=np.array(self._segment_states).reshape(-1, states)[keep],
+            moments=np.array(self._period_moments, dtype=complex).reshape(-1, self.width),
             contact_peaks=np.array(self._peaks, dtype=float).reshape(-1, 2),
             stats=self.stats | (stats or {}),
+            impact_stops=np.array(self._impact_stops, dtype=np.int64),
+            segment_stops=np.array(self._segment_stops, dtype=np.int64)[keep] if keep.size else np.zeros(0, dtype=np.int64),
+            contact_peak_stops=np.array(self._peak_stops, dtype=np.int64),
         )
 
 
@@ -239,5 +274,6 @@ def check_run(engine: str, problem: ImpactProblem, contact: type[Contact], perio
     """
     if periods < 0:
         raise ValueError(f"periods = {periods} is out of range: allowed [0, inf)")
-    if not isinstance(problem.contact, contact):
-        raise TypeError(f"engine {engine!r} solves a {contact.__name__}, not problem.contact = {problem.contact!r}")
+    for k, stop in enumerate(problem.stops):
+        if not isinstance(stop.law, contact):
+            raise TypeError(f"engine {engine!r} solves a {contact.__name__}, not stop {k}'s contact = {stop.law!r}")
