@@ -104,7 +104,7 @@ def test_a_negative_period_count_is_refused(engine: str) -> None:
 
 def test_a_start_beyond_the_stop_is_refused() -> None:
     problem = ImpactProblem(PAPER_SYSTEM, RigidStop(PAPER_CLEARANCE, 0.4), HarmonicForce(PAPER_AMPLITUDE, 25.0))
-    with pytest.raises(ValueError, match="penetrates stop 0 \(x2 <= "):
+    with pytest.raises(ValueError, match=r"penetrates stop 0 \(x2 <= "):
         make_engine("momentary").integrate(problem, np.array([0.0, 2 * PAPER_CLEARANCE, 0.0, 0.0]), 0.0, 1)
 
 

@@ -130,7 +130,7 @@ def test_restitution_law_at_every_impact(system: TwoDofSystem) -> None:
 
 def test_rejects_a_start_inside_the_stop(system: TwoDofSystem) -> None:
     problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.3), HarmonicForce(PAPER_AMPLITUDE, 26.0))
-    with pytest.raises(ValueError, match="penetrates stop 0 \(x2 <= "):
+    with pytest.raises(ValueError, match=r"penetrates stop 0 \(x2 <= "):
         ENGINE.integrate(problem, np.array([0.0, 0.004, 0.0, 0.0]), 0.0, 1)
 
 
