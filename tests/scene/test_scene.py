@@ -191,7 +191,7 @@ MISTAKES = [
     ("restitution-negative", _set("stop", "restitution", -0.1), ["stop.restitution: -0.1 is out of range: allowed [0, 1]"]),
     ("restitution-sweep-item", _sweep_restitution([0.2, 1.2]), ["sweep.restitution[1]: 1.2 is out of range: allowed [0, 1]"]),
     ("restitution-sweep-string", _sweep_restitution([0.2, "x"]), ["sweep.restitution[1]: expected a number", "'x'"]),
-    ("negative-clearance", _set("stop", "clearance", -0.001), ["stop.clearance: -0.001 is out of range: allowed [0, inf"]),
+    ("infinite-clearance", _set("stop", "clearance", float("inf")), ["stop.clearance: inf is out of range: allowed (-inf, inf)"]),
     ("zero-frequency-list", _sweep_frequency([0.0, 10.0]), ["sweep.frequency[0]: 0.0 is out of range: allowed (0, inf"]),
     ("negative-frequency-start", _sweep_frequency({"start": -5, "stop": 10, "step": 1}), ["sweep.frequency.start: -5 is out of range: allowed (0, inf"]),
     ("empty-grid", _sweep_frequency([]), ["sweep.frequency: empty grid: give at least one value"]),
@@ -217,7 +217,7 @@ MISTAKES = [
     ("missing-system-k2", _drop("system", "k2"), ["system.k2: required key is missing"]),
     ("missing-amplitude", _drop("excitation", "amplitude"), ["excitation.amplitude: required key is missing"]),
     ("restitution-nowhere", _drop("stop", "restitution"), ["stop.restitution: required unless swept (sweep.restitution)", "allowed range [0, 1]"]),
-    ("clearance-nowhere", _drop("stop", "clearance"), ["stop.clearance: required unless swept (sweep.clearance)", "allowed range [0, inf"]),
+    ("clearance-nowhere", _drop("stop", "clearance"), ["stop.clearance: required unless swept (sweep.clearance)", "allowed range (-inf, inf)"]),
     ("restitution-in-stop-and-sweep", _set("sweep", "restitution", [0.2, 0.4]), ["stop.restitution: also swept in sweep.restitution: give it in one place only"]),
     ("clearance-in-stop-and-sweep", _set("sweep", "clearance", [0.003]), ["stop.clearance: also swept in sweep.clearance: give it in one place only"]),
     ("unknown-solution", _top("solutions", ["linear", "fem"]), ["solutions[1]: unknown name 'fem'", "allowed: linear, pgf, pgf_paper"]),
@@ -370,7 +370,7 @@ def test_cli_empty_file_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[st
 
 def test_cli_existing_empty_out_stays_empty(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """An existing --out folder is left untouched by a bad scene."""
-    path = write_yaml(tmp_path / "bad.yaml", scene_with(_set("stop", "clearance", -1.0)))
+    path = write_yaml(tmp_path / "bad.yaml", scene_with(_set("stop", "clearance", float("inf"))))
     out = tmp_path / "out"
     out.mkdir()
     assert cli.main([str(path), "--out", str(out)]) == 2

@@ -33,7 +33,8 @@ __all__ = ["read_yaml", "parse_scene", "load_scene"]
 
 class _UniqueKeyLoader(yaml.SafeLoader):
     """``yaml.SafeLoader`` that refuses a key repeated in one mapping (PyYAML silently keeps the last one) and reads
-    YAML 1.2 numbers such as ``3e-3`` as floats (YAML 1.1, PyYAML's default, reads them as strings)."""
+    YAML 1.2 numbers such as ``3e-3`` as floats (YAML 1.1, PyYAML's default, reads them as strings) and YAML 1.2
+    booleans (``true``/``false`` only: ``on``, ``off``, ``yes``, ``no`` stay strings, so ``on: x1`` is a key)."""
 
     def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
         seen: set[Any] = set()
@@ -45,6 +46,12 @@ class _UniqueKeyLoader(yaml.SafeLoader):
         return super().construct_mapping(node, deep=deep)
 
 
+# YAML 1.2 booleans: only true/false (YAML 1.1 also reads on/off/yes/no as booleans, so `on: x1` lost its key)
+_UniqueKeyLoader.yaml_implicit_resolvers = {
+    first: [(tag, regexp) for tag, regexp in resolvers if tag != "tag:yaml.org,2002:bool"]
+    for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
+}
+_UniqueKeyLoader.add_implicit_resolver("tag:yaml.org,2002:bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF"))
 _UniqueKeyLoader.add_implicit_resolver(
     "tag:yaml.org,2002:float",
     re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),

@@ -19,7 +19,9 @@ from vibroimpact.engines.settings import ATOL_RATIO, STEPPED_TOLERANCES, EngineS
 from vibroimpact.model.contact import KelvinVoigtBumper, loss_factor_from_restitution
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.scene.layout import LoadSpec, StopSpec
 from vibroimpact.simulation.settings import START_MODES, SWEEP_STARTS, SteadySettings
 
 if TYPE_CHECKING:
@@ -42,6 +44,8 @@ __all__ = [
     "MOTION_QUANTITIES",
     "SWEEPABLE",
     "GRID_DIMS",
+    "STOP_QUANTITIES",
+    "quantities_for",
 ]
 
 #: Kinds of study a scene can be (:attr:`Scene.kind`); each has its run and estimate (``study/kinds.py``) and its page.
@@ -89,11 +93,29 @@ QUANTITIES = (
 )
 #: The evidence of what a non-periodic simulated motion is (NaN where the motion is periodic, and for closed forms).
 MOTION_QUANTITIES = ("lyapunov_exponent", "lyapunov_error", "rotation_number", "spectral_line_fraction")
+#: Quantities with one value per stop (a ``stop`` dimension in a general scene with several stops).
+STOP_QUANTITIES = ("impulse", "one_impact_impulse", "peak_acceleration", "peak_contact_force")
+#: Quantities with one value per coordinate: ``x1``/``x2`` in the paper's names, ``<name>`` in a general scene.
+_PER_COORDINATE = {"x1_amplitude": "{}_amplitude", "one_impact_x1_amplitude": "one_impact_{}_amplitude", "x1_rms": "{}_rms"}
+
+
+def quantities_for(coordinates: tuple[str, ...]) -> tuple[str, ...]:
+    """The quantities a scene with these coordinates can ask for: :data:`QUANTITIES` with the per-coordinate ones
+    (``x1_amplitude``, ``x2_amplitude`` ...) named after each coordinate (the same tuple for ``x1, x2``)."""
+    out: list[str] = []
+    for quantity in QUANTITIES:
+        if quantity in _PER_COORDINATE:
+            out += [_PER_COORDINATE[quantity].format(name) for name in coordinates]
+        elif quantity.replace("x2", "x1") not in _PER_COORDINATE:
+            out.append(quantity)
+    return tuple(out)
+
+
 #: Parameters that can be swept, with their units and allowed ranges (low, high, low inclusive).
 SWEEPABLE = {
     "frequency": ("Hz", 0.0, math.inf, False),
     "restitution": ("1", 0.0, 1.0, True),
-    "clearance": ("m", 0.0, math.inf, True),
+    "clearance": ("m", -math.inf, math.inf, False),
     "bumper_frequency": ("Hz", 0.0, 1e6, False),
     "bumper_loss_factor": ("1", 0.0, 1e3, True),
 }
@@ -281,10 +303,10 @@ class Scene:
         Scene name; output goes to ``<out>/<name>.nc``.
     description : str
         Free text.
-    system : TwoDofSystem
-        The linear system.
+    system : TwoDofSystem or LinearStructure
+        The linear system: the paper's named one, or any structure given by matrices.
     amplitude : float
-        Excitation force amplitude q [N].
+        Excitation amplitude: force q [N] (for a base motion, the base displacement [m]).
     frequency : ndarray
         Excitation frequencies [Hz], increasing.
     restitution : ndarray
@@ -314,11 +336,20 @@ class Scene:
         Whether ``run-study`` writes the comparison report.
     text : str
         The YAML source, stored in the output's attributes.
+    load : LoadSpec or None
+        A general scene's load (weights, static force, base motion); None: the paper's force on the primary mass.
+    stops : tuple of StopSpec
+        A general scene's stops; ``()``: the paper's stop (see :attr:`stop_specs`).
+    sweep_stops : tuple of int or None
+        The stops that swept restitution, clearance and bumper values apply to; None: every stop.
+    general : bool
+        The scene uses the general format (matrices, a load beyond a force on the primary mass, or ``stops``): its
+        outputs are named after its coordinates and stops. False: the paper's named form and outputs.
     """
 
     name: str
     description: str
-    system: TwoDofSystem
+    system: TwoDofSystem | LinearStructure
     amplitude: float
     frequency: np.ndarray
     restitution: np.ndarray
@@ -335,6 +366,25 @@ class Scene:
     bifurcation: "BifurcationSettings | None" = None
     report: bool = True
     text: str = ""
+    load: LoadSpec | None = None
+    stops: tuple[StopSpec, ...] = ()
+    sweep_stops: tuple[int, ...] | None = None
+    general: bool = False
+
+    @property
+    def coordinates(self) -> tuple[str, ...]:
+        """Names of the structure's coordinates (``x1, x2`` for the paper's system)."""
+        return tuple(self.system.coordinates)
+
+    @property
+    def stop_specs(self) -> tuple[StopSpec, ...]:
+        """Every stop: the scene's ``stops``, or the paper's upper stop on the absorber taking the grid's values."""
+        return self.stops or (StopSpec(coordinate=1),)
+
+    @property
+    def load_spec(self) -> LoadSpec:
+        """The load: the scene's, or the paper's force on the primary mass."""
+        return self.load if self.load is not None else LoadSpec()
 
     def loss_factors(self) -> np.ndarray:
         """The bumper's xi_b for each restitution of the grid [-] (NaN where none gives it, R = 0)."""

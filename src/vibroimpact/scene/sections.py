@@ -20,6 +20,9 @@ from vibroimpact.model.contact import restitution_from_loss_factor
 from vibroimpact.model.modal import underdamped_mode_count
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.checker import Checker, SceneError, interval
+from vibroimpact.scene.layout_checks import check_general_solutions
+from vibroimpact.scene.layout_grids import general_grids
+from vibroimpact.scene.layout_parse import is_general, document_names, parse_load, parse_stop_layout, parse_structure, parse_sweep_stops
 from vibroimpact.scene.schema import (
     ENGINE_CONTACT,
     ENGINE_SOLUTIONS,
@@ -31,6 +34,7 @@ from vibroimpact.scene.schema import (
     SWEEP_DIRECTIONS,
     SWEEPABLE,
     Scene,
+    quantities_for,
     SimulationSettings,
     SweptSineSettings,
 )
@@ -39,7 +43,7 @@ from vibroimpact.simulation.settings import SteadySettings
 __all__ = ["TOP_KEYS", "NAME", "parse_grid_scene", "parse_header", "check_sweep_run"]
 
 #: Top-level keys of a grid scene.
-TOP_KEYS = {"name", "description", "system", "excitation", "stop", "bumper", "sweep", "swept_sine", "solutions", "quantities", "settings", "simulation", "report"}
+TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bumper", "sweep", "swept_sine", "solutions", "quantities", "settings", "simulation", "report"}
 #: A scene's or a case's name: safe as a file name.
 NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 #: Simulation keys that only stepped steady states use.
@@ -55,16 +59,33 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     all problems."""
     c = Checker()
     doc = c.mapping("", document, TOP_KEYS, {"name", "system", "excitation", "sweep", "solutions"})
+    general = is_general(doc)
 
-    name, description, system, amplitude, report = parse_header(c, doc)
+    load = None
+    if general:
+        name, description, report = parse_names(c, doc)
+        system = parse_structure(c, doc["system"]) if "system" in doc else None
+        names = tuple(system.coordinates) if system is not None else document_names(doc.get("system"))
+        amplitude, load = parse_load(c, doc["excitation"], names) if "excitation" in doc else (None, None)
+    else:
+        name, description, system, amplitude, report = parse_header(c, doc)
 
-    sweep = c.mapping("sweep", doc.get("sweep", {}), set(SWEEPABLE), {"frequency"}) if "sweep" in doc else {}
+    sweep = c.mapping("sweep", doc.get("sweep", {}), {*SWEEPABLE, "stop"}, {"frequency"}) if "sweep" in doc else {}
     fixed = {
         "stop": c.mapping("stop", doc["stop"], {"clearance", "restitution"}) if "stop" in doc else {},
         "bumper": c.mapping("bumper", doc["bumper"], {"frequency", "loss_factor"}) if "bumper" in doc else {},
     }
     solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
+    specs = parse_stop_layout(c, doc, system)
+    targets = None
+    if "stop" in sweep:
+        if "stops" not in doc:
+            c.fail("sweep.stop", "names which of the scene's stops the swept values apply to: only with a 'stops' list")
+        else:
+            targets = parse_sweep_stops(c, sweep["stop"], len(specs) if specs else None)
+    sweep = {key: value for key, value in sweep.items() if key != "stop"}
     derived_restitution = "bumper_loss_factor" in sweep
+    bumper_solutions = [name for name in solutions if ENGINE_CONTACT.get(name) == BUMPER]
     grids: dict[str, np.ndarray | None] = {}
     for key, (_units, low, high, low_inclusive) in SWEEPABLE.items():
         section, field_name = _FIXED_PLACE.get(key, ("", ""))
@@ -79,27 +100,36 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
             grids[key] = None if value is None else np.array([value])
         elif key == "restitution" and derived_restitution:
             continue  # R(xi_b) of the swept loss factors
-        elif key == "restitution" or key == "clearance":
+        elif (key == "restitution" or key == "clearance") and "stops" not in doc:
             c.fail(place, f"required unless swept (sweep.{key}); allowed range {interval(low, high, low_inclusive)}")
-    if derived_restitution and "restitution" in grids:
+    if derived_restitution and "restitution" in grids and "stops" not in doc:
         c.fail("sweep.bumper_loss_factor", "sweeping the bumper's loss factor sets the restitution R(xi_b): do not also give restitution")
     if derived_restitution and (xi := grids.get("bumper_loss_factor")) is not None:
         grids["restitution"] = np.array([restitution_from_loss_factor(x) for x in xi])
-    bumper_solutions = [name for name in solutions if ENGINE_CONTACT.get(name) == BUMPER]
     needs_bumper = bool(bumper_solutions) or "swept_sine" in doc
-    if needs_bumper and "bumper_frequency" not in sweep and "bumper" not in doc:
-        c.fail("bumper", "required by the compliant solution and swept-sine tests: {frequency: Omega_b / 2 pi [Hz], loss_factor: xi_b (optional)}")
-    elif "bumper" in doc and "bumper_frequency" not in sweep and "frequency" not in fixed["bumper"]:
-        c.fail("bumper.frequency", "required unless swept (sweep.bumper_frequency): Omega_b / 2 pi [Hz] in (0, inf)")
-    if bumper_solutions and "bumper_loss_factor" not in grids and (r := grids.get("restitution")) is not None and np.any(r == 0.0):
-        c.fail("stop.restitution", "R = 0 needs an infinitely damped bumper for the compliant solution: give bumper.loss_factor, or sweep R > 0")
+    if "stops" in doc:
+        if specs is not None:
+            specs = general_grids(c, specs, grids, sweep, {k: v for k, v in fixed["bumper"].items() if not isinstance(v, bool) and isinstance(v, (int, float))}, targets, needs_bumper)
+    else:
+        if needs_bumper and "bumper_frequency" not in sweep and "bumper" not in doc:
+            c.fail("bumper", "required by the compliant solution and swept-sine tests: {frequency: Omega_b / 2 pi [Hz], loss_factor: xi_b (optional)}")
+        elif "bumper" in doc and "bumper_frequency" not in sweep and "frequency" not in fixed["bumper"]:
+            c.fail("bumper.frequency", "required unless swept (sweep.bumper_frequency): Omega_b / 2 pi [Hz] in (0, inf)")
+        if bumper_solutions and "bumper_loss_factor" not in grids and (r := grids.get("restitution")) is not None and np.any(r == 0.0):
+            c.fail("stop.restitution", "R = 0 needs an infinitely damped bumper for the compliant solution: give bumper.loss_factor, or sweep R > 0")
+    if general and system is not None:
+        check_general_solutions(c, solutions, system, specs or (), load, "swept_sine" in doc)
 
     sizes = [g.size for g in grids.values() if g is not None]
     if len(sizes) >= 3 and math.prod(sizes) > MAX_STUDY_POINTS:
         c.fail("sweep", f"{math.prod(sizes):,} points (product of the swept grids) is too many: allowed at most {MAX_STUDY_POINTS:,}")
-    if "pgf_paper" in solutions and system is not None and (modes := underdamped_mode_count(system)) != 2:
+    if "pgf_paper" in solutions and not general and system is not None and (modes := underdamped_mode_count(system)) != 2:
         c.fail("solutions", f"pgf_paper needs two underdamped modes (the paper's eq. 10 fit); this system has {modes}")
-    quantities = c.choices("quantities", doc["quantities"], QUANTITIES) if "quantities" in doc else QUANTITIES
+    allowed = quantities_for(system.coordinates) if general and system is not None else QUANTITIES
+    if len(set(allowed)) != len(allowed):
+        clashing = sorted({q for q in allowed if allowed.count(q) > 1})
+        c.fail("system.coordinates", f"names that make output names clash ({', '.join(clashing)}): rename them (e.g. not 'force')")
+    quantities = c.choices("quantities", doc["quantities"], allowed) if "quantities" in doc else allowed
     if "regime" not in quantities:
         quantities = (*quantities, "regime")
 
@@ -143,7 +173,7 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
         frequency=frequency, restitution=restitution, clearance=clearance, swept=swept,
         solutions=solutions, quantities=quantities, admissibility=admissibility, simulation=simulation,
         bumper_frequency=grids.get("bumper_frequency"), bumper_loss_factor=grids.get("bumper_loss_factor"), swept_sine=swept_sine,
-        report=report, text=text,
+        report=report, text=text, load=load, stops=specs if "stops" in doc and specs is not None else (), sweep_stops=targets, general=general,
     )
 
 
@@ -194,23 +224,33 @@ def check_sweep_run(c: Checker, key: str, low: float, high: float, rate: float |
 
 
 def parse_header(c: Checker, doc: dict) -> tuple[Any, str, TwoDofSystem | None, float | None, bool]:
-    """What every scene has: name, description, system, excitation amplitude and the report switch."""
+    """What every scene in the paper's named form has: name, description, system, excitation amplitude and the report
+    switch."""
+    name, description, report = parse_names(c, doc)
+    system = parse_structure(c, doc.get("system")) if "system" in doc else None
+    if system is not None and not isinstance(system, TwoDofSystem):
+        c.fail("system", "this kind of scene takes the paper's named system {m1, m2, k1, k2, b1, b2} only")
+        system = None
+    amplitude = None
+    if "excitation" in doc:
+        excitation = c.mapping("excitation", doc["excitation"], {"amplitude"}, {"amplitude"})
+        if "amplitude" in excitation:
+            amplitude = c.number("excitation.amplitude", excitation["amplitude"], 0.0, math.inf, low_inclusive=False)
+    return name, description, system, amplitude, report
+
+
+def parse_names(c: Checker, doc: dict) -> tuple[Any, str, bool]:
+    """Name, description and the report switch of any scene."""
     name = doc.get("name")
     if "name" in doc and not (isinstance(name, str) and NAME.match(name)):
         c.fail("name", f"expected a file-name-safe string (letters, digits, '_', '-', '.'), got {name!r}")
     description = doc.get("description", "")
     if not isinstance(description, str):
         c.fail("description", f"expected a string, got {type(description).__name__}")
-    system = _parse_system(c, doc.get("system")) if "system" in doc else None
-    amplitude = None
-    if "excitation" in doc:
-        excitation = c.mapping("excitation", doc["excitation"], {"amplitude"}, {"amplitude"})
-        if "amplitude" in excitation:
-            amplitude = c.number("excitation.amplitude", excitation["amplitude"], 0.0, math.inf, low_inclusive=False)
     report = doc.get("report", True)
     if not isinstance(report, bool):
         c.fail("report", f"expected true or false, got {report!r}")
-    return name, description, system, amplitude, bool(report)
+    return name, description, bool(report)
 
 
 def _parse_simulation(c: Checker, value: Any, default_frequency: np.ndarray, swept: bool = False) -> SimulationSettings | None:
@@ -244,16 +284,3 @@ def _settings(c: Checker, kind: type[_T], kwargs: dict[str, Any]) -> _T | None:
     except (ValueError, TypeError) as error:
         c.fail("simulation." + str(error).split(" ")[0], str(error))
         return None
-
-
-def _parse_system(c: Checker, value: Any) -> TwoDofSystem | None:
-    spec = c.mapping("system", value, {"m1", "m2", "k1", "k2", "b1", "b2"}, {"m1", "m2", "k1", "k2"})
-    numbers: dict[str, float] = {}
-    for key in ("m1", "m2", "k1", "k2", "b1", "b2"):
-        if key in spec:
-            number = c.number(f"system.{key}", spec[key], 0.0, math.inf, low_inclusive=key.startswith("b"))
-            if number is not None:
-                numbers[key] = number
-    if not {"m1", "m2", "k1", "k2"} <= set(numbers) or len(numbers) < len(spec.keys() & {"m1", "m2", "k1", "k2", "b1", "b2"}):
-        return None
-    return TwoDofSystem(**numbers)
