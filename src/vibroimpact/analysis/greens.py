@@ -8,6 +8,15 @@ For a causal impulse response ``h(t) = sum_k r_k exp(p_k t)`` the T-periodic Gre
 
 This is the paper's eq. 12 for any set of poles; eq. 12 itself is kept as :func:`paper_periodic_green` for the
 ``pgf_paper`` variant and as an independent check.
+
+The *antiperiodic* Green function is the response to impulses of alternating sign every half period,
+``psi(t) = sum_{n >= 0} (-1)^n h(t + n T / 2)``, so that psi(t + T/2) = -psi(t); for ``0 <= t <= T/2``::
+
+    psi(t) = sum_k r_k exp(p_k t) / (1 + exp(p_k T / 2))
+
+(the two-sided symmetric stop, :mod:`.two_sided`). Its only harmonics are the odd ones, and unlike chi it stays
+finite for a pole at 0 (a rigid-body mode) since 1 + exp(0) = 2. :func:`green_vector` gives either function for
+every coordinate at once from a :class:`~vibroimpact.model.modal.ModalResponse`.
 """
 
 from __future__ import annotations
@@ -15,12 +24,19 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from vibroimpact.model.modal import ModalParameters, PoleResidueModel
+from vibroimpact.model.modal import ModalParameters, ModalResponse, PoleResidueModel
 
-__all__ = ["periodic_green", "paper_periodic_green"]
+__all__ = ["periodic_green", "paper_periodic_green", "green_vector"]
 
 
-def periodic_green(model: PoleResidueModel, omega: ArrayLike, t: ArrayLike, derivative: int = 0) -> NDArray[np.float64]:
+def _weights(poles: NDArray[np.complex128], t: NDArray[np.float64], period: NDArray[np.float64], derivative: int, antiperiodic: bool) -> NDArray[np.complex128]:
+    """p^d exp(p t) / (1 -+ exp(p T')) with T' = T (periodic) or T/2 (antiperiodic)."""
+    if antiperiodic:
+        return poles**derivative * np.exp(poles * t) / (1.0 + np.exp(poles * 0.5 * period))
+    return poles**derivative * np.exp(poles * t) / (1.0 - np.exp(poles * period))
+
+
+def periodic_green(model: PoleResidueModel, omega: ArrayLike, t: ArrayLike, derivative: int = 0, antiperiodic: bool = False) -> NDArray[np.float64]:
     """Periodic Green function chi(t) (or its time derivative) for excitation angular frequency ``omega``.
 
     Parameters
@@ -34,6 +50,8 @@ def periodic_green(model: PoleResidueModel, omega: ArrayLike, t: ArrayLike, deri
         at t = 0 is the right limit chi^(d)(0+) and at t = T the left limit chi^(d)(T-) = chi^(d)(0-).
     derivative : int
         Order of the time derivative, >= 0.
+    antiperiodic : bool
+        The antiperiodic function psi (impulses of alternating sign every T/2), for 0 <= t <= T/2.
 
     Returns
     -------
@@ -44,8 +62,38 @@ def periodic_green(model: PoleResidueModel, omega: ArrayLike, t: ArrayLike, deri
     tt = np.asarray(t, dtype=float)[..., None]
     period = 2.0 * np.pi / w
     p = model.poles
-    terms = model.residues * p**derivative * np.exp(p * tt) / (1.0 - np.exp(p * period))
-    return np.sum(terms, axis=-1).real
+    if not antiperiodic:  # the paper's path, unchanged
+        terms = model.residues * p**derivative * np.exp(p * tt) / (1.0 - np.exp(p * period))
+        return np.sum(terms, axis=-1).real
+    return np.sum(model.residues * _weights(p, tt, period, derivative, True), axis=-1).real
+
+
+def green_vector(modes: ModalResponse, omega: ArrayLike, t: ArrayLike, derivative: int = 0, antiperiodic: bool = False) -> NDArray[np.float64]:
+    """The periodic (or antiperiodic) Green function of every coordinate, shape broadcast(omega, t) + (N,).
+
+    Parameters
+    ----------
+    modes : ModalResponse
+        Poles and residues of the coordinates' response to a unit impulse along some direction.
+    omega : array_like
+        Excitation angular frequency [rad s-1].
+    t : array_like
+        Time within the period (0 <= t <= T; antiperiodic: 0 <= t <= T/2) [s], broadcast against ``omega``; the ends
+        are one-sided limits as in :func:`periodic_green`.
+    derivative : int
+        Order of the time derivative, >= 0.
+    antiperiodic : bool
+        psi instead of chi (module docstring).
+
+    Returns
+    -------
+    ndarray
+        [m N-1 s-1-derivative], last axis the coordinates.
+    """
+    w = np.asarray(omega, dtype=float)[..., None]
+    tt = np.asarray(t, dtype=float)[..., None]
+    weights = _weights(modes.poles, tt, 2.0 * np.pi / w, derivative, antiperiodic)
+    return np.einsum("...k,ik->...i", weights, modes.residues).real
 
 
 def paper_periodic_green(modes: ModalParameters, omega: ArrayLike, t: ArrayLike) -> NDArray[np.float64]:

@@ -1,4 +1,11 @@
-"""Steady-state response of the linear system (no stop, Delta -> infinity) and its resonance peaks."""
+"""Steady-state response of the linear system (no stop, Delta -> infinity) and its resonance peaks.
+
+:func:`linear_response` and :func:`resonance_peaks` are the paper's named two-mass system (X1, X2, suspension force).
+:func:`linear_amplitudes` is any structure under its problem's load: the complex amplitude of every coordinate,
+H(jw) F(w), and of every stop's coordinate n_k . H F (a relative coordinate x_i - x_j for a relative stop, signed
+by the stop's side), plus the static deflection K^-1 F0 where K is invertible; :func:`structure_peaks` finds the
+maxima of any of them near each natural frequency.
+"""
 
 from __future__ import annotations
 
@@ -8,9 +15,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize_scalar
 
+from vibroimpact.analysis.layout import harmonic_load
+from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["LinearResponse", "linear_response", "ResonancePeak", "resonance_peaks"]
+__all__ = ["LinearResponse", "linear_response", "ResonancePeak", "resonance_peaks", "LinearAmplitudes", "linear_amplitudes", "structure_peaks"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -79,6 +88,104 @@ def resonance_peaks(system: TwoDofSystem, amplitude: float, quantity: str = "x1"
 
     peaks = []
     for mode, omega_n in enumerate(system.natural_frequencies(), start=1):
+        grid = omega_n * np.linspace(1.0 - span, 1.0 + span, 4001)
+        k = int(np.argmax(magnitude(grid)))
+        lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+        best = minimize_scalar(lambda w: -float(magnitude(w)), bounds=(lo, hi), method="bounded", options={"xatol": 1e-10 * omega_n})
+        peaks.append(ResonancePeak(mode=mode, frequency=float(best.x) / (2.0 * np.pi), value=float(-best.fun)))
+    return peaks
+
+
+@dataclass(frozen=True, eq=False)
+class LinearAmplitudes:
+    """The linear steady state of a structure under its problem's load, without stops.
+
+    Attributes
+    ----------
+    omega : ndarray
+        Angular frequencies w [rad s-1], shape S.
+    coordinates : ndarray of complex, shape S + (N,)
+        H(jw) F(w): complex amplitude of each coordinate in the problem's time [m].
+    stops : ndarray of complex, shape S + (K,)
+        n_k . H F: complex amplitude of each stop's coordinate (the quantity its gap Delta_k - n_k . x subtracts) [m].
+    static : ndarray, shape (N,)
+        K^-1 F0, the static deflection [m] (NaN where K is singular and a static load is given; zeros without one).
+    stop_static : ndarray, shape (K,)
+        n_k . K^-1 F0 [m].
+    names : tuple of str
+        The coordinates' names.
+    """
+
+    omega: NDArray[np.float64]
+    coordinates: NDArray[np.complex128]
+    stops: NDArray[np.complex128]
+    static: NDArray[np.float64]
+    stop_static: NDArray[np.float64]
+    names: tuple[str, ...]
+
+    def coordinate(self, name: str) -> NDArray[np.complex128]:
+        """The complex amplitude of the coordinate called ``name`` [m]."""
+        if name not in self.names:
+            raise ValueError(f"coordinate = {name!r} is not a coordinate of the system: allowed {list(self.names)}")
+        return self.coordinates[..., self.names.index(name)]
+
+    def relative(self, first: str, second: str) -> NDArray[np.complex128]:
+        """The complex amplitude of x_first - x_second [m]."""
+        return self.coordinate(first) - self.coordinate(second)
+
+    def fits(self, clearances: ArrayLike) -> NDArray[np.bool_]:
+        """True where every stop's linear coordinate stays inside its clearance: |n_k H F| + n_k K^-1 F0 <= Delta_k."""
+        return np.all(np.abs(self.stops) + self.stop_static <= np.asarray(clearances, dtype=float), axis=-1)
+
+
+def linear_amplitudes(problem: ImpactProblem, omega: ArrayLike | None = None, amplitude: ArrayLike | None = None) -> LinearAmplitudes:
+    """The complex amplitudes of every coordinate and every stop's coordinate over ``omega`` (module docstring).
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+        Structure, stops and a harmonic load (force on any coordinates, or base motion: then the coordinates are
+        relative to the base).
+    omega : array_like, optional
+        w [rad s-1]; default the problem's.
+    amplitude : array_like, optional
+        q [N] (base motion: Y [m]); default the problem's.
+    """
+    structure = problem.structure
+    w = np.asarray(problem.omega if omega is None else omega, dtype=float)
+    load = harmonic_load(problem, w, amplitude)
+    x = np.einsum("...ij,...j->...i", structure.receptance_matrix(w), load)
+    normals = problem.normals()
+    _, static_load = problem.load()
+    if not np.any(static_load):
+        static = np.zeros(structure.size)
+    elif structure.rigid_body_modes():
+        static = np.full(structure.size, np.nan)
+    else:
+        static = np.linalg.solve(structure.stiffness_matrix, static_load)
+    return LinearAmplitudes(w, x, x @ normals.T, static, normals @ static, tuple(structure.coordinates))
+
+
+def structure_peaks(problem: ImpactProblem, output: ArrayLike, span: float = 0.05) -> list[ResonancePeak]:
+    """Maxima of |output . H F| near each non-zero natural frequency of the problem's structure.
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+        The structure and its load.
+    output : array_like, shape (N,)
+        Weights of the coordinates (e.g. e_i, or e_i - e_j for a relative coordinate) [-].
+    span : float
+        Relative half-width of the search window around each natural frequency [-].
+    """
+    weights = np.asarray(output, dtype=float)
+
+    def magnitude(w: ArrayLike) -> NDArray[np.float64]:
+        return np.abs(linear_amplitudes(problem, np.asarray(w, dtype=float)).coordinates @ weights)
+
+    peaks = []
+    modes = [wn for wn in problem.structure.natural_frequencies() if wn > 0.0]
+    for mode, omega_n in enumerate(modes, start=1):
         grid = omega_n * np.linspace(1.0 - span, 1.0 + span, 4001)
         k = int(np.argmax(magnitude(grid)))
         lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]

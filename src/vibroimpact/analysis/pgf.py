@@ -24,11 +24,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import Enum
+from typing import overload
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.analysis.greens import periodic_green
+from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
+from vibroimpact.analysis.layout import closed_form_layout
 from vibroimpact.model.modal import PoleResidueModel, exact_pole_residue, fit_modal_parameters
+from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import Receptances, TwoDofSystem
 
 __all__ = ["PgfVariant", "OneImpactSolution", "solve_one_impact", "AdmissibilitySettings"]
@@ -282,21 +287,35 @@ def green_models(system: TwoDofSystem, variant: PgfVariant) -> tuple[PoleResidue
     return fit_modal_parameters(system).to_pole_residue(), green12
 
 
+@overload
+def solve_one_impact(system: TwoDofSystem, omega: ArrayLike, clearance: ArrayLike, restitution: ArrayLike, amplitude: float,
+                     variant: PgfVariant | str = ..., models: tuple[PoleResidueModel, PoleResidueModel] | None = ...) -> OneImpactSolution: ...  # fmt: skip
+@overload
+def solve_one_impact(system: ImpactProblem, omega: ArrayLike | None = ..., clearance: ArrayLike | None = ..., restitution: ArrayLike | None = ...,
+                     amplitude: ArrayLike | None = ..., variant: PgfVariant | str = ..., models: None = ...) -> ImpactOrbit: ...  # fmt: skip
 def solve_one_impact(
-    system: TwoDofSystem,
-    omega: ArrayLike,
-    clearance: ArrayLike,
-    restitution: ArrayLike,
-    amplitude: float,
+    system: TwoDofSystem | ImpactProblem,
+    omega: ArrayLike | None = None,
+    clearance: ArrayLike | None = None,
+    restitution: ArrayLike | None = None,
+    amplitude: ArrayLike | None = None,
     variant: PgfVariant | str = PgfVariant.EXACT,
     models: tuple[PoleResidueModel, PoleResidueModel] | None = None,
-) -> OneImpactSolution:
+) -> OneImpactSolution | ImpactOrbit:
     """Impulse and phase of the one-impact-per-period regime (eqs. 15-16, corrected), vectorised.
+
+    Two forms. ``solve_one_impact(system, omega, clearance, restitution, amplitude, variant)`` with the paper's
+    :class:`TwoDofSystem` is the paper's layout (both variants, :class:`OneImpactSolution`).
+    ``solve_one_impact(problem, omega=None, clearance=None, restitution=None, amplitude=None)`` with an
+    :class:`ImpactProblem` of any structure with one rigid stop (absolute or relative, upper or lower) gives the
+    general closed form (:class:`~vibroimpact.analysis.impact_orbit.ImpactOrbit`, exact Green functions only; omitted
+    values are the problem's); ``ValueError`` saying why where it does not apply (several stops, a bumper, a rigid-body
+    mode; a symmetric two-sided stop is :func:`vibroimpact.analysis.two_sided.solve_two_impacts`).
 
     Parameters
     ----------
-    system : TwoDofSystem
-        The linear system.
+    system : TwoDofSystem or ImpactProblem
+        The linear system (paper's layout), or the whole problem.
     omega : array_like
         Excitation angular frequency [rad s-1], > 0.
     clearance : array_like
@@ -310,6 +329,15 @@ def solve_one_impact(
     models : (PoleResidueModel, PoleResidueModel), optional
         Precomputed :func:`green_models` for this system and variant (saves the curve fit on repeated calls).
     """
+    if isinstance(system, ImpactProblem):
+        if PgfVariant(variant) is not PgfVariant.EXACT or models is not None:
+            raise ValueError(f"variant = {PgfVariant(variant).value!r}: the paper's curve fit (pgf_paper) exists for the named two-mass system only; a problem takes 'pgf'")
+        layout = closed_form_layout(system)
+        if layout.two_sided:
+            raise ValueError("contact: the stops form a symmetric two-sided stop, whose closed form has two impacts per period: use analysis.two_sided.solve_two_impacts")
+        return solve_impact_orbit(system, omega, clearance, restitution, amplitude)
+    if omega is None or clearance is None or restitution is None or amplitude is None:
+        raise TypeError("solve_one_impact(system, omega, clearance, restitution, amplitude): the paper's form needs all five")
     variant = PgfVariant(variant)
     w, delta, r = (np.asarray(x, dtype=float) for x in np.broadcast_arrays(omega, clearance, restitution))
     green22, green12 = models if models is not None else green_models(system, variant)

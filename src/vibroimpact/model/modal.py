@@ -19,9 +19,19 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
+from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["ModalParameters", "PoleResidueModel", "exact_modal_parameters", "exact_pole_residue", "fit_modal_parameters", "underdamped_mode_count"]
+__all__ = [
+    "ModalParameters",
+    "ModalResponse",
+    "PoleResidueModel",
+    "exact_modal_parameters",
+    "exact_pole_residue",
+    "fit_modal_parameters",
+    "impulse_modes",
+    "underdamped_mode_count",
+]
 
 
 @dataclass(frozen=True, eq=False)
@@ -196,3 +206,70 @@ def fit_modal_parameters(system: TwoDofSystem, omega_grid: tuple[float, ...] | N
     if not fit.success:
         raise RuntimeError(f"the modal curve fit did not converge: {fit.message}")
     return ModalParameters(omega=omega_n, loss_factor=fit.x[2:], form_factor=fit.x[:2])
+
+
+@dataclass(frozen=True, eq=False)
+class ModalResponse:
+    """Displacements of every coordinate after a unit impulse: ``x(t) = Re sum_k residues[:, k] exp(poles[k] t)``.
+
+    The Laplace transform of the columns is ``H(s) d`` for the impulse direction ``d`` (``H(s) = (M s^2 + C s + K)^-1``),
+    so each row is a :class:`PoleResidueModel` of one coordinate and ``weights @ residues`` that of a combination
+    (e.g. a stop's coordinate n . x).
+
+    Attributes
+    ----------
+    poles : ndarray of complex, shape (2N,)
+        Eigenvalues of the state matrix [rad s-1].
+    residues : ndarray of complex, shape (N, 2N)
+        Residue of each coordinate at each pole [m N-1 s-1].
+    """
+
+    poles: NDArray[np.complex128]
+    residues: NDArray[np.complex128]
+
+    def output(self, weights: ArrayLike) -> PoleResidueModel:
+        """The model of the combination ``weights . x`` (e.g. a stop's normal)."""
+        return PoleResidueModel(poles=self.poles, residues=np.asarray(weights, dtype=float) @ self.residues)
+
+    def coordinate(self, index: int) -> PoleResidueModel:
+        """The model of coordinate ``index``."""
+        return PoleResidueModel(poles=self.poles, residues=self.residues[index].copy())
+
+
+@lru_cache(maxsize=64)
+def _impulse_modes(structure: LinearStructure, direction: tuple[float, ...]) -> ModalResponse:
+    a = structure.state_matrix
+    poles, vectors = np.linalg.eig(a)
+    condition = float(np.linalg.cond(vectors))
+    if not np.isfinite(condition) or condition > 1e10:
+        raise ValueError(
+            f"the structure's state matrix is (nearly) defective (eigenvector condition {condition:.3g}): a repeated pole, "
+            "e.g. a critically damped mode or a rigid-body mode, has no pole-residue form"
+        )
+    size = structure.size
+    kick = np.concatenate([np.zeros(size), np.linalg.solve(structure.mass_matrix, np.asarray(direction, dtype=float))])
+    weights = np.linalg.solve(vectors, kick.astype(complex))
+    order = np.lexsort((poles.imag, np.abs(poles)))
+    return ModalResponse(poles=poles[order], residues=(vectors[:size, :] * weights[None, :])[:, order])
+
+
+def impulse_modes(structure: LinearStructure, direction: ArrayLike) -> ModalResponse:
+    """Poles and residues of every coordinate's response to a unit impulse along ``direction`` (cached per structure).
+
+    The impulse gives the velocity jump M^-1 d; the free motion from (0, M^-1 d) is expanded on the eigenvectors of
+    the state matrix A = [[0, I], [-M^-1 K, -M^-1 C]]: residues = V[:N] diag(V^-1 (0, M^-1 d)).
+
+    Parameters
+    ----------
+    structure : LinearStructure
+        The structure (any N).
+    direction : array_like, shape (N,)
+        Distribution of the unit impulse over the coordinates [-] (a stop's normal n for the impulse n; the contact
+        impulse of a stop is -J n).
+
+    Raises
+    ------
+    ValueError
+        If the state matrix has no eigenvector basis (repeated poles).
+    """
+    return _impulse_modes(structure, tuple(float(x) for x in np.asarray(direction, dtype=float)))
