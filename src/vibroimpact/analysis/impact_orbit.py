@@ -293,7 +293,8 @@ class ImpactOrbit:
         lo = np.take_along_axis(t, np.maximum(k - 1, 0)[..., None], axis=-1)
         hi = np.take_along_axis(t, np.minimum(k + 1, fractions.size - 1)[..., None], axis=-1)
         tk = np.take_along_axis(t, k[..., None], axis=-1)
-        side = np.sign(np.take_along_axis(u, k[..., None], axis=-1))  # refine u's maximum, or its minimum
+        # refine u's maximum, or (two-sided, where the lower stop is nearer) its minimum
+        side = np.sign(np.take_along_axis(u, k[..., None], axis=-1)) if self.two_sided else np.ones(k.shape + (1,))
         for _ in range(8):
             slope, curvature = side * self.coordinate(tk, 1), side * self.coordinate(tk, 2)
             with np.errstate(divide="ignore", invalid="ignore"):
