@@ -1,0 +1,166 @@
+"""The dataset of a concepts study: every concept's curves and figures of merit, labelled, with CF units.
+
+Dimensions: ``concept`` (names), ``frequency`` [Hz] (closed forms and the worst stable response), ``simulation_frequency``
+[Hz] (time-domain steady states), ``point`` (continued orbits, NaN-padded). Variables:
+
+* per concept: ``label``, ``absorber``, ``stops`` (text), ``absorber_stiffness`` [N m-1], ``absorber_damping``
+  [N s m-1]; the figures of merit ``peak_x1_amplitude`` [m] and ``peak_x1_frequency`` [Hz],
+  ``peak_base_force_amplitude`` [N] and ``peak_base_force_frequency`` [Hz], ``peak_impact_acceleration`` [m s-2] and
+  ``peak_contact_force`` [N] (bumper twins), ``notch_depth`` [dB] and ``notch_frequency`` [Hz],
+  ``band_impact_fraction`` [1], ``band_coverage`` [1], ``band_impacts``, ``unstable_stretches``,
+  ``nonperiodic_stretches`` (text), ``notes``;
+* (concept, frequency): ``linear_x1_amplitude``, ``linear_fits``, ``closed_x1_amplitude``,
+  ``closed_base_force_amplitude``, ``closed_stable``, ``worst_x1_amplitude``, ``worst_base_force_amplitude``,
+  ``worst_impacts``;
+* (concept, simulation_frequency): ``simulated_*`` (exact) and ``bumper_*`` (compliant);
+* (concept, point): ``branch_*``.
+
+Attributes: ``band_low_Hz``, ``band_high_Hz``, ``anti_resonance_Hz`` (the anti-resonance band of the scene's system
+without a stop), ``static_deflection_m`` (q / k1), ``excitation_amplitude_N``, ``bumper_frequency_Hz``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from vibroimpact.scene.concepts import Concept, ConceptsSettings
+from vibroimpact.study.concepts_closed import ClosedForms, closed_forms
+from vibroimpact.study.concepts_metrics import anti_resonance_band, band_metrics, envelope, stretches
+
+__all__ = ["concepts_dataset"]
+
+_UNITS = {"x1_amplitude": "m", "base_force_amplitude": "N", "peak_acceleration": "m s-2", "contact_force": "N"}
+
+
+def _text(spans: list[tuple[float, float]]) -> str:
+    return ", ".join(f"{a:.2f}-{b:.2f}" if b > a else f"{a:.2f}" for a, b in spans) or "none"
+
+
+def concepts_dataset(settings: ConceptsSettings, closed: dict[str, ClosedForms], simulated: dict[str, dict[str, np.ndarray]], branches: dict[str, dict[str, Any]]) -> xr.Dataset:
+    """Assemble the dataset (module docstring) from the three kinds of results, keyed by concept name."""
+    names = [c.name for c in settings.concepts]
+    f, fs = settings.frequency, settings.simulation_frequency
+    static = settings.static_deflection
+    reference = closed_forms(Concept("reference", "", settings.system), settings.amplitude, f)
+    low, high, anti = anti_resonance_band(f, reference.linear_x1, static)
+    points = max([b["frequency"].size for b in branches.values()] + [1])
+    fine = {k: np.full((len(names), f.size), np.nan) for k in ("linear_x1", "closed_x1", "closed_force", "worst_x1", "worst_force")}
+    flags = {k: np.full((len(names), f.size), -1, dtype=np.int8) for k in ("linear_fits", "closed_stable", "worst_impacts")}
+    sim_keys = ("x1", "base_force", "impacts_per_period", "converged", "multiplicity", "bumper_x1", "bumper_base_force", "bumper_impacts_per_period",
+                "bumper_peak_acceleration", "bumper_peak_contact_force", "bumper_converged")  # fmt: skip
+    sim = {k: np.full((len(names), fs.size), np.nan) for k in sim_keys}
+    branch_keys = ("frequency", "x1_amplitude", "base_force_amplitude", "floquet_modulus", "impacts_per_period", "period", "branch")
+    orbit = {k: np.full((len(names), points), np.nan) for k in branch_keys}
+    per: dict[str, list[Any]] = {k: [] for k in ("peak_x1", "peak_x1_f", "peak_force", "peak_force_f", "accel", "contact", "depth", "depth_f",
+                                                 "fraction", "coverage", "band_impacts", "unstable", "nonperiodic", "notes")}  # fmt: skip
+    for i, concept in enumerate(settings.concepts):
+        cf = closed[concept.name]
+        fine["linear_x1"][i], fine["closed_x1"][i], fine["closed_force"][i] = cf.linear_x1, cf.impact_x1, cf.impact_base_force
+        flags["linear_fits"][i], flags["closed_stable"][i] = cf.linear_fits, cf.impact_stable
+        s = simulated.get(concept.name)
+        notes = [cf.note] if cf.note else []
+        sim_tuple: tuple = (fs, np.full(fs.size, np.nan), np.full(fs.size, np.nan), np.zeros(fs.size))
+        if s is not None:
+            for k in sim_keys:
+                sim[k][i] = np.abs(s[k]) if np.iscomplexobj(s[k]) else s[k]
+            sim_tuple = (fs, sim["x1"][i], sim["base_force"][i], sim["impacts_per_period"][i])
+            failed = int(np.nansum(s["failed"]) + np.nansum(s["bumper_failed"]))
+            if failed:
+                notes.append(f"{failed} simulated points failed")
+        b = branches.get(concept.name)
+        empty = np.zeros(0)
+        branch_tuple: tuple = (empty,) * 6
+        unstable: list[tuple[float, float]] = []
+        if b is not None:
+            count = b["frequency"].size
+            for k in branch_keys:
+                orbit[k][i, :count] = b[k]
+            branch_tuple = (b["frequency"], b["x1_amplitude"], b["base_force_amplitude"], b["floquet_modulus"], b["impacts_per_period"], b["branch"])
+            unstable = _unstable(b)
+            notes.append(str(b["note"][0]))
+        if concept.stops:
+            closed_unstable = stretches(f, cf.impact_stable == 0, 1.5 * float(np.median(np.diff(f))) if f.size > 1 else 0.0)
+            unstable = _union(unstable + closed_unstable)
+        worst = envelope(f, (cf.linear_x1, cf.linear_base_force, cf.linear_fits), (cf.impact_x1, cf.impact_base_force, cf.impact_stable, cf.impacts_per_period), sim_tuple, branch_tuple)
+        fine["worst_x1"][i], fine["worst_force"][i], flags["worst_impacts"][i] = worst.x1, worst.base_force, worst.impacts
+        m = band_metrics(f, worst, (low, high), static)
+        nonperiodic = stretches(fs, (sim["converged"][i] == 0.0), 1.5 * float(np.median(np.diff(fs))) if fs.size > 1 else 0.0) if s is not None else []
+        accel = np.nanmax(sim["bumper_peak_acceleration"][i]) if np.any(np.isfinite(sim["bumper_peak_acceleration"][i])) else (0.0 if not concept.stops else math.nan)
+        contact = np.nanmax(sim["bumper_peak_contact_force"][i]) if np.any(np.isfinite(sim["bumper_peak_contact_force"][i])) else (0.0 if not concept.stops else math.nan)
+        for key, value in (("peak_x1", m.peak_x1), ("peak_x1_f", m.peak_x1_frequency), ("peak_force", m.peak_force), ("peak_force_f", m.peak_force_frequency),
+                           ("accel", accel), ("contact", contact), ("depth", m.notch_depth), ("depth_f", m.notch_frequency), ("fraction", m.band_impact_fraction),
+                           ("coverage", m.band_coverage), ("band_impacts", _text(m.band_impacts)), ("unstable", _text(unstable)),
+                           ("nonperiodic", _text(nonperiodic)), ("notes", "; ".join(n for n in notes if n))):  # fmt: skip
+            per[key].append(value)
+    cf_dims, sim_dims, pt_dims = ("concept", "frequency"), ("concept", "simulation_frequency"), ("concept", "point")
+    data = {
+        "label": ("concept", [c.label for c in settings.concepts], {"long_name": "what the concept is"}),
+        "absorber": ("concept", [c.absorber for c in settings.concepts], {"long_name": "absorber stiffness and damping, and how they were chosen"}),
+        "stops": ("concept", [c.describe_stops() for c in settings.concepts], {"long_name": "rigid stops"}),
+        "absorber_stiffness": ("concept", [c.system.k2 for c in settings.concepts], {"units": "N m-1", "long_name": "absorber stiffness k2"}),
+        "absorber_damping": ("concept", [c.system.b2 for c in settings.concepts], {"units": "N s m-1", "long_name": "absorber damping b2"}),
+        "peak_x1_amplitude": ("concept", per["peak_x1"], {"units": "m", "long_name": "largest |X1| of the worst stable motion over the band"}),
+        "peak_x1_frequency": ("concept", per["peak_x1_f"], {"units": "Hz", "long_name": "where |X1| peaks"}),
+        "peak_base_force_amplitude": ("concept", per["peak_force"], {"units": "N", "long_name": "largest fundamental of the force on the base (suspension and absolute stops), worst stable motion"}),
+        "peak_base_force_frequency": ("concept", per["peak_force_f"], {"units": "Hz", "long_name": "where the base force peaks"}),
+        "peak_impact_acceleration": ("concept", per["accel"], {"units": "m s-2", "long_name": "largest contact deceleration with the Kelvin-Voigt bumpers (compliant steady states)"}),
+        "peak_contact_force": ("concept", per["contact"], {"units": "N", "long_name": "largest bumper force (time domain, compliant steady states)"}),
+        "notch_depth": ("concept", per["depth"], {"units": "dB", "long_name": "20 log10 of the smallest worst-stable |X1| in the anti-resonance band over q / k1"}),
+        "notch_frequency": ("concept", per["depth_f"], {"units": "Hz", "long_name": "where the notch is deepest"}),
+        "band_impact_fraction": ("concept", per["fraction"], {"units": "1", "long_name": "share of the anti-resonance band where the motion impacts"}),
+        "band_coverage": ("concept", per["coverage"], {"units": "1", "long_name": "share of the anti-resonance band where a stable motion was found"}),
+        "band_impacts": ("concept", per["band_impacts"], {"long_name": "where in the anti-resonance band the motion impacts [Hz]"}),
+        "unstable_stretches": ("concept", per["unstable"], {"long_name": "frequencies [Hz] of unstable continued or closed-form orbits"}),
+        "nonperiodic_stretches": ("concept", per["nonperiodic"], {"long_name": "simulated frequencies [Hz] where the steady motion is not periodic"}),
+        "notes": ("concept", per["notes"], {"long_name": "how the concept's branches and closed forms went"}),
+        "linear_x1_amplitude": (cf_dims, fine["linear_x1"], {"units": "m", "long_name": "|X1| of the linear steady state without a stop"}),
+        "linear_fits": (cf_dims, flags["linear_fits"], {"long_name": "the linear motion clears every stop", "flag_values": np.array([0, 1], dtype=np.int8), "flag_meanings": "hits_a_stop clears_the_stops"}),
+        "closed_x1_amplitude": (cf_dims, fine["closed_x1"], {"units": "m", "long_name": "|X1| of the closed-form impact orbit (admissible)"}),
+        "closed_base_force_amplitude": (cf_dims, fine["closed_force"], {"units": "N", "long_name": "base force fundamental of the closed-form impact orbit"}),
+        "closed_stable": (cf_dims, flags["closed_stable"], {"long_name": "Floquet stability of the closed-form impact orbit", "flag_values": np.array([-1, 0, 1], dtype=np.int8), "flag_meanings": "none_or_unknown unstable stable"}),
+        "worst_x1_amplitude": (cf_dims, fine["worst_x1"], {"units": "m", "long_name": "largest |X1| over the stable motions found"}),
+        "worst_base_force_amplitude": (cf_dims, fine["worst_force"], {"units": "N", "long_name": "largest base force fundamental over the stable motions found"}),
+        "worst_impacts": (cf_dims, flags["worst_impacts"], {"long_name": "does the motion impact", "flag_values": np.array([-1, 0, 1], dtype=np.int8), "flag_meanings": "unknown no yes"}),
+        **{f"simulated_{k}" if not k.startswith("bumper") else k: (sim_dims, sim[k], _attrs(k)) for k in sim_keys},
+        **{f"branch_{k}": (pt_dims, orbit[k], _attrs(k)) for k in branch_keys},
+    }
+    coords = {"concept": names, "frequency": ("frequency", f, {"units": "Hz", "long_name": "excitation frequency"}),
+              "simulation_frequency": ("simulation_frequency", fs, {"units": "Hz", "long_name": "excitation frequency of the simulations"}),
+              "point": ("point", np.arange(points))}  # fmt: skip
+    dataset = xr.Dataset({k: xr.Variable(*v) for k, v in data.items()}, coords=coords)
+    dataset.attrs.update({"band_low_Hz": low, "band_high_Hz": high, "anti_resonance_Hz": anti, "static_deflection_m": static,
+                          "excitation_amplitude_N": settings.amplitude, "bumper_frequency_Hz": settings.bumper_frequency,
+                          "study_kind": "concepts"})  # fmt: skip
+    return dataset
+
+
+def _attrs(key: str) -> dict[str, str]:
+    units = {"x1": "m", "base_force": "N", "x1_amplitude": "m", "base_force_amplitude": "N", "frequency": "Hz", "impacts_per_period": "1",
+             "bumper_x1": "m", "bumper_base_force": "N", "bumper_peak_acceleration": "m s-2", "bumper_peak_contact_force": "N", "floquet_modulus": "1",
+             "bumper_impacts_per_period": "1", "period": "1", "multiplicity": "1"}  # fmt: skip
+    out = {"long_name": key.replace("_", " ")}
+    if key in units:
+        out["units"] = units[key]
+    return out
+
+
+def _unstable(branch: dict[str, Any]) -> list[tuple[float, float]]:
+    """Frequency spans [Hz] between consecutive unstable orbits of one branch."""
+    f, modulus, label = (np.asarray(branch[k], dtype=float) for k in ("frequency", "floquet_modulus", "branch"))
+    spans = [tuple(sorted((float(f[a]), float(f[a + 1])))) for a in range(f.size - 1) if label[a] == label[a + 1] and modulus[a] >= 1.0 and modulus[a + 1] >= 1.0]
+    return _union(spans)  # type: ignore[arg-type]
+
+
+def _union(spans: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """Overlapping or touching spans (within 0.02 Hz) joined, sorted."""
+    out: list[tuple[float, float]] = []
+    for a, b in sorted(spans):
+        if out and a <= out[-1][1] + 0.02:
+            out[-1] = (out[-1][0], max(out[-1][1], b))
+        else:
+            out.append((a, b))
+    return out
