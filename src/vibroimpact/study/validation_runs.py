@@ -1,0 +1,224 @@
+"""Validation cases checked on simulated runs: the Zeno time of a dropped ball, engine by engine, and the impacts of
+a relative stop one by one.
+
+* Zeno: every listed rigid-stop engine drops the ball from rest at height h; the time of its first sticking segment
+  is compared with sqrt(2 h / g) (1 + e) / (1 - e). An engine sticks at the first impact no faster than its sticking
+  velocity v_s (a fraction of the problem's velocity scale, g / w here), so it misses the bounces after it, whose
+  total duration 2 e v_n / (g (1 - e)) lies in (2 e^2 v_s / (g (1 - e)), 2 e v_s / (g (1 - e))]: the tolerance is
+  that bound plus the engine's own precision (round-off of the event times for the exact engines; the integrator's
+  tolerance, measured, for the others).
+* Relative stop: an ``exact`` run of many impacts; before each impact the state is propagated independently from
+  the start of the flight that ends there (matrix exponential of the forced flow, not the engine's eigenvectors),
+  and the engine's state after it is checked against the impact law: total momentum kept, relative velocity
+  restituted (n.x'(t+) = -R n.x'(t-)), the recorded impulse m_eff (1 + R) n.x'(t-), displacements unchanged.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+from numpy.typing import NDArray
+from scipy.linalg import expm
+
+from vibroimpact.engines.base import MODE_STUCK, Trajectory
+from vibroimpact.engines.registry import make_engine
+from vibroimpact.engines.settings import ATOL_RATIO, EngineSettings
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.scene.validation_problems import relative_stop_problem, zeno_problem
+from vibroimpact.scene.validation_settings import RelativeStopCase, ZenoCase
+from vibroimpact.study.validation_checks import CaseOutcome, Check, check
+from vibroimpact.study.validation_formulas import zeno_sticking_bounds, zeno_sticking_deficit, zeno_time
+
+__all__ = ["run_zeno", "run_relative_stop", "free_flight", "INTEGRATOR_ALLOWANCE", "ROUND_OFF_EVENTS"]
+
+#: Engines whose event times are exact to round-off.
+EXACT_ENGINES = ("exact", "exact_python")
+#: Round-off allowance of an exact engine's sticking time, per impact, in units of eps x t_Z [-].
+ROUND_OFF_EVENTS = 64.0
+#: Allowance of an integrator's sticking time beyond the sticking bound, in units of its rtol [-] (measured: see the
+#: report's notes and tests/validation/test_zeno.py).
+INTEGRATOR_ALLOWANCE = 1e3
+#: Samples of the exact run's height drawn in the report.
+_TRACE_SAMPLES = 1500
+
+
+def run_zeno(case: ZenoCase, say=lambda message: None) -> CaseOutcome:
+    """Drop the ball with every engine of ``case`` and compare the sticking time with the Zeno time."""
+    problem = zeno_problem(case)
+    e, g, h = case.restitution, case.gravity, case.height
+    t_zeno = zeno_time(h, g, e)
+    v_s = case.sticking_velocity * problem.velocity_scale()
+    low, high = zeno_sticking_bounds(e, g, v_s)
+    deficit = zeno_sticking_deficit(h, g, e, v_s)
+    periods = int(math.ceil(1.25 * t_zeno * case.frequency)) + 1
+    start = np.array([h, 0.0])
+    settings = EngineSettings(rtol=case.rtol, atol=case.rtol * ATOL_RATIO, sticking_velocity=case.sticking_velocity)
+    rows: list[Check] = []
+    times, counts, trace = [], [], None
+    for name in case.engines:
+        say(f"zeno: {name}")
+        engine = make_engine(name, settings)
+        run = engine.integrate(problem, start, 0.0, periods)
+        t_stick, impacts = _sticking(run)
+        times.append(t_stick)
+        counts.append(impacts)
+        exact = name in EXACT_ENGINES
+        own = ROUND_OFF_EVENTS * max(impacts, 1) * np.finfo(float).eps if exact else INTEGRATOR_ALLOWANCE * case.rtol
+        tolerance = high / t_zeno + max(own, case.tolerance if exact else 0.0)
+        why = "round-off of the event times" if exact else f"{INTEGRATOR_ALLOWANCE:g} x rtol"
+        rows.append(check(f"Zeno time, {name}", t_zeno, t_stick, tolerance, "s", f"sticking bound 2 e v_s / (g (1 - e)) / t_Z = {high / t_zeno:.2e} plus {why}; {impacts} impacts"))
+        if exact:
+            own_abs = ROUND_OFF_EVENTS * max(impacts, 1) * np.finfo(float).eps * t_zeno
+            rows.append(check(f"bounces left out after sticking, {name}", deficit, t_zeno - t_stick, max(own_abs / deficit, case.tolerance), "s",
+                              f"2 e v_n / (g (1 - e)) with v_n the first impact speed <= v_s = {v_s:.3g} m/s; in ({low:.3g}, {high:.3g}] s"))  # fmt: skip
+        if trace is None and exact:
+            trace = _trace(engine, run, t_zeno)
+    data = xr.Dataset(
+        {
+            "sticking_time": ("engine", np.array(times), {"units": "s", "long_name": "start of the engine's first sticking segment (the ball comes to rest)"}),
+            "impacts_before_sticking": ("engine", np.array(counts, dtype=np.int32), {"units": "1", "long_name": "impacts up to and including the one that sticks"}),
+        },
+        coords={"engine": ("engine", np.array(case.engines, dtype=str), {"long_name": "rigid-stop engine"})},
+    )
+    if trace is not None:
+        data["trace_height"] = ("trace_time", trace[1], {"units": "m", "long_name": "height of the ball above the table (first exact engine)"})
+        data = data.assign_coords(trace_time=("trace_time", trace[0], {"units": "s", "long_name": "time of the height trace"}))
+    data.attrs.update({"zeno_time_s": t_zeno, "sticking_velocity_m_s": v_s, "deficit_low_s": low, "deficit_high_s": high, "predicted_deficit_s": deficit})
+    notes = (
+        f"Zeno time sqrt(2 h / g) (1 + e) / (1 - e) = {t_zeno:.12g} s (h = {h:g} m, g = {g:g} m/s2, e = {e:g}).",
+        f"Sticking velocity v_s = {case.sticking_velocity:g} x the velocity scale g / w = {v_s:.4g} m/s: an engine misses the bounces after the first impact "
+        f"no faster than v_s, {low:.3g} to {high:.3g} s ({high / t_zeno:.2e} of the Zeno time).",
+        f"Integrators run at rtol = {case.rtol:g}, atol = {case.rtol * ATOL_RATIO:g} m; their tolerance adds {INTEGRATOR_ALLOWANCE:g} x rtol.",
+    )
+    return CaseOutcome("zeno", tuple(rows), data, notes)
+
+
+def _sticking(run: Trajectory) -> tuple[float, int]:
+    """(start of the first sticking segment [s], impacts up to it); (NaN, all impacts) if the ball never sticks."""
+    stuck = np.flatnonzero(run.segments[:, 2] == MODE_STUCK) if run.segments.size else np.array([], dtype=int)
+    if stuck.size == 0:
+        return math.nan, int(run.impact_times.size)
+    t_stick = float(run.segments[stuck[0], 0])
+    return t_stick, int(np.count_nonzero(run.impact_times <= t_stick))
+
+
+def _trace(engine, run: Trajectory, t_zeno: float) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """Height of the ball over 1.1 Zeno times (the engine's own dense output)."""
+    if not hasattr(engine, "dense"):
+        return None
+    times = np.linspace(0.0, min(1.1 * t_zeno, float(run.strobe_times[-1])), _TRACE_SAMPLES)
+    return times, np.asarray(engine.dense(run, times))[:, 0]
+
+
+# ------------------------------------------------------------------------------------------------ relative stop
+#: What is recorded of each impact of the relative stop: name -> (units, long name).
+_IMPACT_COLUMNS = {
+    "impact_time": ("s", "time of the impact"),
+    "approach_velocity": ("m s-1", "relative approach velocity n.x'(t-) (independent propagation)"),
+    "relative_velocity_after": ("m s-1", "relative velocity n.x'(t+) after the impact (engine)"),
+    "relative_velocity_expected": ("m s-1", "-R n.x'(t-) (0 where the impact sticks)"),
+    "momentum_before": ("kg m s-1", "total momentum m1 x1' + m2 x2' before the impact (independent propagation)"),
+    "momentum_after": ("kg m s-1", "total momentum after the impact (engine)"),
+    "impulse_expected": ("N s", "m_eff (n.x'(t-) - n.x'(t+)) from the independent state"),
+    "impulse_recorded": ("N s", "impulse recorded by the engine"),
+    "gap_before": ("m", "gap Delta - n.x(t-) at the impact (independent propagation)"),
+    "momentum_error": ("1", "|change of total momentum| over m1 |x1'| + m2 |x2'|"),
+    "restitution_error": ("1", "|n.x'(t+) + R n.x'(t-)| over |n.x'(t-)|"),
+    "impulse_error": ("1", "|recorded - expected impulse| over m_eff |n.x'(t-)|"),
+    "position_error": ("1", "largest of |gap at the impact| and |x(t+) - x(t-)|, over Delta"),
+}
+def free_flight(problem: ImpactProblem, state: NDArray[np.float64], t0: float, t1: float) -> NDArray[np.float64]:
+    """The state at ``t1`` of the free flight from ``state`` at ``t0``, by the matrix exponential of the forced flow.
+
+    y' = A y + Re(b e^{jwt}) + b0 is written as Y' = M Y with Y = (y, cos wt, sin wt, 1): independent of the engines'
+    eigen-decompositions and particular solutions.
+    """
+    a, b, b0 = problem.first_order()
+    n, w = a.shape[0], problem.omega
+    m = np.zeros((n + 3, n + 3))
+    m[:n, :n] = a
+    m[:n, n], m[:n, n + 1], m[:n, n + 2] = b.real, -b.imag, b0
+    m[n, n + 1], m[n + 1, n] = -w, w
+    y = np.concatenate([np.asarray(state, dtype=float), [math.cos(w * t0), math.sin(w * t0), 1.0]])
+    return (expm(m * (t1 - t0)) @ y)[:n]
+
+
+def run_relative_stop(case: RelativeStopCase, say=lambda message: None) -> CaseOutcome:
+    """A long ``exact`` run of the relative stop, every impact checked (module docstring)."""
+    problem = relative_stop_problem(case)
+    say(f"relative stop: {case.periods} periods")
+    run = make_engine("exact").integrate(problem, np.zeros(4), 0.0, case.periods)
+    stop = problem.stops[0]
+    n = stop.normal(2)
+    masses = problem.structure.mass_matrix
+    m_eff = stop.effective_mass(masses)
+    starts = run.segments[:, 0] if run.segments.size else np.zeros(0)
+    columns: dict[str, list[float]] = {name: [] for name in _IMPACT_COLUMNS}
+    for t, impulse in zip(run.impact_times, run.impulses):
+        after = np.flatnonzero(starts == t)
+        if after.size == 0 or after[0] == 0:
+            for name in _IMPACT_COLUMNS:
+                columns[name].append(float(t) if name == "impact_time" else math.nan)
+            continue
+        first, last = int(after[0]), int(after[-1])  # several events at one instant: the flight ends before the first
+        before = free_flight(problem, run.segment_states[first - 1], float(starts[first - 1]), float(t))
+        post = run.segment_states[last]
+        v_minus, v_plus = before[2:], post[2:]
+        approach = float(n @ v_minus)
+        sticks = abs(float(n @ v_plus)) < 1e-12 * abs(approach)
+        expected = 0.0 if sticks else -case.restitution * approach
+        weight = float(np.abs(np.diag(masses)) @ np.abs(v_minus))
+        values = {
+            "impact_time": float(t), "approach_velocity": approach, "relative_velocity_after": float(n @ v_plus), "relative_velocity_expected": expected,
+            "momentum_before": float(np.sum(masses @ v_minus)), "momentum_after": float(np.sum(masses @ v_plus)),
+            "impulse_expected": m_eff * (approach - expected), "impulse_recorded": float(impulse),
+            "gap_before": case.clearance - float(n @ before[:2]),
+            "momentum_error": abs(float(np.sum(masses @ (v_plus - v_minus)))) / weight,
+            "restitution_error": abs(float(n @ v_plus) - expected) / abs(approach),
+            "impulse_error": abs(impulse - m_eff * (approach - expected)) / (m_eff * abs(approach)),
+            "position_error": max(abs(case.clearance - float(n @ before[:2])), float(np.max(np.abs(post[:2] - before[:2])))) / case.clearance,
+        }  # fmt: skip
+        for name in _IMPACT_COLUMNS:
+            columns[name].append(values[name])
+    table = {name: np.array(values, dtype=float) for name, values in columns.items()}
+    count = table["impact_time"].size
+    tol = case.tolerance
+    rows_out: list[Check] = [check("impacts in the run", math.nan, count, math.nan, "1", f"{case.periods} periods of {case.frequency:g} Hz from rest")]
+
+    def worst(error: str) -> int:
+        values = table[error]
+        return int(np.nanargmax(values)) if np.any(np.isfinite(values)) else 0
+
+    if count and np.all(np.isfinite(table["momentum_error"])):
+        k = worst("momentum_error")
+        rows_out.append(check(f"momentum m1 x1' + m2 x2' after an impact (worst of {count})", table["momentum_before"][k], table["momentum_after"][k], tol, "kg m s-1",
+                              "error relative to m1 |x1'| + m2 |x2'| before the impact", error=table["momentum_error"][k]))  # fmt: skip
+        k = worst("restitution_error")
+        rows_out.append(check(f"relative velocity n.x' after an impact (worst of {count})", table["relative_velocity_expected"][k], table["relative_velocity_after"][k], tol, "m s-1",
+                              "published: -R n.x'(t-); error relative to |n.x'(t-)|", error=table["restitution_error"][k]))  # fmt: skip
+        k = worst("impulse_error")
+        rows_out.append(check(f"impulse of an impact (worst of {count})", table["impulse_expected"][k], table["impulse_recorded"][k], tol, "N s",
+                              "published: m_eff (n.x'(t-) - n.x'(t+)), the engine's record", error=table["impulse_error"][k]))  # fmt: skip
+        k = worst("position_error")
+        rows_out.append(check(f"gap at the impact, displacements kept (worst of {count})", 0.0, table["gap_before"][k], tol, "m",
+                              "|Delta - n.x(t-)| and |x(t+) - x(t-)| over Delta", error=table["position_error"][k]))  # fmt: skip
+    else:
+        rows_out.append(check("every impact checked", 1.0, 0.0, tol, "1", "no impact, or an impact without its flight: choose a larger amplitude or a smaller clearance"))
+    data = xr.Dataset(
+        {name: ("impact", table[name], {"units": _IMPACT_COLUMNS[name][0], "long_name": _IMPACT_COLUMNS[name][1]}) for name in _IMPACT_COLUMNS if name != "impact_time"},
+        coords={"impact_time": ("impact", table["impact_time"], {"units": "s", "long_name": _IMPACT_COLUMNS["impact_time"][1]})},
+    )
+    last = np.linspace(max(0.0, run.strobe_times[-1] - 5.0 / case.frequency), run.strobe_times[-1], 600)
+    states = make_engine("exact").dense(run, last)
+    data["trace_relative_displacement"] = ("trace_time", states[:, :2] @ n, {"units": "m", "long_name": "x2 - x1 over the last 5 periods"})
+    data = data.assign_coords(trace_time=("trace_time", last, {"units": "s", "long_name": "time of the trace"}))
+    data.attrs.update({"clearance_m": case.clearance, "restitution": case.restitution, "effective_mass_kg": m_eff})
+    notes = (
+        f"Stop x2 - x1 <= {case.clearance * 1e3:g} mm between the absorber and the primary mass (Ormondroyd & Den Hartog's layout), R = {case.restitution:g}; "
+        f"force {case.amplitude:g} N at {case.frequency:g} Hz on the primary mass; effective mass m1 m2 / (m1 + m2) = {m_eff:.6g} kg.",
+        "The state before each impact is propagated from the start of the flight that ends there by the matrix exponential of the forced flow "
+        "(independent of the engine's eigenvectors); the state after it is the engine's.",
+    )
+    return CaseOutcome("relative_stop", tuple(rows_out), data, notes)
