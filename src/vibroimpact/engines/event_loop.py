@@ -1,19 +1,19 @@
-"""Bookkeeping shared by the integrator-based engines: modes, contact map, sticking, strobes, harmonic moments.
+"""Bookkeeping shared by the integrator-based rigid-stop engines: modes, contact map, sticking, strobes, moments.
 
 An engine subclasses :class:`EventLoopEngine` and implements only :meth:`EventLoopEngine._begin` (set up its
-integrator) and :meth:`EventLoopEngine._advance` (integrate from
-a state until the period boundary or the first event). The integrated state is (X1, u, X1', X2') with the gap
-u = X2 - Delta in place of X2, so that positions near the stop keep their absolute precision (with X2 itself, a
-gap of 1e-20 m vanishes in X2 - Delta and the event function looks identically zero); it is followed, when harmonic
-moments are wanted, by eight quadrature states: the integrals of X1 cos, X1 sin, X2 cos, X2 sin (of w t), of the
-holding force times cos and sin (non-zero only while stuck), and of X1^2 and X2^2.
+integrator) and :meth:`EventLoopEngine._advance` (integrate from a state until the period boundary or the first
+event). Any N-dof structure with any rigid stops: the integrated state is (w, v) of :mod:`.flow_layout` (each
+stop's penetration u_k = n_k . x - Delta_k in place of one coordinate, so that positions near a stop keep their
+absolute precision; for the paper's layout (X1, X2 - Delta, X1', X2')), followed, when harmonic moments are wanted, by
+the 3 N + 2 K quadratures of :mod:`.rigid_kernels`. A stop is held closed (*stuck*) with the constrained flow of
+:mod:`.flow_layout` and released when its holding force turns negative; an impact on another stop frees it. Sticking
+on two stops at once is refused (``NotImplementedError`` naming both).
 """
 
 from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from dataclasses import dataclass, field
 from enum import Enum
 from typing import Callable
 
@@ -21,27 +21,21 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory, TrajectoryBuilder
+from vibroimpact.engines.flow_layout import flow_layout
 from vibroimpact.engines.rigid_contact import RigidContact
+from vibroimpact.engines.rigid_kernels import APEX, STUCK, events_kernel, holding_kernel, jacobian_kernel, pack_parameters, quadrature_count, rhs_kernel
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["EventLoopEngine", "Stop", "Model"]
-
-QUADRATURES = 8
+__all__ = ["EventLoopEngine", "Stop", "Model", "moment_row"]
 
 
-def write_quadratures(yp: NDArray[np.float64], first: int, t: float, omega: float, x1: float, x2: float, contact: float) -> None:
-    """Write the eight moment integrands into ``yp[first:first + 8]``: X1, X2 and the contact force times cos and
-    sin of w t, then X1^2 and X2^2."""
-    c, s = math.cos(omega * t), math.sin(omega * t)
-    yp[first], yp[first + 1], yp[first + 2], yp[first + 3] = x1 * c, x1 * s, x2 * c, x2 * s
-    yp[first + 4], yp[first + 5] = contact * c, contact * s
-    yp[first + 6], yp[first + 7] = x1 * x1, x2 * x2
-
-
-def moment_row(q: NDArray[np.float64]) -> NDArray[np.complex128]:
-    """Integrals of the eight quadratures over a period -> the Trajectory's moment row (e^{-jwt} = cos - j sin)."""
-    return np.array([q[0] - 1j * q[1], q[2] - 1j * q[3], q[4] - 1j * q[5], q[6], q[7]])
+def moment_row(q: NDArray[np.float64], size: int = 2, stops: int = 1) -> NDArray[np.complex128]:
+    """Integrals of the quadratures over a period -> the Trajectory's moment row of 2 N + K entries (e^{-jwt} =
+    cos - j sin): x_i, each stop's contact force, x_i^2 (see :mod:`.rigid_kernels` for the quadratures' order)."""
+    coordinates = q[0 : 2 * size : 2] - 1j * q[1 : 2 * size : 2]
+    forces = q[2 * size : 2 * size + 2 * stops : 2] - 1j * q[2 * size + 1 : 2 * size + 2 * stops : 2]
+    return np.concatenate([coordinates, forces, q[2 * size + 2 * stops : 3 * size + 2 * stops].astype(complex)])
 
 
 class Stop(Enum):
@@ -52,142 +46,97 @@ class Stop(Enum):
     RELEASE = 2
 
 
-@dataclass
 class Model:
-    """Right-hand side, Jacobian and event functions of one problem, with a mutable mode flag (free or stuck).
+    """Right-hand side, Jacobian and event functions of one problem, with a mutable mode (free, or stuck on a stop).
 
-    Between impacts the flow is linear: y' = A y + c + e q cos(w t + phase), with one constant matrix A per mode.
-    :attr:`rhs`, :attr:`jacobian` and :attr:`events` are closures over those coefficients as Python floats (built once
-    per model): a solver calls them at every step, where numpy scalars and attribute lookups cost more than the
-    arithmetic.
+    Between impacts the flow is linear, y' = A y + c + Re(b e^{jwt}), one (A, c, b) per mode (:mod:`.flow_layout`).
+    :attr:`rhs`, :attr:`jacobian` and :attr:`events` call the compiled kernels of :mod:`.rigid_kernels` over
+    :attr:`parameters`, the same array the compiled CVODE callbacks read: the mode written there is seen by both.
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+        Structure, rigid stops and harmonic excitation.
+    with_moments : bool
+        Add the moment quadratures to the state.
     """
 
-    problem: ImpactProblem
-    with_moments: bool
-    stuck: bool = False
-    apex_event: bool = True
-    size: int = field(init=False)
-    #: y' into ``yp`` (scikit-sundae convention ``rhs(t, y, yp)``).
-    rhs: Callable[[float, NDArray[np.float64], NDArray[np.float64]], None] = field(init=False, repr=False)
-    #: d y' / d y into ``jac`` (scikit-sundae convention ``jacobian(t, y, yp, jac)``), exact: the flow is linear.
-    jacobian: Callable[[float, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]], None] = field(init=False, repr=False)
-    #: The three event functions into ``out`` (``events(t, y, out)``), see :data:`NUM_EVENTS`.
-    events: Callable[[float, NDArray[np.float64], NDArray[np.float64]], None] = field(init=False, repr=False)
+    #: Number of event functions and their crossing directions for one stop (the paper's layout): penetration
+    #: rising, holding force falling, apex (approach velocity falling); :attr:`num_events` and :attr:`directions`
+    #: give them for any number of stops. Inactive events return a constant, so they never cross zero.
+    NUM_EVENTS = 3
+    DIRECTIONS = (1, -1, -1)
 
-    def __post_init__(self) -> None:
-        self.size = 4 + (QUADRATURES if self.with_moments else 0)
+    def __init__(self, problem: ImpactProblem, with_moments: bool) -> None:
+        self.problem, self.with_moments = problem, with_moments
+        self.layout = flow_layout(problem)
+        n, k = self.layout.size, self.layout.stop_count
+        self.states = 2 * n
+        self.size = self.states + (quadrature_count(n, k) if with_moments else 0)
+        self.parameters = pack_parameters(self.layout, self.size)
+        self.num_events = 2 * k + 1
+        self.directions = (1,) * k + (-1,) + (-1,) * k
         self._calls = [0]
-        self.rhs = self._make_rhs()
-        self.jacobian = self._make_jacobian()
-        self.events = self._make_events()
+        parameters, calls = self.parameters, self._calls
+
+        def rhs(t: float, y: NDArray[np.float64], yp: NDArray[np.float64]) -> None:
+            calls[0] += 1
+            rhs_kernel(t, y, yp, parameters)
+
+        def jacobian(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], jac: NDArray[np.float64]) -> None:
+            jacobian_kernel(t, y, jac.T, parameters)
+
+        def events(t: float, y: NDArray[np.float64], out: NDArray[np.float64]) -> None:
+            events_kernel(t, y, out, parameters)
+
+        #: y' into ``yp`` (scikit-sundae convention ``rhs(t, y, yp)``).
+        self.rhs: Callable[[float, NDArray[np.float64], NDArray[np.float64]], None] = rhs
+        #: d y' / d y into ``jac`` (``jacobian(t, y, yp, jac)``, jac[i, j] = d y'_i / d y_j), exact: the flow is linear.
+        self.jacobian: Callable[[float, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]], None] = jacobian
+        #: The event functions into ``out`` (``events(t, y, out)``), see :attr:`num_events`.
+        self.events: Callable[[float, NDArray[np.float64], NDArray[np.float64]], None] = events
+
+    @property
+    def stuck_on(self) -> int:
+        """Index of the stop held closed (-1: free flight)."""
+        return int(self.parameters[STUCK])
+
+    @stuck_on.setter
+    def stuck_on(self, stop: int) -> None:
+        self.parameters[STUCK] = float(stop)
+
+    @property
+    def stuck(self) -> bool:
+        """Is a stop held closed? (Setting True holds stop 0: for one-stop callers.)"""
+        return self.parameters[STUCK] >= 0.0
+
+    @stuck.setter
+    def stuck(self, value: bool) -> None:
+        self.parameters[STUCK] = 0.0 if value else -1.0
+
+    @property
+    def apex_event(self) -> bool:
+        """Is the grazing guard (apex events) on?"""
+        return bool(self.parameters[APEX] != 0.0)
+
+    @apex_event.setter
+    def apex_event(self, value: bool) -> None:
+        self.parameters[APEX] = 1.0 if value else 0.0
 
     @property
     def rhs_calls(self) -> int:
         """Right-hand-side evaluations so far."""
         return self._calls[0]
 
-    def matrix(self, stuck: bool) -> NDArray[np.float64]:
-        """The constant matrix A (4, 4) of the flow of (X1, u, X1', X2') in one mode [SI]."""
-        s = self.problem.system
-        a = np.zeros((4, 4))
-        a[0, 2] = 1.0
-        a[2, 0], a[2, 2] = -(s.k1 + s.k2) / s.m1, -(s.b1 + s.b2) / s.m1
-        if not stuck:
-            a[1, 3] = 1.0
-            a[2, 1], a[2, 3] = s.k2 / s.m1, s.b2 / s.m1
-            a[3] = [s.k2 / s.m2, -s.k2 / s.m2, s.b2 / s.m2, -s.b2 / s.m2]
-        return a
-
-    def coefficients(self) -> tuple[float, ...]:
-        """The flow's numbers as Python floats: rows 2 and 3 of the free-flight :meth:`matrix` (a20 ... a33), the
-        constant accelerations c2 = K2 Delta / M1 and c3 = -K2 Delta / M2 [m s-2], q / M1 [m s-2], w [rad s-1],
-        phase [rad], Delta [m], K2 [N m-1], B2 [N s m-1]. X1'' = a20 X1 + a21 u + a22 X1' + a23 X2' + c2 + (q / M1)
-        cos(w t + phase), X2'' = a30 X1 + ... + c3; stuck, a21 and a23 drop out (u = X2' = 0) and X2'' = 0."""
-        s, p = self.problem.system, self.problem
-        rows = [float(v) for v in self.matrix(False)[2:].ravel()]
-        k2, delta = float(s.k2), float(p.clearance)
-        return (*rows, k2 * delta / s.m1, -k2 * delta / s.m2, p.amplitude / s.m1, float(p.omega), float(p.phase), delta, k2, float(s.b2))
-
-    def _make_rhs(self) -> Callable[[float, NDArray[np.float64], NDArray[np.float64]], None]:
-        model, calls = self, self._calls
-        a20, a21, a22, a23, a30, a31, a32, a33, c2, c3, f2, w, phase, delta, k2, b2 = self.coefficients()
-        cos, sin = math.cos, math.sin
-
-        def rhs(t: float, y: NDArray[np.float64], yp: NDArray[np.float64]) -> None:
-            calls[0] += 1
-            x1, u, v1, v2 = y.tolist()  # Python floats: their arithmetic is several times cheaper than numpy's
-            yp[0] = v1
-            if model.stuck:
-                yp[1] = 0.0
-                yp[2] = a20 * x1 + a22 * v1 + c2 + f2 * cos(w * t + phase)
-                yp[3] = 0.0
-            else:
-                yp[1] = v2
-                yp[2] = a20 * x1 + a21 * u + a22 * v1 + a23 * v2 + c2 + f2 * cos(w * t + phase)
-                yp[3] = a30 * x1 + a31 * u + a32 * v1 + a33 * v2 + c3
-
-        def rhs_with_moments(t: float, y: NDArray[np.float64], yp: NDArray[np.float64]) -> None:
-            calls[0] += 1
-            x1, u, v1, v2 = y[:4].tolist()
-            forcing = c2 + f2 * cos(w * t + phase)
-            if model.stuck:
-                holding = b2 * v1 + k2 * (x1 - delta)
-                a2, a3 = a20 * x1 + a22 * v1 + forcing, 0.0
-            else:
-                holding = 0.0
-                a2 = a20 * x1 + a21 * u + a22 * v1 + a23 * v2 + forcing
-                a3 = a30 * x1 + a31 * u + a32 * v1 + a33 * v2 + c3
-            x2, c, sn = u + delta, cos(w * t), sin(w * t)
-            yp[:] = (v1, 0.0 if model.stuck else v2, a2, a3, x1 * c, x1 * sn, x2 * c, x2 * sn, holding * c, holding * sn, x1 * x1, x2 * x2)
-
-        return rhs_with_moments if self.with_moments else rhs
-
-    def _make_jacobian(self) -> Callable[[float, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]], None]:
-        free, stuck = self.matrix(False), self.matrix(True)
-        p, s, model, with_moments = self.problem, self.problem.system, self, self.with_moments
-        delta, w = float(p.clearance), float(p.omega)
-
-        def jacobian(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], jac: NDArray[np.float64]) -> None:
-            jac[:4, :4] = stuck if model.stuck else free
-            if with_moments:
-                # the quadratures' rows: d/dy of X1 cos, X1 sin, X2 cos, X2 sin, H cos, H sin, X1^2, X2^2 (X2 = u + Delta)
-                c, sn = math.cos(w * t), math.sin(w * t)
-                x1, x2 = float(y[0]), float(y[1]) + delta
-                jac[4:, :] = 0.0
-                jac[4, 0], jac[5, 0], jac[6, 1], jac[7, 1] = c, sn, c, sn
-                if model.stuck:
-                    jac[8, 0], jac[8, 2], jac[9, 0], jac[9, 2] = s.k2 * c, s.b2 * c, s.k2 * sn, s.b2 * sn
-                jac[10, 0], jac[11, 1] = 2.0 * x1, 2.0 * x2
-
-        return jacobian
-
-    def _make_events(self) -> Callable[[float, NDArray[np.float64], NDArray[np.float64]], None]:
-        p, model = self.problem, self
-        delta, k2, b2 = float(p.clearance), float(p.system.k2), float(p.system.b2)
-
-        def events(t: float, y: NDArray[np.float64], out: NDArray[np.float64]) -> None:
-            if model.stuck:
-                out[0] = -1.0
-                out[1] = b2 * float(y[2]) + k2 * (float(y[0]) - delta)  # the holding force
-                out[2] = 1.0
-            else:
-                out[0] = y[1]
-                out[1] = 1.0
-                out[2] = y[3] if model.apex_event else 1.0
-
-        return events
-
     def derivative(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         """y' as a new array."""
         yp = np.empty(self.size)
-        self.rhs(t, y, yp)
+        rhs_kernel(t, np.ascontiguousarray(y, dtype=float), yp, self.parameters)
         return yp
 
-    #: Number of event functions and their crossing directions: gap rising, holding force falling, apex (X2' falling).
-    #: Inactive events return a constant, so they never cross zero: free flight has the gap X2 - Delta and the apex
-    #: X2', the stuck mode the holding force.
-    NUM_EVENTS = 3
-    DIRECTIONS = (1, -1, -1)
+    def holding(self, t: float, y: NDArray[np.float64], stop: int | None = None) -> float:
+        """Holding force [N] of ``stop`` (default: the stop held) in state y at time t."""
+        return float(holding_kernel(t, np.ascontiguousarray(y, dtype=float), self.parameters, self.stuck_on if stop is None else stop))
 
 
 class EventLoopEngine(ABC):
@@ -203,8 +152,9 @@ class EventLoopEngine(ABC):
         """Prepare the integrator for ``model`` (called once per :meth:`integrate`)."""
 
     @abstractmethod
-    def _advance(self, model: Model, t: float, y: NDArray[np.float64], t_stop: float) -> tuple[Stop, float, NDArray[np.float64]]:
-        """Integrate from (t, y) to ``t_stop`` or to the first event of the current mode; return why, when, state."""
+    def _advance(self, model: Model, t: float, y: NDArray[np.float64], t_stop: float) -> tuple[Stop, float, NDArray[np.float64], int]:
+        """Integrate from (t, y) to ``t_stop`` or to the first event of the current mode; return why, when, the
+        state, and the stop of a contact or release (-1 at the boundary)."""
 
     def _counters(self) -> dict[str, int]:
         """Integrator counters to add to the trajectory's stats."""
@@ -218,40 +168,48 @@ class EventLoopEngine(ABC):
         """Release what :meth:`_begin` set up (called once per :meth:`integrate`, also after an error)."""
 
     def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
-        """Integrate ``periods`` whole periods from ``state`` (X1, X2, X1', X2') at ``t_start`` [s]."""
+        """Integrate ``periods`` whole periods from ``state`` (x_1 ... x_N, x_1' ... x_N') at ``t_start`` [s]."""
         law = RigidContact(self.name, problem, self.settings, periods)
         state = np.asarray(state, dtype=float)
+        n = problem.size
+        if state.shape != (2 * n,):
+            raise ValueError(f"state: expected {2 * n} values (x and x' of {n} coordinates), got shape {state.shape}")
         law.check_start(state)
         model = Model(problem, moments)
+        layout = model.layout
         y = np.zeros(model.size)
-        y[:4] = state
-        y[1] = min(y[1] - problem.clearance, 0.0)  # integrate the gap u = X2 - Delta; round-off above is the stop
-        model.stuck = bool(y[1] == 0.0 and y[3] == 0.0 and self._pushed(model, t_start, y))
+        y[: 2 * n] = layout.internal(state)
+        for p in layout.pivots:
+            if p >= 0:
+                y[p] = min(y[p], 0.0)  # round-off beyond a stop is the stop
+        resting = [k for k in range(layout.stop_count) if layout.penetration(y, k) >= 0.0 and layout.approach(y, k) == 0.0 and self._pushed(model, t_start, y, k)]
+        if len(resting) > 1:
+            raise NotImplementedError(f"the initial state rests on stops {resting[0]} and {resting[1]} at once, both pushing: sticking on two stops at once is not supported")
+        model.stuck_on = resting[0] if resting else -1
+        touching = _touch_probe(model)
         self._begin(model)
         try:
             rec = TrajectoryBuilder(problem, moments)
-
-            def physical(y: NDArray[np.float64]) -> NDArray[np.float64]:
-                return np.array([y[0], y[1] + problem.clearance, y[2], y[3]])  # the gap u back to X2
-
-            rec.strobe(t_start, physical(y))
-            rec.segment(t_start, MODE_STUCK if model.stuck else MODE_FREE, physical(y))
-            quadratures = y[4:].copy()
+            rec.strobe(t_start, layout.physical(y))
+            rec.segment(t_start, MODE_STUCK if model.stuck else MODE_FREE, layout.physical(y), stop=model.stuck_on)
+            quadratures = y[2 * n :].copy()
             t = float(t_start)
             for k in range(1, periods + 1):
                 boundary = t_start + k * problem.period
                 impacts = events = 0
                 while True:
-                    if not model.stuck and y[1] >= 0.0 and y[3] > 0.0:
-                        # at the stop and moving into it (a start there, or an impact exactly on a period boundary):
-                        # integrators do not report a root at their initial time, so the contact is applied here
+                    which = touching(y)
+                    if which >= 0:
+                        # at a stop and moving into it (a start there, or an impact exactly on a period boundary, or
+                        # a stop freed by an impact on another): integrators do not report a root at their initial
+                        # time, so the contact is applied here
                         stop = Stop.CONTACT
                     elif boundary - t <= 4.0 * math.ulp(boundary):
                         stop, t = Stop.BOUNDARY, boundary  # nothing left of this period to integrate
                     else:
-                        stop, t, y = self._advance(model, t, y, boundary)
+                        stop, t, y, which = self._advance(model, t, y, boundary)
                     if stop is Stop.BOUNDARY:
-                        if not model.stuck and y[1] >= 0.0 and y[3] > 0.0:
+                        if touching(y) >= 0:
                             continue  # an impact exactly at the boundary is applied before the strobe
                         break
                     events += 1
@@ -259,41 +217,94 @@ class EventLoopEngine(ABC):
                         raise RuntimeError(f"no progress at t = {t!r} s: {events} events in one period")
                     if stop is Stop.RELEASE:
                         rec.stats["releases"] += 1
-                        model.stuck = False
+                        model.stuck_on = -1
                     else:
                         impacts += 1
-                        y = y.copy()
-                        y[1] = 0.0
-                        impact = law.collide(rec, t, max(y[3], 0.0), impacts, lambda: self._pushed(model, t, y))
-                        model.stuck = impact.sticks
-                        y[3] = impact.after
-                    rec.segment(t, MODE_STUCK if model.stuck else MODE_FREE, physical(y))
+                        y = self._contact(model, law, rec, t, y, which, impacts)
+                    rec.segment(t, MODE_STUCK if model.stuck else MODE_FREE, layout.physical(y), stop=model.stuck_on)
                 if moments:
-                    q = y[4:] - quadratures
-                    quadratures = y[4:].copy()
-                    rec.add_moments(moment_row(q))
-                rec.strobe(t, physical(y))
+                    q = y[2 * n :] - quadratures
+                    quadratures = y[2 * n :].copy()
+                    rec.add_moments(moment_row(q, n, layout.stop_count))
+                rec.strobe(t, layout.physical(y))
         finally:
             self._end()
         return rec.build(self._counters() | {"rhs_calls": model.rhs_calls + self._compiled_rhs_calls()})
 
-    def _pushed(self, model: Model, t: float, y: NDArray[np.float64]) -> bool:
-        """The stop must push to hold the absorber: holding force > 0, or = 0 and rising."""
-        p = model.problem
-        force = p.holding_force(y[0], y[2])
-        scale = 1e-12 * (p.system.k2 * (p.clearance + abs(y[0])) + p.system.b2 * abs(y[2])) + 1e-300
-        if abs(force) > scale:
-            return bool(force > 0.0)
-        was = model.stuck
-        model.stuck = True
-        rate = model.derivative(t, y)
-        # an undamped absorber (B2 = 0) at rest on the stop has H' = K2 X1' = 0 as well: H'' = B2 X1''' + K2 X1''
-        # decides (X1''' by a forward difference along the stuck motion); returned as "not pushed", a start at rest
-        # on the stop went through it, since the integrators see no crossing of a gap that is 0 at their start
-        step = 1e-6 * p.period
-        ahead = model.derivative(t + step, y + step * rate)
-        model.stuck = was
-        first = p.system.b2 * rate[2] + p.system.k2 * rate[0]
-        if abs(first) > scale * p.omega:
-            return bool(first > 0.0)
-        return bool(p.system.b2 * (ahead[2] - rate[2]) / step + p.system.k2 * rate[2] > 0.0)
+    def _contact(self, model: Model, law: RigidContact, rec: TrajectoryBuilder, t: float, y: NDArray[np.float64], which: int, impacts: int) -> NDArray[np.float64]:
+        """Apply stop ``which``'s impact law at time t to the state y (its gap closed exactly); return the new state."""
+        layout, n = model.layout, model.layout.size
+        y = y.copy()
+        held = model.stuck_on
+        if held == which:
+            raise RuntimeError(f"stop {which} is held closed and reported a contact at t = {t!r} s")
+        model.stuck_on = -1  # an impact on another stop frees the one held
+        layout.close(y, which)
+        velocity = max(layout.approach(y, which), 0.0)
+
+        def pushed() -> bool:
+            resting = y.copy()
+            self._kick(model, resting, which, float(law.masses[which]) * velocity, 0.0)
+            return self._pushed(model, t, resting, which)
+
+        outcome = law.collide(rec, t, velocity, impacts, pushed, stop=which)
+        self._kick(model, y, which, outcome.impulse, outcome.after)
+        if outcome.sticks:
+            if held >= 0 and layout.penetration(y, held) >= 0.0 and layout.approach(y, held) >= 0.0 and self._pushed(model, t, y, held):
+                raise NotImplementedError(f"at t = {t!r} s the motion sticks on stop {which} while held on stop {held}: sticking on two stops at once is not supported")
+            model.stuck_on = which
+        return y
+
+    @staticmethod
+    def _kick(model: Model, y: NDArray[np.float64], stop: int, impulse: float, after: float) -> None:
+        """x' -> x' - impulse M^-1 n_k in place; when the impulse moves one coordinate only (an absolute stop on a
+        decoupled mass), that velocity is set to n_k . x'(t+) = ``after`` exactly."""
+        layout, n = model.layout, model.layout.size
+        i = layout.kicked[stop]
+        if i >= 0:
+            y[n + i] = after / layout.probes[stop][1]
+        else:
+            y[n : 2 * n] -= impulse * layout.kicks[stop]
+
+    def _pushed(self, model: Model, t: float, y: NDArray[np.float64], stop: int) -> bool:
+        """Stop ``stop`` must push to hold the structure in y (its gap closed and at rest): holding force > 0, or = 0
+        and rising (its first non-zero derivative along the stuck flight decides; the flow is linear, so they are
+        exact: lambda' = H . y' + Re(jw hb e^{jwt}), y'' = A y' + Re(jw b e^{jwt}))."""
+        layout, n = model.layout, model.layout.size
+        rows, constants, harmonic = layout.holding
+        was = model.stuck_on
+        model.stuck_on = stop
+        try:
+            force = model.holding(t, y, stop)
+            scale = 1e-12 * (float(np.abs(rows[stop]) @ np.abs(y[: 2 * n])) + abs(constants[stop]) + abs(harmonic[stop])) + 1e-300
+            if abs(force) > scale:
+                return bool(force > 0.0)
+            omega = layout.omega
+            turn = complex(math.cos(omega * t), math.sin(omega * t))
+            rate = model.derivative(t, y)[: 2 * n]
+            first = float(rows[stop] @ rate) + (1j * omega * harmonic[stop] * turn).real
+            if abs(first) > scale * omega:
+                return bool(first > 0.0)
+            a, _, b = layout.stuck[stop]
+            second_rate = a @ rate + (1j * omega * b * turn).real
+            return bool(float(rows[stop] @ second_rate) - (omega**2 * harmonic[stop] * turn).real > 0.0)
+        finally:
+            model.stuck_on = was
+
+
+def _touch_probe(model: Model) -> Callable[[NDArray[np.float64]], int]:
+    """A function of the state: the first stop (not held) at or beyond its gap and moving into it, else -1. Written
+    with Python scalars: it runs at every event and period boundary."""
+    layout, n = model.layout, model.layout.size
+    probes = [(k, layout.pivots[k], n + i, n + j, a, b) for k, (i, a, j, b) in enumerate(layout.probes)]
+
+    def touching(y: NDArray[np.float64]) -> int:
+        held = model.stuck_on
+        for k, p, i, j, a, b in probes:
+            if k == held:
+                continue
+            if (y[p] if p >= 0 else layout.penetration(y, k)) >= 0.0 and a * y[i] + (b * y[j] if j >= 0 else 0.0) > 0.0:
+                return k
+        return -1
+
+    return touching

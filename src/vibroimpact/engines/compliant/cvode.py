@@ -33,7 +33,7 @@ class CompliantCvodeEngine(CompliantEngine):
         """One CVODE call over ``tspan`` (an ODE solver needs no y0')."""
         return solver.solve(tspan, y0)
 
-    def _solver(self, model: BumperModel, contact: bool, omega_ref: float) -> tuple[Any, Any]:
+    def _solver(self, model: BumperModel, contact: int, omega_ref: float) -> tuple[Any, Any]:
         residual = model.residual(contact)
         zero = np.zeros(model.size)
 
@@ -50,19 +50,16 @@ class CompliantCvodeEngine(CompliantEngine):
 
         cvode_events.terminal = events.terminal  # type: ignore[attr-defined]
         cvode_events.direction = events.direction  # type: ignore[attr-defined]
-        s = model.problem.system
         options: dict[str, Any] = {
             "method": "Adams" if self.settings.method == "adams" else "BDF",
             "rtol": self.settings.rtol,
-            "atol": absolute_tolerances(self.settings.atol, omega_ref, s.m2, model.quadratures),
+            "atol": absolute_tolerances(self.settings.atol, omega_ref, model.layout.masses, model.quadratures, model.layout.size),
             "max_num_steps": 1_000_000,
             "eventsfn": cvode_events,
-            "num_events": 3 if contact else 2,
+            "num_events": model.event_count(contact),
             "first_step": self.first_step(model, contact, omega_ref),  # CVODE's own guess collapsed at contact onsets
         }
         if self.settings.max_step > 0.0:
             options["max_step"] = self.settings.max_step
             options["first_step"] = min(options["first_step"], self.settings.max_step)
         return CVODE(rhs, **options), cvode_events
-
-

@@ -46,7 +46,7 @@ from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.validation import require_positive
 
-__all__ = ["CompliantEngine"]
+__all__ = ["CompliantEngine", "check_sweep_layout", "base_force"]
 
 _STATUS_ROOT = 2  # IDA_ROOT_RETURN
 _STATUS_ILL_INPUT = -22  # IDA_ILL_INPUT (CV_ILL_INPUT): among others, "Root found at and very near t"
@@ -57,7 +57,7 @@ _MAX_SWITCHES_IN_PLACE = 100
 
 
 class CompliantEngine:
-    """IDA with a Kelvin-Voigt bumper, the problem's contact (see module docstring): a stepping and a sweeping engine.
+    """IDA with Kelvin-Voigt bumpers, the problem's stops (see module docstring): a stepping and a sweeping engine.
 
     Parameters
     ----------
@@ -72,21 +72,22 @@ class CompliantEngine:
         self.settings = settings
 
     def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
-        """Integrate ``periods`` whole periods from ``state`` (X1, X2, X1', X2') at ``t_start`` [s]."""
+        """Integrate ``periods`` whole periods from ``state`` (x_1 ... x_N, x_1' ... x_N') at ``t_start`` [s]."""
         check_run(self.name, problem, KelvinVoigtBumper, periods)
         model = BumperModel(problem, moments)
         rec = TrajectoryBuilder(problem, moments)
         run = _Run(self, model, rec, float(t_start), state, problem.omega)
         rec.strobe(run.t, run.physical())
-        previous = run.y[5:].copy()
+        first, n, count = model.first_quadrature, problem.size, model.stop_count
+        previous = run.y[first:].copy()
 
-        def strobes(times: NDArray[np.float64], ys: NDArray[np.float64], contact: bool) -> None:
+        def strobes(times: NDArray[np.float64], ys: NDArray[np.float64], contact: int) -> None:
             nonlocal previous
             for t, y in zip(times, ys):
                 if moments:
-                    rec.add_moments(moment_row(y[5:] - previous))
-                    previous = y[5:].copy()
-                rec.strobe(float(t), np.array([y[0], y[1] + problem.clearance, y[2], y[3]]))
+                    rec.add_moments(moment_row(y[first:] - previous, n, count))
+                    previous = y[first:].copy()
+                rec.strobe(float(t), model.layout.physical(y))
 
         run.run(np.asarray(t_start + problem.period * np.arange(1, periods + 1), dtype=np.float64), strobes)
         return rec.build(run.stats())
@@ -95,6 +96,9 @@ class CompliantEngine:
         self, problem: ImpactProblem, sample_rate: float, state: NDArray[np.float64] | None = None, progress: Callable[[float], None] | None = None
     ) -> SweepRecord:
         """Swept-sine test (the paper's Simulink run): q sin(theta(t)) from t = 0 to the sweep's end, sampled.
+
+        Two coordinates and one stop (any kind: the record holds x1, x2 and one contact force); others are refused
+        (``NotImplementedError``).
 
         Parameters
         ----------
@@ -108,7 +112,8 @@ class CompliantEngine:
             Receives the simulated time reached [s] after each block of samples.
         """
         check_run(self.name, problem, KelvinVoigtBumper)
-        sweep, system, clearance = problem.sweep, problem.system, problem.clearance
+        check_sweep_layout(self.name, problem)
+        sweep = problem.sweep
         require_positive("sample_rate", sample_rate)
         model = BumperModel(problem, False)
         rec = TrajectoryBuilder(problem, False)
@@ -116,15 +121,16 @@ class CompliantEngine:
         run = _Run(self, model, rec, 0.0, np.zeros(4) if state is None else state, omega_ref)
         times = np.arange(0.0, sweep.duration, 1.0 / sample_rate)
         out = np.empty((times.size, 7))  # X1, X2, X1', X2', F, Fourier integral (real, -imaginary)
-        filled = 0
+        filled, first = 0, model.first_quadrature
+        layout = model.layout
 
-        def samples(t: NDArray[np.float64], ys: NDArray[np.float64], contact: bool) -> None:
+        def samples(t: NDArray[np.float64], ys: NDArray[np.float64], contact: int) -> None:
             nonlocal filled
             block = out[filled : filled + t.size]
-            block[:, :4] = ys[:, :4]
-            block[:, 1] += clearance
-            block[:, 4] = model.k * ys[:, 1] + model.b * ys[:, 3] if contact else 0.0
-            block[:, 5:] = ys[:, 5:7]
+            block[:, :2] = ys[:, :2] @ layout.t_inverse.T + layout.offset
+            block[:, 2:4] = ys[:, 2:4]
+            block[:, 4] = ys[:, :4] @ model.force_rows[0] + model.force_constants[0] if contact else 0.0
+            block[:, 5:] = ys[:, first : first + 2]
             filled += t.size
             if progress is not None:
                 progress(float(t[-1]))
@@ -133,33 +139,31 @@ class CompliantEngine:
         if filled != times.size:
             raise RuntimeError(f"the sweep produced {filled} of {times.size} samples")
         rec.strobe(run.t, run.physical())
-        base_force = system.k1 * out[:, 0] + system.b1 * out[:, 2] + out[:, 4]
         fourier = out[:, 5] - 1j * out[:, 6]
-        return SweepRecord(sweep, times, out[:, 0], out[:, 1], base_force, out[:, 4], rec.build(run.stats()), fourier)
+        return SweepRecord(sweep, times, out[:, 0], out[:, 1], base_force(problem, out[:, :4], out[:, 4]), out[:, 4], rec.build(run.stats()), fourier)
 
     def solve(self, solver: Any, tspan: NDArray[np.float64], y0: NDArray[np.float64], yp0: NDArray[np.float64]) -> Any:
         """One solver call over ``tspan`` from a consistent (y0, y0')."""
         return solver.solve(tspan, y0, yp0)
 
-    def first_step(self, model: BumperModel, contact: bool, omega_ref: float) -> float:
+    def first_step(self, model: BumperModel, contact: int, omega_ref: float) -> float:
         """First step after a (re)start [s]: sqrt(2 rtol) / (the mode's fastest angular frequency), a backward-Euler
         step of about the tolerance (h^2 |y''| / 2 ~ rtol |y|)."""
-        s = model.problem.system
-        natural = float(np.abs(np.linalg.eigvals(s.state_matrix)).max())
-        fastest = max(math.sqrt(natural**2 + (model.k / s.m2 if contact else 0.0)), omega_ref)
+        natural = float(np.abs(np.linalg.eigvals(model.problem.structure.state_matrix)).max())
+        bumpers = [model.k[k] / model.layout.masses[k] for k in range(model.stop_count) if (int(contact) >> k) & 1]
+        fastest = max(math.sqrt(natural**2 + max(bumpers, default=0.0)), omega_ref)
         return math.sqrt(2.0 * self.settings.rtol) / fastest
 
-    def _solver(self, model: BumperModel, contact: bool, omega_ref: float) -> tuple[IDA, Any]:
+    def _solver(self, model: BumperModel, contact: int, omega_ref: float) -> tuple[IDA, Any]:
         """The IDA solver of one mode and its event function."""
         events = model.events(contact)
-        s = model.problem.system
         first = self.first_step(model, contact, omega_ref)
         options: dict[str, Any] = {
             "rtol": self.settings.rtol,
-            "atol": absolute_tolerances(self.settings.atol, omega_ref, s.m2, model.quadratures),
+            "atol": absolute_tolerances(self.settings.atol, omega_ref, model.layout.masses, model.quadratures, model.layout.size),
             "max_num_steps": 1_000_000,
             "eventsfn": events,
-            "num_events": 3 if contact else 2,  # see events()
+            "num_events": model.event_count(contact),
             "jacfn": model.jacobian(contact),
             "first_step": first,
         }
@@ -169,32 +173,65 @@ class CompliantEngine:
         return IDA(model.residual(contact), **options), events
 
 
+def check_sweep_layout(engine: str, problem: ImpactProblem) -> None:
+    """A swept-sine record holds x1, x2 and one contact force: two coordinates and one stop, else
+    ``NotImplementedError`` naming the layout."""
+    if problem.size != 2 or len(problem.stops) != 1:
+        raise NotImplementedError(
+            f"engine {engine!r}: a swept-sine run records two coordinates (x1, x2) and one contact force; this problem has "
+            f"{problem.size} coordinates and {len(problem.stops)} stops: sweep it in steps (steady states) instead")
+
+
+def base_force(problem: ImpactProblem, states: NDArray[np.float64], contact: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Force on the base [N] from samples of (x, x') (rows) and the contact force: the springs and dashpots to the
+    ground, 1^T (K x + C x'), plus the stop's force on the base, (1^T n) lambda (an absolute stop; a relative one
+    loads only the structure). For the paper's layout K1 X1 + B1 X1' + F."""
+    structure, n = problem.structure, problem.size
+    ground = np.concatenate([structure.stiffness_matrix.sum(axis=0), structure.damping_matrix.sum(axis=0)])
+    return states[:, : 2 * n] @ ground + float(problem.normals()[0].sum()) * contact
+
+
 class _Run:
-    """One integration: the state, one IDA solver per mode, and what happens at each switch and recorded root."""
+    """One integration: the state, one IDA solver per contact mode, and what happens at each switch and recorded root."""
 
     def __init__(self, engine: CompliantEngine, model: BumperModel, rec: TrajectoryBuilder, t: float, state: NDArray[np.float64], omega_ref: float) -> None:
-        self.engine, self.model, self.rec = engine, model, rec
-        self.clearance = model.problem.clearance
+        self.engine, self.model, self.rec, self.omega_ref = engine, model, rec, omega_ref
+        n = model.layout.size
+        state = np.asarray(state, dtype=float)
+        if state.shape != (2 * n,):
+            raise ValueError(f"state: expected {2 * n} values (x and x' of {n} coordinates), got shape {state.shape}")
         self.t = t
         self.y = np.zeros(model.size)
-        self.y[:4] = np.asarray(state, dtype=float)
-        self.y[1] -= self.clearance
+        self.y[: 2 * n] = model.layout.internal(state)
         self.contact = model.enters(t, self.y)
-        self.solvers = {mode: engine._solver(model, mode, omega_ref) for mode in (False, True)}
+        self.solvers: dict[int, tuple[IDA, Any]] = {}
         self.counts = {"events": 0, "contacts": 0, "solver_calls": 0, "grazing": 0}
-        self.onset, self.peak_force, self.peak_deceleration = (t, 0.0, 0.0), 0.0, 0.0
-        if self.contact:
-            self._begin_contact()
-        self.rec.segment(self.t, MODE_CONTACT if self.contact else MODE_FREE, self.physical())
+        count = model.stop_count
+        self.onsets: list[tuple[float, float, float]] = [(t, 0.0, 0.0)] * count
+        self.peak_force, self.peak_deceleration = [0.0] * count, [0.0] * count
+        for k in range(count):
+            if (self.contact >> k) & 1:
+                self._begin_contact(k)
+        self.rec.segment(self.t, MODE_CONTACT if self.contact else MODE_FREE, self.physical(), stop=self._segment_stop())
+
+    def solver(self, mode: int) -> tuple[IDA, Any]:
+        """The solver of a contact mode (made on first use)."""
+        if mode not in self.solvers:
+            self.solvers[mode] = self.engine._solver(self.model, mode, self.omega_ref)
+        return self.solvers[mode]
 
     def physical(self) -> NDArray[np.float64]:
-        """(X1, X2, X1', X2') now."""
-        return np.array([self.y[0], self.y[1] + self.clearance, self.y[2], self.y[3]])
+        """(x, x') now."""
+        return self.model.layout.physical(self.y)
+
+    def _segment_stop(self) -> int:
+        """The stop in contact for the segment record (the lowest one if several, -1 in flight)."""
+        return (self.contact & -self.contact).bit_length() - 1 if self.contact else -1
 
     def stats(self) -> dict[str, int]:
         return self.counts | {"steps": self.model.steps, "rhs_calls": self.model.rhs_calls}
 
-    def run(self, outputs: NDArray[np.float64], emit: Callable[[NDArray[np.float64], NDArray[np.float64], bool], None]) -> None:
+    def run(self, outputs: NDArray[np.float64], emit: Callable[[NDArray[np.float64], NDArray[np.float64], int], None]) -> None:
         """Integrate to ``outputs[-1]``, handing the states at the increasing ``outputs`` (all after or at the
         current time) to ``emit(times, states, contact)`` in order, in blocks of one mode."""
         n, i, in_place, last_switch = outputs.size, 0, 0, math.nan
@@ -211,7 +248,7 @@ class _Run:
             midpoint = tspan.size == 2  # IDA.solve interpolates at given times only with three or more
             if midpoint:
                 tspan = np.array([self.t, 0.5 * (self.t + outputs[i]), outputs[i]])
-            solver, events = self.solvers[self.contact]
+            solver, events = self.solver(self.contact)
             self.counts["solver_calls"] += 1
             result = self.engine.solve(solver, tspan, self.y, self.model.derivative(self.t, self.y, self.contact))
             close_roots = self._close_roots(result)
@@ -223,8 +260,9 @@ class _Run:
             rows, end_t, end_y = times.size - 1 if stopped or close_roots else times.size, float(times[-1]), states[-1]
             records = (result.i_events, result.t_events, result.y_events)
             clear_event_records(events)
+            switching = 0
             if records[0] is not None:
-                rows, end_t, end_y, stopped = self._roots(records, times, rows, end_t, end_y, stopped)
+                rows, end_t, end_y, stopped, switching = self._roots(records, times, rows, end_t, end_y, stopped)
             first = 1 if midpoint else 0
             if rows > first:
                 emit(times[first:rows], states[first:rows], self.contact)
@@ -240,11 +278,11 @@ class _Run:
                 if in_place > _MAX_SWITCHES_IN_PLACE:
                     raise RuntimeError(f"the contact switches mode over and over at t = {self.t!r} s")
                 last_switch = self.t
-                self._switch()
+                self._switch(switching)
 
     def _close_roots(self, result: Any) -> bool:
         """The solver refused to go on from a recorded root because an event function is exactly 0 there and just
-        after it ("Root found at and very near t", IDA_ILL_INPUT): in a long contact (the absorber pressed on the
+        after it ("Root found at and very near t", IDA_ILL_INPUT): in a long contact (a structure pressed on the
         bumper) the deceleration's extremum event (jerk) hovers at round-off zero. Its last output row is that root,
         consistent; a restart from it is safe, since at a start SUNDIALS ignores a function that stays 0 until it
         moves. Any other failure is an error."""
@@ -253,38 +291,54 @@ class _Run:
         end = float(result.t[-1])
         return end > self.t and end == float(result.t_events[-1])
 
-    def _roots(self, records: tuple[Any, Any, Any], times: NDArray[np.float64], rows: int, end_t: float, end_y: NDArray[np.float64], stopped: bool) -> tuple[int, float, NDArray[np.float64], bool]:
-        """Handle the roots recorded in one solver call; return the output rows to keep and where the run goes on
-        (a grazing contact cuts the call short at its apex)."""
-        model = self.model
+    def _roots(self, records: tuple[Any, Any, Any], times: NDArray[np.float64], rows: int, end_t: float, end_y: NDArray[np.float64],
+               stopped: bool) -> tuple[int, float, NDArray[np.float64], bool, int]:
+        """Handle the roots recorded in one solver call; return the output rows to keep, where the run goes on (a
+        grazing contact cuts the call short at its apex), and the stops whose mode switches there (a bit mask)."""
+        model, count = self.model, self.model.stop_count
+        roles = model.event_roles(self.contact)
         for flags, t_root, y_root in zip(*records):
-            if stopped and t_root == end_t and flags[0] != 0:
-                break  # the terminal event: the caller switches mode
+            terminal = [k for k in range(count) if flags[k] != 0]
+            if stopped and t_root == end_t and terminal:
+                return rows, end_t, end_y, stopped, sum(1 << k for k in terminal)  # the terminal event: the caller switches
             self.counts["events"] += 1
-            if self.contact:  # a largest force or deceleration
-                self.peak_force = max(self.peak_force, model.force(y_root))
-                self.peak_deceleration = max(self.peak_deceleration, -model.derivative(float(t_root), y_root, True)[3])
-            elif y_root[1] >= 0.0:  # an apex at or beyond the bumper: a grazing contact the onset event missed
-                self.counts["grazing"] += 1
-                return int(np.searchsorted(times[:rows], t_root, side="right")), float(t_root), y_root, True
-        return rows, end_t, end_y, stopped
+            for index in range(count, len(roles)):
+                if flags[index] == 0:
+                    continue
+                stop, role = roles[index]
+                if role == "apex":
+                    if model.layout.penetration(y_root, stop) >= 0.0:  # an apex at or beyond the bumper: a grazing contact the onset event missed
+                        self.counts["grazing"] += 1
+                        return int(np.searchsorted(times[:rows], t_root, side="right")), float(t_root), y_root, True, 1 << stop
+                else:  # a largest force or deceleration
+                    self.peak_force[stop] = max(self.peak_force[stop], model.force(y_root, stop))
+                    self.peak_deceleration[stop] = max(self.peak_deceleration[stop], model.deceleration(float(t_root), y_root, self.contact, stop))
+        return rows, end_t, end_y, stopped, 0
 
-    def _begin_contact(self) -> None:
+    def _begin_contact(self, stop: int) -> None:
         """Onset (time, entry speed, impulse integral) and the force and deceleration at first touch."""
         self.counts["contacts"] += 1
-        self.onset = (self.t, float(self.y[3]), float(self.y[4]))
-        self.peak_force = self.model.force(self.y)
-        self.peak_deceleration = max(-self.model.derivative(self.t, self.y, True)[3], 0.0)
+        model = self.model
+        self.onsets[stop] = (self.t, model.layout.approach(self.y, stop), float(self.y[model.states + stop]))
+        self.peak_force[stop] = model.force(self.y, stop)
+        self.peak_deceleration[stop] = max(model.deceleration(self.t, self.y, self.contact, stop), 0.0)
 
-    def _switch(self) -> None:
-        """Onset (or grazing apex) in flight, release in contact: change mode at the current state."""
+    def _switch(self, stops: int) -> None:
+        """Onset (or grazing apex) in flight, release in contact, of each stop in the mask ``stops``: change mode at
+        the current state."""
         self.counts["events"] += 1
-        if self.contact:  # release: the bumper would pull
-            self.rec.contact_peaks(self.peak_force, self.peak_deceleration)
-            self.rec.impact(self.onset[0], self.onset[1], float(self.y[4]) - self.onset[2], in_moments=False)
-            self.contact = False
-        else:
-            self.contact = True
-            self.y[1] = max(self.y[1], 0.0)
-            self._begin_contact()
-        self.rec.segment(self.t, MODE_CONTACT if self.contact else MODE_FREE, self.physical())
+        model = self.model
+        for k in range(model.stop_count):
+            if not (stops >> k) & 1:
+                continue
+            if (self.contact >> k) & 1:  # release: the bumper would pull
+                self.rec.contact_peaks(self.peak_force[k], self.peak_deceleration[k], stop=k)
+                onset = self.onsets[k]
+                self.rec.impact(onset[0], onset[1], float(self.y[model.states + k]) - onset[2], in_moments=False, stop=k)
+                self.contact &= ~(1 << k)
+            else:
+                self.contact |= 1 << k
+                if model.layout.penetration(self.y, k) < 0.0:
+                    model.layout.close(self.y, k)
+                self._begin_contact(k)
+        self.rec.segment(self.t, MODE_CONTACT if self.contact else MODE_FREE, self.physical(), stop=self._segment_stop())

@@ -1,19 +1,24 @@
-"""The Kelvin-Voigt bumper model of eq. 25 as the compliant engines integrate it: residuals, Jacobians and events.
+"""The Kelvin-Voigt bumper model (eq. 25, any structure and stops) as the compliant engines integrate it: residuals,
+Jacobians and events of each contact mode.
 
-The equations of motion are written as the residual ``y' - f(t, y)`` of the state (X1, u, X1', X2') with the gap
-u = X2 - Delta, then the running integral of the bumper force (impulses), then quadratures: for ``integrate``, the
-harmonic moments of :mod:`vibroimpact.engines.event_loop` when asked (their contact-force channel integrates the bumper force itself);
-for ``sweep``, the Fourier integral of the bumper force against the sweep's own phase, integral of
-F exp(-j theta) theta' dt (the force is a pulse far shorter than the output sampling: it cannot be summed from
-samples). In contact the bumper force F = K u + B X2' acts on the absorber, outside it does not. Each mode has its
-own IDA solver, residual, Jacobian ``cj I - df/dy`` and events, so every residual is smooth; the switches are events:
+Each stop k with a :class:`~vibroimpact.model.contact.KelvinVoigtBumper` pushes along -n_k with
+lambda_k = K_k u_k + B_k n_k . x' while its penetration u_k = n_k . x - Delta_k >= 0 and lambda_k > 0 (eq. 25, the
+bumper never pulls), K_k = m_k Omega_b^2 and B_k = 2 m_k xi_b Omega_b with the stop's effective mass m_k (M2 for the
+paper's stop; a relative bumper acts on both bodies). The state is (w, v) of :mod:`..flow_layout` (the penetrations
+in place of one coordinate each; (X1, X2 - Delta, X1', X2') for the paper's layout), the running integral of each
+stop's force (impulses), then quadratures (:mod:`.kernels`): the harmonic moments of :mod:`..event_loop` when asked
+(their contact-force channels integrate the bumper forces themselves), or for a sweep the Fourier integral of each
+force against the sweep's own phase, integral of F exp(-j theta) theta' dt (the force is a pulse far shorter than the
+output sampling: it cannot be summed from samples). A *mode* is the set of stops in contact (bit k of an int); each
+has its own solver, residual, Jacobian ``cj I - df/dy`` and events, so every residual is smooth; the switches are
+events, per stop:
 
-* free flight: the gap rising through zero, or within the bumper's reach (after a release with u > 0) the force it
-  would exert rising through zero (onset, terminal), and the absorber's apex, X2' falling through zero
-  (recorded only): an apex at u >= 0 is a grazing contact whose two gap crossings fell inside one step; the run goes
-  back to that apex and the contact starts there;
-* contact: -F rising through zero (release, terminal: eq. 25, the bumper never pulls), dF/dt falling through zero
-  (largest force) and the absorber's jerk rising through zero (largest deceleration), both recorded only.
+* free: the penetration rising through zero, or within the bumper's reach (after a release with u > 0) the force it
+  would exert rising through zero (onset, terminal), and the apex, n_k . x' falling through zero (recorded only): an
+  apex at u >= 0 is a grazing contact whose two crossings fell inside one step; the run goes back to that apex and
+  the contact starts there;
+* contact: -lambda_k rising through zero (release, terminal), d lambda_k / dt falling through zero (largest force)
+  and the jerk of n_k . x rising through zero (largest deceleration), both recorded only.
 """
 
 from __future__ import annotations
@@ -24,22 +29,27 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.engines.event_loop import QUADRATURES, write_quadratures
+from vibroimpact.engines.compliant.kernels import MOMENTS, NONE, SWEEP, bumper_events, bumper_residual, bumper_rhs, force_kernel, pack_mode
+from vibroimpact.engines.flow_layout import flow_layout
+from vibroimpact.engines.rigid_kernels import quadrature_count
+from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem
 
 __all__ = ["MODE_CONTACT", "BumperModel", "absolute_tolerances"]
 
-MODE_CONTACT = 2  # segment mode: absorber on the bumper
+MODE_CONTACT = 2  # segment mode: a bumper pushing
+
+_KINDS = {"none": NONE, "sweep": SWEEP, "moments": MOMENTS}
 
 
-def absolute_tolerances(atol: float, omega_ref: float, m2: float, quadratures: str = "none") -> NDArray[np.float64]:
-    """Per-component absolute tolerances of the compliant engine's state.
+def absolute_tolerances(atol: float, omega_ref: float, masses: NDArray[np.float64] | float, quadratures: str = "none", size: int = 2) -> NDArray[np.float64]:
+    """Per-component absolute tolerances of the compliant engines' state.
 
-    ``atol`` [m] applies to X1 and u; the velocities get ``atol * omega_ref`` [m s-1], the force integral
-    ``atol * omega_ref * m2`` [N s] (a momentum). Quadratures: the sweep's Fourier integrals of the force [N]
-    ``atol * omega_ref**2 * m2``; the harmonic moments of the displacements [m s] ``atol / omega_ref``, of the force
-    ``atol * m2`` [N s], of the squares [m2 s] ``1e-3 * atol / omega_ref`` (millimetre amplitudes).
+    ``atol`` [m] applies to the displacements (w); the velocities get ``atol * omega_ref`` [m s-1], each force
+    integral ``atol * omega_ref * m_k`` [N s] (a momentum). Quadratures: the sweep's Fourier integrals of the forces
+    [N] ``atol * omega_ref**2 * m_k``; the harmonic moments of the displacements [m s] ``atol / omega_ref``, of the
+    forces ``atol * m_k`` [N s], of the squares [m2 s] ``1e-3 * atol / omega_ref`` (millimetre amplitudes).
 
     Parameters
     ----------
@@ -47,51 +57,91 @@ def absolute_tolerances(atol: float, omega_ref: float, m2: float, quadratures: s
         Absolute tolerance of the displacements [m].
     omega_ref : float
         Angular frequency of the motion [rad s-1] (the excitation's, or the sweep's highest).
-    m2 : float
-        Absorber mass [kg].
+    masses : ndarray or float
+        Effective mass of each stop [kg] (M2 for the paper's stop).
     quadratures : {'none', 'sweep', 'moments'}
-        The states after the force integral: none, the sweep's two Fourier integrals, or the eight moments.
+        The states after the force integrals: none, the sweep's Fourier integrals, or the moments.
+    size : int
+        N, the number of coordinates.
     """
+    masses = np.atleast_1d(np.asarray(masses, dtype=float))
     v = atol * omega_ref
-    tolerances = [atol, atol, v, v, v * m2]
+    tolerances = [atol] * size + [v] * size + list(v * masses)
     if quadratures == "sweep":
-        tolerances += [v * omega_ref * m2] * 2
+        for mass in masses:
+            tolerances += [v * omega_ref * mass] * 2
     elif quadratures == "moments":
         d = atol / omega_ref
-        tolerances += [d, d, d, d, atol * m2, atol * m2, 1e-3 * d, 1e-3 * d]
+        tolerances += [d] * (2 * size)
+        for mass in masses:
+            tolerances += [atol * mass] * 2
+        tolerances += [1e-3 * d] * size
     elif quadratures != "none":
         raise ValueError(f"quadratures = {quadratures!r} is not allowed: use 'none', 'sweep' or 'moments'")
     return np.array(tolerances)
 
 
 class BumperModel:
-    """Residuals, Jacobians and events of each mode, and the right-hand side, of the system with a bumper."""
+    """Residuals, Jacobians and events of each contact mode, and the right-hand side, of a structure with bumpers.
+
+    Attributes
+    ----------
+    layout : FlowLayout
+        Coordinates and flows (:mod:`..flow_layout`).
+    k, b : ndarray, shape (K,)
+        Bumper stiffness K_k [N m-1] and damping B_k [N s m-1] of each stop.
+    size : int
+        Number of states.
+    """
 
     def __init__(self, problem: ImpactProblem, with_moments: bool) -> None:
-        s, bumper = problem.system, problem.bumper
         sweep = problem.excitation if isinstance(problem.excitation, SweptSine) else None
         if with_moments and sweep is not None:
             raise ValueError("harmonic moments are for a harmonic force, not a sweep")
+        laws = [stop.law for stop in problem.stops]
+        for index, law in enumerate(laws):
+            if not isinstance(law, KelvinVoigtBumper):
+                raise TypeError(f"stop {index}'s contact = {law!r} is not a KelvinVoigtBumper")
         self.problem, self.sweep = problem, sweep
-        # (X1, u, X1', X2', integral of F), then 8 moments (integrate) or 2 Fourier integrals of F (sweep)
+        self.layout = layout = flow_layout(problem)
+        n, count = layout.size, layout.stop_count
+        self.stop_count, self.states = count, 2 * n
         self.quadratures = "sweep" if sweep is not None else "moments" if with_moments else "none"
-        self.size = 5 + {"none": 0, "sweep": 2, "moments": QUADRATURES}[self.quadratures]
-        self.k, self.b = bumper.stiffness(s.m2), bumper.damping(s.m2)
+        self.first_quadrature = 2 * n + count
+        extra = {"none": 0, "sweep": 2 * count, "moments": quadrature_count(n, count)}[self.quadratures]
+        self.size = 2 * n + count + extra
+        self.k = np.array([law.stiffness(m) for law, m in zip(laws, layout.masses)])  # type: ignore[union-attr]
+        self.b = np.array([law.damping(m) for law, m in zip(laws, layout.masses)])  # type: ignore[union-attr]
         #: [residual calls, step attempts (distinct residual times), last residual time]
         self.counter: list[float] = [0, 0, math.nan]
         if sweep is None:
             self._w0, self._half_alpha = problem.omega, 0.0
         else:  # theta(t) = t (w0 + pi alpha t), theta'(t) = w0 + 2 pi alpha t
             self._w0, self._half_alpha = 2.0 * math.pi * sweep.start_frequency, math.pi * sweep.alpha
-        base = np.zeros((self.size, self.size))
-        base[:4, :4] = s.state_matrix
-        contact = base.copy()
-        contact[3, 1] -= self.k / s.m2
-        contact[3, 3] -= self.b / s.m2
-        contact[4, 1] += self.k
-        contact[4, 3] += self.b
-        self._minus_jacobian = {False: -base, True: -contact}
-        self._identity = np.eye(self.size)
+        self.force_rows = np.hstack([self.k[:, None] * layout.gap_rows, self.b[:, None] * layout.normals])
+        self.force_constants = self.k * layout.gap_constants
+        self._mass = problem.structure.mass_matrix
+        self._modes: dict[int, tuple[NDArray[np.float64], NDArray[np.float64]]] = {}
+
+    # ------------------------------------------------------------------ modes
+    def mode(self, mask: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(parameters, minus the Jacobian d f / d y without the moment rows' state dependence) of a mode."""
+        mask = int(mask)
+        if mask not in self._modes:
+            layout = self.layout
+            n, count = layout.size, self.stop_count
+            active = tuple(k for k in range(count) if (mask >> k) & 1)
+            a, c = layout.bumper_mode(self._mass, active, self.k, self.b)
+            b = layout.free[2]
+            kind = _KINDS[self.quadratures]
+            parameters = pack_mode(n, count, self.size, mask, kind, self.sweep is not None, layout.omega, self._w0, self._half_alpha, a, c, b,
+                                   self.force_rows, self.force_constants, layout.normals, layout.t, layout.t_inverse, layout.offset)
+            jacobian = np.zeros((self.size, self.size))
+            jacobian[: 2 * n, : 2 * n] = a
+            for k in active:
+                jacobian[2 * n + k, : 2 * n] = self.force_rows[k]
+            self._modes[mask] = (parameters, -jacobian)
+        return self._modes[mask]
 
     @property
     def rhs_calls(self) -> int:
@@ -101,161 +151,121 @@ class BumperModel:
     def steps(self) -> int:
         return int(self.counter[1])
 
-    def external(self, t: float) -> float:
-        """Force on the primary mass [N]."""
-        p = self.problem
-        if self.sweep is None:
-            return p.amplitude * math.cos(p.omega * t + p.phase)
-        return self.sweep.amplitude * math.sin(t * (self._w0 + self._half_alpha * t))
+    def force(self, y: NDArray[np.float64], stop: int = 0) -> float:
+        """Bumper force of ``stop`` in contact, K_k u_k + B_k n_k . x' [N] (may be negative: then it releases)."""
+        return float(force_kernel(np.ascontiguousarray(y, dtype=float), self.mode(0)[0], stop))
 
-    def force(self, y: NDArray[np.float64]) -> float:
-        """Bumper force on the absorber in contact mode, K u + B X2' [N] (may be negative: then it releases)."""
-        return self.k * y[1] + self.b * y[3]
+    def derivative(self, t: float, y: NDArray[np.float64], mask: int) -> NDArray[np.float64]:
+        """f(t, y) of the mode ``mask`` (restarts, peaks, moments)."""
+        f = np.empty(self.size)
+        bumper_rhs(t, np.ascontiguousarray(y, dtype=float), f, self.mode(mask)[0])
+        return f
 
-    def enters(self, t: float, y: NDArray[np.float64]) -> bool:
-        """Does a run started in state y at time t begin in contact? At or beyond the bumper (u >= 0) with a force
-        K u + B X2' > 0: yes; < 0: no. A force of exactly 0 (at rest on the bumper, as from rest with Delta = 0, or an
-        elastic bumper touched at u = 0) is decided by the gap's first non-zero time derivative in free flight: the
-        onset event cannot see a gap that is 0 at the start and then only rises, so a free start would go through
+    def deceleration(self, t: float, y: NDArray[np.float64], mask: int, stop: int) -> float:
+        """-n_k . x'' [m s-2] in the mode ``mask``: the stopped coordinate's deceleration."""
+        n = self.layout.size
+        return float(-(self.layout.normals[stop] @ self.derivative(t, y, mask)[n : 2 * n]))
+
+    def enters(self, t: float, y: NDArray[np.float64]) -> int:
+        """The mode a run started in state y at time t begins in: the stops at or beyond their bumper (u >= 0) whose
+        force is > 0. A force of exactly 0 (at rest on the bumper, as from rest with Delta = 0, or an elastic bumper
+        touched at u = 0) is decided by the penetration's first non-zero time derivative in free flight: the onset
+        event cannot see a penetration that is 0 at the start and then only rises, so a free start would go through
         the bumper. The derivatives follow y^(k+1) = A y^(k) + F^(k)(t) (a sweep's force is taken as harmonic at its
         instantaneous frequency and phase, exact to first order, which decides every start but a tie)."""
-        if y[1] < 0.0:
-            return False
-        force = self.force(y)
-        if force != 0.0:
-            return force > 0.0
-        s = self.problem.system
+        layout = self.layout
+        mask = 0
+        for k in range(self.stop_count):
+            if layout.penetration(y, k) < 0.0:
+                continue
+            force = self.force(y, k)
+            if force > 0.0 or (force == 0.0 and self._rises(t, y, k)):
+                mask |= 1 << k
+        return mask
+
+    def _rises(self, t: float, y: NDArray[np.float64], stop: int) -> bool:
+        layout = self.layout
+        n = layout.size
+        a, c, b = layout.free
         if self.sweep is None:
-            amplitude, omega, angle = self.problem.amplitude, self.problem.omega, self.problem.omega * t + self.problem.phase
-        else:  # q sin(theta) = q cos(theta - pi / 2)
-            amplitude, omega = self.sweep.amplitude, self._w0 + 2.0 * self._half_alpha * t
-            angle = t * (self._w0 + self._half_alpha * t) - 0.5 * math.pi
-        a = s.state_matrix
+            omega, angle, amplitude = self.problem.omega, self.problem.omega * t, b
+        else:  # Re(b) sin(theta) = Re(b e^{j (theta - pi / 2)})
+            omega, angle = self._w0 + 2.0 * self._half_alpha * t, t * (self._w0 + self._half_alpha * t) - 0.5 * math.pi
+            amplitude = b.real.astype(complex)
         size = float(np.abs(a).max())
-        rate = np.array([y[0], y[1] + self.problem.clearance, y[2], y[3]], dtype=float)
-        scale = float(np.abs(rate).max())
-        for k in range(6):
-            forcing = amplitude / s.m1 * (complex(0.0, omega) ** k * complex(math.cos(angle), math.sin(angle))).real
-            rate = a @ rate + np.array([0.0, 0.0, forcing, 0.0])  # y^(k + 1)
-            scale = size * scale + amplitude / s.m1 * omega**k
-            if abs(rate[1]) > 1e-12 * scale:
-                return bool(rate[1] > 0.0)
+        rate = np.array(y[: 2 * n], dtype=float)
+        scale = float(np.abs(rate).max()) + float(np.abs(c).max())
+        forcing_scale = float(np.abs(amplitude).max())
+        row = np.concatenate([layout.gap_rows[stop], np.zeros(n)])
+        for order in range(6):
+            forcing = (amplitude * complex(0.0, omega) ** order * complex(math.cos(angle), math.sin(angle))).real
+            rate = a @ rate + forcing + (c if order == 0 else 0.0)  # y^(order + 1)
+            scale = size * scale + forcing_scale * omega**order
+            value = float(row @ rate)
+            if abs(value) > 1e-12 * scale:
+                return value > 0.0
         return False
 
-    def derivative(self, t: float, y: NDArray[np.float64], contact: bool) -> NDArray[np.float64]:
-        """f(t, y) of the given mode (restarts, peaks, moments)."""
-        s, delta = self.problem.system, self.problem.clearance
-        x1, gap, v1, v2 = float(y[0]), float(y[1]), float(y[2]), float(y[3])
-        spring = s.k2 * (x1 - gap - delta) + s.b2 * (v1 - v2)
-        bumper = self.k * gap + self.b * v2 if contact else 0.0
-        yp = np.zeros(self.size)
-        yp[:5] = v1, v2, (self.external(t) - s.k1 * x1 - s.b1 * v1 - spring) / s.m1, (spring - bumper) / s.m2, bumper
-        if self.quadratures == "moments":
-            write_quadratures(yp, 5, t, self.problem.omega, x1, gap + delta, bumper)
-        elif self.sweep is not None and contact:
-            theta, rate = t * (self._w0 + self._half_alpha * t), self._w0 + 2.0 * self._half_alpha * t
-            yp[5], yp[6] = bumper * math.cos(theta) * rate, bumper * math.sin(theta) * rate
-        return yp
-
-    def residual(self, contact: bool) -> Callable[..., None]:
-        """The residual y' - f(t, y) of one mode, written for speed (it is called millions of times)."""
-        s, delta, counter = self.problem.system, self.problem.clearance, self.counter
-        if self.quadratures == "moments":
-
-            def general(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], res: NDArray[np.float64]) -> None:
-                counter[0] += 1
-                if t != counter[2]:
-                    counter[1] += 1
-                    counter[2] = t
-                np.subtract(yp, self.derivative(t, y, contact), out=res)
-
-            return general
-        m1, m2, k1, k2, b1, b2, k, b = s.m1, s.m2, s.k1, s.k2, s.b1, s.b2, self.k, self.b
-        sin, cos, swept = math.sin, math.cos, self.sweep is not None
-        q = self.problem.amplitude
-        w0, half_alpha, phase = self._w0, self._half_alpha, 0.0 if swept else self.problem.phase
+    # ---------------------------------------------------- solver callbacks
+    def residual(self, mask: int) -> Callable[..., None]:
+        """The residual y' - f(t, y) of one mode (compiled kernel; counts calls and distinct times)."""
+        parameters, counter = self.mode(mask)[0], self.counter
 
         def residual(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], res: NDArray[np.float64]) -> None:
             counter[0] += 1
             if t != counter[2]:
                 counter[1] += 1
                 counter[2] = t
-            x1, u, v1, v2 = y[:4].tolist()
-            d = yp.tolist()
-            spring = k2 * (x1 - u - delta) + b2 * (v1 - v2)
-            if swept:
-                theta = t * (w0 + half_alpha * t)
-                sine = sin(theta)
-                external = q * sine
-            else:
-                external = q * cos(w0 * t + phase)
-            bumper = k * u + b * v2 if contact else 0.0
-            res[0] = d[0] - v1
-            res[1] = d[1] - v2
-            res[2] = d[2] - (external - k1 * x1 - b1 * v1 - spring) / m1
-            res[3] = d[3] - (spring - bumper) / m2
-            res[4] = d[4] - bumper
-            if swept:
-                if contact:
-                    rate = bumper * (w0 + 2.0 * half_alpha * t)
-                    res[5] = d[5] - rate * cos(theta)
-                    res[6] = d[6] - rate * sine
-                else:
-                    res[5] = d[5]
-                    res[6] = d[6]
+            bumper_residual(t, y, yp, res, parameters)
 
         return residual
 
-    def jacobian(self, contact: bool) -> Callable[..., None]:
+    def jacobian(self, mask: int) -> Callable[..., None]:
         """d(res)/dy + cj d(res)/dy' = cj I - df/dy; exact but for the moment rows (their dependence on the state is
         left out, which only slows Newton's convergence on those rows, never the solution)."""
-        minus, identity = self._minus_jacobian[contact], self._identity
-        fourier = self.sweep is not None and contact
-        k, b, w0, half_alpha = self.k, self.b, self._w0, self._half_alpha
+        minus = self.mode(mask)[1]
+        identity = np.eye(self.size)
+        n = self.layout.size
+        q = self.first_quadrature
+        active = [k for k in range(self.stop_count) if (mask >> k) & 1] if self.sweep is not None else []
+        rows = self.force_rows
+        w0, half_alpha = self._w0, self._half_alpha
 
         def jacobian(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], res: NDArray[np.float64], cj: float, jj: NDArray[np.float64]) -> None:
             np.multiply(identity, cj, out=jj)
             jj += minus
-            if fourier:  # rows of F cos(theta) theta' and F sin(theta) theta'
+            if active:  # rows of F_k cos(theta) theta' and F_k sin(theta) theta'
                 theta, rate = t * (w0 + half_alpha * t), w0 + 2.0 * half_alpha * t
                 c, s = math.cos(theta) * rate, math.sin(theta) * rate
-                jj[5, 1], jj[5, 3], jj[6, 1], jj[6, 3] = -k * c, -b * c, -k * s, -b * s
+                for k in active:
+                    jj[q + 2 * k, : 2 * n] = -c * rows[k]
+                    jj[q + 2 * k + 1, : 2 * n] = -s * rows[k]
 
         return jacobian
 
-    def events(self, contact: bool) -> Callable[..., None]:
-        """The event function of one mode, with its ``terminal`` and ``direction`` attributes.
+    def event_count(self, mask: int) -> int:
+        """Event functions of a mode: one terminal per stop, then two recorded per stop in contact, one per free stop."""
+        contact = bin(int(mask) & ((1 << self.stop_count) - 1)).count("1")
+        return self.stop_count + 2 * contact + (self.stop_count - contact)
 
-        Free: [K u, or the force K u + B X2' within the bumper's reach (rising, terminal: onset), X2' (falling:
-        apex)]. Contact: [-F (rising, terminal: release), dF/dt (falling: largest force), jerk of X2 (rising: largest
-        deceleration)]. The rates use the y' that IDA passes
-        (its interpolant's derivative): a root of a rate is located to the solution's accuracy, and the peak values
-        are then evaluated from the state at the root, where an error in the time only enters to second order.
-        """
-        s = self.problem.system
-        k, b, k2, b2, m2 = self.k, self.b, s.k2, s.b2, s.m2
-        if contact:
+    def event_roles(self, mask: int) -> list[tuple[int, str]]:
+        """(stop, role) of each event function of a mode: ``onset``, ``release``, ``apex``, ``rate``, ``jerk``."""
+        roles = [(k, "release" if (mask >> k) & 1 else "onset") for k in range(self.stop_count)]
+        for k in range(self.stop_count):
+            roles += [(k, "rate"), (k, "jerk")] if (mask >> k) & 1 else [(k, "apex")]
+        return roles
 
-            def contact_events(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], out: NDArray[np.float64]) -> None:
-                u, v1, v2, a1, a2 = y[1], y[2], y[3], yp[2], yp[3]
-                rate = k * v2 + b * a2
-                out[0] = -(k * u + b * v2)
-                out[1] = rate
-                out[2] = (k2 * (v1 - v2) + b2 * (a1 - a2) - rate) / m2
+    def events(self, mask: int) -> Callable[..., None]:
+        """The event function of one mode, with its ``terminal`` and ``direction`` attributes (:meth:`event_roles`;
+        compiled kernel). The rates use the y' that IDA passes (its interpolant's derivative): a root of a rate is
+        located to the solution's accuracy, and the peak values are then evaluated from the state at the root, where
+        an error in the time only enters to second order."""
+        parameters = self.mode(mask)[0]
 
-            contact_events.terminal = [True, False, False]  # type: ignore[attr-defined]
-            contact_events.direction = [1, -1, 1]  # type: ignore[attr-defined]
-            return contact_events
+        def events(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], out: NDArray[np.float64]) -> None:
+            bumper_events(t, y, yp, out, parameters)
 
-        def free_events(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], out: NDArray[np.float64]) -> None:
-            u = y[1]
-            # onset: K u < 0 short of the bumper; within its reach (u >= 0, after a release that left the absorber
-            # inside it, the dashpot having cancelled the spring) the force K u + B X2' it would exert: pushed back
-            # in before it got out, the contact resumes when that force turns positive, not when u crosses 0 (it
-            # does not). The two agree at u = 0 but for the dashpot's B X2' > 0 there: a rise through 0 either way.
-            out[0] = k * u + b * y[3] if u >= 0.0 else k * u
-            out[1] = y[3]
-
-        free_events.terminal = [True, False]  # type: ignore[attr-defined]
-        free_events.direction = [1, -1]  # type: ignore[attr-defined]
-        return free_events
+        roles = self.event_roles(mask)
+        events.terminal = [role in ("onset", "release") for _, role in roles]  # type: ignore[attr-defined]
+        events.direction = [{"onset": 1, "release": 1, "apex": -1, "rate": -1, "jerk": 1}[role] for _, role in roles]  # type: ignore[attr-defined]
+        return events

@@ -1,0 +1,176 @@
+"""The rigid-stop flight of any layout as compiled kernels: right-hand side, Jacobian, event functions and holding
+force over one flat parameter array (:func:`pack_parameters`), for the ``momentary`` engine's CVODE callbacks (numba
+``cfunc`` wrappers in :mod:`.momentary`) and, called from Python, for its fallback and the ``solve_ivp_*`` engines.
+
+The integrated state (see :mod:`.flow_layout`) is y = (w, v) of 2 N entries, followed, when harmonic moments are
+wanted, by 3 N + 2 K quadratures: x_i cos(wt) and x_i sin(wt) for each coordinate, the contact force of each stop
+times cos and sin (the holding force of the stuck stop, 0 for the others: impulses are added by the engine), and
+x_i^2 for each coordinate (for the paper's layout: X1 c, X1 s, X2 c, X2 s, H c, H s, X1^2, X2^2).
+
+Event functions (2 K + 1): the penetration u_k of each stop (rising: contact; -1 on the stop held), the holding force
+of the stuck stop (falling: release; 1 in free flight), and the approach velocity n_k . v of each stop (falling: an
+apex, the grazing guard; 1 on the stop held or without the guard).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from vibroimpact.engines.flow_layout import FlowLayout
+
+__all__ = ["pack_parameters", "quadrature_count", "rhs_kernel", "jacobian_kernel", "events_kernel", "holding_kernel", "STUCK", "APEX", "SIZE", "STOPS", "LENGTH", "HEADER"]
+
+# header of the parameter array: mode, flags, sizes and the offsets of the blocks after it
+STUCK, APEX, SIZE, _N, STOPS, _OMEGA, _A, _C, _BR, _BI, _G, _G0, _NORMAL, _H, _H0, _HBR, _HBI, _TINV, _XOFF, LENGTH = range(20)
+HEADER = 20
+
+
+def quadrature_count(size: int, stops: int) -> int:
+    """Moment quadratures of N coordinates and K stops: 3 N + 2 K (8 for the paper's layout)."""
+    return 3 * size + 2 * stops
+
+
+def pack_parameters(layout: FlowLayout, states: int, apex: bool = True) -> NDArray[np.float64]:
+    """The flat parameter array of ``layout`` for a state of ``states`` entries (2 N, or 2 N plus the quadratures).
+
+    Blocks: the matrices A of the free flight and of each stuck mode ((K + 1) x 2N x 2N, row-major), their c, Re b
+    and Im b ((K + 1) x 2N each), the gap rows and constants, the normals, the holding rows H, h0, Re hb, Im hb, T^-1
+    and its offset. Entry :data:`STUCK` holds the stuck stop (-1: free flight), :data:`APEX` the grazing guard flag.
+    """
+    n, k = layout.size, layout.stop_count
+    modes = (layout.free, *layout.stuck)
+    holding_rows, holding_constants, holding_harmonic = layout.holding
+    blocks = [
+        np.concatenate([m[0].ravel() for m in modes]),
+        np.concatenate([m[1] for m in modes]),
+        np.concatenate([m[2].real for m in modes]),
+        np.concatenate([m[2].imag for m in modes]),
+        layout.gap_rows.ravel(),
+        layout.gap_constants,
+        layout.normals.ravel(),
+        holding_rows.ravel(),
+        holding_constants,
+        holding_harmonic.real,
+        holding_harmonic.imag,
+        layout.t_inverse.ravel(),
+        layout.offset,
+    ]
+    header = np.zeros(HEADER)
+    header[STUCK], header[APEX], header[SIZE], header[_N], header[STOPS], header[_OMEGA] = -1.0, float(apex), states, n, k, layout.omega
+    start = HEADER
+    for index, block in zip(range(_A, LENGTH), blocks):
+        header[index] = start
+        start += block.size
+    header[LENGTH] = start
+    return np.concatenate([header, *blocks]).astype(np.float64)
+
+
+@njit(cache=True)
+def holding_kernel(t: float, y: NDArray[np.float64], p: NDArray[np.float64], stop: int) -> float:  # pragma: no cover - compiled
+    """lambda_k [N]: the force stop ``stop`` must exert to hold its gap closed, in state y at time t."""
+    n2 = 2 * int(p[_N])
+    row = int(p[_H]) + stop * n2
+    wt = p[_OMEGA] * t
+    value = p[int(p[_H0]) + stop] + p[int(p[_HBR]) + stop] * math.cos(wt) - p[int(p[_HBI]) + stop] * math.sin(wt)
+    for j in range(n2):
+        value += p[row + j] * y[j]
+    return value
+
+
+@njit(cache=True)
+def rhs_kernel(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], p: NDArray[np.float64]) -> None:  # pragma: no cover - compiled
+    """y' of the current mode into ``yp`` (and the moment quadratures when the state has them)."""
+    n = int(p[_N])
+    n2 = 2 * n
+    stuck = int(p[STUCK])
+    mode = stuck + 1
+    a0, c0 = int(p[_A]) + mode * n2 * n2, int(p[_C]) + mode * n2
+    br0, bi0 = int(p[_BR]) + mode * n2, int(p[_BI]) + mode * n2
+    wt = p[_OMEGA] * t
+    c, s = math.cos(wt), math.sin(wt)
+    for i in range(n2):
+        acc = p[c0 + i] + p[br0 + i] * c - p[bi0 + i] * s
+        row = a0 + i * n2
+        for j in range(n2):
+            acc += p[row + j] * y[j]
+        yp[i] = acc
+    if int(p[SIZE]) > n2:
+        k_count = int(p[STOPS])
+        tinv, xoff = int(p[_TINV]), int(p[_XOFF])
+        squares = n2 + 2 * n + 2 * k_count
+        for i in range(n):
+            x = p[xoff + i]
+            for j in range(n):
+                x += p[tinv + i * n + j] * y[j]
+            yp[n2 + 2 * i] = x * c
+            yp[n2 + 2 * i + 1] = x * s
+            yp[squares + i] = x * x
+        for k in range(k_count):
+            force = holding_kernel(t, y, p, k) if k == stuck else 0.0
+            yp[n2 + 2 * n + 2 * k] = force * c
+            yp[n2 + 2 * n + 2 * k + 1] = force * s
+
+
+@njit(cache=True)
+def jacobian_kernel(t: float, y: NDArray[np.float64], jt: NDArray[np.float64], p: NDArray[np.float64]) -> None:  # pragma: no cover - compiled
+    """d y' / d y into ``jt`` transposed: jt[j, i] = d y'_i / d y_j (CVODE's column-major dense matrix)."""
+    n = int(p[_N])
+    n2 = 2 * n
+    stuck = int(p[STUCK])
+    size = int(p[SIZE])
+    a0 = int(p[_A]) + (stuck + 1) * n2 * n2
+    jt[:, :] = 0.0
+    for i in range(n2):
+        for j in range(n2):
+            jt[j, i] = p[a0 + i * n2 + j]
+    if size > n2:
+        k_count = int(p[STOPS])
+        tinv, xoff = int(p[_TINV]), int(p[_XOFF])
+        wt = p[_OMEGA] * t
+        c, s = math.cos(wt), math.sin(wt)
+        squares = n2 + 2 * n + 2 * k_count
+        for i in range(n):
+            x = p[xoff + i]
+            for j in range(n):
+                x += p[tinv + i * n + j] * y[j]
+            for j in range(n):
+                entry = p[tinv + i * n + j]
+                jt[j, n2 + 2 * i] = entry * c
+                jt[j, n2 + 2 * i + 1] = entry * s
+                jt[j, squares + i] = 2.0 * x * entry
+        if stuck >= 0:
+            row = int(p[_H]) + stuck * n2
+            for j in range(n2):
+                jt[j, n2 + 2 * n + 2 * stuck] = p[row + j] * c
+                jt[j, n2 + 2 * n + 2 * stuck + 1] = p[row + j] * s
+
+
+@njit(cache=True)
+def events_kernel(t: float, y: NDArray[np.float64], out: NDArray[np.float64], p: NDArray[np.float64]) -> None:  # pragma: no cover - compiled
+    """The 2 K + 1 event functions into ``out``: penetrations, the holding force, approach velocities."""
+    n = int(p[_N])
+    k_count = int(p[STOPS])
+    stuck = int(p[STUCK])
+    apex = p[APEX] != 0.0
+    g, g0, normal = int(p[_G]), int(p[_G0]), int(p[_NORMAL])
+    for k in range(k_count):
+        if k == stuck:
+            out[k] = -1.0
+            out[k_count + 1 + k] = 1.0
+            continue
+        value = p[g0 + k]
+        for j in range(n):
+            value += p[g + k * n + j] * y[j]
+        out[k] = value
+        if apex:
+            speed = 0.0
+            for j in range(n):
+                speed += p[normal + k * n + j] * y[n + j]
+            out[k_count + 1 + k] = speed
+        else:
+            out[k_count + 1 + k] = 1.0
+    out[k_count] = holding_kernel(t, y, p, stuck) if stuck >= 0 else 1.0
