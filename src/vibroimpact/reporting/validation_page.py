@@ -15,10 +15,11 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from vibroimpact.reporting.page import Section, Table, saved
+from vibroimpact.reporting.page import Section, Table, render_page, saved, write_page
+from vibroimpact.reporting.record import stored_description
 from vibroimpact.reporting.validation_figures import validation_figure
 
-__all__ = ["ValidationPage", "validation_table"]
+__all__ = ["ValidationPage", "validation_table", "write_validation_report"]
 
 #: What each flag of ``passed`` shows.
 _VERDICT = {0: "<b style='color:#b00'>fail</b>", 1: "<span style='color:#070'>pass</span>", 2: "<span style='color:#777'>shown only</span>"}
@@ -82,3 +83,14 @@ class ValidationPage:
         )
         figures = saved([validation_figure(self.dataset)], out)
         return [Section("Agreement with the published closed form", intro, [], [validation_table(self.dataset)]), Section("Figure", "", figures, [])]
+
+
+def write_validation_report(dataset: xr.Dataset, out_dir: str | Path) -> Path:
+    """``report.html`` of a validation dataset in ``out_dir`` (what :func:`vibroimpact.reporting.report.write_report`
+    writes for it, in this process); return its path."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    page = ValidationPage(dataset)
+    text = str(dataset.attrs.get("scene", ""))
+    paragraphs = [stored_description(text), f"vibroimpact {dataset.attrs.get('vibroimpact_version', '?')}; {page.summary()}."]
+    return write_page(out / "report.html", render_page(f"Study '{dataset.attrs.get('scene_name', '')}'", paragraphs, page.sections(out), text))
