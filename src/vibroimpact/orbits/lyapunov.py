@@ -1,6 +1,7 @@
 """Lyapunov exponents of the stroboscopic map: from its exact per-period Jacobians, or from two nearby trajectories.
 
-The stroboscopic map P advances the state (X1, X2, X1', X2') by one excitation period T. Its largest Lyapunov exponent
+The stroboscopic map P advances the state (x, x') (2N wide; (X1, X2, X1', X2') on the paper's layout) by one
+excitation period T. Its largest Lyapunov exponent
 
     lambda_1 = lim (1/n) ln |J_{n-1} ... J_1 J_0 v|,   J_k = dP(y_k),
 
@@ -31,6 +32,20 @@ __all__ = ["LyapunovEstimate", "lyapunov_from_jacobians", "lyapunov_spectrum", "
 #: A generic start direction: no component zero, no simple relation between components (so that it has a component
 #: along every Oseledets direction, with probability one).
 _GENERIC = np.array([0.5406, -0.3212, 0.7188, 0.3005, -0.1873, 0.6021, 0.2507, -0.4411])
+
+
+def _generic(m: int) -> NDArray[np.float64]:
+    """A fixed, generic start vector of length m (the first 8 entries are :data:`_GENERIC`)."""
+    if m <= _GENERIC.size:
+        return _GENERIC[:m].copy()
+    extra = np.sin(1.618 * np.arange(_GENERIC.size, m) + 0.37) * 0.5
+    return np.concatenate([_GENERIC, extra])
+
+
+def _start_direction(problem: ImpactProblem) -> NDArray[np.float64]:
+    """The unit start direction of a perturbation of the 2N-wide state: the paper's 4 entries on its layout."""
+    v = _generic(2 * problem.size)
+    return v / np.linalg.norm(v)
 
 
 @dataclass(frozen=True)
@@ -131,7 +146,7 @@ def lyapunov_from_jacobians(jacobians: ArrayLike, transient: int | None = None, 
     """
     jac, skip = _check_jacobians(jacobians, transient)
     n, m = jac.shape[0], jac.shape[1]
-    v = np.array(start, dtype=float) if start is not None else _GENERIC[:m].copy()
+    v = np.array(start, dtype=float) if start is not None else _generic(m)
     norm = float(np.linalg.norm(v))
     if v.shape != (m,) or not norm > 0.0:
         raise ValueError(f"start: expected a non-zero vector of length {m}")
@@ -191,13 +206,15 @@ def lyapunov_spectrum(jacobians: ArrayLike, transient: int | None = None, blocks
 
 
 def state_scales(problem: ImpactProblem) -> NDArray[np.float64]:
-    """Scales of (X1, X2, X1', X2') that make a perturbation dimensionless [m, m, m/s, m/s].
+    """Scales of the state (x, x') that make a perturbation dimensionless [m ..., m/s ...], shape (2N,).
 
-    L = Delta + v / w = 2 Delta + q |H12| for the displacements (v = w (Delta + q |H12|) is the problem's velocity
-    scale; the rigid-contact engines use the same length for their relative thresholds) and w L for the velocities.
+    L = Delta + v / w = 2 Delta + q |H12| for the displacements on the paper's layout (v = w (Delta + q |H12|) is the
+    problem's velocity scale; the rigid-contact engines use the same length for their relative thresholds), in
+    general the largest |Delta_k| plus v / w; w L for the velocities.
     """
-    length = problem.clearance + problem.velocity_scale() / problem.omega
-    return np.array([length, length, problem.omega * length, problem.omega * length])
+    clearance = problem.clearance if not isinstance(problem.contact, tuple) else float(np.max(np.abs(problem.clearances()), initial=0.0))
+    length = clearance + problem.velocity_scale() / problem.omega
+    return np.repeat([length, problem.omega * length], problem.size)
 
 
 def lyapunov_two_trajectories(
@@ -270,7 +287,7 @@ def lyapunov_two_trajectories(
         raise ValueError(f"transient = {transient} is out of range: allowed [0, {intervals - 1}]")
     scale = state_scales(problem)
     y = np.array(state, dtype=float)
-    d = _GENERIC[:4] / np.linalg.norm(_GENERIC[:4]) * relative_size
+    d = _start_direction(problem) * relative_size
     t = float(t_start)
     growth = np.empty(intervals)
     for i in range(intervals):
@@ -318,7 +335,7 @@ def lyapunov_along_run(engine: Engine, problem: ImpactProblem, run: Trajectory, 
     """
     intervals = run.periods // every
     scale = state_scales(problem)
-    direction = _GENERIC[:4] / np.linalg.norm(_GENERIC[:4])
+    direction = _start_direction(problem)
     growth = np.empty(intervals)
     for i in range(intervals):
         start = run.strobe_states[i * every]
@@ -334,8 +351,21 @@ def lyapunov_along_run(engine: Engine, problem: ImpactProblem, run: Trajectory, 
 
 
 def _inside(problem: ImpactProblem, y: NDArray[np.float64], d: NDArray[np.float64], scale: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The perturbation, with its X2 component turned away from the stop when it would push the absorber through."""
-    if y[1] + d[1] * scale[1] > problem.clearance:
-        d = d.copy()
-        d[1] = -abs(d[1])
+    """The perturbation, turned away from every stop it would push the structure through.
+
+    On the paper's layout: its X2 component made negative when X2 + dX2 > Delta. In general, for each stop k whose gap
+    Delta_k - n_k . (x + dx) would be negative, the displacement part is mirrored in the stop's plane (dx -> dx - 2
+    (n_k . dx) n_k / |n_k|^2, the displacement scales being equal), which for n = e2 is the same sign flip.
+    """
+    if not isinstance(problem.contact, tuple):
+        if y[1] + d[1] * scale[1] > problem.clearance:
+            d = d.copy()
+            d[1] = -abs(d[1])
+        return d
+    size = problem.size
+    for n, clearance in zip(problem.normals(), problem.clearances()):
+        step = d[:size] * scale[:size]
+        if clearance - n @ (y[:size] + step) < 0.0 and n @ step > 0.0:
+            d = d.copy()
+            d[:size] = d[:size] - 2.0 * (n @ d[:size]) * n / (n @ n)
     return d

@@ -1,15 +1,21 @@
 """The impacting system as a parametrised map: the stroboscopic map of an :class:`ImpactProblem` over k periods.
 
-``ImpactMap(problem, periods=k)`` maps the state (X1, X2, X1', X2') at t = 0 (mod T) to the state k excitation
-periods later, with the exact Jacobian of the compiled ``exact`` engine (state-transition matrices times saltation
-matrices of impacts, sticking and release). Its parameters are ``frequency`` [Hz], ``restitution`` [-],
-``clearance`` [m] and ``amplitude`` [N]; a parameter vector becomes a new problem (the frequency changes the
-period, the strobes stay at t = 0 mod T). dP/dp comes from central differences (see
-:data:`vibroimpact.orbits.shooting.FD_RELATIVE_STEP`). Each evaluation carries the hybrid information continuation
-watches: impacts per orbit period, the slowest impact, the closest approach of a free flight to the stop, sticks.
+``ImpactMap(problem, periods=k)`` maps the state (x, x') at t = 0 (mod T), 2N wide ((X1, X2, X1', X2') on the
+paper's layout), to the state k excitation periods later, with the exact Jacobian of the compiled ``exact`` engine
+(state-transition matrices times saltation matrices of impacts, sticking and release). Its parameters are
+``frequency`` [Hz], ``restitution`` [-], ``clearance`` [m] and ``amplitude`` [N] (or the base amplitude [m] of a base
+motion); a parameter vector becomes a new problem (the frequency changes the period, the strobes stay at t = 0 mod
+T; the force's phase, distribution over the coordinates and static part are kept). With several stops, ``stop``
+says which one ``restitution`` and ``clearance`` belong to: an index k (that stop alone), or ``"all"`` (every stop
+takes the values; they must be equal in the base problem, e.g. a two-sided stop); by default ``"all"`` where the
+stops' values are equal (one stop always), else a ``ValueError`` asks for a choice. dP/dp comes from central
+differences (see :data:`vibroimpact.orbits.shooting.FD_RELATIVE_STEP`). Each evaluation carries the hybrid
+information continuation watches: impacts per orbit period, the slowest impact, the closest approach of a free
+flight to any stop, sticks.
 
-:func:`one_impact_state` gives the closed-form one-impact orbit's strobe state (a shooting guess), and
-:func:`orbit_measures` what an orbit means physically (impulse per impact, harmonic amplitudes).
+:func:`orbit_measures` says what an orbit means physically (impulse per impact, harmonic amplitudes);
+:func:`resection` moves a strobe away from the impacts. The closed-form starts (:func:`one_impact_state`,
+:func:`with_impulse`, :func:`section_phase`) live in :mod:`.starts` and are re-exported here.
 """
 
 from __future__ import annotations
@@ -21,17 +27,41 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
 from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.model.contact import RigidStop
-from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.orbits.branch import HybridInfo, MapEvaluation, PeriodicOrbit
+from vibroimpact.orbits.starts import closed_form_state, one_impact_state, section_phase, with_impulse
 
-__all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "one_impact_state", "with_impulse", "section_phase", "resection", "PARAMETERS"]
+__all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "one_impact_state", "closed_form_state", "with_impulse", "section_phase", "resection", "PARAMETERS", "stop_selection"]
 
 #: The parameters of an :class:`ImpactMap`, in order, with their units.
 PARAMETERS = {"frequency": "Hz", "restitution": "1", "clearance": "m", "amplitude": "N"}
+
+
+def stop_selection(problem: ImpactProblem, stop: int | str | None) -> tuple[int, ...]:
+    """The stops whose clearance and restitution an :class:`ImpactMap`'s parameters set (module docstring).
+
+    Raises
+    ------
+    ValueError
+        ``stop`` out of range, ``"all"`` over stops whose values differ, or no choice where they differ.
+    TypeError
+        A stop that is not rigid.
+    """
+    stops = problem.stops
+    for k, item in enumerate(stops):
+        if not item.rigid:
+            raise TypeError(f"contact: stops[{k}] is a {type(item.law).__name__}; an ImpactMap needs rigid stops (the exact engine)")
+    values = {(item.clearance, item.law.restitution) for item in stops}
+    if stop is None or stop == "all":
+        if len(values) > 1:
+            raise ValueError(f"stop = {stop!r}: the {len(stops)} stops have different clearances or restitutions; choose the one the parameters set: allowed 0 ... {len(stops) - 1}")
+        return tuple(range(len(stops)))
+    if isinstance(stop, bool) or not isinstance(stop, int) or not 0 <= stop < len(stops):
+        raise ValueError(f"stop = {stop!r} is out of range: allowed 0 ... {len(stops) - 1} or 'all'")
+    return (stop,)
 
 
 class ImpactMap:
@@ -40,38 +70,53 @@ class ImpactMap:
     Parameters
     ----------
     problem : ImpactProblem
-        The base problem (rigid stop, harmonic force); its values are the default parameter vector.
+        The base problem (rigid stops, harmonic force); its values are the default parameter vector.
     periods : int
         k >= 1: excitation periods per map iteration.
     engine : ExactEngine, optional
         The engine that computes the map (default settings when omitted).
     bounds : dict, optional
         Parameter name -> (lower, upper): outside this box the map has no image (NaN, a failed step), e.g. to keep a
-        continuation's trials at physical frequencies. Parameters outside their own ranges (a negative clearance or
-        frequency, R > 1) never have one.
+        continuation's trials at physical frequencies. Parameters outside their own ranges (a negative frequency,
+        R > 1) never have one.
+    stop : int or 'all', optional
+        The stop(s) whose clearance and restitution the parameters are (module docstring).
 
     Attributes
     ----------
     parameters : ndarray, shape (4,)
         The base problem's (frequency [Hz], restitution [-], clearance [m], amplitude [N]).
-    state_scale : ndarray, shape (4,)
-        (L, L, V, V) with L = Delta + q |H12(w)| [m] and V = w L [m s-1] of the base problem.
+    dimension : int
+        2N, the state's length.
+    stops : tuple of int
+        The stops the parameters set.
+    state_scale : ndarray, shape (2N,)
+        (L, ..., V, ...) with L = Delta + q |H12(w)| [m] on the paper's layout (in general the largest |Delta_k| +
+        |n_k H F| plus a static load's excursion, :meth:`ImpactProblem.velocity_scale` / w) and V = w L [m s-1].
     parameter_scale : ndarray, shape (4,)
         (1 Hz, 0.1, 1 mm, 1 N): what counts as a unit of arclength for each parameter.
     """
 
     parameter_names = tuple(PARAMETERS)
-    dimension = 4
 
-    def __init__(self, problem: ImpactProblem, periods: int = 1, engine: ExactEngine | None = None, bounds: dict[str, tuple[float, float]] | None = None) -> None:
-        _checked = (problem.rigid_stop, problem.harmonic)  # TypeError naming the part unless a rigid stop and a harmonic force
+    def __init__(self, problem: ImpactProblem, periods: int = 1, engine: ExactEngine | None = None, bounds: dict[str, tuple[float, float]] | None = None,
+                 stop: int | str | None = None) -> None:  # fmt: skip
+        _checked = problem.harmonic  # TypeError naming the part unless a harmonic force
+        self.stops = stop_selection(problem, stop)
+        self.stop = stop
         if int(periods) < 1:
             raise ValueError(f"periods = {periods!r} is out of range: allowed [1, inf)")
         self.problem, self.periods = problem, int(periods)
         self.engine = engine if engine is not None else ExactEngine()
-        self.parameters = np.array([problem.frequency, problem.restitution, problem.clearance, problem.amplitude])
-        length = problem.clearance + problem.amplitude * float(np.abs(problem.system.receptances(problem.omega).h12))
-        self.state_scale = np.array([length, length, problem.omega * length, problem.omega * length])
+        chosen = problem.stops[self.stops[0]]
+        self.parameters = np.array([problem.frequency, chosen.law.restitution, chosen.clearance, problem.amplitude])
+        self.dimension = 2 * problem.size
+        self._paper = isinstance(problem.system, TwoDofSystem) and not isinstance(problem.contact, tuple) and problem.paper_layout
+        if self._paper:
+            length = problem.clearance + problem.amplitude * float(np.abs(problem.system.receptances(problem.omega).h12))
+        else:
+            length = problem.velocity_scale() / problem.omega
+        self.state_scale = np.repeat([length, problem.omega * length], problem.size)
         self.parameter_scale = np.array([1.0, 0.1, 1e-3, 1.0])
         self.bounds = dict(bounds or {})
         unknown = set(self.bounds) - set(PARAMETERS)
@@ -81,35 +126,41 @@ class ImpactMap:
 
     def with_periods(self, periods: int) -> "ImpactMap":
         """The same map over ``periods`` excitation periods (one compiled call per evaluation, unlike ``Iterated``)."""
-        return ImpactMap(self.problem, periods, self.engine, self.bounds)
+        return ImpactMap(self.problem, periods, self.engine, self.bounds, self.stop)
 
     def problem_at(self, p: NDArray[np.float64]) -> ImpactProblem:
         """The problem with parameter vector ``p``."""
         frequency, restitution, clearance, amplitude = (float(x) for x in p)
         base = self.problem
-        return ImpactProblem(base.system, RigidStop(clearance, restitution), HarmonicForce(amplitude, frequency, base.phase))
+        excitation = dataclasses.replace(base.harmonic, amplitude=amplitude, frequency=frequency)
+        if self._paper:
+            return ImpactProblem(base.system, RigidStop(clearance, restitution), excitation)
+        law = RigidStop(clearance, restitution)
+        stops = tuple(dataclasses.replace(item, law=law) if k in self.stops else item for k, item in enumerate(base.stops))
+        return ImpactProblem(base.system, stops, excitation)
 
     def evaluate(self, y: NDArray[np.float64], p: NDArray[np.float64]) -> MapEvaluation:
         """The state k periods after ``y`` at t = 0, its Jacobian and the hybrid information.
 
-        A state inside the stop (X2 > Delta), a non-finite state, invalid parameters (e.g. a Newton iterate at a
-        negative frequency or clearance), parameters outside ``bounds`` and a flight on which the engine makes no
-        progress (endless chattering) have no image: NaN, which Newton's method and the corrector treat as a failed step.
+        A state inside a stop (a negative gap), a non-finite state, invalid parameters (e.g. a Newton iterate at a
+        negative frequency, R > 1), parameters outside ``bounds`` and a flight on which the engine makes no progress
+        (endless chattering) have no image: NaN, which Newton's method and the corrector treat as a failed step.
         """
         problem = None
         if all(low <= p[i] <= high for i, low, high in self._box) and np.all(np.isfinite(y)):
             try:
                 problem = self.problem_at(p)
-            except ValueError:  # a Newton iterate outside the parameters' ranges (negative clearance, R > 1, ...)
+            except ValueError:  # a Newton iterate outside the parameters' ranges (negative frequency, R > 1, ...)
                 problem = None
         strobe = None
-        if problem is not None and y[1] <= problem.clearance:  # inside the stop, no flight starts
+        if problem is not None and _outside_stops(problem, y):
             try:
                 strobe = self.engine.strobe_map(problem, np.asarray(y, dtype=float), 0.0, self.periods)
             except RuntimeError:  # the engine made no progress (endless chattering)
                 strobe = None
         if strobe is None:
-            return MapEvaluation(np.full(4, np.nan), np.full((4, 4), np.nan), None, None)
+            n = self.dimension
+            return MapEvaluation(np.full(n, np.nan), np.full((n, n), np.nan), None, None)
         velocities = strobe.impact_velocities
         length = self.state_scale[0]
         hybrid = HybridInfo(
@@ -123,6 +174,13 @@ class ImpactMap:
         return MapEvaluation(strobe.state, strobe.jacobian, None, hybrid)
 
 
+def _outside_stops(problem: ImpactProblem, y: NDArray[np.float64]) -> bool:
+    """Every gap Delta_k - n_k . x >= 0 (on the paper's layout: X2 <= Delta)."""
+    if not isinstance(problem.contact, tuple):
+        return bool(y[1] <= problem.clearance)
+    return bool(np.all(problem.clearances() - problem.normals() @ np.asarray(y[: problem.size], dtype=float) >= 0.0))
+
+
 @dataclass(frozen=True)
 class OrbitMeasures:
     """What a periodic orbit of an :class:`ImpactMap` means physically.
@@ -133,14 +191,26 @@ class OrbitMeasures:
         Approach speed of each impact over the orbit's period [m s-1].
     impulses : ndarray
         Impulse of each impact [N s].
-    x1_amplitude, x2_amplitude : float
-        |fundamental harmonic| of X1 and X2 at the excitation frequency, averaged over the orbit's period [m].
+    amplitudes : ndarray, shape (N,)
+        |fundamental harmonic| of each coordinate at the excitation frequency, averaged over the orbit's period [m].
+    impact_stops : ndarray of int
+        The stop of each impact.
     """
 
     impact_velocities: NDArray[np.float64]
     impulses: NDArray[np.float64]
-    x1_amplitude: float
-    x2_amplitude: float
+    amplitudes: NDArray[np.float64]
+    impact_stops: NDArray[np.int_] = dataclasses.field(default_factory=lambda: np.zeros(0, dtype=int))
+
+    @property
+    def x1_amplitude(self) -> float:
+        """|X1|: the first coordinate's amplitude [m] (the paper's primary mass)."""
+        return float(self.amplitudes[0])
+
+    @property
+    def x2_amplitude(self) -> float:
+        """|X2|: the second coordinate's amplitude [m] (the paper's absorber); NaN for a single coordinate."""
+        return float(self.amplitudes[1]) if self.amplitudes.size > 1 else math.nan
 
 
 def orbit_measures(system: ImpactMap, orbit: PeriodicOrbit) -> OrbitMeasures:
@@ -150,66 +220,10 @@ def orbit_measures(system: ImpactMap, orbit: PeriodicOrbit) -> OrbitMeasures:
     trajectory = system.engine.integrate(problem, orbit.state, 0.0, periods, moments=True)
     moments = trajectory.moments.sum(axis=0)
     scale = 2.0 / (periods * problem.period)
-    return OrbitMeasures(trajectory.impact_velocities.copy(), trajectory.impulses.copy(), float(abs(moments[0]) * scale), float(abs(moments[1]) * scale))
-
-
-def one_impact_state(problem: ImpactProblem, solution: OneImpactSolution | None = None) -> NDArray[np.float64]:
-    """The closed-form one-impact orbit's state (X1, X2, X1', X2') at t = 0 (mod T) of ``problem``'s time.
-
-    The closed form measures time from the impact, with the linear response q |H12| cos(w t + phi); in the problem's
-    time the force is q cos(w t' + phase), so t' = t + (phi - arg H12 - phase) / w. NaN where no solution exists.
-
-    Parameters
-    ----------
-    problem : ImpactProblem
-        Rigid stop and harmonic force.
-    solution : OneImpactSolution, optional
-        A scalar solution for this problem (solved when omitted), e.g. with another root of eq. 16.
-    """
-    if solution is None:
-        solution = solve_one_impact(problem.system, problem.omega, problem.clearance, problem.restitution, problem.amplitude)
-    w, period = float(solution.omega), float(solution.period)
-    impact_at = (float(solution.phase) - float(np.angle(solution.receptances.h12)) - problem.phase) / w
-    t = np.array([[(-impact_at) % period]])
-    return np.array([solution.x1(t)[0, 0], solution.x2(t)[0, 0], solution.x1(t, 1)[0, 0], solution.x2(t, 1)[0, 0]])
-
-
-def with_impulse(solution: OneImpactSolution, impulse: float) -> OneImpactSolution:
-    """A scalar closed-form solution with another root J of eq. 16 (its phase follows from eq. 15)."""
-    c = (1.0 / (solution.system.m2 * (1.0 + solution.restitution)) + solution.chi_rate_before) / solution.omega
-    a = solution.amplitude * np.abs(solution.receptances.h12)
-    phase = np.arctan2(-impulse * c / a, (solution.clearance + impulse * solution.chi0) / a)
-    return dataclasses.replace(solution, impulse=np.asarray(impulse, dtype=float), phase=np.asarray(phase, dtype=float))
-
-
-def section_phase(problem: ImpactProblem, frequencies: NDArray[np.float64]) -> float:
-    """A force phase [rad] that keeps the strobe (t = 0 mod T) away from the one-impact orbits' impacts.
-
-    Where an impact crosses the strobe time the fixed point of the stroboscopic map jumps between the states just
-    before and just after it, and a continuation cannot follow. The impact instants of both roots of eq. 16, as
-    fractions of the period, are found over ``frequencies`` [Hz] from the closed form; the phase puts the strobe in
-    the middle of the widest gap between them. Use it as ``HarmonicForce(q, f, phase)``.
-    """
-    system, delta, r, q = problem.system, problem.clearance, problem.restitution, problem.amplitude
-    f = np.asarray(frequencies, dtype=float)
-    sol = solve_one_impact(system, 2.0 * np.pi * f, delta, r, q)
-    c = (1.0 / (system.m2 * (1.0 + r)) + sol.chi_rate_before) / sol.omega
-    a = q * np.abs(sol.receptances.h12)
-    quad_a, quad_b = c**2 + sol.chi0**2, delta * sol.chi0
-    disc = quad_a * a**2 - (c * delta) ** 2
-    fractions = []
-    with np.errstate(invalid="ignore"):
-        for sign in (1.0, -1.0):
-            impulse = (-quad_b + sign * np.sqrt(disc)) / quad_a
-            ok = (disc >= 0.0) & (impulse >= 0.0)
-            phase = np.arctan2(-impulse * c / a, (delta + impulse * sol.chi0) / a)
-            fractions.append((((phase - np.angle(sol.receptances.h12)) / (2.0 * np.pi)) % 1.0)[ok])
-    points = np.sort(np.concatenate(fractions))
-    if points.size == 0:
-        return 0.0
-    gaps = np.diff(np.concatenate([points, [points[0] + 1.0]]))
-    k = int(np.argmax(gaps))
-    return float(2.0 * np.pi * ((points[k] + 0.5 * gaps[k]) % 1.0))
+    stops = getattr(trajectory, "impact_stops", None)
+    stops = np.asarray(stops, dtype=int).copy() if stops is not None else np.zeros(trajectory.impulses.size, dtype=int)
+    amplitudes = np.abs(np.asarray(moments[: problem.size])) * scale
+    return OrbitMeasures(trajectory.impact_velocities.copy(), trajectory.impulses.copy(), amplitudes, stops)
 
 
 def resection(problem: ImpactProblem, state: NDArray[np.float64], periods: int, engine: ExactEngine | None = None) -> tuple[ImpactProblem, NDArray[np.float64]]:
@@ -224,7 +238,7 @@ def resection(problem: ImpactProblem, state: NDArray[np.float64], periods: int, 
     Returns
     -------
     (ImpactProblem, ndarray)
-        The problem with the new force phase [rad], and the state (X1, X2, X1', X2') at its t = 0.
+        The problem with the new force phase [rad] (everything else kept), and the state (x, x') at its t = 0.
     """
     engine = engine if engine is not None else ExactEngine()
     run = engine.integrate(problem, np.asarray(state, dtype=float), 0.0, int(periods))
@@ -236,5 +250,4 @@ def resection(problem: ImpactProblem, state: NDArray[np.float64], periods: int, 
     g = float((fractions[k] + 0.5 * gaps[k]) % 1.0)
     moved = engine.dense(run, np.array([g * problem.period]))[0]
     phase = float((problem.phase + 2.0 * np.pi * g) % (2.0 * np.pi))
-    base = problem
-    return ImpactProblem(base.system, base.contact, HarmonicForce(base.amplitude, base.frequency, phase)), np.asarray(moved, dtype=float)
+    return ImpactProblem(problem.system, problem.contact, dataclasses.replace(problem.harmonic, phase=phase)), np.asarray(moved, dtype=float)
