@@ -1,12 +1,14 @@
 """The compliant-bumper swept-sine test through ``scipy.integrate.solve_ivp``: a cross-check of the IDA engine.
 
-Written independently of :mod:`.ida` and :mod:`.model` (its own right-hand side, in the physical coordinates X1, X2, X1', X2',
-its own events and restarts), so that agreement between the two means something. The model is the same: the
-Kelvin-Voigt bumper of eq. 25 pushes with F = K (X2 - Delta) + B X2' from the moment X2 reaches Delta until F falls
-to zero. The loop a user of SciPy would write:
+Written independently of :mod:`.ida` and :mod:`.model` (its own right-hand side, in the physical coordinates x1, x2, x1', x2',
+its own events and restarts), so that agreement between the two means something. The model is the same, on any
+two-coordinate structure with one stop (normal n, clearance Delta, effective mass m): the Kelvin-Voigt bumper of
+eq. 25 pushes along -n with F = K (n . x - Delta) + B n . x' (K = m Omega_b^2, B = 2 m xi_b Omega_b) from the moment
+n . x reaches Delta until F falls to zero (for the paper's layout n = e_2, F = K (X2 - Delta) + B X2'). The loop a
+user of SciPy would write:
 
-* free flight: ``solve_ivp`` with a terminal event on X2 - Delta (rising) and a recorded one on X2' (falling, the
-  apex); an apex at X2 >= Delta is a contact whose two crossings fell inside one step: the run restarts there;
+* free flight: ``solve_ivp`` with a terminal event on n . x - Delta (rising) and a recorded one on n . x' (falling,
+  the apex); an apex at n . x >= Delta is a contact whose two crossings fell inside one step: the run restarts there;
 * contact: a terminal event on F (falling), recorded ones on dF/dt (falling, largest force) and on the jerk
   (rising, largest deceleration);
 * each terminal event restarts ``solve_ivp`` in the other mode; the samples come from ``t_eval`` (each method's
@@ -29,6 +31,7 @@ from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
 from vibroimpact.engines.base import MODE_FREE, SweepRecord, TrajectoryBuilder, check_run
+from vibroimpact.engines.compliant.ida import base_force, check_sweep_layout
 from vibroimpact.engines.compliant.model import MODE_CONTACT
 from vibroimpact.engines.settings import SWEEP_SETTINGS
 from vibroimpact.model.contact import KelvinVoigtBumper
@@ -80,19 +83,20 @@ def solve_ivp_sweep(
     if method not in IVP_METHODS:
         raise ValueError(f"method = {method!r} is not allowed: use one of {', '.join(IVP_METHODS)}")
     check_run(f"solve_ivp_{method}", problem, KelvinVoigtBumper)
-    system, sweep = problem.system, problem.sweep
+    check_sweep_layout(f"solve_ivp_{method}", problem)
+    sweep = problem.sweep
     require_positive("sample_rate", sample_rate)
     run = _IvpRun(problem, method, rtol, atol)
     times = np.arange(0.0, sweep.duration, 1.0 / sample_rate)
     start = np.zeros(4) if state is None else np.asarray(state, dtype=float)
     samples = run.run(np.concatenate([start, np.zeros(3)]), times)
-    x1, x2, v1, force = samples[:, 0], samples[:, 1], samples[:, 2], samples[:, 7]
+    force = samples[:, 7]
     return SweepRecord(
         sweep=sweep,
         time=times,
-        x1=x1.copy(),
-        x2=x2.copy(),
-        base_force=system.k1 * x1 + system.b1 * v1 + force,
+        x1=samples[:, 0].copy(),
+        x2=samples[:, 1].copy(),
+        base_force=base_force(problem, samples[:, :4], force),
         contact_force=force.copy(),
         trajectory=run.rec.build(run.stats | {"rhs_calls": run.stats["nfev"]}),
         contact_fourier=samples[:, 5] - 1j * samples[:, 6],
@@ -104,65 +108,75 @@ class _IvpRun:
     of F cos(theta) theta' and F sin(theta) theta'."""
 
     def __init__(self, problem: ImpactProblem, method: str, rtol: float, atol: float) -> None:
-        system, bumper, sweep = problem.system, problem.bumper, problem.sweep
-        self.system, self.delta, self.sweep, self.method, self.rtol = system, problem.clearance, sweep, method, rtol
-        self.k, self.b = bumper.stiffness(system.m2), bumper.damping(system.m2)
+        structure, bumper, sweep, stop = problem.structure, problem.bumper, problem.sweep, problem.stops[0]
+        self.delta, self.sweep, self.method, self.rtol = problem.clearance, sweep, method, rtol
+        mass = structure.mass_matrix
+        self.normal = stop.normal(2)
+        m = stop.effective_mass(mass)
+        self.k, self.b = bumper.stiffness(m), bumper.damping(m)
+        self.minv = np.linalg.inv(mass)
+        self.stiffness, self.damping = structure.stiffness_matrix, structure.damping_matrix
+        harmonic, self.static = problem.load()
+        self.weights = harmonic.real  # the sweep's q times its distribution over the coordinates [N]
         w = 2.0 * math.pi * max(sweep.start_frequency, sweep.stop_frequency)
-        self.atol = np.array([atol, atol, atol * w, atol * w, atol * w * system.m2, atol * w * w * system.m2, atol * w * w * system.m2])
+        self.atol = np.array([atol, atol, atol * w, atol * w, atol * w * m, atol * w * w * m, atol * w * w * m])
         self.rec = TrajectoryBuilder(problem, False)
         self.stats = {"nfev": 0, "njev": 0, "nlu": 0, "solver_calls": 0, "contacts": 0, "events": 0, "grazing": 0}
-        s = system
         free = np.zeros((7, 7))
         free[0, 2] = free[1, 3] = 1.0
-        free[2, :4] = [-(s.k1 + s.k2) / s.m1, s.k2 / s.m1, -(s.b1 + s.b2) / s.m1, s.b2 / s.m1]
-        free[3, :4] = [s.k2 / s.m2, -s.k2 / s.m2, s.b2 / s.m2, -s.b2 / s.m2]
+        free[2:4, :2] = -self.minv @ self.stiffness
+        free[2:4, 2:4] = -self.minv @ self.damping
         contact = free.copy()
-        contact[3, 1] -= self.k / s.m2
-        contact[3, 3] -= self.b / s.m2
-        contact[4, 1], contact[4, 3] = self.k, self.b
+        push = np.concatenate([self.k * self.normal, self.b * self.normal])  # d F / d (x, x')
+        contact[2:4, :4] -= np.outer(self.minv @ self.normal, push)
+        contact[4, :4] = push
         self.jacobians = {False: free, True: contact}
 
+    def push(self, y: NDArray[np.float64]) -> float:
+        """K (n . x - Delta) + B n . x' [N]."""
+        n = self.normal
+        return float(self.k * (n[0] * y[0] + n[1] * y[1] - self.delta) + self.b * (n[0] * y[2] + n[1] * y[3]))
+
     def rhs(self, contact: bool) -> Callable[[float, NDArray[np.float64]], NDArray[np.float64]]:
-        s, delta, k, b, q = self.system, self.delta, self.k, self.b, self.sweep.amplitude
+        k, c, minv, n = self.stiffness, self.damping, self.minv, self.normal
+        weights, static = self.weights, self.static
         f0, alpha = self.sweep.start_frequency, self.sweep.alpha
+        push_of = self.push
 
         def f(t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
-            x1, x2, v1, v2 = y[0], y[1], y[2], y[3]
             theta = 2.0 * math.pi * (f0 * t + 0.5 * alpha * t * t)
-            coupling = s.k2 * (x2 - x1) + s.b2 * (v2 - v1)  # spring and dashpot pull on the primary mass
-            push = k * (x2 - delta) + b * v2 if contact else 0.0
+            push = push_of(y) if contact else 0.0
+            force = weights * math.sin(theta) + static - k @ y[:2] - c @ y[2:4] - n * push
             speed = 2.0 * math.pi * (f0 + alpha * t)  # theta'
-            return np.array([
-                v1,
-                v2,
-                (q * math.sin(theta) - s.k1 * x1 - s.b1 * v1 + coupling) / s.m1,
-                (-coupling - push) / s.m2,
-                push,
-                push * math.cos(theta) * speed,
-                push * math.sin(theta) * speed,
-            ])
+            a = minv @ force
+            return np.array([y[2], y[3], a[0], a[1], push, push * math.cos(theta) * speed, push * math.sin(theta) * speed])
 
         return f
 
     def events(self, contact: bool, f: Callable[[float, NDArray[np.float64]], NDArray[np.float64]]) -> list[Callable[..., float]]:
         """Terminal first, then the recorded ones (see the module docstring)."""
-        delta, k, b, s = self.delta, self.k, self.b, self.system
+        delta, k, b, n = self.delta, self.k, self.b, self.normal
+        stiffness, damping, minv, weights = self.stiffness, self.damping, self.minv, self.weights
+        f0, alpha = self.sweep.start_frequency, self.sweep.alpha
 
         def onset(t: float, y: NDArray[np.float64]) -> float:
-            return float(y[1] - delta)
+            return float(n @ y[:2] - delta)
 
         def apex(t: float, y: NDArray[np.float64]) -> float:
-            return float(y[3])
+            return float(n @ y[2:4])
 
         def release(t: float, y: NDArray[np.float64]) -> float:
-            return float(k * (y[1] - delta) + b * y[3])
+            return self.push(y)
 
         def force_rate(t: float, y: NDArray[np.float64]) -> float:
-            return float(k * y[3] + b * f(t, y)[3])
+            return float(k * (n @ y[2:4]) + b * (n @ f(t, y)[2:4]))
 
         def jerk(t: float, y: NDArray[np.float64]) -> float:
             d = f(t, y)
-            return float(s.k2 * (y[2] - y[3]) + s.b2 * (d[2] - d[3]) - k * y[3] - b * d[3]) / s.m2
+            theta = 2.0 * math.pi * (f0 * t + 0.5 * alpha * t * t)
+            rate = k * (n @ y[2:4]) + b * (n @ d[2:4])
+            force_rate = weights * math.cos(theta) * 2.0 * math.pi * (f0 + alpha * t) - stiffness @ y[2:4] - damping @ d[2:4] - n * rate
+            return float(n @ (minv @ force_rate))
 
         onset.terminal, onset.direction = True, 1.0  # type: ignore[attr-defined]
         apex.terminal, apex.direction = False, -1.0  # type: ignore[attr-defined]
@@ -175,7 +189,7 @@ class _IvpRun:
         """Integrate over the samples ``times`` from ``y`` at t = 0; rows X1, X2, X1', X2', the three integrals, F."""
         out = np.empty((times.size, 8))
         t, n, i = 0.0, times.size, 0
-        contact = bool(y[1] >= self.delta and self.k * (y[1] - self.delta) + self.b * y[3] > 0.0)
+        contact = bool(self.normal @ y[:2] >= self.delta and self.push(y) > 0.0)
         functions = {mode: self.rhs(mode) for mode in (False, True)}
         events = {mode: self.events(mode, functions[mode]) for mode in (False, True)}
         jacobians = {mode: self._constant(self.jacobians[mode]) for mode in (False, True)}  # LSODA takes callables only
@@ -204,11 +218,11 @@ class _IvpRun:
                 for which, column in ((1, 0), (2, 1)):
                     for tr, yr in zip(sol.t_events[which], sol.y_events[which]):
                         self.stats["events"] += 1
-                        value = self.k * (yr[1] - self.delta) + self.b * yr[3] if column == 0 else -functions[True](tr, yr)[3]
+                        value = self.push(yr) if column == 0 else -float(self.normal @ functions[True](tr, yr)[2:4])
                         onset["peaks"][column] = max(onset["peaks"][column], value)
             else:  # an apex at or past the bumper: a missed contact
                 self.stats["events"] += len(sol.t_events[1])
-                late = [(tr, yr) for tr, yr in zip(sol.t_events[1], sol.y_events[1]) if yr[1] >= self.delta]
+                late = [(tr, yr) for tr, yr in zip(sol.t_events[1], sol.y_events[1]) if self.normal @ yr[:2] >= self.delta]
                 if late:
                     self.stats["grazing"] += 1
                     t, y, switch = float(late[0][0]), late[0][1].copy(), True
@@ -216,7 +230,7 @@ class _IvpRun:
             if kept:
                 block = out[i : i + kept]
                 block[:, :7] = sol.y[:, :kept].T
-                block[:, 7] = self.k * (block[:, 1] - self.delta) + self.b * block[:, 3] if contact else 0.0
+                block[:, 7] = self.k * (block[:, :2] @ self.normal - self.delta) + self.b * (block[:, 2:4] @ self.normal) if contact else 0.0
             i += kept
             if switch:
                 self.stats["events"] += 1
@@ -237,10 +251,11 @@ class _IvpRun:
     def _begin(self, t: float, y: NDArray[np.float64], contact_rhs: Callable[[float, NDArray[np.float64]], NDArray[np.float64]]) -> dict[str, Any]:
         """A contact starts: its onset time, entry speed, force integral, and the force and deceleration now."""
         self.stats["contacts"] += 1
-        y[1] = max(y[1], self.delta)
-        force = self.k * (y[1] - self.delta) + self.b * y[3]
-        return {"t": t, "v": float(y[3]), "impulse": float(y[4]), "peaks": [force, max(-contact_rhs(t, y)[3], 0.0)]}
+        gap = self.delta - float(self.normal @ y[:2])
+        if gap > 0.0:  # the located root short of the stop by round-off: onto it along the stopped coordinate
+            y[:2] += gap * self.normal / float(self.normal @ self.normal)
+        return {"t": t, "v": float(self.normal @ y[2:4]), "impulse": float(y[4]), "peaks": [self.push(y), max(-float(self.normal @ contact_rhs(t, y)[2:4]), 0.0)]}
 
     def _sample(self, y: NDArray[np.float64], contact: bool) -> NDArray[np.float64]:
-        force = self.k * (y[1] - self.delta) + self.b * y[3] if contact else 0.0
+        force = self.push(y) if contact else 0.0
         return np.concatenate([y[:7], [force]])
