@@ -108,7 +108,7 @@ class CaseOutcome:
 def outcome_dataset(outcome: CaseOutcome, attrs: dict[str, object]) -> xr.Dataset:
     """The dataset of a validation (module docstring), with ``attrs`` added."""
     rows = outcome.checks
-    index = np.arange(len(rows))
+    index = np.arange(len(rows), dtype=np.int32)
     table = xr.Dataset(
         {
             "quantity": ("check", np.array([c.quantity for c in rows], dtype=str), {"long_name": "compared quantity"}),
@@ -124,8 +124,8 @@ def outcome_dataset(outcome: CaseOutcome, attrs: dict[str, object]) -> xr.Datase
         },  # fmt: skip
         coords={"check": ("check", index, {"long_name": "index of the compared quantity", "units": "1"})},
     )
-    merged = xr.merge([table, outcome.data], combine_attrs="drop")
-    merged.attrs.update(outcome.data.attrs)
+    merged = xr.merge([table, outcome.data], combine_attrs="override")  # each variable keeps its own attributes
+    merged.attrs = dict(outcome.data.attrs)
     merged.attrs.update(attrs)
     merged.attrs["validation_case"] = outcome.case
     merged.attrs["validation_passed"] = np.int8(outcome.passed)
