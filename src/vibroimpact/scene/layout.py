@@ -21,8 +21,8 @@ import numpy as np
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution, restitution_from_loss_factor
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.stops import Stop
-from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.simulation.layout import named_system_of
 
 __all__ = ["LoadSpec", "StopSpec", "build_stops", "stop_descriptions", "describe_stop", "as_named_system", "paper_layout"]
 
@@ -149,20 +149,9 @@ def stop_descriptions(specs: tuple[StopSpec, ...], names: tuple[str, ...], resti
     return tuple(describe_stop(spec, names, delta, r) for spec in specs)
 
 
-def as_named_system(structure: object) -> "TwoDofSystem | None":
-    """The paper's named system that ``structure`` is, if it is one: two coordinates, a diagonal mass matrix, and
-    stiffness and damping of a chain (base - x1 - x2) with K1, K2 > 0 and B1, B2 >= 0; else None."""
-    if isinstance(structure, TwoDofSystem):
-        return structure
-    if not isinstance(structure, LinearStructure) or structure.size != 2:
-        return None
-    m, k, b = structure.mass_matrix, structure.stiffness_matrix, structure.damping_matrix
-    if m[0, 1] != 0.0 or k[1, 1] != -k[0, 1] or b[1, 1] != -b[0, 1]:
-        return None
-    values = {"m1": m[0, 0], "m2": m[1, 1], "k1": k[0, 0] + k[0, 1], "k2": k[1, 1], "b1": b[0, 0] + b[0, 1], "b2": b[1, 1]}
-    if min(values["k1"], values["k2"]) <= 0.0 or min(values["b1"], values["b2"]) < 0.0:
-        return None
-    return TwoDofSystem(**{key: float(value) for key, value in values.items()})
+def as_named_system(structure: object) -> TwoDofSystem | None:
+    """The paper's named system that ``structure`` is, if it is one (see :func:`vibroimpact.simulation.layout.named_system_of`)."""
+    return named_system_of(structure)
 
 
 def paper_layout(structure: object, specs: tuple[StopSpec, ...], load: LoadSpec | None) -> bool:

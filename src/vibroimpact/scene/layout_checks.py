@@ -4,29 +4,34 @@ from __future__ import annotations
 
 import numpy as np
 
+from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.checker import Checker
-from vibroimpact.scene.layout import LoadSpec, StopSpec, paper_layout
+from vibroimpact.scene.layout import LoadSpec, StopSpec, build_stops
 
 __all__ = ["check_general_solutions", "pgf_refusal", "static_drift"]
 
 
-def pgf_refusal(system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, ...], load: LoadSpec | None) -> str | None:
-    """Why the closed-form (PGF) solution does not apply to this layout; None where it does.
-
-    It applies to one rigid stop on a structure without rigid-body modes, harmonically loaded without a static force.
-    """
+def pgf_refusal(system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, ...], load: LoadSpec | None, restitution: np.ndarray | None = None, clearance: np.ndarray | None = None) -> str | None:
+    """Why the closed-form (PGF) solution does not apply to this layout at some grid point; None where it applies
+    everywhere (:func:`vibroimpact.analysis.layout.closed_form_refusal`: one rigid stop, or a symmetric two-sided
+    stop, on a structure without rigid-body modes, with a harmonic load)."""
     stops = specs or (StopSpec(coordinate=1),)
-    if system.rigid_body_modes():
-        return f"the structure has {system.rigid_body_modes()} rigid-body mode(s) (a free mass): its periodic Green function does not exist"
-    if load is not None and load.static is not None and any(load.static):
-        return "a static force (excitation.static) shifts the orbit: the closed form has none"
-    if len(stops) != 1:
-        return f"it solves one stop; the layout has {len(stops)}"
-    if paper_layout(system, specs, load):
-        return None
-    return "its general form (any coordinate, relative stops, any load) is not available in this version: the paper's layout only (two masses in a chain, an upper stop on x2, the force on x1)"
+    r_grid = np.array([np.nan]) if restitution is None else restitution
+    d_grid = np.array([np.nan]) if clearance is None else clearance
+    corners = {(float(r), float(d)) for r in (r_grid[0], r_grid[-1]) for d in (d_grid[0], d_grid[-1])}
+    force = (load or LoadSpec()).force(1.0, 1.0)
+    for r, d in sorted(corners):
+        try:
+            problem = ImpactProblem(system, build_stops(stops, False, 0.5 if np.isnan(r) else r, 1e-3 if np.isnan(d) else d), force)
+        except (ValueError, TypeError) as error:  # an unusable stop: reported where it is parsed
+            return str(error)
+        reason = closed_form_refusal(problem)
+        if reason is not None:
+            return reason
+    return None
 
 
 def static_drift(system: TwoDofSystem | LinearStructure, load: LoadSpec | None) -> bool:
@@ -41,11 +46,14 @@ def static_drift(system: TwoDofSystem | LinearStructure, load: LoadSpec | None) 
     return bool(np.max(np.abs(free.T @ static)) > 1e-12 * float(np.max(np.abs(static))))
 
 
-def check_general_solutions(c: Checker, solutions: tuple[str, ...], system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, ...], load: LoadSpec | None, swept_sine: bool) -> None:
+def check_general_solutions(
+    c: Checker, solutions: tuple[str, ...], system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, ...], load: LoadSpec | None, swept_sine: bool,
+    restitution: np.ndarray | None = None, clearance: np.ndarray | None = None,
+) -> None:  # fmt: skip
     """Record the solutions (and swept-sine tests) a general scene asks for that its layout does not admit."""
     if "pgf_paper" in solutions:
         c.fail("solutions", "pgf_paper is the paper's own route for its named layout (system {m1 ... b2}, stop, force on x1): use pgf")
-    if "pgf" in solutions and (reason := pgf_refusal(system, specs, load)) is not None:
+    if "pgf" in solutions and (reason := pgf_refusal(system, specs, load, restitution, clearance)) is not None:
         c.fail("solutions", f"pgf does not apply to this layout: {reason}")
     if "linear" in solutions and static_drift(system, load):
         c.fail("solutions", "linear does not apply: the static force pushes the structure along a rigid-body mode, so it has no steady state without its stops")

@@ -118,7 +118,7 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
         if bumper_solutions and "bumper_loss_factor" not in grids and (r := grids.get("restitution")) is not None and np.any(r == 0.0):
             c.fail("stop.restitution", "R = 0 needs an infinitely damped bumper for the compliant solution: give bumper.loss_factor, or sweep R > 0")
     if general and system is not None:
-        check_general_solutions(c, solutions, system, specs or (), load, "swept_sine" in doc)
+        check_general_solutions(c, solutions, system, specs or (), load, "swept_sine" in doc, grids.get("restitution"), grids.get("clearance"))
 
     sizes = [g.size for g in grids.values() if g is not None]
     if len(sizes) >= 3 and math.prod(sizes) > MAX_STUDY_POINTS:

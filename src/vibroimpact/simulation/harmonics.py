@@ -16,6 +16,7 @@ from scipy.integrate import cumulative_trapezoid
 
 from vibroimpact.engines.base import Trajectory
 from vibroimpact.model.excitation import SweptSine
+from vibroimpact.simulation.layout import base_weights, suspension_force
 
 __all__ = ["HarmonicMeasures", "RunningEstimate", "measure", "running_fundamental", "running_at", "window_times"]
 
@@ -49,6 +50,18 @@ class HarmonicMeasures:
         force is an impulse; 0 without contact).
     peak_acceleration : float
         Largest deceleration of the absorber in contact [m s-2]: compliant bumpers only (NaN for a rigid stop).
+    displacements : tuple of complex
+        Fundamental of every coordinate [m] (N values; ``x1``, ``x2`` are the first two).
+    rms : tuple of float
+        RMS of every coordinate [m].
+    stop_contact_forces : tuple of complex
+        Fundamental of each stop's contact force lambda_k [N] (K values).
+    stop_impacts : tuple of float
+        Impacts per period on each stop [-].
+    stop_impulses : tuple of float
+        Impulse per period on each stop [N s].
+    stop_peak_forces, stop_peak_accelerations : tuple of float
+        Per stop as ``peak_contact_force`` and ``peak_acceleration`` (the stopped coordinate's deceleration).
     """
 
     x1: complex
@@ -63,6 +76,13 @@ class HarmonicMeasures:
     periods: int
     peak_contact_force: float = math.nan
     peak_acceleration: float = math.nan
+    displacements: tuple[complex, ...] = ()
+    rms: tuple[float, ...] = ()
+    stop_contact_forces: tuple[complex, ...] = ()
+    stop_impacts: tuple[float, ...] = ()
+    stop_impulses: tuple[float, ...] = ()
+    stop_peak_forces: tuple[float, ...] = ()
+    stop_peak_accelerations: tuple[float, ...] = ()
 
     @property
     def force(self) -> complex:
@@ -71,36 +91,62 @@ class HarmonicMeasures:
 
 
 def measure(trajectory: Trajectory) -> HarmonicMeasures:
-    """Fundamental harmonics, RMS and impact statistics over all periods of ``trajectory`` (needs its moments)."""
+    """Fundamental harmonics, RMS and impact statistics over all periods of ``trajectory`` (needs its moments).
+
+    Moments are (coordinates, contact force of each stop, squares of the coordinates) per period; the force on the
+    base is the suspension's plus the absolute stops' ((1^T n_k) lambda_k: a relative stop acts inside the structure).
+    """
     periods = trajectory.periods
     if periods == 0 or trajectory.moments.shape[0] != periods:
         raise ValueError("measure() needs a trajectory of at least one period integrated with moments=True")
     problem = trajectory.problem
+    size, count = problem.size, len(problem.stops)
     window = periods * problem.period
     total = trajectory.moments.sum(axis=0)
-    x1 = complex(2.0 * total[0] / window)
+    x = 2.0 * total[:size] / window
+    forces = 2.0 * total[size : size + count] / window
+    squares = total[size + count : 2 * size + count].real
+    rms = np.sqrt(np.maximum(squares, 0.0) / window)
     impacts = trajectory.impulses.size
+    stops = trajectory.impact_stops
+    stop_impacts = np.bincount(stops, minlength=count)[:count] / periods
+    stop_impulses = np.bincount(stops, weights=trajectory.impulses, minlength=count)[:count] / periods
     peaks = trajectory.contact_peaks
-    if peaks.shape[0]:
-        peak_force, peak_acceleration = float(peaks[:, 0].max()), float(peaks[:, 1].max())
-    elif impacts:
-        peak_force = peak_acceleration = math.nan  # a rigid stop: impulses, no finite peak
-    else:
-        peak_force = peak_acceleration = 0.0
+    peak_force, peak_acceleration = _peaks(peaks, impacts)
+    per_stop = [_peaks(peaks[trajectory.contact_peak_stops == k], int(np.count_nonzero(stops == k))) for k in range(count)]
+    contact = complex(forces[0]) if problem.paper_layout else complex(base_weights(problem) @ forces)
+    nan = complex(math.nan, math.nan)
     return HarmonicMeasures(
-        x1=x1,
-        x2=complex(2.0 * total[1] / window),
-        suspension_force=(problem.system.k1 + 1j * problem.omega * problem.system.b1) * x1,
-        contact_force=complex(2.0 * total[2] / window),
-        x1_rms=math.sqrt(max(total[3].real, 0.0) / window),
-        x2_rms=math.sqrt(max(total[4].real, 0.0) / window),
+        x1=complex(x[0]),
+        x2=complex(x[1]) if size > 1 else nan,
+        suspension_force=suspension_force(problem.system, problem.omega, x),
+        contact_force=contact,
+        x1_rms=math.sqrt(max(squares[0], 0.0) / window),
+        x2_rms=math.sqrt(max(squares[1], 0.0) / window) if size > 1 else math.nan,
         impacts_per_period=impacts / periods,
         mean_impulse=float(np.mean(trajectory.impulses)) if impacts else 0.0,
         impulse_per_period=float(np.sum(trajectory.impulses)) / periods,
         periods=periods,
         peak_contact_force=peak_force,
         peak_acceleration=peak_acceleration,
+        displacements=tuple(complex(v) for v in x),
+        rms=tuple(float(v) for v in rms),
+        stop_contact_forces=tuple(complex(v) for v in forces),
+        stop_impacts=tuple(float(v) for v in stop_impacts),
+        stop_impulses=tuple(float(v) for v in stop_impulses),
+        stop_peak_forces=tuple(p[0] for p in per_stop),
+        stop_peak_accelerations=tuple(p[1] for p in per_stop),
     )
+
+
+def _peaks(peaks: np.ndarray, impacts: int) -> tuple[float, float]:
+    """Largest contact force [N] and deceleration [m s-2] of compliant contacts; NaN for impulses of a rigid stop;
+    0 without contact."""
+    if peaks.shape[0]:
+        return float(peaks[:, 0].max()), float(peaks[:, 1].max())
+    if impacts:
+        return math.nan, math.nan
+    return 0.0, 0.0
 
 
 @dataclass(frozen=True)

@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 from vibroimpact.engines.base import Engine, Trajectory
 from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.simulation.layout import gaps
 from vibroimpact.orbits.branch import HybridInfo, MapEvaluation
 from vibroimpact.orbits.lyapunov import lyapunov_along_run, state_scales
 from vibroimpact.orbits.motion import MotionEvidence, classify_motion, classify_strobes
@@ -49,23 +50,30 @@ class SectionMap:
     """
 
     parameter_names = ("frequency",)
-    dimension = 4
 
     def __init__(self, problem: ImpactProblem, section: float, engine: ExactEngine) -> None:
         self.problem, self.section, self.engine = problem, float(section), engine
-        self.state_scale = state_scales(problem)
+        self.dimension = 2 * problem.size
+        self.state_scale = state_scales(problem) if problem.paper_layout else _general_scales(problem)
         self.parameter_scale = np.array([1.0])
         self.evaluations = 0
 
     def evaluate(self, y: NDArray[np.float64], p: NDArray[np.float64]) -> MapEvaluation:
-        """The state one period after ``y`` at the section, with its exact Jacobian (NaN for a start inside the stop)."""
-        if not y[1] <= self.problem.clearance:
-            return MapEvaluation(np.full(4, np.nan), np.full((4, 4), np.nan), None, None)
+        """The state one period after ``y`` at the section, with its exact Jacobian (NaN for a start inside a stop)."""
+        n = self.dimension
+        if not np.all(gaps(self.problem, y) >= 0.0):
+            return MapEvaluation(np.full(n, np.nan), np.full((n, n), np.nan), None, None)
         self.evaluations += 1
         image = self.engine.strobe_map(self.problem, np.asarray(y, dtype=float), self.section, 1)
         v = image.impact_velocities
         hybrid = HybridInfo(int(v.size), float(v.min()) if v.size else np.inf, image.closest_approach, image.sticks)
         return MapEvaluation(image.state, image.jacobian, None, hybrid)
+
+
+def _general_scales(problem: ImpactProblem) -> NDArray[np.float64]:
+    """Scales of (x, x') for any layout [m, m s-1]: L = max |Delta_k| + v / w (the paper's 2 Delta + q |H12|)."""
+    length = float(np.max(np.abs(problem.clearances()))) + problem.velocity_scale() / problem.omega
+    return np.concatenate([np.full(problem.size, length), np.full(problem.size, problem.omega * length)])
 
 
 @dataclass(frozen=True)
@@ -76,8 +84,8 @@ class ShotOrbit:
     ----------
     time : float
         Time of its section [s].
-    state : ndarray, shape (4,)
-        Its state there (X1, X2, X1', X2').
+    state : ndarray, shape (2 N,)
+        Its state there (x, x'); for the paper (X1, X2, X1', X2').
     floquet_modulus : float
         Largest |Floquet multiplier| [-].
     periods : int

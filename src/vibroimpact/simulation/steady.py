@@ -22,7 +22,10 @@ from numpy.typing import NDArray
 from vibroimpact.engines.base import Engine
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.simulation.harmonics import HarmonicMeasures, measure
+from vibroimpact.simulation.layout import gaps, linear_state, named_system_of, resting_state, suspension_force
+from vibroimpact.model.stops import Stop
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
 from vibroimpact.simulation.periodic import motion_evidence, shoot_orbit
@@ -49,8 +52,8 @@ class SteadyResult:
         Periods integrated in all, transient plus measurement (0: answered without integrating).
     end_time : float
         Time of the final state [s].
-    end_state : ndarray, shape (4,)
-        Final (X1, X2, X1', X2'), for the next point of a sweep.
+    end_state : ndarray, shape (2 N,)
+        Final (x, x') (the paper's (X1, X2, X1', X2')), for the next point of a sweep.
     integrated : bool
         False when the answer is the linear steady state, given without integrating.
     motion : MotionEvidence or None
@@ -70,49 +73,75 @@ class SteadyResult:
     search_periods: int = 0
 
 
-def start_state(problem: ImpactProblem, mode: str, orbit_stop: RigidStop | None = None) -> tuple[float, NDArray[np.float64]]:
+def start_state(problem: ImpactProblem, mode: str, orbit_stop: RigidStop | tuple[Stop, ...] | None = None) -> tuple[float, NDArray[np.float64]]:
     """Initial (time, state) for a start mode; ``pgf`` falls back to ``linear`` where no one-impact orbit exists.
 
     ``orbit_stop`` is the rigid stop whose one-impact orbit a ``pgf`` start follows (see :func:`orbit_stop_of`).
+    ``rest`` is at rest at the static position, on the stops it would cross (a negative clearance); ``linear`` is the
+    linear steady state, or ``rest`` where that would start inside a stop.
     """
     if mode not in START_MODES:
         raise ValueError(f"start = {mode!r} is not allowed: use one of {', '.join(START_MODES)}")
     if mode == "rest":
-        return 0.0, np.zeros(4)
+        return 0.0, _rest(problem)
     if mode in ("pgf", "shooting"):
         guess = pgf_guesses(problem, [problem.frequency], orbit_stop)[0]
         if guess is not None:
             return guess
+    if not _paper(problem):
+        state = linear_state(problem).state(problem.omega)
+        return (0.0, _rest(problem)) if np.any(gaps(problem, state) < 0.0) else (0.0, state)
     response = linear_response(problem.system, problem.omega, problem.amplitude)
     x = np.array([response.x1, response.x2]) * np.exp(1j * problem.phase)
     state = np.concatenate([x.real, (1j * problem.omega * x).real])
     if state[1] > problem.clearance:  # the linear state would start inside the stop: start at rest instead
-        return 0.0, np.zeros(4)
+        return 0.0, _rest(problem)
     return 0.0, state
 
 
-def orbit_stop_of(problem: ImpactProblem, orbit_stop: RigidStop | None = None) -> RigidStop:
-    """The rigid stop whose one-impact orbit starts a ``pgf`` run: ``orbit_stop`` if given, else the problem's own
-    rigid stop, else (a bumper) the rigid stop of the bumper's clearance and one-collision restitution."""
+def _paper(problem: ImpactProblem) -> bool:
+    """The paper's named system in the paper's layout: the closed forms of its named receptances apply."""
+    return isinstance(problem.system, TwoDofSystem) and problem.paper_layout
+
+
+def _rest(problem: ImpactProblem) -> NDArray[np.float64]:
+    """At rest, respecting every stop (zeros for the paper's layout with Delta >= 0)."""
+    if _paper(problem) and problem.clearance >= 0.0:
+        return np.zeros(4)
+    return resting_state(problem)
+
+
+def orbit_stop_of(problem: ImpactProblem, orbit_stop: RigidStop | tuple[Stop, ...] | None = None) -> RigidStop | tuple[Stop, ...]:
+    """The rigid stop(s) whose one-impact orbit starts a ``pgf`` run: ``orbit_stop`` if given, else the problem's own
+    rigid stops, else (bumpers) the rigid stops of the bumpers' clearances and one-collision restitutions."""
     if orbit_stop is not None:
         return orbit_stop
     if isinstance(problem.contact, RigidStop):
         return problem.contact
+    if isinstance(problem.contact, tuple):
+        return tuple(stop if stop.rigid else Stop(RigidStop(stop.clearance, stop.law.restitution), stop.coordinate, stop.other, stop.side) for stop in problem.contact)
     return RigidStop(problem.clearance, problem.contact.restitution)
 
 
-def pgf_guesses(problem: ImpactProblem, frequencies: Sequence[float], orbit_stop: RigidStop | None = None) -> list[tuple[float, NDArray[np.float64]] | None]:
+def pgf_guesses(problem: ImpactProblem, frequencies: Sequence[float], orbit_stop: RigidStop | tuple[Stop, ...] | None = None) -> list[tuple[float, NDArray[np.float64]] | None]:
     """The ``pgf`` start (time [s], state) at each of ``frequencies`` [Hz], from one vectorised closed-form solution;
     None where no admissible one-impact orbit exists.
 
     The orbit's time origin is its impact, where the force has phase (phi - psi12); in the problem's time (force
     q cos(w t + phase)) that is t_impact = (phi - psi12 - phase) / w. The start is half a period after it, away from
     the impact. ``problem`` gives the system, the force's amplitude and phase, and (with ``orbit_stop``, see
-    :func:`orbit_stop_of`) the stop.
+    :func:`orbit_stop_of`) the stop. Layouts without a closed form get None everywhere (the ``linear`` start).
     """
     stop = orbit_stop_of(problem, orbit_stop)
+    system = named_system_of(problem.system)
+    if isinstance(stop, tuple):
+        if system is None or not ImpactProblem(problem.system, stop, problem.excitation).paper_layout:
+            return [None] * len(frequencies)
+        stop = stop[0].law
+    if system is None or not isinstance(stop, RigidStop):
+        return [None] * len(frequencies)
     omega = 2.0 * np.pi * np.asarray(frequencies, dtype=float)
-    orbit = solve_one_impact(problem.system, omega, stop.clearance, stop.restitution, problem.amplitude)
+    orbit = solve_one_impact(system, omega, stop.clearance, stop.restitution, problem.amplitude)
     ok = orbit.exists & orbit.admissible()
     period = 2.0 * np.pi / omega
     half = 0.5 * period[:, None]
@@ -124,8 +153,19 @@ def pgf_guesses(problem: ImpactProblem, frequencies: Sequence[float], orbit_stop
 
 
 def linear_fits(problem: ImpactProblem) -> bool:
-    """The linear steady state stays inside the clearance, q |H12| <= Delta."""
-    return bool(problem.amplitude * abs(complex(problem.system.receptances(problem.omega).h12)) <= problem.clearance)
+    """The linear steady state stays clear of every stop (the paper's layout: q |H12| <= Delta)."""
+    if _paper(problem):
+        return bool(problem.amplitude * abs(complex(problem.system.receptances(problem.omega).h12)) <= problem.clearance)
+    return linear_state(problem).fits(problem)
+
+
+def motion_scale(problem: ImpactProblem) -> NDArray[np.float64]:
+    """Scales of the state's entries for the repeat test [m, m s-1]: L for displacements, w L for velocities, with
+    L = Delta + q |H12| for the paper's layout and the largest |Delta_k| + |n_k . X| (+ a static term) in general."""
+    if _paper(problem):
+        return np.array([1.0, 1.0, problem.omega, problem.omega]) * (problem.clearance + problem.amplitude * abs(complex(problem.system.receptances(problem.omega).h12)))
+    length = problem.velocity_scale() / problem.omega
+    return np.concatenate([np.full(problem.size, length), np.full(problem.size, problem.omega * length)])
 
 
 def steady_state(
@@ -133,7 +173,7 @@ def steady_state(
     problem: ImpactProblem,
     start: str | tuple[float, NDArray[np.float64]] = "linear",
     settings: SteadySettings = SteadySettings(),
-    orbit_stop: RigidStop | None = None,
+    orbit_stop: RigidStop | tuple[Stop, ...] | None = None,
     guess: tuple[float, NDArray[np.float64]] | None | str = "compute",
 ) -> SteadyResult:
     """Integrate to the steady state and measure it.
@@ -165,11 +205,11 @@ def steady_state(
         t, y = guess[0], np.array(guess[1], dtype=float)  # type: ignore[index]
     else:
         t, y = start_state(problem, start, orbit_stop) if isinstance(start, str) else (float(start[0]), np.asarray(start[1], dtype=float))
-    scale = np.array([1.0, 1.0, problem.omega, problem.omega]) * (problem.clearance + problem.amplitude * abs(complex(problem.system.receptances(problem.omega).h12)))
+    scale = motion_scale(problem)
     used = 0
     first_chunk = settings.chunk_periods
     if start == "shooting":
-        shot = shoot_orbit(problem if isinstance(problem.contact, RigidStop) else _rigid(problem, orbit_stop), t, y)
+        shot = shoot_orbit(problem if all(stop.rigid for stop in problem.stops) else _rigid(problem, orbit_stop), t, y)
         used = shot.periods if shot is not None else 0
         if shot is not None and shot.stable:
             t, y = shot.time, shot.state
@@ -179,7 +219,9 @@ def steady_state(
         else:
             start = "pgf"  # no stable orbit near the closed form: march from it, perturbed
     if start == "pgf":
-        y = y + settings.start_perturbation * scale * np.array([1.0, 0.0, 0.0, 0.0])
+        kick = np.zeros(y.size)
+        kick[0] = 1.0
+        y = y + settings.start_perturbation * scale * kick
     strobes = [y]
     searched = used
     multiplicity = 0
@@ -239,7 +281,7 @@ def _measure(
     )
 
 
-def _rigid(problem: ImpactProblem, orbit_stop: RigidStop | None) -> ImpactProblem:
+def _rigid(problem: ImpactProblem, orbit_stop: RigidStop | tuple[Stop, ...] | None) -> ImpactProblem:
     """The problem with the rigid stop a ``pgf`` start follows in place of its bumper (shooting needs a rigid stop)."""
     return ImpactProblem(problem.system, orbit_stop_of(problem, orbit_stop), problem.excitation)
 
@@ -265,6 +307,8 @@ def _repeat(strobes: NDArray[np.float64], scale: NDArray[np.float64], settings: 
 
 
 def _linear_answer(problem: ImpactProblem) -> SteadyResult:
+    if not _paper(problem):
+        return _general_linear_answer(problem)
     response = linear_response(problem.system, problem.omega, problem.amplitude)
     rotation = np.exp(1j * problem.phase)
     x1, x2 = complex(response.x1) * rotation, complex(response.x2) * rotation
@@ -281,6 +325,43 @@ def _linear_answer(problem: ImpactProblem) -> SteadyResult:
         periods=0,
         peak_contact_force=0.0,
         peak_acceleration=0.0,
+        displacements=(x1, x2),
+        rms=(abs(x1) / math.sqrt(2.0), abs(x2) / math.sqrt(2.0)),
+        stop_contact_forces=(0j,),
+        stop_impacts=(0.0,),
+        stop_impulses=(0.0,),
+        stop_peak_forces=(0.0,),
+        stop_peak_accelerations=(0.0,),
     )
     _t, state = start_state(problem, "linear")
     return SteadyResult(measures=measures, converged=True, multiplicity=1, periods_used=0, end_time=0.0, end_state=state, integrated=False)
+
+
+def _general_linear_answer(problem: ImpactProblem) -> SteadyResult:
+    """The linear steady state of any layout, where it stays clear of every stop (an exact steady state)."""
+    linear = linear_state(problem)
+    x, rms = linear.amplitudes, linear.rms()
+    count = len(problem.stops)
+    nan = complex(math.nan, math.nan)
+    measures = HarmonicMeasures(
+        x1=complex(x[0]),
+        x2=complex(x[1]) if x.size > 1 else nan,
+        suspension_force=suspension_force(problem.system, problem.omega, x),
+        contact_force=0j,
+        x1_rms=float(rms[0]),
+        x2_rms=float(rms[1]) if x.size > 1 else math.nan,
+        impacts_per_period=0.0,
+        mean_impulse=0.0,
+        impulse_per_period=0.0,
+        periods=0,
+        peak_contact_force=0.0,
+        peak_acceleration=0.0,
+        displacements=tuple(complex(v) for v in x),
+        rms=tuple(float(v) for v in rms),
+        stop_contact_forces=(0j,) * count,
+        stop_impacts=(0.0,) * count,
+        stop_impulses=(0.0,) * count,
+        stop_peak_forces=(0.0,) * count,
+        stop_peak_accelerations=(0.0,) * count,
+    )
+    return SteadyResult(measures=measures, converged=True, multiplicity=1, periods_used=0, end_time=0.0, end_state=linear.state(problem.omega), integrated=False)

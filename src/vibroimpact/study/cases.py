@@ -20,6 +20,9 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.stops import Stop
+from vibroimpact.model.structure import LinearStructure
+from vibroimpact.scene.layout import LoadSpec
 from vibroimpact.study.fingerprint import case_key
 from vibroimpact.study.runner import CaseResult, ProgressReport
 from vibroimpact.simulation.steady import linear_fits, pgf_guesses, steady_state
@@ -52,6 +55,11 @@ FIELDS = (
     "rotation_number",
     "spectral_line_fraction",
 )
+#: Fields with one value per coordinate (shape (frequencies, N)) or per stop ((frequencies, K)).
+COORDINATE_FIELDS = ("displacements", "rms")
+STOP_FIELDS = ("stop_contact_force", "stop_impacts", "stop_impulse", "stop_peak_force", "stop_peak_acceleration")
+#: Complex fields.
+COMPLEX_FIELDS = ("x1", "x2", "suspension_force", "contact_force", "displacements", "stop_contact_force")
 
 
 @dataclass(frozen=True)
@@ -62,34 +70,42 @@ class SimulationCase:
     ----------
     engine : str
         Registered engine name.
-    system : TwoDofSystem
+    system : TwoDofSystem or LinearStructure
         The linear system.
     amplitude : float
-        q [N].
-    contact : RigidStop or KelvinVoigtBumper
-        The contact law the engine solves.
+        q [N] (a base motion's displacement [m]).
+    contact : RigidStop, KelvinVoigtBumper or tuple of Stop
+        The contact law the engine solves (a single law: the paper's stop), or every stop of a general layout.
     frequencies : tuple of float
         Excitation frequencies [Hz].
     start : str
         A start of :data:`~vibroimpact.simulation.settings.START_MODES` or of :data:`~vibroimpact.simulation.settings.SWEEP_STARTS`.
     engine_settings, steady_settings
         Numerical settings.
-    orbit_stop : RigidStop or None
-        The rigid stop whose one-impact orbit a ``pgf`` start follows (a bumper's study grid point); None: the
+    orbit_stop : RigidStop, tuple of Stop, or None
+        The rigid stop(s) whose one-impact orbit a ``pgf`` start follows (a bumper's study grid point); None: the
         contact's own (:func:`vibroimpact.simulation.steady.orbit_stop_of`).
+    load : LoadSpec or None
+        A general scene's load (weights, static force, base motion); None: the paper's force on the primary mass.
     """
 
     engine: str
-    system: TwoDofSystem
+    system: TwoDofSystem | LinearStructure
     amplitude: float
-    contact: RigidStop | KelvinVoigtBumper
+    contact: RigidStop | KelvinVoigtBumper | tuple[Stop, ...]
     frequencies: tuple[float, ...]
     start: str
     engine_settings: EngineSettings
     steady_settings: SteadySettings
-    orbit_stop: RigidStop | None = None
+    orbit_stop: RigidStop | tuple[Stop, ...] | None = None
+    load: LoadSpec | None = None
 
-    fields = FIELDS
+    fields = FIELDS + COORDINATE_FIELDS + STOP_FIELDS
+
+    def problem(self, frequency: float, phase: float = 0.0) -> ImpactProblem:
+        """The impact problem at ``frequency`` [Hz] with the force's phase at t = 0 [rad]."""
+        force = HarmonicForce(self.amplitude, frequency, phase=phase) if self.load is None else self.load.force(self.amplitude, frequency, phase)
+        return ImpactProblem(self.system, self.contact, force)
 
     progress_unit = "points"
 
@@ -107,10 +123,11 @@ class SimulationCase:
         return case_key(
             {
                 "engine": self.engine,
-                "system": asdict(self.system),
+                "system": {"kind": type(self.system).__name__, **asdict(self.system)},
                 "amplitude": self.amplitude,
-                "contact": {"law": type(self.contact).__name__, **asdict(self.contact)},
-                "orbit_stop": None if self.orbit_stop is None else asdict(self.orbit_stop),
+                "contact": _contact_key(self.contact),
+                "orbit_stop": None if self.orbit_stop is None else _contact_key(self.orbit_stop),
+                "load": None if self.load is None else asdict(self.load),
                 "frequencies": list(self.frequencies),
                 "start": self.start,
                 "engine_settings": asdict(self.engine_settings),
@@ -119,20 +136,30 @@ class SimulationCase:
         )
 
 
+def _contact_key(contact: object) -> object:
+    """The contact as plain data for a case key (the law's class named: a bumper's fields differ from a stop's)."""
+    if isinstance(contact, tuple):
+        return [{"law": type(stop.law).__name__, **asdict(stop)} for stop in contact]
+    return {"law": type(contact).__name__, **asdict(contact)}  # type: ignore[call-overload]
+
+
 def run_case(case: SimulationCase, report: ProgressReport | None = None) -> CaseResult:
     """Steady states of one case, in the order of ``case.frequencies``; ``report`` receives the points done."""
     engine = make_engine(case.engine, case.engine_settings)
     n = len(case.frequencies)
-    out: dict[str, NDArray[np.generic]] = {name: np.full(n, np.nan, dtype=complex if name in ("x1", "x2", "suspension_force", "contact_force") else float) for name in FIELDS}
+    first = case.problem(case.frequencies[0])
+    widths = {**{name: first.size for name in COORDINATE_FIELDS}, **{name: len(first.stops) for name in STOP_FIELDS}}
+    out: dict[str, NDArray[np.generic]] = {
+        name: np.full((n, widths[name]) if name in widths else n, np.nan, dtype=complex if name in COMPLEX_FIELDS else float) for name in case.fields
+    }
     order = range(n - 1, -1, -1) if case.start == "sweep_down" else range(n)
     previous = None
     guesses: list[tuple[float, NDArray[np.float64]] | None] | None = None
     if case.start in ("pgf", "shooting"):  # the closed-form orbits of the whole case in one vectorised solution
-        first = ImpactProblem(case.system, case.contact, HarmonicForce(case.amplitude, case.frequencies[0], phase=0.0))
         guesses = pgf_guesses(first, case.frequencies, case.orbit_stop)
     for i in order:
         frequency = case.frequencies[i]
-        problem = ImpactProblem(case.system, case.contact, HarmonicForce(case.amplitude, frequency, phase=0.0))
+        problem = case.problem(frequency)
         start: str | tuple[float, NDArray[np.float64]] = case.start
         if case.start in SWEEP_STARTS:
             if previous is None or (previous[2] == 0.0 and linear_fits(problem)):
@@ -141,7 +168,7 @@ def run_case(case: SimulationCase, report: ProgressReport | None = None) -> Case
                 old_problem, result, _impacts = previous
                 # keep the force continuous: the new force at t = 0 continues the old one at its end time
                 phase = (old_problem.omega * result.end_time + old_problem.phase) % (2.0 * math.pi)
-                problem = ImpactProblem(case.system, case.contact, HarmonicForce(case.amplitude, frequency, phase=phase))
+                problem = case.problem(frequency, phase)
                 start = (0.0, result.end_state)
         started = time.perf_counter()
         try:
@@ -177,6 +204,13 @@ def run_case(case: SimulationCase, report: ProgressReport | None = None) -> Case
             "lyapunov_error": motion.lyapunov_error if motion is not None else math.nan,
             "rotation_number": motion.rotation_number if motion is not None and motion.rotation_regular else math.nan,
             "spectral_line_fraction": motion.spectral_line_fraction if motion is not None else math.nan,
+            "displacements": np.array(m.displacements, dtype=complex),
+            "rms": np.array(m.rms),
+            "stop_contact_force": np.array(m.stop_contact_forces, dtype=complex),
+            "stop_impacts": np.array(m.stop_impacts),
+            "stop_impulse": np.array(m.stop_impulses),
+            "stop_peak_force": np.array(m.stop_peak_forces),
+            "stop_peak_acceleration": np.array(m.stop_peak_accelerations),
         }
         for name, value in values.items():
             out[name][i] = value

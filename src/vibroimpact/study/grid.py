@@ -14,12 +14,14 @@ import xarray as xr
 
 from vibroimpact.analysis.pgf import PgfVariant
 from vibroimpact.model.modal import fit_modal_parameters
+from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.scene.layout import stop_descriptions
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, Scene
 from vibroimpact.scene.variables import COORDINATE_ATTRIBUTES
 from vibroimpact.study.io import provenance
 from vibroimpact.study.solutions import linear_values, pgf_values
 
-__all__ = ["Progress", "StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset"]
+__all__ = ["Progress", "StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset", "layout_attributes"]
 
 Progress = Callable[[str], None]
 #: The values of one solution, quantity -> array over (part of) the full grid.
@@ -111,6 +113,8 @@ def finish_dataset(dataset: xr.Dataset, scene: Scene, coords: dict[str, object],
         swept = key in scene.swept or (key == "restitution" and "bumper_loss_factor" in scene.swept)
         if not swept and key in dataset.dims:
             dataset = dataset.squeeze(key, drop=key not in coords)
+        if key in dataset.coords and dataset[key].ndim == 0 and dataset[key].dtype.kind == "f" and not np.isfinite(float(dataset[key])):
+            dataset = dataset.drop_vars(key)  # the stops give different values: the stop descriptions say them
     if scene.bumper_frequency is not None:
         losses = scene.loss_factors()
         dataset = dataset.assign_coords(bumper_loss_factor=("restitution", losses) if "restitution" in dataset.dims else float(losses[0]))
@@ -133,12 +137,16 @@ def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[st
         **provenance(),
         "excitation_amplitude_N": scene.amplitude,
         "natural_frequencies_Hz": np.array(system.natural_frequencies()) / (2.0 * np.pi),
-        "antiresonance_frequency_Hz": system.antiresonance_frequency() / (2.0 * np.pi),
-        "method_pgf": "exact poles and residues of H22; exact chi22'(0-) from the derivative of eq. 12; stable (+) root of corrected eq. 16",
-        "method_pgf_paper": "curve-fitted modal parameters of H22 (eq. 10, Omega fixed from eq. 11); chi22'(0-) = -1/(2 M2); stable (+) root of corrected eq. 16",
     }
-    for key, value in system.as_dict().items():
-        attrs[f"system_{key}"] = value
+    if isinstance(system, TwoDofSystem):
+        attrs["antiresonance_frequency_Hz"] = system.antiresonance_frequency() / (2.0 * np.pi)
+    if not scene.general:
+        attrs["method_pgf"] = "exact poles and residues of H22; exact chi22'(0-) from the derivative of eq. 12; stable (+) root of corrected eq. 16"
+        attrs["method_pgf_paper"] = "curve-fitted modal parameters of H22 (eq. 10, Omega fixed from eq. 11); chi22'(0-) = -1/(2 M2); stable (+) root of corrected eq. 16"
+        for key, value in system.as_dict().items():
+            attrs[f"system_{key}"] = value
+    else:
+        attrs.update(layout_attributes(scene))
     for key, value in asdict(scene.admissibility).items():
         attrs[f"admissibility_{key}"] = value
     attrs.update(simulation_attributes)
@@ -146,3 +154,30 @@ def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[st
         attrs["pgf_paper_form_factors_per_kg"] = np.real(fit.form_factor)
         attrs["pgf_paper_loss_factors"] = fit.loss_factor
     return attrs
+
+
+def layout_attributes(scene: Scene) -> dict[str, object]:
+    """What a general scene's dataset records of its structure, load and stops (plain netCDF attributes: matrices
+    flattened row by row, names and descriptions joined), so that a report can rebuild them."""
+    structure = scene.system.structure
+    load = scene.load_spec
+    size = structure.size
+    specs = scene.stop_specs
+    return {
+        "scene_format": "general",
+        "system_size": size,
+        "system_coordinates": " ".join(structure.coordinates),
+        "system_mass_kg": np.asarray(structure.mass_matrix).ravel(),
+        "system_stiffness_N_per_m": np.asarray(structure.stiffness_matrix).ravel(),
+        "system_damping_N_s_per_m": np.asarray(structure.damping_matrix).ravel(),
+        "excitation_kind": "base_motion" if load.base_motion else "force",
+        "excitation_weights": np.array(load.weights if load.weights is not None else [1.0] + [0.0] * (size - 1)),
+        "excitation_static_N": np.array(load.static if load.static is not None else [0.0] * size),
+        "stop_count": len(specs),
+        "stop_layout": "; ".join(stop_descriptions(specs, tuple(structure.coordinates), scene.restitution, scene.clearance)),
+        "stop_coordinate": np.array([spec.coordinate for spec in specs]),
+        "stop_other": np.array([-1 if spec.other is None else spec.other for spec in specs]),
+        "stop_side": " ".join(spec.side for spec in specs),
+        "method_pgf": "closed-form impact orbit (periodic Green function of the stopped coordinate n^T H n; one impact per period on one stop, two on a symmetric two-sided stop); stable (+) root",
+        "method_force": "force on the base: 1^T (K x + C x') through springs and dashpots plus (1^T n_k) lambda_k of each absolute stop",
+    }

@@ -16,6 +16,7 @@ from vibroimpact.scene.variables import quantity_attributes
 from vibroimpact.simulation.settings import SWEEP_STARTS
 from vibroimpact.study.cost_model import Costs, EnginePart, Estimate, grid_estimate
 from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates, solve_each, steady_variable
+from vibroimpact.study.general_stepped import run_general
 from vibroimpact.study.solutions import simulated_values
 
 __all__ = ["SteppedStudy", "expected_periods", "SETTLING_PERIODS", "SHOOTING_PERIODS", "ESTIMATE_POINTS"]
@@ -36,6 +37,8 @@ class SteppedStudy:
 
     def run(self, scene: Scene, progress: Progress | None, jobs: int, cache_dir: Path | None) -> xr.Dataset:
         """Every solution of ``scene`` over its grid (see :func:`vibroimpact.study.run.run_study`)."""
+        if scene.general:
+            return run_general(scene, progress, jobs, cache_dir, self.simulation_attributes(scene))
         grid = StudyGrid.of(scene)
         per_solution = solve_each(scene, grid, lambda name: simulated_values(scene, name, grid.full, jobs, cache_dir, progress is not None), progress)
         solutions = list(scene.solutions)

@@ -1,0 +1,84 @@
+"""Stepped studies of general scenes: any structure, load and stops (the paper's named scenes keep
+:class:`vibroimpact.study.stepped.SteppedStudy`'s own path and outputs).
+
+Output: dimension ``solution``, the swept parameters and ``frequency`` as for the paper's scenes; one
+``<name>_amplitude`` and ``<name>_rms`` per coordinate; per-stop quantities (``impulse``, ``one_impact_impulse``,
+``peak_contact_force``, ``peak_acceleration``) with a dimension ``stop`` (index in the scene's ``stops``) and its
+coordinate ``stop_description`` (e.g. ``x2 - x1 <= 3 mm, R = 0.2``) where the scene has several stops, without it
+where it has one. The structure, load and stop layout are attributes (:func:`vibroimpact.study.grid.layout_attributes`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from vibroimpact.scene.layout import stop_descriptions
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, STOP_QUANTITIES, Scene
+from vibroimpact.scene.variables import quantity_attributes
+from vibroimpact.study.general_engines import general_simulated_values
+from vibroimpact.study.general_values import general_linear_values, general_pgf_values
+from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates
+
+__all__ = ["run_general", "general_quantity_attributes"]
+
+_PER_COORDINATE = {"_amplitude": "x1_amplitude", "_rms": "x1_rms"}
+
+
+def general_quantity_attributes(quantity: str, scene: Scene) -> dict[str, object]:
+    """Units and long name of a general scene's quantity (per-coordinate names included)."""
+    relative = " relative to the base" if scene.load_spec.base_motion else ""
+    for name in scene.coordinates:
+        if quantity == f"{name}_amplitude":
+            return {"units": "m", "long_name": f"fundamental-harmonic amplitude of coordinate {name}{relative}"}
+        if quantity == f"{name}_rms":
+            return {"units": "m", "long_name": f"RMS of coordinate {name}{relative} (static offset included)"}
+        if quantity == f"one_impact_{name}_amplitude":
+            return {"units": "m", "long_name": f"|{name}| fundamental of the closed-form impact orbit wherever it exists, unchecked"}
+    attrs = quantity_attributes(quantity)
+    if quantity in STOP_QUANTITIES:
+        attrs = attrs | {"long_name": f"{attrs.get('long_name', quantity)}; per stop (the stopped coordinate's deceleration)"}
+    if quantity in ("force_amplitude", "suspension_force_amplitude"):
+        attrs = attrs | {"long_name": "fundamental-harmonic amplitude of the force on the base: 1^T (K x + C x') through springs and dashpots" + (" plus the absolute stops' contact forces" if quantity == "force_amplitude" else "")}
+    return attrs
+
+
+def run_general(scene: Scene, progress: Progress | None, jobs: int, cache_dir: Path | None, simulation_attributes: dict[str, object]) -> xr.Dataset:
+    """Every solution of a general ``scene`` over its grid."""
+    grid = StudyGrid.of(scene)
+    report = progress or (lambda _message: None)
+    per_solution = []
+    for i, name in enumerate(scene.solutions, start=1):
+        if name == "linear":
+            values = general_linear_values(scene, grid.omega, grid.base)
+        elif name in ENGINE_SOLUTIONS:
+            values = general_simulated_values(scene, name, grid.full, jobs, cache_dir, progress is not None)
+        else:
+            values = general_pgf_values(scene, grid.omega, grid.delta, grid.r, grid.base)
+        per_solution.append(values)
+        report(f"[{i}/{len(scene.solutions)}] {name}: done")
+    solutions = list(scene.solutions)
+    coords = grid_coordinates(scene, grid, solutions)
+    count = len(scene.stop_specs)
+    data_vars = {}
+    for quantity in scene.quantities:
+        attrs = general_quantity_attributes(quantity, scene)
+        if quantity in STOP_QUANTITIES:
+            stacked = np.stack([np.broadcast_to(values[quantity], (count, *grid.full)) for values in per_solution])
+            if count > 1:
+                data_vars[quantity] = xr.Variable(("solution", "stop", *GRID_DIMS), stacked, attrs)
+            else:
+                data_vars[quantity] = xr.Variable(("solution", *GRID_DIMS), stacked[:, 0], attrs)
+        else:
+            stacked = np.stack([np.broadcast_to(values[quantity], grid.full) for values in per_solution])
+            data_vars[quantity] = xr.Variable(("solution", *GRID_DIMS), stacked, attrs)
+    if count > 1 and any(q in STOP_QUANTITIES for q in scene.quantities):
+        coords["stop"] = np.arange(count)
+        coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.stop_specs, scene.coordinates, scene.restitution, scene.clearance), dtype=object))
+    dataset = xr.Dataset(data_vars, coords=coords)
+    if "stop" in dataset.coords:
+        dataset["stop"].attrs.update({"units": "1", "long_name": "index of the stop in the scene's stops"})
+        dataset["stop_description"].attrs.update({"long_name": "the stop's constraint in words (Delta, R: the swept values)"})
+    return finish_dataset(dataset, scene, coords, simulation_attributes)
