@@ -34,6 +34,7 @@ COMPLEX_FIELDS = ("x1", "x2", "base_force", "bumper_x1", "bumper_base_force")
 CASE_FIELDS = (
     *COMPLEX_FIELDS,
     "impacts_per_period",
+    "impulse_per_period",
     "converged",
     "multiplicity",
     "failed",
@@ -112,7 +113,7 @@ class ConceptCase:
                 continue
             m = outcome.measures
             out["x1"][i], out["x2"][i], out["base_force"][i] = m.x[0], m.x[1], m.base_force
-            out["impacts_per_period"][i] = m.impacts_per_period
+            out["impacts_per_period"][i], out["impulse_per_period"][i] = m.impacts_per_period, m.impulse_per_period
             out["converged"][i], out["multiplicity"][i], out["failed"][i] = float(outcome.converged), float(outcome.multiplicity), 0.0
             out["end_time"][i], out["end_state"][i] = outcome.time, outcome.state
             if bumper is not None:

@@ -50,7 +50,7 @@ def concepts_dataset(settings: ConceptsSettings, closed: dict[str, ClosedForms],
     points = max([b["frequency"].size for b in branches.values()] + [1])
     fine = {k: np.full((len(names), f.size), np.nan) for k in ("linear_x1", "closed_x1", "closed_force", "worst_x1", "worst_force")}
     flags = {k: np.full((len(names), f.size), -1, dtype=np.int8) for k in ("linear_fits", "closed_stable", "worst_impacts")}
-    sim_keys = ("x1", "base_force", "impacts_per_period", "converged", "multiplicity", "bumper_x1", "bumper_base_force", "bumper_impacts_per_period",
+    sim_keys = ("x1", "base_force", "impacts_per_period", "impulse_per_period", "converged", "multiplicity", "bumper_x1", "bumper_base_force", "bumper_impacts_per_period",
                 "bumper_peak_acceleration", "bumper_peak_contact_force", "bumper_converged")  # fmt: skip
     sim = {k: np.full((len(names), fs.size), np.nan) for k in sim_keys}
     branch_keys = ("frequency", "x1_amplitude", "base_force_amplitude", "floquet_modulus", "impacts_per_period", "period", "branch")
@@ -141,7 +141,7 @@ def concepts_dataset(settings: ConceptsSettings, closed: dict[str, ClosedForms],
 def _attrs(key: str) -> dict[str, str]:
     units = {"x1": "m", "base_force": "N", "x1_amplitude": "m", "base_force_amplitude": "N", "frequency": "Hz", "impacts_per_period": "1",
              "bumper_x1": "m", "bumper_base_force": "N", "bumper_peak_acceleration": "m s-2", "bumper_peak_contact_force": "N", "floquet_modulus": "1",
-             "bumper_impacts_per_period": "1", "period": "1", "multiplicity": "1"}  # fmt: skip
+             "bumper_impacts_per_period": "1", "period": "1", "multiplicity": "1", "impulse_per_period": "N s"}  # fmt: skip
     out = {"long_name": key.replace("_", " ")}
     if key in units:
         out["units"] = units[key]

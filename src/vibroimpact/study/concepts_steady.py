@@ -44,6 +44,8 @@ class Fundamentals:
         Fundamental of the force on the base [N] (module docstring).
     impacts_per_period : float
         Impacts (rigid) or contacts (bumper) per period [-].
+    impulse_per_period : float
+        Total impulse of the impacts (contacts) per period, every stop [N s].
     peak_acceleration : float
         Largest deceleration in contact [m s-2]: bumpers only (NaN for a rigid stop with impacts, 0 without contact).
     peak_contact_force : float
@@ -54,6 +56,7 @@ class Fundamentals:
     contact: NDArray[np.complex128]
     base_force: complex
     impacts_per_period: float
+    impulse_per_period: float
     peak_acceleration: float
     peak_contact_force: float
 
@@ -87,7 +90,7 @@ def fundamentals(trajectory: Trajectory) -> Fundamentals:
         peak_force = peak_acceleration = math.nan
     else:
         peak_force = peak_acceleration = 0.0
-    return Fundamentals(x, contact, base_force(problem, x, contact), contacts / periods, peak_acceleration, peak_force)
+    return Fundamentals(x, contact, base_force(problem, x, contact), contacts / periods, float(np.sum(trajectory.impulses)) / periods, peak_acceleration, peak_force)
 
 
 def length_scale(problem: ImpactProblem) -> float:
