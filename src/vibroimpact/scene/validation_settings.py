@@ -223,7 +223,7 @@ class RelativeStopCase:
     b1: float = 0.8
     b2: float = 0.08
     amplitude: float = 10.0
-    frequency: float = 30.0
+    frequency: float = 24.0
     clearance: float = 0.003
     restitution: float = 0.6
     periods: int = 2000
