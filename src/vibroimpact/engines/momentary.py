@@ -25,14 +25,15 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numba import carray, cfunc, njit, types
 from numpy.typing import NDArray
 from sksundae.cvode import CVODE
 
 from vibroimpact.engines.event_loop import EventLoopEngine, Model, Stop
-from vibroimpact.engines.rigid_kernels import HEADER, LENGTH, SIZE, STOPS, events_kernel, jacobian_kernel, rhs_kernel
+from vibroimpact.engines.rigid_kernels import COMPILED_EVENTS as _events
+from vibroimpact.engines.rigid_kernels import COMPILED_JACOBIAN as _jacobian
+from vibroimpact.engines.rigid_kernels import COMPILED_RHS as _rhs
 from vibroimpact.engines.settings import EngineSettings
-from vibroimpact.engines.sundae import ROOT_RETURN, CompiledCvode, as_doubles, clear_event_records, compiled_cvode_problem, content_data
+from vibroimpact.engines.sundae import ROOT_RETURN, CompiledCvode, clear_event_records, compiled_cvode_problem
 
 __all__ = ["MomentaryEngine", "compiled_parameters", "COMPILED_RHS", "COMPILED_JACOBIAN", "COMPILED_EVENTS"]
 
@@ -42,37 +43,6 @@ _STATUS_TSTOP = 1
 def compiled_parameters(model: Model) -> NDArray[np.float64]:
     """A copy of the user data of the compiled callbacks for ``model`` (its mode flags as they are now)."""
     return model.parameters.copy()
-
-
-@njit(cache=True, inline="always")
-def _parameters(data: Any) -> Any:  # pragma: no cover - compiled
-    """The user data as the parameter array of :func:`~vibroimpact.engines.rigid_kernels.pack_parameters`."""
-    return carray(as_doubles(data), (int(carray(as_doubles(data), (HEADER,))[LENGTH]),))
-
-
-@cfunc(types.intc(types.float64, types.voidptr, types.voidptr, types.voidptr), cache=True)
-def _rhs(t: float, y_vector: Any, yp_vector: Any, data: Any) -> int:  # pragma: no cover - compiled
-    p = _parameters(data)
-    size = int(p[SIZE])
-    rhs_kernel(t, carray(content_data(y_vector), (size,)), carray(content_data(yp_vector), (size,)), p)
-    return 0
-
-
-@cfunc(types.intc(types.float64, types.voidptr, types.voidptr, types.voidptr, types.voidptr, types.voidptr, types.voidptr, types.voidptr), cache=True)
-def _jacobian(t: float, y_vector: Any, f_vector: Any, matrix: Any, data: Any, tmp1: Any, tmp2: Any, tmp3: Any) -> int:  # pragma: no cover
-    p = _parameters(data)
-    size = int(p[SIZE])
-    # column-major: jac[j, i] = d y'_i / d y_j
-    jacobian_kernel(t, carray(content_data(y_vector), (size,)), carray(content_data(matrix), (size, size)), p)
-    return 0
-
-
-@cfunc(types.intc(types.float64, types.voidptr, types.CPointer(types.float64), types.voidptr), cache=True)
-def _events(t: float, y_vector: Any, out: Any, data: Any) -> int:  # pragma: no cover - compiled
-    p = _parameters(data)
-    size = int(p[SIZE])
-    events_kernel(t, carray(content_data(y_vector), (size,)), carray(out, (2 * int(p[STOPS]) + 1,)), p)
-    return 0
 
 
 #: The compiled callbacks (numba ``cfunc``; ``.address`` for CVODE, ``.ctypes`` to call them from Python).

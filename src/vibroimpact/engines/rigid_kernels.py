@@ -15,14 +15,16 @@ apex, the grazing guard; 1 on the stop held or without the guard).
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
-from numba import njit
+from numba import carray, cfunc, njit, types
 from numpy.typing import NDArray
 
 from vibroimpact.engines.flow_layout import FlowLayout
+from vibroimpact.engines.sundae import as_doubles, content_data
 
-__all__ = ["pack_parameters", "quadrature_count", "rhs_kernel", "jacobian_kernel", "events_kernel", "holding_kernel", "STUCK", "APEX", "SIZE", "STOPS", "LENGTH", "HEADER"]
+__all__ = ["pack_parameters", "quadrature_count", "rhs_kernel", "jacobian_kernel", "events_kernel", "holding_kernel", "STUCK", "APEX", "SIZE", "STOPS", "LENGTH", "HEADER", "COMPILED_RHS", "COMPILED_JACOBIAN", "COMPILED_EVENTS"]
 
 # header of the parameter array: mode, flags, sizes and the offsets of the blocks after it
 STUCK, APEX, SIZE, _N, STOPS, _OMEGA, _A, _C, _BR, _BI, _G, _G0, _NORMAL, _H, _H0, _HBR, _HBI, _TINV, _XOFF, LENGTH = range(20)
@@ -174,3 +176,41 @@ def events_kernel(t: float, y: NDArray[np.float64], out: NDArray[np.float64], p:
         else:
             out[k_count + 1 + k] = 1.0
     out[k_count] = holding_kernel(t, y, p, stuck) if stuck >= 0 else 1.0
+
+
+# The CVODE callbacks (``CVRhsFn``, ``CVLsJacFn``, ``CVRootFn``) over the kernels, in this module: numba's disk cache
+# keys a compiled function on its own file only, so callbacks in another file would keep a stale copy of an edited
+# kernel.
+@njit(cache=True, inline="always")
+def _parameters(data: Any) -> Any:  # pragma: no cover - compiled
+    """The user data as the parameter array of :func:`~vibroimpact.engines.rigid_kernels.pack_parameters`."""
+    return carray(as_doubles(data), (int(carray(as_doubles(data), (HEADER,))[LENGTH]),))
+
+
+@cfunc(types.intc(types.float64, types.voidptr, types.voidptr, types.voidptr), cache=True)
+def _rhs(t: float, y_vector: Any, yp_vector: Any, data: Any) -> int:  # pragma: no cover - compiled
+    p = _parameters(data)
+    size = int(p[SIZE])
+    rhs_kernel(t, carray(content_data(y_vector), (size,)), carray(content_data(yp_vector), (size,)), p)
+    return 0
+
+
+@cfunc(types.intc(types.float64, types.voidptr, types.voidptr, types.voidptr, types.voidptr, types.voidptr, types.voidptr, types.voidptr), cache=True)
+def _jacobian(t: float, y_vector: Any, f_vector: Any, matrix: Any, data: Any, tmp1: Any, tmp2: Any, tmp3: Any) -> int:  # pragma: no cover
+    p = _parameters(data)
+    size = int(p[SIZE])
+    # column-major: jac[j, i] = d y'_i / d y_j
+    jacobian_kernel(t, carray(content_data(y_vector), (size,)), carray(content_data(matrix), (size, size)), p)
+    return 0
+
+
+@cfunc(types.intc(types.float64, types.voidptr, types.CPointer(types.float64), types.voidptr), cache=True)
+def _events(t: float, y_vector: Any, out: Any, data: Any) -> int:  # pragma: no cover - compiled
+    p = _parameters(data)
+    size = int(p[SIZE])
+    events_kernel(t, carray(content_data(y_vector), (size,)), carray(out, (2 * int(p[STOPS]) + 1,)), p)
+    return 0
+
+
+#: The compiled callbacks (numba ``cfunc``; ``.address`` for CVODE, ``.ctypes`` to call them from Python).
+COMPILED_RHS, COMPILED_JACOBIAN, COMPILED_EVENTS = _rhs, _jacobian, _events
