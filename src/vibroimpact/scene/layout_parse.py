@@ -142,7 +142,7 @@ def parse_load(c: Checker, value: Any, names: tuple[str, ...] | None) -> tuple[f
     if base_motion and "on" in spec:
         c.fail("excitation.on", "a base motion loads every coordinate through its mass: remove 'on' (amplitude is the base displacement [m])")
     weights = None
-    if "on" in spec and names is not None:
+    if "on" in spec and names is not None and not base_motion:
         weights = _weights(c, spec["on"], names)
     static = _vector(c, "excitation.static", spec["static"], names, "constant force per coordinate [N]") if "static" in spec else None
     return amplitude, LoadSpec(weights=weights, static=static, base_motion=base_motion)

@@ -1,0 +1,136 @@
+"""Studies of general scenes: the paper written with matrices gives the paper's dataset; relative, two-sided and
+3-dof layouts give outputs named after their coordinates and stops."""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from vibroimpact.analysis.regime import Regime
+from vibroimpact.scene import parse_scene
+from vibroimpact.study.run import run_study
+
+NAMED = {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0, "b1": 0.8, "b2": 0.08}
+MATRICES = {"mass": [[1.0, 0.0], [0.0, 0.1]], "stiffness": [[29300.0, -4300.0], [-4300.0, 4300.0]], "damping": [[0.88, -0.08], [-0.08, 0.08]]}
+SWEEP = {"restitution": [0.0, 0.5, 1.0], "clearance": [0.002, 0.003], "frequency": {"start": 20.0, "stop": 40.0, "step": 0.5}}
+
+
+def named_document() -> dict[str, Any]:
+    return {"name": "named", "system": dict(NAMED), "excitation": {"amplitude": 10.0}, "bumper": {"frequency": 250.0}, "sweep": copy.deepcopy(SWEEP), "solutions": ["linear", "pgf"], "report": False}
+
+
+def general_document() -> dict[str, Any]:
+    document = named_document()
+    document.update(name="general", system=copy.deepcopy(MATRICES), excitation={"amplitude": 10.0, "on": "x1"}, stops=[{"coordinate": "x2", "side": "upper"}])
+    return document
+
+
+@pytest.fixture(scope="module")
+def paper_pair() -> tuple[xr.Dataset, xr.Dataset]:
+    """The paper's closed forms from the named and from the general form of the same scene."""
+    return run_study(parse_scene(named_document()), progress=None), run_study(parse_scene(general_document()), progress=None)
+
+
+def test_paper_in_general_form_equals_named_form(paper_pair: tuple[xr.Dataset, xr.Dataset]) -> None:
+    """Same variables, dimensions and coordinates; values to 1e-10 relative (measured 4e-12: receptances by matrix
+    inversion and the general PGF against the paper's closed forms); flags identical."""
+    named, general = paper_pair
+    assert set(named.data_vars) == set(general.data_vars)
+    assert dict(named.sizes) == dict(general.sizes)
+    for name in named.data_vars:
+        if named[name].dtype.kind in "iu":
+            xr.testing.assert_equal(named[name], general[name])
+        else:
+            xr.testing.assert_allclose(named[name], general[name], rtol=1e-10, atol=1e-300)
+    assert general.attrs["scene_format"] == "general"
+    assert general.attrs["stop_layout"] == "x2 <= Delta"
+
+
+def test_paper_general_form_has_one_impact_orbits(paper_pair: tuple[xr.Dataset, xr.Dataset]) -> None:
+    """The comparison above is not vacuous: the grid holds one-impact orbits and linear points."""
+    regime = paper_pair[1]["regime"].sel(solution="pgf").values
+    assert np.count_nonzero(regime == Regime.ONE_IMPACT) > 10 and np.count_nonzero(regime == Regime.LINEAR) > 10
+
+
+def relative_document() -> dict[str, Any]:
+    return {
+        "name": "relative",
+        "system": {**copy.deepcopy(MATRICES), "coordinates": ["primary", "absorber"]},
+        "excitation": {"amplitude": 10.0, "on": "primary"},
+        "stops": [
+            {"between": ["absorber", "primary"], "side": "upper", "clearance": 0.003, "restitution": 0.2},
+            {"between": ["absorber", "primary"], "side": "lower", "clearance": 0.003, "restitution": 0.2},
+        ],
+        "sweep": {"frequency": {"start": 15.0, "stop": 45.0, "step": 0.25}},
+        "solutions": ["linear", "pgf"],
+        "report": False,
+    }
+
+
+@pytest.fixture(scope="module")
+def relative() -> xr.Dataset:
+    return run_study(parse_scene(relative_document()), progress=None)
+
+
+def test_relative_two_sided_outputs(relative: xr.Dataset) -> None:
+    """Amplitudes per named coordinate; impulses per stop on a ``stop`` dimension described in words."""
+    assert {"primary_amplitude", "absorber_amplitude", "primary_rms", "absorber_rms"} <= set(relative.data_vars)
+    assert "x1_amplitude" not in relative
+    assert relative["impulse"].dims == ("solution", "stop", "frequency")
+    assert relative["primary_amplitude"].dims == ("solution", "frequency")
+    assert list(relative["stop_description"].values) == ["absorber - primary <= 3 mm, R = 0.2", "absorber - primary >= -3 mm, R = 0.2"]
+    assert float(relative["clearance"]) == pytest.approx(0.003, rel=1e-15)
+
+
+def test_relative_stop_does_not_load_the_base(relative: xr.Dataset) -> None:
+    """A relative stop acts inside the structure: the force on the base is the suspension's alone (same numbers)."""
+    pgf = relative.sel(solution="pgf")
+    impacting = pgf["regime"].values == Regime.ONE_IMPACT
+    assert impacting.any()
+    np.testing.assert_allclose(pgf["force_amplitude"].values[impacting], pgf["suspension_force_amplitude"].values[impacting], rtol=1e-15)
+
+
+def test_symmetric_orbit_has_equal_impulses_on_both_sides(relative: xr.Dataset) -> None:
+    """The symmetric two-sided orbit: the same impulse on the upper and the lower stop, two impacts per period."""
+    pgf = relative.sel(solution="pgf")
+    impacting = pgf["regime"].values == Regime.ONE_IMPACT
+    upper, lower = pgf["impulse"].sel(stop=0).values, pgf["impulse"].sel(stop=1).values
+    np.testing.assert_allclose(upper[impacting], lower[impacting], rtol=1e-15)
+    assert np.all(upper[impacting] > 0.0)
+    np.testing.assert_allclose(pgf["impacts_per_period"].values[impacting], 2.0, rtol=0)
+
+
+def test_linear_amplitude_of_the_relative_coordinate_decides_the_regime(relative: xr.Dataset) -> None:
+    """``linear`` is flagged as crossing the stop exactly where |X2 - X1| of the linear state exceeds Delta."""
+    from vibroimpact.model.structure import LinearStructure
+
+    structure = LinearStructure(MATRICES["mass"], MATRICES["stiffness"], MATRICES["damping"])
+    w = 2.0 * np.pi * relative["frequency"].values
+    h = structure.receptance_matrix(w)
+    relative_amplitude = np.abs(10.0 * (h[:, 1, 0] - h[:, 0, 0]))
+    flags = relative["regime"].sel(solution="linear").values
+    np.testing.assert_array_equal(flags == Regime.LINEAR_EXCEEDS_CLEARANCE, relative_amplitude > 0.003)
+
+
+def test_three_dof_names_and_no_stop_dimension_for_one_stop() -> None:
+    """A 3-dof chain with one absolute stop: three amplitudes, ``impulse`` without a stop dimension."""
+    document = {
+        "name": "chain3",
+        "system": {"mass": [[1.0, 0, 0], [0, 0.5, 0], [0, 0, 0.1]], "stiffness": [[2e4, -1e4, 0], [-1e4, 1.5e4, -5e3], [0, -5e3, 5e3]],
+                   "damping": [[2.0, -1.0, 0], [-1.0, 1.5, -0.5], [0, -0.5, 0.5]], "coordinates": ["a", "b", "c"]},  # fmt: skip
+        "excitation": {"amplitude": 10.0, "on": "a"},
+        "stops": [{"coordinate": "c", "side": "lower", "clearance": 0.002, "restitution": 0.5}],
+        "sweep": {"frequency": {"start": 5.0, "stop": 40.0, "step": 1.0}},
+        "solutions": ["linear", "pgf"],
+        "report": False,
+    }
+    dataset = run_study(parse_scene(document), progress=None)
+    assert {"a_amplitude", "b_amplitude", "c_amplitude"} <= set(dataset.data_vars)
+    assert dataset["impulse"].dims == ("solution", "frequency")
+    assert "stop" not in dataset.dims
+    assert dataset.attrs["stop_layout"] == "c >= -2 mm, R = 0.5"
+    assert (dataset["regime"].sel(solution="pgf").values == Regime.ONE_IMPACT).any()
