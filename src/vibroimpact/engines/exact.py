@@ -1,11 +1,15 @@
 """Engine ``exact``: piecewise-exact propagation, the reference every integrator is measured against.
 
-Between events the motion is linear with harmonic forcing, so it is propagated in closed form (eigenvectors of the
-state matrix plus the harmonic particular solution). Contacts are found by guaranteed root bracketing (Taylor bounds
-of the gap, :func:`.linear_flow.first_crossing`): no contact is missed however tangent, and contact times are exact
-to round-off. At a contact X2' -> -R X2'. When impacts accumulate (chattering, small R) and the stop pushes the
-absorber, it sticks: X2 = Delta, X2' = 0, only the primary mass moves, until the holding force
-B2 X1' + K2 (X1 - Delta) turns negative (found by the same root search).
+Between events the motion is linear with harmonic and constant loads, so it is propagated in closed form (eigenvectors
+of the state matrix plus the harmonic particular solution, and a polynomial for rigid-body modes, :mod:`.exact_flows`).
+Any N-dof structure with any rigid stops: contacts are found by guaranteed root bracketing (Taylor bounds of each
+stop's gap, :func:`.linear_flow.first_crossing`): no contact is missed however tangent, and contact times are exact to
+round-off. An impact on stop k restitutes its gap velocity, n_k . x' -> -R_k n_k . x', by an impulse along M^-1 n_k
+(two bodies' momentum is conserved on a relative stop). When impacts accumulate (chattering, small R) and the stop
+pushes the structure, it sticks: the flow held on the stop's surface (n_k . x = Delta_k, n_k . x' = 0) runs until the
+holding force (:meth:`~vibroimpact.model.problem.ImpactProblem.contact_holding`; B2 X1' + K2 (X1 - Delta) on the
+paper's layout) turns negative (found by the same root search), or an impact on another stop frees it. Sticking on two
+stops at once is refused (``NotImplementedError`` naming both).
 
 The event loop runs compiled (:mod:`.exact_core`, numba); this module is its thin Python face. It also returns the
 exact Jacobian of the stroboscopic map (state-transition matrices times the saltation matrices of impacts, sticking
@@ -14,7 +18,6 @@ and release), for shooting, continuation and Lyapunov exponents (:mod:`vibroimpa
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from functools import lru_cache
 
@@ -23,12 +26,13 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines import exact_core
 from vibroimpact.engines.base import Trajectory, check_run
+from vibroimpact.engines.exact_flows import ExactModel, Flow, build_model
 from vibroimpact.engines.exact_python import PythonExactEngine
+from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.engines.rigid_contact import RigidContact
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.system import TwoDofSystem
 
 __all__ = ["ExactEngine", "StrobeMap"]
 
@@ -39,21 +43,25 @@ class StrobeMap:
 
     Attributes
     ----------
-    state : ndarray, shape (4,)
-        Image (X1, X2, X1', X2') after the periods [m, m, m s-1, m s-1].
-    jacobian : ndarray, shape (4, 4)
+    state : ndarray, shape (2 N,)
+        Image (x, x') after the periods [m, m s-1]; (X1, X2, X1', X2') on the paper's layout.
+    jacobian : ndarray, shape (2 N, 2 N)
         d state / d start [-, s-1 or s]: NaN where the map is not differentiable (a grazing touch at zero speed).
     impact_times : ndarray
         Times of the impacts [s].
     impact_velocities : ndarray
-        Speed of the absorber just before each impact, > 0 [m s-1].
+        Approach speed n_k . x' just before each impact, > 0 [m s-1].
     sticks, releases : int
-        Impacts that ended in sticking, and releases from the stop.
+        Impacts that ended in sticking, and releases from a stop.
     closest_approach : float
-        Largest X2 - Delta at an interior local maximum of a free flight [m] (<= 0; -inf if none): a new impact
-        is born (grazing) where it reaches 0.
+        Largest n_k . x - Delta_k (minus the gap) at an interior local maximum of a flight, over the stops not held
+        [m] (<= 0; -inf if none): a new impact is born (grazing) where it reaches 0.
     closest_approach_time : float
         When it happens [s] (NaN if none).
+    impact_stops : ndarray of int
+        Stop index of each impact.
+    closest_approach_stop : int
+        The stop of the closest approach (-1 if none).
     """
 
     state: NDArray[np.float64]
@@ -65,44 +73,42 @@ class StrobeMap:
     closest_approach: float
     closest_approach_time: float
     stats: dict[str, int] = field(default_factory=dict)
+    impact_stops: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    closest_approach_stop: int = -1
 
 
-@lru_cache(maxsize=32)
-def _eigen(matrix: tuple[tuple[float, ...], ...]) -> tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128]]:
-    """Eigenvalues, eigenvectors and their inverse of a state matrix: once per system (cached)."""
-    a = np.array(matrix, dtype=complex)
-    lam, vec = np.linalg.eig(a)
-    return lam, np.ascontiguousarray(vec), np.ascontiguousarray(np.linalg.inv(vec))
+def _half(lam: NDArray[np.complex128]) -> NDArray[np.complex128]:
+    """The eigenvalues a real observable needs, in order: one of each complex-conjugate pair (Im > 0) and the real ones."""
+    return lam[lam.imag >= 0.0]
 
 
-@lru_cache(maxsize=32)
-def _matrices(system: TwoDofSystem) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The free state matrix A (4 x 4) and the stuck one of (X1, X1') (2 x 2)."""
-    s = system
-    stuck = np.array([[0.0, 1.0], [-(s.k1 + s.k2) / s.m1, -(s.b1 + s.b2) / s.m1]])
-    return np.ascontiguousarray(s.state_matrix, dtype=float), stuck
-
-
-class _Flows:
-    """The arrays the compiled loop needs for one problem (eigen-decompositions shared per system).
-
-    The harmonic particular solution is a linear solve, (jw I - A) Y = b: through the eigenvectors it is ~10x less
-    accurate (7e-11 against 1e-11 of the motion at the anti-resonance).
-    """
-
-    def __init__(self, problem: ImpactProblem) -> None:
-        s, p = problem.system, problem
-        a, stuck = _matrices(s)
-        self.a = a
-        self.lam, self.vec, self.inv = _eigen(tuple(map(tuple, a)))
-        self.slam, self.svec, self.sinv = _eigen(tuple(map(tuple, stuck)))
-        forcing = p.amplitude * complex(math.cos(p.phase), math.sin(p.phase)) / s.m1
-        jw = 1j * p.omega
-        self.hrm = np.linalg.solve(jw * np.eye(4) - a, np.array([0, 0, forcing, 0], dtype=complex))
-        self.cst = np.zeros(4)
-        self.shrm = np.linalg.solve(jw * np.eye(2) - stuck, np.array([0, forcing], dtype=complex))
-        # stuck: X1'' = -(K1 + K2)/M1 X1 - ... + K2 Delta / M1: the constant solution X1 = K2 Delta / (K1 + K2)
-        self.scst = np.array([s.k2 * p.clearance / (s.k1 + s.k2), 0.0])
+def _stack(flows: tuple[Flow, ...], omega: float) -> tuple:
+    """The flows as the compiled loop's stacked arrays (see :mod:`.exact_core`)."""
+    count, n = len(flows), flows[0].harmonic.size
+    widest = max(flow.eigenvalues.size for flow in flows)
+    lams = np.zeros((count, widest), dtype=complex)
+    hlams = np.zeros((count, widest), dtype=complex)
+    vecs = np.zeros((count, n, widest), dtype=complex)
+    invs = np.zeros((count, widest, n), dtype=complex)
+    rates = np.zeros((count, widest + 2), dtype=complex)
+    rinv = np.zeros((count, widest + 3, widest + 2), dtype=complex)
+    counts, hcounts = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)
+    for f, flow in enumerate(flows):
+        m = flow.eigenvalues.size
+        half = _half(flow.eigenvalues)
+        counts[f], hcounts[f] = m, half.size
+        lams[f, :m], hlams[f, : half.size], vecs[f, :, :m], invs[f, :m, :] = flow.eigenvalues, half, flow.vectors, flow.inverse
+        r, inverse = exact_core.moment_rates(np.ascontiguousarray(flow.eigenvalues), omega)
+        rates[f, : m + 2], rinv[f, : m + 3, : m + 2] = r, inverse
+    hrms = np.array([flow.harmonic for flow in flows], dtype=complex).reshape(count, n)
+    csts = np.array([flow.constant for flow in flows], dtype=float).reshape(count, n)
+    zpros = np.array([flow.projector for flow in flows], dtype=float).reshape(count, n, n)
+    znils = np.array([flow.nilpotent for flow in flows], dtype=float).reshape(count, n, n)
+    zdrvs = np.array([flow.drift for flow in flows], dtype=float).reshape(count, n)
+    zdrv2s = np.array([flow.drift2 for flow in flows], dtype=float).reshape(count, n)
+    polys = np.array([flow.polynomial for flow in flows], dtype=np.bool_)
+    fastests = np.array([omega + (float(np.max(np.abs(flow.eigenvalues))) if flow.eigenvalues.size else 0.0) for flow in flows])
+    return (lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates, rinv, fastests)
 
 
 @dataclass(frozen=True, eq=False)
@@ -110,6 +116,7 @@ class _Setup:
     """What the compiled loop needs of one problem: its flows and thresholds, as the loop's leading arguments."""
 
     law: RigidContact
+    model: ExactModel
     arguments: tuple
 
 
@@ -117,16 +124,25 @@ class _Setup:
 def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
     """Once per problem (continuation and Lyapunov runs call the map of one problem thousands of times)."""
     law = RigidContact("exact", problem, settings, 0)
-    f, p, s = _Flows(problem), problem, problem.system
     length = law.length_scale
+    model = build_model(problem, length)
+    size, count = model.size, len(problem.stops)
+    n = 2 * size
+    zero = np.zeros((count, size))
+    gapw = np.ascontiguousarray(np.hstack([model.normals, zero]))
+    velw = np.ascontiguousarray(np.hstack([zero, model.normals]))
+    kickw = np.ascontiguousarray(np.hstack([zero, model.kicks]))
+    signs = np.array([model.normals[k, i] if i >= 0 else 0.0 for k, i in enumerate(model.simple)])
+    nodes, weights = gauss_legendre(16)
     arguments = (
-        f.lam, f.vec, f.inv, f.hrm, f.cst, f.slam, f.svec, f.sinv, f.shrm, f.scst,
-        f.a, p.amplitude / s.m1, p.phase, p.omega, p.period,
-        p.clearance, p.restitution, s.m2, s.k2, s.b2,
-        law.sticking_velocity, law.max_impacts, 1e-15 * length, 1e-15 * (s.k2 + s.b2 * p.omega) * length,
-        1e-14 * law.velocity_scale,
+        *_stack((model.free, *model.stuck), problem.omega),
+        model.matrix, np.ascontiguousarray(model.load), np.ascontiguousarray(model.static), problem.omega, problem.period,
+        gapw, velw, kickw, model.clearances, model.restitutions, model.masses, model.simple, signs,
+        np.ascontiguousarray(model.hold_weights.reshape(count, n)), model.hold_offsets, model.hold_harmonics, model.force_tolerances,
+        model.bounce, model.stick, model.touch,
+        law.sticking_velocity, law.max_impacts, 1e-15 * length, 1e-14 * law.velocity_scale, nodes, weights,
     )  # fmt: skip
-    return _Setup(law, arguments)
+    return _Setup(law, model, arguments)
 
 
 class ExactEngine:
@@ -141,22 +157,33 @@ class ExactEngine:
         check_run(self.name, problem, RigidStop, periods)
         setup = _setup(problem, self.settings)
         state = np.ascontiguousarray(state, dtype=float)
+        if state.shape != (2 * problem.size,):
+            raise ValueError(f"state: expected {2 * problem.size} values (x and x' of {problem.size} coordinates), got shape {state.shape}")
         setup.law.check_start(state)
         out = exact_core.run_periods(*setup.arguments, state, float(t_start), int(periods), moments, jacobians, approach)
-        if out[0] != exact_core.STATUS_OK:
+        if out[0] == exact_core.STATUS_NO_PROGRESS:
             raise RuntimeError(f"no progress at t = {out[1]!r} s: more than {10 * setup.law.max_impacts} events in one period")
+        if out[0] == exact_core.STATUS_TWO_STICKS:
+            first, second = (int(x) for x in (out[8][4], out[9][2]))
+            names = setup.law.names
+            raise NotImplementedError(
+                f"at t = {out[1]!r} s the structure would stick on two stops at once (stop {first}: "
+                f"{problem.stops[first].describe(names)}, stop {second}: {problem.stops[second].describe(names)}); "
+                "the exact engine holds one stop at a time"
+            )
         return out
 
     def integrate(
         self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False, jacobians: bool = False
     ) -> Trajectory:
-        """Integrate ``periods`` whole periods from ``state`` (X1, X2, X1', X2') at ``t_start`` [s].
+        """Integrate ``periods`` whole periods from ``state`` (x, x') at ``t_start`` [s].
 
         With ``jacobians``, ``strobe_jacobians[k]`` is the exact Jacobian of period k's stroboscopic map.
         """
         _status, _t, strobes, jac, impacts, segments, segment_states, period_moments, counters, _approach = self._run(
             problem, state, t_start, periods, moments, jacobians, False
         )
+        n, width = 2 * problem.size, 2 * problem.size + len(problem.stops)
         times = float(t_start) + np.arange(periods + 1) * problem.period  # the loop's boundaries, bit for bit
         starts = segments[:, 0]
         ends = np.append(starts[1:], times[-1]) if starts.size else starts
@@ -170,16 +197,18 @@ class ExactEngine:
             impulses=impacts[:, 2].copy(),
             segments=np.column_stack([starts, ends, segments[:, 1]])[keep],
             segment_states=segment_states[keep],
-            moments=period_moments if moments else np.zeros((0, 5), dtype=complex),
+            moments=period_moments if moments else np.zeros((0, width), dtype=complex),
             stats=_stats(counters, impacts.shape[0]),
-            strobe_jacobians=jac if jacobians else np.zeros((0, 4, 4)),
+            strobe_jacobians=jac if jacobians else np.zeros((0, n, n)),
+            impact_stops=impacts[:, 3].astype(np.int64),
+            segment_stops=segments[keep, 2].astype(np.int64),
         )
 
     def strobe_map(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float = 0.0, periods: int = 1) -> StrobeMap:
         """The stroboscopic map over ``periods`` periods from ``state`` at ``t_start`` [s], with its exact Jacobian
-        and what a continuation watches (impact speeds, closest approach of the gap)."""
+        and what a continuation watches (impact speeds, closest approach of the gaps)."""
         _status, _t, strobes, jac, impacts, _segments, _states, _moments, counters, approach = self._run(problem, state, t_start, periods, False, True, True)
-        product = np.eye(4)
+        product = np.eye(2 * problem.size)
         for factor in jac:
             product = factor @ product
         return StrobeMap(
@@ -192,11 +221,21 @@ class ExactEngine:
             closest_approach=float(approach[0]),
             closest_approach_time=float(approach[1]),
             stats=_stats(counters, impacts.shape[0]),
+            impact_stops=impacts[:, 3].astype(np.int64),
+            closest_approach_stop=int(approach[2]),
         )
 
-    def dense(self, trajectory: Trajectory, times: NDArray[np.float64]) -> NDArray[np.float64]:
-        """States at arbitrary ``times`` inside a trajectory, shape (n, 4), exact (from its segments)."""
-        return PythonExactEngine(self.settings).dense(trajectory, times)
+    def dense(self, trajectory: Trajectory, times: NDArray[np.float64], side: str = "right") -> NDArray[np.float64]:
+        """States at arbitrary ``times`` inside a trajectory, shape (n, 2 N), exact (from its segments).
+
+        At an event's time, ``side="right"`` gives the state just after it and ``"left"`` the state just before it
+        (the end of the earlier segment: e.g. the velocities before an impact)."""
+        return PythonExactEngine(self.settings).dense(trajectory, times, side)
+
+    def model(self, problem: ImpactProblem) -> ExactModel:
+        """The flows and stop maps the engine prepared for ``problem`` (cached per problem)."""
+        check_run(self.name, problem, RigidStop)
+        return _setup(problem, self.settings).model
 
 
 def _stats(counters: NDArray[np.int64], impacts: int) -> dict[str, int]:

@@ -1,27 +1,31 @@
 """The compiled core of the ``exact`` engine: its whole event loop in one numba function, with the exact Jacobian.
 
-Everything the loop calls lives in this one module on purpose: numba's on-disk cache is keyed by the source file of
-each cached function only, so a change in a function called from another file would not recompile its callers
-(numba PR #8396, unmerged); a kernel module beside this one served stale machine code after an edit.
+Everything the loop calls lives in this one module on purpose, which is why it is longer than the house's ~400
+lines: numba's on-disk cache is keyed by the source file of each cached function only, so a change in a function
+called from another file would not recompile its callers (numba PR #8396, unmerged); a kernel module beside this one
+served stale machine code after an edit.
 
 The algorithm is :mod:`.exact_python`'s (closed-form flow, guaranteed first-root search by Taylor bounds, impact map,
 sticking and release, strobes, Fourier moments), compiled with ``@njit(cache=True)``: the interpreter overhead of the
-pure-Python loop was ~97 % of its cost (README, "Speed: before and after the compiled core"). Flows are passed as
-arrays:
+pure-Python loop was ~97 % of its cost (README, "Speed: before and after the compiled core"). It runs any N-dof
+structure (state y = (x, x') of n = 2 N entries) with any K rigid stops. Flows (:mod:`.exact_flows`) are passed
+stacked, flow 0 the free flight and flow 1 + k the flight held on stop k, all in the full state's coordinates:
 
-* ``lam`` (n,) eigenvalues, ``vec`` (n, n) eigenvectors, ``inv`` (n, n) their inverse, ``hrm`` (n,) the complex
-  amplitude Y of the harmonic particular solution Re(Y e^{jwt}), ``cst`` (n,) the constant particular solution;
-  the free flow has n = 4 (X1, X2, X1', X2'), the stuck flow n = 2 (X1, X1') with X2 = Delta, X2' = 0.
+* ``lams[f, :counts[f]]`` the nonzero eigenvalues, ``vecs[f]`` (n, m) their eigenvectors, ``invs[f]`` (m, n) the
+  rows giving the modal coordinates, ``hrms[f]`` the amplitude Y of the harmonic particular solution Re(Y e^{jwt}),
+  ``csts[f]`` the constant one; where ``polys[f]`` (rigid-body modes), the polynomial part z0 + q1 tau + q2 tau^2
+  from the projector ``zpros[f]``, the nilpotent ``znils[f]`` and the drifts ``zdrvs[f]`` (c), ``zdrv2s[f]`` (q2).
 * an observable h = w . y + offset of a piece from (t0, y0) is ``amp`` complex (one per eigenvalue; the root search
-  keeps one of each conjugate pair, doubled), ``har`` (complex), ``con`` (float):
-  h(t) = Re(sum amp_i e^{lam_i (t - t0)} + har e^{jwt}) + con.
+  keeps one of each conjugate pair, doubled), ``har`` (complex), ``con`` (float), ``p1``, ``p2``:
+  h(t) = Re(sum amp_i e^{lam_i tau} + har e^{jwt}) + con + p1 tau + p2 tau^2, tau = t - t0. The loop watches one
+  observable per stop: the gap's n_k . x - Delta_k in free flight, minus the holding force while held on stop k.
 
 The Jacobian of the stroboscopic map is the product, over the pieces of a period, of the state-transition matrices
-Re(V diag(e^{lam dt}) V^-1) and of the saltation matrix of each event (Leine & Nijmeijer; di Bernardo et al.):
-an impact y+ = D y- with D = diag(1, 1, 1, -R) (or diag(1, 1, 1, 0) when it sticks) gives
-S = D + (f(y+) - D f(y-)) e2^T / X2'(t-); a release is continuous in y and in the vector field (the absorber leaves
-at rest with zero holding force), so its saltation matrix is the identity. While stuck, X2 and X2' are held, so the
-transition matrix has zero rows for them.
+Re(V diag(e^{lam dt}) V^+) + P_z + A_z dt and of the saltation matrix of each event (Leine & Nijmeijer; di Bernardo et
+al.): an impact on stop k maps y+ = D y- (D restitutes n_k . x' along M^-1 n_k, or cancels it when it sticks) and gives
+S = D + (f(y+) - D f(y-)) (grad g)^T / (grad g . f(y-)) with grad g = (n_k, 0); a release is continuous in y and in the
+vector field (the stop lets go at zero holding force), so its saltation matrix is the identity. While held, the
+transition matrix of the lifted flow projects onto the stop's surface.
 """
 
 from __future__ import annotations
@@ -31,73 +35,90 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["run_periods", "STATUS_OK", "STATUS_NO_PROGRESS"]
+__all__ = ["run_periods", "STATUS_OK", "STATUS_NO_PROGRESS", "STATUS_TWO_STICKS"]
 
-STATUS_OK, STATUS_NO_PROGRESS = 0, 1
+STATUS_OK, STATUS_NO_PROGRESS, STATUS_TWO_STICKS = 0, 1, 2
 
 
 @njit(cache=True, error_model="numpy")
-def _modal(lam, vec, inv, hrm, cst, omega, t0, y0, out):
+def _modal(lam, inv, hrm, cst, omega, t0, y0, out):
     """Modal coordinates of the homogeneous part through y0 at t0, into ``out``."""
-    n = lam.size
+    m = lam.size
     phasor = complex(math.cos(omega * t0), math.sin(omega * t0))
-    for r in range(n):
+    for r in range(m):
         out[r] = 0j
-    for i in range(n):
+    for i in range(y0.size):
         rel = y0[i] - ((hrm[i] * phasor).real + cst[i])
-        for r in range(n):
+        for r in range(m):
             out[r] += inv[r, i] * rel
 
 
 @njit(cache=True, error_model="numpy")
-def _state(lam, vec, hrm, cst, omega, t0, modal, t, out):
-    n = lam.size
-    phasor = complex(math.cos(omega * t), math.sin(omega * t))
-    for r in range(n):
-        out[r] = (hrm[r] * phasor).real + cst[r]
+def _rigid(zpro, znil, zdrv, zdrv2, hrm, cst, omega, t0, y0, z0, q1, q2):
+    """The polynomial part through y0 at t0: z0 = P_z (y0 - p(t0)), q1 = A_z z0 + c, q2 = A_z c / 2."""
+    n = y0.size
+    phasor = complex(math.cos(omega * t0), math.sin(omega * t0))
+    rel = np.empty(n)
     for i in range(n):
+        rel[i] = y0[i] - ((hrm[i] * phasor).real + cst[i])
+    for r in range(n):
+        acc = 0.0
+        for i in range(n):
+            acc += zpro[r, i] * rel[i]
+        z0[r] = acc
+    for r in range(n):
+        acc = zdrv[r]
+        for i in range(n):
+            acc += znil[r, i] * z0[i]
+        q1[r] = acc
+        q2[r] = zdrv2[r]
+
+
+@njit(cache=True, error_model="numpy")
+def _state(lam, vec, hrm, cst, omega, t0, modal, t, out, poly, z0, q1, q2):
+    phasor = complex(math.cos(omega * t), math.sin(omega * t))
+    for r in range(out.size):
+        out[r] = (hrm[r] * phasor).real + cst[r]
+    for i in range(lam.size):
         if lam[i].imag < 0.0:
             continue  # its conjugate's term, doubled, stands for both (the state is real)
         growth = np.exp(lam[i] * (t - t0)) * modal[i] * (2.0 if lam[i].imag > 0.0 else 1.0)
-        for r in range(n):
+        for r in range(out.size):
             out[r] += (vec[r, i] * growth).real
+    if poly:
+        tau = t - t0
+        for r in range(out.size):
+            out[r] += z0[r] + (q1[r] + q2[r] * tau) * tau
 
 
 @njit(cache=True, error_model="numpy")
-def _observable(weights, offset, vec, hrm, cst, modal, amp):
-    """h = weights . y + offset of the piece with ``modal`` coordinates: amplitudes into ``amp``; (har, con)."""
-    n = modal.size
-    har = 0j
-    con = offset
-    for i in range(n):
+def _observable(weights, offset, extra, vec, hrm, cst, modal, amp, poly, z0, q1, q2):
+    """h = weights . y + offset (+ Re(extra e^{jwt})) of the piece with ``modal`` coordinates: amplitudes into
+    ``amp``; returns (har, con, p1, p2)."""
+    for i in range(modal.size):
         acc = 0j
-        for r in range(n):
+        for r in range(weights.size):
             acc += weights[r] * vec[r, i]
         amp[i] = acc * modal[i]
-        har += weights[i] * hrm[i]
-        con += weights[i] * cst[i]
-    return har, con
-
-
-@njit(cache=True, error_model="numpy")
-def _half_rates(lam):
-    """The eigenvalues a real observable needs: one of each complex-conjugate pair (Im > 0) and the real ones."""
-    count = 0
-    for i in range(lam.size):
-        if lam[i].imag >= 0.0:
-            count += 1
-    out = np.empty(count, dtype=np.complex128)
-    count = 0
-    for i in range(lam.size):
-        if lam[i].imag >= 0.0:
-            out[count] = lam[i]
-            count += 1
-    return out
+    har = 0j
+    con = offset
+    for r in range(weights.size):
+        har += weights[r] * hrm[r]
+        con += weights[r] * cst[r]
+    har += extra
+    p1 = 0.0
+    p2 = 0.0
+    if poly:
+        for r in range(weights.size):
+            con += weights[r] * z0[r]
+            p1 += weights[r] * q1[r]
+            p2 += weights[r] * q2[r]
+    return har, con, p1, p2
 
 
 @njit(cache=True, error_model="numpy")
 def _halve(lam, amp, out):
-    """Amplitudes on :func:`_half_rates`: Re(a e^{lt}) + Re(conj) = Re(2 a e^{lt}), so each pair is kept once,
+    """Amplitudes on the half rates (Im >= 0): Re(a e^{lt}) + Re(conj) = Re(2 a e^{lt}), so each pair is kept once,
     doubled (every evaluation of the observable then costs half)."""
     count = 0
     for i in range(lam.size):
@@ -110,16 +131,17 @@ def _halve(lam, amp, out):
 
 
 @njit(cache=True, error_model="numpy")
-def _value(lam, amp, har, con, omega, t0, t):
+def _value(lam, amp, har, con, p1, p2, omega, t0, t):
     """h(t)."""
     total = har * complex(math.cos(omega * t), math.sin(omega * t))
     for i in range(lam.size):
         total += amp[i] * np.exp(lam[i] * (t - t0))
-    return total.real + con
+    tau = t - t0
+    return total.real + con + (p1 + p2 * tau) * tau
 
 
 @njit(cache=True, error_model="numpy")
-def _derivatives(lam, amp, har, con, omega, t0, t, out):
+def _derivatives(lam, amp, har, con, p1, p2, omega, t0, t, out):
     """h, h', ..., h^(len(out) - 1) at t."""
     forced = har * complex(math.cos(omega * t), math.sin(omega * t))
     jw = 1j * omega
@@ -132,19 +154,33 @@ def _derivatives(lam, amp, har, con, omega, t0, t, out):
         for k in range(out.size):
             out[k] += term.real
             term *= lam[i]
+    tau = t - t0
+    out[0] += (p1 + p2 * tau) * tau
+    if out.size > 1:
+        out[1] += p1 + 2.0 * p2 * tau
+    if out.size > 2:
+        out[2] += 2.0 * p2
 
 
 @njit(cache=True, error_model="numpy")
-def _bound(lam, amp, har, omega, t0, t, order):
-    """An upper bound of |h^(order)| over [t, inf) (all Re(lam) <= 0)."""
+def _bound(lam, amp, har, p1, p2, omega, t0, t, order):
+    """An upper bound of |h^(order)| over [t, inf) (all Re(lam) <= 0) for order >= 2; for orders 0 and 1, whose
+    polynomial part grows, its size at t (a scale)."""
     total = abs(har) * omega**order
     for i in range(lam.size):
         total += abs(amp[i]) * abs(lam[i]) ** order * math.exp(lam[i].real * (t - t0))
+    tau = t - t0
+    if order == 0:
+        total += (abs(p1) + abs(p2) * tau) * tau
+    elif order == 1:
+        total += abs(p1) + 2.0 * abs(p2) * tau
+    elif order == 2:
+        total += 2.0 * abs(p2)
     return total
 
 
 @njit(cache=True, error_model="numpy")
-def _step_data(lam, amp, har, con, omega, t0, t):
+def _step_data(lam, amp, har, con, p1, p2, omega, t0, t):
     h0 = 0j
     h1 = 0j
     h2 = 0j
@@ -161,19 +197,26 @@ def _step_data(lam, amp, har, con, omega, t0, t):
         bound2 += size
         bound3 += size * abs(l)
     forced = har * complex(math.cos(omega * t), math.sin(omega * t))
-    return (h0 + forced).real + con, (h1 + forced * 1j * omega).real, (h2 - forced * omega * omega).real, bound2, bound3
+    tau = t - t0
+    return (
+        (h0 + forced).real + con + (p1 + p2 * tau) * tau,
+        (h1 + forced * 1j * omega).real + p1 + 2.0 * p2 * tau,
+        (h2 - forced * omega * omega).real + 2.0 * p2,
+        bound2 + 2.0 * abs(p2),
+        bound3,
+    )
 
 
 @njit(cache=True, error_model="numpy")
-def _escape_step(lam, amp, har, con, omega, t0, t):
+def _escape_step(lam, amp, har, con, p1, p2, omega, t0, t):
     """A step over which h stays < 0 from h(t) = 0 when h leaves the surface; -1.0 if it does not leave (orders up to
     4, see linear_flow.escape_step)."""
     values = np.empty(5)
-    _derivatives(lam, amp, har, con, omega, t0, t, values)
+    _derivatives(lam, amp, har, con, p1, p2, omega, t0, t, values)
     for k in range(1, 5):
-        scale = _bound(lam, amp, har, omega, t0, t, k)
+        scale = _bound(lam, amp, har, p1, p2, omega, t0, t, k)
         if values[k] < -1e-9 * scale:
-            return -(k + 1) * values[k] / _bound(lam, amp, har, omega, t0, t, k + 1)
+            return -(k + 1) * values[k] / _bound(lam, amp, har, p1, p2, omega, t0, t, k + 1)
         if values[k] > 1e-9 * scale:
             return -1.0
     return -1.0
@@ -196,19 +239,20 @@ def _polish(h0, h1, h2):
 
 
 @njit(cache=True, error_model="numpy")
-def _first_crossing(lam, amp, har, con, omega, t0, t_from, t_to, tolerance, leaving):
+def _first_crossing(lam, amp, har, con, p1, p2, omega, t0, t_from, t_to, tolerance, leaving):
     """First time in (t_from, t_to] at which h reaches 0 from below; NaN if none (see linear_flow.first_crossing)."""
-    size = abs(har) + abs(con)
+    tau = t_from - t0
+    size = abs(har) + abs(con) + (abs(p1) + abs(p2) * tau) * tau
     for i in range(amp.size):
         size += abs(amp[i])
     tolerance = max(tolerance, 1e-15 * size)
     pair = np.empty(2)
     t = t_from
     if leaving:
-        if _value(lam, amp, har, con, omega, t0, t) >= -tolerance:
-            step = _escape_step(lam, amp, har, con, omega, t0, t)
+        if _value(lam, amp, har, con, p1, p2, omega, t0, t) >= -tolerance:
+            step = _escape_step(lam, amp, har, con, p1, p2, omega, t0, t)
             if step < 0.0:
-                if _bound(lam, amp, har, omega, t0, t, 0) <= tolerance:
+                if _bound(lam, amp, har, 0.0, 0.0, omega, t0, t, 0) <= tolerance and abs(p1) + abs(p2) <= tolerance:
                     return math.nan
                 return t_from
             t += step
@@ -216,9 +260,9 @@ def _first_crossing(lam, amp, har, con, omega, t0, t_from, t_to, tolerance, leav
                 return math.nan
     departing = leaving
     while True:
-        h0, h1, h2, curvature, jerk = _step_data(lam, amp, har, con, omega, t0, t)
+        h0, h1, h2, curvature, jerk = _step_data(lam, amp, har, con, p1, p2, omega, t0, t)
         if departing and h0 >= -8.0 * tolerance:
-            step = _escape_step(lam, amp, har, con, omega, t0, t)
+            step = _escape_step(lam, amp, har, con, p1, p2, omega, t0, t)
             if step >= 0.0:
                 if t + step >= t_to:
                     return math.nan
@@ -237,7 +281,7 @@ def _first_crossing(lam, amp, har, con, omega, t0, t_from, t_to, tolerance, leav
         if t + step >= t_to:
             # h < 0 on [t, t_to); a root at t_to (an impact on a period boundary) is still a root, and so is one
             # within a few round-off units of it, arriving: it is applied before the strobe, not after it
-            _derivatives(lam, amp, har, con, omega, t0, t_to, pair)
+            _derivatives(lam, amp, har, con, p1, p2, omega, t0, t_to, pair)
             return t_to if pair[0] >= -tolerance or (pair[0] >= -8.0 * tolerance and pair[1] > 0.0) else math.nan
         if t + step == t:
             return t
@@ -245,33 +289,81 @@ def _first_crossing(lam, amp, har, con, omega, t0, t_from, t_to, tolerance, leav
 
 
 @njit(cache=True, error_model="numpy")
-def _transition(lam, vec, inv, dt):
-    n = lam.size
-    scaled = np.empty((n, n), dtype=np.complex128)
-    for i in range(n):
+def _transition(lam, vec, inv, dt, poly, zpro, znil, out):
+    """exp(A dt) of the flow: Re(V diag(e^{lam dt}) V^+) (+ P_z + A_z dt), into ``out`` (n x n)."""
+    n = out.shape[0]
+    for r in range(n):
+        for c in range(n):
+            out[r, c] = 0.0
+    for i in range(lam.size):
         g = np.exp(lam[i] * dt)
-        for j in range(n):
-            scaled[i, j] = g * inv[i, j]
-    return np.ascontiguousarray((vec @ scaled).real)
+        for r in range(n):
+            left = vec[r, i] * g
+            for c in range(n):
+                out[r, c] += (left * inv[i, c]).real
+    if poly:
+        for r in range(n):
+            for c in range(n):
+                out[r, c] += zpro[r, c] + znil[r, c] * dt
 
 
 @njit(cache=True, error_model="numpy")
 def _left_multiply(factor, jac, work):
-    """jac <- factor @ jac (4 x 4), through ``work``."""
-    for r in range(4):
-        for c in range(4):
+    """jac <- factor @ jac (n x n), through ``work``."""
+    n = jac.shape[0]
+    for r in range(n):
+        for c in range(n):
             acc = 0.0
-            for m in range(4):
+            for m in range(n):
                 acc += factor[r, m] * jac[m, c]
             work[r, c] = acc
     jac[:, :] = work
 
 
 @njit(cache=True, error_model="numpy")
-def _free_field(a_matrix, force_over_m1, omega, phase, t, y):
-    f = a_matrix @ y
-    f[2] += force_over_m1 * math.cos(omega * t + phase)
-    return f
+def _field(a_matrix, load, static, omega, t, y, held, velw, kickw, masses, simple, out):
+    """The vector field at (t, y): free (``held`` < 0), or held on stop ``held`` (its holding force subtracted)."""
+    n = y.size
+    phasor = complex(math.cos(omega * t), math.sin(omega * t))
+    for r in range(n):
+        acc = (load[r] * phasor).real + static[r]
+        for c in range(n):
+            acc += a_matrix[r, c] * y[c]
+        out[r] = acc
+    if held >= 0:
+        i = simple[held]
+        if i >= 0:
+            out[n // 2 + i] = 0.0
+            return
+        normal = 0.0
+        for r in range(n):
+            normal += velw[held, r] * out[r]
+        for r in range(n):
+            out[r] -= masses[held] * kickw[held, r] * normal
+
+
+@njit(cache=True, error_model="numpy")
+def _saltation(jump, a_matrix, load, static, omega, t, before, after, velocity, held_before, held_after, stop, gapw, velw, kickw, masses, simple, out):
+    """Saltation matrix of an impact on ``stop`` at time t from ``before`` (at the contact, approach ``velocity``) to
+    ``after``, with the impact's velocity map ``jump``: S = D + (f+ - D f-) (grad g)^T / v."""
+    n = before.size
+    out[:, :] = jump
+    if velocity <= 0.0:
+        if held_after < 0:
+            out[:, :] = math.nan  # a grazing touch: the map is not differentiable here
+        return  # touch and stick: the gap and its velocity are held from here on (``jump`` holds both)
+    f_before = np.empty(n)
+    f_after = np.empty(n)
+    _field(a_matrix, load, static, omega, t, before, held_before, velw, kickw, masses, simple, f_before)
+    _field(a_matrix, load, static, omega, t, after, held_after, velw, kickw, masses, simple, f_after)
+    for r in range(n):
+        acc = 0.0
+        for c in range(n):
+            acc += jump[r, c] * f_before[c]
+        difference = (f_after[r] - acc) / velocity
+        for c in range(n):
+            if gapw[stop, c] != 0.0:
+                out[r, c] += difference * gapw[stop, c]
 
 
 @njit(cache=True, error_model="numpy")
@@ -282,237 +374,297 @@ def _grow(array, rows):
 
 
 @njit(cache=True, error_model="numpy")
-def _closest_approach(lam, amp, har, con, omega, t0, ta, tb, fastest, best):
+def _closest_approach(lam, amp, har, con, p1, p2, omega, t0, ta, tb, fastest, best, stop):
     """Largest interior local maximum of h on (ta, tb) (h' from + to -), if above best[0]: stored in best."""
     chunks = max(2, int(math.ceil(fastest * (tb - ta) / 0.5)))
     d = np.empty(3)
     t_prev = ta
-    _derivatives(lam, amp, har, con, omega, t0, ta, d)
+    _derivatives(lam, amp, har, con, p1, p2, omega, t0, ta, d)
     slope_prev = d[1]
     for c in range(1, chunks + 1):
         t = ta + (tb - ta) * c / chunks
-        _derivatives(lam, amp, har, con, omega, t0, t, d)
+        _derivatives(lam, amp, har, con, p1, p2, omega, t0, t, d)
         if slope_prev > 0.0 and d[1] < 0.0:
             lo, hi = t_prev, t
             for _ in range(200):  # bisection on h' (sign + at lo, - at hi)
                 mid = 0.5 * (lo + hi)
                 if mid <= lo or mid >= hi:
                     break
-                _derivatives(lam, amp, har, con, omega, t0, mid, d)
+                _derivatives(lam, amp, har, con, p1, p2, omega, t0, mid, d)
                 if d[1] > 0.0:
                     lo = mid
                 else:
                     hi = mid
-            _derivatives(lam, amp, har, con, omega, t0, lo, d)
+            _derivatives(lam, amp, har, con, p1, p2, omega, t0, lo, d)
             if lo > ta and lo < tb and d[0] > best[0]:
-                best[0], best[1] = d[0], lo
-            _derivatives(lam, amp, har, con, omega, t0, t, d)
+                best[0], best[1], best[2] = d[0], lo, stop
+            _derivatives(lam, amp, har, con, p1, p2, omega, t0, t, d)
         slope_prev, t_prev = d[1], t
 
 
 @njit(cache=True, error_model="numpy")
+def _gap(gapw, clearances, stop, y):
+    """h = n . x - Delta of ``stop`` (>= 0: at or beyond it)."""
+    acc = -clearances[stop]
+    for r in range(y.size):
+        acc += gapw[stop, r] * y[r]
+    return acc
+
+
+@njit(cache=True, error_model="numpy")
+def _snap(gapw, clearances, simple, signs, stop, y):
+    """Put the position on stop ``stop``'s surface (exactly, for a stop that moves one coordinate)."""
+    i = simple[stop]
+    if i >= 0:
+        y[i] = signs[stop] * clearances[stop]
+        return
+    excess = _gap(gapw, clearances, stop, y)
+    norm = 0.0
+    for r in range(y.size):
+        norm += gapw[stop, r] * gapw[stop, r]
+    for r in range(y.size):
+        y[r] -= excess * gapw[stop, r] / norm
+
+
+@njit(cache=True, error_model="numpy")
+def _pushed(stop, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hold_w, hold_off, hold_har, force_tolerance, omega, t, y):
+    """Would stop ``stop`` have to push to hold the structure at rest on it at (t, y) (holding force > 0, or = 0 and
+    rising)?"""
+    f = stop + 1
+    m = counts[f]
+    n = y.size
+    lam, vec, hrm, cst, poly = lams[f, :m], vecs[f, :, :m], hrms[f], csts[f], polys[f]
+    modal = np.empty(m, dtype=np.complex128)
+    amp = np.empty(m, dtype=np.complex128)
+    z0, q1, q2 = np.zeros(n), np.zeros(n), np.zeros(n)
+    _modal(lam, invs[f, :m, :], hrm, cst, omega, t, y, modal)
+    if poly:
+        _rigid(zpros[f], znils[f], zdrvs[f], zdrv2s[f], hrm, cst, omega, t, y, z0, q1, q2)
+    har, con, p1, p2 = _observable(hold_w[stop], hold_off[stop], hold_har[stop], vec, hrm, cst, modal, amp, poly, z0, q1, q2)
+    value = _value(lam, amp, har, con, p1, p2, omega, t, t)
+    if abs(value) > 64.0 * force_tolerance:
+        return value < 0.0
+    return _escape_step(lam, amp, har, con, p1, p2, omega, t, t) >= 0.0
+
+
+@njit(cache=True, error_model="numpy")
 def run_periods(
-    lam, vec, inv, hrm, cst,  # free flow
-    slam, svec, sinv, shrm, scst,  # stuck flow of (X1, X1')
-    a_matrix, force_over_m1, phase, omega, period,
-    clearance, restitution, m2, k2, b2,
-    sticking_velocity, max_impacts, tolerance, force_tolerance, resolution_velocity,
+    lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
+    a_matrix, load, static, omega, period,
+    gapw, velw, kickw, clearances, restitutions, masses, simple, signs,
+    hold_w, hold_off, hold_har, force_tolerances, bounce, stick, touch,
+    sticking_velocity, max_impacts, tolerance, resolution_velocity, gl_nodes, gl_weights,
     y_start, t_start, periods, want_moments, want_jacobians, want_approach,
 ):  # fmt: skip
     """Integrate ``periods`` periods from (t_start, y_start); see :class:`vibroimpact.engines.exact.ExactEngine`.
 
-    Returns (status, t_fail, strobes, jacobians, impacts (m, 3): time, speed, impulse, segments (s, 2): start, mode,
-    segment_states (s, 4), moments (periods, 5), counters [steps, events, sticks, releases, touches],
-    approach [value, time]).
+    Returns (status, t_fail, strobes (periods + 1, n), jacobians (periods, n, n), impacts (m, 4): time, speed,
+    impulse, stop, segments (s, 3): start, mode, stop, segment_states (s, n), moments (periods, 2 N + K),
+    counters [steps, events, sticks, releases, touches], approach [value, time, stop]); status
+    :data:`STATUS_TWO_STICKS` stops the run where the structure would stick on two stops at once (t_fail, and
+    approach[2] the other stop, counters[4] the first).
     """
-    n_strobes = periods + 1
-    strobes = np.empty((n_strobes, 4))
-    jacobians = np.empty((periods if want_jacobians else 0, 4, 4))
-    moments = np.zeros((periods if want_moments else 0, 5), dtype=np.complex128)
-    impacts = np.empty((max(4, 2 * periods), 3))
-    segments = np.empty((max(4, 2 * periods), 2))
-    segment_states = np.empty((max(4, 2 * periods), 4))
+    n = y_start.size
+    size = n // 2
+    stops = clearances.size
+    width = 2 * size + stops
+    strobes = np.empty((periods + 1, n))
+    jacobians = np.empty((periods if want_jacobians else 0, n, n))
+    moments = np.zeros((periods if want_moments else 0, width), dtype=np.complex128)
+    impacts = np.empty((max(4, 2 * periods), 4))
+    segments = np.empty((max(4, 2 * periods), 3))
+    segment_states = np.empty((max(4, 2 * periods), n))
     counters = np.zeros(5, dtype=np.int64)
-    approach = np.array([-math.inf, math.nan])
+    approach = np.array([-math.inf, math.nan, -1.0])
     n_impacts = 0
     n_segments = 0
-    gap_w = np.array([0.0, 1.0, 0.0, 0.0])
-    hold_w = np.array([-k2, -b2])
-    fastest = omega
-    for i in range(lam.size):
-        fastest = max(fastest, abs(lam[i]) + omega)
+    mmax = lams.shape[1]
+    hmax = hlams.shape[1]
     y = y_start.copy()
-    y[1] = min(y[1], clearance)
+    for j in range(stops):  # round-off beyond a stop is the stop
+        if _gap(gapw, clearances, j, y) > 0.0:
+            _snap(gapw, clearances, simple, signs, j, y)
     t = t_start
-    jac = np.eye(4)
-    # is the start stuck (at rest on the stop and pushed)?
-    stuck = False
-    if y[1] == clearance and y[3] == 0.0:
-        stuck = _pushed(slam, svec, sinv, shrm, scst, omega, hold_w, k2 * clearance, force_tolerance, t, y)
-    # at the stop to round-off (a strobe just after an impact may land a few 1e-19 m below it): the first search
-    # starts by leaving the surface, or finds the contact at once if the absorber moves into the stop
-    leaving = y[1] >= clearance - tolerance
+    jac = np.eye(n)
+    # is the start held (at rest on a stop that pushes)?
+    stuck = -1
+    for j in range(stops):
+        speed = 0.0
+        for r in range(n):
+            speed += velw[j, r] * y[r]
+        if _gap(gapw, clearances, j, y) >= -tolerance and abs(speed) <= resolution_velocity:
+            if _pushed(j, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hold_w, hold_off, hold_har, force_tolerances[j], omega, t, y):
+                if stuck >= 0:
+                    counters[4], approach[2] = stuck, j
+                    return STATUS_TWO_STICKS, t, strobes[:0], jacobians[:0], impacts[:0], segments[:0], segment_states[:0], moments[:0], counters, approach
+                stuck = j
     origin = t
     strobes[0] = y
     k = 1
     fresh = True
-    impacts_period = 0
+    impacts_period = np.zeros(stops, dtype=np.int64)
     events_period = 0
-    events_at = t if leaving else math.nan
-    modal = np.empty(4, dtype=np.complex128)
-    amp = np.empty(4, dtype=np.complex128)
-    smodal = np.empty(2, dtype=np.complex128)
-    samp = np.empty(2, dtype=np.complex128)
-    hlam, hslam = _half_rates(lam), _half_rates(slam)  # the observables' rates: one of each conjugate pair
-    hamp, hsamp = np.empty(hlam.size, dtype=np.complex128), np.empty(hslam.size, dtype=np.complex128)
-    free_rates, stuck_rates = _moment_rates(lam, omega), _moment_rates(slam, omega)  # the closed-form moments' exponents
-    m = lam.size + 2
-    buffers = (np.empty(m, dtype=np.complex128), np.empty((m, m), dtype=np.complex128), np.empty(m, dtype=np.complex128), np.empty(m + 1, dtype=np.complex128), np.empty(m, dtype=np.complex128), np.empty(m, dtype=np.complex128))
-    weights = (np.array([1.0, 0.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0, 0.0]), np.array([1.0, 0.0]), np.array([k2, b2]))  # X1, X2; stuck X1, holding force
-    work = np.empty((4, 4))
-    har = 0j
-    con = 0.0
+    leave = np.zeros(stops, dtype=np.bool_)
+    events_at = np.full(stops, math.nan)
+    modal = np.empty(mmax, dtype=np.complex128)
+    amp = np.empty(mmax, dtype=np.complex128)
+    hamps = np.empty((stops, hmax), dtype=np.complex128)
+    hars = np.empty(stops, dtype=np.complex128)
+    cons = np.empty(stops)
+    p1s = np.empty(stops)
+    p2s = np.empty(stops)
+    z0, q1, q2 = np.zeros(n), np.zeros(n), np.zeros(n)
+    mm = mmax + 2
+    buffers = (np.empty(mm, dtype=np.complex128), np.empty((mm, mm), dtype=np.complex128), np.empty(mm, dtype=np.complex128), np.empty(mm + 1, dtype=np.complex128), np.empty(mm, dtype=np.complex128), np.empty(mm, dtype=np.complex128))
+    work = np.empty((n, n))
+    phi = np.empty((n, n))
+    salt = np.empty((n, n))
+    before = np.empty(n)
+    ybuf = np.empty(n)
+    ynew = np.empty(n)
     t_piece = t
-    ynew = np.empty(4)
-    y2 = np.empty(2)
+    f = 0
+    m = 0
+    hm = 0
+    poly = False
+    lam = lams[0, :0]
+    vec = vecs[0, :, :0]
+    hrm = hrms[0]
+    cst = csts[0]
+    hl = hlams[0, :0]
     while k <= periods:
         boundary = origin + k * period
         if fresh:
             t_piece = t
-            if stuck:
-                y2[0], y2[1] = y[0], y[2]
-                _modal(slam, svec, sinv, shrm, scst, omega, t, y2, smodal)
-                har, con = _observable(hold_w, k2 * clearance, svec, shrm, scst, smodal, samp)
-                _halve(slam, samp, hsamp)
-            else:
-                _modal(lam, vec, inv, hrm, cst, omega, t, y, modal)
-                har, con = _observable(gap_w, -clearance, vec, hrm, cst, modal, amp)
-                _halve(lam, amp, hamp)
+            f = stuck + 1
+            m = counts[f]
+            hm = hcounts[f]
+            lam, vec, hrm, cst, poly, hl = lams[f, :m], vecs[f, :, :m], hrms[f], csts[f], polys[f], hlams[f, :hm]
+            _modal(lam, invs[f, :m, :], hrm, cst, omega, t, y, modal[:m])
+            if poly:
+                _rigid(zpros[f], znils[f], zdrvs[f], zdrv2s[f], hrm, cst, omega, t, y, z0, q1, q2)
+            for j in range(stops):
+                if j == stuck:
+                    har, con, p1, p2 = _observable(hold_w[j], hold_off[j], hold_har[j], vec, hrm, cst, modal[:m], amp[:m], poly, z0, q1, q2)
+                    leave[j] = True  # a fresh stick's holding force starts by leaving zero (or the start is held)
+                else:
+                    har, con, p1, p2 = _observable(gapw[j], -clearances[j], 0j, vec, hrm, cst, modal[:m], amp[:m], poly, z0, q1, q2)
+                    leave[j] = _gap(gapw, clearances, j, y) >= -tolerance  # at the surface: the search starts by leaving it
+                hars[j], cons[j], p1s[j], p2s[j] = har, con, p1, p2
+                _halve(lam, amp[:m], hamps[j, :hm])
+                if leave[j]:
+                    events_at[j] = t
             if n_segments == segments.shape[0]:
                 segments = _grow(segments, n_segments + 1)
                 segment_states = _grow(segment_states, n_segments + 1)
-            segments[n_segments, 0], segments[n_segments, 1] = t, 1.0 if stuck else 0.0
+            segments[n_segments, 0], segments[n_segments, 1], segments[n_segments, 2] = t, 1.0 if stuck >= 0 else 0.0, stuck
             segment_states[n_segments] = y
             n_segments += 1
             fresh = False  # the piece lasts until the next event, across period boundaries
         counters[0] += 1
-        if stuck:
-            t_event = _first_crossing(hslam, hsamp, har, con, omega, t_piece, t, boundary, force_tolerance, leaving)
-        else:
-            t_event = _first_crossing(hlam, hamp, har, con, omega, t_piece, t, boundary, tolerance, leaving)
-        leaving = False
-        t_end = boundary if math.isnan(t_event) else t_event
+        t_event = math.nan
+        event = -1
+        limit = boundary
+        for j in range(stops):
+            found = _first_crossing(hl, hamps[j, :hm], hars[j], cons[j], p1s[j], p2s[j], omega, t_piece, t, limit, force_tolerances[j] if j == stuck else tolerance, leave[j])
+            leave[j] = False
+            if not math.isnan(found) and (event < 0 or found < t_event):
+                t_event, event, limit = found, j, found
+        t_end = boundary if event < 0 else t_event
         # moments, closest approach and the transition matrix of [t, t_end]
         if t_end > t:
             if want_moments:
-                _add_moments(
-                    moments, k - 1, stuck, lam, vec, hrm, cst, slam, svec, shrm, scst, omega, t_piece, smodal if stuck else modal,
-                    t, t_end, clearance, k2, b2, free_rates, stuck_rates, buffers, weights,
-                )  # fmt: skip
-            if want_approach and not stuck:
-                _closest_approach(hlam, hamp, har, con, omega, t_piece, t, t_end, fastest, approach)
-            if want_jacobians:
-                if stuck:
-                    phi2 = _transition(slam, svec, sinv, t_end - t)
-                    phi = np.zeros((4, 4))
-                    phi[0, 0], phi[0, 2], phi[2, 0], phi[2, 2] = phi2[0, 0], phi2[0, 1], phi2[1, 0], phi2[1, 1]
+                if poly:
+                    _add_moments_gl(moments[k - 1], stuck, lam, vec, hrm, cst, modal[:m], omega, t_piece, t, t_end, fastests[f], gl_nodes, gl_weights, hold_w, hold_off, hold_har, size, stops, z0, q1, q2, ybuf)
                 else:
-                    phi = _transition(lam, vec, inv, t_end - t)
+                    _add_moments(moments[k - 1], stuck, lam, vec, hrm, cst, modal[:m], omega, t_piece, t, t_end, rates_all[f, : m + 2], rinv_all[f, : m + 3, : m + 2], buffers, hold_w, hold_off, hold_har, size, stops)
+            if want_approach:
+                for j in range(stops):
+                    if j != stuck:
+                        _closest_approach(hl, hamps[j, :hm], hars[j], cons[j], p1s[j], p2s[j], omega, t_piece, t, t_end, fastests[f], approach, j)
+            if want_jacobians:
+                _transition(lam, vec, invs[f, :m, :], t_end - t, poly, zpros[f], znils[f], phi)
                 _left_multiply(phi, jac, work)
-        if stuck:
-            _state(slam, svec, shrm, scst, omega, t_piece, smodal, t_end, y2)
-            ynew[0], ynew[1], ynew[2], ynew[3] = y2[0], clearance, y2[1], 0.0
-        else:
-            _state(lam, vec, hrm, cst, omega, t_piece, modal, t_end, ynew)
-            ynew[1] = min(ynew[1], clearance)
+        _state(lam, vec, hrm, cst, omega, t_piece, modal[:m], t_end, ynew, poly, z0, q1, q2)
+        for j in range(stops):
+            if j != stuck and _gap(gapw, clearances, j, ynew) > 0.0:
+                _snap(gapw, clearances, simple, signs, j, ynew)  # round-off beyond a stop is the stop
         y[:] = ynew
         t = t_end
-        if math.isnan(t_event):
-            leaving = t_end - events_at <= 1e-9 * period
+        if event < 0:
+            for j in range(stops):
+                leave[j] = t_end - events_at[j] <= 1e-9 * period
             strobes[k] = y
             if want_jacobians:
                 jacobians[k - 1] = jac
                 jac[:, :] = 0.0
-                for r in range(4):
+                for r in range(n):
                     jac[r, r] = 1.0
             k += 1
-            impacts_period = 0
+            impacts_period[:] = 0
             events_period = 0
             continue
         events_period += 1
-        events_at = t
         if events_period > 10 * max_impacts:
             return STATUS_NO_PROGRESS, t, strobes, jacobians, impacts[:n_impacts], segments[:n_segments], segment_states[:n_segments], moments, counters, approach
-        if stuck:
-            counters[3] += 1
-            stuck = False  # release: continuous state and vector field, saltation = identity
-        else:
-            impacts_period += 1
-            counters[1] += 1
-            y[1] = clearance
-            velocity = y[3] if y[3] > resolution_velocity else 0.0
-            chatters = velocity <= sticking_velocity or impacts_period > max_impacts or restitution == 0.0
-            sticks = False
-            if chatters:
-                sticks = _pushed(slam, svec, sinv, shrm, scst, omega, hold_w, k2 * clearance, force_tolerance, t, y)
-            after = 0.0 if sticks else -restitution * velocity
-            if want_jacobians:
-                _left_multiply(_saltation(a_matrix, force_over_m1, phase, omega, t, y, after, restitution, sticks, velocity), jac, work)
-            impulse = m2 * (velocity - after)
-            if velocity > 0.0:
-                if n_impacts == impacts.shape[0]:
-                    impacts = _grow(impacts, n_impacts + 1)
-                impacts[n_impacts, 0], impacts[n_impacts, 1], impacts[n_impacts, 2] = t, velocity, impulse
-                n_impacts += 1
-                if want_moments:
-                    moments[k - 1, 2] += impulse * complex(math.cos(omega * t), -math.sin(omega * t))
-            else:
-                counters[4] += 1
-            counters[2] += 1 if sticks else 0
-            y[3] = after
-            stuck = sticks
         fresh = True
-        leaving = True
-        continue
-    return STATUS_OK, t, strobes, jacobians, impacts[:n_impacts], segments[:n_segments], segment_states[:n_segments], moments, counters, approach
-
-
-@njit(cache=True, error_model="numpy")
-def _pushed(slam, svec, sinv, shrm, scst, omega, hold_w, hold_offset, force_tolerance, t, y):
-    """Would the stop have to push to hold the absorber at rest at (t, y) (holding force > 0, or = 0 and rising)?"""
-    y2 = np.array([y[0], y[2]])
-    modal = np.empty(2, dtype=np.complex128)
-    amp = np.empty(2, dtype=np.complex128)
-    _modal(slam, svec, sinv, shrm, scst, omega, t, y2, modal)
-    har, con = _observable(hold_w, hold_offset, svec, shrm, scst, modal, amp)
-    value = _value(slam, amp, har, con, omega, t, t)
-    if abs(value) > 64.0 * force_tolerance:
-        return value < 0.0
-    return _escape_step(slam, amp, har, con, omega, t, t) >= 0.0
-
-
-@njit(cache=True, error_model="numpy")
-def _saltation(a_matrix, force_over_m1, phase, omega, t, y_contact, after, restitution, sticks, velocity):
-    """Saltation matrix of an impact at time t, at ``y_contact`` (X2 = Delta), from X2' = velocity to ``after``."""
-    salt = np.eye(4)
-    salt[3, 3] = 0.0 if sticks else -restitution
-    if velocity <= 0.0:
-        if not sticks:
-            salt[:, :] = math.nan  # a grazing touch: the map is not differentiable here
+        if event == stuck:
+            counters[3] += 1
+            stuck = -1  # release: continuous state and vector field, saltation = identity
+            continue
+        # an impact on stop ``event`` (from free flight, or while held on another stop, which it frees)
+        held_before = stuck
+        if stuck >= 0:
+            counters[3] += 1
+            stuck = -1
+        j = event
+        impacts_period[j] += 1
+        counters[1] += 1
+        _snap(gapw, clearances, simple, signs, j, y)
+        raw = 0.0
+        for r in range(n):
+            raw += velw[j, r] * y[r]
+        velocity = raw if raw > resolution_velocity else 0.0
+        chatters = velocity <= sticking_velocity or impacts_period[j] > max_impacts or restitutions[j] == 0.0
+        sticks = False
+        if chatters:
+            sticks = _pushed(j, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hold_w, hold_off, hold_har, force_tolerances[j], omega, t, y)
+        if sticks:
+            for other in range(stops):
+                if other != j and _gap(gapw, clearances, other, y) >= -tolerance:
+                    if _pushed(other, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hold_w, hold_off, hold_har, force_tolerances[other], omega, t, y):
+                        counters[4], approach[2] = j, other
+                        return STATUS_TWO_STICKS, t, strobes, jacobians, impacts[:n_impacts], segments[:n_segments], segment_states[:n_segments], moments, counters, approach
+        after = 0.0 if sticks else -restitutions[j] * velocity
+        if want_jacobians:
+            before[:] = y
+        i = simple[j]
+        if i >= 0:
+            y[size + i] = signs[j] * after
         else:
-            salt[1, 1] = 0.0  # touch and stick: X2 and X2' are held from here on
-        return salt
-    before = y_contact.copy()
-    before[3] = velocity
-    y_after = y_contact.copy()
-    y_after[3] = after
-    f_before = _free_field(a_matrix, force_over_m1, omega, phase, t, before)
-    f_after = _free_field(a_matrix, force_over_m1, omega, phase, t, y_after)
-    if sticks:
-        f_after[3] = 0.0  # the stuck field: X2' stays 0
-    for r in range(4):  # S = D + (f+ - D f-) e2^T / X2'(t-), D = diag(salt) before this loop changes column 1
-        salt[r, 1] += (f_after[r] - salt[r, r] * f_before[r]) / f_before[1]
-    return salt
+            change = (after - raw) * masses[j]
+            for r in range(n):
+                y[r] += change * kickw[j, r]
+        if want_jacobians:
+            if sticks:
+                jump = stick[j] if velocity > 0.0 else touch[j]
+            else:
+                jump = bounce[j]
+            _saltation(jump, a_matrix, load, static, omega, t, before, y, velocity, held_before, j if sticks else -1, j, gapw, velw, kickw, masses, simple, salt)
+            _left_multiply(salt, jac, work)
+        impulse = masses[j] * (velocity - after)
+        if velocity > 0.0:
+            if n_impacts == impacts.shape[0]:
+                impacts = _grow(impacts, n_impacts + 1)
+            impacts[n_impacts, 0], impacts[n_impacts, 1], impacts[n_impacts, 2], impacts[n_impacts, 3] = t, velocity, impulse, j
+            n_impacts += 1
+            if want_moments:
+                moments[k - 1, size + j] += impulse * complex(math.cos(omega * t), -math.sin(omega * t))
+        else:
+            counters[4] += 1
+        counters[2] += 1 if sticks else 0
+        stuck = j if sticks else -1
+    return STATUS_OK, t, strobes, jacobians, impacts[:n_impacts], segments[:n_segments], segment_states[:n_segments], moments, counters, approach
 
 
 @njit(cache=True, error_model="numpy")
@@ -526,10 +678,10 @@ def _series(z):
 
 
 @njit(cache=True, error_model="numpy")
-def _moment_rates(lam, omega):
+def moment_rates(lam, omega):
     """The exponents of a piece's components (the eigenvalues, then +-jw for the two halves of the harmonic term) and
-    the reciprocals the closed-form integrals divide by: of each rate, of each pairwise sum, of each rate - jw (0 where
-    the sum vanishes: that integral is then taken by its series)."""
+    the reciprocals the closed-form integrals divide by: of each pairwise sum, of each rate - jw (0 where the sum
+    vanishes: that integral is then taken by its series). Called once per flow when the engine prepares a problem."""
     m = lam.size + 2
     rates = np.empty(m, dtype=np.complex128)
     rates[: lam.size] = lam
@@ -545,18 +697,29 @@ def _moment_rates(lam, omega):
 
 
 @njit(cache=True, error_model="numpy")
-def _amplitudes(lam, vec, hrm, modal, omega, t0, weights, amps):
-    """weights . y of the piece as sum_k amps_k e^{rates_k (t - t0)} plus a constant: the modal terms (their sum is
-    real) and the harmonic Re(Y e^{jwt}) as two conjugate halves."""
+def _amplitudes(lam, vec, hrm, modal, omega, t0, row, amps):
+    """Coordinate ``row`` of the piece as sum_k amps_k e^{rates_k (t - t0)} plus a constant: the modal terms (their
+    sum is real) and the harmonic Re(Y e^{jwt}) as two conjugate halves."""
     n = lam.size
-    harmonic = 0j
+    for i in range(n):
+        amps[i] = vec[row, i] * modal[i]
+    harmonic = hrm[row] * complex(math.cos(omega * t0), math.sin(omega * t0))
+    amps[n], amps[n + 1] = 0.5 * harmonic, 0.5 * np.conj(harmonic)
+
+
+@njit(cache=True, error_model="numpy")
+def _weighted_amplitudes(lam, vec, hrm, modal, omega, t0, weights, extra, amps):
+    """As :func:`_amplitudes` for minus the observable weights . y + Re(extra e^{jwt}) (the holding force)."""
+    n = lam.size
+    harmonic = extra
+    for r in range(weights.size):
+        harmonic += weights[r] * hrm[r]
     for i in range(n):
         acc = 0j
-        for r in range(n):
+        for r in range(weights.size):
             acc += weights[r] * vec[r, i]
-        amps[i] = acc * modal[i]
-        harmonic += weights[i] * hrm[i]
-    harmonic *= complex(math.cos(omega * t0), math.sin(omega * t0))
+        amps[i] = -acc * modal[i]
+    harmonic *= -complex(math.cos(omega * t0), math.sin(omega * t0))
     amps[n], amps[n + 1] = 0.5 * harmonic, 0.5 * np.conj(harmonic)
 
 
@@ -607,24 +770,46 @@ def _integrals(amps, constant, length, pair, single, fourier, phasor, out, slot_
 
 
 @njit(cache=True, error_model="numpy")
-def _add_moments(moments, row, stuck, lam, vec, hrm, cst, slam, svec, shrm, scst, omega, t_piece, modal, ta, tb, clearance, k2, b2, free_rates, stuck_rates, buffers, weights):
-    """Add the piece's Fourier and square integrals over [ta, tb] to ``moments[row]``, in closed form (the motion is
-    a sum of exponentials): X1 and X2 times e^{-jwt}, the holding force times e^{-jwt} while stuck, X1^2 and X2^2."""
-    rates, inverse = stuck_rates if stuck else free_rates
+def _add_moments(out, stuck, lam, vec, hrm, cst, modal, omega, t_piece, ta, tb, rates, inverse, buffers, hold_w, hold_off, hold_har, size, stops):
+    """Add the piece's Fourier and square integrals over [ta, tb] to the period's row ``out``, in closed form (the
+    motion is a sum of exponentials): each coordinate times e^{-jwt}, the holding force times e^{-jwt} while held,
+    each coordinate squared."""
     m = rates.size
     amps, pair, single, fourier = buffers[0][:m], buffers[1][:m, :m], buffers[2][:m], buffers[3][: m + 1]
     a, length = ta - t_piece, tb - ta
     _piece_factors(rates, inverse, omega, a, length, pair, single, fourier, buffers[4][:m], buffers[5][:m])
     phasor = complex(math.cos(omega * t_piece), -math.sin(omega * t_piece))
-    out = moments[row]
-    if stuck:
-        _amplitudes(slam, svec, shrm, modal, omega, t_piece, weights[2], amps)
-        _integrals(amps, scst[0], length, pair, single, fourier, phasor, out, 0, 3)
-        _integrals(amps[:0], clearance, length, pair, single, fourier[m:], phasor, out, 1, 4)  # X2 = Delta
-        _amplitudes(slam, svec, shrm, modal, omega, t_piece, weights[3], amps)
-        _integrals(amps, k2 * (scst[0] - clearance) + b2 * scst[1], length, pair, single, fourier, phasor, out, 2, -1)
-        return
-    _amplitudes(lam, vec, hrm, modal, omega, t_piece, weights[0], amps)
-    _integrals(amps, cst[0], length, pair, single, fourier, phasor, out, 0, 3)
-    _amplitudes(lam, vec, hrm, modal, omega, t_piece, weights[1], amps)
-    _integrals(amps, cst[1], length, pair, single, fourier, phasor, out, 1, 4)
+    for i in range(size):
+        _amplitudes(lam, vec, hrm, modal, omega, t_piece, i, amps)
+        _integrals(amps, cst[i], length, pair, single, fourier, phasor, out, i, size + stops + i)
+    if stuck >= 0:
+        weights = hold_w[stuck]
+        _weighted_amplitudes(lam, vec, hrm, modal, omega, t_piece, weights, hold_har[stuck], amps)
+        constant = hold_off[stuck]
+        for r in range(weights.size):
+            constant += weights[r] * cst[r]
+        _integrals(amps, -constant, length, pair, single, fourier, phasor, out, size + stuck, -1)
+
+
+@njit(cache=True, error_model="numpy")
+def _add_moments_gl(out, stuck, lam, vec, hrm, cst, modal, omega, t_piece, ta, tb, fastest, nodes, weights, hold_w, hold_off, hold_har, size, stops, z0, q1, q2, y):
+    """As :func:`_add_moments` for a flow with rigid-body (polynomial) terms, by Gauss-Legendre quadrature on chunks
+    of at most 2 / (|lambda|max + w) [s]: exact for the polynomial parts (degree <= 4 in the squares), to round-off
+    for the exponentials."""
+    chunks = max(1, int(math.ceil(fastest * (tb - ta) / 2.0)))
+    for c in range(chunks):
+        a = ta + (tb - ta) * c / chunks
+        b = ta + (tb - ta) * (c + 1) / chunks
+        for q in range(nodes.size):
+            t = a + (b - a) * nodes[q]
+            w = (b - a) * weights[q]
+            _state(lam, vec, hrm, cst, omega, t_piece, modal, t, y, True, z0, q1, q2)
+            phasor = complex(math.cos(omega * t), -math.sin(omega * t))
+            for i in range(size):
+                out[i] += w * y[i] * phasor
+                out[size + stops + i] += w * y[i] * y[i]
+            if stuck >= 0:
+                force = hold_off[stuck] + (hold_har[stuck] * complex(math.cos(omega * t), math.sin(omega * t))).real
+                for r in range(y.size):
+                    force += hold_w[stuck, r] * y[r]
+                out[size + stuck] -= w * force * phasor

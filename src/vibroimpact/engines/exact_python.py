@@ -1,29 +1,32 @@
 """Engine ``exact_python``: the ``exact`` engine's algorithm in pure Python (the compiled core, :mod:`.exact_core`, is
 the same loop under numba; this copy cross-checks it and is the speed baseline of ``engine_cost``).
 
-Between events the motion is linear with harmonic forcing, so it is propagated in closed form (eigenvectors of the
-state matrix plus the harmonic particular solution, :mod:`.linear_flow`). Contacts are found by guaranteed root
-bracketing (:func:`.linear_flow.first_crossing`): no contact is missed however tangent, and contact times are exact
-to round-off. At a contact X2' -> -R X2'. When impacts accumulate (chattering, small R) and the stop pushes the
-absorber, it sticks: X2 = Delta, X2' = 0, only the primary mass moves, until the holding force
-B2 X1' + K2 (X1 - Delta) turns negative (found by the same root search).
+Between events the motion is linear with harmonic and constant loads, so it is propagated in closed form (the flows of
+:mod:`.exact_flows`: exponentials plus the harmonic particular solution, and a polynomial on rigid-body modes).
+Contacts with any of the stops are found by guaranteed root bracketing (:func:`.linear_flow.first_crossing`): no
+contact is missed however tangent, and contact times are exact to round-off. An impact on stop k restitutes n_k . x'
+by an impulse along M^-1 n_k (:meth:`.rigid_contact.RigidContact.kick`). When impacts accumulate (chattering, small R)
+and the stop pushes the structure, it sticks: the flow held on the stop's surface runs until the holding force
+(:meth:`~vibroimpact.model.problem.ImpactProblem.contact_holding`) turns negative (found by the same root search), or
+an impact on another stop frees it. Moments are integrated by Gauss-Legendre quadrature (the compiled core has them in
+closed form: an independent check).
 """
 
 from __future__ import annotations
 
 import math
+
 import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory, TrajectoryBuilder
+from vibroimpact.engines.exact_flows import ExactModel, build_model
 from vibroimpact.engines.linear_flow import HarmonicLinearFlow, Observable, Piece, escape_step, first_crossing, gauss_legendre
 from vibroimpact.engines.rigid_contact import RigidContact
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.problem import ImpactProblem
 
 __all__ = ["PythonExactEngine"]
-
-_GAP = np.array([0.0, 1.0, 0.0, 0.0])
 
 
 class PythonExactEngine:
@@ -35,21 +38,26 @@ class PythonExactEngine:
         self.settings = settings
 
     def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
-        """Integrate ``periods`` whole periods from ``state`` (X1, X2, X1', X2') at ``t_start`` [s]."""
+        """Integrate ``periods`` whole periods from ``state`` (x, x') at ``t_start`` [s]."""
         run = _Run(RigidContact(self.name, problem, self.settings, periods), problem, TrajectoryBuilder(problem, moments))
         return run.go(np.asarray(state, dtype=float), float(t_start), int(periods))
 
-    def dense(self, trajectory: Trajectory, times: NDArray[np.float64]) -> NDArray[np.float64]:
-        """States at arbitrary ``times`` inside a trajectory, shape (n, 4), exact (from its segments)."""
-        run = _Run(RigidContact(self.name, trajectory.problem, self.settings, 0), trajectory.problem, TrajectoryBuilder(trajectory.problem, False))
+    def dense(self, trajectory: Trajectory, times: NDArray[np.float64], side: str = "right") -> NDArray[np.float64]:
+        """States at arbitrary ``times`` inside a trajectory, shape (n, 2 N), exact (from its segments); at an event's
+        time ``side="right"`` gives the state after it, ``"left"`` the state before it."""
+        if side not in ("left", "right"):
+            raise ValueError(f"side = {side!r} is not allowed: use 'left' or 'right'")
+        problem = trajectory.problem
+        run = _Run(RigidContact(self.name, problem, self.settings, 0), problem, TrajectoryBuilder(problem, False))
         times = np.asarray(times, dtype=float)
-        index = np.clip(np.searchsorted(trajectory.segments[:, 0], times, side="right") - 1, 0, len(trajectory.segments) - 1)
-        out = np.empty((times.size, 4))
+        index = np.clip(np.searchsorted(trajectory.segments[:, 0], times, side=side) - 1, 0, len(trajectory.segments) - 1)  # type: ignore[call-overload]
+        out = np.empty((times.size, 2 * problem.size))
         for i in np.unique(index):
             start, _end, mode = trajectory.segments[i]
-            piece, _watch = run._piece(start, trajectory.segment_states[i], mode == MODE_STUCK)
+            held = int(trajectory.segment_stops[i]) if mode == MODE_STUCK else -1
+            piece = run.flows[held + 1].start(start, trajectory.segment_states[i])
             chosen = index == i
-            out[chosen] = [run._state(piece, t, mode == MODE_STUCK) for t in times[chosen]]
+            out[chosen] = [run._state(piece, t, held) for t in times[chosen]]
         return out
 
 
@@ -59,115 +67,163 @@ class _Run:
     def __init__(self, law: RigidContact, problem: ImpactProblem, builder: TrajectoryBuilder) -> None:
         self.law, self.problem, self.rec = law, problem, builder
         self.steps = self.events = 0
-        s = problem.system
-        self.free = HarmonicLinearFlow(s.state_matrix, np.array([0, 0, problem.amplitude * np.exp(1j * problem.phase) / s.m1, 0]), np.zeros(4), problem.omega)
-        stuck_matrix = np.array([[0.0, 1.0], [-(s.k1 + s.k2) / s.m1, -(s.b1 + s.b2) / s.m1]])
-        self.stuck = HarmonicLinearFlow(
-            stuck_matrix, np.array([0, problem.amplitude * np.exp(1j * problem.phase) / s.m1]), np.array([0.0, s.k2 * problem.clearance / s.m1]), problem.omega
-        )
         self.length_scale = law.length_scale
+        self.model: ExactModel = build_model(problem, self.length_scale)
+        self.flows = [HarmonicLinearFlow.from_flow(flow) for flow in (self.model.free, *self.model.stuck)]
+        self.size = problem.size
+        self.count = len(problem.stops)
+        zero = np.zeros((self.count, self.size))
+        self.gap_weights = np.hstack([self.model.normals, zero])
         self.tolerance = 1e-15 * self.length_scale
-        self.force_tolerance = 1e-15 * (s.k2 + s.b2 * problem.omega) * self.length_scale
-        self.resolution_velocity = 1e-14 * problem.velocity_scale()
+        self.resolution_velocity = 1e-14 * law.velocity_scale
 
     # ------------------------------------------------------------------ loop
     def go(self, y: NDArray[np.float64], t: float, periods: int) -> Trajectory:
-        p, rec = self.problem, self.rec
+        p, rec, count = self.problem, self.rec, self.count
         y = y.copy()
+        if y.shape != (2 * self.size,):
+            raise ValueError(f"state: expected {2 * self.size} values (x and x' of {self.size} coordinates), got shape {y.shape}")
         self.law.check_start(y)
-        y[1] = min(y[1], p.clearance)  # round-off above the stop is the stop
-        stuck = bool(y[1] == p.clearance and y[3] == 0.0 and self._pushed(t, y))
-        leaving = y[1] == p.clearance
+        self._clamp(y, -1)  # round-off beyond a stop is the stop
+        held = -1
+        for k in range(count):
+            if self._gap(k, y) >= -self.tolerance and abs(self.law.approach(y)[k]) <= self.resolution_velocity and self._pushed(k, t, y):
+                if held >= 0:
+                    raise NotImplementedError(f"the start would stick on two stops at once (stops {held} and {k}); the exact engine holds one stop at a time")
+                held = k
         origin = t
         rec.strobe(t, y)
-        k, piece, impacts_this_period, events_this_period = 1, None, 0, 0
-        events_at = t if leaving else math.nan  # time of the last event: a search starting there leaves the surface
+        k, piece, events_this_period = 1, None, 0
+        impacts_this_period = np.zeros(count, dtype=int)
+        leave = np.zeros(count, dtype=bool)
+        events_at = np.full(count, math.nan)  # time of each observable's last event: a search starting there leaves it
+        watch: list[Observable] = []
         while k <= periods:
             boundary = origin + k * p.period
             fresh = piece is None
             if piece is None:  # a new closed-form piece after each event
-                piece, watch = self._piece(t, y, stuck)
+                piece = self.flows[held + 1].start(t, y)
+                watch = []
+                for j in range(count):
+                    watch.append(self._observable(piece, j, held))
+                    leave[j] = True if j == held else self._gap(j, y) >= -self.tolerance
+                    if leave[j]:
+                        events_at[j] = t
             self.steps += 1
-            tolerance = self.force_tolerance if stuck else self.tolerance
-            t_event = first_crossing(watch, t, boundary, tolerance, leaving=leaving)
-            leaving = False
+            t_event, event, limit = None, -1, boundary
+            for j in range(count):
+                tolerance = self.model.force_tolerances[j] if j == held else self.tolerance
+                found = first_crossing(watch[j], t, limit, tolerance, leaving=bool(leave[j]))
+                leave[j] = False
+                if found is not None and (t_event is None or found < t_event):
+                    t_event, event, limit = found, j, found
             t_end = boundary if t_event is None else t_event
             if fresh:
-                rec.segment(t, MODE_STUCK if stuck else MODE_FREE, y)
-            self._moments(piece, t, t_end, MODE_STUCK if stuck else MODE_FREE)
-            y, t = self._state(piece, t_end, stuck), t_end
+                rec.segment(t, MODE_STUCK if held >= 0 else MODE_FREE, y, stop=held)
+            self._moments(piece, t, t_end, held)
+            y, t = self._state(piece, t_end, held), t_end
             if t_event is None:  # period boundary: strobe, keep the piece
                 # a search cut short by the boundary right after an event there must still start by leaving the surface
-                leaving = t_end - events_at <= 1e-9 * p.period
+                leave = t_end - events_at <= 1e-9 * p.period
                 rec.strobe(t, y)
-                k, impacts_this_period, events_this_period = k + 1, 0, 0
+                k, events_this_period = k + 1, 0
+                impacts_this_period[:] = 0
                 continue
             events_this_period += 1
-            events_at = t
             if events_this_period > 10 * self.law.max_impacts:
                 raise RuntimeError(f"no progress at t = {t!r} s: {events_this_period} events in one period")
-            if stuck:
+            piece = None
+            if event == held:
                 rec.stats["releases"] += 1
-                stuck = False
-            else:
-                impacts_this_period += 1
-                stuck = self._contact(t, y, impacts_this_period)
-            piece, leaving = None, True  # leaving the stop, or the free flight into sticking
+                held = -1
+                continue
+            if held >= 0:  # an impact on another stop frees the held one
+                rec.stats["releases"] += 1
+                held = -1
+            impacts_this_period[event] += 1
+            held = self._contact(t, y, event, int(impacts_this_period[event]))
         return rec.build({"steps": self.steps, "events": self.events})
 
-    def _pushed(self, t: float, y: NDArray[np.float64]) -> bool:
-        """Would the stop have to push to hold the absorber at rest here (holding force > 0, or = 0 and rising)?"""
-        _piece, release = self._piece(t, y, stuck=True)  # release = -holding force
+    def _gap(self, k: int, y: NDArray[np.float64]) -> float:
+        """n_k . x - Delta_k (>= 0: at or beyond stop k)."""
+        return float(self.gap_weights[k] @ y - self.model.clearances[k])
+
+    def _clamp(self, y: NDArray[np.float64], held: int) -> None:
+        """Round-off beyond a stop (other than the held one) is the stop: in place."""
+        for k in range(self.count):
+            if k != held and self._gap(k, y) > 0.0:
+                self._snap(k, y)
+
+    def _snap(self, k: int, y: NDArray[np.float64]) -> None:
+        i = self.model.simple[k]
+        if i >= 0:
+            y[i] = self.model.normals[k, i] * self.model.clearances[k]
+            return
+        normal = self.model.normals[k]
+        y[: self.size] -= self._gap(k, y) * normal / float(normal @ normal)
+
+    def _observable(self, piece: Piece, k: int, held: int) -> Observable:
+        """What ends the piece at stop k: minus the holding force if held there, else minus its gap."""
+        m = self.model
+        if k == held:
+            return piece.observable(m.hold_weights[k], float(m.hold_offsets[k]), complex(m.hold_harmonics[k]))
+        return piece.observable(self.gap_weights[k], -float(m.clearances[k]))
+
+    def _pushed(self, k: int, t: float, y: NDArray[np.float64]) -> bool:
+        """Would stop k have to push to hold the structure at rest on it here (holding force > 0, or = 0 and rising)?"""
+        release = self._observable(self.flows[k + 1].start(t, y), k, k)  # minus the holding force
         value = release.derivatives(t, 1)[0]
         # a holding force of a few round-off units is zero: its sign is noise (the flow's particular solution can be
         # larger than the length scale when Delta = 0, so allow 64 units), and the derivatives decide
-        if abs(value) > 64.0 * self.force_tolerance:
+        if abs(value) > 64.0 * self.model.force_tolerances[k]:
             return value < 0.0
         return escape_step(release, t) is not None
 
-    def _piece(self, t: float, y: NDArray[np.float64], stuck: bool) -> tuple[Piece, Observable]:
-        """Closed-form motion from (t, y) and the function whose first zero ends it (gap, or holding force)."""
-        p = self.problem
-        if stuck:
-            piece = self.stuck.start(t, y[[0, 2]])
-            return piece, piece.observable(np.array([-p.system.k2, -p.system.b2]), p.system.k2 * p.clearance)
-        piece = self.free.start(t, y)
-        return piece, piece.observable(_GAP, -p.clearance)
-
-    def _state(self, piece: Piece, t: float, stuck: bool) -> NDArray[np.float64]:
-        if stuck:
-            x1, v1 = piece.state(t)
-            return np.array([x1, self.problem.clearance, v1, 0.0])
+    def _state(self, piece: Piece, t: float, held: int) -> NDArray[np.float64]:
         y = piece.state(t)
-        y[1] = min(y[1], self.problem.clearance)  # round-off above the stop is the stop
+        self._clamp(y, held)
         return y
 
-    def _contact(self, t: float, y: NDArray[np.float64], impacts_this_period: int) -> bool:
-        """Apply the contact at time t to ``y`` in place; return True if the absorber sticks."""
+    def _contact(self, t: float, y: NDArray[np.float64], k: int, impacts_this_period: int) -> int:
+        """Apply the contact with stop k at time t to ``y`` in place; return k if it sticks there, else -1."""
         self.events += 1
-        y[1] = self.problem.clearance
-        velocity = y[3] if y[3] > self.resolution_velocity else 0.0  # below round-off: a touch, not an impact
-        impact = self.law.collide(self.rec, t, velocity, impacts_this_period, lambda: self._pushed(t, y))
-        y[3] = impact.after
-        return impact.sticks
+        self._snap(k, y)
+        raw = float(self.law.approach(y)[k])
+        velocity = raw if raw > self.resolution_velocity else 0.0  # below round-off: a touch, not an impact
+        if self.count > 1:
+            others = [j for j in range(self.count) if j != k and self._gap(j, y) >= -self.tolerance]
+        impact = self.law.collide(self.rec, t, velocity, impacts_this_period, lambda: self._pushed(k, t, y), stop=k)
+        if impact.sticks and self.count > 1:
+            for j in others:
+                if self._pushed(j, t, y):
+                    raise NotImplementedError(f"at t = {t!r} s the structure would stick on two stops at once (stops {k} and {j}); the exact engine holds one stop at a time")
+        i = self.model.simple[k]
+        if i >= 0:
+            y[self.size + i] = self.model.normals[k, i] * impact.after
+        else:
+            y[:] = self.law.kick(y, k, (raw - impact.after) * self.model.masses[k])
+        return k if impact.sticks else -1
 
     # --------------------------------------------------------------- moments
-    def _moments(self, piece: Piece, t0: float, t1: float, mode: int) -> None:
+    def _moments(self, piece: Piece, t0: float, t1: float, held: int) -> None:
         """Add the segment's Fourier and square integrals (Gauss-Legendre, exact for smooth pieces)."""
         rec = self.rec
         if not rec.moments or t1 <= t0:
             return
-        p = self.problem
-        fastest = max(abs(x) for x in piece.flow.eigenvalues) + p.omega
+        p, size = self.problem, self.size
+        rates = piece.flow.eigenvalues
+        fastest = (float(np.max(np.abs(rates))) if rates.size else 0.0) + p.omega
         nodes, weights = gauss_legendre(int(min(400, 16 + math.ceil(0.8 * fastest * (t1 - t0)))))
         times = t0 + (t1 - t0) * nodes
         w = (t1 - t0) * weights
         phasor = np.exp(-1j * p.omega * times)
         states = piece.state(times)
-        if mode == MODE_FREE:
-            x1, x2 = states[:, 0], states[:, 1]
-            contact = np.zeros_like(x1)
-        else:
-            x1, x2 = states[:, 0], np.full(times.shape, p.clearance)
-            contact = np.asarray(p.holding_force(states[:, 0], states[:, 1]))
-        rec.add_moments(np.array([w @ (x1 * phasor), w @ (x2 * phasor), w @ (contact * phasor), w @ x1**2, w @ x2**2]))
+        x = states[:, :size]
+        values = np.zeros(2 * size + self.count, dtype=complex)
+        values[:size] = (w * phasor) @ x
+        values[size + self.count :] = w @ x**2
+        if held >= 0:
+            m = self.model
+            force = -(states @ m.hold_weights[held] + m.hold_offsets[held] + np.real(m.hold_harmonics[held] * np.exp(1j * p.omega * times)))
+            values[size + held] = w @ (force * phasor)
+        rec.add_moments(values)

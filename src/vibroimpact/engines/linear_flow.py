@@ -1,13 +1,15 @@
 """Exact flow of a harmonically forced linear system, and guaranteed first-root search of its observables.
 
-``y' = A y + Re(b exp(j w t)) + b0`` has the solution
+``y' = A y + Re(b exp(j w t)) + b0`` has the solution (:mod:`.exact_flows`)
 
-    y(t) = Re(Y exp(j w t)) + y_c + Re(V diag(exp(lambda (t - t0))) w0),   Y = (j w I - A)^-1 b,  y_c = -A^-1 b0
+    y(t) = Re(Y exp(j w t)) + y_c + Re(V diag(exp(lambda tau)) m) + z0 + q1 tau + q2 tau^2,   tau = t - t0,
 
-so any linear observable ``h = c.y + d`` is a sum of complex exponentials whose derivatives of every order and
-their bounds over [t, inf) are explicit (all Re(lambda) <= 0). :func:`first_crossing` uses a Taylor bound to step
-safely: from h(t) < 0 it jumps to the first s at which ``h + h' s + sup|h''| s^2 / 2`` could reach 0, so no root
-is ever skipped, and it converges quadratically onto the first root.
+with Y = (j w I - A)^-1 b, the exponentials on the nonzero eigenvalues and a polynomial of degree <= 2 on the
+rigid-body modes (the generalized null space of A), so any linear observable ``h = c.y + d`` is a sum of complex
+exponentials and a polynomial, whose derivatives of every order are explicit, and those of order >= 2 bounded over
+[t, inf) (all Re(lambda) <= 0). :func:`first_crossing` uses a Taylor bound to step safely: from h(t) < 0 it jumps to
+the first s at which ``h + h' s + sup|h''| s^2 / 2`` could reach 0, so no root is ever skipped, and it converges
+quadratically onto the first root.
 """
 
 from __future__ import annotations
@@ -20,6 +22,8 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
+from vibroimpact.engines.exact_flows import Flow, decompose
+
 __all__ = ["HarmonicLinearFlow", "Piece", "Observable", "first_crossing", "escape_step", "polish_step", "gauss_legendre"]
 
 
@@ -29,51 +33,68 @@ class HarmonicLinearFlow:
     Parameters
     ----------
     matrix : ndarray, shape (n, n)
-        A [s-1]; all eigenvalues must have Re <= 0 and be distinct.
+        A [s-1]: eigenvalues with Re <= 0, the nonzero ones non-defective; Jordan blocks at 0 of size <= 2 (rigid-body
+        modes, found from singular values).
     harmonic : ndarray of complex, shape (n,)
         b, complex amplitude of the harmonic forcing [state units s-1].
     constant : ndarray, shape (n,)
         b0, constant forcing [state units s-1].
     omega : float
         Forcing angular frequency [rad s-1].
+    flow : Flow, optional
+        A decomposition made already (:func:`.exact_flows.decompose`, or an engine's held flow); then the other
+        arguments are not used and may be None.
     """
 
-    def __init__(self, matrix: NDArray[np.float64], harmonic: NDArray[np.complex128], constant: NDArray[np.float64], omega: float) -> None:
-        self.matrix = np.asarray(matrix, dtype=float)
+    def __init__(
+        self, matrix: NDArray[np.float64] | None, harmonic: NDArray[np.complex128] | None, constant: NDArray[np.float64] | None, omega: float,
+        flow: Flow | None = None,
+    ) -> None:  # fmt: skip
         self.omega = float(omega)
-        n = self.matrix.shape[0]
-        self.eigenvalues, self.vectors = np.linalg.eig(self.matrix.astype(complex))
-        self.inverse_vectors = np.linalg.inv(self.vectors)
-        self.harmonic_response = np.linalg.solve(1j * self.omega * np.eye(n) - self.matrix, np.asarray(harmonic, dtype=complex))
-        b0 = np.asarray(constant, dtype=float)
-        self.constant_response = -np.linalg.solve(self.matrix, b0) if np.any(b0) else np.zeros(n)
+        if flow is None:
+            flow = decompose(np.asarray(matrix, dtype=float), np.asarray(harmonic, dtype=complex), np.asarray(constant, dtype=float), self.omega)
+        self.flow = flow
+        self.eigenvalues, self.vectors, self.inverse_vectors = flow.eigenvalues, flow.vectors, flow.inverse
+        self.harmonic_response, self.constant_response = flow.harmonic, flow.constant
+
+    @classmethod
+    def from_flow(cls, flow: Flow) -> "HarmonicLinearFlow":
+        """The flow of a ready decomposition."""
+        return cls(None, None, None, flow.omega, flow)
 
     def particular(self, t: float | NDArray[np.float64]) -> NDArray[np.float64]:
         """Periodic particular solution at time(s) t, shape (..., n)."""
-        phasor = np.exp(1j * self.omega * np.asarray(t, dtype=float))[..., None]
-        return np.real(self.harmonic_response * phasor) + self.constant_response
+        return self.flow.particular(t)
 
     def start(self, t0: float, y0: NDArray[np.float64]) -> "Piece":
         """The solution through state ``y0`` at time ``t0``."""
-        modal = self.inverse_vectors @ (np.asarray(y0, dtype=float) - self.particular(t0)).astype(complex)
-        return Piece(self, float(t0), modal)
+        relative = np.asarray(y0, dtype=float) - self.particular(t0)
+        modal = self.inverse_vectors @ relative.astype(complex)
+        z0 = self.flow.projector @ relative
+        q1 = self.flow.nilpotent @ z0 + self.flow.drift
+        return Piece(self, float(t0), modal, z0, q1, self.flow.drift2)
 
 
 @dataclass(frozen=True, eq=False)
 class Piece:
-    """One solution of a :class:`HarmonicLinearFlow`, from (t0, y0)."""
+    """One solution of a :class:`HarmonicLinearFlow`, from (t0, y0): modal coordinates and the polynomial part."""
 
     flow: HarmonicLinearFlow
     t0: float
     modal: NDArray[np.complex128]
+    z0: NDArray[np.float64]
+    q1: NDArray[np.float64]
+    q2: NDArray[np.float64]
 
     def state(self, t: float | NDArray[np.float64]) -> NDArray[np.float64]:
         """State at time(s) t >= t0, shape (..., n)."""
-        growth = np.exp(self.flow.eigenvalues * (np.asarray(t, dtype=float)[..., None] - self.t0))
-        return self.flow.particular(t) + np.real((growth * self.modal) @ self.flow.vectors.T)
+        tau = np.asarray(t, dtype=float)[..., None] - self.t0
+        growth = np.exp(self.flow.eigenvalues * tau)
+        exponential = np.real((growth * self.modal) @ self.flow.vectors.T)
+        return self.flow.particular(t) + exponential + self.z0 + (self.q1 + self.q2 * tau) * tau
 
-    def observable(self, weights: NDArray[np.float64], offset: float = 0.0) -> "Observable":
-        """h(t) = weights . y(t) + offset as a sum of exponentials.
+    def observable(self, weights: NDArray[np.float64], offset: float = 0.0, extra: complex = 0j) -> "Observable":
+        """h(t) = weights . y(t) + offset + Re(extra e^{jwt}) as a sum of exponentials and a polynomial.
 
         A real observable's terms come in complex-conjugate pairs; each pair is kept once, doubled (Re(a e^lt) +
         Re(conj) = 2 Re(a e^lt)), which halves the work of every evaluation.
@@ -88,14 +109,17 @@ class Piece:
             rates=tuple(complex(x) for x in rates[keep]),
             amplitudes=tuple(complex(x) for x in (amplitudes * doubled)[keep]),
             omega=self.flow.omega,
-            harmonic=complex(w @ self.flow.harmonic_response),
-            constant=float(w @ self.flow.constant_response) + offset,
+            harmonic=complex(w @ self.flow.harmonic_response) + complex(extra),
+            constant=float(w @ self.flow.constant_response) + offset + float(w @ self.z0),
+            p1=float(w @ self.q1),
+            p2=float(w @ self.q2),
         )
 
 
 @dataclass(frozen=True)
 class Observable:
-    """``h(t) = Re(sum_i a_i exp(l_i (t - t0)) + beta exp(j w t)) + gamma`` with its derivatives and bounds."""
+    """``h(t) = Re(sum_i a_i exp(l_i tau) + beta exp(j w t)) + gamma + p1 tau + p2 tau^2`` (tau = t - t0) with its
+    derivatives and bounds."""
 
     t0: float
     rates: tuple[complex, ...]
@@ -103,16 +127,20 @@ class Observable:
     omega: float
     harmonic: complex
     constant: float
+    p1: float = 0.0
+    p2: float = 0.0
 
     def derivatives(self, t: float, orders: int) -> list[float]:
         """h(t), h'(t), ..., h^(orders-1)(t)."""
         terms = [a * cmath.exp(l * (t - self.t0)) for a, l in zip(self.amplitudes, self.rates)]
         forced = self.harmonic * cmath.exp(1j * self.omega * t)
         jw = 1j * self.omega
+        tau = t - self.t0
+        polynomial = ((self.p1 + self.p2 * tau) * tau, self.p1 + 2.0 * self.p2 * tau, 2.0 * self.p2)
         values = []
         for k in range(orders):
             total = sum(term * l**k for term, l in zip(terms, self.rates)) + forced * jw**k
-            values.append(total.real + (self.constant if k == 0 else 0.0))
+            values.append(total.real + (self.constant if k == 0 else 0.0) + (polynomial[k] if k < 3 else 0.0))
         return values
 
     def step_data(self, t: float) -> tuple[float, float, float, float, float]:
@@ -130,13 +158,28 @@ class Observable:
             bound2 += size
             bound3 += size * abs(l)
         forced = self.harmonic * cmath.exp(1j * w * t)
-        return (h0 + forced).real + self.constant, (h1 + forced * 1j * w).real, (h2 - forced * w * w).real, bound2, bound3
+        tau = t - self.t0
+        return (
+            (h0 + forced).real + self.constant + (self.p1 + self.p2 * tau) * tau,
+            (h1 + forced * 1j * w).real + self.p1 + 2.0 * self.p2 * tau,
+            (h2 - forced * w * w).real + 2.0 * self.p2,
+            bound2 + 2.0 * abs(self.p2),
+            bound3,
+        )
 
     def bound(self, t: float, order: int) -> float:
-        """An upper bound of |h^(order)| over [t, inf)."""
+        """An upper bound of |h^(order)| over [t, inf) for order >= 2; for orders 0 and 1, whose polynomial part
+        grows, its size at t (a scale)."""
         total = abs(self.harmonic) * self.omega**order
         for a, l in zip(self.amplitudes, self.rates):
             total += abs(a) * abs(l) ** order * math.exp(l.real * (t - self.t0))
+        tau = t - self.t0
+        if order == 0:
+            total += (abs(self.p1) + abs(self.p2) * tau) * tau
+        elif order == 1:
+            total += abs(self.p1) + 2.0 * abs(self.p2) * tau
+        elif order == 2:
+            total += 2.0 * abs(self.p2)
         return total
 
 
@@ -161,12 +204,14 @@ def first_crossing(h: Observable, t_from: float, t_to: float, tolerance: float, 
     root can be skipped, however tangent (grazing). Near a transversal root the steps converge quadratically.
     """
     # h cannot be evaluated more accurately than the round-off of its largest terms
-    tolerance = max(tolerance, 1e-15 * (sum(abs(a) for a in h.amplitudes) + abs(h.harmonic) + abs(h.constant)))
+    tau = t_from - h.t0
+    polynomial = (abs(h.p1) + abs(h.p2) * tau) * tau
+    tolerance = max(tolerance, 1e-15 * (sum(abs(a) for a in h.amplitudes) + abs(h.harmonic) + abs(h.constant) + polynomial))
     t = t_from
     if leaving and h.derivatives(t, 1)[0] >= -tolerance:  # at the surface: the start must not count as a root
         step = escape_step(h, t)
         if step is None:
-            if h.bound(t, 0) <= tolerance:
+            if h.bound(t, 0) - polynomial <= tolerance and abs(h.p1) + abs(h.p2) <= tolerance:
                 return None  # h is zero from here on (at rest on the surface, no forcing): nothing crosses
             return t_from  # not leaving after all: the caller decides (contact or sticking)
         t += step
