@@ -25,7 +25,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.model.contact import RigidStop
@@ -81,6 +81,9 @@ class ImpactMap:
         R > 1) never have one.
     stop : int or 'all', optional
         The stop(s) whose clearance and restitution the parameters are (module docstring).
+    parameter_scale : array_like, shape (4,), optional
+        A unit of arclength for each parameter (default (1 Hz, 0.1, 1 mm, 1 N); e.g. dimensionless problems take
+        their own).
 
     Attributes
     ----------
@@ -94,13 +97,13 @@ class ImpactMap:
         (L, ..., V, ...) with L = Delta + q |H12(w)| [m] on the paper's layout (in general the largest |Delta_k| +
         |n_k H F| plus a static load's excursion, :meth:`ImpactProblem.velocity_scale` / w) and V = w L [m s-1].
     parameter_scale : ndarray, shape (4,)
-        (1 Hz, 0.1, 1 mm, 1 N): what counts as a unit of arclength for each parameter.
+        What counts as a unit of arclength for each parameter.
     """
 
     parameter_names = tuple(PARAMETERS)
 
     def __init__(self, problem: ImpactProblem, periods: int = 1, engine: ExactEngine | None = None, bounds: dict[str, tuple[float, float]] | None = None,
-                 stop: int | str | None = None) -> None:  # fmt: skip
+                 stop: int | str | None = None, parameter_scale: ArrayLike | None = None) -> None:  # fmt: skip
         _checked = problem.harmonic  # TypeError naming the part unless a harmonic force
         self.stops = stop_selection(problem, stop)
         self.stop = stop
@@ -117,7 +120,9 @@ class ImpactMap:
         else:
             length = problem.velocity_scale() / problem.omega
         self.state_scale = np.repeat([length, problem.omega * length], problem.size)
-        self.parameter_scale = np.array([1.0, 0.1, 1e-3, 1.0])
+        self.parameter_scale = np.array([1.0, 0.1, 1e-3, 1.0]) if parameter_scale is None else np.array(parameter_scale, dtype=float)
+        if self.parameter_scale.shape != (4,) or not np.all(self.parameter_scale > 0.0):
+            raise ValueError(f"parameter_scale = {parameter_scale!r}: expected 4 positive numbers (frequency, restitution, clearance, amplitude)")
         self.bounds = dict(bounds or {})
         unknown = set(self.bounds) - set(PARAMETERS)
         if unknown:
@@ -126,7 +131,7 @@ class ImpactMap:
 
     def with_periods(self, periods: int) -> "ImpactMap":
         """The same map over ``periods`` excitation periods (one compiled call per evaluation, unlike ``Iterated``)."""
-        return ImpactMap(self.problem, periods, self.engine, self.bounds, self.stop)
+        return ImpactMap(self.problem, periods, self.engine, self.bounds, self.stop, self.parameter_scale)
 
     def problem_at(self, p: NDArray[np.float64]) -> ImpactProblem:
         """The problem with parameter vector ``p``."""

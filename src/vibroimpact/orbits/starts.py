@@ -110,14 +110,16 @@ def _paper_fractions(problem: ImpactProblem, f: NDArray[np.float64]) -> list[NDA
     return fractions
 
 
-def section_phase(problem: ImpactProblem, frequencies: ArrayLike) -> float:
+def section_phase(problem: ImpactProblem, frequencies: ArrayLike, clearances: ArrayLike | None = None, amplitudes: ArrayLike | None = None) -> float:
     """A force phase [rad] that keeps the strobe (t = 0 mod T) away from the closed-form orbits' impacts.
 
     Where an impact crosses the strobe time the fixed point of the stroboscopic map jumps between the states just
     before and just after it, and a continuation cannot follow. The impact instants of both roots of the impulse
     equation (both stops' impacts, T/2 apart, for a two-sided stop), as fractions of the period, are found over
     ``frequencies`` [Hz] from the closed form; the phase puts the strobe in the middle of the widest gap between them.
-    Use it as the problem's force phase (``dataclasses.replace(problem.harmonic, phase=...)``). 0 where no closed form applies (start
+    Use it as the problem's force phase (``dataclasses.replace(problem.harmonic, phase=...)``). ``clearances`` and
+    ``amplitudes`` (broadcast against ``frequencies``; the problem's when omitted) cover a continuation in those
+    parameters (any layout but the paper's named form, which varies the frequency only). 0 where no closed form applies (start
     from a simulated state and :func:`vibroimpact.orbits.maps.resection` instead) or no orbit exists.
     """
     f = np.asarray(frequencies, dtype=float)
@@ -128,7 +130,7 @@ def section_phase(problem: ImpactProblem, frequencies: ArrayLike) -> float:
             return 0.0
         fractions = []
         for root in ROOTS:
-            orbit = solve_impact_orbit(problem, 2.0 * np.pi * f, root=root)
+            orbit = solve_impact_orbit(problem, 2.0 * np.pi * f, clearances, None, amplitudes, root=root)
             # the impact time includes the problem's phase: measure it against a force of phase 0
             base = ((orbit.impact_time + problem.phase / orbit.omega) / orbit.period) % 1.0
             fractions.append(base[orbit.exists])
