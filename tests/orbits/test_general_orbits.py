@@ -32,6 +32,7 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.stops import Stop
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import PAPER_SYSTEM
+from vibroimpact.orbits.bifurcations import switch_period_doubling
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
 from vibroimpact.orbits.lyapunov import _inside, state_scales
 from vibroimpact.orbits.maps import ImpactMap, closed_form_state, one_impact_state, orbit_measures, section_phase
@@ -154,6 +155,27 @@ def test_fixed_points_are_the_closed_form_orbits(make, frequency: float) -> None
 
 
 @needs_engine
+@pytest.mark.parametrize(("make", "frequency"), [(relative, 22.5), (relative, 42.0), (two_sided, 25.0), (two_sided, 23.5)])
+def test_exact_engine_stays_on_the_closed_form_orbit_and_is_attracted(make, frequency: float) -> None:
+    """The exact engine run from the closed-form state repeats its strobes to 1e-9 of the state scale over 20 periods,
+    with the closed form's impulse at each impact (1e-9); these orbits are stable (Floquet modulus mu < 1), and a
+    start 1e-3 off returns to within 100 mu^600 1e-3 (or the round-off floor 1e-11) after 600 periods."""
+    problem = make(frequency)
+    closed = solve_impact_orbit(problem)
+    modulus = float(np.max(np.abs(floquet_multipliers(closed))))
+    assert closed.admissible() and modulus < 0.99
+    engine = ExactEngine()
+    start = closed_form_state(problem)
+    scale = ImpactMap(problem).state_scale
+    run = engine.integrate(problem, start, 0.0, 20)
+    assert np.max(np.abs(run.strobe_states - start) / scale) < 1e-9
+    assert run.impulses.size == 20 * closed.impacts_per_period
+    np.testing.assert_allclose(run.impulses, float(closed.impulse), rtol=1e-9)
+    perturbed = engine.integrate(problem, start + 1e-3 * scale * np.array([0.3, -0.5, 0.2, 0.4]), 0.0, 600)
+    assert np.max(np.abs(perturbed.final_state - start) / scale) < max(100.0 * modulus**600 * 1e-3, 1e-11)
+
+
+@needs_engine
 def test_grazing_boundary_of_the_forced_oscillator() -> None:
     """x'' + 0.5 x' + 100 x = A cos(8 t), x <= 0.01: the impacting orbit continued down in A ends at a grazing point at
     A = 0.01 sqrt((100 - 64)^2 + (0.5 * 8)^2), to 1e-8 relative."""
@@ -197,3 +219,6 @@ def test_budd_dux_branch_lies_on_the_ellipse_and_doubles_where_predicted() -> No
         assert abs(residual) < 1e-8 * gamma**2
     (doubling,) = branch.special("period_doubling")
     assert doubling.value == pytest.approx(sigma_pd, rel=1e-8)
+    # the period-two orbit born there: two impacts per period-two, its halves differ
+    two = switch_period_doubling(mapping, doubling)
+    assert two.period == 2 and two.impacts == 2
