@@ -27,6 +27,8 @@ from vibroimpact.simulation.harmonics import HarmonicMeasures, measure
 from vibroimpact.simulation.layout import gaps, linear_state, named_system_of, resting_state, suspension_force
 from vibroimpact.model.stops import Stop
 from vibroimpact.analysis.linear import linear_response
+from vibroimpact.analysis.impact_orbit import solve_impact_orbit
+from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
 from vibroimpact.simulation.periodic import motion_evidence, shoot_orbit
 from vibroimpact.simulation.settings import START_MODES, SteadySettings
@@ -135,8 +137,9 @@ def pgf_guesses(problem: ImpactProblem, frequencies: Sequence[float], orbit_stop
     stop = orbit_stop_of(problem, orbit_stop)
     system = named_system_of(problem.system)
     if isinstance(stop, tuple):
-        if system is None or not ImpactProblem(problem.system, stop, problem.excitation).paper_layout:
-            return [None] * len(frequencies)
+        rigid = ImpactProblem(problem.system, stop, problem.excitation)
+        if system is None or not rigid.paper_layout:
+            return _general_guesses(rigid, frequencies)
         stop = stop[0].law
     if system is None or not isinstance(stop, RigidStop):
         return [None] * len(frequencies)
@@ -150,6 +153,21 @@ def pgf_guesses(problem: ImpactProblem, frequencies: Sequence[float], orbit_stop
         forcing_phase = orbit.phase - np.angle(orbit.receptances.h12)
         t_impact = np.mod((forcing_phase - problem.phase) / omega, period)
     return [(float(t_impact[i] + half[i, 0]), states[i]) if ok[i] else None for i in range(omega.size)]
+
+
+def _general_guesses(problem: ImpactProblem, frequencies: Sequence[float]) -> list[tuple[float, NDArray[np.float64]] | None]:
+    """The ``pgf`` starts of any layout with a closed-form orbit (one stop, or a symmetric two-sided stop), midway
+    between impacts; None everywhere where no closed form applies, and where its orbit is not admissible."""
+    if closed_form_refusal(problem) is not None:
+        return [None] * len(frequencies)
+    omega = 2.0 * np.pi * np.asarray(frequencies, dtype=float)
+    orbit = solve_impact_orbit(problem, omega)
+    with np.errstate(invalid="ignore"):
+        ok = orbit.exists & orbit.admissible()
+        offset = 0.5 * orbit.window  # half-way to the next impact (T/2, or T/4 for a two-sided stop)
+        states = orbit.state(offset[:, None])[:, 0, :]
+        times = orbit.impact_time + offset
+    return [(float(times[i]), states[i]) if ok[i] else None for i in range(omega.size)]
 
 
 def linear_fits(problem: ImpactProblem) -> bool:

@@ -199,10 +199,14 @@ def _duration(seconds: float) -> str:
 EnginePart = tuple[float, str, float]
 
 
-def grid_estimate(scene: Scene, jobs: int, costs: Costs, engine_part: Callable[[str, str], EnginePart], figures: int, sweep_samples: float = 0.0) -> Estimate:
-    """The estimate of a stepped or swept study on the calibration machine: the closed forms per grid point, each
-    time-domain solution by ``engine_part(solution, cost engine)``, spread over the processes, and the report's
-    ``figures``; ``sweep_samples`` output samples of one swept run held in memory per worker."""
+def grid_estimate(
+    scene: Scene, jobs: int, costs: Costs, engine_part: Callable[[str, str], EnginePart], figures: int, sweep_samples: float = 0.0,
+    closed_form_scale: Callable[[str], float] = lambda _name: 1.0,
+) -> Estimate:  # fmt: skip
+    """The estimate of a stepped or swept study on the calibration machine: the closed forms per grid point (times
+    ``closed_form_scale(solution)``: a general layout's relative cost), each time-domain solution by
+    ``engine_part(solution, cost engine)``, spread over the processes, and the report's ``figures``;
+    ``sweep_samples`` output samples of one swept run held in memory per worker."""
     parts: dict[str, float] = {}
     points: dict[str, str] = {}
     frequency = scene.all_frequencies
@@ -213,7 +217,7 @@ def grid_estimate(scene: Scene, jobs: int, costs: Costs, engine_part: Callable[[
     biggest_case = 0.0
     for name in scene.solutions:
         if name not in ENGINE_SOLUTIONS:
-            seconds = costs.closed_form_per_point[name] * grid * (bumpers if name == "pgf" and scene.bumper_frequency is not None else 1)
+            seconds = costs.closed_form_per_point[name] * grid * (bumpers if name == "pgf" and scene.bumper_frequency is not None else 1) * closed_form_scale(name)
             parts[name] = seconds
             closed_form += seconds
             continue

@@ -16,6 +16,7 @@ from vibroimpact.scene.variables import quantity_attributes
 from vibroimpact.simulation.settings import SWEEP_STARTS
 from vibroimpact.study.cost_model import Costs, EnginePart, Estimate, grid_estimate
 from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates, solve_each, steady_variable
+from vibroimpact.study.general_estimate import closed_form_scale, engine_scale, general_orbit_outlook
 from vibroimpact.study.general_stepped import run_general
 from vibroimpact.study.solutions import simulated_values
 
@@ -81,7 +82,7 @@ class SteppedStudy:
             # where the motion may never settle, an integrator also runs a perturbed copy of its Lyapunov run
             wandering = np.count_nonzero(periods >= steady.max_periods + steady.lyapunov_periods) if name != "exact" else 0
             total_periods = (float(periods.sum()) + wandering * steady.lyapunov_periods) * scale * copies
-            seconds = costs.per_period_cost(engine, scene.simulation.engine.rtol) * total_periods
+            seconds = costs.per_period_cost(engine, scene.simulation.engine.rtol) * engine_scale(scene) * total_periods
             integrated = int(np.count_nonzero(periods) * scale) * copies
             points = f"{scene.restitution.size * scene.clearance.size * scene.simulation.frequency.size * copies} points, ~{integrated} integrated, ~{total_periods:.0f} periods"
             serial = 0.0
@@ -89,7 +90,7 @@ class SteppedStudy:
                 serial = seconds / (scene.restitution.size * scene.clearance.size * copies)
             return seconds, points, serial
 
-        return grid_estimate(scene, jobs, costs, engine_part, report_figures(scene))
+        return grid_estimate(scene, jobs, costs, engine_part, report_figures(scene), closed_form_scale=lambda name: closed_form_scale(scene, name))
 
 
 def report_figures(scene: Scene) -> int:
@@ -118,14 +119,18 @@ def expected_periods(scene: Scene) -> tuple[np.ndarray, float]:
     shape = (scene.restitution.size, scene.clearance.size, frequencies.size)
     if sim.start == "rest":
         return np.full(shape, float(wander)), scale
-    omega = 2.0 * np.pi * frequencies[None, None, :]
-    orbit = solve_one_impact(scene.system, omega, scene.clearance[None, :, None], scene.restitution[:, None, None], scene.amplitude)
-    admissible = orbit.admissible()
-    stable = np.zeros(admissible.shape, dtype=bool)
-    if admissible.any():
-        modulus = np.max(np.abs(floquet_multipliers(orbit)), axis=-1)
-        stable = admissible & (modulus < 1.0)
-    fits = orbit.linear_amplitude_x2 <= orbit.clearance
+    wandering = 0.0
+    if scene.general:
+        fits, admissible, stable, wandering = general_orbit_outlook(scene, frequencies)
+    else:
+        omega = 2.0 * np.pi * frequencies[None, None, :]
+        orbit = solve_one_impact(scene.system, omega, scene.clearance[None, :, None], scene.restitution[:, None, None], scene.amplitude)
+        admissible = orbit.admissible()
+        stable = np.zeros(admissible.shape, dtype=bool)
+        if admissible.any():
+            modulus = np.max(np.abs(floquet_multipliers(orbit)), axis=-1)
+            stable = admissible & (modulus < 1.0)
+        fits = orbit.linear_amplitude_x2 <= orbit.clearance
     settle = (SHOOTING_PERIODS if sim.start == "shooting" else SETTLING_PERIODS) + steady.measure_periods
     if sim.start in SWEEP_STARTS:
         # a chain: a fitting point is answered linear unless the point before it impacted (then it integrates from
@@ -138,4 +143,5 @@ def expected_periods(scene: Scene) -> tuple[np.ndarray, float]:
             impacting = ~fits[..., k] | (impacting & admissible[..., k])
     else:
         no_integration = fits & ~admissible if sim.start in ("pgf", "shooting") else fits
-    return np.where(no_integration, 0, np.where(stable, settle, wander)).astype(float), scale
+    unknown = settle + wandering * (wander - settle)  # no closed form: an assumed share never settles
+    return np.where(no_integration, 0, np.where(stable, settle, unknown if wandering else wander)).astype(float), scale
