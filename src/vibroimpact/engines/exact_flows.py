@@ -26,7 +26,7 @@ unchanged bit for bit; the general route gives the same to ~1e-13 (tests/engines
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -415,7 +415,3 @@ def build_model(problem: ImpactProblem, length_scale: float) -> ExactModel:
         hold_harmonics=hold_harmonics, force_tolerances=force_tolerances, bounce=bounce, stick=stick, touch=touch,
     )  # fmt: skip
 
-
-def with_flows(model: ExactModel, free: Flow, stuck: tuple[Flow, ...]) -> ExactModel:
-    """The same model with other flows (for tests comparing the two routes)."""
-    return replace(model, free=free, stuck=stuck)
