@@ -15,6 +15,7 @@ impact count (``SpecialPoint.continues``, ``impacts_after``).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -198,7 +199,19 @@ class _Walker:
             return None if point is None else float(point.p[self.index] - value)
 
         lo, hi, _width = locate(self.arc, a, sigma, test, self.tolerance(a), self.settings.tolerance)
-        return hi if hi is not None else lo
+        found = hi if hi is not None else lo
+        if abs(float(found.p[self.index]) - value) <= self.settings.locate_tolerance * max(abs(value), 1e-300):
+            return found
+        # the orbit at the bound itself: Newton on the state with the parameter held at the bound (a map whose own
+        # bounds box ends there fails for every trial beyond it, so the bracket may stop short)
+        fixed = np.array(found.z, dtype=float)
+        fixed[self.n] = value / self.arc.sp[0]
+        direction = np.zeros_like(fixed)
+        direction[self.n] = 1.0
+        polished = self.arc.correct(fixed, direction, self.settings.tolerance, self.settings.max_corrector_iterations)
+        if polished is None or _signature(polished) != _signature(found):
+            return found
+        return dataclasses.replace(polished, tangent=self.arc.tangent(polished.jacobian, a.tangent))
 
     def run(self, start: Point) -> tuple[list[Point], str]:
         s = self.settings
@@ -238,6 +251,12 @@ class _Walker:
             elif changed:
                 b = None
             if b is None:
+                predicted = float((a.z[self.n] + h * a.tangent[self.n]) * self.arc.sp[0])
+                if not s.lower <= predicted <= s.upper:
+                    # no orbit beyond the bound (e.g. the map's own bounds box): locate the bound by bisection
+                    # instead of creeping up to it with ever smaller steps
+                    points.append(self.bound(a, h, s.lower if predicted < s.lower else s.upper))
+                    return points, "bound"
                 h *= 0.5
                 if h < s.min_step:
                     return points, "step_too_small"
