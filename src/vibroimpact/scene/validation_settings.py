@@ -188,7 +188,7 @@ class GrazingCase:
     frequency: float = 0.12
     clearance: float = 1.0
     restitution: float = 0.8
-    amplitude: tuple[float, float] = (0.1, 2.0)
+    amplitude: tuple[float, float] = (0.1, 1.0)
     tolerance: float = DEFAULT_TOLERANCE
     name = "grazing"
 
