@@ -166,7 +166,7 @@ def test_three_dof_relative_stop_multipliers_equal_integrated_jacobian() -> None
     """N = 3, a lower relative stop (tip - middle >= -2 mm) with a static load: the 6 x 6 monodromy's multipliers
     equal the eigenvalues of the finite-difference Jacobian of the integrated map (1e-5 of the largest)."""
     stop = Stop(RigidStop(2e-3, 0.5), 2, other=1, side="lower")
-    load = HarmonicForce(30.0, 0.0 + 40.0, 0.2, weights=(1.0, 0.0, 0.0), static=(0.0, -5.0, 3.0))
+    load = HarmonicForce(30.0, 40.0, 0.2, weights=(1.0, 0.0, 0.0), static=(0.0, -5.0, 3.0))
     problem = ImpactProblem(THREE_DOF, (stop,), load)
     frequencies = np.linspace(20.0, 60.0, 401)
     survey = solve_impact_orbit(problem, 2 * np.pi * frequencies)
