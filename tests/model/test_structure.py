@@ -94,8 +94,8 @@ def test_bad_stops_and_loads_are_refused_naming_the_key(build, message: str) -> 
 
 
 def test_a_negative_clearance_is_allowed_and_preloads() -> None:
-    assert RigidStop(-0.001, 0.5).clearance == -0.001
-    assert KelvinVoigtBumper(-0.001, 200.0, 0.3).clearance == -0.001
+    assert RigidStop(-0.001, 0.5).clearance == -0.001  # exact: the stored input
+    assert KelvinVoigtBumper(-0.001, 200.0, 0.3).clearance == -0.001  # exact: the stored input
 
 
 def test_the_paper_layout_in_general_form_is_recognised_and_holds_like_the_named_one() -> None:
