@@ -1,6 +1,7 @@
 """vibroimpact: vibration protection by a tuned dynamic absorber whose motion is limited by a stop on the base.
 
-Linear two-degree-of-freedom model, closed-form periodic-Green-function (PGF) solution of the one-impact regime,
+Linear models (the paper's two masses, or any N-dof structure with stops on any coordinate, absolute or relative,
+one- or two-sided), closed-form periodic-Green-function (PGF) solution of the one-impact regime,
 time-domain engines, and studies that put them side by side (seed paper: the absorber with a stop mounted on the
 base). The names users import are available here and load their layer on first use, so ``import vibroimpact``
 stays light::
@@ -29,8 +30,15 @@ _PUBLIC = {
     "HarmonicForce": "vibroimpact.model.excitation",
     "SweptSine": "vibroimpact.model.excitation",
     "ImpactProblem": "vibroimpact.model.problem",
+    "LinearStructure": "vibroimpact.model.structure",
+    "Stop": "vibroimpact.model.stops",
     "solve_one_impact": "vibroimpact.analysis.pgf",
+    "solve_impact_orbit": "vibroimpact.analysis.impact_orbit",
+    "solve_two_impacts": "vibroimpact.analysis.two_sided",
+    "closed_form_refusal": "vibroimpact.analysis.layout",
+    "floquet_multipliers": "vibroimpact.analysis.stability",
     "linear_response": "vibroimpact.analysis.linear",
+    "linear_amplitudes": "vibroimpact.analysis.linear",
     "EngineSettings": "vibroimpact.engines.settings",
     "ENGINES": "vibroimpact.engines.registry",
     "make_engine": "vibroimpact.engines.registry",
