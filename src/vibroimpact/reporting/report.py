@@ -11,6 +11,8 @@ the kind of study, in this one place:
 * swept-sine tests: running estimates against the steady states (:class:`~vibroimpact.reporting.sweep_page.SweptSinePage`);
 * stepped studies with a swept bumper frequency: convergence of the compliant bumper to the rigid stop
   (:class:`~vibroimpact.reporting.bumper_page.BumperStiffnessPage`);
+* stepped studies of general scenes (any structure and stops): one curve per coordinate and per stop, the layout in
+  words (:class:`~vibroimpact.reporting.general_page.GeneralResponsePage`);
 * other stepped studies: frequency responses, regimes, stability, simulations against the closed form, reduction
   factors and resonance peaks (:class:`~vibroimpact.reporting.stepped_page.FrequencyResponsePage`).
 """
@@ -25,6 +27,8 @@ from vibroimpact.reporting.page import StudyPage, render_page, rendering, write_
 from vibroimpact.reporting.accuracy_page import AccuracyPage  # noqa: E402
 from vibroimpact.reporting.bifurcation_page import BifurcationPage  # noqa: E402
 from vibroimpact.reporting.bumper_page import BumperStiffnessPage  # noqa: E402
+from vibroimpact.reporting.general_page import GeneralResponsePage  # noqa: E402
+from vibroimpact.reporting.general_record import is_general  # noqa: E402
 from vibroimpact.reporting.record import study_kind, study_record, study_setting  # noqa: E402
 from vibroimpact.reporting.stepped_page import FrequencyResponsePage  # noqa: E402
 from vibroimpact.reporting.sweep_page import SweptSinePage  # noqa: E402
@@ -52,6 +56,8 @@ def page_for(dataset: xr.Dataset) -> StudyPage:
         return AccuracyPage(dataset)
     if kind == "bifurcation":
         return BifurcationPage(dataset)
+    if kind == "stepped" and is_general(dataset):
+        return GeneralResponsePage(dataset)
     setting = study_setting(dataset)
     if kind == "swept":
         return SweptSinePage(dataset, setting)

@@ -55,14 +55,20 @@ _FREQUENCY = "frequency [Hz]"
 
 
 def clearance_text(part: xr.Dataset) -> str:
-    """Delta of a dataset at one clearance, in mm."""
+    """Delta of a dataset at one clearance, in mm (a general layout whose stops have their own clearances: its stops
+    in words)."""
+    if "clearance" not in part.coords:
+        return f"stops {part.attrs.get('stop_layout', '')}"
     return f"Delta = {fmt(float(part['clearance']) * 1e3, '.6g')} mm"
 
 
 def series_by_restitution(part: xr.Dataset) -> list[tuple[str, xr.Dataset]]:
-    """(legend text, dataset) for each restitution ratio of ``part``."""
+    """(legend text, dataset) for each restitution ratio of ``part`` (one series, "each stop's R", where the stops of
+    a general layout have their own)."""
     if "restitution" in part.dims:
         return [(f"R = {fmt(r, 'g')}", part.sel(restitution=r)) for r in part["restitution"].values]
+    if "restitution" not in part.coords:
+        return [("each stop's R", part)]
     return [(f"R = {fmt(part['restitution'], 'g')}", part)]
 
 

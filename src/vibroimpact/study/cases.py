@@ -143,6 +143,14 @@ def _contact_key(contact: object) -> object:
     return {"law": type(contact).__name__, **asdict(contact)}  # type: ignore[call-overload]
 
 
+def _contact_words(problem: ImpactProblem) -> str:
+    """The problem's stops in words (the paper's stop: its law, as before)."""
+    if not isinstance(problem.contact, tuple):
+        return str(problem.contact)
+    names = tuple(problem.structure.coordinates)
+    return "; ".join(f"{stop.describe(names)} ({type(stop.law).__name__})" for stop in problem.contact)
+
+
 def run_case(case: SimulationCase, report: ProgressReport | None = None) -> CaseResult:
     """Steady states of one case, in the order of ``case.frequencies``; ``report`` receives the points done."""
     engine = make_engine(case.engine, case.engine_settings)
@@ -176,7 +184,7 @@ def run_case(case: SimulationCase, report: ProgressReport | None = None) -> Case
             result = steady_state(engine, problem, start, case.steady_settings, case.orbit_stop, guess)
         except (RuntimeError, ValueError, ArithmeticError, np.linalg.LinAlgError) as error:
             # one failing point must not cost the others: it stays NaN, flagged, and a sweep restarts after it
-            print(f"{case.engine}: {case.contact}, f = {frequency:g} Hz failed: {error}", file=sys.stderr)
+            print(f"{case.engine}: {_contact_words(problem)}, f = {frequency:g} Hz failed: {error}", file=sys.stderr)
             out["failed"][i] = 1.0
             previous = None
             continue

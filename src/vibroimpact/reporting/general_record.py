@@ -1,0 +1,98 @@
+"""What a report knows of a general scene's structure, load and stops, read from its dataset's attributes
+(written by :func:`vibroimpact.study.grid.layout_attributes`); nothing is re-validated from the scene text."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+from vibroimpact.model.structure import LinearStructure
+
+__all__ = ["GeneralSetting", "general_setting", "is_general"]
+
+
+def is_general(dataset: xr.Dataset) -> bool:
+    """Was the dataset written from a general scene (its attribute ``scene_format``)?"""
+    return dataset.attrs.get("scene_format") == "general"
+
+
+@dataclass(frozen=True, eq=False)
+class GeneralSetting:
+    """A general study's structure, load and stops.
+
+    Attributes
+    ----------
+    structure : LinearStructure
+        M, K, C and the coordinates' names.
+    amplitude : float
+        q [N], or the base displacement [m] (``base_motion``).
+    base_motion : bool
+        The load is a base motion (coordinates relative to the base).
+    weights : ndarray
+        Harmonic force per coordinate per unit amplitude [-].
+    static : ndarray
+        Constant force per coordinate [N].
+    stops : tuple of str
+        Each stop in words (e.g. ``x2 - x1 <= 3 mm, R = 0.2``).
+    normals : ndarray, shape (K, N)
+        n of every stop (the stopped coordinate n . x).
+    solutions : tuple of str
+        The ``solution`` coordinate.
+    """
+
+    structure: LinearStructure
+    amplitude: float
+    base_motion: bool
+    weights: np.ndarray
+    static: np.ndarray
+    stops: tuple[str, ...]
+    normals: np.ndarray
+    solutions: tuple[str, ...]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The coordinates' names."""
+        return tuple(self.structure.coordinates)
+
+    def load_text(self) -> str:
+        """The load in words."""
+        if self.base_motion:
+            return f"base motion of amplitude {self.amplitude * 1e3:g} mm (coordinates relative to the base)"
+        on = [f"{w:g} x {name}" if w != 1.0 else name for w, name in zip(self.weights, self.names) if w != 0.0]
+        text = f"harmonic force of amplitude {self.amplitude:g} N on {' + '.join(on)}"
+        if np.any(self.static):
+            text += "; constant force " + ", ".join(f"{f:g} N on {name}" for f, name in zip(self.static, self.names) if f != 0.0)
+        return text
+
+
+def general_setting(dataset: xr.Dataset) -> GeneralSetting:
+    """The :class:`GeneralSetting` of a general study's ``dataset`` (``KeyError`` naming a missing attribute)."""
+    attrs = dataset.attrs
+    size = int(attrs["system_size"])
+    names = tuple(str(attrs["system_coordinates"]).split())
+
+    def matrix(key: str) -> np.ndarray:
+        return np.asarray(attrs[key], dtype=float).reshape(size, size)
+
+    structure = LinearStructure(matrix("system_mass_kg"), matrix("system_stiffness_N_per_m"), matrix("system_damping_N_s_per_m"), names)
+    coordinate = np.atleast_1d(np.asarray(attrs["stop_coordinate"], dtype=int))
+    other = np.atleast_1d(np.asarray(attrs["stop_other"], dtype=int))
+    sides = str(attrs["stop_side"]).split()
+    normals = np.zeros((coordinate.size, size))
+    for k, (i, j, side) in enumerate(zip(coordinate, other, sides)):
+        sign = 1.0 if side == "upper" else -1.0
+        normals[k, i] = sign
+        if j >= 0:
+            normals[k, j] = -sign
+    return GeneralSetting(
+        structure=structure,
+        amplitude=float(attrs["excitation_amplitude_N"]),
+        base_motion=attrs.get("excitation_kind") == "base_motion",
+        weights=np.atleast_1d(np.asarray(attrs["excitation_weights"], dtype=float)),
+        static=np.atleast_1d(np.asarray(attrs["excitation_static_N"], dtype=float)),
+        stops=tuple(part.strip() for part in str(attrs["stop_layout"]).split(";")),
+        normals=normals,
+        solutions=tuple(str(s) for s in dataset["solution"].values) if "solution" in dataset.coords else (),
+    )
