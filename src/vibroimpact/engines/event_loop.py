@@ -217,6 +217,7 @@ class EventLoopEngine(ABC):
                         raise RuntimeError(f"no progress at t = {t!r} s: {events} events in one period")
                     if stop is Stop.RELEASE:
                         rec.stats["releases"] += 1
+                        layout.set_approach(y, which, 0.0)  # held: n . x' = 0 but for the stuck flight's round-off
                         model.stuck_on = -1
                     else:
                         impacts += 1
@@ -233,7 +234,7 @@ class EventLoopEngine(ABC):
 
     def _contact(self, model: Model, law: RigidContact, rec: TrajectoryBuilder, t: float, y: NDArray[np.float64], which: int, impacts: int) -> NDArray[np.float64]:
         """Apply stop ``which``'s impact law at time t to the state y (its gap closed exactly); return the new state."""
-        layout, n = model.layout, model.layout.size
+        layout = model.layout
         y = y.copy()
         held = model.stuck_on
         if held == which:
@@ -257,14 +258,12 @@ class EventLoopEngine(ABC):
 
     @staticmethod
     def _kick(model: Model, y: NDArray[np.float64], stop: int, impulse: float, after: float) -> None:
-        """x' -> x' - impulse M^-1 n_k in place; when the impulse moves one coordinate only (an absolute stop on a
-        decoupled mass), that velocity is set to n_k . x'(t+) = ``after`` exactly."""
+        """x' -> x' - impulse M^-1 n_k in place, with n_k . x'(t+) = ``after`` made exact (when the impulse moves one
+        coordinate only, an absolute stop on a decoupled mass, that velocity is set to it directly)."""
         layout, n = model.layout, model.layout.size
-        i = layout.kicked[stop]
-        if i >= 0:
-            y[n + i] = after / layout.probes[stop][1]
-        else:
+        if layout.kicked[stop] < 0:
             y[n : 2 * n] -= impulse * layout.kicks[stop]
+        layout.set_approach(y, stop, after)
 
     def _pushed(self, model: Model, t: float, y: NDArray[np.float64], stop: int) -> bool:
         """Stop ``stop`` must push to hold the structure in y (its gap closed and at rest): holding force > 0, or = 0
@@ -301,9 +300,14 @@ def _touch_probe(model: Model) -> Callable[[NDArray[np.float64]], int]:
     def touching(y: NDArray[np.float64]) -> int:
         held = model.stuck_on
         for k, p, i, j, a, b in probes:
-            if k == held:
+            if k == held or (y[p] if p >= 0 else layout.penetration(y, k)) < 0.0:
                 continue
-            if (y[p] if p >= 0 else layout.penetration(y, k)) >= 0.0 and a * y[i] + (b * y[j] if j >= 0 else 0.0) > 0.0:
+            if j < 0:
+                if a * y[i] > 0.0:
+                    return k
+            # a relative stop's n . x' after a kick along M^-1 n (or in a stuck flight) is 0 only to round-off of
+            # the two velocities: closer to 0 than 1e-12 of them, it is not an approach (a phantom impact otherwise)
+            elif a * y[i] + b * y[j] > 1e-12 * (abs(y[i]) + abs(y[j])):
                 return k
         return -1
 

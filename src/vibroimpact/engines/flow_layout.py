@@ -119,7 +119,10 @@ class FlowLayout:
         self.masses = 1.0 / np.einsum("ki,ki->k", self.normals, self.kicks)
         self.reactions = self.kicks * self.masses[:, None]  # r_k = M^-1 n_k m_k
         #: the one velocity an impulse of each stop moves (an absolute stop on a decoupled mass), else -1
-        self.kicked = tuple(int(np.flatnonzero(kick)[0]) if np.count_nonzero(kick) == 1 else -1 for kick in self.kicks)
+        self.kicked = tuple(
+            int(np.flatnonzero(kick)[0]) if np.count_nonzero(kick) == 1 and np.count_nonzero(normal) == 1 and np.flatnonzero(kick)[0] == np.flatnonzero(normal)[0] else -1
+            for kick, normal in zip(self.kicks, self.normals)
+        )
         #: each stop's n_k . v as (i, n_ki, j, n_kj) with j = -1 for an absolute stop: for scalar arithmetic
         self.probes = tuple(_probe(normal) for normal in self.normals)
         self.omega = float(problem.omega) if isinstance(problem.excitation, HarmonicForce) else 0.0
@@ -201,6 +204,18 @@ class FlowLayout:
         i, a, j, b = self.probes[stop]
         n = self.size
         return float(a * y[n + i] + b * y[n + j]) if j >= 0 else float(a * y[n + i])
+
+    def set_approach(self, y: NDArray[np.float64], stop: int, value: float) -> None:
+        """Make n_k . v = ``value`` in place: the correction along M^-1 n_k (an impulse of stop k's), then exact on
+        the stop's first coordinate (for value 0 on a relative stop, v_i = v_j exactly: no round-off approach)."""
+        n = self.size
+        i, a, j, b = self.probes[stop]
+        if j >= 0:
+            residual = a * y[n + i] + b * y[n + j] - value
+            y[n : 2 * n] -= residual * self.kicks[stop] * (self.masses[stop])
+            y[n + i] = (value - b * y[n + j]) / a
+        else:
+            y[n + i] = value / a
 
     def close(self, y: NDArray[np.float64], stop: int) -> None:
         """Set stop ``stop``'s penetration to zero in place (the pivot, or the largest entry of its gap row)."""
