@@ -64,21 +64,20 @@ def _budd_dux(ds: xr.Dataset) -> DrawnFigure:
 
 def _bouncing_ball(ds: xr.Dataset) -> DrawnFigure:
     fig, (ax,) = new_figure(1, panel_height=5.0, columns=1, legend_rows=legend_rows(6))
+    _stability(ax, ds["acceleration"].values, ds["impact_phase"].values, ds["stable"].values == 1, "continued period-one orbit")
     if "brute_acceleration" in ds.coords:
         gamma = np.repeat(ds["brute_acceleration"].values[:, None], ds.sizes["brute_impact"], axis=1)
-        ax.plot(gamma.ravel(), ds["brute_impact_speed"].values.ravel(), ",", color="0.45", alpha=0.8)
-        ax.plot([], [], "s", ms=4, color="0.45", label="brute force: impacts of the last periods")
-    _stability(ax, ds["acceleration"].values, ds["impact_speed"].values, ds["stable"].values == 1, "continued period-one orbit")
+        ax.plot(gamma.ravel(), ds["brute_impact_phase"].values.ravel(), ".", ms=2.0, color="k", zorder=3, label="brute force: impacts of the last periods")
     ax.axvline(float(ds.attrs["existence_acceleration"]), label="existence pi (1-e)/(1+e)", **_THRESHOLD)
     ax.axvline(float(ds.attrs["period_doubling_acceleration"]), color="C3", lw=1.2, ls="-.", label="period doubling, exact table (issue 12)")
     ax.axvline(float(ds.attrs["high_bounce_period_doubling_acceleration"]), color="0.5", lw=1.0, ls=":", label="period doubling, Holmes' high-bounce map")
-    top = float(np.nanmax(ds["impact_speed"].values))
-    ax.set_ylim(0.0, 2.2 * top)
-    finish_axes(ax, "Gamma = A w^2 / g", "impact speed relative to the table [m/s]", "The bouncing ball: bifurcation diagram")
+    ax.set_ylim(-np.pi, np.pi)
+    finish_axes(ax, "Gamma = A w^2 / g", "table phase at the impact theta [rad]", "The bouncing ball: bifurcation diagram")
     figure_legend(fig, [ax], columns=3)
-    caption = (f"Impact speed of the ball relative to the table (e = {ds.attrs['restitution']:g}) against the table's acceleration Gamma: grey dots are the brute-force "
-               "sweep's impacts, circles the continued period-one orbit (filled: stable). The red lines are the published existence threshold and the "
-               "exact table's period doubling; the dotted grey line is where Holmes' high-bounce map would double.")  # fmt: skip
+    caption = (f"The table's phase at each impact of the ball (e = {ds.attrs['restitution']:g}; table at A sin theta) against the table's acceleration Gamma: "
+               "black dots are the brute-force sweep's impacts over its last periods, circles the continued period-one orbit (filled: stable; the "
+               "branch turns at the fold where the orbit is born, its unstable half below). The red lines are the published existence threshold and the "
+               "exact table's period doubling, where one phase per period becomes two; the dotted grey line is where Holmes' high-bounce map would double.")  # fmt: skip
     return DrawnFigure(fig, "validation_bouncing_ball", "The bouncing ball's period-one orbit: existence and period doubling", caption)
 
 

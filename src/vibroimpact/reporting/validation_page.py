@@ -48,9 +48,10 @@ def validation_table(dataset: xr.Dataset) -> Table:
             _error(float(row["relative_error"])),
             _error(float(row["tolerance"])),
             _VERDICT.get(int(row["passed"]), "?"),
-            f"<span style='white-space:normal'>{html.escape(str(row['note'].values))}</span>",
+            html.escape(str(row["note"].values)),
         )
-        rows.append("<tr>" + "".join(f"<td>{cell}</td>" for cell in cells) + "</tr>")
+        wrap = "style='white-space:normal;text-align:left;min-width:{}em'"
+        rows.append(f"<tr><td {wrap.format(16)}>{cells[0]}</td>" + "".join(f"<td>{cell}</td>" for cell in cells[1:-1]) + f"<td {wrap.format(18)}>{cells[-1]}</td></tr>")
     return Table("Published against computed", f"<table><tr>{header}</tr>{''.join(rows)}</table>")
 
 

@@ -27,8 +27,9 @@ __all__ = ["ValidationStudy", "run_validation", "RUNNERS", "CASE_SECONDS"]
 RUNNERS: MappingProxyType[str, Callable[..., CaseOutcome]] = MappingProxyType(
     {"budd_dux": run_budd_dux, "bouncing_ball": run_bouncing_ball, "zeno": run_zeno, "grazing": run_grazing, "relative_stop": run_relative_stop}
 )
-#: Wall time of each shipped case on the calibration machine [s] (measured; see the README's validation section).
-CASE_SECONDS = MappingProxyType({"budd_dux": 10.0, "bouncing_ball": 15.0, "zeno": 5.0, "grazing": 5.0, "relative_stop": 5.0})
+#: Wall time of each shipped case [s] (measured at load ~7 on the 2-core machine: 1.1, 3.8, 0.6, 2.5, 0.8-3.3 s; the
+#: numba cache warm).
+CASE_SECONDS = MappingProxyType({"budd_dux": 1.5, "bouncing_ball": 4.0, "zeno": 1.0, "grazing": 2.5, "relative_stop": 2.0})
 #: Figures of a validation page.
 REPORT_FIGURES = 1
 

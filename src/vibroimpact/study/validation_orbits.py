@@ -199,7 +199,8 @@ def run_bouncing_ball(case: BouncingBallCase, say=lambda message: None, brute: b
     )
     if brute:
         say(f"bouncing_ball: brute force over Gamma in [{low:g}, {high:g}] step {case.brute_step:g}")
-        data = xr.merge([data, brute_force(case)], combine_attrs="drop_conflicts")
+        brute = brute_force(case)
+        data = xr.merge([data, brute], combine_attrs="override")
     data.attrs.update({"existence_acceleration": ball_existence(e), "period_doubling_acceleration": ball_period_doubling(e),
                        "high_bounce_period_doubling_acceleration": ball_period_doubling_high_bounce(e), "restitution": e})  # fmt: skip
     notes = (
@@ -211,6 +212,13 @@ def run_bouncing_ball(case: BouncingBallCase, say=lambda message: None, brute: b
         f"Gamma sin theta = 2 (1 + e^2)/(1 + e)^2, Gamma = {ball_period_doubling(e):.10g}: the formula of issue 12, checked to 1e-8; the high-bounce value is shown for comparison only.",
         f"Continuation from Gamma = {start:.6g} both ways (branch end: {branch.end}).",
     )
+    if brute:
+        blank = brute["brute_acceleration"].values[brute["brute_failed"].values == 1]
+        notes += (f"Brute force: {brute.sizes['brute_acceleration']} values of Gamma, each {case.transient_periods} periods from the last end state, then "
+                  f"{case.strobes} recorded; the sweep starts on the period-one orbit at Gamma = {start:.6g} and runs down, then up.",)  # fmt: skip
+        if blank.size:
+            notes += (f"The exact engine made no progress (more than 10 x max_impacts_per_period events in a period) at Gamma = "
+                      f"{', '.join(f'{g:g}' for g in blank)}: left blank.",)  # fmt: skip
     return CaseOutcome("bouncing_ball", tuple(rows), data, notes)
 
 
