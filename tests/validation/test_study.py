@@ -45,6 +45,16 @@ def test_dataset_table_and_page(tmp_path: Path) -> None:
 
 
 @pytest.mark.skipif(not REGISTERED, reason="the kind 'validation' is not registered yet (scene/schema.py, reader, study/kinds.py, reporting/report.py)")
+def test_every_shipped_scene_is_a_validation_scene() -> None:
+    """Once registered, the scene reader dispatches on the ``validation`` section and the scene's kind says so."""
+    from vibroimpact.scene import load_scene
+
+    for path in sorted(STUDIES.glob("*.yaml")):
+        scene = load_scene(path)
+        assert scene.kind == "validation" and scene.validation is not None and scene.validation.name in path.stem
+
+
+@pytest.mark.skipif(not REGISTERED, reason="the kind 'validation' is not registered yet (scene/schema.py, reader, study/kinds.py, reporting/report.py)")
 def test_run_study_runs_a_validation_scene(tmp_path: Path) -> None:
     """Once registered, ``run-study`` reads, runs and reports a validation scene like any other."""
     from vibroimpact.cli import main
