@@ -22,6 +22,7 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.layout import LoadSpec, StopSpec
+from vibroimpact.scene.quantities import MOTION_QUANTITIES, QUANTITIES, STOP_QUANTITIES, quantities_for
 from vibroimpact.simulation.settings import START_MODES, SWEEP_STARTS, SteadySettings
 
 if TYPE_CHECKING:
@@ -64,53 +65,6 @@ BENCHMARK_METHODS = tuple(name for name in engine_names() if name != BENCHMARK_R
 SWEEP_DIRECTIONS = ("up", "down")
 #: How a simulation starts at each frequency.
 SIMULATION_STARTS = START_MODES + SWEEP_STARTS
-#: Quantities a scene can ask for (``regime`` is always written: it says what the others mean).
-QUANTITIES = (
-    "x1_amplitude",
-    "x2_amplitude",
-    "force_amplitude",
-    "suspension_force_amplitude",
-    "impulse",
-    "phase",
-    "regime",
-    "stable",
-    "floquet_modulus",
-    "one_impact_x1_amplitude",
-    "one_impact_x2_amplitude",
-    "one_impact_force_amplitude",
-    "one_impact_impulse",
-    "impacts_per_period",
-    "converged",
-    "x1_rms",
-    "x2_rms",
-    "peak_acceleration",
-    "peak_contact_force",
-    "wall_time",
-    "lyapunov_exponent",
-    "lyapunov_error",
-    "rotation_number",
-    "spectral_line_fraction",
-)
-#: The evidence of what a non-periodic simulated motion is (NaN where the motion is periodic, and for closed forms).
-MOTION_QUANTITIES = ("lyapunov_exponent", "lyapunov_error", "rotation_number", "spectral_line_fraction")
-#: Quantities with one value per stop (a ``stop`` dimension in a general scene with several stops).
-STOP_QUANTITIES = ("impulse", "one_impact_impulse", "peak_acceleration", "peak_contact_force")
-#: Quantities with one value per coordinate: ``x1``/``x2`` in the paper's names, ``<name>`` in a general scene.
-_PER_COORDINATE = {"x1_amplitude": "{}_amplitude", "one_impact_x1_amplitude": "one_impact_{}_amplitude", "x1_rms": "{}_rms"}
-
-
-def quantities_for(coordinates: tuple[str, ...]) -> tuple[str, ...]:
-    """The quantities a scene with these coordinates can ask for: :data:`QUANTITIES` with the per-coordinate ones
-    (``x1_amplitude``, ``x2_amplitude`` ...) named after each coordinate (the same tuple for ``x1, x2``)."""
-    out: list[str] = []
-    for quantity in QUANTITIES:
-        if quantity in _PER_COORDINATE:
-            out += [_PER_COORDINATE[quantity].format(name) for name in coordinates]
-        elif quantity.replace("x2", "x1") not in _PER_COORDINATE:
-            out.append(quantity)
-    return tuple(out)
-
-
 #: Parameters that can be swept, with their units and allowed ranges (low, high, low inclusive).
 SWEEPABLE = {
     "frequency": ("Hz", 0.0, math.inf, False),
