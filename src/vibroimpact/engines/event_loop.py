@@ -250,11 +250,28 @@ class EventLoopEngine(ABC):
 
         outcome = law.collide(rec, t, velocity, impacts, pushed, stop=which)
         self._kick(model, y, which, outcome.impulse, outcome.after)
+        # the stop held before: still closed, not driven off by this impulse and still pushed, it holds on (an
+        # impulse on another stop that leaves its coordinates alone); driven into it, the next contact applies
+        holds = held >= 0 and self._holds(model, t, y, held)
         if outcome.sticks:
-            if held >= 0 and layout.penetration(y, held) >= 0.0 and layout.approach(y, held) >= 0.0 and self._pushed(model, t, y, held):
+            if holds:
                 raise NotImplementedError(f"at t = {t!r} s the motion sticks on stop {which} while held on stop {held}: sticking on two stops at once is not supported")
             model.stuck_on = which
+        elif holds:
+            layout.set_approach(y, held, 0.0)
+            model.stuck_on = held
         return y
+
+    def _holds(self, model: Model, t: float, y: NDArray[np.float64], stop: int) -> bool:
+        """Is ``stop`` closed in y, at rest on it (n . x' = 0 to round-off of the velocities) and pushed?"""
+        layout, n = model.layout, model.layout.size
+        i, _, j, _ = layout.probes[stop]
+        noise = 1e-12 * (abs(y[n + i]) + (abs(y[n + j]) if j >= 0 else 0.0))
+        if layout.penetration(y, stop) < 0.0 or abs(layout.approach(y, stop)) > noise:
+            return False
+        resting = y.copy()
+        layout.set_approach(resting, stop, 0.0)
+        return self._pushed(model, t, resting, stop)
 
     @staticmethod
     def _kick(model: Model, y: NDArray[np.float64], stop: int, impulse: float, after: float) -> None:
