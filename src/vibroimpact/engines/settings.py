@@ -38,8 +38,8 @@ class EngineSettings:
     max_step : float
         Largest step [s]; 0 means no limit.
     sticking_velocity : float
-        Impacts slower than this fraction of :meth:`ImpactProblem.velocity_scale` while the stop pushes the absorber
-        end a chattering sequence: the absorber sticks [-]. Rebounds much slower than the default would rise less
+        Impacts slower than this fraction of :meth:`ImpactProblem.velocity_scale` while the stop pushes the
+        structure end a chattering sequence: the structure sticks on the stop (the absorber, on the paper's) [-]. Rebounds much slower than the default would rise less
         than a few hundred round-off units of the gap, where no integrator resolves them; the chatter left out
         lasts about 2 R v / ((1 - R) a), of the order of 1e-9 s.
     max_impacts_per_period : int
