@@ -6,8 +6,10 @@ event). Any N-dof structure with any rigid stops: the integrated state is (w, v)
 stop's penetration u_k = n_k . x - Delta_k in place of one coordinate, so that positions near a stop keep their
 absolute precision; for the paper's layout (X1, X2 - Delta, X1', X2')), followed, when harmonic moments are wanted, by
 the 3 N + 2 K quadratures of :mod:`.rigid_kernels`. A stop is held closed (*stuck*) with the constrained flow of
-:mod:`.flow_layout` and released when its holding force turns negative; an impact on another stop frees it. Sticking
-on two stops at once is refused (``NotImplementedError`` naming both).
+:mod:`.flow_layout` and released when its holding force turns negative; an impact on another stop frees it unless
+it is still closed, at rest on it and pushed after the impulse. Sticking on two stops at once is refused
+(``NotImplementedError`` naming both). A relative stop's n . x' is set exactly (to -R v, or 0 at a stick or a
+release) so that round-off of two velocities never reads as an approach.
 """
 
 from __future__ import annotations
