@@ -26,6 +26,7 @@ import xarray as xr
 from vibroimpact.reporting.page import StudyPage, render_page, rendering, write_page  # selects the Agg backend
 from vibroimpact.reporting.accuracy_page import AccuracyPage  # noqa: E402
 from vibroimpact.reporting.bifurcation_page import BifurcationPage  # noqa: E402
+from vibroimpact.reporting.validation_page import ValidationPage  # noqa: E402
 from vibroimpact.reporting.bumper_page import BumperStiffnessPage  # noqa: E402
 from vibroimpact.reporting.general_page import GeneralResponsePage  # noqa: E402
 from vibroimpact.reporting.general_record import is_general  # noqa: E402
@@ -54,6 +55,8 @@ def page_for(dataset: xr.Dataset) -> StudyPage:
     kind = study_kind(dataset)
     if kind == "benchmark":
         return AccuracyPage(dataset)
+    if kind == "validation":
+        return ValidationPage(dataset)
     if kind == "bifurcation":
         return BifurcationPage(dataset)
     if kind == "stepped" and is_general(dataset):

@@ -24,6 +24,7 @@ import yaml
 
 from vibroimpact.scene.benchmark import parse_benchmark_scene
 from vibroimpact.scene.bifurcation import parse_bifurcation_scene
+from vibroimpact.scene.validation import parse_validation_scene
 from vibroimpact.scene.checker import SceneError
 from vibroimpact.scene.schema import Scene
 from vibroimpact.scene.sections import TOP_KEYS, parse_grid_scene
@@ -75,6 +76,8 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
         raise SceneError([f"scene: expected a mapping with keys {sorted(TOP_KEYS)}, got {what}"], source)
     if "benchmark" in document:
         return parse_benchmark_scene(document, text, source)
+    if "validation" in document:
+        return parse_validation_scene(document, text, source)
     if "bifurcation" in document:
         return parse_bifurcation_scene(document, text, source)
     return parse_grid_scene(document, text, source)

@@ -27,6 +27,7 @@ from vibroimpact.simulation.settings import START_MODES, SWEEP_STARTS, SteadySet
 
 if TYPE_CHECKING:
     from vibroimpact.scene.bifurcation_settings import BifurcationSettings
+    from vibroimpact.scene.validation_settings import ValidationSettings
 
 __all__ = [
     "Scene",
@@ -50,7 +51,7 @@ __all__ = [
 ]
 
 #: Kinds of study a scene can be (:attr:`Scene.kind`); each has its run and estimate (``study/kinds.py``) and its page.
-STUDY_KINDS = ("stepped", "swept", "benchmark", "bifurcation")
+STUDY_KINDS = ("stepped", "swept", "benchmark", "bifurcation", "validation")
 #: Solutions computed by time integration (they need the ``simulation`` section's settings): registered engines.
 ENGINE_SOLUTIONS = ("momentary", "exact", "compliant")
 #: Solutions a scene can ask for: the closed forms, then the engines.
@@ -318,6 +319,7 @@ class Scene:
     bumper_loss_factor: np.ndarray | None = None
     swept_sine: SweptSineSettings | None = None
     bifurcation: "BifurcationSettings | None" = None
+    validation: "ValidationSettings | None" = None
     report: bool = True
     text: str = ""
     load: LoadSpec | None = None
@@ -348,11 +350,13 @@ class Scene:
 
     @property
     def kind(self) -> str:
-        """What kind of study the scene is: ``benchmark``, ``bifurcation``, ``swept`` (swept-sine tests) or ``stepped``
-        (steady states).
+        """What kind of study the scene is: ``validation`` (a published closed form), ``benchmark``, ``bifurcation``,
+        ``swept`` (swept-sine tests) or ``stepped`` (steady states).
 
         The one place that decides it; everything else dispatches on this name.
         """
+        if self.validation is not None:
+            return "validation"
         if self.benchmark is not None:
             return "benchmark"
         if self.bifurcation is not None:
