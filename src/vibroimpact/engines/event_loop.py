@@ -79,6 +79,7 @@ class Model:
         self.num_events = 2 * k + 1
         self.directions = (1,) * k + (-1,) + (-1,) * k
         self._calls = [0]
+        self._stuck = -1  # mirrors parameters[STUCK] as a Python int (read at every event)
         parameters, calls = self.parameters, self._calls
 
         def rhs(t: float, y: NDArray[np.float64], yp: NDArray[np.float64]) -> None:
@@ -101,20 +102,21 @@ class Model:
     @property
     def stuck_on(self) -> int:
         """Index of the stop held closed (-1: free flight)."""
-        return int(self.parameters[STUCK])
+        return self._stuck
 
     @stuck_on.setter
     def stuck_on(self, stop: int) -> None:
+        self._stuck = int(stop)
         self.parameters[STUCK] = float(stop)
 
     @property
     def stuck(self) -> bool:
         """Is a stop held closed? (Setting True holds stop 0: for one-stop callers.)"""
-        return self.parameters[STUCK] >= 0.0
+        return self._stuck >= 0
 
     @stuck.setter
     def stuck(self, value: bool) -> None:
-        self.parameters[STUCK] = 0.0 if value else -1.0
+        self.stuck_on = 0 if value else -1
 
     @property
     def apex_event(self) -> bool:
