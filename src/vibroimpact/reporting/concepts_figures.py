@@ -137,7 +137,8 @@ def impact_figure(dataset: xr.Dataset) -> DrawnFigure | None:
     if not rows:
         return None
     panels = (("bumper_peak_acceleration", "peak impact acceleration [m/s²]", "bumper twins: acceleration", True),
-              ("bumper_peak_contact_force", "peak bumper force [N]", "bumper twins: force (time domain)", True),
+              ("bumper_peak_contact_force", "peak bumper force [N]", "bumper twins: contact force (time domain)", True),
+              ("bumper_peak_base_force", "peak base force [N]", "bumper twins: force on the base (time domain)", True),
               ("simulated_impulse_per_period", "impulse per period [N s]", "rigid stops: impulse", False),
               ("simulated_impacts_per_period", "impacts per period", "rigid stops: impacts", False))  # fmt: skip
     fig, axes = new_figure(len(panels), panel_height=3.2, legend_rows=legend_rows(len(rows), 2))
@@ -151,9 +152,10 @@ def impact_figure(dataset: xr.Dataset) -> DrawnFigure | None:
     figure_legend(fig, axes, columns=2)
     bumper = fmt(dataset.attrs.get("bumper_frequency_Hz"), ".4g")
     caption = (
-        f"Top: steady states of each rigid stop's Kelvin-Voigt twin (Omega_b/2pi = {bumper} Hz, loss factor giving the stop's R) through the "
-        "compliant engine: the largest deceleration in contact and the largest bumper force, against frequency (log scales; no point "
-        "where nothing touches). Bottom: the exact engine's rigid stops: total impulse and impacts per excitation period (chattering shows "
+        f"First three panels: steady states of each rigid stop's Kelvin-Voigt twin (Omega_b/2pi = {bumper} Hz, loss factor giving the stop's R) "
+        "through the compliant engine: the largest deceleration in contact, the largest bumper force, and the largest force on the base "
+        "(k1 x1 + b1 x1' plus the absolute stops' force, from a dense replay of the steady state), against frequency (log scales; no point "
+        "where nothing touches). Last two: the exact engine's rigid stops, total impulse and impacts per excitation period (chattering shows "
         "as many impacts). Shaded: the anti-resonance band."
     )
     return DrawnFigure(fig, "concepts_impacts", "What the impacts cost: bumper acceleration and force, impulse", caption)

@@ -11,6 +11,7 @@ import html
 import math
 from pathlib import Path
 
+import numpy as np
 import xarray as xr
 
 from vibroimpact.reporting.concepts_figures import impact_figure, overview_figure, response_figure
@@ -28,12 +29,15 @@ DEFINITIONS = (
     "closed-form impact orbit where its Floquet multipliers are inside the unit circle, the stable stretches of the continued "
     "branches, and the exact engine's simulated steady state (an attractor, periodic or not). <b>Peak</b>: its largest value "
     "over the band. <b>Base force</b>: fundamental of k1 x1 + b1 x1' plus the force of the absolute stops (a stop between the "
-    "masses pushes no force into the base). <b>Bumper force and impact acceleration</b>: every rigid stop replaced by a "
-    "Kelvin-Voigt bumper of the same clearance whose one collision restitutes the same R, largest force and deceleration "
-    "in contact over the simulated steady states (time domain). <b>Anti-resonance band</b>: {band}. <b>Impacts in the "
+    "masses pushes no force into the base). <b>With bumpers</b>: every rigid stop replaced by a Kelvin-Voigt bumper of the "
+    "same clearance whose one collision restitutes the same R; the time-domain peak of the base force over the simulated "
+    "steady states (from a dense replay of each, whose state after the replayed periods agrees with the compliant engine's "
+    "to {mismatch} of the motion's scale; without a stop, the amplitude of the linear force), and the largest deceleration "
+    "in contact. <b>Anti-resonance band</b>: {band}. <b>Impacts in the "
     "band</b>: share of the band where the motion impacts (wherever the linear motion hits a stop every steady motion "
     "impacts). <b>Notch depth</b>: 20 log10 of the smallest worst-stable |X1| in the band over q/k1 = {static} mm. "
-    "★ bold: the best value of the column (smallest; deepest notch).</p>"
+    "★ bold: the best value of the column (smallest; deepest notch). (DH): Den Hartog's optimum. <b>Unstable orbits</b>: "
+    "frequencies of the continued branches' and the closed form's unstable stretches.</p>"
 )
 #: Den Hartog's optimum as the page states it (HTML).
 DEN_HARTOG = (
@@ -66,7 +70,9 @@ class ConceptsPage:
         low, high = float(d.attrs.get("band_low_Hz", math.nan)), float(d.attrs.get("band_high_Hz", math.nan))
         band = (f"{fmt(low, '.2f')}-{fmt(high, '.2f')} Hz around the anti-resonance at {fmt(d.attrs.get('anti_resonance_Hz'), '.2f')} Hz, where "
                 "the scene's lightly damped absorber without a stop keeps |X1| below q/k1") if math.isfinite(low) else "none (|X1| never drops below q/k1)"  # fmt: skip
-        definitions = DEFINITIONS.format(band=html.escape(band), static=fmt(1e3 * float(d.attrs["static_deflection_m"]), ".2g"))
+        mismatch = d["bumper_replay_mismatch"].values if "bumper_replay_mismatch" in d else np.zeros(0)
+        worst = f"{np.nanmax(mismatch):.1e}" if np.any(np.isfinite(mismatch)) else "(no replay)"
+        definitions = DEFINITIONS.format(band=html.escape(band), static=fmt(1e3 * float(d.attrs["static_deflection_m"]), ".2g"), mismatch=worst)
         answer = Section("Which absorber concept, with which stop", DEN_HARTOG, tables=[Table("Concepts side by side", concepts_table(d) + definitions)])
         figures = Section("Figures", "", figures=saved((overview_figure(d), response_figure(d), impact_figure(d)), out))
         notes = "".join(f"<li><b>{html.escape(str(d['label'].values[i]))}</b>: {html.escape(str(d['notes'].values[i]) or 'closed forms only')}</li>" for i in range(d.sizes["concept"]))

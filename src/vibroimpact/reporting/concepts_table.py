@@ -54,9 +54,9 @@ class Column:
 COLUMNS = (
     Column("peak_x1_amplitude", "peak |X1| [mm]", 1e3, ".3g", "peak |X1|", "peak_x1_frequency"),
     Column("peak_base_force_amplitude", "peak base force, fundamental [N]", 1.0, ".3g", "base force", "peak_base_force_frequency"),
-    Column("peak_contact_force", "peak bumper force, time domain [N]", 1.0, ".3g", "bumper force", stops_only=True),
-    Column("peak_impact_acceleration", "peak impact acceleration, bumper [m/s²]", 1.0, ".3g", "impact acceleration", stops_only=True),
-    Column("band_impact_fraction", "impacts in the anti-resonance band [% of band]", 100.0, ".0f", "impacts in the band"),
+    Column("peak_base_force_bumper", "peak base force with bumpers, time domain [N]", 1.0, ".3g", "time-domain base force"),
+    Column("peak_impact_acceleration", "peak impact acceleration, bumper [m/s²]", 1.0, ".0f", "impact acceleration", stops_only=True),
+    Column("band_impact_fraction", "impacts in the anti-resonance band [% of band]", 100.0, ".0f", "impacts in the band", stops_only=True),
     Column("notch_depth", "notch depth, min |X1| / (q/k1) [dB]", 1.0, ".1f", "notch depth", "notch_frequency"),
 )
 
@@ -128,7 +128,7 @@ def concepts_table(dataset: xr.Dataset) -> str:
     has_stops = _has_stops(dataset)
     wrap = "style='white-space:normal'"
     head = "".join(f"<th {wrap}>{html.escape(c.title)}</th>" for c in COLUMNS)
-    lines = [f"<table><tr><th {wrap}>concept</th><th {wrap}>k2 [N/m]</th><th {wrap}>b2 [N s/m]</th>{head}<th {wrap}>unstable orbits [Hz]</th><th>verdict</th></tr>"]
+    lines = [f"<table style='font-size:93%'><tr><th {wrap}>concept</th><th {wrap}>k2 [N/m], b2 [N s/m]</th>{head}<th {wrap}>unstable orbits [Hz]</th><th>verdict</th></tr>"]
     marks = {c.variable: best_rows(_values(dataset, c)) for c in COLUMNS}
     texts = verdicts(dataset)
     for row in range(rows):
@@ -149,10 +149,10 @@ def concepts_table(dataset: xr.Dataset) -> str:
         label = html.escape(str(dataset["label"].values[row]))
         absorber = str(dataset["absorber"].values[row])
         k2, b2 = (fmt(dataset[name].values[row], ".4g") for name in ("absorber_stiffness", "absorber_damping"))
-        k2 += "<br><small>Den Hartog</small>" if absorber.startswith("k2") and "Den Hartog" in absorber.split(", b2")[0] else ""
-        b2 += "<br><small>Den Hartog</small>" if "Den Hartog" in absorber.split(", b2")[-1] else ""
+        k2 += " <small>(DH)</small>" if "Den Hartog" in absorber.split(", b2")[0] else ""
+        b2 += " <small>(DH)</small>" if "Den Hartog" in absorber.split(", b2")[-1] else ""
         unstable = html.escape(str(dataset["unstable_stretches"].values[row]))
-        lines.append(f"<tr><td style='white-space:normal;min-width:11em'>{label}</td><td title='{html.escape(absorber)}'>{k2}</td><td>{b2}</td>{''.join(cells)}"
-                     f"<td style='white-space:normal;min-width:7em'>{unstable}</td><td style='white-space:normal;min-width:20em;text-align:left'>{html.escape(texts[row])}</td></tr>")  # fmt: skip
+        lines.append(f"<tr><td style='white-space:normal;min-width:10em'>{label}</td><td title='{html.escape(absorber)}'>{k2}<br>{b2}</td>{''.join(cells)}"
+                     f"<td style='white-space:normal;min-width:6em'><small>{unstable}</small></td><td style='white-space:normal;min-width:17em;text-align:left'>{html.escape(texts[row])}</td></tr>")  # fmt: skip
     lines.append("</table>")
     return "".join(lines)

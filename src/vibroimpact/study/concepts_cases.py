@@ -3,8 +3,9 @@
 A case is one concept over a chunk of frequencies. At each frequency the ``exact`` engine marches the rigid stops to
 their steady state (from the closed-form impact orbit where the package has one, else from the linear steady state,
 or rest if that starts inside a stop), and, when the scene has a bumper, the ``compliant`` engine marches each stop's
-Kelvin-Voigt twin from that rigid steady state: its peak contact acceleration and force, and the fundamental of the
-force on the base. Every value is per frequency; a point that fails is NaN and flagged, never fatal.
+Kelvin-Voigt twin from that rigid steady state (where the rigid motion impacts; elsewhere that impactless motion is the
+bumpers' too): its peak contact acceleration and force, the fundamental of the force on the base, and the peak of that
+force in the time domain from a dense replay (:mod:`.concepts_replay`), whose agreement with the engine is recorded. Every value is per frequency; a point that fails is NaN and flagged, never fatal.
 """
 
 from __future__ import annotations
@@ -17,12 +18,15 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.engines.registry import make_engine
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.scene.concepts import Concept
 from vibroimpact.simulation.settings import SteadySettings
-from vibroimpact.study.concepts_steady import linear_start, march
+from vibroimpact.simulation.steady import pgf_guesses
+from vibroimpact.study.concepts_replay import replay_base_force
+from vibroimpact.study.concepts_steady import length_scale, linear_start, march
 from vibroimpact.study.fingerprint import case_key
 from vibroimpact.study.runner import CaseResult, ProgressReport
 
@@ -44,11 +48,16 @@ CASE_FIELDS = (
     "bumper_converged",
     "bumper_peak_acceleration",
     "bumper_peak_contact_force",
+    "bumper_peak_base_force",
+    "bumper_replay_mismatch",
     "bumper_failed",
     "wall_time",
 )
-#: Most periods a bumper twin marches from the rigid steady state (IDA costs ~4 ms a period).
-MAX_BUMPER_PERIODS = 400
+#: Periods replayed densely where the bumper motion is not periodic (for its time-domain peak base force).
+REPLAY_PERIODS = 4
+#: Most periods a bumper twin marches from the rigid steady state (IDA costs ~4 ms a period; from the rigid orbit a
+#: periodic bumper motion repeats within ~20-60).
+MAX_BUMPER_PERIODS = 200
 
 
 @dataclass(frozen=True)
@@ -116,7 +125,13 @@ class ConceptCase:
             out["impacts_per_period"][i], out["impulse_per_period"][i] = m.impacts_per_period, m.impulse_per_period
             out["converged"][i], out["multiplicity"][i], out["failed"][i] = float(outcome.converged), float(outcome.multiplicity), 0.0
             out["end_time"][i], out["end_state"][i] = outcome.time, outcome.state
-            if bumper is not None:
+            if bumper is not None and m.impacts_per_period == 0.0:
+                # the rigid steady state never touches: it is the bumpers' too (the same linear motion, no contact)
+                out["bumper_x1"][i], out["bumper_base_force"][i] = m.x[0], m.base_force
+                out["bumper_impacts_per_period"][i], out["bumper_converged"][i], out["bumper_failed"][i] = 0.0, float(outcome.converged), 0.0
+                out["bumper_peak_acceleration"][i] = out["bumper_peak_contact_force"][i] = 0.0
+                out["bumper_peak_base_force"][i], out["bumper_replay_mismatch"][i] = abs(m.base_force), 0.0
+            elif bumper is not None:
                 self._bumper(bumper, frequency, outcome.time, outcome.state, out, i)
             out["wall_time"][i] = time.perf_counter() - started
             if report is not None:
@@ -128,6 +143,9 @@ class ConceptCase:
         problem = self.concept.problem(self.amplitude, frequency, bumper_frequency=self.bumper_frequency)
         try:
             outcome = march(engine, problem, t, y, self.steady_settings, min(self.steady_settings.max_periods, MAX_BUMPER_PERIODS))
+            periods = outcome.multiplicity if outcome.converged else REPLAY_PERIODS
+            replay = replay_base_force(problem, outcome.time, outcome.state, periods)
+            check = engine.integrate(problem, outcome.state, outcome.time, periods)  # type: ignore[attr-defined]
         except (RuntimeError, ValueError, TypeError, ArithmeticError, np.linalg.LinAlgError) as error:
             print(f"concept {self.concept.name}: compliant, f = {frequency:g} Hz failed: {error}", file=sys.stderr)
             out["bumper_failed"][i] = 1.0
@@ -137,17 +155,28 @@ class ConceptCase:
         out["bumper_impacts_per_period"][i] = m.impacts_per_period
         out["bumper_converged"][i], out["bumper_failed"][i] = float(outcome.converged), 0.0
         out["bumper_peak_acceleration"][i], out["bumper_peak_contact_force"][i] = m.peak_acceleration, m.peak_contact_force
+        length = length_scale(problem)
+        size = problem.size
+        scale = np.concatenate([np.full(size, length), np.full(size, problem.omega * length)])
+        out["bumper_peak_base_force"][i] = replay.peak_base_force
+        out["bumper_replay_mismatch"][i] = float(np.max(np.abs(replay.end_state - check.final_state) / scale))
 
 
 def start(concept: Concept, problem: ImpactProblem, settings: SteadySettings) -> tuple[float, NDArray[np.float64]]:
-    """Where the rigid march starts: on the closed-form impact orbit (slightly perturbed, so that an unstable orbit is
-    left) where the package has one, else the linear steady state (rest if that is inside a stop)."""
+    """Where the rigid march starts: on the closed-form impact orbit where it exists and is admissible (moved by the
+    settings' start perturbation, so that an unstable orbit is left), else the linear steady state (rest if that is
+    inside a stop)."""
+    length = problem.velocity_scale() / problem.omega
+    nudge = settings.start_perturbation * length * np.eye(1, 2 * problem.size, 0)[0]
     if concept.paper_layout:
-        from vibroimpact.simulation.steady import pgf_guesses
-
         guess = pgf_guesses(problem, [problem.frequency])[0]
         if guess is not None:
-            t, y = guess
-            length = problem.velocity_scale() / problem.omega
-            return t, np.asarray(y, dtype=float) + settings.start_perturbation * length * np.eye(1, y.size, 0)[0]
+            return guess[0], np.asarray(guess[1], dtype=float) + nudge
+        return 0.0, linear_start(problem)
+    try:
+        orbit = solve_impact_orbit(problem)
+    except ValueError:  # no closed form for this layout
+        return 0.0, linear_start(problem)
+    if bool(orbit.admissible()):
+        return 0.0, orbit.state_at(np.zeros(1))[0] + nudge
     return 0.0, linear_start(problem)

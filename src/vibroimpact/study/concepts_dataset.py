@@ -51,12 +51,12 @@ def concepts_dataset(settings: ConceptsSettings, closed: dict[str, ClosedForms],
     fine = {k: np.full((len(names), f.size), np.nan) for k in ("linear_x1", "closed_x1", "closed_force", "worst_x1", "worst_force")}
     flags = {k: np.full((len(names), f.size), -1, dtype=np.int8) for k in ("linear_fits", "closed_stable", "worst_impacts")}
     sim_keys = ("x1", "base_force", "impacts_per_period", "impulse_per_period", "converged", "multiplicity", "bumper_x1", "bumper_base_force", "bumper_impacts_per_period",
-                "bumper_peak_acceleration", "bumper_peak_contact_force", "bumper_converged")  # fmt: skip
+                "bumper_peak_acceleration", "bumper_peak_contact_force", "bumper_peak_base_force", "bumper_replay_mismatch", "bumper_converged")  # fmt: skip
     sim = {k: np.full((len(names), fs.size), np.nan) for k in sim_keys}
     branch_keys = ("frequency", "x1_amplitude", "base_force_amplitude", "floquet_modulus", "impacts_per_period", "period", "branch")
     orbit = {k: np.full((len(names), points), np.nan) for k in branch_keys}
     per: dict[str, list[Any]] = {k: [] for k in ("peak_x1", "peak_x1_f", "peak_force", "peak_force_f", "accel", "contact", "depth", "depth_f",
-                                                 "fraction", "coverage", "band_impacts", "unstable", "nonperiodic", "notes")}  # fmt: skip
+                                                 "fraction", "coverage", "band_impacts", "base_peak", "unstable", "nonperiodic", "notes")}  # fmt: skip
     for i, concept in enumerate(settings.concepts):
         cf = closed[concept.name]
         fine["linear_x1"][i], fine["closed_x1"][i], fine["closed_force"][i] = cf.linear_x1, cf.impact_x1, cf.impact_base_force
@@ -91,8 +91,10 @@ def concepts_dataset(settings: ConceptsSettings, closed: dict[str, ClosedForms],
         nonperiodic = stretches(fs, (sim["converged"][i] == 0.0), 1.5 * float(np.median(np.diff(fs))) if fs.size > 1 else 0.0) if s is not None else []
         accel = np.nanmax(sim["bumper_peak_acceleration"][i]) if np.any(np.isfinite(sim["bumper_peak_acceleration"][i])) else (0.0 if not concept.stops else math.nan)
         contact = np.nanmax(sim["bumper_peak_contact_force"][i]) if np.any(np.isfinite(sim["bumper_peak_contact_force"][i])) else (0.0 if not concept.stops else math.nan)
+        # without a stop the force on the base is a pure sinusoid: its time-domain peak is its amplitude
+        base_peak = np.nanmax(sim["bumper_peak_base_force"][i]) if np.any(np.isfinite(sim["bumper_peak_base_force"][i])) else (m.peak_force if not concept.stops else math.nan)
         for key, value in (("peak_x1", m.peak_x1), ("peak_x1_f", m.peak_x1_frequency), ("peak_force", m.peak_force), ("peak_force_f", m.peak_force_frequency),
-                           ("accel", accel), ("contact", contact), ("depth", m.notch_depth), ("depth_f", m.notch_frequency), ("fraction", m.band_impact_fraction),
+                           ("accel", accel), ("contact", contact), ("base_peak", base_peak), ("depth", m.notch_depth), ("depth_f", m.notch_frequency), ("fraction", m.band_impact_fraction),
                            ("coverage", m.band_coverage), ("band_impacts", _text(m.band_impacts)), ("unstable", _text(unstable)),
                            ("nonperiodic", _text(nonperiodic)), ("notes", "; ".join(n for n in notes if n))):  # fmt: skip
             per[key].append(value)
@@ -109,6 +111,7 @@ def concepts_dataset(settings: ConceptsSettings, closed: dict[str, ClosedForms],
         "peak_base_force_frequency": ("concept", per["peak_force_f"], {"units": "Hz", "long_name": "where the base force peaks"}),
         "peak_impact_acceleration": ("concept", per["accel"], {"units": "m s-2", "long_name": "largest contact deceleration with the Kelvin-Voigt bumpers (compliant steady states)"}),
         "peak_contact_force": ("concept", per["contact"], {"units": "N", "long_name": "largest bumper force (time domain, compliant steady states)"}),
+        "peak_base_force_bumper": ("concept", per["base_peak"], {"units": "N", "long_name": "largest force on the base in the time domain with the bumpers (dense replay of the compliant steady states; without a stop, the amplitude of the linear one)"}),
         "notch_depth": ("concept", per["depth"], {"units": "dB", "long_name": "20 log10 of the smallest worst-stable |X1| in the anti-resonance band over q / k1"}),
         "notch_frequency": ("concept", per["depth_f"], {"units": "Hz", "long_name": "where the notch is deepest"}),
         "band_impact_fraction": ("concept", per["fraction"], {"units": "1", "long_name": "share of the anti-resonance band where the motion impacts"}),
@@ -141,7 +144,8 @@ def concepts_dataset(settings: ConceptsSettings, closed: dict[str, ClosedForms],
 def _attrs(key: str) -> dict[str, str]:
     units = {"x1": "m", "base_force": "N", "x1_amplitude": "m", "base_force_amplitude": "N", "frequency": "Hz", "impacts_per_period": "1",
              "bumper_x1": "m", "bumper_base_force": "N", "bumper_peak_acceleration": "m s-2", "bumper_peak_contact_force": "N", "floquet_modulus": "1",
-             "bumper_impacts_per_period": "1", "period": "1", "multiplicity": "1", "impulse_per_period": "N s"}  # fmt: skip
+             "bumper_impacts_per_period": "1", "period": "1", "multiplicity": "1", "impulse_per_period": "N s",
+             "bumper_peak_base_force": "N", "bumper_replay_mismatch": "1"}  # fmt: skip
     out = {"long_name": key.replace("_", " ")}
     if key in units:
         out["units"] = units[key]

@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.engines.base import Trajectory
+from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.simulation.settings import SteadySettings
 
@@ -110,10 +111,12 @@ def linear_start(problem: ImpactProblem) -> NDArray[np.float64]:
 
 
 def check_stops(trajectory: Trajectory) -> None:
-    """``RuntimeError`` unless every impact of ``trajectory`` happens on its stop's closed gap and no recorded state
+    """Rigid stops: ``RuntimeError`` unless every impact of ``trajectory`` happens on its stop's closed gap and no recorded state
     (strobes, segment starts) is inside a stop, to :data:`GAP_TOLERANCE` of the motion's length: an engine that does
     not know a layout (e.g. takes a relative stop for the paper's) is refused instead of trusted."""
     problem = trajectory.problem
+    if not all(isinstance(stop.law, RigidStop) for stop in problem.stops):
+        return  # a bumper is compressed while in contact: penetration is its law, nothing to check
     normals, clearances = problem.normals(), problem.clearances()
     size = problem.size
     tolerance = GAP_TOLERANCE * length_scale(problem)
