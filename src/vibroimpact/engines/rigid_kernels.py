@@ -27,8 +27,8 @@ from vibroimpact.engines.sundae import as_doubles, content_data
 __all__ = ["pack_parameters", "quadrature_count", "rhs_kernel", "jacobian_kernel", "events_kernel", "holding_kernel", "STUCK", "APEX", "SIZE", "STOPS", "LENGTH", "HEADER", "COMPILED_RHS", "COMPILED_JACOBIAN", "COMPILED_EVENTS"]
 
 # header of the parameter array: mode, flags, sizes and the offsets of the blocks after it
-STUCK, APEX, SIZE, _N, STOPS, _OMEGA, _A, _C, _BR, _BI, _G, _G0, _NORMAL, _H, _H0, _HBR, _HBI, _TINV, _XOFF, LENGTH = range(20)
-HEADER = 20
+STUCK, APEX, SIZE, _N, STOPS, _OMEGA, _TRIG, _A, _C, _BR, _BI, _G, _G0, _NORMAL, _H, _H0, _HBR, _HBI, _TINV, _XOFF, LENGTH = range(21)
+HEADER = 21
 
 
 def quadrature_count(size: int, stops: int) -> int:
@@ -39,6 +39,7 @@ def quadrature_count(size: int, stops: int) -> int:
 def pack_parameters(layout: FlowLayout, states: int, apex: bool = True) -> NDArray[np.float64]:
     """The flat parameter array of ``layout`` for a state of ``states`` entries (2 N, or 2 N plus the quadratures).
 
+    Header: mode, flags, sizes, w, the trigonometric functions the forcing needs, and the blocks' offsets.
     Blocks: the matrices A of the free flight and of each stuck mode ((K + 1) x 2N x 2N, row-major), their c, Re b
     and Im b ((K + 1) x 2N each), the gap rows and constants, the normals, the holding rows H, h0, Re hb, Im hb, T^-1
     and its offset. Entry :data:`STUCK` holds the stuck stop (-1: free flight), :data:`APEX` the grazing guard flag.
@@ -63,6 +64,8 @@ def pack_parameters(layout: FlowLayout, states: int, apex: bool = True) -> NDArr
     ]
     header = np.zeros(HEADER)
     header[STUCK], header[APEX], header[SIZE], header[_N], header[STOPS], header[_OMEGA] = -1.0, float(apex), states, n, k, layout.omega
+    # which of cos(wt), sin(wt) the flight's forcing needs (the moments need both): none, cos, or both
+    header[_TRIG] = 2.0 if np.any(blocks[3] != 0.0) else 1.0 if np.any(blocks[2] != 0.0) else 0.0
     start = HEADER
     for index, block in zip(range(_A, LENGTH), blocks):
         header[index] = start
@@ -93,7 +96,9 @@ def rhs_kernel(t: float, y: NDArray[np.float64], yp: NDArray[np.float64], p: NDA
     a0, c0 = int(p[_A]) + mode * n2 * n2, int(p[_C]) + mode * n2
     br0, bi0 = int(p[_BR]) + mode * n2, int(p[_BI]) + mode * n2
     wt = p[_OMEGA] * t
-    c, s = math.cos(wt), math.sin(wt)
+    trig = 2 if int(p[SIZE]) > n2 else int(p[_TRIG])
+    c = math.cos(wt) if trig > 0 else 0.0
+    s = math.sin(wt) if trig > 1 else 0.0
     for i in range(n2):
         acc = p[c0 + i] + p[br0 + i] * c - p[bi0 + i] * s
         row = a0 + i * n2
