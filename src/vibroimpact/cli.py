@@ -98,13 +98,15 @@ def _estimate(scene: Scene, jobs: int, costs_file: Path | None) -> int:
 
     try:
         costs = Costs.load(costs_file) if costs_file is not None else None
-        print(estimate_scene(scene, jobs=jobs, costs=costs).text())
-    except (OSError, ValueError) as error:
+    except (OSError, ValueError) as error:  # only the cost file's own problems are named as such
         print(f"run-study: error: --costs {costs_file}: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    try:
+        text = estimate_scene(scene, jobs=jobs, costs=costs).text()
     except KeyError as error:  # a cost file without the engine the scene runs
         print(f"run-study: error: the cost file {costs_file} has no cost for {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    print(text)
     return 0
 
 
