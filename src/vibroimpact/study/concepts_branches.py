@@ -2,9 +2,8 @@
 the closed forms found are stable, and where they lose stability (folds, period doublings, torus and grazing points).
 
 A concept's branches start from every simulated periodic steady state with impacts that no earlier branch passes
-through (same period, impact count and |X1| within :data:`SAME_ORBIT`), and, on the paper's layout, from the middle
-of each stretch where the closed-form one-impact orbit is admissible (its unstable parts too, which no simulation
-reaches). Each start is moved to a stroboscopic section clear of its impacts (:func:`vibroimpact.orbits.maps.resection`),
+through (same period, impact count and |X1| within :data:`SAME_ORBIT`), and from the middle of each stretch where the
+closed-form impact orbit is admissible (its unstable parts too, which no simulation reaches). Each start is moved to a stroboscopic section clear of its impacts (:func:`vibroimpact.orbits.maps.resection`),
 shot as a fixed point of the exact map (:func:`vibroimpact.orbits.shooting.shoot`) and continued both ways over the
 band (:func:`vibroimpact.orbits.continuation.continue_branch`). A failure is a note, never fatal.
 """
@@ -17,6 +16,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.orbits.branch import Branch
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
 from vibroimpact.orbits.maps import ImpactMap, resection
@@ -109,13 +109,12 @@ class BranchCase:
         return out
 
     def _starts(self, notes: list[str]) -> list[tuple[float, int, float, tuple[float, ...]]]:
-        """The simulated seeds, then (paper's layout) the closed-form one-impact orbit's admissible stretches."""
+        """The simulated seeds, then the closed-form impact orbit's admissible stretches."""
         starts = list(self.seeds)
-        if self.concept.paper_layout:
-            try:
-                starts += _one_impact_starts(self.concept, self.amplitude, self.low, self.high)
-            except Exception as error:  # noqa: BLE001
-                notes.append(f"closed-form starts failed: {type(error).__name__}: {error}")
+        try:
+            starts += _closed_form_starts(self.concept, self.amplitude, self.low, self.high)
+        except Exception as error:  # noqa: BLE001 - no closed-form starts: the simulated ones remain
+            notes.append(f"closed-form starts failed: {type(error).__name__}: {error}")
         return starts
 
     def _known(self, points: list, mapping: ImpactMap, y: NDArray[np.float64], period: int) -> bool:
@@ -150,22 +149,22 @@ def _measure(mapping: ImpactMap, branch: Branch, label: int) -> list[tuple[float
     return rows
 
 
-def _one_impact_starts(concept: Concept, amplitude: float, low: float, high: float) -> list[tuple[float, int, float, tuple[float, ...]]]:
-    """The middle of each stretch where the paper's closed-form one-impact orbit is admissible, as a state at t = 0."""
-    from vibroimpact.analysis.pgf import solve_one_impact
-    from vibroimpact.orbits.maps import one_impact_state
-
-    law = concept.stops[0].law
+def _closed_form_starts(concept: Concept, amplitude: float, low: float, high: float) -> list[tuple[float, int, float, tuple[float, ...]]]:
+    """The middle of each stretch where the closed-form impact orbit (one stop, or a symmetric two-sided pair) is
+    admissible, as a state at t = 0; none where no closed form applies."""
     frequency = np.arange(low, high + 0.005, 0.01)
-    solution = solve_one_impact(concept.system, 2.0 * np.pi * frequency, law.clearance, law.restitution, amplitude)
-    admissible = np.flatnonzero(solution.admissible())
+    try:
+        orbit = solve_impact_orbit(concept.problem(amplitude, float(frequency[0])), omega=2.0 * np.pi * frequency)
+    except ValueError:
+        return []
+    admissible = np.flatnonzero(orbit.admissible())
     starts = []
     for run in np.split(admissible, np.flatnonzero(np.diff(admissible) > 1) + 1):
         if run.size:
-            f0 = float(frequency[run[run.size // 2]])
-            state = one_impact_state(concept.problem(amplitude, f0))
+            k = int(run[run.size // 2])
+            state = orbit.take([k]).state_at(np.zeros((1, 1)))[0, 0]
             if np.all(np.isfinite(state)):
-                starts.append((f0, 1, 0.0, tuple(float(v) for v in state)))
+                starts.append((float(frequency[k]), 1, 0.0, tuple(float(v) for v in state)))
     return starts
 
 

@@ -53,6 +53,9 @@ CASE_FIELDS = (
     "bumper_failed",
     "wall_time",
 )
+#: Most periods a bumper twin marches where the rigid motion is not periodic either: enough to leave the rigid
+#: attractor's neighbourhood for the bumper's, whose impacts are then measured over ``irregular_measure_periods``.
+SETTLE_PERIODS = 60
 #: Periods replayed densely where the bumper motion is not periodic (for its time-domain peak base force).
 REPLAY_PERIODS = 4
 #: Most periods a bumper twin marches from the rigid steady state (IDA costs ~4 ms a period; from the rigid orbit a
@@ -132,17 +135,17 @@ class ConceptCase:
                 out["bumper_peak_acceleration"][i] = out["bumper_peak_contact_force"][i] = 0.0
                 out["bumper_peak_base_force"][i], out["bumper_replay_mismatch"][i] = abs(m.base_force), 0.0
             elif bumper is not None:
-                self._bumper(bumper, frequency, outcome.time, outcome.state, out, i)
+                self._bumper(bumper, frequency, outcome.time, outcome.state, out, i, MAX_BUMPER_PERIODS if outcome.converged else SETTLE_PERIODS)
             out["wall_time"][i] = time.perf_counter() - started
             if report is not None:
                 report(float(i + 1))
         return out
 
-    def _bumper(self, engine: object, frequency: float, t: float, y: NDArray[np.float64], out: dict[str, NDArray], i: int) -> None:
-        """The bumper twins' steady state from the rigid one (t [s], y)."""
+    def _bumper(self, engine: object, frequency: float, t: float, y: NDArray[np.float64], out: dict[str, NDArray], i: int, periods: int) -> None:
+        """The bumper twins' steady state from the rigid one (t [s], y), marching at most ``periods``."""
         problem = self.concept.problem(self.amplitude, frequency, bumper_frequency=self.bumper_frequency)
         try:
-            outcome = march(engine, problem, t, y, self.steady_settings, min(self.steady_settings.max_periods, MAX_BUMPER_PERIODS))
+            outcome = march(engine, problem, t, y, self.steady_settings, min(self.steady_settings.max_periods, periods))
             periods = outcome.multiplicity if outcome.converged else REPLAY_PERIODS
             replay = replay_base_force(problem, outcome.time, outcome.state, periods)
             check = engine.integrate(problem, outcome.state, outcome.time, periods)  # type: ignore[attr-defined]
