@@ -175,3 +175,28 @@ def test_three_dof_base_motion_exact_repeats_the_closed_form() -> None:
     assert np.all(pgf["stable"].values == 1) and np.all(exact["regime"].values == Regime.ONE_IMPACT)
     for name in ("a_amplitude", "b_amplitude", "c_amplitude", "impulse", "force_amplitude"):
         np.testing.assert_allclose(exact[name].values, pgf[name].values, rtol=1e-9)
+
+
+def test_sweep_of_one_stop_among_stops_with_their_own_values() -> None:
+    """``sweep.stop`` sweeps the clearance of stop 0 only; stop 1 keeps its own values. The swept parameter is a
+    dimension, each stop is described with what it takes (``Delta`` where swept), and no scalar restitution or
+    bumper loss factor pretends to be shared."""
+    document = {
+        "name": "mixed",
+        "system": copy.deepcopy(MATRICES),
+        "excitation": {"amplitude": 10.0, "on": "x1"},
+        "stops": [{"coordinate": "x2", "side": "upper", "restitution": 0.2, "bumper": {"frequency": 300.0}},
+                  {"between": ["x2", "x1"], "side": "lower", "clearance": 0.002, "restitution": 0.6}],  # fmt: skip
+        "bumper": {"frequency": 250.0},
+        "sweep": {"clearance": [0.002, 0.004], "stop": 0, "frequency": {"start": 20.0, "stop": 26.0, "step": 0.5}},
+        "solutions": ["linear", "exact"],
+        "simulation": {"frequency": [24.0], "max_periods": 100, "lyapunov_periods": 0, "irregular_measure_periods": 16},
+        "report": False,
+    }
+    dataset = run_study(parse_scene(document), progress=None)
+    assert dataset["impulse"].dims == ("solution", "stop", "clearance", "frequency")
+    assert list(dataset["stop_description"].values) == ["x2 <= Delta, R = 0.2, bumper 300 Hz", "x2 - x1 >= -2 mm, R = 0.6, bumper 250 Hz"]
+    assert "restitution" not in dataset.coords and "bumper_loss_factor" not in dataset.coords
+    impulses = dataset["impulse"].sel(solution="exact", frequency=24.0).values  # (stop, clearance)
+    assert np.all(impulses > 0.0), "both stops are hit at 24 Hz, whichever clearance stop 0 has"
+    assert not np.allclose(impulses[:, 0], impulses[:, 1], rtol=1e-3), "stop 0's clearance changes the motion"

@@ -117,7 +117,8 @@ def finish_dataset(dataset: xr.Dataset, scene: Scene, coords: dict[str, object],
             dataset = dataset.drop_vars(key)  # the stops give different values: the stop descriptions say them
     if scene.bumper_frequency is not None:
         losses = scene.loss_factors()
-        dataset = dataset.assign_coords(bumper_loss_factor=("restitution", losses) if "restitution" in dataset.dims else float(losses[0]))
+        if "restitution" in dataset.dims or not scene.general or np.isfinite(losses[0]):  # a general scene's stops may each have their own
+            dataset = dataset.assign_coords(bumper_loss_factor=("restitution", losses) if "restitution" in dataset.dims else float(losses[0]))
         if "bumper_loss_factor" in scene.swept:
             dataset = dataset.swap_dims({"restitution": "bumper_loss_factor"})
     for key, attrs in COORDINATE_ATTRIBUTES.items():
