@@ -57,7 +57,7 @@ def test_a_concept_without_a_stop_is_its_linear_receptance(dataset: xr.Dataset) 
     assert math.isclose(float(concept["peak_x1_amplitude"]), float(x1.max()), rel_tol=1e-12)
     band = (f >= dataset.attrs["band_low_Hz"]) & (f <= dataset.attrs["band_high_Hz"])
     assert math.isclose(float(concept["notch_depth"]), 20.0 * math.log10(x1[band].min() / 4e-4), rel_tol=1e-12)
-    assert float(concept["peak_impact_acceleration"]) == 0.0 and str(concept["unstable_stretches"].values) == "none"
+    assert float(concept["peak_impact_acceleration"]) == 0.0 and str(concept["unstable_stretches"].values) == "none"  # exact: no contact, no acceleration
 
 
 def test_the_simulated_orbit_is_the_closed_form_one(dataset: xr.Dataset) -> None:
