@@ -15,10 +15,13 @@ stacked, flow 0 the free flight and flow 1 + k the flight held on stop k, all in
   rows giving the modal coordinates, ``hrms[f]`` the amplitude Y of the harmonic particular solution Re(Y e^{jwt}),
   ``csts[f]`` the constant one; where ``polys[f]`` (rigid-body modes), the polynomial part z0 + q1 tau + q2 tau^2
   from the projector ``zpros[f]``, the nilpotent ``znils[f]`` and the drifts ``zdrvs[f]`` (c), ``zdrv2s[f]`` (q2).
-* an observable h = w . y + offset of a piece from (t0, y0) is ``amp`` complex (one per eigenvalue; the root search
-  keeps one of each conjugate pair, doubled), ``har`` (complex), ``con`` (float), ``p1``, ``p2``:
+* an observable h = w . y + offset of a piece from (t0, y0) is its amplitudes (one per eigenvalue; the root search
+  keeps one of each conjugate pair, doubled: ``hlams[f, :hcounts[f]]``), ``har`` (complex), ``con``, ``p1``, ``p2``:
   h(t) = Re(sum amp_i e^{lam_i tau} + har e^{jwt}) + con + p1 tau + p2 tau^2, tau = t - t0. The loop watches one
   observable per stop: the gap's n_k . x - Delta_k in free flight, minus the holding force while held on stop k.
+
+Helpers index the stacked arrays (flow f, stop j) instead of receiving slices: an array view made in the loop, or an
+array variable reassigned in it, costs numba's atomic reference counting, which took ~20 % of a run.
 
 The Jacobian of the stroboscopic map is the product, over the pieces of a period, of the state-transition matrices
 Re(V diag(e^{lam dt}) V^+) + P_z + A_z dt and of the saltation matrix of each event (Leine & Nijmeijer; di Bernardo et
@@ -35,56 +38,55 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["run_periods", "STATUS_OK", "STATUS_NO_PROGRESS", "STATUS_TWO_STICKS"]
+__all__ = ["run_periods", "moment_rates", "STATUS_OK", "STATUS_NO_PROGRESS", "STATUS_TWO_STICKS"]
 
 STATUS_OK, STATUS_NO_PROGRESS, STATUS_TWO_STICKS = 0, 1, 2
 
 
+# ------------------------------------------------------------------------------------------------ a piece of flow f
 @njit(cache=True, error_model="numpy")
-def _modal(lam, inv, hrm, cst, omega, t0, y0, out):
-    """Modal coordinates of the homogeneous part through y0 at t0, into ``out``."""
-    m = lam.size
+def _modal(lams, invs, hrms, csts, f, m, omega, t0, y0, out):
+    """Modal coordinates of the homogeneous part of flow f through y0 at t0, into ``out[:m]``."""
     phasor = complex(math.cos(omega * t0), math.sin(omega * t0))
     for r in range(m):
         out[r] = 0j
     for i in range(y0.size):
-        rel = y0[i] - ((hrm[i] * phasor).real + cst[i])
+        rel = y0[i] - ((hrms[f, i] * phasor).real + csts[f, i])
         for r in range(m):
-            out[r] += inv[r, i] * rel
+            out[r] += invs[f, r, i] * rel
 
 
 @njit(cache=True, error_model="numpy")
-def _rigid(zpro, znil, zdrv, zdrv2, hrm, cst, omega, t0, y0, z0, q1, q2):
+def _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t0, y0, z0, q1, q2):
     """The polynomial part through y0 at t0: z0 = P_z (y0 - p(t0)), q1 = A_z z0 + c, q2 = A_z c / 2."""
     n = y0.size
     phasor = complex(math.cos(omega * t0), math.sin(omega * t0))
-    rel = np.empty(n)
-    for i in range(n):
-        rel[i] = y0[i] - ((hrm[i] * phasor).real + cst[i])
     for r in range(n):
         acc = 0.0
         for i in range(n):
-            acc += zpro[r, i] * rel[i]
+            acc += zpros[f, r, i] * (y0[i] - ((hrms[f, i] * phasor).real + csts[f, i]))
         z0[r] = acc
     for r in range(n):
-        acc = zdrv[r]
+        acc = zdrvs[f, r]
         for i in range(n):
-            acc += znil[r, i] * z0[i]
+            acc += znils[f, r, i] * z0[i]
         q1[r] = acc
-        q2[r] = zdrv2[r]
+        q2[r] = zdrv2s[f, r]
 
 
 @njit(cache=True, error_model="numpy")
-def _state(lam, vec, hrm, cst, omega, t0, modal, t, out, poly, z0, q1, q2):
+def _state(lams, vecs, hrms, csts, f, m, omega, t0, modal, t, out, poly, z0, q1, q2):
+    """The state of the piece at t, into ``out``."""
     phasor = complex(math.cos(omega * t), math.sin(omega * t))
     for r in range(out.size):
-        out[r] = (hrm[r] * phasor).real + cst[r]
-    for i in range(lam.size):
-        if lam[i].imag < 0.0:
+        out[r] = (hrms[f, r] * phasor).real + csts[f, r]
+    for i in range(m):
+        rate = lams[f, i]
+        if rate.imag < 0.0:
             continue  # its conjugate's term, doubled, stands for both (the state is real)
-        growth = np.exp(lam[i] * (t - t0)) * modal[i] * (2.0 if lam[i].imag > 0.0 else 1.0)
+        growth = np.exp(rate * (t - t0)) * modal[i] * (2.0 if rate.imag > 0.0 else 1.0)
         for r in range(out.size):
-            out[r] += (vec[r, i] * growth).real
+            out[r] += (vecs[f, r, i] * growth).real
     if poly:
         tau = t - t0
         for r in range(out.size):
@@ -92,56 +94,58 @@ def _state(lam, vec, hrm, cst, omega, t0, modal, t, out, poly, z0, q1, q2):
 
 
 @njit(cache=True, error_model="numpy")
-def _observable(weights, offset, extra, vec, hrm, cst, modal, amp, poly, z0, q1, q2):
-    """h = weights . y + offset (+ Re(extra e^{jwt})) of the piece with ``modal`` coordinates: amplitudes into
-    ``amp``; returns (har, con, p1, p2)."""
-    for i in range(modal.size):
+def _observable(weights, row, offset, extra, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2):
+    """h = weights[row] . y + offset (+ Re(extra e^{jwt})) of the piece with ``modal`` coordinates: amplitudes into
+    ``amp[0, :m]``; returns (har, con, p1, p2)."""
+    n = weights.shape[1]
+    for i in range(m):
         acc = 0j
-        for r in range(weights.size):
-            acc += weights[r] * vec[r, i]
-        amp[i] = acc * modal[i]
+        for r in range(n):
+            acc += weights[row, r] * vecs[f, r, i]
+        amp[0, i] = acc * modal[i]
     har = 0j
     con = offset
-    for r in range(weights.size):
-        har += weights[r] * hrm[r]
-        con += weights[r] * cst[r]
+    for r in range(n):
+        har += weights[row, r] * hrms[f, r]
+        con += weights[row, r] * csts[f, r]
     har += extra
     p1 = 0.0
     p2 = 0.0
     if poly:
-        for r in range(weights.size):
-            con += weights[r] * z0[r]
-            p1 += weights[r] * q1[r]
-            p2 += weights[r] * q2[r]
+        for r in range(n):
+            con += weights[row, r] * z0[r]
+            p1 += weights[row, r] * q1[r]
+            p2 += weights[row, r] * q2[r]
     return har, con, p1, p2
 
 
 @njit(cache=True, error_model="numpy")
-def _halve(lam, amp, out):
-    """Amplitudes on the half rates (Im >= 0): Re(a e^{lt}) + Re(conj) = Re(2 a e^{lt}), so each pair is kept once,
-    doubled (every evaluation of the observable then costs half)."""
+def _halve(lams, f, m, amp, out, row):
+    """Amplitudes on the half rates (Im >= 0) into ``out[row]``: Re(a e^{lt}) + Re(conj) = Re(2 a e^{lt}), so each pair
+    is kept once, doubled (every evaluation of the observable then costs half)."""
     count = 0
-    for i in range(lam.size):
-        if lam[i].imag > 0.0:
-            out[count] = 2.0 * amp[i]
+    for i in range(m):
+        if lams[f, i].imag > 0.0:
+            out[row, count] = 2.0 * amp[0, i]
             count += 1
-        elif lam[i].imag == 0.0:
-            out[count] = amp[i]
+        elif lams[f, i].imag == 0.0:
+            out[row, count] = amp[0, i]
             count += 1
 
 
+# ---------------------------------------------------------------- an observable: rates[rr, :rc], amplitudes amp[ar]
 @njit(cache=True, error_model="numpy")
-def _value(lam, amp, har, con, p1, p2, omega, t0, t):
+def _value(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t):
     """h(t)."""
     total = har * complex(math.cos(omega * t), math.sin(omega * t))
-    for i in range(lam.size):
-        total += amp[i] * np.exp(lam[i] * (t - t0))
+    for i in range(rc):
+        total += amp[ar, i] * np.exp(rates[rr, i] * (t - t0))
     tau = t - t0
     return total.real + con + (p1 + p2 * tau) * tau
 
 
 @njit(cache=True, error_model="numpy")
-def _derivatives(lam, amp, har, con, p1, p2, omega, t0, t, out):
+def _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, out):
     """h, h', ..., h^(len(out) - 1) at t."""
     forced = har * complex(math.cos(omega * t), math.sin(omega * t))
     jw = 1j * omega
@@ -149,11 +153,12 @@ def _derivatives(lam, amp, har, con, p1, p2, omega, t0, t, out):
     for k in range(out.size):
         out[k] = (forced * power).real + (con if k == 0 else 0.0)
         power *= jw
-    for i in range(lam.size):
-        term = amp[i] * np.exp(lam[i] * (t - t0))
+    for i in range(rc):
+        rate = rates[rr, i]
+        term = amp[ar, i] * np.exp(rate * (t - t0))
         for k in range(out.size):
             out[k] += term.real
-            term *= lam[i]
+            term *= rate
     tau = t - t0
     out[0] += (p1 + p2 * tau) * tau
     if out.size > 1:
@@ -163,12 +168,12 @@ def _derivatives(lam, amp, har, con, p1, p2, omega, t0, t, out):
 
 
 @njit(cache=True, error_model="numpy")
-def _bound(lam, amp, har, p1, p2, omega, t0, t, order):
+def _bound(rates, rr, rc, amp, ar, har, p1, p2, omega, t0, t, order):
     """An upper bound of |h^(order)| over [t, inf) (all Re(lam) <= 0) for order >= 2; for orders 0 and 1, whose
     polynomial part grows, its size at t (a scale)."""
     total = abs(har) * omega**order
-    for i in range(lam.size):
-        total += abs(amp[i]) * abs(lam[i]) ** order * math.exp(lam[i].real * (t - t0))
+    for i in range(rc):
+        total += abs(amp[ar, i]) * abs(rates[rr, i]) ** order * math.exp(rates[rr, i].real * (t - t0))
     tau = t - t0
     if order == 0:
         total += (abs(p1) + abs(p2) * tau) * tau
@@ -180,16 +185,17 @@ def _bound(lam, amp, har, p1, p2, omega, t0, t, order):
 
 
 @njit(cache=True, error_model="numpy")
-def _step_data(lam, amp, har, con, p1, p2, omega, t0, t):
+def _step_data(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t):
+    """h, h', h'' at t and bounds of |h''|, |h'''| over [t, inf), in one pass (the root search's inner loop)."""
     h0 = 0j
     h1 = 0j
     h2 = 0j
     magnitude = abs(har)
     bound2 = magnitude * omega * omega
     bound3 = bound2 * omega
-    for i in range(lam.size):
-        term = amp[i] * np.exp(lam[i] * (t - t0))
-        l = lam[i]
+    for i in range(rc):
+        l = rates[rr, i]
+        term = amp[ar, i] * np.exp(l * (t - t0))
         h0 += term
         h1 += term * l
         h2 += term * l * l
@@ -208,15 +214,15 @@ def _step_data(lam, amp, har, con, p1, p2, omega, t0, t):
 
 
 @njit(cache=True, error_model="numpy")
-def _escape_step(lam, amp, har, con, p1, p2, omega, t0, t):
+def _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t):
     """A step over which h stays < 0 from h(t) = 0 when h leaves the surface; -1.0 if it does not leave (orders up to
     4, see linear_flow.escape_step)."""
     values = np.empty(5)
-    _derivatives(lam, amp, har, con, p1, p2, omega, t0, t, values)
+    _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, values)
     for k in range(1, 5):
-        scale = _bound(lam, amp, har, p1, p2, omega, t0, t, k)
+        scale = _bound(rates, rr, rc, amp, ar, har, p1, p2, omega, t0, t, k)
         if values[k] < -1e-9 * scale:
-            return -(k + 1) * values[k] / _bound(lam, amp, har, p1, p2, omega, t0, t, k + 1)
+            return -(k + 1) * values[k] / _bound(rates, rr, rc, amp, ar, har, p1, p2, omega, t0, t, k + 1)
         if values[k] > 1e-9 * scale:
             return -1.0
     return -1.0
@@ -239,20 +245,20 @@ def _polish(h0, h1, h2):
 
 
 @njit(cache=True, error_model="numpy")
-def _first_crossing(lam, amp, har, con, p1, p2, omega, t0, t_from, t_to, tolerance, leaving):
+def _first_crossing(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t_from, t_to, tolerance, leaving):
     """First time in (t_from, t_to] at which h reaches 0 from below; NaN if none (see linear_flow.first_crossing)."""
     tau = t_from - t0
     size = abs(har) + abs(con) + (abs(p1) + abs(p2) * tau) * tau
-    for i in range(amp.size):
-        size += abs(amp[i])
+    for i in range(rc):
+        size += abs(amp[ar, i])
     tolerance = max(tolerance, 1e-15 * size)
     pair = np.empty(2)
     t = t_from
     if leaving:
-        if _value(lam, amp, har, con, p1, p2, omega, t0, t) >= -tolerance:
-            step = _escape_step(lam, amp, har, con, p1, p2, omega, t0, t)
+        if _value(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t) >= -tolerance:
+            step = _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t)
             if step < 0.0:
-                if _bound(lam, amp, har, 0.0, 0.0, omega, t0, t, 0) <= tolerance and abs(p1) + abs(p2) <= tolerance:
+                if _bound(rates, rr, rc, amp, ar, har, 0.0, 0.0, omega, t0, t, 0) <= tolerance and abs(p1) + abs(p2) <= tolerance:
                     return math.nan
                 return t_from
             t += step
@@ -260,9 +266,9 @@ def _first_crossing(lam, amp, har, con, p1, p2, omega, t0, t_from, t_to, toleran
                 return math.nan
     departing = leaving
     while True:
-        h0, h1, h2, curvature, jerk = _step_data(lam, amp, har, con, p1, p2, omega, t0, t)
+        h0, h1, h2, curvature, jerk = _step_data(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t)
         if departing and h0 >= -8.0 * tolerance:
-            step = _escape_step(lam, amp, har, con, p1, p2, omega, t0, t)
+            step = _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t)
             if step >= 0.0:
                 if t + step >= t_to:
                     return math.nan
@@ -281,7 +287,7 @@ def _first_crossing(lam, amp, har, con, p1, p2, omega, t0, t_from, t_to, toleran
         if t + step >= t_to:
             # h < 0 on [t, t_to); a root at t_to (an impact on a period boundary) is still a root, and so is one
             # within a few round-off units of it, arriving: it is applied before the strobe, not after it
-            _derivatives(lam, amp, har, con, p1, p2, omega, t0, t_to, pair)
+            _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t_to, pair)
             return t_to if pair[0] >= -tolerance or (pair[0] >= -8.0 * tolerance and pair[1] > 0.0) else math.nan
         if t + step == t:
             return t
@@ -289,22 +295,52 @@ def _first_crossing(lam, amp, har, con, p1, p2, omega, t0, t_from, t_to, toleran
 
 
 @njit(cache=True, error_model="numpy")
-def _transition(lam, vec, inv, dt, poly, zpro, znil, out):
-    """exp(A dt) of the flow: Re(V diag(e^{lam dt}) V^+) (+ P_z + A_z dt), into ``out`` (n x n)."""
+def _closest_approach(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, ta, tb, fastest, best, stop):
+    """Largest interior local maximum of h on (ta, tb) (h' from + to -), if above best[0]: stored in best."""
+    chunks = max(2, int(math.ceil(fastest * (tb - ta) / 0.5)))
+    d = np.empty(3)
+    t_prev = ta
+    _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, ta, d)
+    slope_prev = d[1]
+    for c in range(1, chunks + 1):
+        t = ta + (tb - ta) * c / chunks
+        _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, d)
+        if slope_prev > 0.0 and d[1] < 0.0:
+            lo, hi = t_prev, t
+            for _ in range(200):  # bisection on h' (sign + at lo, - at hi)
+                mid = 0.5 * (lo + hi)
+                if mid <= lo or mid >= hi:
+                    break
+                _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, mid, d)
+                if d[1] > 0.0:
+                    lo = mid
+                else:
+                    hi = mid
+            _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, lo, d)
+            if lo > ta and lo < tb and d[0] > best[0]:
+                best[0], best[1], best[2] = d[0], lo, stop
+            _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, d)
+        slope_prev, t_prev = d[1], t
+
+
+# ------------------------------------------------------------------------------------ Jacobians, stops, bookkeeping
+@njit(cache=True, error_model="numpy")
+def _transition(lams, vecs, invs, f, m, dt, poly, zpros, znils, out):
+    """exp(A dt) of flow f: Re(V diag(e^{lam dt}) V^+) (+ P_z + A_z dt), into ``out`` (n x n)."""
     n = out.shape[0]
     for r in range(n):
         for c in range(n):
             out[r, c] = 0.0
-    for i in range(lam.size):
-        g = np.exp(lam[i] * dt)
+    for i in range(m):
+        g = np.exp(lams[f, i] * dt)
         for r in range(n):
-            left = vec[r, i] * g
+            left = vecs[f, r, i] * g
             for c in range(n):
-                out[r, c] += (left * inv[i, c]).real
+                out[r, c] += (left * invs[f, i, c]).real
     if poly:
         for r in range(n):
             for c in range(n):
-                out[r, c] += zpro[r, c] + znil[r, c] * dt
+                out[r, c] += zpros[f, r, c] + znils[f, r, c] * dt
 
 
 @njit(cache=True, error_model="numpy")
@@ -317,7 +353,9 @@ def _left_multiply(factor, jac, work):
             for m in range(n):
                 acc += factor[r, m] * jac[m, c]
             work[r, c] = acc
-    jac[:, :] = work
+    for r in range(n):
+        for c in range(n):
+            jac[r, c] = work[r, c]
 
 
 @njit(cache=True, error_model="numpy")
@@ -343,15 +381,17 @@ def _field(a_matrix, load, static, omega, t, y, held, velw, kickw, masses, simpl
 
 
 @njit(cache=True, error_model="numpy")
-def _saltation(jump, a_matrix, load, static, omega, t, before, after, velocity, held_before, held_after, stop, gapw, velw, kickw, masses, simple, out):
+def _saltation(jumps, stop, a_matrix, load, static, omega, t, before, after, velocity, held_before, held_after, gapw, velw, kickw, masses, simple, out):
     """Saltation matrix of an impact on ``stop`` at time t from ``before`` (at the contact, approach ``velocity``) to
-    ``after``, with the impact's velocity map ``jump``: S = D + (f+ - D f-) (grad g)^T / v."""
+    ``after``, with the impact's velocity map D = ``jumps[stop]``: S = D + (f+ - D f-) (grad g)^T / v."""
     n = before.size
-    out[:, :] = jump
+    for r in range(n):
+        for c in range(n):
+            out[r, c] = jumps[stop, r, c]
     if velocity <= 0.0:
         if held_after < 0:
             out[:, :] = math.nan  # a grazing touch: the map is not differentiable here
-        return  # touch and stick: the gap and its velocity are held from here on (``jump`` holds both)
+        return  # touch and stick: the gap and its velocity are held from here on (the touch's D holds both)
     f_before = np.empty(n)
     f_after = np.empty(n)
     _field(a_matrix, load, static, omega, t, before, held_before, velw, kickw, masses, simple, f_before)
@@ -359,7 +399,7 @@ def _saltation(jump, a_matrix, load, static, omega, t, before, after, velocity, 
     for r in range(n):
         acc = 0.0
         for c in range(n):
-            acc += jump[r, c] * f_before[c]
+            acc += jumps[stop, r, c] * f_before[c]
         difference = (f_after[r] - acc) / velocity
         for c in range(n):
             if gapw[stop, c] != 0.0:
@@ -371,35 +411,6 @@ def _grow(array, rows):
     bigger = np.empty((max(2 * array.shape[0], rows),) + array.shape[1:], dtype=array.dtype)
     bigger[: array.shape[0]] = array
     return bigger
-
-
-@njit(cache=True, error_model="numpy")
-def _closest_approach(lam, amp, har, con, p1, p2, omega, t0, ta, tb, fastest, best, stop):
-    """Largest interior local maximum of h on (ta, tb) (h' from + to -), if above best[0]: stored in best."""
-    chunks = max(2, int(math.ceil(fastest * (tb - ta) / 0.5)))
-    d = np.empty(3)
-    t_prev = ta
-    _derivatives(lam, amp, har, con, p1, p2, omega, t0, ta, d)
-    slope_prev = d[1]
-    for c in range(1, chunks + 1):
-        t = ta + (tb - ta) * c / chunks
-        _derivatives(lam, amp, har, con, p1, p2, omega, t0, t, d)
-        if slope_prev > 0.0 and d[1] < 0.0:
-            lo, hi = t_prev, t
-            for _ in range(200):  # bisection on h' (sign + at lo, - at hi)
-                mid = 0.5 * (lo + hi)
-                if mid <= lo or mid >= hi:
-                    break
-                _derivatives(lam, amp, har, con, p1, p2, omega, t0, mid, d)
-                if d[1] > 0.0:
-                    lo = mid
-                else:
-                    hi = mid
-            _derivatives(lam, amp, har, con, p1, p2, omega, t0, lo, d)
-            if lo > ta and lo < tb and d[0] > best[0]:
-                best[0], best[1], best[2] = d[0], lo, stop
-            _derivatives(lam, amp, har, con, p1, p2, omega, t0, t, d)
-        slope_prev, t_prev = d[1], t
 
 
 @njit(cache=True, error_model="numpy")
@@ -433,20 +444,20 @@ def _pushed(stop, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdr
     f = stop + 1
     m = counts[f]
     n = y.size
-    lam, vec, hrm, cst, poly = lams[f, :m], vecs[f, :, :m], hrms[f], csts[f], polys[f]
     modal = np.empty(m, dtype=np.complex128)
-    amp = np.empty(m, dtype=np.complex128)
+    amp = np.empty((1, m), dtype=np.complex128)
     z0, q1, q2 = np.zeros(n), np.zeros(n), np.zeros(n)
-    _modal(lam, invs[f, :m, :], hrm, cst, omega, t, y, modal)
-    if poly:
-        _rigid(zpros[f], znils[f], zdrvs[f], zdrv2s[f], hrm, cst, omega, t, y, z0, q1, q2)
-    har, con, p1, p2 = _observable(hold_w[stop], hold_off[stop], hold_har[stop], vec, hrm, cst, modal, amp, poly, z0, q1, q2)
-    value = _value(lam, amp, har, con, p1, p2, omega, t, t)
+    _modal(lams, invs, hrms, csts, f, m, omega, t, y, modal)
+    if polys[f]:
+        _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t, y, z0, q1, q2)
+    har, con, p1, p2 = _observable(hold_w, stop, hold_off[stop], hold_har[stop], vecs, hrms, csts, f, m, modal, amp, polys[f], z0, q1, q2)
+    value = _value(lams, f, m, amp, 0, har, con, p1, p2, omega, t, t)
     if abs(value) > 64.0 * force_tolerance:
         return value < 0.0
-    return _escape_step(lam, amp, har, con, p1, p2, omega, t, t) >= 0.0
+    return _escape_step(lams, f, m, amp, 0, har, con, p1, p2, omega, t, t) >= 0.0
 
 
+# ------------------------------------------------------------------------------------------------------- the loop
 @njit(cache=True, error_model="numpy")
 def run_periods(
     lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
@@ -478,8 +489,7 @@ def run_periods(
     approach = np.array([-math.inf, math.nan, -1.0])
     n_impacts = 0
     n_segments = 0
-    mmax = lams.shape[1]
-    hmax = hlams.shape[1]
+    widest = lams.shape[1]
     y = y_start.copy()
     for j in range(stops):  # round-off beyond a stop is the stop
         if _gap(gapw, clearances, j, y) > 0.0:
@@ -499,22 +509,23 @@ def run_periods(
                     return STATUS_TWO_STICKS, t, strobes[:0], jacobians[:0], impacts[:0], segments[:0], segment_states[:0], moments[:0], counters, approach
                 stuck = j
     origin = t
-    strobes[0] = y
+    for r in range(n):
+        strobes[0, r] = y[r]
     k = 1
     fresh = True
     impacts_period = np.zeros(stops, dtype=np.int64)
     events_period = 0
     leave = np.zeros(stops, dtype=np.bool_)
     events_at = np.full(stops, math.nan)
-    modal = np.empty(mmax, dtype=np.complex128)
-    amp = np.empty(mmax, dtype=np.complex128)
-    hamps = np.empty((stops, hmax), dtype=np.complex128)
+    modal = np.empty(widest, dtype=np.complex128)
+    amp = np.empty((1, widest), dtype=np.complex128)
+    hamps = np.empty((stops, widest), dtype=np.complex128)
     hars = np.empty(stops, dtype=np.complex128)
     cons = np.empty(stops)
     p1s = np.empty(stops)
     p2s = np.empty(stops)
     z0, q1, q2 = np.zeros(n), np.zeros(n), np.zeros(n)
-    mm = mmax + 2
+    mm = widest + 2
     buffers = (np.empty(mm, dtype=np.complex128), np.empty((mm, mm), dtype=np.complex128), np.empty(mm, dtype=np.complex128), np.empty(mm + 1, dtype=np.complex128), np.empty(mm, dtype=np.complex128), np.empty(mm, dtype=np.complex128))
     work = np.empty((n, n))
     phi = np.empty((n, n))
@@ -523,42 +534,36 @@ def run_periods(
     ybuf = np.empty(n)
     ynew = np.empty(n)
     t_piece = t
-    f = 0
+    f = 0  # the piece's flow: 0 free, 1 + k held on stop k
     m = 0
     hm = 0
     poly = False
-    lam = lams[0, :0]
-    vec = vecs[0, :, :0]
-    hrm = hrms[0]
-    cst = csts[0]
-    hl = hlams[0, :0]
     while k <= periods:
         boundary = origin + k * period
         if fresh:
             t_piece = t
             f = stuck + 1
-            m = counts[f]
-            hm = hcounts[f]
-            lam, vec, hrm, cst, poly, hl = lams[f, :m], vecs[f, :, :m], hrms[f], csts[f], polys[f], hlams[f, :hm]
-            _modal(lam, invs[f, :m, :], hrm, cst, omega, t, y, modal[:m])
+            m, hm, poly = counts[f], hcounts[f], polys[f]
+            _modal(lams, invs, hrms, csts, f, m, omega, t, y, modal)
             if poly:
-                _rigid(zpros[f], znils[f], zdrvs[f], zdrv2s[f], hrm, cst, omega, t, y, z0, q1, q2)
+                _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t, y, z0, q1, q2)
             for j in range(stops):
                 if j == stuck:
-                    har, con, p1, p2 = _observable(hold_w[j], hold_off[j], hold_har[j], vec, hrm, cst, modal[:m], amp[:m], poly, z0, q1, q2)
+                    har, con, p1, p2 = _observable(hold_w, j, hold_off[j], hold_har[j], vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
                     leave[j] = True  # a fresh stick's holding force starts by leaving zero (or the start is held)
                 else:
-                    har, con, p1, p2 = _observable(gapw[j], -clearances[j], 0j, vec, hrm, cst, modal[:m], amp[:m], poly, z0, q1, q2)
+                    har, con, p1, p2 = _observable(gapw, j, -clearances[j], 0j, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
                     leave[j] = _gap(gapw, clearances, j, y) >= -tolerance  # at the surface: the search starts by leaving it
                 hars[j], cons[j], p1s[j], p2s[j] = har, con, p1, p2
-                _halve(lam, amp[:m], hamps[j, :hm])
+                _halve(lams, f, m, amp, hamps, j)
                 if leave[j]:
                     events_at[j] = t
             if n_segments == segments.shape[0]:
                 segments = _grow(segments, n_segments + 1)
                 segment_states = _grow(segment_states, n_segments + 1)
             segments[n_segments, 0], segments[n_segments, 1], segments[n_segments, 2] = t, 1.0 if stuck >= 0 else 0.0, stuck
-            segment_states[n_segments] = y
+            for r in range(n):
+                segment_states[n_segments, r] = y[r]
             n_segments += 1
             fresh = False  # the piece lasts until the next event, across period boundaries
         counters[0] += 1
@@ -566,7 +571,7 @@ def run_periods(
         event = -1
         limit = boundary
         for j in range(stops):
-            found = _first_crossing(hl, hamps[j, :hm], hars[j], cons[j], p1s[j], p2s[j], omega, t_piece, t, limit, force_tolerances[j] if j == stuck else tolerance, leave[j])
+            found = _first_crossing(hlams, f, hm, hamps, j, hars[j], cons[j], p1s[j], p2s[j], omega, t_piece, t, limit, force_tolerances[j] if j == stuck else tolerance, leave[j])
             leave[j] = False
             if not math.isnan(found) and (event < 0 or found < t_event):
                 t_event, event, limit = found, j, found
@@ -575,33 +580,35 @@ def run_periods(
         if t_end > t:
             if want_moments:
                 if poly:
-                    _add_moments_gl(moments[k - 1], stuck, lam, vec, hrm, cst, modal[:m], omega, t_piece, t, t_end, fastests[f], gl_nodes, gl_weights, hold_w, hold_off, hold_har, size, stops, z0, q1, q2, ybuf)
+                    _add_moments_gl(moments, k - 1, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, fastests[f], gl_nodes, gl_weights, hold_w, hold_off, hold_har, size, stops, z0, q1, q2, ybuf)
                 else:
-                    _add_moments(moments[k - 1], stuck, lam, vec, hrm, cst, modal[:m], omega, t_piece, t, t_end, rates_all[f, : m + 2], rinv_all[f, : m + 3, : m + 2], buffers, hold_w, hold_off, hold_har, size, stops)
+                    _add_moments(moments, k - 1, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, rates_all, rinv_all, buffers, hold_w, hold_off, hold_har, size, stops)
             if want_approach:
                 for j in range(stops):
                     if j != stuck:
-                        _closest_approach(hl, hamps[j, :hm], hars[j], cons[j], p1s[j], p2s[j], omega, t_piece, t, t_end, fastests[f], approach, j)
+                        _closest_approach(hlams, f, hm, hamps, j, hars[j], cons[j], p1s[j], p2s[j], omega, t_piece, t, t_end, fastests[f], approach, j)
             if want_jacobians:
-                _transition(lam, vec, invs[f, :m, :], t_end - t, poly, zpros[f], znils[f], phi)
+                _transition(lams, vecs, invs, f, m, t_end - t, poly, zpros, znils, phi)
                 _left_multiply(phi, jac, work)
-        _state(lam, vec, hrm, cst, omega, t_piece, modal[:m], t_end, ynew, poly, z0, q1, q2)
+        _state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t_end, ynew, poly, z0, q1, q2)
         for j in range(stops):
             if j != stuck and _gap(gapw, clearances, j, ynew) > 0.0:
                 _snap(gapw, clearances, simple, signs, j, ynew)  # round-off beyond a stop is the stop
-        y[:] = ynew
+        for r in range(n):
+            y[r] = ynew[r]
         t = t_end
         if event < 0:
             for j in range(stops):
                 leave[j] = t_end - events_at[j] <= 1e-9 * period
-            strobes[k] = y
+                impacts_period[j] = 0
+            for r in range(n):
+                strobes[k, r] = y[r]
             if want_jacobians:
-                jacobians[k - 1] = jac
-                jac[:, :] = 0.0
                 for r in range(n):
-                    jac[r, r] = 1.0
+                    for c in range(n):
+                        jacobians[k - 1, r, c] = jac[r, c]
+                        jac[r, c] = 1.0 if r == c else 0.0
             k += 1
-            impacts_period[:] = 0
             events_period = 0
             continue
         events_period += 1
@@ -637,7 +644,8 @@ def run_periods(
                         return STATUS_TWO_STICKS, t, strobes, jacobians, impacts[:n_impacts], segments[:n_segments], segment_states[:n_segments], moments, counters, approach
         after = 0.0 if sticks else -restitutions[j] * velocity
         if want_jacobians:
-            before[:] = y
+            for r in range(n):
+                before[r] = y[r]
         i = simple[j]
         if i >= 0:
             y[size + i] = signs[j] * after
@@ -646,11 +654,13 @@ def run_periods(
             for r in range(n):
                 y[r] += change * kickw[j, r]
         if want_jacobians:
-            if sticks:
-                jump = stick[j] if velocity > 0.0 else touch[j]
+            held_after = j if sticks else -1
+            if not sticks:
+                _saltation(bounce, j, a_matrix, load, static, omega, t, before, y, velocity, held_before, held_after, gapw, velw, kickw, masses, simple, salt)
+            elif velocity > 0.0:
+                _saltation(stick, j, a_matrix, load, static, omega, t, before, y, velocity, held_before, held_after, gapw, velw, kickw, masses, simple, salt)
             else:
-                jump = bounce[j]
-            _saltation(jump, a_matrix, load, static, omega, t, before, y, velocity, held_before, j if sticks else -1, j, gapw, velw, kickw, masses, simple, salt)
+                _saltation(touch, j, a_matrix, load, static, omega, t, before, y, velocity, held_before, held_after, gapw, velw, kickw, masses, simple, salt)
             _left_multiply(salt, jac, work)
         impulse = masses[j] * (velocity - after)
         if velocity > 0.0:
@@ -667,6 +677,7 @@ def run_periods(
     return STATUS_OK, t, strobes, jacobians, impacts[:n_impacts], segments[:n_segments], segment_states[:n_segments], moments, counters, approach
 
 
+# ---------------------------------------------------------------------------------------------------------- moments
 @njit(cache=True, error_model="numpy")
 def _series(z):
     """(e^z - 1) / z for small z, without cancellation: e^(x+iy) - 1 = expm1(x) cos y - 2 sin^2(y/2) + i e^x sin y."""
@@ -697,68 +708,64 @@ def moment_rates(lam, omega):
 
 
 @njit(cache=True, error_model="numpy")
-def _amplitudes(lam, vec, hrm, modal, omega, t0, row, amps):
-    """Coordinate ``row`` of the piece as sum_k amps_k e^{rates_k (t - t0)} plus a constant: the modal terms (their
-    sum is real) and the harmonic Re(Y e^{jwt}) as two conjugate halves."""
-    n = lam.size
-    for i in range(n):
-        amps[i] = vec[row, i] * modal[i]
-    harmonic = hrm[row] * complex(math.cos(omega * t0), math.sin(omega * t0))
-    amps[n], amps[n + 1] = 0.5 * harmonic, 0.5 * np.conj(harmonic)
+def _amplitudes(vecs, hrms, f, m, modal, omega, t0, coordinate, amps):
+    """Coordinate ``coordinate`` of the piece as sum_k amps_k e^{rates_k (t - t0)} plus a constant: the modal terms
+    (their sum is real) and the harmonic Re(Y e^{jwt}) as two conjugate halves."""
+    for i in range(m):
+        amps[i] = vecs[f, coordinate, i] * modal[i]
+    harmonic = hrms[f, coordinate] * complex(math.cos(omega * t0), math.sin(omega * t0))
+    amps[m], amps[m + 1] = 0.5 * harmonic, 0.5 * np.conj(harmonic)
 
 
 @njit(cache=True, error_model="numpy")
-def _weighted_amplitudes(lam, vec, hrm, modal, omega, t0, weights, extra, amps):
-    """As :func:`_amplitudes` for minus the observable weights . y + Re(extra e^{jwt}) (the holding force)."""
-    n = lam.size
+def _weighted_amplitudes(vecs, hrms, f, m, modal, omega, t0, weights, row, extra, amps):
+    """As :func:`_amplitudes` for minus the observable weights[row] . y + Re(extra e^{jwt}) (the holding force)."""
     harmonic = extra
-    for r in range(weights.size):
-        harmonic += weights[r] * hrm[r]
-    for i in range(n):
+    for r in range(weights.shape[1]):
+        harmonic += weights[row, r] * hrms[f, r]
+    for i in range(m):
         acc = 0j
-        for r in range(weights.size):
-            acc += weights[r] * vec[r, i]
+        for r in range(weights.shape[1]):
+            acc += weights[row, r] * vecs[f, r, i]
         amps[i] = -acc * modal[i]
     harmonic *= -complex(math.cos(omega * t0), math.sin(omega * t0))
-    amps[n], amps[n + 1] = 0.5 * harmonic, 0.5 * np.conj(harmonic)
+    amps[m], amps[m + 1] = 0.5 * harmonic, 0.5 * np.conj(harmonic)
 
 
 @njit(cache=True, error_model="numpy")
-def _piece_factors(rates, inverse, omega, a, length, pair, single, fourier, ea, el):
+def _piece_factors(rates_all, rinv_all, f, m, omega, a, length, pair, single, fourier, ea, el):
     """E(s) = int_a^{a+L} e^{s u} du = e^{s a} (e^{s L} - 1) / s for every sum of two rates (``pair``), every rate
     (``single``) and every rate - jw (``fourier``; the last entry: the constant's, s = -jw); near s L = 0 by the series.
-    Every exponential is a product of the m exponentials e^{r_k a}, e^{r_k L} of this piece."""
-    m = rates.size
+    Every exponential is a product of the m exponentials e^{r_k a}, e^{r_k L} of this piece (rates of flow f)."""
     for k in range(m):
-        ea[k] = np.exp(rates[k] * a)
-        el[k] = np.exp(rates[k] * length)
+        ea[k] = np.exp(rates_all[f, k] * a)
+        el[k] = np.exp(rates_all[f, k] * length)
     wa = complex(math.cos(omega * a), -math.sin(omega * a))
     wl = complex(math.cos(omega * length), -math.sin(omega * length))
     for k in range(m):
         for l in range(k, m):
-            s = rates[k] + rates[l]
+            s = rates_all[f, k] + rates_all[f, l]
             growth = ea[k] * ea[l]
             if abs(s) * length >= 0.5:
-                pair[k, l] = growth * (el[k] * el[l] - 1.0) * inverse[k, l]
+                pair[k, l] = growth * (el[k] * el[l] - 1.0) * rinv_all[f, k, l]
             else:
                 pair[k, l] = growth * length * _series(s * length)
-        s = rates[k]
+        s = rates_all[f, k]
         single[k] = ea[k] * ((el[k] - 1.0) / s if abs(s) * length >= 0.5 else length * _series(s * length))
-        s = rates[k] - complex(0.0, omega)
-        fourier[k] = ea[k] * wa * ((el[k] * wl - 1.0) * inverse[m, k] if abs(s) * length >= 0.5 else length * _series(s * length))
+        s = rates_all[f, k] - complex(0.0, omega)
+        fourier[k] = ea[k] * wa * ((el[k] * wl - 1.0) * rinv_all[f, m, k] if abs(s) * length >= 0.5 else length * _series(s * length))
     s = complex(0.0, -omega)
     fourier[m] = wa * ((wl - 1.0) / s if abs(s) * length >= 0.5 else length * _series(s * length))
 
 
 @njit(cache=True, error_model="numpy")
-def _integrals(amps, constant, length, pair, single, fourier, phasor, out, slot_fourier, slot_square):
-    """Add int x e^{-jwt} dt (``phasor`` = e^{-jw t0}) to out[slot_fourier] and int x^2 dt to out[slot_square]
-    (if >= 0) for x = sum_k amps_k e^{rates_k u} + constant, from the piece's factors."""
-    m = amps.size
+def _integrals(amps, m, constant, length, pair, single, fourier, phasor, out, row, slot_fourier, slot_square):
+    """Add int x e^{-jwt} dt (``phasor`` = e^{-jw t0}) to out[row, slot_fourier] and int x^2 dt to
+    out[row, slot_square] (if >= 0) for x = sum_k amps_k e^{rates_k u} + constant (k < m), from the piece's factors."""
     total = constant * fourier[m]
     for k in range(m):
         total += amps[k] * fourier[k]
-    out[slot_fourier] += total * phasor
+    out[row, slot_fourier] += total * phasor
     if slot_square < 0:
         return
     square = constant * constant * length + 0j
@@ -766,33 +773,32 @@ def _integrals(amps, constant, length, pair, single, fourier, phasor, out, slot_
         square += amps[k] * (2.0 * constant * single[k] + amps[k] * pair[k, k])
         for l in range(k + 1, m):
             square += 2.0 * amps[k] * amps[l] * pair[k, l]
-    out[slot_square] += square.real
+    out[row, slot_square] += square.real
 
 
 @njit(cache=True, error_model="numpy")
-def _add_moments(out, stuck, lam, vec, hrm, cst, modal, omega, t_piece, ta, tb, rates, inverse, buffers, hold_w, hold_off, hold_har, size, stops):
-    """Add the piece's Fourier and square integrals over [ta, tb] to the period's row ``out``, in closed form (the
-    motion is a sum of exponentials): each coordinate times e^{-jwt}, the holding force times e^{-jwt} while held,
-    each coordinate squared."""
-    m = rates.size
-    amps, pair, single, fourier = buffers[0][:m], buffers[1][:m, :m], buffers[2][:m], buffers[3][: m + 1]
+def _add_moments(out, row, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, ta, tb, rates_all, rinv_all, buffers, hold_w, hold_off, hold_har, size, stops):
+    """Add the piece's Fourier and square integrals over [ta, tb] to the period's row ``out[row]``, in closed form
+    (the motion is a sum of exponentials): each coordinate times e^{-jwt}, the holding force times e^{-jwt} while
+    held, each coordinate squared."""
+    mm = m + 2
+    amps, pair, single, fourier, ea, el = buffers
     a, length = ta - t_piece, tb - ta
-    _piece_factors(rates, inverse, omega, a, length, pair, single, fourier, buffers[4][:m], buffers[5][:m])
+    _piece_factors(rates_all, rinv_all, f, mm, omega, a, length, pair, single, fourier, ea, el)
     phasor = complex(math.cos(omega * t_piece), -math.sin(omega * t_piece))
     for i in range(size):
-        _amplitudes(lam, vec, hrm, modal, omega, t_piece, i, amps)
-        _integrals(amps, cst[i], length, pair, single, fourier, phasor, out, i, size + stops + i)
+        _amplitudes(vecs, hrms, f, m, modal, omega, t_piece, i, amps)
+        _integrals(amps, mm, csts[f, i], length, pair, single, fourier, phasor, out, row, i, size + stops + i)
     if stuck >= 0:
-        weights = hold_w[stuck]
-        _weighted_amplitudes(lam, vec, hrm, modal, omega, t_piece, weights, hold_har[stuck], amps)
+        _weighted_amplitudes(vecs, hrms, f, m, modal, omega, t_piece, hold_w, stuck, hold_har[stuck], amps)
         constant = hold_off[stuck]
-        for r in range(weights.size):
-            constant += weights[r] * cst[r]
-        _integrals(amps, -constant, length, pair, single, fourier, phasor, out, size + stuck, -1)
+        for r in range(hold_w.shape[1]):
+            constant += hold_w[stuck, r] * csts[f, r]
+        _integrals(amps, mm, -constant, length, pair, single, fourier, phasor, out, row, size + stuck, -1)
 
 
 @njit(cache=True, error_model="numpy")
-def _add_moments_gl(out, stuck, lam, vec, hrm, cst, modal, omega, t_piece, ta, tb, fastest, nodes, weights, hold_w, hold_off, hold_har, size, stops, z0, q1, q2, y):
+def _add_moments_gl(out, row, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, ta, tb, fastest, nodes, weights, hold_w, hold_off, hold_har, size, stops, z0, q1, q2, y):
     """As :func:`_add_moments` for a flow with rigid-body (polynomial) terms, by Gauss-Legendre quadrature on chunks
     of at most 2 / (|lambda|max + w) [s]: exact for the polynomial parts (degree <= 4 in the squares), to round-off
     for the exponentials."""
@@ -803,13 +809,13 @@ def _add_moments_gl(out, stuck, lam, vec, hrm, cst, modal, omega, t_piece, ta, t
         for q in range(nodes.size):
             t = a + (b - a) * nodes[q]
             w = (b - a) * weights[q]
-            _state(lam, vec, hrm, cst, omega, t_piece, modal, t, y, True, z0, q1, q2)
+            _state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t, y, True, z0, q1, q2)
             phasor = complex(math.cos(omega * t), -math.sin(omega * t))
             for i in range(size):
-                out[i] += w * y[i] * phasor
-                out[size + stops + i] += w * y[i] * y[i]
+                out[row, i] += w * y[i] * phasor
+                out[row, size + stops + i] += w * y[i] * y[i]
             if stuck >= 0:
                 force = hold_off[stuck] + (hold_har[stuck] * complex(math.cos(omega * t), math.sin(omega * t))).real
                 for r in range(y.size):
                     force += hold_w[stuck, r] * y[r]
-                out[size + stuck] -= w * force * phasor
+                out[row, size + stuck] -= w * force * phasor
