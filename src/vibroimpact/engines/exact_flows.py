@@ -117,6 +117,8 @@ def numeric_null_basis(matrix: NDArray[np.float64]) -> NDArray[np.float64]:
     scale = float(np.linalg.norm(a, 2)) or 1.0
     _u, s, vt = np.linalg.svd(a @ a)
     zero = int(np.sum(s <= (1e-8 * scale) ** 2))
+    if int(np.sum(np.linalg.svd(a @ a @ a, compute_uv=False) <= (1e-8 * scale) ** 3)) > zero:
+        raise ValueError("system: the state matrix has a Jordan block at zero longer than 2 (a rigid-body chain); the exact engine handles blocks of size <= 2 only")
     return vt[n - zero :].T.copy() if zero else np.zeros((n, 0))
 
 
