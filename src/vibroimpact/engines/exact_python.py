@@ -15,6 +15,7 @@ closed form: an independent check).
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
@@ -61,6 +62,13 @@ class PythonExactEngine:
         return out
 
 
+@lru_cache(maxsize=64)
+def _prepared(problem: ImpactProblem, length_scale: float) -> tuple[ExactModel, tuple[HarmonicLinearFlow, ...]]:
+    """The model and flows of a problem, once (``dense`` is called many times on one trajectory)."""
+    model = build_model(problem, length_scale)
+    return model, tuple(HarmonicLinearFlow.from_flow(flow) for flow in (model.free, *model.stuck))
+
+
 class _Run:
     """One integration: the event loop of the exact engine."""
 
@@ -68,8 +76,7 @@ class _Run:
         self.law, self.problem, self.rec = law, problem, builder
         self.steps = self.events = 0
         self.length_scale = law.length_scale
-        self.model: ExactModel = build_model(problem, self.length_scale)
-        self.flows = [HarmonicLinearFlow.from_flow(flow) for flow in (self.model.free, *self.model.stuck)]
+        self.model, self.flows = _prepared(problem, self.length_scale)
         self.size = problem.size
         self.count = len(problem.stops)
         zero = np.zeros((self.count, self.size))
