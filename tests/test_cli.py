@@ -25,7 +25,8 @@ REPOSITORY = Path(__file__).resolve().parents[1]
 def test_list_shows_every_shipped_study_with_its_description(capsys: pytest.CaptureFixture[str]) -> None:
     assert cli.main(["--list"]) == 0
     printed = capsys.readouterr().out.splitlines()
-    names = sorted(path.stem for path in shipped_studies_dir().glob("*.yaml"))
+    root = shipped_studies_dir()
+    names = sorted(path.relative_to(root).with_suffix("").as_posix() for path in root.rglob("*.yaml"))
     assert "restitution" in names and len(printed) == len(names)
     for line, name, (listed, description) in zip(printed, names, shipped_studies()):
         assert line.split()[0] == name == listed and description and description in line
@@ -154,6 +155,8 @@ def test_installed_package_finds_its_studies(tmp_path: Path) -> None:
     assert listed.returncode == 0 and "restitution" in listed.stdout and "bumper_sweep" in listed.stdout
     estimated = run("restitution.yaml", "--estimate")
     assert estimated.returncode == 0, estimated.stderr
+    assert "validation/zeno" in listed.stdout  # a shipped scene in a subfolder is listed and found with its folder
+    assert run("validation/zeno.yaml", "--estimate").returncode == 0
     assert yaml.safe_load((site / "vibroimpact" / "studies" / "restitution.yaml").read_text())["name"] == "restitution"
     assert list(empty.iterdir()) == []  # --list and --estimate write nothing
 

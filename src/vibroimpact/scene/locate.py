@@ -28,6 +28,7 @@ def find_scene(name: str | Path) -> Path:
     candidates = [given]
     if not given.is_absolute():
         candidates.append(Path.cwd() / "studies" / given)
+        candidates.append(shipped_studies_dir() / given)  # a shipped scene in a subfolder: validation/zeno.yaml
         candidates.append(shipped_studies_dir() / given.name)
     if given.suffix not in (".yaml", ".yml"):
         candidates += [c.with_name(c.name + ".yaml") for c in list(candidates)]
@@ -46,13 +47,15 @@ def shipped_studies_dir() -> Path:
 
 
 def shipped_studies() -> list[tuple[str, str]]:
-    """Name and one-line description of every shipped scene, sorted by name (a scene that fails to load says so)."""
+    """Name and one-line description of every shipped scene, sorted by name (a scene that fails to load says so);
+    a scene in a subfolder is named with it (``validation/zeno``), as ``run-study`` finds it."""
     listing = []
-    for path in sorted(shipped_studies_dir().glob("*.yaml")):
+    root = shipped_studies_dir()
+    for path in sorted(root.rglob("*.yaml"), key=lambda p: p.relative_to(root).with_suffix("").as_posix()):
         try:
             document = read_yaml(path.read_text(encoding="utf-8"))
             description = str(document.get("description", "")) if isinstance(document, dict) else ""
         except (OSError, UnicodeDecodeError, yaml.YAMLError) as error:
             description = f"(unreadable: {error})"
-        listing.append((path.stem, " ".join(description.split())))
+        listing.append((path.relative_to(root).with_suffix("").as_posix(), " ".join(description.split())))
     return listing
