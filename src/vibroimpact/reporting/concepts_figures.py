@@ -12,6 +12,7 @@ import math
 import numpy as np
 import xarray as xr
 from matplotlib.axes import Axes
+from matplotlib.ticker import FormatStrFormatter
 
 from vibroimpact.reporting.page import DrawnFigure
 from vibroimpact.reporting.style import LINEAR_STYLE, STABLE_STYLE, UNSTABLE_STYLE, Caption, figure_legend, fmt, new_figure
@@ -36,6 +37,23 @@ def _band(ax: Axes, dataset: xr.Dataset, static: bool = True) -> None:
         ax.axvspan(low, high, **_BAND)
     if static:
         ax.axhline(1e3 * float(dataset.attrs["static_deflection_m"]), **_STATIC)
+
+
+def _isolated(y: np.ndarray) -> np.ndarray:
+    """Finite values whose neighbours are both missing: a line does not show them, a marker must."""
+    finite = np.isfinite(y)
+    before = np.concatenate([[False], finite[:-1]])
+    after = np.concatenate([finite[1:], [False]])
+    return finite & ~before & ~after
+
+
+def _plain_ticks(ax: Axes) -> None:
+    """Plain numbers on a log axis (0.5, 1, 2 rather than 5 x 10^-1), minor ticks labelled only when the axis spans
+    less than about a decade and a half."""
+    ax.yaxis.set_major_formatter(FormatStrFormatter("%g"))
+    low, high = ax.get_ylim()
+    if low > 0.0 and high / low < 30.0:
+        ax.yaxis.set_minor_formatter(FormatStrFormatter("%g"))
 
 
 def _split(x: np.ndarray, y: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -74,6 +92,7 @@ def response_figure(dataset: xr.Dataset) -> DrawnFigure:
         _simulated(ax, dataset, i, fs, colour, caption)
         ax.set_xlim(float(f[0]), float(f[-1]))
         finish_axes(ax, FREQUENCY, "|X1| [mm]", str(dataset["label"].values[i]), log=True)
+        _plain_ticks(ax)
     caption.add("band", f"The shaded stretch is the anti-resonance band ({fmt(dataset.attrs['band_low_Hz'], '.2f')}-{fmt(dataset.attrs['band_high_Hz'], '.2f')} Hz), where the lightly damped absorber without a stop keeps |X1| below the static deflection q/k1 = {fmt(1e3 * dataset.attrs['static_deflection_m'], '.2g')} mm (dotted grey line).")
     caption.add("worst", "The wide pale band is the worst stable motion found at each frequency, from which the table's peak and notch are taken.")
     figure_legend(fig, axes, columns=4)
@@ -111,18 +130,21 @@ def overview_figure(dataset: xr.Dataset) -> DrawnFigure:
     fig, axes = new_figure(2, panel_height=4.2, legend_rows=legend_rows(dataset.sizes["concept"], 2))
     for i in range(dataset.sizes["concept"]):
         label = str(dataset["label"].values[i])
-        axes[0].plot(f, dataset["worst_x1_amplitude"].values[i] * 1e3, color=concept_colour(i), lw=1.5, label=label)
-        axes[1].plot(f, dataset["worst_base_force_amplitude"].values[i], color=concept_colour(i), lw=1.5, label=label)
+        for ax, values in ((axes[0], dataset["worst_x1_amplitude"].values[i] * 1e3), (axes[1], dataset["worst_base_force_amplitude"].values[i])):
+            ax.plot(f, values, color=concept_colour(i), lw=1.5, label=label)
+            alone = _isolated(values)
+            ax.plot(f[alone], values[alone], "o", ms=3.0, color=concept_colour(i))
     _band(axes[0], dataset)
     _band(axes[1], dataset, static=False)
     finish_axes(axes[0], FREQUENCY, "worst stable |X1| [mm]", "primary mass", log=True)
     finish_axes(axes[1], FREQUENCY, "worst stable base force, fundamental [N]", "force on the base", log=True)
     for ax in axes:
         ax.set_xlim(float(f[0]), float(f[-1]))
+        _plain_ticks(ax)
     figure_legend(fig, axes, columns=2)
     caption = (
-        "Left: the worst stable |X1| found at each frequency, every concept in its colour (log scale; gaps where no stable motion was found "
-        "between simulated points). Right: the fundamental of the force on the base of that motion, through the suspension "
+        "Left: the worst stable |X1| found at each frequency, every concept in its colour (log scale; where no stable periodic orbit is "
+        "known only the simulated steady states are drawn, as dots). Right: the fundamental of the force on the base of that motion, through the suspension "
         "(k1 x1 + b1 x1') and the absolute stops (a relative stop's force stays between the masses). Shaded: the anti-resonance band; "
         "dotted grey: q/k1."
     )
@@ -149,13 +171,15 @@ def impact_figure(dataset: xr.Dataset) -> DrawnFigure | None:
             ax.plot(fs, np.where(values > 0, values, np.nan) if log else values, "o-", ms=3.0, lw=1.0, color=concept_colour(i), label=str(dataset["label"].values[i]))
         finish_axes(ax, FREQUENCY, ylabel, title, log=log)
         ax.set_xlim(float(fs[0]), float(fs[-1]))
+        if log:
+            _plain_ticks(ax)
     figure_legend(fig, axes, columns=2)
     bumper = fmt(dataset.attrs.get("bumper_frequency_Hz"), ".4g")
     caption = (
         f"First three panels: steady states of each rigid stop's Kelvin-Voigt twin (Omega_b/2pi = {bumper} Hz, loss factor giving the stop's R) "
         "through the compliant engine: the largest deceleration in contact, the largest bumper force, and the largest force on the base "
-        "(k1 x1 + b1 x1' plus the absolute stops' force, from a dense replay of the steady state), against frequency (log scales; no point "
-        "where nothing touches). Last two: the exact engine's rigid stops, total impulse and impacts per excitation period (chattering shows "
+        "(k1 x1 + b1 x1' plus the absolute stops' force, from a dense replay of the steady state), against frequency (log scales; the first two "
+        "have no point where nothing touches). Last two: the exact engine's rigid stops, total impulse and impacts per excitation period (chattering shows "
         "as many impacts). Shaded: the anti-resonance band."
     )
     return DrawnFigure(fig, "concepts_impacts", "What the impacts cost: bumper acceleration and force, impulse", caption)

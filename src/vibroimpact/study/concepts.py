@@ -37,10 +37,13 @@ __all__ = ["ConceptsStudy", "run_concepts", "CHUNK"]
 
 #: Frequencies per simulation case (load balancing between processes).
 CHUNK = 8
-#: Calibration of :meth:`ConceptsStudy.estimate` on this project's 2-core machine: seconds per simulated frequency
-#: point of one concept (exact march and bumper twin), and per continued concept.
-SECONDS_PER_POINT = 0.35
-SECONDS_PER_BRANCH_CASE = 6.0
+#: Costs of :meth:`ConceptsStudy.estimate` on the calibration machine: seconds per simulated frequency point of one
+#: concept (exact march, bumper twin and replay where it impacts), per continued concept, and for the report. Measured
+#: on the shipped scene: 100 s with --jobs 2 on 2 cores shared at load ~3 (warm caches; 171 s compiling from a fresh
+#: tree), the speed probe reading 1.2-2.7 over that hour.
+SECONDS_PER_POINT = 0.12
+SECONDS_PER_BRANCH_CASE = 8.0
+SECONDS_REPORT = 10.0
 
 
 def run_concepts(settings: ConceptsSettings, progress: Progress | None = None, jobs: int = 1, cache_dir: Path | None = None) -> xr.Dataset:
@@ -96,6 +99,6 @@ class ConceptsStudy:
         points = stopped * settings.simulation_frequency.size
         simulations = points * SECONDS_PER_POINT * (1.0 if math.isfinite(settings.bumper_frequency) else 0.1)
         branches = SECONDS_PER_BRANCH_CASE * stopped if settings.continuation_steps else 0.0
-        wall = simulations / max(jobs, 1) + branches / max(min(jobs, max(stopped, 1)), 1)
-        parts = {"simulations": simulations, "continuation": branches}
+        wall = simulations / max(jobs, 1) + branches / max(min(jobs, max(stopped, 1)), 1) + SECONDS_REPORT
+        parts = {"simulations": simulations, "continuation": branches, "report": SECONDS_REPORT}
         return Estimate(wall_time=wall, memory=300e6, parts=parts, points={"simulations": f"{points} points of {stopped} concepts"})
