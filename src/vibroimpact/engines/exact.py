@@ -26,7 +26,8 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines import exact_core
 from vibroimpact.engines.base import Trajectory, check_run
-from vibroimpact.engines.exact_flows import ExactModel, Flow, build_model
+from vibroimpact.engines.exact_flows import Flow
+from vibroimpact.engines.exact_model import ExactModel, build_model
 from vibroimpact.engines.exact_python import PythonExactEngine
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.engines.rigid_contact import RigidContact

@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory, TrajectoryBuilder
-from vibroimpact.engines.exact_flows import ExactModel, build_model
+from vibroimpact.engines.exact_model import ExactModel, build_model
 from vibroimpact.engines.linear_flow import HarmonicLinearFlow, Observable, Piece, escape_step, first_crossing, gauss_legendre
 from vibroimpact.engines.rigid_contact import RigidContact
 from vibroimpact.engines.settings import EngineSettings
