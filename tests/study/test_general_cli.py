@@ -48,6 +48,7 @@ def test_relative_stop_scene_end_to_end(tmp_path: Path, capsys: pytest.CaptureFi
         pgf, simulated = at.sel(solution="pgf"), at.sel(solution="momentary")
         assert int(pgf["regime"]) == Regime.ONE_IMPACT and int(pgf["stable"]) == 1
         assert float(simulated["impacts_per_period"]) == pytest.approx(2.0, abs=0)
+        assert int(simulated["regime"]) == Regime.ONE_IMPACT  # on a two-sided stop: one impact per period on each side
         np.testing.assert_allclose(simulated["impulse"].values, pgf["impulse"].values, rtol=1e-6)
         np.testing.assert_allclose(simulated["x1_amplitude"].values, pgf["x1_amplitude"].values, rtol=1e-6)
         assert int(dataset["regime"].sel(solution="momentary", frequency=30.0)) == Regime.LINEAR

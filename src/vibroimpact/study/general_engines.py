@@ -3,7 +3,8 @@
 One case per (restitution, clearance, bumper) grid point and chunk of frequencies, as for the paper's layout
 (:func:`vibroimpact.study.solutions.simulated_values`); each stop's values come from itself or from the grid
 (:func:`vibroimpact.scene.layout.build_stops`). States are 2 N wide; the measured fundamentals are per coordinate and
-the impulses, peaks and contact forces per stop.
+the impulses, peaks and contact forces per stop. On a symmetric two-sided stop the flag ``one_impact`` means the
+closed form's kind of orbit, one impact per period on each side (as ``pgf`` flags it there).
 """
 
 from __future__ import annotations
@@ -18,11 +19,20 @@ from vibroimpact.scene.layout import build_stops
 from vibroimpact.scene.schema import Scene
 from vibroimpact.simulation.settings import SWEEP_STARTS
 from vibroimpact.study.cases import COMPLEX_FIELDS, COORDINATE_FIELDS, FIELDS, STOP_FIELDS, SimulationCase
-from vibroimpact.study.general_values import _broadcast, coordinate_quantity
+from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.study.general_values import _broadcast, coordinate_quantity, scene_problem
 from vibroimpact.study.runner import run_cases
 from vibroimpact.study.solutions import CASE_CHUNK, no_one_impact_orbit
 
 __all__ = ["general_simulated_values"]
+
+
+def _two_sided(scene: Scene) -> bool:
+    """Is the layout a symmetric two-sided stop (two stops whose closed form is the two-impacts orbit)?"""
+    if len(scene.stop_specs) != 2:
+        return False
+    problem = scene_problem(scene, float(scene.all_frequencies[0]), float(scene.restitution[0]), float(scene.clearance[0]))
+    return closed_form_refusal(problem) is None
 
 
 def general_simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], jobs: int, cache_dir: Path | None, progress: bool) -> dict[str, np.ndarray]:
@@ -63,7 +73,11 @@ def general_simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], 
     regime[classified] = fields["motion_regime"][classified].astype(np.int8)
     regime[computed & converged] = Regime.PERIODIC_IMPACTS
     regime[computed & converged & (impacts == 0.0)] = Regime.LINEAR
-    regime[computed & converged & (fields["multiplicity"] == 1.0) & (impacts == 1.0)] = Regime.ONE_IMPACT
+    if _two_sided(scene):  # the closed form's kind of orbit: one impact per period on each side
+        each = np.all(fields["stop_impacts"] == 1.0, axis=-1)
+        regime[computed & converged & (fields["multiplicity"] == 1.0) & each] = Regime.ONE_IMPACT
+    else:
+        regime[computed & converged & (fields["multiplicity"] == 1.0) & (impacts == 1.0)] = Regime.ONE_IMPACT
     regime[fields["failed"] == 1.0] = Regime.FAILED
     force = fields["suspension_force"] + fields["contact_force"]
 
