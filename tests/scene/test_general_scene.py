@@ -199,3 +199,19 @@ def test_gravity_on_a_free_mass_refuses_linear() -> None:
 
     problems = problems_of(with_change(change))
     assert any(p.startswith("solutions: linear does not apply") for p in problems), problems
+
+
+def test_a_bumper_instead_of_a_restitution() -> None:
+    """A stop with its own bumper (and loss factor) needs no restitution: R is the bumper's one-collision R(xi_b);
+    the compliant solution builds the stop's own bumper."""
+    from vibroimpact.model.contact import KelvinVoigtBumper, restitution_from_loss_factor
+
+    def change(d: dict[str, Any]) -> None:
+        d["stops"] = [{"between": ["x2", "x1"], "side": "upper", "clearance": 0.003, "bumper": {"frequency": 300.0, "loss_factor": 0.3}}]
+        d["solutions"] = ["linear", "pgf", "compliant"]
+
+    scene = parse_scene(with_change(change))
+    np.testing.assert_allclose(scene.restitution, [restitution_from_loss_factor(0.3)], rtol=1e-15)
+    (stop,) = build_stops(scene.stop_specs, True, float(scene.restitution[0]), float(scene.clearance[0]), float(scene.bumper_frequency[0]))
+    assert isinstance(stop.law, KelvinVoigtBumper)
+    np.testing.assert_allclose([stop.law.frequency, stop.law.loss_factor, stop.clearance], [300.0, 0.3, 0.003], rtol=1e-15)

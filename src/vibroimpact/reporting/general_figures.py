@@ -41,6 +41,8 @@ def where_text(part: xr.Dataset) -> str:
         bits.append(f"Delta = {fmt(float(part['clearance']) * 1e3, '.6g')} mm")
     if "restitution" in part.coords and part["restitution"].ndim == 0:
         bits.append(f"R = {fmt(float(part['restitution']), 'g')}")
+    if "bumper_frequency" in part.coords and part["bumper_frequency"].ndim == 0 and np.isfinite(float(part["bumper_frequency"])):
+        bits.append(f"bumper {fmt(float(part['bumper_frequency']), 'g')} Hz")
     return ", ".join(bits) if bits else "each stop's own values"
 
 
@@ -164,7 +166,7 @@ def peaks_table(dataset: xr.Dataset, setting: GeneralSetting) -> Table:
             columns += [("impulse", f"impulse on stop {k} [N s]", 1.0, k) for k in range(dataset.sizes["stop"])]
         else:
             columns.append(("impulse", "impulse [N s]", 1.0, None))
-    others = [d for d in ("restitution", "clearance") if d in dataset.dims]
+    others = [d for d in ("restitution", "clearance", "bumper_frequency") if d in dataset.dims]
     head = "".join(f"<th>{d}</th>" for d in others) + "<th>solution</th>" + "".join(f"<th>{html.escape(label)} (at Hz)</th>" for _, label, _, _ in columns)
     rows = []
     f = dataset["frequency"].values

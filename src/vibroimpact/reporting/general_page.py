@@ -39,13 +39,12 @@ class GeneralResponsePage:
         clearances = np.atleast_1d(dataset["clearance"].values) if "clearance" in dataset.coords else np.array([])
         intro = f"<p>Stops: {html.escape('; '.join(setting.stops))}. Load: {html.escape(setting.load_text())}.</p>"
         sections = [Section("Structure and stops", intro=intro, figures=saved([structure_figure(setting, dataset['frequency'].values, clearances)], out), tables=layout_tables(setting))]
-        several = "clearance" in dataset.dims
-        for index in range(dataset.sizes.get("clearance", 1)):
-            part = dataset.isel(clearance=index) if several else dataset
-            tag = f"_clearance{index}" if several else ""
+        outer = [d for d in ("clearance", "bumper_frequency") if d in dataset.dims]
+        for index in np.ndindex(*(dataset.sizes[d] for d in outer)):
+            part = dataset.isel(dict(zip(outer, index)))
+            tag = "".join(f"_{d}{i}" for d, i in zip(outer, index))
             figures: list[DrawnFigure | None] = []
-            restitutions = range(part.sizes.get("restitution", 1))
-            for r in restitutions:
+            for r in range(part.sizes.get("restitution", 1)):
                 line = part.isel(restitution=r) if "restitution" in part.dims else part
                 figures.append(response_panels_figure(line, setting, f"responses{tag}_r{r}" if "restitution" in part.dims else f"responses{tag}"))
             if "regime" in part:
@@ -55,6 +54,6 @@ class GeneralResponsePage:
             engines = [str(s) for s in part["solution"].values if s in ENGINE_SOLUTIONS]
             if engines:
                 figures.append(lyapunov_figure(part, engines, f"lyapunov{tag}"))
-            sections.append(Section(f"Responses, {where_text(part) if several else 'every coordinate and stop'}", figures=saved(figures, out)))
+            sections.append(Section(f"Responses, {where_text(part) if outer else 'every coordinate and stop'}", figures=saved(figures, out)))
         sections.append(Section("Largest responses", tables=[peaks_table(dataset, setting)]))
         return sections

@@ -224,10 +224,10 @@ def _stop(c: Checker, key: str, entry: Any, names: tuple[str, ...] | None) -> St
     restitution = c.number(f"{key}.restitution", spec["restitution"], 0.0, 1.0) if "restitution" in spec else None
     frequency = loss = None
     if "bumper" in spec:
-        bumper = c.mapping(f"{key}.bumper", spec["bumper"], {"frequency", "loss_factor"}, {"frequency"})
+        bumper = c.mapping(f"{key}.bumper", spec["bumper"], {"frequency", "loss_factor"})
         frequency = c.number(f"{key}.bumper.frequency", bumper["frequency"], 0.0, 1e6, low_inclusive=False) if "frequency" in bumper else None
         loss = c.number(f"{key}.bumper.loss_factor", bumper["loss_factor"], 0.0, 1e3) if "loss_factor" in bumper else None
-        if frequency is None:
+        if "frequency" in bumper and frequency is None:
             return None
     failed = (
         names is None or side is None or coordinate is None or ("between" in spec and other is None)
