@@ -45,10 +45,10 @@ DEN_HARTOG = (
     "J. E. Brock, J. Appl. Mech. 13 (1946) A-284): with mu = m2/m1 and Omega_p = sqrt(k1/m1), the optimal tuning "
     "omega_a/Omega_p = 1/(1 + mu) makes the two fixed points P and Q of |X1| equally high, and the damping "
     "zeta = c2/(2 m2 Omega_p) = sqrt(3 mu / (8 (1 + mu)^3)) (Den Hartog's c_c = 2 m2 Omega_p, with the primary's natural "
-    "frequency) makes the curve flat there. The paper's k2 tunes the absorber to 33 Hz instead, to put the anti-resonance "
-    "at 33 Hz, not to minimise the resonant peak: concept (a) is Den Hartog's tuning and damping, (a') the paper's k2 with "
-    "Den Hartog's dashpot. The relative stop x2 - x1 &lt;= Delta is the one Ormondroyd and Den Hartog proposed (Trans. ASME "
-    "APM-50-7, 1928).</p>"
+    "frequency) makes the curve flat there; the table marks such values (DH). That optimum minimises the resonant peak; "
+    "the scene's own k2 puts the anti-resonance (the smallest |X1| without a stop) at {anti} Hz instead, where the lightly damped "
+    "absorber cuts |X1| far below q/k1. A stop between the masses (on x2 - x1) is the kind Ormondroyd and Den Hartog "
+    "proposed (Trans. ASME APM-50-7, 1928), one against the base (on x2) the paper's.</p>"
 )
 
 
@@ -73,7 +73,8 @@ class ConceptsPage:
         mismatch = d["bumper_replay_mismatch"].values if "bumper_replay_mismatch" in d else np.zeros(0)
         worst = f"{np.nanmax(mismatch):.1e}" if np.any(np.isfinite(mismatch)) else "(no replay)"
         definitions = DEFINITIONS.format(band=html.escape(band), static=fmt(1e3 * float(d.attrs["static_deflection_m"]), ".2g"), mismatch=worst)
-        answer = Section("Which absorber concept, with which stop", DEN_HARTOG, tables=[Table("Concepts side by side", concepts_table(d) + definitions)])
+        intro = DEN_HARTOG.format(anti=fmt(d.attrs.get("anti_resonance_Hz"), ".2f"))
+        answer = Section("Which absorber concept, with which stop", intro, tables=[Table("Concepts side by side", concepts_table(d) + definitions)])
         figures = Section("Figures", "", figures=saved((overview_figure(d), response_figure(d), impact_figure(d)), out))
         notes = "".join(f"<li><b>{html.escape(str(d['label'].values[i]))}</b>: {html.escape(str(d['notes'].values[i]) or 'closed forms only')}</li>" for i in range(d.sizes["concept"]))
         return [answer, figures, Section("How each concept was computed", f"<ul>{notes}</ul>")]

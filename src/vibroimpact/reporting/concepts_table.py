@@ -128,7 +128,7 @@ def concepts_table(dataset: xr.Dataset) -> str:
     has_stops = _has_stops(dataset)
     wrap = "style='white-space:normal'"
     head = "".join(f"<th {wrap}>{html.escape(c.title)}</th>" for c in COLUMNS)
-    lines = [f"<table style='font-size:93%'><tr><th {wrap}>concept</th><th {wrap}>k2 [N/m], b2 [N s/m]</th>{head}<th {wrap}>unstable orbits [Hz]</th><th>verdict</th></tr>"]
+    lines = [f"<table style='font-size:93%'><tr><th {wrap}>concept</th><th {wrap}>k2 [N/m], b2 [N s/m]</th>{head}<th {wrap}>unstable orbits [Hz]</th><th style='text-align:left'>verdict</th></tr>"]
     marks = {c.variable: best_rows(_values(dataset, c)) for c in COLUMNS}
     texts = verdicts(dataset)
     for row in range(rows):
