@@ -12,7 +12,7 @@ import math
 import numpy as np
 import xarray as xr
 from matplotlib.axes import Axes
-from matplotlib.ticker import FormatStrFormatter
+from matplotlib.ticker import FormatStrFormatter, LogFormatter
 
 from vibroimpact.reporting.page import DrawnFigure
 from vibroimpact.reporting.style import LINEAR_STYLE, STABLE_STYLE, UNSTABLE_STYLE, Caption, figure_legend, fmt, new_figure
@@ -47,13 +47,18 @@ def _isolated(y: np.ndarray) -> np.ndarray:
     return finite & ~before & ~after
 
 
+class PlainLogFormatter(LogFormatter):
+    """matplotlib's log-axis labels (its choice of which minor ticks to label) written as plain numbers: 0.2, 3."""
+
+    def _num_to_string(self, x: float, vmin: float, vmax: float) -> str:
+        return f"{x:g}"
+
+
 def _plain_ticks(ax: Axes) -> None:
-    """Plain numbers on a log axis (0.5, 1, 2 rather than 5 x 10^-1), minor ticks labelled only when the axis spans
-    less than about a decade and a half."""
+    """Plain numbers on a log axis (0.5, 1, 2 rather than 5 x 10^-1); a few minor ticks labelled when the axis spans
+    about a decade or less (matplotlib's thinning)."""
     ax.yaxis.set_major_formatter(FormatStrFormatter("%g"))
-    low, high = ax.get_ylim()
-    if low > 0.0 and high / low < 30.0:
-        ax.yaxis.set_minor_formatter(FormatStrFormatter("%g"))
+    ax.yaxis.set_minor_formatter(PlainLogFormatter(labelOnlyBase=False, minor_thresholds=(1.0, 0.5)))
 
 
 def _split(x: np.ndarray, y: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
