@@ -54,7 +54,7 @@ class SectionMap:
     def __init__(self, problem: ImpactProblem, section: float, engine: ExactEngine) -> None:
         self.problem, self.section, self.engine = problem, float(section), engine
         self.dimension = 2 * problem.size
-        self.state_scale = state_scales(problem) if problem.paper_layout else _general_scales(problem)
+        self.state_scale = state_scales(problem)
         self.parameter_scale = np.array([1.0])
         self.evaluations = 0
 
@@ -68,12 +68,6 @@ class SectionMap:
         v = image.impact_velocities
         hybrid = HybridInfo(int(v.size), float(v.min()) if v.size else np.inf, image.closest_approach, image.sticks)
         return MapEvaluation(image.state, image.jacobian, None, hybrid)
-
-
-def _general_scales(problem: ImpactProblem) -> NDArray[np.float64]:
-    """Scales of (x, x') for any layout [m, m s-1]: L = max |Delta_k| + v / w (the paper's 2 Delta + q |H12|)."""
-    length = float(np.max(np.abs(problem.clearances()))) + problem.velocity_scale() / problem.omega
-    return np.concatenate([np.full(problem.size, length), np.full(problem.size, problem.omega * length)])
 
 
 @dataclass(frozen=True)
