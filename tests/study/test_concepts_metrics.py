@@ -145,3 +145,19 @@ def test_every_problem_names_its_key(change, key: str) -> None:
     with pytest.raises(SceneError) as error:
         parse_concepts(document)
     assert any(problem.startswith(key) for problem in error.value.problems), error.value.problems
+
+
+def test_the_shipped_scene() -> None:
+    """studies/absorber_concepts.yaml: the six concepts of issue 12 item 4, Den Hartog's optimum where it says so."""
+    from vibroimpact.scene.locate import shipped_studies_dir
+    from vibroimpact.scene.reader import read_yaml
+
+    document = read_yaml((shipped_studies_dir() / "absorber_concepts.yaml").read_text(encoding="utf-8"))
+    name, _description, _report, settings = parse_concepts(document)
+    optimum = den_hartog_absorber(1.0, 25000.0, 0.1)
+    concepts = {c.name: c for c in settings.concepts}
+    assert name == "absorber_concepts" and settings.bumper_frequency == 250.0 and settings.amplitude == 10.0  # exact: parsed inputs
+    assert (concepts["den_hartog"].system.k2, concepts["den_hartog"].system.b2) == (optimum.stiffness, optimum.damping)
+    assert (concepts["den_hartog_damping"].system.k2, concepts["den_hartog_damping"].system.b2) == (4300.0, optimum.damping)
+    assert concepts["absolute_stop"].paper_layout and [s.side for s in concepts["two_sided_stop"].stops] == ["upper", "lower"]
+    assert [(s.coordinate, s.other, s.side) for s in concepts["relative_two_sided"].stops] == [(1, 0, "upper"), (1, 0, "lower")]
