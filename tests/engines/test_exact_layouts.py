@@ -218,6 +218,29 @@ def test_a_preloaded_stop_holds_until_the_force_pulls_harder() -> None:
     np.testing.assert_allclose(python.segments, run.segments, rtol=0, atol=1e-8 * problem.period)
 
 
+@pytest.mark.parametrize("engine", [ENGINE, PYTHON], ids=["compiled", "python"])
+def test_a_ball_on_a_table_at_gamma_one_stays_on_it(engine: ExactEngine | PythonExactEngine) -> None:
+    """A ball at rest on a table vibrating at exactly Gamma = A w^2 / g = 1 (table coordinates, 10 Hz): the holding
+    force m g (1 + sin(w t)) touches zero at w t = 3 pi / 2 every period without turning negative, and the free
+    flight's acceleration -(1 + sin(w t)) g is never positive, so the ball stays on the table. The engine may let go
+    within round-off of the touch, but it lands at once: over 20 periods no impact faster than 1e-12 m/s, |z| <= 1e-15
+    m and |z'| <= 1e-12 m/s everywhere (measured 2e-20 m, 4e-16 m/s), held but for 1e-6 of the time (measured 1.2e-8),
+    at most one release per period, and the holding force's Fourier moment is its closed form
+    int m g sin(w t) e^{-jwt} dt = -j m g T / 2 (1e-12 of m g T). (It ran out of events, 'no progress', at the fifth
+    touch: the held search stopped where the force was within round-off of zero, still falling, and the stop, asked
+    if it pushed, answered from that fall that it did not, while the flight went into it.)"""
+    problem = ImpactProblem(LinearStructure([[1.0]], [[0.0]]), (Stop(RigidStop(0.0, 0.5), 0, side="lower"),), HarmonicForce(GRAVITY, 10.0, 0.5 * math.pi, static=(-GRAVITY,)))
+    periods = 20
+    run = engine.integrate(problem, np.zeros(2), 0.0, periods, moments=True)
+    assert np.all(run.impact_velocities <= 1e-12)
+    assert run.stats["releases"] <= periods and run.stats["sticks"] <= periods
+    dense = engine.dense(run, np.linspace(0.0, run.strobe_times[-1], 20001))
+    assert np.max(np.abs(dense[:, 0])) <= 1e-15 and np.max(np.abs(dense[:, 1])) <= 1e-12
+    np.testing.assert_allclose(run.strobe_states, 0.0, atol=1e-15)
+    assert run.stuck_time >= (1.0 - 1e-6) * periods * problem.period
+    np.testing.assert_allclose(run.moments[:, 1], -0.5j * GRAVITY * problem.period, rtol=0, atol=1e-12 * GRAVITY * problem.period)
+
+
 class _OscillatorMap:
     """The one-period stroboscopic map of an impact oscillator at t = 0, as :func:`shoot` wants it."""
 

@@ -214,9 +214,10 @@ def _step_data(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t):
 
 
 @njit(cache=True, error_model="numpy")
-def _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t):
+def _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, band):
     """A step over which h stays < 0 from h(t) = 0 when h leaves the surface; -1.0 if it does not leave (orders up to
-    4, see linear_flow.escape_step)."""
+    4); with ``band`` >= 0 (h's round-off), a rise that peaks within it is stepped over (see linear_flow.escape_step
+    and linear_flow.tangency_step)."""
     values = np.empty(5)
     _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, values)
     for k in range(1, 5):
@@ -224,8 +225,29 @@ def _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t):
         if values[k] < -1e-9 * scale:
             return -(k + 1) * values[k] / _bound(rates, rr, rc, amp, ar, har, p1, p2, omega, t0, t, k + 1)
         if values[k] > 1e-9 * scale:
-            return -1.0
+            if band < 0.0 or k == 4 or values[k + 1] >= 0.0:
+                return -1.0
+            s0 = -(k + 1) * values[k] / values[k + 1]
+            factorial = 1.0  # (k + 1)!
+            for i in range(2, k + 2):
+                factorial *= i
+            peak = values[0] + (k * s0 / (k + 1)) ** k * values[k] / factorial
+            slack = _bound(rates, rr, rc, amp, ar, har, p1, p2, omega, t0, t, k + 2) * s0 ** (k + 2) / (factorial * (k + 2))
+            term = 1.0  # s0^j / j!
+            for j in range(1, k):
+                term *= s0 / j
+                slack += abs(values[j]) * term
+            return s0 if peak + slack <= band else -1.0
     return -1.0
+
+
+@njit(cache=True, error_model="numpy")
+def _round_off(rc, amp, ar, har, con, p1, p2, tau, tolerance):
+    """How accurately h can be evaluated at t0 + tau: ``tolerance``, or 1e-15 of its largest terms if that is more."""
+    size = abs(har) + abs(con) + (abs(p1) + abs(p2) * tau) * tau
+    for i in range(rc):
+        size += abs(amp[ar, i])
+    return max(tolerance, 1e-15 * size)
 
 
 @njit(cache=True, error_model="numpy")
@@ -247,16 +269,12 @@ def _polish(h0, h1, h2):
 @njit(cache=True, error_model="numpy")
 def _first_crossing(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t_from, t_to, tolerance, leaving):
     """First time in (t_from, t_to] at which h reaches 0 from below; NaN if none (see linear_flow.first_crossing)."""
-    tau = t_from - t0
-    size = abs(har) + abs(con) + (abs(p1) + abs(p2) * tau) * tau
-    for i in range(rc):
-        size += abs(amp[ar, i])
-    tolerance = max(tolerance, 1e-15 * size)
+    tolerance = _round_off(rc, amp, ar, har, con, p1, p2, t_from - t0, tolerance)
     pair = np.empty(2)
     t = t_from
     if leaving:
         if _value(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t) >= -tolerance:
-            step = _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t)
+            step = _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, tolerance)
             if step < 0.0:
                 if _bound(rates, rr, rc, amp, ar, har, 0.0, 0.0, omega, t0, t, 0) <= tolerance and abs(p1) + abs(p2) <= tolerance:
                     return math.nan
@@ -268,7 +286,7 @@ def _first_crossing(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t_from,
     while True:
         h0, h1, h2, curvature, jerk = _step_data(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t)
         if departing and h0 >= -8.0 * tolerance:
-            step = _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t)
+            step = _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, tolerance)
             if step >= 0.0:
                 if t + step >= t_to:
                     return math.nan
@@ -454,7 +472,8 @@ def _pushed(stop, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdr
     value = _value(lams, f, m, amp, 0, har, con, p1, p2, omega, t, t)
     if abs(value) > 64.0 * force_tolerance:
         return value < 0.0
-    return _escape_step(lams, f, m, amp, 0, har, con, p1, p2, omega, t, t) >= 0.0
+    band = _round_off(m, amp, 0, har, con, p1, p2, 0.0, force_tolerance)  # as the held search will allow
+    return _escape_step(lams, f, m, amp, 0, har, con, p1, p2, omega, t, t, band) >= 0.0
 
 
 # ------------------------------------------------------------------------------------------------------- the loop

@@ -181,10 +181,13 @@ class _Run:
         release = self._observable(self.flows[k + 1].start(t, y), k, k)  # minus the holding force
         value = release.derivatives(t, 1)[0]
         # a holding force of a few round-off units is zero: its sign is noise (the flow's particular solution can be
-        # larger than the length scale when Delta = 0, so allow 64 units), and the derivatives decide
-        if abs(value) > 64.0 * self.model.force_tolerances[k]:
+        # larger than the length scale when Delta = 0, so allow 64 units), and the derivatives decide; a force that
+        # falls to touch zero and rises again within the round-off the held search allows is a push, as that search
+        # finds (escape_step's band)
+        tolerance = float(self.model.force_tolerances[k])
+        if abs(value) > 64.0 * tolerance:
             return value < 0.0
-        return escape_step(release, t) is not None
+        return escape_step(release, t, release.round_off(t, tolerance)) is not None
 
     def _state(self, piece: Piece, t: float, held: int) -> NDArray[np.float64]:
         y = piece.state(t)

@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines.exact_flows import Flow, decompose
 
-__all__ = ["HarmonicLinearFlow", "Piece", "Observable", "first_crossing", "escape_step", "polish_step", "gauss_legendre"]
+__all__ = ["HarmonicLinearFlow", "Piece", "Observable", "first_crossing", "escape_step", "tangency_step", "polish_step", "gauss_legendre"]
 
 
 class HarmonicLinearFlow:
@@ -167,6 +167,12 @@ class Observable:
             bound3,
         )
 
+    def round_off(self, t: float, tolerance: float) -> float:
+        """How accurately h can be evaluated at t: ``tolerance``, or 1e-15 of its largest terms if that is more."""
+        tau = t - self.t0
+        polynomial = (abs(self.p1) + abs(self.p2) * tau) * tau
+        return max(tolerance, 1e-15 * (sum(abs(a) for a in self.amplitudes) + abs(self.harmonic) + abs(self.constant) + polynomial))
+
     def bound(self, t: float, order: int) -> float:
         """An upper bound of |h^(order)| over [t, inf) for order >= 2; for orders 0 and 1, whose polynomial part
         grows, its size at t (a scale)."""
@@ -206,10 +212,10 @@ def first_crossing(h: Observable, t_from: float, t_to: float, tolerance: float, 
     # h cannot be evaluated more accurately than the round-off of its largest terms
     tau = t_from - h.t0
     polynomial = (abs(h.p1) + abs(h.p2) * tau) * tau
-    tolerance = max(tolerance, 1e-15 * (sum(abs(a) for a in h.amplitudes) + abs(h.harmonic) + abs(h.constant) + polynomial))
+    tolerance = h.round_off(t_from, tolerance)
     t = t_from
     if leaving and h.derivatives(t, 1)[0] >= -tolerance:  # at the surface: the start must not count as a root
-        step = escape_step(h, t)
+        step = escape_step(h, t, tolerance)
         if step is None:
             if h.bound(t, 0) - polynomial <= tolerance and abs(h.p1) + abs(h.p2) <= tolerance:
                 return None  # h is zero from here on (at rest on the surface, no forcing): nothing crosses
@@ -225,7 +231,7 @@ def first_crossing(h: Observable, t_from: float, t_to: float, tolerance: float, 
             # on the stop, a holding force of -2e-6 N against a 49 N force took ~1e3 of them): while h still goes
             # down it is not a root (returned as one, the caller applied a contact at zero speed and searched again,
             # ~1e-11 s further on, until the period's event budget ran out); clear of the band, the search goes on
-            step = escape_step(h, t)
+            step = escape_step(h, t, tolerance)
             if step is not None:
                 if t + step >= t_to:
                     return None
@@ -270,7 +276,7 @@ def _quadratic_step(h0: float, h1: float, curvature: float) -> float:
     return 2.0 * -h0 / (h1 + math.sqrt(h1 * h1 - 2.0 * curvature * h0))
 
 
-def escape_step(h: Observable, t: float) -> float | None:
+def escape_step(h: Observable, t: float, band: float | None = None) -> float | None:
     """A step over which h stays < 0 when h(t) = 0 and h leaves the surface; ``None`` if it does not leave.
 
     With derivatives h^(1) = ... = h^(k-1) = 0 and h^(k) < 0, ``h(t + s) <= h^(k) s^k / k! + M s^(k+1) / (k+1)!`` with
@@ -278,6 +284,14 @@ def escape_step(h: Observable, t: float) -> float | None:
     holding force and an undamped spring (B2 = 0) leaves at the fourth order (h^(2) = H / M2 = 0, h^(3) = B2 X1^(2)
     / M2 = 0, h^(4) = K2 X1^(2) / M2); with three orders that start was neither leaving nor a contact, and the loop
     applied a touch at the same instant until its event budget ran out.
+
+    Given ``band`` (the round-off of h), a rise that only touches the band is not a departure from it either: when
+    h^(k) > 0 but h^(k+1) < 0 and h peaks within ``band`` of zero (:func:`tangency_step`), the step over the peak is
+    returned. A holding force that touches zero once a period without turning negative (a ball at rest on a table
+    vibrating at exactly Gamma = A w^2 / g = 1) is found within round-off of zero at a time within sqrt(round-off) of
+    the touch, still falling at ~3e-8 of its scale: the stop let go there, the free flight went into it at once
+    (its acceleration, -(1 + sin) g, never turns positive), and the stop, asked whether it pushed, answered from that
+    fall that it did not: a touch without sticking, at the same instant, until the event budget ran out.
     """
     values = h.derivatives(t, 5)
     for k in range(1, 5):
@@ -285,8 +299,25 @@ def escape_step(h: Observable, t: float) -> float | None:
         if values[k] < -1e-9 * scale:
             return -(k + 1) * values[k] / h.bound(t, k + 1)
         if values[k] > 1e-9 * scale:
-            return None
+            return None if band is None or k == 4 else tangency_step(values, k, h.bound(t, k + 2), band)
     return None
+
+
+def tangency_step(values: list[float], k: int, bound: float, band: float) -> float | None:
+    """The step over a rise of h that stays within ``band`` of zero, or ``None``.
+
+    ``values`` are h, h', ..., h^(k+1) at t, the orders below k negligible, h^(k) > 0, and ``bound`` >= sup
+    |h^(k+2)|. The model h^(k) s^k / k! + h^(k+1) s^(k+1) / (k+1)! (h^(k+1) < 0) peaks at s* = -k h^(k) / h^(k+1) at
+    s*^k h^(k) / (k+1)! and is back to 0 at s0 = (k + 1) s* / k; on [0, s0] h is at most h(t) plus that peak, the
+    neglected orders' sum |h^(j)| s0^j / j! and the remainder bound s0^(k+2) / (k+2)!: if that stays <= band, h
+    never rises out of its round-off (a tangency, not a crossing) and s0 is returned.
+    """
+    if values[k + 1] >= 0.0:
+        return None
+    s0 = -(k + 1) * values[k] / values[k + 1]
+    peak = values[0] + (k * s0 / (k + 1)) ** k * values[k] / math.factorial(k + 1)
+    slack = bound * s0 ** (k + 2) / math.factorial(k + 2) + sum(abs(values[j]) * s0**j / math.factorial(j) for j in range(1, k))
+    return s0 if peak + slack <= band else None
 
 
 @lru_cache(maxsize=64)
