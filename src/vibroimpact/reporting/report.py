@@ -5,6 +5,8 @@ base64, a table of contents linking every figure and table) into ``out_dir``. Ev
 itself (:mod:`vibroimpact.reporting.record`), never from a re-validated scene. :func:`page_for` chooses the page by
 the kind of study, in this one place:
 
+* absorber concepts side by side: the designer's table and figures (:class:`~vibroimpact.reporting.concepts_page.ConceptsPage`);
+* validation against published closed forms: published against computed (:class:`~vibroimpact.reporting.validation_page.ValidationPage`);
 * benchmark studies: work-precision diagrams and tolerance guidance (:class:`~vibroimpact.reporting.accuracy_page.AccuracyPage`);
 * bifurcation studies: diagrams with brute force and continued branches, special points, multipliers and the chart
   (:class:`~vibroimpact.reporting.bifurcation_page.BifurcationPage`);
@@ -26,6 +28,7 @@ import xarray as xr
 from vibroimpact.reporting.page import StudyPage, render_page, rendering, write_page  # selects the Agg backend
 from vibroimpact.reporting.accuracy_page import AccuracyPage  # noqa: E402
 from vibroimpact.reporting.bifurcation_page import BifurcationPage  # noqa: E402
+from vibroimpact.reporting.concepts_page import ConceptsPage  # noqa: E402
 from vibroimpact.reporting.validation_page import ValidationPage  # noqa: E402
 from vibroimpact.reporting.bumper_page import BumperStiffnessPage  # noqa: E402
 from vibroimpact.reporting.general_page import GeneralResponsePage  # noqa: E402
@@ -55,6 +58,8 @@ def page_for(dataset: xr.Dataset) -> StudyPage:
     kind = study_kind(dataset)
     if kind == "benchmark":
         return AccuracyPage(dataset)
+    if kind == "concepts":
+        return ConceptsPage(dataset)
     if kind == "validation":
         return ValidationPage(dataset)
     if kind == "bifurcation":

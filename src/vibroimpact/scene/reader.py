@@ -24,6 +24,7 @@ import yaml
 
 from vibroimpact.scene.benchmark import parse_benchmark_scene
 from vibroimpact.scene.bifurcation import parse_bifurcation_scene
+from vibroimpact.scene.concepts import parse_concepts_scene
 from vibroimpact.scene.validation import parse_validation_scene
 from vibroimpact.scene.checker import SceneError
 from vibroimpact.scene.schema import Scene
@@ -68,14 +69,16 @@ def read_yaml(text: str) -> Any:
 def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
     """Validate a parsed YAML document and build the :class:`Scene`; raise :class:`SceneError` listing all problems.
 
-    A document with a ``benchmark`` section is a benchmark scene, one with a ``bifurcation`` section a bifurcation
-    scene; any other is a scene over parameter grids.
+    A document with a ``benchmark``, ``concepts``, ``validation`` or ``bifurcation`` section is a scene of that
+    kind; any other is a scene over parameter grids.
     """
     if not isinstance(document, dict):
         what = "an empty document" if document is None else f"a {type(document).__name__}"
         raise SceneError([f"scene: expected a mapping with keys {sorted(TOP_KEYS)}, got {what}"], source)
     if "benchmark" in document:
         return parse_benchmark_scene(document, text, source)
+    if "concepts" in document:
+        return parse_concepts_scene(document, text, source)
     if "validation" in document:
         return parse_validation_scene(document, text, source)
     if "bifurcation" in document:

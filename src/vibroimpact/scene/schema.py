@@ -27,6 +27,7 @@ from vibroimpact.simulation.settings import START_MODES, SWEEP_STARTS, SteadySet
 
 if TYPE_CHECKING:
     from vibroimpact.scene.bifurcation_settings import BifurcationSettings
+    from vibroimpact.scene.concepts import ConceptsSettings
     from vibroimpact.scene.validation_settings import ValidationSettings
 
 __all__ = [
@@ -51,7 +52,7 @@ __all__ = [
 ]
 
 #: Kinds of study a scene can be (:attr:`Scene.kind`); each has its run and estimate (``study/kinds.py``) and its page.
-STUDY_KINDS = ("stepped", "swept", "benchmark", "bifurcation", "validation")
+STUDY_KINDS = ("stepped", "swept", "benchmark", "bifurcation", "validation", "concepts")
 #: Solutions computed by time integration (they need the ``simulation`` section's settings): registered engines.
 ENGINE_SOLUTIONS = ("momentary", "exact", "compliant")
 #: Solutions a scene can ask for: the closed forms, then the engines.
@@ -320,6 +321,7 @@ class Scene:
     swept_sine: SweptSineSettings | None = None
     bifurcation: "BifurcationSettings | None" = None
     validation: "ValidationSettings | None" = None
+    concepts: "ConceptsSettings | None" = None
     report: bool = True
     text: str = ""
     load: LoadSpec | None = None
@@ -350,11 +352,14 @@ class Scene:
 
     @property
     def kind(self) -> str:
-        """What kind of study the scene is: ``validation`` (a published closed form), ``benchmark``, ``bifurcation``,
+        """What kind of study the scene is: ``concepts`` (absorber concepts side by side), ``validation`` (a published
+        closed form), ``benchmark``, ``bifurcation``,
         ``swept`` (swept-sine tests) or ``stepped`` (steady states).
 
         The one place that decides it; everything else dispatches on this name.
         """
+        if self.concepts is not None:
+            return "concepts"
         if self.validation is not None:
             return "validation"
         if self.benchmark is not None:

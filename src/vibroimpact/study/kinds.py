@@ -17,6 +17,7 @@ import xarray as xr
 from vibroimpact.scene.schema import Scene
 from vibroimpact.study.benchmark import BenchmarkStudy
 from vibroimpact.study.bifurcation import BifurcationStudy
+from vibroimpact.study.concepts import ConceptsStudy
 from vibroimpact.study.validation import ValidationStudy
 from vibroimpact.study.cost_model import Costs, Estimate
 from vibroimpact.study.grid import Progress
@@ -44,7 +45,7 @@ class StudyKind(Protocol):
 
 
 #: Every kind of study by name.
-KINDS: Mapping[str, StudyKind] = MappingProxyType({kind.name: kind for kind in (SteppedStudy(), SweptStudy(), BenchmarkStudy(), BifurcationStudy(), ValidationStudy())})
+KINDS: Mapping[str, StudyKind] = MappingProxyType({kind.name: kind for kind in (SteppedStudy(), SweptStudy(), BenchmarkStudy(), BifurcationStudy(), ValidationStudy(), ConceptsStudy())})
 
 
 def study_kind(scene: Scene) -> StudyKind:
