@@ -60,4 +60,4 @@ def test_run_study_runs_a_validation_scene(tmp_path: Path) -> None:
     from vibroimpact.cli import main
 
     assert main([str(STUDIES / "zeno.yaml"), "--out", str(tmp_path), "--jobs", "1"]) == 0
-    assert (tmp_path / "zeno.nc").is_file() and (tmp_path / "report.html").is_file()
+    assert (tmp_path / "validation_zeno.nc").is_file() and (tmp_path / "report.html").is_file()
