@@ -16,7 +16,7 @@ from vibroimpact.model.stops import Stop
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.checker import SceneError
 from vibroimpact.scene.concepts import parse_concepts
-from vibroimpact.scene.concepts_absorber import den_hartog_absorber
+from vibroimpact.model.absorber import den_hartog_absorber
 from vibroimpact.study.concepts_metrics import anti_resonance_band, band_metrics, envelope, stretches
 from vibroimpact.study.concepts_steady import base_force, check_stops
 

@@ -16,7 +16,7 @@ Example (the shipped ``absorber_concepts``, shortened)::
       - {name: stop_1928, label: "(c) relative stop", stops: [{between: [x2, x1], side: upper, clearance: 0.003, restitution: 0.2}]}
 
 Each concept keeps m1, k1, b1 and m2; ``absorber`` may replace k2 and b2 (a number, or ``den_hartog``: Den Hartog's
-optimum, :mod:`.concepts_absorber`), and ``stops`` lists rigid stops: ``coordinate: x2`` against the base, or
+optimum, :mod:`vibroimpact.model.absorber`), and ``stops`` lists rigid stops: ``coordinate: x2`` against the base, or
 ``between: [x2, x1]`` (on x2 - x1), ``side: upper`` (coordinate <= clearance) or ``lower`` (>= -clearance). The
 anti-resonance band of the comparison is where the scene's own system, without a stop, keeps |X1| below the static
 deflection q / k1, around the absorber's anti-resonance sqrt(k2 / m2).
@@ -37,7 +37,7 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.stops import SIDES, Stop
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.checker import Checker, SceneError
-from vibroimpact.scene.concepts_absorber import den_hartog_absorber
+from vibroimpact.model.absorber import den_hartog_absorber
 from vibroimpact.scene.sections import NAME, parse_header
 from vibroimpact.simulation.settings import SteadySettings
 

@@ -1,5 +1,5 @@
 """Den Hartog's damped absorber (Mechanical Vibrations, 4th ed., 1956, sec. 3.3; Brock, J. Appl. Mech. 13, 1946):
-the formulas of :mod:`vibroimpact.scene.concepts_absorber` against the receptance of the structure itself.
+the formulas of :mod:`vibroimpact.model.absorber` against the receptance of the structure itself.
 
 |X1| is taken from :meth:`LinearStructure.receptance_matrix` (an undamped primary, force on the primary mass), not
 from Den Hartog's formula, so each test checks a published property against an independent computation.
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from vibroimpact.model.structure import LinearStructure
-from vibroimpact.scene.concepts_absorber import (
+from vibroimpact.model.absorber import (
     den_hartog_absorber,
     fixed_point_height,
     fixed_point_ratios,
