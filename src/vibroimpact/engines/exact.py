@@ -8,8 +8,9 @@ round-off. An impact on stop k restitutes its gap velocity, n_k . x' -> -R_k n_k
 (two bodies' momentum is conserved on a relative stop). When impacts accumulate (chattering, small R) and the stop
 pushes the structure, it sticks: the flow held on the stop's surface (n_k . x = Delta_k, n_k . x' = 0) runs until the
 holding force (:meth:`~vibroimpact.model.problem.ImpactProblem.contact_holding`; B2 X1' + K2 (X1 - Delta) on the
-paper's layout) turns negative (found by the same root search), or an impact on another stop frees it. Sticking on two
-stops at once is refused (``NotImplementedError`` naming both).
+paper's layout) turns negative (found by the same root search), or an impact on another stop frees it (unless the
+impulse leaves it closed, at rest on it, n_k . x' = 0 to round-off, and pushed: then it holds on, as in the
+``momentary`` engine). Sticking on two stops at once is refused (``NotImplementedError`` naming both).
 
 The event loop runs compiled (:mod:`.exact_core`, numba); this module is its thin Python face. It also returns the
 exact Jacobian of the stroboscopic map (state-transition matrices times the saltation matrices of impacts, sticking

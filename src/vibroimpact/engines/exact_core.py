@@ -407,7 +407,7 @@ def _saltation(jumps, stop, a_matrix, load, static, omega, t, before, after, vel
         for c in range(n):
             out[r, c] = jumps[stop, r, c]
     if velocity <= 0.0:
-        if held_after < 0:
+        if held_after != stop:
             out[:, :] = math.nan  # a grazing touch: the map is not differentiable here
         return  # touch and stick: the gap and its velocity are held from here on (the touch's D holds both)
     f_before = np.empty(n)
@@ -474,6 +474,22 @@ def _pushed(stop, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdr
         return value < 0.0
     band = _round_off(m, amp, 0, har, con, p1, p2, 0.0, force_tolerance)  # as the held search will allow
     return _escape_step(lams, f, m, amp, 0, har, con, p1, p2, omega, t, t, band) >= 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _holds(stop, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hold_w, hold_off, hold_har, force_tolerance, omega, t, y, gapw, velw, clearances, tolerance):
+    """Does held stop ``stop`` hold on after an impulse on another stop: still closed, at rest on it (n . x' within
+    1e-12 of the velocities it is made of: a relative stop's two velocities cancel only to round-off) and pushed?"""
+    if _gap(gapw, clearances, stop, y) < -tolerance:
+        return False
+    speed = 0.0
+    noise = 0.0
+    for r in range(y.size):
+        speed += velw[stop, r] * y[r]
+        noise += abs(velw[stop, r] * y[r])
+    if abs(speed) > 1e-12 * noise:
+        return False
+    return _pushed(stop, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hold_w, hold_off, hold_har, force_tolerance, omega, t, y)
 
 
 # ------------------------------------------------------------------------------------------------------- the loop
@@ -638,19 +654,21 @@ def run_periods(
             counters[3] += 1
             stuck = -1  # release: continuous state and vector field, saltation = identity
             continue
-        # an impact on stop ``event`` (from free flight, or while held on another stop, which it frees)
+        # an impact on stop ``event`` (from free flight, or while held on another stop, which it frees unless that
+        # stop holds on after the impulse)
         held_before = stuck
-        if stuck >= 0:
-            counters[3] += 1
-            stuck = -1
+        stuck = -1
         j = event
         impacts_period[j] += 1
         counters[1] += 1
         _snap(gapw, clearances, simple, signs, j, y)
         raw = 0.0
+        noise = 0.0
         for r in range(n):
             raw += velw[j, r] * y[r]
-        velocity = raw if raw > resolution_velocity else 0.0
+            noise += abs(velw[j, r] * y[r])
+        # below round-off (of the velocity scale, or of the velocities a relative stop's n . x' is made of): a touch
+        velocity = raw if raw > resolution_velocity and raw > 1e-12 * noise else 0.0
         chatters = velocity <= sticking_velocity or impacts_period[j] > max_impacts or restitutions[j] == 0.0
         sticks = False
         if chatters:
@@ -672,8 +690,26 @@ def run_periods(
             change = (after - raw) * masses[j]
             for r in range(n):
                 y[r] += change * kickw[j, r]
+        held_after = j if sticks else -1
+        if held_before >= 0 and not sticks:
+            h = held_before
+            if _holds(h, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hold_w, hold_off, hold_har, force_tolerances[h], omega, t, y, gapw, velw, clearances, tolerance):
+                # still closed, at rest on it (n . x' at round-off) and pushed: it holds on, its n . x' made exactly 0
+                held_after = h
+                _snap(gapw, clearances, simple, signs, h, y)
+                i = simple[h]
+                if i >= 0:
+                    y[size + i] = 0.0
+                else:
+                    change = 0.0
+                    for r in range(n):
+                        change -= velw[h, r] * y[r]
+                    change *= masses[h]
+                    for r in range(n):
+                        y[r] += change * kickw[h, r]
+        if held_before >= 0 and held_after != held_before:
+            counters[3] += 1
         if want_jacobians:
-            held_after = j if sticks else -1
             if not sticks:
                 _saltation(bounce, j, a_matrix, load, static, omega, t, before, y, velocity, held_before, held_after, gapw, velw, kickw, masses, simple, salt)
             elif velocity > 0.0:
@@ -692,7 +728,7 @@ def run_periods(
         else:
             counters[4] += 1
         counters[2] += 1 if sticks else 0
-        stuck = j if sticks else -1
+        stuck = held_after
     return STATUS_OK, t, strobes, jacobians, impacts[:n_impacts], segments[:n_segments], segment_states[:n_segments], moments, counters, approach
 
 

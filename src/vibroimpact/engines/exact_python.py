@@ -8,7 +8,7 @@ contact is missed however tangent, and contact times are exact to round-off. An 
 by an impulse along M^-1 n_k (:meth:`.rigid_contact.RigidContact.kick`). When impacts accumulate (chattering, small R)
 and the stop pushes the structure, it sticks: the flow held on the stop's surface runs until the holding force
 (:meth:`~vibroimpact.model.problem.ImpactProblem.contact_holding`) turns negative (found by the same root search), or
-an impact on another stop frees it. Moments are integrated by Gauss-Legendre quadrature (the compiled core has them in
+an impact on another stop frees it (unless the impulse leaves it closed, at rest on it and pushed). Moments are integrated by Gauss-Legendre quadrature (the compiled core has them in
 closed form: an independent check).
 """
 
@@ -144,11 +144,8 @@ class _Run:
                 rec.stats["releases"] += 1
                 held = -1
                 continue
-            if held >= 0:  # an impact on another stop frees the held one
-                rec.stats["releases"] += 1
-                held = -1
             impacts_this_period[event] += 1
-            held = self._contact(t, y, event, int(impacts_this_period[event]))
+            held = self._contact(t, y, event, int(impacts_this_period[event]), held)
         return rec.build({"steps": self.steps, "events": self.events})
 
     def _gap(self, k: int, y: NDArray[np.float64]) -> float:
@@ -194,12 +191,23 @@ class _Run:
         self._clamp(y, held)
         return y
 
-    def _contact(self, t: float, y: NDArray[np.float64], k: int, impacts_this_period: int) -> int:
-        """Apply the contact with stop k at time t to ``y`` in place; return k if it sticks there, else -1."""
+    def _holds(self, k: int, t: float, y: NDArray[np.float64]) -> bool:
+        """Does held stop k hold on after an impulse on another stop: still closed, at rest on it (n . x' within 1e-12
+        of the velocities it is made of: a relative stop's two velocities cancel only to round-off) and pushed?"""
+        terms = self.model.normals[k] * y[self.size :]
+        if self._gap(k, y) < -self.tolerance or abs(float(np.sum(terms))) > 1e-12 * float(np.sum(np.abs(terms))):
+            return False
+        return self._pushed(k, t, y)
+
+    def _contact(self, t: float, y: NDArray[np.float64], k: int, impacts_this_period: int, held: int) -> int:
+        """Apply the contact with stop k at time t to ``y`` in place; return the stop held after it: k if it sticks
+        there, ``held`` (the stop held before, -1 if none) if that one holds on through the impulse, else -1."""
         self.events += 1
         self._snap(k, y)
         raw = float(self.law.approach(y)[k])
-        velocity = raw if raw > self.resolution_velocity else 0.0  # below round-off: a touch, not an impact
+        noise = 1e-12 * float(np.abs(self.model.normals[k]) @ np.abs(y[self.size :]))
+        # below round-off (of the velocity scale, or of the velocities a relative stop's n . x' is made of): a touch
+        velocity = raw if raw > self.resolution_velocity and raw > noise else 0.0
         if self.count > 1:
             others = [j for j in range(self.count) if j != k and self._gap(j, y) >= -self.tolerance]
         impact = self.law.collide(self.rec, t, velocity, impacts_this_period, lambda: self._pushed(k, t, y), stop=k)
@@ -212,6 +220,18 @@ class _Run:
             y[self.size + i] = self.model.normals[k, i] * impact.after
         else:
             y[:] = self.law.kick(y, k, (raw - impact.after) * self.model.masses[k])
+        if held >= 0 and not impact.sticks and self._holds(held, t, y):
+            # an impulse on another stop that leaves the held one closed, at rest and pushed: it holds on, its n . x'
+            # made exactly 0 (a round-off approach would read as an impact on it next)
+            self._snap(held, y)
+            i = self.model.simple[held]
+            if i >= 0:
+                y[self.size + i] = 0.0
+            else:
+                y[:] = self.law.kick(y, held, float(self.law.approach(y)[held]) * self.model.masses[held])
+            return held
+        if held >= 0:
+            self.rec.stats["releases"] += 1
         return k if impact.sticks else -1
 
     # --------------------------------------------------------------- moments
