@@ -9,7 +9,8 @@ x_i^2 for each coordinate (for the paper's layout: X1 c, X1 s, X2 c, X2 s, H c, 
 
 Event functions (2 K + 1): the penetration u_k of each stop (rising: contact; -1 on the stop held), the holding force
 of the stuck stop (falling: release; 1 in free flight), and the approach velocity n_k . v of each stop (falling: an
-apex, the grazing guard; 1 on the stop held or without the guard).
+apex, the grazing guard; 1 on the stop held or without the guard). A stop parallel to the one held (the other side of
+a two-sided stop) cannot be reached while it is held: its events are constants too.
 """
 
 from __future__ import annotations
@@ -157,6 +158,18 @@ def jacobian_kernel(t: float, y: NDArray[np.float64], jt: NDArray[np.float64], p
 
 
 @njit(cache=True)
+def _parallel(p: NDArray[np.float64], normal: int, n: int, k: int, held: int) -> bool:  # pragma: no cover - compiled
+    """Is n_k = +-n_held? (Equality in Cauchy-Schwarz; exact for the normals' entries 0, +-1.)"""
+    dot = kk = hh = 0.0
+    for j in range(n):
+        a, b = p[normal + k * n + j], p[normal + held * n + j]
+        dot += a * b
+        kk += a * a
+        hh += b * b
+    return dot * dot == kk * hh
+
+
+@njit(cache=True)
 def events_kernel(t: float, y: NDArray[np.float64], out: NDArray[np.float64], p: NDArray[np.float64]) -> None:  # pragma: no cover - compiled
     """The 2 K + 1 event functions into ``out``: penetrations, the holding force, approach velocities."""
     n = int(p[_N])
@@ -165,7 +178,9 @@ def events_kernel(t: float, y: NDArray[np.float64], out: NDArray[np.float64], p:
     apex = p[APEX] != 0.0
     g, g0, normal = int(p[_G]), int(p[_G0]), int(p[_NORMAL])
     for k in range(k_count):
-        if k == stuck:
+        if k == stuck or (stuck >= 0 and _parallel(p, normal, n, k, stuck)):
+            # the stop held, or another side of it (n_k = +-n_held): its gap and n_k . v are frozen while held, and
+            # n_k . v is round-off of 0 whose sign changes are not apexes (a root at and near one point is an error)
             out[k] = -1.0
             out[k_count + 1 + k] = 1.0
             continue
