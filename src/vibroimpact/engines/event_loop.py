@@ -4,7 +4,8 @@ An engine subclasses :class:`EventLoopEngine` and implements only :meth:`EventLo
 integrator) and :meth:`EventLoopEngine._advance` (integrate from a state until the period boundary or the first
 event). Any N-dof structure with any rigid stops: the integrated state is (w, v) of :mod:`.flow_layout` (each
 stop's penetration u_k = n_k . x - Delta_k in place of one coordinate, so that positions near a stop keep their
-absolute precision; for the paper's layout (X1, X2 - Delta, X1', X2')), followed, when harmonic moments are wanted, by
+absolute precision; for the paper's layout (X1, X2 - Delta, X1', X2'); a stop hit without one, the second side of a
+two-sided stop, gets one by a switch of layout, :meth:`Model.carry`), followed, when harmonic moments are wanted, by
 the 3 N + 2 K quadratures of :mod:`.rigid_kernels`. A stop is held closed (*stuck*) with the constrained flow of
 :mod:`.flow_layout` and released when its holding force turns negative; an impact on another stop frees it unless
 it is still closed, at rest on it and pushed after the impulse. Sticking on two stops at once is refused
@@ -49,7 +50,8 @@ class Stop(Enum):
 
 
 class Model:
-    """Right-hand side, Jacobian and event functions of one problem, with a mutable mode (free, or stuck on a stop).
+    """Right-hand side, Jacobian and event functions of one problem, with a mutable mode (free, or stuck on a stop)
+    and a mutable :attr:`layout` (the stop last hit carries its penetration, :meth:`carry`).
 
     Between impacts the flow is linear, y' = A y + c + Re(b e^{jwt}), one (A, c, b) per mode (:mod:`.flow_layout`).
     :attr:`rhs`, :attr:`jacobian` and :attr:`events` call the compiled kernels of :mod:`.rigid_kernels` over
@@ -80,6 +82,7 @@ class Model:
         self.directions = (1,) * k + (-1,) + (-1,) * k
         self._calls = [0]
         self._stuck = -1  # mirrors parameters[STUCK] as a Python int (read at every event)
+        self._packed = {self.layout.first: self.parameters.copy()}
         parameters, calls = self.parameters, self._calls
 
         def rhs(t: float, y: NDArray[np.float64], yp: NDArray[np.float64]) -> None:
@@ -126,6 +129,23 @@ class Model:
     @apex_event.setter
     def apex_event(self, value: bool) -> None:
         self.parameters[APEX] = 1.0 if value else 0.0
+
+    def carry(self, y: NDArray[np.float64], stop: int) -> NDArray[np.float64]:
+        """y in a layout where ``stop`` carries its penetration (:meth:`FlowLayout.carrying`), switching the model's
+        layout and its parameter array (in place: the compiled callbacks keep reading it) when it has none. A stop
+        held keeps its pivot: where it would lose it, the layout stays."""
+        target = self.layout.carrying(stop)
+        held = self._stuck
+        if target is self.layout or (held >= 0 and target.pivots[held] < 0):
+            return y
+        if target.first not in self._packed:
+            self._packed[target.first] = pack_parameters(target, self.size)
+        y = target.convert(y, self.layout)
+        flags = self.parameters[STUCK], self.parameters[APEX]
+        self.parameters[:] = self._packed[target.first]
+        self.parameters[STUCK], self.parameters[APEX] = flags
+        self.layout = target
+        return y
 
     @property
     def rhs_calls(self) -> int:
@@ -189,13 +209,16 @@ class EventLoopEngine(ABC):
         resting = [k for k in range(layout.stop_count) if layout.penetration(y, k) >= 0.0 and layout.approach(y, k) == 0.0 and self._pushed(model, t_start, y, k)]
         if len(resting) > 1:
             raise NotImplementedError(f"the initial state rests on stops {resting[0]} and {resting[1]} at once, both pushing: sticking on two stops at once is not supported")
+        if resting and layout.pivots[resting[0]] < 0:
+            y = model.carry(y, resting[0])
+            model.layout.close(y, resting[0])
         model.stuck_on = resting[0] if resting else -1
         touching = _touch_probe(model)
         self._begin(model)
         try:
             rec = TrajectoryBuilder(problem, moments)
-            rec.strobe(t_start, layout.physical(y))
-            rec.segment(t_start, MODE_STUCK if model.stuck else MODE_FREE, layout.physical(y), stop=model.stuck_on)
+            rec.strobe(t_start, model.layout.physical(y))
+            rec.segment(t_start, MODE_STUCK if model.stuck else MODE_FREE, model.layout.physical(y), stop=model.stuck_on)
             quadratures = y[2 * n :].copy()
             t = float(t_start)
             for k in range(1, periods + 1):
@@ -221,28 +244,29 @@ class EventLoopEngine(ABC):
                         raise RuntimeError(f"no progress at t = {t!r} s: {events} events in one period")
                     if stop is Stop.RELEASE:
                         rec.stats["releases"] += 1
-                        layout.set_approach(y, which, 0.0)  # held: n . x' = 0 but for the stuck flight's round-off
+                        model.layout.set_approach(y, which, 0.0)  # held: n . x' = 0 but for the stuck flight's round-off
                         model.stuck_on = -1
                     else:
                         impacts += 1
                         y = self._contact(model, law, rec, t, y, which, impacts)
-                    rec.segment(t, MODE_STUCK if model.stuck else MODE_FREE, layout.physical(y), stop=model.stuck_on)
+                    rec.segment(t, MODE_STUCK if model.stuck else MODE_FREE, model.layout.physical(y), stop=model.stuck_on)
                 if moments:
                     q = y[2 * n :] - quadratures
                     quadratures = y[2 * n :].copy()
                     rec.add_moments(moment_row(q, n, layout.stop_count))
-                rec.strobe(t, layout.physical(y))
+                rec.strobe(t, model.layout.physical(y))
         finally:
             self._end()
         return rec.build(self._counters() | {"rhs_calls": model.rhs_calls + self._compiled_rhs_calls()})
 
     def _contact(self, model: Model, law: RigidContact, rec: TrajectoryBuilder, t: float, y: NDArray[np.float64], which: int, impacts: int) -> NDArray[np.float64]:
-        """Apply stop ``which``'s impact law at time t to the state y (its gap closed exactly); return the new state."""
-        layout = model.layout
-        y = y.copy()
+        """Apply stop ``which``'s impact law at time t to the state y (its gap closed exactly, and carried by the
+        integrator from here on: :meth:`Model.carry`); return the new state."""
         held = model.stuck_on
         if held == which:
             raise RuntimeError(f"stop {which} is held closed and reported a contact at t = {t!r} s")
+        y = model.carry(y.copy(), which)
+        layout = model.layout
         model.stuck_on = -1  # an impact on another stop frees the one held
         layout.close(y, which)
         velocity = max(layout.approach(y, which), 0.0)
@@ -315,12 +339,15 @@ class EventLoopEngine(ABC):
 def _touch_probe(model: Model) -> Callable[[NDArray[np.float64]], int]:
     """A function of the state: the first stop (not held) at or beyond its gap and moving into it, else -1. Written
     with Python scalars: it runs at every event and period boundary."""
-    layout, n = model.layout, model.layout.size
-    probes = [(k, layout.pivots[k], n + i, n + j, a, b) for k, (i, a, j, b) in enumerate(layout.probes)]
+    n = model.layout.size
+    probes: dict[int, list[tuple[int, int, int, int, float, float]]] = {}
 
     def touching(y: NDArray[np.float64]) -> int:
         held = model.stuck_on
-        for k, p, i, j, a, b in probes:
+        layout = model.layout  # it changes where a stop without a pivot is hit (Model.carry)
+        if layout.first not in probes:
+            probes[layout.first] = [(k, layout.pivots[k], n + i, n + j, a, b) for k, (i, a, j, b) in enumerate(layout.probes)]
+        for k, p, i, j, a, b in probes[layout.first]:
             if k == held or (y[p] if p >= 0 else layout.penetration(y, k)) < 0.0:
                 continue
             if j < 0:

@@ -6,7 +6,9 @@ with each stop's penetration u_k = n_k . x - Delta_k = -g_k in place of one coor
 n_k and d_{p_k} = Delta_k; every other row of T is e_i (d_i = 0). A gap near zero then keeps its absolute precision
 (with x itself, a gap of 1e-20 m vanishes in x - Delta, and an event function would look identically zero). A stop
 whose normal is a combination of rows already taken (the second side of a two-sided stop) has no pivot: its
-penetration is computed, G_k . w + g0_k. T has entries 0 and +-1 with at most one +1 and one -1 per row, so it is
+penetration is computed, G_k . w + g0_k, from a coordinate near -2 Delta (1 ulp ~ 1e-18 m, and integrated to rtol x
+2 Delta), too coarse for a chatter on it; the engines switch to the layout with that stop taken first when it is hit
+(``flow_layout(problem, first=k)``, :meth:`FlowLayout.carrying`, :meth:`FlowLayout.convert`). T has entries 0 and +-1 with at most one +1 and one -1 per row, so it is
 totally unimodular: its inverse is an integer matrix, exact in floating point. For the paper's layout T = I and
 w = (X1, X2 - Delta): the state of the engines before the N-dof generalisation.
 
@@ -36,21 +38,21 @@ from vibroimpact.model.problem import ImpactProblem
 __all__ = ["FlowLayout", "flow_layout"]
 
 
-def _pivots(normals: NDArray[np.float64], stops: tuple, size: int) -> tuple[NDArray[np.float64], list[int]]:
-    """T and the pivot coordinate of each stop (-1: none, its normal depends on the pivots already taken)."""
+def _pivots(normals: NDArray[np.float64], stops: tuple, size: int, first: int = -1) -> tuple[NDArray[np.float64], list[int]]:
+    """T and the pivot coordinate of each stop (-1: none, its normal depends on the pivots already taken), the stops
+    taken in order, stop ``first`` (if >= 0) before the others."""
     t = np.eye(size)
-    pivots: list[int] = []
-    for k, stop in enumerate(stops):
-        chosen = -1
+    pivots = [-1] * len(stops)
+    for k in ([first] if first >= 0 else []) + [k for k in range(len(stops)) if k != first]:
+        stop = stops[k]
         for candidate in (stop.coordinate, stop.other):
             if candidate is None or candidate in pivots:
                 continue
             trial = t.copy()
             trial[candidate] = normals[k]
             if abs(np.linalg.det(trial)) > 0.5:  # +-1 or 0: totally unimodular
-                t, chosen = trial, candidate
+                t, pivots[k] = trial, candidate
                 break
-        pivots.append(chosen)
     return t, pivots
 
 
@@ -91,13 +93,14 @@ class FlowLayout:
         Angular frequency of the harmonic excitation (0 for a sweep) [rad s-1].
     """
 
-    def __init__(self, problem: ImpactProblem) -> None:
+    def __init__(self, problem: ImpactProblem, first: int = -1) -> None:
         structure = problem.structure
         n, stops = problem.size, problem.stops
         mass, stiffness, damping = structure.mass_matrix, structure.stiffness_matrix, structure.damping_matrix
+        self.problem, self.first = problem, first
         self.size, self.stop_count = n, len(stops)
         self.normals, self.clearances = problem.normals(), problem.clearances()
-        t, pivots = _pivots(self.normals, stops, n)
+        t, pivots = _pivots(self.normals, stops, n, first)
         inverse = np.linalg.inv(t)
         rounded = np.rint(inverse)
         self.t, self.t_inverse = t, (rounded if np.array_equal(t @ rounded, np.eye(n)) else inverse)
@@ -217,6 +220,27 @@ class FlowLayout:
         else:
             y[n + i] = value / a
 
+    def carrying(self, stop: int) -> "FlowLayout":
+        """The layout of the same problem in which ``stop`` has a pivot: this one if it has one, else the layout with
+        the stop taken first (the other side of a two-sided stop then carries its own penetration, and the first
+        side's is computed)."""
+        return self if self.pivots[stop] >= 0 else flow_layout(self.problem, stop)
+
+    def convert(self, y: NDArray[np.float64], source: "FlowLayout") -> NDArray[np.float64]:
+        """The state y of layout ``source`` in this layout (a new array): a displacement whose row of T and offset are
+        the same keeps its value, a pivot's is its stop's penetration in ``source``, any other is T x; velocities and
+        the quadratures after them are unchanged."""
+        n = self.size
+        out = np.array(y, dtype=float)
+        x = source.physical(y)[:n]
+        owner = {p: k for k, p in enumerate(self.pivots) if p >= 0}
+        old_owner = {p: k for k, p in enumerate(source.pivots) if p >= 0}
+        for i in range(n):
+            if owner.get(i, -1) == old_owner.get(i, -1):
+                continue  # the same row of T and the same clearance
+            out[i] = source.penetration(y, owner[i]) if i in owner else float(self.t[i] @ x)
+        return out
+
     def close(self, y: NDArray[np.float64], stop: int) -> None:
         """Set stop ``stop``'s penetration to zero in place (the pivot, or the largest entry of its gap row)."""
         p = self.pivots[stop]
@@ -229,6 +253,7 @@ class FlowLayout:
 
 
 @lru_cache(maxsize=64)
-def flow_layout(problem: ImpactProblem) -> FlowLayout:
-    """The :class:`FlowLayout` of ``problem`` (cached: problems are frozen)."""
-    return FlowLayout(problem)
+def flow_layout(problem: ImpactProblem, first: int = -1) -> FlowLayout:
+    """The :class:`FlowLayout` of ``problem`` (cached: problems are frozen), its pivots chosen with stop ``first``
+    (if >= 0) before the others."""
+    return FlowLayout(problem, first)
