@@ -117,24 +117,30 @@ def numeric_null_basis(matrix: NDArray[np.float64]) -> NDArray[np.float64]:
     return vt[n - zero :].T.copy() if zero else np.zeros((n, 0))
 
 
-def mechanical_null_basis(mass: NDArray[np.float64], stiffness: NDArray[np.float64], damping: NDArray[np.float64]) -> NDArray[np.float64]:
+def mechanical_null_basis(
+    mass: NDArray[np.float64], stiffness: NDArray[np.float64], damping: NDArray[np.float64], stiffness_scale: float = 0.0, damping_scale: float = 0.0,
+) -> NDArray[np.float64]:  # fmt: skip
     """A basis of the generalized null space of ``A = [[0, I], [-M^-1 K, -M^-1 C]]``, from its structure.
 
     null(A) = {(r, 0): K r = 0} (every rigid-body mode r); a rigid mode u that no dashpot resists (r^T C u = 0 for all
     rigid r) adds a Jordan chain of length 2, (x_u, u) with K x_u = -C u (then A (x_u, u) = (u, 0)). Longer chains
     cannot occur (M is definite), so A_z^2 = 0.
+
+    ``stiffness_scale`` and ``damping_scale`` [N m-1, N s m-1] are the scales below which an eigenvalue is round-off
+    zero, at least the matrices' own: a reduced (held) structure passes the full structure's, since its K may be
+    round-off alone (a free-free pair held together by a relative stop: T^T K T ~ 1e-29 of nothing).
     """
     size = mass.shape[0]
     if size == 0:
         return np.zeros((0, 0))
     mu, q = np.linalg.eigh(stiffness)
-    top = float(np.max(np.abs(mu))) if mu.size else 0.0
+    top = max(float(np.max(np.abs(mu))) if mu.size else 0.0, float(stiffness_scale))
     rigid = q[:, mu <= _ZERO * top] if top > 0.0 else np.eye(size)
     if rigid.shape[1] == 0:
         return np.zeros((2 * size, 0))
     inner = rigid.T @ damping @ rigid
     nu, w = np.linalg.eigh(0.5 * (inner + inner.T))
-    damping_scale = float(np.max(np.abs(damping))) if damping.size else 0.0
+    damping_scale = max(float(np.max(np.abs(damping))) if damping.size else 0.0, float(damping_scale))
     free = rigid @ w[:, np.abs(nu) <= _ZERO * max(damping_scale, 1e-300)] if damping_scale > 0.0 else rigid
     flexible = q[:, mu > _ZERO * top] if top > 0.0 else np.zeros((size, 0))
     pseudo = flexible @ np.diag(1.0 / mu[mu > _ZERO * top]) @ flexible.T if top > 0.0 else np.zeros((size, size))

@@ -110,7 +110,8 @@ def _stuck_flow(problem: ImpactProblem, k: int) -> tuple[Flow, NDArray[np.float6
         a = np.block([[np.zeros((reduced, reduced)), np.eye(reduced)], [-minv @ kr, -minv @ cr]])
         b = np.concatenate([np.zeros(reduced, dtype=complex), minv @ (tangent.T @ harmonic)])
         b0 = np.concatenate([np.zeros(reduced), minv @ (tangent.T @ (static - stiffness @ point))])
-        flow = decompose(a, b, b0, problem.omega, mechanical_null_basis(mr, kr, cr))
+        scales = float(np.max(np.abs(stiffness))), float(np.max(np.abs(damping)))
+        flow = decompose(a, b, b0, problem.omega, mechanical_null_basis(mr, kr, cr, *scales))
     else:
         flow = decompose(np.zeros((0, 0)), np.zeros(0, dtype=complex), np.zeros(0), problem.omega)
     zero = np.zeros((size, reduced))
