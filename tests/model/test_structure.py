@@ -131,3 +131,15 @@ def test_a_relative_stops_holding_force_keeps_the_two_bodies_together() -> None:
     force = 10.0 * math.cos(problem.omega * 0.01) * np.array([1.0, 0.0]) - PAPER.damping_matrix @ state[2:] - PAPER.stiffness_matrix @ state[:2] - n * holding
     acceleration = np.linalg.solve(PAPER.mass_matrix, force)
     assert abs(n @ acceleration) < 1e-12 * np.max(np.abs(acceleration))
+
+
+def test_two_opposite_stops_must_leave_room() -> None:
+    """x1 <= -2 mm and x1 >= -1 mm allow no position; x2 - x1 <= 1 mm with x1 - x2 <= -1 mm clamps the pair at one."""
+    law = RigidStop
+    with pytest.raises(ValueError, match=r"stop 0 \(x1 <= -2 mm\) and stop 1 \(x1 >= -1 mm\) leave no room"):
+        ImpactProblem(LinearStructure([[1.0]], [[1.0]]), (Stop(law(-0.002, 0.5), 0), Stop(law(0.001, 0.5), 0, side="lower")), HarmonicForce(1.0, 1.0))
+    with pytest.raises(ValueError, match="leave no room"):
+        ImpactProblem(PAPER, (Stop(law(0.001, 0.5), 1, other=0), Stop(law(-0.001, 0.5), 0, other=1)), HarmonicForce(1.0, 1.0))
+    # a preloading stop with room on the other side is fine
+    problem = ImpactProblem(LinearStructure([[1.0]], [[1.0]]), (Stop(law(-0.001, 0.5), 0), Stop(law(0.002, 0.5), 0, side="lower")), HarmonicForce(1.0, 1.0))
+    assert len(problem.stops) == 2

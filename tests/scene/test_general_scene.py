@@ -215,3 +215,28 @@ def test_a_bumper_instead_of_a_restitution() -> None:
     (stop,) = build_stops(scene.stop_specs, True, float(scene.restitution[0]), float(scene.clearance[0]), float(scene.bumper_frequency[0]))
     assert isinstance(stop.law, KelvinVoigtBumper)
     np.testing.assert_allclose([stop.law.frequency, stop.law.loss_factor, stop.clearance], [300.0, 0.3, 0.003], rtol=1e-15)
+
+
+def test_opposite_stops_without_room_are_refused_before_any_work() -> None:
+    import yaml
+
+    from vibroimpact.scene import SceneError, parse_scene
+
+    text = """
+name: infeasible
+description: x
+system: {mass: [[1.0]], stiffness: [[1000.0]], damping: [[0.1]]}
+excitation: {amplitude: 1.0, on: x1}
+stops:
+  - {coordinate: x1, side: upper, clearance: -0.002, restitution: 0.5}
+  - {coordinate: x1, side: lower, clearance: 0.001, restitution: 0.5}
+sweep:
+  frequency: {start: 2.0, stop: 8.0, step: 1.0}
+solutions: [linear, exact]
+simulation:
+  frequency: {start: 2.0, stop: 8.0, step: 1.0}
+"""
+    import pytest
+
+    with pytest.raises(SceneError, match=r"stops: stop 0 \(x1 <= -2 mm\) and stop 1 \(x1 >= -1 mm\) leave no room"):
+        parse_scene(yaml.safe_load(text), text)

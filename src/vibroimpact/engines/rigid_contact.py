@@ -87,7 +87,7 @@ class RigidContact:
         for k, gap in enumerate(gaps):
             if gap < -1e-12 * self.length_scale:
                 where = self.stops[k].describe(self.names)
-                raise ValueError(f"the initial state penetrates stop {k} ({where}) by {-gap!r} m: start on the allowed side of every stop")
+                raise ValueError(f"the initial state penetrates stop {k} ({where}) by {float(-gap):.6g} m: start on the allowed side of every stop")
 
     def collide(self, rec: TrajectoryBuilder, t: float, velocity: float, impacts: int, pushed: Callable[[], bool], stop: int = 0) -> Impact:
         """Apply stop ``stop``'s law to an impact at time t [s] at approach ``velocity`` = n . x' >= 0 [m s-1], the

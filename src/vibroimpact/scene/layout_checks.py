@@ -50,7 +50,15 @@ def check_general_solutions(
     c: Checker, solutions: tuple[str, ...], system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, ...], load: LoadSpec | None, swept_sine: bool,
     restitution: np.ndarray | None = None, clearance: np.ndarray | None = None,
 ) -> None:  # fmt: skip
-    """Record the solutions (and swept-sine tests) a general scene asks for that its layout does not admit."""
+    """Record the solutions (and swept-sine tests) a general scene asks for that its layout does not admit, and stops
+    that leave a coordinate no room (two opposite stops whose clearances sum to <= 0 at a corner of the grid)."""
+    for d in sorted({float(clearance[0]), float(clearance[-1])} if clearance is not None and clearance.size else {float("nan")}):
+        try:
+            ImpactProblem(system, build_stops(specs or (StopSpec(coordinate=1),), False, 0.5, 1e-3 if np.isnan(d) else d), (load or LoadSpec()).force(1.0, 1.0))
+        except ValueError as error:
+            if "leave no room" in str(error):
+                c.fail("stops", str(error).removeprefix("stops: ") + (f" (at clearance {d:g} m of the grid)" if not np.isnan(d) else ""))
+                break
     if "pgf_paper" in solutions:
         c.fail("solutions", "pgf_paper is the paper's own route for its named layout (system {m1 ... b2}, stop, force on x1): use pgf")
     if "pgf" in solutions and (reason := pgf_refusal(system, specs, load, restitution, clearance)) is not None:
