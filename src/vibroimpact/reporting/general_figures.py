@@ -10,7 +10,6 @@ import html
 
 import numpy as np
 import xarray as xr
-from matplotlib.lines import Line2D
 
 from vibroimpact.reporting.general_record import GeneralSetting
 from vibroimpact.reporting.page import DrawnFigure, Table
@@ -53,30 +52,55 @@ def _load(setting: GeneralSetting, w: np.ndarray) -> np.ndarray:
     return setting.weights * setting.amplitude * np.ones(w.shape)[..., None]
 
 
-def structure_figure(setting: GeneralSetting, frequency: np.ndarray, clearances: np.ndarray) -> DrawnFigure:
-    """The linear system: |X| of every coordinate and |n_k . X| of every stop's coordinate, clearances dashed."""
+def structure_figure(setting: GeneralSetting, frequency: np.ndarray) -> DrawnFigure:
+    """The linear system: |X| of every coordinate and |n_k . X| of every stop's coordinate (dashed), each against
+    the gap the static deflection leaves it, Delta_k - n_k . x_static (dotted, the stop's colour)."""
     f = np.union1d(frequency, np.linspace(frequency.min(), frequency.max(), _LINEAR_POINTS))
     w = 2.0 * np.pi * f
     x = np.einsum("...ij,...j->...i", setting.structure.receptance_matrix(w), _load(setting, w))
-    fig, axes = new_figure(2, panel_height=3.6, legend_rows=legend_rows(setting.structure.size + len(setting.stops) + 1))
+    fig, axes = new_figure(2, panel_height=3.6, legend_rows=legend_rows(setting.structure.size + 2 * len(setting.stops)))
     for i, name in enumerate(setting.names):
         axes[0].semilogy(f, np.abs(x[:, i]), color=series_colour(i), lw=1.4, label=f"|{name}|", gid=f"linear:{name}")
     finish_axes(axes[0], _FREQUENCY, "amplitude [m]", "Every coordinate, linear system (no stop)")
+    static = setting.static_deflection()
+    gaps = setting.clearances - (setting.normals @ static if static is not None else 0.0)
     for k, (normal, words) in enumerate(zip(setting.normals, setting.stops)):
         axes[1].semilogy(f, np.abs(x @ normal), color=series_colour(k), lw=1.4, ls="--", label=f"stop {k}: {_target(words)}", gid=f"linear:stop{k}")
-    for delta in clearances:
-        if delta > 0.0:
-            axes[1].axhline(delta, color="k", lw=0.9, ls=":")
+        if np.isfinite(gaps[k]) and gaps[k] > 0.0:
+            axes[1].axhline(gaps[k], color=series_colour(k), lw=1.1, ls=":", label=f"stop {k}: gap {fmt(gaps[k] * 1e3, '.4g')} mm", gid=f"gap:stop{k}")
     finish_axes(axes[1], _FREQUENCY, "amplitude [m]", "Each stop's coordinate, linear system")
-    figure_legend(fig, axes, [Line2D([], [], color="k", lw=0.9, ls=":", label="clearance Delta")] if np.any(clearances > 0.0) else [])
+    figure_legend(fig, axes)
     natural = ", ".join(fmt(v / (2 * np.pi), ".3f") for v in setting.structure.natural_frequencies())
     caption = (
         f"Linear steady state without stops under the {setting.load_text()}: left, the amplitude of every coordinate "
-        f"({', '.join(setting.names)}); right, the amplitude of each stop's coordinate n . x (dashed), against its "
-        f"clearance (dotted): where it is above, the linear motion would cross that stop. Stops: {'; '.join(setting.stops)}. "
-        f"Natural frequencies {natural} Hz."
+        f"({', '.join(setting.names)}); right, the amplitude of each stop's coordinate n . x (dashed) and, dotted in the "
+        f"same colour, {_gap_words(setting, static, gaps)} Stops: {'; '.join(setting.stops)}. Natural frequencies {natural} Hz."
     )
     return DrawnFigure(fig, "structure", "Linear responses of every coordinate and stop", caption)
+
+
+def _gap_words(setting: GeneralSetting, static: np.ndarray | None, gaps: np.ndarray) -> str:
+    """What the dotted lines of the structure figure are, and which stops have none."""
+    if static is None:
+        words = (
+            "its clearance Delta: where the dashed curve is above, the linear motion would cross that stop if the "
+            "structure stood at rest on its mean; the constant force shifts the mean (K is singular: no static "
+            "deflection is drawn)."
+        )
+    elif np.any(setting.static):
+        words = (
+            "the gap the static deflection leaves it, Delta - n . x_static (x_static = K^-1 F0): where the dashed "
+            "curve is above, the linear motion would cross that stop."
+        )
+    else:
+        words = "its clearance Delta: where the dashed curve is above, the linear motion would cross that stop."
+    swept = [str(k) for k in range(gaps.size) if not np.isfinite(gaps[k])]
+    closed = [str(k) for k in range(gaps.size) if np.isfinite(gaps[k]) and gaps[k] <= 0.0]
+    if swept:
+        words += f" No line for stop {', '.join(swept)}: its clearance is swept (one value per section below)."
+    if closed:
+        words += f" No line for stop {', '.join(closed)}: the static deflection already closes it (gap <= 0)."
+    return words
 
 
 def _target(words: str) -> str:

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,6 +41,9 @@ class GeneralSetting:
         n of every stop (the stopped coordinate n . x).
     solutions : tuple of str
         The ``solution`` coordinate.
+    clearances : ndarray, shape (K,)
+        Delta of every stop [m] (attribute ``stop_clearance_m``, else read from its description); NaN where the grid
+        sweeps it.
     """
 
     structure: LinearStructure
@@ -50,11 +54,21 @@ class GeneralSetting:
     stops: tuple[str, ...]
     normals: np.ndarray
     solutions: tuple[str, ...]
+    clearances: np.ndarray
 
     @property
     def names(self) -> tuple[str, ...]:
         """The coordinates' names."""
         return tuple(self.structure.coordinates)
+
+    def static_deflection(self) -> np.ndarray | None:
+        """x_static = K^-1 F0 [m] under the constant force (zeros without one); None where K is singular."""
+        if not np.any(self.static):
+            return np.zeros(self.structure.size)
+        stiffness = self.structure.stiffness_matrix
+        if self.structure.rigid_body_modes() or np.linalg.cond(stiffness) > 1e12:
+            return None
+        return np.linalg.solve(stiffness, self.static)
 
     def load_text(self) -> str:
         """The load in words."""
@@ -86,13 +100,33 @@ def general_setting(dataset: xr.Dataset) -> GeneralSetting:
         normals[k, i] = sign
         if j >= 0:
             normals[k, j] = -sign
+    stops = tuple(part.strip() for part in str(attrs["stop_layout"]).split(";"))
+    if "stop_clearance_m" in attrs:
+        clearances = np.atleast_1d(np.asarray(attrs["stop_clearance_m"], dtype=float))
+    else:
+        clearances = np.array([_described_clearance(words, side) for words, side in zip(stops, sides)])
     return GeneralSetting(
         structure=structure,
         amplitude=float(attrs["excitation_amplitude_N"]),
         base_motion=attrs.get("excitation_kind") == "base_motion",
         weights=np.atleast_1d(np.asarray(attrs["excitation_weights"], dtype=float)),
         static=np.atleast_1d(np.asarray(attrs["excitation_static_N"], dtype=float)),
-        stops=tuple(part.strip() for part in str(attrs["stop_layout"]).split(";")),
+        stops=stops,
         normals=normals,
         solutions=tuple(str(s) for s in dataset["solution"].values) if "solution" in dataset.coords else (),
+        clearances=clearances,
     )
+
+
+#: The bound of a stop's description (:func:`vibroimpact.scene.layout.describe_stop`): ``<= 3 mm``, ``>= -2 mm``.
+_BOUND = re.compile(r"(<=|>=)\s*(-?[0-9.]+(?:e[-+]?[0-9]+)?) mm")
+
+
+def _described_clearance(words: str, side: str) -> float:
+    """Delta [m] of a stop from its description (upper: n . x <= Delta; lower: the coordinate >= -Delta); NaN where
+    it is written ``Delta`` (swept)."""
+    match = _BOUND.search(words.split(",")[0])
+    if match is None:
+        return float("nan")
+    value = float(match.group(2)) * 1e-3
+    return value if side == "upper" else -value
