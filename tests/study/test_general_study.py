@@ -200,3 +200,33 @@ def test_sweep_of_one_stop_among_stops_with_their_own_values() -> None:
     impulses = dataset["impulse"].sel(solution="exact", frequency=24.0).values  # (stop, clearance)
     assert np.all(impulses > 0.0), "both stops are hit at 24 Hz, whichever clearance stop 0 has"
     assert not np.allclose(impulses[:, 0], impulses[:, 1], rtol=1e-3), "stop 0's clearance changes the motion"
+
+
+def test_a_mass_held_on_a_preloading_stop_is_not_called_linear(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """k = 1e4 N/m pressed 1 mm into its stop (x1 <= -1 mm: a 10 N preload) by nothing; a 5 N force never lifts it. The
+    exact engine holds it (amplitude ~0, contact force = the force's fundamental): periodic motion with sticking
+    (regime 8), not the linear regime, whose response would cross the stop (regime 6)."""
+    from vibroimpact.analysis.regime import Regime
+    from vibroimpact.scene import load_scene
+    from vibroimpact.study.run import run_study
+
+    text = """
+name: held
+description: a preloaded mass the force never lifts
+system: {mass: [[1.0]], stiffness: [[10000.0]], damping: [[1.0]]}
+excitation: {amplitude: 5.0, on: x1}
+stops:
+  - {coordinate: x1, side: upper, clearance: -0.001, restitution: 0.5}
+sweep:
+  frequency: {start: 2.0, stop: 4.0, step: 1.0}
+solutions: [linear, exact]
+simulation:
+  frequency: {start: 2.0, stop: 4.0, step: 1.0}
+"""
+    path = tmp_path / "held.yaml"
+    path.write_text(text, encoding="utf-8")
+    dataset = run_study(load_scene(path), progress=None, jobs=1)
+    exact = dataset.sel(solution="exact").squeeze()
+    assert np.all(exact.regime.values == Regime.PERIODIC_IMPACTS)
+    assert np.all(exact.x1_amplitude.values <= 1e-12)
+    assert np.all(dataset.sel(solution="linear").squeeze().regime.values == Regime.LINEAR_EXCEEDS_CLEARANCE)

@@ -72,7 +72,10 @@ def general_simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], 
     classified = computed & ~converged & ~np.isnan(fields["motion_regime"])
     regime[classified] = fields["motion_regime"][classified].astype(np.int8)
     regime[computed & converged] = Regime.PERIODIC_IMPACTS
-    regime[computed & converged & (impacts == 0.0)] = Regime.LINEAR
+    # no impact and no contact force: linear; a structure held on a stop without impacts (a preloading stop the force
+    # never lifts it from) is periodic motion with sticking, not linear
+    held = np.abs(fields["contact_force"]) > 1e-9 * (np.abs(fields["suspension_force"]) + np.abs(fields["contact_force"]))
+    regime[computed & converged & (impacts == 0.0) & ~held] = Regime.LINEAR
     if _two_sided(scene):  # the closed form's kind of orbit: one impact per period on each side
         each = np.all(fields["stop_impacts"] == 1.0, axis=-1)
         regime[computed & converged & (fields["multiplicity"] == 1.0) & each] = Regime.ONE_IMPACT

@@ -187,7 +187,10 @@ def simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], jobs: in
     classified = computed & ~converged & ~np.isnan(fields["motion_regime"])
     regime[classified] = fields["motion_regime"][classified].astype(np.int8)  # quasi_periodic, chaotic or irregular
     regime[computed & converged] = Regime.PERIODIC_IMPACTS
-    regime[computed & converged & (impacts == 0.0)] = Regime.LINEAR
+    # no impact and no contact force: linear; a structure held on a stop without impacts (a preloading stop the force
+    # never lifts it from) is periodic motion with sticking, not linear
+    held = np.abs(fields["contact_force"]) > 1e-9 * (np.abs(fields["suspension_force"]) + np.abs(fields["contact_force"]))
+    regime[computed & converged & (impacts == 0.0) & ~held] = Regime.LINEAR
     regime[computed & converged & (fields["multiplicity"] == 1.0) & (impacts == 1.0)] = Regime.ONE_IMPACT
     regime[fields["failed"] == 1.0] = Regime.FAILED
     force = fields["suspension_force"] + fields["contact_force"]
