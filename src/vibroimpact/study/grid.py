@@ -179,6 +179,10 @@ def layout_attributes(scene: Scene) -> dict[str, object]:
         "stop_coordinate": np.array([spec.coordinate for spec in specs]),
         "stop_other": np.array([-1 if spec.other is None else spec.other for spec in specs]),
         "stop_side": " ".join(spec.side for spec in specs),
+        # each stop's own clearance, or the grid's single value; NaN where the grid sweeps it
+        "stop_clearance_m": np.array([
+            spec.clearance if spec.clearance is not None else (float(scene.clearance[0]) if scene.clearance.size == 1 else np.nan) for spec in specs
+        ], dtype=float),  # fmt: skip
         "method_pgf": "closed-form impact orbit (periodic Green function of the stopped coordinate n^T H n; one impact per period on one stop, two on a symmetric two-sided stop); stable (+) root",
         "method_force": "force on the base: 1^T (K x + C x') through springs and dashpots plus (1^T n_k) lambda_k of each absolute stop",
     }
