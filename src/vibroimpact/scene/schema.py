@@ -27,7 +27,7 @@ from vibroimpact.simulation.settings import START_MODES, SWEEP_STARTS, SteadySet
 
 if TYPE_CHECKING:
     from vibroimpact.scene.bifurcation_settings import BifurcationSettings
-    from vibroimpact.scene.concepts import ConceptsSettings
+    from vibroimpact.scene.concepts_settings import ConceptsSettings
     from vibroimpact.scene.validation_settings import ValidationSettings
 
 __all__ = [
