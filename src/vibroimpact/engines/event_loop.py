@@ -221,8 +221,9 @@ class EventLoopEngine(ABC):
             rec.segment(t_start, MODE_STUCK if model.stuck else MODE_FREE, model.layout.physical(y), stop=model.stuck_on)
             quadratures = y[2 * n :].copy()
             t = float(t_start)
+            period, limit, advance, contact, segment = problem.period, 10 * law.max_impacts, self._advance, self._contact, rec.segment
             for k in range(1, periods + 1):
-                boundary = t_start + k * problem.period
+                boundary = t_start + k * period
                 impacts = events = 0
                 while True:
                     which = touching(y)
@@ -234,13 +235,13 @@ class EventLoopEngine(ABC):
                     elif boundary - t <= 4.0 * math.ulp(boundary):
                         stop, t = Stop.BOUNDARY, boundary  # nothing left of this period to integrate
                     else:
-                        stop, t, y, which = self._advance(model, t, y, boundary)
+                        stop, t, y, which = advance(model, t, y, boundary)
                     if stop is Stop.BOUNDARY:
                         if touching(y) >= 0:
                             continue  # an impact exactly at the boundary is applied before the strobe
                         break
                     events += 1
-                    if events > 10 * law.max_impacts:
+                    if events > limit:
                         raise RuntimeError(f"no progress at t = {t!r} s: {events} events in one period")
                     if stop is Stop.RELEASE:
                         rec.stats["releases"] += 1
@@ -248,8 +249,9 @@ class EventLoopEngine(ABC):
                         model.stuck_on = -1
                     else:
                         impacts += 1
-                        y = self._contact(model, law, rec, t, y, which, impacts)
-                    rec.segment(t, MODE_STUCK if model.stuck else MODE_FREE, model.layout.physical(y), stop=model.stuck_on)
+                        y = contact(model, law, rec, t, y, which, impacts)
+                    held = model._stuck
+                    segment(t, MODE_FREE if held < 0 else MODE_STUCK, model.layout.physical(y), stop=held)
                 if moments:
                     q = y[2 * n :] - quadratures
                     quadratures = y[2 * n :].copy()
@@ -262,16 +264,19 @@ class EventLoopEngine(ABC):
     def _contact(self, model: Model, law: RigidContact, rec: TrajectoryBuilder, t: float, y: NDArray[np.float64], which: int, impacts: int) -> NDArray[np.float64]:
         """Apply stop ``which``'s impact law at time t to the state y (its gap closed exactly, and carried by the
         integrator from here on: :meth:`Model.carry`); return the new state."""
-        held = model.stuck_on
+        held = model._stuck
         if held == which:
             raise RuntimeError(f"stop {which} is held closed and reported a contact at t = {t!r} s")
-        y = model.carry(y.copy(), which)
+        y = y.copy()
+        if model.layout.pivots[which] < 0:
+            y = model.carry(y, which)
         layout = model.layout
-        model.stuck_on = -1  # an impact on another stop frees the one held
+        if held >= 0:
+            model.stuck_on = -1  # an impact on another stop frees the one held
         layout.close(y, which)
         velocity = max(layout.approach(y, which), 0.0)
 
-        def pushed() -> bool:
+        def pushed() -> bool:  # asked only of a chattering impact
             resting = y.copy()
             self._kick(model, resting, which, float(law.masses[which]) * velocity, 0.0)
             return self._pushed(model, t, resting, which)
@@ -340,14 +345,20 @@ def _touch_probe(model: Model) -> Callable[[NDArray[np.float64]], int]:
     """A function of the state: the first stop (not held) at or beyond its gap and moving into it, else -1. Written
     with Python scalars: it runs at every event and period boundary."""
     n = model.layout.size
-    probes: dict[int, list[tuple[int, int, int, int, float, float]]] = {}
+    probes: dict[int, tuple[tuple[int, int, int, int, float, float], ...]] = {}
+    current: list = [None, ()]  # the layout last seen and its probes (the layout changes only at a carry)
 
     def touching(y: NDArray[np.float64]) -> int:
-        held = model.stuck_on
+        held = model._stuck
         layout = model.layout  # it changes where a stop without a pivot is hit (Model.carry)
-        if layout.first not in probes:
-            probes[layout.first] = [(k, layout.pivots[k], n + i, n + j, a, b) for k, (i, a, j, b) in enumerate(layout.probes)]
-        for k, p, i, j, a, b in probes[layout.first]:
+        if layout is current[0]:
+            table = current[1]
+        else:
+            table = probes.get(layout.first)
+            if table is None:
+                table = probes[layout.first] = tuple((k, layout.pivots[k], n + i, n + j, a, b) for k, (i, a, j, b) in enumerate(layout.probes))
+            current[0], current[1] = layout, table
+        for k, p, i, j, a, b in table:
             if k == held or (y[p] if p >= 0 else layout.penetration(y, k)) < 0.0:
                 continue
             if j < 0:

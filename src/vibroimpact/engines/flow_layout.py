@@ -111,6 +111,8 @@ class FlowLayout:
                 d[p] = self.clearances[k]
         self.pivots = tuple(pivots)
         self.offset = self.t_inverse @ d
+        # (offset, -0.0...): y[:2N] + this is x = w + offset and v unchanged to the bit (v + -0.0 = v, also for -0.0)
+        self._shift = np.concatenate([self.offset, np.full(n, -0.0)])
         self.gap_rows = self.normals @ self.t_inverse
         self.gap_constants = self.normals @ self.offset - self.clearances
         for k, p in enumerate(pivots):
@@ -191,8 +193,10 @@ class FlowLayout:
     def physical(self, y: NDArray[np.float64]) -> NDArray[np.float64]:
         """(w, v, ...) -> (x, x')."""
         n = self.size
+        if self._identity:
+            return y[: 2 * n] + self._shift  # a new array (the hot path: every event and strobe)
         out = np.array(y[: 2 * n], dtype=float)
-        out[:n] = (out[:n] if self._identity else self.t_inverse @ out[:n]) + self.offset
+        out[:n] = self.t_inverse @ out[:n] + self.offset
         return out
 
     def penetration(self, y: NDArray[np.float64], stop: int) -> float:

@@ -21,7 +21,6 @@ and inactive events return a constant; errors do not raise but return a negative
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -49,12 +48,6 @@ def compiled_parameters(model: Model) -> NDArray[np.float64]:
 COMPILED_RHS, COMPILED_JACOBIAN, COMPILED_EVENTS = _rhs, _jacobian, _events
 
 
-@dataclass(frozen=True)
-class _Position:
-    t: float
-    y: NDArray[np.float64] | None
-
-
 class MomentaryEngine(EventLoopEngine):
     """CVODE (Adams or BDF) with terminal contact/release events and a grazing guard.
 
@@ -80,7 +73,9 @@ class MomentaryEngine(EventLoopEngine):
 
     def _begin(self, model: Model) -> None:
         model.apex_event = self.grazing_guard
-        self._at = _Position(np.nan, None)
+        # where the integrator stands (its state array) after a boundary return: the next call goes on from there
+        self._at_t: float = np.nan
+        self._at_y: NDArray[np.float64] | None = None
         self._apexes = self._touches = self._events_found = self._solver_rhs = 0
         if self.compiled:
             # the model's own parameter array: the mode it writes there is what the callbacks read
@@ -116,7 +111,7 @@ class MomentaryEngine(EventLoopEngine):
             self._solver_rhs = self._cvode.total_rhs_evaluations()
             self._cvode.close()
             self._cvode = None
-        self._at = _Position(np.nan, None)
+        self._at_t, self._at_y = np.nan, None
 
     def _counters(self) -> dict[str, int]:
         return {"events": self._events_found, "apex_checks": self._apexes, "tangent_touches": self._touches}
@@ -128,20 +123,21 @@ class MomentaryEngine(EventLoopEngine):
         if self._cvode is None:
             return self._advance_python(model, t, y, t_stop)
         cvode = self._cvode
-        if not (self._at.t == t and self._at.y is y):
+        if not (self._at_t == t and self._at_y is y):
             cvode.restart(t, y)
+        advance, roots, decide = cvode.advance, cvode.roots, self._decide
         while True:
-            flag, now = cvode.advance(t_stop)
+            flag, now = advance(t_stop)
             if flag != ROOT_RETURN:  # at t_stop (CV_TSTOP_RETURN, or CV_SUCCESS with t_stop = tout)
                 state = cvode.state.copy()
-                self._at = _Position(now, state)
+                self._at_t, self._at_y = now, state
                 return Stop.BOUNDARY, now, state, -1
-            found = self._decide(model, cvode.roots(), now, cvode.state)
+            found = decide(model, roots(), now, cvode.state)
             if found is not None:
                 return found
 
     def _advance_python(self, model: Model, t: float, y: NDArray[np.float64], t_stop: float) -> tuple[Stop, float, NDArray[np.float64], int]:
-        if not (self._at.t == t and self._at.y is y):
+        if not (self._at_t == t and self._at_y is y):
             clear_event_records(self._events)
             started = self._solver.init_step(t, y)
             if started.status < 0:
@@ -152,7 +148,7 @@ class MomentaryEngine(EventLoopEngine):
                 raise RuntimeError(f"CVODE failed at t = {result.t!r} s: {result.message}")
             if result.status == _STATUS_TSTOP:
                 now = np.array(result.y)
-                self._at = _Position(float(result.t), now)
+                self._at_t, self._at_y = float(result.t), now
                 return Stop.BOUNDARY, float(result.t), now, -1
             fired = tuple(int(i) for i in result.i_events[-1])
             clear_event_records(self._events)
@@ -181,5 +177,5 @@ class MomentaryEngine(EventLoopEngine):
 
     def _event(self, kind: Stop, t: float, state: NDArray[np.float64], stop: int) -> tuple[Stop, float, NDArray[np.float64], int]:
         self._events_found += 1
-        self._at = _Position(np.nan, None)
+        self._at_t, self._at_y = np.nan, None
         return kind, t, state.copy(), stop

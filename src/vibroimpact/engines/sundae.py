@@ -231,6 +231,9 @@ class CompiledCvode:
         if max_step > 0.0:
             self._check(lib["CVodeSetMaxStep"](mem, max_step), "CVodeSetMaxStep")
         self._set_stop, self._cvode, self._mem = lib["CVodeSetStopTime"], lib["CVode"], mem
+        # made once: the arguments of the calls at every event (ctypes builds them at a cost otherwise)
+        self._time_ref, self._count_ref, self._vector = C.byref(self._time), C.byref(self._count), h["y"]
+        self._get_rhs, self._reinit, self._root_info = lib["CVodeGetNumRhsEvals"], lib["CVodeReInit"], lib["CVodeGetRootInfo"]
         self.rhs_evaluations = 0
 
     def _check(self, flag: int, what: str, t: float | None = None) -> int:
@@ -240,24 +243,29 @@ class CompiledCvode:
         return flag
 
     def _count_rhs(self) -> None:
-        self._lib["CVodeGetNumRhsEvals"](self._mem, C.byref(self._count))
+        self._get_rhs(self._mem, self._count_ref)
         self.rhs_evaluations += self._count.value
 
     def restart(self, t: float, y: NDArray[np.float64]) -> None:
         """Start again from (t, y): a new history, order 1 (CVODE's counters restart too: counted first)."""
         self._count_rhs()
         self.state[:] = y
-        self._check(self._lib["CVodeReInit"](self._mem, t, self._handles["y"]), "CVodeReInit", t)
+        flag = self._reinit(self._mem, t, self._vector)
+        if flag < 0:
+            self._check(flag, "CVodeReInit", t)
 
     def advance(self, t_stop: float) -> tuple[int, float]:
         """Integrate to ``t_stop`` or the first root: (flag, time); the state is in :attr:`state`."""
-        self._set_stop(self._mem, t_stop)
-        flag = self._cvode(self._mem, t_stop, self._handles["y"], C.byref(self._time), _NORMAL)
-        return self._check(flag, "CVode", self._time.value), self._time.value
+        mem = self._mem
+        self._set_stop(mem, t_stop)
+        flag = self._cvode(mem, t_stop, self._vector, self._time_ref, _NORMAL)
+        if flag < 0:
+            self._check(flag, "CVode", self._time.value)
+        return flag, self._time.value
 
     def roots(self) -> tuple[int, ...]:
         """Which event functions have a root at the last return (+1 rising, -1 falling, 0 none)."""
-        self._lib["CVodeGetRootInfo"](self._mem, self._roots)
+        self._root_info(self._mem, self._roots)
         return tuple(self._roots)
 
     def total_rhs_evaluations(self) -> int:
