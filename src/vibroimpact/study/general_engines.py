@@ -13,7 +13,6 @@ from pathlib import Path
 
 import numpy as np
 
-from vibroimpact.analysis.regime import Regime
 from vibroimpact.engines.registry import BUMPER, engine_spec
 from vibroimpact.scene.layout import build_stops
 from vibroimpact.scene.schema import Scene
@@ -22,7 +21,7 @@ from vibroimpact.study.cases import COMPLEX_FIELDS, COORDINATE_FIELDS, FIELDS, S
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.study.general_values import _broadcast, coordinate_quantity, scene_problem
 from vibroimpact.study.runner import run_cases
-from vibroimpact.study.solutions import CASE_CHUNK, no_one_impact_orbit
+from vibroimpact.study.solutions import CASE_CHUNK, no_one_impact_orbit, simulated_regime
 
 __all__ = ["general_simulated_values"]
 
@@ -67,21 +66,9 @@ def general_simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], 
     computed = ~np.isnan(fields["converged"])
     converged = fields["converged"] == 1.0
     impacts = fields["impacts_per_period"]
-    regime = np.full(grid, Regime.NOT_COMPUTED, dtype=np.int8)
-    regime[computed & ~converged] = Regime.IRREGULAR
-    classified = computed & ~converged & ~np.isnan(fields["motion_regime"])
-    regime[classified] = fields["motion_regime"][classified].astype(np.int8)
-    regime[computed & converged] = Regime.PERIODIC_IMPACTS
-    # no impact and no contact force: linear; a structure held on a stop without impacts (a preloading stop the force
-    # never lifts it from) is periodic motion with sticking, not linear
-    held = np.abs(fields["contact_force"]) > 1e-9 * (np.abs(fields["suspension_force"]) + np.abs(fields["contact_force"]))
-    regime[computed & converged & (impacts == 0.0) & ~held] = Regime.LINEAR
-    if _two_sided(scene):  # the closed form's kind of orbit: one impact per period on each side
-        each = np.all(fields["stop_impacts"] == 1.0, axis=-1)
-        regime[computed & converged & (fields["multiplicity"] == 1.0) & each] = Regime.ONE_IMPACT
-    else:
-        regime[computed & converged & (fields["multiplicity"] == 1.0) & (impacts == 1.0)] = Regime.ONE_IMPACT
-    regime[fields["failed"] == 1.0] = Regime.FAILED
+    # the closed form's kind of orbit: one impact per period, or one on each side of a symmetric two-sided stop
+    one_impact_orbit = np.all(fields["stop_impacts"] == 1.0, axis=-1) if _two_sided(scene) else impacts == 1.0
+    regime = simulated_regime(fields, one_impact_orbit)
     force = fields["suspension_force"] + fields["contact_force"]
 
     def stop_first(name: str) -> np.ndarray:

@@ -149,6 +149,29 @@ def no_one_impact_orbit(shape: tuple[int, ...]) -> dict[str, np.ndarray]:
     }
 
 
+def simulated_regime(fields: dict[str, np.ndarray], one_impact_orbit: np.ndarray) -> np.ndarray:
+    """The ``regime`` flag of simulated steady states from a case's measured fields (the arrays of the grid).
+
+    Not computed, failed, or: not converged -> the motion's own classification (quasi-periodic, chaotic) else
+    irregular; converged -> linear when there was neither an impact nor a contact force (a structure held on a stop
+    without impacts, by a preloading stop the force never lifts it from, is periodic motion with sticking, not
+    linear), one impact where ``one_impact_orbit`` (the closed form's kind of orbit: one impact per period, or one
+    on each side of a symmetric two-sided stop) holds at multiplicity 1, else periodic impacts.
+    """
+    computed = ~np.isnan(fields["converged"])
+    converged = fields["converged"] == 1.0
+    regime = np.full(fields["converged"].shape, Regime.NOT_COMPUTED, dtype=np.int8)
+    regime[computed & ~converged] = Regime.IRREGULAR
+    classified = computed & ~converged & ~np.isnan(fields["motion_regime"])
+    regime[classified] = fields["motion_regime"][classified].astype(np.int8)  # quasi_periodic, chaotic or irregular
+    regime[computed & converged] = Regime.PERIODIC_IMPACTS
+    held = np.abs(fields["contact_force"]) > 1e-9 * (np.abs(fields["suspension_force"]) + np.abs(fields["contact_force"]))
+    regime[computed & converged & (fields["impacts_per_period"] == 0.0) & ~held] = Regime.LINEAR
+    regime[computed & converged & (fields["multiplicity"] == 1.0) & one_impact_orbit] = Regime.ONE_IMPACT
+    regime[fields["failed"] == 1.0] = Regime.FAILED
+    return regime
+
+
 def simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], jobs: int, cache_dir: Path | None, progress: bool) -> dict[str, np.ndarray]:
     """Steady states of a time-domain engine on the simulation grid; NaN at the other frequencies.
 
@@ -182,17 +205,7 @@ def simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], jobs: in
     computed = ~np.isnan(fields["converged"])
     converged = fields["converged"] == 1.0
     impacts = fields["impacts_per_period"]
-    regime = np.full(grid, Regime.NOT_COMPUTED, dtype=np.int8)
-    regime[computed & ~converged] = Regime.IRREGULAR
-    classified = computed & ~converged & ~np.isnan(fields["motion_regime"])
-    regime[classified] = fields["motion_regime"][classified].astype(np.int8)  # quasi_periodic, chaotic or irregular
-    regime[computed & converged] = Regime.PERIODIC_IMPACTS
-    # no impact and no contact force: linear; a structure held on a stop without impacts (a preloading stop the force
-    # never lifts it from) is periodic motion with sticking, not linear
-    held = np.abs(fields["contact_force"]) > 1e-9 * (np.abs(fields["suspension_force"]) + np.abs(fields["contact_force"]))
-    regime[computed & converged & (impacts == 0.0) & ~held] = Regime.LINEAR
-    regime[computed & converged & (fields["multiplicity"] == 1.0) & (impacts == 1.0)] = Regime.ONE_IMPACT
-    regime[fields["failed"] == 1.0] = Regime.FAILED
+    regime = simulated_regime(fields, impacts == 1.0)
     force = fields["suspension_force"] + fields["contact_force"]
     values = {
         "x1_amplitude": np.abs(fields["x1"]),
