@@ -10,7 +10,6 @@ maxima of any of them near each natural frequency.
 from __future__ import annotations
 
 from collections.abc import Callable
-
 from dataclasses import dataclass
 
 import numpy as np

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
-from vibroimpact.model.excitation import HarmonicForce, SweptSine
+from vibroimpact.model.excitation import HarmonicForce, SweptSine, load_weights, static_load
 from vibroimpact.model.stops import Stop
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
@@ -146,8 +146,6 @@ class ImpactProblem:
         excitation = self.excitation
         if isinstance(excitation, HarmonicForce):
             return excitation.load_vector(self.structure.mass_matrix), excitation.static_vector(size)
-        from vibroimpact.model.excitation import load_weights, static_load
-
         return load_weights(excitation.weights, size).astype(complex) * excitation.amplitude, static_load(excitation.static, size)
 
     def first_order(self) -> tuple[NDArray[np.float64], NDArray[np.complex128], NDArray[np.float64]]:
@@ -162,10 +160,13 @@ class ImpactProblem:
 
     def gap_amplitude(self, stop: int = 0) -> float:
         """|n . H(jw) F|: the amplitude of stop ``stop``'s coordinate in the linear motion without stops [m]."""
+        return self.gap_amplitudes()[stop]
+
+    def gap_amplitudes(self) -> list[float]:
+        """|n_k . H(jw) F| of every stop [m] (the load and the receptance computed once)."""
         harmonic, _ = self.load()
-        n = self.stops[stop].normal(self.size)
         h = self.structure.receptance_matrix(self.omega)
-        return float(abs(n @ h @ harmonic))
+        return [float(abs(stop.normal(self.size) @ h @ harmonic)) for stop in self.stops]
 
     def contact_holding(self, stop: int, state: NDArray[np.float64], t: float) -> float:
         """Force lambda [N] that stop ``stop`` must exert to hold its gap closed (g = 0, g' = 0) in ``state`` at t.
@@ -261,5 +262,5 @@ class ImpactProblem:
         _, static = self.load()
         minv_static = np.linalg.solve(self.structure.mass_matrix, static)
         # a static load's length: how far it moves a stop's coordinate in 1/w [s] (gravity on a free mass)
-        sizes = [abs(stop.clearance) + self.gap_amplitude(k) + abs(stop.normal(self.size) @ minv_static) / self.omega**2 for k, stop in enumerate(self.stops)]
+        sizes = [abs(stop.clearance) + linear + abs(stop.normal(self.size) @ minv_static) / self.omega**2 for stop, linear in zip(self.stops, self.gap_amplitudes())]
         return self.omega * max(sizes) + 1e-300
