@@ -9,12 +9,12 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
 from vibroimpact import cli
 from vibroimpact.study import run as study
-from vibroimpact.study.runner import cached_case_count
 from vibroimpact.scene import load_scene, shipped_studies, shipped_studies_dir
 
 from tests.scene.test_scene import base_scene, write_yaml
@@ -78,8 +78,18 @@ def test_a_local_file_wins_over_the_shipped_scene(tmp_path: Path, monkeypatch: p
     assert find_scene("restitution").resolve() == local.resolve()
 
 
+def _finished_blocks(store: Path) -> int:
+    """Blocks flagged done in a study's zarr store (0 before it exists)."""
+    import zarr
+
+    try:
+        return int(np.asarray(zarr.open_group(str(store), mode="r")["block_done"][...]).sum())
+    except (FileNotFoundError, KeyError, ValueError, zarr.errors.GroupNotFoundError):
+        return 0
+
+
 def _slow_scene(folder: Path) -> Path:
-    """Enough simulation cases (momentary, 16 points each) that an interrupt lands between two of them."""
+    """Enough grid blocks (momentary, 16 simulated points each) that an interrupt lands between two of them."""
     document = base_scene()
     document.update(
         name="interrupted",
@@ -106,24 +116,25 @@ def _start(arguments: list[str], folder: Path) -> subprocess.Popen[str]:
 
 
 @pytest.mark.timeout(480)
-def test_ctrl_c_leaves_one_line_and_a_resumable_cache(tmp_path: Path) -> None:
-    """Ctrl-C (SIGINT to the whole process group, workers included): exit 130, one line saying what was kept, no
-    traceback; the same command then starts from the kept cases."""
+def test_ctrl_c_leaves_one_line_and_a_resumable_store(tmp_path: Path) -> None:
+    """Ctrl-C (SIGINT to the whole process group, dask workers included): exit 130, one line saying what was kept,
+    no traceback; the same command then starts from the kept blocks."""
     scene = _slow_scene(tmp_path)
-    cache = tmp_path / "out" / ".cache"
+    store = tmp_path / "out" / "interrupted.zarr"
     arguments = [str(scene), "--out", "out", "--jobs", "2"]
     run = _start(arguments, tmp_path)
     deadline = time.monotonic() + 180.0
-    while cached_case_count(cache) == 0 and run.poll() is None and time.monotonic() < deadline:
+    while _finished_blocks(store) == 0 and run.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)
     assert run.poll() is None, "the study ended before it could be interrupted"
     os.killpg(run.pid, signal.SIGINT)
     _out, err = run.communicate(timeout=120)  # hang guards: ending takes a second on a quiet machine
-    kept = cached_case_count(cache)
+    kept = _finished_blocks(store)
     assert run.returncode == 130, err
     assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
-    assert err.rstrip().splitlines()[-1] == f"interrupted: {kept} finished case{'s' if kept != 1 else ''} kept; run the same command to resume"
-    assert 1 <= kept < 5  # 71 points in 16-point cases: 5 cases
+    assert err.rstrip().splitlines()[-1] == f"interrupted: {kept} finished block{'s' if kept != 1 else ''} kept in out/interrupted.zarr; run the same command to resume"
+    assert 1 <= kept < 5  # 71 simulated points in 16-point blocks: 5 blocks
+    assert not (tmp_path / "out" / ".run-study.lock").exists()
     # the rerun begins with the kept cases done
     rerun = _start(arguments, tmp_path)
     assert rerun.stderr is not None

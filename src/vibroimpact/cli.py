@@ -1,5 +1,5 @@
-"""``run-study SCENE.yaml [--out DIR] [--jobs N] [--no-report] [--estimate [--costs FILE]]``, ``run-study --list``: run a
-scene, write ``DIR/<name>.nc`` and the comparison report; ``run-study calibrate ACCURACY.nc [--out FILE]`` and
+"""``run-study SCENE.yaml [--out DIR] [--jobs N | --scheduler ADDRESS] [--keep-zarr] [--no-report] [--estimate [--costs
+FILE]]``, ``run-study --list``: run a scene, write ``DIR/<name>.nc`` and the comparison report; ``run-study calibrate ACCURACY.nc [--out FILE]`` and
 ``run-study sweep-cost [options]``: the companions that measure costs.
 
 A first argument that names a subcommand runs it (a scene file of that name is still reached as ``./calibrate.yaml``).
@@ -10,7 +10,6 @@ from __future__ import annotations
 import argparse
 import os
 import resource
-import shutil
 import sys
 import tempfile
 import time
@@ -19,10 +18,11 @@ from typing import Callable
 
 import numpy as np
 
-from vibroimpact.study.runner import cached_case_count
 from vibroimpact.scene import Scene, SceneError, find_scene, load_scene, shipped_studies
+from vibroimpact.study.cluster import SCHEDULER_VARIABLE, ClusterLost, choose_scheduler
 from vibroimpact.study.io import write_dataset
 from vibroimpact.study.run import run_study
+from vibroimpact.study.store import OutputBusy, StudyStore, claim_output, store_fingerprint
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILURE = 1
@@ -46,7 +46,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("scene", nargs="?", help="scene file; a bare name (with or without .yaml) is also looked up in ./studies/ and the shipped studies (a local file wins)")
     parser.add_argument("--out", type=Path, default=None, help="output folder (default: results/<scene name>/)")
     parser.add_argument("--no-report", action="store_true", help="write the dataset only")
-    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="processes for the simulations (default: all cores)")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="worker processes of the local dask cluster (default: all cores; 1: this process alone)")
+    parser.add_argument("--scheduler", default=None, metavar="ADDRESS", help=f"run on a running dask cluster, e.g. tcp://head-node:8786 (default: ${SCHEDULER_VARIABLE}, else the scene's cluster.scheduler, else a local cluster of --jobs workers)")
+    parser.add_argument("--keep-zarr", action="store_true", help="keep the chunked store DIR/<name>.zarr after the netCDF file is written (for grids too large for one netCDF file)")
     parser.add_argument("--estimate", action="store_true", help="print the predicted wall time and memory of the scene, and run nothing")
     parser.add_argument("--costs", type=Path, default=None, help="cost file of --estimate (default: the package's calibrated costs, see run-study calibrate)")
     parser.add_argument("--list", action="store_true", help="list the shipped studies with their descriptions, and run nothing")
@@ -75,6 +77,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.jobs < 1:
         print(f"run-study: error: --jobs {args.jobs} is out of range: allowed [1, inf)", file=sys.stderr)
         return EXIT_BAD_INPUT
+    scheduler = choose_scheduler(args.scheduler, scene.cluster_scheduler)
     if args.estimate:
         return _estimate(scene, args.jobs, args.costs)
     out_dir = args.out if args.out is not None else Path("results") / scene.name
@@ -82,13 +85,28 @@ def main(argv: list[str] | None = None) -> int:
     if problem is not None:
         print(f"run-study: error: --out {out_dir} cannot be written: {problem}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    cache = out_dir / ".cache"  # finished simulation cases: an interrupted run resumes from here
     try:
-        return _run(scene, args, out_dir, cache)
-    except KeyboardInterrupt:
-        kept = cached_case_count(cache)
-        print(f"\ninterrupted: {kept} finished case{'s' if kept != 1 else ''} kept; run the same command to resume", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        with claim_output(out_dir):
+            # finished blocks and cases: a rerun of the same scene skips them
+            store = StudyStore(out_dir / f"{scene.name}.zarr", store_fingerprint(scene.text))
+            try:
+                return _run(scene, args, out_dir, store, scheduler)
+            except KeyboardInterrupt:
+                print(f"\ninterrupted: {_kept(store)} kept in {store.path}; run the same command to resume", file=sys.stderr)
+                return EXIT_INTERRUPTED
+            except ClusterLost as error:
+                print(f"\nrun-study: {error}: {_kept(store)} kept in {store.path}; run the same command to resume", file=sys.stderr)
+                return EXIT_FAILURE
+    except OutputBusy as error:
+        print(f"run-study: error: {error}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+
+def _kept(store: StudyStore) -> str:
+    """What an interrupted run keeps, in words (``12 finished blocks and 3 finished cases``)."""
+    blocks, cases = store.block_count(), store.case_count()
+    parts = [f"{n} finished {word}{'s' if n != 1 else ''}" for n, word in ((blocks, "block"), (cases, "case")) if n or (word == "case" and not blocks)]
+    return " and ".join(parts)
 
 
 def _estimate(scene: Scene, jobs: int, costs_file: Path | None) -> int:
@@ -147,6 +165,24 @@ def sweep_cost_command(argv: list[str]) -> int:
     return 0
 
 
+#: Largest dataset [bytes] that the report reads into memory; a larger one is written without a report.
+REPORT_MEMORY_LIMIT = 2e9
+
+
+def _report(path: Path, out_dir: Path, jobs: int) -> Path | str:
+    """Write the report of the dataset at ``path`` (read into memory), or say why not (too large to draw)."""
+    import xarray as xr
+
+    with xr.open_dataset(path) as lazy:
+        size = lazy.nbytes
+    if size > REPORT_MEMORY_LIMIT:
+        return f"no report: the dataset holds {size / 1e9:.1f} GB, more than the {REPORT_MEMORY_LIMIT / 1e9:.0f} GB a report reads into memory (the data are in {path})"
+    from vibroimpact.reporting.report import write_report  # matplotlib is imported only when a report is made
+
+    dataset = xr.load_dataset(path)
+    return write_report(dataset, out_dir, jobs=jobs)
+
+
 def unwritable(out_dir: Path) -> str | None:
     """Why files cannot be written into ``out_dir`` (created if missing), or ``None`` if they can."""
     if out_dir.exists() and not out_dir.is_dir():
@@ -160,23 +196,24 @@ def unwritable(out_dir: Path) -> str | None:
     return None
 
 
-def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, cache: Path) -> int:
+def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, store: StudyStore, scheduler: str | None) -> int:
     started = time.perf_counter()
     try:
-        dataset = run_study(scene, jobs=args.jobs, cache_dir=cache)
+        dataset = run_study(scene, jobs=args.jobs, store=store, scheduler=scheduler, load=False)
         # what this run cost, for comparing with ``--estimate`` (simulations: excluding cases taken from the cache)
         dataset.attrs["run_wall_time_s"] = time.perf_counter() - started
         dataset.attrs["run_jobs"] = args.jobs
+        dataset.attrs["run_scheduler"] = scheduler or ("local dask cluster" if args.jobs > 1 else "this process")
         dataset.attrs["run_peak_memory_bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-        dataset.attrs["run_peak_memory_worker_bytes"] = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * 1024  # largest worker
-        path = write_dataset(dataset, out_dir / f"{scene.name}.nc")
-        shutil.rmtree(cache, ignore_errors=True)
+        path = write_dataset(dataset, out_dir / f"{scene.name}.nc")  # streamed from the store, chunk by chunk
         print(f"wrote {path}")
+        if args.keep_zarr:
+            print(f"kept {store.path}")
+        else:
+            store.remove()
         if scene.report and not args.no_report:
-            from vibroimpact.reporting.report import write_report  # matplotlib is imported only when a report is made
-
-            report = write_report(dataset, out_dir, jobs=args.jobs)
-            print(f"wrote {report}")
+            report = _report(path, out_dir, args.jobs)
+            print(f"wrote {report}" if isinstance(report, Path) else report)
     except (OSError, ValueError, ArithmeticError, np.linalg.LinAlgError, RuntimeError) as error:
         print(f"run-study: error while running {scene.name!r}: {type(error).__name__}: {error}", file=sys.stderr)
         return EXIT_FAILURE

@@ -1,5 +1,5 @@
-"""Steady-state cases of a study (study/cases.py): stepped sweeps from point to point, the resumable cache, processes
-against one process, and a failing point that costs only itself."""
+"""Steady-state cases of a study (study/cases.py): stepped sweeps from point to point, the resumable store, dask
+workers against one process, and a failing point that costs only itself."""
 
 from __future__ import annotations
 
@@ -15,7 +15,8 @@ from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.simulation.settings import SteadySettings
 from vibroimpact.study import cases as study_cases
 from vibroimpact.study.cases import SimulationCase
-from vibroimpact.study.runner import run_cases
+from vibroimpact.study.runner import Runner
+from vibroimpact.study.store import StudyStore
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
 from tests.simulation.test_steady import pgf_values
@@ -36,26 +37,30 @@ def test_stepped_sweep_lands_on_the_stable_orbits(system: TwoDofSystem, start: s
         assert abs(result["x1"][i]) == pytest.approx(expected["x1"], rel=1e-7)
 
 
-def test_cache_resumes_without_recomputing(system: TwoDofSystem, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_store_resumes_without_recomputing(system: TwoDofSystem, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     cases = [_case(system, "pgf", frequencies=(25.0,)), _case(system, "linear", frequencies=(30.0, 31.0))]
-    first = run_cases(cases, cache_dir=tmp_path, progress=False)
-    assert len(list(tmp_path.glob("*.npz"))) == 2
+    store = tmp_path / "study.zarr"
+    first = Runner(store=StudyStore(store, "fingerprint"), progress=False).map(cases)
+    assert StudyStore(store, "fingerprint").case_count() == 2
+    assert StudyStore(store, "another scene").case_count() == 0  # another fingerprint: started afresh
+    first = Runner(store=StudyStore(store, "fingerprint"), progress=False).map(cases)
 
     def fail(case: SimulationCase, report: object = None) -> dict:
         raise AssertionError("a cached case was recomputed")
 
     monkeypatch.setattr(study_cases, "run_case", fail)
-    second = run_cases(cases, cache_dir=tmp_path, progress=False)
+    second = Runner(store=StudyStore(store, "fingerprint"), progress=False).map(cases)
     for a, b in zip(first, second):
         for name in study_cases.FIELDS:
             if name != "wall_time":
                 np.testing.assert_array_equal(a[name], b[name])
 
 
-def test_processes_give_the_same_results(system: TwoDofSystem) -> None:
+def test_dask_workers_give_the_same_results(system: TwoDofSystem) -> None:
     cases = [_case(system, "pgf", frequencies=(25.0, 26.0)), _case(system, "pgf", engine="momentary", frequencies=(25.0,))]
-    serial = run_cases(cases, jobs=1, progress=False)
-    parallel = run_cases(cases, jobs=2, progress=False)
+    serial = Runner(jobs=1, progress=False).map(cases)
+    with Runner(jobs=2, progress=False) as runner:
+        parallel = runner.map(cases)
     for a, b in zip(serial, parallel):
         np.testing.assert_array_equal(a["x1"], b["x1"])
 

@@ -288,8 +288,8 @@ class Scene:
         When given, the time-domain solutions are swept-sine tests, not stepped steady states.
     bifurcation : BifurcationSettings or None
         When given, a bifurcation study (:mod:`vibroimpact.scene.bifurcation`): brute force, branches, chart.
-    report : bool
-        Whether ``run-study`` writes the comparison report.
+    report : bool or str
+        Whether ``run-study`` writes the comparison report; a string names the page (``design_map``).
     text : str
         The YAML source, stored in the output's attributes.
     load : LoadSpec or None
@@ -298,6 +298,8 @@ class Scene:
         A general scene's stops; ``()``: the paper's stop (see :attr:`stop_specs`).
     sweep_stops : tuple of int or None
         The stops that swept restitution, clearance and bumper values apply to; None: every stop.
+    cluster_scheduler : str or None
+        The scene's ``cluster: {scheduler: ADDRESS}``: a running dask scheduler to run on; None: a local cluster.
     general : bool
         The scene uses the general format (matrices, a load beyond a force on the primary mass, or ``stops``): its
         outputs are named after its coordinates and stops. False: the paper's named form and outputs.
@@ -322,12 +324,13 @@ class Scene:
     bifurcation: "BifurcationSettings | None" = None
     validation: "ValidationSettings | None" = None
     concepts: "ConceptsSettings | None" = None
-    report: bool = True
+    report: bool | str = True
     text: str = ""
     load: LoadSpec | None = None
     stops: tuple[StopSpec, ...] = ()
     sweep_stops: tuple[int, ...] | None = None
     general: bool = False
+    cluster_scheduler: str | None = None
 
     @property
     def coordinates(self) -> tuple[str, ...]:

@@ -43,7 +43,9 @@ from vibroimpact.simulation.settings import SteadySettings
 __all__ = ["TOP_KEYS", "NAME", "parse_grid_scene", "parse_header", "check_sweep_run"]
 
 #: Top-level keys of a grid scene.
-TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bumper", "sweep", "swept_sine", "solutions", "quantities", "settings", "simulation", "report"}
+TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bumper", "sweep", "swept_sine", "solutions", "quantities", "settings", "simulation", "report", "cluster"}
+#: Report pages a grid scene may ask for by name (``report: design_map``) instead of its kind's page.
+REPORT_PAGES = ("design_map",)
 #: A scene's or a case's name: safe as a file name.
 NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 #: Simulation keys that only stepped steady states use.
@@ -63,12 +65,12 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
 
     load = None
     if general:
-        name, description, report = parse_names(c, doc)
+        name, description, report = parse_names(c, doc, REPORT_PAGES)
         system = parse_structure(c, doc["system"]) if "system" in doc else None
         names = tuple(system.coordinates) if system is not None else document_names(doc.get("system"))
         amplitude, load = parse_load(c, doc["excitation"], names) if "excitation" in doc else (None, None)
     else:
-        name, description, system, amplitude, report = parse_header(c, doc)
+        name, description, system, amplitude, report = parse_header(c, doc, REPORT_PAGES)
 
     sweep = c.mapping("sweep", doc.get("sweep", {}), {*SWEEPABLE, "stop"}, {"frequency"}) if "sweep" in doc else {}
     fixed = {
@@ -76,6 +78,9 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
         "bumper": c.mapping("bumper", doc["bumper"], {"frequency", "loss_factor"}) if "bumper" in doc else {},
     }
     solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
+    scheduler = parse_cluster(c, doc)
+    if isinstance(report, str) and ("swept_sine" in doc or general):
+        c.fail("report", f"the {report} page is for stepped studies of the paper's named system")
     specs = parse_stop_layout(c, doc, system)
     targets = None
     if "stop" in sweep:
@@ -174,6 +179,7 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
         solutions=solutions, quantities=quantities, admissibility=admissibility, simulation=simulation,
         bumper_frequency=grids.get("bumper_frequency"), bumper_loss_factor=grids.get("bumper_loss_factor"), swept_sine=swept_sine,
         report=report, text=text, load=load, stops=specs if "stops" in doc and specs is not None else (), sweep_stops=targets, general=general,
+        cluster_scheduler=scheduler,
     )
 
 
@@ -223,10 +229,10 @@ def check_sweep_run(c: Checker, key: str, low: float, high: float, rate: float |
     return rate, sample_rate
 
 
-def parse_header(c: Checker, doc: dict) -> tuple[Any, str, TwoDofSystem | None, float | None, bool]:
+def parse_header(c: Checker, doc: dict, pages: tuple[str, ...] = ()) -> tuple[Any, str, TwoDofSystem | None, float | None, bool | str]:
     """What every scene in the paper's named form has: name, description, system, excitation amplitude and the report
-    switch."""
-    name, description, report = parse_names(c, doc)
+    switch (or one of ``pages``)."""
+    name, description, report = parse_names(c, doc, pages)
     system = parse_structure(c, doc.get("system")) if "system" in doc else None
     if system is not None and not isinstance(system, TwoDofSystem):
         c.fail("system", "this kind of scene takes the paper's named system {m1, m2, k1, k2, b1, b2} only")
@@ -239,8 +245,8 @@ def parse_header(c: Checker, doc: dict) -> tuple[Any, str, TwoDofSystem | None, 
     return name, description, system, amplitude, report
 
 
-def parse_names(c: Checker, doc: dict) -> tuple[Any, str, bool]:
-    """Name, description and the report switch of any scene."""
+def parse_names(c: Checker, doc: dict, pages: tuple[str, ...] = ()) -> tuple[Any, str, bool | str]:
+    """Name, description and the report switch of any scene (or one of ``pages``, the report pages it may name)."""
     name = doc.get("name")
     if "name" in doc and not (isinstance(name, str) and NAME.match(name)):
         c.fail("name", f"expected a file-name-safe string (letters, digits, '_', '-', '.'), got {name!r}")
@@ -248,9 +254,22 @@ def parse_names(c: Checker, doc: dict) -> tuple[Any, str, bool]:
     if not isinstance(description, str):
         c.fail("description", f"expected a string, got {type(description).__name__}")
     report = doc.get("report", True)
-    if not isinstance(report, bool):
-        c.fail("report", f"expected true or false, got {report!r}")
-    return name, description, bool(report)
+    if not isinstance(report, bool) and report not in pages:
+        c.fail("report", f"expected true or false{' or a page name (' + ', '.join(pages) + ')' if pages else ''}, got {report!r}")
+        report = True
+    return name, description, report
+
+
+def parse_cluster(c: Checker, doc: dict) -> str | None:
+    """The scene's ``cluster: {scheduler: ADDRESS}``: a running dask scheduler to run on (None: a local cluster)."""
+    if "cluster" not in doc:
+        return None
+    section = c.mapping("cluster", doc["cluster"], {"scheduler"}, {"scheduler"})
+    address = section.get("scheduler")
+    if address is not None and not (isinstance(address, str) and "://" in address or isinstance(address, str) and ":" in address):
+        c.fail("cluster.scheduler", f"expected a scheduler address such as tcp://host:8786, got {address!r}")
+        return None
+    return address
 
 
 def _parse_simulation(c: Checker, value: Any, default_frequency: np.ndarray, swept: bool = False) -> SimulationSettings | None:

@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import xarray as xr
 
@@ -12,6 +11,7 @@ from vibroimpact.scene.schema import Scene
 from vibroimpact.study.cost_model import Costs, Estimate
 from vibroimpact.study.grid import Progress
 from vibroimpact.study.io import provenance
+from vibroimpact.study.runner import Runner
 
 __all__ = ["BenchmarkStudy"]
 
@@ -21,9 +21,9 @@ class BenchmarkStudy:
 
     name = "benchmark"
 
-    def run(self, scene: Scene, progress: Progress | None, jobs: int, cache_dir: Path | None) -> xr.Dataset:
+    def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """Every method at every tolerance on every case, in this process (timings are compared with each other:
-        ``jobs`` and ``cache_dir`` are not used)."""
+        ``runner`` is not used)."""
         assert scene.benchmark is not None
         dataset = run_benchmark(list(scene.benchmark.cases), scene.benchmark.settings, progress=progress is not None)
         dataset.attrs.update({"title": f"vibroimpact benchmark '{scene.name}'", "scene_name": scene.name, "scene": scene.text} | provenance())

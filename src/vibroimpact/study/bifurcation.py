@@ -25,7 +25,6 @@ point coordinates carry the prefix of their dimension.
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import xarray as xr
@@ -39,7 +38,7 @@ from vibroimpact.study.bifurcation_seeds import Seed, sweep_seeds
 from vibroimpact.study.cost_model import Costs, Estimate
 from vibroimpact.study.grid import Progress
 from vibroimpact.study.io import provenance
-from vibroimpact.study.runner import CaseResult, run_cases
+from vibroimpact.study.runner import CaseResult, Runner
 
 __all__ = ["BifurcationStudy", "CONTINUATION_SECONDS", "CLOSED_FORM_SECONDS", "CHART_SECONDS", "REPORT_FIGURES"]
 
@@ -60,7 +59,7 @@ class BifurcationStudy:
 
     name = "bifurcation"
 
-    def run(self, scene: Scene, progress: Progress | None, jobs: int, cache_dir: Path | None) -> xr.Dataset:
+    def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """The study's dataset (module docstring); ``progress`` gets a line per stage and per branch set."""
         settings = scene.bifurcation
         assert settings is not None
@@ -77,7 +76,7 @@ class BifurcationStudy:
         charted = [ChartCase(system, q, delta, chart.restitution, settings.low, settings.high, chart.clearance, chart.kinds, chart.max_steps)] if chart else []
         say(f"brute force: {len(sweeps)} sweeps of {scene.frequency.size} frequencies" + (f", regime map: {len(maps)} sweeps of {settings.chart_frequency.size}" if maps else "")
             + (f"; the chart's curves (R = {chart.restitution:g})" if chart else ""))  # fmt: skip
-        first = run_cases(charted + sweeps + maps, jobs, cache_dir, progress is not None)
+        first = runner.map(charted + sweeps + maps)
         chart_result, swept = (first[0], first[1:]) if chart else (None, first)
         if chart_result is not None:
             for note in chart_result["notes"]:
@@ -91,7 +90,7 @@ class BifurcationStudy:
                     seeds += sweep_seeds(scene.frequency, result["period"], result["impacts"], result["state"], j)
             continuation.append(BranchCase(system, q, delta, r, settings.low, settings.high, options, tuple(seeds)))
         say(f"continuing the branches of R = {', '.join(f'{r:g}' for r in settings.restitution)}")
-        results = run_cases(continuation, jobs, cache_dir, progress is not None)
+        results = runner.map(continuation)
         for case, result in zip(continuation, results):
             for note in result["notes"]:
                 say(f"  R = {case.restitution:g}: {note}")

@@ -18,7 +18,6 @@ Output contract: dimensions ``concept`` (names), ``frequency`` [Hz] (fine grid),
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -31,7 +30,7 @@ from vibroimpact.study.concepts_closed import closed_forms
 from vibroimpact.study.concepts_dataset import concepts_dataset
 from vibroimpact.study.cost_model import Costs, Estimate
 from vibroimpact.study.grid import Progress
-from vibroimpact.study.runner import run_cases
+from vibroimpact.study.runner import Runner
 
 __all__ = ["ConceptsStudy", "run_concepts", "CHUNK"]
 
@@ -46,9 +45,10 @@ SECONDS_PER_BRANCH_CASE = 8.0
 SECONDS_REPORT = 10.0
 
 
-def run_concepts(settings: ConceptsSettings, progress: Progress | None = None, jobs: int = 1, cache_dir: Path | None = None) -> xr.Dataset:
+def run_concepts(settings: ConceptsSettings, progress: Progress | None = None, runner: Runner | None = None) -> xr.Dataset:
     """Every concept's closed forms, simulations and branches, and the figures of merit (module docstring)."""
     say = progress if progress is not None else (lambda message: None)
+    runner = runner if runner is not None else Runner(progress=progress is not None)
     closed = {c.name: closed_forms(c, settings.amplitude, settings.frequency) for c in settings.concepts}
     say(f"closed forms of {len(closed)} concepts on {settings.frequency.size} frequencies")
     stopped = [c for c in settings.concepts if c.stops]
@@ -58,7 +58,7 @@ def run_concepts(settings: ConceptsSettings, progress: Progress | None = None, j
             chunk = tuple(float(f) for f in settings.simulation_frequency[first : first + CHUNK])
             cases.append(ConceptCase(concept, settings.amplitude, chunk, settings.engine, settings.steady, settings.bumper_frequency))
             owners.append(concept.name)
-    results = run_cases(cases, jobs=jobs, cache_dir=cache_dir, progress=progress is not None)
+    results = runner.map(cases)
     simulated: dict[str, dict[str, np.ndarray]] = {}
     for concept in stopped:
         parts = [r for r, owner in zip(results, owners) if owner == concept.name]
@@ -72,7 +72,7 @@ def run_concepts(settings: ConceptsSettings, progress: Progress | None = None, j
             s = simulated[concept.name]
             seeds = branch_seeds(settings.simulation_frequency, s["converged"], s["multiplicity"], s["impacts_per_period"], s["end_state"], s["end_time"])
             branch_cases.append(BranchCase(concept, settings.amplitude, low, high, seeds, settings.continuation_steps))
-        for concept, result in zip(stopped, run_cases(branch_cases, jobs=jobs, cache_dir=cache_dir, progress=progress is not None)):
+        for concept, result in zip(stopped, runner.map(branch_cases)):
             branches[concept.name] = result
             say(f"{concept.name}: {str(result['note'][0])}")
     return concepts_dataset(settings, closed, simulated, branches)
@@ -83,11 +83,11 @@ class ConceptsStudy:
 
     name = "concepts"
 
-    def run(self, scene: Any, progress: Progress | None, jobs: int, cache_dir: Path | None) -> xr.Dataset:
+    def run(self, scene: Any, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """The scene's dataset, with its name, text and provenance."""
         from vibroimpact.study.io import provenance
 
-        dataset = run_concepts(scene.concepts, progress, jobs, cache_dir)
+        dataset = run_concepts(scene.concepts, progress, runner)
         dataset.attrs.update({"title": f"vibroimpact absorber concepts '{scene.name}'", "scene_name": scene.name, "scene": scene.text} | provenance())
         return dataset
 

@@ -9,7 +9,6 @@ closed form's kind of orbit, one impact per period on each side (as ``pgf`` flag
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 
@@ -20,7 +19,7 @@ from vibroimpact.simulation.settings import SWEEP_STARTS
 from vibroimpact.study.cases import COMPLEX_FIELDS, COORDINATE_FIELDS, FIELDS, STOP_FIELDS, SimulationCase
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.study.general_values import _broadcast, coordinate_quantity, scene_problem
-from vibroimpact.study.runner import run_cases
+from vibroimpact.study.runner import Runner
 from vibroimpact.study.solutions import CASE_CHUNK, no_one_impact_orbit, simulated_regime
 
 __all__ = ["general_simulated_values"]
@@ -34,7 +33,7 @@ def _two_sided(scene: Scene) -> bool:
     return closed_form_refusal(problem) is None
 
 
-def general_simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], jobs: int, cache_dir: Path | None, progress: bool) -> dict[str, np.ndarray]:
+def general_simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], runner: Runner) -> dict[str, np.ndarray]:
     """Steady states of a time-domain engine on the simulation grid of a general scene; NaN at the other frequencies."""
     assert scene.simulation is not None
     sim = scene.simulation
@@ -55,7 +54,7 @@ def general_simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], 
                     case = SimulationCase(engine, scene.system, scene.amplitude, contact, frequencies, sim.start, sim.engine, sim.steady, rigid if on_bumper else None, scene.load)
                     cases.append(case)
                     places.append((i, j, k, columns[first : first + chunk]))
-    results = run_cases(cases, jobs=jobs, cache_dir=cache_dir, progress=progress)
+    results = runner.map(cases)
     grid = (shape[0], shape[1], bumpers.size, 1, shape[4])
     size, count = scene.system.size, len(specs)
     widths = {**{name: (size,) for name in COORDINATE_FIELDS}, **{name: (count,) for name in STOP_FIELDS}}

@@ -10,8 +10,6 @@ where it has one. The structure, load and stop layout are attributes (:func:`vib
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import xarray as xr
 
@@ -20,9 +18,10 @@ from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, STOP_QUANTITIE
 from vibroimpact.scene.variables import quantity_attributes
 from vibroimpact.study.general_engines import general_simulated_values
 from vibroimpact.study.general_values import general_linear_values, general_pgf_values
-from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates
+from vibroimpact.study.grid import StudyGrid, grid_coordinates
+from vibroimpact.study.runner import Runner
 
-__all__ = ["run_general", "general_quantity_attributes"]
+__all__ = ["general_block", "general_coordinates", "describe_stops", "general_quantity_attributes"]
 
 _PER_COORDINATE = {"_amplitude": "x1_amplitude", "_rms": "x1_rms"}
 
@@ -45,22 +44,19 @@ def general_quantity_attributes(quantity: str, scene: Scene) -> dict[str, object
     return attrs
 
 
-def run_general(scene: Scene, progress: Progress | None, jobs: int, cache_dir: Path | None, simulation_attributes: dict[str, object]) -> xr.Dataset:
-    """Every solution of a general ``scene`` over its grid."""
+def general_block(scene: Scene, runner: Runner) -> xr.Dataset:
+    """Every solution of a general ``scene`` (or of a block of one) over its unsqueezed grid, without coordinates or
+    metadata; per-stop quantities have the dimension ``stop`` where the scene has several stops."""
     grid = StudyGrid.of(scene)
-    report = progress or (lambda _message: None)
     per_solution = []
-    for i, name in enumerate(scene.solutions, start=1):
+    for name in scene.solutions:
         if name == "linear":
             values = general_linear_values(scene, grid.omega, grid.base)
         elif name in ENGINE_SOLUTIONS:
-            values = general_simulated_values(scene, name, grid.full, jobs, cache_dir, progress is not None)
+            values = general_simulated_values(scene, name, grid.full, runner)
         else:
             values = general_pgf_values(scene, grid.omega, grid.delta, grid.r, grid.base)
         per_solution.append(values)
-        report(f"[{i}/{len(scene.solutions)}] {name}: done")
-    solutions = list(scene.solutions)
-    coords = grid_coordinates(scene, grid, solutions)
     count = len(scene.stop_specs)
     data_vars = {}
     for quantity in scene.quantities:
@@ -74,11 +70,23 @@ def run_general(scene: Scene, progress: Progress | None, jobs: int, cache_dir: P
         else:
             stacked = np.stack([np.broadcast_to(values[quantity], grid.full) for values in per_solution])
             data_vars[quantity] = xr.Variable(("solution", *GRID_DIMS), stacked, attrs)
+    return xr.Dataset(data_vars)
+
+
+def general_coordinates(scene: Scene, grid: StudyGrid) -> dict[str, object]:
+    """Coordinates of a general scene's dataset before squeezing: those of :func:`grid_coordinates`, and ``stop``
+    with ``stop_description`` where the scene has several stops and writes a per-stop quantity."""
+    coords = grid_coordinates(scene, grid, list(scene.solutions))
+    count = len(scene.stop_specs)
     if count > 1 and any(q in STOP_QUANTITIES for q in scene.quantities):
         coords["stop"] = np.arange(count)
         coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.stop_specs, scene.coordinates, scene.restitution, scene.clearance), dtype=object))
-    dataset = xr.Dataset(data_vars, coords=coords)
+    return coords
+
+
+def describe_stops(dataset: xr.Dataset) -> xr.Dataset:
+    """The attributes of the ``stop`` coordinates, where the dataset has them."""
     if "stop" in dataset.coords:
         dataset["stop"].attrs.update({"units": "1", "long_name": "index of the stop in the scene's stops"})
         dataset["stop_description"].attrs.update({"long_name": "the stop's constraint in words (Delta, R: the swept values)"})
-    return finish_dataset(dataset, scene, coords, simulation_attributes)
+    return dataset

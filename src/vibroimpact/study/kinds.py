@@ -8,7 +8,6 @@ methods and one line in :data:`KINDS` (and its name in :attr:`vibroimpact.scene.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from pathlib import Path
 from types import MappingProxyType
 from typing import Protocol
 
@@ -21,6 +20,7 @@ from vibroimpact.study.concepts import ConceptsStudy
 from vibroimpact.study.validation import ValidationStudy
 from vibroimpact.study.cost_model import Costs, Estimate
 from vibroimpact.study.grid import Progress
+from vibroimpact.study.runner import Runner
 from vibroimpact.study.stepped import SteppedStudy
 from vibroimpact.study.swept import SweptStudy
 
@@ -35,8 +35,9 @@ class StudyKind(Protocol):
         """The kind's name, as :attr:`Scene.kind` says it and datasets record it (``study_kind``)."""
         ...
 
-    def run(self, scene: Scene, progress: Progress | None, jobs: int, cache_dir: Path | None) -> xr.Dataset:
-        """The scene's dataset; ``progress`` receives a line per finished step (None: silence)."""
+    def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
+        """The scene's dataset; ``progress`` receives a line per finished step (None: silence); its work runs in
+        ``runner`` (this process, a local dask cluster or a running one), which keeps finished work in its store."""
         ...
 
     def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:

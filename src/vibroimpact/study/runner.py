@@ -1,40 +1,53 @@
-"""Run simulation cases in processes: progress that advances inside each case, a resumable cache, a clean interrupt.
+"""Run a study's work on dask.distributed (or in this process), with a progress bar, a resumable store and a clean
+interrupt.
 
-A *case* is a picklable piece of work with a stable key (:class:`Case`). Each finished case is saved to the cache
-folder (written atomically), so an interrupted study picks up where it stopped; the key includes a hash of the
-package's source, so results of other code are never reused. Workers ignore Ctrl-C: the main process alone
-receives it, stops the workers and raises :class:`KeyboardInterrupt` with every finished case kept.
+Two kinds of work go through a :class:`Runner`:
+
+* *cases* (:class:`Case`): picklable pieces of work with a stable key, e.g. one engine at one stop over 16
+  frequencies (:meth:`Runner.map`). Consecutive cases are batched into one dask task, so that the scheduler's cost
+  per task (~2 ms) stays a small share of the task's work; each finished case is kept in the store;
+* *tasks* over shared data (:meth:`Runner.run_tasks`): e.g. the blocks of a stepped study's grid, each written by
+  the caller into the store as it arrives.
+
+``jobs = 1`` without a scheduler runs everything here, in order; otherwise a local cluster of ``jobs`` worker
+processes starts on first use (:mod:`vibroimpact.study.cluster`), or the named scheduler's workers run it. A task on
+a worker that dies is run again by the scheduler on another one; a task that raises ends the study. Workers send
+their progress through the scheduler's event log, so the bar advances inside long tasks.
 """
 
 from __future__ import annotations
 
-import multiprocessing
-import queue
-import signal
-import sys
+import threading
 import time
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from pathlib import Path
-from typing import Callable, Protocol, Sequence
+import uuid
+from concurrent.futures import CancelledError
+from typing import Any, Callable, Protocol, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.study.io import atomic_path
+from vibroimpact.study.cluster import ClusterLost, Connection, connect
+from vibroimpact.study.progress import ProgressBar, ProgressReport, Throttled
+from vibroimpact.study.store import StudyStore
 
-__all__ = ["Case", "CaseResult", "ProgressReport", "run_cases", "cached_case_count"]
+__all__ = ["Case", "CaseResult", "ProgressReport", "Runner", "TaskFunction", "MAX_CASES_PER_TASK"]
 
 CaseResult = dict[str, NDArray[np.generic]]
-#: Called by a running case with the work it has done so far, in its ``progress_unit`` (0 ... ``progress_total``).
-ProgressReport = Callable[[float], None]
-#: Shortest interval between two progress messages of one worker [s].
-REPORT_INTERVAL = 0.25
-#: How often the main process looks at the workers' progress messages [s].
+#: What a task runs on a worker: ``function(shared, item, report)`` -> its result.
+TaskFunction = Callable[[Any, Any, ProgressReport], Any]
+#: Most cases batched into one task (batching keeps the scheduler's cost per task small; more tasks share the work
+#: between workers more evenly).
+MAX_CASES_PER_TASK = 8
+#: Tasks per worker a batch count aims at (load balance: the last tasks do not leave workers idle for long).
+TASKS_PER_WORKER = 4
+#: Tasks in flight per worker: enough to keep every worker busy, few enough that the scheduler holds little.
+IN_FLIGHT_PER_WORKER = 3
+#: How often the main process looks at finished tasks and at the scheduler [s].
 POLL_INTERVAL = 0.2
 
 
 class Case(Protocol):
-    """What :func:`run_cases` runs."""
+    """What :meth:`Runner.map` runs."""
 
     engine: str
     fields: tuple[str, ...]
@@ -52,166 +65,240 @@ class Case(Protocol):
     def run(self, report: ProgressReport | None = None) -> CaseResult: ...
 
 
-def run_cases(cases: Sequence[Case], jobs: int = 1, cache_dir: Path | None = None, progress: bool = True) -> list[CaseResult]:
-    """Run cases serially (``jobs = 1``) or in ``jobs`` processes, reusing and filling ``cache_dir``.
+class Runner:
+    """Where a study's cases and tasks run, and where finished work is kept.
 
-    Progress (work done, elapsed, estimated remaining) goes to stderr and advances while cases run.
-
-    Raises
-    ------
-    KeyboardInterrupt
-        On Ctrl-C, after the workers are stopped; finished cases stay in ``cache_dir``.
+    Parameters
+    ----------
+    jobs : int
+        Worker processes of the local cluster; 1: this process alone (unless ``scheduler`` is given).
+    scheduler : str or None
+        Address of a running dask scheduler (``tcp://host:8786``); None: local.
+    store : StudyStore or None
+        Where finished cases are kept (and read back by a rerun); None: nowhere.
+    progress : bool
+        Show the progress bar on stderr.
+    report : callable or None
+        Receives the work done so far by this runner, summed over its cases (a runner inside a worker task passes its
+        progress on to the task's own report).
     """
-    results: list[CaseResult | None] = [_load(cache_dir, case) if cache_dir is not None else None for case in cases]
-    pending = [index for index, result in enumerate(results) if result is None]
-    unit = cases[0].progress_unit if cases else "points"
-    bar = _Progress([case.progress_total for case in cases], [index for index in range(len(cases)) if results[index] is not None], unit, progress)
 
-    def finish(index: int, result: CaseResult) -> None:
-        results[index] = result
-        if cache_dir is not None:
-            _save(cache_dir, cases[index], result)
-        bar.finish(index)
+    def __init__(self, jobs: int = 1, scheduler: str | None = None, store: StudyStore | None = None, progress: bool = True, report: ProgressReport | None = None) -> None:
+        self.jobs = jobs
+        self.scheduler = scheduler
+        self.store = store
+        self.progress = progress and report is None
+        self.report = report
+        self._offset = 0.0
+        self._connection: Connection | None = None
+        #: The largest resident memory of one worker process [bytes], read when the connection closes (0: none ran).
+        self.worker_peak_memory = 0
 
-    try:
-        if jobs <= 1 or len(pending) <= 1:
-            for index in pending:
-                finish(index, cases[index].run(_Throttled(lambda done, index=index: bar.partial(index, done))))
-        else:
-            _run_in_processes(cases, pending, jobs, bar, finish)
-    finally:
-        bar.close()
-    finished = [r for r in results if r is not None]
-    if len(finished) != len(cases):  # cannot happen: every case either came from the cache or was run
-        raise RuntimeError(f"{len(cases) - len(finished)} simulation cases have no result")
-    return finished
+    @property
+    def distributed(self) -> bool:
+        """Whether work goes to dask workers (not run here)."""
+        return self.scheduler is not None or self.jobs > 1
 
+    @property
+    def connection(self) -> Connection:
+        """The dask connection, started on first use."""
+        if self._connection is None:
+            self._connection = connect(self.jobs, self.scheduler)
+        return self._connection
 
-def cached_case_count(cache_dir: Path) -> int:
-    """Finished cases kept in ``cache_dir`` (not counting a temporary file being written, whose name starts with a dot)."""
-    return sum(1 for path in cache_dir.glob("*.npz") if not path.name.startswith(".")) if cache_dir.is_dir() else 0
-
-
-def _run_in_processes(cases: Sequence[Case], pending: list[int], jobs: int, bar: "_Progress", finish: Callable[[int, CaseResult], None]) -> None:
-    context = multiprocessing.get_context()
-    messages = context.Queue()
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=context, initializer=_start_worker, initargs=(messages,))
-    try:
-        futures: dict[Future[CaseResult], int] = {pool.submit(_run_in_worker, index, cases[index]): index for index in pending}
-        waiting = set(futures)
-        while waiting:
-            done, waiting = wait(waiting, timeout=POLL_INTERVAL, return_when=FIRST_COMPLETED)
-            _drain(messages, bar)
-            for future in done:
-                finish(futures[future], future.result())
-    except BaseException:
-        # Ctrl-C or a failed case: stop the workers now instead of letting them finish their cases
-        for process in list(getattr(pool, "_processes", {}).values()):
-            process.terminate()
-        pool.shutdown(wait=False, cancel_futures=True)
-        raise
-    else:
-        pool.shutdown()
-    finally:
-        messages.close()
-        messages.cancel_join_thread()
-
-
-def _drain(messages: "multiprocessing.Queue[tuple[int, float]]", bar: "_Progress") -> None:
-    while True:
-        try:
-            index, done = messages.get_nowait()
-        except queue.Empty:
-            return
-        bar.partial(index, done)
-
-
-_worker_messages: "multiprocessing.Queue[tuple[int, float]] | None" = None
-
-
-def _start_worker(messages: "multiprocessing.Queue[tuple[int, float]]") -> None:
-    """Worker set-up: Ctrl-C is the main process's to handle; progress goes to ``messages``."""
-    global _worker_messages
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _worker_messages = messages
-
-
-def _run_in_worker(index: int, case: Case) -> CaseResult:
-    messages = _worker_messages
-    report = _Throttled(lambda done: messages.put((index, done))) if messages is not None else None
-    return case.run(report)
-
-
-class _Throttled:
-    """Passes a progress value on at most every :data:`REPORT_INTERVAL` seconds."""
-
-    def __init__(self, send: ProgressReport) -> None:
-        self.send, self.last = send, -np.inf
-
-    def __call__(self, done: float) -> None:
-        now = time.monotonic()
-        if now - self.last >= REPORT_INTERVAL:
-            self.last = now
-            self.send(done)
-
-
-class _Progress:
-    """A one-line progress bar on stderr (a line per 10 % when stderr is not a terminal)."""
-
-    def __init__(self, totals: list[float], finished: list[int], unit: str, enabled: bool) -> None:
-        self.totals = totals
-        self.total = max(sum(totals), 1e-300)
-        self.done = {index: totals[index] for index in finished}
-        self.unit = unit
-        self.enabled = enabled and sum(totals) > 0
-        self.started = time.perf_counter()
-        self.first_done = sum(self.done.values())
-        self.tty = sys.stderr.isatty()
-        self.last_decile = -1
-        self._show()
-
-    def partial(self, index: int, done: float) -> None:
-        self.done[index] = min(max(done, 0.0), self.totals[index])
-        self._show()
-
-    def finish(self, index: int) -> None:
-        self.partial(index, self.totals[index])
-
-    def _show(self) -> None:
-        if not self.enabled:
-            return
-        done = sum(self.done.values())
-        fraction = min(done / self.total, 1.0)
-        elapsed = time.perf_counter() - self.started
-        rate = (done - self.first_done) / elapsed if elapsed > 0 and done > self.first_done else 0.0
-        remaining = f"{(self.total - done) / rate:.0f} s left" if rate > 0 else "..."
-        filled = int(30 * fraction)
-        line = f"simulating [{'#' * filled}{'.' * (30 - filled)}] {done:.0f}/{self.total:.0f} {self.unit}, {elapsed:.0f} s, {remaining}"
-        if self.tty:
-            print("\r" + line + "  ", end="", file=sys.stderr, flush=True)
-        elif int(10 * fraction) > self.last_decile:
-            self.last_decile = int(10 * fraction)
-            print(line, file=sys.stderr, flush=True)
+    @property
+    def workers(self) -> int:
+        """Workers the work is shared between (``jobs`` for a local cluster, the scheduler's worker threads now)."""
+        if self.scheduler is None:
+            return self.jobs
+        return self.connection.workers
 
     def close(self) -> None:
-        if self.enabled and self.tty:
-            print(file=sys.stderr, flush=True)
+        """Close the dask connection (a local cluster's workers stop)."""
+        if self._connection is not None:
+            connection, self._connection = self._connection, None
+            try:
+                if connection.client.status == "running":  # type: ignore[attr-defined]
+                    peaks = connection.client.run(_peak_memory, wait=True)  # type: ignore[attr-defined]
+                    self.worker_peak_memory = max(peaks.values(), default=0)
+            except (OSError, TimeoutError, ValueError):
+                pass  # a lost scheduler: nothing to read
+            finally:
+                connection.close()
+
+    def __enter__(self) -> "Runner":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # -- cases -------------------------------------------------------------------------------------------------
+
+    def map(self, cases: Sequence[Case]) -> list[CaseResult]:
+        """The results of ``cases`` in their order: taken from the store where finished before, else run (and stored).
+
+        Raises
+        ------
+        KeyboardInterrupt
+            On Ctrl-C, after the running tasks are cancelled; finished cases stay in the store.
+        ClusterLost
+            When the dask scheduler goes away.
+        """
+        names = [f"{case.engine}-{case.key()}" for case in cases] if self.store is not None else []
+        results: list[CaseResult | None] = [None] * len(cases)
+        if self.store is not None:
+            results = [self.store.load_case(name, case.fields) for name, case in zip(names, cases)]
+        pending = [index for index, result in enumerate(results) if result is None]
+
+        def keep(index: int, result: CaseResult) -> None:
+            results[index] = result
+            if self.store is not None:
+                self.store.save_case(names[index], result)
+
+        unit = cases[0].progress_unit if cases else "points"
+        if not self.distributed or len(pending) <= 1:
+            self._run_here(cases, pending, [i for i in range(len(cases)) if results[i] is not None], unit, keep)
+        else:
+            per_task = max(1, min(MAX_CASES_PER_TASK, len(pending) // (TASKS_PER_WORKER * self.workers)))
+            batches = [pending[first : first + per_task] for first in range(0, len(pending), per_task)]
+            totals = [sum(cases[i].progress_total for i in batch) for batch in batches]
+
+            def finished(task: int, outputs: list[CaseResult]) -> None:
+                for index, result in zip(batches[task], outputs):
+                    keep(index, result)
+
+            items = [[cases[i] for i in batch] for batch in batches]
+            done_before = sum(cases[i].progress_total for i in range(len(cases)) if results[i] is not None)
+            self.run_tasks(_run_cases, None, items, totals, unit, finished, done_before=done_before)
+        finished_results = [result for result in results if result is not None]
+        if len(finished_results) != len(cases):  # cannot happen: every case either came from the store or was run
+            raise RuntimeError(f"{len(cases) - len(finished_results)} simulation cases have no result")
+        return finished_results
+
+    def _run_here(self, cases: Sequence[Case], pending: list[int], finished: list[int], unit: str, keep: Callable[[int, CaseResult], None]) -> None:
+        bar = ProgressBar([case.progress_total for case in cases], finished, unit, self.progress)
+        try:
+            for index in pending:
+                offset = self._offset
+
+                def report(done: float, index: int = index, offset: float = offset) -> None:
+                    bar.partial(index, done)
+                    if self.report is not None:
+                        self.report(offset + done)
+
+                keep(index, cases[index].run(Throttled(report)))
+                bar.finish(index)
+                self._offset += cases[index].progress_total
+        finally:
+            bar.close()
+
+    # -- tasks -------------------------------------------------------------------------------------------------
+
+    def run_tasks(self, function: TaskFunction, shared: Any, items: Sequence[Any], totals: Sequence[float], unit: str, finished: Callable[[int, Any], None], skip: Sequence[int] = (), verb: str = "simulating", done_before: float = 0.0) -> None:
+        """Run ``function(shared, item, report)`` for every item not in ``skip`` and pass each result to
+        ``finished(index, result)`` in this process, as it arrives.
+
+        ``totals`` are the items' work in ``unit`` (the progress bar's); ``shared`` goes to the workers once.
+        ``done_before``: work already done elsewhere (shown as done by the bar).
+        """
+        skipped = set(skip)
+        order = [index for index in range(len(items)) if index not in skipped]
+        bar_totals = [*totals, done_before]
+        bar = ProgressBar(bar_totals, [*skipped, len(items)], unit, self.progress, verb)
+        try:
+            if not self.distributed:
+                for index in order:
+                    finished(index, function(shared, items[index], Throttled(lambda done, index=index: bar.partial(index, done))))
+                    bar.finish(index)
+            else:
+                self._run_distributed(function, shared, items, order, bar, finished)
+        finally:
+            bar.close()
+
+    def _run_distributed(self, function: TaskFunction, shared: Any, items: Sequence[Any], order: list[int], bar: ProgressBar, finished: Callable[[int, Any], None]) -> None:
+        connection = self.connection
+        client: Any = connection.client
+        token = uuid.uuid4().hex[:12]
+        topic = f"vibroimpact-progress-{token}"
+        client.subscribe_topic(topic, lambda event: bar.partial(*event[1]))
+        shared_data = client.scatter(shared, broadcast=True, hash=False) if shared is not None else None
+        queue = iter(order)
+        limit = IN_FLIGHT_PER_WORKER * max(self.workers, 1)
+        running: dict[Any, int] = {}
+        arrived = threading.Event()
+
+        def submit() -> None:
+            index = next(queue, None)
+            if index is not None:
+                future = client.submit(_task, function, shared_data, items[index], topic, index, key=f"vibroimpact-{token}-{index}", pure=False)
+                running[future] = index
+                future.add_done_callback(lambda _future: arrived.set())
+
+        try:
+            for _ in range(limit):
+                submit()
+            while running:
+                if not arrived.wait(POLL_INTERVAL):
+                    _check(client, connection.address)
+                    continue
+                arrived.clear()
+                done = [future for future in running if future.done()]
+                for future in done:
+                    index = running.pop(future)
+                    try:
+                        result = future.result()
+                    except CancelledError:
+                        _check(client, connection.address)
+                        raise ClusterLost(f"the dask scheduler at {connection.address} cancelled a task") from None
+                    finished(index, result)
+                    bar.finish(index)
+                    submit()
+        except BaseException:
+            # Ctrl-C, a failed task or a lost scheduler: nothing more runs for this study
+            if client.status == "running":
+                client.cancel(list(running), force=True)
+            raise
+        finally:
+            if client.status == "running":
+                client.unsubscribe_topic(topic)
 
 
-def _cache_path(cache_dir: Path, case: Case) -> Path:
-    return cache_dir / f"{case.engine}-{case.key()}.npz"
+def _peak_memory() -> int:
+    """Run on a worker: its process's largest resident memory so far [bytes]."""
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
-def _load(cache_dir: Path, case: Case) -> CaseResult | None:
-    path = _cache_path(cache_dir, case)
-    if not path.is_file():
-        return None
-    with np.load(path) as stored:
-        if not set(case.fields) <= set(stored.files):
-            return None  # written by an older version: run the case again
-        return {name: stored[name] for name in case.fields}
+def _check(client: Any, address: str) -> None:
+    """Raise :class:`ClusterLost` when the client has lost its scheduler."""
+    if client.status not in ("running", "connecting", "newly-created"):
+        raise ClusterLost(f"lost the dask scheduler at {address} (client {client.status})")
+    if client.status == "connecting":
+        raise ClusterLost(f"lost the dask scheduler at {address} (reconnecting)")
 
 
-def _save(cache_dir: Path, case: Case, result: CaseResult) -> None:
-    with atomic_path(_cache_path(cache_dir, case), suffix=".npz") as temporary:
-        np.savez(temporary, **result)  # type: ignore[arg-type]
+def _task(function: TaskFunction, shared: Any, item: Any, topic: str, index: int) -> Any:
+    """Run on a worker: ``function`` with a report that sends the task's progress to the scheduler's event log."""
+    from distributed import get_worker
+
+    worker = get_worker()
+    last = [0.0]
+
+    def send(done: float) -> None:
+        now = time.monotonic()
+        if now - last[0] >= 0.25:
+            last[0] = now
+            worker.log_event(topic, (index, done))
+
+    return function(shared, item, send)
+
+
+def _run_cases(_shared: Any, cases: list[Case], report: ProgressReport) -> list[CaseResult]:
+    """A batch of cases, one after the other, reporting their summed progress."""
+    results = []
+    offset = 0.0
+    for case in cases:
+        results.append(case.run(lambda done, offset=offset: report(offset + done)))
+        offset += case.progress_total
+    return results

@@ -5,7 +5,6 @@ bumper_frequency, sweep, frequency), or along the axes it depends on, broadcast 
 from __future__ import annotations
 
 import functools
-from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -20,7 +19,7 @@ from vibroimpact.scene.schema import MOTION_QUANTITIES, Scene
 from vibroimpact.scene.variables import STABLE_MARGINAL
 from vibroimpact.simulation.settings import SWEEP_STARTS
 from vibroimpact.study.cases import FIELDS, SimulationCase
-from vibroimpact.study.runner import run_cases
+from vibroimpact.study.runner import Runner
 
 __all__ = ["linear_values", "pgf_values", "peak_estimates", "no_one_impact_orbit", "simulated_values", "MARGINAL_MODULUS", "CASE_CHUNK"]
 
@@ -172,7 +171,7 @@ def simulated_regime(fields: dict[str, np.ndarray], one_impact_orbit: np.ndarray
     return regime
 
 
-def simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], jobs: int, cache_dir: Path | None, progress: bool) -> dict[str, np.ndarray]:
+def simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], runner: Runner) -> dict[str, np.ndarray]:
     """Steady states of a time-domain engine on the simulation grid; NaN at the other frequencies.
 
     Only a bumper engine (``compliant``) depends on the bumper: the rigid engines run once per (restitution, clearance).
@@ -196,7 +195,7 @@ def simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], jobs: in
                     case = SimulationCase(engine, scene.system, scene.amplitude, contact, frequencies, sim.start, sim.engine, sim.steady, None if contact is stop else stop)
                     cases.append(case)
                     places.append((i, j, k, columns[first : first + chunk]))
-    results = run_cases(cases, jobs=jobs, cache_dir=cache_dir, progress=progress)
+    results = runner.map(cases)
     grid = (shape[0], shape[1], bumpers.size, 1, shape[4])
     fields = {name: np.full(grid, np.nan, dtype=complex if name in ("x1", "x2", "suspension_force", "contact_force") else float) for name in FIELDS}
     for (i, j, k, where), result in zip(places, results):

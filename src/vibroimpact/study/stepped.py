@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from dataclasses import asdict
-from pathlib import Path
 
 import numpy as np
 import xarray as xr
@@ -17,10 +16,12 @@ from vibroimpact.simulation.settings import SWEEP_STARTS
 from vibroimpact.study.cost_model import Costs, EnginePart, Estimate, grid_estimate
 from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates, solve_each, steady_variable
 from vibroimpact.study.general_estimate import closed_form_scale, engine_scale, general_orbit_outlook
-from vibroimpact.study.general_stepped import run_general
+from vibroimpact.study.blocks import run_grid
+from vibroimpact.study.general_stepped import describe_stops, general_block, general_coordinates
+from vibroimpact.study.runner import Runner
 from vibroimpact.study.solutions import simulated_values
 
-__all__ = ["SteppedStudy", "expected_periods", "SETTLING_PERIODS", "SHOOTING_PERIODS", "ESTIMATE_POINTS"]
+__all__ = ["SteppedStudy", "paper_block", "expected_periods", "SETTLING_PERIODS", "SHOOTING_PERIODS", "ESTIMATE_POINTS"]
 
 #: Periods of a transient that settles on a stable orbit (two convergence chunks), before the measurement.
 SETTLING_PERIODS = 40
@@ -36,20 +37,20 @@ class SteppedStudy:
 
     name = "stepped"
 
-    def run(self, scene: Scene, progress: Progress | None, jobs: int, cache_dir: Path | None) -> xr.Dataset:
-        """Every solution of ``scene`` over its grid (see :func:`vibroimpact.study.run.run_study`)."""
-        if scene.general:
-            return run_general(scene, progress, jobs, cache_dir, self.simulation_attributes(scene))
+    def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
+        """Every solution of ``scene`` over its grid (see :func:`vibroimpact.study.run.run_study`), solved block by
+        block (:mod:`vibroimpact.study.blocks`); the variables are read lazily from the runner's store."""
+        say = progress or (lambda _message: None)
         grid = StudyGrid.of(scene)
-        per_solution = solve_each(scene, grid, lambda name: simulated_values(scene, name, grid.full, jobs, cache_dir, progress is not None), progress)
         solutions = list(scene.solutions)
-        coords = grid_coordinates(scene, grid, solutions)
-        data_vars = {}
-        for quantity in scene.quantities:
-            stacked = steady_variable(quantity, scene, grid, per_solution, solutions)
-            if stacked is not None:
-                data_vars[quantity] = xr.Variable(("solution", *GRID_DIMS), stacked, quantity_attributes(quantity))
-        dataset = xr.Dataset(data_vars, coords=coords)
+        if scene.general:
+            coords = general_coordinates(scene, grid)
+            raw = run_grid(scene, runner, general_block, {"solution": len(solutions), "stop": len(scene.stop_specs)})
+            dataset = describe_stops(raw.assign_coords(coords))
+        else:
+            coords = grid_coordinates(scene, grid, solutions)
+            dataset = run_grid(scene, runner, paper_block, {"solution": len(solutions)}).assign_coords(coords)
+        say(f"{', '.join(solutions)}: done")
         return finish_dataset(dataset, scene, coords, self.simulation_attributes(scene))
 
     @staticmethod
@@ -91,6 +92,18 @@ class SteppedStudy:
             return seconds, points, serial
 
         return grid_estimate(scene, jobs, costs, engine_part, report_figures(scene), closed_form_scale=lambda name: closed_form_scale(scene, name))
+
+
+def paper_block(scene: Scene, runner: Runner) -> xr.Dataset:
+    """Every solution of a paper scene (or of a block of one) over its unsqueezed grid, without the dataset's metadata."""
+    grid = StudyGrid.of(scene)
+    per_solution = solve_each(scene, grid, lambda name: simulated_values(scene, name, grid.full, runner), None)
+    data_vars = {}
+    for quantity in scene.quantities:
+        stacked = steady_variable(quantity, scene, grid, per_solution, list(scene.solutions))
+        if stacked is not None:
+            data_vars[quantity] = xr.Variable(("solution", *GRID_DIMS), stacked, quantity_attributes(quantity))
+    return xr.Dataset(data_vars)
 
 
 def report_figures(scene: Scene) -> int:

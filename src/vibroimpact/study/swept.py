@@ -8,7 +8,6 @@ elapsed_time) and their costs ``sweep_<statistic>`` (sweep).
 from __future__ import annotations
 
 from dataclasses import asdict
-from pathlib import Path
 
 import numpy as np
 import xarray as xr
@@ -19,7 +18,7 @@ from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, MOTION_QUANTIT
 from vibroimpact.scene.variables import SWEEP_STAT_ATTRIBUTES, SWEEP_TIME_ATTRIBUTES, quantity_attributes, running_attributes, swept_attributes
 from vibroimpact.study.cost_model import Costs, EnginePart, Estimate, grid_estimate
 from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates, solve_each, steady_variable
-from vibroimpact.study.runner import run_cases
+from vibroimpact.study.runner import Runner
 from vibroimpact.study.solutions import no_one_impact_orbit
 from vibroimpact.simulation.swept import SWEEP_QUANTITIES
 from vibroimpact.study.swept_cases import SWEEP_STATS, SweepCase
@@ -35,14 +34,14 @@ class SweptStudy:
 
     name = "swept"
 
-    def run(self, scene: Scene, progress: Progress | None, jobs: int, cache_dir: Path | None) -> xr.Dataset:
+    def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """Every solution of ``scene`` over its grid (see :func:`vibroimpact.study.run.run_study`)."""
         grid = StudyGrid.of(scene)
         running: dict[str, np.ndarray] = {}
         sweep_axes: dict[str, np.ndarray] = {}
 
         def simulate(name: str) -> dict[str, np.ndarray]:
-            values, sweep_running, axes = swept_values(scene, grid.full, jobs, cache_dir, progress is not None)
+            values, sweep_running, axes = swept_values(scene, grid.full, runner)
             running.update(sweep_running)
             sweep_axes.update(axes)
             return values
@@ -108,7 +107,7 @@ class SweptStudy:
         return grid_estimate(scene, jobs, costs, engine_part, REPORT_FIGURES, samples)
 
 
-def swept_values(scene: Scene, shape: tuple[int, ...], jobs: int, cache_dir: Path | None, progress: bool) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray], dict[str, np.ndarray]]:
+def swept_values(scene: Scene, shape: tuple[int, ...], runner: Runner) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray], dict[str, np.ndarray]]:
     """Swept-sine tests of the compliant model: estimates on the frequency grid, running estimates against time, and
     the time axes (``time``, ``instantaneous_frequency`` per direction)."""
     assert scene.swept_sine is not None and scene.bumper_frequency is not None and scene.simulation is not None
@@ -121,7 +120,7 @@ def swept_values(scene: Scene, shape: tuple[int, ...], jobs: int, cache_dir: Pat
                 for d, direction in enumerate(scene.swept_sine.directions):
                     cases.append(SweepCase(scene.system, scene.amplitude, KelvinVoigtBumper(float(clearance), float(bumper), float(losses[i])), scene.swept_sine, direction, scene.simulation.engine, frequencies))
                     places.append((i, j, k, d))
-    results = run_cases(cases, jobs=jobs, cache_dir=cache_dir, progress=progress)
+    results = runner.map(cases)
     times = results[0]["time"]
     values = {name: np.full(shape, np.nan) for name in SWEEP_QUANTITIES}
     running = {f"running_{name}": np.full((*shape[:-1], times.size), np.nan) for name in SWEEP_QUANTITIES}

@@ -9,7 +9,6 @@ orbits; :mod:`.validation_runs`: simulated runs) and writes ``<name>.nc``: a tab
 from __future__ import annotations
 
 from collections.abc import Callable
-from pathlib import Path
 from types import MappingProxyType
 
 import xarray as xr
@@ -17,6 +16,7 @@ import xarray as xr
 from vibroimpact.scene.validation_settings import ValidationSettings
 from vibroimpact.study.cost_model import Costs, Estimate
 from vibroimpact.study.io import provenance
+from vibroimpact.study.runner import Runner
 from vibroimpact.study.validation_checks import CaseOutcome, outcome_dataset
 from vibroimpact.study.validation_orbits import run_bouncing_ball, run_budd_dux, run_grazing
 from vibroimpact.study.validation_runs import run_relative_stop, run_zeno
@@ -56,7 +56,7 @@ class ValidationStudy:
 
     name = "validation"
 
-    def run(self, scene, progress: Callable[[str], None] | None, jobs: int, cache_dir: Path | None) -> xr.Dataset:
+    def run(self, scene, progress: Callable[[str], None] | None, runner: Runner) -> xr.Dataset:
         """The scene's dataset (module docstring); one process (each case takes seconds)."""
         return run_validation(scene.validation, scene.name, scene.text, progress)
 

@@ -1,0 +1,91 @@
+"""Where a study's work runs: this process, a local dask cluster of worker processes, or a running dask cluster.
+
+Which scheduler, first found wins: ``run-study --scheduler ADDRESS``, the environment variable
+``VIBROIMPACT_SCHEDULER``, the scene's ``cluster: {scheduler: ADDRESS}``; none: a local cluster of ``--jobs`` worker
+processes (one thread each), or this process alone for ``--jobs 1``.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import threading
+from dataclasses import dataclass
+
+__all__ = ["SCHEDULER_VARIABLE", "ClusterLost", "Connection", "choose_scheduler", "connect", "dask_setup"]
+
+#: The environment variable naming a running scheduler (``tcp://host:8786``).
+SCHEDULER_VARIABLE = "VIBROIMPACT_SCHEDULER"
+#: How long connecting to a named scheduler may take before the study gives up [s].
+CONNECT_TIMEOUT = 30.0
+
+
+class ClusterLost(RuntimeError):
+    """The dask scheduler went away (or could not be reached) while a study ran."""
+
+
+def choose_scheduler(option: str | None, scene_scheduler: str | None) -> str | None:
+    """The scheduler address to use: the command line's, the environment's, the scene's, or None (local)."""
+    for candidate in (option, os.environ.get(SCHEDULER_VARIABLE), scene_scheduler):
+        if candidate:
+            return candidate
+    return None
+
+
+@dataclass
+class Connection:
+    """A dask client and, for a local cluster, the cluster it started (closed with it)."""
+
+    client: object
+    cluster: object | None
+    address: str
+
+    @property
+    def workers(self) -> int:
+        """Worker threads the scheduler knows of now (at least 1)."""
+        info = self.client.scheduler_info(n_workers=-1)  # type: ignore[attr-defined]
+        return max(1, sum(int(worker.get("nthreads", 1)) for worker in info.get("workers", {}).values()))
+
+    def close(self) -> None:
+        """Close the client, and the local cluster if this connection started one (its workers stop)."""
+        try:
+            self.client.close(timeout=10)  # type: ignore[attr-defined]
+        finally:
+            if self.cluster is not None:
+                self.cluster.close(timeout=10)  # type: ignore[attr-defined]
+
+
+def connect(jobs: int, scheduler: str | None) -> Connection:
+    """Start a local cluster of ``jobs`` worker processes, or connect to ``scheduler``.
+
+    Raises
+    ------
+    ClusterLost
+        When the named scheduler cannot be reached within :data:`CONNECT_TIMEOUT`.
+    """
+    from distributed import Client, LocalCluster
+
+    if scheduler is None:
+        # Ctrl-C is the study's to handle: the worker processes ignore SIGINT from their start (an ignored signal
+        # stays ignored in a child process) and after a restart (the preload)
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if threading.current_thread() is threading.main_thread() else None
+        try:
+            cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR, preload=[__name__])
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGINT, previous)
+        client = Client(cluster, set_as_default=False)
+        return Connection(client, cluster, cluster.scheduler_address)
+    try:
+        client = Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
+    except (OSError, TimeoutError) as error:
+        raise ClusterLost(f"cannot reach the dask scheduler at {scheduler}: {error}") from None
+    return Connection(client, None, scheduler)
+
+
+def dask_setup(worker: object) -> None:
+    """Preload of a local cluster's workers (dask calls it in each worker process): ignore Ctrl-C, which the study
+    handles."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)

@@ -1,0 +1,218 @@
+"""The study's chunked store (zarr): finished grid blocks and finished cases, written as they arrive, read back by a
+rerun so that nothing finished is computed twice.
+
+Layout of ``<out>/<name>.zarr`` (zarr format 2, which every zarr reader opens; format 3 has no specification yet for
+the fixed-width strings that some results hold):
+
+* the grid variables of a stepped study, with the grid's full dimensions (``solution``, ``restitution``,
+  ``clearance``, ``bumper_frequency``, ``sweep``, ``frequency``, and ``stop`` where a variable has one), chunked like
+  the grid's blocks, and ``block_done`` (one flag per block, set after every variable of the block is written, so a
+  block cut off half-way is computed again);
+* the group ``cases``: one group per finished case (``<engine>-<key>``), one array per result field, marked complete
+  after its arrays;
+* the attribute ``fingerprint``: the scene's text, the package version and its source; a store of another scene or
+  other code is started afresh rather than mixed.
+
+Only the process that runs the study writes the store (workers return their results to it), so a cluster needs no
+shared file system. :func:`claim_output` keeps a second study off the same output.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import socket
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+import zarr
+from numpy.typing import NDArray
+
+from vibroimpact import __version__
+from vibroimpact.study.fingerprint import source_hash
+
+__all__ = ["StudyStore", "OutputBusy", "claim_output", "store_fingerprint", "ZARR_FORMAT"]
+
+ZARR_FORMAT = 2
+_CASES = "cases"
+_BLOCK_DONE = "block_done"
+#: Attributes whose values must keep the variable's own type (CF: flag_values of an int8 flag are int8).
+_TYPED_ATTRIBUTES = ("flag_values", "flag_masks", "valid_min", "valid_max", "valid_range")
+
+
+class OutputBusy(RuntimeError):
+    """Another study is writing the same output folder."""
+
+
+def store_fingerprint(scene_text: str) -> str:
+    """What a store's results depend on: the scene's text, the package version and the package's source."""
+    return hashlib.sha256(f"{__version__}\0{source_hash()}\0{scene_text}".encode()).hexdigest()[:24]
+
+
+@contextmanager
+def claim_output(out_dir: Path) -> Iterator[Path]:
+    """Hold ``out_dir/.run-study.lock`` while a study writes there.
+
+    Raises
+    ------
+    OutputBusy
+        When a live ``run-study`` holds it (its process id, host and start time are named). A lock left by a process
+        of this host that no longer exists is taken over.
+    """
+    lock = out_dir / ".run-study.lock"
+    host = socket.gethostname()
+    for _attempt in range(2):
+        try:
+            handle = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+        except FileExistsError:
+            owner = _lock_owner(lock)
+            if owner is not None and owner[1] == host and not _alive(owner[0]):
+                lock.unlink(missing_ok=True)  # left by a run that was killed: take it over
+                continue
+            who = f"process {owner[0]} on {owner[1]}, since {owner[2]}" if owner else "another run"
+            raise OutputBusy(f"{out_dir} is being written by another run-study ({who}); wait for it to finish or choose another --out (a stale lock: delete {lock})") from None
+        with os.fdopen(handle, "w") as file:
+            file.write(f"{os.getpid()} {host} {time.strftime('%Y-%m-%dT%H:%M:%S')}\n")
+        break
+    try:
+        yield lock
+    finally:
+        lock.unlink(missing_ok=True)
+
+
+def _lock_owner(lock: Path) -> tuple[int, str, str] | None:
+    try:
+        pid, host, since = lock.read_text().split()
+        return int(pid), host, since
+    except (OSError, ValueError):
+        return None
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+class StudyStore:
+    """A zarr store of a study's finished work (module docstring); ``path=None`` keeps it in memory.
+
+    Parameters
+    ----------
+    path : Path or None
+        The store's folder (``<out>/<name>.zarr``), or None for an in-memory store (a study run from Python).
+    fingerprint : str
+        :func:`store_fingerprint` of the scene; a folder holding another fingerprint is emptied first.
+    """
+
+    def __init__(self, path: Path | None, fingerprint: str) -> None:
+        self.path = path
+        self.fingerprint = fingerprint
+        self.store: Any = str(path) if path is not None else zarr.storage.MemoryStore()
+        if path is not None and path.exists() and not self._matches():
+            shutil.rmtree(path)  # another scene or other code: its results are not ours
+        self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT)
+        if "fingerprint" not in self.root.attrs:
+            self.root.attrs["fingerprint"] = fingerprint
+        self._grid_ready = _BLOCK_DONE in self.root
+
+    def _matches(self) -> bool:
+        try:
+            group = zarr.open_group(str(self.path), mode="r", zarr_format=ZARR_FORMAT)
+        except (FileNotFoundError, ValueError, KeyError, zarr.errors.GroupNotFoundError):
+            return False
+        return group.attrs.get("fingerprint") == self.fingerprint
+
+    # -- cases -------------------------------------------------------------------------------------------------
+
+    def load_case(self, name: str, fields: tuple[str, ...]) -> dict[str, NDArray[np.generic]] | None:
+        """The stored result of the case called ``name``, or None if it is not (completely) stored."""
+        path = f"{_CASES}/{name}"
+        if path not in self.root:
+            return None
+        group = self.root[path]
+        if not group.attrs.get("complete") or not set(fields) <= set(group.array_keys()):
+            return None
+        return {field: np.asarray(group[field][...]) for field in fields}
+
+    def save_case(self, name: str, result: dict[str, NDArray[np.generic]]) -> None:
+        """Store a finished case's result; it counts as stored once every array is written."""
+        group = self.root.require_group(f"{_CASES}/{name}")
+        group.attrs["complete"] = False
+        for field, value in result.items():
+            array = np.asarray(value)
+            if array.dtype == object:
+                array = array.astype(str)  # text (notes, names): fixed-width strings
+            group.create_array(field, shape=array.shape, dtype=array.dtype, chunks=array.shape or None, overwrite=True)
+            group[field][...] = array
+        group.attrs["complete"] = True
+
+    def case_count(self) -> int:
+        """Finished cases in the store."""
+        if _CASES not in self.root:
+            return 0
+        return sum(1 for _name, group in self.root[_CASES].groups() if group.attrs.get("complete"))
+
+    # -- grid blocks -------------------------------------------------------------------------------------------
+
+    @property
+    def grid_ready(self) -> bool:
+        """Whether the grid's variables exist (the first finished block creates them)."""
+        return self._grid_ready
+
+    def begin_grid(self, template: xr.Dataset, block_count: int) -> None:
+        """Create the grid's variables from ``template`` (lazy arrays with the grid's dimensions and chunks; nothing
+        is computed) and ``block_done``."""
+        encoding = {name: {"_FillValue": None} for name, variable in template.data_vars.items() if variable.dtype.kind in "iub"}
+        # the dataset's attributes become the group's: the fingerprint goes with them
+        template = template.assign_attrs(fingerprint=self.fingerprint)
+        template.to_zarr(self.store, mode="a", compute=False, zarr_format=ZARR_FORMAT, encoding=encoding, consolidated=False)
+        self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT)
+        done = self.root.create_array(_BLOCK_DONE, shape=(block_count,), chunks=(1,), dtype="uint8", fill_value=0)
+        done.attrs["_ARRAY_DIMENSIONS"] = ["block"]
+        self._grid_ready = True
+
+    def finished_blocks(self) -> NDArray[np.bool_]:
+        """One flag per block: its results are stored."""
+        return np.asarray(self.root[_BLOCK_DONE][...], dtype=bool)
+
+    def write_block(self, index: int, region: dict[str, slice], block: dict[str, tuple[tuple[str, ...], NDArray[np.generic]]]) -> None:
+        """Write the variables of block ``index`` (name -> (dimensions, values)) into ``region`` (dimension ->
+        slice; unnamed dimensions whole), then flag the block done."""
+        for name, (dims, values) in block.items():
+            array = self.root[name]
+            array[tuple(region.get(dim, slice(None)) for dim in dims)] = values.astype(array.dtype, copy=False)
+        self.root[_BLOCK_DONE][index] = 1
+
+    def block_count(self) -> int:
+        """Finished blocks in the store."""
+        return int(self.finished_blocks().sum()) if self._grid_ready else 0
+
+    def grid_dataset(self) -> xr.Dataset:
+        """The grid's variables, lazily (dask arrays over the store's chunks), without ``block_done``."""
+        dataset = xr.open_zarr(self.store, consolidated=False, zarr_format=ZARR_FORMAT).drop_vars(_BLOCK_DONE)
+        dataset.attrs.pop("fingerprint", None)
+        for variable in dataset.variables.values():
+            for key in _TYPED_ATTRIBUTES:
+                if key in variable.attrs and isinstance(variable.attrs[key], list):
+                    variable.attrs[key] = np.asarray(variable.attrs[key], dtype=variable.dtype)
+        return dataset
+
+    def finished_count(self) -> int:
+        """Finished blocks and cases in the store (for the message of an interrupted run)."""
+        return self.block_count() + self.case_count()
+
+    def remove(self) -> None:
+        """Delete the store (after its results are exported)."""
+        if self.path is not None:
+            shutil.rmtree(self.path, ignore_errors=True)
