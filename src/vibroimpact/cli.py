@@ -50,6 +50,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS", help=f"run on a running dask cluster, e.g. tcp://head-node:8786 (default: ${SCHEDULER_VARIABLE}, else the scene's cluster.scheduler, else a local cluster of --jobs workers)")
     parser.add_argument("--keep-zarr", action="store_true", help="keep the chunked store DIR/<name>.zarr after the netCDF file is written (for grids too large for one netCDF file)")
     parser.add_argument("--estimate", action="store_true", help="print the predicted wall time and memory of the scene, and run nothing")
+    parser.add_argument("--workers", type=int, default=None, metavar="N", help="with --estimate: predict the wall time on N workers of a dask cluster (default: --jobs on this machine's cores)")
     parser.add_argument("--costs", type=Path, default=None, help="cost file of --estimate (default: the package's calibrated costs, see run-study calibrate)")
     parser.add_argument("--list", action="store_true", help="list the shipped studies with their descriptions, and run nothing")
     return parser
@@ -78,8 +79,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"run-study: error: --jobs {args.jobs} is out of range: allowed [1, inf)", file=sys.stderr)
         return EXIT_BAD_INPUT
     scheduler = choose_scheduler(args.scheduler, scene.cluster_scheduler)
+    if args.workers is not None and args.workers < 1:
+        print(f"run-study: error: --workers {args.workers} is out of range: allowed [1, inf)", file=sys.stderr)
+        return EXIT_BAD_INPUT
     if args.estimate:
-        return _estimate(scene, args.jobs, args.costs)
+        return _estimate(scene, args.jobs, args.costs, args.workers)
     out_dir = args.out if args.out is not None else Path("results") / scene.name
     problem = unwritable(out_dir)
     if problem is not None:
@@ -109,9 +113,12 @@ def _kept(store: StudyStore) -> str:
     return " and ".join(parts)
 
 
-def _estimate(scene: Scene, jobs: int, costs_file: Path | None) -> int:
-    """Print the predicted cost of ``scene`` (with the costs of ``costs_file``, by default the package's)."""
-    from vibroimpact.study.cost_model import Costs
+def _estimate(scene: Scene, jobs: int, costs_file: Path | None, workers: int | None = None) -> int:
+    """Print the predicted cost of ``scene`` (with the costs of ``costs_file``, by default the package's), on ``jobs``
+    local workers or ``workers`` workers of a cluster."""
+    from contextlib import nullcontext
+
+    from vibroimpact.study.cost_model import Costs, cluster_cores
     from vibroimpact.study.estimate import estimate_scene
 
     try:
@@ -120,11 +127,13 @@ def _estimate(scene: Scene, jobs: int, costs_file: Path | None) -> int:
         print(f"run-study: error: --costs {costs_file}: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
     try:
-        text = estimate_scene(scene, jobs=jobs, costs=costs).text()
+        with cluster_cores(workers) if workers is not None else nullcontext():
+            text = estimate_scene(scene, jobs=workers or jobs, costs=costs).text()
     except KeyError as error:  # a cost file without the engine the scene runs
         print(f"run-study: error: the cost file {costs_file} has no cost for {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    print(text)
+    where = f"{workers} workers of a dask cluster" if workers is not None else (f"a local cluster of {jobs} workers" if jobs > 1 else "this process")
+    print(f"{text}\n(on {where})")
     return 0
 
 

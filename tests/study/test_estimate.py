@@ -53,16 +53,21 @@ def test_costs_grow_as_tolerances_tighten() -> None:
     assert costs.per_period_cost("exact", 1e-3) == costs.per_period_cost("exact", 1e-12)
 
 
-def test_memory_estimate_grows_with_the_dataset_and_the_workers() -> None:
+def test_memory_estimate_grows_with_the_dataset_read_by_the_report_and_the_workers() -> None:
+    """A stepped study streams its blocks into the store and exports them chunk by chunk: without a report its main
+    process does not grow with the grid; the report reads the dataset whole."""
     costs = default_costs()
     scene = parse_scene(small_scene())
+    reported = parse_scene(small_scene() | {"report": True})
     one = estimate_scene(scene, jobs=1)
     dataset = run_study(scene, progress=None)
-    assert one.memory >= costs.main_process_memory + dataset.nbytes
+    assert one.memory == costs.main_process_memory  # exact: no report, no workers, blocks only
+    assert estimate_scene(reported, jobs=1).memory >= costs.main_process_memory + dataset.nbytes
     assert estimate_scene(scene, jobs=2).memory == one.memory + costs.worker_process_memory * min(2, __import__("os").cpu_count() or 1) or (__import__("os").cpu_count() or 1) == 1
     big = small_scene() | {"sweep": {"restitution": [0.1, 0.2, 0.3], "frequency": {"start": 18.0, "stop": 30.0, "step": 0.001}}}
     big["stop"] = {"clearance": 0.003}
-    assert estimate_scene(parse_scene(big), jobs=1).memory > one.memory + 2 * dataset.nbytes
+    assert estimate_scene(parse_scene(big), jobs=1).memory == one.memory  # exact: bounded, the same sum
+    assert estimate_scene(parse_scene(big | {"report": True}), jobs=1).memory > one.memory + 2 * dataset.nbytes
     assert "momentary" in one.parts and "integrated" in one.points["momentary"]
 
 

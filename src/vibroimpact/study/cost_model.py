@@ -12,7 +12,9 @@ import functools
 import json
 import math
 import os
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -21,7 +23,17 @@ import numpy as np
 from vibroimpact.engines.registry import engine_spec
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, Scene
 
-__all__ = ["COSTS_FILE", "Costs", "Estimate", "default_costs", "cost_engine", "grid_estimate", "memory", "os_cpus"]
+__all__ = ["COSTS_FILE", "Costs", "Estimate", "default_costs", "cost_engine", "grid_estimate", "memory", "os_cpus", "cluster_cores", "CLUSTER_STARTUP", "TASK_SECONDS", "WRITE_SECONDS_PER_VARIABLE"]
+
+#: Starting a local dask cluster: worker processes spawned, the package imported in each [s] (measured on the
+#: 2-core machine: 2.5-3.5 s for 2 workers).
+CLUSTER_STARTUP = 3.0
+#: The dask scheduler's cost per task, submit to result in the main process [s] (measured: 1.5-1.9 ms with 2 workers).
+TASK_SECONDS = 0.002
+#: Writing one variable of a finished block into the zarr store [s] (measured: ~1 ms per variable of 2 x 250 values).
+WRITE_SECONDS_PER_VARIABLE = 0.001
+#: Cores that an estimate spreads the work over when it is for a cluster (None: this machine's).
+_CLUSTER_CORES: ContextVar[int | None] = ContextVar("cluster_cores", default=None)
 
 #: The package's own cost file.
 COSTS_FILE = Path(__file__).with_name("costs.json")
@@ -201,12 +213,13 @@ EnginePart = tuple[float, str, float]
 
 def grid_estimate(
     scene: Scene, jobs: int, costs: Costs, engine_part: Callable[[str, str], EnginePart], figures: int, sweep_samples: float = 0.0,
-    closed_form_scale: Callable[[str], float] = lambda _name: 1.0,
+    closed_form_scale: Callable[[str], float] = lambda _name: 1.0, blocks: Callable[[int], int] | None = None,
 ) -> Estimate:  # fmt: skip
     """The estimate of a stepped or swept study on the calibration machine: the closed forms per grid point (times
     ``closed_form_scale(solution)``: a general layout's relative cost), each time-domain solution by
-    ``engine_part(solution, cost engine)``, spread over the processes, and the report's ``figures``;
-    ``sweep_samples`` output samples of one swept run held in memory per worker."""
+    ``engine_part(solution, cost engine)``, spread over the workers, and the report's ``figures``;
+    ``sweep_samples`` output samples of one swept run held in memory per worker; ``blocks(workers)``: the dask tasks
+    of a study solved in grid blocks, each costing the scheduler and the store's writes in the main process."""
     parts: dict[str, float] = {}
     points: dict[str, str] = {}
     frequency = scene.all_frequencies
@@ -229,26 +242,46 @@ def grid_estimate(
     if scene.report:
         report = costs.report_base + costs.report_per_figure * figures
         parts["report"] = report
-    wall = costs.startup + closed_form + max(simulated / min(jobs, os_cpus()), biggest_case) + report
-    return Estimate(wall_time=wall, memory=memory(scene, jobs, costs, sweep_samples), parts=parts, points=points)
+    workers = min(jobs, os_cpus())
+    overhead = 0.0
+    if blocks is not None:
+        overhead = blocks(workers) * (TASK_SECONDS + WRITE_SECONDS_PER_VARIABLE * len(scene.quantities))
+        parts["scheduler and store"] = overhead
+        closed_form /= workers  # the closed forms are solved block by block on the workers too
+    startup = costs.startup + (CLUSTER_STARTUP if jobs > 1 and _CLUSTER_CORES.get() is None else 0.0)
+    wall = startup + closed_form + max(simulated / workers, biggest_case) + overhead + report
+    return Estimate(wall_time=wall, memory=memory(scene, jobs, costs, sweep_samples, streamed=blocks is not None), parts=parts, points=points)
 
 
 def os_cpus() -> int:
-    """Processes that really run at once (the machine's cores)."""
-    return os.cpu_count() or 1
+    """Processes that really run at once: the machine's cores, or a cluster's (:func:`cluster_cores`)."""
+    return _CLUSTER_CORES.get() or os.cpu_count() or 1
 
 
-def memory(scene: Scene, jobs: int, costs: Costs, sweep_samples: float = 0.0) -> float:
+@contextmanager
+def cluster_cores(cores: int) -> Iterator[None]:
+    """Estimates made inside spread the work over ``cores`` workers of a cluster, not this machine's cores."""
+    token = _CLUSTER_CORES.set(max(1, cores))
+    try:
+        yield
+    finally:
+        _CLUSTER_CORES.reset(token)
+
+
+def memory(scene: Scene, jobs: int, costs: Costs, sweep_samples: float = 0.0, streamed: bool = False) -> float:
     """Peak memory of the run, main process and workers [bytes]: the main process's footprint and its dataset (built,
-    stacked, written: ~3 copies), one worker footprint per process simulating, and the ``sweep_samples`` of one sweep
+    stacked, written: ~3 copies; ``streamed``: solved in blocks into the store and exported chunk by chunk, so only
+    the report reads it whole), one worker footprint per process simulating, and the ``sweep_samples`` of one sweep
     per worker."""
     frequency = scene.all_frequencies
     bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
     directions = max(1, len(scene.sweep_directions))
     cells = scene.restitution.size * scene.clearance.size * bumpers * directions * frequency.size
     dataset = 3.0 * 8.0 * len(scene.quantities) * len(scene.solutions) * cells
+    if streamed:
+        dataset = dataset / 3.0 if scene.report else 0.0
     simulating = any(name in ENGINE_SOLUTIONS for name in scene.solutions)
-    workers = min(jobs, os_cpus()) if simulating and jobs > 1 else 0
+    workers = min(jobs, os_cpus()) if (simulating or streamed) and jobs > 1 else 0
     sweep = 0.0
     if sweep_samples:
         sweep = sweep_samples * 8.0 * 16 * max(1, workers)  # samples, cumulative integrals and temporaries of the estimators

@@ -16,7 +16,7 @@ from vibroimpact.simulation.settings import SWEEP_STARTS
 from vibroimpact.study.cost_model import Costs, EnginePart, Estimate, grid_estimate
 from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates, solve_each, steady_variable
 from vibroimpact.study.general_estimate import closed_form_scale, engine_scale, general_orbit_outlook
-from vibroimpact.study.blocks import run_grid
+from vibroimpact.study.blocks import plan_blocks, run_grid
 from vibroimpact.study.general_stepped import describe_stops, general_block, general_coordinates
 from vibroimpact.study.runner import Runner
 from vibroimpact.study.solutions import simulated_values
@@ -91,7 +91,10 @@ class SteppedStudy:
                 serial = seconds / (scene.restitution.size * scene.clearance.size * copies)
             return seconds, points, serial
 
-        return grid_estimate(scene, jobs, costs, engine_part, report_figures(scene), closed_form_scale=lambda name: closed_form_scale(scene, name))
+        return grid_estimate(
+            scene, jobs, costs, engine_part, report_figures(scene), closed_form_scale=lambda name: closed_form_scale(scene, name),
+            blocks=lambda workers: plan_blocks(scene, workers).count,
+        )  # fmt: skip
 
 
 def paper_block(scene: Scene, runner: Runner) -> xr.Dataset:
@@ -106,8 +109,14 @@ def paper_block(scene: Scene, runner: Runner) -> xr.Dataset:
     return xr.Dataset(data_vars)
 
 
+#: Figures of the design-map page (three band maps, the regime map, the response at the recommended design).
+DESIGN_MAP_FIGURES = 5
+
+
 def report_figures(scene: Scene) -> int:
     """Figures of the study's report page."""
+    if scene.report == "design_map":
+        return DESIGN_MAP_FIGURES
     per_clearance = 12 if any(s in ENGINE_SOLUTIONS for s in scene.solutions) else 7
     return 1 + per_clearance * scene.clearance.size + (2 if len(scene.swept) > 1 else 0)
 
