@@ -19,7 +19,7 @@ from typing import Callable
 import numpy as np
 
 from vibroimpact.scene import Scene, SceneError, find_scene, load_scene, shipped_studies
-from vibroimpact.study.cluster import SCHEDULER_VARIABLE, ClusterLost, choose_scheduler
+from vibroimpact.study.cluster import SCHEDULER_VARIABLE, ClusterLost, choose_scheduler, unreachable
 from vibroimpact.study.io import write_dataset
 from vibroimpact.study.run import run_study
 from vibroimpact.study.store import OutputBusy, StudyStore, claim_output, store_fingerprint
@@ -84,6 +84,9 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     if args.estimate:
         return _estimate(scene, args.jobs, args.costs, args.workers)
+    if scheduler is not None and (why := unreachable(scheduler)) is not None:
+        print(f"run-study: error: cannot reach the dask scheduler at {scheduler} (--scheduler, ${SCHEDULER_VARIABLE} or the scene's cluster.scheduler): {why}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     out_dir = args.out if args.out is not None else Path("results") / scene.name
     problem = unwritable(out_dir)
     if problem is not None:
@@ -217,6 +220,7 @@ def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, store: StudyStor
         path = write_dataset(dataset, out_dir / f"{scene.name}.nc")  # streamed from the store, chunk by chunk
         print(f"wrote {path}")
         if args.keep_zarr:
+            store.keep(dict(dataset.attrs))
             print(f"kept {store.path}")
         else:
             store.remove()

@@ -13,7 +13,7 @@ import signal
 import threading
 from dataclasses import dataclass
 
-__all__ = ["SCHEDULER_VARIABLE", "ClusterLost", "Connection", "choose_scheduler", "connect", "dask_setup"]
+__all__ = ["SCHEDULER_VARIABLE", "ClusterLost", "Connection", "choose_scheduler", "connect", "unreachable", "dask_setup"]
 
 #: The environment variable naming a running scheduler (``tcp://host:8786``).
 SCHEDULER_VARIABLE = "VIBROIMPACT_SCHEDULER"
@@ -54,6 +54,18 @@ class Connection:
         finally:
             if self.cluster is not None:
                 self.cluster.close(timeout=10)  # type: ignore[attr-defined]
+
+
+def unreachable(scheduler: str, timeout: float = 10.0) -> str | None:
+    """Why the dask scheduler at ``scheduler`` cannot be reached (within ``timeout`` [s]), or None if it can."""
+    from distributed import Client
+
+    try:
+        client = Client(scheduler, timeout=timeout, set_as_default=False)
+    except (OSError, TimeoutError, ValueError, TypeError) as error:
+        return str(error) or type(error).__name__
+    client.close()
+    return None
 
 
 def connect(jobs: int, scheduler: str | None) -> Connection:

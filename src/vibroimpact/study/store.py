@@ -212,6 +212,12 @@ class StudyStore:
         """Finished blocks and cases in the store (for the message of an interrupted run)."""
         return self.block_count() + self.case_count()
 
+    def keep(self, attrs: dict[str, Any]) -> None:
+        """Finish a store that outlives its study: the dataset's attributes on the group (netCDF-style values made
+        JSON-able) and consolidated metadata, so that ``xarray.open_zarr(path)`` opens it at once."""
+        self.root.attrs.update({key: value.tolist() if isinstance(value, np.ndarray) else value.item() if isinstance(value, np.generic) else value for key, value in attrs.items()})
+        zarr.consolidate_metadata(self.store, zarr_format=ZARR_FORMAT)
+
     def remove(self) -> None:
         """Delete the store (after its results are exported)."""
         if self.path is not None:

@@ -1,0 +1,174 @@
+"""The study's chunked store (study/store.py) and the grid's blocks (study/blocks.py): blocks tile the grid once, a
+block is the same scene on fewer points (same numbers), finished blocks and cases survive a rerun, another scene or
+other code starts afresh, and a second study on the same output is refused."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from vibroimpact.scene import parse_scene
+from vibroimpact.scene.schema import GRID_DIMS
+from vibroimpact.study.blocks import BlockPlan, block_scene, plan_blocks
+from vibroimpact.study.run import run_study
+from vibroimpact.study.runner import Runner
+from vibroimpact.study.stepped import paper_block
+from vibroimpact.study.store import OutputBusy, StudyStore, claim_output, store_fingerprint
+
+from tests.study.test_estimate import small_scene
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(full=st.tuples(*(st.integers(1, 7) for _ in GRID_DIMS)), block=st.tuples(*(st.integers(1, 7) for _ in GRID_DIMS)))
+def test_blocks_tile_the_grid_exactly_once(full: tuple[int, ...], block: tuple[int, ...]) -> None:
+    plan = BlockPlan(full, tuple(min(b, n) for b, n in zip(block, full)))
+    hits = np.zeros(full, dtype=int)
+    for index in range(plan.count):
+        region = plan.region(index)
+        hits[tuple(region[dim] for dim in GRID_DIMS)] += 1
+        assert plan.points(index) == np.prod([s.stop - s.start for s in region.values()])
+    assert np.all(hits == 1)
+
+
+def _grid_scene(**changes: object):
+    document = small_scene() | {
+        "sweep": {"restitution": [0.0, 0.4, 0.8], "clearance": [0.002, 0.003], "frequency": {"start": 20.0, "stop": 40.0, "step": 0.25}},
+        "solutions": ["linear", "pgf", "pgf_paper"],
+    }
+    document.pop("stop", None)
+    document.pop("simulation", None)
+    return parse_scene(document | changes)
+
+
+def test_a_block_is_the_same_scene_on_fewer_points() -> None:
+    """Every variable of every block equals the whole grid's values at the block's points (closed forms: pointwise)."""
+    scene = _grid_scene()
+    whole = paper_block(scene, Runner(progress=False))
+    plan = BlockPlan(plan_blocks(scene, 1).full, (2, 1, 1, 1, 30))
+    assert plan.count == 2 * 2 * 3
+    for index in range(plan.count):
+        region = plan.region(index)
+        part = paper_block(block_scene(scene, region), Runner(progress=False))
+        for name, variable in part.data_vars.items():
+            expected = whole[name].isel(region).values
+            np.testing.assert_allclose(variable.values.astype(float), expected.astype(float), rtol=1e-15, atol=0.0, equal_nan=True, err_msg=name)
+
+
+def test_block_scene_keeps_the_simulation_frequencies_inside_the_block() -> None:
+    scene = parse_scene(small_scene() | {"sweep": {"frequency": {"start": 20.0, "stop": 30.0, "step": 0.5}}, "simulation": {"frequency": [21.0, 25.0, 29.5], "start": "pgf"}})
+    region = {"restitution": slice(0, 1), "clearance": slice(0, 1), "bumper_frequency": slice(0, 1), "sweep": slice(0, 1), "frequency": slice(8, 15)}
+    part = block_scene(scene, region)
+    np.testing.assert_array_equal(part.all_frequencies, scene.all_frequencies[8:15])
+    assert part.simulation is not None and list(part.simulation.frequency) == [25.0]
+
+
+def test_the_stored_grid_reads_back_with_its_types_and_flags(tmp_path: Path) -> None:
+    """A study through a store on disk equals the in-memory one, flags keep their int8 type (CF flag_values)."""
+    scene = _grid_scene()
+    store = StudyStore(tmp_path / "grid.zarr", store_fingerprint(scene.text))
+    stored = run_study(scene, progress=None, store=store, load=False)
+    memory = run_study(scene, progress=None)
+    assert isinstance(stored["x1_amplitude"].data, __import__("dask").array.Array)  # lazy: read from the store
+    xr.testing.assert_identical(stored.load(), memory)
+    assert stored["regime"].dtype == np.int8 and stored["regime"].attrs["flag_values"].dtype == np.int8
+    assert store.finished_blocks().all() and store.block_count() == plan_blocks(scene, 1).count
+
+
+def test_a_rerun_takes_finished_blocks_from_the_store(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    scene = _grid_scene()
+    path = tmp_path / "grid.zarr"
+    first = run_study(scene, progress=None, store=StudyStore(path, store_fingerprint(scene.text)))
+    from vibroimpact.study import blocks
+
+    def fail(*_arguments: object) -> None:
+        raise AssertionError("a finished block was solved again")
+
+    monkeypatch.setattr(blocks, "_solve_block", fail)
+    again = run_study(scene, progress=None, store=StudyStore(path, store_fingerprint(scene.text)))
+    xr.testing.assert_identical(first, again)
+
+
+def test_a_half_written_store_resumes_with_the_missing_blocks_only(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Interrupted after some blocks (a block whose flag is not set counts as not written): the rerun solves the
+    others only and the result equals an uninterrupted run."""
+    scene = _grid_scene()
+    path = tmp_path / "grid.zarr"
+    from vibroimpact.study import blocks
+
+    monkeypatch.setattr(blocks, "CLOSED_FORM_POINTS", 30)  # 18 blocks of 30 frequencies
+    real = blocks._solve_block
+    solved: list[int] = []
+
+    def interrupted(shared: object, index: int, report: object) -> object:
+        if len(solved) == 4:
+            raise KeyboardInterrupt
+        solved.append(index)
+        return real(shared, index, report)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(blocks, "_solve_block", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run_study(scene, progress=None, store=StudyStore(path, store_fingerprint(scene.text)))
+    assert StudyStore(path, store_fingerprint(scene.text)).block_count() == 4
+    solved.clear()
+    monkeypatch.setattr(blocks, "_solve_block", lambda shared, index, report: (solved.append(index), real(shared, index, report))[1])
+    resumed = run_study(scene, progress=None, store=StudyStore(path, store_fingerprint(scene.text)))
+    assert len(solved) == plan_blocks(scene, 1).count - 4 and not set(solved) & set(range(4))
+    xr.testing.assert_identical(resumed, run_study(scene, progress=None))
+
+
+def test_another_scene_or_other_code_starts_afresh(tmp_path: Path) -> None:
+    scene = _grid_scene()
+    path = tmp_path / "grid.zarr"
+    run_study(scene, progress=None, store=StudyStore(path, store_fingerprint(scene.text)))
+    assert StudyStore(path, store_fingerprint(scene.text)).block_count() > 0
+    assert StudyStore(path, store_fingerprint(scene.text + "\n# edited")).block_count() == 0
+
+
+def test_cases_keep_their_text_and_numbers(tmp_path: Path) -> None:
+    store = StudyStore(tmp_path / "cases.zarr", "fingerprint")
+    result = {"x": np.array([1.0, np.nan]), "z": np.array([1 + 2j]), "notes": np.array(["fold at 24.1 Hz", "grazing"], dtype=object), "flag": np.int8([1, -1])}
+    store.save_case("exact-abc", result)
+    loaded = StudyStore(tmp_path / "cases.zarr", "fingerprint").load_case("exact-abc", ("x", "z", "notes", "flag"))
+    assert loaded is not None
+    np.testing.assert_array_equal(loaded["x"], result["x"])
+    np.testing.assert_array_equal(loaded["z"], result["z"])
+    assert list(loaded["notes"]) == ["fold at 24.1 Hz", "grazing"] and loaded["flag"].dtype == np.int8
+    assert store.load_case("exact-abc", ("x", "missing")) is None  # written by older code: run again
+
+
+def test_a_second_study_on_the_same_output_is_refused(tmp_path: Path) -> None:
+    with claim_output(tmp_path):
+        with pytest.raises(OutputBusy, match=rf"is being written by another run-study \(process {os.getpid()} on "):
+            with claim_output(tmp_path):
+                pass
+    assert not (tmp_path / ".run-study.lock").exists()
+
+
+def test_a_lock_left_by_a_killed_run_is_taken_over(tmp_path: Path) -> None:
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True, check=True)
+    import socket
+
+    (tmp_path / ".run-study.lock").write_text(f"{dead.stdout.strip()} {socket.gethostname()} 2026-01-01T00:00:00\n")
+    with claim_output(tmp_path) as lock:
+        assert lock.read_text().split()[0] == str(os.getpid())
+
+
+def test_the_block_plan_follows_the_work() -> None:
+    """Closed forms only: blocks of up to 50 000 points; a stepped sweep (a chain along frequency) keeps whole rows;
+    independent simulated points: 16-256 per block, more blocks for more workers."""
+    closed = _grid_scene()
+    assert plan_blocks(closed, 2).count == 1
+    simulated = parse_scene(small_scene() | {"stop": {"clearance": 0.003}, "sweep": {"restitution": [0.2, 0.4], "frequency": {"start": 20.0, "stop": 40.0, "step": 0.01}}, "simulation": {"frequency": {"start": 20.0, "stop": 40.0, "step": 0.05}, "start": "pgf"}})
+    one, eight = plan_blocks(simulated, 1), plan_blocks(simulated, 8)
+    assert one.count < eight.count
+    chain = replace(simulated, simulation=replace(simulated.simulation, start="sweep_up"))
+    assert plan_blocks(chain, 8).block[-1] == simulated.all_frequencies.size

@@ -1,0 +1,97 @@
+"""run-study and the dask runner: where the scheduler comes from, an unreachable one refused before any work,
+--keep-zarr, --workers for the estimate, a second run on the same output refused, the scene's cluster section."""
+
+from __future__ import annotations
+
+import functools
+import os
+import socket
+from pathlib import Path
+
+import pytest
+import xarray as xr
+import yaml
+
+from vibroimpact import cli
+from vibroimpact.scene import SceneError, parse_scene
+from vibroimpact.study import cluster
+from vibroimpact.study.cluster import SCHEDULER_VARIABLE, choose_scheduler
+
+from tests.study.test_estimate import small_scene
+
+
+def _scene_file(folder: Path, **changes: object) -> Path:
+    document = small_scene() | {"solutions": ["linear", "pgf"], "name": "tiny"} | changes
+    document.pop("simulation", None)
+    path = folder / "tiny.yaml"
+    path.write_text(yaml.safe_dump(document))
+    return path
+
+
+def test_the_scheduler_comes_from_the_option_then_the_environment_then_the_scene(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv(SCHEDULER_VARIABLE, "tcp://env:8786")
+    assert choose_scheduler("tcp://option:8786", "tcp://scene:8786") == "tcp://option:8786"
+    assert choose_scheduler(None, "tcp://scene:8786") == "tcp://env:8786"
+    monkeypatch.delenv(SCHEDULER_VARIABLE)
+    assert choose_scheduler(None, "tcp://scene:8786") == "tcp://scene:8786"
+    assert choose_scheduler(None, None) is None
+
+
+def test_the_scene_names_its_cluster() -> None:
+    assert parse_scene(small_scene() | {"cluster": {"scheduler": "tcp://head:8786"}}).cluster_scheduler == "tcp://head:8786"
+    with pytest.raises(SceneError, match=r"cluster.scheduler: expected a scheduler address such as tcp://host:8786, got 3"):
+        parse_scene(small_scene() | {"cluster": {"scheduler": 3}})
+    with pytest.raises(SceneError, match=r"cluster.workers: unknown key \(allowed: scheduler\)"):
+        parse_scene(small_scene() | {"cluster": {"scheduler": "tcp://head:8786", "workers": 4}})
+
+
+def test_an_unreachable_scheduler_is_refused_before_any_work(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setattr(cli, "unreachable", functools.partial(cluster.unreachable, timeout=1.0))
+    with socket.socket() as probe:  # a loopback port nothing listens on
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    out = tmp_path / "out"
+    assert cli.main([str(_scene_file(tmp_path)), "--scheduler", f"tcp://127.0.0.1:{port}", "--out", str(out)]) == cli.EXIT_BAD_INPUT
+    assert f"run-study: error: cannot reach the dask scheduler at tcp://127.0.0.1:{port}" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_keep_zarr_keeps_the_store_beside_the_netcdf_file(tmp_path: Path) -> None:
+    scene = _scene_file(tmp_path)
+    assert cli.main([str(scene), "--out", str(tmp_path / "kept"), "--jobs", "1", "--keep-zarr"]) == 0
+    assert cli.main([str(scene), "--out", str(tmp_path / "plain"), "--jobs", "1"]) == 0
+    assert (tmp_path / "kept" / "tiny.zarr").is_dir() and not (tmp_path / "plain" / "tiny.zarr").exists()
+    written = xr.load_dataset(tmp_path / "kept" / "tiny.nc")
+    stored = xr.open_zarr(tmp_path / "kept" / "tiny.zarr")  # consolidated: opens without a warning
+    assert stored.attrs["scene_name"] == "tiny" and stored.attrs["fingerprint"]
+    # the store holds the unsqueezed grid: (solution, restitution, clearance, bumper_frequency, sweep, frequency)
+    assert stored["x1_amplitude"].shape == (2, 1, 1, 1, 1, written.sizes["frequency"])
+    xr.testing.assert_equal(stored["x1_amplitude"].squeeze(drop=True).load().variable, written["x1_amplitude"].variable)
+    assert not (tmp_path / "kept" / ".run-study.lock").exists()
+
+
+def test_a_second_run_on_the_same_output_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / ".run-study.lock").write_text(f"{os.getpid()} {socket.gethostname()} 2026-11-23T01:00:00\n")  # a live run: this process
+    assert cli.main([str(_scene_file(tmp_path)), "--out", str(out), "--jobs", "1"]) == cli.EXIT_BAD_INPUT
+    assert f"is being written by another run-study (process {os.getpid()} on {socket.gethostname()}, since 2026-11-23T01:00:00)" in capsys.readouterr().err
+    assert sorted(p.name for p in out.iterdir()) == [".run-study.lock"]  # nothing written
+
+
+def test_the_estimate_is_for_a_number_of_workers(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--workers N spreads the work over N workers of a cluster, beyond this machine's cores."""
+    document = small_scene() | {"sweep": {"frequency": {"start": 15.0, "stop": 45.0, "step": 0.01}}}
+    path = tmp_path / "big.yaml"
+    path.write_text(yaml.safe_dump(document))
+
+    def wall(*options: str) -> float:
+        assert cli.main([str(path), "--estimate", *options]) == 0
+        text = capsys.readouterr().out
+        first = text.splitlines()[0].split("predicted wall time: ")[1].split(";")[0]
+        value, unit = first.split()
+        return float(value) * {"s": 1.0, "min": 60.0, "h": 3600.0}[unit]
+
+    one, many = wall("--jobs", "1"), wall("--workers", "64")
+    assert many < one / 4
+    assert cli.main([str(path), "--estimate", "--workers", "0"]) == cli.EXIT_BAD_INPUT
