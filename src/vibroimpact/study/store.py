@@ -19,6 +19,7 @@ shared file system. :func:`claim_output` keeps a second study off the same outpu
 
 from __future__ import annotations
 
+import asyncio
 import hashlib
 import os
 import shutil
@@ -33,6 +34,7 @@ import numpy as np
 import xarray as xr
 import zarr
 from numpy.typing import NDArray
+from zarr.core.sync import sync  # zarr's own event loop, the one its synchronous API runs on
 
 from vibroimpact import __version__
 from vibroimpact.study.fingerprint import source_hash
@@ -125,6 +127,7 @@ class StudyStore:
         if "fingerprint" not in self.root.attrs:
             self.root.attrs["fingerprint"] = fingerprint
         self._grid_ready = _BLOCK_DONE in self.root
+        self._arrays: dict[str, Any] = {}
 
     def _matches(self) -> bool:
         try:
@@ -189,10 +192,23 @@ class StudyStore:
     def write_block(self, index: int, region: dict[str, slice], block: dict[str, tuple[tuple[str, ...], NDArray[np.generic]]]) -> None:
         """Write the variables of block ``index`` (name -> (dimensions, values)) into ``region`` (dimension ->
         slice; unnamed dimensions whole), then flag the block done."""
+        writes = []
         for name, (dims, values) in block.items():
-            array = self.root[name]
-            array[tuple(region.get(dim, slice(None)) for dim in dims)] = values.astype(array.dtype, copy=False)
-        self.root[_BLOCK_DONE][index] = 1
+            array = self._array(name)
+            writes.append(array.async_array.setitem(tuple(region.get(dim, slice(None)) for dim in dims), values.astype(array.dtype, copy=False)))
+
+        async def write_all() -> None:
+            await asyncio.gather(*writes)
+
+        # one round trip to zarr's event loop for every variable of the block (one per variable costs 2.3x as much)
+        sync(write_all())
+        self._array(_BLOCK_DONE)[index] = 1
+
+    def _array(self, name: str) -> Any:
+        """The store's array ``name``, opened once."""
+        if name not in self._arrays:
+            self._arrays[name] = self.root[name]
+        return self._arrays[name]
 
     def block_count(self) -> int:
         """Finished blocks in the store."""
