@@ -11,6 +11,9 @@ the kind of study, in this one place:
 * bifurcation studies: diagrams with brute force and continued branches, special points, multipliers and the chart
   (:class:`~vibroimpact.reporting.bifurcation_page.BifurcationPage`);
 * swept-sine tests: running estimates against the steady states (:class:`~vibroimpact.reporting.sweep_page.SweptSinePage`);
+* stepped design maps (attribute ``report_page`` = ``design_map``: restitution x clearance x frequency): which R and
+  clearance to choose, peak |X1| per band, realisable regimes, the recommended design
+  (:class:`~vibroimpact.reporting.design_page.DesignMapPage`);
 * stepped studies with a swept bumper frequency: convergence of the compliant bumper to the rigid stop
   (:class:`~vibroimpact.reporting.bumper_page.BumperStiffnessPage`);
 * stepped studies of general scenes (any structure and stops): one curve per coordinate and per stop, the layout in
@@ -29,6 +32,7 @@ from vibroimpact.reporting.page import StudyPage, render_page, rendering, write_
 from vibroimpact.reporting.accuracy_page import AccuracyPage  # noqa: E402
 from vibroimpact.reporting.bifurcation_page import BifurcationPage  # noqa: E402
 from vibroimpact.reporting.concepts_page import ConceptsPage  # noqa: E402
+from vibroimpact.reporting.design_page import DesignMapPage  # noqa: E402
 from vibroimpact.reporting.validation_page import ValidationPage  # noqa: E402
 from vibroimpact.reporting.bumper_page import BumperStiffnessPage  # noqa: E402
 from vibroimpact.reporting.general_page import GeneralResponsePage  # noqa: E402
@@ -64,6 +68,8 @@ def page_for(dataset: xr.Dataset) -> StudyPage:
         return ValidationPage(dataset)
     if kind == "bifurcation":
         return BifurcationPage(dataset)
+    if kind == "stepped" and dataset.attrs.get("report_page") == "design_map":
+        return DesignMapPage(dataset)
     if kind == "stepped" and is_general(dataset):
         return GeneralResponsePage(dataset)
     setting = study_setting(dataset)
