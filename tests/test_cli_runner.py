@@ -95,3 +95,14 @@ def test_the_estimate_is_for_a_number_of_workers(tmp_path: Path, capsys: pytest.
     one, many = wall("--jobs", "1"), wall("--workers", "64")
     assert many < one / 4
     assert cli.main([str(path), "--estimate", "--workers", "0"]) == cli.EXIT_BAD_INPUT
+
+
+def test_a_worker_running_other_code_refuses_its_tasks(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The study's source hash travels with every task; a worker whose package differs raises instead of computing."""
+    from vibroimpact.study import runner as runner_module
+    from vibroimpact.study.runner import OtherCode, Runner, _run_cases
+
+    monkeypatch.setattr(runner_module, "source_hash", lambda: "0" * 64)  # this process "runs other code"
+    with Runner(jobs=2, progress=False) as runner:
+        with pytest.raises(OtherCode, match=r"the dask worker .* runs vibroimpact .* whose source differs from the study's"):
+            runner.run_tasks(_run_cases, None, [[]], [1.0], "tasks", lambda index, result: None)

@@ -103,8 +103,12 @@ def test_brute_force_settles_on_the_stable_branch(dataset: xr.Dataset) -> None:
 @pytest.mark.slow
 def test_the_shipped_study_runs(tmp_path) -> None:
     from vibroimpact.scene import find_scene, load_scene
+    from vibroimpact.study.store import StudyStore, store_fingerprint
 
-    data = run_study(load_scene(find_scene("bifurcation")), progress=None, jobs=2, cache_dir=tmp_path / "cache")
+    scene = load_scene(find_scene("bifurcation"))
+    store = StudyStore(tmp_path / "bifurcation.zarr", store_fingerprint(scene.text))  # its cases kept as they finish
+    data = run_study(scene, progress=None, jobs=2, store=store)
+    assert store.case_count() > 0
     kinds = data["special_point_kind"].values
     assert {0, 1, 2, 3} <= set(kinds.tolist())
     assert set(data["restitution"].values) == {0.2, 0.8} and data.sizes["frequency"] == 601

@@ -21,16 +21,19 @@ import threading
 import time
 import uuid
 from concurrent.futures import CancelledError
+from pathlib import Path
 from typing import Any, Callable, Protocol, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
+from vibroimpact import __version__
 from vibroimpact.study.cluster import ClusterLost, Connection, connect
+from vibroimpact.study.fingerprint import source_hash
 from vibroimpact.study.progress import ProgressBar, ProgressReport, Throttled
 from vibroimpact.study.store import StudyStore
 
-__all__ = ["Case", "CaseResult", "ProgressReport", "Runner", "TaskFunction", "MAX_CASES_PER_TASK"]
+__all__ = ["Case", "CaseResult", "ProgressReport", "Runner", "TaskFunction", "OtherCode", "MAX_CASES_PER_TASK"]
 
 CaseResult = dict[str, NDArray[np.generic]]
 #: What a task runs on a worker: ``function(shared, item, report)`` -> its result.
@@ -222,6 +225,7 @@ class Runner:
         topic = f"vibroimpact-progress-{token}"
         client.subscribe_topic(topic, lambda event: bar.partial(*event[1]))
         shared_data = client.scatter(shared, broadcast=True, hash=False) if shared is not None else None
+        source = source_hash()  # a worker running other code refuses the task rather than mixing its results in
         queue = iter(order)
         limit = IN_FLIGHT_PER_WORKER * max(self.workers, 1)
         running: dict[Any, int] = {}
@@ -230,7 +234,7 @@ class Runner:
         def submit() -> None:
             index = next(queue, None)
             if index is not None:
-                future = client.submit(_task, function, shared_data, items[index], topic, index, key=f"vibroimpact-{token}-{index}", pure=False)
+                future = client.submit(_task, function, shared_data, items[index], topic, index, source, key=f"vibroimpact-{token}-{index}", pure=False)
                 running[future] = index
                 future.add_done_callback(lambda _future: arrived.set())
 
@@ -278,11 +282,17 @@ def _check(client: Any, address: str) -> None:
         raise ClusterLost(f"lost the dask scheduler at {address} (reconnecting)")
 
 
-def _task(function: TaskFunction, shared: Any, item: Any, topic: str, index: int) -> Any:
+class OtherCode(RuntimeError):
+    """A dask worker runs another version of the package than the study's process."""
+
+
+def _task(function: TaskFunction, shared: Any, item: Any, topic: str, index: int, source: str) -> Any:
     """Run on a worker: ``function`` with a report that sends the task's progress to the scheduler's event log."""
     from distributed import get_worker
 
     worker = get_worker()
+    if source_hash() != source:
+        raise OtherCode(f"the dask worker {worker.address} runs vibroimpact {__version__} from {Path(__file__).parents[1]} whose source differs from the study's: install the same version on every worker")
     last = [0.0]
 
     def send(done: float) -> None:
