@@ -31,7 +31,7 @@ _WRAPPED_COLUMNS = {8: 9, 10: 14}
 
 
 def frequency_ranges(values: tuple[float, ...] | np.ndarray, grid: np.ndarray) -> str:
-    """``values`` [Hz] as ranges of consecutive points of ``grid``: '21.5, 34.5-35, 37.5-38' ('none' if empty)."""
+    """``values`` [Hz] as ranges of consecutive points of ``grid``, 4 significant digits: '21.5, 34.5-35, 37.5-38' ('none' if empty)."""
     if len(values) == 0:
         return "none"
     index = np.searchsorted(grid, np.asarray(values, dtype=float))
@@ -39,13 +39,13 @@ def frequency_ranges(values: tuple[float, ...] | np.ndarray, grid: np.ndarray) -
     for previous, current in zip(index, [*index[1:], None]):
         if current is None or current != previous + 1:
             low, high = grid[start], grid[previous]
-            parts.append(fmt(low, "g") if start == previous else f"{fmt(low, 'g')}-{fmt(high, 'g')}")
+            parts.append(fmt(low, ".4g") if start == previous else f"{fmt(low, '.4g')}-{fmt(high, '.4g')}")
             start = current
     return ", ".join(parts)
 
 
 def _mm(value: float, bound: bool = False) -> str:
-    return ("≥ " if bound else "") + fmt(1e3 * value, ".3g", "{} mm") if math.isfinite(value) else "n/a"
+    return ("≥ " if bound else "") + fmt(1e3 * value, "#.3g", "{} mm") if math.isfinite(value) else "n/a"
 
 
 def _design_name(design: Candidate) -> str:
