@@ -227,6 +227,8 @@ def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, store: StudyStor
         if scene.report and not args.no_report:
             report = _report(path, out_dir, args.jobs)
             print(f"wrote {report}" if isinstance(report, Path) else report)
+    except ClusterLost:
+        raise  # main says what was kept
     except (OSError, ValueError, ArithmeticError, np.linalg.LinAlgError, RuntimeError) as error:
         print(f"run-study: error while running {scene.name!r}: {type(error).__name__}: {error}", file=sys.stderr)
         return EXIT_FAILURE

@@ -219,14 +219,6 @@ def test_a_lost_scheduler_ends_the_study_and_a_restarted_one_resumes_it(lost_sch
     assert not (folder / "out" / f"{SCENE_NAME}.zarr").exists()
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="runner bug (reported to the lead): a lost scheduler ends run-study with 'run-study: error while running ...: "
-    "ClusterLost: ...' (cli._run catches RuntimeError, and ClusterLost is one, before main's ClusterLost handler) or "
-    "'...: CommClosedError: ...' (Future.result() raises distributed's CommClosedError, an OSError, not CancelledError), "
-    "never naming the kept blocks, after tracebacks logged by distributed (distributed.batched 'Batched Comm Closed' at "
-    "INFO; distributed.client ERROR: Client.close() cancels the @log_errors _reconnect task)",
-)
 @pytest.mark.timeout(120)
 def test_a_lost_scheduler_is_told_in_one_line(lost_scheduler: LostScheduler) -> None:
     """The run that lost its scheduler ends with one line naming the scheduler and the kept blocks, and prints no

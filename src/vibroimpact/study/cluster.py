@@ -89,6 +89,9 @@ def connect(jobs: int, scheduler: str | None) -> Connection:
                 signal.signal(signal.SIGINT, previous)
         client = Client(cluster, set_as_default=False)
         return Connection(client, cluster, cluster.scheduler_address)
+    # a running cluster's comings and goings (a worker lost, a connection closed) are the scheduler's to log; the
+    # study's process says what matters to it in one line
+    logging.getLogger("distributed").setLevel(logging.WARNING)
     try:
         client = Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
     except (OSError, TimeoutError) as error:

@@ -17,6 +17,7 @@ their progress through the scheduler's event log, so the bar advances inside lon
 
 from __future__ import annotations
 
+import logging
 import threading
 import time
 import uuid
@@ -116,24 +117,38 @@ class Runner:
             return self.jobs
         return self.connection.workers
 
-    def close(self) -> None:
-        """Close the dask connection (a local cluster's workers stop)."""
-        if self._connection is not None:
-            connection, self._connection = self._connection, None
+    def close(self, failed: bool = False) -> None:
+        """Close the dask connection (a local cluster's workers stop); after a success, first read the workers' peak
+        memory. ``failed``: leaving on an error, an interrupt or a lost scheduler: close at once, quietly."""
+        if self._connection is None:
+            return
+        connection, self._connection = self._connection, None
+        if not failed:
             try:
-                if connection.client.status == "running":  # type: ignore[attr-defined]
-                    peaks = connection.client.run(_peak_memory, wait=True)  # type: ignore[attr-defined]
-                    self.worker_peak_memory = max(peaks.values(), default=0)
-            except (OSError, TimeoutError, ValueError):
-                pass  # a lost scheduler: nothing to read
-            finally:
-                connection.close()
+                peaks = connection.client.run(_peak_memory, wait=True)  # type: ignore[attr-defined]
+                self.worker_peak_memory = max(peaks.values(), default=0)
+            except (OSError, TimeoutError, ValueError, CancelledError):
+                pass  # the scheduler went away at the very end: nothing to read
+            connection.close()
+            return
+        # the client's reconnect task logs its cancellation with a traceback: the study says what happened in one line
+        loggers = [logging.getLogger(name) for name in ("distributed", *logging.root.manager.loggerDict) if name.startswith("distributed")]
+        levels = [logger.level for logger in loggers]
+        for logger in loggers:
+            logger.setLevel(logging.CRITICAL)
+        try:
+            connection.close()
+        except (OSError, TimeoutError, CancelledError):
+            pass  # the scheduler is gone: nothing left to close
+        finally:
+            for logger, level in zip(loggers, levels):
+                logger.setLevel(level)
 
     def __enter__(self) -> "Runner":
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    def __exit__(self, kind: type[BaseException] | None, *rest: object) -> None:
+        self.close(failed=kind is not None)
 
     # -- cases -------------------------------------------------------------------------------------------------
 
@@ -251,9 +266,11 @@ class Runner:
                     index = running.pop(future)
                     try:
                         result = future.result()
-                    except CancelledError:
-                        _check(client, connection.address)
-                        raise ClusterLost(f"the dask scheduler at {connection.address} cancelled a task") from None
+                    except Exception as error:
+                        if future.status == "error":
+                            raise  # the task's own error
+                        # cancelled with "scheduler-connection-lost", or its result lost on the way (CommClosedError)
+                        raise ClusterLost(f"lost the dask scheduler at {connection.address} ({type(error).__name__})") from None
                     finished(index, result)
                     bar.finish(index)
                     submit()
