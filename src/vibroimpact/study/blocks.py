@@ -33,7 +33,7 @@ CLOSED_FORM_POINTS = 50_000
 #: Simulated points of a block with time-domain engines: at least ``SIMULATED_POINTS[0]`` (the compiled exact
 #: engine's ~1-3 ms per point then outweigh the ~2 ms a task costs the scheduler 15-50 times), at most
 #: ``SIMULATED_POINTS[1]``, aiming at :data:`BLOCKS_PER_WORKER` blocks per worker.
-SIMULATED_POINTS = (32, 256)
+SIMULATED_POINTS = (32, 1024)
 BLOCKS_PER_WORKER = 16
 
 #: Solves one block: (the block's scene, a runner in this process) -> its variables over the block's unsqueezed grid.

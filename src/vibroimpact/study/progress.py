@@ -54,6 +54,7 @@ class ProgressBar:
         self.totals = totals
         self.total = max(sum(totals), 1e-300)
         self.done = {index: totals[index] for index in finished}
+        self.finished = set(finished)
         self.done_sum = float(sum(self.done.values()))
         self.unit = unit
         self.verb = verb
@@ -66,8 +67,10 @@ class ProgressBar:
         self._show()
 
     def partial(self, index: int, done: float) -> None:
-        """Task ``index`` has done ``done`` of its work."""
+        """Task ``index`` has done ``done`` of its work (a late message of a finished task changes nothing)."""
         with self.lock:
+            if index in self.finished:
+                return
             value = min(max(done, 0.0), self.totals[index])
             self.done_sum += value - self.done.get(index, 0.0)
             self.done[index] = value
@@ -76,6 +79,7 @@ class ProgressBar:
     def finish(self, index: int) -> None:
         """Task ``index`` is done."""
         self.partial(index, self.totals[index])
+        self.finished.add(index)
 
     def _show(self) -> None:
         if not self.enabled:
