@@ -135,13 +135,17 @@ def test_another_scene_or_other_code_starts_afresh(tmp_path: Path) -> None:
 
 def test_cases_keep_their_text_and_numbers(tmp_path: Path) -> None:
     store = StudyStore(tmp_path / "cases.zarr", "fingerprint")
-    result = {"x": np.array([1.0, np.nan]), "z": np.array([1 + 2j]), "notes": np.array(["fold at 24.1 Hz", "grazing"], dtype=object), "flag": np.int8([1, -1])}
+    result = {
+        "x": np.array([1.0, np.nan]), "z": np.array([1 + 2j]), "notes": np.array(["fold at 24.1 Hz", "grazing"], dtype=object), "flag": np.int8([1, -1]),
+        "duration": np.array(300.0), "none": np.zeros((0, 3)),
+    }  # fmt: skip
     store.save_case("exact-abc", result)
-    loaded = StudyStore(tmp_path / "cases.zarr", "fingerprint").load_case("exact-abc", ("x", "z", "notes", "flag"))
+    loaded = StudyStore(tmp_path / "cases.zarr", "fingerprint").load_case("exact-abc", ("x", "z", "notes", "flag", "duration", "none"))
     assert loaded is not None
     np.testing.assert_array_equal(loaded["x"], result["x"])
     np.testing.assert_array_equal(loaded["z"], result["z"])
     assert list(loaded["notes"]) == ["fold at 24.1 Hz", "grazing"] and loaded["flag"].dtype == np.int8
+    assert loaded["duration"].shape == () and float(loaded["duration"]) == 300.0 and loaded["none"].shape == (0, 3)  # exact: stored as given
     assert store.load_case("exact-abc", ("x", "missing")) is None  # written by older code: run again
 
 

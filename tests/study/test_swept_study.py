@@ -37,9 +37,16 @@ def sweep_document(**changes: Any) -> dict[str, Any]:
 
 
 @pytest.fixture(scope="module")
-def sweep_run() -> xr.Dataset:
+def sweep_run(tmp_path_factory: pytest.TempPathFactory) -> xr.Dataset:
+    """The sweeps on two dask workers, each finished case kept in a store on disk (as run-study does)."""
+    from vibroimpact.study.store import StudyStore, store_fingerprint
+
     document = sweep_document()
-    return run_study(parse_scene(document, text=yaml.safe_dump(document)), progress=None, jobs=2)
+    text = yaml.safe_dump(document)
+    store = StudyStore(tmp_path_factory.mktemp("store") / "short_sweep.zarr", store_fingerprint(text))
+    dataset = run_study(parse_scene(document, text=text), progress=None, jobs=2, store=store)
+    assert store.case_count() == len(dataset["sweep"])  # one case per direction, scalars and all
+    return dataset
 
 
 @pytest.mark.timeout(120)

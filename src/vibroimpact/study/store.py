@@ -156,8 +156,7 @@ class StudyStore:
             array = np.asarray(value)
             if array.dtype == object:
                 array = array.astype(str)  # text (notes, names): fixed-width strings
-            group.create_array(field, shape=array.shape, dtype=array.dtype, chunks=array.shape or None, overwrite=True)
-            group[field][...] = array
+            group.create_array(field, data=array, overwrite=True)  # scalars and empty arrays included
         group.attrs["complete"] = True
 
     def case_count(self) -> int:
