@@ -216,7 +216,7 @@ class StudyStore:
     def grid_dataset(self) -> xr.Dataset:
         """The grid's variables, lazily (dask arrays over the store's chunks), without ``block_done``."""
         dataset = xr.open_zarr(self.store, consolidated=False, zarr_format=ZARR_FORMAT).drop_vars(_BLOCK_DONE)
-        dataset.attrs.pop("fingerprint", None)
+        dataset.attrs.clear()  # the fingerprint, and a kept store's attributes of its last run: the study sets its own
         for variable in dataset.variables.values():
             for key in _TYPED_ATTRIBUTES:
                 if key in variable.attrs and isinstance(variable.attrs[key], list):
