@@ -106,3 +106,15 @@ def test_a_worker_running_other_code_refuses_its_tasks(monkeypatch: pytest.Monke
     with Runner(jobs=2, progress=False) as runner:
         with pytest.raises(OtherCode, match=r"the dask worker .* runs vibroimpact .* whose source differs from the study's"):
             runner.run_tasks(_run_cases, None, [[]], [1.0], "tasks", lambda index, result: None)
+
+
+def test_an_explicit_jobs_runs_here_whatever_the_environment_says(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv(SCHEDULER_VARIABLE, "tcp://127.0.0.1:1")  # nothing listens there
+    assert cli.main([str(_scene_file(tmp_path)), "--out", str(tmp_path / "out"), "--jobs", "1"]) == 0
+    assert xr.load_dataset(tmp_path / "out" / "tiny.nc").attrs["run_scheduler"] == "this process"
+
+
+def test_workers_is_for_the_estimate(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.main([str(_scene_file(tmp_path)), "--out", str(tmp_path / "out"), "--workers", "4"]) == cli.EXIT_BAD_INPUT
+    assert "--workers is for --estimate" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()

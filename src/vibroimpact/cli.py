@@ -46,7 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("scene", nargs="?", help="scene file; a bare name (with or without .yaml) is also looked up in ./studies/ and the shipped studies (a local file wins)")
     parser.add_argument("--out", type=Path, default=None, help="output folder (default: results/<scene name>/)")
     parser.add_argument("--no-report", action="store_true", help="write the dataset only")
-    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="worker processes of the local dask cluster (default: all cores; 1: this process alone)")
+    parser.add_argument("--jobs", type=int, default=None, help="worker processes of a local dask cluster (default: all cores; 1: this process alone); given, it runs locally whatever $VIBROIMPACT_SCHEDULER or the scene say")
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS", help=f"run on a running dask cluster, e.g. tcp://head-node:8786 (default: ${SCHEDULER_VARIABLE}, else the scene's cluster.scheduler, else a local cluster of --jobs workers)")
     parser.add_argument("--keep-zarr", action="store_true", help="keep the chunked store DIR/<name>.zarr after the netCDF file is written (for grids too large for one netCDF file)")
     parser.add_argument("--estimate", action="store_true", help="print the predicted wall time and memory of the scene, and run nothing")
@@ -75,10 +75,15 @@ def main(argv: list[str] | None = None) -> int:
     except (SceneError, OSError) as error:  # OSError: missing, a directory, unreadable
         print(f"run-study: error: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    local = args.jobs is not None  # an explicit --jobs runs here, unless --scheduler is given too
+    args.jobs = args.jobs if args.jobs is not None else os.cpu_count() or 1
     if args.jobs < 1:
         print(f"run-study: error: --jobs {args.jobs} is out of range: allowed [1, inf)", file=sys.stderr)
         return EXIT_BAD_INPUT
-    scheduler = choose_scheduler(args.scheduler, scene.cluster_scheduler)
+    scheduler = args.scheduler if local else choose_scheduler(args.scheduler, scene.cluster_scheduler)
+    if args.workers is not None and not args.estimate:
+        print("run-study: error: --workers is for --estimate (the workers of a running cluster are the scheduler's)", file=sys.stderr)
+        return EXIT_BAD_INPUT
     if args.workers is not None and args.workers < 1:
         print(f"run-study: error: --workers {args.workers} is out of range: allowed [1, inf)", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -219,14 +224,15 @@ def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, store: StudyStor
         dataset.attrs["run_peak_memory_bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
         path = write_dataset(dataset, out_dir / f"{scene.name}.nc")  # streamed from the store, chunk by chunk
         print(f"wrote {path}")
+        if scene.report and not args.no_report:
+            report = _report(path, out_dir, args.jobs)
+            print(f"wrote {report}" if isinstance(report, Path) else report)
+        # the store goes last: a run interrupted while drawing its report reruns from the store in seconds
         if args.keep_zarr:
             store.keep(dict(dataset.attrs))
             print(f"kept {store.path}")
         else:
             store.remove()
-        if scene.report and not args.no_report:
-            report = _report(path, out_dir, args.jobs)
-            print(f"wrote {report}" if isinstance(report, Path) else report)
     except ClusterLost:
         raise  # main says what was kept
     except (OSError, ValueError, ArithmeticError, np.linalg.LinAlgError, RuntimeError) as error:

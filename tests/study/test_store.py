@@ -176,3 +176,46 @@ def test_the_block_plan_follows_the_work() -> None:
     assert one.count < eight.count
     chain = replace(simulated, simulation=replace(simulated.simulation, start="sweep_up"))
     assert plan_blocks(chain, 8).block[-1] == simulated.all_frequencies.size
+
+
+def test_a_resumed_study_keeps_its_blocks_whatever_its_workers(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The block plan depends on the workers; a study resumed with other workers (another plan) reuses the plan
+    stored with its blocks, so its values land where they belong."""
+    scene = _grid_scene()
+    path = tmp_path / "grid.zarr"
+    from vibroimpact.study import blocks
+
+    monkeypatch.setattr(blocks, "CLOSED_FORM_POINTS", 30)  # the first run's plan: 18 blocks of 30 frequencies
+    real = blocks._solve_block
+    solved: list[int] = []
+
+    def interrupted(shared: object, index: int, report: object) -> object:
+        if len(solved) == 5:
+            raise KeyboardInterrupt
+        solved.append(index)
+        return real(shared, index, report)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(blocks, "_solve_block", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run_study(scene, progress=None, store=StudyStore(path, store_fingerprint(scene.text)))
+    monkeypatch.setattr(blocks, "_solve_block", real)
+    monkeypatch.setattr(blocks, "CLOSED_FORM_POINTS", 50)  # the resumed run would plan other blocks
+    store = StudyStore(path, store_fingerprint(scene.text))
+    assert store.grid_plan() == ((3, 2, 1, 1, 81), (1, 1, 1, 1, 30))
+    resumed = run_study(scene, progress=None, store=store)
+    monkeypatch.setattr(blocks, "CLOSED_FORM_POINTS", 30)  # the same plan, uninterrupted: bit for bit
+    xr.testing.assert_identical(resumed, run_study(scene, progress=None))
+
+
+def test_where_the_work_runs_is_not_part_of_the_fingerprint() -> None:
+    text = "name: a\nsweep: {frequency: [20.0, 21.0]}\n"
+    assert store_fingerprint(text) == store_fingerprint(text + "cluster: {scheduler: tcp://head:8786}\n")
+    assert store_fingerprint(text) != store_fingerprint(text.replace("21.0", "22.0"))
+
+
+def test_a_removed_store_leaves_nothing_behind(tmp_path: Path) -> None:
+    scene = _grid_scene()
+    store = StudyStore(tmp_path / "grid.zarr", store_fingerprint(scene.text))
+    run_study(scene, progress=None, store=store)
+    store.remove()
+    assert list(tmp_path.iterdir()) == []

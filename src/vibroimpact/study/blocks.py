@@ -150,13 +150,17 @@ def run_grid(scene: Scene, runner: Runner, solve: BlockSolver, extra_sizes: dict
 
     store = runner.store if runner.store is not None else StudyStore(None, store_fingerprint(scene.text))
     plan = plan_blocks(scene, runner.workers if runner.distributed else 1)
+    if store.grid_ready:
+        kept = store.grid_plan()
+        if kept is not None and kept[0] == plan.full:
+            plan = BlockPlan(plan.full, kept[1])  # a resumed study keeps the blocks it began with, whatever its workers
     skip = np.flatnonzero(store.finished_blocks()).tolist() if store.grid_ready else []
     sizes = dict(zip(GRID_DIMS, plan.full)) | (extra_sizes or {})
     chunks = dict(zip(GRID_DIMS, plan.block))
 
     def finished(index: int, variables: dict[str, tuple[tuple[str, ...], np.ndarray, dict[str, object]]]) -> None:
         if not store.grid_ready:
-            store.begin_grid(_template(variables, sizes, chunks), plan.count)
+            store.begin_grid(_template(variables, sizes, chunks), plan.count, (plan.full, plan.block))
         store.write_block(index, plan.region(index), {name: (dims, values) for name, (dims, values, _attrs) in variables.items()})
 
     totals = [block_work(scene, plan, index) for index in range(plan.count)]

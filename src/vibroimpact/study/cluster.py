@@ -11,6 +11,7 @@ import logging
 import os
 import signal
 import threading
+import time
 from dataclasses import dataclass
 
 __all__ = ["SCHEDULER_VARIABLE", "ClusterLost", "Connection", "choose_scheduler", "connect", "unreachable", "dask_setup"]
@@ -48,12 +49,20 @@ class Connection:
     client: object
     cluster: object | None
     address: str
+    _counted: tuple[float, int] | None = None
 
     @property
     def workers(self) -> int:
         """Worker threads the scheduler knows of now (at least 1)."""
-        info = self.client.scheduler_info(n_workers=-1)  # type: ignore[attr-defined]
-        return max(1, sum(int(worker.get("nthreads", 1)) for worker in info.get("workers", {}).values()))
+        return max(1, self.worker_count())
+
+    def worker_count(self) -> int:
+        """Worker threads the scheduler knows of (0 for a cluster without workers), asked at most once a second."""
+        now = time.monotonic()
+        if self._counted is None or now - self._counted[0] > 1.0:
+            info = self.client.scheduler_info(n_workers=-1)  # type: ignore[attr-defined]
+            self._counted = (now, sum(int(worker.get("nthreads", 1)) for worker in info.get("workers", {}).values()))
+        return self._counted[1]
 
     def close(self) -> None:
         """Close the client, and the local cluster if this connection started one (its workers stop)."""

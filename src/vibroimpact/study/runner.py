@@ -34,7 +34,7 @@ from vibroimpact.study.fingerprint import source_hash
 from vibroimpact.study.progress import ProgressBar, ProgressReport, Throttled
 from vibroimpact.study.store import StudyStore
 
-__all__ = ["Case", "CaseResult", "ProgressReport", "Runner", "TaskFunction", "OtherCode", "MAX_CASES_PER_TASK"]
+__all__ = ["Case", "CaseResult", "ProgressReport", "Runner", "TaskFunction", "OtherCode", "WorkerDied", "MAX_CASES_PER_TASK"]
 
 CaseResult = dict[str, NDArray[np.generic]]
 #: What a task runs on a worker: ``function(shared, item, report)`` -> its result.
@@ -174,7 +174,7 @@ class Runner:
                 self.store.save_case(names[index], result)
 
         unit = cases[0].progress_unit if cases else "points"
-        if not self.distributed or len(pending) <= 1:
+        if not self.distributed or (len(pending) <= 1 and self.scheduler is None):
             self._run_here(cases, pending, [i for i in range(len(cases)) if results[i] is not None], unit, keep)
         else:
             per_task = max(1, min(MAX_CASES_PER_TASK, len(pending) // (TASKS_PER_WORKER * self.workers)))
@@ -242,23 +242,32 @@ class Runner:
         shared_data = client.scatter(shared, broadcast=True, hash=False) if shared is not None else None
         source = source_hash()  # a worker running other code refuses the task rather than mixing its results in
         queue = iter(order)
-        limit = IN_FLIGHT_PER_WORKER * max(self.workers, 1)
         running: dict[Any, int] = {}
         arrived = threading.Event()
 
-        def submit() -> None:
+        def submit() -> bool:
             index = next(queue, None)
-            if index is not None:
-                future = client.submit(_task, function, shared_data, items[index], topic, index, source, key=f"vibroimpact-{token}-{index}", pure=False)
-                running[future] = index
-                future.add_done_callback(lambda _future: arrived.set())
+            if index is None:
+                return False
+            future = client.submit(_task, function, shared_data, items[index], topic, index, source, key=f"vibroimpact-{token}-{index}", pure=False)
+            running[future] = index
+            future.add_done_callback(lambda _future: arrived.set())
+            return True
+
+        alone_since: list[float] = []  # when the cluster was last seen with no worker
+
+        def top_up() -> None:
+            # workers that join a running cluster get work at once
+            while len(running) < IN_FLIGHT_PER_WORKER * max(connection.worker_count(), 1) and submit():
+                pass
 
         try:
-            for _ in range(limit):
-                submit()
+            top_up()
             while running:
                 if not arrived.wait(POLL_INTERVAL):
                     _check(client, connection.address)
+                    _check_workers(connection, alone_since)
+                    top_up()
                     continue
                 arrived.clear()
                 done = [future for future in running if future.done()]
@@ -268,12 +277,14 @@ class Runner:
                         result = future.result()
                     except Exception as error:
                         if future.status == "error":
+                            if type(error).__name__ == "KilledWorker":  # its worker died on every try (out of memory?)
+                                raise WorkerDied(f"task {index} of {len(items)} killed its worker {ALLOWED_FAILURES} times: {error}") from None
                             raise  # the task's own error
                         # cancelled with "scheduler-connection-lost", or its result lost on the way (CommClosedError)
                         raise ClusterLost(f"lost the dask scheduler at {connection.address} ({type(error).__name__})") from None
                     finished(index, result)
                     bar.finish(index)
-                    submit()
+                top_up()
         except BaseException:
             # Ctrl-C, a failed task or a lost scheduler: nothing more runs for this study
             if client.status == "running":
@@ -289,6 +300,27 @@ def _peak_memory() -> int:
     import resource
 
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+class WorkerDied(RuntimeError):
+    """A task's worker died every time it ran it (the scheduler gives up after ``distributed.scheduler.allowed-failures``)."""
+
+
+#: How often the scheduler reruns a task whose worker died before giving up (dask's default).
+ALLOWED_FAILURES = 3
+#: How long a cluster may have no worker at all before the study gives up [s].
+NO_WORKER_TIMEOUT = 120.0
+
+
+def _check_workers(connection: Connection, alone_since: list[float]) -> None:
+    """Raise :class:`ClusterLost` when the cluster has had no worker for :data:`NO_WORKER_TIMEOUT`."""
+    if connection.worker_count() > 0:
+        alone_since.clear()
+        return
+    if not alone_since:
+        alone_since.append(time.monotonic())
+    elif time.monotonic() - alone_since[0] > NO_WORKER_TIMEOUT:
+        raise ClusterLost(f"the dask scheduler at {connection.address} has had no worker for {NO_WORKER_TIMEOUT:.0f} s")
 
 
 def _check(client: Any, address: str) -> None:

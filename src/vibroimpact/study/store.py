@@ -53,7 +53,16 @@ class OutputBusy(RuntimeError):
 
 
 def store_fingerprint(scene_text: str) -> str:
-    """What a store's results depend on: the scene's text, the package version and the package's source."""
+    """What a store's results depend on: the scene's text (but its ``cluster:`` section: where the work runs does not
+    change it), the package version and the package's source."""
+    import yaml
+
+    try:
+        document = yaml.safe_load(scene_text)
+    except yaml.YAMLError:
+        document = None
+    if isinstance(document, dict):
+        scene_text = yaml.safe_dump({key: value for key, value in document.items() if key != "cluster"}, sort_keys=True)
     return hashlib.sha256(f"{__version__}\0{source_hash()}\0{scene_text}".encode()).hexdigest()[:24]
 
 
@@ -172,17 +181,24 @@ class StudyStore:
         """Whether the grid's variables exist (the first finished block creates them)."""
         return self._grid_ready
 
-    def begin_grid(self, template: xr.Dataset, block_count: int) -> None:
+    def begin_grid(self, template: xr.Dataset, block_count: int, plan: tuple[tuple[int, ...], tuple[int, ...]]) -> None:
         """Create the grid's variables from ``template`` (lazy arrays with the grid's dimensions and chunks; nothing
-        is computed) and ``block_done``."""
+        is computed) and ``block_done``; ``plan`` (the grid's shape and a block's) is kept for a resumed run."""
         encoding = {name: {"_FillValue": None} for name, variable in template.data_vars.items() if variable.dtype.kind in "iub"}
         # the dataset's attributes become the group's: the fingerprint goes with them
-        template = template.assign_attrs(fingerprint=self.fingerprint)
+        template = template.assign_attrs(fingerprint=self.fingerprint, grid_shape=list(plan[0]), block_shape=list(plan[1]))
         template.to_zarr(self.store, mode="a", compute=False, zarr_format=ZARR_FORMAT, encoding=encoding, consolidated=False)
         self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT)
         done = self.root.create_array(_BLOCK_DONE, shape=(block_count,), chunks=(1,), dtype="uint8", fill_value=0)
         done.attrs["_ARRAY_DIMENSIONS"] = ["block"]
         self._grid_ready = True
+
+    def grid_plan(self) -> tuple[tuple[int, ...], tuple[int, ...]] | None:
+        """The grid's shape and a block's, as the run that began the store planned them (None: not recorded)."""
+        attrs = self.root.attrs
+        if "grid_shape" not in attrs or "block_shape" not in attrs:
+            return None
+        return tuple(int(n) for n in attrs["grid_shape"]), tuple(int(n) for n in attrs["block_shape"])  # type: ignore[union-attr]
 
     def finished_blocks(self) -> NDArray[np.bool_]:
         """One flag per block: its results are stored."""
@@ -234,6 +250,9 @@ class StudyStore:
         zarr.consolidate_metadata(self.store, zarr_format=ZARR_FORMAT)
 
     def remove(self) -> None:
-        """Delete the store (after its results are exported)."""
-        if self.path is not None:
-            shutil.rmtree(self.path, ignore_errors=True)
+        """Delete the store (after its results are exported): renamed first, so that a removal cut off half-way
+        never leaves a store whose flags outlive its data."""
+        if self.path is not None and self.path.exists():
+            doomed = self.path.with_name(f".{self.path.name}.removed-{os.getpid()}")
+            os.replace(self.path, doomed)
+            shutil.rmtree(doomed, ignore_errors=True)
