@@ -98,7 +98,9 @@ def connect(jobs: int, scheduler: str | None) -> Connection:
 
     if scheduler is None:
         # Ctrl-C is the study's to handle: the worker processes ignore SIGINT from their start (an ignored signal
-        # stays ignored in a child process) and after a restart (the preload)
+        # stays ignored in a child process) and after a restart (the preload). A Ctrl-C in the ~1 s this takes is ignored
+        # too: blocking it instead does not reach the workers (a spawned child starts with every signal unblocked,
+        # and then prints tracebacks of its interrupted imports)
         previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if threading.current_thread() is threading.main_thread() else None
         try:
             with dask.config.set(WORKER_CONFIG):  # the nannies hand it to the worker processes
