@@ -8,6 +8,7 @@ import os
 import socket
 from pathlib import Path
 
+import numpy as np
 import pytest
 import xarray as xr
 import yaml
@@ -67,6 +68,9 @@ def test_keep_zarr_keeps_the_store_beside_the_netcdf_file(tmp_path: Path) -> Non
     # the store holds the unsqueezed grid: (solution, restitution, clearance, bumper_frequency, sweep, frequency)
     assert stored["x1_amplitude"].shape == (2, 1, 1, 1, 1, written.sizes["frequency"])
     xr.testing.assert_equal(stored["x1_amplitude"].squeeze(drop=True).load().variable, written["x1_amplitude"].variable)
+    # labelled: the frequencies, the parameters and the solutions
+    np.testing.assert_array_equal(stored["frequency"].values, written["frequency"].values)
+    assert list(stored["solution"].values) == ["linear", "pgf"] and stored["clearance"].values.tolist() == [float(written["clearance"])]
     assert not (tmp_path / "kept" / ".run-study.lock").exists()
 
 

@@ -229,7 +229,7 @@ def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, store: StudyStor
             print(f"wrote {report}" if isinstance(report, Path) else report)
         # the store goes last: a run interrupted while drawing its report reruns from the store in seconds
         if args.keep_zarr:
-            store.keep(dict(dataset.attrs))
+            store.keep(dataset)
             print(f"kept {store.path}")
         else:
             store.remove()

@@ -243,9 +243,23 @@ class StudyStore:
         """Finished blocks and cases in the store (for the message of an interrupted run)."""
         return self.block_count() + self.case_count()
 
-    def keep(self, attrs: dict[str, Any]) -> None:
-        """Finish a store that outlives its study: the dataset's attributes on the group (netCDF-style values made
-        JSON-able) and consolidated metadata, so that ``xarray.open_zarr(path)`` opens it at once."""
+    def keep(self, dataset: xr.Dataset) -> None:
+        """Finish a store that outlives its study: the coordinates of its dimensions (``frequency``, the swept
+        parameters, ``solution``) and the attributes of the study's ``dataset``, and consolidated metadata, so that
+        ``xarray.open_zarr(path)`` opens a labelled dataset at once."""
+        sizes: dict[str, int] = {}
+        for _name, array in self.root.arrays():
+            sizes.update(zip(array.attrs.get("_ARRAY_DIMENSIONS", ()), array.shape))
+        coords = {}
+        for dim, size in sizes.items():
+            if dim in dataset.coords and dim not in self.root:
+                values = np.atleast_1d(dataset[dim].values)
+                if values.size == size:
+                    coords[dim] = values.astype(str) if values.dtype == object else values
+        if coords:
+            xr.Dataset(coords=coords, attrs=dict(self.root.attrs)).to_zarr(self.store, mode="a", zarr_format=ZARR_FORMAT, consolidated=False)  # keeps the group's attributes
+            self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT)
+        attrs = dict(dataset.attrs)
         self.root.attrs.update({key: value.tolist() if isinstance(value, np.ndarray) else value.item() if isinstance(value, np.generic) else value for key, value in attrs.items()})
         zarr.consolidate_metadata(self.store, zarr_format=ZARR_FORMAT)
 
