@@ -75,12 +75,15 @@ def test_keep_zarr_keeps_the_store_beside_the_netcdf_file(tmp_path: Path) -> Non
 
 
 def test_a_second_run_on_the_same_output_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from vibroimpact.study.store import claim_output
+
     out = tmp_path / "out"
     out.mkdir()
-    (out / ".run-study.lock").write_text(f"{os.getpid()} {socket.gethostname()} 2026-11-23T01:00:00\n")  # a live run: this process
-    assert cli.main([str(_scene_file(tmp_path)), "--out", str(out), "--jobs", "1"]) == cli.EXIT_BAD_INPUT
-    assert f"is being written by another run-study (process {os.getpid()} on {socket.gethostname()}, since 2026-11-23T01:00:00)" in capsys.readouterr().err
-    assert sorted(p.name for p in out.iterdir()) == [".run-study.lock"]  # nothing written
+    with claim_output(out):  # a live run: this process, through another open file
+        assert cli.main([str(_scene_file(tmp_path)), "--out", str(out), "--jobs", "1"]) == cli.EXIT_BAD_INPUT
+        assert f"is being written by another run-study (process {os.getpid()} on {socket.gethostname()}, since " in capsys.readouterr().err
+        assert sorted(p.name for p in out.iterdir()) == [".run-study.lock"]  # nothing written
+    assert cli.main([str(_scene_file(tmp_path)), "--out", str(out), "--jobs", "1"]) == 0  # released
 
 
 def test_the_estimate_is_for_a_number_of_workers(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -157,7 +157,7 @@ def test_a_second_study_on_the_same_output_is_refused(tmp_path: Path) -> None:
     assert not (tmp_path / ".run-study.lock").exists()
 
 
-def test_a_lock_left_by_a_killed_run_is_taken_over(tmp_path: Path) -> None:
+def test_a_lock_file_left_by_a_killed_run_holds_nothing(tmp_path: Path) -> None:
     dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True, check=True)
     import socket
 

@@ -20,6 +20,7 @@ shared file system. :func:`claim_output` keeps a second study off the same outpu
 from __future__ import annotations
 
 import asyncio
+import fcntl
 import hashlib
 import os
 import shutil
@@ -68,33 +69,40 @@ def store_fingerprint(scene_text: str) -> str:
 
 @contextmanager
 def claim_output(out_dir: Path) -> Iterator[Path]:
-    """Hold ``out_dir/.run-study.lock`` while a study writes there.
+    """Hold an exclusive lock on ``out_dir/.run-study.lock`` while a study writes there.
+
+    The lock is the operating system's (``flock``): it goes with the process, so a run that was killed leaves nothing
+    to clean up, and two runs can never both hold it. The file says who holds it.
 
     Raises
     ------
     OutputBusy
-        When a live ``run-study`` holds it (its process id, host and start time are named). A lock left by a process
-        of this host that no longer exists is taken over.
+        When another process holds it (its process id, host and start time are named).
     """
     lock = out_dir / ".run-study.lock"
-    host = socket.gethostname()
-    for _attempt in range(2):
+    while True:
+        handle = os.open(lock, os.O_CREAT | os.O_RDWR, 0o644)
         try:
-            handle = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
-        except FileExistsError:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(handle)
             owner = _lock_owner(lock)
-            if owner is not None and owner[1] == host and not _alive(owner[0]):
-                lock.unlink(missing_ok=True)  # left by a run that was killed: take it over
-                continue
-            who = f"process {owner[0]} on {owner[1]}, since {owner[2]}" if owner else "another run"
-            raise OutputBusy(f"{out_dir} is being written by another run-study ({who}); wait for it to finish or choose another --out (a stale lock: delete {lock})") from None
-        with os.fdopen(handle, "w") as file:
-            file.write(f"{os.getpid()} {host} {time.strftime('%Y-%m-%dT%H:%M:%S')}\n")
-        break
+            who = f"process {owner[0]} on {owner[1]}, since {owner[2]}" if owner else "another process"
+            raise OutputBusy(f"{out_dir} is being written by another run-study ({who}); wait for it to finish or choose another --out") from None
+        try:
+            same = os.fstat(handle).st_ino == os.stat(lock).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            break
+        os.close(handle)  # the file was removed by its last holder between our open and our lock: take the new one
+    os.ftruncate(handle, 0)
+    os.write(handle, f"{os.getpid()} {socket.gethostname()} {time.strftime('%Y-%m-%dT%H:%M:%S')}\n".encode())
     try:
         yield lock
     finally:
-        lock.unlink(missing_ok=True)
+        lock.unlink(missing_ok=True)  # while still locked: a waiting run then locks a removed file, sees it, retries
+        os.close(handle)
 
 
 def _lock_owner(lock: Path) -> tuple[int, str, str] | None:
@@ -103,16 +111,6 @@ def _lock_owner(lock: Path) -> tuple[int, str, str] | None:
         return int(pid), host, since
     except (OSError, ValueError):
         return None
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
 
 
 class StudyStore:
