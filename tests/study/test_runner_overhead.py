@@ -56,7 +56,7 @@ def test_the_runner_costs_under_a_tenth_of_an_exact_block(tmp_path: Path) -> Non
     variables = {name: (tuple(map(str, v.dims)), np.asarray(v.values), dict(v.attrs)) for name, v in block.data_vars.items()}
     from vibroimpact.study.blocks import _template
 
-    store.begin_grid(_template(variables, dict(zip(("restitution", "clearance", "bumper_frequency", "sweep", "frequency"), plan.full)) | {"solution": 3}, {"frequency": plan.full[-1]}), 10)
+    store.begin_grid(_template(variables, dict(zip(("restitution", "clearance", "bumper_frequency", "sweep", "frequency"), plan.full)) | {"solution": 3}, {"frequency": plan.full[-1]}), 10, (plan.full, plan.block))
     started = time.perf_counter()
     for index in range(10):
         store.write_block(index, {}, {name: (dims, values) for name, (dims, values, _attrs) in variables.items()})
