@@ -97,6 +97,27 @@ def test_a_rerun_takes_finished_blocks_from_the_store(tmp_path: Path, monkeypatc
     xr.testing.assert_identical(first, again)
 
 
+def _interrupt_after(blocks_solved: int, scene: object, path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Run ``scene`` into the store at ``path`` in blocks of 30 frequencies (18 blocks) and interrupt it (Ctrl-C)
+    after ``blocks_solved`` blocks."""
+    from vibroimpact.study import blocks
+
+    monkeypatch.setattr(blocks, "CLOSED_FORM_POINTS", 30)
+    real = blocks._solve_block
+    solved: list[int] = []
+
+    def interrupted(shared: object, index: int, report: object) -> object:
+        if len(solved) == blocks_solved:
+            raise KeyboardInterrupt
+        solved.append(index)
+        return real(shared, index, report)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(blocks, "_solve_block", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run_study(scene, progress=None, store=StudyStore(path, store_fingerprint(scene.text)))  # type: ignore[arg-type, attr-defined]
+    monkeypatch.setattr(blocks, "_solve_block", real)
+
+
 def test_a_half_written_store_resumes_with_the_missing_blocks_only(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Interrupted after some blocks (a block whose flag is not set counts as not written): the rerun solves the
     others only and the result equals an uninterrupted run."""
@@ -104,21 +125,10 @@ def test_a_half_written_store_resumes_with_the_missing_blocks_only(tmp_path: Pat
     path = tmp_path / "grid.zarr"
     from vibroimpact.study import blocks
 
-    monkeypatch.setattr(blocks, "CLOSED_FORM_POINTS", 30)  # 18 blocks of 30 frequencies
+    _interrupt_after(4, scene, path, monkeypatch)
+    assert StudyStore(path, store_fingerprint(scene.text)).block_count() == 4
     real = blocks._solve_block
     solved: list[int] = []
-
-    def interrupted(shared: object, index: int, report: object) -> object:
-        if len(solved) == 4:
-            raise KeyboardInterrupt
-        solved.append(index)
-        return real(shared, index, report)  # type: ignore[arg-type]
-
-    monkeypatch.setattr(blocks, "_solve_block", interrupted)
-    with pytest.raises(KeyboardInterrupt):
-        run_study(scene, progress=None, store=StudyStore(path, store_fingerprint(scene.text)))
-    assert StudyStore(path, store_fingerprint(scene.text)).block_count() == 4
-    solved.clear()
     monkeypatch.setattr(blocks, "_solve_block", lambda shared, index, report: (solved.append(index), real(shared, index, report))[1])
     resumed = run_study(scene, progress=None, store=StudyStore(path, store_fingerprint(scene.text)))
     assert len(solved) == plan_blocks(scene, 1).count - 4 and not set(solved) & set(range(4))
@@ -185,20 +195,7 @@ def test_a_resumed_study_keeps_its_blocks_whatever_its_workers(tmp_path: Path, m
     path = tmp_path / "grid.zarr"
     from vibroimpact.study import blocks
 
-    monkeypatch.setattr(blocks, "CLOSED_FORM_POINTS", 30)  # the first run's plan: 18 blocks of 30 frequencies
-    real = blocks._solve_block
-    solved: list[int] = []
-
-    def interrupted(shared: object, index: int, report: object) -> object:
-        if len(solved) == 5:
-            raise KeyboardInterrupt
-        solved.append(index)
-        return real(shared, index, report)  # type: ignore[arg-type]
-
-    monkeypatch.setattr(blocks, "_solve_block", interrupted)
-    with pytest.raises(KeyboardInterrupt):
-        run_study(scene, progress=None, store=StudyStore(path, store_fingerprint(scene.text)))
-    monkeypatch.setattr(blocks, "_solve_block", real)
+    _interrupt_after(5, scene, path, monkeypatch)  # the first run's plan: 18 blocks of 30 frequencies
     monkeypatch.setattr(blocks, "CLOSED_FORM_POINTS", 50)  # the resumed run would plan other blocks
     store = StudyStore(path, store_fingerprint(scene.text))
     assert store.grid_plan() == ((3, 2, 1, 1, 81), (1, 1, 1, 1, 30))
