@@ -104,7 +104,7 @@ def connect(jobs: int, scheduler: str | None) -> Connection:
         previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if threading.current_thread() is threading.main_thread() else None
         try:
             with dask.config.set(WORKER_CONFIG):  # the nannies hand it to the worker processes
-                cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR, preload=[__name__])
+                cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL, preload=[__name__])
         finally:
             if previous is not None:
                 signal.signal(signal.SIGINT, previous)
