@@ -17,6 +17,7 @@ from vibroimpact import cli
 from vibroimpact.study import run as study
 from vibroimpact.scene import load_scene, shipped_studies, shipped_studies_dir
 
+from tests.run_study_process import start_run_study, stored_blocks
 from tests.scene.test_scene import base_scene, write_yaml
 
 REPOSITORY = Path(__file__).resolve().parents[1]
@@ -78,16 +79,6 @@ def test_a_local_file_wins_over_the_shipped_scene(tmp_path: Path, monkeypatch: p
     assert find_scene("restitution").resolve() == local.resolve()
 
 
-def _finished_blocks(store: Path) -> int:
-    """Blocks flagged done in a study's zarr store (0 before it exists)."""
-    import zarr
-
-    try:
-        return int(np.asarray(zarr.open_group(str(store), mode="r")["block_done"][...]).sum())
-    except (FileNotFoundError, KeyError, ValueError, zarr.errors.GroupNotFoundError):
-        return 0
-
-
 def _slow_scene(folder: Path) -> Path:
     """Enough grid blocks (momentary, 32 simulated points each) that an interrupt lands between two of them."""
     document = base_scene()
@@ -102,19 +93,6 @@ def _slow_scene(folder: Path) -> Path:
     return write_yaml(folder / "interrupted.yaml", document)
 
 
-def _start(arguments: list[str], folder: Path) -> subprocess.Popen[str]:
-    # its own process group, as a terminal's foreground job; SIGINT handled as in an interactive shell
-    return subprocess.Popen(
-        [sys.executable, "-m", "vibroimpact.cli", *arguments],
-        cwd=folder,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-    )
-
-
 @pytest.mark.timeout(480)
 def test_ctrl_c_leaves_one_line_and_a_resumable_store(tmp_path: Path) -> None:
     """Ctrl-C (SIGINT to the whole process group, dask workers included): exit 130, one line saying what was kept,
@@ -122,21 +100,21 @@ def test_ctrl_c_leaves_one_line_and_a_resumable_store(tmp_path: Path) -> None:
     scene = _slow_scene(tmp_path)
     store = tmp_path / "out" / "interrupted.zarr"
     arguments = [str(scene), "--out", "out", "--jobs", "2"]
-    run = _start(arguments, tmp_path)
+    run = start_run_study(arguments, tmp_path)
     deadline = time.monotonic() + 180.0
-    while _finished_blocks(store) == 0 and run.poll() is None and time.monotonic() < deadline:
+    while stored_blocks(store) == 0 and run.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)
     assert run.poll() is None, "the study ended before it could be interrupted"
     os.killpg(run.pid, signal.SIGINT)
     _out, err = run.communicate(timeout=120)  # hang guards: ending takes a second on a quiet machine
-    kept = _finished_blocks(store)
+    kept = stored_blocks(store)
     assert run.returncode == 130, err
     assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
     assert err.rstrip().splitlines()[-1] == f"interrupted: {kept} finished block{'s' if kept != 1 else ''} kept in out/interrupted.zarr; run the same command to resume"
     assert 1 <= kept < 3  # 71 simulated points in blocks of 32: 3 blocks
     assert not (tmp_path / "out" / ".run-study.lock").exists()
     # the rerun begins with the kept cases done
-    rerun = _start(arguments, tmp_path)
+    rerun = start_run_study(arguments, tmp_path)
     assert rerun.stderr is not None
     first_progress = next(line for line in rerun.stderr if line.startswith("simulating"))
     os.killpg(rerun.pid, signal.SIGINT)

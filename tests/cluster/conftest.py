@@ -15,11 +15,9 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
 import pytest
 
-from vibroimpact.study.cluster import SCHEDULER_VARIABLE
-
+from tests.run_study_process import stored_blocks
 from tests.scene.test_scene import base_scene, write_yaml
 
 #: The venv's ``dask`` command (the same dask and distributed as the study's own process).
@@ -50,34 +48,7 @@ def cluster_scene(folder: Path) -> Path:
 
 def finished_blocks(out: Path) -> int:
     """Blocks flagged done in the study's zarr store under ``out`` (0 before the store or its flags exist)."""
-    import zarr
-
-    try:
-        return int(np.asarray(zarr.open_group(str(out / f"{SCENE_NAME}.zarr"), mode="r")["block_done"][...]).sum())
-    except (FileNotFoundError, KeyError, ValueError, zarr.errors.GroupNotFoundError):
-        return 0
-
-
-def study_environment(scheduler: str | None = None) -> dict[str, str]:
-    """This process's environment for ``run-study``, with ``VIBROIMPACT_SCHEDULER`` set to ``scheduler`` (None: unset,
-    whatever the machine running the tests has set)."""
-    environment = {name: value for name, value in os.environ.items() if name != SCHEDULER_VARIABLE}
-    return environment | ({SCHEDULER_VARIABLE: scheduler} if scheduler is not None else {})
-
-
-def start_run_study(arguments: list[str], folder: Path, scheduler_variable: str | None = None) -> subprocess.Popen[str]:
-    """``run-study ARGUMENTS`` in ``folder`` (``VIBROIMPACT_SCHEDULER``: ``scheduler_variable``), in its own process
-    group as a terminal's foreground job (SIGINT handled as in an interactive shell), stdout and stderr piped."""
-    return subprocess.Popen(
-        [sys.executable, "-m", "vibroimpact.cli", *arguments],
-        cwd=folder,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=study_environment(scheduler_variable),
-        start_new_session=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-    )
+    return stored_blocks(out / f"{SCENE_NAME}.zarr")
 
 
 def wait_for_blocks(run: subprocess.Popen[str], out: Path, timeout: float = 120.0) -> int:

@@ -20,7 +20,8 @@ import xarray as xr
 from vibroimpact.scene import load_scene
 from vibroimpact.study.blocks import BlockPlan, plan_blocks
 
-from tests.cluster.conftest import SCENE_NAME, DaskCluster, cluster_scene, finished_blocks, kill_group, start_run_study, study_environment, wait_for_blocks
+from tests.cluster.conftest import SCENE_NAME, DaskCluster, cluster_scene, finished_blocks, kill_group, wait_for_blocks
+from tests.run_study_process import start_run_study, study_environment
 
 pytestmark = pytest.mark.cluster
 
