@@ -75,14 +75,18 @@ class BlockPlan:
         return math.prod(s.stop - s.start for s in self.region(index).values())
 
 
+def _simulates(scene: Scene) -> bool:
+    """Whether the scene asks for a time-domain solution (and so has simulation settings)."""
+    return scene.simulation is not None and any(name in ENGINE_SOLUTIONS for name in scene.solutions)
+
+
 def plan_blocks(scene: Scene, workers: int) -> BlockPlan:
     """Blocks of ``scene``'s grid for ``workers`` workers (module docstring)."""
     frequency = scene.all_frequencies
     bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
     directions = max(len(scene.sweep_directions), 1)
     full = (scene.restitution.size, scene.clearance.size, bumpers, directions, frequency.size)
-    simulated = any(name in ENGINE_SOLUTIONS for name in scene.solutions) and scene.simulation is not None
-    if simulated:
+    if _simulates(scene):
         assert scene.simulation is not None
         rows = full[0] * full[1] * full[2] * full[3]
         per_row = scene.simulation.frequency.size
@@ -131,8 +135,9 @@ def _solve_block(shared: tuple[Scene, BlockPlan, BlockSolver], index: int, repor
 def block_work(scene: Scene, plan: BlockPlan, index: int) -> float:
     """A block's work for the progress bar: simulated points times engine runs, or grid points of closed forms."""
     region = plan.region(index)
-    if scene.simulation is None or not any(name in ENGINE_SOLUTIONS for name in scene.solutions):
+    if not _simulates(scene):
         return float(plan.points(index))
+    assert scene.simulation is not None
     frequencies = scene.all_frequencies[region["frequency"]]
     simulated = np.count_nonzero((scene.simulation.frequency >= frequencies[0]) & (scene.simulation.frequency <= frequencies[-1]))
     rows = math.prod(s.stop - s.start for dim, s in region.items() if dim != "frequency")
@@ -164,9 +169,7 @@ def run_grid(scene: Scene, runner: Runner, solve: BlockSolver, extra_sizes: dict
         store.write_block(index, plan.region(index), {name: (dims, values) for name, (dims, values, _attrs) in variables.items()})
 
     totals = [block_work(scene, plan, index) for index in range(plan.count)]
-    simulated = scene.simulation is not None and any(name in ENGINE_SOLUTIONS for name in scene.solutions)
-    unit, verb = ("points", "simulating") if simulated else ("points", "solving")
-    runner.run_tasks(_solve_block, (scene, plan, solve), list(range(plan.count)), totals, unit, finished, skip=skip, verb=verb)
+    runner.run_tasks(_solve_block, (scene, plan, solve), list(range(plan.count)), totals, "points", finished, skip=skip, verb="simulating" if _simulates(scene) else "solving")
     return store.grid_dataset()
 
 

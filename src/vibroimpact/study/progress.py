@@ -48,17 +48,19 @@ class ProgressBar:
         False: print nothing.
     verb : str
         The bar's first word.
+    done_before : float
+        Work done before these tasks (cases an interrupted run finished), in ``unit``: counted as done.
     """
 
-    def __init__(self, totals: list[float], finished: list[int], unit: str, enabled: bool, verb: str = "simulating") -> None:
+    def __init__(self, totals: list[float], finished: list[int], unit: str, enabled: bool, verb: str = "simulating", done_before: float = 0.0) -> None:
         self.totals = totals
-        self.total = max(sum(totals), 1e-300)
+        self.total = max(sum(totals) + done_before, 1e-300)
         self.done = {index: totals[index] for index in finished}
         self.finished = set(finished)
-        self.done_sum = float(sum(self.done.values()))
+        self.done_sum = float(sum(self.done.values())) + done_before
         self.unit = unit
         self.verb = verb
-        self.enabled = enabled and sum(totals) > 0
+        self.enabled = enabled and sum(totals) + done_before > 0
         self.started = time.perf_counter()
         self.first_done = self.done_sum
         self.tty = sys.stderr.isatty()

@@ -221,8 +221,7 @@ class Runner:
         """
         skipped = set(skip)
         order = [index for index in range(len(items)) if index not in skipped]
-        bar_totals = [*totals, done_before]
-        bar = ProgressBar(bar_totals, [*skipped, len(items)], unit, self.progress, verb)
+        bar = ProgressBar(list(totals), list(skipped), unit, self.progress, verb, done_before)
         try:
             if not self.distributed:
                 for index in order:
@@ -342,15 +341,7 @@ def _task(function: TaskFunction, shared: Any, item: Any, topic: str, index: int
     worker = get_worker()
     if source_hash() != source:
         raise OtherCode(f"the dask worker {worker.address} runs vibroimpact {__version__} from {Path(__file__).parents[1]} whose source differs from the study's: install the same version on every worker")
-    last = [0.0]
-
-    def send(done: float) -> None:
-        now = time.monotonic()
-        if now - last[0] >= 0.25:
-            last[0] = now
-            worker.log_event(topic, (index, done))
-
-    return function(shared, item, send)
+    return function(shared, item, Throttled(lambda done: worker.log_event(topic, (index, done))))
 
 
 def _run_cases(_shared: Any, cases: list[Case], report: ProgressReport) -> list[CaseResult]:

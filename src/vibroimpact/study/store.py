@@ -237,10 +237,6 @@ class StudyStore:
                     variable.attrs[key] = np.asarray(variable.attrs[key], dtype=variable.dtype)
         return dataset
 
-    def finished_count(self) -> int:
-        """Finished blocks and cases in the store (for the message of an interrupted run)."""
-        return self.block_count() + self.case_count()
-
     def keep(self, dataset: xr.Dataset) -> None:
         """Finish a store that outlives its study: the coordinates of its dimensions (``frequency``, the swept
         parameters, ``solution``) and the attributes of the study's ``dataset``, and consolidated metadata, so that
