@@ -1,0 +1,31 @@
+"""Write the golden files again: ``python -m tests.golden.bless [NAME ...]`` (default: every golden scene).
+
+Only on purpose: say in the commit message why the numbers or the pages changed (``CHANGES.md`` for a re-bless of
+the whole suite).
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+from pathlib import Path
+
+from tests.golden.golden import DATA, compute, scene_names
+from vibroimpact.study.io import write_dataset
+
+
+def bless(name: str) -> None:
+    with tempfile.TemporaryDirectory() as folder:
+        dataset, text = compute(name, Path(folder))
+    write_dataset(dataset, DATA / f"{name}.nc")
+    page = DATA / f"{name}.txt"
+    if text is None:
+        page.unlink(missing_ok=True)
+    else:
+        page.write_text(text, encoding="utf-8")
+    print(f"blessed {name}", flush=True)
+
+
+if __name__ == "__main__":
+    for name in sys.argv[1:] or scene_names():
+        bless(name)
