@@ -50,3 +50,43 @@ def test_a_fixed_method_overrides_the_settings() -> None:
 def test_an_unknown_name_lists_the_registered_ones() -> None:
     with pytest.raises(ValueError, match="engine 'adams' is unknown: use one of exact, exact_python, momentary"):
         make_engine("adams")
+
+
+@pytest.mark.parametrize("name", list(ENGINES))
+def test_a_built_engine_carries_its_registry_rows_capabilities(name: str) -> None:
+    engine = make_engine(name)
+    assert engine.capabilities == engine_spec(name).capabilities
+    assert engine.capabilities.contact == engine_spec(name).contact
+
+
+@pytest.mark.parametrize("name", [name for name, spec in ENGINES.items() if spec.capabilities.exact_jacobians])
+def test_an_engine_with_exact_jacobians_returns_one_per_period(name: str) -> None:
+    problem = ImpactProblem(PAPER_SYSTEM, RigidStop(PAPER_CLEARANCE, 0.4), HarmonicForce(PAPER_AMPLITUDE, 25.0))
+    trajectory = make_engine(name).integrate(problem, np.zeros(4), 0.0, 3, jacobians=True)
+    assert trajectory.strobe_jacobians.shape == (3, 4, 4) and np.all(np.isfinite(trajectory.strobe_jacobians))
+
+
+def test_steady_states_ask_the_capability_not_the_name() -> None:
+    """The exact engine registered under another name is measured on its shot orbit as ``exact`` is (the steady
+    state asked its name once: a renamed twin marched from the orbit instead)."""
+    from vibroimpact.engines.exact import ExactEngine
+    from vibroimpact.simulation.steady import steady_state
+
+    class Renamed(ExactEngine):
+        name = "exact_under_another_name"
+
+    problem = ImpactProblem(PAPER_SYSTEM, RigidStop(PAPER_CLEARANCE, 0.2), HarmonicForce(PAPER_AMPLITUDE, 25.0))
+    reference = steady_state(make_engine("exact"), problem, "shooting")
+    renamed = steady_state(Renamed(EngineSettings()), problem, "shooting")
+    assert reference.converged and renamed.converged
+    assert renamed.periods_used == reference.periods_used  # exact: a count
+    assert renamed.measures.x1 == pytest.approx(reference.measures.x1, rel=1e-14, abs=0.0)
+
+
+def test_every_stepped_solution_has_a_presentation_row() -> None:
+    from vibroimpact.reporting.style import SOLUTION_LOOKS
+    from vibroimpact.scene.schema import ENGINE_SOLUTIONS, SOLUTIONS
+
+    assert set(SOLUTIONS) == set(SOLUTION_LOOKS)
+    assert all(SOLUTION_LOOKS[name].marker is not None for name in ENGINE_SOLUTIONS)
+    assert set(ENGINE_SOLUTIONS) == {name for name, spec in ENGINES.items() if spec.capabilities.stepped_solution}

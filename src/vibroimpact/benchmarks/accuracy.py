@@ -36,7 +36,7 @@ from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.engines.base import Engine, SweepRecord, Trajectory
-from vibroimpact.engines.registry import BUMPER, engine_spec, make_engine
+from vibroimpact.engines.registry import BUMPER, ENGINES, engine_spec, make_engine
 from vibroimpact.engines.settings import REFERENCE_RTOL, EngineSettings
 from vibroimpact.engines.compliant.ivp import solve_ivp_sweep
 from vibroimpact.simulation.harmonics import measure, running_fundamental
@@ -49,7 +49,7 @@ __all__ = ["run_benchmark", "model_ladder", "equal_error_speedup", "loosest_tole
 
 SLOW_RUN = 5.0  # [s] a run longer than this is not repeated
 #: Engines whose runs ignore rtol and atol: measured once per case, stored at every tolerance.
-TOLERANCE_FREE = frozenset({"exact", "exact_python"})
+TOLERANCE_FREE = frozenset(name for name, spec in ENGINES.items() if spec.capabilities.tolerance_free)
 
 _T = TypeVar("_T")
 

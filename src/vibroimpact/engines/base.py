@@ -11,6 +11,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from vibroimpact.engines.registry import Capabilities
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import Contact, ImpactProblem
 
@@ -239,6 +240,8 @@ class Engine(Protocol):
     """A time-domain solver of an :class:`ImpactProblem` with a harmonic force, period by period."""
 
     name: str
+    #: what it can do (its registry row's; code asks these, never the name)
+    capabilities: Capabilities
 
     def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
         """Integrate ``periods`` whole periods from ``state`` at ``t_start``."""
@@ -249,6 +252,7 @@ class SweepingEngine(Protocol):
     """A time-domain solver of an :class:`ImpactProblem` with a :class:`SweptSine` excitation, start to end."""
 
     name: str
+    capabilities: Capabilities
 
     def sweep(
         self, problem: ImpactProblem, sample_rate: float, state: NDArray[np.float64] | None = None, progress: Callable[[float], None] | None = None

@@ -23,6 +23,7 @@ from typing import Callable
 import numpy as np
 from numpy.typing import NDArray
 
+from vibroimpact.engines.registry import INTEGRATOR, Capabilities
 from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory, TrajectoryBuilder
 from vibroimpact.engines.flow_layout import flow_layout
 from vibroimpact.engines.rigid_contact import RigidContact
@@ -167,6 +168,8 @@ class EventLoopEngine(ABC):
     """Template: integrate period by period, apply the contact map and the sticking rules between calls."""
 
     name = "event-loop"
+    #: what it can do when built directly (:func:`~vibroimpact.engines.registry.make_engine` sets its registry row's)
+    capabilities: Capabilities = INTEGRATOR
 
     def __init__(self, settings: EngineSettings = EngineSettings()) -> None:
         self.settings = settings

@@ -25,6 +25,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
+from vibroimpact.engines.registry import ENGINES, Capabilities
 from vibroimpact.engines import exact_core
 from vibroimpact.engines.base import Trajectory, check_run
 from vibroimpact.engines.exact_flows import Flow
@@ -151,6 +152,8 @@ class ExactEngine:
     """Exact piecewise-linear reference engine, compiled (see module docstring)."""
 
     name = "exact"
+    #: what it can do when built directly (the registry's row; :func:`~vibroimpact.engines.registry.make_engine` sets its own)
+    capabilities: Capabilities = ENGINES["exact"].capabilities
 
     def __init__(self, settings: EngineSettings = EngineSettings()) -> None:
         self.settings = settings

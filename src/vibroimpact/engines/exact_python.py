@@ -20,6 +20,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
+from vibroimpact.engines.registry import ENGINES, Capabilities
 from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory, TrajectoryBuilder
 from vibroimpact.engines.exact_model import ExactModel, build_model
 from vibroimpact.engines.linear_flow import HarmonicLinearFlow, Observable, Piece, escape_step, first_crossing, gauss_legendre
@@ -34,6 +35,8 @@ class PythonExactEngine:
     """The pure-Python exact engine (see module docstring): the compiled core's cross-check and speed baseline."""
 
     name = "exact_python"
+    #: what it can do when built directly (the registry's row; :func:`~vibroimpact.engines.registry.make_engine` sets its own)
+    capabilities: Capabilities = ENGINES["exact_python"].capabilities
 
     def __init__(self, settings: EngineSettings = EngineSettings()) -> None:
         self.settings = settings

@@ -1,10 +1,11 @@
 """Every engine by name: the one vocabulary of scenes, studies, benchmarks, the cost estimate and the tests.
 
 An entry names the class that implements the engine (imported on first use, so that a scene can check engine names
-without loading a solver library), the contact law it solves, and the options it is built with. Adding an engine
-is one module plus one line here::
+without loading a solver library), what it can do (:class:`Capabilities`: the contact law it solves, exact
+Jacobians, an exact flow, tolerances), and the options it is built with. Code asks an engine's capabilities, never
+its name. Adding an engine is one module plus one line here::
 
-    "my_engine": EngineSpec("vibroimpact.engines.my_engine:MyEngine", RIGID, "what it is"),
+    "my_engine": EngineSpec("vibroimpact.engines.my_engine:MyEngine", Capabilities(RIGID), "what it is"),
 """
 
 from __future__ import annotations
@@ -16,10 +17,42 @@ from typing import Any, Mapping
 
 from vibroimpact.engines.settings import EngineSettings
 
-__all__ = ["RIGID", "BUMPER", "EngineSpec", "ENGINES", "engine_names", "engine_spec", "make_engine"]
+__all__ = ["RIGID", "BUMPER", "Capabilities", "EngineSpec", "ENGINES", "engine_names", "stepped_solutions", "engine_spec", "make_engine"]
 
 #: Contact laws an engine can solve: the momentary-impact stop and the Kelvin-Voigt bumper.
 RIGID, BUMPER = "rigid", "bumper"
+
+
+@dataclass(frozen=True)
+class Capabilities:
+    """What an engine can do, as the code that runs it asks.
+
+    Attributes
+    ----------
+    contact : str
+        :data:`RIGID` or :data:`BUMPER`: the contact law of the problems it integrates.
+    exact_jacobians : bool
+        ``integrate(..., jacobians=True)`` also returns the exact Jacobian of each period's stroboscopic map.
+    exact_flow : bool
+        Its trajectories are the exact piecewise-linear flow (no tolerance): an orbit shot on the exact stroboscopic
+        map is its own steady state, measured without confirming it by marching.
+    tolerance_free : bool
+        Its tolerances change nothing: one run stands for every tolerance of a benchmark.
+    stepped_solution : bool
+        Offered as a time-domain solution of stepped studies under its registry name.
+    """
+
+    contact: str
+    exact_jacobians: bool = False
+    exact_flow: bool = False
+    tolerance_free: bool = False
+    stepped_solution: bool = False
+
+    def __post_init__(self) -> None:
+        if self.contact not in (RIGID, BUMPER):
+            raise ValueError(f"contact = {self.contact!r} is not allowed: use {RIGID!r} or {BUMPER!r}")
+        if self.exact_flow and not self.tolerance_free:
+            raise ValueError("an engine with an exact flow has no tolerance: tolerance_free must be True")
 
 
 @dataclass(frozen=True)
@@ -30,8 +63,8 @@ class EngineSpec:
     ----------
     target : str
         ``module:class`` of the engine; the class is called as ``cls(settings, **options)``.
-    contact : str
-        :data:`RIGID` or :data:`BUMPER`: the contact law of the problems it integrates.
+    capabilities : Capabilities
+        What it can do; the built engine carries them (``engine.capabilities``).
     description : str
         One line for listings.
     options : mapping
@@ -41,7 +74,7 @@ class EngineSpec:
     """
 
     target: str
-    contact: str
+    capabilities: Capabilities
     description: str
     options: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
     settings_method: str | None = None
@@ -52,30 +85,43 @@ class EngineSpec:
         engine_class = getattr(importlib.import_module(module_name), class_name)
         if self.settings_method is not None and settings.method != self.settings_method:
             settings = EngineSettings(**{**settings.__dict__, "method": self.settings_method})
-        return engine_class(settings, **self.options)
+        engine = engine_class(settings, **self.options)
+        engine.capabilities = self.capabilities
+        return engine
+
+    @property
+    def contact(self) -> str:
+        """:data:`RIGID` or :data:`BUMPER`: the contact law of the problems it integrates."""
+        return self.capabilities.contact
+
+
+#: A rigid-stop engine that integrates to a tolerance; the bumper's.
+INTEGRATOR, BUMPER_INTEGRATOR = Capabilities(RIGID), Capabilities(BUMPER)
+#: The exact engine's algorithm: the closed-form flow.
+EXACT_FLOW = Capabilities(RIGID, exact_flow=True, tolerance_free=True)
 
 
 def _solve_ivp(method: str) -> EngineSpec:
-    return EngineSpec("vibroimpact.engines.scipy_ivp:SolveIvpEngine", RIGID, f"scipy solve_ivp ({method}) with terminal events and restarts: a comparison baseline", MappingProxyType({"method": method}))
+    return EngineSpec("vibroimpact.engines.scipy_ivp:SolveIvpEngine", INTEGRATOR, f"scipy solve_ivp ({method}) with terminal events and restarts: a comparison baseline", MappingProxyType({"method": method}))
 
 
 #: name -> engine. ``momentary`` uses the method of its settings; the suffixed names fix it.
 ENGINES: Mapping[str, EngineSpec] = MappingProxyType(
     {
-        "exact": EngineSpec("vibroimpact.engines.exact:ExactEngine", RIGID, "piecewise-exact closed-form flow with guaranteed contact search, compiled: the reference"),
-        "exact_python": EngineSpec("vibroimpact.engines.exact_python:PythonExactEngine", RIGID, "the exact engine's algorithm in pure Python: its cross-check and speed baseline"),
-        "momentary": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", RIGID, "SUNDIALS CVODE with contact events and a grazing guard (method from the settings)"),
-        "momentary_adams": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", RIGID, "SUNDIALS CVODE, Adams, with contact events and a grazing guard", settings_method="adams"),
-        "momentary_bdf": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", RIGID, "SUNDIALS CVODE, BDF, with contact events and a grazing guard", settings_method="bdf"),
+        "exact": EngineSpec("vibroimpact.engines.exact:ExactEngine", Capabilities(RIGID, exact_jacobians=True, exact_flow=True, tolerance_free=True, stepped_solution=True), "piecewise-exact closed-form flow with guaranteed contact search, compiled: the reference"),
+        "exact_python": EngineSpec("vibroimpact.engines.exact_python:PythonExactEngine", EXACT_FLOW, "the exact engine's algorithm in pure Python: its cross-check and speed baseline"),
+        "momentary": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", Capabilities(RIGID, stepped_solution=True), "SUNDIALS CVODE with contact events and a grazing guard (method from the settings)"),
+        "momentary_adams": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", INTEGRATOR, "SUNDIALS CVODE, Adams, with contact events and a grazing guard", settings_method="adams"),
+        "momentary_bdf": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", INTEGRATOR, "SUNDIALS CVODE, BDF, with contact events and a grazing guard", settings_method="bdf"),
         "solve_ivp_RK45": _solve_ivp("RK45"),
         "solve_ivp_DOP853": _solve_ivp("DOP853"),
         "solve_ivp_LSODA": _solve_ivp("LSODA"),
         "solve_ivp_Radau": _solve_ivp("Radau"),
         "solve_ivp_BDF": _solve_ivp("BDF"),
-        "compliant": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", BUMPER, "Kelvin-Voigt bumper through SUNDIALS IDA, one solver per contact mode"),
-        "compliant_ida": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", BUMPER, "the engine compliant, under the name benchmark scenes use"),
-        "compliant_cvode_adams": EngineSpec("vibroimpact.engines.compliant.cvode:CompliantCvodeEngine", BUMPER, "Kelvin-Voigt bumper through SUNDIALS CVODE (Adams)", settings_method="adams"),
-        "compliant_cvode_bdf": EngineSpec("vibroimpact.engines.compliant.cvode:CompliantCvodeEngine", BUMPER, "Kelvin-Voigt bumper through SUNDIALS CVODE (BDF)", settings_method="bdf"),
+        "compliant": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", Capabilities(BUMPER, stepped_solution=True), "Kelvin-Voigt bumper through SUNDIALS IDA, one solver per contact mode"),
+        "compliant_ida": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", BUMPER_INTEGRATOR, "the engine compliant, under the name benchmark scenes use"),
+        "compliant_cvode_adams": EngineSpec("vibroimpact.engines.compliant.cvode:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (Adams)", settings_method="adams"),
+        "compliant_cvode_bdf": EngineSpec("vibroimpact.engines.compliant.cvode:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (BDF)", settings_method="bdf"),
     }
 )
 
@@ -83,6 +129,11 @@ ENGINES: Mapping[str, EngineSpec] = MappingProxyType(
 def engine_names(contact: str | None = None) -> tuple[str, ...]:
     """Registered names, in registry order; only those solving ``contact`` (:data:`RIGID`, :data:`BUMPER`) if given."""
     return tuple(name for name, spec in ENGINES.items() if contact is None or spec.contact == contact)
+
+
+def stepped_solutions() -> tuple[str, ...]:
+    """Engines offered as time-domain solutions of stepped studies, in registry order."""
+    return tuple(name for name, spec in ENGINES.items() if spec.capabilities.stepped_solution)
 
 
 def engine_spec(name: str) -> EngineSpec:

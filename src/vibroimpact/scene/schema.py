@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from vibroimpact.analysis.pgf import AdmissibilitySettings
-from vibroimpact.engines.registry import BUMPER, RIGID, engine_names, engine_spec
+from vibroimpact.engines.registry import BUMPER, RIGID, engine_names, engine_spec, stepped_solutions
 from vibroimpact.engines.settings import ATOL_RATIO, STEPPED_TOLERANCES, EngineSettings
 from vibroimpact.model.contact import KelvinVoigtBumper, loss_factor_from_restitution
 from vibroimpact.model.excitation import SweptSine
@@ -53,8 +53,9 @@ __all__ = [
 
 #: Kinds of study a scene can be (:attr:`Scene.kind`); each has its run and estimate (``study/kinds.py``) and its page.
 STUDY_KINDS = ("stepped", "swept", "benchmark", "bifurcation", "validation", "concepts")
-#: Solutions computed by time integration (they need the ``simulation`` section's settings): registered engines.
-ENGINE_SOLUTIONS = ("momentary", "exact", "compliant")
+#: Solutions computed by time integration (they need the ``simulation`` section's settings): the registered engines
+#: offered as stepped solutions.
+ENGINE_SOLUTIONS = stepped_solutions()
 #: Solutions a scene can ask for: the closed forms, then the engines.
 SOLUTIONS = ("linear", "pgf", "pgf_paper", *ENGINE_SOLUTIONS)
 #: The contact law of each engine solution (from the engine registry, which must name every one of them).

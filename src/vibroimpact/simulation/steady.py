@@ -231,7 +231,7 @@ def steady_state(
         used = shot.periods if shot is not None else 0
         if shot is not None and shot.stable:
             t, y = shot.time, shot.state
-            if engine.name == "exact":  # the orbit is the steady state: measure it
+            if engine.capabilities.exact_flow:  # the orbit is the engine's own steady state: measure it
                 return _measure(engine, problem, t, y, 1, used, settings, scale)
             first_chunk = 3  # an integrator starts on the orbit: it needs only to confirm that its state repeats
         else:
@@ -266,7 +266,7 @@ def _measure(
 ) -> SteadyResult:
     """Measure whole periods from (t, y): a periodic motion over a multiple of its period.
 
-    A motion that did not converge first runs ``lyapunov_periods`` more (with the exact Jacobians for ``exact``):
+    A motion that did not converge first runs ``lyapunov_periods`` more (with the exact Jacobians where the engine has them):
     if its strobes then repeat with a period up to :data:`LONG_MULTIPLICITY`, it is that periodic orbit, reached
     late (the same repeat test as marching's, on the same ``scale`` of the motion); otherwise that run says what the
     motion is (:func:`motion_evidence`), and ``irregular_measure_periods`` are measured after it.
@@ -274,7 +274,7 @@ def _measure(
     motion = None
     periods = 0
     if not multiplicity and settings.lyapunov_periods:
-        exact = engine.name == "exact"
+        exact = engine.capabilities.exact_jacobians
         run = engine.integrate(problem, y, t, settings.lyapunov_periods, jacobians=True) if exact else engine.integrate(problem, y, t, settings.lyapunov_periods)
         periods = settings.lyapunov_periods
         t, y = float(run.strobe_times[-1]), run.final_state

@@ -78,10 +78,12 @@ class SteppedStudy:
 
         def engine_part(name: str, engine: str) -> EnginePart:
             assert scene.simulation is not None
-            copies = bumpers if engine_spec(name).contact == BUMPER else 1  # a bumper engine runs once per bumper
+            capabilities = engine_spec(name).capabilities
+            copies = bumpers if capabilities.contact == BUMPER else 1  # a bumper engine runs once per bumper
             steady = scene.simulation.steady
-            # where the motion may never settle, an integrator also runs a perturbed copy of its Lyapunov run
-            wandering = np.count_nonzero(periods >= steady.max_periods + steady.lyapunov_periods) if name != "exact" else 0
+            # where the motion may never settle, an engine without exact Jacobians also runs a perturbed copy of its
+            # Lyapunov run
+            wandering = np.count_nonzero(periods >= steady.max_periods + steady.lyapunov_periods) if not capabilities.exact_jacobians else 0
             total_periods = (float(periods.sum()) + wandering * steady.lyapunov_periods) * scale * copies
             seconds = costs.per_period_cost(engine, scene.simulation.engine.rtol) * engine_scale(scene) * total_periods
             integrated = int(np.count_nonzero(periods) * scale) * copies

@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from scipy.linalg import matrix_balance
 
 from vibroimpact.engines.base import MODE_STUCK, Trajectory
-from vibroimpact.engines.registry import make_engine
+from vibroimpact.engines.registry import ENGINES, make_engine
 from vibroimpact.engines.settings import ATOL_RATIO, EngineSettings
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.scene.validation_problems import relative_stop_problem, zeno_problem
@@ -33,8 +33,8 @@ from vibroimpact.study.validation_formulas import zeno_sticking_bounds, zeno_sti
 
 __all__ = ["run_zeno", "run_relative_stop", "FreeFlight", "free_flight", "INTEGRATOR_ALLOWANCE", "ROUND_OFF_EVENTS"]
 
-#: Engines whose event times are exact to round-off.
-EXACT_ENGINES = ("exact", "exact_python")
+#: Engines whose event times are exact to round-off: those computing the exact flow.
+EXACT_ENGINES = tuple(name for name, spec in ENGINES.items() if spec.capabilities.exact_flow)
 #: Round-off allowance of an exact engine's sticking time, per impact, in units of eps x t_Z [-].
 ROUND_OFF_EVENTS = 64.0
 #: Allowance of an integrator's sticking time, in units of atol / (v_s (1 - e)) [-]: an event's time is off by about

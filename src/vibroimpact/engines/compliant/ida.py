@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 from sksundae.ida import IDA
 
+from vibroimpact.engines.registry import BUMPER_INTEGRATOR, Capabilities
 from vibroimpact.engines.base import MODE_FREE, SweepRecord, Trajectory, TrajectoryBuilder, check_run
 from vibroimpact.engines.compliant.model import MODE_CONTACT, BumperModel, absolute_tolerances
 from vibroimpact.engines.event_loop import moment_row
@@ -67,6 +68,8 @@ class CompliantEngine:
     """
 
     name = "compliant"
+    #: what it can do when built directly (:func:`~vibroimpact.engines.registry.make_engine` sets its registry row's)
+    capabilities: Capabilities = BUMPER_INTEGRATOR
 
     def __init__(self, settings: EngineSettings = EngineSettings()) -> None:
         self.settings = settings
