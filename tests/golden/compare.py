@@ -3,8 +3,8 @@
 
 Each golden scene is run again and compared with its blessed dataset:
 
-* **settled points** (the whole dataset where it has no ``regime``; else the points whose regime, blessed and now, is
-  neither irregular, quasi-periodic, chaotic nor failed): every float variable to :data:`TOLERANCE` relative to the
+* **settled points** (the points whose regime, blessed and now, is neither irregular, quasi-periodic, chaotic nor
+  failed, or whose simulation converged, by :data:`MARKERS`; every point where nothing says): every float variable to :data:`TOLERANCE` relative to the
   variable's largest magnitude, every integer variable (flags, counts) equal;
 * **unsettled points** (not periodic, blessed or now: chaotic sets re-rolled by round-off): by class, count and
   statistics (the count of each regime and the median |X1| over them), reported, not held to a tolerance;
@@ -56,11 +56,22 @@ def _where(array: xr.DataArray, index: int) -> str:
     return ", ".join(f"{dim}={array[dim].values[i]}" if dim in array.coords else f"{dim}[{i}]" for dim, i in zip(array.dims, position))
 
 
-def _settled_mask(now: xr.Dataset, blessed: xr.Dataset, variable: xr.DataArray) -> np.ndarray:
-    """Points of ``variable`` whose motion is periodic blessed and now (all points where there is no regime)."""
-    if "regime" not in blessed or "regime" not in now or not set(blessed["regime"].dims) <= set(variable.dims):
+#: Which variable says whether a point settled, by the prefix of the variables it covers (the longest prefix wins):
+#: a regime flag (unsettled: :data:`UNSETTLED`) or a converged flag (unsettled: 0).
+MARKERS = {"": "regime", "brute_": "brute_regime", "simulated_": "simulated_converged", "bumper_": "bumper_converged"}
+
+
+def _unsettled(marker: xr.DataArray) -> xr.DataArray:
+    return marker.isin(UNSETTLED) if "regime" in str(marker.name) else marker == 0
+
+
+def _settled_mask(now: xr.Dataset, blessed: xr.Dataset, name: str, variable: xr.DataArray) -> np.ndarray:
+    """Points of ``variable`` whose motion is periodic blessed and now (all points where nothing says)."""
+    prefix = max((p for p in MARKERS if name.startswith(p) and MARKERS[p] in blessed), key=len, default=None)
+    marker = MARKERS[prefix] if prefix is not None else None
+    if marker is None or marker not in now or not set(blessed[marker].dims) <= set(variable.dims):
         return np.ones(variable.shape, dtype=bool)
-    unsettled = blessed["regime"].isin(UNSETTLED) | now["regime"].isin(UNSETTLED)
+    unsettled = _unsettled(blessed[marker]) | _unsettled(now[marker])
     return ~xr.broadcast(unsettled, variable)[0].transpose(*variable.dims).values
 
 
@@ -83,14 +94,14 @@ def compare_datasets(name: str, now: xr.Dataset, blessed: xr.Dataset) -> SceneCh
             if not np.array_equal(old.values, new.values):
                 changes.structure.append(f"`{variable_name}`: values changed")
             continue
-        settled = _settled_mask(now, blessed, old)
+        settled = _settled_mask(now, blessed, str(variable_name), old)
         a, b = np.asarray(new.values), np.asarray(old.values)
         if old.dtype.kind in "iu":
             differ = (a != b) & settled
             count = int(np.count_nonzero(differ))
             where = _where(old, int(np.flatnonzero(differ)[0])) if count else ""
             changes.rows.append((f"`{variable_name}`", f"{count} of {int(settled.sum())} settled points differ", where, count == 0))
-            if variable_name == "regime":
+            if variable_name in ("regime", "brute_regime"):
                 for index in np.flatnonzero((a != b).ravel()):
                     changes.reclassified.append(f"{_where(old, int(index))}: {int(b.ravel()[index])} -> {int(a.ravel()[index])}")
             continue

@@ -81,3 +81,21 @@ def test_unstable_pgf_orbit_is_left(system: TwoDofSystem, engine: object) -> Non
     result = steady_state(engine, problem, "pgf", SteadySettings(max_periods=300))  # type: ignore[arg-type]
     expected = pgf_values(system, 38.0, 0.2)
     assert not (result.converged and abs(abs(result.measures.x1) - expected["x1"]) < 1e-3 * expected["x1"])
+
+
+def test_a_preloaded_stop_on_the_named_system_converges(system: TwoDofSystem) -> None:
+    """A negative clearance (the stop preloads the absorber by 1 mm) on the paper's named system: the repeat test's
+    scale is the general one, |Delta| + q |n . H|, positive; the paper's own Delta + q |H12| was negative at 40 Hz
+    (-0.14 mm), so the strobes could never repeat and every such point was reported not converged."""
+    from vibroimpact.simulation.steady import motion_scale
+
+    problem = ImpactProblem(system, RigidStop(-0.001, 0.5), HarmonicForce(PAPER_AMPLITUDE, 40.0))
+    assert np.all(motion_scale(problem) > 0.0)
+    # the stop holds the absorber (no impact): the primary mass's transient decays at xi ~ 0.0026, slowly
+    result = steady_state(ExactEngine(), problem, "rest", SteadySettings(lyapunov_periods=0, max_periods=3000))
+    assert result.converged and result.multiplicity == 1  # exact: a count
+    assert result.measures.impacts_per_period == 0.0 and abs(result.measures.x2) < 1e-15  # exact: held, no impact
+    # held, the primary mass moves as the linear system with the absorber fixed: X1 = q / (k1 + k2 - m1 w^2 + j w (b1 + b2))
+    omega = problem.omega
+    held = PAPER_AMPLITUDE / (system.k1 + system.k2 - system.m1 * omega**2 + 1j * omega * (system.b1 + system.b2))
+    assert abs(result.measures.x1) == pytest.approx(abs(held), rel=1e-6)

@@ -15,12 +15,14 @@ from vibroimpact.study.bifurcation_seeds import seed_branches, sweep_seeds
 pytestmark = pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")
 
 Q, DELTA, R, LOW, HIGH = 10.0, 3e-3, 0.8, 20.4, 22.0
-FREQUENCIES = (20.4, 20.5, 20.6, 20.8, 21.0, 21.5, 22.0)
+#: The sweep starts past the chaotic stretch (20.6-21 Hz): a sweep through it carries a state that round-off re-rolls
+#: into either of two coexisting attractors at 21-22 Hz (period 6 with 6 impacts, or period 1 with 2 impacts)
+FREQUENCIES = (21.5, 22.0)
 
 
 @pytest.fixture(scope="module")
 def seeded():
-    """R = 0.8, sweeping up over 20.4-22 Hz: at 22 Hz the sweep settles on an orbit of period 6 with 6 impacts."""
+    """R = 0.8, sweeping up over 21.5-22 Hz: at 22 Hz the sweep settles on an orbit of period 6 with 6 impacts."""
     sweep = SweepCase(PAPER_SYSTEM, Q, DELTA, R, "up", FREQUENCIES, 300, 64).run()
     seeds = sweep_seeds(np.array(FREQUENCIES), sweep["period"], sweep["impacts"], sweep["state"])
     found = find_branches(PAPER_SYSTEM, Q, DELTA, R, LOW, HIGH)

@@ -7,14 +7,11 @@ plane n_k^T T = 0 and x_p = Delta_k n_k / |n_k|^2, so the held flow is the struc
 loads T^T (f - K x_p)), of 2N - 2 states, lifted to the full state. The holding force is
 lambda_k = m_k (M^-1 n_k) . (f(t) - C x' - K x) (:meth:`~vibroimpact.model.problem.ImpactProblem.contact_holding`).
 
-The paper's layout (:class:`~vibroimpact.model.system.TwoDofSystem`, one upper stop on the absorber, force on the
-primary mass) is built exactly as before the generalisation to any layout (same formulas, same round-off), so that its
-results are unchanged bit for bit; the general route gives the same to ~1e-13 (tests/engines/test_exact_layouts.py).
+Every layout, the paper's included, is built by this one route.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,7 +19,6 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines.exact_flows import Flow, decompose, mechanical_null_basis
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.system import TwoDofSystem
 
 __all__ = ["ExactModel", "build_model"]
 
@@ -120,30 +116,6 @@ def _stuck_flow(problem: ImpactProblem, k: int) -> tuple[Flow, NDArray[np.float6
     return flow.lifted(lift, offset, lift.T), lift  # T orthonormal: L^T is L's left inverse
 
 
-def _paper_flows(problem: ImpactProblem) -> tuple[Flow, Flow]:
-    """The paper's free and stuck flows by the formulas the engine always used (complex eigen-decomposition, X1's
-    constant solution K2 Delta / (K1 + K2)), so that its results do not change by a bit."""
-    s, p = problem.system, problem
-    assert isinstance(s, TwoDofSystem)
-    a = np.ascontiguousarray(s.state_matrix, dtype=float)
-    stuck = np.array([[0.0, 1.0], [-(s.k1 + s.k2) / s.m1, -(s.b1 + s.b2) / s.m1]])
-    forcing = p.amplitude * complex(math.cos(p.phase), math.sin(p.phase)) / s.m1
-    jw = 1j * p.omega
-
-    def raw(matrix: NDArray[np.float64], load: NDArray[np.complex128], constant: NDArray[np.float64]) -> Flow:
-        lam, vec = np.linalg.eig(np.array(matrix, dtype=complex))
-        n = lam.size
-        return Flow(
-            lam, np.ascontiguousarray(vec), np.ascontiguousarray(np.linalg.inv(vec)), np.linalg.solve(jw * np.eye(n) - matrix, load), constant,
-            np.zeros((n, n)), np.zeros((n, n)), np.zeros(n), p.omega,
-        )  # fmt: skip
-
-    free = raw(a, np.array([0, 0, forcing, 0], dtype=complex), np.zeros(4))
-    held = raw(stuck, np.array([0, forcing], dtype=complex), np.array([s.k2 * p.clearance / (s.k1 + s.k2), 0.0]))
-    lift = np.array([[1.0, 0.0], [0.0, 0.0], [0.0, 1.0], [0.0, 0.0]])
-    return free, held.lifted(lift, np.array([0.0, p.clearance, 0.0, 0.0]), lift.T)
-
-
 def build_model(problem: ImpactProblem, length_scale: float) -> ExactModel:
     """The :class:`ExactModel` of a problem with rigid stops and a harmonic load; ``length_scale`` [m] sets the
     round-off of the holding forces (see :class:`~vibroimpact.engines.rigid_contact.RigidContact`)."""
@@ -152,7 +124,6 @@ def build_model(problem: ImpactProblem, length_scale: float) -> ExactModel:
     structure = problem.structure
     mass, stiffness, damping = structure.mass_matrix, structure.stiffness_matrix, structure.damping_matrix
     a, b, b0 = problem.first_order()
-    paper = isinstance(problem.system, TwoDofSystem) and problem.paper_layout
     normals = problem.normals()
     kicks = np.linalg.solve(mass, normals.T).T.reshape(count, size)
     masses = 1.0 / np.einsum("ki,ki->k", normals, kicks)
@@ -162,33 +133,20 @@ def build_model(problem: ImpactProblem, length_scale: float) -> ExactModel:
         support = np.flatnonzero(normals[k])
         if support.size == 1 and np.count_nonzero(kicks[k]) == 1 and kicks[k, support[0]] != 0.0:
             simple[k] = support[0]
-    if paper:
-        free, held = _paper_flows(problem)
-        stuck = (held,)
-        s = problem.system
-        assert isinstance(s, TwoDofSystem)
-        a = np.ascontiguousarray(s.state_matrix, dtype=float)
-        b = np.array([0, 0, problem.amplitude * complex(math.cos(problem.phase), math.sin(problem.phase)) / s.m1, 0], dtype=complex)
-        masses = np.array([s.m2])
-        hold_weights = np.array([[-s.k2, 0.0, -s.b2, 0.0]])
-        hold_offsets = np.array([s.k2 * problem.clearance])
-        hold_harmonics = np.zeros(1, dtype=complex)
-        force_tolerances = np.array([1e-15 * (s.k2 + s.b2 * problem.omega) * length_scale])
-    else:
-        free = decompose(a, b, b0, problem.omega, mechanical_null_basis(mass, stiffness, damping))
-        flows = [_stuck_flow(problem, k) for k in range(count)]
-        stuck = tuple(flow for flow, _lift in flows)
-        # lambda_k = m_k (M^-1 n_k) . (f(t) - C x' - K x): minus it, as weights over y, an offset and a harmonic
-        hold_weights = np.array([masses[k] * np.concatenate([kicks[k] @ stiffness, kicks[k] @ damping]) for k in range(count)]).reshape(count, n)
-        hold_offsets = np.array([-masses[k] * kicks[k] @ static for k in range(count)])
-        hold_harmonics = np.array([-masses[k] * kicks[k] @ harmonic for k in range(count)], dtype=complex)
-        tolerances = []
-        for k, (_flow, lift) in enumerate(flows):
-            on_surface = hold_weights[k] @ lift
-            half = on_surface.size // 2
-            spread = (np.sum(np.abs(on_surface[:half])) + problem.omega * np.sum(np.abs(on_surface[half:]))) * length_scale
-            tolerances.append(1e-15 * (spread + abs(hold_harmonics[k]) + abs(hold_offsets[k])))
-        force_tolerances = np.array(tolerances)
+    free = decompose(a, b, b0, problem.omega, mechanical_null_basis(mass, stiffness, damping))
+    flows = [_stuck_flow(problem, k) for k in range(count)]
+    stuck = tuple(flow for flow, _lift in flows)
+    # lambda_k = m_k (M^-1 n_k) . (f(t) - C x' - K x): minus it, as weights over y, an offset and a harmonic
+    hold_weights = np.array([masses[k] * np.concatenate([kicks[k] @ stiffness, kicks[k] @ damping]) for k in range(count)]).reshape(count, n)
+    hold_offsets = np.array([-masses[k] * kicks[k] @ static for k in range(count)])
+    hold_harmonics = np.array([-masses[k] * kicks[k] @ harmonic for k in range(count)], dtype=complex)
+    tolerances = []
+    for k, (_flow, lift) in enumerate(flows):
+        on_surface = hold_weights[k] @ lift
+        half = on_surface.size // 2
+        spread = (np.sum(np.abs(on_surface[:half])) + problem.omega * np.sum(np.abs(on_surface[half:]))) * length_scale
+        tolerances.append(1e-15 * (spread + abs(hold_harmonics[k]) + abs(hold_offsets[k])))
+    force_tolerances = np.array(tolerances)
     restitutions = np.array([stop.law.restitution for stop in problem.stops])
     bounce, stick, touch = (np.tile(np.eye(n), (count, 1, 1)) for _ in range(3))
     for k in range(count):

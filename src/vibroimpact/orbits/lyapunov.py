@@ -212,7 +212,7 @@ def state_scales(problem: ImpactProblem) -> NDArray[np.float64]:
     problem's velocity scale; the rigid-contact engines use the same length for their relative thresholds), in
     general the largest |Delta_k| plus v / w; w L for the velocities.
     """
-    clearance = problem.clearance if not isinstance(problem.contact, tuple) else float(np.max(np.abs(problem.clearances()), initial=0.0))
+    clearance = float(np.max(np.abs(problem.clearances()), initial=0.0))
     length = clearance + problem.velocity_scale() / problem.omega
     return np.repeat([length, problem.omega * length], problem.size)
 
@@ -353,15 +353,10 @@ def lyapunov_along_run(engine: Engine, problem: ImpactProblem, run: Trajectory, 
 def _inside(problem: ImpactProblem, y: NDArray[np.float64], d: NDArray[np.float64], scale: NDArray[np.float64]) -> NDArray[np.float64]:
     """The perturbation, turned away from every stop it would push the structure through.
 
-    On the paper's layout: its X2 component made negative when X2 + dX2 > Delta. In general, for each stop k whose gap
+    For each stop k whose gap
     Delta_k - n_k . (x + dx) would be negative, the displacement part is mirrored in the stop's plane (dx -> dx - 2
     (n_k . dx) n_k / |n_k|^2, the displacement scales being equal), which for n = e2 is the same sign flip.
     """
-    if not isinstance(problem.contact, tuple):
-        if y[1] + d[1] * scale[1] > problem.clearance:
-            d = d.copy()
-            d[1] = -abs(d[1])
-        return d
     size = problem.size
     for n, clearance in zip(problem.normals(), problem.clearances()):
         step = d[:size] * scale[:size]

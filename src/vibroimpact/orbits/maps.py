@@ -30,7 +30,6 @@ from numpy.typing import ArrayLike, NDArray
 from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.orbits.branch import HybridInfo, MapEvaluation, PeriodicOrbit
 from vibroimpact.orbits.starts import closed_form_state, one_impact_state, section_phase, with_impulse
 
@@ -114,11 +113,7 @@ class ImpactMap:
         chosen = problem.stops[self.stops[0]]
         self.parameters = np.array([problem.frequency, chosen.law.restitution, chosen.clearance, problem.amplitude])
         self.dimension = 2 * problem.size
-        self._paper = isinstance(problem.system, TwoDofSystem) and not isinstance(problem.contact, tuple) and problem.paper_layout
-        if self._paper:
-            length = problem.clearance + problem.amplitude * float(np.abs(problem.system.receptances(problem.omega).h12))
-        else:
-            length = problem.velocity_scale() / problem.omega
+        length = problem.velocity_scale() / problem.omega  # Delta + q |H12| on the paper's layout
         self.state_scale = np.repeat([length, problem.omega * length], problem.size)
         self.parameter_scale = np.array([1.0, 0.1, 1e-3, 1.0]) if parameter_scale is None else np.array(parameter_scale, dtype=float)
         if self.parameter_scale.shape != (4,) or not np.all(self.parameter_scale > 0.0):
@@ -138,8 +133,6 @@ class ImpactMap:
         frequency, restitution, clearance, amplitude = (float(x) for x in p)
         base = self.problem
         excitation = dataclasses.replace(base.harmonic, amplitude=amplitude, frequency=frequency)
-        if self._paper:
-            return ImpactProblem(base.system, RigidStop(clearance, restitution), excitation)
         law = RigidStop(clearance, restitution)
         stops = tuple(dataclasses.replace(item, law=law) if k in self.stops else item for k, item in enumerate(base.stops))
         return ImpactProblem(base.system, stops, excitation)
@@ -181,8 +174,6 @@ class ImpactMap:
 
 def _outside_stops(problem: ImpactProblem, y: NDArray[np.float64]) -> bool:
     """Every gap Delta_k - n_k . x >= 0 (on the paper's layout: X2 <= Delta)."""
-    if not isinstance(problem.contact, tuple):
-        return bool(y[1] <= problem.clearance)
     return bool(np.all(problem.clearances() - problem.normals() @ np.asarray(y[: problem.size], dtype=float) >= 0.0))
 
 

@@ -22,9 +22,8 @@ from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.stops import Stop
 from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.simulation.layout import named_system_of
 
-__all__ = ["LoadSpec", "StopSpec", "build_stops", "stop_descriptions", "describe_stop", "as_named_system", "paper_layout"]
+__all__ = ["LoadSpec", "StopSpec", "build_stops", "stop_descriptions", "describe_stop"]
 
 
 @dataclass(frozen=True)
@@ -147,19 +146,3 @@ def stop_descriptions(specs: tuple[StopSpec, ...], names: tuple[str, ...], resti
     delta = float(clearance[0]) if clearance.size == 1 else None
     r = float(restitution[0]) if restitution.size == 1 else None
     return tuple(describe_stop(spec, names, delta, r) for spec in specs)
-
-
-def as_named_system(structure: object) -> TwoDofSystem | None:
-    """The paper's named system that ``structure`` is, if it is one (see :func:`vibroimpact.simulation.layout.named_system_of`)."""
-    return named_system_of(structure)
-
-
-def paper_layout(structure: object, specs: tuple[StopSpec, ...], load: LoadSpec | None) -> bool:
-    """Is this the paper's layout: a named (or chain) two-mass system, one upper stop on x2 against the base, the
-    harmonic force on x1 alone, no static force and no base motion?"""
-    if as_named_system(structure) is None:
-        return False
-    stops = specs or (StopSpec(coordinate=1),)
-    one = len(stops) == 1 and stops[0].coordinate == 1 and stops[0].other is None and stops[0].side == "upper"
-    plain = load is None or (load.weights in (None, (1.0, 0.0)) and not any(load.static or ()) and not load.base_motion)
-    return one and plain

@@ -114,7 +114,7 @@ def measure(trajectory: Trajectory) -> HarmonicMeasures:
     peaks = trajectory.contact_peaks
     peak_force, peak_acceleration = _peaks(peaks, impacts)
     per_stop = [_peaks(peaks[trajectory.contact_peak_stops == k], int(np.count_nonzero(stops == k))) for k in range(count)]
-    contact = complex(forces[0]) if problem.paper_layout else complex(base_weights(problem) @ forces)
+    contact = complex(base_weights(problem) @ forces)
     nan = complex(math.nan, math.nan)
     return HarmonicMeasures(
         x1=complex(x[0]),

@@ -1,7 +1,7 @@
-"""What steady states need to know of any layout: the linear steady state, the force on the base, a start that
-respects every stop, and whether a structure is the paper's named two-mass system.
+"""What steady states need to know of any layout: the linear steady state, the force on the base and a start that
+respects every stop.
 
-For the paper's layout these give the paper's quantities: the suspension force (K1 + j w B1) X1, the stop's force on
+For the paper's layout these are the paper's quantities: the suspension force (K1 + j w B1) X1, the stop's force on
 the base, the linear state q H X. For any structure the force on the base through its springs and dashpots is
 1^T (K x + C x') (internal springs cancel in the sum), and an absolute stop k pushes the base with (1^T n_k) lambda_k
 (+lambda for an upper stop, -lambda for a lower one; a relative stop acts inside the structure, 1^T n_k = 0).
@@ -16,39 +16,18 @@ from numpy.typing import NDArray
 
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
-from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["named_system_of", "base_coupling", "base_weights", "LinearState", "linear_state", "static_offset", "resting_state", "gaps"]
-
-
-def named_system_of(structure: object) -> TwoDofSystem | None:
-    """The paper's named system that ``structure`` is, if it is one: two coordinates, a diagonal mass matrix, and
-    stiffness and damping of a chain (base - x1 - x2) with K1, K2 > 0 and B1, B2 >= 0; else None."""
-    if isinstance(structure, TwoDofSystem):
-        return structure
-    if not isinstance(structure, LinearStructure) or structure.size != 2:
-        return None
-    m, k, b = structure.mass_matrix, structure.stiffness_matrix, structure.damping_matrix
-    if m[0, 1] != 0.0 or k[1, 1] != -k[0, 1] or b[1, 1] != -b[0, 1]:
-        return None
-    values = {"m1": m[0, 0], "m2": m[1, 1], "k1": k[0, 0] + k[0, 1], "k2": k[1, 1], "b1": b[0, 0] + b[0, 1], "b2": b[1, 1]}
-    if min(values["k1"], values["k2"]) <= 0.0 or min(values["b1"], values["b2"]) < 0.0:
-        return None
-    return TwoDofSystem(**{key: float(value) for key, value in values.items()})
+__all__ = ["base_coupling", "base_weights", "LinearState", "linear_state", "static_offset", "resting_state", "gaps"]
 
 
-def base_coupling(system: TwoDofSystem | LinearStructure) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def base_coupling(system: LinearStructure) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """(1^T K, 1^T C): the force on the base through the springs [N m-1] and dashpots [N s m-1] per coordinate
     ((K1, 0) and (B1, 0) for the paper's system)."""
-    if isinstance(system, TwoDofSystem):
-        return np.array([system.k1, 0.0]), np.array([system.b1, 0.0])
     return system.stiffness_matrix.sum(axis=0), system.damping_matrix.sum(axis=0)
 
 
-def suspension_force(system: TwoDofSystem | LinearStructure, omega: float, x: NDArray[np.complex128]) -> complex:
+def suspension_force(system: LinearStructure, omega: float, x: NDArray[np.complex128]) -> complex:
     """Fundamental of the force on the base through springs and dashpots [N] for coordinate fundamentals ``x`` [m]."""
-    if isinstance(system, TwoDofSystem):
-        return complex((system.k1 + 1j * omega * system.b1) * x[0])  # the paper's expression, bit for bit
     stiffness, damping = base_coupling(system)
     return complex((stiffness + 1j * omega * damping) @ x)
 

@@ -22,14 +22,11 @@ from numpy.typing import NDArray
 from vibroimpact.engines.base import Engine
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.simulation.harmonics import HarmonicMeasures, measure
-from vibroimpact.simulation.layout import gaps, linear_state, named_system_of, resting_state, suspension_force
+from vibroimpact.simulation.layout import gaps, linear_state, resting_state, suspension_force
 from vibroimpact.model.stops import Stop
-from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
-from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
 from vibroimpact.simulation.periodic import motion_evidence, shoot_orbit
 from vibroimpact.simulation.settings import START_MODES, SteadySettings
 from vibroimpact.orbits.motion import MotionEvidence
@@ -85,32 +82,13 @@ def start_state(problem: ImpactProblem, mode: str, orbit_stop: RigidStop | tuple
     if mode not in START_MODES:
         raise ValueError(f"start = {mode!r} is not allowed: use one of {', '.join(START_MODES)}")
     if mode == "rest":
-        return 0.0, _rest(problem)
+        return 0.0, resting_state(problem)
     if mode in ("pgf", "shooting"):
         guess = pgf_guesses(problem, [problem.frequency], orbit_stop)[0]
         if guess is not None:
             return guess
-    if not _paper(problem):
-        state = linear_state(problem).state(problem.omega)
-        return (0.0, _rest(problem)) if np.any(gaps(problem, state) < 0.0) else (0.0, state)
-    response = linear_response(problem.system, problem.omega, problem.amplitude)
-    x = np.array([response.x1, response.x2]) * np.exp(1j * problem.phase)
-    state = np.concatenate([x.real, (1j * problem.omega * x).real])
-    if state[1] > problem.clearance:  # the linear state would start inside the stop: start at rest instead
-        return 0.0, _rest(problem)
-    return 0.0, state
-
-
-def _paper(problem: ImpactProblem) -> bool:
-    """The paper's named system in the paper's layout: the closed forms of its named receptances apply."""
-    return isinstance(problem.system, TwoDofSystem) and problem.paper_layout
-
-
-def _rest(problem: ImpactProblem) -> NDArray[np.float64]:
-    """At rest, respecting every stop (zeros for the paper's layout with Delta >= 0)."""
-    if _paper(problem) and problem.clearance >= 0.0:
-        return np.zeros(4)
-    return resting_state(problem)
+    state = linear_state(problem).state(problem.omega)
+    return (0.0, resting_state(problem)) if np.any(gaps(problem, state) < 0.0) else (0.0, state)
 
 
 def orbit_stop_of(problem: ImpactProblem, orbit_stop: RigidStop | tuple[Stop, ...] | None = None) -> RigidStop | tuple[Stop, ...]:
@@ -129,39 +107,16 @@ def pgf_guesses(problem: ImpactProblem, frequencies: Sequence[float], orbit_stop
     """The ``pgf`` start (time [s], state) at each of ``frequencies`` [Hz], from one vectorised closed-form solution;
     None where no admissible one-impact orbit exists.
 
-    The orbit's time origin is its impact, where the force has phase (phi - psi12); in the problem's time (force
-    q cos(w t + phase)) that is t_impact = (phi - psi12 - phase) / w. The start is half a period after it, away from
-    the impact. ``problem`` gives the system, the force's amplitude and phase, and (with ``orbit_stop``, see
-    :func:`orbit_stop_of`) the stop. Layouts without a closed form get None everywhere (the ``linear`` start).
+    The start is midway between impacts (half a period after the impact, a quarter for a symmetric two-sided stop),
+    away from them. ``problem`` gives the system, the force's amplitude and phase, and (with ``orbit_stop``, see
+    :func:`orbit_stop_of`) the stop. Layouts without a closed form (one stop, or a symmetric two-sided stop) get None
+    everywhere (the ``linear`` start).
     """
-    stop = orbit_stop_of(problem, orbit_stop)
-    system = named_system_of(problem.system)
-    if isinstance(stop, tuple):
-        rigid = ImpactProblem(problem.system, stop, problem.excitation)
-        if system is None or not rigid.paper_layout:
-            return _general_guesses(rigid, frequencies)
-        stop = stop[0].law
-    if system is None or not isinstance(stop, RigidStop):
+    rigid = ImpactProblem(problem.system, orbit_stop_of(problem, orbit_stop), problem.excitation)
+    if closed_form_refusal(rigid) is not None:
         return [None] * len(frequencies)
     omega = 2.0 * np.pi * np.asarray(frequencies, dtype=float)
-    orbit = solve_one_impact(system, omega, stop.clearance, stop.restitution, problem.amplitude)
-    ok = orbit.exists & orbit.admissible()
-    period = 2.0 * np.pi / omega
-    half = 0.5 * period[:, None]
-    with np.errstate(invalid="ignore"):
-        states = np.stack([orbit.x1(half)[:, 0], orbit.x2(half)[:, 0], orbit.x1(half, 1)[:, 0], orbit.x2(half, 1)[:, 0]], axis=-1)
-        forcing_phase = orbit.phase - np.angle(orbit.receptances.h12)
-        t_impact = np.mod((forcing_phase - problem.phase) / omega, period)
-    return [(float(t_impact[i] + half[i, 0]), states[i]) if ok[i] else None for i in range(omega.size)]
-
-
-def _general_guesses(problem: ImpactProblem, frequencies: Sequence[float]) -> list[tuple[float, NDArray[np.float64]] | None]:
-    """The ``pgf`` starts of any layout with a closed-form orbit (one stop, or a symmetric two-sided stop), midway
-    between impacts; None everywhere where no closed form applies, and where its orbit is not admissible."""
-    if closed_form_refusal(problem) is not None:
-        return [None] * len(frequencies)
-    omega = 2.0 * np.pi * np.asarray(frequencies, dtype=float)
-    orbit = solve_impact_orbit(problem, omega)
+    orbit = solve_impact_orbit(rigid, omega)
     with np.errstate(invalid="ignore"):
         ok = orbit.exists & orbit.admissible()
         offset = 0.5 * orbit.window  # half-way to the next impact (T/2, or T/4 for a two-sided stop)
@@ -172,16 +127,12 @@ def _general_guesses(problem: ImpactProblem, frequencies: Sequence[float]) -> li
 
 def linear_fits(problem: ImpactProblem) -> bool:
     """The linear steady state stays clear of every stop (the paper's layout: q |H12| <= Delta)."""
-    if _paper(problem):
-        return bool(problem.amplitude * abs(complex(problem.system.receptances(problem.omega).h12)) <= problem.clearance)
     return linear_state(problem).fits(problem)
 
 
 def motion_scale(problem: ImpactProblem) -> NDArray[np.float64]:
     """Scales of the state's entries for the repeat test [m, m s-1]: L for displacements, w L for velocities, with
-    L = Delta + q |H12| for the paper's layout and the largest |Delta_k| + |n_k . X| (+ a static term) in general."""
-    if _paper(problem):
-        return np.array([1.0, 1.0, problem.omega, problem.omega]) * (problem.clearance + problem.amplitude * abs(complex(problem.system.receptances(problem.omega).h12)))
+    L the largest |Delta_k| + |n_k . X| (+ a static term): Delta + q |H12| on the paper's layout."""
     length = problem.velocity_scale() / problem.omega
     return np.concatenate([np.full(problem.size, length), np.full(problem.size, problem.omega * length)])
 
@@ -325,37 +276,6 @@ def _repeat(strobes: NDArray[np.float64], scale: NDArray[np.float64], settings: 
 
 
 def _linear_answer(problem: ImpactProblem) -> SteadyResult:
-    if not _paper(problem):
-        return _general_linear_answer(problem)
-    response = linear_response(problem.system, problem.omega, problem.amplitude)
-    rotation = np.exp(1j * problem.phase)
-    x1, x2 = complex(response.x1) * rotation, complex(response.x2) * rotation
-    measures = HarmonicMeasures(
-        x1=x1,
-        x2=x2,
-        suspension_force=complex(response.force) * rotation,
-        contact_force=0j,
-        x1_rms=abs(x1) / math.sqrt(2.0),
-        x2_rms=abs(x2) / math.sqrt(2.0),
-        impacts_per_period=0.0,
-        mean_impulse=0.0,
-        impulse_per_period=0.0,
-        periods=0,
-        peak_contact_force=0.0,
-        peak_acceleration=0.0,
-        displacements=(x1, x2),
-        rms=(abs(x1) / math.sqrt(2.0), abs(x2) / math.sqrt(2.0)),
-        stop_contact_forces=(0j,),
-        stop_impacts=(0.0,),
-        stop_impulses=(0.0,),
-        stop_peak_forces=(0.0,),
-        stop_peak_accelerations=(0.0,),
-    )
-    _t, state = start_state(problem, "linear")
-    return SteadyResult(measures=measures, converged=True, multiplicity=1, periods_used=0, end_time=0.0, end_state=state, integrated=False)
-
-
-def _general_linear_answer(problem: ImpactProblem) -> SteadyResult:
     """The linear steady state of any layout, where it stays clear of every stop (an exact steady state)."""
     linear = linear_state(problem)
     x, rms = linear.amplitudes, linear.rms()
