@@ -266,3 +266,18 @@ def test_the_page_of_a_real_study_names_its_recommendation(paper_map: xr.Dataset
         assert (tmp_path / f"{figure}.png").stat().st_size > 10_000
     row = re.search(r"<tr><td><b>★ 1</b></td><td><b>([0-9.]+)</b></td><td><b>([0-9.]+)</b></td>", text)
     assert row is not None and float(row.group(1)) == pytest.approx(best.design.restitution) and float(row.group(2)) == pytest.approx(3.5)
+
+
+@pytest.mark.parametrize(("simulated", "closed_form_larger"), [(3e-3 * (1.0 - 1e-12), False), (3e-3 * (1.0 + 1e-12), False), (2e-3, True)])
+def test_the_closed_form_coexists_only_where_it_is_another_orbit(simulated: float, closed_form_larger: bool) -> None:
+    """The simulation settled on the closed form's own orbit (|X1| equal to round-off) is one steady state, not two
+    coexisting ones: the page's dagger and "coexists" once followed a 1e-14 change of the simulated amplitude."""
+    from vibroimpact.reporting.design_metrics import worst_stable_x1
+
+    ds = synthetic([0.2], [1e-3], ("linear", "pgf", "exact"))
+    put(ds, at(ds, "pgf", 0, 0, 24.0), x1_amplitude=3e-3, regime=int(Regime.ONE_IMPACT), stable=1, impacts_per_period=1.0)
+    put(ds, at(ds, "exact", 0, 0, 24.0), x1_amplitude=simulated, regime=int(Regime.ONE_IMPACT), converged=1, impacts_per_period=1.0)
+    worst, realised, larger = worst_stable_x1(ds, "exact")
+    k = int(np.flatnonzero(F == 24.0)[0])
+    assert bool(realised[0, 0, k]) and bool(larger[0, 0, k]) is closed_form_larger
+    assert worst[0, 0, k] == pytest.approx(3e-3 if closed_form_larger else simulated, rel=1e-15)

@@ -97,6 +97,9 @@ _MUST_IMPACT = (Regime.ONE_IMPACT, Regime.NONE, Regime.NONE_INADMISSIBLE_ONE_IMP
 _UNSTABLE = 0
 #: The closed form whose stable states count alongside a simulation's.
 COMPANION = "pgf"
+#: Relative margin [-] by which the companion's |X1| must exceed the simulated one to count as another, larger steady
+#: state: within it the two are one orbit (a converged simulation repeats to a tolerance of ~1e-7 of the motion).
+SAME_ORBIT = 1e-6
 
 
 @dataclass(frozen=True)
@@ -237,7 +240,7 @@ def worst_stable_x1(dataset: xr.Dataset, solution: str) -> tuple[np.ndarray, np.
     (ndarray, ndarray, ndarray)
         Shape (restitution, clearance, frequency): |X1| [m] (NaN: none known); where ``solution`` itself realised a
         value (the others are counted as unknown); where the value is the companion closed form's
-        (:func:`companion_solution`), larger than the simulated one or the only one.
+        (:func:`companion_solution`), larger than the simulated one by more than :data:`SAME_ORBIT` or the only one.
     """
     classes = design_regimes(dataset, solution)
     x1 = _part(dataset, solution)["x1_amplitude"].sel(frequency=classes["frequency"]).values
@@ -247,7 +250,7 @@ def worst_stable_x1(dataset: xr.Dataset, solution: str) -> tuple[np.ndarray, np.
     if companion is None:
         return own, realised, np.zeros(own.shape, bool)
     other = companion[0]
-    larger = np.isfinite(other) & ~(own >= other)
+    larger = np.isfinite(other) & ~(own >= other * (1.0 - SAME_ORBIT))
     return np.where(larger, other, own), realised, larger
 
 
