@@ -18,7 +18,8 @@ from vibroimpact.scene.checker import SceneError
 from vibroimpact.scene.concepts import parse_concepts
 from vibroimpact.model.absorber import den_hartog_absorber
 from vibroimpact.study.concepts_metrics import anti_resonance_band, band_metrics, envelope, stretches
-from vibroimpact.study.concepts_steady import base_force, check_stops
+from vibroimpact.simulation.layout import base_force, base_weights
+from vibroimpact.study.concepts_steady import check_stops
 
 SYSTEM = TwoDofSystem(1.0, 0.1, 25000.0, 4300.0, 0.8, 0.08)
 
@@ -80,7 +81,7 @@ def test_the_force_on_the_base(stops: tuple[Stop, ...], through: float) -> None:
     x = np.array([1e-3 + 2e-4j, 3e-3 - 1e-3j])
     contact = np.array([0.7 - 0.2j])
     expected = (25000.0 + 1j * problem.omega * 0.8) * x[0] + through * contact[0]
-    assert abs(base_force(problem, x, contact) - expected) <= 1e-12 * abs(expected)
+    assert abs(base_force(problem.structure, problem.omega, x, base_weights(problem), contact) - expected) <= 1e-12 * abs(expected)
 
 
 def _trajectory(problem: ImpactProblem, after_impact: np.ndarray) -> Trajectory:

@@ -27,7 +27,11 @@ from numpy.typing import NDArray
 from vibroimpact.analysis.impact_orbit import ImpactOrbit
 from vibroimpact.analysis.pgf import OneImpactSolution
 
-__all__ = ["floquet_multipliers", "is_stable", "monodromy", "half_period_jacobian", "saltation"]
+__all__ = ["floquet_multipliers", "is_stable", "monodromy", "half_period_jacobian", "saltation", "MARGINAL_MODULUS"]
+
+#: Distance of the largest |Floquet multiplier| from 1 [-] within which an orbit is marginal: on the unit circle to
+#: round-off (a conservative orbit, the closed form of an undamped or R = 1 layout), neither stable nor unstable.
+MARGINAL_MODULUS = 1e-9
 
 
 def _flow(state_matrix: NDArray[np.float64], duration: NDArray[np.float64]) -> NDArray[np.float64]:

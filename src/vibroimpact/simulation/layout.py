@@ -12,12 +12,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
 
-__all__ = ["base_coupling", "base_weights", "LinearState", "linear_state", "static_offset", "resting_state", "gaps"]
+__all__ = ["base_force", "suspension_force", "base_coupling", "base_weights", "LinearState", "linear_state", "static_offset", "resting_state", "gaps"]
 
 
 def base_coupling(system: LinearStructure) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -26,10 +26,33 @@ def base_coupling(system: LinearStructure) -> tuple[NDArray[np.float64], NDArray
     return system.stiffness_matrix.sum(axis=0), system.damping_matrix.sum(axis=0)
 
 
+def base_force(system: LinearStructure, omega: ArrayLike, x: ArrayLike, through: ArrayLike | None = None, contact: ArrayLike | None = None) -> NDArray[np.complex128]:
+    """Fundamental of the force on the base [N]: 1^T (K + j w C) x through the springs and dashpots, plus
+    sum_k (1^T n_k) F_k of the stops' contact forces when given; the one formula of every closed form and study.
+
+    Parameters
+    ----------
+    system : LinearStructure
+        The structure (K, C).
+    omega : array_like
+        Angular frequency [rad s-1], broadcast against ``x``'s leading axes.
+    x : array_like of complex, shape (..., N)
+        Fundamentals of the coordinates [m].
+    through : array_like, shape (K,), optional
+        1^T n_k of each stop (:func:`base_weights`): +1 an upper stop against the base, -1 a lower one, 0 relative.
+    contact : array_like of complex, shape (..., K), optional
+        Fundamentals of the stops' contact forces [N].
+    """
+    stiffness, damping = base_coupling(system)
+    force = np.einsum("...i,...i->...", stiffness + 1j * np.asarray(omega, dtype=float)[..., None] * damping, np.asarray(x))
+    if contact is not None and through is not None:
+        force = force + np.einsum("...k,k->...", np.asarray(contact), np.asarray(through, dtype=float))
+    return force
+
+
 def suspension_force(system: LinearStructure, omega: float, x: NDArray[np.complex128]) -> complex:
     """Fundamental of the force on the base through springs and dashpots [N] for coordinate fundamentals ``x`` [m]."""
-    stiffness, damping = base_coupling(system)
-    return complex((stiffness + 1j * omega * damping) @ x)
+    return complex(base_force(system, omega, x))
 
 
 def base_weights(problem: ImpactProblem) -> NDArray[np.float64]:

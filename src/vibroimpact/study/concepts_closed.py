@@ -16,13 +16,11 @@ from numpy.typing import NDArray
 
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.pgf import solve_one_impact
-from vibroimpact.analysis.stability import floquet_multipliers
+from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.scene.concepts import Concept
+from vibroimpact.simulation.layout import base_force
 
 __all__ = ["ClosedForms", "closed_forms", "MARGINAL_MODULUS"]
-
-#: |Floquet multiplier| within this distance of 1 is marginal, not stable.
-MARGINAL_MODULUS = 1e-9
 
 
 @dataclass(frozen=True)
@@ -66,9 +64,7 @@ def closed_forms(concept: Concept, amplitude: float, frequency: NDArray[np.float
     load = np.zeros(structure.size, dtype=complex)
     load[0] = amplitude
     x = structure.receptance_matrix(w) @ load
-    ones = np.ones(structure.size)
-    dynamic = structure.stiffness_matrix[None] + 1j * w[:, None, None] * structure.damping_matrix[None]
-    base = np.einsum("i,fij,fj->f", ones, dynamic, x)
+    base = base_force(structure, w, x)
     fits = np.ones(f.shape, dtype=bool)
     for stop in concept.stops:
         fits &= np.abs(x @ stop.normal(structure.size)) <= stop.clearance
@@ -107,13 +103,11 @@ def _general_orbit(concept: Concept, amplitude: float, linear: ClosedForms) -> C
     admissible = orbit.admissible()
     harmonics = orbit.harmonics()
     x1 = np.where(admissible, np.abs(harmonics[..., 0]), np.nan)
-    structure = concept.system.structure
     w = orbit.omega
-    dynamic = structure.stiffness_matrix[None] + 1j * w[:, None, None] * structure.damping_matrix[None]
     rate = orbit.impacts_per_period * 2.0 * orbit.impulse / orbit.period
     through = float(np.sum(orbit.normal))  # 1^T n: 0 for a relative stop, whose impulses stay inside the structure
     # time from the impact: the base feels (1^T n) J at t = 0 and, two-sided, -(1^T n) J at T/2: fundamental k J / T
-    base = np.einsum("i,fij,fj->f", np.ones(structure.size), dynamic, harmonics) + through * rate
+    base = base_force(concept.system.structure, w, harmonics) + through * rate
     force = np.where(admissible, np.abs(base), np.nan)
     stable = np.full(w.shape, -1, dtype=np.int8)
     index = np.flatnonzero(admissible)

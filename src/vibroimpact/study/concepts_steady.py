@@ -23,9 +23,10 @@ from numpy.typing import NDArray
 from vibroimpact.engines.base import Trajectory
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.simulation.layout import base_force, base_weights
 from vibroimpact.simulation.settings import SteadySettings
 
-__all__ = ["Fundamentals", "SteadyOutcome", "fundamentals", "base_force", "linear_start", "march", "length_scale", "check_stops", "GAP_TOLERANCE"]
+__all__ = ["Fundamentals", "SteadyOutcome", "fundamentals", "linear_start", "march", "length_scale", "check_stops", "GAP_TOLERANCE"]
 
 #: Largest |gap| at an impact, and largest penetration anywhere recorded, as a fraction of the motion's length scale [-].
 GAP_TOLERANCE = 1e-6
@@ -62,16 +63,6 @@ class Fundamentals:
     peak_contact_force: float
 
 
-def base_force(problem: ImpactProblem, x: NDArray[np.complex128], contact: NDArray[np.complex128]) -> complex:
-    """Complex fundamental of the force on the base [N] from the coordinates' ``x`` [m] and the stops' ``contact``
-    [N] fundamentals: 1^T (K + j w C) x + sum_k (1^T n_k) F_k."""
-    structure = problem.structure
-    ones = np.ones(problem.size)
-    dynamic = structure.stiffness_matrix + 1j * problem.omega * structure.damping_matrix
-    through_stops = problem.normals().sum(axis=1) if problem.stops else np.zeros(0)
-    return complex(ones @ dynamic @ np.asarray(x) + through_stops @ np.asarray(contact))
-
-
 def fundamentals(trajectory: Trajectory) -> Fundamentals:
     """:class:`Fundamentals` over every period of ``trajectory`` (integrated with ``moments=True``)."""
     periods = trajectory.periods
@@ -91,7 +82,7 @@ def fundamentals(trajectory: Trajectory) -> Fundamentals:
         peak_force = peak_acceleration = math.nan
     else:
         peak_force = peak_acceleration = 0.0
-    return Fundamentals(x, contact, base_force(problem, x, contact), contacts / periods, float(np.sum(trajectory.impulses)) / periods, peak_acceleration, peak_force)
+    return Fundamentals(x, contact, complex(base_force(problem.structure, problem.omega, x, base_weights(problem), contact)), contacts / periods, float(np.sum(trajectory.impulses)) / periods, peak_acceleration, peak_force)
 
 
 def length_scale(problem: ImpactProblem) -> float:

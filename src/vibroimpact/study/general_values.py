@@ -18,18 +18,16 @@ import numpy as np
 from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
 from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.analysis.regime import Regime, classify
-from vibroimpact.analysis.stability import floquet_multipliers
+from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.model.contact import peak_acceleration_factor
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.scene.layout import build_stops
 from vibroimpact.scene.schema import MOTION_QUANTITIES, STOP_QUANTITIES, Scene
 from vibroimpact.scene.variables import STABLE_MARGINAL
-from vibroimpact.simulation.layout import base_coupling
+from vibroimpact.simulation.layout import base_force
 
 __all__ = ["general_linear_values", "general_pgf_values", "scene_problem", "stop_clearances", "coordinate_quantity"]
 
-#: |Floquet multiplier| within this distance of 1 is reported as marginal (as for the paper's layout).
-MARGINAL_MODULUS = 1e-9
 _IMPACT_REGIMES = (Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR)
 _LINEAR_REGIMES = (Regime.LINEAR, Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT, Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT)
 
@@ -69,8 +67,7 @@ def general_linear_values(scene: Scene, omega: np.ndarray, shape: tuple[int, ...
     count = len(scene.stop_specs)
     clearances = stop_clearances(scene)[None, :, None, None, None, :]  # (1, nc, 1, 1, 1, K)
     fits = linear.fits(clearances)  # (1, nc, 1, 1, F)
-    stiffness, damping = base_coupling(scene.system)
-    force = np.einsum("...i,...i->...", stiffness + 1j * omega[..., None] * damping, x)
+    force = base_force(scene.system, omega, x)
     rms = np.sqrt(linear.static**2 + 0.5 * np.abs(x) ** 2)
     zero_or_nan = np.where(fits, 0.0, np.nan)
     values = {
@@ -130,11 +127,8 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
 
     harmonics = functools.cache(orbit.harmonics)
     rms = functools.cache(orbit.rms)
-    stiffness, damping = base_coupling(scene.system)
-
-    def base_force(suspension_only: bool) -> np.ndarray:
-        x = harmonics()
-        force = np.einsum("...i,...i->...", stiffness + 1j * w[..., None] * damping, x)
+    def orbit_base_force(suspension_only: bool) -> np.ndarray:
+        force = base_force(scene.system, w, harmonics())
         if suspension_only:
             return force
         rate = (4.0 if orbit.two_sided else 2.0) * orbit.impulse / orbit.period
@@ -153,13 +147,13 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
     peaks = functools.cache(lambda: _peak_estimates(scene, orbit, count))
     makers: dict[str, Callable[[], np.ndarray]] = {
         "regime": lambda: regime,
-        "force_amplitude": lambda: choose(np.abs(base_force(False)), np.abs(_linear_force(stiffness, damping, w, linear.coordinates))),
-        "suspension_force_amplitude": lambda: choose(np.abs(base_force(True)), np.abs(_linear_force(stiffness, damping, w, linear.coordinates))),
+        "force_amplitude": lambda: choose(np.abs(orbit_base_force(False)), np.abs(base_force(scene.system, w, linear.coordinates))),
+        "suspension_force_amplitude": lambda: choose(np.abs(orbit_base_force(True)), np.abs(base_force(scene.system, w, linear.coordinates))),
         "impulse": lambda: np.where(impact, per_stop(orbit.impulse), np.where(free, 0.0, np.nan)),
         "phase": lambda: np.where(impact, orbit.phase, np.nan),
         "floquet_modulus": lambda: modulus,
         "stable": stable_flag,
-        "one_impact_force_amplitude": lambda: np.where(orbit.exists, np.abs(base_force(False)), np.nan),
+        "one_impact_force_amplitude": lambda: np.where(orbit.exists, np.abs(orbit_base_force(False)), np.nan),
         "one_impact_impulse": lambda: np.where(orbit.exists, per_stop(orbit.impulse), np.nan),
         "impacts_per_period": lambda: np.where(impact, float(orbit.impacts_per_period), np.where(free, 0.0, np.nan)),
         "converged": lambda: np.full(w.shape, -1, dtype=np.int8),
@@ -173,10 +167,6 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
         makers[coordinate_quantity("x1_rms", name)] = lambda i=i: choose(rms()[..., i], linear_rms[..., i])
         makers[coordinate_quantity("one_impact_x1_amplitude", name)] = lambda i=i: np.where(orbit.exists, np.abs(harmonics()[..., i]), np.nan)
     return _broadcast(scene, {q: makers[q]() for q in scene.quantities}, shape)
-
-
-def _linear_force(stiffness: np.ndarray, damping: np.ndarray, w: np.ndarray, x: np.ndarray) -> np.ndarray:
-    return np.einsum("...i,...i->...", stiffness + 1j * w[..., None] * damping, x)
 
 
 def _peak_estimates(scene: Scene, orbit: ImpactOrbit, count: int) -> tuple[np.ndarray, np.ndarray]:

@@ -12,7 +12,7 @@ import numpy as np
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import OneImpactSolution, PgfVariant, green_models, solve_one_impact
 from vibroimpact.analysis.regime import Regime, classify
-from vibroimpact.analysis.stability import floquet_multipliers
+from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.engines.registry import BUMPER, engine_spec
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, peak_acceleration_factor
 from vibroimpact.scene.schema import MOTION_QUANTITIES, Scene
@@ -25,8 +25,6 @@ __all__ = ["linear_values", "pgf_values", "peak_estimates", "no_one_impact_orbit
 
 #: Frequencies per simulation case when points are independent (load balancing between processes).
 CASE_CHUNK = 16
-#: |Floquet multiplier| within this distance of 1 is reported as marginal, not decided by round-off.
-MARGINAL_MODULUS = 1e-9
 _IMPACT_REGIMES = (Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR)
 _LINEAR_REGIMES = (Regime.LINEAR, Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT, Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT)
 
