@@ -120,8 +120,8 @@ def test_a_concepts_scene() -> None:
     assert name == "tiny" and report and settings.simulation_frequency.tolist() == [25.0, 34.0] and math.isnan(settings.bumper_frequency)
     assert (dh.system.k2, dh.system.b2) == (optimum.stiffness, optimum.damping) and not dh.stops
     assert (paper_k2.system.k2, paper_k2.system.b2) == (4300.0, optimum.damping)
-    assert stop.paper_layout and stop.system == SYSTEM and stop.describe_stops() == "x2 <= 3 mm, R = 0.2"
-    assert not rel.paper_layout and rel.stops[0].normal(2).tolist() == [-1.0, 1.0]
+    assert [(s.coordinate, s.other, s.side) for s in stop.stops] == [(1, None, "upper")] and stop.system == SYSTEM and stop.describe_stops() == "x2 <= 3 mm, R = 0.2"
+    assert rel.stops[0].other == 0 and rel.stops[0].normal(2).tolist() == [-1.0, 1.0]
     assert rel.problem(10.0, 30.0).stops[0].other == 0 and stop.problem(10.0, 30.0, bumper_frequency=250.0).bumper.frequency == 250.0  # exact: a parsed input
 
 
@@ -160,5 +160,5 @@ def test_the_shipped_scene() -> None:
     assert name == "absorber_concepts" and settings.bumper_frequency == 250.0 and settings.amplitude == 10.0  # exact: parsed inputs
     assert (concepts["den_hartog"].system.k2, concepts["den_hartog"].system.b2) == (optimum.stiffness, optimum.damping)
     assert (concepts["den_hartog_damping"].system.k2, concepts["den_hartog_damping"].system.b2) == (4300.0, optimum.damping)
-    assert concepts["absolute_stop"].paper_layout and [s.side for s in concepts["two_sided_stop"].stops] == ["upper", "lower"]
+    assert [(s.coordinate, s.other, s.side) for s in concepts["absolute_stop"].stops] == [(1, None, "upper")] and [s.side for s in concepts["two_sided_stop"].stops] == ["upper", "lower"]
     assert [(s.coordinate, s.other, s.side) for s in concepts["relative_two_sided"].stops] == [(1, 0, "upper"), (1, 0, "lower")]

@@ -44,11 +44,6 @@ class Concept:
     stops: tuple[Stop, ...] = ()
     absorber: str = ""
 
-    @property
-    def paper_layout(self) -> bool:
-        """One upper stop of the absorber against the base: the paper's layout, which every solution handles."""
-        return len(self.stops) == 1 and self.stops[0].coordinate == 1 and self.stops[0].other is None and self.stops[0].side == "upper"
-
     def describe_stops(self) -> str:
         """E.g. ``x2 <= 3 mm, R = 0.2``; ``no stop``."""
         if not self.stops:
@@ -57,14 +52,12 @@ class Concept:
 
     def problem(self, amplitude: float, frequency: float, phase: float = 0.0, bumper_frequency: float | None = None) -> ImpactProblem:
         """The concept's impact problem at ``frequency`` [Hz]: its rigid stops, or (``bumper_frequency`` [Hz]) each
-        stop's Kelvin-Voigt twin of the same clearance whose loss factor gives its restitution. The paper's layout
-        keeps the single-law form every engine knows; ``ValueError`` for a concept without a stop."""
+        stop's Kelvin-Voigt twin of the same clearance whose loss factor gives its restitution; ``ValueError`` for a
+        concept without a stop."""
         if not self.stops:
             raise ValueError(f"concept {self.name!r} has no stop: its steady state is the linear one")
         laws = [stop.law if bumper_frequency is None else bumper_twin(stop.law, bumper_frequency) for stop in self.stops]
         force = HarmonicForce(amplitude, frequency, phase)
-        if self.paper_layout:
-            return ImpactProblem(self.system, laws[0], force)
         stops = tuple(Stop(law, stop.coordinate, stop.other, stop.side) for law, stop in zip(laws, self.stops))
         return ImpactProblem(self.system, stops, force)
 

@@ -24,7 +24,6 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.scene.concepts import Concept
 from vibroimpact.simulation.settings import SteadySettings
-from vibroimpact.simulation.steady import pgf_guesses
 from vibroimpact.study.concepts_replay import replay_base_force
 from vibroimpact.study.concepts_steady import length_scale, linear_start, march
 from vibroimpact.study.fingerprint import case_key
@@ -171,11 +170,6 @@ def start(concept: Concept, problem: ImpactProblem, settings: SteadySettings) ->
     inside a stop)."""
     length = problem.velocity_scale() / problem.omega
     nudge = settings.start_perturbation * length * np.eye(1, 2 * problem.size, 0)[0]
-    if concept.paper_layout:
-        guess = pgf_guesses(problem, [problem.frequency])[0]
-        if guess is not None:
-            return guess[0], np.asarray(guess[1], dtype=float) + nudge
-        return 0.0, linear_start(problem)
     try:
         orbit = solve_impact_orbit(problem)
     except ValueError:  # no closed form for this layout

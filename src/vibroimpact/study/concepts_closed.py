@@ -1,9 +1,9 @@
 """The closed forms of each absorber concept on the fine frequency grid: the linear steady state (no stop, or a stop
 it does not reach), and the impact orbit where a closed form applies, with its admissibility and Floquet stability.
 
-The one-impact orbit of the paper's layout is :func:`vibroimpact.analysis.pgf.solve_one_impact`; other layouts use the
-general closed form :func:`vibroimpact.analysis.impact_orbit.solve_impact_orbit` (one stop, absolute or relative, or
-a symmetric two-sided stop); both with :func:`vibroimpact.analysis.stability.floquet_multipliers`. Where no closed
+Every layout, the paper's included, uses the closed form :func:`vibroimpact.analysis.impact_orbit.solve_impact_orbit`
+(one stop, absolute or relative, or a symmetric two-sided stop) with
+:func:`vibroimpact.analysis.stability.floquet_multipliers`. Where no closed
 form applies the values are NaN and ``note`` says why: the simulations and the continuation cover those concepts.
 """
 
@@ -15,7 +15,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
-from vibroimpact.analysis.pgf import solve_one_impact
 from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.scene.concepts import Concept
 from vibroimpact.simulation.layout import base_force
@@ -72,27 +71,10 @@ def closed_forms(concept: Concept, amplitude: float, frequency: NDArray[np.float
     empty = ClosedForms(f, np.abs(x[:, 0]), np.abs(base), fits, nan, nan, np.full(f.shape, -1, dtype=np.int8))
     if not concept.stops:
         return empty
-    if concept.paper_layout:
-        return _paper_orbit(concept, amplitude, empty)
-    return _general_orbit(concept, amplitude, empty)
+    return _orbit(concept, amplitude, empty)
 
 
-def _paper_orbit(concept: Concept, amplitude: float, linear: ClosedForms) -> ClosedForms:
-    """The paper's one-impact orbit (exact PGF) with its Floquet multipliers."""
-    law = concept.stops[0].law
-    w = 2.0 * np.pi * linear.frequency
-    solution = solve_one_impact(concept.system, w, law.clearance, law.restitution, amplitude)
-    admissible = solution.admissible()
-    modulus = np.full(w.shape, np.nan)
-    if np.any(admissible):
-        modulus[admissible] = np.max(np.abs(floquet_multipliers(solution._subset(np.flatnonzero(admissible)))), axis=-1)
-    stable = np.where(admissible, np.where(modulus < 1.0 - MARGINAL_MODULUS, 1, 0), -1).astype(np.int8)
-    x1 = np.where(admissible, np.abs(solution.x1_harmonic()), np.nan)
-    force = np.where(admissible, np.abs(solution.force_harmonic()), np.nan)
-    return ClosedForms(linear.frequency, linear.linear_x1, linear.linear_base_force, linear.linear_fits, x1, force, stable, 1)
-
-
-def _general_orbit(concept: Concept, amplitude: float, linear: ClosedForms) -> ClosedForms:
+def _orbit(concept: Concept, amplitude: float, linear: ClosedForms) -> ClosedForms:
     """The general closed form (one stop, or a symmetric two-sided pair) with its Floquet multipliers; a layout that
     has none (e.g. two stops on different coordinates) gets a note instead."""
     problem = concept.problem(amplitude, float(linear.frequency[0]))
