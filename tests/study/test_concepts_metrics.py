@@ -136,6 +136,7 @@ def test_a_concepts_scene() -> None:
         (lambda d: d["concepts"][2]["stops"][0].update(side="above"), "concepts[2].stops[0].side"),
         (lambda d: d.update(continuation={"max_steps": -1}), "continuation.max_steps"),
         (lambda d: d.update(concepts=[]), "concepts"),
+        (lambda d: d["simulation"].update(lyapunov_periods=256), "simulation.lyapunov_periods: not used by the concepts kind"),
     ],
 )
 def test_every_problem_names_its_key(change, key: str) -> None:

@@ -45,7 +45,12 @@ __all__ = ["CONCEPTS_TOP_KEYS", "Concept", "ConceptsSettings", "bumper_twin", "p
 CONCEPTS_TOP_KEYS = {"name", "description", "system", "excitation", "frequency", "simulation", "bumper", "continuation", "concepts", "report"}
 _CONCEPT_KEYS = {"name", "label", "absorber", "stops"}
 _STOP_KEYS = {"coordinate", "between", "side", "clearance", "restitution"}
-_SIMULATION_KEYS = {"frequency", "rtol", "atol", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods"}
+_SIMULATION_KEYS = {"frequency", "rtol", "atol", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods"}
+#: Simulation keys of other kinds that a concepts scene does not use: refused with the reason, never ignored.
+_UNUSED_SIMULATION_KEYS = {
+    "lyapunov_periods": "a concepts scene does not classify non-periodic motion (its steady states march, then measure "
+    "irregular_measure_periods); stepped scenes do",
+}
 _CONTINUATION_KEYS = {"max_steps", "enabled"}
 #: Most concepts of one scene (a table row and a panel each).
 MAX_CONCEPTS = 12
@@ -98,6 +103,10 @@ def parse_concepts_scene(document: Any, text: str = "", source: str = "scene") -
 
 
 def _simulation(c: Checker, value: Any, frequency: np.ndarray | None) -> tuple[np.ndarray, EngineSettings, SteadySettings] | None:
+    if isinstance(value, dict):
+        for key in sorted(set(value) & set(_UNUSED_SIMULATION_KEYS)):
+            c.fail(f"simulation.{key}", f"not used by the concepts kind: {_UNUSED_SIMULATION_KEYS[key]}")
+        value = {key: item for key, item in value.items() if key not in _UNUSED_SIMULATION_KEYS}
     spec = c.mapping("simulation", value, _SIMULATION_KEYS)
     grid = c.grid("simulation.frequency", spec["frequency"], 0.0, math.inf, False) if "frequency" in spec else None
     if grid is None and "frequency" not in spec and frequency is not None:
