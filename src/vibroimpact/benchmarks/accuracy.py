@@ -106,7 +106,7 @@ def _runner(case: BenchmarkCase, method: str, settings: EngineSettings) -> Calla
         sweep = case.sweep
 
         def from_record(record: SweepRecord) -> _Run:
-            return _Run(record.trajectory, running_fundamental(record.time, record.x1, sweep, cycles=8).amplitude)
+            return _Run(record.trajectory, running_fundamental(record.time, record.displacements[:, 0], sweep, cycles=8).amplitude)
 
         assert case.bumper is not None
         swept = ImpactProblem(problem.system, case.bumper, sweep)
