@@ -133,8 +133,8 @@ def test_slow_sweep_without_contact_follows_the_linear_response(system: TwoDofSy
     x = np.array([h.x1, h.x2]) * -1j  # the response to q sin(theta) at theta = 0
     state = np.concatenate([x.real, (2j * math.pi * 15.0 * x).real])
     record = CompliantEngine().sweep(ImpactProblem(system, KelvinVoigtBumper(1.0, 250.0, 0.73), sweep), 2000.0, state)
-    assert record.trajectory.impact_times.size == 0 and np.all(record.contact_force == 0.0)  # exact: no contact: force set to 0
-    estimate = running_fundamental(record.time, record.x1, sweep, cycles=8)
+    assert record.trajectory.impact_times.size == 0 and np.all(record.contact_forces[:, 0] == 0.0)  # exact: no contact: force set to 0
+    estimate = running_fundamental(record.time, record.displacement("x1"), sweep, cycles=8)
     linear = np.abs(linear_response(system, 2 * math.pi * estimate.frequency, PAPER_AMPLITUDE).x1)
     np.testing.assert_allclose(estimate.amplitude, linear, rtol=1e-3)
 
@@ -149,7 +149,7 @@ def test_slow_sweep_with_contact_follows_the_one_impact_orbit(system: TwoDofSyst
 
     sweep = SweptSine(PAPER_AMPLITUDE, 24.0, 25.0, 0.1)
     record = CompliantEngine().sweep(ImpactProblem(system, KelvinVoigtBumper(PAPER_CLEARANCE, 4000.0, loss_factor_from_restitution(0.2)), sweep), 2000.0)
-    estimate = running_fundamental(record.time, record.x1, sweep, cycles=8)
+    estimate = running_fundamental(record.time, record.displacement("x1"), sweep, cycles=8)
     settled = estimate.time > 5.0
     orbit = solve_one_impact(system, 2 * math.pi * estimate.frequency[settled], PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE)
     np.testing.assert_allclose(estimate.amplitude[settled], np.abs(orbit.x1_harmonic()), rtol=0.015)
@@ -178,10 +178,10 @@ def test_sweep_settings_agree_with_a_tight_run() -> None:
     np.testing.assert_allclose(a.impact_times, b.impact_times, atol=1e-6)
     np.testing.assert_allclose(a.contact_peaks, b.contact_peaks, rtol=2e-4)
     np.testing.assert_allclose(a.impulses, b.impulses, rtol=2e-4)
-    fundamental = running_fundamental(record.time, record.x1, sweep, cycles=8).amplitude
-    reference = running_fundamental(tight.time, tight.x1, sweep, cycles=8).amplitude
+    fundamental = running_fundamental(record.time, record.displacement("x1"), sweep, cycles=8).amplitude
+    reference = running_fundamental(tight.time, tight.displacement("x1"), sweep, cycles=8).amplitude
     assert np.max(np.abs(fundamental - reference)) < 2e-5 * reference.max()
-    np.testing.assert_allclose(record.contact_fourier, tight.contact_fourier, atol=1e-4 * np.abs(tight.contact_fourier).max())
+    np.testing.assert_allclose(record.contact_fourier[:, 0], tight.contact_fourier[:, 0], atol=1e-4 * np.abs(tight.contact_fourier[:, 0]).max())
 
 
 @pytest.mark.timeout(60)
@@ -197,11 +197,11 @@ def test_sweep_record_contacts_stats_and_force_quadrature() -> None:
     assert np.all(trajectory.contact_peaks > 0.0) and np.all(np.diff(trajectory.impact_times) > 0.0)
     assert trajectory.stats["contacts"] - trajectory.impact_times.size in (0, 1)
     assert trajectory.stats["steps"] > 0 and trajectory.stats["rhs_calls"] >= trajectory.stats["steps"]
-    assert np.all(record.contact_force >= 0.0) and record.contact_force.max() <= trajectory.contact_peaks[:, 0].max() * (1 + 1e-6)
-    assert record.contact_force.max() > 0.9 * trajectory.contact_peaks[:, 0].max()
+    assert np.all(record.contact_forces[:, 0] >= 0.0) and record.contact_forces[:, 0].max() <= trajectory.contact_peaks[:, 0].max() * (1 + 1e-6)
+    assert record.contact_forces[:, 0].max() > 0.9 * trajectory.contact_peaks[:, 0].max()
     rotor = np.exp(-1j * sweep.phase(record.time)) * 2 * math.pi * sweep.frequency(record.time)
-    sampled = cumulative_trapezoid(record.contact_force * rotor, record.time, initial=0.0)
-    np.testing.assert_allclose(record.contact_fourier, sampled, atol=1e-2 * np.abs(sampled).max())
+    sampled = cumulative_trapezoid(record.contact_forces[:, 0] * rotor, record.time, initial=0.0)
+    np.testing.assert_allclose(record.contact_fourier[:, 0], sampled, atol=1e-2 * np.abs(sampled).max())
 
 
 def test_sweep_clears_the_event_records() -> None:
@@ -323,7 +323,7 @@ def test_paper_sweep_is_fast_and_close_to_a_tight_run() -> None:
     onsets = [r.trajectory.impact_times[(r.trajectory.impact_times >= 60.0) & (r.trajectory.impact_times < 90.0)] for r in (record, tight)]
     assert onsets[0].size == onsets[1].size > 600
     np.testing.assert_allclose(onsets[0], onsets[1], atol=1e-5)
-    a = running_fundamental(record.time, record.x1, sweep, cycles=8)
-    b = running_fundamental(tight.time, tight.x1, sweep, cycles=8)
+    a = running_fundamental(record.time, record.displacement("x1"), sweep, cycles=8)
+    b = running_fundamental(tight.time, tight.displacement("x1"), sweep, cycles=8)
     window = (a.time >= 60.0) & (a.time < 90.0)
     assert np.max(np.abs(a.amplitude[window] - b.amplitude[window])) < 1e-4 * b.amplitude[window].max()

@@ -76,7 +76,7 @@ def test_swept_sine_page_shows_the_sweeps_against_the_steady_states(tmp_path: Pa
     figures, tables = _names(sections[1])
     assert figures == ["sweep_displacements", "sweep_force_impulse", "sweep_regime", "sweep_time"]
     assert tables == ["Cost of the swept-sine runs (one process each)", "Swept sine against the stable pgf steady state (|X1| fundamental)"]
-    run = swept_sine_run(ds, study_setting(ds))
+    run = swept_sine_run(ds)
     assert run.text() == "21 <-> 29 Hz at 1 Hz/s, bumper 250 Hz, xi_b = 0.7312, estimator window 8 cycles"
     assert run.duration == pytest.approx(8.0, rel=1e-15)
 

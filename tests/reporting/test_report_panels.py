@@ -78,7 +78,7 @@ def test_peak_contact_panels_show_the_simulation_and_the_estimate() -> None:
 
 def test_sweep_panels_show_both_sweeps_and_the_steady_states() -> None:
     ds = swept_dataset()
-    figures = {drawn.name: drawn for drawn in sweep_figures(ds, swept_sine_run(ds, study_setting(ds)))}
+    figures = {drawn.name: drawn for drawn in sweep_figures(ds, swept_sine_run(ds))}
     assert {"sweep_displacements", "sweep_force_impulse", "sweep_regime", "sweep_time"} <= set(figures)
     f = ds["frequency"].values
     panels = {"sweep_displacements": ("x1_amplitude", "x2_amplitude"), "sweep_force_impulse": ("force_amplitude", "impulse", "impacts_per_period")}

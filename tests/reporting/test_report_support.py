@@ -26,7 +26,7 @@ from vibroimpact.reporting.record import StudySetting, study_setting
 from vibroimpact.reporting.style import DPI, FIGURE_WIDTH
 from vibroimpact.scene import parse_scene
 from vibroimpact.study.run import run_study
-from vibroimpact.simulation.swept import SWEEP_QUANTITIES
+from vibroimpact.simulation.swept import sweep_quantities
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
 
@@ -139,7 +139,7 @@ def swept_dataset() -> xr.Dataset:
     inside = (f > 21.5) & (f < 28.5)
     pgf = closed.sel(solution="pgf", drop=True)
     dataset = closed.assign_coords(sweep=["up", "down"])
-    for name in SWEEP_QUANTITIES:
+    for name in sweep_quantities(("x1", "x2")):
         base = pgf[name] if name in pgf else xr.zeros_like(pgf["x1_amplitude"])
         dataset[f"swept_{name}"] = xr.concat([base.where(inside) * 1.01, base.where(inside) * 0.99], dim="sweep").assign_attrs(pgf[name].attrs if name in pgf else {})
     contact = dataset["swept_impacts_per_period"] > 0.0
@@ -249,7 +249,7 @@ def _builders() -> dict[str, Callable[[], list[Any]]]:
         "simulation_impulse": lambda: [simulation_figure(steady(), "impulse", list(ENGINE_SOLUTIONS), "sim")],
         "peak_acceleration": lambda: [peak_acceleration_figure(steady(), "peak")],
         "peaks_vs_restitution": lambda: [peak_figure(steady(), setting_of(steady()), "restitution", "peaks")],
-        "sweep": lambda: sweep_figures(swept_dataset(), swept_sine_run(swept_dataset(), setting_of(swept_dataset()))),
+        "sweep": lambda: sweep_figures(swept_dataset(), swept_sine_run(swept_dataset())),
         "stiffness": lambda: [stiffness_figure(stiffness_dataset(), setting_of(stiffness_dataset()), "stiffness")],
         "work_precision": lambda: accuracy_figures(benchmark_dataset()),
         "lyapunov": lambda: [lyapunov_figure(steady(), ["momentary", "exact"], "lyapunov")],

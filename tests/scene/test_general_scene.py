@@ -164,7 +164,7 @@ MISTAKES = [
     ("stop-and-stops", lambda d: d.update(stop={"clearance": 0.003}), ["stop:", "not both"]),
     ("pgf-paper", lambda d: d.update(solutions=["pgf_paper"]), ["solutions:", "pgf_paper", "use pgf"]),
     ("pgf-unequal-pair", lambda d: d["stops"][1].update(clearance=0.002), ["solutions: pgf does not apply", "symmetric"]),
-    ("swept-sine", lambda d: d.update(swept_sine={"start": 20.0, "stop": 26.0, "rate": 0.5}, solutions=["compliant"], bumper={"frequency": 250.0}), ["swept_sine:", "named layout only"]),
+    ("swept-base-motion", lambda d: d.update(swept_sine={"start": 20.0, "stop": 26.0, "rate": 0.5}, solutions=["compliant"], bumper={"frequency": 250.0}, excitation={"amplitude": 0.001, "base_motion": True}), ["excitation.base_motion:", "swept base motion is not supported"]),
     ("compliant-no-bumper", lambda d: d.update(solutions=["compliant"]), ["stops[0].bumper.frequency: required unless swept"]),
 ]
 

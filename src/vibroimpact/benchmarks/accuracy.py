@@ -7,8 +7,11 @@ measured against the ``exact`` engine; compliant-model methods (``compliant_ida`
 integrated by CVODE (Adams) at rtol 1e-13: another integrator, converged. Each impact of the reference is matched to
 the nearest impact of the method (within 1e-3 of a period); unmatched reference impacts are *missed*, unmatched
 method impacts *extra*; impact-time and impulse errors are over matched impacts. The quantity users care about most,
-the fundamental of X1, is compared over the whole run (stepped: from the exact per-period moments; swept: the running
-8-cycle fundamental, largest difference over the run relative to its largest value). Wall time is the median of
+the fundamental of the first coordinate (X1, the primary mass, on the paper's layout), is compared over the whole run
+(stepped: from the exact per-period moments; swept: the running 8-cycle fundamental, largest difference over the run
+relative to its largest value); its variables are named after that coordinate (``x1_error``, ``reference_x1``,
+``ladder_x1_amplitude`` ... on the paper's layout). Cases run on any structure, load and stops (:class:`BenchmarkCase`:
+rigid stops, and the same stops as bumpers for the compliant methods). Wall time is the median of
 ``repeats`` runs (one run when a run takes more than 5 s). Timings on shared machines are noisy: read the ratios,
 measured in the same process run, not the absolute seconds.
 
@@ -23,6 +26,7 @@ reference is what the engine's Python face adds.
 from __future__ import annotations
 
 import math
+import re
 import statistics
 import sys
 import time
@@ -32,8 +36,8 @@ from typing import Any, Callable, TypeVar, cast
 import numpy as np
 import xarray as xr
 
-from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
-from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.analysis.impact_orbit import solve_impact_orbit
+from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.engines.base import Engine, SweepRecord, Trajectory
 from vibroimpact.engines.registry import BUMPER, ENGINES, engine_spec, make_engine
@@ -41,11 +45,10 @@ from vibroimpact.engines.settings import REFERENCE_RTOL, EngineSettings
 from vibroimpact.engines.compliant.ivp import solve_ivp_sweep
 from vibroimpact.simulation.harmonics import measure, running_fundamental
 from vibroimpact.simulation.steady import start_state
-from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.variables import BENCHMARK_ATTRIBUTES, LADDER_ATTRIBUTES
 from vibroimpact.scene.schema import BenchmarkCase, BenchmarkSettings, LadderSettings
 
-__all__ = ["run_benchmark", "model_ladder", "equal_error_speedup", "loosest_tolerance", "exact_kernel", "REFERENCE_RTOL", "TOLERANCE_FREE"]
+__all__ = ["run_benchmark", "model_ladder", "equal_error_speedup", "loosest_tolerance", "exact_kernel", "measured_names", "REFERENCE_RTOL", "TOLERANCE_FREE"]
 
 SLOW_RUN = 5.0  # [s] a run longer than this is not repeated
 #: Engines whose runs ignore rtol and atol: measured once per case, stored at every tolerance.
@@ -88,15 +91,36 @@ def _compare(reference: Trajectory, trial: Trajectory, period: float) -> dict[st
     return {"missed_impacts": missed, "extra_impacts": extra, "impact_time_error": time_error, "impulse_error": impulse_error, "final_state_error": state_error}
 
 
+#: The coordinate whose fundamental the benchmark compares: the first (the paper's primary mass X1).
+MEASURED = 0
+#: The errors that are not of the measured fundamental.
+_OTHER_ERRORS = ("impact_time_error", "impulse_error", "final_state_error")
+
+
+def measured_names(coordinate: str) -> dict[str, str]:
+    """The benchmark's variables named after the measured coordinate (``x1_error`` ... for the paper's ``x1``), by
+    their name in :data:`~vibroimpact.scene.variables.BENCHMARK_ATTRIBUTES` and ``LADDER_ATTRIBUTES``."""
+    return {template: template.replace("x1", coordinate, 1) for template in ("x1_error", "reference_x1", "ladder_x1_amplitude", "ladder_x1_difference")}
+
+
+def _attributes(template: str, coordinate: str) -> dict[str, str]:
+    """The attributes of a measured variable, the coordinate named (X1 for the paper's ``x1``)."""
+    attrs = dict(BENCHMARK_ATTRIBUTES.get(template) or LADDER_ATTRIBUTES[template])
+    label = coordinate.upper() if re.fullmatch(r"x[0-9]+", coordinate) else coordinate
+    attrs["long_name"] = attrs["long_name"].replace("X1", label)
+    return attrs
+
+
 class _Run:
-    """What one timed run returns: the trajectory, and for a sweep its running X1 fundamental."""
+    """What one timed run returns: the trajectory, and the fundamental of the measured coordinate (a sweep: its
+    running fundamental)."""
 
-    def __init__(self, trajectory: Trajectory, x1: np.ndarray) -> None:
-        self.trajectory, self.x1 = trajectory, x1
+    def __init__(self, trajectory: Trajectory, fundamental: np.ndarray) -> None:
+        self.trajectory, self.fundamental = trajectory, fundamental
 
 
-def _x1_of(trajectory: Trajectory) -> np.ndarray:
-    return np.array([abs(measure(trajectory).x1)]) if trajectory.periods else np.array([np.nan])
+def _fundamental_of(trajectory: Trajectory) -> np.ndarray:
+    return np.array([abs(measure(trajectory).displacements[MEASURED])]) if trajectory.periods else np.array([np.nan])
 
 
 def _runner(case: BenchmarkCase, method: str, settings: EngineSettings) -> Callable[[], _Run]:
@@ -106,7 +130,7 @@ def _runner(case: BenchmarkCase, method: str, settings: EngineSettings) -> Calla
         sweep = case.sweep
 
         def from_record(record: SweepRecord) -> _Run:
-            return _Run(record.trajectory, running_fundamental(record.time, record.x1, sweep, cycles=8).amplitude)
+            return _Run(record.trajectory, running_fundamental(record.time, record.displacements[:, MEASURED], sweep, cycles=8).amplitude)
 
         assert case.bumper is not None
         swept = ImpactProblem(problem.system, case.bumper, sweep)
@@ -123,7 +147,7 @@ def _runner(case: BenchmarkCase, method: str, settings: EngineSettings) -> Calla
 
     def run() -> _Run:
         trajectory = stepped.integrate(problem, y0, t0, case.periods, moments=True)
-        return _Run(trajectory, _x1_of(trajectory))
+        return _Run(trajectory, _fundamental_of(trajectory))
 
     return run
 
@@ -183,7 +207,7 @@ def _references(case: BenchmarkCase, settings: BenchmarkSettings) -> tuple[dict[
 
         def exact() -> _Run:
             trajectory = make_engine("exact").integrate(case.problem, y0, t0, case.periods, moments=True)
-            return _Run(trajectory, _x1_of(trajectory))
+            return _Run(trajectory, _fundamental_of(trajectory))
 
         make_engine("exact").integrate(case.problem, y0, t0, 1, moments=True)  # untimed: loads the compiled kernel
         kernels = [exact_kernel(case, moments) for moments in (True, False)]
@@ -204,6 +228,8 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
     a rigid-stop engine on a swept case) are NaN there.
     """
     shape = (len(cases), len(settings.methods), len(settings.tolerances))
+    coordinate = str(cases[0].problem.structure.coordinates[MEASURED]) if cases else "x1"
+    measured = measured_names(coordinate)
     names = ("wall_time", "rhs_calls", "steps", "impacts", "missed_impacts", "extra_impacts", "impact_time_error", "impulse_error", "final_state_error", "x1_error")
     data = {name: np.full(shape, np.nan) for name in names}
     reference_time = np.full((len(cases), 2), np.nan)
@@ -226,7 +252,7 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
             if kind in references:
                 reference, reference_time[c, r] = references[kind]
                 reference_impacts[c, r] = reference.trajectory.impact_times.size
-                reference_x1[c, r] = float(np.nanmax(reference.x1))
+                reference_x1[c, r] = float(np.nanmax(reference.fundamental))
         for m, method in enumerate(settings.methods):
             if not case.runs(method):
                 continue
@@ -239,29 +265,29 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
                     continue
                 run, wall = _timed(_runner(case, method, EngineSettings(rtol=rtol, atol=rtol * settings.atol_ratio)), settings.repeats)
                 trajectory = run.trajectory
-                scale = float(np.nanmax(reference.x1))
+                scale = float(np.nanmax(reference.fundamental))
                 values = _compare(reference.trajectory, trajectory, case.problem.period) | {
                     "wall_time": wall,
                     "rhs_calls": trajectory.stats.get("rhs_calls", np.nan),
                     "steps": trajectory.stats.get("steps", np.nan),
                     "impacts": trajectory.impact_times.size,
-                    "x1_error": float(np.nanmax(np.abs(run.x1 - reference.x1))) / scale if run.x1.shape == reference.x1.shape else np.nan,
+                    "x1_error": float(np.nanmax(np.abs(run.fundamental - reference.fundamental))) / scale if run.fundamental.shape == reference.fundamental.shape else np.nan,
                 }
                 if case.sweep is not None:
                     values["final_state_error"] = np.nan  # samples, not strobes: x1_error says it
                 for name in names:
                     data[name][c, m, k] = values[name]
                 if progress:
-                    print(f"benchmark {case.name}: {method} rtol {'(none)' if method in TOLERANCE_FREE else format(rtol, 'g')}: {wall:.3f} s, X1 error {values['x1_error']:.1e}, missed {values['missed_impacts']}", file=sys.stderr, flush=True)
+                    print(f"benchmark {case.name}: {method} rtol {'(none)' if method in TOLERANCE_FREE else format(rtol, 'g')}: {wall:.3f} s, {coordinate} error {values['x1_error']:.1e}, missed {values['missed_impacts']}", file=sys.stderr, flush=True)
                 if wall > settings.max_seconds and method not in TOLERANCE_FREE:
                     break  # tighter tolerances would only take longer
     dataset = xr.Dataset(
-        {name: (("case", "engine", "rtol"), data[name], dict(BENCHMARK_ATTRIBUTES[name])) for name in names},
+        {measured.get(name, name): (("case", "engine", "rtol"), data[name], _attributes(name, coordinate)) for name in names},
         coords={"case": [c.name for c in cases], "engine": list(settings.methods), "rtol": list(settings.tolerances), "reference": ["exact", "compliant_cvode_adams"]},
     )
     dataset["reference_wall_time"] = (("case", "reference"), reference_time, dict(BENCHMARK_ATTRIBUTES["reference_wall_time"]))
     dataset["reference_impacts"] = (("case", "reference"), reference_impacts, dict(BENCHMARK_ATTRIBUTES["reference_impacts"]))
-    dataset["reference_x1"] = (("case", "reference"), reference_x1, dict(BENCHMARK_ATTRIBUTES["reference_x1"]))
+    dataset[measured["reference_x1"]] = (("case", "reference"), reference_x1, _attributes("reference_x1", coordinate))
     dataset["exact_wall_time"] = dataset["reference_wall_time"].sel(reference="exact", drop=True).assign_attrs(BENCHMARK_ATTRIBUTES["exact_wall_time"])
     dataset["periods"] = ("case", periods, dict(BENCHMARK_ATTRIBUTES["periods"]))
     dataset["time_per_period"] = (dataset["wall_time"] / dataset["periods"]).assign_attrs(BENCHMARK_ATTRIBUTES["time_per_period"])
@@ -280,16 +306,18 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
     if settings.ladder is not None and cases:
         if progress:
             print("benchmark: model cost ladder", file=sys.stderr, flush=True)
-        ladder = model_ladder(cases[0].problem.system, cases[0].problem.amplitude, settings.ladder, settings.atol_ratio)
+        ladder = model_ladder(settings.ladder, settings.atol_ratio)
         dataset = dataset.merge(ladder, combine_attrs="no_conflicts")
     return dataset
 
 
 def loosest_tolerance(dataset: xr.Dataset, case: str, method: str, target: float) -> tuple[float, float]:
-    """The loosest rtol of ``method`` whose X1 error on ``case`` is within ``target`` (no missed or extra impact), with all
-    tighter ones that were run too (a method stops at its time limit); returns (rtol, wall time) or (nan, nan)."""
+    """The loosest rtol of ``method`` whose error of the measured fundamental (``<coordinate>_error``, ``x1_error`` on
+    the paper's layout) on ``case`` is within ``target`` (no missed or extra impact), with all tighter ones that were
+    run too (a method stops at its time limit); returns (rtol, wall time) or (nan, nan)."""
     line = dataset.sel(case=case, engine=method)
-    error, missed, extra, wall = line["x1_error"].values, line["missed_impacts"].values, line["extra_impacts"].values, line["wall_time"].values
+    error_name = next(str(n) for n in dataset.data_vars if str(n).endswith("_error") and str(n) not in _OTHER_ERRORS)
+    error, missed, extra, wall = line[error_name].values, line["missed_impacts"].values, line["extra_impacts"].values, line["wall_time"].values
     order = [i for i in np.argsort(line["rtol"].values) if np.isfinite(wall[i])]  # tight to loose, the tolerances run
     best = (math.nan, math.nan)
     for i in order:
@@ -326,31 +354,35 @@ def equal_error_speedup(dataset: xr.Dataset, case: str, method: str, tolerance: 
     return best / float(point["wall_time"]), best_name
 
 
-def model_ladder(system: TwoDofSystem, amplitude: float, ladder: LadderSettings, atol_ratio: float) -> xr.Dataset:
-    """Wall time of one steady-state point and its |X1| for ``pgf``, ``exact``, ``momentary`` and ``compliant`` at
-    each bumper frequency, and the relative difference from ``exact``; dimension ``model``."""
-    from vibroimpact.analysis.pgf import solve_one_impact
+def model_ladder(ladder: LadderSettings, atol_ratio: float) -> xr.Dataset:
+    """Wall time of one steady-state point and the fundamental of its first coordinate for ``pgf`` (where the layout
+    has a closed form), ``exact``, ``momentary`` and ``compliant`` at each bumper frequency, and the relative difference
+    from ``exact``; dimension ``model``. ``ladder.problem`` is the structure, load and rigid stops at the point,
+    ``ladder.compliant`` the bumpers of each frequency."""
     from vibroimpact.simulation.steady import steady_state
     from vibroimpact.simulation.settings import SteadySettings
 
-    stop = RigidStop(ladder.clearance, ladder.restitution)
-    problem = ImpactProblem(system, stop, HarmonicForce(amplitude, ladder.frequency))
+    problem = ladder.problem
+    assert problem is not None
+    coordinate = str(problem.structure.coordinates[MEASURED])
+    measured = measured_names(coordinate)
+    stops = problem.stops
     settings = EngineSettings(rtol=ladder.rtol, atol=ladder.rtol * atol_ratio)
     steady = SteadySettings(tolerance=max(10.0 * ladder.rtol, 1e-10))
     omega = np.array([problem.omega])
 
     def pgf() -> float:
-        return float(np.abs(solve_one_impact(system, omega, ladder.clearance, ladder.restitution, amplitude).x1_harmonic())[0])
+        return float(np.abs(solve_impact_orbit(problem, omega).harmonics()[0, MEASURED]))
 
-    models: dict[str, Callable[[], float]] = {"pgf": pgf}
+    models: dict[str, Callable[[], float]] = {"pgf": pgf} if closed_form_refusal(problem) is None else {}
     engines: dict[str, tuple[Engine, ImpactProblem]] = {"exact": (make_engine("exact"), problem), "momentary": (make_engine("momentary", settings), problem)}
-    xi = loss_factor_from_restitution(ladder.restitution)
-    for frequency in ladder.bumper_frequencies:
-        engines[f"compliant_{frequency:g}Hz"] = (make_engine("compliant", settings), replace(problem, contact=KelvinVoigtBumper(ladder.clearance, frequency, xi)))
+    for frequency, bumpers in zip(ladder.bumper_frequencies, ladder.compliant):
+        engines[f"compliant_{frequency:g}Hz"] = (make_engine("compliant", settings), replace(problem, contact=bumpers))
     for name, (engine, run_problem) in engines.items():
-        # every model starts from the rigid stop's one-impact orbit (a bumper's own R(xi_b) differs in the last digits)
-        models[name] = lambda engine=engine, run_problem=run_problem: abs(steady_state(engine, run_problem, "pgf", steady, stop).measures.x1)
-    wall, x1 = [], []
+        # every model starts from the rigid stops' closed-form orbit (a bumper's own R(xi_b) differs in the last
+        # digits), the linear motion where the layout has none
+        models[name] = lambda engine=engine, run_problem=run_problem: abs(steady_state(engine, run_problem, "pgf", steady, stops).measures.displacements[MEASURED])
+    wall, fundamental = [], []
     for name, model in models.items():
         times = []
         for _ in range(ladder.repeats):
@@ -358,20 +390,25 @@ def model_ladder(system: TwoDofSystem, amplitude: float, ladder: LadderSettings,
             value = model()
             times.append(time.perf_counter() - started)
         wall.append(statistics.median(times))
-        x1.append(value)
-    exact = x1[list(models).index("exact")]
+        fundamental.append(value)
+    exact = fundamental[list(models).index("exact")]
+    if math.isfinite(ladder.restitution) and math.isfinite(ladder.clearance):
+        point = f"{ladder.frequency:g} Hz, R = {ladder.restitution:g}, Delta = {ladder.clearance * 1e3:g} mm"
+    else:
+        point = f"{ladder.frequency:g} Hz, stops {'; '.join(stop.describe(tuple(problem.structure.coordinates)) + f', R = {stop.law.restitution:g}' for stop in stops)}"
+    start = "one-impact orbit" if problem.paper_layout else "closed-form orbit" if "pgf" in models else "linear motion (no closed form for this layout)"
     return xr.Dataset(
         {
             "ladder_wall_time": ("model", wall, dict(LADDER_ATTRIBUTES["ladder_wall_time"])),
-            "ladder_x1_amplitude": ("model", x1, dict(LADDER_ATTRIBUTES["ladder_x1_amplitude"])),
-            "ladder_x1_difference": ("model", np.abs(np.array(x1) - exact) / exact, dict(LADDER_ATTRIBUTES["ladder_x1_difference"])),
+            measured["ladder_x1_amplitude"]: ("model", fundamental, _attributes("ladder_x1_amplitude", coordinate)),
+            measured["ladder_x1_difference"]: ("model", np.abs(np.array(fundamental) - exact) / exact, _attributes("ladder_x1_difference", coordinate)),
         },
         coords={"model": list(models)},
         attrs={
             "ladder_description": (
-                f"{ladder.frequency:g} Hz, R = {ladder.restitution:g}, Delta = {ladder.clearance * 1e3:g} mm; steady states from the "
-                f"slightly perturbed one-impact orbit, integrators at rtol {ladder.rtol:g}, steady-state tolerance {steady.tolerance:g}; "
-                "bumpers with the loss factor that gives R. The compliant differences are the bumper's physics, not error."
+                f"{point}; steady states from the slightly perturbed {start}, integrators at rtol {ladder.rtol:g}, "
+                f"steady-state tolerance {steady.tolerance:g}; bumpers with the loss factor that gives R. The compliant "
+                "differences are the bumper's physics, not error."
             )
         },
     )

@@ -129,8 +129,8 @@ def run_sweep_cost(settings: SweepCostSettings = SweepCostSettings(), log: Calla
 
     def add(name: str, sweep: SweptSine, record: SweepRecord, wall: float) -> None:
         base, base_wall = baselines[_span(sweep)]
-        mine = running_fundamental(record.time, record.x1, sweep, cycles=8)
-        theirs = running_fundamental(base.time, base.x1, sweep, cycles=8)
+        mine = running_fundamental(record.time, record.displacements[:, 0], sweep, cycles=8)
+        theirs = running_fundamental(base.time, base.displacements[:, 0], sweep, cycles=8)
         diff = np.abs(mine.amplitude - theirs.amplitude) if record is not base else np.zeros(0)  # (none against itself)
         worst = int(np.argmax(diff)) if diff.size else 0
         stats = record.trajectory.stats

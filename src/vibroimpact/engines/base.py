@@ -201,39 +201,68 @@ class TrajectoryBuilder:
 
 @dataclass(frozen=True, eq=False)
 class SweepRecord:
-    """A swept-sine run, sampled uniformly in time.
+    """A swept-sine run, sampled uniformly in time: every coordinate of any structure and each stop's contact force.
 
     Attributes
     ----------
     sweep : SweptSine
         The excitation.
-    time : ndarray
+    time : ndarray, shape (S,)
         Sample times [s].
-    x1, x2 : ndarray
-        Displacements [m].
-    base_force : ndarray
-        Force on the base: suspension K1 X1 + B1 X1' plus bumper [N].
-    contact_force : ndarray
-        Bumper force [N] (0 outside contact).
+    displacements : ndarray, shape (S, N)
+        x_1 ... x_N at each sample [m], in the order of the structure's coordinates (``trajectory.problem``;
+        (X1, X2) for the paper's system); :meth:`displacement` picks one by name.
+    base_force : ndarray, shape (S,)
+        Force on the base [N]: through the springs and dashpots, 1^T (K x + C x'), plus each absolute stop's
+        (1^T n_k) lambda_k (the paper's K1 X1 + B1 X1' + F).
+    contact_forces : ndarray, shape (S, K)
+        Bumper force lambda_k of each stop [N] (0 outside its contact).
     trajectory : Trajectory
         Contacts: ``impact_times`` (onsets) [s], ``impact_velocities`` [m s-1], ``impulses`` [N s] and
-        ``contact_peaks`` (c, 2) = [peak force N, peak deceleration m s-2], one row per completed contact (a contact
-        still open at the end is counted in ``stats["contacts"]`` only); ``segments`` (free and contact); ``stats``:
-        ``steps`` (step attempts), ``rhs_calls`` (residual or right-hand-side evaluations), ``contacts``, ``events``
-        (roots handled), ``solver_calls``, ``grazing`` (contacts caught at an apex).
-    contact_fourier : ndarray of complex
-        Running integral of F exp(-j theta) theta' dt from t = 0 to each sample [N], integrated with the motion:
-        its increase over a window of whole cycles, divided by pi times the cycles, is the bumper force's fundamental.
+        ``contact_peaks`` (c, 2) = [peak force N, peak deceleration m s-2], one row per completed contact with its
+        stop in ``impact_stops`` and ``contact_peak_stops`` (a contact still open at the end is counted in
+        ``stats["contacts"]`` only); ``segments`` (free and contact); ``stats``: ``steps`` (step attempts),
+        ``rhs_calls`` (residual or right-hand-side evaluations), ``contacts``, ``events`` (roots handled),
+        ``solver_calls``, ``grazing`` (contacts caught at an apex).
+    contact_fourier : ndarray of complex, shape (S, K)
+        Running integral of lambda_k exp(-j theta) theta' dt from t = 0 to each sample, per stop [N], integrated with
+        the motion: its increase over a window of whole cycles, divided by pi times the cycles, is the bumper force's
+        fundamental.
     """
 
     sweep: SweptSine
     time: NDArray[np.float64]
-    x1: NDArray[np.float64]
-    x2: NDArray[np.float64]
+    displacements: NDArray[np.float64]
     base_force: NDArray[np.float64]
-    contact_force: NDArray[np.float64]
+    contact_forces: NDArray[np.float64]
     trajectory: Trajectory
     contact_fourier: NDArray[np.complex128]
+
+    def __post_init__(self) -> None:
+        samples = np.shape(self.time)
+        problem = self.trajectory.problem
+        expected = {
+            "time": ((samples[0],) if len(samples) == 1 else None, self.time),
+            "displacements": ((*samples, problem.size), self.displacements),
+            "base_force": (samples, self.base_force),
+            "contact_forces": ((*samples, len(problem.stops)), self.contact_forces),
+            "contact_fourier": ((*samples, len(problem.stops)), self.contact_fourier),
+        }
+        for name, (shape, value) in expected.items():
+            if shape is None or np.shape(value) != shape:
+                raise ValueError(f"{name}: expected shape {shape or '(S,)'} (S samples, N = {problem.size} coordinates, K = {len(problem.stops)} stops), got {np.shape(value)}")
+
+    @property
+    def coordinates(self) -> tuple[str, ...]:
+        """Names of the coordinates, in the order of the columns of :attr:`displacements`."""
+        return tuple(self.trajectory.problem.structure.coordinates)
+
+    def displacement(self, coordinate: str) -> NDArray[np.float64]:
+        """The samples of one coordinate by name [m] (``ValueError`` naming the coordinates if it has none)."""
+        names = self.coordinates
+        if coordinate not in names:
+            raise ValueError(f"coordinate = {coordinate!r} is not a coordinate of the structure: allowed {', '.join(names)}")
+        return self.displacements[:, names.index(coordinate)]
 
 
 class Engine(Protocol):

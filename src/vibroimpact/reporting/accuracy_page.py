@@ -3,19 +3,24 @@
 Every figure and table reads the dataset of :func:`vibroimpact.benchmarks.accuracy.run_benchmark` (dimensions case, engine,
 rtol), and the model-cost ladder when the scene asked for one. Wall times are medians of several runs, all measured
 in one process run: read ratios, not seconds. Engines without a tolerance (the dataset's ``tolerance_free_engines``)
-were run once per case and are shown once.
+were run once per case and are shown once. Errors are of the fundamental of the structure's first coordinate: X1 on
+the paper's layout, a general scene's first coordinate by its name (its dataset records the layout, which the page
+states).
 """
 
 from __future__ import annotations
 
+import html
 import math
+import re
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
-from vibroimpact.benchmarks.accuracy import equal_error_speedup, loosest_tolerance
+from vibroimpact.benchmarks.accuracy import equal_error_speedup, loosest_tolerance, measured_names
 from vibroimpact.engines.settings import STEPPED_TOLERANCES
+from vibroimpact.reporting.general_record import general_setting, is_general
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.reporting.style import Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour
 
@@ -29,9 +34,15 @@ _REFERENCES = {
     "exact": ("reference: exact", "the exact engine (rigid-stop methods)"),
     "compliant_cvode_adams": ("reference: CVODE Adams 1e-13", "CVODE Adams at rtol 1e-13 (compliant model)"),
 }
-_ERRORS = (("x1_error", "relative error of the X1 fundamental [1]"), ("impact_time_error", "largest impact-time error [s]"))
+_IMPACT_ERROR = ("impact_time_error", "largest impact-time error [s]")
 #: The integrator shown in the per-period table, at the default rtol of stepped steady states.
 _INTEGRATOR = "momentary_adams"
+
+
+def _measured(dataset: xr.Dataset) -> tuple[dict[str, str], str]:
+    """The measured coordinate's variable names (``x1_error`` ... on the paper's layout) and its label (X1)."""
+    coordinate = str(dataset.attrs["system_coordinates"]).split()[0] if is_general(dataset) else "x1"
+    return measured_names(coordinate), coordinate.upper() if re.fullmatch(r"x[0-9]+", coordinate) else coordinate
 
 
 def _tolerance_free(dataset: xr.Dataset) -> set[str]:
@@ -56,12 +67,20 @@ class AccuracyPage:
         return f"methods: {', '.join(map(str, self.dataset['engine'].values))}"
 
     def sections(self, out: Path) -> list[Section]:
-        """One section: the work-precision diagrams and every table."""
-        return [Section("Work-precision", figures=saved(accuracy_figures(self.dataset), out), tables=accuracy_tables(self.dataset))]
+        """One section: the work-precision diagrams and every table (a general scene's layout in words first)."""
+        intro = ""
+        if is_general(self.dataset):
+            setting = general_setting(self.dataset)
+            label = _measured(self.dataset)[1]
+            intro = f"<p>Structure: {', '.join(setting.names)}. Stops: {html.escape('; '.join(setting.stops))}. Load: {html.escape(setting.load_text())}. Errors are of the {html.escape(label)} fundamental.</p>"
+        return [Section("Work-precision", intro=intro, figures=saved(accuracy_figures(self.dataset), out), tables=accuracy_tables(self.dataset))]
 
 
 def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
-    """Work-precision diagrams: X1 error and impact-time error against wall time, one row of two panels per case."""
+    """Work-precision diagrams: the measured fundamental's error (X1's) and impact-time error against wall time, one
+    row of two panels per case."""
+    names, label = _measured(dataset)
+    errors = ((names["x1_error"], f"relative error of the {label} fundamental [1]"), _IMPACT_ERROR)
     cases = [str(c) for c in dataset["case"].values]
     methods = [str(m) for m in dataset["engine"].values]
     fig, axes = new_figure(2 * len(cases), panel_height=3.6, legend_rows=legend_rows(len(methods) + 4))
@@ -71,7 +90,7 @@ def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
         "left), error against the reference, wall time the median of repeated runs in one process (read ratios, not seconds)."
     )
     for j, case in enumerate(cases):
-        for column, (quantity, label) in enumerate(_ERRORS):
+        for column, (quantity, axis) in enumerate(errors):
             ax = axes[2 * j + column]
             for k, method in enumerate(methods):
                 line = dataset.sel(case=case, engine=method)
@@ -95,18 +114,19 @@ def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
                     legend, text = _REFERENCES[reference]
                     ax.axvline(value, color=colour, ls=":", lw=1.3, label=legend)
                     caption.add(f"reference {reference}", f"Dotted vertical{' (grey)' if colour != 'k' else ''}: the wall time of the reference, {text}.")
-            if quantity == "x1_error":
+            if quantity == names["x1_error"]:
                 for target in TARGETS:
                     ax.axhline(target, color="k", lw=0.6, alpha=0.5)
                 caption.add("targets", f"Thin horizontal lines: the {' and '.join(fmt(t, '.0e') for t in TARGETS)} targets.")
-            finish_axes(ax, "wall time [s] (median)", label, case)
+            finish_axes(ax, "wall time [s] (median)", axis, case)
     figure_legend(fig, axes, columns=4)
     return [DrawnFigure(fig, "work_precision", "Work-precision diagrams", caption.text())]
 
 
 def accuracy_tables(dataset: xr.Dataset) -> list[Table]:
     """The answer (cheapest way to each target), tolerance guidance, the ladder, and every measured point."""
-    tables = [Table("Cheapest way to the X1 fundamental within a target", _answer_table(dataset)), Table("Tolerance guidance: loosest rtol meeting each target", _guidance_table(dataset))]
+    label = _measured(dataset)[1]
+    tables = [Table(f"Cheapest way to the {label} fundamental within a target", _answer_table(dataset)), Table("Tolerance guidance: loosest rtol meeting each target", _guidance_table(dataset))]
     if "floor_time_per_period" in dataset:
         tables.insert(0, Table("Cost per period: the exact engine against its floor, the pure-Python loop and momentary", per_period_table(dataset)))
     if "momentary_adams" in dataset["engine"].values:
@@ -153,7 +173,7 @@ def _answer_table(dataset: xr.Dataset) -> str:
                 f"<td>{fmt(exact)}</td></tr>"
             )
     note = (
-        "<p>For each method the loosest tolerance whose X1 fundamental is within the target (and every tighter one run, "
+        f"<p>For each method the loosest tolerance whose {_measured(dataset)[1]} fundamental is within the target (and every tighter one run, "
         "without a missed impact), and the wall time of a run at it; the cheapest of our integrators against the cheapest "
         "solve_ivp method, within one model: the rigid stop on stepped cases, the compliant model on the swept one (whose "
         "reference is CVODE Adams at rtol 1e-13: CVODE Adams there is measured against its own integrator at a far tighter "
@@ -202,15 +222,17 @@ def _equal_error_table(dataset: xr.Dataset) -> str:
 
 
 def _ladder_table(dataset: xr.Dataset) -> str:
-    """One steady state through each model: wall time [s], |X1| [m], difference from exact and relative cost (HTML)."""
-    rows = ["<tr><th>model</th><th>wall time per frequency point [s]</th><th>|X1| [m]</th><th>relative difference from exact</th><th>cost / exact</th></tr>"]
+    """One steady state through each model: wall time [s], |X1| [m] (the measured coordinate's), difference from exact
+    and relative cost (HTML)."""
+    names, label = _measured(dataset)
+    rows = [f"<tr><th>model</th><th>wall time per frequency point [s]</th><th>|{label}| [m]</th><th>relative difference from exact</th><th>cost / exact</th></tr>"]
     exact_wall = float(dataset["ladder_wall_time"].sel(model="exact"))
     for model in dataset["model"].values:
         point = dataset.sel(model=model)
         wall = float(point["ladder_wall_time"])
         rows.append(
-            f"<tr><td>{model}</td><td>{fmt(wall)}</td><td>{fmt(point['ladder_x1_amplitude'], '.6e')}</td>"
-            f"<td>{fmt(point['ladder_x1_difference'], '.2e')}</td><td>{fmt(wall / exact_wall)}</td></tr>"
+            f"<tr><td>{model}</td><td>{fmt(wall)}</td><td>{fmt(point[names['ladder_x1_amplitude']], '.6e')}</td>"
+            f"<td>{fmt(point[names['ladder_x1_difference']], '.2e')}</td><td>{fmt(wall / exact_wall)}</td></tr>"
         )
     return "<table>" + "".join(rows) + "</table>" + f"<p>{dataset.attrs.get('ladder_description', '')}</p>"
 
@@ -244,7 +266,8 @@ def _estimate_table(results: Path = Path("results")) -> str:
 
 def _points_table(dataset: xr.Dataset, case: str) -> str:
     """Every measured point of ``case``: cost, impacts found and missed, errors (HTML)."""
-    rows = ["<tr><th>method</th><th>rtol</th><th>wall [s]</th><th>steps</th><th>rhs calls</th><th>impacts</th><th>missed</th><th>extra</th><th>X1 error</th><th>impact-time error [s]</th><th>impulse error</th></tr>"]
+    names, label = _measured(dataset)
+    rows = [f"<tr><th>method</th><th>rtol</th><th>wall [s]</th><th>steps</th><th>rhs calls</th><th>impacts</th><th>missed</th><th>extra</th><th>{label} error</th><th>impact-time error [s]</th><th>impulse error</th></tr>"]
     free = _tolerance_free(dataset)
     for method in dataset["engine"].values:
         for tolerance in dataset["rtol"].values[:1] if method in free else dataset["rtol"].values:
@@ -253,7 +276,7 @@ def _points_table(dataset: xr.Dataset, case: str) -> str:
                 continue
             rows.append(
                 f"<tr><td>{method}</td><td>{'none' if method in free else fmt(tolerance, 'g')}</td><td>{fmt(p['wall_time'], '.4f')}</td><td>{fmt(p['steps'], '.0f')}</td><td>{fmt(p['rhs_calls'], '.0f')}</td>"
-                f"<td>{fmt(p['impacts'], '.0f')}</td><td>{fmt(p['missed_impacts'], '.0f')}</td><td>{fmt(p['extra_impacts'], '.0f')}</td><td>{fmt(p['x1_error'], '.2e')}</td>"
+                f"<td>{fmt(p['impacts'], '.0f')}</td><td>{fmt(p['missed_impacts'], '.0f')}</td><td>{fmt(p['extra_impacts'], '.0f')}</td><td>{fmt(p[names['x1_error']], '.2e')}</td>"
                 f"<td>{fmt(p['impact_time_error'], '.2e')}</td><td>{fmt(p['impulse_error'], '.2e')}</td></tr>"
             )
     for reference in dataset["reference"].values:
@@ -296,7 +319,7 @@ def per_period_table(dataset: xr.Dataset) -> str:
         "<p>Wall time of one run of the case divided by its periods, in microseconds; every number, and so every ratio, "
         "measured in one process run (median of the repeated runs; shared machines are noisy: read the ratios, not the "
         "microseconds). exact: the compiled engine as studies call it (its Python face included), with the per-period "
-        "Fourier moments the benchmark's X1 needs. Floor: its compiled kernel (exact_core.run_periods) alone on the same "
+        f"Fourier moments the benchmark's {_measured(dataset)[1]} needs. Floor: its compiled kernel (exact_core.run_periods) alone on the same "
         "run with the arguments the engine prepares, prepared once and untimed, its runs taken in turn with the exact ones so that a change of the machine's load falls on both; "
         "exact / floor is what the Python face adds. "
         "Without moments: the kernel computing strobes, impacts and segments only. exact_python: the same algorithm in "

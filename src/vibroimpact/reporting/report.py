@@ -10,7 +10,8 @@ the kind of study, in this one place:
 * benchmark studies: work-precision diagrams and tolerance guidance (:class:`~vibroimpact.reporting.accuracy_page.AccuracyPage`);
 * bifurcation studies: diagrams with brute force and continued branches, special points, multipliers and the chart
   (:class:`~vibroimpact.reporting.bifurcation_page.BifurcationPage`);
-* swept-sine tests: running estimates against the steady states (:class:`~vibroimpact.reporting.sweep_page.SweptSinePage`);
+* swept-sine tests: running estimates against the steady states (:class:`~vibroimpact.reporting.sweep_page.SweptSinePage`;
+  :class:`~vibroimpact.reporting.sweep_page.GeneralSweptPage` for a general scene: every coordinate and stop);
 * stepped design maps (attribute ``report_page`` = ``design_map``: restitution x clearance x frequency): which R and
   clearance to choose, peak |X1| per band, realisable regimes, the recommended design
   (:class:`~vibroimpact.reporting.design_page.DesignMapPage`);
@@ -39,7 +40,7 @@ from vibroimpact.reporting.general_page import GeneralResponsePage  # noqa: E402
 from vibroimpact.reporting.general_record import is_general  # noqa: E402
 from vibroimpact.reporting.record import study_kind, study_record, study_setting  # noqa: E402
 from vibroimpact.reporting.stepped_page import FrequencyResponsePage  # noqa: E402
-from vibroimpact.reporting.sweep_page import SweptSinePage  # noqa: E402
+from vibroimpact.reporting.sweep_page import GeneralSweptPage, SweptSinePage  # noqa: E402
 
 __all__ = ["write_report", "page_for"]
 
@@ -72,6 +73,8 @@ def page_for(dataset: xr.Dataset) -> StudyPage:
         return DesignMapPage(dataset)
     if kind == "stepped" and is_general(dataset):
         return GeneralResponsePage(dataset)
+    if kind == "swept" and is_general(dataset):
+        return GeneralSweptPage(dataset)
     setting = study_setting(dataset)
     if kind == "swept":
         return SweptSinePage(dataset, setting)

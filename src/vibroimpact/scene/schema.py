@@ -16,9 +16,10 @@ import numpy as np
 from vibroimpact.analysis.pgf import AdmissibilitySettings
 from vibroimpact.engines.registry import BUMPER, RIGID, engine_names, engine_spec, stepped_solutions
 from vibroimpact.engines.settings import ATOL_RATIO, STEPPED_TOLERANCES, EngineSettings
-from vibroimpact.model.contact import KelvinVoigtBumper, loss_factor_from_restitution
+from vibroimpact.model.contact import loss_factor_from_restitution
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.stops import Stop
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.layout import LoadSpec, StopSpec
@@ -165,6 +166,11 @@ class LadderSettings:
         Tolerance of the integrators (atol = rtol x the scene's atol_ratio); default: that of stepped steady states.
     repeats : int
         Runs per model (median wall time).
+    problem : ImpactProblem
+        The scene's structure, load and rigid stops at this point (the stops' own values where they give them; NaN
+        ``restitution``, ``clearance`` where every stop does); required.
+    compliant : tuple of tuple of Stop
+        The same stops as bumpers, one layout per bumper frequency (loss factors from each stop's restitution).
     """
 
     frequency: float
@@ -173,6 +179,14 @@ class LadderSettings:
     bumper_frequencies: tuple[float, ...]
     rtol: float = STEPPED_TOLERANCES[0]
     repeats: int = 3
+    problem: ImpactProblem | None = None
+    compliant: tuple[tuple[Stop, ...], ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.problem is None:
+            raise ValueError("problem: the ladder needs its structure, load and rigid stops (an ImpactProblem)")
+        if len(self.compliant) != len(self.bumper_frequencies):
+            raise ValueError(f"compliant: expected one bumper layout per bumper frequency ({len(self.bumper_frequencies)}), got {len(self.compliant)}")
 
 
 @dataclass(frozen=True)
@@ -184,14 +198,16 @@ class BenchmarkCase:
     name : str
         Label of the case.
     problem : ImpactProblem
-        System, rigid stop and harmonic force (a swept case: its start frequency), for the rigid-stop methods and
-        the start of every stepped run.
+        Structure, rigid stops and harmonic load (a swept case: at its start frequency), for the rigid-stop methods
+        and the start of every stepped run.
     start : str
-        ``rest``, ``linear`` or ``pgf`` (see :func:`vibroimpact.simulation.steady.start_state`); swept cases start at rest.
+        ``rest``, ``linear`` or ``pgf`` (see :func:`vibroimpact.simulation.steady.start_state`: ``pgf`` is the closed-form
+        orbit where the layout has one, else the linear start); swept cases start at rest.
     periods : int
         Whole periods integrated (stepped cases).
-    bumper : KelvinVoigtBumper or None
-        The compliant model's contact (its loss factor gives the stop's restitution); None: no compliant methods.
+    bumper : tuple of Stop or None
+        The compliant model's stops, the rigid ones as Kelvin-Voigt bumpers (each loss factor gives its stop's
+        restitution); None: no compliant methods.
     sweep : SweptSine or None
         A swept-sine case of the compliant model.
     sample_rate : float
@@ -202,7 +218,7 @@ class BenchmarkCase:
     problem: ImpactProblem
     start: str
     periods: int
-    bumper: KelvinVoigtBumper | None = None
+    bumper: tuple[Stop, ...] | None = None
     sweep: SweptSine | None = None
     sample_rate: float = 2000.0
 

@@ -1,8 +1,14 @@
-"""Swept-sine studies: the compliant model run through whole sweeps (the paper's Simulink runs, section 5).
+"""Swept-sine studies: the compliant model run through whole sweeps (the paper's Simulink runs, section 5), on any
+structure, load and stops.
 
 The steady-state solutions are not repeated along ``sweep``; the swept runs' estimates on the frequency grid are the
 ``swept_<quantity>`` variables (sweep, frequency), their running estimates ``running_<quantity>`` (sweep,
-elapsed_time) and their costs ``sweep_<statistic>`` (sweep).
+elapsed_time) and their costs ``sweep_<statistic>`` (sweep). Quantities are named as a stepped study of the same
+scene names them: the paper's (``x1_amplitude`` ...) for its named form, ``<coordinate>_amplitude`` and
+``<coordinate>_rms`` per coordinate of a general scene; per-stop quantities (impulse, peaks) get a dimension ``stop``
+where the scene has several stops. The closed forms are the general ones
+(:func:`~vibroimpact.study.general_values.general_linear_values`, :func:`~vibroimpact.study.general_values.general_pgf_values`);
+``pgf_paper``, the paper's own fitted route, exists for the named form only.
 """
 
 from __future__ import annotations
@@ -12,21 +18,25 @@ from dataclasses import asdict
 import numpy as np
 import xarray as xr
 
+from vibroimpact.analysis.pgf import PgfVariant
 from vibroimpact.analysis.regime import Regime
-from vibroimpact.model.contact import KelvinVoigtBumper
-from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, MOTION_QUANTITIES, Scene
-from vibroimpact.scene.variables import SWEEP_STAT_ATTRIBUTES, SWEEP_TIME_ATTRIBUTES, quantity_attributes, running_attributes, swept_attributes
+from vibroimpact.scene.layout import build_stops, stop_descriptions
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, MOTION_QUANTITIES, STOP_QUANTITIES, Scene
+from vibroimpact.scene.variables import SWEEP_STAT_ATTRIBUTES, SWEEP_TIME_ATTRIBUTES, quantity_attributes, swept_attributes
+from vibroimpact.simulation.swept import SWEEP_STOP_QUANTITIES, sweep_quantities
 from vibroimpact.study.cost_model import Costs, EnginePart, Estimate, grid_estimate
-from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates, solve_each, steady_variable
+from vibroimpact.study.general_estimate import closed_form_scale, engine_scale
+from vibroimpact.study.general_stepped import describe_stops, general_quantity_attributes
+from vibroimpact.study.general_values import coordinate_quantity, general_linear_values, general_pgf_values
+from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates
 from vibroimpact.study.runner import Runner
-from vibroimpact.study.solutions import no_one_impact_orbit
-from vibroimpact.simulation.swept import SWEEP_QUANTITIES
 from vibroimpact.study.swept_cases import SWEEP_STATS, SweepCase
 
-__all__ = ["SweptStudy", "swept_values", "REPORT_FIGURES"]
+__all__ = ["SweptStudy", "swept_values", "closed_form_values", "REPORT_FIGURES"]
 
 #: Figures of a swept-sine study's report page.
 REPORT_FIGURES = 4
+Values = dict[str, np.ndarray]
 
 
 class SweptStudy:
@@ -37,41 +47,59 @@ class SweptStudy:
     def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """Every solution of ``scene`` over its grid (see :func:`vibroimpact.study.run.run_study`)."""
         grid = StudyGrid.of(scene)
-        running: dict[str, np.ndarray] = {}
-        sweep_axes: dict[str, np.ndarray] = {}
-
-        def simulate(name: str) -> dict[str, np.ndarray]:
-            values, sweep_running, axes = swept_values(scene, grid.full, runner)
-            running.update(sweep_running)
-            sweep_axes.update(axes)
-            return values
-
-        per_solution = solve_each(scene, grid, simulate, progress)
+        report = progress or (lambda _message: None)
+        count = len(scene.stop_specs)
+        steady: dict[str, Values] = {}
+        swept: Values = {}
+        running: Values = {}
+        axes: Values = {}
+        for i, name in enumerate(scene.solutions, start=1):
+            if name in ENGINE_SOLUTIONS:
+                swept, running, axes = swept_values(scene, grid.full, runner)
+            else:
+                steady[name] = closed_form_values(scene, name, grid)
+            report(f"[{i}/{len(scene.solutions)}] {name}: done")
         # a swept-sine test depends on its direction, the steady-state solutions do not: they are not repeated along
         # ``sweep``; the swept runs' estimates on the frequency grid are the ``swept_*`` variables (sweep, frequency)
-        steady_solutions = [name for name in scene.solutions if name not in ENGINE_SOLUTIONS]
+        engine = next((name for name in scene.solutions if name in ENGINE_SOLUTIONS), "")
         steady_dims = tuple(d for d in GRID_DIMS if d != "sweep")
-        coords = grid_coordinates(scene, grid, steady_solutions)
+        coords = grid_coordinates(scene, grid, list(steady))
         coords["sweep"] = np.array(grid.directions, dtype=object)
+        several = count > 1 and any(q in STOP_QUANTITIES for q in scene.quantities)
+        if several:
+            coords["stop"] = np.arange(count)
+            coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.stop_specs, scene.coordinates, scene.restitution, scene.clearance), dtype=object))
+
+        def stop_dims(quantity: str, dims: tuple[str, ...]) -> tuple[str, ...]:
+            return ("stop", *dims) if quantity in STOP_QUANTITIES and several else dims
+
+        def per_stop(quantity: str, values: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+            """Per-stop values with their leading stop axis (dropped for one stop), others as they are."""
+            if quantity not in STOP_QUANTITIES:
+                return np.broadcast_to(values, shape)
+            values = np.broadcast_to(values, (count, *shape))
+            return values if several else values[0]
+
         data_vars = {}
         for quantity in scene.quantities:
-            attrs = quantity_attributes(quantity)
-            stacked = steady_variable(quantity, scene, grid, per_solution, steady_solutions)
-            if stacked is not None:
-                data_vars[quantity] = xr.Variable(("solution", *steady_dims), stacked[:, :, :, :, 0, :], attrs)
-            for name, values in zip(scene.solutions, per_solution):
-                if name not in steady_solutions and quantity not in MOTION_QUANTITIES:
-                    data_vars[f"swept_{quantity}"] = xr.Variable(GRID_DIMS, values[quantity], swept_attributes(name, attrs))
+            attrs = _attributes(scene, quantity)
+            if steady:
+                stacked = np.stack([per_stop(quantity, values[quantity], grid.full) for values in steady.values()])
+                data_vars[quantity] = xr.Variable(("solution", *stop_dims(quantity, steady_dims)), stacked[..., 0, :], attrs)
+            if swept and quantity not in MOTION_QUANTITIES:
+                data_vars[f"swept_{quantity}"] = xr.Variable(stop_dims(quantity, GRID_DIMS), per_stop(quantity, swept[quantity], grid.full), swept_attributes(engine, attrs))
         for name, values in running.items():
             if name.startswith("sweep_"):  # one value per sweep run
                 data_vars[name] = xr.Variable(GRID_DIMS[:-1], values, SWEEP_STAT_ATTRIBUTES[name])
             else:
-                data_vars[name] = xr.Variable((*GRID_DIMS[:-1], "elapsed_time"), values, running_attributes(name))
-        dataset = xr.Dataset(data_vars, coords=coords)
+                quantity = name.removeprefix("running_")
+                shape = (*grid.full[:-1], axes["time"].size)
+                data_vars[name] = xr.Variable(stop_dims(quantity, (*GRID_DIMS[:-1], "elapsed_time")), per_stop(quantity, values, shape), _running_attributes(_attributes(scene, quantity)))
+        dataset = describe_stops(xr.Dataset(data_vars, coords=coords))
         if running:
             dataset = dataset.assign_coords(
-                elapsed_time=("elapsed_time", sweep_axes["time"], dict(SWEEP_TIME_ATTRIBUTES["elapsed_time"])),
-                instantaneous_frequency=(("sweep", "elapsed_time"), sweep_axes["instantaneous_frequency"], dict(SWEEP_TIME_ATTRIBUTES["instantaneous_frequency"])),
+                elapsed_time=("elapsed_time", axes["time"], dict(SWEEP_TIME_ATTRIBUTES["elapsed_time"])),
+                instantaneous_frequency=(("sweep", "elapsed_time"), axes["instantaneous_frequency"], dict(SWEEP_TIME_ATTRIBUTES["instantaneous_frequency"])),
             )
         # a swept-sine study keeps its sweep dimension even with one direction
         return finish_dataset(dataset, scene, coords, self.simulation_attributes(scene), keep=("sweep",))
@@ -89,8 +117,9 @@ class SweptStudy:
         return attrs
 
     def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:
-        """Seconds per simulated second of the compliant engine at its tolerance times the sweeps' durations, on the
-        calibration machine; the memory holds one sweep's samples per worker."""
+        """Seconds per simulated second of the compliant engine at its tolerance (scaled for the layout's coordinates
+        and stops) times the sweeps' durations, on the calibration machine; the memory holds one sweep's samples per
+        worker."""
         assert scene.swept_sine is not None
         s = scene.swept_sine
         bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
@@ -99,37 +128,70 @@ class SweptStudy:
         def engine_part(name: str, engine: str) -> EnginePart:
             assert scene.simulation is not None
             duration = abs(s.stop_frequency - s.start_frequency) / s.rate
-            one = costs.per_sweep_second_cost(engine, scene.simulation.engine.rtol) * duration
+            one = costs.per_sweep_second_cost(engine, scene.simulation.engine.rtol) * duration * engine_scale(scene)
             runs = scene.restitution.size * scene.clearance.size * bumpers * directions
             return one * runs, f"{runs} sweeps of {duration:g} s", one
 
         samples = abs(s.stop_frequency - s.start_frequency) / s.rate * s.sample_rate
-        return grid_estimate(scene, jobs, costs, engine_part, REPORT_FIGURES, samples)
+        return grid_estimate(scene, jobs, costs, engine_part, REPORT_FIGURES, samples, closed_form_scale=lambda name: closed_form_scale(scene, name))
 
 
-def swept_values(scene: Scene, shape: tuple[int, ...], runner: Runner) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """Swept-sine tests of the compliant model: estimates on the frequency grid, running estimates against time, and
-    the time axes (``time``, ``instantaneous_frequency`` per direction)."""
+def _attributes(scene: Scene, quantity: str) -> dict[str, object]:
+    """Units and long name of a quantity: the paper's for its named form, named after the coordinates and stops for a
+    general scene."""
+    return general_quantity_attributes(quantity, scene) if scene.general else quantity_attributes(quantity)
+
+
+def _running_attributes(attrs: dict[str, object]) -> dict[str, object]:
+    """Attributes of a running estimate against the sweep's elapsed time, from its quantity's."""
+    return {"units": attrs.get("units", "1"), "long_name": f"running estimate over the sweep's window: {attrs.get('long_name', '')}"}
+
+
+def closed_form_values(scene: Scene, name: str, grid: StudyGrid) -> Values:
+    """A closed-form steady-state solution (``linear``, ``pgf``; ``pgf_paper`` for the named form) over the grid, the
+    scene's quantities; per-stop ones with a leading axis of one entry per stop."""
+    if name == "linear":
+        return general_linear_values(scene, grid.omega, grid.base)
+    if name == "pgf":
+        return general_pgf_values(scene, grid.omega, grid.delta, grid.r, grid.base)
+    from vibroimpact.study.solutions import pgf_values  # the paper's fitted route (named form only: the checker refuses it elsewhere)
+
+    values = pgf_values(scene, PgfVariant(name), grid.omega, grid.delta, grid.r, grid.base)
+    return {q: value[None] if q in STOP_QUANTITIES else value for q, value in values.items()}
+
+
+def swept_values(scene: Scene, shape: tuple[int, ...], runner: Runner) -> tuple[Values, Values, Values]:
+    """Swept-sine tests of the compliant model: estimates on the frequency grid (per-stop ones with a leading stop
+    axis), running estimates against time and each run's statistics (``sweep_<stat>``), and the time axes
+    (``time``, ``instantaneous_frequency`` per direction)."""
     assert scene.swept_sine is not None and scene.bumper_frequency is not None and scene.simulation is not None
-    losses = scene.loss_factors()
+    # xi_b: the scene's where it gives one, else each stop's own from its restitution (build_stops)
+    losses = scene.loss_factors() if scene.bumper_loss_factor is not None else np.full(scene.restitution.shape, np.nan)
     frequencies = tuple(float(f) for f in scene.all_frequencies)
     cases, places = [], []
-    for i in range(scene.restitution.size):
+    for i, restitution in enumerate(scene.restitution):
         for j, clearance in enumerate(scene.clearance):
             for k, bumper in enumerate(scene.bumper_frequency):
+                stops = build_stops(scene.stop_specs, True, float(restitution), float(clearance), float(bumper), float(losses[i]))
                 for d, direction in enumerate(scene.swept_sine.directions):
-                    cases.append(SweepCase(scene.system, scene.amplitude, KelvinVoigtBumper(float(clearance), float(bumper), float(losses[i])), scene.swept_sine, direction, scene.simulation.engine, frequencies))
+                    cases.append(SweepCase(scene.system, scene.amplitude, stops, scene.swept_sine, direction, scene.simulation.engine, frequencies, scene.load))
                     places.append((i, j, k, d))
     results = runner.map(cases)
     times = results[0]["time"]
-    values = {name: np.full(shape, np.nan) for name in SWEEP_QUANTITIES}
-    running = {f"running_{name}": np.full((*shape[:-1], times.size), np.nan) for name in SWEEP_QUANTITIES}
+    count = len(scene.stop_specs)
+    names = sweep_quantities(scene.coordinates)
+
+    def room(name: str, tail: tuple[int, ...]) -> np.ndarray:
+        return np.full(((count,) if name in SWEEP_STOP_QUANTITIES else ()) + tail, np.nan)
+
+    values = {name: room(name, shape) for name in names}
+    running = {f"running_{name}": room(name, (*shape[:-1], times.size)) for name in names}
     stats = {name: np.full(shape[:-1], np.nan) for name in SWEEP_STATS}
     instantaneous = np.full((shape[3], times.size), np.nan)
     for (i, j, k, d), result in zip(places, results):
-        for name in SWEEP_QUANTITIES:
-            values[name][i, j, k, d] = result[name]
-            running[f"running_{name}"][i, j, k, d] = result[f"running_{name}"]
+        for name in names:
+            values[name][..., i, j, k, d, :] = result[name]
+            running[f"running_{name}"][..., i, j, k, d, :] = result[f"running_{name}"]
         for name in stats:
             stats[name][i, j, k, d] = result[name]
         instantaneous[d] = result["instantaneous_frequency"]
@@ -138,13 +200,18 @@ def swept_values(scene: Scene, shape: tuple[int, ...], runner: Runner) -> tuple[
     regime[impacts == 0.0] = Regime.LINEAR
     regime[impacts > 0.0] = Regime.SWEPT_CONTACT
     regime[np.broadcast_to(stats["failed"][..., None] == 1.0, shape)] = Regime.FAILED
+    nan = np.full(shape, np.nan)
     values |= {
-        "phase": np.full(shape, np.nan),
+        "phase": nan,
         "regime": regime,
-        **no_one_impact_orbit(shape),
+        "stable": np.full(shape, -1, dtype=np.int8),
+        "floquet_modulus": nan,
+        "one_impact_force_amplitude": nan,
+        "one_impact_impulse": np.full((count, *shape), np.nan),
+        **{coordinate_quantity("one_impact_x1_amplitude", c): nan for c in scene.coordinates},
         "converged": np.full(shape, -1, dtype=np.int8),
         "wall_time": np.broadcast_to(stats["wall_time"][..., None], shape),
-        **{name: np.full(shape, np.nan) for name in MOTION_QUANTITIES},  # a sweep is a transient: no attractor to classify
+        **{name: nan for name in MOTION_QUANTITIES},  # a sweep is a transient: no attractor to classify
     }
     running = {name: value for name, value in running.items() if name.removeprefix("running_") in scene.quantities}
     for name, value in stats.items():

@@ -1,34 +1,36 @@
 """Swept-sine tests of the compliant model as cases of a study (the paper's Simulink runs, section 5).
 
-One case is one sweep direction at one (restitution, clearance, bumper): the compliant engine integrates the whole
-sweep, then :func:`vibroimpact.simulation.swept.sweep_estimates` measures it (running estimates on the study's
-frequency grid and on a uniform time grid); the case adds the run's cost, and a failed run is NaN and flagged.
+One case is one sweep direction at one (restitution, clearance, bumper) grid point of any structure, load and stops:
+the compliant engine integrates the whole sweep, then :func:`vibroimpact.simulation.swept.sweep_estimates` measures it
+(running estimates on the study's frequency grid and on a uniform time grid, one per coordinate and per stop); the
+case adds the run's cost, and a failed run is NaN and flagged.
 """
 
 from __future__ import annotations
 
 import sys
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.registry import make_engine
-from vibroimpact.model.contact import KelvinVoigtBumper
-from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.study.fingerprint import case_key
-from vibroimpact.simulation.swept import SWEEP_QUANTITIES, sweep_estimates, sweep_start_state
-from vibroimpact.study.runner import ProgressReport
+from vibroimpact.engines.settings import EngineSettings
+from vibroimpact.model.excitation import SweptSine
+from vibroimpact.model.problem import ImpactProblem, Structure
+from vibroimpact.model.stops import Stop
+from vibroimpact.scene.layout import LoadSpec
 from vibroimpact.scene.schema import SweptSineSettings
-from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.simulation.layout import resting_state
+from vibroimpact.simulation.swept import SWEEP_STOP_QUANTITIES, sweep_estimates, sweep_quantities, sweep_start_state
+from vibroimpact.study.fingerprint import case_key
+from vibroimpact.study.runner import ProgressReport
 
-__all__ = ["SweepCase", "SWEEP_STATS", "SWEEP_FIELDS", "run_sweep_case"]
+__all__ = ["SweepCase", "SWEEP_STATS", "run_sweep_case"]
 
 #: Whole-run statistics of a sweep.
 SWEEP_STATS = ("wall_time", "steps", "contacts", "rhs_calls", "linear_start", "failed")
-SWEEP_FIELDS = SWEEP_QUANTITIES + tuple(f"running_{q}" for q in SWEEP_QUANTITIES) + ("time", "instantaneous_frequency") + SWEEP_STATS
 
 
 @dataclass(frozen=True)
@@ -37,12 +39,13 @@ class SweepCase:
 
     Attributes
     ----------
-    system : TwoDofSystem
-        The linear system.
+    system : TwoDofSystem or LinearStructure
+        The linear structure.
     amplitude : float
         q [N].
-    bumper : KelvinVoigtBumper
-        The contact: clearance Delta [m], Omega_b / 2 pi [Hz] and xi_b [-].
+    stops : tuple of Stop
+        Every stop, each with its :class:`~vibroimpact.model.contact.KelvinVoigtBumper` (clearance Delta [m],
+        Omega_b / 2 pi [Hz], xi_b [-]).
     settings : SweptSineSettings
         The sweep (ends, rate, sampling, window).
     direction : str
@@ -51,34 +54,60 @@ class SweepCase:
         IDA tolerances.
     frequencies : tuple of float
         Frequencies at which window-centred estimates are reported [Hz] (NaN outside the sweep or its windows).
+    load : LoadSpec or None
+        How q is distributed over the coordinates, and a constant force; None: all of q on the first coordinate.
     time_points : int
         Points of the uniform time grid of the running estimates.
     """
 
-    system: TwoDofSystem
+    system: Structure
     amplitude: float
-    bumper: KelvinVoigtBumper
+    stops: tuple[Stop, ...]
     settings: SweptSineSettings
     direction: str
     engine_settings: EngineSettings
     frequencies: tuple[float, ...]
+    load: LoadSpec | None = None
     time_points: int = 2001
 
     engine = "compliant_sweep"
     #: The registered engine that runs the sweep.
     engine_name = "compliant"
-    fields = SWEEP_FIELDS
-
     progress_unit = "s simulated"
+
+    def __post_init__(self) -> None:
+        if not self.stops:
+            raise ValueError("stops: a swept-sine run needs at least one stop")
+        if self.load is not None and self.load.base_motion:
+            raise ValueError("load: a swept-sine run drives a force; a swept base motion is not supported")
+
+    @property
+    def fields(self) -> tuple[str, ...]:
+        """Names of the result's arrays: every estimate, on the frequency grid and running, the time axes and the
+        run's statistics."""
+        names = sweep_quantities(tuple(self.system.coordinates))
+        return names + tuple(f"running_{q}" for q in names) + ("time", "instantaneous_frequency") + SWEEP_STATS
+
+    @property
+    def sweep(self) -> SweptSine:
+        """The excitation: the settings' sweep in this direction, distributed as the load says."""
+        sweep = self.settings.sweep(self.amplitude, self.direction)
+        if self.load is None:
+            return sweep
+        return replace(sweep, weights=self.load.weights, static=self.load.static)
+
+    def problem(self) -> ImpactProblem:
+        """The structure, its bumpers and the sweep."""
+        return ImpactProblem(self.system, self.stops, self.sweep)
 
     @property
     def progress_total(self) -> float:
         """The sweep's duration [s]: progress is counted in simulated time."""
-        return self.settings.sweep(self.amplitude, self.direction).duration
+        return self.sweep.duration
 
     def key(self) -> str:
         """A stable hash of everything that determines the result, the package version and its source code."""
-        return case_key(asdict(self))
+        return case_key({"kind": type(self.system).__name__, **asdict(self)})
 
     def run(self, report: ProgressReport | None = None) -> dict[str, NDArray[np.generic]]:
         """Simulate the sweep and estimate (see :func:`run_sweep_case`)."""
@@ -88,22 +117,31 @@ class SweepCase:
 def run_sweep_case(case: SweepCase, report: ProgressReport | None = None) -> dict[str, NDArray[np.generic]]:
     """Run one sweep; estimates on ``case.frequencies`` and on the time grid, and the run's cost.
 
-    ``report`` receives the simulated time reached [s] as the run goes on."""
-    sweep = case.settings.sweep(case.amplitude, case.direction)
+    The run starts on the linear steady state at its first frequency where the settings ask for it and that motion
+    stays clear of every stop, else at rest (the static position, on the stops it would cross). ``report`` receives
+    the simulated time reached [s] as the run goes on."""
+    problem = case.problem()
+    sweep = problem.sweep
     engine = make_engine(case.engine_name, case.engine_settings)
     started = time.perf_counter()
-    state = sweep_start_state(case.system, sweep, case.bumper.clearance) if case.settings.initial_state == "linear" else None
+    linear = sweep_start_state(problem) if case.settings.initial_state == "linear" else None
+    state = linear if linear is not None else resting_state(problem)
     times = np.linspace(0.0, sweep.duration, case.time_points)
+    names = sweep_quantities(tuple(case.system.coordinates))
+    count = len(case.stops)
     try:
-        record = engine.sweep(ImpactProblem(case.system, case.bumper, sweep), case.settings.sample_rate, state, report)
+        record = engine.sweep(problem, case.settings.sample_rate, state, report)
     except (RuntimeError, ValueError, ArithmeticError) as error:
         # a failing run must not cost the others: it stays NaN, flagged, and the study goes on
-        print(f"compliant sweep {case.direction}: {case.bumper} failed: {error}", file=sys.stderr)
-        failed: dict[str, NDArray[np.generic]] = {name: np.full(len(case.frequencies), np.nan) for name in SWEEP_QUANTITIES}
-        failed |= {f"running_{name}": np.full(times.size, np.nan) for name in SWEEP_QUANTITIES}
+        print(f"compliant sweep {case.direction}: {case.stops} failed: {error}", file=sys.stderr)
+        failed: dict[str, NDArray[np.generic]] = {}
+        for name in names:
+            per_stop = (count,) if name in SWEEP_STOP_QUANTITIES else ()
+            failed[name] = np.full((*per_stop, len(case.frequencies)), np.nan)
+            failed[f"running_{name}"] = np.full((*per_stop, times.size), np.nan)
         failed |= {"time": times, "instantaneous_frequency": sweep.frequency(times)}
         failed |= {name: np.array(np.nan) for name in SWEEP_STATS}
-        failed["linear_start"] = np.array(float(state is not None))
+        failed["linear_start"] = np.array(float(linear is not None))
         failed["failed"] = np.array(1.0)
         return failed
     wall_time = time.perf_counter() - started
@@ -112,6 +150,6 @@ def run_sweep_case(case: SweepCase, report: ProgressReport | None = None) -> dic
     out["wall_time"] = np.array(wall_time)
     for name in ("steps", "contacts", "rhs_calls"):
         out[name] = np.array(float(stats.get(name, np.nan)))
-    out["linear_start"] = np.array(float(state is not None))  # the linear start falls back to rest where it would cross the stop
+    out["linear_start"] = np.array(float(linear is not None))  # the linear start falls back to rest where it would reach a stop
     out["failed"] = np.array(0.0)
     return out

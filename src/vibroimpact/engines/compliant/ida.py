@@ -47,7 +47,7 @@ from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.validation import require_positive
 
-__all__ = ["CompliantEngine", "check_sweep_layout", "base_force"]
+__all__ = ["CompliantEngine", "base_force"]
 
 _STATUS_ROOT = 2  # IDA_ROOT_RETURN
 _STATUS_ILL_INPUT = -22  # IDA_ILL_INPUT (CV_ILL_INPUT): among others, "Root found at and very near t"
@@ -100,40 +100,43 @@ class CompliantEngine:
     ) -> SweepRecord:
         """Swept-sine test (the paper's Simulink run): q sin(theta(t)) from t = 0 to the sweep's end, sampled.
 
-        Two coordinates and one stop (any kind: the record holds x1, x2 and one contact force); others are refused
-        (``NotImplementedError``).
+        Any structure and stops (each a bumper): the record holds every coordinate, each stop's contact force and
+        its Fourier integral, and the force on the base (:func:`base_force`).
 
         Parameters
         ----------
         problem : ImpactProblem
-            System, bumper and a :class:`~vibroimpact.model.excitation.SweptSine` excitation.
+            Structure, bumpers and a :class:`~vibroimpact.model.excitation.SweptSine` excitation.
         sample_rate : float
             Output samples per second [Hz] (IDA interpolates; the step is set by the tolerances).
         state : ndarray, optional
-            (X1, X2, X1', X2') at t = 0; rest by default.
+            (x_1 ... x_N, x_1' ... x_N') at t = 0 [m, m s-1]; rest (zeros) by default.
         progress : callable, optional
             Receives the simulated time reached [s] after each block of samples.
         """
         check_run(self.name, problem, KelvinVoigtBumper)
-        check_sweep_layout(self.name, problem)
         sweep = problem.sweep
         require_positive("sample_rate", sample_rate)
         model = BumperModel(problem, False)
         rec = TrajectoryBuilder(problem, False)
+        n, count = problem.size, model.stop_count
         omega_ref = 2.0 * math.pi * max(sweep.start_frequency, sweep.stop_frequency)
-        run = _Run(self, model, rec, 0.0, np.zeros(4) if state is None else state, omega_ref)
+        run = _Run(self, model, rec, 0.0, np.zeros(2 * n) if state is None else state, omega_ref)
         times = np.arange(0.0, sweep.duration, 1.0 / sample_rate)
-        out = np.empty((times.size, 7))  # X1, X2, X1', X2', F, Fourier integral (real, -imaginary)
+        # x, x', each stop's force, each stop's Fourier integral (real, -imaginary)
+        out = np.empty((times.size, 2 * n + 3 * count))
+        forces, fourier = 2 * n, 2 * n + count
         filled, first = 0, model.first_quadrature
         layout = model.layout
 
         def samples(t: NDArray[np.float64], ys: NDArray[np.float64], contact: int) -> None:
             nonlocal filled
             block = out[filled : filled + t.size]
-            block[:, :2] = ys[:, :2] @ layout.t_inverse.T + layout.offset
-            block[:, 2:4] = ys[:, 2:4]
-            block[:, 4] = ys[:, :4] @ model.force_rows[0] + model.force_constants[0] if contact else 0.0
-            block[:, 5:] = ys[:, first : first + 2]
+            block[:, :n] = ys[:, :n] @ layout.t_inverse.T + layout.offset
+            block[:, n : 2 * n] = ys[:, n : 2 * n]
+            for k in range(count):
+                block[:, forces + k] = ys[:, : 2 * n] @ model.force_rows[k] + model.force_constants[k] if (contact >> k) & 1 else 0.0
+            block[:, fourier:] = ys[:, first : first + 2 * count]
             filled += t.size
             if progress is not None:
                 progress(float(t[-1]))
@@ -142,8 +145,9 @@ class CompliantEngine:
         if filled != times.size:
             raise RuntimeError(f"the sweep produced {filled} of {times.size} samples")
         rec.strobe(run.t, run.physical())
-        fourier = out[:, 5] - 1j * out[:, 6]
-        return SweepRecord(sweep, times, out[:, 0], out[:, 1], base_force(problem, out[:, :4], out[:, 4]), out[:, 4], rec.build(run.stats()), fourier)
+        contact = out[:, forces:fourier]
+        integrals = out[:, fourier:]
+        return SweepRecord(sweep, times, out[:, :n], base_force(problem, out[:, : 2 * n], contact), contact, rec.build(run.stats()), integrals[:, 0::2] - 1j * integrals[:, 1::2])
 
     def solve(self, solver: Any, tspan: NDArray[np.float64], y0: NDArray[np.float64], yp0: NDArray[np.float64]) -> Any:
         """One solver call over ``tspan`` from a consistent (y0, y0')."""
@@ -176,22 +180,14 @@ class CompliantEngine:
         return IDA(model.residual(contact), **options), events
 
 
-def check_sweep_layout(engine: str, problem: ImpactProblem) -> None:
-    """A swept-sine record holds x1, x2 and one contact force: two coordinates and one stop, else
-    ``NotImplementedError`` naming the layout."""
-    if problem.size != 2 or len(problem.stops) != 1:
-        raise NotImplementedError(
-            f"engine {engine!r}: a swept-sine run records two coordinates (x1, x2) and one contact force; this problem has "
-            f"{problem.size} coordinates and {len(problem.stops)} stops: sweep it in steps (steady states) instead")
-
-
 def base_force(problem: ImpactProblem, states: NDArray[np.float64], contact: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Force on the base [N] from samples of (x, x') (rows) and the contact force: the springs and dashpots to the
-    ground, 1^T (K x + C x'), plus the stop's force on the base, (1^T n) lambda (an absolute stop; a relative one
-    loads only the structure). For the paper's layout K1 X1 + B1 X1' + F."""
+    """Force on the base [N] from samples of (x, x') (rows) and of each stop's contact force (rows of K): the springs
+    and dashpots to the ground, 1^T (K x + C x'), plus each stop's force on the base, (1^T n_k) lambda_k (+lambda_k
+    for an upper absolute stop, -lambda_k for a lower one; a relative stop loads only the structure). For the paper's
+    layout K1 X1 + B1 X1' + F."""
     structure, n = problem.structure, problem.size
     ground = np.concatenate([structure.stiffness_matrix.sum(axis=0), structure.damping_matrix.sum(axis=0)])
-    return states[:, : 2 * n] @ ground + float(problem.normals()[0].sum()) * contact
+    return states[:, : 2 * n] @ ground + contact @ problem.normals().sum(axis=1)
 
 
 class _Run:

@@ -1,23 +1,23 @@
 """The compliant-bumper swept-sine test through ``scipy.integrate.solve_ivp``: a cross-check of the IDA engine.
 
-Written independently of :mod:`.ida` and :mod:`.model` (its own right-hand side, in the physical coordinates x1, x2, x1', x2',
-its own events and restarts), so that agreement between the two means something. The model is the same, on any
-two-coordinate structure with one stop (normal n, clearance Delta, effective mass m): the Kelvin-Voigt bumper of
-eq. 25 pushes along -n with F = K (n . x - Delta) + B n . x' (K = m Omega_b^2, B = 2 m xi_b Omega_b) from the moment
-n . x reaches Delta until F falls to zero (for the paper's layout n = e_2, F = K (X2 - Delta) + B X2'). The loop a
-user of SciPy would write:
+Written independently of :mod:`.ida` and :mod:`.model` (its own right-hand side, in the physical coordinates
+(x, x'), its own events and restarts), so that agreement between the two means something. The model is the same, on
+any structure with any stops (normal n_k, clearance Delta_k, effective mass m_k): the Kelvin-Voigt bumper of eq. 25
+of stop k pushes along -n_k with F_k = K_k (n_k . x - Delta_k) + B_k n_k . x' (K_k = m_k Omega_b^2,
+B_k = 2 m_k xi_b Omega_b) from the moment n_k . x reaches Delta_k until F_k falls to zero (for the paper's layout
+n = e_2, F = K (X2 - Delta) + B X2'). A *mode* is the set of stops in contact. The loop a user of SciPy would write:
 
-* free flight: ``solve_ivp`` with a terminal event on n . x - Delta (rising) and a recorded one on n . x' (falling,
-  the apex); an apex at n . x >= Delta is a contact whose two crossings fell inside one step: the run restarts there;
-* contact: a terminal event on F (falling), recorded ones on dF/dt (falling, largest force) and on the jerk
-  (rising, largest deceleration);
-* each terminal event restarts ``solve_ivp`` in the other mode; the samples come from ``t_eval`` (each method's
-  dense output).
+* a stop in free flight: a terminal event on n_k . x - Delta_k (rising) and a recorded one on n_k . x' (falling, the
+  apex); an apex at n_k . x >= Delta_k is a contact whose two crossings fell inside one step: the run restarts there;
+* a stop in contact: a terminal event on F_k (falling), recorded ones on dF_k/dt (falling, largest force) and on the
+  jerk of n_k . x (rising, largest deceleration);
+* each terminal event restarts ``solve_ivp`` in the new mode; the samples come from ``t_eval`` (each method's dense
+  output).
 
-The state carries the force integral and the Fourier integral of the force against the sweep's phase, so the record
-has the same impulses and ``contact_fourier`` as :meth:`.ida.CompliantEngine.sweep`. Implicit methods get the
-mode's constant Jacobian (the Fourier rows excepted: they vary with time; solve_ivp's finite differences fill them
-when ``jac`` is omitted, so it is given without them).
+The state carries each stop's force integral and the Fourier integral of its force against the sweep's phase, so
+the record has the same impulses and ``contact_fourier`` as :meth:`.ida.CompliantEngine.sweep`. Implicit methods get
+the mode's constant Jacobian (the Fourier rows excepted: they vary with time; solve_ivp's finite differences fill
+them when ``jac`` is omitted, so it is given without them).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
 from vibroimpact.engines.base import MODE_FREE, SweepRecord, TrajectoryBuilder, check_run
-from vibroimpact.engines.compliant.ida import base_force, check_sweep_layout
+from vibroimpact.engines.compliant.ida import base_force
 from vibroimpact.engines.compliant.model import MODE_CONTACT
 from vibroimpact.engines.settings import SWEEP_SETTINGS
 from vibroimpact.model.contact import KelvinVoigtBumper
@@ -60,7 +60,7 @@ def solve_ivp_sweep(
     Parameters
     ----------
     problem : ImpactProblem
-        System, :class:`~vibroimpact.model.contact.KelvinVoigtBumper` and
+        Structure, :class:`~vibroimpact.model.contact.KelvinVoigtBumper` stops and a
         :class:`~vibroimpact.model.excitation.SweptSine` excitation.
     sample_rate : float
         Output samples per second [Hz]; the samples are those of the IDA engine, ``arange(0, duration, 1 / rate)``.
@@ -70,9 +70,10 @@ def solve_ivp_sweep(
         Relative tolerance.
     atol : float
         Absolute tolerance of the displacements [m]; velocities get ``atol`` times the sweep's highest angular
-        frequency w, the force integral that times M2, its Fourier integral that times w again (as IDA's).
+        frequency w, each force integral that times the stop's effective mass m_k, its Fourier integrals that times w
+        again (as IDA's).
     state : ndarray, optional
-        (X1, X2, X1', X2') at t = 0; rest by default.
+        (x_1 ... x_N, x_1' ... x_N') at t = 0 [m, m s-1]; rest by default.
 
     Returns
     -------
@@ -83,179 +84,248 @@ def solve_ivp_sweep(
     if method not in IVP_METHODS:
         raise ValueError(f"method = {method!r} is not allowed: use one of {', '.join(IVP_METHODS)}")
     check_run(f"solve_ivp_{method}", problem, KelvinVoigtBumper)
-    check_sweep_layout(f"solve_ivp_{method}", problem)
     sweep = problem.sweep
     require_positive("sample_rate", sample_rate)
     run = _IvpRun(problem, method, rtol, atol)
+    n, count = run.n, run.count
     times = np.arange(0.0, sweep.duration, 1.0 / sample_rate)
-    start = np.zeros(4) if state is None else np.asarray(state, dtype=float)
-    samples = run.run(np.concatenate([start, np.zeros(3)]), times)
-    force = samples[:, 7]
+    start = np.zeros(2 * n) if state is None else np.asarray(state, dtype=float)
+    if start.shape != (2 * n,):
+        raise ValueError(f"state: expected {2 * n} values (x and x' of {n} coordinates), got shape {start.shape}")
+    samples = run.run(np.concatenate([start, np.zeros(3 * count)]), times)
+    forces = samples[:, 2 * n + 3 * count :].copy()
+    fourier = samples[:, 2 * n + count : 2 * n + 3 * count]
     return SweepRecord(
         sweep=sweep,
         time=times,
-        x1=samples[:, 0].copy(),
-        x2=samples[:, 1].copy(),
-        base_force=base_force(problem, samples[:, :4], force),
-        contact_force=force.copy(),
+        displacements=samples[:, :n].copy(),
+        base_force=base_force(problem, samples[:, : 2 * n], forces),
+        contact_forces=forces,
         trajectory=run.rec.build(run.stats | {"rhs_calls": run.stats["nfev"]}),
-        contact_fourier=samples[:, 5] - 1j * samples[:, 6],
+        contact_fourier=fourier[:, 0::2] - 1j * fourier[:, 1::2],
     )
 
 
 class _IvpRun:
-    """State, events and restarts of one solve_ivp sweep. State: X1, X2, X1', X2', integral of F, and the integrals
-    of F cos(theta) theta' and F sin(theta) theta'."""
+    """State, events and restarts of one solve_ivp sweep. State: x, x' (N each), the integral of each stop's force F_k
+    (K), then per stop the integrals of F_k cos(theta) theta' and F_k sin(theta) theta' (2 K)."""
 
     def __init__(self, problem: ImpactProblem, method: str, rtol: float, atol: float) -> None:
-        structure, bumper, sweep, stop = problem.structure, problem.bumper, problem.sweep, problem.stops[0]
-        self.delta, self.sweep, self.method, self.rtol = problem.clearance, sweep, method, rtol
+        structure, sweep, stops = problem.structure, problem.sweep, problem.stops
+        n, count = problem.size, len(stops)
+        self.n, self.count = n, count
+        self.sweep, self.method, self.rtol = sweep, method, rtol
+        self.deltas = problem.clearances()
         mass = structure.mass_matrix
-        self.normal = stop.normal(2)
-        m = stop.effective_mass(mass)
-        self.k, self.b = bumper.stiffness(m), bumper.damping(m)
+        self.normals = problem.normals()
+        masses = np.array([stop.effective_mass(mass) for stop in stops])
+        self.k = np.array([stop.law.stiffness(m) for stop, m in zip(stops, masses)])  # type: ignore[union-attr]
+        self.b = np.array([stop.law.damping(m) for stop, m in zip(stops, masses)])  # type: ignore[union-attr]
         self.minv = np.linalg.inv(mass)
         self.stiffness, self.damping = structure.stiffness_matrix, structure.damping_matrix
         harmonic, self.static = problem.load()
         self.weights = harmonic.real  # the sweep's q times its distribution over the coordinates [N]
         w = 2.0 * math.pi * max(sweep.start_frequency, sweep.stop_frequency)
-        self.atol = np.array([atol, atol, atol * w, atol * w, atol * w * m, atol * w * w * m, atol * w * w * m])
+        self.atol = np.concatenate([np.full(n, atol), np.full(n, atol * w), atol * w * masses, np.repeat(atol * w * w * masses, 2)])
         self.rec = TrajectoryBuilder(problem, False)
         self.stats = {"nfev": 0, "njev": 0, "nlu": 0, "solver_calls": 0, "contacts": 0, "events": 0, "grazing": 0}
-        free = np.zeros((7, 7))
-        free[0, 2] = free[1, 3] = 1.0
-        free[2:4, :2] = -self.minv @ self.stiffness
-        free[2:4, 2:4] = -self.minv @ self.damping
-        contact = free.copy()
-        push = np.concatenate([self.k * self.normal, self.b * self.normal])  # d F / d (x, x')
-        contact[2:4, :4] -= np.outer(self.minv @ self.normal, push)
-        contact[4, :4] = push
-        self.jacobians = {False: free, True: contact}
+        size = 2 * n + 3 * count
+        free = np.zeros((size, size))
+        free[:n, n : 2 * n] = np.eye(n)
+        free[n : 2 * n, :n] = -self.minv @ self.stiffness
+        free[n : 2 * n, n : 2 * n] = -self.minv @ self.damping
+        self._free = free
+        self._jacobians: dict[int, NDArray[np.float64]] = {}
 
-    def push(self, y: NDArray[np.float64]) -> float:
-        """K (n . x - Delta) + B n . x' [N]."""
-        n = self.normal
-        return float(self.k * (n[0] * y[0] + n[1] * y[1] - self.delta) + self.b * (n[0] * y[2] + n[1] * y[3]))
+    def active(self, mask: int) -> list[int]:
+        """The stops in contact in the mode ``mask``."""
+        return [k for k in range(self.count) if (mask >> k) & 1]
 
-    def rhs(self, contact: bool) -> Callable[[float, NDArray[np.float64]], NDArray[np.float64]]:
-        k, c, minv, n = self.stiffness, self.damping, self.minv, self.normal
+    def jacobian(self, mask: int) -> NDArray[np.float64]:
+        """The mode's constant Jacobian (the Fourier rows left out)."""
+        if mask not in self._jacobians:
+            n = self.n
+            matrix = self._free.copy()
+            for k in self.active(mask):
+                push = np.concatenate([self.k[k] * self.normals[k], self.b[k] * self.normals[k]])  # d F_k / d (x, x')
+                matrix[n : 2 * n, : 2 * n] -= np.outer(self.minv @ self.normals[k], push)
+                matrix[2 * n + k, : 2 * n] = push
+            self._jacobians[mask] = matrix
+        return self._jacobians[mask]
+
+    def push(self, y: NDArray[np.float64], k: int) -> float:
+        """K_k (n_k . x - Delta_k) + B_k n_k . x' [N]."""
+        n, normal = self.n, self.normals[k]
+        return float(self.k[k] * (normal @ y[:n] - self.deltas[k]) + self.b[k] * (normal @ y[n : 2 * n]))
+
+    def rhs(self, mask: int) -> Callable[[float, NDArray[np.float64]], NDArray[np.float64]]:
+        k, c, minv, normals = self.stiffness, self.damping, self.minv, self.normals
         weights, static = self.weights, self.static
         f0, alpha = self.sweep.start_frequency, self.sweep.alpha
-        push_of = self.push
+        push_of, n, count = self.push, self.n, self.count
+        active = self.active(mask)
 
         def f(t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
             theta = 2.0 * math.pi * (f0 * t + 0.5 * alpha * t * t)
-            push = push_of(y) if contact else 0.0
-            force = weights * math.sin(theta) + static - k @ y[:2] - c @ y[2:4] - n * push
+            pushes = np.zeros(count)
+            force = weights * math.sin(theta) + static - k @ y[:n] - c @ y[n : 2 * n]
+            for stop in active:
+                pushes[stop] = push_of(y, stop)
+                force = force - normals[stop] * pushes[stop]
             speed = 2.0 * math.pi * (f0 + alpha * t)  # theta'
             a = minv @ force
-            return np.array([y[2], y[3], a[0], a[1], push, push * math.cos(theta) * speed, push * math.sin(theta) * speed])
+            fourier = np.empty(2 * count)
+            fourier[0::2] = pushes * math.cos(theta) * speed
+            fourier[1::2] = pushes * math.sin(theta) * speed
+            return np.concatenate([y[n : 2 * n], a, pushes, fourier])
 
         return f
 
-    def events(self, contact: bool, f: Callable[[float, NDArray[np.float64]], NDArray[np.float64]]) -> list[Callable[..., float]]:
-        """Terminal first, then the recorded ones (see the module docstring)."""
-        delta, k, b, n = self.delta, self.k, self.b, self.normal
+    def events(self, mask: int, f: Callable[[float, NDArray[np.float64]], NDArray[np.float64]]) -> tuple[list[Callable[..., float]], list[tuple[int, str]]]:
+        """The mode's events, terminal first (one per stop: onset or release), then the recorded ones of each stop
+        (apex; or force rate and jerk), and their (stop, role)."""
         stiffness, damping, minv, weights = self.stiffness, self.damping, self.minv, self.weights
-        f0, alpha = self.sweep.start_frequency, self.sweep.alpha
+        f0, alpha, n = self.sweep.start_frequency, self.sweep.alpha, self.n
+        terminal: list[Callable[..., float]] = []
+        recorded: list[Callable[..., float]] = []
+        roles: list[tuple[int, str]] = []
+        later: list[tuple[int, str]] = []
+        for stop in range(self.count):
+            normal, delta, kk, bb = self.normals[stop], self.deltas[stop], self.k[stop], self.b[stop]
+            if (mask >> stop) & 1:
 
-        def onset(t: float, y: NDArray[np.float64]) -> float:
-            return float(n @ y[:2] - delta)
+                def release(t: float, y: NDArray[np.float64], stop: int = stop) -> float:
+                    return self.push(y, stop)
 
-        def apex(t: float, y: NDArray[np.float64]) -> float:
-            return float(n @ y[2:4])
+                def force_rate(t: float, y: NDArray[np.float64], normal: NDArray[np.float64] = normal, kk: float = kk, bb: float = bb) -> float:
+                    return float(kk * (normal @ y[n : 2 * n]) + bb * (normal @ f(t, y)[n : 2 * n]))
 
-        def release(t: float, y: NDArray[np.float64]) -> float:
-            return self.push(y)
+                def jerk(t: float, y: NDArray[np.float64], normal: NDArray[np.float64] = normal, kk: float = kk, bb: float = bb) -> float:
+                    d = f(t, y)
+                    theta = 2.0 * math.pi * (f0 * t + 0.5 * alpha * t * t)
+                    rate = kk * (normal @ y[n : 2 * n]) + bb * (normal @ d[n : 2 * n])
+                    force_rate = weights * math.cos(theta) * 2.0 * math.pi * (f0 + alpha * t) - stiffness @ y[n : 2 * n] - damping @ d[n : 2 * n] - normal * rate
+                    for other in self.active(mask):  # the other bumpers' force rates
+                        if other != stop:
+                            other_normal = self.normals[other]
+                            force_rate = force_rate - other_normal * (self.k[other] * (other_normal @ y[n : 2 * n]) + self.b[other] * (other_normal @ d[n : 2 * n]))
+                    return float(normal @ (minv @ force_rate))
 
-        def force_rate(t: float, y: NDArray[np.float64]) -> float:
-            return float(k * (n @ y[2:4]) + b * (n @ f(t, y)[2:4]))
+                release.terminal, release.direction = True, -1.0  # type: ignore[attr-defined]
+                force_rate.terminal, force_rate.direction = False, -1.0  # type: ignore[attr-defined]
+                jerk.terminal, jerk.direction = False, 1.0  # type: ignore[attr-defined]
+                terminal.append(release)
+                recorded += [force_rate, jerk]
+                roles.append((stop, "release"))
+                later += [(stop, "rate"), (stop, "jerk")]
+            else:
 
-        def jerk(t: float, y: NDArray[np.float64]) -> float:
-            d = f(t, y)
-            theta = 2.0 * math.pi * (f0 * t + 0.5 * alpha * t * t)
-            rate = k * (n @ y[2:4]) + b * (n @ d[2:4])
-            force_rate = weights * math.cos(theta) * 2.0 * math.pi * (f0 + alpha * t) - stiffness @ y[2:4] - damping @ d[2:4] - n * rate
-            return float(n @ (minv @ force_rate))
+                def onset(t: float, y: NDArray[np.float64], normal: NDArray[np.float64] = normal, delta: float = delta) -> float:
+                    return float(normal @ y[:n] - delta)
 
-        onset.terminal, onset.direction = True, 1.0  # type: ignore[attr-defined]
-        apex.terminal, apex.direction = False, -1.0  # type: ignore[attr-defined]
-        release.terminal, release.direction = True, -1.0  # type: ignore[attr-defined]
-        force_rate.terminal, force_rate.direction = False, -1.0  # type: ignore[attr-defined]
-        jerk.terminal, jerk.direction = False, 1.0  # type: ignore[attr-defined]
-        return [release, force_rate, jerk] if contact else [onset, apex]
+                def apex(t: float, y: NDArray[np.float64], normal: NDArray[np.float64] = normal) -> float:
+                    return float(normal @ y[n : 2 * n])
+
+                onset.terminal, onset.direction = True, 1.0  # type: ignore[attr-defined]
+                apex.terminal, apex.direction = False, -1.0  # type: ignore[attr-defined]
+                terminal.append(onset)
+                recorded.append(apex)
+                roles.append((stop, "onset"))
+                later.append((stop, "apex"))
+        return terminal + recorded, roles + later
 
     def run(self, y: NDArray[np.float64], times: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Integrate over the samples ``times`` from ``y`` at t = 0; rows X1, X2, X1', X2', the three integrals, F."""
-        out = np.empty((times.size, 8))
-        t, n, i = 0.0, times.size, 0
-        contact = bool(self.normal @ y[:2] >= self.delta and self.push(y) > 0.0)
-        functions = {mode: self.rhs(mode) for mode in (False, True)}
-        events = {mode: self.events(mode, functions[mode]) for mode in (False, True)}
-        jacobians = {mode: self._constant(self.jacobians[mode]) for mode in (False, True)}  # LSODA takes callables only
-        onset: dict[str, Any] = self._begin(t, y, functions[True]) if contact else {}
-        self.rec.segment(t, MODE_CONTACT if contact else MODE_FREE, y[:4])
-        while i < n:
-            while i < n and times[i] <= t:  # samples at the current time
-                out[i] = self._sample(y, contact)
+        """Integrate over the samples ``times`` from ``y`` at t = 0; rows x, x', the 3 K integrals, each F_k."""
+        n, count = self.n, self.count
+        width = 2 * n + 3 * count
+        out = np.empty((times.size, width + count))
+        t, samples, i = 0.0, times.size, 0
+        mask = sum(1 << k for k in range(count) if self.normals[k] @ y[:n] >= self.deltas[k] and self.push(y, k) > 0.0)
+        modes: dict[int, tuple[Callable[..., NDArray[np.float64]], list[Callable[..., float]], list[tuple[int, str]], Callable[..., NDArray[np.float64]]]] = {}
+
+        def mode(m: int) -> tuple[Callable[..., NDArray[np.float64]], list[Callable[..., float]], list[tuple[int, str]], Callable[..., NDArray[np.float64]]]:
+            if m not in modes:
+                function = self.rhs(m)
+                events, roles = self.events(m, function)
+                modes[m] = (function, events, roles, self._constant(self.jacobian(m)))  # LSODA takes callables only
+            return modes[m]
+
+        onsets: dict[int, dict[str, Any]] = {k: self._begin(t, y, k, mode(mask)[0]) for k in self.active(mask)}
+        self.rec.segment(t, MODE_CONTACT if mask else MODE_FREE, y[: 2 * n])
+        while i < samples:
+            while i < samples and times[i] <= t:  # samples at the current time
+                out[i] = self._sample(y, mask)
                 i += 1
-            if i == n:
+            if i == samples:
                 break
-            j = min(n, i + _SAMPLES_PER_CALL)
-            options: dict[str, Any] = {"jac": jacobians[contact]} if self.method in _IMPLICIT else {}
-            sol = solve_ivp(functions[contact], (t, times[j - 1]), y, method=self.method, t_eval=times[i:j], events=events[contact], rtol=self.rtol, atol=self.atol, **options)
+            j = min(samples, i + _SAMPLES_PER_CALL)
+            function, events, roles, jacobian = mode(mask)
+            options: dict[str, Any] = {"jac": jacobian} if self.method in _IMPLICIT else {}
+            sol = solve_ivp(function, (t, times[j - 1]), y, method=self.method, t_eval=times[i:j], events=events, rtol=self.rtol, atol=self.atol, **options)
             if sol.status < 0:
                 raise RuntimeError(f"solve_ivp ({self.method}) failed after t = {t!r} s: {sol.message}")
             self.stats["solver_calls"] += 1
             for name in ("nfev", "njev", "nlu"):
                 self.stats[name] += int(getattr(sol, name))
-            kept, switch = len(sol.t), sol.status == 1  # (t is an empty list when no sample was reached)
-            if switch:
-                t, y = float(sol.t_events[0][-1]), sol.y_events[0][-1].copy()
+            kept, switching = len(sol.t), []  # (t is an empty list when no sample was reached)
+            if sol.status == 1:  # a terminal event: the stops whose event ended the call
+                fired = [e for e in range(count) if len(sol.t_events[e])]
+                end = max(float(sol.t_events[e][-1]) for e in fired)
+                switching = [roles[e][0] for e in fired if float(sol.t_events[e][-1]) == end]
+                t, y = end, sol.y_events[fired[[float(sol.t_events[e][-1]) for e in fired].index(end)]][-1].copy()
             else:
                 t, y = float(sol.t[-1]), sol.y[:, -1].copy()
-            if contact:  # largest force and deceleration: at the recorded roots, and at onset
-                for which, column in ((1, 0), (2, 1)):
-                    for tr, yr in zip(sol.t_events[which], sol.y_events[which]):
-                        self.stats["events"] += 1
-                        value = self.push(yr) if column == 0 else -float(self.normal @ functions[True](tr, yr)[2:4])
-                        onset["peaks"][column] = max(onset["peaks"][column], value)
-            else:  # an apex at or past the bumper: a missed contact
-                self.stats["events"] += len(sol.t_events[1])
-                late = [(tr, yr) for tr, yr in zip(sol.t_events[1], sol.y_events[1]) if self.normal @ yr[:2] >= self.delta]
-                if late:
-                    self.stats["grazing"] += 1
-                    t, y, switch = float(late[0][0]), late[0][1].copy(), True
-                    kept = int(np.searchsorted(sol.t, t, side="right"))
+            late: list[tuple[float, int, NDArray[np.float64]]] = []
+            for e in range(count, len(events)):
+                stop, role = roles[e]
+                for tr, yr in zip(sol.t_events[e], sol.y_events[e]):
+                    self.stats["events"] += 1
+                    if role == "rate":  # largest force and deceleration: at the recorded roots, and at onset
+                        onsets[stop]["peaks"][0] = max(onsets[stop]["peaks"][0], self.push(yr, stop))
+                    elif role == "jerk":
+                        onsets[stop]["peaks"][1] = max(onsets[stop]["peaks"][1], -float(self.normals[stop] @ function(tr, yr)[n : 2 * n]))
+                    elif self.normals[stop] @ yr[:n] >= self.deltas[stop]:  # an apex at or past the bumper: a missed contact
+                        late.append((float(tr), stop, yr))
+            if late:
+                self.stats["grazing"] += 1
+                first = min(late, key=lambda item: item[0])
+                t, y, switching = first[0], first[2].copy(), [first[1]]
+                kept = int(np.searchsorted(sol.t, t, side="right"))
             if kept:
                 block = out[i : i + kept]
-                block[:, :7] = sol.y[:, :kept].T
-                block[:, 7] = self.k * (block[:, :2] @ self.normal - self.delta) + self.b * (block[:, 2:4] @ self.normal) if contact else 0.0
+                block[:, :width] = sol.y[:, :kept].T
+                for k in range(count):
+                    block[:, width + k] = self.k[k] * (block[:, :n] @ self.normals[k] - self.deltas[k]) + self.b[k] * (block[:, n : 2 * n] @ self.normals[k]) if (mask >> k) & 1 else 0.0
             i += kept
-            if switch:
+            if switching:
                 self.stats["events"] += 1
-                if contact:
-                    self.rec.contact_peaks(*onset["peaks"])
-                    self.rec.impact(onset["t"], onset["v"], float(y[4]) - onset["impulse"], in_moments=False)
-                else:
-                    onset = self._begin(t, y, functions[True])
-                contact = not contact
-                self.rec.segment(t, MODE_CONTACT if contact else MODE_FREE, y[:4])
-        self.rec.strobe(t, y[:4])
+                for k in switching:
+                    if (mask >> k) & 1:
+                        onset = onsets.pop(k)
+                        self.rec.contact_peaks(*onset["peaks"], stop=k)
+                        self.rec.impact(onset["t"], onset["v"], float(y[2 * n + k]) - onset["impulse"], in_moments=False, stop=k)
+                    mask ^= 1 << k
+                for k in switching:
+                    if (mask >> k) & 1:
+                        onsets[k] = self._begin(t, y, k, mode(mask)[0])
+                self.rec.segment(t, MODE_CONTACT if mask else MODE_FREE, y[: 2 * n])
+        self.rec.strobe(t, y[: 2 * n])
         return out
 
     @staticmethod
     def _constant(matrix: NDArray[np.float64]) -> Callable[[float, NDArray[np.float64]], NDArray[np.float64]]:
         return lambda t, y: matrix
 
-    def _begin(self, t: float, y: NDArray[np.float64], contact_rhs: Callable[[float, NDArray[np.float64]], NDArray[np.float64]]) -> dict[str, Any]:
-        """A contact starts: its onset time, entry speed, force integral, and the force and deceleration now."""
+    def _begin(self, t: float, y: NDArray[np.float64], stop: int, contact_rhs: Callable[[float, NDArray[np.float64]], NDArray[np.float64]]) -> dict[str, Any]:
+        """Stop ``stop``'s contact starts: its onset time, entry speed, force integral, and the force and
+        deceleration now (``contact_rhs``: the right-hand side of the mode with it in contact)."""
         self.stats["contacts"] += 1
-        gap = self.delta - float(self.normal @ y[:2])
+        n, normal = self.n, self.normals[stop]
+        gap = self.deltas[stop] - float(normal @ y[:n])
         if gap > 0.0:  # the located root short of the stop by round-off: onto it along the stopped coordinate
-            y[:2] += gap * self.normal / float(self.normal @ self.normal)
-        return {"t": t, "v": float(self.normal @ y[2:4]), "impulse": float(y[4]), "peaks": [self.push(y), max(-float(self.normal @ contact_rhs(t, y)[2:4]), 0.0)]}
+            y[:n] += gap * normal / float(normal @ normal)
+        return {"t": t, "v": float(normal @ y[n : 2 * n]), "impulse": float(y[2 * n + stop]), "peaks": [self.push(y, stop), max(-float(normal @ contact_rhs(t, y)[n : 2 * n]), 0.0)]}
 
-    def _sample(self, y: NDArray[np.float64], contact: bool) -> NDArray[np.float64]:
-        force = self.push(y) if contact else 0.0
-        return np.concatenate([y[:7], [force]])
+    def _sample(self, y: NDArray[np.float64], mask: int) -> NDArray[np.float64]:
+        forces = [self.push(y, k) if (mask >> k) & 1 else 0.0 for k in range(self.count)]
+        return np.concatenate([y[: 2 * self.n + 3 * self.count], forces])
