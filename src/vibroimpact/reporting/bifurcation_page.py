@@ -2,7 +2,9 @@
 points, the Floquet multipliers along the branches, and the two-parameter chart with its regime map.
 
 Dataset layout read here: see :mod:`vibroimpact.study.bifurcation` (``branch_point``, ``special_point``, the
-``brute_*`` variables over (restitution, sweep, frequency, ...), ``chart_point`` and ``chart_regime``).
+``brute_*`` variables over (restitution, sweep, frequency, ...), ``chart_point`` and ``chart_regime``). The amplitude
+drawn is the first coordinate's (``system_coordinates``: X1, the primary mass, on the paper's layout); the stops are
+named as the dataset's ``stop_layout`` says.
 """
 
 from __future__ import annotations
@@ -20,8 +22,9 @@ from matplotlib.patches import Patch
 
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure
+from vibroimpact.scene.bifurcation_settings import coordinate_label
 
-__all__ = ["BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class", "orbit_colours"]
+__all__ = ["BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class", "orbit_colours", "first_coordinate"]
 
 #: Brute-force dots of each sweep direction.
 SWEEP_COLOURS = {"up": "C3", "down": "C2"}
@@ -38,6 +41,11 @@ REGIME_COLOURS = ("#ffffff", "#d9d9d9", "#9ecae1", "#a1d99b", "#fdae6b", "#e6550
 _FREQUENCY = "excitation frequency [Hz]"
 #: Top of the multiplier figure's axis [-].
 MODULUS_TOP = 20.0
+
+
+def first_coordinate(dataset: xr.Dataset) -> str:
+    """The coordinate whose amplitude the page draws: the first of ``system_coordinates`` (``x1`` when absent)."""
+    return str(dataset.attrs.get("system_coordinates", "x1")).split()[0]
 
 
 def orbit_class(impacts_per_period: float, period: int) -> tuple[int, int]:
@@ -75,7 +83,7 @@ def _flags(variable: xr.DataArray) -> list[str]:
 def _branches(dataset: xr.Dataset, restitution: float) -> Iterator[tuple[int, xr.Dataset]]:
     """Each branch of one restitution, its points in arclength order."""
     mask = np.isclose(dataset["branch_restitution"].values, restitution)
-    part = dataset[["x1_amplitude", "floquet_modulus", "stable", "impacts_per_period", "period_multiplicity", "impact_velocity"]].isel(branch_point=np.flatnonzero(mask))
+    part = dataset[[f"{first_coordinate(dataset)}_amplitude", "floquet_modulus", "stable", "impacts_per_period", "period_multiplicity", "impact_velocity"]].isel(branch_point=np.flatnonzero(mask))
     for label in np.unique(part["branch"].values):
         yield int(label), part.isel(branch_point=np.flatnonzero(part["branch"].values == label))
 
@@ -100,15 +108,18 @@ def _draw_branch(ax: Axes, frequency: np.ndarray, values: np.ndarray, stable: np
 
 
 def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> DrawnFigure:
-    """The bifurcation diagram of one restitution: X1 amplitude and impact velocities against frequency."""
+    """The bifurcation diagram of one restitution: the first coordinate's amplitude and impact velocities against
+    frequency."""
     keys = _classes(dataset, restitution)
+    name = first_coordinate(dataset)
+    label = coordinate_label(name)
     fig, (top, bottom) = new_figure(2, panel_height=4.2, columns=1, sharex=True, legend_rows=legend_rows(len(keys) + 8, 5))
     classes: set[tuple[int, int]] = set()
     r_index = int(np.argmin(np.abs(dataset["restitution"].values - restitution)))
     for direction in dataset["sweep"].values:
         brute = dataset.isel(restitution=r_index).sel(sweep=direction)
         f = brute["frequency"].values
-        amp = brute["brute_x1_amplitude"].values
+        amp = brute[f"brute_{name}_amplitude"].values
         top.scatter(np.repeat(f, amp.shape[1]), amp.ravel() * 1e3, s=1.5, color=SWEEP_COLOURS.get(str(direction), "C7"), alpha=0.6, lw=0, zorder=1)
         vel = brute["brute_impact_velocity"].values
         bottom.scatter(np.repeat(f, vel.shape[1]), vel.ravel(), s=1.5, color=SWEEP_COLOURS.get(str(direction), "C7"), alpha=0.6, lw=0, zorder=1)
@@ -119,7 +130,7 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
         colour = colours.get(key, "0.5")
         classes.add(key)
         stable = branch["stable"].values == 1
-        _draw_branch(top, f, branch["x1_amplitude"].values * 1e3, stable, colour, "_")
+        _draw_branch(top, f, branch[f"{name}_amplitude"].values * 1e3, stable, colour, "_")
         velocities = branch["impact_velocity"].values
         for k in range(velocities.shape[1]):
             if np.isfinite(velocities[:, k]).any():
@@ -129,9 +140,9 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
     for code, kind in enumerate(kinds):
         chosen = specials.isel(special_point=np.flatnonzero(specials["special_point_kind"].values == code))
         if chosen.sizes["special_point"]:
-            top.scatter(chosen["special_point_frequency"], chosen["special_point_x1_amplitude"] * 1e3, marker=SPECIAL_MARKERS.get(kind, "x"), s=42,
+            top.scatter(chosen["special_point_frequency"], chosen[f"special_point_{name}_amplitude"] * 1e3, marker=SPECIAL_MARKERS.get(kind, "x"), s=42,
                         facecolor="none", edgecolor="k", lw=1.2, zorder=5, label=kind.replace("_", "-"))  # fmt: skip
-    finish_axes(top, "", "|X1| fundamental [mm]", f"R = {fmt(restitution, 'g')}: X1 amplitude")
+    finish_axes(top, "", f"|{label}| fundamental [mm]", f"R = {fmt(restitution, 'g')}: {label} amplitude")
     finish_axes(bottom, _FREQUENCY, "impact velocity [m/s]", f"R = {fmt(restitution, 'g')}: impact velocities")
     dots = [Line2D([], [], ls="", marker="o", ms=5, color=SWEEP_COLOURS.get(str(d), "C7"), label=f"brute force, sweep {d}") for d in dataset["sweep"].values]
     extra = [*dots, Line2D([], [], color="k", **STABLE_STYLE, label="stable"), Line2D([], [], color="k", **UNSTABLE_STYLE, label="unstable")]
@@ -139,7 +150,7 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
     caption = (
         f"Bifurcation diagram at R = {fmt(restitution, 'g')}, Delta = {fmt(float(dataset['clearance']) * 1e3, 'g')} mm. Dots: brute-force "
         f"time simulation (compiled exact engine) sweeping up (red) and down (green), the end state carried to the next frequency; "
-        f"top: the X1 fundamental over each of the {dataset.sizes['strobe']} kept periods; bottom: the velocity of every impact in them. "
+        f"top: the {label} fundamental over each of the {dataset.sizes['strobe']} kept periods; bottom: the velocity of every impact in them. "
         "Lines: every continued branch (solid stable, dashed unstable; colour: impacts per orbit period and period), the linear orbit "
         "where it fits inside the clearance in black; markers: the located special points (table below)."
     )
@@ -148,7 +159,7 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
 
 def _specials(dataset: xr.Dataset, restitution: float) -> xr.Dataset:
     mask = np.isclose(dataset["special_point_restitution"].values, restitution)
-    return dataset[["special_point_x1_amplitude", "special_point_floquet_modulus"]].isel(special_point=np.flatnonzero(mask))
+    return dataset[[f"special_point_{first_coordinate(dataset)}_amplitude", "special_point_floquet_modulus"]].isel(special_point=np.flatnonzero(mask))
 
 
 def multiplier_figure(dataset: xr.Dataset, restitution: float, index: int) -> DrawnFigure:
@@ -203,11 +214,19 @@ def chart_figure(dataset: xr.Dataset) -> DrawnFigure:
         f"{dataset.sizes['map_frequency']} x {dataset.sizes['map_clearance']} grid (sweeping in frequency at each clearance, the end state "
         "carried over): linear motion, one impact per period, another periodic motion, or non-periodic motion (quasi-periodic, chaotic, or "
         "undecided: irregular) from the exact Lyapunov exponent. Lines: the fold, period-doubling and Neimark-Sacker points of the "
-        "one-impact branches continued in (frequency, clearance); dashed, the grazing curves: q |H12| = Delta where the one-impact "
-        "orbit's impact velocity vanishes and the linear motion touches the stop, and the points where a free flight of the one-impact "
-        "orbit touches the stop (located again at each clearance); dotted: the clearance of the diagrams."
+        f"branches started from the closed form, continued in (frequency, clearance); dashed, the grazing curves: the clearance the linear "
+        f"motion of {_stopped(dataset)} just reaches (q |H12| = Delta on the paper's layout), where the closed-form orbit's impact "
+        "velocity vanishes and the linear motion touches the stop, and the points where a free flight of an impacting orbit touches "
+        "the stop (located again at each clearance); dotted: the clearance of the diagrams."
     )
     return DrawnFigure(fig, "chart", f"Two-parameter chart, R = {fmt(r, 'g')}", caption)
+
+
+def _stopped(dataset: xr.Dataset) -> str:
+    """The stopped coordinates in words (``x2``, ``x2 - x1``), from ``stop_layout`` (``x2`` when absent)."""
+    layout = str(dataset.attrs.get("stop_layout", "x2 <= Delta"))
+    targets = [part.split(" <=")[0].split(" >=")[0].strip() for part in layout.split("; ")]
+    return " and ".join(dict.fromkeys(targets))
 
 
 def bifurcation_figures(dataset: xr.Dataset) -> Iterator[DrawnFigure]:
@@ -246,10 +265,11 @@ class BifurcationPage:
         self.dataset = dataset
 
     def summary(self) -> str:
-        """What was computed."""
+        """What was computed, and the stops."""
         d = self.dataset
+        stops = f"; stops: {d.attrs['stop_layout']}" if "stop_layout" in d.attrs else ""
         return (f"{int(np.unique(d['branch'].values).size)} branches, {d.sizes['special_point']} special points, brute force at "
-                f"{d.sizes['frequency']} frequencies x {d.sizes['sweep']} directions for R = {', '.join(fmt(r, 'g') for r in d['restitution'].values)}")  # fmt: skip
+                f"{d.sizes['frequency']} frequencies x {d.sizes['sweep']} directions for R = {', '.join(fmt(r, 'g') for r in d['restitution'].values)}{stops}")  # fmt: skip
 
     def sections(self, out: Path) -> list[Section]:
         """Diagrams and multipliers per restitution with the special points' table, then the chart."""
