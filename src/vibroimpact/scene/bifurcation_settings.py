@@ -17,8 +17,8 @@ from vibroimpact.model.validation import require_in_range, require_positive
 
 __all__ = ["BIFURCATION_TOP_KEYS", "CHART_KINDS", "BruteForceSettings", "BranchSettings", "ChartSettings", "BifurcationSettings", "coordinate_label"]
 
-#: Top-level keys of a bifurcation scene.
-BIFURCATION_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "bifurcation", "report"}
+#: Top-level keys of a bifurcation scene (``stop`` is the paper's stop on x2, ``stops`` any layout).
+BIFURCATION_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bifurcation", "report"}
 #: Special points whose curves the two-parameter chart can follow (the order of the CF flags of ``special_point_kind``).
 CHART_KINDS = ("fold", "period_doubling", "neimark_sacker", "grazing")
 #: Most brute-force periods of one scene (frequencies x restitutions x directions x periods per point).
