@@ -74,7 +74,7 @@ def test_the_matrix_twin_gives_the_same_special_points_names_and_page(twins) -> 
     assert set(named.variables) == set(twin.variables)
     assert {"x1_amplitude", "x2_amplitude", "special_point_x1_amplitude", "brute_x1", "brute_x1_amplitude"} <= set(named.variables)
     assert named_page == twin_page
-    assert "stops: x2 <= 3 mm" in named_page and "top: the X1 fundamental" in named_page
+    assert "R = 0.2: up to |X1| =" in named_page and "stops: x2 <= 3 mm" in named_page
 
 
 def test_the_one_impact_branch_is_the_closed_form_of_the_general_problem(twins) -> None:
@@ -177,4 +177,5 @@ def test_a_layout_without_closed_form_is_found_by_the_brute_force() -> None:
 def test_the_page_of_a_general_layout_names_its_coordinate_and_stops(tmp_path: Path) -> None:
     data = run_study(parse_scene(read_yaml(NO_CLOSED_FORM)), progress=None)
     text = page_text(write_report(data, tmp_path).read_text(encoding="utf-8"))
-    assert "stops: absorber <= 3 mm; primary <= 3 mm" in text and "top: the primary fundamental" in text
+    assert "stops: absorber <= 3 mm; primary <= 3 mm" in text and "|primary| =" in text and "no branch from the closed form" in text
+    assert "top: the primary fundamental" in text
