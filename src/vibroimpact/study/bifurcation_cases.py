@@ -5,7 +5,8 @@ of one restitution, and the two-parameter chart's curves.
   the next frequency; at each frequency a transient is dropped, then the strobes of the first coordinate (X1 on the
   paper's layout), its per-period fundamental and the impact velocities are kept and the motion is classified (:data:`MOTION_CLASSES`): linear, one impact per period,
   another periodic motion, or, where the strobes do not repeat, quasi-periodic, chaotic or irregular from the exact
-  Jacobians (:func:`vibroimpact.orbits.motion.classify_motion`). A strictly negative Lyapunov exponent means a periodic
+  Jacobians (:func:`vibroimpact.orbits.motion.classify_motion`; from the strobes alone where a Jacobian is undefined,
+  :func:`~vibroimpact.orbits.motion.classify_strobes`). A strictly negative Lyapunov exponent means a periodic
   orbit approached slowly: the motion is classified by the period that repeats best.
 * :class:`BranchCase`: :func:`vibroimpact.study.bifurcation_branches.find_branches` of one restitution.
 * :class:`ChartCase`: the special points of the chart's restitution followed in (frequency, clearance): folds, period
@@ -34,7 +35,7 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Iterated
 from vibroimpact.orbits.continuation import ContinuationSettings
 from vibroimpact.orbits.grazing_curve import trace_grazing
-from vibroimpact.orbits.motion import classify_motion
+from vibroimpact.orbits.motion import classify_motion, classify_strobes
 from vibroimpact.orbits.two_parameter import continue_special_point
 from vibroimpact.simulation.layout import linear_state, resting_state
 from vibroimpact.study.bifurcation_branches import MAX_ORBIT_IMPACTS, OrbitSet, find_branches, problem_at, stop_values
@@ -128,7 +129,11 @@ def _measure(engine: ExactEngine, problem: ImpactProblem, state: NDArray[np.floa
         out["regime"][k], out["period"][k] = 0, 1
         return run.final_state
     if not period:
-        evidence = classify_motion(run.strobe_jacobians, s[1:])
+        jacobians = run.strobe_jacobians
+        if np.all(np.isfinite(jacobians)):
+            evidence = classify_motion(jacobians, s[1:])
+        else:  # a degenerate event (e.g. a chatter sequence ending as a release begins) left a Jacobian undefined
+            evidence = classify_strobes(s[1:])  # the strobes alone decide the clear cases; no exponent
         out["lyapunov"][k] = evidence.lyapunov_exponent
         if evidence.lyapunov_exponent < -0.005:  # contracting: a periodic orbit approached slowly
             period = int(np.argmin(mismatch)) + 1
