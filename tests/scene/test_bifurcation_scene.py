@@ -101,6 +101,13 @@ def general(stops: list[dict[str, Any]], **changes: Any) -> dict[str, Any]:
 RELATIVE_PAIR = [{"between": ["x2", "x1"], "side": "upper", "clearance": 0.003}, {"between": ["x2", "x1"], "side": "lower", "clearance": 0.003}]
 
 
+def test_the_shipped_relative_stop_study_is_a_general_bifurcation_scene() -> None:
+    scene = load_scene(find_scene("bifurcation_relative_stop"))
+    assert scene.kind == "bifurcation" and scene.general and scene.bifurcation.restitution == (0.2,)
+    assert [(s.coordinate, s.other, s.side) for s in scene.stops] == [(1, 0, "upper"), (1, 0, "lower")]
+    assert float(scene.clearance[0]) == pytest.approx(3e-3) and scene.load.weights == (1.0, 0.0)
+
+
 def test_the_general_form_takes_its_restitution_from_the_stops_or_the_diagrams() -> None:
     doc = general([{"coordinate": "x2", "clearance": 0.003, "restitution": 0.5}])
     del doc["bifurcation"]["restitution"]
