@@ -82,3 +82,67 @@ def test_the_settings_default_directions_are_the_sweep_directions() -> None:
     from vibroimpact.scene.schema import SWEEP_DIRECTIONS
 
     assert BruteForceSettings.__dataclass_fields__["directions"].default == SWEEP_DIRECTIONS
+
+
+#: The paper's system written with matrices (the general form), force on x1.
+MATRIX_SYSTEM_SPEC = {"mass": [[1.0, 0.0], [0.0, 0.1]], "stiffness": [[29300.0, -4300.0], [-4300.0, 4300.0]], "damping": [[0.88, -0.08], [-0.08, 0.08]], "coordinates": ["x1", "x2"]}
+
+
+def general(stops: list[dict[str, Any]], **changes: Any) -> dict[str, Any]:
+    """The small scene in the general form: matrices, a force on x1, ``stops``."""
+    doc = document(**changes)
+    doc["system"] = copy.deepcopy(MATRIX_SYSTEM_SPEC)
+    doc["excitation"] = {"amplitude": 10.0, "on": "x1"}
+    del doc["stop"]
+    doc["stops"] = copy.deepcopy(stops)
+    return doc
+
+
+RELATIVE_PAIR = [{"between": ["x2", "x1"], "side": "upper", "clearance": 0.003}, {"between": ["x2", "x1"], "side": "lower", "clearance": 0.003}]
+
+
+def test_the_shipped_relative_stop_study_is_a_general_bifurcation_scene() -> None:
+    scene = load_scene(find_scene("bifurcation_relative_stop"))
+    assert scene.kind == "bifurcation" and scene.general and scene.bifurcation.restitution == (0.2,)
+    assert [(s.coordinate, s.other, s.side) for s in scene.stops] == [(1, 0, "upper"), (1, 0, "lower")]
+    assert float(scene.clearance[0]) == pytest.approx(3e-3) and scene.load.weights == (1.0, 0.0)
+
+
+def test_the_general_form_takes_its_restitution_from_the_stops_or_the_diagrams() -> None:
+    doc = general([{"coordinate": "x2", "clearance": 0.003, "restitution": 0.5}])
+    del doc["bifurcation"]["restitution"]
+    from_stops = parse_scene(doc)
+    assert from_stops.bifurcation.restitution == (0.5,) and from_stops.stops[0].restitution is None  # the study's value
+    from_diagrams = parse_scene(general(RELATIVE_PAIR, restitution=[0.2, 0.6]))
+    assert from_diagrams.bifurcation.restitution == (0.2, 0.6) and len(from_diagrams.stops) == 2
+    differ = general([{"coordinate": "x2", "clearance": 0.003, "restitution": 0.2}, {"coordinate": "x1", "clearance": 0.003, "restitution": 0.5}])
+    del differ["bifurcation"]["restitution"]
+    assert any(p.startswith("stops[1].restitution:") and "differs" in p for p in problems(differ))
+
+
+@pytest.mark.parametrize(
+    ("stops", "key"),
+    [
+        ([{**RELATIVE_PAIR[0], "restitution": 0.2}, RELATIVE_PAIR[1]], "stops[0].restitution"),  # also in bifurcation.restitution
+        ([RELATIVE_PAIR[0], {**RELATIVE_PAIR[1], "clearance": 0.002}], "stops[1].clearance"),  # one clearance for every stop
+        ([{"coordinate": "x2"}], "stops[0].clearance"),  # required
+        ([{"coordinate": "x2", "clearance": -0.001}], "stops[0].clearance"),  # (0, inf)
+        ([{"coordinate": "x2", "clearance": 0.003, "bumper": {"frequency": 100.0}}], "stops[0].bumper"),  # rigid only
+        ([{"coordinate": "x3", "clearance": 0.003}], "stops[0].coordinate"),  # the stepped parser's own check
+    ],
+)
+def test_each_mistake_of_the_general_form_names_its_key(stops: list[dict[str, Any]], key: str) -> None:
+    found = problems(general(stops))
+    assert any(p.startswith(key + ":") for p in found), found
+
+
+def test_the_general_form_reports_the_load_and_the_missing_restitution() -> None:
+    doc = general([{"coordinate": "x2", "clearance": 0.003}])
+    doc["excitation"]["on"] = "x9"
+    del doc["bifurcation"]["restitution"]
+    found = problems(doc)
+    assert any(p.startswith("excitation.on:") and "x9" in p for p in found), found
+    assert any(p.startswith("bifurcation.restitution:") for p in found) and any(p.startswith("stops[0].restitution:") for p in found), found
+    both = general([{"coordinate": "x2", "clearance": 0.003}])
+    both["stop"] = {"clearance": 0.003}
+    assert any(p.startswith("stop:") for p in problems(both))

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.scene import parse_scene
-from vibroimpact.study.bifurcation_branches import one_impact_roots
+from vibroimpact.study.bifurcation import scene_problem
+from vibroimpact.study.bifurcation_branches import closed_form_orbits
 from vibroimpact.study.io import write_dataset
 from vibroimpact.study.run import run_study
 
@@ -64,7 +64,7 @@ def test_one_impact_branch_is_the_closed_form(dataset: xr.Dataset) -> None:
     one = dataset.where((dataset["impacts_per_period"] == 1) & (dataset["period_multiplicity"] == 1), drop=True)
     assert one.sizes["branch_point"] > 50
     f = one["branch_frequency"].values
-    _sol, (plus, minus) = one_impact_roots(PAPER_SYSTEM, f, 3e-3, 0.8, 10.0)
+    plus, minus = (orbit.impulse for orbit in closed_form_orbits(scene_problem(parse_scene(SMALL), 0.8), f))
     impulse = one["impulse"].values
     closest = np.where(np.abs(plus - impulse) < np.abs(minus - impulse), plus, minus)
     assert np.nanmax(np.abs(impulse - closest) / np.nanmax(plus)) < 1e-8

@@ -2,7 +2,9 @@
 points, the Floquet multipliers along the branches, and the two-parameter chart with its regime map.
 
 Dataset layout read here: see :mod:`vibroimpact.study.bifurcation` (``branch_point``, ``special_point``, the
-``brute_*`` variables over (restitution, sweep, frequency, ...), ``chart_point`` and ``chart_regime``).
+``brute_*`` variables over (restitution, sweep, frequency, ...), ``chart_point`` and ``chart_regime``). The amplitude
+drawn is the first coordinate's (``system_coordinates``: X1, the primary mass, on the paper's layout); the stops are
+named as the dataset's ``stop_layout`` says.
 """
 
 from __future__ import annotations
@@ -20,8 +22,9 @@ from matplotlib.patches import Patch
 
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure
+from vibroimpact.scene.bifurcation_settings import coordinate_label
 
-__all__ = ["BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class", "orbit_colours"]
+__all__ = ["BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class", "orbit_colours", "first_coordinate", "headline", "answer_text"]
 
 #: Brute-force dots of each sweep direction.
 SWEEP_COLOURS = {"up": "C3", "down": "C2"}
@@ -38,6 +41,11 @@ REGIME_COLOURS = ("#ffffff", "#d9d9d9", "#9ecae1", "#a1d99b", "#fdae6b", "#e6550
 _FREQUENCY = "excitation frequency [Hz]"
 #: Top of the multiplier figure's axis [-].
 MODULUS_TOP = 20.0
+
+
+def first_coordinate(dataset: xr.Dataset) -> str:
+    """The coordinate whose amplitude the page draws: the first of ``system_coordinates`` (``x1`` when absent)."""
+    return str(dataset.attrs.get("system_coordinates", "x1")).split()[0]
 
 
 def orbit_class(impacts_per_period: float, period: int) -> tuple[int, int]:
@@ -75,7 +83,7 @@ def _flags(variable: xr.DataArray) -> list[str]:
 def _branches(dataset: xr.Dataset, restitution: float) -> Iterator[tuple[int, xr.Dataset]]:
     """Each branch of one restitution, its points in arclength order."""
     mask = np.isclose(dataset["branch_restitution"].values, restitution)
-    part = dataset[["x1_amplitude", "floquet_modulus", "stable", "impacts_per_period", "period_multiplicity", "impact_velocity"]].isel(branch_point=np.flatnonzero(mask))
+    part = dataset[[f"{first_coordinate(dataset)}_amplitude", "floquet_modulus", "stable", "impacts_per_period", "period_multiplicity", "impact_velocity"]].isel(branch_point=np.flatnonzero(mask))
     for label in np.unique(part["branch"].values):
         yield int(label), part.isel(branch_point=np.flatnonzero(part["branch"].values == label))
 
@@ -100,15 +108,18 @@ def _draw_branch(ax: Axes, frequency: np.ndarray, values: np.ndarray, stable: np
 
 
 def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> DrawnFigure:
-    """The bifurcation diagram of one restitution: X1 amplitude and impact velocities against frequency."""
+    """The bifurcation diagram of one restitution: the first coordinate's amplitude and impact velocities against
+    frequency."""
     keys = _classes(dataset, restitution)
+    name = first_coordinate(dataset)
+    label = coordinate_label(name)
     fig, (top, bottom) = new_figure(2, panel_height=4.2, columns=1, sharex=True, legend_rows=legend_rows(len(keys) + 8, 5))
     classes: set[tuple[int, int]] = set()
     r_index = int(np.argmin(np.abs(dataset["restitution"].values - restitution)))
     for direction in dataset["sweep"].values:
         brute = dataset.isel(restitution=r_index).sel(sweep=direction)
         f = brute["frequency"].values
-        amp = brute["brute_x1_amplitude"].values
+        amp = brute[f"brute_{name}_amplitude"].values
         top.scatter(np.repeat(f, amp.shape[1]), amp.ravel() * 1e3, s=1.5, color=SWEEP_COLOURS.get(str(direction), "C7"), alpha=0.6, lw=0, zorder=1)
         vel = brute["brute_impact_velocity"].values
         bottom.scatter(np.repeat(f, vel.shape[1]), vel.ravel(), s=1.5, color=SWEEP_COLOURS.get(str(direction), "C7"), alpha=0.6, lw=0, zorder=1)
@@ -119,7 +130,7 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
         colour = colours.get(key, "0.5")
         classes.add(key)
         stable = branch["stable"].values == 1
-        _draw_branch(top, f, branch["x1_amplitude"].values * 1e3, stable, colour, "_")
+        _draw_branch(top, f, branch[f"{name}_amplitude"].values * 1e3, stable, colour, "_")
         velocities = branch["impact_velocity"].values
         for k in range(velocities.shape[1]):
             if np.isfinite(velocities[:, k]).any():
@@ -129,9 +140,9 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
     for code, kind in enumerate(kinds):
         chosen = specials.isel(special_point=np.flatnonzero(specials["special_point_kind"].values == code))
         if chosen.sizes["special_point"]:
-            top.scatter(chosen["special_point_frequency"], chosen["special_point_x1_amplitude"] * 1e3, marker=SPECIAL_MARKERS.get(kind, "x"), s=42,
+            top.scatter(chosen["special_point_frequency"], chosen[f"special_point_{name}_amplitude"] * 1e3, marker=SPECIAL_MARKERS.get(kind, "x"), s=42,
                         facecolor="none", edgecolor="k", lw=1.2, zorder=5, label=kind.replace("_", "-"))  # fmt: skip
-    finish_axes(top, "", "|X1| fundamental [mm]", f"R = {fmt(restitution, 'g')}: X1 amplitude")
+    finish_axes(top, "", f"|{label}| fundamental [mm]", f"R = {fmt(restitution, 'g')}: {label} amplitude")
     finish_axes(bottom, _FREQUENCY, "impact velocity [m/s]", f"R = {fmt(restitution, 'g')}: impact velocities")
     dots = [Line2D([], [], ls="", marker="o", ms=5, color=SWEEP_COLOURS.get(str(d), "C7"), label=f"brute force, sweep {d}") for d in dataset["sweep"].values]
     extra = [*dots, Line2D([], [], color="k", **STABLE_STYLE, label="stable"), Line2D([], [], color="k", **UNSTABLE_STYLE, label="unstable")]
@@ -139,7 +150,7 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
     caption = (
         f"Bifurcation diagram at R = {fmt(restitution, 'g')}, Delta = {fmt(float(dataset['clearance']) * 1e3, 'g')} mm. Dots: brute-force "
         f"time simulation (compiled exact engine) sweeping up (red) and down (green), the end state carried to the next frequency; "
-        f"top: the X1 fundamental over each of the {dataset.sizes['strobe']} kept periods; bottom: the velocity of every impact in them. "
+        f"top: the {label} fundamental over each of the {dataset.sizes['strobe']} kept periods; bottom: the velocity of every impact in them. "
         "Lines: every continued branch (solid stable, dashed unstable; colour: impacts per orbit period and period), the linear orbit "
         "where it fits inside the clearance in black; markers: the located special points (table below)."
     )
@@ -148,7 +159,7 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
 
 def _specials(dataset: xr.Dataset, restitution: float) -> xr.Dataset:
     mask = np.isclose(dataset["special_point_restitution"].values, restitution)
-    return dataset[["special_point_x1_amplitude", "special_point_floquet_modulus"]].isel(special_point=np.flatnonzero(mask))
+    return dataset[[f"special_point_{first_coordinate(dataset)}_amplitude", "special_point_floquet_modulus"]].isel(special_point=np.flatnonzero(mask))
 
 
 def multiplier_figure(dataset: xr.Dataset, restitution: float, index: int) -> DrawnFigure:
@@ -203,11 +214,127 @@ def chart_figure(dataset: xr.Dataset) -> DrawnFigure:
         f"{dataset.sizes['map_frequency']} x {dataset.sizes['map_clearance']} grid (sweeping in frequency at each clearance, the end state "
         "carried over): linear motion, one impact per period, another periodic motion, or non-periodic motion (quasi-periodic, chaotic, or "
         "undecided: irregular) from the exact Lyapunov exponent. Lines: the fold, period-doubling and Neimark-Sacker points of the "
-        "one-impact branches continued in (frequency, clearance); dashed, the grazing curves: q |H12| = Delta where the one-impact "
-        "orbit's impact velocity vanishes and the linear motion touches the stop, and the points where a free flight of the one-impact "
-        "orbit touches the stop (located again at each clearance); dotted: the clearance of the diagrams."
+        f"branches started from the closed form, continued in (frequency, clearance); dashed, the grazing curves: the clearance the linear "
+        f"motion of {_stopped(dataset)} just reaches (q |H12| = Delta on the paper's layout), where the closed-form orbit's impact "
+        "velocity vanishes and the linear motion touches the stop, and the points where a free flight of an impacting orbit touches "
+        "the stop (located again at each clearance); dotted: the clearance of the diagrams."
+        + (" The symmetric orbit of the two-sided stop has two impacts per period: it counts as another periodic motion." if _has_origin(dataset, "two_impacts") else "")
     )
     return DrawnFigure(fig, "chart", f"Two-parameter chart, R = {fmt(r, 'g')}", caption)
+
+
+def _has_origin(dataset: xr.Dataset, origin: str) -> bool:
+    """Does a branch of ``dataset`` come from ``origin`` (a flag of ``branch_origin``)?"""
+    flags = _flags(dataset["branch_origin"])
+    return origin in flags and bool(np.any(dataset["branch_origin"].values == flags.index(origin)))
+
+
+def _stopped(dataset: xr.Dataset) -> str:
+    """The stopped coordinates in words (``x2``, ``x2 - x1``), from ``stop_layout`` (``x2`` when absent)."""
+    layout = str(dataset.attrs.get("stop_layout", "x2 <= Delta"))
+    targets = [part.split(" <=")[0].split(" >=")[0].strip() for part in layout.split("; ")]
+    return " and ".join(dict.fromkeys(targets))
+
+
+#: The brute-force classes that are no periodic motion.
+_NON_PERIODIC = ("quasi_periodic", "chaotic", "irregular")
+
+
+def _ranges(values: np.ndarray, step: float) -> str:
+    """Sorted frequencies [Hz] as ranges ``a-b`` (a gap wider than 1.5 ``step`` starts a new one), at most four."""
+    if values.size == 0:
+        return ""
+    values = np.sort(values)
+    breaks = np.flatnonzero(np.diff(values) > 1.5 * step)
+    starts, ends = np.r_[values[0], values[breaks + 1]], np.r_[values[breaks], values[-1]]
+    parts = [f"{fmt(a, '.2f')}-{fmt(b, '.2f')}" if b > a else fmt(a, ".2f") for a, b in zip(starts, ends)]
+    return ", ".join(parts[:4]) + (f" and {len(parts) - 4} more" if len(parts) > 4 else "") + " Hz"
+
+
+def _brute_facts(dataset: xr.Dataset, index: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Of the brute force at restitution ``index``: the largest amplitude of the first coordinate per (sweep,
+    frequency) [m], the regime flags per (sweep, frequency), and where either sweep settles on no periodic motion."""
+    brute = dataset.isel(restitution=index)
+    amplitude = np.nanmax(brute[f"brute_{first_coordinate(dataset)}_amplitude"].values, axis=-1)
+    regime = brute["brute_regime"].values
+    meanings = _flags(dataset["brute_regime"])
+    codes = [meanings.index(m) - 1 for m in _NON_PERIODIC if m in meanings]
+    return amplitude, regime, np.isin(regime, codes).any(axis=0)
+
+
+def headline(dataset: xr.Dataset) -> str:
+    """The answer in one line per restitution: the largest amplitude the brute force settles on, and at how many
+    frequencies it settles on no periodic motion."""
+    label = coordinate_label(first_coordinate(dataset))
+    frequency = dataset["frequency"].values
+    lines = []
+    for i, r in enumerate(dataset["restitution"].values):
+        amplitude, _regime, wild = _brute_facts(dataset, i)
+        top = ""
+        if np.isfinite(amplitude).any():
+            _j, k = np.unravel_index(int(np.nanargmax(amplitude)), amplitude.shape)
+            top = f"up to |{label}| = {fmt(amplitude[_j, k] * 1e3, '.3g')} mm (at {fmt(frequency[k], '.2f')} Hz), "
+        lines.append(f"R = {fmt(r, 'g')}: {top}no periodic motion at {int(wild.sum())} of {frequency.size} frequencies")
+    return "; ".join(lines)
+
+
+def answer_text(dataset: xr.Dataset) -> str:
+    """What the motion is, per restitution, in a few sentences: the largest amplitude the brute force settles on, where
+    it settles on no periodic motion, where the two sweeps disagree (coexisting attractors), where the closed-form
+    orbit is stable, and how many special points were located."""
+    label = coordinate_label(first_coordinate(dataset))
+    meanings = _flags(dataset["brute_regime"])
+    frequency = dataset["frequency"].values
+    step = float(np.median(np.diff(frequency))) if frequency.size > 1 else 1.0
+    origins = _flags(dataset["branch_origin"])
+    closed = [origins.index(k) for k in ("one_impact", "two_impacts") if k in origins]
+    kinds = _flags(dataset["special_point_kind"])
+    paragraphs = []
+    for i, r in enumerate(dataset["restitution"].values):
+        amplitude, regime, wild = _brute_facts(dataset, i)
+        words = [f"<b>R = {fmt(r, 'g')}</b>:"]
+        if np.isfinite(amplitude).any():
+            j, k = np.unravel_index(int(np.nanargmax(amplitude)), amplitude.shape)
+            kind = meanings[int(regime[j, k]) + 1].replace("_", " ")
+            words.append(f"the brute force settles at most on |{label}| = {fmt(amplitude[j, k] * 1e3, '.3g')} mm ({fmt(frequency[k], '.2f')} Hz, "
+                         f"sweeping {dataset['sweep'].values[j]}: {kind});")  # fmt: skip
+        words.append(f"no periodic motion at {int(wild.sum())} of {frequency.size} frequencies{' (' + _ranges(frequency[wild], step) + ')' if wild.any() else ''};")
+        if regime.shape[0] > 1:
+            scale = np.nanmax(amplitude) if np.isfinite(amplitude).any() else 1.0
+            differ = (regime != regime[:1]).any(axis=0) | (np.abs(np.nan_to_num(amplitude - amplitude[:1])) > 0.05 * scale).any(axis=0)
+            words.append(f"the sweeps settle on different motions (coexisting attractors) at {int(differ.sum())} frequencies"
+                         f"{' (' + _ranges(frequency[differ], step) + ')' if differ.any() else ''};")  # fmt: skip
+        on_branch = np.isclose(dataset["branch_restitution"].values, r) & np.isin(dataset["branch_origin"].values, closed) & (dataset["stable"].values == 1)
+        if on_branch.any():
+            words.append(f"the closed-form orbit is stable over {_stable_bands(dataset, on_branch)};")
+        elif not np.isin(dataset["branch_origin"].values[np.isclose(dataset["branch_restitution"].values, r)], closed).any():
+            words.append("no branch from the closed form;")
+        else:
+            words.append("the closed-form orbit is nowhere stable;")
+        mask = np.isclose(dataset["special_point_restitution"].values, r)
+        counts = [f"{int(np.count_nonzero(dataset['special_point_kind'].values[mask] == code))} {kind.replace('_', '-')}" for code, kind in enumerate(kinds)]
+        words.append(f"special points: {', '.join(counts)}.")
+        paragraphs.append("<p>" + " ".join(words) + "</p>")
+    return "".join(paragraphs)
+
+
+def _stable_bands(dataset: xr.Dataset, chosen: np.ndarray) -> str:
+    """The frequency bands [Hz] over which the chosen branch points are stable: each branch's runs of consecutive
+    stable points, merged where they overlap."""
+    bands: list[list[float]] = []
+    branch, f = dataset["branch"].values, dataset["branch_frequency"].values
+    for label in np.unique(branch[chosen]):
+        index = np.flatnonzero(branch == label)
+        runs = np.split(index, np.flatnonzero(~chosen[index][1:] | ~chosen[index][:-1]) + 1)
+        bands += [[float(f[run].min()), float(f[run].max())] for run in runs if run.size and chosen[run].all()]
+    merged: list[list[float]] = []
+    for low, high in sorted(bands):
+        if merged and low <= merged[-1][1]:
+            merged[-1][1] = max(merged[-1][1], high)
+        else:
+            merged.append([low, high])
+    parts = [f"{fmt(a, '.2f')}-{fmt(b, '.2f')}" for a, b in merged]
+    return ", ".join(parts[:4]) + (f" and {len(parts) - 4} more" if len(parts) > 4 else "") + " Hz"
 
 
 def bifurcation_figures(dataset: xr.Dataset) -> Iterator[DrawnFigure]:
@@ -246,17 +373,18 @@ class BifurcationPage:
         self.dataset = dataset
 
     def summary(self) -> str:
-        """What was computed."""
+        """The answer (:func:`headline`), then what was computed."""
         d = self.dataset
-        return (f"{int(np.unique(d['branch'].values).size)} branches, {d.sizes['special_point']} special points, brute force at "
-                f"{d.sizes['frequency']} frequencies x {d.sizes['sweep']} directions for R = {', '.join(fmt(r, 'g') for r in d['restitution'].values)}")  # fmt: skip
+        stops = f"; stops: {d.attrs['stop_layout']}" if "stop_layout" in d.attrs else ""
+        return (f"{headline(d)}; {int(np.unique(d['branch'].values).size)} branches, {d.sizes['special_point']} special points, brute force at "
+                f"{d.sizes['frequency']} frequencies x {d.sizes['sweep']} directions for R = {', '.join(fmt(r, 'g') for r in d['restitution'].values)}{stops}")  # fmt: skip
 
     def sections(self, out: Path) -> list[Section]:
         """Diagrams and multipliers per restitution with the special points' table, then the chart."""
         figures = saved(bifurcation_figures(self.dataset), out)
         notes = str(self.dataset.attrs.get("continuation_notes", ""))
-        intro = ("<p>Every branch of periodic orbits found by continuation (how it was started and where it ends):</p>"
-                 f"<pre>{html.escape(notes)}</pre>") if notes else ""  # fmt: skip
+        intro = answer_text(self.dataset) + (("<p>Every branch of periodic orbits found by continuation (how it was started and where it ends):</p>"
+                                              f"<pre>{html.escape(notes)}</pre>") if notes else "")  # fmt: skip
         chart = [f for f in figures if f.path.stem == "chart"]
         sections = [Section("Bifurcation diagrams", intro, [f for f in figures if f not in chart], [special_point_table(self.dataset)])]
         if chart:

@@ -1,5 +1,12 @@
-"""Bifurcation scenes: the header of every scene, the stop's clearance and ``bifurcation`` (brute force, continued
-branches and the two-parameter chart).
+"""Bifurcation scenes: the header of every scene, the layout, and ``bifurcation`` (brute force, continued branches and
+the two-parameter chart).
+
+The layout is written as in stepped scenes (:mod:`vibroimpact.scene.layout_parse`, the same parsers): the paper's
+named form (``system: {m1 ... b2}``, ``excitation: {amplitude}``, ``stop: {clearance}``: one upper stop on x2, the
+force on x1), or the general one (``system: {mass, stiffness, damping, coordinates}``, ``excitation: {amplitude, on |
+base_motion, static}``, ``stops: [...]``). Every stop is rigid and shares one clearance Delta > 0 (the chart varies
+it) and one restitution: the diagrams' ``bifurcation.restitution`` (then no stop gives its own), or, without that
+key, the value every stop gives.
 
 Example (the shipped ``bifurcation``, shortened)::
 
@@ -14,13 +21,22 @@ Example (the shipped ``bifurcation``, shortened)::
       continuation: {one_impact: true, period_doubling: true, grazing: true, linear: true, brute_force: true, max_steps: 2000}
       chart: {restitution: 0.2, clearance: {start: 0.001, stop: 0.006}, kinds: [fold, neimark_sacker, grazing]}
 
+and with relative two-sided stops (``studies/bifurcation_relative_stop.yaml``)::
+
+    system: {mass: [[1.0, 0.0], [0.0, 0.1]], stiffness: [[29300, -4300], [-4300, 4300]], damping: [[0.88, -0.08], [-0.08, 0.08]], coordinates: [x1, x2]}
+    excitation: {amplitude: 10.0, on: x1}
+    stops:
+      - {between: [x2, x1], side: upper, clearance: 0.003}
+      - {between: [x2, x1], side: lower, clearance: 0.003}
+    bifurcation: {frequency: {start: 15.0, stop: 45.0}, restitution: [0.2], ...}
+
 Every key is checked (unknown keys, wrong types and out-of-range values are reported together, each naming its key).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -35,8 +51,11 @@ from vibroimpact.scene.bifurcation_settings import (
     ChartSettings,
 )
 from vibroimpact.scene.checker import Checker, SceneError
+from vibroimpact.scene.layout import StopSpec
+from vibroimpact.scene.layout_checks import static_drift
+from vibroimpact.scene.layout_parse import document_names, is_general, parse_load, parse_stop_layout, parse_structure
 from vibroimpact.scene.schema import SWEEP_DIRECTIONS, Scene
-from vibroimpact.scene.sections import parse_header
+from vibroimpact.scene.sections import parse_header, parse_names
 
 __all__ = [
     "BIFURCATION_TOP_KEYS",
@@ -59,11 +78,22 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
     """Validate a bifurcation scene's document (a mapping with ``bifurcation``) and build the :class:`Scene`; raise
     :class:`SceneError` listing all problems."""
     c = Checker()
-    doc = c.mapping("", document, BIFURCATION_TOP_KEYS, {"name", "system", "excitation", "stop", "bifurcation"})
-    name, description, system, amplitude, report = parse_header(c, doc)
-    stop = c.mapping("stop", doc["stop"], {"clearance"}, {"clearance"}) if "stop" in doc else {}
-    clearance = c.number("stop.clearance", stop["clearance"], 0.0, math.inf, low_inclusive=False) if "clearance" in stop else None
-    spec = c.mapping("bifurcation", doc.get("bifurcation"), _KEYS, {"frequency", "restitution"}) if "bifurcation" in doc else {}
+    doc = c.mapping("", document, BIFURCATION_TOP_KEYS, {"name", "system", "excitation", "bifurcation"})
+    general = is_general(doc)
+    load = None
+    if general:
+        name, description, report = parse_names(c, doc)
+        system = parse_structure(c, doc["system"]) if "system" in doc else None
+        names = tuple(system.coordinates) if system is not None else document_names(doc.get("system"))
+        amplitude, load = parse_load(c, doc["excitation"], names) if "excitation" in doc else (None, None)
+        if load is not None and system is not None and static_drift(system, load):
+            c.fail("excitation.static", "the static force pushes the structure along a rigid-body mode: it has no steady state to follow")
+    else:
+        name, description, system, amplitude, report = parse_header(c, doc)
+    stops_give_restitution = isinstance(doc.get("stops"), list) and bool(doc["stops"]) and all(isinstance(e, dict) and "restitution" in e for e in doc["stops"])
+    required = {"frequency"} if stops_give_restitution else {"frequency", "restitution"}
+    spec = c.mapping("bifurcation", doc.get("bifurcation"), _KEYS, required) if "bifurcation" in doc else {}
+    specs, clearance, own_restitution = _layout(c, doc, system, "restitution" in spec)
     low = high = None
     if "frequency" in spec:
         band = c.mapping("bifurcation.frequency", spec["frequency"], {"start", "stop"}, {"start", "stop"})
@@ -72,7 +102,7 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
         if low is not None and high is not None and high <= low:
             c.fail("bifurcation.frequency.stop", f"{high:g} must be greater than start = {low:g}")
             high = None
-    restitution = c.grid("bifurcation.restitution", spec["restitution"], 0.0, 1.0, True) if "restitution" in spec else None
+    restitution = c.grid("bifurcation.restitution", spec["restitution"], 0.0, 1.0, True) if "restitution" in spec else own_restitution
     brute = _settings(c, "bifurcation.brute_force", spec.get("brute_force", {}), _BRUTE_KEYS, _brute_values)
     branches = _settings(c, "bifurcation.continuation", spec.get("continuation", {}), _BRANCH_KEYS, _branch_values)
     chart = _settings(c, "bifurcation.chart", spec["chart"], _CHART_KEYS, _chart_values) if "chart" in spec else None
@@ -104,7 +134,57 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
         bifurcation=settings,
         report=report,
         text=text,
+        load=load,
+        stops=specs or (),
+        general=general,
     )
+
+
+def _layout(c: Checker, doc: dict, system: Any, swept_restitution: bool) -> tuple[tuple[StopSpec, ...] | None, float | None, np.ndarray | None]:
+    """The stops (``()``: the paper's stop on x2; None: unusable), their shared clearance Delta [m] and, when they give
+    it and ``bifurcation.restitution`` does not (``swept_restitution`` False), their shared restitution as a grid.
+
+    The returned stops take Delta and R from the study (their own values moved to the grid), as a stepped scene's
+    shared values do (:mod:`vibroimpact.scene.layout_grids`)."""
+    if "stop" not in doc and "stops" not in doc:
+        c.fail("stop", "required: the paper's stop {clearance: Delta [m]} above the absorber x2, or 'stops' (any layout)")
+        return None, None, None
+    specs = parse_stop_layout(c, doc, system)
+    if "stops" not in doc:
+        stop = c.mapping("stop", doc["stop"], {"clearance"}, {"clearance"})
+        clearance = c.number("stop.clearance", stop["clearance"], 0.0, math.inf, low_inclusive=False) if "clearance" in stop else None
+        return (), clearance, None
+    if specs is None:
+        return None, None, None
+    ok = True
+    for k, stop in enumerate(specs):
+        entry = doc["stops"][k]
+        if "bumper" in entry:
+            c.fail(f"stops[{k}].bumper", "a bifurcation study runs rigid stops (the exact engine's stroboscopic map): remove the bumper")
+            ok = False
+        if stop.clearance is None:
+            c.fail(f"stops[{k}].clearance", "required: Delta [m] in (0, inf), the same for every stop (the chart varies it)")
+            ok = False
+        elif not stop.clearance > 0.0:
+            c.fail(f"stops[{k}].clearance", f"{stop.clearance!r} is out of range: allowed (0, inf) [m]")
+            ok = False
+        elif stop.clearance != specs[0].clearance and specs[0].clearance is not None:
+            c.fail(f"stops[{k}].clearance", f"{stop.clearance:g} m differs from stops[0]'s {specs[0].clearance:g} m: a bifurcation study has one clearance Delta shared by every stop (the chart varies it)")
+            ok = False
+        if swept_restitution and stop.restitution is not None:
+            c.fail(f"stops[{k}].restitution", "also given in bifurcation.restitution (the diagrams' values, for every stop): give it in one place only")
+            ok = False
+        elif not swept_restitution and stop.restitution is None:
+            c.fail(f"stops[{k}].restitution", "required unless bifurcation.restitution gives the diagrams' values: R in [0, 1], the same for every stop")
+            ok = False
+        elif stop.restitution is not None and stop.restitution != specs[0].restitution and specs[0].restitution is not None:
+            c.fail(f"stops[{k}].restitution", f"{stop.restitution:g} differs from stops[0]'s {specs[0].restitution:g}: a bifurcation diagram has one R shared by every stop")
+            ok = False
+    if not ok:
+        return None, None, None
+    own = None if swept_restitution else np.array([specs[0].restitution])
+    shared = tuple(dataclasses.replace(spec, clearance=None, restitution=None) for spec in specs)
+    return shared, specs[0].clearance, own
 
 
 def _settings(c: Checker, key: str, value: Any, allowed: set[str], values: Any) -> Any:

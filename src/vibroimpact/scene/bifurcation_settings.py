@@ -8,20 +8,27 @@ name :class:`BifurcationSettings` without a circle of imports.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from vibroimpact.model.validation import require_in_range, require_positive
 
-__all__ = ["BIFURCATION_TOP_KEYS", "CHART_KINDS", "BruteForceSettings", "BranchSettings", "ChartSettings", "BifurcationSettings"]
+__all__ = ["BIFURCATION_TOP_KEYS", "CHART_KINDS", "BruteForceSettings", "BranchSettings", "ChartSettings", "BifurcationSettings", "coordinate_label"]
 
-#: Top-level keys of a bifurcation scene.
-BIFURCATION_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "bifurcation", "report"}
+#: Top-level keys of a bifurcation scene (``stop`` is the paper's stop on x2, ``stops`` any layout).
+BIFURCATION_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bifurcation", "report"}
 #: Special points whose curves the two-parameter chart can follow (the order of the CF flags of ``special_point_kind``).
 CHART_KINDS = ("fold", "period_doubling", "neimark_sacker", "grazing")
 #: Most brute-force periods of one scene (frequencies x restitutions x directions x periods per point).
 MAX_BRUTE_PERIODS = 50_000_000
+
+
+def coordinate_label(name: str) -> str:
+    """How a bifurcation study's texts name a coordinate: ``X1`` for ``x1`` (a letter and digits, capitalised, as
+    the paper writes them), any other name as it is (``floor2``)."""
+    return name.upper() if re.fullmatch(r"[a-z][0-9]+", name) else name
 
 
 @dataclass(frozen=True)
@@ -58,13 +65,15 @@ class BranchSettings:
     Attributes
     ----------
     one_impact : bool
-        The one-impact branches, started from the closed form (PGF) at both roots of eq. 16.
+        The branches of the closed-form impact orbit, started at both roots of eq. 16 (corrected): one impact per
+        period on one stop, the symmetric two impacts per period on a two-sided stop; none where the layout has no
+        closed form.
     period_doubling : bool
         Period-2 branches switched at every period doubling of a period-1 branch.
     grazing : bool
         Branches born at grazing points where an orbit with another (non-zero) impact count continues.
     linear : bool
-        The impactless (linear) orbit wherever it fits inside the clearance (closed form).
+        The impactless (linear) orbit wherever it fits inside every stop (closed form).
     brute_force : bool
         Branches seeded from the brute force: where a sweep's strobes repeat with a period k on an orbit no other
         branch passes through, that orbit continued as a fixed point of the k-period map.

@@ -1,45 +1,74 @@
 """Every periodic orbit of one restitution over a frequency band: branches continued from the closed form, at period
 doublings and at grazing points, the linear orbit, and their special points, as flat arrays for a dataset.
 
-:func:`find_branches` starts a branch at the middle of every frequency segment where a root of eq. 16 (corrected)
-gives an admissible one-impact orbit, unless an earlier branch already passes through that orbit (same impulse at
-that frequency); each branch gets its own stroboscopic section, away from the impacts of its band
-(:func:`vibroimpact.orbits.maps.section_phase`). Period doublings of period-1 branches switch to the period-2 branch;
-grazing points where an orbit with another, non-zero impact count continues start a branch there. The linear orbit
-comes from the closed form wherever q |H12| <= Delta. Failures of a continuation are recorded, never fatal.
+Everything works on the general problem (:class:`~vibroimpact.model.problem.ImpactProblem` with a tuple of rigid
+:class:`~vibroimpact.model.stops.Stop`, any structure and harmonic load; the paper's layout is one of them).
+:func:`find_branches` starts a branch at the middle of every frequency segment where a root of the impulse equation
+(eq. 16 corrected, :func:`vibroimpact.analysis.impact_orbit.solve_impact_orbit`) gives an admissible closed-form
+orbit (one impact per period on one stop, the symmetric two impacts per period on a two-sided stop), unless an
+earlier branch already passes through that orbit (same impulse at that frequency); each branch gets its own
+stroboscopic section, away from the impacts of its band (:func:`vibroimpact.orbits.maps.section_phase`). A layout
+without a closed form (:func:`vibroimpact.analysis.layout.closed_form_refusal`) starts no such branch; its orbits
+come from the brute force (:mod:`.bifurcation_seeds`). Period doublings of period-1 branches switch to the period-2
+branch; grazing points where an orbit with another, non-zero impact count continues start a branch there. The linear
+orbit comes from the closed form wherever it fits inside every stop (|n_k H F| + n_k K^-1 F0 <= Delta_k). Failures
+of a continuation are recorded, never fatal.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import brentq
 
-from vibroimpact.analysis.pgf import solve_one_impact
+from vibroimpact.analysis.impact_orbit import ROOTS, ImpactOrbit, solve_impact_orbit
+from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.model.contact import RigidStop
-from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.orbits.bifurcations import switch_period_doubling
-from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Branch, Iterated, MapEvaluation, PeriodicOrbit, SpecialPoint
+from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Branch, Iterated, PeriodicOrbit, SpecialPoint
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
-from vibroimpact.orbits.maps import ImpactMap, one_impact_state, orbit_measures, section_phase, with_impulse
+from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures, section_phase
 from vibroimpact.orbits.shooting import shoot
 
-__all__ = ["ORIGINS", "MAX_ORBIT_IMPACTS", "map_bounds", "OrbitSet", "find_branches", "one_impact_roots", "linear_segments"]
+__all__ = ["ORIGINS", "MAX_ORBIT_IMPACTS", "map_bounds", "problem_at", "stop_values", "OrbitSet", "find_branches", "closed_form_orbits", "linear_segments"]
 
-#: How a branch was found (CF flags of ``branch_origin``).
-ORIGINS = ("linear", "one_impact", "period_doubling", "grazing", "brute_force")
+#: How a branch was found (CF flags of ``branch_origin``): the closed forms' kinds (one impact per period, the
+#: symmetric two impacts of a two-sided stop) are :data:`vibroimpact.analysis.layout.KINDS`.
+ORIGINS = ("linear", "one_impact", "period_doubling", "grazing", "brute_force", "two_impacts")
 #: Impact velocities kept per orbit (the rest are dropped; ``impacts_per_period`` counts them all).
 MAX_ORBIT_IMPACTS = 8
-#: Frequency step of the closed-form scan for one-impact starts [Hz].
+#: Frequency step of the closed-form scan for closed-form starts [Hz].
 SCAN_STEP = 0.01
 #: Largest relative impulse difference of an orbit from a branch it is taken to lie on [-].
 SAME_ORBIT = 0.02
 #: Most branches born at grazing points per restitution (each may have its own grazing points).
 MAX_GRAZING_BRANCHES = 8
+#: |max |mu| - 1| up to which an orbit is marginal (``stable`` = 2) [-].
+MARGINAL = 1e-9
+
+
+def problem_at(problem: ImpactProblem, frequency: float, clearance: float | None = None, phase: float | None = None) -> ImpactProblem:
+    """``problem`` at another excitation frequency [Hz] and, when given, with every stop at ``clearance`` [m] and the
+    load's phase ``phase`` [rad]; the structure, the load's distribution and static part and each stop's restitution
+    are kept."""
+    excitation = dataclasses.replace(problem.harmonic, frequency=float(frequency))
+    if phase is not None:
+        excitation = dataclasses.replace(excitation, phase=float(phase))
+    stops = problem.stops
+    if clearance is not None:
+        stops = tuple(dataclasses.replace(stop, law=RigidStop(float(clearance), stop.law.restitution)) for stop in stops)
+    return ImpactProblem(problem.system, stops, excitation)
+
+
+def stop_values(problem: ImpactProblem) -> tuple[float, float]:
+    """(Delta [m], R [-]) shared by every stop of a bifurcation study's problem (the scene checks they are equal)."""
+    first = problem.stops[0]
+    return first.clearance, first.law.restitution
 
 
 @dataclass
@@ -65,17 +94,16 @@ class OrbitSet:
         self.notes.append(f"branch {label} ({origin}): {len(branch.orbits)} points, {branch.values.min():.4f}-{branch.values.max():.4f} Hz, ends: {branch.end}")
         return label
 
-    def add_linear(self, system: TwoDofSystem, amplitude: float, clearance: float, frequency: NDArray[np.float64]) -> None:
-        """The impactless orbit on one segment of frequencies where it fits inside the clearance."""
+    def add_linear(self, problem: ImpactProblem, frequency: NDArray[np.float64]) -> None:
+        """The impactless orbit of ``problem`` on one segment of frequencies [Hz] where it fits inside every stop."""
         label = self.count
         self.count += 1
-        multipliers = _linear_multipliers(system, frequency)
-        h = system.receptances(2.0 * np.pi * frequency)
+        multipliers = _linear_multipliers(problem, frequency)
+        amplitudes = np.abs(linear_amplitudes(problem, 2.0 * np.pi * np.asarray(frequency)).coordinates)
         for k, f in enumerate(frequency):
             modulus = float(np.max(np.abs(multipliers[k])))
             self.points.append({
-                "branch": label, "origin": 0, "frequency": float(f), "x1_amplitude": amplitude * abs(complex(h.h11[k])),
-                "x2_amplitude": amplitude * abs(complex(h.h12[k])), "impulse": 0.0, "floquet_modulus": modulus,
+                "branch": label, "origin": 0, "frequency": float(f), "amplitudes": amplitudes[k], "impulse": 0.0, "floquet_modulus": modulus,
                 "stable": int(modulus < 1.0), "impacts": 0, "period": 1, "multipliers": multipliers[k], "velocities": np.zeros(0),
             })  # fmt: skip
         self.notes.append(f"branch {label} (linear): {frequency.size} points, {frequency[0]:.4f}-{frequency[-1]:.4f} Hz")
@@ -118,16 +146,15 @@ def map_bounds(low: float, high: float) -> dict[str, tuple[float, float]]:
 def _record(system: ImpactMap, orbit: PeriodicOrbit) -> dict:
     measures = orbit_measures(system, orbit)
     periods = orbit.period * system.periods  # excitation periods per orbit period
-    multipliers = np.zeros(4, dtype=complex)
+    multipliers = np.zeros(system.dimension, dtype=complex)
     multipliers[: orbit.multipliers.size] = orbit.multipliers
     modulus = orbit.floquet_modulus
     return {
         "frequency": orbit.parameter("frequency"),
-        "x1_amplitude": measures.x1_amplitude,
-        "x2_amplitude": measures.x2_amplitude,
+        "amplitudes": measures.amplitudes,
         "impulse": float(measures.impulses.sum()) / periods,
         "floquet_modulus": modulus,
-        "stable": 2 if abs(modulus - 1.0) <= 1e-9 else int(modulus < 1.0),
+        "stable": 2 if abs(modulus - 1.0) <= MARGINAL else int(modulus < 1.0),
         "impacts": int(measures.impulses.size),
         "period": periods,
         "multipliers": multipliers,
@@ -135,32 +162,30 @@ def _record(system: ImpactMap, orbit: PeriodicOrbit) -> dict:
     }
 
 
-def _linear_multipliers(system: TwoDofSystem, frequency: NDArray[np.float64]) -> NDArray[np.complex128]:
-    """exp(lambda T) of the free system's eigenvalues at each frequency, by decreasing modulus."""
-    eigenvalues = np.linalg.eigvals(system.state_matrix)
+def _linear_multipliers(problem: ImpactProblem, frequency: NDArray[np.float64]) -> NDArray[np.complex128]:
+    """exp(lambda T) of the free structure's eigenvalues at each frequency, by decreasing modulus, shape (n, 2N)."""
+    eigenvalues = np.linalg.eigvals(problem.structure.state_matrix)
     mu = np.exp(eigenvalues[None, :] / np.asarray(frequency)[:, None])
     order = np.argsort(-np.abs(mu), axis=1, kind="stable")
     return np.take_along_axis(mu, order, axis=1)
 
 
-def one_impact_roots(system: TwoDofSystem, frequency: NDArray[np.float64], clearance: float, restitution: float, amplitude: float) -> tuple:
-    """The closed-form solution at ``frequency`` [Hz] and both roots of eq. 16 (corrected) [N s], NaN where none."""
-    sol = solve_one_impact(system, 2.0 * np.pi * frequency, clearance, restitution, amplitude)
-    c = (1.0 / (system.m2 * (1.0 + restitution)) + sol.chi_rate_before) / sol.omega
-    a = amplitude * np.abs(sol.receptances.h12)
-    quad_a, quad_b = c**2 + sol.chi0**2, clearance * sol.chi0
-    disc = quad_a * a**2 - (c * clearance) ** 2
-    root = np.sqrt(np.where(disc >= 0.0, disc, np.nan))
-    roots = [(-quad_b + sign * root) / quad_a for sign in (1.0, -1.0)]
-    return sol, [np.where(j >= 0.0, j, np.nan) for j in roots]
+def closed_form_orbits(problem: ImpactProblem, frequency: NDArray[np.float64]) -> list[ImpactOrbit]:
+    """The closed-form impact orbit of ``problem`` at ``frequency`` [Hz] for each root of the impulse equation
+    (:data:`~vibroimpact.analysis.impact_orbit.ROOTS`), NaN impulses where none exists; ``ValueError`` with the
+    reason where the layout has no closed form."""
+    plus = solve_impact_orbit(problem, 2.0 * np.pi * np.asarray(frequency, dtype=float))
+    return [plus if root == "+" else plus.with_root(root) for root in ROOTS]
 
 
-def linear_segments(system: TwoDofSystem, amplitude: float, clearance: float, low: float, high: float, step: float = 0.02) -> list[NDArray[np.float64]]:
-    """Frequency segments [Hz] where the linear orbit fits inside the clearance, with their exact grazing ends."""
+def linear_segments(problem: ImpactProblem, low: float, high: float, step: float = 0.02) -> list[NDArray[np.float64]]:
+    """Frequency segments [Hz] where the linear orbit fits inside every stop, with their exact grazing ends."""
     frequency = np.arange(low, high + 0.5 * step, step)
+    clearances = problem.clearances()
 
     def gap(f: float) -> float:
-        return clearance - amplitude * abs(complex(system.receptances(2.0 * np.pi * f).h12))
+        linear = linear_amplitudes(problem, 2.0 * np.pi * f)
+        return float(np.min(clearances - linear.stop_static - np.abs(linear.stops)))
 
     fits = np.array([gap(f) >= 0.0 for f in frequency])
     segments = []
@@ -177,22 +202,36 @@ def linear_segments(system: TwoDofSystem, amplitude: float, clearance: float, lo
 
 
 def find_branches(
-    system: TwoDofSystem, amplitude: float, clearance: float, restitution: float, low: float, high: float,
+    problem: ImpactProblem, low: float, high: float,
     one_impact: bool = True, period_doubling: bool = True, grazing: bool = True, linear: bool = True,
     max_steps: int = 2000, max_step: float = 0.1, progress=None,
 ) -> OrbitSet:  # fmt: skip
-    """Every branch of one restitution over [low, high] Hz (module docstring); ``progress`` gets a line per branch."""
+    """Every branch of ``problem``'s restitution over [low, high] Hz (module docstring); ``progress`` gets a line per
+    branch.
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+        Structure, rigid stops sharing one clearance and restitution, harmonic load; its frequency is not used.
+    low, high : float
+        The band [Hz].
+    one_impact : bool
+        Branches from the closed form (one impact per period, or two on a symmetric two-sided stop) at both roots.
+    period_doubling, grazing, linear : bool
+        Period-2 branches at period doublings, branches born at grazing points, the linear orbit.
+    max_steps : int
+        Most continuation steps per direction of a branch.
+    max_step : float
+        Largest arclength step [-].
+    """
     found = OrbitSet()
     settings = ContinuationSettings(lower=low, upper=high, max_steps=max_steps, max_step=max_step)
     bounds = map_bounds(low, high)
+    restitution = stop_values(problem)[1]
 
     def say(message: str) -> None:
         if progress is not None:
             progress(f"R = {restitution:g}: {message}")
-
-    def guarded(frequency: float, phase: float) -> ImpactMap:
-        problem = ImpactProblem(system, RigidStop(clearance, restitution), HarmonicForce(amplitude, frequency, phase))
-        return ImpactMap(problem, bounds=bounds)
 
     def attempt(what: str, run) -> None:
         try:
@@ -203,36 +242,37 @@ def find_branches(
 
     maps: list[tuple[ImpactMap, Branch]] = []
     if linear:
-        for segment in linear_segments(system, amplitude, clearance, low, high):
-            found.add_linear(system, amplitude, clearance, segment)
-    if one_impact:
+        for segment in linear_segments(problem, low, high):
+            found.add_linear(problem, segment)
+    refusal = closed_form_refusal(problem) if one_impact else None
+    if refusal is not None:
+        found.notes.append(f"no closed-form orbit for this layout ({refusal}): its branches come from the brute force")
+    elif one_impact:
         frequency = np.arange(low, high + 0.5 * SCAN_STEP, SCAN_STEP)
-        sol, roots = one_impact_roots(system, frequency, clearance, restitution, amplitude)
-        exists = np.isfinite(roots[0]) | np.isfinite(roots[1])
-        for root in roots:
-            ok = np.isfinite(root)
-            candidate = with_impulse(sol, np.where(ok, root, 0.0))
-            admissible = ok & candidate.admissible()
+        orbits = closed_form_orbits(problem, frequency)
+        exists = np.logical_or.reduce([orbit.exists for orbit in orbits])
+        for root, orbit in zip(ROOTS, orbits):
+            admissible = orbit.admissible()
+            kind, impacts = orbit.layout.kind, orbit.impacts_per_period
             runs = np.split(np.flatnonzero(admissible), np.flatnonzero(np.diff(np.flatnonzero(admissible)) > 1) + 1)
             for run in (r for r in runs if r.size):
                 k = int(run[run.size // 2])
-                f0, j0 = float(frequency[k]), float(root[k])
-                if found.known(f0, 1, 1, j0):
+                f0 = float(frequency[k])
+                if found.known(f0, 1, impacts, impacts * float(orbit.impulse[k])):
                     continue
                 band = _segment(exists, k)
-                base = ImpactProblem(system, RigidStop(clearance, restitution), HarmonicForce(amplitude, f0))
-                phase = section_phase(base, frequency[band[0] : band[1] + 1])
-                mapping = guarded(f0, phase)
+                phase = section_phase(problem_at(problem, f0), frequency[band[0] : band[1] + 1])
+                mapping = ImpactMap(problem_at(problem, f0, phase=phase), bounds=bounds)
 
-                def start(mapping: ImpactMap = mapping, f0: float = f0, j0: float = j0) -> None:
-                    single = with_impulse(solve_one_impact(system, 2.0 * np.pi * f0, clearance, restitution, amplitude), j0)
-                    orbit = shoot(mapping, one_impact_state(mapping.problem, single), mapping.parameters)
-                    branch = continue_branch(mapping, orbit, "frequency", settings)
-                    label = found.add_branch(mapping, branch, "one_impact")
+                def start(mapping: ImpactMap = mapping, f0: float = f0, root: str = root, kind: str = kind) -> None:
+                    closed = solve_impact_orbit(mapping.problem, root=root)
+                    first = shoot(mapping, closed_form_state(mapping.problem, closed), mapping.parameters)
+                    branch = continue_branch(mapping, first, "frequency", settings)
+                    label = found.add_branch(mapping, branch, kind)
                     maps.append((mapping, branch))
-                    say(f"one-impact branch {label} from {f0:.2f} Hz: {len(branch.orbits)} points, {len(branch.special_points)} special points")
+                    say(f"{kind.replace('_', '-')} branch {label} from {f0:.2f} Hz: {len(branch.orbits)} points, {len(branch.special_points)} special points")
 
-                attempt(f"one-impact branch from {f0:.2f} Hz", start)
+                attempt(f"{kind.replace('_', '-')} branch from {f0:.2f} Hz", start)
     if period_doubling:
         for mapping, branch in list(maps):
             for point in branch.special("period_doubling"):

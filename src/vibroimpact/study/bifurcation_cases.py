@@ -2,17 +2,23 @@
 of one restitution, and the two-parameter chart's curves.
 
 * :class:`SweepCase`: a stepped sweep of the ``exact`` engine over frequencies (up or down), the end state carried to
-  the next frequency; at each frequency a transient is dropped, then the strobes, the per-period X1 fundamental and the
-  impact velocities are kept and the motion is classified (:data:`MOTION_CLASSES`): linear, one impact per period,
+  the next frequency; at each frequency a transient is dropped, then the strobes of the first coordinate (X1 on the
+  paper's layout), its per-period fundamental and the impact velocities are kept and the motion is classified (:data:`MOTION_CLASSES`): linear, one impact per period,
   another periodic motion, or, where the strobes do not repeat, quasi-periodic, chaotic or irregular from the exact
-  Jacobians (:func:`vibroimpact.orbits.motion.classify_motion`). A strictly negative Lyapunov exponent means a periodic
+  Jacobians (:func:`vibroimpact.orbits.motion.classify_motion`; from the strobes alone where a Jacobian is undefined,
+  :func:`~vibroimpact.orbits.motion.classify_strobes`). A strictly negative Lyapunov exponent means a periodic
   orbit approached slowly: the motion is classified by the period that repeats best.
 * :class:`BranchCase`: :func:`vibroimpact.study.bifurcation_branches.find_branches` of one restitution.
 * :class:`ChartCase`: the special points of the chart's restitution followed in (frequency, clearance): folds, period
   doublings and Neimark-Sacker points continued (:func:`vibroimpact.orbits.two_parameter.continue_special_point`), the
   points where a free flight of an orbit touches the stop traced by repeated location
-  (:func:`vibroimpact.orbits.grazing_curve.trace_grazing`), and the one-impact orbit's vanishing impact velocity
-  (where q |H12| = Delta, the linear orbit's grazing) from the closed form.
+  (:func:`vibroimpact.orbits.grazing_curve.trace_grazing`), and the closed-form orbit's vanishing impact velocity
+  (where the linear motion reaches a stop, max_k |n_k H F| + n_k K^-1 F0 = Delta: q |H12| = Delta on the paper's
+  layout) from the linear response.
+
+Every case holds the general problem (:class:`~vibroimpact.model.problem.ImpactProblem`: structure, a tuple of rigid
+stops sharing one clearance and restitution, harmonic load) and moves it in frequency (and clearance) with
+:func:`~vibroimpact.study.bifurcation_branches.problem_at`.
 """
 
 from __future__ import annotations
@@ -23,17 +29,16 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.engines.exact import ExactEngine
-from vibroimpact.model.contact import RigidStop
-from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Iterated
 from vibroimpact.orbits.continuation import ContinuationSettings
 from vibroimpact.orbits.grazing_curve import trace_grazing
-from vibroimpact.orbits.motion import classify_motion
+from vibroimpact.orbits.motion import classify_motion, classify_strobes
 from vibroimpact.orbits.two_parameter import continue_special_point
-from vibroimpact.study.bifurcation_branches import MAX_ORBIT_IMPACTS, OrbitSet, find_branches
+from vibroimpact.simulation.layout import linear_state, resting_state
+from vibroimpact.study.bifurcation_branches import MAX_ORBIT_IMPACTS, OrbitSet, find_branches, problem_at, stop_values
 from vibroimpact.study.bifurcation_seeds import Seed, seed_branches
 from vibroimpact.study.fingerprint import case_key
 from vibroimpact.study.runner import CaseResult, ProgressReport
@@ -46,24 +51,23 @@ MOTION_CLASSES = ("linear", "one_impact", "other_periodic", "quasi_periodic", "c
 MAX_KEPT_IMPACTS = 64
 #: Longest period looked for in the strobes [periods] (the strobes kept must cover it twice).
 MAX_PERIOD = 32
-#: Strobes repeat when they differ by less than this, relative to Delta + q |H12| (velocities: times w) [-].
+#: Strobes repeat when they differ by less than this, relative to the motion's length (Delta + q |H12| on the paper's
+#: layout, :meth:`ImpactProblem.velocity_scale` / w in general; velocities: times w) [-].
 REPEAT_TOLERANCE = 1e-6
 
 
 @dataclass(frozen=True, eq=False)
 class SweepCase:
-    """A stepped brute-force sweep of one (restitution, clearance, direction) over ``frequencies`` [Hz]."""
+    """A stepped brute-force sweep of ``problem`` (its restitution and clearance) in one direction over
+    ``frequencies`` [Hz]; ``strobe`` and ``amplitude`` are the first coordinate's."""
 
-    system: TwoDofSystem
-    amplitude: float
-    clearance: float
-    restitution: float
+    problem: ImpactProblem
     direction: str
     frequencies: tuple[float, ...]
     transient: int
     strobes: int
     engine: str = "exact"
-    fields: tuple[str, ...] = ("x1", "x1_amplitude", "velocity", "impacts", "regime", "period", "lyapunov", "state")
+    fields: tuple[str, ...] = ("strobe", "amplitude", "velocity", "impacts", "regime", "period", "lyapunov", "state")
     progress_unit: str = "frequency points"
 
     @property
@@ -73,40 +77,36 @@ class SweepCase:
 
     def key(self) -> str:
         """Hash of everything that determines the result."""
-        return case_key({"kind": "bifurcation_sweep", **{k: v for k, v in asdict(self).items() if k != "system"}, "system": asdict(self.system)})
+        return case_key({"kind": "bifurcation_sweep", **asdict(self)})
 
     def run(self, report: ProgressReport | None = None) -> CaseResult:
         """Arrays over the frequencies in increasing order (whatever the direction)."""
         engine = ExactEngine()
         f = np.array(self.frequencies)
         order = np.argsort(f) if self.direction == "up" else np.argsort(f)[::-1]
-        n, s = f.size, self.strobes
+        n, s, width = f.size, self.strobes, 2 * self.problem.size
         out = {
-            "x1": np.full((n, s), np.nan), "x1_amplitude": np.full((n, s), np.nan), "velocity": np.full((n, MAX_KEPT_IMPACTS), np.nan),
+            "strobe": np.full((n, s), np.nan), "amplitude": np.full((n, s), np.nan), "velocity": np.full((n, MAX_KEPT_IMPACTS), np.nan),
             "impacts": np.zeros(n), "regime": np.full(n, -1, dtype=np.int8), "period": np.zeros(n, dtype=np.int16), "lyapunov": np.full(n, np.nan),
-            "state": np.full((n, 4), np.nan),
+            "state": np.full((n, width), np.nan),
         }  # fmt: skip
         state = None
         for done, k in enumerate(order):
-            problem = ImpactProblem(self.system, RigidStop(self.clearance, self.restitution), HarmonicForce(self.amplitude, float(f[k])))
+            problem = problem_at(self.problem, float(f[k]))
             state = _linear_start(problem) if state is None else state
             try:
                 state = _measure(engine, problem, state, self.transient, s, out, k)
             except RuntimeError:  # the engine made no progress (endless chattering): start the next point at rest
-                state = np.zeros(4)
+                state = resting_state(problem)
             if report is not None:
                 report(done + 1)
         return out
 
 
 def _linear_start(problem: ImpactProblem) -> NDArray[np.float64]:
-    """The linear steady state at t = 0 if it fits inside the clearance, else rest."""
-    h = problem.system.receptances(problem.omega)
-    x1, x2 = problem.amplitude * complex(h.h11), problem.amplitude * complex(h.h12)
-    if abs(x2) > problem.clearance:
-        return np.zeros(4)
-    w = problem.omega
-    return np.array([x1.real, x2.real, (1j * w * x1).real, (1j * w * x2).real])
+    """The linear steady state at t = 0 if it fits inside every stop, else rest on the stops."""
+    linear = linear_state(problem)
+    return linear.state(problem.omega) if linear.fits(problem) else resting_state(problem)
 
 
 def _measure(engine: ExactEngine, problem: ImpactProblem, state: NDArray[np.float64], transient: int, strobes: int, out: dict, k: int) -> NDArray[np.float64]:
@@ -116,20 +116,24 @@ def _measure(engine: ExactEngine, problem: ImpactProblem, state: NDArray[np.floa
     run = engine.integrate(problem, state, 0.0, strobes, moments=True, jacobians=True)
     s = run.strobe_states
     out["state"][k] = run.final_state
-    out["x1"][k] = s[1:, 0]
-    out["x1_amplitude"][k] = np.abs(run.moments[:, 0]) * 2.0 / problem.period
+    out["strobe"][k] = s[1:, 0]
+    out["amplitude"][k] = np.abs(run.moments[:, 0]) * 2.0 / problem.period
     velocities = run.impact_velocities
     out["velocity"][k, : min(velocities.size, MAX_KEPT_IMPACTS)] = velocities[-MAX_KEPT_IMPACTS:]
     out["impacts"][k] = velocities.size / strobes
-    length = problem.clearance + problem.amplitude * abs(complex(problem.system.receptances(problem.omega).h12))
-    scale = np.array([length, length, problem.omega * length, problem.omega * length])
+    length = problem.velocity_scale() / problem.omega
+    scale = np.repeat([length, problem.omega * length], problem.size)
     mismatch = [float(np.max(np.abs(s[p:] - s[:-p]) / scale)) if s.shape[0] > 2 * p else math.inf for p in range(1, MAX_PERIOD + 1)]
     period = next((p for p, m in enumerate(mismatch, start=1) if m < REPEAT_TOLERANCE), 0)
     if velocities.size == 0:
         out["regime"][k], out["period"][k] = 0, 1
         return run.final_state
     if not period:
-        evidence = classify_motion(run.strobe_jacobians, s[1:])
+        jacobians = run.strobe_jacobians
+        if np.all(np.isfinite(jacobians)):
+            evidence = classify_motion(jacobians, s[1:])
+        else:  # a degenerate event (e.g. a chatter sequence ending as a release begins) left a Jacobian undefined
+            evidence = classify_strobes(s[1:])  # the strobes alone decide the clear cases; no exponent
         out["lyapunov"][k] = evidence.lyapunov_exponent
         if evidence.lyapunov_exponent < -0.005:  # contracting: a periodic orbit approached slowly
             period = int(np.argmin(mismatch)) + 1
@@ -145,21 +149,18 @@ def _measure(engine: ExactEngine, problem: ImpactProblem, state: NDArray[np.floa
 
 #: Fields of :func:`branch_arrays`.
 BRANCH_FIELDS = (
-    "branch", "origin", "frequency", "x1_amplitude", "x2_amplitude", "impulse", "floquet_modulus", "stable", "impacts", "period",
+    "branch", "origin", "frequency", "amplitudes", "impulse", "floquet_modulus", "stable", "impacts", "period",
     "multipliers_real", "multipliers_imag", "velocities",
-    "sp_branch", "sp_kind", "sp_frequency", "sp_x1_amplitude", "sp_impulse", "sp_floquet_modulus", "sp_impacts", "sp_period",
+    "sp_branch", "sp_kind", "sp_frequency", "sp_amplitudes", "sp_impulse", "sp_floquet_modulus", "sp_impacts", "sp_period",
     "sp_multipliers_real", "sp_multipliers_imag", "sp_note", "notes",
 )  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
 class BranchCase:
-    """Every branch of one restitution (:func:`find_branches`); arrays from :func:`branch_arrays`."""
+    """Every branch of ``problem``'s restitution (:func:`find_branches`); arrays from :func:`branch_arrays`."""
 
-    system: TwoDofSystem
-    amplitude: float
-    clearance: float
-    restitution: float
+    problem: ImpactProblem
     low: float
     high: float
     options: tuple[tuple[str, object], ...]
@@ -169,29 +170,34 @@ class BranchCase:
     progress_unit: str = "frequency points"
 
     @property
+    def restitution(self) -> float:
+        """R [-] of the problem's stops."""
+        return stop_values(self.problem)[1]
+
+    @property
     def progress_total(self) -> float:
         """One unit per branch set."""
         return 1.0
 
     def key(self) -> str:
         """Hash of everything that determines the result."""
-        return case_key({"kind": "bifurcation_branches", "system": asdict(self.system), "amplitude": self.amplitude, "clearance": self.clearance,
-                         "restitution": self.restitution, "band": [self.low, self.high], "options": dict(self.options),
+        return case_key({"kind": "bifurcation_branches", "problem": asdict(self.problem), "band": [self.low, self.high], "options": dict(self.options),
                          "seeds": [asdict(seed) for seed in self.seeds]})  # fmt: skip
 
     def run(self, report: ProgressReport | None = None) -> CaseResult:
         """The branches' and special points' arrays."""
         options = dict(self.options)
         brute_force = bool(options.pop("brute_force", True))
-        found = find_branches(self.system, self.amplitude, self.clearance, self.restitution, self.low, self.high, **options)
+        found = find_branches(self.problem, self.low, self.high, **options)
         if brute_force and self.seeds:
             settings = ContinuationSettings(lower=self.low, upper=self.high, max_steps=int(options.get("max_steps", 2000)), max_step=float(options.get("max_step", 0.1)))
-            seed_branches(found, self.system, self.amplitude, self.clearance, self.restitution, self.low, self.high, self.seeds, settings)
-        return branch_arrays(found)
+            seed_branches(found, self.problem, self.low, self.high, self.seeds, settings)
+        return branch_arrays(found, self.problem.size)
 
 
-def branch_arrays(found: OrbitSet) -> CaseResult:
-    """Flat arrays of an :class:`OrbitSet` (one row per branch point, one per special point)."""
+def branch_arrays(found: OrbitSet, size: int) -> CaseResult:
+    """Flat arrays of an :class:`OrbitSet` of a structure of ``size`` coordinates (one row per branch point, one per
+    special point; amplitudes (rows, N), multipliers (rows, 2N))."""
 
     def column(rows: list[dict], name: str, dtype: type = float) -> np.ndarray:
         return np.array([row[name] for row in rows], dtype=dtype)
@@ -202,16 +208,18 @@ def branch_arrays(found: OrbitSet) -> CaseResult:
             out[i, : row["velocities"].size] = row["velocities"]
         return out
 
+    def table(rows: list[dict], name: str, width: int, dtype: type = float) -> np.ndarray:
+        return np.array([row[name] for row in rows], dtype=dtype).reshape(-1, width)
+
     points, specials = found.points, found.specials
-    pm = np.array([row["multipliers"] for row in points]).reshape(-1, 4)
-    sm = np.array([row["multipliers"] for row in specials]).reshape(-1, 4)
+    pm, sm = table(points, "multipliers", 2 * size, complex), table(specials, "multipliers", 2 * size, complex)
     return {
         "branch": column(points, "branch", int), "origin": column(points, "origin", int), "frequency": column(points, "frequency"),
-        "x1_amplitude": column(points, "x1_amplitude"), "x2_amplitude": column(points, "x2_amplitude"), "impulse": column(points, "impulse"),
+        "amplitudes": table(points, "amplitudes", size), "impulse": column(points, "impulse"),
         "floquet_modulus": column(points, "floquet_modulus"), "stable": column(points, "stable", int), "impacts": column(points, "impacts", int),
         "period": column(points, "period", int), "multipliers_real": pm.real, "multipliers_imag": pm.imag, "velocities": velocities(points),
         "sp_branch": column(specials, "branch", int), "sp_kind": column(specials, "kind", int), "sp_frequency": column(specials, "frequency"),
-        "sp_x1_amplitude": column(specials, "x1_amplitude"), "sp_impulse": column(specials, "impulse"),
+        "sp_amplitudes": table(specials, "amplitudes", size), "sp_impulse": column(specials, "impulse"),
         "sp_floquet_modulus": column(specials, "floquet_modulus"), "sp_impacts": column(specials, "impacts", int),
         "sp_period": column(specials, "period", int), "sp_multipliers_real": sm.real, "sp_multipliers_imag": sm.imag,
         "sp_note": np.array([row["note"] for row in specials], dtype=str), "notes": np.array(found.notes, dtype=str),
@@ -220,12 +228,10 @@ def branch_arrays(found: OrbitSet) -> CaseResult:
 
 @dataclass(frozen=True, eq=False)
 class ChartCase:
-    """Curves of special points in (frequency, clearance) at one restitution, from the branches at ``clearance``."""
+    """Curves of special points in (frequency, clearance) at ``problem``'s restitution, from the branches at its
+    clearance."""
 
-    system: TwoDofSystem
-    amplitude: float
-    clearance: float
-    restitution: float
+    problem: ImpactProblem
     low: float
     high: float
     clearance_range: tuple[float, float]
@@ -242,11 +248,12 @@ class ChartCase:
 
     def key(self) -> str:
         """Hash of everything that determines the result."""
-        return case_key({"kind": "bifurcation_chart", **{k: v for k, v in asdict(self).items() if k != "system"}, "system": asdict(self.system)})
+        return case_key({"kind": "bifurcation_chart", **asdict(self)})
 
     def run(self, report: ProgressReport | None = None) -> CaseResult:
         """The curves as flat arrays (one row per curve point)."""
-        found = find_branches(self.system, self.amplitude, self.clearance, self.restitution, self.low, self.high, grazing=False, linear=False)
+        found = find_branches(self.problem, self.low, self.high, grazing=False, linear=False)
+        clearance = stop_values(self.problem)[0]
         low_c, high_c = self.clearance_range
         bounds = {"clearance": (low_c, high_c), "frequency": (self.low, self.high)}
         settings = ContinuationSettings(max_steps=self.max_steps, max_step=0.2)
@@ -254,7 +261,7 @@ class ChartCase:
         notes = list(found.notes)
         curve = 0
         if "grazing" in self.kinds:
-            for f, d in _grazing_curves(self.system, self.amplitude, self.low, self.high, low_c, high_c):
+            for f, d in _grazing_curves(self.problem, self.low, self.high, low_c, high_c):
                 rows += [(curve, SPECIAL_POINT_KINDS.index("grazing"), fi, di) for fi, di in zip(f, d)]
                 curve += 1
         for mapping, branch in found.maps:
@@ -262,8 +269,8 @@ class ChartCase:
             for point in branch.special_points:
                 kind = SPECIAL_POINT_KINDS.index(point.kind)
                 if point.kind not in self.kinds or (point.kind == "grazing" and "velocity" in point.note):
-                    continue  # the one-impact orbit's vanishing impact: the closed-form curve above
-                if any(k == kind and abs(f - point.value) < 1e-3 and abs(d - self.clearance) < 1e-6 for _c, k, f, d in rows):
+                    continue  # the closed-form orbit's vanishing impact: the linear-response curve above
+                if any(k == kind and abs(f - point.value) < 1e-3 and abs(d - clearance) < 1e-6 for _c, k, f, d in rows):
                     continue  # on a curve already followed
                 try:
                     if point.kind == "grazing":  # not differentiable there: located again at each clearance
@@ -283,11 +290,13 @@ class ChartCase:
         return {"curve": table[:, 0].astype(int), "kind": table[:, 1].astype(int), "frequency": table[:, 2], "clearance": table[:, 3], "notes": np.array(notes, dtype=str)}
 
 
-def _grazing_curves(system: TwoDofSystem, amplitude: float, low: float, high: float, low_c: float, high_c: float, step: float = 0.01) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Delta = q |H12(f)| over the band, split where it leaves [low_c, high_c]: where the one-impact orbit's impact
-    velocity vanishes and the linear orbit touches the stop."""
+def _grazing_curves(problem: ImpactProblem, low: float, high: float, low_c: float, high_c: float, step: float = 0.01) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Delta = max_k (|n_k H F(f)| + n_k K^-1 F0) over the band (q |H12(f)| on the paper's layout), split where it
+    leaves [low_c, high_c]: where the closed-form orbit's impact velocity vanishes and the linear orbit touches a stop
+    (every stop sharing the clearance Delta)."""
     f = np.arange(low, high + 0.5 * step, step)
-    d = amplitude * np.abs(system.receptances(2.0 * np.pi * f).h12)
+    linear = linear_amplitudes(problem, 2.0 * np.pi * f)
+    d = np.max(np.abs(linear.stops) + linear.stop_static, axis=-1)
     inside = (d >= low_c) & (d <= high_c)
     runs = np.split(np.flatnonzero(inside), np.flatnonzero(np.diff(np.flatnonzero(inside)) > 1) + 1)
     return [(f[r], d[r]) for r in runs if r.size > 1]

@@ -24,15 +24,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.engines.exact import ExactEngine
-from vibroimpact.model.contact import RigidStop
-from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.orbits.branch import lower_period_maps
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
 from vibroimpact.orbits.maps import ImpactMap, orbit_measures, resection
 from vibroimpact.orbits.shooting import ShootingError, shoot
-from vibroimpact.study.bifurcation_branches import OrbitSet, map_bounds
+from vibroimpact.study.bifurcation_branches import OrbitSet, map_bounds, problem_at, stop_values
 
 __all__ = ["Seed", "MAX_SEEDED_BRANCHES", "SEEDED_MAX_STEPS", "sweep_seeds", "seed_branches"]
 
@@ -45,13 +42,13 @@ SEEDED_MAX_STEPS = 600
 
 @dataclass(frozen=True)
 class Seed:
-    """A brute-force point whose strobes repeat: frequency [Hz], period k [excitation periods], the state at the
-    strobe (t = 0 mod T, force phase 0) [m, m, m/s, m/s], and the run of like points it belongs to (sweep, first
-    and last frequency index)."""
+    """A brute-force point whose strobes repeat: frequency [Hz], period k [excitation periods], the state (x, x') at
+    the strobe (t = 0 mod T, the problem's force phase) [m, m s-1], 2N entries, and the run of like points it belongs
+    to (sweep, first and last frequency index)."""
 
     frequency: float
     period: int
-    state: tuple[float, float, float, float]
+    state: tuple[float, ...]
     run: tuple[int, int, int] = (0, 0, 0)
 
 
@@ -66,7 +63,7 @@ def sweep_seeds(frequency: NDArray[np.float64], period: NDArray[np.int_], impact
         The period its strobes repeat with (0: they do not).
     impacts : ndarray, shape (n,)
         Impacts per excitation period.
-    state : ndarray, shape (n, 4)
+    state : ndarray, shape (n, 2N)
         The end state at each frequency (a strobe).
     sweep : int
         A label of the sweep (kept in each seed's ``run``).
@@ -86,7 +83,7 @@ def sweep_seeds(frequency: NDArray[np.float64], period: NDArray[np.int_], impact
     for a, b in runs:
         middle = (a + b) // 2
         for k in range(a, b + 1):
-            seed = Seed(float(frequency[k]), kind[k][0], tuple(float(x) for x in state[k]), (sweep, a, b))  # type: ignore[arg-type]
+            seed = Seed(float(frequency[k]), kind[k][0], tuple(float(x) for x in state[k]), (sweep, a, b))
             (first if k == middle else rest).append(seed)
     first.sort(key=lambda s: s.run[1] - s.run[2])  # the longest runs (the most robust attractors) first
     rest.sort(key=lambda s: abs(s.frequency - 0.5 * (frequency[s.run[1]] + frequency[s.run[2]])))
@@ -94,11 +91,30 @@ def sweep_seeds(frequency: NDArray[np.float64], period: NDArray[np.int_], impact
 
 
 def seed_branches(
-    found: OrbitSet, system: TwoDofSystem, amplitude: float, clearance: float, restitution: float, low: float, high: float,
+    found: OrbitSet, problem: ImpactProblem, low: float, high: float,
     seeds: Sequence[Seed], settings: ContinuationSettings, max_branches: int = MAX_SEEDED_BRANCHES, progress: Callable[[str], None] | None = None,
 ) -> int:  # fmt: skip
-    """Continue a branch from every seed no known branch passes through (module docstring); return how many."""
+    """Continue a branch from every seed no known branch passes through (module docstring); return how many.
+
+    Parameters
+    ----------
+    found : OrbitSet
+        The branches known so far; the new ones are added.
+    problem : ImpactProblem
+        Structure, rigid stops (the sweep's restitution and clearance) and harmonic load, as the sweep ran it.
+    low, high : float
+        The band [Hz].
+    seeds : sequence of Seed
+        From :func:`sweep_seeds`, in the order to try.
+    settings : ContinuationSettings
+        Of the continuation (its steps capped at :data:`SEEDED_MAX_STEPS`).
+    max_branches : int
+        Most branches added.
+    progress : callable, optional
+        Gets a line per branch.
+    """
     engine = ExactEngine()
+    restitution = stop_values(problem)[1]
     bounds = map_bounds(low, high)
     settings = dataclasses.replace(settings, max_steps=min(settings.max_steps, SEEDED_MAX_STEPS))
     added, skipped, failed, unstable = 0, 0, 0, 0
@@ -106,8 +122,8 @@ def seed_branches(
         if added >= max_branches:
             found.notes.append(f"brute-force seeds: stopped after {max_branches} new branches ({len(seeds)} seeds)")
             break
-        problem = ImpactProblem(system, RigidStop(clearance, restitution), HarmonicForce(amplitude, seed.frequency))
-        sweep_map = ImpactMap(problem, seed.period, engine, bounds)
+        at = problem_at(problem, seed.frequency)
+        sweep_map = ImpactMap(at, seed.period, engine, bounds)
         try:
             orbit = shoot(sweep_map, np.array(seed.state), sweep_map.parameters)
         except ShootingError:
@@ -116,7 +132,7 @@ def seed_branches(
         period = seed.period
         for d, lower in reversed(lower_period_maps(sweep_map)):  # a slowly settled point may repeat after a multiple
             if np.max(np.abs(lower.evaluate(orbit.state, orbit.parameters).image - orbit.state) / sweep_map.state_scale) < 1e-7:
-                period, sweep_map = d, ImpactMap(problem, d, engine, bounds)
+                period, sweep_map = d, ImpactMap(at, d, engine, bounds)
                 orbit = shoot(sweep_map, orbit.state, sweep_map.parameters)
                 break
         if not orbit.stable:  # not the attractor the sweep settled on (its strobes only nearly repeated)
@@ -128,7 +144,7 @@ def seed_branches(
             skipped += 1
             continue
         try:
-            moved, state = resection(problem, orbit.state, period, engine)
+            moved, state = resection(at, orbit.state, period, engine)
             mapping = ImpactMap(moved, period, engine, bounds)
             start = shoot(mapping, state, mapping.parameters)
             branch = continue_branch(mapping, start, "frequency", settings)
