@@ -39,8 +39,8 @@ class SweepCase:
 
     Attributes
     ----------
-    system : TwoDofSystem or LinearStructure
-        The linear structure.
+    system : Structure
+        The linear structure: the paper's named system or matrices with named coordinates.
     amplitude : float
         q [N].
     stops : tuple of Stop
