@@ -278,6 +278,6 @@ def test_the_closed_form_coexists_only_where_it_is_another_orbit(simulated: floa
     put(ds, at(ds, "pgf", 0, 0, 24.0), x1_amplitude=3e-3, regime=int(Regime.ONE_IMPACT), stable=1, impacts_per_period=1.0)
     put(ds, at(ds, "exact", 0, 0, 24.0), x1_amplitude=simulated, regime=int(Regime.ONE_IMPACT), converged=1, impacts_per_period=1.0)
     worst, realised, larger = worst_stable_x1(ds, "exact")
-    k = int(np.flatnonzero(F == 24.0)[0])
+    k = int(np.flatnonzero(F == 24.0)[0])  # exact: 24.0 is a value of the synthetic grid F
     assert bool(realised[0, 0, k]) and bool(larger[0, 0, k]) is closed_form_larger
     assert worst[0, 0, k] == pytest.approx(3e-3 if closed_form_larger else simulated, rel=1e-15)

@@ -17,9 +17,8 @@ from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, MOTION_QUANTITIES, Scene
 from vibroimpact.scene.variables import SWEEP_STAT_ATTRIBUTES, SWEEP_TIME_ATTRIBUTES, quantity_attributes, running_attributes, swept_attributes
 from vibroimpact.study.cost_model import Costs, EnginePart, Estimate, grid_estimate
-from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates, solve_each, steady_variable
+from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates, no_one_impact_orbit, solve_each, steady_variable
 from vibroimpact.study.runner import Runner
-from vibroimpact.study.solutions import no_one_impact_orbit
 from vibroimpact.simulation.swept import SWEEP_QUANTITIES
 from vibroimpact.study.swept_cases import SWEEP_STATS, SweepCase
 
