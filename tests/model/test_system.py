@@ -93,3 +93,34 @@ def test_invalid_parameters_name_the_field(field: str, value: float, fragment: s
     params[field] = value
     with pytest.raises(ValueError, match=__import__("re").escape(fragment)):
         TwoDofSystem(**params)
+
+
+def test_named_view_of_a_chain_written_as_matrices(system: TwoDofSystem) -> None:
+    """The paper's system written as matrices has the named view: the same parameters (K1, B1 to round-off)."""
+    from vibroimpact.model.structure import LinearStructure
+
+    written = LinearStructure([[1.0, 0.0], [0.0, 0.1]], [[29300.0, -4300.0], [-4300.0, 4300.0]], [[0.88, -0.08], [-0.08, 0.08]], ("x1", "x2"))
+    named = TwoDofSystem.of(written)
+    assert named is not None
+    np.testing.assert_allclose(list(named.as_dict().values()), [1.0, 0.1, 25000.0, 4300.0, 0.8, 0.08], rtol=1e-15)
+    assert TwoDofSystem.of(system) is system
+    assert TwoDofSystem.of(system.structure) == system
+
+
+@pytest.mark.parametrize(
+    ("mass", "stiffness", "damping", "names"),
+    [
+        ([[1.0, 0.0], [0.0, 0.1]], [[29300.0, -4300.0], [-4300.0, 4300.0]], [[0.88, -0.08], [-0.08, 0.08]], ("primary", "absorber")),  # other names
+        ([[0.1, 0.0], [0.0, 1.0]], [[4300.0, -4300.0], [-4300.0, 29300.0]], [[0.08, -0.08], [-0.08, 0.88]], ("x1", "x2")),  # absorber first
+        ([[1.0, 0.0], [0.0, 0.1]], [[29300.0, -4300.0], [-4300.0, 5300.0]], [[0.88, -0.08], [-0.08, 0.08]], ("x1", "x2")),  # absorber grounded too
+        ([[1.0, 0.0], [0.0, 0.1]], [[4300.0, -4300.0], [-4300.0, 4300.0]], [[0.08, -0.08], [-0.08, 0.08]], ("x1", "x2")),  # no suspension (K1 = 0)
+        ([[1.0, 0.01], [0.01, 0.1]], [[29300.0, -4300.0], [-4300.0, 4300.0]], [[0.88, -0.08], [-0.08, 0.08]], ("x1", "x2")),  # coupled masses
+        ([[1.0, 0.0], [0.0, 0.1]], [[29300.0, -4300.0], [-4300.0, 4300.0]], [[0.88, -0.08], [-0.08, 0.1]], ("x1", "x2")),  # dashpot to ground
+        ([[1.0, 0, 0], [0, 1.0, 0], [0, 0, 0.1]], [[2e4, -1e4, 0], [-1e4, 1.5e4, -5e3], [0, -5e3, 5e3]], [], ("x1", "x2", "x3")),  # three masses
+    ],
+)
+def test_no_named_view_of_other_structures(mass: list, stiffness: list, damping: list, names: tuple[str, ...]) -> None:
+    """Anything but the two-mass chain with coordinates x1 (primary) and x2 (absorber) has no named view."""
+    from vibroimpact.model.structure import LinearStructure
+
+    assert TwoDofSystem.of(LinearStructure(mass, stiffness, tuple(map(tuple, damping)), names)) is None

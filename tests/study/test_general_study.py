@@ -1,4 +1,4 @@
-"""Studies of general scenes: the paper written with matrices gives the paper's dataset; relative, two-sided and
+"""Stepped studies of any layout: the paper written with matrices gives the paper's dataset; relative, two-sided and
 3-dof layouts give outputs named after their coordinates and stops."""
 
 from __future__ import annotations
@@ -46,8 +46,9 @@ def test_paper_in_general_form_equals_named_form(paper_pair: tuple[xr.Dataset, x
             xr.testing.assert_equal(named[name], general[name])
         else:
             xr.testing.assert_allclose(named[name], general[name], rtol=1e-10, atol=1e-300)
-    assert general.attrs["scene_format"] == "general"
-    assert general.attrs["stop_layout"] == "x2 <= Delta"
+    assert general.attrs["stop_layout"] == named.attrs["stop_layout"] == "x2 <= Delta"
+    different = {key for key in set(named.attrs) | set(general.attrs) if str(named.attrs.get(key)) != str(general.attrs.get(key))}
+    assert different == {"title", "scene_name"}, "one dataset layout: the same attributes, named ones included"
 
 
 def test_paper_general_form_has_one_impact_orbits(paper_pair: tuple[xr.Dataset, xr.Dataset]) -> None:

@@ -13,7 +13,7 @@ import pytest
 from vibroimpact.scene import parse_scene
 from vibroimpact.study.blocks import SIMULATED_POINTS, plan_blocks
 from vibroimpact.study.runner import Runner, _run_cases
-from vibroimpact.study.stepped import paper_block
+from vibroimpact.study.general_stepped import general_block
 from vibroimpact.study.store import StudyStore
 
 from tests.study.test_estimate import small_scene
@@ -38,9 +38,9 @@ def _exact_scene():
 
 def test_the_runner_costs_under_a_tenth_of_an_exact_block(tmp_path: Path) -> None:
     scene = _exact_scene()
-    paper_block(scene, Runner(progress=False))  # compile and warm the caches
+    general_block(scene, Runner(progress=False))  # compile and warm the caches
     started = time.perf_counter()
-    block = paper_block(scene, Runner(progress=False))
+    block = general_block(scene, Runner(progress=False))
     points = scene.restitution.size * scene.simulation.frequency.size
     per_point = (time.perf_counter() - started) / points  # closed forms included: what a block of the grid costs
     smallest = SIMULATED_POINTS[0] * per_point

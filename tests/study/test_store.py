@@ -21,7 +21,7 @@ from vibroimpact.scene.schema import GRID_DIMS
 from vibroimpact.study.blocks import BlockPlan, block_scene, plan_blocks
 from vibroimpact.study.run import run_study
 from vibroimpact.study.runner import Runner
-from vibroimpact.study.stepped import paper_block
+from vibroimpact.study.general_stepped import general_block
 from vibroimpact.study.store import OutputBusy, StudyStore, claim_output, store_fingerprint
 
 from tests.study.test_estimate import small_scene
@@ -52,12 +52,12 @@ def _grid_scene(**changes: object):
 def test_a_block_is_the_same_scene_on_fewer_points() -> None:
     """Every variable of every block equals the whole grid's values at the block's points (closed forms: pointwise)."""
     scene = _grid_scene()
-    whole = paper_block(scene, Runner(progress=False))
+    whole = general_block(scene, Runner(progress=False))
     plan = BlockPlan(plan_blocks(scene, 1).full, (2, 1, 1, 1, 30))
     assert plan.count == 2 * 2 * 3
     for index in range(plan.count):
         region = plan.region(index)
-        part = paper_block(block_scene(scene, region), Runner(progress=False))
+        part = general_block(block_scene(scene, region), Runner(progress=False))
         for name, variable in part.data_vars.items():
             expected = whole[name].isel(region).values
             np.testing.assert_allclose(variable.values.astype(float), expected.astype(float), rtol=1e-15, atol=0.0, equal_nan=True, err_msg=name)

@@ -13,6 +13,7 @@ import pytest
 import xarray as xr
 
 from vibroimpact import cli
+from vibroimpact.reporting.general_record import is_general
 from vibroimpact.scene import SceneError, parse_scene
 from vibroimpact.study.run import run_study
 
@@ -77,7 +78,7 @@ def test_the_paper_layout_as_matrices_gives_the_named_forms_dataset() -> None:
     general_document.pop("stop")
     general_document["stops"] = [{"coordinate": "x2", "side": "upper", "clearance": 0.003, "restitution": 0.2}]
     general = run_study(parse_scene(general_document), progress=None)
-    assert general.attrs["scene_format"] == "general" and "scene_format" not in named.attrs
+    assert general.attrs["system_coordinates"] == named.attrs["system_coordinates"] == "x1 x2"  # both record their layout
     assert set(general.data_vars) == set(named.data_vars)
     assert np.nanmax(named["swept_impacts_per_period"].values) >= 1.0  # the sweep reaches the stop
     for name in named.data_vars:
@@ -100,7 +101,7 @@ def relative_run() -> xr.Dataset:
 @pytest.mark.timeout(120)
 def test_relative_stops_sweep_names_each_coordinate_and_stop(relative_run: xr.Dataset) -> None:
     ds = relative_run
-    assert ds.attrs["scene_format"] == "general" and ds.attrs["stop_count"] == 2
+    assert is_general(ds) and ds.attrs["stop_count"] == 2
     assert ds["swept_x1_amplitude"].dims == ("sweep", "frequency") and ds["swept_x2_rms"].dims == ("sweep", "frequency")
     assert ds["swept_impulse"].dims == ("stop", "sweep", "frequency") and ds["impulse"].dims == ("solution", "stop", "frequency")
     assert ds["running_impulse"].dims == ("stop", "sweep", "elapsed_time") and ds["running_x2_amplitude"].dims == ("sweep", "elapsed_time")

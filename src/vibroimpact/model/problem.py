@@ -129,6 +129,13 @@ class ImpactProblem:
         return (self.size == 2 and len(stops) == 1 and stops[0].coordinate == 1 and stops[0].other is None and stops[0].side == "upper"
                 and weights_ok and static_ok and not base)  # fmt: skip
 
+    @property
+    def named_system(self) -> TwoDofSystem | None:
+        """The paper's named system where this problem is the paper's layout on it (:attr:`paper_layout` on a
+        structure with the named view, :meth:`TwoDofSystem.of`): where the paper's own routes (its curve-fitted PGF)
+        apply. None otherwise."""
+        return TwoDofSystem.of(self.system) if self.paper_layout else None
+
     def normals(self) -> NDArray[np.float64]:
         """n of every stop, shape (K, N): gap_k = Delta_k - n_k . x."""
         return np.array([stop.normal(self.size) for stop in self.stops]).reshape(-1, self.size)

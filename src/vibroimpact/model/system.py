@@ -77,6 +77,42 @@ class TwoDofSystem:
         for name in ("b1", "b2"):
             require_non_negative(f"system.{name}", getattr(self, name))
 
+    @classmethod
+    def of(cls, structure: "TwoDofSystem | LinearStructure") -> "TwoDofSystem | None":
+        """The named view of ``structure``: the paper's two-mass chain it is, or None if it is not one.
+
+        A :class:`LinearStructure` is the named system when its coordinates are ``x1`` (primary) and ``x2``
+        (absorber), its mass matrix is diagonal, and its stiffness and damping matrices are those of a suspension
+        (K1, B1: base to x1) and an absorber spring and dashpot (K2, B2: x1 to x2) and nothing else::
+
+            K = [[K1 + K2, -K2], [-K2, K2]],  C = [[B1 + B2, -B2], [-B2, B2]],  K1, K2 > 0,  B1, B2 >= 0
+
+        The absorber's row is compared exactly (a chain written in a scene repeats the same number); K1 = K[0, 0] - K2
+        and B1 = C[0, 0] - B2 [SI]. This is the one place that decides whether a structure has the named view (its
+        parameters m1 ... b2, natural and anti-resonance frequencies, the paper's fit of H22).
+
+        Parameters
+        ----------
+        structure : TwoDofSystem or LinearStructure
+            A named system (returned as it is) or any structure.
+
+        Returns
+        -------
+        TwoDofSystem or None
+            The named system with the same matrices (K1 and B1 to round-off), or None.
+        """
+        if isinstance(structure, TwoDofSystem):
+            return structure
+        if structure.size != 2 or tuple(structure.coordinates) != ("x1", "x2"):
+            return None
+        m, k, c = structure.mass_matrix, structure.stiffness_matrix, structure.damping_matrix
+        k2, b2 = -float(k[0, 1]), -float(c[0, 1])
+        chain = m[0, 1] == 0.0 and m[1, 0] == 0.0 and k[1, 0] == k[0, 1] and c[1, 0] == c[0, 1] and k[1, 1] == k2 and c[1, 1] == b2  # exact: see above
+        k1, b1 = float(k[0, 0]) - k2, float(c[0, 0]) - b2
+        if not (chain and k1 > 0.0 and k2 > 0.0 and b1 >= 0.0 and b2 >= 0.0):
+            return None
+        return cls(m1=float(m[0, 0]), m2=float(m[1, 1]), k1=k1, k2=k2, b1=b1, b2=b2)
+
     # ------------------------------------------------------------------ matrices
     @property
     def mass_matrix(self) -> NDArray[np.float64]:

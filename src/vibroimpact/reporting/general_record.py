@@ -1,5 +1,10 @@
-"""What a report knows of a general scene's structure, load and stops, read from its dataset's attributes
-(written by :func:`vibroimpact.study.grid.layout_attributes`); nothing is re-validated from the scene text."""
+"""What a report knows of a stepped study's structure, load and stops, read from its dataset's attributes
+(written by :func:`vibroimpact.study.grid.layout_attributes`); nothing is re-validated from the scene text.
+
+:func:`named_layout` says whether the study had the paper's layout on its named system, however its scene wrote it:
+the model decides (:attr:`vibroimpact.model.problem.ImpactProblem.named_system`) on the layout rebuilt from the
+attributes; a dataset written before the layout was recorded is a study of the paper's named scenes.
+"""
 
 from __future__ import annotations
 
@@ -9,14 +14,42 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.stops import Stop
 from vibroimpact.model.structure import LinearStructure
+from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["GeneralSetting", "general_setting", "is_general"]
+__all__ = ["GeneralSetting", "general_setting", "named_layout", "is_general"]
+
+_NAMED_KEYS = ("m1", "m2", "k1", "k2", "b1", "b2")
+
+
+def named_layout(dataset: xr.Dataset) -> TwoDofSystem | None:
+    """The named system where ``dataset``'s study had the paper's layout on it (two-mass chain, one upper stop on x2,
+    force on x1); None otherwise. Datasets without the layout attributes (written before they were recorded) are
+    studies of the paper's named scenes: their ``system_m1`` ... ``system_b2``."""
+    attrs = dataset.attrs
+    if "system_size" not in attrs:
+        return TwoDofSystem(**{key: float(attrs[f"system_{key}"]) for key in _NAMED_KEYS}) if "system_m1" in attrs else None
+    size = int(attrs["system_size"])
+    sides = str(attrs["stop_side"]).split()
+    coordinate = np.atleast_1d(np.asarray(attrs["stop_coordinate"], dtype=int))
+    other = np.atleast_1d(np.asarray(attrs["stop_other"], dtype=int))
+    # the layout does not depend on the clearances and restitutions: any valid values stand in for them
+    stops = tuple(Stop(RigidStop(1e-3, 0.5), coordinate=int(i), other=None if j < 0 else int(j), side=side) for i, j, side in zip(coordinate, other, sides))
+    weights = tuple(float(w) for w in np.atleast_1d(np.asarray(attrs["excitation_weights"], dtype=float)))
+    static = tuple(float(f) for f in np.atleast_1d(np.asarray(attrs["excitation_static_N"], dtype=float)))
+    base_motion = attrs.get("excitation_kind") == "base_motion"  # loads every coordinate through its mass: no weights
+    force = HarmonicForce(float(attrs["excitation_amplitude_N"]), 1.0, weights=weights if len(weights) == size and not base_motion else None, static=static if len(static) == size else None, base_motion=base_motion)
+    return ImpactProblem(_structure(attrs), stops, force).named_system
 
 
 def is_general(dataset: xr.Dataset) -> bool:
-    """Was the dataset written from a general scene (its attribute ``scene_format``)?"""
-    return dataset.attrs.get("scene_format") == "general"
+    """Does ``dataset`` record a layout (its structure, load and stops) that is not the paper's, so that its page
+    draws every coordinate and stop by name? The paper's layout, however its scene wrote it, is not general."""
+    return "system_size" in dataset.attrs and named_layout(dataset) is None
 
 
 @dataclass(frozen=True, eq=False)
@@ -85,12 +118,7 @@ def general_setting(dataset: xr.Dataset) -> GeneralSetting:
     """The :class:`GeneralSetting` of a general study's ``dataset`` (``KeyError`` naming a missing attribute)."""
     attrs = dataset.attrs
     size = int(attrs["system_size"])
-    names = tuple(str(attrs["system_coordinates"]).split())
-
-    def matrix(key: str) -> np.ndarray:
-        return np.asarray(attrs[key], dtype=float).reshape(size, size)
-
-    structure = LinearStructure(matrix("system_mass_kg"), matrix("system_stiffness_N_per_m"), matrix("system_damping_N_s_per_m"), names)
+    structure = _structure(attrs)
     coordinate = np.atleast_1d(np.asarray(attrs["stop_coordinate"], dtype=int))
     other = np.atleast_1d(np.asarray(attrs["stop_other"], dtype=int))
     sides = str(attrs["stop_side"]).split()
@@ -116,6 +144,17 @@ def general_setting(dataset: xr.Dataset) -> GeneralSetting:
         solutions=tuple(str(s) for s in dataset["solution"].values) if "solution" in dataset.coords else (),
         clearances=clearances,
     )
+
+
+def _structure(attrs: dict) -> LinearStructure:
+    """The structure of the attributes ``system_size``, ``system_coordinates`` and the flattened matrices."""
+    size = int(attrs["system_size"])
+
+    def matrix(key: str) -> np.ndarray:
+        return np.asarray(attrs[key], dtype=float).reshape(size, size)
+
+    names = tuple(str(attrs["system_coordinates"]).split())
+    return LinearStructure(matrix("system_mass_kg"), matrix("system_stiffness_N_per_m"), matrix("system_damping_N_s_per_m"), names)
 
 
 #: The bound of a stop's description (:func:`vibroimpact.scene.layout.describe_stop`): ``<= 3 mm``, ``>= -2 mm``.

@@ -17,10 +17,11 @@ the kind of study, in this one place:
   (:class:`~vibroimpact.reporting.design_page.DesignMapPage`);
 * stepped studies with a swept bumper frequency: convergence of the compliant bumper to the rigid stop
   (:class:`~vibroimpact.reporting.bumper_page.BumperStiffnessPage`);
-* stepped studies of general scenes (any structure and stops): one curve per coordinate and per stop, the layout in
-  words (:class:`~vibroimpact.reporting.general_page.GeneralResponsePage`);
-* other stepped studies: frequency responses, regimes, stability, simulations against the closed form, reduction
-  factors and resonance peaks (:class:`~vibroimpact.reporting.stepped_page.FrequencyResponsePage`).
+* other stepped studies, by what the dataset holds, not by how the scene was written: the paper's layout on its named
+  system (:func:`~vibroimpact.reporting.general_record.named_layout`): frequency responses, regimes, stability,
+  simulations against the closed form, reduction factors and resonance peaks
+  (:class:`~vibroimpact.reporting.stepped_page.FrequencyResponsePage`); any other structure and stops: one curve per
+  coordinate and per stop, the layout in words (:class:`~vibroimpact.reporting.general_page.GeneralResponsePage`).
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from vibroimpact.reporting.design_page import DesignMapPage  # noqa: E402
 from vibroimpact.reporting.validation_page import ValidationPage  # noqa: E402
 from vibroimpact.reporting.bumper_page import BumperStiffnessPage  # noqa: E402
 from vibroimpact.reporting.general_page import GeneralResponsePage  # noqa: E402
-from vibroimpact.reporting.general_record import is_general  # noqa: E402
+from vibroimpact.reporting.general_record import is_general, named_layout  # noqa: E402
 from vibroimpact.reporting.record import study_kind, study_record, study_setting  # noqa: E402
 from vibroimpact.reporting.stepped_page import FrequencyResponsePage  # noqa: E402
 from vibroimpact.reporting.sweep_page import GeneralSweptPage, SweptSinePage  # noqa: E402
@@ -71,7 +72,7 @@ def page_for(dataset: xr.Dataset) -> StudyPage:
         return BifurcationPage(dataset)
     if kind == "stepped" and dataset.attrs.get("report_page") == "design_map":
         return DesignMapPage(dataset)
-    if kind == "stepped" and is_general(dataset):
+    if kind == "stepped" and named_layout(dataset) is None:
         return GeneralResponsePage(dataset)
     if kind == "swept" and is_general(dataset):
         return GeneralSweptPage(dataset)

@@ -128,7 +128,7 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     sizes = [g.size for g in grids.values() if g is not None]
     if len(sizes) >= 3 and math.prod(sizes) > MAX_STUDY_POINTS:
         c.fail("sweep", f"{math.prod(sizes):,} points (product of the swept grids) is too many: allowed at most {MAX_STUDY_POINTS:,}")
-    if "pgf_paper" in solutions and not general and system is not None and (modes := underdamped_mode_count(system)) != 2:
+    if "pgf_paper" in solutions and system is not None and (named := TwoDofSystem.of(system)) is not None and (modes := underdamped_mode_count(named)) != 2:
         c.fail("solutions", f"pgf_paper needs two underdamped modes (the paper's eq. 10 fit); this system has {modes}")
     allowed = quantities_for(system.coordinates) if general and system is not None else QUANTITIES
     if len(set(allowed)) != len(allowed):

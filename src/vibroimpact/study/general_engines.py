@@ -1,7 +1,7 @@
-"""Steady states of the time-domain engines for a general scene: any structure, load and stops.
+"""Steady states of the time-domain engines over a stepped study's grid: any structure, load and stops.
 
-One case per (restitution, clearance, bumper) grid point and chunk of frequencies, as for the paper's layout
-(:func:`vibroimpact.study.solutions.simulated_values`); each stop's values come from itself or from the grid
+One case per (restitution, clearance, bumper) grid point and chunk of frequencies (a bumper engine runs once per
+bumper, the rigid engines once per (restitution, clearance)); each stop's values come from itself or from the grid
 (:func:`vibroimpact.scene.layout.build_stops`). States are 2 N wide; the measured fundamentals are per coordinate and
 the impulses, peaks and contact forces per stop. On a symmetric two-sided stop the flag ``one_impact`` means the
 closed form's kind of orbit, one impact per period on each side (as ``pgf`` flags it there).
@@ -9,20 +9,46 @@ closed form's kind of orbit, one impact per period on each side (as ``pgf`` flag
 
 from __future__ import annotations
 
-
 import numpy as np
 
+from vibroimpact.analysis.regime import Regime
 from vibroimpact.engines.registry import BUMPER, engine_spec
 from vibroimpact.scene.layout import build_stops
 from vibroimpact.scene.schema import Scene
 from vibroimpact.simulation.settings import SWEEP_STARTS
 from vibroimpact.study.cases import COMPLEX_FIELDS, COORDINATE_FIELDS, FIELDS, STOP_FIELDS, SimulationCase
 from vibroimpact.analysis.layout import closed_form_refusal
-from vibroimpact.study.general_values import _broadcast, coordinate_quantity, scene_problem
+from vibroimpact.study.general_values import broadcast_quantities, coordinate_quantity, scene_problem
+from vibroimpact.study.grid import no_one_impact_orbit
 from vibroimpact.study.runner import Runner
-from vibroimpact.study.solutions import CASE_CHUNK, no_one_impact_orbit, simulated_regime
 
-__all__ = ["general_simulated_values"]
+__all__ = ["general_simulated_values", "simulated_regime", "CASE_CHUNK"]
+
+#: Frequencies per simulation case when points are independent (load balancing between processes).
+CASE_CHUNK = 16
+
+
+def simulated_regime(fields: dict[str, np.ndarray], one_impact_orbit: np.ndarray) -> np.ndarray:
+    """The ``regime`` flag of simulated steady states from a case's measured fields (the arrays of the grid).
+
+    Not computed, failed, or: not converged -> the motion's own classification (quasi-periodic, chaotic) else
+    irregular; converged -> linear when there was neither an impact nor a contact force (a structure held on a stop
+    without impacts, by a preloading stop the force never lifts it from, is periodic motion with sticking, not
+    linear), one impact where ``one_impact_orbit`` (the closed form's kind of orbit: one impact per period, or one
+    on each side of a symmetric two-sided stop) holds at multiplicity 1, else periodic impacts.
+    """
+    computed = ~np.isnan(fields["converged"])
+    converged = fields["converged"] == 1.0
+    regime = np.full(fields["converged"].shape, Regime.NOT_COMPUTED, dtype=np.int8)
+    regime[computed & ~converged] = Regime.IRREGULAR
+    classified = computed & ~converged & ~np.isnan(fields["motion_regime"])
+    regime[classified] = fields["motion_regime"][classified].astype(np.int8)  # quasi_periodic, chaotic or irregular
+    regime[computed & converged] = Regime.PERIODIC_IMPACTS
+    held = np.abs(fields["contact_force"]) > 1e-9 * (np.abs(fields["suspension_force"]) + np.abs(fields["contact_force"]))
+    regime[computed & converged & (fields["impacts_per_period"] == 0.0) & ~held] = Regime.LINEAR
+    regime[computed & converged & (fields["multiplicity"] == 1.0) & one_impact_orbit] = Regime.ONE_IMPACT
+    regime[fields["failed"] == 1.0] = Regime.FAILED
+    return regime
 
 
 def _two_sided(scene: Scene) -> bool:
@@ -34,7 +60,7 @@ def _two_sided(scene: Scene) -> bool:
 
 
 def general_simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], runner: Runner) -> dict[str, np.ndarray]:
-    """Steady states of a time-domain engine on the simulation grid of a general scene; NaN at the other frequencies."""
+    """Steady states of a time-domain engine on the simulation grid of ``scene``; NaN at the other frequencies."""
     assert scene.simulation is not None
     sim = scene.simulation
     columns = np.searchsorted(scene.all_frequencies, sim.frequency)
@@ -95,4 +121,4 @@ def general_simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], 
         values[coordinate_quantity("x1_amplitude", name)] = np.abs(fields["displacements"][..., c])
         values[coordinate_quantity("x1_rms", name)] = fields["rms"][..., c]
         values[coordinate_quantity("one_impact_x1_amplitude", name)] = np.full(grid, np.nan)
-    return _broadcast(scene, values, grid)
+    return broadcast_quantities(scene, values, grid)

@@ -1,12 +1,14 @@
-"""What ``--estimate`` assumes for general scenes (any structure, load and stops).
+"""What ``--estimate`` assumes of a stepped scene's layout (any structure, load and stops).
 
-The costs were measured on the paper's layout (N = 2 coordinates, K = 1 stop). For N coordinates and K stops:
+The costs were measured on the paper's layout (N = 2 coordinates, K = 1 stop; the closed forms by its named route).
+For N coordinates and K stops:
 
 * an engine's cost per simulated period is scaled by (N / 2)^2 K: each step propagates 2N x 2N matrices (exact:
   eigenvector products; integrators: a Jacobian of that size, solved densely at this size) and checks every stop's
   gap (event functions, root bracketing);
 * a closed form's cost per grid point by 1.3 (N / 2)^2 (the general closed form, matrices instead of the named
   receptances: 7.3 s against 5.8 s for 30 000 points of the paper's layout, measured) and by K for ``linear``;
+  ``pgf_paper`` is still the named route (factor 1);
 * the periods each point integrates are predicted as for the paper's layout where a closed form applies (none where
   the linear motion stays clear of every stop, a short transient where a stable closed-form orbit exists, the full
   search elsewhere); where none applies (several stops that are not a symmetric pair, a free mass), a point whose
@@ -35,14 +37,12 @@ CLOSED_FORM_FACTOR = 1.3
 
 def engine_scale(scene: Scene) -> float:
     """(N / 2)^2 K: an engine's cost per period relative to the paper's layout's."""
-    if not scene.general:
-        return 1.0
     return (scene.system.size / 2.0) ** 2 * len(scene.stop_specs)
 
 
 def closed_form_scale(scene: Scene, solution: str) -> float:
-    """A closed form's cost per grid point relative to the paper's layout's."""
-    if not scene.general:
+    """A closed form's cost per grid point relative to the one measured on the paper's layout by its named route."""
+    if solution == "pgf_paper":
         return 1.0
     size = (scene.system.size / 2.0) ** 2
     return CLOSED_FORM_FACTOR * size * (len(scene.stop_specs) if solution == "linear" else 1.0)

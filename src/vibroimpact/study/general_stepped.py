@@ -1,8 +1,8 @@
-"""Stepped studies of general scenes: any structure, load and stops (the paper's named scenes keep
-:class:`vibroimpact.study.stepped.SteppedStudy`'s own path and outputs).
+"""The values of a stepped study, whichever way its scene writes the system (the paper's named form is the layout
+of a two-mass chain, one upper stop on x2 and a force on x1, and takes this path too): any structure, load and stops.
 
-Output: dimension ``solution``, the swept parameters and ``frequency`` as for the paper's scenes; one
-``<name>_amplitude`` and ``<name>_rms`` per coordinate; per-stop quantities (``impulse``, ``one_impact_impulse``,
+Output: dimension ``solution``, the swept parameters and ``frequency``; one ``<name>_amplitude`` and ``<name>_rms``
+per coordinate (``x1_amplitude``, ``x2_amplitude``, ... for the paper's layout); per-stop quantities (``impulse``, ``one_impact_impulse``,
 ``peak_contact_force``, ``peak_acceleration``) with a dimension ``stop`` (index in the scene's ``stops``) and its
 coordinate ``stop_description`` (e.g. ``x2 - x1 <= 3 mm, R = 0.2``) where the scene has several stops, without it
 where it has one. The structure, load and stop layout are attributes (:func:`vibroimpact.study.grid.layout_attributes`).
@@ -14,11 +14,10 @@ import numpy as np
 import xarray as xr
 
 from vibroimpact.scene.layout import stop_descriptions
-from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, STOP_QUANTITIES, Scene
+from vibroimpact.scene.schema import GRID_DIMS, STOP_QUANTITIES, Scene
 from vibroimpact.scene.variables import quantity_attributes
 from vibroimpact.study.general_engines import general_simulated_values
-from vibroimpact.study.general_values import general_linear_values, general_pgf_values
-from vibroimpact.study.grid import StudyGrid, grid_coordinates
+from vibroimpact.study.grid import StudyGrid, grid_coordinates, solve_each
 from vibroimpact.study.runner import Runner
 
 __all__ = ["general_block", "general_coordinates", "describe_stops", "general_quantity_attributes"]
@@ -27,7 +26,7 @@ _PER_COORDINATE = {"_amplitude": "x1_amplitude", "_rms": "x1_rms"}
 
 
 def general_quantity_attributes(quantity: str, scene: Scene) -> dict[str, object]:
-    """Units and long name of a general scene's quantity (per-coordinate names included)."""
+    """Units and long name of a stepped study's quantity (per-coordinate names included)."""
     relative = " relative to the base" if scene.load_spec.base_motion else ""
     for name in scene.coordinates:
         if quantity == f"{name}_amplitude":
@@ -45,18 +44,10 @@ def general_quantity_attributes(quantity: str, scene: Scene) -> dict[str, object
 
 
 def general_block(scene: Scene, runner: Runner) -> xr.Dataset:
-    """Every solution of a general ``scene`` (or of a block of one) over its unsqueezed grid, without coordinates or
-    metadata; per-stop quantities have the dimension ``stop`` where the scene has several stops."""
+    """Every solution of ``scene`` (or of a block of one) over its unsqueezed grid, without coordinates or metadata;
+    per-stop quantities have the dimension ``stop`` where the scene has several stops."""
     grid = StudyGrid.of(scene)
-    per_solution = []
-    for name in scene.solutions:
-        if name == "linear":
-            values = general_linear_values(scene, grid.omega, grid.base)
-        elif name in ENGINE_SOLUTIONS:
-            values = general_simulated_values(scene, name, grid.full, runner)
-        else:
-            values = general_pgf_values(scene, grid.omega, grid.delta, grid.r, grid.base)
-        per_solution.append(values)
+    per_solution = solve_each(scene, grid, lambda name: general_simulated_values(scene, name, grid.full, runner), None)
     count = len(scene.stop_specs)
     data_vars = {}
     for quantity in scene.quantities:
@@ -74,7 +65,7 @@ def general_block(scene: Scene, runner: Runner) -> xr.Dataset:
 
 
 def general_coordinates(scene: Scene, grid: StudyGrid) -> dict[str, object]:
-    """Coordinates of a general scene's dataset before squeezing: those of :func:`grid_coordinates`, and ``stop``
+    """Coordinates of a stepped study's dataset before squeezing: those of :func:`grid_coordinates`, and ``stop``
     with ``stop_description`` where the scene has several stops and writes a per-stop quantity."""
     coords = grid_coordinates(scene, grid, list(scene.solutions))
     count = len(scene.stop_specs)

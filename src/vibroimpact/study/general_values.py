@@ -26,7 +26,7 @@ from vibroimpact.scene.schema import MOTION_QUANTITIES, STOP_QUANTITIES, Scene
 from vibroimpact.scene.variables import STABLE_MARGINAL
 from vibroimpact.simulation.layout import base_force
 
-__all__ = ["general_linear_values", "general_pgf_values", "scene_problem", "stop_clearances", "coordinate_quantity"]
+__all__ = ["general_linear_values", "general_pgf_values", "scene_problem", "first_problem", "broadcast_quantities", "stop_clearances", "coordinate_quantity"]
 
 _IMPACT_REGIMES = (Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR)
 _LINEAR_REGIMES = (Regime.LINEAR, Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT, Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT)
@@ -49,7 +49,7 @@ def stop_clearances(scene: Scene) -> np.ndarray:
     return np.array([[spec.values(np.nan, float(d))[1] for spec in scene.stop_specs] for d in scene.clearance])
 
 
-def _first_problem(scene: Scene) -> ImpactProblem:
+def first_problem(scene: Scene) -> ImpactProblem:
     return scene_problem(scene, float(scene.all_frequencies[0]), float(scene.restitution[0]), float(scene.clearance[0]))
 
 
@@ -61,7 +61,7 @@ def _per_coordinate(scene: Scene, template: str, values: np.ndarray) -> dict[str
 def general_linear_values(scene: Scene, omega: np.ndarray, shape: tuple[int, ...]) -> dict[str, np.ndarray]:
     """The linear steady state (no stop) at ``omega`` [rad s-1] (axes of the full grid), flagged where it crosses a
     stop; the scene's quantities broadcast to ``shape`` (per-stop ones to (K, *shape))."""
-    problem = _first_problem(scene)
+    problem = first_problem(scene)
     linear = linear_amplitudes(problem, omega)
     x = linear.coordinates  # omega.shape + (N,)
     count = len(scene.stop_specs)
@@ -90,23 +90,24 @@ def general_linear_values(scene: Scene, omega: np.ndarray, shape: tuple[int, ...
         "wall_time": np.full(shape, np.nan),
         **{name: np.full(shape, np.nan) for name in MOTION_QUANTITIES},
     }
-    return _broadcast(scene, values, shape)
+    return broadcast_quantities(scene, values, shape)
 
 
-def _broadcast(scene: Scene, values: dict[str, np.ndarray], shape: tuple[int, ...]) -> dict[str, np.ndarray]:
-    """The scene's quantities, each broadcast to ``shape`` (per-stop ones to (K, *shape))."""
+def broadcast_quantities(scene: Scene, values: dict[str, np.ndarray], shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+    """The scene's quantities, each broadcast to ``shape`` (per-stop ones to (K, *shape)), or to a larger shape where a
+    value depends on more of the grid's axes (a peak estimate on the bumper axis)."""
     count = len(scene.stop_specs)
     out = {}
     for name in scene.quantities:
         target = (count, *shape) if name in STOP_QUANTITIES else shape
-        out[name] = np.broadcast_to(values[name], target)
+        out[name] = np.broadcast_to(values[name], np.broadcast_shapes(target, np.shape(values[name])))
     return out
 
 
 def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.ndarray, shape: tuple[int, ...]) -> dict[str, np.ndarray]:
     """The closed-form impact orbit at ``omega`` [rad s-1], clearance ``delta`` [m] and restitution ``r`` [-] where
     it is admissible (and stable), else the linear motion where that fits; NaN elsewhere (as for the paper's pgf)."""
-    problem = _first_problem(scene)
+    problem = first_problem(scene)
     w, d, rr = np.broadcast_arrays(omega, delta, r)
     orbit = solve_impact_orbit(problem, w, d, rr)
     linear = linear_amplitudes(problem, w)
@@ -166,25 +167,26 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
         makers[coordinate_quantity("x1_amplitude", name)] = lambda i=i: choose(np.abs(harmonics()[..., i]), np.abs(linear.coordinates[..., i]))
         makers[coordinate_quantity("x1_rms", name)] = lambda i=i: choose(rms()[..., i], linear_rms[..., i])
         makers[coordinate_quantity("one_impact_x1_amplitude", name)] = lambda i=i: np.where(orbit.exists, np.abs(harmonics()[..., i]), np.nan)
-    return _broadcast(scene, {q: makers[q]() for q in scene.quantities}, shape)
+    return broadcast_quantities(scene, {q: makers[q]() for q in scene.quantities}, shape)
 
 
 def _peak_estimates(scene: Scene, orbit: ImpactOrbit, count: int) -> tuple[np.ndarray, np.ndarray]:
-    """Peak bumper force [N] and peak deceleration of the stopped coordinate [m s-2] per stop, from the rigid impulse.
+    """Peak bumper force [N] and peak deceleration of the stopped coordinate [m s-2] per stop, from the rigid impulse,
+    on the grid's axes and the bumper's (a swept bumper frequency: one estimate per value).
 
     One collision of a bumper of the stop's effective mass, entered at J / (m_eff (1 + R)), peaks at
     Gamma(xi_b) Omega_b J / (1 + R); the deceleration is that force less the force the structure presses the stop with
     at the impact (the holding force n M^-1 (f - C x' - K x) m_eff, just before it), over m_eff (for the paper's layout
-    the paper's estimate). NaN without one bumper frequency.
+    the paper's estimate). The bumper is the orbit's first stop's own, else the grid's. NaN without a bumper.
     """
-    shape = (count, *orbit.omega.shape)
-    force_out, acceleration_out = np.full(shape, np.nan), np.full(shape, np.nan)
-    if scene.bumper_frequency is None or scene.bumper_frequency.size != 1:
-        return force_out, acceleration_out
-    losses = scene.loss_factors()
+    spec = scene.stop_specs[orbit.layout.stops[0]]
+    grid_frequency = scene.bumper_frequency if scene.bumper_frequency is not None else np.array([np.nan])
+    frequency = np.array([spec.bumper_frequency]) if spec.bumper_frequency is not None else grid_frequency
+    grid_losses = scene.loss_factors()
+    losses = np.array([spec.values(float(r), np.nan, np.nan, float(xi))[3] for r, xi in zip(scene.restitution, grid_losses)])
     gamma = np.array([peak_acceleration_factor(xi) if np.isfinite(xi) else np.nan for xi in losses])[:, None, None, None, None]
-    omega_b = 2.0 * np.pi * float(scene.bumper_frequency[0])
-    force = gamma * omega_b * orbit.impulse / (1.0 + orbit.restitution)
+    omega_b = 2.0 * np.pi * frequency[None, None, :, None, None]
+    force = gamma * omega_b * orbit.impulse / (1.0 + orbit.restitution)  # (R, D, bumper, 1, F)
     structure = scene.system.structure
     size = structure.size
     n = orbit.normal
@@ -195,9 +197,10 @@ def _peak_estimates(scene: Scene, orbit: ImpactOrbit, count: int) -> tuple[np.nd
         x, v = before[..., :size], before[..., size:]
         t = orbit.impact_time
         harmonic = (orbit.load * np.exp(1j * orbit.omega * t)[..., None]).real
-        _, static = _first_problem(scene).load()
+        _, static = first_problem(scene).load()
         pressing = (harmonic + static - v @ structure.damping_matrix.T - x @ structure.stiffness_matrix.T) @ minv_n * m_eff
         acceleration = (force - pressing) / m_eff
+    force_out, acceleration_out = np.full((count, *force.shape), np.nan), np.full((count, *force.shape), np.nan)
     force_out[list(orbit.layout.stops)] = force
     acceleration_out[list(orbit.layout.stops)] = acceleration
     return force_out, acceleration_out

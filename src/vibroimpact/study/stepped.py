@@ -7,21 +7,17 @@ from dataclasses import asdict
 import numpy as np
 import xarray as xr
 
-from vibroimpact.analysis.pgf import solve_one_impact
-from vibroimpact.analysis.stability import floquet_multipliers
 from vibroimpact.engines.registry import BUMPER, engine_spec
-from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, Scene
-from vibroimpact.scene.variables import quantity_attributes
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS, Scene
 from vibroimpact.simulation.settings import SWEEP_STARTS
 from vibroimpact.study.cost_model import Costs, EnginePart, Estimate, grid_estimate
-from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates, solve_each, steady_variable
+from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset
 from vibroimpact.study.general_estimate import closed_form_scale, engine_scale, general_orbit_outlook
 from vibroimpact.study.blocks import plan_blocks, run_grid
 from vibroimpact.study.general_stepped import describe_stops, general_block, general_coordinates
 from vibroimpact.study.runner import Runner
-from vibroimpact.study.solutions import simulated_values
 
-__all__ = ["SteppedStudy", "paper_block", "expected_periods", "SETTLING_PERIODS", "SHOOTING_PERIODS", "ESTIMATE_POINTS"]
+__all__ = ["SteppedStudy", "expected_periods", "SETTLING_PERIODS", "SHOOTING_PERIODS", "ESTIMATE_POINTS"]
 
 #: Periods of a transient that settles on a stable orbit (two convergence chunks), before the measurement.
 SETTLING_PERIODS = 40
@@ -39,17 +35,14 @@ class SteppedStudy:
 
     def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """Every solution of ``scene`` over its grid (see :func:`vibroimpact.study.run.run_study`), solved block by
-        block (:mod:`vibroimpact.study.blocks`); the variables are read lazily from the runner's store."""
+        block (:mod:`vibroimpact.study.blocks`) by :func:`~vibroimpact.study.general_stepped.general_block`, whichever
+        way the scene writes its system; the variables are read lazily from the runner's store."""
         say = progress or (lambda _message: None)
         grid = StudyGrid.of(scene)
         solutions = list(scene.solutions)
-        if scene.general:
-            coords = general_coordinates(scene, grid)
-            raw = run_grid(scene, runner, general_block, {"solution": len(solutions), "stop": len(scene.stop_specs)})
-            dataset = describe_stops(raw.assign_coords(coords))
-        else:
-            coords = grid_coordinates(scene, grid, solutions)
-            dataset = run_grid(scene, runner, paper_block, {"solution": len(solutions)}).assign_coords(coords)
+        coords = general_coordinates(scene, grid)
+        raw = run_grid(scene, runner, general_block, {"solution": len(solutions), "stop": len(scene.stop_specs)})
+        dataset = describe_stops(raw.assign_coords(coords))
         say(f"{', '.join(solutions)}: done")
         return finish_dataset(dataset, scene, coords, self.simulation_attributes(scene))
 
@@ -99,18 +92,6 @@ class SteppedStudy:
         )  # fmt: skip
 
 
-def paper_block(scene: Scene, runner: Runner) -> xr.Dataset:
-    """Every solution of a paper scene (or of a block of one) over its unsqueezed grid, without the dataset's metadata."""
-    grid = StudyGrid.of(scene)
-    per_solution = solve_each(scene, grid, lambda name: simulated_values(scene, name, grid.full, runner), None)
-    data_vars = {}
-    for quantity in scene.quantities:
-        stacked = steady_variable(quantity, scene, grid, per_solution, list(scene.solutions))
-        if stacked is not None:
-            data_vars[quantity] = xr.Variable(("solution", *GRID_DIMS), stacked, quantity_attributes(quantity))
-    return xr.Dataset(data_vars)
-
-
 #: Figures of the design-map page (three band maps, the regime map, the response at the recommended design).
 DESIGN_MAP_FIGURES = 5
 
@@ -143,18 +124,7 @@ def expected_periods(scene: Scene) -> tuple[np.ndarray, float]:
     shape = (scene.restitution.size, scene.clearance.size, frequencies.size)
     if sim.start == "rest":
         return np.full(shape, float(wander)), scale
-    wandering = 0.0
-    if scene.general:
-        fits, admissible, stable, wandering = general_orbit_outlook(scene, frequencies)
-    else:
-        omega = 2.0 * np.pi * frequencies[None, None, :]
-        orbit = solve_one_impact(scene.system, omega, scene.clearance[None, :, None], scene.restitution[:, None, None], scene.amplitude)
-        admissible = orbit.admissible()
-        stable = np.zeros(admissible.shape, dtype=bool)
-        if admissible.any():
-            modulus = np.max(np.abs(floquet_multipliers(orbit)), axis=-1)
-            stable = admissible & (modulus < 1.0)
-        fits = orbit.linear_amplitude_x2 <= orbit.clearance
+    fits, admissible, stable, wandering = general_orbit_outlook(scene, frequencies)
     settle = (SHOOTING_PERIODS if sim.start == "shooting" else SETTLING_PERIODS) + steady.measure_periods
     if sim.start in SWEEP_STARTS:
         # a chain: a fitting point is answered linear unless the point before it impacted (then it integrates from

@@ -18,7 +18,6 @@ from dataclasses import asdict
 import numpy as np
 import xarray as xr
 
-from vibroimpact.analysis.pgf import PgfVariant
 from vibroimpact.analysis.regime import Regime
 from vibroimpact.scene.layout import build_stops, stop_descriptions
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, MOTION_QUANTITIES, STOP_QUANTITIES, Scene
@@ -29,6 +28,7 @@ from vibroimpact.study.general_estimate import closed_form_scale, engine_scale
 from vibroimpact.study.general_stepped import describe_stops, general_quantity_attributes
 from vibroimpact.study.general_values import coordinate_quantity, general_linear_values, general_pgf_values
 from vibroimpact.study.grid import Progress, StudyGrid, finish_dataset, grid_coordinates
+from vibroimpact.study.pgf_paper import paper_pgf_values
 from vibroimpact.study.runner import Runner
 from vibroimpact.study.swept_cases import SWEEP_STATS, SweepCase
 
@@ -154,10 +154,7 @@ def closed_form_values(scene: Scene, name: str, grid: StudyGrid) -> Values:
         return general_linear_values(scene, grid.omega, grid.base)
     if name == "pgf":
         return general_pgf_values(scene, grid.omega, grid.delta, grid.r, grid.base)
-    from vibroimpact.study.solutions import pgf_values  # the paper's fitted route (named form only: the checker refuses it elsewhere)
-
-    values = pgf_values(scene, PgfVariant(name), grid.omega, grid.delta, grid.r, grid.base)
-    return {q: value[None] if q in STOP_QUANTITIES else value for q, value in values.items()}
+    return paper_pgf_values(scene, grid.omega, grid.delta, grid.r, grid.base)  # the paper's fitted route (its layout only)
 
 
 def swept_values(scene: Scene, shape: tuple[int, ...], runner: Runner) -> tuple[Values, Values, Values]:
