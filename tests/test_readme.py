@@ -30,6 +30,7 @@ def test_readme_reduction_factors_are_what_the_study_gives() -> None:
     """The README's results table is recomputed here: change both together."""
     import yaml
 
+    from vibroimpact.reporting.general_record import general_setting
     from vibroimpact.reporting.reduction import reduction_factors
     from vibroimpact.scene import parse_scene
     from vibroimpact.study.run import run_study
@@ -42,7 +43,7 @@ def test_readme_reduction_factors_are_what_the_study_gives() -> None:
     readme = (ROOT / "README.md").read_text()
 
     def factors(quantity: str, solution: str) -> list[str]:
-        row = next(r for r in reduction_factors(dataset, scene.system, scene.amplitude, quantity, solution) if r.restitution == 0.2)  # exact: a grid value
+        row = next(r for r in reduction_factors(dataset, general_setting(dataset), quantity, solution) if r.restitution == 0.2)  # exact: a grid value
         return [f"{x:.1f}" for x in row.factor]
 
     for solution, label in (("pgf", "`pgf` (exact)"), ("pgf_paper", "`pgf_paper`")):

@@ -1,4 +1,5 @@
-"""The page of a general study: one curve per coordinate and per stop, captions that say which, the layout in words."""
+"""The stepped page on layouts other than the paper's: one curve per coordinate and per stop, captions that say
+which, the layout in words."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ import xarray as xr
 
 from vibroimpact.reporting import page as page_module
 from vibroimpact.reporting.general_figures import response_panels_figure, structure_figure
-from vibroimpact.reporting.general_page import GeneralResponsePage, unswept_restitution
+from vibroimpact.reporting.stepped_page import FrequencyResponsePage, unswept_restitution
 from vibroimpact.reporting.general_record import general_setting
 from vibroimpact.reporting.report import page_for, write_report
 from vibroimpact.reporting.responses import regime_figure
@@ -72,13 +73,13 @@ def test_structure_figure_draws_every_coordinate_and_stop(dataset: xr.Dataset) -
 
 
 def test_page_is_chosen_and_written(dataset: xr.Dataset, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """A general dataset gets the general page; the HTML says the layout in words and has the tables."""
+    """A layout with two stops gets a panel per stop; the HTML says the layout in words and has the tables."""
     monkeypatch.setattr(page_module, "save_figure", quick_save)
     page = page_for(dataset)
-    assert isinstance(page, GeneralResponsePage)
+    assert isinstance(page, FrequencyResponsePage)
     assert page.summary() == "solutions: linear, pgf; stops: absorber - primary <= 3 mm, R = 0.2; absorber - primary >= -3 mm, R = 0.2"
     titles = [s.title for s in page.sections(tmp_path)]
-    assert titles == ["Structure and stops", "Responses, every coordinate and stop", "Largest responses"]
+    assert titles == ["Largest responses", "Linear system", "Responses, every coordinate and stop"], "the primary/absorber chain has no named view"
     html = write_report(dataset, tmp_path).read_text(encoding="utf-8")
     assert "absorber - primary &gt;= -3 mm, R = 0.2" in html
     assert "impulse on stop 1 [N s]" in html
@@ -145,7 +146,7 @@ def test_unswept_restitution_is_not_named(tmp_path: Path, monkeypatch: pytest.Mo
     monkeypatch.setattr(page_module, "save_figure", quick_save)
     data = run_study(parse_scene(copy.deepcopy(CHAIN)), progress=None)
     assert "restitution" not in data.coords
-    page = GeneralResponsePage(data)
+    page = FrequencyResponsePage(data)
     for section in page.sections(tmp_path):
         for figure in section.figures:
             assert "per restitution ratio" not in figure.caption

@@ -8,6 +8,7 @@ import xarray as xr
 
 from vibroimpact.analysis.linear import linear_response, resonance_peaks
 from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.reporting.general_record import GeneralSetting
 from vibroimpact.reporting.reduction import paper_reduction_factors, reduction_factors
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
@@ -17,6 +18,8 @@ FREQUENCY = np.round(np.arange(15.0, 45.0 + 1e-9, 0.005), 6)
 SYSTEM = TwoDofSystem(**PAPER_SYSTEM_SPEC)
 #: The paper's excitation amplitude q [N].
 AMPLITUDE = 10.0
+#: The paper's layout: force on x1, one upper stop on x2 (3 mm).
+SETTING = GeneralSetting(SYSTEM.structure, AMPLITUDE, False, np.array([1.0, 0.0]), np.zeros(2), ("x2 <= 3 mm",), np.array([[0.0, 1.0]]), ("pgf",), np.array([0.003]), SYSTEM)
 
 
 def dataset(values: np.ndarray, stable: np.ndarray | None = None) -> xr.Dataset:
@@ -29,7 +32,7 @@ def dataset(values: np.ndarray, stable: np.ndarray | None = None) -> xr.Dataset:
 
 def test_factor_is_linear_peak_over_largest_realisable_value() -> None:
     values = np.full(FREQUENCY.size, 1e-4)
-    row = reduction_factors(dataset(values, np.ones(FREQUENCY.size)), SYSTEM, AMPLITUDE, "x1_amplitude", "pgf")[0]
+    row = reduction_factors(dataset(values, np.ones(FREQUENCY.size)), SETTING, "x1_amplitude", "pgf")[0]
     linear = np.abs(linear_response(SYSTEM, 2 * np.pi * FREQUENCY, AMPLITUDE).x1)
     fits = np.abs(linear_response(SYSTEM, 2 * np.pi * FREQUENCY, AMPLITUDE).x2) <= 0.003
     split = FREQUENCY < SYSTEM.antiresonance_frequency() / (2 * np.pi)
@@ -45,7 +48,7 @@ def test_unstable_and_undefined_values_are_left_out_and_counted() -> None:
     stable = np.ones(FREQUENCY.size)
     values[100], stable[100] = 1.0, 0  # an unstable orbit with a huge amplitude in band 1
     values[5000] = np.nan  # undefined in band 2
-    row = reduction_factors(dataset(values, stable), SYSTEM, AMPLITUDE, "x1_amplitude", "pgf")[0]
+    row = reduction_factors(dataset(values, stable), SETTING, "x1_amplitude", "pgf")[0]
     assert row.largest[0] < 0.1
     assert row.unstable == (1, 0) and row.undefined == (0, 1)
 
@@ -53,7 +56,7 @@ def test_unstable_and_undefined_values_are_left_out_and_counted() -> None:
 def test_without_stability_information_nothing_is_excluded() -> None:
     values = np.full(FREQUENCY.size, 1e-4)
     values[100] = 1.0
-    row = reduction_factors(dataset(values), SYSTEM, AMPLITUDE, "x1_amplitude", "pgf")[0]
+    row = reduction_factors(dataset(values), SETTING, "x1_amplitude", "pgf")[0]
     assert row.largest[0] == 1.0 and row.unstable is None  # exact: the value put in
 
 
@@ -63,7 +66,7 @@ def test_coarse_grid_is_flagged() -> None:
         {"x1_amplitude": (("solution", "restitution", "frequency"), np.full((1, 1, coarse.size), 1e-4))},
         coords={"solution": ["pgf"], "restitution": [0.2], "frequency": coarse, "clearance": 0.003},
     )
-    assert reduction_factors(data, SYSTEM, AMPLITUDE, "x1_amplitude", "pgf")[0].coarse == (True, True)
+    assert reduction_factors(data, SETTING, "x1_amplitude", "pgf")[0].coarse == (True, True)
 
 
 def test_paper_values_only_for_the_papers_case() -> None:

@@ -120,7 +120,7 @@ def test_agreement_table_counts_each_kind_of_non_periodic_motion() -> None:
 
     dataset = steady_dataset()
     split = study_setting(dataset).split_frequency
-    table = agreement_table(dataset, study_setting(dataset))
+    table = agreement_table(dataset, split)
     assert table is not None
     rows = [[html_module.unescape(re.sub("<[^>]+>", "", c)).strip() for c in re.findall(r"<t[dh][^>]*>(.*?)</t[dh]>", r, re.S)] for r in re.findall(r"<tr>(.*?)</tr>", table.html, re.S)]
     header, body = rows[0], rows[1:]

@@ -36,9 +36,10 @@ def test_stepped_page_has_responses_simulations_peaks_agreement_and_reduction_fa
     ds = steady_dataset()
     page = page_for(ds)
     assert isinstance(page, FrequencyResponsePage)
-    assert page.summary() == "solutions: linear, pgf, pgf_paper, momentary, exact, compliant"
+    assert page.summary() == "solutions: linear, pgf, pgf_paper, momentary, exact, compliant; stops: x2 <= 3 mm"
     sections = {s.title: s for s in page.sections(tmp_path)}
     assert list(sections) == [
+        "Largest responses",
         "Linear system",
         "Resonance peaks against the restitution",
         "Frequency responses, Delta = 3 mm",
@@ -46,7 +47,8 @@ def test_stepped_page_has_responses_simulations_peaks_agreement_and_reduction_fa
         "Simulation against the closed form: agreement by band",
         "Reduction factors",
     ]
-    assert _names(sections["Linear system"]) == (["linear"], ["Modal parameters of H22"])
+    assert _names(sections["Largest responses"]) == ([], ["Largest value of every response, per solution"])
+    assert _names(sections["Linear system"]) == (["structure"], ["Modal parameters of H22", "Structure", "Stops and load"])
     assert _names(sections["Resonance peaks against the restitution"]) == (["peaks_vs_restitution"], ["Resonance peaks of |X1| against the restitution: values"])
     figures, _ = _names(sections["Frequency responses, Delta = 3 mm"])
     assert figures == ["x2_amplitude", "x1_amplitude", "force_amplitude", "suspension_force_amplitude", "impulse", "regime", "stability", "peak_acceleration"]

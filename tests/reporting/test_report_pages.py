@@ -16,6 +16,7 @@ from vibroimpact.analysis.regime import Regime
 from vibroimpact.reporting import page as page_module
 from vibroimpact.reporting.report import page_for
 from vibroimpact.reporting.page import DrawnFigure, Figure, Section, Table, render_page, save_figure
+from vibroimpact.reporting.general_record import general_setting
 from vibroimpact.reporting.tables import reduction_tables
 
 from tests.reporting.test_report_support import setting_of, steady_dataset, swept_dataset
@@ -37,7 +38,7 @@ def test_undefined_points_are_computed_points_without_a_value() -> None:
     setting = setting_of(ds)
     split = setting.system.antiresonance_frequency() / (2.0 * np.pi)
     bands = (ds["frequency"].values < split, ds["frequency"].values >= split)
-    table = next(t for t in reduction_tables(ds, setting) if "|X1|" in t.title)
+    table = next(t for t in reduction_tables(ds, general_setting(ds), True) if "|X1|" in t.title)
     header, *rows = _rows(table.html)
     column = {name: i for i, name in enumerate(header)}
     checked = 0

@@ -87,21 +87,50 @@ def test_same_page(pair: tuple[xr.Dataset, xr.Dataset], tmp_path: Path) -> None:
     assert "Reduction factors" in texts[0] and "Modal parameters of H22" in texts[0]
 
 
+THREE = {"mass": [[1.0, 0, 0], [0, 1.0, 0], [0, 0, 0.1]], "stiffness": [[2e4, -1e4, 0], [-1e4, 1.5e4, -5e3], [0, -5e3, 5e3]], "coordinates": ["x1", "x2", "x3"]}
+RELATIVE = [{"between": ["x2", "x1"], "side": side, "clearance": 0.003, "restitution": 0.2} for side in ("upper", "lower")]
+
+
 @pytest.mark.parametrize(
-    ("changes", "paper_page"),
+    ("changes", "extras", "panels"),
     [
-        ({}, True),
-        ({"excitation": {"amplitude": 0.001, "base_motion": True}}, False),  # the paper's masses on a moving base
-        ({"excitation": {"amplitude": 10.0, "on": "x2"}}, False),  # the force on the absorber
-        ({"stops": [{"between": ["x2", "x1"], "side": "upper", "clearance": 0.003, "restitution": 0.2}]}, False),  # a relative stop
+        ({}, True, False),
+        ({"excitation": {"amplitude": 0.001, "base_motion": True}}, True, False),  # the paper's masses on a moving base
+        ({"stops": RELATIVE}, True, True),  # the paper's masses, the 1928 two-sided relative stop
+        ({"system": MATRICES | {"coordinates": ["primary", "absorber"]}, "excitation": {"amplitude": 10.0, "on": "primary"}, "stops": [{"coordinate": "absorber", "side": "upper", "clearance": 0.003, "restitution": 0.2}]}, False, True),
+        ({"system": THREE, "stops": [{"coordinate": "x3", "side": "upper", "clearance": 0.003, "restitution": 0.2}]}, False, True),
     ],
 )
-def test_the_page_follows_the_layout(changes: dict[str, Any], paper_page: bool) -> None:
-    """The paper's page where the dataset's layout is the paper's (two-mass chain, one upper stop on x2, force on x1);
-    the general page for the same masses under another load or stop."""
+def test_the_sections_follow_what_the_dataset_holds(changes: dict[str, Any], extras: bool, panels: bool, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """One page for every stepped layout: the paper's extras (modal table, reduction factors) where the structure is
+    the paper's two-mass chain x1, x2 (another load or stop included), a panel per coordinate and stop where there are
+    several stops or no named view, the paper's figure per quantity otherwise."""
+    from vibroimpact.reporting import page as page_module
     from vibroimpact.reporting.stepped_page import FrequencyResponsePage
+    from tests.reporting.test_report_pages import quick_save
 
-    document = matrix_scene() | {"solutions": ["linear", "pgf"], "sweep": {"frequency": [20.0, 30.0]}} | changes
+    monkeypatch.setattr(page_module, "save_figure", quick_save)
+    document = matrix_scene() | {"solutions": ["linear", "pgf"], "sweep": {"frequency": [20.0, 25.0, 30.0]}} | changes
     document.pop("simulation")
     dataset = run_study(parse_scene(document), progress=None)
-    assert isinstance(page_for(dataset), FrequencyResponsePage) is paper_page
+    page = page_for(dataset)
+    assert isinstance(page, FrequencyResponsePage)
+    sections = page.sections(tmp_path)
+    titles = [section.title for section in sections]
+    tables = {table.title for section in sections for table in section.tables}
+    assert titles[:2] == ["Largest responses", "Linear system"]
+    assert ("Modal parameters of H22" in tables) is extras and ("Reduction factors" in titles) is extras
+    assert any(title.startswith("Responses, ") for title in titles) is panels
+    assert any(title.startswith("Frequency responses") for title in titles) is not panels
+
+
+def test_the_paper_layout_as_matrices_may_ask_for_the_design_map_and_pgf_paper() -> None:
+    """What the named form may ask for, the matrix form of the same layout may too (the design map, the paper's
+    route); the same masses with another stop may not (tests/scene/test_general_scene.py)."""
+    document = matrix_scene() | {"solutions": ["linear", "pgf", "pgf_paper"], "report": "design_map"}
+    document.pop("simulation")
+    document["stops"][0].pop("clearance")
+    document["stops"][0].pop("restitution")
+    document["sweep"] = {"restitution": [0.2, 0.8], "clearance": [0.002, 0.003], "frequency": [20.0, 25.0]}
+    scene = parse_scene(document)
+    assert scene.report == "design_map" and scene.solutions == ("linear", "pgf", "pgf_paper")

@@ -20,7 +20,7 @@ from vibroimpact.analysis.layout import harmonic_load
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["LinearResponse", "linear_response", "ResonancePeak", "resonance_peaks", "LinearAmplitudes", "linear_amplitudes", "structure_peaks"]
+__all__ = ["peaks_near", "LinearResponse", "linear_response", "ResonancePeak", "resonance_peaks", "LinearAmplitudes", "linear_amplitudes", "structure_peaks"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -87,7 +87,7 @@ def resonance_peaks(system: TwoDofSystem, amplitude: float, quantity: str = "x1"
     def magnitude(w: ArrayLike) -> NDArray[np.float64]:
         return np.abs(getattr(linear_response(system, w, amplitude), quantity))
 
-    return _peaks_near(system.natural_frequencies(), magnitude, span)
+    return peaks_near(system.natural_frequencies(), magnitude, span)
 
 
 @dataclass(frozen=True, eq=False)
@@ -177,10 +177,10 @@ def structure_peaks(problem: ImpactProblem, output: ArrayLike, span: float = 0.0
     def magnitude(w: ArrayLike) -> NDArray[np.float64]:
         return np.abs(linear_amplitudes(problem, np.asarray(w, dtype=float)).coordinates @ weights)
 
-    return _peaks_near([wn for wn in problem.structure.natural_frequencies() if wn > 0.0], magnitude, span)
+    return peaks_near([wn for wn in problem.structure.natural_frequencies() if wn > 0.0], magnitude, span)
 
 
-def _peaks_near(frequencies: ArrayLike, magnitude: Callable[[ArrayLike], NDArray[np.float64]], span: float) -> list[ResonancePeak]:
+def peaks_near(frequencies: ArrayLike, magnitude: Callable[[ArrayLike], NDArray[np.float64]], span: float) -> list[ResonancePeak]:
     """The maximum of ``magnitude`` within a relative ``span`` of each angular frequency [rad s-1] in turn: the best
     of 4001 samples, refined by a bounded scalar search to 1e-10 of the frequency."""
     peaks = []

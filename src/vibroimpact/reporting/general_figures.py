@@ -11,11 +11,13 @@ import html
 import numpy as np
 import xarray as xr
 
+from vibroimpact.model.modal import fit_modal_parameters, underdamped_mode_count
 from vibroimpact.reporting.general_record import GeneralSetting
 from vibroimpact.reporting.page import DrawnFigure, Table
 from vibroimpact.reporting.series import SimulationMarkers, draw_curve, draw_linear, draw_points, periodic_points, stability_keys, unstable_points
 from vibroimpact.reporting.style import SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
+from vibroimpact.simulation.layout import base_force
 
 __all__ = ["structure_figure", "layout_tables", "response_panels_figure", "peaks_table", "where_text"]
 
@@ -45,20 +47,16 @@ def where_text(part: xr.Dataset) -> str:
     return ", ".join(bits) if bits else "each stop's own values"
 
 
-def _load(setting: GeneralSetting, w: np.ndarray) -> np.ndarray:
-    """Harmonic load per coordinate at each w [N], shape w.shape + (N,)."""
-    if setting.base_motion:
-        return (setting.structure.mass_matrix @ np.ones(setting.structure.size)) * (setting.amplitude * w**2)[..., None]
-    return setting.weights * setting.amplitude * np.ones(w.shape)[..., None]
-
-
 def structure_figure(setting: GeneralSetting, frequency: np.ndarray) -> DrawnFigure:
-    """The linear system: |X| of every coordinate and |n_k . X| of every stop's coordinate (dashed), each against
-    the gap the static deflection leaves it, Delta_k - n_k . x_static (dotted, the stop's colour)."""
+    """The linear system: |X| of every coordinate, |n_k . X| of every stop's coordinate (dashed) against the gap the
+    static deflection leaves it, Delta_k - n_k . x_static (dotted, the stop's colour), the force on the base, and,
+    where the structure has the named view, |H22| exact against the paper's curve fit (paper figures 2-4)."""
     f = np.union1d(frequency, np.linspace(frequency.min(), frequency.max(), _LINEAR_POINTS))
     w = 2.0 * np.pi * f
-    x = np.einsum("...ij,...j->...i", setting.structure.receptance_matrix(w), _load(setting, w))
-    fig, axes = new_figure(2, panel_height=3.6, legend_rows=legend_rows(setting.structure.size + 2 * len(setting.stops)))
+    x = setting.linear(w)
+    named = setting.named
+    fit = fit_modal_parameters(named) if named is not None and underdamped_mode_count(named) == 2 else None
+    fig, axes = new_figure(3 if named is None else 4, panel_height=3.6, legend_rows=legend_rows(setting.structure.size + 2 * len(setting.stops) + 2))
     for i, name in enumerate(setting.names):
         axes[0].semilogy(f, np.abs(x[:, i]), color=series_colour(i), lw=1.4, label=f"|{name}|", gid=f"linear:{name}")
     finish_axes(axes[0], _FREQUENCY, "amplitude [m]", "Every coordinate, linear system (no stop)")
@@ -69,14 +67,28 @@ def structure_figure(setting: GeneralSetting, frequency: np.ndarray) -> DrawnFig
         if np.isfinite(gaps[k]) and gaps[k] > 0.0:
             axes[1].axhline(gaps[k], color=series_colour(k), lw=1.1, ls=":", label=f"stop {k}: gap {fmt(gaps[k] * 1e3, '.4g')} mm", gid=f"gap:stop{k}")
     finish_axes(axes[1], _FREQUENCY, "amplitude [m]", "Each stop's coordinate, linear system")
+    axes[2].semilogy(f, np.abs(base_force(setting.structure, w, x)), color="C2", lw=1.4, label="|F| on the base", gid="linear:force")
+    finish_axes(axes[2], _FREQUENCY, "|F| on the base [N]", "Linear force on the base (paper fig. 3)")
+    if named is not None:
+        axes[3].semilogy(f, np.abs(named.receptances(w).h22), label="|H22| exact (eq. 4)", color="k", lw=1.4)
+        if fit is not None:
+            step = max(1, f.size // 120)
+            axes[3].semilogy(f[::step], np.abs(fit.receptance(w[::step])), "o", color="C3", mfc="none", ms=4.5, label="|H22| of eq. 10, the paper's fitted modes")
+        finish_axes(axes[3], _FREQUENCY, "|H22| [m/N]", "Accuracy of the curve fit (paper fig. 4)")
     figure_legend(fig, axes)
-    natural = ", ".join(fmt(v / (2 * np.pi), ".3f") for v in setting.structure.natural_frequencies())
+    natural = ", ".join(fmt(v / (2 * np.pi), ".3f") for v in (named.natural_frequencies() if named is not None else setting.structure.natural_frequencies()))
     caption = (
-        f"Linear steady state without stops under the {setting.load_text()}: left, the amplitude of every coordinate "
-        f"({', '.join(setting.names)}); right, the amplitude of each stop's coordinate n . x (dashed) and, dotted in the "
-        f"same colour, {_gap_words(setting, static, gaps)} Stops: {'; '.join(setting.stops)}. Natural frequencies {natural} Hz."
+        f"Linear steady state without stops under the {setting.load_text()}: the amplitude of every coordinate "
+        f"({', '.join(setting.names)}); the amplitude of each stop's coordinate n . x (dashed) and, dotted in the "
+        f"same colour, {_gap_words(setting, static, gaps)} The force on the base, 1^T (K + j w C) X."
     )
-    return DrawnFigure(fig, "structure", "Linear responses of every coordinate and stop", caption)
+    if named is not None:
+        fitted = "against the paper's curve fit (circles)" if fit is not None else "(the paper's fit needs two underdamped modes)"
+        caption += f" |H22| exact {fitted}. Natural frequencies {natural} Hz, anti-resonance {fmt(named.antiresonance_frequency() / (2 * np.pi), '.3f')} Hz."
+    else:
+        caption += f" Natural frequencies {natural} Hz."
+    caption += f" Stops: {'; '.join(setting.stops)}."
+    return DrawnFigure(fig, "structure", "Linear responses, force on the base" + (", fit of H22" if named is not None else ""), caption)
 
 
 def _gap_words(setting: GeneralSetting, static: np.ndarray | None, gaps: np.ndarray) -> str:
@@ -200,7 +212,7 @@ def peaks_table(dataset: xr.Dataset, setting: GeneralSetting) -> Table:
             cells = []
             for quantity, _, scale, stop in columns:
                 values = _values(part.sel(solution=solution), quantity, stop)
-                if np.isfinite(values).any():
+                if np.isfinite(values).any() and not (solution == "linear" and quantity == "impulse"):  # no stop, no impulse
                     k = int(np.nanargmax(values))
                     cells.append(f"<td>{fmt(values[k] * scale, '.4g')} ({fmt(f[k], '.4g')})</td>")
                 else:
@@ -208,4 +220,4 @@ def peaks_table(dataset: xr.Dataset, setting: GeneralSetting) -> Table:
             labels = "".join(f"<td>{fmt(float(part[d]), 'g')}</td>" for d in others)
             rows.append(f"<tr>{labels}<td>{html.escape(str(solution))}</td>{''.join(cells)}</tr>")
     note = "<p>Largest value over the frequencies each solution computed (simulations: their own grid), and where it occurs. A closed form counts only where its orbit is admissible and stable or the motion linear.</p>"
-    return Table("Largest responses", f"{note}<table><tr>{head}</tr>{''.join(rows)}</table>")
+    return Table("Largest value of every response, per solution", f"{note}<table><tr>{head}</tr>{''.join(rows)}</table>")

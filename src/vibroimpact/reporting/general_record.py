@@ -1,9 +1,11 @@
 """What a report knows of a stepped study's structure, load and stops, read from its dataset's attributes
 (written by :func:`vibroimpact.study.grid.layout_attributes`); nothing is re-validated from the scene text.
 
-:func:`named_layout` says whether the study had the paper's layout on its named system, however its scene wrote it:
-the model decides (:attr:`vibroimpact.model.problem.ImpactProblem.named_system`) on the layout rebuilt from the
-attributes; a dataset written before the layout was recorded is a study of the paper's named scenes.
+A dataset written before the layout was recorded is a study of the paper's named scenes: its layout is the paper's
+(its ``system_m1`` ... ``system_b2``, one upper stop on x2, the force on x1). :func:`named_view` is the structure's
+named system where the study wrote one (the model decided: :meth:`vibroimpact.model.system.TwoDofSystem.of`);
+:func:`named_layout` says whether the study had the paper's whole layout on it (the model decides again, on the layout
+rebuilt from the attributes: :attr:`vibroimpact.model.problem.ImpactProblem.named_system`).
 """
 
 from __future__ import annotations
@@ -20,19 +22,27 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.stops import Stop
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.scene.layout import StopSpec, stop_descriptions
+from vibroimpact.simulation.layout import base_force
 
-__all__ = ["GeneralSetting", "general_setting", "named_layout", "is_general"]
+__all__ = ["GeneralSetting", "general_setting", "named_layout", "named_view", "is_general"]
 
 _NAMED_KEYS = ("m1", "m2", "k1", "k2", "b1", "b2")
 
 
+def named_view(dataset: xr.Dataset) -> TwoDofSystem | None:
+    """The named system of ``dataset``'s structure (attributes ``system_m1`` ... ``system_b2``); None where it has
+    none."""
+    attrs = dataset.attrs
+    return TwoDofSystem(**{key: float(attrs[f"system_{key}"]) for key in _NAMED_KEYS}) if "system_m1" in attrs else None
+
+
 def named_layout(dataset: xr.Dataset) -> TwoDofSystem | None:
     """The named system where ``dataset``'s study had the paper's layout on it (two-mass chain, one upper stop on x2,
-    force on x1); None otherwise. Datasets without the layout attributes (written before they were recorded) are
-    studies of the paper's named scenes: their ``system_m1`` ... ``system_b2``."""
-    attrs = dataset.attrs
-    if "system_size" not in attrs:
-        return TwoDofSystem(**{key: float(attrs[f"system_{key}"]) for key in _NAMED_KEYS}) if "system_m1" in attrs else None
+    force on x1); None otherwise."""
+    if "system_size" not in dataset.attrs:
+        return named_view(dataset)  # written before the layout was recorded: a study of the paper's named scenes
+    attrs = _layout(dataset)
     size = int(attrs["system_size"])
     sides = str(attrs["stop_side"]).split()
     coordinate = np.atleast_1d(np.asarray(attrs["stop_coordinate"], dtype=int))
@@ -50,6 +60,35 @@ def is_general(dataset: xr.Dataset) -> bool:
     """Does ``dataset`` record a layout (its structure, load and stops) that is not the paper's, so that its page
     draws every coordinate and stop by name? The paper's layout, however its scene wrote it, is not general."""
     return "system_size" in dataset.attrs and named_layout(dataset) is None
+
+
+def _layout(dataset: xr.Dataset) -> dict:
+    """The dataset's attributes with its layout's: those it recorded, else (written before they were recorded) the
+    paper's named layout on its ``system_m1`` ... ``system_b2``, the clearance and restitution from its coordinates."""
+    attrs = dict(dataset.attrs)
+    named = named_view(dataset)
+    if "system_size" in attrs or named is None:
+        return attrs
+    def grid(name: str) -> np.ndarray:
+        return np.atleast_1d(np.asarray(dataset[name].values, dtype=float)) if name in dataset.coords else np.array([np.nan, np.nan])
+
+    clearance = grid("clearance")
+    structure = named.structure
+    return attrs | {
+        "system_size": 2,
+        "system_coordinates": "x1 x2",
+        "system_mass_kg": structure.mass_matrix.ravel(),
+        "system_stiffness_N_per_m": structure.stiffness_matrix.ravel(),
+        "system_damping_N_s_per_m": structure.damping_matrix.ravel(),
+        "excitation_kind": "force",
+        "excitation_weights": np.array([1.0, 0.0]),
+        "excitation_static_N": np.zeros(2),
+        "stop_layout": stop_descriptions((StopSpec(coordinate=1),), ("x1", "x2"), grid("restitution"), clearance)[0],
+        "stop_coordinate": 1,
+        "stop_other": -1,
+        "stop_side": "upper",
+        "stop_clearance_m": float(clearance[0]) if clearance.size == 1 else np.nan,
+    }
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,6 +116,9 @@ class GeneralSetting:
     clearances : ndarray, shape (K,)
         Delta of every stop [m] (attribute ``stop_clearance_m``, else read from its description); NaN where the grid
         sweeps it.
+    named : TwoDofSystem or None
+        The structure's named view (the paper's m1 ... b2) where the dataset has one: the paper's extras (modal
+        parameters and fit of H22, resonance bands split at the anti-resonance, reduction factors) apply.
     """
 
     structure: LinearStructure
@@ -88,6 +130,7 @@ class GeneralSetting:
     normals: np.ndarray
     solutions: tuple[str, ...]
     clearances: np.ndarray
+    named: TwoDofSystem | None = None
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -103,6 +146,32 @@ class GeneralSetting:
             return None
         return np.linalg.solve(stiffness, self.static)
 
+    def load(self, w: np.ndarray) -> np.ndarray:
+        """Harmonic load per coordinate at each w [rad s-1] [N], shape w.shape + (N,)."""
+        if self.base_motion:
+            return (self.structure.mass_matrix @ np.ones(self.structure.size)) * (self.amplitude * w**2)[..., None]
+        return self.weights * self.amplitude * np.ones(np.shape(w))[..., None]
+
+    def linear(self, w: np.ndarray) -> np.ndarray:
+        """Complex amplitudes of the linear steady state without stops at each w [rad s-1] [m], shape w.shape + (N,)."""
+        return np.einsum("...ij,...j->...i", self.structure.receptance_matrix(w), self.load(w))
+
+    def linear_value(self, quantity: str, w: np.ndarray) -> np.ndarray:
+        """|quantity| of the linear steady state at each w [rad s-1]: ``<name>_amplitude`` [m] of a coordinate, or
+        ``force_amplitude`` / ``suspension_force_amplitude`` [N], 1^T (K + j w C) X (no stop loads the base)."""
+        x = self.linear(w)
+        if quantity in ("force_amplitude", "suspension_force_amplitude"):
+            return np.abs(base_force(self.structure, w, x))
+        return np.abs(x[..., self.names.index(quantity.removesuffix("_amplitude"))])
+
+    def linear_fits(self, w: np.ndarray, clearance: float = float("nan")) -> np.ndarray:
+        """Where the linear steady state stays clear of every stop, |n_k . X| + n_k . x_static <= Delta_k, at each
+        w [rad s-1]; ``clearance`` [m] stands for the stops whose Delta the grid sweeps."""
+        static = self.static_deflection()
+        shift = self.normals @ static if static is not None else np.zeros(len(self.stops))
+        deltas = np.where(np.isfinite(self.clearances), self.clearances, clearance)
+        return np.all(np.abs(self.linear(w) @ self.normals.T) + shift <= deltas, axis=-1)
+
     def load_text(self) -> str:
         """The load in words."""
         if self.base_motion:
@@ -115,8 +184,8 @@ class GeneralSetting:
 
 
 def general_setting(dataset: xr.Dataset) -> GeneralSetting:
-    """The :class:`GeneralSetting` of a general study's ``dataset`` (``KeyError`` naming a missing attribute)."""
-    attrs = dataset.attrs
+    """The :class:`GeneralSetting` of a stepped study's ``dataset`` (``KeyError`` naming a missing attribute)."""
+    attrs = _layout(dataset)
     size = int(attrs["system_size"])
     structure = _structure(attrs)
     coordinate = np.atleast_1d(np.asarray(attrs["stop_coordinate"], dtype=int))
@@ -143,6 +212,7 @@ def general_setting(dataset: xr.Dataset) -> GeneralSetting:
         normals=normals,
         solutions=tuple(str(s) for s in dataset["solution"].values) if "solution" in dataset.coords else (),
         clearances=clearances,
+        named=named_view(dataset),
     )
 
 

@@ -158,7 +158,7 @@ def study_setting(dataset: xr.Dataset) -> StudySetting:
         amplitude=float(attrs["excitation_amplitude_N"]),
         solutions=steady + swept,
         frequency=np.asarray(dataset["frequency"].values, dtype=float),
-        clearance=_values(dataset, "clearance"),
+        clearance=_values(dataset, "clearance") if "clearance" in dataset.coords else np.atleast_1d(np.asarray(attrs.get("stop_clearance_m", np.nan), dtype=float)),
         simulation_frequency=_simulation_frequency(dataset),
         bumper_frequency=_values(dataset, "bumper_frequency"),
         bumper_loss_factor=_values(dataset, "bumper_loss_factor"),

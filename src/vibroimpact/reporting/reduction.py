@@ -1,13 +1,16 @@
 """Reduction factors: how much a stop lowers the response at each linear resonance.
 
+They need the structure's named view (the paper's two resonances and its anti-resonance); the linear response, its
+peaks and where it fits are those of the study's own load and stops (:class:`~vibroimpact.reporting.general_record.GeneralSetting`).
+
 Definition (stated in every report): for a quantity (|X1|, |X2| or the force on the base) and linear resonance i,
 
     factor_i = (peak of the linear response near natural frequency i, by analytic maximisation)
                / (largest realisable steady response on the grid within resonance i's band)
 
 The bands split the frequency range at the anti-resonance sqrt(K2/M2). A steady response is *realisable* if it is a
-one-impact value that is not known to be unstable, or the linear value wherever the linear motion fits inside the
-clearance (it coexists with any impact regime there, and a frequency sweep can stay on it). Unstable one-impact
+one-impact value that is not known to be unstable, or the linear value wherever the linear motion stays clear of the
+stops (it coexists with any impact regime there, and a frequency sweep can stay on it). Unstable one-impact
 values and undefined points (NaN) are left out and counted; where there are any, the factor is an upper bound.
 """
 
@@ -18,15 +21,19 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from vibroimpact.analysis.linear import linear_response, resonance_peaks
+from vibroimpact.analysis.linear import ResonancePeak, peaks_near
 from vibroimpact.model.modal import exact_modal_parameters
 from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
+from vibroimpact.reporting.general_record import GeneralSetting
 
 __all__ = ["DEFINITION", "ReductionRow", "reduction_factors", "paper_reduction_factors"]
 
 DEFINITION = " ".join(__doc__.split("Definition (stated in every report): ")[1].split())
 
-_PEAK_QUANTITY = {"x1_amplitude": "x1", "x2_amplitude": "x2", "force_amplitude": "force", "suspension_force_amplitude": "force"}
+#: Quantities with reduction factors (coordinates of the named view, the force on the base).
+QUANTITIES = ("x1_amplitude", "x2_amplitude", "force_amplitude", "suspension_force_amplitude")
+#: Relative half-width of the search for each linear peak around its undamped natural frequency [-].
+_SPAN = 0.05
 #: Reduction factors quoted in the paper (section 4) for its example at R = 0.2, Delta = 3 mm.
 _PAPER = {"x1_amplitude": (28.0, 23.0), "force_amplitude": (25.0, 30.0)}
 
@@ -66,42 +73,49 @@ class ReductionRow:
     coarse: tuple[bool, ...]
 
 
-def reduction_factors(dataset: xr.Dataset, system: TwoDofSystem, amplitude: float, quantity: str, solution: str) -> list[ReductionRow]:
+def reduction_factors(dataset: xr.Dataset, setting: GeneralSetting, quantity: str, solution: str) -> list[ReductionRow]:
     """Reduction factors of ``quantity`` for ``solution`` at each (clearance, R) of ``dataset`` (see module doc).
 
     Parameters
     ----------
     dataset : xarray.Dataset
         A stepped study's dataset (or part of it) holding ``quantity`` along ``solution`` and ``frequency``.
-    system : TwoDofSystem
-        The system the dataset was computed for.
-    amplitude : float
-        Excitation amplitude q [N].
+    setting : GeneralSetting
+        The study's structure (with its named view), load and stops.
     quantity : str
         ``x1_amplitude``, ``x2_amplitude``, ``force_amplitude`` or ``suspension_force_amplitude``.
     solution : str
         The solution whose factors are wanted.
+
+    Raises
+    ------
+    ValueError
+        For another quantity, or a structure without the named view.
     """
-    if quantity not in _PEAK_QUANTITY:
-        raise ValueError(f"quantity must be one of {sorted(_PEAK_QUANTITY)}, got {quantity!r}")
-    peaks = resonance_peaks(system, amplitude, _PEAK_QUANTITY[quantity])
+    if quantity not in QUANTITIES:
+        raise ValueError(f"quantity must be one of {sorted(QUANTITIES)}, got {quantity!r}")
+    system = setting.named
+    if system is None:
+        raise ValueError("reduction factors need the paper's two-mass chain (its two resonances and anti-resonance)")
+    peaks = linear_peaks(setting, quantity)
     split = system.antiresonance_frequency() / (2.0 * np.pi)
     data = dataset[quantity].sel(solution=solution)
     stable = dataset["stable"].sel(solution=solution) if "stable" in dataset and solution == "pgf" else None
     f = data["frequency"].values
+    w = 2.0 * np.pi * f
     bands = [f < split, f >= split]
-    response = linear_response(system, 2.0 * np.pi * f, amplitude)
-    linear_value = {"x1": np.abs(response.x1), "x2": np.abs(response.x2), "force": np.abs(response.force)}[_PEAK_QUANTITY[quantity]]
+    linear_value = setting.linear_value(quantity, w)
     widths = [2.0 * zeta * peak.frequency for zeta, peak in zip(_loss_factors(system), peaks)]
     coarse = tuple(bool(np.sum(band) < 2 or np.max(np.diff(f[band]), initial=0.0) > width / 4.0) for band, width in zip(bands, widths))
     rows = []
-    for delta in np.atleast_1d(data["clearance"].values):
-        for r in np.atleast_1d(data["restitution"].values):
+    for delta in _values(data, "clearance"):
+        fits = setting.linear_fits(w, float(delta))
+        for r in _values(data, "restitution"):
             sel = {k: v for k, v in (("clearance", delta), ("restitution", r)) if k in data.dims}
             values = np.asarray(data.sel(sel).values, dtype=float)
             unstable = np.asarray(stable.sel(sel).values == 0) if stable is not None else np.zeros(f.shape, bool)
             realisable = np.where(unstable | np.isnan(values), -np.inf, values)
-            realisable = np.maximum(realisable, np.where(np.abs(response.x2) <= float(delta), linear_value, -np.inf))
+            realisable = np.maximum(realisable, np.where(fits, linear_value, -np.inf))
             largest = tuple(float(np.max(realisable[b], initial=-np.inf)) for b in bands)
             rows.append(
                 ReductionRow(
@@ -123,6 +137,17 @@ def paper_reduction_factors(system: TwoDofSystem, amplitude: float, quantity: st
     if system == PAPER_SYSTEM and amplitude == 10.0 and abs(clearance - 3e-3) < 1e-12 and abs(restitution - 0.2) < 1e-12:
         return _PAPER.get(quantity)
     return None
+
+
+def linear_peaks(setting: GeneralSetting, quantity: str) -> list[ResonancePeak]:
+    """Maxima of the linear |quantity| near each natural frequency of the named view, by analytic maximisation."""
+    assert setting.named is not None
+    return peaks_near(setting.named.natural_frequencies(), lambda w: setting.linear_value(quantity, np.asarray(w, dtype=float)), _SPAN)
+
+
+def _values(data: xr.DataArray, name: str) -> np.ndarray:
+    """The values of coordinate ``name`` (NaN where the stops give their own and the dataset has none)."""
+    return np.atleast_1d(data[name].values) if name in data.coords else np.array([np.nan])
 
 
 def _loss_factors(system: TwoDofSystem) -> list[float]:

@@ -15,13 +15,13 @@ the kind of study, in this one place:
 * stepped design maps (attribute ``report_page`` = ``design_map``: restitution x clearance x frequency): which R and
   clearance to choose, peak |X1| per band, realisable regimes, the recommended design
   (:class:`~vibroimpact.reporting.design_page.DesignMapPage`);
-* stepped studies with a swept bumper frequency: convergence of the compliant bumper to the rigid stop
+* stepped studies of the paper's layout (:func:`~vibroimpact.reporting.general_record.named_layout`) with a swept
+  bumper frequency: convergence of the compliant bumper to the rigid stop
   (:class:`~vibroimpact.reporting.bumper_page.BumperStiffnessPage`);
-* other stepped studies, by what the dataset holds, not by how the scene was written: the paper's layout on its named
-  system (:func:`~vibroimpact.reporting.general_record.named_layout`): frequency responses, regimes, stability,
-  simulations against the closed form, reduction factors and resonance peaks
-  (:class:`~vibroimpact.reporting.stepped_page.FrequencyResponsePage`); any other structure and stops: one curve per
-  coordinate and per stop, the layout in words (:class:`~vibroimpact.reporting.general_page.GeneralResponsePage`).
+* every other stepped study, any structure and stops: one page (:class:`~vibroimpact.reporting.stepped_page.FrequencyResponsePage`)
+  whose sections follow what the dataset holds, never how its scene was written: the paper's extras (fit of H22,
+  modal parameters, reduction factors, resonance peaks by band) where the structure has the named view, one curve per
+  stop where there are several.
 """
 
 from __future__ import annotations
@@ -37,7 +37,6 @@ from vibroimpact.reporting.concepts_page import ConceptsPage  # noqa: E402
 from vibroimpact.reporting.design_page import DesignMapPage  # noqa: E402
 from vibroimpact.reporting.validation_page import ValidationPage  # noqa: E402
 from vibroimpact.reporting.bumper_page import BumperStiffnessPage  # noqa: E402
-from vibroimpact.reporting.general_page import GeneralResponsePage  # noqa: E402
 from vibroimpact.reporting.general_record import is_general, named_layout  # noqa: E402
 from vibroimpact.reporting.record import study_kind, study_record, study_setting  # noqa: E402
 from vibroimpact.reporting.stepped_page import FrequencyResponsePage  # noqa: E402
@@ -72,13 +71,10 @@ def page_for(dataset: xr.Dataset) -> StudyPage:
         return BifurcationPage(dataset)
     if kind == "stepped" and dataset.attrs.get("report_page") == "design_map":
         return DesignMapPage(dataset)
-    if kind == "stepped" and named_layout(dataset) is None:
-        return GeneralResponsePage(dataset)
     if kind == "swept" and is_general(dataset):
         return GeneralSweptPage(dataset)
-    setting = study_setting(dataset)
     if kind == "swept":
-        return SweptSinePage(dataset, setting)
-    if "bumper_frequency" in dataset.dims:
-        return BumperStiffnessPage(dataset, setting)
-    return FrequencyResponsePage(dataset, setting)
+        return SweptSinePage(dataset, study_setting(dataset))
+    if "bumper_frequency" in dataset.dims and named_layout(dataset) is not None:
+        return BumperStiffnessPage(dataset, study_setting(dataset))
+    return FrequencyResponsePage(dataset)

@@ -1,6 +1,7 @@
 """Figures of the frequency-response pages (paper figures 2-8 and 21-24): linear system, responses of every solution,
-regime maps, stability, and simulations against the closed form; the linear-system section every stepped and swept
-page opens with, and what those pages share (:class:`SolutionsPage`).
+regime maps, stability, and simulations against the closed form; the linear-system section the swept-sine and bumper
+pages open with, and what those pages share (:class:`SolutionsPage`; the stepped page draws its linear system for any
+layout, :func:`vibroimpact.reporting.general_figures.structure_figure`).
 
 Each builder returns a :class:`~vibroimpact.reporting.page.DrawnFigure` whose caption is put together from what was
 drawn. Closed forms are drawn as curves on the dataset's grid, simulations as markers on their own grid
@@ -94,7 +95,7 @@ class SolutionsPage:
 
 
 def linear_section(setting: StudySetting, out: Path) -> Section:
-    """The section every stepped and swept page opens with: the linear system and the modal parameters of H22."""
+    """The section the swept-sine and bumper pages open with: the linear system and the modal parameters of H22."""
     return Section("Linear system", figures=saved([linear_figure(setting)], out), tables=[modal_table(setting.system)])
 
 

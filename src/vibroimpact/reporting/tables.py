@@ -12,10 +12,10 @@ import numpy as np
 import xarray as xr
 
 from vibroimpact.model.modal import exact_modal_parameters, fit_modal_parameters
+from vibroimpact.reporting.general_record import GeneralSetting
 from vibroimpact.reporting.reduction import DEFINITION, paper_reduction_factors, reduction_factors
 from vibroimpact.analysis.regime import Regime
 from vibroimpact.reporting.page import Table
-from vibroimpact.reporting.record import StudySetting
 from vibroimpact.reporting.style import QUANTITIES, fmt
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
@@ -66,10 +66,13 @@ def reduction_intro() -> str:
     )
 
 
-def reduction_tables(dataset: xr.Dataset, setting: StudySetting) -> list[Table]:
-    """One table per quantity: reduction factors of every solution but ``linear`` at each (clearance, R)."""
+def reduction_tables(dataset: xr.Dataset, setting: GeneralSetting, paper_layout: bool) -> list[Table]:
+    """One table per quantity: reduction factors of every solution but ``linear`` at each (clearance, R) of a study
+    whose structure has the named view; the paper's own values beside them where the study has its layout
+    (``paper_layout``) and its example's numbers."""
+    assert setting.named is not None
     solutions = [str(s) for s in dataset["solution"].values if s != "linear"]
-    split = setting.split_frequency
+    split = setting.named.antiresonance_frequency() / (2.0 * np.pi)
     tables = []
     for quantity in _REDUCTION_QUANTITIES:
         if quantity not in dataset or not solutions:
@@ -84,8 +87,8 @@ def reduction_tables(dataset: xr.Dataset, setting: StudySetting) -> list[Table]:
             part = computed_part(dataset, solution)
             f = part["frequency"].values
             computed = f"{int(np.sum(f < split))} / {int(np.sum(f >= split))}"
-            for row in reduction_factors(part, setting.system, setting.amplitude, quantity, solution):
-                paper = paper_reduction_factors(setting.system, setting.amplitude, quantity, row.restitution, row.clearance)
+            for row in reduction_factors(part, setting, quantity, solution):
+                paper = paper_reduction_factors(setting.named, setting.amplitude, quantity, row.restitution, row.clearance) if paper_layout else None
                 factors = "".join(f"<td>{fmt(factor, '.1f')}{' &dagger;' if coarse else ''}</td>" for factor, coarse in zip(row.factor, row.coarse))
                 unstable = "n/a" if row.unstable is None else f"{row.unstable[0]} / {row.unstable[1]}"
                 body.append(
@@ -98,12 +101,12 @@ def reduction_tables(dataset: xr.Dataset, setting: StudySetting) -> list[Table]:
     return tables
 
 
-def agreement_table(dataset: xr.Dataset, setting: StudySetting) -> Table | None:
-    """Simulation against pgf by band: relative differences of |X1| where the pgf orbit is stable and where not."""
+def agreement_table(dataset: xr.Dataset, split: float) -> Table | None:
+    """Simulation against pgf by band (split at ``split`` [Hz], the anti-resonance): relative differences of |X1|
+    where the pgf orbit is stable and where not."""
     engines = [str(name) for name in dataset["solution"].values if name in ENGINE_SOLUTIONS]
     if not engines or "pgf" not in dataset["solution"].values or "x1_amplitude" not in dataset:
         return None
-    split = setting.split_frequency
     header = _header(
         "band", "computed points", "max rel. diff. |X1|, pgf stable or linear", "median", "pgf unstable: points", "max rel. diff. there",
         "simulation quasi-periodic", "chaotic", "not periodic, undecided", "simulation with other than 1 or 0 impacts per period",
@@ -112,8 +115,8 @@ def agreement_table(dataset: xr.Dataset, setting: StudySetting) -> Table | None:
     for engine in engines:
         data = computed_part(dataset, engine)
         sim_f = data["frequency"].values
-        for delta in np.atleast_1d(data["clearance"].values):
-            for r in np.atleast_1d(data["restitution"].values):
+        for delta in _grid_values(data, "clearance"):
+            for r in _grid_values(data, "restitution"):
                 line = data.sel({k: v for k, v in (("clearance", delta), ("restitution", r)) if k in data.dims})
                 sim = line["x1_amplitude"].sel(solution=engine).values
                 pgf = line["x1_amplitude"].sel(solution="pgf").values
@@ -142,6 +145,11 @@ def agreement_table(dataset: xr.Dataset, setting: StudySetting) -> Table | None:
 def _header(*columns: str) -> str:
     """Header row of a table over the (clearance, R) grid: solution, Delta [mm], R, then ``columns`` (HTML)."""
     return "<tr>" + "".join(f"<th>{column}</th>" for column in ("solution", "Delta [mm]", "R", *columns)) + "</tr>"
+
+
+def _grid_values(data: xr.Dataset, name: str) -> np.ndarray:
+    """The values of coordinate ``name`` (NaN where the stops give their own and the dataset has none)."""
+    return np.atleast_1d(data[name].values) if name in data.coords else np.array([np.nan])
 
 
 def _largest(values: np.ndarray) -> float:

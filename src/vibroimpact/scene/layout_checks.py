@@ -11,7 +11,7 @@ from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.checker import Checker
 from vibroimpact.scene.layout import LoadSpec, StopSpec, build_stops
 
-__all__ = ["check_general_solutions", "pgf_refusal", "pgf_paper_applies", "static_drift"]
+__all__ = ["check_general_solutions", "pgf_refusal", "paper_layout_applies", "static_drift"]
 
 
 def pgf_refusal(system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, ...], load: LoadSpec | None, restitution: np.ndarray | None = None, clearance: np.ndarray | None = None) -> str | None:
@@ -34,9 +34,9 @@ def pgf_refusal(system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, .
     return None
 
 
-def pgf_paper_applies(system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, ...], load: LoadSpec | None) -> bool:
-    """Does the paper's own route (``pgf_paper``) apply: the paper's layout on its named system, however written
-    (:attr:`vibroimpact.model.problem.ImpactProblem.named_system`)?"""
+def paper_layout_applies(system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, ...], load: LoadSpec | None) -> bool:
+    """Is the layout the paper's on its named system, however written (:attr:`vibroimpact.model.problem.ImpactProblem.named_system`):
+    where its own route (``pgf_paper``) and its design map apply?"""
     try:
         problem = ImpactProblem(system, build_stops(specs or (StopSpec(coordinate=1),), False, 0.5, 1e-3), (load or LoadSpec()).force(1.0, 1.0))
     except (ValueError, TypeError):  # an unusable stop: reported where it is parsed
@@ -69,7 +69,7 @@ def check_general_solutions(
             if "leave no room" in str(error):
                 c.fail("stops", str(error).removeprefix("stops: ") + (f" (at clearance {d:g} m of the grid)" if not np.isnan(d) else ""))
                 break
-    if "pgf_paper" in solutions and not pgf_paper_applies(system, specs, load):
+    if "pgf_paper" in solutions and not paper_layout_applies(system, specs, load):
         c.fail("solutions", "pgf_paper is the paper's own route for its layout (a two-mass chain x1, x2 as {m1 ... b2}; one upper stop on x2; force on x1): use pgf")
     if "pgf" in solutions and (reason := pgf_refusal(system, specs, load, restitution, clearance)) is not None:
         c.fail("solutions", f"pgf does not apply to this layout: {reason}")

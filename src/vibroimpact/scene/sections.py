@@ -20,7 +20,7 @@ from vibroimpact.model.contact import restitution_from_loss_factor
 from vibroimpact.model.modal import underdamped_mode_count
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.checker import Checker, SceneError, interval
-from vibroimpact.scene.layout_checks import check_general_solutions
+from vibroimpact.scene.layout_checks import check_general_solutions, paper_layout_applies
 from vibroimpact.scene.layout_grids import general_grids
 from vibroimpact.scene.layout_parse import is_general, document_names, parse_load, parse_stop_layout, parse_structure, parse_sweep_stops
 from vibroimpact.scene.schema import (
@@ -79,9 +79,9 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     }
     solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
     scheduler = parse_cluster(c, doc)
-    if isinstance(report, str) and ("swept_sine" in doc or general):
-        c.fail("report", f"the {report} page is for stepped studies of the paper's named system")
     specs = parse_stop_layout(c, doc, system)
+    if isinstance(report, str) and ("swept_sine" in doc or general and system is not None and not paper_layout_applies(system, specs or (), load)):
+        c.fail("report", f"the {report} page is for stepped studies of the paper's layout (a two-mass chain x1, x2 as {{m1 ... b2}}; one upper stop on x2; force on x1), however written")
     targets = None
     if "stop" in sweep:
         if "stops" not in doc:
