@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vibroimpact.study.cluster import SCHEDULER_VARIABLE
+from vibroimpact.runs.cluster import SCHEDULER_VARIABLE
 
 
 def study_environment(scheduler: str | None = None) -> dict[str, str]:

@@ -14,7 +14,7 @@ import pytest
 import yaml
 
 from vibroimpact import cli
-from vibroimpact.study import run as study
+from vibroimpact.runs import run as study
 from vibroimpact.scene import load_scene, shipped_studies, shipped_studies_dir
 
 from tests.run_study_process import start_run_study, stored_blocks
@@ -152,10 +152,10 @@ def test_installed_package_finds_its_studies(tmp_path: Path) -> None:
 
 def test_a_code_change_invalidates_the_resume_cache(monkeypatch: pytest.MonkeyPatch) -> None:
     """The cache key hashes the package's source: other code, other key (the version number alone would not do)."""
-    from vibroimpact.study import fingerprint
+    from vibroimpact.runs import store as fingerprint
     from vibroimpact.engines.settings import EngineSettings
     from vibroimpact.model.contact import RigidStop
-    from vibroimpact.study.cases import SimulationCase
+    from vibroimpact.kinds.stepped.cases import SimulationCase
     from vibroimpact.simulation.settings import SteadySettings
     from vibroimpact.model.system import PAPER_SYSTEM
 
@@ -167,7 +167,7 @@ def test_a_code_change_invalidates_the_resume_cache(monkeypatch: pytest.MonkeyPa
 
 
 def test_datasets_record_the_source_they_came_from(tmp_path: Path) -> None:
-    from vibroimpact.study.fingerprint import source_hash
+    from vibroimpact.runs.store import source_hash
     from vibroimpact.scene import load_scene
 
     document = base_scene()
@@ -210,8 +210,8 @@ def test_help_lists_the_subcommands(capsys: pytest.CaptureFixture[str]) -> None:
 
 def test_calibrate_writes_a_cost_file_that_estimate_reads(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """calibrate -> the cost file (measured tables replaced, the rest kept) -> ``--estimate --costs`` predicts from it."""
-    from vibroimpact.study.cost_model import Costs, default_costs
-    from vibroimpact.study.estimate import estimate_scene
+    from vibroimpact.runs.estimate import Costs, default_costs
+    from vibroimpact.runs.estimate import estimate_scene
 
     out = tmp_path / "costs" / "costs.json"
     assert cli.main(["calibrate", str(tiny_accuracy_dataset(tmp_path / "accuracy.nc")), "--out", str(out)]) == 0
@@ -241,7 +241,7 @@ def test_calibrate_writes_a_cost_file_that_estimate_reads(tmp_path: Path, capsys
 
 
 def test_calibrate_writes_the_package_file_by_default_or_says_why_not(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
-    from vibroimpact.study import estimate
+    from vibroimpact.runs import estimate
 
     package_file = tmp_path / "package" / "costs.json"
     package_file.parent.mkdir()
@@ -291,7 +291,7 @@ def test_estimate_refuses_a_bad_cost_file(tmp_path: Path, capsys: pytest.Capture
 def test_sweep_cost_options_make_its_settings() -> None:
     import argparse
 
-    from vibroimpact.benchmarks.sweep_cost import add_arguments, settings_from_arguments
+    from vibroimpact.kinds.benchmark.sweep_cost import add_arguments, settings_from_arguments
 
     parser = argparse.ArgumentParser()
     add_arguments(parser)

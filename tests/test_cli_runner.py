@@ -15,8 +15,8 @@ import yaml
 
 from vibroimpact import cli
 from vibroimpact.scene import SceneError, parse_scene
-from vibroimpact.study import cluster
-from vibroimpact.study.cluster import SCHEDULER_VARIABLE, choose_scheduler
+from vibroimpact.runs import cluster
+from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, choose_scheduler
 
 from tests.study.test_estimate import small_scene
 
@@ -75,7 +75,7 @@ def test_keep_zarr_keeps_the_store_beside_the_netcdf_file(tmp_path: Path) -> Non
 
 
 def test_a_second_run_on_the_same_output_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from vibroimpact.study.store import claim_output
+    from vibroimpact.runs.store import claim_output
 
     out = tmp_path / "out"
     out.mkdir()
@@ -106,8 +106,8 @@ def test_the_estimate_is_for_a_number_of_workers(tmp_path: Path, capsys: pytest.
 
 def test_a_worker_running_other_code_refuses_its_tasks(monkeypatch: pytest.MonkeyPatch) -> None:
     """The study's source hash travels with every task; a worker whose package differs raises instead of computing."""
-    from vibroimpact.study import runner as runner_module
-    from vibroimpact.study.runner import OtherCode, Runner, _run_cases
+    from vibroimpact.runs import runner as runner_module
+    from vibroimpact.runs.runner import OtherCode, Runner, _run_cases
 
     monkeypatch.setattr(runner_module, "source_hash", lambda: "0" * 64)  # this process "runs other code"
     with Runner(jobs=2, progress=False) as runner:

@@ -13,7 +13,7 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "vibroimpact"
 #: Lowest first: a module may import from its own layer and those before it (README, "Architecture").
-LAYERS = ("model", "analysis", "engines", "orbits", "simulation", "scene", "benchmarks", "study", "reporting", "cli")
+LAYERS = ("model", "analysis", "engines", "orbits", "simulation", "scene", "runs", "reporting", "kinds", "cli")
 #: Third-party libraries a layer must not import (lower layers are physics and numerics only).
 FORBIDDEN_LIBRARIES = {
     "model": ("yaml", "xarray", "matplotlib", "netCDF4", "sksundae"),
@@ -23,15 +23,21 @@ FORBIDDEN_LIBRARIES = {
     "simulation": ("yaml", "xarray", "matplotlib", "netCDF4"),
     "scene": ("xarray", "matplotlib", "netCDF4", "sksundae", "scipy.integrate"),
 }
+#: A kind's scene section is read with the scene layer (reading a scene loads no solver): these kind modules are held
+#: to the scene layer's rules, and may import each other.
+SCENE_LEVEL_KIND_MODULES = ("scene", "settings")
 
 
 def layer_of(module: str) -> str | None:
-    """The layer of ``vibroimpact.<layer>...`` (``cli`` and the package itself are the top), None outside."""
+    """The layer of ``vibroimpact.<layer>...`` (``cli`` and the package itself are the top), None outside; a kind's
+    scene section (``vibroimpact.kinds.<kind>.scene``, ``.settings``) is of the scene layer."""
     parts = module.split(".")
     if parts[0] != "vibroimpact" or module in ("vibroimpact", "vibroimpact.__version__"):
         return None  # outside, or the package's version: metadata every layer may read
     if len(parts) == 1:
         return "cli"  # the package's __init__: lazy public names, the top
+    if parts[1] == "kinds" and len(parts) >= 4 and parts[3] in SCENE_LEVEL_KIND_MODULES:
+        return "scene"
     return parts[1] if parts[1] in LAYERS else "cli"
 
 
@@ -92,7 +98,18 @@ def test_lower_layers_import_no_io_or_plotting(path: Path) -> None:
 def test_the_checks_see_an_upward_import(tmp_path: Path) -> None:
     """The scan is not blind: an import of the study layer from a model module, even inside a function, is found."""
     module = tmp_path / "probe.py"
-    module.write_text("def f():\n    from vibroimpact.study.run import run_study\n    import xarray\n")
+    module.write_text("def f():\n    from vibroimpact.runs.run import run_study\n    import xarray\n")
     found = [target for _line, target in imports(module)]
-    assert "vibroimpact.study.run" in found and "xarray" in found
-    assert LAYERS.index(layer_of("vibroimpact.study.run")) > LAYERS.index("model")  # type: ignore[arg-type]
+    assert "vibroimpact.runs.run" in found and "xarray" in found
+    assert LAYERS.index(layer_of("vibroimpact.runs.run")) > LAYERS.index("model")  # type: ignore[arg-type]
+
+
+def test_a_kind_scene_section_is_held_to_the_scene_layer() -> None:
+    """The kinds' scene parsers named by the table are scene-level modules (no solver, no xarray), so the scan above
+    holds them to the scene layer's imports."""
+    from vibroimpact.scene.kinds import KINDS
+
+    for kind in KINDS:
+        module = kind.scene.partition(":")[0]
+        assert layer_of(module) == "scene", f"{kind.name}: {module} is not read at the scene layer"
+        assert layer_of(kind.study.partition(":")[0]) == "kinds" and layer_of(kind.page.partition(":")[0]) == "kinds"

@@ -30,10 +30,10 @@ def test_readme_reduction_factors_are_what_the_study_gives() -> None:
     """The README's results table is recomputed here: change both together."""
     import yaml
 
-    from vibroimpact.reporting.general_record import general_setting
-    from vibroimpact.reporting.reduction import reduction_factors
+    from vibroimpact.reporting.record import general_setting
+    from vibroimpact.kinds.stepped.tables import reduction_factors
     from vibroimpact.scene import parse_scene
-    from vibroimpact.study.run import run_study
+    from vibroimpact.runs.run import run_study
 
     document = yaml.safe_load((ROOT / "studies" / "restitution.yaml").read_text())
     document["solutions"] = [s for s in document["solutions"] if s in ("linear", "pgf", "pgf_paper")]  # the closed forms only

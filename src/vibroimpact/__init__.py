@@ -31,10 +31,10 @@ _PUBLIC = {
     "SweptSine": "vibroimpact.model.excitation",
     "ImpactProblem": "vibroimpact.model.problem",
     "LinearStructure": "vibroimpact.model.structure",
-    "Stop": "vibroimpact.model.stops",
+    "Stop": "vibroimpact.model.contact",
     "solve_one_impact": "vibroimpact.analysis.pgf",
     "solve_impact_orbit": "vibroimpact.analysis.impact_orbit",
-    "solve_two_impacts": "vibroimpact.analysis.two_sided",
+    "solve_two_impacts": "vibroimpact.analysis.impact_orbit",
     "closed_form_refusal": "vibroimpact.analysis.layout",
     "floquet_multipliers": "vibroimpact.analysis.stability",
     "linear_response": "vibroimpact.analysis.linear",
@@ -53,8 +53,8 @@ _PUBLIC = {
     "load_scene": "vibroimpact.scene",
     "parse_scene": "vibroimpact.scene",
     "find_scene": "vibroimpact.scene",
-    "run_study": "vibroimpact.study.run",
-    "write_dataset": "vibroimpact.study.io",
+    "run_study": "vibroimpact.runs.run",
+    "write_dataset": "vibroimpact.runs.run",
     "write_report": "vibroimpact.reporting.report",
 }
 

@@ -19,10 +19,9 @@ from typing import Callable
 import numpy as np
 
 from vibroimpact.scene import Scene, SceneError, find_scene, load_scene, shipped_studies
-from vibroimpact.study.cluster import SCHEDULER_VARIABLE, ClusterLost, choose_scheduler, unreachable
-from vibroimpact.study.io import write_dataset
-from vibroimpact.study.run import run_study
-from vibroimpact.study.store import OutputBusy, StudyStore, claim_output, store_fingerprint
+from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, ClusterLost, choose_scheduler, unreachable
+from vibroimpact.runs.run import write_dataset, run_study
+from vibroimpact.runs.store import OutputBusy, StudyStore, claim_output, store_fingerprint
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILURE = 1
@@ -126,8 +125,8 @@ def _estimate(scene: Scene, jobs: int, costs_file: Path | None, workers: int | N
     local workers or ``workers`` workers of a cluster."""
     from contextlib import nullcontext
 
-    from vibroimpact.study.cost_model import Costs, cluster_cores
-    from vibroimpact.study.estimate import estimate_scene
+    from vibroimpact.runs.estimate import Costs, cluster_cores
+    from vibroimpact.runs.estimate import estimate_scene
 
     try:
         costs = Costs.load(costs_file) if costs_file is not None else None
@@ -151,7 +150,7 @@ def calibrate_command(argv: list[str]) -> int:
     parser.add_argument("accuracy", type=Path, help="dataset of the accuracy_cost study, e.g. results/accuracy_cost/accuracy_cost.nc")
     parser.add_argument("--out", type=Path, default=None, help="cost file to write (default: the package's own costs.json, where the package is writable)")
     args = parser.parse_args(argv)
-    from vibroimpact.study.estimate import calibrate, write_costs
+    from vibroimpact.runs.estimate import calibrate, write_costs
 
     try:
         path = write_costs(calibrate(args.accuracy), args.out)
@@ -163,8 +162,8 @@ def calibrate_command(argv: list[str]) -> int:
 
 
 def sweep_cost_command(argv: list[str]) -> int:
-    """``run-study sweep-cost [options]``: the swept-sine cost table (:mod:`vibroimpact.benchmarks.sweep_cost`)."""
-    from vibroimpact.benchmarks import sweep_cost
+    """``run-study sweep-cost [options]``: the swept-sine cost table (:mod:`vibroimpact.kinds.benchmark.sweep_cost`)."""
+    from vibroimpact.kinds.benchmark import sweep_cost
 
     parser = argparse.ArgumentParser(prog="run-study sweep-cost", description=(sweep_cost.__doc__ or "").split("\n\n")[0])
     sweep_cost.add_arguments(parser)

@@ -27,7 +27,7 @@ from vibroimpact.analysis.stability import floquet_multipliers
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.stops import Stop
+from vibroimpact.model.contact import Stop
 from vibroimpact.model.structure import LinearStructure
 
 OSCILLATOR = LinearStructure([[1.0]], [[1.0]], [[0.0]], ("x",))

@@ -18,7 +18,7 @@ from vibroimpact.analysis.stability import floquet_multipliers, monodromy
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
 from vibroimpact.model.excitation import HarmonicForce, SweptSine
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.stops import Stop
+from vibroimpact.model.contact import Stop
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import PAPER_SYSTEM
 

@@ -9,7 +9,7 @@ import pytest
 
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.pgf import solve_one_impact
-from vibroimpact.analysis.regime import Regime, classify, regime_attributes
+from vibroimpact.analysis.stability import Regime, classify, regime_attributes
 from vibroimpact.model.system import PAPER_SYSTEM
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE

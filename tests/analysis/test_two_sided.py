@@ -1,7 +1,7 @@
 """The symmetric two-impacts-per-period orbit of a two-sided stop (analysis.two_sided) against its defining conditions,
 an independent integration (tests/analysis/impact_flow.py: DOP853, events on both gaps) and an analytic special case.
 
-Derivation: the module docstring of vibroimpact.analysis.two_sided (antiperiodic Green function).
+Derivation: the module docstring of vibroimpact.analysis.greens (antiperiodic Green function).
 """
 
 from __future__ import annotations
@@ -11,11 +11,11 @@ import pytest
 
 from vibroimpact.analysis.impact_orbit import ImpactOrbit
 from vibroimpact.analysis.stability import floquet_multipliers, half_period_jacobian, monodromy
-from vibroimpact.analysis.two_sided import solve_two_impacts
+from vibroimpact.analysis.impact_orbit import solve_two_impacts
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.stops import Stop
+from vibroimpact.model.contact import Stop
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import PAPER_SYSTEM
 

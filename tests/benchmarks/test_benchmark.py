@@ -12,9 +12,9 @@ import yaml
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
 from vibroimpact.model.excitation import HarmonicForce
-from vibroimpact.model.stops import Stop
+from vibroimpact.model.contact import Stop
 from vibroimpact import cli
-from vibroimpact.benchmarks.accuracy import _compare, equal_error_speedup, run_benchmark
+from vibroimpact.kinds.benchmark.study import _compare, equal_error_speedup, run_benchmark
 from vibroimpact.scene.schema import BenchmarkCase, BenchmarkSettings
 from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.engines.base import Trajectory
@@ -105,7 +105,7 @@ def test_compliant_cvode_is_an_independent_integrator_of_the_same_model(system: 
     from vibroimpact.model.contact import KelvinVoigtBumper, loss_factor_from_restitution, restitution_from_loss_factor
     from vibroimpact.engines.settings import EngineSettings
     from vibroimpact.engines.compliant.ida import CompliantEngine
-    from vibroimpact.engines.compliant.cvode import CompliantCvodeEngine
+    from vibroimpact.engines.compliant.ida import CompliantCvodeEngine
 
     free = TwoDofSystem(m1=1.0, m2=0.1, k1=1.0, k2=1e-12)
     problem = ImpactProblem(free, KelvinVoigtBumper(1e-3, 250.0, 0.3), HarmonicForce(0.0, 1.0))
@@ -127,7 +127,7 @@ def test_compliant_cvode_is_an_independent_integrator_of_the_same_model(system: 
 def test_accuracy_benchmark_with_compliant_and_swept_cases(system: TwoDofSystem) -> None:
     """Compliant methods are measured against CVODE Adams at rtol 1e-13, rigid ones against exact; X1 errors shrink
     with the tolerance; a swept case runs only the compliant model; the ladder ranks the models."""
-    from vibroimpact.benchmarks.accuracy import loosest_tolerance
+    from vibroimpact.kinds.benchmark.study import loosest_tolerance
     from vibroimpact.scene.schema import LadderSettings
     from vibroimpact.model.excitation import SweptSine
 
@@ -170,7 +170,7 @@ def test_matching_is_one_to_one(system: TwoDofSystem) -> None:
 def test_loosest_tolerance_needs_every_tighter_one() -> None:
     """Synthetic line: errors meet 1e-3 at rtol 1e-8, 1e-6 and 1e-4, not at 1e-7 (a fluke): the answer is 1e-8; a
     missed or an extra impact disqualifies a tolerance; tolerances not run are skipped."""
-    from vibroimpact.benchmarks.accuracy import loosest_tolerance
+    from vibroimpact.kinds.benchmark.study import loosest_tolerance
 
     rtol = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
     error = np.array([[[5e-3, 5e-4, 5e-4, 5e-5, 2e-3, 5e-6, np.nan]]])

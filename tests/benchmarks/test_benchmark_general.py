@@ -14,7 +14,7 @@ import xarray as xr
 
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.scene import SceneError, parse_scene
-from vibroimpact.study.run import run_study
+from vibroimpact.runs.run import run_study
 
 from tests.golden.golden import is_timing
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC

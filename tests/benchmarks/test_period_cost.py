@@ -8,7 +8,7 @@ import functools
 import numpy as np
 import xarray as xr
 
-from vibroimpact.benchmarks.accuracy import TOLERANCE_FREE, exact_kernel, run_benchmark
+from vibroimpact.kinds.benchmark.study import TOLERANCE_FREE, exact_kernel, run_benchmark
 from vibroimpact.engines import exact_core
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce

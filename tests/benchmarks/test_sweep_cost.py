@@ -14,7 +14,7 @@ from vibroimpact.engines.settings import SWEEP_SETTINGS
 from vibroimpact.engines.compliant.ivp import solve_ivp_sweep
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.simulation.harmonics import running_fundamental
-from vibroimpact.benchmarks.sweep_cost import SweepCostSettings, markdown_table, run_sweep_cost
+from vibroimpact.kinds.benchmark.sweep_cost import SweepCostSettings, markdown_table, run_sweep_cost
 from vibroimpact.model.system import TwoDofSystem
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE

@@ -7,7 +7,7 @@ import os
 
 import pytest
 
-from vibroimpact.study.runner import Runner, WorkerDied
+from vibroimpact.runs.runner import Runner, WorkerDied
 
 pytestmark = [pytest.mark.cluster, pytest.mark.timeout(180)]
 

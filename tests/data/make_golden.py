@@ -6,8 +6,8 @@ Say in the commit message why the numbers changed.
 from pathlib import Path
 
 from vibroimpact.scene import load_scene
-from vibroimpact.study.io import write_dataset
-from vibroimpact.study.run import run_study
+from vibroimpact.runs.run import write_dataset
+from vibroimpact.runs.run import run_study
 
 HERE = Path(__file__).parent
 

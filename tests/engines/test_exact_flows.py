@@ -15,7 +15,7 @@ from vibroimpact.engines.linear_flow import HarmonicLinearFlow
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.stops import Stop
+from vibroimpact.model.contact import Stop
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import PAPER_SYSTEM
 

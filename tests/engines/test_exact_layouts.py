@@ -17,7 +17,7 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.stops import Stop
+from vibroimpact.model.contact import Stop
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.orbits.branch import MapEvaluation

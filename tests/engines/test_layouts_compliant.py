@@ -16,7 +16,7 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution, peak_acceleration_factor, restitution_from_loss_factor
 from vibroimpact.model.excitation import HarmonicForce, SweptSine
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.stops import Stop
+from vibroimpact.model.contact import Stop
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import PAPER_SYSTEM
 

@@ -15,7 +15,7 @@ from vibroimpact.engines.sundae import compiled_cvode_problem, evaluate_compiled
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.stops import Stop
+from vibroimpact.model.contact import Stop
 from vibroimpact.model.system import PAPER_SYSTEM
 
 from tests.conftest import PAPER_AMPLITUDE

@@ -11,7 +11,7 @@ import tempfile
 from pathlib import Path
 
 from tests.golden.golden import DATA, compute, read_back, scene_names, written
-from vibroimpact.study.io import write_dataset
+from vibroimpact.runs.run import write_dataset
 
 
 def bless(name: str) -> None:

@@ -123,7 +123,7 @@ def compute(name: str, workdir: Path) -> tuple[xr.Dataset, str | None]:
     draws no report)."""
     from vibroimpact.reporting.report import write_report
     from vibroimpact.scene import load_scene
-    from vibroimpact.study.run import run_study
+    from vibroimpact.runs.run import run_study
 
     scene = load_scene(SCENES / f"{name}.yaml")
     dataset = run_study(scene, progress=None)
@@ -143,7 +143,7 @@ def read_back(path: Path) -> xr.Dataset:
 
 def written(dataset: xr.Dataset, folder: Path) -> xr.Dataset:
     """``dataset`` as the package's writer stores it and a reader reads it back (what the blessed file holds)."""
-    from vibroimpact.study.io import write_dataset
+    from vibroimpact.runs.run import write_dataset
 
     return read_back(write_dataset(dataset, folder / "golden.nc"))
 

@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from vibroimpact.analysis.regime import Regime
+from vibroimpact.analysis.stability import Regime
 from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.engines.momentary import MomentaryEngine
 from vibroimpact.orbits.lyapunov import LyapunovEstimate, lyapunov_two_trajectories

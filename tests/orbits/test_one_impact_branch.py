@@ -184,7 +184,7 @@ def test_period_doubling_and_its_period_two_branch_confirmed_by_momentary() -> N
 
 
 def test_fold_and_torus_curves_in_frequency_and_clearance(branches) -> None:
-    from vibroimpact.orbits.two_parameter import continue_special_point
+    from vibroimpact.orbits.continuation import continue_special_point
 
     system, branch = branches["low"]
     settings = ContinuationSettings(step=0.05, max_steps=40)

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from vibroimpact.orbits.spectrum import rotation_number, strobe_spectrum
+from vibroimpact.orbits.motion import rotation_number, strobe_spectrum
 
 GOLDEN = (3.0 - math.sqrt(5.0)) / 2.0  # 0.381966..., the most irrational rotation in (0, 1/2)
 

@@ -8,7 +8,7 @@ import pytest
 from tests.orbits.toy_maps import DelayedLogisticMap, HenonMap
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
 from vibroimpact.orbits.shooting import shoot
-from vibroimpact.orbits.two_parameter import continue_special_point
+from vibroimpact.orbits.continuation import continue_special_point
 
 
 @pytest.fixture(scope="module")

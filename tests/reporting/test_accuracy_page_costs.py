@@ -8,12 +8,12 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from vibroimpact.benchmarks.accuracy import run_benchmark
+from vibroimpact.kinds.benchmark.study import run_benchmark
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.reporting.accuracy_page import AccuracyPage, accuracy_tables, per_period_table
+from vibroimpact.kinds.benchmark.page import AccuracyPage, accuracy_tables, per_period_table
 from vibroimpact.scene.schema import BenchmarkCase, BenchmarkSettings
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE

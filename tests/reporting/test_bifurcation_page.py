@@ -7,10 +7,10 @@ from pathlib import Path
 import pytest
 import xarray as xr
 
-from vibroimpact.reporting.bifurcation_page import BifurcationPage
+from vibroimpact.kinds.bifurcation.page import BifurcationPage
 from vibroimpact.reporting.report import page_for, write_report
 from vibroimpact.scene import parse_scene
-from vibroimpact.study.run import run_study
+from vibroimpact.runs.run import run_study
 from tests.study.test_bifurcation import SMALL
 
 
@@ -33,7 +33,7 @@ def test_the_page_opens_with_its_answer(dataset: xr.Dataset) -> None:
     settles on no periodic motion, where the closed-form orbit is stable, how many special points of each kind."""
     import numpy as np
 
-    from vibroimpact.reporting.bifurcation_page import answer_text, headline
+    from vibroimpact.kinds.bifurcation.page import answer_text, headline
 
     amplitude = np.nanmax(dataset["brute_x1_amplitude"].values[0], axis=-1)  # (sweep, frequency)
     sweep, k = np.unravel_index(int(np.nanargmax(amplitude)), amplitude.shape)

@@ -11,14 +11,14 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from vibroimpact.reporting.concepts_figures import concept_colour, impact_figure, overview_figure, response_figure
-from vibroimpact.reporting.concepts_page import write_concepts_report
-from vibroimpact.reporting.concepts_table import COLUMNS, best_rows, verdicts
-from vibroimpact.scene.concepts import parse_concepts
-from vibroimpact.study.concepts_branches import BRANCH_FIELDS
-from vibroimpact.study.concepts_cases import CASE_FIELDS, COMPLEX_FIELDS
-from vibroimpact.study.concepts_closed import closed_forms
-from vibroimpact.study.concepts_dataset import concepts_dataset
+from vibroimpact.kinds.concepts.page import concept_colour, impact_figure, overview_figure, response_figure
+from vibroimpact.kinds.concepts.page import write_concepts_report
+from vibroimpact.kinds.concepts.page import COLUMNS, best_rows, verdicts
+from vibroimpact.kinds.concepts.scene import parse_concepts
+from vibroimpact.kinds.concepts.branches import BRANCH_FIELDS
+from vibroimpact.kinds.concepts.cases import CASE_FIELDS, COMPLEX_FIELDS
+from vibroimpact.kinds.concepts.study import closed_forms
+from vibroimpact.kinds.concepts.study import concepts_dataset
 
 DOCUMENT = {
     "name": "page",

@@ -13,9 +13,9 @@ import xarray as xr
 import yaml
 
 from vibroimpact.analysis.linear import resonance_peaks
-from vibroimpact.analysis.regime import Regime
+from vibroimpact.analysis.stability import Regime
 from vibroimpact.model.system import PAPER_SYSTEM
-from vibroimpact.reporting.design_metrics import (
+from vibroimpact.kinds.stepped.design_metrics import (
     DesignRegime,
     FrequencyBands,
     band_peaks,
@@ -25,11 +25,11 @@ from vibroimpact.reporting.design_metrics import (
     no_stop_peaks,
     regime_map,
 )
-from vibroimpact.reporting.design_page import DesignMapPage, frequency_ranges
-from vibroimpact.reporting.design_ranking import Candidate, design_map, rank, recommend
+from vibroimpact.kinds.stepped.design_page import DesignMapPage, frequency_ranges
+from vibroimpact.kinds.stepped.design_ranking import Candidate, design_map, rank, recommend
 from vibroimpact.reporting.report import page_for, write_report
 from vibroimpact.scene import parse_scene
-from vibroimpact.study.run import run_study
+from vibroimpact.runs.run import run_study
 
 #: Synthetic system: natural frequencies 20 and 40 Hz, anti-resonance 30 Hz; splits at 25 and 35 Hz, working band
 #: 29.1-30.9 Hz (3 %).
@@ -272,7 +272,7 @@ def test_the_page_of_a_real_study_names_its_recommendation(paper_map: xr.Dataset
 def test_the_closed_form_coexists_only_where_it_is_another_orbit(simulated: float, closed_form_larger: bool) -> None:
     """The simulation settled on the closed form's own orbit (|X1| equal to round-off) is one steady state, not two
     coexisting ones: the page's dagger and "coexists" once followed a 1e-14 change of the simulated amplitude."""
-    from vibroimpact.reporting.design_metrics import worst_stable_x1
+    from vibroimpact.kinds.stepped.design_metrics import worst_stable_x1
 
     ds = synthetic([0.2], [1e-3], ("linear", "pgf", "exact"))
     put(ds, at(ds, "pgf", 0, 0, 24.0), x1_amplitude=3e-3, regime=int(Regime.ONE_IMPACT), stable=1, impacts_per_period=1.0)

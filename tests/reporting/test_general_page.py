@@ -13,13 +13,13 @@ import pytest
 import xarray as xr
 
 from vibroimpact.reporting import page as page_module
-from vibroimpact.reporting.general_figures import response_panels_figure, structure_figure
-from vibroimpact.reporting.stepped_page import FrequencyResponsePage, unswept_restitution
-from vibroimpact.reporting.general_record import general_setting
+from vibroimpact.kinds.stepped.figures import response_panels_figure, structure_figure
+from vibroimpact.kinds.stepped.page import FrequencyResponsePage, unswept_restitution
+from vibroimpact.reporting.record import general_setting
 from vibroimpact.reporting.report import page_for, write_report
-from vibroimpact.reporting.responses import regime_figure
+from vibroimpact.kinds.stepped.responses import regime_figure
 from vibroimpact.scene import parse_scene
-from vibroimpact.study.run import run_study
+from vibroimpact.runs.run import run_study
 
 from tests.reporting.test_report_pages import quick_save
 

@@ -8,8 +8,8 @@ import xarray as xr
 
 from vibroimpact.analysis.linear import linear_response, resonance_peaks
 from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.reporting.general_record import GeneralSetting
-from vibroimpact.reporting.reduction import paper_reduction_factors, reduction_factors
+from vibroimpact.reporting.record import GeneralSetting
+from vibroimpact.kinds.stepped.tables import paper_reduction_factors, reduction_factors
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
 

@@ -9,7 +9,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
-from vibroimpact.analysis.regime import Regime
+from vibroimpact.analysis.stability import Regime
 from vibroimpact.reporting.style import QUANTITIES, SOLUTION_DESCRIPTIONS, SOLUTION_TITLES
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, SOLUTIONS
 from vibroimpact.scene.variables import VARIABLE_ATTRIBUTES
@@ -88,7 +88,7 @@ def test_lyapunov_figure_draws_every_non_periodic_point_in_the_colour_of_its_kin
     says how the exponent was estimated and what the thresholds are."""
     from matplotlib.colors import to_hex
 
-    from vibroimpact.reporting.motion_figure import lyapunov_figure
+    from vibroimpact.kinds.stepped.page import lyapunov_figure
     from vibroimpact.reporting.style import REGIME_COLOURS
 
 
@@ -116,7 +116,7 @@ def test_agreement_table_counts_each_kind_of_non_periodic_motion() -> None:
     import html as html_module
 
     from vibroimpact.reporting.record import study_setting
-    from vibroimpact.reporting.tables import agreement_table
+    from vibroimpact.kinds.stepped.tables import agreement_table
 
     dataset = steady_dataset()
     split = study_setting(dataset).split_frequency

@@ -10,12 +10,12 @@ import pytest
 import xarray as xr
 
 from vibroimpact.reporting import page as page_module
-from vibroimpact.reporting.accuracy_page import AccuracyPage
-from vibroimpact.reporting.bumper_page import BumperStiffnessPage
+from vibroimpact.kinds.benchmark.page import AccuracyPage
+from vibroimpact.kinds.stepped.page import BumperStiffnessPage
 from vibroimpact.reporting.record import StudyRecord, stored_description, study_kind, study_record, study_setting
 from vibroimpact.reporting.report import page_for, write_report
-from vibroimpact.reporting.stepped_page import FrequencyResponsePage
-from vibroimpact.reporting.sweep_page import SweptSinePage, swept_sine_run
+from vibroimpact.kinds.stepped.page import FrequencyResponsePage
+from vibroimpact.kinds.swept.page import SweptSinePage, swept_sine_run
 
 from tests.reporting.test_report_pages import quick_save
 from tests.reporting.test_report_support import benchmark_dataset, steady_dataset, stiffness_dataset, swept_dataset
@@ -113,7 +113,7 @@ def test_the_study_kind_attribute_decides_and_is_checked() -> None:
     ds.attrs = dict(ds.attrs, study_kind="benchmark")
     assert study_kind(ds) == "benchmark"
     ds.attrs["study_kind"] = "continuation"
-    with pytest.raises(ValueError, match="study_kind must be one of stepped, swept, benchmark"):
+    with pytest.raises(ValueError, match="study_kind must be one of concepts, validation, benchmark, bifurcation, swept, stepped"):
         study_kind(ds)
     with pytest.raises(ValueError, match="kind must be one of"):
         StudyRecord(kind="other", name="x", description="", scene_text="", version="0")

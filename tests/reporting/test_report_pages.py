@@ -11,13 +11,13 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
-from vibroimpact.reporting.reduction import DEFINITION
-from vibroimpact.analysis.regime import Regime
+from vibroimpact.kinds.stepped.tables import DEFINITION
+from vibroimpact.analysis.stability import Regime
 from vibroimpact.reporting import page as page_module
 from vibroimpact.reporting.report import page_for
 from vibroimpact.reporting.page import DrawnFigure, Figure, Section, Table, render_page, save_figure
-from vibroimpact.reporting.general_record import general_setting
-from vibroimpact.reporting.tables import reduction_tables
+from vibroimpact.reporting.record import general_setting
+from vibroimpact.kinds.stepped.tables import reduction_tables
 
 from tests.reporting.test_report_support import setting_of, steady_dataset, swept_dataset
 

@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from vibroimpact.reporting.bumper_page import peak_acceleration_figure
-from vibroimpact.reporting.responses import response_figure, simulation_figure
+from vibroimpact.kinds.stepped.page import peak_acceleration_figure
+from vibroimpact.kinds.stepped.responses import response_figure, simulation_figure
 from vibroimpact.reporting.record import study_setting
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
-from vibroimpact.reporting.sweep_page import sweep_figures, swept_sine_run
+from vibroimpact.kinds.swept.page import sweep_figures, swept_sine_run
 
 from tests.reporting.test_report_support import shown_points, steady_dataset, swept_dataset
 

@@ -21,11 +21,11 @@ from matplotlib.figure import Figure as MatplotlibFigure
 from matplotlib.lines import Line2D
 from matplotlib.text import Text
 
-from vibroimpact.analysis.regime import Regime, regime_attributes
+from vibroimpact.analysis.stability import Regime, regime_attributes
 from vibroimpact.reporting.record import StudySetting, study_setting
 from vibroimpact.reporting.style import DPI, FIGURE_WIDTH
 from vibroimpact.scene import parse_scene
-from vibroimpact.study.run import run_study
+from vibroimpact.runs.run import run_study
 from vibroimpact.simulation.swept import sweep_quantities
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
@@ -226,12 +226,12 @@ def _one_regime_panel() -> xr.Dataset:
 
 def _builders() -> dict[str, Callable[[], list[Any]]]:
     """Every kind of report figure, each built from a tiny dataset: name -> () -> list of DrawnFigure."""
-    from vibroimpact.reporting.accuracy_page import accuracy_figures
-    from vibroimpact.reporting.bumper_page import peak_acceleration_figure, peak_figure, stiffness_figure
-    from vibroimpact.reporting.motion_figure import lyapunov_figure
-    from vibroimpact.reporting.responses import linear_figure, regime_figure, response_figure, simulation_figure, stability_figure
+    from vibroimpact.kinds.benchmark.page import accuracy_figures
+    from vibroimpact.kinds.stepped.page import peak_acceleration_figure, peak_figure, stiffness_figure
+    from vibroimpact.kinds.stepped.page import lyapunov_figure
+    from vibroimpact.kinds.stepped.responses import linear_figure, regime_figure, response_figure, simulation_figure, stability_figure
     from vibroimpact.scene.schema import ENGINE_SOLUTIONS
-    from vibroimpact.reporting.sweep_page import sweep_figures, swept_sine_run
+    from vibroimpact.kinds.swept.page import sweep_figures, swept_sine_run
 
     def steady() -> xr.Dataset:
         return steady_dataset()

@@ -78,7 +78,7 @@ def test_all_problems_at_once_and_the_stop_is_required() -> None:
 
 def test_the_settings_default_directions_are_the_sweep_directions() -> None:
     """bifurcation_settings imports nothing from the scene layer (no circle with schema): its default is a copy."""
-    from vibroimpact.scene.bifurcation_settings import BruteForceSettings
+    from vibroimpact.kinds.bifurcation.scene import BruteForceSettings
     from vibroimpact.scene.schema import SWEEP_DIRECTIONS
 
     assert BruteForceSettings.__dataclass_fields__["directions"].default == SWEEP_DIRECTIONS

@@ -17,10 +17,11 @@ FORBIDDEN = (
     "netCDF4",
     "vibroimpact.simulation.steady",
     "vibroimpact.simulation.harmonics",
-    "vibroimpact.benchmarks",
-    "vibroimpact.study",
+    "vibroimpact.runs",
     "vibroimpact.reporting",
 )
+#: What reading a scene may load of a kind's folder: its scene section (``vibroimpact.kinds.<kind>.scene``, ``.settings``).
+KIND_SCENE_MODULES = ("scene", "settings")
 #: What the scene may use of the engines package: the settings and the registry of names (no engine module).
 ENGINE_MODULES_ALLOWED = ("vibroimpact.engines", "vibroimpact.engines.settings", "vibroimpact.engines.registry")
 
@@ -28,7 +29,7 @@ ENGINE_MODULES_ALLOWED = ("vibroimpact.engines", "vibroimpact.engines.settings",
 _PROGRAM = """
 import json, sys
 import vibroimpact.scene as scene
-for path in sorted(scene.shipped_studies_dir().glob("*.yaml")):
+for path in sorted(scene.shipped_studies_dir().rglob("*.yaml")):
     scene.load_scene(path)
 print(json.dumps(sorted(sys.modules)))
 """
@@ -48,7 +49,9 @@ def forbidden_among(modules: list[str]) -> list[str]:
     return [
         name
         for name in modules
-        if any(under(name, package) for package in FORBIDDEN) or (under(name, "vibroimpact.engines") and name not in ENGINE_MODULES_ALLOWED)
+        if any(under(name, package) for package in FORBIDDEN)
+        or (under(name, "vibroimpact.engines") and name not in ENGINE_MODULES_ALLOWED)
+        or (under(name, "vibroimpact.kinds") and name.count(".") == 3 and name.rsplit(".", 1)[1] not in KIND_SCENE_MODULES)
     ]
 
 
@@ -64,6 +67,12 @@ def test_the_check_sees_an_engine_module() -> None:
     found = forbidden_among(modules)
     assert "vibroimpact.engines.momentary" in found
     assert any(name.startswith("sksundae") for name in found)
+
+
+def test_the_check_sees_a_kind_study_module() -> None:
+    """A kind's study module (its run) is no part of reading a scene, and the check names it."""
+    modules = loaded_modules("import vibroimpact.kinds.stepped.study\n" + _PROGRAM)
+    assert "vibroimpact.kinds.stepped.study" in forbidden_among(modules)
 
 
 def test_engine_names_come_from_the_registry() -> None:

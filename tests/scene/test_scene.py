@@ -272,7 +272,7 @@ def test_empty_file_is_an_error(tmp_path: Path) -> None:
     with pytest.raises(SceneError) as caught:
         load_scene(path)
     assert len(caught.value.problems) == 1
-    assert caught.value.problems[0].startswith("scene: expected a mapping with keys") and caught.value.problems[0].endswith("got an empty document")
+    assert caught.value.problems[0].startswith("scene: expected a mapping of a scene's sections") and caught.value.problems[0].endswith("got an empty document")
 
 
 def test_load_scene_names_the_file_and_keeps_the_text(tmp_path: Path) -> None:

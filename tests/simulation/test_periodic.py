@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from vibroimpact.analysis.pgf import solve_one_impact
-from vibroimpact.analysis.regime import Regime
+from vibroimpact.analysis.stability import Regime
 from vibroimpact.engines.registry import make_engine
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce

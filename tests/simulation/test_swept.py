@@ -11,7 +11,7 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.stops import Stop
+from vibroimpact.model.contact import Stop
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.simulation.swept import SWEEP_STOP_QUANTITIES, sweep_estimates, sweep_quantities, sweep_start_state

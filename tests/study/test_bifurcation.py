@@ -7,10 +7,10 @@ import pytest
 import xarray as xr
 
 from vibroimpact.scene import parse_scene
-from vibroimpact.study.bifurcation import scene_problem
-from vibroimpact.study.bifurcation_branches import closed_form_orbits
-from vibroimpact.study.io import write_dataset
-from vibroimpact.study.run import run_study
+from vibroimpact.kinds.bifurcation.study import scene_problem
+from vibroimpact.kinds.bifurcation.branches import closed_form_orbits
+from vibroimpact.runs.run import write_dataset
+from vibroimpact.runs.run import run_study
 
 SMALL = {
     "name": "bif_small",
@@ -103,7 +103,7 @@ def test_brute_force_settles_on_the_stable_branch(dataset: xr.Dataset) -> None:
 @pytest.mark.slow
 def test_the_shipped_study_runs(tmp_path) -> None:
     from vibroimpact.scene import find_scene, load_scene
-    from vibroimpact.study.store import StudyStore, store_fingerprint
+    from vibroimpact.runs.store import StudyStore, store_fingerprint
 
     scene = load_scene(find_scene("bifurcation"))
     store = StudyStore(tmp_path / "bifurcation.zarr", store_fingerprint(scene.text))  # its cases kept as they finish

@@ -16,9 +16,9 @@ from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.reporting.report import write_report
 from vibroimpact.scene import parse_scene, read_yaml
-from vibroimpact.study.bifurcation import scene_problem
-from vibroimpact.study.bifurcation_branches import ORIGINS, closed_form_orbits
-from vibroimpact.study.run import run_study
+from vibroimpact.kinds.bifurcation.study import scene_problem
+from vibroimpact.kinds.bifurcation.branches import ORIGINS, closed_form_orbits
+from vibroimpact.runs.run import run_study
 
 #: The paper's system as matrices (k1 + k2 = 29300, b1 + b2 = 0.88), force on x1: the named form's structure.
 MATRICES = {"mass": [[1.0, 0.0], [0.0, 0.1]], "stiffness": [[29300.0, -4300.0], [-4300.0, 4300.0]], "damping": [[0.88, -0.08], [-0.08, 0.08]], "coordinates": ["x1", "x2"]}

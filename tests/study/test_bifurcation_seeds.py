@@ -9,12 +9,12 @@ from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.stops import Stop
+from vibroimpact.model.contact import Stop
 from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.orbits.continuation import ContinuationSettings
-from vibroimpact.study.bifurcation_branches import find_branches
-from vibroimpact.study.bifurcation_cases import SweepCase
-from vibroimpact.study.bifurcation_seeds import seed_branches, sweep_seeds
+from vibroimpact.kinds.bifurcation.branches import find_branches
+from vibroimpact.kinds.bifurcation.cases import SweepCase
+from vibroimpact.kinds.bifurcation.cases import seed_branches, sweep_seeds
 
 pytestmark = pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")
 

@@ -12,10 +12,10 @@ from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.stops import Stop
+from vibroimpact.model.contact import Stop
 from vibroimpact.model.system import PAPER_SYSTEM
-from vibroimpact.study import bifurcation_cases
-from vibroimpact.study.bifurcation_cases import MOTION_CLASSES, SweepCase
+from vibroimpact.kinds.bifurcation import cases as bifurcation_cases
+from vibroimpact.kinds.bifurcation.cases import MOTION_CLASSES, SweepCase
 
 #: The paper's layout at R = 0.2, 34 Hz: a non-periodic attractor (Lyapunov exponent ~0.11 per period).
 AT_34_HZ = ImpactProblem(PAPER_SYSTEM.structure, (Stop(RigidStop(3e-3, 0.2), coordinate=1),), HarmonicForce(10.0, 34.0))

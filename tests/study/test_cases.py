@@ -13,10 +13,10 @@ from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.simulation.settings import SteadySettings
-from vibroimpact.study import cases as study_cases
-from vibroimpact.study.cases import SimulationCase
-from vibroimpact.study.runner import Runner
-from vibroimpact.study.store import StudyStore
+from vibroimpact.kinds.stepped import cases as study_cases
+from vibroimpact.kinds.stepped.cases import SimulationCase
+from vibroimpact.runs.runner import Runner
+from vibroimpact.runs.store import StudyStore
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
 from tests.simulation.test_steady import pgf_values

@@ -11,8 +11,8 @@ import yaml
 from compliance_checker.runner import CheckSuite, ComplianceChecker
 
 from vibroimpact.scene import parse_scene
-from vibroimpact.study.io import write_dataset
-from vibroimpact.study.run import run_study
+from vibroimpact.runs.run import write_dataset
+from vibroimpact.runs.run import run_study
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
 from tests.study.test_swept_study import sweep_document

@@ -12,14 +12,14 @@ from vibroimpact.engines.base import Trajectory
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.stops import Stop
+from vibroimpact.model.contact import Stop
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.checker import SceneError
-from vibroimpact.scene.concepts import parse_concepts
+from vibroimpact.kinds.concepts.scene import parse_concepts
 from vibroimpact.model.absorber import den_hartog_absorber
-from vibroimpact.study.concepts_metrics import anti_resonance_band, band_metrics, envelope, stretches
-from vibroimpact.simulation.layout import base_force, base_weights
-from vibroimpact.study.concepts_steady import check_stops
+from vibroimpact.kinds.concepts.metrics import anti_resonance_band, band_metrics, envelope, stretches
+from vibroimpact.simulation.harmonics import base_force, base_weights
+from vibroimpact.kinds.concepts.branches import check_stops
 
 SYSTEM = TwoDofSystem(1.0, 0.1, 25000.0, 4300.0, 0.8, 0.08)
 
@@ -151,7 +151,7 @@ def test_every_problem_names_its_key(change, key: str) -> None:
 
 def test_the_shipped_scene() -> None:
     """studies/absorber_concepts.yaml: the six concepts of issue 12 item 4, Den Hartog's optimum where it says so."""
-    from vibroimpact.scene.locate import shipped_studies_dir
+    from vibroimpact.scene.reader import shipped_studies_dir
     from vibroimpact.scene.reader import read_yaml
 
     document = read_yaml((shipped_studies_dir() / "absorber_concepts.yaml").read_text(encoding="utf-8"))

@@ -12,8 +12,8 @@ import xarray as xr
 
 from vibroimpact.analysis.pgf import solve_one_impact
 from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.scene.concepts import parse_concepts
-from vibroimpact.study.concepts import ConceptsStudy, run_concepts
+from vibroimpact.kinds.concepts.scene import parse_concepts
+from vibroimpact.kinds.concepts.study import ConceptsStudy, run_concepts
 
 DOCUMENT = {
     "name": "tiny_concepts",

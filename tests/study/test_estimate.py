@@ -10,12 +10,12 @@ import yaml
 
 from vibroimpact import cli
 from vibroimpact.model.contact import RigidStop
-from vibroimpact.study.cost_model import default_costs
-from vibroimpact.study.estimate import SPEED_FACTOR_RANGE, estimate_scene, speed_factor
-from vibroimpact.study.stepped import expected_periods
+from vibroimpact.runs.estimate import default_costs
+from vibroimpact.runs.estimate import SPEED_FACTOR_RANGE, estimate_scene, speed_factor
+from vibroimpact.kinds.stepped.study import expected_periods
 from vibroimpact.scene import load_scene, parse_scene, shipped_studies_dir
-from vibroimpact.study.cases import SimulationCase, run_case
-from vibroimpact.study.run import run_study
+from vibroimpact.kinds.stepped.cases import SimulationCase, run_case
+from vibroimpact.runs.run import run_study
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
 

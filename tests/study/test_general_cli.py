@@ -13,7 +13,7 @@ import xarray as xr
 import yaml
 
 from vibroimpact import cli
-from vibroimpact.analysis.regime import Regime
+from vibroimpact.analysis.stability import Regime
 from vibroimpact.scene import load_scene, shipped_studies_dir
 
 SCENE: dict[str, Any] = {

@@ -9,11 +9,11 @@ from typing import Any
 import numpy as np
 
 from vibroimpact.scene import parse_scene
-from vibroimpact.study.cases import SimulationCase, run_case
-from vibroimpact.study.estimate import estimate_scene
-from vibroimpact.study.general_estimate import UNKNOWN_WANDERING, closed_form_scale, engine_scale
-from vibroimpact.study.general_values import scene_problem
-from vibroimpact.study.stepped import SETTLING_PERIODS, expected_periods
+from vibroimpact.kinds.stepped.cases import SimulationCase, run_case
+from vibroimpact.runs.estimate import estimate_scene
+from vibroimpact.kinds.stepped.study import UNKNOWN_WANDERING, closed_form_scale, engine_scale
+from vibroimpact.kinds.stepped.values import scene_problem
+from vibroimpact.kinds.stepped.study import SETTLING_PERIODS, expected_periods
 
 SCENE: dict[str, Any] = {
     "name": "relative_estimate",

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from vibroimpact.analysis.regime import Regime
+from vibroimpact.analysis.stability import Regime
 from vibroimpact.scene import parse_scene
-from vibroimpact.study.run import run_study
+from vibroimpact.runs.run import run_study
 
 NAMED = {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0, "b1": 0.8, "b2": 0.08}
 MATRICES = {"mass": [[1.0, 0.0], [0.0, 0.1]], "stiffness": [[29300.0, -4300.0], [-4300.0, 4300.0]], "damping": [[0.88, -0.08], [-0.08, 0.08]]}
@@ -207,9 +207,9 @@ def test_a_mass_held_on_a_preloading_stop_is_not_called_linear(tmp_path) -> None
     """k = 1e4 N/m pressed 1 mm into its stop (x1 <= -1 mm: a 10 N preload) by nothing; a 5 N force never lifts it. The
     exact engine holds it (amplitude ~0, contact force = the force's fundamental): periodic motion with sticking
     (regime 8), not the linear regime, whose response would cross the stop (regime 6)."""
-    from vibroimpact.analysis.regime import Regime
+    from vibroimpact.analysis.stability import Regime
     from vibroimpact.scene import load_scene
-    from vibroimpact.study.run import run_study
+    from vibroimpact.runs.run import run_study
 
     text = """
 name: held

@@ -1,23 +1,52 @@
-"""The kinds of study are one vocabulary: every kind a scene can be has its run and estimate, and the shipped
-scenes cover every kind."""
+"""The kinds of study are one table: every kind a scene can be has its scene section, its run and estimate and its
+page, the precedence of kinds is the table's order, and the shipped scenes cover every kind."""
 
 from __future__ import annotations
 
-from vibroimpact.scene import load_scene
-from vibroimpact.scene.locate import shipped_studies_dir
-from vibroimpact.scene.schema import STUDY_KINDS
-from vibroimpact.study.kinds import KINDS, study_kind
+import pytest
+
+from vibroimpact.runs.run import study_kind
+from vibroimpact.scene import SceneError, load_scene, parse_scene
+from vibroimpact.scene.kinds import KIND_NAMES, KINDS, Kind, kind_named, kind_of_document
+from vibroimpact.scene.reader import shipped_studies_dir
 
 
-def test_every_kind_a_scene_can_be_has_a_study_type() -> None:
-    assert tuple(KINDS) == STUDY_KINDS
-    assert all(KINDS[name].name == name for name in KINDS)
+def test_every_row_of_the_table_resolves_to_its_scene_parser_study_and_page() -> None:
+    for kind in KINDS:
+        study = kind.make_study()
+        assert study.name == kind.name
+        assert callable(study.run) and callable(study.estimate)
+        for target in (kind.scene, kind.page):
+            module, _, attribute = target.partition(":")
+            assert callable(getattr(__import__(module, fromlist=[attribute]), attribute)), target
+    assert [kind.section for kind in KINDS].count(None) == 1 and KINDS[-1].section is None  # the last row takes the rest
+    assert len(set(KIND_NAMES)) == len(KINDS)
 
 
-def test_each_shipped_scene_is_run_by_the_type_of_its_kind() -> None:
+def test_each_shipped_scene_is_run_by_the_study_of_its_kind() -> None:
     seen = set()
     for path in sorted(shipped_studies_dir().rglob("*.yaml")):  # validation scenes live in studies/validation/
         scene = load_scene(path)
-        assert study_kind(scene) is KINDS[scene.kind]
+        assert type(study_kind(scene)) is type(kind_named(scene.kind).make_study())
+        assert study_kind(scene).name == scene.kind
         seen.add(scene.kind)
-    assert seen == set(STUDY_KINDS), f"no shipped scene of kind {set(STUDY_KINDS) - seen}"
+    assert seen == set(KIND_NAMES), f"no shipped scene of kind {set(KIND_NAMES) - seen}"
+
+
+def test_the_precedence_of_kinds_is_the_table_order_for_documents_and_scenes() -> None:
+    """A document with two kinds' sections is the earlier row's kind, when read and when asked of the scene: the one
+    precedence, spelled once. The later section is then a key that kind does not take: an error naming it."""
+    assert kind_of_document({"concepts": {}, "bifurcation": {}}).name == "concepts"
+    assert kind_of_document({"swept_sine": {}}).name == "swept"
+    assert kind_of_document({"name": "x"}).name == "stepped"
+    base = {"name": "s", "system": {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0}, "excitation": {"amplitude": 10.0}, "stop": {"clearance": 0.003}}
+    document = base | {"bifurcation": {"restitution": 0.2, "frequency": {"start": 20.0, "stop": 30.0}}, "swept_sine": {"rate": 1.0}}
+    with pytest.raises(SceneError, match="swept_sine"):
+        parse_scene(document)
+
+
+def test_a_row_names_modules_of_the_kinds_package() -> None:
+    with pytest.raises(ValueError, match="study"):
+        Kind("x", "x", "vibroimpact.kinds.x.scene:parse", "vibroimpact.runs.run:run_study", "vibroimpact.kinds.x.page:page_for")
+    with pytest.raises(KeyError, match="stepped"):
+        kind_named("nonsense")

@@ -13,7 +13,7 @@ import xarray as xr
 
 from vibroimpact.reporting.report import page_for, write_report
 from vibroimpact.scene import parse_scene
-from vibroimpact.study.run import run_study
+from vibroimpact.runs.run import run_study
 
 from tests.golden.golden import fixed_timings, page_text
 
@@ -106,7 +106,7 @@ def test_the_sections_follow_what_the_dataset_holds(changes: dict[str, Any], ext
     the paper's two-mass chain x1, x2 (another load or stop included), a panel per coordinate and stop where there are
     several stops or no named view, the paper's figure per quantity otherwise."""
     from vibroimpact.reporting import page as page_module
-    from vibroimpact.reporting.stepped_page import FrequencyResponsePage
+    from vibroimpact.kinds.stepped.page import FrequencyResponsePage
     from tests.reporting.test_report_pages import quick_save
 
     monkeypatch.setattr(page_module, "save_figure", quick_save)

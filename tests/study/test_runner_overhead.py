@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from vibroimpact.scene import parse_scene
-from vibroimpact.study.blocks import SIMULATED_POINTS, plan_blocks
-from vibroimpact.study.runner import Runner, _run_cases
-from vibroimpact.study.general_stepped import general_block
-from vibroimpact.study.store import StudyStore
+from vibroimpact.runs.blocks import SIMULATED_POINTS, plan_blocks
+from vibroimpact.runs.runner import Runner, _run_cases
+from vibroimpact.kinds.stepped.study import general_block
+from vibroimpact.runs.store import StudyStore
 
 from tests.study.test_estimate import small_scene
 
@@ -54,7 +54,7 @@ def test_the_runner_costs_under_a_tenth_of_an_exact_block(tmp_path: Path) -> Non
     store = StudyStore(tmp_path / "s.zarr", "overhead")
     plan = plan_blocks(scene, 2)
     variables = {name: (tuple(map(str, v.dims)), np.asarray(v.values), dict(v.attrs)) for name, v in block.data_vars.items()}
-    from vibroimpact.study.blocks import _template
+    from vibroimpact.runs.blocks import _template
 
     store.begin_grid(_template(variables, dict(zip(("restitution", "clearance", "bumper_frequency", "sweep", "frequency"), plan.full)) | {"solution": 3}, {"frequency": plan.full[-1]}), 10, (plan.full, plan.block))
     started = time.perf_counter()

@@ -9,10 +9,10 @@ import pytest
 import xarray as xr
 import yaml
 
-from vibroimpact.analysis.regime import Regime
+from vibroimpact.analysis.stability import Regime
 from vibroimpact.scene import load_scene, parse_scene
-from vibroimpact.study.io import write_dataset
-from vibroimpact.study.run import run_study
+from vibroimpact.runs.run import write_dataset
+from vibroimpact.runs.run import run_study
 
 DATA = Path(__file__).parents[1] / "data"
 

@@ -11,7 +11,7 @@ import xarray as xr
 
 from vibroimpact.model.contact import peak_acceleration_factor, restitution_from_loss_factor
 from vibroimpact.scene import parse_scene
-from vibroimpact.study.run import run_study
+from vibroimpact.runs.run import run_study
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
 

@@ -13,9 +13,9 @@ import pytest
 import xarray as xr
 
 from vibroimpact import cli
-from vibroimpact.reporting.general_record import is_general
+from vibroimpact.reporting.record import is_general
 from vibroimpact.scene import SceneError, parse_scene
-from vibroimpact.study.run import run_study
+from vibroimpact.runs.run import run_study
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
 
@@ -165,7 +165,7 @@ def test_relative_stops_sweep_page_draws_every_coordinate_and_stop(relative_run:
     import matplotlib.pyplot as plt
 
     from vibroimpact.reporting.report import page_for
-    from vibroimpact.reporting.sweep_page import GeneralSweptPage, sweep_figures, sweep_layout, swept_sine_run
+    from vibroimpact.kinds.swept.page import GeneralSweptPage, sweep_figures, sweep_layout, swept_sine_run
     from tests.reporting.test_report_support import shown_points
 
     ds = relative_run

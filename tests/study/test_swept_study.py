@@ -10,10 +10,10 @@ import pytest
 import xarray as xr
 import yaml
 
-from vibroimpact.analysis.regime import Regime
+from vibroimpact.analysis.stability import Regime
 from vibroimpact.scene import parse_scene
-from vibroimpact.study.io import write_dataset
-from vibroimpact.study.run import run_study
+from vibroimpact.runs.run import write_dataset
+from vibroimpact.runs.run import run_study
 from vibroimpact.model.system import PAPER_SYSTEM
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
@@ -39,7 +39,7 @@ def sweep_document(**changes: Any) -> dict[str, Any]:
 @pytest.fixture(scope="module")
 def sweep_run(tmp_path_factory: pytest.TempPathFactory) -> xr.Dataset:
     """The sweeps on two dask workers, each finished case kept in a store on disk (as run-study does)."""
-    from vibroimpact.study.store import StudyStore, store_fingerprint
+    from vibroimpact.runs.store import StudyStore, store_fingerprint
 
     document = sweep_document()
     text = yaml.safe_dump(document)

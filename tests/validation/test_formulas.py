@@ -1,6 +1,6 @@
 """The closed forms of the validation scenes against independent derivations: each impact map is written out here
 from its flight (root-found next impact, finite-difference Jacobian), so a slip in the algebra of
-:mod:`vibroimpact.study.validation_formulas` shows as a disagreement."""
+:mod:`vibroimpact.kinds.validation.formulas` shows as a disagreement."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from vibroimpact.study.validation_formulas import (
+from vibroimpact.kinds.validation.formulas import (
     ball_existence,
     ball_multipliers,
     ball_period_doubling,

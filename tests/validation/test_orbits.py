@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vibroimpact.scene.validation_settings import BouncingBallCase, BuddDuxCase, GrazingCase
-from vibroimpact.study.validation_formulas import (
+from vibroimpact.kinds.validation.settings import BouncingBallCase, BuddDuxCase, GrazingCase
+from vibroimpact.kinds.validation.formulas import (
     ball_existence,
     ball_period_doubling,
     ball_period_doubling_high_bounce,
@@ -15,7 +15,7 @@ from vibroimpact.study.validation_formulas import (
     budd_dux_residual,
     grazing_amplitude,
 )
-from vibroimpact.study.validation_orbits import run_bouncing_ball, run_budd_dux, run_grazing
+from vibroimpact.kinds.validation.orbits import run_bouncing_ball, run_budd_dux, run_grazing
 
 
 def _failed(outcome) -> list[tuple[str, float, float]]:
@@ -66,7 +66,7 @@ def test_bouncing_ball_brute_force_doubles_where_the_branch_does() -> None:
     """The brute-force sweep (each Gamma from the last end state) has one impact speed per period up to the period
     doubling, and two distinct ones just above it (period two)."""
     case = BouncingBallCase(acceleration=(1.1, 1.7), brute_step=0.02)
-    from vibroimpact.study.validation_ball import brute_force
+    from vibroimpact.kinds.validation.orbits import brute_force
 
     data = brute_force(case)
     gamma = data["brute_acceleration"].values

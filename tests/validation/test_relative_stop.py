@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vibroimpact.scene.validation_problems import relative_stop_problem
-from vibroimpact.scene.validation_settings import RelativeStopCase
-from vibroimpact.study.validation_runs import free_flight, run_relative_stop
+from vibroimpact.kinds.validation.scene import relative_stop_problem
+from vibroimpact.kinds.validation.settings import RelativeStopCase
+from vibroimpact.kinds.validation.study import free_flight, run_relative_stop
 
 
 def test_free_flight_is_the_linear_flow() -> None:

@@ -8,8 +8,8 @@ import pytest
 
 from vibroimpact.scene.checker import SceneError
 from vibroimpact.scene.reader import read_yaml
-from vibroimpact.scene.validation import read_validation_scene
-from vibroimpact.scene.validation_settings import CASE_PARAMETERS, VALIDATION_CASES, BuddDuxCase
+from vibroimpact.kinds.validation.scene import read_validation_scene
+from vibroimpact.kinds.validation.settings import CASE_PARAMETERS, VALIDATION_CASES, BuddDuxCase
 
 STUDIES = Path(__file__).resolve().parents[2] / "studies" / "validation"
 

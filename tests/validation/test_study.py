@@ -7,13 +7,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vibroimpact.reporting.validation_page import ValidationPage, write_validation_report
+from vibroimpact.kinds.validation.page import ValidationPage, write_validation_report
 from vibroimpact.scene.reader import read_yaml
-from vibroimpact.scene.schema import STUDY_KINDS
-from vibroimpact.scene.validation import read_validation_scene
-from vibroimpact.study.io import write_dataset
-from vibroimpact.study.validation import run_validation
-from vibroimpact.study.validation_checks import PASSED_MEANINGS
+from vibroimpact.scene.kinds import KIND_NAMES as STUDY_KINDS
+from vibroimpact.kinds.validation.scene import read_validation_scene
+from vibroimpact.runs.run import write_dataset
+from vibroimpact.kinds.validation.study import run_validation
+from vibroimpact.kinds.validation.formulas import PASSED_MEANINGS
 
 from tests.study.test_cf import cf_findings
 

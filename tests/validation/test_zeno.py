@@ -8,9 +8,9 @@ import math
 import pytest
 
 from vibroimpact.engines.registry import RIGID, engine_names
-from vibroimpact.scene.validation_settings import ZenoCase
-from vibroimpact.study.validation_formulas import zeno_sticking_bounds, zeno_time
-from vibroimpact.study.validation_runs import run_zeno
+from vibroimpact.kinds.validation.settings import ZenoCase
+from vibroimpact.kinds.validation.formulas import zeno_sticking_bounds, zeno_time
+from vibroimpact.kinds.validation.study import run_zeno
 
 #: Every registered rigid-stop engine the case knows (``momentary`` is ``momentary_adams``).
 ENGINES = tuple(name for name in engine_names(RIGID) if name != "momentary")

@@ -14,7 +14,7 @@ The *antiperiodic* Green function is the response to impulses of alternating sig
 
     psi(t) = sum_k r_k exp(p_k t) / (1 + exp(p_k T / 2))
 
-(the two-sided symmetric stop, :mod:`.two_sided`). Its only harmonics are the odd ones, and unlike chi it stays
+(the two-sided symmetric stop, :mod:`~vibroimpact.analysis.impact_orbit`). Its only harmonics are the odd ones, and unlike chi it stays
 finite for a pole at 0 (a rigid-body mode) since 1 + exp(0) = 2. :func:`green_vector` gives either function for
 every coordinate at once from a :class:`~vibroimpact.model.modal.ModalResponse`.
 """

@@ -1,6 +1,6 @@
 """Which closed-form impact orbit a problem's layout has, and its harmonic load at any frequency.
 
-The closed forms (:mod:`.pgf` for one stop, :mod:`.two_sided` for a symmetric pair) superpose the linear response and
+The closed forms (:mod:`~vibroimpact.analysis.pgf` for one stop, :mod:`~vibroimpact.analysis.impact_orbit` for a symmetric pair) superpose the linear response and
 the response to a train of impulses through Green functions of the stopped coordinate. That needs
 
 * a harmonic force (the forcing must be periodic),

@@ -310,7 +310,7 @@ def solve_one_impact(
     :class:`ImpactProblem` of any structure with one rigid stop (absolute or relative, upper or lower) gives the
     general closed form (:class:`~vibroimpact.analysis.impact_orbit.ImpactOrbit`, exact Green functions only; omitted
     values are the problem's); ``ValueError`` saying why where it does not apply (several stops, a bumper, a rigid-body
-    mode; a symmetric two-sided stop is :func:`vibroimpact.analysis.two_sided.solve_two_impacts`).
+    mode; a symmetric two-sided stop is :func:`vibroimpact.analysis.impact_orbit.solve_two_impacts`).
 
     Parameters
     ----------

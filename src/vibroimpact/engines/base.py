@@ -41,7 +41,7 @@ class Trajectory:
         velocity for the paper's stop).
     impulses : ndarray
         Impulse of each impact [N s]: m_eff (1 + R) v, or m_eff v for the impact that ends a chattering sequence in
-        sticking (m_eff = M2 for the paper's stop, see :class:`~vibroimpact.model.stops.Stop`).
+        sticking (m_eff = M2 for the paper's stop, see :class:`~vibroimpact.model.contact.Stop`).
     segments : ndarray, shape (s, 3)
         Rows (start [s], end [s], mode): ``MODE_FREE`` flight or ``MODE_STUCK`` (a stop held closed).
     segment_states : ndarray, shape (s, 2 N)

@@ -2,12 +2,12 @@
 
 An engine subclasses :class:`EventLoopEngine` and implements only :meth:`EventLoopEngine._begin` (set up its
 integrator) and :meth:`EventLoopEngine._advance` (integrate from a state until the period boundary or the first
-event). Any N-dof structure with any rigid stops: the integrated state is (w, v) of :mod:`.flow_layout` (each
+event). Any N-dof structure with any rigid stops: the integrated state is (w, v) of :mod:`~vibroimpact.engines.flow_layout` (each
 stop's penetration u_k = n_k . x - Delta_k in place of one coordinate, so that positions near a stop keep their
 absolute precision; for the paper's layout (X1, X2 - Delta, X1', X2'); a stop hit without one, the second side of a
 two-sided stop, gets one by a switch of layout, :meth:`Model.carry`), followed, when harmonic moments are wanted, by
-the 3 N + 2 K quadratures of :mod:`.rigid_kernels`. A stop is held closed (*stuck*) with the constrained flow of
-:mod:`.flow_layout` and released when its holding force turns negative; an impact on another stop frees it unless
+the 3 N + 2 K quadratures of :mod:`~vibroimpact.engines.rigid_kernels`. A stop is held closed (*stuck*) with the constrained flow of
+:mod:`~vibroimpact.engines.flow_layout` and released when its holding force turns negative; an impact on another stop frees it unless
 it is still closed, at rest on it and pushed after the impulse. Sticking on two stops at once is refused
 (``NotImplementedError`` naming both). A relative stop's n . x' is set exactly (to -R v, or 0 at a stick or a
 release) so that round-off of two velocities never reads as an approach.
@@ -26,8 +26,7 @@ from numpy.typing import NDArray
 from vibroimpact.engines.registry import INTEGRATOR, Capabilities
 from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory, TrajectoryBuilder
 from vibroimpact.engines.flow_layout import flow_layout
-from vibroimpact.engines.rigid_contact import RigidContact
-from vibroimpact.engines.rigid_kernels import APEX, STUCK, events_kernel, holding_kernel, jacobian_kernel, pack_parameters, quadrature_count, rhs_kernel
+from vibroimpact.engines.rigid_kernels import RigidContact, APEX, STUCK, events_kernel, holding_kernel, jacobian_kernel, pack_parameters, quadrature_count, rhs_kernel
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.problem import ImpactProblem
 
@@ -36,7 +35,7 @@ __all__ = ["EventLoopEngine", "Stop", "Model", "moment_row"]
 
 def moment_row(q: NDArray[np.float64], size: int = 2, stops: int = 1) -> NDArray[np.complex128]:
     """Integrals of the quadratures over a period -> the Trajectory's moment row of 2 N + K entries (e^{-jwt} =
-    cos - j sin): x_i, each stop's contact force, x_i^2 (see :mod:`.rigid_kernels` for the quadratures' order)."""
+    cos - j sin): x_i, each stop's contact force, x_i^2 (see :mod:`~vibroimpact.engines.rigid_kernels` for the quadratures' order)."""
     coordinates = q[0 : 2 * size : 2] - 1j * q[1 : 2 * size : 2]
     forces = q[2 * size : 2 * size + 2 * stops : 2] - 1j * q[2 * size + 1 : 2 * size + 2 * stops : 2]
     return np.concatenate([coordinates, forces, q[2 * size + 2 * stops : 3 * size + 2 * stops].astype(complex)])
@@ -54,8 +53,8 @@ class Model:
     """Right-hand side, Jacobian and event functions of one problem, with a mutable mode (free, or stuck on a stop)
     and a mutable :attr:`layout` (the stop last hit carries its penetration, :meth:`carry`).
 
-    Between impacts the flow is linear, y' = A y + c + Re(b e^{jwt}), one (A, c, b) per mode (:mod:`.flow_layout`).
-    :attr:`rhs`, :attr:`jacobian` and :attr:`events` call the compiled kernels of :mod:`.rigid_kernels` over
+    Between impacts the flow is linear, y' = A y + c + Re(b e^{jwt}), one (A, c, b) per mode (:mod:`~vibroimpact.engines.flow_layout`).
+    :attr:`rhs`, :attr:`jacobian` and :attr:`events` call the compiled kernels of :mod:`~vibroimpact.engines.rigid_kernels` over
     :attr:`parameters`, the same array the compiled CVODE callbacks read: the mode written there is seen by both.
 
     Parameters

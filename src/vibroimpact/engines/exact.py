@@ -1,7 +1,7 @@
 """Engine ``exact``: piecewise-exact propagation, the reference every integrator is measured against.
 
 Between events the motion is linear with harmonic and constant loads, so it is propagated in closed form (eigenvectors
-of the state matrix plus the harmonic particular solution, and a polynomial for rigid-body modes, :mod:`.exact_flows`).
+of the state matrix plus the harmonic particular solution, and a polynomial for rigid-body modes, :mod:`~vibroimpact.engines.exact_flows`).
 Any N-dof structure with any rigid stops: contacts are found by guaranteed root bracketing (Taylor bounds of each
 stop's gap, :func:`.linear_flow.first_crossing`): no contact is missed however tangent, and contact times are exact to
 round-off. An impact on stop k restitutes its gap velocity, n_k . x' -> -R_k n_k . x', by an impulse along M^-1 n_k
@@ -12,7 +12,7 @@ paper's layout) turns negative (found by the same root search), or an impact on 
 impulse leaves it closed, at rest on it, n_k . x' = 0 to round-off, and pushed: then it holds on, as in the
 ``momentary`` engine). Sticking on two stops at once is refused (``NotImplementedError`` naming both).
 
-The event loop runs compiled (:mod:`.exact_core`, numba); this module is its thin Python face. It also returns the
+The event loop runs compiled (:mod:`~vibroimpact.engines.exact_core`, numba); this module is its thin Python face. It also returns the
 exact Jacobian of the stroboscopic map (state-transition matrices times the saltation matrices of impacts, sticking
 and release), for shooting, continuation and Lyapunov exponents (:mod:`vibroimpact.orbits`).
 """
@@ -28,11 +28,10 @@ from numpy.typing import NDArray
 from vibroimpact.engines.registry import ENGINES, Capabilities
 from vibroimpact.engines import exact_core
 from vibroimpact.engines.base import Trajectory, check_run
-from vibroimpact.engines.exact_flows import Flow
-from vibroimpact.engines.exact_model import ExactModel, build_model
+from vibroimpact.engines.exact_flows import Flow, ExactModel, build_model
 from vibroimpact.engines.exact_python import PythonExactEngine
 from vibroimpact.engines.linear_flow import gauss_legendre
-from vibroimpact.engines.rigid_contact import RigidContact
+from vibroimpact.engines.rigid_kernels import RigidContact
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
@@ -86,7 +85,7 @@ def _half(lam: NDArray[np.complex128]) -> NDArray[np.complex128]:
 
 
 def _stack(flows: tuple[Flow, ...], omega: float) -> tuple:
-    """The flows as the compiled loop's stacked arrays (see :mod:`.exact_core`)."""
+    """The flows as the compiled loop's stacked arrays (see :mod:`~vibroimpact.engines.exact_core`)."""
     count, n = len(flows), flows[0].harmonic.size
     widest = max(flow.eigenvalues.size for flow in flows)
     lams = np.zeros((count, widest), dtype=complex)

@@ -5,10 +5,10 @@ lines: numba's on-disk cache is keyed by the source file of each cached function
 called from another file would not recompile its callers (numba PR #8396, unmerged); a kernel module beside this one
 served stale machine code after an edit.
 
-The algorithm is :mod:`.exact_python`'s (closed-form flow, guaranteed first-root search by Taylor bounds, impact map,
+The algorithm is :mod:`~vibroimpact.engines.exact_python`'s (closed-form flow, guaranteed first-root search by Taylor bounds, impact map,
 sticking and release, strobes, Fourier moments), compiled with ``@njit(cache=True)``: the interpreter overhead of the
 pure-Python loop was ~97 % of its cost (README, "Speed: before and after the compiled core"). It runs any N-dof
-structure (state y = (x, x') of n = 2 N entries) with any K rigid stops. Flows (:mod:`.exact_flows`) are passed
+structure (state y = (x, x') of n = 2 N entries) with any K rigid stops. Flows (:mod:`~vibroimpact.engines.exact_flows`) are passed
 stacked, flow 0 the free flight and flow 1 + k the flight held on stop k, all in the full state's coordinates:
 
 * ``lams[f, :counts[f]]`` the nonzero eigenvalues, ``vecs[f]`` (n, m) their eigenvectors, ``invs[f]`` (m, n) the

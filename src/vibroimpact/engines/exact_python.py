@@ -1,8 +1,8 @@
-"""Engine ``exact_python``: the ``exact`` engine's algorithm in pure Python (the compiled core, :mod:`.exact_core`, is
+"""Engine ``exact_python``: the ``exact`` engine's algorithm in pure Python (the compiled core, :mod:`~vibroimpact.engines.exact_core`, is
 the same loop under numba; this copy cross-checks it and is the speed baseline of ``engine_cost``).
 
 Between events the motion is linear with harmonic and constant loads, so it is propagated in closed form (the flows of
-:mod:`.exact_flows`: exponentials plus the harmonic particular solution, and a polynomial on rigid-body modes).
+:mod:`~vibroimpact.engines.exact_flows`: exponentials plus the harmonic particular solution, and a polynomial on rigid-body modes).
 Contacts with any of the stops are found by guaranteed root bracketing (:func:`.linear_flow.first_crossing`): no
 contact is missed however tangent, and contact times are exact to round-off. An impact on stop k restitutes n_k . x'
 by an impulse along M^-1 n_k (:meth:`.rigid_contact.RigidContact.kick`). When impacts accumulate (chattering, small R)
@@ -22,9 +22,9 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines.registry import ENGINES, Capabilities
 from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory, TrajectoryBuilder
-from vibroimpact.engines.exact_model import ExactModel, build_model
+from vibroimpact.engines.exact_flows import ExactModel, build_model
 from vibroimpact.engines.linear_flow import HarmonicLinearFlow, Observable, Piece, escape_step, first_crossing, gauss_legendre
-from vibroimpact.engines.rigid_contact import RigidContact
+from vibroimpact.engines.rigid_kernels import RigidContact
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.problem import ImpactProblem
 

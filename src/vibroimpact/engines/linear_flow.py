@@ -1,6 +1,6 @@
 """Exact flow of a harmonically forced linear system, and guaranteed first-root search of its observables.
 
-``y' = A y + Re(b exp(j w t)) + b0`` has the solution (:mod:`.exact_flows`)
+``y' = A y + Re(b exp(j w t)) + b0`` has the solution (:mod:`~vibroimpact.engines.exact_flows`)
 
     y(t) = Re(Y exp(j w t)) + y_c + Re(V diag(exp(lambda tau)) m) + z0 + q1 tau + q2 tau^2,   tau = t - t0,
 

@@ -1,6 +1,6 @@
 """Engine ``momentary``: SUNDIALS CVODE (the one scikit-sundae ships) with exact contact events and a grazing guard.
 
-Any N-dof structure with any rigid stops (:mod:`.event_loop`, :mod:`.flow_layout`). CVODE finds roots only as sign
+Any N-dof structure with any rigid stops (:mod:`~vibroimpact.engines.event_loop`, :mod:`~vibroimpact.engines.flow_layout`). CVODE finds roots only as sign
 changes between steps, so a nearly tangent contact (a gap's minimum slightly below zero inside one step) would be
 missed. The guard: an event function per stop, its approach velocity n_k . x' falling through zero, stops the
 integrator at every local maximum of n_k . x in free flight. CVODE locates that root and evaluates all
@@ -21,20 +21,20 @@ and inactive events return a constant; errors do not raise but return a negative
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.integrate import solve_ivp
 from sksundae.cvode import CVODE
 
 from vibroimpact.engines.event_loop import EventLoopEngine, Model, Stop
-from vibroimpact.engines.rigid_kernels import COMPILED_EVENTS as _events
-from vibroimpact.engines.rigid_kernels import COMPILED_JACOBIAN as _jacobian
-from vibroimpact.engines.rigid_kernels import COMPILED_RHS as _rhs
+from vibroimpact.engines.rigid_kernels import COMPILED_EVENTS as _events, COMPILED_JACOBIAN as _jacobian, COMPILED_RHS as _rhs
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.sundae import ROOT_RETURN, CompiledCvode, clear_event_records, compiled_cvode_problem
 
-__all__ = ["MomentaryEngine", "compiled_parameters", "COMPILED_RHS", "COMPILED_JACOBIAN", "COMPILED_EVENTS"]
+__all__ = ["MomentaryEngine", "compiled_parameters", "COMPILED_RHS", "COMPILED_JACOBIAN", "COMPILED_EVENTS", "SolveIvpEngine", "SOLVE_IVP_METHODS"]
 
 _STATUS_TSTOP = 1
 
@@ -179,3 +179,86 @@ class MomentaryEngine(EventLoopEngine):
         self._events_found += 1
         self._at_t, self._at_y = np.nan, None
         return kind, t, state.copy(), stop
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Comparison engines: ``scipy.integrate.solve_ivp`` (DOP853, LSODA, Radau, ...) with terminal events and restarts.
+# --------------------------------------------------------------------------------------------------------------------
+
+SOLVE_IVP_METHODS = ("RK45", "DOP853", "LSODA", "Radau", "BDF")
+
+
+class SolveIvpEngine(EventLoopEngine):
+    """``solve_ivp`` with a terminal contact event (free flight) or release event (stuck).
+
+    Parameters
+    ----------
+    settings : EngineSettings
+        rtol, atol and max_step are used; ``method`` of the settings is ignored.
+    method : str
+        One of :data:`SOLVE_IVP_METHODS`.
+    """
+
+    def __init__(self, settings: EngineSettings = EngineSettings(), method: str = "DOP853") -> None:
+        if method not in SOLVE_IVP_METHODS:
+            raise ValueError(f"method = {method!r} is not allowed: use one of {', '.join(SOLVE_IVP_METHODS)}")
+        super().__init__(settings)
+        self.method = method
+        self.name = f"solve_ivp_{method}"
+
+    def _begin(self, model: Model) -> None:
+        def contact(stop: int) -> Any:
+            def event(t: float, y: NDArray[np.float64]) -> float:
+                gap = model.layout.penetration(y, stop)  # n . x - Delta
+                # At the restart time, and wherever it is exactly 0, the gap counts as short of the stop. Every
+                # restart on the stop (after an impact, a touch or a release) has a gap of 0, and SciPy takes g = 0 at
+                # a step's start with g >= 0 at its end for a crossing at that start (brentq returns the end where
+                # g = 0): a fast return to the stop (chatter) was applied at the start itself, to the rebound's
+                # velocity, over and over, and at rest on the stop with no force (g = 0 throughout) every step
+                # reported one. Negative there, the root is the first crossing after the start. (By time as well as
+                # by value: brentq re-evaluates the start on the dense output, whose gap there may differ from 0 by
+                # round-off.)
+                return -1.0 if gap == 0.0 or (t == self._restart and gap > 0.0) else gap
+
+            event.terminal, event.direction = True, 1.0  # type: ignore[attr-defined]
+            return event
+
+        def release(t: float, y: NDArray[np.float64]) -> float:
+            return model.holding(t, y)
+
+        release.terminal, release.direction = True, -1.0  # type: ignore[attr-defined]
+        self._contacts = [contact(k) for k in range(model.layout.stop_count)]
+        self._release = release
+
+        def rhs(t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+            return model.derivative(t, y)
+
+        self._rhs = rhs
+        self._steps = self._events_found = self._nfev = 0
+        self._restart = math.nan
+
+    def _counters(self) -> dict[str, int]:
+        return {"steps": self._steps, "events": self._events_found, "solver_rhs_calls": self._nfev}
+
+    def _advance(self, model: Model, t: float, y: NDArray[np.float64], t_stop: float) -> tuple[Stop, float, NDArray[np.float64], int]:
+        options: dict[str, Any] = {"method": self.method, "rtol": self.settings.rtol, "atol": self.settings.atol}
+        if self.settings.max_step > 0.0:
+            options["max_step"] = self.settings.max_step
+        # the contacts of every stop not held, then the release of the one held
+        watched = [k for k in range(model.layout.stop_count) if k != model.stuck_on]
+        events = [self._contacts[k] for k in watched] + ([self._release] if model.stuck else [])
+        self._restart = t
+        result = solve_ivp(self._rhs, (t, t_stop), y, events=events, **options)
+        if result.status < 0:
+            raise RuntimeError(f"solve_ivp ({self.method}) failed at t = {result.t[-1]!r} s: {result.message}")
+        self._steps += result.t.size - 1
+        self._nfev += result.nfev
+        if result.status == 1:
+            self._events_found += 1
+            for index, times in enumerate(result.t_events):
+                if times.size:
+                    state = np.array(result.y_events[index][0])
+                    if index < len(watched):
+                        return Stop.CONTACT, float(times[0]), state, watched[index]
+                    return Stop.RELEASE, float(times[0]), state, model.stuck_on
+        return Stop.BOUNDARY, float(result.t[-1]), np.array(result.y[:, -1]), -1

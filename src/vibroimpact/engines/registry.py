@@ -102,7 +102,7 @@ EXACT_FLOW = Capabilities(RIGID, exact_flow=True, tolerance_free=True)
 
 
 def _solve_ivp(method: str) -> EngineSpec:
-    return EngineSpec("vibroimpact.engines.scipy_ivp:SolveIvpEngine", INTEGRATOR, f"scipy solve_ivp ({method}) with terminal events and restarts: a comparison baseline", MappingProxyType({"method": method}))
+    return EngineSpec("vibroimpact.engines.momentary:SolveIvpEngine", INTEGRATOR, f"scipy solve_ivp ({method}) with terminal events and restarts: a comparison baseline", MappingProxyType({"method": method}))
 
 
 #: name -> engine. ``momentary`` uses the method of its settings; the suffixed names fix it.
@@ -120,8 +120,8 @@ ENGINES: Mapping[str, EngineSpec] = MappingProxyType(
         "solve_ivp_BDF": _solve_ivp("BDF"),
         "compliant": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", Capabilities(BUMPER, stepped_solution=True), "Kelvin-Voigt bumper through SUNDIALS IDA, one solver per contact mode"),
         "compliant_ida": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", BUMPER_INTEGRATOR, "the engine compliant, under the name benchmark scenes use"),
-        "compliant_cvode_adams": EngineSpec("vibroimpact.engines.compliant.cvode:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (Adams)", settings_method="adams"),
-        "compliant_cvode_bdf": EngineSpec("vibroimpact.engines.compliant.cvode:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (BDF)", settings_method="bdf"),
+        "compliant_cvode_adams": EngineSpec("vibroimpact.engines.compliant.ida:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (Adams)", settings_method="adams"),
+        "compliant_cvode_bdf": EngineSpec("vibroimpact.engines.compliant.ida:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (BDF)", settings_method="bdf"),
     }
 )
 

@@ -1,8 +1,8 @@
 """The rigid-stop flight of any layout as compiled kernels: right-hand side, Jacobian, event functions and holding
 force over one flat parameter array (:func:`pack_parameters`), for the ``momentary`` engine's CVODE callbacks (numba
-``cfunc`` wrappers in :mod:`.momentary`) and, called from Python, for its fallback and the ``solve_ivp_*`` engines.
+``cfunc`` wrappers in :mod:`~vibroimpact.engines.momentary`) and, called from Python, for its fallback and the ``solve_ivp_*`` engines.
 
-The integrated state (see :mod:`.flow_layout`) is y = (w, v) of 2 N entries, followed, when harmonic moments are
+The integrated state (see :mod:`~vibroimpact.engines.flow_layout`) is y = (w, v) of 2 N entries, followed, when harmonic moments are
 wanted, by 3 N + 2 K quadratures: x_i cos(wt) and x_i sin(wt) for each coordinate, the contact force of each stop
 times cos and sin (the holding force of the stuck stop, 0 for the others: impulses are added by the engine), and
 x_i^2 for each coordinate (for the paper's layout: X1 c, X1 s, X2 c, X2 s, H c, H s, X1^2, X2^2).
@@ -16,16 +16,21 @@ a two-sided stop) cannot be reached while it is held: its events are constants t
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 from numba import carray, cfunc, njit, types
 from numpy.typing import NDArray
 
+from vibroimpact.engines.base import TrajectoryBuilder, check_run
 from vibroimpact.engines.flow_layout import FlowLayout
+from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.sundae import as_doubles, content_data
+from vibroimpact.model.contact import Impact, RigidStop
+from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["pack_parameters", "quadrature_count", "rhs_kernel", "jacobian_kernel", "events_kernel", "holding_kernel", "STUCK", "APEX", "SIZE", "STOPS", "LENGTH", "HEADER", "COMPILED_RHS", "COMPILED_JACOBIAN", "COMPILED_EVENTS"]
+__all__ = ["pack_parameters", "quadrature_count", "rhs_kernel", "jacobian_kernel", "events_kernel", "holding_kernel", "STUCK", "APEX", "SIZE", "STOPS", "LENGTH", "HEADER", "COMPILED_RHS", "COMPILED_JACOBIAN", "COMPILED_EVENTS", "RigidContact"]
 
 # header of the parameter array: mode, flags, sizes and the offsets of the blocks after it
 STUCK, APEX, SIZE, _N, STOPS, _OMEGA, _TRIG, _A, _C, _BR, _BI, _G, _G0, _NORMAL, _H, _H0, _HBR, _HBI, _TINV, _XOFF, LENGTH = range(21)
@@ -234,3 +239,95 @@ def _events(t: float, y_vector: Any, out: Any, data: Any) -> int:  # pragma: no 
 
 #: The compiled callbacks (numba ``cfunc``; ``.address`` for CVODE, ``.ctypes`` to call them from Python).
 COMPILED_RHS, COMPILED_JACOBIAN, COMPILED_EVENTS = _rhs, _jacobian, _events
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# The rigid stop's law as the momentary-impact engines apply it: one place for ``exact`` and the event loop.
+# --------------------------------------------------------------------------------------------------------------------
+
+class RigidContact:
+    """The rigid stops of one problem with an engine's settings.
+
+    Parameters
+    ----------
+    engine : str
+        Name of the engine (for messages).
+    problem : ImpactProblem
+        Every stop must have a :class:`RigidStop` law, and the excitation must be harmonic (``TypeError`` otherwise).
+    settings : EngineSettings
+        Sticking velocity (a fraction of the problem's velocity scale) and impacts per period before sticking.
+    periods : int
+        Periods the run integrates (>= 0).
+
+    Attributes
+    ----------
+    laws : tuple of RigidStop
+        The law of each stop (``stop``: the first one's, for single-stop callers).
+    normals : ndarray, shape (K, N)
+        n_k: stop k's gap is clearances[k] - n_k . x.
+    clearances : ndarray, shape (K,)
+        Delta_k [m].
+    masses : ndarray, shape (K,)
+        Effective mass m_eff = 1 / (n^T M^-1 n) of each stop [kg] (``mass``: the first one's; M2 on the paper's layout).
+    kicks : ndarray, shape (K, N)
+        M^-1 n_k [kg-1]: an impulse P on stop k changes the velocities by -P M^-1 n_k.
+    velocity_scale : float
+        The problem's velocity scale (w (Delta + q |H12|) on the paper's layout) [m s-1].
+    length_scale : float
+        max |Delta| + velocity_scale / w [m]: the size of the motion, for round-off thresholds.
+    sticking_velocity : float
+        Impacts at most this fast [m s-1] are chattering.
+    """
+
+    def __init__(self, engine: str, problem: ImpactProblem, settings: EngineSettings, periods: int) -> None:
+        check_run(engine, problem, RigidStop, periods)
+        problem.harmonic  # a frequency is needed for the scales (TypeError naming the excitation otherwise)
+        mass_matrix = problem.structure.mass_matrix
+        self.size = problem.size
+        self.names = problem.structure.coordinates
+        self.stops = problem.stops
+        self.laws: tuple[RigidStop, ...] = tuple(stop.law for stop in self.stops)  # type: ignore[misc]
+        self.normals = problem.normals()
+        self.clearances = problem.clearances()
+        self.kicks = np.linalg.solve(mass_matrix, self.normals.T).T.reshape(-1, self.size)
+        self.masses = 1.0 / np.einsum("ki,ki->k", self.normals, self.kicks)
+        self.stop, self.mass = self.laws[0], float(self.masses[0])
+        self.velocity_scale = problem.velocity_scale()
+        self.length_scale = float(np.max(np.abs(self.clearances))) + self.velocity_scale / problem.omega
+        self.sticking_velocity = settings.sticking_velocity * self.velocity_scale
+        self.max_impacts = settings.max_impacts_per_period
+
+    def gaps(self, state: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Delta_k - n_k . x of every stop [m] (negative: penetrating)."""
+        return self.clearances - self.normals @ np.asarray(state[: self.size], dtype=float)
+
+    def approach(self, state: NDArray[np.float64]) -> NDArray[np.float64]:
+        """n_k . x' of every stop [m s-1]: positive while the gap closes."""
+        return self.normals @ np.asarray(state[self.size : 2 * self.size], dtype=float)
+
+    def check_start(self, state: NDArray[np.float64]) -> None:
+        """A start beyond any stop (by more than round-off of the length scale) is an error naming the stop."""
+        gaps = self.gaps(state)
+        for k, gap in enumerate(gaps):
+            if gap < -1e-12 * self.length_scale:
+                where = self.stops[k].describe(self.names)
+                raise ValueError(f"the initial state penetrates stop {k} ({where}) by {float(-gap):.6g} m: start on the allowed side of every stop")
+
+    def collide(self, rec: TrajectoryBuilder, t: float, velocity: float, impacts: int, pushed: Callable[[], bool], stop: int = 0) -> Impact:
+        """Apply stop ``stop``'s law to an impact at time t [s] at approach ``velocity`` = n . x' >= 0 [m s-1], the
+        ``impacts``-th of its period, and record it (an impact at zero speed is a touch: only a stick is counted)."""
+        law = self.laws[stop]
+        outcome = law.impact(float(self.masses[stop]), velocity, law.chatters(velocity, impacts, self.sticking_velocity, self.max_impacts), pushed)
+        if velocity > 0.0:
+            rec.impact(t, velocity, outcome.impulse, stop=stop)  # m_eff (1 + R) v, or m_eff v when it sticks
+        rec.stats["sticks"] += int(outcome.sticks)
+        return outcome
+
+    def kick(self, state: NDArray[np.float64], stop: int, impulse: float) -> NDArray[np.float64]:
+        """The state after an impulse ``impulse`` [N s] of stop ``stop``: x' -> x' - impulse M^-1 n (x unchanged).
+
+        With impulse m_eff (1 + R) v this restitutes the gap velocity, n . x'(t+) = -R n . x'(t-), and on a relative
+        stop it conserves the momentum of the two bodies."""
+        out = np.array(state, dtype=float)
+        out[self.size : 2 * self.size] -= impulse * self.kicks[stop]
+        return out

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from vibroimpact.model.validation import require_in_range, require_non_negative
+from vibroimpact.model.structure import require_in_range, require_non_negative
 
 __all__ = ["EngineSettings", "STEPPED_TOLERANCES", "SWEPT_TOLERANCES", "SWEEP_SETTINGS", "SWEEP_REFERENCE_RTOL", "REFERENCE_RTOL", "ATOL_RATIO"]
 

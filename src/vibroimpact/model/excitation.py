@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from vibroimpact.model.validation import require_non_negative, require_positive
+from vibroimpact.model.structure import require_non_negative, require_positive
 
 __all__ = ["HarmonicForce", "SweptSine", "load_weights", "static_load"]
 

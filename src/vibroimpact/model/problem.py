@@ -2,7 +2,7 @@
 
 :class:`ImpactProblem` composes the three validated parts and answers what the engines ask of them (clearance,
 excitation frequency and period, force, a typical velocity). Each part validates itself; the problem only checks
-that each is of a kind it knows. The contact law (:mod:`.contact`) owns where and how the stop acts, so a problem
+that each is of a kind it knows. The contact law (:mod:`~vibroimpact.model.contact`) owns where and how the stop acts, so a problem
 with another stop (another coordinate, a second side) changes the contact and the flow, not every engine.
 """
 
@@ -14,9 +14,8 @@ from typing import TypeVar, Union
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
+from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce, SweptSine, load_weights, static_load
-from vibroimpact.model.stops import Stop
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 

@@ -9,7 +9,7 @@ free mass: a rigid-body mode). The paper's two-mass system (:class:`~vibroimpact
 such structure, whose :attr:`~vibroimpact.model.system.TwoDofSystem.structure` gives the same matrices.
 
 Coordinates are displacements [m] measured from the position of the unloaded springs (relative to the base when the
-excitation is a base motion, see :mod:`.excitation`).
+excitation is a base motion, see :mod:`~vibroimpact.model.excitation`).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["LinearStructure", "as_matrix_rows"]
+__all__ = ["LinearStructure", "as_matrix_rows", "require_finite", "require_positive", "require_non_negative", "require_in_range"]
 
 #: Relative tolerance of the symmetry and definiteness checks.
 _TOLERANCE = 1e-12
@@ -202,3 +202,45 @@ class LinearStructure:
 
     def __repr__(self) -> str:
         return f"LinearStructure(N={self.size}, coordinates={list(self.coordinates)}, natural frequencies {np.round(self.natural_frequencies() / (2 * math.pi), 4).tolist()} Hz)"
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Checks of physical parameters that raise a ``ValueError`` naming the field, its value and the allowed range.
+# --------------------------------------------------------------------------------------------------------------------
+
+def _number(name: str, value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f"{name}: expected a number, got {value!r} ({type(value).__name__})")
+    number = float(value)
+    if not math.isfinite(number):
+        raise ValueError(f"{name}: expected a finite number, got {value!r}")
+    return number
+
+
+def require_finite(name: str, value: object) -> float:
+    """Return ``value`` as float if it is a finite number, else raise ``ValueError`` naming ``name``."""
+    return _number(name, value)
+
+
+def require_positive(name: str, value: object) -> float:
+    """Return ``value`` as float if it is a finite number > 0, else raise ``ValueError`` naming ``name``."""
+    number = _number(name, value)
+    if number <= 0.0:
+        raise ValueError(f"{name} = {value!r} is out of range: allowed (0, inf)")
+    return number
+
+
+def require_non_negative(name: str, value: object) -> float:
+    """Return ``value`` as float if it is a finite number >= 0, else raise ``ValueError`` naming ``name``."""
+    number = _number(name, value)
+    if number < 0.0:
+        raise ValueError(f"{name} = {value!r} is out of range: allowed [0, inf)")
+    return number
+
+
+def require_in_range(name: str, value: object, low: float, high: float) -> float:
+    """Return ``value`` as float if low <= value <= high, else raise ``ValueError`` naming ``name``."""
+    number = _number(name, value)
+    if not low <= number <= high:
+        raise ValueError(f"{name} = {value!r} is out of range: allowed [{low:g}, {high:g}]")
+    return number

@@ -18,8 +18,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from vibroimpact.model.structure import LinearStructure
-from vibroimpact.model.validation import require_positive, require_non_negative
+from vibroimpact.model.structure import LinearStructure, require_positive, require_non_negative
 
 __all__ = ["TwoDofSystem", "Receptances", "PAPER_SYSTEM"]
 

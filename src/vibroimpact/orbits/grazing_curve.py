@@ -3,7 +3,7 @@
 A grazing point is where a periodic orbit's free flight touches the stop tangentially (its closest approach
 ``closest_approach`` reaches 0: a new impact is born) or where one of its impacts loses its speed
 (``min_impact_velocity`` reaches 0). The map is not differentiable there, so the extended system of
-:mod:`.two_parameter` (Newton on ``[P^k(y) - y, g]``) has no Jacobian to work with across the point. Here the curve is
+:mod:`~vibroimpact.orbits.continuation` (Newton on ``[P^k(y) - y, g]``) has no Jacobian to work with across the point. Here the curve is
 traced instead by stepping the second parameter and, at each value, locating the point in the first parameter
 from the smooth side (:func:`locate_grazing_at`): the orbit is shot (damped Newton, exact Jacobian) at trial values
 of the first parameter on the side where it keeps its impact count, and the zero of its grazing measure (the
@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.model.validation import require_in_range, require_positive
+from vibroimpact.model.structure import require_in_range, require_positive
 from vibroimpact.orbits.branch import HybridInfo, ParametrisedMap, PeriodicOrbit, SpecialPoint
 from vibroimpact.orbits.shooting import ShootingError, ShootingSettings, shoot
 

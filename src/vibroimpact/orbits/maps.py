@@ -15,7 +15,7 @@ flight to any stop, sticks.
 
 :func:`orbit_measures` says what an orbit means physically (impulse per impact, harmonic amplitudes);
 :func:`resection` moves a strobe away from the impacts. The closed-form starts (:func:`one_impact_state`,
-:func:`with_impulse`, :func:`section_phase`) live in :mod:`.starts` and are re-exported here.
+:func:`with_impulse`, :func:`section_phase`) live in :mod:`~vibroimpact.orbits.shooting` and are re-exported here.
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import HybridInfo, MapEvaluation, PeriodicOrbit
-from vibroimpact.orbits.starts import closed_form_state, one_impact_state, section_phase, with_impulse
+from vibroimpact.orbits.shooting import closed_form_state, one_impact_state, section_phase, with_impulse
 
 __all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "one_impact_state", "closed_form_state", "with_impulse", "section_phase", "resection", "PARAMETERS", "stop_selection"]
 

@@ -1,1 +1,2 @@
-"""HTML pages with figures and tables, drawn from a dataset alone."""
+"""What every report page shares: the HTML shell, figure and table records, captions, colours and how values are drawn.
+Each kind's page lives in its folder (``vibroimpact.kinds.<kind>.page``); :mod:`~vibroimpact.reporting.report` writes it."""

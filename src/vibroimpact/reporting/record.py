@@ -13,17 +13,25 @@ itself is shown verbatim.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
 import yaml
 
-from vibroimpact.analysis.regime import Regime
+from vibroimpact.analysis.stability import Regime
+from vibroimpact.model.contact import RigidStop, Stop
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.scene.schema import ENGINE_SOLUTIONS, STUDY_KINDS
+from vibroimpact.scene.kinds import KIND_NAMES
+from vibroimpact.scene.layout import StopSpec, stop_descriptions
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS
+from vibroimpact.simulation.harmonics import base_force
 
-__all__ = ["SWEPT_SOLUTION", "StudyRecord", "StudySetting", "study_kind", "study_record", "study_setting", "stored_description"]
+__all__ = ["SWEPT_SOLUTION", "StudyRecord", "StudySetting", "study_kind", "study_record", "study_setting", "stored_description", "GeneralSetting", "general_setting", "named_layout", "named_view", "is_general"]
 
 #: The solution a swept-sine test runs: the compliant bumper (scenes allow no other); its estimates are the
 #: ``swept_<quantity>`` variables, not a value of the ``solution`` coordinate.
@@ -36,8 +44,8 @@ def study_kind(dataset: xr.Dataset) -> str:
     existed, its dimensions (``engine`` or ``case``: benchmark; ``sweep``: swept; else stepped)."""
     kind = dataset.attrs.get("study_kind")
     if kind is not None:
-        if kind not in STUDY_KINDS:
-            raise ValueError(f"study_kind must be one of {', '.join(STUDY_KINDS)}, got {kind!r}")
+        if kind not in KIND_NAMES:
+            raise ValueError(f"study_kind must be one of {', '.join(KIND_NAMES)}, got {kind!r}")
         return str(kind)
     if "engine" in dataset.dims or "case" in dataset.dims:
         return "benchmark"
@@ -61,7 +69,7 @@ class StudyRecord:
     Attributes
     ----------
     kind : str
-        One of :data:`STUDY_KINDS`.
+        One of :data:`vibroimpact.scene.kinds.KIND_NAMES`.
     name : str
         The scene's name (attribute ``scene_name``).
     description : str
@@ -79,8 +87,8 @@ class StudyRecord:
     version: str
 
     def __post_init__(self) -> None:
-        if self.kind not in STUDY_KINDS:
-            raise ValueError(f"kind must be one of {', '.join(STUDY_KINDS)}, got {self.kind!r}")
+        if self.kind not in KIND_NAMES:
+            raise ValueError(f"kind must be one of {', '.join(KIND_NAMES)}, got {self.kind!r}")
 
 
 def study_record(dataset: xr.Dataset) -> StudyRecord:
@@ -188,3 +196,222 @@ def _simulation_frequency(dataset: xr.Dataset) -> np.ndarray:
     others = [d for d in computed.dims if d != "frequency"]
     mask = computed.any(others) if others else computed
     return np.asarray(dataset["frequency"].values[np.asarray(mask.values)], dtype=float)
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# What a report knows of a stepped study's structure, load and stops, read from its dataset's attributes
+# (written by :func:`vibroimpact.kinds.stepped.grid.layout_attributes`); nothing is re-validated from the scene text.
+# --------------------------------------------------------------------------------------------------------------------
+
+_NAMED_KEYS = ("m1", "m2", "k1", "k2", "b1", "b2")
+
+
+def named_view(dataset: xr.Dataset) -> TwoDofSystem | None:
+    """The named system of ``dataset``'s structure (attributes ``system_m1`` ... ``system_b2``); None where it has
+    none."""
+    attrs = dataset.attrs
+    return TwoDofSystem(**{key: float(attrs[f"system_{key}"]) for key in _NAMED_KEYS}) if "system_m1" in attrs else None
+
+
+def named_layout(dataset: xr.Dataset) -> TwoDofSystem | None:
+    """The named system where ``dataset``'s study had the paper's layout on it (two-mass chain, one upper stop on x2,
+    force on x1); None otherwise."""
+    if "system_size" not in dataset.attrs:
+        return named_view(dataset)  # written before the layout was recorded: a study of the paper's named scenes
+    attrs = _layout(dataset)
+    size = int(attrs["system_size"])
+    sides = str(attrs["stop_side"]).split()
+    coordinate = np.atleast_1d(np.asarray(attrs["stop_coordinate"], dtype=int))
+    other = np.atleast_1d(np.asarray(attrs["stop_other"], dtype=int))
+    # the layout does not depend on the clearances and restitutions: any valid values stand in for them
+    stops = tuple(Stop(RigidStop(1e-3, 0.5), coordinate=int(i), other=None if j < 0 else int(j), side=side) for i, j, side in zip(coordinate, other, sides))
+    weights = tuple(float(w) for w in np.atleast_1d(np.asarray(attrs["excitation_weights"], dtype=float)))
+    static = tuple(float(f) for f in np.atleast_1d(np.asarray(attrs["excitation_static_N"], dtype=float)))
+    base_motion = attrs.get("excitation_kind") == "base_motion"  # loads every coordinate through its mass: no weights
+    force = HarmonicForce(float(attrs["excitation_amplitude_N"]), 1.0, weights=weights if len(weights) == size and not base_motion else None, static=static if len(static) == size else None, base_motion=base_motion)
+    return ImpactProblem(_structure(attrs), stops, force).named_system
+
+
+def is_general(dataset: xr.Dataset) -> bool:
+    """Does ``dataset`` record a layout (its structure, load and stops) that is not the paper's, so that its page
+    draws every coordinate and stop by name? The paper's layout, however its scene wrote it, is not general."""
+    return "system_size" in dataset.attrs and named_layout(dataset) is None
+
+
+def _layout(dataset: xr.Dataset) -> dict:
+    """The dataset's attributes with its layout's: those it recorded, else (written before they were recorded) the
+    paper's named layout on its ``system_m1`` ... ``system_b2``, the clearance and restitution from its coordinates."""
+    attrs = dict(dataset.attrs)
+    named = named_view(dataset)
+    if "system_size" in attrs or named is None:
+        return attrs
+    def grid(name: str) -> np.ndarray:
+        return np.atleast_1d(np.asarray(dataset[name].values, dtype=float)) if name in dataset.coords else np.array([np.nan, np.nan])
+
+    clearance = grid("clearance")
+    structure = named.structure
+    return attrs | {
+        "system_size": 2,
+        "system_coordinates": "x1 x2",
+        "system_mass_kg": structure.mass_matrix.ravel(),
+        "system_stiffness_N_per_m": structure.stiffness_matrix.ravel(),
+        "system_damping_N_s_per_m": structure.damping_matrix.ravel(),
+        "excitation_kind": "force",
+        "excitation_weights": np.array([1.0, 0.0]),
+        "excitation_static_N": np.zeros(2),
+        "stop_layout": stop_descriptions((StopSpec(coordinate=1),), ("x1", "x2"), grid("restitution"), clearance)[0],
+        "stop_coordinate": 1,
+        "stop_other": -1,
+        "stop_side": "upper",
+        "stop_clearance_m": float(clearance[0]) if clearance.size == 1 else np.nan,
+    }
+
+
+@dataclass(frozen=True, eq=False)
+class GeneralSetting:
+    """A general study's structure, load and stops.
+
+    Attributes
+    ----------
+    structure : LinearStructure
+        M, K, C and the coordinates' names.
+    amplitude : float
+        q [N], or the base displacement [m] (``base_motion``).
+    base_motion : bool
+        The load is a base motion (coordinates relative to the base).
+    weights : ndarray
+        Harmonic force per coordinate per unit amplitude [-].
+    static : ndarray
+        Constant force per coordinate [N].
+    stops : tuple of str
+        Each stop in words (e.g. ``x2 - x1 <= 3 mm, R = 0.2``).
+    normals : ndarray, shape (K, N)
+        n of every stop (the stopped coordinate n . x).
+    solutions : tuple of str
+        The ``solution`` coordinate.
+    clearances : ndarray, shape (K,)
+        Delta of every stop [m] (attribute ``stop_clearance_m``, else read from its description); NaN where the grid
+        sweeps it.
+    named : TwoDofSystem or None
+        The structure's named view (the paper's m1 ... b2) where the dataset has one: the paper's extras (modal
+        parameters and fit of H22, resonance bands split at the anti-resonance, reduction factors) apply.
+    """
+
+    structure: LinearStructure
+    amplitude: float
+    base_motion: bool
+    weights: np.ndarray
+    static: np.ndarray
+    stops: tuple[str, ...]
+    normals: np.ndarray
+    solutions: tuple[str, ...]
+    clearances: np.ndarray
+    named: TwoDofSystem | None = None
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The coordinates' names."""
+        return tuple(self.structure.coordinates)
+
+    def static_deflection(self) -> np.ndarray | None:
+        """x_static = K^-1 F0 [m] under the constant force (zeros without one); None where K is singular."""
+        if not np.any(self.static):
+            return np.zeros(self.structure.size)
+        stiffness = self.structure.stiffness_matrix
+        if self.structure.rigid_body_modes() or np.linalg.cond(stiffness) > 1e12:
+            return None
+        return np.linalg.solve(stiffness, self.static)
+
+    def load(self, w: np.ndarray) -> np.ndarray:
+        """Harmonic load per coordinate at each w [rad s-1] [N], shape w.shape + (N,)."""
+        if self.base_motion:
+            return (self.structure.mass_matrix @ np.ones(self.structure.size)) * (self.amplitude * w**2)[..., None]
+        return self.weights * self.amplitude * np.ones(np.shape(w))[..., None]
+
+    def linear(self, w: np.ndarray) -> np.ndarray:
+        """Complex amplitudes of the linear steady state without stops at each w [rad s-1] [m], shape w.shape + (N,)."""
+        return np.einsum("...ij,...j->...i", self.structure.receptance_matrix(w), self.load(w))
+
+    def linear_value(self, quantity: str, w: np.ndarray) -> np.ndarray:
+        """|quantity| of the linear steady state at each w [rad s-1]: ``<name>_amplitude`` [m] of a coordinate, or
+        ``force_amplitude`` / ``suspension_force_amplitude`` [N], 1^T (K + j w C) X (no stop loads the base)."""
+        x = self.linear(w)
+        if quantity in ("force_amplitude", "suspension_force_amplitude"):
+            return np.abs(base_force(self.structure, w, x))
+        return np.abs(x[..., self.names.index(quantity.removesuffix("_amplitude"))])
+
+    def linear_fits(self, w: np.ndarray, clearance: float = float("nan")) -> np.ndarray:
+        """Where the linear steady state stays clear of every stop, |n_k . X| + n_k . x_static <= Delta_k, at each
+        w [rad s-1]; ``clearance`` [m] stands for the stops whose Delta the grid sweeps."""
+        static = self.static_deflection()
+        shift = self.normals @ static if static is not None else np.zeros(len(self.stops))
+        deltas = np.where(np.isfinite(self.clearances), self.clearances, clearance)
+        return np.all(np.abs(self.linear(w) @ self.normals.T) + shift <= deltas, axis=-1)
+
+    def load_text(self) -> str:
+        """The load in words."""
+        if self.base_motion:
+            return f"base motion of amplitude {self.amplitude * 1e3:g} mm (coordinates relative to the base)"
+        on = [f"{w:g} x {name}" if w != 1.0 else name for w, name in zip(self.weights, self.names) if w != 0.0]
+        text = f"harmonic force of amplitude {self.amplitude:g} N on {' + '.join(on)}"
+        if np.any(self.static):
+            text += "; constant force " + ", ".join(f"{f:g} N on {name}" for f, name in zip(self.static, self.names) if f != 0.0)
+        return text
+
+
+def general_setting(dataset: xr.Dataset) -> GeneralSetting:
+    """The :class:`GeneralSetting` of a stepped study's ``dataset`` (``KeyError`` naming a missing attribute)."""
+    attrs = _layout(dataset)
+    size = int(attrs["system_size"])
+    structure = _structure(attrs)
+    coordinate = np.atleast_1d(np.asarray(attrs["stop_coordinate"], dtype=int))
+    other = np.atleast_1d(np.asarray(attrs["stop_other"], dtype=int))
+    sides = str(attrs["stop_side"]).split()
+    normals = np.zeros((coordinate.size, size))
+    for k, (i, j, side) in enumerate(zip(coordinate, other, sides)):
+        sign = 1.0 if side == "upper" else -1.0
+        normals[k, i] = sign
+        if j >= 0:
+            normals[k, j] = -sign
+    stops = tuple(part.strip() for part in str(attrs["stop_layout"]).split(";"))
+    if "stop_clearance_m" in attrs:
+        clearances = np.atleast_1d(np.asarray(attrs["stop_clearance_m"], dtype=float))
+    else:
+        clearances = np.array([_described_clearance(words, side) for words, side in zip(stops, sides)])
+    return GeneralSetting(
+        structure=structure,
+        amplitude=float(attrs["excitation_amplitude_N"]),
+        base_motion=attrs.get("excitation_kind") == "base_motion",
+        weights=np.atleast_1d(np.asarray(attrs["excitation_weights"], dtype=float)),
+        static=np.atleast_1d(np.asarray(attrs["excitation_static_N"], dtype=float)),
+        stops=stops,
+        normals=normals,
+        solutions=tuple(str(s) for s in dataset["solution"].values) if "solution" in dataset.coords else (),
+        clearances=clearances,
+        named=named_view(dataset),
+    )
+
+
+def _structure(attrs: dict) -> LinearStructure:
+    """The structure of the attributes ``system_size``, ``system_coordinates`` and the flattened matrices."""
+    size = int(attrs["system_size"])
+
+    def matrix(key: str) -> np.ndarray:
+        return np.asarray(attrs[key], dtype=float).reshape(size, size)
+
+    names = tuple(str(attrs["system_coordinates"]).split())
+    return LinearStructure(matrix("system_mass_kg"), matrix("system_stiffness_N_per_m"), matrix("system_damping_N_s_per_m"), names)
+
+
+#: The bound of a stop's description (:func:`vibroimpact.scene.layout.describe_stop`): ``<= 3 mm``, ``>= -2 mm``.
+_BOUND = re.compile(r"(<=|>=)\s*(-?[0-9.]+(?:e[-+]?[0-9]+)?) mm")
+
+
+def _described_clearance(words: str, side: str) -> float:
+    """Delta [m] of a stop from its description (upper: n . x <= Delta; lower: the coordinate >= -Delta); NaN where
+    it is written ``Delta`` (swept)."""
+    match = _BOUND.search(words.split(",")[0])
+    if match is None:
+        return float("nan")
+    value = float(match.group(2)) * 1e-3
+    return value if side == "upper" else -value

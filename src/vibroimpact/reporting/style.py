@@ -21,7 +21,7 @@ from matplotlib.axes import Axes  # noqa: E402
 from matplotlib.figure import Figure as MatplotlibFigure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
-from vibroimpact.analysis.regime import Regime  # noqa: E402
+from vibroimpact.analysis.stability import Regime  # noqa: E402
 
 __all__ = [
     "DPI",

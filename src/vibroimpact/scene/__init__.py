@@ -1,13 +1,15 @@
 """YAML scenes -> validated, frozen :class:`Scene` objects. Imports no engine, no solver library and no xarray.
 
-``schema`` (what a scene says: the dataclasses, vocabulary and limits), ``checker`` (problem-collecting checks and
-:class:`SceneError`), ``sections`` (the sections of a scene over parameter grids), ``benchmark`` (benchmark scenes),
-``reader`` (safe YAML, :func:`parse_scene`, :func:`load_scene`), ``locate`` (named and shipped scenes).
+The grammar every kind shares: ``schema`` (what a scene says: the dataclasses, vocabulary and limits), ``checker``
+(problem-collecting checks and :class:`SceneError`), ``layout`` and ``layout_parse`` (the system, excitation and
+stops sections), ``variables`` (units, long names and flags of every variable), ``kinds`` (the table of kinds: which
+section makes a scene of which kind, and where each kind's scene parser, run and page are) and ``reader`` (safe YAML,
+:func:`parse_scene`, :func:`load_scene`, named and shipped scenes). A kind's own section is checked by its folder's
+``scene`` module (``vibroimpact.kinds.<kind>.scene``), imported only when a scene of that kind is read.
 """
 
 from vibroimpact.scene.checker import SceneError
-from vibroimpact.scene.locate import find_scene, shipped_studies, shipped_studies_dir
-from vibroimpact.scene.reader import load_scene, parse_scene, read_yaml
+from vibroimpact.scene.reader import find_scene, shipped_studies, shipped_studies_dir, load_scene, parse_scene, read_yaml
 from vibroimpact.scene.schema import Scene
 
 __all__ = ["Scene", "SceneError", "find_scene", "load_scene", "parse_scene", "read_yaml", "shipped_studies", "shipped_studies_dir"]

@@ -7,7 +7,7 @@ on the primary mass) and writes the paper's outputs. Anything else is a *general
 :class:`StopSpec` entries, and its outputs are named after its coordinates and stops.
 
 Values of a stop follow the study's grid where the stop gives none (a swept parameter, or one value shared by every
-stop); :func:`build_stops` turns the specifications and one grid point into model :class:`~vibroimpact.model.stops.Stop`
+stop); :func:`build_stops` turns the specifications and one grid point into model :class:`~vibroimpact.model.contact.Stop`
 objects. Nothing here reads YAML (:mod:`vibroimpact.scene.layout_parse` does).
 """
 
@@ -18,9 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution, restitution_from_loss_factor
+from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution, restitution_from_loss_factor, Stop
 from vibroimpact.model.excitation import HarmonicForce
-from vibroimpact.model.stops import Stop
 from vibroimpact.model.system import TwoDofSystem
 
 __all__ = ["LoadSpec", "StopSpec", "build_stops", "stop_descriptions", "describe_stop"]

@@ -23,16 +23,21 @@ its key and the allowed values, and returns None where a value is unusable.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
-from vibroimpact.model.stops import SIDES
+import numpy as np
+
+from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.model.contact import SIDES, restitution_from_loss_factor
+from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.scene.checker import Checker
-from vibroimpact.scene.layout import LoadSpec, StopSpec
+from vibroimpact.scene.checker import Checker, interval
+from vibroimpact.scene.layout import LoadSpec, StopSpec, build_stops
 
-__all__ = ["NAMED_SYSTEM_KEYS", "MATRIX_SYSTEM_KEYS", "EXCITATION_KEYS", "STOP_KEYS", "parse_structure", "parse_load", "parse_stops", "parse_sweep_stops", "is_general", "parse_stop_layout", "document_names"]
+__all__ = ["NAMED_SYSTEM_KEYS", "MATRIX_SYSTEM_KEYS", "EXCITATION_KEYS", "STOP_KEYS", "parse_structure", "parse_load", "parse_stops", "parse_sweep_stops", "is_general", "parse_stop_layout", "document_names", "check_general_solutions", "pgf_refusal", "paper_layout_applies", "static_drift", "general_grids"]
 
 #: Keys of the paper's named system.
 NAMED_SYSTEM_KEYS = ("m1", "m2", "k1", "k2", "b1", "b2")
@@ -290,3 +295,173 @@ def parse_stop_layout(c: Checker, doc: dict, system: TwoDofSystem | LinearStruct
     if system is not None and system.size != 2:
         c.fail("stops", f"required for a structure of {system.size} coordinates: the 'stop' section means the paper's stop above the absorber of two masses")
     return None
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Which solutions a general scene's layout admits, each refusal with its reason (checked before any work).
+# --------------------------------------------------------------------------------------------------------------------
+
+def pgf_refusal(system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, ...], load: LoadSpec | None, restitution: np.ndarray | None = None, clearance: np.ndarray | None = None) -> str | None:
+    """Why the closed-form (PGF) solution does not apply to this layout at some grid point; None where it applies
+    everywhere (:func:`vibroimpact.analysis.layout.closed_form_refusal`: one rigid stop, or a symmetric two-sided
+    stop, on a structure without rigid-body modes, with a harmonic load)."""
+    stops = specs or (StopSpec(coordinate=1),)
+    r_grid = np.array([np.nan]) if restitution is None else restitution
+    d_grid = np.array([np.nan]) if clearance is None else clearance
+    corners = {(float(r), float(d)) for r in (r_grid[0], r_grid[-1]) for d in (d_grid[0], d_grid[-1])}
+    force = (load or LoadSpec()).force(1.0, 1.0)
+    for r, d in sorted(corners):
+        try:
+            problem = ImpactProblem(system, build_stops(stops, False, 0.5 if np.isnan(r) else r, 1e-3 if np.isnan(d) else d), force)
+        except (ValueError, TypeError) as error:  # an unusable stop: reported where it is parsed
+            return str(error)
+        reason = closed_form_refusal(problem)
+        if reason is not None:
+            return reason
+    return None
+
+
+def paper_layout_applies(system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, ...], load: LoadSpec | None) -> bool:
+    """Is the layout the paper's on its named system, however written (:attr:`vibroimpact.model.problem.ImpactProblem.named_system`):
+    where its own route (``pgf_paper``) and its design map apply?"""
+    try:
+        problem = ImpactProblem(system, build_stops(specs or (StopSpec(coordinate=1),), False, 0.5, 1e-3), (load or LoadSpec()).force(1.0, 1.0))
+    except (ValueError, TypeError):  # an unusable stop: reported where it is parsed
+        return False
+    return problem.named_system is not None
+
+
+def static_drift(system: TwoDofSystem | LinearStructure, load: LoadSpec | None) -> bool:
+    """Does the static force push the structure along a rigid-body mode (no static equilibrium without stops)?"""
+    if load is None or load.static is None or not any(load.static) or not system.rigid_body_modes():
+        return False
+    stiffness = system.structure.stiffness_matrix
+    values, vectors = np.linalg.eigh(stiffness)
+    scale = float(np.max(np.abs(stiffness))) if np.any(stiffness) else 0.0
+    free = vectors[:, values <= 1e-10 * scale] if scale > 0.0 else vectors
+    static = np.asarray(load.static)
+    return bool(np.max(np.abs(free.T @ static)) > 1e-12 * float(np.max(np.abs(static))))
+
+
+def check_general_solutions(
+    c: Checker, solutions: tuple[str, ...], system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, ...], load: LoadSpec | None, swept_sine: bool,
+    restitution: np.ndarray | None = None, clearance: np.ndarray | None = None,
+) -> None:  # fmt: skip
+    """Record the solutions (and swept-sine tests: any layout, but a force, not a base motion) a general scene asks for
+    that its layout does not admit, and stops that leave a coordinate no room (two opposite stops whose clearances sum to <= 0 at a corner of the grid)."""
+    for d in sorted({float(clearance[0]), float(clearance[-1])} if clearance is not None and clearance.size else {float("nan")}):
+        try:
+            ImpactProblem(system, build_stops(specs or (StopSpec(coordinate=1),), False, 0.5, 1e-3 if np.isnan(d) else d), (load or LoadSpec()).force(1.0, 1.0))
+        except ValueError as error:
+            if "leave no room" in str(error):
+                c.fail("stops", str(error).removeprefix("stops: ") + (f" (at clearance {d:g} m of the grid)" if not np.isnan(d) else ""))
+                break
+    if "pgf_paper" in solutions and not paper_layout_applies(system, specs, load):
+        c.fail("solutions", "pgf_paper is the paper's own route for its layout (a two-mass chain x1, x2 as {m1 ... b2}; one upper stop on x2; force on x1): use pgf")
+    if "pgf" in solutions and (reason := pgf_refusal(system, specs, load, restitution, clearance)) is not None:
+        c.fail("solutions", f"pgf does not apply to this layout: {reason}")
+    if "linear" in solutions and static_drift(system, load):
+        c.fail("solutions", "linear does not apply: the static force pushes the structure along a rigid-body mode, so it has no steady state without its stops")
+    if swept_sine and load is not None and load.base_motion:
+        c.fail("excitation.base_motion", "a swept-sine test drives a force q sin(theta(t)) on the coordinates ('on'): a swept base motion is not supported; use base_motion: false")
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# The grids of a general scene's stop values: what each stop takes from the sweep, from itself, or from ``bumper``.
+# --------------------------------------------------------------------------------------------------------------------
+
+#: Swept parameter -> (field of StopSpec, key of a stop entry, key of the scene's ``bumper`` section).
+_PARAMETERS = {
+    "restitution": ("restitution", "restitution", None),
+    "clearance": ("clearance", "clearance", None),
+    "bumper_frequency": ("bumper_frequency", "bumper.frequency", "frequency"),
+    "bumper_loss_factor": ("bumper_loss_factor", "bumper.loss_factor", "loss_factor"),
+}
+
+
+def general_grids(
+    c: Checker,
+    specs: tuple[StopSpec, ...],
+    grids: dict[str, np.ndarray | None],
+    sweep: dict[str, Any],
+    bumper: dict[str, Any],
+    targets: tuple[int, ...] | None,
+    needs_bumper: bool,
+) -> tuple[StopSpec, ...]:
+    """Check which stop gets which value and fill ``grids`` (restitution, clearance, bumper_frequency,
+    bumper_loss_factor); return the stops with the values they take from the grid set to None.
+
+    Parameters
+    ----------
+    c : Checker
+        Records the problems.
+    specs : tuple of StopSpec
+        The stops as given.
+    grids : dict
+        The swept grids already checked (key: parameter); unswept ones are added here.
+    sweep : dict
+        The ``sweep`` section.
+    bumper : dict
+        The scene's ``bumper`` section (values every stop without its own bumper takes), checked by the caller.
+    targets : tuple of int or None
+        ``sweep.stop``: the stops swept values apply to (None: all).
+    needs_bumper : bool
+        A solution needs a bumper on every stop (``compliant``).
+    """
+    swept_to = set(range(len(specs))) if targets is None else set(targets)
+    out = [dataclasses.asdict(spec) for spec in specs]
+    for parameter, (field, key, bumper_key) in _PARAMETERS.items():
+        if parameter == "bumper_loss_factor" and "bumper_loss_factor" not in sweep and "loss_factor" not in bumper and all(s.bumper_loss_factor is None for s in specs):
+            continue  # each stop's loss factor follows its restitution
+        if parameter == "bumper_frequency" and not needs_bumper and "bumper_frequency" not in sweep:
+            continue  # no solution needs a bumper: the stops' own bumpers are not used
+        derived = parameter == "restitution" and "bumper_loss_factor" in sweep
+        values: list[float | None] = []
+        for k, spec in enumerate(specs):
+            own = getattr(spec, field)
+            if (parameter in sweep or derived) and k in swept_to:
+                if own is not None:
+                    c.fail(f"stops[{k}].{key}", f"also swept in sweep.{'bumper_loss_factor' if derived else parameter}: give it in one place only")
+                values.append(None)
+                continue
+            if own is None and bumper_key is not None and bumper_key in bumper:
+                own = bumper[bumper_key]
+            if own is None and parameter == "restitution" and spec.bumper_loss_factor is not None:
+                own = restitution_from_loss_factor(spec.bumper_loss_factor)  # R(xi_b) of the stop's own bumper
+            if own is None and parameter == "restitution" and "loss_factor" in bumper and isinstance(bumper["loss_factor"], (int, float)):
+                own = restitution_from_loss_factor(float(bumper["loss_factor"]))
+            if own is None and parameter != "bumper_loss_factor":
+                where = f"sweep.{parameter}" + ("" if targets is None else " with sweep.stop naming it")
+                extra = " or the scene's bumper section" if bumper_key is not None else ""
+                c.fail(f"stops[{k}].{key}", f"required unless swept ({where}{extra})")
+            values.append(own)
+            out[k][field] = own
+        given = [v for v in values if v is not None]
+        if parameter in sweep or derived:
+            if derived and grids.get("bumper_loss_factor") is not None:
+                grids["restitution"] = np.array([restitution_from_loss_factor(x) for x in grids["bumper_loss_factor"]])  # type: ignore[union-attr]
+            continue
+        if parameter == "bumper_loss_factor" and len(given) < len(values):
+            grids[parameter] = None  # some stops follow their restitution: no one loss factor
+            continue
+        if given and len(given) == len(values) and all(math.isclose(v, given[0], rel_tol=0.0, abs_tol=0.0) for v in given):
+            grids[parameter] = np.array([given[0]])
+            for entry in out:
+                entry[field] = None  # shared: the grid's one value
+        else:
+            grids[parameter] = np.array([math.nan])
+    _check_zero_restitution(c, out, grids, needs_bumper)
+    return tuple(StopSpec(**entry) for entry in out)
+
+
+def _check_zero_restitution(c: Checker, specs: list[dict[str, Any]], grids: dict[str, np.ndarray | None], needs_bumper: bool) -> None:
+    """R = 0 needs an infinitely damped bumper: a compliant solution needs the loss factor given for such a stop."""
+    if not needs_bumper or grids.get("bumper_loss_factor") is not None:
+        return
+    r_grid = grids.get("restitution")
+    for k, spec in enumerate(specs):
+        if spec["bumper_loss_factor"] is not None:
+            continue
+        values = [spec["restitution"]] if spec["restitution"] is not None else ([] if r_grid is None else list(r_grid))
+        if any(v == 0.0 for v in values):
+            c.fail(f"stops[{k}].restitution", f"R = 0 needs an infinitely damped bumper for the compliant solution: give the stop's bumper.loss_factor in {interval(0.0, 1e3)}, or R > 0")

@@ -16,22 +16,18 @@ naming its key and the allowed range) in one :class:`SceneError`. Example (all v
 
 from __future__ import annotations
 
+import importlib.resources
 import re
 from pathlib import Path
 from typing import Any
 
 import yaml
 
-from vibroimpact.scene.benchmark import parse_benchmark_scene
-from vibroimpact.scene.bifurcation import parse_bifurcation_scene
-from vibroimpact.scene.concepts import parse_concepts_scene
-from vibroimpact.scene.validation import parse_validation_scene
 from vibroimpact.scene.checker import SceneError
+from vibroimpact.scene.kinds import KINDS, kind_of_document
 from vibroimpact.scene.schema import Scene
-from vibroimpact.scene.sections import TOP_KEYS, parse_grid_scene
 
-__all__ = ["read_yaml", "parse_scene", "load_scene"]
-
+__all__ = ["read_yaml", "parse_scene", "load_scene", "find_scene", "shipped_studies_dir", "shipped_studies"]
 
 class _UniqueKeyLoader(yaml.SafeLoader):
     """``yaml.SafeLoader`` that refuses a key repeated in one mapping (PyYAML silently keeps the last one) and reads
@@ -69,21 +65,15 @@ def read_yaml(text: str) -> Any:
 def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
     """Validate a parsed YAML document and build the :class:`Scene`; raise :class:`SceneError` listing all problems.
 
-    A document with a ``benchmark``, ``concepts``, ``validation`` or ``bifurcation`` section is a scene of that
-    kind; any other is a scene over parameter grids.
+    The document is a scene of the first kind (:data:`vibroimpact.scene.kinds.KINDS`) whose section it has
+    (``concepts``, ``validation``, ``benchmark``, ``bifurcation``, ``swept_sine``); any other is a stepped scene over
+    parameter grids. Only that kind's scene parser is imported.
     """
     if not isinstance(document, dict):
         what = "an empty document" if document is None else f"a {type(document).__name__}"
-        raise SceneError([f"scene: expected a mapping with keys {sorted(TOP_KEYS)}, got {what}"], source)
-    if "benchmark" in document:
-        return parse_benchmark_scene(document, text, source)
-    if "concepts" in document:
-        return parse_concepts_scene(document, text, source)
-    if "validation" in document:
-        return parse_validation_scene(document, text, source)
-    if "bifurcation" in document:
-        return parse_bifurcation_scene(document, text, source)
-    return parse_grid_scene(document, text, source)
+        sections = ", ".join(kind.section for kind in KINDS if kind.section)
+        raise SceneError([f"scene: expected a mapping of a scene's sections (name, system, excitation, ...; a kind's own: {sections}), got {what}"], source)
+    return kind_of_document(document).parse_scene(document, text, source)
 
 
 def load_scene(path: str | Path) -> Scene:
@@ -101,3 +91,56 @@ def load_scene(path: str | Path) -> Scene:
                 mark.name = str(path)  # PyYAML names a parsed string "<unicode string>"
         raise SceneError([f"not valid YAML: {error}"], str(path)) from None
     return parse_scene(document, text=text, source=str(path))
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Where scenes are: a scene named on the command line, and the scenes shipped with the package.
+# --------------------------------------------------------------------------------------------------------------------
+
+def find_scene(name: str | Path) -> Path:
+    """Locate a scene: the path as given, else ``studies/<name>`` in the working directory, else the shipped one.
+
+    A bare name may omit ``.yaml``. A local file wins over a shipped scene of the same name.
+
+    Raises
+    ------
+    FileNotFoundError
+        Naming every place looked at, each once.
+    """
+    given = Path(name)
+    if given.is_dir():
+        raise IsADirectoryError(f"scene {given} is a directory, not a YAML file")
+    candidates = [given]
+    if not given.is_absolute():
+        candidates.append(Path.cwd() / "studies" / given)
+        candidates.append(shipped_studies_dir() / given)  # a shipped scene in a subfolder: validation/zeno.yaml
+        candidates.append(shipped_studies_dir() / given.name)
+    if given.suffix not in (".yaml", ".yml"):
+        candidates += [c.with_name(c.name + ".yaml") for c in list(candidates)]
+    unique: dict[Path, Path] = {}
+    for candidate in candidates:
+        unique.setdefault(candidate.resolve(), candidate)  # in a checkout ./studies is the shipped folder
+    for candidate in unique.values():
+        if candidate.is_file():
+            return candidate
+    raise FileNotFoundError("scene not found; looked at: " + ", ".join(str(p) for p in unique.values()))
+
+
+def shipped_studies_dir() -> Path:
+    """The shipped scenes: package data ``vibroimpact/studies`` (in a checkout, its top-level ``studies/``)."""
+    return Path(str(importlib.resources.files("vibroimpact.studies")))
+
+
+def shipped_studies() -> list[tuple[str, str]]:
+    """Name and one-line description of every shipped scene, sorted by name (a scene that fails to load says so);
+    a scene in a subfolder is named with it (``validation/zeno``), as ``run-study`` finds it."""
+    listing = []
+    root = shipped_studies_dir()
+    for path in sorted(root.rglob("*.yaml"), key=lambda p: p.relative_to(root).with_suffix("").as_posix()):
+        try:
+            document = read_yaml(path.read_text(encoding="utf-8"))
+            description = str(document.get("description", "")) if isinstance(document, dict) else ""
+        except (OSError, UnicodeDecodeError, yaml.YAMLError) as error:
+            description = f"(unreadable: {error})"
+        listing.append((path.relative_to(root).with_suffix("").as_posix(), " ".join(description.split())))
+    return listing

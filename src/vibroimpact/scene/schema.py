@@ -1,7 +1,7 @@
 """What a scene says: the frozen :class:`Scene` and its parts, and the vocabulary and limits of the scene format.
 
-Nothing here reads YAML or checks a document (see :mod:`vibroimpact.scene.sections` and
-:mod:`vibroimpact.scene.benchmark`); a :class:`Scene` is built only from checked values. Engine names come from
+Nothing here reads YAML or checks a document (see :mod:`vibroimpact.kinds.stepped.scene` and
+:mod:`vibroimpact.kinds.benchmark.scene`); a :class:`Scene` is built only from checked values. Engine names come from
 :mod:`vibroimpact.engines.registry`, which names every engine without importing one.
 """
 
@@ -16,20 +16,20 @@ import numpy as np
 from vibroimpact.analysis.pgf import AdmissibilitySettings
 from vibroimpact.engines.registry import BUMPER, RIGID, engine_names, engine_spec, stepped_solutions
 from vibroimpact.engines.settings import ATOL_RATIO, STEPPED_TOLERANCES, EngineSettings
-from vibroimpact.model.contact import loss_factor_from_restitution
+from vibroimpact.model.contact import loss_factor_from_restitution, Stop
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.stops import Stop
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.scene.kinds import KINDS
 from vibroimpact.scene.layout import LoadSpec, StopSpec
-from vibroimpact.scene.quantities import MOTION_QUANTITIES, QUANTITIES, STOP_QUANTITIES, quantities_for
+from vibroimpact.scene.variables import MOTION_QUANTITIES, QUANTITIES, STOP_QUANTITIES, quantities_for
 from vibroimpact.simulation.settings import START_MODES, SWEEP_STARTS, SteadySettings
 
 if TYPE_CHECKING:
-    from vibroimpact.scene.bifurcation_settings import BifurcationSettings
-    from vibroimpact.scene.concepts_settings import ConceptsSettings
-    from vibroimpact.scene.validation_settings import ValidationSettings
+    from vibroimpact.kinds.bifurcation.scene import BifurcationSettings
+    from vibroimpact.kinds.concepts.scene import ConceptsSettings
+    from vibroimpact.kinds.validation.settings import ValidationSettings
 
 __all__ = [
     "Scene",
@@ -52,8 +52,6 @@ __all__ = [
     "quantities_for",
 ]
 
-#: Kinds of study a scene can be (:attr:`Scene.kind`); each has its run and estimate (``study/kinds.py``) and its page.
-STUDY_KINDS = ("stepped", "swept", "benchmark", "bifurcation", "validation", "concepts")
 #: Solutions computed by time integration (they need the ``simulation`` section's settings): the registered engines
 #: offered as stepped solutions.
 ENGINE_SOLUTIONS = stepped_solutions()
@@ -260,7 +258,7 @@ class BenchmarkSettings:
 
 @dataclass(frozen=True, eq=False)
 class BenchmarkScene:
-    """A benchmark scene's cases and settings (run by :mod:`vibroimpact.benchmarks.accuracy`)."""
+    """A benchmark scene's cases and settings (run by :mod:`vibroimpact.kinds.benchmark.study`)."""
 
     cases: tuple[BenchmarkCase, ...]
     settings: BenchmarkSettings
@@ -304,7 +302,7 @@ class Scene:
     swept_sine : SweptSineSettings or None
         When given, the time-domain solutions are swept-sine tests, not stepped steady states.
     bifurcation : BifurcationSettings or None
-        When given, a bifurcation study (:mod:`vibroimpact.scene.bifurcation`): brute force, branches, chart.
+        When given, a bifurcation study (:mod:`vibroimpact.kinds.bifurcation.scene`): brute force, branches, chart.
     report : bool or str
         Whether ``run-study`` writes the comparison report; a string names the page (``design_map``).
     text : str
@@ -378,15 +376,7 @@ class Scene:
 
         The one place that decides it; everything else dispatches on this name.
         """
-        if self.concepts is not None:
-            return "concepts"
-        if self.validation is not None:
-            return "validation"
-        if self.benchmark is not None:
-            return "benchmark"
-        if self.bifurcation is not None:
-            return "bifurcation"
-        return "stepped" if self.swept_sine is None else "swept"
+        return next(kind.name for kind in KINDS if kind.section is None or getattr(self, kind.section) is not None)
 
     @property
     def sweep_directions(self) -> tuple[str, ...]:

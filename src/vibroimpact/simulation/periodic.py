@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from vibroimpact.engines.base import Engine, Trajectory
 from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.simulation.layout import gaps
+from vibroimpact.simulation.harmonics import gaps
 from vibroimpact.orbits.branch import HybridInfo, MapEvaluation
 from vibroimpact.orbits.lyapunov import lyapunov_along_run, state_scales
 from vibroimpact.orbits.motion import MotionEvidence, classify_motion, classify_strobes

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from vibroimpact.model.validation import require_in_range
+from vibroimpact.model.structure import require_in_range
 
 __all__ = ["SteadySettings", "START_MODES", "SWEEP_STARTS"]
 

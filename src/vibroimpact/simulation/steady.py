@@ -20,11 +20,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.engines.base import Engine
-from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.contact import RigidStop, Stop
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.simulation.harmonics import HarmonicMeasures, measure
-from vibroimpact.simulation.layout import gaps, linear_state, resting_state, suspension_force
-from vibroimpact.model.stops import Stop
+from vibroimpact.simulation.harmonics import HarmonicMeasures, measure, gaps, linear_state, resting_state, suspension_force
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.simulation.periodic import motion_evidence, shoot_orbit

@@ -18,8 +18,7 @@ from scipy.integrate import cumulative_trapezoid
 from vibroimpact.engines.base import SweepRecord
 from vibroimpact.model.excitation import HarmonicForce, SweptSine
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.simulation.harmonics import running_at, running_fundamental, window_times
-from vibroimpact.simulation.layout import base_weights, linear_state
+from vibroimpact.simulation.harmonics import running_at, running_fundamental, window_times, base_weights, linear_state
 
 __all__ = ["SWEEP_STOP_QUANTITIES", "sweep_quantities", "sweep_start_state", "sweep_estimates", "running_quantities"]
 
@@ -55,7 +54,7 @@ def sweep_quantities(coordinates: tuple[str, ...]) -> tuple[str, ...]:
 def sweep_start_state(problem: ImpactProblem) -> NDArray[np.float64] | None:
     """(x, x') at t = 0 of the linear steady response (no stops) to the sweep's load at its start frequency,
     q sin(2 pi f0 t) distributed as the sweep says, plus the static deflection under its constant load
-    (:func:`vibroimpact.simulation.layout.linear_state`); None (start at rest) where that motion would reach a stop.
+    (:func:`vibroimpact.simulation.harmonics.linear_state`); None (start at rest) where that motion would reach a stop.
 
     Parameters
     ----------

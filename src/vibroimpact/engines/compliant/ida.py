@@ -1,4 +1,4 @@
-"""Engine ``compliant``: the Kelvin-Voigt bumper of eq. 25 (:mod:`.model`) through SUNDIALS IDA (scikit-sundae).
+"""Engine ``compliant``: the Kelvin-Voigt bumper of eq. 25 (:mod:`~vibroimpact.engines.compliant.model`) through SUNDIALS IDA (scikit-sundae).
 
 How it runs, and why it is fast: between two mode switches the mode's solver runs in one ``IDA.solve`` call over
 the output times (sweep samples or period boundaries) in that stretch (at most :data:`_OUTPUTS_PER_CALL`), so
@@ -35,19 +35,20 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from sksundae.cvode import CVODE
 from sksundae.ida import IDA
 
-from vibroimpact.engines.registry import BUMPER_INTEGRATOR, Capabilities
 from vibroimpact.engines.base import MODE_FREE, SweepRecord, Trajectory, TrajectoryBuilder, check_run
 from vibroimpact.engines.compliant.model import MODE_CONTACT, BumperModel, absolute_tolerances
 from vibroimpact.engines.event_loop import moment_row
+from vibroimpact.engines.registry import BUMPER_INTEGRATOR, Capabilities
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.sundae import clear_event_records
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.validation import require_positive
+from vibroimpact.model.structure import require_positive
 
-__all__ = ["CompliantEngine", "base_force"]
+__all__ = ["CompliantEngine", "base_force", "CompliantCvodeEngine"]
 
 _STATUS_ROOT = 2  # IDA_ROOT_RETURN
 _STATUS_ILL_INPUT = -22  # IDA_ILL_INPUT (CV_ILL_INPUT): among others, "Root found at and very near t"
@@ -341,3 +342,50 @@ class _Run:
                     model.layout.close(self.y, k)
                 self._begin_contact(k)
         self.rec.segment(self.t, MODE_CONTACT if self.contact else MODE_FREE, self.physical(), stop=self._segment_stop())
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# The compliant-bumper model of :mod:`~vibroimpact.engines.compliant.model` (engine :mod:`~vibroimpact.engines.compliant.ida`) through SUNDIALS CVODE instead of IDA.
+# --------------------------------------------------------------------------------------------------------------------
+
+class CompliantCvodeEngine(CompliantEngine):
+    """The Kelvin-Voigt bumper through CVODE (``settings.method``: ``adams`` or ``bdf``); see :class:`CompliantEngine`."""
+
+    def __init__(self, settings: EngineSettings = EngineSettings()) -> None:
+        super().__init__(settings)
+        self.name = f"compliant_cvode_{settings.method}"
+
+    def solve(self, solver: Any, tspan: NDArray[np.float64], y0: NDArray[np.float64], yp0: NDArray[np.float64]) -> Any:
+        """One CVODE call over ``tspan`` (an ODE solver needs no y0')."""
+        return solver.solve(tspan, y0)
+
+    def _solver(self, model: BumperModel, contact: int, omega_ref: float) -> tuple[Any, Any]:
+        residual = model.residual(contact)
+        zero = np.zeros(model.size)
+
+        def rhs(t: float, y: NDArray[np.float64], yp: NDArray[np.float64]) -> None:
+            residual(t, y, zero, yp)  # yp <- 0 - f(t, y)
+            np.negative(yp, out=yp)
+
+        events = model.events(contact)
+        derivative = np.empty(model.size)
+
+        def cvode_events(t: float, y: NDArray[np.float64], out: NDArray[np.float64]) -> None:
+            rhs(t, y, derivative)
+            events(t, y, derivative, out)
+
+        cvode_events.terminal = events.terminal  # type: ignore[attr-defined]
+        cvode_events.direction = events.direction  # type: ignore[attr-defined]
+        options: dict[str, Any] = {
+            "method": "Adams" if self.settings.method == "adams" else "BDF",
+            "rtol": self.settings.rtol,
+            "atol": absolute_tolerances(self.settings.atol, omega_ref, model.layout.masses, model.quadratures, model.layout.size),
+            "max_num_steps": 1_000_000,
+            "eventsfn": cvode_events,
+            "num_events": model.event_count(contact),
+            "first_step": self.first_step(model, contact, omega_ref),  # CVODE's own guess collapsed at contact onsets
+        }
+        if self.settings.max_step > 0.0:
+            options["max_step"] = self.settings.max_step
+            options["first_step"] = min(options["first_step"], self.settings.max_step)
+        return CVODE(rhs, **options), cvode_events

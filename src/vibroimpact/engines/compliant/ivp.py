@@ -1,6 +1,6 @@
 """The compliant-bumper swept-sine test through ``scipy.integrate.solve_ivp``: a cross-check of the IDA engine.
 
-Written independently of :mod:`.ida` and :mod:`.model` (its own right-hand side, in the physical coordinates
+Written independently of :mod:`~vibroimpact.engines.compliant.ida` and :mod:`~vibroimpact.engines.compliant.model` (its own right-hand side, in the physical coordinates
 (x, x'), its own events and restarts), so that agreement between the two means something. The model is the same, on
 any structure with any stops (normal n_k, clearance Delta_k, effective mass m_k): the Kelvin-Voigt bumper of eq. 25
 of stop k pushes along -n_k with F_k = K_k (n_k . x - Delta_k) + B_k n_k . x' (K_k = m_k Omega_b^2,
@@ -36,7 +36,7 @@ from vibroimpact.engines.compliant.model import MODE_CONTACT
 from vibroimpact.engines.settings import SWEEP_SETTINGS
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.validation import require_positive
+from vibroimpact.model.structure import require_positive
 
 __all__ = ["IVP_METHODS", "solve_ivp_sweep"]
 

@@ -1,0 +1,299 @@
+"""Benchmark scenes: the header of every scene plus ``benchmark`` (cases, methods, tolerances, the model ladder).
+
+Example (the shipped ``accuracy_cost``, shortened)::
+
+    name: accuracy_cost
+    system: {m1: 1.0, m2: 0.1, k1: 25000, k2: 4300, b1: 0.8, b2: 0.08}
+    excitation: {amplitude: 10.0}
+    benchmark:
+      duration: 2.0
+      methods: [momentary_adams, compliant_ida, solve_ivp_DOP853]
+      tolerances: [1.0e-4, 1.0e-6, 1.0e-8]
+      cases:
+        - {name: one_impact, frequency: 25.0, restitution: 0.2, clearance: 0.003, start: pgf, bumper_frequency: 1000}
+
+The structure, load and stops are written as in stepped scenes (:mod:`vibroimpact.scene.layout_parse`): the paper's
+named form above (its stop above the absorber), or matrices with named coordinates, ``excitation: {amplitude, on,
+static, base_motion}`` and a ``stops`` list. A case's ``restitution``, ``clearance`` (or ``clearance_below_linear``:
+that far inside each stop's linear reach |n . X| + n . x0) and ``bumper_frequency`` go to the stops that do not give
+their own (each stop's loss factor follows its restitution); they are required where a stop takes them, refused where
+none does. Method names are engines of :mod:`vibroimpact.engines.registry` (see
+:data:`~vibroimpact.scene.schema.BENCHMARK_METHODS`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+import numpy as np
+
+from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.engines.settings import STEPPED_TOLERANCES
+from vibroimpact.model.excitation import SweptSine
+from vibroimpact.model.problem import ImpactProblem, Structure
+from vibroimpact.model.contact import Stop
+from vibroimpact.scene.checker import Checker, SceneError
+from vibroimpact.scene.layout import LoadSpec, StopSpec, build_stops
+from vibroimpact.scene.layout_parse import document_names, is_general, parse_load, parse_stop_layout, parse_structure
+from vibroimpact.scene.schema import (
+    BENCHMARK_METHODS,
+    MAX_BENCHMARK_PERIODS,
+    MAX_BUMPER_FREQUENCY,
+    BenchmarkCase,
+    BenchmarkScene,
+    BenchmarkSettings,
+    LadderSettings,
+    Scene,
+)
+from vibroimpact.kinds.stepped.scene import NAME, check_sweep_run, parse_names
+from vibroimpact.simulation.settings import START_MODES
+
+__all__ = ["BENCHMARK_TOP_KEYS", "parse_benchmark_scene"]
+
+#: Top-level keys of a benchmark scene.
+BENCHMARK_TOP_KEYS = {"name", "description", "system", "excitation", "stops", "benchmark", "report"}
+_BENCHMARK_KEYS = {"duration", "methods", "tolerances", "atol_ratio", "repeats", "max_seconds", "cases", "ladder"}
+_BENCHMARK_CASE_KEYS = {"name", "frequency", "restitution", "clearance", "clearance_below_linear", "start", "bumper_frequency", "swept_sine"}
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class _Layout:
+    """What every case of a scene shares: the structure, the load and the stops as given (checked values)."""
+
+    system: Structure
+    amplitude: float
+    load: LoadSpec
+    specs: tuple[StopSpec, ...]
+
+    def taking(self, field: str) -> list[int]:
+        """The stops that take ``field`` (``restitution``, ``clearance``, ``bumper_frequency``) from the case."""
+        return [k for k, spec in enumerate(self.specs) if getattr(spec, field) is None]
+
+    def takes(self, field: str) -> bool:
+        """Does some stop take ``field`` from the case?"""
+        return bool(self.taking(field))
+
+
+def parse_benchmark_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
+    """Validate a benchmark scene's document (a mapping with ``benchmark``) and build the :class:`Scene`; raise
+    :class:`SceneError` listing all problems."""
+    c = Checker()
+    doc = c.mapping("", document, BENCHMARK_TOP_KEYS, {"name", "system", "excitation", "benchmark"})
+    general = is_general(doc)
+    name, description, report = parse_names(c, doc)
+    system = parse_structure(c, doc["system"]) if "system" in doc else None
+    names = tuple(system.coordinates) if system is not None else document_names(doc.get("system"))
+    amplitude, load = parse_load(c, doc["excitation"], names) if "excitation" in doc else (None, None)
+    specs = parse_stop_layout(c, doc, system)
+    layout = None
+    if system is not None and amplitude is not None and (specs is not None or "stops" not in doc):
+        layout = _Layout(system, amplitude, load or LoadSpec(), specs or (StopSpec(coordinate=1),))
+    spec = c.mapping("benchmark", doc["benchmark"], _BENCHMARK_KEYS, {"duration", "methods", "tolerances", "cases"}) if "benchmark" in doc else {}
+    duration = c.number("benchmark.duration", spec.get("duration"), 0.0, 1e5, low_inclusive=False) if "duration" in spec else None
+    methods = c.choices("benchmark.methods", spec.get("methods"), BENCHMARK_METHODS) if "methods" in spec else ()
+    tolerances = c.grid("benchmark.tolerances", spec.get("tolerances"), 1e-15, 1e-1, True) if "tolerances" in spec else None
+    options: dict[str, Any] = {}
+    if "atol_ratio" in spec:
+        options["atol_ratio"] = c.number("benchmark.atol_ratio", spec["atol_ratio"], 1e-12, 1.0)
+    if "repeats" in spec:
+        options["repeats"] = c.integer("benchmark.repeats", spec["repeats"], 1, 100)
+    if "max_seconds" in spec:
+        options["max_seconds"] = c.number("benchmark.max_seconds", spec["max_seconds"], 0.0, 1e5, low_inclusive=False)
+    if "ladder" in spec:
+        options["ladder"] = _parse_ladder(c, spec["ladder"], layout)
+    cases = []
+    raw_cases = spec.get("cases", [])
+    if not isinstance(raw_cases, list) or not raw_cases:
+        c.fail("benchmark.cases", "expected a non-empty list of cases {name, frequency, restitution, clearance | clearance_below_linear, start[, bumper_frequency] | swept_sine}")
+        raw_cases = []
+    case_names: list[str] = []
+    for i, raw in enumerate(raw_cases):
+        case = _parse_case(c, f"benchmark.cases[{i}]", raw, case_names, layout, duration)
+        if case is not None:
+            cases.append(case)
+    if c.problems:
+        raise SceneError(c.problems, source)
+    assert tolerances is not None and isinstance(name, str) and layout is not None
+    settings = BenchmarkSettings(methods=methods, tolerances=tuple(float(t) for t in tolerances[::-1]), **options)
+    return Scene(
+        name=name,
+        description=description,
+        system=layout.system,
+        amplitude=layout.amplitude,
+        frequency=np.array(sorted({case.problem.frequency for case in cases})),
+        restitution=_given(case.problem.stops[k].law.restitution for case in cases for k in layout.taking("restitution")),
+        clearance=_given(case.problem.stops[k].clearance for case in cases for k in layout.taking("clearance")),
+        swept=(),
+        solutions=(),
+        quantities=(),
+        benchmark=BenchmarkScene(tuple(cases), settings),
+        report=report,
+        text=text,
+        load=load,
+        stops=specs or (),
+        general=general,
+    )
+
+
+def _given(values: Any) -> np.ndarray:
+    """The distinct finite values the cases give, sorted; [NaN] where every stop gives its own."""
+    finite = sorted({float(v) for v in values if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)})
+    return np.array(finite) if finite else np.array([math.nan])
+
+
+def _own_or_case(c: Checker, key: str, case: dict[str, Any], layout: _Layout, field: str, words: str) -> bool:
+    """Whether the case must give ``field`` (some stop takes it); a case value no stop takes is refused."""
+    needed = layout.takes(field)
+    given = field in case or (field == "clearance" and "clearance_below_linear" in case)
+    if not needed and given:
+        c.fail(key, f"every stop of 'stops' gives its own {words}: remove the case's {field if field in case else 'clearance_below_linear'}")
+    return needed
+
+
+def _parse_case(c: Checker, key: str, raw: Any, names: list[str], layout: _Layout | None, duration: float | None) -> BenchmarkCase | None:
+    """One entry of ``benchmark.cases``, checked; None where it is unusable (every problem recorded)."""
+    case = c.mapping(key, raw, _BENCHMARK_CASE_KEYS, {"name"})
+    if "name" in case:
+        if not (isinstance(case["name"], str) and NAME.match(case["name"])):
+            c.fail(f"{key}.name", f"expected a name of letters, digits, '_', '-', '.', got {case['name']!r}")
+        elif case["name"] in names:
+            c.fail(f"{key}.name", f"{case['name']!r} is used by another case: names must be unique")
+        names.append(str(case["name"]))
+    swept = case.get("swept_sine")
+    if "swept_sine" in case and not isinstance(swept, dict):
+        c.fail(f"{key}.swept_sine", f"expected a mapping {{start, stop, rate, sample_rate}}, got {swept!r}")
+        return None
+    needs = {"restitution": True, "clearance": True, "bumper_frequency": swept is not None}
+    if layout is not None:
+        needs = {field: _own_or_case(c, key, case, layout, field, words) for field, words in (("restitution", "restitution"), ("clearance", "clearance"), ("bumper_frequency", "bumper frequency"))}
+    f_start = f_stop = rate = sample_rate = None
+    if swept is not None:
+        spec_s = c.mapping(f"{key}.swept_sine", swept, {"start", "stop", "rate", "sample_rate"}, {"start", "stop", "rate"})
+        f_start = c.number(f"{key}.swept_sine.start", spec_s.get("start"), 0.0, math.inf, low_inclusive=False) if "start" in spec_s else None
+        f_stop = c.number(f"{key}.swept_sine.stop", spec_s.get("stop"), 0.0, math.inf, low_inclusive=False) if "stop" in spec_s else None
+        rate = c.number(f"{key}.swept_sine.rate", spec_s.get("rate"), 0.0, math.inf, low_inclusive=False) if "rate" in spec_s else None
+        sample_rate = c.number(f"{key}.swept_sine.sample_rate", spec_s.get("sample_rate", 2000.0), 0.0, 1e7, low_inclusive=False)
+        if "frequency" in case or "start" in case:
+            c.fail(key, "a swept_sine case sets its own frequencies and starts at rest: remove frequency and start")
+        if "bumper_frequency" not in case and needs["bumper_frequency"]:
+            c.fail(f"{key}.bumper_frequency", "required by a swept_sine case (the compliant model): Omega_b / 2 pi [Hz] in (0, inf)")
+        if layout is not None and layout.load.base_motion:
+            c.fail(f"{key}.swept_sine", "a swept-sine case drives a force q sin(theta(t)): a swept base motion (excitation.base_motion) is not supported")
+            return None
+        if f_start is not None and f_stop is not None and f_start == f_stop:
+            c.fail(f"{key}.swept_sine.stop", "must differ from start")
+            f_start = None
+        if f_start is not None and f_stop is not None:  # the benchmark's running fundamental uses 8-cycle windows
+            rate, sample_rate = check_sweep_run(c, f"{key}.swept_sine", min(f_start, f_stop), max(f_start, f_stop), rate, sample_rate, 8)
+        frequency = f_start
+    else:
+        if "frequency" not in case:
+            c.fail(f"{key}.frequency", "required key is missing")
+        if "start" not in case:
+            c.fail(f"{key}.start", "required key is missing")
+        frequency = c.number(f"{key}.frequency", case.get("frequency"), 0.0, math.inf, low_inclusive=False) if "frequency" in case else None
+    if needs["restitution"] and "restitution" not in case:
+        c.fail(f"{key}.restitution", "required key is missing")
+    restitution = c.number(f"{key}.restitution", case.get("restitution"), 0.0, 1.0) if "restitution" in case else math.nan
+    bumper = c.number(f"{key}.bumper_frequency", case["bumper_frequency"], 0.0, MAX_BUMPER_FREQUENCY, low_inclusive=False) if "bumper_frequency" in case else math.nan
+    if bumper is not None and math.isfinite(bumper) and restitution == 0.0:
+        c.fail(f"{key}.restitution", "R = 0 needs an infinitely damped bumper: use R > 0 with bumper_frequency")
+    if needs["clearance"] and ("clearance" in case) == ("clearance_below_linear" in case):
+        c.fail(key, "give exactly one of 'clearance' [m] or 'clearance_below_linear' [m]")
+        return None
+    start = case.get("start", "rest")
+    if start not in START_MODES:
+        c.fail(f"{key}.start", f"{start!r} is not allowed: use rest, linear or pgf")
+    clearance = c.number(f"{key}.clearance", case["clearance"], 0.0, math.inf) if "clearance" in case else math.nan
+    below = c.number(f"{key}.clearance_below_linear", case["clearance_below_linear"], -1.0, 1.0) if "clearance_below_linear" in case else math.nan
+    if None in (frequency, restitution, layout, duration, bumper, clearance, below) or start not in START_MODES:
+        return None
+    assert frequency is not None and restitution is not None and layout is not None and duration is not None and bumper is not None and clearance is not None and below is not None
+    stops = _case_stops(c, key, layout, frequency, restitution, clearance, below, bumper)
+    if stops is None:
+        return None
+    rigid, compliant = stops
+    load = layout.load
+    problem = ImpactProblem(layout.system, rigid, load.force(layout.amplitude, frequency))
+    name = str(case["name"])
+    if swept is not None:
+        if None in (f_start, f_stop, rate, sample_rate):
+            return None
+        assert f_start is not None and f_stop is not None and rate is not None and sample_rate is not None
+        sweep = SweptSine(layout.amplitude, f_start, f_stop, rate, weights=load.weights, static=load.static)
+        return BenchmarkCase(name, problem, "rest", 0, compliant, sweep, sample_rate)
+    periods = max(1, round(duration * frequency))
+    if periods > MAX_BENCHMARK_PERIODS:
+        c.fail(f"{key}.frequency", f"{periods:,} periods per run (duration x frequency) is too many: allowed at most {MAX_BENCHMARK_PERIODS:,}")
+        return None
+    return BenchmarkCase(name, problem, start, periods, compliant)
+
+
+def _case_stops(c: Checker, key: str, layout: _Layout, frequency: float, restitution: float, clearance: float, below: float, bumper: float) -> tuple[tuple[Stop, ...], tuple[Stop, ...] | None] | None:
+    """The rigid stops of a case and its bumpers (None where a stop has no bumper frequency: no compliant methods).
+
+    ``below``: a clearance that far inside each stop's linear reach, |n . X| + n . x0 at ``frequency``, for the stops
+    taking the case's clearance (NaN: ``clearance`` instead). Problems are recorded under ``key``."""
+    specs = layout.specs
+    force = layout.load.force(layout.amplitude, frequency)
+    try:
+        if math.isfinite(below):
+            probe = ImpactProblem(layout.system, build_stops(specs, False, 0.5, 1.0), force)
+            linear = linear_amplitudes(probe)
+            reach = np.abs(linear.stops) + linear.stop_static
+            chosen = []
+            for k, spec in enumerate(specs):
+                if spec.clearance is None:
+                    if reach[k] - below < 0.0:
+                        of = f" of stop {k}" if len(specs) > 1 else ""
+                        c.fail(f"{key}.clearance_below_linear", f"{below:g} m exceeds the linear amplitude{of} {reach[k]:g} m")
+                        return None
+                    spec = dataclasses.replace(spec, clearance=float(reach[k] - below))
+                chosen.append(spec)
+            specs = tuple(chosen)
+        rigid = build_stops(specs, False, restitution, clearance)
+        ImpactProblem(layout.system, rigid, force)  # the stops' room between each other
+    except ValueError as error:
+        c.fail(key, str(error))
+        return None
+    compliant = None
+    values = [spec.values(restitution, clearance, bumper) for spec in specs]
+    if all(math.isfinite(fb) for _, _, fb, _ in values):
+        # R = 0 needs an infinitely damped bumper: no compliant model (the case's own R = 0 is reported by the caller)
+        undamped = [k for k, (_, _, _, xi) in enumerate(values) if not math.isfinite(xi)]
+        for k in undamped:
+            if specs[k].restitution is not None:
+                c.fail(f"stops[{k}].restitution", "R = 0 needs an infinitely damped bumper for the compliant methods: give the stop's bumper.loss_factor, or R > 0")
+        if not undamped:
+            compliant = build_stops(specs, True, restitution, clearance, bumper)
+    return rigid, compliant
+
+
+def _parse_ladder(c: Checker, value: Any, layout: _Layout | None) -> LadderSettings | None:
+    """``ladder: {frequency, restitution, clearance, bumper_frequencies, rtol, repeats}``; restitution and clearance
+    go to the stops that give none (required where one does)."""
+    needed = {field for field in ("restitution", "clearance") if layout is None or layout.takes(field)}
+    spec = c.mapping("benchmark.ladder", value, {"frequency", "restitution", "clearance", "bumper_frequencies", "rtol", "repeats"}, {"frequency", "bumper_frequencies"} | needed)
+    frequency = c.number("benchmark.ladder.frequency", spec["frequency"], 0.0, math.inf, low_inclusive=False) if "frequency" in spec else None
+    restitution = c.number("benchmark.ladder.restitution", spec["restitution"], 0.0, 1.0, low_inclusive=False) if "restitution" in spec else math.nan
+    clearance = c.number("benchmark.ladder.clearance", spec["clearance"], 0.0, math.inf) if "clearance" in spec else math.nan
+    bumpers = c.grid("benchmark.ladder.bumper_frequencies", spec["bumper_frequencies"], 0.0, MAX_BUMPER_FREQUENCY, False) if "bumper_frequencies" in spec else None
+    rtol = c.number("benchmark.ladder.rtol", spec.get("rtol", STEPPED_TOLERANCES[0]), 1e-14, 1e-2)
+    repeats = c.integer("benchmark.ladder.repeats", spec.get("repeats", 3), 1, 100)
+    if layout is not None:
+        for field in ("restitution", "clearance"):
+            if field in spec and field not in needed:
+                c.fail(f"benchmark.ladder.{field}", f"every stop of 'stops' gives its own {field}: remove it")
+    if any(v is None for v in (frequency, restitution, clearance, bumpers, rtol, repeats, layout)) or not needed <= set(spec):
+        return None
+    assert frequency is not None and restitution is not None and clearance is not None and bumpers is not None and rtol is not None and repeats is not None and layout is not None
+    try:
+        rigid = build_stops(layout.specs, False, restitution, clearance)
+        problem = ImpactProblem(layout.system, rigid, layout.load.force(layout.amplitude, frequency))
+        compliant = tuple(build_stops(layout.specs, True, restitution, clearance, float(b)) for b in bumpers)
+    except ValueError as error:
+        c.fail("benchmark.ladder", str(error))
+        return None
+    return LadderSettings(frequency, restitution, clearance, tuple(float(b) for b in bumpers), rtol, repeats, problem, compliant)

@@ -1,0 +1,341 @@
+"""Every periodic orbit of one restitution over a frequency band: branches continued from the closed form, at period
+doublings and at grazing points, the linear orbit, and their special points, as flat arrays for a dataset.
+
+Everything works on the general problem (:class:`~vibroimpact.model.problem.ImpactProblem` with a tuple of rigid
+:class:`~vibroimpact.model.contact.Stop`, any structure and harmonic load; the paper's layout is one of them).
+:func:`find_branches` starts a branch at the middle of every frequency segment where a root of the impulse equation
+(eq. 16 corrected, :func:`vibroimpact.analysis.impact_orbit.solve_impact_orbit`) gives an admissible closed-form
+orbit (one impact per period on one stop, the symmetric two impacts per period on a two-sided stop), unless an
+earlier branch already passes through that orbit (same impulse at that frequency); each branch gets its own
+stroboscopic section, away from the impacts of its band (:func:`vibroimpact.orbits.maps.section_phase`). A layout
+without a closed form (:func:`vibroimpact.analysis.layout.closed_form_refusal`) starts no such branch; its orbits
+come from the brute force (:mod:`~vibroimpact.kinds.bifurcation.cases`). Period doublings of period-1 branches switch to the period-2
+branch; grazing points where an orbit with another, non-zero impact count continues start a branch there. The linear
+orbit comes from the closed form wherever it fits inside every stop (|n_k H F| + n_k K^-1 F0 <= Delta_k). Failures
+of a continuation are recorded, never fatal.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import brentq
+
+from vibroimpact.analysis.impact_orbit import ROOTS, ImpactOrbit, solve_impact_orbit
+from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.orbits.bifurcations import switch_period_doubling
+from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Branch, Iterated, PeriodicOrbit, SpecialPoint
+from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
+from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures, section_phase
+from vibroimpact.orbits.shooting import shoot
+
+__all__ = ["ORIGINS", "MAX_ORBIT_IMPACTS", "map_bounds", "problem_at", "stop_values", "OrbitSet", "find_branches", "closed_form_orbits", "linear_segments"]
+
+#: How a branch was found (CF flags of ``branch_origin``): the closed forms' kinds (one impact per period, the
+#: symmetric two impacts of a two-sided stop) are :data:`vibroimpact.analysis.layout.KINDS`.
+ORIGINS = ("linear", "one_impact", "period_doubling", "grazing", "brute_force", "two_impacts")
+#: Impact velocities kept per orbit (the rest are dropped; ``impacts_per_period`` counts them all).
+MAX_ORBIT_IMPACTS = 8
+#: Frequency step of the closed-form scan for closed-form starts [Hz].
+SCAN_STEP = 0.01
+#: Largest relative impulse difference of an orbit from a branch it is taken to lie on [-].
+SAME_ORBIT = 0.02
+#: Most branches born at grazing points per restitution (each may have its own grazing points).
+MAX_GRAZING_BRANCHES = 8
+#: |max |mu| - 1| up to which an orbit is marginal (``stable`` = 2) [-].
+MARGINAL = 1e-9
+
+
+def problem_at(problem: ImpactProblem, frequency: float, clearance: float | None = None, phase: float | None = None) -> ImpactProblem:
+    """``problem`` at another excitation frequency [Hz] and, when given, with every stop at ``clearance`` [m] and the
+    load's phase ``phase`` [rad]; the structure, the load's distribution and static part and each stop's restitution
+    are kept."""
+    excitation = dataclasses.replace(problem.harmonic, frequency=float(frequency))
+    if phase is not None:
+        excitation = dataclasses.replace(excitation, phase=float(phase))
+    stops = problem.stops
+    if clearance is not None:
+        stops = tuple(dataclasses.replace(stop, law=RigidStop(float(clearance), stop.law.restitution)) for stop in stops)
+    return ImpactProblem(problem.system, stops, excitation)
+
+
+def stop_values(problem: ImpactProblem) -> tuple[float, float]:
+    """(Delta [m], R [-]) shared by every stop of a bifurcation study's problem (the scene checks they are equal)."""
+    first = problem.stops[0]
+    return first.clearance, first.law.restitution
+
+
+@dataclass
+class OrbitSet:
+    """Branches and special points of one restitution, as lists of per-point records (see :meth:`add_branch`), and
+    the continued branches with their maps (``maps``: (ImpactMap, Branch) pairs)."""
+
+    points: list[dict] = field(default_factory=list)
+    specials: list[dict] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    count: int = 0
+    maps: list = field(default_factory=list)
+    _index: tuple | None = None
+
+    def add_branch(self, system: ImpactMap, branch: Branch, origin: str) -> int:
+        """Measure every orbit of ``branch`` and keep it with its special points; return its label."""
+        label = self.count
+        self.count += 1
+        for orbit in branch.orbits:
+            self.points.append(_record(system, orbit) | {"branch": label, "origin": ORIGINS.index(origin)})
+        for point in branch.special_points:
+            self.specials.append(_record(system, point.orbit) | {"branch": label, "kind": SPECIAL_POINT_KINDS.index(point.kind), "frequency": point.value, "note": point.note})
+        self.notes.append(f"branch {label} ({origin}): {len(branch.orbits)} points, {branch.values.min():.4f}-{branch.values.max():.4f} Hz, ends: {branch.end}")
+        return label
+
+    def add_linear(self, problem: ImpactProblem, frequency: NDArray[np.float64]) -> None:
+        """The impactless orbit of ``problem`` on one segment of frequencies [Hz] where it fits inside every stop."""
+        label = self.count
+        self.count += 1
+        multipliers = _linear_multipliers(problem, frequency)
+        amplitudes = np.abs(linear_amplitudes(problem, 2.0 * np.pi * np.asarray(frequency)).coordinates)
+        for k, f in enumerate(frequency):
+            modulus = float(np.max(np.abs(multipliers[k])))
+            self.points.append({
+                "branch": label, "origin": 0, "frequency": float(f), "amplitudes": amplitudes[k], "impulse": 0.0, "floquet_modulus": modulus,
+                "stable": int(modulus < 1.0), "impacts": 0, "period": 1, "multipliers": multipliers[k], "velocities": np.zeros(0),
+            })  # fmt: skip
+        self.notes.append(f"branch {label} (linear): {frequency.size} points, {frequency[0]:.4f}-{frequency[-1]:.4f} Hz")
+
+    def impulse_at(self, frequency: float, period: int, impacts: int) -> list[float]:
+        """Impulses per excitation period of the known branches with this period and impact count at ``frequency``."""
+        if self._index is None or self._index[0] != len(self.points):
+            self._index = (len(self.points), _segments(self.points))
+        segments = self._index[1].get((period, impacts))
+        if segments is None:
+            return []
+        fa, fb, ja, jb = segments
+        inside = (np.minimum(fa, fb) <= frequency) & (frequency <= np.maximum(fa, fb))
+        span = np.where(fb[inside] == fa[inside], 1.0, fb[inside] - fa[inside])
+        t = np.where(fb[inside] == fa[inside], 0.0, (frequency - fa[inside]) / span)
+        return list(ja[inside] + t * (jb[inside] - ja[inside]))
+
+    def known(self, frequency: float, period: int, impacts: int, impulse: float, tolerance: float = 0.0) -> bool:
+        """Does a known branch pass through an orbit of this period, impact count and impulse at ``frequency``
+        (within :data:`SAME_ORBIT`, or ``tolerance`` when larger)?"""
+        limit = max(SAME_ORBIT, tolerance) * max(abs(impulse), 1e-12)
+        return any(abs(j - impulse) <= limit for j in self.impulse_at(frequency, period, impacts))
+
+
+def _segments(points: list[dict]) -> dict[tuple[int, int], tuple[np.ndarray, ...]]:
+    """(period, impacts per orbit period) -> (f_a, f_b, J_a, J_b) of each pair of consecutive points of one branch."""
+    groups: dict[tuple[int, int], list[tuple[float, float, float, float]]] = {}
+    for a, b in zip(points[:-1], points[1:]):
+        if a["branch"] == b["branch"] and a["period"] == b["period"] and a["impacts"] == b["impacts"]:
+            groups.setdefault((a["period"], a["impacts"]), []).append((a["frequency"], b["frequency"], a["impulse"], b["impulse"]))
+    return {key: tuple(np.array(column) for column in zip(*rows)) for key, rows in groups.items()}
+
+
+def map_bounds(low: float, high: float) -> dict[str, tuple[float, float]]:
+    """The parameter box of the study's maps: frequencies within a factor 2 of the band [Hz] (a continuation's trials
+    stay physical; outside, the map has no image)."""
+    return {"frequency": (0.5 * low, 2.0 * high)}
+
+
+def _record(system: ImpactMap, orbit: PeriodicOrbit) -> dict:
+    measures = orbit_measures(system, orbit)
+    periods = orbit.period * system.periods  # excitation periods per orbit period
+    multipliers = np.zeros(system.dimension, dtype=complex)
+    multipliers[: orbit.multipliers.size] = orbit.multipliers
+    modulus = orbit.floquet_modulus
+    return {
+        "frequency": orbit.parameter("frequency"),
+        "amplitudes": measures.amplitudes,
+        "impulse": float(measures.impulses.sum()) / periods,
+        "floquet_modulus": modulus,
+        "stable": 2 if abs(modulus - 1.0) <= MARGINAL else int(modulus < 1.0),
+        "impacts": int(measures.impulses.size),
+        "period": periods,
+        "multipliers": multipliers,
+        "velocities": measures.impact_velocities[:MAX_ORBIT_IMPACTS],
+    }
+
+
+def _linear_multipliers(problem: ImpactProblem, frequency: NDArray[np.float64]) -> NDArray[np.complex128]:
+    """exp(lambda T) of the free structure's eigenvalues at each frequency, by decreasing modulus, shape (n, 2N)."""
+    eigenvalues = np.linalg.eigvals(problem.structure.state_matrix)
+    mu = np.exp(eigenvalues[None, :] / np.asarray(frequency)[:, None])
+    order = np.argsort(-np.abs(mu), axis=1, kind="stable")
+    return np.take_along_axis(mu, order, axis=1)
+
+
+def closed_form_orbits(problem: ImpactProblem, frequency: NDArray[np.float64]) -> list[ImpactOrbit]:
+    """The closed-form impact orbit of ``problem`` at ``frequency`` [Hz] for each root of the impulse equation
+    (:data:`~vibroimpact.analysis.impact_orbit.ROOTS`), NaN impulses where none exists; ``ValueError`` with the
+    reason where the layout has no closed form."""
+    plus = solve_impact_orbit(problem, 2.0 * np.pi * np.asarray(frequency, dtype=float))
+    return [plus if root == "+" else plus.with_root(root) for root in ROOTS]
+
+
+def linear_segments(problem: ImpactProblem, low: float, high: float, step: float = 0.02) -> list[NDArray[np.float64]]:
+    """Frequency segments [Hz] where the linear orbit fits inside every stop, with their exact grazing ends."""
+    frequency = np.arange(low, high + 0.5 * step, step)
+    clearances = problem.clearances()
+
+    def gap(f: float) -> float:
+        linear = linear_amplitudes(problem, 2.0 * np.pi * f)
+        return float(np.min(clearances - linear.stop_static - np.abs(linear.stops)))
+
+    fits = np.array([gap(f) >= 0.0 for f in frequency])
+    segments = []
+    for run in np.split(np.flatnonzero(fits), np.flatnonzero(np.diff(np.flatnonzero(fits)) > 1) + 1):
+        if run.size == 0:
+            continue
+        inner = list(frequency[run])
+        if run[0] > 0:
+            inner.insert(0, brentq(gap, frequency[run[0] - 1], frequency[run[0]], xtol=1e-12))
+        if run[-1] < frequency.size - 1:
+            inner.append(brentq(gap, frequency[run[-1]], frequency[run[-1] + 1], xtol=1e-12))
+        segments.append(np.array(inner))
+    return segments
+
+
+def find_branches(
+    problem: ImpactProblem, low: float, high: float,
+    one_impact: bool = True, period_doubling: bool = True, grazing: bool = True, linear: bool = True,
+    max_steps: int = 2000, max_step: float = 0.1, progress=None,
+) -> OrbitSet:  # fmt: skip
+    """Every branch of ``problem``'s restitution over [low, high] Hz (module docstring); ``progress`` gets a line per
+    branch.
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+        Structure, rigid stops sharing one clearance and restitution, harmonic load; its frequency is not used.
+    low, high : float
+        The band [Hz].
+    one_impact : bool
+        Branches from the closed form (one impact per period, or two on a symmetric two-sided stop) at both roots.
+    period_doubling, grazing, linear : bool
+        Period-2 branches at period doublings, branches born at grazing points, the linear orbit.
+    max_steps : int
+        Most continuation steps per direction of a branch.
+    max_step : float
+        Largest arclength step [-].
+    """
+    found = OrbitSet()
+    settings = ContinuationSettings(lower=low, upper=high, max_steps=max_steps, max_step=max_step)
+    bounds = map_bounds(low, high)
+    restitution = stop_values(problem)[1]
+
+    def say(message: str) -> None:
+        if progress is not None:
+            progress(f"R = {restitution:g}: {message}")
+
+    def attempt(what: str, run) -> None:
+        try:
+            run()
+        except Exception as error:  # noqa: BLE001 - a failed branch is recorded, the others go on
+            found.notes.append(f"{what} failed: {type(error).__name__}: {str(error)[:200]}")
+            say(f"{what} failed ({type(error).__name__})")
+
+    maps: list[tuple[ImpactMap, Branch]] = []
+    if linear:
+        for segment in linear_segments(problem, low, high):
+            found.add_linear(problem, segment)
+    refusal = closed_form_refusal(problem) if one_impact else None
+    if refusal is not None:
+        found.notes.append(f"no closed-form orbit for this layout ({refusal}): its branches come from the brute force")
+    elif one_impact:
+        frequency = np.arange(low, high + 0.5 * SCAN_STEP, SCAN_STEP)
+        orbits = closed_form_orbits(problem, frequency)
+        exists = np.logical_or.reduce([orbit.exists for orbit in orbits])
+        for root, orbit in zip(ROOTS, orbits):
+            admissible = orbit.admissible()
+            kind, impacts = orbit.layout.kind, orbit.impacts_per_period
+            runs = np.split(np.flatnonzero(admissible), np.flatnonzero(np.diff(np.flatnonzero(admissible)) > 1) + 1)
+            for run in (r for r in runs if r.size):
+                k = int(run[run.size // 2])
+                f0 = float(frequency[k])
+                if found.known(f0, 1, impacts, impacts * float(orbit.impulse[k])):
+                    continue
+                band = _segment(exists, k)
+                phase = section_phase(problem_at(problem, f0), frequency[band[0] : band[1] + 1])
+                mapping = ImpactMap(problem_at(problem, f0, phase=phase), bounds=bounds)
+
+                def start(mapping: ImpactMap = mapping, f0: float = f0, root: str = root, kind: str = kind) -> None:
+                    closed = solve_impact_orbit(mapping.problem, root=root)
+                    first = shoot(mapping, closed_form_state(mapping.problem, closed), mapping.parameters)
+                    branch = continue_branch(mapping, first, "frequency", settings)
+                    label = found.add_branch(mapping, branch, kind)
+                    maps.append((mapping, branch))
+                    say(f"{kind.replace('_', '-')} branch {label} from {f0:.2f} Hz: {len(branch.orbits)} points, {len(branch.special_points)} special points")
+
+                attempt(f"{kind.replace('_', '-')} branch from {f0:.2f} Hz", start)
+    if period_doubling:
+        for mapping, branch in list(maps):
+            for point in branch.special("period_doubling"):
+                if point.orbit.period != 1:
+                    continue
+
+                def doubled(mapping: ImpactMap = mapping, point: SpecialPoint = point) -> None:
+                    orbit = switch_period_doubling(mapping, point)
+                    child = continue_branch(Iterated(mapping, 2), orbit, "frequency", settings)
+                    label = found.add_branch(mapping, child, "period_doubling")
+                    maps.append((mapping, child))
+                    say(f"period-2 branch {label} from the period doubling at {point.value:.3f} Hz: {len(child.orbits)} points")
+
+                attempt(f"period-2 branch at {point.value:.3f} Hz", doubled)
+    if grazing:
+        born = 0
+        for mapping, branch in maps:  # grows while it runs: a born branch's own grazing points are visited too
+            for point in branch.special("grazing"):
+                if not point.continues or not point.impacts_after or point.impacts_after in set(branch.impacts.tolist()) or born >= MAX_GRAZING_BRANCHES:
+                    continue
+
+                def beyond(mapping: ImpactMap = mapping, point: SpecialPoint = point) -> None:
+                    orbit = _orbit_beyond(mapping, point)
+                    if orbit is None:
+                        found.notes.append(f"no orbit with {point.impacts_after} impacts found next to the grazing point at {point.value:.4f} Hz")
+                        return
+                    measures = orbit_measures(mapping, orbit)
+                    if found.known(orbit.parameter("frequency"), orbit.period, orbit.impacts, float(measures.impulses.sum()) / orbit.period):
+                        return
+                    child = continue_branch(Iterated(mapping, orbit.period) if orbit.period > 1 else mapping, orbit, "frequency", settings)
+                    label = found.add_branch(mapping, child, "grazing")
+                    maps.append((mapping, child))
+                    say(f"branch {label} born at the grazing point at {point.value:.3f} Hz: {len(child.orbits)} points")
+
+                born += 1
+                attempt(f"branch born at {point.value:.4f} Hz", beyond)
+    found.maps = maps
+    return found
+
+
+def _segment(mask: NDArray[np.bool_], k: int) -> tuple[int, int]:
+    """First and last index of the run of True in ``mask`` that contains index ``k``."""
+    first, last = k, k
+    while first > 0 and mask[first - 1]:
+        first -= 1
+    while last < mask.size - 1 and mask[last + 1]:
+        last += 1
+    return first, last
+
+
+def _orbit_beyond(mapping: ImpactMap, point: SpecialPoint) -> PeriodicOrbit | None:
+    """The orbit with ``point.impacts_after`` impacts next to a grazing point: shooting from the grazing orbit on
+    either side of it, ever farther."""
+    orbit = point.orbit
+    index = orbit.parameter_names.index("frequency")
+    for offset in (1e-4, 1e-3, 1e-2, 5e-2):
+        for sign in (1.0, -1.0):
+            p = orbit.parameters.copy()
+            p[index] = point.value + sign * offset
+            try:
+                found = shoot(mapping, orbit.state, p, orbit.period)
+            except Exception:  # noqa: BLE001 - no orbit there: try the next guess
+                continue
+            if found.impacts == point.impacts_after:
+                return found
+    return None

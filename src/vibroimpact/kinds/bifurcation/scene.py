@@ -1,0 +1,414 @@
+"""Bifurcation scenes: the header of every scene, the layout, and ``bifurcation`` (brute force, continued branches and
+the two-parameter chart).
+
+The layout is written as in stepped scenes (:mod:`vibroimpact.scene.layout_parse`, the same parsers): the paper's
+named form (``system: {m1 ... b2}``, ``excitation: {amplitude}``, ``stop: {clearance}``: one upper stop on x2, the
+force on x1), or the general one (``system: {mass, stiffness, damping, coordinates}``, ``excitation: {amplitude, on |
+base_motion, static}``, ``stops: [...]``). Every stop is rigid and shares one clearance Delta > 0 (the chart varies
+it) and one restitution: the diagrams' ``bifurcation.restitution`` (then no stop gives its own), or, without that
+key, the value every stop gives.
+
+Example (the shipped ``bifurcation``, shortened)::
+
+    name: bifurcation
+    system: {m1: 1.0, m2: 0.1, k1: 25000, k2: 4300, b1: 0.8, b2: 0.08}
+    excitation: {amplitude: 10.0}
+    stop: {clearance: 0.003}
+    bifurcation:
+      frequency: {start: 15.0, stop: 45.0}          # the band [Hz]
+      restitution: [0.2, 0.8]
+      brute_force: {step: 0.05, transient_periods: 300, strobes: 64, directions: [up, down]}
+      continuation: {one_impact: true, period_doubling: true, grazing: true, linear: true, brute_force: true, max_steps: 2000}
+      chart: {restitution: 0.2, clearance: {start: 0.001, stop: 0.006}, kinds: [fold, neimark_sacker, grazing]}
+
+and with relative two-sided stops (``studies/bifurcation_relative_stop.yaml``)::
+
+    system: {mass: [[1.0, 0.0], [0.0, 0.1]], stiffness: [[29300, -4300], [-4300, 4300]], damping: [[0.88, -0.08], [-0.08, 0.08]], coordinates: [x1, x2]}
+    excitation: {amplitude: 10.0, on: x1}
+    stops:
+      - {between: [x2, x1], side: upper, clearance: 0.003}
+      - {between: [x2, x1], side: lower, clearance: 0.003}
+    bifurcation: {frequency: {start: 15.0, stop: 45.0}, restitution: [0.2], ...}
+
+Every key is checked (unknown keys, wrong types and out-of-range values are reported together, each naming its key).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from vibroimpact.kinds.stepped.scene import parse_header, parse_names
+from vibroimpact.model.structure import require_in_range, require_positive
+from vibroimpact.scene.checker import Checker, SceneError
+from vibroimpact.scene.layout import StopSpec
+from vibroimpact.scene.layout_parse import static_drift, document_names, is_general, parse_load, parse_stop_layout, parse_structure
+from vibroimpact.scene.schema import SWEEP_DIRECTIONS, Scene
+
+__all__ = ["BIFURCATION_TOP_KEYS", "CHART_KINDS", "BruteForceSettings", "BranchSettings", "ChartSettings", "BifurcationSettings", "coordinate_label", "parse_bifurcation_scene"]
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# What a bifurcation scene says, as frozen dataclasses: the brute force, the continued branches and the
+# two-parameter chart (the parser, :mod:`vibroimpact.kinds.bifurcation.scene`, builds them from checked values).
+# --------------------------------------------------------------------------------------------------------------------
+
+#: Top-level keys of a bifurcation scene (``stop`` is the paper's stop on x2, ``stops`` any layout).
+BIFURCATION_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bifurcation", "report"}
+#: Special points whose curves the two-parameter chart can follow (the order of the CF flags of ``special_point_kind``).
+CHART_KINDS = ("fold", "period_doubling", "neimark_sacker", "grazing")
+#: Most brute-force periods of one scene (frequencies x restitutions x directions x periods per point).
+MAX_BRUTE_PERIODS = 50_000_000
+
+
+def coordinate_label(name: str) -> str:
+    """How a bifurcation study's texts name a coordinate: ``X1`` for ``x1`` (a letter and digits, capitalised, as
+    the paper writes them), any other name as it is (``floor2``)."""
+    return name.upper() if re.fullmatch(r"[a-z][0-9]+", name) else name
+
+
+@dataclass(frozen=True)
+class BruteForceSettings:
+    """Stepped sweeps of the time simulation (``exact``), the end state carried to the next frequency.
+
+    Attributes
+    ----------
+    step : float
+        Frequency step [Hz].
+    transient_periods : int
+        Periods integrated and dropped at each frequency.
+    strobes : int
+        Strobes (whole periods) kept at each frequency.
+    directions : tuple of str
+        ``up`` and/or ``down``.
+    """
+
+    step: float = 0.05
+    transient_periods: int = 300
+    strobes: int = 64
+    directions: tuple[str, ...] = ("up", "down")  # scene.schema.SWEEP_DIRECTIONS (the parser checks against it)
+
+    def __post_init__(self) -> None:
+        require_positive("step", self.step)
+        require_in_range("transient_periods", self.transient_periods, 0, 1_000_000)
+        require_in_range("strobes", self.strobes, 1, 100_000)
+
+
+@dataclass(frozen=True)
+class BranchSettings:
+    """Which branches are continued in frequency, and how far.
+
+    Attributes
+    ----------
+    one_impact : bool
+        The branches of the closed-form impact orbit, started at both roots of eq. 16 (corrected): one impact per
+        period on one stop, the symmetric two impacts per period on a two-sided stop; none where the layout has no
+        closed form.
+    period_doubling : bool
+        Period-2 branches switched at every period doubling of a period-1 branch.
+    grazing : bool
+        Branches born at grazing points where an orbit with another (non-zero) impact count continues.
+    linear : bool
+        The impactless (linear) orbit wherever it fits inside every stop (closed form).
+    brute_force : bool
+        Branches seeded from the brute force: where a sweep's strobes repeat with a period k on an orbit no other
+        branch passes through, that orbit continued as a fixed point of the k-period map.
+    max_steps : int
+        Most continuation steps per direction of a branch.
+    max_step : float
+        Largest arclength step, in the continuation's scaled variables [-].
+    """
+
+    one_impact: bool = True
+    period_doubling: bool = True
+    grazing: bool = True
+    linear: bool = True
+    brute_force: bool = True
+    max_steps: int = 2000
+    max_step: float = 0.1
+
+    def __post_init__(self) -> None:
+        require_in_range("max_steps", self.max_steps, 1, 100_000)
+        require_in_range("max_step", self.max_step, 1e-4, 1.0)
+
+
+@dataclass(frozen=True)
+class ChartSettings:
+    """The two-parameter chart (frequency x clearance at one restitution).
+
+    Attributes
+    ----------
+    restitution : float
+        R of the chart [-].
+    clearance : (float, float)
+        Clearance range [m].
+    kinds : tuple of str
+        Special points followed in (frequency, clearance), from :data:`CHART_KINDS`.
+    max_steps : int
+        Most continuation steps per direction of a curve.
+    frequency_step : float
+        Frequency step of the regime map's brute-force sweeps [Hz].
+    clearance_num : int
+        Clearances of the regime map (evenly spaced over the range).
+    transient_periods, strobes : int
+        Periods dropped, and kept for the classification, at each point of the regime map.
+    """
+
+    restitution: float = 0.2
+    clearance: tuple[float, float] = (1e-3, 6e-3)
+    kinds: tuple[str, ...] = CHART_KINDS
+    max_steps: int = 300
+    frequency_step: float = 0.25
+    clearance_num: int = 12
+    transient_periods: int = 300
+    strobes: int = 128
+
+    def __post_init__(self) -> None:
+        require_in_range("restitution", self.restitution, 0.0, 1.0)
+        if not 0.0 < self.clearance[0] < self.clearance[1]:
+            raise ValueError(f"clearance = {self.clearance!r}: expected 0 < start < stop [m]")
+        require_in_range("max_steps", self.max_steps, 1, 100_000)
+        require_positive("frequency_step", self.frequency_step)
+        require_in_range("clearance_num", self.clearance_num, 2, 1000)
+        require_in_range("transient_periods", self.transient_periods, 0, 1_000_000)
+        require_in_range("strobes", self.strobes, 64, 100_000)
+
+    @property
+    def clearances(self) -> np.ndarray:
+        """The regime map's clearances [m]."""
+        return np.linspace(self.clearance[0], self.clearance[1], self.clearance_num)
+
+
+@dataclass(frozen=True, eq=False)
+class BifurcationSettings:
+    """What a bifurcation study computes.
+
+    Attributes
+    ----------
+    low, high : float
+        The frequency band [Hz].
+    restitution : tuple of float
+        R of each bifurcation diagram [-].
+    brute_force : BruteForceSettings
+        Stepped sweeps up and down.
+    branches : BranchSettings
+        Continued branches.
+    chart : ChartSettings or None
+        The two-parameter chart (None: none).
+    """
+
+    low: float
+    high: float
+    restitution: tuple[float, ...]
+    brute_force: BruteForceSettings = BruteForceSettings()
+    branches: BranchSettings = BranchSettings()
+    chart: ChartSettings | None = None
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.low < self.high:
+            raise ValueError(f"frequency band ({self.low!r}, {self.high!r}): expected 0 < start < stop [Hz]")
+
+    @property
+    def frequency(self) -> np.ndarray:
+        """The brute-force frequency grid [Hz], increasing."""
+        count = math.floor((self.high - self.low) / self.brute_force.step * (1.0 + 1e-12)) + 1
+        return np.round(self.low + self.brute_force.step * np.arange(count), 10)
+
+    @property
+    def chart_frequency(self) -> np.ndarray:
+        """The regime map's frequency grid [Hz] (empty without a chart)."""
+        if self.chart is None:
+            return np.zeros(0)
+        count = math.floor((self.high - self.low) / self.chart.frequency_step * (1.0 + 1e-12)) + 1
+        return np.round(self.low + self.chart.frequency_step * np.arange(count), 10)
+
+#: Keys of the ``bifurcation`` section and of its parts.
+_KEYS = {"frequency", "restitution", "brute_force", "continuation", "chart"}
+_BRUTE_KEYS = {"step", "transient_periods", "strobes", "directions"}
+_BRANCH_KEYS = {"one_impact", "period_doubling", "grazing", "linear", "brute_force", "max_steps", "max_step"}
+_CHART_KEYS = {"restitution", "clearance", "kinds", "max_steps", "frequency_step", "clearance_num", "transient_periods", "strobes"}
+
+
+def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
+    """Validate a bifurcation scene's document (a mapping with ``bifurcation``) and build the :class:`Scene`; raise
+    :class:`SceneError` listing all problems."""
+    c = Checker()
+    doc = c.mapping("", document, BIFURCATION_TOP_KEYS, {"name", "system", "excitation", "bifurcation"})
+    general = is_general(doc)
+    load = None
+    if general:
+        name, description, report = parse_names(c, doc)
+        system = parse_structure(c, doc["system"]) if "system" in doc else None
+        names = tuple(system.coordinates) if system is not None else document_names(doc.get("system"))
+        amplitude, load = parse_load(c, doc["excitation"], names) if "excitation" in doc else (None, None)
+        if load is not None and system is not None and static_drift(system, load):
+            c.fail("excitation.static", "the static force pushes the structure along a rigid-body mode: it has no steady state to follow")
+    else:
+        name, description, system, amplitude, report = parse_header(c, doc)
+    stops_give_restitution = isinstance(doc.get("stops"), list) and bool(doc["stops"]) and all(isinstance(e, dict) and "restitution" in e for e in doc["stops"])
+    required = {"frequency"} if stops_give_restitution else {"frequency", "restitution"}
+    spec = c.mapping("bifurcation", doc.get("bifurcation"), _KEYS, required) if "bifurcation" in doc else {}
+    specs, clearance, own_restitution = _layout(c, doc, system, "restitution" in spec)
+    low = high = None
+    if "frequency" in spec:
+        band = c.mapping("bifurcation.frequency", spec["frequency"], {"start", "stop"}, {"start", "stop"})
+        low = c.number("bifurcation.frequency.start", band["start"], 0.0, math.inf, low_inclusive=False) if "start" in band else None
+        high = c.number("bifurcation.frequency.stop", band["stop"], 0.0, math.inf, low_inclusive=False) if "stop" in band else None
+        if low is not None and high is not None and high <= low:
+            c.fail("bifurcation.frequency.stop", f"{high:g} must be greater than start = {low:g}")
+            high = None
+    restitution = c.grid("bifurcation.restitution", spec["restitution"], 0.0, 1.0, True) if "restitution" in spec else own_restitution
+    brute = _settings(c, "bifurcation.brute_force", spec.get("brute_force", {}), _BRUTE_KEYS, _brute_values)
+    branches = _settings(c, "bifurcation.continuation", spec.get("continuation", {}), _BRANCH_KEYS, _branch_values)
+    chart = _settings(c, "bifurcation.chart", spec["chart"], _CHART_KEYS, _chart_values) if "chart" in spec else None
+    if brute is not None and low is not None and high is not None and restitution is not None:
+        if brute.step > high - low:
+            c.fail("bifurcation.brute_force.step", f"{brute.step:g} Hz is out of range: allowed (0, {high - low:g}] (the band's width)")
+        else:
+            periods = (high - low) / brute.step * restitution.size * len(brute.directions) * (brute.transient_periods + brute.strobes)
+            if periods > MAX_BRUTE_PERIODS:
+                c.fail("bifurcation.brute_force", f"{periods:.3g} simulated periods is too many: allowed at most {MAX_BRUTE_PERIODS:.0e} (raise step, or fewer periods)")
+    if chart is not None and low is not None and high is not None and chart.frequency_step > high - low:
+        c.fail("bifurcation.chart.frequency_step", f"{chart.frequency_step:g} Hz is out of range: allowed (0, {high - low:g}] (the band's width)")
+    if c.problems:
+        raise SceneError(c.problems, source)
+    assert system is not None and amplitude is not None and isinstance(name, str) and clearance is not None
+    assert low is not None and high is not None and restitution is not None and brute is not None and branches is not None
+    settings = BifurcationSettings(low, high, tuple(float(r) for r in restitution), brute, branches, chart)
+    return Scene(
+        name=name,
+        description=description,
+        system=system,
+        amplitude=amplitude,
+        frequency=settings.frequency,
+        restitution=np.asarray(restitution, dtype=float),
+        clearance=np.array([clearance]),
+        swept=("restitution", "frequency"),
+        solutions=(),
+        quantities=(),
+        bifurcation=settings,
+        report=report,
+        text=text,
+        load=load,
+        stops=specs or (),
+        general=general,
+    )
+
+
+def _layout(c: Checker, doc: dict, system: Any, swept_restitution: bool) -> tuple[tuple[StopSpec, ...] | None, float | None, np.ndarray | None]:
+    """The stops (``()``: the paper's stop on x2; None: unusable), their shared clearance Delta [m] and, when they give
+    it and ``bifurcation.restitution`` does not (``swept_restitution`` False), their shared restitution as a grid.
+
+    The returned stops take Delta and R from the study (their own values moved to the grid), as a stepped scene's
+    shared values do (:mod:`vibroimpact.scene.layout`)."""
+    if "stop" not in doc and "stops" not in doc:
+        c.fail("stop", "required: the paper's stop {clearance: Delta [m]} above the absorber x2, or 'stops' (any layout)")
+        return None, None, None
+    specs = parse_stop_layout(c, doc, system)
+    if "stops" not in doc:
+        stop = c.mapping("stop", doc["stop"], {"clearance"}, {"clearance"})
+        clearance = c.number("stop.clearance", stop["clearance"], 0.0, math.inf, low_inclusive=False) if "clearance" in stop else None
+        return (), clearance, None
+    if specs is None:
+        return None, None, None
+    ok = True
+    for k, stop in enumerate(specs):
+        entry = doc["stops"][k]
+        if "bumper" in entry:
+            c.fail(f"stops[{k}].bumper", "a bifurcation study runs rigid stops (the exact engine's stroboscopic map): remove the bumper")
+            ok = False
+        if stop.clearance is None:
+            c.fail(f"stops[{k}].clearance", "required: Delta [m] in (0, inf), the same for every stop (the chart varies it)")
+            ok = False
+        elif not stop.clearance > 0.0:
+            c.fail(f"stops[{k}].clearance", f"{stop.clearance!r} is out of range: allowed (0, inf) [m]")
+            ok = False
+        elif stop.clearance != specs[0].clearance and specs[0].clearance is not None:
+            c.fail(f"stops[{k}].clearance", f"{stop.clearance:g} m differs from stops[0]'s {specs[0].clearance:g} m: a bifurcation study has one clearance Delta shared by every stop (the chart varies it)")
+            ok = False
+        if swept_restitution and stop.restitution is not None:
+            c.fail(f"stops[{k}].restitution", "also given in bifurcation.restitution (the diagrams' values, for every stop): give it in one place only")
+            ok = False
+        elif not swept_restitution and stop.restitution is None:
+            c.fail(f"stops[{k}].restitution", "required unless bifurcation.restitution gives the diagrams' values: R in [0, 1], the same for every stop")
+            ok = False
+        elif stop.restitution is not None and stop.restitution != specs[0].restitution and specs[0].restitution is not None:
+            c.fail(f"stops[{k}].restitution", f"{stop.restitution:g} differs from stops[0]'s {specs[0].restitution:g}: a bifurcation diagram has one R shared by every stop")
+            ok = False
+    if not ok:
+        return None, None, None
+    own = None if swept_restitution else np.array([specs[0].restitution])
+    shared = tuple(dataclasses.replace(spec, clearance=None, restitution=None) for spec in specs)
+    return shared, specs[0].clearance, own
+
+
+def _settings(c: Checker, key: str, value: Any, allowed: set[str], values: Any) -> Any:
+    """A settings dataclass from the mapping ``value`` under ``key``: ``values(c, key, spec)`` checks each entry and
+    returns (class, keyword arguments) or None; a failure of the class's own validation names the key."""
+    spec = c.mapping(key, value, allowed)
+    if set(map(str, spec)) - allowed:
+        return None
+    built = values(c, key, spec)
+    if built is None:
+        return None
+    kind, kwargs = built
+    try:
+        return kind(**kwargs)
+    except (ValueError, TypeError) as error:
+        c.fail(f"{key}.{str(error).split(' ')[0]}", str(error))
+        return None
+
+
+def _brute_values(c: Checker, key: str, spec: dict) -> tuple[type, dict] | None:
+    kwargs: dict[str, Any] = {}
+    if "step" in spec:
+        kwargs["step"] = c.number(f"{key}.step", spec["step"], 0.0, math.inf, low_inclusive=False)
+    if "transient_periods" in spec:
+        kwargs["transient_periods"] = c.integer(f"{key}.transient_periods", spec["transient_periods"], 0, 1_000_000)
+    if "strobes" in spec:
+        kwargs["strobes"] = c.integer(f"{key}.strobes", spec["strobes"], 1, 100_000)
+    if "directions" in spec:
+        kwargs["directions"] = c.choices(f"{key}.directions", spec["directions"], SWEEP_DIRECTIONS) or None
+    return None if None in kwargs.values() else (BruteForceSettings, kwargs)
+
+
+def _branch_values(c: Checker, key: str, spec: dict) -> tuple[type, dict] | None:
+    kwargs: dict[str, Any] = {}
+    for flag in ("one_impact", "period_doubling", "grazing", "linear", "brute_force"):
+        if flag in spec:
+            if not isinstance(spec[flag], bool):
+                c.fail(f"{key}.{flag}", f"expected true or false, got {spec[flag]!r}")
+                kwargs[flag] = None
+            else:
+                kwargs[flag] = spec[flag]
+    if "max_steps" in spec:
+        kwargs["max_steps"] = c.integer(f"{key}.max_steps", spec["max_steps"], 1, 100_000)
+    if "max_step" in spec:
+        kwargs["max_step"] = c.number(f"{key}.max_step", spec["max_step"], 1e-4, 1.0)
+    return None if None in kwargs.values() else (BranchSettings, kwargs)
+
+
+def _chart_values(c: Checker, key: str, spec: dict) -> tuple[type, dict] | None:
+    kwargs: dict[str, Any] = {}
+    if "restitution" in spec:
+        kwargs["restitution"] = c.number(f"{key}.restitution", spec["restitution"], 0.0, 1.0)
+    if "clearance" in spec:
+        band = c.mapping(f"{key}.clearance", spec["clearance"], {"start", "stop"}, {"start", "stop"})
+        start = c.number(f"{key}.clearance.start", band["start"], 0.0, 1.0, low_inclusive=False) if "start" in band else None
+        stop = c.number(f"{key}.clearance.stop", band["stop"], 0.0, 1.0, low_inclusive=False) if "stop" in band else None
+        if start is not None and stop is not None and stop <= start:
+            c.fail(f"{key}.clearance.stop", f"{stop:g} must be greater than start = {start:g}")
+        kwargs["clearance"] = (start, stop) if start is not None and stop is not None and stop > start else None
+    if "kinds" in spec:
+        kwargs["kinds"] = c.choices(f"{key}.kinds", spec["kinds"], CHART_KINDS) or None
+    for name, low, high in (("max_steps", 1, 100_000), ("clearance_num", 2, 1000), ("transient_periods", 0, 1_000_000), ("strobes", 64, 100_000)):
+        if name in spec:
+            kwargs[name] = c.integer(f"{key}.{name}", spec[name], low, high)
+    if "frequency_step" in spec:
+        kwargs["frequency_step"] = c.number(f"{key}.frequency_step", spec["frequency_step"], 0.0, math.inf, low_inclusive=False)
+    return None if None in kwargs.values() else (ChartSettings, kwargs)

@@ -1,0 +1,320 @@
+"""Bifurcation studies: every periodic orbit of a frequency band with its stability and special points, brute-force
+sweeps up and down, and the two-parameter chart (frequency x clearance) with its regime map.
+
+Output (``bifurcation.nc``; attributes from :data:`vibroimpact.scene.variables.BIFURCATION_ATTRIBUTES`):
+
+* dimension ``branch_point``: coordinates ``branch`` (integer label), ``branch_frequency`` [Hz] and
+  ``branch_restitution``; variables ``<c>_amplitude`` [m] of every coordinate c of the structure (``x1_amplitude``,
+  ``x2_amplitude`` for the paper's system), ``impulse`` [N s], ``floquet_modulus``, ``stable`` (flags),
+  ``impacts_per_period``, ``period_multiplicity``, ``branch_origin`` (flags), the multipliers
+  ``floquet_multiplier_real``/``_imag`` (branch_point, multiplier: 2N of them) and ``impact_velocity``
+  (branch_point, orbit_impact);
+* dimension ``special_point``: coordinates ``special_point_kind`` (CF flags ``fold period_doubling neimark_sacker
+  grazing``), ``special_point_frequency`` [Hz], ``special_point_restitution``, ``special_point_branch``; the orbit's
+  multipliers and measures there (``special_point_<c0>_amplitude`` of the first coordinate c0), and
+  ``special_point_note``;
+* brute force along (``restitution``, ``sweep``, ``frequency``, ``strobe``): ``brute_<c0>``, ``brute_<c0>_amplitude``
+  of the first coordinate (``brute_x1``, ``brute_x1_amplitude`` for the paper's system);
+  along (restitution, sweep, frequency, ``impact``): ``brute_impact_velocity`` (NaN-padded); along (restitution,
+  sweep, frequency): ``brute_regime`` (flags), ``brute_period``, ``brute_impacts_per_period``,
+  ``brute_lyapunov_exponent``;
+* the chart: dimension ``chart_point`` with coordinates ``chart_curve``, ``chart_kind`` (flags as
+  ``special_point_kind``), ``chart_frequency`` [Hz], ``chart_clearance`` [m]; the regime map ``chart_regime``
+  (sweep, map_clearance, map_frequency) with ``chart_impacts_per_period`` and ``chart_period``.
+
+One netCDF group cannot hold ``frequency`` both as the brute force's dimension and as a coordinate of
+``branch_point``, nor ``restitution`` as a dimension and a coordinate of ``special_point``: the branch and special
+point coordinates carry the prefix of their dimension.
+
+The scene's layout (the paper's named form or the general one: matrices, a load on any coordinate or a base motion,
+a list of stops) becomes one general :class:`~vibroimpact.model.problem.ImpactProblem` per restitution
+(:func:`scene_problem`); every part of the study runs on it. The dataset's attributes describe that structure
+(``system_coordinates``, the matrices flattened row by row, the load, ``stop_layout`` in words).
+"""
+
+from __future__ import annotations
+
+
+import numpy as np
+import xarray as xr
+
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS
+from vibroimpact.kinds.bifurcation.scene import coordinate_label
+from vibroimpact.scene.layout import build_stops, describe_stop
+from vibroimpact.scene.schema import Scene
+from vibroimpact.scene.variables import BIFURCATION_ATTRIBUTES, COORDINATE_ATTRIBUTES, STABLE_ATTRIBUTES, flag_attributes
+from vibroimpact.kinds.bifurcation.branches import MAX_ORBIT_IMPACTS, ORIGINS
+from vibroimpact.kinds.bifurcation.cases import MAX_KEPT_IMPACTS, MAX_PERIOD, MOTION_CLASSES, BranchCase, ChartCase, SweepCase, Seed, sweep_seeds
+from vibroimpact.runs.estimate import Costs, Estimate
+from vibroimpact.runs.cluster import Progress
+from vibroimpact.runs.run import provenance
+from vibroimpact.runs.runner import CaseResult, Runner
+
+__all__ = ["BifurcationStudy", "scene_problem", "CONTINUATION_SECONDS", "CLOSED_FORM_SECONDS", "CHART_SECONDS", "REPORT_FIGURES"]
+
+#: Wall time of the continuation of one restitution's branches on the calibration machine [s], with the branches
+#: seeded from the brute force (measured: 11-15 s for R = 0.2 and 0.8 at load ~2), and without (1.8-2.3 s).
+CONTINUATION_SECONDS = 13.0
+CLOSED_FORM_SECONDS = 3.0
+#: Wall time of the chart's curves on the calibration machine [s] (measured: ~15 s).
+CHART_SECONDS = 20.0
+#: Figures of the report: per restitution a diagram and the multipliers; the chart.
+REPORT_FIGURES = 3
+#: Cost of a brute-force period with moments and Jacobians, relative to a plain ``exact`` period [-].
+BRUTE_FACTOR = 1.5
+
+
+def scene_problem(scene: Scene, restitution: float, clearance: float | None = None) -> ImpactProblem:
+    """The general problem of a bifurcation scene: its structure (the named system's matrices for the paper's form),
+    every stop rigid with ``restitution`` [-] and the scene's clearance (or ``clearance`` [m]), and its harmonic load
+    at the band's lower frequency (each part of the study moves it in frequency)."""
+    settings = scene.bifurcation
+    assert settings is not None
+    delta = float(scene.clearance[0]) if clearance is None else float(clearance)
+    stops = build_stops(scene.stop_specs, False, float(restitution), delta)
+    return ImpactProblem(scene.system.structure, stops, scene.load_spec.force(scene.amplitude, settings.low))
+
+
+class BifurcationStudy:
+    """Branches, special points, brute force and the chart of a scene's ``bifurcation`` section."""
+
+    name = "bifurcation"
+
+    def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
+        """The study's dataset (module docstring); ``progress`` gets a line per stage and per branch set."""
+        settings = scene.bifurcation
+        assert settings is not None
+        say = progress if progress is not None else (lambda message: None)
+        delta = float(scene.clearance[0])
+        options = tuple(sorted(vars(settings.branches).items()))
+        brute = settings.brute_force
+        chart = settings.chart
+        sweeps = [SweepCase(scene_problem(scene, r), d, tuple(scene.frequency), brute.transient_periods, brute.strobes) for r in settings.restitution for d in brute.directions]
+        maps = []
+        if chart is not None:
+            maps = [SweepCase(scene_problem(scene, chart.restitution, float(c)), d, tuple(settings.chart_frequency), chart.transient_periods, chart.strobes) for c in chart.clearances for d in brute.directions]
+        # the chart's curves (the longest case) first, alongside the sweeps; then the branches, seeded from the sweeps
+        charted = [ChartCase(scene_problem(scene, chart.restitution), settings.low, settings.high, chart.clearance, chart.kinds, chart.max_steps)] if chart else []
+        say(f"brute force: {len(sweeps)} sweeps of {scene.frequency.size} frequencies" + (f", regime map: {len(maps)} sweeps of {settings.chart_frequency.size}" if maps else "")
+            + (f"; the chart's curves (R = {chart.restitution:g})" if chart else ""))  # fmt: skip
+        first = runner.map(charted + sweeps + maps)
+        chart_result, swept = (first[0], first[1:]) if chart else (None, first)
+        if chart_result is not None:
+            for note in chart_result["notes"]:
+                say(f"  chart {chart.restitution:g}: {note}")
+        continuation = []
+        for i, r in enumerate(settings.restitution):
+            seeds: list[Seed] = []
+            if settings.branches.brute_force:
+                for j, _direction in enumerate(brute.directions):
+                    result = swept[i * len(brute.directions) + j]
+                    seeds += sweep_seeds(scene.frequency, result["period"], result["impacts"], result["state"], j)
+            continuation.append(BranchCase(scene_problem(scene, r), settings.low, settings.high, options, tuple(seeds)))
+        say(f"continuing the branches of R = {', '.join(f'{r:g}' for r in settings.restitution)}")
+        results = runner.map(continuation)
+        for case, result in zip(continuation, results):
+            for note in result["notes"]:
+                say(f"  R = {case.restitution:g}: {note}")
+        if chart_result is not None:
+            results = [*results, chart_result]
+        data = _branches(results[: len(settings.restitution)], settings.restitution, scene.coordinates, scene.load_spec.base_motion)
+        data = data.merge(_brute(swept[: len(sweeps)], scene, brute.directions, brute.strobes))
+        if chart is not None:
+            data = data.merge(_chart(results[-1], swept[len(sweeps) :], chart.clearances, settings.chart_frequency, brute.directions))
+        data = data.assign_coords(clearance=delta)
+        for key in ("restitution", "frequency", "sweep", "clearance"):
+            data[key].attrs.update(COORDINATE_ATTRIBUTES[key])
+        data.attrs.update(_metadata(scene, results, swept[: len(sweeps)]))
+        return data
+
+    def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:
+        """Brute-force periods times the cost of an ``exact`` period, plus measured continuation times, on the
+        calibration machine; the sweeps and the continuations are spread over ``jobs`` processes."""
+        settings = scene.bifurcation
+        assert settings is not None
+        brute = settings.brute_force
+        per_period = costs.per_period_cost("exact", 0.0) * BRUTE_FACTOR
+        periods = scene.frequency.size * len(settings.restitution) * len(brute.directions) * (brute.transient_periods + brute.strobes)
+        continuation = [CONTINUATION_SECONDS if settings.branches.brute_force else CLOSED_FORM_SECONDS] * len(settings.restitution)
+        chart_seconds = 0.0
+        if settings.chart is not None:
+            chart = settings.chart
+            periods += settings.chart_frequency.size * chart.clearance_num * len(brute.directions) * (chart.transient_periods + chart.strobes)
+            chart_seconds = CHART_SECONDS
+        sweeps = periods * per_period
+        jobs = max(1, jobs)
+        first = max(chart_seconds, (chart_seconds + sweeps) / jobs)  # the chart's curves run alongside the sweeps
+        branches = max(max(continuation), sum(continuation) / jobs)  # then the branches, seeded from the sweeps
+        report = costs.report_base + REPORT_FIGURES * len(settings.restitution) * costs.report_per_figure
+        wall = costs.startup + first + branches + report
+        parts = {"brute force and chart": first, "continuation": branches, "report": report}
+        memory = costs.main_process_memory + (jobs - 1) * costs.worker_process_memory
+        return Estimate(wall_time=wall, memory=memory, parts=parts, points={"brute force": f"{periods:,} periods", "continuation": f"{len(continuation)} continuations"})
+
+
+def coordinate_attributes(key: str, name: str, base_motion: bool = False) -> dict[str, str]:
+    """Units and long name of a per-coordinate variable: the entry ``key`` of the attributes (written for X1) with
+    ``X1`` replaced by coordinate ``name``'s label (:func:`coordinate_label`; unchanged for ``x1``)."""
+    attrs = dict(BIFURCATION_ATTRIBUTES[key])
+    label = coordinate_label(name)
+    attrs["long_name"] = attrs["long_name"].replace("X1", label if label != name else f"coordinate {name}") + (" (relative to the base)" if base_motion else "")
+    return attrs
+
+
+def _branches(results: list[CaseResult], restitutions: tuple[float, ...], coordinates: tuple[str, ...], base_motion: bool) -> xr.Dataset:
+    """branch_point and special_point variables of every restitution (labels numbered across them)."""
+    points: dict[str, list] = {}
+    specials: dict[str, list] = {}
+    offset = 0
+    size = len(coordinates)
+    for r, result in zip(restitutions, results):
+        n = result["frequency"].size
+        points.setdefault("branch", []).append(result["branch"] + offset)
+        points.setdefault("restitution", []).append(np.full(n, r))
+        for name in ("origin", "frequency", "amplitudes", "impulse", "floquet_modulus", "stable", "impacts", "period", "multipliers_real", "multipliers_imag", "velocities"):
+            points.setdefault(name, []).append(result[name])
+        m = result["sp_frequency"].size
+        specials.setdefault("branch", []).append(result["sp_branch"] + offset)
+        specials.setdefault("restitution", []).append(np.full(m, r))
+        for name in ("kind", "frequency", "amplitudes", "impulse", "floquet_modulus", "impacts", "period", "multipliers_real", "multipliers_imag", "note"):
+            specials.setdefault(name, []).append(result[f"sp_{name}"])
+        offset += int(result["branch"].max()) + 1 if n else 0
+    p = {k: np.concatenate(v) for k, v in points.items()}
+    s = {k: np.concatenate(v) for k, v in specials.items()}
+    a = BIFURCATION_ATTRIBUTES
+    kind_flags = flag_attributes("kind of special point", SPECIAL_POINT_KINDS)
+    bp, sp = ("branch_point",), ("special_point",)
+    amplitudes = p["amplitudes"].reshape(-1, size)
+    first = coordinates[0]
+    return xr.Dataset(
+        {
+            **{f"{c}_amplitude": (bp, amplitudes[:, i], coordinate_attributes("x1_amplitude", c, base_motion)) for i, c in enumerate(coordinates)},
+            "impulse": (bp, p["impulse"], a["impulse"]),
+            "floquet_modulus": (bp, p["floquet_modulus"], a["floquet_modulus"]),
+            "stable": (bp, p["stable"].astype(np.int8), STABLE_ATTRIBUTES | {"long_name": "Floquet stability of the orbit"}),
+            "impacts_per_period": (bp, p["impacts"] / p["period"], a["impacts_per_period"]),
+            "period_multiplicity": (bp, p["period"].astype(np.int16), a["period_multiplicity"]),
+            "branch_origin": (bp, p["origin"].astype(np.int8), flag_attributes("how the branch was found", ORIGINS)),
+            "floquet_multiplier_real": (bp + ("multiplier",), p["multipliers_real"].reshape(-1, 2 * size), a["floquet_multiplier_real"]),
+            "floquet_multiplier_imag": (bp + ("multiplier",), p["multipliers_imag"].reshape(-1, 2 * size), a["floquet_multiplier_imag"]),
+            "impact_velocity": (bp + ("orbit_impact",), p["velocities"].reshape(-1, MAX_ORBIT_IMPACTS), a["impact_velocity"]),
+            f"special_point_{first}_amplitude": (sp, s["amplitudes"].reshape(-1, size)[:, 0], coordinate_attributes("special_point_x1_amplitude", first, base_motion)),
+            "special_point_impulse": (sp, s["impulse"], a["special_point_impulse"]),
+            "special_point_floquet_modulus": (sp, s["floquet_modulus"], a["special_point_floquet_modulus"]),
+            "special_point_impacts_per_period": (sp, s["impacts"] / np.maximum(s["period"], 1), a["special_point_impacts_per_period"]),
+            "special_point_period_multiplicity": (sp, s["period"].astype(np.int16), a["special_point_period_multiplicity"]),
+            "special_point_multiplier_real": (sp + ("multiplier",), s["multipliers_real"].reshape(-1, 2 * size), a["special_point_multiplier_real"]),
+            "special_point_multiplier_imag": (sp + ("multiplier",), s["multipliers_imag"].reshape(-1, 2 * size), a["special_point_multiplier_imag"]),
+            "special_point_note": (sp, s["note"].astype(str), a["special_point_note"]),
+        },
+        coords={
+            "branch": (bp, p["branch"].astype(np.int32), a["branch"]),
+            "branch_frequency": (bp, p["frequency"], a["branch_frequency"]),
+            "branch_restitution": (bp, p["restitution"], a["branch_restitution"]),
+            "special_point_kind": (sp, s["kind"].astype(np.int8), kind_flags),
+            "special_point_frequency": (sp, s["frequency"], a["special_point_frequency"]),
+            "special_point_restitution": (sp, s["restitution"], a["special_point_restitution"]),
+            "special_point_branch": (sp, s["branch"].astype(np.int32), a["special_point_branch"]),
+        },
+    )
+
+
+def _brute(results: list[CaseResult], scene: Scene, directions: tuple[str, ...], strobes: int) -> xr.Dataset:
+    """Brute-force variables over (restitution, sweep, frequency[, strobe | impact])."""
+    settings = scene.bifurcation
+    assert settings is not None
+    shape = (len(settings.restitution), len(directions))
+
+    def stack(name: str) -> np.ndarray:
+        values = np.array([r[name] for r in results])
+        return values.reshape(shape + values.shape[1:])
+
+    a = BIFURCATION_ATTRIBUTES
+    grid = ("restitution", "sweep", "frequency")
+    regime = _regime_flags("brute force: what the motion is at each frequency")
+    first, base = scene.coordinates[0], scene.load_spec.base_motion
+    return xr.Dataset(
+        {
+            f"brute_{first}": (grid + ("strobe",), stack("strobe"), coordinate_attributes("brute_x1", first, base)),
+            f"brute_{first}_amplitude": (grid + ("strobe",), stack("amplitude"), coordinate_attributes("brute_x1_amplitude", first, base)),
+            "brute_impact_velocity": (grid + ("impact",), stack("velocity").reshape(shape + (-1, MAX_KEPT_IMPACTS)), a["brute_impact_velocity"]),
+            "brute_impacts_per_period": (grid, stack("impacts"), a["brute_impacts_per_period"]),
+            "brute_regime": (grid, stack("regime").astype(np.int8), regime),
+            "brute_period": (grid, stack("period").astype(np.int16), a["brute_period"]),
+            "brute_lyapunov_exponent": (grid, stack("lyapunov"), a["brute_lyapunov_exponent"]),
+        },
+        coords={"restitution": np.array(settings.restitution), "sweep": list(directions), "frequency": scene.frequency, "strobe": ("strobe", np.arange(strobes), a["strobe"])},
+    )
+
+
+def _chart(curves: CaseResult, results: list[CaseResult], clearances: np.ndarray, frequency: np.ndarray, directions: tuple[str, ...]) -> xr.Dataset:
+    """The chart's curves (chart_point) and regime map (sweep, map_clearance, map_frequency)."""
+    shape = (clearances.size, len(directions), frequency.size)
+    a = BIFURCATION_ATTRIBUTES
+
+    def stack(name: str) -> np.ndarray:
+        return np.moveaxis(np.array([r[name] for r in results]).reshape(shape), 1, 0)
+
+    regime = _regime_flags("regime map: what the brute-force motion is at each (clearance, frequency)")
+    cp, grid = ("chart_point",), ("sweep", "map_clearance", "map_frequency")
+    return xr.Dataset(
+        {
+            "chart_regime": (grid, stack("regime").astype(np.int8), regime),
+            "chart_impacts_per_period": (grid, stack("impacts"), a["chart_impacts_per_period"]),
+            "chart_period": (grid, stack("period").astype(np.int16), a["chart_period"]),
+        },
+        coords={
+            "chart_curve": (cp, curves["curve"].astype(np.int32), a["chart_curve"]),
+            "chart_kind": (cp, curves["kind"].astype(np.int8), flag_attributes("kind of special point the curve follows", SPECIAL_POINT_KINDS)),
+            "chart_frequency": (cp, curves["frequency"], a["chart_frequency"]),
+            "chart_clearance": (cp, curves["clearance"], a["chart_clearance"]),
+            "map_clearance": ("map_clearance", clearances, a["map_clearance"]),
+            "map_frequency": ("map_frequency", frequency, a["map_frequency"]),
+        },
+    )
+
+
+def _regime_flags(long_name: str) -> dict[str, object]:
+    """CF flags of a motion class (:data:`MOTION_CLASSES`), with -1 where the engine failed."""
+    return {"long_name": long_name, "units": "1", "flag_values": np.arange(-1, len(MOTION_CLASSES), dtype=np.int8), "flag_meanings": " ".join(("failed", *MOTION_CLASSES))}
+
+
+def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult]) -> dict[str, object]:
+    settings = scene.bifurcation
+    assert settings is not None
+    attrs: dict[str, object] = {
+        "title": f"vibroimpact bifurcation study '{scene.name}'",
+        "scene_name": scene.name,
+        "scene": scene.text,
+        **provenance(),
+        **_layout_attributes(scene),
+        "frequency_band_Hz": np.array([settings.low, settings.high]),
+        "brute_force_transient_periods": settings.brute_force.transient_periods,
+        "continuation_notes": "\n".join(f"R = {r:g}: {note}" for r, result in zip(settings.restitution, results) for note in result["notes"]),
+        "method_branches": "pseudo-arclength continuation of fixed points of the exact stroboscopic map (compiled exact engine, exact Jacobians), started from the closed-form impact orbit at both roots of eq. 16 (one impact per period; two on a symmetric two-sided stop; none where the layout has no closed form), at period doublings, at grazing points and from every periodic brute-force attractor no other branch passes through",
+        "method_brute_force": f"compiled exact engine, stepped sweeps carrying the end state; strobes compared over periods 1-{MAX_PERIOD}, else the Lyapunov exponent from the exact Jacobians",
+    }
+    if settings.chart is not None:
+        attrs["chart_restitution"] = settings.chart.restitution
+        attrs["chart_notes"] = "\n".join(str(n) for n in results[-1]["notes"])
+    return attrs
+
+
+def _layout_attributes(scene: Scene) -> dict[str, object]:
+    """The structure, load and stops the study ran (plain netCDF attributes: matrices flattened row by row)."""
+    structure = scene.system.structure
+    load = scene.load_spec
+    size = structure.size
+    names = tuple(structure.coordinates)
+    return {
+        "system_coordinates": " ".join(names),
+        "system_mass_kg": structure.mass_matrix.ravel(),
+        "system_stiffness_N_per_m": structure.stiffness_matrix.ravel(),
+        "system_damping_N_s_per_m": structure.damping_matrix.ravel(),
+        "excitation_kind": "base_motion" if load.base_motion else "force",
+        f"excitation_amplitude_{'m' if load.base_motion else 'N'}": scene.amplitude,
+        "excitation_weights": np.array(load.weights if load.weights is not None else [1.0] + [0.0] * (size - 1)),
+        "excitation_static_N": np.array(load.static if load.static is not None else [0.0] * size),
+        "stop_layout": "; ".join(describe_stop(spec, names, float(scene.clearance[0])) for spec in scene.stop_specs),
+    }

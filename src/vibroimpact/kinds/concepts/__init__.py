@@ -1,0 +1,1 @@
+"""Concepts studies: absorber concepts side by side (which absorber, with which stop) over one band; their page."""

@@ -1,0 +1,346 @@
+"""Branches of periodic orbits of each absorber concept, continued in frequency: where the orbits the simulations and
+the closed forms found are stable, and where they lose stability (folds, period doublings, torus and grazing points).
+
+A concept's branches start from every simulated periodic steady state with impacts that no earlier branch passes
+through (same period, impact count and |X1| within :data:`SAME_ORBIT`), and from the middle of each stretch where the
+closed-form impact orbit is admissible (its unstable parts too, which no simulation reaches). Each start is moved to a stroboscopic section clear of its impacts (:func:`vibroimpact.orbits.maps.resection`),
+shot as a fixed point of the exact map (:func:`vibroimpact.orbits.shooting.shoot`) and continued both ways over the
+band (:func:`vibroimpact.orbits.continuation.continue_branch`). A failure is a note, never fatal.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, asdict
+
+import numpy as np
+from numpy.typing import NDArray
+
+from vibroimpact.analysis.impact_orbit import solve_impact_orbit
+from vibroimpact.engines.base import Trajectory
+from vibroimpact.kinds.concepts.scene import Concept
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.orbits.branch import Branch
+from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
+from vibroimpact.orbits.maps import ImpactMap, resection
+from vibroimpact.orbits.shooting import shoot
+from vibroimpact.runs.runner import CaseResult, ProgressReport
+from vibroimpact.runs.store import case_key
+from vibroimpact.simulation.harmonics import base_force, base_weights
+from vibroimpact.simulation.settings import SteadySettings
+
+__all__ = ["Fundamentals", "SteadyOutcome", "fundamentals", "linear_start", "march", "length_scale", "check_stops", "GAP_TOLERANCE", "BranchCase", "BRANCH_FIELDS", "SAME_ORBIT", "MAX_SEEDS", "branch_seeds"]
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Steady states of an absorber concept at one frequency, for any structure and any stops: march until the
+# stroboscopic state repeats, then measure whole periods.
+# --------------------------------------------------------------------------------------------------------------------
+
+#: Largest |gap| at an impact, and largest penetration anywhere recorded, as a fraction of the motion's length scale [-].
+GAP_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True)
+class Fundamentals:
+    """Fundamental harmonics and impact statistics over whole periods of a trajectory.
+
+    Attributes
+    ----------
+    x : ndarray of complex, shape (N,)
+        Complex fundamental amplitude of each coordinate [m] (phase relative to cos(w t)).
+    contact : ndarray of complex, shape (K,)
+        Fundamental of each stop's contact force lambda_k [N].
+    base_force : complex
+        Fundamental of the force on the base [N] (module docstring).
+    impacts_per_period : float
+        Impacts (rigid) or contacts (bumper) per period [-].
+    impulse_per_period : float
+        Total impulse of the impacts (contacts) per period, every stop [N s].
+    peak_acceleration : float
+        Largest deceleration in contact [m s-2]: bumpers only (NaN for a rigid stop with impacts, 0 without contact).
+    peak_contact_force : float
+        Largest contact force [N]: bumpers only (NaN for a rigid stop with impacts, 0 without contact).
+    """
+
+    x: NDArray[np.complex128]
+    contact: NDArray[np.complex128]
+    base_force: complex
+    impacts_per_period: float
+    impulse_per_period: float
+    peak_acceleration: float
+    peak_contact_force: float
+
+
+def fundamentals(trajectory: Trajectory) -> Fundamentals:
+    """:class:`Fundamentals` over every period of ``trajectory`` (integrated with ``moments=True``)."""
+    periods = trajectory.periods
+    if periods == 0 or trajectory.moments.shape[0] != periods:
+        raise ValueError("fundamentals() needs a trajectory of at least one period integrated with moments=True")
+    problem = trajectory.problem
+    n, k = problem.size, len(problem.stops)
+    total = trajectory.moments.sum(axis=0)
+    scale = 2.0 / (periods * problem.period)
+    x = total[:n] * scale
+    contact = total[n : n + k] * scale
+    peaks = trajectory.contact_peaks
+    contacts = trajectory.impulses.size
+    if peaks.shape[0]:
+        peak_force, peak_acceleration = float(peaks[:, 0].max()), float(peaks[:, 1].max())
+    elif contacts:
+        peak_force = peak_acceleration = math.nan
+    else:
+        peak_force = peak_acceleration = 0.0
+    return Fundamentals(x, contact, complex(base_force(problem.structure, problem.omega, x, base_weights(problem), contact)), contacts / periods, float(np.sum(trajectory.impulses)) / periods, peak_acceleration, peak_force)
+
+
+def length_scale(problem: ImpactProblem) -> float:
+    """A displacement typical of the motion [m]: the largest |Delta_k| + |n_k . H F| over the stops."""
+    return problem.velocity_scale() / problem.omega
+
+
+def linear_start(problem: ImpactProblem) -> NDArray[np.float64]:
+    """The linear steady state (no stop) at t = 0 as a state (x, x'), or rest if it starts inside a stop."""
+    harmonic, static = problem.load()
+    structure = problem.structure
+    x = structure.receptance_matrix(problem.omega) @ harmonic
+    offset = np.linalg.lstsq(structure.stiffness_matrix, static, rcond=None)[0] if np.any(static) else np.zeros(problem.size)
+    state = np.concatenate([x.real + offset, (1j * problem.omega * x).real])
+    gaps = problem.clearances() - problem.normals() @ state[: problem.size]
+    return state if np.all(gaps >= 0.0) else np.zeros(2 * problem.size)
+
+
+def check_stops(trajectory: Trajectory) -> None:
+    """Rigid stops: ``RuntimeError`` unless every impact of ``trajectory`` happens on its stop's closed gap and no recorded state
+    (strobes, segment starts) is inside a stop, to :data:`GAP_TOLERANCE` of the motion's length: an engine that does
+    not know a layout (e.g. takes a relative stop for the paper's) is refused instead of trusted."""
+    problem = trajectory.problem
+    if not all(isinstance(stop.law, RigidStop) for stop in problem.stops):
+        return  # a bumper is compressed while in contact: penetration is its law, nothing to check
+    normals, clearances = problem.normals(), problem.clearances()
+    size = problem.size
+    tolerance = GAP_TOLERANCE * length_scale(problem)
+    states = np.concatenate([trajectory.strobe_states[:, :size], trajectory.segment_states[:, :size]])
+    if states.size and np.min(clearances[None, :] - states @ normals.T) < -tolerance:
+        raise RuntimeError(f"a recorded state is inside a stop of {[stop.describe(problem.structure.coordinates) for stop in problem.stops]}: the engine does not honour this layout")
+    starts = trajectory.segments[:, 0] if trajectory.segments.size else np.zeros(0)
+    for time, stop in zip(trajectory.impact_times, trajectory.impact_stops):
+        k = int(np.argmin(np.abs(starts - time))) if starts.size else -1
+        if k < 0 or abs(starts[k] - time) > 1e-9 * problem.period:
+            continue  # no segment starts at this impact (an engine that records none): nothing to check
+        gap = clearances[stop] - normals[stop] @ trajectory.segment_states[k, :size]
+        if abs(gap) > tolerance:
+            raise RuntimeError(f"an impact on stop {stop} ({problem.stops[stop].describe(problem.structure.coordinates)}) at t = {time:.6g} s leaves a gap of {gap:.3g} m: the engine does not honour this layout")
+
+
+@dataclass(frozen=True)
+class SteadyOutcome:
+    """A steady state found by :func:`march`.
+
+    Attributes
+    ----------
+    measures : Fundamentals
+        Over the measured periods.
+    converged : bool
+        The stroboscopic state repeated to the tolerance.
+    multiplicity : int
+        Its period in excitation periods (0 if not converged).
+    periods : int
+        Periods integrated in all.
+    time : float
+        Time of the first measured strobe [s] (on the steady motion when converged).
+    state : ndarray, shape (2 N,)
+        State at ``time``.
+    """
+
+    measures: Fundamentals
+    converged: bool
+    multiplicity: int
+    periods: int
+    time: float
+    state: NDArray[np.float64]
+
+
+def _repeat(strobes: NDArray[np.float64], scale: NDArray[np.float64], settings: SteadySettings) -> int:
+    """Smallest p <= max_multiplicity with the last 2 p + 1 strobes repeating with period p (0 if none); p > 1 only
+    when successive strobes differ macroscopically (a slowly turning transient is not a period-p motion)."""
+    step = float(np.max(np.abs(strobes[-1] - strobes[-2]) / scale)) if strobes.shape[0] >= 2 else 0.0
+    for p in range(1, settings.max_multiplicity + 1):
+        if (p > 1 and step < 1e3 * settings.tolerance) or strobes.shape[0] < 2 * p + 1:
+            break
+        if np.all(np.abs(strobes[-(p + 1) :] - strobes[-(2 * p + 1) : -p]) <= settings.tolerance * scale):
+            return p
+    return 0
+
+
+def march(engine: object, problem: ImpactProblem, t: float, y: NDArray[np.float64], settings: SteadySettings, max_periods: int | None = None) -> SteadyOutcome:
+    """Integrate from (t [s], y) until the strobes repeat (at most ``max_periods``, default the settings'), then
+    measure ``measure_periods`` (a multiple of the period found) or ``irregular_measure_periods`` with moments."""
+    length = length_scale(problem)
+    n = problem.size
+    scale = np.concatenate([np.full(n, length), np.full(n, problem.omega * length)])
+    limit = settings.max_periods if max_periods is None else int(max_periods)
+    strobes = [np.asarray(y, dtype=float)]
+    used = multiplicity = 0
+    while used < limit and not multiplicity:
+        chunk = min(settings.chunk_periods, limit - used)
+        run = engine.integrate(problem, y, t, chunk)  # type: ignore[attr-defined]
+        used += chunk
+        strobes.extend(run.strobe_states[1:])
+        t, y = float(run.strobe_times[-1]), run.final_state
+        multiplicity = _repeat(np.array(strobes[-3 * settings.max_multiplicity - 1 :]), scale, settings)
+    measured = multiplicity * math.ceil(settings.measure_periods / multiplicity) if multiplicity else settings.irregular_measure_periods
+    final = engine.integrate(problem, y, t, measured, moments=True)  # type: ignore[attr-defined]
+    check_stops(final)
+    return SteadyOutcome(fundamentals(final), multiplicity > 0, multiplicity, used + measured, t, np.array(y, dtype=float))
+
+#: Largest relative |X1| difference of an orbit from a branch it is taken to lie on [-].
+SAME_ORBIT = 0.02
+#: Most branches started per concept.
+MAX_SEEDS = 8
+#: Fields of a branch case's result: one entry per orbit point (``note``: one string).
+BRANCH_FIELDS = ("frequency", "x1_amplitude", "base_force_amplitude", "floquet_modulus", "impacts_per_period", "period", "branch", "note")
+
+
+@dataclass(frozen=True)
+class BranchCase:
+    """The branches of one concept over [low, high] Hz.
+
+    Attributes
+    ----------
+    concept : Concept
+        System and rigid stops.
+    amplitude : float
+        q [N].
+    low, high : float
+        The band [Hz].
+    seeds : tuple of (float, int, float, tuple of float)
+        Simulated periodic steady states with impacts: (frequency [Hz], period [excitation periods], force phase at
+        t = 0 [rad], state at t = 0).
+    max_steps : int
+        Most points per branch and direction.
+    """
+
+    concept: Concept
+    amplitude: float
+    low: float
+    high: float
+    seeds: tuple[tuple[float, int, float, tuple[float, ...]], ...]
+    max_steps: int
+
+    engine = "continuation"
+    fields = BRANCH_FIELDS
+    progress_unit = "branches"
+
+    @property
+    def progress_total(self) -> float:
+        """Seeds to try."""
+        return float(max(len(self.seeds), 1))
+
+    def key(self) -> str:
+        """A stable hash of everything that determines the result."""
+        return case_key({"kind": "concept_branches", "concept": asdict(self.concept), "amplitude": self.amplitude, "band": [self.low, self.high],
+                         "seeds": [list(s[:3]) + list(s[3]) for s in self.seeds], "max_steps": self.max_steps})  # fmt: skip
+
+    def run(self, report: ProgressReport | None = None) -> CaseResult:
+        """Every branch of the concept, as flat per-point arrays."""
+        points: list[tuple[float, float, float, float, float, float, float]] = []
+        notes: list[str] = []
+        settings = ContinuationSettings(lower=self.low, upper=self.high, max_steps=self.max_steps, max_step=0.1)
+        bounds = {"frequency": (0.5 * self.low, 2.0 * self.high)}
+        count = 0
+        for done, (frequency, period, phase, state) in enumerate(self._starts(notes)):
+            if count >= MAX_SEEDS:
+                notes.append(f"more than {MAX_SEEDS} starts: the rest were not continued")
+                break
+            try:
+                problem = self.concept.problem(self.amplitude, frequency, phase)
+                moved, y = resection(problem, np.array(state), period)
+                mapping = ImpactMap(moved, periods=period, bounds=bounds)
+                if self._known(points, mapping, y, period):
+                    continue
+                orbit = shoot(mapping, y, mapping.parameters)
+                branch = continue_branch(mapping, orbit, "frequency", settings)
+            except Exception as error:  # noqa: BLE001 - a failed branch is a note, the others go on
+                notes.append(f"branch from {frequency:.2f} Hz failed: {type(error).__name__}: {str(error)[:160]}")
+                continue
+            points.extend(_measure(mapping, branch, count))
+            notes.append(f"branch {count} from {frequency:.2f} Hz: {len(branch.orbits)} points, {branch.values.min():.2f}-{branch.values.max():.2f} Hz, ends: {branch.end}")
+            count += 1
+            if report is not None:
+                report(float(done + 1))
+        table = np.array(points, dtype=float).reshape(-1, 7)
+        out: dict[str, NDArray] = {name: table[:, i].copy() for i, name in enumerate(BRANCH_FIELDS[:-1])}
+        out["note"] = np.array(["; ".join(notes)])
+        return out
+
+    def _starts(self, notes: list[str]) -> list[tuple[float, int, float, tuple[float, ...]]]:
+        """The simulated seeds, then the closed-form impact orbit's admissible stretches."""
+        starts = list(self.seeds)
+        try:
+            starts += _closed_form_starts(self.concept, self.amplitude, self.low, self.high)
+        except Exception as error:  # noqa: BLE001 - no closed-form starts: the simulated ones remain
+            notes.append(f"closed-form starts failed: {type(error).__name__}: {error}")
+        return starts
+
+    def _known(self, points: list, mapping: ImpactMap, y: NDArray[np.float64], period: int) -> bool:
+        """Does a branch already found pass through the orbit that a march from ``y`` settles on (same period and
+        impacts, |X1| within :data:`SAME_ORBIT` at the nearest branch frequency)?"""
+        if not points:
+            return False
+        frequency = float(mapping.parameters[0])
+        run = mapping.engine.integrate(mapping.problem, y, 0.0, period, moments=True)
+        x1 = abs(fundamentals(run).x[0])
+        impacts = run.impulses.size / period
+        table = np.array(points)
+        same = (table[:, 5] == period) & (np.abs(table[:, 4] - impacts) < 1e-9)
+        for branch in np.unique(table[same, 6]):
+            rows = table[same & (table[:, 6] == branch)]
+            for a, b in zip(rows[:-1], rows[1:]):
+                if min(a[0], b[0]) <= frequency <= max(a[0], b[0]) and abs(np.interp(frequency, sorted([a[0], b[0]]), [a[1], b[1]] if a[0] <= b[0] else [b[1], a[1]]) - x1) <= SAME_ORBIT * x1:
+                    return True
+        return False
+
+
+def _measure(mapping: ImpactMap, branch: Branch, label: int) -> list[tuple[float, float, float, float, float, float, float]]:
+    """(frequency, |X1|, |base force|, Floquet modulus, impacts per excitation period, period, branch) per orbit."""
+    rows = []
+    base = mapping.periods
+    for orbit in branch.orbits:
+        periods = orbit.period * base
+        problem = mapping.problem_at(orbit.parameters)
+        run = mapping.engine.integrate(problem, orbit.state, 0.0, periods, moments=True)
+        m = fundamentals(run)
+        rows.append((orbit.parameter("frequency"), abs(m.x[0]), abs(m.base_force), orbit.floquet_modulus, m.impacts_per_period, float(periods), float(label)))
+    return rows
+
+
+def _closed_form_starts(concept: Concept, amplitude: float, low: float, high: float) -> list[tuple[float, int, float, tuple[float, ...]]]:
+    """The middle of each stretch where the closed-form impact orbit (one stop, or a symmetric two-sided pair) is
+    admissible, as a state at t = 0; none where no closed form applies."""
+    frequency = np.arange(low, high + 0.005, 0.01)
+    try:
+        orbit = solve_impact_orbit(concept.problem(amplitude, float(frequency[0])), omega=2.0 * np.pi * frequency)
+    except ValueError:
+        return []
+    admissible = np.flatnonzero(orbit.admissible())
+    starts = []
+    for run in np.split(admissible, np.flatnonzero(np.diff(admissible) > 1) + 1):
+        if run.size:
+            k = int(run[run.size // 2])
+            state = orbit.take([k]).state_at(np.zeros((1, 1)))[0, 0]
+            if np.all(np.isfinite(state)):
+                starts.append((float(frequency[k]), 1, 0.0, tuple(float(v) for v in state)))
+    return starts
+
+
+def branch_seeds(frequency: NDArray[np.float64], converged: NDArray, multiplicity: NDArray, impacts: NDArray, states: NDArray, times: NDArray) -> tuple:
+    """Simulated periodic steady states with impacts as seeds (frequency, period, phase, state): the state at time
+    ``times`` of a problem whose force has phase 0 is the state at t = 0 of the problem whose force has phase w t."""
+    seeds = []
+    for i, f in enumerate(frequency):
+        if converged[i] == 1.0 and impacts[i] > 0.0 and np.all(np.isfinite(states[i])) and math.isfinite(times[i]):
+            phase = float((2.0 * math.pi * f * times[i]) % (2.0 * math.pi))
+            seeds.append((float(f), int(multiplicity[i]), phase, tuple(float(v) for v in states[i])))
+    return tuple(seeds)

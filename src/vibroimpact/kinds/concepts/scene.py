@@ -1,0 +1,328 @@
+"""Scenes that compare absorber concepts: one primary mass, one absorber mass, several ways of damping or stopping the
+absorber, side by side over one frequency band.
+
+Example (the shipped ``absorber_concepts``, shortened)::
+
+    name: absorber_concepts
+    system: {m1: 1.0, m2: 0.1, k1: 25000.0, k2: 4300.0, b1: 0.8, b2: 0.08}   # the paper's, lightly damped absorber
+    excitation: {amplitude: 10.0}                                          # q [N] on the primary mass
+    frequency: {start: 15.0, stop: 45.0, step: 0.01}                       # closed forms [Hz]
+    simulation: {frequency: {start: 15.0, stop: 45.0, step: 0.5}}          # time-domain steady states [Hz]
+    bumper: {frequency: 250.0}            # each rigid stop's Kelvin-Voigt twin (same clearance, loss factor from R)
+    continuation: {max_steps: 400}
+    concepts:
+      - {name: den_hartog, label: "(a) Den Hartog", absorber: {stiffness: den_hartog, damping: den_hartog}}
+      - {name: paper_stop, label: "(b) absolute stop", stops: [{coordinate: x2, side: upper, clearance: 0.003, restitution: 0.2}]}
+      - {name: stop_1928, label: "(c) relative stop", stops: [{between: [x2, x1], side: upper, clearance: 0.003, restitution: 0.2}]}
+
+Each concept keeps m1, k1, b1 and m2; ``absorber`` may replace k2 and b2 (a number, or ``den_hartog``: Den Hartog's
+optimum, :mod:`vibroimpact.model.absorber`), and ``stops`` lists rigid stops: ``coordinate: x2`` against the base, or
+``between: [x2, x1]`` (on x2 - x1), ``side: upper`` (coordinate <= clearance) or ``lower`` (>= -clearance). The
+anti-resonance band of the comparison is where the scene's own system, without a stop, keeps |X1| below the static
+deflection q / k1, around the absorber's anti-resonance sqrt(k2 / m2).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from vibroimpact.engines.settings import EngineSettings, STEPPED_TOLERANCES
+from vibroimpact.kinds.stepped.scene import NAME, parse_header
+from vibroimpact.model.absorber import den_hartog_absorber
+from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution, Stop, SIDES
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.scene.checker import Checker, SceneError
+from vibroimpact.simulation.settings import SteadySettings
+
+__all__ = ["Concept", "ConceptsSettings", "bumper_twin", "CONCEPTS_TOP_KEYS", "parse_concepts", "parse_concepts_scene", "MAX_CONCEPTS"]
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# What a concepts scene builds: the concepts and the settings of the study (dataclasses; they import nothing from the
+# scene layer, so that :mod:`~vibroimpact.scene.schema` can name them without a circle of imports; :mod:`~vibroimpact.kinds.concepts.scene` parses them).
+# --------------------------------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Concept:
+    """One absorber concept: the system it has and the stops it adds.
+
+    Attributes
+    ----------
+    name : str
+        Short, file-name-safe name (the dataset's ``concept`` coordinate).
+    label : str
+        What the report calls it.
+    system : TwoDofSystem
+        m1, k1, b1 and m2 of the scene, with this concept's k2 and b2.
+    stops : tuple of Stop
+        Rigid stops (none: the linear absorber).
+    absorber : str
+        How k2 and b2 were chosen, in words.
+    """
+
+    name: str
+    label: str
+    system: TwoDofSystem
+    stops: tuple[Stop, ...] = ()
+    absorber: str = ""
+
+    def describe_stops(self) -> str:
+        """E.g. ``x2 <= 3 mm, R = 0.2``; ``no stop``."""
+        if not self.stops:
+            return "no stop"
+        return "; ".join(f"{stop.describe(self.system.coordinates)}, R = {stop.law.restitution:g}" for stop in self.stops if isinstance(stop.law, RigidStop))
+
+    def problem(self, amplitude: float, frequency: float, phase: float = 0.0, bumper_frequency: float | None = None) -> ImpactProblem:
+        """The concept's impact problem at ``frequency`` [Hz]: its rigid stops, or (``bumper_frequency`` [Hz]) each
+        stop's Kelvin-Voigt twin of the same clearance whose loss factor gives its restitution; ``ValueError`` for a
+        concept without a stop."""
+        if not self.stops:
+            raise ValueError(f"concept {self.name!r} has no stop: its steady state is the linear one")
+        laws = [stop.law if bumper_frequency is None else bumper_twin(stop.law, bumper_frequency) for stop in self.stops]
+        force = HarmonicForce(amplitude, frequency, phase)
+        stops = tuple(Stop(law, stop.coordinate, stop.other, stop.side) for law, stop in zip(laws, self.stops))
+        return ImpactProblem(self.system, stops, force)
+
+
+def bumper_twin(law: Any, bumper_frequency: float) -> KelvinVoigtBumper:
+    """The Kelvin-Voigt bumper of a rigid stop: same clearance, Omega_b / 2 pi = ``bumper_frequency`` [Hz], the loss
+    factor whose one collision restitutes R (:func:`loss_factor_from_restitution`)."""
+    if not isinstance(law, RigidStop):
+        raise TypeError(f"expected a RigidStop, got {law!r}")
+    return KelvinVoigtBumper(law.clearance, bumper_frequency, loss_factor_from_restitution(law.restitution))
+
+
+@dataclass(frozen=True, eq=False)
+class ConceptsSettings:
+    """Everything a concepts study computes from.
+
+    Attributes
+    ----------
+    system : TwoDofSystem
+        The scene's system: the reference of the anti-resonance band and the base of every concept.
+    amplitude : float
+        q [N] on the primary mass.
+    concepts : tuple of Concept
+        In the order of the scene.
+    frequency : ndarray
+        Closed-form grid [Hz].
+    simulation_frequency : ndarray
+        Time-domain grid [Hz] (steady states of the exact engine and of the bumper twins).
+    engine : EngineSettings
+        Tolerances of the integrators (the bumper's IDA).
+    steady : SteadySettings
+        Convergence and measurement of the steady states.
+    bumper_frequency : float
+        Omega_b / 2 pi of every bumper twin [Hz]; NaN: no bumper runs.
+    continuation_steps : int
+        Most points per continued branch and direction; 0: no continuation.
+    """
+
+    system: TwoDofSystem
+    amplitude: float
+    concepts: tuple[Concept, ...]
+    frequency: np.ndarray
+    simulation_frequency: np.ndarray
+    engine: EngineSettings = field(default_factory=EngineSettings)
+    steady: SteadySettings = field(default_factory=SteadySettings)
+    bumper_frequency: float = math.nan
+    continuation_steps: int = 400
+
+    @property
+    def static_deflection(self) -> float:
+        """q / k1 [m]: the primary's deflection under the force amplitude held still."""
+        return self.amplitude / self.system.k1
+
+#: Top-level keys of a concepts scene.
+CONCEPTS_TOP_KEYS = {"name", "description", "system", "excitation", "frequency", "simulation", "bumper", "continuation", "concepts", "report"}
+_CONCEPT_KEYS = {"name", "label", "absorber", "stops"}
+_STOP_KEYS = {"coordinate", "between", "side", "clearance", "restitution"}
+_SIMULATION_KEYS = {"frequency", "rtol", "atol", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods"}
+#: Simulation keys of other kinds that a concepts scene does not use: refused with the reason, never ignored.
+_UNUSED_SIMULATION_KEYS = {
+    "lyapunov_periods": "a concepts scene does not classify non-periodic motion (its steady states march, then measure "
+    "irregular_measure_periods); stepped scenes do",
+}
+_CONTINUATION_KEYS = {"max_steps", "enabled"}
+#: Most concepts of one scene (a table row and a panel each).
+MAX_CONCEPTS = 12
+#: Most time-domain frequencies per concept.
+MAX_SIMULATION_POINTS = 2000
+
+
+def parse_concepts(document: Any, source: str = "scene") -> tuple[str, str, bool, ConceptsSettings]:
+    """Check a concepts scene's document and return (name, description, report, settings); :class:`SceneError`
+    listing every problem otherwise."""
+    c = Checker()
+    doc = c.mapping("", document, CONCEPTS_TOP_KEYS, {"name", "system", "excitation", "frequency", "concepts"})
+    name, description, system, amplitude, report = parse_header(c, doc)
+    frequency = c.grid("frequency", doc["frequency"], 0.0, math.inf, False) if "frequency" in doc else None
+    simulation = _simulation(c, doc.get("simulation", {}), frequency)
+    bumper_frequency = math.nan
+    if "bumper" in doc:
+        bumper = c.mapping("bumper", doc["bumper"], {"frequency"}, {"frequency"})
+        if "frequency" in bumper:
+            bumper_frequency = c.number("bumper.frequency", bumper["frequency"], 0.0, 1e6, low_inclusive=False) or math.nan
+    steps = 400
+    if "continuation" in doc:
+        spec = c.mapping("continuation", doc["continuation"], _CONTINUATION_KEYS)
+        if "max_steps" in spec:
+            steps = c.integer("continuation.max_steps", spec["max_steps"], 0, 100_000) or 0
+        if spec.get("enabled", True) is False:
+            steps = 0
+        elif "enabled" in spec and spec["enabled"] is not True:
+            c.fail("continuation.enabled", f"expected true or false, got {spec['enabled']!r}")
+    concepts = _concepts(c, doc["concepts"], system) if "concepts" in doc and system is not None else ()
+    if c.problems:
+        raise SceneError(c.problems, source)
+    assert isinstance(name, str) and system is not None and amplitude is not None and frequency is not None and simulation is not None
+    sim_frequency, engine, steady = simulation
+    settings = ConceptsSettings(system, amplitude, concepts, frequency, sim_frequency, engine, steady, bumper_frequency, steps)
+    return name, description, report, settings
+
+
+def parse_concepts_scene(document: Any, text: str = "", source: str = "scene") -> Any:
+    """The :class:`~vibroimpact.scene.schema.Scene` of a concepts scene (its ``concepts`` attribute holds the
+    :class:`ConceptsSettings`; :attr:`Scene.kind` is then ``concepts``)."""
+    from vibroimpact.scene.schema import Scene
+
+    name, description, report, settings = parse_concepts(document, source)
+    return Scene(
+        name=name, description=description, system=settings.system, amplitude=settings.amplitude, frequency=settings.frequency,
+        restitution=np.array([np.nan]), clearance=np.array([np.nan]), swept=("frequency",), solutions=(), quantities=(),
+        concepts=settings, report=report, text=text,  # type: ignore[call-arg]
+    )  # fmt: skip
+
+
+def _simulation(c: Checker, value: Any, frequency: np.ndarray | None) -> tuple[np.ndarray, EngineSettings, SteadySettings] | None:
+    if isinstance(value, dict):
+        for key in sorted(set(value) & set(_UNUSED_SIMULATION_KEYS)):
+            c.fail(f"simulation.{key}", f"not used by the concepts kind: {_UNUSED_SIMULATION_KEYS[key]}")
+        value = {key: item for key, item in value.items() if key not in _UNUSED_SIMULATION_KEYS}
+    spec = c.mapping("simulation", value, _SIMULATION_KEYS)
+    grid = c.grid("simulation.frequency", spec["frequency"], 0.0, math.inf, False) if "frequency" in spec else None
+    if grid is None and "frequency" not in spec and frequency is not None:
+        grid = frequency[:: max(1, frequency.size // 61)]
+    if grid is not None and grid.size > MAX_SIMULATION_POINTS:
+        c.fail("simulation.frequency", f"{grid.size} points is too many: allowed at most {MAX_SIMULATION_POINTS} (raise the step)")
+        grid = None
+    kwargs: dict[str, Any] = {}
+    for key in sorted(set(spec) - {"frequency"}):
+        item = spec[key]
+        if isinstance(item, bool) or not isinstance(item, (int, float)):
+            c.fail(f"simulation.{key}", f"expected a number, got {item!r}")
+        else:
+            kwargs[key] = item
+    engine_kwargs = {k: kwargs[k] for k in ("rtol", "atol") if k in kwargs}
+    if "rtol" in engine_kwargs and "atol" not in engine_kwargs:
+        engine_kwargs["atol"] = engine_kwargs["rtol"] * STEPPED_TOLERANCES[1] / STEPPED_TOLERANCES[0]
+    steady_kwargs = {k: kwargs[k] for k in kwargs if k not in ("rtol", "atol")}
+    try:
+        engine = EngineSettings(**engine_kwargs)
+        steady = SteadySettings(**steady_kwargs)
+    except (TypeError, ValueError) as error:
+        c.fail("simulation." + str(error).split(" ")[0], str(error))
+        return None
+    return None if grid is None else (grid, engine, steady)
+
+
+def _concepts(c: Checker, value: Any, system: TwoDofSystem) -> tuple[Concept, ...]:
+    if not isinstance(value, list) or not value:
+        c.fail("concepts", f"expected a non-empty list of concepts ({{name, label, absorber, stops}}), got {value!r}")
+        return ()
+    if len(value) > MAX_CONCEPTS:
+        c.fail("concepts", f"{len(value)} concepts is too many: allowed at most {MAX_CONCEPTS}")
+        return ()
+    concepts: list[Concept] = []
+    for i, entry in enumerate(value):
+        key = f"concepts[{i}]"
+        spec = c.mapping(key, entry, _CONCEPT_KEYS, {"name"})
+        name = spec.get("name")
+        if "name" in spec and not (isinstance(name, str) and NAME.match(name)):
+            c.fail(f"{key}.name", f"expected a file-name-safe string (letters, digits, '_', '-', '.'), got {name!r}")
+            continue
+        if name in [concept.name for concept in concepts]:
+            c.fail(f"{key}.name", f"{name!r} is used twice: names must be unique")
+            continue
+        label = spec.get("label", name)
+        if not isinstance(label, str):
+            c.fail(f"{key}.label", f"expected a string, got {label!r}")
+            continue
+        built = _absorber(c, f"{key}.absorber", spec.get("absorber", {}), system)
+        stops = _stops(c, f"{key}.stops", spec["stops"], system.coordinates) if "stops" in spec else ()
+        if built is not None and stops is not None and isinstance(name, str):
+            concepts.append(Concept(name, label, built[0], stops, built[1]))
+    return tuple(concepts)
+
+
+def _absorber(c: Checker, key: str, value: Any, system: TwoDofSystem) -> tuple[TwoDofSystem, str] | None:
+    spec = c.mapping(key, value, {"stiffness", "damping"})
+    optimum = den_hartog_absorber(system.m1, system.k1, system.m2)
+    chosen = {"stiffness": system.k2, "damping": system.b2}
+    words = {"stiffness": f"k2 = {system.k2:g} N/m", "damping": f"b2 = {system.b2:g} N s/m"}
+    for part, (low_inclusive, best, unit, why) in {
+        "stiffness": (False, optimum.stiffness, "N/m", f"Den Hartog's tuning f = 1/(1 + mu) = {optimum.tuning:.4f}"),
+        "damping": (True, optimum.damping, "N s/m", f"Den Hartog's zeta = sqrt(3 mu / (8 (1 + mu)^3)) = {optimum.damping_ratio:.4f}"),
+    }.items():
+        if part not in spec:
+            continue
+        item = spec[part]
+        if item == "den_hartog":
+            chosen[part], words[part] = best, f"{'k2' if part == 'stiffness' else 'b2'} = {best:.4g} {unit} ({why})"
+        else:
+            number = c.number(f"{key}.{part}", item, 0.0, math.inf, low_inclusive=low_inclusive) if not isinstance(item, str) else None
+            if isinstance(item, str):
+                c.fail(f"{key}.{part}", f"{item!r} is not allowed: a number [{unit}] or den_hartog")
+            if number is None:
+                return None
+            chosen[part], words[part] = number, f"{'k2' if part == 'stiffness' else 'b2'} = {number:g} {unit}"
+    built = TwoDofSystem(system.m1, system.m2, system.k1, chosen["stiffness"], system.b1, chosen["damping"])
+    return built, ", ".join(words.values())
+
+
+def _stops(c: Checker, key: str, value: Any, names: tuple[str, ...]) -> tuple[Stop, ...] | None:
+    if not isinstance(value, list):
+        c.fail(key, f"expected a list of stops ({{coordinate | between, side, clearance, restitution}}), got {value!r}")
+        return None
+    stops: list[Stop] = []
+    for i, entry in enumerate(value):
+        here = f"{key}[{i}]"
+        spec = c.mapping(here, entry, _STOP_KEYS, {"side", "clearance", "restitution"})
+        if ("coordinate" in spec) == ("between" in spec):
+            c.fail(here, "give exactly one of 'coordinate' (against the base) or 'between' (two coordinates)")
+            continue
+        coordinate = other = None
+        if "coordinate" in spec:
+            coordinate = _index(c, f"{here}.coordinate", spec["coordinate"], names)
+        else:
+            pair = spec["between"]
+            if not (isinstance(pair, list) and len(pair) == 2):
+                c.fail(f"{here}.between", f"expected two coordinate names [i, j] (the gap is on x_i - x_j), got {pair!r}")
+                continue
+            coordinate = _index(c, f"{here}.between[0]", pair[0], names)
+            other = _index(c, f"{here}.between[1]", pair[1], names)
+            if coordinate is not None and coordinate == other:
+                c.fail(f"{here}.between", f"the two coordinates must differ, got {pair!r}")
+                continue
+        side = spec.get("side")
+        if "side" in spec and side not in SIDES:
+            c.fail(f"{here}.side", f"{side!r} is not allowed: use one of {', '.join(SIDES)}")
+        clearance = c.number(f"{here}.clearance", spec["clearance"], 0.0, math.inf, low_inclusive=False) if "clearance" in spec else None
+        restitution = c.number(f"{here}.restitution", spec["restitution"], 0.0, 1.0, low_inclusive=False) if "restitution" in spec else None
+        if coordinate is None or ("between" in spec and other is None) or side not in SIDES or clearance is None or restitution is None:
+            continue
+        stops.append(Stop(RigidStop(clearance, restitution), coordinate, other, str(side)))
+    return tuple(stops)
+
+
+def _index(c: Checker, key: str, name: Any, names: tuple[str, ...]) -> int | None:
+    if name not in names:
+        c.fail(key, f"{name!r} is not a coordinate: allowed {', '.join(names)}")
+        return None
+    return names.index(name)

@@ -1,0 +1,225 @@
+"""What stepped and swept studies share: the full grid, the loop over solutions, and the dataset around the values.
+
+The full grid is (restitution, clearance, bumper_frequency, sweep, frequency): unswept axes have length 1 and are
+squeezed at the end; each solution computes only along the axes it depends on, then is broadcast.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Callable
+
+import numpy as np
+import xarray as xr
+
+from vibroimpact.model.modal import fit_modal_parameters
+from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.scene.layout import stop_descriptions
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS, STOP_QUANTITIES, Scene
+from vibroimpact.scene.variables import COORDINATE_ATTRIBUTES
+from vibroimpact.kinds.stepped.values import general_linear_values, general_pgf_values, paper_pgf_values
+from vibroimpact.runs.cluster import Progress
+from vibroimpact.runs.run import provenance
+
+__all__ = ["StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset", "layout_attributes", "no_one_impact_orbit"]
+
+#: The values of one solution, quantity -> array over (part of) the full grid.
+Values = dict[str, np.ndarray]
+
+
+@dataclass(frozen=True, eq=False)
+class StudyGrid:
+    """The full grid of a study and its axes, shaped for broadcasting.
+
+    Attributes
+    ----------
+    frequency : ndarray
+        Every frequency of the dataset [Hz].
+    bumper : ndarray
+        Omega_b / 2 pi [Hz]; ``[nan]`` without a bumper.
+    directions : tuple of str
+        Sweep directions; ``("",)`` for stepped studies.
+    full : tuple of int
+        Shape of the full grid.
+    r, delta, omega : ndarray
+        Restitution [-], clearance [m] and angular frequency [rad s-1] on their axes of the full grid.
+    base : tuple of int
+        Shape of the closed forms' grid (restitution, clearance, frequency).
+    """
+
+    frequency: np.ndarray
+    bumper: np.ndarray
+    directions: tuple[str, ...]
+    full: tuple[int, ...]
+    r: np.ndarray
+    delta: np.ndarray
+    omega: np.ndarray
+    base: tuple[int, ...]
+
+    @classmethod
+    def of(cls, scene: Scene) -> "StudyGrid":
+        """The grid of ``scene``."""
+        frequency = scene.all_frequencies
+        bumper = scene.bumper_frequency if scene.bumper_frequency is not None else np.array([np.nan])
+        directions = scene.sweep_directions or ("",)
+        full = (scene.restitution.size, scene.clearance.size, bumper.size, len(directions), frequency.size)
+        r = scene.restitution[:, None, None, None, None]
+        delta = scene.clearance[None, :, None, None, None]
+        omega = 2.0 * np.pi * frequency[None, None, None, None, :]
+        base = np.broadcast_shapes(r.shape, delta.shape, omega.shape)
+        return cls(frequency, bumper, directions, full, r, delta, omega, base)
+
+
+def solve_each(scene: Scene, grid: StudyGrid, simulate: Callable[[str], Values], progress: Progress | None) -> list[Values]:
+    """The values of every solution of ``scene``, in its order; ``simulate(name)`` computes a time-domain one.
+
+    The closed forms are those of any layout (:mod:`vibroimpact.kinds.stepped.values`): per-coordinate quantities named
+    after the coordinates, per-stop ones with a leading axis of one entry per stop; ``pgf_paper`` is the paper's own
+    route where the scene has its layout (:mod:`vibroimpact.kinds.stepped.values`).
+    """
+    report = progress or (lambda _message: None)
+    total = len(scene.solutions)
+    per_solution = []
+    for i, name in enumerate(scene.solutions, start=1):
+        if name == "linear":
+            values = general_linear_values(scene, grid.omega, grid.base)
+        elif name in ENGINE_SOLUTIONS:
+            values = simulate(name)
+        elif name == "pgf_paper":
+            values = paper_pgf_values(scene, grid.omega, grid.delta, grid.r, grid.base)
+        else:
+            values = general_pgf_values(scene, grid.omega, grid.delta, grid.r, grid.base)
+        per_solution.append(values)
+        report(f"[{i}/{total}] {name}: done")
+    return per_solution
+
+
+def grid_coordinates(scene: Scene, grid: StudyGrid, solutions: list[str]) -> dict[str, object]:
+    """Coordinates of the dataset before squeezing: ``solution`` (if any), the parameters and ``frequency``."""
+    coords: dict[str, object] = {"solution": np.array(solutions, dtype=object), "restitution": scene.restitution, "clearance": scene.clearance, "frequency": grid.frequency}
+    if scene.bumper_frequency is not None:
+        coords["bumper_frequency"] = scene.bumper_frequency
+    if not solutions:
+        del coords["solution"]
+    return coords
+
+
+def steady_variable(quantity: str, scene: Scene, grid: StudyGrid, per_solution: list[Values], solutions: list[str]) -> np.ndarray | None:
+    """``quantity`` of the named solutions stacked along a leading ``solution`` axis over the full grid; None if none.
+    A per-stop quantity is taken at the scene's one stop (a layout with one stop has no ``stop`` dimension)."""
+    one_stop = quantity in STOP_QUANTITIES and len(scene.stop_specs) == 1
+
+    def full(name: str, values: Values) -> np.ndarray:
+        value = values[quantity]
+        if one_stop and name not in ENGINE_SOLUTIONS:
+            value = np.broadcast_to(value, (1, *grid.full))[0]
+        return np.broadcast_to(value, grid.full)
+
+    steady = [full(name, values) for name, values in zip(scene.solutions, per_solution) if name in solutions]
+    return np.stack(steady) if steady else None
+
+
+def finish_dataset(dataset: xr.Dataset, scene: Scene, coords: dict[str, object], simulation_attributes: dict[str, object], keep: tuple[str, ...] = ()) -> xr.Dataset:
+    """Squeeze the unswept axes (not those in ``keep``), add the bumper's loss factor, the coordinates' attributes and
+    the dataset's metadata (``simulation_attributes``: what the study kind says of its simulations)."""
+    for key in ("restitution", "clearance", "bumper_frequency", "sweep"):
+        if key in keep:
+            continue
+        swept = key in scene.swept or (key == "restitution" and "bumper_loss_factor" in scene.swept)
+        if not swept and key in dataset.dims:
+            dataset = dataset.squeeze(key, drop=key not in coords)
+        if key in dataset.coords and dataset[key].ndim == 0 and dataset[key].dtype.kind == "f" and not np.isfinite(float(dataset[key])):
+            dataset = dataset.drop_vars(key)  # the stops give different values: the stop descriptions say them
+    if scene.bumper_frequency is not None:
+        losses = scene.loss_factors()
+        if "restitution" in dataset.dims or np.isfinite(losses[0]):  # none at R = 0 (no loss factor gives it); stops may each have their own
+            dataset = dataset.assign_coords(bumper_loss_factor=("restitution", losses) if "restitution" in dataset.dims else float(losses[0]))
+        if "bumper_loss_factor" in scene.swept:
+            dataset = dataset.swap_dims({"restitution": "bumper_loss_factor"})
+    for key, attrs in COORDINATE_ATTRIBUTES.items():
+        if key in dataset.coords:
+            dataset[key].attrs.update(attrs)
+    dataset.attrs.update(_metadata(scene, simulation_attributes))
+    return dataset
+
+
+def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[str, object]:
+    structure = scene.system.structure
+    named = TwoDofSystem.of(scene.system)  # the named view: the paper's two-mass chain, however it was written
+    fit = fit_modal_parameters(named) if named is not None and "pgf_paper" in scene.solutions else None
+    natural = named.natural_frequencies() if named is not None else structure.natural_frequencies()
+    attrs: dict[str, object] = {
+        "title": f"vibroimpact study '{scene.name}'",
+        "scene_name": scene.name,
+        "scene": scene.text,
+        **provenance(),
+        "excitation_amplitude_N": scene.amplitude,
+        "natural_frequencies_Hz": np.array(natural) / (2.0 * np.pi),
+    }
+    if named is not None:
+        attrs["antiresonance_frequency_Hz"] = named.antiresonance_frequency() / (2.0 * np.pi)
+        for key, value in named.as_dict().items():
+            attrs[f"system_{key}"] = value
+    attrs.update(layout_attributes(scene))
+    if "pgf_paper" in scene.solutions:
+        attrs["method_pgf_paper"] = "the paper's route: curve-fitted modal parameters of H22 (eq. 10, Omega fixed from eq. 11); chi22'(0-) = -1/(2 M2); stable (+) root of corrected eq. 16"
+    for key, value in asdict(scene.admissibility).items():
+        attrs[f"admissibility_{key}"] = value
+    attrs.update(simulation_attributes)
+    if isinstance(scene.report, str):
+        attrs["report_page"] = scene.report  # the page the scene asks for (reporting.report.page_for)
+    if fit is not None:
+        attrs["pgf_paper_form_factors_per_kg"] = np.real(fit.form_factor)
+        attrs["pgf_paper_loss_factors"] = fit.loss_factor
+    return attrs
+
+
+def layout_attributes(scene: Scene) -> dict[str, object]:
+    """What a dataset records of its scene's structure, load and stops (plain netCDF attributes: matrices flattened
+    row by row, names and descriptions joined, one value per stop), so that a report can rebuild them."""
+    structure = scene.system.structure
+    load = scene.load_spec
+    size = structure.size
+    specs = scene.stop_specs
+    return {
+        "system_size": size,
+        "system_coordinates": " ".join(structure.coordinates),
+        "system_mass_kg": _attribute(structure.mass_matrix),
+        "system_stiffness_N_per_m": _attribute(structure.stiffness_matrix),
+        "system_damping_N_s_per_m": _attribute(structure.damping_matrix),
+        "excitation_kind": "base_motion" if load.base_motion else "force",
+        "excitation_weights": _attribute(load.weights if load.weights is not None else [1.0] + [0.0] * (size - 1)),
+        "excitation_static_N": _attribute(load.static if load.static is not None else [0.0] * size),
+        "stop_count": len(specs),
+        "stop_layout": "; ".join(stop_descriptions(specs, tuple(structure.coordinates), scene.restitution, scene.clearance)),
+        "stop_coordinate": _attribute([spec.coordinate for spec in specs]),
+        "stop_other": _attribute([-1 if spec.other is None else spec.other for spec in specs]),
+        "stop_side": " ".join(spec.side for spec in specs),
+        # each stop's own clearance, or the grid's single value; NaN where the grid sweeps it
+        "stop_clearance_m": _attribute([
+            float(spec.clearance) if spec.clearance is not None else (float(scene.clearance[0]) if scene.clearance.size == 1 else np.nan) for spec in specs
+        ]),  # fmt: skip
+        "method_pgf": "closed-form impact orbit (periodic Green function of the stopped coordinate n^T H n; one impact per period on one stop, two on a symmetric two-sided stop); stable (+) root",
+        "method_force": "force on the base: 1^T (K x + C x') through springs and dashpots plus (1^T n_k) lambda_k of each absolute stop",
+    }
+
+
+def _attribute(values: object) -> object:
+    """``values`` as a flat array attribute, or its one value (netCDF stores a one-entry attribute as a scalar: a
+    dataset reads back as written)."""
+    flat = np.asarray(values).ravel()
+    return flat[0].item() if flat.size == 1 else flat
+
+
+def no_one_impact_orbit(shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+    """Values of the variables that describe the closed form's orbit, for solutions that have none (time-domain
+    engines, swept-sine tests)."""
+    nan = np.full(shape, np.nan)
+    return {
+        "stable": np.full(shape, -1, dtype=np.int8),
+        "floquet_modulus": nan,
+        "one_impact_x1_amplitude": nan,
+        "one_impact_x2_amplitude": nan,
+        "one_impact_force_amplitude": nan,
+        "one_impact_impulse": nan,
+    }

@@ -1,0 +1,303 @@
+"""The sections of a scene over parameter grids (stepped steady states or swept-sine tests), and the grid scene itself.
+
+Each ``_parse_*`` function checks one section of the document with a :class:`~vibroimpact.scene.checker.Checker`
+(recording every problem, returning None where a value is unusable); :func:`parse_grid_scene` puts them together.
+:func:`parse_header` and :func:`check_sweep_run` are shared with benchmark scenes.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import Any, TypeVar
+
+import numpy as np
+
+from vibroimpact.analysis.pgf import AdmissibilitySettings
+from vibroimpact.engines.registry import BUMPER
+from vibroimpact.engines.settings import STEPPED_TOLERANCES, SWEPT_TOLERANCES, EngineSettings
+from vibroimpact.model.contact import restitution_from_loss_factor
+from vibroimpact.model.modal import underdamped_mode_count
+from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.scene.checker import Checker, SceneError, interval
+from vibroimpact.scene.layout_parse import check_general_solutions, paper_layout_applies, general_grids, is_general, document_names, parse_load, parse_stop_layout, parse_structure, parse_sweep_stops
+from vibroimpact.scene.schema import (
+    ENGINE_CONTACT,
+    ENGINE_SOLUTIONS,
+    MAX_STUDY_POINTS,
+    MAX_SWEEP_SAMPLES,
+    QUANTITIES,
+    SIMULATION_STARTS,
+    SOLUTIONS,
+    SWEEP_DIRECTIONS,
+    SWEEPABLE,
+    Scene,
+    quantities_for,
+    SimulationSettings,
+    SweptSineSettings,
+)
+from vibroimpact.simulation.settings import SteadySettings
+
+__all__ = ["TOP_KEYS", "NAME", "parse_grid_scene", "parse_header", "check_sweep_run"]
+
+#: Top-level keys of a grid scene.
+TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bumper", "sweep", "swept_sine", "solutions", "quantities", "settings", "simulation", "report", "cluster"}
+#: Report pages a grid scene may ask for by name (``report: design_map``) instead of its kind's page.
+REPORT_PAGES = ("design_map",)
+#: A scene's or a case's name: safe as a file name.
+NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+#: Simulation keys that only stepped steady states use.
+_STEADY_ONLY_KEYS = {"frequency", "start", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods"}
+_SIMULATION_KEYS = {"frequency", "start", "method", "rtol", "atol", "max_step", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods"}
+#: Where an unswept parameter is given instead (``frequency`` is always swept).
+_FIXED_PLACE = {"restitution": ("stop", "restitution"), "clearance": ("stop", "clearance"), "bumper_frequency": ("bumper", "frequency"), "bumper_loss_factor": ("bumper", "loss_factor")}
+_T = TypeVar("_T")
+
+
+def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
+    """Validate a grid scene's document (a mapping) and build the :class:`Scene`; raise :class:`SceneError` listing
+    all problems."""
+    c = Checker()
+    doc = c.mapping("", document, TOP_KEYS, {"name", "system", "excitation", "sweep", "solutions"})
+    general = is_general(doc)
+
+    load = None
+    if general:
+        name, description, report = parse_names(c, doc, REPORT_PAGES)
+        system = parse_structure(c, doc["system"]) if "system" in doc else None
+        names = tuple(system.coordinates) if system is not None else document_names(doc.get("system"))
+        amplitude, load = parse_load(c, doc["excitation"], names) if "excitation" in doc else (None, None)
+    else:
+        name, description, system, amplitude, report = parse_header(c, doc, REPORT_PAGES)
+
+    sweep = c.mapping("sweep", doc.get("sweep", {}), {*SWEEPABLE, "stop"}, {"frequency"}) if "sweep" in doc else {}
+    fixed = {
+        "stop": c.mapping("stop", doc["stop"], {"clearance", "restitution"}) if "stop" in doc else {},
+        "bumper": c.mapping("bumper", doc["bumper"], {"frequency", "loss_factor"}) if "bumper" in doc else {},
+    }
+    solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
+    scheduler = parse_cluster(c, doc)
+    specs = parse_stop_layout(c, doc, system)
+    if isinstance(report, str) and ("swept_sine" in doc or general and system is not None and not paper_layout_applies(system, specs or (), load)):
+        c.fail("report", f"the {report} page is for stepped studies of the paper's layout (a two-mass chain x1, x2 as {{m1 ... b2}}; one upper stop on x2; force on x1), however written")
+    targets = None
+    if "stop" in sweep:
+        if "stops" not in doc:
+            c.fail("sweep.stop", "names which of the scene's stops the swept values apply to: only with a 'stops' list")
+        else:
+            targets = parse_sweep_stops(c, sweep["stop"], len(specs) if specs else None)
+    sweep = {key: value for key, value in sweep.items() if key != "stop"}
+    derived_restitution = "bumper_loss_factor" in sweep
+    bumper_solutions = [name for name in solutions if ENGINE_CONTACT.get(name) == BUMPER]
+    grids: dict[str, np.ndarray | None] = {}
+    for key, (_units, low, high, low_inclusive) in SWEEPABLE.items():
+        section, field_name = _FIXED_PLACE.get(key, ("", ""))
+        place = f"{section}.{field_name}"
+        given_fixed = field_name in fixed.get(section, {})
+        if key in sweep:
+            if given_fixed:
+                c.fail(place, f"also swept in sweep.{key}: give it in one place only")
+            grids[key] = c.grid(f"sweep.{key}", sweep[key], low, high, low_inclusive)
+        elif given_fixed:
+            value = c.number(place, fixed[section][field_name], low, high, low_inclusive)
+            grids[key] = None if value is None else np.array([value])
+        elif key == "restitution" and derived_restitution:
+            continue  # R(xi_b) of the swept loss factors
+        elif (key == "restitution" or key == "clearance") and "stops" not in doc:
+            c.fail(place, f"required unless swept (sweep.{key}); allowed range {interval(low, high, low_inclusive)}")
+    if derived_restitution and "restitution" in grids and "stops" not in doc:
+        c.fail("sweep.bumper_loss_factor", "sweeping the bumper's loss factor sets the restitution R(xi_b): do not also give restitution")
+    if derived_restitution and (xi := grids.get("bumper_loss_factor")) is not None:
+        grids["restitution"] = np.array([restitution_from_loss_factor(x) for x in xi])
+    needs_bumper = bool(bumper_solutions) or "swept_sine" in doc
+    if "stops" in doc:
+        if specs is not None:
+            specs = general_grids(c, specs, grids, sweep, {k: v for k, v in fixed["bumper"].items() if not isinstance(v, bool) and isinstance(v, (int, float))}, targets, needs_bumper)
+    else:
+        if needs_bumper and "bumper_frequency" not in sweep and "bumper" not in doc:
+            c.fail("bumper", "required by the compliant solution and swept-sine tests: {frequency: Omega_b / 2 pi [Hz], loss_factor: xi_b (optional)}")
+        elif "bumper" in doc and "bumper_frequency" not in sweep and "frequency" not in fixed["bumper"]:
+            c.fail("bumper.frequency", "required unless swept (sweep.bumper_frequency): Omega_b / 2 pi [Hz] in (0, inf)")
+        if bumper_solutions and "bumper_loss_factor" not in grids and (r := grids.get("restitution")) is not None and np.any(r == 0.0):
+            c.fail("stop.restitution", "R = 0 needs an infinitely damped bumper for the compliant solution: give bumper.loss_factor, or sweep R > 0")
+    if general and system is not None:
+        check_general_solutions(c, solutions, system, specs or (), load, "swept_sine" in doc, grids.get("restitution"), grids.get("clearance"))
+
+    sizes = [g.size for g in grids.values() if g is not None]
+    if len(sizes) >= 3 and math.prod(sizes) > MAX_STUDY_POINTS:
+        c.fail("sweep", f"{math.prod(sizes):,} points (product of the swept grids) is too many: allowed at most {MAX_STUDY_POINTS:,}")
+    if "pgf_paper" in solutions and system is not None and (named := TwoDofSystem.of(system)) is not None and (modes := underdamped_mode_count(named)) != 2:
+        c.fail("solutions", f"pgf_paper needs two underdamped modes (the paper's eq. 10 fit); this system has {modes}")
+    allowed = quantities_for(system.coordinates) if general and system is not None else QUANTITIES
+    if len(set(allowed)) != len(allowed):
+        clashing = sorted({q for q in allowed if allowed.count(q) > 1})
+        c.fail("system.coordinates", f"names that make output names clash ({', '.join(clashing)}): rename them (e.g. not 'force')")
+    quantities = c.choices("quantities", doc["quantities"], allowed) if "quantities" in doc else allowed
+    if "regime" not in quantities:
+        quantities = (*quantities, "regime")
+
+    admissibility = AdmissibilitySettings()
+    if "settings" in doc:
+        settings = c.mapping("settings", doc["settings"], {"admissibility"})
+        if "admissibility" in settings:
+            adm = c.mapping("settings.admissibility", settings["admissibility"], {"samples_per_period", "relative_tolerance"})
+            kwargs: dict[str, Any] = {}
+            if "samples_per_period" in adm:
+                kwargs["samples_per_period"] = c.integer("settings.admissibility.samples_per_period", adm["samples_per_period"], 16, 1_000_000)
+            if "relative_tolerance" in adm:
+                kwargs["relative_tolerance"] = c.number("settings.admissibility.relative_tolerance", adm["relative_tolerance"], 0.0, 1e-2)
+            if None not in kwargs.values():
+                admissibility = AdmissibilitySettings(**kwargs)
+
+    simulation = None
+    engines = [name for name in solutions if name in ENGINE_SOLUTIONS]
+    swept_sine = _parse_swept_sine(c, doc["swept_sine"], engines, grids.get("frequency")) if "swept_sine" in doc else None
+    if "simulation" in doc:
+        if not engines:
+            c.fail("simulation", f"given, but no time-domain solution ({', '.join(ENGINE_SOLUTIONS)}) is asked for")
+        elif (main_grid := grids.get("frequency")) is not None:
+            if "swept_sine" in doc:
+                for key in sorted(set(doc["simulation"]) & _STEADY_ONLY_KEYS if isinstance(doc["simulation"], dict) else ()):
+                    c.fail(f"simulation.{key}", "not used by a swept-sine test (it sets stepped steady states): remove it")
+            simulation = _parse_simulation(c, doc["simulation"], main_grid, "swept_sine" in doc)
+    elif engines and (main_grid := grids.get("frequency")) is not None:
+        simulation = _parse_simulation(c, {}, main_grid, "swept_sine" in doc)
+
+    if c.problems:
+        raise SceneError(c.problems, source)
+    frequency, restitution, clearance = grids["frequency"], grids["restitution"], grids["clearance"]
+    # guaranteed when no problem was recorded
+    assert system is not None and amplitude is not None and isinstance(name, str)
+    assert frequency is not None and restitution is not None and clearance is not None
+    order = ("bumper_loss_factor", "restitution", "clearance", "bumper_frequency")
+    swept = tuple(k for k in order if k in sweep) + ("frequency",)
+    return Scene(
+        name=name, description=description, system=system, amplitude=amplitude,
+        frequency=frequency, restitution=restitution, clearance=clearance, swept=swept,
+        solutions=solutions, quantities=quantities, admissibility=admissibility, simulation=simulation,
+        bumper_frequency=grids.get("bumper_frequency"), bumper_loss_factor=grids.get("bumper_loss_factor"), swept_sine=swept_sine,
+        report=report, text=text, load=load, stops=specs if "stops" in doc and specs is not None else (), sweep_stops=targets, general=general,
+        cluster_scheduler=scheduler,
+    )
+
+
+def _parse_swept_sine(c: Checker, value: Any, engines: list[str], grid: np.ndarray | None) -> SweptSineSettings | None:
+    """``swept_sine: {start, stop, rate, directions, sample_rate, window_cycles, initial_state}`` (frequencies [Hz],
+    rate [Hz s-1]); every problem is reported."""
+    spec = c.mapping("swept_sine", value, {"start", "stop", "rate", "directions", "sample_rate", "window_cycles", "initial_state"}, {"start", "stop", "rate"})
+    if engines != ["compliant"]:
+        c.fail("solutions", f"a swept-sine test runs the compliant solution only (and needs it): got {engines or 'none'}")
+    start = c.number("swept_sine.start", spec["start"], 0.0, math.inf, low_inclusive=False) if "start" in spec else None
+    stop = c.number("swept_sine.stop", spec["stop"], 0.0, math.inf, low_inclusive=False) if "stop" in spec else None
+    rate = c.number("swept_sine.rate", spec["rate"], 0.0, math.inf, low_inclusive=False) if "rate" in spec else None
+    directions = c.choices("swept_sine.directions", spec["directions"], SWEEP_DIRECTIONS) if "directions" in spec else SWEEP_DIRECTIONS
+    sample_rate = c.number("swept_sine.sample_rate", spec.get("sample_rate", 1000.0), 0.0, 1e7, low_inclusive=False)
+    cycles = c.integer("swept_sine.window_cycles", spec.get("window_cycles", 8), 1, 10_000)
+    initial = spec.get("initial_state", "linear")
+    if initial not in ("linear", "rest"):
+        c.fail("swept_sine.initial_state", f"{initial!r} is not allowed: use linear or rest")
+    if start is None or stop is None:
+        return None
+    if stop <= start:
+        c.fail("swept_sine.stop", f"{stop:g} must be greater than start = {start:g} (directions say which way it runs)")
+        return None
+    rate, sample_rate = check_sweep_run(c, "swept_sine", start, stop, rate, sample_rate, cycles, " or swept_sine.window_cycles")
+    if grid is not None and not np.any((grid >= start) & (grid <= stop)):
+        c.fail("sweep.frequency", f"no frequency of the grid lies in the swept band [{start:g}, {stop:g}] Hz, where the running estimates are reported")
+    if rate is None or sample_rate is None or cycles is None or not directions or initial not in ("linear", "rest"):
+        return None
+    return SweptSineSettings(start, stop, rate, directions, sample_rate, cycles, initial)
+
+
+def check_sweep_run(c: Checker, key: str, low: float, high: float, rate: float | None, sample_rate: float | None, cycles: int | None, window_hint: str = "") -> tuple[float | None, float | None]:
+    """Limits of one swept-sine run between ``low`` and ``high`` [Hz], shared by scenes and benchmark cases: 20 output
+    samples per cycle at the top, at most :data:`MAX_SWEEP_SAMPLES` samples, and room for two estimator windows of
+    ``cycles`` cycles. Returns (rate, sample_rate), each None where it failed."""
+    if sample_rate is not None and sample_rate < 20.0 * high:
+        c.fail(f"{key}.sample_rate", f"{sample_rate:g} Hz is too coarse for {high:g} Hz: allowed [{20.0 * high:g}, 1e+07] (20 samples per cycle)")
+        sample_rate = None
+    if rate is not None:
+        duration = (high - low) / rate
+        if sample_rate is not None and duration * sample_rate > MAX_SWEEP_SAMPLES:
+            c.fail(f"{key}.rate", f"{duration:g} s at {sample_rate:g} samples/s is {duration * sample_rate:.3g} samples per run: allowed at most {MAX_SWEEP_SAMPLES:.0e} (raise the rate or lower {key}.sample_rate)")
+            rate = None
+        elif cycles is not None and 2.0 * cycles / low >= duration:
+            c.fail(f"{key}.rate", f"the sweep lasts {duration:g} s, shorter than two {cycles}-cycle estimator windows at {low:g} Hz ({2.0 * cycles / low:g} s): lower the rate{window_hint}")
+            rate = None
+    return rate, sample_rate
+
+
+def parse_header(c: Checker, doc: dict, pages: tuple[str, ...] = ()) -> tuple[Any, str, TwoDofSystem | None, float | None, bool | str]:
+    """What every scene in the paper's named form has: name, description, system, excitation amplitude and the report
+    switch (or one of ``pages``)."""
+    name, description, report = parse_names(c, doc, pages)
+    system = parse_structure(c, doc.get("system")) if "system" in doc else None
+    if system is not None and not isinstance(system, TwoDofSystem):
+        c.fail("system", "this kind of scene takes the paper's named system {m1, m2, k1, k2, b1, b2} only")
+        system = None
+    amplitude = None
+    if "excitation" in doc:
+        excitation = c.mapping("excitation", doc["excitation"], {"amplitude"}, {"amplitude"})
+        if "amplitude" in excitation:
+            amplitude = c.number("excitation.amplitude", excitation["amplitude"], 0.0, math.inf, low_inclusive=False)
+    return name, description, system, amplitude, report
+
+
+def parse_names(c: Checker, doc: dict, pages: tuple[str, ...] = ()) -> tuple[Any, str, bool | str]:
+    """Name, description and the report switch of any scene (or one of ``pages``, the report pages it may name)."""
+    name = doc.get("name")
+    if "name" in doc and not (isinstance(name, str) and NAME.match(name)):
+        c.fail("name", f"expected a file-name-safe string (letters, digits, '_', '-', '.'), got {name!r}")
+    description = doc.get("description", "")
+    if not isinstance(description, str):
+        c.fail("description", f"expected a string, got {type(description).__name__}")
+    report = doc.get("report", True)
+    if not isinstance(report, bool) and report not in pages:
+        c.fail("report", f"expected true or false{' or a page name (' + ', '.join(pages) + ')' if pages else ''}, got {report!r}")
+        report = True
+    return name, description, report
+
+
+def parse_cluster(c: Checker, doc: dict) -> str | None:
+    """The scene's ``cluster: {scheduler: ADDRESS}``: a running dask scheduler to run on (None: a local cluster)."""
+    if "cluster" not in doc:
+        return None
+    section = c.mapping("cluster", doc["cluster"], {"scheduler"}, {"scheduler"})
+    address = section.get("scheduler")
+    if address is not None and not (isinstance(address, str) and "://" in address or isinstance(address, str) and ":" in address):
+        c.fail("cluster.scheduler", f"expected a scheduler address such as tcp://host:8786, got {address!r}")
+        return None
+    return address
+
+
+def _parse_simulation(c: Checker, value: Any, default_frequency: np.ndarray, swept: bool = False) -> SimulationSettings | None:
+    spec = dict(c.mapping("simulation", value, _SIMULATION_KEYS))
+    rtol, atol = SWEPT_TOLERANCES if swept else STEPPED_TOLERANCES
+    if "rtol" in spec and "atol" not in spec and isinstance(spec["rtol"], (int, float)) and not isinstance(spec["rtol"], bool):
+        spec["atol"] = spec["rtol"] * (atol / rtol)  # the ratio the guidance was measured with: atol = rtol x 1e-4 m
+    spec.setdefault("rtol", rtol)
+    spec.setdefault("atol", atol)
+    frequency: np.ndarray | None = c.grid("simulation.frequency", spec["frequency"], 0.0, math.inf, False) if "frequency" in spec else default_frequency
+    start = spec.get("start", "pgf")
+    if start not in SIMULATION_STARTS:
+        c.fail("simulation.start", f"{start!r} is not allowed: use one of {', '.join(SIMULATION_STARTS)}")
+    engine_kwargs = {k: spec[k] for k in ("method", "rtol", "atol", "max_step") if k in spec}
+    steady_kwargs = {k: spec[k] for k in ("tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods") if k in spec}
+    engine = _settings(c, EngineSettings, engine_kwargs)
+    steady = _settings(c, SteadySettings, steady_kwargs)
+    if frequency is None or start not in SIMULATION_STARTS or engine is None or steady is None:
+        return None
+    return SimulationSettings(frequency=frequency, start=start, engine=engine, steady=steady)
+
+
+def _settings(c: Checker, kind: type[_T], kwargs: dict[str, Any]) -> _T | None:
+    """Build a settings dataclass, turning its validation errors into scene problems under ``simulation.``."""
+    for key, item in kwargs.items():
+        if isinstance(item, bool) or not isinstance(item, (int, float, str)):
+            c.fail(f"simulation.{key}", f"expected a number or name, got {item!r}")
+            return None
+    try:
+        return kind(**kwargs)
+    except (ValueError, TypeError) as error:
+        c.fail("simulation." + str(error).split(" ")[0], str(error))
+        return None

@@ -1,0 +1,260 @@
+"""Stepped studies: steady states (closed forms and time-domain engines) at each point of the grid."""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+
+import numpy as np
+import xarray as xr
+
+from vibroimpact.analysis.impact_orbit import solve_impact_orbit
+from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.analysis.stability import floquet_multipliers
+from vibroimpact.engines.registry import BUMPER, engine_spec
+from vibroimpact.kinds.stepped.cases import general_simulated_values
+from vibroimpact.kinds.stepped.grid import StudyGrid, grid_coordinates, solve_each, finish_dataset
+from vibroimpact.kinds.stepped.values import scene_problem, stop_clearances
+from vibroimpact.runs.blocks import plan_blocks, run_grid
+from vibroimpact.runs.cluster import Progress
+from vibroimpact.runs.estimate import Costs, EnginePart, Estimate, grid_estimate
+from vibroimpact.runs.runner import Runner
+from vibroimpact.scene.layout import stop_descriptions
+from vibroimpact.scene.schema import Scene, GRID_DIMS, STOP_QUANTITIES, ENGINE_SOLUTIONS
+from vibroimpact.scene.variables import quantity_attributes
+from vibroimpact.simulation.settings import SWEEP_STARTS
+
+__all__ = ["engine_scale", "closed_form_scale", "general_orbit_outlook", "UNKNOWN_WANDERING", "CLOSED_FORM_FACTOR", "general_block", "general_coordinates", "describe_stops", "general_quantity_attributes", "SteppedStudy", "expected_periods", "SETTLING_PERIODS", "SHOOTING_PERIODS", "ESTIMATE_POINTS"]
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# What ``--estimate`` assumes of a stepped scene's layout (any structure, load and stops).
+# --------------------------------------------------------------------------------------------------------------------
+
+#: Share of impacting points assumed never to settle where no closed form says which orbits are stable.
+UNKNOWN_WANDERING = 0.25
+#: Cost of the general closed form per point over the named one's, on the paper's layout (measured).
+CLOSED_FORM_FACTOR = 1.3
+
+
+def engine_scale(scene: Scene) -> float:
+    """(N / 2)^2 K: an engine's cost per period relative to the paper's layout's."""
+    return (scene.system.size / 2.0) ** 2 * len(scene.stop_specs)
+
+
+def closed_form_scale(scene: Scene, solution: str) -> float:
+    """A closed form's cost per grid point relative to the one measured on the paper's layout by its named route."""
+    if solution == "pgf_paper":
+        return 1.0
+    size = (scene.system.size / 2.0) ** 2
+    return CLOSED_FORM_FACTOR * size * (len(scene.stop_specs) if solution == "linear" else 1.0)
+
+
+def general_orbit_outlook(scene: Scene, frequencies: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """(fits, admissible, stable, wandering share) over (restitution, clearance, frequency) for a general scene.
+
+    ``fits``: the linear motion stays clear of every stop; ``admissible``/``stable``: a closed-form orbit exists, stays
+    off the stops, is stable (all False without a closed form); the share of impacting points without a closed form
+    assumed never to settle (0 where a closed form applies).
+    """
+    problem = scene_problem(scene, float(frequencies[0]), float(scene.restitution[0]), float(scene.clearance[0]))
+    omega = 2.0 * np.pi * frequencies[None, None, :]
+    clearances = stop_clearances(scene)[None, :, None, :]  # (1, nc, 1, K)
+    fits = np.broadcast_to(linear_amplitudes(problem, omega).fits(clearances), (scene.restitution.size, scene.clearance.size, frequencies.size))
+    shape = fits.shape
+    if closed_form_refusal(problem) is not None:
+        return fits, np.zeros(shape, dtype=bool), np.zeros(shape, dtype=bool), UNKNOWN_WANDERING
+    orbit = solve_impact_orbit(problem, omega, scene.clearance[None, :, None], scene.restitution[:, None, None])
+    admissible = np.broadcast_to(orbit.admissible(), shape)
+    stable = np.zeros(shape, dtype=bool)
+    if admissible.any():
+        modulus = np.max(np.abs(floquet_multipliers(orbit)), axis=-1)
+        stable = admissible & (modulus < 1.0)
+    return fits, admissible, stable, 0.0
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# The values of a stepped study, whichever way its scene writes the system (the paper's named form is the layout
+# of a two-mass chain, one upper stop on x2 and a force on x1, and takes this path too): any structure, load and stops.
+# --------------------------------------------------------------------------------------------------------------------
+
+_PER_COORDINATE = {"_amplitude": "x1_amplitude", "_rms": "x1_rms"}
+
+
+def general_quantity_attributes(quantity: str, scene: Scene) -> dict[str, object]:
+    """Units and long name of a stepped study's quantity (per-coordinate names included)."""
+    relative = " relative to the base" if scene.load_spec.base_motion else ""
+    for name in scene.coordinates:
+        if quantity == f"{name}_amplitude":
+            return {"units": "m", "long_name": f"fundamental-harmonic amplitude of coordinate {name}{relative}"}
+        if quantity == f"{name}_rms":
+            return {"units": "m", "long_name": f"RMS of coordinate {name}{relative} (static offset included)"}
+        if quantity == f"one_impact_{name}_amplitude":
+            return {"units": "m", "long_name": f"|{name}| fundamental of the closed-form impact orbit wherever it exists, unchecked"}
+    attrs = quantity_attributes(quantity)
+    if quantity in STOP_QUANTITIES:
+        attrs = attrs | {"long_name": f"{attrs.get('long_name', quantity)}; per stop (the stopped coordinate's deceleration)"}
+    if quantity in ("force_amplitude", "suspension_force_amplitude"):
+        attrs = attrs | {"long_name": "fundamental-harmonic amplitude of the force on the base: 1^T (K x + C x') through springs and dashpots" + (" plus the absolute stops' contact forces" if quantity == "force_amplitude" else "")}
+    return attrs
+
+
+def general_block(scene: Scene, runner: Runner) -> xr.Dataset:
+    """Every solution of ``scene`` (or of a block of one) over its unsqueezed grid, without coordinates or metadata;
+    per-stop quantities have the dimension ``stop`` where the scene has several stops."""
+    grid = StudyGrid.of(scene)
+    per_solution = solve_each(scene, grid, lambda name: general_simulated_values(scene, name, grid.full, runner), None)
+    count = len(scene.stop_specs)
+    data_vars = {}
+    for quantity in scene.quantities:
+        attrs = general_quantity_attributes(quantity, scene)
+        if quantity in STOP_QUANTITIES:
+            stacked = np.stack([np.broadcast_to(values[quantity], (count, *grid.full)) for values in per_solution])
+            if count > 1:
+                data_vars[quantity] = xr.Variable(("solution", "stop", *GRID_DIMS), stacked, attrs)
+            else:
+                data_vars[quantity] = xr.Variable(("solution", *GRID_DIMS), stacked[:, 0], attrs)
+        else:
+            stacked = np.stack([np.broadcast_to(values[quantity], grid.full) for values in per_solution])
+            data_vars[quantity] = xr.Variable(("solution", *GRID_DIMS), stacked, attrs)
+    return xr.Dataset(data_vars)
+
+
+def general_coordinates(scene: Scene, grid: StudyGrid) -> dict[str, object]:
+    """Coordinates of a stepped study's dataset before squeezing: those of :func:`grid_coordinates`, and ``stop``
+    with ``stop_description`` where the scene has several stops and writes a per-stop quantity."""
+    coords = grid_coordinates(scene, grid, list(scene.solutions))
+    count = len(scene.stop_specs)
+    if count > 1 and any(q in STOP_QUANTITIES for q in scene.quantities):
+        coords["stop"] = np.arange(count)
+        coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.stop_specs, scene.coordinates, scene.restitution, scene.clearance), dtype=object))
+    return coords
+
+
+def describe_stops(dataset: xr.Dataset) -> xr.Dataset:
+    """The attributes of the ``stop`` coordinates, where the dataset has them."""
+    if "stop" in dataset.coords:
+        dataset["stop"].attrs.update({"units": "1", "long_name": "index of the stop in the scene's stops"})
+        dataset["stop_description"].attrs.update({"long_name": "the stop's constraint in words (Delta, R: the swept values)"})
+    return dataset
+
+#: Periods of a transient that settles on a stable orbit (two convergence chunks), before the measurement.
+SETTLING_PERIODS = 40
+#: Periods a ``shooting`` start integrates before measuring a stable orbit: 1-2 map evaluations and the 3-period check
+#: of an integrator (measured on the restitution study: 1-4).
+SHOOTING_PERIODS = 5
+#: Largest number of simulated points whose closed form is solved for the estimate (a larger grid is subsampled).
+ESTIMATE_POINTS = 20_000
+
+
+class SteppedStudy:
+    """Steady states over (restitution, clearance, bumper, frequency): dimension ``solution`` for every solution."""
+
+    name = "stepped"
+
+    def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
+        """Every solution of ``scene`` over its grid (see :func:`vibroimpact.runs.run.run_study`), solved block by
+        block (:mod:`vibroimpact.runs.blocks`) by :func:`~vibroimpact.kinds.stepped.study.general_block`, whichever
+        way the scene writes its system; the variables are read lazily from the runner's store."""
+        say = progress or (lambda _message: None)
+        grid = StudyGrid.of(scene)
+        solutions = list(scene.solutions)
+        coords = general_coordinates(scene, grid)
+        raw = run_grid(scene, runner, general_block, {"solution": len(solutions), "stop": len(scene.stop_specs)})
+        dataset = describe_stops(raw.assign_coords(coords))
+        say(f"{', '.join(solutions)}: done")
+        return finish_dataset(dataset, scene, coords, self.simulation_attributes(scene))
+
+    @staticmethod
+    def simulation_attributes(scene: Scene) -> dict[str, object]:
+        """What the dataset records of the time-domain solutions' settings and methods."""
+        attrs: dict[str, object] = {}
+        if scene.simulation is not None:
+            attrs["simulation_frequency_Hz"] = scene.simulation.frequency
+            attrs["simulation_start"] = scene.simulation.start
+            for key, value in asdict(scene.simulation.engine).items():
+                attrs[f"simulation_engine_{key}"] = value
+            for key, value in asdict(scene.simulation.steady).items():
+                attrs[f"simulation_steady_{key}"] = value
+            attrs["method_exact"] = "piecewise-exact propagation (eigenvectors + harmonic particular solution), contacts by guaranteed Taylor-bound root bracketing"
+            attrs["method_momentary"] = "scikit-sundae CVODE with contact/release events and an apex event guarding grazing contacts"
+            attrs["method_compliant"] = "Kelvin-Voigt bumper (eq. 25) through scikit-sundae IDA: one solver per contact mode, onset/release events, recorded force and deceleration peaks; atol of the displacements [m], other states scaled"
+        return attrs
+
+    def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:
+        """Seconds per simulated period of each engine at its tolerance times the periods each point is predicted to
+        integrate (:func:`expected_periods`), on the calibration machine."""
+        bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
+        # the same for every engine: solved once (the closed form over up to ESTIMATE_POINTS points)
+        periods, scale = expected_periods(scene) if scene.simulation is not None else (np.zeros(0), 1.0)
+
+        def engine_part(name: str, engine: str) -> EnginePart:
+            assert scene.simulation is not None
+            capabilities = engine_spec(name).capabilities
+            copies = bumpers if capabilities.contact == BUMPER else 1  # a bumper engine runs once per bumper
+            steady = scene.simulation.steady
+            # where the motion may never settle, an engine without exact Jacobians also runs a perturbed copy of its
+            # Lyapunov run
+            wandering = np.count_nonzero(periods >= steady.max_periods + steady.lyapunov_periods) if not capabilities.exact_jacobians else 0
+            total_periods = (float(periods.sum()) + wandering * steady.lyapunov_periods) * scale * copies
+            seconds = costs.per_period_cost(engine, scene.simulation.engine.rtol) * engine_scale(scene) * total_periods
+            integrated = int(np.count_nonzero(periods) * scale) * copies
+            points = f"{scene.restitution.size * scene.clearance.size * scene.simulation.frequency.size * copies} points, ~{integrated} integrated, ~{total_periods:.0f} periods"
+            serial = 0.0
+            if scene.simulation.start in SWEEP_STARTS:  # one serial chain per (R, Delta, bumper)
+                serial = seconds / (scene.restitution.size * scene.clearance.size * copies)
+            return seconds, points, serial
+
+        return grid_estimate(
+            scene, jobs, costs, engine_part, report_figures(scene), closed_form_scale=lambda name: closed_form_scale(scene, name),
+            blocks=lambda workers: plan_blocks(scene, workers).count,
+        )  # fmt: skip
+
+
+#: Figures of the design-map page (three band maps, the regime map, the response at the recommended design).
+DESIGN_MAP_FIGURES = 5
+
+
+def report_figures(scene: Scene) -> int:
+    """Figures of the study's report page."""
+    if scene.report == "design_map":
+        return DESIGN_MAP_FIGURES
+    per_clearance = 12 if any(s in ENGINE_SOLUTIONS for s in scene.solutions) else 7
+    return 1 + per_clearance * scene.clearance.size + (2 if len(scene.swept) > 1 else 0)
+
+
+def expected_periods(scene: Scene) -> tuple[np.ndarray, float]:
+    """Periods each simulated (restitution, clearance, frequency) point is predicted to integrate, on the grid or on
+    an evenly subsampled frequency grid, and the factor that scales its sum to the whole grid.
+
+    As :func:`vibroimpact.simulation.steady.steady_state` and :func:`vibroimpact.kinds.stepped.cases.run_case` do: ``linear`` and stepped
+    sweeps answer a point whose linear motion fits without integrating; ``pgf`` also needs no admissible one-impact
+    orbit there; a stable orbit settles in a short transient; elsewhere the motion may never settle (``max_periods``
+    plus the irregular measurement). From ``rest`` every point integrates, and the lightly damped transient of the
+    linear modes (damping ratios ~1e-3) outlasts ``max_periods``.
+    """
+    assert scene.simulation is not None
+    sim = scene.simulation
+    per_line = max(1, ESTIMATE_POINTS // (scene.restitution.size * scene.clearance.size))
+    frequencies = sim.frequency if sim.frequency.size <= per_line else sim.frequency[np.linspace(0, sim.frequency.size - 1, per_line).astype(int)]
+    scale = sim.frequency.size / frequencies.size
+    steady = sim.steady
+    wander = steady.max_periods + steady.lyapunov_periods + steady.irregular_measure_periods
+    shape = (scene.restitution.size, scene.clearance.size, frequencies.size)
+    if sim.start == "rest":
+        return np.full(shape, float(wander)), scale
+    fits, admissible, stable, wandering = general_orbit_outlook(scene, frequencies)
+    settle = (SHOOTING_PERIODS if sim.start == "shooting" else SETTLING_PERIODS) + steady.measure_periods
+    if sim.start in SWEEP_STARTS:
+        # a chain: a fitting point is answered linear unless the point before it impacted (then it integrates from
+        # there, and keeps impacting where a one-impact orbit coexists with the linear motion)
+        order = range(frequencies.size) if sim.start == "sweep_up" else range(frequencies.size - 1, -1, -1)
+        no_integration = np.zeros(shape, dtype=bool)
+        impacting = np.zeros(shape[:2], dtype=bool)
+        for k in order:
+            no_integration[..., k] = fits[..., k] & ~impacting
+            impacting = ~fits[..., k] | (impacting & admissible[..., k])
+    else:
+        no_integration = fits & ~admissible if sim.start in ("pgf", "shooting") else fits
+    unknown = settle + wandering * (wander - settle)  # no closed form: an assumed share never settles
+    return np.where(no_integration, 0, np.where(stable, settle, unknown if wandering else wander)).astype(float), scale

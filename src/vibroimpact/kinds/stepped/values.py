@@ -1,0 +1,289 @@
+"""The closed-form solutions (``linear``, ``pgf``) of a general scene over its grid: any structure, load and stops.
+
+Values are named after the scene's coordinates (``<name>_amplitude``, ``<name>_rms``) and stops: a per-stop quantity
+(:data:`~vibroimpact.scene.schema.STOP_QUANTITIES`) has a leading axis of one entry per stop. The force on the base
+is the suspension's, 1^T (K + j w C) X, plus that of the absolute stops ((1^T n_k) times the impulse train's
+fundamental; a relative stop acts inside the structure). ``pgf`` is the closed-form impact orbit of
+:func:`vibroimpact.analysis.impact_orbit.solve_impact_orbit`: one impact per period on one rigid stop, or two on a
+symmetric two-sided stop (the scene checker refuses layouts without one, with the reason).
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Callable
+
+import numpy as np
+
+from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
+from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.analysis.pgf import OneImpactSolution, PgfVariant, green_models, solve_one_impact
+from vibroimpact.analysis.stability import Regime, classify, MARGINAL_MODULUS, floquet_multipliers
+from vibroimpact.model.contact import peak_acceleration_factor
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.scene.layout import build_stops
+from vibroimpact.scene.schema import MOTION_QUANTITIES, STOP_QUANTITIES, Scene
+from vibroimpact.scene.variables import STABLE_MARGINAL
+from vibroimpact.simulation.harmonics import base_force
+
+__all__ = ["general_linear_values", "general_pgf_values", "scene_problem", "first_problem", "broadcast_quantities", "stop_clearances", "coordinate_quantity", "paper_pgf_values"]
+
+_IMPACT_REGIMES = (Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR)
+_LINEAR_REGIMES = (Regime.LINEAR, Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT, Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT)
+
+
+def coordinate_quantity(quantity: str, name: str) -> str:
+    """The scene's name of a per-coordinate quantity: ``x1_amplitude`` -> ``<name>_amplitude`` (also ``_rms``,
+    ``one_impact_x1_amplitude``)."""
+    return quantity.replace("x1", name, 1)
+
+
+def scene_problem(scene: Scene, frequency: float, restitution: float, clearance: float, bumper: bool = False, bumper_frequency: float = np.nan, loss_factor: float = np.nan, phase: float = 0.0) -> ImpactProblem:
+    """The impact problem of a general scene at one grid point (rigid stops, or bumpers for ``bumper``)."""
+    stops = build_stops(scene.stop_specs, bumper, restitution, clearance, bumper_frequency, loss_factor)
+    return ImpactProblem(scene.system, stops, scene.load_spec.force(scene.amplitude, frequency, phase))
+
+
+def stop_clearances(scene: Scene) -> np.ndarray:
+    """Delta of every stop at every clearance of the grid [m], shape (clearance, K)."""
+    return np.array([[spec.values(np.nan, float(d))[1] for spec in scene.stop_specs] for d in scene.clearance])
+
+
+def first_problem(scene: Scene) -> ImpactProblem:
+    return scene_problem(scene, float(scene.all_frequencies[0]), float(scene.restitution[0]), float(scene.clearance[0]))
+
+
+def _per_coordinate(scene: Scene, template: str, values: np.ndarray) -> dict[str, np.ndarray]:
+    """{<name>_<template>: values[..., i]} for every coordinate."""
+    return {coordinate_quantity(template, name): values[..., i] for i, name in enumerate(scene.coordinates)}
+
+
+def general_linear_values(scene: Scene, omega: np.ndarray, shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+    """The linear steady state (no stop) at ``omega`` [rad s-1] (axes of the full grid), flagged where it crosses a
+    stop; the scene's quantities broadcast to ``shape`` (per-stop ones to (K, *shape))."""
+    problem = first_problem(scene)
+    linear = linear_amplitudes(problem, omega)
+    x = linear.coordinates  # omega.shape + (N,)
+    count = len(scene.stop_specs)
+    clearances = stop_clearances(scene)[None, :, None, None, None, :]  # (1, nc, 1, 1, 1, K)
+    fits = linear.fits(clearances)  # (1, nc, 1, 1, F)
+    force = base_force(scene.system, omega, x)
+    rms = np.sqrt(linear.static**2 + 0.5 * np.abs(x) ** 2)
+    zero_or_nan = np.where(fits, 0.0, np.nan)
+    values = {
+        **_per_coordinate(scene, "x1_amplitude", np.abs(x)),
+        **_per_coordinate(scene, "x1_rms", rms),
+        **_per_coordinate(scene, "one_impact_x1_amplitude", np.full(x.shape, np.nan)),
+        "force_amplitude": np.abs(force),
+        "suspension_force_amplitude": np.abs(force),
+        "impulse": np.zeros((count, *shape)),
+        "phase": np.full(shape, np.nan),
+        "regime": np.where(fits, Regime.LINEAR, Regime.LINEAR_EXCEEDS_CLEARANCE).astype(np.int8),
+        "stable": np.full(shape, -1, dtype=np.int8),
+        "floquet_modulus": np.full(shape, np.nan),
+        "one_impact_force_amplitude": np.full(shape, np.nan),
+        "one_impact_impulse": np.full((count, *shape), np.nan),
+        "impacts_per_period": np.zeros(shape),
+        "converged": np.full(shape, -1, dtype=np.int8),
+        "peak_acceleration": np.broadcast_to(zero_or_nan, (count, *np.shape(zero_or_nan))),
+        "peak_contact_force": np.broadcast_to(zero_or_nan, (count, *np.shape(zero_or_nan))),
+        "wall_time": np.full(shape, np.nan),
+        **{name: np.full(shape, np.nan) for name in MOTION_QUANTITIES},
+    }
+    return broadcast_quantities(scene, values, shape)
+
+
+def broadcast_quantities(scene: Scene, values: dict[str, np.ndarray], shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+    """The scene's quantities, each broadcast to ``shape`` (per-stop ones to (K, *shape)), or to a larger shape where a
+    value depends on more of the grid's axes (a peak estimate on the bumper axis)."""
+    count = len(scene.stop_specs)
+    out = {}
+    for name in scene.quantities:
+        target = (count, *shape) if name in STOP_QUANTITIES else shape
+        out[name] = np.broadcast_to(values[name], np.broadcast_shapes(target, np.shape(values[name])))
+    return out
+
+
+def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.ndarray, shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+    """The closed-form impact orbit at ``omega`` [rad s-1], clearance ``delta`` [m] and restitution ``r`` [-] where
+    it is admissible (and stable), else the linear motion where that fits; NaN elsewhere (as for the paper's pgf)."""
+    problem = first_problem(scene)
+    w, d, rr = np.broadcast_arrays(omega, delta, r)
+    orbit = solve_impact_orbit(problem, w, d, rr)
+    linear = linear_amplitudes(problem, w)
+    fits = linear.fits(stop_clearances(scene)[None, :, None, None, None, :])
+    settings = scene.admissibility
+    admissible = orbit.admissible(settings.relative_tolerance, settings.samples_per_period)
+    regime = classify(np.broadcast_to(fits, w.shape), orbit.exists, admissible)
+    modulus = np.where(admissible, np.max(np.abs(floquet_multipliers(orbit)), axis=-1), np.nan)
+    unstable = modulus > 1.0 + MARGINAL_MODULUS
+    regime[(regime == Regime.ONE_IMPACT_COEXISTING_LINEAR) & unstable] = Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT
+    impact = np.isin(regime, _IMPACT_REGIMES)
+    free = np.isin(regime, _LINEAR_REGIMES)
+    count = len(scene.stop_specs)
+    stops = orbit.layout.stops  # the orbit's stop(s): one, or the upper and lower of a pair
+
+    def choose(impact_value: np.ndarray, linear_value: np.ndarray) -> np.ndarray:
+        return np.where(impact, impact_value, np.where(free, linear_value, np.nan))
+
+    harmonics = functools.cache(orbit.harmonics)
+    rms = functools.cache(orbit.rms)
+    def orbit_base_force(suspension_only: bool) -> np.ndarray:
+        force = base_force(scene.system, w, harmonics())
+        if suspension_only:
+            return force
+        rate = (4.0 if orbit.two_sided else 2.0) * orbit.impulse / orbit.period
+        return force + float(np.sum(orbit.normal)) * rate
+
+    def per_stop(values: np.ndarray) -> np.ndarray:
+        out = np.zeros((count, *w.shape))
+        out[list(stops)] = values
+        return out
+
+    def stable_flag() -> np.ndarray:
+        flag = np.where(np.abs(modulus - 1.0) <= MARGINAL_MODULUS, STABLE_MARGINAL, modulus < 1.0)
+        return np.where(impact & np.isfinite(modulus), flag, -1).astype(np.int8)
+
+    linear_rms = np.sqrt(linear.static**2 + 0.5 * np.abs(linear.coordinates) ** 2)
+    peaks = functools.cache(lambda: _peak_estimates(scene, orbit, count))
+    makers: dict[str, Callable[[], np.ndarray]] = {
+        "regime": lambda: regime,
+        "force_amplitude": lambda: choose(np.abs(orbit_base_force(False)), np.abs(base_force(scene.system, w, linear.coordinates))),
+        "suspension_force_amplitude": lambda: choose(np.abs(orbit_base_force(True)), np.abs(base_force(scene.system, w, linear.coordinates))),
+        "impulse": lambda: np.where(impact, per_stop(orbit.impulse), np.where(free, 0.0, np.nan)),
+        "phase": lambda: np.where(impact, orbit.phase, np.nan),
+        "floquet_modulus": lambda: modulus,
+        "stable": stable_flag,
+        "one_impact_force_amplitude": lambda: np.where(orbit.exists, np.abs(orbit_base_force(False)), np.nan),
+        "one_impact_impulse": lambda: np.where(orbit.exists, per_stop(orbit.impulse), np.nan),
+        "impacts_per_period": lambda: np.where(impact, float(orbit.impacts_per_period), np.where(free, 0.0, np.nan)),
+        "converged": lambda: np.full(w.shape, -1, dtype=np.int8),
+        "peak_contact_force": lambda: np.where(impact, peaks()[0], np.where(free, 0.0, np.nan)),
+        "peak_acceleration": lambda: np.where(impact, peaks()[1], np.where(free, 0.0, np.nan)),
+        "wall_time": lambda: np.full(w.shape, np.nan),
+        **{name: (lambda: np.full(w.shape, np.nan)) for name in MOTION_QUANTITIES},
+    }
+    for i, name in enumerate(scene.coordinates):
+        makers[coordinate_quantity("x1_amplitude", name)] = lambda i=i: choose(np.abs(harmonics()[..., i]), np.abs(linear.coordinates[..., i]))
+        makers[coordinate_quantity("x1_rms", name)] = lambda i=i: choose(rms()[..., i], linear_rms[..., i])
+        makers[coordinate_quantity("one_impact_x1_amplitude", name)] = lambda i=i: np.where(orbit.exists, np.abs(harmonics()[..., i]), np.nan)
+    return broadcast_quantities(scene, {q: makers[q]() for q in scene.quantities}, shape)
+
+
+def _peak_estimates(scene: Scene, orbit: ImpactOrbit, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Peak bumper force [N] and peak deceleration of the stopped coordinate [m s-2] per stop, from the rigid impulse,
+    on the grid's axes and the bumper's (a swept bumper frequency: one estimate per value).
+
+    One collision of a bumper of the stop's effective mass, entered at J / (m_eff (1 + R)), peaks at
+    Gamma(xi_b) Omega_b J / (1 + R); the deceleration is that force less the force the structure presses the stop with
+    at the impact (the holding force n M^-1 (f - C x' - K x) m_eff, just before it), over m_eff (for the paper's layout
+    the paper's estimate). The bumper is the orbit's first stop's own, else the grid's. NaN without a bumper.
+    """
+    spec = scene.stop_specs[orbit.layout.stops[0]]
+    grid_frequency = scene.bumper_frequency if scene.bumper_frequency is not None else np.array([np.nan])
+    frequency = np.array([spec.bumper_frequency]) if spec.bumper_frequency is not None else grid_frequency
+    grid_losses = scene.loss_factors()
+    losses = np.array([spec.values(float(r), np.nan, np.nan, float(xi))[3] for r, xi in zip(scene.restitution, grid_losses)])
+    gamma = np.array([peak_acceleration_factor(xi) if np.isfinite(xi) else np.nan for xi in losses])[:, None, None, None, None]
+    omega_b = 2.0 * np.pi * frequency[None, None, :, None, None]
+    force = gamma * omega_b * orbit.impulse / (1.0 + orbit.restitution)  # (R, D, bumper, 1, F)
+    structure = scene.system.structure
+    size = structure.size
+    n = orbit.normal
+    m_eff = orbit.layout.effective_mass
+    minv_n = np.linalg.solve(structure.mass_matrix, n)
+    with np.errstate(invalid="ignore"):
+        before = orbit.state_before_impact()
+        x, v = before[..., :size], before[..., size:]
+        t = orbit.impact_time
+        harmonic = (orbit.load * np.exp(1j * orbit.omega * t)[..., None]).real
+        _, static = first_problem(scene).load()
+        pressing = (harmonic + static - v @ structure.damping_matrix.T - x @ structure.stiffness_matrix.T) @ minv_n * m_eff
+        acceleration = (force - pressing) / m_eff
+    force_out, acceleration_out = np.full((count, *force.shape), np.nan), np.full((count, *force.shape), np.nan)
+    force_out[list(orbit.layout.stops)] = force
+    acceleration_out[list(orbit.layout.stops)] = acceleration
+    return force_out, acceleration_out
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# ``pgf_paper``: the paper's own closed form over a study's grid, where the scene has the paper's layout on its named
+# system (:attr:`vibroimpact.model.problem.ImpactProblem.named_system`; the scene checker refuses it elsewhere).
+# --------------------------------------------------------------------------------------------------------------------
+
+def paper_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.ndarray, shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+    """The paper's one-impact orbit at ``omega`` [rad s-1] (axes of the full grid), clearance ``delta`` [m] and
+    restitution ``r`` [-] where it is admissible, else the linear motion where that fits; NaN elsewhere. Each of the
+    scene's quantities is computed only if asked for, broadcast to ``shape`` (per-stop ones to (1, *shape)).
+
+    Raises
+    ------
+    ValueError
+        If the scene does not have the paper's layout on its named system.
+    """
+    problem = first_problem(scene)
+    system = problem.named_system
+    if system is None:
+        raise ValueError("pgf_paper is the paper's route for its layout (a two-mass chain x1, x2; one upper stop on x2; force on x1): use pgf")
+    solution = solve_one_impact(system, omega, delta, r, scene.amplitude, PgfVariant.PAPER, green_models(system, PgfVariant.PAPER))
+    w = np.broadcast_to(omega, shape)
+    linear = linear_amplitudes(problem, w)
+    fits = np.broadcast_to(linear.fits(stop_clearances(scene)[None, :, None, None, None, :]), shape)
+    regime = classify(fits, solution.exists, solution.admissible(scene.admissibility))
+    impact = np.isin(regime, _IMPACT_REGIMES)
+    free = np.isin(regime, _LINEAR_REGIMES)
+
+    def choose(impact_value: np.ndarray, linear_value: np.ndarray) -> np.ndarray:
+        return np.where(impact, impact_value, np.where(free, linear_value, np.nan))
+
+    def per_stop(values: np.ndarray) -> np.ndarray:
+        return np.broadcast_to(values, shape)[None]
+
+    rms = functools.cache(solution.rms)
+    peaks = functools.cache(lambda: _paper_peak_estimates(scene, system, solution, r, shape))
+    x = linear.coordinates
+    linear_force = np.abs(base_force(scene.system, w, x))
+    linear_rms = np.sqrt(linear.static**2 + 0.5 * np.abs(x) ** 2)
+    nan = np.full(shape, np.nan)
+    makers: dict[str, Callable[[], np.ndarray]] = {
+        "regime": lambda: regime,
+        "x1_amplitude": lambda: choose(np.abs(solution.x1_harmonic()), np.abs(x[..., 0])),
+        "x2_amplitude": lambda: choose(np.abs(solution.x2_harmonic()), np.abs(x[..., 1])),
+        "force_amplitude": lambda: choose(np.abs(solution.force_harmonic()), linear_force),
+        "suspension_force_amplitude": lambda: choose(np.abs(solution.suspension_force_harmonic()), linear_force),
+        "impulse": lambda: per_stop(choose(solution.impulse, np.zeros(shape))),
+        "phase": lambda: np.where(impact, solution.phase, np.nan),
+        "floquet_modulus": lambda: nan,  # the paper's orbits are not orbits of the real system: no Floquet analysis
+        "stable": lambda: np.full(shape, -1, dtype=np.int8),
+        # the raw one-impact solution of eqs. 15-18 wherever it exists, admissible or not (what the paper plots)
+        "one_impact_x1_amplitude": lambda: np.where(solution.exists, np.abs(solution.x1_harmonic()), np.nan),
+        "one_impact_x2_amplitude": lambda: np.where(solution.exists, np.abs(solution.x2_harmonic()), np.nan),
+        "one_impact_force_amplitude": lambda: np.where(solution.exists, np.abs(solution.force_harmonic()), np.nan),
+        "one_impact_impulse": lambda: per_stop(solution.impulse),
+        "impacts_per_period": lambda: np.where(impact, 1.0, np.where(free, 0.0, np.nan)),
+        "converged": lambda: np.full(shape, -1, dtype=np.int8),
+        "x1_rms": lambda: choose(rms()[0], linear_rms[..., 0]),
+        "x2_rms": lambda: choose(rms()[1], linear_rms[..., 1]),
+        "peak_acceleration": lambda: per_stop(choose(peaks()[0], np.zeros(shape))),
+        "peak_contact_force": lambda: per_stop(choose(peaks()[1], np.zeros(shape))),
+        "wall_time": lambda: nan,
+        **{name: (lambda: nan) for name in MOTION_QUANTITIES},
+    }
+    return broadcast_quantities(scene, {q: makers[q]() for q in scene.quantities}, shape)
+
+
+def _paper_peak_estimates(scene: Scene, system: TwoDofSystem, solution: OneImpactSolution, r: np.ndarray, shape: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """Peak deceleration of the absorber [m s-2] and peak bumper force [N] from the paper's impulse (section 6.3,
+    corrected): one collision with the bumper entered at J / (M2 (1 + R)) peaks at M2 Gamma(xi_b) Omega_b v0; the
+    deceleration is that force less the absorber spring's pull at the impact, K2 (X1 - Delta) + B2 (X1' - X2'(0-)),
+    over M2. NaN without one bumper frequency (a swept bumper: one per grid point)."""
+    if scene.bumper_frequency is None:
+        return np.full(shape, np.nan), np.full(shape, np.nan)
+    gamma = np.array([peak_acceleration_factor(xi) if np.isfinite(xi) else np.nan for xi in scene.loss_factors()])[:, None, None, None, None]
+    omega_b = 2.0 * np.pi * scene.bumper_frequency[None, None, :, None, None]
+    force = gamma * omega_b * solution.impulse / (1.0 + r)
+    at_impact = np.zeros(1)
+    with np.errstate(invalid="ignore"):
+        spring = system.k2 * (solution.x1(at_impact)[..., 0] - solution.clearance) + system.b2 * (solution.x1(at_impact, 1)[..., 0] - solution.pre_impact_velocity)
+    return np.broadcast_to((force - spring) / system.m2, shape), np.broadcast_to(force, shape)

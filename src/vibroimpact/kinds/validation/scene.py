@@ -1,0 +1,244 @@
+"""Validation scenes: one published closed form, reproduced by the project's engines and continuation.
+
+Example (``studies/validation/budd_dux.yaml``)::
+
+    name: budd_dux
+    description: Budd & Dux's impact oscillator ...
+    validation:
+      case: budd_dux              # budd_dux, bouncing_ball, zeno, grazing or relative_stop
+      forcing_frequency: 2.8      # every other key is optional (the case's defaults)
+      restitution: 0.8
+      clearance: {start: -0.5, stop: 0.14}
+
+The keys of each case, their units and ranges are :data:`vibroimpact.kinds.validation.settings.CASE_PARAMETERS`.
+Every unknown key, wrong type and out-of-range value is reported together, each naming its key.
+"""
+
+from __future__ import annotations
+
+import cmath
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from vibroimpact.kinds.stepped.scene import parse_names
+from vibroimpact.kinds.validation.settings import BouncingBallCase, BuddDuxCase, GrazingCase, RelativeStopCase, ValidationCase, ZenoCase
+from vibroimpact.kinds.validation.settings import (
+    CASE_PARAMETERS,
+    VALIDATION_CASES,
+    VALIDATION_TOP_KEYS,
+    ZENO_ENGINES,
+    Parameter,
+    ValidationSettings,
+)
+from vibroimpact.model.contact import RigidStop, Stop
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.structure import LinearStructure
+from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.scene.checker import Checker, SceneError
+from vibroimpact.scene.schema import Scene
+
+__all__ = ["BALL_TIME_SHIFT", "case_structure", "budd_dux_problem", "ball_problem", "ball_amplitude", "zeno_problem", "grazing_problem", "grazing_phase", "relative_stop_problem", "ValidationScene", "read_validation_scene", "parse_validation_scene", "validation_settings"]
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# The impact problems of the validation cases: each published system written in the project's general model.
+# --------------------------------------------------------------------------------------------------------------------
+
+#: The ball problem's time t is the table's time t + T/2 ... as a phase: the table is A sin(w t + BALL_TIME_SHIFT).
+BALL_TIME_SHIFT = math.pi
+
+
+def case_structure(case: ValidationCase) -> LinearStructure:
+    """The structure of a case."""
+    if isinstance(case, BuddDuxCase):
+        return LinearStructure([[1.0]], [[1.0]], [[0.0]], ("x",))
+    if isinstance(case, (BouncingBallCase, ZenoCase)):
+        return LinearStructure([[case.mass]], [[0.0]], [[0.0]], ("z",))
+    if isinstance(case, GrazingCase):
+        return LinearStructure([[case.mass]], [[case.stiffness]], [[case.damping]], ("x",))
+    named = TwoDofSystem(case.m1, case.m2, case.k1, case.k2, case.b1, case.b2)
+    return named.structure
+
+
+def budd_dux_problem(case: BuddDuxCase, clearance: float) -> ImpactProblem:
+    """x'' + x = cos(w t), x <= ``clearance`` (sigma), x' -> -r x'."""
+    w = case.forcing_frequency
+    stop = Stop(RigidStop(clearance, case.restitution), coordinate=0, side="upper")
+    return ImpactProblem(case_structure(case), (stop,), HarmonicForce(1.0, w / (2.0 * math.pi), 0.0, weights=(1.0,)))
+
+
+def ball_amplitude(case: BouncingBallCase, gamma: float) -> float:
+    """The harmonic force m A w^2 [N] of the table acceleration Gamma = A w^2 / g."""
+    return case.mass * gamma * case.gravity
+
+
+def ball_problem(case: BouncingBallCase, gamma: float) -> ImpactProblem:
+    """The ball in table coordinates at Gamma = A w^2 / g (module docstring; force m A w^2 cos(w t + pi/2))."""
+    stop = Stop(RigidStop(0.0, case.restitution), coordinate=0, side="lower")
+    force = HarmonicForce(ball_amplitude(case, gamma), case.frequency, BALL_TIME_SHIFT - 0.5 * math.pi, weights=(1.0,), static=(-case.mass * case.gravity,))
+    return ImpactProblem(case_structure(case), (stop,), force)
+
+
+def zeno_problem(case: ZenoCase) -> ImpactProblem:
+    """A free mass with gravity above a fixed table z >= 0 (no harmonic force)."""
+    stop = Stop(RigidStop(0.0, case.restitution), coordinate=0, side="lower")
+    return ImpactProblem(case_structure(case), (stop,), HarmonicForce(0.0, case.frequency, 0.0, weights=(1.0,), static=(-case.mass * case.gravity,)))
+
+
+def grazing_phase(case: GrazingCase) -> float:
+    """Force phase [rad] that puts the linear orbit's maximum at t = T/2: x = |H| A cos(w t + phase + arg H)."""
+    w = 2.0 * math.pi * case.frequency
+    h = 1.0 / complex(case.stiffness - case.mass * w * w, case.damping * w)
+    return (-math.pi - cmath.phase(h)) % (2.0 * math.pi)
+
+
+def grazing_problem(case: GrazingCase, amplitude: float) -> ImpactProblem:
+    """m x'' + c x' + k x = A cos(w t + phase), x <= d."""
+    stop = Stop(RigidStop(case.clearance, case.restitution), coordinate=0, side="upper")
+    return ImpactProblem(case_structure(case), (stop,), HarmonicForce(amplitude, case.frequency, grazing_phase(case), weights=(1.0,)))
+
+
+def relative_stop_problem(case: RelativeStopCase) -> ImpactProblem:
+    """The paper's masses with a stop between absorber and primary mass, x2 - x1 <= Delta."""
+    stop = Stop(RigidStop(case.clearance, case.restitution), coordinate=1, other=0, side="upper")
+    return ImpactProblem(case_structure(case), (stop,), HarmonicForce(case.amplitude, case.frequency, 0.0, weights=(1.0, 0.0)))
+
+@dataclass(frozen=True)
+class ValidationScene:
+    """A checked validation scene: what :class:`Scene` carries for the ``validation`` kind.
+
+    Attributes
+    ----------
+    name : str
+        Scene name (output ``<name>.nc``).
+    description : str
+        Free text.
+    settings : ValidationSettings
+        The case and its parameters.
+    report : bool
+        Whether ``run-study`` writes the report.
+    text : str
+        The YAML source.
+    """
+
+    name: str
+    description: str
+    settings: ValidationSettings
+    report: bool = True
+    text: str = ""
+
+
+def validation_settings(c: Checker, value: Any) -> ValidationSettings | None:
+    """The ``validation`` section as settings, or None with every problem recorded in ``c``."""
+    if not isinstance(value, dict):
+        c.fail("validation", f"expected a mapping with 'case' and the case's parameters, got {type(value).__name__}")
+        return None
+    case_name = value.get("case")
+    if case_name not in VALIDATION_CASES:
+        c.fail("validation.case", f"{case_name!r} is not allowed: use one of {', '.join(VALIDATION_CASES)}" if "case" in value else "required key is missing")
+        return None
+    parameters = CASE_PARAMETERS[case_name]
+    spec = c.mapping("validation", value, {"case", *parameters})
+    cls = VALIDATION_CASES[case_name]
+    defaults = {f.name: f.default for f in dataclasses.fields(cls)}
+    kwargs: dict[str, Any] = {}
+    ok = True
+    for key, parameter in parameters.items():
+        if key not in spec:
+            continue
+        checked = _value(c, f"validation.{key}", spec[key], parameter)
+        if checked is None:
+            ok = False
+        else:
+            kwargs[key] = checked
+    if not ok or set(map(str, spec)) - {"case", *parameters}:
+        return None
+    values = defaults | kwargs
+    if not _consistent(c, case_name, values):
+        return None
+    return ValidationSettings(cls(**kwargs))
+
+
+def _value(c: Checker, key: str, value: Any, parameter: Parameter) -> Any:
+    """One parameter's checked value (None: a problem was recorded)."""
+    bounds = (parameter.low, parameter.high, parameter.low_inclusive, parameter.high_inclusive)
+    if parameter.kind == "number":
+        return c.number(key, value, *bounds)
+    if parameter.kind == "integer":
+        return c.integer(key, value, int(parameter.low), int(parameter.high))
+    if parameter.kind == "engines":
+        chosen = c.choices(key, value, ZENO_ENGINES)
+        return chosen if chosen and len(chosen) == len(value) else None
+    spec = c.mapping(key, value, {"start", "stop"}, {"start", "stop"})
+    if set(map(str, spec)) != {"start", "stop"}:
+        return None
+    low, high = c.number(f"{key}.start", spec["start"], *bounds), c.number(f"{key}.stop", spec["stop"], *bounds)
+    if low is None or high is None:
+        return None
+    if not high > low:
+        c.fail(f"{key}.stop", f"{high:g} must be greater than start = {low:g}")
+        return None
+    return (low, high)
+
+
+def _consistent(c: Checker, case: str, values: dict[str, Any]) -> bool:
+    """Checks that involve several keys of a case (each failure names the key to change)."""
+    problems = len(c.problems)
+    if case == "budd_dux":
+        w = values["forcing_frequency"]
+        if abs(w - 1.0) < 1e-6 or abs(math.sin(2.0 * math.pi / w)) < 1e-6:
+            c.fail("validation.forcing_frequency", f"{w!r}: the ellipse needs w != 1 (resonance) and sin(2 pi / w) != 0 (w != 1/k)")
+        low, high = values["clearance"]
+        if not low <= values["start_clearance"] <= high:
+            c.fail("validation.start_clearance", f"{values['start_clearance']!r} is out of range: allowed [{low:g}, {high:g}] (validation.clearance)")
+        if high >= abs(1.0 / (1.0 - w * w)):
+            c.fail("validation.clearance.stop", f"{high!r} is out of range: allowed below |gamma| = {abs(1.0 / (1.0 - w * w)):.6g}, where the orbit grazes")
+    if case == "bouncing_ball":
+        low, high = values["acceleration"]
+        if values["brute_step"] > high - low:
+            c.fail("validation.brute_step", f"{values['brute_step']!r} is out of range: allowed (0, {high - low:g}] (the width of validation.acceleration)")
+    return len(c.problems) == problems
+
+
+def read_validation_scene(document: Any, text: str = "", source: str = "scene") -> ValidationScene:
+    """Check a validation scene's document (a mapping with ``validation``); raise :class:`SceneError` listing all
+    problems."""
+    c = Checker()
+    doc = c.mapping("", document, VALIDATION_TOP_KEYS, {"name", "validation"})
+    name, description, report = parse_names(c, doc)
+    settings = validation_settings(c, doc["validation"]) if "validation" in doc else None
+    if c.problems:
+        raise SceneError(c.problems, source)
+    assert isinstance(name, str) and settings is not None
+    return ValidationScene(name, description, settings, report, text)
+
+
+def parse_validation_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
+    """The :class:`Scene` of a validation scene (kind ``validation``): the case in :attr:`Scene.validation`; the grid
+    fields say the case's forcing frequency, restitution and clearance for listings."""
+    checked = read_validation_scene(document, text, source)
+    case = checked.settings.case
+    frequency = float(getattr(case, "frequency", getattr(case, "forcing_frequency", 1.0) / (2.0 * math.pi)))
+    restitution = float(case.restitution)
+    clearance = getattr(case, "clearance", 0.0)
+    clearance = float(np.mean(clearance)) if isinstance(clearance, tuple) else float(clearance)
+    return Scene(  # type: ignore[call-arg]
+        name=checked.name,
+        description=checked.description,
+        system=case_structure(case),
+        amplitude=1.0,
+        frequency=np.array([frequency]),
+        restitution=np.array([restitution]),
+        clearance=np.array([clearance]),
+        swept=(),
+        solutions=(),
+        quantities=(),
+        validation=checked.settings,
+        report=checked.report,
+        text=text,
+    )

@@ -1,0 +1,231 @@
+"""Where a study's work runs: this process, a local dask cluster of worker processes, or a running dask cluster.
+
+Which scheduler, first found wins: ``run-study --scheduler ADDRESS``, the environment variable
+``VIBROIMPACT_SCHEDULER``, the scene's ``cluster: {scheduler: ADDRESS}``; none: a local cluster of ``--jobs`` worker
+processes (one thread each), or this process alone for ``--jobs 1``.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import sys
+import threading
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+__all__ = ["SCHEDULER_VARIABLE", "ClusterLost", "Connection", "choose_scheduler", "connect", "unreachable", "dask_setup", "Progress", "ProgressReport", "Throttled", "ProgressBar", "REPORT_INTERVAL"]
+
+#: The environment variable naming a running scheduler (``tcp://host:8786``).
+SCHEDULER_VARIABLE = "VIBROIMPACT_SCHEDULER"
+#: Environment of a local cluster's worker processes, set before they start: dask's default but for its
+#: MALLOC_TRIM_THRESHOLD_ (glibc returning freed memory above 64 KiB to the system at once, 4 % more time for the
+#: exact engine's many small arrays, measured in one process), and one malloc arena (a worker computes in a thread).
+WORKER_ENVIRONMENT = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1, "MALLOC_ARENA_MAX": 1}
+#: dask settings of a local cluster's workers: no statistical profiler (it samples the computing thread every 10 ms
+#: for a dashboard the study does not show; 36 blocks of the design map on 2 workers: 6.6 s with it, 6.1 s without,
+#: the mean of 3 interleaved runs each).
+WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ": WORKER_ENVIRONMENT, "distributed.worker.profile.enabled": False}
+#: How long connecting to a named scheduler may take before the study gives up [s].
+CONNECT_TIMEOUT = 30.0
+
+
+class ClusterLost(RuntimeError):
+    """The dask scheduler went away (or could not be reached) while a study ran."""
+
+
+def choose_scheduler(option: str | None, scene_scheduler: str | None) -> str | None:
+    """The scheduler address to use: the command line's, the environment's, the scene's, or None (local)."""
+    for candidate in (option, os.environ.get(SCHEDULER_VARIABLE), scene_scheduler):
+        if candidate:
+            return candidate
+    return None
+
+
+@dataclass
+class Connection:
+    """A dask client and, for a local cluster, the cluster it started (closed with it)."""
+
+    client: object
+    cluster: object | None
+    address: str
+    _counted: tuple[float, int] | None = None
+
+    @property
+    def workers(self) -> int:
+        """Worker threads the scheduler knows of now (at least 1)."""
+        return max(1, self.worker_count())
+
+    def worker_count(self) -> int:
+        """Worker threads the scheduler knows of (0 for a cluster without workers), asked at most once a second."""
+        now = time.monotonic()
+        if self._counted is None or now - self._counted[0] > 1.0:
+            info = self.client.scheduler_info(n_workers=-1)  # type: ignore[attr-defined]
+            self._counted = (now, sum(int(worker.get("nthreads", 1)) for worker in info.get("workers", {}).values()))
+        return self._counted[1]
+
+    def close(self) -> None:
+        """Close the client, and the local cluster if this connection started one (its workers stop)."""
+        try:
+            self.client.close(timeout=10)  # type: ignore[attr-defined]
+        finally:
+            if self.cluster is not None:
+                self.cluster.close(timeout=10)  # type: ignore[attr-defined]
+
+
+def unreachable(scheduler: str, timeout: float = 10.0) -> str | None:
+    """Why the dask scheduler at ``scheduler`` cannot be reached (within ``timeout`` [s]), or None if it can."""
+    from distributed import Client
+
+    try:
+        client = Client(scheduler, timeout=timeout, set_as_default=False)
+    except (OSError, TimeoutError, ValueError, TypeError) as error:
+        return str(error) or type(error).__name__
+    client.close()
+    return None
+
+
+def connect(jobs: int, scheduler: str | None) -> Connection:
+    """Start a local cluster of ``jobs`` worker processes, or connect to ``scheduler``.
+
+    Raises
+    ------
+    ClusterLost
+        When the named scheduler cannot be reached within :data:`CONNECT_TIMEOUT`.
+    """
+    import dask.config
+    from distributed import Client, LocalCluster
+
+    if scheduler is None:
+        # Ctrl-C is the study's to handle: the worker processes ignore SIGINT from their start (an ignored signal
+        # stays ignored in a child process) and after a restart (the preload). A Ctrl-C in the ~1 s this takes is ignored
+        # too: blocking it instead does not reach the workers (a spawned child starts with every signal unblocked,
+        # and then prints tracebacks of its interrupted imports)
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if threading.current_thread() is threading.main_thread() else None
+        try:
+            with dask.config.set(WORKER_CONFIG):  # the nannies hand it to the worker processes
+                cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL, preload=[__name__])
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGINT, previous)
+        client = Client(cluster, set_as_default=False)
+        return Connection(client, cluster, cluster.scheduler_address)
+    # a running cluster's comings and goings (a worker lost, a connection closed) are the scheduler's to log; the
+    # study's process says what matters to it in one line
+    logging.getLogger("distributed").setLevel(logging.WARNING)
+    try:
+        client = Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
+    except (OSError, TimeoutError) as error:
+        raise ClusterLost(f"cannot reach the dask scheduler at {scheduler}: {error}") from None
+    return Connection(client, None, scheduler)
+
+
+def dask_setup(worker: object) -> None:
+    """Preload of a local cluster's workers (dask calls it in each worker process): ignore Ctrl-C, which the study
+    handles."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Progress of a study's work: a one-line bar on stderr that advances while tasks run, fed from this process or,
+# through the dask scheduler's event log, from the workers.
+# --------------------------------------------------------------------------------------------------------------------
+
+#: Called by running work with what it has done so far, in its progress unit (points, simulated seconds).
+#: Where a study's one-line messages go (a finished step, a kept block): a callable taking the line.
+Progress = Callable[[str], None]
+ProgressReport = Callable[[float], None]
+#: Shortest interval between two progress messages of one task [s].
+REPORT_INTERVAL = 0.25
+
+
+class Throttled:
+    """Passes a progress value on at most every :data:`REPORT_INTERVAL` seconds."""
+
+    def __init__(self, send: ProgressReport) -> None:
+        self.send, self.last = send, -np.inf
+
+    def __call__(self, done: float) -> None:
+        now = time.monotonic()
+        if now - self.last >= REPORT_INTERVAL:
+            self.last = now
+            self.send(done)
+
+
+class ProgressBar:
+    """A one-line progress bar on stderr (a line per 10 % when stderr is not a terminal).
+
+    Thread-safe: the dask client delivers the workers' progress messages on its own thread.
+
+    Parameters
+    ----------
+    totals : list of float
+        The work of each task, in ``unit``.
+    finished : list of int
+        Tasks already done (taken from the store of an interrupted run).
+    unit : str
+        What the work is counted in (``points``, ``s``).
+    enabled : bool
+        False: print nothing.
+    verb : str
+        The bar's first word.
+    done_before : float
+        Work done before these tasks (cases an interrupted run finished), in ``unit``: counted as done.
+    """
+
+    def __init__(self, totals: list[float], finished: list[int], unit: str, enabled: bool, verb: str = "simulating", done_before: float = 0.0) -> None:
+        self.totals = totals
+        self.total = max(sum(totals) + done_before, 1e-300)
+        self.done = {index: totals[index] for index in finished}
+        self.finished = set(finished)
+        self.done_sum = float(sum(self.done.values())) + done_before
+        self.unit = unit
+        self.verb = verb
+        self.enabled = enabled and sum(totals) + done_before > 0
+        self.started = time.perf_counter()
+        self.first_done = self.done_sum
+        self.tty = sys.stderr.isatty()
+        self.last_decile = -1
+        self.lock = threading.Lock()
+        self._show()
+
+    def partial(self, index: int, done: float) -> None:
+        """Task ``index`` has done ``done`` of its work (a late message of a finished task changes nothing)."""
+        with self.lock:
+            if index in self.finished:
+                return
+            value = min(max(done, 0.0), self.totals[index])
+            self.done_sum += value - self.done.get(index, 0.0)
+            self.done[index] = value
+            self._show()
+
+    def finish(self, index: int) -> None:
+        """Task ``index`` is done."""
+        self.partial(index, self.totals[index])
+        self.finished.add(index)
+
+    def _show(self) -> None:
+        if not self.enabled:
+            return
+        done = self.done_sum
+        fraction = min(done / self.total, 1.0)
+        elapsed = time.perf_counter() - self.started
+        rate = (done - self.first_done) / elapsed if elapsed > 0 and done > self.first_done else 0.0
+        remaining = f"{(self.total - done) / rate:.0f} s left" if rate > 0 else "..."
+        filled = int(30 * fraction)
+        line = f"{self.verb} [{'#' * filled}{'.' * (30 - filled)}] {done:.0f}/{self.total:.0f} {self.unit}, {elapsed:.0f} s, {remaining}"
+        if self.tty:
+            print("\r" + line + "  ", end="", file=sys.stderr, flush=True)
+        elif int(10 * fraction) > self.last_decile:
+            self.last_decile = int(10 * fraction)
+            print(line, file=sys.stderr, flush=True)
+
+    def close(self) -> None:
+        """End the bar's line."""
+        if self.enabled and self.tty:
+            print(file=sys.stderr, flush=True)

@@ -1,0 +1,149 @@
+"""Run a scene: its kind of study (:data:`vibroimpact.scene.kinds.KINDS`) expands it into its grid, computes the solutions it
+asks for and gathers one labelled ``xarray.Dataset``.
+
+Output contract (read by other tools; keep these names): dimensions ``solution`` (strings), each swept parameter
+(``restitution`` [1], ``clearance`` [m]) and ``frequency`` [Hz]; variables ``x1_amplitude`` [m],
+``x2_amplitude`` [m], ``force_amplitude`` [N], ``suspension_force_amplitude`` [N], ``impulse`` [N s], ``phase``
+[rad] and ``regime`` (CF flags). Unswept stop parameters are scalar coordinates. Swept-sine scenes add dimension
+``sweep``: the swept runs' estimates are ``swept_<quantity>`` (sweep, frequency) and their running estimates
+``running_<quantity>`` (sweep, elapsed_time); the steady-state solutions are not repeated along ``sweep``. Benchmark
+scenes have dimensions (case, engine, rtol). Every dataset names its kind in the attribute ``study_kind``.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import TYPE_CHECKING, Protocol
+
+import xarray as xr
+
+from vibroimpact import __version__
+from vibroimpact.runs.cluster import Progress
+from vibroimpact.runs.runner import Runner
+from vibroimpact.runs.store import StudyStore, source_hash
+from vibroimpact.scene.kinds import kind_named
+from vibroimpact.scene.schema import Scene
+
+if TYPE_CHECKING:
+    from vibroimpact.runs.estimate import Costs, Estimate
+
+__all__ = ["StudyKind", "study_kind", "run_study", "atomic_path", "write_dataset", "provenance"]
+
+class StudyKind(Protocol):
+    """What a kind of study does with a scene (each kind's ``study.py``, registered in :data:`vibroimpact.scene.kinds.KINDS`)."""
+
+    @property
+    def name(self) -> str:
+        """The kind's name, as :attr:`Scene.kind` says it and datasets record it (``study_kind``)."""
+        ...
+
+    def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
+        """The scene's dataset; ``progress`` receives a line per finished step (None: silence); its work runs in
+        ``runner`` (this process, a local dask cluster or a running one), which keeps finished work in its store."""
+        ...
+
+    def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:
+        """The predicted wall time and memory of running the scene with ``jobs`` processes, on the calibration machine."""
+        ...
+
+
+def study_kind(scene: Scene) -> StudyKind:
+    """The study of ``scene``'s kind (its module is imported now)."""
+    study: StudyKind = kind_named(scene.kind).make_study()
+    return study
+
+
+def _stderr_progress(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
+
+
+def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: int = 1, store: StudyStore | None = None, scheduler: str | None = None, load: bool = True) -> xr.Dataset:
+    """Compute every solution of ``scene`` over its grid.
+
+    Parameters
+    ----------
+    scene : Scene
+        A validated scene.
+    progress : callable, optional
+        Receives one line per finished step; ``None`` for silence (also silences the progress bar).
+    jobs : int
+        Worker processes of the local dask cluster; 1: this process alone.
+    store : StudyStore, optional
+        Where finished work is kept as it arrives (a rerun skips it); None: in memory.
+    scheduler : str, optional
+        Address of a running dask scheduler to run the work on instead of a local cluster.
+    load : bool
+        Load the dataset into memory; False: a stepped study's variables stay lazy arrays over ``store``.
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions ``solution``, the swept parameters (``sweep`` for swept-sine tests) and ``frequency``; benchmark
+        scenes: ``case``, ``engine``, ``rtol``.
+
+    Raises
+    ------
+    KeyboardInterrupt
+        On Ctrl-C, after the work in progress is cancelled (finished work stays in ``store``).
+    vibroimpact.runs.cluster.ClusterLost
+        When the dask scheduler goes away.
+    """
+    kind = study_kind(scene)
+    with Runner(jobs, scheduler, store, progress is not None) as runner:
+        dataset = kind.run(scene, progress, runner)
+    dataset.attrs["study_kind"] = kind.name
+    if runner.worker_peak_memory:
+        dataset.attrs["run_peak_memory_worker_bytes"] = runner.worker_peak_memory  # the largest dask worker
+    return dataset.load() if load else dataset
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Writing datasets: atomic files (a reader never sees half a file, a failed write leaves the previous one intact),
+# netCDF with compression and CF-clean coordinates, and the provenance every dataset carries.
+# --------------------------------------------------------------------------------------------------------------------
+
+@contextmanager
+def atomic_path(path: Path, suffix: str = ".tmp") -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; on success it replaces ``path`` (mode 0644), on failure it is removed.
+
+    ``suffix`` is the temporary file's ending (``.npz`` for ``numpy.savez``, which would otherwise add one).
+    """
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+    os.close(handle)
+    temporary = Path(name)
+    try:
+        yield temporary
+        os.chmod(temporary, 0o644)
+        os.replace(temporary, path)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
+
+
+def provenance() -> dict[str, str]:
+    """What every dataset says about how it was made: the package version, its source and the conventions followed."""
+    return {"vibroimpact_version": __version__, "vibroimpact_source_sha256": source_hash(), "Conventions": "CF-1.8"}
+
+
+def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
+    """Write ``dataset`` to netCDF atomically: a temporary file in the same folder, then a rename.
+
+    A reader never sees a half-written file, and an interrupted run leaves the previous file intact.
+    """
+    path = Path(path)
+    encoding: dict[str, dict[str, object]] = {name: {"zlib": True, "complevel": 4} for name in dataset.data_vars}
+    # CF 2.5.1: coordinate variables carry no _FillValue (xarray adds one to every float variable unless told not to)
+    encoding |= {name: {"_FillValue": None} for name in dataset.coords if dataset[name].dtype.kind == "f"}
+    if not dataset.attrs.get("history"):
+        stamp = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+        dataset = dataset.assign_attrs(history=f"{stamp} vibroimpact {__version__}: {dataset.attrs.get('title', 'dataset')} written")
+    with atomic_path(path) as temporary:
+        dataset.to_netcdf(temporary, engine="netcdf4", format="NETCDF4", encoding=encoding)
+    return path

@@ -1,0 +1,295 @@
+"""The study's chunked store (zarr): finished grid blocks and finished cases, written as they arrive, read back by a
+rerun so that nothing finished is computed twice.
+
+Layout of ``<out>/<name>.zarr`` (zarr format 2, which every zarr reader opens; format 3 has no specification yet for
+the fixed-width strings that some results hold):
+
+* the grid variables of a stepped study, with the grid's full dimensions (``solution``, ``restitution``,
+  ``clearance``, ``bumper_frequency``, ``sweep``, ``frequency``, and ``stop`` where a variable has one), chunked like
+  the grid's blocks, and ``block_done`` (one flag per block, set after every variable of the block is written, so a
+  block cut off half-way is computed again);
+* the group ``cases``: one group per finished case (``<engine>-<key>``), one array per result field, marked complete
+  after its arrays;
+* the attribute ``fingerprint``: the scene's text, the package version and its source; a store of another scene or
+  other code is started afresh rather than mixed.
+
+Only the process that runs the study writes the store (workers return their results to it), so a cluster needs no
+shared file system. :func:`claim_output` keeps a second study off the same output.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import fcntl
+import functools
+import hashlib
+import json
+import os
+import shutil
+import socket
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+import zarr
+from numpy.typing import NDArray
+from zarr.core.sync import sync  # zarr's own event loop, the one its synchronous API runs on
+
+from vibroimpact import __version__
+
+__all__ = ["source_hash", "case_key", "StudyStore", "OutputBusy", "claim_output", "store_fingerprint", "ZARR_FORMAT"]
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# A fingerprint of the code that computes: cache keys and datasets name the exact source they came from.
+# --------------------------------------------------------------------------------------------------------------------
+
+_PACKAGE = Path(__file__).resolve().parents[1]  # the vibroimpact package
+
+
+@functools.cache
+def source_hash() -> str:
+    """SHA-256 (hex) over the package's Python source files, their paths and contents, in a stable order.
+
+    Any edit of the code changes it, whatever the version number says, so results cached by older code are not reused.
+    """
+    digest = hashlib.sha256()
+    for path in sorted(_PACKAGE.rglob("*.py")):
+        digest.update(path.relative_to(_PACKAGE).as_posix().encode())
+        digest.update(b"\0")
+        digest.update(path.read_bytes())
+        digest.update(b"\0")
+    return digest.hexdigest()
+
+
+def case_key(content: dict[str, Any]) -> str:
+    """A stable 24-hex-digit key of ``content`` (JSON-serialisable), the package version and its source hash."""
+    text = json.dumps({"version": __version__, "source": source_hash(), "case": content}, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+ZARR_FORMAT = 2
+_CASES = "cases"
+_BLOCK_DONE = "block_done"
+#: Attributes whose values must keep the variable's own type (CF: flag_values of an int8 flag are int8).
+_TYPED_ATTRIBUTES = ("flag_values", "flag_masks", "valid_min", "valid_max", "valid_range")
+
+
+class OutputBusy(RuntimeError):
+    """Another study is writing the same output folder."""
+
+
+def store_fingerprint(scene_text: str) -> str:
+    """What a store's results depend on: the scene's text (but its ``cluster:`` section: where the work runs does not
+    change it), the package version and the package's source."""
+    import yaml
+
+    try:
+        document = yaml.safe_load(scene_text)
+    except yaml.YAMLError:
+        document = None
+    if isinstance(document, dict):
+        scene_text = yaml.safe_dump({key: value for key, value in document.items() if key != "cluster"}, sort_keys=True)
+    return hashlib.sha256(f"{__version__}\0{source_hash()}\0{scene_text}".encode()).hexdigest()[:24]
+
+
+@contextmanager
+def claim_output(out_dir: Path) -> Iterator[Path]:
+    """Hold an exclusive lock on ``out_dir/.run-study.lock`` while a study writes there.
+
+    The lock is the operating system's (``flock``): it goes with the process, so a run that was killed leaves nothing
+    to clean up, and two runs can never both hold it. The file says who holds it.
+
+    Raises
+    ------
+    OutputBusy
+        When another process holds it (its process id, host and start time are named).
+    """
+    lock = out_dir / ".run-study.lock"
+    while True:
+        handle = os.open(lock, os.O_CREAT | os.O_RDWR, 0o644)
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(handle)
+            owner = _lock_owner(lock)
+            who = f"process {owner[0]} on {owner[1]}, since {owner[2]}" if owner else "another process"
+            raise OutputBusy(f"{out_dir} is being written by another run-study ({who}); wait for it to finish or choose another --out") from None
+        try:
+            same = os.fstat(handle).st_ino == os.stat(lock).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            break
+        os.close(handle)  # the file was removed by its last holder between our open and our lock: take the new one
+    os.ftruncate(handle, 0)
+    os.write(handle, f"{os.getpid()} {socket.gethostname()} {time.strftime('%Y-%m-%dT%H:%M:%S')}\n".encode())
+    try:
+        yield lock
+    finally:
+        lock.unlink(missing_ok=True)  # while still locked: a waiting run then locks a removed file, sees it, retries
+        os.close(handle)
+
+
+def _lock_owner(lock: Path) -> tuple[int, str, str] | None:
+    try:
+        pid, host, since = lock.read_text().split()
+        return int(pid), host, since
+    except (OSError, ValueError):
+        return None
+
+
+class StudyStore:
+    """A zarr store of a study's finished work (module docstring); ``path=None`` keeps it in memory.
+
+    Parameters
+    ----------
+    path : Path or None
+        The store's folder (``<out>/<name>.zarr``), or None for an in-memory store (a study run from Python).
+    fingerprint : str
+        :func:`store_fingerprint` of the scene; a folder holding another fingerprint is emptied first.
+    """
+
+    def __init__(self, path: Path | None, fingerprint: str) -> None:
+        self.path = path
+        self.fingerprint = fingerprint
+        self.store: Any = str(path) if path is not None else zarr.storage.MemoryStore()
+        if path is not None and path.exists() and not self._matches():
+            shutil.rmtree(path)  # another scene or other code: its results are not ours
+        self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT)
+        if "fingerprint" not in self.root.attrs:
+            self.root.attrs["fingerprint"] = fingerprint
+        self._grid_ready = _BLOCK_DONE in self.root
+        self._arrays: dict[str, Any] = {}
+
+    def _matches(self) -> bool:
+        try:
+            group = zarr.open_group(str(self.path), mode="r", zarr_format=ZARR_FORMAT)
+        except (FileNotFoundError, ValueError, KeyError, zarr.errors.GroupNotFoundError):
+            return False
+        return group.attrs.get("fingerprint") == self.fingerprint
+
+    # -- cases -------------------------------------------------------------------------------------------------
+
+    def load_case(self, name: str, fields: tuple[str, ...]) -> dict[str, NDArray[np.generic]] | None:
+        """The stored result of the case called ``name``, or None if it is not (completely) stored."""
+        path = f"{_CASES}/{name}"
+        if path not in self.root:
+            return None
+        group = self.root[path]
+        if not group.attrs.get("complete") or not set(fields) <= set(group.array_keys()):
+            return None
+        return {field: np.asarray(group[field][...]) for field in fields}
+
+    def save_case(self, name: str, result: dict[str, NDArray[np.generic]]) -> None:
+        """Store a finished case's result; it counts as stored once every array is written."""
+        group = self.root.require_group(f"{_CASES}/{name}")
+        group.attrs["complete"] = False
+        for field, value in result.items():
+            array = np.asarray(value)
+            if array.dtype == object:
+                array = array.astype(str)  # text (notes, names): fixed-width strings
+            group.create_array(field, data=array, overwrite=True)  # scalars and empty arrays included
+        group.attrs["complete"] = True
+
+    def case_count(self) -> int:
+        """Finished cases in the store."""
+        if _CASES not in self.root:
+            return 0
+        return sum(1 for _name, group in self.root[_CASES].groups() if group.attrs.get("complete"))
+
+    # -- grid blocks -------------------------------------------------------------------------------------------
+
+    @property
+    def grid_ready(self) -> bool:
+        """Whether the grid's variables exist (the first finished block creates them)."""
+        return self._grid_ready
+
+    def begin_grid(self, template: xr.Dataset, block_count: int, plan: tuple[tuple[int, ...], tuple[int, ...]]) -> None:
+        """Create the grid's variables from ``template`` (lazy arrays with the grid's dimensions and chunks; nothing
+        is computed) and ``block_done``; ``plan`` (the grid's shape and a block's) is kept for a resumed run."""
+        encoding = {name: {"_FillValue": None} for name, variable in template.data_vars.items() if variable.dtype.kind in "iub"}
+        # the dataset's attributes become the group's: the fingerprint goes with them
+        template = template.assign_attrs(fingerprint=self.fingerprint, grid_shape=list(plan[0]), block_shape=list(plan[1]))
+        template.to_zarr(self.store, mode="a", compute=False, zarr_format=ZARR_FORMAT, encoding=encoding, consolidated=False)
+        self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT)
+        done = self.root.create_array(_BLOCK_DONE, shape=(block_count,), chunks=(1,), dtype="uint8", fill_value=0)
+        done.attrs["_ARRAY_DIMENSIONS"] = ["block"]
+        self._grid_ready = True
+
+    def grid_plan(self) -> tuple[tuple[int, ...], tuple[int, ...]] | None:
+        """The grid's shape and a block's, as the run that began the store planned them (None: not recorded)."""
+        attrs = self.root.attrs
+        if "grid_shape" not in attrs or "block_shape" not in attrs:
+            return None
+        return tuple(int(n) for n in attrs["grid_shape"]), tuple(int(n) for n in attrs["block_shape"])  # type: ignore[union-attr]
+
+    def finished_blocks(self) -> NDArray[np.bool_]:
+        """One flag per block: its results are stored."""
+        return np.asarray(self.root[_BLOCK_DONE][...], dtype=bool)
+
+    def write_block(self, index: int, region: dict[str, slice], block: dict[str, tuple[tuple[str, ...], NDArray[np.generic]]]) -> None:
+        """Write the variables of block ``index`` (name -> (dimensions, values)) into ``region`` (dimension ->
+        slice; unnamed dimensions whole), then flag the block done."""
+        writes = []
+        for name, (dims, values) in block.items():
+            array = self._array(name)
+            writes.append(array.async_array.setitem(tuple(region.get(dim, slice(None)) for dim in dims), values.astype(array.dtype, copy=False)))
+
+        async def write_all() -> None:
+            await asyncio.gather(*writes)
+
+        # one round trip to zarr's event loop for every variable of the block (one per variable costs 2.3x as much)
+        sync(write_all())
+        self._array(_BLOCK_DONE)[index] = 1
+
+    def _array(self, name: str) -> Any:
+        """The store's array ``name``, opened once."""
+        if name not in self._arrays:
+            self._arrays[name] = self.root[name]
+        return self._arrays[name]
+
+    def block_count(self) -> int:
+        """Finished blocks in the store."""
+        return int(self.finished_blocks().sum()) if self._grid_ready else 0
+
+    def grid_dataset(self) -> xr.Dataset:
+        """The grid's variables, lazily (dask arrays over the store's chunks), without ``block_done``."""
+        dataset = xr.open_zarr(self.store, consolidated=False, zarr_format=ZARR_FORMAT).drop_vars(_BLOCK_DONE)
+        dataset.attrs.clear()  # the fingerprint, and a kept store's attributes of its last run: the study sets its own
+        for variable in dataset.variables.values():
+            for key in _TYPED_ATTRIBUTES:
+                if key in variable.attrs and isinstance(variable.attrs[key], list):
+                    variable.attrs[key] = np.asarray(variable.attrs[key], dtype=variable.dtype)
+        return dataset
+
+    def keep(self, dataset: xr.Dataset) -> None:
+        """Finish a store that outlives its study: the coordinates of its dimensions (``frequency``, the swept
+        parameters, ``solution``) and the attributes of the study's ``dataset``, and consolidated metadata, so that
+        ``xarray.open_zarr(path)`` opens a labelled dataset at once."""
+        sizes: dict[str, int] = {}
+        for _name, array in self.root.arrays():
+            sizes.update(zip(array.attrs.get("_ARRAY_DIMENSIONS", ()), array.shape))
+        coords = {}
+        for dim, size in sizes.items():
+            if dim in dataset.coords and dim not in self.root:
+                values = np.atleast_1d(dataset[dim].values)
+                if values.size == size:
+                    coords[dim] = values.astype(str) if values.dtype == object else values
+        if coords:
+            xr.Dataset(coords=coords, attrs=dict(self.root.attrs)).to_zarr(self.store, mode="a", zarr_format=ZARR_FORMAT, consolidated=False)  # keeps the group's attributes
+            self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT)
+        attrs = dict(dataset.attrs)
+        self.root.attrs.update({key: value.tolist() if isinstance(value, np.ndarray) else value.item() if isinstance(value, np.generic) else value for key, value in attrs.items()})
+        zarr.consolidate_metadata(self.store, zarr_format=ZARR_FORMAT)
+
+    def remove(self) -> None:
+        """Delete the store (after its results are exported): renamed first, so that a removal cut off half-way
+        never leaves a store whose flags outlive its data."""
+        if self.path is not None and self.path.exists():
+            doomed = self.path.with_name(f".{self.path.name}.removed-{os.getpid()}")
+            os.replace(self.path, doomed)
+            shutil.rmtree(doomed, ignore_errors=True)

@@ -1,2 +1,0 @@
-"""A scene's grid run as cases (locally, resumable), gathered into one labelled dataset, written atomically; its cost
-estimated before it runs."""
