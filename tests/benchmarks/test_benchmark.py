@@ -15,7 +15,7 @@ from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.contact import Stop
 from vibroimpact import cli
 from vibroimpact.kinds.benchmark.study import _compare, equal_error_speedup, run_benchmark
-from vibroimpact.scene.schema import BenchmarkCase, BenchmarkSettings
+from vibroimpact.kinds.benchmark.scene import BenchmarkCase, BenchmarkSettings
 from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.engines.base import Trajectory
 from vibroimpact.model.system import TwoDofSystem
@@ -128,7 +128,7 @@ def test_accuracy_benchmark_with_compliant_and_swept_cases(system: TwoDofSystem)
     """Compliant methods are measured against CVODE Adams at rtol 1e-13, rigid ones against exact; X1 errors shrink
     with the tolerance; a swept case runs only the compliant model; the ladder ranks the models."""
     from vibroimpact.kinds.benchmark.study import loosest_tolerance
-    from vibroimpact.scene.schema import LadderSettings
+    from vibroimpact.kinds.benchmark.scene import LadderSettings
     from vibroimpact.model.excitation import SweptSine
 
     problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.2), HarmonicForce(PAPER_AMPLITUDE, 25.0))

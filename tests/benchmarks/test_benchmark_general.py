@@ -128,8 +128,8 @@ def test_the_frame_benchmark_measures_floor1_against_its_references(frame_run: x
         assert float(itself[name]) == 0.0, name  # exact: the reference's own run, repeated
     assert int(itself["impacts"]) == int(ds["reference_impacts"].sel(case="two_impact", reference="compliant_cvode_adams")) >= 14  # two per period
     scene = parse_scene(frame_benchmark())
-    assert scene.benchmark is not None
-    problem = scene.benchmark.cases[0].problem
+    assert scene.settings is not None
+    problem = scene.settings.cases[0].problem
     closed = float(np.abs(solve_impact_orbit(problem).harmonics()[0]))
     assert float(ds["reference_floor1"].sel(case="two_impact", reference="exact")) == pytest.approx(closed, rel=1e-7)
     momentary = ds.sel(case="two_impact", engine="momentary_adams", rtol=1e-6)
@@ -197,8 +197,8 @@ def test_a_case_on_a_layout_without_closed_form_starts_linear() -> None:
     document = frame_benchmark()
     document["stops"].append({"coordinate": "floor1", "side": "upper", "clearance": 0.05, "restitution": 0.5})
     three = parse_scene(document)
-    assert two.benchmark is not None and three.benchmark is not None
-    orbit, fallback = two.benchmark.cases[0].problem, three.benchmark.cases[0].problem
+    assert two.settings is not None and three.settings is not None
+    orbit, fallback = two.settings.cases[0].problem, three.settings.cases[0].problem
     assert closed_form_refusal(orbit) is None and closed_form_refusal(fallback) is not None
     assert start_state(orbit, "pgf")[0] > 0.0
     t0, state = start_state(fallback, "pgf")

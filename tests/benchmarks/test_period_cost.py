@@ -14,7 +14,7 @@ from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.scene.schema import BenchmarkCase, BenchmarkSettings
+from vibroimpact.kinds.benchmark.scene import BenchmarkCase, BenchmarkSettings
 from vibroimpact.scene.variables import BENCHMARK_ATTRIBUTES
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE

@@ -14,7 +14,7 @@ from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.kinds.benchmark.page import AccuracyPage, accuracy_tables, per_period_table
-from vibroimpact.scene.schema import BenchmarkCase, BenchmarkSettings
+from vibroimpact.kinds.benchmark.scene import BenchmarkCase, BenchmarkSettings
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
 from tests.reporting.test_report_support import benchmark_dataset

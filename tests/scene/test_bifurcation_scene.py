@@ -34,7 +34,7 @@ def problems(doc: dict[str, Any]) -> list[str]:
 def test_the_shipped_study_is_a_bifurcation_scene() -> None:
     scene = load_scene(find_scene("bifurcation"))
     assert scene.kind == "bifurcation"
-    settings = scene.bifurcation
+    settings = scene.settings
     assert (settings.low, settings.high) == (15.0, 45.0) and settings.restitution == (0.2, 0.8)
     assert scene.frequency.size == 601 and scene.frequency[-1] == pytest.approx(45.0)
     assert settings.chart is not None and settings.chart.restitution == 0.2 and float(scene.clearance[0]) == pytest.approx(3e-3)  # exact: parsed inputs
@@ -42,8 +42,8 @@ def test_the_shipped_study_is_a_bifurcation_scene() -> None:
 
 def test_a_small_scene_parses_with_defaults() -> None:
     scene = parse_scene(document())
-    assert scene.kind == "bifurcation" and scene.bifurcation.chart is None
-    assert scene.bifurcation.brute_force.directions == ("up", "down") and scene.frequency.size == 15
+    assert scene.kind == "bifurcation" and scene.settings.chart is None
+    assert scene.settings.brute_force.directions == ("up", "down") and scene.frequency.size == 15
 
 
 @pytest.mark.parametrize(
@@ -103,7 +103,7 @@ RELATIVE_PAIR = [{"between": ["x2", "x1"], "side": "upper", "clearance": 0.003},
 
 def test_the_shipped_relative_stop_study_is_a_general_bifurcation_scene() -> None:
     scene = load_scene(find_scene("bifurcation_relative_stop"))
-    assert scene.kind == "bifurcation" and scene.general and scene.bifurcation.restitution == (0.2,)
+    assert scene.kind == "bifurcation" and scene.general and scene.settings.restitution == (0.2,)
     assert [(s.coordinate, s.other, s.side) for s in scene.stops] == [(1, 0, "upper"), (1, 0, "lower")]
     assert float(scene.clearance[0]) == pytest.approx(3e-3) and scene.load.weights == (1.0, 0.0)
 
@@ -112,9 +112,9 @@ def test_the_general_form_takes_its_restitution_from_the_stops_or_the_diagrams()
     doc = general([{"coordinate": "x2", "clearance": 0.003, "restitution": 0.5}])
     del doc["bifurcation"]["restitution"]
     from_stops = parse_scene(doc)
-    assert from_stops.bifurcation.restitution == (0.5,) and from_stops.stops[0].restitution is None  # the study's value
+    assert from_stops.settings.restitution == (0.5,) and from_stops.stops[0].restitution is None  # the study's value
     from_diagrams = parse_scene(general(RELATIVE_PAIR, restitution=[0.2, 0.6]))
-    assert from_diagrams.bifurcation.restitution == (0.2, 0.6) and len(from_diagrams.stops) == 2
+    assert from_diagrams.settings.restitution == (0.2, 0.6) and len(from_diagrams.stops) == 2
     differ = general([{"coordinate": "x2", "clearance": 0.003, "restitution": 0.2}, {"coordinate": "x1", "clearance": 0.003, "restitution": 0.5}])
     del differ["bifurcation"]["restitution"]
     assert any(p.startswith("stops[1].restitution:") and "differs" in p for p in problems(differ))

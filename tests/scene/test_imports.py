@@ -82,7 +82,7 @@ def test_engine_names_come_from_the_registry() -> None:
     from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 
     assert set(ENGINE_SOLUTIONS) <= set(engine_names())
-    shipped = load_scene(shipped_studies_dir() / "accuracy_cost.yaml").benchmark
+    shipped = load_scene(shipped_studies_dir() / "accuracy_cost.yaml").settings
     assert shipped is not None and set(shipped.settings.methods) <= set(engine_names())
     case = {"name": "a", "frequency": 25.0, "restitution": 0.2, "clearance": 0.003, "start": "pgf"}
     document = {"name": "b", "system": {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0}, "excitation": {"amplitude": 10.0}, "benchmark": {"duration": 1.0, "methods": ["solve_ivp_BDF", "exact"], "tolerances": [1e-6], "cases": [case]}}

@@ -597,8 +597,8 @@ def test_simulation_without_engine_solutions_is_an_error() -> None:
 
 def test_shipped_engine_cost_scene_parses() -> None:
     scene = load_scene(shipped_studies_dir() / "engine_cost.yaml")
-    assert scene.benchmark is not None and len(scene.benchmark.cases) == 4
-    assert scene.benchmark.settings.tolerances[0] > scene.benchmark.settings.tolerances[-1]  # loose to tight
+    assert scene.settings is not None and len(scene.settings.cases) == 4
+    assert scene.settings.settings.tolerances[0] > scene.settings.settings.tolerances[-1]  # loose to tight
 
 
 @pytest.mark.parametrize(

@@ -94,7 +94,7 @@ def test_the_bumpers_and_the_branches(dataset: xr.Dataset) -> None:
 
 def test_the_estimate_is_a_few_minutes_at_most() -> None:
     class Scene:
-        concepts = parse_concepts(copy.deepcopy(DOCUMENT))[3]
+        settings = parse_concepts(copy.deepcopy(DOCUMENT))[3]
 
     estimate = ConceptsStudy().estimate(Scene(), 2, costs=None)  # type: ignore[arg-type]
     assert 0.0 < estimate.wall_time < 60.0

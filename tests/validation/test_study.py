@@ -51,7 +51,7 @@ def test_every_shipped_scene_is_a_validation_scene() -> None:
 
     for path in sorted(STUDIES.glob("*.yaml")):
         scene = load_scene(path)
-        assert scene.kind == "validation" and scene.validation is not None and scene.validation.name in path.stem
+        assert scene.kind == "validation" and scene.settings is not None and scene.settings.name in path.stem
 
 
 @pytest.mark.skipif(not REGISTERED, reason="the kind 'validation' is not registered yet (scene/schema.py, reader, study/kinds.py, reporting/report.py)")

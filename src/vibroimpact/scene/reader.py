@@ -73,7 +73,11 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
         what = "an empty document" if document is None else f"a {type(document).__name__}"
         sections = ", ".join(kind.section for kind in KINDS if kind.section)
         raise SceneError([f"scene: expected a mapping of a scene's sections (name, system, excitation, ...; a kind's own: {sections}), got {what}"], source)
-    return kind_of_document(document).parse_scene(document, text, source)
+    kind = kind_of_document(document)
+    scene: Scene = kind.parse_scene(document, text, source)
+    if scene.kind != kind.name:  # a parser that names another kind than its row: a broken table, not a user error
+        raise RuntimeError(f"the scene parser of kind {kind.name!r} ({kind.scene}) made a scene of kind {scene.kind!r}")
+    return scene
 
 
 def load_scene(path: str | Path) -> Scene:

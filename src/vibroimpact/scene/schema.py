@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 
@@ -21,24 +21,15 @@ from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.scene.kinds import KINDS
+from vibroimpact.scene.kinds import KIND_NAMES
 from vibroimpact.scene.layout import LoadSpec, StopSpec
 from vibroimpact.scene.variables import MOTION_QUANTITIES, QUANTITIES, STOP_QUANTITIES, quantities_for
 from vibroimpact.simulation.settings import START_MODES, SWEEP_STARTS, SteadySettings
-
-if TYPE_CHECKING:
-    from vibroimpact.kinds.bifurcation.scene import BifurcationSettings
-    from vibroimpact.kinds.concepts.scene import ConceptsSettings
-    from vibroimpact.kinds.validation.settings import ValidationSettings
 
 __all__ = [
     "Scene",
     "SimulationSettings",
     "SweptSineSettings",
-    "BenchmarkScene",
-    "BenchmarkCase",
-    "BenchmarkSettings",
-    "LadderSettings",
     "SOLUTIONS",
     "ENGINE_SOLUTIONS",
     "ENGINE_CONTACT",
@@ -146,124 +137,6 @@ class SweptSineSettings:
         return SweptSine(amplitude, low, high, self.rate) if direction == "up" else SweptSine(amplitude, high, low, self.rate)
 
 
-@dataclass(frozen=True)
-class LadderSettings:
-    """One frequency point through every model, from the closed form to ever stiffer bumpers.
-
-    Attributes
-    ----------
-    frequency : float
-        Excitation frequency [Hz].
-    restitution : float
-        R [-] (the bumpers get the loss factor that gives it).
-    clearance : float
-        Delta [m].
-    bumper_frequencies : tuple of float
-        Omega_b / 2 pi of the compliant models [Hz].
-    rtol : float
-        Tolerance of the integrators (atol = rtol x the scene's atol_ratio); default: that of stepped steady states.
-    repeats : int
-        Runs per model (median wall time).
-    problem : ImpactProblem
-        The scene's structure, load and rigid stops at this point (the stops' own values where they give them; NaN
-        ``restitution``, ``clearance`` where every stop does); required.
-    compliant : tuple of tuple of Stop
-        The same stops as bumpers, one layout per bumper frequency (loss factors from each stop's restitution).
-    """
-
-    frequency: float
-    restitution: float
-    clearance: float
-    bumper_frequencies: tuple[float, ...]
-    rtol: float = STEPPED_TOLERANCES[0]
-    repeats: int = 3
-    problem: ImpactProblem | None = None
-    compliant: tuple[tuple[Stop, ...], ...] = ()
-
-    def __post_init__(self) -> None:
-        if self.problem is None:
-            raise ValueError("problem: the ladder needs its structure, load and rigid stops (an ImpactProblem)")
-        if len(self.compliant) != len(self.bumper_frequencies):
-            raise ValueError(f"compliant: expected one bumper layout per bumper frequency ({len(self.bumper_frequencies)}), got {len(self.compliant)}")
-
-
-@dataclass(frozen=True)
-class BenchmarkCase:
-    """One benchmark run: the problem, where it starts and how long it lasts.
-
-    Attributes
-    ----------
-    name : str
-        Label of the case.
-    problem : ImpactProblem
-        Structure, rigid stops and harmonic load (a swept case: at its start frequency), for the rigid-stop methods
-        and the start of every stepped run.
-    start : str
-        ``rest``, ``linear`` or ``pgf`` (see :func:`vibroimpact.simulation.steady.start_state`: ``pgf`` is the closed-form
-        orbit where the layout has one, else the linear start); swept cases start at rest.
-    periods : int
-        Whole periods integrated (stepped cases).
-    bumper : tuple of Stop or None
-        The compliant model's stops, the rigid ones as Kelvin-Voigt bumpers (each loss factor gives its stop's
-        restitution); None: no compliant methods.
-    sweep : SweptSine or None
-        A swept-sine case of the compliant model.
-    sample_rate : float
-        Output samples per second of a swept case [Hz].
-    """
-
-    name: str
-    problem: ImpactProblem
-    start: str
-    periods: int
-    bumper: tuple[Stop, ...] | None = None
-    sweep: SweptSine | None = None
-    sample_rate: float = 2000.0
-
-    def runs(self, method: str) -> bool:
-        """Whether ``method`` applies to this case."""
-        contact = engine_spec(method).contact
-        if self.sweep is not None:
-            return contact == BUMPER or method.startswith("solve_ivp_")
-        return contact == RIGID or (contact == BUMPER and self.bumper is not None)
-
-
-@dataclass(frozen=True)
-class BenchmarkSettings:
-    """What to compare.
-
-    Attributes
-    ----------
-    methods : tuple of str
-        Names of :data:`BENCHMARK_METHODS`.
-    tolerances : tuple of float
-        Relative tolerances; atol = rtol * ``atol_ratio`` [m, m s-1].
-    atol_ratio : float
-        Absolute tolerance per unit of relative tolerance [m].
-    repeats : int
-        Runs per point (median wall time).
-    max_seconds : float
-        The largest run time allowed: tighter tolerances of a method are skipped once a run took longer [s].
-    ladder : LadderSettings or None
-        The model-cost ladder to measure as well.
-    """
-
-    methods: tuple[str, ...]
-    tolerances: tuple[float, ...]
-    atol_ratio: float = ATOL_RATIO
-    repeats: int = 3
-    max_seconds: float = 60.0
-    ladder: LadderSettings | None = None
-
-
-@dataclass(frozen=True, eq=False)
-class BenchmarkScene:
-    """A benchmark scene's cases and settings (run by :mod:`vibroimpact.kinds.benchmark.study`)."""
-
-    cases: tuple[BenchmarkCase, ...]
-    settings: BenchmarkSettings
-
-
 @dataclass(frozen=True, eq=False)
 class Scene:
     """A validated scene.
@@ -301,8 +174,6 @@ class Scene:
         holds R(xi_b), eq. 26 corrected); None: each restitution's own loss factor (the exact inverse of R(xi_b)).
     swept_sine : SweptSineSettings or None
         When given, the time-domain solutions are swept-sine tests, not stepped steady states.
-    bifurcation : BifurcationSettings or None
-        When given, a bifurcation study (:mod:`vibroimpact.kinds.bifurcation.scene`): brute force, branches, chart.
     report : bool or str
         Whether ``run-study`` writes the comparison report; a string names the page (``design_map``).
     text : str
@@ -318,6 +189,13 @@ class Scene:
     general : bool
         The scene uses the general format (matrices, a load beyond a force on the primary mass, or ``stops``): its
         outputs are named after its coordinates and stops. False: the paper's named form and outputs.
+    kind : str
+        The kind of study (a name of :data:`vibroimpact.scene.kinds.KINDS`), set by the kind's scene parser: the row
+        of the table whose section the document has.
+    settings : object or None
+        The kind's own frozen settings, built by its parser (``BenchmarkScene``, ``BifurcationSettings``,
+        ``ValidationSettings``, ``ConceptsSettings``); None for stepped and swept scenes, whose settings are the
+        grid fields above.
     """
 
     name: str
@@ -332,13 +210,9 @@ class Scene:
     quantities: tuple[str, ...]
     admissibility: AdmissibilitySettings = field(default_factory=AdmissibilitySettings)
     simulation: SimulationSettings | None = None
-    benchmark: BenchmarkScene | None = None
     bumper_frequency: np.ndarray | None = None
     bumper_loss_factor: np.ndarray | None = None
     swept_sine: SweptSineSettings | None = None
-    bifurcation: "BifurcationSettings | None" = None
-    validation: "ValidationSettings | None" = None
-    concepts: "ConceptsSettings | None" = None
     report: bool | str = True
     text: str = ""
     load: LoadSpec | None = None
@@ -346,6 +220,14 @@ class Scene:
     sweep_stops: tuple[int, ...] | None = None
     general: bool = False
     cluster_scheduler: str | None = None
+    kind: str = "stepped"
+    settings: Any = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in KIND_NAMES:
+            raise ValueError(f"kind must be one of {', '.join(KIND_NAMES)}, got {self.kind!r}")
+        if (self.settings is None) != (self.kind in ("stepped", "swept")):
+            raise ValueError(f"settings: a {self.kind} scene {'has' if self.settings is None else 'takes'} no settings of its kind")
 
     @property
     def coordinates(self) -> tuple[str, ...]:
@@ -367,16 +249,6 @@ class Scene:
         if self.bumper_loss_factor is not None:
             return np.broadcast_to(self.bumper_loss_factor, self.restitution.shape).astype(float)
         return np.array([loss_factor_from_restitution(r) if r > 0.0 else np.nan for r in self.restitution])
-
-    @property
-    def kind(self) -> str:
-        """What kind of study the scene is: ``concepts`` (absorber concepts side by side), ``validation`` (a published
-        closed form), ``benchmark``, ``bifurcation``,
-        ``swept`` (swept-sine tests) or ``stepped`` (steady states).
-
-        The one place that decides it; everything else dispatches on this name.
-        """
-        return next(kind.name for kind in KINDS if kind.section is None or getattr(self, kind.section) is not None)
 
     @property
     def sweep_directions(self) -> tuple[str, ...]:

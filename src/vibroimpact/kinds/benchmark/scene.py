@@ -25,12 +25,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from vibroimpact.analysis.linear import linear_amplitudes
-from vibroimpact.engines.settings import STEPPED_TOLERANCES
+from vibroimpact.engines.registry import BUMPER, RIGID, engine_spec
+from vibroimpact.engines.settings import ATOL_RATIO, STEPPED_TOLERANCES
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem, Structure
 from vibroimpact.model.contact import Stop
@@ -41,21 +43,136 @@ from vibroimpact.scene.schema import (
     BENCHMARK_METHODS,
     MAX_BENCHMARK_PERIODS,
     MAX_BUMPER_FREQUENCY,
-    BenchmarkCase,
-    BenchmarkScene,
-    BenchmarkSettings,
-    LadderSettings,
     Scene,
 )
 from vibroimpact.kinds.stepped.scene import NAME, check_sweep_run, parse_names
 from vibroimpact.simulation.settings import START_MODES
 
-__all__ = ["BENCHMARK_TOP_KEYS", "parse_benchmark_scene"]
+__all__ = ["BenchmarkScene", "BenchmarkCase", "BenchmarkSettings", "LadderSettings", "BENCHMARK_TOP_KEYS", "parse_benchmark_scene"]
 
 #: Top-level keys of a benchmark scene.
 BENCHMARK_TOP_KEYS = {"name", "description", "system", "excitation", "stops", "benchmark", "report"}
 _BENCHMARK_KEYS = {"duration", "methods", "tolerances", "atol_ratio", "repeats", "max_seconds", "cases", "ladder"}
 _BENCHMARK_CASE_KEYS = {"name", "frequency", "restitution", "clearance", "clearance_below_linear", "start", "bumper_frequency", "swept_sine"}
+
+
+@dataclass(frozen=True)
+class LadderSettings:
+    """One frequency point through every model, from the closed form to ever stiffer bumpers.
+
+    Attributes
+    ----------
+    frequency : float
+        Excitation frequency [Hz].
+    restitution : float
+        R [-] (the bumpers get the loss factor that gives it).
+    clearance : float
+        Delta [m].
+    bumper_frequencies : tuple of float
+        Omega_b / 2 pi of the compliant models [Hz].
+    rtol : float
+        Tolerance of the integrators (atol = rtol x the scene's atol_ratio); default: that of stepped steady states.
+    repeats : int
+        Runs per model (median wall time).
+    problem : ImpactProblem
+        The scene's structure, load and rigid stops at this point (the stops' own values where they give them; NaN
+        ``restitution``, ``clearance`` where every stop does); required.
+    compliant : tuple of tuple of Stop
+        The same stops as bumpers, one layout per bumper frequency (loss factors from each stop's restitution).
+    """
+
+    frequency: float
+    restitution: float
+    clearance: float
+    bumper_frequencies: tuple[float, ...]
+    rtol: float = STEPPED_TOLERANCES[0]
+    repeats: int = 3
+    problem: ImpactProblem | None = None
+    compliant: tuple[tuple[Stop, ...], ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.problem is None:
+            raise ValueError("problem: the ladder needs its structure, load and rigid stops (an ImpactProblem)")
+        if len(self.compliant) != len(self.bumper_frequencies):
+            raise ValueError(f"compliant: expected one bumper layout per bumper frequency ({len(self.bumper_frequencies)}), got {len(self.compliant)}")
+
+
+@dataclass(frozen=True)
+class BenchmarkCase:
+    """One benchmark run: the problem, where it starts and how long it lasts.
+
+    Attributes
+    ----------
+    name : str
+        Label of the case.
+    problem : ImpactProblem
+        Structure, rigid stops and harmonic load (a swept case: at its start frequency), for the rigid-stop methods
+        and the start of every stepped run.
+    start : str
+        ``rest``, ``linear`` or ``pgf`` (see :func:`vibroimpact.simulation.steady.start_state`: ``pgf`` is the closed-form
+        orbit where the layout has one, else the linear start); swept cases start at rest.
+    periods : int
+        Whole periods integrated (stepped cases).
+    bumper : tuple of Stop or None
+        The compliant model's stops, the rigid ones as Kelvin-Voigt bumpers (each loss factor gives its stop's
+        restitution); None: no compliant methods.
+    sweep : SweptSine or None
+        A swept-sine case of the compliant model.
+    sample_rate : float
+        Output samples per second of a swept case [Hz].
+    """
+
+    name: str
+    problem: ImpactProblem
+    start: str
+    periods: int
+    bumper: tuple[Stop, ...] | None = None
+    sweep: SweptSine | None = None
+    sample_rate: float = 2000.0
+
+    def runs(self, method: str) -> bool:
+        """Whether ``method`` applies to this case."""
+        contact = engine_spec(method).contact
+        if self.sweep is not None:
+            return contact == BUMPER or method.startswith("solve_ivp_")
+        return contact == RIGID or (contact == BUMPER and self.bumper is not None)
+
+
+@dataclass(frozen=True)
+class BenchmarkSettings:
+    """What to compare.
+
+    Attributes
+    ----------
+    methods : tuple of str
+        Names of :data:`BENCHMARK_METHODS`.
+    tolerances : tuple of float
+        Relative tolerances; atol = rtol * ``atol_ratio`` [m, m s-1].
+    atol_ratio : float
+        Absolute tolerance per unit of relative tolerance [m].
+    repeats : int
+        Runs per point (median wall time).
+    max_seconds : float
+        The largest run time allowed: tighter tolerances of a method are skipped once a run took longer [s].
+    ladder : LadderSettings or None
+        The model-cost ladder to measure as well.
+    """
+
+    methods: tuple[str, ...]
+    tolerances: tuple[float, ...]
+    atol_ratio: float = ATOL_RATIO
+    repeats: int = 3
+    max_seconds: float = 60.0
+    ladder: LadderSettings | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class BenchmarkScene:
+    """A benchmark scene's cases and settings (run by :mod:`vibroimpact.kinds.benchmark.study`)."""
+
+    cases: tuple[BenchmarkCase, ...]
+    settings: BenchmarkSettings
+
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -128,7 +245,8 @@ def parse_benchmark_scene(document: dict, text: str = "", source: str = "scene")
         swept=(),
         solutions=(),
         quantities=(),
-        benchmark=BenchmarkScene(tuple(cases), settings),
+        kind="benchmark",
+        settings=BenchmarkScene(tuple(cases), settings),
         report=report,
         text=text,
         load=load,

@@ -28,7 +28,8 @@ from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.run import provenance
 from vibroimpact.runs.runner import Runner
-from vibroimpact.scene.schema import BenchmarkCase, BenchmarkSettings, LadderSettings, Scene
+from vibroimpact.kinds.benchmark.scene import BenchmarkCase, BenchmarkSettings, LadderSettings
+from vibroimpact.scene.schema import Scene
 from vibroimpact.scene.variables import BENCHMARK_ATTRIBUTES, LADDER_ATTRIBUTES
 from vibroimpact.simulation.harmonics import measure, running_fundamental
 from vibroimpact.simulation.steady import start_state
@@ -411,8 +412,8 @@ class BenchmarkStudy:
     def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """Every method at every tolerance on every case, in this process (timings are compared with each other:
         ``runner`` is not used)."""
-        assert scene.benchmark is not None
-        dataset = run_benchmark(list(scene.benchmark.cases), scene.benchmark.settings, progress=progress is not None)
+        assert scene.settings is not None
+        dataset = run_benchmark(list(scene.settings.cases), scene.settings.settings, progress=progress is not None)
         dataset.attrs.update({"title": f"vibroimpact benchmark '{scene.name}'", "scene_name": scene.name, "scene": scene.text} | provenance())
         if scene.general:
             dataset.attrs.update(layout_attributes(scene) | {"excitation_amplitude_N": scene.amplitude})
@@ -422,8 +423,8 @@ class BenchmarkStudy:
         """Every method at every tolerance (loose to tight), repeated unless a run is slow, and no tighter tolerance
         after a run over the scene's time limit, as :func:`vibroimpact.kinds.benchmark.study.run_benchmark` does; on the
         calibration machine, scaled for a general layout's coordinates and stops."""
-        assert scene.benchmark is not None
-        bench = scene.benchmark
+        assert scene.settings is not None
+        bench = scene.settings
         scale = engine_scale(scene)
         total = 0.0
         for case in bench.cases:

@@ -69,7 +69,7 @@ def scene_problem(scene: Scene, restitution: float, clearance: float | None = No
     """The general problem of a bifurcation scene: its structure (the named system's matrices for the paper's form),
     every stop rigid with ``restitution`` [-] and the scene's clearance (or ``clearance`` [m]), and its harmonic load
     at the band's lower frequency (each part of the study moves it in frequency)."""
-    settings = scene.bifurcation
+    settings = scene.settings
     assert settings is not None
     delta = float(scene.clearance[0]) if clearance is None else float(clearance)
     stops = build_stops(scene.stop_specs, False, float(restitution), delta)
@@ -83,7 +83,7 @@ class BifurcationStudy:
 
     def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """The study's dataset (module docstring); ``progress`` gets a line per stage and per branch set."""
-        settings = scene.bifurcation
+        settings = scene.settings
         assert settings is not None
         say = progress if progress is not None else (lambda message: None)
         delta = float(scene.clearance[0])
@@ -131,7 +131,7 @@ class BifurcationStudy:
     def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:
         """Brute-force periods times the cost of an ``exact`` period, plus measured continuation times, on the
         calibration machine; the sweeps and the continuations are spread over ``jobs`` processes."""
-        settings = scene.bifurcation
+        settings = scene.settings
         assert settings is not None
         brute = settings.brute_force
         per_period = costs.per_period_cost("exact", 0.0) * BRUTE_FACTOR
@@ -222,7 +222,7 @@ def _branches(results: list[CaseResult], restitutions: tuple[float, ...], coordi
 
 def _brute(results: list[CaseResult], scene: Scene, directions: tuple[str, ...], strobes: int) -> xr.Dataset:
     """Brute-force variables over (restitution, sweep, frequency[, strobe | impact])."""
-    settings = scene.bifurcation
+    settings = scene.settings
     assert settings is not None
     shape = (len(settings.restitution), len(directions))
 
@@ -281,7 +281,7 @@ def _regime_flags(long_name: str) -> dict[str, object]:
 
 
 def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult]) -> dict[str, object]:
-    settings = scene.bifurcation
+    settings = scene.settings
     assert settings is not None
     attrs: dict[str, object] = {
         "title": f"vibroimpact bifurcation study '{scene.name}'",

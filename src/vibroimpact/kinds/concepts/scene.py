@@ -196,7 +196,7 @@ def parse_concepts_scene(document: Any, text: str = "", source: str = "scene") -
     return Scene(
         name=name, description=description, system=settings.system, amplitude=settings.amplitude, frequency=settings.frequency,
         restitution=np.array([np.nan]), clearance=np.array([np.nan]), swept=("frequency",), solutions=(), quantities=(),
-        concepts=settings, report=report, text=text,  # type: ignore[call-arg]
+        kind="concepts", settings=settings, report=report, text=text,
     )  # fmt: skip
 
 

@@ -318,14 +318,14 @@ class ConceptsStudy:
         """The scene's dataset, with its name, text and provenance."""
         from vibroimpact.runs.run import provenance
 
-        dataset = run_concepts(scene.concepts, progress, runner)
+        dataset = run_concepts(scene.settings, progress, runner)
         dataset.attrs.update({"title": f"vibroimpact absorber concepts '{scene.name}'", "scene_name": scene.name, "scene": scene.text} | provenance())
         return dataset
 
     def estimate(self, scene: Any, jobs: int, costs: Costs) -> Estimate:
         """Predicted wall time and memory on the calibration machine, from this kind's own measured costs per point
         (:data:`SECONDS_PER_POINT`, :data:`SECONDS_PER_BRANCH_CASE`; ``costs`` has none for it)."""
-        settings: ConceptsSettings = scene.concepts
+        settings: ConceptsSettings = scene.settings
         stopped = sum(1 for c in settings.concepts if c.stops)
         points = stopped * settings.simulation_frequency.size
         simulations = points * SECONDS_PER_POINT * (1.0 if math.isfinite(settings.bumper_frequency) else 0.1)

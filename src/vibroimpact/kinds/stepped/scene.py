@@ -175,7 +175,7 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
         name=name, description=description, system=system, amplitude=amplitude,
         frequency=frequency, restitution=restitution, clearance=clearance, swept=swept,
         solutions=solutions, quantities=quantities, admissibility=admissibility, simulation=simulation,
-        bumper_frequency=grids.get("bumper_frequency"), bumper_loss_factor=grids.get("bumper_loss_factor"), swept_sine=swept_sine,
+        bumper_frequency=grids.get("bumper_frequency"), bumper_loss_factor=grids.get("bumper_loss_factor"), swept_sine=swept_sine, kind="stepped" if swept_sine is None else "swept",
         report=report, text=text, load=load, stops=specs if "stops" in doc and specs is not None else (), sweep_stops=targets, general=general,
         cluster_scheduler=scheduler,
     )

@@ -227,7 +227,7 @@ def parse_validation_scene(document: Any, text: str = "", source: str = "scene")
     restitution = float(case.restitution)
     clearance = getattr(case, "clearance", 0.0)
     clearance = float(np.mean(clearance)) if isinstance(clearance, tuple) else float(clearance)
-    return Scene(  # type: ignore[call-arg]
+    return Scene(
         name=checked.name,
         description=checked.description,
         system=case_structure(case),
@@ -238,7 +238,8 @@ def parse_validation_scene(document: Any, text: str = "", source: str = "scene")
         swept=(),
         solutions=(),
         quantities=(),
-        validation=checked.settings,
+        kind="validation",
+        settings=checked.settings,
         report=checked.report,
         text=text,
     )

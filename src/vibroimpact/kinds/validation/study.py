@@ -299,10 +299,10 @@ class ValidationStudy:
 
     def run(self, scene, progress: Callable[[str], None] | None, runner: Runner) -> xr.Dataset:
         """The scene's dataset (module docstring); one process (each case takes seconds)."""
-        return run_validation(scene.validation, scene.name, scene.text, progress)
+        return run_validation(scene.settings, scene.name, scene.text, progress)
 
     def estimate(self, scene, jobs: int, costs: Costs) -> Estimate:
         """The case's measured time plus the report, on the calibration machine."""
-        work = CASE_SECONDS[scene.validation.name]
+        work = CASE_SECONDS[scene.settings.name]
         report = costs.report_base + REPORT_FIGURES * costs.report_per_figure
-        return Estimate(wall_time=costs.startup + work + report, memory=costs.main_process_memory, parts={scene.validation.name: work, "report": report})
+        return Estimate(wall_time=costs.startup + work + report, memory=costs.main_process_memory, parts={scene.settings.name: work, "report": report})
