@@ -77,6 +77,7 @@ def test_the_comparison_sees_every_regime(pair: tuple[xr.Dataset, xr.Dataset]) -
     assert np.count_nonzero(np.isfinite(simulated)) == 3
 
 
+@pytest.mark.slow  # 13 s: both pages drawn; the golden suite holds every shipped page's text
 def test_same_page(pair: tuple[xr.Dataset, xr.Dataset], tmp_path: Path) -> None:
     """The same page, chosen by what the dataset holds: its text (headings, paragraphs, captions, table cells) is
     the same line for line."""
