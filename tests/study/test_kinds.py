@@ -50,3 +50,27 @@ def test_a_row_names_modules_of_the_kinds_package() -> None:
         Kind("x", "x", "vibroimpact.kinds.x.scene:parse", "vibroimpact.runs.run:run_study", "vibroimpact.kinds.x.page:page_for")
     with pytest.raises(KeyError, match="stepped"):
         kind_named("nonsense")
+
+
+@pytest.mark.parametrize(
+    ("extra", "kind", "owner"),
+    [
+        ({"sweep": {}}, "bifurcation", None),
+        ({"simulation": {}}, "bifurcation", None),
+        ({"concepts_typo": {}}, "bifurcation", None),
+    ],
+)
+def test_a_key_the_kind_does_not_use_is_an_error_naming_the_kind(extra: dict, kind: str, owner: str | None) -> None:
+    document = {"name": "s", "system": {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0}, "excitation": {"amplitude": 10.0}, "stop": {"clearance": 0.003},
+                "bifurcation": {"restitution": [0.2], "frequency": {"start": 20.0, "stop": 30.0}}} | extra  # fmt: skip
+    with pytest.raises(SceneError) as caught:
+        parse_scene(document)
+    key = next(iter(extra))
+    assert f"{key}: unknown key: a {kind} scene does not use it (allowed: " in "\n".join(caught.value.problems)
+
+
+def test_another_kinds_section_is_named_as_such() -> None:
+    document = {"name": "v", "validation": {"case": "zeno"}, "concepts": {}}  # concepts comes first in the table
+    with pytest.raises(SceneError) as caught:
+        parse_scene(document)
+    assert any(p.startswith("validation: unknown key: a concepts scene does not use it; it is the section of a validation scene") for p in caught.value.problems)

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from vibroimpact.scene.kinds import KINDS
 from vibroimpact.scene.schema import MAX_GRID_POINTS
 
 __all__ = ["SceneError", "Checker", "interval"]
@@ -42,13 +43,20 @@ class Checker:
         """Record the problem ``message`` of ``key``."""
         self.problems.append(f"{key}: {message}")
 
-    def mapping(self, key: str, value: Any, allowed: set[str], required: frozenset[str] | set[str] = frozenset()) -> dict:
-        """``value`` as a mapping (``{}`` if it is none), reporting unknown and missing keys."""
+    def mapping(self, key: str, value: Any, allowed: set[str], required: frozenset[str] | set[str] = frozenset(), kind: str | None = None) -> dict:
+        """``value`` as a mapping (``{}`` if it is none), reporting unknown and missing keys; ``kind`` names the kind of
+        scene whose top level ``value`` is, so that a key it does not use is an error naming the kind (and the kind
+        whose section it is, if it is one)."""
         if not isinstance(value, dict):
             self.fail(key, f"expected a mapping with keys {sorted(allowed)}, got {type(value).__name__}")
             return {}
         for unknown in sorted(set(map(str, value)) - allowed):
-            self.fail(f"{key}.{unknown}" if key else unknown, f"unknown key (allowed: {', '.join(sorted(allowed))})")
+            if kind is None:
+                self.fail(f"{key}.{unknown}" if key else unknown, f"unknown key (allowed: {', '.join(sorted(allowed))})")
+                continue
+            owner = next((row.name for row in KINDS if row.section == unknown), None)
+            whose = f"; it is the section of a {owner} scene" if owner is not None and owner != kind else ""
+            self.fail(f"{key}.{unknown}" if key else unknown, f"unknown key: a {kind} scene does not use it{whose} (allowed: {', '.join(sorted(allowed))})")
         for missing in sorted(required - set(value)):
             self.fail(f"{key}.{missing}" if key else missing, "required key is missing")
         return value

@@ -197,7 +197,7 @@ def parse_benchmark_scene(document: dict, text: str = "", source: str = "scene")
     """Validate a benchmark scene's document (a mapping with ``benchmark``) and build the :class:`Scene`; raise
     :class:`SceneError` listing all problems."""
     c = Checker()
-    doc = c.mapping("", document, BENCHMARK_TOP_KEYS, {"name", "system", "excitation", "benchmark"})
+    doc = c.mapping("", document, BENCHMARK_TOP_KEYS, {"name", "system", "excitation", "benchmark"}, kind="benchmark")
     general = is_general(doc)
     name, description, report = parse_names(c, doc)
     system = parse_structure(c, doc["system"]) if "system" in doc else None

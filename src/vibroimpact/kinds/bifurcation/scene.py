@@ -238,7 +238,7 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
     """Validate a bifurcation scene's document (a mapping with ``bifurcation``) and build the :class:`Scene`; raise
     :class:`SceneError` listing all problems."""
     c = Checker()
-    doc = c.mapping("", document, BIFURCATION_TOP_KEYS, {"name", "system", "excitation", "bifurcation"})
+    doc = c.mapping("", document, BIFURCATION_TOP_KEYS, {"name", "system", "excitation", "bifurcation"}, kind="bifurcation")
     general = is_general(doc)
     load = None
     if general:

@@ -160,7 +160,7 @@ def parse_concepts(document: Any, source: str = "scene") -> tuple[str, str, bool
     """Check a concepts scene's document and return (name, description, report, settings); :class:`SceneError`
     listing every problem otherwise."""
     c = Checker()
-    doc = c.mapping("", document, CONCEPTS_TOP_KEYS, {"name", "system", "excitation", "frequency", "concepts"})
+    doc = c.mapping("", document, CONCEPTS_TOP_KEYS, {"name", "system", "excitation", "frequency", "concepts"}, kind="concepts")
     name, description, system, amplitude, report = parse_header(c, doc)
     frequency = c.grid("frequency", doc["frequency"], 0.0, math.inf, False) if "frequency" in doc else None
     simulation = _simulation(c, doc.get("simulation", {}), frequency)

@@ -58,7 +58,7 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     """Validate a grid scene's document (a mapping) and build the :class:`Scene`; raise :class:`SceneError` listing
     all problems."""
     c = Checker()
-    doc = c.mapping("", document, TOP_KEYS, {"name", "system", "excitation", "sweep", "solutions"})
+    doc = c.mapping("", document, TOP_KEYS, {"name", "system", "excitation", "sweep", "solutions"}, kind="swept" if "swept_sine" in document else "stepped")
     general = is_general(doc)
 
     load = None

@@ -209,7 +209,7 @@ def read_validation_scene(document: Any, text: str = "", source: str = "scene") 
     """Check a validation scene's document (a mapping with ``validation``); raise :class:`SceneError` listing all
     problems."""
     c = Checker()
-    doc = c.mapping("", document, VALIDATION_TOP_KEYS, {"name", "validation"})
+    doc = c.mapping("", document, VALIDATION_TOP_KEYS, {"name", "validation"}, kind="validation")
     name, description, report = parse_names(c, doc)
     settings = validation_settings(c, doc["validation"]) if "validation" in doc else None
     if c.problems:
