@@ -20,7 +20,6 @@ import numpy as np
 
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution, restitution_from_loss_factor, Stop
 from vibroimpact.model.excitation import HarmonicForce
-from vibroimpact.model.system import TwoDofSystem
 
 __all__ = ["LoadSpec", "StopSpec", "build_stops", "stop_descriptions", "describe_stop"]
 
