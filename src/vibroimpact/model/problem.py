@@ -270,3 +270,8 @@ class ImpactProblem:
         # a static load's length: how far it moves a stop's coordinate in 1/w [s] (gravity on a free mass)
         sizes = [abs(stop.clearance) + linear + abs(stop.normal(self.size) @ minv_static) / self.omega**2 for stop, linear in zip(self.stops, self.gap_amplitudes())]
         return self.omega * max(sizes) + 1e-300
+
+    def length_scale(self) -> float:
+        """A displacement typical of the motion [m], for relative thresholds: Delta + q |H12| on the paper's layout, in
+        general the largest |Delta_k| + |n_k . H F| over the stops (:meth:`velocity_scale` / w)."""
+        return self.velocity_scale() / self.omega

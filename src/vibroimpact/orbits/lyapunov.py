@@ -213,7 +213,7 @@ def state_scales(problem: ImpactProblem) -> NDArray[np.float64]:
     general the largest |Delta_k| plus v / w; w L for the velocities.
     """
     clearance = float(np.max(np.abs(problem.clearances()), initial=0.0))
-    length = clearance + problem.velocity_scale() / problem.omega
+    length = clearance + problem.length_scale()
     return np.repeat([length, problem.omega * length], problem.size)
 
 

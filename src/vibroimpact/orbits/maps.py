@@ -113,7 +113,7 @@ class ImpactMap:
         chosen = problem.stops[self.stops[0]]
         self.parameters = np.array([problem.frequency, chosen.law.restitution, chosen.clearance, problem.amplitude])
         self.dimension = 2 * problem.size
-        length = problem.velocity_scale() / problem.omega  # Delta + q |H12| on the paper's layout
+        length = problem.length_scale()  # Delta + q |H12| on the paper's layout
         self.state_scale = np.repeat([length, problem.omega * length], problem.size)
         self.parameter_scale = np.array([1.0, 0.1, 1e-3, 1.0]) if parameter_scale is None else np.array(parameter_scale, dtype=float)
         if self.parameter_scale.shape != (4,) or not np.all(self.parameter_scale > 0.0):

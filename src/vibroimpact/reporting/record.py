@@ -13,6 +13,8 @@ itself is shown verbatim.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import re
 from dataclasses import dataclass
 
@@ -162,7 +164,7 @@ def study_setting(dataset: xr.Dataset) -> StudySetting:
     steady = tuple(str(s) for s in dataset["solution"].values) if "solution" in dataset.coords else ()
     swept = (SWEPT_SOLUTION,) if any(str(name).startswith("swept_") for name in dataset.data_vars) else ()
     return StudySetting(
-        system=TwoDofSystem(**{key: float(attrs[f"system_{key}"]) for key in _SYSTEM_KEYS}),
+        system=_named(attrs),
         amplitude=float(attrs["excitation_amplitude_N"]),
         solutions=steady + swept,
         frequency=np.asarray(dataset["frequency"].values, dtype=float),
@@ -203,14 +205,17 @@ def _simulation_frequency(dataset: xr.Dataset) -> np.ndarray:
 # (written by :func:`vibroimpact.kinds.stepped.grid.layout_attributes`); nothing is re-validated from the scene text.
 # --------------------------------------------------------------------------------------------------------------------
 
-_NAMED_KEYS = ("m1", "m2", "k1", "k2", "b1", "b2")
 
 
 def named_view(dataset: xr.Dataset) -> TwoDofSystem | None:
     """The named system of ``dataset``'s structure (attributes ``system_m1`` ... ``system_b2``); None where it has
     none."""
-    attrs = dataset.attrs
-    return TwoDofSystem(**{key: float(attrs[f"system_{key}"]) for key in _NAMED_KEYS}) if "system_m1" in attrs else None
+    return _named(dataset.attrs) if "system_m1" in dataset.attrs else None
+
+
+def _named(attrs: Mapping[str, object]) -> TwoDofSystem:
+    """The named system the attributes ``system_m1`` ... ``system_b2`` give (``KeyError`` naming one missing)."""
+    return TwoDofSystem(**{key: float(attrs[f"system_{key}"]) for key in _SYSTEM_KEYS})  # type: ignore[arg-type]
 
 
 def named_layout(dataset: xr.Dataset) -> TwoDofSystem | None:

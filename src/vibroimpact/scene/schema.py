@@ -14,13 +14,11 @@ from typing import Any
 import numpy as np
 
 from vibroimpact.analysis.pgf import AdmissibilitySettings
-from vibroimpact.engines.registry import BUMPER, RIGID, engine_names, engine_spec, stepped_solutions
-from vibroimpact.engines.settings import ATOL_RATIO, STEPPED_TOLERANCES, EngineSettings
-from vibroimpact.model.contact import loss_factor_from_restitution, Stop
+from vibroimpact.engines.registry import engine_names, engine_spec, stepped_solutions
+from vibroimpact.engines.settings import EngineSettings
+from vibroimpact.model.contact import loss_factor_from_restitution
 from vibroimpact.model.excitation import SweptSine
-from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.structure import LinearStructure
-from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.model.problem import Structure
 from vibroimpact.scene.kinds import KIND_NAMES
 from vibroimpact.scene.layout import LoadSpec, StopSpec
 from vibroimpact.scene.variables import MOTION_QUANTITIES, QUANTITIES, STOP_QUANTITIES, quantities_for
@@ -200,7 +198,7 @@ class Scene:
 
     name: str
     description: str
-    system: TwoDofSystem | LinearStructure
+    system: Structure
     amplitude: float
     frequency: np.ndarray
     restitution: np.ndarray

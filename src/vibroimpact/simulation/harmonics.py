@@ -143,7 +143,7 @@ def resting_state(problem: ImpactProblem) -> NDArray[np.float64]:
 
 def velocity_length(problem: ImpactProblem) -> float:
     """A length typical of the motion [m]: the problem's velocity scale over w (Delta + q |H12| for the paper)."""
-    return problem.velocity_scale() / problem.omega if problem.omega > 0.0 else math.inf
+    return problem.length_scale() if problem.omega > 0.0 else math.inf
 
 @dataclass(frozen=True)
 class HarmonicMeasures:

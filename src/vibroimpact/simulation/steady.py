@@ -29,7 +29,7 @@ from vibroimpact.simulation.periodic import motion_evidence, shoot_orbit
 from vibroimpact.simulation.settings import START_MODES, SteadySettings
 from vibroimpact.orbits.motion import MotionEvidence
 
-__all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "pgf_guesses", "orbit_stop_of", "START_MODES"]
+__all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "pgf_guesses", "orbit_stop_of", "START_MODES", "strobes_repeat", "motion_scale"]
 
 
 
@@ -131,7 +131,7 @@ def linear_fits(problem: ImpactProblem) -> bool:
 def motion_scale(problem: ImpactProblem) -> NDArray[np.float64]:
     """Scales of the state's entries for the repeat test [m, m s-1]: L for displacements, w L for velocities, with
     L the largest |Delta_k| + |n_k . X| (+ a static term): Delta + q |H12| on the paper's layout."""
-    length = problem.velocity_scale() / problem.omega
+    length = problem.length_scale()
     return np.concatenate([np.full(problem.size, length), np.full(problem.size, problem.omega * length)])
 
 
@@ -199,7 +199,7 @@ def steady_state(
         strobes.extend(trajectory.strobe_states[1:])
         t, y = float(trajectory.strobe_times[-1]), trajectory.final_state
         recent = np.array(strobes[-3 * settings.max_multiplicity - 1 :])
-        multiplicity = _repeat(recent, scale, settings)
+        multiplicity = strobes_repeat(recent, scale, settings)
         if multiplicity:
             break
     return _measure(engine, problem, t, y, multiplicity, used, settings, scale)
@@ -227,7 +227,7 @@ def _measure(
         run = engine.integrate(problem, y, t, settings.lyapunov_periods, jacobians=True) if exact else engine.integrate(problem, y, t, settings.lyapunov_periods)
         periods = settings.lyapunov_periods
         t, y = float(run.strobe_times[-1]), run.final_state
-        multiplicity = _repeat(run.strobe_states[-(3 * LONG_MULTIPLICITY + 1) :], scale, replace(settings, max_multiplicity=LONG_MULTIPLICITY))
+        multiplicity = strobes_repeat(run.strobe_states[-(3 * LONG_MULTIPLICITY + 1) :], scale, replace(settings, max_multiplicity=LONG_MULTIPLICITY))
         if not multiplicity:
             motion = motion_evidence(engine, problem, run)
             periods += 0 if exact else settings.lyapunov_periods  # the perturbed copy of an integrator's run
@@ -253,7 +253,7 @@ def _rigid(problem: ImpactProblem, orbit_stop: RigidStop | tuple[Stop, ...] | No
     return ImpactProblem(problem.system, orbit_stop_of(problem, orbit_stop), problem.excitation)
 
 
-def _repeat(strobes: NDArray[np.float64], scale: NDArray[np.float64], settings: SteadySettings) -> int:
+def strobes_repeat(strobes: NDArray[np.float64], scale: NDArray[np.float64], settings: SteadySettings) -> int:
     """Smallest p <= max_multiplicity such that the last 2 p + 1 strobes repeat with period p; 0 if none.
 
     A transient decaying with complex Floquet multipliers of angle near 2 pi / p repeats better after p periods than

@@ -258,7 +258,7 @@ def _measure(engine: ExactEngine, problem: ImpactProblem, state: NDArray[np.floa
     velocities = run.impact_velocities
     out["velocity"][k, : min(velocities.size, MAX_KEPT_IMPACTS)] = velocities[-MAX_KEPT_IMPACTS:]
     out["impacts"][k] = velocities.size / strobes
-    length = problem.velocity_scale() / problem.omega
+    length = problem.length_scale()
     scale = np.repeat([length, problem.omega * length], problem.size)
     mismatch = [float(np.max(np.abs(s[p:] - s[:-p]) / scale)) if s.shape[0] > 2 * p else math.inf for p in range(1, MAX_PERIOD + 1)]
     period = next((p for p, m in enumerate(mismatch, start=1) if m < REPEAT_TOLERANCE), 0)

@@ -29,8 +29,9 @@ from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.store import case_key
 from vibroimpact.simulation.harmonics import base_force, base_weights
 from vibroimpact.simulation.settings import SteadySettings
+from vibroimpact.simulation.steady import motion_scale, strobes_repeat
 
-__all__ = ["Fundamentals", "SteadyOutcome", "fundamentals", "linear_start", "march", "length_scale", "check_stops", "GAP_TOLERANCE", "BranchCase", "BRANCH_FIELDS", "SAME_ORBIT", "MAX_SEEDS", "branch_seeds"]
+__all__ = ["Fundamentals", "SteadyOutcome", "fundamentals", "linear_start", "march", "check_stops", "GAP_TOLERANCE", "BranchCase", "BRANCH_FIELDS", "SAME_ORBIT", "MAX_SEEDS", "branch_seeds"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -95,11 +96,6 @@ def fundamentals(trajectory: Trajectory) -> Fundamentals:
     return Fundamentals(x, contact, complex(base_force(problem.structure, problem.omega, x, base_weights(problem), contact)), contacts / periods, float(np.sum(trajectory.impulses)) / periods, peak_acceleration, peak_force)
 
 
-def length_scale(problem: ImpactProblem) -> float:
-    """A displacement typical of the motion [m]: the largest |Delta_k| + |n_k . H F| over the stops."""
-    return problem.velocity_scale() / problem.omega
-
-
 def linear_start(problem: ImpactProblem) -> NDArray[np.float64]:
     """The linear steady state (no stop) at t = 0 as a state (x, x'), or rest if it starts inside a stop."""
     harmonic, static = problem.load()
@@ -120,7 +116,7 @@ def check_stops(trajectory: Trajectory) -> None:
         return  # a bumper is compressed while in contact: penetration is its law, nothing to check
     normals, clearances = problem.normals(), problem.clearances()
     size = problem.size
-    tolerance = GAP_TOLERANCE * length_scale(problem)
+    tolerance = GAP_TOLERANCE * problem.length_scale()
     states = np.concatenate([trajectory.strobe_states[:, :size], trajectory.segment_states[:, :size]])
     if states.size and np.min(clearances[None, :] - states @ normals.T) < -tolerance:
         raise RuntimeError(f"a recorded state is inside a stop of {[stop.describe(problem.structure.coordinates) for stop in problem.stops]}: the engine does not honour this layout")
@@ -162,24 +158,10 @@ class SteadyOutcome:
     state: NDArray[np.float64]
 
 
-def _repeat(strobes: NDArray[np.float64], scale: NDArray[np.float64], settings: SteadySettings) -> int:
-    """Smallest p <= max_multiplicity with the last 2 p + 1 strobes repeating with period p (0 if none); p > 1 only
-    when successive strobes differ macroscopically (a slowly turning transient is not a period-p motion)."""
-    step = float(np.max(np.abs(strobes[-1] - strobes[-2]) / scale)) if strobes.shape[0] >= 2 else 0.0
-    for p in range(1, settings.max_multiplicity + 1):
-        if (p > 1 and step < 1e3 * settings.tolerance) or strobes.shape[0] < 2 * p + 1:
-            break
-        if np.all(np.abs(strobes[-(p + 1) :] - strobes[-(2 * p + 1) : -p]) <= settings.tolerance * scale):
-            return p
-    return 0
-
-
 def march(engine: object, problem: ImpactProblem, t: float, y: NDArray[np.float64], settings: SteadySettings, max_periods: int | None = None) -> SteadyOutcome:
     """Integrate from (t [s], y) until the strobes repeat (at most ``max_periods``, default the settings'), then
     measure ``measure_periods`` (a multiple of the period found) or ``irregular_measure_periods`` with moments."""
-    length = length_scale(problem)
-    n = problem.size
-    scale = np.concatenate([np.full(n, length), np.full(n, problem.omega * length)])
+    scale = motion_scale(problem)
     limit = settings.max_periods if max_periods is None else int(max_periods)
     strobes = [np.asarray(y, dtype=float)]
     used = multiplicity = 0
@@ -189,7 +171,7 @@ def march(engine: object, problem: ImpactProblem, t: float, y: NDArray[np.float6
         used += chunk
         strobes.extend(run.strobe_states[1:])
         t, y = float(run.strobe_times[-1]), run.final_state
-        multiplicity = _repeat(np.array(strobes[-3 * settings.max_multiplicity - 1 :]), scale, settings)
+        multiplicity = strobes_repeat(np.array(strobes[-3 * settings.max_multiplicity - 1 :]), scale, settings)
     measured = multiplicity * math.ceil(settings.measure_periods / multiplicity) if multiplicity else settings.irregular_measure_periods
     final = engine.integrate(problem, y, t, measured, moments=True)  # type: ignore[attr-defined]
     check_stops(final)

@@ -22,7 +22,8 @@ from scipy.integrate import solve_ivp
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.engines.registry import make_engine
 from vibroimpact.engines.settings import EngineSettings
-from vibroimpact.kinds.concepts.branches import length_scale, linear_start, march
+from vibroimpact.kinds.concepts.branches import linear_start, march
+from vibroimpact.simulation.steady import motion_scale
 from vibroimpact.kinds.concepts.scene import Concept
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
@@ -230,9 +231,7 @@ class ConceptCase:
         out["bumper_impacts_per_period"][i] = m.impacts_per_period
         out["bumper_converged"][i], out["bumper_failed"][i] = float(outcome.converged), 0.0
         out["bumper_peak_acceleration"][i], out["bumper_peak_contact_force"][i] = m.peak_acceleration, m.peak_contact_force
-        length = length_scale(problem)
-        size = problem.size
-        scale = np.concatenate([np.full(size, length), np.full(size, problem.omega * length)])
+        scale = motion_scale(problem)
         out["bumper_peak_base_force"][i] = replay.peak_base_force
         out["bumper_replay_mismatch"][i] = float(np.max(np.abs(replay.end_state - check.final_state) / scale))
 
@@ -241,7 +240,7 @@ def start(concept: Concept, problem: ImpactProblem, settings: SteadySettings) ->
     """Where the rigid march starts: on the closed-form impact orbit where it exists and is admissible (moved by the
     settings' start perturbation, so that an unstable orbit is left), else the linear steady state (rest if that is
     inside a stop)."""
-    length = problem.velocity_scale() / problem.omega
+    length = problem.length_scale()
     nudge = settings.start_perturbation * length * np.eye(1, 2 * problem.size, 0)[0]
     try:
         orbit = solve_impact_orbit(problem)

@@ -25,9 +25,7 @@ from vibroimpact.kinds.stepped.grid import no_one_impact_orbit
 from vibroimpact.kinds.stepped.values import broadcast_quantities, coordinate_quantity, scene_problem
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
-from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.structure import LinearStructure
-from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.model.problem import ImpactProblem, Structure
 from vibroimpact.runs.runner import CaseResult, ProgressReport, Runner
 from vibroimpact.runs.store import case_key
 from vibroimpact.scene.layout import LoadSpec, build_stops
@@ -78,7 +76,7 @@ class SimulationCase:
     ----------
     engine : str
         Registered engine name.
-    system : TwoDofSystem or LinearStructure
+    system : Structure
         The linear system.
     amplitude : float
         q [N] (a base motion's displacement [m]).
@@ -98,7 +96,7 @@ class SimulationCase:
     """
 
     engine: str
-    system: TwoDofSystem | LinearStructure
+    system: Structure
     amplitude: float
     contact: RigidStop | KelvinVoigtBumper | tuple[Stop, ...]
     frequencies: tuple[float, ...]

@@ -42,7 +42,7 @@ from scipy.optimize import minimize_scalar
 
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.analysis.stability import Regime
-from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.reporting.record import named_view
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 
 __all__ = [
@@ -60,7 +60,6 @@ WORKING_FRACTION = 0.03
 #: Samples of the analytic no-stop response per band.
 _DENSE_POINTS = 20001
 #: The system's attributes in a dataset.
-_SYSTEM_KEYS = ("m1", "m2", "k1", "k2", "b1", "b2")
 
 
 class DesignRegime(IntEnum):
@@ -336,9 +335,9 @@ class NoStopPeak:
 def no_stop_amplitude(dataset: xr.Dataset, frequency: np.ndarray, quantity: str = "x1") -> np.ndarray | None:
     """|X1| or |X2| (``quantity`` 'x1' or 'x2') [m] of the absorber without a stop at ``frequency`` [Hz], from the
     system and excitation the dataset stores (None if it does not)."""
-    if not all(f"system_{key}" in dataset.attrs for key in _SYSTEM_KEYS) or "excitation_amplitude_N" not in dataset.attrs:
+    system = named_view(dataset)
+    if system is None or "excitation_amplitude_N" not in dataset.attrs:
         return None
-    system = TwoDofSystem(**{key: float(dataset.attrs[f"system_{key}"]) for key in _SYSTEM_KEYS})
     response = linear_response(system, 2.0 * np.pi * np.asarray(frequency, dtype=float), float(dataset.attrs["excitation_amplitude_N"]))
     return np.abs(getattr(response, quantity))
 
