@@ -98,3 +98,21 @@ def test_the_estimate_is_a_few_minutes_at_most() -> None:
 
     estimate = ConceptsStudy().estimate(Scene(), 2, costs=None)  # type: ignore[arg-type]
     assert 0.0 < estimate.wall_time < 60.0
+
+
+def test_the_chain_written_as_matrices_is_the_same_scene() -> None:
+    """The shared ``system`` grammar: the two-mass chain as matrices (coordinates x1, x2) gives the concepts the same
+    named system as m1 ... b2; a structure that is not that chain is refused, naming the key."""
+    from vibroimpact.scene import SceneError
+
+    matrices = copy.deepcopy(DOCUMENT)
+    matrices["system"] = {"mass": [[1.0, 0.0], [0.0, 0.1]], "stiffness": [[29300.0, -4300.0], [-4300.0, 4300.0]], "damping": [[0.88, -0.08], [-0.08, 0.08]], "coordinates": ["x1", "x2"]}
+    named = parse_concepts(copy.deepcopy(DOCUMENT))[3]
+    written = parse_concepts(matrices)[3]
+    for key in ("m1", "m2", "k1", "k2", "b1", "b2"):
+        assert getattr(written.system, key) == pytest.approx(getattr(named.system, key), rel=1e-15, abs=1e-15)
+    assert [c.name for c in written.concepts] == [c.name for c in named.concepts]
+    three = copy.deepcopy(DOCUMENT)
+    three["system"] = {"mass": [[1.0, 0.0], [0.0, 0.1]], "stiffness": [[29300.0, 0.0], [0.0, 4300.0]], "coordinates": ["x1", "x2"]}
+    with pytest.raises(SceneError, match="system: this kind of scene needs the two-mass chain"):
+        parse_concepts(three)

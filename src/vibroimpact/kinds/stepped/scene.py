@@ -228,13 +228,14 @@ def check_sweep_run(c: Checker, key: str, low: float, high: float, rate: float |
 
 
 def parse_header(c: Checker, doc: dict, pages: tuple[str, ...] = ()) -> tuple[Any, str, TwoDofSystem | None, float | None, bool | str]:
-    """What every scene in the paper's named form has: name, description, system, excitation amplitude and the report
-    switch (or one of ``pages``)."""
+    """What every scene of the two-mass chain has: name, description, system (the named view of the ``system``
+    section, written with m1 ... b2 or as matrices), excitation amplitude and the report switch (or one of
+    ``pages``)."""
     name, description, report = parse_names(c, doc, pages)
-    system = parse_structure(c, doc.get("system")) if "system" in doc else None
-    if system is not None and not isinstance(system, TwoDofSystem):
-        c.fail("system", "this kind of scene takes the paper's named system {m1, m2, k1, k2, b1, b2} only")
-        system = None
+    structure = parse_structure(c, doc.get("system")) if "system" in doc else None
+    system = TwoDofSystem.of(structure) if structure is not None else None  # the named view, however it is written
+    if structure is not None and system is None:
+        c.fail("system", "this kind of scene needs the two-mass chain (a primary mass on its suspension, an absorber on the primary): the named form {m1, m2, k1, k2, b1, b2}, or its matrices with coordinates [x1, x2]")
     amplitude = None
     if "excitation" in doc:
         excitation = c.mapping("excitation", doc["excitation"], {"amplitude"}, {"amplitude"})
