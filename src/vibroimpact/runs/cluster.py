@@ -13,12 +13,13 @@ import signal
 import sys
 import threading
 import time
+import traceback
 from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
-__all__ = ["SCHEDULER_VARIABLE", "ClusterLost", "Connection", "choose_scheduler", "connect", "unreachable", "dask_setup", "Progress", "ProgressReport", "Throttled", "ProgressBar", "REPORT_INTERVAL"]
+__all__ = ["SCHEDULER_VARIABLE", "ClusterLost", "SyncCancelRace", "Connection", "choose_scheduler", "connect", "unreachable", "dask_setup", "Progress", "ProgressReport", "Throttled", "ProgressBar", "REPORT_INTERVAL"]
 
 #: The environment variable naming a running scheduler (``tcp://host:8786``).
 SCHEDULER_VARIABLE = "VIBROIMPACT_SCHEDULER"
@@ -89,6 +90,28 @@ def unreachable(scheduler: str, timeout: float = 10.0) -> str | None:
     return None
 
 
+class SyncCancelRace(logging.Filter):
+    """Drops tornado's traceback of a race in ``distributed.utils.sync`` (distributed 2026.8): on Ctrl-C, ``sync``
+    schedules a callback that cancels the future of the coroutine it waits for, and when the interrupt comes before
+    that coroutine has made its future, the callback raises ``NameError`` (``free variable 'future'``) in the event
+    loop's thread, which tornado logs as an error with a traceback. The interrupt itself is the study's to handle (it
+    says in one line what it kept); this filter drops that one record and nothing else."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        error = record.exc_info[1] if record.exc_info else None
+        if not isinstance(error, NameError) or "future" not in str(error) or error.__traceback__ is None:
+            return True
+        frames = [frame.f_code for frame, _line in traceback.walk_tb(error.__traceback__)]
+        return not any(code.co_name == "cancel" and os.path.join("distributed", "utils.py") in code.co_filename for code in frames)
+
+
+def _drop_sync_cancel_race() -> None:
+    """Install :class:`SyncCancelRace` on tornado's application logger (once)."""
+    logger = logging.getLogger("tornado.application")
+    if not any(isinstance(existing, SyncCancelRace) for existing in logger.filters):
+        logger.addFilter(SyncCancelRace())
+
+
 def connect(jobs: int, scheduler: str | None) -> Connection:
     """Start a local cluster of ``jobs`` worker processes, or connect to ``scheduler``.
 
@@ -100,6 +123,7 @@ def connect(jobs: int, scheduler: str | None) -> Connection:
     import dask.config
     from distributed import Client, LocalCluster
 
+    _drop_sync_cancel_race()
     if scheduler is None:
         # Ctrl-C is the study's to handle: the worker processes ignore SIGINT from their start (an ignored signal
         # stays ignored in a child process) and after a restart (the preload). A Ctrl-C in the ~1 s this takes is ignored
