@@ -18,7 +18,7 @@ import pytest
 import xarray as xr
 
 from vibroimpact.scene import load_scene
-from vibroimpact.runs.blocks import BlockPlan, plan_blocks
+from vibroimpact.kinds.stepped.blocks import BlockPlan, plan_blocks
 
 from tests.cluster.conftest import SCENE_NAME, DaskCluster, cluster_scene, finished_blocks, kill_group, wait_for_blocks
 from tests.run_study_process import start_run_study, study_environment

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from vibroimpact.scene import parse_scene
-from vibroimpact.runs.blocks import SIMULATED_POINTS, plan_blocks
+from vibroimpact.kinds.stepped.blocks import SIMULATED_POINTS, plan_blocks
 from vibroimpact.runs.runner import Runner, _run_cases
 from vibroimpact.kinds.stepped.study import general_block
 from vibroimpact.runs.store import StudyStore
@@ -54,7 +54,7 @@ def test_the_runner_costs_under_a_tenth_of_an_exact_block(tmp_path: Path) -> Non
     store = StudyStore(tmp_path / "s.zarr", "overhead")
     plan = plan_blocks(scene, 2)
     variables = {name: (tuple(map(str, v.dims)), np.asarray(v.values), dict(v.attrs)) for name, v in block.data_vars.items()}
-    from vibroimpact.runs.blocks import _template
+    from vibroimpact.kinds.stepped.blocks import _template
 
     store.begin_grid(_template(variables, dict(zip(("restitution", "clearance", "bumper_frequency", "sweep", "frequency"), plan.full)) | {"solution": 3}, {"frequency": plan.full[-1]}), 10, (plan.full, plan.block))
     started = time.perf_counter()

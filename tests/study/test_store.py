@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 
 from vibroimpact.scene import parse_scene
 from vibroimpact.scene.schema import GRID_DIMS
-from vibroimpact.runs.blocks import BlockPlan, block_scene, plan_blocks
+from vibroimpact.kinds.stepped.blocks import BlockPlan, block_scene, plan_blocks
 from vibroimpact.runs.run import run_study
 from vibroimpact.runs.runner import Runner
 from vibroimpact.kinds.stepped.study import general_block
@@ -87,7 +87,7 @@ def test_a_rerun_takes_finished_blocks_from_the_store(tmp_path: Path, monkeypatc
     scene = _grid_scene()
     path = tmp_path / "grid.zarr"
     first = run_study(scene, progress=None, store=StudyStore(path, store_fingerprint(scene.text)))
-    from vibroimpact.runs import blocks
+    from vibroimpact.kinds.stepped import blocks
 
     def fail(*_arguments: object) -> None:
         raise AssertionError("a finished block was solved again")
@@ -100,7 +100,7 @@ def test_a_rerun_takes_finished_blocks_from_the_store(tmp_path: Path, monkeypatc
 def _interrupt_after(blocks_solved: int, scene: object, path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Run ``scene`` into the store at ``path`` in blocks of 30 frequencies (18 blocks) and interrupt it (Ctrl-C)
     after ``blocks_solved`` blocks."""
-    from vibroimpact.runs import blocks
+    from vibroimpact.kinds.stepped import blocks
 
     monkeypatch.setattr(blocks, "CLOSED_FORM_POINTS", 30)
     real = blocks._solve_block
@@ -123,7 +123,7 @@ def test_a_half_written_store_resumes_with_the_missing_blocks_only(tmp_path: Pat
     others only and the result equals an uninterrupted run."""
     scene = _grid_scene()
     path = tmp_path / "grid.zarr"
-    from vibroimpact.runs import blocks
+    from vibroimpact.kinds.stepped import blocks
 
     _interrupt_after(4, scene, path, monkeypatch)
     assert StudyStore(path, store_fingerprint(scene.text)).block_count() == 4
@@ -193,7 +193,7 @@ def test_a_resumed_study_keeps_its_blocks_whatever_its_workers(tmp_path: Path, m
     stored with its blocks, so its values land where they belong."""
     scene = _grid_scene()
     path = tmp_path / "grid.zarr"
-    from vibroimpact.runs import blocks
+    from vibroimpact.kinds.stepped import blocks
 
     _interrupt_after(5, scene, path, monkeypatch)  # the first run's plan: 18 blocks of 30 frequencies
     monkeypatch.setattr(blocks, "CLOSED_FORM_POINTS", 50)  # the resumed run would plan other blocks

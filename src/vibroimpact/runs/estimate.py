@@ -29,7 +29,7 @@ import functools
 import json
 import math
 import os
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass, field
@@ -40,9 +40,9 @@ import xarray as xr
 
 from vibroimpact.engines.registry import engine_spec
 from vibroimpact.runs.run import atomic_path, study_kind
-from vibroimpact.scene.schema import ENGINE_SOLUTIONS, Scene
+from vibroimpact.scene.schema import Scene
 
-__all__ = ["COSTS_FILE", "Costs", "Estimate", "default_costs", "cost_engine", "grid_estimate", "memory", "os_cpus", "cluster_cores", "CLUSTER_STARTUP", "TASK_SECONDS", "WRITE_SECONDS_PER_VARIABLE", "estimate_scene", "speed_probe", "speed_factor", "calibrate", "write_costs", "SPEED_FACTOR_RANGE"]
+__all__ = ["COSTS_FILE", "Costs", "Estimate", "default_costs", "cost_engine", "cluster_startup", "os_cpus", "cluster_cores", "CLUSTER_STARTUP", "TASK_SECONDS", "WRITE_SECONDS_PER_VARIABLE", "estimate_scene", "speed_probe", "speed_factor", "calibrate", "write_costs", "SPEED_FACTOR_RANGE"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -231,50 +231,10 @@ def _duration(seconds: float) -> str:
     return f"{seconds / 3600.0:.1f} h"
 
 
-#: One time-domain solution's predicted work: (seconds, what it runs, the longest serial case [s]).
-EnginePart = tuple[float, str, float]
-
-
-def grid_estimate(
-    scene: Scene, jobs: int, costs: Costs, engine_part: Callable[[str, str], EnginePart], figures: int, sweep_samples: float = 0.0,
-    closed_form_scale: Callable[[str], float] = lambda _name: 1.0, blocks: Callable[[int], int] | None = None,
-) -> Estimate:  # fmt: skip
-    """The estimate of a stepped or swept study on the calibration machine: the closed forms per grid point (times
-    ``closed_form_scale(solution)``: a general layout's relative cost), each time-domain solution by
-    ``engine_part(solution, cost engine)``, spread over the workers, and the report's ``figures``;
-    ``sweep_samples`` output samples of one swept run held in memory per worker; ``blocks(workers)``: the dask tasks
-    of a study solved in grid blocks, each costing the scheduler and the store's writes in the main process."""
-    parts: dict[str, float] = {}
-    points: dict[str, str] = {}
-    frequency = scene.all_frequencies
-    bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
-    grid = scene.restitution.size * scene.clearance.size * frequency.size
-    closed_form = 0.0
-    simulated = 0.0
-    biggest_case = 0.0
-    for name in scene.solutions:
-        if name not in ENGINE_SOLUTIONS:
-            seconds = costs.closed_form_per_point[name] * grid * (bumpers if name == "pgf" and scene.bumper_frequency is not None else 1) * closed_form_scale(name)
-            parts[name] = seconds
-            closed_form += seconds
-            continue
-        assert scene.simulation is not None
-        parts[name], points[name], serial = engine_part(name, cost_engine(name, scene.simulation.engine.method))
-        biggest_case = max(biggest_case, serial)
-        simulated += parts[name]
-    report = 0.0
-    if scene.report:
-        report = costs.report_base + costs.report_per_figure * figures
-        parts["report"] = report
-    workers = min(jobs, os_cpus())
-    overhead = 0.0
-    if blocks is not None:
-        overhead = blocks(workers) * (TASK_SECONDS + WRITE_SECONDS_PER_VARIABLE * len(scene.quantities))
-        parts["scheduler and store"] = overhead
-        closed_form /= workers  # the closed forms are solved block by block on the workers too
-    startup = costs.startup + (CLUSTER_STARTUP if jobs > 1 and _CLUSTER_CORES.get() is None else 0.0)
-    wall = startup + closed_form + max(simulated / workers, biggest_case) + overhead + report
-    return Estimate(wall_time=wall, memory=memory(scene, jobs, costs, sweep_samples, streamed=blocks is not None), parts=parts, points=points)
+def cluster_startup(jobs: int) -> float:
+    """What starting a local cluster of ``jobs`` worker processes adds to a run [s] (nothing on a running cluster,
+    :func:`cluster_cores`, or in this process alone)."""
+    return CLUSTER_STARTUP if jobs > 1 and _CLUSTER_CORES.get() is None else 0.0
 
 
 def os_cpus() -> int:
@@ -291,25 +251,6 @@ def cluster_cores(cores: int) -> Iterator[None]:
     finally:
         _CLUSTER_CORES.reset(token)
 
-
-def memory(scene: Scene, jobs: int, costs: Costs, sweep_samples: float = 0.0, streamed: bool = False) -> float:
-    """Peak memory of the run, main process and workers [bytes]: the main process's footprint and its dataset (built,
-    stacked, written: ~3 copies; ``streamed``: solved in blocks into the store and exported chunk by chunk, so only
-    the report reads it whole), one worker footprint per process simulating, and the ``sweep_samples`` of one sweep
-    per worker."""
-    frequency = scene.all_frequencies
-    bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
-    directions = max(1, len(scene.sweep_directions))
-    cells = scene.restitution.size * scene.clearance.size * bumpers * directions * frequency.size
-    dataset = 3.0 * 8.0 * len(scene.quantities) * len(scene.solutions) * cells
-    if streamed:
-        dataset = dataset / 3.0 if scene.report else 0.0
-    simulating = any(name in ENGINE_SOLUTIONS for name in scene.solutions)
-    workers = min(jobs, os_cpus()) if (simulating or streamed) and jobs > 1 else 0
-    sweep = 0.0
-    if sweep_samples:
-        sweep = sweep_samples * 8.0 * 16 * max(1, workers)  # samples, cumulative integrals and temporaries of the estimators
-    return costs.main_process_memory + dataset + workers * costs.worker_process_memory + sweep
 
 #: Bounds of the machine-speed factor: a probe outside them is a glitch rather than a machine.
 SPEED_FACTOR_RANGE = (0.2, 10.0)

@@ -19,9 +19,10 @@ from vibroimpact.scene.schema import ENGINE_SOLUTIONS, STOP_QUANTITIES, Scene
 from vibroimpact.scene.variables import COORDINATE_ATTRIBUTES
 from vibroimpact.kinds.stepped.values import general_linear_values, general_pgf_values, paper_pgf_values
 from vibroimpact.runs.cluster import Progress
+from vibroimpact.runs.estimate import TASK_SECONDS, WRITE_SECONDS_PER_VARIABLE, Costs, Estimate, cluster_startup, cost_engine, os_cpus
 from vibroimpact.runs.run import provenance
 
-__all__ = ["StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset", "layout_attributes", "no_one_impact_orbit"]
+__all__ = ["EnginePart", "grid_estimate", "memory", "StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset", "layout_attributes", "no_one_impact_orbit"]
 
 #: The values of one solution, quantity -> array over (part of) the full grid.
 Values = dict[str, np.ndarray]
@@ -223,3 +224,73 @@ def no_one_impact_orbit(shape: tuple[int, ...]) -> dict[str, np.ndarray]:
         "one_impact_force_amplitude": nan,
         "one_impact_impulse": nan,
     }
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# The estimate of a stepped or swept study: its grid's closed forms, engines, report and memory.
+# --------------------------------------------------------------------------------------------------------------------
+
+#: One time-domain solution's predicted work: (seconds, what it runs, the longest serial case [s]).
+EnginePart = tuple[float, str, float]
+
+
+def grid_estimate(
+    scene: Scene, jobs: int, costs: Costs, engine_part: Callable[[str, str], EnginePart], figures: int, sweep_samples: float = 0.0,
+    closed_form_scale: Callable[[str], float] = lambda _name: 1.0, blocks: Callable[[int], int] | None = None,
+) -> Estimate:  # fmt: skip
+    """The estimate of a stepped or swept study on the calibration machine: the closed forms per grid point (times
+    ``closed_form_scale(solution)``: a general layout's relative cost), each time-domain solution by
+    ``engine_part(solution, cost engine)``, spread over the workers, and the report's ``figures``;
+    ``sweep_samples`` output samples of one swept run held in memory per worker; ``blocks(workers)``: the dask tasks
+    of a study solved in grid blocks, each costing the scheduler and the store's writes in the main process."""
+    parts: dict[str, float] = {}
+    points: dict[str, str] = {}
+    frequency = scene.all_frequencies
+    bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
+    grid = scene.restitution.size * scene.clearance.size * frequency.size
+    closed_form = 0.0
+    simulated = 0.0
+    biggest_case = 0.0
+    for name in scene.solutions:
+        if name not in ENGINE_SOLUTIONS:
+            seconds = costs.closed_form_per_point[name] * grid * (bumpers if name == "pgf" and scene.bumper_frequency is not None else 1) * closed_form_scale(name)
+            parts[name] = seconds
+            closed_form += seconds
+            continue
+        assert scene.simulation is not None
+        parts[name], points[name], serial = engine_part(name, cost_engine(name, scene.simulation.engine.method))
+        biggest_case = max(biggest_case, serial)
+        simulated += parts[name]
+    report = 0.0
+    if scene.report:
+        report = costs.report_base + costs.report_per_figure * figures
+        parts["report"] = report
+    workers = min(jobs, os_cpus())
+    overhead = 0.0
+    if blocks is not None:
+        overhead = blocks(workers) * (TASK_SECONDS + WRITE_SECONDS_PER_VARIABLE * len(scene.quantities))
+        parts["scheduler and store"] = overhead
+        closed_form /= workers  # the closed forms are solved block by block on the workers too
+    startup = costs.startup + cluster_startup(jobs)
+    wall = startup + closed_form + max(simulated / workers, biggest_case) + overhead + report
+    return Estimate(wall_time=wall, memory=memory(scene, jobs, costs, sweep_samples, streamed=blocks is not None), parts=parts, points=points)
+
+
+def memory(scene: Scene, jobs: int, costs: Costs, sweep_samples: float = 0.0, streamed: bool = False) -> float:
+    """Peak memory of the run, main process and workers [bytes]: the main process's footprint and its dataset (built,
+    stacked, written: ~3 copies; ``streamed``: solved in blocks into the store and exported chunk by chunk, so only
+    the report reads it whole), one worker footprint per process simulating, and the ``sweep_samples`` of one sweep
+    per worker."""
+    frequency = scene.all_frequencies
+    bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
+    directions = max(1, len(scene.sweep_directions))
+    cells = scene.restitution.size * scene.clearance.size * bumpers * directions * frequency.size
+    dataset = 3.0 * 8.0 * len(scene.quantities) * len(scene.solutions) * cells
+    if streamed:
+        dataset = dataset / 3.0 if scene.report else 0.0
+    simulating = any(name in ENGINE_SOLUTIONS for name in scene.solutions)
+    workers = min(jobs, os_cpus()) if (simulating or streamed) and jobs > 1 else 0
+    sweep = 0.0
+    if sweep_samples:
+        sweep = sweep_samples * 8.0 * 16 * max(1, workers)  # samples, cumulative integrals and temporaries of the estimators
+    return costs.main_process_memory + dataset + workers * costs.worker_process_memory + sweep

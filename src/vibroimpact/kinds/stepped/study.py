@@ -13,11 +13,11 @@ from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.analysis.stability import floquet_multipliers
 from vibroimpact.engines.registry import BUMPER, engine_spec
 from vibroimpact.kinds.stepped.cases import general_simulated_values
-from vibroimpact.kinds.stepped.grid import StudyGrid, grid_coordinates, solve_each, finish_dataset
+from vibroimpact.kinds.stepped.grid import StudyGrid, grid_coordinates, solve_each, finish_dataset, EnginePart, grid_estimate
 from vibroimpact.kinds.stepped.values import scene_problem, stop_clearances
-from vibroimpact.runs.blocks import plan_blocks, run_grid
+from vibroimpact.kinds.stepped.blocks import plan_blocks, run_grid
 from vibroimpact.runs.cluster import Progress
-from vibroimpact.runs.estimate import Costs, EnginePart, Estimate, grid_estimate
+from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.runner import Runner
 from vibroimpact.scene.layout import stop_descriptions
 from vibroimpact.scene.schema import Scene, GRID_DIMS, STOP_QUANTITIES, ENGINE_SOLUTIONS
@@ -154,7 +154,7 @@ class SteppedStudy:
 
     def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """Every solution of ``scene`` over its grid (see :func:`vibroimpact.runs.run.run_study`), solved block by
-        block (:mod:`vibroimpact.runs.blocks`) by :func:`~vibroimpact.kinds.stepped.study.general_block`, whichever
+        block (:mod:`vibroimpact.kinds.stepped.blocks`) by :func:`~vibroimpact.kinds.stepped.study.general_block`, whichever
         way the scene writes its system; the variables are read lazily from the runner's store."""
         say = progress or (lambda _message: None)
         grid = StudyGrid.of(scene)

@@ -24,14 +24,14 @@ from numpy.typing import NDArray
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.engines.registry import make_engine
 from vibroimpact.engines.settings import EngineSettings
-from vibroimpact.kinds.stepped.grid import StudyGrid, finish_dataset, grid_coordinates
+from vibroimpact.kinds.stepped.grid import StudyGrid, finish_dataset, grid_coordinates, EnginePart, grid_estimate
 from vibroimpact.kinds.stepped.study import closed_form_scale, engine_scale, describe_stops, general_quantity_attributes
 from vibroimpact.kinds.stepped.values import coordinate_quantity, general_linear_values, general_pgf_values, paper_pgf_values
 from vibroimpact.model.contact import Stop
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem, Structure
 from vibroimpact.runs.cluster import Progress
-from vibroimpact.runs.estimate import Costs, EnginePart, Estimate, grid_estimate
+from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.runner import ProgressReport, Runner
 from vibroimpact.runs.store import case_key
 from vibroimpact.scene.layout import LoadSpec, build_stops, stop_descriptions
