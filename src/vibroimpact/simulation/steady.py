@@ -29,7 +29,7 @@ from vibroimpact.simulation.periodic import motion_evidence, shoot_orbit
 from vibroimpact.simulation.settings import START_MODES, SteadySettings
 from vibroimpact.orbits.motion import MotionEvidence
 
-__all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "pgf_guesses", "orbit_stop_of", "START_MODES", "strobes_repeat", "motion_scale"]
+__all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "pgf_guesses", "orbit_stop_of", "START_MODES", "strobes_repeat", "motion_scale", "march"]
 
 
 
@@ -189,20 +189,38 @@ def steady_state(
         kick = np.zeros(y.size)
         kick[0] = 1.0
         y = y + settings.start_perturbation * scale * kick
-    strobes = [y]
     searched = used
-    multiplicity = 0
-    while used - searched < settings.max_periods:
-        chunk = min(first_chunk if used == searched else settings.chunk_periods, settings.max_periods - (used - searched))
+    t, y, multiplicity, marched = march(engine, problem, t, y, settings, first_chunk=first_chunk, scale=scale)
+    return _measure(engine, problem, t, y, multiplicity, searched + marched, settings, scale)
+
+
+def march(
+    engine: Engine, problem: ImpactProblem, t: float, y: NDArray[np.float64], settings: SteadySettings, max_periods: int | None = None,
+    first_chunk: int | None = None, scale: NDArray[np.float64] | None = None,
+) -> tuple[float, NDArray[np.float64], int, int]:  # fmt: skip
+    """Integrate from (t [s], y) in chunks until the strobes repeat (:func:`strobes_repeat`), at most ``max_periods``
+    (default the settings'); the first chunk ``first_chunk`` periods (default the settings' ``chunk_periods``).
+
+    Returns
+    -------
+    tuple
+        (time [s], state) of the last strobe, the period found in excitation periods (0: none), periods integrated.
+    """
+    scale = motion_scale(problem) if scale is None else scale
+    limit = settings.max_periods if max_periods is None else int(max_periods)
+    first = settings.chunk_periods if first_chunk is None else first_chunk
+    strobes = [y]
+    used = multiplicity = 0
+    while used < limit:
+        chunk = min(first if used == 0 else settings.chunk_periods, limit - used)
         trajectory = engine.integrate(problem, y, t, chunk)
         used += chunk
         strobes.extend(trajectory.strobe_states[1:])
         t, y = float(trajectory.strobe_times[-1]), trajectory.final_state
-        recent = np.array(strobes[-3 * settings.max_multiplicity - 1 :])
-        multiplicity = strobes_repeat(recent, scale, settings)
+        multiplicity = strobes_repeat(np.array(strobes[-3 * settings.max_multiplicity - 1 :]), scale, settings)
         if multiplicity:
             break
-    return _measure(engine, problem, t, y, multiplicity, used, settings, scale)
+    return t, y, multiplicity, used
 
 
 #: Longest period [excitation periods] recognised in the strobes of the long run of a motion that marching did not

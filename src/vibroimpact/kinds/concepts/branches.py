@@ -29,9 +29,9 @@ from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.store import case_key
 from vibroimpact.simulation.harmonics import base_force, base_weights
 from vibroimpact.simulation.settings import SteadySettings
-from vibroimpact.simulation.steady import motion_scale, strobes_repeat
+from vibroimpact.simulation.steady import march as march_to_repeat
 
-__all__ = ["Fundamentals", "SteadyOutcome", "fundamentals", "linear_start", "march", "check_stops", "GAP_TOLERANCE", "BranchCase", "BRANCH_FIELDS", "SAME_ORBIT", "MAX_SEEDS", "branch_seeds"]
+__all__ = ["Fundamentals", "SteadyOutcome", "fundamentals", "march", "check_stops", "GAP_TOLERANCE", "BranchCase", "BRANCH_FIELDS", "SAME_ORBIT", "MAX_SEEDS", "branch_seeds"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -96,17 +96,6 @@ def fundamentals(trajectory: Trajectory) -> Fundamentals:
     return Fundamentals(x, contact, complex(base_force(problem.structure, problem.omega, x, base_weights(problem), contact)), contacts / periods, float(np.sum(trajectory.impulses)) / periods, peak_acceleration, peak_force)
 
 
-def linear_start(problem: ImpactProblem) -> NDArray[np.float64]:
-    """The linear steady state (no stop) at t = 0 as a state (x, x'), or rest if it starts inside a stop."""
-    harmonic, static = problem.load()
-    structure = problem.structure
-    x = structure.receptance_matrix(problem.omega) @ harmonic
-    offset = np.linalg.lstsq(structure.stiffness_matrix, static, rcond=None)[0] if np.any(static) else np.zeros(problem.size)
-    state = np.concatenate([x.real + offset, (1j * problem.omega * x).real])
-    gaps = problem.clearances() - problem.normals() @ state[: problem.size]
-    return state if np.all(gaps >= 0.0) else np.zeros(2 * problem.size)
-
-
 def check_stops(trajectory: Trajectory) -> None:
     """Rigid stops: ``RuntimeError`` unless every impact of ``trajectory`` happens on its stop's closed gap and no recorded state
     (strobes, segment starts) is inside a stop, to :data:`GAP_TOLERANCE` of the motion's length: an engine that does
@@ -159,19 +148,10 @@ class SteadyOutcome:
 
 
 def march(engine: object, problem: ImpactProblem, t: float, y: NDArray[np.float64], settings: SteadySettings, max_periods: int | None = None) -> SteadyOutcome:
-    """Integrate from (t [s], y) until the strobes repeat (at most ``max_periods``, default the settings'), then
-    measure ``measure_periods`` (a multiple of the period found) or ``irregular_measure_periods`` with moments."""
-    scale = motion_scale(problem)
-    limit = settings.max_periods if max_periods is None else int(max_periods)
-    strobes = [np.asarray(y, dtype=float)]
-    used = multiplicity = 0
-    while used < limit and not multiplicity:
-        chunk = min(settings.chunk_periods, limit - used)
-        run = engine.integrate(problem, y, t, chunk)  # type: ignore[attr-defined]
-        used += chunk
-        strobes.extend(run.strobe_states[1:])
-        t, y = float(run.strobe_times[-1]), run.final_state
-        multiplicity = strobes_repeat(np.array(strobes[-3 * settings.max_multiplicity - 1 :]), scale, settings)
+    """Integrate from (t [s], y) until the strobes repeat (the steady states' march,
+    :func:`vibroimpact.simulation.steady.march`, at most ``max_periods``, default the settings'), then measure
+    ``measure_periods`` (a multiple of the period found) or ``irregular_measure_periods`` with moments."""
+    t, y, multiplicity, used = march_to_repeat(engine, problem, t, y, settings, max_periods)  # type: ignore[arg-type]
     measured = multiplicity * math.ceil(settings.measure_periods / multiplicity) if multiplicity else settings.irregular_measure_periods
     final = engine.integrate(problem, y, t, measured, moments=True)  # type: ignore[attr-defined]
     check_stops(final)

@@ -22,8 +22,8 @@ from scipy.integrate import solve_ivp
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.engines.registry import make_engine
 from vibroimpact.engines.settings import EngineSettings
-from vibroimpact.kinds.concepts.branches import linear_start, march
-from vibroimpact.simulation.steady import motion_scale
+from vibroimpact.kinds.concepts.branches import march
+from vibroimpact.simulation.steady import motion_scale, start_state
 from vibroimpact.kinds.concepts.scene import Concept
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
@@ -245,7 +245,7 @@ def start(concept: Concept, problem: ImpactProblem, settings: SteadySettings) ->
     try:
         orbit = solve_impact_orbit(problem)
     except ValueError:  # no closed form for this layout
-        return 0.0, linear_start(problem)
+        return start_state(problem, "linear")
     if bool(orbit.admissible()):
         return 0.0, orbit.state_at(np.zeros(1))[0] + nudge
-    return 0.0, linear_start(problem)
+    return start_state(problem, "linear")
