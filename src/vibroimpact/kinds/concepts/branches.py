@@ -27,7 +27,7 @@ from vibroimpact.orbits.maps import ImpactMap, resection
 from vibroimpact.orbits.shooting import shoot
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.store import case_key
-from vibroimpact.simulation.harmonics import base_force, base_weights
+from vibroimpact.simulation.harmonics import measure
 from vibroimpact.simulation.settings import SteadySettings
 from vibroimpact.simulation.steady import march as march_to_repeat
 
@@ -75,25 +75,13 @@ class Fundamentals:
 
 
 def fundamentals(trajectory: Trajectory) -> Fundamentals:
-    """:class:`Fundamentals` over every period of ``trajectory`` (integrated with ``moments=True``)."""
-    periods = trajectory.periods
-    if periods == 0 or trajectory.moments.shape[0] != periods:
-        raise ValueError("fundamentals() needs a trajectory of at least one period integrated with moments=True")
-    problem = trajectory.problem
-    n, k = problem.size, len(problem.stops)
-    total = trajectory.moments.sum(axis=0)
-    scale = 2.0 / (periods * problem.period)
-    x = total[:n] * scale
-    contact = total[n : n + k] * scale
-    peaks = trajectory.contact_peaks
-    contacts = trajectory.impulses.size
-    if peaks.shape[0]:
-        peak_force, peak_acceleration = float(peaks[:, 0].max()), float(peaks[:, 1].max())
-    elif contacts:
-        peak_force = peak_acceleration = math.nan
-    else:
-        peak_force = peak_acceleration = 0.0
-    return Fundamentals(x, contact, complex(base_force(problem.structure, problem.omega, x, base_weights(problem), contact)), contacts / periods, float(np.sum(trajectory.impulses)) / periods, peak_acceleration, peak_force)
+    """:class:`Fundamentals` over every period of ``trajectory`` (integrated with ``moments=True``): the steady
+    states' measures (:func:`vibroimpact.simulation.harmonics.measure`), as the concepts compare them."""
+    m = measure(trajectory)
+    return Fundamentals(
+        np.array(m.displacements), np.array(m.stop_contact_forces), m.suspension_force + m.contact_force, m.impacts_per_period, m.impulse_per_period,
+        m.peak_acceleration, m.peak_contact_force,
+    )  # fmt: skip
 
 
 def check_stops(trajectory: Trajectory) -> None:
