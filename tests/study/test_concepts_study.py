@@ -116,3 +116,26 @@ def test_the_chain_written_as_matrices_is_the_same_scene() -> None:
     three["system"] = {"mass": [[1.0, 0.0], [0.0, 0.1]], "stiffness": [[29300.0, 0.0], [0.0, 4300.0]], "coordinates": ["x1", "x2"]}
     with pytest.raises(SceneError, match="system: this kind of scene needs the two-mass chain"):
         parse_concepts(three)
+
+
+def test_a_concepts_stops_are_the_shared_stops_grammar() -> None:
+    """A concept's ``stops`` read like any scene's (side defaults to upper, the same checks and messages, keyed by
+    where they stand); what a concepts scene cannot take (a swept or missing value, a stop's own bumper) is refused."""
+    from vibroimpact.scene import SceneError
+
+    document = copy.deepcopy(DOCUMENT)
+    document["concepts"][1]["stops"] = [{"coordinate": "x2", "clearance": 0.003, "restitution": 0.2}]  # no side: upper
+    settings = parse_concepts(document)[3]
+    stop = settings.concepts[1].stops[0]
+    assert stop.side == "upper" and stop.coordinate == 1 and stop.law.clearance == pytest.approx(0.003)
+    document["concepts"][1]["stops"] = [{"coordinate": "x3", "clearance": 0.003, "restitution": 0.2}, {"coordinate": "x2", "restitution": 0.2, "bumper": {"frequency": 500.0}}]
+    with pytest.raises(SceneError) as caught:
+        parse_concepts(document)
+    problems = "\n".join(caught.value.problems)
+    assert "concepts[1].stops[0].coordinate: 'x3' is not a coordinate of the system" in problems
+    document["concepts"][1]["stops"] = [{"coordinate": "x2", "restitution": 0.2, "bumper": {"frequency": 500.0}}]
+    with pytest.raises(SceneError) as caught:
+        parse_concepts(document)
+    problems = "\n".join(caught.value.problems)
+    assert "concepts[1].stops[0].clearance: a concept's stop gives its clearance" in problems
+    assert "concepts[1].stops[0].bumper: a concept's bumper twins are the scene's 'bumper' section" in problems

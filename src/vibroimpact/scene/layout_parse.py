@@ -176,25 +176,26 @@ def _vector(c: Checker, key: str, value: Any, names: tuple[str, ...] | None, wha
     return tuple(float(x) for x in value)
 
 
-def parse_stops(c: Checker, value: Any, names: tuple[str, ...] | None) -> tuple[StopSpec, ...] | None:
-    """``stops``: a non-empty list of {coordinate | between, side, clearance, restitution, bumper}; None if unusable.
+def parse_stops(c: Checker, value: Any, names: tuple[str, ...] | None, key: str = "stops") -> tuple[StopSpec, ...] | None:
+    """``stops`` (or the list at ``key``): a non-empty list of {coordinate | between, side, clearance, restitution,
+    bumper}; None if unusable.
 
     Values a stop does not give come from the sweep (or the scene's ``bumper`` section); which stop needs which
     value is checked by the caller, who knows what is swept.
     """
     if not isinstance(value, list) or not value:
-        c.fail("stops", "expected a non-empty list of stops, each {coordinate: NAME | between: [NAME, NAME], side: upper | lower, clearance: [m], restitution: [0, 1]}")
+        c.fail(key, "expected a non-empty list of stops, each {coordinate: NAME | between: [NAME, NAME], side: upper | lower, clearance: [m], restitution: [0, 1]}")
         return None
     if len(value) > MAX_STOPS:
-        c.fail("stops", f"{len(value)} stops is too many: allowed at most {MAX_STOPS}")
+        c.fail(key, f"{len(value)} stops is too many: allowed at most {MAX_STOPS}")
         return None
-    specs: list[StopSpec | None] = [_stop(c, f"stops[{k}]", entry, names) for k, entry in enumerate(value)]
+    specs: list[StopSpec | None] = [_stop(c, f"{key}[{k}]", entry, names) for k, entry in enumerate(value)]
     if any(spec is None for spec in specs):
         return None
     places = [(s.coordinate, s.other, s.side) for s in specs if s is not None]
     for k, place in enumerate(places):
         if place in places[:k]:
-            c.fail(f"stops[{k}]", f"acts where stops[{places.index(place)}] acts (same coordinates and side): merge them")
+            c.fail(f"{key}[{k}]", f"acts where {key}[{places.index(place)}] acts (same coordinates and side): merge them")
             return None
     return tuple(s for s in specs if s is not None)
 

@@ -33,10 +33,11 @@ import numpy as np
 from vibroimpact.engines.settings import EngineSettings, STEPPED_TOLERANCES
 from vibroimpact.kinds.stepped.scene import NAME, parse_header
 from vibroimpact.model.absorber import den_hartog_absorber
-from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution, Stop, SIDES
+from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution, Stop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.scene.layout_parse import parse_stops
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.simulation.settings import SteadySettings
 
@@ -142,7 +143,6 @@ class ConceptsSettings:
 #: Top-level keys of a concepts scene.
 CONCEPTS_TOP_KEYS = {"name", "description", "system", "excitation", "frequency", "simulation", "bumper", "continuation", "concepts", "report"}
 _CONCEPT_KEYS = {"name", "label", "absorber", "stops"}
-_STOP_KEYS = {"coordinate", "between", "side", "clearance", "restitution"}
 _SIMULATION_KEYS = {"frequency", "rtol", "atol", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods"}
 #: Simulation keys of other kinds that a concepts scene does not use: refused with the reason, never ignored.
 _UNUSED_SIMULATION_KEYS = {
@@ -287,42 +287,24 @@ def _absorber(c: Checker, key: str, value: Any, system: TwoDofSystem) -> tuple[T
 
 
 def _stops(c: Checker, key: str, value: Any, names: tuple[str, ...]) -> tuple[Stop, ...] | None:
-    if not isinstance(value, list):
-        c.fail(key, f"expected a list of stops ({{coordinate | between, side, clearance, restitution}}), got {value!r}")
+    """A concept's rigid stops in the shared ``stops`` grammar (:func:`~vibroimpact.scene.layout_parse.parse_stops`),
+    each giving its clearance (> 0) and restitution (> 0: the bumper twin's loss factor follows from it); a concept's
+    bumper is the scene's ``bumper`` section, not a stop's."""
+    specs = parse_stops(c, value, names, key)
+    if specs is None:
         return None
-    stops: list[Stop] = []
-    for i, entry in enumerate(value):
-        here = f"{key}[{i}]"
-        spec = c.mapping(here, entry, _STOP_KEYS, {"side", "clearance", "restitution"})
-        if ("coordinate" in spec) == ("between" in spec):
-            c.fail(here, "give exactly one of 'coordinate' (against the base) or 'between' (two coordinates)")
-            continue
-        coordinate = other = None
-        if "coordinate" in spec:
-            coordinate = _index(c, f"{here}.coordinate", spec["coordinate"], names)
-        else:
-            pair = spec["between"]
-            if not (isinstance(pair, list) and len(pair) == 2):
-                c.fail(f"{here}.between", f"expected two coordinate names [i, j] (the gap is on x_i - x_j), got {pair!r}")
-                continue
-            coordinate = _index(c, f"{here}.between[0]", pair[0], names)
-            other = _index(c, f"{here}.between[1]", pair[1], names)
-            if coordinate is not None and coordinate == other:
-                c.fail(f"{here}.between", f"the two coordinates must differ, got {pair!r}")
-                continue
-        side = spec.get("side")
-        if "side" in spec and side not in SIDES:
-            c.fail(f"{here}.side", f"{side!r} is not allowed: use one of {', '.join(SIDES)}")
-        clearance = c.number(f"{here}.clearance", spec["clearance"], 0.0, math.inf, low_inclusive=False) if "clearance" in spec else None
-        restitution = c.number(f"{here}.restitution", spec["restitution"], 0.0, 1.0, low_inclusive=False) if "restitution" in spec else None
-        if coordinate is None or ("between" in spec and other is None) or side not in SIDES or clearance is None or restitution is None:
-            continue
-        stops.append(Stop(RigidStop(clearance, restitution), coordinate, other, str(side)))
-    return tuple(stops)
-
-
-def _index(c: Checker, key: str, name: Any, names: tuple[str, ...]) -> int | None:
-    if name not in names:
-        c.fail(key, f"{name!r} is not a coordinate: allowed {', '.join(names)}")
+    usable = True
+    for k, spec in enumerate(specs):
+        here = f"{key}[{k}]"
+        if spec.clearance is None or spec.clearance <= 0.0:
+            c.fail(f"{here}.clearance", "a concept's stop gives its clearance, > 0 [m] (a concepts scene sweeps none)")
+            usable = False
+        if spec.restitution is None or spec.restitution <= 0.0:
+            c.fail(f"{here}.restitution", "a concept's stop gives its restitution, in (0, 1] (the bumper twin's loss factor follows from it)")
+            usable = False
+        if spec.bumper_frequency is not None or spec.bumper_loss_factor is not None:
+            c.fail(f"{here}.bumper", "a concept's bumper twins are the scene's 'bumper' section: remove this stop's bumper")
+            usable = False
+    if not usable:
         return None
-    return names.index(name)
+    return tuple(spec.stop(RigidStop(float(spec.clearance), float(spec.restitution))) for spec in specs)  # type: ignore[arg-type]
