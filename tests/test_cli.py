@@ -229,9 +229,9 @@ def test_calibrate_writes_a_cost_file_that_estimate_reads(tmp_path: Path, capsys
     document.update(solutions=["linear", "momentary"], sweep={"frequency": [24.0, 25.0]}, simulation={"rtol": 1e-7, "start": "rest", "max_periods": 100}, report=False)
     scene_path = write_yaml(tmp_path / "tiny.yaml", document)
     scene = load_scene(scene_path)
-    assert scene.simulation is not None
+    assert scene.settings.simulation is not None
     ours = estimate_scene(scene, speed=1.0, costs=costs).parts["momentary"]
-    steady = scene.simulation.steady
+    steady = scene.settings.simulation.steady
     # from rest: every point, the whole budget: marching, the Lyapunov run and its perturbed copy, the measurement
     periods = (steady.max_periods + 2 * steady.lyapunov_periods + steady.irregular_measure_periods) * 2
     assert ours == pytest.approx(TINY_PER_PERIOD * periods)

@@ -36,14 +36,14 @@ def test_the_shipped_study_is_a_bifurcation_scene() -> None:
     assert scene.kind == "bifurcation"
     settings = scene.settings
     assert (settings.low, settings.high) == (15.0, 45.0) and settings.restitution == (0.2, 0.8)
-    assert scene.frequency.size == 601 and scene.frequency[-1] == pytest.approx(45.0)
-    assert settings.chart is not None and settings.chart.restitution == 0.2 and float(scene.clearance[0]) == pytest.approx(3e-3)  # exact: parsed inputs
+    assert scene.settings.frequency.size == 601 and scene.settings.frequency[-1] == pytest.approx(45.0)
+    assert settings.chart is not None and settings.chart.restitution == 0.2 and scene.settings.clearance == pytest.approx(3e-3)  # exact: parsed inputs
 
 
 def test_a_small_scene_parses_with_defaults() -> None:
     scene = parse_scene(document())
     assert scene.kind == "bifurcation" and scene.settings.chart is None
-    assert scene.settings.brute_force.directions == ("up", "down") and scene.frequency.size == 15
+    assert scene.settings.brute_force.directions == ("up", "down") and scene.settings.frequency.size == 15
 
 
 @pytest.mark.parametrize(
@@ -105,7 +105,7 @@ def test_the_shipped_relative_stop_study_is_a_general_bifurcation_scene() -> Non
     scene = load_scene(find_scene("bifurcation_relative_stop"))
     assert scene.kind == "bifurcation" and scene.general and scene.settings.restitution == (0.2,)
     assert [(s.coordinate, s.other, s.side) for s in scene.stops] == [(1, 0, "upper"), (1, 0, "lower")]
-    assert float(scene.clearance[0]) == pytest.approx(3e-3) and scene.load.weights == (1.0, 0.0)
+    assert scene.settings.clearance == pytest.approx(3e-3) and scene.load.weights == (1.0, 0.0)
 
 
 def test_the_general_form_takes_its_restitution_from_the_stops_or_the_diagrams() -> None:

@@ -56,10 +56,10 @@ def test_relative_scene_parses_to_general_layout() -> None:
     assert isinstance(scene.system, LinearStructure)
     assert scene.coordinates == ("x1", "x2")
     assert [(s.coordinate, s.other, s.side) for s in scene.stop_specs] == [(1, 0, "upper"), (1, 0, "lower")]
-    np.testing.assert_allclose(scene.restitution, [0.2], rtol=0, atol=0)
-    np.testing.assert_allclose(scene.clearance, [0.003], rtol=0, atol=0)
+    np.testing.assert_allclose(scene.settings.restitution, [0.2], rtol=0, atol=0)
+    np.testing.assert_allclose(scene.settings.clearance, [0.003], rtol=0, atol=0)
     assert scene.load is not None and scene.load.weights == (1.0, 0.0)
-    assert scene.quantities == QUANTITIES  # default names x1, x2: the paper's quantity names
+    assert scene.settings.quantities == QUANTITIES  # default names x1, x2: the paper's quantity names
 
 
 def test_named_scene_is_not_general() -> None:
@@ -86,15 +86,15 @@ def test_coordinate_names_name_the_outputs() -> None:
     """Named coordinates give <name>_amplitude, <name>_rms, one_impact_<name>_amplitude."""
     scene = parse_scene(with_change(lambda d: (d["system"].update(coordinates=["body", "tmd"]), d["excitation"].update(on="body"),
                                               [s.update(between=["tmd", "body"]) for s in d["stops"]])))  # fmt: skip
-    assert {"body_amplitude", "tmd_amplitude", "body_rms", "tmd_rms", "one_impact_tmd_amplitude"} <= set(scene.quantities)
-    assert "x1_amplitude" not in scene.quantities
+    assert {"body_amplitude", "tmd_amplitude", "body_rms", "tmd_rms", "one_impact_tmd_amplitude"} <= set(scene.settings.quantities)
+    assert "x1_amplitude" not in scene.settings.quantities
 
 
 def test_different_stop_values_stay_with_the_stops() -> None:
     """Unswept values that differ between stops stay with each stop; the grid holds NaN (no scalar coordinate)."""
     scene = parse_scene(with_change(lambda d: (d["stops"][1].update(clearance=0.002, restitution=0.5), d.update(solutions=["linear"]))))
-    assert np.isnan(scene.clearance[0]) and np.isnan(scene.restitution[0])
-    stops = build_stops(scene.stop_specs, False, float(scene.restitution[0]), float(scene.clearance[0]))
+    assert np.isnan(scene.settings.clearance[0]) and np.isnan(scene.settings.restitution[0])
+    stops = build_stops(scene.stop_specs, False, float(scene.settings.restitution[0]), float(scene.settings.clearance[0]))
     np.testing.assert_allclose([s.clearance for s in stops], [0.003, 0.002], rtol=0, atol=0)
     np.testing.assert_allclose([s.law.restitution for s in stops], [0.2, 0.5], rtol=0, atol=0)
 
@@ -108,8 +108,8 @@ def test_sweep_applies_to_the_named_stop_only() -> None:
         d["solutions"] = ["linear", "exact"]  # an unequal pair has no closed form
 
     scene = parse_scene(change_scene := with_change(change))
-    assert scene.sweep_stops == (0,)
-    stops = build_stops(scene.stop_specs, False, 0.9, float(scene.clearance[0]))
+    assert scene.settings.sweep_stops == (0,)
+    stops = build_stops(scene.stop_specs, False, 0.9, float(scene.settings.clearance[0]))
     np.testing.assert_allclose([s.law.restitution for s in stops], [0.9, 0.2], rtol=0, atol=0)
     assert change_scene["sweep"]["stop"] == 0
 
@@ -117,7 +117,7 @@ def test_sweep_applies_to_the_named_stop_only() -> None:
 def test_negative_clearance_preloads() -> None:
     """A clearance may be negative (the stop preloads the structure)."""
     scene = parse_scene(with_change(lambda d: [s.update(clearance=-0.001) for s in d["stops"][:1]] and d["stops"].pop()))
-    np.testing.assert_allclose(scene.clearance, [-0.001], rtol=0, atol=0)
+    np.testing.assert_allclose(scene.settings.clearance, [-0.001], rtol=0, atol=0)
 
 
 def test_three_dof_base_motion_with_static_force() -> None:
@@ -132,7 +132,7 @@ def test_three_dof_base_motion_with_static_force() -> None:
     }
     scene = parse_scene(document)
     assert scene.load is not None and scene.load.base_motion and scene.load.static == (0.0, 0.0, -0.981)
-    assert {"a_amplitude", "b_amplitude", "c_amplitude"} <= set(scene.quantities)
+    assert {"a_amplitude", "b_amplitude", "c_amplitude"} <= set(scene.settings.quantities)
 
 
 # (case id, change, fragments that must all appear in one reported problem)
@@ -212,8 +212,8 @@ def test_a_bumper_instead_of_a_restitution() -> None:
         d["solutions"] = ["linear", "pgf", "compliant"]
 
     scene = parse_scene(with_change(change))
-    np.testing.assert_allclose(scene.restitution, [restitution_from_loss_factor(0.3)], rtol=1e-15)
-    (stop,) = build_stops(scene.stop_specs, True, float(scene.restitution[0]), float(scene.clearance[0]), float(scene.bumper_frequency[0]))
+    np.testing.assert_allclose(scene.settings.restitution, [restitution_from_loss_factor(0.3)], rtol=1e-15)
+    (stop,) = build_stops(scene.stop_specs, True, float(scene.settings.restitution[0]), float(scene.settings.clearance[0]), float(scene.settings.bumper_frequency[0]))
     assert isinstance(stop.law, KelvinVoigtBumper)
     np.testing.assert_allclose([stop.law.frequency, stop.law.loss_factor, stop.clearance], [300.0, 0.3, 0.003], rtol=1e-15)
 

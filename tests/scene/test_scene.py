@@ -87,11 +87,11 @@ def test_minimal_scene_parses() -> None:
     assert scene.description == ""
     assert scene.system.m1 == 1.0 and scene.system.k2 == 4300.0 and scene.system.b2 == 0.08  # exact: parsed input
     assert scene.amplitude == 10.0  # exact: parsed input
-    np.testing.assert_array_equal(scene.restitution, [0.2])
-    np.testing.assert_array_equal(scene.clearance, [0.003])
-    assert scene.swept == ("frequency",)
-    assert scene.solutions == ("linear", "pgf")
-    assert scene.quantities == QUANTITIES
+    np.testing.assert_array_equal(scene.settings.restitution, [0.2])
+    np.testing.assert_array_equal(scene.settings.clearance, [0.003])
+    assert scene.settings.swept == ("frequency",)
+    assert scene.settings.solutions == ("linear", "pgf")
+    assert scene.settings.quantities == QUANTITIES
     assert scene.report is True
 
 
@@ -115,7 +115,7 @@ def test_damping_is_optional() -> None:
 def test_frequency_grids(spec: Any, expected: list[float]) -> None:
     """Step grids include the stop (exact decimals), num grids are linspaces, lists are sorted."""
     scene = parse_scene(scene_with(_sweep_frequency(spec)))
-    assert scene.frequency.tolist() == expected
+    assert scene.settings.frequency.tolist() == expected
 
 
 def test_swept_restitution_and_clearance_are_dimensions_with_frequency_last() -> None:
@@ -130,31 +130,31 @@ def test_swept_restitution_and_clearance_are_dimensions_with_frequency_last() ->
         }
 
     scene = parse_scene(scene_with(change))
-    assert scene.swept == ("restitution", "clearance", "frequency")
-    assert scene.restitution.tolist() == [0.0, 0.4, 0.8]
-    assert scene.clearance.tolist() == [0.002, 0.004]
-    assert scene.frequency.tolist() == [20.0, 21.0]
+    assert scene.settings.swept == ("restitution", "clearance", "frequency")
+    assert scene.settings.restitution.tolist() == [0.0, 0.4, 0.8]
+    assert scene.settings.clearance.tolist() == [0.002, 0.004]
+    assert scene.settings.frequency.tolist() == [20.0, 21.0]
 
 
 def test_one_swept_parameter_other_from_stop() -> None:
     """Sweeping only restitution leaves clearance as a one-value array out of ``swept``."""
     scene = parse_scene(scene_with(_sweep_restitution([0.6, 0.2])))
-    assert scene.swept == ("restitution", "frequency")
-    assert scene.restitution.tolist() == [0.2, 0.6]
-    assert scene.clearance.tolist() == [0.003]
+    assert scene.settings.swept == ("restitution", "frequency")
+    assert scene.settings.restitution.tolist() == [0.2, 0.6]
+    assert scene.settings.clearance.tolist() == [0.003]
 
 
 def test_regime_is_always_written_and_report_can_be_off() -> None:
     """``regime`` is appended to the requested quantities; ``report: false`` is kept."""
     scene = parse_scene(scene_with(lambda d: d.update(quantities=["x2_amplitude"], report=False)))
-    assert scene.quantities == ("x2_amplitude", "regime")
+    assert scene.settings.quantities == ("x2_amplitude", "regime")
     assert scene.report is False
 
 
 def test_grid_of_exactly_the_maximum_size_is_accepted() -> None:
     """MAX_GRID_POINTS points is allowed (the limit is inclusive)."""
     scene = parse_scene(scene_with(_sweep_frequency({"start": 1, "stop": 2, "num": MAX_GRID_POINTS})))
-    assert scene.frequency.size == MAX_GRID_POINTS
+    assert scene.settings.frequency.size == MAX_GRID_POINTS
 
 
 def test_shipped_restitution_scene_loads() -> None:
@@ -162,9 +162,9 @@ def test_shipped_restitution_scene_loads() -> None:
     path = shipped_studies_dir() / "restitution.yaml"
     scene = load_scene(path)
     assert scene.name == "restitution"
-    assert scene.swept == ("restitution", "frequency")
-    assert scene.restitution.tolist() == [0.0, 0.2, 0.4, 0.6, 0.8]
-    assert scene.frequency[0] == 15.0 and scene.frequency[-1] == 45.0 and scene.frequency.size == 6001  # exact: grid ends are the inputs
+    assert scene.settings.swept == ("restitution", "frequency")
+    assert scene.settings.restitution.tolist() == [0.0, 0.2, 0.4, 0.6, 0.8]
+    assert scene.settings.frequency[0] == 15.0 and scene.settings.frequency[-1] == 45.0 and scene.settings.frequency.size == 6001  # exact: grid ends are the inputs
     assert scene.text == path.read_text(encoding="utf-8")
 
 
@@ -508,7 +508,7 @@ def test_tiny_clearance_grid_keeps_its_values() -> None:
     doc["stop"] = {"restitution": 0.2}
     doc["sweep"]["clearance"] = {"start": 1e-12, "stop": 2e-12, "num": 11}
     scene = parse_scene(doc)
-    np.testing.assert_allclose(scene.clearance, np.linspace(1e-12, 2e-12, 11), rtol=1e-12)
+    np.testing.assert_allclose(scene.settings.clearance, np.linspace(1e-12, 2e-12, 11), rtol=1e-12)
 
 
 def test_infinite_upper_bound_is_printed_open() -> None:
@@ -522,7 +522,7 @@ def test_yaml_12_exponent_numbers_are_floats(tmp_path: Path) -> None:
     path = tmp_path / "exp.yaml"
     path.write_text(doc, encoding="utf-8")
     scene = load_scene(path)
-    assert scene.clearance[0] == 0.003 and scene.system.k1 == 25000.0  # exact: parsed input
+    assert scene.settings.clearance[0] == 0.003 and scene.system.k1 == 25000.0  # exact: parsed input
 
 
 def test_total_grid_size_is_bounded() -> None:
@@ -563,14 +563,14 @@ def _with_engines(**simulation: Any) -> dict[str, Any]:
 
 def test_simulation_defaults_to_the_analytic_grid() -> None:
     scene = parse_scene(_with_engines())
-    assert scene.simulation is not None and scene.simulation.start == "pgf"
-    np.testing.assert_array_equal(scene.simulation.frequency, scene.frequency)
+    assert scene.settings.simulation is not None and scene.settings.simulation.start == "pgf"
+    np.testing.assert_array_equal(scene.settings.simulation.frequency, scene.settings.frequency)
 
 
 def test_simulation_grid_is_merged_into_the_frequency_axis() -> None:
     scene = parse_scene(_with_engines(frequency=[20.25, 21.0], start="sweep_up", rtol=1e-7, max_periods=50))
-    assert 20.25 in scene.all_frequencies and scene.all_frequencies.size == scene.frequency.size + 1
-    assert scene.simulation is not None and scene.simulation.engine.rtol == 1e-7 and scene.simulation.steady.max_periods == 50  # exact: parsed input
+    assert 20.25 in scene.settings.all_frequencies and scene.settings.all_frequencies.size == scene.settings.frequency.size + 1
+    assert scene.settings.simulation is not None and scene.settings.simulation.engine.rtol == 1e-7 and scene.settings.simulation.steady.max_periods == 50  # exact: parsed input
 
 
 @pytest.mark.parametrize(

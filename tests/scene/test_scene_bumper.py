@@ -27,14 +27,14 @@ def test_loss_factor_defaults_to_the_exact_inverse_of_each_restitution() -> None
     document["stop"] = {"clearance": 0.003}
     document["sweep"]["restitution"] = [0.2, 0.5]
     scene = parse_scene(document)
-    np.testing.assert_allclose([restitution_from_loss_factor(x) for x in scene.loss_factors()], [0.2, 0.5], rtol=1e-13)
-    assert scene.bumper_frequency is not None and scene.bumper_frequency.tolist() == [250.0]
+    np.testing.assert_allclose([restitution_from_loss_factor(x) for x in scene.settings.loss_factors()], [0.2, 0.5], rtol=1e-13)
+    assert scene.settings.bumper_frequency is not None and scene.settings.bumper_frequency.tolist() == [250.0]
 
 
 def test_given_loss_factor_is_kept_apart_from_the_rigid_restitution() -> None:
     """The paper's own choice: xi_b = 0.65 for the bumper while the rigid-stop solutions use R = 0.2."""
     scene = parse_scene(compliant_scene(bumper={"frequency": 250.0, "loss_factor": 0.65}))
-    assert scene.restitution.tolist() == [0.2] and scene.loss_factors().tolist() == [0.65]
+    assert scene.settings.restitution.tolist() == [0.2] and scene.settings.loss_factors().tolist() == [0.65]
 
 
 def test_swept_loss_factor_sets_the_restitution() -> None:
@@ -43,9 +43,9 @@ def test_swept_loss_factor_sets_the_restitution() -> None:
     document["bumper"] = {"frequency": 500.0}
     document["sweep"]["bumper_loss_factor"] = [0.1, 0.7, 1.5]
     scene = parse_scene(document)
-    assert scene.swept == ("bumper_loss_factor", "frequency")
-    np.testing.assert_allclose(scene.restitution, [restitution_from_loss_factor(x) for x in (0.1, 0.7, 1.5)])
-    np.testing.assert_allclose(scene.loss_factors(), [0.1, 0.7, 1.5])
+    assert scene.settings.swept == ("bumper_loss_factor", "frequency")
+    np.testing.assert_allclose(scene.settings.restitution, [restitution_from_loss_factor(x) for x in (0.1, 0.7, 1.5)])
+    np.testing.assert_allclose(scene.settings.loss_factors(), [0.1, 0.7, 1.5])
 
 
 @pytest.mark.parametrize(
@@ -76,10 +76,10 @@ def sweep_scene(**swept_sine: Any) -> dict[str, Any]:
 
 def test_swept_sine_settings() -> None:
     scene = parse_scene(sweep_scene(directions=["down"], window_cycles=4))
-    assert scene.swept_sine is not None and scene.sweep_directions == ("down",)
-    sweep = scene.swept_sine.sweep(10.0, "down")
+    assert scene.settings.swept_sine is not None and scene.settings.sweep_directions == ("down",)
+    sweep = scene.settings.swept_sine.sweep(10.0, "down")
     assert (sweep.start_frequency, sweep.stop_frequency, sweep.alpha, sweep.duration) == (26.0, 20.0, -0.5, 12.0)
-    assert scene.swept_sine.window_cycles == 4 and scene.swept_sine.sample_rate == 1000.0  # exact: parsed input
+    assert scene.settings.swept_sine.window_cycles == 4 and scene.settings.swept_sine.sample_rate == 1000.0  # exact: parsed input
 
 
 @pytest.mark.parametrize(
@@ -111,10 +111,10 @@ def test_shipped_bumper_studies_parse() -> None:
 
     for name in ("bumper_sweep", "bumper_stiffness", "restitution_peaks", "clearance_peaks", "peak_acceleration"):
         scene = load_scene(shipped_studies_dir() / f"{name}.yaml")
-        assert "compliant" in scene.solutions and scene.bumper_frequency is not None, name
-        assert np.all(np.isfinite(scene.loss_factors()) & (scene.loss_factors() > 0.0)), name
+        assert "compliant" in scene.settings.solutions and scene.settings.bumper_frequency is not None, name
+        assert np.all(np.isfinite(scene.settings.loss_factors()) & (scene.settings.loss_factors() > 0.0)), name
     sweep = load_scene(shipped_studies_dir() / "bumper_sweep.yaml")
-    assert sweep.loss_factors()[0] == pytest.approx(loss_factor_from_restitution(0.2)) and math.isclose(sweep.loss_factors()[0], 0.7312, abs_tol=5e-5)
+    assert sweep.settings.loss_factors()[0] == pytest.approx(loss_factor_from_restitution(0.2)) and math.isclose(sweep.settings.loss_factors()[0], 0.7312, abs_tol=5e-5)
 
 
 def test_every_swept_sine_problem_is_reported_at_once() -> None:
@@ -129,8 +129,8 @@ def test_default_tolerances_follow_the_guidance() -> None:
     from vibroimpact.engines.settings import STEPPED_TOLERANCES, SWEPT_TOLERANCES
 
     stepped = parse_scene(compliant_scene())
-    assert stepped.simulation is not None and (stepped.simulation.engine.rtol, stepped.simulation.engine.atol) == STEPPED_TOLERANCES == (1e-8, 1e-12)
+    assert stepped.settings.simulation is not None and (stepped.settings.simulation.engine.rtol, stepped.settings.simulation.engine.atol) == STEPPED_TOLERANCES == (1e-8, 1e-12)
     swept = parse_scene(sweep_scene())
-    assert swept.simulation is not None and (swept.simulation.engine.rtol, swept.simulation.engine.atol) == SWEPT_TOLERANCES == (1e-7, 1e-11)
+    assert swept.settings.simulation is not None and (swept.settings.simulation.engine.rtol, swept.settings.simulation.engine.atol) == SWEPT_TOLERANCES == (1e-7, 1e-11)
     given = parse_scene(sweep_scene() | {"simulation": {"rtol": 1e-6}})  # atol follows: rtol x 1e-4 m, as measured
-    assert given.simulation is not None and given.simulation.engine.rtol == 1e-6 and given.simulation.engine.atol == pytest.approx(1e-10)  # exact: parsed input
+    assert given.settings.simulation is not None and given.settings.simulation.engine.rtol == 1e-6 and given.settings.simulation.engine.atol == pytest.approx(1e-10)  # exact: parsed input

@@ -36,11 +36,11 @@ def small_scene() -> dict:
 def test_predicted_integration_matches_what_the_run_does() -> None:
     """Points predicted to need no integration are exactly those the run answers without integrating."""
     scene = parse_scene(small_scene())
-    assert scene.simulation is not None
+    assert scene.settings.simulation is not None
     periods, scale = expected_periods(scene)
     assert scale == 1.0  # exact: no subsampling: factor set to 1
     predicted = periods[0, 0]
-    case = SimulationCase("momentary", scene.system, scene.amplitude, RigidStop(0.003, 0.2), tuple(scene.simulation.frequency), "pgf", scene.simulation.engine, scene.simulation.steady)
+    case = SimulationCase("momentary", scene.system, scene.amplitude, RigidStop(0.003, 0.2), tuple(scene.settings.simulation.frequency), "pgf", scene.settings.simulation.engine, scene.settings.simulation.steady)
     used = run_case(case)["periods_used"]
     np.testing.assert_array_equal(predicted == 0, used == 0)
     assert np.all(predicted[used > 0] >= 48)  # a settling transient plus the measurement, or the irregular budget
@@ -80,7 +80,7 @@ def test_start_modes_are_predicted_as_they_run() -> None:
     document["simulation"]["start"] = "sweep_up"
     scene = parse_scene(document)
     swept, _ = expected_periods(scene)
-    case = SimulationCase("momentary", scene.system, scene.amplitude, RigidStop(0.003, 0.2), tuple(scene.simulation.frequency), "sweep_up", scene.simulation.engine, scene.simulation.steady)  # type: ignore[union-attr]
+    case = SimulationCase("momentary", scene.system, scene.amplitude, RigidStop(0.003, 0.2), tuple(scene.settings.simulation.frequency), "sweep_up", scene.settings.simulation.engine, scene.settings.simulation.steady)  # type: ignore[union-attr]
     used = run_case(case)["periods_used"]
     np.testing.assert_array_equal(swept[0, 0] == 0, used == 0)
 
@@ -90,7 +90,7 @@ def test_large_grids_are_subsampled() -> None:
     document["sweep"] = {"frequency": {"start": 15.0, "stop": 45.0, "step": 0.0005}}
     scene = parse_scene(document)
     periods, scale = expected_periods(scene)
-    assert periods.shape[-1] <= 20_000 and scale * periods.shape[-1] == pytest.approx(scene.simulation.frequency.size)  # type: ignore[union-attr]
+    assert periods.shape[-1] <= 20_000 and scale * periods.shape[-1] == pytest.approx(scene.settings.simulation.frequency.size)  # type: ignore[union-attr]
 
 
 def test_cli_estimate_runs_nothing(tmp_path: Path, capsys: object) -> None:

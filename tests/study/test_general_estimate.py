@@ -44,11 +44,11 @@ def test_scales_of_the_cost() -> None:
 def test_predicted_integration_matches_what_the_run_does() -> None:
     """With the two-sided closed form: points predicted to need no integration are those the run answers at once."""
     scene = parse_scene(copy.deepcopy(SCENE))
-    assert scene.simulation is not None
+    assert scene.settings.simulation is not None
     periods, scale = expected_periods(scene)
     assert scale == 1.0  # exact: no subsampling
     problem = scene_problem(scene, 20.0, 0.2, 0.003)
-    case = SimulationCase("momentary", scene.system, scene.amplitude, problem.contact, tuple(scene.simulation.frequency), "pgf", scene.simulation.engine, scene.simulation.steady, load=scene.load)
+    case = SimulationCase("momentary", scene.system, scene.amplitude, problem.contact, tuple(scene.settings.simulation.frequency), "pgf", scene.settings.simulation.engine, scene.settings.simulation.steady, load=scene.load)
     used = run_case(case)["periods_used"]
     np.testing.assert_array_equal(periods[0, 0] == 0, used == 0)
     assert np.any(used > 0) and np.any(used == 0)
@@ -60,9 +60,9 @@ def test_without_a_closed_form_a_stated_share_is_assumed_to_wander() -> None:
     document["stops"][1]["clearance"] = 0.002
     document["solutions"] = ["linear", "momentary"]
     scene = parse_scene(document)
-    assert scene.simulation is not None
+    assert scene.settings.simulation is not None
     periods, _ = expected_periods(scene)
-    steady = scene.simulation.steady
+    steady = scene.settings.simulation.steady
     settle = SETTLING_PERIODS + steady.measure_periods
     wander = steady.max_periods + steady.lyapunov_periods + steady.irregular_measure_periods
     values = set(np.unique(periods).tolist())

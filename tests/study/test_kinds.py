@@ -33,6 +33,23 @@ def test_each_shipped_scene_is_run_by_the_study_of_its_kind() -> None:
     assert seen == set(KIND_NAMES), f"no shipped scene of kind {set(KIND_NAMES) - seen}"
 
 
+def test_a_scene_is_a_header_plus_its_kinds_own_settings() -> None:
+    """Every kind's settings live in its own folder (a swept test is a grid scene: the stepped folder's), and the
+    scene itself carries no field of any kind: only the header every kind shares."""
+    from dataclasses import fields
+
+    from vibroimpact.scene.schema import Scene
+
+    header = {"name", "description", "system", "amplitude", "kind", "settings", "report", "text", "load", "stops", "general", "cluster_scheduler"}
+    assert {f.name for f in fields(Scene)} == header
+    for path in sorted(shipped_studies_dir().rglob("*.yaml")):
+        scene = load_scene(path)
+        home = "stepped" if scene.kind == "swept" else scene.kind
+        assert type(scene.settings).__module__.startswith(f"vibroimpact.kinds.{home}."), (path.name, type(scene.settings))
+    with pytest.raises(ValueError, match="settings"):
+        Scene("s", "", scene.system, 1.0, "stepped", None)
+
+
 def test_the_precedence_of_kinds_is_the_table_order_for_documents_and_scenes() -> None:
     """A document with two kinds' sections is the earlier row's kind, when read and when asked of the scene: the one
     precedence, spelled once. The later section is then a key that kind does not take: an error naming it."""

@@ -134,4 +134,4 @@ def test_the_paper_layout_as_matrices_may_ask_for_the_design_map_and_pgf_paper()
     document["stops"][0].pop("restitution")
     document["sweep"] = {"restitution": [0.2, 0.8], "clearance": [0.002, 0.003], "frequency": [20.0, 25.0]}
     scene = parse_scene(document)
-    assert scene.report == "design_map" and scene.solutions == ("linear", "pgf", "pgf_paper")
+    assert scene.report == "design_map" and scene.settings.solutions == ("linear", "pgf", "pgf_paper")

@@ -41,7 +41,7 @@ def test_the_runner_costs_under_a_tenth_of_an_exact_block(tmp_path: Path) -> Non
     general_block(scene, Runner(progress=False))  # compile and warm the caches
     started = time.perf_counter()
     block = general_block(scene, Runner(progress=False))
-    points = scene.restitution.size * scene.simulation.frequency.size
+    points = scene.settings.restitution.size * scene.settings.simulation.frequency.size
     per_point = (time.perf_counter() - started) / points  # closed forms included: what a block of the grid costs
     smallest = SIMULATED_POINTS[0] * per_point
 

@@ -67,8 +67,8 @@ def test_block_scene_keeps_the_simulation_frequencies_inside_the_block() -> None
     scene = parse_scene(small_scene() | {"sweep": {"frequency": {"start": 20.0, "stop": 30.0, "step": 0.5}}, "simulation": {"frequency": [21.0, 25.0, 29.5], "start": "pgf"}})
     region = {"restitution": slice(0, 1), "clearance": slice(0, 1), "bumper_frequency": slice(0, 1), "sweep": slice(0, 1), "frequency": slice(8, 15)}
     part = block_scene(scene, region)
-    np.testing.assert_array_equal(part.all_frequencies, scene.all_frequencies[8:15])
-    assert part.simulation is not None and list(part.simulation.frequency) == [25.0]
+    np.testing.assert_array_equal(part.settings.all_frequencies, scene.settings.all_frequencies[8:15])
+    assert part.settings.simulation is not None and list(part.settings.simulation.frequency) == [25.0]
 
 
 def test_the_stored_grid_reads_back_with_its_types_and_flags(tmp_path: Path) -> None:
@@ -184,8 +184,8 @@ def test_the_block_plan_follows_the_work() -> None:
     simulated = parse_scene(small_scene() | {"stop": {"clearance": 0.003}, "sweep": {"restitution": [0.2, 0.4], "frequency": {"start": 20.0, "stop": 40.0, "step": 0.01}}, "simulation": {"frequency": {"start": 20.0, "stop": 40.0, "step": 0.05}, "start": "pgf"}})
     one, eight = plan_blocks(simulated, 1), plan_blocks(simulated, 8)
     assert one.count < eight.count
-    chain = replace(simulated, simulation=replace(simulated.simulation, start="sweep_up"))
-    assert plan_blocks(chain, 8).block[-1] == simulated.all_frequencies.size
+    chain = replace(simulated, settings=replace(simulated.settings, simulation=replace(simulated.settings.simulation, start="sweep_up")))
+    assert plan_blocks(chain, 8).block[-1] == simulated.settings.all_frequencies.size
 
 
 def test_a_resumed_study_keeps_its_blocks_whatever_its_workers(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

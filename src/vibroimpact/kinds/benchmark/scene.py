@@ -239,12 +239,6 @@ def parse_benchmark_scene(document: dict, text: str = "", source: str = "scene")
         description=description,
         system=layout.system,
         amplitude=layout.amplitude,
-        frequency=np.array(sorted({case.problem.frequency for case in cases})),
-        restitution=_given(case.problem.stops[k].law.restitution for case in cases for k in layout.taking("restitution")),
-        clearance=_given(case.problem.stops[k].clearance for case in cases for k in layout.taking("clearance")),
-        swept=(),
-        solutions=(),
-        quantities=(),
         kind="benchmark",
         settings=BenchmarkScene(tuple(cases), settings),
         report=report,
@@ -253,12 +247,6 @@ def parse_benchmark_scene(document: dict, text: str = "", source: str = "scene")
         stops=specs or (),
         general=general,
     )
-
-
-def _given(values: Any) -> np.ndarray:
-    """The distinct finite values the cases give, sorted; [NaN] where every stop gives its own."""
-    finite = sorted({float(v) for v in values if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)})
-    return np.array(finite) if finite else np.array([math.nan])
 
 
 def _own_or_case(c: Checker, key: str, case: dict[str, Any], layout: _Layout, field: str, words: str) -> bool:

@@ -416,7 +416,7 @@ class BenchmarkStudy:
         dataset = run_benchmark(list(scene.settings.cases), scene.settings.settings, progress=progress is not None)
         dataset.attrs.update({"title": f"vibroimpact benchmark '{scene.name}'", "scene_name": scene.name, "scene": scene.text} | provenance())
         if scene.general:
-            dataset.attrs.update(layout_attributes(scene) | {"excitation_amplitude_N": scene.amplitude})
+            dataset.attrs.update(layout_attributes(scene, *_shared_values(scene.settings.cases, scene.stop_specs)) | {"excitation_amplitude_N": scene.amplitude})
         return dataset
 
     def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:
@@ -445,3 +445,18 @@ class BenchmarkStudy:
                     if one > bench.settings.max_seconds:
                         break
         return Estimate(wall_time=costs.startup + total, memory=costs.main_process_memory, parts={"benchmark": total})
+
+
+def _shared_values(cases: Any, specs: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The restitutions [-] and clearances [m] the cases give the stops that take the study's values: the distinct
+    finite ones, sorted ([NaN] where every stop gives its own)."""
+
+    def given(values: Any) -> np.ndarray:
+        finite = sorted({float(v) for v in values if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)})
+        return np.array(finite) if finite else np.array([math.nan])
+
+    taking_r = [k for k, spec in enumerate(specs) if spec.restitution is None]
+    taking_d = [k for k, spec in enumerate(specs) if spec.clearance is None]
+    restitution = given(case.problem.stops[k].law.restitution for case in cases for k in taking_r)
+    clearance = given(case.problem.stops[k].clearance for case in cases for k in taking_d)
+    return restitution, clearance

@@ -194,6 +194,8 @@ class BifurcationSettings:
         The frequency band [Hz].
     restitution : tuple of float
         R of each bifurcation diagram [-].
+    clearance : float
+        Delta [m] shared by every stop.
     brute_force : BruteForceSettings
         Stepped sweeps up and down.
     branches : BranchSettings
@@ -205,6 +207,7 @@ class BifurcationSettings:
     low: float
     high: float
     restitution: tuple[float, ...]
+    clearance: float
     brute_force: BruteForceSettings = BruteForceSettings()
     branches: BranchSettings = BranchSettings()
     chart: ChartSettings | None = None
@@ -279,18 +282,12 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
         raise SceneError(c.problems, source)
     assert system is not None and amplitude is not None and isinstance(name, str) and clearance is not None
     assert low is not None and high is not None and restitution is not None and brute is not None and branches is not None
-    settings = BifurcationSettings(low, high, tuple(float(r) for r in restitution), brute, branches, chart)
+    settings = BifurcationSettings(low, high, tuple(float(r) for r in restitution), float(clearance), brute, branches, chart)
     return Scene(
         name=name,
         description=description,
         system=system,
         amplitude=amplitude,
-        frequency=settings.frequency,
-        restitution=np.asarray(restitution, dtype=float),
-        clearance=np.array([clearance]),
-        swept=("restitution", "frequency"),
-        solutions=(),
-        quantities=(),
         kind="bifurcation",
         settings=settings,
         report=report,

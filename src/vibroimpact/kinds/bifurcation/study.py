@@ -71,7 +71,7 @@ def scene_problem(scene: Scene, restitution: float, clearance: float | None = No
     at the band's lower frequency (each part of the study moves it in frequency)."""
     settings = scene.settings
     assert settings is not None
-    delta = float(scene.clearance[0]) if clearance is None else float(clearance)
+    delta = settings.clearance if clearance is None else float(clearance)
     stops = build_stops(scene.stop_specs, False, float(restitution), delta)
     return ImpactProblem(scene.system.structure, stops, scene.load_spec.force(scene.amplitude, settings.low))
 
@@ -86,17 +86,17 @@ class BifurcationStudy:
         settings = scene.settings
         assert settings is not None
         say = progress if progress is not None else (lambda message: None)
-        delta = float(scene.clearance[0])
+        delta = settings.clearance
         options = tuple(sorted(vars(settings.branches).items()))
         brute = settings.brute_force
         chart = settings.chart
-        sweeps = [SweepCase(scene_problem(scene, r), d, tuple(scene.frequency), brute.transient_periods, brute.strobes) for r in settings.restitution for d in brute.directions]
+        sweeps = [SweepCase(scene_problem(scene, r), d, tuple(settings.frequency), brute.transient_periods, brute.strobes) for r in settings.restitution for d in brute.directions]
         maps = []
         if chart is not None:
             maps = [SweepCase(scene_problem(scene, chart.restitution, float(c)), d, tuple(settings.chart_frequency), chart.transient_periods, chart.strobes) for c in chart.clearances for d in brute.directions]
         # the chart's curves (the longest case) first, alongside the sweeps; then the branches, seeded from the sweeps
         charted = [ChartCase(scene_problem(scene, chart.restitution), settings.low, settings.high, chart.clearance, chart.kinds, chart.max_steps)] if chart else []
-        say(f"brute force: {len(sweeps)} sweeps of {scene.frequency.size} frequencies" + (f", regime map: {len(maps)} sweeps of {settings.chart_frequency.size}" if maps else "")
+        say(f"brute force: {len(sweeps)} sweeps of {settings.frequency.size} frequencies" + (f", regime map: {len(maps)} sweeps of {settings.chart_frequency.size}" if maps else "")
             + (f"; the chart's curves (R = {chart.restitution:g})" if chart else ""))  # fmt: skip
         first = runner.map(charted + sweeps + maps)
         chart_result, swept = (first[0], first[1:]) if chart else (None, first)
@@ -109,7 +109,7 @@ class BifurcationStudy:
             if settings.branches.brute_force:
                 for j, _direction in enumerate(brute.directions):
                     result = swept[i * len(brute.directions) + j]
-                    seeds += sweep_seeds(scene.frequency, result["period"], result["impacts"], result["state"], j)
+                    seeds += sweep_seeds(settings.frequency, result["period"], result["impacts"], result["state"], j)
             continuation.append(BranchCase(scene_problem(scene, r), settings.low, settings.high, options, tuple(seeds)))
         say(f"continuing the branches of R = {', '.join(f'{r:g}' for r in settings.restitution)}")
         results = runner.map(continuation)
@@ -135,7 +135,7 @@ class BifurcationStudy:
         assert settings is not None
         brute = settings.brute_force
         per_period = costs.per_period_cost("exact", 0.0) * BRUTE_FACTOR
-        periods = scene.frequency.size * len(settings.restitution) * len(brute.directions) * (brute.transient_periods + brute.strobes)
+        periods = settings.frequency.size * len(settings.restitution) * len(brute.directions) * (brute.transient_periods + brute.strobes)
         continuation = [CONTINUATION_SECONDS if settings.branches.brute_force else CLOSED_FORM_SECONDS] * len(settings.restitution)
         chart_seconds = 0.0
         if settings.chart is not None:
@@ -244,7 +244,7 @@ def _brute(results: list[CaseResult], scene: Scene, directions: tuple[str, ...],
             "brute_period": (grid, stack("period").astype(np.int16), a["brute_period"]),
             "brute_lyapunov_exponent": (grid, stack("lyapunov"), a["brute_lyapunov_exponent"]),
         },
-        coords={"restitution": np.array(settings.restitution), "sweep": list(directions), "frequency": scene.frequency, "strobe": ("strobe", np.arange(strobes), a["strobe"])},
+        coords={"restitution": np.array(settings.restitution), "sweep": list(directions), "frequency": settings.frequency, "strobe": ("strobe", np.arange(strobes), a["strobe"])},
     )
 
 
@@ -316,5 +316,5 @@ def _layout_attributes(scene: Scene) -> dict[str, object]:
         f"excitation_amplitude_{'m' if load.base_motion else 'N'}": scene.amplitude,
         "excitation_weights": np.array(load.weights if load.weights is not None else [1.0] + [0.0] * (size - 1)),
         "excitation_static_N": np.array(load.static if load.static is not None else [0.0] * size),
-        "stop_layout": "; ".join(describe_stop(spec, names, float(scene.clearance[0])) for spec in scene.stop_specs),
+        "stop_layout": "; ".join(describe_stop(spec, names, scene.settings.clearance) for spec in scene.stop_specs),
     }

@@ -194,9 +194,7 @@ def parse_concepts_scene(document: Any, text: str = "", source: str = "scene") -
 
     name, description, report, settings = parse_concepts(document, source)
     return Scene(
-        name=name, description=description, system=settings.system, amplitude=settings.amplitude, frequency=settings.frequency,
-        restitution=np.array([np.nan]), clearance=np.array([np.nan]), swept=("frequency",), solutions=(), quantities=(),
-        kind="concepts", settings=settings, report=report, text=text,
+        name=name, description=description, system=settings.system, amplitude=settings.amplitude, kind="concepts", settings=settings, report=report, text=text,
     )  # fmt: skip
 
 

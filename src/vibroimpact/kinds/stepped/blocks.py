@@ -77,21 +77,21 @@ class BlockPlan:
 
 def _simulates(scene: Scene) -> bool:
     """Whether the scene asks for a time-domain solution (and so has simulation settings)."""
-    return scene.simulation is not None and any(name in ENGINE_SOLUTIONS for name in scene.solutions)
+    return scene.settings.simulation is not None and any(name in ENGINE_SOLUTIONS for name in scene.settings.solutions)
 
 
 def plan_blocks(scene: Scene, workers: int) -> BlockPlan:
     """Blocks of ``scene``'s grid for ``workers`` workers (module docstring)."""
-    frequency = scene.all_frequencies
-    bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
-    directions = max(len(scene.sweep_directions), 1)
-    full = (scene.restitution.size, scene.clearance.size, bumpers, directions, frequency.size)
+    frequency = scene.settings.all_frequencies
+    bumpers = scene.settings.bumper_frequency.size if scene.settings.bumper_frequency is not None else 1
+    directions = max(len(scene.settings.sweep_directions), 1)
+    full = (scene.settings.restitution.size, scene.settings.clearance.size, bumpers, directions, frequency.size)
     if _simulates(scene):
-        assert scene.simulation is not None
+        assert scene.settings.simulation is not None
         rows = full[0] * full[1] * full[2] * full[3]
-        per_row = scene.simulation.frequency.size
+        per_row = scene.settings.simulation.frequency.size
         target = int(np.clip(rows * per_row / (BLOCKS_PER_WORKER * max(workers, 1)), *SIMULATED_POINTS))
-        if scene.simulation.start in SWEEP_STARTS:
+        if scene.settings.simulation.start in SWEEP_STARTS:
             row = frequency.size  # a chain: whole rows
         else:
             row = max(1, min(frequency.size, math.ceil(target * frequency.size / max(per_row, 1))))
@@ -108,20 +108,21 @@ def plan_blocks(scene: Scene, workers: int) -> BlockPlan:
 def block_scene(scene: Scene, region: dict[str, slice]) -> Scene:
     """The scene restricted to a block: the same scene with the block's restitution, clearance, bumper and frequency
     values (the analytic and the simulation grids each keep their frequencies inside the block's range)."""
-    frequencies = scene.all_frequencies[region["frequency"]]
+    grid = scene.settings
+    frequencies = grid.all_frequencies[region["frequency"]]
     restitution = region["restitution"]
     changes: dict[str, object] = {
-        "restitution": scene.restitution[restitution],
-        "clearance": scene.clearance[region["clearance"]],
-        "frequency": np.intersect1d(scene.frequency, frequencies),
+        "restitution": grid.restitution[restitution],
+        "clearance": grid.clearance[region["clearance"]],
+        "frequency": np.intersect1d(grid.frequency, frequencies),
     }
-    if scene.bumper_frequency is not None:
-        changes["bumper_frequency"] = scene.bumper_frequency[region["bumper_frequency"]]
-    if scene.bumper_loss_factor is not None and np.size(scene.bumper_loss_factor) == scene.restitution.size and scene.restitution.size > 1:
-        changes["bumper_loss_factor"] = np.asarray(scene.bumper_loss_factor)[restitution]
-    if scene.simulation is not None:
-        changes["simulation"] = replace(scene.simulation, frequency=np.intersect1d(scene.simulation.frequency, frequencies))
-    return replace(scene, **changes)  # type: ignore[arg-type]
+    if grid.bumper_frequency is not None:
+        changes["bumper_frequency"] = grid.bumper_frequency[region["bumper_frequency"]]
+    if grid.bumper_loss_factor is not None and np.size(grid.bumper_loss_factor) == grid.restitution.size and grid.restitution.size > 1:
+        changes["bumper_loss_factor"] = np.asarray(grid.bumper_loss_factor)[restitution]
+    if grid.simulation is not None:
+        changes["simulation"] = replace(grid.simulation, frequency=np.intersect1d(grid.simulation.frequency, frequencies))
+    return replace(scene, settings=replace(grid, **changes))  # type: ignore[arg-type]
 
 
 def _solve_block(shared: tuple[Scene, BlockPlan, BlockSolver], index: int, report: ProgressReport) -> dict[str, tuple[tuple[str, ...], np.ndarray, dict[str, object]]]:
@@ -137,11 +138,11 @@ def block_work(scene: Scene, plan: BlockPlan, index: int) -> float:
     region = plan.region(index)
     if not _simulates(scene):
         return float(plan.points(index))
-    assert scene.simulation is not None
-    frequencies = scene.all_frequencies[region["frequency"]]
-    simulated = np.count_nonzero((scene.simulation.frequency >= frequencies[0]) & (scene.simulation.frequency <= frequencies[-1]))
+    assert scene.settings.simulation is not None
+    frequencies = scene.settings.all_frequencies[region["frequency"]]
+    simulated = np.count_nonzero((scene.settings.simulation.frequency >= frequencies[0]) & (scene.settings.simulation.frequency <= frequencies[-1]))
     rows = math.prod(s.stop - s.start for dim, s in region.items() if dim != "frequency")
-    engines = sum(1 for name in scene.solutions if name in ENGINE_SOLUTIONS)
+    engines = sum(1 for name in scene.settings.solutions if name in ENGINE_SOLUTIONS)
     return float(simulated * rows * engines)
 
 

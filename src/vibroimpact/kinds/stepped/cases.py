@@ -260,23 +260,23 @@ def _two_sided(scene: Scene) -> bool:
     """Is the layout a symmetric two-sided stop (two stops whose closed form is the two-impacts orbit)?"""
     if len(scene.stop_specs) != 2:
         return False
-    problem = scene_problem(scene, float(scene.all_frequencies[0]), float(scene.restitution[0]), float(scene.clearance[0]))
+    problem = scene_problem(scene, float(scene.settings.all_frequencies[0]), float(scene.settings.restitution[0]), float(scene.settings.clearance[0]))
     return closed_form_refusal(problem) is None
 
 
 def general_simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], runner: Runner) -> dict[str, np.ndarray]:
     """Steady states of a time-domain engine on the simulation grid of ``scene``; NaN at the other frequencies."""
-    assert scene.simulation is not None
-    sim = scene.simulation
-    columns = np.searchsorted(scene.all_frequencies, sim.frequency)
+    assert scene.settings.simulation is not None
+    sim = scene.settings.simulation
+    columns = np.searchsorted(scene.settings.all_frequencies, sim.frequency)
     on_bumper = engine_spec(engine).contact == BUMPER
-    bumpers = scene.bumper_frequency if on_bumper and scene.bumper_frequency is not None else np.array([np.nan])
-    losses = scene.loss_factors() if on_bumper and scene.bumper_loss_factor is not None else np.full(scene.restitution.shape, np.nan)
+    bumpers = scene.settings.bumper_frequency if on_bumper and scene.settings.bumper_frequency is not None else np.array([np.nan])
+    losses = scene.settings.loss_factors() if on_bumper and scene.settings.bumper_loss_factor is not None else np.full(scene.settings.restitution.shape, np.nan)
     chunk = sim.frequency.size if sim.start in SWEEP_STARTS else CASE_CHUNK
     specs = scene.stop_specs
     cases, places = [], []
-    for i, restitution in enumerate(scene.restitution):
-        for j, clearance in enumerate(scene.clearance):
+    for i, restitution in enumerate(scene.settings.restitution):
+        for j, clearance in enumerate(scene.settings.clearance):
             for k, bumper in enumerate(bumpers):
                 rigid = build_stops(specs, False, float(restitution), float(clearance))
                 contact = build_stops(specs, True, float(restitution), float(clearance), float(bumper), float(losses[i])) if on_bumper else rigid

@@ -60,12 +60,12 @@ class StudyGrid:
     @classmethod
     def of(cls, scene: Scene) -> "StudyGrid":
         """The grid of ``scene``."""
-        frequency = scene.all_frequencies
-        bumper = scene.bumper_frequency if scene.bumper_frequency is not None else np.array([np.nan])
-        directions = scene.sweep_directions or ("",)
-        full = (scene.restitution.size, scene.clearance.size, bumper.size, len(directions), frequency.size)
-        r = scene.restitution[:, None, None, None, None]
-        delta = scene.clearance[None, :, None, None, None]
+        frequency = scene.settings.all_frequencies
+        bumper = scene.settings.bumper_frequency if scene.settings.bumper_frequency is not None else np.array([np.nan])
+        directions = scene.settings.sweep_directions or ("",)
+        full = (scene.settings.restitution.size, scene.settings.clearance.size, bumper.size, len(directions), frequency.size)
+        r = scene.settings.restitution[:, None, None, None, None]
+        delta = scene.settings.clearance[None, :, None, None, None]
         omega = 2.0 * np.pi * frequency[None, None, None, None, :]
         base = np.broadcast_shapes(r.shape, delta.shape, omega.shape)
         return cls(frequency, bumper, directions, full, r, delta, omega, base)
@@ -79,9 +79,9 @@ def solve_each(scene: Scene, grid: StudyGrid, simulate: Callable[[str], Values],
     route where the scene has its layout (:mod:`vibroimpact.kinds.stepped.values`).
     """
     report = progress or (lambda _message: None)
-    total = len(scene.solutions)
+    total = len(scene.settings.solutions)
     per_solution = []
-    for i, name in enumerate(scene.solutions, start=1):
+    for i, name in enumerate(scene.settings.solutions, start=1):
         if name == "linear":
             values = general_linear_values(scene, grid.omega, grid.base)
         elif name in ENGINE_SOLUTIONS:
@@ -97,9 +97,9 @@ def solve_each(scene: Scene, grid: StudyGrid, simulate: Callable[[str], Values],
 
 def grid_coordinates(scene: Scene, grid: StudyGrid, solutions: list[str]) -> dict[str, object]:
     """Coordinates of the dataset before squeezing: ``solution`` (if any), the parameters and ``frequency``."""
-    coords: dict[str, object] = {"solution": np.array(solutions, dtype=object), "restitution": scene.restitution, "clearance": scene.clearance, "frequency": grid.frequency}
-    if scene.bumper_frequency is not None:
-        coords["bumper_frequency"] = scene.bumper_frequency
+    coords: dict[str, object] = {"solution": np.array(solutions, dtype=object), "restitution": scene.settings.restitution, "clearance": scene.settings.clearance, "frequency": grid.frequency}
+    if scene.settings.bumper_frequency is not None:
+        coords["bumper_frequency"] = scene.settings.bumper_frequency
     if not solutions:
         del coords["solution"]
     return coords
@@ -116,7 +116,7 @@ def steady_variable(quantity: str, scene: Scene, grid: StudyGrid, per_solution: 
             value = np.broadcast_to(value, (1, *grid.full))[0]
         return np.broadcast_to(value, grid.full)
 
-    steady = [full(name, values) for name, values in zip(scene.solutions, per_solution) if name in solutions]
+    steady = [full(name, values) for name, values in zip(scene.settings.solutions, per_solution) if name in solutions]
     return np.stack(steady) if steady else None
 
 
@@ -126,16 +126,16 @@ def finish_dataset(dataset: xr.Dataset, scene: Scene, coords: dict[str, object],
     for key in ("restitution", "clearance", "bumper_frequency", "sweep"):
         if key in keep:
             continue
-        swept = key in scene.swept or (key == "restitution" and "bumper_loss_factor" in scene.swept)
+        swept = key in scene.settings.swept or (key == "restitution" and "bumper_loss_factor" in scene.settings.swept)
         if not swept and key in dataset.dims:
             dataset = dataset.squeeze(key, drop=key not in coords)
         if key in dataset.coords and dataset[key].ndim == 0 and dataset[key].dtype.kind == "f" and not np.isfinite(float(dataset[key])):
             dataset = dataset.drop_vars(key)  # the stops give different values: the stop descriptions say them
-    if scene.bumper_frequency is not None:
-        losses = scene.loss_factors()
+    if scene.settings.bumper_frequency is not None:
+        losses = scene.settings.loss_factors()
         if "restitution" in dataset.dims or np.isfinite(losses[0]):  # none at R = 0 (no loss factor gives it); stops may each have their own
             dataset = dataset.assign_coords(bumper_loss_factor=("restitution", losses) if "restitution" in dataset.dims else float(losses[0]))
-        if "bumper_loss_factor" in scene.swept:
+        if "bumper_loss_factor" in scene.settings.swept:
             dataset = dataset.swap_dims({"restitution": "bumper_loss_factor"})
     for key, attrs in COORDINATE_ATTRIBUTES.items():
         if key in dataset.coords:
@@ -147,7 +147,7 @@ def finish_dataset(dataset: xr.Dataset, scene: Scene, coords: dict[str, object],
 def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[str, object]:
     structure = scene.system.structure
     named = TwoDofSystem.of(scene.system)  # the named view: the paper's two-mass chain, however it was written
-    fit = fit_modal_parameters(named) if named is not None and "pgf_paper" in scene.solutions else None
+    fit = fit_modal_parameters(named) if named is not None and "pgf_paper" in scene.settings.solutions else None
     natural = named.natural_frequencies() if named is not None else structure.natural_frequencies()
     attrs: dict[str, object] = {
         "title": f"vibroimpact study '{scene.name}'",
@@ -161,10 +161,10 @@ def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[st
         attrs["antiresonance_frequency_Hz"] = named.antiresonance_frequency() / (2.0 * np.pi)
         for key, value in named.as_dict().items():
             attrs[f"system_{key}"] = value
-    attrs.update(layout_attributes(scene))
-    if "pgf_paper" in scene.solutions:
+    attrs.update(layout_attributes(scene, scene.settings.restitution, scene.settings.clearance))
+    if "pgf_paper" in scene.settings.solutions:
         attrs["method_pgf_paper"] = "the paper's route: curve-fitted modal parameters of H22 (eq. 10, Omega fixed from eq. 11); chi22'(0-) = -1/(2 M2); stable (+) root of corrected eq. 16"
-    for key, value in asdict(scene.admissibility).items():
+    for key, value in asdict(scene.settings.admissibility).items():
         attrs[f"admissibility_{key}"] = value
     attrs.update(simulation_attributes)
     if isinstance(scene.report, str):
@@ -175,9 +175,12 @@ def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[st
     return attrs
 
 
-def layout_attributes(scene: Scene) -> dict[str, object]:
+def layout_attributes(scene: Scene, restitution: np.ndarray, clearance: np.ndarray) -> dict[str, object]:
     """What a dataset records of its scene's structure, load and stops (plain netCDF attributes: matrices flattened
-    row by row, names and descriptions joined, one value per stop), so that a report can rebuild them."""
+    row by row, names and descriptions joined, one value per stop), so that a report can rebuild them.
+
+    ``restitution`` [-] and ``clearance`` [m] are the values the study gives the stops that take them (one value:
+    stated; several: swept)."""
     structure = scene.system.structure
     load = scene.load_spec
     size = structure.size
@@ -192,13 +195,13 @@ def layout_attributes(scene: Scene) -> dict[str, object]:
         "excitation_weights": _attribute(load.weights if load.weights is not None else [1.0] + [0.0] * (size - 1)),
         "excitation_static_N": _attribute(load.static if load.static is not None else [0.0] * size),
         "stop_count": len(specs),
-        "stop_layout": "; ".join(stop_descriptions(specs, tuple(structure.coordinates), scene.restitution, scene.clearance)),
+        "stop_layout": "; ".join(stop_descriptions(specs, tuple(structure.coordinates), restitution, clearance)),
         "stop_coordinate": _attribute([spec.coordinate for spec in specs]),
         "stop_other": _attribute([-1 if spec.other is None else spec.other for spec in specs]),
         "stop_side": " ".join(spec.side for spec in specs),
         # each stop's own clearance, or the grid's single value; NaN where the grid sweeps it
         "stop_clearance_m": _attribute([
-            float(spec.clearance) if spec.clearance is not None else (float(scene.clearance[0]) if scene.clearance.size == 1 else np.nan) for spec in specs
+            float(spec.clearance) if spec.clearance is not None else (float(clearance[0]) if clearance.size == 1 else np.nan) for spec in specs
         ]),  # fmt: skip
         "method_pgf": "closed-form impact orbit (periodic Green function of the stopped coordinate n^T H n; one impact per period on one stop, two on a symmetric two-sided stop); stable (+) root",
         "method_force": "force on the base: 1^T (K x + C x') through springs and dashpots plus (1^T n_k) lambda_k of each absolute stop",
@@ -245,20 +248,20 @@ def grid_estimate(
     of a study solved in grid blocks, each costing the scheduler and the store's writes in the main process."""
     parts: dict[str, float] = {}
     points: dict[str, str] = {}
-    frequency = scene.all_frequencies
-    bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
-    grid = scene.restitution.size * scene.clearance.size * frequency.size
+    frequency = scene.settings.all_frequencies
+    bumpers = scene.settings.bumper_frequency.size if scene.settings.bumper_frequency is not None else 1
+    grid = scene.settings.restitution.size * scene.settings.clearance.size * frequency.size
     closed_form = 0.0
     simulated = 0.0
     biggest_case = 0.0
-    for name in scene.solutions:
+    for name in scene.settings.solutions:
         if name not in ENGINE_SOLUTIONS:
-            seconds = costs.closed_form_per_point[name] * grid * (bumpers if name == "pgf" and scene.bumper_frequency is not None else 1) * closed_form_scale(name)
+            seconds = costs.closed_form_per_point[name] * grid * (bumpers if name == "pgf" and scene.settings.bumper_frequency is not None else 1) * closed_form_scale(name)
             parts[name] = seconds
             closed_form += seconds
             continue
-        assert scene.simulation is not None
-        parts[name], points[name], serial = engine_part(name, cost_engine(name, scene.simulation.engine.method))
+        assert scene.settings.simulation is not None
+        parts[name], points[name], serial = engine_part(name, cost_engine(name, scene.settings.simulation.engine.method))
         biggest_case = max(biggest_case, serial)
         simulated += parts[name]
     report = 0.0
@@ -268,7 +271,7 @@ def grid_estimate(
     workers = min(jobs, os_cpus())
     overhead = 0.0
     if blocks is not None:
-        overhead = blocks(workers) * (TASK_SECONDS + WRITE_SECONDS_PER_VARIABLE * len(scene.quantities))
+        overhead = blocks(workers) * (TASK_SECONDS + WRITE_SECONDS_PER_VARIABLE * len(scene.settings.quantities))
         parts["scheduler and store"] = overhead
         closed_form /= workers  # the closed forms are solved block by block on the workers too
     startup = costs.startup + cluster_startup(jobs)
@@ -281,14 +284,14 @@ def memory(scene: Scene, jobs: int, costs: Costs, sweep_samples: float = 0.0, st
     stacked, written: ~3 copies; ``streamed``: solved in blocks into the store and exported chunk by chunk, so only
     the report reads it whole), one worker footprint per process simulating, and the ``sweep_samples`` of one sweep
     per worker."""
-    frequency = scene.all_frequencies
-    bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
-    directions = max(1, len(scene.sweep_directions))
-    cells = scene.restitution.size * scene.clearance.size * bumpers * directions * frequency.size
-    dataset = 3.0 * 8.0 * len(scene.quantities) * len(scene.solutions) * cells
+    frequency = scene.settings.all_frequencies
+    bumpers = scene.settings.bumper_frequency.size if scene.settings.bumper_frequency is not None else 1
+    directions = max(1, len(scene.settings.sweep_directions))
+    cells = scene.settings.restitution.size * scene.settings.clearance.size * bumpers * directions * frequency.size
+    dataset = 3.0 * 8.0 * len(scene.settings.quantities) * len(scene.settings.solutions) * cells
     if streamed:
         dataset = dataset / 3.0 if scene.report else 0.0
-    simulating = any(name in ENGINE_SOLUTIONS for name in scene.solutions)
+    simulating = any(name in ENGINE_SOLUTIONS for name in scene.settings.solutions)
     workers = min(jobs, os_cpus()) if (simulating or streamed) and jobs > 1 else 0
     sweep = 0.0
     if sweep_samples:

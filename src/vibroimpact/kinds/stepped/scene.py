@@ -1,4 +1,6 @@
-"""The sections of a scene over parameter grids (stepped steady states or swept-sine tests), and the grid scene itself.
+"""The sections of a scene over parameter grids (stepped steady states or swept-sine tests), the grid scene itself,
+and its settings (:class:`GridSettings`: the :attr:`~vibroimpact.scene.schema.Scene.settings` of a ``stepped`` or
+``swept`` scene).
 
 Each ``_parse_*`` function checks one section of the document with a :class:`~vibroimpact.scene.checker.Checker`
 (recording every problem, returning None where a value is unusable); :func:`parse_grid_scene` puts them together.
@@ -9,6 +11,7 @@ from __future__ import annotations
 
 import math
 import re
+from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
 import numpy as np
@@ -16,7 +19,8 @@ import numpy as np
 from vibroimpact.analysis.pgf import AdmissibilitySettings
 from vibroimpact.engines.registry import BUMPER
 from vibroimpact.engines.settings import STEPPED_TOLERANCES, SWEPT_TOLERANCES, EngineSettings
-from vibroimpact.model.contact import restitution_from_loss_factor
+from vibroimpact.model.contact import loss_factor_from_restitution, restitution_from_loss_factor
+from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.modal import underdamped_mode_count
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.checker import Checker, SceneError, interval
@@ -33,12 +37,10 @@ from vibroimpact.scene.schema import (
     SWEEPABLE,
     Scene,
     quantities_for,
-    SimulationSettings,
-    SweptSineSettings,
 )
 from vibroimpact.simulation.settings import SteadySettings
 
-__all__ = ["TOP_KEYS", "NAME", "parse_grid_scene", "parse_header", "check_sweep_run"]
+__all__ = ["GridSettings", "SimulationSettings", "SweptSineSettings", "TOP_KEYS", "NAME", "parse_grid_scene", "parse_header", "check_sweep_run"]
 
 #: Top-level keys of a grid scene.
 TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bumper", "sweep", "swept_sine", "solutions", "quantities", "settings", "simulation", "report", "cluster"}
@@ -52,6 +54,128 @@ _SIMULATION_KEYS = {"frequency", "start", "method", "rtol", "atol", "max_step", 
 #: Where an unswept parameter is given instead (``frequency`` is always swept).
 _FIXED_PLACE = {"restitution": ("stop", "restitution"), "clearance": ("stop", "clearance"), "bumper_frequency": ("bumper", "frequency"), "bumper_loss_factor": ("bumper", "loss_factor")}
 _T = TypeVar("_T")
+
+
+@dataclass(frozen=True, eq=False)
+class SimulationSettings:
+    """How the time-domain solutions (``momentary``, ``exact``) are run.
+
+    Attributes
+    ----------
+    frequency : ndarray
+        Frequencies simulated [Hz] (a coarser grid than the analytic one, merged into the dataset's axis).
+    start : str
+        One of :data:`SIMULATION_STARTS`.
+    engine : EngineSettings
+        Integrator tolerances and method.
+    steady : SteadySettings
+        Convergence and measurement of the steady state.
+    """
+
+    frequency: np.ndarray
+    start: str = "pgf"
+    engine: EngineSettings = field(default_factory=EngineSettings)
+    steady: SteadySettings = field(default_factory=SteadySettings)
+
+
+@dataclass(frozen=True)
+class SweptSineSettings:
+    """A swept-sine test (the paper's Simulink run, section 5) instead of stepped steady states.
+
+    Attributes
+    ----------
+    start_frequency, stop_frequency : float
+        Ends of the sweep [Hz] (a sweep down runs from ``stop_frequency`` to ``start_frequency``).
+    rate : float
+        |alpha| [Hz s-1].
+    directions : tuple of str
+        Some of ``up``, ``down``.
+    sample_rate : float
+        Output samples per second of the simulated signals [Hz].
+    window_cycles : int
+        Cycles of the excitation in the running estimators' window.
+    initial_state : str
+        ``linear``: each run starts on the linear steady state at its first frequency (where it fits inside the
+        clearance; else at rest), so no start-up transient shows; ``rest``: at rest, like a bench test.
+    """
+
+    start_frequency: float
+    stop_frequency: float
+    rate: float
+    directions: tuple[str, ...] = SWEEP_DIRECTIONS
+    sample_rate: float = 1000.0
+    window_cycles: int = 8
+    initial_state: str = "linear"
+
+    def sweep(self, amplitude: float, direction: str) -> SweptSine:
+        """The excitation of one direction."""
+        low, high = self.start_frequency, self.stop_frequency
+        return SweptSine(amplitude, low, high, self.rate) if direction == "up" else SweptSine(amplitude, high, low, self.rate)
+
+
+@dataclass(frozen=True, eq=False)
+class GridSettings:
+    """What a grid scene computes: its solutions over a grid of frequencies, restitutions, clearances and bumpers.
+
+    Attributes
+    ----------
+    frequency : ndarray
+        Excitation frequencies [Hz], increasing.
+    restitution : ndarray
+        Restitution ratios R [-]; one value unless swept.
+    clearance : ndarray
+        Clearances Delta [m]; one value unless swept.
+    swept : tuple of str
+        Parameters that are dimensions of the output, in dimension order (``frequency`` last).
+    solutions : tuple of str
+        Solutions to compute.
+    quantities : tuple of str
+        Quantities to write.
+    admissibility : AdmissibilitySettings
+        Settings of the X2(t) <= Delta check.
+    simulation : SimulationSettings or None
+        Settings of the time-domain solutions, when the scene asks for any.
+    bumper_frequency : ndarray or None
+        Omega_b / 2 pi of the compliant bumper [Hz] (one value unless swept); None without a bumper.
+    bumper_loss_factor : ndarray or None
+        xi_b [-]: one value, or one per ``restitution`` when ``bumper_loss_factor`` is swept (``restitution`` then
+        holds R(xi_b), eq. 26 corrected); None: each restitution's own loss factor (the exact inverse of R(xi_b)).
+    swept_sine : SweptSineSettings or None
+        When given, the time-domain solutions are swept-sine tests, not stepped steady states.
+    sweep_stops : tuple of int or None
+        The stops that swept restitution, clearance and bumper values apply to; None: every stop.
+    """
+
+    frequency: np.ndarray
+    restitution: np.ndarray
+    clearance: np.ndarray
+    swept: tuple[str, ...]
+    solutions: tuple[str, ...]
+    quantities: tuple[str, ...]
+    admissibility: AdmissibilitySettings = field(default_factory=AdmissibilitySettings)
+    simulation: SimulationSettings | None = None
+    bumper_frequency: np.ndarray | None = None
+    bumper_loss_factor: np.ndarray | None = None
+    swept_sine: SweptSineSettings | None = None
+    sweep_stops: tuple[int, ...] | None = None
+
+    def loss_factors(self) -> np.ndarray:
+        """The bumper's xi_b for each restitution of the grid [-] (NaN where none gives it, R = 0)."""
+        if self.bumper_loss_factor is not None:
+            return np.broadcast_to(self.bumper_loss_factor, self.restitution.shape).astype(float)
+        return np.array([loss_factor_from_restitution(r) if r > 0.0 else np.nan for r in self.restitution])
+
+    @property
+    def sweep_directions(self) -> tuple[str, ...]:
+        """Directions of the swept-sine test; ``()`` for stepped steady states."""
+        return () if self.swept_sine is None else self.swept_sine.directions
+
+    @property
+    def all_frequencies(self) -> np.ndarray:
+        """The dataset's frequency axis: the analytic grid merged with the simulation grid [Hz]."""
+        if self.simulation is None:
+            return self.frequency
+        return np.union1d(self.frequency, self.simulation.frequency)
 
 
 def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
@@ -171,12 +295,14 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     assert frequency is not None and restitution is not None and clearance is not None
     order = ("bumper_loss_factor", "restitution", "clearance", "bumper_frequency")
     swept = tuple(k for k in order if k in sweep) + ("frequency",)
+    grid = GridSettings(
+        frequency=frequency, restitution=restitution, clearance=clearance, swept=swept, solutions=solutions, quantities=quantities,
+        admissibility=admissibility, simulation=simulation, bumper_frequency=grids.get("bumper_frequency"),
+        bumper_loss_factor=grids.get("bumper_loss_factor"), swept_sine=swept_sine, sweep_stops=targets,
+    )
     return Scene(
-        name=name, description=description, system=system, amplitude=amplitude,
-        frequency=frequency, restitution=restitution, clearance=clearance, swept=swept,
-        solutions=solutions, quantities=quantities, admissibility=admissibility, simulation=simulation,
-        bumper_frequency=grids.get("bumper_frequency"), bumper_loss_factor=grids.get("bumper_loss_factor"), swept_sine=swept_sine, kind="stepped" if swept_sine is None else "swept",
-        report=report, text=text, load=load, stops=specs if "stops" in doc and specs is not None else (), sweep_stops=targets, general=general,
+        name=name, description=description, system=system, amplitude=amplitude, kind="stepped" if swept_sine is None else "swept", settings=grid,
+        report=report, text=text, load=load, stops=specs if "stops" in doc and specs is not None else (), general=general,
         cluster_scheduler=scheduler,
     )
 

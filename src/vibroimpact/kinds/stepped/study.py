@@ -57,14 +57,14 @@ def general_orbit_outlook(scene: Scene, frequencies: np.ndarray) -> tuple[np.nda
     off the stops, is stable (all False without a closed form); the share of impacting points without a closed form
     assumed never to settle (0 where a closed form applies).
     """
-    problem = scene_problem(scene, float(frequencies[0]), float(scene.restitution[0]), float(scene.clearance[0]))
+    problem = scene_problem(scene, float(frequencies[0]), float(scene.settings.restitution[0]), float(scene.settings.clearance[0]))
     omega = 2.0 * np.pi * frequencies[None, None, :]
     clearances = stop_clearances(scene)[None, :, None, :]  # (1, nc, 1, K)
-    fits = np.broadcast_to(linear_amplitudes(problem, omega).fits(clearances), (scene.restitution.size, scene.clearance.size, frequencies.size))
+    fits = np.broadcast_to(linear_amplitudes(problem, omega).fits(clearances), (scene.settings.restitution.size, scene.settings.clearance.size, frequencies.size))
     shape = fits.shape
     if closed_form_refusal(problem) is not None:
         return fits, np.zeros(shape, dtype=bool), np.zeros(shape, dtype=bool), UNKNOWN_WANDERING
-    orbit = solve_impact_orbit(problem, omega, scene.clearance[None, :, None], scene.restitution[:, None, None])
+    orbit = solve_impact_orbit(problem, omega, scene.settings.clearance[None, :, None], scene.settings.restitution[:, None, None])
     admissible = np.broadcast_to(orbit.admissible(), shape)
     stable = np.zeros(shape, dtype=bool)
     if admissible.any():
@@ -106,7 +106,7 @@ def general_block(scene: Scene, runner: Runner) -> xr.Dataset:
     per_solution = solve_each(scene, grid, lambda name: general_simulated_values(scene, name, grid.full, runner), None)
     count = len(scene.stop_specs)
     data_vars = {}
-    for quantity in scene.quantities:
+    for quantity in scene.settings.quantities:
         attrs = general_quantity_attributes(quantity, scene)
         if quantity in STOP_QUANTITIES:
             stacked = np.stack([np.broadcast_to(values[quantity], (count, *grid.full)) for values in per_solution])
@@ -123,11 +123,11 @@ def general_block(scene: Scene, runner: Runner) -> xr.Dataset:
 def general_coordinates(scene: Scene, grid: StudyGrid) -> dict[str, object]:
     """Coordinates of a stepped study's dataset before squeezing: those of :func:`grid_coordinates`, and ``stop``
     with ``stop_description`` where the scene has several stops and writes a per-stop quantity."""
-    coords = grid_coordinates(scene, grid, list(scene.solutions))
+    coords = grid_coordinates(scene, grid, list(scene.settings.solutions))
     count = len(scene.stop_specs)
-    if count > 1 and any(q in STOP_QUANTITIES for q in scene.quantities):
+    if count > 1 and any(q in STOP_QUANTITIES for q in scene.settings.quantities):
         coords["stop"] = np.arange(count)
-        coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.stop_specs, scene.coordinates, scene.restitution, scene.clearance), dtype=object))
+        coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.stop_specs, scene.coordinates, scene.settings.restitution, scene.settings.clearance), dtype=object))
     return coords
 
 
@@ -158,7 +158,7 @@ class SteppedStudy:
         way the scene writes its system; the variables are read lazily from the runner's store."""
         say = progress or (lambda _message: None)
         grid = StudyGrid.of(scene)
-        solutions = list(scene.solutions)
+        solutions = list(scene.settings.solutions)
         coords = general_coordinates(scene, grid)
         raw = run_grid(scene, runner, general_block, {"solution": len(solutions), "stop": len(scene.stop_specs)})
         dataset = describe_stops(raw.assign_coords(coords))
@@ -169,12 +169,12 @@ class SteppedStudy:
     def simulation_attributes(scene: Scene) -> dict[str, object]:
         """What the dataset records of the time-domain solutions' settings and methods."""
         attrs: dict[str, object] = {}
-        if scene.simulation is not None:
-            attrs["simulation_frequency_Hz"] = scene.simulation.frequency
-            attrs["simulation_start"] = scene.simulation.start
-            for key, value in asdict(scene.simulation.engine).items():
+        if scene.settings.simulation is not None:
+            attrs["simulation_frequency_Hz"] = scene.settings.simulation.frequency
+            attrs["simulation_start"] = scene.settings.simulation.start
+            for key, value in asdict(scene.settings.simulation.engine).items():
                 attrs[f"simulation_engine_{key}"] = value
-            for key, value in asdict(scene.simulation.steady).items():
+            for key, value in asdict(scene.settings.simulation.steady).items():
                 attrs[f"simulation_steady_{key}"] = value
             attrs["method_exact"] = "piecewise-exact propagation (eigenvectors + harmonic particular solution), contacts by guaranteed Taylor-bound root bracketing"
             attrs["method_momentary"] = "scikit-sundae CVODE with contact/release events and an apex event guarding grazing contacts"
@@ -184,25 +184,25 @@ class SteppedStudy:
     def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:
         """Seconds per simulated period of each engine at its tolerance times the periods each point is predicted to
         integrate (:func:`expected_periods`), on the calibration machine."""
-        bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
+        bumpers = scene.settings.bumper_frequency.size if scene.settings.bumper_frequency is not None else 1
         # the same for every engine: solved once (the closed form over up to ESTIMATE_POINTS points)
-        periods, scale = expected_periods(scene) if scene.simulation is not None else (np.zeros(0), 1.0)
+        periods, scale = expected_periods(scene) if scene.settings.simulation is not None else (np.zeros(0), 1.0)
 
         def engine_part(name: str, engine: str) -> EnginePart:
-            assert scene.simulation is not None
+            assert scene.settings.simulation is not None
             capabilities = engine_spec(name).capabilities
             copies = bumpers if capabilities.contact == BUMPER else 1  # a bumper engine runs once per bumper
-            steady = scene.simulation.steady
+            steady = scene.settings.simulation.steady
             # where the motion may never settle, an engine without exact Jacobians also runs a perturbed copy of its
             # Lyapunov run
             wandering = np.count_nonzero(periods >= steady.max_periods + steady.lyapunov_periods) if not capabilities.exact_jacobians else 0
             total_periods = (float(periods.sum()) + wandering * steady.lyapunov_periods) * scale * copies
-            seconds = costs.per_period_cost(engine, scene.simulation.engine.rtol) * engine_scale(scene) * total_periods
+            seconds = costs.per_period_cost(engine, scene.settings.simulation.engine.rtol) * engine_scale(scene) * total_periods
             integrated = int(np.count_nonzero(periods) * scale) * copies
-            points = f"{scene.restitution.size * scene.clearance.size * scene.simulation.frequency.size * copies} points, ~{integrated} integrated, ~{total_periods:.0f} periods"
+            points = f"{scene.settings.restitution.size * scene.settings.clearance.size * scene.settings.simulation.frequency.size * copies} points, ~{integrated} integrated, ~{total_periods:.0f} periods"
             serial = 0.0
-            if scene.simulation.start in SWEEP_STARTS:  # one serial chain per (R, Delta, bumper)
-                serial = seconds / (scene.restitution.size * scene.clearance.size * copies)
+            if scene.settings.simulation.start in SWEEP_STARTS:  # one serial chain per (R, Delta, bumper)
+                serial = seconds / (scene.settings.restitution.size * scene.settings.clearance.size * copies)
             return seconds, points, serial
 
         return grid_estimate(
@@ -219,8 +219,8 @@ def report_figures(scene: Scene) -> int:
     """Figures of the study's report page."""
     if scene.report == "design_map":
         return DESIGN_MAP_FIGURES
-    per_clearance = 12 if any(s in ENGINE_SOLUTIONS for s in scene.solutions) else 7
-    return 1 + per_clearance * scene.clearance.size + (2 if len(scene.swept) > 1 else 0)
+    per_clearance = 12 if any(s in ENGINE_SOLUTIONS for s in scene.settings.solutions) else 7
+    return 1 + per_clearance * scene.settings.clearance.size + (2 if len(scene.settings.swept) > 1 else 0)
 
 
 def expected_periods(scene: Scene) -> tuple[np.ndarray, float]:
@@ -233,14 +233,14 @@ def expected_periods(scene: Scene) -> tuple[np.ndarray, float]:
     plus the irregular measurement). From ``rest`` every point integrates, and the lightly damped transient of the
     linear modes (damping ratios ~1e-3) outlasts ``max_periods``.
     """
-    assert scene.simulation is not None
-    sim = scene.simulation
-    per_line = max(1, ESTIMATE_POINTS // (scene.restitution.size * scene.clearance.size))
+    assert scene.settings.simulation is not None
+    sim = scene.settings.simulation
+    per_line = max(1, ESTIMATE_POINTS // (scene.settings.restitution.size * scene.settings.clearance.size))
     frequencies = sim.frequency if sim.frequency.size <= per_line else sim.frequency[np.linspace(0, sim.frequency.size - 1, per_line).astype(int)]
     scale = sim.frequency.size / frequencies.size
     steady = sim.steady
     wander = steady.max_periods + steady.lyapunov_periods + steady.irregular_measure_periods
-    shape = (scene.restitution.size, scene.clearance.size, frequencies.size)
+    shape = (scene.settings.restitution.size, scene.settings.clearance.size, frequencies.size)
     if sim.start == "rest":
         return np.full(shape, float(wander)), scale
     fits, admissible, stable, wandering = general_orbit_outlook(scene, frequencies)

@@ -47,11 +47,11 @@ def scene_problem(scene: Scene, frequency: float, restitution: float, clearance:
 
 def stop_clearances(scene: Scene) -> np.ndarray:
     """Delta of every stop at every clearance of the grid [m], shape (clearance, K)."""
-    return np.array([[spec.values(np.nan, float(d))[1] for spec in scene.stop_specs] for d in scene.clearance])
+    return np.array([[spec.values(np.nan, float(d))[1] for spec in scene.stop_specs] for d in scene.settings.clearance])
 
 
 def first_problem(scene: Scene) -> ImpactProblem:
-    return scene_problem(scene, float(scene.all_frequencies[0]), float(scene.restitution[0]), float(scene.clearance[0]))
+    return scene_problem(scene, float(scene.settings.all_frequencies[0]), float(scene.settings.restitution[0]), float(scene.settings.clearance[0]))
 
 
 def _per_coordinate(scene: Scene, template: str, values: np.ndarray) -> dict[str, np.ndarray]:
@@ -99,7 +99,7 @@ def broadcast_quantities(scene: Scene, values: dict[str, np.ndarray], shape: tup
     value depends on more of the grid's axes (a peak estimate on the bumper axis)."""
     count = len(scene.stop_specs)
     out = {}
-    for name in scene.quantities:
+    for name in scene.settings.quantities:
         target = (count, *shape) if name in STOP_QUANTITIES else shape
         out[name] = np.broadcast_to(values[name], np.broadcast_shapes(target, np.shape(values[name])))
     return out
@@ -113,7 +113,7 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
     orbit = solve_impact_orbit(problem, w, d, rr)
     linear = linear_amplitudes(problem, w)
     fits = linear.fits(stop_clearances(scene)[None, :, None, None, None, :])
-    settings = scene.admissibility
+    settings = scene.settings.admissibility
     admissible = orbit.admissible(settings.relative_tolerance, settings.samples_per_period)
     regime = classify(np.broadcast_to(fits, w.shape), orbit.exists, admissible)
     modulus = np.where(admissible, np.max(np.abs(floquet_multipliers(orbit)), axis=-1), np.nan)
@@ -168,7 +168,7 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
         makers[coordinate_quantity("x1_amplitude", name)] = lambda i=i: choose(np.abs(harmonics()[..., i]), np.abs(linear.coordinates[..., i]))
         makers[coordinate_quantity("x1_rms", name)] = lambda i=i: choose(rms()[..., i], linear_rms[..., i])
         makers[coordinate_quantity("one_impact_x1_amplitude", name)] = lambda i=i: np.where(orbit.exists, np.abs(harmonics()[..., i]), np.nan)
-    return broadcast_quantities(scene, {q: makers[q]() for q in scene.quantities}, shape)
+    return broadcast_quantities(scene, {q: makers[q]() for q in scene.settings.quantities}, shape)
 
 
 def _peak_estimates(scene: Scene, orbit: ImpactOrbit, count: int) -> tuple[np.ndarray, np.ndarray]:
@@ -181,10 +181,10 @@ def _peak_estimates(scene: Scene, orbit: ImpactOrbit, count: int) -> tuple[np.nd
     the paper's estimate). The bumper is the orbit's first stop's own, else the grid's. NaN without a bumper.
     """
     spec = scene.stop_specs[orbit.layout.stops[0]]
-    grid_frequency = scene.bumper_frequency if scene.bumper_frequency is not None else np.array([np.nan])
+    grid_frequency = scene.settings.bumper_frequency if scene.settings.bumper_frequency is not None else np.array([np.nan])
     frequency = np.array([spec.bumper_frequency]) if spec.bumper_frequency is not None else grid_frequency
-    grid_losses = scene.loss_factors()
-    losses = np.array([spec.values(float(r), np.nan, np.nan, float(xi))[3] for r, xi in zip(scene.restitution, grid_losses)])
+    grid_losses = scene.settings.loss_factors()
+    losses = np.array([spec.values(float(r), np.nan, np.nan, float(xi))[3] for r, xi in zip(scene.settings.restitution, grid_losses)])
     gamma = np.array([peak_acceleration_factor(xi) if np.isfinite(xi) else np.nan for xi in losses])[:, None, None, None, None]
     omega_b = 2.0 * np.pi * frequency[None, None, :, None, None]
     force = gamma * omega_b * orbit.impulse / (1.0 + orbit.restitution)  # (R, D, bumper, 1, F)
@@ -230,7 +230,7 @@ def paper_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.n
     w = np.broadcast_to(omega, shape)
     linear = linear_amplitudes(problem, w)
     fits = np.broadcast_to(linear.fits(stop_clearances(scene)[None, :, None, None, None, :]), shape)
-    regime = classify(fits, solution.exists, solution.admissible(scene.admissibility))
+    regime = classify(fits, solution.exists, solution.admissible(scene.settings.admissibility))
     impact = np.isin(regime, _IMPACT_REGIMES)
     free = np.isin(regime, _LINEAR_REGIMES)
 
@@ -270,7 +270,7 @@ def paper_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.n
         "wall_time": lambda: nan,
         **{name: (lambda: nan) for name in MOTION_QUANTITIES},
     }
-    return broadcast_quantities(scene, {q: makers[q]() for q in scene.quantities}, shape)
+    return broadcast_quantities(scene, {q: makers[q]() for q in scene.settings.quantities}, shape)
 
 
 def _paper_peak_estimates(scene: Scene, system: TwoDofSystem, solution: OneImpactSolution, r: np.ndarray, shape: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
@@ -278,10 +278,10 @@ def _paper_peak_estimates(scene: Scene, system: TwoDofSystem, solution: OneImpac
     corrected): one collision with the bumper entered at J / (M2 (1 + R)) peaks at M2 Gamma(xi_b) Omega_b v0; the
     deceleration is that force less the absorber spring's pull at the impact, K2 (X1 - Delta) + B2 (X1' - X2'(0-)),
     over M2. NaN without one bumper frequency (a swept bumper: one per grid point)."""
-    if scene.bumper_frequency is None:
+    if scene.settings.bumper_frequency is None:
         return np.full(shape, np.nan), np.full(shape, np.nan)
-    gamma = np.array([peak_acceleration_factor(xi) if np.isfinite(xi) else np.nan for xi in scene.loss_factors()])[:, None, None, None, None]
-    omega_b = 2.0 * np.pi * scene.bumper_frequency[None, None, :, None, None]
+    gamma = np.array([peak_acceleration_factor(xi) if np.isfinite(xi) else np.nan for xi in scene.settings.loss_factors()])[:, None, None, None, None]
+    omega_b = 2.0 * np.pi * scene.settings.bumper_frequency[None, None, :, None, None]
     force = gamma * omega_b * solution.impulse / (1.0 + r)
     at_impact = np.zeros(1)
     with np.errstate(invalid="ignore"):

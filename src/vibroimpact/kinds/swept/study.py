@@ -35,7 +35,8 @@ from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.runner import ProgressReport, Runner
 from vibroimpact.runs.store import case_key
 from vibroimpact.scene.layout import LoadSpec, build_stops, stop_descriptions
-from vibroimpact.scene.schema import SweptSineSettings, ENGINE_SOLUTIONS, GRID_DIMS, MOTION_QUANTITIES, STOP_QUANTITIES, Scene
+from vibroimpact.kinds.stepped.scene import SweptSineSettings
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, MOTION_QUANTITIES, STOP_QUANTITIES, Scene
 from vibroimpact.scene.variables import SWEEP_STAT_ATTRIBUTES, SWEEP_TIME_ATTRIBUTES, quantity_attributes, swept_attributes
 from vibroimpact.simulation.harmonics import resting_state
 from vibroimpact.simulation.swept import SWEEP_STOP_QUANTITIES, sweep_estimates, sweep_quantities, sweep_start_state
@@ -191,22 +192,22 @@ class SweptStudy:
         swept: Values = {}
         running: Values = {}
         axes: Values = {}
-        for i, name in enumerate(scene.solutions, start=1):
+        for i, name in enumerate(scene.settings.solutions, start=1):
             if name in ENGINE_SOLUTIONS:
                 swept, running, axes = swept_values(scene, grid.full, runner)
             else:
                 steady[name] = closed_form_values(scene, name, grid)
-            report(f"[{i}/{len(scene.solutions)}] {name}: done")
+            report(f"[{i}/{len(scene.settings.solutions)}] {name}: done")
         # a swept-sine test depends on its direction, the steady-state solutions do not: they are not repeated along
         # ``sweep``; the swept runs' estimates on the frequency grid are the ``swept_*`` variables (sweep, frequency)
-        engine = next((name for name in scene.solutions if name in ENGINE_SOLUTIONS), "")
+        engine = next((name for name in scene.settings.solutions if name in ENGINE_SOLUTIONS), "")
         steady_dims = tuple(d for d in GRID_DIMS if d != "sweep")
         coords = grid_coordinates(scene, grid, list(steady))
         coords["sweep"] = np.array(grid.directions, dtype=object)
-        several = count > 1 and any(q in STOP_QUANTITIES for q in scene.quantities)
+        several = count > 1 and any(q in STOP_QUANTITIES for q in scene.settings.quantities)
         if several:
             coords["stop"] = np.arange(count)
-            coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.stop_specs, scene.coordinates, scene.restitution, scene.clearance), dtype=object))
+            coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.stop_specs, scene.coordinates, scene.settings.restitution, scene.settings.clearance), dtype=object))
 
         def stop_dims(quantity: str, dims: tuple[str, ...]) -> tuple[str, ...]:
             return ("stop", *dims) if quantity in STOP_QUANTITIES and several else dims
@@ -219,7 +220,7 @@ class SweptStudy:
             return values if several else values[0]
 
         data_vars = {}
-        for quantity in scene.quantities:
+        for quantity in scene.settings.quantities:
             attrs = _attributes(scene, quantity)
             if steady:
                 stacked = np.stack([per_stop(quantity, values[quantity], grid.full) for values in steady.values()])
@@ -245,29 +246,29 @@ class SweptStudy:
     @staticmethod
     def simulation_attributes(scene: Scene) -> dict[str, object]:
         """What the dataset records of the sweep and of the compliant engine's tolerances."""
-        assert scene.swept_sine is not None
+        assert scene.settings.swept_sine is not None
         attrs: dict[str, object] = {}
-        if scene.simulation is not None:
-            for key, value in asdict(scene.swept_sine).items():
+        if scene.settings.simulation is not None:
+            for key, value in asdict(scene.settings.swept_sine).items():
                 attrs[f"swept_sine_{key}"] = np.array(value, dtype=str) if key == "directions" else value
             for key in ("rtol", "atol", "max_step"):
-                attrs[f"simulation_engine_{key}"] = getattr(scene.simulation.engine, key)
+                attrs[f"simulation_engine_{key}"] = getattr(scene.settings.simulation.engine, key)
         return attrs
 
     def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:
         """Seconds per simulated second of the compliant engine at its tolerance (scaled for the layout's coordinates
         and stops) times the sweeps' durations, on the calibration machine; the memory holds one sweep's samples per
         worker."""
-        assert scene.swept_sine is not None
-        s = scene.swept_sine
-        bumpers = scene.bumper_frequency.size if scene.bumper_frequency is not None else 1
-        directions = max(1, len(scene.sweep_directions))
+        assert scene.settings.swept_sine is not None
+        s = scene.settings.swept_sine
+        bumpers = scene.settings.bumper_frequency.size if scene.settings.bumper_frequency is not None else 1
+        directions = max(1, len(scene.settings.sweep_directions))
 
         def engine_part(name: str, engine: str) -> EnginePart:
-            assert scene.simulation is not None
+            assert scene.settings.simulation is not None
             duration = abs(s.stop_frequency - s.start_frequency) / s.rate
-            one = costs.per_sweep_second_cost(engine, scene.simulation.engine.rtol) * duration * engine_scale(scene)
-            runs = scene.restitution.size * scene.clearance.size * bumpers * directions
+            one = costs.per_sweep_second_cost(engine, scene.settings.simulation.engine.rtol) * duration * engine_scale(scene)
+            runs = scene.settings.restitution.size * scene.settings.clearance.size * bumpers * directions
             return one * runs, f"{runs} sweeps of {duration:g} s", one
 
         samples = abs(s.stop_frequency - s.start_frequency) / s.rate * s.sample_rate
@@ -299,17 +300,17 @@ def swept_values(scene: Scene, shape: tuple[int, ...], runner: Runner) -> tuple[
     """Swept-sine tests of the compliant model: estimates on the frequency grid (per-stop ones with a leading stop
     axis), running estimates against time and each run's statistics (``sweep_<stat>``), and the time axes
     (``time``, ``instantaneous_frequency`` per direction)."""
-    assert scene.swept_sine is not None and scene.bumper_frequency is not None and scene.simulation is not None
+    assert scene.settings.swept_sine is not None and scene.settings.bumper_frequency is not None and scene.settings.simulation is not None
     # xi_b: the scene's where it gives one, else each stop's own from its restitution (build_stops)
-    losses = scene.loss_factors() if scene.bumper_loss_factor is not None else np.full(scene.restitution.shape, np.nan)
-    frequencies = tuple(float(f) for f in scene.all_frequencies)
+    losses = scene.settings.loss_factors() if scene.settings.bumper_loss_factor is not None else np.full(scene.settings.restitution.shape, np.nan)
+    frequencies = tuple(float(f) for f in scene.settings.all_frequencies)
     cases, places = [], []
-    for i, restitution in enumerate(scene.restitution):
-        for j, clearance in enumerate(scene.clearance):
-            for k, bumper in enumerate(scene.bumper_frequency):
+    for i, restitution in enumerate(scene.settings.restitution):
+        for j, clearance in enumerate(scene.settings.clearance):
+            for k, bumper in enumerate(scene.settings.bumper_frequency):
                 stops = build_stops(scene.stop_specs, True, float(restitution), float(clearance), float(bumper), float(losses[i]))
-                for d, direction in enumerate(scene.swept_sine.directions):
-                    cases.append(SweepCase(scene.system, scene.amplitude, stops, scene.swept_sine, direction, scene.simulation.engine, frequencies, scene.load))
+                for d, direction in enumerate(scene.settings.swept_sine.directions):
+                    cases.append(SweepCase(scene.system, scene.amplitude, stops, scene.settings.swept_sine, direction, scene.settings.simulation.engine, frequencies, scene.load))
                     places.append((i, j, k, d))
     results = runner.map(cases)
     times = results[0]["time"]
@@ -348,7 +349,7 @@ def swept_values(scene: Scene, shape: tuple[int, ...], runner: Runner) -> tuple[
         "wall_time": np.broadcast_to(stats["wall_time"][..., None], shape),
         **{name: nan for name in MOTION_QUANTITIES},  # a sweep is a transient: no attractor to classify
     }
-    running = {name: value for name, value in running.items() if name.removeprefix("running_") in scene.quantities}
+    running = {name: value for name, value in running.items() if name.removeprefix("running_") in scene.settings.quantities}
     for name, value in stats.items():
         running[f"sweep_{name}"] = value  # one value per sweep: the run's cost
-    return {q: values[q] for q in scene.quantities}, running, {"time": times, "instantaneous_frequency": instantaneous}
+    return {q: values[q] for q in scene.settings.quantities}, running, {"time": times, "instantaneous_frequency": instantaneous}

@@ -22,7 +22,6 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
 
 from vibroimpact.kinds.stepped.scene import parse_names
 from vibroimpact.kinds.validation.settings import BouncingBallCase, BuddDuxCase, GrazingCase, RelativeStopCase, ValidationCase, ZenoCase
@@ -219,25 +218,15 @@ def read_validation_scene(document: Any, text: str = "", source: str = "scene") 
 
 
 def parse_validation_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
-    """The :class:`Scene` of a validation scene (kind ``validation``): the case in :attr:`Scene.validation`; the grid
-    fields say the case's forcing frequency, restitution and clearance for listings."""
+    """The :class:`Scene` of a validation scene (kind ``validation``): its :class:`ValidationSettings` (the case) in
+    :attr:`Scene.settings`."""
     checked = read_validation_scene(document, text, source)
     case = checked.settings.case
-    frequency = float(getattr(case, "frequency", getattr(case, "forcing_frequency", 1.0) / (2.0 * math.pi)))
-    restitution = float(case.restitution)
-    clearance = getattr(case, "clearance", 0.0)
-    clearance = float(np.mean(clearance)) if isinstance(clearance, tuple) else float(clearance)
     return Scene(
         name=checked.name,
         description=checked.description,
         system=case_structure(case),
         amplitude=1.0,
-        frequency=np.array([frequency]),
-        restitution=np.array([restitution]),
-        clearance=np.array([clearance]),
-        swept=(),
-        solutions=(),
-        quantities=(),
         kind="validation",
         settings=checked.settings,
         report=checked.report,
