@@ -35,7 +35,7 @@ from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.orbits.bifurcations import switch_period_doubling
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
 from vibroimpact.orbits.lyapunov import _inside, state_scales
-from vibroimpact.orbits.maps import ImpactMap, closed_form_state, one_impact_state, orbit_measures, section_phase
+from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures, section_phase
 from vibroimpact.orbits.shooting import shoot
 
 
@@ -128,10 +128,10 @@ def test_section_phase_keeps_the_strobe_clear_of_the_impacts(make) -> None:
 
 
 def test_closed_form_state_is_the_orbit_at_the_problems_time_zero() -> None:
-    """one_impact_state on a general layout is the closed-form orbit's state at t = 0 (its impact time shifted)."""
+    """closed_form_state on a general layout is the closed-form orbit's state at t = 0 (its impact time shifted)."""
     problem = relative(42.0)
     orbit = solve_impact_orbit(problem)
-    state = one_impact_state(problem)
+    state = closed_form_state(problem)
     np.testing.assert_allclose(state, orbit.state(np.array([(-orbit.impact_time) % orbit.period]))[0], rtol=1e-13, atol=1e-18)
     assert np.all(np.isnan(closed_form_state(budd_dux(10.0))))  # sigma beyond |gamma|: no impacting orbit
 

@@ -15,7 +15,7 @@ from vibroimpact.orbits.continuation import ContinuationSettings, continue_branc
 from vibroimpact.orbits.grazing_curve import trace_grazing
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.pgf import solve_one_impact
-from vibroimpact.orbits.maps import ImpactMap, one_impact_state, section_phase, with_impulse
+from vibroimpact.orbits.maps import ImpactMap, closed_form_state, section_phase, with_impulse
 from vibroimpact.orbits.shooting import ShootingError, shoot
 
 pytestmark = pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")
@@ -53,7 +53,7 @@ def test_the_one_impact_orbits_own_tangency_is_followed() -> None:
     c = (1.0 / (PAPER_SYSTEM.m2 * 1.2) + sol.chi_rate_before) / sol.omega
     a, quad_a = Q * np.abs(sol.receptances.h12), c**2 + sol.chi0**2
     smaller = (-3e-3 * sol.chi0 - np.sqrt(quad_a * a**2 - (c * 3e-3) ** 2)) / quad_a  # the admissible root of eq. 16 here
-    orbit = shoot(system, one_impact_state(problem, with_impulse(solve_impact_orbit(problem), float(smaller))), system.parameters)
+    orbit = shoot(system, closed_form_state(problem, with_impulse(solve_impact_orbit(problem), float(smaller))), system.parameters)
     assert orbit.impacts == 1
     branch = continue_branch(system, orbit, "frequency", ContinuationSettings(lower=15.0, upper=45.0, max_step=0.1))
     touching = [p for p in branch.special("grazing") if "touches" in p.note]

@@ -25,7 +25,7 @@ from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.orbits.bifurcations import switch_period_doubling
 from vibroimpact.orbits.branch import Iterated
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
-from vibroimpact.orbits.maps import ImpactMap, one_impact_state, orbit_measures, section_phase, with_impulse
+from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures, section_phase, with_impulse
 from vibroimpact.orbits.shooting import shoot
 
 pytestmark = pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")
@@ -61,7 +61,7 @@ def branches():
     for name, (band, f0) in BANDS.items():
         problem = _problem(f0, band)
         system = ImpactMap(problem)
-        orbit = shoot(system, one_impact_state(problem), system.parameters)
+        orbit = shoot(system, closed_form_state(problem), system.parameters)
         out[name] = (system, continue_branch(system, orbit, "frequency", ContinuationSettings(lower=15.0, upper=45.0)))
     return out
 
@@ -92,7 +92,7 @@ def test_every_point_is_the_closed_form_orbit(branches) -> None:
             x1, x2 = np.abs(closed.harmonics()).reshape(-1)[:2]
             assert measures.x1_amplitude == pytest.approx(x1, rel=1e-9)
             assert measures.x2_amplitude == pytest.approx(x2, rel=1e-9)
-            state = one_impact_state(problem, closed)
+            state = closed_form_state(problem, closed)
             assert np.max(np.abs(orbit.state - state) / system.state_scale) < 1e-9
             expected = np.sort_complex(floquet_multipliers(closed).ravel())
             got = np.sort_complex(orbit.multipliers)
@@ -166,7 +166,7 @@ def test_period_doubling_and_its_period_two_branch_confirmed_by_momentary() -> N
     band = (15.5, 19.0)
     problem = _problem(17.8, band, delta=1e-3)
     system = ImpactMap(problem)
-    branch = continue_branch(system, shoot(system, one_impact_state(problem), system.parameters), "frequency", ContinuationSettings(lower=15.0, upper=20.0))
+    branch = continue_branch(system, shoot(system, closed_form_state(problem), system.parameters), "frequency", ContinuationSettings(lower=15.0, upper=20.0))
     # the orbit is stable between two period doublings, near 17.576 Hz and just before it grazes near 17.96 Hz
     assert len(branch.special("period_doubling")) == 2
     doubling = min(branch.special("period_doubling"), key=lambda p: p.value)

@@ -14,7 +14,7 @@ information continuation watches: impacts per orbit period, the slowest impact, 
 flight to any stop, sticks.
 
 :func:`orbit_measures` says what an orbit means physically (impulse per impact, harmonic amplitudes);
-:func:`resection` moves a strobe away from the impacts. The closed-form starts (:func:`one_impact_state`,
+:func:`resection` moves a strobe away from the impacts. The closed-form starts (:func:`closed_form_state`,
 :func:`with_impulse`, :func:`section_phase`) live in :mod:`~vibroimpact.orbits.shooting` and are re-exported here.
 """
 
@@ -31,9 +31,9 @@ from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import HybridInfo, MapEvaluation, PeriodicOrbit
-from vibroimpact.orbits.shooting import closed_form_state, one_impact_state, section_phase, with_impulse
+from vibroimpact.orbits.shooting import closed_form_state, section_phase, with_impulse
 
-__all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "one_impact_state", "closed_form_state", "with_impulse", "section_phase", "resection", "PARAMETERS", "stop_selection"]
+__all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "closed_form_state", "with_impulse", "section_phase", "resection", "PARAMETERS", "stop_selection"]
 
 #: The parameters of an :class:`ImpactMap`, in order, with their units.
 PARAMETERS = {"frequency": "Hz", "restitution": "1", "clearance": "m", "amplitude": "N"}

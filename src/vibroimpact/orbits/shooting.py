@@ -25,7 +25,7 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import require_in_range, require_positive
 from vibroimpact.orbits.branch import Iterated, MapEvaluation, ParametrisedMap, PeriodicOrbit
 
-__all__ = ["ShootingSettings", "ShootingError", "shoot", "make_orbit", "parameter_derivative", "scaled_residual", "one_impact_state", "closed_form_state", "with_impulse", "section_phase"]
+__all__ = ["ShootingSettings", "ShootingError", "shoot", "make_orbit", "parameter_derivative", "scaled_residual", "closed_form_state", "with_impulse", "section_phase"]
 
 #: Finite-difference step for dP/dp, relative to max(|p|, parameter_scale): sqrt(eps) balances the O(h) truncation of
 #: a one-sided difference against its O(eps / h) round-off, leaving ~sqrt(eps) ~ 1.5e-8 relative error. dP/dp only
@@ -188,21 +188,6 @@ def shoot(system: ParametrisedMap, guess: ArrayLike, parameters: ArrayLike, peri
 # Closed-form starts for shooting and continuation: the impact orbit's state at the strobe, another root, a strobe
 # phase clear of the impacts.
 # --------------------------------------------------------------------------------------------------------------------
-
-def one_impact_state(problem: ImpactProblem, solution: ImpactOrbit | None = None) -> NDArray[np.float64]:
-    """The closed-form impact orbit's state (x, x') at t = 0 (mod T) of ``problem``'s time, any layout with a closed
-    form (one stop: one impact per period; a symmetric two-sided stop: the two-impacts orbit); NaN where none exists.
-
-    Parameters
-    ----------
-    problem : ImpactProblem
-        Rigid stop(s) and harmonic force.
-    solution : ImpactOrbit, optional
-        A scalar orbit of this problem (solved when omitted), e.g. with another root of the impulse equation
-        (:func:`with_impulse`).
-    """
-    return closed_form_state(problem, solution)
-
 
 def closed_form_state(problem: ImpactProblem, orbit: ImpactOrbit | None = None, root: str = "+") -> NDArray[np.float64]:
     """The state (x, x') at t = 0 of ``problem``'s time on its closed-form impact orbit (any structure), shape (2N,).

@@ -26,7 +26,7 @@ from vibroimpact.reporting.style import DPI  # first: selects the Agg backend be
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.figure import Figure as MatplotlibFigure  # noqa: E402
 
-from vibroimpact.runs.run import atomic_path  # noqa: E402
+from vibroimpact.runs.store import atomic_path  # noqa: E402
 
 __all__ = ["DrawnFigure", "Figure", "Table", "Section", "StudyPage", "save_figure", "saved", "rendering", "render_page", "write_page"]
 

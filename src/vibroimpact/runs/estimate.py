@@ -39,7 +39,8 @@ import numpy as np
 import xarray as xr
 
 from vibroimpact.engines.registry import engine_spec
-from vibroimpact.runs.run import atomic_path, study_kind
+from vibroimpact.runs.store import atomic_path
+from vibroimpact.scene.kinds import kind_named
 from vibroimpact.scene.schema import Scene
 
 __all__ = ["COSTS_FILE", "Costs", "Estimate", "default_costs", "cost_engine", "cluster_startup", "os_cpus", "cluster_cores", "CLUSTER_STARTUP", "TASK_SECONDS", "WRITE_SECONDS_PER_VARIABLE", "estimate_scene", "speed_probe", "speed_factor", "calibrate", "write_costs", "SPEED_FACTOR_RANGE"]
@@ -301,7 +302,7 @@ def estimate_scene(scene: Scene, jobs: int = 1, speed: float | None = None, cost
     jobs = max(1, jobs)
     costs = default_costs() if costs is None else costs
     speed = speed_factor(costs) if speed is None else speed
-    unscaled = study_kind(scene).estimate(scene, jobs, costs)
+    unscaled = kind_named(scene.kind).make_study().estimate(scene, jobs, costs)
     return Estimate(
         wall_time=unscaled.wall_time * speed,
         memory=unscaled.memory,

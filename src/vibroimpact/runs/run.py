@@ -12,26 +12,20 @@ scenes have dimensions (case, engine, rtol). Every dataset names its kind in the
 
 from __future__ import annotations
 
-import os
 import sys
-import tempfile
-from collections.abc import Iterator
-from contextlib import contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import TYPE_CHECKING, Protocol
+from typing import Protocol
 
 import xarray as xr
 
 from vibroimpact import __version__
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.runner import Runner
-from vibroimpact.runs.store import StudyStore, source_hash
+from vibroimpact.runs.estimate import Costs, Estimate
+from vibroimpact.runs.store import StudyStore, atomic_path, source_hash
 from vibroimpact.scene.kinds import kind_named
 from vibroimpact.scene.schema import Scene
-
-if TYPE_CHECKING:
-    from vibroimpact.runs.estimate import Costs, Estimate
 
 __all__ = ["StudyKind", "study_kind", "run_study", "atomic_path", "write_dataset", "provenance"]
 
@@ -104,28 +98,9 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
 
 
 # --------------------------------------------------------------------------------------------------------------------
-# Writing datasets: atomic files (a reader never sees half a file, a failed write leaves the previous one intact),
-# netCDF with compression and CF-clean coordinates, and the provenance every dataset carries.
+# Writing datasets: atomic files (runs.store.atomic_path: a reader never sees half a file, a failed write leaves the
+# previous one intact), netCDF with compression and CF-clean coordinates, and the provenance every dataset carries.
 # --------------------------------------------------------------------------------------------------------------------
-
-@contextmanager
-def atomic_path(path: Path, suffix: str = ".tmp") -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; on success it replaces ``path`` (mode 0644), on failure it is removed.
-
-    ``suffix`` is the temporary file's ending (``.npz`` for ``numpy.savez``, which would otherwise add one).
-    """
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
-    os.close(handle)
-    temporary = Path(name)
-    try:
-        yield temporary
-        os.chmod(temporary, 0o644)
-        os.replace(temporary, path)
-    except BaseException:
-        temporary.unlink(missing_ok=True)
-        raise
-
 
 def provenance() -> dict[str, str]:
     """What every dataset says about how it was made: the package version, its source and the conventions followed."""

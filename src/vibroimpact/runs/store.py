@@ -27,6 +27,7 @@ import json
 import os
 import shutil
 import socket
+import tempfile
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -41,7 +42,26 @@ from zarr.core.sync import sync  # zarr's own event loop, the one its synchronou
 
 from vibroimpact import __version__
 
-__all__ = ["source_hash", "case_key", "StudyStore", "OutputBusy", "claim_output", "store_fingerprint", "ZARR_FORMAT"]
+__all__ = ["atomic_path", "source_hash", "case_key", "StudyStore", "OutputBusy", "claim_output", "store_fingerprint", "ZARR_FORMAT"]
+
+
+@contextmanager
+def atomic_path(path: Path, suffix: str = ".tmp") -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; on success it replaces ``path`` (mode 0644), on failure it is removed.
+
+    ``suffix`` is the temporary file's ending (``.npz`` for ``numpy.savez``, which would otherwise add one).
+    """
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+    os.close(handle)
+    temporary = Path(name)
+    try:
+        yield temporary
+        os.chmod(temporary, 0o644)
+        os.replace(temporary, path)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
 
 
 # --------------------------------------------------------------------------------------------------------------------

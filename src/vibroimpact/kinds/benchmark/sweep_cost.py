@@ -37,7 +37,8 @@ from vibroimpact.engines.settings import SWEEP_REFERENCE_RTOL, SWEEP_SETTINGS, E
 from vibroimpact.engines.compliant.ivp import IVP_METHODS, solve_ivp_sweep
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.simulation.harmonics import running_fundamental
-from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
+from vibroimpact.model.problem import Structure
+from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.scene.variables import SWEEP_COST_ATTRIBUTES
 
 __all__ = ["SweepCostSettings", "markdown_table", "run_sweep_cost", "add_arguments", "settings_from_arguments"]
@@ -48,8 +49,8 @@ class SweepCostSettings:
 
     Attributes
     ----------
-    system : TwoDofSystem
-        The linear system.
+    system : Structure
+        The linear structure (default: the paper's system).
     clearance : float
         Delta [m].
     bumper_frequency : float
@@ -74,7 +75,7 @@ class SweepCostSettings:
         rtol of an extra IDA row over the full sweep (the accuracy context); None leaves it out.
     """
 
-    system: TwoDofSystem = PAPER_SYSTEM
+    system: Structure = PAPER_SYSTEM
     clearance: float = 3e-3
     bumper_frequency: float = 250.0
     restitution: float = 0.2

@@ -27,11 +27,11 @@ from vibroimpact.orbits.maps import ImpactMap, resection
 from vibroimpact.orbits.shooting import shoot
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.store import case_key
-from vibroimpact.simulation.harmonics import measure
+from vibroimpact.simulation.harmonics import HarmonicMeasures, measure
 from vibroimpact.simulation.settings import SteadySettings
 from vibroimpact.simulation.steady import march as march_to_repeat
 
-__all__ = ["Fundamentals", "SteadyOutcome", "fundamentals", "march", "check_stops", "GAP_TOLERANCE", "BranchCase", "BRANCH_FIELDS", "SAME_ORBIT", "MAX_SEEDS", "branch_seeds"]
+__all__ = ["SteadyOutcome", "march", "check_stops", "GAP_TOLERANCE", "BranchCase", "BRANCH_FIELDS", "SAME_ORBIT", "MAX_SEEDS", "branch_seeds"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -41,47 +41,6 @@ __all__ = ["Fundamentals", "SteadyOutcome", "fundamentals", "march", "check_stop
 
 #: Largest |gap| at an impact, and largest penetration anywhere recorded, as a fraction of the motion's length scale [-].
 GAP_TOLERANCE = 1e-6
-
-
-@dataclass(frozen=True)
-class Fundamentals:
-    """Fundamental harmonics and impact statistics over whole periods of a trajectory.
-
-    Attributes
-    ----------
-    x : ndarray of complex, shape (N,)
-        Complex fundamental amplitude of each coordinate [m] (phase relative to cos(w t)).
-    contact : ndarray of complex, shape (K,)
-        Fundamental of each stop's contact force lambda_k [N].
-    base_force : complex
-        Fundamental of the force on the base [N] (module docstring).
-    impacts_per_period : float
-        Impacts (rigid) or contacts (bumper) per period [-].
-    impulse_per_period : float
-        Total impulse of the impacts (contacts) per period, every stop [N s].
-    peak_acceleration : float
-        Largest deceleration in contact [m s-2]: bumpers only (NaN for a rigid stop with impacts, 0 without contact).
-    peak_contact_force : float
-        Largest contact force [N]: bumpers only (NaN for a rigid stop with impacts, 0 without contact).
-    """
-
-    x: NDArray[np.complex128]
-    contact: NDArray[np.complex128]
-    base_force: complex
-    impacts_per_period: float
-    impulse_per_period: float
-    peak_acceleration: float
-    peak_contact_force: float
-
-
-def fundamentals(trajectory: Trajectory) -> Fundamentals:
-    """:class:`Fundamentals` over every period of ``trajectory`` (integrated with ``moments=True``): the steady
-    states' measures (:func:`vibroimpact.simulation.harmonics.measure`), as the concepts compare them."""
-    m = measure(trajectory)
-    return Fundamentals(
-        np.array(m.displacements), np.array(m.stop_contact_forces), m.suspension_force + m.contact_force, m.impacts_per_period, m.impulse_per_period,
-        m.peak_acceleration, m.peak_contact_force,
-    )  # fmt: skip
 
 
 def check_stops(trajectory: Trajectory) -> None:
@@ -113,7 +72,7 @@ class SteadyOutcome:
 
     Attributes
     ----------
-    measures : Fundamentals
+    measures : HarmonicMeasures
         Over the measured periods.
     converged : bool
         The stroboscopic state repeated to the tolerance.
@@ -127,7 +86,7 @@ class SteadyOutcome:
         State at ``time``.
     """
 
-    measures: Fundamentals
+    measures: HarmonicMeasures
     converged: bool
     multiplicity: int
     periods: int
@@ -143,7 +102,7 @@ def march(engine: object, problem: ImpactProblem, t: float, y: NDArray[np.float6
     measured = multiplicity * math.ceil(settings.measure_periods / multiplicity) if multiplicity else settings.irregular_measure_periods
     final = engine.integrate(problem, y, t, measured, moments=True)  # type: ignore[attr-defined]
     check_stops(final)
-    return SteadyOutcome(fundamentals(final), multiplicity > 0, multiplicity, used + measured, t, np.array(y, dtype=float))
+    return SteadyOutcome(measure(final), multiplicity > 0, multiplicity, used + measured, t, np.array(y, dtype=float))
 
 #: Largest relative |X1| difference of an orbit from a branch it is taken to lie on [-].
 SAME_ORBIT = 0.02
@@ -241,7 +200,7 @@ class BranchCase:
             return False
         frequency = float(mapping.parameters[0])
         run = mapping.engine.integrate(mapping.problem, y, 0.0, period, moments=True)
-        x1 = abs(fundamentals(run).x[0])
+        x1 = abs(measure(run).displacements[0])
         impacts = run.impulses.size / period
         table = np.array(points)
         same = (table[:, 5] == period) & (np.abs(table[:, 4] - impacts) < 1e-9)
@@ -261,8 +220,8 @@ def _measure(mapping: ImpactMap, branch: Branch, label: int) -> list[tuple[float
         periods = orbit.period * base
         problem = mapping.problem_at(orbit.parameters)
         run = mapping.engine.integrate(problem, orbit.state, 0.0, periods, moments=True)
-        m = fundamentals(run)
-        rows.append((orbit.parameter("frequency"), abs(m.x[0]), abs(m.base_force), orbit.floquet_modulus, m.impacts_per_period, float(periods), float(label)))
+        m = measure(run)
+        rows.append((orbit.parameter("frequency"), abs(m.displacements[0]), abs(m.force), orbit.floquet_modulus, m.impacts_per_period, float(periods), float(label)))
     return rows
 
 

@@ -197,16 +197,16 @@ class ConceptCase:
                 out["wall_time"][i] = time.perf_counter() - started
                 continue
             m = outcome.measures
-            out["x1"][i], out["x2"][i], out["base_force"][i] = m.x[0], m.x[1], m.base_force
+            out["x1"][i], out["x2"][i], out["base_force"][i] = m.displacements[0], m.displacements[1], m.force
             out["impacts_per_period"][i], out["impulse_per_period"][i] = m.impacts_per_period, m.impulse_per_period
             out["converged"][i], out["multiplicity"][i], out["failed"][i] = float(outcome.converged), float(outcome.multiplicity), 0.0
             out["end_time"][i], out["end_state"][i] = outcome.time, outcome.state
             if bumper is not None and m.impacts_per_period == 0.0:
                 # the rigid steady state never touches: it is the bumpers' too (the same linear motion, no contact)
-                out["bumper_x1"][i], out["bumper_base_force"][i] = m.x[0], m.base_force
+                out["bumper_x1"][i], out["bumper_base_force"][i] = m.displacements[0], m.force
                 out["bumper_impacts_per_period"][i], out["bumper_converged"][i], out["bumper_failed"][i] = 0.0, float(outcome.converged), 0.0
                 out["bumper_peak_acceleration"][i] = out["bumper_peak_contact_force"][i] = 0.0
-                out["bumper_peak_base_force"][i], out["bumper_replay_mismatch"][i] = abs(m.base_force), 0.0
+                out["bumper_peak_base_force"][i], out["bumper_replay_mismatch"][i] = abs(m.force), 0.0
             elif bumper is not None:
                 self._bumper(bumper, frequency, outcome.time, outcome.state, out, i, MAX_BUMPER_PERIODS if outcome.converged else SETTLE_PERIODS)
             out["wall_time"][i] = time.perf_counter() - started
@@ -227,7 +227,7 @@ class ConceptCase:
             out["bumper_failed"][i] = 1.0
             return
         m = outcome.measures
-        out["bumper_x1"][i], out["bumper_base_force"][i] = m.x[0], m.base_force
+        out["bumper_x1"][i], out["bumper_base_force"][i] = m.displacements[0], m.force
         out["bumper_impacts_per_period"][i] = m.impacts_per_period
         out["bumper_converged"][i], out["bumper_failed"][i] = float(outcome.converged), 0.0
         out["bumper_peak_acceleration"][i], out["bumper_peak_contact_force"][i] = m.peak_acceleration, m.peak_contact_force
