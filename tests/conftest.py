@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import pytest
 
 from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 #: Excitation amplitude q of the paper's example [N].
 PAPER_AMPLITUDE = 10.0
@@ -16,3 +21,25 @@ PAPER_CLEARANCE = 3e-3
 def system() -> TwoDofSystem:
     """The paper's numerical example, eq. 24."""
     return PAPER_SYSTEM
+
+
+@pytest.fixture(scope="session")
+def small_bifurcation(tmp_path_factory: pytest.TempPathFactory) -> "xr.Dataset":
+    """The small bifurcation study (``tests/study/test_bifurcation.py::SMALL``) run once for the whole test run and
+    read back from its netCDF file: its dataset tests and its page tests share it, whichever workers run them (the
+    first worker to need it runs it under a file lock; the others read its file)."""
+    import fcntl
+
+    import xarray as xr
+
+    from tests.study.test_bifurcation import SMALL
+    from vibroimpact.runs.run import run_study, write_dataset
+    from vibroimpact.scene import parse_scene
+
+    shared = tmp_path_factory.getbasetemp().parent  # the run's folder, shared by the xdist workers
+    path = shared / "small_bifurcation.nc"
+    with open(shared / "small_bifurcation.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not path.exists():
+            write_dataset(run_study(parse_scene(SMALL), progress=None), path)
+    return xr.load_dataset(path)

@@ -9,14 +9,11 @@ import xarray as xr
 
 from vibroimpact.kinds.bifurcation.page import BifurcationPage
 from vibroimpact.reporting.report import page_for, write_report
-from vibroimpact.scene import parse_scene
-from vibroimpact.runs.run import run_study
-from tests.study.test_bifurcation import SMALL
 
 
-@pytest.fixture(scope="module")
-def dataset() -> xr.Dataset:
-    return run_study(parse_scene(SMALL), progress=None)
+@pytest.fixture
+def dataset(small_bifurcation: xr.Dataset) -> xr.Dataset:
+    return small_bifurcation
 
 
 def test_the_report_has_every_figure(dataset: xr.Dataset, tmp_path: Path) -> None:

@@ -28,11 +28,9 @@ SMALL = {
 }  # fmt: skip
 
 
-@pytest.fixture(scope="module")
-def dataset(tmp_path_factory: pytest.TempPathFactory) -> xr.Dataset:
-    data = run_study(parse_scene(SMALL), progress=None)
-    path = write_dataset(data, tmp_path_factory.mktemp("bif") / "bif_small.nc")
-    return xr.load_dataset(path)
+@pytest.fixture
+def dataset(small_bifurcation: xr.Dataset) -> xr.Dataset:
+    return small_bifurcation
 
 
 def test_output_contract(dataset: xr.Dataset) -> None:
