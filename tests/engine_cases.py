@@ -20,7 +20,7 @@ from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
 
 def pgf_start(frequency: float, restitution: float, clearance: float = PAPER_CLEARANCE, system: TwoDofSystem = PAPER_SYSTEM) -> tuple[ImpactProblem, np.ndarray, float, OneImpactSolution]:
     """Problem whose force phase puts the PGF impacts at t = k T, and the orbit's state at t = T/2."""
-    orbit = solve_one_impact(system, np.array([2 * np.pi * frequency]), clearance, restitution, PAPER_AMPLITUDE)
+    orbit = solve_one_impact(system, omega=np.array([2 * np.pi * frequency]), clearance=clearance, restitution=restitution, amplitude=PAPER_AMPLITUDE)
     assert orbit.exists[0]
     phase = float(orbit.phase[0] - np.angle(orbit.receptances.h12[0]))
     problem = ImpactProblem(system, RigidStop(clearance, restitution), HarmonicForce(PAPER_AMPLITUDE, frequency, phase=phase))
@@ -31,7 +31,7 @@ def pgf_start(frequency: float, restitution: float, clearance: float = PAPER_CLE
 
 def linear_state(problem: ImpactProblem, t: float = 0.0) -> np.ndarray:
     """The linear steady state (no stop) at time t under q cos(w t + phase)."""
-    response = linear_response(problem.system, problem.omega, problem.amplitude)
+    response = linear_response(problem.system, omega=problem.omega, amplitude=problem.amplitude)
     rotation = np.exp(1j * (problem.omega * t + problem.phase))
     x = np.array([response.x1, response.x2]) * rotation
     return np.concatenate([x.real, (1j * problem.omega * x).real])

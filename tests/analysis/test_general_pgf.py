@@ -60,8 +60,8 @@ def test_paper_layout_as_structure_equals_named_form() -> None:
     (near a resonance the periodic Green function amplifies a pole's last-bit difference by T|p| / |1 - e^{pT}| ~ 500,
     so relative to a small harmonic the two differ by up to 1e-11); multipliers to 1e-12 of the largest."""
     w = 2.0 * np.pi * FREQUENCIES
-    named = solve_one_impact(PAPER_SYSTEM, w, 3e-3, 0.2, 10.0)
-    general = solve_one_impact(paper_problem(), w)
+    named = solve_one_impact(PAPER_SYSTEM, omega=w, clearance=3e-3, restitution=0.2, amplitude=10.0)
+    general = solve_one_impact(paper_problem(), omega=w)
     assert isinstance(general, ImpactOrbit)
     np.testing.assert_array_equal(general.exists, named.exists)
     e = named.exists
@@ -86,11 +86,11 @@ def test_linear_amplitudes_of_paper_layout_and_relative_coordinate() -> None:
     """linear_amplitudes equals linear_response (q H11, q H12) on the paper's layout; a relative stop's amplitude is
     x2 - x1 = q (H12 - H11), to round-off."""
     w = 2.0 * np.pi * FREQUENCIES
-    paper = linear_response(PAPER_SYSTEM, w, 10.0)
-    general = linear_amplitudes(paper_problem(), w)
+    paper = linear_response(PAPER_SYSTEM, omega=w, amplitude=10.0)
+    general = linear_amplitudes(paper_problem(), omega=w)
     np.testing.assert_allclose(general.coordinate("x1"), paper.x1, rtol=1e-13)
     np.testing.assert_allclose(general.stops[..., 0], paper.x2, rtol=1e-13)
-    relative = linear_amplitudes(relative_problem(25.0, phase=0.0), w)
+    relative = linear_amplitudes(relative_problem(25.0, phase=0.0), omega=w)
     np.testing.assert_allclose(relative.stops[..., 0], paper.x2 - paper.x1, rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(relative.relative("x2", "x1"), paper.x2 - paper.x1, rtol=1e-12, atol=1e-15)
 
@@ -169,7 +169,7 @@ def test_three_dof_relative_stop_multipliers_equal_integrated_jacobian() -> None
     load = HarmonicForce(30.0, 40.0, 0.2, weights=(1.0, 0.0, 0.0), static=(0.0, -5.0, 3.0))
     problem = ImpactProblem(THREE_DOF, (stop,), load)
     frequencies = np.linspace(20.0, 60.0, 401)
-    survey = solve_impact_orbit(problem, 2 * np.pi * frequencies)
+    survey = solve_impact_orbit(problem, omega=2 * np.pi * frequencies)
     good = np.flatnonzero(survey.admissible())
     assert good.size > 10
     frequency = float(frequencies[good[good.size // 2]])

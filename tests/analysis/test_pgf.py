@@ -19,7 +19,7 @@ CASES = [(21.5, 0.0), (24.0, 0.2), (25.0, 0.6), (27.0, 0.8), (35.0, 0.2), (38.0,
 
 
 def solve(system: TwoDofSystem, frequency: float, restitution: float, clearance: float = PAPER_CLEARANCE, variant: str = "pgf") -> OneImpactSolution:
-    return solve_one_impact(system, np.array([2 * np.pi * frequency]), clearance, restitution, PAPER_AMPLITUDE, variant)
+    return solve_one_impact(system, omega=np.array([2 * np.pi * frequency]), clearance=clearance, restitution=restitution, amplitude=PAPER_AMPLITUDE, variant=variant)
 
 
 def at(solution: OneImpactSolution, fraction: np.ndarray | float, derivative: int = 0, signal: str = "x2") -> np.ndarray:
@@ -107,7 +107,7 @@ def test_large_clearance_gives_linear_response(system: TwoDofSystem, clearance: 
     """Delta -> infinity: no one-impact regime anywhere in 15-45 Hz (0.005 Hz grid), for every R."""
     omega = 2 * np.pi * np.arange(15.0, 45.0, 0.005)
     for restitution in (0.0, 0.2, 0.8, 1.0):
-        s = solve_one_impact(system, omega, clearance, restitution, PAPER_AMPLITUDE, "pgf")
+        s = solve_one_impact(system, omega=omega, clearance=clearance, restitution=restitution, amplitude=PAPER_AMPLITUDE, variant="pgf")
         assert not s.exists.any()
         assert np.all(s.linear_amplitude_x2 < clearance)
 
@@ -116,7 +116,7 @@ def test_paper_variant_invents_impacts_at_large_clearance(system: TwoDofSystem) 
     """Erratum evidence: with chi22'(0-) = -1/(2 M2), c vanishes at R = 1 and the paper's variant finds
     one-impact orbits next to the resonances even at Delta = 1 m, where the exact solution has none."""
     omega = 2 * np.pi * np.arange(15.0, 45.0, 0.005)
-    paper = solve_one_impact(system, omega, 1.0, 1.0, PAPER_AMPLITUDE, "pgf_paper")
+    paper = solve_one_impact(system, omega=omega, clearance=1.0, restitution=1.0, amplitude=PAPER_AMPLITUDE, variant="pgf_paper")
     assert paper.admissible().sum() > 1000
 
 
@@ -124,10 +124,10 @@ def test_impulse_vanishes_continuously_at_grazing(system: TwoDofSystem) -> None:
     """As q |H12| falls to Delta (from above) J -> 0 and the harmonics tend to the linear ones."""
     frequency = 21.0
     omega = 2 * np.pi * frequency
-    linear = linear_response(system, omega, PAPER_AMPLITUDE)
+    linear = linear_response(system, omega=omega, amplitude=PAPER_AMPLITUDE)
     grazing = abs(linear.x2)
     for excess in (1e-3, 1e-5, 1e-7):
-        s = solve_one_impact(system, np.array([omega]), grazing / (1 + excess), 0.2, PAPER_AMPLITUDE)
+        s = solve_one_impact(system, omega=np.array([omega]), clearance=grazing / (1 + excess), restitution=0.2, amplitude=PAPER_AMPLITUDE)
         assert s.exists[0]
         assert s.impulse[0] < 50 * excess * system.m2 * omega * grazing
         assert abs(s.x1_harmonic()[0]) == pytest.approx(abs(linear.x1), rel=50 * excess)
@@ -167,7 +167,7 @@ def test_admissibility_matches_dense_sampling(system: TwoDofSystem) -> None:
     """Points judged admissible stay below Delta on a 20000-sample grid; inadmissible ones exceed it there."""
     omega = 2 * np.pi * np.arange(20.0, 45.0, 0.01)
     for variant in ("pgf", "pgf_paper"):
-        s = solve_one_impact(system, omega, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, variant)
+        s = solve_one_impact(system, omega=omega, clearance=PAPER_CLEARANCE, restitution=0.2, amplitude=PAPER_AMPLITUDE, variant=variant)
         admissible = s.admissible()
         fractions = np.linspace(0.0, 1.0, 20001)[1:-1]
         for index in np.flatnonzero(s.exists)[::7]:
@@ -182,8 +182,8 @@ def test_admissibility_matches_dense_sampling(system: TwoDofSystem) -> None:
 def test_paper_variant_penetrates_near_second_resonance(system: TwoDofSystem) -> None:
     """Erratum evidence: with the constant chi22'(0-) the 'solutions' right at 36 Hz cross the stop; the exact ones do not."""
     omega = 2 * np.pi * np.arange(35.9, 36.3, 0.005)
-    exact = solve_one_impact(system, omega, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, "pgf")
-    paper = solve_one_impact(system, omega, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, "pgf_paper")
+    exact = solve_one_impact(system, omega=omega, clearance=PAPER_CLEARANCE, restitution=0.2, amplitude=PAPER_AMPLITUDE, variant="pgf")
+    paper = solve_one_impact(system, omega=omega, clearance=PAPER_CLEARANCE, restitution=0.2, amplitude=PAPER_AMPLITUDE, variant="pgf_paper")
     assert exact.admissible().all()
     assert (paper.exists & ~paper.admissible()).sum() > 10
 
@@ -221,7 +221,7 @@ def test_max_overshoot_is_the_supremum_over_the_period(system: TwoDofSystem) -> 
 
     omega = 2 * np.pi * np.array([22.9, 23.05, 36.0, 36.1, 25.0, 38.0])
     for variant in ("pgf_paper", "pgf"):
-        s = solve_one_impact(system, omega, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE, variant)
+        s = solve_one_impact(system, omega=omega, clearance=PAPER_CLEARANCE, restitution=0.2, amplitude=PAPER_AMPLITUDE, variant=variant)
         overshoot = s.max_overshoot()
         for index in np.flatnonzero(s.exists):
             one = s._subset(np.array([index]))
@@ -250,7 +250,7 @@ def test_rms_of_the_orbit_matches_a_simulation(system: TwoDofSystem) -> None:
     from vibroimpact.simulation.steady import steady_state
     from vibroimpact.simulation.settings import SteadySettings
 
-    orbit = solve_one_impact(system, np.array([2 * np.pi * 25.0]), 0.003, 0.2, 10.0)
+    orbit = solve_one_impact(system, omega=np.array([2 * np.pi * 25.0]), clearance=0.003, restitution=0.2, amplitude=10.0)
     x1_rms, x2_rms = orbit.rms()
     measured = steady_state(ExactEngine(), ImpactProblem(system, RigidStop(0.003, 0.2), HarmonicForce(10.0, 25.0)), "pgf", SteadySettings(tolerance=1e-10)).measures
     assert x1_rms[0] == pytest.approx(measured.x1_rms, rel=1e-5) and x2_rms[0] == pytest.approx(measured.x2_rms, rel=1e-5)

@@ -94,8 +94,8 @@ FITS_FROM, FITS_TO = 26.0265, 33.9722
 def paper_regimes(frequency: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Regime flags of the paper's system at R = 0.2 from the exact PGF solution, and whether the linear motion fits."""
     omega = 2.0 * np.pi * np.asarray(frequency, dtype=float)
-    solution = solve_one_impact(PAPER_SYSTEM, omega, PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE)
-    fits = PAPER_AMPLITUDE * np.abs(linear_response(PAPER_SYSTEM, omega, 1.0).x2) <= PAPER_CLEARANCE
+    solution = solve_one_impact(PAPER_SYSTEM, omega=omega, clearance=PAPER_CLEARANCE, restitution=0.2, amplitude=PAPER_AMPLITUDE)
+    fits = PAPER_AMPLITUDE * np.abs(linear_response(PAPER_SYSTEM, omega=omega, amplitude=1.0).x2) <= PAPER_CLEARANCE
     return classify(fits, solution.exists, solution.admissible()), fits
 
 

@@ -52,7 +52,7 @@ class ImpactSimulator:
 
 
 def orbit(system: TwoDofSystem, frequency: float, restitution: float = 0.2) -> OneImpactSolution:
-    return solve_one_impact(system, np.array([2 * np.pi * frequency]), PAPER_CLEARANCE, restitution, PAPER_AMPLITUDE)
+    return solve_one_impact(system, omega=np.array([2 * np.pi * frequency]), clearance=PAPER_CLEARANCE, restitution=restitution, amplitude=PAPER_AMPLITUDE)
 
 
 @pytest.mark.parametrize("frequency", [21.0, 25.0, 38.0])
@@ -77,7 +77,7 @@ def test_multipliers_match_finite_difference_monodromy(system: TwoDofSystem, fre
 def test_product_of_multipliers(system: TwoDofSystem, restitution: float) -> None:
     """det(monodromy) = det(S) det(exp(A T)) = R^2 exp(tr(A) T), analytically."""
     frequencies = np.array([22.0, 24.0, 26.0, 36.0, 38.0])
-    o = solve_one_impact(system, 2 * np.pi * frequencies, PAPER_CLEARANCE, restitution, PAPER_AMPLITUDE)
+    o = solve_one_impact(system, omega=2 * np.pi * frequencies, clearance=PAPER_CLEARANCE, restitution=restitution, amplitude=PAPER_AMPLITUDE)
     assert o.exists.all()
     trace = np.trace(system.state_matrix)
     expected = restitution**2 * np.exp(trace * o.period)

@@ -129,13 +129,13 @@ def test_slow_sweep_without_contact_follows_the_linear_response(system: TwoDofSy
     from vibroimpact.analysis.linear import linear_response
 
     sweep = SweptSine(PAPER_AMPLITUDE, 15.0, 17.0, 0.2)
-    h = linear_response(system, 2 * math.pi * 15.0, PAPER_AMPLITUDE)
+    h = linear_response(system, omega=2 * math.pi * 15.0, amplitude=PAPER_AMPLITUDE)
     x = np.array([h.x1, h.x2]) * -1j  # the response to q sin(theta) at theta = 0
     state = np.concatenate([x.real, (2j * math.pi * 15.0 * x).real])
     record = CompliantEngine().sweep(ImpactProblem(system, KelvinVoigtBumper(1.0, 250.0, 0.73), sweep), 2000.0, state)
     assert record.trajectory.impact_times.size == 0 and np.all(record.contact_forces[:, 0] == 0.0)  # exact: no contact: force set to 0
     estimate = running_fundamental(record.time, record.displacement("x1"), sweep, cycles=8)
-    linear = np.abs(linear_response(system, 2 * math.pi * estimate.frequency, PAPER_AMPLITUDE).x1)
+    linear = np.abs(linear_response(system, omega=2 * math.pi * estimate.frequency, amplitude=PAPER_AMPLITUDE).x1)
     np.testing.assert_allclose(estimate.amplitude, linear, rtol=1e-3)
 
 
@@ -151,7 +151,7 @@ def test_slow_sweep_with_contact_follows_the_one_impact_orbit(system: TwoDofSyst
     record = CompliantEngine().sweep(ImpactProblem(system, KelvinVoigtBumper(PAPER_CLEARANCE, 4000.0, loss_factor_from_restitution(0.2)), sweep), 2000.0)
     estimate = running_fundamental(record.time, record.displacement("x1"), sweep, cycles=8)
     settled = estimate.time > 5.0
-    orbit = solve_one_impact(system, 2 * math.pi * estimate.frequency[settled], PAPER_CLEARANCE, 0.2, PAPER_AMPLITUDE)
+    orbit = solve_one_impact(system, omega=2 * math.pi * estimate.frequency[settled], clearance=PAPER_CLEARANCE, restitution=0.2, amplitude=PAPER_AMPLITUDE)
     np.testing.assert_allclose(estimate.amplitude[settled], np.abs(orbit.x1_harmonic()), rtol=0.015)
     assert record.trajectory.impact_times.size == pytest.approx(sweep.duration * 24.5, rel=0.02)  # one contact per period
 

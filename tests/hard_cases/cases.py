@@ -234,13 +234,13 @@ def _pgf(frequency: float, restitution: float, clearance: float = PAPER_CLEARANC
 
 def _grazing(margin: float, phase: float) -> ImpactProblem:
     """30 Hz, R = 0.9: the linear orbit's largest X2 is ``margin`` short of the stop (negative: beyond it)."""
-    amplitude_x2 = PAPER_AMPLITUDE * abs(linear_response(PAPER_SYSTEM, 2 * math.pi * 30.0, 1.0).x2)
+    amplitude_x2 = PAPER_AMPLITUDE * abs(linear_response(PAPER_SYSTEM, omega=2 * math.pi * 30.0, amplitude=1.0).x2)
     return ImpactProblem(PAPER_SYSTEM, RigidStop(amplitude_x2 + margin, 0.9), HarmonicForce(PAPER_AMPLITUDE, 30.0, phase=phase))
 
 
 UNDAMPED = TwoDofSystem(m1=1.0, m2=0.1, k1=25_000.0, k2=4_300.0)
-RESONANCES = tuple(w / (2 * math.pi) for w in PAPER_SYSTEM.natural_frequencies())  # 23.02, 36.07 Hz
-ANTIRESONANCE = PAPER_SYSTEM.antiresonance_frequency() / (2 * math.pi)  # 33.00 Hz
+RESONANCES = tuple(w / (2 * math.pi) for w in PAPER_SYSTEM.natural_angular_frequencies())  # 23.02, 36.07 Hz
+ANTIRESONANCE = PAPER_SYSTEM.antiresonance_angular_frequency() / (2 * math.pi)  # 33.00 Hz
 OVERDAMPED = 2.0  # bumper loss factor xi_b
 TINY = 1e-7  # scale of the near-zero amplitude case
 HUGE = 1e3  # scale of the very large amplitude case

@@ -105,7 +105,7 @@ def reference_error(run: Run) -> float:
         amplitude = np.abs(linear).max(axis=0)
         return float(np.max(np.abs(trajectory.strobe_states - linear) / amplitude))
     if case.reference == "pgf":
-        orbit = solve_one_impact(p.system, np.array([p.omega]), p.clearance, p.restitution, p.amplitude)
+        orbit = solve_one_impact(p.system, omega=np.array([p.omega]), clearance=p.clearance, restitution=p.restitution, amplitude=p.amplitude)
         if trajectory.impulses.size != case.periods:
             return math.inf
         return float(np.max(np.abs(trajectory.impulses / orbit.impulse[0] - 1.0)))

@@ -25,7 +25,7 @@ def test_the_paper_system_as_matrices_has_the_named_forms_receptances() -> None:
     np.testing.assert_allclose(h[:, 0, 1], named.h12, rtol=1e-12)
     np.testing.assert_allclose(h[:, 1, 0], named.h12, rtol=1e-12)
     np.testing.assert_allclose(h[:, 1, 1], named.h22, rtol=1e-12)
-    np.testing.assert_allclose(PAPER.natural_frequencies(), PAPER_SYSTEM.natural_frequencies(), rtol=1e-12)
+    np.testing.assert_allclose(PAPER.natural_angular_frequencies(), PAPER_SYSTEM.natural_angular_frequencies(), rtol=1e-12)
     assert PAPER.coordinates == ("x1", "x2") and PAPER.rigid_body_modes() == 0
 
 
@@ -40,7 +40,7 @@ def test_a_free_mass_has_a_rigid_body_mode_and_the_receptance_of_a_mass() -> Non
     ball = LinearStructure([[2.0]], [[0.0]])
     assert ball.rigid_body_modes() == 1 and ball.coordinates == ("x1",)
     np.testing.assert_allclose(ball.receptance_matrix(np.array([3.0]))[0, 0, 0], -1.0 / (2.0 * 9.0), rtol=1e-14)
-    np.testing.assert_allclose(ball.natural_frequencies(), [0.0], atol=1e-12)
+    np.testing.assert_allclose(ball.natural_angular_frequencies(), [0.0], atol=1e-12)
 
 
 @pytest.mark.parametrize(

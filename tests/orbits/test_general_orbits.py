@@ -120,7 +120,7 @@ def test_section_phase_keeps_the_strobe_clear_of_the_impacts(make) -> None:
     moved = make(23.0, phase)
     fractions = []
     for root in ("+", "-"):
-        orbit = solve_impact_orbit(moved, 2 * np.pi * band, root=root)
+        orbit = solve_impact_orbit(moved, omega=2 * np.pi * band, root=root)
         f = (orbit.impact_time / orbit.period)[orbit.exists]
         fractions += [f, (f + 0.5) % 1.0] if orbit.two_sided else [f]
     f = np.concatenate(fractions)

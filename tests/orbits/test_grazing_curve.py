@@ -49,7 +49,7 @@ def test_the_one_impact_orbits_own_tangency_is_followed() -> None:
     base = ImpactProblem(PAPER_SYSTEM, RigidStop(3e-3, 0.2), HarmonicForce(Q, 18.5))
     problem = ImpactProblem(PAPER_SYSTEM, RigidStop(3e-3, 0.2), HarmonicForce(Q, 18.5, section_phase(base, np.linspace(18.2, 18.8, 61))))
     system = ImpactMap(problem, bounds={"frequency": (5.0, 90.0)})
-    sol = solve_one_impact(PAPER_SYSTEM, problem.omega, 3e-3, 0.2, Q)
+    sol = solve_one_impact(PAPER_SYSTEM, omega=problem.omega, clearance=3e-3, restitution=0.2, amplitude=Q)
     c = (1.0 / (PAPER_SYSTEM.m2 * 1.2) + sol.chi_rate_before) / sol.omega
     a, quad_a = Q * np.abs(sol.receptances.h12), c**2 + sol.chi0**2
     smaller = (-3e-3 * sol.chi0 - np.sqrt(quad_a * a**2 - (c * 3e-3) ** 2)) / quad_a  # the admissible root of eq. 16 here

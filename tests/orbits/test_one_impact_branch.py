@@ -45,13 +45,13 @@ def _roots(f: float | np.ndarray, delta: float = DELTA, restitution: float = R):
     form's orbit there (:func:`solve_impact_orbit`, into which :func:`with_impulse` puts either root): the paper's
     formula checks the general path."""
     omega = 2.0 * np.pi * np.asarray(f, dtype=float)
-    sol = solve_one_impact(PAPER_SYSTEM, omega, delta, restitution, Q)
+    sol = solve_one_impact(PAPER_SYSTEM, omega=omega, clearance=delta, restitution=restitution, amplitude=Q)
     c = (1.0 / (PAPER_SYSTEM.m2 * (1.0 + restitution)) + sol.chi_rate_before) / sol.omega
     a = Q * np.abs(sol.receptances.h12)
     quad_a, quad_b = c**2 + sol.chi0**2, delta * sol.chi0
     disc = quad_a * a**2 - (c * delta) ** 2
     root = np.sqrt(np.maximum(disc, 0.0))
-    orbit = solve_impact_orbit(ImpactProblem(PAPER_SYSTEM, RigidStop(delta, restitution), HarmonicForce(Q, float(np.ravel(f)[0]))), omega, delta, restitution, Q)
+    orbit = solve_impact_orbit(ImpactProblem(PAPER_SYSTEM, RigidStop(delta, restitution), HarmonicForce(Q, float(np.ravel(f)[0]))), omega=omega, clearance=delta, restitution=restitution, amplitude=Q)
     return orbit, (-quad_b + root) / quad_a, (-quad_b - root) / quad_a, disc
 
 

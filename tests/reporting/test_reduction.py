@@ -33,9 +33,9 @@ def dataset(values: np.ndarray, stable: np.ndarray | None = None) -> xr.Dataset:
 def test_factor_is_linear_peak_over_largest_realisable_value() -> None:
     values = np.full(FREQUENCY.size, 1e-4)
     row = reduction_factors(dataset(values, np.ones(FREQUENCY.size)), SETTING, "x1_amplitude", "pgf")[0]
-    linear = np.abs(linear_response(SYSTEM, 2 * np.pi * FREQUENCY, AMPLITUDE).x1)
-    fits = np.abs(linear_response(SYSTEM, 2 * np.pi * FREQUENCY, AMPLITUDE).x2) <= 0.003
-    split = FREQUENCY < SYSTEM.antiresonance_frequency() / (2 * np.pi)
+    linear = np.abs(linear_response(SYSTEM, omega=2 * np.pi * FREQUENCY, amplitude=AMPLITUDE).x1)
+    fits = np.abs(linear_response(SYSTEM, omega=2 * np.pi * FREQUENCY, amplitude=AMPLITUDE).x2) <= 0.003
+    split = FREQUENCY < SYSTEM.antiresonance_angular_frequency() / (2 * np.pi)
     for band, mask in enumerate([split, ~split]):
         expected = max(1e-4, linear[mask & fits].max())
         assert row.largest[band] == pytest.approx(expected, rel=1e-12)

@@ -36,7 +36,7 @@ def test_undefined_points_are_computed_points_without_a_value() -> None:
     """Points a simulation never ran (regime not_computed, 90 % here) are not counted as undefined."""
     ds = steady_dataset()
     setting = setting_of(ds)
-    split = setting.system.antiresonance_frequency() / (2.0 * np.pi)
+    split = setting.system.antiresonance_angular_frequency() / (2.0 * np.pi)
     bands = (ds["frequency"].values < split, ds["frequency"].values >= split)
     table = next(t for t in reduction_tables(ds, general_setting(ds), True) if "|X1|" in t.title)
     header, *rows = _rows(table.html)

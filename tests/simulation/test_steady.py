@@ -22,7 +22,7 @@ from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
 
 
 def pgf_values(system: TwoDofSystem, frequency: float, restitution: float) -> dict[str, float]:
-    orbit = solve_one_impact(system, np.array([2 * np.pi * frequency]), PAPER_CLEARANCE, restitution, PAPER_AMPLITUDE)
+    orbit = solve_one_impact(system, omega=np.array([2 * np.pi * frequency]), clearance=PAPER_CLEARANCE, restitution=restitution, amplitude=PAPER_AMPLITUDE)
     return {
         "x1": abs(orbit.x1_harmonic()[0]),
         "x2": abs(orbit.x2_harmonic()[0]),
@@ -58,13 +58,13 @@ def test_linear_point_is_answered_without_integrating(system: TwoDofSystem) -> N
     problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.2), HarmonicForce(PAPER_AMPLITUDE, 30.0))
     result = steady_state(ExactEngine(), problem, "linear")
     assert not result.integrated and result.periods_used == 0
-    assert abs(result.measures.x1) == pytest.approx(abs(linear_response(system, problem.omega, PAPER_AMPLITUDE).x1), rel=1e-15)
+    assert abs(result.measures.x1) == pytest.approx(abs(linear_response(system, omega=problem.omega, amplitude=PAPER_AMPLITUDE).x1), rel=1e-15)
 
 
 def test_measured_linear_motion_has_exact_harmonics_and_rms(system: TwoDofSystem) -> None:
     """Integrating the linear steady state (no contact) measures its amplitude and RMS = amplitude / sqrt 2 exactly."""
     problem = ImpactProblem(system, RigidStop(1.0, 0.2), HarmonicForce(PAPER_AMPLITUDE, 30.0))
-    response = linear_response(system, problem.omega, PAPER_AMPLITUDE)
+    response = linear_response(system, omega=problem.omega, amplitude=PAPER_AMPLITUDE)
     state = np.array([response.x1.real, response.x2.real, (1j * problem.omega * response.x1).real, (1j * problem.omega * response.x2).real])
     result = steady_state(ExactEngine(), problem, (0.0, state), SteadySettings(tolerance=1e-10))
     m = result.measures

@@ -115,7 +115,7 @@ def test_relative_two_sided_stops_continue_the_symmetric_two_impact_orbit() -> N
     assert two.sizes["branch_point"] > 10 and np.all(two["impacts_per_period"].values == 2)
     f = two["branch_frequency"].values
     problem = scene_problem(scene, 0.2)
-    orbit = solve_impact_orbit(problem, 2.0 * np.pi * f)
+    orbit = solve_impact_orbit(problem, omega=2.0 * np.pi * f)
     assert orbit.two_sided
     # two impacts of J each per period, one on each side, half a period apart
     assert np.nanmax(np.abs(two["impulse"].values - 2.0 * orbit.impulse)) < 1e-8 * np.nanmax(2.0 * orbit.impulse)
@@ -132,7 +132,7 @@ def test_relative_two_sided_stops_continue_the_symmetric_two_impact_orbit() -> N
             continue
         assert int(point["brute_period"]) == 1 and float(point["brute_impacts_per_period"]) == pytest.approx(2.0)
         speeds = point["brute_impact_velocity"].values[np.isfinite(point["brute_impact_velocity"].values)]
-        expected = float(solve_impact_orbit(problem, 2.0 * np.pi * frequency).pre_impact_velocity)
+        expected = float(solve_impact_orbit(problem, omega=2.0 * np.pi * frequency).pre_impact_velocity)
         assert np.max(np.abs(speeds - expected)) < 1e-4 * expected
         checked += 1
     assert checked >= 2
@@ -169,7 +169,7 @@ def test_a_layout_without_closed_form_is_found_by_the_brute_force() -> None:
     assert seeded.sizes["branch_point"] > 5 and np.all(seeded["impacts_per_period"].values == 1)
     problem = scene_problem(scene, 0.8)
     alone = ImpactProblem(problem.system, problem.stops[:1], problem.excitation)
-    orbit = solve_impact_orbit(alone, 2.0 * np.pi * seeded["branch_frequency"].values)
+    orbit = solve_impact_orbit(alone, omega=2.0 * np.pi * seeded["branch_frequency"].values)
     assert np.nanmax(orbit.displacement(np.linspace(0.0, 1.0, 256)[None, :] * orbit.period[:, None])[..., 0]) < 2.9e-3
     assert np.max(np.abs(seeded["impulse"].values - orbit.impulse)) < 1e-8 * np.max(orbit.impulse)
 

@@ -64,7 +64,7 @@ def test_the_simulated_orbit_is_the_closed_form_one(dataset: xr.Dataset) -> None
     """At 25 Hz the paper's stop has a stable one-impact orbit: the exact engine's steady state equals the closed form
     (|X1| and the base force's fundamental, eq. 23) to 1e-6, and so does the worst stable response there."""
     concept = dataset.sel(concept="absolute")
-    solution = solve_one_impact(SYSTEM, 2.0 * np.pi * 25.0, 0.003, 0.2, 10.0)
+    solution = solve_one_impact(SYSTEM, omega=2.0 * np.pi * 25.0, clearance=0.003, restitution=0.2, amplitude=10.0)
     x1, force = float(np.abs(solution.x1_harmonic())), float(np.abs(solution.force_harmonic()))
     simulated = concept.sel(simulation_frequency=25.0)
     assert abs(float(simulated["simulated_x1"]) / x1 - 1.0) <= 1e-6

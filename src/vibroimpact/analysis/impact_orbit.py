@@ -32,6 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.analysis.greens import green_vector, periodic_green
 from vibroimpact.analysis.layout import ClosedFormLayout, closed_form_layout, harmonic_load
+from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
 from vibroimpact.model.modal import ModalResponse, impulse_modes
 from vibroimpact.model.problem import ImpactProblem
 
@@ -334,11 +335,13 @@ def _impulse_and_phase(w: NDArray, delta: NDArray, r: NDArray, m_eff: float, a: 
 
 def solve_impact_orbit(
     problem: ImpactProblem,
-    omega: ArrayLike | None = None,
+    frequency: ArrayLike | None = None,
     clearance: ArrayLike | None = None,
     restitution: ArrayLike | None = None,
     amplitude: ArrayLike | None = None,
     root: str = "+",
+    *,
+    omega: ArrayLike | None = None,
 ) -> ImpactOrbit:
     """The closed-form impact orbit of ``problem`` (one stop, or a symmetric two-sided stop), vectorised.
 
@@ -347,8 +350,8 @@ def solve_impact_orbit(
     problem : ImpactProblem
         Structure, rigid stop(s) and harmonic force (:func:`.layout.closed_form_layout` says whether a closed form
         applies: ``ValueError`` with the reason otherwise).
-    omega : array_like, optional
-        w [rad s-1], > 0; default the problem's.
+    frequency : array_like, optional
+        f [Hz], > 0; default the problem's.
     clearance : array_like, optional
         Delta [m] of the stop (both sides of a pair); default the problem's.
     restitution : array_like, optional
@@ -357,10 +360,13 @@ def solve_impact_orbit(
         q [N] (base motion: Y [m]); default the problem's.
     root : {'+', '-'}
         Which root of the impulse equation.
+    omega : array_like, optional
+        w [rad s-1] instead of ``frequency`` (keyword only).
     """
     layout = closed_form_layout(problem)
+    check_closed_form_inputs(clearance, restitution, amplitude)
     w, delta, r, q = (np.asarray(x, dtype=float) for x in np.broadcast_arrays(
-        problem.omega if omega is None else omega, layout.clearance if clearance is None else clearance,
+        angular_frequency(frequency, omega, problem.omega), layout.clearance if clearance is None else clearance,
         layout.restitution if restitution is None else restitution, problem.amplitude if amplitude is None else amplitude))  # fmt: skip
     if layout.two_sided and np.any(delta <= 0.0):
         raise ValueError("clearance: a two-sided stop needs Delta > 0 (room between its sides)")
@@ -387,11 +393,13 @@ def solve_impact_orbit(
 
 def solve_two_impacts(
     problem: ImpactProblem,
-    omega: ArrayLike | None = None,
+    frequency: ArrayLike | None = None,
     clearance: ArrayLike | None = None,
     restitution: ArrayLike | None = None,
     amplitude: ArrayLike | None = None,
     root: str = "+",
+    *,
+    omega: ArrayLike | None = None,
 ) -> ImpactOrbit:
     """The symmetric two-impacts-per-period orbit of a two-sided stop, vectorised.
 
@@ -399,8 +407,8 @@ def solve_two_impacts(
     ----------
     problem : ImpactProblem
         Structure without rigid-body modes, two rigid stops forming a symmetric pair, harmonic force.
-    omega : array_like, optional
-        w [rad s-1]; default the problem's.
+    frequency : array_like, optional
+        f [Hz], > 0; default the problem's.
     clearance : array_like, optional
         Delta [m] of both sides, > 0; default the problem's.
     restitution : array_like, optional
@@ -409,6 +417,8 @@ def solve_two_impacts(
         q [N] (base motion: Y [m]); default the problem's.
     root : {'+', '-'}
         Which root of the impulse equation.
+    omega : array_like, optional
+        w [rad s-1] instead of ``frequency`` (keyword only).
 
     Raises
     ------
@@ -469,4 +479,4 @@ def solve_two_impacts(
     layout = closed_form_layout(problem)
     if not layout.two_sided:
         raise ValueError("contact: one stop has no two-sided symmetric orbit; its closed form is analysis.pgf.solve_one_impact(problem)")
-    return solve_impact_orbit(problem, omega, clearance, restitution, amplitude, root)
+    return solve_impact_orbit(problem, frequency, clearance, restitution, amplitude, root, omega=omega)

@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize_scalar
 
 from vibroimpact.analysis.layout import harmonic_load
+from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
 
@@ -40,9 +41,13 @@ class LinearResponse:
     force: NDArray[np.complex128]
 
 
-def linear_response(system: TwoDofSystem, omega: ArrayLike, amplitude: float) -> LinearResponse:
-    """Linear steady-state amplitudes at angular frequencies ``omega`` [rad s-1] for force amplitude q [N]."""
-    w = np.asarray(omega, dtype=float)
+def linear_response(system: TwoDofSystem, frequency: ArrayLike | None = None, amplitude: float | None = None, *, omega: ArrayLike | None = None) -> LinearResponse:
+    """Linear steady-state amplitudes of the paper's system at ``frequency`` [Hz] (or angular frequencies ``omega``
+    [rad s-1], keyword only) for force amplitude q [N] (``amplitude``, finite)."""
+    if amplitude is None:
+        raise TypeError("linear_response(system, frequency, amplitude): the force amplitude q [N] is needed")
+    check_closed_form_inputs(None, None, amplitude)
+    w = np.asarray(angular_frequency(frequency, omega), dtype=float)
     h = system.receptances(w)
     x1 = amplitude * h.h11
     return LinearResponse(x1=x1, x2=amplitude * h.h12, force=(system.k1 + 1j * w * system.b1) * x1)
@@ -85,9 +90,9 @@ def resonance_peaks(system: TwoDofSystem, amplitude: float, quantity: str = "x1"
         raise ValueError(f"quantity must be 'x1', 'x2' or 'force', got {quantity!r}")
 
     def magnitude(w: ArrayLike) -> NDArray[np.float64]:
-        return np.abs(getattr(linear_response(system, w, amplitude), quantity))
+        return np.abs(getattr(linear_response(system, omega=w, amplitude=amplitude), quantity))
 
-    return peaks_near(system.natural_frequencies(), magnitude, span)
+    return peaks_near(system.natural_angular_frequencies(), magnitude, span)
 
 
 @dataclass(frozen=True, eq=False)
@@ -132,21 +137,23 @@ class LinearAmplitudes:
         return np.all(np.abs(self.stops) + self.stop_static <= np.asarray(clearances, dtype=float), axis=-1)
 
 
-def linear_amplitudes(problem: ImpactProblem, omega: ArrayLike | None = None, amplitude: ArrayLike | None = None) -> LinearAmplitudes:
-    """The complex amplitudes of every coordinate and every stop's coordinate over ``omega`` (module docstring).
+def linear_amplitudes(problem: ImpactProblem, frequency: ArrayLike | None = None, amplitude: ArrayLike | None = None, *, omega: ArrayLike | None = None) -> LinearAmplitudes:
+    """The complex amplitudes of every coordinate and every stop's coordinate over ``frequency`` (module docstring).
 
     Parameters
     ----------
     problem : ImpactProblem
         Structure, stops and a harmonic load (force on any coordinates, or base motion: then the coordinates are
         relative to the base).
-    omega : array_like, optional
-        w [rad s-1]; default the problem's.
+    frequency : array_like, optional
+        f [Hz], > 0; default the problem's.
     amplitude : array_like, optional
         q [N] (base motion: Y [m]); default the problem's.
+    omega : array_like, optional
+        w [rad s-1] instead of ``frequency`` (keyword only).
     """
     structure = problem.structure
-    w = np.asarray(problem.omega if omega is None else omega, dtype=float)
+    w = np.asarray(angular_frequency(frequency, omega, problem.omega), dtype=float)
     load = harmonic_load(problem, w, amplitude)
     x = np.einsum("...ij,...j->...i", structure.receptance_matrix(w), load)
     normals = problem.normals()
@@ -175,9 +182,9 @@ def structure_peaks(problem: ImpactProblem, output: ArrayLike, span: float = 0.0
     weights = np.asarray(output, dtype=float)
 
     def magnitude(w: ArrayLike) -> NDArray[np.float64]:
-        return np.abs(linear_amplitudes(problem, np.asarray(w, dtype=float)).coordinates @ weights)
+        return np.abs(linear_amplitudes(problem, omega=np.asarray(w, dtype=float)).coordinates @ weights)
 
-    return peaks_near([wn for wn in problem.structure.natural_frequencies() if wn > 0.0], magnitude, span)
+    return peaks_near([wn for wn in problem.structure.natural_angular_frequencies() if wn > 0.0], magnitude, span)
 
 
 def peaks_near(frequencies: ArrayLike, magnitude: Callable[[ArrayLike], NDArray[np.float64]], span: float) -> list[ResonancePeak]:

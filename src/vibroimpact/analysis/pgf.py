@@ -32,6 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 from vibroimpact.analysis.greens import periodic_green
 from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_layout
+from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
 from vibroimpact.model.modal import PoleResidueModel, exact_pole_residue, fit_modal_parameters
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import Receptances, TwoDofSystem
@@ -288,25 +289,27 @@ def green_models(system: TwoDofSystem, variant: PgfVariant) -> tuple[PoleResidue
 
 
 @overload
-def solve_one_impact(system: TwoDofSystem, omega: ArrayLike, clearance: ArrayLike, restitution: ArrayLike, amplitude: float,
-                     variant: PgfVariant | str = ..., models: tuple[PoleResidueModel, PoleResidueModel] | None = ...) -> OneImpactSolution: ...  # fmt: skip
+def solve_one_impact(system: TwoDofSystem, frequency: ArrayLike | None = ..., clearance: ArrayLike | None = ..., restitution: ArrayLike | None = ..., amplitude: ArrayLike | None = ...,
+                     variant: PgfVariant | str = ..., models: tuple[PoleResidueModel, PoleResidueModel] | None = ..., *, omega: ArrayLike | None = ...) -> OneImpactSolution: ...  # fmt: skip
 @overload
-def solve_one_impact(system: ImpactProblem, omega: ArrayLike | None = ..., clearance: ArrayLike | None = ..., restitution: ArrayLike | None = ...,
-                     amplitude: ArrayLike | None = ..., variant: PgfVariant | str = ..., models: None = ...) -> ImpactOrbit: ...  # fmt: skip
+def solve_one_impact(system: ImpactProblem, frequency: ArrayLike | None = ..., clearance: ArrayLike | None = ..., restitution: ArrayLike | None = ...,
+                     amplitude: ArrayLike | None = ..., variant: PgfVariant | str = ..., models: None = ..., *, omega: ArrayLike | None = ...) -> ImpactOrbit: ...  # fmt: skip
 def solve_one_impact(
     system: TwoDofSystem | ImpactProblem,
-    omega: ArrayLike | None = None,
+    frequency: ArrayLike | None = None,
     clearance: ArrayLike | None = None,
     restitution: ArrayLike | None = None,
     amplitude: ArrayLike | None = None,
     variant: PgfVariant | str = PgfVariant.EXACT,
     models: tuple[PoleResidueModel, PoleResidueModel] | None = None,
+    *,
+    omega: ArrayLike | None = None,
 ) -> OneImpactSolution | ImpactOrbit:
     """Impulse and phase of the one-impact-per-period regime (eqs. 15-16, corrected), vectorised.
 
-    Two forms. ``solve_one_impact(system, omega, clearance, restitution, amplitude, variant)`` with the paper's
+    Two forms. ``solve_one_impact(system, frequency, clearance, restitution, amplitude, variant)`` with the paper's
     :class:`TwoDofSystem` is the paper's layout (both variants, :class:`OneImpactSolution`).
-    ``solve_one_impact(problem, omega=None, clearance=None, restitution=None, amplitude=None)`` with an
+    ``solve_one_impact(problem, frequency=None, clearance=None, restitution=None, amplitude=None)`` with an
     :class:`ImpactProblem` of any structure with one rigid stop (absolute or relative, upper or lower) gives the
     general closed form (:class:`~vibroimpact.analysis.impact_orbit.ImpactOrbit`, exact Green functions only; omitted
     values are the problem's); ``ValueError`` saying why where it does not apply (several stops, a bumper, a rigid-body
@@ -316,18 +319,20 @@ def solve_one_impact(
     ----------
     system : TwoDofSystem or ImpactProblem
         The linear system (paper's layout), or the whole problem.
-    omega : array_like
-        Excitation angular frequency [rad s-1], > 0.
+    frequency : array_like
+        Excitation frequency f [Hz], > 0 (``ValueError`` otherwise).
     clearance : array_like
-        Clearance Delta of the stop [m], >= 0; broadcast against ``omega``.
+        Clearance Delta of the stop [m]; broadcast against ``frequency``.
     restitution : array_like
-        Restitution ratio R [-], 0 <= R <= 1; broadcast against ``omega``.
+        Restitution ratio R [-], 0 <= R <= 1; broadcast against ``frequency``.
     amplitude : float
         Excitation force amplitude q [N].
     variant : PgfVariant or {'pgf', 'pgf_paper'}
         Exact Green function and chi22'(0-), or the paper's fitted modes and constant chi22'(0-).
     models : (PoleResidueModel, PoleResidueModel), optional
         Precomputed :func:`green_models` for this system and variant (saves the curve fit on repeated calls).
+    omega : array_like, optional
+        Excitation angular frequency w [rad s-1] instead of ``frequency`` (keyword only).
     """
     if isinstance(system, ImpactProblem):
         if PgfVariant(variant) is not PgfVariant.EXACT or models is not None:
@@ -335,11 +340,12 @@ def solve_one_impact(
         layout = closed_form_layout(system)
         if layout.two_sided:
             raise ValueError("contact: the stops form a symmetric two-sided stop, whose closed form has two impacts per period: use analysis.two_sided.solve_two_impacts")
-        return solve_impact_orbit(system, omega, clearance, restitution, amplitude)
-    if omega is None or clearance is None or restitution is None or amplitude is None:
-        raise TypeError("solve_one_impact(system, omega, clearance, restitution, amplitude): the paper's form needs all five")
+        return solve_impact_orbit(system, frequency, clearance, restitution, amplitude, omega=omega)
+    if (frequency is None and omega is None) or clearance is None or restitution is None or amplitude is None:
+        raise TypeError("solve_one_impact(system, frequency, clearance, restitution, amplitude): the paper's form needs all five")
+    check_closed_form_inputs(clearance, restitution, amplitude)
     variant = PgfVariant(variant)
-    w, delta, r = (np.asarray(x, dtype=float) for x in np.broadcast_arrays(omega, clearance, restitution))
+    w, delta, r = (np.asarray(x, dtype=float) for x in np.broadcast_arrays(angular_frequency(frequency, omega), clearance, restitution))
     green22, green12 = models if models is not None else green_models(system, variant)
     h = system.receptances(w)
     period = 2.0 * np.pi / w

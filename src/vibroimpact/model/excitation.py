@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.model.structure import require_non_negative, require_positive
 
-__all__ = ["HarmonicForce", "SweptSine", "load_weights", "static_load"]
+__all__ = ["HarmonicForce", "SweptSine", "load_weights", "static_load", "angular_frequency", "check_closed_form_inputs"]
 
 
 def _vector(name: str, value: object) -> tuple[float, ...] | None:
@@ -184,3 +184,47 @@ class SweptSine:
     def force(self, t: ArrayLike) -> NDArray[np.float64]:
         """q sin(theta(t)) [N]."""
         return self.amplitude * np.sin(self.phase(t))
+
+
+def angular_frequency(frequency: ArrayLike | None, omega: ArrayLike | None, default: ArrayLike | None = None) -> ArrayLike:
+    """The angular frequency [rad s-1] of a public call that takes ``frequency`` [Hz] or, under the name that says
+    so, ``omega`` [rad s-1]: the one conversion between the package's public unit (Hz) and its internal one.
+
+    Parameters
+    ----------
+    frequency : array_like or None
+        f [Hz]: finite and > 0 (``ValueError`` naming the value otherwise).
+    omega : array_like or None
+        w [rad s-1], as given (the caller's own angular frequencies).
+    default : array_like, optional
+        w [rad s-1] where neither is given (a problem's own); ``TypeError`` when there is none.
+    """
+    if frequency is not None and omega is not None:
+        raise TypeError("give frequency [Hz] or omega [rad s-1], not both")
+    if frequency is not None:
+        f = np.asarray(frequency, dtype=float)
+        if f.size and not np.all(np.isfinite(f) & (f > 0.0)):
+            bad = f[~(np.isfinite(f) & (f > 0.0))].ravel()[0]
+            raise ValueError(f"frequency: {float(bad):g} Hz is out of range: allowed (0, inf) [Hz] (an angular frequency goes in omega= [rad s-1])")
+        return 2.0 * np.pi * f
+    if omega is not None:
+        return omega
+    if default is None:
+        raise TypeError("a frequency is needed: give frequency [Hz] (or omega [rad s-1])")
+    return default
+
+
+def check_closed_form_inputs(clearance: ArrayLike | None, restitution: ArrayLike | None, amplitude: ArrayLike | None) -> None:
+    """``ValueError`` naming the argument and its allowed range where a closed form's given inputs are out of range:
+    clearance Delta finite [m], restitution R in [0, 1] [-], amplitude q finite [N] (None: not given, not checked)."""
+    for name, value, ok, allowed in (
+        ("clearance", clearance, np.isfinite, "finite [m]"),
+        ("restitution", restitution, lambda r: (r >= 0.0) & (r <= 1.0), "[0, 1] [-]"),
+        ("amplitude", amplitude, np.isfinite, "finite [N] (base motion: [m])"),
+    ):
+        if value is None:
+            continue
+        array = np.asarray(value, dtype=float)
+        good = ok(array)
+        if array.size and not np.all(good):
+            raise ValueError(f"{name}: {float(array[~good].ravel()[0]):g} is out of range: allowed {allowed}")

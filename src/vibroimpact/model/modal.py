@@ -185,7 +185,7 @@ def fit_modal_parameters(system: TwoDofSystem, omega_grid: tuple[float, ...] | N
     modes = underdamped_mode_count(system)
     if modes != 2:
         raise ValueError(f"the paper's modal fit (eq. 10) needs two underdamped modes; this system has {modes}")
-    omega_n = np.array(system.natural_frequencies())
+    omega_n = np.array(system.natural_angular_frequencies())
     if omega_grid is None:
         wide = np.linspace(0.5 * omega_n[0], 1.5 * omega_n[1], 2001)
         peaks = [wn * (1.0 + np.linspace(-0.02, 0.02, 401)) for wn in omega_n]

@@ -188,12 +188,16 @@ class LinearStructure:
             return self.size
         return int(np.sum(np.linalg.eigvalsh(stiffness) <= 1e-10 * scale))
 
-    def natural_frequencies(self) -> NDArray[np.float64]:
+    def natural_angular_frequencies(self) -> NDArray[np.float64]:
         """Undamped natural angular frequencies, ascending [rad s-1] (0 for each rigid-body mode)."""
         chol = np.linalg.cholesky(self.mass_matrix)
         inv = np.linalg.inv(chol)
         eigenvalues = np.linalg.eigvalsh(inv @ self.stiffness_matrix @ inv.T)
         return np.sqrt(np.maximum(eigenvalues, 0.0))
+
+    def natural_frequencies(self) -> NDArray[np.float64]:
+        """Undamped natural frequencies, ascending [Hz] (:meth:`natural_angular_frequencies` / 2 pi)."""
+        return self.natural_angular_frequencies() / (2.0 * np.pi)
 
     def as_dict(self) -> dict[str, object]:
         """Plain dictionary of the matrices (SI units) and names, for dataset attributes."""
@@ -201,7 +205,7 @@ class LinearStructure:
                 "damping": [list(r) for r in self.damping], "coordinates": list(self.coordinates)}  # fmt: skip
 
     def __repr__(self) -> str:
-        return f"LinearStructure(N={self.size}, coordinates={list(self.coordinates)}, natural frequencies {np.round(self.natural_frequencies() / (2 * math.pi), 4).tolist()} Hz)"
+        return f"LinearStructure(N={self.size}, coordinates={list(self.coordinates)}, natural frequencies {np.round(self.natural_angular_frequencies() / (2 * math.pi), 4).tolist()} Hz)"
 
 
 # --------------------------------------------------------------------------------------------------------------------

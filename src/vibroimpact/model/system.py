@@ -213,7 +213,7 @@ class TwoDofSystem:
         return Receptances(h11=d22 / det, h12=coupling / det, h22=d11 / det)
 
     # ---------------------------------------------------------------- frequencies
-    def natural_frequencies(self) -> tuple[float, float]:
+    def natural_angular_frequencies(self) -> tuple[float, float]:
         """Undamped natural angular frequencies Omega_1 < Omega_2 [rad s-1] from the corrected eq. 11.
 
         The printed eq. 11 has ``K1*M1 + K1*M2 + K2*M1`` as the first term; the roots of D(j omega) = 0 with
@@ -227,15 +227,24 @@ class TwoDofSystem:
         omega2_low = self.k1 * self.k2 / (self.m1 * self.m2) / omega2_high
         return math.sqrt(omega2_low), math.sqrt(omega2_high)
 
-    def natural_frequencies_eig(self) -> tuple[float, float]:
+    def natural_frequencies(self) -> tuple[float, float]:
+        """Undamped natural frequencies f_1 < f_2 [Hz] (:meth:`natural_angular_frequencies` / 2 pi)."""
+        low, high = self.natural_angular_frequencies()
+        return low / (2.0 * math.pi), high / (2.0 * math.pi)
+
+    def natural_angular_frequencies_eig(self) -> tuple[float, float]:
         """Undamped natural angular frequencies [rad s-1] from the eigenvalues of M^-1 K (independent check)."""
         eigenvalues = np.linalg.eigvals(np.linalg.solve(self.mass_matrix, self.stiffness_matrix)).real
         low, high = np.sqrt(np.sort(eigenvalues))
         return float(low), float(high)
 
-    def antiresonance_frequency(self) -> float:
+    def antiresonance_angular_frequency(self) -> float:
         """Undamped anti-resonance of the primary mass, sqrt(K2/M2) [rad s-1]: H11 = 0 there when B2 = 0."""
         return math.sqrt(self.k2 / self.m2)
+
+    def antiresonance_frequency(self) -> float:
+        """Undamped anti-resonance of the primary mass, sqrt(K2/M2) / 2 pi [Hz]."""
+        return self.antiresonance_angular_frequency() / (2.0 * math.pi)
 
     def as_dict(self) -> dict[str, float]:
         """Plain dictionary of the parameters (SI units), for dataset attributes."""

@@ -241,7 +241,7 @@ def section_phase(problem: ImpactProblem, frequencies: ArrayLike, clearances: Ar
         return 0.0
     fractions = []
     for root in ROOTS:
-        orbit = solve_impact_orbit(problem, 2.0 * np.pi * f, clearances, None, amplitudes, root=root)
+        orbit = solve_impact_orbit(problem, omega=2.0 * np.pi * f, clearance=clearances, restitution=None, amplitude=amplitudes, root=root)
         # the impact time includes the problem's phase: measure it against a force of phase 0
         base = ((orbit.impact_time + problem.phase / orbit.omega) / orbit.period) % 1.0
         fractions.append(base[orbit.exists])

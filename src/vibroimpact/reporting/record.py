@@ -149,7 +149,7 @@ class StudySetting:
     @property
     def split_frequency(self) -> float:
         """The anti-resonance frequency [Hz], which separates the two resonance bands."""
-        return self.system.antiresonance_frequency() / (2.0 * np.pi)
+        return self.system.antiresonance_angular_frequency() / (2.0 * np.pi)
 
 
 def study_setting(dataset: xr.Dataset) -> StudySetting:

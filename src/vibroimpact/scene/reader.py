@@ -81,8 +81,10 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
 
 
 def load_scene(path: str | Path) -> Scene:
-    """Read and validate a scene file; raise :class:`SceneError` (or ``OSError`` if it cannot be read)."""
-    path = Path(path)
+    """Read and validate a scene, found as ``run-study`` finds it (:func:`find_scene`: a path, ``studies/<name>`` here,
+    or a shipped scene such as ``restitution`` or ``validation/zeno``); raise :class:`SceneError` (or ``OSError`` if
+    it cannot be found or read: ``FileNotFoundError`` names every place looked at)."""
+    path = find_scene(path)
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError as error:

@@ -114,7 +114,7 @@ def pgf_guesses(problem: ImpactProblem, frequencies: Sequence[float], orbit_stop
     if closed_form_refusal(rigid) is not None:
         return [None] * len(frequencies)
     omega = 2.0 * np.pi * np.asarray(frequencies, dtype=float)
-    orbit = solve_impact_orbit(rigid, omega)
+    orbit = solve_impact_orbit(rigid, omega=omega)
     with np.errstate(invalid="ignore"):
         ok = orbit.exists & orbit.admissible()
         offset = 0.5 * orbit.window  # half-way to the next impact (T/2, or T/4 for a two-sided stop)

@@ -363,7 +363,7 @@ def model_ladder(ladder: LadderSettings, atol_ratio: float) -> xr.Dataset:
     omega = np.array([problem.omega])
 
     def pgf() -> float:
-        return float(np.abs(solve_impact_orbit(problem, omega).harmonics()[0, MEASURED]))
+        return float(np.abs(solve_impact_orbit(problem, omega=omega).harmonics()[0, MEASURED]))
 
     models: dict[str, Callable[[], float]] = {"pgf": pgf} if closed_form_refusal(problem) is None else {}
     engines: dict[str, tuple[Engine, ImpactProblem]] = {"exact": (make_engine("exact"), problem), "momentary": (make_engine("momentary", settings), problem)}

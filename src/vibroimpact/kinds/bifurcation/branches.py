@@ -99,7 +99,7 @@ class OrbitSet:
         label = self.count
         self.count += 1
         multipliers = _linear_multipliers(problem, frequency)
-        amplitudes = np.abs(linear_amplitudes(problem, 2.0 * np.pi * np.asarray(frequency)).coordinates)
+        amplitudes = np.abs(linear_amplitudes(problem, omega=2.0 * np.pi * np.asarray(frequency)).coordinates)
         for k, f in enumerate(frequency):
             modulus = float(np.max(np.abs(multipliers[k])))
             self.points.append({
@@ -174,7 +174,7 @@ def closed_form_orbits(problem: ImpactProblem, frequency: NDArray[np.float64]) -
     """The closed-form impact orbit of ``problem`` at ``frequency`` [Hz] for each root of the impulse equation
     (:data:`~vibroimpact.analysis.impact_orbit.ROOTS`), NaN impulses where none exists; ``ValueError`` with the
     reason where the layout has no closed form."""
-    plus = solve_impact_orbit(problem, 2.0 * np.pi * np.asarray(frequency, dtype=float))
+    plus = solve_impact_orbit(problem, omega=2.0 * np.pi * np.asarray(frequency, dtype=float))
     return [plus if root == "+" else plus.with_root(root) for root in ROOTS]
 
 
@@ -184,7 +184,7 @@ def linear_segments(problem: ImpactProblem, low: float, high: float, step: float
     clearances = problem.clearances()
 
     def gap(f: float) -> float:
-        linear = linear_amplitudes(problem, 2.0 * np.pi * f)
+        linear = linear_amplitudes(problem, omega=2.0 * np.pi * f)
         return float(np.min(clearances - linear.stop_static - np.abs(linear.stops)))
 
     fits = np.array([gap(f) >= 0.0 for f in frequency])

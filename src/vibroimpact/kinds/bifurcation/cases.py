@@ -432,7 +432,7 @@ def _grazing_curves(problem: ImpactProblem, low: float, high: float, low_c: floa
     leaves [low_c, high_c]: where the closed-form orbit's impact velocity vanishes and the linear orbit touches a stop
     (every stop sharing the clearance Delta)."""
     f = np.arange(low, high + 0.5 * step, step)
-    linear = linear_amplitudes(problem, 2.0 * np.pi * f)
+    linear = linear_amplitudes(problem, omega=2.0 * np.pi * f)
     d = np.max(np.abs(linear.stops) + linear.stop_static, axis=-1)
     inside = (d >= low_c) & (d <= high_c)
     runs = np.split(np.flatnonzero(inside), np.flatnonzero(np.diff(np.flatnonzero(inside)) > 1) + 1)

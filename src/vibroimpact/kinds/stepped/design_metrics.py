@@ -338,7 +338,7 @@ def no_stop_amplitude(dataset: xr.Dataset, frequency: np.ndarray, quantity: str 
     system = named_view(dataset)
     if system is None or "excitation_amplitude_N" not in dataset.attrs:
         return None
-    response = linear_response(system, 2.0 * np.pi * np.asarray(frequency, dtype=float), float(dataset.attrs["excitation_amplitude_N"]))
+    response = linear_response(system, omega=2.0 * np.pi * np.asarray(frequency, dtype=float), amplitude=float(dataset.attrs["excitation_amplitude_N"]))
     return np.abs(getattr(response, quantity))
 
 

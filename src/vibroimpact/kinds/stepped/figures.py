@@ -76,7 +76,7 @@ def structure_figure(setting: GeneralSetting, frequency: np.ndarray) -> DrawnFig
             axes[3].semilogy(f[::step], np.abs(fit.receptance(w[::step])), "o", color="C3", mfc="none", ms=4.5, label="|H22| of eq. 10, the paper's fitted modes")
         finish_axes(axes[3], _FREQUENCY, "|H22| [m/N]", "Accuracy of the curve fit (paper fig. 4)")
     figure_legend(fig, axes)
-    natural = ", ".join(fmt(v / (2 * np.pi), ".3f") for v in (named.natural_frequencies() if named is not None else setting.structure.natural_frequencies()))
+    natural = ", ".join(fmt(v / (2 * np.pi), ".3f") for v in (named.natural_angular_frequencies() if named is not None else setting.structure.natural_angular_frequencies()))
     caption = (
         f"Linear steady state without stops under the {setting.load_text()}: the amplitude of every coordinate "
         f"({', '.join(setting.names)}); the amplitude of each stop's coordinate n . x (dashed) and, dotted in the "
@@ -84,7 +84,7 @@ def structure_figure(setting: GeneralSetting, frequency: np.ndarray) -> DrawnFig
     )
     if named is not None:
         fitted = "against the paper's curve fit (circles)" if fit is not None else "(the paper's fit needs two underdamped modes)"
-        caption += f" |H22| exact {fitted}. Natural frequencies {natural} Hz, anti-resonance {fmt(named.antiresonance_frequency() / (2 * np.pi), '.3f')} Hz."
+        caption += f" |H22| exact {fitted}. Natural frequencies {natural} Hz, anti-resonance {fmt(named.antiresonance_angular_frequency() / (2 * np.pi), '.3f')} Hz."
     else:
         caption += f" Natural frequencies {natural} Hz."
     caption += f" Stops: {'; '.join(setting.stops)}."
@@ -130,7 +130,7 @@ def layout_tables(setting: GeneralSetting) -> list[Table]:
         return f"<p><b>{title}</b> [{units}]</p><table><tr><th></th>{head}</tr>{rows}</table>"
 
     s = setting.structure
-    natural = ", ".join(fmt(v / (2 * np.pi), ".4f") for v in s.natural_frequencies())
+    natural = ", ".join(fmt(v / (2 * np.pi), ".4f") for v in s.natural_angular_frequencies())
     matrices = matrix("mass M", s.mass_matrix, "kg") + matrix("stiffness K", s.stiffness_matrix, "N/m") + matrix("damping C", s.damping_matrix, "N s/m")
     matrices += f"<p>Natural frequencies (undamped): {natural} Hz; rigid-body modes: {s.rigid_body_modes()}.</p>"
     stops = "".join(f"<tr><td>{k}</td><td>{html.escape(words)}</td></tr>" for k, words in enumerate(setting.stops))

@@ -148,7 +148,7 @@ def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[st
     structure = scene.system.structure
     named = TwoDofSystem.of(scene.system)  # the named view: the paper's two-mass chain, however it was written
     fit = fit_modal_parameters(named) if named is not None and "pgf_paper" in scene.settings.solutions else None
-    natural = named.natural_frequencies() if named is not None else structure.natural_frequencies()
+    natural = named.natural_angular_frequencies() if named is not None else structure.natural_angular_frequencies()
     attrs: dict[str, object] = {
         "title": f"vibroimpact study '{scene.name}'",
         "scene_name": scene.name,
@@ -158,7 +158,7 @@ def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[st
         "natural_frequencies_Hz": np.array(natural) / (2.0 * np.pi),
     }
     if named is not None:
-        attrs["antiresonance_frequency_Hz"] = named.antiresonance_frequency() / (2.0 * np.pi)
+        attrs["antiresonance_frequency_Hz"] = named.antiresonance_angular_frequency() / (2.0 * np.pi)
         for key, value in named.as_dict().items():
             attrs[f"system_{key}"] = value
     attrs.update(layout_attributes(scene, scene.settings.restitution, scene.settings.clearance))

@@ -105,7 +105,7 @@ def linear_figure(setting: StudySetting) -> DrawnFigure:
     # the closed form is cheap: a fine grid over the study's range (its own grid may be a handful of points)
     f = np.union1d(setting.frequency, np.linspace(setting.frequency.min(), setting.frequency.max(), LINEAR_FIGURE_POINTS))
     w = 2.0 * np.pi * f
-    response = linear_response(system, w, setting.amplitude)
+    response = linear_response(system, omega=w, amplitude=setting.amplitude)
     fit = fit_modal_parameters(system) if underdamped_mode_count(system) == 2 else None
     fig, axes = new_figure(3, panel_height=3.6, legend_rows=2)
     ax = axes[0]
@@ -124,11 +124,11 @@ def linear_figure(setting: StudySetting) -> DrawnFigure:
         ax.semilogy(f[::step], np.abs(fit.receptance(w[::step])), "o", color="C3", mfc="none", ms=4.5, label="|H22| of eq. 10, the paper's fitted modes")
     finish_axes(ax, _FREQUENCY, "|H22| [m/N]", "Accuracy of the curve fit (paper fig. 4)")
     figure_legend(fig, axes, [Line2D([], [], color="k", lw=0.9, ls="--", label="clearance Delta")])
-    natural = ", ".join(fmt(x / (2 * np.pi), ".3f") for x in system.natural_frequencies())
+    natural = ", ".join(fmt(x / (2 * np.pi), ".3f") for x in system.natural_angular_frequencies())
     caption = (
         f"Linear system (Delta -> infinity): |X1| and |X2| (dashed: the clearance), the force on the base, and |H22| exact "
         f"{'against the paper' + chr(39) + 's curve fit (circles)' if fit is not None else '(the paper' + chr(39) + 's fit needs two underdamped modes)'}. "
-        f"Natural frequencies {natural} Hz, anti-resonance {fmt(system.antiresonance_frequency() / (2 * np.pi), '.3f')} Hz."
+        f"Natural frequencies {natural} Hz, anti-resonance {fmt(system.antiresonance_angular_frequency() / (2 * np.pi), '.3f')} Hz."
     )
     return DrawnFigure(fig, "linear", "Linear responses, force on the base, fit of H22", caption)
 

@@ -60,11 +60,11 @@ def general_orbit_outlook(scene: Scene, frequencies: np.ndarray) -> tuple[np.nda
     problem = scene_problem(scene, float(frequencies[0]), float(scene.settings.restitution[0]), float(scene.settings.clearance[0]))
     omega = 2.0 * np.pi * frequencies[None, None, :]
     clearances = stop_clearances(scene)[None, :, None, :]  # (1, nc, 1, K)
-    fits = np.broadcast_to(linear_amplitudes(problem, omega).fits(clearances), (scene.settings.restitution.size, scene.settings.clearance.size, frequencies.size))
+    fits = np.broadcast_to(linear_amplitudes(problem, omega=omega).fits(clearances), (scene.settings.restitution.size, scene.settings.clearance.size, frequencies.size))
     shape = fits.shape
     if closed_form_refusal(problem) is not None:
         return fits, np.zeros(shape, dtype=bool), np.zeros(shape, dtype=bool), UNKNOWN_WANDERING
-    orbit = solve_impact_orbit(problem, omega, scene.settings.clearance[None, :, None], scene.settings.restitution[:, None, None])
+    orbit = solve_impact_orbit(problem, omega=omega, clearance=scene.settings.clearance[None, :, None], restitution=scene.settings.restitution[:, None, None])
     admissible = np.broadcast_to(orbit.admissible(), shape)
     stable = np.zeros(shape, dtype=bool)
     if admissible.any():

@@ -113,7 +113,7 @@ def reduction_factors(dataset: xr.Dataset, setting: GeneralSetting, quantity: st
     if system is None:
         raise ValueError("reduction factors need the paper's two-mass chain (its two resonances and anti-resonance)")
     peaks = linear_peaks(setting, quantity)
-    split = system.antiresonance_frequency() / (2.0 * np.pi)
+    split = system.antiresonance_angular_frequency() / (2.0 * np.pi)
     data = dataset[quantity].sel(solution=solution)
     stable = dataset["stable"].sel(solution=solution) if "stable" in dataset and solution == "pgf" else None
     f = data["frequency"].values
@@ -157,7 +157,7 @@ def paper_reduction_factors(system: TwoDofSystem, amplitude: float, quantity: st
 def linear_peaks(setting: GeneralSetting, quantity: str) -> list[ResonancePeak]:
     """Maxima of the linear |quantity| near each natural frequency of the named view, by analytic maximisation."""
     assert setting.named is not None
-    return peaks_near(setting.named.natural_frequencies(), lambda w: setting.linear_value(quantity, np.asarray(w, dtype=float)), _SPAN)
+    return peaks_near(setting.named.natural_angular_frequencies(), lambda w: setting.linear_value(quantity, np.asarray(w, dtype=float)), _SPAN)
 
 
 def _values(data: xr.DataArray, name: str) -> np.ndarray:
@@ -220,7 +220,7 @@ def reduction_tables(dataset: xr.Dataset, setting: GeneralSetting, paper_layout:
     (``paper_layout``) and its example's numbers."""
     assert setting.named is not None
     solutions = [str(s) for s in dataset["solution"].values if s != "linear"]
-    split = setting.named.antiresonance_frequency() / (2.0 * np.pi)
+    split = setting.named.antiresonance_angular_frequency() / (2.0 * np.pi)
     tables = []
     for quantity in _REDUCTION_QUANTITIES:
         if quantity not in dataset or not solutions:

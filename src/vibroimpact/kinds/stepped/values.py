@@ -63,7 +63,7 @@ def general_linear_values(scene: Scene, omega: np.ndarray, shape: tuple[int, ...
     """The linear steady state (no stop) at ``omega`` [rad s-1] (axes of the full grid), flagged where it crosses a
     stop; the scene's quantities broadcast to ``shape`` (per-stop ones to (K, *shape))."""
     problem = first_problem(scene)
-    linear = linear_amplitudes(problem, omega)
+    linear = linear_amplitudes(problem, omega=omega)
     x = linear.coordinates  # omega.shape + (N,)
     count = len(scene.stop_specs)
     clearances = stop_clearances(scene)[None, :, None, None, None, :]  # (1, nc, 1, 1, 1, K)
@@ -110,8 +110,8 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
     it is admissible (and stable), else the linear motion where that fits; NaN elsewhere (as for the paper's pgf)."""
     problem = first_problem(scene)
     w, d, rr = np.broadcast_arrays(omega, delta, r)
-    orbit = solve_impact_orbit(problem, w, d, rr)
-    linear = linear_amplitudes(problem, w)
+    orbit = solve_impact_orbit(problem, omega=w, clearance=d, restitution=rr)
+    linear = linear_amplitudes(problem, omega=w)
     fits = linear.fits(stop_clearances(scene)[None, :, None, None, None, :])
     settings = scene.settings.admissibility
     admissible = orbit.admissible(settings.relative_tolerance, settings.samples_per_period)
@@ -226,9 +226,9 @@ def paper_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.n
     system = problem.named_system
     if system is None:
         raise ValueError("pgf_paper is the paper's route for its layout (a two-mass chain x1, x2; one upper stop on x2; force on x1): use pgf")
-    solution = solve_one_impact(system, omega, delta, r, scene.amplitude, PgfVariant.PAPER, green_models(system, PgfVariant.PAPER))
+    solution = solve_one_impact(system, omega=omega, clearance=delta, restitution=r, amplitude=scene.amplitude, variant=PgfVariant.PAPER, models=green_models(system, PgfVariant.PAPER))
     w = np.broadcast_to(omega, shape)
-    linear = linear_amplitudes(problem, w)
+    linear = linear_amplitudes(problem, omega=w)
     fits = np.broadcast_to(linear.fits(stop_clearances(scene)[None, :, None, None, None, :]), shape)
     regime = classify(fits, solution.exists, solution.admissible(scene.settings.admissibility))
     impact = np.isin(regime, _IMPACT_REGIMES)
