@@ -160,7 +160,7 @@ class ExactEngine:
     def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, jacobians: bool, approach: bool) -> tuple:
         check_run(self.name, problem, RigidStop, periods)
         setup = _setup(problem, self.settings)
-        state = np.ascontiguousarray(state, dtype=float)
+        state = np.array(state, dtype=float, order="C")  # a writable copy: one compiled overload (a read-only array would compile another, ~10 s)
         if state.shape != (2 * problem.size,):
             raise ValueError(f"state: expected {2 * problem.size} values (x and x' of {problem.size} coordinates), got shape {state.shape}")
         setup.law.check_start(state)
