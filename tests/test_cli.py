@@ -29,8 +29,17 @@ def test_list_shows_every_shipped_study_with_its_description(capsys: pytest.Capt
     root = shipped_studies_dir()
     names = sorted(path.relative_to(root).with_suffix("").as_posix() for path in root.rglob("*.yaml"))
     assert "restitution" in names and len(printed) == len(names)
+    column = max(len(name) for name in names) + 2
     for line, name, (listed, description) in zip(printed, names, shipped_studies()):
-        assert line.split()[0] == name == listed and description and description in line
+        assert line.split()[0] == name == listed and description
+        assert len(line) <= 120 and line[column - 2 : column] == "  " and line[column] != " "  # one aligned line each
+        shown = line[column:].removesuffix("...")
+        assert description.startswith(shown), (shown, description)  # the description's beginning, cut where it must be
+
+
+def test_the_listing_shows_a_first_clause_not_an_abbreviation() -> None:
+    listing = cli.study_listing([("a", "Validation against Holmes (J. Sound Vib. 84, 1982): a ball bouncing. More."), ("long_name", "Short one. Two.")], 200)
+    assert listing.splitlines() == ["a          Validation against Holmes (J. Sound Vib. 84, 1982)", "long_name  Short one"]
 
 
 def test_a_scene_is_required_without_list(capsys: pytest.CaptureFixture[str]) -> None:

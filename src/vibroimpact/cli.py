@@ -10,6 +10,8 @@ from __future__ import annotations
 import argparse
 import os
 import resource
+import re
+import shutil
 import sys
 import tempfile
 import time
@@ -55,6 +57,31 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def study_listing(studies: list[tuple[str, str]], width: int = 120) -> str:
+    """One line per study: its name in an aligned column, then its description's first clause, cut to ``width``
+    characters with an ellipsis (``run-study NAME`` runs it; the whole description is in the scene file)."""
+    column = max((len(name) for name, _ in studies), default=0) + 2
+    room = max(width - column, 20)
+    lines = []
+    for name, description in studies:
+        first = _first_clause(description)
+        lines.append(f"{name:<{column}}{first if len(first) <= room else first[: room - 3].rstrip() + '...'}")
+    return "\n".join(lines)
+
+
+def _first_clause(text: str) -> str:
+    """``text`` up to its first '.', ':' or ';' followed by a space outside parentheses (a '.' ending a word of three
+    letters or more: not an abbreviation such as "J." or "Vib.")."""
+    depth = 0
+    for i, char in enumerate(text[:-1]):
+        depth += (char == "(") - (char == ")")
+        if depth == 0 and char in ".:;" and text[i + 1] == " ":
+            word = re.findall(r"[A-Za-z]+$", text[:i])
+            if char != "." or not word or len(word[0]) >= 3:
+                return text[:i]
+    return text.rstrip(".")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the process exit code (2 for a bad scene or arguments, 130 when interrupted)."""
     argv = sys.argv[1:] if argv is None else list(argv)
@@ -63,7 +90,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.list:
-        print("\n".join(f"{name:<20} {description}" for name, description in shipped_studies()))
+        print(study_listing(shipped_studies(), shutil.get_terminal_size((120, 24)).columns))
         return 0
     if args.scene is None:
         parser.print_usage(sys.stderr)

@@ -171,7 +171,8 @@ class Runner:
             if self.store is not None:
                 self.store.save_case(names[index], result)
 
-        unit = cases[0].progress_unit if cases else "points"
+        units = list(dict.fromkeys(case.progress_unit for case in cases))  # each unit once, in order
+        unit = " + ".join(units) if units else "points"  # mixed cases (sweeps beside a chart) count each in its own unit
         if not self.distributed or (len(pending) <= 1 and self.scheduler is None):
             self._run_here(cases, pending, [i for i in range(len(cases)) if results[i] is not None], unit, keep)
         else:

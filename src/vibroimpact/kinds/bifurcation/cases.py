@@ -304,7 +304,7 @@ class BranchCase:
     seeds: tuple[Seed, ...] = ()
     engine: str = "exact"
     fields: tuple[str, ...] = BRANCH_FIELDS
-    progress_unit: str = "frequency points"
+    progress_unit: str = "branch sets"
 
     @property
     def restitution(self) -> float:
@@ -376,7 +376,7 @@ class ChartCase:
     max_steps: int
     engine: str = "exact"
     fields: tuple[str, ...] = ("curve", "kind", "frequency", "clearance", "notes")
-    progress_unit: str = "frequency points"
+    progress_unit: str = "charts"
 
     @property
     def progress_total(self) -> float:
