@@ -187,6 +187,10 @@ class Outputs:
         """The next time to record [s] (inf when all are recorded)."""
         return float(self.times[self.next]) if self.next < self.times.size else math.inf
 
+    def due(self, t: float) -> NDArray[np.float64]:
+        """The times still to record before t [s] (strictly), in order."""
+        return self.times[self.next : self.next + int(np.searchsorted(self.times[self.next :], t, side="left"))]
+
     def record(self, state: NDArray[np.float64]) -> None:
         """The state (x, x') at :meth:`next_time`."""
         self.states[self.next] = state

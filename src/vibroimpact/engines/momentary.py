@@ -267,9 +267,10 @@ class SolveIvpEngine(EventLoopEngine):
         self._steps += result.t.size - 1
         self._nfev += result.nfev
         if outputs is not None:
-            end = float(result.t[-1])
-            while outputs.next_time() < end:
-                outputs.record(model.layout.physical(result.sol(outputs.next_time())))
+            due = outputs.due(float(result.t[-1]))
+            if due.size:
+                for state in result.sol(due).T:
+                    outputs.record(model.layout.physical(state))
         if result.status == 1:
             self._events_found += 1
             for index, times in enumerate(result.t_events):
