@@ -260,7 +260,11 @@ class ExactEngine:
         """Integrate ``periods`` periods from ``state`` at ``t_start`` [s] and give the states at ``times`` [s] (inside
         the run, increasing), shape (n, 2 N) [m, m s-1]: exact, from the trajectory's segments (:meth:`states`); at an
         event's time, the state just after it."""
+        times = np.asarray(times, dtype=float).reshape(-1)
         trajectory = self.integrate(problem, state, t_start, periods)
+        t_end = float(trajectory.strobe_times[-1])
+        if times.size and (np.any(np.diff(times) < 0.0) or times[0] < t_start or times[-1] > t_end):
+            raise ValueError(f"times: expected increasing times inside the run [{t_start!r}, {t_end!r}] s, got [{times.min()!r}, {times.max()!r}] s")
         return trajectory, self.states(trajectory, times)
 
     def model(self, problem: ImpactProblem) -> ExactModel:

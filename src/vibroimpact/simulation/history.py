@@ -103,8 +103,8 @@ def engine_of(engine: Engine | str) -> Any:
 
 
 def _periods(problem: ImpactProblem, t_start: float, t_last: float) -> int:
-    """Whole periods from t_start that reach t_last, on the engines' own boundaries t_start + k T."""
-    periods = max(0, math.ceil((t_last - t_start) / problem.period * (1.0 - 1e-12)))
+    """Whole periods (at least one) from t_start that reach t_last, on the engines' own boundaries t_start + k T."""
+    periods = max(1, math.ceil((t_last - t_start) / problem.period * (1.0 - 1e-12)))
     while t_start + periods * problem.period < t_last:
         periods += 1
     return periods
