@@ -276,6 +276,12 @@ class Engine(Protocol):
         """Integrate ``periods`` whole periods from ``state`` at ``t_start``."""
         ...
 
+    def sample(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, times: NDArray[np.float64]) -> tuple[Trajectory, NDArray[np.float64]]:
+        """Integrate as :meth:`integrate` and give the states (x, x') at ``times`` [s] (increasing, inside the run),
+        shape (len(times), 2 N) [m, m s-1]: exact where the flow is closed form, else the integrator's own
+        interpolation; at an event's time the state just after it (:func:`vibroimpact.simulation.history.time_history`)."""
+        ...
+
 
 class SweepingEngine(Protocol):
     """A time-domain solver of an :class:`ImpactProblem` with a :class:`SweptSine` excitation, start to end."""

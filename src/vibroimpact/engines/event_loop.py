@@ -30,7 +30,7 @@ from vibroimpact.engines.rigid_kernels import RigidContact, APEX, STUCK, events_
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["EventLoopEngine", "Stop", "Model", "moment_row"]
+__all__ = ["EventLoopEngine", "Outputs", "Stop", "Model", "moment_row"]
 
 
 def moment_row(q: NDArray[np.float64], size: int = 2, stops: int = 1) -> NDArray[np.complex128]:
@@ -163,6 +163,53 @@ class Model:
         return float(holding_kernel(t, np.ascontiguousarray(y, dtype=float), self.parameters, self.stuck_on if stop is None else stop))
 
 
+class Outputs:
+    """Times at which a run records its state, and the states recorded there (a sampled run, :meth:`EventLoopEngine.sample`).
+
+    Parameters
+    ----------
+    times : array_like
+        Increasing times inside the run [s].
+    t_start, t_end : float
+        The run's span [s].
+    width : int
+        Entries of a state (2 N).
+    """
+
+    def __init__(self, times: NDArray[np.float64], t_start: float, t_end: float, width: int) -> None:
+        self.times = np.asarray(times, dtype=float).reshape(-1)
+        if self.times.size and (np.any(np.diff(self.times) < 0.0) or self.times[0] < t_start or self.times[-1] > t_end):
+            raise ValueError(f"times: expected increasing times inside the run [{t_start!r}, {t_end!r}] s, got [{self.times.min()!r}, {self.times.max()!r}] s")
+        self.states = np.full((self.times.size, width), math.nan)
+        self.next = 0
+
+    def next_time(self) -> float:
+        """The next time to record [s] (inf when all are recorded)."""
+        return float(self.times[self.next]) if self.next < self.times.size else math.inf
+
+    def due(self, t: float) -> NDArray[np.float64]:
+        """The times still to record before t [s] (strictly), in order."""
+        return self.times[self.next : self.next + int(np.searchsorted(self.times[self.next :], t, side="left"))]
+
+    def record(self, state: NDArray[np.float64]) -> None:
+        """The state (x, x') at :meth:`next_time`."""
+        self.states[self.next] = state
+        self.next += 1
+
+    def reached(self, t: float, state: NDArray[np.float64]) -> None:
+        """The run stands at t [s] in ``state`` (x, x'): every time up to t (within the round-off an integrator
+        cannot step over, 16 eps t) gets it."""
+        close = t + 16.0 * np.finfo(float).eps * max(1.0, abs(t))
+        while self.next < self.times.size and self.times[self.next] <= close:
+            self.record(state)
+
+    def finished(self, engine: str) -> NDArray[np.float64]:
+        """The states, shape (len(times), 2 N); ``RuntimeError`` if the run left any time unrecorded."""
+        if self.next < self.times.size:
+            raise RuntimeError(f"engine {engine!r} recorded {self.next} of {self.times.size} output times (the first missing: {self.times[self.next]!r} s)")
+        return self.states
+
+
 class EventLoopEngine(ABC):
     """Template: integrate period by period, apply the contact map and the sticking rules between calls."""
 
@@ -178,9 +225,11 @@ class EventLoopEngine(ABC):
         """Prepare the integrator for ``model`` (called once per :meth:`integrate`)."""
 
     @abstractmethod
-    def _advance(self, model: Model, t: float, y: NDArray[np.float64], t_stop: float) -> tuple[Stop, float, NDArray[np.float64], int]:
+    def _advance(self, model: Model, t: float, y: NDArray[np.float64], t_stop: float, outputs: Outputs | None = None) -> tuple[Stop, float, NDArray[np.float64], int]:
         """Integrate from (t, y) to ``t_stop`` or to the first event of the current mode; return why, when, the
-        state, and the stop of a contact or release (-1 at the boundary)."""
+        state, and the stop of a contact or release (-1 at the boundary). With ``outputs``, record on the way the
+        state (x, x') at each of its times before the one returned (:meth:`Outputs.next_time`,
+        :meth:`Outputs.record`), interpolated by the integrator without changing its steps."""
 
     def _counters(self) -> dict[str, int]:
         """Integrator counters to add to the trajectory's stats."""
@@ -195,6 +244,19 @@ class EventLoopEngine(ABC):
 
     def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
         """Integrate ``periods`` whole periods from ``state`` (x_1 ... x_N, x_1' ... x_N') at ``t_start`` [s]."""
+        return self._run(problem, state, t_start, periods, moments, None)
+
+    def sample(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, times: NDArray[np.float64]) -> tuple[Trajectory, NDArray[np.float64]]:
+        """Integrate ``periods`` periods from ``state`` at ``t_start`` [s] and give the states (x, x') at ``times`` [s]
+        (inside the run, increasing), shape (n, 2 N) [m, m s-1]: the integrator's own interpolation between events
+        (:meth:`_advance` with :class:`Outputs`), the state just after the events at an event's time, the strobe
+        state at a period boundary. The events are handled as :meth:`integrate` handles them."""
+        outputs = Outputs(times, t_start, t_start + periods * problem.period, 2 * problem.size)
+        trajectory = self._run(problem, state, t_start, periods, False, outputs)
+        return trajectory, outputs.finished(self.name)
+
+    def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, outputs: Outputs | None) -> Trajectory:
+        """:meth:`integrate`, recording the states at the times of ``outputs`` if given."""
         law = RigidContact(self.name, problem, self.settings, periods)
         state = np.asarray(state, dtype=float)
         n = problem.size
@@ -236,8 +298,11 @@ class EventLoopEngine(ABC):
                         stop = Stop.CONTACT
                     elif boundary - t <= 4.0 * math.ulp(boundary):
                         stop, t = Stop.BOUNDARY, boundary  # nothing left of this period to integrate
-                    else:
+                    elif outputs is None:
                         stop, t, y, which = advance(model, t, y, boundary)
+                    else:
+                        outputs.reached(t, model.layout.physical(y))  # the outputs at t: the state after its events
+                        stop, t, y, which = advance(model, t, y, boundary, outputs)
                     if stop is Stop.BOUNDARY:
                         if touching(y) >= 0:
                             continue  # an impact exactly at the boundary is applied before the strobe
@@ -259,6 +324,8 @@ class EventLoopEngine(ABC):
                     quadratures = y[2 * n :].copy()
                     rec.add_moments(moment_row(q, n, layout.stop_count))
                 rec.strobe(t, model.layout.physical(y))
+                if outputs is not None:
+                    outputs.reached(t, model.layout.physical(y))
         finally:
             self._end()
         return rec.build(self._counters() | {"rhs_calls": model.rhs_calls + self._compiled_rhs_calls()})

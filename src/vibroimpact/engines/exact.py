@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines.registry import ENGINES, Capabilities
 from vibroimpact.engines import exact_core
-from vibroimpact.engines.base import Trajectory, check_run
+from vibroimpact.engines.base import MODE_STUCK, Trajectory, check_run
 from vibroimpact.engines.exact_flows import Flow, ExactModel, build_model
 from vibroimpact.engines.exact_python import PythonExactEngine
 from vibroimpact.engines.linear_flow import gauss_legendre
@@ -120,6 +120,8 @@ class _Setup:
     law: RigidContact
     model: ExactModel
     arguments: tuple
+    #: the leading arguments of :func:`~vibroimpact.engines.exact_core.sample_states`: the flows, the stops' gaps
+    sampling: tuple
 
 
 @lru_cache(maxsize=512)
@@ -144,7 +146,8 @@ def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
         model.bounce, model.stick, model.touch,
         law.sticking_velocity, law.max_impacts, 1e-15 * length, 1e-14 * law.velocity_scale, nodes, weights,
     )  # fmt: skip
-    return _Setup(law, model, arguments)
+    a = arguments
+    return _Setup(law, model, arguments, (*a[:11], a[19], a[21], a[24], a[27], a[28]))
 
 
 class ExactEngine:
@@ -233,8 +236,36 @@ class ExactEngine:
         """States at arbitrary ``times`` inside a trajectory, shape (n, 2 N), exact (from its segments).
 
         At an event's time, ``side="right"`` gives the state just after it and ``"left"`` the state just before it
-        (the end of the earlier segment: e.g. the velocities before an impact)."""
+        (the end of the earlier segment: e.g. the velocities before an impact). Evaluated by the pure-Python flows
+        (the studies that read it keep their numbers); :meth:`states` is the compiled twin, the same to round-off."""
         return PythonExactEngine(self.settings).dense(trajectory, times, side)
+
+    def states(self, trajectory: Trajectory, times: NDArray[np.float64], side: str = "right") -> NDArray[np.float64]:
+        """As :meth:`dense`, compiled (:func:`~vibroimpact.engines.exact_core.sample_states`): states (x, x') at
+        ``times`` [s] inside the trajectory, shape (n, 2 N) [m, m s-1], each piece evaluated as the run's own loop
+        evaluates it (a time on a strobe gives its strobe state)."""
+        if side not in ("left", "right"):
+            raise ValueError(f"side = {side!r} is not allowed: use 'left' or 'right'")
+        times = np.ascontiguousarray(times, dtype=float).reshape(-1)
+        segments = trajectory.segments
+        if segments.shape[0] == 0:
+            raise ValueError("the trajectory has no segments (0 periods): there is nothing to sample")
+        setup = _setup(trajectory.problem, self.settings)
+        pieces = np.clip(np.searchsorted(segments[:, 0], times, side=side) - 1, 0, segments.shape[0] - 1)  # type: ignore[call-overload]
+        flows = np.where(segments[:, 2] == MODE_STUCK, trajectory.segment_stops + 1, 0).astype(np.int64)
+        starts = np.ascontiguousarray(segments[:, 0])
+        return exact_core.sample_states(*setup.sampling, starts, flows, np.ascontiguousarray(trajectory.segment_states), times, pieces.astype(np.int64))
+
+    def sample(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, times: NDArray[np.float64]) -> tuple[Trajectory, NDArray[np.float64]]:
+        """Integrate ``periods`` periods from ``state`` at ``t_start`` [s] and give the states at ``times`` [s] (inside
+        the run, increasing), shape (n, 2 N) [m, m s-1]: exact, from the trajectory's segments (:meth:`states`); at an
+        event's time, the state just after it."""
+        times = np.asarray(times, dtype=float).reshape(-1)
+        trajectory = self.integrate(problem, state, t_start, periods)
+        t_end = float(trajectory.strobe_times[-1])
+        if times.size and (np.any(np.diff(times) < 0.0) or times[0] < t_start or times[-1] > t_end):
+            raise ValueError(f"times: expected increasing times inside the run [{t_start!r}, {t_end!r}] s, got [{times.min()!r}, {times.max()!r}] s")
+        return trajectory, self.states(trajectory, times)
 
     def model(self, problem: ImpactProblem) -> ExactModel:
         """The flows and stop maps the engine prepared for ``problem`` (cached per problem)."""

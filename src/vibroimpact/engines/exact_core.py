@@ -38,7 +38,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["run_periods", "moment_rates", "STATUS_OK", "STATUS_NO_PROGRESS", "STATUS_TWO_STICKS"]
+__all__ = ["run_periods", "sample_states", "moment_rates", "STATUS_OK", "STATUS_NO_PROGRESS", "STATUS_TWO_STICKS"]
 
 STATUS_OK, STATUS_NO_PROGRESS, STATUS_TWO_STICKS = 0, 1, 2
 
@@ -730,6 +730,39 @@ def run_periods(
         counters[2] += 1 if sticks else 0
         stuck = held_after
     return STATUS_OK, t, strobes, jacobians, impacts[:n_impacts], segments[:n_segments], segment_states[:n_segments], moments, counters, approach
+
+
+# ------------------------------------------------------------------------------------------------------ sampling
+@njit(cache=True, error_model="numpy")
+def sample_states(lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, omega, gapw, clearances, simple, signs, starts, flows, states, times, pieces):
+    """The states at ``times`` on the pieces of a run, exact: piece ``pieces[i]`` (start time ``starts[p]``, state
+    ``states[p]`` there, flow ``flows[p]``: 0 free, 1 + k held on stop k) is evaluated at ``times[i]`` as the loop
+    evaluates it (modal coordinates at the piece's start, :func:`_state`, round-off beyond a stop not held snapped
+    onto it), so a time on a strobe gives the strobe state. Returns (len(times), n)."""
+    count = times.size
+    n = states.shape[1]
+    out = np.empty((count, n))
+    modal = np.empty(lams.shape[1], dtype=np.complex128)
+    z0, q1, q2 = np.zeros(n), np.zeros(n), np.zeros(n)
+    y = np.empty(n)
+    current = -1
+    for i in range(count):
+        p = pieces[i]
+        f = flows[p]
+        m = counts[f]
+        poly = polys[f]
+        if p != current:
+            _modal(lams, invs, hrms, csts, f, m, omega, starts[p], states[p], modal)
+            if poly:
+                _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, starts[p], states[p], z0, q1, q2)
+            current = p
+        _state(lams, vecs, hrms, csts, f, m, omega, starts[p], modal, times[i], y, poly, z0, q1, q2)
+        for j in range(clearances.size):
+            if j != f - 1 and _gap(gapw, clearances, j, y) > 0.0:
+                _snap(gapw, clearances, simple, signs, j, y)  # round-off beyond a stop is the stop
+        for r in range(n):
+            out[i, r] = y[r]
+    return out
 
 
 # ---------------------------------------------------------------------------------------------------------- moments

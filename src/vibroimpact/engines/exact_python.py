@@ -46,6 +46,12 @@ class PythonExactEngine:
         run = _Run(RigidContact(self.name, problem, self.settings, periods), problem, TrajectoryBuilder(problem, moments))
         return run.go(np.asarray(state, dtype=float), float(t_start), int(periods))
 
+    def sample(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, times: NDArray[np.float64]) -> tuple[Trajectory, NDArray[np.float64]]:
+        """Integrate ``periods`` periods from ``state`` at ``t_start`` [s] and give the states at ``times`` [s] (inside
+        the run, increasing), shape (n, 2 N) [m, m s-1], exact (:meth:`dense`; at an event's time, the state after it)."""
+        trajectory = self.integrate(problem, state, t_start, periods)
+        return trajectory, self.dense(trajectory, times)
+
     def dense(self, trajectory: Trajectory, times: NDArray[np.float64], side: str = "right") -> NDArray[np.float64]:
         """States at arbitrary ``times`` inside a trajectory, shape (n, 2 N), exact (from its segments); at an event's
         time ``side="right"`` gives the state after it, ``"left"`` the state before it."""

@@ -29,14 +29,14 @@ from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 from sksundae.cvode import CVODE
 
-from vibroimpact.engines.event_loop import EventLoopEngine, Model, Stop
+from vibroimpact.engines.event_loop import EventLoopEngine, Model, Outputs, Stop
 from vibroimpact.engines.rigid_kernels import COMPILED_EVENTS as _events, COMPILED_JACOBIAN as _jacobian, COMPILED_RHS as _rhs
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.sundae import ROOT_RETURN, CompiledCvode, clear_event_records, compiled_cvode_problem
 
 __all__ = ["MomentaryEngine", "compiled_parameters", "COMPILED_RHS", "COMPILED_JACOBIAN", "COMPILED_EVENTS", "SolveIvpEngine", "SOLVE_IVP_METHODS"]
 
-_STATUS_TSTOP = 1
+_STATUS_TSTOP, _STATUS_ROOT = 1, 2
 
 
 def compiled_parameters(model: Model) -> NDArray[np.float64]:
@@ -119,15 +119,22 @@ class MomentaryEngine(EventLoopEngine):
     def _compiled_rhs_calls(self) -> int:
         return self._solver_rhs
 
-    def _advance(self, model: Model, t: float, y: NDArray[np.float64], t_stop: float) -> tuple[Stop, float, NDArray[np.float64], int]:
+    def _advance(self, model: Model, t: float, y: NDArray[np.float64], t_stop: float, outputs: Outputs | None = None) -> tuple[Stop, float, NDArray[np.float64], int]:
         if self._cvode is None:
-            return self._advance_python(model, t, y, t_stop)
+            return self._advance_python(model, t, y, t_stop, outputs)
         cvode = self._cvode
         if not (self._at_t == t and self._at_y is y):
             cvode.restart(t, y)
         advance, roots, decide = cvode.advance, cvode.roots, self._decide
         while True:
-            flag, now = advance(t_stop)
+            t_out = outputs.next_time() if outputs is not None else math.inf
+            if t_out < t_stop:  # an output time before the boundary: CVODE's interpolation there, or a root before it
+                flag, now = advance(t_stop, t_out)
+                if flag != ROOT_RETURN:
+                    outputs.record(model.layout.physical(cvode.state))  # type: ignore[union-attr]
+                    continue
+            else:
+                flag, now = advance(t_stop)
             if flag != ROOT_RETURN:  # at t_stop (CV_TSTOP_RETURN, or CV_SUCCESS with t_stop = tout)
                 state = cvode.state.copy()
                 self._at_t, self._at_y = now, state
@@ -136,16 +143,20 @@ class MomentaryEngine(EventLoopEngine):
             if found is not None:
                 return found
 
-    def _advance_python(self, model: Model, t: float, y: NDArray[np.float64], t_stop: float) -> tuple[Stop, float, NDArray[np.float64], int]:
+    def _advance_python(self, model: Model, t: float, y: NDArray[np.float64], t_stop: float, outputs: Outputs | None) -> tuple[Stop, float, NDArray[np.float64], int]:
         if not (self._at_t == t and self._at_y is y):
             clear_event_records(self._events)
             started = self._solver.init_step(t, y)
             if started.status < 0:
                 raise RuntimeError(f"CVODE could not start at t = {t!r} s: {started.message}")
         while True:
-            result = self._solver.step(t_stop, tstop=t_stop)
+            t_out = outputs.next_time() if outputs is not None else math.inf
+            result = self._solver.step(min(t_out, t_stop), tstop=t_stop)
             if result.status < 0:
                 raise RuntimeError(f"CVODE failed at t = {result.t!r} s: {result.message}")
+            if t_out < t_stop and result.status != _STATUS_ROOT:  # interpolated at the output time
+                outputs.record(model.layout.physical(np.array(result.y)))  # type: ignore[union-attr]
+                continue
             if result.status == _STATUS_TSTOP:
                 now = np.array(result.y)
                 self._at_t, self._at_y = float(result.t), now
@@ -240,8 +251,10 @@ class SolveIvpEngine(EventLoopEngine):
     def _counters(self) -> dict[str, int]:
         return {"steps": self._steps, "events": self._events_found, "solver_rhs_calls": self._nfev}
 
-    def _advance(self, model: Model, t: float, y: NDArray[np.float64], t_stop: float) -> tuple[Stop, float, NDArray[np.float64], int]:
+    def _advance(self, model: Model, t: float, y: NDArray[np.float64], t_stop: float, outputs: Outputs | None = None) -> tuple[Stop, float, NDArray[np.float64], int]:
         options: dict[str, Any] = {"method": self.method, "rtol": self.settings.rtol, "atol": self.settings.atol}
+        if outputs is not None:
+            options["dense_output"] = True  # the outputs on the way: the method's own interpolant
         if self.settings.max_step > 0.0:
             options["max_step"] = self.settings.max_step
         # the contacts of every stop not held, then the release of the one held
@@ -253,6 +266,11 @@ class SolveIvpEngine(EventLoopEngine):
             raise RuntimeError(f"solve_ivp ({self.method}) failed at t = {result.t[-1]!r} s: {result.message}")
         self._steps += result.t.size - 1
         self._nfev += result.nfev
+        if outputs is not None:
+            due = outputs.due(float(result.t[-1]))
+            if due.size:
+                for state in result.sol(due).T:
+                    outputs.record(model.layout.physical(state))
         if result.status == 1:
             self._events_found += 1
             for index, times in enumerate(result.t_events):

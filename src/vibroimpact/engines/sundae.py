@@ -254,11 +254,13 @@ class CompiledCvode:
         if flag < 0:
             self._check(flag, "CVodeReInit", t)
 
-    def advance(self, t_stop: float) -> tuple[int, float]:
-        """Integrate to ``t_stop`` or the first root: (flag, time); the state is in :attr:`state`."""
+    def advance(self, t_stop: float, t_out: float | None = None) -> tuple[int, float]:
+        """Integrate to ``t_stop`` or the first root: (flag, time); the state is in :attr:`state`. With ``t_out``
+        (< ``t_stop``), return there instead if no root comes first: CVODE steps on as it would towards ``t_stop``
+        and interpolates the state at ``t_out`` (its steps and roots are those of a run without it)."""
         mem = self._mem
         self._set_stop(mem, t_stop)
-        flag = self._cvode(mem, t_stop, self._vector, self._time_ref, _NORMAL)
+        flag = self._cvode(mem, t_stop if t_out is None else t_out, self._vector, self._time_ref, _NORMAL)
         if flag < 0:
             self._check(flag, "CVode", self._time.value)
         return flag, self._time.value

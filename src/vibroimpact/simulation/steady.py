@@ -26,7 +26,9 @@ from vibroimpact.simulation.harmonics import HarmonicMeasures, measure, gaps, li
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.simulation.periodic import motion_evidence, shoot_orbit
+from vibroimpact.simulation.history import TimeHistory, engine_of, linear_history, time_history
 from vibroimpact.simulation.settings import START_MODES, SteadySettings
+from vibroimpact.model.structure import require_in_range
 from vibroimpact.orbits.motion import MotionEvidence
 
 __all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "pgf_guesses", "orbit_stop_of", "START_MODES", "strobes_repeat", "motion_scale", "march"]
@@ -57,6 +59,10 @@ class SteadyResult:
         Where the motion did not converge (and ``lyapunov_periods`` > 0): what it is, with the evidence.
     search_periods : int
         Periods spent finding the steady state (shooting's map evaluations, or marching), before measuring it.
+    engine : Engine or None
+        The engine that ran it (for :meth:`history`; not compared).
+    problem : ImpactProblem or None
+        The problem solved (for :meth:`history`; not compared).
     """
 
     measures: HarmonicMeasures
@@ -68,6 +74,36 @@ class SteadyResult:
     integrated: bool = True
     motion: MotionEvidence | None = None
     search_periods: int = 0
+    engine: Engine | None = field(default=None, repr=False, compare=False)
+    problem: ImpactProblem | None = field(default=None, repr=False, compare=False)
+
+    def history(self, periods: int | None = None, samples_per_period: int = 200) -> TimeHistory:
+        """The steady motion's time history from :attr:`end_time` on, ``samples_per_period`` samples a period.
+
+        Parameters
+        ----------
+        periods : int, optional
+            Periods to sample; by default the motion's own period (``multiplicity``, 1 if it did not converge).
+        samples_per_period : int
+            Samples per excitation period (evenly spaced; both ends included).
+
+        Returns
+        -------
+        TimeHistory
+            The engine's run from (:attr:`end_time`, :attr:`end_state`) (:func:`time_history`); where the answer is
+            the linear steady state (``integrated`` False: it stays clear of every stop) its closed form x0 + Re(X
+            e^{jwt}) (:func:`linear_history`, no contacts, ``engine`` "linear").
+        """
+        if self.problem is None or (self.integrated and self.engine is None):
+            raise ValueError("this result does not know its engine and problem (made by hand, not by steady_state): it has no history")
+        periods = max(self.multiplicity, 1) if periods is None else periods
+        require_in_range("periods", periods, 1, 1e6)
+        require_in_range("samples_per_period", samples_per_period, 1, 1e7)
+        step = self.problem.period / samples_per_period
+        times = self.end_time + step * np.arange(int(periods) * int(samples_per_period) + 1)
+        if not self.integrated:
+            return linear_history(self.problem, times)
+        return time_history(self.engine, self.problem, self.end_state, self.end_time, times)  # type: ignore[arg-type]
 
 
 def start_state(problem: ImpactProblem, mode: str, orbit_stop: RigidStop | tuple[Stop, ...] | None = None) -> tuple[float, NDArray[np.float64]]:
@@ -136,7 +172,7 @@ def motion_scale(problem: ImpactProblem) -> NDArray[np.float64]:
 
 
 def steady_state(
-    engine: Engine,
+    engine: Engine | str,
     problem: ImpactProblem,
     start: str | tuple[float, NDArray[np.float64]] = "linear",
     settings: SteadySettings = SteadySettings(),
@@ -147,8 +183,9 @@ def steady_state(
 
     Parameters
     ----------
-    engine : Engine
-        Time-domain engine.
+    engine : Engine or str
+        Time-domain engine, or the name of a registered one (built with default :class:`~vibroimpact.engines.settings.EngineSettings`;
+        ``ValueError`` naming the registered engines for an unknown name).
     problem : ImpactProblem
         System, stop and excitation.
     start : {'linear', 'pgf', 'rest', 'shooting'} or (time [s], state)
@@ -160,7 +197,25 @@ def steady_state(
     guess : (time [s], state) or None, optional
         The ``pgf`` start, precomputed for a whole grid by :func:`pgf_guesses` (None: no admissible one-impact
         orbit); by default computed here.
+
+    Returns
+    -------
+    SteadyResult
+        The measures, and the engine and problem, so that :meth:`SteadyResult.history` samples the steady motion.
     """
+    engine = engine_of(engine)
+    return replace(_steady_state(engine, problem, start, settings, orbit_stop, guess), engine=engine, problem=problem)
+
+
+def _steady_state(
+    engine: Engine,
+    problem: ImpactProblem,
+    start: str | tuple[float, NDArray[np.float64]],
+    settings: SteadySettings,
+    orbit_stop: RigidStop | tuple[Stop, ...] | None,
+    guess: tuple[float, NDArray[np.float64]] | None | str,
+) -> SteadyResult:
+    """:func:`steady_state` with an engine."""
     if start in ("pgf", "shooting"):
         if isinstance(guess, str):
             guess = pgf_guesses(problem, [problem.frequency], orbit_stop)[0]

@@ -77,6 +77,22 @@ class CompliantEngine:
 
     def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
         """Integrate ``periods`` whole periods from ``state`` (x_1 ... x_N, x_1' ... x_N') at ``t_start`` [s]."""
+        return self._integrate(problem, state, t_start, periods, moments, None)[0]
+
+    def sample(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, times: NDArray[np.float64]) -> tuple[Trajectory, NDArray[np.float64]]:
+        """Integrate ``periods`` periods from ``state`` at ``t_start`` [s] and give the states (x, x') at ``times`` [s]
+        (inside the run, increasing), shape (n, 2 N) [m, m s-1]: the solver's own interpolation (the times join the
+        strobe times as outputs of its calls), the state after a mode switch at the switch's time."""
+        times = np.asarray(times, dtype=float).reshape(-1)
+        t_end = float(t_start) + periods * problem.period
+        if times.size and (np.any(np.diff(times) < 0.0) or times[0] < t_start or times[-1] > t_end):
+            raise ValueError(f"times: expected increasing times inside the run [{t_start!r}, {t_end!r}] s, got [{times.min()!r}, {times.max()!r}] s")
+        return self._integrate(problem, state, t_start, periods, False, times)  # type: ignore[return-value]
+
+    def _integrate(
+        self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, samples: NDArray[np.float64] | None
+    ) -> tuple[Trajectory, NDArray[np.float64] | None]:
+        """:meth:`integrate`, also giving the states at the times ``samples`` if given."""
         check_run(self.name, problem, KelvinVoigtBumper, periods)
         model = BumperModel(problem, moments)
         rec = TrajectoryBuilder(problem, moments)
@@ -93,8 +109,31 @@ class CompliantEngine:
                     previous = y[first:].copy()
                 rec.strobe(float(t), model.layout.physical(y))
 
-        run.run(np.asarray(t_start + problem.period * np.arange(1, periods + 1), dtype=np.float64), strobes)
-        return rec.build(run.stats())
+        boundaries = np.asarray(t_start + problem.period * np.arange(1, periods + 1), dtype=np.float64)
+        if samples is None:
+            run.run(boundaries, strobes)
+            return rec.build(run.stats()), None
+        # the sample times join the boundaries as outputs, once each: an output row is a strobe where a boundary
+        # falls on its time, and the state of every sample at its time
+        sampled = np.empty((samples.size, 2 * n))
+        merged, inverse = np.unique(np.concatenate([boundaries, samples]), return_inverse=True)
+        strobe_at = np.zeros(merged.size, dtype=bool)
+        strobe_at[inverse[: boundaries.size]] = True
+        sample_rows = inverse[boundaries.size :]  # increasing, as the samples are
+        done = 0
+
+        def outputs(times: NDArray[np.float64], ys: NDArray[np.float64], contact: int) -> None:
+            nonlocal done
+            chosen = strobe_at[done : done + times.size]
+            if np.any(chosen):
+                strobes(times[chosen], ys[chosen], contact)
+            lo, hi = np.searchsorted(sample_rows, [done, done + times.size])
+            for slot in range(lo, hi):
+                sampled[slot] = model.layout.physical(ys[sample_rows[slot] - done])
+            done += times.size
+
+        run.run(merged, outputs)
+        return rec.build(run.stats()), sampled
 
     def sweep(
         self, problem: ImpactProblem, sample_rate: float, state: NDArray[np.float64] | None = None, progress: Callable[[float], None] | None = None
