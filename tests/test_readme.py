@@ -1,9 +1,14 @@
-"""The README's promises: two set-up commands, and CI running the second one."""
+"""The README's promises: two set-up commands, CI running the second one, and a quick start that runs."""
 
 from __future__ import annotations
 
+import os
 import re
+import subprocess
+import sys
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -64,3 +69,35 @@ def test_every_file_and_test_the_readme_names_exists() -> None:
         elif test and not re.search(rf"def {test}\(", found.read_text()):
             missing.append(f"{path}::{test}")
     assert not missing, f"the README names what is not there: {missing}"
+
+
+def quick_start() -> tuple[int, str]:
+    """The line number of the `## Quick start` heading and the first ```python block after it."""
+    lines = (ROOT / "README.md").read_text().splitlines()
+    heading = next(number for number, line in enumerate(lines, start=1) if line.strip() == "## Quick start")
+    block = re.search(r"```python\n(.*?)```", "\n".join(lines[heading:]), flags=re.S)
+    assert block is not None, "no ```python block after ## Quick start"
+    return heading, block.group(1)
+
+
+def test_readme_is_an_entry_not_a_manual() -> None:
+    """A new user sees what it is, the set-up commands and the quick start on the first screens: the heading within
+    the first 80 lines, one short example, and the whole README at most 500 lines."""
+    heading, code = quick_start()
+    assert heading <= 80, f"## Quick start is on line {heading}"
+    lines = (ROOT / "README.md").read_text().splitlines()
+    section = "\n".join(lines[heading:next((n for n, line in enumerate(lines[heading:], start=heading) if line.startswith("## ")), len(lines))])
+    assert section.count("```python") == 1, "the quick start holds one python block"
+    assert len(code.splitlines()) <= 25
+    assert len((ROOT / "README.md").read_text().splitlines()) <= 500
+
+
+@pytest.mark.timeout(600)
+def test_quick_start_runs(tmp_path: Path) -> None:
+    """The quick start's code runs as a user would paste it, in a fresh interpreter in an empty folder (the first run
+    may compile the exact engine's numba core), and prints both of its results."""
+    _, code = quick_start()
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=540)
+    assert result.returncode == 0, result.stderr
+    assert "closed form:" in result.stdout and "exact engine:" in result.stdout, result.stdout

@@ -89,9 +89,9 @@ def test_cost_table_runs_slices_over_budget() -> None:
 @pytest.mark.slow
 @pytest.mark.timeout(1800)
 def test_paper_sweep_cost() -> None:
-    """The full cost run (the paper's sweep: IDA, IDA at rtol 1e-9, LSODA, Radau). Its wall times are the README's
-    benchmark table (IDA's 300 s in 11 s: a measured figure, not asserted here, since a test must not depend on the
-    machine's speed); every other run has IDA's contacts on its span to 1 %, and within the contact-rich 21 -> 24 Hz band the same
+    """The full cost run (the paper's sweep: IDA, IDA at rtol 1e-9, LSODA, Radau). Its wall times are what
+    `run-study sweep-cost` prints (the README of c3744b1 quoted them: IDA's 300 s in 11 s), measured, not asserted
+    here, since a test must not depend on the machine's speed; every other run has IDA's contacts on its span to 1 %, and within the contact-rich 21 -> 24 Hz band the same
     contacts and running X1 fundamental to 1e-4 of its largest value there (measured ~1e-5)."""
     table = run_sweep_cost()
     for run in table.run.values:

@@ -7,7 +7,7 @@ served stale machine code after an edit.
 
 The algorithm is :mod:`~vibroimpact.engines.exact_python`'s (closed-form flow, guaranteed first-root search by Taylor bounds, impact map,
 sticking and release, strobes, Fourier moments), compiled with ``@njit(cache=True)``: the interpreter overhead of the
-pure-Python loop was ~97 % of its cost (README, "Speed: before and after the compiled core"). It runs any N-dof
+pure-Python loop was ~97 % of its cost (the README of c3744b1, "Speed: before and after the compiled core"). It runs any N-dof
 structure (state y = (x, x') of n = 2 N entries) with any K rigid stops. Flows (:mod:`~vibroimpact.engines.exact_flows`) are passed
 stacked, flow 0 the free flight and flow 1 + k the flight held on stop k, all in the full state's coordinates:
 
