@@ -101,3 +101,6 @@ def test_quick_start_runs(tmp_path: Path) -> None:
     result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=540)
     assert result.returncode == 0, result.stderr
     assert "closed form:" in result.stdout and "exact engine:" in result.stdout, result.stdout
+    printed = result.stdout.splitlines()
+    assert all(f"`{line}`" in (ROOT / "README.md").read_text(encoding="utf-8") for line in printed), printed  # what the README says it prints
+    assert (tmp_path / "quick_start.png").stat().st_size > 10_000  # the time history's figure
