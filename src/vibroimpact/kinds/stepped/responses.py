@@ -11,12 +11,13 @@ drawn. Closed forms are drawn as curves on the dataset's grid, simulations as ma
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import xarray as xr
 from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.lines import Line2D
-from matplotlib.patches import Patch
+from matplotlib.patches import Patch, Rectangle
 
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.model.modal import fit_modal_parameters, underdamped_mode_count
@@ -201,23 +202,39 @@ def _first(part: xr.Dataset) -> dict[str, int]:
 
 
 def regime_figure(part: xr.Dataset, name: str) -> DrawnFigure:
-    """Regime flag of every point: one panel per solution, one row per restitution ratio, one colour per flag."""
+    """Regime flag of every point: one panel per solution, one row per restitution ratio, one colour per flag; the
+    closed-form one-impact orbits that are unstable (``stable`` = 0) hatched over their colour."""
     lines = series_by_restitution(part)
-    panels = [
-        (f"{solution_ref(str(s))}: regime, {clearance_text(part)}", [text for text, _ in lines], np.array([line["regime"].sel(solution=s).values for _, line in lines], dtype=int))
-        for s in part["solution"].values
-    ]
+    panels = []
+    for s in part["solution"].values:
+        flags = np.array([line["regime"].sel(solution=s).values for _, line in lines], dtype=int)
+        unstable = np.array([line["stable"].sel(solution=s).values == 0 for _, line in lines]) if "stable" in part else None
+        panels.append((f"{solution_ref(str(s))}: regime, {clearance_text(part)}", [text for text, _ in lines], flags, unstable))
     solutions = ", ".join(solution_ref(str(s)) for s in part["solution"].values)
     return regime_map(panels, part["frequency"].values, name, f"Regime map, {clearance_text(part)}", f"Regime of each point of {solutions}")
 
 
-def regime_map(panels: list[tuple[str, list[str], np.ndarray]], f: np.ndarray, name: str, title: str, lead: str) -> DrawnFigure:
+def _hatch_runs(ax: Any, edges: np.ndarray, marked: np.ndarray, gid: str) -> None:
+    """Hatch every run of marked cells (rows x columns between ``edges`` [Hz]) over the colours drawn below."""
+    for row, cells in enumerate(marked):
+        padded = np.concatenate(([False], cells, [False])).astype(int)
+        starts, ends = np.flatnonzero(np.diff(padded) == 1), np.flatnonzero(np.diff(padded) == -1)
+        for a, b in zip(starts, ends):
+            ax.add_patch(Rectangle((edges[a], row - 0.5), edges[b] - edges[a], 1.0, fill=False, hatch="////", edgecolor="0.15", linewidth=0.0, gid=gid))
+
+
+#: Regime flags of an admissible one-impact orbit, the ones whose stability a hatch shows.
+_ONE_IMPACT_FLAGS = (Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR)
+
+
+def regime_map(panels: list[tuple], f: np.ndarray, name: str, title: str, lead: str) -> DrawnFigure:
     """Regime flags as coloured bands, one colour per flag, the legend below the panels.
 
     Parameters
     ----------
-    panels : list of (str, list of str, ndarray)
-        Per panel: its title, its row labels, and the flags, shape (rows, frequency).
+    panels : list of (str, list of str, ndarray[, ndarray or None])
+        Per panel: its title, its row labels, the flags, shape (rows, frequency), and optionally where the
+        one-impact orbit is unstable (bool, same shape): those cells are hatched over their flag's colour.
     f : ndarray
         Frequency grid [Hz].
     name, title : str
@@ -228,25 +245,41 @@ def regime_map(panels: list[tuple[str, list[str], np.ndarray]], f: np.ndarray, n
     flags = sorted(REGIME_COLOURS)
     cmap = ListedColormap([REGIME_COLOURS[r] for r in flags])
     norm = BoundaryNorm(np.arange(len(flags) + 1) - 0.5, len(flags))
-    heights = [0.95 + 0.3 * len(labels) for _, labels, _ in panels]
-    fig, axes = new_figure(len(panels), columns=1, sharex=True, legend_rows=legend_rows(len(flags), 3), row_heights=heights)
+    heights = [0.95 + 0.3 * len(panel[1]) for panel in panels]
+    fig, axes = new_figure(len(panels), columns=1, sharex=True, legend_rows=legend_rows(len(flags) + 1, 3), row_heights=heights)
     seen: set[int] = set()
     coarse = False
-    for ax, (panel_title, labels, grid) in zip(axes, panels):
+    hatched = 0
+    for ax, (panel_title, labels, grid, *rest) in zip(axes, panels):
+        unstable = rest[0] if rest and rest[0] is not None else None
         computed = np.any(grid != Regime.NOT_COMPUTED, axis=0)
         columns = f[computed]
         if columns.size:
             edges = block_edges(columns, f)
-            ax.pcolormesh(edges, np.arange(len(labels) + 1) - 0.5, np.searchsorted(flags, grid[:, computed]), cmap=cmap, norm=norm, shading="flat", gid=f"regime:{panel_title}")
+            rows = np.arange(len(labels) + 1) - 0.5
+            ax.pcolormesh(edges, rows, np.searchsorted(flags, grid[:, computed]), cmap=cmap, norm=norm, shading="flat", gid=f"regime:{panel_title}")
             seen.update(int(v) for v in np.unique(grid[:, computed]))
             coarse |= bool(columns.size < f.size)
+            if unstable is not None:
+                marked = np.asarray(unstable, dtype=bool)[:, computed] & np.isin(grid[:, computed], _ONE_IMPACT_FLAGS)
+                if marked.any():
+                    hatched += int(marked.sum())
+                    _hatch_runs(ax, edges, marked, f"unstable:{panel_title}")
         ax.set_ylim(len(labels) - 0.5, -0.5)
         ax.set_yticks(range(len(labels)), labels)
         ax.set_title(panel_title, fontsize=11)
     axes[-1].set_xlabel(_FREQUENCY)
     shown = [r for r in flags if int(r) in seen]
-    figure_legend(fig, [], [Patch(color=REGIME_COLOURS[r], label=regime_label(r)) for r in shown], columns=3)
+    handles = [Patch(color=REGIME_COLOURS[r], label=regime_label(r)) for r in shown]
+    if hatched:
+        handles.append(Patch(facecolor="white", edgecolor="0.15", hatch="////", label="hatched: the one-impact orbit is unstable"))
+    figure_legend(fig, [], handles, columns=3)
     caption = f"{lead} (the dataset's regime flag, its value in brackets), one colour per flag."
+    if hatched:
+        caption += (
+            f" Hatched ({hatched} points): an admissible one-impact orbit that is unstable (largest Floquet multiplier"
+            " outside the unit circle); the motion settles elsewhere there (see the simulations), however its colour reads."
+        )
     if coarse:
         caption += (
             " A solution computed on a coarser grid (simulations) shows each point as a block reaching halfway to its"
