@@ -29,6 +29,7 @@ def small_bifurcation(tmp_path_factory: pytest.TempPathFactory) -> "xr.Dataset":
     read back from its netCDF file: its dataset tests and its page tests share it, whichever workers run them (the
     first worker to need it runs it under a file lock; the others read its file)."""
     import fcntl
+    import os
 
     import xarray as xr
 
@@ -36,7 +37,10 @@ def small_bifurcation(tmp_path_factory: pytest.TempPathFactory) -> "xr.Dataset":
     from vibroimpact.runs.run import run_study, write_dataset
     from vibroimpact.scene import parse_scene
 
-    shared = tmp_path_factory.getbasetemp().parent  # the run's folder, shared by the xdist workers
+    # the run's folder: shared by the xdist workers (their base folders' parent); without xdist the base folder itself,
+    # since its parent (/tmp/pytest-of-<user>) outlives the run and is shared by every checkout of the machine
+    base = tmp_path_factory.getbasetemp()
+    shared = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
     path = shared / "small_bifurcation.nc"
     with open(shared / "small_bifurcation.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)

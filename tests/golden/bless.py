@@ -10,17 +10,18 @@ import sys
 import tempfile
 from pathlib import Path
 
-from tests.golden.golden import DATA, compute, read_back, scene_names, written
+from tests.golden.golden import DATA, compute, dtypes, read_back, scene_names, written
 from vibroimpact.runs.run import write_dataset
 
 
 def bless(name: str) -> None:
-    """Write ``name``'s golden files; a dataset identical to the blessed one is left as it is (its file would differ
-    only by the ``history`` stamp)."""
+    """Write ``name``'s golden files; a dataset identical to the blessed one, types included, is left as it is (its
+    file would differ only by the ``history`` stamp)."""
     with tempfile.TemporaryDirectory() as folder:
         dataset, text = compute(name, Path(folder))
         target = DATA / f"{name}.nc"
-        same = target.exists() and written(dataset, Path(folder)).identical(read_back(target))
+        now = written(dataset, Path(folder))
+        same = target.exists() and now.identical(blessed := read_back(target)) and dtypes(now) == dtypes(blessed)
     if not same:
         write_dataset(dataset, target)
     page = DATA / f"{name}.txt"

@@ -148,6 +148,11 @@ def written(dataset: xr.Dataset, folder: Path) -> xr.Dataset:
     return read_back(write_dataset(dataset, folder / "golden.nc"))
 
 
+def dtypes(dataset: xr.Dataset) -> dict[str, str]:
+    """The stored type of every variable (``xarray.testing.assert_identical`` compares values, so int32 equals int64)."""
+    return {str(name): str(variable.dtype) for name, variable in dataset.variables.items()}
+
+
 def stored(name: str) -> tuple[xr.Dataset, str | None]:
     """The blessed dataset and page text of ``name``."""
     page = DATA / f"{name}.txt"

@@ -1,19 +1,25 @@
-"""Datasets are CF-1.8 clean: the IOOS compliance checker finds no error and no warning in what ``run-study`` writes."""
+"""Datasets are CF-1.8 clean: the IOOS compliance checker finds no error and no warning in what ``run-study`` writes,
+for every kind of study; and the numbers a dataset records as attributes stay numbers when it is read back."""
 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
+import xarray as xr
 import yaml
 from compliance_checker.runner import CheckSuite, ComplianceChecker
 
-from vibroimpact.scene import parse_scene
-from vibroimpact.runs.run import write_dataset
+from vibroimpact.scene import load_scene, parse_scene
+from vibroimpact.scene.kinds import KIND_NAMES
+from vibroimpact.runs.run import netcdf_attribute, write_dataset
 from vibroimpact.runs.run import run_study
 
+from tests.golden.golden import SCENES
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
 from tests.study.test_swept_study import sweep_document
 
@@ -38,6 +44,66 @@ def cf_findings(path: Path, report: Path) -> list[str]:
 def write(document: dict[str, Any], folder: Path) -> Path:
     scene = parse_scene(document, text=yaml.safe_dump(document))
     return write_dataset(run_study(scene, progress=None), folder / f"{scene.name}.nc")
+
+
+#: A string attribute that reads as a number or as numpy's text of an array ('[23.02212513 36.07439742]').
+_NUMBER = r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?"
+NUMBER_TEXT = re.compile(rf"^\s*\[?\s*{_NUMBER}((\s*,\s*|\s+){_NUMBER})*\s*\]?\s*$")
+#: Attributes that are text by CF even where they read as a number (units "1").
+TEXT_BY_CF = ("units",)
+
+
+def numbers_as_text(path: Path) -> list[str]:
+    """Every attribute of the file at ``path`` (the dataset's and its variables') whose value is text that reads as a
+    number or an array of numbers: a number written as its repr."""
+    found = []
+    with xr.open_dataset(path) as dataset:
+        owners = [("dataset", dataset.attrs)] + [(str(name), variable.attrs) for name, variable in dataset.variables.items()]
+        for owner, attrs in owners:
+            for key, value in attrs.items():
+                if isinstance(value, str) and key not in TEXT_BY_CF and NUMBER_TEXT.match(value):
+                    found.append(f"{owner}.{key} = {value!r}")
+    return found
+
+
+#: A concepts study small enough for the default tier (2 s): a concept without a stop and one with (continued
+#: branch points, the notch depth in dB).
+CONCEPTS_DOCUMENT: dict[str, Any] = {
+    "name": "cf_concepts",
+    "system": dict(PAPER_SYSTEM_SPEC),
+    "excitation": {"amplitude": 10.0},
+    "frequency": {"start": 30.0, "stop": 36.0, "step": 0.25},
+    "simulation": {"frequency": [34.0], "rtol": 1.0e-7, "irregular_measure_periods": 16},
+    "bumper": {"frequency": 250.0},
+    "continuation": {"max_steps": 20},
+    "concepts": [
+        {"name": "den_hartog", "label": "(a)", "absorber": {"stiffness": "den_hartog", "damping": "den_hartog"}},
+        {"name": "absolute", "label": "(b)", "stops": [{"coordinate": "x2", "side": "upper", "clearance": 0.003, "restitution": 0.2}]},
+    ],
+    "report": False,
+}
+#: The datasets checked by :func:`test_every_kind_is_cf_clean` (case -> its kind), besides the documents of the
+#: three tests above (stepped, swept, benchmark): shrunk shipped scenes of the golden suite (``golden:<name>``, under
+#: a second each), the small bifurcation study the other tests share, and :data:`CONCEPTS_DOCUMENT`.
+KIND_CASES: dict[str, str] = {
+    "golden:base_motion_frame": "stepped",  # two stops (coordinate ``stop``), base motion, a simulation engine
+    "bifurcation": "bifurcation",
+    "concepts": "concepts",
+    # three of the five validation cases (the other two, bouncing ball and grazing, write the same kinds of
+    # variables as these and cost 3 s each): continued orbits on ``point``, a table of checks, an impact sequence
+    **{f"golden:validation_{case}": "validation" for case in ("budd_dux", "relative_stop", "zeno")},
+}
+
+
+def write_case(case: str, request: pytest.FixtureRequest, folder: Path) -> Path:
+    """The dataset of ``case`` (:data:`KIND_CASES`) as ``run-study`` writes it."""
+    if case == "bifurcation":
+        dataset = request.getfixturevalue("small_bifurcation")  # run once per test run, read back from its file
+        return write_dataset(dataset, folder / "bifurcation.nc")
+    if case == "concepts":
+        return write(CONCEPTS_DOCUMENT, folder)
+    name = case.removeprefix("golden:")
+    return write_dataset(run_study(load_scene(SCENES / f"{name}.yaml"), progress=None), folder / f"{name}.nc")
 
 
 @pytest.mark.timeout(120)
@@ -82,6 +148,61 @@ def test_benchmark_study_is_cf_clean(tmp_path: Path) -> None:
     }
     path = write(document, tmp_path)
     assert cf_findings(path, tmp_path / "cf.json") == []
+
+
+@pytest.mark.timeout(120)
+@pytest.mark.parametrize("case", list(KIND_CASES))
+def test_every_kind_is_cf_clean(case: str, request: pytest.FixtureRequest, tmp_path: Path) -> None:
+    """Each kind's dataset: no CF error or warning, and no number stored as text."""
+    path = write_case(case, request, tmp_path)
+    with xr.open_dataset(path) as dataset:
+        assert dataset.attrs["study_kind"] == KIND_CASES[case]
+    assert cf_findings(path, tmp_path / "cf.json") == []
+    assert numbers_as_text(path) == []
+
+
+def test_the_cases_cover_every_kind() -> None:
+    """A new kind of study needs its case here: the three documents above and :data:`KIND_CASES`."""
+    assert {"stepped", "swept", "benchmark", *KIND_CASES.values()} == set(KIND_NAMES)
+
+
+@pytest.mark.timeout(120)
+def test_numeric_attributes_are_numbers_when_read_back(tmp_path: Path) -> None:
+    """The three-storey frame's natural frequencies, mass and stiffness matrices and stop clearances are arrays of
+    numbers in the file, and agree with each other: the frequencies are the eigenvalues of M^-1 K read back."""
+    path = write_dataset(run_study(load_scene(SCENES / "base_motion_frame.yaml"), progress=None), tmp_path / "frame.nc")
+    with xr.open_dataset(path) as dataset:
+        attrs = dict(dataset.attrs)
+    natural, mass, stiffness = (attrs[key] for key in ("natural_frequencies_Hz", "system_mass_kg", "system_stiffness_N_per_m"))
+    for value in (natural, mass, stiffness, attrs["stop_clearance_m"], attrs["simulation_frequency_Hz"]):
+        assert isinstance(value, np.ndarray) and value.dtype.kind == "f"
+    size = int(attrs["system_size"])
+    assert isinstance(attrs["system_size"], np.integer) and size == 3 and natural.shape == (size,)
+    eigenvalues = np.linalg.eigvals(np.linalg.solve(mass.reshape(size, size), stiffness.reshape(size, size))).real
+    np.testing.assert_allclose(natural, np.sqrt(np.sort(eigenvalues)) / (2.0 * np.pi), rtol=1e-12)
+    np.testing.assert_allclose(attrs["stop_clearance_m"], [0.002, 0.002], rtol=1e-15)
+    assert isinstance(attrs["admissibility_samples_per_period"], np.integer) and int(attrs["admissibility_samples_per_period"]) == 512
+
+
+def test_attributes_that_netcdf_would_turn_into_text_are_refused() -> None:
+    """Sequences become arrays of one type, booleans int8; a mix of numbers and text, or an array of arrays (which
+    the netCDF4 library writes as the text of each entry: '[23.02212513 36.07439742]') is an error."""
+    as_array = netcdf_attribute([23.0, 36.5], "test")
+    assert isinstance(as_array, np.ndarray) and as_array.dtype.kind == "f" and as_array.shape == (2,)
+    flag = netcdf_attribute(True, "test")
+    assert isinstance(flag, np.int8) and int(flag) == 1
+    assert netcdf_attribute("x1 x2", "test") == "x1 x2"
+    with pytest.raises(ValueError, match="mixes"):
+        netcdf_attribute([np.array([23.0, 36.5]), "Hz"], "test")
+    with pytest.raises(ValueError, match="2-d"):
+        netcdf_attribute(np.ones((2, 2)), "test")
+
+
+def test_the_text_check_finds_a_number_written_as_text(tmp_path: Path) -> None:
+    """numbers_as_text is not blind: numpy's text of an array and a number as text are found, units "1" is not."""
+    dataset = xr.Dataset({"x": ("f", [1.0], {"units": "1", "scale": "2.5"})}, attrs={"natural_frequencies_Hz": "[23.02212513 36.07439742]", "title": "t 1"})
+    dataset.to_netcdf(tmp_path / "text.nc")
+    assert numbers_as_text(tmp_path / "text.nc") == ["dataset.natural_frequencies_Hz = '[23.02212513 36.07439742]'", "x.scale = '2.5'"]
 
 
 def test_the_check_finds_what_it_should(tmp_path: Path) -> None:

@@ -44,7 +44,10 @@ def test_the_dataset_is_labelled(dataset: xr.Dataset) -> None:
     assert dataset.attrs["study_kind"] == "concepts" and (dataset.attrs["band_low_Hz"], dataset.attrs["band_high_Hz"]) == (29.35, 34.6)
     for name in ("peak_x1_amplitude", "worst_x1_amplitude", "simulated_x1", "bumper_peak_acceleration", "branch_floquet_modulus"):
         assert "long_name" in dataset[name].attrs
-    assert dataset["peak_x1_amplitude"].attrs["units"] == "m" and dataset["notch_depth"].attrs["units"] == "dB"
+    assert dataset["peak_x1_amplitude"].attrs["units"] == "m"
+    # decibels are not a UDUNITS unit: the depth keeps its dB values, units "1", and says so
+    assert dataset["notch_depth"].attrs["units"] == "1" and "in dB" in dataset["notch_depth"].attrs["long_name"]
+    assert dataset["point"].dtype == np.int32 and "long_name" in dataset["point"].attrs  # CF 2.2: no int64
 
 
 def test_a_concept_without_a_stop_is_its_linear_receptance(dataset: xr.Dataset) -> None:

@@ -74,6 +74,24 @@ def test_contract(sweep_run: xr.Dataset, tmp_path: Path) -> None:
     xr.testing.assert_identical(loaded, ds)
 
 
+def test_every_variable_carries_data(sweep_run: xr.Dataset) -> None:
+    """No placeholder: a sweep is a transient (no phase of a periodic orbit, no Floquet stability, no one-impact closed
+    form, no attractor to classify, no convergence) and the closed forms simulate nothing (no Lyapunov exponent,
+    convergence flag or wall time), so none of these is written; every variable has a finite value, every flag a
+    value other than not_applicable (-1)."""
+    ds = sweep_run
+    for name in ("phase", "stable", "floquet_modulus", "one_impact_x1_amplitude", "one_impact_x2_amplitude", "one_impact_force_amplitude", "one_impact_impulse", "converged"):
+        assert f"swept_{name}" not in ds, name
+    for name in ("lyapunov_exponent", "lyapunov_error", "rotation_number", "spectral_line_fraction", "converged", "wall_time"):
+        assert name not in ds, name
+    for name, variable in ds.data_vars.items():
+        values = variable.values
+        carries = np.isfinite(values).any() if values.dtype.kind == "f" else bool(np.any(values != -1))
+        assert carries, name
+    # what the sweep does measure stays: its regime (in contact through this sweep, not computed outside its band)
+    assert set(np.unique(ds["swept_regime"].values).tolist()) == {int(Regime.NOT_COMPUTED), int(Regime.SWEPT_CONTACT)}
+
+
 @pytest.mark.timeout(120)
 def test_slow_sweep_follows_the_steady_states(sweep_run: xr.Dataset) -> None:
     """A slow sweep through stable one-impact orbits stays on them, one contact per cycle: |X1| and the force on the

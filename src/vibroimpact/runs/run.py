@@ -15,8 +15,9 @@ from __future__ import annotations
 import sys
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Protocol
+from typing import Any, Protocol
 
+import numpy as np
 import xarray as xr
 
 from vibroimpact import __version__
@@ -27,7 +28,7 @@ from vibroimpact.runs.store import StudyStore, atomic_path, source_hash
 from vibroimpact.scene.kinds import kind_named
 from vibroimpact.scene.schema import Scene
 
-__all__ = ["StudyKind", "study_kind", "run_study", "prepare_compiled_core", "atomic_path", "write_dataset", "provenance"]
+__all__ = ["StudyKind", "study_kind", "run_study", "prepare_compiled_core", "atomic_path", "write_dataset", "netcdf_attribute", "provenance"]
 
 class StudyKind(Protocol):
     """What a kind of study does with a scene (each kind's ``study.py``, registered in :data:`vibroimpact.scene.kinds.KINDS`)."""
@@ -145,12 +146,46 @@ def provenance() -> dict[str, str]:
     return {"vibroimpact_version": __version__, "vibroimpact_source_sha256": source_hash(), "Conventions": "CF-1.8"}
 
 
+def netcdf_attribute(value: object, where: str) -> object:
+    """``value`` as a netCDF attribute keeps it: numbers stay numbers, never the text of their repr.
+
+    Sequences become one numpy array (the netCDF4 library would turn a list mixing numbers and text into the text of
+    each entry, and a nested one into the repr of an array), booleans become int8 (netCDF has no boolean).
+
+    Raises
+    ------
+    ValueError
+        For a sequence mixing numbers and text, or nested (a writer's bug: netCDF would keep it as text).
+    """
+    if isinstance(value, (bool, np.bool_)):
+        return np.int8(value)
+    if isinstance(value, (list, tuple)):
+        kinds = {"text" if isinstance(item, (str, bytes)) else "number" if isinstance(item, (int, float, np.number, np.bool_)) else type(item).__name__ for item in value}
+        if len(kinds) > 1 or kinds - {"text", "number"}:
+            raise ValueError(f"attribute of {where}: {value!r} mixes {sorted(kinds)}; netCDF keeps one flat array of numbers or of text")
+        value = np.asarray(value)
+    if isinstance(value, np.ndarray):
+        if value.ndim > 1 or value.dtype == object:
+            raise ValueError(f"attribute of {where}: a {value.ndim}-d {value.dtype} array; netCDF keeps one flat array of numbers or of text")
+        return value.astype(np.int8) if value.dtype == np.bool_ else value
+    return value
+
+
+def netcdf_attributes(attrs: dict[Any, Any], where: str) -> dict[Any, Any]:
+    """Every attribute of ``attrs`` through :func:`netcdf_attribute` (``where`` names their owner in errors)."""
+    return {key: netcdf_attribute(value, f"{where}, {key}") for key, value in attrs.items()}
+
+
 def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
     """Write ``dataset`` to netCDF atomically: a temporary file in the same folder, then a rename.
 
     A reader never sees a half-written file, and an interrupted run leaves the previous file intact.
     """
     path = Path(path)
+    dataset = dataset.copy()  # shallow: the attributes are replaced, the data shared
+    dataset.attrs = netcdf_attributes(dataset.attrs, "the dataset")
+    for name, variable in dataset.variables.items():
+        variable.attrs = netcdf_attributes(variable.attrs, f"variable {name}")
     encoding: dict[str, dict[str, object]] = {name: {"zlib": True, "complevel": 4} for name in dataset.data_vars}
     # CF 2.5.1: coordinate variables carry no _FillValue (xarray adds one to every float variable unless told not to)
     encoding |= {name: {"_FillValue": None} for name in dataset.coords if dataset[name].dtype.kind == "f"}

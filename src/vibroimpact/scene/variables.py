@@ -21,14 +21,14 @@ VARIABLE_ATTRIBUTES: dict[str, dict[str, str]] = {
     "suspension_force_amplitude": {"units": "N", "long_name": "fundamental-harmonic amplitude of the force through the suspension alone (eq. 21)"},
     "impulse": {"units": "N s", "long_name": "impact impulse per period (0 where the motion is linear; simulations: total impulse of the impacts per period)"},
     "phase": {"units": "rad", "long_name": "phase of the impact relative to the linear absorber motion (varphi + psi12, eq. 15)"},
-    "floquet_modulus": {"units": "1", "long_name": "largest modulus of the Floquet multipliers of the admissible one-impact orbit (< 1: stable); solution pgf only"},
+    "floquet_modulus": {"units": "1", "long_name": "largest modulus of the Floquet multipliers of the admissible closed-form impact orbit (one impact per period; two on a symmetric pair of stops) (< 1: stable); solution pgf only"},
     "one_impact_x1_amplitude": {"units": "m", "long_name": "|X1| fundamental of the one-impact solution of eqs. 15-17 wherever it exists, unchecked (admissible or not, stable or not)"},
     "one_impact_x2_amplitude": {"units": "m", "long_name": "|X2| fundamental of the one-impact solution of eqs. 15-18 wherever it exists, unchecked"},
     "one_impact_force_amplitude": {"units": "N", "long_name": "force fundamental (eq. 23) of the one-impact solution wherever it exists, unchecked"},
     "one_impact_impulse": {"units": "N s", "long_name": "impulse (eq. 16) of the one-impact solution wherever it exists, unchecked"},
     "impacts_per_period": {"units": "1", "long_name": "impacts per excitation period (simulations: measured over whole periods)"},
-    "x1_rms": {"units": "m", "long_name": "RMS of X1 (simulations: over the measured periods; pgf: of the reconstructed orbit, 512 samples per period; linear regimes: |X1| / sqrt 2)"},
-    "x2_rms": {"units": "m", "long_name": "RMS of X2 (simulations: over the measured periods; pgf: of the reconstructed orbit, 512 samples per period; linear regimes: |X2| / sqrt 2)"},
+    "x1_rms": {"units": "m", "long_name": "RMS of x1(t) over a period, static offset included (simulations: integrated exactly over the measured whole periods; closed-form impact orbits: Gauss-Legendre quadrature of the reconstructed orbit, 64 nodes; linear motion: sqrt(static^2 + |X1|^2 / 2))"},
+    "x2_rms": {"units": "m", "long_name": "RMS of x2(t) over a period, static offset included (simulations: integrated exactly over the measured whole periods; closed-form impact orbits: Gauss-Legendre quadrature of the reconstructed orbit, 64 nodes; linear motion: sqrt(static^2 + |X2|^2 / 2))"},
     "peak_acceleration": {"units": "m s-2", "long_name": "largest deceleration of the absorber on the bumper, bumper force less absorber spring over M2 (compliant: measured; pgf: (M2 Gamma(xi_b) Omega_b J / (M2 (1 + R)) - absorber spring force at the impact) / M2; rigid engines: NaN; no contact: 0)"},
     "peak_contact_force": {"units": "N", "long_name": "largest bumper force (compliant: measured; pgf: Gamma(xi_b) Omega_b J / (1 + R); rigid engines: NaN; no contact: 0)"},
     "wall_time": {"units": "s", "long_name": "wall time of the simulation at this point (one process; swept-sine tests: the whole sweep)"},
@@ -55,7 +55,7 @@ CONVERGED_ATTRIBUTES = {
 #: The ``stable`` flag of an orbit whose largest |Floquet multiplier| is 1 within round-off.
 STABLE_MARGINAL = 2
 STABLE_ATTRIBUTES = {
-    "long_name": "Floquet stability of the reported one-impact orbit (solution pgf only)",
+    "long_name": "Floquet stability of the reported closed-form impact orbit (one impact per period; two on a symmetric pair of stops) (solution pgf only)",
     "units": "1",
     "flag_values": np.array([-1, 0, 1, STABLE_MARGINAL], dtype=np.int8),
     "flag_meanings": "not_applicable unstable stable marginal",

@@ -244,7 +244,7 @@ def _brute(results: list[CaseResult], scene: Scene, directions: tuple[str, ...],
             "brute_period": (grid, stack("period").astype(np.int16), a["brute_period"]),
             "brute_lyapunov_exponent": (grid, stack("lyapunov"), a["brute_lyapunov_exponent"]),
         },
-        coords={"restitution": np.array(settings.restitution), "sweep": list(directions), "frequency": settings.frequency, "strobe": ("strobe", np.arange(strobes), a["strobe"])},
+        coords={"restitution": np.array(settings.restitution), "sweep": list(directions), "frequency": settings.frequency, "strobe": ("strobe", np.arange(strobes, dtype=np.int32), a["strobe"])},
     )
 
 

@@ -130,6 +130,13 @@ def _with_note(linear: ClosedForms, note: str) -> ClosedForms:
 # --------------------------------------------------------------------------------------------------------------------
 
 _UNITS = {"x1_amplitude": "m", "base_force_amplitude": "N", "peak_acceleration": "m s-2", "contact_force": "N"}
+#: The notch depth is kept in decibels, as the page and the metrics give it; UDUNITS (and so CF) has no dB, so its units
+#: are "1" and its long name and comment say the scale.
+NOTCH_DEPTH_ATTRIBUTES = {
+    "units": "1",
+    "long_name": "notch depth in dB: 20 log10 of the smallest worst-stable |X1| in the anti-resonance band over q / k1",
+    "comment": "decibels of an amplitude ratio (negative: below the static deflection q / k1); the ratio is 10**(notch_depth / 20)",
+}
 
 
 def _text(spans: list[tuple[float, float]]) -> str:
@@ -208,7 +215,7 @@ def concepts_dataset(settings: ConceptsSettings, closed: dict[str, ClosedForms],
         "peak_impact_acceleration": ("concept", per["accel"], {"units": "m s-2", "long_name": "largest contact deceleration with the Kelvin-Voigt bumpers (compliant steady states)"}),
         "peak_contact_force": ("concept", per["contact"], {"units": "N", "long_name": "largest bumper force (time domain, compliant steady states)"}),
         "peak_base_force_bumper": ("concept", per["base_peak"], {"units": "N", "long_name": "largest force on the base in the time domain with the bumpers (dense replay of the compliant steady states; without a stop, the amplitude of the linear one)"}),
-        "notch_depth": ("concept", per["depth"], {"units": "dB", "long_name": "20 log10 of the smallest worst-stable |X1| in the anti-resonance band over q / k1"}),
+        "notch_depth": ("concept", per["depth"], NOTCH_DEPTH_ATTRIBUTES),
         "notch_frequency": ("concept", per["depth_f"], {"units": "Hz", "long_name": "where the notch is deepest"}),
         "band_impact_fraction": ("concept", per["fraction"], {"units": "1", "long_name": "share of the anti-resonance band where the motion impacts"}),
         "band_coverage": ("concept", per["coverage"], {"units": "1", "long_name": "share of the anti-resonance band where a stable motion was found"}),
@@ -229,7 +236,7 @@ def concepts_dataset(settings: ConceptsSettings, closed: dict[str, ClosedForms],
     }
     coords = {"concept": names, "frequency": ("frequency", f, {"units": "Hz", "long_name": "excitation frequency"}),
               "simulation_frequency": ("simulation_frequency", fs, {"units": "Hz", "long_name": "excitation frequency of the simulations"}),
-              "point": ("point", np.arange(points))}  # fmt: skip
+              "point": ("point", np.arange(points, dtype=np.int32), {"units": "1", "long_name": "index of the point along each concept's continued branch"})}  # fmt: skip
     dataset = xr.Dataset({k: xr.Variable(*v) for k, v in data.items()}, coords=coords)
     dataset.attrs.update({"band_low_Hz": low, "band_high_Hz": high, "anti_resonance_Hz": anti, "static_deflection_m": static,
                           "excitation_amplitude_N": settings.amplitude, "bumper_frequency_Hz": settings.bumper_frequency,

@@ -126,7 +126,7 @@ def general_coordinates(scene: Scene, grid: StudyGrid) -> dict[str, object]:
     coords = grid_coordinates(scene, grid, list(scene.settings.solutions))
     count = len(scene.stop_specs)
     if count > 1 and any(q in STOP_QUANTITIES for q in scene.settings.quantities):
-        coords["stop"] = np.arange(count)
+        coords["stop"] = np.arange(count, dtype=np.int32)  # CF 2.2 (netCDF classic types): no int64
         coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.stop_specs, scene.coordinates, scene.settings.restitution, scene.settings.clearance), dtype=object))
     return coords
 

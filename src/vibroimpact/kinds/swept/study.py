@@ -26,7 +26,7 @@ from vibroimpact.engines.registry import make_engine
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.kinds.stepped.grid import StudyGrid, finish_dataset, grid_coordinates, EnginePart, grid_estimate
 from vibroimpact.kinds.stepped.study import closed_form_scale, engine_scale, describe_stops, general_quantity_attributes
-from vibroimpact.kinds.stepped.values import coordinate_quantity, general_linear_values, general_pgf_values, paper_pgf_values
+from vibroimpact.kinds.stepped.values import general_linear_values, general_pgf_values, paper_pgf_values
 from vibroimpact.model.contact import Stop
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem, Structure
@@ -175,6 +175,10 @@ def run_sweep_case(case: SweepCase, report: ProgressReport | None = None) -> dic
 
 #: Figures of a swept-sine study's report page.
 REPORT_FIGURES = 4
+#: Quantities of a simulated steady state that the closed forms (the steady-state solutions of a swept-sine study) do
+#: not compute: the attractor's classification, whether a simulation converged and its wall time. Not written for
+#: them (they would be all NaN, and ``converged`` all -1).
+NOT_CLOSED_FORM = (*MOTION_QUANTITIES, "converged", "wall_time")
 Values = dict[str, np.ndarray]
 
 
@@ -206,7 +210,7 @@ class SweptStudy:
         coords["sweep"] = np.array(grid.directions, dtype=object)
         several = count > 1 and any(q in STOP_QUANTITIES for q in scene.settings.quantities)
         if several:
-            coords["stop"] = np.arange(count)
+            coords["stop"] = np.arange(count, dtype=np.int32)  # CF 2.2 (netCDF classic types): no int64
             coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.stop_specs, scene.coordinates, scene.settings.restitution, scene.settings.clearance), dtype=object))
 
         def stop_dims(quantity: str, dims: tuple[str, ...]) -> tuple[str, ...]:
@@ -222,10 +226,10 @@ class SweptStudy:
         data_vars = {}
         for quantity in scene.settings.quantities:
             attrs = _attributes(scene, quantity)
-            if steady:
+            if steady and quantity not in NOT_CLOSED_FORM:
                 stacked = np.stack([per_stop(quantity, values[quantity], grid.full) for values in steady.values()])
                 data_vars[quantity] = xr.Variable(("solution", *stop_dims(quantity, steady_dims)), stacked[..., 0, :], attrs)
-            if swept and quantity not in MOTION_QUANTITIES:
+            if quantity in swept:  # what the sweep estimates (swept_values): no placeholder of a steady-state quantity
                 data_vars[f"swept_{quantity}"] = xr.Variable(stop_dims(quantity, GRID_DIMS), per_stop(quantity, swept[quantity], grid.full), swept_attributes(engine, attrs))
         for name, values in running.items():
             if name.startswith("sweep_"):  # one value per sweep run
@@ -336,20 +340,12 @@ def swept_values(scene: Scene, shape: tuple[int, ...], runner: Runner) -> tuple[
     regime[impacts == 0.0] = Regime.LINEAR
     regime[impacts > 0.0] = Regime.SWEPT_CONTACT
     regime[np.broadcast_to(stats["failed"][..., None] == 1.0, shape)] = Regime.FAILED
-    nan = np.full(shape, np.nan)
-    values |= {
-        "phase": nan,
-        "regime": regime,
-        "stable": np.full(shape, -1, dtype=np.int8),
-        "floquet_modulus": nan,
-        "one_impact_force_amplitude": nan,
-        "one_impact_impulse": np.full((count, *shape), np.nan),
-        **{coordinate_quantity("one_impact_x1_amplitude", c): nan for c in scene.coordinates},
-        "converged": np.full(shape, -1, dtype=np.int8),
-        "wall_time": np.broadcast_to(stats["wall_time"][..., None], shape),
-        **{name: nan for name in MOTION_QUANTITIES},  # a sweep is a transient: no attractor to classify
-    }
+    # only what a sweep measures: a sweep is a transient, so it has no phase of a periodic orbit, no stability, Floquet
+    # modulus or one-impact closed form, no attractor to classify and no convergence (those would be NaN or -1 only)
+    values |= {"regime": regime, "wall_time": np.broadcast_to(stats["wall_time"][..., None], shape)}
     running = {name: value for name, value in running.items() if name.removeprefix("running_") in scene.settings.quantities}
     for name, value in stats.items():
-        running[f"sweep_{name}"] = value  # one value per sweep: the run's cost
-    return {q: values[q] for q in scene.settings.quantities}, running, {"time": times, "instantaneous_frequency": instantaneous}
+        # one value per sweep: its cost, and two flags (started on the linear steady state, failed) that vary from run
+        # to run although a small study's runs may agree
+        running[f"sweep_{name}"] = value
+    return {q: values[q] for q in scene.settings.quantities if q in values}, running, {"time": times, "instantaneous_frequency": instantaneous}
