@@ -40,12 +40,12 @@ def test_stepped_page_has_responses_simulations_peaks_agreement_and_reduction_fa
     sections = {s.title: s for s in page.sections(tmp_path)}
     assert list(sections) == [
         "Largest responses",
+        "Reduction factors",  # the answer first: what the stop buys
         "Linear system",
         "Resonance peaks against the restitution",
         "Frequency responses, Delta = 3 mm",
         "Simulations against the closed form, Delta = 3 mm",
         "Simulation against the closed form: agreement by band",
-        "Reduction factors",
     ]
     assert _names(sections["Largest responses"]) == ([], ["Largest value of every response, per solution"])
     assert _names(sections["Linear system"]) == (["structure"], ["Modal parameters of H22", "Structure", "Stops and load"])

@@ -188,13 +188,21 @@ def solution_ref(solution: str) -> str:
     return f"'{solution}'"
 
 
+#: Sweep directions, one palette for every page: vermillion up, sky blue down (Okabe-Ito: told apart with any colour
+#: vision, unlike red and green).
+SWEEP_COLOURS = {"up": "#D55E00", "down": "#56B4E9"}
+
+
 def fmt(value: SupportsFloat | None, spec: str = ".3g", pattern: str = "{}") -> str:
     """The one number formatter of every report: ``value`` formatted with ``spec`` and put into ``pattern`` (its
     ``{}``, e.g. ``"{}x"`` or ``" ({} s)"``); empty for NaN, infinity or None (a table cell with nothing to show)."""
     if value is None:
         return ""
     number = float(value)
-    return "" if not math.isfinite(number) else pattern.format(format(number, spec))
+    if not math.isfinite(number):
+        return ""
+    text = format(number, spec)
+    return pattern.format(text[:-1] if text.endswith(".") else text)  # '#' keeps trailing zeros, not a bare point: 1982, not 1982.
 
 
 # ---------------------------------------------------------------------------------------------- captions

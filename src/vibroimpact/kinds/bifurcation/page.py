@@ -21,13 +21,12 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
-from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure
+from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure, SWEEP_COLOURS
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
 
 __all__ = ["page_for", "BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class", "orbit_colours", "first_coordinate", "headline", "answer_text"]
 
 #: Brute-force dots of each sweep direction.
-SWEEP_COLOURS = {"up": "C3", "down": "C2"}
 #: Marker of each kind of special point.
 SPECIAL_MARKERS = {"fold": "o", "period_doubling": "s", "neimark_sacker": "D", "grazing": "^"}
 #: Colour of an orbit by (impacts per orbit period, period multiplicity); other classes take :data:`EXTRA_COLOURS`.
@@ -149,7 +148,7 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
     figure_legend(fig, [top, bottom], [*_class_legend(colours, classes), *extra], columns=5)
     caption = (
         f"Bifurcation diagram at R = {fmt(restitution, 'g')}, Delta = {fmt(float(dataset['clearance']) * 1e3, 'g')} mm. Dots: brute-force "
-        f"time simulation (compiled exact engine) sweeping up (red) and down (green), the end state carried to the next frequency; "
+        f"time simulation (compiled exact engine) sweeping up (vermillion) and down (sky blue), the end state carried to the next frequency; "
         f"top: the {label} fundamental over each of the {dataset.sizes['strobe']} kept periods; bottom: the velocity of every impact in them. "
         "Lines: every continued branch (solid stable, dashed unstable; colour: impacts per orbit period and period), the linear orbit "
         "where it fits inside the clearance in black; markers: the located special points (table below)."
@@ -380,16 +379,22 @@ class BifurcationPage:
                 f"{d.sizes['frequency']} frequencies x {d.sizes['sweep']} directions for R = {', '.join(fmt(r, 'g') for r in d['restitution'].values)}{stops}")  # fmt: skip
 
     def sections(self, out: Path) -> list[Section]:
-        """Diagrams and multipliers per restitution with the special points' table, then the chart."""
+        """The answer with the diagrams, multipliers and special points per restitution, then the chart, then the
+        continuation's logs, collapsed (what a reader checks, not what they read first)."""
         figures = saved(bifurcation_figures(self.dataset), out)
-        notes = str(self.dataset.attrs.get("continuation_notes", ""))
-        intro = answer_text(self.dataset) + (("<p>Every branch of periodic orbits found by continuation (how it was started and where it ends):</p>"
-                                              f"<pre>{html.escape(notes)}</pre>") if notes else "")  # fmt: skip
         chart = [f for f in figures if f.path.stem == "chart"]
-        sections = [Section("Bifurcation diagrams", intro, [f for f in figures if f not in chart], [special_point_table(self.dataset)])]
+        sections = [Section("Bifurcation diagrams", answer_text(self.dataset), [f for f in figures if f not in chart], [special_point_table(self.dataset)])]
         if chart:
-            chart_notes = str(self.dataset.attrs.get("chart_notes", ""))
-            sections.append(Section("Two-parameter chart", f"<pre>{html.escape(chart_notes)}</pre>" if chart_notes else "", chart))
+            sections.append(Section("Two-parameter chart", "", chart))
+        logs = [
+            (title, str(self.dataset.attrs.get(key, "")))
+            for key, title in (("continuation_notes", "Every branch found by continuation: how it was started and where it ends"), ("chart_notes", "The chart's curves: how each was traced"))
+        ]
+        shown = "".join(
+            f"<details><summary>{html.escape(title)} ({len(text.splitlines())} lines)</summary><pre>{html.escape(text)}</pre></details>" for title, text in logs if text
+        )
+        if shown:
+            sections.append(Section("Continuation logs", shown))
         return sections
 
 

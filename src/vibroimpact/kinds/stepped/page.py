@@ -336,10 +336,12 @@ class FrequencyResponsePage:
         return f"solutions: {', '.join(self.layout.solutions)}; stops: {'; '.join(self.layout.stops)}"
 
     def sections(self, out: Path) -> list[Section]:
-        """The answer, the linear system, resonance peaks, per clearance the responses and simulations, agreement,
-        reduction factors."""
+        """The answer (largest responses, then the reduction factors the stop gives), the linear system, resonance
+        peaks, per clearance the responses and simulations, agreement."""
         dataset, layout, setting = self.dataset, self.layout, self.setting
         sections = [Section("Largest responses", intro=f"<p>{html.escape(answer_text(dataset, layout))}</p>", tables=[peaks_table(dataset, layout)])]
+        if setting is not None and any(s != "linear" for s in dataset["solution"].values):
+            sections.append(Section("Reduction factors", intro=reduction_intro(), tables=reduction_tables(dataset, layout, named_layout(dataset) is not None)))
         intro = f"<p>Stops: {html.escape('; '.join(layout.stops))}. Load: {html.escape(layout.load_text())}.</p>"
         tables = ([modal_table(layout.named)] if layout.named is not None else []) + layout_tables(layout)
         sections.append(Section("Linear system", intro=intro, figures=saved([structure_figure(layout, dataset["frequency"].values)], out), tables=tables))
@@ -357,8 +359,6 @@ class FrequencyResponsePage:
             agreement = agreement_table(dataset, setting.split_frequency)
             if agreement is not None:
                 sections.append(Section("Simulation against the closed form: agreement by band", tables=[agreement]))
-            if any(s != "linear" for s in dataset["solution"].values):
-                sections.append(Section("Reduction factors", intro=reduction_intro(), tables=reduction_tables(dataset, layout, named_layout(dataset) is not None)))
         return sections
 
 

@@ -27,12 +27,11 @@ from vibroimpact.reporting.record import GeneralSetting, general_setting, is_gen
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.kinds.stepped.responses import SolutionsPage, linear_section, regime_map
 from vibroimpact.reporting.series import draw_curve, draw_linear, stability_keys, unstable_points
-from vibroimpact.reporting.style import QUANTITIES, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref
+from vibroimpact.reporting.style import QUANTITIES, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref, SWEEP_COLOURS
 
 __all__ = ["page_for", "SweptSinePage", "GeneralSweptPage", "SweptSineRun", "SweepLayout", "sweep_layout", "swept_sine_run", "sweep_figures", "sweep_tables"]
 
 #: Colour of each sweep direction.
-SWEEP_COLOURS = {"up": "C3", "down": "C2"}
 #: Running fundamental of a sweep: thinner than the steady states' curves, which show beneath.
 SWEPT_STYLE = {"ls": "-", "lw": 0.9}
 #: sqrt 2 x running RMS: thinner, dash-dot (dashed means an unstable orbit).
@@ -281,7 +280,7 @@ def _displacement_figure(dataset: xr.Dataset, run: SweptSineRun, solution: str, 
             ax.plot(dataset["frequency"].values, np.sqrt(2.0) * dataset[rms].sel(solution="pgf").values, color=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')}: sqrt 2 x RMS", gid="pgf", **RMS_STYLE)
             caption.add("pgf rms", f"Dash-dot: sqrt 2 x RMS (equal to the fundamental for a pure sine) of the orbit reconstructed by {solution_ref('pgf')} and of the sweeps.")
         if _draw_swept(ax, dataset, quantity, solution):
-            caption.add("swept", "Red: sweep up, green: sweep down, running fundamental over the estimator window (solid).")
+            caption.add("swept", "Vermillion: sweep up, sky blue: sweep down, running fundamental over the estimator window (solid).")
         _draw_swept(ax, dataset, rms, solution, scale=np.sqrt(2.0), style=RMS_STYLE, suffix=": sqrt 2 x RMS")
         finish_axes(ax, _FREQUENCY, f"{name} amplitude [m]", f"{name}: swept sine against steady states", log=True)
     if any_unstable:
@@ -301,7 +300,7 @@ def _force_figure(dataset: xr.Dataset, solution: str, layout: SweepLayout) -> Dr
     for quantity in quantities:
         several = quantity == "impulse" and layout.stops and "stop" in dataset[f"swept_{quantity}"].dims
         panels += [(quantity, k) for k in range(len(layout.stops))] if several else [(quantity, None)]
-    caption = Caption(f"{', '.join(QUANTITIES[q].label for q in quantities)} over the estimator window of each {solution_ref(solution)} sweep (red: up, green: down) against the instantaneous frequency (paper figures 21-24).")
+    caption = Caption(f"{', '.join(QUANTITIES[q].label for q in quantities)} over the estimator window of each {solution_ref(solution)} sweep (vermillion: up, sky blue: down) against the instantaneous frequency (paper figures 21-24).")
     if any(stop is not None for _, stop in panels):
         caption.add("stops", "The impulse per period on each stop in its own panel (its constraint in the title).")
     fig, axes = new_figure(len(panels), panel_height=3.8, legend_rows=legend_rows(6))

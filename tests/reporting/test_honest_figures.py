@@ -1,5 +1,6 @@
-"""Regime maps draw unstable one-impact orbits distinctly: hatched over their colour, counted in the caption and named
-in the legend; stable ones and other flags are not hatched."""
+"""Honest figures and tables: regime maps draw unstable one-impact orbits distinctly (hatched over their colour,
+counted in the caption, named in the legend; stable ones and other flags are not hatched), and table numbers carry no
+bare trailing point."""
 
 from __future__ import annotations
 
@@ -40,3 +41,11 @@ def test_without_unstable_points_nothing_is_hatched() -> None:
         assert "Hatched" not in drawn.caption
     finally:
         plt.close(drawn.figure)
+
+
+def test_numbers_in_tables_carry_no_bare_trailing_point() -> None:
+    """Significant figures kept ('#' format), but 1982 is printed as 1982, not '1982.'."""
+    from vibroimpact.reporting.style import fmt
+
+    assert fmt(1982.0, "#.4g") == "1982" and fmt(0.0793, "#.4g") == "0.07930" and fmt(289.6, "#.4g") == "289.6"
+    assert fmt(float("nan")) == "" and fmt(12.0, ".3g", "{} Hz") == "12 Hz"
