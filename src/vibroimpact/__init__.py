@@ -58,7 +58,7 @@ _PUBLIC = {
     "find_scene": "vibroimpact.scene",
     "run_study": "vibroimpact.runs.run",
     "write_dataset": "vibroimpact.runs.run",
-    "write_report": "vibroimpact.reporting.report",
+    "write_report": "vibroimpact.reporting.page",
 }
 
 __all__ = ["__version__", *_PUBLIC]

@@ -220,7 +220,7 @@ def _report(path: Path, out_dir: Path, jobs: int) -> Path | str:
         size = lazy.nbytes
     if size > REPORT_MEMORY_LIMIT:
         return f"no report: the dataset holds {size / 1e9:.1f} GB, more than the {REPORT_MEMORY_LIMIT / 1e9:.0f} GB a report reads into memory (the data are in {path})"
-    from vibroimpact.reporting.report import write_report  # matplotlib is imported only when a report is made
+    from vibroimpact.reporting.page import write_report  # matplotlib is imported only when a report is made
 
     dataset = xr.load_dataset(path)
     return write_report(dataset, out_dir, jobs=jobs)

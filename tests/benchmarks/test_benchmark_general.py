@@ -152,7 +152,7 @@ def test_the_frame_ladder_converges_to_the_rigid_stop(frame_run: xr.Dataset) -> 
 def test_the_frame_benchmark_page_names_its_coordinate_and_layout(frame_run: xr.Dataset, tmp_path: Path) -> None:
     import matplotlib.pyplot as plt
 
-    from vibroimpact.reporting.report import page_for
+    from vibroimpact.reporting.page import page_for
 
     page = page_for(frame_run)
     (section,) = page.sections(tmp_path)

@@ -121,7 +121,7 @@ def _inside(folder: Path) -> Iterator[None]:
 def compute(name: str, workdir: Path) -> tuple[xr.Dataset, str | None]:
     """The golden scene ``name`` run in this process: its machine-free dataset and its page's text (None: the scene
     draws no report)."""
-    from vibroimpact.reporting.report import write_report
+    from vibroimpact.reporting.page import write_report
     from vibroimpact.scene import load_scene
     from vibroimpact.runs.run import run_study
 

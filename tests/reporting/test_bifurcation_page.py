@@ -8,7 +8,7 @@ import pytest
 import xarray as xr
 
 from vibroimpact.kinds.bifurcation.page import BifurcationPage
-from vibroimpact.reporting.report import page_for, write_report
+from vibroimpact.reporting.page import page_for, write_report
 
 
 @pytest.fixture

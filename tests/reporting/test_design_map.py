@@ -27,7 +27,7 @@ from vibroimpact.kinds.stepped.design_metrics import (
 )
 from vibroimpact.kinds.stepped.design_page import DesignMapPage, frequency_ranges
 from vibroimpact.kinds.stepped.design_ranking import Candidate, design_map, rank, recommend
-from vibroimpact.reporting.report import page_for, write_report
+from vibroimpact.reporting.page import page_for, write_report
 from vibroimpact.scene import parse_scene
 from vibroimpact.runs.run import run_study
 

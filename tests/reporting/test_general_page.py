@@ -16,7 +16,7 @@ from vibroimpact.reporting import page as page_module
 from vibroimpact.kinds.stepped.figures import response_panels_figure, structure_figure
 from vibroimpact.kinds.stepped.page import FrequencyResponsePage, unswept_restitution
 from vibroimpact.reporting.record import general_setting
-from vibroimpact.reporting.report import page_for, write_report
+from vibroimpact.reporting.page import page_for, write_report
 from vibroimpact.kinds.stepped.responses import regime_figure
 from vibroimpact.scene import parse_scene
 from vibroimpact.runs.run import run_study

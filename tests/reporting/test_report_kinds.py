@@ -13,7 +13,7 @@ from vibroimpact.reporting import page as page_module
 from vibroimpact.kinds.benchmark.page import AccuracyPage
 from vibroimpact.kinds.stepped.page import BumperStiffnessPage
 from vibroimpact.reporting.record import StudyRecord, stored_description, study_kind, study_record, study_setting
-from vibroimpact.reporting.report import page_for, write_report
+from vibroimpact.reporting.page import page_for, write_report
 from vibroimpact.kinds.stepped.page import FrequencyResponsePage
 from vibroimpact.kinds.swept.page import SweptSinePage, swept_sine_run
 

@@ -14,7 +14,7 @@ import pytest
 from vibroimpact.kinds.stepped.tables import DEFINITION
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.reporting import page as page_module
-from vibroimpact.reporting.report import page_for
+from vibroimpact.reporting.page import page_for
 from vibroimpact.reporting.page import DrawnFigure, Figure, Section, Table, render_page, save_figure
 from vibroimpact.reporting.record import general_setting
 from vibroimpact.kinds.stepped.tables import reduction_tables

@@ -14,7 +14,7 @@ import xarray as xr
 from tests.golden.golden import SCENES, page_text
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.reporting.report import write_report
+from vibroimpact.reporting.page import write_report
 from vibroimpact.scene import parse_scene, read_yaml
 from vibroimpact.kinds.bifurcation.study import scene_problem
 from vibroimpact.kinds.bifurcation.branches import ORIGINS, closed_form_orbits

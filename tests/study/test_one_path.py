@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from vibroimpact.reporting.report import page_for, write_report
+from vibroimpact.reporting.page import page_for, write_report
 from vibroimpact.scene import parse_scene
 from vibroimpact.runs.run import run_study
 

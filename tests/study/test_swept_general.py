@@ -164,7 +164,7 @@ def test_relative_stops_sweep_page_draws_every_coordinate_and_stop(relative_run:
     the steady state; the comparison with pgf in one band (no anti-resonance split for a general structure)."""
     import matplotlib.pyplot as plt
 
-    from vibroimpact.reporting.report import page_for
+    from vibroimpact.reporting.page import page_for
     from vibroimpact.kinds.swept.page import GeneralSweptPage, sweep_figures, sweep_layout, swept_sine_run
     from tests.reporting.test_report_support import shown_points
 

@@ -113,7 +113,7 @@ def test_slow_sweep_follows_the_steady_states(sweep_run: xr.Dataset) -> None:
 
 @pytest.mark.timeout(120)
 def test_report(sweep_run: xr.Dataset, tmp_path: Path) -> None:
-    from vibroimpact.reporting.report import write_report
+    from vibroimpact.reporting.page import write_report
 
     page = write_report(sweep_run, tmp_path).read_text()
     for name in ("sweep_displacements.png", "sweep_force_impulse.png", "sweep_time.png", "Cost of the swept-sine runs"):
@@ -123,7 +123,7 @@ def test_report(sweep_run: xr.Dataset, tmp_path: Path) -> None:
 @pytest.mark.timeout(120)
 def test_only_the_quantities_asked_for(tmp_path: Path) -> None:
     """A swept scene that asks for |X1| only writes no running RMS and still gets its report."""
-    from vibroimpact.reporting.report import write_report
+    from vibroimpact.reporting.page import write_report
 
     document = sweep_document(quantities=["x1_amplitude", "regime"], swept_sine={"start": 24.0, "stop": 24.5, "rate": 0.25, "sample_rate": 2000.0, "directions": ["up"]})
     document["sweep"] = {"frequency": [24.2, 24.25]}

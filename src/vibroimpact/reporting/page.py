@@ -4,6 +4,12 @@ Figure builders return a :class:`DrawnFigure` (the matplotlib figure still open,
 drawn); :func:`save_figure` writes it and closes it. A page is a list of :class:`Section`; :func:`render_page` writes
 the HTML with a table of contents linking every section, figure and table. Each kind of study has a page type
 (:class:`StudyPage`) that gives the line naming what was computed and the sections, both read from the dataset.
+
+:func:`write_report` writes a dataset's report: PNG figures and a self-contained ``report.html`` (figures embedded as
+base64) into a folder, everything read from the dataset itself (:mod:`vibroimpact.reporting.record`), never from a
+re-validated scene; :func:`page_for` asks the dataset's kind (:data:`vibroimpact.scene.kinds.KINDS`) for its page
+(each kind's ``page.py``: concepts, validation, benchmark, bifurcation, swept; stepped: the design map, the bumper
+stiffness page and one frequency-response page for every other layout, whose sections follow what the dataset holds).
 """
 
 from __future__ import annotations
@@ -24,11 +30,14 @@ from typing import Iterable, Protocol
 from vibroimpact.reporting.style import DPI  # first: selects the Agg backend before pyplot is imported
 
 import matplotlib.pyplot as plt  # noqa: E402
+import xarray as xr  # noqa: E402
 from matplotlib.figure import Figure as MatplotlibFigure  # noqa: E402
 
+from vibroimpact.reporting.record import study_kind, study_record  # noqa: E402
 from vibroimpact.runs.store import atomic_path  # noqa: E402
+from vibroimpact.scene.kinds import kind_named  # noqa: E402
 
-__all__ = ["DrawnFigure", "Figure", "Table", "Section", "StudyPage", "save_figure", "saved", "rendering", "render_page", "write_page"]
+__all__ = ["DrawnFigure", "Figure", "Table", "Section", "StudyPage", "save_figure", "saved", "rendering", "render_page", "write_page", "write_report", "page_for"]
 
 #: The processes that render figures to PNG while :func:`rendering` is active (None: this process).
 _RENDERERS: ContextVar[Executor | None] = ContextVar("renderers", default=None)
@@ -84,7 +93,7 @@ class Section:
 
 
 class StudyPage(Protocol):
-    """The page of one kind of study (:func:`vibroimpact.reporting.report.page_for` chooses it)."""
+    """The page of one kind of study (:func:`vibroimpact.reporting.page.page_for` chooses it)."""
 
     def summary(self) -> str:
         """What was computed, for the page's heading: ``solutions: ...`` or ``methods: ...``."""
@@ -237,3 +246,27 @@ def write_page(path: Path, text: str) -> Path:
     with atomic_path(path) as temporary:
         temporary.write_text(text, encoding="utf-8")
     return path
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# The report of a dataset: its kind's page, written. 
+# --------------------------------------------------------------------------------------------------------------------
+
+def write_report(dataset: xr.Dataset, out_dir: str | Path, jobs: int = 1) -> Path:
+    """Write the PNG figures and ``report.html`` for ``dataset`` into ``out_dir``, rendering the figures in ``jobs``
+    processes; return the HTML path."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    record = study_record(dataset)
+    page = page_for(dataset)
+    with rendering(jobs):
+        sections = page.sections(out)
+    paragraphs = [record.description, f"vibroimpact {record.version}; {page.summary()}."]
+    return write_page(out / "report.html", render_page(f"Study '{record.name}'", paragraphs, sections, record.scene_text))
+
+
+def page_for(dataset: xr.Dataset) -> StudyPage:
+    """The page of ``dataset``: its kind's (:func:`~vibroimpact.reporting.record.study_kind`, the kind's ``page_for``
+    in :data:`vibroimpact.scene.kinds.KINDS`)."""
+    page: StudyPage = kind_named(study_kind(dataset)).page_for(dataset)
+    return page

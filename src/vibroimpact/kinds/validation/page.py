@@ -223,7 +223,7 @@ class ValidationPage:
 
 
 def write_validation_report(dataset: xr.Dataset, out_dir: str | Path) -> Path:
-    """``report.html`` of a validation dataset in ``out_dir`` (what :func:`vibroimpact.reporting.report.write_report`
+    """``report.html`` of a validation dataset in ``out_dir`` (what :func:`vibroimpact.reporting.page.write_report`
     writes for it, in this process); return its path."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
