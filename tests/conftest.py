@@ -17,6 +17,18 @@ PAPER_AMPLITUDE = 10.0
 PAPER_CLEARANCE = 3e-3
 
 
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """Compile the exact engine's numba core once, in the controlling process, before the xdist workers start: with a
+    cold cache (a fresh clone) every worker would otherwise compile it at once (~40 s of CPU each); they load it
+    from numba's on-disk cache instead. Nothing happens where the cache holds it (a check of its index)."""
+    import os
+
+    if os.environ.get("PYTEST_XDIST_WORKER") is None:
+        from vibroimpact.runs.run import prepare_compiled_core
+
+        prepare_compiled_core(None)
+
+
 @pytest.fixture
 def system() -> TwoDofSystem:
     """The paper's numerical example, eq. 24."""
