@@ -38,8 +38,12 @@ def test_list_shows_every_shipped_study_with_its_description(capsys: pytest.Capt
 
 
 def test_the_listing_shows_a_first_clause_not_an_abbreviation() -> None:
-    listing = cli.study_listing([("a", "Validation against Holmes (J. Sound Vib. 84, 1982): a ball bouncing. More."), ("long_name", "Short one. Two.")], 200)
-    assert listing.splitlines() == ["a          Validation against Holmes (J. Sound Vib. 84, 1982)", "long_name  Short one"]
+    studies = [("a", "Validation against Holmes (J. Sound Vib. 84, 1982): a ball bouncing. More."), ("long_name", "Short one. Two."), ("b", "After Den Hartog, cf. Ormondroyd: the stop")]
+    assert cli.study_listing(studies, 200).splitlines() == [
+        "a          Validation against Holmes (J. Sound Vib. 84, 1982)",  # inside parentheses: no clause ends
+        "long_name  Short one",
+        "b          After Den Hartog, cf. Ormondroyd",  # outside them, a short word's point is an abbreviation
+    ]
 
 
 def test_a_scene_is_required_without_list(capsys: pytest.CaptureFixture[str]) -> None:
