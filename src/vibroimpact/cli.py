@@ -22,6 +22,7 @@ import numpy as np
 
 from vibroimpact.scene import Scene, SceneError, find_scene, load_scene, shipped_studies
 from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, ClusterLost, choose_scheduler, unreachable
+from vibroimpact.runs.failures import console_line, run_failures
 from vibroimpact.runs.run import write_dataset, run_study
 from vibroimpact.runs.store import OutputBusy, StudyStore, claim_output, store_fingerprint
 
@@ -222,8 +223,15 @@ def _report(path: Path, out_dir: Path, jobs: int) -> Path | str:
         return f"no report: the dataset holds {size / 1e9:.1f} GB, more than the {REPORT_MEMORY_LIMIT / 1e9:.0f} GB a report reads into memory (the data are in {path})"
     from vibroimpact.reporting.page import write_report  # matplotlib is imported only when a report is made
 
+    from vibroimpact.runs.cluster import ProgressBar
+
     dataset = xr.load_dataset(path)
-    return write_report(dataset, out_dir, jobs=jobs)
+    bar = ProgressBar([1.0], [], "page", enabled=True, verb="report", status="drawing the figures")  # its heartbeat
+    try:
+        return write_report(dataset, out_dir, jobs=jobs)
+    finally:
+        bar.finish(0)
+        bar.close()
 
 
 def unwritable(out_dir: Path) -> str | None:
@@ -250,9 +258,13 @@ def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, store: StudyStor
         dataset.attrs["run_peak_memory_bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
         path = write_dataset(dataset, out_dir / f"{scene.name}.nc")  # streamed from the store, chunk by chunk
         print(f"wrote {path}")
+        failures = run_failures(dataset)  # read before the store (which a lazy dataset reads) goes
+        report: Path | str | None = None
         if scene.report and not args.no_report:
             report = _report(path, out_dir, args.jobs)
             print(f"wrote {report}" if isinstance(report, Path) else report)
+        if failures:
+            print(console_line(failures, f"{report}" if isinstance(report, Path) else None), file=sys.stderr)
         # the store goes last: a run interrupted while drawing its report reruns from the store in seconds
         if args.keep_zarr:
             store.keep(dataset)

@@ -34,10 +34,11 @@ import xarray as xr  # noqa: E402
 from matplotlib.figure import Figure as MatplotlibFigure  # noqa: E402
 
 from vibroimpact.reporting.record import study_kind, study_record  # noqa: E402
+from vibroimpact.runs.failures import failure_details, run_failures  # noqa: E402
 from vibroimpact.runs.store import atomic_path  # noqa: E402
 from vibroimpact.scene.kinds import kind_named  # noqa: E402
 
-__all__ = ["DrawnFigure", "Figure", "Table", "Section", "StudyPage", "save_figure", "saved", "rendering", "render_page", "write_page", "write_report", "page_for"]
+__all__ = ["DrawnFigure", "Figure", "Table", "Section", "StudyPage", "save_figure", "saved", "rendering", "render_page", "write_page", "write_report", "with_failures", "page_for"]
 
 #: The processes that render figures to PNG while :func:`rendering` is active (None: this process).
 _RENDERERS: ContextVar[Executor | None] = ContextVar("renderers", default=None)
@@ -261,8 +262,23 @@ def write_report(dataset: xr.Dataset, out_dir: str | Path, jobs: int = 1) -> Pat
     page = page_for(dataset)
     with rendering(jobs):
         sections = page.sections(out)
+    sections = with_failures(sections, run_failures(dataset), failure_details(dataset))
     paragraphs = [record.description, f"vibroimpact {record.version}; {page.summary()}."]
     return write_page(out / "report.html", render_page(f"Study '{record.name}'", paragraphs, sections, record.scene_text))
+
+
+def with_failures(sections: list[Section], failures: list[str], details: list[str]) -> list[Section]:
+    """``sections`` with the run's failures said right after the page's answer (its first section), each in one line,
+    and their raw messages in a collapsed section at the end; unchanged when nothing failed."""
+    if not failures:
+        return sections
+    items = "".join(f"<li>{html.escape(line)}</li>" for line in failures)
+    summary = Section("What failed in this run", f"<p><b>The run finished, but not everywhere.</b></p><ul>{items}</ul>")
+    out = [*sections[:1], summary, *sections[1:]]
+    if details:
+        raw = html.escape("\n".join(details))
+        out.append(Section("Failure details", f"<details><summary>The raw messages ({len(details)})</summary><pre>{raw}</pre></details>"))
+    return out
 
 
 def page_for(dataset: xr.Dataset) -> StudyPage:

@@ -19,7 +19,7 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["SCHEDULER_VARIABLE", "ClusterLost", "SyncCancelRace", "Connection", "choose_scheduler", "connect", "unreachable", "dask_setup", "Progress", "ProgressReport", "Throttled", "ProgressBar", "REPORT_INTERVAL"]
+__all__ = ["SCHEDULER_VARIABLE", "ClusterLost", "SyncCancelRace", "Connection", "choose_scheduler", "connect", "unreachable", "dask_setup", "Progress", "ProgressReport", "Throttled", "ProgressBar", "REPORT_INTERVAL", "HEARTBEAT"]
 
 #: The environment variable naming a running scheduler (``tcp://host:8786``).
 SCHEDULER_VARIABLE = "VIBROIMPACT_SCHEDULER"
@@ -166,6 +166,8 @@ Progress = Callable[[str], None]
 ProgressReport = Callable[[float], None]
 #: Shortest interval between two progress messages of one task [s].
 REPORT_INTERVAL = 0.25
+#: Longest a study's progress bar stays silent while nothing arrives (workers starting, a long first task) [s].
+HEARTBEAT = 10.0
 
 
 class Throttled:
@@ -200,9 +202,14 @@ class ProgressBar:
         The bar's first word.
     done_before : float
         Work done before these tasks (cases an interrupted run finished), in ``unit``: counted as done.
+    heartbeat : float
+        Longest silence of the bar [s]: while no work arrives (workers starting, a long first task) the bar is shown
+        again with its elapsed time and :attr:`status` at least this often (on a terminal every second).
+    status : str
+        What the run is doing before work arrives (see :meth:`set_status`).
     """
 
-    def __init__(self, totals: list[float], finished: list[int], unit: str, enabled: bool, verb: str = "simulating", done_before: float = 0.0) -> None:
+    def __init__(self, totals: list[float], finished: list[int], unit: str, enabled: bool, verb: str = "simulating", done_before: float = 0.0, heartbeat: float = HEARTBEAT, status: str = "") -> None:
         self.totals = totals
         self.total = max(sum(totals) + done_before, 1e-300)
         self.done = {index: totals[index] for index in finished}
@@ -216,7 +223,25 @@ class ProgressBar:
         self.tty = sys.stderr.isatty()
         self.last_decile = -1
         self.lock = threading.Lock()
+        #: What the run is doing while no work has arrived (e.g. "starting 2 worker processes"); shown in the bar.
+        self.status = status
+        self.heartbeat = heartbeat
+        self.last_shown = -np.inf  # when a line was last printed [s, perf_counter]
         self._show()
+        self._stop = threading.Event()
+        self._ticker: threading.Thread | None = None
+        if self.enabled:
+            self._ticker = threading.Thread(target=self._tick, name="vibroimpact-progress", daemon=True)
+            self._ticker.start()
+
+    def _tick(self) -> None:
+        """Show the bar again while nothing arrives: no line is silent for longer than :attr:`heartbeat`."""
+        interval = min(1.0, self.heartbeat / 10.0)
+        silence = interval if self.tty else self.heartbeat - interval  # a terminal's bar counts seconds in place
+        while not self._stop.wait(interval):
+            with self.lock:
+                if time.perf_counter() - self.last_shown >= silence:
+                    self._show(force=True)
 
     def partial(self, index: int, done: float) -> None:
         """Task ``index`` has done ``done`` of its work (a late message of a finished task changes nothing)."""
@@ -226,6 +251,7 @@ class ProgressBar:
             value = min(max(done, 0.0), self.totals[index])
             self.done_sum += value - self.done.get(index, 0.0)
             self.done[index] = value
+            self.status = ""  # work arrives: the run is past its start
             self._show()
 
     def finish(self, index: int) -> None:
@@ -233,23 +259,35 @@ class ProgressBar:
         self.partial(index, self.totals[index])
         self.finished.add(index)
 
-    def _show(self) -> None:
+    def set_status(self, status: str) -> None:
+        """Say what the run is doing before work arrives (shown at once and with every heartbeat)."""
+        with self.lock:
+            self.status = status
+            self._show(force=True)
+
+    def _show(self, force: bool = False) -> None:
         if not self.enabled:
             return
         done = self.done_sum
         fraction = min(done / self.total, 1.0)
-        elapsed = time.perf_counter() - self.started
+        now = time.perf_counter()
+        elapsed = now - self.started
         rate = (done - self.first_done) / elapsed if elapsed > 0 and done > self.first_done else 0.0
-        remaining = f"{(self.total - done) / rate:.0f} s left" if rate > 0 else "..."
+        remaining = f"{(self.total - done) / rate:.0f} s left" if rate > 0 else (self.status or "...")
         filled = int(30 * fraction)
         line = f"{self.verb} [{'#' * filled}{'.' * (30 - filled)}] {done:.0f}/{self.total:.0f} {self.unit}, {elapsed:.0f} s, {remaining}"
         if self.tty:
             print("\r" + line + "  ", end="", file=sys.stderr, flush=True)
-        elif int(10 * fraction) > self.last_decile:
-            self.last_decile = int(10 * fraction)
+            self.last_shown = now
+        elif int(10 * fraction) > self.last_decile or force:
+            self.last_decile = max(self.last_decile, int(10 * fraction))
             print(line, file=sys.stderr, flush=True)
+            self.last_shown = now
 
     def close(self) -> None:
-        """End the bar's line."""
+        """Stop the heartbeat and end the bar's line."""
+        self._stop.set()
+        if self._ticker is not None:
+            self._ticker.join()
         if self.enabled and self.tty:
             print(file=sys.stderr, flush=True)

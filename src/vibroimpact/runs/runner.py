@@ -220,7 +220,10 @@ class Runner:
         """
         skipped = set(skip)
         order = [index for index in range(len(items)) if index not in skipped]
-        bar = ProgressBar(list(totals), list(skipped), unit, self.progress, verb, done_before)
+        starting = ""  # the bar's heartbeat says why nothing moves while the cluster starts (5-16 s)
+        if self.distributed and self._connection is None:
+            starting = f"starting {self.jobs} worker processes" if self.scheduler is None else f"connecting to the dask scheduler at {self.scheduler}"
+        bar = ProgressBar(list(totals), list(skipped), unit, self.progress, verb, done_before, status=starting)
         try:
             if not self.distributed:
                 for index in order:
@@ -233,6 +236,7 @@ class Runner:
 
     def _run_distributed(self, function: TaskFunction, shared: Any, items: Sequence[Any], order: list[int], bar: ProgressBar, finished: Callable[[int, Any], None]) -> None:
         connection = self.connection
+        bar.set_status("waiting for the workers' first results")
         client: Any = connection.client
         token = uuid.uuid4().hex[:12]
         topic = f"vibroimpact-progress-{token}"

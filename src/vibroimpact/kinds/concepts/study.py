@@ -160,6 +160,7 @@ def concepts_dataset(settings: ConceptsSettings, closed: dict[str, ClosedForms],
     orbit = {k: np.full((len(names), points), np.nan) for k in branch_keys}
     per: dict[str, list[Any]] = {k: [] for k in ("peak_x1", "peak_x1_f", "peak_force", "peak_force_f", "accel", "contact", "depth", "depth_f",
                                                  "fraction", "coverage", "band_impacts", "base_peak", "unstable", "nonperiodic", "notes")}  # fmt: skip
+    failures: list[str] = []  # one line per concept whose simulations failed somewhere
     for i, concept in enumerate(settings.concepts):
         cf = closed[concept.name]
         fine["linear_x1"][i], fine["closed_x1"][i], fine["closed_force"][i] = cf.linear_x1, cf.impact_x1, cf.impact_base_force
@@ -174,6 +175,8 @@ def concepts_dataset(settings: ConceptsSettings, closed: dict[str, ClosedForms],
             failed = int(np.nansum(s["failed"]) + np.nansum(s["bumper_failed"]))
             if failed:
                 notes.append(f"{failed} simulated points failed")
+                failures.append(f"concept {concept.name}: {failed} of {fs.size * (2 if math.isfinite(settings.bumper_frequency) else 1)} simulated points failed (rigid stops and bumpers together): "
+                                "they are blank (NaN) in the dataset and missing from the figures; the closed forms and the other points are unaffected")
         b = branches.get(concept.name)
         empty = np.zeros(0)
         branch_tuple: tuple = (empty,) * 6
@@ -241,6 +244,8 @@ def concepts_dataset(settings: ConceptsSettings, closed: dict[str, ClosedForms],
     dataset.attrs.update({"band_low_Hz": low, "band_high_Hz": high, "anti_resonance_Hz": anti, "static_deflection_m": static,
                           "excitation_amplitude_N": settings.amplitude, "bumper_frequency_Hz": settings.bumper_frequency,
                           "study_kind": "concepts"})  # fmt: skip
+    if failures:
+        dataset.attrs["run_failures"] = failures  # said on the page and in the console (vibroimpact.runs.failures)
     return dataset
 
 
