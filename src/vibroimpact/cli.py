@@ -24,7 +24,7 @@ from vibroimpact.scene import Scene, SceneError, find_scene, load_scene, shipped
 from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, ClusterLost, choose_scheduler, unreachable
 from vibroimpact.runs.failures import console_line, run_failures
 from vibroimpact.runs.run import write_dataset, run_study
-from vibroimpact.runs.store import OutputBusy, StudyStore, claim_output, store_fingerprint
+from vibroimpact.runs.store import OutputBusy, StoreOfAnotherScene, StudyStore, claim_output, store_fingerprint
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILURE = 1
@@ -98,7 +98,8 @@ def main(argv: list[str] | None = None) -> int:
         print("run-study: error: a scene is required (or --list)", file=sys.stderr)
         return EXIT_BAD_INPUT
     try:
-        scene = load_scene(find_scene(args.scene))
+        scene_path = find_scene(args.scene)
+        scene = load_scene(scene_path)
     except (SceneError, OSError) as error:  # OSError: missing, a directory, unreadable
         print(f"run-study: error: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -127,7 +128,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         with claim_output(out_dir):
             # finished blocks and cases: a rerun of the same scene skips them
-            store = StudyStore(out_dir / f"{scene.name}.zarr", store_fingerprint(scene.text))
+            store = StudyStore(out_dir / f"{scene.name}.zarr", store_fingerprint(scene.text), scene_path, _say)
             try:
                 return _run(scene, args, out_dir, store, scheduler)
             except KeyboardInterrupt:
@@ -136,9 +137,14 @@ def main(argv: list[str] | None = None) -> int:
             except ClusterLost as error:
                 print(f"\nrun-study: {error}: {_kept(store)} kept in {store.path}; run the same command to resume", file=sys.stderr)
                 return EXIT_FAILURE
-    except OutputBusy as error:
+    except (OutputBusy, StoreOfAnotherScene) as error:
         print(f"run-study: error: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
+
+
+def _say(line: str) -> None:
+    """A line of the run's own (finished work discarded or recomputed), on stderr beside the progress bar."""
+    print(line, file=sys.stderr, flush=True)
 
 
 def _kept(store: StudyStore) -> str:

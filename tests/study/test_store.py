@@ -140,7 +140,7 @@ def test_another_scene_or_other_code_starts_afresh(tmp_path: Path) -> None:
     path = tmp_path / "grid.zarr"
     run_study(scene, progress=None, store=StudyStore(path, store_fingerprint(scene.text)))
     assert StudyStore(path, store_fingerprint(scene.text)).block_count() > 0
-    assert StudyStore(path, store_fingerprint(scene.text + "\n# edited")).block_count() == 0
+    assert StudyStore(path, store_fingerprint(scene.text + "\nsweep: {clearance: [0.0025]}")).block_count() == 0
 
 
 def test_cases_keep_their_text_and_numbers(tmp_path: Path) -> None:

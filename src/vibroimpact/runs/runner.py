@@ -163,7 +163,10 @@ class Runner:
         names = [f"{case.engine}-{case.key()}" for case in cases] if self.store is not None else []
         results: list[CaseResult | None] = [None] * len(cases)
         if self.store is not None:
+            damaged_before = self.store.damaged_cases
             results = [self.store.load_case(name, case.fields) for name, case in zip(names, cases)]
+            if self.store.damaged_cases > damaged_before:
+                self.store.say(f"{self.store.damaged_cases - damaged_before} damaged cases of {len(cases)} are computed again")
         pending = [index for index, result in enumerate(results) if result is None]
 
         def keep(index: int, result: CaseResult) -> None:

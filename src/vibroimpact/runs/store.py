@@ -6,12 +6,19 @@ the fixed-width strings that some results hold):
 
 * the grid variables of a stepped study, with the grid's full dimensions (``solution``, ``restitution``,
   ``clearance``, ``bumper_frequency``, ``sweep``, ``frequency``, and ``stop`` where a variable has one), chunked like
-  the grid's blocks, and ``block_done`` (one flag per block, set after every variable of the block is written, so a
-  block cut off half-way is computed again);
+  the grid's blocks, ``block_checksum`` (the SHA-256 of the values each block wrote) and ``block_done`` (one flag per
+  block, set after every variable of the block and its checksum are written, so a block cut off half-way is computed
+  again);
 * the group ``cases``: one group per finished case (``<engine>-<key>``), one array per result field, marked complete
-  after its arrays;
-* the attribute ``fingerprint``: the scene's text, the package version and its source; a store of another scene or
-  other code is started afresh rather than mixed.
+  after its arrays, with the checksum of its values;
+* the attributes ``fingerprint`` (the scene's values, the package version and its source), ``code`` and
+  ``scene_path``: a store of changed values or other code is started afresh rather than mixed, saying why and how
+  much it discards; a store begun by another scene file is refused, never deleted.
+
+A store proves what it serves: every finished block is checked against its checksum when a run resumes and again
+before its values are exported, and every case when it is read; one that fails (a lost, truncated or swapped chunk,
+lost metadata) is computed again and the run says how many in one line. No fill value passes as a result: every
+point belongs to a block, and the export waits until every block has proved itself.
 
 Only the process that runs the study writes the store (workers return their results to it), so a cluster needs no
 shared file system. :func:`claim_output` keeps a second study off the same output.
@@ -29,10 +36,11 @@ import shutil
 import socket
 import tempfile
 import time
+import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 import xarray as xr
@@ -42,7 +50,7 @@ from zarr.core.sync import sync  # zarr's own event loop, the one its synchronou
 
 from vibroimpact import __version__
 
-__all__ = ["atomic_path", "source_hash", "case_key", "StudyStore", "OutputBusy", "claim_output", "store_fingerprint", "ZARR_FORMAT"]
+__all__ = ["atomic_path", "source_hash", "case_key", "StudyStore", "OutputBusy", "claim_output", "store_fingerprint", "code_fingerprint", "values_digest", "StoreOfAnotherScene", "NOT_IN_FINGERPRINT", "ZARR_FORMAT"]
 
 
 @contextmanager
@@ -94,6 +102,24 @@ def case_key(content: dict[str, Any]) -> str:
 ZARR_FORMAT = 2
 _CASES = "cases"
 _BLOCK_DONE = "block_done"
+#: One SHA-256 per block (32 bytes) of the values it wrote, set before its ``block_done`` flag.
+_BLOCK_CHECKSUM = "block_checksum"
+#: The grid's variables, recorded when the grid begins (a variable whose metadata is lost is missed by name).
+_GRID_VARIABLES = "grid_variables"
+
+
+def values_digest(arrays: list[tuple[str, NDArray[np.generic]]]) -> bytes:
+    """SHA-256 of named arrays: each name, dtype, shape and C-order bytes, in the given order.
+
+    A block's or a case's values read back from the store must give the digest they were written with: a lost chunk
+    (read as the fill value), a truncated or swapped one, all change it.
+    """
+    digest = hashlib.sha256()
+    for name, values in arrays:
+        array = np.ascontiguousarray(values)
+        digest.update(f"{name}\0{array.dtype.str}\0{array.shape}\0".encode())
+        digest.update(array.tobytes())
+    return digest.digest()
 #: Attributes whose values must keep the variable's own type (CF: flag_values of an int8 flag are int8).
 _TYPED_ATTRIBUTES = ("flag_values", "flag_masks", "valid_min", "valid_max", "valid_range")
 
@@ -102,9 +128,13 @@ class OutputBusy(RuntimeError):
     """Another study is writing the same output folder."""
 
 
+#: Top-level scene keys that change no number: a store survives their edits (where the work runs, the page's words).
+NOT_IN_FINGERPRINT = ("cluster", "description", "report")
+
+
 def store_fingerprint(scene_text: str) -> str:
-    """What a store's results depend on: the scene's text (but its ``cluster:`` section: where the work runs does not
-    change it), the package version and the package's source."""
+    """What a store's results depend on: the scene's values (not its comments, nor the keys of
+    :data:`NOT_IN_FINGERPRINT`), the package version and the package's source (:func:`code_fingerprint`)."""
     import yaml
 
     try:
@@ -112,8 +142,17 @@ def store_fingerprint(scene_text: str) -> str:
     except yaml.YAMLError:
         document = None
     if isinstance(document, dict):
-        scene_text = yaml.safe_dump({key: value for key, value in document.items() if key != "cluster"}, sort_keys=True)
-    return hashlib.sha256(f"{__version__}\0{source_hash()}\0{scene_text}".encode()).hexdigest()[:24]
+        scene_text = yaml.safe_dump({key: value for key, value in document.items() if key not in NOT_IN_FINGERPRINT}, sort_keys=True)
+    return hashlib.sha256(f"{code_fingerprint()}\0{scene_text}".encode()).hexdigest()[:24]
+
+
+def code_fingerprint() -> str:
+    """The package version and its source (:func:`source_hash`): results of other code are not reused."""
+    return hashlib.sha256(f"{__version__}\0{source_hash()}".encode()).hexdigest()[:24]
+
+
+class StoreOfAnotherScene(RuntimeError):
+    """The output folder's store holds the finished work of another scene file (a name clash): it is not deleted."""
 
 
 @contextmanager
@@ -162,6 +201,24 @@ def _lock_owner(lock: Path) -> tuple[int, str, str] | None:
         return None
 
 
+def _finished_work(path: Path) -> str:
+    """'N finished blocks and M finished cases' of the store at ``path`` (what discarding it costs), read part by part
+    so that a damaged root does not hide them."""
+    blocks = cases = 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # zarr warns of what it cannot recognise: counted as nothing
+        try:
+            blocks = int(np.asarray(zarr.open_array(str(path / _BLOCK_DONE), mode="r", zarr_format=ZARR_FORMAT)[...]).astype(bool).sum())
+        except Exception:  # noqa: BLE001 - none, or damaged
+            pass
+        try:
+            group = zarr.open_group(str(path / _CASES), mode="r", zarr_format=ZARR_FORMAT)
+            cases = sum(1 for _name, case in group.groups() if case.attrs.get("complete"))
+        except Exception:  # noqa: BLE001 - none, or damaged
+            pass
+    return f"{blocks} finished blocks and {cases} finished cases"
+
+
 class StudyStore:
     """A zarr store of a study's finished work (module docstring); ``path=None`` keeps it in memory.
 
@@ -170,27 +227,56 @@ class StudyStore:
     path : Path or None
         The store's folder (``<out>/<name>.zarr``), or None for an in-memory store (a study run from Python).
     fingerprint : str
-        :func:`store_fingerprint` of the scene; a folder holding another fingerprint is emptied first.
+        :func:`store_fingerprint` of the scene; a folder holding another fingerprint is emptied first, and ``say``
+        is told why and how much finished work that discards.
+    scene_path : Path or None
+        The scene file the work comes from (recorded; a store begun by another scene file is refused, not emptied).
+    say : callable or None
+        Receives one line whenever finished work is discarded (a changed scene or code, damaged blocks or cases).
+
+    Raises
+    ------
+    StoreOfAnotherScene
+        When ``path`` holds the store of another scene file (same name, other file): nothing is deleted.
     """
 
-    def __init__(self, path: Path | None, fingerprint: str) -> None:
+    def __init__(self, path: Path | None, fingerprint: str, scene_path: Path | None = None, say: Callable[[str], None] | None = None) -> None:
         self.path = path
         self.fingerprint = fingerprint
+        self.say = say or (lambda _line: None)
+        #: Cases read back whose values failed their checksum (computed again).
+        self.damaged_cases = 0
         self.store: Any = str(path) if path is not None else zarr.storage.MemoryStore()
-        if path is not None and path.exists() and not self._matches():
-            shutil.rmtree(path)  # another scene or other code: its results are not ours
+        source = str(Path(scene_path).resolve()) if scene_path is not None else ""
+        if path is not None and path.exists():
+            self._discard_unless_ours(path, source)
         self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT)
         if "fingerprint" not in self.root.attrs:
-            self.root.attrs["fingerprint"] = fingerprint
-        self._grid_ready = _BLOCK_DONE in self.root
+            self.root.attrs.update({"fingerprint": fingerprint, "code": code_fingerprint(), "scene_path": source})
+        self._grid_ready = _BLOCK_DONE in self.root or _GRID_VARIABLES in self.root.attrs
         self._arrays: dict[str, Any] = {}
 
-    def _matches(self) -> bool:
+    def _discard_unless_ours(self, path: Path, source: str) -> None:
+        """Empty the folder ``path`` unless it holds this scene's store; say why and how much was discarded."""
         try:
-            group = zarr.open_group(str(self.path), mode="r", zarr_format=ZARR_FORMAT)
-        except (FileNotFoundError, ValueError, KeyError, zarr.errors.GroupNotFoundError):
-            return False
-        return group.attrs.get("fingerprint") == self.fingerprint
+            attrs: dict[str, Any] | None = dict(zarr.open_group(str(path), mode="r", zarr_format=ZARR_FORMAT).attrs)
+        except Exception:  # noqa: BLE001 - unreadable or damaged root metadata (a JSON error, a missing file)
+            attrs = None
+        if attrs is not None and attrs.get("fingerprint") == self.fingerprint:
+            return
+        if attrs is not None and source and attrs.get("scene_path") and attrs["scene_path"] != source:
+            raise StoreOfAnotherScene(
+                f"{path} holds the finished work of another scene ({attrs['scene_path']}); it is kept: remove it, or "
+                "run this scene with another --out (or another name)")
+        if attrs is None:
+            why = "its attributes are unreadable (damaged)"
+        elif attrs.get("code") != code_fingerprint():
+            why = "the package's code changed since it was written"
+        else:
+            why = "the scene's values changed since it was written"
+        self.say(f"{path}: {why}: {_finished_work(path)} discarded, computed again")
+        shutil.rmtree(path)
+
 
     # -- cases -------------------------------------------------------------------------------------------------
 
@@ -202,18 +288,27 @@ class StudyStore:
         group = self.root[path]
         if not group.attrs.get("complete") or not set(fields) <= set(group.array_keys()):
             return None
-        return {field: np.asarray(group[field][...]) for field in fields}
+        try:
+            result = {field: np.asarray(group[field][...]) for field in sorted(group.array_keys())}
+        except Exception:  # noqa: BLE001 - a damaged chunk raises whatever its codec raises (blosc: RuntimeError)
+            result = None
+        if result is None or values_digest(sorted(result.items())).hex() != group.attrs.get("checksum"):
+            self.damaged_cases += 1  # computed again; the run says how many
+            return None
+        return {field: result[field] for field in fields}
 
     def save_case(self, name: str, result: dict[str, NDArray[np.generic]]) -> None:
         """Store a finished case's result; it counts as stored once every array is written."""
         group = self.root.require_group(f"{_CASES}/{name}")
         group.attrs["complete"] = False
+        written = {}
         for field, value in result.items():
             array = np.asarray(value)
             if array.dtype == object:
                 array = array.astype(str)  # text (notes, names): fixed-width strings
             group.create_array(field, data=array, overwrite=True)  # scalars and empty arrays included
-        group.attrs["complete"] = True
+            written[field] = array
+        group.attrs.update({"checksum": values_digest(sorted(written.items())).hex(), "complete": True})
 
     def case_count(self) -> int:
         """Finished cases in the store."""
@@ -233,11 +328,14 @@ class StudyStore:
         is computed) and ``block_done``; ``plan`` (the grid's shape and a block's) is kept for a resumed run."""
         encoding = {name: {"_FillValue": None} for name, variable in template.data_vars.items() if variable.dtype.kind in "iub"}
         # the dataset's attributes become the group's: the fingerprint goes with them
-        template = template.assign_attrs(fingerprint=self.fingerprint, grid_shape=list(plan[0]), block_shape=list(plan[1]))
+        template = template.assign_attrs(dict(self.root.attrs) | {"grid_shape": list(plan[0]), "block_shape": list(plan[1]), _GRID_VARIABLES: sorted(map(str, template.data_vars))})
         template.to_zarr(self.store, mode="a", compute=False, zarr_format=ZARR_FORMAT, encoding=encoding, consolidated=False)
         self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT)
-        done = self.root.create_array(_BLOCK_DONE, shape=(block_count,), chunks=(1,), dtype="uint8", fill_value=0)
+        checksum = self.root.create_array(_BLOCK_CHECKSUM, shape=(block_count, 32), chunks=(1, 32), dtype="uint8", fill_value=0, overwrite=True)
+        checksum.attrs["_ARRAY_DIMENSIONS"] = ["block", "sha256_byte"]
+        done = self.root.create_array(_BLOCK_DONE, shape=(block_count,), chunks=(1,), dtype="uint8", fill_value=0, overwrite=True)
         done.attrs["_ARRAY_DIMENSIONS"] = ["block"]
+        self._arrays.clear()
         self._grid_ready = True
 
     def grid_plan(self) -> tuple[tuple[int, ...], tuple[int, ...]] | None:
@@ -255,16 +353,73 @@ class StudyStore:
         """Write the variables of block ``index`` (name -> (dimensions, values)) into ``region`` (dimension ->
         slice; unnamed dimensions whole), then flag the block done."""
         writes = []
-        for name, (dims, values) in block.items():
+        written = []
+        for name, (dims, values) in sorted(block.items()):
             array = self._array(name)
-            writes.append(array.async_array.setitem(tuple(region.get(dim, slice(None)) for dim in dims), values.astype(array.dtype, copy=False)))
+            typed = values.astype(array.dtype, copy=False)
+            writes.append(array.async_array.setitem(tuple(region.get(dim, slice(None)) for dim in dims), typed))
+            written.append((name, typed))
 
         async def write_all() -> None:
             await asyncio.gather(*writes)
 
         # one round trip to zarr's event loop for every variable of the block (one per variable costs 2.3x as much)
         sync(write_all())
+        self._array(_BLOCK_CHECKSUM)[index] = np.frombuffer(values_digest(written), dtype=np.uint8)
         self._array(_BLOCK_DONE)[index] = 1
+
+    def verify_blocks(self, region_of: Callable[[int], dict[str, slice]]) -> int:
+        """Check every finished block against the checksum it was written with; a block that fails (a lost, truncated
+        or swapped chunk) is flagged unfinished, so that it is computed again. Return how many failed.
+
+        A grid whose metadata is damaged (a variable, ``block_done`` or the checksums missing) is dropped whole: all
+        its finished blocks count as failed. ``region_of(index)``: the block's slices (dimension -> slice).
+        """
+        if not self._grid_ready or self.path is None:  # memory is not damaged on its way to and from a disk
+            return 0
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")  # zarr warns of an array whose metadata is lost: the grid is damaged
+                done = self.finished_blocks()
+                names = [str(name) for name in self.root.attrs[_GRID_VARIABLES]]  # type: ignore[union-attr]
+                arrays = {name: self._array(name) for name in names}
+                checksums = np.asarray(self._array(_BLOCK_CHECKSUM)[...])
+        except Exception:  # noqa: BLE001 - missing or unreadable metadata: nothing of the grid can be trusted
+            return self._drop_grid()
+        damaged = 0
+        for index in np.flatnonzero(done):
+            region = region_of(int(index))
+            try:
+                values = [(name, np.asarray(array[tuple(region.get(dim, slice(None)) for dim in array.attrs["_ARRAY_DIMENSIONS"])])) for name, array in arrays.items()]
+                good = values_digest(values) == checksums[index].tobytes()
+            except Exception:  # noqa: BLE001 - a damaged chunk raises whatever its codec raises (blosc: RuntimeError)
+                good = False
+            if not good:
+                self._array(_BLOCK_DONE)[index] = 0
+                damaged += 1
+        return damaged
+
+    def _drop_grid(self) -> int:
+        """Forget the grid (its arrays deleted, the next finished block begins it again); return its finished blocks."""
+        try:
+            count = int(self.finished_blocks().sum())
+        except Exception:  # noqa: BLE001 - the flags themselves are damaged: count what the plan says
+            plan = self.grid_plan()
+            count = int(np.prod([-(-n // b) for n, b in zip(*plan)])) if plan is not None else 0
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # zarr warns of the array whose metadata is lost: it goes anyway
+            names = {str(name) for name in self.root.attrs.get(_GRID_VARIABLES, [])} | set(self.root.array_keys())  # type: ignore[union-attr]
+            names -= {_CASES}
+            for name in names:
+                if self.path is not None:  # on disk: the folder whole, an array whose metadata is lost has chunk files
+                    shutil.rmtree(self.path / name, ignore_errors=True)
+                elif name in self.root:
+                    del self.root[name]
+            self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT)
+        self.root.attrs.pop(_GRID_VARIABLES, None)
+        self._arrays.clear()
+        self._grid_ready = False
+        return max(count, 1)
 
     def _array(self, name: str) -> Any:
         """The store's array ``name``, opened once."""
@@ -278,7 +433,7 @@ class StudyStore:
 
     def grid_dataset(self) -> xr.Dataset:
         """The grid's variables, lazily (dask arrays over the store's chunks), without ``block_done``."""
-        dataset = xr.open_zarr(self.store, consolidated=False, zarr_format=ZARR_FORMAT).drop_vars(_BLOCK_DONE)
+        dataset = xr.open_zarr(self.store, consolidated=False, zarr_format=ZARR_FORMAT).drop_vars([_BLOCK_DONE, _BLOCK_CHECKSUM])
         dataset.attrs.clear()  # the fingerprint, and a kept store's attributes of its last run: the study sets its own
         for variable in dataset.variables.values():
             for key in _TYPED_ATTRIBUTES:

@@ -160,7 +160,6 @@ def run_grid(scene: Scene, runner: Runner, solve: BlockSolver, extra_sizes: dict
         kept = store.grid_plan()
         if kept is not None and kept[0] == plan.full:
             plan = BlockPlan(plan.full, kept[1])  # a resumed study keeps the blocks it began with, whatever its workers
-    skip = np.flatnonzero(store.finished_blocks()).tolist() if store.grid_ready else []
     sizes = dict(zip(GRID_DIMS, plan.full)) | (extra_sizes or {})
     chunks = dict(zip(GRID_DIMS, plan.block))
 
@@ -170,7 +169,18 @@ def run_grid(scene: Scene, runner: Runner, solve: BlockSolver, extra_sizes: dict
         store.write_block(index, plan.region(index), {name: (dims, values) for name, (dims, values, _attrs) in variables.items()})
 
     totals = [block_work(scene, plan, index) for index in range(plan.count)]
-    runner.run_tasks(_solve_block, (scene, plan, solve), list(range(plan.count)), totals, "points", finished, skip=skip, verb="simulating" if _simulates(scene) else "solving")
+    # every finished block proves its values against its checksum: on resume, and again before they are exported
+    for check in ("resumed", "exported"):
+        finished_before = store.block_count()
+        damaged = store.verify_blocks(plan.region)
+        if damaged:
+            store.say(f"{damaged} damaged blocks of {max(finished_before, damaged)} finished ({check}) are computed again")
+        skip = np.flatnonzero(store.finished_blocks()).tolist() if store.grid_ready else []
+        if check == "exported" and len(skip) == plan.count:
+            break
+        runner.run_tasks(_solve_block, (scene, plan, solve), list(range(plan.count)), totals, "points", finished, skip=skip, verb="simulating" if _simulates(scene) else "solving")
+    if store.block_count() != plan.count:  # cannot happen: a block that failed twice in one run raises on the way
+        raise RuntimeError(f"the store holds {store.block_count()} of the grid's {plan.count} blocks after the run")
     return store.grid_dataset()
 
 

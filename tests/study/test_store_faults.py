@@ -1,0 +1,124 @@
+"""A store that proves its blocks (issue 22, item 1-2): every finished block is checked against the checksum it was
+written with, on resume and before export; a damaged one is computed again and the run says so in one line, so a
+damaged store never serves damaged values: each fault below ends in the undisturbed run's dataset, bit for bit.
+Finished work is discarded only for a change of values or code, said in one line, never for another scene's store."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from vibroimpact.runs.run import run_study
+from vibroimpact.runs.store import StoreOfAnotherScene, StudyStore, store_fingerprint
+
+from tests.study.test_store import _grid_scene
+
+
+@pytest.fixture(scope="module")
+def undisturbed(tmp_path_factory: pytest.TempPathFactory) -> tuple[object, xr.Dataset, Path]:
+    """The closed-form grid of 18 blocks (30 frequencies each) run once into a store, kept as a pristine copy."""
+    from vibroimpact.kinds.stepped import blocks
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(blocks, "CLOSED_FORM_POINTS", 30)
+        scene = _grid_scene()
+        path = tmp_path_factory.mktemp("pristine") / "grid.zarr"
+        dataset = run_study(scene, progress=None, store=StudyStore(path, store_fingerprint(scene.text)))
+    return scene, dataset, path
+
+
+def _rerun(undisturbed: tuple[object, xr.Dataset, Path], tmp_path: Path, damage: object, monkeypatch: pytest.MonkeyPatch) -> tuple[xr.Dataset, list[str], int]:
+    """Copy the pristine store, ``damage(path)`` it, rerun: the dataset, the run's lines and the blocks solved again."""
+    from vibroimpact.kinds.stepped import blocks
+
+    scene, _dataset, pristine = undisturbed
+    path = tmp_path / "grid.zarr"
+    shutil.copytree(pristine, path)
+    damage(path)  # type: ignore[operator]
+    monkeypatch.setattr(blocks, "CLOSED_FORM_POINTS", 30)
+    real, solved = blocks._solve_block, []
+    monkeypatch.setattr(blocks, "_solve_block", lambda shared, index, report: (solved.append(index), real(shared, index, report))[1])
+    lines: list[str] = []
+    dataset = run_study(scene, progress=None, store=StudyStore(path, store_fingerprint(scene.text), say=lines.append))  # type: ignore[attr-defined]
+    return dataset, lines, len(solved)
+
+
+def _chunks(path: Path, variable: str) -> list[Path]:
+    return sorted(chunk for chunk in (path / variable).iterdir() if not chunk.name.startswith("."))
+
+
+def _missing_chunk(path: Path) -> None:
+    _chunks(path, "regime")[3].unlink()  # read back as the fill value 0: 'linear' everywhere in the block
+
+
+def _truncated_chunk(path: Path) -> None:
+    chunk = _chunks(path, "x1_amplitude")[5]
+    chunk.write_bytes(chunk.read_bytes()[:20])  # blosc fails to decompress it
+
+
+def _swapped_chunks(path: Path) -> None:
+    first, second = _chunks(path, "x1_amplitude")[0], _chunks(path, "x1_amplitude")[7]
+    a, b = first.read_bytes(), second.read_bytes()
+    first.write_bytes(b)
+    second.write_bytes(a)
+
+
+def _missing_metadata(path: Path) -> None:
+    (path / "regime" / ".zarray").unlink()
+
+
+@pytest.mark.parametrize(("damage", "blocks_again"), [(_missing_chunk, 1), (_truncated_chunk, 1), (_swapped_chunks, 2), (_missing_metadata, 18)])
+def test_a_damaged_store_ends_in_the_undisturbed_dataset(undisturbed: tuple[object, xr.Dataset, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch, damage: object, blocks_again: int) -> None:
+    dataset, lines, solved = _rerun(undisturbed, tmp_path, damage, monkeypatch)
+    xr.testing.assert_identical(dataset, undisturbed[1])
+    assert solved == blocks_again
+    assert lines == [f"{blocks_again} damaged blocks of 18 finished (resumed) are computed again"]
+
+
+def test_a_damaged_root_attribute_file_discards_the_store_in_one_line(undisturbed: tuple[object, xr.Dataset, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    dataset, lines, solved = _rerun(undisturbed, tmp_path, lambda path: (path / ".zattrs").write_text("{ not json"), monkeypatch)
+    xr.testing.assert_identical(dataset, undisturbed[1])
+    assert solved == 18
+    assert len(lines) == 1 and "its attributes are unreadable (damaged): 18 finished blocks and 0 finished cases discarded" in lines[0]
+
+
+def test_an_undamaged_store_is_served_without_a_word(undisturbed: tuple[object, xr.Dataset, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    dataset, lines, solved = _rerun(undisturbed, tmp_path, lambda path: None, monkeypatch)
+    xr.testing.assert_identical(dataset, undisturbed[1])
+    assert (solved, lines) == (0, [])
+
+
+def test_the_fingerprint_covers_values_not_words() -> None:
+    document = {"name": "s", "description": "first words", "system": {"m1": 1.0}, "report": True, "sweep": {"frequency": [20.0, 21.0]}}
+    text = yaml.safe_dump(document)
+    same = [text + "# a comment\n", yaml.safe_dump(document | {"description": "better words"}), yaml.safe_dump(document | {"report": False}),
+            yaml.safe_dump(document | {"cluster": {"scheduler": "tcp://host:8786"}})]  # fmt: skip
+    assert {store_fingerprint(other) for other in same} == {store_fingerprint(text)}
+    assert store_fingerprint(yaml.safe_dump(document | {"system": {"m1": 1.5}})) != store_fingerprint(text)
+
+
+def test_changed_values_discard_in_one_line_and_another_scenes_store_is_kept(tmp_path: Path) -> None:
+    path = tmp_path / "s.zarr"
+    first, second = tmp_path / "a.yaml", tmp_path / "b.yaml"
+    store = StudyStore(path, "one", scene_path=first)
+    store.save_case("exact-1", {"x": np.arange(3.0)})
+    with pytest.raises(StoreOfAnotherScene, match=r"holds the finished work of another scene \(.*a\.yaml\); it is kept"):
+        StudyStore(path, "two", scene_path=second)
+    assert StudyStore(path, "one", scene_path=first).case_count() == 1, "the refused run deleted nothing"
+    lines: list[str] = []
+    assert StudyStore(path, "two", scene_path=first, say=lines.append).case_count() == 0
+    assert lines == [f"{path}: the scene's values changed since it was written: 0 finished blocks and 1 finished cases discarded, computed again"]
+
+
+def test_a_case_that_fails_its_checksum_is_computed_again(tmp_path: Path) -> None:
+    store = StudyStore(tmp_path / "c.zarr", "f")
+    store.save_case("exact-1", {"x": np.arange(1000.0), "y": np.ones(4)})
+    assert store.load_case("exact-1", ("x", "y")) is not None and store.damaged_cases == 0
+    chunk = next(c for c in (tmp_path / "c.zarr" / "cases" / "exact-1" / "x").iterdir() if not c.name.startswith("."))
+    chunk.write_bytes(chunk.read_bytes()[:-8] + bytes(8))
+    assert StudyStore(tmp_path / "c.zarr", "f").load_case("exact-1", ("x", "y")) is None
