@@ -12,6 +12,13 @@ stays light::
 
 from __future__ import annotations
 
+import os
+
+if os.environ.get("VIBROIMPACT_WORKER") == "1":  # a local cluster's worker, spawned by run-study (runs.cluster)
+    from vibroimpact.runs.interrupts import ignore_interrupts_in_workers
+
+    ignore_interrupts_in_workers()  # before its seconds of imports: Ctrl-C is the study's process's to handle
+
 import importlib
 from importlib.metadata import PackageNotFoundError, version
 from typing import Any

@@ -12,7 +12,9 @@ import os
 import resource
 import re
 import shutil
+import signal
 import sys
+import threading
 import tempfile
 import time
 from pathlib import Path
@@ -21,7 +23,7 @@ from typing import Callable
 import numpy as np
 
 from vibroimpact.scene import Scene, SceneError, find_scene, load_scene, shipped_studies
-from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, ClusterLost, choose_scheduler, unreachable
+from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, ClusterLost, Terminated, choose_scheduler, unreachable
 from vibroimpact.runs.failures import console_line, run_failures
 from vibroimpact.runs.run import write_dataset, run_study
 from vibroimpact.runs.store import OutputBusy, StoreOfAnotherScene, StudyStore, claim_output, store_fingerprint
@@ -30,6 +32,8 @@ EXIT_BAD_INPUT = 2
 EXIT_FAILURE = 1
 #: 128 + SIGINT, what a shell reports for a program ended by Ctrl-C.
 EXIT_INTERRUPTED = 130
+#: 128 + SIGTERM: a batch system's end of time or ``timeout``, handled like Ctrl-C (finished work kept, one line).
+EXIT_TERMINATED = 143
 #: Subcommands and what they do (``run-study --help`` lists them).
 SUBCOMMANDS = {
     "calibrate": "calibrate ACCURACY.nc [--out FILE]: measure the costs of --estimate from an accuracy_cost dataset and write the cost file",
@@ -125,21 +129,28 @@ def main(argv: list[str] | None = None) -> int:
     if problem is not None:
         print(f"run-study: error: --out {out_dir} cannot be written: {problem}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _terminate)  # SIGTERM ends the run as Ctrl-C does
     try:
         with claim_output(out_dir):
             # finished blocks and cases: a rerun of the same scene skips them
             store = StudyStore(out_dir / f"{scene.name}.zarr", store_fingerprint(scene.text), scene_path, _say)
             try:
                 return _run(scene, args, out_dir, store, scheduler)
-            except KeyboardInterrupt:
-                print(f"\ninterrupted: {_kept(store)} kept in {store.path}; run the same command to resume", file=sys.stderr)
-                return EXIT_INTERRUPTED
+            except KeyboardInterrupt as interrupt:
+                what = "terminated (SIGTERM)" if isinstance(interrupt, Terminated) else "interrupted"
+                print(f"\n{what}: {_kept(store)}", file=sys.stderr)
+                return EXIT_TERMINATED if isinstance(interrupt, Terminated) else EXIT_INTERRUPTED
             except ClusterLost as error:
-                print(f"\nrun-study: {error}: {_kept(store)} kept in {store.path}; run the same command to resume", file=sys.stderr)
+                print(f"\nrun-study: {error}: {_kept(store)}", file=sys.stderr)
                 return EXIT_FAILURE
     except (OutputBusy, StoreOfAnotherScene) as error:
         print(f"run-study: error: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
+
+
+def _terminate(_signum: int, _frame: object) -> None:
+    raise Terminated()
 
 
 def _say(line: str) -> None:
@@ -148,10 +159,13 @@ def _say(line: str) -> None:
 
 
 def _kept(store: StudyStore) -> str:
-    """What an interrupted run keeps, in words (``12 finished blocks and 3 finished cases``)."""
+    """What an interrupted run keeps and how to go on, in words (``12 finished blocks and 3 finished cases kept in
+    ...; run the same command to resume``)."""
     blocks, cases = store.block_count(), store.case_count()
-    parts = [f"{n} finished {word}{'s' if n != 1 else ''}" for n, word in ((blocks, "block"), (cases, "case")) if n or (word == "case" and not blocks)]
-    return " and ".join(parts)
+    if not blocks and not cases:
+        return "nothing had finished yet; run the same command to start again"
+    parts = [f"{n} finished {word}{'s' if n != 1 else ''}" for n, word in ((blocks, "block"), (cases, "case")) if n]
+    return f"{' and '.join(parts)} kept in {store.path}; run the same command to resume"
 
 
 def _estimate(scene: Scene, jobs: int, costs_file: Path | None, workers: int | None = None) -> int:

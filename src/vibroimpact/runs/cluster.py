@@ -19,14 +19,16 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["SCHEDULER_VARIABLE", "ClusterLost", "SyncCancelRace", "Connection", "choose_scheduler", "connect", "unreachable", "dask_setup", "Progress", "ProgressReport", "Throttled", "ProgressBar", "REPORT_INTERVAL", "HEARTBEAT"]
+__all__ = ["SCHEDULER_VARIABLE", "ClusterLost", "SyncCancelRace", "Connection", "choose_scheduler", "connect", "Terminated", "unreachable", "dask_setup", "Progress", "ProgressReport", "Throttled", "ProgressBar", "REPORT_INTERVAL", "HEARTBEAT"]
 
 #: The environment variable naming a running scheduler (``tcp://host:8786``).
 SCHEDULER_VARIABLE = "VIBROIMPACT_SCHEDULER"
 #: Environment of a local cluster's worker processes, set before they start: dask's default but for its
 #: MALLOC_TRIM_THRESHOLD_ (glibc returning freed memory above 64 KiB to the system at once, 4 % more time for the
 #: exact engine's many small arrays, measured in one process), and one malloc arena (a worker computes in a thread).
-WORKER_ENVIRONMENT = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1, "MALLOC_ARENA_MAX": 1}
+#: ``VIBROIMPACT_WORKER`` makes a worker ignore Ctrl-C from its first import of the package (the parent's main module,
+#: which ``multiprocessing`` imports first in a spawned child): the study's process handles it.
+WORKER_ENVIRONMENT = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1, "MALLOC_ARENA_MAX": 1, "VIBROIMPACT_WORKER": 1}
 #: dask settings of a local cluster's workers: no statistical profiler (it samples the computing thread every 10 ms
 #: for a dashboard the study does not show; 36 blocks of the design map on 2 workers: 6.6 s with it, 6.1 s without,
 #: the mean of 3 interleaved runs each).
@@ -79,15 +81,35 @@ class Connection:
 
 
 def unreachable(scheduler: str, timeout: float = 10.0) -> str | None:
-    """Why the dask scheduler at ``scheduler`` cannot be reached (within ``timeout`` [s]), or None if it can."""
-    from distributed import Client
+    """Why the dask scheduler at ``scheduler`` cannot be reached (within ``timeout`` [s]), or None if it can.
 
-    try:
-        client = Client(scheduler, timeout=timeout, set_as_default=False)
-    except (OSError, TimeoutError, ValueError, TypeError) as error:
-        return str(error) or type(error).__name__
-    client.close()
-    return None
+    The handshake has a deadline of its own: a server that accepts the connection but is not a dask scheduler (its
+    dashboard's port, a web server) would otherwise keep the client waiting for an answer that never comes.
+    """
+    from distributed import Client
+    from distributed.comm.registry import backends
+
+    scheme = scheduler.split("://", 1)[0] if "://" in scheduler else "tcp"
+    if scheme not in backends:  # refused before a client exists (a client that never connected warns as it goes)
+        return f"unknown address scheme {scheme!r}: dask knows {', '.join(sorted(backends))} (e.g. tcp://host:8786)"
+    outcome: list[str | None] = []
+
+    def handshake() -> None:
+        logging.getLogger("distributed").setLevel(logging.CRITICAL)  # the one line below says what went wrong
+        try:
+            client = Client(scheduler, timeout=timeout, set_as_default=False)
+        except Exception as error:  # noqa: BLE001 - any failure of the handshake is an answer: not reachable
+            outcome.append(f"{type(error).__name__}: {error}" if str(error) else type(error).__name__)
+            return
+        client.close()
+        outcome.append(None)
+
+    thread = threading.Thread(target=handshake, name="vibroimpact-scheduler-check", daemon=True)
+    thread.start()
+    thread.join(timeout + 2.0)
+    if not outcome:  # the thread is left behind: the study stops here (exit 2)
+        return f"no dask scheduler answered within {timeout:.0f} s (a server that is not a dask scheduler, such as the dashboard's port?)"
+    return outcome[0]
 
 
 class SyncCancelRace(logging.Filter):
@@ -120,24 +142,11 @@ def connect(jobs: int, scheduler: str | None) -> Connection:
     ClusterLost
         When the named scheduler cannot be reached within :data:`CONNECT_TIMEOUT`.
     """
-    import dask.config
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     _drop_sync_cancel_race()
     if scheduler is None:
-        # Ctrl-C is the study's to handle: the worker processes ignore SIGINT from their start (an ignored signal
-        # stays ignored in a child process) and after a restart (the preload). A Ctrl-C in the ~1 s this takes is ignored
-        # too: blocking it instead does not reach the workers (a spawned child starts with every signal unblocked,
-        # and then prints tracebacks of its interrupted imports)
-        previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if threading.current_thread() is threading.main_thread() else None
-        try:
-            with dask.config.set(WORKER_CONFIG):  # the nannies hand it to the worker processes
-                cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL, preload=[__name__])
-        finally:
-            if previous is not None:
-                signal.signal(signal.SIGINT, previous)
-        client = Client(cluster, set_as_default=False)
-        return Connection(client, cluster, cluster.scheduler_address)
+        return _start_local_cluster(jobs)
     # a running cluster's comings and goings (a worker lost, a connection closed) are the scheduler's to log; the
     # study's process says what matters to it in one line
     logging.getLogger("distributed").setLevel(logging.WARNING)
@@ -146,6 +155,97 @@ def connect(jobs: int, scheduler: str | None) -> Connection:
     except (OSError, TimeoutError) as error:
         raise ClusterLost(f"cannot reach the dask scheduler at {scheduler}: {error}") from None
     return Connection(client, None, scheduler)
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (a batch system's end of time, ``timeout``, ``kill``): handled like Ctrl-C, finished work kept."""
+
+
+#: Longest wait for a local cluster's worker processes to be spawned (not started: spawning is a fork and exec) [s].
+SPAWN_TIMEOUT = 30.0
+
+
+def _start_local_cluster(jobs: int) -> Connection:
+    """A local cluster of ``jobs`` worker processes, Ctrl-C (and SIGTERM) honoured at every moment of its start.
+
+    A terminal's Ctrl-C goes to every process of its group. The workers ignore it from their first instant: they are
+    spawned while this process ignores SIGINT (an ignored signal stays ignored across ``exec``), which lasts only the
+    fork of each (milliseconds: a child is seen in ``/proc`` at once), then they ignore it on their own (the package's ``__init__`` with
+    ``VIBROIMPACT_WORKER``, then the preload). The rest of the start (the scheduler; the workers importing dask and
+    numba, 5-16 s under load) records a Ctrl-C, says so at once, stops waiting, closes the cluster and raises it.
+    """
+    import dask.config
+    from distributed import Client, LocalCluster
+
+    interrupted: list[int] = []
+
+    def record(signum: int, _frame: object) -> None:
+        if not interrupted:
+            print("\ninterrupted: stopping the workers as they start", file=sys.stderr, flush=True)
+        interrupted.append(signum)
+
+    def stop_if_interrupted(cluster: object | None, client: object | None) -> None:
+        if not interrupted:
+            return
+        for closing in (client, cluster):
+            if closing is not None:
+                closing.close(timeout=10)  # type: ignore[attr-defined]
+        raise Terminated() if interrupted[0] == signal.SIGTERM else KeyboardInterrupt()
+
+    main = threading.current_thread() is threading.main_thread()
+    previous = {signum: signal.signal(signum, record) for signum in (signal.SIGINT, signal.SIGTERM)} if main else {}
+    cluster = client = None
+    try:
+        with dask.config.set(WORKER_CONFIG):  # the nannies hand it to the worker processes as they are made
+            cluster = LocalCluster(n_workers=0, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL, preload=[__name__])
+            client = Client(cluster, set_as_default=False)
+            stop_if_interrupted(cluster, client)
+            before = _children()
+            if main:
+                signal.signal(signal.SIGINT, signal.SIG_IGN)  # only while the workers are forked
+            try:
+                cluster.scale(jobs)
+                deadline = time.monotonic() + SPAWN_TIMEOUT
+                while len(_children() - before) < jobs and time.monotonic() < deadline:
+                    time.sleep(0.005)
+            finally:
+                if main:
+                    signal.signal(signal.SIGINT, record)
+        while len(client.scheduler_info(n_workers=-1).get("workers", {})) < jobs and not interrupted:
+            if cluster.status.name in ("failed", "closed"):
+                raise RuntimeError(f"the local cluster's workers failed to start ({cluster.status.name})")
+            time.sleep(0.1)
+        stop_if_interrupted(cluster, client)
+    except Exception:
+        if interrupted:  # a worker hit by the interrupt before it could ignore it: the interrupt is what happened
+            raise Terminated() if interrupted[0] == signal.SIGTERM else KeyboardInterrupt() from None
+        raise
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+    return Connection(client, cluster, cluster.scheduler_address)
+
+
+def _children() -> set[int]:
+    """Process ids of this process's children: read from ``/proc`` at once (a child is listed from its fork, before
+    ``multiprocessing`` has finished handing it its start-up data); elsewhere the processes ``multiprocessing`` knows."""
+    import multiprocessing
+
+    me = str(os.getpid())
+    try:
+        entries = [entry for entry in os.listdir("/proc") if entry.isdigit()]
+    except OSError:
+        return {child.pid for child in multiprocessing.active_children() if child.pid is not None}
+    children = set()
+    for entry in entries:
+        try:
+            with open(f"/proc/{entry}/stat", "rb") as stat:
+                fields = stat.read().rsplit(b")", 1)[1].split()
+        except (OSError, IndexError):
+            continue  # ended meanwhile
+        if fields[1].decode() == me:
+            children.add(int(entry))
+    return children
 
 
 def dask_setup(worker: object) -> None:

@@ -1,0 +1,85 @@
+"""Interrupts honoured at every moment and bounded waits (issue 22, items 5-6): Ctrl-C while the local cluster starts
+stops the run (exit 130, one line, no traceback), SIGTERM ends it like Ctrl-C (exit 143, finished blocks kept, no
+leaked-semaphore noise), and an address that is not a dask scheduler is refused within seconds."""
+
+from __future__ import annotations
+
+import http.server
+import os
+import signal
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from tests.run_study_process import start_run_study, stored_blocks
+from tests.test_cli import _slow_scene
+from vibroimpact.runs.cluster import unreachable
+
+
+def _wait_for(run: object, stream_lines: list[str], text: str, deadline: float) -> None:
+    while not any(text in line for line in stream_lines) and run.poll() is None and time.monotonic() < deadline:  # type: ignore[attr-defined]
+        time.sleep(0.02)
+
+
+def _reader(stream: object, lines: list[str]) -> threading.Thread:
+    thread = threading.Thread(target=lambda: lines.extend(iter(stream.readline, "")), daemon=True)  # type: ignore[attr-defined]
+    thread.start()
+    return thread
+
+
+@pytest.mark.faults
+@pytest.mark.timeout(300)
+def test_ctrl_c_while_the_workers_start_stops_the_run_in_one_line(tmp_path: Path) -> None:
+    run = start_run_study([str(_slow_scene(tmp_path)), "--out", "out", "--jobs", "2"], tmp_path)
+    lines: list[str] = []
+    reader = _reader(run.stderr, lines)
+    _wait_for(run, lines, "starting 2 worker processes", time.monotonic() + 120.0)
+    assert run.poll() is None, "".join(lines)
+    time.sleep(0.5)  # the workers are being spawned and import the package
+    os.killpg(run.pid, signal.SIGINT)
+    run.wait(timeout=120)
+    reader.join(timeout=10)
+    run.stdout.close()  # type: ignore[union-attr]
+    run.stderr.close()  # type: ignore[union-attr]
+    err = "".join(lines)
+    assert run.returncode == 130, err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+    assert err.rstrip().splitlines()[-1] == "interrupted: nothing had finished yet; run the same command to start again"
+
+
+@pytest.mark.faults
+@pytest.mark.timeout(480)
+def test_sigterm_ends_the_run_like_ctrl_c_with_its_blocks_kept(tmp_path: Path) -> None:
+    run = start_run_study([str(_slow_scene(tmp_path)), "--out", "out", "--jobs", "2"], tmp_path)
+    store = tmp_path / "out" / "interrupted.zarr"
+    deadline = time.monotonic() + 180.0
+    while stored_blocks(store) == 0 and run.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert run.poll() is None, "the study ended before it could be terminated"
+    run.send_signal(signal.SIGTERM)  # to the study's process alone, as a batch system or `timeout` sends it
+    _out, err = run.communicate(timeout=120)
+    kept = stored_blocks(store)
+    assert run.returncode == 143, err
+    assert "Traceback" not in err and "leaked semaphore" not in err, err
+    assert err.rstrip().splitlines()[-1] == f"terminated (SIGTERM): {kept} finished block{'s' if kept != 1 else ''} kept in out/interrupted.zarr; run the same command to resume"
+    assert kept >= 1
+
+
+class _Silent(http.server.BaseHTTPRequestHandler):
+    def log_message(self, *_arguments: object) -> None:
+        pass
+
+
+def test_a_server_that_is_not_a_dask_scheduler_is_refused_within_seconds() -> None:
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), _Silent)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    try:
+        started = time.monotonic()
+        why = unreachable(f"tcp://127.0.0.1:{server.server_address[1]}", timeout=1.0)
+        assert why is not None and "no dask scheduler answered within 1 s" in why
+        assert time.monotonic() - started < 30.0  # the deadline is 3 s; generous for a loaded machine, never forever
+    finally:
+        server.shutdown()
+    assert unreachable("foo://bar") == "unknown address scheme 'foo': dask knows inproc, tcp, tls, ucx, ws, wss (e.g. tcp://host:8786)"
