@@ -21,8 +21,11 @@ __all__ = ["SceneError", "Checker", "interval"]
 class SceneError(ValueError):
     """A scene is invalid. ``problems`` lists every problem found, each naming its key."""
 
+    #: Longest problem kept whole [characters]: a value quoted in a message is cut beyond it.
+    MAX_PROBLEM = 400
+
     def __init__(self, problems: list[str], source: str = "scene") -> None:
-        self.problems = list(problems)
+        self.problems = [p if len(p) <= self.MAX_PROBLEM else f"{p[: self.MAX_PROBLEM]}... ({len(p)} characters)" for p in problems]
         super().__init__(f"invalid {source}:\n" + "\n".join(f"  - {p}" for p in self.problems))
 
 

@@ -37,11 +37,13 @@ class _UniqueKeyLoader(yaml.SafeLoader):
     def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
         seen: set[Any] = set()
         for key_node, _value_node in node.value:
+            if key_node.tag == "tag:yaml.org,2002:merge":  # `<<: *defaults`: merged below, its keys overridable
+                continue
             key = self.construct_object(key_node, deep=deep)
             if key in seen:
                 raise yaml.constructor.ConstructorError(None, None, f"key {key!r} is repeated", key_node.start_mark)
             seen.add(key)
-        return super().construct_mapping(node, deep=deep)
+        return super().construct_mapping(node, deep=deep)  # SafeConstructor's: flattens merge keys first
 
 
 # YAML 1.2 booleans: only true/false (YAML 1.1 also reads on/off/yes/no as booleans, so `on: x1` lost its key)
@@ -57,9 +59,57 @@ _UniqueKeyLoader.add_implicit_resolver(
 )
 
 
+#: Most nodes a scene may hold once its aliases are expanded (the largest shipped scene holds a few hundred): aliases
+#: that multiply (`a: [*b, *b, ...]` nested, "billion laughs") are refused before anything reads the values.
+MAX_EXPANDED_NODES = 100_000
+
+
 def read_yaml(text: str) -> Any:
-    """Parse YAML safely (no Python objects), rejecting repeated keys."""
-    return yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 - a SafeLoader subclass
+    """Parse YAML safely (no Python objects), rejecting repeated keys, aliases that expand beyond
+    :data:`MAX_EXPANDED_NODES` nodes, and numbers too long to read; the merge key ``<<`` works as in ``yaml.safe_load``.
+
+    Raises
+    ------
+    yaml.YAMLError
+        Naming the problem and, where it has one, its line.
+    """
+    loader = _UniqueKeyLoader(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        size = _expanded_size(node, {}, 0)
+        if size > MAX_EXPANDED_NODES:
+            raise yaml.YAMLError(f"its aliases expand to more than {MAX_EXPANDED_NODES} values (a scene needs a few hundred); refused before reading them")
+        try:
+            return loader.construct_document(node)
+        except ValueError as error:  # Python's limit on the digits of an integer (4300), as PyYAML lets it through
+            raise yaml.YAMLError(f"a number cannot be read: {str(error).split(';')[0]}") from None
+    finally:
+        loader.dispose()
+
+
+def _expanded_size(node: yaml.Node, sizes: dict[int, int], depth: int) -> int:
+    """Nodes under ``node`` with every alias expanded (shared nodes counted each time they are referred to)."""
+    known = sizes.get(id(node))
+    if known is not None:
+        return known
+    if depth > 100:  # deeper than any scene: as good as too large (and a recursive alias never ends)
+        return MAX_EXPANDED_NODES + 1
+    sizes[id(node)] = MAX_EXPANDED_NODES + 1  # a node met again while being counted: an alias of itself
+    total = 1
+    if isinstance(node, yaml.SequenceNode):
+        for child in node.value:
+            total += _expanded_size(child, sizes, depth + 1)
+            if total > MAX_EXPANDED_NODES:
+                break
+    elif isinstance(node, yaml.MappingNode):
+        for key, value in node.value:
+            total += _expanded_size(key, sizes, depth + 1) + _expanded_size(value, sizes, depth + 1)
+            if total > MAX_EXPANDED_NODES:
+                break
+    sizes[id(node)] = total
+    return total
 
 
 def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
@@ -116,6 +166,8 @@ def find_scene(name: str | Path) -> Path:
     given = Path(name)
     if given.is_dir():
         raise IsADirectoryError(f"scene {given} is a directory, not a YAML file")
+    if given.exists() and not given.is_file():  # a device (/dev/zero would be read for ever), a pipe, a socket
+        raise OSError(f"scene {given} is not a regular file (a device, pipe or socket); give a YAML file")
     candidates = [given]
     if not given.is_absolute():
         candidates.append(Path.cwd() / "studies" / given)
