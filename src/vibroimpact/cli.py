@@ -133,6 +133,8 @@ def main(argv: list[str] | None = None) -> int:
         signal.signal(signal.SIGTERM, _terminate)  # SIGTERM ends the run as Ctrl-C does
     try:
         with claim_output(out_dir):
+            for stale in out_dir.glob(".*.tmp"):  # a write cut off by a kill (runs.store.atomic_path): never a result
+                stale.unlink(missing_ok=True)
             # finished blocks and cases: a rerun of the same scene skips them
             store = StudyStore(out_dir / f"{scene.name}.zarr", store_fingerprint(scene.text), scene_path, _say)
             try:

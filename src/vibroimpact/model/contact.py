@@ -338,4 +338,4 @@ class Stop:
         target = names[self.coordinate] if self.other is None else f"{names[self.coordinate]} - {names[self.other]}"
         bound = self.clearance if self.side == "upper" else -self.clearance
         relation = "<=" if self.side == "upper" else ">="
-        return f"{target} {relation} {bound * 1e3:g} mm"
+        return f"{target} {relation} {bound * 1e3 + 0.0:g} mm"  # + 0.0: no "-0 mm"

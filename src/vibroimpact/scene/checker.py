@@ -46,6 +46,14 @@ class Checker:
         """Record the problem ``message`` of ``key``."""
         self.problems.append(f"{key}: {message}")
 
+    def fail_settings(self, section: str, error: Exception) -> None:
+        """Record the validation error of a settings dataclass (``"tolerance: expected ..."`` or ``"tolerance = -1 is
+        out of range ..."``) under ``section.<its key>``, the key said once."""
+        text = str(error)
+        head, _, rest = text.partition(" ")
+        key = head.rstrip(":")
+        self.fail(f"{section}.{key}", rest if head.endswith(":") and rest else text)
+
     def mapping(self, key: str, value: Any, allowed: set[str], required: frozenset[str] | set[str] = frozenset(), kind: str | None = None) -> dict:
         """``value`` as a mapping (``{}`` if it is none), reporting unknown and missing keys; ``kind`` names the kind of
         scene whose top level ``value`` is, so that a key it does not use is an error naming the kind (and the kind

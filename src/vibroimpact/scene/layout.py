@@ -130,7 +130,7 @@ def describe_stop(spec: StopSpec, names: tuple[str, ...], clearance: float | Non
     if delta is None or not np.isfinite(delta):
         bound = "Delta" if spec.side == "upper" else "-Delta"
     else:
-        bound = f"{(delta if spec.side == 'upper' else -delta) * 1e3:g} mm"
+        bound = f"{(delta if spec.side == 'upper' else -delta) * 1e3 + 0.0:g} mm"  # + 0.0: no "-0 mm"
     words = f"{target} {relation} {bound}"
     if r is not None and np.isfinite(r):
         words += f", R = {r:g}"

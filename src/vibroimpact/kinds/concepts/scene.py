@@ -225,7 +225,7 @@ def _simulation(c: Checker, value: Any, frequency: np.ndarray | None) -> tuple[n
         engine = EngineSettings(**engine_kwargs)
         steady = SteadySettings(**steady_kwargs)
     except (TypeError, ValueError) as error:
-        c.fail("simulation." + str(error).split(" ")[0], str(error))
+        c.fail_settings("simulation", error)
         return None
     return None if grid is None else (grid, engine, steady)
 

@@ -426,5 +426,5 @@ def _settings(c: Checker, kind: type[_T], kwargs: dict[str, Any]) -> _T | None:
     try:
         return kind(**kwargs)
     except (ValueError, TypeError) as error:
-        c.fail("simulation." + str(error).split(" ")[0], str(error))
+        c.fail_settings("simulation", error)
         return None
