@@ -22,7 +22,7 @@ import numpy as np
 
 from vibroimpact.scene import Scene, SceneError, find_scene, load_scene, shipped_studies
 from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, ClusterLost, choose_scheduler, unreachable
-from vibroimpact.runs.run import write_dataset, run_study
+from vibroimpact.runs.run import read_dataset, write_dataset, run_study
 from vibroimpact.runs.store import OutputBusy, StudyStore, claim_output, store_fingerprint
 
 EXIT_BAD_INPUT = 2
@@ -216,14 +216,15 @@ def _report(path: Path, out_dir: Path, jobs: int) -> Path | str:
     """Write the report of the dataset at ``path`` (read into memory), or say why not (too large to draw)."""
     import xarray as xr
 
-    with xr.open_dataset(path) as lazy:
-        size = lazy.nbytes
+    groups = xr.open_groups(path)
+    size = sum(group.nbytes for group in groups.values())
+    for group in groups.values():
+        group.close()
     if size > REPORT_MEMORY_LIMIT:
         return f"no report: the dataset holds {size / 1e9:.1f} GB, more than the {REPORT_MEMORY_LIMIT / 1e9:.0f} GB a report reads into memory (the data are in {path})"
     from vibroimpact.reporting.page import write_report  # matplotlib is imported only when a report is made
 
-    dataset = xr.load_dataset(path)
-    return write_report(dataset, out_dir, jobs=jobs)
+    return write_report(read_dataset(path), out_dir, jobs=jobs)  # the file's groups joined: the dataset the run gave
 
 
 def unwritable(out_dir: Path) -> str | None:
