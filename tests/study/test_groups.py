@@ -1,15 +1,18 @@
-"""A dataset splits into netCDF groups, the closed forms on every frequency and the simulated solutions on the
-frequencies they were simulated at (issue 21, item 7), and joins back."""
+"""The written file keeps each solution on the frequencies it was computed at: the closed forms in the root group on
+every frequency, the simulated solutions in the group ``simulated`` on the frequencies they were simulated at, so
+that the naive plot of a simulated solution draws its curve (issue 21, item 7)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import netCDF4
+import numpy as np
 import pytest
 import xarray as xr
+from matplotlib.figure import Figure
 
-from vibroimpact.runs.run import SIMULATED_GROUP, join_groups, read_dataset, run_study, split_groups, write_dataset
+from vibroimpact.runs.run import SIMULATED_GROUP, absent_value, join_groups, read_dataset, run_study, split_groups, write_dataset
 from vibroimpact.scene import load_scene
 
 from tests.golden.golden import SCENES
@@ -19,6 +22,36 @@ from tests.golden.golden import SCENES
 def relative_stop() -> xr.Dataset:
     """The golden relative-stop scene (2 s): linear and pgf on a 0.1 Hz grid, momentary and exact at 11 frequencies."""
     return run_study(load_scene(SCENES / "relative_stop.yaml"), progress=None)
+
+
+def drawn(data: xr.DataArray) -> tuple[np.ndarray, np.ndarray]:
+    """The x and y of the line ``data.plot()`` draws."""
+    (line,) = data.plot(ax=Figure().add_subplot())
+    return np.asarray(line.get_xdata(), dtype=float), np.asarray(line.get_ydata(), dtype=float)
+
+
+def test_the_naive_plot_of_a_simulated_solution_draws_its_curve(relative_stop: xr.Dataset, tmp_path: Path) -> None:
+    """In the group, ``x1_amplitude.sel(solution=engine).plot()`` draws a finite value at every simulated frequency;
+    the same plot of the one in-memory dataset draws isolated points between NaNs (the trap)."""
+    path = write_dataset(relative_stop, tmp_path / "relative_stop.nc")
+    simulation = np.atleast_1d(relative_stop.attrs["simulation_frequency_Hz"])
+    with xr.open_dataset(path, group=SIMULATED_GROUP) as simulated, xr.open_dataset(path) as root:
+        assert list(simulated["solution"].values) == ["momentary", "exact"] and list(root["solution"].values) == ["linear", "pgf"]
+        assert root.attrs["simulated_solutions_group"] == SIMULATED_GROUP and SIMULATED_GROUP in root.attrs["comment"]
+        for engine in ("momentary", "exact"):
+            x, y = drawn(simulated["x1_amplitude"].sel(solution=engine))
+            np.testing.assert_array_equal(x, simulation)
+            assert np.isfinite(y).all() and (y > 0.0).all(), engine
+        assert root["frequency"].size == relative_stop["frequency"].size > 10 * simulation.size
+        # no placeholder: every variable holds a value over its group's solutions, but the rotation number, a result
+        # of the simulations that is NaN wherever the motion is not quasi-periodic (nowhere here)
+        for group in (root, simulated):
+            empty = [str(name) for name, variable in group.data_vars.items() if not bool((variable.notnull() if variable.dtype.kind == "f" else variable != absent_value(variable)).any())]
+            assert empty == ([] if group is root else ["rotation_number"])
+        assert "converged" not in root and "lyapunov_exponent" not in root and "stable" not in simulated and "phase" not in simulated
+        assert simulated["x1_amplitude"].attrs == root["x1_amplitude"].attrs == relative_stop["x1_amplitude"].attrs
+    _, trap = drawn(relative_stop["x1_amplitude"].sel(solution="exact"))
+    assert np.isnan(trap).sum() > 10 * np.isfinite(trap).sum()
 
 
 @pytest.mark.parametrize("solutions", [None, ["exact"]], ids=["closed_forms_and_engines", "engine_only"])

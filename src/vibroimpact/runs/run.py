@@ -9,6 +9,16 @@ Output contract (read by other tools; keep these names): dimensions ``solution``
 ``running_<quantity>`` (sweep, elapsed_time); the steady-state solutions are not repeated along ``sweep``. Benchmark
 scenes have dimensions (case, engine, rtol). Every dataset names its kind in the attribute ``study_kind``.
 
+In the file (:func:`write_dataset`) each solution lives on the frequencies it was computed at: the root group holds
+the solutions computed on every frequency (the closed forms), and a study that simulates puts its simulated solutions
+(the time-domain engines, ``solution`` = ``exact``, ``momentary``, ...) in the group ``simulated``, on its own
+``frequency`` coordinate (the scene's ``simulation.frequency``), with the same variable names, dimensions, other
+coordinates and attributes. A variable that holds no value over a group's solutions is not in that group (``converged``
+and ``lyapunov_*`` are only in ``simulated``, ``stable`` and ``phase`` only in the root). The root says where the
+simulations are: attribute ``simulated_solutions_group`` and its ``comment``. Read both with ``xarray.open_groups``
+(``xarray.open_datatree`` refuses a child whose ``frequency`` differs from its parent's); :func:`read_dataset` joins
+them into the one dataset :func:`run_study` returns (every solution on every frequency, NaN or ``not_applicable``
+where it was not computed), :func:`split_groups` splits that one.
 """
 
 from __future__ import annotations
@@ -119,7 +129,9 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
     -------
     xarray.Dataset
         Dimensions ``solution``, the swept parameters (``sweep`` for swept-sine tests) and ``frequency``; benchmark
-        scenes: ``case``, ``engine``, ``rtol``.
+        scenes: ``case``, ``engine``, ``rtol``. Every solution is on every frequency: a simulated one is NaN (flags
+        ``not_applicable``) where it was not simulated, so plot it from :func:`split_groups`'s ``"/simulated"``
+        (its own frequencies), as the file written by :func:`write_dataset` holds it.
 
     Raises
     ------
@@ -323,10 +335,12 @@ def _netcdf_encoding(dataset: xr.Dataset) -> tuple[xr.Dataset, dict[str, dict[st
 def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
     """Write ``dataset`` to netCDF atomically: a temporary file in the same folder, then a rename.
 
-    A reader never sees a half-written file, and an interrupted run leaves the previous file intact.
+    The simulated solutions go to the group ``simulated``, on the frequencies they were simulated at
+    (:func:`split_groups`); :func:`read_dataset` reads the file back as ``dataset``. A reader never sees a
+    half-written file, and an interrupted run leaves the previous file intact.
     """
     path = Path(path)
-    groups = {"/": dataset}
+    groups = split_groups(dataset)
     with atomic_path(path) as temporary:
         for key, part in groups.items():
             part, encoding = _netcdf_encoding(part)
