@@ -65,6 +65,9 @@ _PUBLIC = {
     "find_scene": "vibroimpact.scene",
     "run_study": "vibroimpact.runs.run",
     "write_dataset": "vibroimpact.runs.run",
+    "read_dataset": "vibroimpact.runs.run",
+    "split_groups": "vibroimpact.runs.run",
+    "join_groups": "vibroimpact.runs.run",
     "write_report": "vibroimpact.reporting.page",
 }
 

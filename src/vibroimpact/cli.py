@@ -25,7 +25,7 @@ import numpy as np
 from vibroimpact.scene import Scene, SceneError, find_scene, load_scene, shipped_studies
 from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, ClusterLost, Terminated, choose_scheduler, unreachable
 from vibroimpact.runs.failures import console_line, run_failures
-from vibroimpact.runs.run import write_dataset, run_study
+from vibroimpact.runs.run import read_dataset, write_dataset, run_study
 from vibroimpact.runs.store import OutputBusy, StoreOfAnotherScene, StudyStore, claim_output, store_fingerprint
 
 EXIT_BAD_INPUT = 2
@@ -239,15 +239,17 @@ def _report(path: Path, out_dir: Path, jobs: int) -> Path | str:
     """Write the report of the dataset at ``path`` (read into memory), or say why not (too large to draw)."""
     import xarray as xr
 
-    with xr.open_dataset(path) as lazy:
-        size = lazy.nbytes
+    groups = xr.open_groups(path)
+    size = sum(group.nbytes for group in groups.values())
+    for group in groups.values():
+        group.close()
     if size > REPORT_MEMORY_LIMIT:
         return f"no report: the dataset holds {size / 1e9:.1f} GB, more than the {REPORT_MEMORY_LIMIT / 1e9:.0f} GB a report reads into memory (the data are in {path})"
     from vibroimpact.reporting.page import write_report  # matplotlib is imported only when a report is made
 
     from vibroimpact.runs.cluster import ProgressBar
 
-    dataset = xr.load_dataset(path)
+    dataset = read_dataset(path)  # the file's groups joined: the dataset the run gave
     bar = ProgressBar([1.0], [], "page", enabled=True, verb="report", status="drawing the figures")  # its heartbeat
     try:
         return write_report(dataset, out_dir, jobs=jobs)

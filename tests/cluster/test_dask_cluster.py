@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from vibroimpact.runs.run import read_dataset
 from vibroimpact.scene import load_scene
 from vibroimpact.kinds.stepped.blocks import BlockPlan, plan_blocks
 
@@ -51,7 +52,7 @@ def reference(tmp_path_factory: pytest.TempPathFactory) -> Reference:
     assert completed.returncode == 0, completed.stderr
     plan = plan_blocks(load_scene(scene), 1)
     assert 8 <= plan.count <= 20, plan  # enough blocks to interrupt between two, few enough to stay quick
-    return Reference(scene, xr.load_dataset(folder / "ref" / f"{SCENE_NAME}.nc"), plan)
+    return Reference(scene, read_dataset(folder / "ref" / f"{SCENE_NAME}.nc"), plan)
 
 
 def study_scene(folder: Path, reference: Reference) -> Path:
@@ -66,7 +67,7 @@ def study_scene(folder: Path, reference: Reference) -> Path:
 def assert_same_results(path: Path, reference: Reference) -> xr.Dataset:
     """The dataset at ``path`` has the serial run's coordinates and variables with the same values (NaN where it has
     NaN), except the measured ones; returns it."""
-    dataset = xr.load_dataset(path)
+    dataset = read_dataset(path)  # the groups joined: the simulations on every frequency, as the serial run
     expected = reference.dataset
     assert set(dataset.variables) == set(expected.variables)
     for name in sorted(set(expected.variables) - MEASURED):

@@ -10,7 +10,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from tests.golden.golden import DATA, compute, dtypes, read_back, scene_names, written
+from tests.golden.golden import DATA, compute, identical, read_back, scene_names, written
 from vibroimpact.runs.run import write_dataset
 
 
@@ -20,8 +20,7 @@ def bless(name: str) -> None:
     with tempfile.TemporaryDirectory() as folder:
         dataset, text = compute(name, Path(folder))
         target = DATA / f"{name}.nc"
-        now = written(dataset, Path(folder))
-        same = target.exists() and now.identical(blessed := read_back(target)) and dtypes(now) == dtypes(blessed)
+        same = target.exists() and identical(written(dataset, Path(folder)), read_back(target))
     if not same:
         write_dataset(dataset, target)
     page = DATA / f"{name}.txt"

@@ -1,13 +1,15 @@
 """The golden suite in tolerance mode, for a change that alters numbers on purpose:
 ``python -m tests.golden.compare [NAME ...] [--out FILE]``.
 
-Each golden scene is run again and compared with its blessed dataset:
+Each golden scene is run again and compared with its blessed dataset (its file's groups joined, every solution on
+every frequency: :func:`vibroimpact.runs.run.join_groups`):
 
 * **settled points** (the points whose regime, blessed and now, is neither irregular, quasi-periodic, chaotic nor
   failed, or whose simulation converged, by :data:`MARKERS`; every point where nothing says): every float variable to :data:`TOLERANCE` relative to the
   variable's largest magnitude, every integer variable (flags, counts) equal;
 * **unsettled points** (not periodic, blessed or now: chaotic sets re-rolled by round-off): by class, count and
   statistics (the count of each regime and the median |X1| over them), reported, not held to a tolerance;
+* the layout: the groups of the file and the variables that appeared in or vanished from each (a move, values equal);
 * the page's text: the lines that changed.
 
 It prints, and writes to ``--out`` (Markdown), the largest difference of every variable and every point whose regime
@@ -27,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from tests.golden.golden import compute, scene_names, stored, written
+from tests.golden.golden import Groups, compute, joined, scene_names, stored, written
 
 #: Relative tolerance of settled points (relative to the variable's largest magnitude in the blessed dataset).
 TOLERANCE = 1e-10
@@ -131,13 +133,28 @@ def compare_datasets(name: str, now: xr.Dataset, blessed: xr.Dataset) -> SceneCh
     return changes
 
 
+def layout_changes(now: Groups, blessed: Groups) -> list[str]:
+    """The groups and the variables of each group that appeared or vanished (values may be the same: a move)."""
+    found = []
+    for key in sorted(set(now) | set(blessed)):
+        if key not in now or key not in blessed:
+            found.append(f"group `{key}` {'vanished' if key not in now else 'appeared'}{f' ({len(now[key].data_vars)} variables)' if key in now else ''}")
+            continue
+        for change, names in (("vanished from", set(blessed[key].data_vars) - set(now[key].data_vars)), ("appeared in", set(now[key].data_vars) - set(blessed[key].data_vars))):
+            if names:
+                found.append(f"{', '.join(f'`{n}`' for n in sorted(map(str, names)))} {change} group `{key}`")
+    return found
+
+
 def compare_scene(name: str) -> SceneChanges:
-    """Run the golden scene ``name`` and compare it with its blessed files."""
+    """Run the golden scene ``name`` and compare it with its blessed files: the values of the joined groups (every
+    solution on every frequency), then the layout (which group holds which variable)."""
     with tempfile.TemporaryDirectory() as folder:
         dataset, text = compute(name, Path(folder))
         now = written(dataset, Path(folder))
     blessed, blessed_text = stored(name)
-    changes = compare_datasets(name, now, blessed)
+    changes = compare_datasets(name, joined(now), joined(blessed))
+    changes.structure += layout_changes(now, blessed)
     if text != blessed_text:
         changes.page = [line.rstrip("\n") for line in difflib.unified_diff((blessed_text or "").splitlines(True), (text or "").splitlines(True), "blessed", "now", n=0) if line[:1] in "+-" and line[:3] not in ("+++", "---")]
     return changes

@@ -135,25 +135,48 @@ def compute(name: str, workdir: Path) -> tuple[xr.Dataset, str | None]:
     return machine_free(dataset), text
 
 
-def read_back(path: Path) -> xr.Dataset:
-    """The dataset written at ``path``, loaded, without what the writer adds of the machine (``history``)."""
-    with xr.open_dataset(path) as dataset:
-        return machine_free(dataset.load())
+#: A dataset as its file holds it: netCDF group path -> that group's dataset (``"/"``; ``"/simulated"`` where the
+#: study simulates, :func:`vibroimpact.runs.run.split_groups`).
+Groups = dict[str, xr.Dataset]
 
 
-def written(dataset: xr.Dataset, folder: Path) -> xr.Dataset:
+def read_back(path: Path) -> Groups:
+    """Every group of the dataset written at ``path``, loaded, without what the writer adds of the machine
+    (``history``)."""
+    groups = xr.open_groups(path)
+    try:
+        return {key: machine_free(group.load()) for key, group in groups.items()}
+    finally:
+        for group in groups.values():
+            group.close()
+
+
+def written(dataset: xr.Dataset, folder: Path) -> Groups:
     """``dataset`` as the package's writer stores it and a reader reads it back (what the blessed file holds)."""
     from vibroimpact.runs.run import write_dataset
 
     return read_back(write_dataset(dataset, folder / "golden.nc"))
 
 
-def dtypes(dataset: xr.Dataset) -> dict[str, str]:
-    """The stored type of every variable (``xarray.testing.assert_identical`` compares values, so int32 equals int64)."""
-    return {str(name): str(variable.dtype) for name, variable in dataset.variables.items()}
+def dtypes(groups: Groups) -> dict[str, str]:
+    """The stored type of every variable of every group (``xarray.testing.assert_identical`` compares values, so
+    int32 equals int64)."""
+    return {f"{key}:{name}": str(variable.dtype) for key, group in groups.items() for name, variable in group.variables.items()}
 
 
-def stored(name: str) -> tuple[xr.Dataset, str | None]:
-    """The blessed dataset and page text of ``name``."""
+def identical(now: Groups, blessed: Groups) -> bool:
+    """The same groups, each identical (values, attributes), with the same types."""
+    return now.keys() == blessed.keys() and all(now[key].identical(blessed[key]) for key in now) and dtypes(now) == dtypes(blessed)
+
+
+def joined(groups: Groups) -> xr.Dataset:
+    """The one dataset of ``groups`` (:func:`vibroimpact.runs.run.join_groups`): every solution on every frequency."""
+    from vibroimpact.runs.run import join_groups
+
+    return join_groups(groups)
+
+
+def stored(name: str) -> tuple[Groups, str | None]:
+    """The blessed dataset's groups and page text of ``name``."""
     page = DATA / f"{name}.txt"
     return read_back(DATA / f"{name}.nc"), page.read_text(encoding="utf-8") if page.exists() else None

@@ -8,6 +8,7 @@ import re
 from pathlib import Path
 from typing import Any
 
+import netCDF4
 import numpy as np
 import pytest
 import xarray as xr
@@ -28,7 +29,39 @@ ERRORS_AND_WARNINGS = ("high_priorities", "medium_priorities")
 
 
 def cf_findings(path: Path, report: Path) -> list[str]:
-    """Every error and warning of ``compliance-checker --test=cf:1.8`` on ``path``, one line each."""
+    """Every error and warning of ``compliance-checker --test=cf:1.8`` on ``path``, one line each, and on each of
+    its netCDF groups (the checker checks where attributes sit in groups, but the variables of the root group only:
+    each group is checked as a flat copy, :func:`flattened`)."""
+    findings = checked(path, report)
+    with netCDF4.Dataset(path) as source:
+        groups = list(source.groups)
+    for group in groups:
+        flat = flattened(path, group, report.with_name(f"{report.stem}_{group}.nc"))
+        findings += [f"group {group}: {finding}" for finding in checked(flat, report)]
+    return findings
+
+
+def flattened(path: Path, group: str, target: Path) -> Path:
+    """The group ``group`` of the file at ``path`` copied to a file of its own at ``target``, as stored (types, fill
+    values, attributes; no compression), under the root's attributes (the group's own override them)."""
+    with netCDF4.Dataset(path) as source, netCDF4.Dataset(target, "w") as flat:
+        part = source.groups[group]
+        flat.setncatts({**source.__dict__, **part.__dict__})
+        for name, variable in part.variables.items():
+            for dimension in variable.get_dims():
+                if dimension.name not in flat.dimensions:
+                    flat.createDimension(dimension.name, len(dimension))
+            attrs = dict(variable.__dict__)
+            copy = flat.createVariable(name, variable.datatype, variable.dimensions, fill_value=attrs.pop("_FillValue", None))
+            copy.setncatts(attrs)
+            variable.set_auto_maskandscale(False)
+            copy.set_auto_maskandscale(False)
+            copy[...] = variable[...]
+    return target
+
+
+def checked(path: Path, report: Path) -> list[str]:
+    """Every error and warning of ``compliance-checker --test=cf:1.8`` on the file at ``path``, one line each."""
     CheckSuite.load_all_available_checkers()
     ComplianceChecker.run_checker(str(path), ["cf:1.8"], 0, "normal", output_filename=str(report), output_format="json")
     result = json.loads(report.read_text())["cf:1.8"]
@@ -54,15 +87,18 @@ TEXT_BY_CF = ("units",)
 
 
 def numbers_as_text(path: Path) -> list[str]:
-    """Every attribute of the file at ``path`` (the dataset's and its variables') whose value is text that reads as a
+    """Every attribute of the file at ``path`` (its groups' and their variables') whose value is text that reads as a
     number or an array of numbers: a number written as its repr."""
     found = []
-    with xr.open_dataset(path) as dataset:
-        owners = [("dataset", dataset.attrs)] + [(str(name), variable.attrs) for name, variable in dataset.variables.items()]
+    groups = xr.open_groups(path)
+    for group, dataset in groups.items():
+        where = "" if group == "/" else f"{group}:"
+        owners = [(f"{where}dataset", dataset.attrs)] + [(f"{where}{name}", variable.attrs) for name, variable in dataset.variables.items()]
         for owner, attrs in owners:
             for key, value in attrs.items():
                 if isinstance(value, str) and key not in TEXT_BY_CF and NUMBER_TEXT.match(value):
                     found.append(f"{owner}.{key} = {value!r}")
+        dataset.close()
     return found
 
 
@@ -206,7 +242,8 @@ def test_the_text_check_finds_a_number_written_as_text(tmp_path: Path) -> None:
 
 
 def test_the_check_finds_what_it_should(tmp_path: Path) -> None:
-    """The check is not blind: a coordinate with a _FillValue and a file without history are reported."""
+    """The check is not blind: a coordinate with a _FillValue and a file without history are reported, and so are a
+    group's coordinate with a _FillValue and its variable's units unknown to UDUNITS."""
     import xarray as xr
 
     dataset = xr.Dataset({"x": ("frequency", [1.0, 2.0], {"units": "m", "long_name": "x"})}, coords={"frequency": ("frequency", [1.0, 2.0], {"units": "Hz", "long_name": "f"})}, attrs={"Conventions": "CF-1.8", "title": "t"})
@@ -214,3 +251,11 @@ def test_the_check_finds_what_it_should(tmp_path: Path) -> None:
     dataset.to_netcdf(path)  # xarray's default: _FillValue on every float variable, no history
     findings = " ".join(cf_findings(path, tmp_path / "cf.json"))
     assert "_FillValue" in findings and "history" in findings
+    dataset.attrs["history"] = "written"
+    dataset.to_netcdf(path, encoding={"frequency": {"_FillValue": None}})
+    assert cf_findings(path, tmp_path / "cf.json") == []
+    group = xr.Dataset({"y": ("frequency", [1.0], {"units": "dB", "long_name": "y"})}, coords={"frequency": ("frequency", [1.5], {"units": "Hz", "long_name": "f"})})
+    group.to_netcdf(path, mode="a", group="simulated")  # a group's variables: the checker alone does not see them
+    findings = cf_findings(path, tmp_path / "cf.json")
+    assert all(finding.startswith("group simulated: ") for finding in findings)
+    assert "_FillValue" in " ".join(findings) and "dB" in " ".join(findings)

@@ -9,11 +9,11 @@ from typing import Any
 
 import numpy as np
 import pytest
-import xarray as xr
 import yaml
 
 from vibroimpact import cli
 from vibroimpact.analysis.stability import Regime
+from vibroimpact.runs.run import read_dataset
 from vibroimpact.scene import load_scene, shipped_studies_dir
 
 SCENE: dict[str, Any] = {
@@ -41,17 +41,17 @@ def test_relative_stop_scene_end_to_end(tmp_path: Path, capsys: pytest.CaptureFi
     symmetric orbit where it is stable (22.5 Hz: both impulses, two impacts per period, to 1e-6; measured 2e-8)."""
     out = tmp_path / "out"
     assert cli.main([str(write(tmp_path / "scene.yaml", copy.deepcopy(SCENE))), "--out", str(out), "--jobs", "1"]) == 0
-    with xr.open_dataset(out / "relative_cli.nc") as dataset:
-        assert dataset["impulse"].dims == ("solution", "stop", "frequency")
-        assert list(dataset["stop_description"].values) == ["x2 - x1 <= 3 mm, R = 0.2", "x2 - x1 >= -3 mm, R = 0.2"]
-        at = dataset.sel(frequency=22.5)
-        pgf, simulated = at.sel(solution="pgf"), at.sel(solution="momentary")
-        assert int(pgf["regime"]) == Regime.ONE_IMPACT and int(pgf["stable"]) == 1
-        assert float(simulated["impacts_per_period"]) == pytest.approx(2.0, abs=0)
-        assert int(simulated["regime"]) == Regime.ONE_IMPACT  # on a two-sided stop: one impact per period on each side
-        np.testing.assert_allclose(simulated["impulse"].values, pgf["impulse"].values, rtol=1e-6)
-        np.testing.assert_allclose(simulated["x1_amplitude"].values, pgf["x1_amplitude"].values, rtol=1e-6)
-        assert int(dataset["regime"].sel(solution="momentary", frequency=30.0)) == Regime.LINEAR
+    dataset = read_dataset(out / "relative_cli.nc")  # the file's groups joined: every solution on every frequency
+    assert dataset["impulse"].dims == ("solution", "stop", "frequency")
+    assert list(dataset["stop_description"].values) == ["x2 - x1 <= 3 mm, R = 0.2", "x2 - x1 >= -3 mm, R = 0.2"]
+    at = dataset.sel(frequency=22.5)
+    pgf, simulated = at.sel(solution="pgf"), at.sel(solution="momentary")
+    assert int(pgf["regime"]) == Regime.ONE_IMPACT and int(pgf["stable"]) == 1
+    assert float(simulated["impacts_per_period"]) == pytest.approx(2.0, abs=0)
+    assert int(simulated["regime"]) == Regime.ONE_IMPACT  # on a two-sided stop: one impact per period on each side
+    np.testing.assert_allclose(simulated["impulse"].values, pgf["impulse"].values, rtol=1e-6)
+    np.testing.assert_allclose(simulated["x1_amplitude"].values, pgf["x1_amplitude"].values, rtol=1e-6)
+    assert int(dataset["regime"].sel(solution="momentary", frequency=30.0)) == Regime.LINEAR
     assert "wrote" in capsys.readouterr().out
 
 

@@ -8,6 +8,17 @@ Output contract (read by other tools; keep these names): dimensions ``solution``
 ``sweep``: the swept runs' estimates are ``swept_<quantity>`` (sweep, frequency) and their running estimates
 ``running_<quantity>`` (sweep, elapsed_time); the steady-state solutions are not repeated along ``sweep``. Benchmark
 scenes have dimensions (case, engine, rtol). Every dataset names its kind in the attribute ``study_kind``.
+
+In the file (:func:`write_dataset`) each solution lives on the frequencies it was computed at: the root group holds
+the solutions computed on every frequency (the closed forms), and a study that simulates puts its simulated solutions
+(the time-domain engines, ``solution`` = ``exact``, ``momentary``, ...) in the group ``simulated``, on its own
+``frequency`` coordinate (the scene's ``simulation.frequency``), with the same variable names, dimensions, other
+coordinates and attributes. A variable that holds no value over a group's solutions is not in that group (``converged``
+and ``lyapunov_*`` are only in ``simulated``, ``stable`` and ``phase`` only in the root). The root says where the
+simulations are: attribute ``simulated_solutions_group`` and its ``comment``. Read both with ``xarray.open_groups``
+(``xarray.open_datatree`` refuses a child whose ``frequency`` differs from its parent's); :func:`read_dataset` joins
+them into the one dataset :func:`run_study` returns (every solution on every frequency, NaN or ``not_applicable``
+where it was not computed), :func:`split_groups` splits that one.
 """
 
 from __future__ import annotations
@@ -15,9 +26,10 @@ from __future__ import annotations
 import sys
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any, Mapping, Protocol
 
 import numpy as np
+import pandas as pd
 import xarray as xr
 
 from vibroimpact import __version__
@@ -26,9 +38,9 @@ from vibroimpact.runs.runner import Runner
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.store import StudyStore, atomic_path, source_hash
 from vibroimpact.scene.kinds import kind_named
-from vibroimpact.scene.schema import Scene
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS, Scene
 
-__all__ = ["StudyKind", "study_kind", "run_study", "prepare_compiled_core", "atomic_path", "write_dataset", "netcdf_attribute", "provenance"]
+__all__ = ["StudyKind", "study_kind", "run_study", "prepare_compiled_core", "atomic_path", "write_dataset", "read_dataset", "split_groups", "join_groups", "absent_value", "SIMULATED_GROUP", "netcdf_attribute", "provenance"]
 
 class StudyKind(Protocol):
     """What a kind of study does with a scene (each kind's ``study.py``, registered in :data:`vibroimpact.scene.kinds.KINDS`)."""
@@ -117,7 +129,9 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
     -------
     xarray.Dataset
         Dimensions ``solution``, the swept parameters (``sweep`` for swept-sine tests) and ``frequency``; benchmark
-        scenes: ``case``, ``engine``, ``rtol``.
+        scenes: ``case``, ``engine``, ``rtol``. Every solution is on every frequency: a simulated one is NaN (flags
+        ``not_applicable``) where it was not simulated, so plot it from :func:`split_groups`'s ``"/simulated"``
+        (its own frequencies), as the file written by :func:`write_dataset` holds it.
 
     Raises
     ------
@@ -176,22 +190,162 @@ def netcdf_attributes(attrs: dict[Any, Any], where: str) -> dict[Any, Any]:
     return {key: netcdf_attribute(value, f"{where}, {key}") for key, value in attrs.items()}
 
 
-def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
-    """Write ``dataset`` to netCDF atomically: a temporary file in the same folder, then a rename.
+#: The netCDF group of a dataset's simulated solutions (:func:`split_groups`).
+SIMULATED_GROUP = "simulated"
+#: What the root group of a file with simulated solutions says of them (its ``comment``, and the attribute
+#: ``simulated_solutions_group``).
+SIMULATED_COMMENT = (
+    f"The simulated solutions (time-domain engines) are in the netCDF group '{SIMULATED_GROUP}', on their own frequency "
+    "axis (the frequencies they were simulated at), with the same variable names; this group holds the solutions "
+    "computed on every frequency."
+)
+#: Flag meanings that say a variable does not apply at a point (the value a solution that does not compute it holds).
+ABSENT_FLAGS = ("not_applicable", "not_computed")
 
-    A reader never sees a half-written file, and an interrupted run leaves the previous file intact.
+
+def absent_value(variable: xr.DataArray | xr.Variable) -> object:
+    """The value ``variable`` holds where it does not apply: NaN for a float variable, the flag meaning
+    ``not_applicable`` or ``not_computed`` (:data:`ABSENT_FLAGS`) for a CF flag variable.
+
+    Raises
+    ------
+    ValueError
+        For any other variable (no value says "nothing here").
     """
-    path = Path(path)
+    if variable.dtype.kind in "fc":
+        return np.nan
+    meanings = str(variable.attrs.get("flag_meanings", "")).split()
+    values = np.atleast_1d(variable.attrs.get("flag_values", []))
+    for meaning, value in zip(meanings, values):
+        if meaning in ABSENT_FLAGS:
+            return value
+    raise ValueError(f"no value of {variable.dtype} variable {getattr(variable, 'name', '')!r} says that it does not apply (a float, or CF flags meaning one of {ABSENT_FLAGS})")
+
+
+def _present(variable: xr.DataArray) -> xr.DataArray:
+    """Where ``variable`` holds a value (not :func:`absent_value`)."""
+    absent = absent_value(variable)
+    return variable.notnull() if isinstance(absent, float) and np.isnan(absent) else variable != absent
+
+
+def _simulated(dataset: xr.Dataset) -> tuple[list[str], np.ndarray]:
+    """The dataset's simulated solutions (the time-domain engines among its ``solution``) and the mask of the
+    frequencies they were simulated at (the attribute ``simulation_frequency_Hz``; without it, wherever one holds a
+    value)."""
+    if "solution" not in dataset.dims or "frequency" not in dataset.dims:
+        return [], np.zeros(0, dtype=bool)
+    simulated = [str(name) for name in dataset["solution"].values if name in ENGINE_SOLUTIONS]
+    if not simulated:
+        return [], np.zeros(0, dtype=bool)
+    if "simulation_frequency_Hz" in dataset.attrs:
+        return simulated, np.isin(dataset["frequency"].values, np.atleast_1d(dataset.attrs["simulation_frequency_Hz"]))
+    mask = np.zeros(dataset.sizes["frequency"], dtype=bool)
+    for variable in dataset.sel(solution=simulated).data_vars.values():
+        if {"solution", "frequency"} <= set(variable.dims):
+            mask |= np.asarray(_present(variable).any([d for d in variable.dims if d != "frequency"]).values)
+    return simulated, mask
+
+
+def split_groups(dataset: xr.Dataset) -> dict[str, xr.Dataset]:
+    """``dataset`` as :func:`write_dataset` stores it: netCDF group path -> dataset (what ``xarray.open_groups`` reads).
+
+    A dataset without a simulated solution is one group, ``"/"``, as it is. Otherwise the solutions computed on every
+    frequency (the closed forms) stay in ``"/"``, and the simulated ones (the time-domain engines) go to
+    ``"/simulated"`` (:data:`SIMULATED_GROUP`) on their own ``frequency`` coordinate, the frequencies they were
+    simulated at, with the same variable names, dimension names, other coordinates and attributes: there
+    ``x1_amplitude.sel(solution="exact").plot()`` draws a curve, not isolated points between NaNs. A variable that
+    holds no value over one group's solutions (all NaN, or all ``not_applicable``: ``converged`` or ``lyapunov_*`` for
+    the closed forms, ``stable`` or ``phase`` for the engines) is left out of that group; one with no value in either
+    goes with the simulations. The root's attributes say where the simulations are (``simulated_solutions_group`` and
+    a sentence in ``comment``). :func:`join_groups` gives ``dataset`` back.
+    """
+    simulated, on_axis = _simulated(dataset)
+    if not simulated:
+        return {"/": dataset}
+    closed = [str(name) for name in dataset["solution"].values if name not in simulated]
+    per_solution = [name for name, variable in dataset.data_vars.items() if "solution" in variable.dims]
+    root = dataset.sel(solution=closed)
+    group = dataset.sel(solution=simulated).isel(frequency=np.flatnonzero(on_axis))
+    in_root = [name for name in per_solution if closed and bool(_present(root[name]).any())]
+    in_group = [name for name in per_solution if name not in in_root or bool(_present(group[name]).any())]
+    root = root.drop_vars([name for name in per_solution if name not in in_root])
+    if not closed:
+        root = root.drop_dims("solution")
+    comment = str(dataset.attrs.get("comment", ""))
+    root.attrs = {**dataset.attrs, "simulated_solutions_group": SIMULATED_GROUP, "comment": f"{comment} {SIMULATED_COMMENT}".strip()}
+    group = group[in_group]
+    group.attrs = {"comment": "The simulated solutions of the root group's study, at the frequencies they were simulated at (the root's simulation_frequency_Hz)."}
+    return {"/": root, f"/{SIMULATED_GROUP}": group}
+
+
+def join_groups(groups: Mapping[str, xr.Dataset]) -> xr.Dataset:
+    """The one dataset of :func:`split_groups`'s groups (or of ``xarray.open_groups`` on a file :func:`write_dataset`
+    wrote): every solution on the root's frequency axis, the simulated ones ``not_applicable`` or NaN at the
+    frequencies they were not simulated at, a variable left out of a group ``not_applicable`` or NaN for its
+    solutions. The root's solutions come first."""
+    root = groups["/"]
+    group = groups.get(f"/{SIMULATED_GROUP}")
+    if group is None:
+        return root
+    parts = [part for part in (root, group) if "solution" in part.dims]
+    solutions = np.concatenate([part["solution"].values for part in parts])
+    order, frequency = pd.Index(solutions), root.indexes["frequency"]
+    names = list(dict.fromkeys(name for part in parts for name, variable in part.data_vars.items() if "solution" in variable.dims))
+    joined = root.drop_dims("solution") if "solution" in root.dims else root.copy()
+    for name in names:
+        template = next(part[name] for part in parts if name in part)
+        shape = tuple(solutions.size if dim == "solution" else frequency.size if dim == "frequency" else template.sizes[dim] for dim in template.dims)
+        values = np.full(shape, absent_value(template), dtype=template.dtype)
+        for part in parts:
+            if name in part:
+                where = [order.get_indexer(part.indexes["solution"]) if dim == "solution" else frequency.get_indexer(part.indexes["frequency"]) if dim == "frequency" else np.arange(template.sizes[dim]) for dim in template.dims]
+                values[np.ix_(*where)] = part[name].transpose(*template.dims).values
+        joined[name] = xr.Variable(template.dims, values, template.attrs)
+    joined = joined.assign_coords(solution=("solution", solutions, (root if "solution" in root.dims else group)["solution"].attrs))
+    attrs = dict(root.attrs)
+    attrs.pop("simulated_solutions_group", None)
+    comment = str(attrs.pop("comment", "")).removesuffix(SIMULATED_COMMENT).strip()
+    joined.attrs = {**attrs, **({"comment": comment} if comment else {})}
+    return joined
+
+
+def read_dataset(path: str | Path) -> xr.Dataset:
+    """The dataset :func:`write_dataset` wrote at ``path``, loaded, its groups joined (:func:`join_groups`): the one
+    dataset :func:`run_study` returned, which the report pages draw from."""
+    groups = xr.open_groups(path)
+    try:
+        return join_groups({key: part.load() for key, part in groups.items()})
+    finally:
+        for part in groups.values():
+            part.close()
+
+
+def _netcdf_encoding(dataset: xr.Dataset) -> tuple[xr.Dataset, dict[str, dict[str, object]]]:
+    """``dataset`` with netCDF attributes (:func:`netcdf_attributes`) and its encoding: compressed variables, and CF
+    2.5.1: coordinate variables carry no _FillValue (xarray adds one to every float variable unless told not to)."""
     dataset = dataset.copy()  # shallow: the attributes are replaced, the data shared
     dataset.attrs = netcdf_attributes(dataset.attrs, "the dataset")
     for name, variable in dataset.variables.items():
         variable.attrs = netcdf_attributes(variable.attrs, f"variable {name}")
-    encoding: dict[str, dict[str, object]] = {name: {"zlib": True, "complevel": 4} for name in dataset.data_vars}
-    # CF 2.5.1: coordinate variables carry no _FillValue (xarray adds one to every float variable unless told not to)
-    encoding |= {name: {"_FillValue": None} for name in dataset.coords if dataset[name].dtype.kind == "f"}
-    if not dataset.attrs.get("history"):
-        stamp = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
-        dataset = dataset.assign_attrs(history=f"{stamp} vibroimpact {__version__}: {dataset.attrs.get('title', 'dataset')} written")
+    encoding: dict[str, dict[str, object]] = {str(name): {"zlib": True, "complevel": 4} for name in dataset.data_vars}
+    encoding |= {str(name): {"_FillValue": None} for name in dataset.coords if dataset[name].dtype.kind == "f"}
+    return dataset, encoding
+
+
+def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
+    """Write ``dataset`` to netCDF atomically: a temporary file in the same folder, then a rename.
+
+    The simulated solutions go to the group ``simulated``, on the frequencies they were simulated at
+    (:func:`split_groups`); :func:`read_dataset` reads the file back as ``dataset``. A reader never sees a
+    half-written file, and an interrupted run leaves the previous file intact.
+    """
+    path = Path(path)
+    groups = split_groups(dataset)
     with atomic_path(path) as temporary:
-        dataset.to_netcdf(temporary, engine="netcdf4", format="NETCDF4", encoding=encoding)
+        for key, part in groups.items():
+            part, encoding = _netcdf_encoding(part)
+            if key == "/" and not part.attrs.get("history"):
+                stamp = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+                part = part.assign_attrs(history=f"{stamp} vibroimpact {__version__}: {part.attrs.get('title', 'dataset')} written")
+            part.to_netcdf(temporary, mode="w" if key == "/" else "a", group=None if key == "/" else key, engine="netcdf4", format="NETCDF4", encoding=encoding)
     return path
