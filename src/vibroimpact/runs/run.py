@@ -341,11 +341,24 @@ def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
     """
     path = Path(path)
     groups = split_groups(dataset)
-    with atomic_path(path) as temporary:
-        for key, part in groups.items():
-            part, encoding = _netcdf_encoding(part)
-            if key == "/" and not part.attrs.get("history"):
-                stamp = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
-                part = part.assign_attrs(history=f"{stamp} vibroimpact {__version__}: {part.attrs.get('title', 'dataset')} written")
-            part.to_netcdf(temporary, mode="w" if key == "/" else "a", group=None if key == "/" else key, engine="netcdf4", format="NETCDF4", encoding=encoding)
+    try:
+        with atomic_path(path) as temporary:
+            for key, part in groups.items():
+                part, encoding = _netcdf_encoding(part)
+                if key == "/" and not part.attrs.get("history"):
+                    stamp = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+                    part = part.assign_attrs(history=f"{stamp} vibroimpact {__version__}: {part.attrs.get('title', 'dataset')} written")
+                part.to_netcdf(temporary, mode="w" if key == "/" else "a", group=None if key == "/" else key, engine="netcdf4", format="NETCDF4", encoding=encoding)
+    except (OSError, RuntimeError) as error:  # the netCDF library says "NetCDF: HDF error" for a full disk
+        raise OSError(f"writing {path} failed ({error}); {_free_space(path.parent)}: free space there or choose another --out (finished work is kept in the store)") from None
     return path
+
+
+def _free_space(folder: Path) -> str:
+    """'N MB free on its disk', or why that is not known."""
+    import shutil
+
+    try:
+        return f"{shutil.disk_usage(folder).free / 1e6:.0f} MB free on its disk"
+    except OSError as error:
+        return f"its free space is unknown ({error.strerror})"
