@@ -104,3 +104,27 @@ def test_quick_start_runs(tmp_path: Path) -> None:
     printed = result.stdout.splitlines()
     assert all(f"`{line}`" in (ROOT / "README.md").read_text(encoding="utf-8") for line in printed), printed  # what the README says it prints
     assert (tmp_path / "quick_start.png").stat().st_size > 10_000  # the time history's figure
+
+
+def test_the_readme_ranges_are_the_checkers() -> None:
+    """'Sweepable: `frequency` (required, > 0), `restitution` ([0, 1]), `clearance` (finite [m]; negative: a preload)':
+    each stated range is what the scene checker accepts, at its edges."""
+    from vibroimpact.scene import SceneError, parse_scene
+    from tests.study.test_estimate import small_scene
+
+    text = " ".join((ROOT / "README.md").read_text().split())
+    assert "`frequency` (required, > 0), `restitution` ([0, 1]), `clearance` (finite [m]; negative: a preload)" in text
+
+    def accepted(**sweep: object) -> bool:
+        document = small_scene() | {"sweep": {"frequency": [25.0]} | sweep, "solutions": ["linear", "pgf"]}
+        document["stop"] = {key: value for key, value in document["stop"].items() if key not in sweep}  # one place only
+        document.pop("simulation", None)
+        try:
+            parse_scene(document)
+        except SceneError:
+            return False
+        return True
+
+    assert accepted(restitution=[0.0, 1.0]) and not accepted(restitution=[1.0001]) and not accepted(restitution=[-0.0001])
+    assert accepted(frequency=[1e-3]) and not accepted(frequency=[0.0])
+    assert accepted(clearance=[-0.001, 0.003]) and not accepted(clearance=[float("inf")])
