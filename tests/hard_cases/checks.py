@@ -13,7 +13,6 @@ import numpy as np
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.contact import restitution_from_loss_factor
 from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory
-from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.compliant.ida import MODE_CONTACT
 from vibroimpact.engines.linear_flow import HarmonicLinearFlow, first_crossing

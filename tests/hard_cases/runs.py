@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vibroimpact.engines.base import MODE_STUCK, Trajectory
+from vibroimpact.engines.base import Trajectory
 from vibroimpact.analysis.pgf import solve_one_impact
 
 from tests.engine_cases import linear_state

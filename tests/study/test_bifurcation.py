@@ -9,7 +9,6 @@ import xarray as xr
 from vibroimpact.scene import parse_scene
 from vibroimpact.kinds.bifurcation.study import scene_problem
 from vibroimpact.kinds.bifurcation.branches import closed_form_orbits
-from vibroimpact.runs.run import write_dataset
 from vibroimpact.runs.run import run_study
 
 SMALL = {

@@ -14,7 +14,6 @@ from vibroimpact.analysis.stability import Regime
 from vibroimpact.scene import parse_scene
 from vibroimpact.runs.run import write_dataset
 from vibroimpact.runs.run import run_study
-from vibroimpact.model.system import PAPER_SYSTEM
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
 

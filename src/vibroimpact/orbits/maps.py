@@ -103,7 +103,7 @@ class ImpactMap:
 
     def __init__(self, problem: ImpactProblem, periods: int = 1, engine: ExactEngine | None = None, bounds: dict[str, tuple[float, float]] | None = None,
                  stop: int | str | None = None, parameter_scale: ArrayLike | None = None) -> None:  # fmt: skip
-        _checked = problem.harmonic  # TypeError naming the part unless a harmonic force
+        problem.harmonic  # noqa: B018 - raises TypeError naming the part unless a harmonic force
         self.stops = stop_selection(problem, stop)
         self.stop = stop
         if int(periods) < 1:
