@@ -289,7 +289,7 @@ BRANCH_FIELDS = (
     "branch", "origin", "frequency", "amplitudes", "impulse", "floquet_modulus", "stable", "impacts", "period",
     "multipliers_real", "multipliers_imag", "velocities",
     "sp_branch", "sp_kind", "sp_frequency", "sp_amplitudes", "sp_impulse", "sp_floquet_modulus", "sp_impacts", "sp_period",
-    "sp_multipliers_real", "sp_multipliers_imag", "sp_note", "notes",
+    "sp_multipliers_real", "sp_multipliers_imag", "sp_note", "sp_found_on", "notes",
 )  # fmt: skip
 
 
@@ -334,7 +334,8 @@ class BranchCase:
 
 def branch_arrays(found: OrbitSet, size: int) -> CaseResult:
     """Flat arrays of an :class:`OrbitSet` of a structure of ``size`` coordinates (one row per branch point, one per
-    special point; amplitudes (rows, N), multipliers (rows, 2N))."""
+    special point; amplitudes (rows, N), multipliers (rows, 2N); ``sp_found_on``: the labels of every branch a special
+    point was found on, space-separated)."""
 
     def column(rows: list[dict], name: str, dtype: type = float) -> np.ndarray:
         return np.array([row[name] for row in rows], dtype=dtype)
@@ -359,7 +360,8 @@ def branch_arrays(found: OrbitSet, size: int) -> CaseResult:
         "sp_amplitudes": table(specials, "amplitudes", size), "sp_impulse": column(specials, "impulse"),
         "sp_floquet_modulus": column(specials, "floquet_modulus"), "sp_impacts": column(specials, "impacts", int),
         "sp_period": column(specials, "period", int), "sp_multipliers_real": sm.real, "sp_multipliers_imag": sm.imag,
-        "sp_note": np.array([row["note"] for row in specials], dtype=str), "notes": np.array(found.notes, dtype=str),
+        "sp_note": np.array([row["note"] for row in specials], dtype=str), "sp_found_on": np.array([" ".join(map(str, row["found_on"])) for row in specials], dtype=str),
+        "notes": np.array(found.notes, dtype=str),
     }  # fmt: skip
 
 

@@ -345,6 +345,13 @@ def bifurcation_figures(dataset: xr.Dataset) -> Iterator[DrawnFigure]:
         yield chart_figure(dataset)
 
 
+def _found_on(point: xr.Dataset) -> str:
+    """The branches a special point was found on, ``3, 7`` (its own branch where the dataset lists no others)."""
+    if "special_point_branches" in point:
+        return ", ".join(str(point["special_point_branches"].values).split())
+    return str(int(point["special_point_branch"]))
+
+
 def special_point_table(dataset: xr.Dataset) -> Table:
     """Every located special point: kind, frequency, R, the orbit, its multipliers and what happens there."""
     kinds = _flags(dataset["special_point_kind"])
@@ -357,7 +364,7 @@ def special_point_table(dataset: xr.Dataset) -> Table:
         key = orbit_class(float(point["special_point_impacts_per_period"]), int(point["special_point_period_multiplicity"]))
         cells = [
             kinds[int(point["special_point_kind"])].replace("_", "-"), fmt(float(point["special_point_frequency"]), ".5f"),
-            fmt(float(point["special_point_restitution"]), "g"), str(int(point["special_point_branch"])), _orbit_label(key),
+            fmt(float(point["special_point_restitution"]), "g"), _found_on(point), _orbit_label(key),
             html.escape(multipliers), fmt(float(point["special_point_floquet_modulus"]), ".4f"), html.escape(str(point["special_point_note"].values)),
         ]  # fmt: skip
         rows.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")

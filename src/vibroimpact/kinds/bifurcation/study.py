@@ -11,8 +11,9 @@ Output (``bifurcation.nc``; attributes from :data:`vibroimpact.scene.variables.B
   (branch_point, orbit_impact);
 * dimension ``special_point``: coordinates ``special_point_kind`` (CF flags ``fold period_doubling neimark_sacker
   grazing``), ``special_point_frequency`` [Hz], ``special_point_restitution``, ``special_point_branch``; the orbit's
-  multipliers and measures there (``special_point_<c0>_amplitude`` of the first coordinate c0), and
-  ``special_point_note``;
+  multipliers and measures there (``special_point_<c0>_amplitude`` of the first coordinate c0),
+  ``special_point_note`` and ``special_point_branches`` (every branch it was found on: each point is listed once,
+  :func:`~vibroimpact.kinds.bifurcation.branches.same_special_point`);
 * brute force along (``restitution``, ``sweep``, ``frequency``, ``strobe``): ``brute_<c0>``, ``brute_<c0>_amplitude``
   of the first coordinate (``brute_x1``, ``brute_x1_amplitude`` for the paper's system);
   along (restitution, sweep, frequency, ``impact``): ``brute_impact_velocity`` (NaN-padded); along (restitution,
@@ -179,6 +180,7 @@ def _branches(results: list[CaseResult], restitutions: tuple[float, ...], coordi
         specials.setdefault("restitution", []).append(np.full(m, r))
         for name in ("kind", "frequency", "amplitudes", "impulse", "floquet_modulus", "impacts", "period", "multipliers_real", "multipliers_imag", "note"):
             specials.setdefault(name, []).append(result[f"sp_{name}"])
+        specials.setdefault("found_on", []).append(np.array([" ".join(str(int(b) + offset) for b in labels.split()) for labels in result["sp_found_on"]], dtype=str))
         offset += int(result["branch"].max()) + 1 if n else 0
     p = {k: np.concatenate(v) for k, v in points.items()}
     s = {k: np.concatenate(v) for k, v in specials.items()}
@@ -207,6 +209,7 @@ def _branches(results: list[CaseResult], restitutions: tuple[float, ...], coordi
             "special_point_multiplier_real": (sp + ("multiplier",), s["multipliers_real"].reshape(-1, 2 * size), a["special_point_multiplier_real"]),
             "special_point_multiplier_imag": (sp + ("multiplier",), s["multipliers_imag"].reshape(-1, 2 * size), a["special_point_multiplier_imag"]),
             "special_point_note": (sp, s["note"].astype(str), a["special_point_note"]),
+            "special_point_branches": (sp, s["found_on"].astype(str), a["special_point_branches"]),
         },
         coords={
             "branch": (bp, p["branch"].astype(np.int32), a["branch"]),
