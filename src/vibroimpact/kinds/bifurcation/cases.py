@@ -9,7 +9,8 @@ of one restitution, and the two-parameter chart's curves.
   :func:`~vibroimpact.orbits.motion.classify_strobes`). A strictly negative Lyapunov exponent means a periodic
   orbit approached slowly: the motion is classified by the period that repeats best.
 * :class:`BranchCase`: :func:`vibroimpact.kinds.bifurcation.branches.find_branches` of one restitution.
-* :class:`ChartCase`: the special points of the chart's restitution followed in (frequency, clearance): folds, period
+* :class:`ChartCase`: the special points of the chart's restitution followed in (frequency, clearance), from the
+  branches of its own continuation (their labels and frequency ranges are returned too): folds, period
   doublings and Neimark-Sacker points continued (:func:`vibroimpact.orbits.continuation.continue_special_point`), the
   points where a free flight of an orbit touches the stop traced by repeated location
   (:func:`vibroimpact.orbits.grazing_curve.trace_grazing`), and the closed-form orbit's vanishing impact velocity
@@ -377,7 +378,7 @@ class ChartCase:
     kinds: tuple[str, ...]
     max_steps: int
     engine: str = "exact"
-    fields: tuple[str, ...] = ("curve", "kind", "frequency", "clearance", "notes")
+    fields: tuple[str, ...] = ("curve", "kind", "frequency", "clearance", "notes", "branch_label", "branch_origin", "branch_low", "branch_high")
     progress_unit: str = "charts"
 
     @property
@@ -426,7 +427,19 @@ class ChartCase:
                 rows += [(curve, kind, fi, di) for fi, di in zip(f, d)]
                 curve += 1
         table = np.array(rows, dtype=float).reshape(-1, 4)
-        return {"curve": table[:, 0].astype(int), "kind": table[:, 1].astype(int), "frequency": table[:, 2], "clearance": table[:, 3], "notes": np.array(notes, dtype=str)}
+        return {"curve": table[:, 0].astype(int), "kind": table[:, 1].astype(int), "frequency": table[:, 2], "clearance": table[:, 3], "notes": np.array(notes, dtype=str), **_branch_ranges(found)}
+
+
+def _branch_ranges(found: OrbitSet) -> CaseResult:
+    """Label, origin flag and frequency range [Hz] of each branch of ``found`` (``branch_label``, ``branch_origin``,
+    ``branch_low``, ``branch_high``)."""
+    labels = sorted({int(point["branch"]) for point in found.points})
+    frequency = {label: [point["frequency"] for point in found.points if point["branch"] == label] for label in labels}
+    origin = {int(point["branch"]): int(point["origin"]) for point in found.points}
+    return {
+        "branch_label": np.array(labels, dtype=int), "branch_origin": np.array([origin[k] for k in labels], dtype=int),
+        "branch_low": np.array([min(frequency[k]) for k in labels]), "branch_high": np.array([max(frequency[k]) for k in labels]),
+    }  # fmt: skip
 
 
 def _grazing_curves(problem: ImpactProblem, low: float, high: float, low_c: float, high_c: float, step: float = 0.01) -> list[tuple[np.ndarray, np.ndarray]]:

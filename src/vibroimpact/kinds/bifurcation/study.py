@@ -46,6 +46,7 @@ from vibroimpact.scene.layout import build_stops, describe_stop
 from vibroimpact.scene.schema import Scene
 from vibroimpact.scene.variables import BIFURCATION_ATTRIBUTES, COORDINATE_ATTRIBUTES, STABLE_ATTRIBUTES, flag_attributes
 from vibroimpact.kinds.bifurcation.branches import MAX_ORBIT_IMPACTS, ORIGINS
+from vibroimpact.kinds.bifurcation.logs import chart_labels, continuation_log, numbered_across, relabel
 from vibroimpact.kinds.bifurcation.cases import MAX_KEPT_IMPACTS, MAX_PERIOD, MOTION_CLASSES, BranchCase, ChartCase, SweepCase, Seed, sweep_seeds
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.cluster import Progress
@@ -101,9 +102,6 @@ class BifurcationStudy:
             + (f"; the chart's curves (R = {chart.restitution:g})" if chart else ""))  # fmt: skip
         first = runner.map(charted + sweeps + maps)
         chart_result, swept = (first[0], first[1:]) if chart else (None, first)
-        if chart_result is not None:
-            for note in chart_result["notes"]:
-                say(f"  chart {chart.restitution:g}: {note}")
         continuation = []
         for i, r in enumerate(settings.restitution):
             seeds: list[Seed] = []
@@ -113,11 +111,16 @@ class BifurcationStudy:
                     seeds += sweep_seeds(settings.frequency, result["period"], result["impacts"], result["state"], j)
             continuation.append(BranchCase(scene_problem(scene, r), settings.low, settings.high, options, tuple(seeds)))
         say(f"continuing the branches of R = {', '.join(f'{r:g}' for r in settings.restitution)}")
-        results = runner.map(continuation)
+        results = numbered_across(runner.map(continuation))  # the dataset's labels
         for case, result in zip(continuation, results):
             for note in result["notes"]:
                 say(f"  R = {case.restitution:g}: {note}")
         if chart_result is not None:
+            same = [result for r, result in zip(settings.restitution, results) if np.isclose(r, chart.restitution)]
+            labels = chart_labels(chart_result, same[0] if same else None)
+            chart_result = dict(chart_result, notes=np.array([relabel(str(note), labels) for note in chart_result["notes"]], dtype=str))
+            for note in chart_result["notes"]:
+                say(f"  chart {chart.restitution:g}: {note}")
             results = [*results, chart_result]
         data = _branches(results[: len(settings.restitution)], settings.restitution, scene.coordinates, scene.load_spec.base_motion)
         data = data.merge(_brute(swept[: len(sweeps)], scene, brute.directions, brute.strobes))
@@ -164,24 +167,22 @@ def coordinate_attributes(key: str, name: str, base_motion: bool = False) -> dic
 
 
 def _branches(results: list[CaseResult], restitutions: tuple[float, ...], coordinates: tuple[str, ...], base_motion: bool) -> xr.Dataset:
-    """branch_point and special_point variables of every restitution (labels numbered across them)."""
+    """branch_point and special_point variables of every restitution (``results`` :func:`numbered` across them)."""
     points: dict[str, list] = {}
     specials: dict[str, list] = {}
-    offset = 0
     size = len(coordinates)
     for r, result in zip(restitutions, results):
         n = result["frequency"].size
-        points.setdefault("branch", []).append(result["branch"] + offset)
+        points.setdefault("branch", []).append(result["branch"])
         points.setdefault("restitution", []).append(np.full(n, r))
         for name in ("origin", "frequency", "amplitudes", "impulse", "floquet_modulus", "stable", "impacts", "period", "multipliers_real", "multipliers_imag", "velocities"):
             points.setdefault(name, []).append(result[name])
         m = result["sp_frequency"].size
-        specials.setdefault("branch", []).append(result["sp_branch"] + offset)
+        specials.setdefault("branch", []).append(result["sp_branch"])
         specials.setdefault("restitution", []).append(np.full(m, r))
         for name in ("kind", "frequency", "amplitudes", "impulse", "floquet_modulus", "impacts", "period", "multipliers_real", "multipliers_imag", "note"):
             specials.setdefault(name, []).append(result[f"sp_{name}"])
-        specials.setdefault("found_on", []).append(np.array([" ".join(str(int(b) + offset) for b in labels.split()) for labels in result["sp_found_on"]], dtype=str))
-        offset += int(result["branch"].max()) + 1 if n else 0
+        specials.setdefault("found_on", []).append(result["sp_found_on"])
     p = {k: np.concatenate(v) for k, v in points.items()}
     s = {k: np.concatenate(v) for k, v in specials.items()}
     a = BIFURCATION_ATTRIBUTES
@@ -294,7 +295,7 @@ def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult])
         **_layout_attributes(scene),
         "frequency_band_Hz": np.array([settings.low, settings.high]),
         "brute_force_transient_periods": settings.brute_force.transient_periods,
-        "continuation_notes": "\n".join(f"R = {r:g}: {note}" for r, result in zip(settings.restitution, results) for note in result["notes"]),
+        "continuation_notes": continuation_log(settings.restitution, results),
         "method_branches": "pseudo-arclength continuation of fixed points of the exact stroboscopic map (compiled exact engine, exact Jacobians), started from the closed-form impact orbit at both roots of eq. 16 (one impact per period; two on a symmetric two-sided stop; none where the layout has no closed form), at period doublings, at grazing points and from every periodic brute-force attractor no other branch passes through",
         "method_brute_force": f"compiled exact engine, stepped sweeps carrying the end state; strobes compared over periods 1-{MAX_PERIOD}, else the Lyapunov exponent from the exact Jacobians",
     }
