@@ -100,14 +100,27 @@ def stop_values(problem: ImpactProblem) -> tuple[float, float]:
 class OrbitSet:
     """Branches and special points of one restitution, as lists of per-point records (see :meth:`add_branch`), and
     the continued branches with their maps (``maps``: (ImpactMap, Branch) pairs). A special point is kept once
-    (:func:`same_special_point`), with the labels of every branch it was found on (``found_on``)."""
+    (:func:`same_special_point`), with the labels of every branch it was found on (``found_on``). What failed is
+    counted (``attempts`` and ``failures`` by kind of work: :meth:`attempted`, :meth:`failed`)."""
 
     points: list[dict] = field(default_factory=list)
     specials: list[dict] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     count: int = 0
     maps: list = field(default_factory=list)
+    attempts: dict[str, int] = field(default_factory=dict)
+    failures: list[tuple[str, str]] = field(default_factory=list)
     _index: tuple | None = None
+
+    def attempted(self, what: str) -> None:
+        """Count one attempt of a kind of work that may fail (``branch``: a branch's start and continuation,
+        ``seed``: a brute-force seed; :data:`vibroimpact.kinds.bifurcation.logs.FAILURES`)."""
+        self.attempts[what] = self.attempts.get(what, 0) + 1
+
+    def failed(self, what: str, detail: str) -> None:
+        """Record a failed attempt of kind ``what`` with its raw message ``detail`` (one line), in the notes too."""
+        self.failures.append((what, detail))
+        self.notes.append(detail)
 
     def add_branch(self, system: ImpactMap, branch: Branch, origin: str) -> int:
         """Measure every orbit of ``branch`` and keep it with its special points; return its label."""
@@ -272,11 +285,11 @@ def find_branches(
             progress(f"R = {restitution:g}: {message}")
 
     def attempt(what: str, run) -> None:
+        found.attempted("branch")
         try:
             run()
         except Exception as error:  # noqa: BLE001 - a failed branch is recorded, the others go on
-            found.notes.append(f"{what} failed: {type(error).__name__}: {str(error)[:200]}")
-            say(f"{what} failed ({type(error).__name__})")
+            found.failed("branch", f"{what} failed: {type(error).__name__}: {str(error)[:200]}")
 
     maps: list[tuple[ImpactMap, Branch]] = []
     if linear:

@@ -24,7 +24,7 @@ from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure, SWEEP_COLOURS
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
 
-__all__ = ["page_for", "BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class", "orbit_colours", "first_coordinate", "headline", "answer_text"]
+__all__ = ["page_for", "BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class", "orbit_colours", "first_coordinate", "headline", "answer_text", "failure_text", "failure_details"]
 
 #: Brute-force dots of each sweep direction.
 #: Marker of each kind of special point.
@@ -336,6 +336,32 @@ def _stable_bands(dataset: xr.Dataset, chosen: np.ndarray) -> str:
     return ", ".join(parts[:4]) + (f" and {len(parts) - 4} more" if len(parts) > 4 else "") + " Hz"
 
 
+def _lines(dataset: xr.Dataset, key: str) -> list[str]:
+    """A list-of-strings attribute as a list (netCDF gives one string back as a string), empty when absent."""
+    value = dataset.attrs.get(key)
+    if value is None:
+        return []
+    return [value] if isinstance(value, str) else [str(v) for v in np.atleast_1d(value)]
+
+
+def failure_text(dataset: xr.Dataset) -> str:
+    """What failed in the run (``run_failures``: what, how many, what it means for the results), as HTML; empty when
+    nothing did."""
+    lines = _lines(dataset, "run_failures")
+    if not lines:
+        return ""
+    items = "".join(f"<li>{html.escape(line)}</li>" for line in lines)
+    return f"<p><b>What failed in this run</b> (each line says what it means for the results; the raw messages are at the end of the page):</p><ul>{items}</ul>"
+
+
+def failure_details(dataset: xr.Dataset) -> str:
+    """The raw messages of what failed (``run_failure_details``), collapsed; empty when nothing failed."""
+    details = _lines(dataset, "run_failure_details")
+    if not details:
+        return ""
+    return f"<details><summary>The raw messages of what failed ({len(details)})</summary><pre>{html.escape(chr(10).join(details))}</pre></details>"
+
+
 def bifurcation_figures(dataset: xr.Dataset) -> Iterator[DrawnFigure]:
     """Every figure of the page, in order."""
     for index, r in enumerate(dataset["restitution"].values):
@@ -386,11 +412,13 @@ class BifurcationPage:
                 f"{d.sizes['frequency']} frequencies x {d.sizes['sweep']} directions for R = {', '.join(fmt(r, 'g') for r in d['restitution'].values)}{stops}")  # fmt: skip
 
     def sections(self, out: Path) -> list[Section]:
-        """The answer with the diagrams, multipliers and special points per restitution, then the chart, then the
-        continuation's logs, collapsed (what a reader checks, not what they read first)."""
+        """The answer (and what failed, if anything did) with the diagrams, multipliers and special points per
+        restitution, then the chart, then the continuation's logs and the raw messages of what failed, collapsed
+        (what a reader checks, not what they read first)."""
         figures = saved(bifurcation_figures(self.dataset), out)
         chart = [f for f in figures if f.path.stem == "chart"]
-        sections = [Section("Bifurcation diagrams", answer_text(self.dataset), [f for f in figures if f not in chart], [special_point_table(self.dataset)])]
+        answer = answer_text(self.dataset) + failure_text(self.dataset)
+        sections = [Section("Bifurcation diagrams", answer, [f for f in figures if f not in chart], [special_point_table(self.dataset)])]
         if chart:
             sections.append(Section("Two-parameter chart", "", chart))
         logs = [
@@ -402,6 +430,8 @@ class BifurcationPage:
         )
         if shown:
             sections.append(Section("Continuation logs", shown))
+        if failure_details(self.dataset):
+            sections.append(Section("What failed, in detail", failure_details(self.dataset)))
         return sections
 
 

@@ -22,6 +22,9 @@ Output (``bifurcation.nc``; attributes from :data:`vibroimpact.scene.variables.B
 * the chart: dimension ``chart_point`` with coordinates ``chart_curve``, ``chart_kind`` (flags as
   ``special_point_kind``), ``chart_frequency`` [Hz], ``chart_clearance`` [m]; the regime map ``chart_regime``
   (sweep, map_clearance, map_frequency) with ``chart_impacts_per_period`` and ``chart_period``.
+* what failed, when anything did (attributes, absent otherwise): ``run_failures``, one line per kind of work and
+  restitution, "<what failed>: <k> of <n> failed (<reasons>); <what it means for the results>", and
+  ``run_failure_details``, every raw message (:mod:`vibroimpact.kinds.bifurcation.logs`); the console gets one line.
 
 One netCDF group cannot hold ``frequency`` both as the brute force's dimension and as a coordinate of
 ``branch_point``, nor ``restitution`` as a dimension and a coordinate of ``special_point``: the branch and special
@@ -46,7 +49,7 @@ from vibroimpact.scene.layout import build_stops, describe_stop
 from vibroimpact.scene.schema import Scene
 from vibroimpact.scene.variables import BIFURCATION_ATTRIBUTES, COORDINATE_ATTRIBUTES, STABLE_ATTRIBUTES, flag_attributes
 from vibroimpact.kinds.bifurcation.branches import MAX_ORBIT_IMPACTS, ORIGINS
-from vibroimpact.kinds.bifurcation.logs import chart_labels, continuation_log, numbered_across, relabel
+from vibroimpact.kinds.bifurcation.logs import Tally, chart_labels, console_line, continuation_log, failure_summary, numbered_across, relabel, sweep_tally, tallies
 from vibroimpact.kinds.bifurcation.cases import MAX_KEPT_IMPACTS, MAX_PERIOD, MOTION_CLASSES, BranchCase, ChartCase, SweepCase, Seed, sweep_seeds
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.cluster import Progress
@@ -113,14 +116,12 @@ class BifurcationStudy:
         say(f"continuing the branches of R = {', '.join(f'{r:g}' for r in settings.restitution)}")
         results = numbered_across(runner.map(continuation))  # the dataset's labels
         for case, result in zip(continuation, results):
-            for note in result["notes"]:
-                say(f"  R = {case.restitution:g}: {note}")
+            _say_notes(say, f"R = {case.restitution:g}", result)
         if chart_result is not None:
             same = [result for r, result in zip(settings.restitution, results) if np.isclose(r, chart.restitution)]
             labels = chart_labels(chart_result, same[0] if same else None)
             chart_result = dict(chart_result, notes=np.array([relabel(str(note), labels) for note in chart_result["notes"]], dtype=str))
-            for note in chart_result["notes"]:
-                say(f"  chart {chart.restitution:g}: {note}")
+            _say_notes(say, f"chart {chart.restitution:g}", chart_result)
             results = [*results, chart_result]
         data = _branches(results[: len(settings.restitution)], settings.restitution, scene.coordinates, scene.load_spec.base_motion)
         data = data.merge(_brute(swept[: len(sweeps)], scene, brute.directions, brute.strobes))
@@ -130,6 +131,10 @@ class BifurcationStudy:
         for key in ("restitution", "frequency", "sweep", "clearance"):
             data[key].attrs.update(COORDINATE_ATTRIBUTES[key])
         data.attrs.update(_metadata(scene, results, swept[: len(sweeps)]))
+        lines, details = failure_summary(_tallies(scene, results, swept))
+        if lines:
+            data.attrs.update(run_failures=lines, run_failure_details=details)
+            say(console_line(lines))
         return data
 
     def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:
@@ -155,6 +160,35 @@ class BifurcationStudy:
         parts = {"brute force and chart": first, "continuation": branches, "report": report}
         memory = costs.main_process_memory + (jobs - 1) * costs.worker_process_memory
         return Estimate(wall_time=wall, memory=memory, parts=parts, points={"brute force": f"{periods:,} periods", "continuation": f"{len(continuation)} continuations"})
+
+
+def _say_notes(say: Progress, where: str, result: CaseResult) -> None:
+    """A case's notes, a line each, but its failures (the run's one line of failures says them)."""
+    failed = set(result["failure_detail"].tolist())
+    for note in result["notes"]:
+        if note not in failed:
+            say(f"  {where}: {note}")
+
+
+def _tallies(scene: Scene, results: list[CaseResult], swept: list[CaseResult]) -> list[Tally]:
+    """What the run attempted and what failed (:func:`~vibroimpact.kinds.bifurcation.logs.failure_summary`): per
+    restitution the branches, the seeds and the brute-force points; then the chart's branches, curves and regime map.
+    ``results``: the branch cases, then the chart's case; ``swept``: the sweeps, then the regime map's."""
+    settings = scene.settings
+    assert settings is not None
+    directions, chart = settings.brute_force.directions, settings.chart
+    counted: list[Tally] = []
+    for i, r in enumerate(settings.restitution):
+        where = f"R = {r:g}"
+        counted += tallies(results[i], where)
+        sweeps = swept[i * len(directions) : (i + 1) * len(directions)]
+        counted.append(sweep_tally("sweep", where, sweeps, [f"sweeping {d}" for d in directions], settings.frequency))
+    if chart is not None:
+        where = f"R = {chart.restitution:g}"
+        counted += tallies(results[-1], where)
+        labels = [f"Delta = {c * 1e3:.4g} mm, sweeping {d}" for c in chart.clearances for d in directions]
+        counted.append(sweep_tally("map", where, swept[len(settings.restitution) * len(directions) :], labels, settings.chart_frequency))
+    return counted
 
 
 def coordinate_attributes(key: str, name: str, base_motion: bool = False) -> dict[str, str]:
