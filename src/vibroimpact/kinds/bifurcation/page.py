@@ -16,10 +16,10 @@ import xarray as xr
 
 from vibroimpact.reporting.page import Section, Table, saved
 from vibroimpact.reporting.style import fmt
-from vibroimpact.kinds.bifurcation.figures import bifurcation_figures, first_coordinate, flags as _flags, orbit_class, orbit_colours, orbit_label as _orbit_label
+from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, bifurcation_figures, branch_class, first_coordinate, flags as _flags, orbit_class, orbit_label as _orbit_label
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
 
-__all__ = ["page_for", "BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class", "orbit_colours", "first_coordinate", "headline", "answer_text", "failure_text", "failure_details"]
+__all__ = ["page_for", "BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class", "first_coordinate", "headline", "answer_text", "failure_text", "failure_details"]
 
 
 #: The brute-force classes that are no periodic motion.
@@ -64,49 +64,17 @@ def headline(dataset: xr.Dataset) -> str:
     return "; ".join(lines)
 
 
-def answer_text(dataset: xr.Dataset) -> str:
-    """What the motion is, per restitution, in a few sentences: the largest amplitude the brute force settles on, where
-    it settles on no periodic motion, where the two sweeps disagree (coexisting attractors), where the closed-form
-    orbit is stable, and how many special points were located."""
-    label = coordinate_label(first_coordinate(dataset))
-    meanings = _flags(dataset["brute_regime"])
-    frequency = dataset["frequency"].values
-    step = float(np.median(np.diff(frequency))) if frequency.size > 1 else 1.0
-    origins = _flags(dataset["branch_origin"])
-    closed = [origins.index(k) for k in ("one_impact", "two_impacts") if k in origins]
-    kinds = _flags(dataset["special_point_kind"])
-    paragraphs = []
-    for i, r in enumerate(dataset["restitution"].values):
-        amplitude, regime, wild = _brute_facts(dataset, i)
-        words = [f"<b>R = {fmt(r, 'g')}</b>:"]
-        if np.isfinite(amplitude).any():
-            j, k = np.unravel_index(int(np.nanargmax(amplitude)), amplitude.shape)
-            kind = meanings[int(regime[j, k]) + 1].replace("_", " ")
-            words.append(f"the brute force settles at most on |{label}| = {fmt(amplitude[j, k] * 1e3, '.3g')} mm ({fmt(frequency[k], '.2f')} Hz, "
-                         f"sweeping {dataset['sweep'].values[j]}: {kind});")  # fmt: skip
-        words.append(f"no periodic motion at {int(wild.sum())} of {frequency.size} frequencies{' (' + _ranges(frequency[wild], step) + ')' if wild.any() else ''};")
-        if regime.shape[0] > 1:
-            scale = np.nanmax(amplitude) if np.isfinite(amplitude).any() else 1.0
-            differ = (regime != regime[:1]).any(axis=0) | (np.abs(np.nan_to_num(amplitude - amplitude[:1])) > 0.05 * scale).any(axis=0)
-            words.append(f"the sweeps settle on different motions (coexisting attractors) at {int(differ.sum())} frequencies"
-                         f"{' (' + _ranges(frequency[differ], step) + ')' if differ.any() else ''};")  # fmt: skip
-        on_branch = np.isclose(dataset["branch_restitution"].values, r) & np.isin(dataset["branch_origin"].values, closed) & (dataset["stable"].values == 1)
-        if on_branch.any():
-            words.append(f"the closed-form orbit is stable over {_stable_bands(dataset, on_branch)};")
-        elif not np.isin(dataset["branch_origin"].values[np.isclose(dataset["branch_restitution"].values, r)], closed).any():
-            words.append("no branch from the closed form;")
-        else:
-            words.append("the closed-form orbit is nowhere stable;")
-        mask = np.isclose(dataset["special_point_restitution"].values, r)
-        counts = [f"{int(np.count_nonzero(dataset['special_point_kind'].values[mask] == code))} {kind.replace('_', '-')}" for code, kind in enumerate(kinds)]
-        words.append(f"special points: {', '.join(counts)}.")
-        paragraphs.append("<p>" + " ".join(words) + "</p>")
-    return "".join(paragraphs)
+#: Table cells of text, which may wrap (the global style keeps cells on one line, right-aligned).
+_TEXT = "white-space:normal;text-align:left"
+#: ... with a minimum width that keeps them readable [em].
+_WRAP = _TEXT + ";min-width:{}em"
+#: The kinds of special point where a branch's stability changes (columns of the orbits' table).
+STABILITY_KINDS = ("fold", "period_doubling", "neimark_sacker")
 
 
-def _stable_bands(dataset: xr.Dataset, chosen: np.ndarray) -> str:
-    """The frequency bands [Hz] over which the chosen branch points are stable: each branch's runs of consecutive
-    stable points, merged where they overlap."""
+def _bands(dataset: xr.Dataset, chosen: np.ndarray) -> list[tuple[float, float]]:
+    """The frequency bands [Hz] of the chosen branch points: each branch's runs of consecutive chosen points, merged
+    where they overlap."""
     bands: list[list[float]] = []
     branch, f = dataset["branch"].values, dataset["branch_frequency"].values
     for label in np.unique(branch[chosen]):
@@ -119,8 +87,114 @@ def _stable_bands(dataset: xr.Dataset, chosen: np.ndarray) -> str:
             merged[-1][1] = max(merged[-1][1], high)
         else:
             merged.append([low, high])
-    parts = [f"{fmt(a, '.2f')}-{fmt(b, '.2f')}" for a, b in merged]
-    return ", ".join(parts[:4]) + (f" and {len(parts) - 4} more" if len(parts) > 4 else "") + " Hz"
+    return [(a, b) for a, b in merged]
+
+
+def _band_text(bands: list[tuple[float, float]], most: int = 4) -> str:
+    """Bands as ``a-b, c-d and 2 more`` [Hz] (a band of one point as ``a``), without the unit; empty for none."""
+    parts = [f"{fmt(a, '.2f')}-{fmt(b, '.2f')}" if b - a >= 0.005 else fmt(a, ".2f") for a, b in bands]
+    return ", ".join(parts[:most]) + (f" and {len(parts) - most} more" if len(parts) > most else "")
+
+
+def _at(values: np.ndarray, most: int = 4) -> str:
+    """Frequencies [Hz] as ``21.21, 26.58``, in order, at most ``most`` and how many more; without the unit."""
+    parts = [fmt(f, ".2f") for f in np.sort(values)]
+    return ", ".join(parts[:most]) + (f" and {len(parts) - most} more" if len(parts) > most else "")
+
+
+def _branch_classes(dataset: xr.Dataset) -> np.ndarray:
+    """The class of each branch point's branch (:func:`branch_class`), shape (branch_point, 2)."""
+    out = np.zeros((dataset.sizes["branch_point"], 2), dtype=int)
+    labels = dataset["branch"].values
+    for label in np.unique(labels):
+        mask = labels == label
+        out[mask] = branch_class(dataset["impacts_per_period"].values[mask], dataset["period_multiplicity"].values[mask])
+    return out
+
+
+def orbit_rows(dataset: xr.Dataset, restitution: float) -> list[dict[str, object]]:
+    """Every class of periodic orbit continued at one restitution, in order of period and impacts: its name, branches,
+    the bands [Hz] where it exists and where it is stable, and the frequencies [Hz] of its special points by kind (each
+    at the class of the branch it was found on)."""
+    at_r = np.isclose(dataset["branch_restitution"].values, restitution)
+    classes = _branch_classes(dataset)
+    kinds = _flags(dataset["special_point_kind"])
+    branch_of = {int(b): tuple(c) for b, c in zip(dataset["branch"].values, classes)}
+    rows = []
+    for key in sorted({tuple(c) for c in classes[at_r]}, key=lambda k: (k[1], k[0])):
+        chosen = at_r & (classes == key).all(axis=1)
+        points = [branch_of.get(int(b)) == key for b in dataset["special_point_branch"].values]
+        special = {kind: dataset["special_point_frequency"].values[np.array(points, dtype=bool) & (dataset["special_point_kind"].values == code)] for code, kind in enumerate(kinds)}
+        rows.append({
+            "key": key, "name": _orbit_label(key), "branches": np.unique(dataset["branch"].values[chosen]).tolist(),
+            "exists": _bands(dataset, chosen), "stable": _bands(dataset, chosen & (dataset["stable"].values == 1)), "special": special,
+        })  # fmt: skip
+    return rows
+
+
+def orbit_table(dataset: xr.Dataset, restitution: float) -> str:
+    """The orbits of one restitution (:func:`orbit_rows`) as an HTML table: where each exists, where it is stable,
+    where it folds and where its stability changes otherwise [Hz]."""
+    head = ["orbit", "branches", "exists over [Hz]", "stable over [Hz]", "folds at [Hz]", "period doublings at [Hz]", "Neimark-Sacker points at [Hz]"]
+    body = []
+    for row in orbit_rows(dataset, restitution):
+        special = row["special"]
+        cells = [row["name"], ", ".join(map(str, row["branches"])), _band_text(row["exists"], 6), _band_text(row["stable"], 6) or "nowhere",
+                 *(_at(special.get(k, np.zeros(0)), 6) for k in STABILITY_KINDS)]  # fmt: skip
+        body.append("<tr>" + "".join(f"<td style='{_TEXT}'>{html.escape(c)}</td>" for c in cells) + "</tr>")
+    caption = f"<caption style='{_TEXT};caption-side:top'>Every kind of periodic orbit continued at R = {fmt(restitution, 'g')}</caption>"
+    header = "".join(f"<th style='{_TEXT}'>{h}</th>" for h in head)
+    return f"<table>{caption}<tr>{header}</tr>{''.join(body)}</table>"
+
+
+def _main_orbit(dataset: xr.Dataset, restitution: float, rows: list[dict[str, object]]) -> str:
+    """The closed-form orbit's class of one restitution in a sentence: where it exists, where it is stable, where it
+    folds and where its stability changes otherwise; the other classes counted."""
+    origins = _flags(dataset["branch_origin"])
+    closed = [origins.index(k) for k in ("one_impact", "two_impacts") if k in origins]
+    at_r = np.isclose(dataset["branch_restitution"].values, restitution) & np.isin(dataset["branch_origin"].values, closed)
+    impacting = [row for row in rows if row["key"][0]]
+    if not at_r.any():
+        return f"no branch from the closed form; {len(impacting)} kind{'s' if len(impacting) != 1 else ''} of impacting periodic orbit (table);"
+    key = tuple(_branch_classes(dataset)[np.flatnonzero(at_r)[0]])
+    row = next(r for r in rows if r["key"] == key)
+    special = row["special"]
+    words = f"the closed-form orbit ({row['name']}) exists over {_band_text(row['exists'])} Hz and is " + (f"stable over {_band_text(row['stable'])} Hz" if row["stable"] else "nowhere stable")
+    changes = [f"{KIND_NAMES[k]} at {_at(special[k])} Hz" for k in STABILITY_KINDS if special.get(k, np.zeros(0)).size]
+    others = len(impacting) - 1
+    return f"{words}{' (' + '; '.join(changes) + ')' if changes else ''}; {others} other kind{'s' if others != 1 else ''} of impacting periodic orbit (table);"
+
+
+def answer_text(dataset: xr.Dataset) -> str:
+    """The answer, per restitution: the closed-form orbit (where it exists, is stable, folds and changes stability,
+    in Hz), how many other kinds of periodic orbit, what the brute force settles on (its largest amplitude, where on
+    no periodic motion, where the two sweeps disagree: coexisting attractors), how many special points; then the table
+    of every kind of orbit (:func:`orbit_table`)."""
+    label = coordinate_label(first_coordinate(dataset))
+    meanings = _flags(dataset["brute_regime"])
+    frequency = dataset["frequency"].values
+    step = float(np.median(np.diff(frequency))) if frequency.size > 1 else 1.0
+    kinds = _flags(dataset["special_point_kind"])
+    parts = []
+    for i, r in enumerate(dataset["restitution"].values):
+        amplitude, regime, wild = _brute_facts(dataset, i)
+        words = [f"<b>R = {fmt(r, 'g')}</b>:", html.escape(_main_orbit(dataset, float(r), orbit_rows(dataset, float(r))))]
+        if np.isfinite(amplitude).any():
+            j, k = np.unravel_index(int(np.nanargmax(amplitude)), amplitude.shape)
+            kind = meanings[int(regime[j, k]) + 1].replace("_", " ")
+            words.append(f"the brute force settles at most on |{label}| = {fmt(amplitude[j, k] * 1e3, '.3g')} mm ({fmt(frequency[k], '.2f')} Hz, "
+                         f"sweeping {dataset['sweep'].values[j]}: {kind});")  # fmt: skip
+        words.append(f"no periodic motion at {int(wild.sum())} of {frequency.size} frequencies{' (' + _ranges(frequency[wild], step) + ')' if wild.any() else ''};")
+        if regime.shape[0] > 1:
+            scale = np.nanmax(amplitude) if np.isfinite(amplitude).any() else 1.0
+            differ = (regime != regime[:1]).any(axis=0) | (np.abs(np.nan_to_num(amplitude - amplitude[:1])) > 0.05 * scale).any(axis=0)
+            words.append(f"the sweeps settle on different motions (coexisting attractors) at {int(differ.sum())} frequencies"
+                         f"{' (' + _ranges(frequency[differ], step) + ')' if differ.any() else ''};")  # fmt: skip
+        mask = np.isclose(dataset["special_point_restitution"].values, r)
+        counts = [f"{int(np.count_nonzero(dataset['special_point_kind'].values[mask] == code))} {KIND_NAMES.get(kind, kind)}" for code, kind in enumerate(kinds)]
+        words.append(f"special points: {', '.join(counts)}.")
+        parts.append("<p>" + " ".join(words) + "</p>" + orbit_table(dataset, float(r)))
+    return "".join(parts)
 
 
 def _lines(dataset: xr.Dataset, key: str) -> list[str]:
@@ -156,23 +230,38 @@ def _found_on(point: xr.Dataset) -> str:
     return str(int(point["special_point_branch"]))
 
 
+def _multipliers(mu: np.ndarray) -> str:
+    """Floquet multipliers in a few characters each: a complex pair once, ``0.739±0.655i``; real ones to 4 digits."""
+    parts = []
+    for m in mu:
+        if abs(m.imag) <= 1e-9 * max(abs(m), 1e-300):
+            parts.append(fmt(m.real, ".4g"))
+        elif m.imag > 0:
+            parts.append(f"{fmt(m.real, '.3f')}±{fmt(m.imag, '.3f')}i")
+    return ", ".join(parts)
+
+
+
+
 def special_point_table(dataset: xr.Dataset) -> Table:
-    """Every located special point: kind, frequency, R, the orbit, its multipliers and what happens there."""
+    """Every located special point, once (in order of R and frequency): kind, frequency, R, the branches it was found
+    on, the orbit there, its largest multiplier modulus and multipliers, and what happens there; fits a 1400 px page
+    (the multipliers and the note wrap)."""
     kinds = _flags(dataset["special_point_kind"])
     rows = []
     order = np.lexsort((dataset["special_point_frequency"].values, dataset["special_point_restitution"].values))
     for k in order:
         point = dataset.isel(special_point=int(k))
         mu = point["special_point_multiplier_real"].values + 1j * point["special_point_multiplier_imag"].values
-        multipliers = ", ".join(f"{m.real:.4f}{m.imag:+.4f}j" if abs(m.imag) > 1e-9 else f"{m.real:.4f}" for m in mu)
         key = orbit_class(float(point["special_point_impacts_per_period"]), int(point["special_point_period_multiplicity"]))
+        kind = kinds[int(point["special_point_kind"])]
         cells = [
-            kinds[int(point["special_point_kind"])].replace("_", "-"), fmt(float(point["special_point_frequency"]), ".5f"),
-            fmt(float(point["special_point_restitution"]), "g"), _found_on(point), _orbit_label(key),
-            html.escape(multipliers), fmt(float(point["special_point_floquet_modulus"]), ".4f"), html.escape(str(point["special_point_note"].values)),
+            (KIND_NAMES.get(kind, kind), ""), (fmt(float(point["special_point_frequency"]), ".4f"), ""), (fmt(float(point["special_point_restitution"]), "g"), ""),
+            (_found_on(point), ""), (_orbit_label(key), _TEXT), (fmt(float(point["special_point_floquet_modulus"]), ".4g"), ""),
+            (_multipliers(mu), _WRAP.format(11)), (str(point["special_point_note"].values), _WRAP.format(18)),
         ]  # fmt: skip
-        rows.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
-    header = "".join(f"<th>{h}</th>" for h in ("kind", "frequency [Hz]", "R", "branch", "orbit", "Floquet multipliers", "max |mu|", "what happens there"))
+        rows.append("<tr>" + "".join(f"<td style='{style}'>{html.escape(c)}</td>" if style else f"<td>{html.escape(c)}</td>" for c, style in cells) + "</tr>")
+    header = "".join(f"<th>{h}</th>" for h in ("kind", "frequency [Hz]", "R", "branches", "orbit", "max |mu|", "Floquet multipliers (a complex pair once)", "what happens there"))
     return Table("Special points", f"<table><tr>{header}</tr>{''.join(rows)}</table>")
 
 
