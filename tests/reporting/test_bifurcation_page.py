@@ -87,3 +87,15 @@ def test_every_kind_of_orbit_has_its_own_look(dataset: xr.Dataset) -> None:
         assert len(set(drawn)) == len(drawn) and not {c for c, _ in drawn} & set(SWEEP_COLOURS.values())
         assert all(look["color"] == "k" for key, look in looks.items() if not key[0])
     assert len(orbit_looks(many, 0.8)) == 14
+
+
+def test_the_orbits_table_takes_its_own_restitution_s_special_points(dataset: xr.Dataset) -> None:
+    """Branch labels run across restitutions: a row of R = 0.8 lists the special points of R = 0.8 only (half the
+    points moved to another R must leave it)."""
+    from vibroimpact.kinds.bifurcation.page import orbit_rows
+
+    n = dataset.sizes["special_point"]
+    moved = dataset.assign_coords(special_point_restitution=("special_point", np.where(np.arange(n) % 2 == 1, 0.5, 0.8)))
+    listed = sorted(f for row in orbit_rows(moved, 0.8) for values in row["special"].values() for f in values)
+    kept = moved["special_point_frequency"].values[np.arange(n) % 2 == 0]
+    assert n > 2 and np.allclose(listed, np.sort(kept))

@@ -120,11 +120,12 @@ def orbit_rows(dataset: xr.Dataset, restitution: float) -> list[dict[str, object
     classes = _branch_classes(dataset)
     kinds = _flags(dataset["special_point_kind"])
     branch_of = {int(b): tuple(c) for b, c in zip(dataset["branch"].values, classes)}
+    sp_at_r = np.isclose(dataset["special_point_restitution"].values, restitution)
     rows = []
     for key in sorted({tuple(c) for c in classes[at_r]}, key=lambda k: (k[1], k[0])):
         chosen = at_r & (classes == key).all(axis=1)
-        points = [branch_of.get(int(b)) == key for b in dataset["special_point_branch"].values]
-        special = {kind: dataset["special_point_frequency"].values[np.array(points, dtype=bool) & (dataset["special_point_kind"].values == code)] for code, kind in enumerate(kinds)}
+        points = np.array([branch_of.get(int(b)) == key for b in dataset["special_point_branch"].values], dtype=bool) & sp_at_r
+        special = {kind: dataset["special_point_frequency"].values[points & (dataset["special_point_kind"].values == code)] for code, kind in enumerate(kinds)}
         rows.append({
             "key": key, "name": _orbit_label(key), "branches": np.unique(dataset["branch"].values[chosen]).tolist(),
             "exists": _bands(dataset, chosen), "stable": _bands(dataset, chosen & (dataset["stable"].values == 1)), "special": special,
