@@ -142,7 +142,7 @@ def orbit_table(dataset: xr.Dataset, restitution: float) -> str:
         special = row["special"]
         cells = [row["name"], ", ".join(map(str, row["branches"])), _band_text(row["exists"], 6), _band_text(row["stable"], 6) or "nowhere",
                  *(_at(special.get(k, np.zeros(0)), 6) for k in STABILITY_KINDS)]  # fmt: skip
-        body.append("<tr>" + "".join(f"<td style='{_TEXT}'>{html.escape(c)}</td>" for c in cells) + "</tr>")
+        body.append("<tr>" + "".join(f"<td style='{_WRAP.format(10) if n == 0 else _TEXT}'>{html.escape(c)}</td>" for n, c in enumerate(cells)) + "</tr>")
     caption = f"<caption style='{_TEXT};caption-side:top'>Every kind of periodic orbit continued at R = {fmt(restitution, 'g')}</caption>"
     header = "".join(f"<th style='{_TEXT}'>{h}</th>" for h in head)
     return f"<table>{caption}<tr>{header}</tr>{''.join(body)}</table>"
@@ -156,21 +156,21 @@ def _main_orbit(dataset: xr.Dataset, restitution: float, rows: list[dict[str, ob
     at_r = np.isclose(dataset["branch_restitution"].values, restitution) & np.isin(dataset["branch_origin"].values, closed)
     impacting = [row for row in rows if row["key"][0]]
     if not at_r.any():
-        return f"no branch from the closed form; {len(impacting)} kind{'s' if len(impacting) != 1 else ''} of impacting periodic orbit (table);"
+        return f"no branch from the closed form; {len(impacting)} kind{'s' if len(impacting) != 1 else ''} of impacting periodic orbit (table below);"
     key = tuple(_branch_classes(dataset)[np.flatnonzero(at_r)[0]])
     row = next(r for r in rows if r["key"] == key)
     special = row["special"]
     words = f"the closed-form orbit ({row['name']}) exists over {_band_text(row['exists'])} Hz and is " + (f"stable over {_band_text(row['stable'])} Hz" if row["stable"] else "nowhere stable")
     changes = [f"{KIND_NAMES[k]} at {_at(special[k])} Hz" for k in STABILITY_KINDS if special.get(k, np.zeros(0)).size]
     others = len(impacting) - 1
-    return f"{words}{' (' + '; '.join(changes) + ')' if changes else ''}; {others} other kind{'s' if others != 1 else ''} of impacting periodic orbit (table);"
+    return f"{words}{' (' + '; '.join(changes) + ')' if changes else ''}; {others} other kind{'s' if others != 1 else ''} of impacting periodic orbit (table below);"
 
 
 def answer_text(dataset: xr.Dataset) -> str:
     """The answer, per restitution: the closed-form orbit (where it exists, is stable, folds and changes stability,
-    in Hz), how many other kinds of periodic orbit, what the brute force settles on (its largest amplitude, where on
-    no periodic motion, where the two sweeps disagree: coexisting attractors), how many special points; then the table
-    of every kind of orbit (:func:`orbit_table`)."""
+    in Hz), how many other kinds of periodic orbit (:func:`orbit_table`), what the brute force settles on (its largest
+    amplitude, where on no periodic motion, where the two sweeps disagree: coexisting attractors), how many special
+    points."""
     label = coordinate_label(first_coordinate(dataset))
     meanings = _flags(dataset["brute_regime"])
     frequency = dataset["frequency"].values
@@ -194,7 +194,7 @@ def answer_text(dataset: xr.Dataset) -> str:
         mask = np.isclose(dataset["special_point_restitution"].values, r)
         counts = [f"{int(np.count_nonzero(dataset['special_point_kind'].values[mask] == code))} {KIND_NAMES.get(kind, kind)}" for code, kind in enumerate(kinds)]
         words.append(f"special points: {', '.join(counts)}.")
-        parts.append("<p>" + " ".join(words) + "</p>" + orbit_table(dataset, float(r)))
+        parts.append("<p>" + " ".join(words) + "</p>")
     return "".join(parts)
 
 
@@ -258,11 +258,12 @@ def special_point_table(dataset: xr.Dataset) -> Table:
         kind = kinds[int(point["special_point_kind"])]
         cells = [
             (KIND_NAMES.get(kind, kind), ""), (fmt(float(point["special_point_frequency"]), ".4f"), ""), (fmt(float(point["special_point_restitution"]), "g"), ""),
-            (_found_on(point), ""), (_orbit_label(key), _TEXT), (fmt(float(point["special_point_floquet_modulus"]), ".4g"), ""),
+            (_found_on(point), ""), (_orbit_label(key), _WRAP.format(8)), (fmt(float(point["special_point_floquet_modulus"]), ".4g"), ""),
             (_multipliers(mu), _WRAP.format(11)), (str(point["special_point_note"].values), _WRAP.format(18)),
         ]  # fmt: skip
         rows.append("<tr>" + "".join(f"<td style='{style}'>{html.escape(c)}</td>" if style else f"<td>{html.escape(c)}</td>" for c, style in cells) + "</tr>")
-    header = "".join(f"<th>{h}</th>" for h in ("kind", "frequency [Hz]", "R", "branches", "orbit", "max |mu|", "Floquet multipliers (a complex pair once)", "what happens there"))
+    heads = ("kind", "frequency [Hz]", "R", "branches", "orbit", "max |mu|", "Floquet multipliers (a complex pair once)", "what happens there")
+    header = "".join(f"<th style='{_TEXT}'>{h}</th>" if h in ("orbit", "Floquet multipliers (a complex pair once)", "what happens there") else f"<th>{h}</th>" for h in heads)
     return Table("Special points", f"<table><tr>{header}</tr>{''.join(rows)}</table>")
 
 
@@ -285,7 +286,8 @@ class BifurcationPage:
         (what a reader checks, not what they read first)."""
         figures = saved(bifurcation_figures(self.dataset), out)
         chart = [f for f in figures if f.path.stem == "chart"]
-        answer = answer_text(self.dataset) + failure_text(self.dataset)
+        tables = "".join(orbit_table(self.dataset, float(r)) for r in self.dataset["restitution"].values)
+        answer = answer_text(self.dataset) + failure_text(self.dataset) + tables  # what failed right after the answer
         sections = [Section("Bifurcation diagrams", answer, [f for f in figures if f not in chart], [special_point_table(self.dataset)])]
         if chart:
             sections.append(Section("Two-parameter chart", "", chart))
