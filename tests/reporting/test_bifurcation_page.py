@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 import xarray as xr
 
@@ -21,7 +22,7 @@ def test_the_report_has_every_figure(dataset: xr.Dataset, tmp_path: Path) -> Non
     html = write_report(dataset, tmp_path).read_text(encoding="utf-8")
     names = {p.stem for p in tmp_path.glob("*.png")}
     assert names == {"bifurcation_R0", "multipliers_R0", "chart"}
-    assert html.count("<figure") == 3 and "Special points" in html and "neimark-sacker" in html
+    assert html.count("<figure") == 3 and "Special points" in html and "Neimark-Sacker" in html
     assert "Two-parameter chart" in html and "brute-force" in html
 
 
@@ -40,8 +41,61 @@ def test_the_page_opens_with_its_answer(dataset: xr.Dataset) -> None:
     assert headline(dataset) == f"R = 0.8: up to {top}, no periodic motion at {wild} of {dataset.sizes['frequency']} frequencies"
     text = answer_text(dataset)
     counts = np.bincount(dataset["special_point_kind"].values, minlength=4)
-    assert f"special points: {counts[0]} fold, {counts[1]} period-doubling, {counts[2]} neimark-sacker, {counts[3]} grazing." in text
-    # R = 0.8: the one-impact orbit is stable from its Neimark-Sacker point (23.39 Hz) up
-    one = dataset.where((dataset["branch_origin"] == 1) & (dataset["stable"] == 1), drop=True)
-    assert f"the closed-form orbit is stable over {one['branch_frequency'].values.min():.2f}-" in text
-    assert abs(float(one["branch_frequency"].min()) - 23.386) < 0.01
+    assert f"special points: {counts[0]} fold, {counts[1]} period doubling, {counts[2]} Neimark-Sacker, {counts[3]} grazing." in text
+    # R = 0.8: the one-impact orbit exists from the band's start, is stable from its Neimark-Sacker point (23.39 Hz) up
+    one = dataset.where(dataset["branch_origin"] == 1, drop=True)
+    stable = one.where(one["stable"] == 1, drop=True)
+    assert abs(float(stable["branch_frequency"].min()) - 23.386) < 0.01
+    assert (f"the closed-form orbit (1 impact per period) exists over {one['branch_frequency'].values.min():.2f}-" in text
+            and f"is stable over {stable['branch_frequency'].values.min():.2f}-" in text and "Neimark-Sacker at 23.39" in text)  # fmt: skip
+
+
+def test_the_answer_lists_every_kind_of_orbit(dataset: xr.Dataset) -> None:
+    """The table after the answer has a row per class of continued branch, with its branches and where it exists."""
+    from vibroimpact.kinds.bifurcation.figures import branch_class, orbit_label
+    from vibroimpact.kinds.bifurcation.page import orbit_rows
+
+    classes: dict[tuple[int, int], list[int]] = {}
+    for label in np.unique(dataset["branch"].values):
+        branch = dataset.isel(branch_point=np.flatnonzero(dataset["branch"].values == label))
+        classes.setdefault(branch_class(branch["impacts_per_period"].values, branch["period_multiplicity"].values), []).append(int(label))
+        f = branch["branch_frequency"].values
+        row = next(r for r in orbit_rows(dataset, 0.8) if int(label) in r["branches"])
+        assert any(a <= f.min() + 1e-9 and f.max() <= b + 1e-9 for a, b in row["exists"])  # where the branch exists
+    rows = orbit_rows(dataset, 0.8)
+    assert {r["key"]: r["branches"] for r in rows} == classes and [r["name"] for r in rows] == [orbit_label(k) for k in sorted(classes, key=lambda k: (k[1], k[0]))]
+
+
+def test_every_kind_of_orbit_has_its_own_look(dataset: xr.Dataset) -> None:
+    """Within a restitution no two classes of orbit are drawn alike (colour and marker), none in the brute-force
+    dots' colours; the linear orbit is black."""
+    from vibroimpact.kinds.bifurcation.figures import orbit_looks
+    from vibroimpact.reporting.style import SWEEP_COLOURS
+
+    impacts, period = np.array([0, 1, 2, 1, 2, 1, 3, 3, 2, 3, 4, 7, 13, 12]), np.array([1, 1, 1, 2, 2, 3, 3, 5, 6, 7, 7, 10, 17, 13])
+    labels = np.repeat(np.arange(impacts.size), 2)  # 14 branches of two points: the linear orbit and 13 classes, as the shipped study has
+    zeros = np.zeros(labels.size)
+    many = xr.Dataset(
+        {name: ("branch_point", zeros) for name in ("x1_amplitude", "floquet_modulus", "stable")}
+        | {"impacts_per_period": ("branch_point", impacts[labels] / period[labels]), "period_multiplicity": ("branch_point", period[labels]),
+           "impact_velocity": (("branch_point", "orbit_impact"), zeros[:, None])},
+        coords={"branch": ("branch_point", labels), "branch_restitution": ("branch_point", np.full(labels.size, 0.8))},
+    )  # fmt: skip
+    for data in (dataset, many):
+        looks = orbit_looks(data, 0.8)
+        drawn = [(look["color"], look.get("marker", "")) for key, look in looks.items() if key[0]]
+        assert len(set(drawn)) == len(drawn) and not {c for c, _ in drawn} & set(SWEEP_COLOURS.values())
+        assert all(look["color"] == "k" for key, look in looks.items() if not key[0])
+    assert len(orbit_looks(many, 0.8)) == 14
+
+
+def test_the_orbits_table_takes_its_own_restitution_s_special_points(dataset: xr.Dataset) -> None:
+    """Branch labels run across restitutions: a row of R = 0.8 lists the special points of R = 0.8 only (half the
+    points moved to another R must leave it)."""
+    from vibroimpact.kinds.bifurcation.page import orbit_rows
+
+    n = dataset.sizes["special_point"]
+    moved = dataset.assign_coords(special_point_restitution=("special_point", np.where(np.arange(n) % 2 == 1, 0.5, 0.8)))
+    listed = sorted(f for row in orbit_rows(moved, 0.8) for values in row["special"].values() for f in values)
+    kept = moved["special_point_frequency"].values[np.arange(n) % 2 == 0]
+    assert n > 2 and np.allclose(listed, np.sort(kept))

@@ -104,6 +104,9 @@ class StudyPage(Protocol):
         """The page's sections, their figures written into ``out``."""
         ...
 
+    # A page may set ``states_failures = True`` when it says the run's failures itself (:func:`write_report` then adds
+    # no "What failed in this run" section of its own).
+
 
 def save_figure(drawn: DrawnFigure, out_dir: Path) -> Figure:
     """Write ``drawn`` as ``out_dir/<name>.png`` atomically, close it, and return its record."""
@@ -262,7 +265,8 @@ def write_report(dataset: xr.Dataset, out_dir: str | Path, jobs: int = 1) -> Pat
     page = page_for(dataset)
     with rendering(jobs):
         sections = page.sections(out)
-    sections = with_failures(sections, run_failures(dataset), failure_details(dataset))
+    if not getattr(page, "states_failures", False):  # a page that places them itself (bifurcation: before its tables)
+        sections = with_failures(sections, run_failures(dataset), failure_details(dataset))
     paragraphs = [record.description, f"vibroimpact {record.version}; {page.summary()}."]
     return write_page(out / "report.html", render_page(f"Study '{record.name}'", paragraphs, sections, record.scene_text))
 

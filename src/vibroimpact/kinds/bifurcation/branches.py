@@ -35,7 +35,7 @@ from vibroimpact.orbits.continuation import ContinuationSettings, continue_branc
 from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures, section_phase
 from vibroimpact.orbits.shooting import shoot
 
-__all__ = ["ORIGINS", "MAX_ORBIT_IMPACTS", "map_bounds", "problem_at", "stop_values", "OrbitSet", "find_branches", "closed_form_orbits", "linear_segments"]
+__all__ = ["ORIGINS", "MAX_ORBIT_IMPACTS", "SAME_POINT_FREQUENCY", "SAME_POINT_ORBIT", "same_special_point", "map_bounds", "problem_at", "stop_values", "OrbitSet", "find_branches", "closed_form_orbits", "linear_segments"]
 
 #: How a branch was found (CF flags of ``branch_origin``): the closed forms' kinds (one impact per period, the
 #: symmetric two impacts of a two-sided stop) are :data:`vibroimpact.analysis.layout.KINDS`.
@@ -50,6 +50,31 @@ SAME_ORBIT = 0.02
 MAX_GRAZING_BRANCHES = 8
 #: |max |mu| - 1| up to which an orbit is marginal (``stable`` = 2) [-].
 MARGINAL = 1e-9
+#: Two special points of one kind are one point when their frequencies differ by at most this, relative [-]. The
+#: continuation locates a special point to 1e-10 relative (``locate_tolerance``): the same point found from two
+#: branches (a branch and the branch born there, a seeded branch on a known orbit, an isola lapped several times)
+#: agreed to 3.5e-12 in the shipped study; its closest distinct pairs of one kind (a period-k orbit's grazing point
+#: and its period-2k child's, 36.01 Hz at R = 0.8 and 38.49 Hz at R = 0.2) differ by 4.7e-6 and 7.6e-6.
+SAME_POINT_FREQUENCY = 1e-6
+#: ... and when the fundamental amplitudes of every coordinate of their orbits differ by at most this, relative to the
+#: larger (Euclidean norms) [-]. At a fold or a grazing point an orbit moves as the square root of the distance in
+#: frequency, so a location good to 1e-10 leaves the orbit good to ~1e-5 (measured: up to 4.5e-6, the golden
+#: scene's grazing point at 33.97 Hz found from a period-1 and a period-7 branch); the two distinct pairs above differ
+#: in X1 by 2.9e-3 and 2.5e-4. Amplitudes, not states: each branch has its own stroboscopic section, so one orbit has
+#: different states on two branches, while a period-1 orbit has the same amplitudes as its period-k description.
+SAME_POINT_ORBIT = 1e-4
+
+
+def same_special_point(a: dict, b: dict) -> bool:
+    """Are two special-point records (``kind``, ``frequency`` [Hz], ``amplitudes`` [m] of every coordinate) one
+    point: same kind, frequencies within :data:`SAME_POINT_FREQUENCY` and amplitudes within :data:`SAME_POINT_ORBIT`,
+    relative?"""
+    if a["kind"] != b["kind"]:
+        return False
+    if abs(a["frequency"] - b["frequency"]) > SAME_POINT_FREQUENCY * max(abs(a["frequency"]), abs(b["frequency"])):
+        return False
+    x, y = np.asarray(a["amplitudes"], dtype=float), np.asarray(b["amplitudes"], dtype=float)
+    return bool(np.linalg.norm(x - y) <= SAME_POINT_ORBIT * max(np.linalg.norm(x), np.linalg.norm(y)))
 
 
 def problem_at(problem: ImpactProblem, frequency: float, clearance: float | None = None, phase: float | None = None) -> ImpactProblem:
@@ -74,14 +99,28 @@ def stop_values(problem: ImpactProblem) -> tuple[float, float]:
 @dataclass
 class OrbitSet:
     """Branches and special points of one restitution, as lists of per-point records (see :meth:`add_branch`), and
-    the continued branches with their maps (``maps``: (ImpactMap, Branch) pairs)."""
+    the continued branches with their maps (``maps``: (ImpactMap, Branch) pairs). A special point is kept once
+    (:func:`same_special_point`), with the labels of every branch it was found on (``found_on``). What failed is
+    counted (``attempts`` and ``failures`` by kind of work: :meth:`attempted`, :meth:`failed`)."""
 
     points: list[dict] = field(default_factory=list)
     specials: list[dict] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     count: int = 0
     maps: list = field(default_factory=list)
+    attempts: dict[str, int] = field(default_factory=dict)
+    failures: list[tuple[str, str]] = field(default_factory=list)
     _index: tuple | None = None
+
+    def attempted(self, what: str) -> None:
+        """Count one attempt of a kind of work that may fail (``branch``: a branch's start and continuation,
+        ``seed``: a brute-force seed; :data:`vibroimpact.kinds.bifurcation.logs.FAILURES`)."""
+        self.attempts[what] = self.attempts.get(what, 0) + 1
+
+    def failed(self, what: str, detail: str) -> None:
+        """Record a failed attempt of kind ``what`` with its raw message ``detail`` (one line), in the notes too."""
+        self.failures.append((what, detail))
+        self.notes.append(detail)
 
     def add_branch(self, system: ImpactMap, branch: Branch, origin: str) -> int:
         """Measure every orbit of ``branch`` and keep it with its special points; return its label."""
@@ -90,9 +129,21 @@ class OrbitSet:
         for orbit in branch.orbits:
             self.points.append(_record(system, orbit) | {"branch": label, "origin": ORIGINS.index(origin)})
         for point in branch.special_points:
-            self.specials.append(_record(system, point.orbit) | {"branch": label, "kind": SPECIAL_POINT_KINDS.index(point.kind), "frequency": point.value, "note": point.note})
+            self.add_special(_record(system, point.orbit) | {"branch": label, "kind": SPECIAL_POINT_KINDS.index(point.kind), "frequency": point.value, "note": point.note})
         self.notes.append(f"branch {label} ({origin}): {len(branch.orbits)} points, {branch.values.min():.4f}-{branch.values.max():.4f} Hz, ends: {branch.end}")
         return label
+
+    def add_special(self, record: dict) -> dict:
+        """Keep a special point's record (``branch``, ``kind``, ``frequency`` [Hz], ``amplitudes`` [m], ...) unless
+        a kept one is the same point (:func:`same_special_point`): then add its branch to that one's ``found_on``;
+        return the kept record."""
+        twin = next((known for known in self.specials if same_special_point(known, record)), None)
+        if twin is None:
+            twin = record | {"found_on": [record["branch"]]}
+            self.specials.append(twin)
+        elif record["branch"] not in twin["found_on"]:
+            twin["found_on"].append(record["branch"])
+        return twin
 
     def add_linear(self, problem: ImpactProblem, frequency: NDArray[np.float64]) -> None:
         """The impactless orbit of ``problem`` on one segment of frequencies [Hz] where it fits inside every stop."""
@@ -234,11 +285,11 @@ def find_branches(
             progress(f"R = {restitution:g}: {message}")
 
     def attempt(what: str, run) -> None:
+        found.attempted("branch")
         try:
             run()
         except Exception as error:  # noqa: BLE001 - a failed branch is recorded, the others go on
-            found.notes.append(f"{what} failed: {type(error).__name__}: {str(error)[:200]}")
-            say(f"{what} failed ({type(error).__name__})")
+            found.failed("branch", f"{what} failed: {type(error).__name__}: {str(error)[:200]}")
 
     maps: list[tuple[ImpactMap, Branch]] = []
     if linear:

@@ -9,7 +9,8 @@ of one restitution, and the two-parameter chart's curves.
   :func:`~vibroimpact.orbits.motion.classify_strobes`). A strictly negative Lyapunov exponent means a periodic
   orbit approached slowly: the motion is classified by the period that repeats best.
 * :class:`BranchCase`: :func:`vibroimpact.kinds.bifurcation.branches.find_branches` of one restitution.
-* :class:`ChartCase`: the special points of the chart's restitution followed in (frequency, clearance): folds, period
+* :class:`ChartCase`: the special points of the chart's restitution followed in (frequency, clearance), from the
+  branches of its own continuation (their labels and frequency ranges are returned too): folds, period
   doublings and Neimark-Sacker points continued (:func:`vibroimpact.orbits.continuation.continue_special_point`), the
   points where a free flight of an orbit touches the stop traced by repeated location
   (:func:`vibroimpact.orbits.grazing_curve.trace_grazing`), and the closed-form orbit's vanishing impact velocity
@@ -33,6 +34,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.engines.exact import ExactEngine
+from vibroimpact.kinds.bifurcation.logs import FAILURE_FIELDS, failure_arrays
 from vibroimpact.kinds.bifurcation.branches import OrbitSet, map_bounds, problem_at, stop_values, MAX_ORBIT_IMPACTS, find_branches
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import lower_period_maps, SPECIAL_POINT_KINDS, Iterated
@@ -145,17 +147,19 @@ def seed_branches(
             break
         at = problem_at(problem, seed.frequency)
         sweep_map = ImpactMap(at, seed.period, engine, bounds)
+        period = seed.period
+        found.attempted("seed")
         try:
             orbit = shoot(sweep_map, np.array(seed.state), sweep_map.parameters)
-        except ShootingError:
+            for d, lower in reversed(lower_period_maps(sweep_map)):  # a slowly settled point may repeat after a multiple
+                if np.max(np.abs(lower.evaluate(orbit.state, orbit.parameters).image - orbit.state) / sweep_map.state_scale) < 1e-7:
+                    period, sweep_map = d, ImpactMap(at, d, engine, bounds)
+                    orbit = shoot(sweep_map, orbit.state, sweep_map.parameters)
+                    break
+        except ShootingError as error:
+            found.failed("seed", _seed_failure(seed, error))
             failed += 1
             continue
-        period = seed.period
-        for d, lower in reversed(lower_period_maps(sweep_map)):  # a slowly settled point may repeat after a multiple
-            if np.max(np.abs(lower.evaluate(orbit.state, orbit.parameters).image - orbit.state) / sweep_map.state_scale) < 1e-7:
-                period, sweep_map = d, ImpactMap(at, d, engine, bounds)
-                orbit = shoot(sweep_map, orbit.state, sweep_map.parameters)
-                break
         if not orbit.stable:  # not the attractor the sweep settled on (its strobes only nearly repeated)
             unstable += 1
             continue
@@ -170,7 +174,7 @@ def seed_branches(
             start = shoot(mapping, state, mapping.parameters)
             branch = continue_branch(mapping, start, "frequency", settings)
         except (ShootingError, RuntimeError, ValueError) as error:
-            found.notes.append(f"brute-force seed at {seed.frequency:.3f} Hz (period {seed.period}) failed: {type(error).__name__}: {str(error)[:160]}")
+            found.failed("seed", _seed_failure(seed, error))
             failed += 1
             continue
         label = found.add_branch(mapping, branch, "brute_force")
@@ -181,6 +185,12 @@ def seed_branches(
             progress(f"R = {restitution:g}: branch {label} from the brute force at {seed.frequency:.3f} Hz (period {period}): {len(branch.orbits)} points")
     found.notes.append(f"brute-force seeds: {len(seeds)}, {added} new branches, {skipped} on known branches, {unstable} unstable (no attractor), {failed} not converged")
     return added
+
+
+def _seed_failure(seed: Seed, error: Exception) -> str:
+    """The raw message of a seed that failed (one line)."""
+    return f"brute-force seed at {seed.frequency:.3f} Hz (period {seed.period}) failed: {type(error).__name__}: {str(error)[:160]}"
+
 
 #: What the motion at a brute-force point is (CF flags of ``brute_regime`` and ``chart_regime``, values 0...).
 MOTION_CLASSES = ("linear", "one_impact", "other_periodic", "quasi_periodic", "chaotic", "irregular")
@@ -204,7 +214,7 @@ class SweepCase:
     transient: int
     strobes: int
     engine: str = "exact"
-    fields: tuple[str, ...] = ("strobe", "amplitude", "velocity", "impacts", "regime", "period", "lyapunov", "state")
+    fields: tuple[str, ...] = ("strobe", "amplitude", "velocity", "impacts", "regime", "period", "lyapunov", "state", "error")
     progress_unit: str = "frequency points"
 
     @property
@@ -217,7 +227,8 @@ class SweepCase:
         return case_key({"kind": "bifurcation_sweep", **asdict(self)})
 
     def run(self, report: ProgressReport | None = None) -> CaseResult:
-        """Arrays over the frequencies in increasing order (whatever the direction)."""
+        """Arrays over the frequencies in increasing order (whatever the direction); ``error``: the raw message where
+        the engine failed (``regime`` -1), else empty."""
         engine = ExactEngine()
         f = np.array(self.frequencies)
         order = np.argsort(f) if self.direction == "up" else np.argsort(f)[::-1]
@@ -228,16 +239,18 @@ class SweepCase:
             "state": np.full((n, width), np.nan),
         }  # fmt: skip
         state = None
+        errors = [""] * n
         for done, k in enumerate(order):
             problem = problem_at(self.problem, float(f[k]))
             state = _linear_start(problem) if state is None else state
             try:
                 state = _measure(engine, problem, state, self.transient, s, out, k)
-            except RuntimeError:  # the engine made no progress (endless chattering): start the next point at rest
+            except RuntimeError as error:  # the engine made no progress (endless chattering): start the next point at rest
                 state = resting_state(problem)
+                errors[k] = f"{type(error).__name__}: {str(error)[:160]}"
             if report is not None:
                 report(done + 1)
-        return out
+        return out | {"error": np.array(errors, dtype=str)}
 
 
 def _linear_start(problem: ImpactProblem) -> NDArray[np.float64]:
@@ -289,7 +302,7 @@ BRANCH_FIELDS = (
     "branch", "origin", "frequency", "amplitudes", "impulse", "floquet_modulus", "stable", "impacts", "period",
     "multipliers_real", "multipliers_imag", "velocities",
     "sp_branch", "sp_kind", "sp_frequency", "sp_amplitudes", "sp_impulse", "sp_floquet_modulus", "sp_impacts", "sp_period",
-    "sp_multipliers_real", "sp_multipliers_imag", "sp_note", "notes",
+    "sp_multipliers_real", "sp_multipliers_imag", "sp_note", "sp_found_on", "notes", *FAILURE_FIELDS,
 )  # fmt: skip
 
 
@@ -334,7 +347,8 @@ class BranchCase:
 
 def branch_arrays(found: OrbitSet, size: int) -> CaseResult:
     """Flat arrays of an :class:`OrbitSet` of a structure of ``size`` coordinates (one row per branch point, one per
-    special point; amplitudes (rows, N), multipliers (rows, 2N))."""
+    special point; amplitudes (rows, N), multipliers (rows, 2N); ``sp_found_on``: the labels of every branch a special
+    point was found on, space-separated)."""
 
     def column(rows: list[dict], name: str, dtype: type = float) -> np.ndarray:
         return np.array([row[name] for row in rows], dtype=dtype)
@@ -359,8 +373,10 @@ def branch_arrays(found: OrbitSet, size: int) -> CaseResult:
         "sp_amplitudes": table(specials, "amplitudes", size), "sp_impulse": column(specials, "impulse"),
         "sp_floquet_modulus": column(specials, "floquet_modulus"), "sp_impacts": column(specials, "impacts", int),
         "sp_period": column(specials, "period", int), "sp_multipliers_real": sm.real, "sp_multipliers_imag": sm.imag,
-        "sp_note": np.array([row["note"] for row in specials], dtype=str), "notes": np.array(found.notes, dtype=str),
+        "sp_note": np.array([row["note"] for row in specials], dtype=str), "sp_found_on": np.array([" ".join(map(str, row["found_on"])) for row in specials], dtype=str),
+        "notes": np.array(found.notes, dtype=str), **failure_arrays(found.attempts, found.failures),
     }  # fmt: skip
+
 
 
 @dataclass(frozen=True, eq=False)
@@ -375,7 +391,7 @@ class ChartCase:
     kinds: tuple[str, ...]
     max_steps: int
     engine: str = "exact"
-    fields: tuple[str, ...] = ("curve", "kind", "frequency", "clearance", "notes")
+    fields: tuple[str, ...] = ("curve", "kind", "frequency", "clearance", "notes", "branch_label", "branch_origin", "branch_low", "branch_high", *FAILURE_FIELDS)
     progress_unit: str = "charts"
 
     @property
@@ -396,6 +412,8 @@ class ChartCase:
         settings = ContinuationSettings(max_steps=self.max_steps, max_step=0.2)
         rows: list[tuple[int, int, float, float]] = []
         notes = list(found.notes)
+        attempts = {f"chart_{kind}": count for kind, count in found.attempts.items()}  # the chart's own branches
+        failures = [(f"chart_{kind}", detail) for kind, detail in found.failures]
         curve = 0
         if "grazing" in self.kinds:
             for f, d in _grazing_curves(self.problem, self.low, self.high, low_c, high_c):
@@ -409,6 +427,7 @@ class ChartCase:
                     continue  # the closed-form orbit's vanishing impact: the linear-response curve above
                 if any(k == kind and abs(f - point.value) < 1e-3 and abs(d - clearance) < 1e-6 for _c, k, f, d in rows):
                     continue  # on a curve already followed
+                attempts["curve"] = attempts.get("curve", 0) + 1
                 try:
                     if point.kind == "grazing":  # not differentiable there: located again at each clearance
                         special = trace_grazing(system, point, "clearance", bounds)
@@ -417,14 +436,28 @@ class ChartCase:
                         special = continue_special_point(system, point, "clearance", settings, bounds=bounds)
                         how = "continued"
                 except Exception as error:  # noqa: BLE001 - a curve that cannot be followed is recorded, not fatal
-                    notes.append(f"{point.kind} curve from {point.value:.4f} Hz failed: {type(error).__name__}: {str(error)[:160]}")
+                    failures.append(("curve", f"{point.kind} curve from {point.value:.4f} Hz failed: {type(error).__name__}: {str(error)[:160]}"))
+                    notes.append(failures[-1][1])
                     continue
                 f, d = special.values("frequency"), special.values("clearance")
                 notes.append(f"{point.kind} curve {curve} from {point.value:.4f} Hz {how}: {f.size} points, {d.min() * 1e3:.3f}-{d.max() * 1e3:.3f} mm, ends: {special.end}")
                 rows += [(curve, kind, fi, di) for fi, di in zip(f, d)]
                 curve += 1
         table = np.array(rows, dtype=float).reshape(-1, 4)
-        return {"curve": table[:, 0].astype(int), "kind": table[:, 1].astype(int), "frequency": table[:, 2], "clearance": table[:, 3], "notes": np.array(notes, dtype=str)}
+        return {"curve": table[:, 0].astype(int), "kind": table[:, 1].astype(int), "frequency": table[:, 2], "clearance": table[:, 3], "notes": np.array(notes, dtype=str), **_branch_ranges(found),
+                **failure_arrays(attempts, failures)}  # fmt: skip
+
+
+def _branch_ranges(found: OrbitSet) -> CaseResult:
+    """Label, origin flag and frequency range [Hz] of each branch of ``found`` (``branch_label``, ``branch_origin``,
+    ``branch_low``, ``branch_high``)."""
+    labels = sorted({int(point["branch"]) for point in found.points})
+    frequency = {label: [point["frequency"] for point in found.points if point["branch"] == label] for label in labels}
+    origin = {int(point["branch"]): int(point["origin"]) for point in found.points}
+    return {
+        "branch_label": np.array(labels, dtype=int), "branch_origin": np.array([origin[k] for k in labels], dtype=int),
+        "branch_low": np.array([min(frequency[k]) for k in labels]), "branch_high": np.array([max(frequency[k]) for k in labels]),
+    }  # fmt: skip
 
 
 def _grazing_curves(problem: ImpactProblem, low: float, high: float, low_c: float, high_c: float, step: float = 0.01) -> list[tuple[np.ndarray, np.ndarray]]:

@@ -11,8 +11,9 @@ Output (``bifurcation.nc``; attributes from :data:`vibroimpact.scene.variables.B
   (branch_point, orbit_impact);
 * dimension ``special_point``: coordinates ``special_point_kind`` (CF flags ``fold period_doubling neimark_sacker
   grazing``), ``special_point_frequency`` [Hz], ``special_point_restitution``, ``special_point_branch``; the orbit's
-  multipliers and measures there (``special_point_<c0>_amplitude`` of the first coordinate c0), and
-  ``special_point_note``;
+  multipliers and measures there (``special_point_<c0>_amplitude`` of the first coordinate c0),
+  ``special_point_note`` and ``special_point_branches`` (every branch it was found on: each point is listed once,
+  :func:`~vibroimpact.kinds.bifurcation.branches.same_special_point`);
 * brute force along (``restitution``, ``sweep``, ``frequency``, ``strobe``): ``brute_<c0>``, ``brute_<c0>_amplitude``
   of the first coordinate (``brute_x1``, ``brute_x1_amplitude`` for the paper's system);
   along (restitution, sweep, frequency, ``impact``): ``brute_impact_velocity`` (NaN-padded); along (restitution,
@@ -21,6 +22,9 @@ Output (``bifurcation.nc``; attributes from :data:`vibroimpact.scene.variables.B
 * the chart: dimension ``chart_point`` with coordinates ``chart_curve``, ``chart_kind`` (flags as
   ``special_point_kind``), ``chart_frequency`` [Hz], ``chart_clearance`` [m]; the regime map ``chart_regime``
   (sweep, map_clearance, map_frequency) with ``chart_impacts_per_period`` and ``chart_period``.
+* what failed, when anything did (attributes, absent otherwise): ``run_failures``, one line per kind of work and
+  restitution, "<what failed>: <k> of <n> failed (<reasons>); <what it means for the results>", and
+  ``run_failure_details``, every raw message (:mod:`vibroimpact.kinds.bifurcation.logs`); the console gets one line.
 
 One netCDF group cannot hold ``frequency`` both as the brute force's dimension and as a coordinate of
 ``branch_point``, nor ``restitution`` as a dimension and a coordinate of ``special_point``: the branch and special
@@ -45,6 +49,7 @@ from vibroimpact.scene.layout import build_stops, describe_stop
 from vibroimpact.scene.schema import Scene
 from vibroimpact.scene.variables import BIFURCATION_ATTRIBUTES, COORDINATE_ATTRIBUTES, STABLE_ATTRIBUTES, flag_attributes
 from vibroimpact.kinds.bifurcation.branches import MAX_ORBIT_IMPACTS, ORIGINS
+from vibroimpact.kinds.bifurcation.logs import Tally, chart_labels, continuation_log, failure_summary, numbered_across, relabel, sweep_tally, tallies
 from vibroimpact.kinds.bifurcation.cases import MAX_KEPT_IMPACTS, MAX_PERIOD, MOTION_CLASSES, BranchCase, ChartCase, SweepCase, Seed, sweep_seeds
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.cluster import Progress
@@ -100,9 +105,6 @@ class BifurcationStudy:
             + (f"; the chart's curves (R = {chart.restitution:g})" if chart else ""))  # fmt: skip
         first = runner.map(charted + sweeps + maps)
         chart_result, swept = (first[0], first[1:]) if chart else (None, first)
-        if chart_result is not None:
-            for note in chart_result["notes"]:
-                say(f"  chart {chart.restitution:g}: {note}")
         continuation = []
         for i, r in enumerate(settings.restitution):
             seeds: list[Seed] = []
@@ -112,11 +114,14 @@ class BifurcationStudy:
                     seeds += sweep_seeds(settings.frequency, result["period"], result["impacts"], result["state"], j)
             continuation.append(BranchCase(scene_problem(scene, r), settings.low, settings.high, options, tuple(seeds)))
         say(f"continuing the branches of R = {', '.join(f'{r:g}' for r in settings.restitution)}")
-        results = runner.map(continuation)
+        results = numbered_across(runner.map(continuation))  # the dataset's labels
         for case, result in zip(continuation, results):
-            for note in result["notes"]:
-                say(f"  R = {case.restitution:g}: {note}")
+            _say_notes(say, f"R = {case.restitution:g}", result)
         if chart_result is not None:
+            same = [result for r, result in zip(settings.restitution, results) if np.isclose(r, chart.restitution)]
+            labels = chart_labels(chart_result, same[0] if same else None)
+            chart_result = dict(chart_result, notes=np.array([relabel(str(note), labels) for note in chart_result["notes"]], dtype=str))
+            _say_notes(say, f"chart {chart.restitution:g}", chart_result)
             results = [*results, chart_result]
         data = _branches(results[: len(settings.restitution)], settings.restitution, scene.coordinates, scene.load_spec.base_motion)
         data = data.merge(_brute(swept[: len(sweeps)], scene, brute.directions, brute.strobes))
@@ -126,6 +131,9 @@ class BifurcationStudy:
         for key in ("restitution", "frequency", "sweep", "clearance"):
             data[key].attrs.update(COORDINATE_ATTRIBUTES[key])
         data.attrs.update(_metadata(scene, results, swept[: len(sweeps)]))
+        lines, details = failure_summary(_tallies(scene, results, swept))
+        if lines:
+            data.attrs.update(run_failures=lines, run_failure_details=details)  # said in one line by run-study
         return data
 
     def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:
@@ -153,6 +161,35 @@ class BifurcationStudy:
         return Estimate(wall_time=wall, memory=memory, parts=parts, points={"brute force": f"{periods:,} periods", "continuation": f"{len(continuation)} continuations"})
 
 
+def _say_notes(say: Progress, where: str, result: CaseResult) -> None:
+    """A case's notes, a line each, but its failures (the run's one line of failures says them)."""
+    failed = set(result["failure_detail"].tolist())
+    for note in result["notes"]:
+        if note not in failed:
+            say(f"  {where}: {note}")
+
+
+def _tallies(scene: Scene, results: list[CaseResult], swept: list[CaseResult]) -> list[Tally]:
+    """What the run attempted and what failed (:func:`~vibroimpact.kinds.bifurcation.logs.failure_summary`): per
+    restitution the branches, the seeds and the brute-force points; then the chart's branches, curves and regime map.
+    ``results``: the branch cases, then the chart's case; ``swept``: the sweeps, then the regime map's."""
+    settings = scene.settings
+    assert settings is not None
+    directions, chart = settings.brute_force.directions, settings.chart
+    counted: list[Tally] = []
+    for i, r in enumerate(settings.restitution):
+        where = f"R = {r:g}"
+        counted += tallies(results[i], where)
+        sweeps = swept[i * len(directions) : (i + 1) * len(directions)]
+        counted.append(sweep_tally("sweep", where, sweeps, [f"sweeping {d}" for d in directions], settings.frequency))
+    if chart is not None:
+        where = f"R = {chart.restitution:g}"
+        counted += tallies(results[-1], where)
+        labels = [f"Delta = {c * 1e3:.4g} mm, sweeping {d}" for c in chart.clearances for d in directions]
+        counted.append(sweep_tally("map", where, swept[len(settings.restitution) * len(directions) :], labels, settings.chart_frequency))
+    return counted
+
+
 def coordinate_attributes(key: str, name: str, base_motion: bool = False) -> dict[str, str]:
     """Units and long name of a per-coordinate variable: the entry ``key`` of the attributes (written for X1) with
     ``X1`` replaced by coordinate ``name``'s label (:func:`coordinate_label`; unchanged for ``x1``)."""
@@ -163,23 +200,22 @@ def coordinate_attributes(key: str, name: str, base_motion: bool = False) -> dic
 
 
 def _branches(results: list[CaseResult], restitutions: tuple[float, ...], coordinates: tuple[str, ...], base_motion: bool) -> xr.Dataset:
-    """branch_point and special_point variables of every restitution (labels numbered across them)."""
+    """branch_point and special_point variables of every restitution (``results`` :func:`numbered` across them)."""
     points: dict[str, list] = {}
     specials: dict[str, list] = {}
-    offset = 0
     size = len(coordinates)
     for r, result in zip(restitutions, results):
         n = result["frequency"].size
-        points.setdefault("branch", []).append(result["branch"] + offset)
+        points.setdefault("branch", []).append(result["branch"])
         points.setdefault("restitution", []).append(np.full(n, r))
         for name in ("origin", "frequency", "amplitudes", "impulse", "floquet_modulus", "stable", "impacts", "period", "multipliers_real", "multipliers_imag", "velocities"):
             points.setdefault(name, []).append(result[name])
         m = result["sp_frequency"].size
-        specials.setdefault("branch", []).append(result["sp_branch"] + offset)
+        specials.setdefault("branch", []).append(result["sp_branch"])
         specials.setdefault("restitution", []).append(np.full(m, r))
         for name in ("kind", "frequency", "amplitudes", "impulse", "floquet_modulus", "impacts", "period", "multipliers_real", "multipliers_imag", "note"):
             specials.setdefault(name, []).append(result[f"sp_{name}"])
-        offset += int(result["branch"].max()) + 1 if n else 0
+        specials.setdefault("found_on", []).append(result["sp_found_on"])
     p = {k: np.concatenate(v) for k, v in points.items()}
     s = {k: np.concatenate(v) for k, v in specials.items()}
     a = BIFURCATION_ATTRIBUTES
@@ -207,6 +243,7 @@ def _branches(results: list[CaseResult], restitutions: tuple[float, ...], coordi
             "special_point_multiplier_real": (sp + ("multiplier",), s["multipliers_real"].reshape(-1, 2 * size), a["special_point_multiplier_real"]),
             "special_point_multiplier_imag": (sp + ("multiplier",), s["multipliers_imag"].reshape(-1, 2 * size), a["special_point_multiplier_imag"]),
             "special_point_note": (sp, s["note"].astype(str), a["special_point_note"]),
+            "special_point_branches": (sp, s["found_on"].astype(str), a["special_point_branches"]),
         },
         coords={
             "branch": (bp, p["branch"].astype(np.int32), a["branch"]),
@@ -291,7 +328,7 @@ def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult])
         **_layout_attributes(scene),
         "frequency_band_Hz": np.array([settings.low, settings.high]),
         "brute_force_transient_periods": settings.brute_force.transient_periods,
-        "continuation_notes": "\n".join(f"R = {r:g}: {note}" for r, result in zip(settings.restitution, results) for note in result["notes"]),
+        "continuation_notes": continuation_log(settings.restitution, results),
         "method_branches": "pseudo-arclength continuation of fixed points of the exact stroboscopic map (compiled exact engine, exact Jacobians), started from the closed-form impact orbit at both roots of eq. 16 (one impact per period; two on a symmetric two-sided stop; none where the layout has no closed form), at period doublings, at grazing points and from every periodic brute-force attractor no other branch passes through",
         "method_brute_force": f"compiled exact engine, stepped sweeps carrying the end state; strobes compared over periods 1-{MAX_PERIOD}, else the Lyapunov exponent from the exact Jacobians",
     }
