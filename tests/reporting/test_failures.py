@@ -10,13 +10,14 @@ import xarray as xr
 
 from vibroimpact.reporting.page import Section, with_failures
 from vibroimpact.runs.failures import console_line, failure_details, run_failures
+from vibroimpact.runs.run import read_dataset
 
 GOLDEN = Path(__file__).parents[1] / "golden" / "data"
 
 
 def _with_failed_points(count: int) -> xr.Dataset:
     """The golden restitution dataset with ``count`` of the exact engine's simulated points marked failed."""
-    dataset = xr.load_dataset(GOLDEN / "restitution.nc")
+    dataset = read_dataset(GOLDEN / "restitution.nc")
     regime = dataset["regime"]
     meanings = regime.attrs["flag_meanings"].split()
     failed = regime.attrs["flag_values"][meanings.index("failed")]
@@ -31,7 +32,7 @@ def _with_failed_points(count: int) -> xr.Dataset:
 
 
 def test_failed_points_are_counted_per_solution_against_the_points_it_computed() -> None:
-    clean = xr.load_dataset(GOLDEN / "restitution.nc")
+    clean = read_dataset(GOLDEN / "restitution.nc")
     assert run_failures(clean) == []
     dataset = _with_failed_points(3)
     exact = dataset["regime"].sel(solution="exact")
@@ -50,7 +51,7 @@ def test_a_kinds_own_lines_and_details_come_first_and_survive_netcdf(tmp_path: P
         run_failures=["shooting from 2 of 9 seeds failed; those branches are missing, the others are unaffected"],
         run_failure_details=["ShootingError: the map returned a non-finite state", "ShootingError: no convergence"],
     )
-    read = xr.load_dataset(write_dataset(dataset, tmp_path / "d.nc"))
+    read = read_dataset(write_dataset(dataset, tmp_path / "d.nc"))
     lines = run_failures(read)
     assert lines[0].startswith("shooting from 2 of 9 seeds failed") and "exact: 1 of" in lines[1]
     assert failure_details(read) == ["ShootingError: the map returned a non-finite state", "ShootingError: no convergence"]
