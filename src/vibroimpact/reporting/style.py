@@ -24,10 +24,13 @@ from matplotlib.lines import Line2D  # noqa: E402
 from vibroimpact.analysis.stability import Regime  # noqa: E402
 
 __all__ = [
+    "DISPLACEMENT_SCALE",
+    "DISPLACEMENT_UNITS",
     "DPI",
     "FIGURE_WIDTH",
     "MAX_COLUMNS",
     "MIN_FONT_SIZE",
+    "PAGE_UNITS",
     "QUANTITIES",
     "REGIME_COLOURS",
     "SOLUTION_LOOKS",
@@ -82,6 +85,24 @@ class Quantity:
     meaning: str
     log: bool
 
+    @property
+    def page_units(self) -> str:
+        """Units on the page (:data:`PAGE_UNITS`): mm for a displacement, m/s² for an acceleration."""
+        return PAGE_UNITS.get(self.units, (self.units, 1.0))[0]
+
+    @property
+    def scale(self) -> float:
+        """Factor from the dataset's value to the page's (1e3 for a displacement: m -> mm)."""
+        return PAGE_UNITS.get(self.units, (self.units, 1.0))[1]
+
+
+#: One unit convention on every page: (units on the page, factor from the dataset's value) for each SI unit the
+#: datasets use where the page writes another. Displacements in mm, accelerations in m/s², forces in N, frequencies in
+#: Hz; the datasets keep SI (CF) units.
+PAGE_UNITS: dict[str, tuple[str, float]] = {"m": ("mm", 1e3), "m s-2": ("m/s²", 1.0)}
+#: Displacements on the page: units and factor from metres.
+DISPLACEMENT_UNITS, DISPLACEMENT_SCALE = PAGE_UNITS["m"]
+
 
 QUANTITIES: dict[str, Quantity] = {
     "x1_amplitude": Quantity("|X1| fundamental", "m", "fundamental-harmonic amplitude of the primary mass's displacement", True),
@@ -98,9 +119,10 @@ QUANTITIES: dict[str, Quantity] = {
 
 
 def axis_label(quantity: str) -> str:
-    """Axis label of ``quantity``: its short name and units in brackets."""
+    """Axis label of ``quantity``: its short name and the page's units in brackets (values drawn times
+    :attr:`Quantity.scale`)."""
     q = QUANTITIES[quantity]
-    return f"{q.label} [{q.units}]"
+    return f"{q.label} [{q.page_units}]"
 
 
 # ----------------------------------------------------------------------------------------------- regimes

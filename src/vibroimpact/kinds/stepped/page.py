@@ -32,7 +32,7 @@ from vibroimpact.orbits.motion import MotionThresholds
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved, StudyPage
 from vibroimpact.reporting.record import StudySetting, GeneralSetting, general_setting, named_layout, study_setting
 from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_points, periodic_points, stability_keys, unstable_points
-from vibroimpact.reporting.style import QUANTITIES, SOLUTION_COLOURS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref, ENGINE_MARKERS, REGIME_COLOURS
+from vibroimpact.reporting.style import DISPLACEMENT_SCALE, QUANTITIES, SOLUTION_COLOURS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref, ENGINE_MARKERS, REGIME_COLOURS
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 
 __all__ = ["page_for", "BumperStiffnessPage", "peak_figure", "peak_tables", "peak_acceleration_figure", "stiffness_figure", "stiffness_tables", "band_peaks", "lyapunov_figure", "FrequencyResponsePage", "RESPONSE_QUANTITIES", "SIMULATION_QUANTITIES", "unswept_restitution", "answer_text"]
@@ -111,7 +111,7 @@ def peak_figure(dataset: xr.Dataset, setting: StudySetting, parameter: str, name
             chosen = [r for r in rows if r[0] == label]
             solution = chosen[0][1]
             x = np.array([r[2] for r in chosen]) * scale
-            y = np.array([r[3 + band][0] for r in chosen])
+            y = DISPLACEMENT_SCALE * np.array([r[3 + band][0] for r in chosen])
             colour = SOLUTION_COLOURS.get(solution, "C5")
             if solution in ENGINE_SOLUTIONS:
                 ax.plot(x, y, color=colour, lw=0.8, label="_nolegend_", gid=solution)

@@ -27,7 +27,7 @@ from vibroimpact.reporting.record import GeneralSetting, general_setting, is_gen
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.kinds.stepped.responses import SolutionsPage, linear_section, regime_map
 from vibroimpact.reporting.series import draw_curve, draw_linear, stability_keys, unstable_points
-from vibroimpact.reporting.style import QUANTITIES, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref, SWEEP_COLOURS
+from vibroimpact.reporting.style import DISPLACEMENT_SCALE, DISPLACEMENT_UNITS, QUANTITIES, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref, SWEEP_COLOURS
 
 __all__ = ["page_for", "SweptSinePage", "GeneralSweptPage", "SweptSineRun", "SweepLayout", "sweep_layout", "swept_sine_run", "sweep_figures", "sweep_tables"]
 
@@ -209,19 +209,19 @@ def _at(variable: xr.DataArray, stop: int | None, **where: str) -> np.ndarray:
     return variable.sel(where).values
 
 
-def _draw_steady(ax: Axes, dataset: xr.Dataset, quantity: str, caption: Caption, layout: SweepLayout, with_linear: bool = True, stop: int | None = None) -> bool:
-    """Linear system and pgf steady state of ``quantity`` (of stop ``stop``); returns whether an unstable stretch
-    was drawn."""
+def _draw_steady(ax: Axes, dataset: xr.Dataset, quantity: str, caption: Caption, layout: SweepLayout, with_linear: bool = True, stop: int | None = None, scale: float = 1.0) -> bool:
+    """Linear system and pgf steady state of ``quantity`` (of stop ``stop``), times ``scale`` (to the page's units);
+    returns whether an unstable stretch was drawn."""
     f = dataset["frequency"].values
     steady = _steady_solutions(dataset)
     if quantity not in dataset:
         return False
     if with_linear and "linear" in steady:
-        draw_linear(ax, f, _at(dataset[quantity], stop, solution="linear"))
+        draw_linear(ax, f, scale * _at(dataset[quantity], stop, solution="linear"))
         caption.add("linear", "LIN (dotted black): the linear system (no stop).")
     unstable = False
     if "pgf" in steady:
-        drawn, unstable = draw_curve(ax, f, _at(dataset[quantity], stop, solution="pgf"), colour=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')} steady state", gid="pgf", unstable=unstable_points(dataset, "pgf"))
+        drawn, unstable = draw_curve(ax, f, scale * _at(dataset[quantity], stop, solution="pgf"), colour=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')} steady state", gid="pgf", unstable=unstable_points(dataset, "pgf"))
         if drawn:
             caption.add("pgf", f"{solution_ref('pgf')}: the {layout.closed_form} (solid where the orbit is stable{', dashed where unstable' if unstable else ''}).")
     return unstable
@@ -259,8 +259,8 @@ def sweep_figures(dataset: xr.Dataset, run: SweptSineRun, layout: SweepLayout | 
         fig, axes = new_figure(1, panel_height=3.6, legend_rows=1)
         for direction in _directions(dataset):
             values = dataset[f"running_{first}_amplitude"].sel(sweep=direction).values
-            draw_curve(axes[0], dataset["elapsed_time"].values, values, colour=SWEEP_COLOURS.get(direction, "C4"), label=f"{solution_ref(solution)} sweep {direction}", gid=solution)
-        finish_axes(axes[0], "time since the start of the sweep [s]", f"running |{label}| fundamental [m]", f"Running fundamental of {label} against time (the Simulink scope view)", log=True)
+            draw_curve(axes[0], dataset["elapsed_time"].values, DISPLACEMENT_SCALE * values, colour=SWEEP_COLOURS.get(direction, "C4"), label=f"{solution_ref(solution)} sweep {direction}", gid=solution)
+        finish_axes(axes[0], "time since the start of the sweep [s]", f"running |{label}| fundamental [{DISPLACEMENT_UNITS}]", f"Running fundamental of {label} against time (the Simulink scope view)", log=True)
         figure_legend(fig, axes)
         caption = f"The running |{label}| fundamental of each {solution_ref(solution)} sweep against the time since its start ({run.text()})."
         figures.append(DrawnFigure(fig, "sweep_time", f"Running |{label}| against time", caption))
@@ -275,14 +275,14 @@ def _displacement_figure(dataset: xr.Dataset, run: SweptSineRun, solution: str, 
     any_unstable = False
     for ax, coordinate, name in zip(axes, layout.coordinates, layout.labels):
         quantity, rms = f"{coordinate}_amplitude", f"{coordinate}_rms"
-        any_unstable |= _draw_steady(ax, dataset, quantity, caption, layout)
+        any_unstable |= _draw_steady(ax, dataset, quantity, caption, layout, scale=DISPLACEMENT_SCALE)
         if rms in dataset and "pgf" in _steady_solutions(dataset):
-            ax.plot(dataset["frequency"].values, np.sqrt(2.0) * dataset[rms].sel(solution="pgf").values, color=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')}: sqrt 2 x RMS", gid="pgf", **RMS_STYLE)
+            ax.plot(dataset["frequency"].values, DISPLACEMENT_SCALE * np.sqrt(2.0) * dataset[rms].sel(solution="pgf").values, color=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')}: sqrt 2 x RMS", gid="pgf", **RMS_STYLE)
             caption.add("pgf rms", f"Dash-dot: sqrt 2 x RMS (equal to the fundamental for a pure sine) of the orbit reconstructed by {solution_ref('pgf')} and of the sweeps.")
-        if _draw_swept(ax, dataset, quantity, solution):
+        if _draw_swept(ax, dataset, quantity, solution, scale=DISPLACEMENT_SCALE):
             caption.add("swept", "Vermillion: sweep up, sky blue: sweep down, running fundamental over the estimator window (solid).")
-        _draw_swept(ax, dataset, rms, solution, scale=np.sqrt(2.0), style=RMS_STYLE, suffix=": sqrt 2 x RMS")
-        finish_axes(ax, _FREQUENCY, f"{name} amplitude [m]", f"{name}: swept sine against steady states", log=True)
+        _draw_swept(ax, dataset, rms, solution, scale=DISPLACEMENT_SCALE * np.sqrt(2.0), style=RMS_STYLE, suffix=": sqrt 2 x RMS")
+        finish_axes(ax, _FREQUENCY, f"{name} amplitude [{DISPLACEMENT_UNITS}]", f"{name}: swept sine against steady states", log=True)
     if any_unstable:
         caption.add("unstable", f"Dashed: {layout.orbits} that exist but are unstable.")
     figure_legend(fig, axes, stability_keys() if any_unstable else [], columns=3)
@@ -306,8 +306,9 @@ def _force_figure(dataset: xr.Dataset, solution: str, layout: SweepLayout) -> Dr
     fig, axes = new_figure(len(panels), panel_height=3.8, legend_rows=legend_rows(6))
     any_unstable = False
     for ax, (quantity, stop) in zip(axes, panels):
-        any_unstable |= _draw_steady(ax, dataset, quantity, caption, layout, with_linear=quantity == "force_amplitude", stop=stop)
-        _draw_swept(ax, dataset, quantity, solution, stop=stop)
+        scale = QUANTITIES[quantity].scale
+        any_unstable |= _draw_steady(ax, dataset, quantity, caption, layout, with_linear=quantity == "force_amplitude", stop=stop, scale=scale)
+        _draw_swept(ax, dataset, quantity, solution, scale=scale, stop=stop)
         title = QUANTITIES[quantity].label if stop is None else f"{QUANTITIES[quantity].label}, stop {stop}: {layout.stops[stop].split(',')[0]}"
         finish_axes(ax, _FREQUENCY, axis_label(quantity), title, log=QUANTITIES[quantity].log)
     if any_unstable:
