@@ -10,8 +10,10 @@ import html
 
 import numpy as np
 import xarray as xr
+from matplotlib.lines import Line2D
 
 from vibroimpact.model.modal import fit_modal_parameters, underdamped_mode_count
+from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.record import GeneralSetting
 from vibroimpact.reporting.page import DrawnFigure, Table
 from vibroimpact.reporting.series import SimulationMarkers, draw_curve, draw_linear, draw_points, periodic_points, stability_keys, unstable_points
@@ -57,16 +59,18 @@ def structure_figure(setting: GeneralSetting, frequency: np.ndarray) -> DrawnFig
     named = setting.named
     fit = fit_modal_parameters(named) if named is not None and underdamped_mode_count(named) == 2 else None
     fig, axes = new_figure(3 if named is None else 4, panel_height=3.6, legend_rows=legend_rows(setting.structure.size + 2 * len(setting.stops) + 2))
-    for i, name in enumerate(setting.names):
-        axes[0].semilogy(f, DISPLACEMENT_SCALE * np.abs(x[:, i]), color=series_colour(i), lw=1.4, label=f"|{name}|", gid=f"linear:{name}")
+    coordinates = [(f"|{name}|", axes[0].semilogy(f, DISPLACEMENT_SCALE * np.abs(x[:, i]), color=series_colour(i), lw=1.4, label=f"|{name}|", gid=f"linear:{name}")) for i, name in enumerate(setting.names)]
     finish_axes(axes[0], _FREQUENCY, f"amplitude [{DISPLACEMENT_UNITS}]", "Every coordinate, linear system (no stop)")
     static = setting.static_deflection()
     gaps = setting.clearances - (setting.normals @ static if static is not None else 0.0)
+    stops: list[tuple[str, list[Line2D]]] = []
+    lines: list[tuple[str, list[Line2D]]] = []
     for k, (normal, words) in enumerate(zip(setting.normals, setting.stops)):
-        axes[1].semilogy(f, DISPLACEMENT_SCALE * np.abs(x @ normal), color=series_colour(k), lw=1.4, ls="--", label=f"stop {k}: {_target(words)}", gid=f"linear:stop{k}")
-        if np.isfinite(gaps[k]) and gaps[k] > 0.0:
-            axes[1].axhline(DISPLACEMENT_SCALE * gaps[k], color=series_colour(k), lw=1.1, ls=":", label=f"stop {k}: gap {fmt(gaps[k] * 1e3, '.4g')} mm", gid=f"gap:stop{k}")
+        stops.append((f"stop {k}", axes[1].semilogy(f, DISPLACEMENT_SCALE * np.abs(x @ normal), color=series_colour(k), lw=1.4, ls="--", label=f"stop {k}: {_target(words)}", gid=f"linear:stop{k}")))
+        if np.isfinite(gaps[k]) and gaps[k] > 0.0:  # drawn on the frequencies, as the curves it is compared with
+            lines.append((f"the gap of stop {k}", axes[1].plot(f, np.full(f.shape, DISPLACEMENT_SCALE * gaps[k]), color=series_colour(k), lw=1.1, ls=":", label=f"stop {k}: gap {fmt(gaps[k] * 1e3, '.4g')} mm", gid=f"gap:stop{k}")))
     finish_axes(axes[1], _FREQUENCY, f"amplitude [{DISPLACEMENT_UNITS}]", "Each stop's coordinate, linear system")
+    coincide = coincidence_phrase([*reveal_coincident(axes[0], coordinates), *reveal_coincident(axes[1], stops), *reveal_coincident(axes[1], lines)])
     axes[2].semilogy(f, np.abs(base_force(setting.structure, w, x)), color="C2", lw=1.4, label="|F| on the base", gid="linear:force")
     finish_axes(axes[2], _FREQUENCY, "|F| on the base [N]", "Linear force on the base (paper fig. 3)")
     if named is not None:
@@ -87,7 +91,7 @@ def structure_figure(setting: GeneralSetting, frequency: np.ndarray) -> DrawnFig
         caption += f" |H22| exact {fitted}. Natural frequencies {natural} Hz, anti-resonance {fmt(named.antiresonance_angular_frequency() / (2 * np.pi), '.3f')} Hz."
     else:
         caption += f" Natural frequencies {natural} Hz."
-    caption += f" Stops: {'; '.join(setting.stops)}."
+    caption += f" Stops: {'; '.join(setting.stops)}." + (f" {coincide}" if coincide else "")
     return DrawnFigure(fig, "structure", "Linear responses, force on the base" + (", fit of H22" if named is not None else ""), caption)
 
 
@@ -160,7 +164,9 @@ def response_panels_figure(part: xr.Dataset, setting: GeneralSetting, name: str)
     fig, axes = new_figure(len(panels), panel_height=3.4, legend_rows=legend_rows(len(solutions) + 4))
     markers = SimulationMarkers()
     any_unstable = False
+    found: list[Coincidence] = []
     for ax, (quantity, label, title, stop, log, scale) in zip(axes, panels):
+        curves: list[tuple[str, list[Line2D]]] = []
         for solution in solutions:
             values = scale * _values(part.sel(solution=solution), quantity, stop)
             if solution == "linear":
@@ -169,9 +175,12 @@ def response_panels_figure(part: xr.Dataset, setting: GeneralSetting, name: str)
             elif solution in ENGINE_SOLUTIONS:
                 markers.add(solution, draw_points(ax, f, values, periodic=periodic_points(part, solution), solution=solution, colour=SOLUTION_COLOURS.get(solution, "C5"), label=None))
             else:
+                before = len(ax.lines)
                 _, unstable = draw_curve(ax, f, values, colour=SOLUTION_COLOURS.get(solution, "C0"), label=solution_ref(solution), gid=solution, unstable=unstable_points(part, solution), coarse=coarse)
+                curves.append((solution_ref(solution), list(ax.lines[before:])))
                 any_unstable |= unstable
         finish_axes(ax, _FREQUENCY, label, title, log=log and bool(np.any(_values(part, quantity, stop) > 0.0)))
+        found += reveal_coincident(ax, curves)
     keys = (stability_keys() if any_unstable else []) + markers.keys()
     figure_legend(fig, axes, keys)
     caption = Caption(
@@ -184,6 +193,7 @@ def response_panels_figure(part: xr.Dataset, setting: GeneralSetting, name: str)
     if any_unstable:
         caption.add("unstable", "Closed form dashed: its orbit exists but is unstable (Floquet): the real motion there is another one.")
     caption.add("engines", markers.phrase())
+    caption.add("coincide", coincidence_phrase(found))
     return DrawnFigure(fig, name, f"Responses, {where_text(part)}", caption.text())
 
 

@@ -29,6 +29,7 @@ from vibroimpact.kinds.stepped.figures import layout_tables, peaks_table, respon
 from vibroimpact.kinds.stepped.responses import SolutionsPage, clearance_text, linear_section, series_by_restitution, regime_figure, response_figure, simulation_figure, stability_figure
 from vibroimpact.kinds.stepped.tables import agreement_table, modal_table, reduction_intro, reduction_tables
 from vibroimpact.orbits.motion import MotionThresholds
+from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved, StudyPage
 from vibroimpact.reporting.record import StudySetting, GeneralSetting, general_setting, named_layout, study_setting
 from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_points, periodic_points, stability_keys, unstable_points
@@ -156,20 +157,26 @@ def peak_acceleration_figure(part: xr.Dataset, name: str) -> DrawnFigure | None:
     )
     any_unstable = False
     engines = SimulationMarkers()
+    found: list[Coincidence] = []
     for ax, quantity in zip(axes, quantities):
-        for i, (_, line) in enumerate(lines):
+        curves: list[tuple[str, list[Line2D]]] = []
+        for i, (text, line) in enumerate(lines):
             if "pgf" in present:
-                drawn, unstable = draw_curve(ax, f, line[quantity].sel(solution="pgf").values, colour=series_colour(i), label=None, gid="pgf", unstable=unstable_points(line, "pgf"), zorder=OVER_MARKERS_ZORDER)
+                before = len(ax.lines)
+                drawn, unstable = draw_curve(ax, f, QUANTITIES[quantity].scale * line[quantity].sel(solution="pgf").values, colour=series_colour(i), label=None, gid="pgf", unstable=unstable_points(line, "pgf"), zorder=OVER_MARKERS_ZORDER)
+                curves.append((text, list(ax.lines[before:])))
                 any_unstable |= unstable
                 if drawn:
                     caption.add("pgf", f"Lines: the estimate from {solution_ref('pgf')}, Gamma(xi_b) Omega_b J / (1 + R) for the force (section 6.3 with the corrected factor Gamma; the deceleration less the absorber spring's pull): the rigid-stop impulse J gives the entry speed, the one-collision solution of the bumper gives the peak.")
             if "compliant" in present:
-                engines.add("compliant", draw_points(ax, f, line[quantity].sel(solution="compliant").values, periodic=periodic_points(line, "compliant"), solution="compliant", colour=series_colour(i), label=None))
+                engines.add("compliant", draw_points(ax, f, QUANTITIES[quantity].scale * line[quantity].sel(solution="compliant").values, periodic=periodic_points(line, "compliant"), solution="compliant", colour=series_colour(i), label=None))
         finish_axes(ax, "frequency [Hz]", axis_label(quantity), QUANTITIES[quantity].label)
+        found += reveal_coincident(ax, curves)
     if any_unstable:
         caption.add("unstable", "Dashed: the estimate on a one-impact orbit that exists but is unstable.")
     if engines:
         caption.add("compliant", engines.phrase(irregular="irregular motion, the largest over the measured window"))
+    caption.add("coincide", coincidence_phrase(found))
     keys: list[Line2D | Patch] = [Patch(color=series_colour(i), label=text) for i, (text, _) in enumerate(lines)]
     figure_legend(fig, [], keys + (stability_keys() if any_unstable else []) + engines.keys())
     return DrawnFigure(fig, name, f"Peak contact deceleration and force, {clearance_text(part)}", caption.text())

@@ -22,6 +22,7 @@ from matplotlib.patches import Patch, Rectangle
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.model.modal import fit_modal_parameters, underdamped_mode_count
 from vibroimpact.analysis.stability import Regime
+from vibroimpact.reporting.coincide import coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, saved
 from vibroimpact.reporting.record import StudySetting
 from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_linear, draw_points, periodic_points, stability_keys, unstable_points
@@ -157,16 +158,20 @@ def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure |
     fig, axes = new_figure(len(panels), panel_height=3.7, sharey=True, legend_rows=legend_rows(len(lines) + 6))
     engines = SimulationMarkers()
     any_unstable = gaps = raw = False
+    curves: list[list[tuple[str, list[Line2D]]]] = []
     for ax, solution in zip(axes, panels):
+        curves.append([])
         if with_linear or solution == "linear":
             draw_linear(ax, f, q.scale * part[quantity].sel(solution="linear").isel(_first(part)).values, coarse)
             caption.add("linear", "LIN (dotted black): the linear system (no stop).")
-        for i, (_, line) in enumerate(lines if solution != "linear" else []):
+        for i, (text, line) in enumerate(lines if solution != "linear" else []):
             values = q.scale * line[quantity].sel(solution=solution).values
             if solution in ENGINE_SOLUTIONS:
                 engines.add(solution, draw_points(ax, f, values, periodic=periodic_points(line, solution), solution=solution, colour=series_colour(i), label=None))
                 continue
+            before = len(ax.lines)
             _, unstable = draw_curve(ax, f, values, colour=series_colour(i), label=None, gid=solution, unstable=unstable_points(line, solution), coarse=coarse)
+            curves[-1].append((text, list(ax.lines[before:])))
             any_unstable |= unstable
             gaps |= bool(np.isnan(values).any())
             if raw_name in line and solution != "linear":
@@ -187,12 +192,14 @@ def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure |
     top = float(np.max(finite[np.isfinite(finite)], initial=0.0))
     if top > 0.0:
         axes[0].set_ylim(top=3.0 * top if q.log else 1.1 * top)
+    coincide = coincidence_phrase(found for ax, drawn in zip(axes, curves) for found in reveal_coincident(ax, drawn))
     keys = [Patch(color=series_colour(i), label=text) for i, (text, _) in enumerate(lines)]
     if with_linear:
         keys.append(Line2D([], [], label="LIN (linear system)", **LINEAR_STYLE))
     keys += stability_keys() if any_unstable else []
     keys += [Line2D([], [], color="k", label="raw one-impact solution", **RAW_STYLE)] if raw else []
     figure_legend(fig, [], keys + engines.keys())
+    caption.add("coincide", coincide)
     missing = [s for s in candidates if s not in panels]
     tail = f"No finite values, not drawn: {', '.join(solution_ref(s) for s in missing)}." if missing else ""
     return DrawnFigure(fig, name, f"{q.label[:1].upper()}{q.label[1:]}, {clearance_text(part)}", caption.text(tail))
@@ -307,15 +314,19 @@ def stability_figure(part: xr.Dataset, name: str) -> DrawnFigure:
     f = part["frequency"].values
     fig, axes = new_figure(1, panel_height=3.8, legend_rows=legend_rows(len(lines) + 1, 6))
     ax = axes[0]
+    curves: list[tuple[str, list[Line2D]]] = []
     for i, (text, line) in enumerate(lines):
+        before = len(ax.lines)
         draw_curve(ax, f, line["floquet_modulus"].sel(solution="pgf").values, colour=series_colour(i), label=text, gid="pgf", coarse=f.size < COARSE_GRID_POINTS)
+        curves.append((text, list(ax.lines[before:])))
     ax.axhline(1.0, color="k", lw=1.0, label="stability limit 1")
     finish_axes(ax, _FREQUENCY, axis_label("floquet_modulus"), f"{solution_ref('pgf')}: stability of the one-impact orbit, {clearance_text(part)}", log=True)
+    coincide = coincidence_phrase(reveal_coincident(ax, curves))
     figure_legend(fig, axes, columns=6)
     caption = (
         f"{QUANTITIES['floquet_modulus'].label} of the exact one-impact orbit of {solution_ref('pgf')} (monodromy = impact "
         "saltation matrix x exact flow over the period), one colour per restitution ratio. Above 1 the orbit exists but "
-        "is unstable: a simulation started on it leaves it."
+        "is unstable: a simulation started on it leaves it." + (f" {coincide}" if coincide else "")
     )
     return DrawnFigure(fig, name, f"Stability of the one-impact orbit, {clearance_text(part)}", caption)
 

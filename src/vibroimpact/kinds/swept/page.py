@@ -20,10 +20,12 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 from matplotlib.axes import Axes
+from matplotlib.lines import Line2D
 
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.kinds.stepped.figures import GENERAL_DESCRIPTIONS, layout_tables, structure_figure
 from vibroimpact.reporting.record import GeneralSetting, general_setting, is_general, study_setting, SWEPT_SOLUTION
+from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.kinds.stepped.responses import SolutionsPage, linear_section, regime_map
 from vibroimpact.reporting.series import draw_curve, draw_linear, stability_keys, unstable_points
@@ -209,9 +211,13 @@ def _at(variable: xr.DataArray, stop: int | None, **where: str) -> np.ndarray:
     return variable.sel(where).values
 
 
-def _draw_steady(ax: Axes, dataset: xr.Dataset, quantity: str, caption: Caption, layout: SweepLayout, with_linear: bool = True, stop: int | None = None, scale: float = 1.0) -> bool:
-    """Linear system and pgf steady state of ``quantity`` (of stop ``stop``), times ``scale`` (to the page's units);
-    returns whether an unstable stretch was drawn."""
+#: Curves of a panel in drawing order, each with its lines (for :func:`~vibroimpact.reporting.coincide.reveal_coincident`).
+Curves = list[tuple[str, list[Line2D]]]
+
+
+def _draw_steady(ax: Axes, dataset: xr.Dataset, quantity: str, caption: Caption, layout: SweepLayout, with_linear: bool = True, stop: int | None = None, scale: float = 1.0, curves: Curves | None = None) -> bool:
+    """Linear system and pgf steady state of ``quantity`` (of stop ``stop``), times ``scale`` (to the page's units),
+    the pgf curve added to ``curves``; returns whether an unstable stretch was drawn."""
     f = dataset["frequency"].values
     steady = _steady_solutions(dataset)
     if quantity not in dataset:
@@ -221,15 +227,18 @@ def _draw_steady(ax: Axes, dataset: xr.Dataset, quantity: str, caption: Caption,
         caption.add("linear", "LIN (dotted black): the linear system (no stop).")
     unstable = False
     if "pgf" in steady:
+        before = len(ax.lines)
         drawn, unstable = draw_curve(ax, f, scale * _at(dataset[quantity], stop, solution="pgf"), colour=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')} steady state", gid="pgf", unstable=unstable_points(dataset, "pgf"))
+        if curves is not None:
+            curves.append((solution_ref("pgf"), list(ax.lines[before:])))
         if drawn:
             caption.add("pgf", f"{solution_ref('pgf')}: the {layout.closed_form} (solid where the orbit is stable{', dashed where unstable' if unstable else ''}).")
     return unstable
 
 
-def _draw_swept(ax: Axes, dataset: xr.Dataset, quantity: str, solution: str, scale: float = 1.0, style: dict[str, object] | None = None, suffix: str = "", stop: int | None = None) -> bool:
-    """The running estimate of ``quantity`` (of stop ``stop``) of each sweep direction; returns whether anything was
-    drawn."""
+def _draw_swept(ax: Axes, dataset: xr.Dataset, quantity: str, solution: str, scale: float = 1.0, style: dict[str, object] | None = None, suffix: str = "", stop: int | None = None, curves: Curves | None = None) -> bool:
+    """The running estimate of ``quantity`` (of stop ``stop``) of each sweep direction, each added to ``curves``;
+    returns whether anything was drawn."""
     name = f"swept_{quantity}"
     if name not in dataset:
         return False
@@ -237,7 +246,10 @@ def _draw_swept(ax: Axes, dataset: xr.Dataset, quantity: str, solution: str, sca
     drawn = False
     for direction in _directions(dataset):
         values = scale * _at(dataset[name], stop, sweep=direction)
+        before = len(ax.lines)
         drawn |= draw_curve(ax, f, values, colour=SWEEP_COLOURS.get(direction, "C4"), label=f"{solution_ref(solution)} sweep {direction}{suffix}", gid=solution, style=style or SWEPT_STYLE)[0]
+        if curves is not None:
+            curves.append((f"sweep {direction}{' RMS' if suffix else ''}", list(ax.lines[before:])))
     return drawn
 
 
@@ -273,18 +285,23 @@ def _displacement_figure(dataset: xr.Dataset, run: SweptSineRun, solution: str, 
     caption = Caption(f"Swept sine ({run.text()}): running estimates of {solution_ref(solution)} against the instantaneous frequency, like the paper's figures 16-20, against the steady states.")
     fig, axes = new_figure(len(layout.coordinates), panel_height=4.0, legend_rows=legend_rows(8))
     any_unstable = False
+    found: list[Coincidence] = []
     for ax, coordinate, name in zip(axes, layout.coordinates, layout.labels):
         quantity, rms = f"{coordinate}_amplitude", f"{coordinate}_rms"
-        any_unstable |= _draw_steady(ax, dataset, quantity, caption, layout, scale=DISPLACEMENT_SCALE)
+        fundamentals: Curves = []
+        spreads: Curves = []
+        any_unstable |= _draw_steady(ax, dataset, quantity, caption, layout, scale=DISPLACEMENT_SCALE, curves=fundamentals)
         if rms in dataset and "pgf" in _steady_solutions(dataset):
-            ax.plot(dataset["frequency"].values, DISPLACEMENT_SCALE * np.sqrt(2.0) * dataset[rms].sel(solution="pgf").values, color=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')}: sqrt 2 x RMS", gid="pgf", **RMS_STYLE)
+            spreads.append((f"{solution_ref('pgf')} RMS", ax.plot(dataset["frequency"].values, DISPLACEMENT_SCALE * np.sqrt(2.0) * dataset[rms].sel(solution="pgf").values, color=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')}: sqrt 2 x RMS", gid="pgf", **RMS_STYLE)))
             caption.add("pgf rms", f"Dash-dot: sqrt 2 x RMS (equal to the fundamental for a pure sine) of the orbit reconstructed by {solution_ref('pgf')} and of the sweeps.")
-        if _draw_swept(ax, dataset, quantity, solution, scale=DISPLACEMENT_SCALE):
+        if _draw_swept(ax, dataset, quantity, solution, scale=DISPLACEMENT_SCALE, curves=fundamentals):
             caption.add("swept", "Vermillion: sweep up, sky blue: sweep down, running fundamental over the estimator window (solid).")
-        _draw_swept(ax, dataset, rms, solution, scale=DISPLACEMENT_SCALE * np.sqrt(2.0), style=RMS_STYLE, suffix=": sqrt 2 x RMS")
+        _draw_swept(ax, dataset, rms, solution, scale=DISPLACEMENT_SCALE * np.sqrt(2.0), style=RMS_STYLE, suffix=": sqrt 2 x RMS", curves=spreads)
         finish_axes(ax, _FREQUENCY, f"{name} amplitude [{DISPLACEMENT_UNITS}]", f"{name}: swept sine against steady states", log=True)
+        found += reveal_coincident(ax, fundamentals) + reveal_coincident(ax, spreads)
     if any_unstable:
         caption.add("unstable", f"Dashed: {layout.orbits} that exist but are unstable.")
+    caption.add("coincide", coincidence_phrase(found, spec=".3g"))
     figure_legend(fig, axes, stability_keys() if any_unstable else [], columns=3)
     return DrawnFigure(fig, "sweep_displacements", f"Swept sine: {layout.both()}", caption.text())
 
@@ -305,14 +322,18 @@ def _force_figure(dataset: xr.Dataset, solution: str, layout: SweepLayout) -> Dr
         caption.add("stops", "The impulse per period on each stop in its own panel (its constraint in the title).")
     fig, axes = new_figure(len(panels), panel_height=3.8, legend_rows=legend_rows(6))
     any_unstable = False
+    found: list[Coincidence] = []
     for ax, (quantity, stop) in zip(axes, panels):
         scale = QUANTITIES[quantity].scale
-        any_unstable |= _draw_steady(ax, dataset, quantity, caption, layout, with_linear=quantity == "force_amplitude", stop=stop, scale=scale)
-        _draw_swept(ax, dataset, quantity, solution, scale=scale, stop=stop)
+        curves: Curves = []
+        any_unstable |= _draw_steady(ax, dataset, quantity, caption, layout, with_linear=quantity == "force_amplitude", stop=stop, scale=scale, curves=curves)
+        _draw_swept(ax, dataset, quantity, solution, scale=scale, stop=stop, curves=curves)
         title = QUANTITIES[quantity].label if stop is None else f"{QUANTITIES[quantity].label}, stop {stop}: {layout.stops[stop].split(',')[0]}"
         finish_axes(ax, _FREQUENCY, axis_label(quantity), title, log=QUANTITIES[quantity].log)
+        found += reveal_coincident(ax, curves)
     if any_unstable:
         caption.add("unstable", f"Dashed: {layout.orbits} that exist but are unstable.")
+    caption.add("coincide", coincidence_phrase(found, spec=".3g"))
     figure_legend(fig, axes, stability_keys() if any_unstable else [], columns=3)
     return DrawnFigure(fig, "sweep_force_impulse", "Swept sine: force, impulse and contacts", caption.text())
 
