@@ -31,7 +31,7 @@ from vibroimpact.kinds.stepped.responses import SolutionsPage, linear_section, r
 from vibroimpact.reporting.series import draw_curve, draw_linear, stability_keys, unstable_points
 from vibroimpact.reporting.style import DISPLACEMENT_SCALE, DISPLACEMENT_UNITS, QUANTITIES, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref, SWEEP_COLOURS
 
-__all__ = ["page_for", "SweptSinePage", "GeneralSweptPage", "SweptSineRun", "SweepLayout", "sweep_layout", "swept_sine_run", "sweep_figures", "sweep_tables"]
+__all__ = ["page_for", "SweptSinePage", "GeneralSweptPage", "SweptSineRun", "SweepLayout", "sweep_layout", "swept_sine_run", "sweep_figures", "sweep_tables", "sweep_answer", "contact_stretches"]
 
 #: Colour of each sweep direction.
 #: Running fundamental of a sweep: thinner than the steady states' curves, which show beneath.
@@ -157,17 +157,91 @@ def _first_point(dataset: xr.Dataset) -> tuple[xr.Dataset, str]:
     return dataset.isel(first), intro
 
 
+def _descending(dataset: xr.Dataset, direction: str) -> bool:
+    """Whether sweep ``direction`` runs down in frequency (its instantaneous frequency falls)."""
+    if "instantaneous_frequency" in dataset.coords:
+        f = np.asarray(dataset["instantaneous_frequency"].sel(sweep=direction).values, dtype=float)
+        f = f[np.isfinite(f)]
+        return f.size > 1 and f[-1] < f[0]
+    return direction == "down"
+
+
+def contact_stretches(f: np.ndarray, contact: np.ndarray, gap: float) -> list[tuple[float, float, tuple[float, float] | None]]:
+    """Stretches of frequency [Hz] where ``contact``, those less than ``gap`` [Hz] apart joined: (start, end, and the
+    span over which a joined stretch had contact-free points, or None)."""
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], contact.astype(int), [0]))))
+    runs = [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2])]
+    joined: list[tuple[int, int, int, int]] = []  # first, last, first gap start, last gap end (-1: none)
+    for a, b in runs:
+        if joined and f[a] - f[joined[-1][1]] <= gap:
+            first, last, g0, _ = joined[-1]
+            joined[-1] = (first, b, g0 if g0 >= 0 else last + 1, a - 1)
+        else:
+            joined.append((a, b, -1, -1))
+    return [(float(f[a]), float(f[b]), (float(f[g0]), float(f[g1])) if g0 >= 0 else None) for a, b, g0, g1 in joined]
+
+
+def sweep_answer(dataset: xr.Dataset, run: SweptSineRun, split: float | None, layout: SweepLayout | None = None) -> str:
+    """What the sweeps show, in numbers (HTML): where each sweep touches the stops, in its own direction (gaps shorter
+    than an estimator window joined, and said), and how far its running fundamental of the first coordinate lies from
+    the pgf orbit where that is stable and the sweep in contact (signed median per band)."""
+    layout = layout or sweep_layout(dataset)
+    f = dataset["frequency"].values
+    paragraphs = []
+    if "swept_regime" in dataset:
+        middle = 0.5 * (run.start_frequency + run.stop_frequency)
+        gap = run.rate * run.window_cycles / middle + float(np.min(np.diff(f), initial=0.0))
+        words = []
+        for direction in _directions(dataset):
+            stretches = contact_stretches(f, dataset["swept_regime"].sel(sweep=direction).values == Regime.SWEPT_CONTACT, gap)
+            down = _descending(dataset, direction)
+            texts = []
+            for start, end, free in reversed(stretches) if down else stretches:
+                a, b = (end, start) if down else (start, end)
+                text = f"{fmt(a, '.1f')}-{fmt(b, '.1f')} Hz"
+                if free is not None:
+                    c, d = (free[1], free[0]) if down else free
+                    text += f" (with contact-free windows over {fmt(c, '.2f')}-{fmt(d, '.2f')} Hz)"
+                texts.append(text)
+            words.append(f"sweeping {direction} over {_and(texts)}" if texts else f"sweeping {direction} none")
+        paragraphs.append(f"Contacts of the {solution_ref(SWEPT_SOLUTION)} sweeps ({run.text()}): {'; '.join(words)}.")
+    quantity, label = f"{layout.coordinates[0]}_amplitude", layout.labels[0]
+    if "pgf" in _steady_solutions(dataset) and f"swept_{quantity}" in dataset and "swept_regime" in dataset:
+        pgf = dataset[quantity].sel(solution="pgf").values
+        stable = dataset["stable"].sel(solution="pgf").values == 1 if "stable" in dataset else np.isfinite(pgf)
+        bands = ((f"band 1 (below {fmt(split, '.4g')} Hz)", f < split), ("band 2", f >= split)) if split is not None else (("", np.ones(f.shape, bool)),)
+        parts = []
+        for band, mask in bands:
+            per = []
+            for direction in _directions(dataset):
+                sim = dataset[f"swept_{quantity}"].sel(sweep=direction).values
+                good = mask & stable & (dataset["swept_regime"].sel(sweep=direction).values == Regime.SWEPT_CONTACT) & np.isfinite(sim) & np.isfinite(pgf) & (pgf > 0)
+                if good.any():
+                    median = float(np.median((sim[good] - pgf[good]) / pgf[good]))
+                    per.append(f"{fmt(100.0 * abs(median), '.1f')} % {'above' if median >= 0 else 'below'} sweeping {direction} ({int(good.sum())} points)")
+            if per:
+                parts.append(f"{_and(per)}{' in ' + band if band else ''}")
+        if parts:
+            paragraphs.append(f"Where a sweep is in contact and the {solution_ref('pgf')} orbit is stable, its running |{label}| fundamental lies (median) {'; '.join(parts)}.")
+    return "".join(f"<p>{html.escape(p)}</p>" for p in paragraphs)
+
+
+def _and(items: list[str]) -> str:
+    return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} and {items[-1]}"
+
+
 class SweptSinePage(SolutionsPage):
     """The page of a swept-sine study of the paper's named system (dimensions ``solution``, ``sweep``, ``frequency``,
     ``elapsed_time``): the linear system, then the sweeps against the steady states; the swept solution is the last
     of the summary's."""
 
     def sections(self, out: Path) -> list[Section]:
-        """Linear system, then the sweeps at the first point of the other swept grids."""
+        """What the sweeps show in numbers, the linear system, then the sweeps at the first point of the other swept
+        grids."""
         run = swept_sine_run(self.dataset)
         part, intro = _first_point(self.dataset)
         sweeps = Section("Swept sine against the steady states", intro=intro, figures=saved(sweep_figures(part, run), out), tables=sweep_tables(part, run, self.setting.split_frequency))
-        return [linear_section(self.setting, out), sweeps]
+        return [Section("Contacts and the steady states", intro=sweep_answer(part, run, self.setting.split_frequency) + intro), linear_section(self.setting, out), sweeps]
 
 
 class GeneralSweptPage:
@@ -184,14 +258,15 @@ class GeneralSweptPage:
         return f"solutions: {', '.join(self.setting.solutions + swept)}; stops: {'; '.join(self.setting.stops)}"
 
     def sections(self, out: Path) -> list[Section]:
-        """Structure and stops, then the sweeps at the first point of the other swept grids."""
+        """What the sweeps show in numbers, the structure and stops, then the sweeps at the first point of the other
+        swept grids."""
         setting = self.setting
         run = swept_sine_run(self.dataset)
         part, intro = _first_point(self.dataset)
         layout = f"<p>Stops: {html.escape('; '.join(setting.stops))}. Load: {html.escape(setting.load_text())}, swept in frequency.</p>"
         structure = Section("Structure and stops", intro=layout, figures=saved([structure_figure(setting, self.dataset['frequency'].values)], out), tables=layout_tables(setting))
         sweeps = Section("Swept sine against the steady states", intro=intro, figures=saved(sweep_figures(part, run), out), tables=sweep_tables(part, run, None))
-        return [structure, sweeps]
+        return [Section("Contacts and the steady states", intro=sweep_answer(part, run, None) + intro), structure, sweeps]
 
 
 def _steady_solutions(dataset: xr.Dataset) -> list[str]:
