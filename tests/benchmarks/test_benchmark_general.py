@@ -159,7 +159,7 @@ def test_the_frame_benchmark_page_names_its_coordinate_and_layout(frame_run: xr.
     assert "Errors are of the floor1 fundamental" in section.intro and "absorber - floor2 &lt;= 2 mm" in section.intro and "base motion" in section.intro
     titles = [t.title for t in section.tables]
     assert titles[0].startswith("Cost per period") and "Cheapest way to the floor1 fundamental within a target" in titles
-    assert "<th>|floor1| [m]</th>" in next(t.html for t in section.tables if t.title.startswith("Model cost ladder"))
+    assert "<th>|floor1| [mm]</th>" in next(t.html for t in section.tables if t.title.startswith("Model cost ladder"))
     assert "<th>floor1 error</th>" in section.tables[-1].html
     plt.close("all")
 

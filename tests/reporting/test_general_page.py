@@ -119,7 +119,7 @@ def test_one_gap_line_per_stop_at_the_static_gap() -> None:
     lines = {line.get_gid(): line for line in drawn.figure.axes[1].get_lines() if str(line.get_gid()).startswith("gap:")}
     assert set(lines) == set(expected)
     for gid, gap in expected.items():
-        assert abs(float(lines[gid].get_ydata()[0]) - gap) < 1e-12
+        assert abs(float(lines[gid].get_ydata()[0]) - 1e3 * gap) < 1e-9  # drawn in mm
         assert lines[gid].get_linestyle() == ":"
     colours = {line.get_gid(): line.get_color() for line in drawn.figure.axes[1].get_lines()}
     assert colours["gap:stop0"] == colours["linear:stop0"] and colours["gap:stop1"] == colours["linear:stop1"]

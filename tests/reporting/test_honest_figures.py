@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import matplotlib.pyplot as plt
 import numpy as np
+import xarray as xr
 from matplotlib.patches import Rectangle
 
 from vibroimpact.analysis.stability import Regime
@@ -49,3 +50,77 @@ def test_numbers_in_tables_carry_no_bare_trailing_point() -> None:
 
     assert fmt(1982.0, "#.4g") == "1982" and fmt(0.0793, "#.4g") == "0.07930" and fmt(289.6, "#.4g") == "289.6"
     assert fmt(float("nan")) == "" and fmt(12.0, ".3g", "{} Hz") == "12 Hz"
+
+
+# ------------------------------------------------------------------------------------- coinciding curves
+def _beneath(ax: object, gid: str) -> list:
+    return [line for line in ax.get_lines() if line.get_gid() == f"beneath:{gid}"]  # type: ignore[attr-defined]
+
+
+def test_a_curve_under_an_identical_one_shows_as_a_band_and_the_caption_says_so() -> None:
+    """Two restitution ratios with the same |X1|: the first (drawn beneath) is drawn again as a band wider than the
+    second by at least a point on each side, behind it, in its own colour, over every value; the caption names both."""
+    from matplotlib.colors import to_hex
+
+    from tests.reporting.test_report_support import steady_dataset
+    from vibroimpact.kinds.stepped.responses import response_figure
+
+    ds = steady_dataset(engines=(), restitution=(0.2, 0.6), step=0.5)
+    same = ds["x1_amplitude"].copy()
+    same.loc[{"restitution": 0.2}] = same.sel(restitution=0.6).values
+    drawn = response_figure(ds.assign(x1_amplitude=same, stable=xr.ones_like(ds["stable"])), "x1_amplitude", "x1")
+    assert drawn is not None
+    try:
+        assert "R = 0.2 lies under R = 0.6" in drawn.caption
+        ax = next(a for a in drawn.figure.axes if a.get_title().startswith("'pgf'"))
+        top = [line for line in ax.get_lines() if line.get_gid() == "pgf" and to_hex(line.get_color()) == to_hex("C1") and len(line.get_xdata()) > 1]
+        bands = _beneath(ax, "pgf")
+        assert top and bands
+        assert all(to_hex(band.get_color()) == to_hex("C0") for band in bands)  # R = 0.2's colour
+        assert min(band.get_linewidth() for band in bands) >= max(line.get_linewidth() for line in top) + 2.0  # >= 1 pt each side
+        assert max(band.get_zorder() for band in bands) < min(line.get_zorder() for line in top)
+        values = 1e3 * same.sel(solution="pgf", restitution=0.2).values
+        shown = np.concatenate([np.asarray(band.get_ydata(), float) for band in bands])
+        assert np.isfinite(values).sum() <= np.isfinite(shown).sum()
+    finally:
+        plt.close(drawn.figure)
+
+
+def test_curves_that_only_cross_are_not_called_coincident() -> None:
+    from vibroimpact.reporting.coincide import coincidence_phrase, reveal_coincident
+
+    fig, ax = plt.subplots()
+    try:
+        x = np.linspace(0.0, 10.0, 1001)
+        rising, falling = ax.plot(x, x, gid="a"), ax.plot(x, 10.0 - x, gid="b")
+        assert reveal_coincident(ax, [("a", rising), ("b", falling)]) == []
+        assert not _beneath(ax, "a") and coincidence_phrase([]) == ""
+        same = ax.plot(x, 10.0 - x, ls="--", gid="c")  # on b everywhere: b lies under c
+        found = reveal_coincident(ax, [("b", falling), ("c", same)])
+        assert [(c.lower, c.upper, c.everywhere) for c in found] == [("b", "c", True)]
+        assert "b lies under c wherever both have values" in coincidence_phrase(found)
+        assert _beneath(ax, "b") and not _beneath(ax, "c")
+    finally:
+        plt.close(fig)
+
+
+def test_the_two_sided_relative_stop_draws_both_stops_coordinates() -> None:
+    """|x2 - x1| of the upper and the lower stop are one curve: stop 0's shows as a band around stop 1's, and the
+    caption says that they coincide."""
+    import copy
+
+    from tests.reporting.test_general_page import CHAIN
+    from vibroimpact.kinds.stepped.figures import structure_figure
+    from vibroimpact.reporting.record import general_setting
+    from vibroimpact.runs.run import run_study
+    from vibroimpact.scene import parse_scene
+
+    document = copy.deepcopy(CHAIN)
+    document["stops"] = [{"between": ["x3", "x2"], "side": "upper", "clearance": 0.001, "restitution": 0.3}, {"between": ["x3", "x2"], "side": "lower", "clearance": 0.001, "restitution": 0.3}]
+    data = run_study(parse_scene(document), progress=None)
+    drawn = structure_figure(general_setting(data), data["frequency"].values)
+    try:
+        assert "stop 0 lies under stop 1 wherever both have values" in drawn.caption
+        assert _beneath(drawn.figure.axes[1], "linear:stop0") and not _beneath(drawn.figure.axes[1], "linear:stop1")
+    finally:
+        plt.close(drawn.figure)

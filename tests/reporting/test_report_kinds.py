@@ -39,15 +39,17 @@ def test_stepped_page_has_responses_simulations_peaks_agreement_and_reduction_fa
     assert page.summary() == "solutions: linear, pgf, pgf_paper, momentary, exact, compliant; stops: x2 <= 3 mm"
     sections = {s.title: s for s in page.sections(tmp_path)}
     assert list(sections) == [
-        "Largest responses",
-        "Reduction factors",  # the answer first: what the stop buys
-        "Linear system",
+        "Largest responses",  # the answer first, in numbers: peaks against R, contact peaks, reduction factors
         "Resonance peaks against the restitution",
+        "Reduction factors",  # what the stop buys
+        "Linear system",
         "Frequency responses, Delta = 3 mm",
         "Simulations against the closed form, Delta = 3 mm",
         "Simulation against the closed form: agreement by band",
     ]
     assert _names(sections["Largest responses"]) == ([], ["Largest value of every response, per solution"])
+    answer = sections["Largest responses"].intro
+    assert "Resonance peaks of |X1| [mm] at R = 0.2, 0.6" in answer and "Largest contact deceleration: compliant" in answer and "Reduction factors: the stop divides" in answer
     assert _names(sections["Linear system"]) == (["structure"], ["Modal parameters of H22", "Structure", "Stops and load"])
     assert _names(sections["Resonance peaks against the restitution"]) == (["peaks_vs_restitution"], ["Resonance peaks of |X1| against the restitution: values"])
     figures, _ = _names(sections["Frequency responses, Delta = 3 mm"])
@@ -62,8 +64,9 @@ def test_bumper_stiffness_page_shows_convergence_and_cost(tmp_path: Path) -> Non
     assert isinstance(page, BumperStiffnessPage)
     assert page.summary() == "solutions: pgf, exact, compliant"
     sections = page.sections(tmp_path)
-    assert [s.title for s in sections] == ["Linear system", "Compliant bumper against the rigid stop"]
-    assert _names(sections[1]) == (["bumper_stiffness"], ["compliant against exact: convergence and cost"])
+    assert [s.title for s in sections] == ["Compliant bumper against the rigid stop", "Linear system"]  # the answer first
+    assert _names(sections[0]) == (["bumper_stiffness"], ["compliant against exact: convergence and cost"])
+    assert "differs from the rigid stop&#x27;s (exact) by" in sections[0].intro and "observed order" in sections[0].intro
     # the simulated frequencies come from the data: the dataset has no simulation_frequency_Hz attribute
     np.testing.assert_array_equal(study_setting(ds).simulation_frequency, [24.0, 25.0])
 
@@ -74,8 +77,9 @@ def test_swept_sine_page_shows_the_sweeps_against_the_steady_states(tmp_path: Pa
     assert isinstance(page, SweptSinePage)
     assert page.summary() == "solutions: linear, pgf, compliant", "the swept solution is not along the solution dimension"
     sections = page.sections(tmp_path)
-    assert [s.title for s in sections] == ["Linear system", "Swept sine against the steady states"]
-    figures, tables = _names(sections[1])
+    assert [s.title for s in sections] == ["Contacts and the steady states", "Linear system", "Swept sine against the steady states"]
+    assert "Contacts of the &#x27;compliant&#x27; sweeps" in sections[0].intro and "sweeping up over" in sections[0].intro
+    figures, tables = _names(sections[2])
     assert figures == ["sweep_displacements", "sweep_force_impulse", "sweep_regime", "sweep_time"]
     assert tables == ["Cost of the swept-sine runs (one process each)", "Swept sine against the stable pgf steady state (|X1| fundamental)"]
     run = swept_sine_run(ds)

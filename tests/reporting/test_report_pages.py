@@ -83,7 +83,7 @@ def test_sweep_page_has_contents_and_explains_only_what_it_shows(tmp_path: Path,
     sections = page_for(ds).sections(tmp_path)
     page = render_page("sweep", [], sections, ds.attrs["scene"])
     titles = [s.title for s in sections]
-    assert titles == ["Linear system", "Swept sine against the steady states"]
+    assert titles == ["Contacts and the steady states", "Linear system", "Swept sine against the steady states"]
     assert "<nav id='contents'>" in page
     for name in ("sweep_displacements.png", "sweep_force_impulse.png", "sweep_regime.png", "sweep_time.png", "Cost of the swept-sine runs", "Swept sine against the stable pgf steady state"):
         assert name in page, name

@@ -13,15 +13,18 @@ import xarray as xr
 
 from vibroimpact.kinds.stepped.page import peak_acceleration_figure
 from vibroimpact.kinds.stepped.responses import response_figure, simulation_figure
+from vibroimpact.reporting.record import study_setting
+from vibroimpact.reporting.style import QUANTITIES
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 from vibroimpact.kinds.swept.page import sweep_figures, swept_sine_run
 
 from tests.reporting.test_report_support import shown_points, steady_dataset, swept_dataset
 
 
-def _expected(values: np.ndarray, f: np.ndarray, log: bool) -> set[tuple[float, float]]:
+def _expected(values: np.ndarray, f: np.ndarray, log: bool, scale: float = 1.0) -> set[tuple[float, float]]:
+    """The points a panel must show: every finite value (positive on a log axis) in the page's units (``scale``)."""
     keep = np.isfinite(values) & ((values > 0.0) if log else True)
-    return set(zip(np.round(f[keep], 9).tolist(), np.round(values[keep], 12).tolist()))
+    return set(zip(np.round(f[keep], 9).tolist(), np.round(scale * values[keep], 12).tolist()))
 
 
 def _panel_solution(title: str) -> str:
@@ -40,7 +43,7 @@ def test_each_solution_panel_shows_every_value_of_its_solution(quantity: str) ->
     for ax in drawn.figure.axes:
         solution = _panel_solution(ax.get_title())
         log = ax.get_yscale() == "log"
-        expected = set().union(*(_expected(ds[quantity].sel(solution=solution, restitution=r).values, f, log) for r in ds["restitution"].values))
+        expected = set().union(*(_expected(ds[quantity].sel(solution=solution, restitution=r).values, f, log, QUANTITIES[quantity].scale) for r in ds["restitution"].values))
         shown = shown_points(ax, solution)
         assert expected, solution
         missing = expected - shown
@@ -58,7 +61,7 @@ def test_each_restitution_panel_shows_every_simulated_value(quantity: str) -> No
     for ax, r in zip(drawn.figure.axes, ds["restitution"].values):
         log = ax.get_yscale() == "log"
         for solution in (*ENGINE_SOLUTIONS, "pgf"):
-            expected = _expected(ds[quantity].sel(solution=solution, restitution=r).values, f, log)
+            expected = _expected(ds[quantity].sel(solution=solution, restitution=r).values, f, log, QUANTITIES[quantity].scale)
             assert expected and not expected - shown_points(ax, solution), (solution, r)
     plt.close(drawn.figure)
 
@@ -86,10 +89,11 @@ def test_sweep_panels_show_both_sweeps_and_the_steady_states() -> None:
         assert len(axes) == len(quantities)
         for ax, quantity in zip(axes, quantities):
             log = ax.get_yscale() == "log"
-            swept = set().union(*(_expected(ds[f"swept_{quantity}"].sel(sweep=d).values, f, log) for d in ds["sweep"].values))
+            scale = QUANTITIES[quantity].scale
+            swept = set().union(*(_expected(ds[f"swept_{quantity}"].sel(sweep=d).values, f, log, scale) for d in ds["sweep"].values))
             assert swept and not swept - shown_points(ax, "compliant"), (name, quantity)
             if quantity in ds:
-                steady = _expected(ds[quantity].sel(solution="pgf").values, f, log)
+                steady = _expected(ds[quantity].sel(solution="pgf").values, f, log, scale)
                 assert steady and not steady - shown_points(ax, "pgf"), (name, quantity)
     for drawn in figures.values():
         plt.close(drawn.figure)
@@ -105,6 +109,6 @@ def test_a_lone_value_between_gaps_still_shows() -> None:
     drawn = response_figure(lonely, "x1_amplitude", "x1")
     assert drawn is not None
     ax = next(a for a in drawn.figure.axes if _panel_solution(a.get_title()) == "pgf")
-    expected = _expected(values[pgf], ds["frequency"].values, True)
+    expected = _expected(values[pgf], ds["frequency"].values, True, 1e3)  # drawn in mm
     assert not expected - shown_points(ax, "pgf")
     plt.close(drawn.figure)

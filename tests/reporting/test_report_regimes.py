@@ -27,6 +27,45 @@ def test_every_flag_has_a_colour_of_its_own() -> None:
         assert distance > DISTINCT, f"{a.name} and {b.name}: {colour_a} and {colour_b}"
 
 
+#: Colour-vision deficiencies simulated on linear RGB (Machado, Oliveira & Fernandes 2009, severity 1).
+_DEFICIENCIES = {
+    "protanopia": ((0.152286, 1.052583, -0.204868), (0.114503, 0.786281, 0.099216), (-0.003882, -0.048116, 1.051998)),
+    "deuteranopia": ((0.367322, 0.860646, -0.227968), (0.280085, 0.672501, 0.047413), (-0.011820, 0.042940, 0.968881)),
+    "tritanopia": ((1.255528, -0.076749, -0.178779), (-0.078411, 0.930809, 0.147602), (0.004733, 0.691367, 0.303900)),
+}
+#: Smallest CIELAB difference (CIE76) between two flags' colours as a colour-blind reader sees them.
+CVD_DISTINCT = 10.0
+
+
+def _lab(colour: str, deficiency: str | None) -> np.ndarray:
+    """CIELAB (D65) of sRGB ``colour`` as seen with ``deficiency`` (None: normal vision)."""
+    rgb = np.asarray(to_rgb(colour))
+    linear = np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+    if deficiency is not None:
+        linear = np.clip(np.asarray(_DEFICIENCIES[deficiency]) @ linear, 0.0, 1.0)
+    xyz = np.array([[0.4124, 0.3576, 0.1805], [0.2126, 0.7152, 0.0722], [0.0193, 0.1192, 0.9505]]) @ linear / np.array([0.95047, 1.0, 1.08883])
+    f = np.where(xyz > 216 / 24389, np.cbrt(xyz), (24389 / 27 * xyz + 16) / 116)
+    return np.array([116 * f[1] - 16, 500 * (f[0] - f[1]), 200 * (f[1] - f[2])])
+
+
+def test_regime_colours_stay_distinct_for_colour_blind_readers() -> None:
+    """No two flags differ by red against green alone: under simulated protanopia, deuteranopia and tritanopia every
+    pair stays at least CVD_DISTINCT apart (the former palette had pairs 4 apart: green and red, blue and lilac)."""
+    for deficiency in (None, *_DEFICIENCIES):
+        for (a, colour_a), (b, colour_b) in itertools.combinations(REGIME_COLOURS.items(), 2):
+            difference = float(np.linalg.norm(_lab(colour_a, deficiency) - _lab(colour_b, deficiency)))
+            assert difference > CVD_DISTINCT, f"{deficiency}: {a.name} {colour_a} and {b.name} {colour_b} differ by {difference:.1f}"
+
+
+def test_the_design_map_colours_its_classes_from_the_one_regime_palette() -> None:
+    from vibroimpact.kinds.stepped.design_figures import REGIME_MAP_COLOURS
+    from vibroimpact.kinds.stepped.design_metrics import DesignRegime
+
+    assert set(REGIME_MAP_COLOURS) == set(DesignRegime)
+    assert set(REGIME_MAP_COLOURS.values()) <= set(REGIME_COLOURS.values())
+    assert len(set(REGIME_MAP_COLOURS.values())) == len(REGIME_MAP_COLOURS)
+
+
 def _every_flag() -> xr.Dataset:
     """One solution whose regime runs through every flag along frequency at the first restitution ratio (the second
     is linear throughout, so that every column is drawn, ``not_computed`` included)."""

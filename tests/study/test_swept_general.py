@@ -173,9 +173,9 @@ def test_relative_stops_sweep_page_draws_every_coordinate_and_stop(relative_run:
     assert isinstance(page, GeneralSweptPage)
     assert page.summary() == "solutions: pgf, compliant; stops: x2 - x1 <= 3 mm, R = 0.2; x2 - x1 >= -3 mm, R = 0.2"
     sections = page.sections(tmp_path)
-    assert [s.title for s in sections] == ["Structure and stops", "Swept sine against the steady states"]
-    assert [f.path.stem for f in sections[1].figures] == ["sweep_displacements", "sweep_force_impulse", "sweep_regime", "sweep_time"]
-    assert sections[1].tables[-1].title == "Swept sine against the stable pgf steady state (|X1| fundamental)" and "<td>all</td>" in sections[1].tables[-1].html
+    assert [s.title for s in sections] == ["Contacts and the steady states", "Structure and stops", "Swept sine against the steady states"]
+    assert [f.path.stem for f in sections[2].figures] == ["sweep_displacements", "sweep_force_impulse", "sweep_regime", "sweep_time"]
+    assert sections[2].tables[-1].title == "Swept sine against the stable pgf steady state (|X1| fundamental)" and "<td>all</td>" in sections[2].tables[-1].html
     layout = sweep_layout(ds)
     assert layout.coordinates == ("x1", "x2") and layout.labels == ("X1", "X2") and len(layout.stops) == 2
     figures = {drawn.name: drawn for drawn in sweep_figures(ds, swept_sine_run(ds))}

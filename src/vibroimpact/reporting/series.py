@@ -26,6 +26,8 @@ __all__ = ["draw_curve", "draw_linear", "draw_points", "stability_keys", "Simula
 MARKER_ZORDER = 2.5
 #: Closed-form curves drawn over simulation markers, to compare the two [matplotlib zorder].
 OVER_MARKERS_ZORDER = 3.0
+#: The linear system's dotted curve, over the closed-form curves (at 2) and under the simulation markers [zorder].
+LINEAR_ZORDER = 2.2
 #: Dot for an isolated closed-form value (no finite neighbour, so no line segment) [pt].
 ISOLATED_MARKER_SIZE = 3.0
 _SHAPES = {"o": "circles", "D": "diamonds", "s": "squares"}
@@ -86,10 +88,11 @@ def _mark_isolated(ax: Axes, x: np.ndarray, y: np.ndarray, colour: str, gid: str
 
 
 def draw_linear(ax: Axes, x: np.ndarray, y: np.ndarray, coarse: bool = False) -> bool:
-    """The linear system's curve (dotted black, legend 'LIN'); returns whether anything was drawn."""
+    """The linear system's curve (dotted black, legend 'LIN'), over the closed-form curves (:data:`LINEAR_ZORDER`):
+    where one of them is the linear motion the dots show on it; returns whether anything was drawn."""
     marker = {"marker": ".", "ms": 4} if coarse else {}
-    ax.plot(x, y, label="LIN", gid="linear", **LINEAR_STYLE, **marker)
-    _mark_isolated(ax, x, np.asarray(y, dtype=float), "k", "linear")
+    ax.plot(x, y, label="LIN", gid="linear", zorder=LINEAR_ZORDER, **LINEAR_STYLE, **marker)
+    _mark_isolated(ax, x, np.asarray(y, dtype=float), "k", "linear", LINEAR_ZORDER)
     return bool(np.isfinite(y).any())
 
 

@@ -24,10 +24,13 @@ from matplotlib.lines import Line2D  # noqa: E402
 from vibroimpact.analysis.stability import Regime  # noqa: E402
 
 __all__ = [
+    "DISPLACEMENT_SCALE",
+    "DISPLACEMENT_UNITS",
     "DPI",
     "FIGURE_WIDTH",
     "MAX_COLUMNS",
     "MIN_FONT_SIZE",
+    "PAGE_UNITS",
     "QUANTITIES",
     "REGIME_COLOURS",
     "SOLUTION_LOOKS",
@@ -82,6 +85,24 @@ class Quantity:
     meaning: str
     log: bool
 
+    @property
+    def page_units(self) -> str:
+        """Units on the page (:data:`PAGE_UNITS`): mm for a displacement, m/s² for an acceleration."""
+        return PAGE_UNITS.get(self.units, (self.units, 1.0))[0]
+
+    @property
+    def scale(self) -> float:
+        """Factor from the dataset's value to the page's (1e3 for a displacement: m -> mm)."""
+        return PAGE_UNITS.get(self.units, (self.units, 1.0))[1]
+
+
+#: One unit convention on every page: (units on the page, factor from the dataset's value) for each SI unit the
+#: datasets use where the page writes another. Displacements in mm, accelerations in m/s², forces in N, frequencies in
+#: Hz; the datasets keep SI (CF) units.
+PAGE_UNITS: dict[str, tuple[str, float]] = {"m": ("mm", 1e3), "m s-2": ("m/s²", 1.0)}
+#: Displacements on the page: units and factor from metres.
+DISPLACEMENT_UNITS, DISPLACEMENT_SCALE = PAGE_UNITS["m"]
+
 
 QUANTITIES: dict[str, Quantity] = {
     "x1_amplitude": Quantity("|X1| fundamental", "m", "fundamental-harmonic amplitude of the primary mass's displacement", True),
@@ -98,30 +119,35 @@ QUANTITIES: dict[str, Quantity] = {
 
 
 def axis_label(quantity: str) -> str:
-    """Axis label of ``quantity``: its short name and units in brackets."""
+    """Axis label of ``quantity``: its short name and the page's units in brackets (values drawn times
+    :attr:`Quantity.scale`)."""
     q = QUANTITIES[quantity]
-    return f"{q.label} [{q.units}]"
+    return f"{q.label} [{q.page_units}]"
 
 
 # ----------------------------------------------------------------------------------------------- regimes
-#: One colour per regime flag, all distinct: blues for the one-impact motion, greens for the linear motion, reds where
-#: no steady state is known, oranges and browns for what simulations found, grey where nothing was computed.
+#: The one regime palette of every page (regime maps, the design map's classes, markers coloured by regime), safe for
+#: colour-blind readers: no two flags are told apart by red against green alone (every pair stays at least 10 CIELAB
+#: units apart under simulated protanopia, deuteranopia and tritanopia; Okabe-Ito and Paul Tol colours). Pale yellows
+#: and sand for the linear motion, blues for the one-impact orbit (indigo where it is unstable), vermillion and rose
+#: where no steady state is known, orange where the linear motion crosses the clearance, teal, brown, olive and purple
+#: for what simulations found, grey where nothing was computed, black where it failed.
 REGIME_COLOURS: dict[Regime, str] = {
-    Regime.NOT_COMPUTED: "#d9d9d9",
-    Regime.LINEAR: "#b2df8a",
-    Regime.ONE_IMPACT: "#1f78b4",
-    Regime.ONE_IMPACT_COEXISTING_LINEAR: "#a6cee3",
-    Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT: "#33a02c",
-    Regime.NONE_INADMISSIBLE_ONE_IMPACT: "#fb9a99",
-    Regime.NONE: "#e31a1c",
-    Regime.LINEAR_EXCEEDS_CLEARANCE: "#fdbf6f",
-    Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT: "#6a3d9a",
-    Regime.PERIODIC_IMPACTS: "#ff7f00",
-    Regime.IRREGULAR: "#b15928",
-    Regime.SWEPT_CONTACT: "#cab2d6",
+    Regime.NOT_COMPUTED: "#dddddd",
+    Regime.LINEAR: "#ffee99",
+    Regime.ONE_IMPACT: "#4477aa",
+    Regime.ONE_IMPACT_COEXISTING_LINEAR: "#77aadd",
+    Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT: "#ddcc77",
+    Regime.NONE_INADMISSIBLE_ONE_IMPACT: "#cc6677",
+    Regime.NONE: "#d55e00",
+    Regime.LINEAR_EXCEEDS_CLEARANCE: "#e69f00",
+    Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT: "#332288",
+    Regime.PERIODIC_IMPACTS: "#44aa99",
+    Regime.IRREGULAR: "#8c510a",
+    Regime.SWEPT_CONTACT: "#88ccee",
     Regime.FAILED: "#000000",
-    Regime.QUASI_PERIODIC: "#ffff99",
-    Regime.CHAOTIC: "#f0027f",
+    Regime.QUASI_PERIODIC: "#999933",
+    Regime.CHAOTIC: "#aa3377",
 }
 
 

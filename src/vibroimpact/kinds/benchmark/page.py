@@ -22,7 +22,7 @@ from vibroimpact.kinds.benchmark.study import equal_error_speedup, loosest_toler
 from vibroimpact.engines.settings import STEPPED_TOLERANCES
 from vibroimpact.reporting.record import general_setting, is_general
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
-from vibroimpact.reporting.style import Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour
+from vibroimpact.reporting.style import DISPLACEMENT_SCALE, DISPLACEMENT_UNITS, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour
 
 __all__ = ["page_for", "AccuracyPage", "accuracy_figures", "accuracy_tables", "per_period_table", "TARGETS"]
 
@@ -222,16 +222,16 @@ def _equal_error_table(dataset: xr.Dataset) -> str:
 
 
 def _ladder_table(dataset: xr.Dataset) -> str:
-    """One steady state through each model: wall time [s], |X1| [m] (the measured coordinate's), difference from exact
+    """One steady state through each model: wall time [s], |X1| [mm] (the measured coordinate's), difference from exact
     and relative cost (HTML)."""
     names, label = _measured(dataset)
-    rows = [f"<tr><th>model</th><th>wall time per frequency point [s]</th><th>|{label}| [m]</th><th>relative difference from exact</th><th>cost / exact</th></tr>"]
+    rows = [f"<tr><th>model</th><th>wall time per frequency point [s]</th><th>|{label}| [{DISPLACEMENT_UNITS}]</th><th>relative difference from exact</th><th>cost / exact</th></tr>"]
     exact_wall = float(dataset["ladder_wall_time"].sel(model="exact"))
     for model in dataset["model"].values:
         point = dataset.sel(model=model)
         wall = float(point["ladder_wall_time"])
         rows.append(
-            f"<tr><td>{model}</td><td>{fmt(wall)}</td><td>{fmt(point[names['ladder_x1_amplitude']], '.6e')}</td>"
+            f"<tr><td>{model}</td><td>{fmt(wall)}</td><td>{fmt(DISPLACEMENT_SCALE * float(point[names['ladder_x1_amplitude']]), '#.7g')}</td>"
             f"<td>{fmt(point[names['ladder_x1_difference']], '.2e')}</td><td>{fmt(wall / exact_wall)}</td></tr>"
         )
     return "<table>" + "".join(rows) + "</table>" + f"<p>{dataset.attrs.get('ladder_description', '')}</p>"

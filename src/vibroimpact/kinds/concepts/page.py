@@ -15,8 +15,10 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 from matplotlib.axes import Axes
+from matplotlib.lines import Line2D
 from matplotlib.ticker import FormatStrFormatter, LogFormatter
 
+from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, render_page, rendering, saved, write_page
 from vibroimpact.reporting.record import stored_description
 from vibroimpact.reporting.style import LINEAR_STYLE, STABLE_STYLE, UNSTABLE_STYLE, Caption, figure_legend, fmt, new_figure, finish_axes, legend_rows
@@ -46,6 +48,11 @@ def _band(ax: Axes, dataset: xr.Dataset, static: bool = True) -> None:
         ax.axvspan(low, high, **_BAND)
     if static:
         ax.axhline(1e3 * float(dataset.attrs["static_deflection_m"]), **_STATIC)
+
+
+def _short(label: str) -> str:
+    """How a caption names a concept: its tag, ``(b)`` of ``(b) light damping, ...``; the whole label if it has none."""
+    return label.split(" ", 1)[0] if label.startswith("(") and ")" in label.split(" ", 1)[0] else label
 
 
 def _isolated(y: np.ndarray) -> np.ndarray:
@@ -142,10 +149,11 @@ def overview_figure(dataset: xr.Dataset) -> DrawnFigure:
     """Every concept's worst stable |X1| and base-force fundamental against frequency, side by side."""
     f = dataset["frequency"].values
     fig, axes = new_figure(2, panel_height=4.2, legend_rows=legend_rows(dataset.sizes["concept"], 2))
+    curves: list[list[tuple[str, list[Line2D]]]] = [[], []]
     for i in range(dataset.sizes["concept"]):
         label = str(dataset["label"].values[i])
-        for ax, values in ((axes[0], dataset["worst_x1_amplitude"].values[i] * 1e3), (axes[1], dataset["worst_base_force_amplitude"].values[i])):
-            ax.plot(f, values, color=concept_colour(i), lw=1.5, label=label)
+        for panel, ax, values in ((0, axes[0], dataset["worst_x1_amplitude"].values[i] * 1e3), (1, axes[1], dataset["worst_base_force_amplitude"].values[i])):
+            curves[panel].append((_short(label), ax.plot(f, values, color=concept_colour(i), lw=1.5, label=label, gid=f"concept:{i}")))
             alone = _isolated(values)
             ax.plot(f[alone], values[alone], "o", ms=3.0, color=concept_colour(i))
     _band(axes[0], dataset)
@@ -155,12 +163,13 @@ def overview_figure(dataset: xr.Dataset) -> DrawnFigure:
     for ax in axes:
         ax.set_xlim(float(f[0]), float(f[-1]))
         _plain_ticks(ax)
+    coincide = coincidence_phrase(found for ax, drawn in zip(axes, curves) for found in reveal_coincident(ax, drawn))
     figure_legend(fig, axes, columns=2)
     caption = (
         "Left: the worst stable |X1| found at each frequency, every concept in its colour (log scale; where no stable periodic orbit is "
         "known only the simulated steady states are drawn, as dots). Right: the fundamental of the force on the base of that motion, through the suspension "
         "(k1 x1 + b1 x1') and the absolute stops (a relative stop's force stays between the masses). Shaded: the anti-resonance band; "
-        "dotted grey: q/k1."
+        "dotted grey: q/k1." + (f" {coincide}" if coincide else "")
     )
     return DrawnFigure(fig, "concepts_overview", "Every concept side by side: |X1| and the force on the base", caption)
 
@@ -178,15 +187,19 @@ def impact_figure(dataset: xr.Dataset) -> DrawnFigure | None:
               ("simulated_impulse_per_period", "impulse per period [N s]", "rigid stops: impulse", False),
               ("simulated_impacts_per_period", "impacts per period", "rigid stops: impacts", False))  # fmt: skip
     fig, axes = new_figure(len(panels), panel_height=3.2, legend_rows=legend_rows(len(rows), 2))
+    found: list[Coincidence] = []
     for ax, (variable, ylabel, title, log) in zip(axes, panels):
         _band(ax, dataset, static=False)
+        curves: list[tuple[str, list[Line2D]]] = []
         for i in rows:
             values = dataset[variable].values[i]
-            ax.plot(fs, np.where(values > 0, values, np.nan) if log else values, "o-", ms=3.0, lw=1.0, color=concept_colour(i), label=str(dataset["label"].values[i]))
+            label = str(dataset["label"].values[i])
+            curves.append((_short(label), ax.plot(fs, np.where(values > 0, values, np.nan) if log else values, "o-", ms=3.0, lw=1.0, color=concept_colour(i), label=label, gid=f"concept:{i}")))
         finish_axes(ax, FREQUENCY, ylabel, title, log=log)
         ax.set_xlim(float(fs[0]), float(fs[-1]))
         if log:
             _plain_ticks(ax)
+        found += reveal_coincident(ax, curves)
     figure_legend(fig, axes, columns=2)
     bumper = fmt(dataset.attrs.get("bumper_frequency_Hz"), ".4g")
     caption = (
@@ -196,6 +209,8 @@ def impact_figure(dataset: xr.Dataset) -> DrawnFigure | None:
         "have no point where nothing touches). Last two: the exact engine's rigid stops, total impulse and impacts per excitation period (chattering shows "
         "as many impacts). Shaded: the anti-resonance band."
     )
+    coincide = coincidence_phrase(found)
+    caption += f" {coincide}" if coincide else ""
     return DrawnFigure(fig, "concepts_impacts", "What the impacts cost: bumper acceleration and force, impulse", caption)
 
 

@@ -15,16 +15,17 @@ import numpy as np
 import xarray as xr
 from matplotlib import colormaps
 from matplotlib.axes import Axes
-from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm, Normalize
+from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm, Normalize, to_rgb
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Rectangle
 from matplotlib.ticker import FormatStrFormatter, FuncFormatter
 
+from vibroimpact.analysis.stability import Regime
 from vibroimpact.kinds.stepped.design_metrics import BAND_NAMES, DESIGN_REGIME_LABELS, DesignRegime, no_stop_amplitude
 from vibroimpact.kinds.stepped.design_ranking import DesignMap
 from vibroimpact.reporting.page import DrawnFigure
 from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_points
-from vibroimpact.reporting.style import MIN_FONT_SIZE, SOLUTION_COLOURS, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref
+from vibroimpact.reporting.style import MIN_FONT_SIZE, REGIME_COLOURS, SOLUTION_COLOURS, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 
 __all__ = ["BAND_TITLES", "REGIME_MAP_COLOURS", "peak_maps_figure", "regime_map_figure", "response_figure"]
@@ -33,15 +34,17 @@ __all__ = ["BAND_TITLES", "REGIME_MAP_COLOURS", "peak_maps_figure", "regime_map_
 BAND_TITLES = {"lower": "lower resonance band", "working": "working band (anti-resonance)", "upper": "upper resonance band"}
 #: Shading of each band in the frequency responses.
 _BAND_SHADES = {"lower": "#fdeeee", "working": "#dff2d8", "upper": "#fdeeee"}
-#: One colour per class of motion, all distinct.
-REGIME_MAP_COLOURS: dict[DesignRegime, str] = {
-    DesignRegime.NO_IMPACT: "#b2df8a",
-    DesignRegime.ONE_IMPACT: "#1f78b4",
-    DesignRegime.PERIODIC_OTHER: "#ff7f00",
-    DesignRegime.IRREGULAR: "#6a3d9a",
-    DesignRegime.UNRESOLVED: "#e31a1c",
-    DesignRegime.NOT_COMPUTED: "#636363",
+#: The regime flag each class of motion stands for: its colour is that flag's in the one regime palette.
+_CLASS_FLAGS: dict[DesignRegime, Regime] = {
+    DesignRegime.NO_IMPACT: Regime.LINEAR,
+    DesignRegime.ONE_IMPACT: Regime.ONE_IMPACT,
+    DesignRegime.PERIODIC_OTHER: Regime.PERIODIC_IMPACTS,
+    DesignRegime.IRREGULAR: Regime.IRREGULAR,
+    DesignRegime.UNRESOLVED: Regime.NONE,
+    DesignRegime.NOT_COMPUTED: Regime.NOT_COMPUTED,
 }
+#: One colour per class of motion, all distinct, from :data:`~vibroimpact.reporting.style.REGIME_COLOURS`.
+REGIME_MAP_COLOURS: dict[DesignRegime, str] = {k: REGIME_COLOURS[flag] for k, flag in _CLASS_FLAGS.items()}
 #: Largest grid whose cells carry their value as text.
 _ANNOTATED_CELLS = 120
 #: Frequencies of the no-stop curve (its resonances are about 0.1 Hz wide).
@@ -82,9 +85,10 @@ def _eligible(dm: DesignMap) -> np.ndarray:
     return flags
 
 
-def _overlay(ax: Axes, dm: DesignMap, annotate: np.ndarray | None = None, texts: np.ndarray | None = None, norm: Normalize | None = None) -> None:
+def _overlay(ax: Axes, dm: DesignMap, annotate: np.ndarray | None = None, texts: np.ndarray | None = None, norm: Normalize | None = None, dark: np.ndarray | None = None) -> None:
     """Hatch the designs whose working band impacts, outline the eligible region, the reach of the no-stop |X2|, the
-    recommended design, and (small grids) each cell's text."""
+    recommended design, and (small grids) each cell's text: white on a dark cell (``dark``, or the lower part of
+    ``norm``), black elsewhere."""
     r, c = _grid(dm)
     xe, ye = _edges(r), _edges(c)
     eligible = _eligible(dm)
@@ -100,8 +104,8 @@ def _overlay(ax: Axes, dm: DesignMap, annotate: np.ndarray | None = None, texts:
                     y = [ye[j + (dj > 0)]] * 2 if dj else [ye[j], ye[j + 1]]
                     ax.plot(x, y, **_OUTLINE)
             if texts is not None and annotate is not None and texts[i, j]:
-                dark = norm is not None and math.isfinite(annotate[i, j]) and norm(annotate[i, j]) < 0.45
-                ax.text(r[i], c[j], texts[i, j], ha="center", va="center", fontsize=MIN_FONT_SIZE, color="white" if dark else "black", zorder=7)
+                white = bool(dark[i, j]) if dark is not None else norm is not None and math.isfinite(annotate[i, j]) and norm(annotate[i, j]) < 0.45
+                ax.text(r[i], c[j], texts[i, j], ha="center", va="center", fontsize=MIN_FONT_SIZE, color="white" if white else "black", zorder=7)
     if math.isfinite(dm.working_clearance) and ye[0] < 1e3 * dm.working_clearance < ye[-1]:
         ax.axhline(1e3 * dm.working_clearance, **_REACH)
     if dm.recommendation is not None:
@@ -124,6 +128,16 @@ def _keys(dm: DesignMap) -> list[Line2D | Patch]:
     if dm.recommendation is not None:
         keys.append(Patch(facecolor="none", edgecolor="k", lw=2.5, label="recommended design (framed cell)"))
     return keys
+
+
+#: Relative luminance below which white text contrasts more than black (WCAG: (1 + 0.05) / (L + 0.05) > (L + 0.05) / 0.05).
+_WHITE_TEXT_BELOW = 0.179
+
+
+def _luminance(colour: str) -> float:
+    """Relative luminance of ``colour`` (0 black, 1 white; WCAG): dark cells take white text."""
+    linear = [c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4 for c in to_rgb(colour)]
+    return 0.2126 * linear[0] + 0.7152 * linear[1] + 0.0722 * linear[2]
 
 
 def _cell_text(values: np.ndarray, bounds: np.ndarray, spec: str) -> np.ndarray:
@@ -226,7 +240,8 @@ def regime_map_figure(dm: DesignMap) -> DrawnFigure:
     counts = np.zeros(worst.shape, dtype=object)
     for index, flag in np.ndenumerate(worst):
         counts[index] = str(int(regimes[f"count_{DesignRegime(flag).name.lower()}"].values[index]))
-    _overlay(axes[0], dm, worst.astype(float), counts if annotate else None, None)
+    dark = np.vectorize(lambda flag: _luminance(REGIME_MAP_COLOURS[DesignRegime(flag)]) < _WHITE_TEXT_BELOW)(worst)
+    _overlay(axes[0], dm, worst.astype(float), counts if annotate else None, None, dark)
     axes[0].set_title("worst motion over the frequency range", fontsize=MIN_FONT_SIZE + 1)
     for ax, (share, title, colours, full) in zip(axes[1:], shares):
         _share_panel(ax, dm, share, title, colours, full)

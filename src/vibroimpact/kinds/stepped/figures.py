@@ -10,12 +10,14 @@ import html
 
 import numpy as np
 import xarray as xr
+from matplotlib.lines import Line2D
 
 from vibroimpact.model.modal import fit_modal_parameters, underdamped_mode_count
+from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.record import GeneralSetting
 from vibroimpact.reporting.page import DrawnFigure, Table
 from vibroimpact.reporting.series import SimulationMarkers, draw_curve, draw_linear, draw_points, periodic_points, stability_keys, unstable_points
-from vibroimpact.reporting.style import SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref
+from vibroimpact.reporting.style import DISPLACEMENT_SCALE, DISPLACEMENT_UNITS, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 from vibroimpact.simulation.harmonics import base_force
 
@@ -57,16 +59,18 @@ def structure_figure(setting: GeneralSetting, frequency: np.ndarray) -> DrawnFig
     named = setting.named
     fit = fit_modal_parameters(named) if named is not None and underdamped_mode_count(named) == 2 else None
     fig, axes = new_figure(3 if named is None else 4, panel_height=3.6, legend_rows=legend_rows(setting.structure.size + 2 * len(setting.stops) + 2))
-    for i, name in enumerate(setting.names):
-        axes[0].semilogy(f, np.abs(x[:, i]), color=series_colour(i), lw=1.4, label=f"|{name}|", gid=f"linear:{name}")
-    finish_axes(axes[0], _FREQUENCY, "amplitude [m]", "Every coordinate, linear system (no stop)")
+    coordinates = [(f"|{name}|", axes[0].semilogy(f, DISPLACEMENT_SCALE * np.abs(x[:, i]), color=series_colour(i), lw=1.4, label=f"|{name}|", gid=f"linear:{name}")) for i, name in enumerate(setting.names)]
+    finish_axes(axes[0], _FREQUENCY, f"amplitude [{DISPLACEMENT_UNITS}]", "Every coordinate, linear system (no stop)")
     static = setting.static_deflection()
     gaps = setting.clearances - (setting.normals @ static if static is not None else 0.0)
+    stops: list[tuple[str, list[Line2D]]] = []
+    lines: list[tuple[str, list[Line2D]]] = []
     for k, (normal, words) in enumerate(zip(setting.normals, setting.stops)):
-        axes[1].semilogy(f, np.abs(x @ normal), color=series_colour(k), lw=1.4, ls="--", label=f"stop {k}: {_target(words)}", gid=f"linear:stop{k}")
-        if np.isfinite(gaps[k]) and gaps[k] > 0.0:
-            axes[1].axhline(gaps[k], color=series_colour(k), lw=1.1, ls=":", label=f"stop {k}: gap {fmt(gaps[k] * 1e3, '.4g')} mm", gid=f"gap:stop{k}")
-    finish_axes(axes[1], _FREQUENCY, "amplitude [m]", "Each stop's coordinate, linear system")
+        stops.append((f"stop {k}", axes[1].semilogy(f, DISPLACEMENT_SCALE * np.abs(x @ normal), color=series_colour(k), lw=1.4, ls="--", label=f"stop {k}: {_target(words)}", gid=f"linear:stop{k}")))
+        if np.isfinite(gaps[k]) and gaps[k] > 0.0:  # drawn on the frequencies, as the curves it is compared with
+            lines.append((f"the gap of stop {k}", axes[1].plot(f, np.full(f.shape, DISPLACEMENT_SCALE * gaps[k]), color=series_colour(k), lw=1.1, ls=":", label=f"stop {k}: gap {fmt(gaps[k] * 1e3, '.4g')} mm", gid=f"gap:stop{k}")))
+    finish_axes(axes[1], _FREQUENCY, f"amplitude [{DISPLACEMENT_UNITS}]", "Each stop's coordinate, linear system")
+    coincide = coincidence_phrase([*reveal_coincident(axes[0], coordinates), *reveal_coincident(axes[1], stops), *reveal_coincident(axes[1], lines)])
     axes[2].semilogy(f, np.abs(base_force(setting.structure, w, x)), color="C2", lw=1.4, label="|F| on the base", gid="linear:force")
     finish_axes(axes[2], _FREQUENCY, "|F| on the base [N]", "Linear force on the base (paper fig. 3)")
     if named is not None:
@@ -87,7 +91,7 @@ def structure_figure(setting: GeneralSetting, frequency: np.ndarray) -> DrawnFig
         caption += f" |H22| exact {fitted}. Natural frequencies {natural} Hz, anti-resonance {fmt(named.antiresonance_angular_frequency() / (2 * np.pi), '.3f')} Hz."
     else:
         caption += f" Natural frequencies {natural} Hz."
-    caption += f" Stops: {'; '.join(setting.stops)}."
+    caption += f" Stops: {'; '.join(setting.stops)}." + (f" {coincide}" if coincide else "")
     return DrawnFigure(fig, "structure", "Linear responses, force on the base" + (", fit of H22" if named is not None else ""), caption)
 
 
@@ -144,31 +148,39 @@ def response_panels_figure(part: xr.Dataset, setting: GeneralSetting, name: str)
     f = part["frequency"].values
     solutions = [str(s) for s in part["solution"].values]
     coarse = f.size < _COARSE
-    panels: list[tuple[str, str, str, int | None, bool]] = [(f"{c}_amplitude", f"|{c}| fundamental [m]", f"coordinate {c}", None, True) for c in setting.names if f"{c}_amplitude" in part]
+    # (quantity, axis label, title, stop, log scale, factor to the page's units)
+    panels: list[tuple[str, str, str, int | None, bool, float]] = [
+        (f"{c}_amplitude", f"|{c}| fundamental [{DISPLACEMENT_UNITS}]", f"coordinate {c}", None, True, DISPLACEMENT_SCALE) for c in setting.names if f"{c}_amplitude" in part
+    ]
     if "force_amplitude" in part:
-        panels.append(("force_amplitude", "|F| on the base [N]", "force on the base", None, True))
+        panels.append(("force_amplitude", "|F| on the base [N]", "force on the base", None, True, 1.0))
     several = "stop" in part.dims
     if "impulse" in part:
         for k, words in enumerate(setting.stops if several else setting.stops[:1]):
-            panels.append(("impulse", "impulse per period [N s]", f"impulse on stop {k}: {_target(words)}", k if several else None, False))
+            panels.append(("impulse", "impulse per period [N s]", f"impulse on stop {k}: {_target(words)}", k if several else None, False, 1.0))
     panels = [p for p in panels if np.isfinite(_values(part, p[0], p[3])).any()]
     if not panels:
         return None
     fig, axes = new_figure(len(panels), panel_height=3.4, legend_rows=legend_rows(len(solutions) + 4))
     markers = SimulationMarkers()
     any_unstable = False
-    for ax, (quantity, label, title, stop, log) in zip(axes, panels):
+    found: list[Coincidence] = []
+    for ax, (quantity, label, title, stop, log, scale) in zip(axes, panels):
+        curves: list[tuple[str, list[Line2D]]] = []
         for solution in solutions:
-            values = _values(part.sel(solution=solution), quantity, stop)
+            values = scale * _values(part.sel(solution=solution), quantity, stop)
             if solution == "linear":
                 if quantity != "impulse":
                     draw_linear(ax, f, values, coarse)
             elif solution in ENGINE_SOLUTIONS:
                 markers.add(solution, draw_points(ax, f, values, periodic=periodic_points(part, solution), solution=solution, colour=SOLUTION_COLOURS.get(solution, "C5"), label=None))
             else:
+                before = len(ax.lines)
                 _, unstable = draw_curve(ax, f, values, colour=SOLUTION_COLOURS.get(solution, "C0"), label=solution_ref(solution), gid=solution, unstable=unstable_points(part, solution), coarse=coarse)
+                curves.append((solution_ref(solution), list(ax.lines[before:])))
                 any_unstable |= unstable
         finish_axes(ax, _FREQUENCY, label, title, log=log and bool(np.any(_values(part, quantity, stop) > 0.0)))
+        found += reveal_coincident(ax, curves)
     keys = (stability_keys() if any_unstable else []) + markers.keys()
     figure_legend(fig, axes, keys)
     caption = Caption(
@@ -181,6 +193,7 @@ def response_panels_figure(part: xr.Dataset, setting: GeneralSetting, name: str)
     if any_unstable:
         caption.add("unstable", "Closed form dashed: its orbit exists but is unstable (Floquet): the real motion there is another one.")
     caption.add("engines", markers.phrase())
+    caption.add("coincide", coincidence_phrase(found))
     return DrawnFigure(fig, name, f"Responses, {where_text(part)}", caption.text())
 
 

@@ -1,9 +1,10 @@
 """The page of a stepped study (paper figures 2-8, 21-26 and any layout's responses), chosen by what its dataset holds,
 never by how its scene was written.
 
-First the answer (the largest responses of every solution, against the linear system's), then the linear system
-(every coordinate, each stop's coordinate against its gap, the force on the base; the structure, stops and load in
-tables), then the detail per clearance, then the tables. Where the structure has the named view (the paper's two-mass
+First the answer in numbers (:mod:`~vibroimpact.kinds.stepped.answers`: the resonance peaks against a swept R or
+Delta, the largest contact deceleration on a bumper, the largest responses of every solution against the linear
+system's, the reduction factors), then the linear system (every coordinate, each stop's coordinate against its gap,
+the force on the base; the structure, stops and load in tables), then the detail per clearance, then the tables. Where the structure has the named view (the paper's two-mass
 chain: ``system_m1`` ... ``system_b2``) the paper's extras join: the fit of H22 and the modal table, resonance peaks
 against a swept parameter, the agreement by band and the reduction factors, both bands split at the anti-resonance.
 With one stop on the named view the responses are the paper's figures (one figure per quantity, one panel per
@@ -14,7 +15,6 @@ ratio with a panel per coordinate, the force on the base and the impulse on each
 from __future__ import annotations
 
 import html
-import math
 from pathlib import Path
 from typing import Iterator
 
@@ -25,14 +25,16 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import NullFormatter
 
 from vibroimpact.analysis.stability import Regime
+from vibroimpact.kinds.stepped.answers import answer_text, band_peaks, contact_text, convergence_rows, convergence_text, peak_rows, peaks_text, reduction_text
 from vibroimpact.kinds.stepped.figures import layout_tables, peaks_table, response_panels_figure, structure_figure, where_text
 from vibroimpact.kinds.stepped.responses import SolutionsPage, clearance_text, linear_section, series_by_restitution, regime_figure, response_figure, simulation_figure, stability_figure
 from vibroimpact.kinds.stepped.tables import agreement_table, modal_table, reduction_intro, reduction_tables
 from vibroimpact.orbits.motion import MotionThresholds
+from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved, StudyPage
 from vibroimpact.reporting.record import StudySetting, GeneralSetting, general_setting, named_layout, study_setting
 from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_points, periodic_points, stability_keys, unstable_points
-from vibroimpact.reporting.style import QUANTITIES, SOLUTION_COLOURS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref, ENGINE_MARKERS, REGIME_COLOURS
+from vibroimpact.reporting.style import DISPLACEMENT_SCALE, QUANTITIES, SOLUTION_COLOURS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref, ENGINE_MARKERS, REGIME_COLOURS
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 
 __all__ = ["page_for", "BumperStiffnessPage", "peak_figure", "peak_tables", "peak_acceleration_figure", "stiffness_figure", "stiffness_tables", "band_peaks", "lyapunov_figure", "FrequencyResponsePage", "RESPONSE_QUANTITIES", "SIMULATION_QUANTITIES", "unswept_restitution", "answer_text"]
@@ -43,47 +45,6 @@ __all__ = ["page_for", "BumperStiffnessPage", "peak_figure", "peak_tables", "pea
 # --------------------------------------------------------------------------------------------------------------------
 
 # ---------------------------------------------------------------------------------------------- peaks
-def band_peaks(values: np.ndarray, f: np.ndarray, split: float) -> tuple[tuple[float, float], tuple[float, float]]:
-    """Largest finite value below and above ``split`` [Hz] and where it is: ((peak 1, f 1), (peak 2, f 2))."""
-    result = []
-    for mask in (f < split, f >= split):
-        v = np.where(mask & np.isfinite(values), values, -np.inf)
-        i = int(np.argmax(v)) if v.size else 0
-        result.append((float(v[i]), float(f[i])) if v.size and np.isfinite(v[i]) else (math.nan, math.nan))
-    return result[0], result[1]
-
-
-#: (label, solution, parameter value, band-1 (peak, f), band-2 (peak, f), band-1 periodic, band-2 periodic)
-PeakRow = tuple[str, str, float, tuple[float, float], tuple[float, float], bool, bool]
-
-
-def _peak_rows(dataset: xr.Dataset, setting: StudySetting, parameter: str) -> list[PeakRow]:
-    """Peaks of |X1| per solution and ``parameter`` value; pgf also with stable orbits only and on the simulation grid."""
-    f = dataset["frequency"].values
-    split = setting.split_frequency
-    sim_f = setting.simulation_frequency
-    rows: list[PeakRow] = []
-    for value in dataset[parameter].values:
-        point = dataset.sel({parameter: value})
-        for solution in (str(s) for s in dataset["solution"].values if s != "linear"):
-            values = point["x1_amplitude"].sel(solution=solution).values
-            if solution in ENGINE_SOLUTIONS:
-                converged = periodic_points(point, solution)
-                peaks = band_peaks(values, f, split)
-                periodic = [bool(np.any(converged & np.isclose(f, at, rtol=0.0, atol=1e-9))) for _, at in peaks]
-                rows.append((solution, solution, float(value), *peaks, *periodic))
-                continue
-            rows.append((solution, solution, float(value), *band_peaks(values, f, split), True, True))
-            if solution == "pgf" and "stable" in point and "regime" in point:
-                impact = np.isin(point["regime"].sel(solution=solution).values, (Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR))
-                stable = impact & (point["stable"].sel(solution=solution).values == 1)
-                rows.append(("pgf, stable one-impact orbits only", solution, float(value), *band_peaks(np.where(stable, values, np.nan), f, split), True, True))
-            if sim_f.size:
-                on = np.isin(f, sim_f)
-                rows.append((f"{solution} on the simulation grid", solution, float(value), *band_peaks(values[on], f[on], split), True, True))
-    return rows
-
-
 #: Variants of a closed-form peak curve (label suffix): line style, width, and what the caption says of them; wide
 #: solid lines under thinner ones, so that equal curves all show.
 _PEAK_VARIANTS = {
@@ -100,7 +61,7 @@ def _variant(label: str, solution: str) -> str:
 
 def peak_figure(dataset: xr.Dataset, setting: StudySetting, parameter: str, name: str) -> DrawnFigure:
     """Peak |X1| of each resonance band against ``parameter`` (``restitution`` or ``clearance``): figures 25-26."""
-    rows = _peak_rows(dataset, setting, parameter)
+    rows = peak_rows(dataset, setting, parameter)
     scale, unit = (1e3, "mm") if parameter == "clearance" else (1.0, "-")
     labels = list(dict.fromkeys(r[0] for r in rows))
     fig, axes = new_figure(2, panel_height=3.9, legend_rows=legend_rows(len(labels) + 2, 3))
@@ -111,7 +72,7 @@ def peak_figure(dataset: xr.Dataset, setting: StudySetting, parameter: str, name
             chosen = [r for r in rows if r[0] == label]
             solution = chosen[0][1]
             x = np.array([r[2] for r in chosen]) * scale
-            y = np.array([r[3 + band][0] for r in chosen])
+            y = DISPLACEMENT_SCALE * np.array([r[3 + band][0] for r in chosen])
             colour = SOLUTION_COLOURS.get(solution, "C5")
             if solution in ENGINE_SOLUTIONS:
                 ax.plot(x, y, color=colour, lw=0.8, label="_nolegend_", gid=solution)
@@ -135,7 +96,7 @@ def peak_tables(dataset: xr.Dataset, setting: StudySetting, parameter: str) -> l
     header = f"<tr><th>solution</th><th>{parameter} [{unit}]</th><th>peak 1 [mm]</th><th>at [Hz]</th><th>peak 2 [mm]</th><th>at [Hz]</th></tr>"
     body = [
         f"<tr><td>{label}</td><td>{fmt(value * scale, 'g')}</td><td>{fmt(p1[0] * 1e3, '#.4g')}</td><td>{fmt(p1[1], '.3f')}</td><td>{fmt(p2[0] * 1e3, '#.4g')}</td><td>{fmt(p2[1], '.3f')}</td></tr>"
-        for label, _, value, p1, p2, _, _ in _peak_rows(dataset, setting, parameter)
+        for label, _, value, p1, p2, _, _ in peak_rows(dataset, setting, parameter)
     ]
     return [Table(f"Resonance peaks of |X1| against the {parameter}: values", f"<table>{header}{''.join(body)}</table>")]
 
@@ -156,20 +117,26 @@ def peak_acceleration_figure(part: xr.Dataset, name: str) -> DrawnFigure | None:
     )
     any_unstable = False
     engines = SimulationMarkers()
+    found: list[Coincidence] = []
     for ax, quantity in zip(axes, quantities):
-        for i, (_, line) in enumerate(lines):
+        curves: list[tuple[str, list[Line2D]]] = []
+        for i, (text, line) in enumerate(lines):
             if "pgf" in present:
-                drawn, unstable = draw_curve(ax, f, line[quantity].sel(solution="pgf").values, colour=series_colour(i), label=None, gid="pgf", unstable=unstable_points(line, "pgf"), zorder=OVER_MARKERS_ZORDER)
+                before = len(ax.lines)
+                drawn, unstable = draw_curve(ax, f, QUANTITIES[quantity].scale * line[quantity].sel(solution="pgf").values, colour=series_colour(i), label=None, gid="pgf", unstable=unstable_points(line, "pgf"), zorder=OVER_MARKERS_ZORDER)
+                curves.append((text, list(ax.lines[before:])))
                 any_unstable |= unstable
                 if drawn:
                     caption.add("pgf", f"Lines: the estimate from {solution_ref('pgf')}, Gamma(xi_b) Omega_b J / (1 + R) for the force (section 6.3 with the corrected factor Gamma; the deceleration less the absorber spring's pull): the rigid-stop impulse J gives the entry speed, the one-collision solution of the bumper gives the peak.")
             if "compliant" in present:
-                engines.add("compliant", draw_points(ax, f, line[quantity].sel(solution="compliant").values, periodic=periodic_points(line, "compliant"), solution="compliant", colour=series_colour(i), label=None))
+                engines.add("compliant", draw_points(ax, f, QUANTITIES[quantity].scale * line[quantity].sel(solution="compliant").values, periodic=periodic_points(line, "compliant"), solution="compliant", colour=series_colour(i), label=None))
         finish_axes(ax, "frequency [Hz]", axis_label(quantity), QUANTITIES[quantity].label)
+        found += reveal_coincident(ax, curves)
     if any_unstable:
         caption.add("unstable", "Dashed: the estimate on a one-impact orbit that exists but is unstable.")
     if engines:
         caption.add("compliant", engines.phrase(irregular="irregular motion, the largest over the measured window"))
+    caption.add("coincide", coincidence_phrase(found))
     keys: list[Line2D | Patch] = [Patch(color=series_colour(i), label=text) for i, (text, _) in enumerate(lines)]
     figure_legend(fig, [], keys + (stability_keys() if any_unstable else []) + engines.keys())
     return DrawnFigure(fig, name, f"Peak contact deceleration and force, {clearance_text(part)}", caption.text())
@@ -181,10 +148,12 @@ class BumperStiffnessPage(SolutionsPage):
     ``frequency``): the compliant bumper against the rigid stop."""
 
     def sections(self, out: Path) -> list[Section]:
-        """Linear system, then the convergence of the compliant bumper and its cost."""
+        """The convergence of the compliant bumper and its cost (the answer), then the linear system."""
         figure = stiffness_figure(self.dataset, self.setting, "bumper_stiffness")
-        convergence = Section("Compliant bumper against the rigid stop", figures=saved([figure], out), tables=stiffness_tables(self.dataset, self.setting))
-        return [linear_section(self.setting, out), convergence]
+        reference = _stiffness_reference(self.dataset)
+        answer = convergence_text(self.dataset, self.setting, reference) if reference is not None and "compliant" in self.dataset["solution"].values and self.setting.simulation_frequency.size else ""
+        convergence = Section("Compliant bumper against the rigid stop", intro=f"<p>{html.escape(answer)}</p>" if answer else "", figures=saved([figure], out), tables=stiffness_tables(self.dataset, self.setting))
+        return [convergence, linear_section(self.setting, out)]
 
 
 def _stiffness_reference(dataset: xr.Dataset) -> str | None:
@@ -237,21 +206,9 @@ def stiffness_tables(dataset: xr.Dataset, setting: StudySetting) -> list[Table]:
     reference = _stiffness_reference(dataset)
     if reference is None or "compliant" not in dataset["solution"].values or not setting.simulation_frequency.size:
         return []
-    bumper = dataset["bumper_frequency"].values
-    data = dataset.sel(frequency=setting.simulation_frequency)
-    sim = data["x1_amplitude"].sel(solution="compliant").transpose("bumper_frequency", "frequency").values
-    ref = data["x1_amplitude"].sel(solution=reference).values
-    difference = np.abs(sim - ref) / ref
-    wall = data["wall_time"].sel(solution="compliant").transpose("bumper_frequency", "frequency").values if "wall_time" in data else np.full(sim.shape, np.nan)
     rows = ["<tr><th>Omega_b/2pi [Hz]</th><th>median rel. diff. |X1|</th><th>largest</th><th>observed order (median)</th><th>median wall time [s]</th></tr>"]
-    for i, b in enumerate(bumper):
-        order = math.nan
-        if i > 0:
-            with np.errstate(invalid="ignore", divide="ignore"):
-                orders = np.log(difference[i - 1] / difference[i]) / np.log(b / bumper[i - 1])
-            if np.isfinite(orders).any():
-                order = float(np.nanmedian(orders))
-        rows.append(f"<tr><td>{fmt(b, 'g')}</td><td>{fmt(np.nanmedian(difference[i]), '.2e')}</td><td>{fmt(np.nanmax(difference[i]), '.2e')}</td><td>{fmt(order, '.2f')}</td><td>{fmt(np.nanmedian(wall[i]), '.3f')}</td></tr>")
+    for r in convergence_rows(dataset, setting, reference):
+        rows.append(f"<tr><td>{fmt(r.bumper_frequency, 'g')}</td><td>{fmt(r.median, '.2e')}</td><td>{fmt(r.largest, '.2e')}</td><td>{fmt(r.order, '.2f')}</td><td>{fmt(r.wall_time, '.3f')}</td></tr>")
     return [Table(f"compliant against {reference}: convergence and cost", "<table>" + "".join(rows) + "</table>")]
 
 
@@ -336,21 +293,25 @@ class FrequencyResponsePage:
         return f"solutions: {', '.join(self.layout.solutions)}; stops: {'; '.join(self.layout.stops)}"
 
     def sections(self, out: Path) -> list[Section]:
-        """The answer (largest responses, then the reduction factors the stop gives), the linear system, resonance
-        peaks, per clearance the responses and simulations, agreement."""
+        """The answer (resonance peaks against a swept R or Delta, contact peaks, largest responses, reduction factors,
+        in numbers), the resonance peaks, the reduction factors, the linear system, per clearance the responses and
+        simulations, agreement."""
         dataset, layout, setting = self.dataset, self.layout, self.setting
-        sections = [Section("Largest responses", intro=f"<p>{html.escape(answer_text(dataset, layout))}</p>", tables=[peaks_table(dataset, layout)])]
+        engines = [str(s) for s in dataset["solution"].values if s in ENGINE_SOLUTIONS]
+        peaks = [p for p in PEAK_PARAMETERS if p in dataset.dims] if setting is not None and "x1_amplitude" in dataset and engines else []
+        answers = [peaks_text(dataset, setting, p) for p in peaks if setting is not None] + [contact_text(dataset), answer_text(dataset, layout)]
+        if setting is not None and any(s != "linear" for s in dataset["solution"].values):
+            answers.append(reduction_text(dataset, layout))
+        sections = [Section("Largest responses", intro="".join(f"<p>{html.escape(a)}</p>" for a in answers if a), tables=[peaks_table(dataset, layout)])]
+        for parameter in peaks:
+            assert setting is not None
+            figure = peak_figure(dataset, setting, parameter, f"peaks_vs_{parameter}")
+            sections.append(Section(f"Resonance peaks against the {parameter}", figures=saved([figure], out), tables=peak_tables(dataset, setting, parameter)))
         if setting is not None and any(s != "linear" for s in dataset["solution"].values):
             sections.append(Section("Reduction factors", intro=reduction_intro(), tables=reduction_tables(dataset, layout, named_layout(dataset) is not None)))
         intro = f"<p>Stops: {html.escape('; '.join(layout.stops))}. Load: {html.escape(layout.load_text())}.</p>"
         tables = ([modal_table(layout.named)] if layout.named is not None else []) + layout_tables(layout)
         sections.append(Section("Linear system", intro=intro, figures=saved([structure_figure(layout, dataset["frequency"].values)], out), tables=tables))
-        engines = [str(s) for s in dataset["solution"].values if s in ENGINE_SOLUTIONS]
-        if setting is not None and "x1_amplitude" in dataset and engines:
-            for parameter in PEAK_PARAMETERS:
-                if parameter in dataset.dims:
-                    figure = peak_figure(dataset, setting, parameter, f"peaks_vs_{parameter}")
-                    sections.append(Section(f"Resonance peaks against the {parameter}", figures=saved([figure], out), tables=peak_tables(dataset, setting, parameter)))
         if setting is not None and "stop" not in dataset.dims:
             sections += _paper_response_sections(dataset, out)
         else:
@@ -360,28 +321,6 @@ class FrequencyResponsePage:
             if agreement is not None:
                 sections.append(Section("Simulation against the closed form: agreement by band", tables=[agreement]))
         return sections
-
-
-def answer_text(dataset: xr.Dataset, layout: GeneralSetting) -> str:
-    """The largest fundamental of the first coordinate of every solution over the frequencies it computed (the
-    largest over the swept parameters, and where), against the linear system's: the page's answer in one sentence."""
-    quantity = f"{layout.names[0]}_amplitude"
-    if quantity not in dataset:
-        return "The largest value of each response over the frequencies every solution computed, and where it occurs."
-    f = dataset["frequency"].values
-    parts = []
-    for solution in (str(s) for s in dataset["solution"].values):
-        data = dataset[quantity].sel(solution=solution)
-        values = np.asarray(data.values, dtype=float)
-        if not np.isfinite(values).any():
-            continue
-        index = np.unravel_index(int(np.nanargmax(values)), values.shape)
-        at = {dim: data[dim].values[i] for dim, i in zip(data.dims, index)}
-        where = [f"{fmt(float(f[index[data.dims.index('frequency')]]), '.4g')} Hz"]
-        where += [f"{'R' if dim == 'restitution' else dim} = {fmt(float(at[dim]) * (1e3 if dim == 'clearance' else 1.0), 'g')}{' mm' if dim == 'clearance' else ''}" for dim in data.dims if dim not in ("frequency", "stop") and solution != "linear"]
-        label = "linear system (no stop)" if solution == "linear" else solution
-        parts.append(f"{label} {fmt(float(values[index]) * 1e3, '.4g')} mm at {', '.join(where)}")
-    return f"Largest |{layout.names[0]}| over the frequencies each solution computed: " + "; ".join(parts) + ". The table gives every response per solution and swept value."
 
 
 def _paper_response_sections(dataset: xr.Dataset, out: Path) -> list[Section]:

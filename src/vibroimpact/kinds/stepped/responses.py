@@ -22,10 +22,13 @@ from matplotlib.patches import Patch, Rectangle
 from vibroimpact.analysis.linear import linear_response
 from vibroimpact.model.modal import fit_modal_parameters, underdamped_mode_count
 from vibroimpact.analysis.stability import Regime
+from vibroimpact.reporting.coincide import coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, saved
 from vibroimpact.reporting.record import StudySetting
 from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_linear, draw_points, periodic_points, stability_keys, unstable_points
 from vibroimpact.reporting.style import (
+    DISPLACEMENT_SCALE,
+    DISPLACEMENT_UNITS,
     LINEAR_STYLE,
     QUANTITIES,
     RAW_STYLE,
@@ -110,11 +113,11 @@ def linear_figure(setting: StudySetting) -> DrawnFigure:
     fit = fit_modal_parameters(system) if underdamped_mode_count(system) == 2 else None
     fig, axes = new_figure(3, panel_height=3.6, legend_rows=2)
     ax = axes[0]
-    ax.semilogy(f, np.abs(response.x1), label="|X1| primary", color="C0", lw=1.4, gid="linear")
-    ax.semilogy(f, np.abs(response.x2), label="|X2| absorber", color="C1", lw=1.4, gid="linear")
+    ax.semilogy(f, DISPLACEMENT_SCALE * np.abs(response.x1), label="|X1| primary", color="C0", lw=1.4, gid="linear")
+    ax.semilogy(f, DISPLACEMENT_SCALE * np.abs(response.x2), label="|X2| absorber", color="C1", lw=1.4, gid="linear")
     for delta in setting.clearance:
-        ax.axhline(delta, color="k", lw=0.9, ls="--")
-    finish_axes(ax, _FREQUENCY, "amplitude [m]", "Linear responses (paper fig. 2)")
+        ax.axhline(DISPLACEMENT_SCALE * delta, color="k", lw=0.9, ls="--")
+    finish_axes(ax, _FREQUENCY, f"amplitude [{DISPLACEMENT_UNITS}]", "Linear responses (paper fig. 2)")
     ax = axes[1]
     ax.semilogy(f, np.abs(response.force), color="C2", lw=1.4, gid="linear")
     finish_axes(ax, _FREQUENCY, "|F| on the base [N]", "Linear force on the base (paper fig. 3)")
@@ -155,20 +158,24 @@ def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure |
     fig, axes = new_figure(len(panels), panel_height=3.7, sharey=True, legend_rows=legend_rows(len(lines) + 6))
     engines = SimulationMarkers()
     any_unstable = gaps = raw = False
+    curves: list[list[tuple[str, list[Line2D]]]] = []
     for ax, solution in zip(axes, panels):
+        curves.append([])
         if with_linear or solution == "linear":
-            draw_linear(ax, f, part[quantity].sel(solution="linear").isel(_first(part)).values, coarse)
+            draw_linear(ax, f, q.scale * part[quantity].sel(solution="linear").isel(_first(part)).values, coarse)
             caption.add("linear", "LIN (dotted black): the linear system (no stop).")
-        for i, (_, line) in enumerate(lines if solution != "linear" else []):
-            values = line[quantity].sel(solution=solution).values
+        for i, (text, line) in enumerate(lines if solution != "linear" else []):
+            values = q.scale * line[quantity].sel(solution=solution).values
             if solution in ENGINE_SOLUTIONS:
                 engines.add(solution, draw_points(ax, f, values, periodic=periodic_points(line, solution), solution=solution, colour=series_colour(i), label=None))
                 continue
+            before = len(ax.lines)
             _, unstable = draw_curve(ax, f, values, colour=series_colour(i), label=None, gid=solution, unstable=unstable_points(line, solution), coarse=coarse)
+            curves[-1].append((text, list(ax.lines[before:])))
             any_unstable |= unstable
             gaps |= bool(np.isnan(values).any())
             if raw_name in line and solution != "linear":
-                raw_values = line[raw_name].sel(solution=solution).values
+                raw_values = q.scale * line[raw_name].sel(solution=solution).values
                 if np.isfinite(raw_values).any():
                     ax.plot(f, raw_values, color=series_colour(i), label="_nolegend_", gid=f"raw:{solution}", **RAW_STYLE)
                     raw = True
@@ -181,16 +188,18 @@ def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure |
         caption.add("raw", "Faint thin lines: the raw one-impact solution wherever eqs. 15-16 have a root, unchecked (admissible or not, stable or not): what the paper plots, spikes included.")
     if engines:
         caption.add("engines", engines.phrase())
-    finite = part[quantity].sel(solution=[*panels, *(["linear"] if with_linear else [])]).values
+    finite = q.scale * part[quantity].sel(solution=[*panels, *(["linear"] if with_linear else [])]).values
     top = float(np.max(finite[np.isfinite(finite)], initial=0.0))
     if top > 0.0:
         axes[0].set_ylim(top=3.0 * top if q.log else 1.1 * top)
+    coincide = coincidence_phrase(found for ax, drawn in zip(axes, curves) for found in reveal_coincident(ax, drawn))
     keys = [Patch(color=series_colour(i), label=text) for i, (text, _) in enumerate(lines)]
     if with_linear:
         keys.append(Line2D([], [], label="LIN (linear system)", **LINEAR_STYLE))
     keys += stability_keys() if any_unstable else []
     keys += [Line2D([], [], color="k", label="raw one-impact solution", **RAW_STYLE)] if raw else []
     figure_legend(fig, [], keys + engines.keys())
+    caption.add("coincide", coincide)
     missing = [s for s in candidates if s not in panels]
     tail = f"No finite values, not drawn: {', '.join(solution_ref(s) for s in missing)}." if missing else ""
     return DrawnFigure(fig, name, f"{q.label[:1].upper()}{q.label[1:]}, {clearance_text(part)}", caption.text(tail))
@@ -305,15 +314,19 @@ def stability_figure(part: xr.Dataset, name: str) -> DrawnFigure:
     f = part["frequency"].values
     fig, axes = new_figure(1, panel_height=3.8, legend_rows=legend_rows(len(lines) + 1, 6))
     ax = axes[0]
+    curves: list[tuple[str, list[Line2D]]] = []
     for i, (text, line) in enumerate(lines):
+        before = len(ax.lines)
         draw_curve(ax, f, line["floquet_modulus"].sel(solution="pgf").values, colour=series_colour(i), label=text, gid="pgf", coarse=f.size < COARSE_GRID_POINTS)
+        curves.append((text, list(ax.lines[before:])))
     ax.axhline(1.0, color="k", lw=1.0, label="stability limit 1")
     finish_axes(ax, _FREQUENCY, axis_label("floquet_modulus"), f"{solution_ref('pgf')}: stability of the one-impact orbit, {clearance_text(part)}", log=True)
+    coincide = coincidence_phrase(reveal_coincident(ax, curves))
     figure_legend(fig, axes, columns=6)
     caption = (
         f"{QUANTITIES['floquet_modulus'].label} of the exact one-impact orbit of {solution_ref('pgf')} (monodromy = impact "
         "saltation matrix x exact flow over the period), one colour per restitution ratio. Above 1 the orbit exists but "
-        "is unstable: a simulation started on it leaves it."
+        "is unstable: a simulation started on it leaves it." + (f" {coincide}" if coincide else "")
     )
     return DrawnFigure(fig, name, f"Stability of the one-impact orbit, {clearance_text(part)}", caption)
 
@@ -334,14 +347,14 @@ def simulation_figure(part: xr.Dataset, quantity: str, engines: list[str], name:
     any_unstable = False
     for ax, (text, line) in zip(axes, lines):
         if "linear" in present and quantity != "impulse":
-            draw_linear(ax, f, line[quantity].sel(solution="linear").values)
+            draw_linear(ax, f, q.scale * line[quantity].sel(solution="linear").values)
             caption.add("linear", "LIN (dotted black): the linear system (no stop).")
         if closed is not None:
-            _, unstable = draw_curve(ax, f, line[quantity].sel(solution=closed).values, colour=SOLUTION_COLOURS[closed], label=solution_ref(closed), gid=closed, unstable=unstable_points(line, closed), zorder=OVER_MARKERS_ZORDER)
+            _, unstable = draw_curve(ax, f, q.scale * line[quantity].sel(solution=closed).values, colour=SOLUTION_COLOURS[closed], label=solution_ref(closed), gid=closed, unstable=unstable_points(line, closed), zorder=OVER_MARKERS_ZORDER)
             any_unstable |= unstable
             caption.add("closed", f"{solution_ref(closed)} (blue line): the {SOLUTION_DESCRIPTIONS[closed]}.")
         for engine in drawn:
-            values = line[quantity].sel(solution=engine).values
+            values = q.scale * line[quantity].sel(solution=engine).values
             markers.add(engine, draw_points(ax, f, values, periodic=periodic_points(line, engine), solution=engine, colour=SOLUTION_COLOURS[engine], label=solution_ref(engine)))
         finish_axes(ax, _FREQUENCY, axis_label(quantity), text, log=q.log)
     if any_unstable:

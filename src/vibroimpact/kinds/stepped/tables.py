@@ -225,9 +225,9 @@ def reduction_tables(dataset: xr.Dataset, setting: GeneralSetting, paper_layout:
     for quantity in _REDUCTION_QUANTITIES:
         if quantity not in dataset or not solutions:
             continue
-        units = QUANTITIES[quantity].units
+        units, scale = QUANTITIES[quantity].page_units, QUANTITIES[quantity].scale
         header = _header(
-            f"linear peak 1 / 2 [{units}]", "largest realisable in band 1 / 2", "reduction factor 1", "reduction factor 2", "computed points 1 / 2",
+            f"linear peak 1 / 2 [{units}]", f"largest realisable in band 1 / 2 [{units}]", "reduction factor 1", "reduction factor 2", "computed points 1 / 2",
             "undefined points 1 / 2", "unstable points 1 / 2", "paper",
         )
         body = []
@@ -241,7 +241,7 @@ def reduction_tables(dataset: xr.Dataset, setting: GeneralSetting, paper_layout:
                 unstable = "n/a" if row.unstable is None else f"{row.unstable[0]} / {row.unstable[1]}"
                 body.append(
                     f"<tr><td>{solution}</td><td>{fmt(row.clearance * 1e3, 'g')}</td><td>{fmt(row.restitution, 'g')}</td>"
-                    f"<td>{fmt(row.linear_peak[0], '#.4g')} / {fmt(row.linear_peak[1], '#.4g')}</td><td>{fmt(row.largest[0], '#.4g')} / {fmt(row.largest[1], '#.4g')}</td>"
+                    f"<td>{fmt(scale * row.linear_peak[0], '#.4g')} / {fmt(scale * row.linear_peak[1], '#.4g')}</td><td>{fmt(scale * row.largest[0], '#.4g')} / {fmt(scale * row.largest[1], '#.4g')}</td>"
                     f"{factors}<td>{computed}</td><td>{row.undefined[0]} / {row.undefined[1]}</td><td>{unstable}</td>"
                     f"<td>{'' if paper is None else fmt(paper[0], 'g') + ' / ' + fmt(paper[1], 'g')}</td></tr>"
                 )

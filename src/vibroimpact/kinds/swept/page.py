@@ -20,16 +20,18 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 from matplotlib.axes import Axes
+from matplotlib.lines import Line2D
 
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.kinds.stepped.figures import GENERAL_DESCRIPTIONS, layout_tables, structure_figure
 from vibroimpact.reporting.record import GeneralSetting, general_setting, is_general, study_setting, SWEPT_SOLUTION
+from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.kinds.stepped.responses import SolutionsPage, linear_section, regime_map
 from vibroimpact.reporting.series import draw_curve, draw_linear, stability_keys, unstable_points
-from vibroimpact.reporting.style import QUANTITIES, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref, SWEEP_COLOURS
+from vibroimpact.reporting.style import DISPLACEMENT_SCALE, DISPLACEMENT_UNITS, QUANTITIES, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref, SWEEP_COLOURS
 
-__all__ = ["page_for", "SweptSinePage", "GeneralSweptPage", "SweptSineRun", "SweepLayout", "sweep_layout", "swept_sine_run", "sweep_figures", "sweep_tables"]
+__all__ = ["page_for", "SweptSinePage", "GeneralSweptPage", "SweptSineRun", "SweepLayout", "sweep_layout", "swept_sine_run", "sweep_figures", "sweep_tables", "sweep_answer", "contact_stretches"]
 
 #: Colour of each sweep direction.
 #: Running fundamental of a sweep: thinner than the steady states' curves, which show beneath.
@@ -155,17 +157,91 @@ def _first_point(dataset: xr.Dataset) -> tuple[xr.Dataset, str]:
     return dataset.isel(first), intro
 
 
+def _descending(dataset: xr.Dataset, direction: str) -> bool:
+    """Whether sweep ``direction`` runs down in frequency (its instantaneous frequency falls)."""
+    if "instantaneous_frequency" in dataset.coords:
+        f = np.asarray(dataset["instantaneous_frequency"].sel(sweep=direction).values, dtype=float)
+        f = f[np.isfinite(f)]
+        return f.size > 1 and f[-1] < f[0]
+    return direction == "down"
+
+
+def contact_stretches(f: np.ndarray, contact: np.ndarray, gap: float) -> list[tuple[float, float, tuple[float, float] | None]]:
+    """Stretches of frequency [Hz] where ``contact``, those less than ``gap`` [Hz] apart joined: (start, end, and the
+    span over which a joined stretch had contact-free points, or None)."""
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], contact.astype(int), [0]))))
+    runs = [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2])]
+    joined: list[tuple[int, int, int, int]] = []  # first, last, first gap start, last gap end (-1: none)
+    for a, b in runs:
+        if joined and f[a] - f[joined[-1][1]] <= gap:
+            first, last, g0, _ = joined[-1]
+            joined[-1] = (first, b, g0 if g0 >= 0 else last + 1, a - 1)
+        else:
+            joined.append((a, b, -1, -1))
+    return [(float(f[a]), float(f[b]), (float(f[g0]), float(f[g1])) if g0 >= 0 else None) for a, b, g0, g1 in joined]
+
+
+def sweep_answer(dataset: xr.Dataset, run: SweptSineRun, split: float | None, layout: SweepLayout | None = None) -> str:
+    """What the sweeps show, in numbers (HTML): where each sweep touches the stops, in its own direction (gaps shorter
+    than an estimator window joined, and said), and how far its running fundamental of the first coordinate lies from
+    the pgf orbit where that is stable and the sweep in contact (signed median per band)."""
+    layout = layout or sweep_layout(dataset)
+    f = dataset["frequency"].values
+    paragraphs = []
+    if "swept_regime" in dataset:
+        middle = 0.5 * (run.start_frequency + run.stop_frequency)
+        gap = run.rate * run.window_cycles / middle + float(np.min(np.diff(f), initial=0.0))
+        words = []
+        for direction in _directions(dataset):
+            stretches = contact_stretches(f, dataset["swept_regime"].sel(sweep=direction).values == Regime.SWEPT_CONTACT, gap)
+            down = _descending(dataset, direction)
+            texts = []
+            for start, end, free in reversed(stretches) if down else stretches:
+                a, b = (end, start) if down else (start, end)
+                text = f"{fmt(a, '.1f')}-{fmt(b, '.1f')} Hz"
+                if free is not None:
+                    c, d = (free[1], free[0]) if down else free
+                    text += f" (with contact-free windows over {fmt(c, '.2f')}-{fmt(d, '.2f')} Hz)"
+                texts.append(text)
+            words.append(f"sweeping {direction} over {_and(texts)}" if texts else f"sweeping {direction} none")
+        paragraphs.append(f"Contacts of the {solution_ref(SWEPT_SOLUTION)} sweeps ({run.text()}): {'; '.join(words)}.")
+    quantity, label = f"{layout.coordinates[0]}_amplitude", layout.labels[0]
+    if "pgf" in _steady_solutions(dataset) and f"swept_{quantity}" in dataset and "swept_regime" in dataset:
+        pgf = dataset[quantity].sel(solution="pgf").values
+        stable = dataset["stable"].sel(solution="pgf").values == 1 if "stable" in dataset else np.isfinite(pgf)
+        bands = ((f"band 1 (below {fmt(split, '.4g')} Hz)", f < split), ("band 2", f >= split)) if split is not None else (("", np.ones(f.shape, bool)),)
+        parts = []
+        for band, mask in bands:
+            per = []
+            for direction in _directions(dataset):
+                sim = dataset[f"swept_{quantity}"].sel(sweep=direction).values
+                good = mask & stable & (dataset["swept_regime"].sel(sweep=direction).values == Regime.SWEPT_CONTACT) & np.isfinite(sim) & np.isfinite(pgf) & (pgf > 0)
+                if good.any():
+                    median = float(np.median((sim[good] - pgf[good]) / pgf[good]))
+                    per.append(f"{fmt(100.0 * abs(median), '.1f')} % {'above' if median >= 0 else 'below'} sweeping {direction} ({int(good.sum())} points)")
+            if per:
+                parts.append(f"{_and(per)}{' in ' + band if band else ''}")
+        if parts:
+            paragraphs.append(f"Where a sweep is in contact and the {solution_ref('pgf')} orbit is stable, its running |{label}| fundamental lies (median) {'; '.join(parts)}.")
+    return "".join(f"<p>{html.escape(p)}</p>" for p in paragraphs)
+
+
+def _and(items: list[str]) -> str:
+    return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} and {items[-1]}"
+
+
 class SweptSinePage(SolutionsPage):
     """The page of a swept-sine study of the paper's named system (dimensions ``solution``, ``sweep``, ``frequency``,
     ``elapsed_time``): the linear system, then the sweeps against the steady states; the swept solution is the last
     of the summary's."""
 
     def sections(self, out: Path) -> list[Section]:
-        """Linear system, then the sweeps at the first point of the other swept grids."""
+        """What the sweeps show in numbers, the linear system, then the sweeps at the first point of the other swept
+        grids."""
         run = swept_sine_run(self.dataset)
         part, intro = _first_point(self.dataset)
         sweeps = Section("Swept sine against the steady states", intro=intro, figures=saved(sweep_figures(part, run), out), tables=sweep_tables(part, run, self.setting.split_frequency))
-        return [linear_section(self.setting, out), sweeps]
+        return [Section("Contacts and the steady states", intro=sweep_answer(part, run, self.setting.split_frequency) + intro), linear_section(self.setting, out), sweeps]
 
 
 class GeneralSweptPage:
@@ -182,14 +258,15 @@ class GeneralSweptPage:
         return f"solutions: {', '.join(self.setting.solutions + swept)}; stops: {'; '.join(self.setting.stops)}"
 
     def sections(self, out: Path) -> list[Section]:
-        """Structure and stops, then the sweeps at the first point of the other swept grids."""
+        """What the sweeps show in numbers, the structure and stops, then the sweeps at the first point of the other
+        swept grids."""
         setting = self.setting
         run = swept_sine_run(self.dataset)
         part, intro = _first_point(self.dataset)
         layout = f"<p>Stops: {html.escape('; '.join(setting.stops))}. Load: {html.escape(setting.load_text())}, swept in frequency.</p>"
         structure = Section("Structure and stops", intro=layout, figures=saved([structure_figure(setting, self.dataset['frequency'].values)], out), tables=layout_tables(setting))
         sweeps = Section("Swept sine against the steady states", intro=intro, figures=saved(sweep_figures(part, run), out), tables=sweep_tables(part, run, None))
-        return [structure, sweeps]
+        return [Section("Contacts and the steady states", intro=sweep_answer(part, run, None) + intro), structure, sweeps]
 
 
 def _steady_solutions(dataset: xr.Dataset) -> list[str]:
@@ -209,27 +286,34 @@ def _at(variable: xr.DataArray, stop: int | None, **where: str) -> np.ndarray:
     return variable.sel(where).values
 
 
-def _draw_steady(ax: Axes, dataset: xr.Dataset, quantity: str, caption: Caption, layout: SweepLayout, with_linear: bool = True, stop: int | None = None) -> bool:
-    """Linear system and pgf steady state of ``quantity`` (of stop ``stop``); returns whether an unstable stretch
-    was drawn."""
+#: Curves of a panel in drawing order, each with its lines (for :func:`~vibroimpact.reporting.coincide.reveal_coincident`).
+Curves = list[tuple[str, list[Line2D]]]
+
+
+def _draw_steady(ax: Axes, dataset: xr.Dataset, quantity: str, caption: Caption, layout: SweepLayout, with_linear: bool = True, stop: int | None = None, scale: float = 1.0, curves: Curves | None = None) -> bool:
+    """Linear system and pgf steady state of ``quantity`` (of stop ``stop``), times ``scale`` (to the page's units),
+    the pgf curve added to ``curves``; returns whether an unstable stretch was drawn."""
     f = dataset["frequency"].values
     steady = _steady_solutions(dataset)
     if quantity not in dataset:
         return False
     if with_linear and "linear" in steady:
-        draw_linear(ax, f, _at(dataset[quantity], stop, solution="linear"))
+        draw_linear(ax, f, scale * _at(dataset[quantity], stop, solution="linear"))
         caption.add("linear", "LIN (dotted black): the linear system (no stop).")
     unstable = False
     if "pgf" in steady:
-        drawn, unstable = draw_curve(ax, f, _at(dataset[quantity], stop, solution="pgf"), colour=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')} steady state", gid="pgf", unstable=unstable_points(dataset, "pgf"))
+        before = len(ax.lines)
+        drawn, unstable = draw_curve(ax, f, scale * _at(dataset[quantity], stop, solution="pgf"), colour=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')} steady state", gid="pgf", unstable=unstable_points(dataset, "pgf"))
+        if curves is not None:
+            curves.append((solution_ref("pgf"), list(ax.lines[before:])))
         if drawn:
             caption.add("pgf", f"{solution_ref('pgf')}: the {layout.closed_form} (solid where the orbit is stable{', dashed where unstable' if unstable else ''}).")
     return unstable
 
 
-def _draw_swept(ax: Axes, dataset: xr.Dataset, quantity: str, solution: str, scale: float = 1.0, style: dict[str, object] | None = None, suffix: str = "", stop: int | None = None) -> bool:
-    """The running estimate of ``quantity`` (of stop ``stop``) of each sweep direction; returns whether anything was
-    drawn."""
+def _draw_swept(ax: Axes, dataset: xr.Dataset, quantity: str, solution: str, scale: float = 1.0, style: dict[str, object] | None = None, suffix: str = "", stop: int | None = None, curves: Curves | None = None) -> bool:
+    """The running estimate of ``quantity`` (of stop ``stop``) of each sweep direction, each added to ``curves``;
+    returns whether anything was drawn."""
     name = f"swept_{quantity}"
     if name not in dataset:
         return False
@@ -237,7 +321,10 @@ def _draw_swept(ax: Axes, dataset: xr.Dataset, quantity: str, solution: str, sca
     drawn = False
     for direction in _directions(dataset):
         values = scale * _at(dataset[name], stop, sweep=direction)
+        before = len(ax.lines)
         drawn |= draw_curve(ax, f, values, colour=SWEEP_COLOURS.get(direction, "C4"), label=f"{solution_ref(solution)} sweep {direction}{suffix}", gid=solution, style=style or SWEPT_STYLE)[0]
+        if curves is not None:
+            curves.append((f"sweep {direction}{' RMS' if suffix else ''}", list(ax.lines[before:])))
     return drawn
 
 
@@ -259,8 +346,8 @@ def sweep_figures(dataset: xr.Dataset, run: SweptSineRun, layout: SweepLayout | 
         fig, axes = new_figure(1, panel_height=3.6, legend_rows=1)
         for direction in _directions(dataset):
             values = dataset[f"running_{first}_amplitude"].sel(sweep=direction).values
-            draw_curve(axes[0], dataset["elapsed_time"].values, values, colour=SWEEP_COLOURS.get(direction, "C4"), label=f"{solution_ref(solution)} sweep {direction}", gid=solution)
-        finish_axes(axes[0], "time since the start of the sweep [s]", f"running |{label}| fundamental [m]", f"Running fundamental of {label} against time (the Simulink scope view)", log=True)
+            draw_curve(axes[0], dataset["elapsed_time"].values, DISPLACEMENT_SCALE * values, colour=SWEEP_COLOURS.get(direction, "C4"), label=f"{solution_ref(solution)} sweep {direction}", gid=solution)
+        finish_axes(axes[0], "time since the start of the sweep [s]", f"running |{label}| fundamental [{DISPLACEMENT_UNITS}]", f"Running fundamental of {label} against time (the Simulink scope view)", log=True)
         figure_legend(fig, axes)
         caption = f"The running |{label}| fundamental of each {solution_ref(solution)} sweep against the time since its start ({run.text()})."
         figures.append(DrawnFigure(fig, "sweep_time", f"Running |{label}| against time", caption))
@@ -273,18 +360,23 @@ def _displacement_figure(dataset: xr.Dataset, run: SweptSineRun, solution: str, 
     caption = Caption(f"Swept sine ({run.text()}): running estimates of {solution_ref(solution)} against the instantaneous frequency, like the paper's figures 16-20, against the steady states.")
     fig, axes = new_figure(len(layout.coordinates), panel_height=4.0, legend_rows=legend_rows(8))
     any_unstable = False
+    found: list[Coincidence] = []
     for ax, coordinate, name in zip(axes, layout.coordinates, layout.labels):
         quantity, rms = f"{coordinate}_amplitude", f"{coordinate}_rms"
-        any_unstable |= _draw_steady(ax, dataset, quantity, caption, layout)
+        fundamentals: Curves = []
+        spreads: Curves = []
+        any_unstable |= _draw_steady(ax, dataset, quantity, caption, layout, scale=DISPLACEMENT_SCALE, curves=fundamentals)
         if rms in dataset and "pgf" in _steady_solutions(dataset):
-            ax.plot(dataset["frequency"].values, np.sqrt(2.0) * dataset[rms].sel(solution="pgf").values, color=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')}: sqrt 2 x RMS", gid="pgf", **RMS_STYLE)
+            spreads.append((f"{solution_ref('pgf')} RMS", ax.plot(dataset["frequency"].values, DISPLACEMENT_SCALE * np.sqrt(2.0) * dataset[rms].sel(solution="pgf").values, color=SOLUTION_COLOURS["pgf"], label=f"{solution_ref('pgf')}: sqrt 2 x RMS", gid="pgf", **RMS_STYLE)))
             caption.add("pgf rms", f"Dash-dot: sqrt 2 x RMS (equal to the fundamental for a pure sine) of the orbit reconstructed by {solution_ref('pgf')} and of the sweeps.")
-        if _draw_swept(ax, dataset, quantity, solution):
+        if _draw_swept(ax, dataset, quantity, solution, scale=DISPLACEMENT_SCALE, curves=fundamentals):
             caption.add("swept", "Vermillion: sweep up, sky blue: sweep down, running fundamental over the estimator window (solid).")
-        _draw_swept(ax, dataset, rms, solution, scale=np.sqrt(2.0), style=RMS_STYLE, suffix=": sqrt 2 x RMS")
-        finish_axes(ax, _FREQUENCY, f"{name} amplitude [m]", f"{name}: swept sine against steady states", log=True)
+        _draw_swept(ax, dataset, rms, solution, scale=DISPLACEMENT_SCALE * np.sqrt(2.0), style=RMS_STYLE, suffix=": sqrt 2 x RMS", curves=spreads)
+        finish_axes(ax, _FREQUENCY, f"{name} amplitude [{DISPLACEMENT_UNITS}]", f"{name}: swept sine against steady states", log=True)
+        found += reveal_coincident(ax, fundamentals) + reveal_coincident(ax, spreads)
     if any_unstable:
         caption.add("unstable", f"Dashed: {layout.orbits} that exist but are unstable.")
+    caption.add("coincide", coincidence_phrase(found, spec=".3g"))
     figure_legend(fig, axes, stability_keys() if any_unstable else [], columns=3)
     return DrawnFigure(fig, "sweep_displacements", f"Swept sine: {layout.both()}", caption.text())
 
@@ -305,13 +397,18 @@ def _force_figure(dataset: xr.Dataset, solution: str, layout: SweepLayout) -> Dr
         caption.add("stops", "The impulse per period on each stop in its own panel (its constraint in the title).")
     fig, axes = new_figure(len(panels), panel_height=3.8, legend_rows=legend_rows(6))
     any_unstable = False
+    found: list[Coincidence] = []
     for ax, (quantity, stop) in zip(axes, panels):
-        any_unstable |= _draw_steady(ax, dataset, quantity, caption, layout, with_linear=quantity == "force_amplitude", stop=stop)
-        _draw_swept(ax, dataset, quantity, solution, stop=stop)
+        scale = QUANTITIES[quantity].scale
+        curves: Curves = []
+        any_unstable |= _draw_steady(ax, dataset, quantity, caption, layout, with_linear=quantity == "force_amplitude", stop=stop, scale=scale, curves=curves)
+        _draw_swept(ax, dataset, quantity, solution, scale=scale, stop=stop, curves=curves)
         title = QUANTITIES[quantity].label if stop is None else f"{QUANTITIES[quantity].label}, stop {stop}: {layout.stops[stop].split(',')[0]}"
         finish_axes(ax, _FREQUENCY, axis_label(quantity), title, log=QUANTITIES[quantity].log)
+        found += reveal_coincident(ax, curves)
     if any_unstable:
         caption.add("unstable", f"Dashed: {layout.orbits} that exist but are unstable.")
+    caption.add("coincide", coincidence_phrase(found, spec=".3g"))
     figure_legend(fig, axes, stability_keys() if any_unstable else [], columns=3)
     return DrawnFigure(fig, "sweep_force_impulse", "Swept sine: force, impulse and contacts", caption.text())
 

@@ -1,0 +1,188 @@
+"""No curve hidden under an identical one: where curves of a panel coincide, the ones beneath are drawn again as
+wider bands of their own colour around the one on top, and the caption says which coincide where.
+
+A figure draws its curves as usual, then hands each panel's curves to :func:`reveal_coincident` in drawing order
+(the first beneath the others). Two curves coincide at a point where both have a value and they lie within
+:data:`TOLERANCE` of the panel's height apart (on a log axis, in decades), the width of a line, over a stretch at
+least :data:`MIN_STRETCH` of the axis wide (a crossing is not a coincidence). Each curve beneath n coinciding ones is
+drawn again there, in its own colour and line style (solid, dashed or dotted as it is), n x :data:`BAND_STEP` wider
+than the widest of them and behind them: every coinciding curve shows as a band around the next. Stable (solid) and
+unstable (dashed) stay told apart, as the pages draw them. :func:`coincidence_phrase` is the caption's sentence.
+
+The bands carry the gid ``beneath:<gid of the curve>`` (tests find them by it).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterable, Sequence
+
+import matplotlib as mpl
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.lines import Line2D
+
+from vibroimpact.reporting.style import fmt
+
+__all__ = ["Coincidence", "reveal_coincident", "coincidence_phrase", "TOLERANCE", "MIN_STRETCH", "BAND_STEP"]
+
+#: Largest distance of two coinciding curves, as a fraction of the panel's height (log axes: of its decades); about a
+#: line's width on a panel of the pages.
+TOLERANCE = 0.005
+#: Shortest stretch of coincidence that counts, as a fraction of the axis' width; shorter ones are crossings.
+MIN_STRETCH = 0.03
+#: Width each curve beneath adds to the band around the curves above it [pt] (1 pt, 1.5 px, on each side).
+BAND_STEP = 2.0
+
+
+@dataclass(frozen=True)
+class Coincidence:
+    """Curve ``lower`` lies under curve ``upper`` (the last drawn of those coinciding with it there) over
+    ``stretches`` [(start, end) of the x axis]; ``everywhere``: wherever ``lower`` has values; ``axis``: the width of the
+    x axis (gaps narrower than :data:`MIN_STRETCH` of it are joined in captions)."""
+
+    lower: str
+    upper: str
+    stretches: tuple[tuple[float, float], ...]
+    everywhere: bool
+    axis: float
+
+
+def _values(lines: Sequence[Line2D]) -> tuple[np.ndarray, np.ndarray] | None:
+    """The x and y of a curve drawn as several lines on one grid (stable and unstable parts, NaN elsewhere); lines on
+    another grid (isolated dots) are left out. None if nothing is drawn."""
+    full = [line for line in lines if np.size(line.get_xdata()) > 1]
+    if not full:
+        return None
+    x = np.asarray(full[0].get_xdata(), dtype=float)
+    y = np.full(x.shape, np.nan)
+    for line in full:
+        xl = np.asarray(line.get_xdata(), dtype=float)
+        if xl.shape == x.shape and np.array_equal(xl, x, equal_nan=True):
+            yl = np.asarray(line.get_ydata(), dtype=float)
+            y = np.where(np.isfinite(yl), yl, y)
+    return x, y
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """(first, last) index of each run of True in ``mask``."""
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], mask.astype(int), [0]))))
+    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2])]
+
+
+def _band(ax: Axes, line: Line2D, x: np.ndarray, mask: np.ndarray, beneath: np.ndarray, width: float, zorder: float) -> None:
+    """Draw ``line`` again where ``mask``, ``width`` wide, its dash pattern (if any) as long as the line's so that
+    dashes stay in step; a stretch reaches one point into a neighbouring one ``beneath`` another curve at another
+    depth, so that the two join (never onto a point where the curve shows, as across a jump)."""
+    y = np.asarray(line.get_ydata(), dtype=float)
+    if y.shape != x.shape:
+        return
+    near = mask | (beneath & (np.r_[mask[1:], False] | np.r_[False, mask[:-1]]))
+    shown = np.where(near, y, np.nan)
+    if not np.isfinite(shown).any():
+        return
+    offset, dashes = getattr(line, "_unscaled_dash_pattern", (0.0, None))
+    style: object = "-" if dashes is None else (offset * line.get_linewidth(), tuple(d * line.get_linewidth() for d in dashes))
+    marker = line.get_marker()
+    with mpl.rc_context({"lines.scale_dashes": False}):
+        ax.plot(x, shown, color=line.get_color(), ls=style, lw=width, marker=marker, ms=line.get_markersize() + (width - line.get_linewidth()),
+                solid_capstyle="butt", dash_capstyle="butt", zorder=zorder, label="_nolegend_", gid=f"beneath:{line.get_gid()}", transform=line.get_transform())  # fmt: skip
+
+
+def reveal_coincident(ax: Axes, curves: Sequence[tuple[str, Sequence[Line2D]]], tolerance: float = TOLERANCE, min_stretch: float = MIN_STRETCH) -> list[Coincidence]:
+    """Draw every curve of ``ax`` lying under a coinciding one as a band around it; return which coincide where.
+
+    Parameters
+    ----------
+    ax : Axes
+        The panel, its limits and scales final.
+    curves : sequence of (str, sequence of Line2D)
+        Each curve's name (as the caption names it) and the lines it was drawn with (one grid; parts on another grid
+        are left out), in drawing order: the first beneath the others.
+    tolerance, min_stretch : float
+        :data:`TOLERANCE` and :data:`MIN_STRETCH`.
+
+    Returns
+    -------
+    list of Coincidence
+        One per pair (lower, upper) that coincides somewhere.
+    """
+    values = [(name, lines, _values(lines)) for name, lines in curves]
+    drawn = [(name, lines, xy) for name, lines, xy in values if xy is not None]
+    log = ax.get_yscale() == "log"
+    low, high = (np.log10(v) if log else v for v in ax.get_ylim())
+    span = abs(high - low) or 1.0
+    x_span = float(abs(np.subtract(*ax.get_xlim()))) or 1.0
+
+    def height(y: np.ndarray) -> np.ndarray:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.log10(np.where(y > 0, y, np.nan)) if log else y
+
+    found: list[Coincidence] = []
+    depth = [np.zeros(xy[0].shape, int) for _, _, xy in drawn]
+    for i, (lower, _, (x, y)) in enumerate(drawn):
+        yi = height(y)
+        top = np.full(x.shape, -1)  # the last curve drawn over this one where they coincide
+        for j in range(i + 1, len(drawn)):
+            xu, yu = drawn[j][2]
+            if xu.shape != x.shape or not np.array_equal(xu, x, equal_nan=True):
+                continue
+            yj = height(yu)
+            with np.errstate(invalid="ignore"):
+                close = np.isfinite(yi) & np.isfinite(yj) & (np.abs(yi - yj) <= tolerance * span)
+            for a, b in _runs(close):
+                if b > a and x[b] - x[a] >= min_stretch * x_span:
+                    depth[i][a : b + 1] += 1
+                    top[a : b + 1] = j
+        for j in np.unique(top[top >= 0]):
+            runs = [(float(x[a]), float(x[b])) for a, b in _runs(top == j)]
+            found.append(Coincidence(lower, drawn[int(j)][0], tuple(runs), bool(np.all(top[np.isfinite(yi)] == j)), x_span))
+    widest = max((line.get_linewidth() for _, lines, _ in drawn for line in lines), default=1.0)
+    bottom = min((line.get_zorder() for _, lines, _ in drawn for line in lines), default=2.0)
+    for (_, lines, (x, _)), d in zip(drawn, depth):
+        for level in range(1, int(d.max(initial=0)) + 1):
+            for line in lines:
+                _band(ax, line, x, d == level, d > 0, widest + BAND_STEP * level, bottom - 0.01 * level)
+    return found
+
+
+def _merge(stretches: Iterable[tuple[float, float]], gap: float = 0.0) -> list[tuple[float, float]]:
+    """Stretches overlapping or less than ``gap`` apart joined, in order."""
+    merged: list[tuple[float, float]] = []
+    for a, b in sorted(stretches):
+        if merged and a <= merged[-1][1] + gap:
+            merged[-1] = (merged[-1][0], max(merged[-1][1], b))
+        else:
+            merged.append((a, b))
+    return merged
+
+
+def _names(names: Sequence[str]) -> str:
+    return names[0] if len(names) == 1 else f"{', '.join(names[:-1])} and {names[-1]}"
+
+
+def coincidence_phrase(found: Iterable[Coincidence], unit: str = "Hz", spec: str = ".3g", most: int = 5) -> str:
+    """The caption's sentence on coinciding curves (empty if none): for each curve drawn on top, the curves lying
+    under it and where (the union over them and over the panels: "parts of" where they do not all coincide over all
+    of it), and how they are drawn."""
+    by_upper: dict[str, dict[str, list[Coincidence]]] = {}
+    for c in found:
+        by_upper.setdefault(c.upper, {}).setdefault(c.lower, []).append(c)
+    if not by_upper:
+        return ""
+    sentences = []
+    for upper, lowers in by_upper.items():
+        every = [c for cs in lowers.values() for c in cs]
+        gap = MIN_STRETCH * max(c.axis for c in every)
+        union = _merge((s for c in every for s in c.stretches), gap)
+        each = [_merge((s for c in cs for s in c.stretches), gap) for cs in lowers.values()]
+        if all(c.everywhere for c in every):
+            where = "wherever both have values"
+        else:
+            shown = _names([f"{fmt(a, spec)}-{fmt(b, spec)}" for a, b in union[:most]])
+            extra = f" (and {len(union) - most} more stretches)" if len(union) > most else ""
+            partly = "parts of " if any(e != union for e in each) else ""
+            where = f"over {partly}{shown} {unit}{extra}"
+        names = list(lowers)
+        sentences.append(f"{_names(names)} {'lies' if len(names) == 1 else 'lie'} under {upper} {where}")
+    return "Coinciding curves: " + "; ".join(sentences) + ". Each curve lying under another is drawn again there as a wider band of its own colour around it."
