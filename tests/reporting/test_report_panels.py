@@ -13,7 +13,6 @@ import xarray as xr
 
 from vibroimpact.kinds.stepped.page import peak_acceleration_figure
 from vibroimpact.kinds.stepped.responses import response_figure, simulation_figure
-from vibroimpact.reporting.record import study_setting
 from vibroimpact.reporting.style import QUANTITIES
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 from vibroimpact.kinds.swept.page import sweep_figures, swept_sine_run
