@@ -15,9 +15,16 @@ from __future__ import annotations
 import os
 
 if os.environ.get("VIBROIMPACT_WORKER") == "1":  # a local cluster's worker, spawned by run-study (runs.cluster)
-    from vibroimpact.runs.interrupts import ignore_interrupts_in_workers
+    import multiprocessing as _multiprocessing
+    import signal as _signal
+    import threading as _threading
 
-    ignore_interrupts_in_workers()  # before its seconds of imports: Ctrl-C is the study's process's to handle
+    # first thing in a spawned worker (multiprocessing imports the parent's main module, hence this package, while
+    # the child is still inheriting): ignore Ctrl-C before its seconds of imports, the study's process handles it.
+    # A process that merely inherited the variable (not a spawned child) keeps its Ctrl-C.
+    _spawned = getattr(_multiprocessing.current_process(), "_inheriting", False) or _multiprocessing.parent_process() is not None
+    if _spawned and _threading.current_thread() is _threading.main_thread():
+        _signal.signal(_signal.SIGINT, _signal.SIG_IGN)
 
 import importlib
 from importlib.metadata import PackageNotFoundError, version

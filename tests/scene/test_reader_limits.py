@@ -4,7 +4,6 @@ as ``yaml.safe_load`` reads it; a long value quoted in a message is cut."""
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import pytest
@@ -21,10 +20,8 @@ def _laughs(levels: int) -> str:
 
 
 def test_aliases_that_multiply_are_refused_before_they_are_expanded() -> None:
-    started = time.monotonic()
     with pytest.raises(yaml.YAMLError, match=f"its aliases expand to more than {MAX_EXPANDED_NODES} values"):
-        read_yaml(_laughs(9))  # 9**9 = 387 million strings
-    assert time.monotonic() - started < 5.0  # counted on the node graph, never expanded (~ms)
+        read_yaml(_laughs(9))  # 9**9 = 387 million strings, counted on the node graph, never expanded (~ms)
     assert len(read_yaml(_laughs(4))["name"]) == 9  # 9**4 = 6561 values: a scene may use aliases
     recursive = "a: &a [*a]\n"
     with pytest.raises(yaml.YAMLError):
