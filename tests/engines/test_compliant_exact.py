@@ -250,3 +250,24 @@ def test_the_compiled_loop_is_stamped_with_the_exact_core_it_contains() -> None:
 
     stamp = exact_loop.run_bumper_periods._cache._cache_file._source_stamp
     assert stamp[-1] == hashlib.sha256(Path(exact_core.__file__).read_bytes()).hexdigest()
+
+
+def test_a_steady_state_started_by_shooting_is_the_bumpers_own() -> None:
+    """``shooting`` shoots the rigid stop's orbit to start a bumper's march: an engine with an exact flow measures a
+    shot orbit directly only when it is the problem's own (it measured the rigid orbit, |X1| 2.748 mm, as the 250 Hz
+    bumper's, 3.007 mm). From every start the bumper's steady state is the same (1e-10) and IDA's to its tolerance."""
+    from dataclasses import replace
+
+    from vibroimpact.model.contact import RigidStop
+    from vibroimpact.simulation.settings import SteadySettings
+    from vibroimpact.simulation.steady import steady_state
+
+    rigid = ImpactProblem(PAPER_SYSTEM, RigidStop(PAPER_CLEARANCE, 0.2), HarmonicForce(PAPER_AMPLITUDE, 25.0))
+    bumper = replace(rigid, contact=KelvinVoigtBumper(PAPER_CLEARANCE, 250.0, loss_factor_from_restitution(0.2)))
+    results = [steady_state(ENGINE, bumper, start, SteadySettings(tolerance=1e-9), rigid.rigid_stop) for start in ("shooting", "pgf", "rest")]
+    assert all(result.converged for result in results)
+    x1 = [abs(result.measures.x1) for result in results]
+    np.testing.assert_allclose(x1, x1[0], rtol=1e-10)
+    assert x1[0] == pytest.approx(3.0074e-3, rel=1e-4)
+    ida = steady_state(make_engine("compliant", EngineSettings(rtol=1e-10, atol=1e-14)), bumper, "pgf", SteadySettings(tolerance=1e-9), rigid.rigid_stop)
+    assert abs(ida.measures.x1) == pytest.approx(x1[0], rel=1e-8)
