@@ -384,7 +384,8 @@ def run_bumper_periods(
 @njit(cache=True, error_model="numpy")
 def sample_pieces(lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, omega, starts, flows, states, times, pieces):
     """The states at ``times``, exact: ``times[i]`` on piece ``pieces[i]`` (start ``starts[p]``, state ``states[p]``
-    there, contact mode ``flows[p]``). Returns (len(times), n)."""
+    there, contact mode ``flows[p]``); a time on a piece's start gives its state as recorded (a start at rest is
+    given back, not its round-off through the flow). Returns (len(times), n)."""
     n = states.shape[1]
     out = np.empty((times.size, n))
     modal = np.empty(lams.shape[1], dtype=np.complex128)
@@ -399,6 +400,10 @@ def sample_pieces(lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdr
             if polys[f]:
                 _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, starts[p], states[p], z0, q1, q2)
             current = p
+        if times[i] == starts[p]:
+            for r in range(n):
+                out[i, r] = states[p, r]
+            continue
         _state(lams, vecs, hrms, csts, f, counts[f], omega, starts[p], modal, times[i], y, polys[f], z0, q1, q2)
         for r in range(n):
             out[i, r] = y[r]
