@@ -28,8 +28,8 @@ def test_every_engine_integrates_a_problem_of_its_contact_law(name: str) -> None
 
 
 @pytest.mark.timeout(60)
-@pytest.mark.parametrize("name", engine_names(BUMPER))
-def test_every_bumper_engine_sweeps(name: str) -> None:
+@pytest.mark.parametrize("name", [name for name, spec in ENGINES.items() if spec.capabilities.sweeps])
+def test_every_sweeping_engine_sweeps(name: str) -> None:
     problem = ImpactProblem(PAPER_SYSTEM, KelvinVoigtBumper(PAPER_CLEARANCE, 1000.0, 0.3), SweptSine(PAPER_AMPLITUDE, 24.0, 24.2, 0.1))
     record = make_engine(name, SETTINGS).sweep(problem, 500.0)
     assert record.time.size == 1000 and record.trajectory.impact_times.size >= 40
@@ -40,6 +40,14 @@ def test_bumper_engines_refuse_a_rigid_stop(name: str) -> None:
     problem = ImpactProblem(PAPER_SYSTEM, RigidStop(PAPER_CLEARANCE, 0.4), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     with pytest.raises(TypeError, match="solves a KelvinVoigtBumper"):
         make_engine(name).integrate(problem, np.zeros(4), 0.0, 1)
+
+
+def test_the_sweeping_bumper_engines_are_the_integrators() -> None:
+    """A closed-form engine has no sweep (a chirp has no closed-form particular solution); every integrating bumper
+    engine has one."""
+    sweeping = {name for name, spec in ENGINES.items() if spec.capabilities.sweeps}
+    assert sweeping == {name for name in engine_names(BUMPER) if not engine_spec(name).capabilities.exact_flow}
+    assert "compliant_exact" in engine_names(BUMPER) and not hasattr(make_engine("compliant_exact"), "sweep")
 
 
 def test_a_fixed_method_overrides_the_settings() -> None:
@@ -61,7 +69,8 @@ def test_a_built_engine_carries_its_registry_rows_capabilities(name: str) -> Non
 
 @pytest.mark.parametrize("name", [name for name, spec in ENGINES.items() if spec.capabilities.exact_jacobians])
 def test_an_engine_with_exact_jacobians_returns_one_per_period(name: str) -> None:
-    problem = ImpactProblem(PAPER_SYSTEM, RigidStop(PAPER_CLEARANCE, 0.4), HarmonicForce(PAPER_AMPLITUDE, 25.0))
+    contact = RigidStop(PAPER_CLEARANCE, 0.4) if engine_spec(name).contact == RIGID else KelvinVoigtBumper(PAPER_CLEARANCE, 1000.0, 0.3)
+    problem = ImpactProblem(PAPER_SYSTEM, contact, HarmonicForce(PAPER_AMPLITUDE, 25.0))
     trajectory = make_engine(name).integrate(problem, np.zeros(4), 0.0, 3, jacobians=True)
     assert trajectory.strobe_jacobians.shape == (3, 4, 4) and np.all(np.isfinite(trajectory.strobe_jacobians))
 

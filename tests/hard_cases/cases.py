@@ -20,9 +20,11 @@ momentary_adams, momentary_bdf         ``MomentaryEngine`` (CVODE with grazing g
 solve_ivp_DOP853, solve_ivp_LSODA      ``SolveIvpEngine`` (no grazing guard, on purpose)           rtol 1e-10, atol 1e-14 m
 solve_ivp_Radau                        ``SolveIvpEngine`` (~1 s per simulated s at 1e-10)          rtol 1e-8, atol 1e-12 m
 compliant                              ``CompliantEngine`` (IDA, Kelvin-Voigt bumper, 5 kHz)       rtol 1e-9, atol 1e-13 m
+compliant_exact                        ``CompliantExactEngine`` (the same bumper in closed form)   round-off
 =====================================  ==========================================================  ========================
 
-The compliant engine runs each case's problem with the case's bumper in place of the rigid stop.
+The compliant engines run each case's problem with the case's bumper in place of the rigid stop; both are held to
+the same expectations (those of the bumper model against the rigid stop).
 """
 
 from __future__ import annotations
@@ -49,7 +51,7 @@ from tests.engine_cases import linear_state, pgf_start
 __all__ = ["ENGINE_NAMES", "RIGID", "SOLVE_IVP", "Expect", "NotRun", "HardCase", "CASES", "build_engine", "matching_bumper"]
 
 #: Registered engines of the table, and each one's settings.
-ENGINE_NAMES = ("exact", "momentary_adams", "momentary_bdf", "solve_ivp_DOP853", "solve_ivp_LSODA", "solve_ivp_Radau", "compliant")
+ENGINE_NAMES = ("exact", "momentary_adams", "momentary_bdf", "solve_ivp_DOP853", "solve_ivp_LSODA", "solve_ivp_Radau", "compliant", "compliant_exact")
 RIGID = tuple(name for name in ENGINE_NAMES if engine_spec(name).contact == RIGID_LAW)
 SOLVE_IVP = ("solve_ivp_DOP853", "solve_ivp_LSODA", "solve_ivp_Radau")
 
@@ -64,6 +66,7 @@ SETTINGS = {
     "solve_ivp_LSODA": TIGHT,
     "solve_ivp_Radau": RADAU,
     "compliant": COMPLIANT,
+    "compliant_exact": EngineSettings(),
 }
 #: Bumper of the compliant engine unless a case sets its own: stiff enough to be compared with the rigid stop.
 BUMPER_FREQUENCY = 5000.0
@@ -207,7 +210,8 @@ def per_engine(
     radau: Expect | NotRun | None = None,
 ) -> dict[str, Expect | NotRun]:
     """Expectations by family: ``momentary`` for momentary_adams and momentary_bdf, ``solve_ivp`` for
-    solve_ivp_DOP853, solve_ivp_LSODA (and solve_ivp_Radau unless ``radau`` is given)."""
+    solve_ivp_DOP853, solve_ivp_LSODA (and solve_ivp_Radau unless ``radau`` is given), ``compliant`` for both
+    bumper engines."""
     return {
         "exact": exact,
         "momentary_adams": momentary,
@@ -216,6 +220,7 @@ def per_engine(
         "solve_ivp_LSODA": solve_ivp,
         "solve_ivp_Radau": solve_ivp if radau is None else radau,
         "compliant": compliant,
+        "compliant_exact": compliant,
     }
 
 

@@ -103,6 +103,7 @@ def test_rigid_engines_on_random_problems(engine: str) -> None:
     check()
 
 
+@pytest.mark.parametrize("engine", ["compliant", "compliant_exact"])
 @pytest.mark.timeout(240)
 @given(
     case=problems(),
@@ -110,11 +111,11 @@ def test_rigid_engines_on_random_problems(engine: str) -> None:
     loss_factor=st.one_of(st.just(0.0), _floats(0.0, 3.0)),
 )
 @_bounded(20)
-def test_compliant_engine_on_random_problems(case: tuple[ImpactProblem, np.ndarray], frequency: float, loss_factor: float) -> None:
-    """The compliant engine ends, its contacts all enter, push and release, and it stays within the bumper's reach."""
+def test_compliant_engine_on_random_problems(engine: str, case: tuple[ImpactProblem, np.ndarray], frequency: float, loss_factor: float) -> None:
+    """Each compliant engine ends, its contacts all enter, push and release, and it stays within the bumper's reach."""
     problem, start = case
     bumper = KelvinVoigtBumper(problem.clearance, frequency, loss_factor)
-    trajectory = build_engine("compliant").integrate(replace(problem, contact=bumper), start, 0.0, PERIODS)
+    trajectory = build_engine(engine).integrate(replace(problem, contact=bumper), start, 0.0, PERIODS)
     assert trajectory.periods == PERIODS and np.all(np.isfinite(trajectory.strobe_states))
     errors = compliant_contact_errors(trajectory, loss_factor)
     assert errors["speed"] == 0 and errors["impulse_sign"] == 0 and errors["unreleased"] in (0.0, 1.0), errors

@@ -36,7 +36,7 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["ExactEngine", "StrobeMap"]
+__all__ = ["ExactEngine", "StrobeMap", "stack_flows"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -84,8 +84,9 @@ def _half(lam: NDArray[np.complex128]) -> NDArray[np.complex128]:
     return lam[lam.imag >= 0.0]
 
 
-def _stack(flows: tuple[Flow, ...], omega: float) -> tuple:
-    """The flows as the compiled loop's stacked arrays (see :mod:`~vibroimpact.engines.exact_core`)."""
+def stack_flows(flows: tuple[Flow, ...], omega: float) -> tuple:
+    """The flows as the compiled loops' stacked arrays (see :mod:`~vibroimpact.engines.exact_core`): flow f is entry f of
+    each array (the exact engine's free and held flights; the bumper engine's contact modes)."""
     count, n = len(flows), flows[0].harmonic.size
     widest = max(flow.eigenvalues.size for flow in flows)
     lams = np.zeros((count, widest), dtype=complex)
@@ -139,7 +140,7 @@ def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
     signs = np.array([model.normals[k, i] if i >= 0 else 0.0 for k, i in enumerate(model.simple)])
     nodes, weights = gauss_legendre(16)
     arguments = (
-        *_stack((model.free, *model.stuck), problem.omega),
+        *stack_flows((model.free, *model.stuck), problem.omega),
         model.matrix, np.ascontiguousarray(model.load), np.ascontiguousarray(model.static), problem.omega, problem.period,
         gapw, velw, kickw, model.clearances, model.restitutions, model.masses, model.simple, signs,
         np.ascontiguousarray(model.hold_weights.reshape(count, n)), model.hold_offsets, model.hold_harmonics, model.force_tolerances,

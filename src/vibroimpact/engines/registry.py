@@ -40,6 +40,9 @@ class Capabilities:
         Its tolerances change nothing: one run stands for every tolerance of a benchmark.
     stepped_solution : bool
         Offered as a time-domain solution of stepped studies under its registry name.
+    sweeps : bool
+        Also a sweeping engine: ``sweep(problem, sample_rate, state, progress)`` runs a swept sine (a closed-form
+        engine cannot: a chirp has no closed-form particular solution).
     """
 
     contact: str
@@ -47,6 +50,7 @@ class Capabilities:
     exact_flow: bool = False
     tolerance_free: bool = False
     stepped_solution: bool = False
+    sweeps: bool = False
 
     def __post_init__(self) -> None:
         if self.contact not in (RIGID, BUMPER):
@@ -96,7 +100,7 @@ class EngineSpec:
 
 
 #: A rigid-stop engine that integrates to a tolerance; the bumper's.
-INTEGRATOR, BUMPER_INTEGRATOR = Capabilities(RIGID), Capabilities(BUMPER)
+INTEGRATOR, BUMPER_INTEGRATOR = Capabilities(RIGID), Capabilities(BUMPER, sweeps=True)
 #: The exact engine's algorithm: the closed-form flow.
 EXACT_FLOW = Capabilities(RIGID, exact_flow=True, tolerance_free=True)
 
@@ -118,10 +122,11 @@ ENGINES: Mapping[str, EngineSpec] = MappingProxyType(
         "solve_ivp_LSODA": _solve_ivp("LSODA"),
         "solve_ivp_Radau": _solve_ivp("Radau"),
         "solve_ivp_BDF": _solve_ivp("BDF"),
-        "compliant": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", Capabilities(BUMPER, stepped_solution=True), "Kelvin-Voigt bumper through SUNDIALS IDA, one solver per contact mode"),
+        "compliant": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", Capabilities(BUMPER, stepped_solution=True, sweeps=True), "Kelvin-Voigt bumper through SUNDIALS IDA, one solver per contact mode"),
         "compliant_ida": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", BUMPER_INTEGRATOR, "the engine compliant, under the name benchmark scenes use"),
         "compliant_cvode_adams": EngineSpec("vibroimpact.engines.compliant.ida:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (Adams)", settings_method="adams"),
         "compliant_cvode_bdf": EngineSpec("vibroimpact.engines.compliant.ida:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (BDF)", settings_method="bdf"),
+        "compliant_exact": EngineSpec("vibroimpact.engines.compliant.exact:CompliantExactEngine", Capabilities(BUMPER, exact_jacobians=True, exact_flow=True, tolerance_free=True), "Kelvin-Voigt bumper in closed form per contact mode with guaranteed switch search, compiled: the bumper's reference"),
     }
 )
 

@@ -231,11 +231,12 @@ def _steady_state(
     used = 0
     first_chunk = settings.chunk_periods
     if start == "shooting":
-        shot = shoot_orbit(problem if all(stop.rigid for stop in problem.stops) else _rigid(problem, orbit_stop), t, y)
+        own = all(stop.rigid for stop in problem.stops)  # shot on the problem itself, not on its rigid stand-in
+        shot = shoot_orbit(problem if own else _rigid(problem, orbit_stop), t, y)
         used = shot.periods if shot is not None else 0
         if shot is not None and shot.stable:
             t, y = shot.time, shot.state
-            if engine.capabilities.exact_flow:  # the orbit is the engine's own steady state: measure it
+            if engine.capabilities.exact_flow and own:  # the orbit is the engine's own steady state: measure it
                 return _measure(engine, problem, t, y, 1, used, settings, scale)
             first_chunk = 3  # an integrator starts on the orbit: it needs only to confirm that its state repeats
         else:

@@ -132,9 +132,10 @@ class BenchmarkCase:
 
     def runs(self, method: str) -> bool:
         """Whether ``method`` applies to this case."""
-        contact = engine_spec(method).contact
+        spec = engine_spec(method)
+        contact = spec.contact
         if self.sweep is not None:
-            return contact == BUMPER or method.startswith("solve_ivp_")
+            return (contact == BUMPER and spec.capabilities.sweeps) or method.startswith("solve_ivp_")
         return contact == RIGID or (contact == BUMPER and self.bumper is not None)
 
 

@@ -1,0 +1,260 @@
+"""Engine ``compliant_exact``: the Kelvin-Voigt bumper of eq. 25 in closed form, the reference the compliant
+integrators are measured against.
+
+The bumper model (:mod:`~vibroimpact.engines.compliant.model`: stop k pushes with F_k = K_k d_k + B_k n_k . x' while
+its penetration d_k = n_k . x - Delta_k >= 0 and F_k > 0, K_k = m_k Omega_b^2, B_k = 2 m_k xi_b Omega_b) is piecewise
+linear: between switches each contact mode, the set of bumpers pushing, is a linear structure with harmonic and
+constant loads, the structure's K and C plus K_k n_k n_k^T and B_k n_k n_k^T for each, loaded by K_k Delta_k n_k.
+Each mode's flow is the ``exact`` engine's closed form (:func:`~vibroimpact.engines.exact_flows.decompose`: the
+eigen-decomposition, the harmonic particular solution, a polynomial on rigid-body modes), made once per problem for
+every mode (2^K of them) and stacked as the exact engine stacks its flows; the switches, the moments and the Jacobian
+come from the same compiled machinery (:mod:`~vibroimpact.engines.compliant.exact_loop` calls
+:mod:`~vibroimpact.engines.exact_core`'s kernels): one piecewise-linear loop with the bumper's contact law in place
+of the impact map. Onsets (the gap closing, or, after a release with the bumper still compressed, its force rising
+through zero while d > 0) and releases (the force falling through zero) are found by guaranteed root bracketing: none
+is missed however tangent, and their times are exact to round-off. No tolerance: the settings are not used (but for
+the event budget, ``max_impacts_per_period``).
+
+Records are those of the compliant integrators (:class:`~vibroimpact.engines.compliant.ida.CompliantEngine`): each
+completed contact is an impact (onset time, entry speed n_k . x' at the onset, impulse = integral of F_k) with its
+largest force and largest deceleration -n_k . x'' (``contact_peaks``, each the maximum over the contact, found in
+closed form); segments are free (``MODE_FREE``) or in contact (``MODE_CONTACT``, the lowest stop in contact); the
+moments' contact-force channels are the integrals of F_k e^{-jwt}.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from numpy.typing import NDArray
+
+from vibroimpact.engines.base import MODE_FREE, Trajectory, check_run
+from vibroimpact.engines.compliant import exact_loop
+from vibroimpact.engines.compliant.model import MODE_CONTACT
+from vibroimpact.engines.exact import StrobeMap, stack_flows
+from vibroimpact.engines.exact_flows import Flow, decompose, mechanical_null_basis
+from vibroimpact.engines.linear_flow import gauss_legendre
+from vibroimpact.engines.registry import ENGINES, Capabilities
+from vibroimpact.engines.settings import EngineSettings
+from vibroimpact.model.contact import KelvinVoigtBumper
+from vibroimpact.model.problem import ImpactProblem
+
+__all__ = ["CompliantExactEngine", "bumper_flows", "prepare_compiled_loop", "MAX_BUMPERS"]
+
+#: Most bumpers of one problem: the engine prepares every contact mode, 2^K flows.
+MAX_BUMPERS = 8
+
+
+def bumper_flows(problem: ImpactProblem) -> tuple[tuple[Flow, ...], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The closed-form flow of every contact mode of a problem with bumpers, and each stop's K_k, B_k and m_k.
+
+    Returns
+    -------
+    tuple
+        (flows, stiffness [N m-1], damping [N s m-1], effective masses [kg]): ``flows[mask]`` is the flow of y = (x, x')
+        with the bumpers of the stops in the bit mask pushing (``flows[0]`` the free flight).
+    """
+    structure = problem.structure
+    mass, stiffness, damping = structure.mass_matrix, structure.stiffness_matrix, structure.damping_matrix
+    size, count = problem.size, len(problem.stops)
+    normals, clearances = problem.normals(), problem.clearances()
+    kicks = np.linalg.solve(mass, normals.T).T.reshape(count, size)
+    masses = 1.0 / np.einsum("ki,ki->k", normals, kicks)
+    laws: list[KelvinVoigtBumper] = [stop.law for stop in problem.stops]  # type: ignore[misc]
+    k_b = np.array([law.stiffness(m) for law, m in zip(laws, masses)])
+    b_b = np.array([law.damping(m) for law, m in zip(laws, masses)])
+    harmonic, static = problem.load()
+    flows = []
+    for mask in range(1 << count):
+        k_mode, c_mode, load = stiffness.copy(), damping.copy(), static.copy()
+        for k in range(count):
+            if (mask >> k) & 1:
+                outer = np.outer(normals[k], normals[k])
+                k_mode += k_b[k] * outer
+                c_mode += b_b[k] * outer
+                load += k_b[k] * clearances[k] * normals[k]
+        a = np.block([[np.zeros((size, size)), np.eye(size)], [-np.linalg.solve(mass, k_mode), -np.linalg.solve(mass, c_mode)]])
+        b = np.concatenate([np.zeros(size, dtype=complex), np.linalg.solve(mass.astype(complex), harmonic)])
+        b0 = np.concatenate([np.zeros(size), np.linalg.solve(mass, load)])
+        try:
+            flows.append(decompose(a, b, b0, problem.omega, mechanical_null_basis(mass, k_mode, c_mode)))
+        except ValueError as error:
+            if not mask:
+                raise
+            pushing = ", ".join(str(k) for k in range(count) if (mask >> k) & 1)
+            raise ValueError(
+                f"contact: in contact with stop(s) {pushing}: {error} (a critically damped bumper, loss factor 1, on a body nothing else "
+                "holds has a repeated eigenvalue): use a loss factor off 1, or the integrating engine 'compliant'"
+            ) from error
+    return tuple(flows), k_b, b_b, masses
+
+
+@dataclass(frozen=True, eq=False)
+class _Setup:
+    """What the compiled loop needs of one problem, as its leading arguments, and the flows for sampling."""
+
+    arguments: tuple
+    sampling: tuple
+
+
+@lru_cache(maxsize=512)
+def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
+    """Once per problem (a continuation calls the map of one problem thousands of times)."""
+    count, size = len(problem.stops), problem.size
+    if count > MAX_BUMPERS:
+        raise ValueError(f"contact: {count} bumpers; the engine 'compliant_exact' prepares every contact mode (2^K flows) and takes at most {MAX_BUMPERS}")
+    flows, k_b, b_b, masses = bumper_flows(problem)
+    n = 2 * size
+    normals, clearances = problem.normals(), problem.clearances()
+    zero = np.zeros(size)
+    # per stop, the observables d, -d, F, -F as weights over y and offsets
+    obsw = np.zeros((4 * count, n))
+    obso = np.zeros(4 * count)
+    velw = np.zeros((count, n))
+    salts = np.tile(np.eye(n), (count, 1, 1))
+    for k in range(count):
+        gap = np.concatenate([normals[k], zero])
+        force = np.concatenate([k_b[k] * normals[k], b_b[k] * normals[k]])
+        obsw[4 * k : 4 * k + 4] = gap, -gap, force, -force
+        obso[4 * k : 4 * k + 4] = -clearances[k], clearances[k], -k_b[k] * clearances[k], k_b[k] * clearances[k]
+        velw[k] = np.concatenate([zero, normals[k]])
+        # onset at d = 0: the field jumps by -(0, M^-1 n) B d', d' = n . x' the crossing speed
+        salts[k, size:, :size] -= b_b[k] * np.outer(np.linalg.solve(problem.structure.mass_matrix, normals[k]), normals[k])
+    length = problem.length_scale()
+    velocity = problem.velocity_scale()
+    force_tolerances = 1e-15 * (k_b * length + b_b * velocity)
+    nodes, weights = gauss_legendre(16)
+    stacked = stack_flows(flows, problem.omega)
+    arguments = (
+        *stacked, problem.omega, problem.period, obsw, obso, velw, salts, np.zeros(4 * count, dtype=complex),
+        1e-15 * length, force_tolerances, 10 * settings.max_impacts_per_period, nodes, weights,
+    )  # fmt: skip
+    return _Setup(arguments, (*stacked[:11], problem.omega))
+
+
+class CompliantExactEngine:
+    """The Kelvin-Voigt bumper in closed form, compiled (see module docstring)."""
+
+    name = "compliant_exact"
+    #: what it can do when built directly (the registry's row; :func:`~vibroimpact.engines.registry.make_engine` sets its own)
+    capabilities: Capabilities = ENGINES["compliant_exact"].capabilities
+
+    def __init__(self, settings: EngineSettings = EngineSettings()) -> None:
+        self.settings = settings
+
+    def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, jacobians: bool) -> tuple:
+        check_run(self.name, problem, KelvinVoigtBumper, periods)
+        problem.harmonic  # TypeError naming the excitation if it is not harmonic (a sweep has no closed form)
+        setup = _setup(problem, self.settings)
+        state = np.array(state, dtype=float, order="C")  # a writable copy: one compiled overload
+        if state.shape != (2 * problem.size,):
+            raise ValueError(f"state: expected {2 * problem.size} values (x and x' of {problem.size} coordinates), got shape {state.shape}")
+        out = exact_loop.run_bumper_periods(*setup.arguments, state, float(t_start), int(periods), bool(moments), bool(jacobians))
+        if out[0] == exact_loop.STATUS_NO_PROGRESS:
+            raise RuntimeError(f"no progress at t = {out[1]!r} s: more than {10 * self.settings.max_impacts_per_period} contact switches in one period")
+        return out
+
+    def integrate(
+        self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False, jacobians: bool = False
+    ) -> Trajectory:
+        """Integrate ``periods`` whole periods from ``state`` (x, x') at ``t_start`` [s].
+
+        With ``jacobians``, ``strobe_jacobians[k]`` is the exact Jacobian of period k's stroboscopic map.
+        """
+        out = self._run(problem, state, t_start, periods, moments, jacobians)
+        return _trajectory(problem, float(t_start), periods, out, moments, jacobians)
+
+    def strobe_map(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float = 0.0, periods: int = 1) -> StrobeMap:
+        """The stroboscopic map over ``periods`` periods from ``state`` at ``t_start`` [s], with its exact Jacobian
+        (contacts as impacts: onset times and entry speeds; no closest approach is tracked: -inf)."""
+        _status, _t, strobes, jac, contacts, _segments, _states, _moments, counters = self._run(problem, state, t_start, periods, False, True)
+        product = np.eye(2 * problem.size)
+        for factor in jac:
+            product = factor @ product
+        return StrobeMap(
+            state=strobes[-1].copy(),
+            jacobian=product,
+            impact_times=contacts[:, 0].copy(),
+            impact_velocities=contacts[:, 1].copy(),
+            sticks=0,
+            releases=int(counters[4]),
+            closest_approach=-np.inf,
+            closest_approach_time=np.nan,
+            stats=_stats(counters, contacts.shape[0]),
+            impact_stops=contacts[:, 5].astype(np.int64),
+        )
+
+    def sample(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, times: NDArray[np.float64]) -> tuple[Trajectory, NDArray[np.float64]]:
+        """Integrate ``periods`` periods from ``state`` at ``t_start`` [s] and give the states (x, x') at ``times`` [s]
+        (inside the run, increasing), shape (n, 2 N) [m, m s-1]: exact, from the run's pieces (at a switch's time, the
+        state after it, which is the same: the bumper's switches are continuous in the state)."""
+        times = np.ascontiguousarray(times, dtype=float).reshape(-1)
+        t_end = float(t_start) + periods * problem.period
+        if times.size and (np.any(np.diff(times) < 0.0) or times[0] < t_start or times[-1] > t_end):
+            raise ValueError(f"times: expected increasing times inside the run [{t_start!r}, {t_end!r}] s, got [{times.min()!r}, {times.max()!r}] s")
+        out = self._run(problem, state, t_start, periods, False, False)
+        segments, states = out[5], out[6]
+        starts = np.ascontiguousarray(segments[:, 0])
+        pieces = np.clip(np.searchsorted(starts, times, side="right") - 1, 0, max(starts.size - 1, 0)).astype(np.int64)
+        flows = segments[:, 1].astype(np.int64)
+        sampled = exact_loop.sample_pieces(*_setup(problem, self.settings).sampling, starts, flows, np.ascontiguousarray(states), times, pieces)
+        return _trajectory(problem, float(t_start), periods, out, False, False), sampled
+
+
+def _stats(counters: NDArray[np.int64], impacts: int) -> dict[str, int]:
+    steps, events, onsets, touches, releases = (int(c) for c in counters)
+    return {"impacts": impacts, "contacts": onsets, "releases": releases, "touches": touches, "steps": steps, "events": events}
+
+
+def _trajectory(problem: ImpactProblem, t_start: float, periods: int, out: tuple, moments: bool, jacobians: bool) -> Trajectory:
+    """The compiled loop's output as a :class:`Trajectory`."""
+    _status, _t, strobes, jac, contacts, segments, segment_states, period_moments, counters = out
+    n, width = 2 * problem.size, 2 * problem.size + len(problem.stops)
+    times = t_start + np.arange(periods + 1) * problem.period  # the loop's boundaries, bit for bit
+    starts = segments[:, 0]
+    ends = np.append(starts[1:], times[-1]) if starts.size else starts
+    keep = ends > starts
+    masks = segments[:, 1].astype(np.int64)
+    lowest = np.array([(int(mask) & -int(mask)).bit_length() - 1 for mask in masks], dtype=np.int64)
+    return Trajectory(
+        problem=problem,
+        strobe_times=times,
+        strobe_states=strobes,
+        impact_times=contacts[:, 0].copy(),
+        impact_velocities=contacts[:, 1].copy(),
+        impulses=contacts[:, 2].copy(),
+        segments=np.column_stack([starts, ends, np.where(masks > 0, MODE_CONTACT, MODE_FREE)])[keep],
+        segment_states=segment_states[keep],
+        moments=period_moments if moments else np.zeros((0, width), dtype=complex),
+        contact_peaks=contacts[:, 3:5].copy(),
+        stats=_stats(counters, contacts.shape[0]),
+        strobe_jacobians=jac if jacobians else np.zeros((0, n, n)),
+        impact_stops=contacts[:, 5].astype(np.int64),
+        segment_stops=lowest[keep],
+        contact_peak_stops=contacts[:, 5].astype(np.int64),
+    )
+
+
+def prepare_compiled_loop() -> float:
+    """Compile the engine's loop in this process unless numba's on-disk cache holds it (a check of its index); return
+    the seconds it took (0 where cached). Run once before parallel workers start, they load it instead of each
+    compiling it at once (~25 s of CPU each on a loaded 2-core machine)."""
+    try:
+        if exact_loop.run_bumper_periods._cache._cache_file._load_index():  # numba's index of cached overloads
+            return 0.0
+    except (AttributeError, OSError, EOFError, ValueError):  # another numba's layout: compile (or load) to be sure
+        pass
+    import time
+
+    from vibroimpact.model.contact import Stop
+    from vibroimpact.model.excitation import HarmonicForce
+    from vibroimpact.model.structure import LinearStructure
+
+    start = time.perf_counter()
+    problem = ImpactProblem(LinearStructure(mass=[[1.0]], stiffness=[[1e4]]), (Stop(KelvinVoigtBumper(1e-3, 100.0, 0.3), coordinate=0),), HarmonicForce(100.0, 10.0))
+    engine = CompliantExactEngine()
+    engine.integrate(problem, np.zeros(2), 0.0, 2, moments=True, jacobians=True)
+    engine.sample(problem, np.zeros(2), 0.0, 1, np.array([0.05]))
+    return time.perf_counter() - start
