@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from vibroimpact.analysis.greens import green_vector, periodic_green
+from vibroimpact.analysis.greens import GREEN_CONDITION_LIMIT, green_condition, green_vector, periodic_green
 from vibroimpact.analysis.layout import ClosedFormLayout, closed_form_layout, harmonic_load
 from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
 from vibroimpact.model.modal import ModalResponse, impulse_modes
@@ -82,11 +82,15 @@ class ImpactOrbit:
     phase : ndarray, shape S
         phi [rad]: u's linear part is a cos(w t + phi) with t from the impact.
     exists : ndarray of bool, shape S
-        A real root with J >= 0.
+        A real root with J >= 0 where the closed form is well-conditioned (:attr:`conditioned`).
     chi0, chi_rate_before : ndarray, shape S
         chi_u(0) [m N-1 s-1] and chi_u'(0-) [m N-1 s-2] (psi for the two-sided stop).
     modes : ModalResponse
         Poles and residues of H(s) n.
+    condition : ndarray, shape S
+        kappa of the Green function sums [-] (:func:`~vibroimpact.analysis.greens.green_condition`): beyond
+        :data:`~vibroimpact.analysis.greens.GREEN_CONDITION_LIMIT` (within ~1.6e-5 relative of an undamped natural
+        frequency) the orbit is not evaluated: ``exists`` is False and J, phi are NaN there, whatever the root.
     """
 
     layout: ClosedFormLayout
@@ -104,8 +108,15 @@ class ImpactOrbit:
     chi0: NDArray[np.float64]
     chi_rate_before: NDArray[np.float64]
     modes: ModalResponse
+    condition: NDArray[np.float64]
 
     # --------------------------------------------------------------- scalars
+    @property
+    def conditioned(self) -> NDArray[np.bool_]:
+        """Where the closed form is evaluated: condition <= GREEN_CONDITION_LIMIT (False where the sums are
+        ill-conditioned, near an undamped natural frequency; the orbit there is unknown, not absent)."""
+        return self.condition <= GREEN_CONDITION_LIMIT
+
     @property
     def two_sided(self) -> bool:
         """The symmetric two-impacts orbit (impacts alternate between the upper and lower stop every T/2)."""
@@ -242,6 +253,7 @@ class ImpactOrbit:
             self, omega=pick(self.omega), clearance=pick(self.clearance), restitution=pick(self.restitution), amplitude=pick(self.amplitude),
             load=pick(self.load, 1), response=pick(self.response, 1), impulse_response=pick(self.impulse_response, 1),
             impulse=pick(self.impulse), phase=pick(self.phase), exists=pick(self.exists), chi0=pick(self.chi0), chi_rate_before=pick(self.chi_rate_before),
+            condition=pick(self.condition),
         )  # fmt: skip
 
     def _chunked(self, function: "Callable[[ImpactOrbit], NDArray]", tail: tuple[int, ...], chunk: int = 1024) -> NDArray[np.float64]:
@@ -317,17 +329,18 @@ class ImpactOrbit:
     def with_root(self, root: str) -> "ImpactOrbit":
         """The same points with the other root of the impulse equation ('+' or '-')."""
         impulse, phase, exists = _impulse_and_phase(self.omega, self.clearance - self.static_offset, self.restitution,
-                                                    self.layout.effective_mass, self.linear_amplitude, self.chi0, self.chi_rate_before, root)  # fmt: skip
+                                                    self.layout.effective_mass, self.linear_amplitude, self.chi0, self.chi_rate_before, root, self.conditioned)  # fmt: skip
         return dataclasses.replace(self, impulse=impulse, phase=phase, exists=exists)
 
 
-def _impulse_and_phase(w: NDArray, delta: NDArray, r: NDArray, m_eff: float, a: NDArray, chi0: NDArray, rate: NDArray, root: str) -> tuple[NDArray, NDArray, NDArray]:
+def _impulse_and_phase(w: NDArray, delta: NDArray, r: NDArray, m_eff: float, a: NDArray, chi0: NDArray, rate: NDArray, root: str,
+                       conditioned: NDArray) -> tuple[NDArray, NDArray, NDArray]:  # fmt: skip
     c = (1.0 / (m_eff * (1.0 + r)) + rate) / w
     quad_a = c**2 + chi0**2
     constant = delta**2 - a**2
     discriminant = quad_a * a**2 - (c * delta) ** 2
     impulse = impulse_roots(quad_a, delta * chi0, discriminant, constant, root)
-    exists = np.isfinite(impulse) & (impulse >= 0.0) & (a > 0.0)
+    exists = np.isfinite(impulse) & (impulse >= 0.0) & (a > 0.0) & conditioned
     with np.errstate(invalid="ignore", divide="ignore"):
         phase = np.where(exists, np.arctan2(-impulse * c / a, (delta + impulse * chi0) / a), np.nan)
     return np.where(exists, impulse, np.nan), phase, exists
@@ -387,8 +400,9 @@ def solve_impact_orbit(
     else:
         rate = periodic_green(model, w, period, 1)
     a = np.abs(response @ n)
-    impulse, phase, exists = _impulse_and_phase(w, delta - float(n @ static), r, layout.effective_mass, a, chi0, rate, root)
-    return ImpactOrbit(layout, w, delta, r, q, load, response, impulse_response, static, impulse, phase, exists, chi0, rate, modes)
+    condition = green_condition(modes.poles, w, anti)
+    impulse, phase, exists = _impulse_and_phase(w, delta - float(n @ static), r, layout.effective_mass, a, chi0, rate, root, condition <= GREEN_CONDITION_LIMIT)
+    return ImpactOrbit(layout, w, delta, r, q, load, response, impulse_response, static, impulse, phase, exists, chi0, rate, modes, condition)
 
 
 def solve_two_impacts(

@@ -29,7 +29,7 @@ from typing import overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from vibroimpact.analysis.greens import periodic_green
+from vibroimpact.analysis.greens import GREEN_CONDITION_LIMIT, green_condition, periodic_green
 from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_layout
 from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
@@ -91,13 +91,20 @@ class OneImpactSolution:
     phase : ndarray
         Impact phase phi (the paper's varphi + psi12) [rad]; NaN where no solution exists.
     exists : ndarray of bool
-        A real root with J >= 0 exists (the paper's existence conditions |sin phi| <= 1, J >= 0).
+        A real root with J >= 0 exists (the paper's existence conditions |sin phi| <= 1, J >= 0), where the closed
+        form is well-conditioned (``condition``).
     chi0 : ndarray
         chi22(0) [m N-1 s-1] as used by the variant.
     chi_rate_before : ndarray
         chi22'(0-) [m N-1 s-2] as used by the variant.
     green22, green12 : PoleResidueModel
         Models whose periodic Green functions reconstruct X2(t) and X1(t).
+    system : TwoDofSystem
+        The linear system.
+    condition : ndarray
+        kappa of the periodic sums of both models [-] (:func:`~vibroimpact.analysis.greens.green_condition`); beyond
+        :data:`~vibroimpact.analysis.greens.GREEN_CONDITION_LIMIT` (near an undamped natural frequency) ``exists`` is
+        False and J, phi are NaN: the closed form is not evaluated there.
     """
 
     omega: NDArray[np.float64]
@@ -113,6 +120,12 @@ class OneImpactSolution:
     green22: PoleResidueModel
     green12: PoleResidueModel
     system: TwoDofSystem
+    condition: NDArray[np.float64]
+
+    @property
+    def conditioned(self) -> NDArray[np.bool_]:
+        """Where the closed form is evaluated: condition <= GREEN_CONDITION_LIMIT."""
+        return self.condition <= GREEN_CONDITION_LIMIT
 
     @property
     def period(self) -> NDArray[np.float64]:
@@ -264,6 +277,7 @@ class OneImpactSolution:
             green22=self.green22,
             green12=self.green12,
             system=self.system,
+            condition=pick(self.condition),
         )
 
 
@@ -361,7 +375,8 @@ def solve_one_impact(
     constant = delta**2 - a_lin**2
     discriminant = quad_a * a_lin**2 - (c * delta) ** 2  # = quad_b^2 - quad_a * constant, without cancellation
     impulse = stable_impulse_root(quad_a, quad_b, discriminant, constant)
-    exists = np.isfinite(impulse) & (impulse >= 0.0)
+    condition = green_condition(np.concatenate([green22.poles, green12.poles]), w)
+    exists = np.isfinite(impulse) & (impulse >= 0.0) & (condition <= GREEN_CONDITION_LIMIT)
     with np.errstate(invalid="ignore", divide="ignore"):
         phase = np.where(exists, np.arctan2(-impulse * c / a_lin, (delta + impulse * chi0) / a_lin), np.nan)
     return OneImpactSolution(
@@ -378,4 +393,5 @@ def solve_one_impact(
         green22=green22,
         green12=green12,
         system=system,
+        condition=condition,
     )

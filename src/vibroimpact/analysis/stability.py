@@ -197,7 +197,10 @@ class Regime(IntEnum):
     #: Swept-sine tests: contacts occurred within the estimator's window. A sweep is a slow transient, not a steady
     #: state: ``impacts_per_period`` says how many contacts per cycle.
     SWEPT_CONTACT = 10
-    #: Time-domain solutions: the integrator failed at this point (the error went to stderr); values are NaN.
+    #: The solution could not be computed at this point; values are NaN. Time-domain solutions: the integrator failed
+    #: (the error went to stderr). Closed forms (``pgf``, ``pgf_paper``): the Green function sums are ill-conditioned,
+    #: near an undamped or nearly undamped natural frequency (:data:`vibroimpact.analysis.greens.GREEN_CONDITION_LIMIT`):
+    #: the closed form is not valid there, and whether an orbit exists is unknown.
     FAILED = 11
     #: Time-domain solutions: no periodic steady state, and the motion is quasi-periodic: its largest Lyapunov exponent
     #: (``lyapunov_exponent`` [1/period]) is 0 within its error and the strobes lie on a closed curve (line spectrum,

@@ -23,13 +23,13 @@ A whole problem's flows and stop maps are assembled in :mod:`~vibroimpact.engine
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.structure import resonance_refusal
 
 __all__ = ["Flow", "decompose", "mechanical_null_basis", "numeric_null_basis", "ExactModel", "build_model"]
 
@@ -175,8 +175,9 @@ def decompose(
     Raises
     ------
     ValueError
-        A Jordan block at zero longer than 2, a defective nonzero eigenvalue, or w equal to an undamped natural
-        frequency (jw an eigenvalue of A: the harmonic response is unbounded) while the harmonic load is nonzero.
+        A Jordan block at zero longer than 2, a defective nonzero eigenvalue, or w so near an undamped (or nearly
+        undamped) natural frequency that the harmonic response is ill-conditioned
+        (:func:`~vibroimpact.model.structure.resonance_refusal`) while the harmonic load is nonzero.
     """
     a = np.asarray(matrix, dtype=float)
     n = a.shape[0]
@@ -227,12 +228,9 @@ def _harmonic_response(a: NDArray[np.float64], b: NDArray[np.complex128], lam: N
         return np.zeros(n, dtype=complex)
     if omega <= 0.0:
         raise ValueError(f"excitation.frequency: w = {omega!r} rad/s: a harmonic load needs w > 0")
-    if lam.size and np.min(np.abs(lam - 1j * omega)) <= 1e-10 * omega:
-        nearest = lam[np.argmin(np.abs(lam - 1j * omega))]
-        raise ValueError(
-            f"excitation.frequency = {omega / (2 * math.pi)!r} Hz equals an undamped natural frequency of the structure "
-            f"({abs(nearest) / (2 * math.pi)!r} Hz): the harmonic response is unbounded; move the frequency or add damping"
-        )
+    refusal = resonance_refusal(lam, omega)  # the closed forms and the steady states refuse the same band
+    if refusal is not None:
+        raise ValueError(refusal)
     return np.linalg.solve(1j * omega * np.eye(n) - a, b)
 
 

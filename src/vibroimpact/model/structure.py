@@ -20,10 +20,121 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["LinearStructure", "as_matrix_rows", "require_finite", "require_positive", "require_non_negative", "require_in_range"]
+__all__ = ["LinearStructure", "as_matrix_rows", "require_finite", "require_positive", "require_non_negative", "require_in_range",
+           "MASS_RATIO", "STIFFNESS_RATIO", "DAMPING_RATIO", "RIGID_BODY_THRESHOLD", "require_ratio", "CONDITION_LIMIT", "harmonic_condition",
+           "resonance_refusal"]
 
 #: Relative tolerance of the symmetry and definiteness checks.
 _TOLERANCE = 1e-12
+
+#: Largest ratio of two masses of one structure (of the largest to the smallest eigenvalue of M) [-]. The dynamics
+#: mix the two in sums like K / M1 + K / M2: beyond ~1e12 double precision (eps 2.2e-16) keeps fewer than 4 digits of
+#: the smaller term, and beyond 1e16 none (m2 = 1e300 gave x1 = 0 where it is 7.4e-4 m).
+MASS_RATIO = 1e12
+#: A stiffness eigenvalue at most this fraction of the largest is a rigid-body mode (a free mass) [-]:
+#: :meth:`LinearStructure.rigid_body_modes`.
+RIGID_BODY_THRESHOLD = 1e-10
+#: Largest ratio of two springs of the named system, k1 / k2 or k2 / k1 [-]: K's eigenvalue ratio is then at most
+#: ~4e9, so that no spring reads as a free mass (:data:`RIGID_BODY_THRESHOLD`); k2 = 1e300 made the absorber's
+#: spring swallow the suspension's (all-NaN linear responses).
+STIFFNESS_RATIO = 1e9
+#: Largest b^2 / (k m) of a dashpot against its spring and mass [-] (4 zeta^2: the ratio of the fast to the slow pole
+#: of an overdamped mode): beyond ~1e12 the slow pole is round-off next to the fast one.
+DAMPING_RATIO = 1e12
+#: Eigenvalues of K below this fraction of the largest are zero to round-off (a free mass written as matrices) [-].
+_ROUND_OFF = 1e-13
+
+
+#: Largest condition number of a harmonic (or periodic) response that is evaluated [-]: the harmonic response
+#: (:func:`harmonic_condition`) by the steady states and the exact engines, the Green function sums
+#: (:func:`vibroimpact.analysis.greens.green_condition`) by the closed forms. Near an undamped natural frequency the
+#: response is ~kappa times the motion it makes with the impacts, and their cancellation leaves an error ~eps kappa^2
+#: (measured: closed form 1.4e-7 at kappa = 1.6e4, 7 % at 1.6e7; the exact engine 3e-3 at 1.6e7): 1e4 keeps it below
+#: ~5e-8. kappa ~ 1 / (2 pi detuning) near an undamped natural frequency (refused within 1.6e-5 of it) and at most
+#: ~1 / (2 pi zeta) at a resonance of damping ratio zeta (refused where zeta < 1.6e-5). The shipped scenes stay below
+#: 146 (zeta >= 0.0022).
+CONDITION_LIMIT = 1e4
+
+
+def harmonic_condition(poles: ArrayLike, omega: ArrayLike) -> NDArray[np.float64]:
+    """kappa = max_k |p_k| / (2 pi |j w - p_k|): the condition of the harmonic response (j w I - A)^-1 b [-].
+
+    ~1 / (2 pi relative detuning) near an undamped natural frequency, 1 / (2 pi zeta) at a damped one's peak, inf at
+    an undamped one; rigid-body poles (p = 0) add nothing.
+
+    Parameters
+    ----------
+    poles : array_like of complex
+        Eigenvalues of the state matrix [rad s-1].
+    omega : array_like
+        w [rad s-1], > 0.
+    """
+    p = np.asarray(poles, dtype=complex).reshape(-1)
+    w = np.asarray(omega, dtype=float)
+    if p.size == 0:
+        return np.zeros(w.shape)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.abs(p) / (2.0 * np.pi * np.abs(1j * w[..., None] - p))
+    return np.max(np.where(np.isnan(ratio), 0.0, ratio), axis=-1)
+
+
+def resonance_refusal(poles: ArrayLike, omega: float) -> str | None:
+    """Why a harmonic load at ``omega`` [rad s-1] has no well-conditioned response (:data:`CONDITION_LIMIT`), or None.
+
+    The message names the frequency, the nearest natural frequency, its mode's damping ratio and what to do.
+    """
+    kappa = float(harmonic_condition(poles, omega))
+    if kappa <= CONDITION_LIMIT:
+        return None
+    p = np.asarray(poles, dtype=complex).reshape(-1)
+    nearest = p[np.argmax(np.abs(p) / np.maximum(np.abs(1j * omega - p), 1e-300))]
+    detuning = abs(1j * omega - nearest) / abs(nearest)
+    zeta = -nearest.real / abs(nearest)
+    mode = "an undamped mode" if zeta < 1e-12 else f"a mode damped zeta = {zeta:.2g}"
+    return (
+        f"excitation.frequency = {omega / (2.0 * math.pi):.12g} Hz is {_short(detuning)} (relative) from the natural frequency "
+        f"{abs(nearest) / (2.0 * math.pi):.12g} Hz of {mode}: the harmonic response there is ill-conditioned (condition "
+        f"{_short(kappa)} > {_power(CONDITION_LIMIT)}, refused within {_short(1.0 / (2.0 * math.pi * CONDITION_LIMIT))} of an undamped "
+        "natural frequency); move the frequency or add damping"
+    )
+
+
+def _short(value: float) -> str:
+    """Two digits, exponent without padding: 1.6e-5, 3.2e8, 0.25."""
+    mantissa, _, exponent = f"{value:.2g}".partition("e")
+    return f"{mantissa}e{int(exponent)}" if exponent else mantissa
+
+
+def _power(value: float) -> str:
+    """1e12 for 1e+12, 1e-9 for 1e-09, 1 for 1."""
+    if value == 1.0:
+        return "1"
+    mantissa, _, exponent = f"{value:.0e}".partition("e")
+    return f"{mantissa}e{int(exponent)}"
+
+
+def require_ratio(key: str, expression: str, ratio: float, high: float, low: float | None = None, why: str = "") -> None:
+    """``ValueError`` naming ``key`` and ``expression`` where ``ratio`` lies outside [low, high] (low: 1 / high).
+
+    Parameters
+    ----------
+    key : str
+        Scene key of the message (e.g. ``system``).
+    expression : str
+        The ratio as the user reads it, e.g. ``m2 / m1``.
+    ratio : float
+        Its value [-] (inf or NaN are out of range).
+    high : float
+        Largest allowed value [-].
+    low : float, optional
+        Smallest allowed value [-]; 1 / ``high`` by default, 0 for a one-sided bound.
+    why : str
+        What goes wrong beyond the range, appended to the message.
+    """
+    low = 1.0 / high if low is None else low
+    if not low <= ratio <= high:
+        allowed = f"<= {_power(high)}" if low == 0.0 else f"[{_power(low)}, {_power(high)}]"
+        raise ValueError(f"{key}: {expression} = {ratio:.3g} is out of range: allowed {allowed}{': ' + why if why else ''}")
 
 
 def as_matrix_rows(name: str, value: object, size: int | None = None) -> tuple[tuple[float, ...], ...]:
@@ -58,10 +169,31 @@ def _check_symmetric_definite(name: str, matrix: NDArray[np.float64], positive: 
         raise ValueError(f"{name}: must be symmetric, but differs from its transpose by up to {asymmetry:.3g}")
     eigenvalues = np.linalg.eigvalsh(0.5 * (matrix + matrix.T))
     smallest = float(eigenvalues[0])
-    if positive and smallest <= _TOLERANCE * scale:
+    if positive and smallest <= 0.0:
         raise ValueError(f"{name}: must be positive definite (every mass > 0), but its smallest eigenvalue is {smallest:.6g}")
+    if positive:
+        require_ratio(name, "largest / smallest eigenvalue (the masses' ratio)", float(eigenvalues[-1]) / smallest, MASS_RATIO, 1.0,
+                      "the smaller masses are lost to round-off next to the larger ones in double precision")
     if not positive and smallest < -_TOLERANCE * scale:
         raise ValueError(f"{name}: must be positive semi-definite (no negative spring or dashpot), but it has the eigenvalue {smallest:.6g}")
+
+
+def _check_dynamic_range(mass: NDArray[np.float64], stiffness: NDArray[np.float64], damping: NDArray[np.float64]) -> None:
+    """``ValueError`` where K has an eigenvalue that is neither a spring nor a free mass to working precision, or C
+    overdamps the structure beyond what double precision resolves (:data:`DAMPING_RATIO`)."""
+    k_values = np.linalg.eigvalsh(stiffness)
+    k_max = float(k_values[-1])
+    if k_max <= 0.0:
+        return  # free masses only: no spring to compare with
+    soft = k_values[(k_values > _ROUND_OFF * k_max) & (k_values <= RIGID_BODY_THRESHOLD * k_max)]
+    if soft.size:
+        require_ratio("system.stiffness", "largest / smallest nonzero eigenvalue", k_max / float(soft[0]), 1.0 / RIGID_BODY_THRESHOLD, 1.0,
+                      "a spring this soft next to the stiffest reads as a free mass (make it 0, or stiffer)")
+    c_max = max(float(np.linalg.eigvalsh(damping)[-1]), 0.0)
+    m_max = float(np.linalg.eigvalsh(mass)[-1])
+    ratio = c_max / (math.sqrt(k_max) * math.sqrt(m_max))
+    require_ratio("system.damping", "c^2 / (k m) of the largest eigenvalues of C, K and M", ratio * ratio, DAMPING_RATIO, 0.0,
+                  "a mode that overdamped has a slow pole lost to round-off next to its fast one")
 
 
 @dataclass(frozen=True)
@@ -114,6 +246,14 @@ class LinearStructure:
         object.__setattr__(self, "stiffness", stiffness)
         object.__setattr__(self, "damping", damping)
         object.__setattr__(self, "coordinates", names)
+
+    def check_dynamic_range(self) -> None:
+        """``ValueError`` where K has an eigenvalue that is neither a spring nor a free mass to working precision
+        (between 1e-13 and :data:`RIGID_BODY_THRESHOLD` of the largest), or C overdamps the structure beyond
+        :data:`DAMPING_RATIO` (its largest eigenvalue squared over K's times M's). M's ratio is checked on
+        construction. The scene checker calls it (a scene is refused before any work); the Python API leaves such
+        structures to its caller."""
+        _check_dynamic_range(self.mass_matrix, self.stiffness_matrix, self.damping_matrix)
 
     # ------------------------------------------------------------------ matrices
     @property
@@ -186,7 +326,7 @@ class LinearStructure:
         scale = float(np.max(np.abs(stiffness))) if np.any(stiffness) else 0.0
         if scale == 0.0:
             return self.size
-        return int(np.sum(np.linalg.eigvalsh(stiffness) <= 1e-10 * scale))
+        return int(np.sum(np.linalg.eigvalsh(stiffness) <= RIGID_BODY_THRESHOLD * scale))
 
     def natural_angular_frequencies(self) -> NDArray[np.float64]:
         """Undamped natural angular frequencies, ascending [rad s-1] (0 for each rigid-body mode)."""

@@ -18,7 +18,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from vibroimpact.model.structure import LinearStructure, require_positive, require_non_negative
+from vibroimpact.model.structure import DAMPING_RATIO, MASS_RATIO, STIFFNESS_RATIO, LinearStructure, require_non_negative, require_positive, require_ratio
 
 __all__ = ["TwoDofSystem", "Receptances", "PAPER_SYSTEM"]
 
@@ -75,6 +75,21 @@ class TwoDofSystem:
             require_positive(f"system.{name}", getattr(self, name))
         for name in ("b1", "b2"):
             require_non_negative(f"system.{name}", getattr(self, name))
+
+    def check_ratios(self) -> None:
+        """``ValueError`` naming the parameters and the allowed ratio where double precision cannot hold them together:
+        m2 / m1 beyond :data:`~vibroimpact.model.structure.MASS_RATIO` (or below its inverse), k2 / k1 beyond
+        :data:`~vibroimpact.model.structure.STIFFNESS_RATIO`, b^2 / (k m) of a dashpot beyond
+        :data:`~vibroimpact.model.structure.DAMPING_RATIO`.
+
+        The scene checker calls it, so that a scene is refused before any work; the Python API leaves such systems to
+        its caller (a test models a free absorber by k2 = 1e-12 k1).
+        """
+        require_ratio("system", "m2 / m1", self.m2 / self.m1, MASS_RATIO, why="one mass is lost to round-off next to the other")
+        require_ratio("system", "k2 / k1", self.k2 / self.k1, STIFFNESS_RATIO, why="one spring is lost to round-off next to the other")
+        for b, k, m in (("b1", "k1", "m1"), ("b2", "k2", "m2")):
+            zeta = getattr(self, b) / (math.sqrt(getattr(self, k)) * math.sqrt(getattr(self, m)))
+            require_ratio("system", f"{b}^2 / ({k} {m})", zeta * zeta, DAMPING_RATIO, 0.0, why="an overdamped mode's slow pole is lost to round-off")
 
     @classmethod
     def of(cls, structure: "TwoDofSystem | LinearStructure") -> "TwoDofSystem | None":

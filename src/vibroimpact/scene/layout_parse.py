@@ -79,7 +79,13 @@ def _named_system(c: Checker, value: Any) -> TwoDofSystem | None:
                 numbers[key] = number
     if not {"m1", "m2", "k1", "k2"} <= set(numbers) or len(numbers) < len(spec.keys() & set(NAMED_SYSTEM_KEYS)):
         return None
-    return TwoDofSystem(**numbers)
+    system = TwoDofSystem(**numbers)
+    try:
+        system.check_ratios()
+    except ValueError as error:  # ratios beyond double precision (model/system.py), named
+        _record(c, "system", error)
+        return None
+    return system
 
 
 def _matrix_structure(c: Checker, value: dict) -> LinearStructure | None:
@@ -110,7 +116,9 @@ def _matrix_structure(c: Checker, value: dict) -> LinearStructure | None:
     if not ok:
         return None
     try:
-        return LinearStructure(mass=rows, stiffness=spec["stiffness"], damping=spec.get("damping", ()), coordinates=names)
+        structure = LinearStructure(mass=rows, stiffness=spec["stiffness"], damping=spec.get("damping", ()), coordinates=names)
+        structure.check_dynamic_range()
+        return structure
     except ValueError as error:
         _record(c, "system", error)
         return None

@@ -8,6 +8,11 @@ finds from the ``pgf`` orbit on the exact stroboscopic map: where it is stable, 
 
 Where the motion does not become periodic, the measured run says what it is (``motion``: quasi-periodic, chaotic or
 undecided, with its Lyapunov exponent; :func:`vibroimpact.simulation.periodic.motion_evidence`).
+
+Two refusals (``ValueError``, whatever the engine): a frequency where the harmonic response is ill-conditioned (near an
+undamped natural frequency, :func:`~vibroimpact.model.structure.resonance_refusal`: the band the exact engines and the
+closed forms refuse too), and a result whose amplitude exceeds :data:`AMPLITUDE_LIMIT` times the scene's scale
+(:func:`amplitude_scale`): no physical steady state, whatever its strobes did.
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines.base import Engine
 from vibroimpact.model.contact import RigidStop, Stop
+from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.simulation.harmonics import HarmonicMeasures, measure, gaps, linear_state, resting_state, suspension_force
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
@@ -28,10 +34,17 @@ from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.simulation.periodic import motion_evidence, shoot_orbit
 from vibroimpact.simulation.history import TimeHistory, engine_of, linear_history, time_history
 from vibroimpact.simulation.settings import START_MODES, SteadySettings
-from vibroimpact.model.structure import require_in_range
+from vibroimpact.model.structure import require_in_range, resonance_refusal
 from vibroimpact.orbits.motion import MotionEvidence
 
-__all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "pgf_guesses", "orbit_stop_of", "START_MODES", "strobes_repeat", "motion_scale", "march"]
+__all__ = ["SteadySettings", "SteadyResult", "steady_state", "start_state", "pgf_guesses", "orbit_stop_of", "START_MODES", "strobes_repeat", "motion_scale", "march",
+           "AMPLITUDE_LIMIT", "amplitude_scale", "check_steady_problem", "check_amplitude"]
+
+#: Largest fundamental amplitude of a steady state, in multiples of :func:`amplitude_scale` [-]. Impacts remove energy
+#: (R <= 1, dissipative bumpers) and limit the stopped coordinates, so a motion 1000 times the clearances plus the
+#: linear response at its own frequency is no steady state of the scene. The golden scenes' 498 steady states reach at
+#: most 8.0 times it (an impacting orbit at 26.5 Hz, where the linear response is small): a margin of 125.
+AMPLITUDE_LIMIT = 1e3
 
 
 
@@ -171,6 +184,42 @@ def motion_scale(problem: ImpactProblem) -> NDArray[np.float64]:
     return np.concatenate([np.full(problem.size, length), np.full(problem.size, problem.omega * length)])
 
 
+def amplitude_scale(problem: ImpactProblem) -> float:
+    """The scene's scale of a steady motion [m]: the largest |Delta_k| plus the largest amplitude of the linear response
+    (every coordinate) at the problem's frequency, plus a static load's excursion in 1/w (as
+    :meth:`ImpactProblem.velocity_scale`). Finite wherever :func:`check_steady_problem` accepts the frequency."""
+    _, static = problem.load()
+    minv_static = np.linalg.solve(problem.structure.mass_matrix, static)
+    linear = float(np.max(np.abs(linear_state(problem).amplitudes)))
+    return float(np.max(np.abs(problem.clearances()))) + linear + float(np.max(np.abs(minv_static))) / problem.omega**2
+
+
+def check_steady_problem(problem: ImpactProblem) -> None:
+    """``ValueError`` where the harmonic load sits so near an undamped (or nearly undamped) natural frequency that
+    its response is ill-conditioned: every steady state there is refused, by every engine (the band the exact engines
+    and the closed forms refuse: :func:`~vibroimpact.model.structure.resonance_refusal`)."""
+    if isinstance(problem.excitation, HarmonicForce) and np.any(problem.load()[0]):
+        refusal = resonance_refusal(np.linalg.eigvals(problem.structure.state_matrix), problem.omega)
+        if refusal is not None:
+            raise ValueError(refusal)
+
+
+def check_amplitude(problem: ImpactProblem, result: "SteadyResult") -> None:
+    """``ValueError`` where a steady state's fundamental amplitude exceeds :data:`AMPLITUDE_LIMIT` times
+    :func:`amplitude_scale`: beyond any physical scale of the scene, so not reported (converged or not)."""
+    amplitudes = np.abs(np.array(result.measures.displacements, dtype=complex))
+    if not np.any(np.isfinite(amplitudes)):
+        return
+    scale = amplitude_scale(problem)
+    i = int(np.nanargmax(amplitudes))
+    if amplitudes[i] > AMPLITUDE_LIMIT * scale:
+        raise ValueError(
+            f"the steady state found has |{problem.structure.coordinates[i]}| = {amplitudes[i]:.3g} m, beyond {AMPLITUDE_LIMIT:g} times the "
+            f"scene's scale {scale:.3g} m (the largest clearance plus the largest linear amplitude at {problem.frequency:g} Hz): "
+            "no physical steady state; not reported"
+        )
+
+
 def steady_state(
     engine: Engine | str,
     problem: ImpactProblem,
@@ -202,9 +251,18 @@ def steady_state(
     -------
     SteadyResult
         The measures, and the engine and problem, so that :meth:`SteadyResult.history` samples the steady motion.
+
+    Raises
+    ------
+    ValueError
+        Near an undamped natural frequency (:func:`check_steady_problem`), or for an amplitude beyond any physical
+        scale of the scene (:func:`check_amplitude`).
     """
     engine = engine_of(engine)
-    return replace(_steady_state(engine, problem, start, settings, orbit_stop, guess), engine=engine, problem=problem)
+    check_steady_problem(problem)
+    result = _steady_state(engine, problem, start, settings, orbit_stop, guess)
+    check_amplitude(problem, result)
+    return replace(result, engine=engine, problem=problem)
 
 
 def _steady_state(

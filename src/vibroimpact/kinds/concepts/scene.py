@@ -281,6 +281,11 @@ def _absorber(c: Checker, key: str, value: Any, system: TwoDofSystem) -> tuple[T
                 return None
             chosen[part], words[part] = number, f"{'k2' if part == 'stiffness' else 'b2'} = {number:g} {unit}"
     built = TwoDofSystem(system.m1, system.m2, system.k1, chosen["stiffness"], system.b1, chosen["damping"])
+    try:
+        built.check_ratios()
+    except ValueError as error:  # a ratio beyond double precision (model/system.py)
+        c.fail(key, str(error).partition(": ")[2])
+        return None
     return built, ", ".join(words.values())
 
 

@@ -107,7 +107,10 @@ def broadcast_quantities(scene: Scene, values: dict[str, np.ndarray], shape: tup
 
 def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.ndarray, shape: tuple[int, ...]) -> dict[str, np.ndarray]:
     """The closed-form impact orbit at ``omega`` [rad s-1], clearance ``delta`` [m] and restitution ``r`` [-] where
-    it is admissible (and stable), else the linear motion where that fits; NaN elsewhere (as for the paper's pgf)."""
+    it is admissible (and stable), else the linear motion where that fits; NaN elsewhere (as for the paper's pgf).
+    Where the Green function sums are ill-conditioned (near an undamped natural frequency, :attr:`ImpactOrbit.conditioned`)
+    the regime is ``failed`` and every value NaN: the closed form is not valid there (the orbit is not known to be
+    absent, so neither ``none`` nor ``linear`` would be honest)."""
     problem = first_problem(scene)
     w, d, rr = np.broadcast_arrays(omega, delta, r)
     orbit = solve_impact_orbit(problem, omega=w, clearance=d, restitution=rr)
@@ -119,6 +122,7 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
     modulus = np.where(admissible, np.max(np.abs(floquet_multipliers(orbit)), axis=-1), np.nan)
     unstable = modulus > 1.0 + MARGINAL_MODULUS
     regime[(regime == Regime.ONE_IMPACT_COEXISTING_LINEAR) & unstable] = Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT
+    regime[~np.broadcast_to(orbit.conditioned, regime.shape)] = Regime.FAILED  # ill-conditioned sums: values NaN
     impact = np.isin(regime, _IMPACT_REGIMES)
     free = np.isin(regime, _LINEAR_REGIMES)
     count = len(scene.stop_specs)
@@ -231,6 +235,7 @@ def paper_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.n
     linear = linear_amplitudes(problem, omega=w)
     fits = np.broadcast_to(linear.fits(stop_clearances(scene)[None, :, None, None, None, :]), shape)
     regime = classify(fits, solution.exists, solution.admissible(scene.settings.admissibility))
+    regime[~np.broadcast_to(solution.conditioned, regime.shape)] = Regime.FAILED  # ill-conditioned sums: values NaN
     impact = np.isin(regime, _IMPACT_REGIMES)
     free = np.isin(regime, _LINEAR_REGIMES)
 

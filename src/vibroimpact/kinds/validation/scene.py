@@ -211,6 +211,15 @@ def read_validation_scene(document: Any, text: str = "", source: str = "scene") 
     doc = c.mapping("", document, VALIDATION_TOP_KEYS, {"name", "validation"}, kind="validation")
     name, description, report = parse_names(c, doc)
     settings = validation_settings(c, doc["validation"]) if "validation" in doc else None
+    if settings is not None and not c.problems:
+        case = settings.case
+        try:
+            if isinstance(case, RelativeStopCase):
+                TwoDofSystem(case.m1, case.m2, case.k1, case.k2, case.b1, case.b2).check_ratios()
+            else:
+                case_structure(case).check_dynamic_range()
+        except ValueError as error:  # a ratio beyond double precision (model/structure.py, model/system.py)
+            c.fail("validation", str(error).partition(": ")[2])
     if c.problems:
         raise SceneError(c.problems, source)
     assert isinstance(name, str) and settings is not None
