@@ -62,7 +62,7 @@ def run_failures(dataset: xr.Dataset) -> list[str]:
             count = int(failed.sum())
             parts = [f"{count} of {int(variable.size)} points"] if count else []
         if parts:
-            lines.append(f"{', '.join(parts)} failed ({name} = {FAILED_FLAG}): the computation raised there; those points are blank (NaN) in the dataset and missing from the figures, the others are unaffected")
+            lines.append(f"{', '.join(parts)} failed ({name} = {FAILED_FLAG}): no value could be computed there (the computation raised, or a closed form is ill-conditioned there); those points are blank (NaN) in the dataset and missing from the figures, the others are unaffected")
     return lines
 
 
