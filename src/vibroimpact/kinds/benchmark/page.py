@@ -73,7 +73,29 @@ class AccuracyPage:
             setting = general_setting(self.dataset)
             label = _measured(self.dataset)[1]
             intro = f"<p>Structure: {', '.join(setting.names)}. Stops: {html.escape('; '.join(setting.stops))}. Load: {html.escape(setting.load_text())}. Errors are of the {html.escape(label)} fundamental.</p>"
-        return [Section("Work-precision", intro=intro, figures=saved(accuracy_figures(self.dataset), out), tables=accuracy_tables(self.dataset))]
+        return [Section("Work-precision", intro=answer_text(self.dataset) + intro, figures=saved(accuracy_figures(self.dataset), out), tables=accuracy_tables(self.dataset))]
+
+
+def answer_text(dataset: xr.Dataset) -> str:
+    """The page's answer, first (HTML): per case, the cheapest way to the tightest target against solve_ivp's, and
+    what the exact engine costs (the tables below give every target and tolerance)."""
+    target = min(TARGETS)
+    label = _measured(dataset)[1]
+    methods = [str(m) for m in dataset["engine"].values]
+    ivp = [m for m in methods if m.startswith("solve_ivp")]
+    parts = []
+    for case in map(str, dataset["case"].values):
+        exact = float(dataset["reference_wall_time"].sel(case=case, reference="exact"))
+        ours = [m for m in methods if m.startswith("compliant") == math.isnan(exact) and m not in ivp and m not in _tolerance_free(dataset)]
+        name, rtol, wall = _cheapest(dataset, case, target, ours)
+        other, other_rtol, other_wall = _cheapest(dataset, case, target, ivp)
+        text = f"<b>{html.escape(case)}</b>: " + (f"{html.escape(name)} at rtol {fmt(rtol, 'g')} in {fmt(wall)} s" if name else "no integrator of ours reaches it")
+        if other:
+            text += f" against {html.escape(other)} at rtol {fmt(other_rtol, 'g')} in {fmt(other_wall)} s" + (f" ({fmt(other_wall / wall, '.1f')}x)" if name else "")
+        if math.isfinite(exact):
+            text += f"; the exact engine, without error, in {fmt(exact)} s"
+        parts.append(text)
+    return f"<p>Cheapest run within {fmt(target, 'g')} of the {html.escape(label)} fundamental, per case: {'; '.join(parts)}.</p>"
 
 
 def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
