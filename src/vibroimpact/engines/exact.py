@@ -36,7 +36,16 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["ExactEngine", "StrobeMap", "stack_flows"]
+__all__ = ["ExactEngine", "StrobeMap", "chained_jacobian", "stack_flows"]
+
+
+def chained_jacobian(factors: NDArray[np.float64], size: int) -> NDArray[np.float64]:
+    """The Jacobian of several periods' stroboscopic map from each period's (``factors[k]``, in order): their product,
+    the last on the left; the identity of ``size`` for none."""
+    product = np.eye(size)
+    for factor in factors:
+        product = factor @ product
+    return product
 
 
 @dataclass(frozen=True, eq=False)
@@ -216,9 +225,7 @@ class ExactEngine:
         """The stroboscopic map over ``periods`` periods from ``state`` at ``t_start`` [s], with its exact Jacobian
         and what a continuation watches (impact speeds, closest approach of the gaps)."""
         _status, _t, strobes, jac, impacts, _segments, _states, _moments, counters, approach = self._run(problem, state, t_start, periods, False, True, True)
-        product = np.eye(2 * problem.size)
-        for factor in jac:
-            product = factor @ product
+        product = chained_jacobian(jac, 2 * problem.size)
         return StrobeMap(
             state=strobes[-1].copy(),
             jacobian=product,

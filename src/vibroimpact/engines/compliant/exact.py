@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 from vibroimpact.engines.base import MODE_FREE, Trajectory, check_run
 from vibroimpact.engines.compliant import exact_loop
 from vibroimpact.engines.compliant.model import MODE_CONTACT
-from vibroimpact.engines.exact import StrobeMap, stack_flows
+from vibroimpact.engines.exact import StrobeMap, chained_jacobian, stack_flows
 from vibroimpact.engines.exact_flows import Flow, decompose, mechanical_null_basis
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.engines.registry import ENGINES, Capabilities
@@ -170,9 +170,7 @@ class CompliantExactEngine:
         """The stroboscopic map over ``periods`` periods from ``state`` at ``t_start`` [s], with its exact Jacobian
         (contacts as impacts: onset times and entry speeds; no closest approach is tracked: -inf)."""
         _status, _t, strobes, jac, contacts, _segments, _states, _moments, counters = self._run(problem, state, t_start, periods, False, True)
-        product = np.eye(2 * problem.size)
-        for factor in jac:
-            product = factor @ product
+        product = chained_jacobian(jac, 2 * problem.size)
         return StrobeMap(
             state=strobes[-1].copy(),
             jacobian=product,
