@@ -132,7 +132,8 @@ def test_paper_impact_free_band_is_linear_throughout() -> None:
 
 
 def test_the_kinds_of_non_periodic_motion_are_appended_without_renumbering() -> None:
-    """Datasets written before keep their meaning: irregular stays 9, failed 11; the new kinds are 12 and 13."""
-    assert (Regime.IRREGULAR, Regime.FAILED, Regime.QUASI_PERIODIC, Regime.CHAOTIC) == (9, 11, 12, 13)
+    """Datasets written before keep their meaning: irregular stays 9, failed 11; the kinds added later are appended:
+    quasi-periodic 12, chaotic 13, held on the stop 14."""
+    assert (Regime.IRREGULAR, Regime.FAILED, Regime.QUASI_PERIODIC, Regime.CHAOTIC, Regime.HELD_ON_STOP) == (9, 11, 12, 13, 14)
     meanings = regime_attributes()["flag_meanings"].split(" ")
-    assert meanings[-2:] == ["quasi_periodic", "chaotic"]
+    assert meanings[-3:] == ["quasi_periodic", "chaotic", "held_on_stop"]

@@ -205,8 +205,8 @@ def test_sweep_of_one_stop_among_stops_with_their_own_values() -> None:
 
 def test_a_mass_held_on_a_preloading_stop_is_not_called_linear(tmp_path) -> None:  # type: ignore[no-untyped-def]
     """k = 1e4 N/m pressed 1 mm into its stop (x1 <= -1 mm: a 10 N preload) by nothing; a 5 N force never lifts it. The
-    exact engine holds it (amplitude ~0, contact force = the force's fundamental): periodic motion with sticking
-    (regime 8), not the linear regime, whose response would cross the stop (regime 6)."""
+    exact engine holds it (amplitude ~0, contact force = the force's fundamental): held on the stop (regime 14), not
+    the linear regime, whose response would cross the stop (regime 6), nor periodic impacts (regime 8: there is none)."""
     from vibroimpact.analysis.stability import Regime
     from vibroimpact.scene import load_scene
     from vibroimpact.runs.run import run_study
@@ -228,6 +228,6 @@ simulation:
     path.write_text(text, encoding="utf-8")
     dataset = run_study(load_scene(path), progress=None, jobs=1)
     exact = dataset.sel(solution="exact").squeeze()
-    assert np.all(exact.regime.values == Regime.PERIODIC_IMPACTS)
+    assert np.all(exact.regime.values == Regime.HELD_ON_STOP)  # no impact, not the linear motion: held by the preload
     assert np.all(exact.x1_amplitude.values <= 1e-12)
     assert np.all(dataset.sel(solution="linear").squeeze().regime.values == Regime.LINEAR_EXCEEDS_CLEARANCE)

@@ -187,8 +187,8 @@ class Regime(IntEnum):
     #: The linear response fits and an admissible one-impact orbit exists but is unstable (Floquet, ``pgf``): the
     #: motion that persists is the linear one, whose values are reported.
     LINEAR_WITH_UNSTABLE_ONE_IMPACT = 7
-    #: Time-domain solutions: a converged periodic motion other than one impact per period (several impacts,
-    #: sticking, or a period of several excitation periods).
+    #: Time-domain solutions: a converged periodic motion with impacts other than one impact per period (several
+    #: impacts, sticking between them, or a period of several excitation periods).
     PERIODIC_IMPACTS = 8
     #: Time-domain solutions: no periodic steady state within the allowed periods, and the evidence (Lyapunov exponent,
     #: strobe spectrum, rotation number) does not decide between quasi-periodic and chaotic motion; values are
@@ -209,6 +209,10 @@ class Regime(IntEnum):
     #: Time-domain solutions: no periodic steady state, and the motion is chaotic: its largest Lyapunov exponent is
     #: positive beyond its error; values are averages over the measured window.
     CHAOTIC = 13
+    #: Time-domain solutions: a converged motion without impacts in which a stop holds the structure (a preloading
+    #: stop whose contact force the excitation never lifts it from): periodic and impact-free, but not the linear
+    #: motion.
+    HELD_ON_STOP = 14
 
 
 def classify(linear_fits: ArrayLike, exists: ArrayLike, admissible: ArrayLike) -> NDArray[np.int8]:

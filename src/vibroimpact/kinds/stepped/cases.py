@@ -237,10 +237,10 @@ def simulated_regime(fields: dict[str, np.ndarray], one_impact_orbit: np.ndarray
     """The ``regime`` flag of simulated steady states from a case's measured fields (the arrays of the grid).
 
     Not computed, failed, or: not converged -> the motion's own classification (quasi-periodic, chaotic) else
-    irregular; converged -> linear when there was neither an impact nor a contact force (a structure held on a stop
-    without impacts, by a preloading stop the force never lifts it from, is periodic motion with sticking, not
-    linear), one impact where ``one_impact_orbit`` (the closed form's kind of orbit: one impact per period, or one
-    on each side of a symmetric two-sided stop) holds at multiplicity 1, else periodic impacts.
+    irregular; converged -> linear when there was neither an impact nor a contact force, held on the stop when there
+    was a contact force but no impact (a preloading stop the force never lifts the structure from), one impact where
+    ``one_impact_orbit`` (the closed form's kind of orbit: one impact per period, or one on each side of a symmetric
+    two-sided stop) holds at multiplicity 1, else periodic impacts.
     """
     computed = ~np.isnan(fields["converged"])
     converged = fields["converged"] == 1.0
@@ -252,6 +252,7 @@ def simulated_regime(fields: dict[str, np.ndarray], one_impact_orbit: np.ndarray
     held = np.abs(fields["contact_force"]) > 1e-9 * (np.abs(fields["suspension_force"]) + np.abs(fields["contact_force"]))
     regime[computed & converged & (fields["impacts_per_period"] == 0.0) & ~held] = Regime.LINEAR
     regime[computed & converged & (fields["multiplicity"] == 1.0) & one_impact_orbit] = Regime.ONE_IMPACT
+    regime[computed & converged & (fields["impacts_per_period"] == 0.0) & held] = Regime.HELD_ON_STOP
     regime[fields["failed"] == 1.0] = Regime.FAILED
     return regime
 

@@ -84,7 +84,7 @@ DESIGN_REGIME_LABELS: dict[DesignRegime, str] = {
 }
 #: The regime flags of each class; a one-impact flag whose orbit is unstable is unresolved instead.
 _CLASSES: dict[DesignRegime, tuple[Regime, ...]] = {
-    DesignRegime.NO_IMPACT: (Regime.LINEAR, Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT, Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT),
+    DesignRegime.NO_IMPACT: (Regime.LINEAR, Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT, Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT, Regime.HELD_ON_STOP),
     DesignRegime.ONE_IMPACT: (Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR),
     DesignRegime.PERIODIC_OTHER: (Regime.PERIODIC_IMPACTS,),
     DesignRegime.IRREGULAR: (Regime.IRREGULAR, Regime.QUASI_PERIODIC, Regime.CHAOTIC),
