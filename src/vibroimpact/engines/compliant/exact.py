@@ -41,7 +41,7 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["CompliantExactEngine", "bumper_flows", "prepare_compiled_loop", "MAX_BUMPERS"]
+__all__ = ["CompliantExactEngine", "bumper_flows", "loop_is_cached", "prepare_compiled_loop", "MAX_BUMPERS"]
 
 #: Most bumpers of one problem: the engine prepares every contact mode, 2^K flows.
 MAX_BUMPERS = 8
@@ -235,15 +235,20 @@ def _trajectory(problem: ImpactProblem, t_start: float, periods: int, out: tuple
     )
 
 
+def loop_is_cached() -> bool:
+    """Whether numba's on-disk cache holds the engine's loop (a check of its index; False where unsure)."""
+    try:
+        return bool(exact_loop.run_bumper_periods._cache._cache_file._load_index())  # numba's index of cached overloads
+    except (AttributeError, OSError, EOFError, ValueError):  # another numba's layout: compile (or load) to be sure
+        return False
+
+
 def prepare_compiled_loop() -> float:
     """Compile the engine's loop in this process unless numba's on-disk cache holds it (a check of its index); return
     the seconds it took (0 where cached). Run once before parallel workers start, they load it instead of each
     compiling it at once (~25 s of CPU each on a loaded 2-core machine)."""
-    try:
-        if exact_loop.run_bumper_periods._cache._cache_file._load_index():  # numba's index of cached overloads
-            return 0.0
-    except (AttributeError, OSError, EOFError, ValueError):  # another numba's layout: compile (or load) to be sure
-        pass
+    if loop_is_cached():
+        return 0.0
     import time
 
     from vibroimpact.model.contact import Stop
