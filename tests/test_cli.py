@@ -105,6 +105,7 @@ def _slow_scene(folder: Path) -> Path:
     return write_yaml(folder / "interrupted.yaml", document)
 
 
+@pytest.mark.faults  # whole run-study processes with dask workers: ~12 s, run with the other interrupts (-m faults)
 @pytest.mark.timeout(480)
 def test_ctrl_c_leaves_one_line_and_a_resumable_store(tmp_path: Path) -> None:
     """Ctrl-C (SIGINT to the whole process group, dask workers included): exit 130, one line saying what was kept,

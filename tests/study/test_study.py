@@ -113,7 +113,7 @@ def test_failed_write_keeps_previous_file(golden_run: xr.Dataset, tmp_path: Path
 
 def test_simulated_solutions_join_the_dataset(tmp_path: Path) -> None:
     """Engines on their own coarse grid (the file's group ``simulated``); on stable one-impact points they equal pgf;
-    CLI --jobs 2."""
+    CLI in this process (--jobs 1; the local dask cluster's results are the same: test_cases.py)."""
     from vibroimpact import cli
 
     doc = small_scene(
@@ -125,7 +125,7 @@ def test_simulated_solutions_join_the_dataset(tmp_path: Path) -> None:
     )
     path = tmp_path / "sim.yaml"
     path.write_text(yaml.safe_dump(doc))
-    assert cli.main([str(path), "--out", str(tmp_path / "o"), "--jobs", "2"]) == 0
+    assert cli.main([str(path), "--out", str(tmp_path / "o"), "--jobs", "1"]) == 0
     assert not (tmp_path / "o" / ".cache").exists()
     path = tmp_path / "o" / "golden_small.nc"
     with xr.open_dataset(path) as ds, xr.open_dataset(path, group="simulated") as simulated:  # the engines on their own grid
