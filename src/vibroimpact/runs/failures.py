@@ -31,14 +31,14 @@ def _as_lines(value: object) -> list[str]:
     return [str(line) for line in np.atleast_1d(np.asarray(value)).tolist() if str(line)]
 
 
-def _flagged(variable: xr.DataArray) -> int | None:
-    """The flag value meaning ``failed`` of a CF flag variable, or None."""
+def _flag_value(variable: xr.DataArray, meaning: str) -> int | None:
+    """The value of a CF flag variable's flag ``meaning`` (e.g. ``failed``), or None if it has no such flag."""
     meanings = str(variable.attrs.get("flag_meanings", "")).split()
     values = variable.attrs.get("flag_values")
-    if FAILED_FLAG not in meanings or values is None:
+    if meaning not in meanings or values is None:
         return None
     values = np.atleast_1d(np.asarray(values))
-    return int(values[meanings.index(FAILED_FLAG)]) if values.size == len(meanings) else None
+    return int(values[meanings.index(meaning)]) if values.size == len(meanings) else None
 
 
 def run_failures(dataset: xr.Dataset) -> list[str]:
@@ -48,7 +48,7 @@ def run_failures(dataset: xr.Dataset) -> list[str]:
     """
     lines = _as_lines(dataset.attrs.get("run_failures"))
     for name, variable in dataset.data_vars.items():
-        flag = _flagged(variable)
+        flag = _flag_value(variable, FAILED_FLAG)
         if flag is None:
             continue
         failed = variable == flag
@@ -56,7 +56,8 @@ def run_failures(dataset: xr.Dataset) -> list[str]:
             other = [dim for dim in variable.dims if dim != "solution"]
             counts = failed.sum(other).values
             # the points each solution was computed at: a simulated solution covers a subset of the grid
-            computed = (variable != _not_computed(variable)).sum(other).values
+            not_computed = _flag_value(variable, "not_computed")
+            computed = (variable != not_computed).sum(other).values if not_computed is not None else np.full(counts.shape, variable.size // variable.sizes["solution"])
             parts = [f"{solution}: {int(count)} of {int(total)} points" for solution, count, total in zip(variable["solution"].values, counts, computed) if count]
         else:
             count = int(failed.sum())
@@ -64,15 +65,6 @@ def run_failures(dataset: xr.Dataset) -> list[str]:
         if parts:
             lines.append(f"{', '.join(parts)} failed ({name} = {FAILED_FLAG}): no value could be computed there (the computation raised, or a closed form is ill-conditioned there); those points are blank (NaN) in the dataset and missing from the figures, the others are unaffected")
     return lines
-
-
-def _not_computed(variable: xr.DataArray) -> int:
-    """The flag value of points a solution was not computed at (``not_computed``), or a value no flag takes."""
-    meanings = str(variable.attrs.get("flag_meanings", "")).split()
-    values = np.atleast_1d(np.asarray(variable.attrs.get("flag_values", [])))
-    if "not_computed" in meanings and values.size == len(meanings):
-        return int(values[meanings.index("not_computed")])
-    return -(1 << 30)
 
 
 def failure_details(dataset: xr.Dataset) -> list[str]:
