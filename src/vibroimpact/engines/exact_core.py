@@ -41,6 +41,10 @@ from numba import njit
 __all__ = ["run_periods", "sample_states", "moment_rates", "STATUS_OK", "STATUS_NO_PROGRESS", "STATUS_TWO_STICKS"]
 
 STATUS_OK, STATUS_NO_PROGRESS, STATUS_TWO_STICKS = 0, 1, 2
+#: -1 (no stop, no event), 0 and True as typed values, not literals: numba compiles a callee once per literal argument
+#: (and a variable first set to a literal is typed as one in the first pass of type inference), so each literal call
+#: site compiled its callees a second time (17 of the 56 compilations of a cold start).
+_NONE, _ZERO, _YES = np.int64(-1), np.int64(0), np.bool_(True)
 
 
 # ------------------------------------------------------------------------------------------------ a piece of flow f
@@ -276,7 +280,7 @@ def _first_crossing(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t_from,
         if _value(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t) >= -tolerance:
             step = _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, tolerance)
             if step < 0.0:
-                if _bound(rates, rr, rc, amp, ar, har, 0.0, 0.0, omega, t0, t, 0) <= tolerance and abs(p1) + abs(p2) <= tolerance:
+                if _bound(rates, rr, rc, amp, ar, har, 0.0, 0.0, omega, t0, t, _ZERO) <= tolerance and abs(p1) + abs(p2) <= tolerance:
                     return math.nan
                 return t_from
             t += step
@@ -469,11 +473,11 @@ def _pushed(stop, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdr
     if polys[f]:
         _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t, y, z0, q1, q2)
     har, con, p1, p2 = _observable(hold_w, stop, hold_off[stop], hold_har[stop], vecs, hrms, csts, f, m, modal, amp, polys[f], z0, q1, q2)
-    value = _value(lams, f, m, amp, 0, har, con, p1, p2, omega, t, t)
+    value = _value(lams, f, m, amp, _ZERO, har, con, p1, p2, omega, t, t)
     if abs(value) > 64.0 * force_tolerance:
         return value < 0.0
-    band = _round_off(m, amp, 0, har, con, p1, p2, 0.0, force_tolerance)  # as the held search will allow
-    return _escape_step(lams, f, m, amp, 0, har, con, p1, p2, omega, t, t, band) >= 0.0
+    band = _round_off(m, amp, _ZERO, har, con, p1, p2, 0.0, force_tolerance)  # as the held search will allow
+    return _escape_step(lams, f, m, amp, _ZERO, har, con, p1, p2, omega, t, t, band) >= 0.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -532,7 +536,7 @@ def run_periods(
     t = t_start
     jac = np.eye(n)
     # is the start held (at rest on a stop that pushes)?
-    stuck = -1
+    stuck = _NONE
     for j in range(stops):
         speed = 0.0
         for r in range(n):
@@ -603,7 +607,7 @@ def run_periods(
             fresh = False  # the piece lasts until the next event, across period boundaries
         counters[0] += 1
         t_event = math.nan
-        event = -1
+        event = _NONE
         limit = boundary
         for j in range(stops):
             found = _first_crossing(hlams, f, hm, hamps, j, hars[j], cons[j], p1s[j], p2s[j], omega, t_piece, t, limit, force_tolerances[j] if j == stuck else tolerance, leave[j])
@@ -652,12 +656,12 @@ def run_periods(
         fresh = True
         if event == stuck:
             counters[3] += 1
-            stuck = -1  # release: continuous state and vector field, saltation = identity
+            stuck = _NONE  # release: continuous state and vector field, saltation = identity
             continue
         # an impact on stop ``event`` (from free flight, or while held on another stop, which it frees unless that
         # stop holds on after the impulse)
         held_before = stuck
-        stuck = -1
+        stuck = _NONE
         j = event
         impacts_period[j] += 1
         counters[1] += 1
@@ -745,7 +749,7 @@ def sample_states(lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdr
     modal = np.empty(lams.shape[1], dtype=np.complex128)
     z0, q1, q2 = np.zeros(n), np.zeros(n), np.zeros(n)
     y = np.empty(n)
-    current = -1
+    current = _NONE
     for i in range(count):
         p = pieces[i]
         f = flows[p]
@@ -882,7 +886,7 @@ def _add_moments(out, row, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_
         constant = hold_off[stuck]
         for r in range(hold_w.shape[1]):
             constant += hold_w[stuck, r] * csts[f, r]
-        _integrals(amps, mm, -constant, length, pair, single, fourier, phasor, out, row, size + stuck, -1)
+        _integrals(amps, mm, -constant, length, pair, single, fourier, phasor, out, row, size + stuck, _NONE)
 
 
 @njit(cache=True, error_model="numpy")
@@ -897,7 +901,7 @@ def _add_moments_gl(out, row, stuck, lams, vecs, hrms, csts, f, m, modal, omega,
         for q in range(nodes.size):
             t = a + (b - a) * nodes[q]
             w = (b - a) * weights[q]
-            _state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t, y, True, z0, q1, q2)
+            _state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t, y, _YES, z0, q1, q2)
             phasor = complex(math.cos(omega * t), -math.sin(omega * t))
             for i in range(size):
                 out[row, i] += w * y[i] * phasor

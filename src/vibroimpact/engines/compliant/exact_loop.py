@@ -58,10 +58,10 @@ BELOW, BEYOND, CONTACT = 0, 1, 2
 _MAX_EXTREMA = 100_000
 #: Spacing of floats near 1.
 _EPSILON = 2.220446049250313e-16
-#: 0, 1, True and False as typed values, not literals: numba compiles a callee once per literal argument (and a
+#: -1, 0, 1, True and False as typed values, not literals: numba compiles a callee once per literal argument (and a
 #: variable first set to a literal is typed as one in the first pass of type inference), which made the first
 #: compilation ~4x longer.
-_ZERO, _ONE, _YES, _NO = np.int64(0), np.int64(1), np.bool_(True), np.bool_(False)
+_NONE, _ZERO, _ONE, _YES, _NO = np.int64(-1), np.int64(0), np.int64(1), np.bool_(True), np.bool_(False)
 
 
 # -------------------------------------------------------------------------------------------- observables of a piece
@@ -82,7 +82,7 @@ def _goes_negative(obsw, obso, row, lams, counts, vecs, invs, hrms, csts, zpros,
     if poly:
         _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t, y, z0, q1, q2)
     har, con, p1, p2 = _observable(obsw, row, obso[row], 0j, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
-    _halve(lams, f, m, amp, hamp, 0)
+    _halve(lams, f, m, amp, hamp, _ZERO)
     values = np.empty(2)
     row = _ZERO  # (not a literal: numba would compile the callees once more for it)
     _derivatives(hlams, f, hm, hamp, row, har, con, p1, p2, omega, t, t, values)
@@ -146,7 +146,7 @@ def _piece_integrals(moments, row, want_moments, mask, impulses, lams, vecs, hrm
         for r in range(obsw.shape[1]):
             constant -= obsw[minus, r] * csts[f, r]
         if want_moments:
-            _integrals(amps, mm, constant, length, pair, single, fourier, phasor, moments, row, size + j, -1)
+            _integrals(amps, mm, constant, length, pair, single, fourier, phasor, moments, row, size + j, _NONE)
         total = constant * length
         for i in range(mm):
             total += (amps[i] * single[i]).real
@@ -158,7 +158,7 @@ def _piece_integrals_gl(moments, row, want_moments, mask, impulses, lams, vecs, 
     """As :func:`_piece_integrals` on a flow with rigid-body (polynomial) terms, by Gauss-Legendre quadrature (the
     exact engine's chunks)."""
     if want_moments:
-        _add_moments_gl(moments, row, -1, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, ta, tb, fastest, nodes, weights, obsw, obso, zero_har, size, stops, z0, q1, q2, y)
+        _add_moments_gl(moments, row, _NONE, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, ta, tb, fastest, nodes, weights, obsw, obso, zero_har, size, stops, z0, q1, q2, y)
     if mask == 0:
         return
     chunks = max(1, int(math.ceil(fastest * (tb - ta) / 2.0)))
@@ -168,7 +168,7 @@ def _piece_integrals_gl(moments, row, want_moments, mask, impulses, lams, vecs, 
         for q in range(nodes.size):
             t = a + (b - a) * nodes[q]
             w = (b - a) * weights[q]
-            _state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t, y, True, z0, q1, q2)
+            _state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t, y, _YES, z0, q1, q2)
             phasor = complex(math.cos(omega * t), -math.sin(omega * t))
             for j in range(stops):
                 if (mask >> j) & 1:
@@ -188,10 +188,10 @@ def _peaks(mask, obsw, obso, velw, lams, vecs, hrms, csts, f, m, hlams, hm, moda
         if not (mask >> j) & 1:
             continue
         har, con, p1, p2 = _observable(obsw, 4 * j + 2, obso[4 * j + 2], 0j, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
-        _halve(lams, f, m, amp, scratch, 0)
+        _halve(lams, f, m, amp, scratch, _ZERO)
         peak_force[j] = _largest(hlams, f, hm, scratch, _ZERO, har, con, p1, p2, omega, t_piece, ta, tb, work, peak_force[j])
         har, con, p1, p2 = _observable(velw, j, 0.0, 0j, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
-        _halve(lams, f, m, amp, scratch, 1)
+        _halve(lams, f, m, amp, scratch, _ONE)
         for i in range(hm):  # -d/dt of n . x'
             scratch[1, i] *= -hlams[f, i]
         peak_deceleration[j] = _largest(hlams, f, hm, scratch, _ONE, -har * jw, -p1, -2.0 * p2, 0.0, omega, t_piece, ta, tb, work, peak_deceleration[j])
