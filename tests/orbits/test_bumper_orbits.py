@@ -149,3 +149,16 @@ def test_fold_and_period_doubling_converge_to_the_rigid_stops_at_first_order() -
         errors = np.array([abs(found[b][kind][0] - rigid) for b in (250.0, 1000.0, 4000.0)])
         orders = np.log(errors[:-1] / errors[1:]) / np.log(4.0)
         assert np.all((orders > 0.85) & (orders < 1.15)), (kind, errors, orders)
+
+
+def test_resection_moves_the_strobe_between_contacts() -> None:
+    """A bumper orbit strobed at t = 0 seen through the middle of the widest gap between its contacts: the moved
+    state is a fixed point of the new problem's map (to 1e-9 of the scale), and no contact is under way there."""
+    from vibroimpact.orbits.maps import resection
+
+    mapping, orbit = shot(25.0, 250.0)
+    moved, state = resection(mapping.problem, orbit.state, 1)
+    assert abs(moved.phase - mapping.problem.phase) > 1e-3
+    image = ImpactMap(moved).evaluate(state, ImpactMap(moved).parameters)
+    np.testing.assert_allclose(image.image, state, rtol=0.0, atol=1e-9 * ImpactMap(moved).state_scale.max())
+    assert image.hybrid.impacts == 1 and state[1] < PAPER_CLEARANCE  # the absorber below the bumper: free flight
