@@ -99,3 +99,43 @@ def test_the_orbits_table_takes_its_own_restitution_s_special_points(dataset: xr
     listed = sorted(f for row in orbit_rows(moved, 0.8) for values in row["special"].values() for f in values)
     kept = moved["special_point_frequency"].values[np.arange(n) % 2 == 0]
     assert n > 2 and np.allclose(listed, np.sort(kept))
+
+
+def _bumper_dataset() -> xr.Dataset:
+    """Branch and special points of the rigid stop and of bumpers of 250, 1000 and 4000 Hz (one-impact branches, as
+    the bumper study measured them): a fold moving as 1/Omega_b, a grazing point shared by all."""
+    from vibroimpact.kinds.bifurcation.branches import ORIGINS
+    from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS
+    from vibroimpact.scene.variables import flag_attributes
+
+    bumpers = np.array([np.inf, 250.0, 1000.0, 4000.0])
+    fold = 26.7027 - np.array([0.0, 0.2722, 0.0751, 0.0193])
+    return xr.Dataset(
+        {"branch_origin": ("branch_point", np.ones(4, dtype=np.int8), flag_attributes("how", ORIGINS)),
+         "special_point_period_multiplicity": ("special_point", np.ones(8, dtype=np.int16))},
+        coords={
+            "branch": ("branch_point", np.arange(4)), "branch_bumper_frequency": ("branch_point", bumpers),
+            "special_point_kind": ("special_point", np.array([0, 3] * 4, dtype=np.int8), flag_attributes("kind", SPECIAL_POINT_KINDS)),
+            "special_point_frequency": ("special_point", np.ravel([[f, 20.617667574] for f in fold])),
+            "special_point_restitution": ("special_point", np.full(8, 0.2)), "special_point_branch": ("special_point", np.repeat(np.arange(4), 2)),
+            "special_point_bumper_frequency": ("special_point", np.repeat(bumpers, 2)), "restitution": [0.2],
+        },
+    )  # fmt: skip
+
+
+def test_the_bumpers_special_points_are_matched_to_the_rigid_stops_with_their_observed_order() -> None:
+    """Each rigid special point against the same kind at each bumper: differences and p = ln(e_a / e_b) / ln(fb / fa);
+    a point shared by every bumper is the same point (no order), and the rest of the page sees the rigid stop's only."""
+    from vibroimpact.kinds.bifurcation.bumper import bumper_answer, convergence_rows, rigid_view
+
+    data = _bumper_dataset()
+    rows = {row["kind"]: row for row in convergence_rows(data, 0.2)}
+    np.testing.assert_allclose(rows["fold"]["errors"], [-0.2722, -0.0751, -0.0193], rtol=1e-9)
+    expected = [np.log(0.2722 / 0.0751) / np.log(4.0), np.log(0.0751 / 0.0193) / np.log(4.0)]
+    np.testing.assert_allclose(rows["fold"]["orders"], expected, rtol=1e-12)
+    assert rows["grazing"]["same"] and all(np.isnan(rows["grazing"]["orders"]))
+    answer = bumper_answer(data)
+    assert "between the 1000 Hz and 4000 Hz bumpers their observed order of convergence in 1/Omega_b is 0.98 (fold 0.98; 1 is first order)" in answer
+    assert "moves them by up to 0.272 Hz (the fold at 26.703 Hz)" in answer and "contact onsets at tangency at 20.618 Hz" in answer
+    rigid = rigid_view(data)
+    assert rigid.sizes["special_point"] == 2 and "branch_bumper_frequency" not in rigid.coords

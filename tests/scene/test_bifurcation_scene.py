@@ -40,6 +40,14 @@ def test_the_shipped_study_is_a_bifurcation_scene() -> None:
     assert settings.chart is not None and settings.chart.restitution == 0.2 and scene.settings.clearance == pytest.approx(3e-3)  # exact: parsed inputs
 
 
+def test_the_shipped_bumper_study_has_three_bumpers_beside_the_rigid_stop() -> None:
+    scene = load_scene(find_scene("bifurcation_bumper"))
+    settings = scene.settings
+    assert scene.kind == "bifurcation" and settings.restitution == (0.2,) and settings.chart is None
+    assert settings.bumper_frequencies == (250.0, 1000.0, 4000.0) and (settings.low, settings.high) == (15.0, 45.0)
+    assert parse_scene(document()).settings.bumper_frequencies == ()
+
+
 def test_a_small_scene_parses_with_defaults() -> None:
     scene = parse_scene(document())
     assert scene.kind == "bifurcation" and scene.settings.chart is None
@@ -61,6 +69,10 @@ def test_a_small_scene_parses_with_defaults() -> None:
         ({"chart": {"kinds": ["cusp"]}}, "bifurcation.chart.kinds[0]"),
         ({"chart": {"clearance": {"start": 0.004, "stop": 0.002}}}, "bifurcation.chart.clearance.stop"),
         ({"chart": {"restitution": -0.1}}, "bifurcation.chart.restitution"),
+        ({"bumper": {"frequency": [0.0]}}, "bifurcation.bumper.frequency[0]"),
+        ({"bumper": {"stiffness": 1.0}}, "bifurcation.bumper.stiffness"),
+        ({"bumper": {"frequency": [250.0]}, "chart": {}}, "bifurcation.chart"),
+        ({"bumper": {"frequency": [250.0]}, "restitution": [0.0]}, "bifurcation.restitution"),
     ],
 )
 def test_each_mistake_names_its_key(change: dict[str, Any], key: str) -> None:

@@ -73,6 +73,12 @@ class StrobeMap:
         Stop index of each impact.
     closest_approach_stop : int
         The stop of the closest approach (-1 if none).
+    surface_onsets : ndarray of bool, optional
+        Per impact, whether it began at the stop's surface (a Kelvin-Voigt bumper's contact may also begin beyond it,
+        where a released, still compressed bumper catches up again); None: every one did (rigid stops).
+    onset_curvatures : ndarray, optional
+        Bumpers: n_k . x'' of the free flight at each impact that began at the surface [m s-2] (0 for the others);
+        None for rigid stops.
     """
 
     state: NDArray[np.float64]
@@ -86,6 +92,8 @@ class StrobeMap:
     stats: dict[str, int] = field(default_factory=dict)
     impact_stops: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     closest_approach_stop: int = -1
+    surface_onsets: NDArray[np.bool_] | None = None
+    onset_curvatures: NDArray[np.float64] | None = None
 
 
 def _half(lam: NDArray[np.complex128]) -> NDArray[np.complex128]:

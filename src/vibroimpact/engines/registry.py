@@ -17,7 +17,7 @@ from typing import Any, Mapping
 
 from vibroimpact.engines.settings import EngineSettings
 
-__all__ = ["RIGID", "BUMPER", "Capabilities", "EngineSpec", "ENGINES", "engine_names", "stepped_solutions", "engine_spec", "make_engine"]
+__all__ = ["RIGID", "BUMPER", "Capabilities", "EngineSpec", "ENGINES", "engine_names", "stepped_solutions", "engine_spec", "make_engine", "jacobian_engine"]
 
 #: Contact laws an engine can solve: the momentary-impact stop and the Kelvin-Voigt bumper.
 RIGID, BUMPER = "rigid", "bumper"
@@ -152,3 +152,12 @@ def engine_spec(name: str) -> EngineSpec:
 def make_engine(name: str, settings: EngineSettings = EngineSettings()) -> Any:
     """The engine registered under ``name``, built with ``settings``."""
     return engine_spec(name).build(settings)
+
+
+def jacobian_engine(contact: str, settings: EngineSettings = EngineSettings()) -> Any:
+    """The first registered engine that solves ``contact`` (:data:`RIGID`, :data:`BUMPER`) with exact Jacobians of its
+    stroboscopic map (what shooting and continuation need), built with ``settings``; ``ValueError`` if none does."""
+    for spec in ENGINES.values():
+        if spec.contact == contact and spec.capabilities.exact_jacobians:
+            return spec.build(settings)
+    raise ValueError(f"contact = {contact!r}: no registered engine gives exact Jacobians for it")

@@ -76,8 +76,9 @@ def neimark_sacker_test(out: MapEvaluation) -> float:
 
 
 def grazing_margin(info: HybridInfo) -> float:
-    """Dimensionless distance to grazing, >= 0: min(-closest_approach / L, min_impact_velocity / V)."""
-    return float(min(-info.closest_approach / info.length_scale, info.min_impact_velocity / info.velocity_scale))
+    """Dimensionless distance to grazing, >= 0: min(-closest_approach / L, min_impact_velocity / V) (bumpers:
+    ``onset_depth`` / L in place of the speed, :attr:`HybridInfo.speed_margin`)."""
+    return float(min(-info.closest_approach / info.length_scale, info.speed_margin))
 
 
 def locate(

@@ -49,6 +49,12 @@ class HybridInfo:
         Length that makes ``closest_approach`` dimensionless [m] (Delta + q |H12|).
     velocity_scale : float
         Velocity that makes ``min_impact_velocity`` dimensionless [m s-1] (w times ``length_scale``).
+    onset_depth : float or None
+        Compliant stops (bumpers): the smallest depth beyond the surface the free flight ending at a contact onset
+        would have reached, v^2 / (2 max(-d'', 0)) with v the entry speed and d'' the flight's acceleration towards
+        the surface there [m] (+inf without such an onset). A soft contact hardly deflects a flight that touches it
+        slowly, so near tangency v grows as the square root of the distance to it and this depth linearly: the
+        mirror of ``closest_approach`` across the tangency. None for rigid stops.
     """
 
     impacts: int
@@ -57,6 +63,7 @@ class HybridInfo:
     sticks: int = 0
     length_scale: float = 1.0
     velocity_scale: float = 1.0
+    onset_depth: float | None = None
 
     def then(self, other: "HybridInfo") -> "HybridInfo":
         """The information of this flight followed by ``other`` (impacts and sticks add, extremes combine)."""
@@ -67,7 +74,16 @@ class HybridInfo:
             self.sticks + other.sticks,
             self.length_scale,
             self.velocity_scale,
+            None if self.onset_depth is None or other.onset_depth is None else min(self.onset_depth, other.onset_depth),
         )
+
+    @property
+    def speed_margin(self) -> float:
+        """The contact side's scaled distance to grazing, >= 0: ``min_impact_velocity / velocity_scale`` (rigid stops),
+        ``onset_depth / length_scale`` (bumpers)."""
+        if self.onset_depth is None:
+            return self.min_impact_velocity / self.velocity_scale
+        return self.onset_depth / self.length_scale
 
     @property
     def signature(self) -> tuple[int, int]:

@@ -146,7 +146,7 @@ class _Walker:
         if not math.isfinite(value):
             return _NOT_GRAZING  # a plain corrector failure, not a grazing
         before = side.out.hybrid
-        tangency = -before.closest_approach / before.length_scale <= before.min_impact_velocity / before.velocity_scale
+        tangency = -before.closest_approach / before.length_scale <= before.speed_margin
         what = "a free flight touches the stop" if tangency else "an impact's velocity goes to zero"
         if beyond is not None:
             after = beyond.out.hybrid

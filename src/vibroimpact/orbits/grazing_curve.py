@@ -35,11 +35,12 @@ MEASURES = ("tangency", "velocity")
 
 
 def grazing_measure(info: HybridInfo, measure: str) -> float:
-    """The scaled distance to grazing, >= 0: ``-closest_approach / L`` (tangency) or ``min_impact_velocity / V``."""
+    """The scaled distance to grazing, >= 0: ``-closest_approach / L`` (tangency) or ``min_impact_velocity / V``
+    (bumpers: ``onset_depth / L``, :attr:`~vibroimpact.orbits.branch.HybridInfo.speed_margin`)."""
     if measure == "tangency":
         return float(-info.closest_approach / info.length_scale)
     if measure == "velocity":
-        return float(info.min_impact_velocity / info.velocity_scale)
+        return float(info.speed_margin)
     raise ValueError(f"measure = {measure!r}: allowed {MEASURES}")
 
 

@@ -1,8 +1,10 @@
 """The impacting system as a parametrised map: the stroboscopic map of an :class:`ImpactProblem` over k periods.
 
 ``ImpactMap(problem, periods=k)`` maps the state (x, x') at t = 0 (mod T), 2N wide ((X1, X2, X1', X2') on the
-paper's layout), to the state k excitation periods later, with the exact Jacobian of the compiled ``exact`` engine
-(state-transition matrices times saltation matrices of impacts, sticking and release). Its parameters are
+paper's layout), to the state k excitation periods later, with the exact Jacobian of a compiled engine that gives one
+(:func:`~vibroimpact.engines.registry.jacobian_engine`, chosen by the stops' contact law: state-transition matrices
+times saltation matrices of impacts, sticking and release for rigid stops; of contact onsets for bumpers). Its
+parameters are
 ``frequency`` [Hz], ``restitution`` [-], ``clearance`` [m] and ``amplitude`` [N] (or the base amplitude [m] of a base
 motion); a parameter vector becomes a new problem (the frequency changes the period, the strobes stay at t = 0 mod
 T; the force's phase, distribution over the coordinates and static part are kept). With several stops, ``stop``
@@ -12,6 +14,16 @@ stops' values are equal (one stop always), else a ``ValueError`` asks for a choi
 differences (see :data:`vibroimpact.orbits.shooting.FD_RELATIVE_STEP`). Each evaluation carries the hybrid
 information continuation watches: impacts per orbit period, the slowest impact, the closest approach of a free
 flight to any stop, sticks.
+
+Kelvin-Voigt bumpers (every stop a :class:`~vibroimpact.model.contact.KelvinVoigtBumper`): ``restitution`` is the
+restitution of one collision with the bumper, R(xi_b) of the corrected eq. 26, and setting it sets the loss factor
+xi_b = :func:`~vibroimpact.model.contact.loss_factor_from_restitution` (R) with the bumper's Omega_b kept (a base
+problem's own R gives back its own xi_b, bit for bit); ``clearance`` moves the bumper's surface. Contacts are the
+impacts (their onsets, each with its entry speed), there are no sticks, and the closest approach is that of a free
+flight to the bumper's surface (d = 0): the grazing the continuation detects is contact onset at tangency, a free
+flight touching d = 0 or an onset at the surface whose entry speed goes to 0. (A re-contact while a released bumper
+is still compressed, d > 0, is counted but has no speed margin: its vector field is continuous.) A state inside a
+bumper is a valid state.
 
 :func:`orbit_measures` says what an orbit means physically (impulse per impact, harmonic amplitudes);
 :func:`resection` moves a strobe away from the impacts. The closed-form starts (:func:`closed_form_state`,
@@ -27,8 +39,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from vibroimpact.engines.exact import ExactEngine
-from vibroimpact.model.contact import RigidStop
+from typing import Any
+
+from vibroimpact.engines.base import MODE_FREE
+from vibroimpact.engines.registry import BUMPER, RIGID, jacobian_engine
+from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import HybridInfo, MapEvaluation, PeriodicOrbit
 from vibroimpact.orbits.shooting import closed_form_state, section_phase, with_impulse
@@ -47,12 +62,12 @@ def stop_selection(problem: ImpactProblem, stop: int | str | None) -> tuple[int,
     ValueError
         ``stop`` out of range, ``"all"`` over stops whose values differ, or no choice where they differ.
     TypeError
-        A stop that is not rigid.
+        Stops of both laws (rigid and bumper) in one problem.
     """
     stops = problem.stops
     for k, item in enumerate(stops):
-        if not item.rigid:
-            raise TypeError(f"contact: stops[{k}] is a {type(item.law).__name__}; an ImpactMap needs rigid stops (the exact engine)")
+        if item.rigid != stops[0].rigid:
+            raise TypeError(f"contact: stops[{k}] is a {type(item.law).__name__} and stops[0] a {type(stops[0].law).__name__}; an ImpactMap needs one contact law for every stop")
     values = {(item.clearance, item.law.restitution) for item in stops}
     if stop is None or stop == "all":
         if len(values) > 1:
@@ -63,17 +78,25 @@ def stop_selection(problem: ImpactProblem, stop: int | str | None) -> tuple[int,
     return (stop,)
 
 
+def contact_of(problem: ImpactProblem) -> str:
+    """:data:`~vibroimpact.engines.registry.RIGID` or :data:`~vibroimpact.engines.registry.BUMPER`: the contact law of
+    ``problem``'s stops."""
+    return RIGID if all(stop.rigid for stop in problem.stops) else BUMPER
+
+
 class ImpactMap:
-    """Stroboscopic map over ``periods`` excitation periods of a rigid-stop problem under a harmonic force.
+    """Stroboscopic map over ``periods`` excitation periods of a problem with rigid stops or Kelvin-Voigt bumpers under
+    a harmonic force.
 
     Parameters
     ----------
     problem : ImpactProblem
-        The base problem (rigid stops, harmonic force); its values are the default parameter vector.
+        The base problem (rigid stops or bumpers, harmonic force); its values are the default parameter vector.
     periods : int
         k >= 1: excitation periods per map iteration.
-    engine : ExactEngine, optional
-        The engine that computes the map (default settings when omitted).
+    engine : optional
+        The engine that computes the map: one with exact Jacobians for the stops' contact law (default: the first
+        registered, :func:`~vibroimpact.engines.registry.jacobian_engine`, default settings).
     bounds : dict, optional
         Parameter name -> (lower, upper): outside this box the map has no image (NaN, a failed step), e.g. to keep a
         continuation's trials at physical frequencies. Parameters outside their own ranges (a negative frequency,
@@ -101,7 +124,7 @@ class ImpactMap:
 
     parameter_names = tuple(PARAMETERS)
 
-    def __init__(self, problem: ImpactProblem, periods: int = 1, engine: ExactEngine | None = None, bounds: dict[str, tuple[float, float]] | None = None,
+    def __init__(self, problem: ImpactProblem, periods: int = 1, engine: Any = None, bounds: dict[str, tuple[float, float]] | None = None,
                  stop: int | str | None = None, parameter_scale: ArrayLike | None = None) -> None:  # fmt: skip
         problem.harmonic  # noqa: B018 - raises TypeError naming the part unless a harmonic force
         self.stops = stop_selection(problem, stop)
@@ -109,7 +132,8 @@ class ImpactMap:
         if int(periods) < 1:
             raise ValueError(f"periods = {periods!r} is out of range: allowed [1, inf)")
         self.problem, self.periods = problem, int(periods)
-        self.engine = engine if engine is not None else ExactEngine()
+        self.contact = contact_of(problem)
+        self.engine = engine if engine is not None else jacobian_engine(self.contact)
         chosen = problem.stops[self.stops[0]]
         self.parameters = np.array([problem.frequency, chosen.law.restitution, chosen.clearance, problem.amplitude])
         self.dimension = 2 * problem.size
@@ -133,8 +157,7 @@ class ImpactMap:
         frequency, restitution, clearance, amplitude = (float(x) for x in p)
         base = self.problem
         excitation = dataclasses.replace(base.harmonic, amplitude=amplitude, frequency=frequency)
-        law = RigidStop(clearance, restitution)
-        stops = tuple(dataclasses.replace(item, law=law) if k in self.stops else item for k, item in enumerate(base.stops))
+        stops = tuple(dataclasses.replace(item, law=_law(item.law, clearance, restitution)) if k in self.stops else item for k, item in enumerate(base.stops))
         return ImpactProblem(base.system, stops, excitation)
 
     def evaluate(self, y: NDArray[np.float64], p: NDArray[np.float64]) -> MapEvaluation:
@@ -160,20 +183,40 @@ class ImpactMap:
             n = self.dimension
             return MapEvaluation(np.full(n, np.nan), np.full((n, n), np.nan), None, None)
         velocities = strobe.impact_velocities
+        surface = velocities if strobe.surface_onsets is None else velocities[strobe.surface_onsets]
+        depth = None
+        if strobe.onset_curvatures is not None:  # bumpers: how far beyond the surface each flight would have gone
+            pull = np.maximum(-strobe.onset_curvatures[strobe.surface_onsets], 0.0)
+            with np.errstate(divide="ignore"):
+                depths = np.where(pull > 0.0, surface**2 / (2.0 * pull), math.inf)
+            depth = float(depths.min()) if depths.size else math.inf
         length = self.state_scale[0]
         hybrid = HybridInfo(
             impacts=int(velocities.size),
-            min_impact_velocity=float(velocities.min()) if velocities.size else math.inf,
+            min_impact_velocity=float(surface.min()) if surface.size else math.inf,
             closest_approach=float(strobe.closest_approach),
             sticks=int(strobe.sticks),
             length_scale=length,
             velocity_scale=problem.omega * length,
+            onset_depth=depth,
         )
         return MapEvaluation(strobe.state, strobe.jacobian, None, hybrid)
 
 
+def _law(law: RigidStop | KelvinVoigtBumper, clearance: float, restitution: float) -> RigidStop | KelvinVoigtBumper:
+    """``law`` with the clearance [m] and restitution [-] of a parameter vector: a rigid stop's R, or a bumper's loss
+    factor matched to R with its Omega_b kept (its own loss factor where R is its own)."""
+    if isinstance(law, RigidStop):
+        return RigidStop(clearance, restitution)
+    xi = law.loss_factor if restitution == law.restitution else loss_factor_from_restitution(restitution)
+    return KelvinVoigtBumper(clearance, law.frequency, xi)
+
+
 def _outside_stops(problem: ImpactProblem, y: NDArray[np.float64]) -> bool:
-    """Every gap Delta_k - n_k . x >= 0 (on the paper's layout: X2 <= Delta)."""
+    """Every gap Delta_k - n_k . x >= 0 (on the paper's layout: X2 <= Delta); any state of a bumper problem (a
+    bumper may be compressed)."""
+    if contact_of(problem) == BUMPER:
+        return True
     return bool(np.all(problem.clearances() - problem.normals() @ np.asarray(y[: problem.size], dtype=float) >= 0.0))
 
 
@@ -222,21 +265,25 @@ def orbit_measures(system: ImpactMap, orbit: PeriodicOrbit) -> OrbitMeasures:
     return OrbitMeasures(trajectory.impact_velocities.copy(), trajectory.impulses.copy(), amplitudes, stops)
 
 
-def resection(problem: ImpactProblem, state: NDArray[np.float64], periods: int, engine: ExactEngine | None = None) -> tuple[ImpactProblem, NDArray[np.float64]]:
+def resection(problem: ImpactProblem, state: NDArray[np.float64], periods: int, engine: Any = None) -> tuple[ImpactProblem, NDArray[np.float64]]:
     """The same motion seen through a strobe away from its impacts.
 
     ``state`` is the state at t = 0 of ``problem`` on (or near) an orbit of ``periods`` excitation periods, e.g. the
     end of a brute-force run. The motion is integrated over ``periods`` periods; the impact instants modulo T leave
     gaps, and the new strobe goes in the middle of the widest: at tau = g T, i.e. the problem with force phase
     phase + 2 pi g, whose t = 0 is the old t = tau. An :class:`ImpactMap` of that problem has the orbit as a fixed
-    point of a map that is smooth near it (no impact crosses its strobe).
+    point of a map that is smooth near it (no impact crosses its strobe). With bumpers the gaps are those the contact
+    intervals leave (from onset to release, modulo T).
 
     Returns
     -------
     (ImpactProblem, ndarray)
         The problem with the new force phase [rad] (everything else kept), and the state (x, x') at its t = 0.
     """
-    engine = engine if engine is not None else ExactEngine()
+    contact = contact_of(problem)
+    engine = engine if engine is not None else jacobian_engine(contact)
+    if contact == BUMPER:
+        return _resection_bumper(problem, np.asarray(state, dtype=float), int(periods), engine)
     run = engine.integrate(problem, np.asarray(state, dtype=float), 0.0, int(periods))
     fractions = np.sort((run.impact_times / problem.period) % 1.0)
     if fractions.size == 0:
@@ -245,5 +292,34 @@ def resection(problem: ImpactProblem, state: NDArray[np.float64], periods: int, 
     k = int(np.argmax(gaps))
     g = float((fractions[k] + 0.5 * gaps[k]) % 1.0)
     moved = engine.dense(run, np.array([g * problem.period]))[0]
+    phase = float((problem.phase + 2.0 * np.pi * g) % (2.0 * np.pi))
+    return ImpactProblem(problem.system, problem.contact, dataclasses.replace(problem.harmonic, phase=phase)), np.asarray(moved, dtype=float)
+
+
+def _resection_bumper(problem: ImpactProblem, state: NDArray[np.float64], periods: int, engine: Any) -> tuple[ImpactProblem, NDArray[np.float64]]:
+    """:func:`resection` with bumpers: the strobe in the middle of the widest gap between contact intervals mod T."""
+    run = engine.integrate(problem, state, 0.0, periods)
+    busy = [(float(a), float(b)) for a, b, mode in run.segments / np.array([problem.period, problem.period, 1.0]) if mode != MODE_FREE and b > a]
+    if not busy:
+        return problem, state.copy()
+    pieces = []  # the intervals modulo 1, split where they wrap
+    for a, b in busy:
+        if b - a >= 1.0:
+            return problem, state.copy()  # in contact all the time: no better strobe
+        lo, hi = a % 1.0, a % 1.0 + (b - a)
+        pieces += [(lo, min(hi, 1.0))] + ([(0.0, hi - 1.0)] if hi > 1.0 else [])
+    pieces.sort()
+    merged = [list(pieces[0])]
+    for lo, hi in pieces[1:]:
+        if lo <= merged[-1][1]:
+            merged[-1][1] = max(merged[-1][1], hi)
+        else:
+            merged.append([lo, hi])
+    ends = [(hi, (merged[(i + 1) % len(merged)][0] + (1.0 if i + 1 == len(merged) else 0.0)) - hi) for i, (_lo, hi) in enumerate(merged)]
+    start, width = max(ends, key=lambda item: item[1])
+    if width <= 0.0:
+        return problem, state.copy()
+    g = float((start + 0.5 * width) % 1.0)
+    moved = engine.sample(problem, state, 0.0, periods, np.array([g * problem.period]))[1][0]
     phase = float((problem.phase + 2.0 * np.pi * g) % (2.0 * np.pi))
     return ImpactProblem(problem.system, problem.contact, dataclasses.replace(problem.harmonic, phase=phase)), np.asarray(moved, dtype=float)

@@ -144,14 +144,14 @@ class CompliantExactEngine:
     def __init__(self, settings: EngineSettings = EngineSettings()) -> None:
         self.settings = settings
 
-    def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, jacobians: bool) -> tuple:
+    def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, jacobians: bool, approach: bool = False) -> tuple:
         check_run(self.name, problem, KelvinVoigtBumper, periods)
         problem.harmonic  # TypeError naming the excitation if it is not harmonic (a sweep has no closed form)
         setup = _setup(problem, self.settings)
         state = np.array(state, dtype=float, order="C")  # a writable copy: one compiled overload
         if state.shape != (2 * problem.size,):
             raise ValueError(f"state: expected {2 * problem.size} values (x and x' of {problem.size} coordinates), got shape {state.shape}")
-        out = exact_loop.run_bumper_periods(*setup.arguments, state, float(t_start), int(periods), bool(moments), bool(jacobians))
+        out = exact_loop.run_bumper_periods(*setup.arguments, state, float(t_start), int(periods), bool(moments), bool(jacobians), bool(approach))
         if out[0] == exact_loop.STATUS_NO_PROGRESS:
             raise RuntimeError(f"no progress at t = {out[1]!r} s: more than {10 * self.settings.max_impacts_per_period} contact switches in one period")
         return out
@@ -168,20 +168,35 @@ class CompliantExactEngine:
 
     def strobe_map(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float = 0.0, periods: int = 1) -> StrobeMap:
         """The stroboscopic map over ``periods`` periods from ``state`` at ``t_start`` [s], with its exact Jacobian
-        (contacts as impacts: onset times and entry speeds; no closest approach is tracked: -inf)."""
-        _status, _t, strobes, jac, contacts, _segments, _states, _moments, counters = self._run(problem, state, t_start, periods, False, True)
+        and what a continuation watches.
+
+        Contacts are its impacts: ``impact_times``, ``impact_velocities`` and ``impact_stops`` are the onsets after
+        the start (a contact under way at the start is not one; one under way at the end is), each with its entry
+        speed n_k . x' [m s-1]: > 0 for an onset at the bumper's surface (d = 0), <= 0 for a re-contact while a
+        released bumper is still compressed (d > 0, its force rising through zero: ``surface_onsets`` tells them
+        apart); ``onset_curvatures`` is the free flight's d_k'' at each onset at the surface [m s-2] (0 for the
+        others). ``closest_approach`` is the largest interior local maximum of a penetration d_k = n_k . x - Delta_k
+        over free flights below the surface (< 0; -inf without one) [m]: the compliant counterpart of the rigid
+        stop's, so that contact onset at tangency (a free flight touching d = 0, or an onset whose entry speed goes
+        to 0) is where either reaches 0.
+        """
+        out = self._run(problem, state, t_start, periods, False, True, True)
+        _status, _t, strobes, jac, contacts, _segments, _states, _moments, counters, onsets, approach = out
         product = chained_jacobian(jac, 2 * problem.size)
         return StrobeMap(
             state=strobes[-1].copy(),
             jacobian=product,
-            impact_times=contacts[:, 0].copy(),
-            impact_velocities=contacts[:, 1].copy(),
+            impact_times=onsets[:, 0].copy(),
+            impact_velocities=onsets[:, 1].copy(),
             sticks=0,
             releases=int(counters[4]),
-            closest_approach=-np.inf,
-            closest_approach_time=np.nan,
+            closest_approach=float(approach[0]),
+            closest_approach_time=float(approach[1]),
             stats=_stats(counters, contacts.shape[0]),
-            impact_stops=contacts[:, 5].astype(np.int64),
+            impact_stops=onsets[:, 2].astype(np.int64),
+            closest_approach_stop=int(approach[2]),
+            surface_onsets=onsets[:, 3] > 0.5,
+            onset_curvatures=onsets[:, 4].copy(),
         )
 
     def sample(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, times: NDArray[np.float64]) -> tuple[Trajectory, NDArray[np.float64]]:
@@ -208,7 +223,7 @@ def _stats(counters: NDArray[np.int64], impacts: int) -> dict[str, int]:
 
 def _trajectory(problem: ImpactProblem, t_start: float, periods: int, out: tuple, moments: bool, jacobians: bool) -> Trajectory:
     """The compiled loop's output as a :class:`Trajectory`."""
-    _status, _t, strobes, jac, contacts, segments, segment_states, period_moments, counters = out
+    _status, _t, strobes, jac, contacts, segments, segment_states, period_moments, counters = out[:9]
     n, width = 2 * problem.size, 2 * problem.size + len(problem.stops)
     times = t_start + np.arange(periods + 1) * problem.period  # the loop's boundaries, bit for bit
     starts = segments[:, 0]

@@ -44,7 +44,7 @@ from numba import njit
 
 from vibroimpact.engines import exact_core
 from vibroimpact.engines.exact_core import (
-    _add_moments_gl, _amplitudes, _derivatives, _escape_step, _first_crossing, _grow, _halve, _integrals, _left_multiply, _modal, _observable,
+    _add_moments_gl, _amplitudes, _closest_approach, _derivatives, _escape_step, _first_crossing, _grow, _halve, _integrals, _left_multiply, _modal, _observable,
     _piece_factors, _rigid, _round_off, _state, _transition, _value, _weighted_amplitudes,
 )  # fmt: skip
 
@@ -202,14 +202,20 @@ def _peaks(mask, obsw, obso, velw, lams, vecs, hrms, csts, f, m, hlams, hm, moda
 def run_bumper_periods(
     lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
     omega, period, obsw, obso, velw, salts, zero_har, gap_tolerance, force_tolerances, max_events, gl_nodes, gl_weights,
-    y_start, t_start, periods, want_moments, want_jacobians,
+    y_start, t_start, periods, want_moments, want_jacobians, want_approach,
 ):  # fmt: skip
     """Integrate ``periods`` periods from (t_start, y_start); see :class:`~vibroimpact.engines.compliant_exact.CompliantExactEngine`.
 
     Returns (status, t, strobes (periods + 1, n), jacobians (periods, n, n), contacts (c, 6): onset time, entry
     speed n . x', impulse, largest force, largest deceleration, stop, of each completed contact; segments (s, 2):
     start, contact mode, with segment_states (s, n); moments (periods, 2 N + K); counters [steps, events, onsets,
-    touches, releases]); status :data:`STATUS_NO_PROGRESS` stops the run at t after ``max_events`` in one period.
+    touches, releases]; onsets (o, 5): time, entry speed n . x', stop, 1 for an onset at the surface (d = 0, from
+    ``BELOW``) or 0 for one at d > 0 (``BEYOND``), and the free flight's d'' there (an onset at the surface; else 0),
+    of each onset after the start; approach [value, time, stop]: the
+    largest interior local maximum of a penetration d_k while stop k is ``BELOW`` (the closest approach of a free
+    flight to the bumper's surface, the exact engine's :func:`~vibroimpact.engines.exact_core._closest_approach`;
+    -inf without one, or unless ``want_approach``)); status :data:`STATUS_NO_PROGRESS` stops the run at t after
+    ``max_events`` in one period.
     """
     n = y_start.size
     size = n // 2
@@ -221,6 +227,10 @@ def run_bumper_periods(
     segments = np.empty((max(4, 2 * periods), 2))
     segment_states = np.empty((max(4, 2 * periods), n))
     counters = np.zeros(5, dtype=np.int64)
+    onsets = np.empty((max(4, 2 * periods), 5))
+    curvature = np.empty(3)
+    approach = np.array([-math.inf, math.nan, -1.0])
+    n_onsets = 0
     n_contacts = 0
     n_segments = 0
     widest = lams.shape[1]
@@ -324,6 +334,10 @@ def run_bumper_periods(
                     _piece_integrals_gl(moments, k - 1, want_moments, mask, impulses, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, fastests[f], gl_nodes, gl_weights, obsw, obso, zero_har, size, stops, z0, q1, q2, ybuf)
                 else:
                     _piece_integrals(moments, k - 1, want_moments, mask, impulses, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, rates_all, rinv_all, buffers, obsw, obso, size, stops)
+            if want_approach:
+                for j in range(stops):
+                    if phase[j] == BELOW:  # slot 2 j watches d_k
+                        _closest_approach(hlams, f, hm, hamps, 2 * j, hars[2 * j], cons[2 * j], p1s[2 * j], p2s[2 * j], omega, t_piece, t, t_end, fastests[f], approach, j)
             if mask != 0:
                 _peaks(mask, obsw, obso, velw, lams, vecs, hrms, csts, f, m, hlams, hm, modal, amp, poly, z0, q1, q2, scratch, work, omega, t_piece, t, t_end, peak_force, peak_deceleration)
         _state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t_end, ynew, poly, z0, q1, q2)
@@ -343,7 +357,7 @@ def run_bumper_periods(
             continue
         events_period += 1
         if events_period > max_events:
-            return STATUS_NO_PROGRESS, t, strobes, jacobians, contacts[:n_contacts], segments[:n_segments], segment_states[:n_segments], moments, counters
+            return STATUS_NO_PROGRESS, t, strobes, jacobians, contacts[:n_contacts], segments[:n_segments], segment_states[:n_segments], moments, counters, onsets[:n_onsets], approach
         counters[1] += 1
         fresh = True
         j = event // 2
@@ -372,12 +386,20 @@ def run_bumper_periods(
             for r in range(n):
                 speed += velw[j, r] * y[r]
             onset_time[j], onset_speed[j], impulses[j], peak_force[j], peak_deceleration[j] = t, speed, 0.0, 0.0, 0.0
+            if n_onsets == onsets.shape[0]:
+                onsets = _grow(onsets, n_onsets + 1)
+            onsets[n_onsets, 0], onsets[n_onsets, 1], onsets[n_onsets, 2] = t, speed, j
+            onsets[n_onsets, 3], onsets[n_onsets, 4] = 0.0, 0.0
+            if phase[j] == BELOW:  # slot 2 j still watches d_k along the free flight that ends here
+                _derivatives(hlams, f, hm, hamps, 2 * j, hars[2 * j], cons[2 * j], p1s[2 * j], p2s[2 * j], omega, t_piece, t, curvature)
+                onsets[n_onsets, 3], onsets[n_onsets, 4] = 1.0, curvature[2]
+            n_onsets += 1
             counters[2] += 1
             mask |= bit
             phase[j] = CONTACT
         else:
             counters[3] += 1  # the gap (or the force) touched zero without a contact
-    return STATUS_OK, t, strobes, jacobians, contacts[:n_contacts], segments[:n_segments], segment_states[:n_segments], moments, counters
+    return STATUS_OK, t, strobes, jacobians, contacts[:n_contacts], segments[:n_segments], segment_states[:n_segments], moments, counters, onsets[:n_onsets], approach
 
 
 # ------------------------------------------------------------------------------------------------------ sampling

@@ -13,6 +13,12 @@ come from the brute force (:mod:`~vibroimpact.kinds.bifurcation.cases`). Period 
 branch; grazing points where an orbit with another, non-zero impact count continues start a branch there. The linear
 orbit comes from the closed form wherever it fits inside every stop (|n_k H F| + n_k K^-1 F0 <= Delta_k). Failures
 of a continuation are recorded, never fatal.
+
+A problem whose stops are Kelvin-Voigt bumpers has no closed form of its own: its one-contact branches start from its
+rigid twin's (:func:`rigid_twin`: the same stops, rigid, with the bumpers' restitution R), whose orbit is shot on the
+rigid map and then on the bumper's, and are continued on the bumper's exact stroboscopic map
+(:class:`~vibroimpact.orbits.maps.ImpactMap` picks its engine by capabilities); their grazing points are contact
+onsets at tangency.
 """
 
 from __future__ import annotations
@@ -35,7 +41,7 @@ from vibroimpact.orbits.continuation import ContinuationSettings, continue_branc
 from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures, section_phase
 from vibroimpact.orbits.shooting import shoot
 
-__all__ = ["ORIGINS", "MAX_ORBIT_IMPACTS", "SAME_POINT_FREQUENCY", "SAME_POINT_ORBIT", "same_special_point", "map_bounds", "problem_at", "stop_values", "OrbitSet", "find_branches", "closed_form_orbits", "linear_segments"]
+__all__ = ["rigid_twin", "ORIGINS", "MAX_ORBIT_IMPACTS", "SAME_POINT_FREQUENCY", "SAME_POINT_ORBIT", "same_special_point", "map_bounds", "problem_at", "stop_values", "OrbitSet", "find_branches", "closed_form_orbits", "linear_segments"]
 
 #: How a branch was found (CF flags of ``branch_origin``): the closed forms' kinds (one impact per period, the
 #: symmetric two impacts of a two-sided stop) are :data:`vibroimpact.analysis.layout.KINDS`.
@@ -88,6 +94,12 @@ def problem_at(problem: ImpactProblem, frequency: float, clearance: float | None
     if clearance is not None:
         stops = tuple(dataclasses.replace(stop, law=RigidStop(float(clearance), stop.law.restitution)) for stop in stops)
     return ImpactProblem(problem.system, stops, excitation)
+
+
+def rigid_twin(problem: ImpactProblem) -> ImpactProblem:
+    """``problem`` with every stop rigid, at its own clearance and with its law's restitution (a bumper's R)."""
+    stops = tuple(dataclasses.replace(stop, law=RigidStop(stop.clearance, stop.law.restitution)) for stop in problem.stops)
+    return ImpactProblem(problem.system, stops, problem.excitation)
 
 
 def stop_values(problem: ImpactProblem) -> tuple[float, float]:
@@ -295,12 +307,14 @@ def find_branches(
     if linear:
         for segment in linear_segments(problem, low, high):
             found.add_linear(problem, segment)
-    refusal = closed_form_refusal(problem) if one_impact else None
+    bumper = not all(stop.rigid for stop in problem.stops)
+    reference = rigid_twin(problem) if bumper else problem  # whose closed form starts the branches
+    refusal = closed_form_refusal(reference) if one_impact else None
     if refusal is not None:
         found.notes.append(f"no closed-form orbit for this layout ({refusal}): its branches come from the brute force")
     elif one_impact:
         frequency = np.arange(low, high + 0.5 * SCAN_STEP, SCAN_STEP)
-        orbits = closed_form_orbits(problem, frequency)
+        orbits = closed_form_orbits(reference, frequency)
         exists = np.logical_or.reduce([orbit.exists for orbit in orbits])
         for root, orbit in zip(ROOTS, orbits):
             admissible = orbit.admissible()
@@ -312,12 +326,19 @@ def find_branches(
                 if found.known(f0, 1, impacts, impacts * float(orbit.impulse[k])):
                     continue
                 band = _segment(exists, k)
-                phase = section_phase(problem_at(problem, f0), frequency[band[0] : band[1] + 1])
+                phase = section_phase(problem_at(reference, f0), frequency[band[0] : band[1] + 1])
                 mapping = ImpactMap(problem_at(problem, f0, phase=phase), bounds=bounds)
 
-                def start(mapping: ImpactMap = mapping, f0: float = f0, root: str = root, kind: str = kind) -> None:
-                    closed = solve_impact_orbit(mapping.problem, root=root)
-                    first = shoot(mapping, closed_form_state(mapping.problem, closed), mapping.parameters)
+                def start(mapping: ImpactMap = mapping, f0: float = f0, root: str = root, kind: str = kind, phase: float = phase) -> None:
+                    if bumper:  # the rigid twin's orbit, shot, then shot again on the bumper's map
+                        twin = ImpactMap(problem_at(reference, f0, phase=phase), bounds=bounds)
+                        guess = shoot(twin, closed_form_state(twin.problem, solve_impact_orbit(twin.problem, root=root)), twin.parameters).state
+                        first = shoot(mapping, guess, mapping.parameters)
+                        if found.known(f0, 1, first.impacts, float(orbit_measures(mapping, first).impulses.sum())):
+                            return  # the bumper's branch from the other root already passed through it
+                    else:
+                        closed = solve_impact_orbit(mapping.problem, root=root)
+                        first = shoot(mapping, closed_form_state(mapping.problem, closed), mapping.parameters)
                     branch = continue_branch(mapping, first, "frequency", settings)
                     label = found.add_branch(mapping, branch, kind)
                     maps.append((mapping, branch))

@@ -9,6 +9,7 @@ Dataset layout read here: see :mod:`vibroimpact.kinds.bifurcation.study` (``bran
 from __future__ import annotations
 
 import html
+import re
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +17,7 @@ import xarray as xr
 
 from vibroimpact.reporting.page import Section, Table, saved
 from vibroimpact.reporting.style import fmt
+from vibroimpact.kinds.bifurcation.bumper import bumper_answer, bumper_figure, convergence_table, has_bumpers, rigid_view
 from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, bifurcation_figures, branch_class, first_coordinate, flags as _flags, orbit_class, orbit_label as _orbit_label
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
 
@@ -274,13 +276,19 @@ class BifurcationPage:
     states_failures = True
 
     def __init__(self, dataset: xr.Dataset) -> None:
-        self.dataset = dataset
+        self.full = dataset
+        self.bumpers = has_bumpers(dataset)
+        self.dataset = rigid_view(dataset)  # the rigid stop's: what every part but the bumpers' draws
 
     def summary(self) -> str:
-        """The answer (:func:`headline`), then what was computed."""
+        """The answer (:func:`headline`; with bumpers, how their special points converge first), then what was
+        computed."""
         d = self.dataset
         stops = f"; stops: {d.attrs['stop_layout']}" if "stop_layout" in d.attrs else ""
-        return (f"{headline(d)}; {int(np.unique(d['branch'].values).size)} branches, {d.sizes['special_point']} special points, brute force at "
+        first = ""
+        if self.bumpers:
+            first = html.unescape(re.sub(r"<[^>]+>", "", bumper_answer(self.full))) + " Rigid stop: "
+        return (f"{first}{headline(d)}; {int(np.unique(d['branch'].values).size)} branches, {d.sizes['special_point']} special points, brute force at "
                 f"{d.sizes['frequency']} frequencies x {d.sizes['sweep']} directions for R = {', '.join(fmt(r, 'g') for r in d['restitution'].values)}{stops}")  # fmt: skip
 
     def sections(self, out: Path) -> list[Section]:
@@ -292,6 +300,9 @@ class BifurcationPage:
         tables = "".join(orbit_table(self.dataset, float(r)) for r in self.dataset["restitution"].values)
         answer = answer_text(self.dataset) + failure_text(self.dataset) + tables  # what failed right after the answer
         sections = [Section("Bifurcation diagrams", answer, [f for f in figures if f not in chart], [special_point_table(self.dataset)])]
+        if self.bumpers:  # the page opens with the bumpers' answer; the rigid stop's diagrams are its reference
+            words = bumper_answer(self.full) + "<p>The rigid stop's bifurcation diagrams, brute force and special points follow below, as the reference.</p>"
+            sections.insert(0, Section("Bumpers against the rigid stop", words, saved([bumper_figure(self.full)], out), [convergence_table(self.full)]))
         if chart:
             sections.append(Section("Two-parameter chart", "", chart))
         logs = [

@@ -8,6 +8,12 @@ base_motion, static}``, ``stops: [...]``). Every stop is rigid and shares one cl
 it) and one restitution: the diagrams' ``bifurcation.restitution`` (then no stop gives its own), or, without that
 key, the value every stop gives.
 
+``bifurcation.bumper: {frequency: [Omega_b / 2 pi, ...]}`` [Hz] adds, for each restitution and each bumper frequency,
+the branches of the same layout with every stop a Kelvin-Voigt bumper of that frequency and the loss factor whose
+collision restitution is R (corrected eq. 26), continued from the rigid stop's closed-form orbit on the bumper's exact
+stroboscopic map; the rigid stop's branches, brute force and special points stay the reference the bumpers' are
+measured against (``studies/bifurcation_bumper.yaml``). No chart with bumpers.
+
 Example (the shipped ``bifurcation``, shortened)::
 
     name: bifurcation
@@ -202,6 +208,8 @@ class BifurcationSettings:
         Continued branches.
     chart : ChartSettings or None
         The two-parameter chart (None: none).
+    bumper_frequencies : tuple of float
+        Omega_b / 2 pi of the bumpers whose branches are continued beside the rigid stop's [Hz] (empty: none).
     """
 
     low: float
@@ -211,6 +219,7 @@ class BifurcationSettings:
     brute_force: BruteForceSettings = BruteForceSettings()
     branches: BranchSettings = BranchSettings()
     chart: ChartSettings | None = None
+    bumper_frequencies: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         if not 0.0 < self.low < self.high:
@@ -231,7 +240,7 @@ class BifurcationSettings:
         return np.round(self.low + self.chart.frequency_step * np.arange(count), 10)
 
 #: Keys of the ``bifurcation`` section and of its parts.
-_KEYS = {"frequency", "restitution", "brute_force", "continuation", "chart"}
+_KEYS = {"frequency", "restitution", "brute_force", "continuation", "chart", "bumper"}
 _BRUTE_KEYS = {"step", "transient_periods", "strobes", "directions"}
 _BRANCH_KEYS = {"one_impact", "period_doubling", "grazing", "linear", "brute_force", "max_steps", "max_step"}
 _CHART_KEYS = {"restitution", "clearance", "kinds", "max_steps", "frequency_step", "clearance_num", "transient_periods", "strobes"}
@@ -269,6 +278,11 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
     brute = _settings(c, "bifurcation.brute_force", spec.get("brute_force", {}), _BRUTE_KEYS, _brute_values)
     branches = _settings(c, "bifurcation.continuation", spec.get("continuation", {}), _BRANCH_KEYS, _branch_values)
     chart = _settings(c, "bifurcation.chart", spec["chart"], _CHART_KEYS, _chart_values) if "chart" in spec else None
+    bumpers = _bumpers(c, spec["bumper"]) if "bumper" in spec else ()
+    if bumpers and "chart" in spec:
+        c.fail("bifurcation.chart", "a chart follows the rigid stop's special points only: remove it, or bifurcation.bumper")
+    if bumpers and restitution is not None and np.any(restitution <= 0.0):
+        c.fail("bifurcation.restitution", "R = 0 needs an infinitely damped bumper: allowed (0, 1] with bifurcation.bumper")
     if brute is not None and low is not None and high is not None and restitution is not None:
         if brute.step > high - low:
             c.fail("bifurcation.brute_force.step", f"{brute.step:g} Hz is out of range: allowed (0, {high - low:g}] (the band's width)")
@@ -282,7 +296,7 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
         raise SceneError(c.problems, source)
     assert system is not None and amplitude is not None and isinstance(name, str) and clearance is not None
     assert low is not None and high is not None and restitution is not None and brute is not None and branches is not None
-    settings = BifurcationSettings(low, high, tuple(float(r) for r in restitution), float(clearance), brute, branches, chart)
+    settings = BifurcationSettings(low, high, tuple(float(r) for r in restitution), float(clearance), brute, branches, chart, tuple(bumpers or ()))
     return Scene(
         name=name,
         description=description,
@@ -318,7 +332,7 @@ def _layout(c: Checker, doc: dict, system: Any, swept_restitution: bool) -> tupl
     for k, stop in enumerate(specs):
         entry = doc["stops"][k]
         if "bumper" in entry:
-            c.fail(f"stops[{k}].bumper", "a bifurcation study runs rigid stops (the exact engine's stroboscopic map): remove the bumper")
+            c.fail(f"stops[{k}].bumper", "a bifurcation study's stops are rigid; bumpers beside them are given by bifurcation.bumper: {frequency: [Hz, ...]}")
             ok = False
         if stop.clearance is None:
             c.fail(f"stops[{k}].clearance", "required: Delta [m] in (0, inf), the same for every stop (the chart varies it)")
@@ -343,6 +357,15 @@ def _layout(c: Checker, doc: dict, system: Any, swept_restitution: bool) -> tupl
     own = None if swept_restitution else np.array([specs[0].restitution])
     shared = tuple(dataclasses.replace(spec, clearance=None, restitution=None) for spec in specs)
     return shared, specs[0].clearance, own
+
+
+def _bumpers(c: Checker, value: Any) -> tuple[float, ...] | None:
+    """``bifurcation.bumper``: {frequency: Omega_b / 2 pi [Hz], a list (or grid) of values > 0}."""
+    spec = c.mapping("bifurcation.bumper", value, {"frequency"}, {"frequency"})
+    if "frequency" not in spec:
+        return None
+    grid = c.grid("bifurcation.bumper.frequency", spec["frequency"], 0.0, math.inf, False)
+    return None if grid is None else tuple(float(f) for f in grid)
 
 
 def _settings(c: Checker, key: str, value: Any, allowed: set[str], values: Any) -> Any:

@@ -30,6 +30,11 @@ One netCDF group cannot hold ``frequency`` both as the brute force's dimension a
 ``branch_point``, nor ``restitution`` as a dimension and a coordinate of ``special_point``: the branch and special
 point coordinates carry the prefix of their dimension.
 
+With ``bifurcation.bumper`` the branch and special points of every (restitution, bumper frequency) follow the rigid
+stop's, each set continued on its own (stops that are Kelvin-Voigt bumpers of that Omega_b and the loss factor of
+R), and both dimensions gain a coordinate ``branch_bumper_frequency`` / ``special_point_bumper_frequency`` [Hz]
+(inf for the rigid stop's points); the brute force is the rigid stop's.
+
 The scene's layout (the paper's named form or the general one: matrices, a load on any coordinate or a base motion,
 a list of stops) becomes one general :class:`~vibroimpact.model.problem.ImpactProblem` per restitution
 (:func:`scene_problem`); every part of the study runs on it. The dataset's attributes describe that structure
@@ -38,10 +43,12 @@ a list of stops) becomes one general :class:`~vibroimpact.model.problem.ImpactPr
 
 from __future__ import annotations
 
+import math
 
 import numpy as np
 import xarray as xr
 
+from vibroimpact.model.contact import loss_factor_from_restitution
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
@@ -70,14 +77,18 @@ REPORT_FIGURES = 3
 BRUTE_FACTOR = 1.5
 
 
-def scene_problem(scene: Scene, restitution: float, clearance: float | None = None) -> ImpactProblem:
+def scene_problem(scene: Scene, restitution: float, clearance: float | None = None, bumper_frequency: float | None = None) -> ImpactProblem:
     """The general problem of a bifurcation scene: its structure (the named system's matrices for the paper's form),
-    every stop rigid with ``restitution`` [-] and the scene's clearance (or ``clearance`` [m]), and its harmonic load
-    at the band's lower frequency (each part of the study moves it in frequency)."""
+    every stop rigid with ``restitution`` [-] (or, given ``bumper_frequency`` [Hz], a Kelvin-Voigt bumper of that
+    Omega_b / 2 pi whose loss factor gives that restitution) and the scene's clearance (or ``clearance`` [m]), and its
+    harmonic load at the band's lower frequency (each part of the study moves it in frequency)."""
     settings = scene.settings
     assert settings is not None
     delta = settings.clearance if clearance is None else float(clearance)
-    stops = build_stops(scene.stop_specs, False, float(restitution), delta)
+    if bumper_frequency is None:
+        stops = build_stops(scene.stop_specs, False, float(restitution), delta)
+    else:
+        stops = build_stops(scene.stop_specs, True, float(restitution), delta, float(bumper_frequency), loss_factor_from_restitution(float(restitution)))
     return ImpactProblem(scene.system.structure, stops, scene.load_spec.force(scene.amplitude, settings.low))
 
 
@@ -113,17 +124,23 @@ class BifurcationStudy:
                     result = swept[i * len(brute.directions) + j]
                     seeds += sweep_seeds(settings.frequency, result["period"], result["impacts"], result["state"], j)
             continuation.append(BranchCase(scene_problem(scene, r), settings.low, settings.high, options, tuple(seeds)))
-        say(f"continuing the branches of R = {', '.join(f'{r:g}' for r in settings.restitution)}")
+        bumpers = [(r, fb) for r in settings.restitution for fb in settings.bumper_frequencies]
+        plain = tuple((k, False if k == "brute_force" else v) for k, v in options)  # no brute force of a bumper
+        continuation += [BranchCase(scene_problem(scene, r, bumper_frequency=fb), settings.low, settings.high, plain) for r, fb in bumpers]
+        say(f"continuing the branches of R = {', '.join(f'{r:g}' for r in settings.restitution)}" + (f" and of bumpers of {', '.join(f'{fb:g}' for fb in settings.bumper_frequencies)} Hz" if bumpers else ""))
         results = numbered_across(runner.map(continuation))  # the dataset's labels
-        for case, result in zip(continuation, results):
-            _say_notes(say, f"R = {case.restitution:g}", result)
+        labels = [f"R = {r:g}" for r in settings.restitution] + [f"R = {r:g}, bumper {fb:g} Hz" for r, fb in bumpers]
+        for label, result in zip(labels, results):
+            _say_notes(say, label, result)
         if chart_result is not None:
             same = [result for r, result in zip(settings.restitution, results) if np.isclose(r, chart.restitution)]
             labels = chart_labels(chart_result, same[0] if same else None)
             chart_result = dict(chart_result, notes=np.array([relabel(str(note), labels) for note in chart_result["notes"]], dtype=str))
             _say_notes(say, f"chart {chart.restitution:g}", chart_result)
             results = [*results, chart_result]
-        data = _branches(results[: len(settings.restitution)], settings.restitution, scene.coordinates, scene.load_spec.base_motion)
+        sets = len(settings.restitution) + len(bumpers)
+        data = _branches(results[:sets], settings.restitution + tuple(r for r, _fb in bumpers), scene.coordinates, scene.load_spec.base_motion,
+                         (None,) * len(settings.restitution) + tuple(fb for _r, fb in bumpers) if bumpers else ())  # fmt: skip
         data = data.merge(_brute(swept[: len(sweeps)], scene, brute.directions, brute.strobes))
         if chart is not None:
             data = data.merge(_chart(results[-1], swept[len(sweeps) :], chart.clearances, settings.chart_frequency, brute.directions))
@@ -145,6 +162,7 @@ class BifurcationStudy:
         per_period = costs.per_period_cost("exact", 0.0) * BRUTE_FACTOR
         periods = settings.frequency.size * len(settings.restitution) * len(brute.directions) * (brute.transient_periods + brute.strobes)
         continuation = [CONTINUATION_SECONDS if settings.branches.brute_force else CLOSED_FORM_SECONDS] * len(settings.restitution)
+        continuation += [CLOSED_FORM_SECONDS] * (len(settings.restitution) * len(settings.bumper_frequencies))
         chart_seconds = 0.0
         if settings.chart is not None:
             chart = settings.chart
@@ -182,6 +200,9 @@ def _tallies(scene: Scene, results: list[CaseResult], swept: list[CaseResult]) -
         counted += tallies(results[i], where)
         sweeps = swept[i * len(directions) : (i + 1) * len(directions)]
         counted.append(sweep_tally("sweep", where, sweeps, [f"sweeping {d}" for d in directions], settings.frequency))
+    bumpers = [(r, fb) for r in settings.restitution for fb in settings.bumper_frequencies]
+    for k, (r, fb) in enumerate(bumpers):
+        counted += tallies(results[len(settings.restitution) + k], f"R = {r:g}, bumper {fb:g} Hz")
     if chart is not None:
         where = f"R = {chart.restitution:g}"
         counted += tallies(results[-1], where)
@@ -199,13 +220,18 @@ def coordinate_attributes(key: str, name: str, base_motion: bool = False) -> dic
     return attrs
 
 
-def _branches(results: list[CaseResult], restitutions: tuple[float, ...], coordinates: tuple[str, ...], base_motion: bool) -> xr.Dataset:
-    """branch_point and special_point variables of every restitution (``results`` :func:`numbered` across them)."""
+def _branches(results: list[CaseResult], restitutions: tuple[float, ...], coordinates: tuple[str, ...], base_motion: bool, bumpers: tuple[float | None, ...] = ()) -> xr.Dataset:
+    """branch_point and special_point variables of every branch set (``results`` :func:`numbered` across them), each
+    of restitution ``restitutions[i]`` and, given ``bumpers``, bumpers of ``bumpers[i]`` Hz (None: the rigid stop)."""
     points: dict[str, list] = {}
     specials: dict[str, list] = {}
     size = len(coordinates)
-    for r, result in zip(restitutions, results):
+    for i, (r, result) in enumerate(zip(restitutions, results)):
         n = result["frequency"].size
+        if bumpers:
+            fb = math.inf if bumpers[i] is None else float(bumpers[i])
+            points.setdefault("bumper", []).append(np.full(n, fb))
+            specials.setdefault("bumper", []).append(np.full(result["sp_frequency"].size, fb))
         points.setdefault("branch", []).append(result["branch"])
         points.setdefault("restitution", []).append(np.full(n, r))
         for name in ("origin", "frequency", "amplitudes", "impulse", "floquet_modulus", "stable", "impacts", "period", "multipliers_real", "multipliers_imag", "velocities"):
@@ -223,6 +249,9 @@ def _branches(results: list[CaseResult], restitutions: tuple[float, ...], coordi
     bp, sp = ("branch_point",), ("special_point",)
     amplitudes = p["amplitudes"].reshape(-1, size)
     first = coordinates[0]
+    extra = {}
+    if bumpers:
+        extra = {"branch_bumper_frequency": (bp, p["bumper"], a["branch_bumper_frequency"]), "special_point_bumper_frequency": (sp, s["bumper"], a["special_point_bumper_frequency"])}
     return xr.Dataset(
         {
             **{f"{c}_amplitude": (bp, amplitudes[:, i], coordinate_attributes("x1_amplitude", c, base_motion)) for i, c in enumerate(coordinates)},
@@ -253,6 +282,7 @@ def _branches(results: list[CaseResult], restitutions: tuple[float, ...], coordi
             "special_point_frequency": (sp, s["frequency"], a["special_point_frequency"]),
             "special_point_restitution": (sp, s["restitution"], a["special_point_restitution"]),
             "special_point_branch": (sp, s["branch"].astype(np.int32), a["special_point_branch"]),
+            **extra,
         },
     )
 
@@ -332,6 +362,15 @@ def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult])
         "method_branches": "pseudo-arclength continuation of fixed points of the exact stroboscopic map (compiled exact engine, exact Jacobians), started from the closed-form impact orbit at both roots of eq. 16 (one impact per period; two on a symmetric two-sided stop; none where the layout has no closed form), at period doublings, at grazing points and from every periodic brute-force attractor no other branch passes through",
         "method_brute_force": f"compiled exact engine, stepped sweeps carrying the end state; strobes compared over periods 1-{MAX_PERIOD}, else the Lyapunov exponent from the exact Jacobians",
     }
+    bumpers = [(r, fb) for r in settings.restitution for fb in settings.bumper_frequencies]
+    if bumpers:
+        start = len(settings.restitution)
+        lines = [f"R = {r:g}, bumper {fb:g} Hz: {note}" for (r, fb), result in zip(bumpers, results[start : start + len(bumpers)]) for note in result["notes"]]
+        attrs["continuation_notes"] = "\n".join([attrs["continuation_notes"], *lines])
+        attrs["bumper_frequencies_Hz"] = np.array(settings.bumper_frequencies)
+        attrs["method_bumper"] = ("the same layout with every stop a Kelvin-Voigt bumper of each Omega_b / 2 pi and the loss factor whose collision restitution is R "
+                                  "(corrected eq. 26): branches started from the rigid stop's closed-form orbit shot on the bumper's map, continued on the exact "
+                                  "stroboscopic map of the engine that gives exact Jacobians for bumpers; grazing: contact onset at tangency")  # fmt: skip
     if settings.chart is not None:
         attrs["chart_restitution"] = settings.chart.restitution
         attrs["chart_notes"] = "\n".join(str(n) for n in results[-1]["notes"])

@@ -1,0 +1,257 @@
+"""The bumper part of a bifurcation page: how the branches of Kelvin-Voigt bumpers (``bifurcation.bumper``) and their
+special points converge to the rigid stop's as the bumper stiffens.
+
+Dataset layout read here: :mod:`vibroimpact.kinds.bifurcation.study` with ``branch_bumper_frequency`` and
+``special_point_bumper_frequency`` [Hz] (inf: the rigid stop). Each special point of the rigid stop's closed-form
+branches (fold, period doubling, Neimark-Sacker, grazing) is followed from the stiffest bumper to the softest: the
+stiffest bumper's nearest point of the same kind on its closed-form branches within :data:`MATCH_WINDOW` of the rigid
+one, then each softer bumper's point within :data:`GROWTH` times the previous distance times the ratio of the bumper
+frequencies (at least :data:`MATCH_FLOOR`) of the previous match: a chain along which the distance may grow at most
+like first order, doubled. A match must be clear: the chain's nearest candidate, at most :data:`SEPARATION` times as
+far as its next, and nearer to this chain's previous match than to any other chain's of the kind; where points of
+one kind crowd (the Neimark-Sacker points of 38-40 Hz at 250 Hz and 1 kHz) the chain stops and the table says
+"ambiguous" (which point continues which would take a continuation in Omega_b). The observed order of convergence
+between two bumper frequencies fa < fb is p = ln(|e_a| / |e_b|) / ln(fb / fa), e the difference from the rigid
+stop's frequency (p = 1: first order in 1/Omega_b). A difference below :data:`SAME_POINT` of the frequency is the same
+point (the contact onset at tangency of the one-contact orbit is where the linear orbit touches the surface, whatever
+the bumper).
+"""
+
+from __future__ import annotations
+
+import html
+import math
+
+import numpy as np
+import xarray as xr
+
+from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, ORBIT_PALETTE, SPECIAL_MARKERS, first_coordinate, flags
+from vibroimpact.kinds.bifurcation.scene import coordinate_label
+from vibroimpact.reporting.page import DrawnFigure, Table
+from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure
+
+__all__ = ["has_bumpers", "rigid_view", "bumper_frequencies", "convergence_rows", "convergence_table", "bumper_answer", "bumper_figure", "MATCH_WINDOW", "SAME_POINT"]
+
+#: Largest distance [Hz] of the stiffest bumper's special point from the rigid stop's it is matched with.
+MATCH_WINDOW = 0.5
+#: Each softer bumper's match lies within GROWTH x (frequency ratio) x the previous distance of the previous match [-] ...
+GROWTH = 2.0
+#: ... or within this [Hz], whichever is larger.
+MATCH_FLOOR = 0.05
+#: A match is clear when the next candidate is at least 1 / SEPARATION times as far from the previous match [-].
+SEPARATION = 0.5
+#: A bumper's special point within this of the rigid stop's, relative, is the same point [-] (the location's accuracy).
+SAME_POINT = 1e-9
+#: Colour of the rigid stop's branches; the bumpers take :data:`ORBIT_PALETTE` in order of frequency.
+RIGID_COLOUR = "k"
+#: Line colours of the convergence panel, one per special point (Okabe-Ito's and grey; black is the rigid stop's).
+CONVERGENCE_COLOURS = ("#0072B2", "#E69F00", "#009E73", "#CC79A7", "#56B4E9", "#D55E00", "#999999", "#F0E442")
+#: Origins of the branches started from the closed form (flags of ``branch_origin``).
+_CLOSED = ("one_impact", "two_impacts")
+
+
+def has_bumpers(dataset: xr.Dataset) -> bool:
+    """Does the dataset hold bumper branches (``branch_bumper_frequency``)?"""
+    return "branch_bumper_frequency" in dataset.coords or "branch_bumper_frequency" in dataset
+
+
+def rigid_view(dataset: xr.Dataset) -> xr.Dataset:
+    """The dataset with the rigid stop's branch and special points only (what the rest of the page draws)."""
+    if not has_bumpers(dataset):
+        return dataset
+    points = np.flatnonzero(np.isinf(dataset["branch_bumper_frequency"].values))
+    specials = np.flatnonzero(np.isinf(dataset["special_point_bumper_frequency"].values))
+    return dataset.isel(branch_point=points, special_point=specials).drop_vars(["branch_bumper_frequency", "special_point_bumper_frequency"])
+
+
+def bumper_frequencies(dataset: xr.Dataset) -> list[float]:
+    """Omega_b / 2 pi of the bumpers [Hz], increasing."""
+    values = dataset["branch_bumper_frequency"].values
+    return sorted(float(f) for f in np.unique(values[np.isfinite(values)]))
+
+
+def _closed_form_specials(dataset: xr.Dataset, restitution: float, bumper: float) -> list[tuple[str, float]]:
+    """(kind, frequency [Hz]) of the special points on the closed-form branches of one set (bumper inf: rigid)."""
+    origins = flags(dataset["branch_origin"])
+    codes = [origins.index(k) for k in _CLOSED if k in origins]
+    closed = set(dataset["branch"].values[np.isin(dataset["branch_origin"].values, codes)].tolist())
+    kinds = flags(dataset["special_point_kind"])
+    fb = dataset["special_point_bumper_frequency"].values
+    chosen = np.isclose(dataset["special_point_restitution"].values, restitution) & ((fb == bumper) | (np.isinf(fb) & math.isinf(bumper)))
+    out = []
+    for k in np.flatnonzero(chosen):
+        if int(dataset["special_point_branch"].values[k]) in closed and int(dataset["special_point_period_multiplicity"].values[k]) == 1:
+            out.append((kinds[int(dataset["special_point_kind"].values[k])], float(dataset["special_point_frequency"].values[k])))
+    return sorted(out, key=lambda item: item[1])
+
+
+def convergence_rows(dataset: xr.Dataset, restitution: float) -> list[dict[str, object]]:
+    """One row per special point of the rigid stop's closed-form branches at ``restitution``: its kind, frequency
+    [Hz], the matched frequency at each bumper (module docstring; NaN: none, or ``ambiguous`` there: more than one
+    candidate, or one another chain also reaches), the differences [Hz] and the observed orders between successive
+    bumper frequencies (NaN where a difference is missing or the same point)."""
+    bumpers = bumper_frequencies(dataset)
+    sets = {fb: _closed_form_specials(dataset, restitution, fb) for fb in bumpers}
+    rigid = _closed_form_specials(dataset, restitution, math.inf)
+    matched = np.full((len(rigid), len(bumpers)), np.nan)
+    ambiguous = np.zeros((len(rigid), len(bumpers)), dtype=bool)
+    previous = np.array([f for _k, f in rigid])
+    window = np.full(len(rigid), MATCH_WINDOW)
+    alive = np.ones(len(rigid), dtype=bool)
+    for i in range(len(bumpers) - 1, -1, -1):  # the stiffest first, every chain at once
+        near = [sorted((f for k, f in sets[bumpers[i]] if k == kind and abs(f - previous[n]) <= window[n]), key=lambda f, n=n: abs(f - previous[n])) if alive[n] else []
+                for n, (kind, _f0) in enumerate(rigid)]  # fmt: skip
+        for n, (kind, f0) in enumerate(rigid):
+            if not alive[n]:
+                continue
+            clear = bool(near[n]) and (len(near[n]) == 1 or abs(near[n][0] - previous[n]) <= SEPARATION * abs(near[n][1] - previous[n]))
+            rivals = [m for m in range(len(rigid)) if alive[m] and rigid[m][0] == kind]
+            if clear and min(rivals, key=lambda m: abs(previous[m] - near[n][0])) == n:  # its nearest, and nearest to it
+                matched[n, i] = near[n][0]
+            else:  # none, or no clear one: the chain stops here
+                ambiguous[n, i], alive[n] = bool(near[n]), False
+        for n, (_kind, f0) in enumerate(rigid):
+            if alive[n] and np.isfinite(matched[n, i]):
+                ratio = bumpers[i] / bumpers[i - 1] if i else 1.0
+                previous[n], window[n] = matched[n, i], max(MATCH_FLOOR, GROWTH * ratio * abs(matched[n, i] - f0))
+    rows = []
+    for n, (kind, f0) in enumerate(rigid):
+        errors = matched[n] - f0
+        found = np.isfinite(errors)
+        same = found & (np.abs(np.nan_to_num(errors)) <= SAME_POINT * f0)
+        orders = [
+            math.log(abs(errors[i]) / abs(errors[i + 1])) / math.log(bumpers[i + 1] / bumpers[i]) if np.all(np.isfinite(errors[i : i + 2])) and not same[i : i + 2].any() else math.nan
+            for i in range(len(bumpers) - 1)
+        ]  # fmt: skip
+        rows.append({"kind": kind, "rigid": f0, "bumpers": list(matched[n]), "errors": errors, "same": bool(found.any() and np.all(same[found])), "orders": orders,
+                     "ambiguous": list(ambiguous[n])})  # fmt: skip
+    return rows
+
+
+def _name(kind: str) -> str:
+    """The page's name of a kind of special point; grazing is the bumper's contact onset at tangency."""
+    return "grazing / contact onset at tangency" if kind == "grazing" else KIND_NAMES.get(kind, kind)
+
+
+def convergence_table(dataset: xr.Dataset) -> Table:
+    """Per restitution and special point: the rigid stop's frequency, each bumper's and its difference, and the
+    observed orders of convergence."""
+    bumpers = bumper_frequencies(dataset)
+    heads = ["R", "special point", "rigid stop [Hz]"] + [f"{fmt(fb, 'g')} Hz bumper [Hz] (difference)" for fb in bumpers]
+    heads += [f"order {fmt(a, 'g')} → {fmt(b, 'g')} Hz" for a, b in zip(bumpers[:-1], bumpers[1:])]
+    body = []
+    for r in dataset["restitution"].values:
+        for row in convergence_rows(dataset, float(r)):
+            cells = [fmt(float(r), "g"), _name(str(row["kind"])), fmt(float(row["rigid"]), ".4f")]
+            for f, e, unclear in zip(row["bumpers"], row["errors"], row["ambiguous"]):
+                cells.append(("ambiguous" if unclear else "not found") if not math.isfinite(f) else f"{fmt(f, '.4f')} ({'+' if e >= 0 else '−'}{fmt(abs(e), '.2e')})")
+            cells += ["same point" if row["same"] else ("—" if not math.isfinite(p) else fmt(p, ".2f")) for p in row["orders"]]
+            body.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
+    header = "".join(f"<th>{html.escape(h)}</th>" for h in heads)
+    return Table("How the bumpers' special points converge to the rigid stop's", f"<table><tr>{header}</tr>{''.join(body)}</table>")
+
+
+def _span(values: list[float]) -> str:
+    """``0.91-0.98``, or one value when they agree to the digits shown."""
+    low, high = fmt(min(values), ".2f"), fmt(max(values), ".2f")
+    return low if low == high else f"{low}-{high}"
+
+
+def bumper_answer(dataset: xr.Dataset) -> str:
+    """The answer (HTML), per restitution: the observed orders of convergence between the two stiffest bumpers by kind
+    of special point, the largest shift at the softest bumper, the contact onsets at tangency that are the rigid
+    stop's grazing points, and how many rigid points have no counterpart at some bumper (the table has each)."""
+    bumpers = bumper_frequencies(dataset)
+    parts = []
+    for r in dataset["restitution"].values:
+        rows = convergence_rows(dataset, float(r))
+        words = []
+        if len(bumpers) > 1:
+            by_kind = {}
+            for row in rows:
+                if not row["same"] and math.isfinite(row["orders"][-1]):
+                    by_kind.setdefault(str(row["kind"]), []).append(float(row["orders"][-1]))
+            if by_kind:
+                every = [p for values in by_kind.values() for p in values]
+                listed = "; ".join(f"{_name(k)} {', '.join(fmt(p, '.2f') for p in sorted(v))}" for k, v in by_kind.items())
+                words.append(f"the special points of the one-impact branches move to the rigid stop's as the bumper stiffens: between the "
+                             f"{fmt(bumpers[-2], 'g')} Hz and {fmt(bumpers[-1], 'g')} Hz bumpers their observed order of convergence in 1/Omega_b is "
+                             f"{_span(every)} ({listed}; 1 is first order)")  # fmt: skip
+        shifts = [(abs(float(row["errors"][0])), row) for row in rows if math.isfinite(float(row["errors"][0])) and not row["same"]]
+        if shifts:
+            size, row = max(shifts, key=lambda item: item[0])
+            words.append(f"the {fmt(bumpers[0], 'g')} Hz bumper moves them by up to {fmt(size, '.3g')} Hz (the {_name(str(row['kind']))} at {fmt(float(row['rigid']), '.3f')} Hz)")
+        same = [row for row in rows if row["same"]]
+        if same:
+            words.append(f"the contact onsets at tangency at {', '.join(fmt(float(row['rigid']), '.3f') for row in same)} Hz, where the one-impact orbit's entry speed "
+                         f"vanishes on the linear orbit touching the surface, are the rigid stop's grazing points for every bumper that has them (within {fmt(SAME_POINT, 'g')} relative)")  # fmt: skip
+        missing = [row for row in rows if not np.all(np.isfinite(np.asarray(row["errors"], dtype=float)))]
+        if missing:
+            words.append(f"{len(missing)} of the rigid stop's {len(rows)} special points have no counterpart at some bumper (table)")
+        parts.append(f"<p><b>R = {fmt(float(r), 'g')}, bumpers of {', '.join(fmt(fb, 'g') for fb in bumpers)} Hz against the rigid stop</b>: " + "; ".join(words) + ".</p>")
+    return "".join(parts)
+
+
+def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
+    """Left: the closed-form branches of the rigid stop and of every bumper, the first coordinate's amplitude against
+    frequency; right: each special point's distance from the rigid stop's against 1 / Omega_b (log-log, a slope-1
+    line for reference)."""
+    name = first_coordinate(dataset)
+    label = coordinate_label(name)
+    bumpers = bumper_frequencies(dataset)
+    colours = {math.inf: RIGID_COLOUR} | {fb: ORBIT_PALETTE[i % len(ORBIT_PALETTE)] for i, fb in enumerate(bumpers)}
+    fig, (left, right) = new_figure(2, panel_height=4.6, columns=2, legend_rows=legend_rows(len(bumpers) + 16, 4))
+    origins = flags(dataset["branch_origin"])
+    codes = [origins.index(k) for k in _CLOSED if k in origins]
+    fb_points = dataset["branch_bumper_frequency"].values
+    for fb in [math.inf, *bumpers]:
+        chosen = np.isin(dataset["branch_origin"].values, codes) & ((fb_points == fb) | (np.isinf(fb_points) & math.isinf(fb)))
+        for branch in np.unique(dataset["branch"].values[chosen]):
+            index = np.flatnonzero(chosen & (dataset["branch"].values == branch))
+            f, amp, stable = dataset["branch_frequency"].values[index], dataset[f"{name}_amplitude"].values[index] * 1e3, dataset["stable"].values[index] == 1
+            change = np.flatnonzero(np.diff(stable.astype(int))) + 1
+            for piece in np.split(np.arange(f.size), change):
+                run = np.append(piece, piece[-1] + 1) if piece.size and piece[-1] + 1 < f.size else piece
+                if run.size:
+                    left.plot(f[run], amp[run], color=colours[fb], **(STABLE_STYLE if stable[piece[0]] else UNSTABLE_STYLE))
+        left.plot([], [], color=colours[fb], lw=2, label="rigid stop" if math.isinf(fb) else f"bumper {fmt(fb, 'g')} Hz")
+    kinds = flags(dataset["special_point_kind"])
+    sp_fb = dataset["special_point_bumper_frequency"].values
+    for code, kind in enumerate(kinds):
+        for fb in [math.inf, *bumpers]:
+            chosen = (dataset["special_point_kind"].values == code) & ((sp_fb == fb) | (np.isinf(sp_fb) & math.isinf(fb)))
+            if chosen.any():
+                left.scatter(dataset["special_point_frequency"].values[chosen], dataset[f"special_point_{name}_amplitude"].values[chosen] * 1e3, marker=SPECIAL_MARKERS.get(kind, "x"),
+                             s=46, facecolor="none", edgecolor=colours[fb], lw=1.3, zorder=5)  # fmt: skip
+        left.scatter([], [], marker=SPECIAL_MARKERS.get(kind, "x"), s=46, facecolor="none", edgecolor="0.3", label=_name(kind))
+    inverse = 1.0 / np.array(bumpers)
+    drawn = 0
+    for r in dataset["restitution"].values:
+        for row in convergence_rows(dataset, float(r)):
+            errors = np.abs(np.asarray(row["errors"], dtype=float))
+            if row["same"] or np.isfinite(errors).sum() < 2:
+                continue
+            right.plot(inverse, errors, marker=SPECIAL_MARKERS.get(str(row["kind"]), "x"), color=CONVERGENCE_COLOURS[drawn % len(CONVERGENCE_COLOURS)], lw=1.4, mfc="none", ms=7,
+                       label=f"{KIND_NAMES.get(str(row['kind']), str(row['kind']))} at {fmt(float(row['rigid']), '.2f')} Hz")  # fmt: skip
+            drawn += 1
+    if drawn:
+        errors = [np.abs(np.asarray(row["errors"], dtype=float)) for r in dataset["restitution"].values for row in convergence_rows(dataset, float(r)) if not row["same"]]
+        middle = float(np.exp(np.nanmedian(np.log([e[-1] for e in errors if np.isfinite(e[-1])]))))
+        right.plot(inverse, middle * inverse / inverse[-1], color="k", ls=":", lw=2.0, label="slope 1 (first order in 1/Omega_b)")
+        right.set_xscale("log")
+        right.set_yscale("log")
+        right.set_xticks(inverse, [f"1/{fmt(fb, 'g')}" for fb in bumpers])
+        right.minorticks_off()
+    finish_axes(left, "excitation frequency [Hz]", f"|{label}| fundamental [mm]", f"{label} amplitude: one-impact branches, rigid stop and bumpers")
+    finish_axes(right, "1 / (Omega_b / 2 pi) [1/Hz]", "|special point's frequency − rigid stop's| [Hz]", "convergence to the rigid stop's special points")
+    figure_legend(fig, [left, right], columns=4)
+    caption = (
+        f"Left: the branches started from the closed form (one impact per period) of the rigid stop (black) and of Kelvin-Voigt bumpers of "
+        f"{', '.join(fmt(fb, 'g') for fb in bumpers)} Hz ({', '.join(['blue', 'orange', 'green', 'pink'][: len(bumpers)])}), each with the loss factor whose "
+        f"collision restitution is R, Delta = {fmt(float(dataset['clearance']) * 1e3, 'g')} mm: the {label} fundamental, solid where stable, dashed where "
+        "unstable; open markers in the branch's colour: its special points. Right: the distance of each special point of the bumpers' branches from the "
+        "rigid stop's against 1 / (Omega_b / 2 pi) [1/Hz], log-log, one colour per special point (legend: its kind and the rigid stop's frequency), "
+        "each followed from the stiffest bumper (the table's matching); the dotted black line has slope 1 (first-order convergence). The contact onsets at tangency, the same points for every bumper, and points found at one bumper only "
+        "are not drawn there."
+    )
+    return DrawnFigure(fig, "bumper_convergence", "One-impact branches of the bumpers and of the rigid stop, and how their special points converge", caption)
