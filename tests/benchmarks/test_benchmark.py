@@ -125,8 +125,9 @@ def test_compliant_cvode_is_an_independent_integrator_of_the_same_model(system: 
 
 @pytest.mark.timeout(120)
 def test_accuracy_benchmark_with_compliant_and_swept_cases(system: TwoDofSystem) -> None:
-    """Compliant methods are measured against CVODE Adams at rtol 1e-13, rigid ones against exact; X1 errors shrink
-    with the tolerance; a swept case runs only the compliant model; the ladder ranks the models."""
+    """Compliant methods are measured against the bumper's closed form (compliant_exact) on a stepped case and against
+    CVODE Adams at rtol 1e-13 on a swept one (no closed form), rigid ones against exact; X1 errors shrink with the
+    tolerance; a swept case runs only the compliant model; the ladder ranks the models."""
     from vibroimpact.kinds.benchmark.study import loosest_tolerance
     from vibroimpact.kinds.benchmark.scene import LadderSettings
     from vibroimpact.model.excitation import SweptSine
@@ -140,14 +141,24 @@ def test_accuracy_benchmark_with_compliant_and_swept_cases(system: TwoDofSystem)
         BenchmarkCase("swept", problem, "rest", 0, bumper=bumper(250.0), sweep=SweptSine(PAPER_AMPLITUDE, 24.0, 24.3, 0.1), sample_rate=1000.0),
     ]
     ladder = LadderSettings(25.0, 0.2, PAPER_CLEARANCE, (1000.0,), 1e-8, 1, problem, (bumper(1000.0),))
-    settings = BenchmarkSettings(methods=("momentary_adams", "compliant_ida", "solve_ivp_DOP853"), tolerances=(1e-4, 1e-7, 1e-10), repeats=1, ladder=ladder)
+    settings = BenchmarkSettings(methods=("momentary_adams", "compliant_ida", "compliant_exact", "solve_ivp_DOP853"), tolerances=(1e-4, 1e-7, 1e-10), repeats=1, ladder=ladder)
     data = run_benchmark(cases, settings, progress=False)
     for case in ("stepped", "swept"):
         error = data["x1_error"].sel(case=case, engine="compliant_ida").values
         assert error[2] < error[0] / 100 and error[2] < 1e-7, error
     assert np.all(np.isnan(data["wall_time"].sel(case="swept", engine="momentary_adams").values))  # no rigid model on a sweep
     assert np.all(np.isfinite(data["wall_time"].sel(case="swept", engine="solve_ivp_DOP853").values))  # the compliant model through solve_ivp
-    assert float(data["reference_impacts"].sel(case="stepped", reference="compliant_cvode_adams")) == 10
+    # the stepped bumper's reference is its closed form, the swept one's CVODE Adams
+    references = data["reference_impacts"]
+    assert float(references.sel(case="stepped", reference="compliant_exact")) == 10 and np.isnan(float(references.sel(case="stepped", reference="compliant_cvode_adams")))
+    assert np.isnan(float(references.sel(case="swept", reference="compliant_exact"))) and float(references.sel(case="swept", reference="compliant_cvode_adams")) > 0
+    # against the closed form, IDA's error is its own: it falls with rtol to below 1e-8 at 1e-10 (CVODE Adams at 1e-13
+    # as the reference would leave compliant_exact an error of its own, ~1e-11: here it is the reference, error 0)
+    ida = data["x1_error"].sel(case="stepped", engine="compliant_ida").values
+    assert ida[2] < 1e-8 and ida[2] < ida[0] / 1e3, ida
+    closed = data.sel(case="stepped", engine="compliant_exact")
+    assert np.all(closed["x1_error"].values < 1e-15) and np.all(closed["final_state_error"].values < 1e-15)
+    assert np.all(np.isnan(data["wall_time"].sel(case="swept", engine="compliant_exact").values))  # a chirp has no closed form
     rtol, wall = loosest_tolerance(data, "stepped", "momentary_adams", 1e-3)
     assert rtol == 1e-4 and wall > 0  # exact: a value of the tolerance grid
     assert np.isnan(loosest_tolerance(data, "stepped", "momentary_adams", 1e-30)[0])

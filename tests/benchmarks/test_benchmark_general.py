@@ -96,7 +96,8 @@ def test_the_paper_layout_as_matrices_gives_the_named_forms_benchmark() -> None:
 
 def frame_benchmark(**changes: Any) -> dict[str, Any]:
     """The frame at 8.5 Hz, started on its stable symmetric two-impact orbit (largest |Floquet multiplier| 0.88), the
-    stops' own R and Delta, a 1 kHz bumper from the case; CVODE Adams at the compliant reference's own rtol 1e-13."""
+    stops' own R and Delta, a 1 kHz bumper from the case; CVODE Adams at rtol 1e-6 and 1e-13 against the bumpers' closed
+    form."""
     benchmark: dict[str, Any] = {
         "duration": 1.0,
         "methods": ["momentary_adams", "compliant_cvode_adams"],
@@ -117,16 +118,18 @@ def frame_run() -> xr.Dataset:
 
 @pytest.mark.timeout(120)
 def test_the_frame_benchmark_measures_floor1_against_its_references(frame_run: xr.Dataset) -> None:
-    """Variables named after the first coordinate (floor1); the compliant reference run as a method at its own
-    tolerance reproduces itself (every error exactly 0); the exact reference's |floor1| fundamental over the run is
-    the closed form's (started on it: 1e-7, measured 3e-8); momentary at rtol 1e-6 within 1e-5, no impact missed."""
+    """Variables named after the first coordinate (floor1); the compliant methods are measured against the two bumpers'
+    closed form (compliant_exact): CVODE Adams at rtol 1e-13 finds its contacts and agrees with it to 1e-11 in the
+    floor1 fundamental and the contact times [s] and to 1e-9 in impulses (measured 8.8e-14, 1.3e-13 s, 8.9e-12); the exact
+    reference's |floor1| fundamental over the run is the closed form's (started on it: 1e-7, measured 3e-8); momentary
+    at rtol 1e-6 within 1e-5, no impact missed."""
     ds = frame_run
     assert {"floor1_error", "reference_floor1", "ladder_floor1_amplitude", "ladder_floor1_difference"} <= set(ds.data_vars)
     assert "x1_error" not in ds and "floor1 fundamental" in ds["floor1_error"].attrs["long_name"]
-    itself = ds.sel(case="two_impact", engine="compliant_cvode_adams", rtol=1e-13)
-    for name in ("floor1_error", "impact_time_error", "impulse_error", "missed_impacts", "extra_impacts"):
-        assert float(itself[name]) == 0.0, name  # exact: the reference's own run, repeated
-    assert int(itself["impacts"]) == int(ds["reference_impacts"].sel(case="two_impact", reference="compliant_cvode_adams")) >= 14  # two per period
+    tight = ds.sel(case="two_impact", engine="compliant_cvode_adams", rtol=1e-13)
+    assert float(tight["floor1_error"]) < 1e-11 and float(tight["impact_time_error"]) < 1e-11 and float(tight["impulse_error"]) < 1e-9
+    assert int(tight["missed_impacts"]) == int(tight["extra_impacts"]) == 0
+    assert int(tight["impacts"]) == int(ds["reference_impacts"].sel(case="two_impact", reference="compliant_exact")) >= 14  # two per period
     scene = parse_scene(frame_benchmark())
     assert scene.settings is not None
     problem = scene.settings.cases[0].problem

@@ -98,7 +98,7 @@ BENCHMARK_ATTRIBUTES: dict[str, dict[str, str]] = {
     "floor_time_per_period": {"units": "s", "long_name": "wall time per excitation period of the exact engine's compiled kernel alone (exact_core.run_periods, arguments prepared untimed) on the same run, moments included: the exact reference's floor"},
     "floor_no_moments_time_per_period": {"units": "s", "long_name": "as floor_time_per_period without the per-period Fourier moments (strobes, impacts and segments only)"},
     "rtol": {"units": "1", "long_name": "relative tolerance rtol (atol = rtol x atol_ratio)"},
-    "reference": {"long_name": "reference of the rigid-stop methods (exact) and of the compliant model (CVODE Adams, rtol 1e-13)"},
+    "reference": {"long_name": "reference of the rigid-stop methods (exact), of the compliant methods on stepped cases (compliant_exact, the bumper in closed form) and on swept ones (CVODE Adams, rtol 1e-13: a chirp has no closed form)"},
 }
 #: The benchmark's model-cost ladder (model).
 LADDER_ATTRIBUTES: dict[str, dict[str, str]] = {

@@ -18,21 +18,24 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from vibroimpact.kinds.benchmark.study import equal_error_speedup, loosest_tolerance, measured_names
+from vibroimpact.kinds.benchmark.study import REFERENCES, equal_error_speedup, loosest_tolerance, measured_names
+from vibroimpact.engines.registry import BUMPER, engine_spec
 from vibroimpact.engines.settings import STEPPED_TOLERANCES
 from vibroimpact.reporting.record import general_setting, is_general
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.reporting.style import DISPLACEMENT_SCALE, DISPLACEMENT_UNITS, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour
 
-__all__ = ["page_for", "AccuracyPage", "accuracy_figures", "accuracy_tables", "per_period_table", "TARGETS"]
+__all__ = ["page_for", "AccuracyPage", "accuracy_figures", "accuracy_tables", "per_period_table", "bumper_answer", "bumper_table", "TARGETS"]
 
 #: X1-fundamental accuracies the guidance is given for [-].
 TARGETS = (1e-3, 1e-6)
-#: What each reference is (rigid stop: the exact engine; compliant model: CVODE Adams at a far tighter tolerance).
-#: Per reference: legend text, caption text.
+#: What each reference is (rigid stop and bumper: their closed forms; the bumper under a swept sine, which has none:
+#: CVODE Adams at a far tighter tolerance), by :data:`~vibroimpact.kinds.benchmark.study.REFERENCES` key: legend text,
+#: caption text, line colour and style.
 _REFERENCES = {
-    "exact": ("reference: exact", "the exact engine (rigid-stop methods)"),
-    "compliant_cvode_adams": ("reference: CVODE Adams 1e-13", "CVODE Adams at rtol 1e-13 (compliant model)"),
+    "rigid": (f"reference: {REFERENCES['rigid']}", f"{REFERENCES['rigid']}, the rigid stop in closed form (rigid-stop methods)", "k", ":"),
+    "bumper": (f"reference: {REFERENCES['bumper']}", f"{REFERENCES['bumper']}, the bumper in closed form (compliant methods on stepped cases)", "k", "-."),
+    "swept": ("reference: CVODE Adams 1e-13", "CVODE Adams at rtol 1e-13 (compliant model under the swept sine: no closed form)", "0.5", ":"),
 }
 _IMPACT_ERROR = ("impact_time_error", "largest impact-time error [s]")
 #: The integrator shown in the per-period table, at the default rtol of stepped steady states.
@@ -73,7 +76,7 @@ class AccuracyPage:
             setting = general_setting(self.dataset)
             label = _measured(self.dataset)[1]
             intro = f"<p>Structure: {', '.join(setting.names)}. Stops: {html.escape('; '.join(setting.stops))}. Load: {html.escape(setting.load_text())}. Errors are of the {html.escape(label)} fundamental.</p>"
-        return [Section("Work-precision", intro=answer_text(self.dataset) + intro, figures=saved(accuracy_figures(self.dataset), out), tables=accuracy_tables(self.dataset))]
+        return [Section("Work-precision", intro=answer_text(self.dataset) + bumper_answer(self.dataset) + intro, figures=saved(accuracy_figures(self.dataset), out), tables=accuracy_tables(self.dataset))]
 
 
 def answer_text(dataset: xr.Dataset) -> str:
@@ -86,7 +89,7 @@ def answer_text(dataset: xr.Dataset) -> str:
     parts = []
     for case in map(str, dataset["case"].values):
         exact = float(dataset["reference_wall_time"].sel(case=case, reference="exact"))
-        ours = [m for m in methods if m.startswith("compliant") == math.isnan(exact) and m not in ivp and m not in _tolerance_free(dataset)]
+        ours = [m for m in methods if _is_bumper(m) == math.isnan(exact) and m not in ivp and m not in _tolerance_free(dataset)]
         name, rtol, wall = _cheapest(dataset, case, target, ours)
         other, other_rtol, other_wall = _cheapest(dataset, case, target, ivp)
         text = f"<b>{html.escape(case)}</b>: " + (f"{html.escape(name)} at rtol {fmt(rtol, 'g')} in {fmt(wall)} s" if name else "no integrator of ours reaches it")
@@ -96,6 +99,104 @@ def answer_text(dataset: xr.Dataset) -> str:
             text += f"; the exact engine, without error, in {fmt(exact)} s"
         parts.append(text)
     return f"<p>Cheapest run within {fmt(target, 'g')} of the {html.escape(label)} fundamental, per case: {'; '.join(parts)}.</p>"
+
+
+def _is_bumper(method: str) -> bool:
+    """Does ``method`` solve the bumper (the compliant model)?"""
+    return engine_spec(method).contact == BUMPER
+
+
+def _bumper_cases(dataset: xr.Dataset) -> list[str]:
+    """The cases whose compliant methods were measured against the bumper's closed form."""
+    reference = REFERENCES["bumper"]
+    if reference not in dataset["reference"].values:
+        return []
+    return [str(c) for c in dataset["case"].values if np.isfinite(float(dataset["reference_wall_time"].sel(case=c, reference=reference)))]
+
+
+def _closed_form_per_period(dataset: xr.Dataset, case: str) -> float:
+    """Wall time per period [s] of the bumper's closed form on ``case``: its row among the methods where it has one
+    (timed as the integrators are), else its run as the reference."""
+    reference = REFERENCES["bumper"]
+    if reference in dataset["engine"].values:
+        value = float(dataset["time_per_period"].sel(case=case, engine=reference).isel(rtol=0))
+        if math.isfinite(value):
+            return value
+    return float(dataset["reference_wall_time"].sel(case=case, reference=reference)) / float(dataset["periods"].sel(case=case))
+
+
+def _times(ratio: float) -> str:
+    """A ratio as ``277x`` (two significant digits below 10: ``0.5x``, ``2.5x``)."""
+    return fmt(ratio, ".0f" if ratio >= 10.0 else ".2g", "{}x")
+
+
+def _bumper_label(dataset: xr.Dataset, case: str) -> str:
+    """``case`` with its bumpers' Omega_b / 2 pi, as words (HTML)."""
+    frequencies = str(dataset.attrs.get(f"case_{case}_bumper_frequency_Hz", "")).split()
+    return f"<b>{html.escape(case)}</b>" + (f" (Omega_b / 2 pi = {', '.join(frequencies)} Hz)" if frequencies else "")
+
+
+def bumper_answer(dataset: xr.Dataset) -> str:
+    """The bumper's measured tolerance guidance (HTML; empty without a bumper case): per case, the loosest rtol at which
+    each compliant integrator is within the tightest target of the closed form's fundamental, its cost per period
+    there, and the closed form's cost per period with how many times cheaper it is than the cheapest of them."""
+    cases = _bumper_cases(dataset)
+    if not cases:
+        return ""
+    target = min(TARGETS)
+    label = _measured(dataset)[1]
+    free = _tolerance_free(dataset)
+    integrators = [str(m) for m in dataset["engine"].values if _is_bumper(str(m)) and str(m) not in free]
+    parts = []
+    for case in cases:
+        periods = float(dataset["periods"].sel(case=case))
+        closed = _closed_form_per_period(dataset, case)
+        reached, cheapest = [], math.inf
+        for method in integrators:
+            rtol, wall = loosest_tolerance(dataset, case, method, target)
+            if math.isfinite(wall):
+                reached.append(f"{html.escape(method)} from rtol {fmt(rtol, 'g')} at {fmt(1e3 * wall / periods, '.3g')} ms per period")
+                cheapest = min(cheapest, wall / periods)
+            elif np.isfinite(dataset["wall_time"].sel(case=case, engine=method).values).any():
+                reached.append(f"{html.escape(method)} at no rtol measured")
+        text = f"{_bumper_label(dataset, case)}: {', '.join(reached) or 'no integrator measured'}; {html.escape(REFERENCES['bumper'])}, without tolerance, {fmt(1e6 * closed, '.3g')} us per period"
+        if math.isfinite(cheapest):
+            text += f", {_times(cheapest / closed)} cheaper than the cheapest of them"
+        parts.append(text)
+    return (
+        f"<p>The bumper, against its closed form ({html.escape(REFERENCES['bumper'])}): the loosest rtol within {fmt(target, 'g')} (relative) of "
+        f"the {html.escape(label)} fundamental, with every tighter rtol measured and no contact missed, per case: {'; '.join(parts)}.</p>"
+    )
+
+
+def bumper_table(dataset: xr.Dataset) -> str:
+    """Per bumper case and rtol: each compliant integrator's error of the measured fundamental against the closed form
+    and its cost per period [ms]; per case, the closed form's cost per period [us] (HTML)."""
+    names, label = _measured(dataset)
+    tolerances = [float(t) for t in np.sort(np.asarray(dataset["rtol"].values, dtype=float))[::-1]]
+    free = _tolerance_free(dataset)
+    integrators = [str(m) for m in dataset["engine"].values if _is_bumper(str(m)) and str(m) not in free]
+    rows = [
+        "<tr><th rowspan='2'>case</th><th rowspan='2'>rtol</th>" + "".join(f"<th colspan='2'>{m}</th>" for m in integrators) + "</tr>",
+        "<tr>" + f"<th>{html.escape(label)} error</th><th>ms / period</th>" * len(integrators) + "</tr>",
+    ]
+    for case in _bumper_cases(dataset):
+        for rtol in tolerances:
+            cells = []
+            for method in integrators:
+                point = dataset.sel(case=case, engine=method, rtol=rtol)
+                flag = " *" if float(point["missed_impacts"]) + float(point["extra_impacts"]) > 0 else ""
+                cells.append(f"<td>{fmt(point[names['x1_error']], '.1e')}{flag}</td><td>{fmt(1e3 * float(point['time_per_period']), '.3g')}</td>")
+            rows.append(f"<tr><td>{case}</td><td>{fmt(rtol, 'g')}</td>{''.join(cells)}</tr>")
+        closed = fmt(1e6 * _closed_form_per_period(dataset, case), ".3g")
+        rows.append(f"<tr><td>{case}</td><td>{REFERENCES['bumper']}</td><td colspan='{2 * len(integrators)}'>the reference, no tolerance: {closed} us per period</td></tr>")
+    note = (
+        f"<p>The relative error of the {html.escape(label)} fundamental over the run against {REFERENCES['bumper']} (the bumper's flow in "
+        "closed form, switches found by guaranteed root bracketing: no tolerance), and the wall time per excitation period "
+        "(median of the repeats, all in one process run: read ratios). *: contacts missed or extra against the reference. "
+        "atol = rtol x the scene's atol_ratio. Empty: not run (a method stops after a run over the scene's time limit).</p>"
+    )
+    return "<table>" + "".join(rows) + "</table>" + note
 
 
 def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
@@ -130,12 +231,15 @@ def accuracy_figures(dataset: xr.Dataset) -> list[DrawnFigure]:
                 if missed.any():
                     ax.loglog(wall[missed], floor[missed], "x", color=series_colour(k), ms=9, mew=2, label="_nolegend_", gid=method)
                     caption.add("missed", "Crosses: runs that missed impacts of the reference (errors floored at 1e-17 where zero).")
-            for reference, colour in (("exact", "k"), ("compliant_cvode_adams", "0.5")):
+            for model, reference in REFERENCES.items():
+                if reference not in dataset["reference"].values:
+                    continue  # a dataset of an older version
                 value = float(dataset["reference_wall_time"].sel(case=case, reference=reference))
                 if math.isfinite(value):
-                    legend, text = _REFERENCES[reference]
-                    ax.axvline(value, color=colour, ls=":", lw=1.3, label=legend)
-                    caption.add(f"reference {reference}", f"Dotted vertical{' (grey)' if colour != 'k' else ''}: the wall time of the reference, {text}.")
+                    legend, text, colour, style = _REFERENCES[model]
+                    ax.axvline(value, color=colour, ls=style, lw=1.3, label=legend)
+                    line = "Dash-dotted" if style == "-." else "Dotted"
+                    caption.add(f"reference {model}", f"{line} vertical{' (grey)' if colour != 'k' else ''}: the wall time of the reference, {text}.")
             if quantity == names["x1_error"]:
                 for target in TARGETS:
                     ax.axhline(target, color="k", lw=0.6, alpha=0.5)
@@ -149,6 +253,8 @@ def accuracy_tables(dataset: xr.Dataset) -> list[Table]:
     """The answer (cheapest way to each target), tolerance guidance, the ladder, and every measured point."""
     label = _measured(dataset)[1]
     tables = [Table(f"Cheapest way to the {label} fundamental within a target", _answer_table(dataset)), Table("Tolerance guidance: loosest rtol meeting each target", _guidance_table(dataset))]
+    if _bumper_cases(dataset):
+        tables.insert(0, Table(f"The bumper against its closed form ({REFERENCES['bumper']}): {label} error and cost per period at each rtol", bumper_table(dataset)))
     if "floor_time_per_period" in dataset:
         tables.insert(0, Table("Cost per period: the exact engine against its floor, the pure-Python loop and momentary", per_period_table(dataset)))
     if "momentary_adams" in dataset["engine"].values:
@@ -184,7 +290,7 @@ def _answer_table(dataset: xr.Dataset) -> str:
         # one model per comparison: the rigid stop on stepped cases (compliant runs answer another question), the
         # compliant model on swept ones
         swept = math.isnan(exact)
-        ours = [m for m in methods if m.startswith("compliant") == swept and not m.startswith("solve_ivp") and m not in _tolerance_free(dataset)]
+        ours = [m for m in methods if _is_bumper(m) == swept and not m.startswith("solve_ivp") and m not in _tolerance_free(dataset)]
         for target in TARGETS:
             name, rtol, wall = _cheapest(dataset, str(case), target, ours)
             other, other_rtol, other_wall = _cheapest(dataset, str(case), target, ivp)
@@ -198,8 +304,9 @@ def _answer_table(dataset: xr.Dataset) -> str:
         f"<p>For each method the loosest tolerance whose {_measured(dataset)[1]} fundamental is within the target (and every tighter one run, "
         "without a missed impact), and the wall time of a run at it; the cheapest of our integrators against the cheapest "
         "solve_ivp method, within one model: the rigid stop on stepped cases, the compliant model on the swept one (whose "
-        "reference is CVODE Adams at rtol 1e-13: CVODE Adams there is measured against its own integrator at a far tighter "
-        "tolerance). For the rigid stop the exact engine needs no tolerance and is cheaper still. Irregular motion "
+        "reference is CVODE Adams at rtol 1e-13: a swept sine has no closed form, so CVODE Adams there is measured against "
+        f"its own integrator at a far tighter tolerance; the bumper on stepped cases is measured against {REFERENCES['bumper']}, "
+        "its closed form: see its own table). For the rigid stop the exact engine needs no tolerance and is cheaper still. Irregular motion "
         "has no converged trajectory: its errors grow with the run's length (trajectories diverge), so its figures hold for "
         "runs of the length measured here only.</p>"
     )

@@ -19,7 +19,7 @@ from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.engines.base import Engine, SweepRecord, Trajectory
 from vibroimpact.engines.compliant.ivp import solve_ivp_sweep
-from vibroimpact.engines.registry import BUMPER, ENGINES, engine_spec, make_engine
+from vibroimpact.engines.registry import BUMPER, ENGINES, RIGID, engine_spec, make_engine
 from vibroimpact.engines.settings import REFERENCE_RTOL, EngineSettings
 from vibroimpact.kinds.stepped.grid import layout_attributes
 from vibroimpact.kinds.stepped.study import engine_scale
@@ -34,7 +34,7 @@ from vibroimpact.scene.variables import BENCHMARK_ATTRIBUTES, LADDER_ATTRIBUTES
 from vibroimpact.simulation.harmonics import measure, running_fundamental
 from vibroimpact.simulation.steady import start_state
 
-__all__ = ["run_benchmark", "model_ladder", "equal_error_speedup", "loosest_tolerance", "exact_kernel", "measured_names", "REFERENCE_RTOL", "TOLERANCE_FREE", "BenchmarkStudy"]
+__all__ = ["run_benchmark", "reference_engine", "REFERENCES", "model_ladder", "equal_error_speedup", "loosest_tolerance", "exact_kernel", "measured_names", "REFERENCE_RTOL", "TOLERANCE_FREE", "BenchmarkStudy"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -187,27 +187,52 @@ def exact_kernel(case: BenchmarkCase, moments: bool = True) -> Callable[[], int]
     return kernel
 
 
+def reference_engine(contact: str) -> str:
+    """The reference of a model: the first registered engine solving ``contact`` (:data:`RIGID`, :data:`BUMPER`) with
+    an exact flow (the compiled closed form, which the registry lists before its pure-Python cross-check)."""
+    return next(name for name, spec in ENGINES.items() if spec.contact == contact and spec.capabilities.exact_flow)
+
+
+#: The references, by the model they measure: the rigid stop's and the bumper's closed forms, and for a swept sine (no
+#: closed form: a chirp has no closed-form particular solution) CVODE Adams at REFERENCE_RTOL; the dataset's
+#: ``reference`` coordinate, in this order.
+REFERENCES = {"rigid": reference_engine(RIGID), "bumper": reference_engine(BUMPER), "swept": "compliant_cvode_adams"}
+
+
+def _model(case: BenchmarkCase, method: str) -> str:
+    """The key of :data:`REFERENCES` that ``method``'s runs on ``case`` are measured against."""
+    return "swept" if case.sweep is not None else "bumper" if engine_spec(method).contact == BUMPER else "rigid"
+
+
 def _references(case: BenchmarkCase, settings: BenchmarkSettings) -> tuple[dict[str, tuple[_Run, float]], list[float]]:
-    """The references a case needs: ``exact`` (rigid methods), ``compliant`` (CVODE Adams at REFERENCE_RTOL); and
-    the wall times [s] of the exact kernel alone with the moments and without (stepped cases; NaN otherwise),
-    timed in turn with the exact reference."""
+    """The references a case needs, by :data:`REFERENCES` key: the rigid stop's closed form (rigid methods, stepped
+    cases), the bumper's (compliant methods, stepped cases), both timed as the methods are (median of the repeats,
+    compiled code loaded untimed first), and CVODE Adams at REFERENCE_RTOL (swept cases, run once); and the wall
+    times [s] of the exact kernel alone with the moments and without (stepped cases; NaN otherwise), timed in turn
+    with the rigid reference."""
     references: dict[str, tuple[_Run, float]] = {}
     floors = [math.nan, math.nan]
     if case.sweep is None:
         t0, y0 = start_state(case.problem, case.start)
+        rigid = make_engine(REFERENCES["rigid"])
 
         def exact() -> _Run:
-            trajectory = make_engine("exact").integrate(case.problem, y0, t0, case.periods, moments=True)
+            trajectory = rigid.integrate(case.problem, y0, t0, case.periods, moments=True)
             return _Run(trajectory, _fundamental_of(trajectory))
 
-        make_engine("exact").integrate(case.problem, y0, t0, 1, moments=True)  # untimed: loads the compiled kernel
+        rigid.integrate(case.problem, y0, t0, 1, moments=True)  # untimed: loads the compiled kernel
         kernels = [exact_kernel(case, moments) for moments in (True, False)]
         timed = _timed_together([exact, *kernels], settings.repeats)
         references["rigid"] = timed[0]
         floors = [wall for _, wall in timed[1:]]
-    if any(case.runs(m) and (engine_spec(m).contact == BUMPER or case.sweep is not None) for m in settings.methods):
+    models = {_model(case, m) for m in settings.methods if case.runs(m)}
+    if "bumper" in models:
+        closed = _runner(case, REFERENCES["bumper"], EngineSettings())
+        _runner(replace(case, periods=1), REFERENCES["bumper"], EngineSettings())()  # untimed: loads the compiled loop
+        references["bumper"] = _timed(closed, settings.repeats)
+    if "swept" in models:
         tight = EngineSettings(rtol=REFERENCE_RTOL, atol=REFERENCE_RTOL * settings.atol_ratio, method="adams")
-        references["compliant"] = _timed(_runner(case, "compliant_cvode_adams", tight), 1)
+        references["swept"] = _timed(_runner(case, REFERENCES["swept"], tight), 1)
     return references, floors
 
 
@@ -223,9 +248,7 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
     measured = measured_names(coordinate)
     names = ("wall_time", "rhs_calls", "steps", "impacts", "missed_impacts", "extra_impacts", "impact_time_error", "impulse_error", "final_state_error", "x1_error")
     data = {name: np.full(shape, np.nan) for name in names}
-    reference_time = np.full((len(cases), 2), np.nan)
-    reference_impacts = np.full((len(cases), 2), np.nan)
-    reference_x1 = np.full((len(cases), 2), np.nan)
+    reference_time, reference_impacts, reference_x1 = (np.full((len(cases), len(REFERENCES)), np.nan) for _ in range(3))
     periods = np.array([np.nan if case.sweep is not None else float(case.periods) for case in cases])
     floors = np.full((len(cases), 2), np.nan)  # [s] the exact kernel alone: with the moments, without
     for c, case in enumerate(cases):
@@ -239,7 +262,7 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
                     file=sys.stderr,
                     flush=True,
                 )
-        for r, kind in enumerate(("rigid", "compliant")):
+        for r, kind in enumerate(REFERENCES):
             if kind in references:
                 reference, reference_time[c, r] = references[kind]
                 reference_impacts[c, r] = reference.trajectory.impact_times.size
@@ -247,8 +270,7 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
         for m, method in enumerate(settings.methods):
             if not case.runs(method):
                 continue
-            kind = "compliant" if engine_spec(method).contact == BUMPER or case.sweep is not None else "rigid"
-            reference = references[kind][0]
+            reference = references[_model(case, method)][0]
             for k, rtol in enumerate(settings.tolerances):
                 if method in TOLERANCE_FREE and k:  # the same run at every tolerance: measured once
                     for name in names:
@@ -274,7 +296,7 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
                     break  # tighter tolerances would only take longer
     dataset = xr.Dataset(
         {measured.get(name, name): (("case", "engine", "rtol"), data[name], _attributes(name, coordinate)) for name in names},
-        coords={"case": [c.name for c in cases], "engine": list(settings.methods), "rtol": list(settings.tolerances), "reference": ["exact", "compliant_cvode_adams"]},
+        coords={"case": [c.name for c in cases], "engine": list(settings.methods), "rtol": list(settings.tolerances), "reference": list(REFERENCES.values())},
     )
     dataset["reference_wall_time"] = (("case", "reference"), reference_time, dict(BENCHMARK_ATTRIBUTES["reference_wall_time"]))
     dataset["reference_impacts"] = (("case", "reference"), reference_impacts, dict(BENCHMARK_ATTRIBUTES["reference_impacts"]))
@@ -294,6 +316,8 @@ def run_benchmark(cases: list[BenchmarkCase], settings: BenchmarkSettings, progr
     for case in cases:  # what a run simulates, for per-period and per-second costs (vibroimpact.runs.estimate.calibrate)
         dataset.attrs[f"case_{case.name}_duration_s"] = case.sweep.duration if case.sweep is not None else case.periods / case.problem.frequency
         dataset.attrs[f"case_{case.name}_frequency_Hz"] = case.problem.frequency
+        if case.bumper is not None:  # the bumpers' Omega_b / 2 pi, for the page's words
+            dataset.attrs[f"case_{case.name}_bumper_frequency_Hz"] = " ".join(f"{stop.law.frequency:g}" for stop in replace(case.problem, contact=case.bumper).stops)
     if settings.ladder is not None and cases:
         if progress:
             print("benchmark: model cost ladder", file=sys.stderr, flush=True)
