@@ -16,13 +16,13 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-__all__ = ["FAILED_FLAG", "run_failures", "failure_details", "console_line"]
+__all__ = ["FAILED_FLAG", "run_failures", "failure_details", "console_line", "as_lines"]
 
 #: The flag meaning that marks a point whose computation raised (its values are blank).
 FAILED_FLAG = "failed"
 
 
-def _as_lines(value: object) -> list[str]:
+def as_lines(value: object) -> list[str]:
     """An attribute read back from netCDF (a string, or an array/list of strings) as a list of lines."""
     if value is None:
         return []
@@ -46,7 +46,7 @@ def run_failures(dataset: xr.Dataset) -> list[str]:
 
     Empty when nothing failed.
     """
-    lines = _as_lines(dataset.attrs.get("run_failures"))
+    lines = as_lines(dataset.attrs.get("run_failures"))
     for name, variable in dataset.data_vars.items():
         flag = _flag_value(variable, FAILED_FLAG)
         if flag is None:
@@ -69,7 +69,7 @@ def run_failures(dataset: xr.Dataset) -> list[str]:
 
 def failure_details(dataset: xr.Dataset) -> list[str]:
     """The raw messages of the run's failures that its kind kept (``run_failure_details``), for a collapsed section."""
-    return _as_lines(dataset.attrs.get("run_failure_details"))
+    return as_lines(dataset.attrs.get("run_failure_details"))
 
 
 def console_line(failures: list[str], report: str | None = None) -> str:

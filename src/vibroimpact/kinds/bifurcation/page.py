@@ -17,6 +17,7 @@ import xarray as xr
 
 from vibroimpact.reporting.page import Section, Table, saved
 from vibroimpact.reporting.style import fmt
+from vibroimpact.runs.failures import as_lines
 from vibroimpact.kinds.bifurcation.bumper import bumper_answer, bumper_figure, convergence_table, has_bumpers, rigid_view
 from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, bifurcation_figures, branch_class, first_coordinate, flags as _flags, orbit_class, orbit_label as _orbit_label
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
@@ -200,18 +201,10 @@ def answer_text(dataset: xr.Dataset) -> str:
     return "".join(parts)
 
 
-def _lines(dataset: xr.Dataset, key: str) -> list[str]:
-    """A list-of-strings attribute as a list (netCDF gives one string back as a string), empty when absent."""
-    value = dataset.attrs.get(key)
-    if value is None:
-        return []
-    return [value] if isinstance(value, str) else [str(v) for v in np.atleast_1d(value)]
-
-
 def failure_text(dataset: xr.Dataset) -> str:
     """What failed in the run (``run_failures``: what, how many, what it means for the results), as HTML; empty when
     nothing did."""
-    lines = _lines(dataset, "run_failures")
+    lines = as_lines(dataset.attrs.get("run_failures"))
     if not lines:
         return ""
     items = "".join(f"<li>{html.escape(line)}</li>" for line in lines)
@@ -220,7 +213,7 @@ def failure_text(dataset: xr.Dataset) -> str:
 
 def failure_details(dataset: xr.Dataset) -> str:
     """The raw messages of what failed (``run_failure_details``), collapsed; empty when nothing failed."""
-    details = _lines(dataset, "run_failure_details")
+    details = as_lines(dataset.attrs.get("run_failure_details"))
     if not details:
         return ""
     return f"<details><summary>The raw messages of what failed ({len(details)})</summary><pre>{html.escape(chr(10).join(details))}</pre></details>"
