@@ -30,6 +30,7 @@ GENERAL_DESCRIPTIONS = {
     "exact": "piecewise-exact simulation, rigid stops",
     "momentary": "CVODE simulation, rigid stops",
     "compliant": "IDA simulation, Kelvin-Voigt bumpers",
+    "compliant_exact": "closed-form Kelvin-Voigt bumpers, exact per contact mode",
 }
 #: Points of the linear figure's own grid.
 _LINEAR_POINTS = 4001
