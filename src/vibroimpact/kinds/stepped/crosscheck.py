@@ -179,5 +179,10 @@ def cross_check_section(checks: list[CrossCheck]) -> Section | None:
             for where, a, b, x, y, d, w, v in check.rows
         )
         tables.append(Table(f"{check.checked} against {check.reference}, point by point", f"<table>{header}{body}</table>"))
-    intro = "".join(f"<p>{html.escape(cross_check_text(check))}</p>" for check in checks)
+    names = "; ".join(f"{solution_ref(c.checked)} against {solution_ref(c.reference)}" for c in checks)
+    intro = (
+        f"<p>Point by point ({html.escape(names)}): the regime each engine found, |X1| and its relative difference where both are periodic, "
+        "and each steady state's wall time in this run (transient plus measurement, one process; the first point a worker computes also loads the compiled engine). "
+        "The page's first section sums them up.</p>"
+    )
     return Section("The same contact by two engines", intro=intro, tables=tables)
