@@ -137,7 +137,7 @@ def peak_acceleration_figure(part: xr.Dataset, name: str) -> DrawnFigure | None:
     if any_unstable:
         caption.add("unstable", "Dashed: the estimate on a one-impact orbit that exists but is unstable.")
     if engines:
-        caption.add("bumper", engines.phrase(irregular="irregular motion, the largest over the measured window"))
+        caption.add("bumper", engines.phrase(irregular="irregular motion, the largest over the measured window", each="one marker per simulated point"))
     caption.add("coincide", coincidence_phrase(found))
     keys: list[Line2D | Patch] = [Patch(color=series_colour(i), label=text) for i, (text, _) in enumerate(lines)]
     figure_legend(fig, [], keys + (stability_keys() if any_unstable else []) + engines.keys())
@@ -188,7 +188,7 @@ def stiffness_figure(dataset: xr.Dataset, setting: StudySetting, name: str) -> D
     ax.loglog(bumper, 0.1 * bumper[0] / bumper, "k--", lw=0.9, label="slope -1")
     finish_axes(ax, "bumper frequency Omega_b / 2 pi [Hz]", f"relative difference of {QUANTITIES['x1_amplitude'].label} [1]", "Convergence to the rigid stop")
     caption = Caption(
-        f"Left: relative difference of the steady-state {QUANTITIES['x1_amplitude'].label} of {solution_ref(compliant)} (restitution-matched "
+        f"Left: relative difference of the steady-state {QUANTITIES['x1_amplitude'].label} of {solution_ref(compliant)}, {SOLUTION_DESCRIPTIONS[compliant]} (restitution-matched "
         f"loss factor) from the rigid-stop simulation {solution_ref(reference)} as the bumper stiffens, one colour per excitation frequency; the dashed line has slope -1."
     )
     if panels == 2:
