@@ -36,7 +36,7 @@ def test_stepped_page_has_responses_simulations_peaks_agreement_and_reduction_fa
     ds = steady_dataset()
     page = page_for(ds)
     assert isinstance(page, FrequencyResponsePage)
-    assert page.summary() == "solutions: linear, pgf, pgf_paper, momentary, exact, compliant; stops: x2 <= 3 mm"
+    assert page.summary() == "solutions: linear, pgf, pgf_paper, exact, momentary, compliant, compliant_exact; stops: x2 <= 3 mm"
     sections = {s.title: s for s in page.sections(tmp_path)}
     assert list(sections) == [
         "Largest responses",  # the answer first, in numbers: peaks against R, contact peaks, reduction factors

@@ -27,6 +27,8 @@ from vibroimpact.reporting.style import DPI, FIGURE_WIDTH
 from vibroimpact.scene import parse_scene
 from vibroimpact.runs.run import run_study
 from vibroimpact.simulation.swept import sweep_quantities
+from vibroimpact.engines.registry import BUMPER
+from vibroimpact.scene.schema import ENGINE_CONTACT, ENGINE_SOLUTIONS
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
 
@@ -36,7 +38,7 @@ SIMULATION_GRID = {"start": 15.0, "stop": 45.0, "step": 0.5}
 PAGE_CONTENT_WIDTH = 1360
 
 
-def steady_document(engines: tuple[str, ...] = ("momentary", "exact", "compliant"), restitution: tuple[float, ...] = (0.2, 0.6), step: float = 0.05) -> dict[str, Any]:
+def steady_document(engines: tuple[str, ...] = ENGINE_SOLUTIONS, restitution: tuple[float, ...] = (0.2, 0.6), step: float = 0.05) -> dict[str, Any]:
     """A restitution-like scene: closed forms on a fine grid, simulations on a coarse one."""
     document: dict[str, Any] = {
         "name": "tiny",
@@ -81,7 +83,7 @@ def _fake_simulation(closed: xr.Dataset, engine: str, offset: float) -> xr.Datas
         if name not in part:
             continue
         values = xr.where(np.isfinite(pgf[name]), pgf[name], linear[name]) * (1.0 + offset)
-        if engine != "compliant" and name.startswith("peak_"):
+        if ENGINE_CONTACT[engine] != BUMPER and name.startswith("peak_"):
             values = values * np.nan  # rigid engines have no contact peaks
         part[name] = values.where(on & ~failed)
     impact = part["impulse"] > 0.0
@@ -104,7 +106,7 @@ def _fake_simulation(closed: xr.Dataset, engine: str, offset: float) -> xr.Datas
 
 
 @functools.cache
-def steady_dataset(engines: tuple[str, ...] = ("momentary", "exact", "compliant"), restitution: tuple[float, ...] = (0.2, 0.6), step: float = 0.05) -> xr.Dataset:
+def steady_dataset(engines: tuple[str, ...] = ENGINE_SOLUTIONS, restitution: tuple[float, ...] = (0.2, 0.6), step: float = 0.05) -> xr.Dataset:
     """The dataset of :func:`steady_document` (closed forms computed, simulations made up); cached: do not modify."""
     document = steady_document(engines, restitution, step)
     closed = _closed_forms(document)

@@ -222,7 +222,7 @@ MISTAKES = [
     ("clearance-in-stop-and-sweep", _set("sweep", "clearance", [0.003]), ["stop.clearance: also swept in sweep.clearance: give it in one place only"]),
     ("unknown-solution", _top("solutions", ["linear", "fem"]), ["solutions[1]: unknown name 'fem'", "allowed: linear, pgf, pgf_paper"]),
     ("solution-twice", _top("solutions", ["pgf", "linear", "pgf"]), ["solutions[2]: 'pgf' is listed twice"]),
-    ("empty-solutions", _top("solutions", []), ["solutions: expected a non-empty list of names from ['linear', 'pgf', 'pgf_paper', 'exact', 'momentary', 'compliant']"]),
+    ("empty-solutions", _top("solutions", []), ["solutions: expected a non-empty list of names from ['linear', 'pgf', 'pgf_paper', 'exact', 'momentary', 'compliant', 'compliant_exact']"]),
     ("solutions-not-list", _top("solutions", "linear"), ["solutions: expected a non-empty list of names", "'linear'"]),
     ("unknown-quantity", _top("quantities", ["x2_amplitude", "velocity"]), ["quantities[1]: unknown name 'velocity'", "allowed: x1_amplitude", "floquet_modulus"]),
     ("quantity-twice", _top("quantities", ["impulse", "impulse"]), ["quantities[1]: 'impulse' is listed twice"]),
@@ -592,7 +592,7 @@ def test_bad_simulation_settings(simulation: dict[str, Any], fragment: str) -> N
 def test_simulation_without_engine_solutions_is_an_error() -> None:
     doc = base_scene()
     doc["simulation"] = {"start": "pgf"}
-    assert problems_of(doc) == ["simulation: given, but no time-domain solution (exact, momentary, compliant) is asked for"]
+    assert problems_of(doc) == ["simulation: given, but no time-domain solution (exact, momentary, compliant, compliant_exact) is asked for"]
 
 
 def test_shipped_engine_cost_scene_parses() -> None:

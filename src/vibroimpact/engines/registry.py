@@ -126,7 +126,7 @@ ENGINES: Mapping[str, EngineSpec] = MappingProxyType(
         "compliant_ida": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", BUMPER_INTEGRATOR, "the engine compliant, under the name benchmark scenes use"),
         "compliant_cvode_adams": EngineSpec("vibroimpact.engines.compliant.ida:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (Adams)", settings_method="adams"),
         "compliant_cvode_bdf": EngineSpec("vibroimpact.engines.compliant.ida:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (BDF)", settings_method="bdf"),
-        "compliant_exact": EngineSpec("vibroimpact.engines.compliant.exact:CompliantExactEngine", Capabilities(BUMPER, exact_jacobians=True, exact_flow=True, tolerance_free=True), "Kelvin-Voigt bumper in closed form per contact mode with guaranteed switch search, compiled: the bumper's reference"),
+        "compliant_exact": EngineSpec("vibroimpact.engines.compliant.exact:CompliantExactEngine", Capabilities(BUMPER, exact_jacobians=True, exact_flow=True, tolerance_free=True, stepped_solution=True), "Kelvin-Voigt bumper in closed form per contact mode with guaranteed switch search, compiled: the bumper's reference"),
     }
 )
 

@@ -30,7 +30,7 @@ OVER_MARKERS_ZORDER = 3.0
 LINEAR_ZORDER = 2.2
 #: Dot for an isolated closed-form value (no finite neighbour, so no line segment) [pt].
 ISOLATED_MARKER_SIZE = 3.0
-_SHAPES = {"o": "circles", "D": "diamonds", "s": "squares"}
+_SHAPES = {"o": "circles", "D": "diamonds", "s": "squares", "^": "triangles"}
 
 
 def draw_curve(ax: Axes, x: np.ndarray, y: np.ndarray, *, colour: str, label: str | None, gid: str, unstable: np.ndarray | None = None, coarse: bool = False, style: dict[str, object] | None = None, zorder: float = 2.0) -> tuple[bool, bool]:

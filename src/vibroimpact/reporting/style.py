@@ -197,6 +197,7 @@ SOLUTION_LOOKS: dict[str, SolutionLook] = {
     "momentary": SolutionLook("C1", "CVODE, rigid stop", "CVODE simulation, rigid stop", ("o", 3.5)),
     "exact": SolutionLook("C2", "exact engine, rigid stop", "piecewise-exact simulation, rigid stop", ("D", 5.0)),
     "compliant": SolutionLook("C3", "IDA, compliant bumper", "IDA simulation, Kelvin-Voigt bumper (eq. 25)", ("s", 4.0)),
+    "compliant_exact": SolutionLook("C6", "closed form, compliant bumper", "closed-form Kelvin-Voigt bumper (eq. 25), exact per contact mode", ("^", 5.0)),
 }
 #: Views of :data:`SOLUTION_LOOKS`: simulation markers and sizes, colours, panel titles, caption descriptions.
 ENGINE_MARKERS: dict[str, tuple[str, float]] = {name: look.marker for name, look in SOLUTION_LOOKS.items() if look.marker is not None}

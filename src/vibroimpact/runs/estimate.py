@@ -63,7 +63,7 @@ _CLUSTER_CORES: ContextVar[int | None] = ContextVar("cluster_cores", default=Non
 #: The package's own cost file.
 COSTS_FILE = Path(__file__).with_name("costs.json")
 #: The registered engine whose measured cost stands for each time-domain solution (``momentary`` by its CVODE method).
-_SOLUTION_ENGINES = {"exact": "exact", "compliant": "compliant_ida"}
+_SOLUTION_ENGINES = {"exact": "exact", "compliant": "compliant_ida", "compliant_exact": "compliant_exact"}
 #: The fixed costs of a cost file (top-level numbers).
 _FIXED = ("main_process_memory", "report_base", "report_per_figure", "speed_probe_seconds", "startup", "worker_process_memory")
 
@@ -346,6 +346,7 @@ def calibrate(accuracy: Path, base: Costs | None = None) -> Costs:
                 if table:
                     target[str(method)] = table
     base = default_costs() if base is None else base
+    per_period = {**{engine: cost for engine, cost in base.per_period.items() if engine not in per_period}, **per_period}  # engines it does not time keep theirs
     # the speed probe on the machine that measured the costs
     return dataclasses.replace(base, per_period=per_period, per_sweep_second=per_sweep, speed_probe_seconds=speed_probe())
 

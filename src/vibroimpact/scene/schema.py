@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Generic, TypeVar
+from typing import Generic, Sequence, TypeVar
 
 
 from vibroimpact.engines.registry import engine_names, engine_spec, stepped_solutions
@@ -24,6 +24,7 @@ __all__ = [
     "SOLUTIONS",
     "ENGINE_SOLUTIONS",
     "ENGINE_CONTACT",
+    "contact_solutions",
     "BENCHMARK_REFERENCE",
     "BENCHMARK_METHODS",
     "QUANTITIES",
@@ -44,6 +45,13 @@ ENGINE_SOLUTIONS = stepped_solutions()
 SOLUTIONS = ("linear", "pgf", "pgf_paper", *ENGINE_SOLUTIONS)
 #: The contact law of each engine solution (from the engine registry, which must name every one of them).
 ENGINE_CONTACT = {name: engine_spec(name).contact for name in ENGINE_SOLUTIONS}
+
+
+def contact_solutions(solutions: Sequence[str], contact: str) -> list[str]:
+    """The time-domain solutions among ``solutions`` that solve ``contact`` (``rigid`` or ``bumper``), those with an
+    exact flow (each contact law's reference) first, then in their order."""
+    chosen = [name for name in solutions if ENGINE_CONTACT.get(name) == contact]
+    return sorted(chosen, key=lambda name: not engine_spec(name).capabilities.exact_flow)
 #: The engine every rigid-stop benchmark method is measured against; a benchmark always runs it.
 BENCHMARK_REFERENCE = "exact"
 #: Engines a benchmark scene may compare: every registered engine but the reference.

@@ -20,6 +20,7 @@ import numpy as np
 import xarray as xr
 
 from vibroimpact.analysis.stability import Regime
+from vibroimpact.kinds.stepped.crosscheck import subset_solutions
 from vibroimpact.kinds.stepped.tables import computed_part, reduction_factors
 from vibroimpact.reporting.record import GeneralSetting, StudySetting
 from vibroimpact.reporting.series import periodic_points
@@ -62,7 +63,8 @@ def answer_text(dataset: xr.Dataset, layout: GeneralSetting) -> str:
         return "The largest value of each response over the frequencies every solution computed, and where it occurs."
     f = dataset["frequency"].values
     parts = []
-    for solution in (str(s) for s in dataset["solution"].values):
+    on_subset = subset_solutions(dataset)  # on a few points: the cross-check says how they compare
+    for solution in (str(s) for s in dataset["solution"].values if s not in on_subset):
         data = dataset[quantity].sel(solution=solution)
         values = np.asarray(data.values, dtype=float)
         if not np.isfinite(values).any():
@@ -86,7 +88,8 @@ def contact_text(dataset: xr.Dataset) -> str:
         return ""
     acceleration, force = dataset["peak_acceleration"], dataset.get("peak_contact_force")
     solutions = [str(s) for s in dataset["solution"].values]
-    measured = [s for s in solutions if s in ENGINE_SOLUTIONS and np.nanmax(acceleration.sel(solution=s).values, initial=0.0) > 0.0]
+    on_subset = subset_solutions(dataset)  # the cross-check says how they compare
+    measured = [s for s in solutions if s in ENGINE_SOLUTIONS and s not in on_subset and np.nanmax(acceleration.sel(solution=s).values, initial=0.0) > 0.0]
     estimates = [s for s in solutions if s not in ENGINE_SOLUTIONS and np.nanmax(acceleration.sel(solution=s).values, initial=0.0) > 0.0]
     sentences = []
     for solution in measured:
@@ -160,9 +163,10 @@ def peak_rows(dataset: xr.Dataset, setting: StudySetting, parameter: str) -> lis
     split = setting.split_frequency
     sim_f = setting.simulation_frequency
     rows: list[PeakRow] = []
+    on_subset = subset_solutions(dataset)  # their peaks would be over other frequencies: the cross-check shows them
     for value in dataset[parameter].values:
         point = dataset.sel({parameter: value})
-        for solution in (str(s) for s in dataset["solution"].values if s != "linear"):
+        for solution in (str(s) for s in dataset["solution"].values if s != "linear" and s not in on_subset):
             values = point["x1_amplitude"].sel(solution=solution).values
             if solution in ENGINE_SOLUTIONS:
                 converged = periodic_points(point, solution)
@@ -236,14 +240,15 @@ class Convergence:
     wall_time: float
 
 
-def convergence_rows(dataset: xr.Dataset, setting: StudySetting, reference: str) -> list[Convergence]:
-    """:class:`Convergence` of ``compliant`` to ``reference`` at each bumper frequency of ``dataset``."""
+def convergence_rows(dataset: xr.Dataset, setting: StudySetting, reference: str, compliant: str) -> list[Convergence]:
+    """:class:`Convergence` of the bumper solution ``compliant`` to the rigid ``reference`` at each bumper frequency of
+    ``dataset``."""
     bumper = dataset["bumper_frequency"].values
     data = dataset.sel(frequency=setting.simulation_frequency)
-    sim = data["x1_amplitude"].sel(solution="compliant").transpose("bumper_frequency", "frequency").values
+    sim = data["x1_amplitude"].sel(solution=compliant).transpose("bumper_frequency", "frequency").values
     ref = data["x1_amplitude"].sel(solution=reference).values
     difference = np.abs(sim - ref) / ref
-    wall = data["wall_time"].sel(solution="compliant").transpose("bumper_frequency", "frequency").values if "wall_time" in data else np.full(sim.shape, np.nan)
+    wall = data["wall_time"].sel(solution=compliant).transpose("bumper_frequency", "frequency").values if "wall_time" in data else np.full(sim.shape, np.nan)
     rows = []
     for i, b in enumerate(bumper):
         order = math.nan
@@ -257,9 +262,10 @@ def convergence_rows(dataset: xr.Dataset, setting: StudySetting, reference: str)
     return rows
 
 
-def convergence_text(dataset: xr.Dataset, setting: StudySetting, reference: str) -> str:
-    """The compliant |X1| against the rigid stop's at each bumper frequency, the observed order, and the cost."""
-    rows = convergence_rows(dataset, setting, reference)
+def convergence_text(dataset: xr.Dataset, setting: StudySetting, reference: str, compliant: str) -> str:
+    """The bumper solution ``compliant``'s |X1| against the rigid stop's at each bumper frequency, the observed order,
+    and the cost."""
+    rows = convergence_rows(dataset, setting, reference, compliant)
     if not rows:
         return ""
     f = setting.simulation_frequency
@@ -274,6 +280,6 @@ def convergence_text(dataset: xr.Dataset, setting: StudySetting, reference: str)
     walls = [r.wall_time for r in rows if math.isfinite(r.wall_time)]
     if walls and "wall_time" in dataset:
         rigid = float(np.nanmedian(dataset["wall_time"].sel(solution=reference).values))
-        text += f". A compliant steady state costs {fmt(min(walls), '.2g')}-{fmt(max(walls), '.2g')} s (median per bumper)"
+        text += f". A {compliant} steady state costs {fmt(min(walls), '.2g')}-{fmt(max(walls), '.2g')} s (median per bumper)"
         text += f", {fmt(float(np.median(walls)) / rigid, '.3g')} times {reference}'s" if rigid > 0 else ""
     return text + "."

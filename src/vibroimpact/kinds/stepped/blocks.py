@@ -21,6 +21,7 @@ from typing import Callable
 import numpy as np
 import xarray as xr
 
+from vibroimpact.scene.subset import subset_axes, subset_share
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, Scene
 from vibroimpact.simulation.settings import SWEEP_STARTS
 from vibroimpact.runs.cluster import ProgressReport
@@ -140,10 +141,11 @@ def block_work(scene: Scene, plan: BlockPlan, index: int) -> float:
         return float(plan.points(index))
     assert scene.settings.simulation is not None
     frequencies = scene.settings.all_frequencies[region["frequency"]]
-    simulated = np.count_nonzero((scene.settings.simulation.frequency >= frequencies[0]) & (scene.settings.simulation.frequency <= frequencies[-1]))
+    simulated = scene.settings.simulation.frequency[(scene.settings.simulation.frequency >= frequencies[0]) & (scene.settings.simulation.frequency <= frequencies[-1])]
     rows = math.prod(s.stop - s.start for dim, s in region.items() if dim != "frequency")
-    engines = sum(1 for name in scene.settings.solutions if name in ENGINE_SOLUTIONS)
-    return float(simulated * rows * engines)
+    axes = subset_axes(block_scene(scene, region), simulated)
+    share = sum(subset_share(scene.settings.simulation.subset, name, axes) for name in scene.settings.solutions if name in ENGINE_SOLUTIONS)
+    return float(simulated.size * rows * share)
 
 
 def run_grid(scene: Scene, runner: Runner, solve: BlockSolver, extra_sizes: dict[str, int] | None = None) -> xr.Dataset:

@@ -22,6 +22,7 @@ from vibroimpact.analysis.stability import Regime
 from vibroimpact.engines.registry import make_engine, BUMPER, engine_spec
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.kinds.stepped.grid import no_one_impact_orbit
+from vibroimpact.scene.subset import on_subset
 from vibroimpact.kinds.stepped.values import broadcast_quantities, coordinate_quantity, scene_problem
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
@@ -269,20 +270,24 @@ def general_simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], 
     """Steady states of a time-domain engine on the simulation grid of ``scene``; NaN at the other frequencies."""
     assert scene.settings.simulation is not None
     sim = scene.settings.simulation
-    columns = np.searchsorted(scene.settings.all_frequencies, sim.frequency)
+    simulated = sim.frequency[on_subset(sim.subset, engine, "frequency", sim.frequency)]  # all but an engine's subset
+    columns = np.searchsorted(scene.settings.all_frequencies, simulated)
     on_bumper = engine_spec(engine).contact == BUMPER
     bumpers = scene.settings.bumper_frequency if on_bumper and scene.settings.bumper_frequency is not None else np.array([np.nan])
     losses = scene.settings.loss_factors() if on_bumper and scene.settings.bumper_loss_factor is not None else np.full(scene.settings.restitution.shape, np.nan)
-    chunk = sim.frequency.size if sim.start in SWEEP_STARTS else CASE_CHUNK
+    chunk = max(simulated.size, 1) if sim.start in SWEEP_STARTS else CASE_CHUNK
     specs = scene.stop_specs
+    kept = [on_subset(sim.subset, engine, axis, values) for axis, values in (("restitution", scene.settings.restitution), ("clearance", scene.settings.clearance), ("bumper_frequency", bumpers))]
     cases, places = [], []
     for i, restitution in enumerate(scene.settings.restitution):
         for j, clearance in enumerate(scene.settings.clearance):
             for k, bumper in enumerate(bumpers):
+                if not (kept[0][i] and kept[1][j] and (kept[2][k] or not on_bumper)):
+                    continue  # outside the engine's subset: not computed
                 rigid = build_stops(specs, False, float(restitution), float(clearance))
                 contact = build_stops(specs, True, float(restitution), float(clearance), float(bumper), float(losses[i])) if on_bumper else rigid
-                for first in range(0, sim.frequency.size, chunk):
-                    frequencies = tuple(float(f) for f in sim.frequency[first : first + chunk])
+                for first in range(0, simulated.size, chunk):
+                    frequencies = tuple(float(f) for f in simulated[first : first + chunk])
                     case = SimulationCase(engine, scene.system, scene.amplitude, contact, frequencies, sim.start, sim.engine, sim.steady, rigid if on_bumper else None, scene.load)
                     cases.append(case)
                     places.append((i, j, k, columns[first : first + chunk]))

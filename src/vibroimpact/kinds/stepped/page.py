@@ -25,7 +25,9 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import NullFormatter
 
 from vibroimpact.analysis.stability import Regime
+from vibroimpact.engines.registry import BUMPER, RIGID
 from vibroimpact.kinds.stepped.answers import answer_text, band_peaks, contact_text, convergence_rows, convergence_text, peak_rows, peaks_text, reduction_text
+from vibroimpact.kinds.stepped.crosscheck import cross_check_section, cross_check_text, cross_checks
 from vibroimpact.kinds.stepped.figures import layout_tables, peaks_table, response_panels_figure, structure_figure, where_text
 from vibroimpact.kinds.stepped.responses import SolutionsPage, clearance_text, linear_section, series_by_restitution, regime_figure, response_figure, simulation_figure, stability_figure
 from vibroimpact.kinds.stepped.tables import agreement_table, modal_table, reduction_intro, reduction_tables
@@ -34,8 +36,8 @@ from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reve
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved, StudyPage
 from vibroimpact.reporting.record import StudySetting, GeneralSetting, general_setting, named_layout, study_setting
 from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_points, periodic_points, stability_keys, unstable_points
-from vibroimpact.reporting.style import DISPLACEMENT_SCALE, QUANTITIES, SOLUTION_COLOURS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref, ENGINE_MARKERS, REGIME_COLOURS
-from vibroimpact.scene.schema import ENGINE_SOLUTIONS
+from vibroimpact.reporting.style import DISPLACEMENT_SCALE, QUANTITIES, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref, ENGINE_MARKERS, REGIME_COLOURS
+from vibroimpact.scene.schema import ENGINE_SOLUTIONS, contact_solutions
 
 __all__ = ["page_for", "BumperStiffnessPage", "peak_figure", "peak_tables", "peak_acceleration_figure", "stiffness_figure", "stiffness_tables", "band_peaks", "lyapunov_figure", "FrequencyResponsePage", "RESPONSE_QUANTITIES", "SIMULATION_QUANTITIES", "unswept_restitution", "answer_text"]
 
@@ -128,14 +130,14 @@ def peak_acceleration_figure(part: xr.Dataset, name: str) -> DrawnFigure | None:
                 any_unstable |= unstable
                 if drawn:
                     caption.add("pgf", f"Lines: the estimate from {solution_ref('pgf')}, Gamma(xi_b) Omega_b J / (1 + R) for the force (section 6.3 with the corrected factor Gamma; the deceleration less the absorber spring's pull): the rigid-stop impulse J gives the entry speed, the one-collision solution of the bumper gives the peak.")
-            if "compliant" in present:
-                engines.add("compliant", draw_points(ax, f, QUANTITIES[quantity].scale * line[quantity].sel(solution="compliant").values, periodic=periodic_points(line, "compliant"), solution="compliant", colour=series_colour(i), label=None))
+            for bumper in contact_solutions(present, BUMPER):
+                engines.add(bumper, draw_points(ax, f, QUANTITIES[quantity].scale * line[quantity].sel(solution=bumper).values, periodic=periodic_points(line, bumper), solution=bumper, colour=series_colour(i), label=None))
         finish_axes(ax, "frequency [Hz]", axis_label(quantity), QUANTITIES[quantity].label)
         found += reveal_coincident(ax, curves)
     if any_unstable:
         caption.add("unstable", "Dashed: the estimate on a one-impact orbit that exists but is unstable.")
     if engines:
-        caption.add("compliant", engines.phrase(irregular="irregular motion, the largest over the measured window"))
+        caption.add("bumper", engines.phrase(irregular="irregular motion, the largest over the measured window", each="one marker per simulated point"))
     caption.add("coincide", coincidence_phrase(found))
     keys: list[Line2D | Patch] = [Patch(color=series_colour(i), label=text) for i, (text, _) in enumerate(lines)]
     figure_legend(fig, [], keys + (stability_keys() if any_unstable else []) + engines.keys())
@@ -151,24 +153,28 @@ class BumperStiffnessPage(SolutionsPage):
         """The convergence of the compliant bumper and its cost (the answer), then the linear system."""
         figure = stiffness_figure(self.dataset, self.setting, "bumper_stiffness")
         reference = _stiffness_reference(self.dataset)
-        answer = convergence_text(self.dataset, self.setting, reference) if reference is not None and "compliant" in self.dataset["solution"].values and self.setting.simulation_frequency.size else ""
-        convergence = Section("Compliant bumper against the rigid stop", intro=f"<p>{html.escape(answer)}</p>" if answer else "", figures=saved([figure], out), tables=stiffness_tables(self.dataset, self.setting))
-        return [convergence, linear_section(self.setting, out)]
+        bumpers = contact_solutions([str(s) for s in self.dataset["solution"].values], BUMPER)
+        answer = convergence_text(self.dataset, self.setting, reference, bumpers[0]) if reference is not None and bumpers and self.setting.simulation_frequency.size else ""
+        checks = cross_checks(self.dataset)
+        intro = "".join(f"<p>{html.escape(text)}</p>" for text in [answer] + [cross_check_text(c) for c in checks] if text)
+        convergence = Section("Compliant bumper against the rigid stop", intro=intro, figures=saved([figure], out), tables=stiffness_tables(self.dataset, self.setting))
+        check = cross_check_section(checks)
+        return [convergence, *([check] if check is not None else []), linear_section(self.setting, out)]
 
 
 def _stiffness_reference(dataset: xr.Dataset) -> str | None:
-    """The rigid-stop simulation the compliant one is compared with (exact if present), or None."""
-    for name in ("exact", "momentary"):
-        if name in dataset["solution"].values:
-            return name
-    return None
+    """The rigid-stop simulation the bumper is compared with (one with an exact flow first), or None."""
+    rigid = contact_solutions([str(s) for s in dataset["solution"].values], RIGID)
+    return rigid[0] if rigid else None
 
 
 def stiffness_figure(dataset: xr.Dataset, setting: StudySetting, name: str) -> DrawnFigure | None:
     """Difference of the compliant |X1| from the rigid-stop one against Omega_b, and the wall time per point."""
     reference = _stiffness_reference(dataset)
-    if reference is None or "compliant" not in dataset["solution"].values:
+    bumpers = contact_solutions([str(s) for s in dataset["solution"].values], BUMPER)
+    if reference is None or not bumpers:
         return None
+    compliant = bumpers[0]  # the one computed everywhere: the exact flow where the scene has it
     bumper = dataset["bumper_frequency"].values
     f = setting.simulation_frequency if setting.simulation_frequency.size else dataset["frequency"].values
     panels = 2 if "wall_time" in dataset else 1
@@ -176,23 +182,34 @@ def stiffness_figure(dataset: xr.Dataset, setting: StudySetting, name: str) -> D
     ax = axes[0]
     for k, frequency in enumerate(f):
         point = dataset.sel(frequency=frequency)
-        sim = point["x1_amplitude"].sel(solution="compliant").values
+        sim = point["x1_amplitude"].sel(solution=compliant).values
         ref = point["x1_amplitude"].sel(solution=reference).values
-        ax.loglog(bumper, np.abs(sim - ref) / ref, "o-", color=series_colour(k), ms=4, label=f"{fmt(frequency, 'g')} Hz", gid="compliant")
+        ax.loglog(bumper, np.abs(sim - ref) / ref, "o-", color=series_colour(k), ms=4, label=f"{fmt(frequency, 'g')} Hz", gid=compliant)
     ax.loglog(bumper, 0.1 * bumper[0] / bumper, "k--", lw=0.9, label="slope -1")
     finish_axes(ax, "bumper frequency Omega_b / 2 pi [Hz]", f"relative difference of {QUANTITIES['x1_amplitude'].label} [1]", "Convergence to the rigid stop")
     caption = Caption(
-        f"Left: relative difference of the steady-state {QUANTITIES['x1_amplitude'].label} of {solution_ref('compliant')} (restitution-matched "
+        f"Left: relative difference of the steady-state {QUANTITIES['x1_amplitude'].label} of {solution_ref(compliant)}, {SOLUTION_DESCRIPTIONS[compliant]} (restitution-matched "
         f"loss factor) from the rigid-stop simulation {solution_ref(reference)} as the bumper stiffens, one colour per excitation frequency; the dashed line has slope -1."
     )
     if panels == 2:
         ax = axes[1]
-        for k, frequency in enumerate(f):
-            ax.loglog(bumper, dataset["wall_time"].sel(solution="compliant", frequency=frequency).values, "o-", color=series_colour(k), ms=4, label=f"{fmt(frequency, 'g')} Hz", gid="compliant")
+        if len(bumpers) == 1:
+            for k, frequency in enumerate(f):
+                ax.loglog(bumper, dataset["wall_time"].sel(solution=compliant, frequency=frequency).values, "o-", color=series_colour(k), ms=4, label=f"{fmt(frequency, 'g')} Hz", gid=compliant)
+            cost = f"Right: the wall time of each steady state of {solution_ref(compliant)} (transient plus measurement, one process)"
+        else:
+            for engine in bumpers:
+                walls = dataset["wall_time"].sel(solution=engine, frequency=f).transpose("bumper_frequency", "frequency").values
+                with np.errstate(all="ignore"):
+                    median = np.array([np.nanmedian(w) if np.isfinite(w).any() else np.nan for w in walls])
+                marker = ENGINE_MARKERS.get(engine, ("o", 4.0))[0]
+                run = np.isfinite(median)  # an engine on a subset of the bumpers: its line joins those it ran
+                ax.loglog(bumper[run], median[run], f"{marker}-", color=SOLUTION_COLOURS[engine], ms=6, lw=1.6, label=f"{solution_ref(engine)} (median)", gid=engine)
+            cost = ("Right: the median wall time of a steady state over the simulated frequencies (transient plus measurement, one process) of " + " and of ".join(f"{solution_ref(e)}, {SOLUTION_DESCRIPTIONS[e]}" for e in bumpers) + ", in the same run")
         rigid = float(np.nanmedian(dataset["wall_time"].sel(solution=reference).values))
         ax.axhline(rigid, color="k", ls=":", lw=1.2, label=f"{reference} (median)", gid=reference)
         finish_axes(ax, "bumper frequency Omega_b / 2 pi [Hz]", "wall time per steady state [s]", "Cost of the compliant model")
-        caption.add("cost", f"Right: the wall time of each steady state of {solution_ref('compliant')} (transient plus measurement, one process); dotted: the median of {solution_ref(reference)}.")
+        caption.add("cost", f"{cost}; dotted: the median of {solution_ref(reference)}.")
     for ax in axes:
         # ticks at the bumpers computed: read off directly, and no crowded minor-tick labels on a short log axis
         ax.set_xticks(bumper, [fmt(b, "g") for b in bumper])
@@ -204,12 +221,13 @@ def stiffness_figure(dataset: xr.Dataset, setting: StudySetting, name: str) -> D
 def stiffness_tables(dataset: xr.Dataset, setting: StudySetting) -> list[Table]:
     """Per bumper frequency: median and largest difference from the rigid stop, fitted order, median wall time."""
     reference = _stiffness_reference(dataset)
-    if reference is None or "compliant" not in dataset["solution"].values or not setting.simulation_frequency.size:
+    bumpers = contact_solutions([str(s) for s in dataset["solution"].values], BUMPER)
+    if reference is None or not bumpers or not setting.simulation_frequency.size:
         return []
     rows = ["<tr><th>Omega_b/2pi [Hz]</th><th>median rel. diff. |X1|</th><th>largest</th><th>observed order (median)</th><th>median wall time [s]</th></tr>"]
-    for r in convergence_rows(dataset, setting, reference):
+    for r in convergence_rows(dataset, setting, reference, bumpers[0]):
         rows.append(f"<tr><td>{fmt(r.bumper_frequency, 'g')}</td><td>{fmt(r.median, '.2e')}</td><td>{fmt(r.largest, '.2e')}</td><td>{fmt(r.order, '.2f')}</td><td>{fmt(r.wall_time, '.3f')}</td></tr>")
-    return [Table(f"compliant against {reference}: convergence and cost", "<table>" + "".join(rows) + "</table>")]
+    return [Table(f"{bumpers[0]} against {reference}: convergence and cost", "<table>" + "".join(rows) + "</table>")]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -299,10 +317,13 @@ class FrequencyResponsePage:
         dataset, layout, setting = self.dataset, self.layout, self.setting
         engines = [str(s) for s in dataset["solution"].values if s in ENGINE_SOLUTIONS]
         peaks = [p for p in PEAK_PARAMETERS if p in dataset.dims] if setting is not None and "x1_amplitude" in dataset and engines else []
-        answers = [peaks_text(dataset, setting, p) for p in peaks if setting is not None] + [contact_text(dataset), answer_text(dataset, layout)]
+        checks = cross_checks(dataset)
+        answers = [peaks_text(dataset, setting, p) for p in peaks if setting is not None] + [contact_text(dataset)] + [cross_check_text(c) for c in checks] + [answer_text(dataset, layout)]
         if setting is not None and any(s != "linear" for s in dataset["solution"].values):
             answers.append(reduction_text(dataset, layout))
         sections = [Section("Largest responses", intro="".join(f"<p>{html.escape(a)}</p>" for a in answers if a), tables=[peaks_table(dataset, layout)])]
+        if (check := cross_check_section(checks)) is not None:
+            sections.append(check)
         for parameter in peaks:
             assert setting is not None
             figure = peak_figure(dataset, setting, parameter, f"peaks_vs_{parameter}")
@@ -349,7 +370,7 @@ def _response_figures(part: xr.Dataset, tag: str) -> Iterator[DrawnFigure | None
         yield regime_figure(part, f"regime{tag}")
     if "floquet_modulus" in part and "pgf" in part["solution"].values:
         yield stability_figure(part, f"stability{tag}")
-    if "compliant" in part["solution"].values:
+    if contact_solutions([str(s) for s in part["solution"].values], BUMPER):
         yield peak_acceleration_figure(part, f"peak_acceleration{tag}")
 
 

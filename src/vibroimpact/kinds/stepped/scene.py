@@ -23,6 +23,7 @@ from vibroimpact.model.contact import loss_factor_from_restitution, restitution_
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.modal import underdamped_mode_count
 from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.scene.subset import Subset, parse_subset
 from vibroimpact.scene.checker import Checker, SceneError, interval
 from vibroimpact.scene.layout_parse import check_general_solutions, paper_layout_applies, general_grids, is_general, document_names, parse_load, parse_stop_layout, parse_structure, parse_sweep_stops
 from vibroimpact.scene.schema import (
@@ -49,8 +50,8 @@ REPORT_PAGES = ("design_map",)
 #: A scene's or a case's name: safe as a file name.
 NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 #: Simulation keys that only stepped steady states use.
-_STEADY_ONLY_KEYS = {"frequency", "start", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods"}
-_SIMULATION_KEYS = {"frequency", "start", "method", "rtol", "atol", "max_step", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods"}
+_STEADY_ONLY_KEYS = {"frequency", "start", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods", "subset"}
+_SIMULATION_KEYS = {"frequency", "start", "method", "rtol", "atol", "max_step", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods", "subset"}
 #: Where an unswept parameter is given instead (``frequency`` is always swept).
 _FIXED_PLACE = {"restitution": ("stop", "restitution"), "clearance": ("stop", "clearance"), "bumper_frequency": ("bumper", "frequency"), "bumper_loss_factor": ("bumper", "loss_factor")}
 _T = TypeVar("_T")
@@ -70,12 +71,17 @@ class SimulationSettings:
         Integrator tolerances and method.
     steady : SteadySettings
         Convergence and measurement of the steady state.
+    subset : mapping
+        Solutions run on part of the grid only (``simulation.subset``, :mod:`~vibroimpact.scene.subset`):
+        solution -> axis (``frequency`` [Hz], a swept ``restitution``, ``clearance`` [m] or ``bumper_frequency``
+        [Hz]) -> the values it keeps; an axis or solution not named is kept whole.
     """
 
     frequency: np.ndarray
     start: str = "pgf"
     engine: EngineSettings = field(default_factory=EngineSettings)
     steady: SteadySettings = field(default_factory=SteadySettings)
+    subset: Subset = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -283,7 +289,8 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
             if "swept_sine" in doc:
                 for key in sorted(set(doc["simulation"]) & _STEADY_ONLY_KEYS if isinstance(doc["simulation"], dict) else ()):
                     c.fail(f"simulation.{key}", "not used by a swept-sine test (it sets stepped steady states): remove it")
-            simulation = _parse_simulation(c, doc["simulation"], main_grid, "swept_sine" in doc)
+            swept_axes = {key: grid for key, grid in grids.items() if key in sweep and key != "frequency"}
+            simulation = _parse_simulation(c, doc["simulation"], main_grid, "swept_sine" in doc, engines, swept_axes)
     elif engines and (main_grid := grids.get("frequency")) is not None:
         simulation = _parse_simulation(c, {}, main_grid, "swept_sine" in doc)
 
@@ -397,7 +404,11 @@ def parse_cluster(c: Checker, doc: dict) -> str | None:
     return address
 
 
-def _parse_simulation(c: Checker, value: Any, default_frequency: np.ndarray, swept: bool = False) -> SimulationSettings | None:
+def _parse_simulation(
+    c: Checker, value: Any, default_frequency: np.ndarray, swept: bool = False, engines: list[str] | None = None, axes: dict[str, np.ndarray | None] | None = None,
+) -> SimulationSettings | None:  # fmt: skip
+    """The ``simulation`` section: tolerances, steady-state settings, the simulated frequencies [Hz] and the
+    solutions run on part of the grid (``subset``, checked against ``engines`` and the swept ``axes``)."""
     spec = dict(c.mapping("simulation", value, _SIMULATION_KEYS))
     rtol, atol = SWEPT_TOLERANCES if swept else STEPPED_TOLERANCES
     if "rtol" in spec and "atol" not in spec and isinstance(spec["rtol"], (int, float)) and not isinstance(spec["rtol"], bool):
@@ -412,9 +423,12 @@ def _parse_simulation(c: Checker, value: Any, default_frequency: np.ndarray, swe
     steady_kwargs = {k: spec[k] for k in ("tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods") if k in spec}
     engine = _settings(c, EngineSettings, engine_kwargs)
     steady = _settings(c, SteadySettings, steady_kwargs)
+    subset: Subset = {}
+    if "subset" in spec and frequency is not None and start in SIMULATION_STARTS:
+        subset = parse_subset(c, spec["subset"], engines or [], {"frequency": frequency, **(axes or {})}, start)
     if frequency is None or start not in SIMULATION_STARTS or engine is None or steady is None:
         return None
-    return SimulationSettings(frequency=frequency, start=start, engine=engine, steady=steady)
+    return SimulationSettings(frequency=frequency, start=start, engine=engine, steady=steady, subset=subset)
 
 
 def _settings(c: Checker, kind: type[_T], kwargs: dict[str, Any]) -> _T | None:

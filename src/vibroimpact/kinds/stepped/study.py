@@ -16,6 +16,7 @@ from vibroimpact.kinds.stepped.cases import general_simulated_values
 from vibroimpact.kinds.stepped.grid import StudyGrid, grid_coordinates, solve_each, finish_dataset, EnginePart, grid_estimate
 from vibroimpact.kinds.stepped.values import scene_problem, stop_clearances
 from vibroimpact.kinds.stepped.blocks import plan_blocks, run_grid
+from vibroimpact.scene.subset import subset_axes, subset_share, subset_text
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.runner import Runner
@@ -179,6 +180,11 @@ class SteppedStudy:
             attrs["method_exact"] = "piecewise-exact propagation (eigenvectors + harmonic particular solution), contacts by guaranteed Taylor-bound root bracketing"
             attrs["method_momentary"] = "scikit-sundae CVODE with contact/release events and an apex event guarding grazing contacts"
             attrs["method_compliant"] = "Kelvin-Voigt bumper (eq. 25) through scikit-sundae IDA: one solver per contact mode, onset/release events, recorded force and deceleration peaks; atol of the displacements [m], other states scaled"
+            for name in scene.settings.solutions:  # any other engine the scene runs: its registry entry says what it is
+                if name in ENGINE_SOLUTIONS and f"method_{name}" not in attrs:
+                    attrs[f"method_{name}"] = engine_spec(name).description
+            for name, kept in scene.settings.simulation.subset.items():
+                attrs[f"simulation_subset_{name}"] = subset_text(kept)
         return attrs
 
     def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:
@@ -196,10 +202,12 @@ class SteppedStudy:
             # where the motion may never settle, an engine without exact Jacobians also runs a perturbed copy of its
             # Lyapunov run
             wandering = np.count_nonzero(periods >= steady.max_periods + steady.lyapunov_periods) if not capabilities.exact_jacobians else 0
-            total_periods = (float(periods.sum()) + wandering * steady.lyapunov_periods) * scale * copies
+            share = subset_share(scene.settings.simulation.subset, name, subset_axes(scene))
+            total_periods = (float(periods.sum()) + wandering * steady.lyapunov_periods) * scale * copies * share
             seconds = costs.per_period_cost(engine, scene.settings.simulation.engine.rtol) * engine_scale(scene) * total_periods
             integrated = int(np.count_nonzero(periods) * scale) * copies
-            points = f"{scene.settings.restitution.size * scene.settings.clearance.size * scene.settings.simulation.frequency.size * copies} points, ~{integrated} integrated, ~{total_periods:.0f} periods"
+            integrated = round(integrated * share)
+            points = f"{round(scene.settings.restitution.size * scene.settings.clearance.size * scene.settings.simulation.frequency.size * copies * share)} points, ~{integrated} integrated, ~{total_periods:.0f} periods"
             serial = 0.0
             if scene.settings.simulation.start in SWEEP_STARTS:  # one serial chain per (R, Delta, bumper)
                 serial = seconds / (scene.settings.restitution.size * scene.settings.clearance.size * copies)
