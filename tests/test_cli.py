@@ -222,7 +222,8 @@ def test_help_lists_the_subcommands(capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_calibrate_writes_a_cost_file_that_estimate_reads(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """calibrate -> the cost file (measured tables replaced, the rest kept) -> ``--estimate --costs`` predicts from it."""
+    """calibrate -> the cost file (measured tables replaced, the rest kept, unmeasured engines scaled by the speed
+    probes) -> ``--estimate --costs`` predicts from it."""
     from vibroimpact.runs.estimate import Costs, default_costs
     from vibroimpact.runs.estimate import estimate_scene
 
@@ -233,8 +234,11 @@ def test_calibrate_writes_a_cost_file_that_estimate_reads(tmp_path: Path, capsys
     assert costs.per_period_cost("momentary_adams", 1e-7) == pytest.approx(TINY_PER_PERIOD)
     assert costs.per_period_cost("exact", 1e-7) == pytest.approx(0.5 / 50)
     assert costs.per_sweep_second_cost("compliant_ida", 1e-6) == pytest.approx(0.5) and costs.per_sweep_second_cost("compliant_ida", 1e-8) == pytest.approx(0.9)
-    assert "compliant_cvode_adams" not in costs.per_period  # only what the dataset measured
     shipped = default_costs()
+    # an engine the dataset does not time keeps the shipped cost, carried over by the two machines' speed probes
+    ratio = costs.speed_probe_seconds / shipped.speed_probe_seconds
+    assert costs.per_period_cost("compliant_cvode_adams", 1e-7) == pytest.approx(shipped.per_period_cost("compliant_cvode_adams", 1e-7) * ratio)
+    assert costs.per_period_cost("compliant_exact", 1e-7) == pytest.approx(shipped.per_period_cost("compliant_exact", 1e-7) * ratio)
     assert costs.closed_form_per_point == shipped.closed_form_per_point and costs.startup == shipped.startup
     assert costs.speed_probe_seconds > 0.0 and costs.to_json() == out.read_text()
     # the estimate reads it: every predicted period of momentary costs TINY_PER_PERIOD seconds

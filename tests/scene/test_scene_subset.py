@@ -62,8 +62,8 @@ def test_the_subset_solution_is_computed_on_its_points_only() -> None:
         exact = general_simulated_values(scene, "compliant_exact", grid.full, runner)
     f = grid.frequency
     computed = ida["regime"][:, 0, 0, 0, :] != Regime.NOT_COMPUTED
-    assert computed.sum() == 1 and computed[1, np.flatnonzero(f == 24.0)[0]]
+    assert computed.sum() == 1 and computed[1, np.flatnonzero(f == 24.0)[0]]  # exact: a parsed grid value
     simulated = np.isin(f, [22.0, 24.0, 26.0])
     assert np.all((exact["regime"][:, 0, 0, 0, :] != Regime.NOT_COMPUTED) == simulated[None, :])
-    at = (1, 0, 0, 0, np.flatnonzero(f == 24.0)[0])
+    at = (1, 0, 0, 0, np.flatnonzero(f == 24.0)[0])  # exact: a parsed grid value
     assert ida["x1_amplitude"][at] == pytest.approx(exact["x1_amplitude"][at], rel=1e-4)

@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from vibroimpact.engines.registry import engine_spec
+from vibroimpact.engines.registry import ENGINES, engine_spec
 from vibroimpact.runs.store import atomic_path
 from vibroimpact.scene.kinds import kind_named
 from vibroimpact.scene.schema import Scene
@@ -314,8 +314,10 @@ def estimate_scene(scene: Scene, jobs: int = 1, speed: float | None = None, cost
 
 def calibrate(accuracy: Path, base: Costs | None = None) -> Costs:
     """Costs from an ``accuracy_cost`` dataset: per period of the stepped one-impact case, per simulated second of
-    the swept case, for each method and tolerance; the closed-form and fixed costs are kept from ``base`` (by default
-    the package's costs); the speed probe is timed on this machine, the one that measured the costs.
+    the swept case, for each method and tolerance (one value for a tolerance-free engine); the closed-form and fixed
+    costs are kept from ``base`` (by default the package's costs), and so is the per-period cost of an engine the
+    dataset does not time, scaled by this machine's speed probe over ``base``'s; the speed probe is timed on this
+    machine, the one that measured the costs.
 
     Raises
     ------
@@ -345,10 +347,22 @@ def calibrate(accuracy: Path, base: Costs | None = None) -> Costs:
                 table = {float(t): float(w) / scale for t, w in zip(line["rtol"].values, line.values) if math.isfinite(float(w))}
                 if table:
                     target[str(method)] = table
+    for engine, table in list(per_period.items()):
+        if isinstance(table, dict) and engine in ENGINES and ENGINES[engine].capabilities.tolerance_free:
+            per_period[engine] = float(np.median(list(table.values())))  # one cost: its tolerances change nothing
     base = default_costs() if base is None else base
-    per_period = {**{engine: cost for engine, cost in base.per_period.items() if engine not in per_period}, **per_period}  # engines it does not time keep theirs
-    # the speed probe on the machine that measured the costs
-    return dataclasses.replace(base, per_period=per_period, per_sweep_second=per_sweep, speed_probe_seconds=speed_probe())
+    probe = speed_probe()  # on the machine that measured the costs
+    # an engine this dataset does not time keeps its cost in base, carried to this machine by the speed probes' ratio
+    ratio = probe / base.speed_probe_seconds
+    carried = {engine: _scaled(cost, ratio) for engine, cost in base.per_period.items() if engine not in per_period}
+    return dataclasses.replace(base, per_period={**carried, **per_period}, per_sweep_second=per_sweep, speed_probe_seconds=probe)
+
+
+def _scaled(cost: float | CostTable, factor: float) -> float | dict[float, float]:
+    """A per-period cost (one value or a table over rtol) times ``factor``."""
+    if isinstance(cost, Mapping):
+        return {rtol: value * factor for rtol, value in cost.items()}
+    return float(cost) * factor
 
 
 def write_costs(costs: Costs, path: Path | None = None) -> Path:
