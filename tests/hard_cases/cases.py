@@ -167,6 +167,9 @@ class HardCase:
         Per-engine test timeout [s] (a hang fails the test).
     slow : bool
         Excluded from the default run.
+    long : bool
+        Every engine's row in the ``hard`` tier, none in the default one (a long run whose ground the default tier
+        covers with shorter cases; the ``slow`` tier runs it 20 times longer).
     measure_periods : int
         Last periods over which the X1 fundamental is compared.
     scaled_from : (ImpactProblem, float) or None
@@ -183,6 +186,7 @@ class HardCase:
     bumper: KelvinVoigtBumper | None = None
     timeout: float = 60.0
     slow: bool = False
+    long: bool = False
     measure_periods: int = 10
     scaled_from: tuple[ImpactProblem, float] | None = field(default=None, repr=False)
 
@@ -455,7 +459,7 @@ def _cases() -> list[HardCase]:
     add(HardCase(
         "long-500-periods", "20 s from rest, 500 impacts", problem, _rest(), 500,
         per_engine(exact(), integrated(), integrated(), long_compliant, radau=NotRun(RADAU_COST)),
-        timeout=120,
+        timeout=120, long=True,
     ))
     add(HardCase(
         "very-long-10000-periods", "400 s from rest, 10 000 impacts", problem, _rest(), 10_000,

@@ -30,7 +30,7 @@ def _params() -> list:
             marks = [pytest.mark.timeout(case.timeout)]
             if case.slow:
                 marks.append(pytest.mark.slow)
-            elif engine not in DEFAULT_TIER_ENGINES:
+            elif case.long or engine not in DEFAULT_TIER_ENGINES:
                 marks.append(pytest.mark.hard)
             if isinstance(expect, NotRun):
                 marks.append(pytest.mark.skip(reason=f"{engine} does not run {case.id}: {expect.reason}"))
