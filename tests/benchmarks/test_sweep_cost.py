@@ -22,6 +22,7 @@ from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
 XI = loss_factor_from_restitution(0.2)
 
 
+@pytest.mark.hard  # solve_ivp against IDA on swept sines (~11 s): the hard tier's other engines
 @pytest.mark.timeout(120)
 @pytest.mark.parametrize(
     ("bumper", "method", "stop"),
@@ -66,6 +67,7 @@ def _small_cost_settings(methods: tuple[str, ...], budget: float) -> SweepCostSe
     )
 
 
+@pytest.mark.hard  # real sweeps through IDA and solve_ivp (~6 s)
 @pytest.mark.timeout(120)
 def test_cost_table_runs_slices_over_budget() -> None:
     """Every method is projected from the probe; one projected over the budget runs the slice, which IDA runs too, so

@@ -72,6 +72,7 @@ def _missing_metadata(path: Path) -> None:
     (path / "regime" / ".zarray").unlink()
 
 
+@pytest.mark.faults  # a real store damaged on disk, run again (1-2 s each): with the other injected faults
 @pytest.mark.parametrize(("damage", "blocks_again"), [(_missing_chunk, 1), (_truncated_chunk, 1), (_swapped_chunks, 2), (_missing_metadata, 18)])
 def test_a_damaged_store_ends_in_the_undisturbed_dataset(undisturbed: tuple[object, xr.Dataset, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch, damage: object, blocks_again: int) -> None:
     dataset, lines, solved = _rerun(undisturbed, tmp_path, damage, monkeypatch)
@@ -80,6 +81,7 @@ def test_a_damaged_store_ends_in_the_undisturbed_dataset(undisturbed: tuple[obje
     assert lines == [f"{blocks_again} damaged blocks of 18 finished (resumed) are computed again"]
 
 
+@pytest.mark.faults  # a real store damaged on disk, run again (1-2 s each): with the other injected faults
 def test_a_damaged_root_attribute_file_discards_the_store_in_one_line(undisturbed: tuple[object, xr.Dataset, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     dataset, lines, solved = _rerun(undisturbed, tmp_path, lambda path: (path / ".zattrs").write_text("{ not json"), monkeypatch)
     xr.testing.assert_identical(dataset, undisturbed[1])
@@ -87,6 +89,7 @@ def test_a_damaged_root_attribute_file_discards_the_store_in_one_line(undisturbe
     assert len(lines) == 1 and "its attributes are unreadable (damaged): 18 finished blocks and 0 finished cases discarded" in lines[0]
 
 
+@pytest.mark.faults  # a real store damaged on disk, run again (1-2 s each): with the other injected faults
 def test_an_undamaged_store_is_served_without_a_word(undisturbed: tuple[object, xr.Dataset, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     dataset, lines, solved = _rerun(undisturbed, tmp_path, lambda path: None, monkeypatch)
     xr.testing.assert_identical(dataset, undisturbed[1])
