@@ -169,8 +169,10 @@ def _start_local_cluster(jobs: int) -> Connection:
     """A local cluster of ``jobs`` worker processes, Ctrl-C (and SIGTERM) honoured at every moment of its start.
 
     A terminal's Ctrl-C goes to every process of its group. The workers ignore it from their first instant: they are
-    spawned while this process ignores SIGINT (an ignored signal stays ignored across ``exec``), which lasts only the
-    fork of each (milliseconds: a child is seen in ``/proc`` at once), then they ignore it on their own (the package's ``__init__`` with
+    spawned while this process ignores SIGINT (an ignored signal stays ignored across ``exec``), which lasts until
+    ``jobs`` children run multiprocessing's ``spawn_main`` (milliseconds; the resource tracker multiprocessing starts
+    beside them is not one: counting it once let the second worker be forked after the window, and its imports died of
+    the Ctrl-C with a traceback), then they ignore it on their own (the package's ``__init__`` with
     ``VIBROIMPACT_WORKER``, then the preload). The rest of the start (the scheduler; the workers importing dask and
     numba, 5-16 s under load) records a Ctrl-C, says so at once, stops waiting, closes the cluster and raises it.
     """
@@ -206,7 +208,7 @@ def _start_local_cluster(jobs: int) -> Connection:
             try:
                 cluster.scale(jobs)
                 deadline = time.monotonic() + SPAWN_TIMEOUT
-                while len(_children() - before) < jobs and time.monotonic() < deadline:
+                while len(_spawned_workers(_children() - before)) < jobs and time.monotonic() < deadline:
                     time.sleep(0.005)
             finally:
                 if main:
@@ -246,6 +248,22 @@ def _children() -> set[int]:
         if fields[1].decode() == me:
             children.add(int(entry))
     return children
+
+
+def _spawned_workers(children: set[int]) -> set[int]:
+    """Those of ``children`` (process ids) that run multiprocessing's ``spawn_main`` (a spawned worker once it has
+    exec'd; a child not yet exec'd, or the resource tracker, is not one); elsewhere than Linux all of them."""
+    if not os.path.isdir("/proc"):
+        return children
+    spawned = set()
+    for child in children:
+        try:
+            with open(f"/proc/{child}/cmdline", "rb") as cmdline:
+                if b"spawn_main" in cmdline.read():
+                    spawned.add(child)
+        except OSError:
+            continue  # ended meanwhile
+    return spawned
 
 
 def dask_setup(worker: object) -> None:
