@@ -208,7 +208,8 @@ def _start_local_cluster(jobs: int) -> Connection:
             try:
                 cluster.scale(jobs)
                 deadline = time.monotonic() + SPAWN_TIMEOUT
-                while len(_spawned_workers(_children() - before)) < jobs and time.monotonic() < deadline:
+                spawn = dask.config.get("distributed.worker.multiprocessing-method") == "spawn"  # else: every child
+                while len(_spawned_workers(_children() - before) if spawn else _children() - before) < jobs and time.monotonic() < deadline:
                     time.sleep(0.005)
             finally:
                 if main:
