@@ -126,25 +126,3 @@ def test_workers_is_for_the_estimate(tmp_path: Path, capsys: pytest.CaptureFixtu
     assert "--workers is for --estimate" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
 
-
-@pytest.mark.skipif(not os.path.isdir("/proc"), reason="the window is measured on /proc")
-def test_the_spawn_window_counts_workers_not_the_resource_tracker() -> None:
-    """The workers inherit an ignored Ctrl-C from the window in which they are spawned, and the window closes when
-    ``jobs`` children run ``spawn_main``: multiprocessing's resource tracker, started beside the first worker, must not
-    count as one (it did, and the second worker, forked after the window, died of a Ctrl-C with a traceback)."""
-    import multiprocessing
-    import time
-    from multiprocessing import resource_tracker
-
-    resource_tracker.ensure_running()
-    tracker = resource_tracker._resource_tracker._pid  # type: ignore[attr-defined]
-    child = multiprocessing.get_context("spawn").Process(target=time.sleep, args=(60,))
-    child.start()
-    try:
-        deadline = time.monotonic() + 60.0
-        while not cluster._spawned_workers({child.pid}) and time.monotonic() < deadline:  # type: ignore[arg-type]
-            time.sleep(0.005)
-        assert cluster._spawned_workers({tracker, child.pid}) == {child.pid}  # type: ignore[arg-type]
-    finally:
-        child.terminate()
-        child.join()

@@ -15,7 +15,7 @@ import pytest
 
 from tests.run_study_process import start_run_study, stored_blocks
 from tests.test_cli import _slow_scene
-from vibroimpact.runs.cluster import unreachable
+from vibroimpact.runs.cluster import connect, unreachable
 
 
 def _wait_for(run: object, stream_lines: list[str], text: str, deadline: float) -> None:
@@ -65,6 +65,26 @@ def test_sigterm_ends_the_run_like_ctrl_c_with_its_blocks_kept(tmp_path: Path) -
     assert "Traceback" not in err and "leaked semaphore" not in err, err
     assert err.rstrip().splitlines()[-1] == f"terminated (SIGTERM): {kept} finished block{'s' if kept != 1 else ''} kept in out/interrupted.zarr; run the same command to resume"
     assert kept >= 1
+
+
+@pytest.mark.faults
+@pytest.mark.timeout(300)
+@pytest.mark.skipif(not os.path.isdir("/proc"), reason="a process's signal mask is read from /proc")
+def test_a_local_clusters_workers_are_born_with_ctrl_c_blocked() -> None:
+    """A terminal's Ctrl-C reaches every process of the group: the workers must not die of it while they import (the
+    flaky traceback above). They are born with SIGINT blocked (nothing in a worker blocks it itself: blocked now means
+    inherited from the spawn), and the study's own thread is left able to receive it."""
+    sigint = 1 << (signal.SIGINT - 1)
+    connection = connect(2, None)
+    try:
+        pids = connection.client.run(os.getpid).values()  # type: ignore[attr-defined]
+        for pid in pids:
+            status = Path(f"/proc/{pid}/status").read_text()
+            blocked = int(next(line.split()[1] for line in status.splitlines() if line.startswith("SigBlk:")), 16)
+            assert blocked & sigint, f"worker {pid}: SigBlk {blocked:#x} lacks SIGINT"
+        assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, [])
+    finally:
+        connection.close()
 
 
 class _Silent(http.server.BaseHTTPRequestHandler):

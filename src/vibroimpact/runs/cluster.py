@@ -27,7 +27,8 @@ SCHEDULER_VARIABLE = "VIBROIMPACT_SCHEDULER"
 #: MALLOC_TRIM_THRESHOLD_ (glibc returning freed memory above 64 KiB to the system at once, 4 % more time for the
 #: exact engine's many small arrays, measured in one process), and one malloc arena (a worker computes in a thread).
 #: ``VIBROIMPACT_WORKER`` makes a worker ignore Ctrl-C from its first import of the package (the parent's main module,
-#: which ``multiprocessing`` imports first in a spawned child): the study's process handles it.
+#: which ``multiprocessing`` imports first in a spawned child), should it not be born with SIGINT blocked
+#: (:func:`_cluster_blocking_ctrl_c`): the study's process handles it.
 WORKER_ENVIRONMENT = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1, "MALLOC_ARENA_MAX": 1, "VIBROIMPACT_WORKER": 1}
 #: dask settings of a local cluster's workers: no statistical profiler (it samples the computing thread every 10 ms
 #: for a dashboard the study does not show; 36 blocks of the design map on 2 workers: 6.6 s with it, 6.1 s without,
@@ -161,23 +162,16 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM (a batch system's end of time, ``timeout``, ``kill``): handled like Ctrl-C, finished work kept."""
 
 
-#: Longest wait for a local cluster's worker processes to be spawned (not started: spawning is a fork and exec) [s].
-SPAWN_TIMEOUT = 30.0
-
-
 def _start_local_cluster(jobs: int) -> Connection:
     """A local cluster of ``jobs`` worker processes, Ctrl-C (and SIGTERM) honoured at every moment of its start.
 
-    A terminal's Ctrl-C goes to every process of its group. The workers ignore it from their first instant: they are
-    spawned while this process ignores SIGINT (an ignored signal stays ignored across ``exec``), which lasts until
-    ``jobs`` children run multiprocessing's ``spawn_main`` (milliseconds; the resource tracker multiprocessing starts
-    beside them is not one: counting it once let the second worker be forked after the window, and its imports died of
-    the Ctrl-C with a traceback), then they ignore it on their own (the package's ``__init__`` with
-    ``VIBROIMPACT_WORKER``, then the preload). The rest of the start (the scheduler; the workers importing dask and
-    numba, 5-16 s under load) records a Ctrl-C, says so at once, stops waiting, closes the cluster and raises it.
+    A terminal's Ctrl-C goes to every process of its group. The workers never receive it: they are born with SIGINT
+    blocked (:func:`_cluster_blocking_ctrl_c`), and their preload then ignores it. This process handles it throughout:
+    the start (the scheduler; the workers importing dask and numba, 5-16 s under load) records a Ctrl-C, says so at
+    once, stops waiting, closes the cluster and raises it.
     """
     import dask.config
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     interrupted: list[int] = []
 
@@ -199,21 +193,10 @@ def _start_local_cluster(jobs: int) -> Connection:
     cluster = client = None
     try:
         with dask.config.set(WORKER_CONFIG):  # the nannies hand it to the worker processes as they are made
-            cluster = LocalCluster(n_workers=0, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL, preload=[__name__])
+            cluster = _cluster_blocking_ctrl_c()
             client = Client(cluster, set_as_default=False)
             stop_if_interrupted(cluster, client)
-            before = _children()
-            if main:
-                signal.signal(signal.SIGINT, signal.SIG_IGN)  # only while the workers are forked
-            try:
-                cluster.scale(jobs)
-                deadline = time.monotonic() + SPAWN_TIMEOUT
-                spawn = dask.config.get("distributed.worker.multiprocessing-method") == "spawn"  # else: every child
-                while len(_spawned_workers(_children() - before) if spawn else _children() - before) < jobs and time.monotonic() < deadline:
-                    time.sleep(0.005)
-            finally:
-                if main:
-                    signal.signal(signal.SIGINT, record)
+            cluster.scale(jobs)
         while len(client.scheduler_info(n_workers=-1).get("workers", {})) < jobs and not interrupted:
             if cluster.status.name in ("failed", "closed"):
                 raise RuntimeError(f"the local cluster's workers failed to start ({cluster.status.name})")
@@ -229,42 +212,29 @@ def _start_local_cluster(jobs: int) -> Connection:
     return Connection(client, cluster, cluster.scheduler_address)
 
 
-def _children() -> set[int]:
-    """Process ids of this process's children: read from ``/proc`` at once (a child is listed from its fork, before
-    ``multiprocessing`` has finished handing it its start-up data); elsewhere the processes ``multiprocessing`` knows."""
-    import multiprocessing
+def _cluster_blocking_ctrl_c() -> object:
+    """A local cluster (no workers yet) whose worker processes will be born with SIGINT blocked.
 
-    me = str(os.getpid())
+    The cluster's event loop thread is started while this thread blocks SIGINT, and a thread inherits its creator's
+    signal mask: the loop's thread, the threads it starts (one per worker process, which spawns it) and the processes
+    they spawn keep SIGINT blocked, across ``exec`` and through the workers' seconds of imports. This thread blocks it
+    only while the cluster object is made (a Ctrl-C meanwhile is held, then handled). Multiprocessing's resource tracker
+    is started here first: started later, from the loop's threads, it would *unblock* SIGINT in the thread that starts
+    it (it blocks SIGINT and SIGTERM around its own spawn, then unblocks them), and the workers spawned from there
+    would be born able to die of a Ctrl-C during their imports, with a traceback (CI's faults tier saw one). Were the
+    tracker ever restarted, the package's ``__init__`` (``VIBROIMPACT_WORKER``) still ignores Ctrl-C from a worker's
+    first import.
+    """
+    from multiprocessing import resource_tracker
+
+    from distributed import LocalCluster
+
+    resource_tracker.ensure_running()
+    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
-        entries = [entry for entry in os.listdir("/proc") if entry.isdigit()]
-    except OSError:
-        return {child.pid for child in multiprocessing.active_children() if child.pid is not None}
-    children = set()
-    for entry in entries:
-        try:
-            with open(f"/proc/{entry}/stat", "rb") as stat:
-                fields = stat.read().rsplit(b")", 1)[1].split()
-        except (OSError, IndexError):
-            continue  # ended meanwhile
-        if fields[1].decode() == me:
-            children.add(int(entry))
-    return children
-
-
-def _spawned_workers(children: set[int]) -> set[int]:
-    """Those of ``children`` (process ids) that run multiprocessing's ``spawn_main`` (a spawned worker once it has
-    exec'd; a child not yet exec'd, or the resource tracker, is not one); elsewhere than Linux all of them."""
-    if not os.path.isdir("/proc"):
-        return children
-    spawned = set()
-    for child in children:
-        try:
-            with open(f"/proc/{child}/cmdline", "rb") as cmdline:
-                if b"spawn_main" in cmdline.read():
-                    spawned.add(child)
-        except OSError:
-            continue  # ended meanwhile
-    return spawned
+        return LocalCluster(n_workers=0, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL, preload=[__name__])
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
 
 
 def dask_setup(worker: object) -> None:
