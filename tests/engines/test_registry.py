@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vibroimpact.engines.registry import BUMPER, ENGINES, RIGID, engine_names, engine_spec, make_engine
+from vibroimpact.engines.registry import BUMPER, CAPABILITIES, ENGINES, RIGID, engine_for, engine_names, engine_spec, make_engine
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
 from vibroimpact.model.excitation import HarmonicForce, SweptSine
@@ -58,6 +58,27 @@ def test_a_fixed_method_overrides_the_settings() -> None:
 def test_an_unknown_name_lists_the_registered_ones() -> None:
     with pytest.raises(ValueError, match="engine 'adams' is unknown: use one of exact, exact_python, momentary"):
         make_engine("adams")
+
+
+@pytest.mark.parametrize("contact", [RIGID, BUMPER])
+@pytest.mark.parametrize("capability", CAPABILITIES)
+def test_engine_for_is_the_first_registered_with_the_capability(contact: str, capability: str) -> None:
+    """Whichever engine it names solves the contact law with the capability, and none registered before it does."""
+    with_it = [name for name in engine_names(contact) if getattr(engine_spec(name).capabilities, capability)]
+    if not with_it:
+        with pytest.raises(ValueError, match=f"contact = '{contact}', capability = '{capability}': no registered engine"):
+            engine_for(contact, capability)
+        return
+    assert engine_for(contact, capability) == with_it[0]
+
+
+def test_engine_for_names_the_references_and_refuses_unknown_capabilities() -> None:
+    assert (engine_for(RIGID, "exact_flow"), engine_for(BUMPER, "exact_flow")) == ("exact", "compliant_exact")
+    assert engine_for(RIGID, "exact_jacobians") == "exact" and engine_for(BUMPER, "sweeps") == "compliant"
+    with pytest.raises(ValueError, match="capability = 'jacobians': the capability is unknown: use one of exact_jacobians, exact_flow"):
+        engine_for(RIGID, "jacobians")
+    with pytest.raises(ValueError, match="contact = 'soft'.*contact laws 'rigid', 'bumper'"):
+        engine_for("soft", "exact_flow")
 
 
 @pytest.mark.parametrize("name", list(ENGINES))

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
+from vibroimpact.model.contact import BUMPER as BUMPER_LAW, RIGID, KelvinVoigtBumper, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce, SweptSine
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import PAPER_SYSTEM
@@ -44,6 +44,14 @@ def test_a_harmonic_property_of_a_sweep_names_the_excitation(name: str) -> None:
     problem = ImpactProblem(PAPER_SYSTEM, BUMPER, SWEEP)
     with pytest.raises(TypeError, match="excitation = SweptSine.*not a HarmonicForce"):
         getattr(problem, name)
+
+
+def test_the_contact_law_is_rigid_only_when_every_stop_is() -> None:
+    both = (Stop(STOP, coordinate=1, side="upper"), Stop(BUMPER, coordinate=1, side="lower"))
+    assert ImpactProblem(PAPER_SYSTEM, STOP, FORCE).contact_law == RIGID
+    assert ImpactProblem(PAPER_SYSTEM, (Stop(STOP), Stop(STOP, side="lower")), FORCE).contact_law == RIGID
+    assert ImpactProblem(PAPER_SYSTEM, BUMPER, FORCE).contact_law == BUMPER_LAW
+    assert ImpactProblem(PAPER_SYSTEM, both, FORCE).contact_law == BUMPER_LAW
 
 
 def test_the_wrong_contact_law_is_named() -> None:

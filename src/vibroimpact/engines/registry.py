@@ -11,16 +11,17 @@ its name. Adding an engine is one module plus one line here::
 from __future__ import annotations
 
 import importlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from types import MappingProxyType
 from typing import Any, Mapping
 
 from vibroimpact.engines.settings import EngineSettings
+from vibroimpact.model.contact import BUMPER, RIGID
 
-__all__ = ["RIGID", "BUMPER", "Capabilities", "EngineSpec", "ENGINES", "engine_names", "stepped_solutions", "engine_spec", "make_engine", "jacobian_engine"]
+__all__ = ["RIGID", "BUMPER", "Capabilities", "CAPABILITIES", "EngineSpec", "ENGINES", "engine_names", "stepped_solutions", "engine_spec", "make_engine", "engine_for"]
 
-#: Contact laws an engine can solve: the momentary-impact stop and the Kelvin-Voigt bumper.
-RIGID, BUMPER = "rigid", "bumper"
+# RIGID and BUMPER, the contact laws an engine can solve (the momentary-impact stop and the Kelvin-Voigt bumper), are
+# the model's names (vibroimpact.model.contact), re-exported here beside the capabilities that use them.
 
 
 @dataclass(frozen=True)
@@ -57,6 +58,10 @@ class Capabilities:
             raise ValueError(f"contact = {self.contact!r} is not allowed: use {RIGID!r} or {BUMPER!r}")
         if self.exact_flow and not self.tolerance_free:
             raise ValueError("an engine with an exact flow has no tolerance: tolerance_free must be True")
+
+
+#: The names of what an engine can do beyond its contact law: the boolean fields of :class:`Capabilities`.
+CAPABILITIES = tuple(item.name for item in fields(Capabilities) if item.name != "contact")
 
 
 @dataclass(frozen=True)
@@ -154,10 +159,19 @@ def make_engine(name: str, settings: EngineSettings = EngineSettings()) -> Any:
     return engine_spec(name).build(settings)
 
 
-def jacobian_engine(contact: str, settings: EngineSettings = EngineSettings()) -> Any:
-    """The first registered engine that solves ``contact`` (:data:`RIGID`, :data:`BUMPER`) with exact Jacobians of its
-    stroboscopic map (what shooting and continuation need), built with ``settings``; ``ValueError`` if none does."""
-    for spec in ENGINES.values():
-        if spec.contact == contact and spec.capabilities.exact_jacobians:
-            return spec.build(settings)
-    raise ValueError(f"contact = {contact!r}: no registered engine gives exact Jacobians for it")
+def engine_for(contact: str, capability: str) -> str:
+    """The name of the first registered engine that solves ``contact`` (:data:`RIGID`, :data:`BUMPER`) and has
+    ``capability`` (one of :data:`CAPABILITIES`): e.g. ``exact_jacobians`` for shooting and continuation,
+    ``exact_flow`` for a contact law's reference.
+
+    Raises
+    ------
+    ValueError
+        ``capability`` is not one of :data:`CAPABILITIES`, or no registered engine solves ``contact`` with it.
+    """
+    if capability not in CAPABILITIES:
+        raise ValueError(f"contact = {contact!r}, capability = {capability!r}: the capability is unknown: use one of {', '.join(CAPABILITIES)}")
+    for name, spec in ENGINES.items():
+        if spec.contact == contact and getattr(spec.capabilities, capability):
+            return name
+    raise ValueError(f"contact = {contact!r}, capability = {capability!r}: no registered engine solves the contact law with the capability (contact laws {RIGID!r}, {BUMPER!r}; capabilities {', '.join(CAPABILITIES)})")

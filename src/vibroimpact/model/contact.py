@@ -38,6 +38,8 @@ if TYPE_CHECKING:
     from vibroimpact.model.system import TwoDofSystem
 
 __all__ = [
+    "RIGID",
+    "BUMPER",
     "Stop",
     "SIDES",
     "ContactLaw",
@@ -50,6 +52,11 @@ __all__ = [
     "release_time",
     "restitution_from_loss_factor",
 ]
+
+#: The contact laws by name, the vocabulary of problems (:attr:`ImpactProblem.contact_law
+#: <vibroimpact.model.problem.ImpactProblem.contact_law>`) and of the engines that solve them: the momentary-impact
+#: stop (:class:`RigidStop`) and the Kelvin-Voigt bumper (:class:`KelvinVoigtBumper`).
+RIGID, BUMPER = "rigid", "bumper"
 
 
 @dataclass(frozen=True)

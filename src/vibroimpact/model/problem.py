@@ -14,7 +14,7 @@ from typing import TypeVar, Union
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop
+from vibroimpact.model.contact import BUMPER, RIGID, KelvinVoigtBumper, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce, SweptSine, load_weights, static_load
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
@@ -197,6 +197,13 @@ class ImpactProblem:
         if len(stops) != 1:
             raise ValueError(f"contact: the problem has {len(stops)} stops; a single-stop quantity needs exactly one")
         return stops[0].law
+
+    @property
+    def contact_law(self) -> str:
+        """:data:`~vibroimpact.model.contact.RIGID` if every stop is a rigid stop, else
+        :data:`~vibroimpact.model.contact.BUMPER`: the contact law an engine must solve for this problem (an engine's
+        ``capabilities.contact``)."""
+        return RIGID if all(stop.rigid for stop in self.stops) else BUMPER
 
     @property
     def clearance(self) -> float:

@@ -2,9 +2,9 @@
 
 ``ImpactMap(problem, periods=k)`` maps the state (x, x') at t = 0 (mod T), 2N wide ((X1, X2, X1', X2') on the
 paper's layout), to the state k excitation periods later, with the exact Jacobian of a compiled engine that gives one
-(:func:`~vibroimpact.engines.registry.jacobian_engine`, chosen by the stops' contact law: state-transition matrices
-times saltation matrices of impacts, sticking and release for rigid stops; of contact onsets for bumpers). Its
-parameters are
+(the first registered with ``exact_jacobians`` for the stops' contact law,
+:func:`~vibroimpact.engines.registry.engine_for`: state-transition matrices times saltation matrices of impacts,
+sticking and release for rigid stops; of contact onsets for bumpers). Its parameters are
 ``frequency`` [Hz], ``restitution`` [-], ``clearance`` [m] and ``amplitude`` [N] (or the base amplitude [m] of a base
 motion); a parameter vector becomes a new problem (the frequency changes the period, the strobes stay at t = 0 mod
 T; the force's phase, distribution over the coordinates and static part are kept). With several stops, ``stop``
@@ -42,7 +42,7 @@ from numpy.typing import ArrayLike, NDArray
 from typing import Any
 
 from vibroimpact.engines.base import MODE_FREE
-from vibroimpact.engines.registry import BUMPER, RIGID, jacobian_engine
+from vibroimpact.engines.registry import BUMPER, engine_for, make_engine
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import HybridInfo, MapEvaluation, PeriodicOrbit
@@ -78,12 +78,6 @@ def stop_selection(problem: ImpactProblem, stop: int | str | None) -> tuple[int,
     return (stop,)
 
 
-def contact_of(problem: ImpactProblem) -> str:
-    """:data:`~vibroimpact.engines.registry.RIGID` or :data:`~vibroimpact.engines.registry.BUMPER`: the contact law of
-    ``problem``'s stops."""
-    return RIGID if all(stop.rigid for stop in problem.stops) else BUMPER
-
-
 class ImpactMap:
     """Stroboscopic map over ``periods`` excitation periods of a problem with rigid stops or Kelvin-Voigt bumpers under
     a harmonic force.
@@ -96,7 +90,7 @@ class ImpactMap:
         k >= 1: excitation periods per map iteration.
     engine : optional
         The engine that computes the map: one with exact Jacobians for the stops' contact law (default: the first
-        registered, :func:`~vibroimpact.engines.registry.jacobian_engine`, default settings).
+        registered, :func:`~vibroimpact.engines.registry.engine_for`, default settings).
     bounds : dict, optional
         Parameter name -> (lower, upper): outside this box the map has no image (NaN, a failed step), e.g. to keep a
         continuation's trials at physical frequencies. Parameters outside their own ranges (a negative frequency,
@@ -132,8 +126,8 @@ class ImpactMap:
         if int(periods) < 1:
             raise ValueError(f"periods = {periods!r} is out of range: allowed [1, inf)")
         self.problem, self.periods = problem, int(periods)
-        self.contact = contact_of(problem)
-        self.engine = engine if engine is not None else jacobian_engine(self.contact)
+        self.contact = problem.contact_law
+        self.engine = engine if engine is not None else make_engine(engine_for(self.contact, "exact_jacobians"))
         chosen = problem.stops[self.stops[0]]
         self.parameters = np.array([problem.frequency, chosen.law.restitution, chosen.clearance, problem.amplitude])
         self.dimension = 2 * problem.size
@@ -215,7 +209,7 @@ def _law(law: RigidStop | KelvinVoigtBumper, clearance: float, restitution: floa
 def _outside_stops(problem: ImpactProblem, y: NDArray[np.float64]) -> bool:
     """Every gap Delta_k - n_k . x >= 0 (on the paper's layout: X2 <= Delta); any state of a bumper problem (a
     bumper may be compressed)."""
-    if contact_of(problem) == BUMPER:
+    if problem.contact_law == BUMPER:
         return True
     return bool(np.all(problem.clearances() - problem.normals() @ np.asarray(y[: problem.size], dtype=float) >= 0.0))
 
@@ -280,8 +274,8 @@ def resection(problem: ImpactProblem, state: NDArray[np.float64], periods: int, 
     (ImpactProblem, ndarray)
         The problem with the new force phase [rad] (everything else kept), and the state (x, x') at its t = 0.
     """
-    contact = contact_of(problem)
-    engine = engine if engine is not None else jacobian_engine(contact)
+    contact = problem.contact_law
+    engine = engine if engine is not None else make_engine(engine_for(contact, "exact_jacobians"))
     if contact == BUMPER:
         return _resection_bumper(problem, np.asarray(state, dtype=float), int(periods), engine)
     run = engine.integrate(problem, np.asarray(state, dtype=float), 0.0, int(periods))

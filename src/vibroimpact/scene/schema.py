@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from typing import Generic, Sequence, TypeVar
 
 
-from vibroimpact.engines.registry import engine_names, engine_spec, stepped_solutions
+from vibroimpact.engines.registry import RIGID, engine_for, engine_names, engine_spec, stepped_solutions
 from vibroimpact.model.problem import Structure
 from vibroimpact.scene.kinds import KIND_NAMES
 from vibroimpact.scene.layout import LoadSpec, StopSpec
@@ -48,12 +48,17 @@ ENGINE_CONTACT = {name: engine_spec(name).contact for name in ENGINE_SOLUTIONS}
 
 
 def contact_solutions(solutions: Sequence[str], contact: str) -> list[str]:
-    """The time-domain solutions among ``solutions`` that solve ``contact`` (``rigid`` or ``bumper``), those with an
-    exact flow (each contact law's reference) first, then in their order."""
+    """The time-domain solutions among ``solutions`` that solve ``contact`` (``rigid`` or ``bumper``), the contact
+    law's reference (its first registered engine with an exact flow,
+    :func:`~vibroimpact.engines.registry.engine_for`) first, then in their order."""
     chosen = [name for name in solutions if ENGINE_CONTACT.get(name) == contact]
-    return sorted(chosen, key=lambda name: not engine_spec(name).capabilities.exact_flow)
-#: The engine every rigid-stop benchmark method is measured against; a benchmark always runs it.
-BENCHMARK_REFERENCE = "exact"
+    reference = engine_for(contact, "exact_flow")
+    return sorted(chosen, key=lambda name: name != reference)
+
+
+#: The engine every rigid-stop benchmark method is measured against (the rigid stop's first registered engine with an
+#: exact flow); a benchmark always runs it.
+BENCHMARK_REFERENCE = engine_for(RIGID, "exact_flow")
 #: Engines a benchmark scene may compare: every registered engine but the reference.
 BENCHMARK_METHODS = tuple(name for name in engine_names() if name != BENCHMARK_REFERENCE)
 #: Directions of a swept-sine test.

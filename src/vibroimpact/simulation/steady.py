@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.engines.base import Engine
-from vibroimpact.model.contact import RigidStop, Stop
+from vibroimpact.model.contact import RIGID, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.simulation.harmonics import HarmonicMeasures, measure, gaps, linear_state, resting_state, suspension_force
@@ -289,7 +289,7 @@ def _steady_state(
     used = 0
     first_chunk = settings.chunk_periods
     if start == "shooting":
-        own = all(stop.rigid for stop in problem.stops)  # shot on the problem itself, not on its rigid stand-in
+        own = problem.contact_law == RIGID  # shot on the problem itself, not on its rigid stand-in
         shot = shoot_orbit(problem if own else _rigid(problem, orbit_stop), t, y)
         used = shot.periods if shot is not None else 0
         if shot is not None and shot.stable:

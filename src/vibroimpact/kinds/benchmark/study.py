@@ -19,7 +19,7 @@ from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.engines.base import Engine, SweepRecord, Trajectory
 from vibroimpact.engines.compliant.ivp import solve_ivp_sweep
-from vibroimpact.engines.registry import BUMPER, ENGINES, RIGID, engine_spec, make_engine
+from vibroimpact.engines.registry import BUMPER, ENGINES, RIGID, engine_for, engine_spec, make_engine
 from vibroimpact.engines.settings import REFERENCE_RTOL, EngineSettings
 from vibroimpact.kinds.stepped.grid import layout_attributes
 from vibroimpact.kinds.stepped.study import engine_scale
@@ -34,7 +34,7 @@ from vibroimpact.scene.variables import BENCHMARK_ATTRIBUTES, LADDER_ATTRIBUTES
 from vibroimpact.simulation.harmonics import measure, running_fundamental
 from vibroimpact.simulation.steady import start_state
 
-__all__ = ["run_benchmark", "reference_engine", "REFERENCES", "model_ladder", "equal_error_speedup", "loosest_tolerance", "exact_kernel", "measured_names", "REFERENCE_RTOL", "TOLERANCE_FREE", "BenchmarkStudy"]
+__all__ = ["run_benchmark", "REFERENCES", "model_ladder", "equal_error_speedup", "loosest_tolerance", "exact_kernel", "measured_names", "REFERENCE_RTOL", "TOLERANCE_FREE", "BenchmarkStudy"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -187,16 +187,12 @@ def exact_kernel(case: BenchmarkCase, moments: bool = True) -> Callable[[], int]
     return kernel
 
 
-def reference_engine(contact: str) -> str:
-    """The reference of a model: the first registered engine solving ``contact`` (:data:`RIGID`, :data:`BUMPER`) with
-    an exact flow (the compiled closed form, which the registry lists before its pure-Python cross-check)."""
-    return next(name for name, spec in ENGINES.items() if spec.contact == contact and spec.capabilities.exact_flow)
-
-
-#: The references, by the model they measure: the rigid stop's and the bumper's closed forms, and for a swept sine (no
-#: closed form: a chirp has no closed-form particular solution) CVODE Adams at REFERENCE_RTOL; the dataset's
-#: ``reference`` coordinate, in this order.
-REFERENCES = {"rigid": reference_engine(RIGID), "bumper": reference_engine(BUMPER), "swept": "compliant_cvode_adams"}
+#: The references, by the model they measure: the rigid stop's and the bumper's closed forms (the first registered
+#: engine with an exact flow for each contact law, :func:`~vibroimpact.engines.registry.engine_for`: the compiled one,
+#: which the registry lists before its pure-Python cross-check), and for a swept sine (no closed form: a chirp has no
+#: closed-form particular solution) CVODE Adams at REFERENCE_RTOL; the dataset's ``reference`` coordinate, in this
+#: order.
+REFERENCES = {"rigid": engine_for(RIGID, "exact_flow"), "bumper": engine_for(BUMPER, "exact_flow"), "swept": "compliant_cvode_adams"}
 
 
 def _model(case: BenchmarkCase, method: str) -> str:

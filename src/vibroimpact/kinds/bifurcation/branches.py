@@ -33,7 +33,7 @@ from scipy.optimize import brentq
 from vibroimpact.analysis.impact_orbit import ROOTS, ImpactOrbit, solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.analysis.linear import linear_amplitudes
-from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.contact import BUMPER, RigidStop
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.bifurcations import switch_period_doubling
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Branch, Iterated, PeriodicOrbit, SpecialPoint
@@ -307,7 +307,7 @@ def find_branches(
     if linear:
         for segment in linear_segments(problem, low, high):
             found.add_linear(problem, segment)
-    bumper = not all(stop.rigid for stop in problem.stops)
+    bumper = problem.contact_law == BUMPER
     reference = rigid_twin(problem) if bumper else problem  # whose closed form starts the branches
     refusal = closed_form_refusal(reference) if one_impact else None
     if refusal is not None:

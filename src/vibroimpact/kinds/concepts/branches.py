@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.engines.base import Trajectory
 from vibroimpact.kinds.concepts.scene import Concept
-from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.contact import RIGID
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import Branch
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
@@ -48,7 +48,7 @@ def check_stops(trajectory: Trajectory) -> None:
     (strobes, segment starts) is inside a stop, to :data:`GAP_TOLERANCE` of the motion's length: an engine that does
     not know a layout (e.g. takes a relative stop for the paper's) is refused instead of trusted."""
     problem = trajectory.problem
-    if not all(isinstance(stop.law, RigidStop) for stop in problem.stops):
+    if problem.contact_law != RIGID:
         return  # a bumper is compressed while in contact: penetration is its law, nothing to check
     normals, clearances = problem.normals(), problem.clearances()
     size = problem.size
