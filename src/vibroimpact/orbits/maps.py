@@ -97,14 +97,15 @@ class ImpactMap:
         R > 1) never have one.
     stop : int or 'all', optional
         The stop(s) whose clearance and restitution the parameters are (module docstring).
-    parameter_scale : array_like, shape (4,), optional
-        A unit of arclength for each parameter (default (1 Hz, 0.1, 1 mm, 1 N); e.g. dimensionless problems take
-        their own).
+    parameter_scale : array_like, shape (m,), optional
+        A unit of arclength for each of the m parameters (default :attr:`default_parameter_scale`: 1 Hz, 0.1, 1 mm,
+        1 N); e.g. dimensionless problems take their own.
 
     Attributes
     ----------
-    parameters : ndarray, shape (4,)
-        The base problem's (frequency [Hz], restitution [-], clearance [m], amplitude [N]).
+    parameters : ndarray, shape (m,)
+        The base problem's (frequency [Hz], restitution [-], clearance [m], amplitude [N]), in the order of
+        ``parameter_names`` (a subclass may add more: :class:`~vibroimpact.orbits.bumper_map.BumperPeriodMap`).
     dimension : int
         2N, the state's length.
     stops : tuple of int
@@ -112,11 +113,13 @@ class ImpactMap:
     state_scale : ndarray, shape (2N,)
         (L, ..., V, ...) with L = Delta + q |H12(w)| [m] on the paper's layout (in general the largest |Delta_k| +
         |n_k H F| plus a static load's excursion, :meth:`ImpactProblem.velocity_scale` / w) and V = w L [m s-1].
-    parameter_scale : ndarray, shape (4,)
+    parameter_scale : ndarray, shape (m,)
         What counts as a unit of arclength for each parameter.
     """
 
-    parameter_names = tuple(PARAMETERS)
+    parameter_names: tuple[str, ...] = tuple(PARAMETERS)
+    #: One unit of arclength per parameter, in the order of ``parameter_names``: 1 Hz, 0.1, 1 mm, 1 N.
+    default_parameter_scale: tuple[float, ...] = (1.0, 0.1, 1e-3, 1.0)
 
     def __init__(self, problem: ImpactProblem, periods: int = 1, engine: Any = None, bounds: dict[str, tuple[float, float]] | None = None,
                  stop: int | str | None = None, parameter_scale: ArrayLike | None = None) -> None:  # fmt: skip
@@ -129,26 +132,31 @@ class ImpactMap:
         self.contact = problem.contact_law
         self.engine = engine if engine is not None else make_engine(engine_for(self.contact, "exact_jacobians"))
         chosen = problem.stops[self.stops[0]]
-        self.parameters = np.array([problem.frequency, chosen.law.restitution, chosen.clearance, problem.amplitude])
+        self.parameters = np.array([problem.frequency, chosen.law.restitution, chosen.clearance, problem.amplitude, *self._more_parameters(chosen.law)])
         self.dimension = 2 * problem.size
         length = problem.length_scale()  # Delta + q |H12| on the paper's layout
         self.state_scale = np.repeat([length, problem.omega * length], problem.size)
-        self.parameter_scale = np.array([1.0, 0.1, 1e-3, 1.0]) if parameter_scale is None else np.array(parameter_scale, dtype=float)
-        if self.parameter_scale.shape != (4,) or not np.all(self.parameter_scale > 0.0):
-            raise ValueError(f"parameter_scale = {parameter_scale!r}: expected 4 positive numbers (frequency, restitution, clearance, amplitude)")
+        names = self.parameter_names
+        self.parameter_scale = np.array(self.default_parameter_scale if parameter_scale is None else parameter_scale, dtype=float)
+        if self.parameter_scale.shape != (len(names),) or not np.all(self.parameter_scale > 0.0):
+            raise ValueError(f"parameter_scale = {parameter_scale!r}: expected {len(names)} positive numbers ({', '.join(names)})")
         self.bounds = dict(bounds or {})
-        unknown = set(self.bounds) - set(PARAMETERS)
+        unknown = set(self.bounds) - set(names)
         if unknown:
-            raise ValueError(f"bounds: unknown parameters {sorted(unknown)}; allowed {list(PARAMETERS)}")
+            raise ValueError(f"bounds: unknown parameters {sorted(unknown)}; allowed {list(names)}")
         self._box = [(self.parameter_names.index(name), float(low), float(high)) for name, (low, high) in self.bounds.items()]
 
     def with_periods(self, periods: int) -> "ImpactMap":
         """The same map over ``periods`` excitation periods (one compiled call per evaluation, unlike ``Iterated``)."""
-        return ImpactMap(self.problem, periods, self.engine, self.bounds, self.stop, self.parameter_scale)
+        return type(self)(self.problem, periods, self.engine, self.bounds, self.stop, self.parameter_scale)
+
+    def _more_parameters(self, law: RigidStop | KelvinVoigtBumper) -> tuple[float, ...]:
+        """Values of the parameters after the four of :data:`PARAMETERS` (none here) for the chosen stop's ``law``."""
+        return ()
 
     def problem_at(self, p: NDArray[np.float64]) -> ImpactProblem:
         """The problem with parameter vector ``p``."""
-        frequency, restitution, clearance, amplitude = (float(x) for x in p)
+        frequency, restitution, clearance, amplitude = (float(x) for x in p[:4])
         base = self.problem
         excitation = dataclasses.replace(base.harmonic, amplitude=amplitude, frequency=frequency)
         stops = tuple(dataclasses.replace(item, law=_law(item.law, clearance, restitution)) if k in self.stops else item for k, item in enumerate(base.stops))

@@ -1,0 +1,80 @@
+"""The stroboscopic map of a problem with Kelvin-Voigt bumpers, with the bumpers' stiffness as a parameter.
+
+:class:`BumperPeriodMap` is :class:`~vibroimpact.orbits.maps.ImpactMap` with a fifth parameter, the bumper period
+T_b = 2 pi / Omega_b [s]: the period of the absorber's own oscillation on the bumper, Omega_b^2 = K_b / M2. The rigid
+stop is its limit T_b -> 0, and the compliant model's steady states, branches and special points approach the rigid
+stop's at first order in T_b: a special point continued in (frequency, T_b) with
+:func:`~vibroimpact.orbits.continuation.continue_special_point` is a nearly straight curve that says which bumper
+point continues which rigid one, and where a branch the rigid stop has ends as the bumper softens (a fold curve
+reaching a cusp), without matching points of separate branches by distance.
+
+Changing T_b keeps the bumper's restitution R, hence its loss factor (R depends on the loss factor alone, corrected
+eq. 26): K_b and B_b = 2 M2 xi_b Omega_b scale together.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from vibroimpact.model.contact import BUMPER, KelvinVoigtBumper, RigidStop
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.orbits.maps import PARAMETERS, ImpactMap
+
+__all__ = ["BumperPeriodMap", "BUMPER_PERIOD"]
+
+#: The added parameter's name; its units are seconds.
+BUMPER_PERIOD = "bumper_period"
+
+
+class BumperPeriodMap(ImpactMap):
+    """:class:`~vibroimpact.orbits.maps.ImpactMap` of a problem whose selected stops are Kelvin-Voigt bumpers, with
+    their period T_b = 2 pi / Omega_b = 1 / (Omega_b / 2 pi) [s] as the fifth parameter.
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+        Harmonic force; the stops the parameters set (``stop``) carry Kelvin-Voigt bumpers of one Omega_b.
+    periods, engine, bounds, stop
+        As :class:`~vibroimpact.orbits.maps.ImpactMap`; ``bounds`` may bound ``bumper_period`` [s] too.
+    parameter_scale : array_like, shape (5,), optional
+        A unit of arclength per parameter (default 1 Hz, 0.1, 1 mm, 1 N, 1 ms).
+
+    Raises
+    ------
+    ValueError
+        A selected stop is a rigid stop, or the selected bumpers differ in Omega_b.
+    """
+
+    parameter_names = (*PARAMETERS, BUMPER_PERIOD)
+    default_parameter_scale = (*ImpactMap.default_parameter_scale, 1e-3)
+
+    def __init__(self, problem: ImpactProblem, periods: int = 1, engine: Any = None, bounds: dict[str, tuple[float, float]] | None = None,
+                 stop: int | str | None = None, parameter_scale: ArrayLike | None = None) -> None:  # fmt: skip
+        super().__init__(problem, periods, engine, bounds, stop, parameter_scale)
+        laws = [problem.stops[k].law for k in self.stops]
+        if problem.contact_law != BUMPER or not all(isinstance(law, KelvinVoigtBumper) for law in laws):
+            raise ValueError(f"stop = {stop!r}: a bumper period needs Kelvin-Voigt bumpers on every selected stop (stops {list(self.stops)})")
+        frequencies = {law.frequency for law in laws}  # type: ignore[union-attr]
+        if len(frequencies) > 1:
+            raise ValueError(f"stop = {stop!r}: the selected bumpers differ in Omega_b / 2 pi ({sorted(frequencies)} Hz): select one stop, or give them one")
+
+    def _more_parameters(self, law: RigidStop | KelvinVoigtBumper) -> tuple[float, ...]:
+        """T_b = 1 / (Omega_b / 2 pi) [s] of the chosen stop's bumper (NaN for a rigid stop: refused after)."""
+        return (1.0 / law.frequency,) if isinstance(law, KelvinVoigtBumper) else (math.nan,)
+
+    def problem_at(self, p: NDArray[np.float64]) -> ImpactProblem:
+        """The problem with parameter vector ``p`` (frequency, restitution, clearance, amplitude, T_b); a T_b <= 0
+        raises ``ValueError`` (the rigid stop is the limit, not a member)."""
+        problem = super().problem_at(p)
+        period = float(p[4])
+        if not period > 0.0:
+            raise ValueError(f"{BUMPER_PERIOD} = {period!r} s is out of range: allowed (0, inf)")
+        stops = tuple(
+            dataclasses.replace(item, law=dataclasses.replace(item.law, frequency=1.0 / period)) if k in self.stops else item for k, item in enumerate(problem.stops)
+        )
+        return ImpactProblem(problem.system, stops, problem.excitation)
