@@ -139,3 +139,75 @@ def test_the_bumpers_special_points_are_matched_to_the_rigid_stops_with_their_ob
     assert "moves them by up to 0.272 Hz (the fold at 26.703 Hz)" in answer and "contact onsets at tangency at 20.618 Hz" in answer
     rigid = rigid_view(data)
     assert rigid.sizes["special_point"] == 2 and "branch_bumper_frequency" not in rigid.coords
+
+
+def _crowded_dataset(curves: bool) -> xr.Dataset:
+    """Two Neimark-Sacker points of the rigid stop 0.54 Hz apart whose bumper counterparts move by up to 1.3 Hz (the
+    38-40 Hz crowd of the shipped study), and a small branch whose two folds meet at a cusp at a 839 Hz bumper (found at
+    4 kHz only); with ``curves``, each followed in the bumper's stiffness (straight lines in T_b, as first order makes
+    them, the fold pair one curve that turns back at T_b = 1/839 s)."""
+    from vibroimpact.kinds.bifurcation.branches import ORIGINS
+    from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS
+    from vibroimpact.scene.variables import flag_attributes
+
+    ns = [(39.0256, -325.3), (39.5635, -292.3)]  # (rigid [Hz], slope [Hz s-1] in T_b)
+    cusp = 1.0 / 839.0
+    folds = [(18.2519, (18.40 - 18.2519) / cusp), (18.7126, (18.40 - 18.7126) / cusp)]
+    bumpers = [250.0, 1000.0, 4000.0]
+    kinds, frequencies, owners = [], [], []
+    for fb in (np.inf, *bumpers):
+        t = 0.0 if np.isinf(fb) else 1.0 / fb
+        for f0, slope in ns:
+            kinds, frequencies, owners = kinds + [2], frequencies + [f0 + slope * t], owners + [fb]
+        if t <= 1.0 / 4000.0:  # the small branch: started at the rigid stop and at 4 kHz only
+            for f0, slope in folds:
+                kinds, frequencies, owners = kinds + [0], frequencies + [f0 + slope * t], owners + [fb]
+    n = len(kinds)
+    coords = {
+        "branch": ("branch_point", np.arange(4)), "branch_bumper_frequency": ("branch_point", np.array([np.inf, *bumpers])),
+        "special_point_kind": ("special_point", np.array(kinds, dtype=np.int8), flag_attributes("kind", SPECIAL_POINT_KINDS)),
+        "special_point_frequency": ("special_point", np.array(frequencies)), "special_point_restitution": ("special_point", np.full(n, 0.2)),
+        "special_point_branch": ("special_point", np.zeros(n, dtype=int)), "special_point_bumper_frequency": ("special_point", np.array(owners)), "restitution": [0.2],
+    }  # fmt: skip
+    if curves:
+        t = np.linspace(1.0 / 64000.0, 1.0 / 200.0, 40)
+        near = np.linspace(1.0 / 64000.0, cusp, 30)
+        rows = [(0, 2, f0 + s * t, t) for f0, s in ns[:1]] + [(1, 2, f0 + s * t, t) for f0, s in ns[1:]]
+        rows.append((2, 0, np.concatenate([folds[0][0] + folds[0][1] * near, (folds[1][0] + folds[1][1] * near)[::-1][1:]]), np.concatenate([near, near[::-1][1:]])))
+        coords |= {
+            "stiffness_curve": ("stiffness_point", np.concatenate([np.full(r[3].size, r[0]) for r in rows]).astype(np.int32)),
+            "stiffness_kind": ("stiffness_point", np.concatenate([np.full(r[3].size, r[1]) for r in rows]).astype(np.int8), flag_attributes("kind", SPECIAL_POINT_KINDS)),
+            "stiffness_restitution": ("stiffness_point", np.full(sum(r[3].size for r in rows), 0.2)),
+            "stiffness_frequency": ("stiffness_point", np.concatenate([r[2] for r in rows])),
+            "stiffness_bumper_frequency": ("stiffness_point", 1.0 / np.concatenate([r[3] for r in rows])),
+        }  # fmt: skip
+    return xr.Dataset({"branch_origin": ("branch_point", np.ones(4, dtype=np.int8), flag_attributes("how", ORIGINS)),
+                       "special_point_period_multiplicity": ("special_point", np.ones(n, dtype=np.int16))}, coords=coords)  # fmt: skip
+
+
+def test_curves_in_the_bumpers_stiffness_match_crowded_points_and_say_where_a_branch_ends() -> None:
+    """By distance, the 1 kHz counterparts of two Neimark-Sacker points 0.54 Hz apart are ambiguous (each chain's two
+    candidates are about equally near); along their curves in the stiffness each is the other's neighbour's, order 1.
+    A fold pair whose curve turns back at 839 Hz: at 1 kHz the curve gives the points (no branch was started there),
+    at 250 Hz there are none, and the page says so."""
+    from vibroimpact.kinds.bifurcation.bumper import bumper_answer, convergence_rows, convergence_table
+    from vibroimpact.kinds.bifurcation.stiffness import monotone_pieces
+
+    by_distance = {round(row["rigid"], 4): row for row in convergence_rows(_crowded_dataset(False), 0.2)}
+    assert by_distance[39.0256]["ambiguous"][1] and not np.isfinite(by_distance[39.0256]["bumpers"][1])
+    rows = {round(row["rigid"], 4): row for row in convergence_rows(_crowded_dataset(True), 0.2)}
+    for f0, slope in ((39.0256, -325.3), (39.5635, -292.3)):
+        row = rows[f0]
+        np.testing.assert_allclose(row["bumpers"], [f0 + slope / fb for fb in (250.0, 1000.0, 4000.0)], rtol=0, atol=1e-9)
+        assert row["followed"] and not any(row["continued"]) and np.allclose(row["orders"], 1.0, atol=1e-6)
+    for f0 in (18.2519, 18.7126):
+        row = rows[f0]
+        assert row["followed"] and row["continued"] == [False, True, False] and np.isnan(row["bumpers"][0])
+        assert row["ends"] == pytest.approx(839.0, rel=1e-9)
+    table = convergence_table(_crowded_dataset(True)).html
+    assert table.count("none: its curve ends at 839 Hz") == 2 and table.count("by the continuation alone") == 2 and "ambiguous" not in table
+    answer = bumper_answer(_crowded_dataset(True))
+    assert "the fold at 18.252 Hz has no counterpart below 839 Hz, where its curve in the bumper's stiffness ends" in answer
+    assert "2 of the table's points are found by the continuation in the stiffness alone" in answer
+    pieces = monotone_pieces(np.array([1.0, 2.0, 3.0, 2.5, 1.5]), np.array([10.0, 11.0, 12.0, 13.0, 14.0]))
+    assert [p[0].tolist() for p in pieces] == [[1.0, 2.0, 3.0], [1.5, 2.5, 3.0]] and pieces[1][1].tolist() == [14.0, 13.0, 12.0]

@@ -2,19 +2,25 @@
 special points converge to the rigid stop's as the bumper stiffens.
 
 Dataset layout read here: :mod:`vibroimpact.kinds.bifurcation.study` with ``branch_bumper_frequency`` and
-``special_point_bumper_frequency`` [Hz] (inf: the rigid stop). Each special point of the rigid stop's closed-form
-branches (fold, period doubling, Neimark-Sacker, grazing) is followed from the stiffest bumper to the softest: the
+``special_point_bumper_frequency`` [Hz] (inf: the rigid stop), and the curves of the stiffest bumper's special points
+in the bumper's stiffness (``stiffness_*``, :mod:`vibroimpact.kinds.bifurcation.stiffness`).
+
+Which bumper point continues which rigid one: along a curve where there is one. A rigid fold, period doubling or
+Neimark-Sacker point is continued by the curve (a piece of it monotone in T_b) whose stiff end, extrapolated to
+T_b = 0 by Richardson's rule (first-order convergence), lands on it within :data:`RICHARDSON` of the distance it
+removes; at each bumper its counterpart is the located point within
+:data:`~vibroimpact.kinds.bifurcation.stiffness.ON_CURVE` of the curve, or the curve's own value where no branch of
+that bumper passes it, or none where the curve ends short of that bumper (the branch's folds meet at a cusp).
+Otherwise (contact onsets at tangency, which do not depend on Omega_b; a dataset without curves) by distance: the
 stiffest bumper's nearest point of the same kind on its closed-form branches within :data:`MATCH_WINDOW` of the rigid
 one, then each softer bumper's point within :data:`GROWTH` times the previous distance times the ratio of the bumper
 frequencies (at least :data:`MATCH_FLOOR`) of the previous match: a chain along which the distance may grow at most
 like first order, doubled. A match must be clear: the chain's nearest candidate, at most :data:`SEPARATION` times as
-far as its next, and nearer to this chain's previous match than to any other chain's of the kind; where points of
-one kind crowd (the Neimark-Sacker points of 38-40 Hz at 250 Hz and 1 kHz) the chain stops and the table says
-"ambiguous" (which point continues which would take a continuation in Omega_b). The observed order of convergence
-between two bumper frequencies fa < fb is p = ln(|e_a| / |e_b|) / ln(fb / fa), e the difference from the rigid
-stop's frequency (p = 1: first order in 1/Omega_b). A difference below :data:`SAME_POINT` of the frequency is the same
-point (the contact onset at tangency of the one-contact orbit is where the linear orbit touches the surface, whatever
-the bumper).
+far as its next, and nearer to this chain's previous match than to any other chain's of the kind; otherwise the
+chain stops and the table says "ambiguous". The observed order of convergence between two bumper frequencies
+fa < fb is p = ln(|e_a| / |e_b|) / ln(fb / fa), e the difference from the rigid stop's frequency (p = 1: first order
+in 1/Omega_b). A difference below :data:`SAME_POINT` of the frequency is the same point (the contact onset at tangency
+of the one-contact orbit is where the linear orbit touches the surface, whatever the bumper).
 """
 
 from __future__ import annotations
@@ -27,6 +33,7 @@ import xarray as xr
 
 from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, ORBIT_PALETTE, SPECIAL_MARKERS, first_coordinate, flags
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
+from vibroimpact.kinds.bifurcation.stiffness import ON_CURVE, SOFTER, STIFFER, monotone_pieces, on_piece
 from vibroimpact.reporting.page import DrawnFigure, Table
 from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure
 
@@ -42,6 +49,12 @@ MATCH_FLOOR = 0.05
 SEPARATION = 0.5
 #: A bumper's special point within this of the rigid stop's, relative, is the same point [-] (the location's accuracy).
 SAME_POINT = 1e-9
+#: A curve continues a rigid special point when Richardson's extrapolation of its stiff end lands within this share of
+#: the distance it removes [-] (first-order convergence: the extrapolation removes nearly all of it; measured 1e-3 of it
+#: for the fold at 26.7 Hz, 64 kHz).
+RICHARDSON = 0.1
+#: A curve that stops short of the softest bumper by more than this share of its period "ends" there [-].
+REACH = 0.01
 #: Colour of the rigid stop's branches; the bumpers take :data:`ORBIT_PALETTE` in order of frequency.
 RIGID_COLOUR = "k"
 #: Line colours of the convergence panel, one per special point (Okabe-Ito's and grey; black is the rigid stop's).
@@ -114,6 +127,19 @@ def convergence_rows(dataset: xr.Dataset, restitution: float) -> list[dict[str, 
             if alive[n] and np.isfinite(matched[n, i]):
                 ratio = bumpers[i] / bumpers[i - 1] if i else 1.0
                 previous[n], window[n] = matched[n, i], max(MATCH_FLOOR, GROWTH * ratio * abs(matched[n, i] - f0))
+    continued = np.zeros((len(rigid), len(bumpers)), dtype=bool)
+    ends = np.full(len(rigid), np.nan)
+    followed = np.zeros(len(rigid), dtype=bool)
+    pieces: list[tuple[np.ndarray, np.ndarray] | None] = [None] * len(rigid)
+    for n, (kind, f0) in enumerate(rigid):
+        curve = pieces[n] = _curve_of(dataset, restitution, kind, f0)
+        if curve is None:
+            continue  # not followed in the stiffness (a contact onset at tangency), or no curve reaches it: by distance
+        followed[n], ambiguous[n] = True, False
+        for i, fb in enumerate(bumpers):
+            matched[n, i], continued[n, i] = _on_curve(curve, 1.0 / fb, [f for k, f in sets[fb] if k == kind])
+        if curve[0][-1] < (1.0 - REACH) / bumpers[0]:
+            ends[n] = 1.0 / curve[0][-1]
     rows = []
     for n, (kind, f0) in enumerate(rigid):
         errors = matched[n] - f0
@@ -124,8 +150,56 @@ def convergence_rows(dataset: xr.Dataset, restitution: float) -> list[dict[str, 
             for i in range(len(bumpers) - 1)
         ]  # fmt: skip
         rows.append({"kind": kind, "rigid": f0, "bumpers": list(matched[n]), "errors": errors, "same": bool(found.any() and np.all(same[found])), "orders": orders,
-                     "ambiguous": list(ambiguous[n])})  # fmt: skip
+                     "ambiguous": list(ambiguous[n]), "followed": bool(followed[n]), "continued": list(continued[n]), "ends": float(ends[n]), "curve": pieces[n]})  # fmt: skip
     return rows
+
+
+def _curves(dataset: xr.Dataset, restitution: float, kind: str) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The curves in the bumper's stiffness of special points of ``kind`` at ``restitution``, as their
+    :func:`~vibroimpact.kinds.bifurcation.stiffness.monotone_pieces` (T_b [s], frequency [Hz]) (none when the dataset
+    has no curves)."""
+    if "stiffness_curve" not in dataset.coords:
+        return []
+    kinds = flags(dataset["stiffness_kind"])
+    if kind not in kinds:
+        return []
+    chosen = (dataset["stiffness_kind"].values == kinds.index(kind)) & np.isclose(dataset["stiffness_restitution"].values, restitution)
+    out = []
+    for label in np.unique(dataset["stiffness_curve"].values[chosen]):
+        index = np.flatnonzero(chosen & (dataset["stiffness_curve"].values == label))
+        out += monotone_pieces(1.0 / dataset["stiffness_bumper_frequency"].values[index], dataset["stiffness_frequency"].values[index])
+    return out
+
+
+def _curve_of(dataset: xr.Dataset, restitution: float, kind: str, rigid: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """The curve that continues the rigid stop's special point (``kind`` at ``rigid`` Hz): its stiff end extrapolated
+    to T_b = 0 by Richardson's rule, 2 f(T) - f(2 T), lands on ``rigid`` within :data:`RICHARDSON` of the distance
+    f(T) - rigid that the extrapolation removes (the nearest such curve); None if none does."""
+    best, distance = None, math.inf
+    for piece in _curves(dataset, restitution, kind):
+        t = piece[0][0]
+        if 2.0 * t > piece[0][-1]:
+            continue  # too short to extrapolate
+        near = on_piece(piece, t)
+        limit = 2.0 * near - on_piece(piece, 2.0 * t)
+        miss = abs(limit - rigid)
+        if miss <= RICHARDSON * abs(near - rigid) + SAME_POINT * rigid and miss < distance:
+            best, distance = piece, miss
+    return best
+
+
+def _on_curve(piece: tuple[np.ndarray, np.ndarray], period: float, located: list[float]) -> tuple[float, bool]:
+    """The special point at bumper period ``period`` [s] on a curve's piece: the located point of that bumper's
+    branches within :data:`~vibroimpact.kinds.bifurcation.stiffness.ON_CURVE` of the piece, else the piece's own value
+    (True: found by the continuation only, no branch of that bumper passes it); NaN where the piece does not reach
+    ``period``."""
+    value = on_piece(piece, period)
+    if not math.isfinite(value):
+        return math.nan, False
+    near = [f for f in located if abs(f - value) <= ON_CURVE]
+    if near:
+        return min(near, key=lambda f: abs(f - value)), False
+    return value, True
 
 
 def _name(kind: str) -> str:
@@ -143,8 +217,13 @@ def convergence_table(dataset: xr.Dataset) -> Table:
     for r in dataset["restitution"].values:
         for row in convergence_rows(dataset, float(r)):
             cells = [fmt(float(r), "g"), _name(str(row["kind"])), fmt(float(row["rigid"]), ".4f")]
-            for f, e, unclear in zip(row["bumpers"], row["errors"], row["ambiguous"]):
-                cells.append(("ambiguous" if unclear else "not found") if not math.isfinite(f) else f"{fmt(f, '.4f')} ({'+' if e >= 0 else '−'}{fmt(abs(e), '.2e')})")
+            for fb, f, e, unclear, alone in zip(bumpers, row["bumpers"], row["errors"], row["ambiguous"], row["continued"]):
+                if math.isfinite(f):
+                    cells.append(f"{fmt(f, '.4f')} ({'+' if e >= 0 else '−'}{fmt(abs(e), '.2e')})" + (", by the continuation alone" if alone else ""))
+                elif math.isfinite(row["ends"]) and fb < row["ends"]:
+                    cells.append(f"none: its curve ends at {fmt(row['ends'], '.0f')} Hz")
+                else:
+                    cells.append("ambiguous" if unclear else "not found")
             cells += ["same point" if row["same"] else ("—" if not math.isfinite(p) else fmt(p, ".2f")) for p in row["orders"]]
             body.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
     header = "".join(f"<th>{html.escape(h)}</th>" for h in heads)
@@ -185,7 +264,19 @@ def bumper_answer(dataset: xr.Dataset) -> str:
         if same:
             words.append(f"the contact onsets at tangency at {', '.join(fmt(float(row['rigid']), '.3f') for row in same)} Hz, where the one-impact orbit's entry speed "
                          f"vanishes on the linear orbit touching the surface, are the rigid stop's grazing points for every bumper that has them (within {fmt(SAME_POINT, 'g')} relative)")  # fmt: skip
-        missing = [row for row in rows if not np.all(np.isfinite(np.asarray(row["errors"], dtype=float)))]
+        followed = [row for row in rows if row["followed"]]
+        if followed:
+            words.append(f"{len(followed)} of the rigid stop's special points (folds, period doublings, Neimark-Sacker points) have a curve in the bumper's "
+                         f"stiffness, followed from the {fmt(bumpers[-1], 'g')} Hz bumper's over {fmt(bumpers[0] / SOFTER, 'g')}-{fmt(bumpers[-1] * STIFFER, 'g')} Hz, "
+                         "whose stiff end, extrapolated to the rigid stop, lands on them: the table matches along these curves")  # fmt: skip
+        for row in rows:
+            if math.isfinite(row["ends"]):
+                words.append(f"the {_name(str(row['kind']))} at {fmt(float(row['rigid']), '.3f')} Hz has no counterpart below {fmt(row['ends'], '.0f')} Hz, where its curve in "
+                             "the bumper's stiffness ends")  # fmt: skip
+        alone = sum(int(np.sum(row["continued"])) for row in rows)
+        if alone:
+            words.append(f"{alone} of the table's points are found by the continuation in the stiffness alone (no branch of that bumper was started through them)")
+        missing = [row for row in rows if not np.all(np.isfinite(np.asarray(row["errors"], dtype=float))) and not math.isfinite(row["ends"])]
         if missing:
             words.append(f"{len(missing)} of the rigid stop's {len(rows)} special points have no counterpart at some bumper (table)")
         parts.append(f"<p><b>R = {fmt(float(r), 'g')}, bumpers of {', '.join(fmt(fb, 'g') for fb in bumpers)} Hz against the rigid stop</b>: " + "; ".join(words) + ".</p>")
@@ -231,8 +322,13 @@ def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
             errors = np.abs(np.asarray(row["errors"], dtype=float))
             if row["same"] or np.isfinite(errors).sum() < 2:
                 continue
-            right.plot(inverse, errors, marker=SPECIAL_MARKERS.get(str(row["kind"]), "x"), color=CONVERGENCE_COLOURS[drawn % len(CONVERGENCE_COLOURS)], lw=1.4, mfc="none", ms=7,
-                       label=f"{KIND_NAMES.get(str(row['kind']), str(row['kind']))} at {fmt(float(row['rigid']), '.2f')} Hz")  # fmt: skip
+            colour, entry = CONVERGENCE_COLOURS[drawn % len(CONVERGENCE_COLOURS)], f"{KIND_NAMES.get(str(row['kind']), str(row['kind']))} at {fmt(float(row['rigid']), '.2f')} Hz"
+            if row["curve"] is not None:  # the curve in the stiffness, and the table's points on it
+                t, f = row["curve"]
+                right.plot(t, np.abs(f - float(row["rigid"])), color=colour, lw=1.4, label=entry)
+                right.plot(inverse, errors, marker=SPECIAL_MARKERS.get(str(row["kind"]), "x"), color=colour, lw=0, mfc="none", ms=7)
+            else:
+                right.plot(inverse, errors, marker=SPECIAL_MARKERS.get(str(row["kind"]), "x"), color=colour, lw=1.4, mfc="none", ms=7, label=entry)
             drawn += 1
     if drawn:
         errors = [np.abs(np.asarray(row["errors"], dtype=float)) for r in dataset["restitution"].values for row in convergence_rows(dataset, float(r)) if not row["same"]]
@@ -251,7 +347,8 @@ def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
         f"collision restitution is R, Delta = {fmt(float(dataset['clearance']) * 1e3, 'g')} mm: the {label} fundamental, solid where stable, dashed where "
         "unstable; open markers in the branch's colour: its special points. Right: the distance of each special point of the bumpers' branches from the "
         "rigid stop's against 1 / (Omega_b / 2 pi) [1/Hz], log-log, one colour per special point (legend: its kind and the rigid stop's frequency), "
-        "each followed from the stiffest bumper (the table's matching); the dotted black line has slope 1 (first-order convergence). The contact onsets at tangency, the same points for every bumper, and points found at one bumper only "
-        "are not drawn there."
+        "markers at the bumpers of the study, lines: the special point followed in the bumper's stiffness (its curve from the stiffest bumper, "
+        "where the table's matching comes from; markers joined by straight lines where no curve was followed); the dotted black line has slope 1 "
+        "(first-order convergence). The contact onsets at tangency, the same points for every bumper, and points found at one bumper only are not drawn there."
     )
     return DrawnFigure(fig, "bumper_convergence", "One-impact branches of the bumpers and of the rigid stop, and how their special points converge", caption)

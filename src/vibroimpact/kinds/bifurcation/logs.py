@@ -120,6 +120,8 @@ FAILURES: dict[str, FailureKind] = {
                                 "the chart lacks the curves of those branches' special points; the diagrams are unaffected"),
     "curve": FailureKind("following special points in (frequency, clearance) for the chart",
                          "those curves are missing from the chart; the regime map and the other curves are unaffected"),
+    "stiffness_curve": FailureKind("following the stiffest bumper's special points in the bumper's stiffness",
+                                   "the convergence table matches those points to the rigid stop's by distance only; the branches are unaffected"),
 }  # fmt: skip
 #: Fields of a case's arrays that count its work and keep its failures (:func:`failure_arrays`).
 FAILURE_FIELDS = ("attempt_kind", "attempt_count", "failure_kind", "failure_detail")

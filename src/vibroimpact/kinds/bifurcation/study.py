@@ -33,7 +33,12 @@ point coordinates carry the prefix of their dimension.
 With ``bifurcation.bumper`` the branch and special points of every (restitution, bumper frequency) follow the rigid
 stop's, each set continued on its own (stops that are Kelvin-Voigt bumpers of that Omega_b and the loss factor of
 R), and both dimensions gain a coordinate ``branch_bumper_frequency`` / ``special_point_bumper_frequency`` [Hz]
-(inf for the rigid stop's points); the brute force is the rigid stop's.
+(inf for the rigid stop's points); the brute force is the rigid stop's. Per restitution the stiffest bumper's folds,
+period doublings and Neimark-Sacker points are followed in the bumper's stiffness
+(:class:`~vibroimpact.kinds.bifurcation.stiffness.StiffnessCase`, alongside the branch sets): dimension
+``stiffness_point`` with coordinates ``stiffness_curve``, ``stiffness_kind`` (flags), ``stiffness_restitution``,
+``stiffness_frequency`` [Hz] and ``stiffness_bumper_frequency`` [Hz] (Omega_b / 2 pi at the curve point), each
+curve's points in their order along it.
 
 The scene's layout (the paper's named form or the general one: matrices, a load on any coordinate or a base motion,
 a list of stops) becomes one general :class:`~vibroimpact.model.problem.ImpactProblem` per restitution
@@ -58,12 +63,13 @@ from vibroimpact.scene.variables import BIFURCATION_ATTRIBUTES, COORDINATE_ATTRI
 from vibroimpact.kinds.bifurcation.branches import MAX_ORBIT_IMPACTS, ORIGINS
 from vibroimpact.kinds.bifurcation.logs import Tally, chart_labels, continuation_log, failure_summary, numbered_across, relabel, sweep_tally, tallies
 from vibroimpact.kinds.bifurcation.cases import MAX_KEPT_IMPACTS, MAX_PERIOD, MOTION_CLASSES, BranchCase, ChartCase, SweepCase, Seed, sweep_seeds
+from vibroimpact.kinds.bifurcation.stiffness import SOFTER, STIFFER, StiffnessCase
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.run import provenance
 from vibroimpact.runs.runner import CaseResult, Runner
 
-__all__ = ["BifurcationStudy", "scene_problem", "CONTINUATION_SECONDS", "CLOSED_FORM_SECONDS", "CHART_SECONDS", "REPORT_FIGURES"]
+__all__ = ["BifurcationStudy", "scene_problem", "CONTINUATION_SECONDS", "CLOSED_FORM_SECONDS", "CHART_SECONDS", "STIFFNESS_SECONDS", "REPORT_FIGURES"]
 
 #: Wall time of the continuation of one restitution's branches on the calibration machine [s], with the branches
 #: seeded from the brute force (measured: 11-15 s for R = 0.2 and 0.8 at load ~2), and without (1.8-2.3 s).
@@ -71,6 +77,9 @@ CONTINUATION_SECONDS = 13.0
 CLOSED_FORM_SECONDS = 3.0
 #: Wall time of the chart's curves on the calibration machine [s] (measured: ~15 s).
 CHART_SECONDS = 20.0
+#: Measured time [s] of one restitution's curves in the bumper's stiffness (the stiffest bumper's branches again, then
+#: its special points followed: 31 s for the shipped bifurcation_bumper's 8 curves, on the quiet machine).
+STIFFNESS_SECONDS = 31.0
 #: Figures of the report: per restitution a diagram and the multipliers; the chart.
 REPORT_FIGURES = 3
 #: Cost of a brute-force period with moments and Jacobians, relative to a plain ``exact`` period [-].
@@ -127,11 +136,16 @@ class BifurcationStudy:
         bumpers = [(r, fb) for r in settings.restitution for fb in settings.bumper_frequencies]
         plain = tuple((k, False if k == "brute_force" else v) for k, v in options)  # no brute force of a bumper
         continuation += [BranchCase(scene_problem(scene, r, bumper_frequency=fb), settings.low, settings.high, plain) for r, fb in bumpers]
-        say(f"continuing the branches of R = {', '.join(f'{r:g}' for r in settings.restitution)}" + (f" and of bumpers of {', '.join(f'{fb:g}' for fb in settings.bumper_frequencies)} Hz" if bumpers else ""))
-        results = numbered_across(runner.map(continuation))  # the dataset's labels
+        stiffness = _stiffness_cases(scene, options) if bumpers else []
+        say(f"continuing the branches of R = {', '.join(f'{r:g}' for r in settings.restitution)}" + (f" and of bumpers of {', '.join(f'{fb:g}' for fb in settings.bumper_frequencies)} Hz"
+            f", and following the stiffest bumper's special points in its stiffness" if bumpers else ""))  # fmt: skip
+        mapped = runner.map(stiffness + continuation)  # the longest cases first
+        curves, results = mapped[: len(stiffness)], numbered_across(mapped[len(stiffness) :])  # the dataset's labels
         labels = [f"R = {r:g}" for r in settings.restitution] + [f"R = {r:g}, bumper {fb:g} Hz" for r, fb in bumpers]
         for label, result in zip(labels, results):
             _say_notes(say, label, result)
+        for r, result in zip(settings.restitution, curves):
+            _say_notes(say, f"R = {r:g}, bumper stiffness", result)
         if chart_result is not None:
             same = [result for r, result in zip(settings.restitution, results) if np.isclose(r, chart.restitution)]
             labels = chart_labels(chart_result, same[0] if same else None)
@@ -142,13 +156,15 @@ class BifurcationStudy:
         data = _branches(results[:sets], settings.restitution + tuple(r for r, _fb in bumpers), scene.coordinates, scene.load_spec.base_motion,
                          (None,) * len(settings.restitution) + tuple(fb for _r, fb in bumpers) if bumpers else ())  # fmt: skip
         data = data.merge(_brute(swept[: len(sweeps)], scene, brute.directions, brute.strobes))
+        if curves:
+            data = data.merge(_stiffness(curves, settings.restitution))
         if chart is not None:
             data = data.merge(_chart(results[-1], swept[len(sweeps) :], chart.clearances, settings.chart_frequency, brute.directions))
         data = data.assign_coords(clearance=delta)
         for key in ("restitution", "frequency", "sweep", "clearance"):
             data[key].attrs.update(COORDINATE_ATTRIBUTES[key])
-        data.attrs.update(_metadata(scene, results, swept[: len(sweeps)]))
-        lines, details = failure_summary(_tallies(scene, results, swept))
+        data.attrs.update(_metadata(scene, results, swept[: len(sweeps)], curves))
+        lines, details = failure_summary(_tallies(scene, results, swept, curves))
         if lines:
             data.attrs.update(run_failures=lines, run_failure_details=details)  # said in one line by run-study
         return data
@@ -163,6 +179,7 @@ class BifurcationStudy:
         periods = settings.frequency.size * len(settings.restitution) * len(brute.directions) * (brute.transient_periods + brute.strobes)
         continuation = [CONTINUATION_SECONDS if settings.branches.brute_force else CLOSED_FORM_SECONDS] * len(settings.restitution)
         continuation += [CLOSED_FORM_SECONDS] * (len(settings.restitution) * len(settings.bumper_frequencies))
+        continuation += [STIFFNESS_SECONDS] * (len(settings.restitution) if settings.bumper_frequencies else 0)
         chart_seconds = 0.0
         if settings.chart is not None:
             chart = settings.chart
@@ -187,7 +204,7 @@ def _say_notes(say: Progress, where: str, result: CaseResult) -> None:
             say(f"  {where}: {note}")
 
 
-def _tallies(scene: Scene, results: list[CaseResult], swept: list[CaseResult]) -> list[Tally]:
+def _tallies(scene: Scene, results: list[CaseResult], swept: list[CaseResult], curves: list[CaseResult]) -> list[Tally]:
     """What the run attempted and what failed (:func:`~vibroimpact.kinds.bifurcation.logs.failure_summary`): per
     restitution the branches, the seeds and the brute-force points; then the chart's branches, curves and regime map.
     ``results``: the branch cases, then the chart's case; ``swept``: the sweeps, then the regime map's."""
@@ -203,6 +220,8 @@ def _tallies(scene: Scene, results: list[CaseResult], swept: list[CaseResult]) -
     bumpers = [(r, fb) for r in settings.restitution for fb in settings.bumper_frequencies]
     for k, (r, fb) in enumerate(bumpers):
         counted += tallies(results[len(settings.restitution) + k], f"R = {r:g}, bumper {fb:g} Hz")
+    for r, result in zip(settings.restitution, curves):
+        counted += tallies(result, f"R = {r:g}")
     if chart is not None:
         where = f"R = {chart.restitution:g}"
         counted += tallies(results[-1], where)
@@ -342,12 +361,42 @@ def _chart(curves: CaseResult, results: list[CaseResult], clearances: np.ndarray
     )
 
 
+def _stiffness_cases(scene: Scene, options: tuple[tuple[str, object], ...]) -> list[StiffnessCase]:
+    """Per restitution, the curves of the stiffest bumper's special points in its stiffness
+    (:class:`~vibroimpact.kinds.bifurcation.stiffness.StiffnessCase`), over :data:`STIFFER` times the stiffest bumper to
+    the softest over :data:`SOFTER`, with the branches' own step settings."""
+    settings = scene.settings
+    assert settings is not None
+    fbs, steps = settings.bumper_frequencies, dict(options)
+    reach = (min(fbs) / SOFTER, max(fbs) * STIFFER)
+    return [StiffnessCase(scene_problem(scene, r, bumper_frequency=max(fbs)), settings.low, settings.high, reach, int(steps.get("max_steps", 2000)), float(steps.get("max_step", 0.1)))
+            for r in settings.restitution]  # fmt: skip
+
+
+def _stiffness(curves: list[CaseResult], restitutions: tuple[float, ...]) -> xr.Dataset:
+    """The curves of special points in (frequency, bumper frequency) of every restitution (``stiffness_point``), their
+    labels numbered across restitutions."""
+    a = BIFURCATION_ATTRIBUTES
+    offsets = np.cumsum([0] + [int(c["curve"].max()) + 1 if c["curve"].size else 0 for c in curves[:-1]])
+    joined = {name: np.concatenate([c[name] for c in curves]) for name in ("kind", "frequency", "bumper_frequency")}
+    labels = np.concatenate([c["curve"] + offset for c, offset in zip(curves, offsets)])
+    restitution = np.concatenate([np.full(c["curve"].size, r) for c, r in zip(curves, restitutions)])
+    sp = ("stiffness_point",)
+    return xr.Dataset(coords={
+        "stiffness_curve": (sp, labels.astype(np.int32), a["stiffness_curve"]),
+        "stiffness_kind": (sp, joined["kind"].astype(np.int8), flag_attributes("kind of special point the curve follows", SPECIAL_POINT_KINDS)),
+        "stiffness_restitution": (sp, restitution, a["stiffness_restitution"]),
+        "stiffness_frequency": (sp, joined["frequency"], a["stiffness_frequency"]),
+        "stiffness_bumper_frequency": (sp, joined["bumper_frequency"], a["stiffness_bumper_frequency"]),
+    })  # fmt: skip
+
+
 def _regime_flags(long_name: str) -> dict[str, object]:
     """CF flags of a motion class (:data:`MOTION_CLASSES`), with -1 where the engine failed."""
     return {"long_name": long_name, "units": "1", "flag_values": np.arange(-1, len(MOTION_CLASSES), dtype=np.int8), "flag_meanings": " ".join(("failed", *MOTION_CLASSES))}
 
 
-def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult]) -> dict[str, object]:
+def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult], curves: list[CaseResult]) -> dict[str, object]:
     settings = scene.settings
     assert settings is not None
     attrs: dict[str, object] = {
@@ -366,6 +415,7 @@ def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult])
     if bumpers:
         start = len(settings.restitution)
         lines = [f"R = {r:g}, bumper {fb:g} Hz: {note}" for (r, fb), result in zip(bumpers, results[start : start + len(bumpers)]) for note in result["notes"]]
+        lines += [f"R = {r:g}, bumper stiffness: {note}" for r, result in zip(settings.restitution, curves) for note in result["notes"]]
         attrs["continuation_notes"] = "\n".join([attrs["continuation_notes"], *lines])
         attrs["bumper_frequencies_Hz"] = np.array(settings.bumper_frequencies)
         attrs["method_bumper"] = ("the same layout with every stop a Kelvin-Voigt bumper of each Omega_b / 2 pi and the loss factor whose collision restitution is R "
