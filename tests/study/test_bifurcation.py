@@ -98,6 +98,7 @@ def test_brute_force_settles_on_the_stable_branch(dataset: xr.Dataset) -> None:
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(900)  # 174 s alone with 2 workers on the quiet machine; the slow tier runs another test beside it
 def test_the_shipped_study_runs(tmp_path) -> None:
     from vibroimpact.scene import find_scene, load_scene
     from vibroimpact.runs.store import StudyStore, store_fingerprint
