@@ -303,3 +303,26 @@ def test_a_steady_state_started_by_shooting_is_the_bumpers_own() -> None:
     assert x1[0] == pytest.approx(3.0074e-3, rel=1e-4)
     ida = steady_state(make_engine("compliant", EngineSettings(rtol=1e-10, atol=1e-14)), bumper, "pgf", SteadySettings(tolerance=1e-9), rigid.rigid_stop)
     assert abs(ida.measures.x1) == pytest.approx(x1[0], rel=1e-8)
+
+
+
+def test_a_new_frequency_keeps_the_contact_modes_and_gives_the_same_flows() -> None:
+    """A continuation in frequency makes a new problem at every step: the modes' decompositions (independent of the
+    frequency) are kept, only the harmonic particular solution is made again, and the flows equal those made with
+    nothing kept (the same operations on the same numbers: to the last bit, as the golden suite holds them against
+    the decomposition before it was split)."""
+    from vibroimpact.engines.compliant.exact import _contact_modes, bumper_flows
+
+    law = KelvinVoigtBumper(PAPER_CLEARANCE, 731.0, loss_factor_from_restitution(0.37))  # a bumper no other test has
+    first, second = (ImpactProblem(PAPER_SYSTEM, law, HarmonicForce(PAPER_AMPLITUDE, f)) for f in (24.0, 24.5))
+    bumper_flows(first)
+    hits = _contact_modes.cache_info().hits
+    kept, *_ = bumper_flows(second)
+    assert _contact_modes.cache_info().hits == hits + 1
+    _contact_modes.cache_clear()
+    fresh, *_ = bumper_flows(second)
+    assert len(kept) == len(fresh) == 2
+    for a, b in zip(kept, fresh):
+        for name in ("eigenvalues", "vectors", "inverse", "harmonic", "constant", "projector", "nilpotent", "drift"):
+            assert np.array_equal(getattr(a, name), getattr(b, name)), name  # exact: the same computation
+        assert a.omega == b.omega == second.omega  # exact: copied input

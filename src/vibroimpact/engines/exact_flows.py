@@ -23,6 +23,8 @@ A whole problem's flows and stop maps are assembled in :mod:`~vibroimpact.engine
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,7 +33,7 @@ from numpy.typing import NDArray
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import resonance_refusal
 
-__all__ = ["Flow", "decompose", "mechanical_null_basis", "numeric_null_basis", "ExactModel", "build_model"]
+__all__ = ["Flow", "decompose", "unforced_flow", "with_harmonic", "mechanical_null_basis", "numeric_null_basis", "ExactModel", "build_model"]
 
 #: Relative size below which an eigenvalue of K (or of the damping on its null space) counts as zero.
 _ZERO = 1e-12
@@ -181,11 +183,19 @@ def decompose(
     """
     a = np.asarray(matrix, dtype=float)
     n = a.shape[0]
-    b = np.asarray(harmonic, dtype=complex)
-    b0 = np.asarray(constant, dtype=float)
     if n == 0:
         empty = np.zeros(0)
         return Flow(empty.astype(complex), np.zeros((0, 0), complex), np.zeros((0, 0), complex), empty.astype(complex), empty, np.zeros((0, 0)), np.zeros((0, 0)), empty, float(omega))
+    return with_harmonic(unforced_flow(a, constant, null_basis), a, harmonic, omega)
+
+
+def unforced_flow(matrix: NDArray[np.float64], constant: NDArray[np.float64], null_basis: NDArray[np.float64] | None = None) -> Flow:
+    """:func:`decompose` without the harmonic load: every part of the flow but ``harmonic`` (zero) and ``omega`` (NaN),
+    which :func:`with_harmonic` adds. What does not depend on the forcing frequency, for a caller that keeps it while
+    the frequency changes (a continuation in frequency); raises as :func:`decompose` does, but for the frequency."""
+    a = np.asarray(matrix, dtype=float)
+    n = a.shape[0]
+    b0 = np.asarray(constant, dtype=float)
     zeros = numeric_null_basis(a) if null_basis is None else np.asarray(null_basis, dtype=float).reshape(n, -1)
     z = zeros.shape[1]
     if z:
@@ -212,13 +222,20 @@ def decompose(
         eigenvalues=np.ascontiguousarray(lam),
         vectors=np.ascontiguousarray(vec),
         inverse=np.ascontiguousarray(inverse),
-        harmonic=_harmonic_response(a, b, lam, omega),
+        harmonic=np.zeros(n, dtype=complex),
         constant=-np.real(vec @ ((inverse @ b0) / lam)) if np.any(b0) and m else np.zeros(n),
         projector=projector,
         nilpotent=nilpotent,
         drift=projector @ b0,
-        omega=float(omega),
+        omega=math.nan,
     )
+
+
+def with_harmonic(flow: Flow, matrix: NDArray[np.float64], harmonic: NDArray[np.complex128], omega: float) -> Flow:
+    """An :func:`unforced_flow` of ``matrix`` (A [s-1]) with the harmonic load b (``harmonic``) at w = ``omega``
+    [rad s-1]: :func:`decompose`'s flow, bit for bit."""
+    a = np.asarray(matrix, dtype=float)
+    return dataclasses.replace(flow, harmonic=_harmonic_response(a, np.asarray(harmonic, dtype=complex), flow.eigenvalues, omega), omega=float(omega))
 
 
 def _harmonic_response(a: NDArray[np.float64], b: NDArray[np.complex128], lam: NDArray[np.complex128], omega: float) -> NDArray[np.complex128]:

@@ -24,6 +24,9 @@ moments' contact-force channels are the integrals of F_k e^{-jwt}.
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -34,7 +37,7 @@ from vibroimpact.engines.base import MODE_FREE, Trajectory, check_run
 from vibroimpact.engines.compliant import exact_loop
 from vibroimpact.engines.compliant.model import MODE_CONTACT
 from vibroimpact.engines.exact import StrobeMap, chained_jacobian, stack_flows
-from vibroimpact.engines.exact_flows import Flow, decompose, mechanical_null_basis
+from vibroimpact.engines.exact_flows import Flow, mechanical_null_basis, unforced_flow, with_harmonic
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.engines.registry import ENGINES, Capabilities
 from vibroimpact.engines.settings import EngineSettings
@@ -50,12 +53,32 @@ MAX_BUMPERS = 8
 def bumper_flows(problem: ImpactProblem) -> tuple[tuple[Flow, ...], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The closed-form flow of every contact mode of a problem with bumpers, and each stop's K_k, B_k and m_k.
 
+    The modes' decompositions do not depend on the forcing frequency: they are kept per problem at any frequency
+    (:func:`_contact_modes`), and only the harmonic particular solution is made here (a continuation in frequency
+    evaluates the map of a new problem at every step).
+
     Returns
     -------
     tuple
         (flows, stiffness [N m-1], damping [N s m-1], effective masses [kg]): ``flows[mask]`` is the flow of y = (x, x')
         with the bumpers of the stops in the bit mask pushing (``flows[0]`` the free flight).
     """
+    modes, k_b, b_b, masses = _contact_modes(dataclasses.replace(problem, excitation=dataclasses.replace(problem.harmonic, frequency=1.0)))
+    size = problem.size
+    harmonic, _static = problem.load()
+    b = np.concatenate([np.zeros(size, dtype=complex), np.linalg.solve(problem.structure.mass_matrix.astype(complex), harmonic)])
+    flows = []
+    for mask, (a, unforced) in enumerate(modes):
+        with _in_contact(mask, len(problem.stops)):
+            flows.append(with_harmonic(unforced, a, b, problem.omega))
+    return tuple(flows), k_b, b_b, masses
+
+
+@lru_cache(maxsize=256)
+def _contact_modes(problem: ImpactProblem) -> tuple[tuple[tuple[NDArray[np.float64], Flow], ...], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Per contact mode, its state matrix A [s-1] and :func:`~vibroimpact.engines.exact_flows.unforced_flow`, with each
+    stop's K_k, B_k and m_k: what :func:`bumper_flows` keeps of a problem whatever its forcing frequency (``problem``
+    is given at 1 Hz)."""
     structure = problem.structure
     mass, stiffness, damping = structure.mass_matrix, structure.stiffness_matrix, structure.damping_matrix
     size, count = problem.size, len(problem.stops)
@@ -65,8 +88,8 @@ def bumper_flows(problem: ImpactProblem) -> tuple[tuple[Flow, ...], NDArray[np.f
     laws: list[KelvinVoigtBumper] = [stop.law for stop in problem.stops]  # type: ignore[misc]
     k_b = np.array([law.stiffness(m) for law, m in zip(laws, masses)])
     b_b = np.array([law.damping(m) for law, m in zip(laws, masses)])
-    harmonic, static = problem.load()
-    flows = []
+    _harmonic, static = problem.load()
+    modes = []
     for mask in range(1 << count):
         k_mode, c_mode, load = stiffness.copy(), damping.copy(), static.copy()
         for k in range(count):
@@ -76,19 +99,26 @@ def bumper_flows(problem: ImpactProblem) -> tuple[tuple[Flow, ...], NDArray[np.f
                 c_mode += b_b[k] * outer
                 load += k_b[k] * clearances[k] * normals[k]
         a = np.block([[np.zeros((size, size)), np.eye(size)], [-np.linalg.solve(mass, k_mode), -np.linalg.solve(mass, c_mode)]])
-        b = np.concatenate([np.zeros(size, dtype=complex), np.linalg.solve(mass.astype(complex), harmonic)])
         b0 = np.concatenate([np.zeros(size), np.linalg.solve(mass, load)])
-        try:
-            flows.append(decompose(a, b, b0, problem.omega, mechanical_null_basis(mass, k_mode, c_mode)))
-        except ValueError as error:
-            if not mask:
-                raise
-            pushing = ", ".join(str(k) for k in range(count) if (mask >> k) & 1)
-            raise ValueError(
-                f"contact: in contact with stop(s) {pushing}: {error} (a critically damped bumper, loss factor 1, on a body nothing else "
-                "holds has a repeated eigenvalue): use a loss factor off 1, or the integrating engine 'compliant'"
-            ) from error
-    return tuple(flows), k_b, b_b, masses
+        with _in_contact(mask, count):
+            modes.append((a, unforced_flow(a, b0, mechanical_null_basis(mass, k_mode, c_mode))))
+    return tuple(modes), k_b, b_b, masses
+
+
+@contextmanager
+def _in_contact(mask: int, count: int) -> Iterator[None]:
+    """A mode's refusal (``ValueError``) said as the contact's: in contact with the stops of ``mask``, the free flight's
+    as it is."""
+    try:
+        yield
+    except ValueError as error:
+        if not mask:
+            raise
+        pushing = ", ".join(str(k) for k in range(count) if (mask >> k) & 1)
+        raise ValueError(
+            f"contact: in contact with stop(s) {pushing}: {error} (a critically damped bumper, loss factor 1, on a body nothing else "
+            "holds has a repeated eigenvalue): use a loss factor off 1, or the integrating engine 'compliant'"
+        ) from error
 
 
 @dataclass(frozen=True, eq=False)
