@@ -23,7 +23,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from vibroimpact.engines.registry import BUMPER, engine_for
-from vibroimpact.kinds.bifurcation.branches import find_branches, map_bounds, stop_values
+from vibroimpact.kinds.bifurcation.branches import find_branches, map_bounds
 from vibroimpact.kinds.bifurcation.logs import FAILURE_FIELDS, failure_arrays
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, SpecialPoint
@@ -79,11 +79,6 @@ class StiffnessCase:
     engine: str = engine_for(BUMPER, "exact_jacobians")  # what computes it (the store names its result after it)
     fields: tuple[str, ...] = STIFFNESS_FIELDS
     progress_unit: str = "branch sets"
-
-    @property
-    def restitution(self) -> float:
-        """R [-] of the problem's bumpers."""
-        return stop_values(self.problem)[1]
 
     @property
     def progress_total(self) -> float:
