@@ -123,7 +123,7 @@ def test_ctrl_c_leaves_one_line_and_a_resumable_store(tmp_path: Path) -> None:
     kept = stored_blocks(store)
     assert run.returncode == 130, err
     assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
-    assert err.rstrip().splitlines()[-1] == f"interrupted: {kept} finished block{'s' if kept != 1 else ''} kept in out/interrupted.zarr; run the same command to resume"
+    assert err.rstrip().splitlines()[-1] == f"interrupted: {kept} finished block{'s' if kept != 1 else ''} kept in out/interrupted.zarr; run the same command to resume", err
     assert 1 <= kept < 3  # 71 simulated points in blocks of 32: 3 blocks
     assert not (tmp_path / "out" / ".run-study.lock").exists()
     # the rerun begins with the kept cases done

@@ -23,7 +23,7 @@ from typing import Callable
 import numpy as np
 
 from vibroimpact.scene import Scene, SceneError, find_scene, load_scene, shipped_studies
-from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, ClusterLost, Terminated, choose_scheduler, unreachable
+from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, ClusterLost, Terminated, choose_scheduler, leave_quietly, unreachable
 from vibroimpact.runs.failures import console_line, run_failures
 from vibroimpact.runs.run import read_dataset, write_dataset, run_study
 from vibroimpact.runs.store import OutputBusy, StoreOfAnotherScene, StudyStore, claim_output, store_fingerprint
@@ -140,10 +140,12 @@ def main(argv: list[str] | None = None) -> int:
             try:
                 return _run(scene, args, out_dir, store, scheduler)
             except KeyboardInterrupt as interrupt:
+                leave_quietly()  # before the one line: nothing dask's cut-off calls say may follow it
                 what = "terminated (SIGTERM)" if isinstance(interrupt, Terminated) else "interrupted"
                 print(f"\n{what}: {_kept(store)}", file=sys.stderr)
                 return EXIT_TERMINATED if isinstance(interrupt, Terminated) else EXIT_INTERRUPTED
             except ClusterLost as error:
+                leave_quietly()
                 print(f"\nrun-study: {error}: {_kept(store)}", file=sys.stderr)
                 return EXIT_FAILURE
     except (OutputBusy, StoreOfAnotherScene) as error:

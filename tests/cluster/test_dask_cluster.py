@@ -149,7 +149,7 @@ def test_ctrl_c_keeps_the_finished_blocks_and_the_same_command_resumes(tmp_path:
     kept = finished_blocks(tmp_path / "out")
     assert run.returncode == 130, stderr
     assert "Traceback" not in stderr and "KeyboardInterrupt" not in stderr, stderr
-    assert stderr.rstrip().splitlines()[-1] == f"interrupted: {kept_line(f'out/{SCENE_NAME}.zarr', kept)}"
+    assert stderr.rstrip().splitlines()[-1] == f"interrupted: {kept_line(f'out/{SCENE_NAME}.zarr', kept)}", stderr
     assert 1 <= kept < reference.plan.count
     assert not (tmp_path / "out" / ".run-study.lock").exists()
     rerun = start_run_study(arguments, tmp_path)

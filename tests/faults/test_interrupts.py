@@ -46,7 +46,7 @@ def test_ctrl_c_while_the_workers_start_stops_the_run_in_one_line(tmp_path: Path
     err = "".join(lines)
     assert run.returncode == 130, err
     assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
-    assert err.rstrip().splitlines()[-1] == "interrupted: nothing had finished yet; run the same command to start again"
+    assert err.rstrip().splitlines()[-1] == "interrupted: nothing had finished yet; run the same command to start again", err
 
 
 @pytest.mark.faults
@@ -63,7 +63,7 @@ def test_sigterm_ends_the_run_like_ctrl_c_with_its_blocks_kept(tmp_path: Path) -
     kept = stored_blocks(store)
     assert run.returncode == 143, err
     assert "Traceback" not in err and "leaked semaphore" not in err, err
-    assert err.rstrip().splitlines()[-1] == f"terminated (SIGTERM): {kept} finished block{'s' if kept != 1 else ''} kept in out/interrupted.zarr; run the same command to resume"
+    assert err.rstrip().splitlines()[-1] == f"terminated (SIGTERM): {kept} finished block{'s' if kept != 1 else ''} kept in out/interrupted.zarr; run the same command to resume", err
     assert kept >= 1
 
 

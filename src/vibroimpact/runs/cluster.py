@@ -14,6 +14,7 @@ import sys
 import threading
 import time
 import traceback
+import warnings
 from dataclasses import dataclass
 from typing import Callable
 
@@ -158,6 +159,19 @@ def connect(jobs: int, scheduler: str | None) -> Connection:
     return Connection(client, None, scheduler)
 
 
+#: What dask's abandoned work says as a failing study closes its cluster: a call cut off by the interrupt leaves the
+#: coroutine it had made for the event loop never awaited (it is collected whenever the loop's objects are, down to
+#: the interpreter's exit, after the study's one line).
+ABANDONED_COROUTINE = r"coroutine '.*' was never awaited"
+
+
+def leave_quietly() -> None:
+    """The study is ending on a failure it says in one line (Ctrl-C, SIGTERM, a lost scheduler): from now on, the
+    warnings of the dask calls that failure cut off (:data:`ABANDONED_COROUTINE`) are not the user's, and are not
+    shown. Left in place to the process's end: the coroutines are collected at no fixed moment."""
+    warnings.filterwarnings("ignore", message=ABANDONED_COROUTINE, category=RuntimeWarning)
+
+
 class Terminated(KeyboardInterrupt):
     """SIGTERM (a batch system's end of time, ``timeout``, ``kill``): handled like Ctrl-C, finished work kept."""
 
@@ -176,6 +190,7 @@ def _start_local_cluster(jobs: int) -> Connection:
     interrupted: list[int] = []
 
     def record(signum: int, _frame: object) -> None:
+        leave_quietly()
         if not interrupted:
             print("\ninterrupted: stopping the workers as they start", file=sys.stderr, flush=True)
         interrupted.append(signum)

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact import __version__
-from vibroimpact.runs.cluster import ClusterLost, Connection, connect, ProgressBar, ProgressReport, Throttled
+from vibroimpact.runs.cluster import ClusterLost, Connection, connect, leave_quietly, ProgressBar, ProgressReport, Throttled
 from vibroimpact.runs.store import source_hash, StudyStore
 
 __all__ = ["Case", "CaseResult", "ProgressReport", "Runner", "TaskFunction", "OtherCode", "WorkerDied", "MAX_CASES_PER_TASK"]
@@ -130,6 +130,7 @@ class Runner:
             connection.close()
             return
         # the client's reconnect task logs its cancellation with a traceback: the study says what happened in one line
+        leave_quietly()
         loggers = [logging.getLogger(name) for name in ("distributed", *logging.root.manager.loggerDict) if name.startswith("distributed")]
         levels = [logger.level for logger in loggers]
         for logger in loggers:
@@ -292,6 +293,7 @@ class Runner:
                 top_up()
         except BaseException:
             # Ctrl-C, a failed task or a lost scheduler: nothing more runs for this study
+            leave_quietly()
             if client.status == "running":
                 client.cancel(list(running), force=True)
             raise
