@@ -154,3 +154,22 @@ def test_the_setting_is_what_the_dataset_stores() -> None:
     np.testing.assert_array_equal(setting.bumper_frequency, [250.0])
     stored = xr.Dataset(ds.data_vars, coords=ds.coords, attrs=dict(ds.attrs, simulation_frequency_Hz=np.array([20.0, 30.0])))
     np.testing.assert_array_equal(study_setting(stored).simulation_frequency, [20.0, 30.0])
+
+
+def test_one_restitution_draws_each_quantity_once(tmp_path: Path) -> None:
+    """With one R, a quantity's panels per solution would each hold one series of what the simulation figure
+    overlays: it is drawn once, there (a study sweeping the clearance had 32 figures of 82 twice). Another closed form
+    (``pgf_paper``) and the raw one-impact values are not in the simulation figure: with either, both figures stay."""
+    full = steady_dataset().isel(restitution=0)
+    raw = [str(name) for name in full.data_vars if str(name).startswith("one_impact_")]
+    assert raw
+    held = full.drop_vars(raw).sel(solution=[s for s in full["solution"].values if s != "pgf_paper"])
+    sections = {s.title: s for s in page_for(held).sections(tmp_path)}
+    assert "Frequency responses, Delta = 3 mm" not in sections and "Simulations against the closed form, Delta = 3 mm" not in sections
+    figures, _ = _names(sections["Frequency responses and simulations, Delta = 3 mm"])
+    assert figures == [f"simulation_{q}" for q in ("x1_amplitude", "x2_amplitude", "force_amplitude", "impulse")] + ["suspension_force_amplitude", "regime", "stability", "peak_acceleration", "lyapunov"]
+    for name, part in (("paper", full.drop_vars(raw)), ("raw", full.sel(solution=held["solution"].values))):
+        (tmp_path / name).mkdir()
+        sections = {s.title: s for s in page_for(part).sections(tmp_path / name)}
+        assert _names(sections["Frequency responses, Delta = 3 mm"])[0][:3] == ["x2_amplitude", "x1_amplitude", "force_amplitude"], name
+        assert _names(sections["Simulations against the closed form, Delta = 3 mm"])[0][0] == "simulation_x1_amplitude", name

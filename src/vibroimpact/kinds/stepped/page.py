@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import html
 from pathlib import Path
-from typing import Iterator
+from typing import Collection, Iterator
 
 import numpy as np
 import xarray as xr
@@ -346,25 +346,52 @@ class FrequencyResponsePage:
 
 def _paper_response_sections(dataset: xr.Dataset, out: Path) -> list[Section]:
     """Per clearance: the frequency responses, regimes, stability and peak contact values, then the simulations (one
-    stop on the named view: the paper's figures 5-8 and 21-24)."""
+    stop on the named view: the paper's figures 5-8 and 21-24). Where one restitution ratio is drawn, a quantity the
+    simulation figure holds whole (:func:`_held_by_simulations`) is drawn once, there, in one section per clearance."""
     sections = []
     several = "clearance" in dataset.dims
     for index in range(dataset.sizes.get("clearance", 1)):
         part = dataset.isel(clearance=index) if several else dataset
         tag = f"_clearance{index}" if several else ""
         where = f", {clearance_text(part)}"
-        sections.append(Section(f"Frequency responses{where}", figures=saved(_response_figures(part, tag), out)))
         engines = [str(name) for name in part["solution"].values if name in ENGINE_SOLUTIONS]
+        held = _held_by_simulations(part, engines)
+        simulations = [simulation_figure(part, quantity, engines, f"simulation_{quantity}{tag}") for quantity in SIMULATION_QUANTITIES if quantity in part] if engines else []
+        lyapunov = [lyapunov_figure(part, engines, f"lyapunov{tag}")] if engines else []
+        if held:
+            sections.append(Section(f"Frequency responses and simulations{where}", figures=saved([*simulations, *_response_figures(part, tag, held), *lyapunov], out)))
+            continue
+        sections.append(Section(f"Frequency responses{where}", figures=saved(_response_figures(part, tag), out)))
         if engines:
-            simulations = [simulation_figure(part, quantity, engines, f"simulation_{quantity}{tag}") for quantity in SIMULATION_QUANTITIES if quantity in part]
-            sections.append(Section(f"Simulations against the closed form{where}", figures=saved(simulations + [lyapunov_figure(part, engines, f"lyapunov{tag}")], out)))
+            sections.append(Section(f"Simulations against the closed form{where}", figures=saved(simulations + lyapunov, out)))
     return sections
 
 
-def _response_figures(part: xr.Dataset, tag: str) -> Iterator[DrawnFigure | None]:
-    """Frequency responses, regime map, stability and peak contact values at one clearance, one at a time."""
+def _held_by_simulations(part: xr.Dataset, engines: list[str]) -> set[str]:
+    """The quantities whose simulation figure draws everything their response figure would: one restitution ratio
+    (the response figure's panels per solution then hold one series each), no closed form but the linear system and
+    ``pgf``, no raw one-impact values, and a simulation with values (else there is no simulation figure)."""
+    if not engines or len(series_by_restitution(part)) != 1:
+        return set()
+    others = [str(s) for s in part["solution"].values if s not in ENGINE_SOLUTIONS and s not in ("linear", "pgf")]
+    held = set()
+    for quantity in SIMULATION_QUANTITIES:
+        if quantity not in part:
+            continue
+        values = part[quantity]
+        raw = f"one_impact_{quantity}"
+        if any(np.isfinite(values.sel(solution=s).values).any() for s in others) or (raw in part and np.isfinite(part[raw].values).any()):
+            continue
+        if any(np.isfinite(values.sel(solution=e).values).any() for e in engines):
+            held.add(quantity)
+    return held
+
+
+def _response_figures(part: xr.Dataset, tag: str, held: Collection[str] = ()) -> Iterator[DrawnFigure | None]:
+    """Frequency responses (but the quantities ``held`` by the simulation figures), regime map, stability and peak
+    contact values at one clearance, one at a time."""
     for quantity in RESPONSE_QUANTITIES:
-        if quantity in part:
+        if quantity in part and quantity not in held:
             yield response_figure(part, quantity, f"{quantity}{tag}")
     if "regime" in part:
         yield regime_figure(part, f"regime{tag}")

@@ -341,17 +341,21 @@ def simulation_figure(part: xr.Dataset, quantity: str, engines: list[str], name:
     if not drawn:
         return None
     closed = "pgf" if "pgf" in present else None
-    caption = Caption(f"{q.label} ({q.meaning}) against frequency, {clearance_text(part)}: one panel per restitution ratio.")
+    coarse = f.size < COARSE_GRID_POINTS
+    panels = "one panel per restitution ratio" if len(lines) > 1 else lines[0][0]
+    caption = Caption(f"{q.label} ({q.meaning}) against frequency, {clearance_text(part)}: {panels}.")
     fig, axes = new_figure(len(lines), panel_height=3.5, legend_rows=legend_rows(2 + 2 * len(drawn) + 2))
     markers = SimulationMarkers()
-    any_unstable = False
+    any_unstable = gaps = False
     for ax, (text, line) in zip(axes, lines):
         if "linear" in present and quantity != "impulse":
-            draw_linear(ax, f, q.scale * line[quantity].sel(solution="linear").values)
+            draw_linear(ax, f, q.scale * line[quantity].sel(solution="linear").values, coarse)
             caption.add("linear", "LIN (dotted black): the linear system (no stop).")
         if closed is not None:
-            _, unstable = draw_curve(ax, f, q.scale * line[quantity].sel(solution=closed).values, colour=SOLUTION_COLOURS[closed], label=solution_ref(closed), gid=closed, unstable=unstable_points(line, closed), zorder=OVER_MARKERS_ZORDER)
+            values = q.scale * line[quantity].sel(solution=closed).values
+            _, unstable = draw_curve(ax, f, values, colour=SOLUTION_COLOURS[closed], label=solution_ref(closed), gid=closed, unstable=unstable_points(line, closed), coarse=coarse, zorder=OVER_MARKERS_ZORDER)
             any_unstable |= unstable
+            gaps |= bool(np.isnan(values).any())
             caption.add("closed", f"{solution_ref(closed)} (blue line): the {SOLUTION_DESCRIPTIONS[closed]}.")
         for engine in drawn:
             values = q.scale * line[quantity].sel(solution=engine).values
@@ -359,6 +363,8 @@ def simulation_figure(part: xr.Dataset, quantity: str, engines: list[str], name:
         finish_axes(ax, _FREQUENCY, axis_label(quantity), text, log=q.log)
     if any_unstable:
         caption.add("unstable", f"{solution_ref(closed)} dashed: the one-impact orbit exists but is unstable (Floquet).")
+    if gaps:
+        caption.add("gaps", f"Gaps in {solution_ref(closed)}: no admissible one-impact regime while the linear motion would cross the stop.")
     caption.add("engines", markers.phrase())
     figure_legend(fig, axes, stability_keys() if any_unstable else [])
     return DrawnFigure(fig, name, f"Simulations against the closed form: {q.label}, {clearance_text(part)}", caption.text())
