@@ -271,19 +271,6 @@ def test_a_sweep_is_refused() -> None:
         ENGINE.integrate(sweep, np.zeros(4), 0.0, 1)
 
 
-def test_the_compiled_loop_is_stamped_with_the_exact_core_it_contains() -> None:
-    """numba keys a cached function on its own source file only; the loop compiles exact_core's kernels into itself,
-    so its cache stamp also carries exact_core's source hash (an edit there recompiles it, not a stale copy)."""
-    import hashlib
-    from pathlib import Path
-
-    from vibroimpact.engines import exact_core
-    from vibroimpact.engines.compliant import exact_loop
-
-    stamp = exact_loop.run_bumper_periods._cache._cache_file._source_stamp
-    assert stamp[-1] == hashlib.sha256(Path(exact_core.__file__).read_bytes()).hexdigest()
-
-
 def test_a_steady_state_started_by_shooting_is_the_bumpers_own() -> None:
     """``shooting`` shoots the rigid stop's orbit to start a bumper's march: an engine with an exact flow measures a
     shot orbit directly only when it is the problem's own (it measured the rigid orbit, |X1| 2.748 mm, as the 250 Hz

@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.engines.registry import ENGINES, Capabilities
-from vibroimpact.engines import exact_core
+from vibroimpact.engines import exact_core, exact_moments
 from vibroimpact.engines.base import MODE_STUCK, Trajectory, check_run
 from vibroimpact.engines.exact_flows import Flow, ExactModel, build_model
 from vibroimpact.engines.exact_python import PythonExactEngine
@@ -118,7 +118,7 @@ def stack_flows(flows: tuple[Flow, ...], omega: float) -> tuple:
         half = _half(flow.eigenvalues)
         counts[f], hcounts[f] = m, half.size
         lams[f, :m], hlams[f, : half.size], vecs[f, :, :m], invs[f, :m, :] = flow.eigenvalues, half, flow.vectors, flow.inverse
-        r, inverse = exact_core.moment_rates(np.ascontiguousarray(flow.eigenvalues), omega)
+        r, inverse = exact_moments.moment_rates(np.ascontiguousarray(flow.eigenvalues), omega)
         rates[f, : m + 2], rinv[f, : m + 3, : m + 2] = r, inverse
     hrms = np.array([flow.harmonic for flow in flows], dtype=complex).reshape(count, n)
     csts = np.array([flow.constant for flow in flows], dtype=float).reshape(count, n)

@@ -1,13 +1,14 @@
 """The compiled core of the ``compliant_exact`` engine: the Kelvin-Voigt bumper's event loop in closed form, on the
-``exact`` engine's machinery (:mod:`~vibroimpact.engines.exact_core`: the flows' pieces, observables, guaranteed
-first-root search, transition matrices and closed-form moments), with the bumper's contact law in place of the
-impact map.
+``exact`` engine's machinery (the flows' pieces and observables, :mod:`~vibroimpact.engines.exact_pieces`; the
+guaranteed first-root search, :mod:`~vibroimpact.engines.exact_roots`; transition matrices,
+:mod:`~vibroimpact.engines.exact_core`; closed-form moments, :mod:`~vibroimpact.engines.exact_moments`), with the
+bumper's contact law in place of the impact map.
 
 Flows are stacked as :func:`~vibroimpact.engines.exact.stack_flows` stacks them, one per *contact mode*: flow f is the
 structure with the bumpers of the stops in the bit mask f pushing (f = 0: free flight). Each stop k is in one of
 three phases, each watched by observables h = w . y + offset of the current piece (rows 4 k ... 4 k + 3 of ``obsw``,
 ``obso``: the penetration d_k = n_k . x - Delta_k, -d_k, the bumper force F_k = K_k d_k + B_k n_k . x', -F_k), every
-root found by :func:`~vibroimpact.engines.exact_core._first_crossing` (Taylor bounds: none missed, however tangent):
+root found by :func:`~vibroimpact.engines.exact_roots._first_crossing` (Taylor bounds: none missed, however tangent):
 
 * ``BELOW`` (free, d < 0): d rising to 0 is an onset;
 * ``BEYOND`` (free, d >= 0 after a release with the bumper still compressed, F < 0): F rising to 0 is an onset (the
@@ -28,25 +29,23 @@ closed form piece by piece (the exact engine's factors; Gauss-Legendre on flows 
 force and largest deceleration -n_k . x'' are the largest of the values at the pieces' ends and of every interior
 maximum, found by the same guaranteed search on the derivative (:func:`_largest`), not by sampling.
 
-Numba's disk cache keys a compiled function on its own source file only (see :mod:`~vibroimpact.engines.exact_core`):
-this module's functions compile exact_core's kernels into themselves, so their cache index is stamped with
-exact_core's file as well (:func:`_stamp_with_callees`) and an edit of either recompiles them.
+Numba's disk cache keys a compiled function on its own source file only: this module's functions compile those four
+modules' kernels into themselves, so their cache index is stamped with their files as well
+(:func:`~vibroimpact.engines.numba_cache.stamp_with_callees`) and an edit of any of them recompiles them.
 """
 
 from __future__ import annotations
 
-import hashlib
 import math
-from pathlib import Path
 
 import numpy as np
 from numba import njit
 
-from vibroimpact.engines import exact_core
-from vibroimpact.engines.exact_core import (
-    _add_moments_gl, _amplitudes, _closest_approach, _derivatives, _escape_step, _first_crossing, _grow, _halve, _integrals, _left_multiply, _modal, _observable,
-    _piece_factors, _rigid, _round_off, _state, _transition, _value, _weighted_amplitudes,
-)  # fmt: skip
+from vibroimpact.engines.exact_core import _grow, _left_multiply, _transition
+from vibroimpact.engines.exact_moments import _add_moments_gl, _amplitudes, _integrals, _piece_factors, _weighted_amplitudes
+from vibroimpact.engines.exact_pieces import _halve, _modal, _observable, _rigid, _state
+from vibroimpact.engines.exact_roots import _closest_approach, _derivatives, _escape_step, _first_crossing, _round_off, _value
+from vibroimpact.engines.numba_cache import stamp_with_callees
 
 __all__ = ["run_bumper_periods", "sample_pieces", "STATUS_OK", "STATUS_NO_PROGRESS", "BELOW", "BEYOND", "CONTACT"]
 
@@ -213,7 +212,7 @@ def run_bumper_periods(
     ``BELOW``) or 0 for one at d > 0 (``BEYOND``), and the free flight's d'' there (an onset at the surface; else 0),
     of each onset after the start; approach [value, time, stop]: the
     largest interior local maximum of a penetration d_k while stop k is ``BELOW`` (the closest approach of a free
-    flight to the bumper's surface, the exact engine's :func:`~vibroimpact.engines.exact_core._closest_approach`;
+    flight to the bumper's surface, the exact engine's :func:`~vibroimpact.engines.exact_roots._closest_approach`;
     -inf without one, or unless ``want_approach``)); status :data:`STATUS_NO_PROGRESS` stops the run at t after
     ``max_events`` in one period.
     """
@@ -432,16 +431,4 @@ def sample_pieces(lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdr
     return out
 
 
-def _stamp_with_callees() -> None:
-    """Add a hash of exact_core's source to the cache stamp of every compiled function here, so that an edit of
-    exact_core invalidates their cached machine code, which contains its kernels (numba compares a cache index's stamp
-    with its own source file's only). Private numba attributes: where they are missing the stamp stays numba's own
-    (tests/engines/test_compliant_exact.py checks that it is not)."""
-    callee = hashlib.sha256(Path(exact_core.__file__).read_bytes()).hexdigest()
-    for function in (_watch, _goes_negative, _largest, _piece_integrals, _piece_integrals_gl, _peaks, run_bumper_periods, sample_pieces):
-        cache_file = getattr(getattr(function, "_cache", None), "_cache_file", None)
-        if cache_file is not None and hasattr(cache_file, "_source_stamp"):
-            cache_file._source_stamp = (cache_file._source_stamp, callee)
-
-
-_stamp_with_callees()
+stamp_with_callees(globals())
