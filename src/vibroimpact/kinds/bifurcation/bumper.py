@@ -33,7 +33,7 @@ import xarray as xr
 
 from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, ORBIT_PALETTE, SPECIAL_MARKERS, first_coordinate, flags
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
-from vibroimpact.kinds.bifurcation.stiffness import ON_CURVE, SOFTER, STIFFER, monotone_pieces, on_piece
+from vibroimpact.kinds.bifurcation.stiffness import ON_CURVE, SOFTER, STIFFER, curve_pieces, on_piece
 from vibroimpact.reporting.page import DrawnFigure, Table
 from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure
 
@@ -164,11 +164,7 @@ def _curves(dataset: xr.Dataset, restitution: float, kind: str) -> list[tuple[np
     if kind not in kinds:
         return []
     chosen = (dataset["stiffness_kind"].values == kinds.index(kind)) & np.isclose(dataset["stiffness_restitution"].values, restitution)
-    out = []
-    for label in np.unique(dataset["stiffness_curve"].values[chosen]):
-        index = np.flatnonzero(chosen & (dataset["stiffness_curve"].values == label))
-        out += monotone_pieces(1.0 / dataset["stiffness_bumper_frequency"].values[index], dataset["stiffness_frequency"].values[index])
-    return out
+    return curve_pieces(*(dataset[name].values[chosen] for name in ("stiffness_curve", "stiffness_bumper_frequency", "stiffness_frequency")))
 
 
 def _curve_of(dataset: xr.Dataset, restitution: float, kind: str, rigid: float) -> tuple[np.ndarray, np.ndarray] | None:

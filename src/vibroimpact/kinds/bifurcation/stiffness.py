@@ -32,7 +32,7 @@ from vibroimpact.orbits.continuation import ContinuationSettings, continue_speci
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.store import case_key
 
-__all__ = ["StiffnessCase", "monotone_pieces", "FOLLOWED", "STIFFER", "SOFTER", "CURVE_SETTINGS", "STIFFNESS_FIELDS", "ON_CURVE"]
+__all__ = ["StiffnessCase", "monotone_pieces", "curve_pieces", "on_piece", "FOLLOWED", "STIFFER", "SOFTER", "CURVE_SETTINGS", "STIFFNESS_FIELDS", "ON_CURVE"]
 
 #: The kinds of special point followed in the bumper's stiffness (a grazing point, the contact onset at tangency,
 #: does not depend on Omega_b).
@@ -92,12 +92,12 @@ class StiffnessCase:
 
     def run(self, report: ProgressReport | None = None) -> CaseResult:
         """The curves as flat arrays (one row per curve point), with notes and what failed."""
+        # the stiffest bumper's branches, computed again: its branch case counts and says what failed of them
         found = find_branches(self.problem, self.low, self.high, period_doubling=False, grazing=False, linear=False, max_steps=self.max_steps, max_step=self.max_step)
         low_b, high_b = self.bumper_range
         periods = (1.0 / high_b, 1.0 / low_b)
         bounds = {BUMPER_PERIOD: periods, "frequency": map_bounds(self.low, self.high)["frequency"]}
         rows: list[tuple[int, int, float, float]] = []
-        # the stiffest bumper's branches, computed again: its branch case counts and says what failed of them
         notes: list[str] = []
         attempts: dict[str, int] = {"stiffness_curve": 0}
         failures: list[tuple[str, str]] = []
@@ -159,11 +159,17 @@ def on_piece(piece: tuple[np.ndarray, np.ndarray], period: float) -> float:
     return float(CubicSpline(t, f)(period)) if t.size >= 4 else float(np.interp(period, t, f))
 
 
+def curve_pieces(labels: np.ndarray, bumper_frequencies: np.ndarray, frequencies: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The :func:`monotone_pieces` of every curve among points labelled by curve (``labels``; each curve's points in
+    their order along it), from their bumper frequencies [Hz] and frequencies [Hz], by increasing label."""
+    out = []
+    for label in np.unique(labels):
+        mine = labels == label
+        out += monotone_pieces(1.0 / bumper_frequencies[mine], frequencies[mine])
+    return out
+
+
 def _on_a_curve(rows: list[tuple[int, int, float, float]], kind: int, frequency: float, period: float) -> bool:
     """Is a special point of ``kind`` at ``frequency`` [Hz] and bumper period ``period`` [s] on a curve of ``rows``?"""
     table = np.array([row for row in rows if row[1] == kind], dtype=float).reshape(-1, 4)
-    for label in np.unique(table[:, 0]):
-        curve = table[table[:, 0] == label]
-        if any(abs(on_piece(piece, period) - frequency) <= ON_CURVE for piece in monotone_pieces(1.0 / curve[:, 3], curve[:, 2])):
-            return True
-    return False
+    return any(abs(on_piece(piece, period) - frequency) <= ON_CURVE for piece in curve_pieces(table[:, 0], table[:, 3], table[:, 2]))
