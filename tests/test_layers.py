@@ -7,6 +7,8 @@ here however rarely it runs.
 from __future__ import annotations
 
 import ast
+import importlib
+import re
 from pathlib import Path
 
 import pytest
@@ -113,3 +115,70 @@ def test_a_kind_scene_section_is_held_to_the_scene_layer() -> None:
         module = kind.scene.partition(":")[0]
         assert layer_of(module) == "scene", f"{kind.name}: {module} is not read at the scene layer"
         assert layer_of(kind.study.partition(":")[0]) == "kinds" and layer_of(kind.page.partition(":")[0]) == "kinds"
+
+
+def kind_folder(module: str) -> str | None:
+    """The kind folder of ``vibroimpact.kinds.<kind>...`` (None outside every kind folder)."""
+    parts = module.split(".")
+    return parts[2] if len(parts) >= 3 and parts[:2] == ["vibroimpact", "kinds"] else None
+
+
+#: Kind folders that import another kind's folder, with the reason each remains (none is wanted: a family's shared code
+#: belongs below the kinds). A swept-sine scene is a grid scene: the same GridSettings, the same grid of closed forms
+#: and the same page sections as a stepped one, with its time-domain solutions swept instead of stepped.
+KIND_IMPORTS_THAT_REMAIN = {("swept", "stepped")}
+
+
+@pytest.mark.parametrize("path", [p for p in SOURCES if kind_folder(module_name(p))], ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_no_kind_folder_imports_another(path: Path) -> None:
+    own = kind_folder(module_name(path))
+    crossing = [f"line {line}: {target}" for line, target in imports(path) if (other := kind_folder(target)) not in (None, own) and (own, other) not in KIND_IMPORTS_THAT_REMAIN]
+    assert not crossing, f"imports of another kind's folder from {own}:\n" + "\n".join(crossing)
+
+
+def test_the_kind_imports_that_remain_are_still_needed() -> None:
+    """An allowed crossing that no module makes any more is removed from the list, so the list says the truth."""
+    made = {(kind_folder(module_name(p)), kind_folder(target)) for p in SOURCES for _line, target in imports(p)}
+    assert KIND_IMPORTS_THAT_REMAIN <= made
+
+
+#: ``module:attribute`` (or a bare module) named in a string: a module loaded by name.
+_BY_NAME = re.compile(r"^vibroimpact(\.[A-Za-z_][A-Za-z0-9_]*)+(:[A-Za-z_][A-Za-z0-9_]*)?$")
+
+
+def loaded_by_name(path: Path) -> list[tuple[int, str]]:
+    """(line, ``module[:attribute]``) of every string constant in ``path`` that names a module of the package: the
+    kinds table, the engine registry, the package's lazy public names."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    return [(node.lineno, node.value) for node in ast.walk(tree) if isinstance(node, ast.Constant) and isinstance(node.value, str) and _BY_NAME.match(node.value)]
+
+
+def test_modules_loaded_by_name_exist_and_keep_the_layers() -> None:
+    """What a table names by string is an import the scan above cannot see: each one resolves (the module and its
+    attribute), and goes downward like an import, except the kinds table's studies and pages, which must be in the
+    folder of the kind whose row names them (a kind is loaded by its row, by the runner and the report above it)."""
+    from vibroimpact.scene.kinds import KINDS
+
+    plugins = {target for kind in KINDS for target in (kind.study, kind.page)}
+    for kind in KINDS:
+        for target in (kind.scene, kind.study, kind.page):
+            assert kind_folder(target.partition(":")[0]) == kind.name, f"{kind.name}: {target} is outside the kind's folder"
+    public = PACKAGE / "__init__.py"
+    found = 0
+    for path in SOURCES:
+        own = layer_of(module_name(path)) or "cli"
+        for line, target in loaded_by_name(path):
+            module, _, attribute = target.partition(":")
+            if path == public:
+                attribute = attribute or None  # the lazy table maps a name to its module: checked below
+            found += 1
+            loaded = importlib.import_module(module)
+            assert not attribute or hasattr(loaded, attribute), f"{path.name}:{line}: {target} does not exist"
+            layer = layer_of(module)
+            if target not in plugins and layer is not None:
+                assert LAYERS.index(layer) <= LAYERS.index(own), f"{path.name}:{line}: {target} is loaded by name from below ({layer} above {own})"
+    assert found >= 20  # the kinds table (3 per kind), the engine registry, the lazy names: the scan is not blind
+    import vibroimpact
+
+    for name in vibroimpact.__all__:
+        assert getattr(vibroimpact, name) is not None, name

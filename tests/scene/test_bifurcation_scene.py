@@ -115,18 +115,18 @@ RELATIVE_PAIR = [{"between": ["x2", "x1"], "side": "upper", "clearance": 0.003},
 
 def test_the_shipped_relative_stop_study_is_a_general_bifurcation_scene() -> None:
     scene = load_scene(find_scene("bifurcation_relative_stop"))
-    assert scene.kind == "bifurcation" and scene.general and scene.settings.restitution == (0.2,)
-    assert [(s.coordinate, s.other, s.side) for s in scene.stops] == [(1, 0, "upper"), (1, 0, "lower")]
-    assert scene.settings.clearance == pytest.approx(3e-3) and scene.load.weights == (1.0, 0.0)
+    assert scene.kind == "bifurcation" and scene.layout.paper_view() is None and scene.settings.restitution == (0.2,)
+    assert [(s.coordinate, s.other, s.side) for s in scene.layout.stops] == [(1, 0, "upper"), (1, 0, "lower")]
+    assert scene.settings.clearance == pytest.approx(3e-3) and scene.layout.load.weights == (1.0, 0.0)
 
 
 def test_the_general_form_takes_its_restitution_from_the_stops_or_the_diagrams() -> None:
     doc = general([{"coordinate": "x2", "clearance": 0.003, "restitution": 0.5}])
     del doc["bifurcation"]["restitution"]
     from_stops = parse_scene(doc)
-    assert from_stops.settings.restitution == (0.5,) and from_stops.stops[0].restitution is None  # the study's value
+    assert from_stops.settings.restitution == (0.5,) and from_stops.layout.stops[0].restitution is None  # the study's value
     from_diagrams = parse_scene(general(RELATIVE_PAIR, restitution=[0.2, 0.6]))
-    assert from_diagrams.settings.restitution == (0.2, 0.6) and len(from_diagrams.stops) == 2
+    assert from_diagrams.settings.restitution == (0.2, 0.6) and len(from_diagrams.layout.stops) == 2
     differ = general([{"coordinate": "x2", "clearance": 0.003, "restitution": 0.2}, {"coordinate": "x1", "clearance": 0.003, "restitution": 0.5}])
     del differ["bifurcation"]["restitution"]
     assert any(p.startswith("stops[1].restitution:") and "differs" in p for p in problems(differ))

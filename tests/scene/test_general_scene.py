@@ -11,7 +11,7 @@ import pytest
 
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.scene import SceneError, parse_scene, read_yaml
-from vibroimpact.scene.layout import build_stops
+from vibroimpact.model.layout import build_stops
 from vibroimpact.scene.schema import QUANTITIES
 
 #: The paper's system (eq. 24) as matrices: K = [[k1 + k2, -k2], [-k2, k2]], C likewise.
@@ -52,13 +52,13 @@ def problems_of(document: Any) -> list[str]:
 def test_relative_scene_parses_to_general_layout() -> None:
     """Matrices give a LinearStructure; each stop its place; values shared by every stop become the grid's."""
     scene = parse_scene(relative_scene())
-    assert scene.general
-    assert isinstance(scene.system, LinearStructure)
+    assert scene.layout.paper_view() is None
+    assert isinstance(scene.layout.structure, LinearStructure)
     assert scene.coordinates == ("x1", "x2")
-    assert [(s.coordinate, s.other, s.side) for s in scene.stop_specs] == [(1, 0, "upper"), (1, 0, "lower")]
+    assert [(s.coordinate, s.other, s.side) for s in scene.layout.stops] == [(1, 0, "upper"), (1, 0, "lower")]
     np.testing.assert_allclose(scene.settings.restitution, [0.2], rtol=0, atol=0)
     np.testing.assert_allclose(scene.settings.clearance, [0.003], rtol=0, atol=0)
-    assert scene.load is not None and scene.load.weights == (1.0, 0.0)
+    assert scene.layout.load.weights == (1.0, 0.0)
     assert scene.settings.quantities == QUANTITIES  # default names x1, x2: the paper's quantity names
 
 
@@ -73,8 +73,8 @@ def test_named_scene_is_not_general() -> None:
         "solutions": ["linear"],
     }
     scene = parse_scene(document)
-    assert not scene.general
-    assert [(s.coordinate, s.other, s.side) for s in scene.stop_specs] == [(1, None, "upper")]
+    assert scene.layout.paper_view() is not None
+    assert [(s.coordinate, s.other, s.side) for s in scene.layout.stops] == [(1, None, "upper")]
 
 
 def test_on_is_a_key_not_a_boolean() -> None:
@@ -94,7 +94,7 @@ def test_different_stop_values_stay_with_the_stops() -> None:
     """Unswept values that differ between stops stay with each stop; the grid holds NaN (no scalar coordinate)."""
     scene = parse_scene(with_change(lambda d: (d["stops"][1].update(clearance=0.002, restitution=0.5), d.update(solutions=["linear"]))))
     assert np.isnan(scene.settings.clearance[0]) and np.isnan(scene.settings.restitution[0])
-    stops = build_stops(scene.stop_specs, False, float(scene.settings.restitution[0]), float(scene.settings.clearance[0]))
+    stops = build_stops(scene.layout.stops, False, float(scene.settings.restitution[0]), float(scene.settings.clearance[0]))
     np.testing.assert_allclose([s.clearance for s in stops], [0.003, 0.002], rtol=0, atol=0)
     np.testing.assert_allclose([s.law.restitution for s in stops], [0.2, 0.5], rtol=0, atol=0)
 
@@ -109,7 +109,7 @@ def test_sweep_applies_to_the_named_stop_only() -> None:
 
     scene = parse_scene(change_scene := with_change(change))
     assert scene.settings.sweep_stops == (0,)
-    stops = build_stops(scene.stop_specs, False, 0.9, float(scene.settings.clearance[0]))
+    stops = build_stops(scene.layout.stops, False, 0.9, float(scene.settings.clearance[0]))
     np.testing.assert_allclose([s.law.restitution for s in stops], [0.9, 0.2], rtol=0, atol=0)
     assert change_scene["sweep"]["stop"] == 0
 
@@ -131,7 +131,7 @@ def test_three_dof_base_motion_with_static_force() -> None:
         "solutions": ["linear", "exact"],
     }
     scene = parse_scene(document)
-    assert scene.load is not None and scene.load.base_motion and scene.load.static == (0.0, 0.0, -0.981)
+    assert scene.layout.load.base_motion and scene.layout.load.static == (0.0, 0.0, -0.981)
     assert {"a_amplitude", "b_amplitude", "c_amplitude"} <= set(scene.settings.quantities)
 
 
@@ -213,7 +213,7 @@ def test_a_bumper_instead_of_a_restitution() -> None:
 
     scene = parse_scene(with_change(change))
     np.testing.assert_allclose(scene.settings.restitution, [restitution_from_loss_factor(0.3)], rtol=1e-15)
-    (stop,) = build_stops(scene.stop_specs, True, float(scene.settings.restitution[0]), float(scene.settings.clearance[0]), float(scene.settings.bumper_frequency[0]))
+    (stop,) = build_stops(scene.layout.stops, True, float(scene.settings.restitution[0]), float(scene.settings.clearance[0]), float(scene.settings.bumper_frequency[0]))
     assert isinstance(stop.law, KelvinVoigtBumper)
     np.testing.assert_allclose([stop.law.frequency, stop.law.loss_factor, stop.clearance], [300.0, 0.3, 0.003], rtol=1e-15)
 

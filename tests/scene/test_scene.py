@@ -85,7 +85,7 @@ def test_minimal_scene_parses() -> None:
     scene = parse_scene(scene_with(lambda d: d.pop("description")))
     assert scene.name == "tiny"
     assert scene.description == ""
-    assert scene.system.m1 == 1.0 and scene.system.k2 == 4300.0 and scene.system.b2 == 0.08  # exact: parsed input
+    assert (named := scene.layout.paper_view()) is not None and named.m1 == 1.0 and named.k2 == 4300.0 and named.b2 == 0.08  # exact: parsed input
     assert scene.amplitude == 10.0  # exact: parsed input
     np.testing.assert_array_equal(scene.settings.restitution, [0.2])
     np.testing.assert_array_equal(scene.settings.clearance, [0.003])
@@ -98,7 +98,7 @@ def test_minimal_scene_parses() -> None:
 def test_damping_is_optional() -> None:
     """b1 and b2 may be left out (undamped system)."""
     scene = parse_scene(scene_with(lambda d: (d["system"].pop("b1"), d["system"].pop("b2"))))
-    assert scene.system.b1 == 0.0 and scene.system.b2 == 0.0  # exact: parsed input
+    assert (named := scene.layout.paper_view()) is not None and named.b1 == 0.0 and named.b2 == 0.0  # exact: parsed input
 
 
 @pytest.mark.parametrize(
@@ -522,7 +522,7 @@ def test_yaml_12_exponent_numbers_are_floats(tmp_path: Path) -> None:
     path = tmp_path / "exp.yaml"
     path.write_text(doc, encoding="utf-8")
     scene = load_scene(path)
-    assert scene.settings.clearance[0] == 0.003 and scene.system.k1 == 25000.0  # exact: parsed input
+    assert scene.settings.clearance[0] == 0.003 and scene.layout.paper_view().k1 == 25000.0  # exact: parsed input
 
 
 def test_total_grid_size_is_bounded() -> None:

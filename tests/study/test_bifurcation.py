@@ -7,7 +7,7 @@ import pytest
 import xarray as xr
 
 from vibroimpact.scene import parse_scene
-from vibroimpact.kinds.bifurcation.study import scene_problem
+from vibroimpact.kinds.bifurcation.study import diagram_problem
 from vibroimpact.kinds.bifurcation.branches import closed_form_orbits
 from vibroimpact.runs.run import run_study
 
@@ -61,7 +61,7 @@ def test_one_impact_branch_is_the_closed_form(dataset: xr.Dataset) -> None:
     one = dataset.where((dataset["impacts_per_period"] == 1) & (dataset["period_multiplicity"] == 1), drop=True)
     assert one.sizes["branch_point"] > 50
     f = one["branch_frequency"].values
-    plus, minus = (orbit.impulse for orbit in closed_form_orbits(scene_problem(parse_scene(SMALL), 0.8), f))
+    plus, minus = (orbit.impulse for orbit in closed_form_orbits(diagram_problem(parse_scene(SMALL), 0.8), f))
     impulse = one["impulse"].values
     closest = np.where(np.abs(plus - impulse) < np.abs(minus - impulse), plus, minus)
     assert np.nanmax(np.abs(impulse - closest) / np.nanmax(plus)) < 1e-8

@@ -16,7 +16,7 @@ from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.reporting.page import write_report
 from vibroimpact.scene import parse_scene, read_yaml
-from vibroimpact.kinds.bifurcation.study import scene_problem
+from vibroimpact.kinds.bifurcation.study import diagram_problem
 from vibroimpact.kinds.bifurcation.branches import ORIGINS, closed_form_orbits
 from vibroimpact.runs.run import run_study
 
@@ -58,9 +58,9 @@ def twins(tmp_path_factory: pytest.TempPathFactory) -> tuple[xr.Dataset, xr.Data
 
 def test_the_twin_parses_to_the_named_scenes_problem() -> None:
     named, twin = (parse_scene(doc) for doc in named_and_twin())
-    assert twin.general and not named.general
+    assert twin.layout.paper_view() is not None and named.layout.paper_view() is not None  # the paper's layout, however written
     for r in (0.2, 0.8):
-        a, b = scene_problem(named, r), scene_problem(twin, r)
+        a, b = diagram_problem(named, r), diagram_problem(twin, r)
         assert a.structure == b.structure and a.stops == b.stops
         assert np.array_equal(a.load()[0], b.load()[0]) and np.array_equal(a.load()[1], b.load()[1])
 
@@ -82,7 +82,7 @@ def test_the_one_impact_branch_is_the_closed_form_of_the_general_problem(twins) 
     one = named.where(named["branch_origin"] == ORIGINS.index("one_impact"), drop=True)
     f = one["branch_frequency"].values
     assert f.size > 50 and f.min() < 20.7 and f.max() > 26.6
-    plus, minus = (orbit.impulse for orbit in closed_form_orbits(scene_problem(parse_scene(named_and_twin()[1]), 0.2), f))
+    plus, minus = (orbit.impulse for orbit in closed_form_orbits(diagram_problem(parse_scene(named_and_twin()[1]), 0.2), f))
     impulse = one["impulse"].values
     closest = np.where(np.abs(plus - impulse) < np.abs(minus - impulse), plus, minus)
     assert np.nanmax(np.abs(impulse - closest) / np.nanmax(plus)) < 1e-8
@@ -114,7 +114,7 @@ def test_relative_two_sided_stops_continue_the_symmetric_two_impact_orbit() -> N
     two = data.where(data["branch_origin"] == ORIGINS.index("two_impacts"), drop=True)
     assert two.sizes["branch_point"] > 10 and np.all(two["impacts_per_period"].values == 2)
     f = two["branch_frequency"].values
-    problem = scene_problem(scene, 0.2)
+    problem = diagram_problem(scene, 0.2)
     orbit = solve_impact_orbit(problem, omega=2.0 * np.pi * f)
     assert orbit.two_sided
     # two impacts of J each per period, one on each side, half a period apart
@@ -167,7 +167,7 @@ def test_a_layout_without_closed_form_is_found_by_the_brute_force() -> None:
     assert "x1_amplitude" not in data and "coordinate absorber" in data["absorber_amplitude"].attrs["long_name"]
     seeded = data.where(data["branch_origin"] == ORIGINS.index("brute_force"), drop=True)
     assert seeded.sizes["branch_point"] > 5 and np.all(seeded["impacts_per_period"].values == 1)
-    problem = scene_problem(scene, 0.8)
+    problem = diagram_problem(scene, 0.8)
     alone = ImpactProblem(problem.system, problem.stops[:1], problem.excitation)
     orbit = solve_impact_orbit(alone, omega=2.0 * np.pi * seeded["branch_frequency"].values)
     assert np.nanmax(orbit.displacement(np.linspace(0.0, 1.0, 256)[None, :] * orbit.period[:, None])[..., 0]) < 2.9e-3

@@ -117,7 +117,7 @@ def test_the_chain_written_as_matrices_is_the_same_scene() -> None:
     assert [c.name for c in written.concepts] == [c.name for c in named.concepts]
     three = copy.deepcopy(DOCUMENT)
     three["system"] = {"mass": [[1.0, 0.0], [0.0, 0.1]], "stiffness": [[29300.0, 0.0], [0.0, 4300.0]], "coordinates": ["x1", "x2"]}
-    with pytest.raises(SceneError, match="system: this kind of scene needs the two-mass chain"):
+    with pytest.raises(SceneError, match="system: a concepts scene needs the paper.s layout: the two-mass chain"):
         parse_concepts(three)
 
 

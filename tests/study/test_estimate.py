@@ -40,7 +40,7 @@ def test_predicted_integration_matches_what_the_run_does() -> None:
     periods, scale = expected_periods(scene)
     assert scale == 1.0  # exact: no subsampling: factor set to 1
     predicted = periods[0, 0]
-    case = SimulationCase("momentary", scene.system, scene.amplitude, RigidStop(0.003, 0.2), tuple(scene.settings.simulation.frequency), "pgf", scene.settings.simulation.engine, scene.settings.simulation.steady)
+    case = SimulationCase("momentary", scene.layout.structure, scene.amplitude, RigidStop(0.003, 0.2), tuple(scene.settings.simulation.frequency), "pgf", scene.settings.simulation.engine, scene.settings.simulation.steady)
     used = run_case(case)["periods_used"]
     np.testing.assert_array_equal(predicted == 0, used == 0)
     assert np.all(predicted[used > 0] >= 48)  # a settling transient plus the measurement, or the irregular budget
@@ -80,7 +80,7 @@ def test_start_modes_are_predicted_as_they_run() -> None:
     document["simulation"]["start"] = "sweep_up"
     scene = parse_scene(document)
     swept, _ = expected_periods(scene)
-    case = SimulationCase("momentary", scene.system, scene.amplitude, RigidStop(0.003, 0.2), tuple(scene.settings.simulation.frequency), "sweep_up", scene.settings.simulation.engine, scene.settings.simulation.steady)  # type: ignore[union-attr]
+    case = SimulationCase("momentary", scene.layout.structure, scene.amplitude, RigidStop(0.003, 0.2), tuple(scene.settings.simulation.frequency), "sweep_up", scene.settings.simulation.engine, scene.settings.simulation.steady)  # type: ignore[union-attr]
     used = run_case(case)["periods_used"]
     np.testing.assert_array_equal(swept[0, 0] == 0, used == 0)
 

@@ -70,6 +70,6 @@ def test_bad_matrix_is_refused_before_any_work(tmp_path: Path, capsys: pytest.Ca
 def test_shipped_relative_stop_scene_and_its_estimate(capsys: pytest.CaptureFixture[str]) -> None:
     """The shipped general example loads, is general, and --estimate predicts without running."""
     scene = load_scene(shipped_studies_dir() / "relative_stop.yaml")
-    assert scene.general and len(scene.stop_specs) == 2
+    assert scene.layout.paper_view() is None and len(scene.layout.stops) == 2
     assert cli.main(["relative_stop.yaml", "--estimate", "--jobs", "2"]) == 0
     assert "predicted wall time" in capsys.readouterr().out

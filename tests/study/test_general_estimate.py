@@ -11,8 +11,8 @@ import numpy as np
 from vibroimpact.scene import parse_scene
 from vibroimpact.kinds.stepped.cases import SimulationCase, run_case
 from vibroimpact.runs.estimate import estimate_scene
-from vibroimpact.kinds.stepped.study import UNKNOWN_WANDERING, closed_form_scale, engine_scale
-from vibroimpact.kinds.stepped.values import scene_problem
+from vibroimpact.kinds.stepped.study import UNKNOWN_WANDERING, closed_form_scale
+from vibroimpact.runs.estimate import engine_scale
 from vibroimpact.kinds.stepped.study import SETTLING_PERIODS, expected_periods
 
 SCENE: dict[str, Any] = {
@@ -33,11 +33,11 @@ SCENE: dict[str, Any] = {
 def test_scales_of_the_cost() -> None:
     """Two stops on two coordinates cost twice the paper's layout per period; a 3-dof chain with one stop 2.25x."""
     scene = parse_scene(copy.deepcopy(SCENE))
-    assert engine_scale(scene) == 2.0  # exact: (2/2)^2 x 2
+    assert engine_scale(scene.layout) == 2.0  # exact: (2/2)^2 x 2
     three = copy.deepcopy(SCENE)
     three.update(system={"mass": [[1.0, 0, 0], [0, 1.0, 0], [0, 0, 0.1]], "stiffness": [[2e4, -1e4, 0], [-1e4, 1.5e4, -5e3], [0, -5e3, 5e3]]}, stops=[SCENE["stops"][0]], solutions=["linear", "momentary"])
     three_scene = parse_scene(three)
-    assert engine_scale(three_scene) == 2.25  # exact: (3/2)^2 x 1
+    assert engine_scale(three_scene.layout) == 2.25  # exact: (3/2)^2 x 1
     assert closed_form_scale(three_scene, "linear") == closed_form_scale(three_scene, "pgf")
 
 
@@ -47,8 +47,8 @@ def test_predicted_integration_matches_what_the_run_does() -> None:
     assert scene.settings.simulation is not None
     periods, scale = expected_periods(scene)
     assert scale == 1.0  # exact: no subsampling
-    problem = scene_problem(scene, 20.0, 0.2, 0.003)
-    case = SimulationCase("momentary", scene.system, scene.amplitude, problem.contact, tuple(scene.settings.simulation.frequency), "pgf", scene.settings.simulation.engine, scene.settings.simulation.steady, load=scene.load)
+    problem = scene.layout.problem(scene.amplitude, 20.0, 0.2, 0.003)
+    case = SimulationCase("momentary", scene.layout.structure, scene.amplitude, problem.contact, tuple(scene.settings.simulation.frequency), "pgf", scene.settings.simulation.engine, scene.settings.simulation.steady, load=scene.layout.load)
     used = run_case(case)["periods_used"]
     np.testing.assert_array_equal(periods[0, 0] == 0, used == 0)
     assert np.any(used > 0) and np.any(used == 0)

@@ -40,14 +40,14 @@ def test_a_scene_is_a_header_plus_its_kinds_own_settings() -> None:
 
     from vibroimpact.scene.schema import Scene
 
-    header = {"name", "description", "system", "amplitude", "kind", "settings", "report", "text", "load", "stops", "general", "cluster_scheduler"}
+    header = {"name", "description", "layout", "amplitude", "kind", "settings", "report", "text", "cluster_scheduler"}
     assert {f.name for f in fields(Scene)} == header
     for path in sorted(shipped_studies_dir().rglob("*.yaml")):
         scene = load_scene(path)
         home = "stepped" if scene.kind == "swept" else scene.kind
         assert type(scene.settings).__module__.startswith(f"vibroimpact.kinds.{home}."), (path.name, type(scene.settings))
     with pytest.raises(ValueError, match="settings"):
-        Scene("s", "", scene.system, 1.0, "stepped", None)
+        Scene("s", "", scene.layout, 1.0, "stepped", None)
 
 
 def test_the_precedence_of_kinds_is_the_table_order_for_documents_and_scenes() -> None:

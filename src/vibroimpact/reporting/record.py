@@ -15,7 +15,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,22 +22,18 @@ import xarray as xr
 import yaml
 
 from vibroimpact.analysis.stability import Regime
-from vibroimpact.model.contact import RigidStop, Stop
-from vibroimpact.model.excitation import HarmonicForce
-from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.layout import NAMED_KEYS, Layout
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.kinds import KIND_NAMES
-from vibroimpact.scene.layout import StopSpec, stop_descriptions
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 from vibroimpact.simulation.harmonics import base_force
 
-__all__ = ["SWEPT_SOLUTION", "StudyRecord", "StudySetting", "study_kind", "study_record", "study_setting", "stored_description", "GeneralSetting", "general_setting", "named_layout", "named_view", "is_general"]
+__all__ = ["SWEPT_SOLUTION", "StudyRecord", "StudySetting", "study_kind", "study_record", "study_setting", "stored_description", "GeneralSetting", "general_setting", "named_layout", "named_view", "is_general", "dataset_layout"]
 
 #: The solution a swept-sine test runs: the compliant bumper (scenes allow no other); its estimates are the
 #: ``swept_<quantity>`` variables, not a value of the ``solution`` coordinate.
 SWEPT_SOLUTION = "compliant"
-_SYSTEM_KEYS = ("m1", "m2", "k1", "k2", "b1", "b2")
 
 
 def study_kind(dataset: xr.Dataset) -> str:
@@ -215,26 +210,21 @@ def named_view(dataset: xr.Dataset) -> TwoDofSystem | None:
 
 def _named(attrs: Mapping[str, object]) -> TwoDofSystem:
     """The named system the attributes ``system_m1`` ... ``system_b2`` give (``KeyError`` naming one missing)."""
-    return TwoDofSystem(**{key: float(attrs[f"system_{key}"]) for key in _SYSTEM_KEYS})  # type: ignore[arg-type]
+    return TwoDofSystem(**{key: float(attrs[f"system_{key}"]) for key in NAMED_KEYS})  # type: ignore[arg-type]
+
+
+def dataset_layout(dataset: xr.Dataset) -> Layout:
+    """The layout ``dataset``'s study ran (:meth:`~vibroimpact.model.layout.Layout.from_attributes`; a dataset written
+    before the layout was recorded had the paper's layout on its named system)."""
+    return Layout.from_attributes(dataset.attrs)
 
 
 def named_layout(dataset: xr.Dataset) -> TwoDofSystem | None:
     """The named system where ``dataset``'s study had the paper's layout on it (two-mass chain, one upper stop on x2,
-    force on x1); None otherwise."""
-    if "system_size" not in dataset.attrs:
-        return named_view(dataset)  # written before the layout was recorded: a study of the paper's named scenes
-    attrs = _layout(dataset)
-    size = int(attrs["system_size"])
-    sides = str(attrs["stop_side"]).split()
-    coordinate = np.atleast_1d(np.asarray(attrs["stop_coordinate"], dtype=int))
-    other = np.atleast_1d(np.asarray(attrs["stop_other"], dtype=int))
-    # the layout does not depend on the clearances and restitutions: any valid values stand in for them
-    stops = tuple(Stop(RigidStop(1e-3, 0.5), coordinate=int(i), other=None if j < 0 else int(j), side=side) for i, j, side in zip(coordinate, other, sides))
-    weights = tuple(float(w) for w in np.atleast_1d(np.asarray(attrs["excitation_weights"], dtype=float)))
-    static = tuple(float(f) for f in np.atleast_1d(np.asarray(attrs["excitation_static_N"], dtype=float)))
-    base_motion = attrs.get("excitation_kind") == "base_motion"  # loads every coordinate through its mass: no weights
-    force = HarmonicForce(float(attrs["excitation_amplitude_N"]), 1.0, weights=weights if len(weights) == size and not base_motion else None, static=static if len(static) == size else None, base_motion=base_motion)
-    return ImpactProblem(_structure(attrs), stops, force).named_system
+    force on x1); None otherwise (:meth:`~vibroimpact.model.layout.Layout.paper_view`)."""
+    if "system_size" not in dataset.attrs and "system_m1" not in dataset.attrs:
+        return None
+    return dataset_layout(dataset).paper_view()
 
 
 def is_general(dataset: xr.Dataset) -> bool:
@@ -247,29 +237,13 @@ def _layout(dataset: xr.Dataset) -> dict:
     """The dataset's attributes with its layout's: those it recorded, else (written before they were recorded) the
     paper's named layout on its ``system_m1`` ... ``system_b2``, the clearance and restitution from its coordinates."""
     attrs = dict(dataset.attrs)
-    named = named_view(dataset)
-    if "system_size" in attrs or named is None:
+    if "system_size" in attrs or "system_m1" not in attrs:
         return attrs
+
     def grid(name: str) -> np.ndarray:
         return np.atleast_1d(np.asarray(dataset[name].values, dtype=float)) if name in dataset.coords else np.array([np.nan, np.nan])
 
-    clearance = grid("clearance")
-    structure = named.structure
-    return attrs | {
-        "system_size": 2,
-        "system_coordinates": "x1 x2",
-        "system_mass_kg": structure.mass_matrix.ravel(),
-        "system_stiffness_N_per_m": structure.stiffness_matrix.ravel(),
-        "system_damping_N_s_per_m": structure.damping_matrix.ravel(),
-        "excitation_kind": "force",
-        "excitation_weights": np.array([1.0, 0.0]),
-        "excitation_static_N": np.zeros(2),
-        "stop_layout": stop_descriptions((StopSpec(coordinate=1),), ("x1", "x2"), grid("restitution"), clearance)[0],
-        "stop_coordinate": 1,
-        "stop_other": -1,
-        "stop_side": "upper",
-        "stop_clearance_m": float(clearance[0]) if clearance.size == 1 else np.nan,
-    }
+    return attrs | Layout.from_attributes(attrs).attributes(grid("restitution"), grid("clearance"))
 
 
 @dataclass(frozen=True, eq=False)
@@ -367,56 +341,23 @@ class GeneralSetting:
 def general_setting(dataset: xr.Dataset) -> GeneralSetting:
     """The :class:`GeneralSetting` of a stepped study's ``dataset`` (``KeyError`` naming a missing attribute)."""
     attrs = _layout(dataset)
-    size = int(attrs["system_size"])
-    structure = _structure(attrs)
-    coordinate = np.atleast_1d(np.asarray(attrs["stop_coordinate"], dtype=int))
-    other = np.atleast_1d(np.asarray(attrs["stop_other"], dtype=int))
-    sides = str(attrs["stop_side"]).split()
-    normals = np.zeros((coordinate.size, size))
-    for k, (i, j, side) in enumerate(zip(coordinate, other, sides)):
-        sign = 1.0 if side == "upper" else -1.0
-        normals[k, i] = sign
-        if j >= 0:
-            normals[k, j] = -sign
-    stops = tuple(part.strip() for part in str(attrs["stop_layout"]).split(";"))
-    if "stop_clearance_m" in attrs:
-        clearances = np.atleast_1d(np.asarray(attrs["stop_clearance_m"], dtype=float))
-    else:
-        clearances = np.array([_described_clearance(words, side) for words, side in zip(stops, sides)])
+    layout = Layout.from_attributes(attrs)
+    size = layout.size
+    normals = np.zeros((len(layout.stops), size))
+    for k, spec in enumerate(layout.stops):
+        sign = 1.0 if spec.side == "upper" else -1.0
+        normals[k, spec.coordinate] = sign
+        if spec.other is not None:
+            normals[k, spec.other] = -sign
     return GeneralSetting(
-        structure=structure,
+        structure=layout.structure,
         amplitude=float(attrs["excitation_amplitude_N"]),
-        base_motion=attrs.get("excitation_kind") == "base_motion",
+        base_motion=layout.load.base_motion,
         weights=np.atleast_1d(np.asarray(attrs["excitation_weights"], dtype=float)),
         static=np.atleast_1d(np.asarray(attrs["excitation_static_N"], dtype=float)),
-        stops=stops,
+        stops=tuple(part.strip() for part in str(attrs["stop_layout"]).split(";")),
         normals=normals,
         solutions=tuple(str(s) for s in dataset["solution"].values) if "solution" in dataset.coords else (),
-        clearances=clearances,
+        clearances=np.array([np.nan if spec.clearance is None else spec.clearance for spec in layout.stops]),
         named=named_view(dataset),
     )
-
-
-def _structure(attrs: dict) -> LinearStructure:
-    """The structure of the attributes ``system_size``, ``system_coordinates`` and the flattened matrices."""
-    size = int(attrs["system_size"])
-
-    def matrix(key: str) -> np.ndarray:
-        return np.asarray(attrs[key], dtype=float).reshape(size, size)
-
-    names = tuple(str(attrs["system_coordinates"]).split())
-    return LinearStructure(matrix("system_mass_kg"), matrix("system_stiffness_N_per_m"), matrix("system_damping_N_s_per_m"), names)
-
-
-#: The bound of a stop's description (:func:`vibroimpact.scene.layout.describe_stop`): ``<= 3 mm``, ``>= -2 mm``.
-_BOUND = re.compile(r"(<=|>=)\s*(-?[0-9.]+(?:e[-+]?[0-9]+)?) mm")
-
-
-def _described_clearance(words: str, side: str) -> float:
-    """Delta [m] of a stop from its description (upper: n . x <= Delta; lower: the coordinate >= -Delta); NaN where
-    it is written ``Delta`` (swept)."""
-    match = _BOUND.search(words.split(",")[0])
-    if match is None:
-        return float("nan")
-    value = float(match.group(2)) * 1e-3
-    return value if side == "upper" else -value

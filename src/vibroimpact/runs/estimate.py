@@ -39,11 +39,12 @@ import numpy as np
 import xarray as xr
 
 from vibroimpact.engines.registry import ENGINES, engine_spec
+from vibroimpact.model.layout import Layout
 from vibroimpact.runs.store import atomic_path
 from vibroimpact.scene.kinds import kind_named
 from vibroimpact.scene.schema import Scene
 
-__all__ = ["COSTS_FILE", "Costs", "Estimate", "default_costs", "cost_engine", "cluster_startup", "os_cpus", "cluster_cores", "CLUSTER_STARTUP", "TASK_SECONDS", "WRITE_SECONDS_PER_VARIABLE", "estimate_scene", "speed_probe", "speed_factor", "calibrate", "write_costs", "SPEED_FACTOR_RANGE"]
+__all__ = ["COSTS_FILE", "Costs", "Estimate", "default_costs", "cost_engine", "cluster_startup", "os_cpus", "cluster_cores", "CLUSTER_STARTUP", "TASK_SECONDS", "WRITE_SECONDS_PER_VARIABLE", "estimate_scene", "engine_scale", "speed_probe", "speed_factor", "calibrate", "write_costs", "SPEED_FACTOR_RANGE"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -380,3 +381,9 @@ def write_costs(costs: Costs, path: Path | None = None) -> Path:
     with atomic_path(Path(path)) as temporary:
         temporary.write_text(costs.to_json(), encoding="utf-8")
     return Path(path)
+
+
+def engine_scale(layout: Layout) -> float:
+    """(N / 2)^2 K: an engine's cost per period on ``layout`` (N coordinates, K stops) relative to the paper's
+    layout's, on which the costs are calibrated."""
+    return (layout.size / 2.0) ** 2 * len(layout.stops)

@@ -25,19 +25,18 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.model.contact import SIDES, restitution_from_loss_factor
-from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.checker import Checker, interval
-from vibroimpact.scene.layout import LoadSpec, StopSpec, build_stops
+from vibroimpact.model.layout import PAPER_STOP, Layout, LoadSpec, StopSpec, build_stops
 
-__all__ = ["NAMED_SYSTEM_KEYS", "MATRIX_SYSTEM_KEYS", "EXCITATION_KEYS", "STOP_KEYS", "parse_structure", "parse_load", "parse_stops", "parse_sweep_stops", "is_general", "parse_stop_layout", "document_names", "check_general_solutions", "pgf_refusal", "paper_layout_applies", "static_drift", "general_grids"]
+__all__ = ["NAMED_SYSTEM_KEYS", "MATRIX_SYSTEM_KEYS", "EXCITATION_KEYS", "STOP_KEYS", "LayoutSection", "parse_layout", "parse_structure", "parse_load", "parse_stops", "parse_sweep_stops", "parse_stop_layout", "document_names", "check_layout_solutions", "pgf_refusal", "static_drift", "stop_grids"]
 
 #: Keys of the paper's named system.
 NAMED_SYSTEM_KEYS = ("m1", "m2", "k1", "k2", "b1", "b2")
@@ -53,13 +52,33 @@ MAX_STOPS = 16
 MAX_COORDINATES = 64
 
 
-def is_general(document: dict) -> bool:
-    """Does the document use the general form (matrices, a load beyond a force on the primary mass, or ``stops``)?"""
-    system = document.get("system")
-    excitation = document.get("excitation")
-    matrices = isinstance(system, dict) and any(key in system for key in MATRIX_SYSTEM_KEYS)
-    load = isinstance(excitation, dict) and any(key in excitation for key in EXCITATION_KEYS - {"amplitude"})
-    return matrices or load or "stops" in document
+class LayoutSection(NamedTuple):
+    """What :func:`parse_layout` read: the layout (None where a part is unusable), the excitation amplitude (None
+    where unusable) and the structure's coordinates (None where the structure is unusable; known even when the
+    stops are not, so that what depends on the names alone is still checked)."""
+
+    layout: Layout | None
+    amplitude: float | None
+    coordinates: tuple[str, ...] | None
+
+
+def parse_layout(c: Checker, doc: dict) -> LayoutSection:
+    """The scene's layout and excitation amplitude, in either form: ``system`` (named {m1 ... b2} or matrices),
+    ``excitation`` (``amplitude``, and ``on``, ``static``, ``base_motion``) and ``stops`` (any layout) or ``stop`` (the
+    paper's stop above the absorber x2, whose values the kind reads). The named form is sugar for the same
+    :class:`~vibroimpact.model.layout.Layout`; every problem is recorded in ``c``."""
+    structure = parse_structure(c, doc["system"]) if "system" in doc else None
+    names = tuple(structure.coordinates) if structure is not None else document_names(doc.get("system"))
+    amplitude, load = parse_load(c, doc["excitation"], names) if "excitation" in doc else (None, None)
+    specs = parse_stop_layout(c, doc, structure)
+    coordinates = tuple(structure.coordinates) if structure is not None else None
+    if structure is None or ("stops" in doc and specs is None):
+        return LayoutSection(None, amplitude, coordinates)
+    try:
+        return LayoutSection(Layout(structure, load or LoadSpec(), specs or (PAPER_STOP,)), amplitude, coordinates)
+    except (TypeError, ValueError) as error:
+        c.fail("stops", str(error))
+        return LayoutSection(None, amplitude, coordinates)
 
 
 def parse_structure(c: Checker, value: Any) -> TwoDofSystem | LinearStructure | None:
@@ -310,18 +329,17 @@ def parse_stop_layout(c: Checker, doc: dict, system: TwoDofSystem | LinearStruct
 # Which solutions a general scene's layout admits, each refusal with its reason (checked before any work).
 # --------------------------------------------------------------------------------------------------------------------
 
-def pgf_refusal(system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, ...], load: LoadSpec | None, restitution: np.ndarray | None = None, clearance: np.ndarray | None = None) -> str | None:
-    """Why the closed-form (PGF) solution does not apply to this layout at some grid point; None where it applies
-    everywhere (:func:`vibroimpact.analysis.layout.closed_form_refusal`: one rigid stop, or a symmetric two-sided
-    stop, on a structure without rigid-body modes, with a harmonic load)."""
-    stops = specs or (StopSpec(coordinate=1),)
+def pgf_refusal(layout: Layout, restitution: np.ndarray | None = None, clearance: np.ndarray | None = None) -> str | None:
+    """Why the closed-form (PGF) solution does not apply to this layout at some corner of the grid; None where it
+    applies everywhere (:func:`vibroimpact.analysis.layout.closed_form_refusal`: one rigid stop, or a symmetric
+    two-sided stop, on a structure without rigid-body modes, with a harmonic load). A grid that gives no restitution
+    or clearance (NaN) is asked at R = 0.5 and Delta = 1 mm: the refusals do not depend on their values."""
     r_grid = np.array([np.nan]) if restitution is None else restitution
     d_grid = np.array([np.nan]) if clearance is None else clearance
     corners = {(float(r), float(d)) for r in (r_grid[0], r_grid[-1]) for d in (d_grid[0], d_grid[-1])}
-    force = (load or LoadSpec()).force(1.0, 1.0)
     for r, d in sorted(corners):
         try:
-            problem = ImpactProblem(system, build_stops(stops, False, 0.5 if np.isnan(r) else r, 1e-3 if np.isnan(d) else d), force)
+            problem = layout.problem(1.0, 1.0, 0.5 if np.isnan(r) else r, 1e-3 if np.isnan(d) else d)
         except (ValueError, TypeError) as error:  # an unusable stop: reported where it is parsed
             return str(error)
         reason = closed_form_refusal(problem)
@@ -330,21 +348,12 @@ def pgf_refusal(system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, .
     return None
 
 
-def paper_layout_applies(system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, ...], load: LoadSpec | None) -> bool:
-    """Is the layout the paper's on its named system, however written (:attr:`vibroimpact.model.problem.ImpactProblem.named_system`):
-    where its own route (``pgf_paper``) and its design map apply?"""
-    try:
-        problem = ImpactProblem(system, build_stops(specs or (StopSpec(coordinate=1),), False, 0.5, 1e-3), (load or LoadSpec()).force(1.0, 1.0))
-    except (ValueError, TypeError):  # an unusable stop: reported where it is parsed
-        return False
-    return problem.named_system is not None
-
-
-def static_drift(system: TwoDofSystem | LinearStructure, load: LoadSpec | None) -> bool:
+def static_drift(layout: Layout) -> bool:
     """Does the static force push the structure along a rigid-body mode (no static equilibrium without stops)?"""
-    if load is None or load.static is None or not any(load.static) or not system.rigid_body_modes():
+    load, structure = layout.load, layout.structure
+    if load.static is None or not any(load.static) or not structure.rigid_body_modes():
         return False
-    stiffness = system.structure.stiffness_matrix
+    stiffness = structure.stiffness_matrix
     values, vectors = np.linalg.eigh(stiffness)
     scale = float(np.max(np.abs(stiffness))) if np.any(stiffness) else 0.0
     free = vectors[:, values <= 1e-10 * scale] if scale > 0.0 else vectors
@@ -352,26 +361,24 @@ def static_drift(system: TwoDofSystem | LinearStructure, load: LoadSpec | None) 
     return bool(np.max(np.abs(free.T @ static)) > 1e-12 * float(np.max(np.abs(static))))
 
 
-def check_general_solutions(
-    c: Checker, solutions: tuple[str, ...], system: TwoDofSystem | LinearStructure, specs: tuple[StopSpec, ...], load: LoadSpec | None, swept_sine: bool,
-    restitution: np.ndarray | None = None, clearance: np.ndarray | None = None,
-) -> None:  # fmt: skip
-    """Record the solutions (and swept-sine tests: any layout, but a force, not a base motion) a general scene asks for
-    that its layout does not admit, and stops that leave a coordinate no room (two opposite stops whose clearances sum to <= 0 at a corner of the grid)."""
+def check_layout_solutions(c: Checker, solutions: tuple[str, ...], layout: Layout, swept_sine: bool, restitution: np.ndarray | None = None, clearance: np.ndarray | None = None) -> None:
+    """Record the solutions (and swept-sine tests: any layout, but a force, not a base motion) a scene asks for that
+    its layout does not admit, and stops that leave a coordinate no room (two opposite stops whose clearances sum to
+    <= 0 at a corner of the grid)."""
     for d in sorted({float(clearance[0]), float(clearance[-1])} if clearance is not None and clearance.size else {float("nan")}):
         try:
-            ImpactProblem(system, build_stops(specs or (StopSpec(coordinate=1),), False, 0.5, 1e-3 if np.isnan(d) else d), (load or LoadSpec()).force(1.0, 1.0))
+            layout.problem(1.0, 1.0, 0.5, 1e-3 if np.isnan(d) else d)
         except ValueError as error:
             if "leave no room" in str(error):
                 c.fail("stops", str(error).removeprefix("stops: ") + (f" (at clearance {d:g} m of the grid)" if not np.isnan(d) else ""))
                 break
-    if "pgf_paper" in solutions and not paper_layout_applies(system, specs, load):
+    if "pgf_paper" in solutions and layout.paper_view() is None:
         c.fail("solutions", "pgf_paper is the paper's own route for its layout (a two-mass chain x1, x2 as {m1 ... b2}; one upper stop on x2; force on x1): use pgf")
-    if "pgf" in solutions and (reason := pgf_refusal(system, specs, load, restitution, clearance)) is not None:
+    if "pgf" in solutions and (reason := pgf_refusal(layout, restitution, clearance)) is not None:
         c.fail("solutions", f"pgf does not apply to this layout: {reason}")
-    if "linear" in solutions and static_drift(system, load):
+    if "linear" in solutions and static_drift(layout):
         c.fail("solutions", "linear does not apply: the static force pushes the structure along a rigid-body mode, so it has no steady state without its stops")
-    if swept_sine and load is not None and load.base_motion:
+    if swept_sine and layout.load.base_motion:
         c.fail("excitation.base_motion", "a swept-sine test drives a force q sin(theta(t)) on the coordinates ('on'): a swept base motion is not supported; use base_motion: false")
 
 
@@ -388,7 +395,7 @@ _PARAMETERS = {
 }
 
 
-def general_grids(
+def stop_grids(
     c: Checker,
     specs: tuple[StopSpec, ...],
     grids: dict[str, np.ndarray | None],

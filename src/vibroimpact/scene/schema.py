@@ -13,9 +13,8 @@ from typing import Generic, Sequence, TypeVar
 
 
 from vibroimpact.engines.registry import RIGID, engine_for, engine_names, engine_spec, stepped_solutions
-from vibroimpact.model.problem import Structure
+from vibroimpact.model.layout import Layout
 from vibroimpact.scene.kinds import KIND_NAMES
-from vibroimpact.scene.layout import LoadSpec, StopSpec
 from vibroimpact.scene.variables import MOTION_QUANTITIES, QUANTITIES, STOP_QUANTITIES, quantities_for
 from vibroimpact.simulation.settings import START_MODES, SWEEP_STARTS
 
@@ -97,8 +96,9 @@ class Scene(Generic[SettingsT]):
         Scene name; output goes to ``<out>/<name>.nc``.
     description : str
         Free text.
-    system : TwoDofSystem or LinearStructure
-        The linear system: the paper's named one, or any structure given by matrices.
+    layout : Layout
+        The structure, its load and where its stops act (:class:`~vibroimpact.model.layout.Layout`), the paper's
+        named form or any other, read by one grammar (:func:`vibroimpact.scene.layout_parse.parse_layout`).
     amplitude : float
         Excitation amplitude: force q [N] (for a base motion, the base displacement [m]).
     kind : str
@@ -111,28 +111,18 @@ class Scene(Generic[SettingsT]):
         Whether ``run-study`` writes the comparison report; a string names the page (``design_map``).
     text : str
         The YAML source, stored in the output's attributes.
-    load : LoadSpec or None
-        A general scene's load (weights, static force, base motion); None: the paper's force on the primary mass.
-    stops : tuple of StopSpec
-        A general scene's stops; ``()``: the paper's stop (see :attr:`stop_specs`).
-    general : bool
-        The scene uses the general format (matrices, a load beyond a force on the primary mass, or ``stops``): its
-        outputs are named after its coordinates and stops. False: the paper's named form and outputs.
     cluster_scheduler : str or None
         The scene's ``cluster: {scheduler: ADDRESS}``: a running dask scheduler to run on; None: a local cluster.
     """
 
     name: str
     description: str
-    system: Structure
+    layout: Layout
     amplitude: float
     kind: str
     settings: SettingsT
     report: bool | str = True
     text: str = ""
-    load: LoadSpec | None = None
-    stops: tuple[StopSpec, ...] = ()
-    general: bool = False
     cluster_scheduler: str | None = None
 
     def __post_init__(self) -> None:
@@ -144,14 +134,4 @@ class Scene(Generic[SettingsT]):
     @property
     def coordinates(self) -> tuple[str, ...]:
         """Names of the structure's coordinates (``x1, x2`` for the paper's system)."""
-        return tuple(self.system.coordinates)
-
-    @property
-    def stop_specs(self) -> tuple[StopSpec, ...]:
-        """Every stop: the scene's ``stops``, or the paper's upper stop on the absorber taking the grid's values."""
-        return self.stops or (StopSpec(coordinate=1),)
-
-    @property
-    def load_spec(self) -> LoadSpec:
-        """The load: the scene's, or the paper's force on the primary mass."""
-        return self.load if self.load is not None else LoadSpec()
+        return self.layout.coordinates

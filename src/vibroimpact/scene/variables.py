@@ -11,7 +11,7 @@ import numpy as np
 
 from vibroimpact.analysis.stability import regime_attributes
 
-__all__ = ["VARIABLE_ATTRIBUTES", "SWEEP_STAT_ATTRIBUTES", "CONVERGED_ATTRIBUTES", "STABLE_MARGINAL", "STABLE_ATTRIBUTES", "COORDINATE_ATTRIBUTES", "SWEEP_TIME_ATTRIBUTES", "BENCHMARK_ATTRIBUTES", "LADDER_ATTRIBUTES", "SWEEP_COST_ATTRIBUTES", "BIFURCATION_ATTRIBUTES", "flag_attributes", "quantity_attributes", "swept_attributes", "running_attributes", "QUANTITIES", "MOTION_QUANTITIES", "STOP_QUANTITIES", "quantities_for"]
+__all__ = ["VARIABLE_ATTRIBUTES", "SWEEP_STAT_ATTRIBUTES", "CONVERGED_ATTRIBUTES", "STABLE_MARGINAL", "STABLE_ATTRIBUTES", "COORDINATE_ATTRIBUTES", "SWEEP_TIME_ATTRIBUTES", "BENCHMARK_ATTRIBUTES", "LADDER_ATTRIBUTES", "SWEEP_COST_ATTRIBUTES", "BIFURCATION_ATTRIBUTES", "flag_attributes", "quantity_attributes", "swept_attributes", "running_attributes", "QUANTITIES", "MOTION_QUANTITIES", "STOP_QUANTITIES", "quantities_for", "CLOSED_FORM_METHODS"]
 
 #: Quantities of a study (solution, grid...).
 VARIABLE_ATTRIBUTES: dict[str, dict[str, str]] = {
@@ -248,3 +248,11 @@ def quantities_for(coordinates: tuple[str, ...]) -> tuple[str, ...]:
         elif quantity.replace("x2", "x1") not in _PER_COORDINATE:
             out.append(quantity)
     return tuple(out)
+
+
+#: How the closed forms and the base force are computed: recorded beside the layout of every grid study (stepped,
+#: swept) and of a benchmark of a layout other than the paper's.
+CLOSED_FORM_METHODS = {
+    "method_pgf": "closed-form impact orbit (periodic Green function of the stopped coordinate n^T H n; one impact per period on one stop, two on a symmetric two-sided stop); stable (+) root",
+    "method_force": "force on the base: 1^T (K x + C x') through springs and dashpots plus (1^T n_k) lambda_k of each absolute stop",
+}

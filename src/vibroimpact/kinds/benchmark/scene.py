@@ -34,18 +34,18 @@ from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.engines.registry import BUMPER, RIGID, engine_spec
 from vibroimpact.engines.settings import ATOL_RATIO, STEPPED_TOLERANCES
 from vibroimpact.model.excitation import SweptSine
-from vibroimpact.model.problem import ImpactProblem, Structure
+from vibroimpact.model.layout import Layout, LoadSpec, StopSpec, build_stops
+from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.contact import Stop
 from vibroimpact.scene.checker import Checker, SceneError
-from vibroimpact.scene.layout import LoadSpec, StopSpec, build_stops
-from vibroimpact.scene.layout_parse import document_names, is_general, parse_load, parse_stop_layout, parse_structure
+from vibroimpact.scene.header import NAME, check_sweep_run, parse_names
+from vibroimpact.scene.layout_parse import parse_layout
 from vibroimpact.scene.schema import (
     BENCHMARK_METHODS,
     MAX_BENCHMARK_PERIODS,
     MAX_BUMPER_FREQUENCY,
     Scene,
 )
-from vibroimpact.kinds.stepped.scene import NAME, check_sweep_run, parse_names
 from vibroimpact.simulation.settings import START_MODES
 
 __all__ = ["BenchmarkScene", "BenchmarkCase", "BenchmarkSettings", "LadderSettings", "BENCHMARK_TOP_KEYS", "parse_benchmark_scene"]
@@ -178,12 +178,21 @@ class BenchmarkScene:
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class _Layout:
-    """What every case of a scene shares: the structure, the load and the stops as given (checked values)."""
+    """What every case of a scene shares: the scene's layout (its stops as given, with their own values) and the
+    excitation amplitude."""
 
-    system: Structure
+    layout: Layout
     amplitude: float
-    load: LoadSpec
-    specs: tuple[StopSpec, ...]
+
+    @property
+    def load(self) -> LoadSpec:
+        """The layout's load."""
+        return self.layout.load
+
+    @property
+    def specs(self) -> tuple[StopSpec, ...]:
+        """The layout's stops."""
+        return self.layout.stops
 
     def taking(self, field: str) -> list[int]:
         """The stops that take ``field`` (``restitution``, ``clearance``, ``bumper_frequency``) from the case."""
@@ -199,15 +208,9 @@ def parse_benchmark_scene(document: dict, text: str = "", source: str = "scene")
     :class:`SceneError` listing all problems."""
     c = Checker()
     doc = c.mapping("", document, BENCHMARK_TOP_KEYS, {"name", "system", "excitation", "benchmark"}, kind="benchmark")
-    general = is_general(doc)
     name, description, report = parse_names(c, doc)
-    system = parse_structure(c, doc["system"]) if "system" in doc else None
-    names = tuple(system.coordinates) if system is not None else document_names(doc.get("system"))
-    amplitude, load = parse_load(c, doc["excitation"], names) if "excitation" in doc else (None, None)
-    specs = parse_stop_layout(c, doc, system)
-    layout = None
-    if system is not None and amplitude is not None and (specs is not None or "stops" not in doc):
-        layout = _Layout(system, amplitude, load or LoadSpec(), specs or (StopSpec(coordinate=1),))
+    parsed, amplitude, _ = parse_layout(c, doc)
+    layout = _Layout(parsed, amplitude) if parsed is not None and amplitude is not None else None
     spec = c.mapping("benchmark", doc["benchmark"], _BENCHMARK_KEYS, {"duration", "methods", "tolerances", "cases"}) if "benchmark" in doc else {}
     duration = c.number("benchmark.duration", spec.get("duration"), 0.0, 1e5, low_inclusive=False) if "duration" in spec else None
     methods = c.choices("benchmark.methods", spec.get("methods"), BENCHMARK_METHODS) if "methods" in spec else ()
@@ -238,15 +241,12 @@ def parse_benchmark_scene(document: dict, text: str = "", source: str = "scene")
     return Scene(
         name=name,
         description=description,
-        system=layout.system,
+        layout=layout.layout,
         amplitude=layout.amplitude,
         kind="benchmark",
         settings=BenchmarkScene(tuple(cases), settings),
         report=report,
         text=text,
-        load=load,
-        stops=specs or (),
-        general=general,
     )
 
 
@@ -323,7 +323,7 @@ def _parse_case(c: Checker, key: str, raw: Any, names: list[str], layout: _Layou
         return None
     rigid, compliant = stops
     load = layout.load
-    problem = ImpactProblem(layout.system, rigid, load.force(layout.amplitude, frequency))
+    problem = layout.layout.problem_with(rigid, load.force(layout.amplitude, frequency))
     name = str(case["name"])
     if swept is not None:
         if None in (f_start, f_stop, rate, sample_rate):
@@ -347,7 +347,7 @@ def _case_stops(c: Checker, key: str, layout: _Layout, frequency: float, restitu
     force = layout.load.force(layout.amplitude, frequency)
     try:
         if math.isfinite(below):
-            probe = ImpactProblem(layout.system, build_stops(specs, False, 0.5, 1.0), force)
+            probe = layout.layout.problem_with(build_stops(specs, False, 0.5, 1.0), force)
             linear = linear_amplitudes(probe)
             reach = np.abs(linear.stops) + linear.stop_static
             chosen = []
@@ -361,7 +361,7 @@ def _case_stops(c: Checker, key: str, layout: _Layout, frequency: float, restitu
                 chosen.append(spec)
             specs = tuple(chosen)
         rigid = build_stops(specs, False, restitution, clearance)
-        ImpactProblem(layout.system, rigid, force)  # the stops' room between each other
+        layout.layout.problem_with(rigid, force)  # the stops' room between each other
     except ValueError as error:
         c.fail(key, str(error))
         return None
@@ -398,7 +398,7 @@ def _parse_ladder(c: Checker, value: Any, layout: _Layout | None) -> LadderSetti
     assert frequency is not None and restitution is not None and clearance is not None and bumpers is not None and rtol is not None and repeats is not None and layout is not None
     try:
         rigid = build_stops(layout.specs, False, restitution, clearance)
-        problem = ImpactProblem(layout.system, rigid, layout.load.force(layout.amplitude, frequency))
+        problem = layout.layout.problem_with(rigid, layout.load.force(layout.amplitude, frequency))
         compliant = tuple(build_stops(layout.specs, True, restitution, clearance, float(b)) for b in bumpers)
     except ValueError as error:
         c.fail("benchmark.ladder", str(error))

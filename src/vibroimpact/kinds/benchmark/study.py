@@ -1,6 +1,6 @@
 """Benchmark studies: every engine at every tolerance on a few cases, timed against a reference
 (:mod:`vibroimpact.kinds.benchmark.study`); dimensions (case, engine, rtol). A general scene's dataset also records its
-structure, load and stops (:func:`vibroimpact.kinds.stepped.grid.layout_attributes`), which its page reads back."""
+structure, load and stops (:meth:`vibroimpact.model.layout.Layout.attributes`), which its page reads back."""
 
 from __future__ import annotations
 
@@ -21,16 +21,14 @@ from vibroimpact.engines.base import Engine, SweepRecord, Trajectory
 from vibroimpact.engines.compliant.ivp import solve_ivp_sweep
 from vibroimpact.engines.registry import BUMPER, ENGINES, RIGID, engine_for, engine_spec, make_engine
 from vibroimpact.engines.settings import REFERENCE_RTOL, EngineSettings
-from vibroimpact.kinds.stepped.grid import layout_attributes
-from vibroimpact.kinds.stepped.study import engine_scale
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.runs.cluster import Progress
-from vibroimpact.runs.estimate import Costs, Estimate
+from vibroimpact.runs.estimate import Costs, Estimate, engine_scale
 from vibroimpact.runs.run import provenance
 from vibroimpact.runs.runner import Runner
 from vibroimpact.kinds.benchmark.scene import BenchmarkCase, BenchmarkSettings, LadderSettings
 from vibroimpact.scene.schema import Scene
-from vibroimpact.scene.variables import BENCHMARK_ATTRIBUTES, LADDER_ATTRIBUTES
+from vibroimpact.scene.variables import BENCHMARK_ATTRIBUTES, CLOSED_FORM_METHODS, LADDER_ATTRIBUTES
 from vibroimpact.simulation.harmonics import measure, running_fundamental
 from vibroimpact.simulation.steady import start_state
 
@@ -435,8 +433,8 @@ class BenchmarkStudy:
         assert scene.settings is not None
         dataset = run_benchmark(list(scene.settings.cases), scene.settings.settings, progress=progress is not None)
         dataset.attrs.update({"title": f"vibroimpact benchmark '{scene.name}'", "scene_name": scene.name, "scene": scene.text} | provenance())
-        if scene.general:
-            dataset.attrs.update(layout_attributes(scene, *_shared_values(scene.settings.cases, scene.stop_specs)) | {"excitation_amplitude_N": scene.amplitude})
+        if scene.layout.paper_view() is None:  # the paper's layout needs no record: its page draws the paper's names
+            dataset.attrs.update(scene.layout.attributes(*_shared_values(scene.settings.cases, scene.layout.stops)) | CLOSED_FORM_METHODS | {"excitation_amplitude_N": scene.amplitude})
         return dataset
 
     def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:
@@ -445,7 +443,7 @@ class BenchmarkStudy:
         calibration machine, scaled for a general layout's coordinates and stops."""
         assert scene.settings is not None
         bench = scene.settings
-        scale = engine_scale(scene)
+        scale = engine_scale(scene.layout)
         total = 0.0
         for case in bench.cases:
             periods = case.periods if case.sweep is None else case.sweep.duration * case.sweep.start_frequency

@@ -49,11 +49,11 @@ from typing import Any
 
 import numpy as np
 
-from vibroimpact.kinds.stepped.scene import parse_header, parse_names
 from vibroimpact.model.structure import require_in_range, require_positive
 from vibroimpact.scene.checker import Checker, SceneError
-from vibroimpact.scene.layout import StopSpec
-from vibroimpact.scene.layout_parse import static_drift, document_names, is_general, parse_load, parse_stop_layout, parse_structure
+from vibroimpact.model.layout import Layout, StopSpec
+from vibroimpact.scene.header import parse_names
+from vibroimpact.scene.layout_parse import parse_layout, static_drift
 from vibroimpact.scene.schema import SWEEP_DIRECTIONS, Scene
 
 __all__ = ["BIFURCATION_TOP_KEYS", "CHART_KINDS", "BruteForceSettings", "BranchSettings", "ChartSettings", "BifurcationSettings", "coordinate_label", "parse_bifurcation_scene"]
@@ -251,21 +251,14 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
     :class:`SceneError` listing all problems."""
     c = Checker()
     doc = c.mapping("", document, BIFURCATION_TOP_KEYS, {"name", "system", "excitation", "bifurcation"}, kind="bifurcation")
-    general = is_general(doc)
-    load = None
-    if general:
-        name, description, report = parse_names(c, doc)
-        system = parse_structure(c, doc["system"]) if "system" in doc else None
-        names = tuple(system.coordinates) if system is not None else document_names(doc.get("system"))
-        amplitude, load = parse_load(c, doc["excitation"], names) if "excitation" in doc else (None, None)
-        if load is not None and system is not None and static_drift(system, load):
-            c.fail("excitation.static", "the static force pushes the structure along a rigid-body mode: it has no steady state to follow")
-    else:
-        name, description, system, amplitude, report = parse_header(c, doc)
+    name, description, report = parse_names(c, doc)
+    layout, amplitude, _ = parse_layout(c, doc)
+    if layout is not None and static_drift(layout):
+        c.fail("excitation.static", "the static force pushes the structure along a rigid-body mode: it has no steady state to follow")
     stops_give_restitution = isinstance(doc.get("stops"), list) and bool(doc["stops"]) and all(isinstance(e, dict) and "restitution" in e for e in doc["stops"])
     required = {"frequency"} if stops_give_restitution else {"frequency", "restitution"}
     spec = c.mapping("bifurcation", doc.get("bifurcation"), _KEYS, required) if "bifurcation" in doc else {}
-    specs, clearance, own_restitution = _layout(c, doc, system, "restitution" in spec)
+    specs, clearance, own_restitution = _stops(c, doc, layout, "restitution" in spec)
     low = high = None
     if "frequency" in spec:
         band = c.mapping("bifurcation.frequency", spec["frequency"], {"start", "stop"}, {"start", "stop"})
@@ -294,34 +287,31 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
         c.fail("bifurcation.chart.frequency_step", f"{chart.frequency_step:g} Hz is out of range: allowed (0, {high - low:g}] (the band's width)")
     if c.problems:
         raise SceneError(c.problems, source)
-    assert system is not None and amplitude is not None and isinstance(name, str) and clearance is not None
+    assert layout is not None and specs is not None and amplitude is not None and isinstance(name, str) and clearance is not None
     assert low is not None and high is not None and restitution is not None and brute is not None and branches is not None
     settings = BifurcationSettings(low, high, tuple(float(r) for r in restitution), float(clearance), brute, branches, chart, tuple(bumpers or ()))
     return Scene(
         name=name,
         description=description,
-        system=system,
+        layout=layout.with_stops(specs) if specs else layout,
         amplitude=amplitude,
         kind="bifurcation",
         settings=settings,
         report=report,
         text=text,
-        load=load,
-        stops=specs or (),
-        general=general,
     )
 
 
-def _layout(c: Checker, doc: dict, system: Any, swept_restitution: bool) -> tuple[tuple[StopSpec, ...] | None, float | None, np.ndarray | None]:
+def _stops(c: Checker, doc: dict, layout: Layout | None, swept_restitution: bool) -> tuple[tuple[StopSpec, ...] | None, float | None, np.ndarray | None]:
     """The stops (``()``: the paper's stop on x2; None: unusable), their shared clearance Delta [m] and, when they give
     it and ``bifurcation.restitution`` does not (``swept_restitution`` False), their shared restitution as a grid.
 
     The returned stops take Delta and R from the study (their own values moved to the grid), as a stepped scene's
-    shared values do (:mod:`vibroimpact.scene.layout`)."""
+    shared values do (:mod:`vibroimpact.model.layout`)."""
     if "stop" not in doc and "stops" not in doc:
         c.fail("stop", "required: the paper's stop {clearance: Delta [m]} above the absorber x2, or 'stops' (any layout)")
         return None, None, None
-    specs = parse_stop_layout(c, doc, system)
+    specs = layout.stops if layout is not None else None
     if "stops" not in doc:
         stop = c.mapping("stop", doc["stop"], {"clearance"}, {"clearance"})
         clearance = c.number("stop.clearance", stop["clearance"], 0.0, math.inf, low_inclusive=False) if "clearance" in stop else None

@@ -42,7 +42,7 @@ curve's points in their order along it.
 
 The scene's layout (the paper's named form or the general one: matrices, a load on any coordinate or a base motion,
 a list of stops) becomes one general :class:`~vibroimpact.model.problem.ImpactProblem` per restitution
-(:func:`scene_problem`); every part of the study runs on it. The dataset's attributes describe that structure
+(:func:`diagram_problem`); every part of the study runs on it. The dataset's attributes describe that structure
 (``system_coordinates``, the matrices flattened row by row, the load, ``stop_layout`` in words).
 """
 
@@ -57,7 +57,7 @@ from vibroimpact.model.contact import loss_factor_from_restitution
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
-from vibroimpact.scene.layout import build_stops, describe_stop
+from vibroimpact.model.layout import build_stops, describe_stop
 from vibroimpact.scene.schema import Scene
 from vibroimpact.scene.variables import BIFURCATION_ATTRIBUTES, COORDINATE_ATTRIBUTES, STABLE_ATTRIBUTES, flag_attributes
 from vibroimpact.kinds.bifurcation.branches import MAX_ORBIT_IMPACTS, ORIGINS
@@ -69,7 +69,7 @@ from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.run import provenance
 from vibroimpact.runs.runner import CaseResult, Runner
 
-__all__ = ["BifurcationStudy", "scene_problem", "CONTINUATION_SECONDS", "CLOSED_FORM_SECONDS", "CHART_SECONDS", "STIFFNESS_SECONDS", "REPORT_FIGURES"]
+__all__ = ["BifurcationStudy", "diagram_problem", "CONTINUATION_SECONDS", "CLOSED_FORM_SECONDS", "CHART_SECONDS", "STIFFNESS_SECONDS", "REPORT_FIGURES"]
 
 #: Wall time of the continuation of one restitution's branches on the calibration machine [s], with the branches
 #: seeded from the brute force (measured: 11-15 s for R = 0.2 and 0.8 at load ~2), and without (1.8-2.3 s).
@@ -87,19 +87,17 @@ REPORT_FIGURES = 3
 BRUTE_FACTOR = 1.5
 
 
-def scene_problem(scene: Scene, restitution: float, clearance: float | None = None, bumper_frequency: float | None = None) -> ImpactProblem:
-    """The general problem of a bifurcation scene: its structure (the named system's matrices for the paper's form),
-    every stop rigid with ``restitution`` [-] (or, given ``bumper_frequency`` [Hz], a Kelvin-Voigt bumper of that
-    Omega_b / 2 pi whose loss factor gives that restitution) and the scene's clearance (or ``clearance`` [m]), and its
-    harmonic load at the band's lower frequency (each part of the study moves it in frequency)."""
+def diagram_problem(scene: Scene, restitution: float, clearance: float | None = None, bumper_frequency: float | None = None) -> ImpactProblem:
+    """The problem a bifurcation diagram starts from: the scene's layout with every stop rigid of ``restitution``
+    [-] (or, given ``bumper_frequency`` [Hz], a Kelvin-Voigt bumper of that Omega_b / 2 pi whose loss factor gives that
+    restitution), the scene's clearance (or ``clearance`` [m]), and its load at the band's lower frequency (each part
+    of the study moves it in frequency)."""
     settings = scene.settings
     assert settings is not None
     delta = settings.clearance if clearance is None else float(clearance)
     if bumper_frequency is None:
-        stops = build_stops(scene.stop_specs, False, float(restitution), delta)
-    else:
-        stops = build_stops(scene.stop_specs, True, float(restitution), delta, float(bumper_frequency), loss_factor_from_restitution(float(restitution)))
-    return ImpactProblem(scene.system.structure, stops, scene.load_spec.force(scene.amplitude, settings.low))
+        return scene.layout.problem(scene.amplitude, settings.low, float(restitution), delta)
+    return scene.layout.problem(scene.amplitude, settings.low, float(restitution), delta, True, float(bumper_frequency), loss_factor_from_restitution(float(restitution)))
 
 
 class BifurcationStudy:
@@ -116,12 +114,12 @@ class BifurcationStudy:
         options = tuple(sorted(vars(settings.branches).items()))
         brute = settings.brute_force
         chart = settings.chart
-        sweeps = [SweepCase(scene_problem(scene, r), d, tuple(settings.frequency), brute.transient_periods, brute.strobes) for r in settings.restitution for d in brute.directions]
+        sweeps = [SweepCase(diagram_problem(scene, r), d, tuple(settings.frequency), brute.transient_periods, brute.strobes) for r in settings.restitution for d in brute.directions]
         maps = []
         if chart is not None:
-            maps = [SweepCase(scene_problem(scene, chart.restitution, float(c)), d, tuple(settings.chart_frequency), chart.transient_periods, chart.strobes) for c in chart.clearances for d in brute.directions]
+            maps = [SweepCase(diagram_problem(scene, chart.restitution, float(c)), d, tuple(settings.chart_frequency), chart.transient_periods, chart.strobes) for c in chart.clearances for d in brute.directions]
         # the chart's curves (the longest case) first, alongside the sweeps; then the branches, seeded from the sweeps
-        charted = [ChartCase(scene_problem(scene, chart.restitution), settings.low, settings.high, chart.clearance, chart.kinds, chart.max_steps)] if chart else []
+        charted = [ChartCase(diagram_problem(scene, chart.restitution), settings.low, settings.high, chart.clearance, chart.kinds, chart.max_steps)] if chart else []
         say(f"brute force: {len(sweeps)} sweeps of {settings.frequency.size} frequencies" + (f", regime map: {len(maps)} sweeps of {settings.chart_frequency.size}" if maps else "")
             + (f"; the chart's curves (R = {chart.restitution:g})" if chart else ""))  # fmt: skip
         first = runner.map(charted + sweeps + maps)
@@ -133,10 +131,10 @@ class BifurcationStudy:
                 for j, _direction in enumerate(brute.directions):
                     result = swept[i * len(brute.directions) + j]
                     seeds += sweep_seeds(settings.frequency, result["period"], result["impacts"], result["state"], j)
-            continuation.append(BranchCase(scene_problem(scene, r), settings.low, settings.high, options, tuple(seeds)))
+            continuation.append(BranchCase(diagram_problem(scene, r), settings.low, settings.high, options, tuple(seeds)))
         bumpers = [(r, fb) for r in settings.restitution for fb in settings.bumper_frequencies]
         plain = tuple((k, False if k == "brute_force" else v) for k, v in options)  # no brute force of a bumper
-        continuation += [BranchCase(scene_problem(scene, r, bumper_frequency=fb), settings.low, settings.high, plain) for r, fb in bumpers]
+        continuation += [BranchCase(diagram_problem(scene, r, bumper_frequency=fb), settings.low, settings.high, plain) for r, fb in bumpers]
         stiffness = _stiffness_cases(scene, options) if bumpers else []
         say(f"continuing the branches of R = {', '.join(f'{r:g}' for r in settings.restitution)}" + (f" and of bumpers of {', '.join(f'{fb:g}' for fb in settings.bumper_frequencies)} Hz"
             f", and following the stiffest bumper's special points in its stiffness" if bumpers else ""))  # fmt: skip
@@ -154,7 +152,7 @@ class BifurcationStudy:
             _say_notes(say, f"chart {chart.restitution:g}", chart_result)
             results = [*results, chart_result]
         sets = len(settings.restitution) + len(bumpers)
-        data = _branches(results[:sets], settings.restitution + tuple(r for r, _fb in bumpers), scene.coordinates, scene.load_spec.base_motion,
+        data = _branches(results[:sets], settings.restitution + tuple(r for r, _fb in bumpers), scene.coordinates, scene.layout.load.base_motion,
                          (None,) * len(settings.restitution) + tuple(fb for _r, fb in bumpers) if bumpers else ())  # fmt: skip
         data = data.merge(_brute(swept[: len(sweeps)], scene, brute.directions, brute.strobes))
         if curves:
@@ -320,7 +318,7 @@ def _brute(results: list[CaseResult], scene: Scene, directions: tuple[str, ...],
     a = BIFURCATION_ATTRIBUTES
     grid = ("restitution", "sweep", "frequency")
     regime = _regime_flags("brute force: what the motion is at each frequency")
-    first, base = scene.coordinates[0], scene.load_spec.base_motion
+    first, base = scene.coordinates[0], scene.layout.load.base_motion
     return xr.Dataset(
         {
             f"brute_{first}": (grid + ("strobe",), stack("strobe"), coordinate_attributes("brute_x1", first, base)),
@@ -370,7 +368,7 @@ def _stiffness_cases(scene: Scene, options: tuple[tuple[str, object], ...]) -> l
     assert settings is not None
     fbs, steps = settings.bumper_frequencies, dict(options)
     reach = (min(fbs) / SOFTER, max(fbs) * STIFFER)
-    return [StiffnessCase(scene_problem(scene, r, bumper_frequency=max(fbs)), settings.low, settings.high, reach, int(steps.get("max_steps", 2000)), float(steps.get("max_step", 0.1)))
+    return [StiffnessCase(diagram_problem(scene, r, bumper_frequency=max(fbs)), settings.low, settings.high, reach, int(steps.get("max_steps", 2000)), float(steps.get("max_step", 0.1)))
             for r in settings.restitution]  # fmt: skip
 
 
@@ -430,8 +428,8 @@ def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult],
 
 def _layout_attributes(scene: Scene) -> dict[str, object]:
     """The structure, load and stops the study ran (plain netCDF attributes: matrices flattened row by row)."""
-    structure = scene.system.structure
-    load = scene.load_spec
+    structure = scene.layout.structure
+    load = scene.layout.load
     size = structure.size
     names = tuple(structure.coordinates)
     return {
@@ -443,5 +441,5 @@ def _layout_attributes(scene: Scene) -> dict[str, object]:
         f"excitation_amplitude_{'m' if load.base_motion else 'N'}": scene.amplitude,
         "excitation_weights": np.array(load.weights if load.weights is not None else [1.0] + [0.0] * (size - 1)),
         "excitation_static_N": np.array(load.static if load.static is not None else [0.0] * size),
-        "stop_layout": "; ".join(describe_stop(spec, names, scene.settings.clearance) for spec in scene.stop_specs),
+        "stop_layout": "; ".join(describe_stop(spec, names, scene.settings.clearance) for spec in scene.layout.stops),
     }

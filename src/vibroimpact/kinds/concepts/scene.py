@@ -30,8 +30,11 @@ from typing import Any
 
 import numpy as np
 
-from vibroimpact.engines.settings import EngineSettings, STEPPED_TOLERANCES
-from vibroimpact.kinds.stepped.scene import NAME, parse_header
+from vibroimpact.engines.settings import EngineSettings
+from vibroimpact.model.layout import Layout
+from vibroimpact.scene.header import NAME, parse_names
+from vibroimpact.scene.layout_parse import parse_layout
+from vibroimpact.scene.simulation import parse_simulation
 from vibroimpact.model.absorber import den_hartog_absorber
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution, Stop
 from vibroimpact.model.excitation import HarmonicForce
@@ -143,7 +146,7 @@ class ConceptsSettings:
 #: Top-level keys of a concepts scene.
 CONCEPTS_TOP_KEYS = {"name", "description", "system", "excitation", "frequency", "simulation", "bumper", "continuation", "concepts", "report"}
 _CONCEPT_KEYS = {"name", "label", "absorber", "stops"}
-_SIMULATION_KEYS = {"frequency", "rtol", "atol", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods"}
+_SIMULATION_KEYS = frozenset({"frequency", "rtol", "atol", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods"})
 #: Simulation keys of other kinds that a concepts scene does not use: refused with the reason, never ignored.
 _UNUSED_SIMULATION_KEYS = {
     "lyapunov_periods": "a concepts scene does not classify non-periodic motion (its steady states march, then measure "
@@ -161,7 +164,11 @@ def parse_concepts(document: Any, source: str = "scene") -> tuple[str, str, bool
     listing every problem otherwise."""
     c = Checker()
     doc = c.mapping("", document, CONCEPTS_TOP_KEYS, {"name", "system", "excitation", "frequency", "concepts"}, kind="concepts")
-    name, description, system, amplitude, report = parse_header(c, doc)
+    name, description, report = parse_names(c, doc)
+    layout, amplitude, _ = parse_layout(c, doc)
+    system = layout.paper_view() if layout is not None else None  # the absorber concepts are variants of the paper's layout
+    if layout is not None and system is None:
+        c.fail("system", "a concepts scene needs the paper's layout: the two-mass chain (a primary mass on its suspension, an absorber on the primary) as {m1, m2, k1, k2, b1, b2} or its matrices with coordinates [x1, x2], the force on x1")
     frequency = c.grid("frequency", doc["frequency"], 0.0, math.inf, False) if "frequency" in doc else None
     simulation = _simulation(c, doc.get("simulation", {}), frequency)
     bumper_frequency = math.nan
@@ -194,7 +201,7 @@ def parse_concepts_scene(document: Any, text: str = "", source: str = "scene") -
 
     name, description, report, settings = parse_concepts(document, source)
     return Scene(
-        name=name, description=description, system=settings.system, amplitude=settings.amplitude, kind="concepts", settings=settings, report=report, text=text,
+        name=name, description=description, layout=Layout(settings.system), amplitude=settings.amplitude, kind="concepts", settings=settings, report=report, text=text,
     )  # fmt: skip
 
 
@@ -203,31 +210,14 @@ def _simulation(c: Checker, value: Any, frequency: np.ndarray | None) -> tuple[n
         for key in sorted(set(value) & set(_UNUSED_SIMULATION_KEYS)):
             c.fail(f"simulation.{key}", f"not used by the concepts kind: {_UNUSED_SIMULATION_KEYS[key]}")
         value = {key: item for key, item in value.items() if key not in _UNUSED_SIMULATION_KEYS}
-    spec = c.mapping("simulation", value, _SIMULATION_KEYS)
-    grid = c.grid("simulation.frequency", spec["frequency"], 0.0, math.inf, False) if "frequency" in spec else None
-    if grid is None and "frequency" not in spec and frequency is not None:
-        grid = frequency[:: max(1, frequency.size // 61)]
-    if grid is not None and grid.size > MAX_SIMULATION_POINTS:
-        c.fail("simulation.frequency", f"{grid.size} points is too many: allowed at most {MAX_SIMULATION_POINTS} (raise the step)")
-        grid = None
-    kwargs: dict[str, Any] = {}
-    for key in sorted(set(spec) - {"frequency"}):
-        item = spec[key]
-        if isinstance(item, bool) or not isinstance(item, (int, float)):
-            c.fail(f"simulation.{key}", f"expected a number, got {item!r}")
-        else:
-            kwargs[key] = item
-    engine_kwargs = {k: kwargs[k] for k in ("rtol", "atol") if k in kwargs}
-    if "rtol" in engine_kwargs and "atol" not in engine_kwargs:
-        engine_kwargs["atol"] = engine_kwargs["rtol"] * STEPPED_TOLERANCES[1] / STEPPED_TOLERANCES[0]
-    steady_kwargs = {k: kwargs[k] for k in kwargs if k not in ("rtol", "atol")}
-    try:
-        engine = EngineSettings(**engine_kwargs)
-        steady = SteadySettings(**steady_kwargs)
-    except (TypeError, ValueError) as error:
-        c.fail_settings("simulation", error)
+    thinned = frequency[:: max(1, frequency.size // 61)] if frequency is not None else None
+    settings = parse_simulation(c, value, thinned, allowed=_SIMULATION_KEYS)
+    if settings is None:
         return None
-    return None if grid is None else (grid, engine, steady)
+    if settings.frequency.size > MAX_SIMULATION_POINTS:
+        c.fail("simulation.frequency", f"{settings.frequency.size} points is too many: allowed at most {MAX_SIMULATION_POINTS} (raise the step)")
+        return None
+    return settings.frequency, settings.engine, settings.steady
 
 
 def _concepts(c: Checker, value: Any, system: TwoDofSystem) -> tuple[Concept, ...]:

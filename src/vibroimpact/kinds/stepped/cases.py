@@ -2,7 +2,7 @@
 
 One case per (restitution, clearance, bumper) grid point and chunk of frequencies (a bumper engine runs once per
 bumper, the rigid engines once per (restitution, clearance)); each stop's values come from itself or from the grid
-(:func:`vibroimpact.scene.layout.build_stops`). States are 2 N wide; the measured fundamentals are per coordinate and
+(:func:`vibroimpact.model.layout.build_stops`). States are 2 N wide; the measured fundamentals are per coordinate and
 the impulses, peaks and contact forces per stop. On a symmetric two-sided stop the flag ``one_impact`` means the
 closed form's kind of orbit, one impact per period on each side (as ``pgf`` flags it there).
 """
@@ -23,13 +23,13 @@ from vibroimpact.engines.registry import make_engine, BUMPER, engine_spec
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.kinds.stepped.grid import no_one_impact_orbit
 from vibroimpact.scene.subset import on_subset
-from vibroimpact.kinds.stepped.values import broadcast_quantities, coordinate_quantity, scene_problem
+from vibroimpact.kinds.stepped.values import broadcast_quantities, coordinate_quantity
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem, Structure
 from vibroimpact.runs.runner import CaseResult, ProgressReport, Runner
 from vibroimpact.runs.store import case_key
-from vibroimpact.scene.layout import LoadSpec, build_stops
+from vibroimpact.model.layout import LoadSpec, build_stops
 from vibroimpact.scene.schema import Scene
 from vibroimpact.simulation.steady import linear_fits, pgf_guesses, steady_state
 from vibroimpact.simulation.settings import SWEEP_STARTS, SteadySettings
@@ -260,9 +260,9 @@ def simulated_regime(fields: dict[str, np.ndarray], one_impact_orbit: np.ndarray
 
 def _two_sided(scene: Scene) -> bool:
     """Is the layout a symmetric two-sided stop (two stops whose closed form is the two-impacts orbit)?"""
-    if len(scene.stop_specs) != 2:
+    if len(scene.layout.stops) != 2:
         return False
-    problem = scene_problem(scene, float(scene.settings.all_frequencies[0]), float(scene.settings.restitution[0]), float(scene.settings.clearance[0]))
+    problem = scene.layout.problem(scene.amplitude, float(scene.settings.all_frequencies[0]), float(scene.settings.restitution[0]), float(scene.settings.clearance[0]))
     return closed_form_refusal(problem) is None
 
 
@@ -276,7 +276,7 @@ def general_simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], 
     bumpers = scene.settings.bumper_frequency if on_bumper and scene.settings.bumper_frequency is not None else np.array([np.nan])
     losses = scene.settings.loss_factors() if on_bumper and scene.settings.bumper_loss_factor is not None else np.full(scene.settings.restitution.shape, np.nan)
     chunk = max(simulated.size, 1) if sim.start in SWEEP_STARTS else CASE_CHUNK
-    specs = scene.stop_specs
+    specs = scene.layout.stops
     kept = [on_subset(sim.subset, engine, axis, values) for axis, values in (("restitution", scene.settings.restitution), ("clearance", scene.settings.clearance), ("bumper_frequency", bumpers))]
     cases, places = [], []
     for i, restitution in enumerate(scene.settings.restitution):
@@ -288,12 +288,12 @@ def general_simulated_values(scene: Scene, engine: str, shape: tuple[int, ...], 
                 contact = build_stops(specs, True, float(restitution), float(clearance), float(bumper), float(losses[i])) if on_bumper else rigid
                 for first in range(0, simulated.size, chunk):
                     frequencies = tuple(float(f) for f in simulated[first : first + chunk])
-                    case = SimulationCase(engine, scene.system, scene.amplitude, contact, frequencies, sim.start, sim.engine, sim.steady, rigid if on_bumper else None, scene.load)
+                    case = SimulationCase(engine, scene.layout.structure, scene.amplitude, contact, frequencies, sim.start, sim.engine, sim.steady, rigid if on_bumper else None, scene.layout.load)
                     cases.append(case)
                     places.append((i, j, k, columns[first : first + chunk]))
     results = runner.map(cases)
     grid = (shape[0], shape[1], bumpers.size, 1, shape[4])
-    size, count = scene.system.size, len(specs)
+    size, count = scene.layout.size, len(specs)
     widths = {**{name: (size,) for name in COORDINATE_FIELDS}, **{name: (count,) for name in STOP_FIELDS}}
     fields = {name: np.full(grid + widths.get(name, ()), np.nan, dtype=complex if name in COMPLEX_FIELDS else float) for name in (*FIELDS, *COORDINATE_FIELDS, *STOP_FIELDS)}
     for (i, j, k, where), result in zip(places, results):

@@ -13,16 +13,14 @@ import numpy as np
 import xarray as xr
 
 from vibroimpact.model.modal import fit_modal_parameters
-from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.scene.layout import stop_descriptions
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, STOP_QUANTITIES, Scene
-from vibroimpact.scene.variables import COORDINATE_ATTRIBUTES
+from vibroimpact.scene.variables import CLOSED_FORM_METHODS, COORDINATE_ATTRIBUTES
 from vibroimpact.kinds.stepped.values import general_linear_values, general_pgf_values, paper_pgf_values
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import TASK_SECONDS, WRITE_SECONDS_PER_VARIABLE, Costs, Estimate, cluster_startup, cost_engine, os_cpus
 from vibroimpact.runs.run import provenance
 
-__all__ = ["EnginePart", "grid_estimate", "memory", "StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset", "layout_attributes", "no_one_impact_orbit"]
+__all__ = ["EnginePart", "grid_estimate", "memory", "StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset", "no_one_impact_orbit"]
 
 #: The values of one solution, quantity -> array over (part of) the full grid.
 Values = dict[str, np.ndarray]
@@ -108,7 +106,7 @@ def grid_coordinates(scene: Scene, grid: StudyGrid, solutions: list[str]) -> dic
 def steady_variable(quantity: str, scene: Scene, grid: StudyGrid, per_solution: list[Values], solutions: list[str]) -> np.ndarray | None:
     """``quantity`` of the named solutions stacked along a leading ``solution`` axis over the full grid; None if none.
     A per-stop quantity is taken at the scene's one stop (a layout with one stop has no ``stop`` dimension)."""
-    one_stop = quantity in STOP_QUANTITIES and len(scene.stop_specs) == 1
+    one_stop = quantity in STOP_QUANTITIES and len(scene.layout.stops) == 1
 
     def full(name: str, values: Values) -> np.ndarray:
         value = values[quantity]
@@ -145,8 +143,8 @@ def finish_dataset(dataset: xr.Dataset, scene: Scene, coords: dict[str, object],
 
 
 def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[str, object]:
-    structure = scene.system.structure
-    named = TwoDofSystem.of(scene.system)  # the named view: the paper's two-mass chain, however it was written
+    structure = scene.layout.structure
+    named = scene.layout.named_view()  # the named view: the paper's two-mass chain, however it was written
     fit = fit_modal_parameters(named) if named is not None and "pgf_paper" in scene.settings.solutions else None
     natural = named.natural_angular_frequencies() if named is not None else structure.natural_angular_frequencies()
     attrs: dict[str, object] = {
@@ -159,9 +157,7 @@ def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[st
     }
     if named is not None:
         attrs["antiresonance_frequency_Hz"] = named.antiresonance_angular_frequency() / (2.0 * np.pi)
-        for key, value in named.as_dict().items():
-            attrs[f"system_{key}"] = value
-    attrs.update(layout_attributes(scene, scene.settings.restitution, scene.settings.clearance))
+    attrs.update(scene.layout.attributes(scene.settings.restitution, scene.settings.clearance) | CLOSED_FORM_METHODS)
     if "pgf_paper" in scene.settings.solutions:
         attrs["method_pgf_paper"] = "the paper's route: curve-fitted modal parameters of H22 (eq. 10, Omega fixed from eq. 11); chi22'(0-) = -1/(2 M2); stable (+) root of corrected eq. 16"
     for key, value in asdict(scene.settings.admissibility).items():
@@ -173,46 +169,6 @@ def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[st
         attrs["pgf_paper_form_factors_per_kg"] = np.real(fit.form_factor)
         attrs["pgf_paper_loss_factors"] = fit.loss_factor
     return attrs
-
-
-def layout_attributes(scene: Scene, restitution: np.ndarray, clearance: np.ndarray) -> dict[str, object]:
-    """What a dataset records of its scene's structure, load and stops (plain netCDF attributes: matrices flattened
-    row by row, names and descriptions joined, one value per stop), so that a report can rebuild them.
-
-    ``restitution`` [-] and ``clearance`` [m] are the values the study gives the stops that take them (one value:
-    stated; several: swept)."""
-    structure = scene.system.structure
-    load = scene.load_spec
-    size = structure.size
-    specs = scene.stop_specs
-    return {
-        "system_size": size,
-        "system_coordinates": " ".join(structure.coordinates),
-        "system_mass_kg": _attribute(structure.mass_matrix),
-        "system_stiffness_N_per_m": _attribute(structure.stiffness_matrix),
-        "system_damping_N_s_per_m": _attribute(structure.damping_matrix),
-        "excitation_kind": "base_motion" if load.base_motion else "force",
-        "excitation_weights": _attribute(load.weights if load.weights is not None else [1.0] + [0.0] * (size - 1)),
-        "excitation_static_N": _attribute(load.static if load.static is not None else [0.0] * size),
-        "stop_count": len(specs),
-        "stop_layout": "; ".join(stop_descriptions(specs, tuple(structure.coordinates), restitution, clearance)),
-        "stop_coordinate": _attribute([spec.coordinate for spec in specs]),
-        "stop_other": _attribute([-1 if spec.other is None else spec.other for spec in specs]),
-        "stop_side": " ".join(spec.side for spec in specs),
-        # each stop's own clearance, or the grid's single value; NaN where the grid sweeps it
-        "stop_clearance_m": _attribute([
-            float(spec.clearance) if spec.clearance is not None else (float(clearance[0]) if clearance.size == 1 else np.nan) for spec in specs
-        ]),  # fmt: skip
-        "method_pgf": "closed-form impact orbit (periodic Green function of the stopped coordinate n^T H n; one impact per period on one stop, two on a symmetric two-sided stop); stable (+) root",
-        "method_force": "force on the base: 1^T (K x + C x') through springs and dashpots plus (1^T n_k) lambda_k of each absolute stop",
-    }
-
-
-def _attribute(values: object) -> object:
-    """``values`` as a flat array attribute, or its one value (netCDF stores a one-entry attribute as a scalar: a
-    dataset reads back as written)."""
-    flat = np.asarray(values).ravel()
-    return flat[0].item() if flat.size == 1 else flat
 
 
 def no_one_impact_orbit(shape: tuple[int, ...]) -> dict[str, np.ndarray]:

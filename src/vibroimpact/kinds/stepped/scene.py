@@ -4,28 +4,26 @@ and its settings (:class:`GridSettings`: the :attr:`~vibroimpact.scene.schema.Sc
 
 Each ``_parse_*`` function checks one section of the document with a :class:`~vibroimpact.scene.checker.Checker`
 (recording every problem, returning None where a value is unusable); :func:`parse_grid_scene` puts them together.
-:func:`parse_header` and :func:`check_sweep_run` are shared with benchmark scenes.
+The header (:mod:`vibroimpact.scene.header`) and the layout (:func:`vibroimpact.scene.layout_parse.parse_layout`) are
+every kind's.
 """
 
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
 
 from vibroimpact.analysis.pgf import AdmissibilitySettings
 from vibroimpact.engines.registry import BUMPER
-from vibroimpact.engines.settings import STEPPED_TOLERANCES, SWEPT_TOLERANCES, EngineSettings
 from vibroimpact.model.contact import loss_factor_from_restitution, restitution_from_loss_factor
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.modal import underdamped_mode_count
-from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.scene.subset import Subset, parse_subset
 from vibroimpact.scene.checker import Checker, SceneError, interval
-from vibroimpact.scene.layout_parse import check_general_solutions, paper_layout_applies, general_grids, is_general, document_names, parse_load, parse_stop_layout, parse_structure, parse_sweep_stops
+from vibroimpact.scene.header import check_sweep_run, parse_cluster, parse_names
+from vibroimpact.scene.layout_parse import check_layout_solutions, parse_layout, parse_sweep_stops, stop_grids
 from vibroimpact.scene.schema import (
     ENGINE_CONTACT,
     ENGINE_SOLUTIONS,
@@ -39,49 +37,18 @@ from vibroimpact.scene.schema import (
     Scene,
     quantities_for,
 )
-from vibroimpact.simulation.settings import SteadySettings
+from vibroimpact.scene.simulation import SimulationSettings, parse_simulation
 
-__all__ = ["GridSettings", "SimulationSettings", "SweptSineSettings", "TOP_KEYS", "NAME", "parse_grid_scene", "parse_header", "check_sweep_run"]
+__all__ = ["GridSettings", "SweptSineSettings", "TOP_KEYS", "parse_grid_scene"]
 
 #: Top-level keys of a grid scene.
 TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bumper", "sweep", "swept_sine", "solutions", "quantities", "settings", "simulation", "report", "cluster"}
 #: Report pages a grid scene may ask for by name (``report: design_map``) instead of its kind's page.
 REPORT_PAGES = ("design_map",)
-#: A scene's or a case's name: safe as a file name.
-NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 #: Simulation keys that only stepped steady states use.
 _STEADY_ONLY_KEYS = {"frequency", "start", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods", "subset"}
-_SIMULATION_KEYS = {"frequency", "start", "method", "rtol", "atol", "max_step", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods", "subset"}
 #: Where an unswept parameter is given instead (``frequency`` is always swept).
 _FIXED_PLACE = {"restitution": ("stop", "restitution"), "clearance": ("stop", "clearance"), "bumper_frequency": ("bumper", "frequency"), "bumper_loss_factor": ("bumper", "loss_factor")}
-_T = TypeVar("_T")
-
-
-@dataclass(frozen=True, eq=False)
-class SimulationSettings:
-    """How the time-domain solutions (``momentary``, ``exact``) are run.
-
-    Attributes
-    ----------
-    frequency : ndarray
-        Frequencies simulated [Hz] (a coarser grid than the analytic one, merged into the dataset's axis).
-    start : str
-        One of :data:`SIMULATION_STARTS`.
-    engine : EngineSettings
-        Integrator tolerances and method.
-    steady : SteadySettings
-        Convergence and measurement of the steady state.
-    subset : mapping
-        Solutions run on part of the grid only (``simulation.subset``, :mod:`~vibroimpact.scene.subset`):
-        solution -> axis (``frequency`` [Hz], a swept ``restitution``, ``clearance`` [m] or ``bumper_frequency``
-        [Hz]) -> the values it keeps; an axis or solution not named is kept whole.
-    """
-
-    frequency: np.ndarray
-    start: str = "pgf"
-    engine: EngineSettings = field(default_factory=EngineSettings)
-    steady: SteadySettings = field(default_factory=SteadySettings)
-    subset: Subset = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -189,16 +156,8 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     all problems."""
     c = Checker()
     doc = c.mapping("", document, TOP_KEYS, {"name", "system", "excitation", "sweep", "solutions"}, kind="swept" if "swept_sine" in document else "stepped")
-    general = is_general(doc)
-
-    load = None
-    if general:
-        name, description, report = parse_names(c, doc, REPORT_PAGES)
-        system = parse_structure(c, doc["system"]) if "system" in doc else None
-        names = tuple(system.coordinates) if system is not None else document_names(doc.get("system"))
-        amplitude, load = parse_load(c, doc["excitation"], names) if "excitation" in doc else (None, None)
-    else:
-        name, description, system, amplitude, report = parse_header(c, doc, REPORT_PAGES)
+    name, description, report = parse_names(c, doc, REPORT_PAGES)
+    layout, amplitude, coordinates = parse_layout(c, doc)
 
     sweep = c.mapping("sweep", doc.get("sweep", {}), {*SWEEPABLE, "stop"}, {"frequency"}) if "sweep" in doc else {}
     fixed = {
@@ -207,8 +166,8 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     }
     solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
     scheduler = parse_cluster(c, doc)
-    specs = parse_stop_layout(c, doc, system)
-    if isinstance(report, str) and ("swept_sine" in doc or general and system is not None and not paper_layout_applies(system, specs or (), load)):
+    specs = layout.stops if layout is not None and "stops" in doc else None
+    if isinstance(report, str) and ("swept_sine" in doc or layout is not None and layout.paper_view() is None):
         c.fail("report", f"the {report} page is for stepped studies of the paper's layout (a two-mass chain x1, x2 as {{m1 ... b2}}; one upper stop on x2; force on x1), however written")
     targets = None
     if "stop" in sweep:
@@ -242,7 +201,7 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     needs_bumper = bool(bumper_solutions) or "swept_sine" in doc
     if "stops" in doc:
         if specs is not None:
-            specs = general_grids(c, specs, grids, sweep, {k: v for k, v in fixed["bumper"].items() if not isinstance(v, bool) and isinstance(v, (int, float))}, targets, needs_bumper)
+            specs = stop_grids(c, specs, grids, sweep, {k: v for k, v in fixed["bumper"].items() if not isinstance(v, bool) and isinstance(v, (int, float))}, targets, needs_bumper)
     else:
         if needs_bumper and "bumper_frequency" not in sweep and "bumper" not in doc:
             c.fail("bumper", "required by the compliant solution and swept-sine tests: {frequency: Omega_b / 2 pi [Hz], loss_factor: xi_b (optional)}")
@@ -250,15 +209,16 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
             c.fail("bumper.frequency", "required unless swept (sweep.bumper_frequency): Omega_b / 2 pi [Hz] in (0, inf)")
         if bumper_solutions and "bumper_loss_factor" not in grids and (r := grids.get("restitution")) is not None and np.any(r == 0.0):
             c.fail("stop.restitution", "R = 0 needs an infinitely damped bumper for the compliant solution: give bumper.loss_factor, or sweep R > 0")
-    if general and system is not None:
-        check_general_solutions(c, solutions, system, specs or (), load, "swept_sine" in doc, grids.get("restitution"), grids.get("clearance"))
+    if layout is not None and (specs is not None or "stops" not in doc):
+        layout = layout.with_stops(specs) if specs is not None else layout
+        check_layout_solutions(c, solutions, layout, "swept_sine" in doc, grids.get("restitution"), grids.get("clearance"))
 
     sizes = [g.size for g in grids.values() if g is not None]
     if len(sizes) >= 3 and math.prod(sizes) > MAX_STUDY_POINTS:
         c.fail("sweep", f"{math.prod(sizes):,} points (product of the swept grids) is too many: allowed at most {MAX_STUDY_POINTS:,}")
-    if "pgf_paper" in solutions and system is not None and (named := TwoDofSystem.of(system)) is not None and (modes := underdamped_mode_count(named)) != 2:
+    if "pgf_paper" in solutions and layout is not None and (named := layout.paper_view()) is not None and (modes := underdamped_mode_count(named)) != 2:
         c.fail("solutions", f"pgf_paper needs two underdamped modes (the paper's eq. 10 fit); this system has {modes}")
-    allowed = quantities_for(system.coordinates) if general and system is not None else QUANTITIES
+    allowed = quantities_for(coordinates) if coordinates is not None else QUANTITIES
     if len(set(allowed)) != len(allowed):
         clashing = sorted({q for q in allowed if allowed.count(q) > 1})
         c.fail("system.coordinates", f"names that make output names clash ({', '.join(clashing)}): rename them (e.g. not 'force')")
@@ -290,15 +250,15 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
                 for key in sorted(set(doc["simulation"]) & _STEADY_ONLY_KEYS if isinstance(doc["simulation"], dict) else ()):
                     c.fail(f"simulation.{key}", "not used by a swept-sine test (it sets stepped steady states): remove it")
             swept_axes = {key: grid for key, grid in grids.items() if key in sweep and key != "frequency"}
-            simulation = _parse_simulation(c, doc["simulation"], main_grid, "swept_sine" in doc, engines, swept_axes)
+            simulation = parse_simulation(c, doc["simulation"], main_grid, swept="swept_sine" in doc, engines=engines, axes=swept_axes)
     elif engines and (main_grid := grids.get("frequency")) is not None:
-        simulation = _parse_simulation(c, {}, main_grid, "swept_sine" in doc)
+        simulation = parse_simulation(c, {}, main_grid, swept="swept_sine" in doc)
 
     if c.problems:
         raise SceneError(c.problems, source)
     frequency, restitution, clearance = grids["frequency"], grids["restitution"], grids["clearance"]
     # guaranteed when no problem was recorded
-    assert system is not None and amplitude is not None and isinstance(name, str)
+    assert layout is not None and amplitude is not None and isinstance(name, str)
     assert frequency is not None and restitution is not None and clearance is not None
     order = ("bumper_loss_factor", "restitution", "clearance", "bumper_frequency")
     swept = tuple(k for k in order if k in sweep) + ("frequency",)
@@ -308,9 +268,8 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
         bumper_loss_factor=grids.get("bumper_loss_factor"), swept_sine=swept_sine, sweep_stops=targets,
     )
     return Scene(
-        name=name, description=description, system=system, amplitude=amplitude, kind="stepped" if swept_sine is None else "swept", settings=grid,
-        report=report, text=text, load=load, stops=specs if "stops" in doc and specs is not None else (), general=general,
-        cluster_scheduler=scheduler,
+        name=name, description=description, layout=layout, amplitude=amplitude, kind="stepped" if swept_sine is None else "swept", settings=grid,
+        report=report, text=text, cluster_scheduler=scheduler,
     )
 
 
@@ -340,105 +299,3 @@ def _parse_swept_sine(c: Checker, value: Any, engines: list[str], grid: np.ndarr
     if rate is None or sample_rate is None or cycles is None or not directions or initial not in ("linear", "rest"):
         return None
     return SweptSineSettings(start, stop, rate, directions, sample_rate, cycles, initial)
-
-
-def check_sweep_run(c: Checker, key: str, low: float, high: float, rate: float | None, sample_rate: float | None, cycles: int | None, window_hint: str = "") -> tuple[float | None, float | None]:
-    """Limits of one swept-sine run between ``low`` and ``high`` [Hz], shared by scenes and benchmark cases: 20 output
-    samples per cycle at the top, at most :data:`MAX_SWEEP_SAMPLES` samples, and room for two estimator windows of
-    ``cycles`` cycles. Returns (rate, sample_rate), each None where it failed."""
-    if sample_rate is not None and sample_rate < 20.0 * high:
-        c.fail(f"{key}.sample_rate", f"{sample_rate:g} Hz is too coarse for {high:g} Hz: allowed [{20.0 * high:g}, 1e+07] (20 samples per cycle)")
-        sample_rate = None
-    if rate is not None:
-        duration = (high - low) / rate
-        if sample_rate is not None and duration * sample_rate > MAX_SWEEP_SAMPLES:
-            c.fail(f"{key}.rate", f"{duration:g} s at {sample_rate:g} samples/s is {duration * sample_rate:.3g} samples per run: allowed at most {MAX_SWEEP_SAMPLES:.0e} (raise the rate or lower {key}.sample_rate)")
-            rate = None
-        elif cycles is not None and 2.0 * cycles / low >= duration:
-            c.fail(f"{key}.rate", f"the sweep lasts {duration:g} s, shorter than two {cycles}-cycle estimator windows at {low:g} Hz ({2.0 * cycles / low:g} s): lower the rate{window_hint}")
-            rate = None
-    return rate, sample_rate
-
-
-def parse_header(c: Checker, doc: dict, pages: tuple[str, ...] = ()) -> tuple[Any, str, TwoDofSystem | None, float | None, bool | str]:
-    """What every scene of the two-mass chain has: name, description, system (the named view of the ``system``
-    section, written with m1 ... b2 or as matrices), excitation amplitude and the report switch (or one of
-    ``pages``)."""
-    name, description, report = parse_names(c, doc, pages)
-    structure = parse_structure(c, doc.get("system")) if "system" in doc else None
-    system = TwoDofSystem.of(structure) if structure is not None else None  # the named view, however it is written
-    if structure is not None and system is None:
-        c.fail("system", "this kind of scene needs the two-mass chain (a primary mass on its suspension, an absorber on the primary): the named form {m1, m2, k1, k2, b1, b2}, or its matrices with coordinates [x1, x2]")
-    amplitude = None
-    if "excitation" in doc:
-        excitation = c.mapping("excitation", doc["excitation"], {"amplitude"}, {"amplitude"})
-        if "amplitude" in excitation:
-            amplitude = c.number("excitation.amplitude", excitation["amplitude"], 0.0, math.inf, low_inclusive=False)
-    return name, description, system, amplitude, report
-
-
-def parse_names(c: Checker, doc: dict, pages: tuple[str, ...] = ()) -> tuple[Any, str, bool | str]:
-    """Name, description and the report switch of any scene (or one of ``pages``, the report pages it may name)."""
-    name = doc.get("name")
-    if "name" in doc and not (isinstance(name, str) and NAME.match(name)):
-        c.fail("name", f"expected a file-name-safe string (letters, digits, '_', '-', '.'), got {name!r}")
-    description = doc.get("description", "")
-    if not isinstance(description, str):
-        c.fail("description", f"expected a string, got {type(description).__name__}")
-    report = doc.get("report", True)
-    if not isinstance(report, bool) and report not in pages:
-        c.fail("report", f"expected true or false{' or a page name (' + ', '.join(pages) + ')' if pages else ''}, got {report!r}")
-        report = True
-    return name, description, report
-
-
-def parse_cluster(c: Checker, doc: dict) -> str | None:
-    """The scene's ``cluster: {scheduler: ADDRESS}``: a running dask scheduler to run on (None: a local cluster)."""
-    if "cluster" not in doc:
-        return None
-    section = c.mapping("cluster", doc["cluster"], {"scheduler"}, {"scheduler"})
-    address = section.get("scheduler")
-    if address is not None and not (isinstance(address, str) and "://" in address or isinstance(address, str) and ":" in address):
-        c.fail("cluster.scheduler", f"expected a scheduler address such as tcp://host:8786, got {address!r}")
-        return None
-    return address
-
-
-def _parse_simulation(
-    c: Checker, value: Any, default_frequency: np.ndarray, swept: bool = False, engines: list[str] | None = None, axes: dict[str, np.ndarray | None] | None = None,
-) -> SimulationSettings | None:  # fmt: skip
-    """The ``simulation`` section: tolerances, steady-state settings, the simulated frequencies [Hz] and the
-    solutions run on part of the grid (``subset``, checked against ``engines`` and the swept ``axes``)."""
-    spec = dict(c.mapping("simulation", value, _SIMULATION_KEYS))
-    rtol, atol = SWEPT_TOLERANCES if swept else STEPPED_TOLERANCES
-    if "rtol" in spec and "atol" not in spec and isinstance(spec["rtol"], (int, float)) and not isinstance(spec["rtol"], bool):
-        spec["atol"] = spec["rtol"] * (atol / rtol)  # the ratio the guidance was measured with: atol = rtol x 1e-4 m
-    spec.setdefault("rtol", rtol)
-    spec.setdefault("atol", atol)
-    frequency: np.ndarray | None = c.grid("simulation.frequency", spec["frequency"], 0.0, math.inf, False) if "frequency" in spec else default_frequency
-    start = spec.get("start", "pgf")
-    if start not in SIMULATION_STARTS:
-        c.fail("simulation.start", f"{start!r} is not allowed: use one of {', '.join(SIMULATION_STARTS)}")
-    engine_kwargs = {k: spec[k] for k in ("method", "rtol", "atol", "max_step") if k in spec}
-    steady_kwargs = {k: spec[k] for k in ("tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods") if k in spec}
-    engine = _settings(c, EngineSettings, engine_kwargs)
-    steady = _settings(c, SteadySettings, steady_kwargs)
-    subset: Subset = {}
-    if "subset" in spec and frequency is not None and start in SIMULATION_STARTS:
-        subset = parse_subset(c, spec["subset"], engines or [], {"frequency": frequency, **(axes or {})}, start)
-    if frequency is None or start not in SIMULATION_STARTS or engine is None or steady is None:
-        return None
-    return SimulationSettings(frequency=frequency, start=start, engine=engine, steady=steady, subset=subset)
-
-
-def _settings(c: Checker, kind: type[_T], kwargs: dict[str, Any]) -> _T | None:
-    """Build a settings dataclass, turning its validation errors into scene problems under ``simulation.``."""
-    for key, item in kwargs.items():
-        if isinstance(item, bool) or not isinstance(item, (int, float, str)):
-            c.fail(f"simulation.{key}", f"expected a number or name, got {item!r}")
-            return None
-    try:
-        return kind(**kwargs)
-    except (ValueError, TypeError) as error:
-        c.fail_settings("simulation", error)
-        return None

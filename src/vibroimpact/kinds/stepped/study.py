@@ -14,18 +14,18 @@ from vibroimpact.analysis.stability import floquet_multipliers
 from vibroimpact.engines.registry import BUMPER, engine_spec
 from vibroimpact.kinds.stepped.cases import general_simulated_values
 from vibroimpact.kinds.stepped.grid import StudyGrid, grid_coordinates, solve_each, finish_dataset, EnginePart, grid_estimate
-from vibroimpact.kinds.stepped.values import scene_problem, stop_clearances
+from vibroimpact.kinds.stepped.values import stop_clearances
 from vibroimpact.kinds.stepped.blocks import plan_blocks, run_grid
 from vibroimpact.scene.subset import subset_axes, subset_share, subset_text
 from vibroimpact.runs.cluster import Progress
-from vibroimpact.runs.estimate import Costs, Estimate
+from vibroimpact.runs.estimate import Costs, Estimate, engine_scale
 from vibroimpact.runs.runner import Runner
-from vibroimpact.scene.layout import stop_descriptions
+from vibroimpact.model.layout import stop_descriptions
 from vibroimpact.scene.schema import Scene, GRID_DIMS, STOP_QUANTITIES, ENGINE_SOLUTIONS
 from vibroimpact.scene.variables import quantity_attributes
 from vibroimpact.simulation.settings import SWEEP_STARTS
 
-__all__ = ["engine_scale", "closed_form_scale", "general_orbit_outlook", "UNKNOWN_WANDERING", "CLOSED_FORM_FACTOR", "general_block", "general_coordinates", "describe_stops", "general_quantity_attributes", "SteppedStudy", "expected_periods", "SETTLING_PERIODS", "SHOOTING_PERIODS", "ESTIMATE_POINTS"]
+__all__ = ["closed_form_scale", "general_orbit_outlook", "UNKNOWN_WANDERING", "CLOSED_FORM_FACTOR", "general_block", "general_coordinates", "describe_stops", "general_quantity_attributes", "SteppedStudy", "expected_periods", "SETTLING_PERIODS", "SHOOTING_PERIODS", "ESTIMATE_POINTS"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -38,17 +38,12 @@ UNKNOWN_WANDERING = 0.25
 CLOSED_FORM_FACTOR = 1.3
 
 
-def engine_scale(scene: Scene) -> float:
-    """(N / 2)^2 K: an engine's cost per period relative to the paper's layout's."""
-    return (scene.system.size / 2.0) ** 2 * len(scene.stop_specs)
-
-
 def closed_form_scale(scene: Scene, solution: str) -> float:
     """A closed form's cost per grid point relative to the one measured on the paper's layout by its named route."""
     if solution == "pgf_paper":
         return 1.0
-    size = (scene.system.size / 2.0) ** 2
-    return CLOSED_FORM_FACTOR * size * (len(scene.stop_specs) if solution == "linear" else 1.0)
+    size = (scene.layout.size / 2.0) ** 2
+    return CLOSED_FORM_FACTOR * size * (len(scene.layout.stops) if solution == "linear" else 1.0)
 
 
 def general_orbit_outlook(scene: Scene, frequencies: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -58,7 +53,7 @@ def general_orbit_outlook(scene: Scene, frequencies: np.ndarray) -> tuple[np.nda
     off the stops, is stable (all False without a closed form); the share of impacting points without a closed form
     assumed never to settle (0 where a closed form applies).
     """
-    problem = scene_problem(scene, float(frequencies[0]), float(scene.settings.restitution[0]), float(scene.settings.clearance[0]))
+    problem = scene.layout.problem(scene.amplitude, float(frequencies[0]), float(scene.settings.restitution[0]), float(scene.settings.clearance[0]))
     omega = 2.0 * np.pi * frequencies[None, None, :]
     clearances = stop_clearances(scene)[None, :, None, :]  # (1, nc, 1, K)
     fits = np.broadcast_to(linear_amplitudes(problem, omega=omega).fits(clearances), (scene.settings.restitution.size, scene.settings.clearance.size, frequencies.size))
@@ -84,7 +79,7 @@ _PER_COORDINATE = {"_amplitude": "x1_amplitude", "_rms": "x1_rms"}
 
 def general_quantity_attributes(quantity: str, scene: Scene) -> dict[str, object]:
     """Units and long name of a stepped study's quantity (per-coordinate names included)."""
-    relative = " relative to the base" if scene.load_spec.base_motion else ""
+    relative = " relative to the base" if scene.layout.load.base_motion else ""
     for name in scene.coordinates:
         if quantity == f"{name}_amplitude":
             return {"units": "m", "long_name": f"fundamental-harmonic amplitude of coordinate {name}{relative}"}
@@ -105,7 +100,7 @@ def general_block(scene: Scene, runner: Runner) -> xr.Dataset:
     per-stop quantities have the dimension ``stop`` where the scene has several stops."""
     grid = StudyGrid.of(scene)
     per_solution = solve_each(scene, grid, lambda name: general_simulated_values(scene, name, grid.full, runner), None)
-    count = len(scene.stop_specs)
+    count = len(scene.layout.stops)
     data_vars = {}
     for quantity in scene.settings.quantities:
         attrs = general_quantity_attributes(quantity, scene)
@@ -125,10 +120,10 @@ def general_coordinates(scene: Scene, grid: StudyGrid) -> dict[str, object]:
     """Coordinates of a stepped study's dataset before squeezing: those of :func:`grid_coordinates`, and ``stop``
     with ``stop_description`` where the scene has several stops and writes a per-stop quantity."""
     coords = grid_coordinates(scene, grid, list(scene.settings.solutions))
-    count = len(scene.stop_specs)
+    count = len(scene.layout.stops)
     if count > 1 and any(q in STOP_QUANTITIES for q in scene.settings.quantities):
         coords["stop"] = np.arange(count, dtype=np.int32)  # CF 2.2 (netCDF classic types): no int64
-        coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.stop_specs, scene.coordinates, scene.settings.restitution, scene.settings.clearance), dtype=object))
+        coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.layout.stops, scene.coordinates, scene.settings.restitution, scene.settings.clearance), dtype=object))
     return coords
 
 
@@ -161,7 +156,7 @@ class SteppedStudy:
         grid = StudyGrid.of(scene)
         solutions = list(scene.settings.solutions)
         coords = general_coordinates(scene, grid)
-        raw = run_grid(scene, runner, general_block, {"solution": len(solutions), "stop": len(scene.stop_specs)})
+        raw = run_grid(scene, runner, general_block, {"solution": len(solutions), "stop": len(scene.layout.stops)})
         dataset = describe_stops(raw.assign_coords(coords))
         say(f"{', '.join(solutions)}: done")
         return finish_dataset(dataset, scene, coords, self.simulation_attributes(scene))
@@ -204,7 +199,7 @@ class SteppedStudy:
             wandering = np.count_nonzero(periods >= steady.max_periods + steady.lyapunov_periods) if not capabilities.exact_jacobians else 0
             share = subset_share(scene.settings.simulation.subset, name, subset_axes(scene))
             total_periods = (float(periods.sum()) + wandering * steady.lyapunov_periods) * scale * copies * share
-            seconds = costs.per_period_cost(engine, scene.settings.simulation.engine.rtol) * engine_scale(scene) * total_periods
+            seconds = costs.per_period_cost(engine, scene.settings.simulation.engine.rtol) * engine_scale(scene.layout) * total_periods
             integrated = int(np.count_nonzero(periods) * scale) * copies
             integrated = round(integrated * share)
             points = f"{round(scene.settings.restitution.size * scene.settings.clearance.size * scene.settings.simulation.frequency.size * copies * share)} points, ~{integrated} integrated, ~{total_periods:.0f} periods"

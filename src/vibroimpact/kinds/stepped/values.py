@@ -22,12 +22,11 @@ from vibroimpact.analysis.stability import Regime, classify, MARGINAL_MODULUS, f
 from vibroimpact.model.contact import peak_acceleration_factor
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.scene.layout import build_stops
 from vibroimpact.scene.schema import MOTION_QUANTITIES, STOP_QUANTITIES, Scene
 from vibroimpact.scene.variables import STABLE_MARGINAL
 from vibroimpact.simulation.harmonics import base_force
 
-__all__ = ["general_linear_values", "general_pgf_values", "scene_problem", "first_problem", "broadcast_quantities", "stop_clearances", "coordinate_quantity", "paper_pgf_values"]
+__all__ = ["general_linear_values", "general_pgf_values", "first_problem", "broadcast_quantities", "stop_clearances", "coordinate_quantity", "paper_pgf_values"]
 
 _IMPACT_REGIMES = (Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR)
 _LINEAR_REGIMES = (Regime.LINEAR, Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT, Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT)
@@ -39,19 +38,14 @@ def coordinate_quantity(quantity: str, name: str) -> str:
     return quantity.replace("x1", name, 1)
 
 
-def scene_problem(scene: Scene, frequency: float, restitution: float, clearance: float, bumper: bool = False, bumper_frequency: float = np.nan, loss_factor: float = np.nan, phase: float = 0.0) -> ImpactProblem:
-    """The impact problem of a general scene at one grid point (rigid stops, or bumpers for ``bumper``)."""
-    stops = build_stops(scene.stop_specs, bumper, restitution, clearance, bumper_frequency, loss_factor)
-    return ImpactProblem(scene.system, stops, scene.load_spec.force(scene.amplitude, frequency, phase))
-
-
 def stop_clearances(scene: Scene) -> np.ndarray:
     """Delta of every stop at every clearance of the grid [m], shape (clearance, K)."""
-    return np.array([[spec.values(np.nan, float(d))[1] for spec in scene.stop_specs] for d in scene.settings.clearance])
+    return np.array([[spec.values(np.nan, float(d))[1] for spec in scene.layout.stops] for d in scene.settings.clearance])
 
 
 def first_problem(scene: Scene) -> ImpactProblem:
-    return scene_problem(scene, float(scene.settings.all_frequencies[0]), float(scene.settings.restitution[0]), float(scene.settings.clearance[0]))
+    """The scene's problem at the first point of its grid (its lowest frequency, first restitution and clearance)."""
+    return scene.layout.problem(scene.amplitude, float(scene.settings.all_frequencies[0]), float(scene.settings.restitution[0]), float(scene.settings.clearance[0]))
 
 
 def _per_coordinate(scene: Scene, template: str, values: np.ndarray) -> dict[str, np.ndarray]:
@@ -65,10 +59,10 @@ def general_linear_values(scene: Scene, omega: np.ndarray, shape: tuple[int, ...
     problem = first_problem(scene)
     linear = linear_amplitudes(problem, omega=omega)
     x = linear.coordinates  # omega.shape + (N,)
-    count = len(scene.stop_specs)
+    count = len(scene.layout.stops)
     clearances = stop_clearances(scene)[None, :, None, None, None, :]  # (1, nc, 1, 1, 1, K)
     fits = linear.fits(clearances)  # (1, nc, 1, 1, F)
-    force = base_force(scene.system, omega, x)
+    force = base_force(scene.layout.structure, omega, x)
     rms = np.sqrt(linear.static**2 + 0.5 * np.abs(x) ** 2)
     zero_or_nan = np.where(fits, 0.0, np.nan)
     values = {
@@ -97,7 +91,7 @@ def general_linear_values(scene: Scene, omega: np.ndarray, shape: tuple[int, ...
 def broadcast_quantities(scene: Scene, values: dict[str, np.ndarray], shape: tuple[int, ...]) -> dict[str, np.ndarray]:
     """The scene's quantities, each broadcast to ``shape`` (per-stop ones to (K, *shape)), or to a larger shape where a
     value depends on more of the grid's axes (a peak estimate on the bumper axis)."""
-    count = len(scene.stop_specs)
+    count = len(scene.layout.stops)
     out = {}
     for name in scene.settings.quantities:
         target = (count, *shape) if name in STOP_QUANTITIES else shape
@@ -125,7 +119,7 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
     regime[~np.broadcast_to(orbit.conditioned, regime.shape)] = Regime.FAILED  # ill-conditioned sums: values NaN
     impact = np.isin(regime, _IMPACT_REGIMES)
     free = np.isin(regime, _LINEAR_REGIMES)
-    count = len(scene.stop_specs)
+    count = len(scene.layout.stops)
     stops = orbit.layout.stops  # the orbit's stop(s): one, or the upper and lower of a pair
 
     def choose(impact_value: np.ndarray, linear_value: np.ndarray) -> np.ndarray:
@@ -134,7 +128,7 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
     harmonics = functools.cache(orbit.harmonics)
     rms = functools.cache(orbit.rms)
     def orbit_base_force(suspension_only: bool) -> np.ndarray:
-        force = base_force(scene.system, w, harmonics())
+        force = base_force(scene.layout.structure, w, harmonics())
         if suspension_only:
             return force
         rate = (4.0 if orbit.two_sided else 2.0) * orbit.impulse / orbit.period
@@ -153,8 +147,8 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
     peaks = functools.cache(lambda: _peak_estimates(scene, orbit, count))
     makers: dict[str, Callable[[], np.ndarray]] = {
         "regime": lambda: regime,
-        "force_amplitude": lambda: choose(np.abs(orbit_base_force(False)), np.abs(base_force(scene.system, w, linear.coordinates))),
-        "suspension_force_amplitude": lambda: choose(np.abs(orbit_base_force(True)), np.abs(base_force(scene.system, w, linear.coordinates))),
+        "force_amplitude": lambda: choose(np.abs(orbit_base_force(False)), np.abs(base_force(scene.layout.structure, w, linear.coordinates))),
+        "suspension_force_amplitude": lambda: choose(np.abs(orbit_base_force(True)), np.abs(base_force(scene.layout.structure, w, linear.coordinates))),
         "impulse": lambda: np.where(impact, per_stop(orbit.impulse), np.where(free, 0.0, np.nan)),
         "phase": lambda: np.where(impact, orbit.phase, np.nan),
         "floquet_modulus": lambda: modulus,
@@ -184,7 +178,7 @@ def _peak_estimates(scene: Scene, orbit: ImpactOrbit, count: int) -> tuple[np.nd
     at the impact (the holding force n M^-1 (f - C x' - K x) m_eff, just before it), over m_eff (for the paper's layout
     the paper's estimate). The bumper is the orbit's first stop's own, else the grid's. NaN without a bumper.
     """
-    spec = scene.stop_specs[orbit.layout.stops[0]]
+    spec = scene.layout.stops[orbit.layout.stops[0]]
     grid_frequency = scene.settings.bumper_frequency if scene.settings.bumper_frequency is not None else np.array([np.nan])
     frequency = np.array([spec.bumper_frequency]) if spec.bumper_frequency is not None else grid_frequency
     grid_losses = scene.settings.loss_factors()
@@ -192,7 +186,7 @@ def _peak_estimates(scene: Scene, orbit: ImpactOrbit, count: int) -> tuple[np.nd
     gamma = np.array([peak_acceleration_factor(xi) if np.isfinite(xi) else np.nan for xi in losses])[:, None, None, None, None]
     omega_b = 2.0 * np.pi * frequency[None, None, :, None, None]
     force = gamma * omega_b * orbit.impulse / (1.0 + orbit.restitution)  # (R, D, bumper, 1, F)
-    structure = scene.system.structure
+    structure = scene.layout.structure
     size = structure.size
     n = orbit.normal
     m_eff = orbit.layout.effective_mass
@@ -248,7 +242,7 @@ def paper_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.n
     rms = functools.cache(solution.rms)
     peaks = functools.cache(lambda: _paper_peak_estimates(scene, system, solution, r, shape))
     x = linear.coordinates
-    linear_force = np.abs(base_force(scene.system, w, x))
+    linear_force = np.abs(base_force(scene.layout.structure, w, x))
     linear_rms = np.sqrt(linear.static**2 + 0.5 * np.abs(x) ** 2)
     nan = np.full(shape, np.nan)
     makers: dict[str, Callable[[], np.ndarray]] = {

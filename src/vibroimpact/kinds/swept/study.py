@@ -25,16 +25,16 @@ from vibroimpact.analysis.stability import Regime
 from vibroimpact.engines.registry import make_engine
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.kinds.stepped.grid import StudyGrid, finish_dataset, grid_coordinates, EnginePart, grid_estimate
-from vibroimpact.kinds.stepped.study import closed_form_scale, engine_scale, describe_stops, general_quantity_attributes
+from vibroimpact.kinds.stepped.study import closed_form_scale, describe_stops, general_quantity_attributes
 from vibroimpact.kinds.stepped.values import general_linear_values, general_pgf_values, paper_pgf_values
 from vibroimpact.model.contact import Stop
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem, Structure
 from vibroimpact.runs.cluster import Progress
-from vibroimpact.runs.estimate import Costs, Estimate
+from vibroimpact.runs.estimate import Costs, Estimate, engine_scale
 from vibroimpact.runs.runner import ProgressReport, Runner
 from vibroimpact.runs.store import case_key
-from vibroimpact.scene.layout import LoadSpec, build_stops, stop_descriptions
+from vibroimpact.model.layout import LoadSpec, build_stops, stop_descriptions
 from vibroimpact.kinds.stepped.scene import SweptSineSettings
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, MOTION_QUANTITIES, STOP_QUANTITIES, Scene
 from vibroimpact.scene.variables import SWEEP_STAT_ATTRIBUTES, SWEEP_TIME_ATTRIBUTES, quantity_attributes, swept_attributes
@@ -191,7 +191,7 @@ class SweptStudy:
         """Every solution of ``scene`` over its grid (see :func:`vibroimpact.runs.run.run_study`)."""
         grid = StudyGrid.of(scene)
         report = progress or (lambda _message: None)
-        count = len(scene.stop_specs)
+        count = len(scene.layout.stops)
         steady: dict[str, Values] = {}
         swept: Values = {}
         running: Values = {}
@@ -211,7 +211,7 @@ class SweptStudy:
         several = count > 1 and any(q in STOP_QUANTITIES for q in scene.settings.quantities)
         if several:
             coords["stop"] = np.arange(count, dtype=np.int32)  # CF 2.2 (netCDF classic types): no int64
-            coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.stop_specs, scene.coordinates, scene.settings.restitution, scene.settings.clearance), dtype=object))
+            coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.layout.stops, scene.coordinates, scene.settings.restitution, scene.settings.clearance), dtype=object))
 
         def stop_dims(quantity: str, dims: tuple[str, ...]) -> tuple[str, ...]:
             return ("stop", *dims) if quantity in STOP_QUANTITIES and several else dims
@@ -271,7 +271,7 @@ class SweptStudy:
         def engine_part(name: str, engine: str) -> EnginePart:
             assert scene.settings.simulation is not None
             duration = abs(s.stop_frequency - s.start_frequency) / s.rate
-            one = costs.per_sweep_second_cost(engine, scene.settings.simulation.engine.rtol) * duration * engine_scale(scene)
+            one = costs.per_sweep_second_cost(engine, scene.settings.simulation.engine.rtol) * duration * engine_scale(scene.layout)
             runs = scene.settings.restitution.size * scene.settings.clearance.size * bumpers * directions
             return one * runs, f"{runs} sweeps of {duration:g} s", one
 
@@ -282,7 +282,7 @@ class SweptStudy:
 def _attributes(scene: Scene, quantity: str) -> dict[str, object]:
     """Units and long name of a quantity: the paper's for its named form, named after the coordinates and stops for a
     general scene."""
-    return general_quantity_attributes(quantity, scene) if scene.general else quantity_attributes(quantity)
+    return general_quantity_attributes(quantity, scene) if scene.layout.paper_view() is None else quantity_attributes(quantity)
 
 
 def _running_attributes(attrs: dict[str, object]) -> dict[str, object]:
@@ -312,13 +312,13 @@ def swept_values(scene: Scene, shape: tuple[int, ...], runner: Runner) -> tuple[
     for i, restitution in enumerate(scene.settings.restitution):
         for j, clearance in enumerate(scene.settings.clearance):
             for k, bumper in enumerate(scene.settings.bumper_frequency):
-                stops = build_stops(scene.stop_specs, True, float(restitution), float(clearance), float(bumper), float(losses[i]))
+                stops = build_stops(scene.layout.stops, True, float(restitution), float(clearance), float(bumper), float(losses[i]))
                 for d, direction in enumerate(scene.settings.swept_sine.directions):
-                    cases.append(SweepCase(scene.system, scene.amplitude, stops, scene.settings.swept_sine, direction, scene.settings.simulation.engine, frequencies, scene.load))
+                    cases.append(SweepCase(scene.layout.structure, scene.amplitude, stops, scene.settings.swept_sine, direction, scene.settings.simulation.engine, frequencies, scene.layout.load))
                     places.append((i, j, k, d))
     results = runner.map(cases)
     times = results[0]["time"]
-    count = len(scene.stop_specs)
+    count = len(scene.layout.stops)
     names = sweep_quantities(scene.coordinates)
 
     def room(name: str, tail: tuple[int, ...]) -> np.ndarray:

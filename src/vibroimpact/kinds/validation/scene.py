@@ -23,7 +23,8 @@ from dataclasses import dataclass
 from typing import Any
 
 
-from vibroimpact.kinds.stepped.scene import parse_names
+from vibroimpact.model.layout import Layout, LoadSpec, StopSpec
+from vibroimpact.scene.header import parse_names
 from vibroimpact.kinds.validation.settings import BouncingBallCase, BuddDuxCase, GrazingCase, RelativeStopCase, ValidationCase, ZenoCase
 from vibroimpact.kinds.validation.settings import (
     CASE_PARAMETERS,
@@ -62,6 +63,17 @@ def case_structure(case: ValidationCase) -> LinearStructure:
         return LinearStructure([[case.mass]], [[case.stiffness]], [[case.damping]], ("x",))
     named = TwoDofSystem(case.m1, case.m2, case.k1, case.k2, case.b1, case.b2)
     return named.structure
+
+
+def case_layout(case: ValidationCase) -> Layout:
+    """The layout of a case: its structure, where its load acts and where its stop acts (its problems below give
+    the values)."""
+    structure = case_structure(case)
+    if isinstance(case, (BouncingBallCase, ZenoCase)):
+        return Layout(structure, LoadSpec(weights=(1.0,), static=(-case.mass * case.gravity,)), (StopSpec(0, side="lower"),))
+    if isinstance(case, (BuddDuxCase, GrazingCase)):
+        return Layout(structure, LoadSpec(weights=(1.0,)), (StopSpec(0, side="upper"),))
+    return Layout(structure, LoadSpec(weights=(1.0, 0.0)), (StopSpec(1, other=0, side="upper"),))
 
 
 def budd_dux_problem(case: BuddDuxCase, clearance: float) -> ImpactProblem:
@@ -234,7 +246,7 @@ def parse_validation_scene(document: Any, text: str = "", source: str = "scene")
     return Scene(
         name=checked.name,
         description=checked.description,
-        system=case_structure(case),
+        layout=case_layout(case),
         amplitude=1.0,
         kind="validation",
         settings=checked.settings,

@@ -1,0 +1,64 @@
+"""What every scene has, whatever its kind: its name, description, report switch and cluster, and the limits of a
+swept-sine run (shared by grid scenes and benchmark cases).
+
+Each function records its problems in a :class:`~vibroimpact.scene.checker.Checker`, naming the key and the allowed
+values. The layout (system, excitation, stops) has its own grammar, :func:`vibroimpact.scene.layout_parse.parse_layout`.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+from vibroimpact.scene.checker import Checker
+from vibroimpact.scene.schema import MAX_SWEEP_SAMPLES
+
+__all__ = ["NAME", "parse_names", "parse_cluster", "check_sweep_run"]
+
+#: A scene's or a case's name: safe as a file name.
+NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+
+
+def parse_names(c: Checker, doc: dict, pages: tuple[str, ...] = ()) -> tuple[Any, str, bool | str]:
+    """Name, description and the report switch of any scene (or one of ``pages``, the report pages it may name)."""
+    name = doc.get("name")
+    if "name" in doc and not (isinstance(name, str) and NAME.match(name)):
+        c.fail("name", f"expected a file-name-safe string (letters, digits, '_', '-', '.'), got {name!r}")
+    description = doc.get("description", "")
+    if not isinstance(description, str):
+        c.fail("description", f"expected a string, got {type(description).__name__}")
+    report = doc.get("report", True)
+    if not isinstance(report, bool) and report not in pages:
+        c.fail("report", f"expected true or false{' or a page name (' + ', '.join(pages) + ')' if pages else ''}, got {report!r}")
+        report = True
+    return name, description, report
+
+
+def parse_cluster(c: Checker, doc: dict) -> str | None:
+    """The scene's ``cluster: {scheduler: ADDRESS}``: a running dask scheduler to run on (None: a local cluster)."""
+    if "cluster" not in doc:
+        return None
+    section = c.mapping("cluster", doc["cluster"], {"scheduler"}, {"scheduler"})
+    address = section.get("scheduler")
+    if address is not None and not (isinstance(address, str) and "://" in address or isinstance(address, str) and ":" in address):
+        c.fail("cluster.scheduler", f"expected a scheduler address such as tcp://host:8786, got {address!r}")
+        return None
+    return address
+
+
+def check_sweep_run(c: Checker, key: str, low: float, high: float, rate: float | None, sample_rate: float | None, cycles: int | None, window_hint: str = "") -> tuple[float | None, float | None]:
+    """Limits of one swept-sine run between ``low`` and ``high`` [Hz], shared by scenes and benchmark cases: 20 output
+    samples per cycle at the top, at most :data:`MAX_SWEEP_SAMPLES` samples, and room for two estimator windows of
+    ``cycles`` cycles. Returns (rate, sample_rate), each None where it failed."""
+    if sample_rate is not None and sample_rate < 20.0 * high:
+        c.fail(f"{key}.sample_rate", f"{sample_rate:g} Hz is too coarse for {high:g} Hz: allowed [{20.0 * high:g}, 1e+07] (20 samples per cycle)")
+        sample_rate = None
+    if rate is not None:
+        duration = (high - low) / rate
+        if sample_rate is not None and duration * sample_rate > MAX_SWEEP_SAMPLES:
+            c.fail(f"{key}.rate", f"{duration:g} s at {sample_rate:g} samples/s is {duration * sample_rate:.3g} samples per run: allowed at most {MAX_SWEEP_SAMPLES:.0e} (raise the rate or lower {key}.sample_rate)")
+            rate = None
+        elif cycles is not None and 2.0 * cycles / low >= duration:
+            c.fail(f"{key}.rate", f"the sweep lasts {duration:g} s, shorter than two {cycles}-cycle estimator windows at {low:g} Hz ({2.0 * cycles / low:g} s): lower the rate{window_hint}")
+            rate = None
+    return rate, sample_rate
