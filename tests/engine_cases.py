@@ -29,9 +29,16 @@ def pgf_start(frequency: float, restitution: float, clearance: float = PAPER_CLE
     return problem, state, 0.5 / frequency, orbit
 
 
+def named(problem: ImpactProblem) -> TwoDofSystem:
+    """The paper's named system of a problem on the two-mass chain (its structure's named view)."""
+    system = TwoDofSystem.of(problem.system)
+    assert system is not None, "not the two-mass chain"
+    return system
+
+
 def linear_state(problem: ImpactProblem, t: float = 0.0) -> np.ndarray:
     """The linear steady state (no stop) at time t under q cos(w t + phase)."""
-    response = linear_response(problem.system, omega=problem.omega, amplitude=problem.amplitude)
+    response = linear_response(named(problem), omega=problem.omega, amplitude=problem.amplitude)
     rotation = np.exp(1j * (problem.omega * t + problem.phase))
     x = np.array([response.x1, response.x2]) * rotation
     return np.concatenate([x.real, (1j * problem.omega * x).real])
@@ -49,7 +56,7 @@ def energy_budget(trajectory: Trajectory) -> dict[str, float]:
     States inside segments come from the exact flow started at each recorded segment state, so for an
     integrator this checks its event states and its restitution map, not its step accuracy.
     """
-    p, s = trajectory.problem, trajectory.problem.system
+    p, s = trajectory.problem, named(trajectory.problem)
     exact = ExactEngine()
     nodes, weights = gauss_legendre(64)
     work = dissipation = 0.0

@@ -24,6 +24,7 @@ from vibroimpact.simulation.settings import SteadySettings
 from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
+from tests.engine_cases import named
 
 TIGHT = EngineSettings(rtol=1e-11, atol=1e-15)
 #: The absorber alone: no forcing and a negligible spring, so one collision is the textbook one.
@@ -46,7 +47,7 @@ def test_one_collision_restitution_impulse_and_peak(xi: float) -> None:
 
 def _reference(problem: ImpactProblem, frequency: float, xi: float, duration: float) -> tuple[np.ndarray, np.ndarray]:
     """The same model integrated independently: solve_ivp (DOP853) with onset and release events, from rest."""
-    s = problem.system
+    s = named(problem)
     k, b = s.m2 * (2 * math.pi * frequency) ** 2, 2 * s.m2 * xi * 2 * math.pi * frequency
     contact = False
 

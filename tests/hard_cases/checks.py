@@ -17,7 +17,7 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.compliant.ida import MODE_CONTACT
 from vibroimpact.engines.linear_flow import HarmonicLinearFlow, first_crossing
 
-from tests.engine_cases import energy_budget
+from tests.engine_cases import energy_budget, named
 
 __all__ = [
     "length_scale",
@@ -70,7 +70,7 @@ def contact_law_errors(trajectory: Trajectory) -> dict[str, float]:
     after, modes = _after_states(trajectory)
     sticks = modes == MODE_STUCK
     expected_after = np.where(sticks, 0.0, -p.restitution * before)
-    expected_impulse = p.system.m2 * (before - expected_after)
+    expected_impulse = named(p).m2 * (before - expected_after)
     # the engines' stated velocity resolution (EngineSettings.sticking_velocity): a rebound slower than it may end
     # the chatter in sticking (measured: a solve_ivp rebound at 1.2x the threshold returned within round-off time)
     floor = EngineSettings().sticking_velocity * p.velocity_scale()
@@ -78,7 +78,7 @@ def contact_law_errors(trajectory: Trajectory) -> dict[str, float]:
         "position": float(np.max(np.abs(after[:, 1] - p.clearance))),
         "speed": float(np.sum(before <= 0.0)),
         "velocity": float(np.max(np.maximum(np.abs(after[:, 3] - expected_after) - floor, 0.0) / before)),
-        "impulse": float(np.max(np.maximum(np.abs(trajectory.impulses - expected_impulse) - p.system.m2 * floor, 0.0) / expected_impulse)),
+        "impulse": float(np.max(np.maximum(np.abs(trajectory.impulses - expected_impulse) - named(p).m2 * floor, 0.0) / expected_impulse)),
     }
 
 
@@ -108,7 +108,7 @@ def compliant_contact_errors(trajectory: Trajectory, loss_factor: float, strong:
     if np.any(strong_ones):
         ratio = -exits[strong_ones] / entries[strong_ones]
         errors["restitution"] = float(np.max(np.abs(ratio - restitution_from_loss_factor(loss_factor))))
-        momentum = p.system.m2 * (entries[strong_ones] - exits[strong_ones])
+        momentum = named(p).m2 * (entries[strong_ones] - exits[strong_ones])
         errors["impulse"] = float(np.max(np.abs(impulses[: exits.size][strong_ones] - momentum) / momentum))
     return errors
 
@@ -127,7 +127,7 @@ def flow_exceedances(trajectory: Trajectory, tolerance: float) -> int:
     exact flow from its event states differs from its steps by the integration error only). The search is the exact
     engine's guaranteed root bracketing, so no excursion is missed however short (a grazing one lasts microseconds).
     """
-    p, s = trajectory.problem, trajectory.problem.system
+    p, s = trajectory.problem, named(trajectory.problem)
     flow = HarmonicLinearFlow(s.state_matrix, np.array([0, 0, p.amplitude * np.exp(1j * p.phase) / s.m1, 0]), np.zeros(4), p.omega)
     level = p.clearance + tolerance
     count = 0
@@ -171,5 +171,5 @@ def bumper_penetration_bound(trajectory: Trajectory, frequency: float) -> float:
     p = trajectory.problem
     omega_b = 2 * math.pi * frequency
     speed = float(trajectory.impact_velocities.max()) if trajectory.impact_velocities.size else 0.0
-    static = (p.system.k2 * length_scale(p) + p.amplitude) / (p.system.m2 * omega_b**2)
+    static = (named(p).k2 * length_scale(p) + p.amplitude) / (named(p).m2 * omega_b**2)
     return speed / omega_b + static

@@ -12,7 +12,7 @@ import numpy as np
 from vibroimpact.engines.base import Trajectory
 from vibroimpact.analysis.pgf import solve_one_impact
 
-from tests.engine_cases import linear_state
+from tests.engine_cases import linear_state, named
 from .cases import CASES, RIGID, Expect, HardCase, build_engine
 from .checks import (
     bumper_penetration_bound,
@@ -105,7 +105,7 @@ def reference_error(run: Run) -> float:
         amplitude = np.abs(linear).max(axis=0)
         return float(np.max(np.abs(trajectory.strobe_states - linear) / amplitude))
     if case.reference == "pgf":
-        orbit = solve_one_impact(p.system, omega=np.array([p.omega]), clearance=p.clearance, restitution=p.restitution, amplitude=p.amplitude)
+        orbit = solve_one_impact(named(p), omega=np.array([p.omega]), clearance=p.clearance, restitution=p.restitution, amplitude=p.amplitude)
         if trajectory.impulses.size != case.periods:
             return math.inf
         return float(np.max(np.abs(trajectory.impulses / orbit.impulse[0] - 1.0)))

@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import math
 
+from dataclasses import astuple
+
 import numpy as np
 import pytest
 
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
 from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.layout import Layout
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.contact import Stop
 from vibroimpact.model.structure import LinearStructure
@@ -101,7 +104,9 @@ def test_a_negative_clearance_is_allowed_and_preloads() -> None:
 def test_the_paper_layout_in_general_form_is_recognised_and_holds_like_the_named_one() -> None:
     named = ImpactProblem(PAPER_SYSTEM, RigidStop(0.003, 0.2), HarmonicForce(10.0, 25.0))
     general = ImpactProblem(PAPER, (Stop(RigidStop(0.003, 0.2), 1),), HarmonicForce(10.0, 25.0, weights=(1.0, 0.0)))
-    assert named.paper_layout and general.paper_layout
+    for view in (Layout.of_problem(named).paper_view(), Layout.of_problem(general).paper_view()):
+        assert view is not None and astuple(view) == pytest.approx(astuple(PAPER_SYSTEM), rel=1e-15)
+    assert Layout.of_problem(ImpactProblem(PAPER, (Stop(RigidStop(0.003, 0.2), 1, side="lower"),), HarmonicForce(10.0, 25.0))).paper_view() is None
     assert general.velocity_scale() == pytest.approx(named.velocity_scale(), rel=1e-12)
     for x1, v1 in [(0.001, 0.2), (0.004, -0.3)]:
         state = np.array([x1, 0.003, v1, 0.0])

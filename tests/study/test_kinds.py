@@ -34,7 +34,7 @@ def test_each_shipped_scene_is_run_by_the_study_of_its_kind() -> None:
 
 
 def test_a_scene_is_a_header_plus_its_kinds_own_settings() -> None:
-    """Every kind's settings live in its own folder (a swept test is a grid scene: the stepped folder's), and the
+    """Every kind's settings live in its own folder (stepped and swept scenes share the grid grammar's), and the
     scene itself carries no field of any kind: only the header every kind shares."""
     from dataclasses import fields
 
@@ -44,8 +44,8 @@ def test_a_scene_is_a_header_plus_its_kinds_own_settings() -> None:
     assert {f.name for f in fields(Scene)} == header
     for path in sorted(shipped_studies_dir().rglob("*.yaml")):
         scene = load_scene(path)
-        home = "stepped" if scene.kind == "swept" else scene.kind
-        assert type(scene.settings).__module__.startswith(f"vibroimpact.kinds.{home}."), (path.name, type(scene.settings))
+        home = "vibroimpact.scene.grid" if scene.kind in ("stepped", "swept") else f"vibroimpact.kinds.{scene.kind}."  # the grid grammar is two kinds'
+        assert type(scene.settings).__module__.startswith(home), (path.name, type(scene.settings))
     with pytest.raises(ValueError, match="settings"):
         Scene("s", "", scene.layout, 1.0, "stepped", None)
 
@@ -91,3 +91,37 @@ def test_another_kinds_section_is_named_as_such() -> None:
     with pytest.raises(SceneError) as caught:
         parse_scene(document)
     assert any(p.startswith("validation: unknown key: a concepts scene does not use it; it is the section of a validation scene") for p in caught.value.problems)
+
+
+def test_a_kind_is_its_folder_one_row_one_shipped_scene_and_one_golden_scene() -> None:
+    """Adding a kind touches its own folder, one row of the table, one shipped scene and one golden scene: the row
+    names modules of the kind's folder only, no module outside that folder imports it (the table loads it by name),
+    and a shipped scene and a golden scene of the kind exist (the golden suite then holds it bit for bit)."""
+    import ast
+    from pathlib import Path
+
+    from tests.golden.golden import SCENES
+
+    package = Path(__file__).resolve().parents[2] / "src" / "vibroimpact"
+    for kind in KINDS:
+        folder = package / "kinds" / kind.name
+        assert {"scene.py", "study.py", "page.py"} <= {p.name for p in folder.glob("*.py")}, kind.name
+        assert all(target.startswith(f"vibroimpact.kinds.{kind.name}.") for target in (kind.scene, kind.study, kind.page)), kind
+    for path in package.rglob("*.py"):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        targets = [node.module or "" for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)]
+        targets += [alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names]
+        inside = path.relative_to(package).parts
+        for target in targets:
+            parts = target.split(".")
+            if parts[:2] == ["vibroimpact", "kinds"] and len(parts) > 2:
+                known = {(("kinds", "swept"), "stepped"), (("cli.py",), "benchmark")}  # the grid kinds; run-study sweep-cost
+                assert inside[:2] == ("kinds", parts[2]) or (inside[:2], parts[2]) in known, f"{path.name} imports {target}"
+    golden = {parse_scene_file(path).kind for path in SCENES.glob("*.yaml")}
+    assert golden == set(KIND_NAMES), f"no golden scene of kind {set(KIND_NAMES) - golden}"
+
+
+def parse_scene_file(path):  # type: ignore[no-untyped-def]
+    """The checked scene of a YAML file."""
+    return load_scene(path)
+

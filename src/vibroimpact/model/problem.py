@@ -19,12 +19,10 @@ from vibroimpact.model.excitation import HarmonicForce, SweptSine, load_weights,
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["Contact", "Excitation", "ImpactProblem", "Structure"]
+__all__ = ["Contact", "Excitation", "ImpactProblem"]
 
 #: The contact laws a problem may have.
 Contact = Union[RigidStop, KelvinVoigtBumper]
-#: The structures a problem may have.
-Structure = Union[TwoDofSystem, LinearStructure]
 #: The excitations a problem may have.
 Excitation = Union[HarmonicForce, SweptSine]
 
@@ -67,8 +65,9 @@ class ImpactProblem:
 
     Parameters
     ----------
-    system : TwoDofSystem or LinearStructure
-        Masses, springs and dashpots: the paper's named two-mass system, or any N-dof structure.
+    system : LinearStructure
+        Masses, springs and dashpots of any N-dof structure; the paper's named :class:`TwoDofSystem` is taken as its
+        structure (its matrices, coordinates x1, x2).
     contact : RigidStop, KelvinVoigtBumper or tuple of Stop
         A single contact law means the paper's stop: an upper stop of the absorber (coordinate 2) against the base.
         A tuple of :class:`Stop` gives any layout (any number, absolute or relative, upper or lower).
@@ -76,11 +75,13 @@ class ImpactProblem:
         q cos(w t + phase) distributed over the coordinates (plus a constant force), or the linear swept sine.
     """
 
-    system: Structure
+    system: LinearStructure
     contact: Contact | tuple[Stop, ...]
     excitation: Excitation
 
     def __post_init__(self) -> None:
+        if isinstance(self.system, TwoDofSystem):
+            object.__setattr__(self, "system", self.system.structure)  # one kind of structure from here on
         for name, kinds in _PARTS.items():
             value = getattr(self, name)
             if not isinstance(value, kinds):
@@ -102,8 +103,8 @@ class ImpactProblem:
     # ----------------------------------------------------------------- structure
     @property
     def structure(self) -> LinearStructure:
-        """The system as a :class:`LinearStructure` (matrices and coordinate names)."""
-        return self.system.structure
+        """The structure (matrices and coordinate names)."""
+        return self.system
 
     @property
     def size(self) -> int:
@@ -116,24 +117,6 @@ class ImpactProblem:
         if isinstance(self.contact, tuple):
             return self.contact
         return (Stop(self.contact, coordinate=1, other=None, side="upper"),)
-
-    @property
-    def paper_layout(self) -> bool:
-        """The paper's layout: two masses, one upper absolute stop on the absorber, force on the primary mass only."""
-        stops = self.stops
-        excitation = self.excitation
-        weights_ok = excitation.weights is None or tuple(excitation.weights) == (1.0, 0.0)
-        static_ok = excitation.static is None or not any(excitation.static)
-        base = isinstance(excitation, HarmonicForce) and excitation.base_motion
-        return (self.size == 2 and len(stops) == 1 and stops[0].coordinate == 1 and stops[0].other is None and stops[0].side == "upper"
-                and weights_ok and static_ok and not base)  # fmt: skip
-
-    @property
-    def named_system(self) -> TwoDofSystem | None:
-        """The paper's named system where this problem is the paper's layout on it (:attr:`paper_layout` on a
-        structure with the named view, :meth:`TwoDofSystem.of`): where the paper's own routes (its curve-fitted PGF)
-        apply. None otherwise."""
-        return TwoDofSystem.of(self.system) if self.paper_layout else None
 
     def normals(self) -> NDArray[np.float64]:
         """n of every stop, shape (K, N): gap_k = Delta_k - n_k . x."""
@@ -227,7 +210,10 @@ class ImpactProblem:
 
     def holding_force(self, x1: float | NDArray[np.float64], v1: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
         """Force the rigid stop must exert to hold the absorber at rest on it [N] (see :meth:`RigidStop.holding_force`)."""
-        return self.rigid_stop.holding_force(self.system, x1, v1)
+        named = TwoDofSystem.of(self.system)
+        if named is None:
+            raise TypeError("holding_force: the absorber's holding force needs the paper's two-mass chain; ask contact_holding(stop, state, t)")
+        return self.rigid_stop.holding_force(named, x1, v1)
 
     # --------------------------------------------------------------- excitation
     @property

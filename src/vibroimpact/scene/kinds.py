@@ -78,8 +78,8 @@ KINDS: tuple[Kind, ...] = (
     Kind("validation", "validation", "vibroimpact.kinds.validation.scene:parse_validation_scene", "vibroimpact.kinds.validation.study:ValidationStudy", "vibroimpact.kinds.validation.page:page_for"),
     Kind("benchmark", "benchmark", "vibroimpact.kinds.benchmark.scene:parse_benchmark_scene", "vibroimpact.kinds.benchmark.study:BenchmarkStudy", "vibroimpact.kinds.benchmark.page:page_for"),
     Kind("bifurcation", "bifurcation", "vibroimpact.kinds.bifurcation.scene:parse_bifurcation_scene", "vibroimpact.kinds.bifurcation.study:BifurcationStudy", "vibroimpact.kinds.bifurcation.page:page_for"),
-    Kind("swept", "swept_sine", "vibroimpact.kinds.stepped.scene:parse_grid_scene", "vibroimpact.kinds.swept.study:SweptStudy", "vibroimpact.kinds.swept.page:page_for"),
-    Kind("stepped", None, "vibroimpact.kinds.stepped.scene:parse_grid_scene", "vibroimpact.kinds.stepped.study:SteppedStudy", "vibroimpact.kinds.stepped.page:page_for"),
+    Kind("swept", "swept_sine", "vibroimpact.kinds.swept.scene:parse_swept_scene", "vibroimpact.kinds.swept.study:SweptStudy", "vibroimpact.kinds.swept.page:page_for"),
+    Kind("stepped", None, "vibroimpact.kinds.stepped.scene:parse_stepped_scene", "vibroimpact.kinds.stepped.study:SteppedStudy", "vibroimpact.kinds.stepped.page:page_for"),
 )  # fmt: skip
 
 #: The kinds' names, in the table's order.

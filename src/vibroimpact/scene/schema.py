@@ -1,6 +1,6 @@
 """What a scene says: the frozen :class:`Scene` and its parts, and the vocabulary and limits of the scene format.
 
-Nothing here reads YAML or checks a document (see :mod:`vibroimpact.kinds.stepped.scene` and
+Nothing here reads YAML or checks a document (see :mod:`vibroimpact.scene.grid` and
 :mod:`vibroimpact.kinds.benchmark.scene`); a :class:`Scene` is built only from checked values. Engine names come from
 :mod:`vibroimpact.engines.registry`, which names every engine without importing one.
 """

@@ -28,6 +28,7 @@ from vibroimpact.runs.run import provenance
 from vibroimpact.runs.runner import Runner
 from vibroimpact.kinds.benchmark.scene import BenchmarkCase, BenchmarkSettings, LadderSettings
 from vibroimpact.scene.schema import Scene
+from vibroimpact.model.layout import Layout
 from vibroimpact.scene.variables import BENCHMARK_ATTRIBUTES, CLOSED_FORM_METHODS, LADDER_ATTRIBUTES
 from vibroimpact.simulation.harmonics import measure, running_fundamental
 from vibroimpact.simulation.steady import start_state
@@ -405,7 +406,7 @@ def model_ladder(ladder: LadderSettings, atol_ratio: float) -> xr.Dataset:
         point = f"{ladder.frequency:g} Hz, R = {ladder.restitution:g}, Delta = {ladder.clearance * 1e3:g} mm"
     else:
         point = f"{ladder.frequency:g} Hz, stops {'; '.join(stop.describe(tuple(problem.structure.coordinates)) + f', R = {stop.law.restitution:g}' for stop in stops)}"
-    start = "one-impact orbit" if problem.paper_layout else "closed-form orbit" if "pgf" in models else "linear motion (no closed form for this layout)"
+    start = "one-impact orbit" if Layout.of_problem(problem).paper_view() is not None else "closed-form orbit" if "pgf" in models else "linear motion (no closed form for this layout)"
     return xr.Dataset(
         {
             "ladder_wall_time": ("model", wall, dict(LADDER_ATTRIBUTES["ladder_wall_time"])),

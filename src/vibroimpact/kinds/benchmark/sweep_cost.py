@@ -37,7 +37,7 @@ from vibroimpact.engines.settings import SWEEP_REFERENCE_RTOL, SWEEP_SETTINGS, E
 from vibroimpact.engines.compliant.ivp import IVP_METHODS, solve_ivp_sweep
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.simulation.harmonics import running_fundamental
-from vibroimpact.model.problem import Structure
+from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.scene.variables import SWEEP_COST_ATTRIBUTES
 
@@ -49,7 +49,7 @@ class SweepCostSettings:
 
     Attributes
     ----------
-    system : Structure
+    system : LinearStructure
         The linear structure (default: the paper's system).
     clearance : float
         Delta [m].
@@ -75,7 +75,7 @@ class SweepCostSettings:
         rtol of an extra IDA row over the full sweep (the accuracy context); None leaves it out.
     """
 
-    system: Structure = PAPER_SYSTEM
+    system: LinearStructure = PAPER_SYSTEM.structure
     clearance: float = 3e-3
     bumper_frequency: float = 250.0
     restitution: float = 0.2

@@ -26,7 +26,8 @@ from vibroimpact.scene.subset import on_subset
 from vibroimpact.kinds.stepped.values import broadcast_quantities, coordinate_quantity
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
-from vibroimpact.model.problem import ImpactProblem, Structure
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.structure import LinearStructure
 from vibroimpact.runs.runner import CaseResult, ProgressReport, Runner
 from vibroimpact.runs.store import case_key
 from vibroimpact.model.layout import LoadSpec, build_stops
@@ -77,7 +78,7 @@ class SimulationCase:
     ----------
     engine : str
         Registered engine name.
-    system : Structure
+    system : LinearStructure
         The linear system.
     amplitude : float
         q [N] (a base motion's displacement [m]).
@@ -97,7 +98,7 @@ class SimulationCase:
     """
 
     engine: str
-    system: Structure
+    system: LinearStructure
     amplitude: float
     contact: RigidStop | KelvinVoigtBumper | tuple[Stop, ...]
     frequencies: tuple[float, ...]

@@ -221,7 +221,7 @@ def paper_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.n
         If the scene does not have the paper's layout on its named system.
     """
     problem = first_problem(scene)
-    system = problem.named_system
+    system = scene.layout.paper_view()
     if system is None:
         raise ValueError("pgf_paper is the paper's route for its layout (a two-mass chain x1, x2; one upper stop on x2; force on x1): use pgf")
     solution = solve_one_impact(system, omega=omega, clearance=delta, restitution=r, amplitude=scene.amplitude, variant=PgfVariant.PAPER, models=green_models(system, PgfVariant.PAPER))

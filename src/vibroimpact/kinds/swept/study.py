@@ -29,13 +29,14 @@ from vibroimpact.kinds.stepped.study import closed_form_scale, describe_stops, g
 from vibroimpact.kinds.stepped.values import general_linear_values, general_pgf_values, paper_pgf_values
 from vibroimpact.model.contact import Stop
 from vibroimpact.model.excitation import SweptSine
-from vibroimpact.model.problem import ImpactProblem, Structure
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.structure import LinearStructure
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import Costs, Estimate, engine_scale
 from vibroimpact.runs.runner import ProgressReport, Runner
 from vibroimpact.runs.store import case_key
 from vibroimpact.model.layout import LoadSpec, build_stops, stop_descriptions
-from vibroimpact.kinds.stepped.scene import SweptSineSettings
+from vibroimpact.scene.grid import SweptSineSettings
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, MOTION_QUANTITIES, STOP_QUANTITIES, Scene
 from vibroimpact.scene.variables import SWEEP_STAT_ATTRIBUTES, SWEEP_TIME_ATTRIBUTES, quantity_attributes, swept_attributes
 from vibroimpact.simulation.harmonics import resting_state
@@ -58,7 +59,7 @@ class SweepCase:
 
     Attributes
     ----------
-    system : Structure
+    system : LinearStructure
         The linear structure: the paper's named system or matrices with named coordinates.
     amplitude : float
         q [N].
@@ -79,7 +80,7 @@ class SweepCase:
         Points of the uniform time grid of the running estimates.
     """
 
-    system: Structure
+    system: LinearStructure
     amplitude: float
     stops: tuple[Stop, ...]
     settings: SweptSineSettings

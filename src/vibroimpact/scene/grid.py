@@ -1,0 +1,303 @@
+"""The grammar of a scene over parameter grids, shared by two kinds: stepped steady states (``stepped``) and swept-sine
+tests (``swept``, a scene with a ``swept_sine`` section). Its settings (:class:`GridSettings`) are the
+:attr:`~vibroimpact.scene.schema.Scene.settings` of both; each kind's parser
+(:mod:`vibroimpact.kinds.stepped.scene`, :mod:`vibroimpact.kinds.swept.scene`) reads its scenes with
+:func:`parse_grid_scene`.
+
+Each ``_parse_*`` function checks one section of the document with a :class:`~vibroimpact.scene.checker.Checker`
+(recording every problem, returning None where a value is unusable); :func:`parse_grid_scene` puts them together.
+The header (:mod:`vibroimpact.scene.header`) and the layout (:func:`vibroimpact.scene.layout_parse.parse_layout`) are
+every kind's.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from vibroimpact.analysis.pgf import AdmissibilitySettings
+from vibroimpact.engines.registry import BUMPER
+from vibroimpact.model.contact import loss_factor_from_restitution, restitution_from_loss_factor
+from vibroimpact.model.excitation import SweptSine
+from vibroimpact.model.modal import underdamped_mode_count
+from vibroimpact.scene.checker import Checker, SceneError, interval
+from vibroimpact.scene.header import check_sweep_run, parse_cluster, parse_names
+from vibroimpact.scene.layout_parse import check_layout_solutions, parse_layout, parse_sweep_stops, stop_grids
+from vibroimpact.scene.schema import (
+    ENGINE_CONTACT,
+    ENGINE_SOLUTIONS,
+    MAX_STUDY_POINTS,
+    MAX_SWEEP_SAMPLES,
+    QUANTITIES,
+    SIMULATION_STARTS,
+    SOLUTIONS,
+    SWEEP_DIRECTIONS,
+    SWEEPABLE,
+    Scene,
+    quantities_for,
+)
+from vibroimpact.scene.simulation import SimulationSettings, parse_simulation
+
+__all__ = ["GridSettings", "SweptSineSettings", "TOP_KEYS", "parse_grid_scene"]
+
+#: Top-level keys of a grid scene.
+TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bumper", "sweep", "swept_sine", "solutions", "quantities", "settings", "simulation", "report", "cluster"}
+#: Report pages a grid scene may ask for by name (``report: design_map``) instead of its kind's page.
+REPORT_PAGES = ("design_map",)
+#: Simulation keys that only stepped steady states use.
+_STEADY_ONLY_KEYS = {"frequency", "start", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods", "subset"}
+#: Where an unswept parameter is given instead (``frequency`` is always swept).
+_FIXED_PLACE = {"restitution": ("stop", "restitution"), "clearance": ("stop", "clearance"), "bumper_frequency": ("bumper", "frequency"), "bumper_loss_factor": ("bumper", "loss_factor")}
+
+
+@dataclass(frozen=True)
+class SweptSineSettings:
+    """A swept-sine test (the paper's Simulink run, section 5) instead of stepped steady states.
+
+    Attributes
+    ----------
+    start_frequency, stop_frequency : float
+        Ends of the sweep [Hz] (a sweep down runs from ``stop_frequency`` to ``start_frequency``).
+    rate : float
+        |alpha| [Hz s-1].
+    directions : tuple of str
+        Some of ``up``, ``down``.
+    sample_rate : float
+        Output samples per second of the simulated signals [Hz].
+    window_cycles : int
+        Cycles of the excitation in the running estimators' window.
+    initial_state : str
+        ``linear``: each run starts on the linear steady state at its first frequency (where it fits inside the
+        clearance; else at rest), so no start-up transient shows; ``rest``: at rest, like a bench test.
+    """
+
+    start_frequency: float
+    stop_frequency: float
+    rate: float
+    directions: tuple[str, ...] = SWEEP_DIRECTIONS
+    sample_rate: float = 1000.0
+    window_cycles: int = 8
+    initial_state: str = "linear"
+
+    def sweep(self, amplitude: float, direction: str) -> SweptSine:
+        """The excitation of one direction."""
+        low, high = self.start_frequency, self.stop_frequency
+        return SweptSine(amplitude, low, high, self.rate) if direction == "up" else SweptSine(amplitude, high, low, self.rate)
+
+
+@dataclass(frozen=True, eq=False)
+class GridSettings:
+    """What a grid scene computes: its solutions over a grid of frequencies, restitutions, clearances and bumpers.
+
+    Attributes
+    ----------
+    frequency : ndarray
+        Excitation frequencies [Hz], increasing.
+    restitution : ndarray
+        Restitution ratios R [-]; one value unless swept.
+    clearance : ndarray
+        Clearances Delta [m]; one value unless swept.
+    swept : tuple of str
+        Parameters that are dimensions of the output, in dimension order (``frequency`` last).
+    solutions : tuple of str
+        Solutions to compute.
+    quantities : tuple of str
+        Quantities to write.
+    admissibility : AdmissibilitySettings
+        Settings of the X2(t) <= Delta check.
+    simulation : SimulationSettings or None
+        Settings of the time-domain solutions, when the scene asks for any.
+    bumper_frequency : ndarray or None
+        Omega_b / 2 pi of the compliant bumper [Hz] (one value unless swept); None without a bumper.
+    bumper_loss_factor : ndarray or None
+        xi_b [-]: one value, or one per ``restitution`` when ``bumper_loss_factor`` is swept (``restitution`` then
+        holds R(xi_b), eq. 26 corrected); None: each restitution's own loss factor (the exact inverse of R(xi_b)).
+    swept_sine : SweptSineSettings or None
+        When given, the time-domain solutions are swept-sine tests, not stepped steady states.
+    sweep_stops : tuple of int or None
+        The stops that swept restitution, clearance and bumper values apply to; None: every stop.
+    """
+
+    frequency: np.ndarray
+    restitution: np.ndarray
+    clearance: np.ndarray
+    swept: tuple[str, ...]
+    solutions: tuple[str, ...]
+    quantities: tuple[str, ...]
+    admissibility: AdmissibilitySettings = field(default_factory=AdmissibilitySettings)
+    simulation: SimulationSettings | None = None
+    bumper_frequency: np.ndarray | None = None
+    bumper_loss_factor: np.ndarray | None = None
+    swept_sine: SweptSineSettings | None = None
+    sweep_stops: tuple[int, ...] | None = None
+
+    def loss_factors(self) -> np.ndarray:
+        """The bumper's xi_b for each restitution of the grid [-] (NaN where none gives it, R = 0)."""
+        if self.bumper_loss_factor is not None:
+            return np.broadcast_to(self.bumper_loss_factor, self.restitution.shape).astype(float)
+        return np.array([loss_factor_from_restitution(r) if r > 0.0 else np.nan for r in self.restitution])
+
+    @property
+    def sweep_directions(self) -> tuple[str, ...]:
+        """Directions of the swept-sine test; ``()`` for stepped steady states."""
+        return () if self.swept_sine is None else self.swept_sine.directions
+
+    @property
+    def all_frequencies(self) -> np.ndarray:
+        """The dataset's frequency axis: the analytic grid merged with the simulation grid [Hz]."""
+        if self.simulation is None:
+            return self.frequency
+        return np.union1d(self.frequency, self.simulation.frequency)
+
+
+def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
+    """Validate a grid scene's document (a mapping) and build the :class:`Scene`; raise :class:`SceneError` listing
+    all problems."""
+    c = Checker()
+    doc = c.mapping("", document, TOP_KEYS, {"name", "system", "excitation", "sweep", "solutions"}, kind="swept" if "swept_sine" in document else "stepped")
+    name, description, report = parse_names(c, doc, REPORT_PAGES)
+    layout, amplitude, coordinates = parse_layout(c, doc)
+
+    sweep = c.mapping("sweep", doc.get("sweep", {}), {*SWEEPABLE, "stop"}, {"frequency"}) if "sweep" in doc else {}
+    fixed = {
+        "stop": c.mapping("stop", doc["stop"], {"clearance", "restitution"}) if "stop" in doc else {},
+        "bumper": c.mapping("bumper", doc["bumper"], {"frequency", "loss_factor"}) if "bumper" in doc else {},
+    }
+    solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
+    scheduler = parse_cluster(c, doc)
+    specs = layout.stops if layout is not None and "stops" in doc else None
+    if isinstance(report, str) and ("swept_sine" in doc or layout is not None and layout.paper_view() is None):
+        c.fail("report", f"the {report} page is for stepped studies of the paper's layout (a two-mass chain x1, x2 as {{m1 ... b2}}; one upper stop on x2; force on x1), however written")
+    targets = None
+    if "stop" in sweep:
+        if "stops" not in doc:
+            c.fail("sweep.stop", "names which of the scene's stops the swept values apply to: only with a 'stops' list")
+        else:
+            targets = parse_sweep_stops(c, sweep["stop"], len(specs) if specs else None)
+    sweep = {key: value for key, value in sweep.items() if key != "stop"}
+    derived_restitution = "bumper_loss_factor" in sweep
+    bumper_solutions = [name for name in solutions if ENGINE_CONTACT.get(name) == BUMPER]
+    grids: dict[str, np.ndarray | None] = {}
+    for key, (_units, low, high, low_inclusive) in SWEEPABLE.items():
+        section, field_name = _FIXED_PLACE.get(key, ("", ""))
+        place = f"{section}.{field_name}"
+        given_fixed = field_name in fixed.get(section, {})
+        if key in sweep:
+            if given_fixed:
+                c.fail(place, f"also swept in sweep.{key}: give it in one place only")
+            grids[key] = c.grid(f"sweep.{key}", sweep[key], low, high, low_inclusive)
+        elif given_fixed:
+            value = c.number(place, fixed[section][field_name], low, high, low_inclusive)
+            grids[key] = None if value is None else np.array([value])
+        elif key == "restitution" and derived_restitution:
+            continue  # R(xi_b) of the swept loss factors
+        elif (key == "restitution" or key == "clearance") and "stops" not in doc:
+            c.fail(place, f"required unless swept (sweep.{key}); allowed range {interval(low, high, low_inclusive)}")
+    if derived_restitution and "restitution" in grids and "stops" not in doc:
+        c.fail("sweep.bumper_loss_factor", "sweeping the bumper's loss factor sets the restitution R(xi_b): do not also give restitution")
+    if derived_restitution and (xi := grids.get("bumper_loss_factor")) is not None:
+        grids["restitution"] = np.array([restitution_from_loss_factor(x) for x in xi])
+    needs_bumper = bool(bumper_solutions) or "swept_sine" in doc
+    if "stops" in doc:
+        if specs is not None:
+            specs = stop_grids(c, specs, grids, sweep, {k: v for k, v in fixed["bumper"].items() if not isinstance(v, bool) and isinstance(v, (int, float))}, targets, needs_bumper)
+    else:
+        if needs_bumper and "bumper_frequency" not in sweep and "bumper" not in doc:
+            c.fail("bumper", "required by the compliant solution and swept-sine tests: {frequency: Omega_b / 2 pi [Hz], loss_factor: xi_b (optional)}")
+        elif "bumper" in doc and "bumper_frequency" not in sweep and "frequency" not in fixed["bumper"]:
+            c.fail("bumper.frequency", "required unless swept (sweep.bumper_frequency): Omega_b / 2 pi [Hz] in (0, inf)")
+        if bumper_solutions and "bumper_loss_factor" not in grids and (r := grids.get("restitution")) is not None and np.any(r == 0.0):
+            c.fail("stop.restitution", "R = 0 needs an infinitely damped bumper for the compliant solution: give bumper.loss_factor, or sweep R > 0")
+    if layout is not None and (specs is not None or "stops" not in doc):
+        layout = layout.with_stops(specs) if specs is not None else layout
+        check_layout_solutions(c, solutions, layout, "swept_sine" in doc, grids.get("restitution"), grids.get("clearance"))
+
+    sizes = [g.size for g in grids.values() if g is not None]
+    if len(sizes) >= 3 and math.prod(sizes) > MAX_STUDY_POINTS:
+        c.fail("sweep", f"{math.prod(sizes):,} points (product of the swept grids) is too many: allowed at most {MAX_STUDY_POINTS:,}")
+    if "pgf_paper" in solutions and layout is not None and (named := layout.paper_view()) is not None and (modes := underdamped_mode_count(named)) != 2:
+        c.fail("solutions", f"pgf_paper needs two underdamped modes (the paper's eq. 10 fit); this system has {modes}")
+    allowed = quantities_for(coordinates) if coordinates is not None else QUANTITIES
+    if len(set(allowed)) != len(allowed):
+        clashing = sorted({q for q in allowed if allowed.count(q) > 1})
+        c.fail("system.coordinates", f"names that make output names clash ({', '.join(clashing)}): rename them (e.g. not 'force')")
+    quantities = c.choices("quantities", doc["quantities"], allowed) if "quantities" in doc else allowed
+    if "regime" not in quantities:
+        quantities = (*quantities, "regime")
+
+    admissibility = AdmissibilitySettings()
+    if "settings" in doc:
+        settings = c.mapping("settings", doc["settings"], {"admissibility"})
+        if "admissibility" in settings:
+            adm = c.mapping("settings.admissibility", settings["admissibility"], {"samples_per_period", "relative_tolerance"})
+            kwargs: dict[str, Any] = {}
+            if "samples_per_period" in adm:
+                kwargs["samples_per_period"] = c.integer("settings.admissibility.samples_per_period", adm["samples_per_period"], 16, 1_000_000)
+            if "relative_tolerance" in adm:
+                kwargs["relative_tolerance"] = c.number("settings.admissibility.relative_tolerance", adm["relative_tolerance"], 0.0, 1e-2)
+            if None not in kwargs.values():
+                admissibility = AdmissibilitySettings(**kwargs)
+
+    simulation = None
+    engines = [name for name in solutions if name in ENGINE_SOLUTIONS]
+    swept_sine = _parse_swept_sine(c, doc["swept_sine"], engines, grids.get("frequency")) if "swept_sine" in doc else None
+    if "simulation" in doc:
+        if not engines:
+            c.fail("simulation", f"given, but no time-domain solution ({', '.join(ENGINE_SOLUTIONS)}) is asked for")
+        elif (main_grid := grids.get("frequency")) is not None:
+            if "swept_sine" in doc:
+                for key in sorted(set(doc["simulation"]) & _STEADY_ONLY_KEYS if isinstance(doc["simulation"], dict) else ()):
+                    c.fail(f"simulation.{key}", "not used by a swept-sine test (it sets stepped steady states): remove it")
+            swept_axes = {key: grid for key, grid in grids.items() if key in sweep and key != "frequency"}
+            simulation = parse_simulation(c, doc["simulation"], main_grid, swept="swept_sine" in doc, engines=engines, axes=swept_axes)
+    elif engines and (main_grid := grids.get("frequency")) is not None:
+        simulation = parse_simulation(c, {}, main_grid, swept="swept_sine" in doc)
+
+    if c.problems:
+        raise SceneError(c.problems, source)
+    frequency, restitution, clearance = grids["frequency"], grids["restitution"], grids["clearance"]
+    # guaranteed when no problem was recorded
+    assert layout is not None and amplitude is not None and isinstance(name, str)
+    assert frequency is not None and restitution is not None and clearance is not None
+    order = ("bumper_loss_factor", "restitution", "clearance", "bumper_frequency")
+    swept = tuple(k for k in order if k in sweep) + ("frequency",)
+    grid = GridSettings(
+        frequency=frequency, restitution=restitution, clearance=clearance, swept=swept, solutions=solutions, quantities=quantities,
+        admissibility=admissibility, simulation=simulation, bumper_frequency=grids.get("bumper_frequency"),
+        bumper_loss_factor=grids.get("bumper_loss_factor"), swept_sine=swept_sine, sweep_stops=targets,
+    )
+    return Scene(
+        name=name, description=description, layout=layout, amplitude=amplitude, kind="stepped" if swept_sine is None else "swept", settings=grid,
+        report=report, text=text, cluster_scheduler=scheduler,
+    )
+
+
+def _parse_swept_sine(c: Checker, value: Any, engines: list[str], grid: np.ndarray | None) -> SweptSineSettings | None:
+    """``swept_sine: {start, stop, rate, directions, sample_rate, window_cycles, initial_state}`` (frequencies [Hz],
+    rate [Hz s-1]); every problem is reported."""
+    spec = c.mapping("swept_sine", value, {"start", "stop", "rate", "directions", "sample_rate", "window_cycles", "initial_state"}, {"start", "stop", "rate"})
+    if engines != ["compliant"]:
+        c.fail("solutions", f"a swept-sine test runs the compliant solution only (and needs it): got {engines or 'none'}")
+    start = c.number("swept_sine.start", spec["start"], 0.0, math.inf, low_inclusive=False) if "start" in spec else None
+    stop = c.number("swept_sine.stop", spec["stop"], 0.0, math.inf, low_inclusive=False) if "stop" in spec else None
+    rate = c.number("swept_sine.rate", spec["rate"], 0.0, math.inf, low_inclusive=False) if "rate" in spec else None
+    directions = c.choices("swept_sine.directions", spec["directions"], SWEEP_DIRECTIONS) if "directions" in spec else SWEEP_DIRECTIONS
+    sample_rate = c.number("swept_sine.sample_rate", spec.get("sample_rate", 1000.0), 0.0, 1e7, low_inclusive=False)
+    cycles = c.integer("swept_sine.window_cycles", spec.get("window_cycles", 8), 1, 10_000)
+    initial = spec.get("initial_state", "linear")
+    if initial not in ("linear", "rest"):
+        c.fail("swept_sine.initial_state", f"{initial!r} is not allowed: use linear or rest")
+    if start is None or stop is None:
+        return None
+    if stop <= start:
+        c.fail("swept_sine.stop", f"{stop:g} must be greater than start = {start:g} (directions say which way it runs)")
+        return None
+    rate, sample_rate = check_sweep_run(c, "swept_sine", start, stop, rate, sample_rate, cycles, " or swept_sine.window_cycles")
+    if grid is not None and not np.any((grid >= start) & (grid <= stop)):
+        c.fail("sweep.frequency", f"no frequency of the grid lies in the swept band [{start:g}, {stop:g}] Hz, where the running estimates are reported")
+    if rate is None or sample_rate is None or cycles is None or not directions or initial not in ("linear", "rest"):
+        return None
+    return SweptSineSettings(start, stop, rate, directions, sample_rate, cycles, initial)
