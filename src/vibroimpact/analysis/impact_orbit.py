@@ -32,6 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.analysis.greens import GREEN_CONDITION_LIMIT, green_condition, green_vector, periodic_green
 from vibroimpact.analysis.layout import ClosedFormLayout, closed_form_layout, harmonic_load
+from vibroimpact.analysis.linear import base_force as suspension_force
 from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
 from vibroimpact.model.modal import ModalResponse, impulse_modes
 from vibroimpact.model.problem import ImpactProblem
@@ -239,6 +240,17 @@ class ImpactOrbit:
         if origin == "problem":
             out = out * np.exp(-1j * self.omega * self.impact_time)[..., None]
         return out
+
+    def base_force(self, suspension_only: bool = False) -> NDArray[np.complex128]:
+        """Fundamental of the force on the base [N], time from the impact, shape S: the suspension's 1^T (K + j w C) X
+        of :meth:`harmonics` (:func:`~vibroimpact.analysis.linear.base_force`), plus (1^T n) k J / T, the fundamental
+        of the impulses an absolute stop passes to the base (J at t = 0 and, two-sided, -J at T/2: k = 2 or 4); a
+        relative stop (1^T n = 0) acts inside the structure. ``suspension_only``: the suspension's part alone."""
+        force = suspension_force(self.layout.structure, self.omega, self.harmonics())
+        if suspension_only:
+            return force
+        rate = (4.0 if self.two_sided else 2.0) * self.impulse / self.period
+        return force + float(np.sum(self.normal)) * rate
 
     def take(self, index: ArrayLike) -> "ImpactOrbit":
         """The points at flat indices ``index`` of the broadcast shape, as a 1-D solution."""

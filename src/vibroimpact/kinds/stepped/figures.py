@@ -12,6 +12,7 @@ import numpy as np
 import xarray as xr
 from matplotlib.lines import Line2D
 
+from vibroimpact.analysis.linear import base_force
 from vibroimpact.kinds.stepped.crosscheck import subset_solutions
 from vibroimpact.model.modal import fit_modal_parameters, underdamped_mode_count
 from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
@@ -20,7 +21,6 @@ from vibroimpact.reporting.page import DrawnFigure, Table
 from vibroimpact.reporting.series import SimulationMarkers, draw_curve, draw_linear, draw_points, periodic_points, stability_keys, unstable_points
 from vibroimpact.reporting.style import DISPLACEMENT_SCALE, DISPLACEMENT_UNITS, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
-from vibroimpact.simulation.harmonics import base_force
 
 __all__ = ["structure_figure", "layout_tables", "response_panels_figure", "peaks_table", "where_text"]
 
