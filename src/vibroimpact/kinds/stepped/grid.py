@@ -21,6 +21,7 @@ from vibroimpact.kinds.stepped.values import general_linear_values, general_pgf_
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import TASK_SECONDS, WRITE_SECONDS_PER_VARIABLE, Costs, Estimate, cluster_startup, cost_engine, os_cpus
 from vibroimpact.runs.run import provenance
+from vibroimpact.reporting.solutions import solution_method
 
 __all__ = ["EnginePart", "grid_estimate", "memory", "StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset", "layout_attributes", "no_one_impact_orbit"]
 
@@ -163,7 +164,7 @@ def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[st
             attrs[f"system_{key}"] = value
     attrs.update(layout_attributes(scene, scene.settings.restitution, scene.settings.clearance))
     if "pgf_paper" in scene.settings.solutions:
-        attrs["method_pgf_paper"] = "the paper's route: curve-fitted modal parameters of H22 (eq. 10, Omega fixed from eq. 11); chi22'(0-) = -1/(2 M2); stable (+) root of corrected eq. 16"
+        attrs["method_pgf_paper"] = solution_method("pgf_paper")
     for key, value in asdict(scene.settings.admissibility).items():
         attrs[f"admissibility_{key}"] = value
     attrs.update(simulation_attributes)
@@ -203,7 +204,7 @@ def layout_attributes(scene: Scene, restitution: np.ndarray, clearance: np.ndarr
         "stop_clearance_m": _attribute([
             float(spec.clearance) if spec.clearance is not None else (float(clearance[0]) if clearance.size == 1 else np.nan) for spec in specs
         ]),  # fmt: skip
-        "method_pgf": "closed-form impact orbit (periodic Green function of the stopped coordinate n^T H n; one impact per period on one stop, two on a symmetric two-sided stop); stable (+) root",
+        "method_pgf": solution_method("pgf"),
         "method_force": "force on the base: 1^T (K x + C x') through springs and dashpots plus (1^T n_k) lambda_k of each absolute stop",
     }
 
