@@ -242,15 +242,11 @@ class ImpactOrbit:
         return out
 
     def base_force(self, suspension_only: bool = False) -> NDArray[np.complex128]:
-        """Fundamental of the force on the base [N], time from the impact, shape S: the suspension's 1^T (K + j w C) X
-        of :meth:`harmonics` (:func:`~vibroimpact.analysis.linear.base_force`), plus (1^T n) k J / T, the fundamental
-        of the impulses an absolute stop passes to the base (J at t = 0 and, two-sided, -J at T/2: k = 2 or 4); a
-        relative stop (1^T n = 0) acts inside the structure. ``suspension_only``: the suspension's part alone."""
+        """Fundamental of the force on the base [N], shape S: 1^T (K + j w C) X (:func:`.linear.base_force`) plus, unless
+        ``suspension_only``, (1^T n) k J / T of the stop's impulses (k as in :meth:`harmonics`; 0 for a relative stop)."""
         force = suspension_force(self.layout.structure, self.omega, self.harmonics())
-        if suspension_only:
-            return force
         rate = (4.0 if self.two_sided else 2.0) * self.impulse / self.period
-        return force + float(np.sum(self.normal)) * rate
+        return force if suspension_only else force + float(np.sum(self.normal)) * rate
 
     def take(self, index: ArrayLike) -> "ImpactOrbit":
         """The points at flat indices ``index`` of the broadcast shape, as a 1-D solution."""
