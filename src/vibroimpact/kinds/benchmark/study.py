@@ -30,7 +30,7 @@ from vibroimpact.runs.run import provenance
 from vibroimpact.runs.runner import Runner
 from vibroimpact.kinds.benchmark.scene import BenchmarkCase, BenchmarkSettings, LadderSettings
 from vibroimpact.scene.schema import Scene
-from vibroimpact.scene.variables import BENCHMARK_ATTRIBUTES, LADDER_ATTRIBUTES
+from vibroimpact.kinds.benchmark.variables import BENCHMARK_ATTRIBUTES, LADDER_ATTRIBUTES
 from vibroimpact.simulation.harmonics import measure, running_fundamental
 from vibroimpact.simulation.steady import start_state
 
@@ -90,7 +90,7 @@ _OTHER_ERRORS = ("impact_time_error", "impulse_error", "final_state_error")
 
 def measured_names(coordinate: str) -> dict[str, str]:
     """The benchmark's variables named after the measured coordinate (``x1_error`` ... for the paper's ``x1``), by
-    their name in :data:`~vibroimpact.scene.variables.BENCHMARK_ATTRIBUTES` and ``LADDER_ATTRIBUTES``."""
+    their name in :data:`~vibroimpact.kinds.benchmark.variables.BENCHMARK_ATTRIBUTES` and ``LADDER_ATTRIBUTES``."""
     return {template: template.replace("x1", coordinate, 1) for template in ("x1_error", "reference_x1", "ladder_x1_amplitude", "ladder_x1_difference")}
 
 
