@@ -15,7 +15,7 @@ from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.kinds.benchmark.scene import BenchmarkCase, BenchmarkSettings
-from vibroimpact.scene.variables import BENCHMARK_ATTRIBUTES
+from vibroimpact.kinds.benchmark.variables import BENCHMARK_ATTRIBUTES
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
 

@@ -18,7 +18,8 @@ from vibroimpact.scene.checker import SceneError
 from vibroimpact.kinds.concepts.scene import parse_concepts
 from vibroimpact.model.absorber import den_hartog_absorber
 from vibroimpact.kinds.concepts.metrics import anti_resonance_band, band_metrics, envelope, stretches
-from vibroimpact.simulation.harmonics import base_force, base_weights
+from vibroimpact.analysis.linear import base_force
+from vibroimpact.simulation.harmonics import base_weights
 from vibroimpact.kinds.concepts.branches import check_stops
 
 SYSTEM = TwoDofSystem(1.0, 0.1, 25000.0, 4300.0, 0.8, 0.08)

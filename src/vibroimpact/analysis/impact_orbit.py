@@ -32,6 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.analysis.greens import GREEN_CONDITION_LIMIT, green_condition, green_vector, periodic_green
 from vibroimpact.analysis.layout import ClosedFormLayout, closed_form_layout, harmonic_load
+from vibroimpact.analysis.linear import base_force as suspension_force
 from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
 from vibroimpact.model.modal import ModalResponse, impulse_modes
 from vibroimpact.model.problem import ImpactProblem
@@ -239,6 +240,13 @@ class ImpactOrbit:
         if origin == "problem":
             out = out * np.exp(-1j * self.omega * self.impact_time)[..., None]
         return out
+
+    def base_force(self, suspension_only: bool = False) -> NDArray[np.complex128]:
+        """Fundamental of the force on the base [N], shape S: 1^T (K + j w C) X (:func:`.linear.base_force`) plus, unless
+        ``suspension_only``, (1^T n) k J / T of the stop's impulses (k as in :meth:`harmonics`; 0 for a relative stop)."""
+        force = suspension_force(self.layout.structure, self.omega, self.harmonics())
+        rate = (4.0 if self.two_sided else 2.0) * self.impulse / self.period
+        return force if suspension_only else force + float(np.sum(self.normal)) * rate
 
     def take(self, index: ArrayLike) -> "ImpactOrbit":
         """The points at flat indices ``index`` of the broadcast shape, as a 1-D solution."""

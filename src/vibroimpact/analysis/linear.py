@@ -4,7 +4,9 @@
 :func:`linear_amplitudes` is any structure under its problem's load: the complex amplitude of every coordinate,
 H(jw) F(w), and of every stop's coordinate n_k . H F (a relative coordinate x_i - x_j for a relative stop, signed
 by the stop's side), plus the static deflection K^-1 F0 where K is invertible; :func:`structure_peaks` finds the
-maxima of any of them near each natural frequency.
+maxima of any of them near each natural frequency. :func:`base_force` is the force such a steady state (or any
+motion's fundamentals) transmits to the base through the springs and dashpots, plus the stops' contact forces when
+given: the one formula of every closed form and study.
 """
 
 from __future__ import annotations
@@ -19,9 +21,40 @@ from scipy.optimize import minimize_scalar
 from vibroimpact.analysis.layout import harmonic_load
 from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["peaks_near", "LinearResponse", "linear_response", "ResonancePeak", "resonance_peaks", "LinearAmplitudes", "linear_amplitudes", "structure_peaks"]
+__all__ = ["base_coupling", "base_force", "peaks_near", "LinearResponse", "linear_response", "ResonancePeak", "resonance_peaks", "LinearAmplitudes", "linear_amplitudes", "structure_peaks"]
+
+
+def base_coupling(system: LinearStructure) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """(1^T K, 1^T C): the force on the base through the springs [N m-1] and dashpots [N s m-1] per coordinate
+    ((K1, 0) and (B1, 0) for the paper's system)."""
+    return system.stiffness_matrix.sum(axis=0), system.damping_matrix.sum(axis=0)
+
+
+def base_force(system: LinearStructure, omega: ArrayLike, x: ArrayLike, through: ArrayLike | None = None, contact: ArrayLike | None = None) -> NDArray[np.complex128]:
+    """Fundamental of the force on the base [N]: 1^T (K + j w C) x through the springs and dashpots, plus
+    sum_k (1^T n_k) F_k of the stops' contact forces when given; the one formula of every closed form and study.
+
+    Parameters
+    ----------
+    system : LinearStructure
+        The structure (K, C).
+    omega : array_like
+        Angular frequency [rad s-1], broadcast against ``x``'s leading axes.
+    x : array_like of complex, shape (..., N)
+        Fundamentals of the coordinates [m].
+    through : array_like, shape (K,), optional
+        1^T n_k of each stop (:func:`~vibroimpact.simulation.harmonics.base_weights`): +1 an upper stop against the base, -1 a lower one, 0 relative.
+    contact : array_like of complex, shape (..., K), optional
+        Fundamentals of the stops' contact forces [N].
+    """
+    stiffness, damping = base_coupling(system)
+    force = np.einsum("...i,...i->...", stiffness + 1j * np.asarray(omega, dtype=float)[..., None] * damping, np.asarray(x))
+    if contact is not None and through is not None:
+        force = force + np.einsum("...k,k->...", np.asarray(contact), np.asarray(through, dtype=float))
+    return force
 
 
 @dataclass(frozen=True, eq=False)

@@ -22,6 +22,16 @@ from matplotlib.figure import Figure as MatplotlibFigure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
 from vibroimpact.analysis.stability import Regime  # noqa: E402
+# every solution's row (colour, title, words), kept without matplotlib for the studies; re-exported for the pages
+from vibroimpact.reporting.solutions import (  # noqa: E402
+    ENGINE_MARKERS,
+    GENERAL_SOLUTION_DESCRIPTIONS,
+    SOLUTION_COLOURS,
+    SOLUTION_DESCRIPTIONS,
+    SOLUTION_LOOKS,
+    SOLUTION_TITLES,
+    SolutionLook,
+)
 
 __all__ = [
     "DISPLACEMENT_SCALE",
@@ -37,6 +47,7 @@ __all__ = [
     "SolutionLook",
     "SOLUTION_COLOURS",
     "SOLUTION_DESCRIPTIONS",
+    "GENERAL_SOLUTION_DESCRIPTIONS",
     "SOLUTION_TITLES",
     "ENGINE_MARKERS",
     "LINEAR_STYLE",
@@ -166,44 +177,6 @@ UNSTABLE_STYLE = {"ls": (0, (5, 2.5)), "lw": 1.4}
 LINEAR_STYLE = {"ls": ":", "lw": 1.3, "color": "k"}
 #: Raw one-impact solution wherever eqs. 15-16 have a root, unchecked: thin and faint, behind everything.
 RAW_STYLE = {"ls": "-", "lw": 0.7, "alpha": 0.35, "zorder": 1}
-@dataclass(frozen=True)
-class SolutionLook:
-    """How every page presents one solution.
-
-    Attributes
-    ----------
-    colour : str
-        Its colour where a figure distinguishes solutions (not restitution ratios).
-    title : str
-        Its short name for panel titles (half a figure wide).
-    description : str
-        What it is, for captions.
-    marker : (str, float) or None
-        Time-domain solutions: the marker (a fillable shape: filled means periodic) and its size [pt].
-    """
-
-    colour: str
-    title: str
-    description: str
-    marker: tuple[str, float] | None = None
-
-
-#: Every solution's presentation, one row each: a new engine offered as a stepped solution adds its row here. The
-#: simulations' markers: exact's larger diamonds show under momentary's circles where both agree.
-SOLUTION_LOOKS: dict[str, SolutionLook] = {
-    "linear": SolutionLook("k", "linear system", "linear system, no stop"),
-    "pgf": SolutionLook("C0", "closed form, exact modes", "one-impact closed form, exact poles/residues and exact chi22'(0-)"),
-    "pgf_paper": SolutionLook("C4", "closed form, paper's fitted modes", "one-impact closed form, the paper's fitted modes and constant chi22'(0-)"),
-    "momentary": SolutionLook("C1", "CVODE, rigid stop", "CVODE simulation, rigid stop", ("o", 3.5)),
-    "exact": SolutionLook("C2", "exact engine, rigid stop", "piecewise-exact simulation, rigid stop", ("D", 5.0)),
-    "compliant": SolutionLook("C3", "IDA, compliant bumper", "IDA simulation, Kelvin-Voigt bumper (eq. 25)", ("s", 4.0)),
-    "compliant_exact": SolutionLook("C6", "closed form, compliant bumper", "closed-form Kelvin-Voigt bumper (eq. 25), exact per contact mode", ("^", 5.0)),
-}
-#: Views of :data:`SOLUTION_LOOKS`: simulation markers and sizes, colours, panel titles, caption descriptions.
-ENGINE_MARKERS: dict[str, tuple[str, float]] = {name: look.marker for name, look in SOLUTION_LOOKS.items() if look.marker is not None}
-SOLUTION_COLOURS: dict[str, str] = {name: look.colour for name, look in SOLUTION_LOOKS.items()}
-SOLUTION_TITLES: dict[str, str] = {name: look.title for name, look in SOLUTION_LOOKS.items()}
-SOLUTION_DESCRIPTIONS: dict[str, str] = {name: look.description for name, look in SOLUTION_LOOKS.items()}
 
 
 def series_colour(index: int) -> str:

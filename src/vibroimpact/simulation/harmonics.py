@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import cumulative_trapezoid
 
+from vibroimpact.analysis.linear import base_coupling, base_force  # their home; here for the callers of this module
 from vibroimpact.engines.base import Trajectory
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem
@@ -27,36 +28,6 @@ __all__ = ["base_force", "suspension_force", "base_coupling", "base_weights", "L
 # What steady states need to know of any layout: the linear steady state, the force on the base and a start that
 # respects every stop.
 # --------------------------------------------------------------------------------------------------------------------
-
-def base_coupling(system: LinearStructure) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """(1^T K, 1^T C): the force on the base through the springs [N m-1] and dashpots [N s m-1] per coordinate
-    ((K1, 0) and (B1, 0) for the paper's system)."""
-    return system.stiffness_matrix.sum(axis=0), system.damping_matrix.sum(axis=0)
-
-
-def base_force(system: LinearStructure, omega: ArrayLike, x: ArrayLike, through: ArrayLike | None = None, contact: ArrayLike | None = None) -> NDArray[np.complex128]:
-    """Fundamental of the force on the base [N]: 1^T (K + j w C) x through the springs and dashpots, plus
-    sum_k (1^T n_k) F_k of the stops' contact forces when given; the one formula of every closed form and study.
-
-    Parameters
-    ----------
-    system : LinearStructure
-        The structure (K, C).
-    omega : array_like
-        Angular frequency [rad s-1], broadcast against ``x``'s leading axes.
-    x : array_like of complex, shape (..., N)
-        Fundamentals of the coordinates [m].
-    through : array_like, shape (K,), optional
-        1^T n_k of each stop (:func:`base_weights`): +1 an upper stop against the base, -1 a lower one, 0 relative.
-    contact : array_like of complex, shape (..., K), optional
-        Fundamentals of the stops' contact forces [N].
-    """
-    stiffness, damping = base_coupling(system)
-    force = np.einsum("...i,...i->...", stiffness + 1j * np.asarray(omega, dtype=float)[..., None] * damping, np.asarray(x))
-    if contact is not None and through is not None:
-        force = force + np.einsum("...k,k->...", np.asarray(contact), np.asarray(through, dtype=float))
-    return force
-
 
 def suspension_force(system: LinearStructure, omega: float, x: NDArray[np.complex128]) -> complex:
     """Fundamental of the force on the base through springs and dashpots [N] for coordinate fundamentals ``x`` [m]."""

@@ -29,7 +29,8 @@ from vibroimpact.runs.runner import Runner
 from vibroimpact.kinds.benchmark.scene import BenchmarkCase, BenchmarkSettings, LadderSettings
 from vibroimpact.scene.schema import Scene
 from vibroimpact.model.layout import Layout
-from vibroimpact.scene.variables import BENCHMARK_ATTRIBUTES, CLOSED_FORM_METHODS, LADDER_ATTRIBUTES
+from vibroimpact.kinds.benchmark.variables import BENCHMARK_ATTRIBUTES, LADDER_ATTRIBUTES
+from vibroimpact.reporting.solutions import closed_form_methods
 from vibroimpact.simulation.harmonics import measure, running_fundamental
 from vibroimpact.simulation.steady import start_state
 
@@ -89,7 +90,7 @@ _OTHER_ERRORS = ("impact_time_error", "impulse_error", "final_state_error")
 
 def measured_names(coordinate: str) -> dict[str, str]:
     """The benchmark's variables named after the measured coordinate (``x1_error`` ... for the paper's ``x1``), by
-    their name in :data:`~vibroimpact.scene.variables.BENCHMARK_ATTRIBUTES` and ``LADDER_ATTRIBUTES``."""
+    their name in :data:`~vibroimpact.kinds.benchmark.variables.BENCHMARK_ATTRIBUTES` and ``LADDER_ATTRIBUTES``."""
     return {template: template.replace("x1", coordinate, 1) for template in ("x1_error", "reference_x1", "ladder_x1_amplitude", "ladder_x1_difference")}
 
 
@@ -435,7 +436,7 @@ class BenchmarkStudy:
         dataset = run_benchmark(list(scene.settings.cases), scene.settings.settings, progress=progress is not None)
         dataset.attrs.update({"title": f"vibroimpact benchmark '{scene.name}'", "scene_name": scene.name, "scene": scene.text} | provenance())
         if scene.layout.paper_view() is None:  # the paper's layout needs no record: its page draws the paper's names
-            dataset.attrs.update(scene.layout.attributes(*_shared_values(scene.settings.cases, scene.layout.stops)) | CLOSED_FORM_METHODS | {"excitation_amplitude_N": scene.amplitude})
+            dataset.attrs.update(scene.layout.attributes(*_shared_values(scene.settings.cases, scene.layout.stops)) | closed_form_methods() | {"excitation_amplitude_N": scene.amplitude})
         return dataset
 
     def estimate(self, scene: Scene, jobs: int, costs: Costs) -> Estimate:

@@ -39,7 +39,7 @@ from vibroimpact.model.excitation import SweptSine
 from vibroimpact.simulation.harmonics import running_fundamental
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import PAPER_SYSTEM
-from vibroimpact.scene.variables import SWEEP_COST_ATTRIBUTES
+from vibroimpact.kinds.benchmark.variables import SWEEP_COST_ATTRIBUTES
 
 __all__ = ["SweepCostSettings", "markdown_table", "run_sweep_cost", "add_arguments", "settings_from_arguments"]
 

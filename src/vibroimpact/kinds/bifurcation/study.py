@@ -1,7 +1,7 @@
 """Bifurcation studies: every periodic orbit of a frequency band with its stability and special points, brute-force
 sweeps up and down, and the two-parameter chart (frequency x clearance) with its regime map.
 
-Output (``bifurcation.nc``; attributes from :data:`vibroimpact.scene.variables.BIFURCATION_ATTRIBUTES`):
+Output (``bifurcation.nc``; attributes from :data:`vibroimpact.kinds.bifurcation.variables.BIFURCATION_ATTRIBUTES`):
 
 * dimension ``branch_point``: coordinates ``branch`` (integer label), ``branch_frequency`` [Hz] and
   ``branch_restitution``; variables ``<c>_amplitude`` [m] of every coordinate c of the structure (``x1_amplitude``,
@@ -59,7 +59,8 @@ from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
 from vibroimpact.model.layout import build_stops, describe_stop
 from vibroimpact.scene.schema import Scene
-from vibroimpact.scene.variables import BIFURCATION_ATTRIBUTES, COORDINATE_ATTRIBUTES, STABLE_ATTRIBUTES, flag_attributes
+from vibroimpact.scene.variables import COORDINATE_ATTRIBUTES, STABLE_ATTRIBUTES, flag_attributes
+from vibroimpact.kinds.bifurcation.variables import BIFURCATION_ATTRIBUTES
 from vibroimpact.kinds.bifurcation.branches import MAX_ORBIT_IMPACTS, ORIGINS
 from vibroimpact.kinds.bifurcation.logs import Tally, chart_labels, continuation_log, failure_summary, numbered_across, relabel, sweep_tally, tallies
 from vibroimpact.kinds.bifurcation.cases import MAX_KEPT_IMPACTS, MAX_PERIOD, MOTION_CLASSES, BranchCase, ChartCase, SweepCase, Seed, sweep_seeds

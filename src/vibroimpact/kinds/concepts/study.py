@@ -26,15 +26,17 @@ import xarray as xr
 from numpy.typing import NDArray
 
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
+from vibroimpact.analysis.linear import base_force, linear_amplitudes
 from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.kinds.concepts.branches import BranchCase, branch_seeds
 from vibroimpact.kinds.concepts.cases import CASE_FIELDS, ConceptCase
 from vibroimpact.kinds.concepts.metrics import anti_resonance_band, band_metrics, envelope, stretches
 from vibroimpact.kinds.concepts.scene import Concept, ConceptsSettings
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.runner import Runner
-from vibroimpact.simulation.harmonics import base_force
 
 __all__ = ["ClosedForms", "closed_forms", "MARGINAL_MODULUS", "concepts_dataset", "ConceptsStudy", "run_concepts", "CHUNK"]
 
@@ -81,14 +83,11 @@ def closed_forms(concept: Concept, amplitude: float, frequency: NDArray[np.float
     """Linear and impact closed forms of ``concept`` under q = ``amplitude`` [N] on the primary mass."""
     f = np.asarray(frequency, dtype=float)
     w = 2.0 * np.pi * f
-    structure = concept.system.structure
-    load = np.zeros(structure.size, dtype=complex)
-    load[0] = amplitude
-    x = structure.receptance_matrix(w) @ load
-    base = base_force(structure, w, x)
-    fits = np.ones(f.shape, dtype=bool)
-    for stop in concept.stops:
-        fits &= np.abs(x @ stop.normal(structure.size)) <= stop.clearance
+    problem = ImpactProblem(concept.system, concept.stops, HarmonicForce(amplitude, float(f[0])))  # without a stop too
+    linear = linear_amplitudes(problem, omega=w)
+    x = linear.coordinates
+    base = base_force(problem.structure, w, x)
+    fits = linear.fits(problem.clearances())  # always true without a stop
     nan = np.full(f.shape, np.nan)
     empty = ClosedForms(f, np.abs(x[:, 0]), np.abs(base), fits, nan, nan, np.full(f.shape, -1, dtype=np.int8))
     if not concept.stops:
@@ -105,15 +104,9 @@ def _orbit(concept: Concept, amplitude: float, linear: ClosedForms) -> ClosedFor
     except ValueError as error:
         return _with_note(linear, f"no closed form: {error}")
     admissible = orbit.admissible()
-    harmonics = orbit.harmonics()
-    x1 = np.where(admissible, np.abs(harmonics[..., 0]), np.nan)
-    w = orbit.omega
-    rate = orbit.impacts_per_period * 2.0 * orbit.impulse / orbit.period
-    through = float(np.sum(orbit.normal))  # 1^T n: 0 for a relative stop, whose impulses stay inside the structure
-    # time from the impact: the base feels (1^T n) J at t = 0 and, two-sided, -(1^T n) J at T/2: fundamental k J / T
-    base = base_force(concept.system.structure, w, harmonics) + through * rate
-    force = np.where(admissible, np.abs(base), np.nan)
-    stable = np.full(w.shape, -1, dtype=np.int8)
+    x1 = np.where(admissible, np.abs(orbit.harmonics()[..., 0]), np.nan)
+    force = np.where(admissible, np.abs(orbit.base_force()), np.nan)  # suspension and absolute stops
+    stable = np.full(orbit.omega.shape, -1, dtype=np.int8)
     index = np.flatnonzero(admissible)
     if index.size:
         modulus = np.max(np.abs(floquet_multipliers(orbit.take(index))), axis=-1)

@@ -12,27 +12,19 @@ import numpy as np
 import xarray as xr
 from matplotlib.lines import Line2D
 
+from vibroimpact.analysis.linear import base_force
 from vibroimpact.kinds.stepped.crosscheck import subset_solutions
 from vibroimpact.model.modal import fit_modal_parameters, underdamped_mode_count
 from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.record import GeneralSetting
 from vibroimpact.reporting.page import DrawnFigure, Table
 from vibroimpact.reporting.series import SimulationMarkers, draw_curve, draw_linear, draw_points, periodic_points, stability_keys, unstable_points
-from vibroimpact.reporting.style import DISPLACEMENT_SCALE, DISPLACEMENT_UNITS, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref
+from vibroimpact.reporting.style import DISPLACEMENT_SCALE, DISPLACEMENT_UNITS, GENERAL_SOLUTION_DESCRIPTIONS, SOLUTION_COLOURS, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
-from vibroimpact.simulation.harmonics import base_force
 
 __all__ = ["structure_figure", "layout_tables", "response_panels_figure", "peaks_table", "where_text"]
 
 _FREQUENCY = "frequency [Hz]"
-#: What a solution is on a general layout, where it differs from the paper's wording.
-GENERAL_DESCRIPTIONS = {
-    "pgf": "closed-form impact orbit (periodic Green function of the stopped coordinate: one impact per period on one stop, two on a symmetric two-sided stop)",
-    "exact": "piecewise-exact simulation, rigid stops",
-    "momentary": "CVODE simulation, rigid stops",
-    "compliant": "IDA simulation, Kelvin-Voigt bumpers",
-    "compliant_exact": "closed-form Kelvin-Voigt bumpers, exact per contact mode",
-}
 #: Points of the linear figure's own grid.
 _LINEAR_POINTS = 4001
 #: Fewer grid points than this: closed-form curves also get a marker per value.
@@ -188,7 +180,7 @@ def response_panels_figure(part: xr.Dataset, setting: GeneralSetting, name: str)
     caption = Caption(
         f"Steady state against frequency, {where_text(part)}: one panel per coordinate ({', '.join(setting.names)}), the force "
         f"on the base, and the impulse per period on each stop ({'; '.join(setting.stops)}). Solutions: "
-        + "; ".join(f"{solution_ref(s)}, {GENERAL_DESCRIPTIONS.get(s, SOLUTION_DESCRIPTIONS.get(s, s))}" for s in solutions if s != "linear") + "."
+        + "; ".join(f"{solution_ref(s)}, {GENERAL_SOLUTION_DESCRIPTIONS.get(s, s)}" for s in solutions if s != "linear") + "."
     )
     if "linear" in solutions:
         caption.add("linear", "LIN (dotted black): the linear system without stops.")

@@ -14,11 +14,12 @@ import xarray as xr
 
 from vibroimpact.model.modal import fit_modal_parameters
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, STOP_QUANTITIES, Scene
-from vibroimpact.scene.variables import CLOSED_FORM_METHODS, COORDINATE_ATTRIBUTES
+from vibroimpact.scene.variables import COORDINATE_ATTRIBUTES
 from vibroimpact.kinds.stepped.values import general_linear_values, general_pgf_values, paper_pgf_values
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import TASK_SECONDS, WRITE_SECONDS_PER_VARIABLE, Costs, Estimate, cluster_startup, cost_engine, os_cpus
 from vibroimpact.runs.run import provenance
+from vibroimpact.reporting.solutions import closed_form_methods, solution_method
 
 __all__ = ["EnginePart", "grid_estimate", "memory", "StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset", "no_one_impact_orbit"]
 
@@ -157,9 +158,9 @@ def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[st
     }
     if named is not None:
         attrs["antiresonance_frequency_Hz"] = named.antiresonance_angular_frequency() / (2.0 * np.pi)
-    attrs.update(scene.layout.attributes(scene.settings.restitution, scene.settings.clearance) | CLOSED_FORM_METHODS)
+    attrs.update(scene.layout.attributes(scene.settings.restitution, scene.settings.clearance) | closed_form_methods())
     if "pgf_paper" in scene.settings.solutions:
-        attrs["method_pgf_paper"] = "the paper's route: curve-fitted modal parameters of H22 (eq. 10, Omega fixed from eq. 11); chi22'(0-) = -1/(2 M2); stable (+) root of corrected eq. 16"
+        attrs["method_pgf_paper"] = solution_method("pgf_paper")
     for key, value in asdict(scene.settings.admissibility).items():
         attrs[f"admissibility_{key}"] = value
     attrs.update(simulation_attributes)

@@ -21,6 +21,7 @@ from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import Costs, Estimate, engine_scale
 from vibroimpact.runs.runner import Runner
 from vibroimpact.model.layout import stop_descriptions
+from vibroimpact.reporting.solutions import solution_method
 from vibroimpact.scene.schema import Scene, GRID_DIMS, STOP_QUANTITIES, ENGINE_SOLUTIONS
 from vibroimpact.scene.variables import quantity_attributes
 from vibroimpact.simulation.settings import SWEEP_STARTS
@@ -172,12 +173,11 @@ class SteppedStudy:
                 attrs[f"simulation_engine_{key}"] = value
             for key, value in asdict(scene.settings.simulation.steady).items():
                 attrs[f"simulation_steady_{key}"] = value
-            attrs["method_exact"] = "piecewise-exact propagation (eigenvectors + harmonic particular solution), contacts by guaranteed Taylor-bound root bracketing"
-            attrs["method_momentary"] = "scikit-sundae CVODE with contact/release events and an apex event guarding grazing contacts"
-            attrs["method_compliant"] = "Kelvin-Voigt bumper (eq. 25) through scikit-sundae IDA: one solver per contact mode, onset/release events, recorded force and deceleration peaks; atol of the displacements [m], other states scaled"
-            for name in scene.settings.solutions:  # any other engine the scene runs: its registry entry says what it is
+            for name in ("exact", "momentary", "compliant"):  # recorded whether the scene runs them or not
+                attrs[f"method_{name}"] = solution_method(name)
+            for name in scene.settings.solutions:  # any other engine the scene runs
                 if name in ENGINE_SOLUTIONS and f"method_{name}" not in attrs:
-                    attrs[f"method_{name}"] = engine_spec(name).description
+                    attrs[f"method_{name}"] = solution_method(name)
             for name, kept in scene.settings.simulation.subset.items():
                 attrs[f"simulation_subset_{name}"] = subset_text(kept)
         return attrs

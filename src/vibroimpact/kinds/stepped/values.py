@@ -16,7 +16,7 @@ from typing import Callable
 import numpy as np
 
 from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
-from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.analysis.linear import base_force, linear_amplitudes
 from vibroimpact.analysis.pgf import OneImpactSolution, PgfVariant, green_models, solve_one_impact
 from vibroimpact.analysis.stability import Regime, classify, MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.model.contact import peak_acceleration_factor
@@ -24,7 +24,6 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.schema import MOTION_QUANTITIES, STOP_QUANTITIES, Scene
 from vibroimpact.scene.variables import STABLE_MARGINAL
-from vibroimpact.simulation.harmonics import base_force
 
 __all__ = ["general_linear_values", "general_pgf_values", "first_problem", "broadcast_quantities", "stop_clearances", "coordinate_quantity", "paper_pgf_values"]
 
@@ -127,12 +126,7 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
 
     harmonics = functools.cache(orbit.harmonics)
     rms = functools.cache(orbit.rms)
-    def orbit_base_force(suspension_only: bool) -> np.ndarray:
-        force = base_force(scene.layout.structure, w, harmonics())
-        if suspension_only:
-            return force
-        rate = (4.0 if orbit.two_sided else 2.0) * orbit.impulse / orbit.period
-        return force + float(np.sum(orbit.normal)) * rate
+    orbit_base_force = functools.cache(orbit.base_force)
 
     def per_stop(values: np.ndarray) -> np.ndarray:
         out = np.zeros((count, *w.shape))

@@ -23,13 +23,13 @@ from matplotlib.axes import Axes
 from matplotlib.lines import Line2D
 
 from vibroimpact.analysis.stability import Regime
-from vibroimpact.kinds.stepped.figures import GENERAL_DESCRIPTIONS, layout_tables, structure_figure
+from vibroimpact.kinds.stepped.figures import layout_tables, structure_figure
 from vibroimpact.reporting.record import GeneralSetting, general_setting, is_general, study_setting, SWEPT_SOLUTION
 from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.kinds.stepped.responses import SolutionsPage, linear_section, regime_map
 from vibroimpact.reporting.series import draw_curve, draw_linear, stability_keys, unstable_points
-from vibroimpact.reporting.style import DISPLACEMENT_SCALE, DISPLACEMENT_UNITS, QUANTITIES, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref, SWEEP_COLOURS
+from vibroimpact.reporting.style import DISPLACEMENT_SCALE, DISPLACEMENT_UNITS, QUANTITIES, GENERAL_SOLUTION_DESCRIPTIONS, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref, SWEEP_COLOURS
 
 __all__ = ["page_for", "SweptSinePage", "GeneralSweptPage", "SweptSineRun", "SweepLayout", "sweep_layout", "swept_sine_run", "sweep_figures", "sweep_tables", "sweep_answer", "contact_stretches"]
 
@@ -88,7 +88,7 @@ def sweep_layout(dataset: xr.Dataset) -> SweepLayout:
     if not is_general(dataset):
         return SweepLayout(stops=stops)
     coordinates = tuple(str(dataset.attrs["system_coordinates"]).split())
-    return SweepLayout(coordinates, tuple(_label(c) for c in coordinates), stops, GENERAL_DESCRIPTIONS["pgf"], "closed-form impact orbits")
+    return SweepLayout(coordinates, tuple(_label(c) for c in coordinates), stops, GENERAL_SOLUTION_DESCRIPTIONS["pgf"], "closed-form impact orbits")
 
 
 @dataclass(frozen=True)

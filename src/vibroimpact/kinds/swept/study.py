@@ -38,7 +38,8 @@ from vibroimpact.runs.store import case_key
 from vibroimpact.model.layout import LoadSpec, build_stops, stop_descriptions
 from vibroimpact.scene.grid import SweptSineSettings
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, MOTION_QUANTITIES, STOP_QUANTITIES, Scene
-from vibroimpact.scene.variables import SWEEP_STAT_ATTRIBUTES, SWEEP_TIME_ATTRIBUTES, quantity_attributes, swept_attributes
+from vibroimpact.scene.variables import quantity_attributes
+from vibroimpact.kinds.swept.variables import SWEEP_STAT_ATTRIBUTES, SWEEP_TIME_ATTRIBUTES, running_attributes, swept_attributes
 from vibroimpact.simulation.harmonics import resting_state
 from vibroimpact.simulation.swept import SWEEP_STOP_QUANTITIES, sweep_estimates, sweep_quantities, sweep_start_state
 
@@ -238,7 +239,7 @@ class SweptStudy:
             else:
                 quantity = name.removeprefix("running_")
                 shape = (*grid.full[:-1], axes["time"].size)
-                data_vars[name] = xr.Variable(stop_dims(quantity, (*GRID_DIMS[:-1], "elapsed_time")), per_stop(quantity, values, shape), _running_attributes(_attributes(scene, quantity)))
+                data_vars[name] = xr.Variable(stop_dims(quantity, (*GRID_DIMS[:-1], "elapsed_time")), per_stop(quantity, values, shape), running_attributes(_attributes(scene, quantity)))
         dataset = describe_stops(xr.Dataset(data_vars, coords=coords))
         if running:
             dataset = dataset.assign_coords(
@@ -284,11 +285,6 @@ def _attributes(scene: Scene, quantity: str) -> dict[str, object]:
     """Units and long name of a quantity: the paper's for its named form, named after the coordinates and stops for a
     general scene."""
     return general_quantity_attributes(quantity, scene) if scene.layout.paper_view() is None else quantity_attributes(quantity)
-
-
-def _running_attributes(attrs: dict[str, object]) -> dict[str, object]:
-    """Attributes of a running estimate against the sweep's elapsed time, from its quantity's."""
-    return {"units": attrs.get("units", "1"), "long_name": f"running estimate over the sweep's window: {attrs.get('long_name', '')}"}
 
 
 def closed_form_values(scene: Scene, name: str, grid: StudyGrid) -> Values:
