@@ -25,7 +25,7 @@ def _sources(*modules: object) -> str:
 
 
 def test_each_loop_finds_every_file_whose_kernels_it_compiles() -> None:
-    assert kernel_modules(vars(exact_loop)) == [exact_core, exact_moments, exact_pieces, exact_roots]  # exact_core's through _transition, and on
+    assert kernel_modules(vars(exact_loop)) == [exact_core, exact_moments, exact_pieces, exact_roots]  # exact_core's through transition_matrix, and on
     assert kernel_modules(vars(exact_core)) == [exact_moments, exact_pieces, exact_roots]
     assert kernel_modules(vars(exact_moments)) == [exact_pieces]
     assert kernel_modules(vars(exact_pieces)) == [] and kernel_modules(vars(exact_roots)) == []

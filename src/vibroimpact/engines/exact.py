@@ -36,7 +36,7 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["ExactEngine", "StrobeMap", "chained_jacobian", "stack_flows"]
+__all__ = ["ExactEngine", "StrobeMap", "chained_jacobian", "loop_setup", "stack_flows"]
 
 
 def chained_jacobian(factors: NDArray[np.float64], size: int) -> NDArray[np.float64]:
@@ -143,7 +143,7 @@ class _Setup:
 
 
 @lru_cache(maxsize=512)
-def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
+def loop_setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
     """Once per problem (continuation and Lyapunov runs call the map of one problem thousands of times)."""
     law = RigidContact("exact", problem, settings, 0)
     length = law.length_scale
@@ -180,7 +180,7 @@ class ExactEngine:
 
     def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, jacobians: bool, approach: bool) -> tuple:
         check_run(self.name, problem, RigidStop, periods)
-        setup = _setup(problem, self.settings)
+        setup = loop_setup(problem, self.settings)
         state = np.array(state, dtype=float, order="C")  # a writable copy: one compiled overload (a read-only array would compile another, ~10 s)
         if state.shape != (2 * problem.size,):
             raise ValueError(f"state: expected {2 * problem.size} values (x and x' of {problem.size} coordinates), got shape {state.shape}")
@@ -266,7 +266,7 @@ class ExactEngine:
         segments = trajectory.segments
         if segments.shape[0] == 0:
             raise ValueError("the trajectory has no segments (0 periods): there is nothing to sample")
-        setup = _setup(trajectory.problem, self.settings)
+        setup = loop_setup(trajectory.problem, self.settings)
         pieces = np.clip(np.searchsorted(segments[:, 0], times, side=side) - 1, 0, segments.shape[0] - 1)  # type: ignore[call-overload]
         flows = np.where(segments[:, 2] == MODE_STUCK, trajectory.segment_stops + 1, 0).astype(np.int64)
         starts = np.ascontiguousarray(segments[:, 0])
@@ -286,7 +286,7 @@ class ExactEngine:
     def model(self, problem: ImpactProblem) -> ExactModel:
         """The flows and stop maps the engine prepared for ``problem`` (cached per problem)."""
         check_run(self.name, problem, RigidStop)
-        return _setup(problem, self.settings).model
+        return loop_setup(problem, self.settings).model
 
 
 def _stats(counters: NDArray[np.int64], impacts: int) -> dict[str, int]:

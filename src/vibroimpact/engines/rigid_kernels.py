@@ -30,7 +30,7 @@ from vibroimpact.engines.sundae import as_doubles, content_data
 from vibroimpact.model.contact import Impact, RigidStop
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["pack_parameters", "quadrature_count", "rhs_kernel", "jacobian_kernel", "events_kernel", "holding_kernel", "STUCK", "APEX", "SIZE", "STOPS", "LENGTH", "HEADER", "COMPILED_RHS", "COMPILED_JACOBIAN", "COMPILED_EVENTS", "RigidContact"]
+__all__ = ["pack_parameters", "quadrature_count", "rhs_kernel", "jacobian_kernel", "events_kernel", "holding_kernel", "STUCK", "APEX", "COMPILED_RHS", "COMPILED_JACOBIAN", "COMPILED_EVENTS", "RigidContact"]
 
 # header of the parameter array: mode, flags, sizes and the offsets of the blocks after it
 STUCK, APEX, SIZE, _N, STOPS, _OMEGA, _TRIG, _A, _C, _BR, _BI, _G, _G0, _NORMAL, _H, _H0, _HBR, _HBI, _TINV, _XOFF, LENGTH = range(21)

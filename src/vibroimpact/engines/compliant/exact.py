@@ -44,7 +44,7 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["CompliantExactEngine", "bumper_flows", "loop_is_cached", "prepare_compiled_loop", "MAX_BUMPERS"]
+__all__ = ["CompliantExactEngine", "bumper_flows", "contact_modes", "loop_is_cached", "prepare_compiled_loop"]
 
 #: Most bumpers of one problem: the engine prepares every contact mode, 2^K flows.
 MAX_BUMPERS = 8
@@ -54,7 +54,7 @@ def bumper_flows(problem: ImpactProblem) -> tuple[tuple[Flow, ...], NDArray[np.f
     """The closed-form flow of every contact mode of a problem with bumpers, and each stop's K_k, B_k and m_k.
 
     The modes' decompositions do not depend on the forcing frequency: they are kept per problem at any frequency
-    (:func:`_contact_modes`), and only the harmonic particular solution is made here (a continuation in frequency
+    (:func:`contact_modes`), and only the harmonic particular solution is made here (a continuation in frequency
     evaluates the map of a new problem at every step).
 
     Returns
@@ -63,7 +63,7 @@ def bumper_flows(problem: ImpactProblem) -> tuple[tuple[Flow, ...], NDArray[np.f
         (flows, stiffness [N m-1], damping [N s m-1], effective masses [kg]): ``flows[mask]`` is the flow of y = (x, x')
         with the bumpers of the stops in the bit mask pushing (``flows[0]`` the free flight).
     """
-    modes, k_b, b_b, masses = _contact_modes(dataclasses.replace(problem, excitation=dataclasses.replace(problem.harmonic, frequency=1.0)))
+    modes, k_b, b_b, masses = contact_modes(dataclasses.replace(problem, excitation=dataclasses.replace(problem.harmonic, frequency=1.0)))
     size = problem.size
     harmonic, _static = problem.load()
     b = np.concatenate([np.zeros(size, dtype=complex), np.linalg.solve(problem.structure.mass_matrix.astype(complex), harmonic)])
@@ -75,7 +75,7 @@ def bumper_flows(problem: ImpactProblem) -> tuple[tuple[Flow, ...], NDArray[np.f
 
 
 @lru_cache(maxsize=256)
-def _contact_modes(problem: ImpactProblem) -> tuple[tuple[tuple[NDArray[np.float64], Flow], ...], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+def contact_modes(problem: ImpactProblem) -> tuple[tuple[tuple[NDArray[np.float64], Flow], ...], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Per contact mode, its state matrix A [s-1] and :func:`~vibroimpact.engines.exact_flows.unforced_flow`, with each
     stop's K_k, B_k and m_k: what :func:`bumper_flows` keeps of a problem whatever its forcing frequency (``problem``
     is given at 1 Hz)."""
