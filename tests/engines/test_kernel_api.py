@@ -22,7 +22,7 @@ KERNEL_MODULES = tuple(
     f"vibroimpact.engines.{name}"
     for name in (
         "exact", "exact_core", "exact_pieces", "exact_roots", "exact_moments", "exact_flows", "rigid_kernels",
-        "flow_layout", "linear_flow", "compliant.exact_loop", "compliant.exact",
+        "flow_layout", "linear_flow", "kernel_arguments", "compliant.exact_loop", "compliant.exact",
     )
 )  # fmt: skip
 

@@ -30,6 +30,7 @@ from vibroimpact.engines import exact_core, exact_moments
 from vibroimpact.engines.base import MODE_STUCK, Trajectory, check_run
 from vibroimpact.engines.exact_flows import Flow, ExactModel, build_model
 from vibroimpact.engines.exact_python import PythonExactEngine
+from vibroimpact.engines.kernel_arguments import LoopArguments, StackedFlows, leading_arguments
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.engines.rigid_kernels import RigidContact
 from vibroimpact.engines.settings import EngineSettings
@@ -101,9 +102,10 @@ def _half(lam: NDArray[np.complex128]) -> NDArray[np.complex128]:
     return lam[lam.imag >= 0.0]
 
 
-def stack_flows(flows: tuple[Flow, ...], omega: float) -> tuple:
-    """The flows as the compiled loops' stacked arrays (see :mod:`~vibroimpact.engines.exact_core`): flow f is entry f of
-    each array (the exact engine's free and held flights; the bumper engine's contact modes)."""
+def stack_flows(flows: tuple[Flow, ...], omega: float) -> StackedFlows:
+    """The flows as the compiled loops' stacked arrays (see :mod:`~vibroimpact.engines.exact_core`), by the loops'
+    parameter names: flow f is entry f of each array (the exact engine's free and held flights; the bumper engine's
+    contact modes); ``omega`` [rad s-1]."""
     count, n = len(flows), flows[0].harmonic.size
     widest = max(flow.eigenvalues.size for flow in flows)
     lams = np.zeros((count, widest), dtype=complex)
@@ -128,7 +130,10 @@ def stack_flows(flows: tuple[Flow, ...], omega: float) -> tuple:
     zdrv2s = np.array([flow.drift2 for flow in flows], dtype=float).reshape(count, n)
     polys = np.array([flow.polynomial for flow in flows], dtype=np.bool_)
     fastests = np.array([omega + (float(np.max(np.abs(flow.eigenvalues))) if flow.eigenvalues.size else 0.0) for flow in flows])
-    return (lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates, rinv, fastests)
+    return StackedFlows(
+        lams=lams, counts=counts, vecs=vecs, invs=invs, hrms=hrms, csts=csts, zpros=zpros, znils=znils, zdrvs=zdrvs, zdrv2s=zdrv2s,
+        polys=polys, hlams=hlams, hcounts=hcounts, rates_all=rates, rinv_all=rinv, fastests=fastests,
+    )  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
@@ -137,8 +142,9 @@ class _Setup:
 
     law: RigidContact
     model: ExactModel
-    arguments: tuple
-    #: the leading arguments of :func:`~vibroimpact.engines.exact_core.sample_states`: the flows, the stops' gaps
+    arguments: LoopArguments
+    #: the leading arguments of :func:`~vibroimpact.engines.exact_core.sample_states`, picked from ``arguments`` by
+    #: its parameter names: the flows, the stops' gaps
     sampling: tuple
 
 
@@ -156,16 +162,16 @@ def loop_setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
     kickw = np.ascontiguousarray(np.hstack([zero, model.kicks]))
     signs = np.array([model.normals[k, i] if i >= 0 else 0.0 for k, i in enumerate(model.simple)])
     nodes, weights = gauss_legendre(16)
-    arguments = (
-        *stack_flows((model.free, *model.stuck), problem.omega),
-        model.matrix, np.ascontiguousarray(model.load), np.ascontiguousarray(model.static), problem.omega, problem.period,
-        gapw, velw, kickw, model.clearances, model.restitutions, model.masses, model.simple, signs,
-        np.ascontiguousarray(model.hold_weights.reshape(count, n)), model.hold_offsets, model.hold_harmonics, model.force_tolerances,
-        model.bounce, model.stick, model.touch,
-        law.sticking_velocity, law.max_impacts, 1e-15 * length, 1e-14 * law.velocity_scale, nodes, weights,
+    arguments = LoopArguments(
+        **stack_flows((model.free, *model.stuck), problem.omega)._asdict(),
+        a_matrix=model.matrix, load=np.ascontiguousarray(model.load), static=np.ascontiguousarray(model.static), omega=problem.omega, period=problem.period,
+        gapw=gapw, velw=velw, kickw=kickw, clearances=model.clearances, restitutions=model.restitutions, masses=model.masses, simple=model.simple, signs=signs,
+        hold_w=np.ascontiguousarray(model.hold_weights.reshape(count, n)), hold_off=model.hold_offsets, hold_har=model.hold_harmonics,
+        force_tolerances=model.force_tolerances, bounce=model.bounce, stick=model.stick, touch=model.touch,
+        sticking_velocity=law.sticking_velocity, max_impacts=law.max_impacts, tolerance=1e-15 * length, resolution_velocity=1e-14 * law.velocity_scale,
+        gl_nodes=nodes, gl_weights=weights,
     )  # fmt: skip
-    a = arguments
-    return _Setup(law, model, arguments, (*a[:11], a[19], a[21], a[24], a[27], a[28]))
+    return _Setup(law, model, arguments, leading_arguments(exact_core.sample_states, arguments))
 
 
 class ExactEngine:

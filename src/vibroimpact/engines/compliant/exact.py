@@ -38,6 +38,7 @@ from vibroimpact.engines.compliant import exact_loop
 from vibroimpact.engines.compliant.model import MODE_CONTACT
 from vibroimpact.engines.exact import StrobeMap, chained_jacobian, stack_flows
 from vibroimpact.engines.exact_flows import Flow, mechanical_null_basis, unforced_flow, with_harmonic
+from vibroimpact.engines.kernel_arguments import BumperLoopArguments, leading_arguments
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.engines.registry import ENGINES, Capabilities
 from vibroimpact.engines.settings import EngineSettings
@@ -123,9 +124,11 @@ def _in_contact(mask: int, count: int) -> Iterator[None]:
 
 @dataclass(frozen=True, eq=False)
 class _Setup:
-    """What the compiled loop needs of one problem, as its leading arguments, and the flows for sampling."""
+    """What the compiled loop needs of one problem, as its leading arguments, and the flows for sampling (the leading
+    arguments of :func:`~vibroimpact.engines.compliant.exact_loop.sample_pieces`, picked from ``arguments`` by its
+    parameter names)."""
 
-    arguments: tuple
+    arguments: BumperLoopArguments
     sampling: tuple
 
 
@@ -156,12 +159,12 @@ def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
     velocity = problem.velocity_scale()
     force_tolerances = 1e-15 * (k_b * length + b_b * velocity)
     nodes, weights = gauss_legendre(16)
-    stacked = stack_flows(flows, problem.omega)
-    arguments = (
-        *stacked, problem.omega, problem.period, obsw, obso, velw, salts, np.zeros(4 * count, dtype=complex),
-        1e-15 * length, force_tolerances, 10 * settings.max_impacts_per_period, nodes, weights,
+    arguments = BumperLoopArguments(
+        **stack_flows(flows, problem.omega)._asdict(), omega=problem.omega, period=problem.period, obsw=obsw, obso=obso, velw=velw, salts=salts,
+        zero_har=np.zeros(4 * count, dtype=complex), gap_tolerance=1e-15 * length, force_tolerances=force_tolerances,
+        max_events=10 * settings.max_impacts_per_period, gl_nodes=nodes, gl_weights=weights,
     )  # fmt: skip
-    return _Setup(arguments, (*stacked[:11], problem.omega))
+    return _Setup(arguments, leading_arguments(exact_loop.sample_pieces, arguments))
 
 
 class CompliantExactEngine:
