@@ -10,7 +10,8 @@ polynomial part z0 + q1 tau + q2 tau^2 from the projector ``zpros[f]``, the nilp
 ``zdrvs[f]``, ``zdrv2s[f]``.
 
 numba's disk cache keys a compiled function on its own source file only; the compiled functions of a module that
-calls these kernels are stamped with this file's source as well (:mod:`~vibroimpact.engines.numba_cache`).
+calls these kernels (or reads these constants) are stamped with this file's source as well, as these would be with
+the sources of any other module they read (:mod:`~vibroimpact.engines.numba_cache`).
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ import math
 
 import numpy as np
 from numba import njit
+
+from vibroimpact.engines.numba_cache import stamp_with_callees
 
 __all__ = ["NONE", "ZERO", "YES", "modal_coordinates", "polynomial_part", "piece_state", "observable", "halve_pairs"]
 
@@ -116,3 +119,6 @@ def halve_pairs(lams, f, m, amp, out, row):
         elif lams[f, i].imag == 0.0:
             out[row, count] = amp[0, i]
             count += 1
+
+
+stamp_with_callees(globals())

@@ -7,7 +7,9 @@ interior maximum (a closest approach).
 An observable is indexed in stacked arrays, never sliced: rates ``rates[rr, :rc]``, amplitudes ``amp[ar]``.
 
 numba's disk cache keys a compiled function on its own source file only; the compiled functions of a module that
-calls these kernels are stamped with this file's source as well (:mod:`~vibroimpact.engines.numba_cache`).
+calls these kernels are stamped with this file's source as well, and these with the source of
+:mod:`~vibroimpact.engines.exact_pieces`, whose ``ZERO`` they hold as a constant
+(:mod:`~vibroimpact.engines.numba_cache`).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import numpy as np
 from numba import njit
 
 from vibroimpact.engines.exact_pieces import ZERO
+from vibroimpact.engines.numba_cache import stamp_with_callees
 
 __all__ = ["observable_value", "observable_derivatives", "escape_step", "round_off_band", "first_crossing", "closest_approach"]
 
@@ -228,3 +231,6 @@ def closest_approach(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, ta, tb
                 best[0], best[1], best[2] = d[0], lo, stop
             observable_derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, d)
         slope_prev, t_prev = d[1], t
+
+
+stamp_with_callees(globals())

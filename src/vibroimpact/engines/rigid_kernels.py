@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines.base import TrajectoryBuilder, check_run
 from vibroimpact.engines.flow_layout import FlowLayout
+from vibroimpact.engines.numba_cache import stamp_with_callees
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.sundae import as_doubles, content_data
 from vibroimpact.model.contact import Impact, RigidStop
@@ -331,3 +332,8 @@ class RigidContact:
         out = np.array(state, dtype=float)
         out[self.size : 2 * self.size] -= impulse * self.kicks[stop]
         return out
+
+
+# the compiled kernels read sundae's intrinsics: an edit of it recompiles them (not the ``cfunc`` callbacks above: they
+# compiled or loaded as they were defined, see numba_cache's docstring)
+stamp_with_callees(globals())
