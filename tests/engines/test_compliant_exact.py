@@ -298,15 +298,15 @@ def test_a_new_frequency_keeps_the_contact_modes_and_gives_the_same_flows() -> N
     frequency) are kept, only the harmonic particular solution is made again, and the flows equal those made with
     nothing kept (the same operations on the same numbers: to the last bit, as the golden suite holds them against
     the decomposition before it was split)."""
-    from vibroimpact.engines.compliant.exact import _contact_modes, bumper_flows
+    from vibroimpact.engines.compliant.exact import contact_modes, bumper_flows
 
     law = KelvinVoigtBumper(PAPER_CLEARANCE, 731.0, loss_factor_from_restitution(0.37))  # a bumper no other test has
     first, second = (ImpactProblem(PAPER_SYSTEM, law, HarmonicForce(PAPER_AMPLITUDE, f)) for f in (24.0, 24.5))
     bumper_flows(first)
-    hits = _contact_modes.cache_info().hits
+    hits = contact_modes.cache_info().hits
     kept, *_ = bumper_flows(second)
-    assert _contact_modes.cache_info().hits == hits + 1
-    _contact_modes.cache_clear()
+    assert contact_modes.cache_info().hits == hits + 1
+    contact_modes.cache_clear()
     fresh, *_ = bumper_flows(second)
     assert len(kept) == len(fresh) == 2
     for a, b in zip(kept, fresh):

@@ -30,13 +30,14 @@ from vibroimpact.engines import exact_core, exact_moments
 from vibroimpact.engines.base import MODE_STUCK, Trajectory, check_run
 from vibroimpact.engines.exact_flows import Flow, ExactModel, build_model
 from vibroimpact.engines.exact_python import PythonExactEngine
+from vibroimpact.engines.kernel_arguments import LoopArguments, StackedFlows, leading_arguments
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.engines.rigid_kernels import RigidContact
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["ExactEngine", "StrobeMap", "chained_jacobian", "stack_flows"]
+__all__ = ["ExactEngine", "StrobeMap", "chained_jacobian", "loop_setup", "stack_flows"]
 
 
 def chained_jacobian(factors: NDArray[np.float64], size: int) -> NDArray[np.float64]:
@@ -101,9 +102,10 @@ def _half(lam: NDArray[np.complex128]) -> NDArray[np.complex128]:
     return lam[lam.imag >= 0.0]
 
 
-def stack_flows(flows: tuple[Flow, ...], omega: float) -> tuple:
-    """The flows as the compiled loops' stacked arrays (see :mod:`~vibroimpact.engines.exact_core`): flow f is entry f of
-    each array (the exact engine's free and held flights; the bumper engine's contact modes)."""
+def stack_flows(flows: tuple[Flow, ...], omega: float) -> StackedFlows:
+    """The flows as the compiled loops' stacked arrays (see :mod:`~vibroimpact.engines.exact_core`), by the loops'
+    parameter names: flow f is entry f of each array (the exact engine's free and held flights; the bumper engine's
+    contact modes); ``omega`` [rad s-1]."""
     count, n = len(flows), flows[0].harmonic.size
     widest = max(flow.eigenvalues.size for flow in flows)
     lams = np.zeros((count, widest), dtype=complex)
@@ -128,7 +130,10 @@ def stack_flows(flows: tuple[Flow, ...], omega: float) -> tuple:
     zdrv2s = np.array([flow.drift2 for flow in flows], dtype=float).reshape(count, n)
     polys = np.array([flow.polynomial for flow in flows], dtype=np.bool_)
     fastests = np.array([omega + (float(np.max(np.abs(flow.eigenvalues))) if flow.eigenvalues.size else 0.0) for flow in flows])
-    return (lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates, rinv, fastests)
+    return StackedFlows(
+        lams=lams, counts=counts, vecs=vecs, invs=invs, hrms=hrms, csts=csts, zpros=zpros, znils=znils, zdrvs=zdrvs, zdrv2s=zdrv2s,
+        polys=polys, hlams=hlams, hcounts=hcounts, rates_all=rates, rinv_all=rinv, fastests=fastests,
+    )  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
@@ -137,13 +142,14 @@ class _Setup:
 
     law: RigidContact
     model: ExactModel
-    arguments: tuple
-    #: the leading arguments of :func:`~vibroimpact.engines.exact_core.sample_states`: the flows, the stops' gaps
+    arguments: LoopArguments
+    #: the leading arguments of :func:`~vibroimpact.engines.exact_core.sample_states`, picked from ``arguments`` by
+    #: its parameter names: the flows, the stops' gaps
     sampling: tuple
 
 
 @lru_cache(maxsize=512)
-def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
+def loop_setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
     """Once per problem (continuation and Lyapunov runs call the map of one problem thousands of times)."""
     law = RigidContact("exact", problem, settings, 0)
     length = law.length_scale
@@ -156,16 +162,16 @@ def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
     kickw = np.ascontiguousarray(np.hstack([zero, model.kicks]))
     signs = np.array([model.normals[k, i] if i >= 0 else 0.0 for k, i in enumerate(model.simple)])
     nodes, weights = gauss_legendre(16)
-    arguments = (
-        *stack_flows((model.free, *model.stuck), problem.omega),
-        model.matrix, np.ascontiguousarray(model.load), np.ascontiguousarray(model.static), problem.omega, problem.period,
-        gapw, velw, kickw, model.clearances, model.restitutions, model.masses, model.simple, signs,
-        np.ascontiguousarray(model.hold_weights.reshape(count, n)), model.hold_offsets, model.hold_harmonics, model.force_tolerances,
-        model.bounce, model.stick, model.touch,
-        law.sticking_velocity, law.max_impacts, 1e-15 * length, 1e-14 * law.velocity_scale, nodes, weights,
+    arguments = LoopArguments(
+        **stack_flows((model.free, *model.stuck), problem.omega)._asdict(),
+        a_matrix=model.matrix, load=np.ascontiguousarray(model.load), static=np.ascontiguousarray(model.static), omega=problem.omega, period=problem.period,
+        gapw=gapw, velw=velw, kickw=kickw, clearances=model.clearances, restitutions=model.restitutions, masses=model.masses, simple=model.simple, signs=signs,
+        hold_w=np.ascontiguousarray(model.hold_weights.reshape(count, n)), hold_off=model.hold_offsets, hold_har=model.hold_harmonics,
+        force_tolerances=model.force_tolerances, bounce=model.bounce, stick=model.stick, touch=model.touch,
+        sticking_velocity=law.sticking_velocity, max_impacts=law.max_impacts, tolerance=1e-15 * length, resolution_velocity=1e-14 * law.velocity_scale,
+        gl_nodes=nodes, gl_weights=weights,
     )  # fmt: skip
-    a = arguments
-    return _Setup(law, model, arguments, (*a[:11], a[19], a[21], a[24], a[27], a[28]))
+    return _Setup(law, model, arguments, leading_arguments(exact_core.sample_states, arguments))
 
 
 class ExactEngine:
@@ -180,7 +186,7 @@ class ExactEngine:
 
     def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, jacobians: bool, approach: bool) -> tuple:
         check_run(self.name, problem, RigidStop, periods)
-        setup = _setup(problem, self.settings)
+        setup = loop_setup(problem, self.settings)
         state = np.array(state, dtype=float, order="C")  # a writable copy: one compiled overload (a read-only array would compile another, ~10 s)
         if state.shape != (2 * problem.size,):
             raise ValueError(f"state: expected {2 * problem.size} values (x and x' of {problem.size} coordinates), got shape {state.shape}")
@@ -266,7 +272,7 @@ class ExactEngine:
         segments = trajectory.segments
         if segments.shape[0] == 0:
             raise ValueError("the trajectory has no segments (0 periods): there is nothing to sample")
-        setup = _setup(trajectory.problem, self.settings)
+        setup = loop_setup(trajectory.problem, self.settings)
         pieces = np.clip(np.searchsorted(segments[:, 0], times, side=side) - 1, 0, segments.shape[0] - 1)  # type: ignore[call-overload]
         flows = np.where(segments[:, 2] == MODE_STUCK, trajectory.segment_stops + 1, 0).astype(np.int64)
         starts = np.ascontiguousarray(segments[:, 0])
@@ -286,7 +292,7 @@ class ExactEngine:
     def model(self, problem: ImpactProblem) -> ExactModel:
         """The flows and stop maps the engine prepared for ``problem`` (cached per problem)."""
         check_run(self.name, problem, RigidStop)
-        return _setup(problem, self.settings).model
+        return loop_setup(problem, self.settings).model
 
 
 def _stats(counters: NDArray[np.int64], impacts: int) -> dict[str, int]:

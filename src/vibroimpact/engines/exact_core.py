@@ -40,19 +40,19 @@ import math
 import numpy as np
 from numba import njit
 
-from vibroimpact.engines.exact_moments import _add_moments, _add_moments_gl
-from vibroimpact.engines.exact_pieces import _NONE, _ZERO, _halve, _modal, _observable, _rigid, _state
-from vibroimpact.engines.exact_roots import _closest_approach, _escape_step, _first_crossing, _round_off, _value
+from vibroimpact.engines.exact_moments import add_moments, add_moments_gl
+from vibroimpact.engines.exact_pieces import NONE, ZERO, halve_pairs, modal_coordinates, observable, piece_state, polynomial_part
+from vibroimpact.engines.exact_roots import closest_approach, escape_step, first_crossing, observable_value, round_off_band
 from vibroimpact.engines.numba_cache import stamp_with_callees
 
-__all__ = ["run_periods", "sample_states", "STATUS_OK", "STATUS_NO_PROGRESS", "STATUS_TWO_STICKS"]
+__all__ = ["run_periods", "sample_states", "STATUS_OK", "STATUS_NO_PROGRESS", "STATUS_TWO_STICKS", "transition_matrix", "left_multiply", "grow_rows"]
 
 STATUS_OK, STATUS_NO_PROGRESS, STATUS_TWO_STICKS = 0, 1, 2
 
 
 # ------------------------------------------------------------------------------------ Jacobians, stops, bookkeeping
 @njit(cache=True, error_model="numpy")
-def _transition(lams, vecs, invs, f, m, dt, poly, zpros, znils, out):
+def transition_matrix(lams, vecs, invs, f, m, dt, poly, zpros, znils, out):
     """exp(A dt) of flow f: Re(V diag(e^{lam dt}) V^+) (+ P_z + A_z dt), into ``out`` (n x n)."""
     n = out.shape[0]
     for r in range(n):
@@ -71,7 +71,7 @@ def _transition(lams, vecs, invs, f, m, dt, poly, zpros, znils, out):
 
 
 @njit(cache=True, error_model="numpy")
-def _left_multiply(factor, jac, work):
+def left_multiply(factor, jac, work):
     """jac <- factor @ jac (n x n), through ``work``."""
     n = jac.shape[0]
     for r in range(n):
@@ -134,7 +134,7 @@ def _saltation(jumps, stop, a_matrix, load, static, omega, t, before, after, vel
 
 
 @njit(cache=True, error_model="numpy")
-def _grow(array, rows):
+def grow_rows(array, rows):
     bigger = np.empty((max(2 * array.shape[0], rows),) + array.shape[1:], dtype=array.dtype)
     bigger[: array.shape[0]] = array
     return bigger
@@ -174,15 +174,15 @@ def _pushed(stop, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdr
     modal = np.empty(m, dtype=np.complex128)
     amp = np.empty((1, m), dtype=np.complex128)
     z0, q1, q2 = np.zeros(n), np.zeros(n), np.zeros(n)
-    _modal(lams, invs, hrms, csts, f, m, omega, t, y, modal)
+    modal_coordinates(lams, invs, hrms, csts, f, m, omega, t, y, modal)
     if polys[f]:
-        _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t, y, z0, q1, q2)
-    har, con, p1, p2 = _observable(hold_w, stop, hold_off[stop], hold_har[stop], vecs, hrms, csts, f, m, modal, amp, polys[f], z0, q1, q2)
-    value = _value(lams, f, m, amp, _ZERO, har, con, p1, p2, omega, t, t)
+        polynomial_part(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t, y, z0, q1, q2)
+    har, con, p1, p2 = observable(hold_w, stop, hold_off[stop], hold_har[stop], vecs, hrms, csts, f, m, modal, amp, polys[f], z0, q1, q2)
+    value = observable_value(lams, f, m, amp, ZERO, har, con, p1, p2, omega, t, t)
     if abs(value) > 64.0 * force_tolerance:
         return value < 0.0
-    band = _round_off(m, amp, _ZERO, har, con, p1, p2, 0.0, force_tolerance)  # as the held search will allow
-    return _escape_step(lams, f, m, amp, _ZERO, har, con, p1, p2, omega, t, t, band) >= 0.0
+    band = round_off_band(m, amp, ZERO, har, con, p1, p2, 0.0, force_tolerance)  # as the held search will allow
+    return escape_step(lams, f, m, amp, ZERO, har, con, p1, p2, omega, t, t, band) >= 0.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -241,7 +241,7 @@ def run_periods(
     t = t_start
     jac = np.eye(n)
     # is the start held (at rest on a stop that pushes)?
-    stuck = _NONE
+    stuck = NONE
     for j in range(stops):
         speed = 0.0
         for r in range(n):
@@ -288,23 +288,23 @@ def run_periods(
             t_piece = t
             f = stuck + 1
             m, hm, poly = counts[f], hcounts[f], polys[f]
-            _modal(lams, invs, hrms, csts, f, m, omega, t, y, modal)
+            modal_coordinates(lams, invs, hrms, csts, f, m, omega, t, y, modal)
             if poly:
-                _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t, y, z0, q1, q2)
+                polynomial_part(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t, y, z0, q1, q2)
             for j in range(stops):
                 if j == stuck:
-                    har, con, p1, p2 = _observable(hold_w, j, hold_off[j], hold_har[j], vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
+                    har, con, p1, p2 = observable(hold_w, j, hold_off[j], hold_har[j], vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
                     leave[j] = True  # a fresh stick's holding force starts by leaving zero (or the start is held)
                 else:
-                    har, con, p1, p2 = _observable(gapw, j, -clearances[j], 0j, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
+                    har, con, p1, p2 = observable(gapw, j, -clearances[j], 0j, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
                     leave[j] = _gap(gapw, clearances, j, y) >= -tolerance  # at the surface: the search starts by leaving it
                 hars[j], cons[j], p1s[j], p2s[j] = har, con, p1, p2
-                _halve(lams, f, m, amp, hamps, j)
+                halve_pairs(lams, f, m, amp, hamps, j)
                 if leave[j]:
                     events_at[j] = t
             if n_segments == segments.shape[0]:
-                segments = _grow(segments, n_segments + 1)
-                segment_states = _grow(segment_states, n_segments + 1)
+                segments = grow_rows(segments, n_segments + 1)
+                segment_states = grow_rows(segment_states, n_segments + 1)
             segments[n_segments, 0], segments[n_segments, 1], segments[n_segments, 2] = t, 1.0 if stuck >= 0 else 0.0, stuck
             for r in range(n):
                 segment_states[n_segments, r] = y[r]
@@ -312,10 +312,10 @@ def run_periods(
             fresh = False  # the piece lasts until the next event, across period boundaries
         counters[0] += 1
         t_event = math.nan
-        event = _NONE
+        event = NONE
         limit = boundary
         for j in range(stops):
-            found = _first_crossing(hlams, f, hm, hamps, j, hars[j], cons[j], p1s[j], p2s[j], omega, t_piece, t, limit, force_tolerances[j] if j == stuck else tolerance, leave[j])
+            found = first_crossing(hlams, f, hm, hamps, j, hars[j], cons[j], p1s[j], p2s[j], omega, t_piece, t, limit, force_tolerances[j] if j == stuck else tolerance, leave[j])
             leave[j] = False
             if not math.isnan(found) and (event < 0 or found < t_event):
                 t_event, event, limit = found, j, found
@@ -324,17 +324,17 @@ def run_periods(
         if t_end > t:
             if want_moments:
                 if poly:
-                    _add_moments_gl(moments, k - 1, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, fastests[f], gl_nodes, gl_weights, hold_w, hold_off, hold_har, size, stops, z0, q1, q2, ybuf)
+                    add_moments_gl(moments, k - 1, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, fastests[f], gl_nodes, gl_weights, hold_w, hold_off, hold_har, size, stops, z0, q1, q2, ybuf)
                 else:
-                    _add_moments(moments, k - 1, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, rates_all, rinv_all, buffers, hold_w, hold_off, hold_har, size, stops)
+                    add_moments(moments, k - 1, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, rates_all, rinv_all, buffers, hold_w, hold_off, hold_har, size, stops)
             if want_approach:
                 for j in range(stops):
                     if j != stuck:
-                        _closest_approach(hlams, f, hm, hamps, j, hars[j], cons[j], p1s[j], p2s[j], omega, t_piece, t, t_end, fastests[f], approach, j)
+                        closest_approach(hlams, f, hm, hamps, j, hars[j], cons[j], p1s[j], p2s[j], omega, t_piece, t, t_end, fastests[f], approach, j)
             if want_jacobians:
-                _transition(lams, vecs, invs, f, m, t_end - t, poly, zpros, znils, phi)
-                _left_multiply(phi, jac, work)
-        _state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t_end, ynew, poly, z0, q1, q2)
+                transition_matrix(lams, vecs, invs, f, m, t_end - t, poly, zpros, znils, phi)
+                left_multiply(phi, jac, work)
+        piece_state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t_end, ynew, poly, z0, q1, q2)
         for j in range(stops):
             if j != stuck and _gap(gapw, clearances, j, ynew) > 0.0:
                 _snap(gapw, clearances, simple, signs, j, ynew)  # round-off beyond a stop is the stop
@@ -361,12 +361,12 @@ def run_periods(
         fresh = True
         if event == stuck:
             counters[3] += 1
-            stuck = _NONE  # release: continuous state and vector field, saltation = identity
+            stuck = NONE  # release: continuous state and vector field, saltation = identity
             continue
         # an impact on stop ``event`` (from free flight, or while held on another stop, which it frees unless that
         # stop holds on after the impulse)
         held_before = stuck
-        stuck = _NONE
+        stuck = NONE
         j = event
         impacts_period[j] += 1
         counters[1] += 1
@@ -425,11 +425,11 @@ def run_periods(
                 _saltation(stick, j, a_matrix, load, static, omega, t, before, y, velocity, held_before, held_after, gapw, velw, kickw, masses, simple, salt)
             else:
                 _saltation(touch, j, a_matrix, load, static, omega, t, before, y, velocity, held_before, held_after, gapw, velw, kickw, masses, simple, salt)
-            _left_multiply(salt, jac, work)
+            left_multiply(salt, jac, work)
         impulse = masses[j] * (velocity - after)
         if velocity > 0.0:
             if n_impacts == impacts.shape[0]:
-                impacts = _grow(impacts, n_impacts + 1)
+                impacts = grow_rows(impacts, n_impacts + 1)
             impacts[n_impacts, 0], impacts[n_impacts, 1], impacts[n_impacts, 2], impacts[n_impacts, 3] = t, velocity, impulse, j
             n_impacts += 1
             if want_moments:
@@ -446,7 +446,7 @@ def run_periods(
 def sample_states(lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, omega, gapw, clearances, simple, signs, starts, flows, states, times, pieces):
     """The states at ``times`` on the pieces of a run, exact: piece ``pieces[i]`` (start time ``starts[p]``, state
     ``states[p]`` there, flow ``flows[p]``: 0 free, 1 + k held on stop k) is evaluated at ``times[i]`` as the loop
-    evaluates it (modal coordinates at the piece's start, :func:`_state`, round-off beyond a stop not held snapped
+    evaluates it (modal coordinates at the piece's start, :func:`piece_state`, round-off beyond a stop not held snapped
     onto it), so a time on a strobe gives the strobe state. Returns (len(times), n)."""
     count = times.size
     n = states.shape[1]
@@ -454,18 +454,18 @@ def sample_states(lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdr
     modal = np.empty(lams.shape[1], dtype=np.complex128)
     z0, q1, q2 = np.zeros(n), np.zeros(n), np.zeros(n)
     y = np.empty(n)
-    current = _NONE
+    current = NONE
     for i in range(count):
         p = pieces[i]
         f = flows[p]
         m = counts[f]
         poly = polys[f]
         if p != current:
-            _modal(lams, invs, hrms, csts, f, m, omega, starts[p], states[p], modal)
+            modal_coordinates(lams, invs, hrms, csts, f, m, omega, starts[p], states[p], modal)
             if poly:
-                _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, starts[p], states[p], z0, q1, q2)
+                polynomial_part(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, starts[p], states[p], z0, q1, q2)
             current = p
-        _state(lams, vecs, hrms, csts, f, m, omega, starts[p], modal, times[i], y, poly, z0, q1, q2)
+        piece_state(lams, vecs, hrms, csts, f, m, omega, starts[p], modal, times[i], y, poly, z0, q1, q2)
         for j in range(clearances.size):
             if j != f - 1 and _gap(gapw, clearances, j, y) > 0.0:
                 _snap(gapw, clearances, simple, signs, j, y)  # round-off beyond a stop is the stop

@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import resonance_refusal
 
-__all__ = ["Flow", "decompose", "unforced_flow", "with_harmonic", "mechanical_null_basis", "numeric_null_basis", "ExactModel", "build_model"]
+__all__ = ["Flow", "decompose", "unforced_flow", "with_harmonic", "mechanical_null_basis", "ExactModel", "build_model"]
 
 #: Relative size below which an eigenvalue of K (or of the damping on its null space) counts as zero.
 _ZERO = 1e-12

@@ -14,10 +14,10 @@ import math
 import numpy as np
 from numba import njit
 
-from vibroimpact.engines.exact_pieces import _NONE, _YES, _state
+from vibroimpact.engines.exact_pieces import NONE, YES, piece_state
 from vibroimpact.engines.numba_cache import stamp_with_callees
 
-__all__ = ["moment_rates"]
+__all__ = ["moment_rates", "coordinate_amplitudes", "weighted_amplitudes", "piece_factors", "moment_integrals", "add_moments", "add_moments_gl"]
 
 
 # ---------------------------------------------------------------------------------------------------------- moments
@@ -51,7 +51,7 @@ def moment_rates(lam, omega):
 
 
 @njit(cache=True, error_model="numpy")
-def _amplitudes(vecs, hrms, f, m, modal, omega, t0, coordinate, amps):
+def coordinate_amplitudes(vecs, hrms, f, m, modal, omega, t0, coordinate, amps):
     """Coordinate ``coordinate`` of the piece as sum_k amps_k e^{rates_k (t - t0)} plus a constant: the modal terms
     (their sum is real) and the harmonic Re(Y e^{jwt}) as two conjugate halves."""
     for i in range(m):
@@ -61,8 +61,8 @@ def _amplitudes(vecs, hrms, f, m, modal, omega, t0, coordinate, amps):
 
 
 @njit(cache=True, error_model="numpy")
-def _weighted_amplitudes(vecs, hrms, f, m, modal, omega, t0, weights, row, extra, amps):
-    """As :func:`_amplitudes` for minus the observable weights[row] . y + Re(extra e^{jwt}) (the holding force)."""
+def weighted_amplitudes(vecs, hrms, f, m, modal, omega, t0, weights, row, extra, amps):
+    """As :func:`coordinate_amplitudes` for minus the observable weights[row] . y + Re(extra e^{jwt}) (the holding force)."""
     harmonic = extra
     for r in range(weights.shape[1]):
         harmonic += weights[row, r] * hrms[f, r]
@@ -76,7 +76,7 @@ def _weighted_amplitudes(vecs, hrms, f, m, modal, omega, t0, weights, row, extra
 
 
 @njit(cache=True, error_model="numpy")
-def _piece_factors(rates_all, rinv_all, f, m, omega, a, length, pair, single, fourier, ea, el):
+def piece_factors(rates_all, rinv_all, f, m, omega, a, length, pair, single, fourier, ea, el):
     """E(s) = int_a^{a+L} e^{s u} du = e^{s a} (e^{s L} - 1) / s for every sum of two rates (``pair``), every rate
     (``single``) and every rate - jw (``fourier``; the last entry: the constant's, s = -jw); near s L = 0 by the series.
     Every exponential is a product of the m exponentials e^{r_k a}, e^{r_k L} of this piece (rates of flow f)."""
@@ -102,7 +102,7 @@ def _piece_factors(rates_all, rinv_all, f, m, omega, a, length, pair, single, fo
 
 
 @njit(cache=True, error_model="numpy")
-def _integrals(amps, m, constant, length, pair, single, fourier, phasor, out, row, slot_fourier, slot_square):
+def moment_integrals(amps, m, constant, length, pair, single, fourier, phasor, out, row, slot_fourier, slot_square):
     """Add int x e^{-jwt} dt (``phasor`` = e^{-jw t0}) to out[row, slot_fourier] and int x^2 dt to
     out[row, slot_square] (if >= 0) for x = sum_k amps_k e^{rates_k u} + constant (k < m), from the piece's factors."""
     total = constant * fourier[m]
@@ -120,29 +120,29 @@ def _integrals(amps, m, constant, length, pair, single, fourier, phasor, out, ro
 
 
 @njit(cache=True, error_model="numpy")
-def _add_moments(out, row, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, ta, tb, rates_all, rinv_all, buffers, hold_w, hold_off, hold_har, size, stops):
+def add_moments(out, row, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, ta, tb, rates_all, rinv_all, buffers, hold_w, hold_off, hold_har, size, stops):
     """Add the piece's Fourier and square integrals over [ta, tb] to the period's row ``out[row]``, in closed form
     (the motion is a sum of exponentials): each coordinate times e^{-jwt}, the holding force times e^{-jwt} while
     held, each coordinate squared."""
     mm = m + 2
     amps, pair, single, fourier, ea, el = buffers
     a, length = ta - t_piece, tb - ta
-    _piece_factors(rates_all, rinv_all, f, mm, omega, a, length, pair, single, fourier, ea, el)
+    piece_factors(rates_all, rinv_all, f, mm, omega, a, length, pair, single, fourier, ea, el)
     phasor = complex(math.cos(omega * t_piece), -math.sin(omega * t_piece))
     for i in range(size):
-        _amplitudes(vecs, hrms, f, m, modal, omega, t_piece, i, amps)
-        _integrals(amps, mm, csts[f, i], length, pair, single, fourier, phasor, out, row, i, size + stops + i)
+        coordinate_amplitudes(vecs, hrms, f, m, modal, omega, t_piece, i, amps)
+        moment_integrals(amps, mm, csts[f, i], length, pair, single, fourier, phasor, out, row, i, size + stops + i)
     if stuck >= 0:
-        _weighted_amplitudes(vecs, hrms, f, m, modal, omega, t_piece, hold_w, stuck, hold_har[stuck], amps)
+        weighted_amplitudes(vecs, hrms, f, m, modal, omega, t_piece, hold_w, stuck, hold_har[stuck], amps)
         constant = hold_off[stuck]
         for r in range(hold_w.shape[1]):
             constant += hold_w[stuck, r] * csts[f, r]
-        _integrals(amps, mm, -constant, length, pair, single, fourier, phasor, out, row, size + stuck, _NONE)
+        moment_integrals(amps, mm, -constant, length, pair, single, fourier, phasor, out, row, size + stuck, NONE)
 
 
 @njit(cache=True, error_model="numpy")
-def _add_moments_gl(out, row, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, ta, tb, fastest, nodes, weights, hold_w, hold_off, hold_har, size, stops, z0, q1, q2, y):
-    """As :func:`_add_moments` for a flow with rigid-body (polynomial) terms, by Gauss-Legendre quadrature on chunks
+def add_moments_gl(out, row, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, ta, tb, fastest, nodes, weights, hold_w, hold_off, hold_har, size, stops, z0, q1, q2, y):
+    """As :func:`add_moments` for a flow with rigid-body (polynomial) terms, by Gauss-Legendre quadrature on chunks
     of at most 2 / (|lambda|max + w) [s]: exact for the polynomial parts (degree <= 4 in the squares), to round-off
     for the exponentials."""
     chunks = max(1, int(math.ceil(fastest * (tb - ta) / 2.0)))
@@ -152,7 +152,7 @@ def _add_moments_gl(out, row, stuck, lams, vecs, hrms, csts, f, m, modal, omega,
         for q in range(nodes.size):
             t = a + (b - a) * nodes[q]
             w = (b - a) * weights[q]
-            _state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t, y, _YES, z0, q1, q2)
+            piece_state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t, y, YES, z0, q1, q2)
             phasor = complex(math.cos(omega * t), -math.sin(omega * t))
             for i in range(size):
                 out[row, i] += w * y[i] * phasor

@@ -10,7 +10,8 @@ polynomial part z0 + q1 tau + q2 tau^2 from the projector ``zpros[f]``, the nilp
 ``zdrvs[f]``, ``zdrv2s[f]``.
 
 numba's disk cache keys a compiled function on its own source file only; the compiled functions of a module that
-calls these kernels are stamped with this file's source as well (:mod:`~vibroimpact.engines.numba_cache`).
+calls these kernels (or reads these constants) are stamped with this file's source as well, as these would be with
+the sources of any other module they read (:mod:`~vibroimpact.engines.numba_cache`).
 """
 
 from __future__ import annotations
@@ -20,17 +21,19 @@ import math
 import numpy as np
 from numba import njit
 
-__all__: list[str] = []
+from vibroimpact.engines.numba_cache import stamp_with_callees
+
+__all__ = ["NONE", "ZERO", "YES", "modal_coordinates", "polynomial_part", "piece_state", "observable", "halve_pairs"]
 
 #: -1 (no stop, no event), 0 and True as typed values, not literals: numba compiles a callee once per literal argument
 #: (and a variable first set to a literal is typed as one in the first pass of type inference), so each literal call
 #: site compiled its callees a second time (17 of the 56 compilations of a cold start).
-_NONE, _ZERO, _YES = np.int64(-1), np.int64(0), np.bool_(True)
+NONE, ZERO, YES = np.int64(-1), np.int64(0), np.bool_(True)
 
 
 # ------------------------------------------------------------------------------------------------ a piece of flow f
 @njit(cache=True, error_model="numpy")
-def _modal(lams, invs, hrms, csts, f, m, omega, t0, y0, out):
+def modal_coordinates(lams, invs, hrms, csts, f, m, omega, t0, y0, out):
     """Modal coordinates of the homogeneous part of flow f through y0 at t0, into ``out[:m]``."""
     phasor = complex(math.cos(omega * t0), math.sin(omega * t0))
     for r in range(m):
@@ -42,7 +45,7 @@ def _modal(lams, invs, hrms, csts, f, m, omega, t0, y0, out):
 
 
 @njit(cache=True, error_model="numpy")
-def _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t0, y0, z0, q1, q2):
+def polynomial_part(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t0, y0, z0, q1, q2):
     """The polynomial part through y0 at t0: z0 = P_z (y0 - p(t0)), q1 = A_z z0 + c, q2 = A_z c / 2."""
     n = y0.size
     phasor = complex(math.cos(omega * t0), math.sin(omega * t0))
@@ -60,7 +63,7 @@ def _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t0, y0, z0, q1, q2
 
 
 @njit(cache=True, error_model="numpy")
-def _state(lams, vecs, hrms, csts, f, m, omega, t0, modal, t, out, poly, z0, q1, q2):
+def piece_state(lams, vecs, hrms, csts, f, m, omega, t0, modal, t, out, poly, z0, q1, q2):
     """The state of the piece at t, into ``out``."""
     phasor = complex(math.cos(omega * t), math.sin(omega * t))
     for r in range(out.size):
@@ -79,7 +82,7 @@ def _state(lams, vecs, hrms, csts, f, m, omega, t0, modal, t, out, poly, z0, q1,
 
 
 @njit(cache=True, error_model="numpy")
-def _observable(weights, row, offset, extra, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2):
+def observable(weights, row, offset, extra, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2):
     """h = weights[row] . y + offset (+ Re(extra e^{jwt})) of the piece with ``modal`` coordinates: amplitudes into
     ``amp[0, :m]``; returns (har, con, p1, p2)."""
     n = weights.shape[1]
@@ -105,7 +108,7 @@ def _observable(weights, row, offset, extra, vecs, hrms, csts, f, m, modal, amp,
 
 
 @njit(cache=True, error_model="numpy")
-def _halve(lams, f, m, amp, out, row):
+def halve_pairs(lams, f, m, amp, out, row):
     """Amplitudes on the half rates (Im >= 0) into ``out[row]``: Re(a e^{lt}) + Re(conj) = Re(2 a e^{lt}), so each pair
     is kept once, doubled (every evaluation of the observable then costs half)."""
     count = 0
@@ -116,3 +119,6 @@ def _halve(lams, f, m, amp, out, row):
         elif lams[f, i].imag == 0.0:
             out[row, count] = amp[0, i]
             count += 1
+
+
+stamp_with_callees(globals())

@@ -7,7 +7,9 @@ interior maximum (a closest approach).
 An observable is indexed in stacked arrays, never sliced: rates ``rates[rr, :rc]``, amplitudes ``amp[ar]``.
 
 numba's disk cache keys a compiled function on its own source file only; the compiled functions of a module that
-calls these kernels are stamped with this file's source as well (:mod:`~vibroimpact.engines.numba_cache`).
+calls these kernels are stamped with this file's source as well, and these with the source of
+:mod:`~vibroimpact.engines.exact_pieces`, whose ``ZERO`` they hold as a constant
+(:mod:`~vibroimpact.engines.numba_cache`).
 """
 
 from __future__ import annotations
@@ -17,14 +19,15 @@ import math
 import numpy as np
 from numba import njit
 
-from vibroimpact.engines.exact_pieces import _ZERO
+from vibroimpact.engines.exact_pieces import ZERO
+from vibroimpact.engines.numba_cache import stamp_with_callees
 
-__all__: list[str] = []
+__all__ = ["observable_value", "observable_derivatives", "escape_step", "round_off_band", "first_crossing", "closest_approach"]
 
 
 # ---------------------------------------------------------------- an observable: rates[rr, :rc], amplitudes amp[ar]
 @njit(cache=True, error_model="numpy")
-def _value(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t):
+def observable_value(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t):
     """h(t)."""
     total = har * complex(math.cos(omega * t), math.sin(omega * t))
     for i in range(rc):
@@ -34,7 +37,7 @@ def _value(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t):
 
 
 @njit(cache=True, error_model="numpy")
-def _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, out):
+def observable_derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, out):
     """h, h', ..., h^(len(out) - 1) at t."""
     forced = har * complex(math.cos(omega * t), math.sin(omega * t))
     jw = 1j * omega
@@ -103,12 +106,12 @@ def _step_data(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t):
 
 
 @njit(cache=True, error_model="numpy")
-def _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, band):
+def escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, band):
     """A step over which h stays < 0 from h(t) = 0 when h leaves the surface; -1.0 if it does not leave (orders up to
     4); with ``band`` >= 0 (h's round-off), a rise that peaks within it is stepped over (see linear_flow.escape_step
     and linear_flow.tangency_step)."""
     values = np.empty(5)
-    _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, values)
+    observable_derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, values)
     for k in range(1, 5):
         scale = _bound(rates, rr, rc, amp, ar, har, p1, p2, omega, t0, t, k)
         if values[k] < -1e-9 * scale:
@@ -131,7 +134,7 @@ def _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, band):
 
 
 @njit(cache=True, error_model="numpy")
-def _round_off(rc, amp, ar, har, con, p1, p2, tau, tolerance):
+def round_off_band(rc, amp, ar, har, con, p1, p2, tau, tolerance):
     """How accurately h can be evaluated at t0 + tau: ``tolerance``, or 1e-15 of its largest terms if that is more."""
     size = abs(har) + abs(con) + (abs(p1) + abs(p2) * tau) * tau
     for i in range(rc):
@@ -156,16 +159,16 @@ def _polish(h0, h1, h2):
 
 
 @njit(cache=True, error_model="numpy")
-def _first_crossing(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t_from, t_to, tolerance, leaving):
+def first_crossing(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t_from, t_to, tolerance, leaving):
     """First time in (t_from, t_to] at which h reaches 0 from below; NaN if none (see linear_flow.first_crossing)."""
-    tolerance = _round_off(rc, amp, ar, har, con, p1, p2, t_from - t0, tolerance)
+    tolerance = round_off_band(rc, amp, ar, har, con, p1, p2, t_from - t0, tolerance)
     pair = np.empty(2)
     t = t_from
     if leaving:
-        if _value(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t) >= -tolerance:
-            step = _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, tolerance)
+        if observable_value(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t) >= -tolerance:
+            step = escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, tolerance)
             if step < 0.0:
-                if _bound(rates, rr, rc, amp, ar, har, 0.0, 0.0, omega, t0, t, _ZERO) <= tolerance and abs(p1) + abs(p2) <= tolerance:
+                if _bound(rates, rr, rc, amp, ar, har, 0.0, 0.0, omega, t0, t, ZERO) <= tolerance and abs(p1) + abs(p2) <= tolerance:
                     return math.nan
                 return t_from
             t += step
@@ -175,7 +178,7 @@ def _first_crossing(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t_from,
     while True:
         h0, h1, h2, curvature, jerk = _step_data(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t)
         if departing and h0 >= -8.0 * tolerance:
-            step = _escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, tolerance)
+            step = escape_step(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, tolerance)
             if step >= 0.0:
                 if t + step >= t_to:
                     return math.nan
@@ -194,7 +197,7 @@ def _first_crossing(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t_from,
         if t + step >= t_to:
             # h < 0 on [t, t_to); a root at t_to (an impact on a period boundary) is still a root, and so is one
             # within a few round-off units of it, arriving: it is applied before the strobe, not after it
-            _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t_to, pair)
+            observable_derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t_to, pair)
             return t_to if pair[0] >= -tolerance or (pair[0] >= -8.0 * tolerance and pair[1] > 0.0) else math.nan
         if t + step == t:
             return t
@@ -202,29 +205,32 @@ def _first_crossing(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t_from,
 
 
 @njit(cache=True, error_model="numpy")
-def _closest_approach(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, ta, tb, fastest, best, stop):
+def closest_approach(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, ta, tb, fastest, best, stop):
     """Largest interior local maximum of h on (ta, tb) (h' from + to -), if above best[0]: stored in best."""
     chunks = max(2, int(math.ceil(fastest * (tb - ta) / 0.5)))
     d = np.empty(3)
     t_prev = ta
-    _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, ta, d)
+    observable_derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, ta, d)
     slope_prev = d[1]
     for c in range(1, chunks + 1):
         t = ta + (tb - ta) * c / chunks
-        _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, d)
+        observable_derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, d)
         if slope_prev > 0.0 and d[1] < 0.0:
             lo, hi = t_prev, t
             for _ in range(200):  # bisection on h' (sign + at lo, - at hi)
                 mid = 0.5 * (lo + hi)
                 if mid <= lo or mid >= hi:
                     break
-                _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, mid, d)
+                observable_derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, mid, d)
                 if d[1] > 0.0:
                     lo = mid
                 else:
                     hi = mid
-            _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, lo, d)
+            observable_derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, lo, d)
             if lo > ta and lo < tb and d[0] > best[0]:
                 best[0], best[1], best[2] = d[0], lo, stop
-            _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, d)
+            observable_derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, t, d)
         slope_prev, t_prev = d[1], t
+
+
+stamp_with_callees(globals())

@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines.exact_flows import Flow, decompose
 
-__all__ = ["HarmonicLinearFlow", "Piece", "Observable", "first_crossing", "escape_step", "tangency_step", "polish_step", "gauss_legendre"]
+__all__ = ["HarmonicLinearFlow", "Piece", "Observable", "first_crossing", "escape_step", "gauss_legendre"]
 
 
 class HarmonicLinearFlow:

@@ -25,12 +25,13 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines.base import TrajectoryBuilder, check_run
 from vibroimpact.engines.flow_layout import FlowLayout
+from vibroimpact.engines.numba_cache import stamp_with_callees
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.sundae import as_doubles, content_data
 from vibroimpact.model.contact import Impact, RigidStop
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["pack_parameters", "quadrature_count", "rhs_kernel", "jacobian_kernel", "events_kernel", "holding_kernel", "STUCK", "APEX", "SIZE", "STOPS", "LENGTH", "HEADER", "COMPILED_RHS", "COMPILED_JACOBIAN", "COMPILED_EVENTS", "RigidContact"]
+__all__ = ["pack_parameters", "quadrature_count", "rhs_kernel", "jacobian_kernel", "events_kernel", "holding_kernel", "STUCK", "APEX", "COMPILED_RHS", "COMPILED_JACOBIAN", "COMPILED_EVENTS", "RigidContact"]
 
 # header of the parameter array: mode, flags, sizes and the offsets of the blocks after it
 STUCK, APEX, SIZE, _N, STOPS, _OMEGA, _TRIG, _A, _C, _BR, _BI, _G, _G0, _NORMAL, _H, _H0, _HBR, _HBI, _TINV, _XOFF, LENGTH = range(21)
@@ -331,3 +332,8 @@ class RigidContact:
         out = np.array(state, dtype=float)
         out[self.size : 2 * self.size] -= impulse * self.kicks[stop]
         return out
+
+
+# the compiled kernels read sundae's intrinsics: an edit of it recompiles them (not the ``cfunc`` callbacks above: they
+# compiled or loaded as they were defined, see numba_cache's docstring)
+stamp_with_callees(globals())

@@ -38,13 +38,14 @@ from vibroimpact.engines.compliant import exact_loop
 from vibroimpact.engines.compliant.model import MODE_CONTACT
 from vibroimpact.engines.exact import StrobeMap, chained_jacobian, stack_flows
 from vibroimpact.engines.exact_flows import Flow, mechanical_null_basis, unforced_flow, with_harmonic
+from vibroimpact.engines.kernel_arguments import BumperLoopArguments, leading_arguments
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.engines.registry import ENGINES, Capabilities
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["CompliantExactEngine", "bumper_flows", "loop_is_cached", "prepare_compiled_loop", "MAX_BUMPERS"]
+__all__ = ["CompliantExactEngine", "bumper_flows", "contact_modes", "loop_is_cached", "prepare_compiled_loop"]
 
 #: Most bumpers of one problem: the engine prepares every contact mode, 2^K flows.
 MAX_BUMPERS = 8
@@ -54,7 +55,7 @@ def bumper_flows(problem: ImpactProblem) -> tuple[tuple[Flow, ...], NDArray[np.f
     """The closed-form flow of every contact mode of a problem with bumpers, and each stop's K_k, B_k and m_k.
 
     The modes' decompositions do not depend on the forcing frequency: they are kept per problem at any frequency
-    (:func:`_contact_modes`), and only the harmonic particular solution is made here (a continuation in frequency
+    (:func:`contact_modes`), and only the harmonic particular solution is made here (a continuation in frequency
     evaluates the map of a new problem at every step).
 
     Returns
@@ -63,7 +64,7 @@ def bumper_flows(problem: ImpactProblem) -> tuple[tuple[Flow, ...], NDArray[np.f
         (flows, stiffness [N m-1], damping [N s m-1], effective masses [kg]): ``flows[mask]`` is the flow of y = (x, x')
         with the bumpers of the stops in the bit mask pushing (``flows[0]`` the free flight).
     """
-    modes, k_b, b_b, masses = _contact_modes(dataclasses.replace(problem, excitation=dataclasses.replace(problem.harmonic, frequency=1.0)))
+    modes, k_b, b_b, masses = contact_modes(dataclasses.replace(problem, excitation=dataclasses.replace(problem.harmonic, frequency=1.0)))
     size = problem.size
     harmonic, _static = problem.load()
     b = np.concatenate([np.zeros(size, dtype=complex), np.linalg.solve(problem.structure.mass_matrix.astype(complex), harmonic)])
@@ -75,7 +76,7 @@ def bumper_flows(problem: ImpactProblem) -> tuple[tuple[Flow, ...], NDArray[np.f
 
 
 @lru_cache(maxsize=256)
-def _contact_modes(problem: ImpactProblem) -> tuple[tuple[tuple[NDArray[np.float64], Flow], ...], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+def contact_modes(problem: ImpactProblem) -> tuple[tuple[tuple[NDArray[np.float64], Flow], ...], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Per contact mode, its state matrix A [s-1] and :func:`~vibroimpact.engines.exact_flows.unforced_flow`, with each
     stop's K_k, B_k and m_k: what :func:`bumper_flows` keeps of a problem whatever its forcing frequency (``problem``
     is given at 1 Hz)."""
@@ -123,9 +124,11 @@ def _in_contact(mask: int, count: int) -> Iterator[None]:
 
 @dataclass(frozen=True, eq=False)
 class _Setup:
-    """What the compiled loop needs of one problem, as its leading arguments, and the flows for sampling."""
+    """What the compiled loop needs of one problem, as its leading arguments, and the flows for sampling (the leading
+    arguments of :func:`~vibroimpact.engines.compliant.exact_loop.sample_pieces`, picked from ``arguments`` by its
+    parameter names)."""
 
-    arguments: tuple
+    arguments: BumperLoopArguments
     sampling: tuple
 
 
@@ -156,12 +159,12 @@ def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
     velocity = problem.velocity_scale()
     force_tolerances = 1e-15 * (k_b * length + b_b * velocity)
     nodes, weights = gauss_legendre(16)
-    stacked = stack_flows(flows, problem.omega)
-    arguments = (
-        *stacked, problem.omega, problem.period, obsw, obso, velw, salts, np.zeros(4 * count, dtype=complex),
-        1e-15 * length, force_tolerances, 10 * settings.max_impacts_per_period, nodes, weights,
+    arguments = BumperLoopArguments(
+        **stack_flows(flows, problem.omega)._asdict(), omega=problem.omega, period=problem.period, obsw=obsw, obso=obso, velw=velw, salts=salts,
+        zero_har=np.zeros(4 * count, dtype=complex), gap_tolerance=1e-15 * length, force_tolerances=force_tolerances,
+        max_events=10 * settings.max_impacts_per_period, gl_nodes=nodes, gl_weights=weights,
     )  # fmt: skip
-    return _Setup(arguments, (*stacked[:11], problem.omega))
+    return _Setup(arguments, leading_arguments(exact_loop.sample_pieces, arguments))
 
 
 class CompliantExactEngine:

@@ -8,7 +8,7 @@ Flows are stacked as :func:`~vibroimpact.engines.exact.stack_flows` stacks them,
 structure with the bumpers of the stops in the bit mask f pushing (f = 0: free flight). Each stop k is in one of
 three phases, each watched by observables h = w . y + offset of the current piece (rows 4 k ... 4 k + 3 of ``obsw``,
 ``obso``: the penetration d_k = n_k . x - Delta_k, -d_k, the bumper force F_k = K_k d_k + B_k n_k . x', -F_k), every
-root found by :func:`~vibroimpact.engines.exact_roots._first_crossing` (Taylor bounds: none missed, however tangent):
+root found by :func:`~vibroimpact.engines.exact_roots.first_crossing` (Taylor bounds: none missed, however tangent):
 
 * ``BELOW`` (free, d < 0): d rising to 0 is an onset;
 * ``BEYOND`` (free, d >= 0 after a release with the bumper still compressed, F < 0): F rising to 0 is an onset (the
@@ -41,13 +41,13 @@ import math
 import numpy as np
 from numba import njit
 
-from vibroimpact.engines.exact_core import _grow, _left_multiply, _transition
-from vibroimpact.engines.exact_moments import _add_moments_gl, _amplitudes, _integrals, _piece_factors, _weighted_amplitudes
-from vibroimpact.engines.exact_pieces import _halve, _modal, _observable, _rigid, _state
-from vibroimpact.engines.exact_roots import _closest_approach, _derivatives, _escape_step, _first_crossing, _round_off, _value
+from vibroimpact.engines.exact_core import grow_rows, left_multiply, transition_matrix
+from vibroimpact.engines.exact_moments import add_moments_gl, coordinate_amplitudes, moment_integrals, piece_factors, weighted_amplitudes
+from vibroimpact.engines.exact_pieces import halve_pairs, modal_coordinates, observable, piece_state, polynomial_part
+from vibroimpact.engines.exact_roots import closest_approach, escape_step, first_crossing, observable_derivatives, observable_value, round_off_band
 from vibroimpact.engines.numba_cache import stamp_with_callees
 
-__all__ = ["run_bumper_periods", "sample_pieces", "STATUS_OK", "STATUS_NO_PROGRESS", "BELOW", "BEYOND", "CONTACT"]
+__all__ = ["run_bumper_periods", "sample_pieces", "STATUS_NO_PROGRESS"]
 
 STATUS_OK, STATUS_NO_PROGRESS = 0, 1
 #: Phases of a stop (module docstring).
@@ -67,8 +67,8 @@ _NONE, _ZERO, _ONE, _YES, _NO = np.int64(-1), np.int64(0), np.int64(1), np.bool_
 @njit(cache=True, error_model="numpy")
 def _watch(obsw, obso, row, lams, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2, hamps, slot, hars, cons, p1s, p2s):
     """Observable ``row`` of the piece (flow f, ``modal`` coordinates) into slot ``slot`` of the watched ones."""
-    har, con, p1, p2 = _observable(obsw, row, obso[row], 0j, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
-    _halve(lams, f, m, amp, hamps, slot)
+    har, con, p1, p2 = observable(obsw, row, obso[row], 0j, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
+    halve_pairs(lams, f, m, amp, hamps, slot)
     hars[slot], cons[slot], p1s[slot], p2s[slot] = har, con, p1, p2
 
 
@@ -77,19 +77,19 @@ def _goes_negative(obsw, obso, row, lams, counts, vecs, invs, hrms, csts, zpros,
     """Is observable ``row`` negative at (t, y) beyond round-off, or zero and falling along flow f (its first non-zero
     derivative; a rise that stays within round-off counts as a fall, as in the exact engine's push test)?"""
     m, hm, poly = counts[f], hcounts[f], polys[f]
-    _modal(lams, invs, hrms, csts, f, m, omega, t, y, modal)
+    modal_coordinates(lams, invs, hrms, csts, f, m, omega, t, y, modal)
     if poly:
-        _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t, y, z0, q1, q2)
-    har, con, p1, p2 = _observable(obsw, row, obso[row], 0j, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
-    _halve(lams, f, m, amp, hamp, _ZERO)
+        polynomial_part(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t, y, z0, q1, q2)
+    har, con, p1, p2 = observable(obsw, row, obso[row], 0j, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
+    halve_pairs(lams, f, m, amp, hamp, _ZERO)
     values = np.empty(2)
     row = _ZERO  # (not a literal: numba would compile the callees once more for it)
-    _derivatives(hlams, f, hm, hamp, row, har, con, p1, p2, omega, t, t, values)
-    band = _round_off(hm, hamp, row, har, con, p1, p2, 0.0, tolerance)  # as a root search on it would allow
+    observable_derivatives(hlams, f, hm, hamp, row, har, con, p1, p2, omega, t, t, values)
+    band = round_off_band(hm, hamp, row, har, con, p1, p2, 0.0, tolerance)  # as a root search on it would allow
     # a root is as close to zero as the time axis allows: h moves by |h'| ulp(t) from one float of t to the next
     if abs(values[0]) > 64.0 * max(band, abs(values[1]) * _EPSILON * abs(t)):
         return values[0] < 0.0
-    return _escape_step(hlams, f, hm, hamp, row, har, con, p1, p2, omega, t, t, band) >= 0.0
+    return escape_step(hlams, f, hm, hamp, row, har, con, p1, p2, omega, t, t, band) >= 0.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -97,8 +97,8 @@ def _largest(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, ta, tb, work, 
     """The largest of ``best`` and of h over [ta, tb]: its ends and every interior maximum, where h' falls through 0
     (the guaranteed search on h' and -h' in turn: from a maximum to the next minimum, and on)."""
     d = np.empty(2)
-    _derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, ta, d)
-    best = max(best, d[0], _value(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, tb))
+    observable_derivatives(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, ta, d)
+    best = max(best, d[0], observable_value(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, tb))
     if tb <= ta:
         return best
     for i in range(rc):
@@ -110,11 +110,11 @@ def _largest(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, ta, tb, work, 
     t = ta
     for _ in range(_MAX_EXTREMA):
         sign = -1.0 if falling else 1.0
-        root = _first_crossing(rates, rr, rc, work, 1 if falling else 0, sign * rate, sign * p1, sign * 2.0 * p2, 0.0, omega, t0, t, tb, 0.0, leaving)
+        root = first_crossing(rates, rr, rc, work, 1 if falling else 0, sign * rate, sign * p1, sign * 2.0 * p2, 0.0, omega, t0, t, tb, 0.0, leaving)
         if math.isnan(root) or (leaving and root <= t):
             break
         if falling:
-            best = max(best, _value(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, root))
+            best = max(best, observable_value(rates, rr, rc, amp, ar, har, con, p1, p2, omega, t0, root))
         if root >= tb:
             break
         t, falling, leaving = root, not falling, _YES
@@ -130,22 +130,22 @@ def _piece_integrals(moments, row, want_moments, mask, impulses, lams, vecs, hrm
     mm = m + 2
     amps, pair, single, fourier, ea, el = buffers
     length = tb - ta
-    _piece_factors(rates_all, rinv_all, f, mm, omega, ta - t_piece, length, pair, single, fourier, ea, el)
+    piece_factors(rates_all, rinv_all, f, mm, omega, ta - t_piece, length, pair, single, fourier, ea, el)
     phasor = complex(math.cos(omega * t_piece), -math.sin(omega * t_piece))
     if want_moments:
         for i in range(size):
-            _amplitudes(vecs, hrms, f, m, modal, omega, t_piece, i, amps)
-            _integrals(amps, mm, csts[f, i], length, pair, single, fourier, phasor, moments, row, i, size + stops + i)
+            coordinate_amplitudes(vecs, hrms, f, m, modal, omega, t_piece, i, amps)
+            moment_integrals(amps, mm, csts[f, i], length, pair, single, fourier, phasor, moments, row, i, size + stops + i)
     for j in range(stops):
         if not (mask >> j) & 1:
             continue
         minus = 4 * j + 3  # amplitudes of minus (-F): the force's
-        _weighted_amplitudes(vecs, hrms, f, m, modal, omega, t_piece, obsw, minus, 0j, amps)
+        weighted_amplitudes(vecs, hrms, f, m, modal, omega, t_piece, obsw, minus, 0j, amps)
         constant = -obso[minus]
         for r in range(obsw.shape[1]):
             constant -= obsw[minus, r] * csts[f, r]
         if want_moments:
-            _integrals(amps, mm, constant, length, pair, single, fourier, phasor, moments, row, size + j, _NONE)
+            moment_integrals(amps, mm, constant, length, pair, single, fourier, phasor, moments, row, size + j, _NONE)
         total = constant * length
         for i in range(mm):
             total += (amps[i] * single[i]).real
@@ -157,7 +157,7 @@ def _piece_integrals_gl(moments, row, want_moments, mask, impulses, lams, vecs, 
     """As :func:`_piece_integrals` on a flow with rigid-body (polynomial) terms, by Gauss-Legendre quadrature (the
     exact engine's chunks)."""
     if want_moments:
-        _add_moments_gl(moments, row, _NONE, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, ta, tb, fastest, nodes, weights, obsw, obso, zero_har, size, stops, z0, q1, q2, y)
+        add_moments_gl(moments, row, _NONE, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, ta, tb, fastest, nodes, weights, obsw, obso, zero_har, size, stops, z0, q1, q2, y)
     if mask == 0:
         return
     chunks = max(1, int(math.ceil(fastest * (tb - ta) / 2.0)))
@@ -167,7 +167,7 @@ def _piece_integrals_gl(moments, row, want_moments, mask, impulses, lams, vecs, 
         for q in range(nodes.size):
             t = a + (b - a) * nodes[q]
             w = (b - a) * weights[q]
-            _state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t, y, _YES, z0, q1, q2)
+            piece_state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t, y, _YES, z0, q1, q2)
             phasor = complex(math.cos(omega * t), -math.sin(omega * t))
             for j in range(stops):
                 if (mask >> j) & 1:
@@ -186,11 +186,11 @@ def _peaks(mask, obsw, obso, velw, lams, vecs, hrms, csts, f, m, hlams, hm, moda
     for j in range(velw.shape[0]):
         if not (mask >> j) & 1:
             continue
-        har, con, p1, p2 = _observable(obsw, 4 * j + 2, obso[4 * j + 2], 0j, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
-        _halve(lams, f, m, amp, scratch, _ZERO)
+        har, con, p1, p2 = observable(obsw, 4 * j + 2, obso[4 * j + 2], 0j, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
+        halve_pairs(lams, f, m, amp, scratch, _ZERO)
         peak_force[j] = _largest(hlams, f, hm, scratch, _ZERO, har, con, p1, p2, omega, t_piece, ta, tb, work, peak_force[j])
-        har, con, p1, p2 = _observable(velw, j, 0.0, 0j, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
-        _halve(lams, f, m, amp, scratch, _ONE)
+        har, con, p1, p2 = observable(velw, j, 0.0, 0j, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2)
+        halve_pairs(lams, f, m, amp, scratch, _ONE)
         for i in range(hm):  # -d/dt of n . x'
             scratch[1, i] *= -hlams[f, i]
         peak_deceleration[j] = _largest(hlams, f, hm, scratch, _ONE, -har * jw, -p1, -2.0 * p2, 0.0, omega, t_piece, ta, tb, work, peak_deceleration[j])
@@ -212,7 +212,7 @@ def run_bumper_periods(
     ``BELOW``) or 0 for one at d > 0 (``BEYOND``), and the free flight's d'' there (an onset at the surface; else 0),
     of each onset after the start; approach [value, time, stop]: the
     largest interior local maximum of a penetration d_k while stop k is ``BELOW`` (the closest approach of a free
-    flight to the bumper's surface, the exact engine's :func:`~vibroimpact.engines.exact_roots._closest_approach`;
+    flight to the bumper's surface, the exact engine's :func:`~vibroimpact.engines.exact_roots.closest_approach`;
     -inf without one, or unless ``want_approach``)); status :data:`STATUS_NO_PROGRESS` stops the run at t after
     ``max_events`` in one period.
     """
@@ -291,9 +291,9 @@ def run_bumper_periods(
             t_piece = t
             f = mask
             m, hm, poly = counts[f], hcounts[f], polys[f]
-            _modal(lams, invs, hrms, csts, f, m, omega, t, y, modal)
+            modal_coordinates(lams, invs, hrms, csts, f, m, omega, t, y, modal)
             if poly:
-                _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t, y, z0, q1, q2)
+                polynomial_part(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, t, y, z0, q1, q2)
             for j in range(stops):
                 # watched: d (below), F and -d (beyond), -F (in contact)
                 rows[2 * j] = 4 * j + (3 if phase[j] == CONTACT else 2 if phase[j] == BEYOND else 0)
@@ -303,8 +303,8 @@ def run_bumper_periods(
                         _watch(obsw, obso, rows[s], lams, vecs, hrms, csts, f, m, modal, amp, poly, z0, q1, q2, hamps, s, hars, cons, p1s, p2s)
             if mask != last_mask:
                 if n_segments == segments.shape[0]:
-                    segments = _grow(segments, n_segments + 1)
-                    segment_states = _grow(segment_states, n_segments + 1)
+                    segments = grow_rows(segments, n_segments + 1)
+                    segment_states = grow_rows(segment_states, n_segments + 1)
                 segments[n_segments, 0], segments[n_segments, 1] = t, mask
                 for r in range(n):
                     segment_states[n_segments, r] = y[r]
@@ -320,14 +320,14 @@ def run_bumper_periods(
                 continue
             # every search starts as if leaving the surface: an observable at zero and rising is a root right here
             tolerance = gap_tolerance if rows[s] % 4 < 2 else force_tolerances[s // 2]
-            found = _first_crossing(hlams, f, hm, hamps, s, hars[s], cons[s], p1s[s], p2s[s], omega, t_piece, t, limit, tolerance, _YES)
+            found = first_crossing(hlams, f, hm, hamps, s, hars[s], cons[s], p1s[s], p2s[s], omega, t_piece, t, limit, tolerance, _YES)
             if not math.isnan(found) and (event < 0 or found < t_event):
                 t_event, event, limit = found, s, found
         t_end = boundary if event < 0 else t_event
         if t_end > t:
             if want_jacobians:
-                _transition(lams, vecs, invs, f, m, t_end - t, poly, zpros, znils, phi)
-                _left_multiply(phi, jac, product)
+                transition_matrix(lams, vecs, invs, f, m, t_end - t, poly, zpros, znils, phi)
+                left_multiply(phi, jac, product)
             if mask != 0 or want_moments:
                 if poly:
                     _piece_integrals_gl(moments, k - 1, want_moments, mask, impulses, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, fastests[f], gl_nodes, gl_weights, obsw, obso, zero_har, size, stops, z0, q1, q2, ybuf)
@@ -336,10 +336,10 @@ def run_bumper_periods(
             if want_approach:
                 for j in range(stops):
                     if phase[j] == BELOW:  # slot 2 j watches d_k
-                        _closest_approach(hlams, f, hm, hamps, 2 * j, hars[2 * j], cons[2 * j], p1s[2 * j], p2s[2 * j], omega, t_piece, t, t_end, fastests[f], approach, j)
+                        closest_approach(hlams, f, hm, hamps, 2 * j, hars[2 * j], cons[2 * j], p1s[2 * j], p2s[2 * j], omega, t_piece, t, t_end, fastests[f], approach, j)
             if mask != 0:
                 _peaks(mask, obsw, obso, velw, lams, vecs, hrms, csts, f, m, hlams, hm, modal, amp, poly, z0, q1, q2, scratch, work, omega, t_piece, t, t_end, peak_force, peak_deceleration)
-        _state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t_end, ynew, poly, z0, q1, q2)
+        piece_state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t_end, ynew, poly, z0, q1, q2)
         for r in range(n):
             y[r] = ynew[r]
         t = t_end
@@ -365,7 +365,7 @@ def run_bumper_periods(
             # the force reached zero: a release if it goes on falling along the free flight (else it only touched zero)
             if _goes_negative(obsw, obso, 4 * j + 2, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, mask & ~bit, omega, t, y, force_tolerances[j], other, amp, scratch, zb, qb1, qb2):
                 if n_contacts == contacts.shape[0]:
-                    contacts = _grow(contacts, n_contacts + 1)
+                    contacts = grow_rows(contacts, n_contacts + 1)
                 contacts[n_contacts, 0], contacts[n_contacts, 1], contacts[n_contacts, 2] = onset_time[j], onset_speed[j], impulses[j]
                 contacts[n_contacts, 3], contacts[n_contacts, 4], contacts[n_contacts, 5] = peak_force[j], peak_deceleration[j], j
                 n_contacts += 1
@@ -380,17 +380,17 @@ def run_bumper_periods(
         elif _goes_negative(obsw, obso, 4 * j + 3, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, mask | bit, omega, t, y, force_tolerances[j], other, amp, scratch, zb, qb1, qb2):
             # onset: the gap closing (the vector field jumps by the dashpot's force), or the force rising beyond it
             if want_jacobians and phase[j] == BELOW:
-                _left_multiply(salts[j], jac, product)
+                left_multiply(salts[j], jac, product)
             speed = 0.0
             for r in range(n):
                 speed += velw[j, r] * y[r]
             onset_time[j], onset_speed[j], impulses[j], peak_force[j], peak_deceleration[j] = t, speed, 0.0, 0.0, 0.0
             if n_onsets == onsets.shape[0]:
-                onsets = _grow(onsets, n_onsets + 1)
+                onsets = grow_rows(onsets, n_onsets + 1)
             onsets[n_onsets, 0], onsets[n_onsets, 1], onsets[n_onsets, 2] = t, speed, j
             onsets[n_onsets, 3], onsets[n_onsets, 4] = 0.0, 0.0
             if phase[j] == BELOW:  # slot 2 j still watches d_k along the free flight that ends here
-                _derivatives(hlams, f, hm, hamps, 2 * j, hars[2 * j], cons[2 * j], p1s[2 * j], p2s[2 * j], omega, t_piece, t, curvature)
+                observable_derivatives(hlams, f, hm, hamps, 2 * j, hars[2 * j], cons[2 * j], p1s[2 * j], p2s[2 * j], omega, t_piece, t, curvature)
                 onsets[n_onsets, 3], onsets[n_onsets, 4] = 1.0, curvature[2]
             n_onsets += 1
             counters[2] += 1
@@ -417,15 +417,15 @@ def sample_pieces(lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdr
         p = pieces[i]
         f = flows[p]
         if p != current:
-            _modal(lams, invs, hrms, csts, f, counts[f], omega, starts[p], states[p], modal)
+            modal_coordinates(lams, invs, hrms, csts, f, counts[f], omega, starts[p], states[p], modal)
             if polys[f]:
-                _rigid(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, starts[p], states[p], z0, q1, q2)
+                polynomial_part(zpros, znils, zdrvs, zdrv2s, hrms, csts, f, omega, starts[p], states[p], z0, q1, q2)
             current = p
         if times[i] == starts[p]:
             for r in range(n):
                 out[i, r] = states[p, r]
             continue
-        _state(lams, vecs, hrms, csts, f, counts[f], omega, starts[p], modal, times[i], y, polys[f], z0, q1, q2)
+        piece_state(lams, vecs, hrms, csts, f, counts[f], omega, starts[p], modal, times[i], y, polys[f], z0, q1, q2)
         for r in range(n):
             out[i, r] = y[r]
     return out

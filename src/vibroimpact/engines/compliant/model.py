@@ -31,6 +31,7 @@ from numba import njit
 from numpy.typing import NDArray
 
 from vibroimpact.engines.flow_layout import flow_layout
+from vibroimpact.engines.numba_cache import stamp_with_callees
 from vibroimpact.engines.rigid_kernels import quadrature_count
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.excitation import SweptSine
@@ -435,3 +436,6 @@ class BumperModel:
         events.terminal = [role in ("onset", "release") for _, role in roles]  # type: ignore[attr-defined]
         events.direction = [{"onset": 1, "release": 1, "apex": -1, "rate": -1, "jerk": 1}[role] for _, role in roles]  # type: ignore[attr-defined]
         return events
+
+
+stamp_with_callees(globals())  # its kernels read no other module today; one that does is stamped with its source

@@ -172,10 +172,10 @@ def exact_kernel(case: BenchmarkCase, moments: bool = True) -> Callable[[], int]
     engine's Python face: this is its floor.
     """
     from vibroimpact.engines import exact_core
-    from vibroimpact.engines.exact import _setup  # the engine's own per-problem preparation
+    from vibroimpact.engines.exact import loop_setup  # the engine's own per-problem preparation
 
     t0, y0 = start_state(case.problem, case.start)
-    arguments = _setup(case.problem, EngineSettings()).arguments
+    arguments = loop_setup(case.problem, EngineSettings()).arguments
     state = np.ascontiguousarray(y0, dtype=float)
 
     def kernel() -> int:

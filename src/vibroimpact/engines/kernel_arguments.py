@@ -1,0 +1,150 @@
+"""The compiled loops' arguments by name: their Python faces build them once per problem as named tuples whose fields
+are the loop's leading parameters, in its order, and pick a kernel's share of them by the kernel's parameter names.
+
+A compiled loop takes ~40 positional arguments (numba compiles no keyword calls into one overload per signature, and
+a named tuple unpacked with ``*`` is the same positional arguments, bit for bit). Slicing one long tuple by position
+(``(*a[:11], a[19], a[21], ...)``) broke silently at any reordering of a signature; here every field is named, and
+``tests/engines/test_kernel_arguments.py`` fails when a tuple's fields and its loop's parameters disagree in name or
+order:
+
+* :class:`StackedFlows`: what :func:`~vibroimpact.engines.exact.stack_flows` returns, the leading parameters of both
+  loops (flow f is entry f of each array, see :mod:`~vibroimpact.engines.exact_core`);
+* :class:`LoopArguments`: :func:`~vibroimpact.engines.exact_core.run_periods` before :data:`RUN_PARAMETERS`;
+* :class:`BumperLoopArguments`: :func:`~vibroimpact.engines.compliant.exact_loop.run_bumper_periods` before them;
+* :func:`leading_arguments`: a kernel's leading arguments taken from such a tuple by its parameter names
+  (:func:`~vibroimpact.engines.exact_core.sample_states`, :func:`~vibroimpact.engines.compliant.exact_loop.sample_pieces`).
+"""
+
+from __future__ import annotations
+
+import inspect
+from functools import lru_cache
+from typing import Any, NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["StackedFlows", "LoopArguments", "BumperLoopArguments", "RUN_PARAMETERS", "leading_arguments"]
+
+#: The parameters of both loops after their named leading ones: the run's start state (x, x') [m, m s-1], its start
+#: time [s], its number of periods, and what to record.
+RUN_PARAMETERS = ("y_start", "t_start", "periods", "want_moments", "want_jacobians", "want_approach")
+
+
+class StackedFlows(NamedTuple):
+    """A problem's flows stacked (flow f is entry f of each array; :mod:`~vibroimpact.engines.exact_core`)."""
+
+    lams: NDArray[np.complex128]  # nonzero eigenvalues [s-1], (F, widest)
+    counts: NDArray[np.int64]  # how many of them per flow
+    vecs: NDArray[np.complex128]  # eigenvectors, (F, n, widest)
+    invs: NDArray[np.complex128]  # rows giving the modal coordinates, (F, widest, n)
+    hrms: NDArray[np.complex128]  # harmonic particular solution's amplitude, (F, n)
+    csts: NDArray[np.float64]  # constant particular solution, (F, n)
+    zpros: NDArray[np.float64]  # projectors on the rigid-body modes, (F, n, n)
+    znils: NDArray[np.float64]  # their nilpotent parts [s-1], (F, n, n)
+    zdrvs: NDArray[np.float64]  # drifts c, (F, n)
+    zdrv2s: NDArray[np.float64]  # drifts q2, (F, n)
+    polys: NDArray[np.bool_]  # which flows have rigid-body modes
+    hlams: NDArray[np.complex128]  # one eigenvalue of each conjugate pair and the real ones [s-1]
+    hcounts: NDArray[np.int64]  # how many of them per flow
+    rates_all: NDArray[np.complex128]  # the moments' rates [s-1], (F, widest + 2)
+    rinv_all: NDArray[np.complex128]  # their factors' inverses, (F, widest + 3, widest + 2)
+    fastests: NDArray[np.float64]  # omega + the largest |lambda| per flow [rad s-1]
+
+
+class LoopArguments(NamedTuple):
+    """The leading arguments of :func:`~vibroimpact.engines.exact_core.run_periods` (see
+    :class:`~vibroimpact.engines.exact_flows.ExactModel` for the stops' arrays)."""
+
+    lams: NDArray[np.complex128]
+    counts: NDArray[np.int64]
+    vecs: NDArray[np.complex128]
+    invs: NDArray[np.complex128]
+    hrms: NDArray[np.complex128]
+    csts: NDArray[np.float64]
+    zpros: NDArray[np.float64]
+    znils: NDArray[np.float64]
+    zdrvs: NDArray[np.float64]
+    zdrv2s: NDArray[np.float64]
+    polys: NDArray[np.bool_]
+    hlams: NDArray[np.complex128]
+    hcounts: NDArray[np.int64]
+    rates_all: NDArray[np.complex128]
+    rinv_all: NDArray[np.complex128]
+    fastests: NDArray[np.float64]
+    a_matrix: NDArray[np.float64]  # A of the free flight [s-1, s-2]
+    load: NDArray[np.complex128]  # its harmonic load b
+    static: NDArray[np.float64]  # its constant load b0
+    omega: float  # [rad s-1]
+    period: float  # [s]
+    gapw: NDArray[np.float64]  # (n_k, 0) per stop: the gap's weights over y
+    velw: NDArray[np.float64]  # (0, n_k): the gap velocity's
+    kickw: NDArray[np.float64]  # (0, M^-1 n_k): an impulse's direction [kg-1]
+    clearances: NDArray[np.float64]  # [m]
+    restitutions: NDArray[np.float64]  # [-]
+    masses: NDArray[np.float64]  # effective masses [kg]
+    simple: NDArray[np.int64]  # the coordinate a stop moves alone (-1: none)
+    signs: NDArray[np.float64]  # its sign in n_k
+    hold_w: NDArray[np.float64]  # minus the holding force's weights over y [N m-1, N s m-1]
+    hold_off: NDArray[np.float64]  # its offsets [N]
+    hold_har: NDArray[np.complex128]  # its harmonic parts [N]
+    force_tolerances: NDArray[np.float64]  # [N]
+    bounce: NDArray[np.float64]  # the impact maps, (K, n, n)
+    stick: NDArray[np.float64]
+    touch: NDArray[np.float64]
+    sticking_velocity: float  # [m s-1]
+    max_impacts: int  # per period
+    tolerance: float  # on a gap [m]
+    resolution_velocity: float  # [m s-1]
+    gl_nodes: NDArray[np.float64]  # Gauss-Legendre nodes on [-1, 1]
+    gl_weights: NDArray[np.float64]
+
+
+class BumperLoopArguments(NamedTuple):
+    """The leading arguments of :func:`~vibroimpact.engines.compliant.exact_loop.run_bumper_periods`."""
+
+    lams: NDArray[np.complex128]
+    counts: NDArray[np.int64]
+    vecs: NDArray[np.complex128]
+    invs: NDArray[np.complex128]
+    hrms: NDArray[np.complex128]
+    csts: NDArray[np.float64]
+    zpros: NDArray[np.float64]
+    znils: NDArray[np.float64]
+    zdrvs: NDArray[np.float64]
+    zdrv2s: NDArray[np.float64]
+    polys: NDArray[np.bool_]
+    hlams: NDArray[np.complex128]
+    hcounts: NDArray[np.int64]
+    rates_all: NDArray[np.complex128]
+    rinv_all: NDArray[np.complex128]
+    fastests: NDArray[np.float64]
+    omega: float  # [rad s-1]
+    period: float  # [s]
+    obsw: NDArray[np.float64]  # weights of d_k, -d_k, F_k, -F_k over y, (4 K, n)
+    obso: NDArray[np.float64]  # their offsets [m, N]
+    velw: NDArray[np.float64]  # (0, n_k) per stop
+    salts: NDArray[np.float64]  # saltation matrix of an onset at d = 0, (K, n, n)
+    zero_har: NDArray[np.complex128]  # zeros, (4 K,)
+    gap_tolerance: float  # [m]
+    force_tolerances: NDArray[np.float64]  # [N]
+    max_events: int  # per period
+    gl_nodes: NDArray[np.float64]
+    gl_weights: NDArray[np.float64]
+
+
+@lru_cache(maxsize=None)
+def _parameters(kernel: Any) -> tuple[str, ...]:
+    """The parameter names of a numba dispatcher's Python function (or of a function), in order."""
+    return tuple(inspect.signature(getattr(kernel, "py_func", kernel)).parameters)
+
+
+def leading_arguments(kernel: Any, arguments: tuple) -> tuple:
+    """``kernel``'s leading arguments taken from the named tuple ``arguments`` by name: its parameters in order, up
+    to the first that is not one of the tuple's fields (the caller gives the rest after them)."""
+    names = []
+    for name in _parameters(kernel):
+        if name not in arguments._fields:  # type: ignore[attr-defined]
+            break
+        names.append(name)
+    return tuple(getattr(arguments, name) for name in names)
