@@ -13,6 +13,7 @@ import pytest
 from vibroimpact.analysis.greens import paper_periodic_green, periodic_green
 from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
 from vibroimpact.analysis.paper_fit import PaperFit
+from vibroimpact.analysis.pgf import solve_one_impact
 from vibroimpact.model.contact import RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.modal import exact_pole_residue
@@ -93,3 +94,16 @@ def test_the_fit_is_refused_off_the_paper_s_layout() -> None:
     other = paper_problem(TwoDofSystem(m1=1.0, m2=0.1, k1=25_000.0, k2=4_000.0, b1=0.8, b2=0.08))
     with pytest.raises(ValueError, match="another system"):
         solve_impact_orbit(other, green=PaperFit.of(paper_problem()))
+
+
+def test_solve_one_impact_takes_the_paper_s_route_on_its_layout_only() -> None:
+    """``solve_one_impact(..., variant='pgf_paper')`` is the option: from the named system or from a problem of the
+    paper's layout the same orbit (an ImpactOrbit), refused (ValueError naming pgf) on another layout."""
+    w = 2.0 * np.pi * FREQUENCIES[::50]
+    named = solve_one_impact(PAPER_SYSTEM, omega=w, clearance=PAPER_CLEARANCE, restitution=0.2, amplitude=PAPER_AMPLITUDE, variant="pgf_paper")
+    assert isinstance(named, ImpactOrbit)
+    np.testing.assert_array_equal(named.impulse, paper_orbit(0.2, FREQUENCIES[::50]).impulse)
+    np.testing.assert_array_equal(solve_one_impact(paper_problem(), omega=w, variant="pgf_paper").impulse, named.impulse)
+    relative = ImpactProblem(PAPER_SYSTEM.structure, (Stop(RigidStop(3e-3, 0.2), 1, other=0),), HarmonicForce(10.0, 25.0))
+    with pytest.raises(ValueError, match="use pgf"):
+        solve_one_impact(relative, variant="pgf_paper")

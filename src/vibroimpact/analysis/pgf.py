@@ -12,32 +12,34 @@ The impact conditions X2(0) = Delta and J = M2 (1 + R) X2'(0-) give (eq. 15, cor
 with chi0 = chi22(0), so ``(c^2 + chi0^2) J^2 + 2 Delta chi0 J + Delta^2 - a^2 = 0`` (eq. 16, corrected bracket).
 The paper replaces chi22'(0-) by -1/(2 M2), which turns c into (1 - R) / (2 (1 + R) M2 w).
 
-Two variants:
+Two variants, both the one closed form of :func:`~vibroimpact.analysis.impact_orbit.solve_impact_orbit` (an
+:class:`~vibroimpact.analysis.impact_orbit.ImpactOrbit`, which holds that form for any structure and stop):
 
 * ``pgf``: exact poles and residues of H22 and the exact chi22'(0-).
 * ``pgf_paper``: the paper's curve-fitted modal parameters (eq. 10 with Omega fixed, eq. 14) and its constant
-  chi22'(0-) = -1/(2 M2). Near the linear resonances chi22'(0-) is far from that constant, which produces the
-  spurious spikes of the paper's figures 5-8.
+  chi22'(0-) = -1/(2 M2) (:class:`~vibroimpact.analysis.paper_fit.PaperFit`, its layout only). Near the linear
+  resonances chi22'(0-) is far from that constant, which produces the spurious spikes of the paper's figures 5-8.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import Enum
-from typing import overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.analysis.greens import GREEN_CONDITION_LIMIT, green_condition, periodic_green
 from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
+from vibroimpact.analysis.paper_fit import PaperFit
 from vibroimpact.analysis.layout import closed_form_layout
-from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.excitation import HarmonicForce, angular_frequency, check_closed_form_inputs
 from vibroimpact.model.modal import PoleResidueModel, exact_pole_residue, fit_modal_parameters
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import Receptances, TwoDofSystem
 
-__all__ = ["PgfVariant", "OneImpactSolution", "solve_one_impact", "AdmissibilitySettings"]
+__all__ = ["PgfVariant", "solve_one_impact", "AdmissibilitySettings"]
 
 
 class PgfVariant(str, Enum):
@@ -302,12 +304,6 @@ def green_models(system: TwoDofSystem, variant: PgfVariant) -> tuple[PoleResidue
     return fit_modal_parameters(system).to_pole_residue(), green12
 
 
-@overload
-def solve_one_impact(system: TwoDofSystem, frequency: ArrayLike | None = ..., clearance: ArrayLike | None = ..., restitution: ArrayLike | None = ..., amplitude: ArrayLike | None = ...,
-                     variant: PgfVariant | str = ..., models: tuple[PoleResidueModel, PoleResidueModel] | None = ..., *, omega: ArrayLike | None = ...) -> OneImpactSolution: ...  # fmt: skip
-@overload
-def solve_one_impact(system: ImpactProblem, frequency: ArrayLike | None = ..., clearance: ArrayLike | None = ..., restitution: ArrayLike | None = ...,
-                     amplitude: ArrayLike | None = ..., variant: PgfVariant | str = ..., models: None = ..., *, omega: ArrayLike | None = ...) -> ImpactOrbit: ...  # fmt: skip
 def solve_one_impact(
     system: TwoDofSystem | ImpactProblem,
     frequency: ArrayLike | None = None,
@@ -315,19 +311,18 @@ def solve_one_impact(
     restitution: ArrayLike | None = None,
     amplitude: ArrayLike | None = None,
     variant: PgfVariant | str = PgfVariant.EXACT,
-    models: tuple[PoleResidueModel, PoleResidueModel] | None = None,
     *,
     omega: ArrayLike | None = None,
-) -> OneImpactSolution | ImpactOrbit:
-    """Impulse and phase of the one-impact-per-period regime (eqs. 15-16, corrected), vectorised.
+) -> ImpactOrbit:
+    """The one-impact-per-period orbit (eqs. 15-16, corrected), vectorised: the closed form of
+    :func:`~vibroimpact.analysis.impact_orbit.solve_impact_orbit` for one rigid stop.
 
-    Two forms. ``solve_one_impact(system, frequency, clearance, restitution, amplitude, variant)`` with the paper's
-    :class:`TwoDofSystem` is the paper's layout (both variants, :class:`OneImpactSolution`).
-    ``solve_one_impact(problem, frequency=None, clearance=None, restitution=None, amplitude=None)`` with an
-    :class:`ImpactProblem` of any structure with one rigid stop (absolute or relative, upper or lower) gives the
-    general closed form (:class:`~vibroimpact.analysis.impact_orbit.ImpactOrbit`, exact Green functions only; omitted
-    values are the problem's); ``ValueError`` saying why where it does not apply (several stops, a bumper, a rigid-body
-    mode; a symmetric two-sided stop is :func:`vibroimpact.analysis.impact_orbit.solve_two_impacts`).
+    Two forms, one result. ``solve_one_impact(system, frequency, clearance, restitution, amplitude, variant)`` with the
+    paper's :class:`TwoDofSystem` is the paper's layout (one upper stop on x2, the force on x1; all five values
+    needed). ``solve_one_impact(problem, frequency=None, clearance=None, restitution=None, amplitude=None)`` with an
+    :class:`ImpactProblem` of any structure with one rigid stop (absolute or relative, upper or lower) takes the
+    problem's own values where none are given; ``ValueError`` saying why where it does not apply (several stops, a
+    bumper, a rigid-body mode; a symmetric two-sided stop is :func:`vibroimpact.analysis.impact_orbit.solve_two_impacts`).
 
     Parameters
     ----------
@@ -339,35 +334,41 @@ def solve_one_impact(
         Clearance Delta of the stop [m]; broadcast against ``frequency``.
     restitution : array_like
         Restitution ratio R [-], 0 <= R <= 1; broadcast against ``frequency``.
-    amplitude : float
+    amplitude : array_like
         Excitation force amplitude q [N].
     variant : PgfVariant or {'pgf', 'pgf_paper'}
-        Exact Green function and chi22'(0-), or the paper's fitted modes and constant chi22'(0-).
-    models : (PoleResidueModel, PoleResidueModel), optional
-        Precomputed :func:`green_models` for this system and variant (saves the curve fit on repeated calls).
+        Exact Green function and chi22'(0-), or the paper's fitted modes and constant chi22'(0-)
+        (:class:`~vibroimpact.analysis.paper_fit.PaperFit`: the paper's layout only, ``ValueError`` elsewhere).
     omega : array_like, optional
         Excitation angular frequency w [rad s-1] instead of ``frequency`` (keyword only).
+
+    Returns
+    -------
+    ImpactOrbit
+        Impulse, phase, existence, motion, harmonics (x1 is coordinate 0, x2 coordinate 1 on the paper's layout).
     """
-    if isinstance(system, ImpactProblem):
-        if PgfVariant(variant) is not PgfVariant.EXACT or models is not None:
-            raise ValueError(f"variant = {PgfVariant(variant).value!r}: the paper's curve fit (pgf_paper) exists for the named two-mass system only; a problem takes 'pgf'")
-        layout = closed_form_layout(system)
-        if layout.two_sided:
-            raise ValueError("contact: the stops form a symmetric two-sided stop, whose closed form has two impacts per period: use analysis.two_sided.solve_two_impacts")
-        return solve_impact_orbit(system, frequency, clearance, restitution, amplitude, omega=omega)
-    if (frequency is None and omega is None) or clearance is None or restitution is None or amplitude is None:
-        raise TypeError("solve_one_impact(system, frequency, clearance, restitution, amplitude): the paper's form needs all five")
-    check_closed_form_inputs(clearance, restitution, amplitude)
     variant = PgfVariant(variant)
-    w, delta, r = (np.asarray(x, dtype=float) for x in np.broadcast_arrays(angular_frequency(frequency, omega), clearance, restitution))
-    green22, green12 = models if models is not None else green_models(system, variant)
-    h = system.receptances(w)
-    period = 2.0 * np.pi / w
-    chi0 = periodic_green(green22, w, 0.0)
-    if variant is PgfVariant.EXACT:
-        chi_rate_before = periodic_green(green22, w, period, derivative=1)
+    if isinstance(system, ImpactProblem):
+        problem = system
+        if closed_form_layout(problem).two_sided:
+            raise ValueError("contact: the stops form a symmetric two-sided stop, whose closed form has two impacts per period: use analysis.two_sided.solve_two_impacts")
     else:
-        chi_rate_before = np.full_like(w, -1.0 / (2.0 * system.m2))
+        if (frequency is None and omega is None) or clearance is None or restitution is None or amplitude is None:
+            raise TypeError("solve_one_impact(system, frequency, clearance, restitution, amplitude): the paper's form needs all five")
+        check_closed_form_inputs(clearance, restitution, amplitude)
+        # the paper's layout; its stop and force are placeholders: the values given replace them
+        problem = ImpactProblem(system, RigidStop(0.0, 0.0), HarmonicForce(1.0, 1.0))
+    green = PaperFit.of(problem) if variant is PgfVariant.PAPER else None
+    return solve_impact_orbit(problem, frequency, clearance, restitution, amplitude, omega=omega, green=green)
+
+
+def _paper_route(system: TwoDofSystem, omega: ArrayLike, clearance: ArrayLike, restitution: ArrayLike, amplitude: float) -> OneImpactSolution:
+    """The paper's own route on its named system, as the study values take it (to be replaced by the option)."""
+    w, delta, r = (np.asarray(x, dtype=float) for x in np.broadcast_arrays(omega, clearance, restitution))
+    green22, green12 = green_models(system, PgfVariant.PAPER)
+    h = system.receptances(w)
+    chi0 = periodic_green(green22, w, 0.0)
+    chi_rate_before = np.full_like(w, -1.0 / (2.0 * system.m2))
     c = (1.0 / (system.m2 * (1.0 + r)) + chi_rate_before) / w
     a_lin = amplitude * np.abs(h.h12)
     quad_a = c**2 + chi0**2

@@ -17,7 +17,7 @@ import numpy as np
 
 from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
 from vibroimpact.analysis.linear import linear_amplitudes
-from vibroimpact.analysis.pgf import OneImpactSolution, PgfVariant, green_models, solve_one_impact
+from vibroimpact.analysis.pgf import OneImpactSolution, _paper_route
 from vibroimpact.analysis.stability import Regime, classify, MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.model.contact import peak_acceleration_factor
 from vibroimpact.model.problem import ImpactProblem
@@ -230,7 +230,7 @@ def paper_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.n
     system = problem.named_system
     if system is None:
         raise ValueError("pgf_paper is the paper's route for its layout (a two-mass chain x1, x2; one upper stop on x2; force on x1): use pgf")
-    solution = solve_one_impact(system, omega=omega, clearance=delta, restitution=r, amplitude=scene.amplitude, variant=PgfVariant.PAPER, models=green_models(system, PgfVariant.PAPER))
+    solution = _paper_route(system, omega, delta, r, scene.amplitude)
     w = np.broadcast_to(omega, shape)
     linear = linear_amplitudes(problem, omega=w)
     fits = np.broadcast_to(linear.fits(stop_clearances(scene)[None, :, None, None, None, :]), shape)
