@@ -12,20 +12,21 @@ from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.engines.base import Trajectory
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.analysis.linear import linear_response
-from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
+from vibroimpact.analysis.impact_orbit import ImpactOrbit
+from vibroimpact.analysis.pgf import solve_one_impact
 from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
 
 
-def pgf_start(frequency: float, restitution: float, clearance: float = PAPER_CLEARANCE, system: TwoDofSystem = PAPER_SYSTEM) -> tuple[ImpactProblem, np.ndarray, float, OneImpactSolution]:
+def pgf_start(frequency: float, restitution: float, clearance: float = PAPER_CLEARANCE, system: TwoDofSystem = PAPER_SYSTEM) -> tuple[ImpactProblem, np.ndarray, float, ImpactOrbit]:
     """Problem whose force phase puts the PGF impacts at t = k T, and the orbit's state at t = T/2."""
     orbit = solve_one_impact(system, omega=np.array([2 * np.pi * frequency]), clearance=clearance, restitution=restitution, amplitude=PAPER_AMPLITUDE)
     assert orbit.exists[0]
-    phase = float(orbit.phase[0] - np.angle(orbit.receptances.h12[0]))
+    phase = float(orbit.phase[0] - np.angle(orbit.gap_response[0]))
     problem = ImpactProblem(system, RigidStop(clearance, restitution), HarmonicForce(PAPER_AMPLITUDE, frequency, phase=phase))
     half = np.array([[0.5 / frequency]])
-    state = np.array([orbit.x1(half)[0, 0], orbit.x2(half)[0, 0], orbit.x1(half, 1)[0, 0], orbit.x2(half, 1)[0, 0]])
+    state = orbit.state(half)[0, 0]
     return problem, state, 0.5 / frequency, orbit
 
 
@@ -34,6 +35,12 @@ def named(problem: ImpactProblem) -> TwoDofSystem:
     system = TwoDofSystem.of(problem.system)
     assert system is not None, "not the two-mass chain"
     return system
+
+
+def orbit_force(system: TwoDofSystem, orbit: ImpactOrbit) -> np.ndarray:
+    """Eq. 23: the fundamental of the force on the base of a one-impact orbit of the paper's layout, suspension
+    (K1 + j w B1) X1 plus the impulse train's 2 J / T through the stop [N], time from the impact."""
+    return (system.k1 + 1j * orbit.omega * system.b1) * orbit.harmonics()[..., 0] + 2.0 * orbit.impulse / orbit.period
 
 
 def linear_state(problem: ImpactProblem, t: float = 0.0) -> np.ndarray:

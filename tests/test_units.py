@@ -29,8 +29,8 @@ PROBLEM = ImpactProblem(PAPER_SYSTEM, (Stop(RigidStop(3e-3, 0.2), coordinate=1),
 
 
 def test_25_means_25_hz_in_the_closed_forms() -> None:
-    """The paper's form at 25.0 is the problem's own closed form at 25 Hz (an independent path: the general layout's
-    orbit of the problem), and the angular spelling gives the same numbers."""
+    """The paper's form at 25.0 is the problem's own closed form at 25 Hz (built from the named system's values rather
+    than the problem's), and the angular spelling gives the same numbers."""
     named = solve_one_impact(PAPER_SYSTEM, 25.0, 3e-3, 0.2, 10.0)
     general = solve_one_impact(PROBLEM)
     angular = solve_one_impact(PAPER_SYSTEM, clearance=3e-3, restitution=0.2, amplitude=10.0, omega=2.0 * math.pi * 25.0)

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from vibroimpact.analysis.pgf import OneImpactSolution, solve_one_impact
+from vibroimpact.analysis.impact_orbit import ImpactOrbit
+from vibroimpact.analysis.pgf import solve_one_impact
 from vibroimpact.analysis.stability import floquet_multipliers, is_stable
 from vibroimpact.model.system import TwoDofSystem
 
@@ -16,15 +17,15 @@ from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
 class ImpactSimulator:
     """DOP853 with exact impact events: an integrator independent of the closed form and of the monodromy."""
 
-    def __init__(self, system: TwoDofSystem, orbit: OneImpactSolution) -> None:
+    def __init__(self, system: TwoDofSystem, orbit: ImpactOrbit) -> None:
         self.system, self.orbit = system, orbit
         self.period = float(orbit.period[0])
         self.omega = float(orbit.omega[0])
-        self.forcing_phase = float(orbit.phase[0] - np.angle(orbit.receptances.h12[0]))
+        self.forcing_phase = float(orbit.phase[0] - np.angle(orbit.gap_response[0]))
         self.minv = np.linalg.inv(system.mass_matrix)
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
-        force = np.array([self.orbit.amplitude * np.cos(self.omega * t + self.forcing_phase), 0.0])
+        force = np.array([self.orbit.amplitude[0] * np.cos(self.omega * t + self.forcing_phase), 0.0])
         return np.concatenate([y[2:], self.minv @ (force - self.system.stiffness_matrix @ y[:2] - self.system.damping_matrix @ y[2:])])
 
     def run(self, y: np.ndarray, t0: float, t1: float) -> tuple[np.ndarray, list[float]]:
@@ -46,12 +47,10 @@ class ImpactSimulator:
             y[3] *= -restitution
 
     def orbit_state(self, fraction: float) -> np.ndarray:
-        t = np.array([[fraction * self.period]])
-        o = self.orbit
-        return np.array([o.x1(t)[0, 0], o.x2(t)[0, 0], o.x1(t, 1)[0, 0], o.x2(t, 1)[0, 0]])
+        return self.orbit.state(np.array([[fraction * self.period]]))[0, 0]
 
 
-def orbit(system: TwoDofSystem, frequency: float, restitution: float = 0.2) -> OneImpactSolution:
+def orbit(system: TwoDofSystem, frequency: float, restitution: float = 0.2) -> ImpactOrbit:
     return solve_one_impact(system, omega=np.array([2 * np.pi * frequency]), clearance=PAPER_CLEARANCE, restitution=restitution, amplitude=PAPER_AMPLITUDE)
 
 

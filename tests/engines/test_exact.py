@@ -157,7 +157,7 @@ def _start_at_impact(frequency: float, restitution: float) -> tuple[ImpactProble
 
     problem, _state, _t0, orbit = pgf_start(frequency, restitution)
     zero = np.array([[0.0]])
-    return problem, np.array([orbit.x1(zero)[0, 0], orbit.x2(zero)[0, 0], orbit.x1(zero, 1)[0, 0], orbit.x2(zero, 1)[0, 0]])
+    return problem, orbit.state(zero)[0, 0]
 
 
 @pytest.mark.timeout(60)

@@ -47,7 +47,7 @@ def _roots(f: float | np.ndarray, delta: float = DELTA, restitution: float = R):
     omega = 2.0 * np.pi * np.asarray(f, dtype=float)
     sol = solve_one_impact(PAPER_SYSTEM, omega=omega, clearance=delta, restitution=restitution, amplitude=Q)
     c = (1.0 / (PAPER_SYSTEM.m2 * (1.0 + restitution)) + sol.chi_rate_before) / sol.omega
-    a = Q * np.abs(sol.receptances.h12)
+    a = Q * np.abs(PAPER_SYSTEM.receptances(sol.omega).h12)
     quad_a, quad_b = c**2 + sol.chi0**2, delta * sol.chi0
     disc = quad_a * a**2 - (c * delta) ** 2
     root = np.sqrt(np.maximum(disc, 0.0))

@@ -19,14 +19,15 @@ from vibroimpact.simulation.settings import SteadySettings
 from vibroimpact.model.system import TwoDofSystem
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
+from tests.engine_cases import orbit_force
 
 
 def pgf_values(system: TwoDofSystem, frequency: float, restitution: float) -> dict[str, float]:
     orbit = solve_one_impact(system, omega=np.array([2 * np.pi * frequency]), clearance=PAPER_CLEARANCE, restitution=restitution, amplitude=PAPER_AMPLITUDE)
     return {
-        "x1": abs(orbit.x1_harmonic()[0]),
-        "x2": abs(orbit.x2_harmonic()[0]),
-        "force": abs(orbit.force_harmonic()[0]),
+        "x1": abs(orbit.harmonics()[0, 0]),
+        "x2": abs(orbit.harmonics()[0, 1]),
+        "force": abs(orbit_force(system, orbit)[0]),
         "impulse": float(orbit.impulse[0]),
     }
 

@@ -15,6 +15,8 @@ from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.kinds.concepts.scene import parse_concepts
 from vibroimpact.kinds.concepts.study import ConceptsStudy, run_concepts
 
+from tests.engine_cases import orbit_force
+
 DOCUMENT = {
     "name": "tiny_concepts",
     "system": {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0, "b1": 0.8, "b2": 0.08},
@@ -68,7 +70,7 @@ def test_the_simulated_orbit_is_the_closed_form_one(dataset: xr.Dataset) -> None
     (|X1| and the base force's fundamental, eq. 23) to 1e-6, and so does the worst stable response there."""
     concept = dataset.sel(concept="absolute")
     solution = solve_one_impact(SYSTEM, omega=2.0 * np.pi * 25.0, clearance=0.003, restitution=0.2, amplitude=10.0)
-    x1, force = float(np.abs(solution.x1_harmonic())), float(np.abs(solution.force_harmonic()))
+    x1, force = float(np.abs(solution.harmonics()[0])), float(np.abs(orbit_force(SYSTEM, solution)))
     simulated = concept.sel(simulation_frequency=25.0)
     assert abs(float(simulated["simulated_x1"]) / x1 - 1.0) <= 1e-6
     assert abs(float(simulated["simulated_base_force"]) / force - 1.0) <= 1e-6

@@ -33,6 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 from vibroimpact.analysis.greens import GREEN_CONDITION_LIMIT, green_condition, green_vector, periodic_green
 from vibroimpact.analysis.layout import ClosedFormLayout, closed_form_layout, harmonic_load
 from vibroimpact.analysis.linear import base_force as suspension_force
+from vibroimpact.analysis.paper_fit import PaperFit
 from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
 from vibroimpact.model.modal import ModalResponse, impulse_modes
 from vibroimpact.model.problem import ImpactProblem
@@ -363,6 +364,7 @@ def solve_impact_orbit(
     root: str = "+",
     *,
     omega: ArrayLike | None = None,
+    green: PaperFit | None = None,
 ) -> ImpactOrbit:
     """The closed-form impact orbit of ``problem`` (one stop, or a symmetric two-sided stop), vectorised.
 
@@ -383,6 +385,9 @@ def solve_impact_orbit(
         Which root of the impulse equation.
     omega : array_like, optional
         w [rad s-1] instead of ``frequency`` (keyword only).
+    green : PaperFit, optional
+        The paper's fitted chi22 and constant chi22'(0-) instead of the exact ones (``pgf_paper``; its layout only,
+        :mod:`~vibroimpact.analysis.paper_fit`).
     """
     layout = closed_form_layout(problem)
     check_closed_form_inputs(clearance, restitution, amplitude)
@@ -398,7 +403,7 @@ def solve_impact_orbit(
     impulse_response = h @ n
     _, static_load = problem.load()
     static = np.linalg.solve(structure.stiffness_matrix, static_load) if np.any(static_load) else np.zeros(structure.size)
-    modes = impulse_modes(structure, n)
+    modes = impulse_modes(structure, n) if green is None else green.modes(problem)
     model = modes.output(n)
     anti = layout.two_sided
     period = 2.0 * np.pi / w
@@ -406,7 +411,7 @@ def solve_impact_orbit(
     if anti:  # psi'(0-) = -psi'(T/2-): antiperiodic
         rate = -periodic_green(model, w, period / 2.0, 1, True)
     else:
-        rate = periodic_green(model, w, period, 1)
+        rate = periodic_green(model, w, period, 1) if green is None else green.rate_before(w)
     a = np.abs(response @ n)
     condition = green_condition(modes.poles, w, anti)
     impulse, phase, exists = _impulse_and_phase(w, delta - float(n @ static), r, layout.effective_mass, a, chi0, rate, root, condition <= GREEN_CONDITION_LIMIT)

@@ -27,7 +27,6 @@ import numpy as np
 from numpy.typing import NDArray, ArrayLike
 
 from vibroimpact.analysis.impact_orbit import ImpactOrbit
-from vibroimpact.analysis.pgf import OneImpactSolution
 
 __all__ = ["floquet_multipliers", "is_stable", "monodromy", "half_period_jacobian", "saltation", "MARGINAL_MODULUS", "Regime", "classify", "regime_attributes"]
 
@@ -92,68 +91,27 @@ def half_period_jacobian(orbit: ImpactOrbit) -> NDArray[np.float64]:
     return -saltation(orbit) @ _flow(orbit.layout.structure.state_matrix, orbit.period / 2.0)
 
 
-def _general_multipliers(orbit: ImpactOrbit) -> NDArray[np.complex128]:
-    matrix = monodromy(orbit)
+def floquet_multipliers(solution: ImpactOrbit) -> NDArray[np.complex128]:
+    """Floquet multipliers of each impact orbit, shape S + (2N,), sorted by decreasing modulus; NaN where no orbit
+    exists.
+
+    Parameters
+    ----------
+    solution : ImpactOrbit
+        Any structure's orbit, one- or two-sided (:func:`vibroimpact.analysis.impact_orbit.solve_impact_orbit`,
+        :func:`vibroimpact.analysis.pgf.solve_one_impact`).
+    """
+    matrix = monodromy(solution)
     size = matrix.shape[-1]
-    out = np.full(orbit.omega.shape + (size,), np.nan, dtype=complex)
-    ok = orbit.exists & np.all(np.isfinite(matrix), axis=(-2, -1))
+    out = np.full(solution.omega.shape + (size,), np.nan, dtype=complex)
+    ok = solution.exists & np.all(np.isfinite(matrix), axis=(-2, -1))
     if np.any(ok):
         values = np.linalg.eigvals(matrix[ok])
         out[ok] = np.take_along_axis(values, np.argsort(-np.abs(values), axis=-1, kind="stable"), axis=-1)
     return out
 
 
-def _flow_over_period(solution: OneImpactSolution) -> NDArray[np.float64]:
-    """exp(A T) for every point, shape (..., 4, 4), from one eigendecomposition of the state matrix."""
-    eigenvalues, vectors = np.linalg.eig(solution.system.state_matrix)
-    inverse = np.linalg.inv(vectors)
-    growth = np.exp(eigenvalues * solution.period[..., None])  # (..., 4)
-    return np.real(np.einsum("ij,...j,jk->...ik", vectors, growth, inverse))
-
-
-def floquet_multipliers(solution: OneImpactSolution | ImpactOrbit) -> NDArray[np.complex128]:
-    """Floquet multipliers of each impact orbit, shape (..., 2N); NaN where no solution exists.
-
-    Parameters
-    ----------
-    solution : OneImpactSolution or ImpactOrbit
-        The paper's solutions from :func:`vibroimpact.analysis.pgf.solve_one_impact` (in the eigenvalue solver's
-        order, as before), or any structure's (one- or two-sided; sorted by decreasing modulus).
-    """
-    if isinstance(solution, ImpactOrbit):
-        return _general_multipliers(solution)
-    system = solution.system
-    shape = solution.omega.shape
-    zeros = np.zeros(shape + (1,))
-    ends = np.concatenate([zeros, solution.period[..., None]], axis=-1)  # t = 0+ and t = T- (= 0-)
-    x1 = solution.x1(ends)
-    v1 = solution.x1(ends, 1)
-    v2 = solution.x2(ends, 1)
-    position = np.stack([x1[..., 0], solution.clearance], axis=-1)
-    forcing_phase = solution.phase - np.angle(solution.receptances.h12)
-    force = np.stack([solution.amplitude * np.cos(forcing_phase), np.zeros(shape)], axis=-1)
-    minv = np.linalg.inv(system.mass_matrix)
-
-    def vector_field(velocity: NDArray) -> NDArray:
-        acceleration = (force - position @ system.stiffness_matrix.T - velocity @ system.damping_matrix.T) @ minv.T
-        return np.concatenate([velocity, acceleration], axis=-1)
-
-    before = vector_field(np.stack([v1[..., 1], v2[..., 1]], axis=-1))
-    after = vector_field(np.stack([v1[..., 0], v2[..., 0]], axis=-1))
-    reset = np.broadcast_to(np.eye(4), shape + (4, 4)).copy()
-    reset[..., 3, 3] = -solution.restitution
-    normal = np.array([0.0, 1.0, 0.0, 0.0])
-    jump = after - np.einsum("...ij,...j->...i", reset, before)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        saltation = reset + jump[..., :, None] * normal[None, :] / before[..., 1, None, None]
-    monodromy = saltation @ _flow_over_period(solution)
-    multipliers = np.full(shape + (4,), np.nan, dtype=complex)
-    ok = solution.exists & np.all(np.isfinite(monodromy), axis=(-2, -1))
-    multipliers[ok] = np.linalg.eigvals(monodromy[ok])
-    return multipliers
-
-
-def is_stable(solution: OneImpactSolution | ImpactOrbit) -> NDArray[np.bool_]:
+def is_stable(solution: ImpactOrbit) -> NDArray[np.bool_]:
     """True where the one-impact orbit exists and all Floquet multipliers satisfy |mu| < 1."""
     moduli = np.abs(floquet_multipliers(solution))
     return solution.exists & np.all(np.isfinite(moduli), axis=-1) & np.all(np.nan_to_num(moduli, nan=np.inf) < 1.0, axis=-1)

@@ -15,7 +15,7 @@ import xarray as xr
 from vibroimpact.model.modal import fit_modal_parameters
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, STOP_QUANTITIES, Scene
 from vibroimpact.scene.variables import COORDINATE_ATTRIBUTES
-from vibroimpact.kinds.stepped.values import general_linear_values, general_pgf_values, paper_pgf_values
+from vibroimpact.kinds.stepped.values import general_linear_values, general_pgf_values
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import TASK_SECONDS, WRITE_SECONDS_PER_VARIABLE, Costs, Estimate, cluster_startup, cost_engine, os_cpus
 from vibroimpact.runs.run import provenance
@@ -85,10 +85,8 @@ def solve_each(scene: Scene, grid: StudyGrid, simulate: Callable[[str], Values],
             values = general_linear_values(scene, grid.omega, grid.base)
         elif name in ENGINE_SOLUTIONS:
             values = simulate(name)
-        elif name == "pgf_paper":
-            values = paper_pgf_values(scene, grid.omega, grid.delta, grid.r, grid.base)
-        else:
-            values = general_pgf_values(scene, grid.omega, grid.delta, grid.r, grid.base)
+        else:  # pgf, or pgf_paper: the same orbit with the paper's fitted Green function
+            values = general_pgf_values(scene, grid.omega, grid.delta, grid.r, grid.base, name)
         per_solution.append(values)
         report(f"[{i}/{total}] {name}: done")
     return per_solution

@@ -1,11 +1,13 @@
-"""The closed-form solutions (``linear``, ``pgf``) of a general scene over its grid: any structure, load and stops.
+"""The closed-form solutions (``linear``, ``pgf``, ``pgf_paper``) of a scene over its grid: any structure, load and stops.
 
 Values are named after the scene's coordinates (``<name>_amplitude``, ``<name>_rms``) and stops: a per-stop quantity
 (:data:`~vibroimpact.scene.schema.STOP_QUANTITIES`) has a leading axis of one entry per stop. The force on the base
 is the suspension's, 1^T (K + j w C) X, plus that of the absolute stops ((1^T n_k) times the impulse train's
 fundamental; a relative stop acts inside the structure). ``pgf`` is the closed-form impact orbit of
 :func:`vibroimpact.analysis.impact_orbit.solve_impact_orbit`: one impact per period on one rigid stop, or two on a
-symmetric two-sided stop (the scene checker refuses layouts without one, with the reason).
+symmetric two-sided stop (the scene checker refuses layouts without one, with the reason). ``pgf_paper`` is the same
+orbit with the paper's fitted Green function and constant chi22'(0-) (:class:`~vibroimpact.analysis.paper_fit.PaperFit`),
+where the scene has the paper's layout on its named system.
 """
 
 from __future__ import annotations
@@ -17,15 +19,14 @@ import numpy as np
 
 from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
 from vibroimpact.analysis.linear import base_force, linear_amplitudes
-from vibroimpact.analysis.pgf import OneImpactSolution, PgfVariant, green_models, solve_one_impact
+from vibroimpact.analysis.paper_fit import PaperFit
 from vibroimpact.analysis.stability import Regime, classify, MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.model.contact import peak_acceleration_factor
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.schema import MOTION_QUANTITIES, STOP_QUANTITIES, Scene
 from vibroimpact.scene.variables import STABLE_MARGINAL
 
-__all__ = ["general_linear_values", "general_pgf_values", "first_problem", "broadcast_quantities", "stop_clearances", "coordinate_quantity", "paper_pgf_values"]
+__all__ = ["general_linear_values", "general_pgf_values", "first_problem", "broadcast_quantities", "stop_clearances", "coordinate_quantity"]
 
 _IMPACT_REGIMES = (Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR)
 _LINEAR_REGIMES = (Regime.LINEAR, Regime.LINEAR_WITH_INADMISSIBLE_ONE_IMPACT, Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT)
@@ -98,21 +99,29 @@ def broadcast_quantities(scene: Scene, values: dict[str, np.ndarray], shape: tup
     return out
 
 
-def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.ndarray, shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.ndarray, shape: tuple[int, ...], solution: str = "pgf") -> dict[str, np.ndarray]:
     """The closed-form impact orbit at ``omega`` [rad s-1], clearance ``delta`` [m] and restitution ``r`` [-] where
-    it is admissible (and stable), else the linear motion where that fits; NaN elsewhere (as for the paper's pgf).
+    it is admissible (and stable), else the linear motion where that fits; NaN elsewhere.
     Where the Green function sums are ill-conditioned (near an undamped natural frequency, :attr:`ImpactOrbit.conditioned`)
     the regime is ``failed`` and every value NaN: the closed form is not valid there (the orbit is not known to be
-    absent, so neither ``none`` nor ``linear`` would be honest)."""
+    absent, so neither ``none`` nor ``linear`` would be honest).
+
+    ``solution`` ``pgf_paper`` takes the paper's fitted Green function and constant chi22'(0-) (``ValueError`` if the
+    scene does not have the paper's layout on its named system). Its orbits are not orbits of the real system (x2'(0-)
+    is not the impact law's), so they have no Floquet analysis: ``floquet_modulus`` NaN, ``stable`` -1, and an
+    admissible orbit is reported where the linear motion also fits."""
     problem = first_problem(scene)
     w, d, rr = np.broadcast_arrays(omega, delta, r)
-    orbit = solve_impact_orbit(problem, omega=w, clearance=d, restitution=rr)
+    if solution not in ("pgf", "pgf_paper"):
+        raise ValueError(f"solution = {solution!r}: the closed-form orbits are 'pgf' and 'pgf_paper'")
+    green = PaperFit.of(problem) if solution == "pgf_paper" else None
+    orbit = solve_impact_orbit(problem, omega=w, clearance=d, restitution=rr, green=green)
     linear = linear_amplitudes(problem, omega=w)
     fits = linear.fits(stop_clearances(scene)[None, :, None, None, None, :])
     settings = scene.settings.admissibility
     admissible = orbit.admissible(settings.relative_tolerance, settings.samples_per_period)
     regime = classify(np.broadcast_to(fits, w.shape), orbit.exists, admissible)
-    modulus = np.where(admissible, np.max(np.abs(floquet_multipliers(orbit)), axis=-1), np.nan)
+    modulus = np.where(admissible, np.max(np.abs(floquet_multipliers(orbit)), axis=-1), np.nan) if green is None else np.full(w.shape, np.nan)
     unstable = modulus > 1.0 + MARGINAL_MODULUS
     regime[(regime == Regime.ONE_IMPACT_COEXISTING_LINEAR) & unstable] = Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT
     regime[~np.broadcast_to(orbit.conditioned, regime.shape)] = Regime.FAILED  # ill-conditioned sums: values NaN
@@ -197,86 +206,3 @@ def _peak_estimates(scene: Scene, orbit: ImpactOrbit, count: int) -> tuple[np.nd
     force_out[list(orbit.layout.stops)] = force
     acceleration_out[list(orbit.layout.stops)] = acceleration
     return force_out, acceleration_out
-
-
-# --------------------------------------------------------------------------------------------------------------------
-# ``pgf_paper``: the paper's own closed form over a study's grid, where the scene has the paper's layout on its named
-# system (:attr:`vibroimpact.model.problem.ImpactProblem.named_system`; the scene checker refuses it elsewhere).
-# --------------------------------------------------------------------------------------------------------------------
-
-def paper_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.ndarray, shape: tuple[int, ...]) -> dict[str, np.ndarray]:
-    """The paper's one-impact orbit at ``omega`` [rad s-1] (axes of the full grid), clearance ``delta`` [m] and
-    restitution ``r`` [-] where it is admissible, else the linear motion where that fits; NaN elsewhere. Each of the
-    scene's quantities is computed only if asked for, broadcast to ``shape`` (per-stop ones to (1, *shape)).
-
-    Raises
-    ------
-    ValueError
-        If the scene does not have the paper's layout on its named system.
-    """
-    problem = first_problem(scene)
-    system = scene.layout.paper_view()
-    if system is None:
-        raise ValueError("pgf_paper is the paper's route for its layout (a two-mass chain x1, x2; one upper stop on x2; force on x1): use pgf")
-    solution = solve_one_impact(system, omega=omega, clearance=delta, restitution=r, amplitude=scene.amplitude, variant=PgfVariant.PAPER, models=green_models(system, PgfVariant.PAPER))
-    w = np.broadcast_to(omega, shape)
-    linear = linear_amplitudes(problem, omega=w)
-    fits = np.broadcast_to(linear.fits(stop_clearances(scene)[None, :, None, None, None, :]), shape)
-    regime = classify(fits, solution.exists, solution.admissible(scene.settings.admissibility))
-    regime[~np.broadcast_to(solution.conditioned, regime.shape)] = Regime.FAILED  # ill-conditioned sums: values NaN
-    impact = np.isin(regime, _IMPACT_REGIMES)
-    free = np.isin(regime, _LINEAR_REGIMES)
-
-    def choose(impact_value: np.ndarray, linear_value: np.ndarray) -> np.ndarray:
-        return np.where(impact, impact_value, np.where(free, linear_value, np.nan))
-
-    def per_stop(values: np.ndarray) -> np.ndarray:
-        return np.broadcast_to(values, shape)[None]
-
-    rms = functools.cache(solution.rms)
-    peaks = functools.cache(lambda: _paper_peak_estimates(scene, system, solution, r, shape))
-    x = linear.coordinates
-    linear_force = np.abs(base_force(scene.layout.structure, w, x))
-    linear_rms = np.sqrt(linear.static**2 + 0.5 * np.abs(x) ** 2)
-    nan = np.full(shape, np.nan)
-    makers: dict[str, Callable[[], np.ndarray]] = {
-        "regime": lambda: regime,
-        "x1_amplitude": lambda: choose(np.abs(solution.x1_harmonic()), np.abs(x[..., 0])),
-        "x2_amplitude": lambda: choose(np.abs(solution.x2_harmonic()), np.abs(x[..., 1])),
-        "force_amplitude": lambda: choose(np.abs(solution.force_harmonic()), linear_force),
-        "suspension_force_amplitude": lambda: choose(np.abs(solution.suspension_force_harmonic()), linear_force),
-        "impulse": lambda: per_stop(choose(solution.impulse, np.zeros(shape))),
-        "phase": lambda: np.where(impact, solution.phase, np.nan),
-        "floquet_modulus": lambda: nan,  # the paper's orbits are not orbits of the real system: no Floquet analysis
-        "stable": lambda: np.full(shape, -1, dtype=np.int8),
-        # the raw one-impact solution of eqs. 15-18 wherever it exists, admissible or not (what the paper plots)
-        "one_impact_x1_amplitude": lambda: np.where(solution.exists, np.abs(solution.x1_harmonic()), np.nan),
-        "one_impact_x2_amplitude": lambda: np.where(solution.exists, np.abs(solution.x2_harmonic()), np.nan),
-        "one_impact_force_amplitude": lambda: np.where(solution.exists, np.abs(solution.force_harmonic()), np.nan),
-        "one_impact_impulse": lambda: per_stop(solution.impulse),
-        "impacts_per_period": lambda: np.where(impact, 1.0, np.where(free, 0.0, np.nan)),
-        "converged": lambda: np.full(shape, -1, dtype=np.int8),
-        "x1_rms": lambda: choose(rms()[0], linear_rms[..., 0]),
-        "x2_rms": lambda: choose(rms()[1], linear_rms[..., 1]),
-        "peak_acceleration": lambda: per_stop(choose(peaks()[0], np.zeros(shape))),
-        "peak_contact_force": lambda: per_stop(choose(peaks()[1], np.zeros(shape))),
-        "wall_time": lambda: nan,
-        **{name: (lambda: nan) for name in MOTION_QUANTITIES},
-    }
-    return broadcast_quantities(scene, {q: makers[q]() for q in scene.settings.quantities}, shape)
-
-
-def _paper_peak_estimates(scene: Scene, system: TwoDofSystem, solution: OneImpactSolution, r: np.ndarray, shape: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
-    """Peak deceleration of the absorber [m s-2] and peak bumper force [N] from the paper's impulse (section 6.3,
-    corrected): one collision with the bumper entered at J / (M2 (1 + R)) peaks at M2 Gamma(xi_b) Omega_b v0; the
-    deceleration is that force less the absorber spring's pull at the impact, K2 (X1 - Delta) + B2 (X1' - X2'(0-)),
-    over M2. NaN without one bumper frequency (a swept bumper: one per grid point)."""
-    if scene.settings.bumper_frequency is None:
-        return np.full(shape, np.nan), np.full(shape, np.nan)
-    gamma = np.array([peak_acceleration_factor(xi) if np.isfinite(xi) else np.nan for xi in scene.settings.loss_factors()])[:, None, None, None, None]
-    omega_b = 2.0 * np.pi * scene.settings.bumper_frequency[None, None, :, None, None]
-    force = gamma * omega_b * solution.impulse / (1.0 + r)
-    at_impact = np.zeros(1)
-    with np.errstate(invalid="ignore"):
-        spring = system.k2 * (solution.x1(at_impact)[..., 0] - solution.clearance) + system.b2 * (solution.x1(at_impact, 1)[..., 0] - solution.pre_impact_velocity)
-    return np.broadcast_to((force - spring) / system.m2, shape), np.broadcast_to(force, shape)

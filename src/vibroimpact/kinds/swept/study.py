@@ -26,7 +26,7 @@ from vibroimpact.engines.registry import make_engine
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.kinds.stepped.grid import StudyGrid, finish_dataset, grid_coordinates, EnginePart, grid_estimate
 from vibroimpact.kinds.stepped.study import closed_form_scale, describe_stops, general_quantity_attributes
-from vibroimpact.kinds.stepped.values import general_linear_values, general_pgf_values, paper_pgf_values
+from vibroimpact.kinds.stepped.values import general_linear_values, general_pgf_values
 from vibroimpact.model.contact import Stop
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem
@@ -292,9 +292,7 @@ def closed_form_values(scene: Scene, name: str, grid: StudyGrid) -> Values:
     scene's quantities; per-stop ones with a leading axis of one entry per stop."""
     if name == "linear":
         return general_linear_values(scene, grid.omega, grid.base)
-    if name == "pgf":
-        return general_pgf_values(scene, grid.omega, grid.delta, grid.r, grid.base)
-    return paper_pgf_values(scene, grid.omega, grid.delta, grid.r, grid.base)  # the paper's fitted route (its layout only)
+    return general_pgf_values(scene, grid.omega, grid.delta, grid.r, grid.base, name)  # pgf_paper: the paper's fitted Green function (its layout only)
 
 
 def swept_values(scene: Scene, shape: tuple[int, ...], runner: Runner) -> tuple[Values, Values, Values]:
