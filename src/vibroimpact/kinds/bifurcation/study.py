@@ -57,7 +57,6 @@ from vibroimpact.model.contact import loss_factor_from_restitution
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
-from vibroimpact.model.layout import build_stops, describe_stop
 from vibroimpact.scene.schema import Scene
 from vibroimpact.scene.variables import COORDINATE_ATTRIBUTES, STABLE_ATTRIBUTES, flag_attributes
 from vibroimpact.kinds.bifurcation.variables import BIFURCATION_ATTRIBUTES
@@ -428,19 +427,9 @@ def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult],
 
 
 def _layout_attributes(scene: Scene) -> dict[str, object]:
-    """The structure, load and stops the study ran (plain netCDF attributes: matrices flattened row by row)."""
-    structure = scene.layout.structure
-    load = scene.layout.load
-    size = structure.size
-    names = tuple(structure.coordinates)
-    return {
-        "system_coordinates": " ".join(names),
-        "system_mass_kg": structure.mass_matrix.ravel(),
-        "system_stiffness_N_per_m": structure.stiffness_matrix.ravel(),
-        "system_damping_N_s_per_m": structure.damping_matrix.ravel(),
-        "excitation_kind": "base_motion" if load.base_motion else "force",
-        f"excitation_amplitude_{'m' if load.base_motion else 'N'}": scene.amplitude,
-        "excitation_weights": np.array(load.weights if load.weights is not None else [1.0] + [0.0] * (size - 1)),
-        "excitation_static_N": np.array(load.static if load.static is not None else [0.0] * size),
-        "stop_layout": "; ".join(describe_stop(spec, names, scene.settings.clearance) for spec in scene.layout.stops),
-    }
+    """The structure, load and stops the study ran, written by the one writer of layout attributes
+    (:meth:`~vibroimpact.model.layout.Layout.attributes`, read back by ``Layout.from_attributes``), and the
+    excitation amplitude. The stops are described with the study's clearance and without a restitution: each diagram
+    has its own."""
+    base_motion = scene.layout.load.base_motion
+    return scene.layout.attributes(np.array([]), np.array([scene.settings.clearance])) | {f"excitation_amplitude_{'m' if base_motion else 'N'}": scene.amplitude}

@@ -1,0 +1,86 @@
+"""The layout value: one structure, load and stop geometry that builds problems, writes and reads a dataset's layout
+attributes, and alone says whether it is the paper's layout."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.layout import PAPER_STOP, Layout, LoadSpec, StopSpec
+from vibroimpact.model.structure import LinearStructure
+from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
+
+from tests.golden.golden import DATA
+
+#: A chain whose K1 does not survive (K1 + K2) - K2 in double precision: 0.1 + 0.2 - 0.2 = 0.10000000000000003.
+ROUNDING = TwoDofSystem(m1=1.0, m2=0.1, k1=0.1, k2=0.2, b1=0.01, b2=0.002)
+
+
+def test_the_named_form_keeps_its_parameters_unrounded() -> None:
+    assert TwoDofSystem.of(ROUNDING.structure).k1 != 0.1  # exact: the matrices alone lose the last bit of K1 (0.10000000000000003)
+    view = Layout(ROUNDING).paper_view()
+    assert view is not None and view.k1 == 0.1 and view.b1 == 0.01  # exact: the parameters as written
+    assert Layout(ROUNDING).with_stops((PAPER_STOP,)).paper_view() is view
+
+
+@pytest.mark.parametrize(
+    ("load", "stops", "size"),
+    [
+        (LoadSpec(), (StopSpec(1, side="lower"),), 2),
+        (LoadSpec(), (StopSpec(1, other=0),), 2),
+        (LoadSpec(), (StopSpec(0),), 2),
+        (LoadSpec(), (PAPER_STOP, StopSpec(1, side="lower")), 2),
+        (LoadSpec(weights=(0.0, 1.0)), (PAPER_STOP,), 2),
+        (LoadSpec(static=(0.0, -1.0)), (PAPER_STOP,), 2),
+        (LoadSpec(base_motion=True), (PAPER_STOP,), 2),
+        (LoadSpec(), (PAPER_STOP,), 3),
+    ],
+    ids=["lower", "relative", "on-x1", "two-stops", "force-on-x2", "static", "base-motion", "three-masses"],
+)
+def test_only_the_papers_layout_has_the_paper_view(load: LoadSpec, stops: tuple[StopSpec, ...], size: int) -> None:
+    structure = PAPER_SYSTEM.structure if size == 2 else LinearStructure(np.eye(3), [[2.0, -1.0, 0.0], [-1.0, 2.0, -1.0], [0.0, -1.0, 1.0]])
+    assert Layout(structure, load, stops).paper_view() is None
+    assert Layout(PAPER_SYSTEM.structure, LoadSpec(weights=(1.0, 0.0)), (StopSpec(1, clearance=0.003),)).paper_view() is not None  # however written
+
+
+def test_a_problem_is_the_layout_at_one_grid_point() -> None:
+    layout = Layout(PAPER_SYSTEM.structure, LoadSpec(weights=(1.0, 0.0)), (StopSpec(1, other=0, clearance=0.002), StopSpec(1, other=0, side="lower")))
+    problem = layout.problem(10.0, 25.0, 0.3, 0.004)
+    assert [stop.clearance for stop in problem.stops] == [0.002, 0.004]  # exact: the stop's own, then the grid's
+    assert [stop.law.restitution for stop in problem.stops] == [0.3, 0.3]  # exact: the grid's
+    assert all(isinstance(stop.law, RigidStop) for stop in problem.stops)
+    assert problem.frequency == 25.0 and problem.amplitude == 10.0  # exact: given
+    bumpers = layout.problem(10.0, 25.0, 0.3, 0.004, bumper=True, bumper_frequency=500.0)
+    assert [stop.law.frequency for stop in bumpers.stops] == [500.0, 500.0]  # exact: given
+    assert isinstance(problem.system, LinearStructure) and Layout.of_problem(problem).stops == tuple(StopSpec(1, 0, s) for s in ("upper", "lower"))
+
+
+def test_the_attributes_read_back_as_the_same_layout() -> None:
+    structure = LinearStructure(np.diag([1.0, 0.5, 0.05]), [[2e4, -1e4, 0.0], [-1e4, 1.02e4, -200.0], [0.0, -200.0, 200.0]], np.eye(3) * 0.1, ("floor1", "floor2", "absorber"))
+    layout = Layout(structure, LoadSpec(static=(0.0, 0.0, -0.49), base_motion=True), (StopSpec(2, other=1, clearance=0.003), StopSpec(2, other=1, side="lower")))
+    attrs = layout.attributes(np.array([0.2]), np.array([0.004, 0.005]))
+    back = Layout.from_attributes(attrs)
+    assert back.structure == structure and back.load == layout.load
+    assert back.stops == (StopSpec(2, 1, "upper", 0.003), StopSpec(2, 1, "lower", None))  # the swept clearance stays the grid's
+    assert attrs["stop_layout"] == "absorber - floor2 <= 3 mm, R = 0.2; absorber - floor2 >= -Delta, R = 0.2"
+    named = Layout(ROUNDING).attributes(np.array([0.2]), np.array([0.003]))
+    view = Layout.from_attributes(named).paper_view()
+    assert view is not None and view.k1 == 0.1  # exact: the recorded parameter, not K[0, 0] - K2
+
+
+@pytest.mark.parametrize(("name", "paper"), [("bifurcation", True), ("bifurcation_relative_stop", False), ("restitution", True), ("relative_stop", False)])
+def test_every_golden_dataset_records_its_layout(name: str, paper: bool) -> None:
+    """The bifurcation kind writes its layout with the one writer too: a page reads any kind's layout back."""
+    with xr.open_dataset(DATA / f"{name}.nc") as dataset:
+        layout = Layout.from_attributes(dataset.attrs)
+    assert (layout.paper_view() is not None) is paper
+    assert layout.coordinates == ("x1", "x2")
+
+
+def test_a_stop_on_a_missing_coordinate_is_refused() -> None:
+    with pytest.raises(ValueError, match=r"stops\[0\]: acts on a coordinate the structure does not have"):
+        Layout(PAPER_SYSTEM, LoadSpec(), (StopSpec(2),))
+    with pytest.raises(TypeError, match="stops"):
+        Layout(PAPER_SYSTEM, LoadSpec(), ())
