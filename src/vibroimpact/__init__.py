@@ -48,7 +48,7 @@ _PUBLIC = {
     "Stop": "vibroimpact.model.contact",
     "solve_one_impact": "vibroimpact.analysis.pgf",
     "solve_impact_orbit": "vibroimpact.analysis.impact_orbit",
-    "solve_two_impacts": "vibroimpact.analysis.impact_orbit",
+    "solve_two_impacts": "vibroimpact.analysis.two_sided",
     "closed_form_refusal": "vibroimpact.analysis.layout",
     "floquet_multipliers": "vibroimpact.analysis.stability",
     "linear_response": "vibroimpact.analysis.linear",

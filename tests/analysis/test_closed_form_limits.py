@@ -17,7 +17,8 @@ import xarray as xr
 
 from vibroimpact import cli
 from vibroimpact.analysis.greens import GREEN_CONDITION_LIMIT, green_condition
-from vibroimpact.analysis.impact_orbit import solve_impact_orbit, solve_two_impacts
+from vibroimpact.analysis.impact_orbit import solve_impact_orbit
+from vibroimpact.analysis.two_sided import solve_two_impacts
 from vibroimpact.analysis.pgf import PgfVariant, solve_one_impact
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.model.contact import RigidStop, Stop

@@ -11,7 +11,7 @@ import pytest
 
 from vibroimpact.analysis.impact_orbit import ImpactOrbit
 from vibroimpact.analysis.stability import floquet_multipliers, half_period_jacobian, monodromy
-from vibroimpact.analysis.impact_orbit import solve_two_impacts
+from vibroimpact.analysis.two_sided import solve_two_impacts
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem

@@ -87,7 +87,7 @@ def solve_one_impact(
     needed). ``solve_one_impact(problem, frequency=None, clearance=None, restitution=None, amplitude=None)`` with an
     :class:`ImpactProblem` of any structure with one rigid stop (absolute or relative, upper or lower) takes the
     problem's own values where none are given; ``ValueError`` saying why where it does not apply (several stops, a
-    bumper, a rigid-body mode; a symmetric two-sided stop is :func:`vibroimpact.analysis.impact_orbit.solve_two_impacts`).
+    bumper, a rigid-body mode; a symmetric two-sided stop is :func:`vibroimpact.analysis.two_sided.solve_two_impacts`).
 
     Parameters
     ----------

@@ -22,7 +22,7 @@ import xarray as xr
 import yaml
 
 from vibroimpact.analysis.stability import Regime
-from vibroimpact.model.layout import NAMED_KEYS, Layout
+from vibroimpact.model.layout import Layout
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.kinds import KIND_NAMES
@@ -203,14 +203,17 @@ def _simulation_frequency(dataset: xr.Dataset) -> np.ndarray:
 
 
 def named_view(dataset: xr.Dataset) -> TwoDofSystem | None:
-    """The named system of ``dataset``'s structure (attributes ``system_m1`` ... ``system_b2``); None where it has
-    none."""
+    """The named system of ``dataset``'s structure (attributes ``system_m1`` ... ``system_b2``, read by
+    :meth:`~vibroimpact.model.layout.Layout.from_attributes`); None where it has none."""
     return _named(dataset.attrs) if "system_m1" in dataset.attrs else None
 
 
 def _named(attrs: Mapping[str, object]) -> TwoDofSystem:
-    """The named system the attributes ``system_m1`` ... ``system_b2`` give (``KeyError`` naming one missing)."""
-    return TwoDofSystem(**{key: float(attrs[f"system_{key}"]) for key in NAMED_KEYS})  # type: ignore[arg-type]
+    """The named system the attributes record (``KeyError`` naming one missing)."""
+    named = Layout.from_attributes(attrs).named_view()
+    if named is None:
+        raise KeyError("system_m1")
+    return named
 
 
 def dataset_layout(dataset: xr.Dataset) -> Layout:
