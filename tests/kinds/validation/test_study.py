@@ -17,7 +17,7 @@ from vibroimpact.kinds.validation.formulas import PASSED_MEANINGS
 
 from tests.study.test_cf import cf_findings
 
-STUDIES = Path(__file__).resolve().parents[2] / "studies" / "validation"
+STUDIES = Path(__file__).resolve().parents[3] / "studies" / "validation"
 #: The kind is registered in the scene schema, the reader, the study kinds and the report (by their owners).
 REGISTERED = "validation" in STUDY_KINDS
 
