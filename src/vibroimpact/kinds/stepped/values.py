@@ -201,7 +201,7 @@ def _peak_estimates(scene: Scene, orbit: ImpactOrbit, count: int) -> tuple[np.nd
 
 # --------------------------------------------------------------------------------------------------------------------
 # ``pgf_paper``: the paper's own closed form over a study's grid, where the scene has the paper's layout on its named
-# system (:attr:`vibroimpact.model.problem.ImpactProblem.named_system`; the scene checker refuses it elsewhere).
+# system (:meth:`vibroimpact.model.layout.Layout.paper_view`; the scene checker refuses it elsewhere).
 # --------------------------------------------------------------------------------------------------------------------
 
 def paper_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np.ndarray, shape: tuple[int, ...]) -> dict[str, np.ndarray]:
