@@ -45,15 +45,15 @@ def system() -> TwoDofSystem:
 
 @pytest.fixture(scope="session")
 def small_bifurcation(tmp_path_factory: pytest.TempPathFactory) -> "xr.Dataset":
-    """The small bifurcation study (``tests/study/test_bifurcation.py::SMALL``) run once for the whole test run and
-    read back from its netCDF file: its dataset tests and its page tests share it, whichever workers run them (the
-    first worker to need it runs it under a file lock; the others read its file)."""
+    """The small bifurcation study (``tests/kinds/bifurcation/test_bifurcation.py::SMALL``) run once for the whole test
+    run and read back from its netCDF file: its dataset tests and its page tests share it, whichever workers run them
+    (the first worker to need it runs it under a file lock; the others read its file)."""
     import fcntl
     import os
 
     import xarray as xr
 
-    from tests.study.test_bifurcation import SMALL
+    from tests.kinds.bifurcation.test_bifurcation import SMALL
     from vibroimpact.runs.run import run_study, write_dataset
     from vibroimpact.scene import parse_scene
 

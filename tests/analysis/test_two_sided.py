@@ -20,7 +20,7 @@ from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import PAPER_SYSTEM
 
 from tests.analysis.impact_flow import ImpactFlow
-from tests.analysis.test_general_pgf import finite_difference_monodromy, scales
+from tests.analysis.test_impact_orbit import finite_difference_monodromy, scales
 
 
 def pair(clearance: float = 3e-3, restitution: float = 0.6, other: int | None = None) -> tuple[Stop, Stop]:

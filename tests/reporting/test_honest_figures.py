@@ -109,7 +109,7 @@ def test_the_two_sided_relative_stop_draws_both_stops_coordinates() -> None:
     caption says that they coincide."""
     import copy
 
-    from tests.reporting.test_general_page import CHAIN
+    from tests.kinds.stepped.test_stepped_layouts_page import CHAIN
     from vibroimpact.kinds.stepped.figures import structure_figure
     from vibroimpact.reporting.record import general_setting
     from vibroimpact.runs.run import run_study

@@ -22,7 +22,7 @@ from vibroimpact.runs.run import run_study
 
 from tests.golden.golden import SCENES
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
-from tests.study.test_swept_study import sweep_document
+from tests.kinds.swept.test_swept_study import sweep_document
 
 #: The checker's priorities: 3 errors, 2 warnings (1 is advice, not checked here).
 ERRORS_AND_WARNINGS = ("high_priorities", "medium_priorities")

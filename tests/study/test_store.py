@@ -1,5 +1,5 @@
-"""The study's chunked store (study/store.py) and the grid's blocks (study/blocks.py): blocks tile the grid once, a
-block is the same scene on fewer points (same numbers), finished blocks and cases survive a rerun, another scene or
+"""The study's chunked store (runs/store.py) and the grid's blocks (kinds/stepped/blocks.py): blocks tile the grid once,
+a block is the same scene on fewer points (same numbers), finished blocks and cases survive a rerun, another scene or
 other code starts afresh, and a second study on the same output is refused."""
 
 from __future__ import annotations

@@ -197,7 +197,7 @@ def _simulation_frequency(dataset: xr.Dataset) -> np.ndarray:
 
 # --------------------------------------------------------------------------------------------------------------------
 # What a report knows of a stepped study's structure, load and stops, read from its dataset's attributes
-# (written by :func:`vibroimpact.kinds.stepped.grid.layout_attributes`); nothing is re-validated from the scene text.
+# (written by :meth:`vibroimpact.model.layout.Layout.attributes`); nothing is re-validated from the scene text.
 # --------------------------------------------------------------------------------------------------------------------
 
 

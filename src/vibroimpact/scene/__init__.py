@@ -1,11 +1,14 @@
 """YAML scenes -> validated, frozen :class:`Scene` objects. Imports no engine, no solver library and no xarray.
 
 The grammar every kind shares: ``schema`` (what a scene says: the dataclasses, vocabulary and limits), ``checker``
-(problem-collecting checks and :class:`SceneError`), ``layout`` and ``layout_parse`` (the system, excitation and
-stops sections), ``variables`` (units, long names and flags of every variable), ``kinds`` (the table of kinds: which
-section makes a scene of which kind, and where each kind's scene parser, run and page are) and ``reader`` (safe YAML,
-:func:`parse_scene`, :func:`load_scene`, named and shipped scenes). A kind's own section is checked by its folder's
-``scene`` module (``vibroimpact.kinds.<kind>.scene``), imported only when a scene of that kind is read.
+(problem-collecting checks and :class:`SceneError`), ``header`` (what every scene has: name, description, report,
+cluster), ``layout_parse`` (the system, excitation and stops sections, read into one
+:class:`~vibroimpact.model.layout.Layout`), ``simulation`` and ``subset`` (the ``simulation`` section), ``grid`` (the
+grid grammar of the stepped and swept kinds), ``variables`` (units, long names and flags of the variables more than
+one kind writes), ``kinds`` (the table of kinds: which section makes a scene of which kind, and where each kind's
+scene parser, run and page are) and ``reader`` (safe YAML, :func:`parse_scene`, :func:`load_scene`, named and shipped
+scenes). A kind's own section is checked by its folder's ``scene`` module (``vibroimpact.kinds.<kind>.scene``),
+imported only when a scene of that kind is read.
 """
 
 from vibroimpact.scene.checker import SceneError

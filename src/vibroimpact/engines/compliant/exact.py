@@ -8,12 +8,13 @@ constant loads, the structure's K and C plus K_k n_k n_k^T and B_k n_k n_k^T for
 Each mode's flow is the ``exact`` engine's closed form (:func:`~vibroimpact.engines.exact_flows.decompose`: the
 eigen-decomposition, the harmonic particular solution, a polynomial on rigid-body modes), made once per problem for
 every mode (2^K of them) and stacked as the exact engine stacks its flows; the switches, the moments and the Jacobian
-come from the same compiled machinery (:mod:`~vibroimpact.engines.compliant.exact_loop` calls
-:mod:`~vibroimpact.engines.exact_core`'s kernels): one piecewise-linear loop with the bumper's contact law in place
-of the impact map. Onsets (the gap closing, or, after a release with the bumper still compressed, its force rising
-through zero while d > 0) and releases (the force falling through zero) are found by guaranteed root bracketing: none
-is missed however tangent, and their times are exact to round-off. No tolerance: the settings are not used (but for
-the event budget, ``max_impacts_per_period``).
+come from the same compiled machinery (:mod:`~vibroimpact.engines.compliant.exact_loop` calls the exact engine's
+kernels: :mod:`~vibroimpact.engines.exact_pieces`, :mod:`~vibroimpact.engines.exact_roots`,
+:mod:`~vibroimpact.engines.exact_core`, :mod:`~vibroimpact.engines.exact_moments`): one piecewise-linear loop with
+the bumper's contact law in place of the impact map. Onsets (the gap closing, or, after a release with the bumper
+still compressed, its force rising through zero while d > 0) and releases (the force falling through zero) are found
+by guaranteed root bracketing: none is missed however tangent, and their times are exact to round-off. No tolerance:
+the settings are not used (but for the event budget, ``max_impacts_per_period``).
 
 Records are those of the compliant integrators (:class:`~vibroimpact.engines.compliant.ida.CompliantEngine`): each
 completed contact is an impact (onset time, entry speed n_k . x' at the onset, impulse = integral of F_k) with its

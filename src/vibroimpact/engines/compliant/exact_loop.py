@@ -203,7 +203,7 @@ def run_bumper_periods(
     omega, period, obsw, obso, velw, salts, zero_har, gap_tolerance, force_tolerances, max_events, gl_nodes, gl_weights,
     y_start, t_start, periods, want_moments, want_jacobians, want_approach,
 ):  # fmt: skip
-    """Integrate ``periods`` periods from (t_start, y_start); see :class:`~vibroimpact.engines.compliant_exact.CompliantExactEngine`.
+    """Integrate ``periods`` periods from (t_start, y_start); see :class:`~vibroimpact.engines.compliant.exact.CompliantExactEngine`.
 
     Returns (status, t, strobes (periods + 1, n), jacobians (periods, n, n), contacts (c, 6): onset time, entry
     speed n . x', impulse, largest force, largest deceleration, stop, of each completed contact; segments (s, 2):

@@ -1,4 +1,4 @@
-"""Time-domain steady states of the absorber concepts, as cases for :func:`vibroimpact.runs.runner.run_cases`.
+"""Time-domain steady states of the absorber concepts, as cases for :meth:`vibroimpact.runs.runner.Runner.map`.
 
 A case is one concept over a chunk of frequencies. At each frequency the ``exact`` engine marches the rigid stops to
 their steady state (from the closed-form impact orbit where the package has one, else from the linear steady state,

@@ -10,7 +10,7 @@ For every concept of the scene (:mod:`vibroimpact.kinds.concepts.scene`):
    (:mod:`~vibroimpact.kinds.concepts.branches`): stable and unstable stretches;
 4. the worst stable response and the figures of merit (:mod:`~vibroimpact.kinds.concepts.metrics`).
 
-Steps 2 and 3 run in ``jobs`` processes through :func:`vibroimpact.runs.runner.run_cases` (resumable cache).
+Steps 2 and 3 run in ``jobs`` processes through :meth:`vibroimpact.runs.runner.Runner.map` (resumable cache).
 Output contract: dimensions ``concept`` (names), ``frequency`` [Hz] (fine grid), ``simulation_frequency`` [Hz] and
 ``point`` (continued orbits); see :func:`concepts_dataset` for the variables.
 """

@@ -39,7 +39,7 @@ __all__ = ["SimulationCase", "run_case", "general_simulated_values", "simulated_
 
 
 # --------------------------------------------------------------------------------------------------------------------
-# Steady states of the time-domain engines over a study's grid, as cases for :func:`vibroimpact.runs.runner.run_cases`.
+# Steady states of the time-domain engines over a study's grid: cases for :meth:`vibroimpact.runs.runner.Runner.map`.
 # --------------------------------------------------------------------------------------------------------------------
 
 #: Fields of a case result, one value per frequency (the coordinates' fundamentals and RMS are per coordinate:
@@ -87,7 +87,7 @@ class SimulationCase:
     frequencies : tuple of float
         Excitation frequencies [Hz].
     start : str
-        A start of :data:`~vibroimpact.simulation.steady.START_MODES` or of :data:`~vibroimpact.simulation.steady.SWEEP_STARTS`.
+        A start of :data:`~vibroimpact.simulation.settings.START_MODES` or of :data:`~vibroimpact.simulation.settings.SWEEP_STARTS`.
     engine_settings, steady_settings
         Numerical settings.
     orbit_stop : RigidStop, tuple of Stop, or None

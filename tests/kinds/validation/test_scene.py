@@ -11,7 +11,7 @@ from vibroimpact.scene.reader import read_yaml
 from vibroimpact.kinds.validation.scene import read_validation_scene
 from vibroimpact.kinds.validation.settings import CASE_PARAMETERS, VALIDATION_CASES, BuddDuxCase
 
-STUDIES = Path(__file__).resolve().parents[2] / "studies" / "validation"
+STUDIES = Path(__file__).resolve().parents[3] / "studies" / "validation"
 
 
 def _read(text: str):

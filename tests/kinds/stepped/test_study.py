@@ -14,7 +14,7 @@ from vibroimpact.scene import load_scene, parse_scene
 from vibroimpact.runs.run import write_dataset
 from vibroimpact.runs.run import run_study
 
-DATA = Path(__file__).parents[1] / "data"
+DATA = Path(__file__).parents[2] / "data"
 
 
 def small_scene(**changes: object) -> dict:

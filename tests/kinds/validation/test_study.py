@@ -17,7 +17,7 @@ from vibroimpact.kinds.validation.formulas import PASSED_MEANINGS
 
 from tests.study.test_cf import cf_findings
 
-STUDIES = Path(__file__).resolve().parents[2] / "studies" / "validation"
+STUDIES = Path(__file__).resolve().parents[3] / "studies" / "validation"
 #: The kind is registered in the scene schema, the reader, the study kinds and the report (by their owners).
 REGISTERED = "validation" in STUDY_KINDS
 
@@ -44,7 +44,7 @@ def test_dataset_table_and_page(tmp_path: Path) -> None:
     assert ValidationPage(dataset).summary() == f"validation case zeno: {dataset.sizes['check']} of {dataset.sizes['check']} checks passed"
 
 
-@pytest.mark.skipif(not REGISTERED, reason="the kind 'validation' is not registered yet (scene/schema.py, reader, study/kinds.py, reporting/page.py)")
+@pytest.mark.skipif(not REGISTERED, reason="the kind 'validation' is not registered yet (scene/schema.py, reader, scene/kinds.py, reporting/page.py)")
 def test_every_shipped_scene_is_a_validation_scene() -> None:
     """Once registered, the scene reader dispatches on the ``validation`` section and the scene's kind says so."""
     from vibroimpact.scene import load_scene
@@ -54,7 +54,7 @@ def test_every_shipped_scene_is_a_validation_scene() -> None:
         assert scene.kind == "validation" and scene.settings is not None and scene.settings.name in path.stem
 
 
-@pytest.mark.skipif(not REGISTERED, reason="the kind 'validation' is not registered yet (scene/schema.py, reader, study/kinds.py, reporting/page.py)")
+@pytest.mark.skipif(not REGISTERED, reason="the kind 'validation' is not registered yet (scene/schema.py, reader, scene/kinds.py, reporting/page.py)")
 def test_run_study_runs_a_validation_scene(tmp_path: Path) -> None:
     """Once registered, ``run-study`` reads, runs and reports a validation scene like any other."""
     from vibroimpact.cli import main

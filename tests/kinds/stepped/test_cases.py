@@ -1,4 +1,4 @@
-"""Steady-state cases of a study (study/cases.py): stepped sweeps from point to point, the resumable store, dask
+"""Steady-state cases of a study (kinds/stepped/cases.py): stepped sweeps from point to point, the resumable store, dask
 workers against one process, and a failing point that costs only itself."""
 
 from __future__ import annotations

@@ -128,7 +128,7 @@ def test_the_sections_follow_what_the_dataset_holds(changes: dict[str, Any], ext
 
 def test_the_paper_layout_as_matrices_may_ask_for_the_design_map_and_pgf_paper() -> None:
     """What the named form may ask for, the matrix form of the same layout may too (the design map, the paper's
-    route); the same masses with another stop may not (tests/scene/test_general_scene.py)."""
+    route); the same masses with another stop may not (tests/scene/test_scene_layout.py)."""
     document = matrix_scene() | {"solutions": ["linear", "pgf", "pgf_paper"], "report": "design_map"}
     document.pop("simulation")
     document["stops"][0].pop("clearance")
