@@ -17,7 +17,7 @@ from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
 from vibroimpact.simulation.harmonics import measure, running_at, running_fundamental, window_times
 
 from tests.conftest import PAPER_AMPLITUDE
-from tests.engine_cases import linear_state, orbit_force, pgf_start
+from tests.engine_cases import linear_state, named, orbit_force, pgf_start
 
 ENGINE = ExactEngine()
 
@@ -75,7 +75,7 @@ def test_one_impact_orbit_measures_the_pgf_solution(frequency: float, restitutio
     np.testing.assert_allclose(m.contact_force, 2.0 * impulse * frequency, rtol=1e-10, atol=1e-10 * impulse * frequency)
     np.testing.assert_allclose(m.x1, orbit.harmonics()[0, 0], rtol=1e-9)
     np.testing.assert_allclose(m.x2, orbit.harmonics()[0, 1], rtol=1e-9)
-    np.testing.assert_allclose(m.force, orbit_force(problem.system, orbit)[0], rtol=1e-9)
+    np.testing.assert_allclose(m.force, orbit_force(named(problem), orbit)[0], rtol=1e-9)
     x1_rms, x2_rms = orbit.rms()[0]  # Gauss-Legendre over the smooth open period: exact to round-off
     assert m.x1_rms == pytest.approx(x1_rms, rel=1e-9)
     assert m.x2_rms == pytest.approx(x2_rms, rel=1e-9)
