@@ -68,7 +68,7 @@ def test_a_bumper_map_runs_on_the_engine_the_registry_offers_for_bumpers() -> No
     mapping = ImpactMap(problem(25.0, 250.0))
     assert mapping.engine.capabilities.contact == BUMPER and mapping.engine.capabilities.exact_jacobians
     assert mapping.parameters[1] == pytest.approx(R, rel=1e-12)
-    law = mapping.problem_at(np.array([25.0, 0.5, 2e-3, 10.0])).stops[0].law
+    law = mapping.problem_at(np.array([25.0, 0.5, 2e-3, 10.0, 0.0])).stops[0].law
     assert isinstance(law, KelvinVoigtBumper) and law.frequency == 250.0 and law.clearance == 2e-3  # exact: copied inputs
     assert law.restitution == pytest.approx(0.5, rel=1e-12)
     assert mapping.problem_at(mapping.parameters).stops[0].law.loss_factor == problem(25.0, 250.0).stops[0].law.loss_factor  # exact: its own, kept

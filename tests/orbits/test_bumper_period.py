@@ -45,28 +45,28 @@ def _fold(mapping: ImpactMap, orbit: object) -> object:
     return folds[0]
 
 
-def test_the_bumper_period_is_the_fifth_parameter_and_keeps_the_restitution() -> None:
+def test_the_bumper_period_is_the_last_parameter_and_keeps_the_restitution() -> None:
     """T_b = 1 / (Omega_b / 2 pi); setting it changes Omega_b alone (the loss factor, hence R, kept); T_b <= 0 has no
     image; a rigid stop is refused with the reason."""
     mapping = BumperPeriodMap(problem(25.0, 1000.0), bounds={BUMPER_PERIOD: PERIODS})
-    assert mapping.parameter_names[-1] == BUMPER_PERIOD and mapping.parameters.shape == (5,)
-    assert mapping.parameters[4] == pytest.approx(1e-3, rel=1e-15)
+    assert mapping.parameter_names[-1] == BUMPER_PERIOD and mapping.parameters.shape == (6,)
+    assert mapping.parameters[-1] == pytest.approx(1e-3, rel=1e-15)
     p = mapping.parameters.copy()
-    p[4] = 1.0 / 4000.0
+    p[-1] = 1.0 / 4000.0
     law = mapping.problem_at(p).stops[0].law
     assert isinstance(law, KelvinVoigtBumper) and law.frequency == pytest.approx(4000.0, rel=1e-15)
     assert law.restitution == pytest.approx(R, rel=1e-12) and law.clearance == PAPER_CLEARANCE  # exact: copied input
     y = shot(25.0, 1000.0)[1].state  # type: ignore[attr-defined]
     for bad in (0.0, -1e-3, 1e-2):  # not positive; outside the bounds
         q = mapping.parameters.copy()
-        q[4] = bad
+        q[-1] = bad
         assert np.all(np.isnan(mapping.evaluate(y, q).image)), bad
-    assert isinstance(mapping.with_periods(2), BumperPeriodMap) and mapping.with_periods(2).parameters.shape == (5,)
+    assert isinstance(mapping.with_periods(2), BumperPeriodMap) and mapping.with_periods(2).parameters.shape == (6,)
     rigid = ImpactProblem(PAPER_SYSTEM, RigidStop(PAPER_CLEARANCE, R), HarmonicForce(PAPER_AMPLITUDE, 25.0))
     with pytest.raises(ValueError, match="needs Kelvin-Voigt bumpers on every selected stop"):
         BumperPeriodMap(rigid)
-    with pytest.raises(ValueError, match=r"expected 5 positive numbers \(frequency, restitution, clearance, amplitude, bumper_period\)"):
-        BumperPeriodMap(problem(25.0, 1000.0), parameter_scale=(1.0, 0.1, 1e-3, 1.0))
+    with pytest.raises(ValueError, match=r"expected 6 positive numbers \(frequency, restitution, clearance, amplitude, phase, bumper_period\)"):
+        BumperPeriodMap(problem(25.0, 1000.0), parameter_scale=(1.0, 0.1, 1e-3, 1.0, 1.0))
 
 
 @pytest.mark.slow
@@ -80,7 +80,7 @@ def test_the_fold_continued_in_the_bumper_period_joins_the_bumpers_folds_and_the
     stiff = BumperPeriodMap(problem(25.0, 4000.0), bounds={"frequency": (15.0, 45.0), BUMPER_PERIOD: PERIODS})
     fold = _fold(stiff, shoot(stiff, orbit.state, stiff.parameters))  # type: ignore[attr-defined]
     curve = continue_special_point(stiff, fold, BUMPER_PERIOD, CURVE, bounds={BUMPER_PERIOD: PERIODS, "frequency": (15.0, 45.0)})  # type: ignore[arg-type]
-    periods = np.array([o.parameters[4] for o in curve.orbits])
+    periods = np.array([o.parameter(BUMPER_PERIOD) for o in curve.orbits])
     frequencies = np.array([o.parameters[0] for o in curve.orbits])
     assert periods.min() < 1.05 / 64000.0 and periods.max() > 0.95 / 200.0, curve.end  # the whole range
     assert all(o.residual < 1e-11 and abs(np.linalg.det(o.monodromy - np.eye(4))) < 1e-8 for o in curve.orbits)  # measured 2e-12, 9e-10

@@ -73,7 +73,7 @@ def test_stop_selection_and_scales() -> None:
     choice; the map's state is 2N wide; a chosen stop's clearance changes that stop only."""
     pair = ImpactMap(two_sided(25.0))
     assert pair.stops == (0, 1) and pair.dimension == 4 and pair.state_scale.shape == (4,)
-    moved = pair.problem_at(pair.parameters + np.array([0.0, 0.0, 1e-3, 0.0]))
+    moved = pair.problem_at(pair.parameters + np.array([0.0, 0.0, 1e-3, 0.0, 0.0]))
     assert moved.clearances() == pytest.approx([4e-3, 4e-3])
     mixed = ImpactProblem(PAPER_SYSTEM.structure, (Stop(RigidStop(3e-3, 0.6), 1), Stop(RigidStop(2e-3, 0.6), 0, side="lower")), HarmonicForce(10.0, 25.0))
     with pytest.raises(ValueError, match="choose"):
@@ -82,10 +82,10 @@ def test_stop_selection_and_scales() -> None:
         ImpactMap(mixed, stop=2)
     second = ImpactMap(mixed, stop=1)
     assert second.parameters[2] == pytest.approx(2e-3)
-    changed = second.problem_at(second.parameters + np.array([0.0, 0.0, 1e-3, 0.0]))
+    changed = second.problem_at(second.parameters + np.array([0.0, 0.0, 1e-3, 0.0, 0.0]))
     assert changed.clearances() == pytest.approx([3e-3, 3e-3])
     weighted = ImpactProblem(PAPER_SYSTEM.structure, (Stop(RigidStop(3e-3, 0.6), 1),), HarmonicForce(10.0, 25.0, 0.4, weights=(0.5, 1.0), static=(1.0, 0.0)))
-    kept = ImpactMap(weighted).problem_at(np.array([30.0, 0.5, 2e-3, 7.0])).harmonic
+    kept = ImpactMap(weighted).problem_at(np.array([30.0, 0.5, 2e-3, 7.0, weighted.phase])).harmonic
     assert (kept.weights, kept.static, kept.phase, kept.amplitude, kept.frequency) == ((0.5, 1.0), (1.0, 0.0), 0.4, 7.0, 30.0)
     one = ImpactMap(budd_dux(0.05))
     assert one.dimension == 2 and state_scales(budd_dux(0.05)).shape == (2,)
@@ -185,7 +185,7 @@ def test_grazing_boundary_of_the_forced_oscillator() -> None:
     base = ImpactProblem(structure, (Stop(RigidStop(d, 0.7), 0),), HarmonicForce(1.05 * expected, w / (2 * math.pi)))
     phase = section_phase(base, np.full(50, w / (2 * math.pi)), amplitudes=np.linspace(expected, 1.5 * expected, 50))
     problem = dataclasses.replace(base, excitation=dataclasses.replace(base.harmonic, phase=phase))
-    mapping = ImpactMap(problem, parameter_scale=(1.0, 0.1, 1e-3, 0.1 * expected))
+    mapping = ImpactMap(problem, parameter_scale=(1.0, 0.1, 1e-3, 0.1 * expected, 1.0))
     orbit = shoot(mapping, closed_form_state(problem), mapping.parameters)
     assert orbit.impacts == 1
     branch = continue_branch(mapping, orbit, "amplitude", ContinuationSettings(lower=0.5 * expected, upper=1.5 * expected), direction=-1)
@@ -207,7 +207,7 @@ def test_budd_dux_branch_lies_on_the_ellipse_and_doubles_where_predicted() -> No
     sigmas = np.linspace(-0.15, 0.12, 60)
     phase = section_phase(budd_dux(-0.12), np.full(sigmas.size, w / (2 * math.pi)), clearances=sigmas)
     problem = budd_dux(-0.12, phase=phase)
-    mapping = ImpactMap(problem, parameter_scale=(1.0, 0.1, 0.01, 1.0))
+    mapping = ImpactMap(problem, parameter_scale=(1.0, 0.1, 0.01, 1.0, 1.0))
     orbit = shoot(mapping, closed_form_state(problem), mapping.parameters)
     branch = continue_branch(mapping, orbit, "clearance", ContinuationSettings(lower=-0.15, upper=0.12))
     values = branch.values

@@ -176,6 +176,11 @@ class Iterated:
             out = step
         return MapEvaluation(out.image, jacobian, dp, hybrid)
 
+    def resectioned(self, y: NDArray[np.float64], p: NDArray[np.float64]) -> object | None:
+        """The base map's ``resectioned`` over all k iterations (None when the base map cannot move its strobe)."""
+        move = getattr(self.base, "resectioned", None)
+        return None if move is None else move(y, p, self.times)
+
 
 def lower_period_maps(system: ParametrisedMap) -> list[tuple[int, ParametrisedMap]]:
     """The maps over each proper divisor d of ``system``'s period, largest d first: (d, P^d).

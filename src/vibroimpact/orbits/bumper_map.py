@@ -1,6 +1,6 @@
 """The stroboscopic map of a problem with Kelvin-Voigt bumpers, with the bumpers' stiffness as a parameter.
 
-:class:`BumperPeriodMap` is :class:`~vibroimpact.orbits.maps.ImpactMap` with a fifth parameter, the bumper period
+:class:`BumperPeriodMap` is :class:`~vibroimpact.orbits.maps.ImpactMap` with one more parameter, the bumper period
 T_b = 2 pi / Omega_b [s]: the period of the absorber's own oscillation on the bumper, Omega_b^2 = K_b / M2. The rigid
 stop is its limit T_b -> 0, and the compliant model's steady states, branches and special points approach the rigid
 stop's at first order in T_b: a special point continued in (frequency, T_b) with
@@ -33,7 +33,7 @@ BUMPER_PERIOD = "bumper_period"
 
 class BumperPeriodMap(ImpactMap):
     """:class:`~vibroimpact.orbits.maps.ImpactMap` of a problem whose selected stops are Kelvin-Voigt bumpers, with
-    their period T_b = 2 pi / Omega_b = 1 / (Omega_b / 2 pi) [s] as the fifth parameter.
+    their period T_b = 2 pi / Omega_b = 1 / (Omega_b / 2 pi) [s] as the last parameter.
 
     Parameters
     ----------
@@ -41,8 +41,8 @@ class BumperPeriodMap(ImpactMap):
         Harmonic force; the stops the parameters set (``stop``) carry Kelvin-Voigt bumpers of one Omega_b.
     periods, engine, bounds, stop
         As :class:`~vibroimpact.orbits.maps.ImpactMap`; ``bounds`` may bound ``bumper_period`` [s] too.
-    parameter_scale : array_like, shape (5,), optional
-        A unit of arclength per parameter (default 1 Hz, 0.1, 1 mm, 1 N, 1 ms).
+    parameter_scale : array_like, shape (6,), optional
+        A unit of arclength per parameter (default 1 Hz, 0.1, 1 mm, 1 N, 1 rad, 1 ms).
 
     Raises
     ------
@@ -68,10 +68,10 @@ class BumperPeriodMap(ImpactMap):
         return (1.0 / law.frequency,) if isinstance(law, KelvinVoigtBumper) else (math.nan,)
 
     def problem_at(self, p: NDArray[np.float64]) -> ImpactProblem:
-        """The problem with parameter vector ``p`` (frequency, restitution, clearance, amplitude, T_b); a T_b <= 0
+        """The problem with parameter vector ``p`` (frequency, restitution, clearance, amplitude, phase, T_b); a T_b <= 0
         raises ``ValueError`` (the rigid stop is the limit, not a member)."""
         problem = super().problem_at(p)
-        period = float(p[4])
+        period = float(p[len(PARAMETERS)])
         if not period > 0.0:
             raise ValueError(f"{BUMPER_PERIOD} = {period!r} s is out of range: allowed (0, inf)")
         stops = tuple(

@@ -5,9 +5,11 @@ paper's layout), to the state k excitation periods later, with the exact Jacobia
 (the first registered with ``exact_jacobians`` for the stops' contact law,
 :func:`~vibroimpact.engines.registry.engine_for`: state-transition matrices times saltation matrices of impacts,
 sticking and release for rigid stops; of contact onsets for bumpers). Its parameters are
-``frequency`` [Hz], ``restitution`` [-], ``clearance`` [m] and ``amplitude`` [N] (or the base amplitude [m] of a base
-motion); a parameter vector becomes a new problem (the frequency changes the period, the strobes stay at t = 0 mod
-T; the force's phase, distribution over the coordinates and static part are kept). With several stops, ``stop``
+``frequency`` [Hz], ``restitution`` [-], ``clearance`` [m], ``amplitude`` [N] (or the base amplitude [m] of a base
+motion) and ``phase`` [rad], the force's phase at the strobe; a parameter vector becomes a new problem (the frequency
+changes the period, the strobes stay at t = 0 mod T; the force's distribution over the coordinates and static part
+are kept). The phase only places the section: continuation holds it, and moves it (:meth:`ImpactMap.resectioned`)
+when an impact nears the strobe, so every orbit of a branch carries the section its state is taken at. With several stops, ``stop``
 says which one ``restitution`` and ``clearance`` belong to: an index k (that stop alone), or ``"all"`` (every stop
 takes the values; they must be equal in the base problem, e.g. a two-sided stop); by default ``"all"`` where the
 stops' values are equal (one stop always), else a ``ValueError`` asks for a choice. dP/dp comes from central
@@ -26,7 +28,7 @@ is still compressed, d > 0, is counted but has no speed margin: its vector field
 bumper is a valid state.
 
 :func:`orbit_measures` says what an orbit means physically (impulse per impact, harmonic amplitudes);
-:func:`resection` moves a strobe away from the impacts. The closed-form starts (:func:`closed_form_state`,
+:func:`resection` (:mod:`~vibroimpact.orbits.sections`) moves a strobe away from the impacts. The closed-form starts (:func:`closed_form_state`,
 :func:`with_impulse`, :func:`section_phase`) live in :mod:`~vibroimpact.orbits.shooting` and are re-exported here.
 """
 
@@ -41,17 +43,19 @@ from numpy.typing import ArrayLike, NDArray
 
 from typing import Any
 
-from vibroimpact.engines.base import MODE_FREE
 from vibroimpact.engines.registry import BUMPER, engine_for, make_engine
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import HybridInfo, MapEvaluation, PeriodicOrbit
+from vibroimpact.orbits.sections import StrobeGap, moved_phase, moved_state, resection, strobe_gap
 from vibroimpact.orbits.shooting import closed_form_state, section_phase, with_impulse
 
-__all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "closed_form_state", "with_impulse", "section_phase", "resection", "PARAMETERS", "stop_selection"]
+__all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "closed_form_state", "with_impulse", "section_phase", "resection", "PARAMETERS", "SECTION_PARAMETER", "stop_selection", "Resection"]
 
 #: The parameters of an :class:`ImpactMap`, in order, with their units.
-PARAMETERS = {"frequency": "Hz", "restitution": "1", "clearance": "m", "amplitude": "N"}
+PARAMETERS = {"frequency": "Hz", "restitution": "1", "clearance": "m", "amplitude": "N", "phase": "rad"}
+#: The parameter that places the strobe: the force's phase at t = 0 (a section of the orbit, not a physical property).
+SECTION_PARAMETER = "phase"
 
 
 def stop_selection(problem: ImpactProblem, stop: int | str | None) -> tuple[int, ...]:
@@ -99,13 +103,13 @@ class ImpactMap:
         The stop(s) whose clearance and restitution the parameters are (module docstring).
     parameter_scale : array_like, shape (m,), optional
         A unit of arclength for each of the m parameters (default :attr:`default_parameter_scale`: 1 Hz, 0.1, 1 mm,
-        1 N); e.g. dimensionless problems take their own.
+        1 N, 1 rad); e.g. dimensionless problems take their own.
 
     Attributes
     ----------
     parameters : ndarray, shape (m,)
-        The base problem's (frequency [Hz], restitution [-], clearance [m], amplitude [N]), in the order of
-        ``parameter_names`` (a subclass may add more: :class:`~vibroimpact.orbits.bumper_map.BumperPeriodMap`).
+        The base problem's (frequency [Hz], restitution [-], clearance [m], amplitude [N], phase [rad]), in the order
+        of ``parameter_names`` (a subclass may add more: :class:`~vibroimpact.orbits.bumper_map.BumperPeriodMap`).
     dimension : int
         2N, the state's length.
     stops : tuple of int
@@ -118,8 +122,8 @@ class ImpactMap:
     """
 
     parameter_names: tuple[str, ...] = tuple(PARAMETERS)
-    #: One unit of arclength per parameter, in the order of ``parameter_names``: 1 Hz, 0.1, 1 mm, 1 N.
-    default_parameter_scale: tuple[float, ...] = (1.0, 0.1, 1e-3, 1.0)
+    #: One unit of arclength per parameter, in the order of ``parameter_names``: 1 Hz, 0.1, 1 mm, 1 N, 1 rad.
+    default_parameter_scale: tuple[float, ...] = (1.0, 0.1, 1e-3, 1.0, 1.0)
 
     def __init__(self, problem: ImpactProblem, periods: int = 1, engine: Any = None, bounds: dict[str, tuple[float, float]] | None = None,
                  stop: int | str | None = None, parameter_scale: ArrayLike | None = None) -> None:  # fmt: skip
@@ -132,7 +136,7 @@ class ImpactMap:
         self.contact = problem.contact_law
         self.engine = engine if engine is not None else make_engine(engine_for(self.contact, "exact_jacobians"))
         chosen = problem.stops[self.stops[0]]
-        self.parameters = np.array([problem.frequency, chosen.law.restitution, chosen.clearance, problem.amplitude, *self._more_parameters(chosen.law)])
+        self.parameters = np.array([problem.frequency, chosen.law.restitution, chosen.clearance, problem.amplitude, problem.phase, *self._more_parameters(chosen.law)])
         self.dimension = 2 * problem.size
         length = problem.length_scale()  # Delta + q |H12| on the paper's layout
         self.state_scale = np.repeat([length, problem.omega * length], problem.size)
@@ -146,19 +150,39 @@ class ImpactMap:
             raise ValueError(f"bounds: unknown parameters {sorted(unknown)}; allowed {list(names)}")
         self._box = [(self.parameter_names.index(name), float(low), float(high)) for name, (low, high) in self.bounds.items()]
 
+    def resectioned(self, y: NDArray[np.float64], p: NDArray[np.float64], times: int = 1) -> "Resection | None":
+        """The orbit through ``y`` (at parameters ``p``) seen through the strobe in the middle of the widest gap its
+        contacts leave over ``times`` map iterations: its state there and ``p`` with the moved force phase [rad]
+        (:mod:`~vibroimpact.orbits.sections`); None where it has no contact or no gap, or ``p`` is no problem."""
+        try:
+            problem = self.problem_at(p)
+        except ValueError:
+            return None
+        periods = self.periods * int(times)
+        state = np.asarray(y, dtype=float)
+        try:
+            gap, run = strobe_gap(problem, state, periods, self.engine)
+        except RuntimeError:  # the engine made no progress (endless chattering)
+            return None
+        if gap is None:
+            return None
+        moved = np.asarray(p, dtype=float).copy()
+        moved[self.parameter_names.index(SECTION_PARAMETER)] = moved_phase(problem, gap.shift)
+        return Resection(moved_state(problem, state, periods, self.engine, run, gap.shift), moved, gap)
+
     def with_periods(self, periods: int) -> "ImpactMap":
         """The same map over ``periods`` excitation periods (one compiled call per evaluation, unlike ``Iterated``)."""
         return type(self)(self.problem, periods, self.engine, self.bounds, self.stop, self.parameter_scale)
 
     def _more_parameters(self, law: RigidStop | KelvinVoigtBumper) -> tuple[float, ...]:
-        """Values of the parameters after the four of :data:`PARAMETERS` (none here) for the chosen stop's ``law``."""
+        """Values of the parameters after those of :data:`PARAMETERS` (none here) for the chosen stop's ``law``."""
         return ()
 
     def problem_at(self, p: NDArray[np.float64]) -> ImpactProblem:
         """The problem with parameter vector ``p``."""
-        frequency, restitution, clearance, amplitude = (float(x) for x in p[:4])
+        frequency, restitution, clearance, amplitude, phase = (float(x) for x in p[: len(PARAMETERS)])
         base = self.problem
-        excitation = dataclasses.replace(base.harmonic, amplitude=amplitude, frequency=frequency)
+        excitation = dataclasses.replace(base.harmonic, amplitude=amplitude, frequency=frequency, phase=phase)
         stops = tuple(dataclasses.replace(item, law=_law(item.law, clearance, restitution)) if k in self.stops else item for k, item in enumerate(base.stops))
         return ImpactProblem(base.system, stops, excitation)
 
@@ -203,6 +227,25 @@ class ImpactMap:
             onset_depth=depth,
         )
         return MapEvaluation(strobe.state, strobe.jacobian, None, hybrid)
+
+
+@dataclass(frozen=True, eq=False)
+class Resection:
+    """A point of an :class:`ImpactMap` seen through another strobe (:meth:`ImpactMap.resectioned`).
+
+    Attributes
+    ----------
+    state : ndarray, shape (2N,)
+        The orbit's state at the new strobe.
+    parameters : ndarray, shape (m,)
+        The parameter vector with the new force phase [rad].
+    gap : StrobeGap
+        The old strobe's distance to the nearest contact and the new one's, in fractions of the period.
+    """
+
+    state: NDArray[np.float64]
+    parameters: NDArray[np.float64]
+    gap: StrobeGap
 
 
 def _law(law: RigidStop | KelvinVoigtBumper, clearance: float, restitution: float) -> RigidStop | KelvinVoigtBumper:
@@ -265,63 +308,3 @@ def orbit_measures(system: ImpactMap, orbit: PeriodicOrbit) -> OrbitMeasures:
     stops = np.asarray(stops, dtype=int).copy() if stops is not None else np.zeros(trajectory.impulses.size, dtype=int)
     amplitudes = np.abs(np.asarray(moments[: problem.size])) * scale
     return OrbitMeasures(trajectory.impact_velocities.copy(), trajectory.impulses.copy(), amplitudes, stops)
-
-
-def resection(problem: ImpactProblem, state: NDArray[np.float64], periods: int, engine: Any = None) -> tuple[ImpactProblem, NDArray[np.float64]]:
-    """The same motion seen through a strobe away from its impacts.
-
-    ``state`` is the state at t = 0 of ``problem`` on (or near) an orbit of ``periods`` excitation periods, e.g. the
-    end of a brute-force run. The motion is integrated over ``periods`` periods; the impact instants modulo T leave
-    gaps, and the new strobe goes in the middle of the widest: at tau = g T, i.e. the problem with force phase
-    phase + 2 pi g, whose t = 0 is the old t = tau. An :class:`ImpactMap` of that problem has the orbit as a fixed
-    point of a map that is smooth near it (no impact crosses its strobe). With bumpers the gaps are those the contact
-    intervals leave (from onset to release, modulo T).
-
-    Returns
-    -------
-    (ImpactProblem, ndarray)
-        The problem with the new force phase [rad] (everything else kept), and the state (x, x') at its t = 0.
-    """
-    contact = problem.contact_law
-    engine = engine if engine is not None else make_engine(engine_for(contact, "exact_jacobians"))
-    if contact == BUMPER:
-        return _resection_bumper(problem, np.asarray(state, dtype=float), int(periods), engine)
-    run = engine.integrate(problem, np.asarray(state, dtype=float), 0.0, int(periods))
-    fractions = np.sort((run.impact_times / problem.period) % 1.0)
-    if fractions.size == 0:
-        return problem, np.asarray(state, dtype=float).copy()
-    gaps = np.diff(np.concatenate([fractions, [fractions[0] + 1.0]]))
-    k = int(np.argmax(gaps))
-    g = float((fractions[k] + 0.5 * gaps[k]) % 1.0)
-    moved = engine.dense(run, np.array([g * problem.period]))[0]
-    phase = float((problem.phase + 2.0 * np.pi * g) % (2.0 * np.pi))
-    return ImpactProblem(problem.system, problem.contact, dataclasses.replace(problem.harmonic, phase=phase)), np.asarray(moved, dtype=float)
-
-
-def _resection_bumper(problem: ImpactProblem, state: NDArray[np.float64], periods: int, engine: Any) -> tuple[ImpactProblem, NDArray[np.float64]]:
-    """:func:`resection` with bumpers: the strobe in the middle of the widest gap between contact intervals mod T."""
-    run = engine.integrate(problem, state, 0.0, periods)
-    busy = [(float(a), float(b)) for a, b, mode in run.segments / np.array([problem.period, problem.period, 1.0]) if mode != MODE_FREE and b > a]
-    if not busy:
-        return problem, state.copy()
-    pieces = []  # the intervals modulo 1, split where they wrap
-    for a, b in busy:
-        if b - a >= 1.0:
-            return problem, state.copy()  # in contact all the time: no better strobe
-        lo, hi = a % 1.0, a % 1.0 + (b - a)
-        pieces += [(lo, min(hi, 1.0))] + ([(0.0, hi - 1.0)] if hi > 1.0 else [])
-    pieces.sort()
-    merged = [list(pieces[0])]
-    for lo, hi in pieces[1:]:
-        if lo <= merged[-1][1]:
-            merged[-1][1] = max(merged[-1][1], hi)
-        else:
-            merged.append([lo, hi])
-    ends = [(hi, (merged[(i + 1) % len(merged)][0] + (1.0 if i + 1 == len(merged) else 0.0)) - hi) for i, (_lo, hi) in enumerate(merged)]
-    start, width = max(ends, key=lambda item: item[1])
-    if width <= 0.0:
-        return problem, state.copy()
-    g = float((start + 0.5 * width) % 1.0)
-    moved = engine.sample(problem, state, 0.0, periods, np.array([g * problem.period]))[1][0]
-    phase = float((problem.phase + 2.0 * np.pi * g) % (2.0 * np.pi))
-    return ImpactProblem(problem.system, problem.contact, dataclasses.replace(problem.harmonic, phase=phase)), np.asarray(moved, dtype=float)

@@ -108,7 +108,7 @@ class StiffnessCase:
             system = BumperPeriodMap(mapping.problem, bounds=bounds)
             for point in branch.special_points:
                 kind = SPECIAL_POINT_KINDS.index(point.kind)
-                if point.kind not in FOLLOWED or _on_a_curve(rows, kind, point.value, float(system.parameters[4])):
+                if point.kind not in FOLLOWED or _on_a_curve(rows, kind, point.value, float(system.parameters[-1])):
                     continue  # not followed; or on a curve already followed (both roots' branches, a fold pair's cusp)
                 attempts["stiffness_curve"] += 1
                 try:
@@ -128,9 +128,10 @@ class StiffnessCase:
 
 
 def _with_period(point: SpecialPoint, system: BumperPeriodMap) -> SpecialPoint:
-    """``point`` (found on the four-parameter map) with its orbit's parameters extended by the bumper period."""
+    """``point`` (found on the :class:`ImpactMap` of the same problem) with its orbit's parameters extended by the bumper
+    period, :class:`BumperPeriodMap`'s last parameter."""
     orbit = point.orbit
-    extended = dataclasses.replace(orbit, parameters=np.append(orbit.parameters, system.parameters[4]), parameter_names=system.parameter_names)
+    extended = dataclasses.replace(orbit, parameters=np.append(orbit.parameters, system.parameters[-1]), parameter_names=system.parameter_names)
     return dataclasses.replace(point, orbit=extended)
 
 

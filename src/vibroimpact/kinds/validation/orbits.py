@@ -115,7 +115,7 @@ def multiplier_distance(computed: NDArray[np.complex128], published: NDArray[np.
 
 def _map(problem, parameter: str, low: float, high: float, scale: float) -> ImpactMap:
     """The exact stroboscopic map with ``parameter`` kept inside [low, high] and measured in units of ``scale``."""
-    scales = np.array([1.0, 0.1, 1e-3, 1.0])
+    scales = np.array(ImpactMap.default_parameter_scale)
     scales[ImpactMap.parameter_names.index(parameter)] = scale
     return ImpactMap(problem, 1, ExactEngine(), bounds={parameter: (low, high)}, parameter_scale=scales)
 
