@@ -57,6 +57,8 @@ _PUBLIC = {
     "ENGINES": "vibroimpact.engines.registry",
     "make_engine": "vibroimpact.engines.registry",
     "ImpactMap": "vibroimpact.orbits.maps",
+    "orbit_measures": "vibroimpact.orbits.maps",
+    "branch_measures": "vibroimpact.orbits.maps",
     "shoot": "vibroimpact.orbits.shooting",
     "continue_branch": "vibroimpact.orbits.continuation",
     "ContinuationSettings": "vibroimpact.orbits.continuation",

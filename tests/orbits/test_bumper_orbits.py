@@ -119,12 +119,12 @@ def test_the_continued_branch_passes_through_steady_states_and_ends_at_contact_o
     """250 Hz bumper, continued over 19.5-23 Hz from 22 Hz: its stable points are the marched steady states (1e-8),
     and the branch ends at a contact onset at tangency where the entry speed goes to 0, at the linear orbit's touch
     of the surface (no Omega_b in it: the rigid stop's grazing point)."""
-    settings = ContinuationSettings(lower=19.5, upper=23.0, max_steps=300, max_step=0.1)
+    settings = ContinuationSettings(lower=19.5, upper=23.0, max_steps=300, max_step=0.1, stop_at_grazing=True)
     mapping, orbit = shot(22.0, 250.0, bounds={"frequency": (10.0, 50.0)})
     branch = continue_branch(mapping, orbit, "frequency", settings)
     onsets = [point for point in branch.special_points if point.kind == "grazing"]
-    assert len(onsets) == 1 and "velocity goes to zero" in onsets[0].note
-    assert onsets[0].value == pytest.approx(_touch(), rel=1e-9)
+    assert len(onsets) == 1 and "depth goes to zero" in onsets[0].note
+    assert onsets[0].value == pytest.approx(_touch(), rel=1e-12)  # the closed form (orbits.onsets)
     stable = [o for o in branch.orbits if o.stable and o.impacts == 1]
     picks = [stable[0], stable[len(stable) // 2], stable[-1]]
     assert max(o.parameter("frequency") for o in picks) - min(o.parameter("frequency") for o in picks) > 1.0
@@ -138,7 +138,7 @@ def test_the_continued_branch_passes_through_steady_states_and_ends_at_contact_o
 def test_fold_and_period_doubling_converge_to_the_rigid_stops_at_first_order() -> None:
     """Bumpers of 250 Hz, 1 kHz and 4 kHz: the fold and the period doubling near 26.6 Hz move towards the rigid stop's
     by about 4x per 4x in Omega_b (observed order 0.9-1.1, first order in 1/Omega_b)."""
-    settings = ContinuationSettings(lower=24.0, upper=28.0, max_steps=500, max_step=0.1)
+    settings = ContinuationSettings(lower=24.0, upper=28.0, max_steps=500, max_step=0.1, stop_at_grazing=True)
     found = {}
     for bumper in (None, 250.0, 1000.0, 4000.0):
         mapping, orbit = shot(25.0, bumper, bounds={"frequency": (10.0, 50.0)})

@@ -29,7 +29,7 @@ from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
 from tests.orbits.test_bumper_orbits import R, problem, shot
 
 #: The branches' window around the fold [Hz].
-WINDOW = ContinuationSettings(step=0.2, max_steps=400, lower=24.0, upper=28.0)
+WINDOW = ContinuationSettings(step=0.2, max_steps=400, lower=24.0, upper=28.0, stop_at_grazing=True)
 #: The fold curve's settings: the fold's test function det(M - I) is computed to ~1e-10 with stiff bumpers (16-32 kHz),
 #: above the default corrector tolerance of 1e-11.
 CURVE = ContinuationSettings(step=0.5, max_steps=400, tolerance=1e-9)

@@ -55,7 +55,7 @@ def test_the_one_impact_orbits_own_tangency_is_followed() -> None:
     smaller = (-3e-3 * sol.chi0 - np.sqrt(quad_a * a**2 - (c * 3e-3) ** 2)) / quad_a  # the admissible root of eq. 16 here
     orbit = shoot(system, closed_form_state(problem, with_impulse(solve_impact_orbit(problem), float(smaller))), system.parameters)
     assert orbit.impacts == 1
-    branch = continue_branch(system, orbit, "frequency", ContinuationSettings(lower=15.0, upper=45.0, max_step=0.1))
+    branch = continue_branch(system, orbit, "frequency", ContinuationSettings(lower=15.0, upper=45.0, max_step=0.1, stop_at_grazing=True))
     touching = [p for p in branch.special("grazing") if "touches" in p.note]
     assert touching
     curve = trace_grazing(system, touching[0], "clearance", {"clearance": (2.5e-3, 3.2e-3)}, direction=-1)

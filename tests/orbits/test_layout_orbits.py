@@ -188,7 +188,7 @@ def test_grazing_boundary_of_the_forced_oscillator() -> None:
     mapping = ImpactMap(problem, parameter_scale=(1.0, 0.1, 1e-3, 0.1 * expected, 1.0))
     orbit = shoot(mapping, closed_form_state(problem), mapping.parameters)
     assert orbit.impacts == 1
-    branch = continue_branch(mapping, orbit, "amplitude", ContinuationSettings(lower=0.5 * expected, upper=1.5 * expected), direction=-1)
+    branch = continue_branch(mapping, orbit, "amplitude", ContinuationSettings(lower=0.5 * expected, upper=1.5 * expected, stop_at_grazing=True), direction=-1)
     grazing = branch.special("grazing")
     assert grazing, branch.end
     assert min(abs(point.value - expected) for point in grazing) < 1e-8 * expected
@@ -209,7 +209,7 @@ def test_budd_dux_branch_lies_on_the_ellipse_and_doubles_where_predicted() -> No
     problem = budd_dux(-0.12, phase=phase)
     mapping = ImpactMap(problem, parameter_scale=(1.0, 0.1, 0.01, 1.0, 1.0))
     orbit = shoot(mapping, closed_form_state(problem), mapping.parameters)
-    branch = continue_branch(mapping, orbit, "clearance", ContinuationSettings(lower=-0.15, upper=0.12))
+    branch = continue_branch(mapping, orbit, "clearance", ContinuationSettings(lower=-0.15, upper=0.12, stop_at_grazing=True))
     values = branch.values
     assert values.min() < -0.14 and values.max() > 0.11
     for point in branch.orbits:

@@ -180,7 +180,9 @@ def locate_grazing(
         target = float(start.z[n] + rough * start.tangent[n]) if math.isfinite(rough) else float(side.z[n])
         tangent = beyond.tangent if beyond.tangent[n] * (target - beyond.z[n]) >= 0.0 else -beyond.tangent
         back = Point(beyond.z, beyond.y, beyond.p, beyond.out, beyond.residual, beyond.jacobian, tangent, 0, beyond.history)
-        reach = 2.0 * abs(target - float(beyond.z[n])) / max(abs(float(tangent[n])), 1e-3) + 10.0 * tolerance
+        # as far as the start's side's nearest point at least: the point lies between it and the orbit beyond
+        span = max(abs(target - float(beyond.z[n])), abs(float(side.z[n]) - float(beyond.z[n])))
+        reach = 2.0 * span / max(abs(float(tangent[n])), 1e-3) + 10.0 * tolerance
         other, other_estimate, _, _ = _approach(arc, back, reach, tolerance, corrector_tolerance)
         if math.isfinite(other_estimate):
             value = float(other.z[n] + (other_estimate - float(back.tangent @ (other.z - back.z))) * other.tangent[n] / float(back.tangent @ other.tangent))

@@ -176,6 +176,11 @@ class Iterated:
             out = step
         return MapEvaluation(out.image, jacobian, dp, hybrid)
 
+    def linear_orbit(self, p: NDArray[np.float64]) -> tuple[NDArray[np.float64], float] | None:
+        """The base map's contact-free orbit (a fixed point of every iterate), None when it has none in closed form."""
+        closed = getattr(self.base, "linear_orbit", None)
+        return None if closed is None else closed(p)
+
     def resectioned(self, y: NDArray[np.float64], p: NDArray[np.float64]) -> object | None:
         """The base map's ``resectioned`` over all k iterations (None when the base map cannot move its strobe)."""
         move = getattr(self.base, "resectioned", None)
@@ -311,7 +316,8 @@ class Branch:
     end : str
         Why the continuation stopped: 'bound', 'grazing', 'max_steps', 'closed' (the branch returned to its start),
         'step_too_small', 'parent' (a period-K branch reached the lower-period orbit it was born from: the period
-        doubling of its period-K/2 parent, or a K/d-tupling of a period-d orbit).
+        doubling of its period-K/2 parent, or a K/d-tupling of a period-d orbit), 'clear' (a contact-free stretch
+        left every stop behind).
     """
 
     parameter: str

@@ -42,7 +42,7 @@ class BumperPeriodMap(ImpactMap):
     periods, engine, bounds, stop
         As :class:`~vibroimpact.orbits.maps.ImpactMap`; ``bounds`` may bound ``bumper_period`` [s] too.
     parameter_scale : array_like, shape (6,), optional
-        A unit of arclength per parameter (default 1 Hz, 0.1, 1 mm, 1 N, 1 rad, 1 ms).
+        A unit of arclength per parameter (default :meth:`natural_scale`).
 
     Raises
     ------
@@ -51,7 +51,11 @@ class BumperPeriodMap(ImpactMap):
     """
 
     parameter_names = (*PARAMETERS, BUMPER_PERIOD)
-    default_parameter_scale = (*ImpactMap.default_parameter_scale, 1e-3)
+
+    @staticmethod
+    def natural_scale(problem: ImpactProblem) -> tuple[float, ...]:
+        """:meth:`ImpactMap.natural_scale` and 1 ms for the bumper period."""
+        return (*ImpactMap.natural_scale(problem), 1e-3)
 
     def __init__(self, problem: ImpactProblem, periods: int = 1, engine: Any = None, bounds: dict[str, tuple[float, float]] | None = None,
                  stop: int | str | None = None, parameter_scale: ArrayLike | None = None) -> None:  # fmt: skip

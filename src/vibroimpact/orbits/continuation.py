@@ -6,96 +6,53 @@ unstable parts alike. The step grows after an easy correction and shrinks after 
 tangent turns by more than ``max_turn``. Between consecutive points the test functions of
 :mod:`~vibroimpact.orbits.bifurcations` are compared and every sign change is located and stored with its multipliers.
 
+Where a step fails next to an impact at the strobe (the map is not smooth where an impact crosses t = 0 mod T), the
+strobe is moved into the middle of the widest gap the contacts leave (``resectioned``, a change of the force's phase:
+:mod:`~vibroimpact.orbits.sections`) and the step is tried again; each orbit of the branch carries its own phase, so
+every state is read at its own strobe.
+
 The continuation stops at a bound of the parameter (the last point lies on the bound), after ``max_steps`` steps,
-when the branch closes on itself (an isola), when the step falls below ``min_step``, or at a grazing point when
-``stop_at_grazing``. At a grazing point the impact count changes (or no orbit is found beyond); the point is
-located, and the orbit beyond it, if Newton's method finds one, tells whether the branch continues with the new
-impact count (``SpecialPoint.continues``, ``impacts_after``).
+when the branch closes on itself (an isola), when the step falls below ``min_step``, at a grazing point when
+``stop_at_grazing``, or on a contact-free stretch that has left every stop behind (``clear``). At a grazing point the
+contact count changes (or no orbit is found beyond); the point is located (in closed form where one side is
+contact-free: :mod:`~vibroimpact.orbits.onsets`), and the orbit beyond it, if one is found, carries the branch on
+with the new count (``SpecialPoint.continues``, ``impacts_after``), in the direction the geometry gives: on through
+the point, or back (a nonsmooth fold). Next to a soft contact's onset the branch curves sharply; it is followed there
+by its distance to grazing instead of its arclength (:meth:`~vibroimpact.orbits.onset_steps.OnsetSteps.leave`). What happens across an onset is in the
+grazing point's note: a jump of the multipliers across the unit circle named as the discontinuity-induced
+bifurcation it is, a nonsmooth fold; special points next to an onset say that it induced them.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
-from vibroimpact.model.structure import require_in_range, require_positive
-from vibroimpact.orbits.arclength import ArclengthSystem, Point, TestFunction
-from vibroimpact.orbits.bifurcations import classify, grazing_margin, locate, locate_grazing, neimark_sacker_test, period_doubling_test
-from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Branch, ParametrisedMap, PeriodicOrbit, SpecialPoint, lower_period_maps, MapEvaluation
+from vibroimpact.orbits.arclength import ArclengthSystem, Point
+from vibroimpact.orbits.bifurcations import classify, grazing_margin, locate
+from vibroimpact.orbits.bifurcations import neimark_sacker_test, period_doubling_test
+from vibroimpact.orbits.branch import Branch, ParametrisedMap, PeriodicOrbit, SpecialPoint, lower_period_maps
+from vibroimpact.orbits.continuation_settings import ContinuationSettings
+from vibroimpact.orbits.onset_steps import NOT_GRAZING, OnsetSteps, signature_of
+from vibroimpact.orbits.onsets import touches_ahead
+from vibroimpact.orbits.special_curves import SpecialCurve, continue_special_point, defining_function
 
 __all__ = ["ContinuationSettings", "continue_branch", "SpecialCurve", "continue_special_point", "defining_function"]
 
-@dataclass(frozen=True)
-class ContinuationSettings:
-    """How a branch is followed.
-
-    Parameters
-    ----------
-    step : float
-        First arclength step, in scaled variables (state / state_scale, parameter / parameter_scale) [-].
-    min_step, max_step : float
-        Limits of the adapted step [-].
-    max_steps : int
-        Most points on the branch (per direction).
-    lower, upper : float
-        Bounds of the continued parameter (its own unit, e.g. Hz).
-    tolerance : float
-        Scaled residual at which the corrector stops [-].
-    max_corrector_iterations : int
-        Newton iterations per corrector.
-    max_turn : float
-        Largest angle between consecutive tangents [rad]; a larger turn halves the step.
-    locate_tolerance : float
-        Relative precision of a located special point's parameter [-].
-    detect : tuple of str
-        Special points to detect (subset of ``SPECIAL_POINT_KINDS``).
-    stop_at_grazing : bool
-        End the branch at a grazing point (True), or carry on with the new impact count when an orbit exists there.
-    grazing_margin : float
-        A failed step from a point whose grazing margin is below this is searched for a grazing point [-].
-    """
-
-    step: float = 0.05
-    min_step: float = 1e-7
-    max_step: float = 0.3
-    max_steps: int = 2000
-    lower: float = -math.inf
-    upper: float = math.inf
-    tolerance: float = 1e-11
-    max_corrector_iterations: int = 8
-    max_turn: float = 0.35
-    locate_tolerance: float = 1e-10
-    detect: tuple[str, ...] = SPECIAL_POINT_KINDS
-    stop_at_grazing: bool = True
-    grazing_margin: float = 0.05
-
-    def __post_init__(self) -> None:
-        for name in ("step", "min_step", "max_step", "tolerance", "locate_tolerance", "grazing_margin"):
-            require_positive(name, getattr(self, name))
-        require_in_range("max_steps", self.max_steps, 1, 10**7)
-        require_in_range("max_turn", self.max_turn, 1e-3, math.pi / 2)
-        if not self.lower < self.upper:
-            raise ValueError(f"lower = {self.lower!r} must be below upper = {self.upper!r}")
-        unknown = set(self.detect) - set(SPECIAL_POINT_KINDS)
-        if unknown:
-            raise ValueError(f"detect: unknown kinds {sorted(unknown)}; allowed {SPECIAL_POINT_KINDS}")
+#: A failed step moves the strobe when the nearest contact is closer to it than this fraction of the distance the moved
+#: strobe would have (half the widest gap between contacts).
+RESECTION_RATIO = 0.5
 
 
-def _signature(point: Point) -> tuple[int, int] | None:
-    return point.out.hybrid.signature if point.out.hybrid is not None else None
-
-
-class _Walker:
-    """One direction of one branch."""
+class _Walker(OnsetSteps):
+    """One direction of one branch (its steps at contact onsets: :class:`~vibroimpact.orbits.onset_steps.OnsetSteps`)."""
 
     def __init__(self, system: ParametrisedMap, orbit: PeriodicOrbit, index: int, settings: ContinuationSettings) -> None:
         self.system, self.index, self.settings = system, index, settings
         self.name = system.parameter_names[index]
-        self.arc = ArclengthSystem(system, orbit.parameters, (index,))
+        self.arc = self.first_arc = ArclengthSystem(system, orbit.parameters, (index,))
         self.n = system.dimension
         self.specials: list[tuple[float, SpecialPoint]] = []
         self.lower = lower_period_maps(system)
@@ -140,36 +97,6 @@ class _Walker:
                 return True
         return False
 
-    def grazing(self, a: Point, sigma: float, arclength: float, hint: Point | None = None) -> object:
-        """Locate a grazing point between a and sigma; return the point beyond it (None: the branch ends there)."""
-        side, grazing, beyond, value = locate_grazing(self.arc, a, sigma, self.tolerance(a), self.settings.tolerance, hint)
-        if not math.isfinite(value):
-            return _NOT_GRAZING  # a plain corrector failure, not a grazing
-        before = side.out.hybrid
-        tangency = -before.closest_approach / before.length_scale <= before.speed_margin
-        what = "a free flight touches the stop" if tangency else "an impact's velocity goes to zero"
-        if beyond is not None:
-            after = beyond.out.hybrid
-            if after.impacts == before.impacts:
-                what = f"{what} (the sticking phases change, {before.sticks} -> {after.sticks})"
-            note = f"{what}; the branch continues with {after.impacts} impacts per period"
-        else:
-            note = f"{what}; no periodic orbit beyond: the branch ends"
-        at = grazing if grazing is not None else side
-        found = SpecialPoint(
-            "grazing",
-            at.orbit(self.system),
-            self.name,
-            value,
-            grazing_margin(at.out.hybrid),
-            note,
-            continues=beyond is not None,
-            impacts_after=None if beyond is None else beyond.out.hybrid.impacts,
-        )
-        self.specials.append((arclength + float(a.tangent @ (side.z - a.z)), found))
-        self.last_before = side
-        return beyond
-
     def detect(self, a: Point, values_a: dict[str, float], b: Point, values_b: dict[str, float], sigma: float, arclength: float) -> None:
         """Locate every test function that changes sign between a and b (sigma along a's tangent)."""
         self.parent = None
@@ -191,6 +118,36 @@ class _Walker:
             return False
         return self.slope is None or margin + 4.0 * h * min(self.slope, 0.0) <= 0.0
 
+    def clear(self, b: Point, a: Point) -> bool:
+        """Is the contact-free orbit at ``b`` clear of every stop by more than ``settings.clear`` of its clearance,
+        farther than at ``a``, and does it touch none ahead (:func:`~vibroimpact.orbits.onsets.touches_ahead`)?
+        False without a closed-form contact-free orbit (:meth:`~vibroimpact.orbits.maps.ImpactMap.linear_orbit`)."""
+        closed = getattr(self.system, "linear_orbit", None)
+        here = None if closed is None else closed(b.p)
+        there = None if closed is None else closed(a.p)
+        if here is None or there is None or not (here[1] > self.settings.clear and here[1] > there[1]):
+            return False
+        way = float(np.sign(b.p[self.index] - a.p[self.index]))
+        return not touches_ahead(self.system, b.p, self.index, way, self.settings.lower, self.settings.upper)
+
+    def resection(self, a: Point) -> Point | None:
+        """``a`` seen through a strobe in the middle of the widest gap between its contacts, on a new arclength system
+        holding that phase; None when the map cannot move its strobe, or the strobe is not near a contact."""
+        move = getattr(self.system, "resectioned", None)
+        if move is None or a is self.moved:
+            return None
+        found = move(a.y, a.p)
+        if found is None or found.gap.nearest >= RESECTION_RATIO * found.gap.half_width:
+            return None
+        arc = ArclengthSystem(self.system, found.parameters, (self.index,))
+        along = np.zeros(self.n + 1)
+        along[self.n] = 1.0 if a.tangent[self.n] >= 0.0 else -1.0  # the same direction in the parameter
+        moved = arc.point(arc.to_z(found.state, found.parameters), along)
+        if not np.all(np.isfinite(moved.residual)) or np.max(np.abs(moved.residual)) > 1e3 * self.settings.tolerance:
+            return None  # not an orbit seen from the new strobe (the engine's run did not close)
+        self.arc, self.moved = arc, moved
+        return moved
+
     def bound(self, a: Point, sigma: float, value: float) -> Point:
         """The point between a and sigma where the parameter equals ``value``."""
 
@@ -208,7 +165,7 @@ class _Walker:
         direction = np.zeros_like(fixed)
         direction[self.n] = 1.0
         polished = self.arc.correct(fixed, direction, self.settings.tolerance, self.settings.max_corrector_iterations)
-        if polished is None or _signature(polished) != _signature(found):
+        if polished is None or signature_of(polished) != signature_of(found):
             return found
         return dataclasses.replace(polished, tangent=self.arc.tangent(polished.jacobian, a.tangent))
 
@@ -217,6 +174,8 @@ class _Walker:
         self.slope: float | None = None
         self.retry_margin = 2e-3  # margin below which a grazing point is sought ahead whatever the step
         a, points, h, arclength = start, [start], s.step, 0.0
+        self.arc = self.first_arc  # each direction starts at the start's strobe
+        self.moved: Point | None = None  # the last point whose strobe was moved
         values_a = self.tests(a)
         turn = math.cos(s.max_turn)
         for _ in range(s.max_steps):
@@ -224,7 +183,7 @@ class _Walker:
             if b is not None and b.tangent @ a.tangent < turn and h > s.min_step:
                 b = None  # the tangent turned too much: a smaller step
             hybrid = a.out.hybrid is not None and "grazing" in s.detect
-            changed = b is not None and _signature(b) != _signature(a)
+            changed = b is not None and signature_of(b) != signature_of(a)
             if changed and h > 1e-3:
                 h *= 0.5  # walk up to the grazing point with ordinary steps, so that no other test is skipped
                 continue
@@ -236,15 +195,45 @@ class _Walker:
                 # a grazing point within the step: the impact count changed, or Newton failed next to it, or the
                 # margin extrapolates to zero (Newton's region shrinks near it, the steps would creep)
                 beyond = self.grazing(a, h if changed or b is None else 1.5 * ahead, arclength, b if changed else None)
-                if beyond is not _NOT_GRAZING:
+                if beyond is not NOT_GRAZING:
                     last = self.last_before
-                    self.detect(a, values_a, last, self.tests(last), float(a.tangent @ (last.z - a.z)), arclength)
-                    points.append(last)
+                    first_special = len(self.specials)
+                    if not self.arrival:  # (else the arriving points replace the approach's nearest one)
+                        self.detect(a, values_a, last, self.tests(last), float(a.tangent @ (last.z - a.z)), arclength)
+                        points.append(last)
+                        arclength += float(a.tangent @ (last.z - a.z))
+                        a, values_a = last, self.tests(last)
+                    near_before = self.reference if self.reference is not None else last  # (1e-3 from it: its stability)
+                    near_start = len(self.specials)
+                    for arriving in self.arrival:  # the last stretch to a soft contact's onset, from its own side
+                        sigma = float(a.tangent @ (arriving.z - a.z))
+                        self.detect(a, values_a, arriving, self.tests(arriving), sigma, arclength)
+                        arclength += sigma
+                        a, values_a = arriving, self.tests(arriving)
+                        points.append(a)
+                    if self.touching is not None:  # the onset's own orbit, on the branch where it goes on past it
+                        touching = dataclasses.replace(self.touching, tangent=self.arc.tangent(self.touching.jacobian, a.tangent))
+                        sigma = float(a.tangent @ (touching.z - a.z))
+                        self.detect(a, values_a, touching, self.tests(touching), sigma, arclength)
+                        arclength += sigma
+                        a, values_a = touching, self.tests(touching)
+                        if beyond is not None and not s.stop_at_grazing:
+                            points.append(a)
+                    graze_at, arriving_way = arclength, float(a.tangent[self.n])
                     if beyond is None or s.stop_at_grazing:
+                        after = [] if beyond is None else [beyond]
+                        self._record_onset(graze_at, near_before, after[-1] if after else None, arriving_way, near_start, first_special)
                         return points, "grazing"
                     arclength += float(a.tangent @ (beyond.z - a.z))
                     a, values_a = beyond, self.tests(beyond)
                     points.append(a)
+                    for left in self.leave(a):  # the first points of a branch that curves sharply from the point
+                        self.detect(a, values_a, left, self.tests(left), float(a.tangent @ (left.z - a.z)), arclength)
+                        arclength += float(np.linalg.norm(left.z - a.z))
+                        a, values_a = left, self.tests(left)
+                        points.append(a)
+                        h = max(min(h, float(np.linalg.norm(points[-1].z - points[-2].z))), s.min_step)
+                    self._record_onset(graze_at, near_before, a, arriving_way, near_start, first_special)
                     continue
                 b = None
             elif changed:
@@ -256,6 +245,10 @@ class _Walker:
                     # instead of creeping up to it with ever smaller steps
                     points.append(self.bound(a, h, s.lower if predicted < s.lower else s.upper))
                     return points, "bound"
+                moved = self.resection(a)
+                if moved is not None:  # an impact at the strobe: the same step from a strobe clear of it
+                    a = points[-1] = moved
+                    continue
                 h *= 0.5
                 if h < s.min_step:
                     return points, "step_too_small"
@@ -274,19 +267,19 @@ class _Walker:
                 points.append(b)
                 return points, "parent"
             arclength += sigma
-            if len(points) > 3:
+            if len(points) > 3 and self.moved is None:  # (a moved strobe reads the states elsewhere than the start's)
                 offset_a, offset_b = a.z - start.z, b.z - start.z
                 if start.tangent @ offset_a < 0.0 <= start.tangent @ offset_b and np.linalg.norm(offset_b) < 2.0 * h:
                     points.append(b)
                     return points, "closed"
             points.append(b)
+            if not s.stop_at_grazing and b.out.hybrid is not None and b.out.hybrid.impacts == 0 and self.clear(b, a):
+                return points, "clear"  # contact-free and moving away from every stop
             self.slope = (grazing_margin(b.out.hybrid) - grazing_margin(a.out.hybrid)) / sigma if b.out.hybrid is not None else 0.0
             a, values_a = b, values_b
             h = min(h * 1.5, s.max_step) if b.iterations <= 3 else (max(h / 1.5, s.min_step) if b.iterations >= 6 else h)
         return points, "max_steps"
 
-
-_NOT_GRAZING = object()
 
 
 def continue_branch(system: ParametrisedMap, orbit: PeriodicOrbit, parameter: str, settings: ContinuationSettings = ContinuationSettings(), direction: int = 0) -> Branch:
@@ -340,154 +333,3 @@ def continue_branch(system: ParametrisedMap, orbit: PeriodicOrbit, parameter: st
     points = list(reversed(down)) + up[1:]
     specials = [s for _, s in reversed(down_specials)] + [s for _, s in up_specials]
     return Branch(parameter, tuple(p.orbit(system) for p in points), tuple(specials), f"{down_end}, {up_end}")
-
-
-# --------------------------------------------------------------------------------------------------------------------
-# Two-parameter continuation of folds, period doublings, Neimark-Sacker and grazing points.
-# --------------------------------------------------------------------------------------------------------------------
-
-@dataclass(frozen=True, eq=False)
-class SpecialCurve:
-    """A curve of special points of one kind in two parameters.
-
-    Attributes
-    ----------
-    kind : str
-        'fold', 'period_doubling', 'neimark_sacker' or 'grazing'.
-    parameters : (str, str)
-        The two free parameters (p1, p2).
-    orbits : tuple of PeriodicOrbit
-        The orbit at each point of the curve, in arclength order.
-    end : str
-        Why each end stopped: ``"<first end>, <last end>"`` ('bound', 'max_steps', 'step_too_small', 'closed').
-    """
-
-    kind: str
-    parameters: tuple[str, str]
-    orbits: tuple[PeriodicOrbit, ...]
-    end: str
-
-    def values(self, name: str) -> NDArray[np.float64]:
-        """One parameter along the curve."""
-        return np.array([o.parameter(name) for o in self.orbits])
-
-
-def defining_function(kind: str, reference: tuple[int, int] | None = None) -> TestFunction:
-    """The scalar g(out, y, p) whose zero set is the ``kind`` of special point (see the module docstring).
-
-    ``reference`` is the (impacts, sticks) signature of the grazing point's own side (grazing only).
-    """
-    identity_cache: dict[int, NDArray[np.float64]] = {}
-
-    def fold(out: MapEvaluation, y: NDArray[np.float64], p: NDArray[np.float64]) -> float:
-        n = out.jacobian.shape[0]
-        if not np.all(np.isfinite(out.jacobian)):
-            return math.nan
-        identity = identity_cache.setdefault(n, np.eye(n))
-        return float(np.linalg.det(out.jacobian - identity))
-
-    def doubling(out: MapEvaluation, y: NDArray[np.float64], p: NDArray[np.float64]) -> float:
-        return period_doubling_test(out)
-
-    def torus(out: MapEvaluation, y: NDArray[np.float64], p: NDArray[np.float64]) -> float:
-        return neimark_sacker_test(out)
-
-    def grazing(out: MapEvaluation, y: NDArray[np.float64], p: NDArray[np.float64]) -> float:
-        if out.hybrid is None:
-            raise ValueError("grazing needs a hybrid map (its evaluations carry no HybridInfo)")
-        margin = grazing_margin(out.hybrid)
-        return margin if out.hybrid.signature == reference else -margin
-
-    table = {"fold": fold, "period_doubling": doubling, "neimark_sacker": torus, "grazing": grazing}
-    if kind not in table:
-        raise ValueError(f"kind = {kind!r}: allowed {sorted(table)}")
-    return table[kind]
-
-
-def continue_special_point(
-    system: ParametrisedMap,
-    point: SpecialPoint,
-    second: str,
-    settings: ContinuationSettings = ContinuationSettings(),
-    bounds: dict[str, tuple[float, float]] | None = None,
-    direction: int = 0,
-) -> SpecialCurve:
-    """Follow a located special point in its own parameter and ``second``.
-
-    Parameters
-    ----------
-    system : ParametrisedMap
-        The map of the branch on which the point was found (``Iterated(map, k)`` for a period-k orbit).
-    point : SpecialPoint
-        A fold, period doubling, Neimark-Sacker or grazing point from :func:`.continuation.continue_branch`.
-    second : str
-        The second free parameter.
-    settings : ContinuationSettings
-        Steps, tolerances, ``max_steps`` (per direction); its ``lower``/``upper`` are ignored: see ``bounds``.
-    bounds : dict, optional
-        Parameter name -> (lower, upper) for either free parameter; the curve stops on a bound.
-    direction : {1, -1, 0}
-        Increasing ``second`` first, decreasing, or both ways.
-
-    Returns
-    -------
-    SpecialCurve
-        The curve of special points with the orbit at each.
-    """
-    names = list(system.parameter_names)
-    free = (names.index(point.parameter), names.index(second))
-    orbit = point.orbit
-    reference = orbit.hybrid.signature if orbit.hybrid is not None else None
-    arc = ArclengthSystem(system, orbit.parameters, free, (defining_function(point.kind, reference),))
-    start = arc.correct(arc.to_z(orbit.state, orbit.parameters), np.eye(arc.n + 2)[arc.n + 1], settings.tolerance, 20)
-    if start is None:
-        raise RuntimeError(f"the {point.kind} point at {point.parameter} = {point.value!r} does not solve its extended system")
-    limits = {free[0]: (-math.inf, math.inf), free[1]: (-math.inf, math.inf)}
-    for name, (low, high) in (bounds or {}).items():
-        limits[names.index(name)] = (low, high)
-    runs = []
-    for sign in ((1.0, -1.0) if direction == 0 else (float(direction),)):
-        t = start.tangent if start.tangent[arc.n + 1] * sign >= 0.0 else -start.tangent
-        first = Point(start.z, start.y, start.p, start.out, start.residual, start.jacobian, t, 0, start.history)
-        runs.append(_walk(arc, first, settings, limits))
-        if runs[-1][1] == "closed":
-            break
-    if len(runs) == 1:
-        points, end = runs[0]
-    else:
-        (up, up_end), (down, down_end) = runs
-        points, end = list(reversed(down)) + up[1:], f"{down_end}, {up_end}"
-    return SpecialCurve(point.kind, (point.parameter, second), tuple(p.orbit(system) for p in points), end)
-
-
-def _walk(arc: ArclengthSystem, start: Point, s: ContinuationSettings, limits: dict[int, tuple[float, float]]) -> tuple[list[Point], str]:
-    a, points, h = start, [start], s.step
-    turn = math.cos(s.max_turn)
-    for _ in range(s.max_steps):
-        b = arc.correct(a.z + h * a.tangent, a.tangent, s.tolerance, s.max_corrector_iterations)
-        if b is None or (b.tangent @ a.tangent < turn and h > s.min_step):
-            h *= 0.5
-            if h < s.min_step:
-                return points, "step_too_small"
-            continue
-        sigma = float(a.tangent @ (b.z - a.z))
-        for index, (low, high) in limits.items():
-            value = float(b.p[index])
-            if not low <= value <= high:
-                bound = low if value < low else high
-
-                def test(point: Point | None, index: int = index, bound: float = bound) -> float | None:
-                    return None if point is None else float(point.p[index] - bound)
-
-                lo, hi, _width = locate(arc, a, sigma, test, s.locate_tolerance * max(1.0, float(np.max(np.abs(a.z)))), s.tolerance)
-                points.append(hi if hi is not None else lo)
-                return points, "bound"
-        if len(points) > 3:
-            offset_a, offset_b = a.z - start.z, b.z - start.z
-            if start.tangent @ offset_a < 0.0 <= start.tangent @ offset_b and np.linalg.norm(offset_b) < 2.0 * h:
-                points.append(b)
-                return points, "closed"
-        points.append(b)
-        a = b
-        h = min(h * 1.5, s.max_step) if b.iterations <= 3 else (max(h / 1.5, s.min_step) if b.iterations >= 6 else h)
-    return points, "max_steps"

@@ -43,14 +43,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from typing import Any
 
+from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.engines.registry import BUMPER, engine_for, make_engine
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.orbits.branch import HybridInfo, MapEvaluation, PeriodicOrbit
+from vibroimpact.orbits.branch import Branch, HybridInfo, MapEvaluation, PeriodicOrbit
 from vibroimpact.orbits.sections import StrobeGap, moved_phase, moved_state, resection, strobe_gap
 from vibroimpact.orbits.shooting import closed_form_state, section_phase, with_impulse
 
-__all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "closed_form_state", "with_impulse", "section_phase", "resection", "PARAMETERS", "SECTION_PARAMETER", "stop_selection", "Resection"]
+__all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "BranchMeasures", "branch_measures", "closed_form_state", "with_impulse", "section_phase", "resection", "PARAMETERS", "SECTION_PARAMETER", "stop_selection", "Resection"]
 
 #: The parameters of an :class:`ImpactMap`, in order, with their units.
 PARAMETERS = {"frequency": "Hz", "restitution": "1", "clearance": "m", "amplitude": "N", "phase": "rad"}
@@ -102,8 +103,9 @@ class ImpactMap:
     stop : int or 'all', optional
         The stop(s) whose clearance and restitution the parameters are (module docstring).
     parameter_scale : array_like, shape (m,), optional
-        A unit of arclength for each of the m parameters (default :attr:`default_parameter_scale`: 1 Hz, 0.1, 1 mm,
-        1 N, 1 rad); e.g. dimensionless problems take their own.
+        A unit of arclength for each of the m parameters (default :meth:`natural_scale` of the problem: 4 % of its
+        frequency, 0.1, 15 % of its length scale, 10 % of its amplitude, 1 rad; on the paper's 25 Hz, 10 N problem
+        1 Hz, 0.1, 1.1 mm, 1 N), so that a 0.1 Hz structure and a 30 Hz one take the same steps in their own units.
 
     Attributes
     ----------
@@ -122,8 +124,13 @@ class ImpactMap:
     """
 
     parameter_names: tuple[str, ...] = tuple(PARAMETERS)
-    #: One unit of arclength per parameter, in the order of ``parameter_names``: 1 Hz, 0.1, 1 mm, 1 N, 1 rad.
-    default_parameter_scale: tuple[float, ...] = (1.0, 0.1, 1e-3, 1.0, 1.0)
+    @staticmethod
+    def natural_scale(problem: ImpactProblem) -> tuple[float, ...]:
+        """One unit of arclength per parameter, in the order of ``parameter_names``, from the problem's own
+        magnitudes: 0.04 f [Hz], 0.1 [-], 0.15 L [m] (L the length scale, :meth:`ImpactProblem.length_scale`),
+        0.1 |q| [N] (1 for q = 0), 1 [rad]."""
+        amplitude = abs(problem.amplitude)
+        return (0.04 * problem.frequency, 0.1, 0.15 * problem.length_scale(), 0.1 * amplitude if amplitude > 0.0 else 1.0, 1.0)
 
     def __init__(self, problem: ImpactProblem, periods: int = 1, engine: Any = None, bounds: dict[str, tuple[float, float]] | None = None,
                  stop: int | str | None = None, parameter_scale: ArrayLike | None = None) -> None:  # fmt: skip
@@ -141,7 +148,7 @@ class ImpactMap:
         length = problem.length_scale()  # Delta + q |H12| on the paper's layout
         self.state_scale = np.repeat([length, problem.omega * length], problem.size)
         names = self.parameter_names
-        self.parameter_scale = np.array(self.default_parameter_scale if parameter_scale is None else parameter_scale, dtype=float)
+        self.parameter_scale = np.array(self.natural_scale(problem) if parameter_scale is None else parameter_scale, dtype=float)
         if self.parameter_scale.shape != (len(names),) or not np.all(self.parameter_scale > 0.0):
             raise ValueError(f"parameter_scale = {parameter_scale!r}: expected {len(names)} positive numbers ({', '.join(names)})")
         self.bounds = dict(bounds or {})
@@ -169,6 +176,25 @@ class ImpactMap:
         moved = np.asarray(p, dtype=float).copy()
         moved[self.parameter_names.index(SECTION_PARAMETER)] = moved_phase(problem, gap.shift)
         return Resection(moved_state(problem, state, periods, self.engine, run, gap.shift), moved, gap)
+
+    def linear_orbit(self, p: NDArray[np.float64]) -> tuple[NDArray[np.float64], float] | None:
+        """The contact-free steady state at parameters ``p``, in closed form (:func:`~vibroimpact.analysis.linear.
+        linear_amplitudes`): its state at the strobe, and its least relative clearance to a stop, min_k (Delta_k -
+        |n_k . X| - n_k . x0) / max(|Delta_k|, L / 1000) with L the length scale [-] (negative: it would cross that
+        stop; zero: it touches it, an onset; 1: it does not move towards any stop). None where ``p`` is no problem,
+        or the structure has no static equilibrium under the load."""
+        try:
+            problem = self.problem_at(p)
+        except ValueError:
+            return None
+        linear = linear_amplitudes(problem)
+        if not np.all(np.isfinite(linear.static)):
+            return None
+        x = linear.coordinates
+        state = np.concatenate([linear.static + x.real, (1j * problem.omega * x).real])
+        reach = np.abs(linear.stops) + linear.stop_static
+        clearances = problem.clearances()
+        return state, float(np.min((clearances - reach) / np.maximum(np.abs(clearances), 1e-3 * self.state_scale[0])))
 
     def with_periods(self, periods: int) -> "ImpactMap":
         """The same map over ``periods`` excitation periods (one compiled call per evaluation, unlike ``Iterated``)."""
@@ -308,3 +334,49 @@ def orbit_measures(system: ImpactMap, orbit: PeriodicOrbit) -> OrbitMeasures:
     stops = np.asarray(stops, dtype=int).copy() if stops is not None else np.zeros(trajectory.impulses.size, dtype=int)
     amplitudes = np.abs(np.asarray(moments[: problem.size])) * scale
     return OrbitMeasures(trajectory.impact_velocities.copy(), trajectory.impulses.copy(), amplitudes, stops)
+
+
+@dataclass(frozen=True, eq=False)
+class BranchMeasures:
+    """What a branch's orbits mean physically, point by point (:func:`branch_measures`).
+
+    Attributes
+    ----------
+    parameter : str
+        The continued parameter.
+    values : ndarray, shape (points,)
+        Its value at each point [its unit: ``PARAMETERS``].
+    amplitudes : ndarray, shape (points, N)
+        |fundamental harmonic| of each coordinate [m].
+    impacts : ndarray of int, shape (points,)
+        Impacts (contact onsets) per orbit period.
+    peak_impulse : ndarray, shape (points,)
+        The largest |impulse| of a contact over the orbit's period [N s] (0 without contact).
+    stable : ndarray of bool, shape (points,)
+        Every Floquet multiplier inside the unit circle.
+    """
+
+    parameter: str
+    values: NDArray[np.float64]
+    amplitudes: NDArray[np.float64]
+    impacts: NDArray[np.int_]
+    peak_impulse: NDArray[np.float64]
+    stable: NDArray[np.bool_]
+
+    def amplitude(self, coordinate: int) -> NDArray[np.float64]:
+        """|X| of one coordinate along the branch [m] (0: the paper's primary mass, 1: its absorber)."""
+        return self.amplitudes[:, coordinate]
+
+
+def branch_measures(system: ImpactMap, branch: Branch) -> BranchMeasures:
+    """:func:`orbit_measures` of every orbit of ``branch`` (continued on ``system``), as arrays along it: one exact
+    integration per point, each at the orbit's own strobe."""
+    measures = [orbit_measures(system, orbit) for orbit in branch.orbits]
+    return BranchMeasures(
+        branch.parameter,
+        branch.values,
+        np.array([m.amplitudes for m in measures]),
+        branch.impacts,
+        np.array([float(np.max(np.abs(m.impulses))) if m.impulses.size else 0.0 for m in measures]),
+        branch.stable,
+    )

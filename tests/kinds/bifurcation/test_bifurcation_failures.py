@@ -32,7 +32,7 @@ def test_seeds_that_fail_are_counted_and_summarised() -> None:
     and the summary says 2 of 2 failed, why, and what that means; the raw messages are kept, one per seed."""
     nan = (float("nan"),) * 4
     found = OrbitSet()
-    settings = ContinuationSettings(lower=24.0, upper=26.0)
+    settings = ContinuationSettings(lower=24.0, upper=26.0, stop_at_grazing=True)
     added = seed_branches(found, PROBLEM, 24.0, 26.0, [Seed(25.0, 1, nan), Seed(25.5, 2, nan)], settings)
     assert added == 0 and found.attempts == {"seed": 2} and [kind for kind, _ in found.failures] == ["seed", "seed"]
     result = failure_arrays(found.attempts, found.failures) | {"notes": np.array(found.notes, dtype=str)}

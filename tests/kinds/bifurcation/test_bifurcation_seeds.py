@@ -35,7 +35,7 @@ def seeded():
     seeds = sweep_seeds(np.array(FREQUENCIES), sweep["period"], sweep["impacts"], sweep["state"])
     found = find_branches(PROBLEM, LOW, HIGH)
     before = found.count
-    settings = ContinuationSettings(lower=LOW, upper=HIGH, max_step=0.1)
+    settings = ContinuationSettings(lower=LOW, upper=HIGH, max_step=0.1, stop_at_grazing=True)
     added = seed_branches(found, PROBLEM, LOW, HIGH, seeds, settings)
     again = seed_branches(found, PROBLEM, LOW, HIGH, seeds, settings)
     return sweep, seeds, found, before, added, again

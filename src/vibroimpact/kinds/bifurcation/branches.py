@@ -288,7 +288,7 @@ def find_branches(
         Largest arclength step [-].
     """
     found = OrbitSet()
-    settings = ContinuationSettings(lower=low, upper=high, max_steps=max_steps, max_step=max_step)
+    settings = ContinuationSettings(lower=low, upper=high, max_steps=max_steps, max_step=max_step, stop_at_grazing=True)
     bounds = map_bounds(low, high)
     restitution = stop_values(problem)[1]
 

@@ -340,7 +340,7 @@ class BranchCase:
         brute_force = bool(options.pop("brute_force", True))
         found = find_branches(self.problem, self.low, self.high, **options)
         if brute_force and self.seeds:
-            settings = ContinuationSettings(lower=self.low, upper=self.high, max_steps=int(options.get("max_steps", 2000)), max_step=float(options.get("max_step", 0.1)))
+            settings = ContinuationSettings(lower=self.low, upper=self.high, max_steps=int(options.get("max_steps", 2000)), max_step=float(options.get("max_step", 0.1)), stop_at_grazing=True)
             seed_branches(found, self.problem, self.low, self.high, self.seeds, settings)
         return branch_arrays(found, self.problem.size)
 
@@ -409,7 +409,7 @@ class ChartCase:
         clearance = stop_values(self.problem)[0]
         low_c, high_c = self.clearance_range
         bounds = {"clearance": (low_c, high_c), "frequency": (self.low, self.high)}
-        settings = ContinuationSettings(max_steps=self.max_steps, max_step=0.2)
+        settings = ContinuationSettings(max_steps=self.max_steps, max_step=0.2, stop_at_grazing=True)
         rows: list[tuple[int, int, float, float]] = []
         notes = list(found.notes)
         attempts = {f"chart_{kind}": count for kind, count in found.attempts.items()}  # the chart's own branches

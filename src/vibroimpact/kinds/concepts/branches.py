@@ -156,7 +156,7 @@ class BranchCase:
         """Every branch of the concept, as flat per-point arrays."""
         points: list[tuple[float, float, float, float, float, float, float]] = []
         notes: list[str] = []
-        settings = ContinuationSettings(lower=self.low, upper=self.high, max_steps=self.max_steps, max_step=0.1)
+        settings = ContinuationSettings(lower=self.low, upper=self.high, max_steps=self.max_steps, max_step=0.1, stop_at_grazing=True)
         bounds = {"frequency": (0.5 * self.low, 2.0 * self.high)}
         count = 0
         for done, (frequency, period, phase, state) in enumerate(self._starts(notes)):

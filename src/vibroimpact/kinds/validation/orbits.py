@@ -115,7 +115,7 @@ def multiplier_distance(computed: NDArray[np.complex128], published: NDArray[np.
 
 def _map(problem, parameter: str, low: float, high: float, scale: float) -> ImpactMap:
     """The exact stroboscopic map with ``parameter`` kept inside [low, high] and measured in units of ``scale``."""
-    scales = np.array(ImpactMap.default_parameter_scale)
+    scales = np.array(ImpactMap.natural_scale(problem))
     scales[ImpactMap.parameter_names.index(parameter)] = scale
     return ImpactMap(problem, 1, ExactEngine(), bounds={parameter: (low, high)}, parameter_scale=scales)
 
@@ -147,7 +147,7 @@ def run_budd_dux(case: BuddDuxCase, say=lambda message: None) -> CaseOutcome:
     mapping = _map(problem, "clearance", low, high, 0.05)
     say(f"budd_dux: shooting at sigma = {sigma0:g}, then continuing over [{low:g}, {high:g}]")
     orbit = shoot(mapping, budd_dux_state(sigma0, v0, w, r, 0.0), mapping.parameters)
-    branch = continue_branch(mapping, orbit, "clearance", ContinuationSettings(step=0.05, max_step=0.3, lower=low, upper=high, max_steps=case.max_steps, detect=_DETECT))
+    branch = continue_branch(mapping, orbit, "clearance", ContinuationSettings(step=0.05, max_step=0.3, lower=low, upper=high, max_steps=case.max_steps, detect=_DETECT, stop_at_grazing=True))
     sigma = branch.values
     velocity = np.array([_impact_velocity(o) for o in branch.orbits])
     roots = budd_dux_velocities(sigma, w, r)
@@ -224,7 +224,7 @@ def run_bouncing_ball(case: BouncingBallCase, say=lambda message: None, brute: b
     say(f"bouncing_ball: shooting at Gamma = {start:.6g}, continuing over [{low:g}, {high:g}]")
     guess = ball_state(start, e, g, omega, 0.5 * period)  # the problem's t = 0 is the table's T / 2
     orbit = shoot(mapping, guess, mapping.parameters)
-    settings = ContinuationSettings(step=0.05, max_step=0.2, lower=ball_amplitude(case, low), upper=ball_amplitude(case, high), max_steps=2000, detect=_DETECT)
+    settings = ContinuationSettings(step=0.05, max_step=0.2, lower=ball_amplitude(case, low), upper=ball_amplitude(case, high), max_steps=2000, detect=_DETECT, stop_at_grazing=True)
     branch = continue_branch(mapping, orbit, "amplitude", settings)
     gamma = branch.values / unit
     speed = np.array([_impact_velocity(o) for o in branch.orbits])

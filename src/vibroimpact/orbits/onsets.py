@@ -1,0 +1,130 @@
+"""Contact onsets located in closed form where one side of them is contact-free.
+
+Where a branch of periodic orbits meets the stops' contact onset (the rigid stop's grazing, a bumper's tangency) and
+one side of it has no contact, the orbit on that side is the linear steady state, known in closed form
+(:meth:`vibroimpact.orbits.maps.ImpactMap.linear_orbit`): the onset is where it touches a stop, the root of its least
+clearance min_k (Delta_k - |n_k . X(p)| - n_k . x0(p)) in the continued parameter p. A bracket is widened around the
+continuation's own estimate until that clearance changes sign, and Brent's method finds the root to round-off. The
+orbit there is the linear orbit touching the stop: the grazing orbit itself, not a neighbour.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import brentq
+
+from vibroimpact.orbits.branch import ParametrisedMap
+
+__all__ = ["contact_free_onset", "linear_clearance", "stability_change", "touches_ahead", "SCAN_POINTS"]
+
+
+def linear_clearance(system: ParametrisedMap, p: NDArray[np.float64], index: int, value: float) -> float:
+    """The contact-free orbit's least clearance [-] with parameter ``index`` set to ``value`` (NaN: none)."""
+    closed = getattr(system, "linear_orbit", None)
+    q = np.array(p, dtype=float)
+    q[index] = value
+    found = None if closed is None else closed(q)
+    return math.nan if found is None else found[1]
+
+
+def contact_free_onset(system: ParametrisedMap, p: NDArray[np.float64], index: int, estimate: float, reach: float) -> tuple[float, NDArray[np.float64]] | None:
+    """The parameter value [its unit] where the contact-free orbit touches a stop, within ``reach`` of ``estimate``,
+    and the parameter vector there; None where the map has no closed-form contact-free orbit, or its clearance does
+    not change sign within ``reach`` (the point is no onset from a contact-free side).
+
+    Parameters
+    ----------
+    system : ParametrisedMap
+        The map (an ``ImpactMap``, or an iterate of one).
+    p : ndarray
+        A parameter vector; entry ``index`` is the continued parameter.
+    estimate : float
+        The continuation's estimate of the onset.
+    reach : float
+        How far from ``estimate`` the onset may lie [the parameter's unit], > 0.
+    """
+    if getattr(system, "linear_orbit", None) is None or not math.isfinite(estimate) or not reach > 0.0:
+        return None
+    at = linear_clearance(system, p, index, estimate)
+    if not math.isfinite(at):
+        return None
+    if at == 0.0:  # exact: the estimate touches already
+        root = estimate
+    else:
+        width = max(reach * 1e-6, abs(estimate) * 1e-14)
+        root = math.nan
+        while width <= reach:
+            for end in (estimate - width, estimate + width):
+                there = linear_clearance(system, p, index, end)
+                if math.isfinite(there) and there * at <= 0.0:
+                    low, high = sorted((estimate, end))
+                    root = brentq(lambda v: linear_clearance(system, p, index, v), low, high, xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=200)
+                    break
+            if math.isfinite(root):
+                break
+            width *= 2.0
+        if not math.isfinite(root):
+            return None
+    q = np.array(p, dtype=float)
+    q[index] = root
+    return float(root), q
+
+
+def stability_change(before: NDArray[np.complex128], after: NDArray[np.complex128]) -> str:
+    """How the Floquet multipliers change across a contact onset, in words: '' where as many lie outside the unit
+    circle on both sides; else which cross it ('a complex pair', 'a real multiplier through +1' / '-1') and the
+    largest moduli on each side, named as the discontinuity-induced bifurcation it is.
+
+    Parameters
+    ----------
+    before, after : ndarray of complex
+        The multipliers of the orbits on the two sides, in the order the branch passes them.
+    """
+    outside_before = np.abs(before) > 1.0
+    outside_after = np.abs(after) > 1.0
+    if int(outside_before.sum()) == int(outside_after.sum()):
+        return ""
+    gained = int(outside_after.sum()) > int(outside_before.sum())
+    changed = after[outside_after] if gained else before[outside_before]
+    complex_pair = bool(np.any(np.abs(changed.imag) > 1e-9 * np.abs(changed)))
+    if complex_pair:
+        what, name = "a complex pair of multipliers", "Neimark-Sacker"
+    elif np.any(changed.real < 0.0):
+        what, name = "a real multiplier through -1", "period doubling"
+    else:
+        what, name = "a real multiplier through +1", "fold"
+    way = "leaves" if gained else "enters"
+    return (f"{what} {way} the unit circle across it, largest |mu| {np.max(np.abs(before)):.4g} -> {np.max(np.abs(after)):.4g}: "
+            f"a discontinuity-induced {name}")
+
+
+#: Points of the closed-form scan for a contact ahead of a contact-free stretch (:func:`touches_ahead`).
+SCAN_POINTS = 4001
+
+
+def touches_ahead(system: ParametrisedMap, p: NDArray[np.float64], index: int, way: float, lower: float, upper: float) -> bool:
+    """Does the contact-free orbit touch a stop anywhere ahead of parameter ``index``'s value in ``p``, going ``way``
+    (+1 up, -1 down), up to the bound (``lower``/``upper``), or within a decade of the value where that bound is
+    infinite? Scanned in closed form over :data:`SCAN_POINTS` values (geometric where the value keeps its sign,
+    linear otherwise); True without a closed form (then nothing may end the stretch early)."""
+    if getattr(system, "linear_orbit", None) is None:
+        return True
+    value = float(p[index])
+    end = upper if way > 0.0 else lower
+    if not math.isfinite(end):
+        magnitude = max(abs(value), 1e-300)
+        end = value + way * 9.0 * magnitude if way > 0.0 or value <= 0.0 else value / 10.0
+    if (end - value) * way <= 0.0:
+        return False
+    if value > 0.0 and end > 0.0:
+        values = np.geomspace(value, end, SCAN_POINTS)
+    else:
+        values = np.linspace(value, end, SCAN_POINTS)
+    for v in values[1:]:
+        clearance = linear_clearance(system, p, index, float(v))
+        if math.isfinite(clearance) and clearance <= 0.0:
+            return True
+    return False
