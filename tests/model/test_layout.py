@@ -84,3 +84,53 @@ def test_a_stop_on_a_missing_coordinate_is_refused() -> None:
         Layout(PAPER_SYSTEM, LoadSpec(), (StopSpec(2),))
     with pytest.raises(TypeError, match="stops"):
         Layout(PAPER_SYSTEM, LoadSpec(), ())
+
+
+# ---------------------------------------------------------------------------------------------------------------------
+# Questions a layout answers from its geometry (and the grid's values where a rule needs one), without a problem.
+# ---------------------------------------------------------------------------------------------------------------------
+
+#: A three-mass chain with named coordinates (no rigid-body mode).
+CHAIN = LinearStructure(np.diag([1.0, 0.5, 0.05]), [[2e4, -1e4, 0.0], [-1e4, 1.02e4, -200.0], [0.0, -200.0, 200.0]], [[2.0, -1.0, 0.0], [-1.0, 1.02, -0.02], [0.0, -0.02, 0.02]], ("a", "b", "c"))
+
+#: (id, layout, grid clearances [m], how many of them leave no room): opposite stops absolute and relative, the
+#: relative coordinate written both ways, stops on different coordinates (never without room), one stop.
+ROOM_LAYOUTS = [
+    ("absolute-pair", Layout(CHAIN, LoadSpec(), (StopSpec(0, clearance=-0.002), StopSpec(0, side="lower"))), (0.001, 0.002, 0.003), 2),
+    ("relative-pair", Layout(CHAIN, LoadSpec(), (StopSpec(2, 1), StopSpec(2, 1, "lower", clearance=-0.002))), (0.001, 0.002, 0.0025), 2),
+    ("written-both-ways", Layout(CHAIN, LoadSpec(), (StopSpec(2, 1, clearance=0.0), StopSpec(1, 2))), (-0.001, 0.0, 0.001), 2),
+    ("same-sides-apart", Layout(CHAIN, LoadSpec(), (StopSpec(0, clearance=-0.005), StopSpec(1, side="lower"), StopSpec(2, 1))), (-0.004, 0.0), 0),
+    ("one-stop", Layout(PAPER_SYSTEM), (-0.003, 0.0, 0.003), 0),
+]
+
+
+@pytest.mark.parametrize(("layout", "clearances", "refusals"), [case[1:] for case in ROOM_LAYOUTS], ids=[case[0] for case in ROOM_LAYOUTS])
+def test_the_room_check_refuses_what_a_problem_refuses(layout: Layout, clearances: tuple[float, ...], refusals: int) -> None:
+    """Two opposite stops whose clearances sum to <= 0 leave no room: the layout says so from its geometry and
+    clearances, with the message a problem with those stops raises, and accepts every layout a problem accepts."""
+    refused = 0
+    for clearance in clearances:
+        try:
+            layout.problem(10.0, 25.0, 0.5, clearance)
+            expected = None
+        except ValueError as error:
+            expected = str(error)
+        try:
+            layout.check_room(clearance)
+            got = None
+        except ValueError as error:
+            got = str(error)
+        assert got == expected, (clearance, got, expected)
+        refused += expected is not None and "leave no room between them" in expected
+    assert refused == refusals
+
+
+def test_a_clearance_the_grid_does_not_give_is_not_judged() -> None:
+    """Without the grid's value (NaN) a stop that takes it leaves no pair refused; its own values still are."""
+    layout = Layout(CHAIN, LoadSpec(), (StopSpec(0), StopSpec(0, side="lower", clearance=-1.0)))
+    layout.check_room()
+    with pytest.raises(ValueError, match=r"stops: stop 0 \(a <= 1 mm\) and stop 1 \(a >= 1000 mm\) leave no room between them"):
+        layout.check_room(0.001)
+    own = Layout(CHAIN, LoadSpec(), (StopSpec(0, clearance=0.001), StopSpec(0, side="lower", clearance=-0.001)))
+    with pytest.raises(ValueError, match="leave no room"):
+        own.check_room()
