@@ -92,6 +92,55 @@ def test_a_stop_on_a_missing_coordinate_is_refused() -> None:
 
 #: A three-mass chain with named coordinates (no rigid-body mode).
 CHAIN = LinearStructure(np.diag([1.0, 0.5, 0.05]), [[2e4, -1e4, 0.0], [-1e4, 1.02e4, -200.0], [0.0, -200.0, 200.0]], [[2.0, -1.0, 0.0], [-1.0, 1.02, -0.02], [0.0, -0.02, 0.02]], ("a", "b", "c"))
+#: Two free masses joined by a spring: one rigid-body mode.
+FREE_FREE = LinearStructure(np.diag([1.0, 0.1]), [[4300.0, -4300.0], [-4300.0, 4300.0]], [[0.08, -0.08], [-0.08, 0.08]])
+
+#: (id, layout): the paper's; a symmetric relative pair (grid values, then its own); a base-motion frame with a pair;
+#: a static load on a lower stop; stops on two coordinates; a free-free structure under a static load.
+REACH_LAYOUTS = [
+    ("paper", Layout(PAPER_SYSTEM)),
+    ("relative-pair", Layout(PAPER_SYSTEM.structure, LoadSpec(weights=(1.0, 0.0)), (StopSpec(1, 0), StopSpec(1, 0, "lower")))),
+    ("own-values", Layout(PAPER_SYSTEM.structure, LoadSpec(), (StopSpec(1, 0, clearance=0.002, restitution=0.4), StopSpec(1, 0, "lower", clearance=0.002, restitution=0.4)))),
+    ("frame-base-motion", Layout(CHAIN, LoadSpec(base_motion=True), (StopSpec(2, 1), StopSpec(2, 1, "lower")))),
+    ("static-lower", Layout(CHAIN, LoadSpec(weights=(0.0, 1.0, 0.5), static=(0.0, 0.0, -0.49)), (StopSpec(2, side="lower"),))),
+    ("two-coordinates", Layout(CHAIN, LoadSpec(static=(3.0, 0.0, 0.0)), (StopSpec(0), StopSpec(2, side="lower")))),
+    ("free-free-static", Layout(FREE_FREE, LoadSpec(static=(0.0, -0.981)), (StopSpec(1, 0),))),
+    ("read-back", Layout.from_attributes(Layout(ROUNDING).attributes(np.array([0.2]), np.array([0.003])))),
+]
+
+
+@pytest.mark.parametrize("layout", [case[1] for case in REACH_LAYOUTS], ids=[case[0] for case in REACH_LAYOUTS])
+def test_the_linear_reach_is_a_problem_s_linear_amplitudes_bit_for_bit(layout: Layout) -> None:
+    """|n_k . X| + n_k . x0 of the layout equals that of a problem built from it, whatever the stops' values (the
+    linear steady state does not see them): same arithmetic, same bits (NaN where K is singular under a static load)."""
+    from vibroimpact.analysis.linear import linear_amplitudes, linear_reach
+
+    for amplitude, frequency in ((10.0, 25.0), (0.001, 8.5), (3.0, 140.0)):
+        reach = linear_reach(layout, amplitude, frequency)
+        assert reach.shape == (len(layout.stops),)
+        for restitution, clearance in ((0.5, 1.0), (0.05, 2e-4)):
+            linear = linear_amplitudes(layout.problem(amplitude, frequency, restitution, clearance))
+            np.testing.assert_array_equal(reach, np.abs(linear.stops) + linear.stop_static)  # exact: the one arithmetic, on the same structure and load
+
+
+def test_the_linear_reach_of_the_paper_s_stop_is_q_h12() -> None:
+    """On the paper's layout the reach is the absorber's linear amplitude q |H12| (no static load); on a relative pair
+    both sides see the same |X2 - X1|; a static load adds n . K^-1 F0, signed by the stop's side."""
+    from vibroimpact.analysis.linear import linear_reach, linear_response
+
+    frequencies = (12.0, 25.0, 33.0)
+    for f in frequencies:
+        reach = linear_reach(Layout(PAPER_SYSTEM), 10.0, f)
+        response = linear_response(PAPER_SYSTEM, f, 10.0)
+        np.testing.assert_allclose(reach, [abs(response.x2)], rtol=1e-12)
+        pair = linear_reach(REACH_LAYOUTS[1][1], 10.0, f)
+        np.testing.assert_allclose(pair, [abs(response.x2 - response.x1)] * 2, rtol=1e-12)
+    loaded = Layout(CHAIN, LoadSpec(static=(0.0, 0.0, -0.49)), (StopSpec(2), StopSpec(2, side="lower")))
+    free = Layout(CHAIN, LoadSpec(), loaded.stops)
+    offset = float(np.linalg.solve(CHAIN.stiffness_matrix, [0.0, 0.0, -0.49])[2])  # x3 of the static deflection [m]
+    np.testing.assert_allclose(linear_reach(loaded, 1.0, 5.0) - linear_reach(free, 1.0, 5.0), [offset, -offset], rtol=1e-12)
+    assert offset < 0.0
+
 
 #: (id, layout, grid clearances [m], how many of them leave no room): opposite stops absolute and relative, the
 #: relative coordinate written both ways, stops on different coordinates (never without room), one stop.

@@ -27,7 +27,7 @@ from vibroimpact.model.excitation import HarmonicForce, load_weights
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
 
-__all__ = ["ClosedFormLayout", "closed_form_layout", "closed_form_refusal", "harmonic_load", "static_offset", "KINDS"]
+__all__ = ["ClosedFormLayout", "closed_form_layout", "closed_form_refusal", "harmonic_load", "harmonic_load_of", "static_offset", "KINDS"]
 
 #: The closed forms: one impact per period on one stop, two per period on a symmetric two-sided stop.
 KINDS = ("one_impact", "two_impacts")
@@ -131,20 +131,25 @@ def closed_form_refusal(problem: ImpactProblem) -> str | None:
 
 
 def harmonic_load(problem: ImpactProblem, omega: ArrayLike, amplitude: ArrayLike | None = None) -> NDArray[np.complex128]:
+    """F(w): the complex harmonic load per coordinate [N] of ``problem`` at angular frequencies ``omega``
+    (:func:`harmonic_load_of` its structure and harmonic force)."""
+    return harmonic_load_of(problem.structure, problem.harmonic, omega, amplitude)
+
+
+def harmonic_load_of(structure: LinearStructure, excitation: HarmonicForce, omega: ArrayLike, amplitude: ArrayLike | None = None) -> NDArray[np.complex128]:
     """F(w): the complex harmonic load per coordinate [N] at angular frequencies ``omega``, shape omega.shape + (N,).
 
-    The load is Re(F e^{jwt}) in the problem's time (its phase included). A force is q w_i e^{j phase} whatever w;
-    a base motion's inertial load M 1 Y w^2 e^{j phase} grows with w. ``amplitude`` (q or Y, broadcast against
-    ``omega``) replaces the problem's.
+    The load is Re(F e^{jwt}) in the excitation's time (its phase included). A force is q w_i e^{j phase} whatever
+    w; a base motion's inertial load M 1 Y w^2 e^{j phase} grows with w. ``amplitude`` (q or Y, broadcast against
+    ``omega``) replaces the excitation's.
     """
-    excitation = problem.harmonic
     w = np.asarray(omega, dtype=float)
     q = np.asarray(excitation.amplitude if amplitude is None else amplitude, dtype=float)
     w, q = np.broadcast_arrays(w, q)
     phasor = complex(math.cos(excitation.phase), math.sin(excitation.phase))
-    size = problem.size
+    size = structure.size
     if excitation.base_motion:
-        distribution = problem.structure.mass_matrix @ np.ones(size)
+        distribution = structure.mass_matrix @ np.ones(size)
         return distribution * (q * w**2 * phasor)[..., None]
     return load_weights(excitation.weights, size) * (q * phasor)[..., None]
 
