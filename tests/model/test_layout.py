@@ -183,3 +183,44 @@ def test_a_clearance_the_grid_does_not_give_is_not_judged() -> None:
     own = Layout(CHAIN, LoadSpec(), (StopSpec(0, clearance=0.001), StopSpec(0, side="lower", clearance=-0.001)))
     with pytest.raises(ValueError, match="leave no room"):
         own.check_room()
+
+
+#: (id, layout, R, Delta, a fragment of the refusal or None): every rule of the closed forms that a layout can break.
+REFUSALS = [
+    ("paper", Layout(PAPER_SYSTEM), 0.2, 0.003, None),
+    ("symmetric-pair", REACH_LAYOUTS[1][1], 0.2, 0.003, None),
+    ("own-symmetric-pair", REACH_LAYOUTS[2][1], 0.7, 0.01, None),
+    ("frame-base-motion", REACH_LAYOUTS[3][1], 0.5, 0.002, None),
+    ("static-one-stop", REACH_LAYOUTS[4][1], 0.5, 0.002, None),
+    ("two-coordinates", REACH_LAYOUTS[5][1], 0.5, 0.002, "not on the same coordinate with opposite sides"),
+    ("same-side-twice", Layout(CHAIN, LoadSpec(), (StopSpec(2, 1), StopSpec(1, 2, "lower"))), 0.5, 0.002, "not on the same coordinate with opposite sides"),
+    ("free-free", Layout(FREE_FREE, LoadSpec(), (StopSpec(1, 0),)), 0.5, 0.002, "1 rigid-body mode(s)"),
+    ("free-free-pair", Layout(FREE_FREE, LoadSpec(base_motion=True), (StopSpec(1, 0), StopSpec(1, 0, "lower"))), 0.5, 0.002, "rigid-body"),
+    ("unequal-clearances", Layout(CHAIN, LoadSpec(), (StopSpec(2, 1), StopSpec(2, 1, "lower", clearance=0.003))), 0.5, 0.002, "their clearances or restitutions differ"),
+    ("unequal-restitutions", Layout(CHAIN, LoadSpec(), (StopSpec(2, 1, restitution=0.4), StopSpec(2, 1, "lower"))), 0.5, 0.002, "their clearances or restitutions differ"),
+    ("static-on-the-pair", Layout(CHAIN, LoadSpec(static=(0.0, 0.0, -0.49)), (StopSpec(2, 1), StopSpec(2, 1, "lower"))), 0.5, 0.002, "the static load moves the two-sided stop's coordinate by"),
+    ("three-stops", Layout(CHAIN, LoadSpec(), (StopSpec(0), StopSpec(2, 1), StopSpec(2, 1, "lower"))), 0.5, 0.002, "the problem has 3 stops"),
+]
+
+
+@pytest.mark.parametrize(("layout", "restitution", "clearance", "fragment"), [case[1:] for case in REFUSALS], ids=[case[0] for case in REFUSALS])
+def test_the_layout_s_closed_form_refusal_is_the_problem_s(layout: Layout, restitution: float, clearance: float, fragment: str | None) -> None:
+    """The layout's question (geometry, and the grid's R and Delta for a pair's equality) gives the same answer and
+    message as the problem's at any load amplitude and frequency: the rules live in one function."""
+    from vibroimpact.analysis.layout import closed_form_refusal, layout_refusal
+
+    reason = layout_refusal(layout, restitution, clearance)
+    assert (reason is None) if fragment is None else (reason is not None and fragment in reason), reason
+    for amplitude, frequency in ((10.0, 25.0), (0.001, 8.5)):
+        assert closed_form_refusal(layout.problem(amplitude, frequency, restitution, clearance)) == reason
+
+
+def test_a_pair_s_values_the_grid_does_not_give_are_not_judged() -> None:
+    """A symmetric pair taking R and Delta from a grid that gives none (NaN) is not refused for them; a pair whose own
+    values differ is."""
+    from vibroimpact.analysis.layout import layout_refusal
+
+    pair = REACH_LAYOUTS[1][1]
+    assert layout_refusal(pair) is None and layout_refusal(pair, 0.3) is None
+    unequal = Layout(CHAIN, LoadSpec(), (StopSpec(2, 1, clearance=0.002), StopSpec(2, 1, "lower", clearance=0.003)))
+    assert "differ" in str(layout_refusal(unequal))
