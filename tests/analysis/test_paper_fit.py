@@ -107,3 +107,21 @@ def test_solve_one_impact_takes_the_paper_s_route_on_its_layout_only() -> None:
     relative = ImpactProblem(PAPER_SYSTEM.structure, (Stop(RigidStop(3e-3, 0.2), 1, other=0),), HarmonicForce(10.0, 25.0))
     with pytest.raises(ValueError, match="use pgf"):
         solve_one_impact(relative, variant="pgf_paper")
+
+
+def test_the_fit_asks_its_own_problem_s_layout_once() -> None:
+    """The fit remembers the problem it found to be the paper's layout and computes its fitted model once: the modes of
+    that problem are those of any problem of the same layout (bit for bit), and the fitted model's poles are eq. 10's
+    -xi Omega +- j Theta; another layout is still refused."""
+    problem = paper_problem()
+    fit = PaperFit.of(problem)
+    assert fit.problem is problem and fit.model is fit.model  # one computation
+    own, other = fit.modes(problem), fit.modes(paper_problem())
+    np.testing.assert_array_equal(own.poles, other.poles)  # exact: the same structure and fit
+    np.testing.assert_array_equal(own.residues, other.residues)  # exact: the same structure and fit
+    parameters = fit.parameters
+    upper = -parameters.loss_factor * parameters.omega + 1j * parameters.damped_omega
+    np.testing.assert_allclose(np.sort_complex(own.poles[-4:]), np.sort_complex(np.concatenate([upper, np.conj(upper)])), rtol=1e-14)
+    relative = ImpactProblem(PAPER_SYSTEM.structure, (Stop(RigidStop(3e-3, 0.2), 1, other=0),), HarmonicForce(10.0, 25.0))
+    with pytest.raises(ValueError, match="another system or layout"):
+        fit.modes(relative)

@@ -88,3 +88,26 @@ def test_sweep_page_has_contents_and_explains_only_what_it_shows(tmp_path: Path,
     for name in ("sweep_displacements.png", "sweep_force_impulse.png", "sweep_regime.png", "sweep_time.png", "Cost of the swept-sine runs", "Swept sine against the stable pgf steady state"):
         assert name in page, name
     assert html.escape(DEFINITION[1:60]) not in page and "Reduction factors" not in page, "no reduction-factor table, so no explanation of one"
+
+
+@pytest.mark.parametrize("name", ["relative_stop", "base_motion_frame", "restitution", "clearance_peaks"])
+def test_the_general_setting_is_the_recorded_layout(name: str) -> None:
+    """A page's setting takes the load and the stops' directions from the layout the dataset records (one reader,
+    Layout.from_attributes): the recorded weights and constant force, and the normals a problem of that layout has."""
+    import xarray as xr
+
+    from vibroimpact.model.layout import Layout
+
+    from tests.golden.golden import DATA
+
+    with xr.open_dataset(DATA / f"{name}.nc") as dataset:
+        setting = general_setting(dataset)
+        attrs = dict(dataset.attrs)
+    layout = Layout.from_attributes(attrs)
+    if "excitation_weights" in attrs:
+        np.testing.assert_array_equal(setting.weights, np.atleast_1d(attrs["excitation_weights"]))  # exact: read back as written
+        np.testing.assert_array_equal(setting.static, np.atleast_1d(attrs["excitation_static_N"]))  # exact: read back as written
+    np.testing.assert_array_equal(setting.normals, layout.problem(1.0, 10.0, 0.5, 0.003).normals())  # exact: signs
+    assert setting.base_motion is (name == "base_motion_frame")
+    if name == "base_motion_frame":  # the absorber's two-sided stop relative to floor2
+        np.testing.assert_array_equal(setting.normals, [[0.0, -1.0, 1.0], [0.0, 1.0, -1.0]])  # exact: signs

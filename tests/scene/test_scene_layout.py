@@ -236,3 +236,49 @@ simulation:
     with pytest.raises(SceneError, match=r"stops: stop 0 \(x1 <= -2 mm\) and stop 1 \(x1 >= -1 mm\) leave no room") as caught:
         parse_scene(read_yaml(text), text)
     assert len(caught.value.problems) == 1, caught.value.problems
+
+
+def test_a_swept_clearance_without_room_at_one_corner_is_refused_there() -> None:
+    """The upper stop takes the swept Delta, the lower one gives -2 mm: at Delta = 1 mm the relative coordinate has no
+    room (1 - 2 <= 0), at 3 mm it has; the layout says so from its geometry, naming the grid's clearance, and pgf is
+    refused for the same reason."""
+
+    def change(d: dict[str, Any]) -> None:
+        d["stops"][0].pop("clearance")
+        d["stops"][1]["clearance"] = -0.002
+        d["sweep"].update(clearance=[0.001, 0.003], stop=0)
+
+    problems = problems_of(with_change(change))
+    room = "stop 0 (x2 - x1 <= 1 mm) and stop 1 (x2 - x1 >= 2 mm) leave no room between them: two opposite stops need clearances whose sum is > 0"
+    assert f"stops: {room} (at clearance 0.001 m of the grid)" in problems, problems
+    assert f"solutions: pgf does not apply to this layout: stops: {room}" in problems, problems
+
+
+#: (id, change of the relative scene, whether pgf applies): the layout's refusal at the grid's corners.
+PGF_LAYOUTS = [
+    ("symmetric", lambda d: None, True),
+    ("swept-both", lambda d: [s.pop(k) for s in d["stops"] for k in ("clearance", "restitution")] and d["sweep"].update(clearance=[0.002, 0.004], restitution=[0.1, 0.9]), True),
+    ("swept-one-side", lambda d: d["stops"][0].pop("clearance") and d["sweep"].update(clearance=[0.002, 0.003], stop=0), False),
+    ("one-stop", lambda d: d["stops"].pop(), True),
+    ("written-reversed", lambda d: d["stops"][1].update(between=["x1", "x2"], side="upper"), True),  # x1 - x2 <= Delta: the lower side
+    ("other-coordinate", lambda d: d["stops"][1].pop("between") and d["stops"][1].update(coordinate="x1"), False),
+    ("static-on-pair", lambda d: d["excitation"].update(static=[0.0, -0.981]), False),
+]
+
+
+@pytest.mark.parametrize(("change", "applies"), [case[1:] for case in PGF_LAYOUTS], ids=[case[0] for case in PGF_LAYOUTS])
+def test_pgf_refusal_is_a_problem_s_at_every_corner_of_the_grid(change: Callable[[dict[str, Any]], Any], applies: bool) -> None:
+    """pgf_refusal asks the layout (no problem built): its answer is that of the problems the study builds at the
+    corners of its R and Delta grids, the first refusal in the corners' order."""
+    from vibroimpact.analysis.layout import closed_form_refusal
+    from vibroimpact.scene.layout_parse import pgf_refusal
+
+    document = with_change(change)
+    document["solutions"] = ["linear"]
+    scene = parse_scene(document)
+    r_grid, d_grid = scene.settings.restitution, scene.settings.clearance
+    corners = sorted({(float(r), float(d)) for r in (r_grid[0], r_grid[-1]) for d in (d_grid[0], d_grid[-1])})
+    reasons = [closed_form_refusal(scene.layout.problem(10.0, f, r, d)) for r, d in corners for f in (20.0, 26.0)]
+    expected = next((reason for reason in reasons if reason is not None), None)
+    assert pgf_refusal(scene.layout, r_grid, d_grid) == expected
+    assert (expected is None) is applies, expected

@@ -3,7 +3,9 @@
 :func:`linear_response` and :func:`resonance_peaks` are the paper's named two-mass system (X1, X2, suspension force).
 :func:`linear_amplitudes` is any structure under its problem's load: the complex amplitude of every coordinate,
 H(jw) F(w), and of every stop's coordinate n_k . H F (a relative coordinate x_i - x_j for a relative stop, signed
-by the stop's side), plus the static deflection K^-1 F0 where K is invertible; :func:`structure_peaks` finds the
+by the stop's side), plus the static deflection K^-1 F0 where K is invertible (:func:`structure_amplitudes` the same
+from the structure, load and stop directions alone; :func:`linear_reach` each stop's |n_k . X| + n_k . x0 of a
+layout); :func:`structure_peaks` finds the
 maxima of any of them near each natural frequency. :func:`base_force` is the force such a steady state (or any
 motion's fundamentals) transmits to the base through the springs and dashpots, plus the stops' contact forces when
 given: the one formula of every closed form and study.
@@ -18,13 +20,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize_scalar
 
-from vibroimpact.analysis.layout import harmonic_load
-from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
+from vibroimpact.analysis.layout import harmonic_load_of
+from vibroimpact.model.excitation import HarmonicForce, angular_frequency, check_closed_form_inputs
+from vibroimpact.model.layout import Layout
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["base_coupling", "base_force", "peaks_near", "LinearResponse", "linear_response", "ResonancePeak", "resonance_peaks", "LinearAmplitudes", "linear_amplitudes", "structure_peaks"]
+__all__ = ["base_coupling", "base_force", "peaks_near", "LinearResponse", "linear_response", "ResonancePeak", "resonance_peaks", "LinearAmplitudes", "linear_amplitudes", "linear_reach", "structure_amplitudes", "structure_peaks"]
 
 
 def base_coupling(system: LinearStructure) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -185,12 +188,32 @@ def linear_amplitudes(problem: ImpactProblem, frequency: ArrayLike | None = None
     omega : array_like, optional
         w [rad s-1] instead of ``frequency`` (keyword only).
     """
-    structure = problem.structure
-    w = np.asarray(angular_frequency(frequency, omega, problem.omega), dtype=float)
-    load = harmonic_load(problem, w, amplitude)
+    return structure_amplitudes(problem.structure, problem.harmonic, problem.normals(), frequency, amplitude, omega=omega)
+
+
+def structure_amplitudes(
+    structure: LinearStructure, excitation: HarmonicForce, normals: ArrayLike, frequency: ArrayLike | None = None, amplitude: ArrayLike | None = None,
+    *, omega: ArrayLike | None = None,
+) -> LinearAmplitudes:  # fmt: skip
+    """:func:`linear_amplitudes` without a problem: the linear steady state does not depend on the stops, only on
+    where they act (``normals``, for the stops' coordinates).
+
+    Parameters
+    ----------
+    structure : LinearStructure
+        M, K, C.
+    excitation : HarmonicForce
+        The harmonic load (its frequency, amplitude and phase the defaults).
+    normals : array_like, shape (K, N)
+        n_k of every stop [-].
+    frequency, amplitude, omega : array_like, optional
+        As :func:`linear_amplitudes`.
+    """
+    w = np.asarray(angular_frequency(frequency, omega, excitation.omega), dtype=float)
+    load = harmonic_load_of(structure, excitation, w, amplitude)
     x = np.einsum("...ij,...j->...i", structure.receptance_matrix(w), load)
-    normals = problem.normals()
-    _, static_load = problem.load()
+    normals = np.asarray(normals, dtype=float)
+    static_load = excitation.static_vector(structure.size)
     if not np.any(static_load):
         static = np.zeros(structure.size)
     elif structure.rigid_body_modes():
@@ -198,6 +221,16 @@ def linear_amplitudes(problem: ImpactProblem, frequency: ArrayLike | None = None
     else:
         static = np.linalg.solve(structure.stiffness_matrix, static_load)
     return LinearAmplitudes(w, x, x @ normals.T, static, normals @ static, tuple(structure.coordinates))
+
+
+def linear_reach(layout: Layout, amplitude: float, frequency: float) -> NDArray[np.float64]:
+    """|n_k . X| + n_k . x0 of every stop of ``layout`` [m], shape (K,): how far the linear steady state at
+    ``frequency`` [Hz] under amplitude q [N] (base motion: Y [m]) carries each stop's coordinate towards it, the
+    amplitude plus the static offset (NaN where K is singular under a static load). It does not depend on the stops'
+    values: the layout's geometry and load answer it, the numbers those of :func:`linear_amplitudes` of any problem
+    of the layout at that point."""
+    linear = structure_amplitudes(layout.problem_structure, layout.load.force(amplitude, frequency), layout.normals())
+    return np.abs(linear.stops) + linear.stop_static
 
 
 def structure_peaks(problem: ImpactProblem, output: ArrayLike, span: float = 0.05) -> list[ResonancePeak]:

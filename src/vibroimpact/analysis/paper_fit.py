@@ -22,7 +22,8 @@ misleads.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -48,10 +49,14 @@ class PaperFit:
         The paper's named system whose H22 was fitted.
     parameters : ModalParameters
         Omega_i [rad s-1] (eq. 11, fixed), fitted loss factors xi_i [-] and real form factors A_i [kg-1] (eq. 10).
+    problem : ImpactProblem or None
+        The problem :meth:`of` found to be the paper's layout on ``system`` (its paper view computed once, there):
+        :meth:`modes` asks no more of it.
     """
 
     system: TwoDofSystem
     parameters: ModalParameters
+    problem: ImpactProblem | None = field(default=None, repr=False)
 
     @classmethod
     def of(cls, problem: ImpactProblem) -> "PaperFit":
@@ -66,11 +71,12 @@ class PaperFit:
         system = Layout.of_problem(problem).paper_view()
         if system is None:
             raise ValueError("pgf_paper is the paper's route for its layout (a two-mass chain x1, x2; one upper stop on x2; force on x1): use pgf")
-        return cls(system, fit_modal_parameters(system))
+        return cls(system, fit_modal_parameters(system), problem)
 
-    @property
+    @cached_property
     def model(self) -> PoleResidueModel:
-        """The fitted H22 as poles and residues (eq. 10): the transform of the fitted chi22's impulse response."""
+        """The fitted H22 as poles and residues (eq. 10): the transform of the fitted chi22's impulse response
+        (computed once)."""
         return self.parameters.to_pole_residue()
 
     def modes(self, problem: ImpactProblem) -> ModalResponse:
@@ -84,7 +90,7 @@ class PaperFit:
         ValueError
             If ``problem`` is not the paper's layout on this fit's system.
         """
-        if Layout.of_problem(problem).paper_view() != self.system:
+        if problem is not self.problem and Layout.of_problem(problem).paper_view() != self.system:
             raise ValueError("green: the paper's fit belongs to another system or layout; build it with PaperFit.of(problem)")
         size = problem.size
         normal = np.zeros(size)

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import cmath
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Union
 
@@ -42,6 +42,9 @@ __all__ = [
     "BUMPER",
     "Stop",
     "SIDES",
+    "check_room",
+    "describe_place",
+    "place_normal",
     "ContactLaw",
     "Impact",
     "KelvinVoigtBumper",
@@ -321,14 +324,15 @@ class Stop:
             if index is not None and index >= size:
                 raise ValueError(f"{key}: coordinate index {index} is out of range for a system of {size} coordinates: allowed [0, {size - 1}]")
 
+    @property
+    def place(self) -> tuple[int, int | None, str]:
+        """(coordinate, other, side): where the stop acts, without its law."""
+        return (self.coordinate, self.other, self.side)
+
     def normal(self, size: int) -> NDArray[np.float64]:
         """n [-], shape (size,): the gap is Delta - n . x."""
         self.check_size(size)
-        n = np.zeros(size)
-        n[self.coordinate] = self.sign
-        if self.other is not None:
-            n[self.other] = -self.sign
-        return n
+        return place_normal(self.place, size)
 
     def selector(self, size: int) -> NDArray[np.float64]:
         """The stopped coordinate as weights: e_i, or e_i - e_j for a relative stop (sign of the upper side)."""
@@ -342,7 +346,55 @@ class Stop:
     def describe(self, names: tuple[str, ...]) -> str:
         """E.g. ``x2 <= 3 mm`` or ``x2 - x1 >= -3 mm``: the constraint in words."""
         self.check_size(len(names))
-        target = names[self.coordinate] if self.other is None else f"{names[self.coordinate]} - {names[self.other]}"
-        bound = self.clearance if self.side == "upper" else -self.clearance
-        relation = "<=" if self.side == "upper" else ">="
-        return f"{target} {relation} {bound * 1e3 + 0.0:g} mm"  # + 0.0: no "-0 mm"
+        return describe_place(self.place, self.clearance, names)
+
+
+def place_normal(place: tuple[int, int | None, str], size: int) -> NDArray[np.float64]:
+    """n [-], shape (size,), of a stop acting at ``place`` = (coordinate, other, side): e_i for an upper stop on x_i,
+    e_i - e_j for an upper one on x_i - x_j, the opposite for a lower one; the gap is Delta - n . x."""
+    coordinate, other, side = place
+    sign = 1.0 if side == "upper" else -1.0
+    n = np.zeros(size)
+    n[coordinate] = sign
+    if other is not None:
+        n[other] = -sign
+    return n
+
+
+def describe_place(place: tuple[int, int | None, str], clearance: float, names: tuple[str, ...]) -> str:
+    """E.g. ``x2 <= 3 mm`` or ``x2 - x1 >= -3 mm``: the constraint of a stop at ``place`` with clearance Delta [m]."""
+    coordinate, other, side = place
+    target = names[coordinate] if other is None else f"{names[coordinate]} - {names[other]}"
+    bound = clearance if side == "upper" else -clearance
+    relation = "<=" if side == "upper" else ">="
+    return f"{target} {relation} {bound * 1e3 + 0.0:g} mm"  # + 0.0: no "-0 mm"
+
+
+def check_room(places: Sequence[tuple[int, int | None, str]], clearances: Sequence[float], names: tuple[str, ...]) -> None:
+    """``ValueError`` if two stops on the same (relative) coordinate from opposite sides leave it no room: a question
+    of where the stops act and of their clearances alone.
+
+    Stop k allows n_k . x <= Delta_k; an opposite stop j (n_j = -c n_k, c > 0) allows n_k . x >= -Delta_j / c. The
+    interval is empty, or a single point where the coordinate would be clamped by both at once, unless
+    Delta_k + Delta_j / c > 0. A clearance that is not known (NaN) leaves its pairs unjudged.
+
+    Parameters
+    ----------
+    places : sequence of (int, int or None, str)
+        (coordinate, other, side) of every stop (:attr:`Stop.place`).
+    clearances : sequence of float
+        Delta of every stop [m].
+    names : tuple of str
+        The coordinates' names (the message describes the two stops with them).
+    """
+    size = len(names)
+    for k, first in enumerate(places):
+        nk = place_normal(first, size)
+        for j in range(k + 1, len(places)):
+            nj = place_normal(places[j], size)
+            ratio = -float(nj @ nk) / float(nk @ nk)
+            if ratio > 0.0 and np.allclose(nj, -ratio * nk, rtol=0.0, atol=1e-14) and clearances[k] + clearances[j] / ratio <= 0.0:
+                raise ValueError(
+                    f"stops: stop {k} ({describe_place(first, clearances[k], names)}) and stop {j} ({describe_place(places[j], clearances[j], names)}) "
+                    "leave no room between them: two opposite stops need clearances whose sum is > 0"
+                )

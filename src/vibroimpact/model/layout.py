@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop, loss_factor_from_restitution, restitution_from_loss_factor
+from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop, check_room, loss_factor_from_restitution, place_normal, restitution_from_loss_factor
 from vibroimpact.model.excitation import HarmonicForce, SweptSine
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
@@ -268,6 +268,29 @@ class Layout:
         """The structure's named view (m1 ... b2) whatever its load and stops: the parameters as written, or those of
         a structure that is the two-mass chain; None otherwise."""
         return self._named if self._named is not None else TwoDofSystem.of(self.structure)
+
+    @property
+    def problem_structure(self) -> LinearStructure:
+        """The structure every problem of this layout holds (:meth:`problem_with`): the named view's own matrices
+        where the layout has one, else :attr:`structure`."""
+        return self._named.structure if self._named is not None else self.structure
+
+    def normals(self) -> np.ndarray:
+        """n of every stop, shape (K, N) [-]: the stopped coordinate is n_k . x, its gap Delta_k - n_k . x (the rows
+        of a problem's :meth:`~vibroimpact.model.problem.ImpactProblem.normals`)."""
+        size = self.size
+        return np.array([place_normal(spec.place, size) for spec in self.stops]).reshape(-1, size)
+
+    def clearances(self, clearance: float = math.nan) -> tuple[float, ...]:
+        """Delta of every stop [m]: its own, else ``clearance`` (the grid's; NaN: not known)."""
+        return tuple(spec.clearance if spec.clearance is not None else clearance for spec in self.stops)
+
+    def check_room(self, clearance: float = math.nan) -> None:
+        """``ValueError`` if two opposite stops on the same (relative) coordinate leave it no room (their clearances
+        sum to <= 0), with each stop's own Delta or ``clearance`` [m] (the grid's) for those that give none; a stop
+        whose Delta is not known (NaN) is not judged. The message is the one a problem with these stops raises
+        (:func:`~vibroimpact.model.contact.check_room`)."""
+        check_room([spec.place for spec in self.stops], self.clearances(clearance), self.coordinates)
 
     def with_stops(self, stops: tuple[StopSpec, ...]) -> Layout:
         """The same structure and load with ``stops`` (the named view kept)."""

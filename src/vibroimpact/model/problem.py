@@ -14,7 +14,7 @@ from typing import TypeVar, Union
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.model.contact import BUMPER, RIGID, KelvinVoigtBumper, RigidStop, Stop
+from vibroimpact.model.contact import BUMPER, RIGID, KelvinVoigtBumper, RigidStop, Stop, check_room
 from vibroimpact.model.excitation import HarmonicForce, SweptSine, load_weights, static_load
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
@@ -37,26 +37,6 @@ def _part_of_kind(name: str, value: object, kind: type[_Kind], why: str) -> _Kin
 
 
 _PARTS = {"system": (TwoDofSystem, LinearStructure), "contact": (RigidStop, KelvinVoigtBumper, tuple), "excitation": (HarmonicForce, SweptSine)}
-
-
-def _check_room(stops: tuple[Stop, ...], names: tuple[str, ...]) -> None:
-    """``ValueError`` if two stops on the same (relative) coordinate from opposite sides leave it no room.
-
-    Stop k allows n_k . x <= Delta_k; an opposite stop j (n_j = -c n_k, c > 0) allows n_k . x >= -Delta_j / c. The
-    interval is empty, or a single point where the coordinate would be clamped by both at once, unless
-    Delta_k + Delta_j / c > 0.
-    """
-    size = len(names)
-    for k, first in enumerate(stops):
-        nk = first.normal(size)
-        for j in range(k + 1, len(stops)):
-            nj = stops[j].normal(size)
-            ratio = -float(nj @ nk) / float(nk @ nk)
-            if ratio > 0.0 and np.allclose(nj, -ratio * nk, rtol=0.0, atol=1e-14) and first.clearance + stops[j].clearance / ratio <= 0.0:
-                raise ValueError(
-                    f"stops: stop {k} ({first.describe(names)}) and stop {j} ({stops[j].describe(names)}) leave no room between them: "
-                    "two opposite stops need clearances whose sum is > 0"
-                )
 
 
 @dataclass(frozen=True)
@@ -92,7 +72,7 @@ class ImpactProblem:
                 if not isinstance(stop, Stop):
                     raise TypeError(f"contact: {stop!r} is not a Stop")
                 stop.check_size(self.system.size)
-            _check_room(self.contact, self.system.coordinates)
+            check_room([stop.place for stop in self.contact], [stop.clearance for stop in self.contact], self.system.coordinates)
         elif self.system.size < 2:
             raise ValueError("contact: a single contact law means the paper's stop on coordinate 2; give a tuple of Stop instead")
         size = self.system.size

@@ -346,21 +346,15 @@ def general_setting(dataset: xr.Dataset) -> GeneralSetting:
     attrs = _layout(dataset)
     layout = Layout.from_attributes(attrs)
     size = layout.size
-    normals = np.zeros((len(layout.stops), size))
-    for k, spec in enumerate(layout.stops):
-        sign = 1.0 if spec.side == "upper" else -1.0
-        normals[k, spec.coordinate] = sign
-        if spec.other is not None:
-            normals[k, spec.other] = -sign
     return GeneralSetting(
         structure=layout.structure,
         amplitude=float(attrs["excitation_amplitude_N"]),
         base_motion=layout.load.base_motion,
-        weights=np.atleast_1d(np.asarray(attrs["excitation_weights"], dtype=float)),
-        static=np.atleast_1d(np.asarray(attrs["excitation_static_N"], dtype=float)),
+        weights=np.array(layout.load.weight_vector(size), dtype=float),
+        static=np.array(layout.load.static_vector(size), dtype=float),
         stops=tuple(part.strip() for part in str(attrs["stop_layout"]).split(";")),
-        normals=normals,
+        normals=layout.normals(),
         solutions=tuple(str(s) for s in dataset["solution"].values) if "solution" in dataset.coords else (),
-        clearances=np.array([np.nan if spec.clearance is None else spec.clearance for spec in layout.stops]),
+        clearances=np.array(layout.clearances()),
         named=named_view(dataset),
     )

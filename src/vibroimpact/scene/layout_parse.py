@@ -29,7 +29,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.analysis.layout import layout_refusal
 from vibroimpact.model.contact import SIDES, restitution_from_loss_factor
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
@@ -330,19 +330,19 @@ def parse_stop_layout(c: Checker, doc: dict, system: TwoDofSystem | LinearStruct
 # --------------------------------------------------------------------------------------------------------------------
 
 def pgf_refusal(layout: Layout, restitution: np.ndarray | None = None, clearance: np.ndarray | None = None) -> str | None:
-    """Why the closed-form (PGF) solution does not apply to this layout at some corner of the grid; None where it
-    applies everywhere (:func:`vibroimpact.analysis.layout.closed_form_refusal`: one rigid stop, or a symmetric
-    two-sided stop, on a structure without rigid-body modes, with a harmonic load). A grid that gives no restitution
-    or clearance (NaN) is asked at R = 0.5 and Delta = 1 mm: the refusals do not depend on their values."""
+    """Why the closed-form (PGF) solution does not apply to this layout at some corner of the grid, None where it
+    applies everywhere: stops without room (:meth:`Layout.check_room`), else :func:`.layout_refusal` (one rigid stop
+    or a symmetric two-sided stop, no rigid-body mode). The grid's R [-] and Delta [m] go to the stops that give
+    none (a two-sided stop's sides must be equal; NaN: not judged)."""
     r_grid = np.array([np.nan]) if restitution is None else restitution
     d_grid = np.array([np.nan]) if clearance is None else clearance
     corners = {(float(r), float(d)) for r in (r_grid[0], r_grid[-1]) for d in (d_grid[0], d_grid[-1])}
     for r, d in sorted(corners):
         try:
-            problem = layout.problem(1.0, 1.0, 0.5 if np.isnan(r) else r, 1e-3 if np.isnan(d) else d)
-        except (ValueError, TypeError) as error:  # an unusable stop: reported where it is parsed
+            layout.check_room(d)
+        except ValueError as error:  # reported where it is checked (check_layout_solutions)
             return str(error)
-        reason = closed_form_refusal(problem)
+        reason = layout_refusal(layout, r, d)
         if reason is not None:
             return reason
     return None
@@ -367,11 +367,10 @@ def check_layout_solutions(c: Checker, solutions: tuple[str, ...], layout: Layou
     <= 0 at a corner of the grid)."""
     for d in sorted({float(clearance[0]), float(clearance[-1])} if clearance is not None and clearance.size else {float("nan")}):
         try:
-            layout.problem(1.0, 1.0, 0.5, 1e-3 if np.isnan(d) else d)
+            layout.check_room(d)
         except ValueError as error:
-            if "leave no room" in str(error):
-                c.fail("stops", str(error).removeprefix("stops: ") + (f" (at clearance {d:g} m of the grid)" if not np.isnan(d) else ""))
-                break
+            c.fail("stops", str(error).removeprefix("stops: ") + (f" (at clearance {d:g} m of the grid)" if not np.isnan(d) else ""))
+            break
     if "pgf_paper" in solutions and layout.paper_view() is None:
         c.fail("solutions", "pgf_paper is the paper's own route for its layout (a two-mass chain x1, x2 as {m1 ... b2}; one upper stop on x2; force on x1): use pgf")
     if "pgf" in solutions and (reason := pgf_refusal(layout, restitution, clearance)) is not None:

@@ -208,3 +208,27 @@ def test_a_case_on_a_layout_without_closed_form_starts_linear() -> None:
     t0, state = start_state(fallback, "pgf")
     t1, linear = start_state(fallback, "linear")
     assert t0 == t1 and np.array_equal(state, linear)
+
+
+def test_a_clearance_below_the_linear_reach_is_a_problem_s_linear_amplitude_minus_it() -> None:
+    """The frame's two-sided stop without its own clearance, a case 0.1 mm inside the linear reach at 8.5 Hz: each
+    stop's Delta is |n . X| + n . x0 of the case's own problem (its linear steady state, which does not see the stops)
+    less 0.1 mm, bit for bit, the same on both sides (no static load); the reach is the stops' relative amplitude
+    |X_absorber - X_floor2| under the base motion."""
+    from vibroimpact.analysis.linear import linear_amplitudes
+
+    document = frame_benchmark()
+    for stop in document["stops"]:
+        stop.pop("clearance")
+    document["benchmark"]["cases"][0].update(clearance_below_linear=1e-4, start="linear")
+    document["benchmark"].pop("ladder")
+    scene = parse_scene(document)
+    assert scene.settings is not None
+    problem = scene.settings.cases[0].problem
+    linear = linear_amplitudes(problem)
+    reach = np.abs(linear.stops) + linear.stop_static
+    np.testing.assert_array_equal([stop.clearance for stop in problem.stops], reach - 1e-4)  # exact: the same arithmetic, at the case's own frequency
+    assert problem.stops[0].clearance == problem.stops[1].clearance  # exact: n_lower = -n_upper, |.| and a zero static load
+    relative = np.abs(linear.relative("absorber", "floor2"))
+    np.testing.assert_allclose(reach, [relative, relative], rtol=1e-14)
+    assert 0.0 < problem.stops[0].clearance < relative

@@ -28,9 +28,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
-from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.analysis.linear import linear_reach
 from vibroimpact.engines.registry import BUMPER, RIGID, engine_spec
 from vibroimpact.engines.settings import ATOL_RATIO, STEPPED_TOLERANCES
 from vibroimpact.model.excitation import SweptSine
@@ -344,12 +342,9 @@ def _case_stops(c: Checker, key: str, layout: _Layout, frequency: float, restitu
     ``below``: a clearance that far inside each stop's linear reach, |n . X| + n . x0 at ``frequency``, for the stops
     taking the case's clearance (NaN: ``clearance`` instead). Problems are recorded under ``key``."""
     specs = layout.specs
-    force = layout.load.force(layout.amplitude, frequency)
     try:
         if math.isfinite(below):
-            probe = layout.layout.problem_with(build_stops(specs, False, 0.5, 1.0), force)
-            linear = linear_amplitudes(probe)
-            reach = np.abs(linear.stops) + linear.stop_static
+            reach = linear_reach(layout.layout, layout.amplitude, frequency)  # the linear steady state: no stop values
             chosen = []
             for k, spec in enumerate(specs):
                 if spec.clearance is None:
@@ -361,7 +356,7 @@ def _case_stops(c: Checker, key: str, layout: _Layout, frequency: float, restitu
                 chosen.append(spec)
             specs = tuple(chosen)
         rigid = build_stops(specs, False, restitution, clearance)
-        layout.layout.problem_with(rigid, force)  # the stops' room between each other
+        layout.layout.with_stops(specs).check_room(clearance)  # the stops' room between each other
     except ValueError as error:
         c.fail(key, str(error))
         return None
