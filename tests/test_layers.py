@@ -15,8 +15,9 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "vibroimpact"
 #: Lowest first: a module may import from its own layer and those before it (README, "Architecture").
-LAYERS = ("model", "analysis", "engines", "orbits", "simulation", "scene", "runs", "reporting", "kinds", "cli")
-#: Third-party libraries a layer must not import (lower layers are physics and numerics only).
+LAYERS = ("model", "analysis", "engines", "orbits", "simulation", "scene", "runs", "reporting", "grids", "kinds", "cli")
+#: Third-party libraries a layer must not import (lower layers are physics and numerics only); the layers from ``runs``
+#: up (``runs``, ``reporting``, ``grids``, ``kinds``, ``cli``) write datasets and draw, and may import any.
 FORBIDDEN_LIBRARIES = {
     "model": ("yaml", "xarray", "matplotlib", "netCDF4", "sksundae"),
     "analysis": ("yaml", "xarray", "matplotlib", "netCDF4", "sksundae"),
@@ -124,8 +125,8 @@ def kind_folder(module: str) -> str | None:
 
 
 #: Kind folders that import another kind's folder, with the reason each remains (none is wanted: a family's shared code
-#: belongs below the kinds). A swept-sine scene is a grid scene: the same GridSettings, the same grid of closed forms
-#: and the same page sections as a stepped one, with its time-domain solutions swept instead of stepped.
+#: belongs below the kinds: the grid study both share is ``grids``). A swept-sine page still draws the stepped one's
+#: sections (the linear system, the regime map), until they move below the kinds too.
 KIND_IMPORTS_THAT_REMAIN = {("swept", "stepped")}
 
 
