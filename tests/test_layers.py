@@ -15,8 +15,9 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "vibroimpact"
 #: Lowest first: a module may import from its own layer and those before it (README, "Architecture").
-LAYERS = ("model", "analysis", "engines", "orbits", "simulation", "scene", "runs", "reporting", "kinds", "cli")
-#: Third-party libraries a layer must not import (lower layers are physics and numerics only).
+LAYERS = ("model", "analysis", "engines", "orbits", "simulation", "scene", "runs", "reporting", "grids", "kinds", "cli")
+#: Third-party libraries a layer must not import (lower layers are physics and numerics only); the layers from ``runs``
+#: up (``runs``, ``reporting``, ``grids``, ``kinds``, ``cli``) write datasets and draw, and may import any.
 FORBIDDEN_LIBRARIES = {
     "model": ("yaml", "xarray", "matplotlib", "netCDF4", "sksundae"),
     "analysis": ("yaml", "xarray", "matplotlib", "netCDF4", "sksundae"),
@@ -123,23 +124,32 @@ def kind_folder(module: str) -> str | None:
     return parts[2] if len(parts) >= 3 and parts[:2] == ["vibroimpact", "kinds"] else None
 
 
-#: Kind folders that import another kind's folder, with the reason each remains (none is wanted: a family's shared code
-#: belongs below the kinds). A swept-sine scene is a grid scene: the same GridSettings, the same grid of closed forms
-#: and the same page sections as a stepped one, with its time-domain solutions swept instead of stepped.
-KIND_IMPORTS_THAT_REMAIN = {("swept", "stepped")}
+def kind_crossings(own: str | None, found: list[tuple[int, str]]) -> list[str]:
+    """The imports among ``found`` of a kind folder other than ``own`` (``line n: module``). None is wanted: what two
+    kinds share is a layer below the kinds (the stepped and swept kinds' frequency-grid study is ``grids``)."""
+    return [f"line {line}: {target}" for line, target in found if kind_folder(target) not in (None, own)]
 
 
 @pytest.mark.parametrize("path", [p for p in SOURCES if kind_folder(module_name(p))], ids=lambda p: str(p.relative_to(PACKAGE)))
 def test_no_kind_folder_imports_another(path: Path) -> None:
     own = kind_folder(module_name(path))
-    crossing = [f"line {line}: {target}" for line, target in imports(path) if (other := kind_folder(target)) not in (None, own) and (own, other) not in KIND_IMPORTS_THAT_REMAIN]
+    crossing = kind_crossings(own, imports(path))
     assert not crossing, f"imports of another kind's folder from {own}:\n" + "\n".join(crossing)
 
 
-def test_the_kind_imports_that_remain_are_still_needed() -> None:
-    """An allowed crossing that no module makes any more is removed from the list, so the list says the truth."""
-    made = {(kind_folder(module_name(p)), kind_folder(target)) for p in SOURCES for _line, target in imports(p)}
-    assert KIND_IMPORTS_THAT_REMAIN <= made
+def test_the_check_sees_a_kind_importing_another(tmp_path: Path) -> None:
+    """The strict check is not blind: a swept module's import of the stepped kind's folder, even inside a function, is
+    a crossing; its own folder and the layers below the kinds (``grids``) are not."""
+    module = tmp_path / "probe.py"
+    module.write_text(
+        "from vibroimpact.grids.grid import StudyGrid\n"
+        "from vibroimpact.kinds.swept.variables import swept_attributes\n"
+        "def f():\n"
+        "    from vibroimpact.kinds.stepped.study import SteppedStudy\n"
+    )
+    found = kind_crossings("swept", imports(module))
+    assert found and all(crossing.startswith("line 4: vibroimpact.kinds.stepped.study") for crossing in found)
+    assert LAYERS.index("grids") < LAYERS.index("kinds")  # the grid study both kinds share is below them
 
 
 #: ``module:attribute`` (or a bare module) named in a string: a module loaded by name.

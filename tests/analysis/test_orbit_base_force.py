@@ -1,5 +1,5 @@
-"""The force an impact orbit passes to the base (:meth:`ImpactOrbit.base_force`): one formula, which the concepts and
-the stepped kinds both call.
+"""The force an impact orbit passes to the base (:meth:`ImpactOrbit.base_force`): one formula, which the concepts kind
+and the grid study of the stepped and swept kinds (:mod:`vibroimpact.grids.closed_forms`) both call.
 
 Hand derivation (Newton's third law on the whole structure): M x'' + C x' + K x = f(t) - n lambda(t) summed over the
 coordinates gives 1^T (K x + C x') + (1^T n) lambda = 1^T f - 1^T M x''; the fundamental of the left side is the base

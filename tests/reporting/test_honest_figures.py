@@ -10,7 +10,7 @@ import xarray as xr
 from matplotlib.patches import Rectangle
 
 from vibroimpact.analysis.stability import Regime
-from vibroimpact.kinds.stepped.responses import regime_map
+from vibroimpact.grids.regime_map import regime_map
 
 
 def test_unstable_one_impact_cells_are_hatched_and_counted() -> None:
@@ -110,7 +110,7 @@ def test_the_two_sided_relative_stop_draws_both_stops_coordinates() -> None:
     import copy
 
     from tests.kinds.stepped.test_stepped_layouts_page import CHAIN
-    from vibroimpact.kinds.stepped.figures import structure_figure
+    from vibroimpact.grids.sections import structure_figure
     from vibroimpact.reporting.record import general_setting
     from vibroimpact.runs.run import run_study
     from vibroimpact.scene import parse_scene

@@ -102,7 +102,7 @@ def test_drawn_map_gives_each_flag_one_colour_and_no_two_flags_the_same() -> Non
 
 def test_coarse_grid_blocks_reach_halfway_to_their_neighbours_only() -> None:
     """A simulation on 16-17 Hz (0.5 Hz steps) on a 15-20 Hz axis covers 15.75-17.25 Hz, not the whole axis."""
-    from vibroimpact.kinds.stepped.responses import block_edges
+    from vibroimpact.grids.regime_map import block_edges
 
     f = np.linspace(15.0, 20.0, 101)
     np.testing.assert_allclose(block_edges(np.array([16.0, 16.5, 17.0]), f), [15.75, 16.25, 16.75, 17.25])

@@ -231,7 +231,8 @@ def _builders() -> dict[str, Callable[[], list[Any]]]:
     from vibroimpact.kinds.benchmark.page import accuracy_figures
     from vibroimpact.kinds.stepped.page import peak_acceleration_figure, peak_figure, stiffness_figure
     from vibroimpact.kinds.stepped.page import lyapunov_figure
-    from vibroimpact.kinds.stepped.responses import linear_figure, regime_figure, response_figure, simulation_figure, stability_figure
+    from vibroimpact.grids.sections import linear_figure
+    from vibroimpact.kinds.stepped.responses import regime_figure, response_figure, simulation_figure, stability_figure
     from vibroimpact.scene.schema import ENGINE_SOLUTIONS
     from vibroimpact.kinds.swept.page import sweep_figures, swept_sine_run
 

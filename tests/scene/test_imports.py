@@ -19,6 +19,7 @@ FORBIDDEN = (
     "vibroimpact.simulation.harmonics",
     "vibroimpact.runs",
     "vibroimpact.reporting",
+    "vibroimpact.grids",
 )
 #: What reading a scene may load of a kind's folder: its scene section (``vibroimpact.kinds.<kind>.scene``, ``.settings``).
 KIND_SCENE_MODULES = ("scene", "settings")

@@ -15,7 +15,7 @@ import yaml
 
 from vibroimpact import cli
 from vibroimpact.analysis.linear import linear_amplitudes
-from vibroimpact.kinds.stepped.values import first_problem
+from vibroimpact.grids.closed_forms import first_problem
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene import SceneError, parse_scene

@@ -10,7 +10,7 @@ import pytest
 
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.kinds.stepped.cases import general_simulated_values
-from vibroimpact.kinds.stepped.grid import StudyGrid
+from vibroimpact.grids.grid import StudyGrid
 from vibroimpact.runs.runner import Runner
 from vibroimpact.scene import parse_scene
 

@@ -11,7 +11,8 @@ import numpy as np
 from vibroimpact.scene import parse_scene
 from vibroimpact.kinds.stepped.cases import SimulationCase, run_case
 from vibroimpact.runs.estimate import estimate_scene
-from vibroimpact.kinds.stepped.study import UNKNOWN_WANDERING, closed_form_scale
+from vibroimpact.grids.estimate import closed_form_scale
+from vibroimpact.kinds.stepped.study import UNKNOWN_WANDERING
 from vibroimpact.runs.estimate import engine_scale
 from vibroimpact.kinds.stepped.study import SETTLING_PERIODS, expected_periods
 

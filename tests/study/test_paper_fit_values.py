@@ -9,8 +9,8 @@ import pytest
 
 from vibroimpact.analysis.pgf import solve_one_impact
 from vibroimpact.analysis.stability import Regime
-from vibroimpact.kinds.stepped.grid import StudyGrid
-from vibroimpact.kinds.stepped.values import general_pgf_values
+from vibroimpact.grids.grid import StudyGrid
+from vibroimpact.grids.closed_forms import general_pgf_values
 from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.runs.run import run_study
 from vibroimpact.scene import parse_scene

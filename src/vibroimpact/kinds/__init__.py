@@ -9,4 +9,7 @@ Each folder holds its kind's scene section (``scene.py``, checked values only, n
 * ``bifurcation``: continued branches, special points and two-parameter charts;
 * ``validation``: published closed forms reproduced;
 * ``concepts``: absorber concepts side by side.
+
+No folder imports another: what two kinds share lives in a layer below them (the stepped and swept kinds'
+frequency-grid study is :mod:`vibroimpact.grids`).
 """

@@ -13,7 +13,8 @@ import pytest
 import xarray as xr
 
 from vibroimpact.reporting import page as page_module
-from vibroimpact.kinds.stepped.figures import response_panels_figure, structure_figure
+from vibroimpact.grids.sections import structure_figure
+from vibroimpact.kinds.stepped.figures import response_panels_figure
 from vibroimpact.kinds.stepped.page import FrequencyResponsePage, unswept_restitution
 from vibroimpact.reporting.record import general_setting
 from vibroimpact.reporting.page import page_for, write_report

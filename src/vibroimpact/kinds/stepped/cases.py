@@ -21,9 +21,9 @@ from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.engines.registry import make_engine, BUMPER, engine_spec
 from vibroimpact.engines.settings import EngineSettings
-from vibroimpact.kinds.stepped.grid import no_one_impact_orbit
+from vibroimpact.grids.grid import no_one_impact_orbit
 from vibroimpact.scene.subset import on_subset
-from vibroimpact.kinds.stepped.values import broadcast_quantities, coordinate_quantity
+from vibroimpact.grids.closed_forms import broadcast_quantities, coordinate_quantity
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem

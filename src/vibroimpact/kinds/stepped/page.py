@@ -28,9 +28,10 @@ from vibroimpact.analysis.stability import Regime
 from vibroimpact.engines.registry import BUMPER, RIGID
 from vibroimpact.kinds.stepped.answers import answer_text, band_peaks, contact_text, convergence_rows, convergence_text, peak_rows, peaks_text, reduction_text
 from vibroimpact.kinds.stepped.crosscheck import cross_check_section, cross_check_text, cross_checks
-from vibroimpact.kinds.stepped.figures import layout_tables, peaks_table, response_panels_figure, structure_figure, where_text
-from vibroimpact.kinds.stepped.responses import SolutionsPage, clearance_text, linear_section, series_by_restitution, regime_figure, response_figure, simulation_figure, stability_figure
-from vibroimpact.kinds.stepped.tables import agreement_table, modal_table, reduction_intro, reduction_tables
+from vibroimpact.kinds.stepped.figures import peaks_table, response_panels_figure, where_text
+from vibroimpact.kinds.stepped.responses import clearance_text, series_by_restitution, regime_figure, response_figure, simulation_figure, stability_figure
+from vibroimpact.kinds.stepped.tables import agreement_table, reduction_intro, reduction_tables
+from vibroimpact.grids.sections import SolutionsPage, layout_tables, linear_section, modal_table, structure_figure
 from vibroimpact.orbits.motion import MotionThresholds
 from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved, StudyPage

@@ -1,7 +1,7 @@
-"""Figures of the frequency-response pages (paper figures 2-8 and 21-24): linear system, responses of every solution,
-regime maps, stability, and simulations against the closed form; the linear-system section the swept-sine and bumper
-pages open with, and what those pages share (:class:`SolutionsPage`; the stepped page draws its linear system for any
-layout, :func:`vibroimpact.kinds.stepped.figures.structure_figure`).
+"""Figures of the stepped frequency-response pages (paper figures 5-8 and 21-24): responses of every solution, regime
+maps, stability, and simulations against the closed form. What the stepped and swept pages share (the page's base
+:class:`~vibroimpact.grids.sections.SolutionsPage`, the linear-system section, the regime map) is in
+:mod:`vibroimpact.grids`.
 
 Each builder returns a :class:`~vibroimpact.reporting.page.DrawnFigure` whose caption is put together from what was
 drawn. Closed forms are drawn as curves on the dataset's grid, simulations as markers on their own grid
@@ -10,29 +10,19 @@ drawn. Closed forms are drawn as curves on the dataset's grid, simulations as ma
 
 from __future__ import annotations
 
-from pathlib import Path
-from typing import Any
-
 import numpy as np
 import xarray as xr
-from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.lines import Line2D
-from matplotlib.patches import Patch, Rectangle
+from matplotlib.patches import Patch
 
-from vibroimpact.analysis.linear import linear_response
-from vibroimpact.model.modal import fit_modal_parameters, underdamped_mode_count
-from vibroimpact.analysis.stability import Regime
+from vibroimpact.grids.regime_map import regime_map
 from vibroimpact.reporting.coincide import coincidence_phrase, reveal_coincident
-from vibroimpact.reporting.page import DrawnFigure, Section, saved
-from vibroimpact.reporting.record import StudySetting
+from vibroimpact.reporting.page import DrawnFigure
 from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_linear, draw_points, periodic_points, stability_keys, unstable_points
 from vibroimpact.reporting.style import (
-    DISPLACEMENT_SCALE,
-    DISPLACEMENT_UNITS,
     LINEAR_STYLE,
     QUANTITIES,
     RAW_STYLE,
-    REGIME_COLOURS,
     SOLUTION_COLOURS,
     SOLUTION_DESCRIPTIONS,
     SOLUTION_TITLES,
@@ -43,17 +33,13 @@ from vibroimpact.reporting.style import (
     fmt,
     legend_rows,
     new_figure,
-    regime_label,
     series_colour,
     solution_ref,
 )
-from vibroimpact.kinds.stepped.tables import modal_table
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 
-__all__ = ["SolutionsPage", "linear_section", "linear_figure", "response_figure", "regime_figure", "regime_map", "block_edges", "stability_figure", "simulation_figure", "series_by_restitution", "clearance_text"]
+__all__ = ["response_figure", "regime_figure", "stability_figure", "simulation_figure", "series_by_restitution", "clearance_text"]
 
-#: Frequencies of the linear system's figure (0.0075 Hz over 15-45 Hz: the resonances are about 0.1 Hz wide).
-LINEAR_FIGURE_POINTS = 4001
 #: Fewer grid points than this: closed-form curves also get a marker per value.
 COARSE_GRID_POINTS = 30
 _FREQUENCY = "frequency [Hz]"
@@ -75,66 +61,6 @@ def series_by_restitution(part: xr.Dataset) -> list[tuple[str, xr.Dataset]]:
     if "restitution" not in part.coords:
         return [("each stop's R", part)]
     return [(f"R = {fmt(part['restitution'], 'g')}", part)]
-
-
-class SolutionsPage:
-    """What the pages of stepped and swept studies share: the dataset, what it says of its study, and the summary
-    naming the solutions; each page gives its own sections.
-
-    Parameters
-    ----------
-    dataset : xarray.Dataset
-        The study's dataset.
-    setting : StudySetting
-        What the dataset says of its system, excitation and grids.
-    """
-
-    def __init__(self, dataset: xr.Dataset, setting: StudySetting) -> None:
-        self.dataset = dataset
-        self.setting = setting
-
-    def summary(self) -> str:
-        """The solutions of the study."""
-        return f"solutions: {', '.join(self.setting.solutions)}"
-
-
-def linear_section(setting: StudySetting, out: Path) -> Section:
-    """The section the swept-sine and bumper pages open with: the linear system and the modal parameters of H22."""
-    return Section("Linear system", figures=saved([linear_figure(setting)], out), tables=[modal_table(setting.system)])
-
-
-def linear_figure(setting: StudySetting) -> DrawnFigure:
-    """Linear responses, force on the base and the curve fit of H22 (paper figures 2-4)."""
-    system = setting.system
-    # the closed form is cheap: a fine grid over the study's range (its own grid may be a handful of points)
-    f = np.union1d(setting.frequency, np.linspace(setting.frequency.min(), setting.frequency.max(), LINEAR_FIGURE_POINTS))
-    w = 2.0 * np.pi * f
-    response = linear_response(system, omega=w, amplitude=setting.amplitude)
-    fit = fit_modal_parameters(system) if underdamped_mode_count(system) == 2 else None
-    fig, axes = new_figure(3, panel_height=3.6, legend_rows=2)
-    ax = axes[0]
-    ax.semilogy(f, DISPLACEMENT_SCALE * np.abs(response.x1), label="|X1| primary", color="C0", lw=1.4, gid="linear")
-    ax.semilogy(f, DISPLACEMENT_SCALE * np.abs(response.x2), label="|X2| absorber", color="C1", lw=1.4, gid="linear")
-    for delta in setting.clearance:
-        ax.axhline(DISPLACEMENT_SCALE * delta, color="k", lw=0.9, ls="--")
-    finish_axes(ax, _FREQUENCY, f"amplitude [{DISPLACEMENT_UNITS}]", "Linear responses (paper fig. 2)")
-    ax = axes[1]
-    ax.semilogy(f, np.abs(response.force), color="C2", lw=1.4, gid="linear")
-    finish_axes(ax, _FREQUENCY, "|F| on the base [N]", "Linear force on the base (paper fig. 3)")
-    ax = axes[2]
-    ax.semilogy(f, np.abs(system.receptances(w).h22), label="|H22| exact (eq. 4)", color="k", lw=1.4)
-    if fit is not None:
-        step = max(1, f.size // 120)
-        ax.semilogy(f[::step], np.abs(fit.receptance(w[::step])), "o", color="C3", mfc="none", ms=4.5, label="|H22| of eq. 10, the paper's fitted modes")
-    finish_axes(ax, _FREQUENCY, "|H22| [m/N]", "Accuracy of the curve fit (paper fig. 4)")
-    figure_legend(fig, axes, [Line2D([], [], color="k", lw=0.9, ls="--", label="clearance Delta")])
-    natural = ", ".join(fmt(x / (2 * np.pi), ".3f") for x in system.natural_angular_frequencies())
-    caption = (
-        f"Linear system (Delta -> infinity): |X1| and |X2| (dashed: the clearance), the force on the base, and |H22| exact "
-        f"{'against the paper' + chr(39) + 's curve fit (circles)' if fit is not None else '(the paper' + chr(39) + 's fit needs two underdamped modes)'}. "
-        f"Natural frequencies {natural} Hz, anti-resonance {fmt(system.antiresonance_angular_frequency() / (2 * np.pi), '.3f')} Hz."
-    )
-    return DrawnFigure(fig, "linear", "Linear responses, force on the base, fit of H22", caption)
 
 
 def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure | None:
@@ -221,91 +147,6 @@ def regime_figure(part: xr.Dataset, name: str) -> DrawnFigure:
         panels.append((f"{solution_ref(str(s))}: regime, {clearance_text(part)}", [text for text, _ in lines], flags, unstable))
     solutions = ", ".join(solution_ref(str(s)) for s in part["solution"].values)
     return regime_map(panels, part["frequency"].values, name, f"Regime map, {clearance_text(part)}", f"Regime of each point of {solutions}")
-
-
-def _hatch_runs(ax: Any, edges: np.ndarray, marked: np.ndarray, gid: str) -> None:
-    """Hatch every run of marked cells (rows x columns between ``edges`` [Hz]) over the colours drawn below."""
-    for row, cells in enumerate(marked):
-        padded = np.concatenate(([False], cells, [False])).astype(int)
-        starts, ends = np.flatnonzero(np.diff(padded) == 1), np.flatnonzero(np.diff(padded) == -1)
-        for a, b in zip(starts, ends):
-            ax.add_patch(Rectangle((edges[a], row - 0.5), edges[b] - edges[a], 1.0, fill=False, hatch="////", edgecolor="0.15", linewidth=0.0, gid=gid))
-
-
-#: Regime flags of an admissible one-impact orbit, the ones whose stability a hatch shows.
-_ONE_IMPACT_FLAGS = (Regime.ONE_IMPACT, Regime.ONE_IMPACT_COEXISTING_LINEAR)
-
-
-def regime_map(panels: list[tuple], f: np.ndarray, name: str, title: str, lead: str) -> DrawnFigure:
-    """Regime flags as coloured bands, one colour per flag, the legend below the panels.
-
-    Parameters
-    ----------
-    panels : list of (str, list of str, ndarray[, ndarray or None])
-        Per panel: its title, its row labels, the flags, shape (rows, frequency), and optionally where the
-        one-impact orbit is unstable (bool, same shape): those cells are hatched over their flag's colour.
-    f : ndarray
-        Frequency grid [Hz].
-    name, title : str
-        File name and heading of the figure.
-    lead : str
-        First sentence of the caption.
-    """
-    flags = sorted(REGIME_COLOURS)
-    cmap = ListedColormap([REGIME_COLOURS[r] for r in flags])
-    norm = BoundaryNorm(np.arange(len(flags) + 1) - 0.5, len(flags))
-    heights = [0.95 + 0.3 * len(panel[1]) for panel in panels]
-    fig, axes = new_figure(len(panels), columns=1, sharex=True, legend_rows=legend_rows(len(flags) + 1, 3), row_heights=heights)
-    seen: set[int] = set()
-    coarse = False
-    hatched = 0
-    for ax, (panel_title, labels, grid, *rest) in zip(axes, panels):
-        unstable = rest[0] if rest and rest[0] is not None else None
-        computed = np.any(grid != Regime.NOT_COMPUTED, axis=0)
-        columns = f[computed]
-        if columns.size:
-            edges = block_edges(columns, f)
-            rows = np.arange(len(labels) + 1) - 0.5
-            ax.pcolormesh(edges, rows, np.searchsorted(flags, grid[:, computed]), cmap=cmap, norm=norm, shading="flat", gid=f"regime:{panel_title}")
-            seen.update(int(v) for v in np.unique(grid[:, computed]))
-            coarse |= bool(columns.size < f.size)
-            if unstable is not None:
-                marked = np.asarray(unstable, dtype=bool)[:, computed] & np.isin(grid[:, computed], _ONE_IMPACT_FLAGS)
-                if marked.any():
-                    hatched += int(marked.sum())
-                    _hatch_runs(ax, edges, marked, f"unstable:{panel_title}")
-        ax.set_ylim(len(labels) - 0.5, -0.5)
-        ax.set_yticks(range(len(labels)), labels)
-        ax.set_title(panel_title, fontsize=11)
-    axes[-1].set_xlabel(_FREQUENCY)
-    shown = [r for r in flags if int(r) in seen]
-    handles = [Patch(color=REGIME_COLOURS[r], label=regime_label(r)) for r in shown]
-    if hatched:
-        handles.append(Patch(facecolor="white", edgecolor="0.15", hatch="////", label="hatched: the one-impact orbit is unstable"))
-    figure_legend(fig, [], handles, columns=3)
-    caption = f"{lead} (the dataset's regime flag, its value in brackets), one colour per flag."
-    if hatched:
-        caption += (
-            f" Hatched ({hatched} points): an admissible one-impact orbit that is unstable (largest Floquet multiplier"
-            " outside the unit circle); the motion settles elsewhere there (see the simulations), however its colour reads."
-        )
-    if coarse:
-        caption += (
-            " A solution computed on a coarser grid (simulations) shows each point as a block reaching halfway to its"
-            " neighbours; blank: frequencies it was not asked to compute."
-        )
-    return DrawnFigure(fig, name, title, caption)
-
-
-def block_edges(columns: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """Edges of blocks around each computed frequency, halfway to its neighbours (coarse simulation grids show as
-    blocks, not hairlines), the end blocks as wide as their neighbours' half spacing, within the frequency axis."""
-    if columns.size == 1:
-        half = 0.5 * float(np.min(np.diff(f))) if f.size > 1 else 0.5
-        return np.array([columns[0] - half, columns[0] + half])
-    middle = (columns[1:] + columns[:-1]) / 2.0
-    first, last = columns[0] - (middle[0] - columns[0]), columns[-1] + (columns[-1] - middle[-1])
-    return np.concatenate([[max(first, f[0])], middle, [min(last, f[-1])]])
 
 
 def stability_figure(part: xr.Dataset, name: str) -> DrawnFigure:

@@ -1,4 +1,5 @@
-"""Stepped studies: steady states (closed forms and time-domain engines) at each point of the grid."""
+"""Stepped studies: steady states (closed forms and time-domain engines) at each point of the grid (the grid, its
+closed forms, its dataset and its estimate: :mod:`vibroimpact.grids`, shared with the swept kind)."""
 
 from __future__ import annotations
 
@@ -13,8 +14,9 @@ from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.analysis.stability import floquet_multipliers
 from vibroimpact.engines.registry import BUMPER, engine_spec
 from vibroimpact.kinds.stepped.cases import general_simulated_values
-from vibroimpact.kinds.stepped.grid import StudyGrid, grid_coordinates, solve_each, finish_dataset, EnginePart, grid_estimate
-from vibroimpact.kinds.stepped.values import stop_clearances
+from vibroimpact.grids.closed_forms import stop_clearances
+from vibroimpact.grids.estimate import EnginePart, closed_form_scale, grid_estimate
+from vibroimpact.grids.grid import StudyGrid, describe_stops, finish_dataset, general_quantity_attributes, grid_coordinates, solve_each
 from vibroimpact.kinds.stepped.blocks import plan_blocks, run_grid
 from vibroimpact.scene.subset import subset_axes, subset_share, subset_text
 from vibroimpact.runs.cluster import Progress
@@ -23,10 +25,9 @@ from vibroimpact.runs.runner import Runner
 from vibroimpact.model.layout import stop_descriptions
 from vibroimpact.reporting.solutions import solution_method
 from vibroimpact.scene.schema import Scene, GRID_DIMS, STOP_QUANTITIES, ENGINE_SOLUTIONS
-from vibroimpact.scene.variables import quantity_attributes
 from vibroimpact.simulation.settings import SWEEP_STARTS
 
-__all__ = ["closed_form_scale", "general_orbit_outlook", "UNKNOWN_WANDERING", "CLOSED_FORM_FACTOR", "general_block", "general_coordinates", "describe_stops", "general_quantity_attributes", "SteppedStudy", "expected_periods", "SETTLING_PERIODS", "SHOOTING_PERIODS", "ESTIMATE_POINTS"]
+__all__ = ["general_orbit_outlook", "UNKNOWN_WANDERING", "general_block", "general_coordinates", "SteppedStudy", "expected_periods", "SETTLING_PERIODS", "SHOOTING_PERIODS", "ESTIMATE_POINTS"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -35,16 +36,6 @@ __all__ = ["closed_form_scale", "general_orbit_outlook", "UNKNOWN_WANDERING", "C
 
 #: Share of impacting points assumed never to settle where no closed form says which orbits are stable.
 UNKNOWN_WANDERING = 0.25
-#: Cost of the general closed form per point over the named one's, on the paper's layout (measured).
-CLOSED_FORM_FACTOR = 1.3
-
-
-def closed_form_scale(scene: Scene, solution: str) -> float:
-    """A closed form's cost per grid point relative to the one measured on the paper's layout by its named route."""
-    if solution == "pgf_paper":
-        return 1.0
-    size = (scene.layout.size / 2.0) ** 2
-    return CLOSED_FORM_FACTOR * size * (len(scene.layout.stops) if solution == "linear" else 1.0)
 
 
 def general_orbit_outlook(scene: Scene, frequencies: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -78,24 +69,6 @@ def general_orbit_outlook(scene: Scene, frequencies: np.ndarray) -> tuple[np.nda
 _PER_COORDINATE = {"_amplitude": "x1_amplitude", "_rms": "x1_rms"}
 
 
-def general_quantity_attributes(quantity: str, scene: Scene) -> dict[str, object]:
-    """Units and long name of a stepped study's quantity (per-coordinate names included)."""
-    relative = " relative to the base" if scene.layout.load.base_motion else ""
-    for name in scene.coordinates:
-        if quantity == f"{name}_amplitude":
-            return {"units": "m", "long_name": f"fundamental-harmonic amplitude of coordinate {name}{relative}"}
-        if quantity == f"{name}_rms":
-            return {"units": "m", "long_name": f"RMS of coordinate {name}{relative} (static offset included)"}
-        if quantity == f"one_impact_{name}_amplitude":
-            return {"units": "m", "long_name": f"|{name}| fundamental of the closed-form impact orbit wherever it exists, unchecked"}
-    attrs = quantity_attributes(quantity)
-    if quantity in STOP_QUANTITIES:
-        attrs = attrs | {"long_name": f"{attrs.get('long_name', quantity)}; per stop (the stopped coordinate's deceleration)"}
-    if quantity in ("force_amplitude", "suspension_force_amplitude"):
-        attrs = attrs | {"long_name": "fundamental-harmonic amplitude of the force on the base: 1^T (K x + C x') through springs and dashpots" + (" plus the absolute stops' contact forces" if quantity == "force_amplitude" else "")}
-    return attrs
-
-
 def general_block(scene: Scene, runner: Runner) -> xr.Dataset:
     """Every solution of ``scene`` (or of a block of one) over its unsqueezed grid, without coordinates or metadata;
     per-stop quantities have the dimension ``stop`` where the scene has several stops."""
@@ -127,13 +100,6 @@ def general_coordinates(scene: Scene, grid: StudyGrid) -> dict[str, object]:
         coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.layout.stops, scene.coordinates, scene.settings.restitution, scene.settings.clearance), dtype=object))
     return coords
 
-
-def describe_stops(dataset: xr.Dataset) -> xr.Dataset:
-    """The attributes of the ``stop`` coordinates, where the dataset has them."""
-    if "stop" in dataset.coords:
-        dataset["stop"].attrs.update({"units": "1", "long_name": "index of the stop in the scene's stops"})
-        dataset["stop_description"].attrs.update({"long_name": "the stop's constraint in words (Delta, R: the swept values)"})
-    return dataset
 
 #: Periods of a transient that settles on a stable orbit (two convergence chunks), before the measurement.
 SETTLING_PERIODS = 40

@@ -1,4 +1,5 @@
-"""Tables of the frequency-response pages: modal parameters, reduction factors, simulation against the closed form.
+"""Tables of the stepped frequency-response pages: reduction factors, simulation against the closed form (the modal
+parameters' table, shared with the swept page, is :func:`vibroimpact.grids.sections.modal_table`).
 
 A solution is judged only on the points it was asked to compute: time-domain solutions run on their own, coarser
 grid and are flagged ``not_computed`` elsewhere; those points are neither failures nor undefined values.
@@ -29,14 +30,14 @@ import xarray as xr
 from vibroimpact.kinds.stepped.crosscheck import subset_solutions
 from vibroimpact.analysis.linear import ResonancePeak, peaks_near
 from vibroimpact.analysis.stability import Regime
-from vibroimpact.model.modal import exact_modal_parameters, fit_modal_parameters
+from vibroimpact.model.modal import exact_modal_parameters
 from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
 from vibroimpact.reporting.page import Table
 from vibroimpact.reporting.record import GeneralSetting
 from vibroimpact.reporting.style import QUANTITIES, fmt
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 
-__all__ = ["DEFINITION", "ReductionRow", "reduction_factors", "paper_reduction_factors", "modal_table", "reduction_tables", "reduction_intro", "agreement_table", "computed_part"]
+__all__ = ["DEFINITION", "ReductionRow", "reduction_factors", "paper_reduction_factors", "reduction_tables", "reduction_intro", "agreement_table", "computed_part"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -185,24 +186,6 @@ def computed_part(dataset: xr.Dataset, solution: str) -> xr.Dataset:
     if others:
         computed = computed.any(others)
     return dataset.isel(frequency=np.flatnonzero(computed.values))
-
-
-def modal_table(system: TwoDofSystem) -> Table:
-    """Exact and fitted modal parameters of H22 of ``system``."""
-    exact = exact_modal_parameters(system)
-    fit = fit_modal_parameters(system) if exact.omega.size == 2 else None
-    rows = ["<tr><th>mode</th><th>Omega/2pi [Hz]</th><th>xi exact</th><th>xi fitted</th><th>A exact (complex) [1/kg]</th><th>A fitted [1/kg]</th></tr>"]
-    for i in range(exact.omega.size):
-        a = exact.form_factor[i]
-        fitted = ("", "") if fit is None else (fmt(fit.loss_factor[i], ".5f"), fmt(np.real(fit.form_factor[i]), ".4f"))
-        rows.append(
-            f"<tr><td>{i + 1}</td><td>{fmt(exact.omega[i] / (2 * np.pi), '.4f')}</td><td>{fmt(exact.loss_factor[i], '.5f')}</td><td>{fitted[0]}</td>"
-            f"<td>{fmt(a.real, '.4f')} {fmt(a.imag, '+.4f')}j</td><td>{fitted[1]}</td></tr>"
-        )
-    note = "The paper prints A = 2.75, 7.25 and xi = 0.0022, 0.0023 for its system (eq. 24)." if system == PAPER_SYSTEM else ""
-    if fit is None:
-        note += " The system has fewer than two underdamped modes: the paper's fit does not apply."
-    return Table("Modal parameters of H22", "<table>" + "".join(rows) + f"</table><p>{note}</p>")
 
 
 def reduction_intro() -> str:

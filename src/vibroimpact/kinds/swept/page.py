@@ -23,11 +23,11 @@ from matplotlib.axes import Axes
 from matplotlib.lines import Line2D
 
 from vibroimpact.analysis.stability import Regime
-from vibroimpact.kinds.stepped.figures import layout_tables, structure_figure
+from vibroimpact.grids.regime_map import regime_map
+from vibroimpact.grids.sections import SolutionsPage, layout_tables, linear_section, structure_figure
 from vibroimpact.reporting.record import GeneralSetting, general_setting, is_general, study_setting, SWEPT_SOLUTION
 from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
-from vibroimpact.kinds.stepped.responses import SolutionsPage, linear_section, regime_map
 from vibroimpact.reporting.series import draw_curve, draw_linear, stability_keys, unstable_points
 from vibroimpact.reporting.style import DISPLACEMENT_SCALE, DISPLACEMENT_UNITS, QUANTITIES, GENERAL_SOLUTION_DESCRIPTIONS, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref, SWEEP_COLOURS
 

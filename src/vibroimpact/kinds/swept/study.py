@@ -7,7 +7,7 @@ elapsed_time) and their costs ``sweep_<statistic>`` (sweep). Quantities are name
 scene names them: the paper's (``x1_amplitude`` ...) for its named form, ``<coordinate>_amplitude`` and
 ``<coordinate>_rms`` per coordinate of a general scene; per-stop quantities (impulse, peaks) get a dimension ``stop``
 where the scene has several stops. The closed forms are the general ones
-(:func:`~vibroimpact.kinds.stepped.values.general_linear_values`, :func:`~vibroimpact.kinds.stepped.values.general_pgf_values`);
+(:func:`~vibroimpact.grids.closed_forms.general_linear_values`, :func:`~vibroimpact.grids.closed_forms.general_pgf_values`);
 ``pgf_paper``, the paper's own fitted route, exists for the named form only.
 """
 
@@ -24,9 +24,9 @@ from numpy.typing import NDArray
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.engines.registry import make_engine
 from vibroimpact.engines.settings import EngineSettings
-from vibroimpact.kinds.stepped.grid import StudyGrid, finish_dataset, grid_coordinates, EnginePart, grid_estimate
-from vibroimpact.kinds.stepped.study import closed_form_scale, describe_stops, general_quantity_attributes
-from vibroimpact.kinds.stepped.values import general_linear_values, general_pgf_values
+from vibroimpact.grids.closed_forms import general_linear_values, general_pgf_values
+from vibroimpact.grids.estimate import EnginePart, closed_form_scale, grid_estimate
+from vibroimpact.grids.grid import StudyGrid, describe_stops, finish_dataset, general_quantity_attributes, grid_coordinates
 from vibroimpact.model.contact import Stop
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem

@@ -1,4 +1,5 @@
-"""The closed-form solutions (``linear``, ``pgf``, ``pgf_paper``) of a scene over its grid: any structure, load and stops.
+"""The closed-form solutions (``linear``, ``pgf``, ``pgf_paper``) of a scene over its grid: any structure, load and stops;
+part of the frequency-grid study shared by the stepped and swept kinds.
 
 Values are named after the scene's coordinates (``<name>_amplitude``, ``<name>_rms``) and stops: a per-stop quantity
 (:data:`~vibroimpact.scene.schema.STOP_QUANTITIES`) has a leading axis of one entry per stop. The force on the base

@@ -1,7 +1,9 @@
-"""What stepped and swept studies share: the full grid, the loop over solutions, and the dataset around the values.
+"""The frequency-grid study shared by the stepped and swept kinds: the full grid, the loop over solutions, and the
+dataset around the values (its coordinates, the attributes of its variables and of its stops, its metadata).
 
 The full grid is (restitution, clearance, bumper_frequency, sweep, frequency): unswept axes have length 1 and are
-squeezed at the end; each solution computes only along the axes it depends on, then is broadcast.
+squeezed at the end; each solution computes only along the axes it depends on, then is broadcast. The closed forms'
+values come from :mod:`vibroimpact.grids.closed_forms`; a study's estimate is :mod:`vibroimpact.grids.estimate`'s.
 """
 
 from __future__ import annotations
@@ -14,14 +16,13 @@ import xarray as xr
 
 from vibroimpact.model.modal import fit_modal_parameters
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, STOP_QUANTITIES, Scene
-from vibroimpact.scene.variables import COORDINATE_ATTRIBUTES
-from vibroimpact.kinds.stepped.values import general_linear_values, general_pgf_values
+from vibroimpact.scene.variables import COORDINATE_ATTRIBUTES, quantity_attributes
+from vibroimpact.grids.closed_forms import general_linear_values, general_pgf_values
 from vibroimpact.runs.cluster import Progress
-from vibroimpact.runs.estimate import TASK_SECONDS, WRITE_SECONDS_PER_VARIABLE, Costs, Estimate, cluster_startup, cost_engine, os_cpus
 from vibroimpact.runs.run import provenance
 from vibroimpact.reporting.solutions import closed_form_methods, solution_method
 
-__all__ = ["EnginePart", "grid_estimate", "memory", "StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset", "no_one_impact_orbit"]
+__all__ = ["StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset", "no_one_impact_orbit", "general_quantity_attributes", "describe_stops"]
 
 #: The values of one solution, quantity -> array over (part of) the full grid.
 Values = dict[str, np.ndarray]
@@ -73,9 +74,9 @@ class StudyGrid:
 def solve_each(scene: Scene, grid: StudyGrid, simulate: Callable[[str], Values], progress: Progress | None) -> list[Values]:
     """The values of every solution of ``scene``, in its order; ``simulate(name)`` computes a time-domain one.
 
-    The closed forms are those of any layout (:mod:`vibroimpact.kinds.stepped.values`): per-coordinate quantities named
+    The closed forms are those of any layout (:mod:`vibroimpact.grids.closed_forms`): per-coordinate quantities named
     after the coordinates, per-stop ones with a leading axis of one entry per stop; ``pgf_paper`` is the paper's own
-    route where the scene has its layout (:mod:`vibroimpact.kinds.stepped.values`).
+    route where the scene has its layout (:mod:`vibroimpact.grids.closed_forms`).
     """
     report = progress or (lambda _message: None)
     total = len(scene.settings.solutions)
@@ -185,70 +186,32 @@ def no_one_impact_orbit(shape: tuple[int, ...]) -> dict[str, np.ndarray]:
 
 
 # --------------------------------------------------------------------------------------------------------------------
-# The estimate of a stepped or swept study: its grid's closed forms, engines, report and memory.
+# The attributes of the grid's variables and of its stops, whichever way the scene writes the system (the paper's
+# named form is the layout of a two-mass chain, one upper stop on x2 and a force on x1, and takes this path too).
 # --------------------------------------------------------------------------------------------------------------------
 
-#: One time-domain solution's predicted work: (seconds, what it runs, the longest serial case [s]).
-EnginePart = tuple[float, str, float]
+
+def general_quantity_attributes(quantity: str, scene: Scene) -> dict[str, object]:
+    """Units and long name of a grid study's quantity, stepped or swept (per-coordinate names included)."""
+    relative = " relative to the base" if scene.layout.load.base_motion else ""
+    for name in scene.coordinates:
+        if quantity == f"{name}_amplitude":
+            return {"units": "m", "long_name": f"fundamental-harmonic amplitude of coordinate {name}{relative}"}
+        if quantity == f"{name}_rms":
+            return {"units": "m", "long_name": f"RMS of coordinate {name}{relative} (static offset included)"}
+        if quantity == f"one_impact_{name}_amplitude":
+            return {"units": "m", "long_name": f"|{name}| fundamental of the closed-form impact orbit wherever it exists, unchecked"}
+    attrs = quantity_attributes(quantity)
+    if quantity in STOP_QUANTITIES:
+        attrs = attrs | {"long_name": f"{attrs.get('long_name', quantity)}; per stop (the stopped coordinate's deceleration)"}
+    if quantity in ("force_amplitude", "suspension_force_amplitude"):
+        attrs = attrs | {"long_name": "fundamental-harmonic amplitude of the force on the base: 1^T (K x + C x') through springs and dashpots" + (" plus the absolute stops' contact forces" if quantity == "force_amplitude" else "")}
+    return attrs
 
 
-def grid_estimate(
-    scene: Scene, jobs: int, costs: Costs, engine_part: Callable[[str, str], EnginePart], figures: int, sweep_samples: float = 0.0,
-    closed_form_scale: Callable[[str], float] = lambda _name: 1.0, blocks: Callable[[int], int] | None = None,
-) -> Estimate:  # fmt: skip
-    """The estimate of a stepped or swept study on the calibration machine: the closed forms per grid point (times
-    ``closed_form_scale(solution)``: a general layout's relative cost), each time-domain solution by
-    ``engine_part(solution, cost engine)``, spread over the workers, and the report's ``figures``;
-    ``sweep_samples`` output samples of one swept run held in memory per worker; ``blocks(workers)``: the dask tasks
-    of a study solved in grid blocks, each costing the scheduler and the store's writes in the main process."""
-    parts: dict[str, float] = {}
-    points: dict[str, str] = {}
-    frequency = scene.settings.all_frequencies
-    bumpers = scene.settings.bumper_frequency.size if scene.settings.bumper_frequency is not None else 1
-    grid = scene.settings.restitution.size * scene.settings.clearance.size * frequency.size
-    closed_form = 0.0
-    simulated = 0.0
-    biggest_case = 0.0
-    for name in scene.settings.solutions:
-        if name not in ENGINE_SOLUTIONS:
-            seconds = costs.closed_form_per_point[name] * grid * (bumpers if name == "pgf" and scene.settings.bumper_frequency is not None else 1) * closed_form_scale(name)
-            parts[name] = seconds
-            closed_form += seconds
-            continue
-        assert scene.settings.simulation is not None
-        parts[name], points[name], serial = engine_part(name, cost_engine(name, scene.settings.simulation.engine.method))
-        biggest_case = max(biggest_case, serial)
-        simulated += parts[name]
-    report = 0.0
-    if scene.report:
-        report = costs.report_base + costs.report_per_figure * figures
-        parts["report"] = report
-    workers = min(jobs, os_cpus())
-    overhead = 0.0
-    if blocks is not None:
-        overhead = blocks(workers) * (TASK_SECONDS + WRITE_SECONDS_PER_VARIABLE * len(scene.settings.quantities))
-        parts["scheduler and store"] = overhead
-        closed_form /= workers  # the closed forms are solved block by block on the workers too
-    startup = costs.startup + cluster_startup(jobs)
-    wall = startup + closed_form + max(simulated / workers, biggest_case) + overhead + report
-    return Estimate(wall_time=wall, memory=memory(scene, jobs, costs, sweep_samples, streamed=blocks is not None), parts=parts, points=points)
-
-
-def memory(scene: Scene, jobs: int, costs: Costs, sweep_samples: float = 0.0, streamed: bool = False) -> float:
-    """Peak memory of the run, main process and workers [bytes]: the main process's footprint and its dataset (built,
-    stacked, written: ~3 copies; ``streamed``: solved in blocks into the store and exported chunk by chunk, so only
-    the report reads it whole), one worker footprint per process simulating, and the ``sweep_samples`` of one sweep
-    per worker."""
-    frequency = scene.settings.all_frequencies
-    bumpers = scene.settings.bumper_frequency.size if scene.settings.bumper_frequency is not None else 1
-    directions = max(1, len(scene.settings.sweep_directions))
-    cells = scene.settings.restitution.size * scene.settings.clearance.size * bumpers * directions * frequency.size
-    dataset = 3.0 * 8.0 * len(scene.settings.quantities) * len(scene.settings.solutions) * cells
-    if streamed:
-        dataset = dataset / 3.0 if scene.report else 0.0
-    simulating = any(name in ENGINE_SOLUTIONS for name in scene.settings.solutions)
-    workers = min(jobs, os_cpus()) if (simulating or streamed) and jobs > 1 else 0
-    sweep = 0.0
-    if sweep_samples:
-        sweep = sweep_samples * 8.0 * 16 * max(1, workers)  # samples, cumulative integrals and temporaries of the estimators
-    return costs.main_process_memory + dataset + workers * costs.worker_process_memory + sweep
+def describe_stops(dataset: xr.Dataset) -> xr.Dataset:
+    """The attributes of the ``stop`` coordinates, where the dataset has them."""
+    if "stop" in dataset.coords:
+        dataset["stop"].attrs.update({"units": "1", "long_name": "index of the stop in the scene's stops"})
+        dataset["stop_description"].attrs.update({"long_name": "the stop's constraint in words (Delta, R: the swept values)"})
+    return dataset
