@@ -30,11 +30,12 @@ def test_no_two_special_points_of_the_golden_scene_coincide() -> None:
                 assert abs(a["frequency"] - b["frequency"]) > SAME_POINT_FREQUENCY * a["frequency"], (name, a, b)
         found_on = [str(labels).split() for labels in dataset["special_point_branches"].values]
         assert all(labels[0] == str(p["branch"]) for labels, p in zip(found_on, points))
-    # the golden scene's grazing points at 26.03 Hz (one-impact branch 3 and the branch born at 27.05 Hz, 7) and at
-    # 33.97 Hz (one-impact branch 4 and the period-7 branch 8): each once, with both branches
+    # the golden scene's grazing points at 26.03 Hz (one-impact branch 3 and the branch born at 27.05 Hz, 7), at
+    # 27.05 Hz (the period-two branch 6, where branch 7 is born) and at 33.97 Hz (one-impact branch 4 and the period-7
+    # branch 8): each once, with both branches
     dataset = xr.load_dataset(DATA / "bifurcation.nc")
     twice = {round(float(f), 2): str(b) for f, b in zip(dataset["special_point_frequency"].values, dataset["special_point_branches"].values) if " " in str(b)}
-    assert twice == {26.03: "3 7", 33.97: "4 8"}
+    assert twice == {26.03: "3 7", 27.05: "6 7", 33.97: "4 8"}
 
 
 def test_every_distinct_special_point_is_kept_once() -> None:
