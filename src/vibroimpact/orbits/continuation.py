@@ -18,9 +18,10 @@ contact count changes (or no orbit is found beyond); the point is located (in cl
 contact-free: :mod:`~vibroimpact.orbits.onsets`), and the orbit beyond it, if one is found, carries the branch on
 with the new count (``SpecialPoint.continues``, ``impacts_after``), in the direction the geometry gives: on through
 the point, or back (a nonsmooth fold). Next to a soft contact's onset the branch curves sharply; it is followed there
-by its distance to grazing instead of its arclength (:meth:`~vibroimpact.orbits.onset_steps.OnsetSteps.leave`). What happens across an onset is in the
-grazing point's note: a jump of the multipliers across the unit circle named as the discontinuity-induced
-bifurcation it is, a nonsmooth fold; special points next to an onset say that it induced them.
+by its distance to grazing instead of its arclength (:meth:`~vibroimpact.orbits.onset_steps.OnsetSteps.leave`).
+What happens across an onset is in the grazing point's note: a jump of the multipliers across the unit circle named
+as the discontinuity-induced bifurcation it is, a nonsmooth fold; special points next to an onset say that it
+induced them.
 """
 
 from __future__ import annotations

@@ -131,6 +131,7 @@ class OnsetSteps:
         touching = self.arc.point(self.arc.to_z(closed[0], q), side.tangent)
         if side.out.hybrid.onset_depth is None or not (np.all(np.isfinite(touching.out.jacobian)) and np.all(np.isfinite(touching.tangent))):
             touching = None  # a rigid stop's impact of zero speed: its Jacobian is singular there (the located point stays)
+        free = None  # (none when the contact-free orbit exists on neither side within the offset)
         offset = max(1e-6 * abs(root), 1e3 * self.tolerance(side) * scale)
         for end in (root + offset, root - offset):
             there = np.array(q)
@@ -147,13 +148,12 @@ class OnsetSteps:
         """Keep the grazing point just located (at arclength ``at``) with what happens across it: the stability change
         between ``before`` and ``after`` (the orbits on either side, at most 1e-3 from it in margin where the branch
         curves sharply; both contact-free or :data:`MEASURABLE_MARGIN` from it) named as a discontinuity-induced
-        bifurcation, and a nonsmooth fold where the branch leaves
-        back the way it came (its parameter's direction reverses with no smooth fold in between). Special points
-        found within that 1e-3 of the onset (from index ``near`` of the points found since ``first``) are marked
-        as induced by it."""
+        bifurcation, and a nonsmooth fold where the branch leaves back the way it came (its parameter's direction
+        reverses with no smooth fold in between). Special points found within that 1e-3 of the onset (from index
+        ``near`` of the points found since ``first``) are marked as induced by it."""
         found = self.graze
         notes = [found.note]
-        folds_near = any(kind == "fold" for kind in (p.kind for _, p in self.specials[first:]))
+        folds_near = any(point.kind == "fold" for _, point in self.specials[first:])
         if after is not None and all(_measurable(point) for point in (before, after)):
             change = stability_change(before.orbit(self.system).multipliers, after.orbit(self.system).multipliers)
             if change:
@@ -185,8 +185,8 @@ class OnsetSteps:
         with the new contact: the orbits whose distance to grazing (:func:`grazing_margin`) is 1e-6, 2e-6, 4e-6, ...
         up to 1e-3, each the solution of the fixed-point equations plus that margin, from the last, with its tangent
         the way they go. ``signature``: the contacts of the side to leave on (default ``start``'s own);
-        ``anchor``: a point of that side to approach ``start`` from, when ``start`` is not on it. Empty when ``start`` is already that far, or no such orbit is found (the
-        pseudo-arclength steps then try).
+        ``anchor``: a point of that side to approach ``start`` from, when ``start`` is not on it. Empty when ``start``
+        is already that far, or no such orbit is found (the pseudo-arclength steps then try).
 
         Next to the grazing point of a soft contact the branch curves sharply (the contact's effect grows like a power
         of the depth above one, a square root in the Jacobian; at a turning point the contacting branch leaves back
