@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -23,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.model.contact import BUMPER, KelvinVoigtBumper, RigidStop
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.orbits.layout_parameters import BUMPER_STIFFNESS
 from vibroimpact.orbits.maps import PARAMETERS, ImpactMap
 
 __all__ = ["BumperPeriodMap", "BUMPER_PERIOD"]
@@ -58,8 +60,10 @@ class BumperPeriodMap(ImpactMap):
         return (*ImpactMap.natural_scale(problem), 1e-3)
 
     def __init__(self, problem: ImpactProblem, periods: int = 1, engine: Any = None, bounds: dict[str, tuple[float, float]] | None = None,
-                 stop: int | str | None = None, parameter_scale: ArrayLike | None = None) -> None:  # fmt: skip
-        super().__init__(problem, periods, engine, bounds, stop, parameter_scale)
+                 stop: int | str | None = None, parameter_scale: ArrayLike | None = None, layout: Sequence[str] = ()) -> None:  # fmt: skip
+        if BUMPER_STIFFNESS in layout:
+            raise ValueError(f"layout = {list(layout)!r}: {BUMPER_STIFFNESS} and {BUMPER_PERIOD} set the same Omega_b: continue in one of them")
+        super().__init__(problem, periods, engine, bounds, stop, parameter_scale, layout)
         laws = [problem.stops[k].law for k in self.stops]
         if problem.contact_law != BUMPER or not all(isinstance(law, KelvinVoigtBumper) for law in laws):
             raise ValueError(f"stop = {stop!r}: a bumper period needs Kelvin-Voigt bumpers on every selected stop (stops {list(self.stops)})")
@@ -71,10 +75,11 @@ class BumperPeriodMap(ImpactMap):
         """T_b = 1 / (Omega_b / 2 pi) [s] of the chosen stop's bumper (NaN for a rigid stop: refused after)."""
         return (1.0 / law.frequency,) if isinstance(law, KelvinVoigtBumper) else (math.nan,)
 
-    def problem_at(self, p: NDArray[np.float64]) -> ImpactProblem:
-        """The problem with parameter vector ``p`` (frequency, restitution, clearance, amplitude, phase, T_b); a T_b <= 0
-        raises ``ValueError`` (the rigid stop is the limit, not a member)."""
-        problem = super().problem_at(p)
+    def _problem_before_layout(self, p: NDArray[np.float64]) -> ImpactProblem:
+        """The problem with parameters (frequency, restitution, clearance, amplitude, phase, T_b); a T_b <= 0 raises
+        ``ValueError`` (the rigid stop is the limit, not a member). Layout scalars after them are set on it
+        (:meth:`ImpactMap.problem_at`): T_b is the bumper's period on the base structure."""
+        problem = super()._problem_before_layout(p)
         period = float(p[len(PARAMETERS)])
         if not period > 0.0:
             raise ValueError(f"{BUMPER_PERIOD} = {period!r} s is out of range: allowed (0, inf)")

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,6 +49,7 @@ from vibroimpact.engines.registry import BUMPER, engine_for, make_engine
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import Branch, HybridInfo, MapEvaluation, PeriodicOrbit
+from vibroimpact.orbits.layout_parameters import LayoutParameter, check_independent, layout_parameter, with_layout
 from vibroimpact.orbits.sections import StrobeGap, moved_phase, moved_state, resection, strobe_gap
 from vibroimpact.orbits.shooting import closed_form_state, section_phase, with_impulse
 
@@ -106,6 +108,10 @@ class ImpactMap:
         A unit of arclength for each of the m parameters (default :meth:`natural_scale` of the problem: 4 % of its
         frequency, 0.1, 15 % of its length scale, 10 % of its amplitude, 1 rad; on the paper's 25 Hz, 10 N problem
         1 Hz, 0.1, 1.1 mm, 1 N), so that a 0.1 Hz structure and a 30 Hz one take the same steps in their own units.
+    layout : sequence of str, optional
+        Layout scalars appended to the parameters (:mod:`~vibroimpact.orbits.layout_parameters`: ``"k2"``,
+        ``"mass[x2]"``, ``"spring[x1,x2]"``, ``"bumper_stiffness"`` ...), so that any of them can be continued or be
+        the second parameter of a special point's curve; their scale is 10 % of their value.
 
     Attributes
     ----------
@@ -133,7 +139,7 @@ class ImpactMap:
         return (0.04 * problem.frequency, 0.1, 0.15 * problem.length_scale(), 0.1 * amplitude if amplitude > 0.0 else 1.0, 1.0)
 
     def __init__(self, problem: ImpactProblem, periods: int = 1, engine: Any = None, bounds: dict[str, tuple[float, float]] | None = None,
-                 stop: int | str | None = None, parameter_scale: ArrayLike | None = None) -> None:  # fmt: skip
+                 stop: int | str | None = None, parameter_scale: ArrayLike | None = None, layout: Sequence[str] = ()) -> None:  # fmt: skip
         problem.harmonic  # noqa: B018 - raises TypeError naming the part unless a harmonic force
         self.stops = stop_selection(problem, stop)
         self.stop = stop
@@ -143,12 +149,20 @@ class ImpactMap:
         self.contact = problem.contact_law
         self.engine = engine if engine is not None else make_engine(engine_for(self.contact, "exact_jacobians"))
         chosen = problem.stops[self.stops[0]]
-        self.parameters = np.array([problem.frequency, chosen.law.restitution, chosen.clearance, problem.amplitude, problem.phase, *self._more_parameters(chosen.law)])
+        self.layout = tuple(layout_parameter(str(name), problem) for name in layout)
+        self.parameter_names = (*type(self).parameter_names, *(item.name for item in self.layout))
+        if len(set(self.parameter_names)) != len(self.parameter_names):
+            raise ValueError(f"layout = {list(layout)!r}: a parameter is named twice among {list(self.parameter_names)}")
+        check_independent(self.layout)
+        self._fixed = len(self.parameter_names) - len(self.layout)
+        layout_values = [item.value(problem, self.stops) for item in self.layout]
+        self.parameters = np.array([problem.frequency, chosen.law.restitution, chosen.clearance, problem.amplitude, problem.phase, *self._more_parameters(chosen.law), *layout_values])
         self.dimension = 2 * problem.size
         length = problem.length_scale()  # Delta + q |H12| on the paper's layout
         self.state_scale = np.repeat([length, problem.omega * length], problem.size)
         names = self.parameter_names
-        self.parameter_scale = np.array(self.natural_scale(problem) if parameter_scale is None else parameter_scale, dtype=float)
+        natural = (*self.natural_scale(problem), *(0.1 * abs(v) if v != 0.0 else 0.1 * _typical(problem, item) for item, v in zip(self.layout, layout_values)))  # exact: a zero entry
+        self.parameter_scale = np.array(natural if parameter_scale is None else parameter_scale, dtype=float)
         if self.parameter_scale.shape != (len(names),) or not np.all(self.parameter_scale > 0.0):
             raise ValueError(f"parameter_scale = {parameter_scale!r}: expected {len(names)} positive numbers ({', '.join(names)})")
         self.bounds = dict(bounds or {})
@@ -198,14 +212,22 @@ class ImpactMap:
 
     def with_periods(self, periods: int) -> "ImpactMap":
         """The same map over ``periods`` excitation periods (one compiled call per evaluation, unlike ``Iterated``)."""
-        return type(self)(self.problem, periods, self.engine, self.bounds, self.stop, self.parameter_scale)
+        return type(self)(self.problem, periods, self.engine, self.bounds, self.stop, self.parameter_scale, tuple(item.name for item in self.layout))
 
     def _more_parameters(self, law: RigidStop | KelvinVoigtBumper) -> tuple[float, ...]:
         """Values of the parameters after those of :data:`PARAMETERS` (none here) for the chosen stop's ``law``."""
         return ()
 
     def problem_at(self, p: NDArray[np.float64]) -> ImpactProblem:
-        """The problem with parameter vector ``p``."""
+        """The problem with parameter vector ``p``: its layout scalars (``layout``) set last, on the problem of the
+        other parameters."""
+        problem = self._problem_before_layout(p)
+        if not self.layout:
+            return problem
+        return with_layout(problem, self.layout, p[self._fixed :], self.stops)
+
+    def _problem_before_layout(self, p: NDArray[np.float64]) -> ImpactProblem:
+        """The problem with the parameters before the layout scalars."""
         frequency, restitution, clearance, amplitude, phase = (float(x) for x in p[: len(PARAMETERS)])
         base = self.problem
         excitation = dataclasses.replace(base.harmonic, amplitude=amplitude, frequency=frequency, phase=phase)
@@ -281,6 +303,15 @@ def _law(law: RigidStop | KelvinVoigtBumper, clearance: float, restitution: floa
         return RigidStop(clearance, restitution)
     xi = law.loss_factor if restitution == law.restitution else loss_factor_from_restitution(restitution)
     return KelvinVoigtBumper(clearance, law.frequency, xi)
+
+
+def _typical(problem: ImpactProblem, item: LayoutParameter) -> float:
+    """A magnitude for a layout scalar that is 0 in the base problem: the largest diagonal entry of its matrix, or of
+    the stiffness (for a bumper) [its unit]."""
+    structure = problem.structure
+    matrix = {"mass": structure.mass_matrix, "damping": structure.damping_matrix}.get(item.matrix, structure.stiffness_matrix)
+    typical = float(np.max(np.abs(np.diag(matrix))))
+    return typical if typical > 0.0 else 1.0
 
 
 def _outside_stops(problem: ImpactProblem, y: NDArray[np.float64]) -> bool:
