@@ -224,3 +224,21 @@ def test_a_pair_s_values_the_grid_does_not_give_are_not_judged() -> None:
     assert layout_refusal(pair) is None and layout_refusal(pair, 0.3) is None
     unequal = Layout(CHAIN, LoadSpec(), (StopSpec(2, 1, clearance=0.002), StopSpec(2, 1, "lower", clearance=0.003)))
     assert "differ" in str(layout_refusal(unequal))
+
+
+def test_a_bumper_given_in_physical_units_is_described_and_recorded_in_them() -> None:
+    """The stops' words and attributes say K_b and B_b as given (with the Omega_b / 2 pi they mean), and read back."""
+    structure = LinearStructure([[1.0, 0.0], [0.0, 0.25]], [[2e4, -5e3], [-5e3, 5e3]], coordinates=("x1", "x2"))
+    own = StopSpec(1, 0, "lower", 0.002, 0.5, bumper_frequency=50.0, bumper_loss_factor=0.1, bumper_stiffness=2e4, bumper_damping=8.0)
+    shared = StopSpec(1, None, "upper", 0.003, bumper_stiffness=1e5)  # Omega_b / 2 pi the grid's
+    layout = Layout(structure, LoadSpec(), (own, shared))
+    np.testing.assert_allclose([own.effective_mass(structure), shared.effective_mass(structure)], [0.2, 0.25], rtol=1e-15)
+    attrs = layout.attributes(np.array([0.5]), np.array([0.003]), np.array([100.0]))
+    assert attrs["stop_layout"] == (
+        "x2 - x1 >= -2 mm, R = 0.5, bumper K_b = 20000 N/m, B_b = 8 N s/m (Omega_b / 2 pi = 50 Hz); x2 <= 3 mm, R = 0.5, bumper K_b = 100000 N/m (Omega_b / 2 pi = 100 Hz)"
+    )
+    np.testing.assert_array_equal(attrs["stop_bumper_stiffness_N_per_m"], [2e4, 1e5])
+    np.testing.assert_array_equal(attrs["stop_bumper_damping_N_s_per_m"], [8.0, np.nan])
+    back = Layout.from_attributes(attrs).stops
+    assert [(s.bumper_stiffness, s.bumper_damping) for s in back] == [(2e4, 8.0), (1e5, None)]  # exact: the attributes as written
+    assert "stop_bumper_stiffness_N_per_m" not in Layout(structure).attributes(np.array([0.5]), np.array([0.003]))  # frequency form: unchanged

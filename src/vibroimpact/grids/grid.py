@@ -157,7 +157,7 @@ def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[st
     }
     if named is not None:
         attrs["antiresonance_frequency_Hz"] = named.antiresonance_angular_frequency() / (2.0 * np.pi)
-    attrs.update(scene.layout.attributes(scene.settings.restitution, scene.settings.clearance) | closed_form_methods())
+    attrs.update(scene.layout.attributes(scene.settings.restitution, scene.settings.clearance, scene.settings.bumper_frequency) | closed_form_methods())
     if "pgf_paper" in scene.settings.solutions:
         attrs["method_pgf_paper"] = solution_method("pgf_paper")
     for key, value in asdict(scene.settings.admissibility).items():

@@ -49,6 +49,7 @@ __all__ = [
     "Impact",
     "KelvinVoigtBumper",
     "RigidStop",
+    "place_effective_mass",
     "loss_factor_from_restitution",
     "paper_restitution",
     "peak_acceleration_factor",
@@ -153,6 +154,44 @@ class KelvinVoigtBumper:
         require_finite("clearance", self.clearance)
         require_positive("frequency", self.frequency)
         require_non_negative("loss_factor", self.loss_factor)
+
+    @classmethod
+    def from_stiffness(
+        cls, clearance: float, stiffness: float, effective_mass: float, damping: float | None = None, loss_factor: float | None = None
+    ) -> KelvinVoigtBumper:
+        """The bumper of stiffness K [N m-1] and damping B [N s m-1] (or loss factor xi_b [-]) on a stop of effective
+        mass m_eff [kg] (:meth:`Stop.effective_mass`): Omega_b = sqrt(K / m_eff), xi_b = B / (2 m_eff Omega_b).
+
+        The inverse of :meth:`stiffness` and :meth:`damping` at that mass, to round-off (a few ulp: the law keeps
+        Omega_b / 2 pi, so K and B come back as m_eff (2 pi f)^2 and 2 m_eff xi_b (2 pi f)).
+
+        Parameters
+        ----------
+        clearance : float
+            Delta [m].
+        stiffness : float
+            K [N m-1], > 0.
+        effective_mass : float
+            m_eff [kg], > 0: the mass the stop feels, 1 / (n . M^-1 n) (M2 for the paper's stop).
+        damping : float, optional
+            B [N s m-1], >= 0. Give either ``damping`` or ``loss_factor``.
+        loss_factor : float, optional
+            xi_b [-], >= 0.
+
+        Raises
+        ------
+        ValueError
+            Naming the key out of range, or both (or neither) of ``damping`` and ``loss_factor``.
+        """
+        k = require_positive("stiffness", stiffness)
+        mass = require_positive("effective_mass", effective_mass)
+        if (damping is None) == (loss_factor is None):
+            raise ValueError(f"damping = {damping!r}, loss_factor = {loss_factor!r}: give exactly one, damping [N s/m] in [0, inf) or loss_factor [-] in [0, inf)")
+        frequency = math.sqrt(k / mass) / (2.0 * math.pi)
+        if loss_factor is None:
+            b = require_non_negative("damping", damping)
+            loss_factor = b / (2.0 * mass * (2.0 * math.pi * frequency))  # the law's own Omega_b: damping(m) gives B back
+        return cls(clearance, frequency, loss_factor)
 
     @property
     def omega(self) -> float:
@@ -340,8 +379,21 @@ class Stop:
 
     def effective_mass(self, mass_matrix: NDArray[np.float64]) -> float:
         """m_eff = 1 / (n^T M^-1 n) [kg]: the mass the stop feels (M2 for the paper's stop)."""
-        n = self.normal(mass_matrix.shape[0])
-        return float(1.0 / (n @ np.linalg.solve(mass_matrix, n)))
+        self.check_size(mass_matrix.shape[0])
+        return place_effective_mass(self.place, mass_matrix)
+
+    @classmethod
+    def bumper(
+        cls, mass_matrix: NDArray[np.float64], clearance: float, stiffness: float, damping: float | None = None, loss_factor: float | None = None,
+        coordinate: int = 1, other: int | None = None, side: str = "upper",
+    ) -> Stop:  # fmt: skip
+        """A stop with a Kelvin-Voigt bumper given in physical units on the structure of mass matrix M [kg]: stiffness
+        K [N m-1] and damping B [N s m-1] (or loss factor xi_b [-]), converted with the stop's own effective mass
+        (:meth:`KelvinVoigtBumper.from_stiffness`); ``coordinate``, ``other`` and ``side`` as for the class."""
+        place = cls(RigidStop(clearance, 1.0), coordinate, other, side)  # validates where it acts
+        place.check_size(mass_matrix.shape[0])
+        law = KelvinVoigtBumper.from_stiffness(clearance, stiffness, place.effective_mass(mass_matrix), damping, loss_factor)
+        return cls(law, coordinate, other, side)
 
     def describe(self, names: tuple[str, ...]) -> str:
         """E.g. ``x2 <= 3 mm`` or ``x2 - x1 >= -3 mm``: the constraint in words."""
@@ -359,6 +411,14 @@ def place_normal(place: tuple[int, int | None, str], size: int) -> NDArray[np.fl
     if other is not None:
         n[other] = -sign
     return n
+
+
+def place_effective_mass(place: tuple[int, int | None, str], mass_matrix: NDArray[np.float64]) -> float:
+    """m_eff = 1 / (n^T M^-1 n) [kg] of a stop acting at ``place`` = (coordinate, other, side) on a structure of mass
+    matrix M [kg]: the mass a bumper there pushes (M2 for the paper's stop, m_a m_b / (m_a + m_b) between two free
+    masses of a diagonal M)."""
+    n = place_normal(place, mass_matrix.shape[0])
+    return float(1.0 / (n @ np.linalg.solve(mass_matrix, n)))
 
 
 def describe_place(place: tuple[int, int | None, str], clearance: float, names: tuple[str, ...]) -> str:

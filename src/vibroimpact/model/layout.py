@@ -20,13 +20,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop, check_room, loss_factor_from_restitution, place_normal, restitution_from_loss_factor
+from vibroimpact.model.contact import (
+    KelvinVoigtBumper, RigidStop, Stop, check_room, loss_factor_from_restitution, place_effective_mass, place_normal, restitution_from_loss_factor,
+)  # fmt: skip
 from vibroimpact.model.excitation import HarmonicForce, SweptSine
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["Layout", "LoadSpec", "StopSpec", "PAPER_STOP", "build_stops", "describe_stop", "stop_descriptions", "NAMED_KEYS"]
+__all__ = ["Layout", "LoadSpec", "StopSpec", "PAPER_STOP", "build_stops", "describe_stop", "stop_descriptions", "bumper_units", "NAMED_KEYS"]
 
 #: The named system's parameters, as the attributes ``system_<key>`` record them.
 NAMED_KEYS = ("m1", "m2", "k1", "k2", "b1", "b2")
@@ -90,6 +92,12 @@ class StopSpec:
         Omega_b / 2 pi of this stop's bumper [Hz]; None: the grid value (the scene's ``bumper`` section or sweep).
     bumper_loss_factor : float or None
         xi_b [-]; None: the grid value, or the exact inverse of the stop's restitution.
+    bumper_stiffness : float or None
+        K_b [N m-1] where the scene gave the bumper in physical units (its words and attributes say it): the values
+        used are still ``bumper_frequency`` and ``bumper_loss_factor`` (or the grid's), converted with the stop's
+        effective mass (:meth:`effective_mass`); None: given as a frequency.
+    bumper_damping : float or None
+        B_b [N s m-1] where the scene gave it with ``bumper_stiffness``; None otherwise.
     """
 
     coordinate: int
@@ -99,6 +107,13 @@ class StopSpec:
     restitution: float | None = None
     bumper_frequency: float | None = None
     bumper_loss_factor: float | None = None
+    bumper_stiffness: float | None = None
+    bumper_damping: float | None = None
+
+    def effective_mass(self, structure: LinearStructure) -> float:
+        """m_eff = 1 / (n . M^-1 n) [kg]: the mass this stop's bumper pushes on ``structure``
+        (:func:`~vibroimpact.model.contact.place_effective_mass`)."""
+        return place_effective_mass(self.place, structure.mass_matrix)
 
     def stop(self, law: RigidStop | KelvinVoigtBumper) -> Stop:
         """The model's :class:`Stop` with contact law ``law``."""
@@ -153,8 +168,10 @@ def build_stops(specs: tuple[StopSpec, ...], bumper: bool, restitution: float, c
     return tuple(stops)
 
 
-def describe_stop(spec: StopSpec, names: tuple[str, ...], clearance: float | None = None, restitution: float | None = None) -> str:
-    """The stop in words, e.g. ``x2 - x1 <= 3 mm, R = 0.2`` (``Delta`` and ``R`` where the grid sweeps them)."""
+def describe_stop(spec: StopSpec, names: tuple[str, ...], clearance: float | None = None, restitution: float | None = None, bumper_frequency: float | None = None) -> str:
+    """The stop in words, e.g. ``x2 - x1 <= 3 mm, R = 0.2`` (``Delta`` and ``R`` where the grid sweeps them); a bumper
+    given in physical units as ``bumper K_b = 100000 N/m, B_b = 20 N s/m (Omega_b / 2 pi = 159.2 Hz)``, its
+    frequency the stop's own or ``bumper_frequency`` [Hz] (the grid's one value)."""
     delta = spec.clearance if spec.clearance is not None else clearance
     r = spec.restitution if spec.restitution is not None else restitution
     target = names[spec.coordinate] if spec.other is None else f"{names[spec.coordinate]} - {names[spec.other]}"
@@ -166,16 +183,31 @@ def describe_stop(spec: StopSpec, names: tuple[str, ...], clearance: float | Non
     words = f"{target} {relation} {bound}"
     if r is not None and np.isfinite(r):
         words += f", R = {r:g}"
-    if spec.bumper_frequency is not None:
+    if spec.bumper_stiffness is not None:
+        words += f", bumper {bumper_units(spec.bumper_stiffness, spec.bumper_damping)}"
+        fb = spec.bumper_frequency if spec.bumper_frequency is not None else bumper_frequency
+        if fb is not None and np.isfinite(fb):
+            words += f" (Omega_b / 2 pi = {fb:.4g} Hz)"
+    elif spec.bumper_frequency is not None:
         words += f", bumper {spec.bumper_frequency:g} Hz"
     return words
 
 
-def stop_descriptions(specs: tuple[StopSpec, ...], names: tuple[str, ...], restitution: np.ndarray, clearance: np.ndarray) -> tuple[str, ...]:
-    """Each stop in words; a value shared through a one-point grid is written out, a swept one as ``Delta``/``R``."""
+def bumper_units(stiffness: float, damping: float | None = None) -> str:
+    """A bumper in the physical units a scene gave: ``K_b = 100000 N/m, B_b = 20 N s/m`` (K_b [N m-1], B_b [N s m-1]
+    where given)."""
+    return f"K_b = {stiffness:g} N/m" + (f", B_b = {damping:g} N s/m" if damping is not None else "")
+
+
+def stop_descriptions(
+    specs: tuple[StopSpec, ...], names: tuple[str, ...], restitution: np.ndarray, clearance: np.ndarray, bumper_frequency: np.ndarray | None = None
+) -> tuple[str, ...]:
+    """Each stop in words; a value shared through a one-point grid is written out, a swept one as ``Delta``/``R``
+    (``bumper_frequency`` [Hz]: the grid's, said only beside a bumper given in physical units)."""
     delta = float(clearance[0]) if clearance.size == 1 else None
     r = float(restitution[0]) if restitution.size == 1 else None
-    return tuple(describe_stop(spec, names, delta, r) for spec in specs)
+    fb = float(bumper_frequency[0]) if bumper_frequency is not None and bumper_frequency.size == 1 else None
+    return tuple(describe_stop(spec, names, delta, r, fb) for spec in specs)
 
 
 def _attribute(values: object) -> object:
@@ -337,13 +369,15 @@ class Layout:
         return ImpactProblem(self._named if self._named is not None else self.structure, stops, excitation)
 
     # ------------------------------------------------------------- attributes
-    def attributes(self, restitution: np.ndarray, clearance: np.ndarray) -> dict[str, object]:
+    def attributes(self, restitution: np.ndarray, clearance: np.ndarray, bumper_frequency: np.ndarray | None = None) -> dict[str, object]:
         """What a dataset records of the layout (plain netCDF attributes: matrices flattened row by row, names and
         descriptions joined, one value per stop), read back by :meth:`from_attributes`.
 
         ``restitution`` [-] and ``clearance`` [m] are the values the study gives the stops that take them (one value:
         stated; several: swept). The named view's parameters (``system_m1`` ... ``system_b2``) are written where the
-        structure has one."""
+        structure has one. Where a stop's bumper was given in physical units, ``stop_bumper_stiffness_N_per_m`` and
+        ``stop_bumper_damping_N_s_per_m`` record them (one per stop, NaN where not given) and the stops' words say
+        them beside the grid's ``bumper_frequency`` [Hz]."""
         structure = self.structure
         size = structure.size
         specs = self.stops
@@ -361,7 +395,7 @@ class Layout:
             "excitation_weights": _attribute(self.load.weight_vector(size)),
             "excitation_static_N": _attribute(self.load.static_vector(size)),
             "stop_count": len(specs),
-            "stop_layout": "; ".join(stop_descriptions(specs, tuple(structure.coordinates), restitution, clearance)),
+            "stop_layout": "; ".join(stop_descriptions(specs, tuple(structure.coordinates), restitution, clearance, bumper_frequency)),
             "stop_coordinate": _attribute([spec.coordinate for spec in specs]),
             "stop_other": _attribute([-1 if spec.other is None else spec.other for spec in specs]),
             "stop_side": " ".join(spec.side for spec in specs),
@@ -369,6 +403,16 @@ class Layout:
             "stop_clearance_m": _attribute([
                 float(spec.clearance) if spec.clearance is not None else (float(clearance[0]) if clearance.size == 1 else np.nan) for spec in specs
             ]),  # fmt: skip
+        } | self._bumper_attributes()
+
+    def _bumper_attributes(self) -> dict[str, object]:
+        """K_b [N m-1] and B_b [N s m-1] of the stops whose bumpers were given in physical units (NaN where not); none
+        where no stop's was."""
+        if all(spec.bumper_stiffness is None for spec in self.stops):
+            return {}
+        return {
+            "stop_bumper_stiffness_N_per_m": _attribute([np.nan if spec.bumper_stiffness is None else spec.bumper_stiffness for spec in self.stops]),
+            "stop_bumper_damping_N_s_per_m": _attribute([np.nan if spec.bumper_damping is None else spec.bumper_damping for spec in self.stops]),
         }
 
     @classmethod
@@ -402,9 +446,12 @@ class Layout:
         else:
             described = [part.strip() for part in str(attrs["stop_layout"]).split(";")]
             clearances = np.array([_described_clearance(words, side) for words, side in zip(described, sides)])
+        given = [np.atleast_1d(np.asarray(attrs.get(key, np.nan), dtype=float)) for key in ("stop_bumper_stiffness_N_per_m", "stop_bumper_damping_N_s_per_m")]
+        k_b, b_b = (np.broadcast_to(values, clearances.shape) for values in given)  # the bumpers given in physical units
         stops = tuple(
-            StopSpec(int(i), None if j < 0 else int(j), side, None if not np.isfinite(d) else float(d))
-            for i, j, side, d in zip(coordinate, other, sides, clearances)
+            StopSpec(int(i), None if j < 0 else int(j), side, None if not np.isfinite(d) else float(d),
+                     bumper_stiffness=float(k) if np.isfinite(k) else None, bumper_damping=float(b) if np.isfinite(b) else None)
+            for i, j, side, d, k, b in zip(coordinate, other, sides, clearances, k_b, b_b)
         )  # fmt: skip
         base_motion = attrs.get("excitation_kind") == "base_motion"
         weights = tuple(float(w) for w in np.atleast_1d(np.asarray(attrs["excitation_weights"], dtype=float)))

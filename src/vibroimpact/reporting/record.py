@@ -22,14 +22,14 @@ import xarray as xr
 import yaml
 
 from vibroimpact.analysis.stability import Regime
-from vibroimpact.model.layout import Layout
+from vibroimpact.model.layout import Layout, bumper_units
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.kinds import KIND_NAMES
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 from vibroimpact.simulation.harmonics import base_force
 
-__all__ = ["SWEPT_SOLUTION", "StudyRecord", "StudySetting", "study_kind", "study_record", "study_setting", "stored_description", "GeneralSetting", "general_setting", "named_layout", "named_view", "is_general", "dataset_layout"]
+__all__ = ["SWEPT_SOLUTION", "StudyRecord", "StudySetting", "study_kind", "study_record", "study_setting", "stored_description", "GeneralSetting", "general_setting", "named_layout", "named_view", "is_general", "dataset_layout", "bumper_text"]
 
 #: The solution a swept-sine test runs: the compliant bumper (scenes allow no other); its estimates are the
 #: ``swept_<quantity>`` variables, not a value of the ``solution`` coordinate.
@@ -228,6 +228,19 @@ def named_layout(dataset: xr.Dataset) -> TwoDofSystem | None:
     if "system_size" not in dataset.attrs and "system_m1" not in dataset.attrs:
         return None
     return dataset_layout(dataset).paper_view()
+
+
+def bumper_text(attrs: Mapping[str, object], frequency: float) -> str:
+    """The bumper of Omega_b / 2 pi = ``frequency`` [Hz] in the units its scene gave: ``bumper 250 Hz``, or where
+    every stop's bumper was given as the same stiffness and damping (``stop_bumper_*`` attributes,
+    :meth:`~vibroimpact.model.layout.Layout.attributes`), ``bumper K_b = 100000 N/m, B_b = 20 N s/m (Omega_b / 2 pi
+    = 159.2 Hz)``."""
+    stiffness, damping = (np.atleast_1d(np.asarray(attrs.get(key, np.nan), dtype=float)) for key in ("stop_bumper_stiffness_N_per_m", "stop_bumper_damping_N_s_per_m"))
+    shared = np.isfinite(stiffness).all() and np.unique(stiffness).size == 1
+    same_damping = np.isnan(damping).all() or (np.isfinite(damping).all() and np.unique(damping).size == 1)
+    if not (shared and same_damping):
+        return f"bumper {frequency:g} Hz"
+    return f"bumper {bumper_units(float(stiffness[0]), float(damping[0]) if np.isfinite(damping[0]) else None)} (Omega_b / 2 pi = {frequency:.4g} Hz)"
 
 
 def is_general(dataset: xr.Dataset) -> bool:

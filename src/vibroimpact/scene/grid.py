@@ -23,9 +23,11 @@ from vibroimpact.engines.registry import BUMPER
 from vibroimpact.model.contact import loss_factor_from_restitution, restitution_from_loss_factor
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.modal import underdamped_mode_count
+from vibroimpact.scene.bumper_parse import BUMPER_KEYS, PHYSICAL_KEYS, scene_bumper
 from vibroimpact.scene.checker import Checker, SceneError, interval
 from vibroimpact.scene.header import check_sweep_run, parse_cluster, parse_names
-from vibroimpact.scene.layout_parse import check_layout_solutions, parse_layout, parse_sweep_stops, stop_grids
+from vibroimpact.scene.layout_parse import check_layout_solutions, parse_layout, parse_sweep_stops
+from vibroimpact.scene.stop_grids import stop_grids
 from vibroimpact.scene.schema import (
     ENGINE_CONTACT,
     ENGINE_SOLUTIONS,
@@ -162,10 +164,13 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     layout, amplitude, coordinates = parse_layout(c, doc)
 
     sweep = c.mapping("sweep", doc.get("sweep", {}), {*SWEEPABLE, "stop"}, {"frequency"}) if "sweep" in doc else {}
+    physical = isinstance(doc.get("bumper"), dict) and bool(doc["bumper"].keys() & PHYSICAL_KEYS)  # K_b [N/m], B_b [N s/m]
     fixed = {
         "stop": c.mapping("stop", doc["stop"], {"clearance", "restitution"}) if "stop" in doc else {},
-        "bumper": c.mapping("bumper", doc["bumper"], {"frequency", "loss_factor"}) if "bumper" in doc else {},
+        "bumper": c.mapping("bumper", doc["bumper"], BUMPER_KEYS) if "bumper" in doc and not physical else {},
     }
+    if physical:
+        fixed["bumper"], layout = scene_bumper(c, doc["bumper"], sweep, layout, "stops" in doc)
     solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
     scheduler = parse_cluster(c, doc)
     specs = layout.stops if layout is not None and "stops" in doc else None
@@ -207,8 +212,8 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     else:
         if needs_bumper and "bumper_frequency" not in sweep and "bumper" not in doc:
             c.fail("bumper", "required by the compliant solution and swept-sine tests: {frequency: Omega_b / 2 pi [Hz], loss_factor: xi_b (optional)}")
-        elif "bumper" in doc and "bumper_frequency" not in sweep and "frequency" not in fixed["bumper"]:
-            c.fail("bumper.frequency", "required unless swept (sweep.bumper_frequency): Omega_b / 2 pi [Hz] in (0, inf)")
+        elif "bumper" in doc and "bumper_frequency" not in sweep and "frequency" not in fixed["bumper"] and not physical:
+            c.fail("bumper.frequency", "required unless swept (sweep.bumper_frequency): Omega_b / 2 pi [Hz] in (0, inf), or bumper.stiffness [N/m] in (0, inf)")
         if bumper_solutions and "bumper_loss_factor" not in grids and (r := grids.get("restitution")) is not None and np.any(r == 0.0):
             c.fail("stop.restitution", "R = 0 needs an infinitely damped bumper for the compliant solution: give bumper.loss_factor, or sweep R > 0")
     if layout is not None and (specs is not None or "stops" not in doc):

@@ -23,20 +23,20 @@ its key and the allowed values, and returns None where a value is unusable.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from typing import Any, NamedTuple
 
 import numpy as np
 
 from vibroimpact.analysis.layout import layout_refusal
-from vibroimpact.model.contact import SIDES, restitution_from_loss_factor
+from vibroimpact.model.contact import SIDES, place_effective_mass
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.scene.checker import Checker, interval
+from vibroimpact.scene.bumper_parse import BumperSpec, parse_bumper
+from vibroimpact.scene.checker import Checker
 from vibroimpact.model.layout import PAPER_STOP, Layout, LoadSpec, StopSpec, build_stops
 
-__all__ = ["NAMED_SYSTEM_KEYS", "MATRIX_SYSTEM_KEYS", "EXCITATION_KEYS", "STOP_KEYS", "LayoutSection", "parse_layout", "parse_structure", "parse_load", "parse_stops", "parse_sweep_stops", "parse_stop_layout", "document_names", "check_layout_solutions", "pgf_refusal", "static_drift", "stop_grids"]
+__all__ = ["NAMED_SYSTEM_KEYS", "MATRIX_SYSTEM_KEYS", "EXCITATION_KEYS", "STOP_KEYS", "LayoutSection", "parse_layout", "parse_structure", "parse_load", "parse_stops", "parse_sweep_stops", "parse_stop_layout", "document_names", "check_layout_solutions", "pgf_refusal", "static_drift"]
 
 #: Keys of the paper's named system.
 NAMED_SYSTEM_KEYS = ("m1", "m2", "k1", "k2", "b1", "b2")
@@ -203,9 +203,10 @@ def _vector(c: Checker, key: str, value: Any, names: tuple[str, ...] | None, wha
     return tuple(float(x) for x in value)
 
 
-def parse_stops(c: Checker, value: Any, names: tuple[str, ...] | None, key: str = "stops") -> tuple[StopSpec, ...] | None:
+def parse_stops(c: Checker, value: Any, names: tuple[str, ...] | None, key: str = "stops", mass: np.ndarray | None = None) -> tuple[StopSpec, ...] | None:
     """``stops`` (or the list at ``key``): a non-empty list of {coordinate | between, side, clearance, restitution,
-    bumper}; None if unusable.
+    bumper}; None if unusable. ``mass``: the structure's mass matrix M [kg], which converts a bumper given in
+    physical units with its stop's effective mass (None: the structure is unusable).
 
     Values a stop does not give come from the sweep (or the scene's ``bumper`` section); which stop needs which
     value is checked by the caller, who knows what is swept.
@@ -216,7 +217,7 @@ def parse_stops(c: Checker, value: Any, names: tuple[str, ...] | None, key: str 
     if len(value) > MAX_STOPS:
         c.fail(key, f"{len(value)} stops is too many: allowed at most {MAX_STOPS}")
         return None
-    specs: list[StopSpec | None] = [_stop(c, f"{key}[{k}]", entry, names) for k, entry in enumerate(value)]
+    specs: list[StopSpec | None] = [_stop(c, f"{key}[{k}]", entry, names, mass) for k, entry in enumerate(value)]
     if any(spec is None for spec in specs):
         return None
     places = [(s.coordinate, s.other, s.side) for s in specs if s is not None]
@@ -227,7 +228,7 @@ def parse_stops(c: Checker, value: Any, names: tuple[str, ...] | None, key: str 
     return tuple(s for s in specs if s is not None)
 
 
-def _stop(c: Checker, key: str, entry: Any, names: tuple[str, ...] | None) -> StopSpec | None:
+def _stop(c: Checker, key: str, entry: Any, names: tuple[str, ...] | None, mass: np.ndarray | None) -> StopSpec | None:
     spec = c.mapping(key, entry, STOP_KEYS)
     if not isinstance(entry, dict):
         return None
@@ -255,22 +256,22 @@ def _stop(c: Checker, key: str, entry: Any, names: tuple[str, ...] | None) -> St
                     coordinate = None
     clearance = c.number(f"{key}.clearance", spec["clearance"], -math.inf, math.inf, False, False) if "clearance" in spec else None
     restitution = c.number(f"{key}.restitution", spec["restitution"], 0.0, 1.0) if "restitution" in spec else None
-    frequency = loss = None
+    bumper = BumperSpec()
     if "bumper" in spec:
-        bumper = c.mapping(f"{key}.bumper", spec["bumper"], {"frequency", "loss_factor"})
-        frequency = c.number(f"{key}.bumper.frequency", bumper["frequency"], 0.0, 1e6, low_inclusive=False) if "frequency" in bumper else None
-        loss = c.number(f"{key}.bumper.loss_factor", bumper["loss_factor"], 0.0, 1e3) if "loss_factor" in bumper else None
-        if "frequency" in bumper and frequency is None:
+        placed = mass is not None and side is not None and coordinate is not None and ("between" not in spec or other is not None)
+        effective_mass = place_effective_mass((coordinate, other, side), mass) if placed else None  # type: ignore[arg-type]
+        parsed = parse_bumper(c, f"{key}.bumper", spec["bumper"], effective_mass)
+        if parsed is None:
             return None
+        bumper = parsed
     failed = (
         names is None or side is None or coordinate is None or ("between" in spec and other is None)
         or ("clearance" in spec and clearance is None) or ("restitution" in spec and restitution is None)
-        or ("bumper" in spec and isinstance(spec["bumper"], dict) and "loss_factor" in spec["bumper"] and loss is None)
     )  # fmt: skip
     if failed:
         return None
     assert coordinate is not None and side is not None
-    return StopSpec(coordinate, other, side, clearance, restitution, frequency, loss)
+    return StopSpec(coordinate, other, side, clearance, restitution, bumper.frequency, bumper.loss_factor, bumper.stiffness, bumper.damping)
 
 
 def _index(c: Checker, key: str, name: Any, names: tuple[str, ...]) -> int | None:
@@ -319,7 +320,9 @@ def parse_stop_layout(c: Checker, doc: dict, system: TwoDofSystem | LinearStruct
         c.fail("stop", "give either 'stop' (the paper's stop above the absorber x2) or 'stops' (any layout), not both")
         return None
     if "stops" in doc:
-        return parse_stops(c, doc["stops"], document_names(doc.get("system")) if system is None else tuple(system.coordinates))
+        if system is None:
+            return parse_stops(c, doc["stops"], document_names(doc.get("system")))
+        return parse_stops(c, doc["stops"], tuple(system.coordinates), mass=system.mass_matrix)
     if system is not None and system.size != 2:
         c.fail("stops", f"required for a structure of {system.size} coordinates: the 'stop' section means the paper's stop above the absorber of two masses")
     return None
@@ -379,104 +382,3 @@ def check_layout_solutions(c: Checker, solutions: tuple[str, ...], layout: Layou
         c.fail("solutions", "linear does not apply: the static force pushes the structure along a rigid-body mode, so it has no steady state without its stops")
     if swept_sine and layout.load.base_motion:
         c.fail("excitation.base_motion", "a swept-sine test drives a force q sin(theta(t)) on the coordinates ('on'): a swept base motion is not supported; use base_motion: false")
-
-
-# --------------------------------------------------------------------------------------------------------------------
-# The grids of a general scene's stop values: what each stop takes from the sweep, from itself, or from ``bumper``.
-# --------------------------------------------------------------------------------------------------------------------
-
-#: Swept parameter -> (field of StopSpec, key of a stop entry, key of the scene's ``bumper`` section).
-_PARAMETERS = {
-    "restitution": ("restitution", "restitution", None),
-    "clearance": ("clearance", "clearance", None),
-    "bumper_frequency": ("bumper_frequency", "bumper.frequency", "frequency"),
-    "bumper_loss_factor": ("bumper_loss_factor", "bumper.loss_factor", "loss_factor"),
-}
-
-
-def stop_grids(
-    c: Checker,
-    specs: tuple[StopSpec, ...],
-    grids: dict[str, np.ndarray | None],
-    sweep: dict[str, Any],
-    bumper: dict[str, Any],
-    targets: tuple[int, ...] | None,
-    needs_bumper: bool,
-) -> tuple[StopSpec, ...]:
-    """Check which stop gets which value and fill ``grids`` (restitution, clearance, bumper_frequency,
-    bumper_loss_factor); return the stops with the values they take from the grid set to None.
-
-    Parameters
-    ----------
-    c : Checker
-        Records the problems.
-    specs : tuple of StopSpec
-        The stops as given.
-    grids : dict
-        The swept grids already checked (key: parameter); unswept ones are added here.
-    sweep : dict
-        The ``sweep`` section.
-    bumper : dict
-        The scene's ``bumper`` section (values every stop without its own bumper takes), checked by the caller.
-    targets : tuple of int or None
-        ``sweep.stop``: the stops swept values apply to (None: all).
-    needs_bumper : bool
-        A solution needs a bumper on every stop (``compliant``).
-    """
-    swept_to = set(range(len(specs))) if targets is None else set(targets)
-    out = [dataclasses.asdict(spec) for spec in specs]
-    for parameter, (field, key, bumper_key) in _PARAMETERS.items():
-        if parameter == "bumper_loss_factor" and "bumper_loss_factor" not in sweep and "loss_factor" not in bumper and all(s.bumper_loss_factor is None for s in specs):
-            continue  # each stop's loss factor follows its restitution
-        if parameter == "bumper_frequency" and not needs_bumper and "bumper_frequency" not in sweep:
-            continue  # no solution needs a bumper: the stops' own bumpers are not used
-        derived = parameter == "restitution" and "bumper_loss_factor" in sweep
-        values: list[float | None] = []
-        for k, spec in enumerate(specs):
-            own = getattr(spec, field)
-            if (parameter in sweep or derived) and k in swept_to:
-                if own is not None:
-                    c.fail(f"stops[{k}].{key}", f"also swept in sweep.{'bumper_loss_factor' if derived else parameter}: give it in one place only")
-                values.append(None)
-                continue
-            if own is None and bumper_key is not None and bumper_key in bumper:
-                own = bumper[bumper_key]
-            if own is None and parameter == "restitution" and spec.bumper_loss_factor is not None:
-                own = restitution_from_loss_factor(spec.bumper_loss_factor)  # R(xi_b) of the stop's own bumper
-            if own is None and parameter == "restitution" and "loss_factor" in bumper and isinstance(bumper["loss_factor"], (int, float)):
-                own = restitution_from_loss_factor(float(bumper["loss_factor"]))
-            if own is None and parameter != "bumper_loss_factor":
-                where = f"sweep.{parameter}" + ("" if targets is None else " with sweep.stop naming it")
-                extra = " or the scene's bumper section" if bumper_key is not None else ""
-                c.fail(f"stops[{k}].{key}", f"required unless swept ({where}{extra})")
-            values.append(own)
-            out[k][field] = own
-        given = [v for v in values if v is not None]
-        if parameter in sweep or derived:
-            if derived and grids.get("bumper_loss_factor") is not None:
-                grids["restitution"] = np.array([restitution_from_loss_factor(x) for x in grids["bumper_loss_factor"]])  # type: ignore[union-attr]
-            continue
-        if parameter == "bumper_loss_factor" and len(given) < len(values):
-            grids[parameter] = None  # some stops follow their restitution: no one loss factor
-            continue
-        if given and len(given) == len(values) and all(math.isclose(v, given[0], rel_tol=0.0, abs_tol=0.0) for v in given):
-            grids[parameter] = np.array([given[0]])
-            for entry in out:
-                entry[field] = None  # shared: the grid's one value
-        else:
-            grids[parameter] = np.array([math.nan])
-    _check_zero_restitution(c, out, grids, needs_bumper)
-    return tuple(StopSpec(**entry) for entry in out)
-
-
-def _check_zero_restitution(c: Checker, specs: list[dict[str, Any]], grids: dict[str, np.ndarray | None], needs_bumper: bool) -> None:
-    """R = 0 needs an infinitely damped bumper: a compliant solution needs the loss factor given for such a stop."""
-    if not needs_bumper or grids.get("bumper_loss_factor") is not None:
-        return
-    r_grid = grids.get("restitution")
-    for k, spec in enumerate(specs):
-        if spec["bumper_loss_factor"] is not None:
-            continue
-        values = [spec["restitution"]] if spec["restitution"] is not None else ([] if r_grid is None else list(r_grid))
-        if any(v == 0.0 for v in values):
-            c.fail(f"stops[{k}].restitution", f"R = 0 needs an infinitely damped bumper for the compliant solution: give the stop's bumper.loss_factor in {interval(0.0, 1e3)}, or R > 0")

@@ -16,7 +16,7 @@ from matplotlib.lines import Line2D
 from vibroimpact.grids.sections import stop_constraint
 from vibroimpact.kinds.stepped.crosscheck import subset_solutions
 from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
-from vibroimpact.reporting.record import GeneralSetting
+from vibroimpact.reporting.record import GeneralSetting, bumper_text
 from vibroimpact.reporting.page import DrawnFigure, Table
 from vibroimpact.reporting.series import SimulationMarkers, draw_curve, draw_linear, draw_points, periodic_points, stability_keys, unstable_points
 from vibroimpact.reporting.style import DISPLACEMENT_SCALE, DISPLACEMENT_UNITS, GENERAL_SOLUTION_DESCRIPTIONS, SOLUTION_COLOURS, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, solution_ref
@@ -37,7 +37,7 @@ def where_text(part: xr.Dataset) -> str:
     if "restitution" in part.coords and part["restitution"].ndim == 0:
         bits.append(f"R = {fmt(float(part['restitution']), 'g')}")
     if "bumper_frequency" in part.coords and part["bumper_frequency"].ndim == 0 and np.isfinite(float(part["bumper_frequency"])):
-        bits.append(f"bumper {fmt(float(part['bumper_frequency']), 'g')} Hz")
+        bits.append(bumper_text(part.attrs, float(part["bumper_frequency"])))  # in the scene's units
     return ", ".join(bits) if bits else "each stop's own values"
 
 

@@ -97,7 +97,7 @@ def general_coordinates(scene: Scene, grid: StudyGrid) -> dict[str, object]:
     count = len(scene.layout.stops)
     if count > 1 and any(q in STOP_QUANTITIES for q in scene.settings.quantities):
         coords["stop"] = np.arange(count, dtype=np.int32)  # CF 2.2 (netCDF classic types): no int64
-        coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.layout.stops, scene.coordinates, scene.settings.restitution, scene.settings.clearance), dtype=object))
+        coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.layout.stops, scene.coordinates, scene.settings.restitution, scene.settings.clearance, scene.settings.bumper_frequency), dtype=object))
     return coords
 
 

@@ -25,7 +25,7 @@ from matplotlib.lines import Line2D
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.grids.regime_map import regime_map
 from vibroimpact.grids.sections import SolutionsPage, layout_tables, linear_section, structure_figure
-from vibroimpact.reporting.record import GeneralSetting, general_setting, is_general, study_setting, SWEPT_SOLUTION
+from vibroimpact.reporting.record import GeneralSetting, bumper_text, general_setting, is_general, study_setting, SWEPT_SOLUTION
 from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.reporting.series import draw_curve, draw_linear, stability_keys, unstable_points
@@ -107,6 +107,8 @@ class SweptSineRun:
         Omega_b / 2 pi of the (first) bumper [Hz]; NaN where each stop has its own (the stops' descriptions say it).
     bumper_loss_factor : float
         xi_b of the (first) bumper [-]; NaN where each stop has its own.
+    bumper_words : str
+        The bumper in its scene's units (:func:`~vibroimpact.reporting.record.bumper_text`); empty: ``bumper_frequency``.
     """
 
     start_frequency: float
@@ -115,6 +117,7 @@ class SweptSineRun:
     window_cycles: int
     bumper_frequency: float
     bumper_loss_factor: float
+    bumper_words: str = ""
 
     def __post_init__(self) -> None:
         if not (0.0 < self.start_frequency and 0.0 < self.stop_frequency and 0.0 < self.rate):
@@ -127,7 +130,7 @@ class SweptSineRun:
 
     def text(self) -> str:
         """The sweep's range [Hz], rate [Hz/s], bumper [Hz], loss factor [-] and window [cycles], for captions."""
-        bumper = f"bumper {fmt(self.bumper_frequency, 'g')} Hz" if np.isfinite(self.bumper_frequency) else "each stop's own bumper"
+        bumper = (self.bumper_words or f"bumper {fmt(self.bumper_frequency, 'g')} Hz") if np.isfinite(self.bumper_frequency) else "each stop's own bumper"
         loss = f", xi_b = {fmt(self.bumper_loss_factor, '.4f')}" if np.isfinite(self.bumper_loss_factor) else ""
         return f"{fmt(self.start_frequency, 'g')} <-> {fmt(self.stop_frequency, 'g')} Hz at {fmt(self.rate, 'g')} Hz/s, {bumper}{loss}, estimator window {self.window_cycles} cycles"
 
@@ -147,6 +150,7 @@ def swept_sine_run(dataset: xr.Dataset) -> SweptSineRun:
         window_cycles=int(attrs["swept_sine_window_cycles"]),
         bumper_frequency=first("bumper_frequency"),
         bumper_loss_factor=first("bumper_loss_factor"),
+        bumper_words=bumper_text(attrs, first("bumper_frequency")) if np.isfinite(first("bumper_frequency")) else "",
     )
 
 

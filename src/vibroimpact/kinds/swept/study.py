@@ -213,7 +213,7 @@ class SweptStudy:
         several = count > 1 and any(q in STOP_QUANTITIES for q in scene.settings.quantities)
         if several:
             coords["stop"] = np.arange(count, dtype=np.int32)  # CF 2.2 (netCDF classic types): no int64
-            coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.layout.stops, scene.coordinates, scene.settings.restitution, scene.settings.clearance), dtype=object))
+            coords["stop_description"] = ("stop", np.array(stop_descriptions(scene.layout.stops, scene.coordinates, scene.settings.restitution, scene.settings.clearance, scene.settings.bumper_frequency), dtype=object))
 
         def stop_dims(quantity: str, dims: tuple[str, ...]) -> tuple[str, ...]:
             return ("stop", *dims) if quantity in STOP_QUANTITIES and several else dims
