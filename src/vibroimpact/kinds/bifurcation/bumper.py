@@ -31,13 +31,15 @@ import math
 import numpy as np
 import xarray as xr
 
+from vibroimpact.kinds.bifurcation.bumper_start import STIFF_START
 from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, ORBIT_PALETTE, SPECIAL_MARKERS, first_coordinate, flags
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
 from vibroimpact.kinds.bifurcation.stiffness import ON_CURVE, SOFTER, STIFFER, curve_pieces, on_piece
 from vibroimpact.reporting.page import DrawnFigure, Table
+from vibroimpact.runs.failures import as_lines
 from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure
 
-__all__ = ["has_bumpers", "rigid_view", "bumper_frequencies", "convergence_rows", "convergence_table", "bumper_answer", "bumper_figure", "MATCH_WINDOW", "SAME_POINT"]
+__all__ = ["has_bumpers", "rigid_view", "bumper_frequencies", "convergence_rows", "convergence_table", "bumper_answer", "absent_text", "bumper_figure", "MATCH_WINDOW", "SAME_POINT"]
 
 #: Largest distance [Hz] of the stiffest bumper's special point from the rigid stop's it is matched with.
 MATCH_WINDOW = 0.5
@@ -276,7 +278,18 @@ def bumper_answer(dataset: xr.Dataset) -> str:
         if missing:
             words.append(f"{len(missing)} of the rigid stop's {len(rows)} special points have no counterpart at some bumper (table)")
         parts.append(f"<p><b>R = {fmt(float(r), 'g')}, bumpers of {', '.join(fmt(fb, 'g') for fb in bumpers)} Hz against the rigid stop</b>: " + "; ".join(words) + ".</p>")
-    return "".join(parts)
+    return "".join(parts) + absent_text(dataset)
+
+
+def absent_text(dataset: xr.Dataset) -> str:
+    """The closed-form starts a bumper has no orbit for (``bumper_starts_without_orbit``), as HTML: an answer, not a
+    failure; empty when every start has one."""
+    lines = as_lines(dataset.attrs.get("bumper_starts_without_orbit"))
+    if not lines:
+        return ""
+    items = "".join(f"<li>{html.escape(line)}</li>" for line in lines)
+    return ("<p>Where a bumper has no one-contact orbit that the rigid stop has (an answer, not a failure: the rigid stop's orbit, followed in the bumper's "
+            f"stiffness from a bumper {fmt(STIFF_START, 'g')} times stiffer, vanishes before it reaches the scene's bumper; {len(lines)} start{'s' if len(lines) != 1 else ''}):</p><ul>{items}</ul>")
 
 
 def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:

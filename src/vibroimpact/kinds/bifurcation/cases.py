@@ -302,7 +302,7 @@ BRANCH_FIELDS = (
     "branch", "origin", "frequency", "amplitudes", "impulse", "floquet_modulus", "stable", "impacts", "period",
     "multipliers_real", "multipliers_imag", "velocities",
     "sp_branch", "sp_kind", "sp_frequency", "sp_amplitudes", "sp_impulse", "sp_floquet_modulus", "sp_impacts", "sp_period",
-    "sp_multipliers_real", "sp_multipliers_imag", "sp_note", "sp_found_on", "notes", *FAILURE_FIELDS,
+    "sp_multipliers_real", "sp_multipliers_imag", "sp_note", "sp_found_on", "notes", "absent", *FAILURE_FIELDS,
 )  # fmt: skip
 
 
@@ -348,7 +348,7 @@ class BranchCase:
 def branch_arrays(found: OrbitSet, size: int) -> CaseResult:
     """Flat arrays of an :class:`OrbitSet` of a structure of ``size`` coordinates (one row per branch point, one per
     special point; amplitudes (rows, N), multipliers (rows, 2N); ``sp_found_on``: the labels of every branch a special
-    point was found on, space-separated)."""
+    point was found on, space-separated; ``absent``: the closed-form starts a bumper has no orbit for, a line each)."""
 
     def column(rows: list[dict], name: str, dtype: type = float) -> np.ndarray:
         return np.array([row[name] for row in rows], dtype=dtype)
@@ -374,7 +374,7 @@ def branch_arrays(found: OrbitSet, size: int) -> CaseResult:
         "sp_floquet_modulus": column(specials, "floquet_modulus"), "sp_impacts": column(specials, "impacts", int),
         "sp_period": column(specials, "period", int), "sp_multipliers_real": sm.real, "sp_multipliers_imag": sm.imag,
         "sp_note": np.array([row["note"] for row in specials], dtype=str), "sp_found_on": np.array([" ".join(map(str, row["found_on"])) for row in specials], dtype=str),
-        "notes": np.array(found.notes, dtype=str), **failure_arrays(found.attempts, found.failures),
+        "notes": np.array(found.notes, dtype=str), "absent": np.array(found.absent, dtype=str), **failure_arrays(found.attempts, found.failures),
     }  # fmt: skip
 
 

@@ -22,6 +22,9 @@ Output (``bifurcation.nc``; attributes from :data:`vibroimpact.kinds.bifurcation
 * the chart: dimension ``chart_point`` with coordinates ``chart_curve``, ``chart_kind`` (flags as
   ``special_point_kind``), ``chart_frequency`` [Hz], ``chart_clearance`` [m]; the regime map ``chart_regime``
   (sweep, map_clearance, map_frequency) with ``chart_impacts_per_period`` and ``chart_period``.
+* with bumpers, ``bumper_starts_without_orbit`` (absent otherwise): the closed-form starts a bumper has no orbit for,
+  a line each, "R = <R>, bumper <Hz> Hz: the rigid stop's ... orbit at <f> Hz ... has no counterpart with this bumper:
+  <where its continuation in the bumper's stiffness turns back>" (an answer, not a failure);
 * what failed, when anything did (attributes, absent otherwise): ``run_failures``, one line per kind of work and
   restitution, "<what failed>: <k> of <n> failed (<reasons>); <what it means for the results>", and
   ``run_failure_details``, every raw message (:mod:`vibroimpact.kinds.bifurcation.logs`); the console gets one line.
@@ -416,6 +419,9 @@ def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult],
         lines = [f"R = {r:g}, bumper {fb:g} Hz: {note}" for (r, fb), result in zip(bumpers, results[start : start + len(bumpers)]) for note in result["notes"]]
         lines += [f"R = {r:g}, bumper stiffness: {note}" for r, result in zip(settings.restitution, curves) for note in result["notes"]]
         attrs["continuation_notes"] = "\n".join([attrs["continuation_notes"], *lines])
+        absent = [f"R = {r:g}, bumper {fb:g} Hz: {line}" for (r, fb), result in zip(bumpers, results[start : start + len(bumpers)]) for line in result["absent"]]
+        if absent:
+            attrs["bumper_starts_without_orbit"] = absent
         attrs["bumper_frequencies_Hz"] = np.array(settings.bumper_frequencies)
         attrs["method_bumper"] = ("the same layout with every stop a Kelvin-Voigt bumper of each Omega_b / 2 pi and the loss factor whose collision restitution is R "
                                   "(corrected eq. 26): branches started from the rigid stop's closed-form orbit shot on the bumper's map, continued on the exact "
