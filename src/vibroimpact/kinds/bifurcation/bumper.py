@@ -39,7 +39,7 @@ from vibroimpact.reporting.page import DrawnFigure, Table
 from vibroimpact.runs.failures import as_lines
 from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure
 
-__all__ = ["has_bumpers", "rigid_view", "bumper_frequencies", "convergence_rows", "convergence_table", "bumper_answer", "absent_text", "bumper_figure", "MATCH_WINDOW", "SAME_POINT"]
+__all__ = ["has_bumpers", "has_rigid", "diagram_models", "model_view", "rigid_view", "bumper_frequencies", "convergence_rows", "convergence_table", "bumper_answer", "absent_text", "bumper_figure", "MATCH_WINDOW", "SAME_POINT"]
 
 #: Largest distance [Hz] of the stiffest bumper's special point from the rigid stop's it is matched with.
 MATCH_WINDOW = 0.5
@@ -70,13 +70,44 @@ def has_bumpers(dataset: xr.Dataset) -> bool:
     return "branch_bumper_frequency" in dataset.coords or "branch_bumper_frequency" in dataset
 
 
+def diagram_models(dataset: xr.Dataset) -> list[float]:
+    """The contact models of a bumper dataset's diagrams, Omega_b / 2 pi [Hz]: the bumpers by increasing frequency,
+    then inf for the rigid stop where it ran (a dataset without the brute force's ``bumper_frequency`` holds the rigid
+    stop's brute force alone, and its diagram)."""
+    if "bumper_frequency" not in dataset.dims:
+        return [math.inf]
+    values = [float(f) for f in dataset["bumper_frequency"].values]
+    return sorted(f for f in values if math.isfinite(f)) + [f for f in values if math.isinf(f)]
+
+
+def has_rigid(dataset: xr.Dataset) -> bool:
+    """Does a bumper dataset hold the rigid stop's diagram, the reference its bumpers converge to?"""
+    return math.inf in diagram_models(dataset)
+
+
+def model_view(dataset: xr.Dataset, bumper: float) -> xr.Dataset:
+    """One diagram of a bumper dataset, shaped as a rigid scene's: the branch and special points of the bumpers of
+    ``bumper`` Hz (inf: the rigid stop) and their brute force (without the ``bumper_frequency`` dimension), with
+    ``diagram_label`` ("bumper 250 Hz", "rigid stop") and ``diagram_tag`` (a file-name suffix) in its attributes."""
+    points = np.flatnonzero(_of(dataset["branch_bumper_frequency"].values, bumper))
+    specials = np.flatnonzero(_of(dataset["special_point_bumper_frequency"].values, bumper))
+    view = dataset.isel(branch_point=points, special_point=specials).drop_vars(["branch_bumper_frequency", "special_point_bumper_frequency"])
+    if "bumper_frequency" in view.dims:
+        index = [float(f) for f in view["bumper_frequency"].values].index(bumper)
+        view = view.isel(bumper_frequency=index).drop_vars("bumper_frequency")
+    rigid = math.isinf(bumper)
+    return view.assign_attrs(diagram_label="rigid stop" if rigid else f"bumper {fmt(bumper, 'g')} Hz", diagram_tag="_rigid" if rigid else f"_bumper{fmt(bumper, 'g')}Hz",
+                             brute_force_engine="compiled exact engine" if rigid else "the bumper's compiled closed-form engine")  # fmt: skip
+
+
+def _of(values: np.ndarray, bumper: float) -> np.ndarray:
+    """Which of ``values`` [Hz] are ``bumper`` (both inf for the rigid stop; equal: the dataset's own values)."""
+    return np.isinf(values) if math.isinf(bumper) else values == bumper
+
+
 def rigid_view(dataset: xr.Dataset) -> xr.Dataset:
-    """The dataset with the rigid stop's branch and special points only (what the rest of the page draws)."""
-    if not has_bumpers(dataset):
-        return dataset
-    points = np.flatnonzero(np.isinf(dataset["branch_bumper_frequency"].values))
-    specials = np.flatnonzero(np.isinf(dataset["special_point_bumper_frequency"].values))
-    return dataset.isel(branch_point=points, special_point=specials).drop_vars(["branch_bumper_frequency", "special_point_bumper_frequency"])
+    """The dataset with the rigid stop's branch and special points only (unchanged without bumpers)."""
+    return model_view(dataset, math.inf) if has_bumpers(dataset) else dataset
 
 
 def bumper_frequencies(dataset: xr.Dataset) -> list[float]:
@@ -278,7 +309,7 @@ def bumper_answer(dataset: xr.Dataset) -> str:
         if missing:
             words.append(f"{len(missing)} of the rigid stop's {len(rows)} special points have no counterpart at some bumper (table)")
         parts.append(f"<p><b>R = {fmt(float(r), 'g')}, bumpers of {', '.join(fmt(fb, 'g') for fb in bumpers)} Hz against the rigid stop</b>: " + "; ".join(words) + ".</p>")
-    return "".join(parts) + absent_text(dataset)
+    return "".join(parts)
 
 
 def absent_text(dataset: xr.Dataset) -> str:

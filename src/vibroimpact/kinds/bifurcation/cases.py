@@ -1,8 +1,9 @@
 """The work of a bifurcation study as runner cases (:mod:`vibroimpact.runs.runner`): brute-force sweeps, the branches
 of one restitution, and the two-parameter chart's curves.
 
-* :class:`SweepCase`: a stepped sweep of the ``exact`` engine over frequencies (up or down), the end state carried to
-  the next frequency; at each frequency a transient is dropped, then the strobes of the first coordinate (X1 on the
+* :class:`SweepCase`: a stepped sweep over frequencies (up or down) of the engine with exact Jacobians for the
+  problem's contact law (the compiled exact engine for rigid stops, the bumper's closed-form engine for Kelvin-Voigt
+  bumpers), the end state carried to the next frequency; at each frequency a transient is dropped, then the strobes of the first coordinate (X1 on the
   paper's layout), its per-period fundamental and the impact velocities are kept and the motion is classified (:data:`MOTION_CLASSES`): linear, one impact per period,
   another periodic motion, or, where the strobes do not repeat, quasi-periodic, chaotic or irregular from the exact
   Jacobians (:func:`vibroimpact.orbits.motion.classify_motion`; from the strobes alone where a Jacobian is undefined,
@@ -27,6 +28,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable, Sequence
+from typing import Any
 from dataclasses import dataclass, asdict
 
 import numpy as np
@@ -34,6 +36,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.engines.exact import ExactEngine
+from vibroimpact.engines.registry import RIGID, engine_for, make_engine
 from vibroimpact.kinds.bifurcation.logs import FAILURE_FIELDS, failure_arrays
 from vibroimpact.kinds.bifurcation.branches import OrbitSet, map_bounds, problem_at, stop_values, MAX_ORBIT_IMPACTS, find_branches
 from vibroimpact.model.problem import ImpactProblem
@@ -205,15 +208,16 @@ REPEAT_TOLERANCE = 1e-6
 
 @dataclass(frozen=True, eq=False)
 class SweepCase:
-    """A stepped brute-force sweep of ``problem`` (its restitution and clearance) in one direction over
-    ``frequencies`` [Hz]; ``strobe`` and ``amplitude`` are the first coordinate's."""
+    """A stepped brute-force sweep of ``problem`` (its restitution and clearance; rigid stops or Kelvin-Voigt
+    bumpers) in one direction over ``frequencies`` [Hz] with ``engine`` (a registry name with exact Jacobians for the
+    problem's contact law); ``strobe`` and ``amplitude`` are the first coordinate's."""
 
     problem: ImpactProblem
     direction: str
     frequencies: tuple[float, ...]
     transient: int
     strobes: int
-    engine: str = "exact"
+    engine: str = engine_for(RIGID, "exact_jacobians")  # the registry's, by capability: exact Jacobians for the problem's contact law
     fields: tuple[str, ...] = ("strobe", "amplitude", "velocity", "impacts", "regime", "period", "lyapunov", "state", "error")
     progress_unit: str = "frequency points"
 
@@ -229,7 +233,7 @@ class SweepCase:
     def run(self, report: ProgressReport | None = None) -> CaseResult:
         """Arrays over the frequencies in increasing order (whatever the direction); ``error``: the raw message where
         the engine failed (``regime`` -1), else empty."""
-        engine = ExactEngine()
+        engine = make_engine(self.engine)
         f = np.array(self.frequencies)
         order = np.argsort(f) if self.direction == "up" else np.argsort(f)[::-1]
         n, s, width = f.size, self.strobes, 2 * self.problem.size
@@ -259,7 +263,7 @@ def _linear_start(problem: ImpactProblem) -> NDArray[np.float64]:
     return linear.state(problem.omega) if linear.fits(problem) else resting_state(problem)
 
 
-def _measure(engine: ExactEngine, problem: ImpactProblem, state: NDArray[np.float64], transient: int, strobes: int, out: dict, k: int) -> NDArray[np.float64]:
+def _measure(engine: Any, problem: ImpactProblem, state: NDArray[np.float64], transient: int, strobes: int, out: dict, k: int) -> NDArray[np.float64]:
     """Drop the transient, keep ``strobes`` periods at row ``k`` of ``out``; return the end state."""
     if transient:
         state = engine.integrate(problem, state, 0.0, transient).final_state

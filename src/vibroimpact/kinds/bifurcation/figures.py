@@ -159,20 +159,28 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
         if chosen.sizes["special_point"]:
             top.scatter(chosen["special_point_frequency"], chosen[f"special_point_{name}_amplitude"] * 1e3, marker=SPECIAL_MARKERS.get(kind, "x"), s=42,
                         facecolor="none", edgecolor="k", lw=1.2, zorder=5, label=KIND_NAMES.get(kind, kind))  # fmt: skip
-    finish_axes(top, "", f"|{label}| fundamental [mm]", f"R = {fmt(restitution, 'g')}: {label} amplitude")
-    finish_axes(bottom, _FREQUENCY, "impact velocity [m/s]", f"R = {fmt(restitution, 'g')}: impact velocities")
+    where = f"R = {fmt(restitution, 'g')}{_model(dataset)}"
+    finish_axes(top, "", f"|{label}| fundamental [mm]", f"{where}: {label} amplitude")
+    finish_axes(bottom, _FREQUENCY, "impact velocity [m/s]", f"{where}: impact velocities")
     dots = [Line2D([], [], ls="", marker="o", ms=5, color=SWEEP_COLOURS.get(str(d), "C7"), label=f"brute force, sweep {d}") for d in dataset["sweep"].values]
     extra = [*dots, Line2D([], [], color="k", **STABLE_STYLE, label="stable"), Line2D([], [], color="k", **UNSTABLE_STYLE, label="unstable")]
     figure_legend(fig, [top, bottom], [*_class_legend(looks, classes), *extra], columns=4)
     caption = (
-        f"Bifurcation diagram at R = {fmt(restitution, 'g')}, Delta = {fmt(float(dataset['clearance']) * 1e3, 'g')} mm. Dots: brute-force "
-        f"time simulation (compiled exact engine) sweeping up (vermillion) and down (sky blue), the end state carried to the next frequency; "
+        f"Bifurcation diagram at R = {fmt(restitution, 'g')}{_model(dataset)}, Delta = {fmt(float(dataset['clearance']) * 1e3, 'g')} mm. Dots: brute-force "
+        f"time simulation ({dataset.attrs.get('brute_force_engine', 'compiled exact engine')}) sweeping up (vermillion) and down (sky blue), the end state carried to the next frequency; "
         f"top: the {label} fundamental over each of the {dataset.sizes['strobe']} kept periods; bottom: the velocity of every impact in them. "
         "Lines: every continued branch (solid stable, dashed unstable; colour, and beyond four classes a small filled marker: the "
         "orbit's period and impacts, legend), the linear orbit where it fits inside the clearance in black; open black markers: the "
         "located special points (table below)."
     )
-    return DrawnFigure(fig, f"bifurcation_R{index}", f"Bifurcation diagram, R = {fmt(restitution, 'g')}", caption)
+    return DrawnFigure(fig, f"bifurcation_R{index}{dataset.attrs.get('diagram_tag', '')}", f"Bifurcation diagram, R = {fmt(restitution, 'g')}{_model(dataset)}", caption)
+
+
+def _model(dataset: xr.Dataset) -> str:
+    """The diagram's contact model after its R (", bumper 250 Hz", ", rigid stop"), from a bumper dataset's view
+    (:func:`~vibroimpact.kinds.bifurcation.bumper.model_view`); empty for a scene of rigid stops."""
+    label = str(dataset.attrs.get("diagram_label", ""))
+    return f", {label}" if label else ""
 
 
 def _specials(dataset: xr.Dataset, restitution: float) -> xr.Dataset:
@@ -195,12 +203,12 @@ def multiplier_figure(dataset: xr.Dataset, restitution: float, index: int) -> Dr
     ax.axhline(1.0, color="k", lw=0.8)
     specials = _specials(dataset, restitution)
     ax.scatter(specials["special_point_frequency"], specials["special_point_floquet_modulus"], s=30, facecolor="none", edgecolor="k", zorder=5, label="special points")
-    finish_axes(ax, _FREQUENCY, "largest |Floquet multiplier|", f"R = {fmt(restitution, 'g')}: stability along the branches", log=True)
+    finish_axes(ax, _FREQUENCY, "largest |Floquet multiplier|", f"R = {fmt(restitution, 'g')}{_model(dataset)}: stability along the branches", log=True)
     ax.set_ylim(0.2, MODULUS_TOP)
     figure_legend(fig, [ax], _class_legend(looks, seen), columns=4)
-    caption = (f"Largest modulus of the Floquet multipliers along every impacting branch at R = {fmt(restitution, 'g')} (log scale, "
+    caption = (f"Largest modulus of the Floquet multipliers along every impacting branch at R = {fmt(restitution, 'g')}{_model(dataset)} (log scale, "
                f"clipped at {fmt(MODULUS_TOP, 'g')}: next to a grazing point the multipliers grow without bound): an orbit is stable below 1 (the horizontal line); solid stable, dashed unstable; colour and marker: the orbit's period and impacts, as in the diagram; open circles: the special points.")  # fmt: skip
-    return DrawnFigure(fig, f"multipliers_R{index}", f"Floquet multipliers, R = {fmt(restitution, 'g')}", caption)
+    return DrawnFigure(fig, f"multipliers_R{index}{dataset.attrs.get('diagram_tag', '')}", f"Floquet multipliers, R = {fmt(restitution, 'g')}{_model(dataset)}", caption)
 
 
 def chart_figure(dataset: xr.Dataset) -> DrawnFigure:

@@ -68,9 +68,10 @@ def numbered_across(results: list[CaseResult]) -> list[CaseResult]:
     return [numbered(result, offset) for result, offset in zip(results, branch_offsets(results))]
 
 
-def continuation_log(restitutions: tuple[float, ...], results: list[CaseResult]) -> str:
-    """The branch cases' notes, one line each, "R = <R>: <note>" (``results`` :func:`numbered_across`)."""
-    return "\n".join(f"R = {r:g}: {note}" for r, result in zip(restitutions, results) for note in result["notes"])
+def continuation_log(diagrams: Sequence[float | str], results: list[CaseResult]) -> str:
+    """The branch cases' notes, one line each, "<diagram>: <note>" (``results`` :func:`numbered_across`), a diagram
+    named by its label ("R = 0.2, bumper 250 Hz") or by its restitution R ("R = <R>")."""
+    return "\n".join(f"{where if isinstance(where, str) else f'R = {where:g}'}: {note}" for where, result in zip(diagrams, results) for note in result["notes"])
 
 
 def chart_labels(chart: CaseResult, branches: CaseResult | None) -> dict[int, str]:
