@@ -63,3 +63,15 @@ def test_the_brute_force_of_a_bumper_integrates_the_bumper() -> None:
     bumper = orbit_measures(mapping, start.orbit).amplitudes[0]
     rigid = orbit_measures(twin, shoot(twin, start.orbit.state, twin.parameters)).amplitudes[0]
     assert np.nanmax(out["amplitude"][0]) == pytest.approx(bumper, rel=1e-6) and abs(bumper - rigid) > 1e-3 * rigid
+
+
+def test_the_linear_orbit_is_sampled_as_a_curve_on_a_narrow_band() -> None:
+    """A band 600 times narrower than the paper's still gets the contact-free orbit at >= 400 frequencies (its
+    closed form), not three points drawn as two straight lines; the paper's band keeps its 0.02 Hz step."""
+    from vibroimpact.kinds.bifurcation.branches import linear_segments
+
+    problem = diagram_problem(load_scene(find_scene("bifurcation_bumper")), 0.2)
+    (narrow,) = linear_segments(problem, 16.0, 16.05)
+    assert narrow.size >= 400 and narrow[0] == 16.0 and narrow[-1] == pytest.approx(16.05)  # exact: the band's start
+    wide = linear_segments(problem, 15.0, 45.0)
+    assert np.diff(wide[0][1:-1]).max() == pytest.approx(0.02)

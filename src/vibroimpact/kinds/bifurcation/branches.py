@@ -43,15 +43,26 @@ from vibroimpact.orbits.continuation import ContinuationSettings, continue_branc
 from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures, section_phase
 from vibroimpact.orbits.shooting import shoot
 
-__all__ = ["rigid_twin", "ORIGINS", "MAX_ORBIT_IMPACTS", "SAME_POINT_FREQUENCY", "SAME_POINT_ORBIT", "same_special_point", "map_bounds", "problem_at", "stop_values", "OrbitSet", "find_branches", "closed_form_orbits", "linear_segments"]
+__all__ = ["rigid_twin", "ORIGINS", "MAX_ORBIT_IMPACTS", "SAME_POINT_FREQUENCY", "SAME_POINT_ORBIT", "same_special_point", "map_bounds", "problem_at", "stop_values", "OrbitSet", "find_branches", "closed_form_orbits", "linear_segments", "band_step"]
 
 #: How a branch was found (CF flags of ``branch_origin``): the closed forms' kinds (one impact per period, the
 #: symmetric two impacts of a two-sided stop) are :data:`vibroimpact.analysis.layout.KINDS`.
 ORIGINS = ("linear", "one_impact", "period_doubling", "grazing", "brute_force", "two_impacts")
 #: Impact velocities kept per orbit (the rest are dropped; ``impacts_per_period`` counts them all).
 MAX_ORBIT_IMPACTS = 8
-#: Frequency step of the closed-form scan for closed-form starts [Hz].
+#: Frequency step of the closed-form scan for closed-form starts [Hz] (at most; a narrower band than
+#: :data:`MIN_POINTS` steps of it is scanned at band / MIN_POINTS) ...
 SCAN_STEP = 0.01
+#: ... and of the linear orbit's curve, sampled in closed form [Hz] (at most, likewise).
+LINEAR_STEP = 0.02
+#: Fewest scan and linear-orbit points over the band (a 0.05 Hz band of a 0.1 Hz structure is sampled as densely as
+#: the paper's 30 Hz band, relative to it, not in 3 points drawn as two straight lines) [-].
+MIN_POINTS = 400
+
+
+def band_step(low: float, high: float, step: float) -> float:
+    """``step`` [Hz], or (high - low) / :data:`MIN_POINTS` where that is finer (a narrow band)."""
+    return min(step, (high - low) / MIN_POINTS)
 #: Largest relative impulse difference of an orbit from a branch it is taken to lie on [-].
 SAME_ORBIT = 0.02
 #: Most branches born at grazing points per restitution (each may have its own grazing points).
@@ -246,8 +257,10 @@ def closed_form_orbits(problem: ImpactProblem, frequency: NDArray[np.float64]) -
     return [plus if root == "+" else plus.with_root(root) for root in ROOTS]
 
 
-def linear_segments(problem: ImpactProblem, low: float, high: float, step: float = 0.02) -> list[NDArray[np.float64]]:
-    """Frequency segments [Hz] where the linear orbit fits inside every stop, with their exact grazing ends."""
+def linear_segments(problem: ImpactProblem, low: float, high: float, step: float = LINEAR_STEP) -> list[NDArray[np.float64]]:
+    """Frequency segments [Hz] where the linear orbit fits inside every stop, with their exact grazing ends, sampled
+    every :func:`band_step` of ``step`` [Hz] (drawn as curves on any band)."""
+    step = band_step(low, high, step)
     frequency = np.arange(low, high + 0.5 * step, step)
     clearances = problem.clearances()
 
@@ -318,7 +331,8 @@ def find_branches(
     if refusal is not None:
         found.notes.append(f"no closed-form orbit for this layout ({refusal}): its branches come from the brute force")
     elif one_impact:
-        frequency = np.arange(low, high + 0.5 * SCAN_STEP, SCAN_STEP)
+        scan = band_step(low, high, SCAN_STEP)
+        frequency = np.arange(low, high + 0.5 * scan, scan)
         orbits = closed_form_orbits(reference, frequency)
         exists = np.logical_or.reduce([orbit.exists for orbit in orbits])
         for root, orbit in zip(ROOTS, orbits):

@@ -32,7 +32,7 @@ import numpy as np
 import xarray as xr
 
 from vibroimpact.kinds.bifurcation.bumper_start import STIFF_START
-from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, ORBIT_PALETTE, SPECIAL_MARKERS, first_coordinate, flags
+from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, ORBIT_PALETTE, SPECIAL_MARKERS, first_coordinate, flags, length_of
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
 from vibroimpact.kinds.bifurcation.stiffness import ON_CURVE, SOFTER, STIFFER, curve_pieces, on_piece
 from vibroimpact.reporting.page import DrawnFigure, Table
@@ -330,6 +330,7 @@ def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
     name = first_coordinate(dataset)
     label = coordinate_label(name)
     bumpers = bumper_frequencies(dataset)
+    unit, scale = length_of(dataset)
     colours = {math.inf: RIGID_COLOUR} | {fb: ORBIT_PALETTE[i % len(ORBIT_PALETTE)] for i, fb in enumerate(bumpers)}
     fig, (left, right) = new_figure(2, panel_height=4.6, columns=2, legend_rows=legend_rows(len(bumpers) + 16, 4))
     origins = flags(dataset["branch_origin"])
@@ -339,7 +340,7 @@ def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
         chosen = np.isin(dataset["branch_origin"].values, codes) & ((fb_points == fb) | (np.isinf(fb_points) & math.isinf(fb)))
         for branch in np.unique(dataset["branch"].values[chosen]):
             index = np.flatnonzero(chosen & (dataset["branch"].values == branch))
-            f, amp, stable = dataset["branch_frequency"].values[index], dataset[f"{name}_amplitude"].values[index] * 1e3, dataset["stable"].values[index] == 1
+            f, amp, stable = dataset["branch_frequency"].values[index], dataset[f"{name}_amplitude"].values[index] * scale, dataset["stable"].values[index] == 1
             change = np.flatnonzero(np.diff(stable.astype(int))) + 1
             for piece in np.split(np.arange(f.size), change):
                 run = np.append(piece, piece[-1] + 1) if piece.size and piece[-1] + 1 < f.size else piece
@@ -352,7 +353,7 @@ def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
         for fb in [math.inf, *bumpers]:
             chosen = (dataset["special_point_kind"].values == code) & ((sp_fb == fb) | (np.isinf(sp_fb) & math.isinf(fb)))
             if chosen.any():
-                left.scatter(dataset["special_point_frequency"].values[chosen], dataset[f"special_point_{name}_amplitude"].values[chosen] * 1e3, marker=SPECIAL_MARKERS.get(kind, "x"),
+                left.scatter(dataset["special_point_frequency"].values[chosen], dataset[f"special_point_{name}_amplitude"].values[chosen] * scale, marker=SPECIAL_MARKERS.get(kind, "x"),
                              s=46, facecolor="none", edgecolor=colours[fb], lw=1.3, zorder=5)  # fmt: skip
         left.scatter([], [], marker=SPECIAL_MARKERS.get(kind, "x"), s=46, facecolor="none", edgecolor="0.3", label=_name(kind))
     inverse = 1.0 / np.array(bumpers)
@@ -378,13 +379,13 @@ def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
         right.set_yscale("log")
         right.set_xticks(inverse, [f"1/{fmt(fb, 'g')}" for fb in bumpers])
         right.minorticks_off()
-    finish_axes(left, "excitation frequency [Hz]", f"|{label}| fundamental [mm]", f"{label} amplitude: one-impact branches, rigid stop and bumpers")
+    finish_axes(left, "excitation frequency [Hz]", f"|{label}| fundamental [{unit}]", f"{label} amplitude: one-impact branches, rigid stop and bumpers")
     finish_axes(right, "1 / (Omega_b / 2 pi) [1/Hz]", "|special point's frequency − rigid stop's| [Hz]", "convergence to the rigid stop's special points")
     figure_legend(fig, [left, right], columns=4)
     caption = (
         f"Left: the branches started from the closed form (one impact per period) of the rigid stop (black) and of Kelvin-Voigt bumpers of "
         f"{', '.join(fmt(fb, 'g') for fb in bumpers)} Hz ({', '.join(['blue', 'orange', 'green', 'pink'][: len(bumpers)])}), each with the loss factor whose "
-        f"collision restitution is R, Delta = {fmt(float(dataset['clearance']) * 1e3, 'g')} mm: the {label} fundamental, solid where stable, dashed where "
+        f"collision restitution is R, Delta = {fmt(float(dataset['clearance']) * scale, 'g')} {unit}: the {label} fundamental, solid where stable, dashed where "
         "unstable; open markers in the branch's colour: its special points. Right: the distance of each special point of the bumpers' branches from the "
         "rigid stop's against 1 / (Omega_b / 2 pi) [1/Hz], log-log, one colour per special point (legend: its kind and the rigid stop's frequency), "
         "markers at the bumpers of the study, lines: the special point followed in the bumper's stiffness (its curve from the stiffest bumper, "

@@ -40,6 +40,7 @@ from vibroimpact.engines.registry import RIGID, engine_for, make_engine
 from vibroimpact.kinds.bifurcation.logs import FAILURE_FIELDS, failure_arrays
 from vibroimpact.kinds.bifurcation.branches import OrbitSet, map_bounds, problem_at, stop_values, MAX_ORBIT_IMPACTS, find_branches
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.units import length_unit
 from vibroimpact.orbits.branch import lower_period_maps, SPECIAL_POINT_KINDS, Iterated
 from vibroimpact.orbits.continuation import continue_special_point, ContinuationSettings, continue_branch
 from vibroimpact.orbits.grazing_curve import trace_grazing
@@ -444,12 +445,18 @@ class ChartCase:
                     notes.append(failures[-1][1])
                     continue
                 f, d = special.values("frequency"), special.values("clearance")
-                notes.append(f"{point.kind} curve {curve} from {point.value:.4f} Hz {how}: {f.size} points, {d.min() * 1e3:.3f}-{d.max() * 1e3:.3f} mm, ends: {special.end}")
+                notes.append(f"{point.kind} curve {curve} from {point.value:.4f} Hz {how}: {f.size} points, {_span(d, clearance)}, ends: {special.end}")
                 rows += [(curve, kind, fi, di) for fi, di in zip(f, d)]
                 curve += 1
         table = np.array(rows, dtype=float).reshape(-1, 4)
         return {"curve": table[:, 0].astype(int), "kind": table[:, 1].astype(int), "frequency": table[:, 2], "clearance": table[:, 3], "notes": np.array(notes, dtype=str), **_branch_ranges(found),
                 **failure_arrays(attempts, failures)}  # fmt: skip
+
+
+def _span(clearances: np.ndarray, magnitude: float) -> str:
+    """The clearances of a curve [m] as "0.500-6.000 mm", in the unit of ``magnitude`` [m]."""
+    unit, factor = length_unit(magnitude)
+    return f"{clearances.min() * factor:.3f}-{clearances.max() * factor:.3f} {unit}"
 
 
 def _branch_ranges(found: OrbitSet) -> CaseResult:

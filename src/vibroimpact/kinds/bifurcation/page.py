@@ -20,7 +20,7 @@ from vibroimpact.reporting.page import Section, Table, saved
 from vibroimpact.reporting.style import fmt
 from vibroimpact.runs.failures import as_lines
 from vibroimpact.kinds.bifurcation.bumper import absent_text, bumper_answer, bumper_figure, convergence_table, diagram_models, has_bumpers, has_rigid, model_view
-from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, bifurcation_figures, branch_class, first_coordinate, flags as _flags, orbit_class, orbit_label as _orbit_label
+from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, bifurcation_figures, branch_class, first_coordinate, flags as _flags, length_of, orbit_class, orbit_label as _orbit_label
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
 
 __all__ = ["page_for", "BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class", "first_coordinate", "headline", "answer_text", "failure_text", "failure_details"]
@@ -56,6 +56,7 @@ def headline(dataset: xr.Dataset) -> str:
     """The answer in one line per restitution: the largest amplitude the brute force settles on, and at how many
     frequencies it settles on no periodic motion."""
     label = coordinate_label(first_coordinate(dataset))
+    unit, scale = length_of(dataset)
     frequency = dataset["frequency"].values
     lines = []
     for i, r in enumerate(dataset["restitution"].values):
@@ -63,7 +64,7 @@ def headline(dataset: xr.Dataset) -> str:
         top = ""
         if np.isfinite(amplitude).any():
             _j, k = np.unravel_index(int(np.nanargmax(amplitude)), amplitude.shape)
-            top = f"up to |{label}| = {fmt(amplitude[_j, k] * 1e3, '.3g')} mm (at {fmt(frequency[k], '.2f')} Hz), "
+            top = f"up to |{label}| = {fmt(amplitude[_j, k] * scale, '.3g')} {unit} (at {fmt(frequency[k], '.2f')} Hz), "
         lines.append(f"R = {fmt(r, 'g')}: {top}no periodic motion at {int(wild.sum())} of {frequency.size} frequencies")
     return "; ".join(lines)
 
@@ -176,6 +177,7 @@ def answer_text(dataset: xr.Dataset) -> str:
     amplitude, where on no periodic motion, where the two sweeps disagree: coexisting attractors), how many special
     points."""
     label = coordinate_label(first_coordinate(dataset))
+    unit, scale = length_of(dataset)
     meanings = _flags(dataset["brute_regime"])
     frequency = dataset["frequency"].values
     step = float(np.median(np.diff(frequency))) if frequency.size > 1 else 1.0
@@ -187,7 +189,7 @@ def answer_text(dataset: xr.Dataset) -> str:
         if np.isfinite(amplitude).any():
             j, k = np.unravel_index(int(np.nanargmax(amplitude)), amplitude.shape)
             kind = meanings[int(regime[j, k]) + 1].replace("_", " ")
-            words.append(f"the brute force settles at most on |{label}| = {fmt(amplitude[j, k] * 1e3, '.3g')} mm ({fmt(frequency[k], '.2f')} Hz, "
+            words.append(f"the brute force settles at most on |{label}| = {fmt(amplitude[j, k] * scale, '.3g')} {unit} ({fmt(frequency[k], '.2f')} Hz, "
                          f"sweeping {dataset['sweep'].values[j]}: {kind});")  # fmt: skip
         words.append(f"no periodic motion at {int(wild.sum())} of {frequency.size} frequencies{' (' + _ranges(frequency[wild], step) + ')' if wild.any() else ''};")
         if regime.shape[0] > 1:

@@ -58,6 +58,7 @@ import xarray as xr
 
 from vibroimpact.engines.registry import BUMPER, RIGID, engine_for
 from vibroimpact.model.contact import loss_factor_from_restitution
+from vibroimpact.model.units import length_text
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
@@ -250,7 +251,7 @@ def _tallies(scene: Scene, results: list[CaseResult], swept: list[CaseResult], c
     if chart is not None:
         where = f"R = {chart.restitution:g}"
         counted += tallies(results[-1], where)
-        labels = [f"Delta = {c * 1e3:.4g} mm, sweeping {d}" for c in chart.clearances for d in directions]
+        labels = [f"Delta = {length_text(c, '.4g', settings.clearance)}, sweeping {d}" for c in chart.clearances for d in directions]
         counted.append(sweep_tally("map", where, swept[len(_diagrams(scene)) * len(directions) :], labels, settings.chart_frequency))
     return counted
 
