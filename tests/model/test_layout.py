@@ -178,7 +178,7 @@ def test_a_clearance_the_grid_does_not_give_is_not_judged() -> None:
     """Without the grid's value (NaN) a stop that takes it leaves no pair refused; its own values still are."""
     layout = Layout(CHAIN, LoadSpec(), (StopSpec(0), StopSpec(0, side="lower", clearance=-1.0)))
     layout.check_room()
-    with pytest.raises(ValueError, match=r"stops: stop 0 \(a <= 1 mm\) and stop 1 \(a >= 1000 mm\) leave no room between them"):
+    with pytest.raises(ValueError, match=r"stops: stop 0 \(a <= 1 mm\) and stop 1 \(a >= 1 m\) leave no room between them"):
         layout.check_room(0.001)
     own = Layout(CHAIN, LoadSpec(), (StopSpec(0, clearance=0.001), StopSpec(0, side="lower", clearance=-0.001)))
     with pytest.raises(ValueError, match="leave no room"):

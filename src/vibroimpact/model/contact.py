@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import brentq
 
+from vibroimpact.model.units import length_text
 from vibroimpact.model.structure import require_finite, require_in_range, require_non_negative, require_positive
 
 
@@ -427,7 +428,7 @@ def describe_place(place: tuple[int, int | None, str], clearance: float, names: 
     target = names[coordinate] if other is None else f"{names[coordinate]} - {names[other]}"
     bound = clearance if side == "upper" else -clearance
     relation = "<=" if side == "upper" else ">="
-    return f"{target} {relation} {bound * 1e3 + 0.0:g} mm"  # + 0.0: no "-0 mm"
+    return f"{target} {relation} {length_text(bound)}"  # in the clearance's own unit: "3 mm", "1 m"
 
 
 def check_room(places: Sequence[tuple[int, int | None, str]], clearances: Sequence[float], names: tuple[str, ...]) -> None:

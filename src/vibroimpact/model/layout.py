@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from vibroimpact.model.units import LENGTH_UNITS, length_text
 from vibroimpact.model.contact import (
     KelvinVoigtBumper, RigidStop, Stop, check_room, loss_factor_from_restitution, place_effective_mass, place_normal, restitution_from_loss_factor,
 )  # fmt: skip
@@ -179,7 +180,7 @@ def describe_stop(spec: StopSpec, names: tuple[str, ...], clearance: float | Non
     if delta is None or not np.isfinite(delta):
         bound = "Delta" if spec.side == "upper" else "-Delta"
     else:
-        bound = f"{(delta if spec.side == 'upper' else -delta) * 1e3 + 0.0:g} mm"  # + 0.0: no "-0 mm"
+        bound = length_text(delta if spec.side == "upper" else -delta)  # in the clearance's own unit: "3 mm", "1 m"
     words = f"{target} {relation} {bound}"
     if r is not None and np.isfinite(r):
         words += f", R = {r:g}"
@@ -217,8 +218,8 @@ def _attribute(values: object) -> object:
     return flat[0].item() if flat.size == 1 else flat
 
 
-#: The bound of a stop's description (:func:`describe_stop`): ``<= 3 mm``, ``>= -2 mm``.
-_BOUND = re.compile(r"(<=|>=)\s*(-?[0-9.]+(?:e[-+]?[0-9]+)?) mm")
+#: The bound of a stop's description (:func:`describe_stop`): ``<= 3 mm``, ``>= -2 mm``, ``<= 1 m``.
+_BOUND = re.compile(r"(<=|>=)\s*(-?[0-9.]+(?:e[-+]?[0-9]+)?) (mm|m|µm)\b")
 
 
 def _described_clearance(words: str, side: str) -> float:
@@ -227,7 +228,7 @@ def _described_clearance(words: str, side: str) -> float:
     match = _BOUND.search(words.split(",")[0])
     if match is None:
         return float("nan")
-    value = float(match.group(2)) * 1e-3
+    value = float(match.group(2)) * {unit: metres for unit, metres, _ in LENGTH_UNITS}[match.group(3)]
     return value if side == "upper" else -value
 
 

@@ -45,7 +45,31 @@ def test_the_shipped_bumper_study_has_three_bumpers_beside_the_rigid_stop() -> N
     settings = scene.settings
     assert scene.kind == "bifurcation" and settings.restitution == (0.2,) and settings.chart is None
     assert settings.bumper_frequencies == (250.0, 1000.0, 4000.0) and (settings.low, settings.high) == (15.0, 45.0)
+    assert settings.reference == "rigid" and settings.models == (None, 250.0, 1000.0, 4000.0)  # it asks for the rigid stop as the reference
     assert parse_scene(document()).settings.bumper_frequencies == ()
+
+
+def test_a_bumper_scene_runs_its_bumpers_alone_unless_it_asks_for_the_rigid_reference() -> None:
+    """The rigid stop's diagram runs for a scene of rigid stops, or with ``reference: rigid``; a bumper scene without
+    it is its bumpers' alone."""
+    alone = parse_scene(document(bumper={"frequency": [1000.0]})).settings
+    assert alone.reference == "none" and not alone.rigid and alone.models == (1000.0,)
+    both = parse_scene(document(bumper={"frequency": [1000.0]}, reference="rigid")).settings
+    assert both.rigid and both.models == (None, 1000.0)
+    assert parse_scene(document()).settings.models == (None,)
+
+
+@pytest.mark.parametrize(
+    ("change", "words"),
+    [
+        ({"bumper": {"frequency": [1000.0]}, "reference": "rigid stop"}, "'rigid stop' is not allowed: use one of rigid, none"),
+        ({"bumper": {"frequency": [1000.0]}, "reference": True}, "True is not allowed: use one of rigid, none"),
+        ({"reference": "rigid"}, "a reference needs bifurcation.bumper"),
+    ],
+)
+def test_a_wrong_reference_names_its_key_and_the_allowed_values(change: dict[str, Any], words: str) -> None:
+    found = problems(document(**change))
+    assert any(p.startswith("bifurcation.reference") and words in p for p in found), found
 
 
 def test_a_small_scene_parses_with_defaults() -> None:

@@ -44,7 +44,7 @@ def test_a_non_periodic_point_is_classified_with_its_exponent() -> None:
 
 
 def test_an_undefined_jacobian_leaves_the_strobes_to_classify_the_motion(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(bifurcation_cases, "ExactEngine", UndefinedJacobian)
+    monkeypatch.setattr(bifurcation_cases, "make_engine", lambda name: UndefinedJacobian())  # the registry's engine, replaced
     out = SweepCase(AT_34_HZ, "up", (34.0,), 100, 64).run()
     assert MOTION_CLASSES[int(out["regime"][0])] in NON_PERIODIC
     assert np.isnan(out["lyapunov"][0]) and out["period"][0] == 0 and out["impacts"][0] > 0.25

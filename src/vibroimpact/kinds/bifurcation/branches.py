@@ -16,7 +16,8 @@ of a continuation are recorded, never fatal.
 
 A problem whose stops are Kelvin-Voigt bumpers has no closed form of its own: its one-contact branches start from its
 rigid twin's (:func:`rigid_twin`: the same stops, rigid, with the bumpers' restitution R), whose orbit is shot on the
-rigid map and then on the bumper's, and are continued on the bumper's exact stroboscopic map
+rigid map and continued to the bumper in its stiffness (:func:`~vibroimpact.kinds.bifurcation.bumper_start.bumper_start`;
+where it has none, ``OrbitSet.absent`` says so), and are continued on the bumper's exact stroboscopic map
 (:class:`~vibroimpact.orbits.maps.ImpactMap` picks its engine by capabilities); their grazing points are contact
 onsets at tangency.
 """
@@ -33,6 +34,7 @@ from scipy.optimize import brentq
 from vibroimpact.analysis.impact_orbit import ROOTS, ImpactOrbit, solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.kinds.bifurcation.bumper_start import bumper_start
 from vibroimpact.model.contact import BUMPER, RigidStop
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.bifurcations import switch_period_doubling
@@ -41,15 +43,26 @@ from vibroimpact.orbits.continuation import ContinuationSettings, continue_branc
 from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures, section_phase
 from vibroimpact.orbits.shooting import shoot
 
-__all__ = ["rigid_twin", "ORIGINS", "MAX_ORBIT_IMPACTS", "SAME_POINT_FREQUENCY", "SAME_POINT_ORBIT", "same_special_point", "map_bounds", "problem_at", "stop_values", "OrbitSet", "find_branches", "closed_form_orbits", "linear_segments"]
+__all__ = ["rigid_twin", "ORIGINS", "MAX_ORBIT_IMPACTS", "SAME_POINT_FREQUENCY", "SAME_POINT_ORBIT", "same_special_point", "map_bounds", "problem_at", "stop_values", "OrbitSet", "find_branches", "closed_form_orbits", "linear_segments", "band_step"]
 
 #: How a branch was found (CF flags of ``branch_origin``): the closed forms' kinds (one impact per period, the
 #: symmetric two impacts of a two-sided stop) are :data:`vibroimpact.analysis.layout.KINDS`.
 ORIGINS = ("linear", "one_impact", "period_doubling", "grazing", "brute_force", "two_impacts")
 #: Impact velocities kept per orbit (the rest are dropped; ``impacts_per_period`` counts them all).
 MAX_ORBIT_IMPACTS = 8
-#: Frequency step of the closed-form scan for closed-form starts [Hz].
+#: Frequency step of the closed-form scan for closed-form starts [Hz] (at most; a narrower band than
+#: :data:`MIN_POINTS` steps of it is scanned at band / MIN_POINTS) ...
 SCAN_STEP = 0.01
+#: ... and of the linear orbit's curve, sampled in closed form [Hz] (at most, likewise).
+LINEAR_STEP = 0.02
+#: Fewest scan and linear-orbit points over the band (a 0.05 Hz band of a 0.1 Hz structure is sampled as densely as
+#: the paper's 30 Hz band, relative to it, not in 3 points drawn as two straight lines) [-].
+MIN_POINTS = 400
+
+
+def band_step(low: float, high: float, step: float) -> float:
+    """``step`` [Hz], or (high - low) / :data:`MIN_POINTS` where that is finer (a narrow band)."""
+    return min(step, (high - low) / MIN_POINTS)
 #: Largest relative impulse difference of an orbit from a branch it is taken to lie on [-].
 SAME_ORBIT = 0.02
 #: Most branches born at grazing points per restitution (each may have its own grazing points).
@@ -113,7 +126,8 @@ class OrbitSet:
     """Branches and special points of one restitution, as lists of per-point records (see :meth:`add_branch`), and
     the continued branches with their maps (``maps``: (ImpactMap, Branch) pairs). A special point is kept once
     (:func:`same_special_point`), with the labels of every branch it was found on (``found_on``). What failed is
-    counted (``attempts`` and ``failures`` by kind of work: :meth:`attempted`, :meth:`failed`)."""
+    counted (``attempts`` and ``failures`` by kind of work: :meth:`attempted`, :meth:`failed`); ``absent`` says, a
+    line each, which closed-form starts a bumper has no orbit for (:class:`~vibroimpact.kinds.bifurcation.bumper_start.BumperStart`)."""
 
     points: list[dict] = field(default_factory=list)
     specials: list[dict] = field(default_factory=list)
@@ -122,11 +136,13 @@ class OrbitSet:
     maps: list = field(default_factory=list)
     attempts: dict[str, int] = field(default_factory=dict)
     failures: list[tuple[str, str]] = field(default_factory=list)
+    absent: list[str] = field(default_factory=list)
     _index: tuple | None = None
 
     def attempted(self, what: str) -> None:
-        """Count one attempt of a kind of work that may fail (``branch``: a branch's start and continuation,
-        ``seed``: a brute-force seed; :data:`vibroimpact.kinds.bifurcation.logs.FAILURES`)."""
+        """Count one attempt of a kind of work that may fail (``closed_form``, ``period_doubling``, ``grazing``: a
+        branch's start and continuation from there, ``seed``: a brute-force seed;
+        :data:`vibroimpact.kinds.bifurcation.logs.FAILURES`)."""
         self.attempts[what] = self.attempts.get(what, 0) + 1
 
     def failed(self, what: str, detail: str) -> None:
@@ -241,8 +257,10 @@ def closed_form_orbits(problem: ImpactProblem, frequency: NDArray[np.float64]) -
     return [plus if root == "+" else plus.with_root(root) for root in ROOTS]
 
 
-def linear_segments(problem: ImpactProblem, low: float, high: float, step: float = 0.02) -> list[NDArray[np.float64]]:
-    """Frequency segments [Hz] where the linear orbit fits inside every stop, with their exact grazing ends."""
+def linear_segments(problem: ImpactProblem, low: float, high: float, step: float = LINEAR_STEP) -> list[NDArray[np.float64]]:
+    """Frequency segments [Hz] where the linear orbit fits inside every stop, with their exact grazing ends, sampled
+    every :func:`band_step` of ``step`` [Hz] (drawn as curves on any band)."""
+    step = band_step(low, high, step)
     frequency = np.arange(low, high + 0.5 * step, step)
     clearances = problem.clearances()
 
@@ -296,12 +314,12 @@ def find_branches(
         if progress is not None:
             progress(f"R = {restitution:g}: {message}")
 
-    def attempt(what: str, run) -> None:
-        found.attempted("branch")
+    def attempt(kind: str, what: str, run) -> None:
+        found.attempted(kind)
         try:
             run()
         except Exception as error:  # noqa: BLE001 - a failed branch is recorded, the others go on
-            found.failed("branch", f"{what} failed: {type(error).__name__}: {str(error)[:200]}")
+            found.failed(kind, f"{what} failed: {type(error).__name__}: {str(error)[:200]}")
 
     maps: list[tuple[ImpactMap, Branch]] = []
     if linear:
@@ -313,7 +331,8 @@ def find_branches(
     if refusal is not None:
         found.notes.append(f"no closed-form orbit for this layout ({refusal}): its branches come from the brute force")
     elif one_impact:
-        frequency = np.arange(low, high + 0.5 * SCAN_STEP, SCAN_STEP)
+        scan = band_step(low, high, SCAN_STEP)
+        frequency = np.arange(low, high + 0.5 * scan, scan)
         orbits = closed_form_orbits(reference, frequency)
         exists = np.logical_or.reduce([orbit.exists for orbit in orbits])
         for root, orbit in zip(ROOTS, orbits):
@@ -330,10 +349,15 @@ def find_branches(
                 mapping = ImpactMap(problem_at(problem, f0, phase=phase), bounds=bounds)
 
                 def start(mapping: ImpactMap = mapping, f0: float = f0, root: str = root, kind: str = kind, phase: float = phase) -> None:
-                    if bumper:  # the rigid twin's orbit, shot, then shot again on the bumper's map
+                    if bumper:  # the rigid twin's orbit, shot, then continued to the bumper in its stiffness
                         twin = ImpactMap(problem_at(reference, f0, phase=phase), bounds=bounds)
-                        guess = shoot(twin, closed_form_state(twin.problem, solve_impact_orbit(twin.problem, root=root)), twin.parameters).state
-                        first = shoot(mapping, guess, mapping.parameters)
+                        rigid = shoot(twin, closed_form_state(twin.problem, solve_impact_orbit(twin.problem, root=root)), twin.parameters)
+                        begun = bumper_start(mapping, rigid)
+                        if begun.orbit is None:  # no such orbit of this bumper here: an answer, not a failure
+                            found.absent.append(f"the rigid stop's {kind.replace('_', '-')} orbit at {f0:.2f} Hz (root {root}) has no counterpart with this bumper: {begun.why}")
+                            found.notes.append(found.absent[-1])
+                            return
+                        first = begun.orbit
                         if found.known(f0, 1, first.impacts, float(orbit_measures(mapping, first).impulses.sum())):
                             return  # the bumper's branch from the other root already passed through it
                     else:
@@ -344,7 +368,7 @@ def find_branches(
                     maps.append((mapping, branch))
                     say(f"{kind.replace('_', '-')} branch {label} from {f0:.2f} Hz: {len(branch.orbits)} points, {len(branch.special_points)} special points")
 
-                attempt(f"{kind.replace('_', '-')} branch from {f0:.2f} Hz", start)
+                attempt("closed_form", f"{kind.replace('_', '-')} branch from {f0:.2f} Hz", start)
     if period_doubling:
         for mapping, branch in list(maps):
             for point in branch.special("period_doubling"):
@@ -358,7 +382,7 @@ def find_branches(
                     maps.append((mapping, child))
                     say(f"period-2 branch {label} from the period doubling at {point.value:.3f} Hz: {len(child.orbits)} points")
 
-                attempt(f"period-2 branch at {point.value:.3f} Hz", doubled)
+                attempt("period_doubling", f"period-2 branch at {point.value:.3f} Hz", doubled)
     if grazing:
         born = 0
         for mapping, branch in maps:  # grows while it runs: a born branch's own grazing points are visited too
@@ -380,7 +404,7 @@ def find_branches(
                     say(f"branch {label} born at the grazing point at {point.value:.3f} Hz: {len(child.orbits)} points")
 
                 born += 1
-                attempt(f"branch born at {point.value:.4f} Hz", beyond)
+                attempt("grazing", f"branch born at {point.value:.4f} Hz", beyond)
     found.maps = maps
     return found
 

@@ -31,13 +31,15 @@ import math
 import numpy as np
 import xarray as xr
 
-from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, ORBIT_PALETTE, SPECIAL_MARKERS, first_coordinate, flags
+from vibroimpact.kinds.bifurcation.bumper_start import STIFF_START
+from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, ORBIT_PALETTE, SPECIAL_MARKERS, first_coordinate, flags, length_of
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
 from vibroimpact.kinds.bifurcation.stiffness import ON_CURVE, SOFTER, STIFFER, curve_pieces, on_piece
 from vibroimpact.reporting.page import DrawnFigure, Table
+from vibroimpact.runs.failures import as_lines
 from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure
 
-__all__ = ["has_bumpers", "rigid_view", "bumper_frequencies", "convergence_rows", "convergence_table", "bumper_answer", "bumper_figure", "MATCH_WINDOW", "SAME_POINT"]
+__all__ = ["has_bumpers", "has_rigid", "diagram_models", "model_view", "rigid_view", "bumper_frequencies", "convergence_rows", "convergence_table", "bumper_answer", "absent_text", "bumper_figure", "MATCH_WINDOW", "SAME_POINT"]
 
 #: Largest distance [Hz] of the stiffest bumper's special point from the rigid stop's it is matched with.
 MATCH_WINDOW = 0.5
@@ -68,13 +70,44 @@ def has_bumpers(dataset: xr.Dataset) -> bool:
     return "branch_bumper_frequency" in dataset.coords or "branch_bumper_frequency" in dataset
 
 
+def diagram_models(dataset: xr.Dataset) -> list[float]:
+    """The contact models of a bumper dataset's diagrams, Omega_b / 2 pi [Hz]: the bumpers by increasing frequency,
+    then inf for the rigid stop where it ran (a dataset without the brute force's ``bumper_frequency`` holds the rigid
+    stop's brute force alone, and its diagram)."""
+    if "bumper_frequency" not in dataset.dims:
+        return [math.inf]
+    values = [float(f) for f in dataset["bumper_frequency"].values]
+    return sorted(f for f in values if math.isfinite(f)) + [f for f in values if math.isinf(f)]
+
+
+def has_rigid(dataset: xr.Dataset) -> bool:
+    """Does a bumper dataset hold the rigid stop's diagram, the reference its bumpers converge to?"""
+    return math.inf in diagram_models(dataset)
+
+
+def model_view(dataset: xr.Dataset, bumper: float) -> xr.Dataset:
+    """One diagram of a bumper dataset, shaped as a rigid scene's: the branch and special points of the bumpers of
+    ``bumper`` Hz (inf: the rigid stop) and their brute force (without the ``bumper_frequency`` dimension), with
+    ``diagram_label`` ("bumper 250 Hz", "rigid stop") and ``diagram_tag`` (a file-name suffix) in its attributes."""
+    points = np.flatnonzero(_of(dataset["branch_bumper_frequency"].values, bumper))
+    specials = np.flatnonzero(_of(dataset["special_point_bumper_frequency"].values, bumper))
+    view = dataset.isel(branch_point=points, special_point=specials).drop_vars(["branch_bumper_frequency", "special_point_bumper_frequency"])
+    if "bumper_frequency" in view.dims:
+        index = [float(f) for f in view["bumper_frequency"].values].index(bumper)
+        view = view.isel(bumper_frequency=index).drop_vars("bumper_frequency")
+    rigid = math.isinf(bumper)
+    return view.assign_attrs(diagram_label="rigid stop" if rigid else f"bumper {fmt(bumper, 'g')} Hz", diagram_tag="_rigid" if rigid else f"_bumper{fmt(bumper, 'g')}Hz",
+                             brute_force_engine="compiled exact engine" if rigid else "the bumper's compiled closed-form engine")  # fmt: skip
+
+
+def _of(values: np.ndarray, bumper: float) -> np.ndarray:
+    """Which of ``values`` [Hz] are ``bumper`` (both inf for the rigid stop; equal: the dataset's own values)."""
+    return np.isinf(values) if math.isinf(bumper) else values == bumper
+
+
 def rigid_view(dataset: xr.Dataset) -> xr.Dataset:
-    """The dataset with the rigid stop's branch and special points only (what the rest of the page draws)."""
-    if not has_bumpers(dataset):
-        return dataset
-    points = np.flatnonzero(np.isinf(dataset["branch_bumper_frequency"].values))
-    specials = np.flatnonzero(np.isinf(dataset["special_point_bumper_frequency"].values))
-    return dataset.isel(branch_point=points, special_point=specials).drop_vars(["branch_bumper_frequency", "special_point_bumper_frequency"])
+    """The dataset with the rigid stop's branch and special points only (unchanged without bumpers)."""
+    return model_view(dataset, math.inf) if has_bumpers(dataset) else dataset
 
 
 def bumper_frequencies(dataset: xr.Dataset) -> list[float]:
@@ -279,6 +312,17 @@ def bumper_answer(dataset: xr.Dataset) -> str:
     return "".join(parts)
 
 
+def absent_text(dataset: xr.Dataset) -> str:
+    """The closed-form starts a bumper has no orbit for (``bumper_starts_without_orbit``), as HTML: an answer, not a
+    failure; empty when every start has one."""
+    lines = as_lines(dataset.attrs.get("bumper_starts_without_orbit"))
+    if not lines:
+        return ""
+    items = "".join(f"<li>{html.escape(line)}</li>" for line in lines)
+    return ("<p>Where a bumper has no one-contact orbit that the rigid stop has (an answer, not a failure: the rigid stop's orbit, followed in the bumper's "
+            f"stiffness from a bumper {fmt(STIFF_START, 'g')} times stiffer, vanishes before it reaches the scene's bumper; {len(lines)} start{'s' if len(lines) != 1 else ''}):</p><ul>{items}</ul>")
+
+
 def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
     """Left: the closed-form branches of the rigid stop and of every bumper, the first coordinate's amplitude against
     frequency; right: each special point's distance from the rigid stop's against 1 / Omega_b (log-log, a slope-1
@@ -286,6 +330,7 @@ def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
     name = first_coordinate(dataset)
     label = coordinate_label(name)
     bumpers = bumper_frequencies(dataset)
+    unit, scale = length_of(dataset)
     colours = {math.inf: RIGID_COLOUR} | {fb: ORBIT_PALETTE[i % len(ORBIT_PALETTE)] for i, fb in enumerate(bumpers)}
     fig, (left, right) = new_figure(2, panel_height=4.6, columns=2, legend_rows=legend_rows(len(bumpers) + 16, 4))
     origins = flags(dataset["branch_origin"])
@@ -295,7 +340,7 @@ def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
         chosen = np.isin(dataset["branch_origin"].values, codes) & ((fb_points == fb) | (np.isinf(fb_points) & math.isinf(fb)))
         for branch in np.unique(dataset["branch"].values[chosen]):
             index = np.flatnonzero(chosen & (dataset["branch"].values == branch))
-            f, amp, stable = dataset["branch_frequency"].values[index], dataset[f"{name}_amplitude"].values[index] * 1e3, dataset["stable"].values[index] == 1
+            f, amp, stable = dataset["branch_frequency"].values[index], dataset[f"{name}_amplitude"].values[index] * scale, dataset["stable"].values[index] == 1
             change = np.flatnonzero(np.diff(stable.astype(int))) + 1
             for piece in np.split(np.arange(f.size), change):
                 run = np.append(piece, piece[-1] + 1) if piece.size and piece[-1] + 1 < f.size else piece
@@ -308,7 +353,7 @@ def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
         for fb in [math.inf, *bumpers]:
             chosen = (dataset["special_point_kind"].values == code) & ((sp_fb == fb) | (np.isinf(sp_fb) & math.isinf(fb)))
             if chosen.any():
-                left.scatter(dataset["special_point_frequency"].values[chosen], dataset[f"special_point_{name}_amplitude"].values[chosen] * 1e3, marker=SPECIAL_MARKERS.get(kind, "x"),
+                left.scatter(dataset["special_point_frequency"].values[chosen], dataset[f"special_point_{name}_amplitude"].values[chosen] * scale, marker=SPECIAL_MARKERS.get(kind, "x"),
                              s=46, facecolor="none", edgecolor=colours[fb], lw=1.3, zorder=5)  # fmt: skip
         left.scatter([], [], marker=SPECIAL_MARKERS.get(kind, "x"), s=46, facecolor="none", edgecolor="0.3", label=_name(kind))
     inverse = 1.0 / np.array(bumpers)
@@ -334,13 +379,13 @@ def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
         right.set_yscale("log")
         right.set_xticks(inverse, [f"1/{fmt(fb, 'g')}" for fb in bumpers])
         right.minorticks_off()
-    finish_axes(left, "excitation frequency [Hz]", f"|{label}| fundamental [mm]", f"{label} amplitude: one-impact branches, rigid stop and bumpers")
+    finish_axes(left, "excitation frequency [Hz]", f"|{label}| fundamental [{unit}]", f"{label} amplitude: one-impact branches, rigid stop and bumpers")
     finish_axes(right, "1 / (Omega_b / 2 pi) [1/Hz]", "|special point's frequency − rigid stop's| [Hz]", "convergence to the rigid stop's special points")
     figure_legend(fig, [left, right], columns=4)
     caption = (
         f"Left: the branches started from the closed form (one impact per period) of the rigid stop (black) and of Kelvin-Voigt bumpers of "
         f"{', '.join(fmt(fb, 'g') for fb in bumpers)} Hz ({', '.join(['blue', 'orange', 'green', 'pink'][: len(bumpers)])}), each with the loss factor whose "
-        f"collision restitution is R, Delta = {fmt(float(dataset['clearance']) * 1e3, 'g')} mm: the {label} fundamental, solid where stable, dashed where "
+        f"collision restitution is R, Delta = {fmt(float(dataset['clearance']) * scale, 'g')} {unit}: the {label} fundamental, solid where stable, dashed where "
         "unstable; open markers in the branch's colour: its special points. Right: the distance of each special point of the bumpers' branches from the "
         "rigid stop's against 1 / (Omega_b / 2 pi) [1/Hz], log-log, one colour per special point (legend: its kind and the rigid stop's frequency), "
         "markers at the bumpers of the study, lines: the special point followed in the bumper's stiffness (its curve from the stiffest bumper, "

@@ -1,8 +1,9 @@
 """The work of a bifurcation study as runner cases (:mod:`vibroimpact.runs.runner`): brute-force sweeps, the branches
 of one restitution, and the two-parameter chart's curves.
 
-* :class:`SweepCase`: a stepped sweep of the ``exact`` engine over frequencies (up or down), the end state carried to
-  the next frequency; at each frequency a transient is dropped, then the strobes of the first coordinate (X1 on the
+* :class:`SweepCase`: a stepped sweep over frequencies (up or down) of the engine with exact Jacobians for the
+  problem's contact law (the compiled exact engine for rigid stops, the bumper's closed-form engine for Kelvin-Voigt
+  bumpers), the end state carried to the next frequency; at each frequency a transient is dropped, then the strobes of the first coordinate (X1 on the
   paper's layout), its per-period fundamental and the impact velocities are kept and the motion is classified (:data:`MOTION_CLASSES`): linear, one impact per period,
   another periodic motion, or, where the strobes do not repeat, quasi-periodic, chaotic or irregular from the exact
   Jacobians (:func:`vibroimpact.orbits.motion.classify_motion`; from the strobes alone where a Jacobian is undefined,
@@ -27,6 +28,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable, Sequence
+from typing import Any
 from dataclasses import dataclass, asdict
 
 import numpy as np
@@ -34,9 +36,11 @@ from numpy.typing import NDArray
 
 from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.engines.exact import ExactEngine
+from vibroimpact.engines.registry import RIGID, engine_for, make_engine
 from vibroimpact.kinds.bifurcation.logs import FAILURE_FIELDS, failure_arrays
 from vibroimpact.kinds.bifurcation.branches import OrbitSet, map_bounds, problem_at, stop_values, MAX_ORBIT_IMPACTS, find_branches
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.units import length_unit
 from vibroimpact.orbits.branch import lower_period_maps, SPECIAL_POINT_KINDS, Iterated
 from vibroimpact.orbits.continuation import continue_special_point, ContinuationSettings, continue_branch
 from vibroimpact.orbits.grazing_curve import trace_grazing
@@ -205,15 +209,16 @@ REPEAT_TOLERANCE = 1e-6
 
 @dataclass(frozen=True, eq=False)
 class SweepCase:
-    """A stepped brute-force sweep of ``problem`` (its restitution and clearance) in one direction over
-    ``frequencies`` [Hz]; ``strobe`` and ``amplitude`` are the first coordinate's."""
+    """A stepped brute-force sweep of ``problem`` (its restitution and clearance; rigid stops or Kelvin-Voigt
+    bumpers) in one direction over ``frequencies`` [Hz] with ``engine`` (a registry name with exact Jacobians for the
+    problem's contact law); ``strobe`` and ``amplitude`` are the first coordinate's."""
 
     problem: ImpactProblem
     direction: str
     frequencies: tuple[float, ...]
     transient: int
     strobes: int
-    engine: str = "exact"
+    engine: str = engine_for(RIGID, "exact_jacobians")  # the registry's, by capability: exact Jacobians for the problem's contact law
     fields: tuple[str, ...] = ("strobe", "amplitude", "velocity", "impacts", "regime", "period", "lyapunov", "state", "error")
     progress_unit: str = "frequency points"
 
@@ -229,7 +234,7 @@ class SweepCase:
     def run(self, report: ProgressReport | None = None) -> CaseResult:
         """Arrays over the frequencies in increasing order (whatever the direction); ``error``: the raw message where
         the engine failed (``regime`` -1), else empty."""
-        engine = ExactEngine()
+        engine = make_engine(self.engine)
         f = np.array(self.frequencies)
         order = np.argsort(f) if self.direction == "up" else np.argsort(f)[::-1]
         n, s, width = f.size, self.strobes, 2 * self.problem.size
@@ -259,7 +264,7 @@ def _linear_start(problem: ImpactProblem) -> NDArray[np.float64]:
     return linear.state(problem.omega) if linear.fits(problem) else resting_state(problem)
 
 
-def _measure(engine: ExactEngine, problem: ImpactProblem, state: NDArray[np.float64], transient: int, strobes: int, out: dict, k: int) -> NDArray[np.float64]:
+def _measure(engine: Any, problem: ImpactProblem, state: NDArray[np.float64], transient: int, strobes: int, out: dict, k: int) -> NDArray[np.float64]:
     """Drop the transient, keep ``strobes`` periods at row ``k`` of ``out``; return the end state."""
     if transient:
         state = engine.integrate(problem, state, 0.0, transient).final_state
@@ -302,7 +307,7 @@ BRANCH_FIELDS = (
     "branch", "origin", "frequency", "amplitudes", "impulse", "floquet_modulus", "stable", "impacts", "period",
     "multipliers_real", "multipliers_imag", "velocities",
     "sp_branch", "sp_kind", "sp_frequency", "sp_amplitudes", "sp_impulse", "sp_floquet_modulus", "sp_impacts", "sp_period",
-    "sp_multipliers_real", "sp_multipliers_imag", "sp_note", "sp_found_on", "notes", *FAILURE_FIELDS,
+    "sp_multipliers_real", "sp_multipliers_imag", "sp_note", "sp_found_on", "notes", "absent", *FAILURE_FIELDS,
 )  # fmt: skip
 
 
@@ -348,7 +353,7 @@ class BranchCase:
 def branch_arrays(found: OrbitSet, size: int) -> CaseResult:
     """Flat arrays of an :class:`OrbitSet` of a structure of ``size`` coordinates (one row per branch point, one per
     special point; amplitudes (rows, N), multipliers (rows, 2N); ``sp_found_on``: the labels of every branch a special
-    point was found on, space-separated)."""
+    point was found on, space-separated; ``absent``: the closed-form starts a bumper has no orbit for, a line each)."""
 
     def column(rows: list[dict], name: str, dtype: type = float) -> np.ndarray:
         return np.array([row[name] for row in rows], dtype=dtype)
@@ -374,7 +379,7 @@ def branch_arrays(found: OrbitSet, size: int) -> CaseResult:
         "sp_floquet_modulus": column(specials, "floquet_modulus"), "sp_impacts": column(specials, "impacts", int),
         "sp_period": column(specials, "period", int), "sp_multipliers_real": sm.real, "sp_multipliers_imag": sm.imag,
         "sp_note": np.array([row["note"] for row in specials], dtype=str), "sp_found_on": np.array([" ".join(map(str, row["found_on"])) for row in specials], dtype=str),
-        "notes": np.array(found.notes, dtype=str), **failure_arrays(found.attempts, found.failures),
+        "notes": np.array(found.notes, dtype=str), "absent": np.array(found.absent, dtype=str), **failure_arrays(found.attempts, found.failures),
     }  # fmt: skip
 
 
@@ -440,12 +445,18 @@ class ChartCase:
                     notes.append(failures[-1][1])
                     continue
                 f, d = special.values("frequency"), special.values("clearance")
-                notes.append(f"{point.kind} curve {curve} from {point.value:.4f} Hz {how}: {f.size} points, {d.min() * 1e3:.3f}-{d.max() * 1e3:.3f} mm, ends: {special.end}")
+                notes.append(f"{point.kind} curve {curve} from {point.value:.4f} Hz {how}: {f.size} points, {_span(d, clearance)}, ends: {special.end}")
                 rows += [(curve, kind, fi, di) for fi, di in zip(f, d)]
                 curve += 1
         table = np.array(rows, dtype=float).reshape(-1, 4)
         return {"curve": table[:, 0].astype(int), "kind": table[:, 1].astype(int), "frequency": table[:, 2], "clearance": table[:, 3], "notes": np.array(notes, dtype=str), **_branch_ranges(found),
                 **failure_arrays(attempts, failures)}  # fmt: skip
+
+
+def _span(clearances: np.ndarray, magnitude: float) -> str:
+    """The clearances of a curve [m] as "0.500-6.000 mm", in the unit of ``magnitude`` [m]."""
+    unit, factor = length_unit(magnitude)
+    return f"{clearances.min() * factor:.3f}-{clearances.max() * factor:.3f} {unit}"
 
 
 def _branch_ranges(found: OrbitSet) -> CaseResult:

@@ -20,10 +20,11 @@ from matplotlib.patches import Patch
 
 from vibroimpact.reporting.page import DrawnFigure
 from vibroimpact.analysis.stability import Regime
+from vibroimpact.model.units import length_unit
 from vibroimpact.reporting.style import REGIME_COLOURS, STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure, SWEEP_COLOURS
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
 
-__all__ = ["KIND_NAMES", "bifurcation_figures", "diagram_figure", "multiplier_figure", "chart_figure", "orbit_class", "branch_class", "orbit_looks", "orbit_label", "first_coordinate", "flags"]
+__all__ = ["KIND_NAMES", "bifurcation_figures", "diagram_figure", "multiplier_figure", "chart_figure", "orbit_class", "branch_class", "orbit_looks", "orbit_label", "first_coordinate", "flags", "length_of"]
 
 #: How the page names each kind of special point.
 KIND_NAMES = {"fold": "fold", "period_doubling": "period doubling", "neimark_sacker": "Neimark-Sacker", "grazing": "grazing"}
@@ -49,6 +50,12 @@ CURVE_COLOURS = {"fold": "k", "period_doubling": "#E69F00", "neimark_sacker": "#
 _FREQUENCY = "excitation frequency [Hz]"
 #: Top of the multiplier figure's axis [-].
 MODULUS_TOP = 20.0
+
+
+def length_of(dataset: xr.Dataset) -> tuple[str, float]:
+    """The page's unit of lengths and its factor from metres, chosen from the clearance (:func:`length_unit`: "mm"
+    for 3 mm, "m" for 1 m)."""
+    return length_unit(float(dataset["clearance"])) if "clearance" in dataset.variables else length_unit(0.0)
 
 
 def first_coordinate(dataset: xr.Dataset) -> str:
@@ -131,6 +138,7 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
     keys = _classes(dataset, restitution)
     name = first_coordinate(dataset)
     label = coordinate_label(name)
+    unit, scale = length_of(dataset)
     fig, (top, bottom) = new_figure(2, panel_height=4.2, columns=1, sharex=True, legend_rows=legend_rows(len(keys) + 8, 4))
     classes: set[tuple[int, int]] = set()
     r_index = int(np.argmin(np.abs(dataset["restitution"].values - restitution)))
@@ -138,7 +146,7 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
         brute = dataset.isel(restitution=r_index).sel(sweep=direction)
         f = brute["frequency"].values
         amp = brute[f"brute_{name}_amplitude"].values
-        top.scatter(np.repeat(f, amp.shape[1]), amp.ravel() * 1e3, s=1.5, color=SWEEP_COLOURS.get(str(direction), "C7"), alpha=0.6, lw=0, zorder=1)
+        top.scatter(np.repeat(f, amp.shape[1]), amp.ravel() * scale, s=1.5, color=SWEEP_COLOURS.get(str(direction), "C7"), alpha=0.6, lw=0, zorder=1)
         vel = brute["brute_impact_velocity"].values
         bottom.scatter(np.repeat(f, vel.shape[1]), vel.ravel(), s=1.5, color=SWEEP_COLOURS.get(str(direction), "C7"), alpha=0.6, lw=0, zorder=1)
     looks = orbit_looks(dataset, restitution)
@@ -147,7 +155,7 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
         key = branch_class(branch["impacts_per_period"].values, branch["period_multiplicity"].values)
         classes.add(key)
         stable = branch["stable"].values == 1
-        _draw_branch(top, f, branch[f"{name}_amplitude"].values * 1e3, stable, looks[key])
+        _draw_branch(top, f, branch[f"{name}_amplitude"].values * scale, stable, looks[key])
         velocities = branch["impact_velocity"].values
         for k in range(velocities.shape[1]):
             if np.isfinite(velocities[:, k]).any():
@@ -157,22 +165,30 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
     for code, kind in enumerate(kinds):
         chosen = specials.isel(special_point=np.flatnonzero(specials["special_point_kind"].values == code))
         if chosen.sizes["special_point"]:
-            top.scatter(chosen["special_point_frequency"], chosen[f"special_point_{name}_amplitude"] * 1e3, marker=SPECIAL_MARKERS.get(kind, "x"), s=42,
+            top.scatter(chosen["special_point_frequency"], chosen[f"special_point_{name}_amplitude"] * scale, marker=SPECIAL_MARKERS.get(kind, "x"), s=42,
                         facecolor="none", edgecolor="k", lw=1.2, zorder=5, label=KIND_NAMES.get(kind, kind))  # fmt: skip
-    finish_axes(top, "", f"|{label}| fundamental [mm]", f"R = {fmt(restitution, 'g')}: {label} amplitude")
-    finish_axes(bottom, _FREQUENCY, "impact velocity [m/s]", f"R = {fmt(restitution, 'g')}: impact velocities")
+    where = f"R = {fmt(restitution, 'g')}{_model(dataset)}"
+    finish_axes(top, "", f"|{label}| fundamental [{unit}]", f"{where}: {label} amplitude")
+    finish_axes(bottom, _FREQUENCY, "impact velocity [m/s]", f"{where}: impact velocities")
     dots = [Line2D([], [], ls="", marker="o", ms=5, color=SWEEP_COLOURS.get(str(d), "C7"), label=f"brute force, sweep {d}") for d in dataset["sweep"].values]
     extra = [*dots, Line2D([], [], color="k", **STABLE_STYLE, label="stable"), Line2D([], [], color="k", **UNSTABLE_STYLE, label="unstable")]
     figure_legend(fig, [top, bottom], [*_class_legend(looks, classes), *extra], columns=4)
     caption = (
-        f"Bifurcation diagram at R = {fmt(restitution, 'g')}, Delta = {fmt(float(dataset['clearance']) * 1e3, 'g')} mm. Dots: brute-force "
-        f"time simulation (compiled exact engine) sweeping up (vermillion) and down (sky blue), the end state carried to the next frequency; "
+        f"Bifurcation diagram at R = {fmt(restitution, 'g')}{_model(dataset)}, Delta = {fmt(float(dataset['clearance']) * scale, 'g')} {unit}. Dots: brute-force "
+        f"time simulation ({dataset.attrs.get('brute_force_engine', 'compiled exact engine')}) sweeping up (vermillion) and down (sky blue), the end state carried to the next frequency; "
         f"top: the {label} fundamental over each of the {dataset.sizes['strobe']} kept periods; bottom: the velocity of every impact in them. "
         "Lines: every continued branch (solid stable, dashed unstable; colour, and beyond four classes a small filled marker: the "
         "orbit's period and impacts, legend), the linear orbit where it fits inside the clearance in black; open black markers: the "
         "located special points (table below)."
     )
-    return DrawnFigure(fig, f"bifurcation_R{index}", f"Bifurcation diagram, R = {fmt(restitution, 'g')}", caption)
+    return DrawnFigure(fig, f"bifurcation_R{index}{dataset.attrs.get('diagram_tag', '')}", f"Bifurcation diagram, R = {fmt(restitution, 'g')}{_model(dataset)}", caption)
+
+
+def _model(dataset: xr.Dataset) -> str:
+    """The diagram's contact model after its R (", bumper 250 Hz", ", rigid stop"), from a bumper dataset's view
+    (:func:`~vibroimpact.kinds.bifurcation.bumper.model_view`); empty for a scene of rigid stops."""
+    label = str(dataset.attrs.get("diagram_label", ""))
+    return f", {label}" if label else ""
 
 
 def _specials(dataset: xr.Dataset, restitution: float) -> xr.Dataset:
@@ -195,12 +211,12 @@ def multiplier_figure(dataset: xr.Dataset, restitution: float, index: int) -> Dr
     ax.axhline(1.0, color="k", lw=0.8)
     specials = _specials(dataset, restitution)
     ax.scatter(specials["special_point_frequency"], specials["special_point_floquet_modulus"], s=30, facecolor="none", edgecolor="k", zorder=5, label="special points")
-    finish_axes(ax, _FREQUENCY, "largest |Floquet multiplier|", f"R = {fmt(restitution, 'g')}: stability along the branches", log=True)
+    finish_axes(ax, _FREQUENCY, "largest |Floquet multiplier|", f"R = {fmt(restitution, 'g')}{_model(dataset)}: stability along the branches", log=True)
     ax.set_ylim(0.2, MODULUS_TOP)
     figure_legend(fig, [ax], _class_legend(looks, seen), columns=4)
-    caption = (f"Largest modulus of the Floquet multipliers along every impacting branch at R = {fmt(restitution, 'g')} (log scale, "
+    caption = (f"Largest modulus of the Floquet multipliers along every impacting branch at R = {fmt(restitution, 'g')}{_model(dataset)} (log scale, "
                f"clipped at {fmt(MODULUS_TOP, 'g')}: next to a grazing point the multipliers grow without bound): an orbit is stable below 1 (the horizontal line); solid stable, dashed unstable; colour and marker: the orbit's period and impacts, as in the diagram; open circles: the special points.")  # fmt: skip
-    return DrawnFigure(fig, f"multipliers_R{index}", f"Floquet multipliers, R = {fmt(restitution, 'g')}", caption)
+    return DrawnFigure(fig, f"multipliers_R{index}{dataset.attrs.get('diagram_tag', '')}", f"Floquet multipliers, R = {fmt(restitution, 'g')}{_model(dataset)}", caption)
 
 
 def chart_figure(dataset: xr.Dataset) -> DrawnFigure:
@@ -213,18 +229,19 @@ def chart_figure(dataset: xr.Dataset) -> DrawnFigure:
     norm = BoundaryNorm(np.arange(-1.5, len(meanings) - 1), cmap.N)
     kinds = flags(dataset["chart_kind"])
     edge = [patheffects.withStroke(linewidth=3.4, foreground="white")]
+    unit, scale = length_of(dataset)
     for ax, direction in zip(axes, directions):
         regime = dataset["chart_regime"].sel(sweep=direction)
-        ax.pcolormesh(dataset["map_frequency"], dataset["map_clearance"] * 1e3, regime.values, cmap=cmap, norm=norm, shading="nearest", rasterized=True)
+        ax.pcolormesh(dataset["map_frequency"], dataset["map_clearance"] * scale, regime.values, cmap=cmap, norm=norm, shading="nearest", rasterized=True)
         for label in np.unique(dataset["chart_curve"].values):
             points = np.flatnonzero(dataset["chart_curve"].values == label)
             kind = kinds[int(dataset["chart_kind"].values[points[0]])]
-            ax.plot(dataset["chart_frequency"].values[points], dataset["chart_clearance"].values[points] * 1e3, color=CURVE_COLOURS.get(kind, "0.3"),
+            ax.plot(dataset["chart_frequency"].values[points], dataset["chart_clearance"].values[points] * scale, color=CURVE_COLOURS.get(kind, "0.3"),
                     lw=1.8, ls="--" if kind == "grazing" else "-", path_effects=edge, label=f"{KIND_NAMES.get(kind, kind)} curve")  # fmt: skip
-        ax.axhline(float(dataset["clearance"]) * 1e3, color="k", lw=0.9, ls=":", path_effects=edge)
-        ax.set_ylim(float(dataset["map_clearance"].min()) * 1e3, float(dataset["map_clearance"].max()) * 1e3)
+        ax.axhline(float(dataset["clearance"]) * scale, color="k", lw=0.9, ls=":", path_effects=edge)
+        ax.set_ylim(float(dataset["map_clearance"].min()) * scale, float(dataset["map_clearance"].max()) * scale)
         ax.set_xlim(float(dataset["map_frequency"].min()), float(dataset["map_frequency"].max()))
-        finish_axes(ax, _FREQUENCY, "clearance Delta [mm]" if ax is axes[0] else "", f"brute force sweeping {direction}")
+        finish_axes(ax, _FREQUENCY, f"clearance Delta [{unit}]" if ax is axes[0] else "", f"brute force sweeping {direction}")
     drawn = set(np.unique(dataset["chart_regime"].values).tolist())
     patches = [Patch(facecolor=colours[k], edgecolor="0.5", label=meaning.replace("_", " ")) for k, meaning in enumerate(meanings) if meaning != "failed" or k - 1 in drawn]
     figure_legend(fig, axes, patches, columns=5)

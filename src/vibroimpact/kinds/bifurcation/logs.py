@@ -68,9 +68,10 @@ def numbered_across(results: list[CaseResult]) -> list[CaseResult]:
     return [numbered(result, offset) for result, offset in zip(results, branch_offsets(results))]
 
 
-def continuation_log(restitutions: tuple[float, ...], results: list[CaseResult]) -> str:
-    """The branch cases' notes, one line each, "R = <R>: <note>" (``results`` :func:`numbered_across`)."""
-    return "\n".join(f"R = {r:g}: {note}" for r, result in zip(restitutions, results) for note in result["notes"])
+def continuation_log(diagrams: Sequence[float | str], results: list[CaseResult]) -> str:
+    """The branch cases' notes, one line each, "<diagram>: <note>" (``results`` :func:`numbered_across`), a diagram
+    named by its label ("R = 0.2, bumper 250 Hz") or by its restitution R ("R = <R>")."""
+    return "\n".join(f"{where if isinstance(where, str) else f'R = {where:g}'}: {note}" for where, result in zip(diagrams, results) for note in result["notes"])
 
 
 def chart_labels(chart: CaseResult, branches: CaseResult | None) -> dict[int, str]:
@@ -106,18 +107,23 @@ class FailureKind:
     meaning: str
 
 
-#: Every kind of work that may fail, by the key the cases record it under.
+#: Every kind of work that may fail, by the key the cases record it under (a line says only the work the scene asked for:
+#: each kind of branch its own key).
 FAILURES: dict[str, FailureKind] = {
-    "branch": FailureKind("continuing branches from the closed form, period doublings and grazing points",
-                          "those branches and their special points are missing from the diagrams and the table; the branches found are unaffected"),
+    "closed_form": FailureKind("continuing the branches started from the closed-form orbit (a bumper's: the rigid stop's orbit continued to the bumper in its stiffness)",
+                               "those branches and their special points are missing from the diagrams and the tables; the branches found are unaffected"),
+    "period_doubling": FailureKind("continuing the period-2 branches born at period doublings",
+                                   "those branches and their special points are missing from the diagrams and the tables; the branches found are unaffected"),
+    "grazing": FailureKind("continuing the branches born at grazing points",
+                           "those branches and their special points are missing from the diagrams and the tables; the branches found are unaffected"),
     "seed": FailureKind("shooting from brute-force seeds (points where a sweep's strobes repeat)",
                         "an orbit the sweeps settle on only there may lack its continued branch (its brute-force dots are still drawn); the branches found are unaffected"),
     "sweep": FailureKind("brute-force frequencies (the engine made no progress, e.g. endless chattering)",
                          "those frequencies have no dots in the diagrams (regime 'failed'); the sweep went on from rest, the other frequencies are unaffected"),
     "map": FailureKind("regime-map points (the engine made no progress, e.g. endless chattering)",
                        "those points are blank ('failed') on the chart's regime map; the other points are unaffected"),
-    "chart_branch": FailureKind("continuing the chart's own branches",
-                                "the chart lacks the curves of those branches' special points; the diagrams are unaffected"),
+    **{f"chart_{kind}": FailureKind(f"continuing the chart's own {what}", "the chart lacks the curves of those branches' special points; the diagrams are unaffected")
+       for kind, what in (("closed_form", "branches from the closed-form orbit"), ("period_doubling", "period-2 branches"), ("grazing", "branches born at grazing points"))},
     "curve": FailureKind("following special points in (frequency, clearance) for the chart",
                          "those curves are missing from the chart; the regime map and the other curves are unaffected"),
     "stiffness_curve": FailureKind("following the stiffest bumper's special points in the bumper's stiffness",

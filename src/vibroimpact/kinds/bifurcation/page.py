@@ -9,6 +9,7 @@ Dataset layout read here: see :mod:`vibroimpact.kinds.bifurcation.study` (``bran
 from __future__ import annotations
 
 import html
+import math
 import re
 from pathlib import Path
 
@@ -18,8 +19,8 @@ import xarray as xr
 from vibroimpact.reporting.page import Section, Table, saved
 from vibroimpact.reporting.style import fmt
 from vibroimpact.runs.failures import as_lines
-from vibroimpact.kinds.bifurcation.bumper import bumper_answer, bumper_figure, convergence_table, has_bumpers, rigid_view
-from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, bifurcation_figures, branch_class, first_coordinate, flags as _flags, orbit_class, orbit_label as _orbit_label
+from vibroimpact.kinds.bifurcation.bumper import absent_text, bumper_answer, bumper_figure, convergence_table, diagram_models, has_bumpers, has_rigid, model_view
+from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, bifurcation_figures, branch_class, first_coordinate, flags as _flags, length_of, orbit_class, orbit_label as _orbit_label
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
 
 __all__ = ["page_for", "BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class", "first_coordinate", "headline", "answer_text", "failure_text", "failure_details"]
@@ -55,6 +56,7 @@ def headline(dataset: xr.Dataset) -> str:
     """The answer in one line per restitution: the largest amplitude the brute force settles on, and at how many
     frequencies it settles on no periodic motion."""
     label = coordinate_label(first_coordinate(dataset))
+    unit, scale = length_of(dataset)
     frequency = dataset["frequency"].values
     lines = []
     for i, r in enumerate(dataset["restitution"].values):
@@ -62,7 +64,7 @@ def headline(dataset: xr.Dataset) -> str:
         top = ""
         if np.isfinite(amplitude).any():
             _j, k = np.unravel_index(int(np.nanargmax(amplitude)), amplitude.shape)
-            top = f"up to |{label}| = {fmt(amplitude[_j, k] * 1e3, '.3g')} mm (at {fmt(frequency[k], '.2f')} Hz), "
+            top = f"up to |{label}| = {fmt(amplitude[_j, k] * scale, '.3g')} {unit} (at {fmt(frequency[k], '.2f')} Hz), "
         lines.append(f"R = {fmt(r, 'g')}: {top}no periodic motion at {int(wild.sum())} of {frequency.size} frequencies")
     return "; ".join(lines)
 
@@ -175,6 +177,7 @@ def answer_text(dataset: xr.Dataset) -> str:
     amplitude, where on no periodic motion, where the two sweeps disagree: coexisting attractors), how many special
     points."""
     label = coordinate_label(first_coordinate(dataset))
+    unit, scale = length_of(dataset)
     meanings = _flags(dataset["brute_regime"])
     frequency = dataset["frequency"].values
     step = float(np.median(np.diff(frequency))) if frequency.size > 1 else 1.0
@@ -186,7 +189,7 @@ def answer_text(dataset: xr.Dataset) -> str:
         if np.isfinite(amplitude).any():
             j, k = np.unravel_index(int(np.nanargmax(amplitude)), amplitude.shape)
             kind = meanings[int(regime[j, k]) + 1].replace("_", " ")
-            words.append(f"the brute force settles at most on |{label}| = {fmt(amplitude[j, k] * 1e3, '.3g')} mm ({fmt(frequency[k], '.2f')} Hz, "
+            words.append(f"the brute force settles at most on |{label}| = {fmt(amplitude[j, k] * scale, '.3g')} {unit} ({fmt(frequency[k], '.2f')} Hz, "
                          f"sweeping {dataset['sweep'].values[j]}: {kind});")  # fmt: skip
         words.append(f"no periodic motion at {int(wild.sum())} of {frequency.size} frequencies{' (' + _ranges(frequency[wild], step) + ')' if wild.any() else ''};")
         if regime.shape[0] > 1:
@@ -271,33 +274,48 @@ class BifurcationPage:
     def __init__(self, dataset: xr.Dataset) -> None:
         self.full = dataset
         self.bumpers = has_bumpers(dataset)
-        self.dataset = rigid_view(dataset)  # the rigid stop's: what every part but the bumpers' draws
+        self.reference = not self.bumpers or has_rigid(dataset)
+        #: every diagram, shaped as a rigid scene's dataset: the bumpers' by frequency, then the rigid stop's
+        self.views = [model_view(dataset, fb) for fb in diagram_models(dataset)] if self.bumpers else [dataset]
+        self.dataset = self.views[-1]  # the rigid stop's where it ran (its chart, its logs: the attributes are shared)
 
     def summary(self) -> str:
-        """The answer (:func:`headline`; with bumpers, how their special points converge first), then what was
-        computed."""
+        """The answer (:func:`headline` per diagram; with the rigid stop as the bumpers' reference, how their special
+        points converge first), then what was computed."""
         d = self.dataset
         stops = f"; stops: {d.attrs['stop_layout']}" if "stop_layout" in d.attrs else ""
         first = ""
-        if self.bumpers:
-            first = html.unescape(re.sub(r"<[^>]+>", "", bumper_answer(self.full))) + " Rigid stop: "
-        return (f"{first}{headline(d)}; {int(np.unique(d['branch'].values).size)} branches, {d.sizes['special_point']} special points, brute force at "
-                f"{d.sizes['frequency']} frequencies x {d.sizes['sweep']} directions for R = {', '.join(fmt(r, 'g') for r in d['restitution'].values)}{stops}")  # fmt: skip
+        if self.bumpers and self.reference:
+            first = html.unescape(re.sub(r"<[^>]+>", "", bumper_answer(self.full))) + " "
+        if not self.bumpers:
+            return (f"{first}{headline(d)}; {int(np.unique(d['branch'].values).size)} branches, {d.sizes['special_point']} special points, brute force at "
+                    f"{d.sizes['frequency']} frequencies x {d.sizes['sweep']} directions for R = {', '.join(fmt(r, 'g') for r in d['restitution'].values)}{stops}")  # fmt: skip
+        each = "; ".join(f"{view.attrs['diagram_label']}: {headline(view)}" for view in self.views)
+        return (f"{first}{each}; {int(np.unique(self.full['branch'].values).size)} branches, {self.full.sizes['special_point']} special points, brute force of "
+                f"each diagram at {d.sizes['frequency']} frequencies x {d.sizes['sweep']} directions for R = {', '.join(fmt(r, 'g') for r in d['restitution'].values)}{stops}")  # fmt: skip
 
     def sections(self, out: Path) -> list[Section]:
         """The answer (and what failed, if anything did) with the diagrams, multipliers and special points per
-        restitution, then the chart, then the continuation's logs and the raw messages of what failed, collapsed
-        (what a reader checks, not what they read first)."""
-        figures = saved(bifurcation_figures(self.dataset), out)
-        chart = [f for f in figures if f.path.stem == "chart"]
-        tables = "".join(orbit_table(self.dataset, float(r)) for r in self.dataset["restitution"].values)
-        answer = answer_text(self.dataset) + failure_text(self.dataset) + tables  # what failed right after the answer
-        sections = [Section("Bifurcation diagrams", answer, [f for f in figures if f not in chart], [special_point_table(self.dataset)])]
-        if self.bumpers:  # the page opens with the bumpers' answer; the rigid stop's diagrams are its reference
-            words = bumper_answer(self.full) + "<p>The rigid stop's bifurcation diagrams, brute force and special points follow below, as the reference.</p>"
-            sections.insert(0, Section("Bumpers against the rigid stop", words, saved([bumper_figure(self.full)], out), [convergence_table(self.full)]))
-        if chart:
-            sections.append(Section("Two-parameter chart", "", chart))
+        restitution (per contact model with bumpers: the bumpers', then the rigid stop's as their reference), then the
+        chart, then the continuation's logs and the raw messages of what failed, collapsed (what a reader checks, not
+        what they read first)."""
+        sections = []
+        for n, view in enumerate(self.views):
+            figures = saved(bifurcation_figures(view), out)
+            chart = [f for f in figures if f.path.stem == "chart"]
+            tables = "".join(orbit_table(view, float(r)) for r in view["restitution"].values)
+            answer = answer_text(view) + ("" if self.bumpers else failure_text(view)) + tables  # what failed right after the answer
+            title = "Bifurcation diagrams" + (f": {view.attrs['diagram_label']}" + (", the reference" if math.isinf(diagram_models(self.full)[n]) else "") if self.bumpers else "")
+            sections.append(Section(title, answer, [f for f in figures if f not in chart], [special_point_table(view)]))
+            if chart:
+                sections.append(Section("Two-parameter chart", "", chart))
+        if self.bumpers:  # the page opens with what failed, then the bumpers' answer
+            words = failure_text(self.full) + absent_text(self.full)
+            if self.reference:
+                words += bumper_answer(self.full) + "<p>The bumpers' bifurcation diagrams, brute force and special points follow below, then the rigid stop's, the reference.</p>"
+                sections.insert(0, Section("Bumpers against the rigid stop", words, saved([bumper_figure(self.full)], out), [convergence_table(self.full)]))
+            else:
+                sections[0] = Section(sections[0].title, words + sections[0].intro, sections[0].figures, sections[0].tables)
         logs = [
             (title, str(self.dataset.attrs.get(key, "")))
             for key, title in (("continuation_notes", "Every branch found by continuation: how it was started and where it ends"), ("chart_notes", "The chart's curves: how each was traced"))

@@ -8,11 +8,13 @@ base_motion, static}``, ``stops: [...]``). Every stop is rigid and shares one cl
 it) and one restitution: the diagrams' ``bifurcation.restitution`` (then no stop gives its own), or, without that
 key, the value every stop gives.
 
-``bifurcation.bumper: {frequency: [Omega_b / 2 pi, ...]}`` [Hz] adds, for each restitution and each bumper frequency,
-the branches of the same layout with every stop a Kelvin-Voigt bumper of that frequency and the loss factor whose
-collision restitution is R (corrected eq. 26), continued from the rigid stop's closed-form orbit on the bumper's exact
-stroboscopic map; the rigid stop's branches, brute force and special points stay the reference the bumpers' are
-measured against (``studies/bifurcation_bumper.yaml``). No chart with bumpers.
+``bifurcation.bumper: {frequency: [Omega_b / 2 pi, ...]}`` [Hz] makes every stop a Kelvin-Voigt bumper: for each
+restitution and each bumper frequency, the branches of the layout with bumpers of that frequency and the loss factor
+whose collision restitution is R (corrected eq. 26), started from the rigid stop's closed-form orbit continued in the
+bumper's stiffness and continued on the bumper's exact stroboscopic map, and the brute force of that bumper (its
+closed-form engine). ``bifurcation.reference: rigid`` adds the rigid stop's own diagram (branches, special points and
+brute force) as the reference the bumpers' converge to, and the curves of the stiffest bumper's special points in its
+stiffness (``studies/bifurcation_bumper.yaml``); ``none``, the default, runs the bumpers alone. No chart with bumpers.
 
 Example (the shipped ``bifurcation``, shortened)::
 
@@ -56,7 +58,7 @@ from vibroimpact.scene.header import parse_names
 from vibroimpact.scene.layout_parse import parse_layout, static_drift
 from vibroimpact.scene.schema import SWEEP_DIRECTIONS, Scene
 
-__all__ = ["BIFURCATION_TOP_KEYS", "CHART_KINDS", "BruteForceSettings", "BranchSettings", "ChartSettings", "BifurcationSettings", "coordinate_label", "parse_bifurcation_scene"]
+__all__ = ["BIFURCATION_TOP_KEYS", "CHART_KINDS", "REFERENCES", "BruteForceSettings", "BranchSettings", "ChartSettings", "BifurcationSettings", "coordinate_label", "parse_bifurcation_scene"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -68,6 +70,8 @@ __all__ = ["BIFURCATION_TOP_KEYS", "CHART_KINDS", "BruteForceSettings", "BranchS
 BIFURCATION_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bifurcation", "report"}
 #: Special points whose curves the two-parameter chart can follow (the order of the CF flags of ``special_point_kind``).
 CHART_KINDS = ("fold", "period_doubling", "neimark_sacker", "grazing")
+#: Values of ``bifurcation.reference`` (with bumpers): the rigid stop's diagram beside the bumpers', or none.
+REFERENCES = ("rigid", "none")
 #: Most brute-force periods of one scene (frequencies x restitutions x directions x periods per point).
 MAX_BRUTE_PERIODS = 50_000_000
 
@@ -209,7 +213,10 @@ class BifurcationSettings:
     chart : ChartSettings or None
         The two-parameter chart (None: none).
     bumper_frequencies : tuple of float
-        Omega_b / 2 pi of the bumpers whose branches are continued beside the rigid stop's [Hz] (empty: none).
+        Omega_b / 2 pi of the bumpers every stop is made of, one diagram each [Hz] (empty: rigid stops).
+    reference : str
+        With bumpers, :data:`REFERENCES`: ``rigid`` adds the rigid stop's diagram as the convergence reference,
+        ``none`` runs the bumpers alone; without bumpers ``none`` (the diagram is the rigid stop's).
     """
 
     low: float
@@ -220,10 +227,26 @@ class BifurcationSettings:
     branches: BranchSettings = BranchSettings()
     chart: ChartSettings | None = None
     bumper_frequencies: tuple[float, ...] = ()
+    reference: str = "none"
 
     def __post_init__(self) -> None:
         if not 0.0 < self.low < self.high:
             raise ValueError(f"frequency band ({self.low!r}, {self.high!r}): expected 0 < start < stop [Hz]")
+        if self.reference not in REFERENCES:
+            raise ValueError(f"reference = {self.reference!r} is not allowed: use one of {', '.join(REFERENCES)}")
+        if self.reference != "none" and not self.bumper_frequencies:
+            raise ValueError(f"reference = {self.reference!r}: a reference needs bumpers (without them the diagram is the rigid stop's)")
+
+    @property
+    def rigid(self) -> bool:
+        """Does the study run the rigid stop's diagram (rigid stops, or bumpers with ``reference: rigid``)?"""
+        return not self.bumper_frequencies or self.reference == "rigid"
+
+    @property
+    def models(self) -> tuple[float | None, ...]:
+        """The contact models of the diagrams, each restitution's in this order: None for the rigid stop (when it
+        runs), then Omega_b / 2 pi of each bumper [Hz]."""
+        return ((None,) if self.rigid else ()) + self.bumper_frequencies
 
     @property
     def frequency(self) -> np.ndarray:
@@ -240,7 +263,7 @@ class BifurcationSettings:
         return np.round(self.low + self.chart.frequency_step * np.arange(count), 10)
 
 #: Keys of the ``bifurcation`` section and of its parts.
-_KEYS = {"frequency", "restitution", "brute_force", "continuation", "chart", "bumper"}
+_KEYS = {"frequency", "restitution", "brute_force", "continuation", "chart", "bumper", "reference"}
 _BRUTE_KEYS = {"step", "transient_periods", "strobes", "directions"}
 _BRANCH_KEYS = {"one_impact", "period_doubling", "grazing", "linear", "brute_force", "max_steps", "max_step"}
 _CHART_KEYS = {"restitution", "clearance", "kinds", "max_steps", "frequency_step", "clearance_num", "transient_periods", "strobes"}
@@ -272,6 +295,14 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
     branches = _settings(c, "bifurcation.continuation", spec.get("continuation", {}), _BRANCH_KEYS, _branch_values)
     chart = _settings(c, "bifurcation.chart", spec["chart"], _CHART_KEYS, _chart_values) if "chart" in spec else None
     bumpers = _bumpers(c, spec["bumper"]) if "bumper" in spec else ()
+    reference = "none"
+    if "reference" in spec:
+        if spec["reference"] not in REFERENCES:
+            c.fail("bifurcation.reference", f"{spec['reference']!r} is not allowed: use one of {', '.join(REFERENCES)} (rigid: the rigid stop's diagram beside the bumpers', as their reference)")
+        elif "bumper" not in spec and spec["reference"] != "none":
+            c.fail("bifurcation.reference", "a reference needs bifurcation.bumper: without bumpers the diagram is the rigid stop's")
+        else:
+            reference = str(spec["reference"])
     if bumpers and "chart" in spec:
         c.fail("bifurcation.chart", "a chart follows the rigid stop's special points only: remove it, or bifurcation.bumper")
     if bumpers and restitution is not None and np.any(restitution <= 0.0):
@@ -280,7 +311,8 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
         if brute.step > high - low:
             c.fail("bifurcation.brute_force.step", f"{brute.step:g} Hz is out of range: allowed (0, {high - low:g}] (the band's width)")
         else:
-            periods = (high - low) / brute.step * restitution.size * len(brute.directions) * (brute.transient_periods + brute.strobes)
+            models = len(bumpers or ()) + (1 if not bumpers or reference == "rigid" else 0)  # a diagram's brute force per contact model
+            periods = (high - low) / brute.step * restitution.size * models * len(brute.directions) * (brute.transient_periods + brute.strobes)
             if periods > MAX_BRUTE_PERIODS:
                 c.fail("bifurcation.brute_force", f"{periods:.3g} simulated periods is too many: allowed at most {MAX_BRUTE_PERIODS:.0e} (raise step, or fewer periods)")
     if chart is not None and low is not None and high is not None and chart.frequency_step > high - low:
@@ -289,7 +321,7 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
         raise SceneError(c.problems, source)
     assert layout is not None and specs is not None and amplitude is not None and isinstance(name, str) and clearance is not None
     assert low is not None and high is not None and restitution is not None and brute is not None and branches is not None
-    settings = BifurcationSettings(low, high, tuple(float(r) for r in restitution), float(clearance), brute, branches, chart, tuple(bumpers or ()))
+    settings = BifurcationSettings(low, high, tuple(float(r) for r in restitution), float(clearance), brute, branches, chart, tuple(bumpers or ()), reference)
     return Scene(
         name=name,
         description=description,

@@ -2,7 +2,8 @@
 one, by continuation instead of by distance.
 
 A :class:`StiffnessCase` finds the one-contact branches of the stiffest bumper of a study (``bifurcation.bumper``)
-and continues each of their folds, period doublings and Neimark-Sacker points (period 1) in (frequency, T_b) on
+and continues each of their folds, period doublings and Neimark-Sacker points (period 1; not those a contact onset
+induces, :data:`INDUCED`) in (frequency, T_b) on
 :class:`~vibroimpact.orbits.bumper_map.BumperPeriodMap`, T_b = 1 / (Omega_b / 2 pi) [s] the bumper period, over
 :data:`STIFFER` times the stiffest bumper's frequency down to the softest's divided by :data:`SOFTER`. A curve says
 where its special point is at every bumper in between (and whether it still exists: a fold curve that turns back in
@@ -32,11 +33,16 @@ from vibroimpact.orbits.continuation import ContinuationSettings, continue_speci
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.store import case_key
 
-__all__ = ["StiffnessCase", "monotone_pieces", "curve_pieces", "on_piece", "FOLLOWED", "STIFFER", "SOFTER", "CURVE_SETTINGS", "STIFFNESS_FIELDS", "ON_CURVE"]
+__all__ = ["StiffnessCase", "monotone_pieces", "curve_pieces", "on_piece", "FOLLOWED", "INDUCED", "STIFFER", "SOFTER", "CURVE_SETTINGS", "STIFFNESS_FIELDS", "ON_CURVE"]
 
 #: The kinds of special point followed in the bumper's stiffness (a grazing point, the contact onset at tangency,
 #: does not depend on Omega_b).
 FOLLOWED = ("fold", "period_doubling", "neimark_sacker")
+#: How the continuation marks a special point located next to a contact onset and induced by it (its note): the
+#: multipliers jump across the unit circle at the onset, which does not depend on Omega_b, so the point solves no
+#: smooth extended system and has no curve in the stiffness (the shipped study's 4 kHz bumper: a period doubling
+#: 1.1e-4 Hz above the onset at 26.026487 Hz, "does not solve its extended system" when followed).
+INDUCED = "induced by it"
 #: The curves reach this many times the stiffest bumper's frequency (Richardson's extrapolation to the rigid stop
 #: takes the curve at its stiffest T_b and twice it) ...
 STIFFER = 16.0
@@ -108,8 +114,8 @@ class StiffnessCase:
             system = BumperPeriodMap(mapping.problem, bounds=bounds)
             for point in branch.special_points:
                 kind = SPECIAL_POINT_KINDS.index(point.kind)
-                if point.kind not in FOLLOWED or _on_a_curve(rows, kind, point.value, float(system.parameters[-1])):
-                    continue  # not followed; or on a curve already followed (both roots' branches, a fold pair's cusp)
+                if point.kind not in FOLLOWED or INDUCED in point.note or _on_a_curve(rows, kind, point.value, float(system.parameters[-1])):
+                    continue  # not followed (or induced by a contact onset); or on a curve already followed (both roots' branches, a fold pair's cusp)
                 attempts["stiffness_curve"] += 1
                 try:
                     special = continue_special_point(system, _with_period(point, system), BUMPER_PERIOD, CURVE_SETTINGS, bounds=bounds)

@@ -22,6 +22,9 @@ Output (``bifurcation.nc``; attributes from :data:`vibroimpact.kinds.bifurcation
 * the chart: dimension ``chart_point`` with coordinates ``chart_curve``, ``chart_kind`` (flags as
   ``special_point_kind``), ``chart_frequency`` [Hz], ``chart_clearance`` [m]; the regime map ``chart_regime``
   (sweep, map_clearance, map_frequency) with ``chart_impacts_per_period`` and ``chart_period``.
+* with bumpers, ``bumper_starts_without_orbit`` (absent otherwise): the closed-form starts a bumper has no orbit for,
+  a line each, "R = <R>, bumper <Hz> Hz: the rigid stop's ... orbit at <f> Hz ... has no counterpart with this bumper:
+  <where its continuation in the bumper's stiffness turns back>" (an answer, not a failure);
 * what failed, when anything did (attributes, absent otherwise): ``run_failures``, one line per kind of work and
   restitution, "<what failed>: <k> of <n> failed (<reasons>); <what it means for the results>", and
   ``run_failure_details``, every raw message (:mod:`vibroimpact.kinds.bifurcation.logs`); the console gets one line.
@@ -53,7 +56,9 @@ import math
 import numpy as np
 import xarray as xr
 
+from vibroimpact.engines.registry import BUMPER, RIGID, engine_for
 from vibroimpact.model.contact import loss_factor_from_restitution
+from vibroimpact.model.units import length_text
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
@@ -114,7 +119,9 @@ class BifurcationStudy:
         options = tuple(sorted(vars(settings.branches).items()))
         brute = settings.brute_force
         chart = settings.chart
-        sweeps = [SweepCase(diagram_problem(scene, r), d, tuple(settings.frequency), brute.transient_periods, brute.strobes) for r in settings.restitution for d in brute.directions]
+        diagrams = _diagrams(scene)
+        sweeps = [SweepCase(diagram_problem(scene, r, bumper_frequency=fb), d, tuple(settings.frequency), brute.transient_periods, brute.strobes, engine=_engine(fb))
+                  for r, fb in diagrams for d in brute.directions]  # fmt: skip
         maps = []
         if chart is not None:
             maps = [SweepCase(diagram_problem(scene, chart.restitution, float(c)), d, tuple(settings.chart_frequency), chart.transient_periods, chart.strobes) for c in chart.clearances for d in brute.directions]
@@ -124,36 +131,32 @@ class BifurcationStudy:
             + (f"; the chart's curves (R = {chart.restitution:g})" if chart else ""))  # fmt: skip
         first = runner.map(charted + sweeps + maps)
         chart_result, swept = (first[0], first[1:]) if chart else (None, first)
+        plain = tuple((k, False if k == "brute_force" else v) for k, v in options)  # seeds from the rigid stop's brute force only
         continuation = []
-        for i, r in enumerate(settings.restitution):
+        for i, (r, fb) in enumerate(diagrams):
             seeds: list[Seed] = []
-            if settings.branches.brute_force:
+            if settings.branches.brute_force and fb is None:
                 for j, _direction in enumerate(brute.directions):
                     result = swept[i * len(brute.directions) + j]
                     seeds += sweep_seeds(settings.frequency, result["period"], result["impacts"], result["state"], j)
-            continuation.append(BranchCase(diagram_problem(scene, r), settings.low, settings.high, options, tuple(seeds)))
-        bumpers = [(r, fb) for r in settings.restitution for fb in settings.bumper_frequencies]
-        plain = tuple((k, False if k == "brute_force" else v) for k, v in options)  # no brute force of a bumper
-        continuation += [BranchCase(diagram_problem(scene, r, bumper_frequency=fb), settings.low, settings.high, plain) for r, fb in bumpers]
-        stiffness = _stiffness_cases(scene, options) if bumpers else []
-        say(f"continuing the branches of R = {', '.join(f'{r:g}' for r in settings.restitution)}" + (f" and of bumpers of {', '.join(f'{fb:g}' for fb in settings.bumper_frequencies)} Hz"
-            f", and following the stiffest bumper's special points in its stiffness" if bumpers else ""))  # fmt: skip
+            continuation.append(BranchCase(diagram_problem(scene, r, bumper_frequency=fb), settings.low, settings.high, options if fb is None else plain, tuple(seeds)))
+        stiffness = _stiffness_cases(scene, options) if settings.bumper_frequencies and settings.rigid else []
+        say(f"continuing the branches of {', '.join(_label(r, fb) for r, fb in diagrams)}" + (", and following the stiffest bumper's special points in its stiffness" if stiffness else ""))
         mapped = runner.map(stiffness + continuation)  # the longest cases first
         curves, results = mapped[: len(stiffness)], numbered_across(mapped[len(stiffness) :])  # the dataset's labels
-        labels = [f"R = {r:g}" for r in settings.restitution] + [f"R = {r:g}, bumper {fb:g} Hz" for r, fb in bumpers]
-        for label, result in zip(labels, results):
-            _say_notes(say, label, result)
+        for (r, fb), result in zip(diagrams, results):
+            _say_notes(say, _label(r, fb), result)
         for r, result in zip(settings.restitution, curves):
             _say_notes(say, f"R = {r:g}, bumper stiffness", result)
         if chart_result is not None:
-            same = [result for r, result in zip(settings.restitution, results) if np.isclose(r, chart.restitution)]
+            same = [result for (r, _fb), result in zip(diagrams, results) if np.isclose(r, chart.restitution)]
             labels = chart_labels(chart_result, same[0] if same else None)
             chart_result = dict(chart_result, notes=np.array([relabel(str(note), labels) for note in chart_result["notes"]], dtype=str))
             _say_notes(say, f"chart {chart.restitution:g}", chart_result)
             results = [*results, chart_result]
-        sets = len(settings.restitution) + len(bumpers)
-        data = _branches(results[:sets], settings.restitution + tuple(r for r, _fb in bumpers), scene.coordinates, scene.layout.load.base_motion,
-                         (None,) * len(settings.restitution) + tuple(fb for _r, fb in bumpers) if bumpers else ())  # fmt: skip
+        sets = len(diagrams)
+        data = _branches(results[:sets], tuple(r for r, _fb in diagrams), scene.coordinates, scene.layout.load.base_motion,
+                         tuple(fb for _r, fb in diagrams) if settings.bumper_frequencies else ())  # fmt: skip
         data = data.merge(_brute(swept[: len(sweeps)], scene, brute.directions, brute.strobes))
         if curves:
             data = data.merge(_stiffness(curves, settings.restitution))
@@ -174,17 +177,20 @@ class BifurcationStudy:
         settings = scene.settings
         assert settings is not None
         brute = settings.brute_force
-        per_period = costs.per_period_cost("exact", 0.0) * BRUTE_FACTOR
-        periods = settings.frequency.size * len(settings.restitution) * len(brute.directions) * (brute.transient_periods + brute.strobes)
-        continuation = [CONTINUATION_SECONDS if settings.branches.brute_force else CLOSED_FORM_SECONDS] * len(settings.restitution)
+        per_model = settings.frequency.size * len(settings.restitution) * len(brute.directions) * (brute.transient_periods + brute.strobes)
+        periods = per_model * len(settings.models)
+        sweeps = sum(per_model * _period_cost(costs, _engine(fb)) for fb in settings.models)
+        rigid = len(settings.restitution) if settings.rigid else 0
+        continuation = [CONTINUATION_SECONDS if settings.branches.brute_force else CLOSED_FORM_SECONDS] * rigid
         continuation += [CLOSED_FORM_SECONDS] * (len(settings.restitution) * len(settings.bumper_frequencies))
-        continuation += [STIFFNESS_SECONDS] * (len(settings.restitution) if settings.bumper_frequencies else 0)
+        continuation += [STIFFNESS_SECONDS] * (rigid if settings.bumper_frequencies else 0)
         chart_seconds = 0.0
         if settings.chart is not None:
             chart = settings.chart
-            periods += settings.chart_frequency.size * chart.clearance_num * len(brute.directions) * (chart.transient_periods + chart.strobes)
+            mapped = settings.chart_frequency.size * chart.clearance_num * len(brute.directions) * (chart.transient_periods + chart.strobes)
+            periods += mapped
+            sweeps += mapped * _period_cost(costs, _engine(None))
             chart_seconds = CHART_SECONDS
-        sweeps = periods * per_period
         jobs = max(1, jobs)
         first = max(chart_seconds, (chart_seconds + sweeps) / jobs)  # the chart's curves run alongside the sweeps
         branches = max(max(continuation), sum(continuation) / jobs)  # then the branches, seeded from the sweeps
@@ -193,6 +199,30 @@ class BifurcationStudy:
         parts = {"brute force and chart": first, "continuation": branches, "report": report}
         memory = costs.main_process_memory + (jobs - 1) * costs.worker_process_memory
         return Estimate(wall_time=wall, memory=memory, parts=parts, points={"brute force": f"{periods:,} periods", "continuation": f"{len(continuation)} continuations"})
+
+
+def _period_cost(costs: Costs, engine: str) -> float:
+    """Measured wall time of one brute-force period of ``engine`` [s] (a plain period's times :data:`BRUTE_FACTOR`)."""
+    return costs.per_period_cost(engine, 0.0) * BRUTE_FACTOR
+
+
+def _diagrams(scene: Scene) -> list[tuple[float, float | None]]:
+    """(R, Omega_b / 2 pi [Hz] or None for the rigid stop) of every diagram, in the dataset's order: per restitution
+    each contact model of :attr:`~vibroimpact.kinds.bifurcation.scene.BifurcationSettings.models`."""
+    settings = scene.settings
+    assert settings is not None
+    return [(r, fb) for r in settings.restitution for fb in settings.models]
+
+
+def _label(r: float, fb: float | None) -> str:
+    """How the logs name a diagram: "R = 0.2", "R = 0.2, bumper 250 Hz"."""
+    return f"R = {r:g}" + ("" if fb is None else f", bumper {fb:g} Hz")
+
+
+def _engine(fb: float | None) -> str:
+    """The brute force's engine of a diagram: the registry's engine with exact Jacobians for its contact law (the
+    compiled exact engine for the rigid stop, the bumper's closed-form engine for a bumper)."""
+    return engine_for(RIGID if fb is None else BUMPER, "exact_jacobians")
 
 
 def _say_notes(say: Progress, where: str, result: CaseResult) -> None:
@@ -211,21 +241,18 @@ def _tallies(scene: Scene, results: list[CaseResult], swept: list[CaseResult], c
     assert settings is not None
     directions, chart = settings.brute_force.directions, settings.chart
     counted: list[Tally] = []
-    for i, r in enumerate(settings.restitution):
-        where = f"R = {r:g}"
+    for i, (r, fb) in enumerate(_diagrams(scene)):
+        where = _label(r, fb)
         counted += tallies(results[i], where)
         sweeps = swept[i * len(directions) : (i + 1) * len(directions)]
         counted.append(sweep_tally("sweep", where, sweeps, [f"sweeping {d}" for d in directions], settings.frequency))
-    bumpers = [(r, fb) for r in settings.restitution for fb in settings.bumper_frequencies]
-    for k, (r, fb) in enumerate(bumpers):
-        counted += tallies(results[len(settings.restitution) + k], f"R = {r:g}, bumper {fb:g} Hz")
     for r, result in zip(settings.restitution, curves):
         counted += tallies(result, f"R = {r:g}")
     if chart is not None:
         where = f"R = {chart.restitution:g}"
         counted += tallies(results[-1], where)
-        labels = [f"Delta = {c * 1e3:.4g} mm, sweeping {d}" for c in chart.clearances for d in directions]
-        counted.append(sweep_tally("map", where, swept[len(settings.restitution) * len(directions) :], labels, settings.chart_frequency))
+        labels = [f"Delta = {length_text(c, '.4g', settings.clearance)}, sweeping {d}" for c in chart.clearances for d in directions]
+        counted.append(sweep_tally("map", where, swept[len(_diagrams(scene)) * len(directions) :], labels, settings.chart_frequency))
     return counted
 
 
@@ -309,14 +336,16 @@ def _brute(results: list[CaseResult], scene: Scene, directions: tuple[str, ...],
     """Brute-force variables over (restitution, sweep, frequency[, strobe | impact])."""
     settings = scene.settings
     assert settings is not None
-    shape = (len(settings.restitution), len(directions))
+    bumpers = bool(settings.bumper_frequencies)
+    shape = (len(settings.restitution), len(settings.models), len(directions)) if bumpers else (len(settings.restitution), len(directions))
 
     def stack(name: str) -> np.ndarray:
         values = np.array([r[name] for r in results])
         return values.reshape(shape + values.shape[1:])
 
     a = BIFURCATION_ATTRIBUTES
-    grid = ("restitution", "sweep", "frequency")
+    grid = ("restitution", "bumper_frequency", "sweep", "frequency") if bumpers else ("restitution", "sweep", "frequency")
+    models = {"bumper_frequency": ("bumper_frequency", np.array([math.inf if fb is None else fb for fb in settings.models]), BIFURCATION_ATTRIBUTES["bumper_frequency"])} if bumpers else {}
     regime = _regime_flags("brute force: what the motion is at each frequency")
     first, base = scene.coordinates[0], scene.layout.load.base_motion
     return xr.Dataset(
@@ -329,8 +358,9 @@ def _brute(results: list[CaseResult], scene: Scene, directions: tuple[str, ...],
             "brute_period": (grid, stack("period").astype(np.int16), a["brute_period"]),
             "brute_lyapunov_exponent": (grid, stack("lyapunov"), a["brute_lyapunov_exponent"]),
         },
-        coords={"restitution": np.array(settings.restitution), "sweep": list(directions), "frequency": settings.frequency, "strobe": ("strobe", np.arange(strobes, dtype=np.int32), a["strobe"])},
-    )
+        coords={"restitution": np.array(settings.restitution), **models, "sweep": list(directions), "frequency": settings.frequency,
+                "strobe": ("strobe", np.arange(strobes, dtype=np.int32), a["strobe"])},
+    )  # fmt: skip
 
 
 def _chart(curves: CaseResult, results: list[CaseResult], clearances: np.ndarray, frequency: np.ndarray, directions: tuple[str, ...]) -> xr.Dataset:
@@ -406,20 +436,26 @@ def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult],
         **_layout_attributes(scene),
         "frequency_band_Hz": np.array([settings.low, settings.high]),
         "brute_force_transient_periods": settings.brute_force.transient_periods,
-        "continuation_notes": continuation_log(settings.restitution, results),
+        "continuation_notes": continuation_log([_label(r, fb) for r, fb in _diagrams(scene)], results),
         "method_branches": "pseudo-arclength continuation of fixed points of the exact stroboscopic map (compiled exact engine, exact Jacobians), started from the closed-form impact orbit at both roots of eq. 16 (one impact per period; two on a symmetric two-sided stop; none where the layout has no closed form), at period doublings, at grazing points and from every periodic brute-force attractor no other branch passes through",
         "method_brute_force": f"compiled exact engine, stepped sweeps carrying the end state; strobes compared over periods 1-{MAX_PERIOD}, else the Lyapunov exponent from the exact Jacobians",
     }
-    bumpers = [(r, fb) for r in settings.restitution for fb in settings.bumper_frequencies]
-    if bumpers:
-        start = len(settings.restitution)
-        lines = [f"R = {r:g}, bumper {fb:g} Hz: {note}" for (r, fb), result in zip(bumpers, results[start : start + len(bumpers)]) for note in result["notes"]]
-        lines += [f"R = {r:g}, bumper stiffness: {note}" for r, result in zip(settings.restitution, curves) for note in result["notes"]]
+    diagrams = _diagrams(scene)
+    if settings.bumper_frequencies:
+        lines = [f"R = {r:g}, bumper stiffness: {note}" for r, result in zip(settings.restitution, curves) for note in result["notes"]]
         attrs["continuation_notes"] = "\n".join([attrs["continuation_notes"], *lines])
+        absent = [f"{_label(r, fb)}: {line}" for (r, fb), result in zip(diagrams, results) for line in result["absent"]]
+        if absent:
+            attrs["bumper_starts_without_orbit"] = absent
         attrs["bumper_frequencies_Hz"] = np.array(settings.bumper_frequencies)
+        attrs["bifurcation_reference"] = settings.reference
+        attrs["method_brute_force"] = (f"each diagram's own contact law: the bumpers' with their closed-form engine ({_engine(settings.bumper_frequencies[0])}), "
+                                       + (f"the rigid stop's with the compiled exact engine ({_engine(None)}); " if settings.rigid else "")
+                                       + f"stepped sweeps carrying the end state; strobes compared over periods 1-{MAX_PERIOD}, else the Lyapunov exponent from the exact Jacobians")  # fmt: skip
         attrs["method_bumper"] = ("the same layout with every stop a Kelvin-Voigt bumper of each Omega_b / 2 pi and the loss factor whose collision restitution is R "
-                                  "(corrected eq. 26): branches started from the rigid stop's closed-form orbit shot on the bumper's map, continued on the exact "
-                                  "stroboscopic map of the engine that gives exact Jacobians for bumpers; grazing: contact onset at tangency")  # fmt: skip
+                                  "(corrected eq. 26): branches started from the rigid stop's closed-form orbit continued in the bumper period from a bumper "
+                                  "64 times stiffer, continued on the exact stroboscopic map of the engine that gives exact Jacobians for bumpers; grazing: "
+                                  "contact onset at tangency" + ("; the rigid stop's diagram is the reference (bifurcation.reference: rigid)" if settings.rigid else ""))  # fmt: skip
     if settings.chart is not None:
         attrs["chart_restitution"] = settings.chart.restitution
         attrs["chart_notes"] = "\n".join(str(n) for n in results[-1]["notes"])

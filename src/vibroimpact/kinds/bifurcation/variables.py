@@ -12,6 +12,7 @@ BIFURCATION_ATTRIBUTES: dict[str, dict[str, str]] = {
     "branch_frequency": {"units": "Hz", "long_name": "excitation frequency of the branch point"},
     "branch_restitution": {"units": "1", "long_name": "restitution ratio R of the branch point"},
     "branch_bumper_frequency": {"units": "Hz", "long_name": "Omega_b / 2 pi of the branch point's Kelvin-Voigt bumpers (inf: the rigid stop)"},
+    "bumper_frequency": {"units": "Hz", "long_name": "Omega_b / 2 pi of the brute force's Kelvin-Voigt bumpers (inf: the rigid stop)"},
     "x1_amplitude": {"units": "m", "long_name": "fundamental-harmonic amplitude of X1 over the orbit's period"},
     "x2_amplitude": {"units": "m", "long_name": "fundamental-harmonic amplitude of X2 over the orbit's period"},
     "impulse": {"units": "N s", "long_name": "total impact impulse of the orbit per excitation period"},
