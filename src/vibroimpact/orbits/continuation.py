@@ -206,9 +206,11 @@ class _Walker(OnsetSteps):
                         a, values_a = last, self.tests(last)
                     near_before = self.reference if self.reference is not None else last  # (1e-3 from it: its stability)
                     near_start = len(self.specials)
-                    for arriving in self.arrival:  # the last stretch to a soft contact's onset, from its own side
-                        sigma = float(a.tangent @ (arriving.z - a.z))
-                        self.detect(a, values_a, arriving, self.tests(arriving), sigma, arclength)
+                    for arriving in self.arrival:  # the last stretch to an onset, from its own side
+                        chord = arriving.z - a.z  # (located along the chord: the branch curves sharply there)
+                        sigma = float(np.linalg.norm(chord))
+                        along = dataclasses.replace(a, tangent=chord / sigma) if sigma > 0.0 else a
+                        self.detect(along, values_a, arriving, self.tests(arriving), sigma, arclength)
                         arclength += sigma
                         a, values_a = arriving, self.tests(arriving)
                         points.append(a)
@@ -234,6 +236,10 @@ class _Walker(OnsetSteps):
                         a, values_a = left, self.tests(left)
                         points.append(a)
                         h = max(min(h, float(np.linalg.norm(points[-1].z - points[-2].z))), s.min_step)
+                    if len(points) >= 2 and points[-2].out.hybrid is not None:  # the approach's margin slope says
+                        step = float(np.linalg.norm(points[-1].z - points[-2].z))  # nothing of the branch leaving it
+                        if step > 0.0:
+                            self.slope = (grazing_margin(a.out.hybrid) - grazing_margin(points[-2].out.hybrid)) / step
                     self._record_onset(graze_at, near_before, a, arriving_way, near_start, first_special)
                     continue
                 b = None

@@ -44,6 +44,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from typing import Any
 
+from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.engines.registry import BUMPER, engine_for, make_engine
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
@@ -209,6 +210,26 @@ class ImpactMap:
         reach = np.abs(linear.stops) + linear.stop_static
         clearances = problem.clearances()
         return state, float(np.min((clearances - reach) / np.maximum(np.abs(clearances), 1e-3 * self.state_scale[0])))
+
+    def impact_orbit(self, p: NDArray[np.float64]) -> tuple[NDArray[np.float64], float] | None:
+        """The closed-form one-impact orbit at parameters ``p`` with the least impulse of its admissible roots
+        (:func:`~vibroimpact.analysis.impact_orbit.solve_impact_orbit`, eqs. 15-18; next to a grazing onset, the
+        orbit born there): its state at the strobe and its distance to grazing, the approach speed over the velocity
+        scale w L [-]. None for a map over several periods, where the closed form does not apply (bumpers, several
+        stops), or where no admissible root exists."""
+        if self.periods != 1:
+            return None
+        try:
+            problem = self.problem_at(p)
+            roots = [solve_impact_orbit(problem, root=root) for root in ("+", "-")]
+        except (ValueError, TypeError):  # no problem at p, or no closed form for it
+            return None
+        admissible = [orbit for orbit in roots if bool(np.all(orbit.admissible()))]
+        if not admissible:
+            return None
+        orbit = min(admissible, key=lambda item: float(np.ravel(item.impulse)[0]))
+        speed = float(np.ravel(orbit.pre_impact_velocity)[0])
+        return closed_form_state(problem, orbit), speed / (problem.omega * self.state_scale[0])
 
     def with_periods(self, periods: int) -> "ImpactMap":
         """The same map over ``periods`` excitation periods (one compiled call per evaluation, unlike ``Iterated``)."""

@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from vibroimpact.orbits.arclength import Point
 from vibroimpact.orbits.bifurcations import grazing_margin, locate_grazing
 from vibroimpact.orbits.branch import SpecialPoint
-from vibroimpact.orbits.onsets import contact_free_onset, stability_change
+from vibroimpact.orbits.onsets import contact_free_onset, impacting_ladder, stability_change
 
 __all__ = ["OnsetSteps", "NOT_GRAZING", "signature_of"]
 
@@ -42,6 +42,11 @@ ONSET_NEIGHBOURHOOD = 1e-2
 #: onset is stable: a rigid stop's impacting orbit has a multiplier growing like one over the impact's speed next to
 #: grazing, which says nothing of the branch beyond that speed.
 MEASURABLE_MARGIN = 1e-4
+
+
+#: The distance to grazing within which a special point found on the last stretch to an onset is said to be induced
+#: by it.
+INDUCED_MARGIN = 1e-3
 
 
 def _measurable(point: Point) -> bool:
@@ -68,19 +73,27 @@ class OnsetSteps:
         if not math.isfinite(value):
             return NOT_GRAZING  # a plain corrector failure, not a grazing
         onset = self.onset(side, beyond, value)
-        self.touching, self.arrival, self.reference = None, [], None
+        self.touching, self.arrival, self.reference, self.departure = None, [], None, []
         if onset is not None:
             value, touching, free = onset
             grazing = touching if touching is not None else grazing
             self.touching = touching
             if side.out.hybrid.impacts > 0 and beyond is None:
                 beyond = free  # the contact-free orbit carries the branch on
+            margin = grazing_margin(a.out.hybrid) if signature_of(a) == signature_of(side) else math.inf
             if side.out.hybrid.impacts > 0 and touching is not None:  # arriving on the contact side: the last stretch by its margin
-                margin = grazing_margin(a.out.hybrid) if signature_of(a) == signature_of(side) else math.inf
                 stretch = self.leave(grazing, signature_of(side), side.z)
                 back = [p for p in stretch if grazing_margin(p.out.hybrid) < margin]
                 self.arrival = [dataclasses.replace(p, tangent=-p.tangent) for p in reversed(back)]
                 self.reference = stretch[-1] if stretch else None
+            elif side.out.hybrid.onset_depth is None and (side.out.hybrid.impacts > 0 or beyond is None):
+                stretch = self._rigid_ladder(side, value)  # a rigid stop: the impacting orbits next to it in closed form
+                if side.out.hybrid.impacts > 0:
+                    back = [p for p in stretch if grazing_margin(p.out.hybrid) < margin]
+                    self.arrival = [dataclasses.replace(p, tangent=-p.tangent) for p in reversed(back)]
+                    self.reference = stretch[-1] if stretch else None
+                elif stretch:
+                    beyond, self.departure = stretch[0], stretch[1:]
         before = side.out.hybrid
         tangency = -before.closest_approach / before.length_scale <= before.speed_margin
         vanishing = "an impact's velocity goes to zero" if before.onset_depth is None else "a contact's depth goes to zero"
@@ -116,9 +129,12 @@ class OnsetSteps:
         exists (None where the closed form does not apply)."""
         if not (side.out.hybrid.impacts == 0 or beyond is None or beyond.out.hybrid.impacts == 0):
             return None
-        if side.out.hybrid.impacts > 0:  # the contact side of an onset is next to the contact-free orbit
+        if side.out.hybrid.impacts > 0:  # the contact side of an onset is next to the contact-free orbit ...
             closed = getattr(self.system, "linear_orbit", lambda p: None)(side.p)
-            if closed is None or np.max(np.abs(side.y - closed[0]) / self.arc.sy) > ONSET_NEIGHBOURHOOD:
+            near = closed is not None and np.max(np.abs(side.y - closed[0]) / self.arc.sy) <= ONSET_NEIGHBOURHOOD
+            impacting = getattr(self.system, "impact_orbit", lambda p: None)(side.p) if not near else None
+            born = impacting is not None and np.max(np.abs(side.y - impacting[0]) / self.arc.sy) <= 1e-6  # ... or the closed-form orbit born there
+            if not (near or born):
                 return None  # not an onset from a contact-free side (another contact count beyond)
         n, scale = self.n, float(self.arc.sp[0])
         known = [float(side.p[self.index])] + ([float(beyond.p[self.index])] if beyond is not None else [])
@@ -144,6 +160,27 @@ class OnsetSteps:
                 break
         return root, touching, free
 
+    def _rigid_ladder(self, side: Point, root: float) -> list[Point]:
+        """The closed-form one-impact orbits born at a rigid stop's onset at ``root`` (:func:`~vibroimpact.orbits.
+        onsets.impacting_ladder`), as points at distances to grazing 1e-6 ... 1e-3 from it, each with its tangent
+        pointing away from the onset; empty where the closed form does not apply."""
+        ladder = impacting_ladder(self.system, side.p, self.index, root)
+        points: list[Point] = []
+        previous = None
+        for state, q, _margin in ladder:
+            point = self.arc.point(self.arc.to_z(state, q), None)
+            if point.out.hybrid is None or point.out.hybrid.impacts == 0 or not np.all(np.isfinite(point.out.jacobian)):
+                break
+            if previous is not None:
+                secant = point.z - previous.z
+                point = dataclasses.replace(point, tangent=self.arc.tangent(point.jacobian, secant / np.linalg.norm(secant)))
+            points.append(point)
+            previous = point
+        if len(points) >= 2:  # the first: the way to the second
+            secant = points[1].z - points[0].z
+            points[0] = dataclasses.replace(points[0], tangent=self.arc.tangent(points[0].jacobian, secant / np.linalg.norm(secant)))
+        return points
+
     def _record_onset(self, at: float, before: Point, after: Point | None, arriving_way: float, near: int, first: int) -> None:
         """Keep the grazing point just located (at arclength ``at``) with what happens across it: the stability change
         between ``before`` and ``after`` (the orbits on either side, at most 1e-3 from it in margin where the branch
@@ -163,6 +200,8 @@ class OnsetSteps:
                 notes.append("the branch turns back here: a nonsmooth fold")
         for k in range(near, len(self.specials)):
             key, point = self.specials[k]
+            if point.orbit.hybrid is not None and grazing_margin(point.orbit.hybrid) >= INDUCED_MARGIN:
+                continue  # found on the way to it, farther than where it induces
             self.specials[k] = (key, dataclasses.replace(point, note=f"{point.note} (next to the contact onset at {found.value:.10g}: induced by it)"))
         self.specials.append((at, dataclasses.replace(found, note="; ".join(notes))))
 
@@ -196,7 +235,8 @@ class OnsetSteps:
         parameter that leaves the point.
         """
         if start.out.hybrid is None or start.out.hybrid.onset_depth is None:
-            return []  # rigid stops: the located point and the orbit beyond carry the branch on
+            departure, self.departure = getattr(self, "departure", []), []
+            return departure  # rigid stops: the closed-form orbits found at the onset (:meth:`_rigid_ladder`)
         signature = signature_of(start) if signature is None else signature
         margin = grazing_margin(start.out.hybrid) if signature_of(start) == signature else 0.0
         if margin >= 1e-3:

@@ -18,7 +18,53 @@ from scipy.optimize import brentq
 
 from vibroimpact.orbits.branch import ParametrisedMap
 
-__all__ = ["contact_free_onset", "linear_clearance", "stability_change", "touches_ahead", "SCAN_POINTS"]
+__all__ = ["contact_free_onset", "impacting_ladder", "linear_clearance", "stability_change", "touches_ahead", "SCAN_POINTS", "LADDER"]
+
+#: The distances to grazing (approach speed over w L) of the closed-form impacting orbits that carry a rigid stop's
+#: branch to and from its onset: 1e-6 doubling to 1.02e-3, where arclength steps take over (the impacting orbit's
+#: multipliers grow like one over the impact speed next to grazing, and Newton's region shrinks with it).
+LADDER = tuple(1e-6 * 2.0**k for k in range(11))
+
+
+def impacting_ladder(system: ParametrisedMap, p: NDArray[np.float64], index: int, root: float, margins: tuple[float, ...] = LADDER) -> list[tuple[NDArray[np.float64], NDArray[np.float64], float]]:
+    """The closed-form one-impact orbits (:meth:`~vibroimpact.orbits.maps.ImpactMap.impact_orbit`) next to a rigid
+    stop's onset at parameter ``index`` = ``root``, at about the distances to grazing ``margins`` [-], on the side of
+    the onset where they exist: (state, parameters, margin) of each, in the order of ``margins``; empty where the map
+    has no closed-form impact orbit or none is born at the onset.
+
+    Next to the onset the orbit's impact speed grows linearly with the parameter's distance to it (the impulse is a
+    simple root of eq. 16 at J = 0), so a probe at 1e-9 of the root's magnitude (or of 1) sets the offset of each margin,
+    refined by one secant step."""
+    closed = getattr(system, "impact_orbit", None)
+    if closed is None or not margins:
+        return []
+    probe = 1e-9 * max(abs(root), 1.0)
+    found = None
+    for sign in (1.0, -1.0):
+        q = np.array(p, dtype=float)
+        q[index] = root + sign * probe
+        found = closed(q)
+        if found is not None and found[1] > 0.0:
+            break
+        found = None
+    if found is None:
+        return []
+    slope = found[1] / probe  # margin per unit of the parameter's distance to the onset
+    ladder = []
+    for target in margins:
+        offset = target / slope
+        for _ in range(2):  # the first guess, then one secant step on the margin
+            q = np.array(p, dtype=float)
+            q[index] = root + sign * offset
+            orbit = closed(q)
+            if orbit is None or not orbit[1] > 0.0:
+                break
+            if abs(orbit[1] - target) <= 0.05 * target:
+                break
+            offset *= target / orbit[1]
+        if orbit is not None and orbit[1] > 0.0:
+            ladder.append((orbit[0], q, orbit[1]))
+    return ladder
 
 
 def linear_clearance(system: ParametrisedMap, p: NDArray[np.float64], index: int, value: float) -> float:

@@ -1,0 +1,103 @@
+"""A rigid stop's contact onsets passed both ways by the default continuation (issue 31, item 2): the paper's system
+(Delta = 3 mm, q = 10 N, R = 0.2) from the contact-free orbit at 33 Hz, between its two impacting bands, and from the
+impacting orbit at 37 Hz. At each onset the linear orbit touches the stop (q |H12| = Delta), the one-impact orbit born
+there has an impulse that grows linearly from 0 (a simple root of eq. 16), and its largest multiplier grows like one
+over the impact speed: the branch reaches and leaves the onset on closed-form orbits 1e-6 ... 1e-3 from grazing.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from vibroimpact.engines.exact import ExactEngine
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import PAPER_SYSTEM
+from vibroimpact.orbits.bifurcations import grazing_margin
+from vibroimpact.orbits.continuation import continue_branch
+from vibroimpact.orbits.maps import ImpactMap, closed_form_state
+from vibroimpact.orbits.shooting import shoot
+
+pytestmark = pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")
+
+DELTA, Q = 3e-3, 10.0
+
+
+def _branch(frequency: float):
+    problem = ImpactProblem(PAPER_SYSTEM, RigidStop(DELTA, 0.2), HarmonicForce(Q, frequency))
+    system = ImpactMap(problem)
+    closed = closed_form_state(problem)
+    start = closed if np.all(np.isfinite(closed)) else system.linear_orbit(system.parameters)[0]
+    return system, continue_branch(system, shoot(system, start, system.parameters), "frequency")
+
+
+@pytest.fixture(scope="module")
+def branches():
+    return {f: _branch(f) for f in (33.0, 37.0)}
+
+
+def _onsets() -> list[float]:
+    """Where q |H12(f)| = Delta between 15 and 45 Hz [Hz] (the linear orbit touches the stop)."""
+    gap = lambda f: Q * abs(PAPER_SYSTEM.receptances(2.0 * np.pi * f).h12) - DELTA  # noqa: E731
+    grid = np.linspace(15.0, 45.0, 3001)
+    values = np.array([gap(f) for f in grid])
+    return [brentq(gap, grid[k], grid[k + 1], xtol=1e-14, rtol=1e-15) for k in np.flatnonzero(np.sign(values[:-1]) != np.sign(values[1:]))]
+
+
+def test_one_call_from_between_the_bands_traces_both_bands(branches) -> None:
+    """From the contact-free orbit at 33 Hz: up through the onset at 33.97 Hz onto the second band, around its fold
+    and down its other root to the onset at 37.50 Hz; down through the onset at 26.03 Hz (a nonsmooth fold) onto the
+    first band's unstable root, around its fold to the onset at 20.62 Hz; contact-free beyond both ends."""
+    _, branch = branches[33.0]
+    assert branch.end == "clear, clear"
+    kinds = [(point.kind, round(point.value, 6)) for point in branch.special_points]
+    assert kinds == [
+        ("grazing", 20.617668), ("neimark_sacker", 21.205174), ("fold", 26.702663), ("period_doubling", 26.583637),
+        ("grazing", 26.026487), ("grazing", 33.972218), ("neimark_sacker", 39.025572), ("fold", 40.1717),
+        ("neimark_sacker", 39.563454), ("neimark_sacker", 37.574128), ("grazing", 37.498585),
+    ]  # fmt: skip
+    assert set(branch.impacts) == {0, 1}
+
+
+def test_both_starts_give_the_same_special_points(branches) -> None:
+    """The branch from 37 Hz (impacting) and from 33 Hz (contact-free): the same points, to 1e-9 Hz."""
+    (_, first), (_, second) = branches[33.0], branches[37.0]
+    one = sorted((p.kind, p.value) for p in first.special_points)
+    other = sorted((p.kind, p.value) for p in second.special_points)
+    assert [k for k, _ in one] == [k for k, _ in other]
+    np.testing.assert_allclose([v for _, v in one], [v for _, v in other], rtol=0.0, atol=1e-9)
+
+
+def test_onsets_are_the_closed_form_tangencies(branches) -> None:
+    """Each grazing point is a root of q |H12| = Delta to 1e-12 relative, and says which way the branch goes on."""
+    roots = _onsets()
+    _, branch = branches[33.0]
+    grazing = [point for point in branch.special_points if point.kind == "grazing"]
+    assert len(grazing) == 4
+    for point in grazing:
+        assert min(abs(point.value - root) for root in roots) <= 1e-12 * point.value
+        assert point.continues
+    notes = {round(point.value, 3): point.note for point in grazing}
+    assert "a free flight touches the stop; the branch continues with 1 impacts per period" in notes[33.972]
+    assert "the branch turns back here: a nonsmooth fold" in notes[26.026]
+    assert "a real multiplier through +1" in notes[37.499] and "a real multiplier through +1" in notes[20.618]
+
+
+def test_the_branch_leaves_an_onset_on_the_closed_form_orbits_born_there(branches) -> None:
+    """Past 33.972218 Hz the first impacting orbits are 1e-6, 2e-6, ... 1.02e-3 from grazing and are the closed form
+    (eqs. 15-18) to 1e-12 of the state scale; the largest multiplier falls like one over the margin (2 % up to
+    1.3e-4, 13 % at 1e-3: the next order)."""
+    system, branch = branches[33.0]
+    values = branch.values
+    index = next(k for k, orbit in enumerate(branch.orbits) if orbit.hybrid.impacts == 1 and abs(values[k] - 33.972218) < 1e-3)
+    ladder = branch.orbits[index : index + 11]
+    margins = np.array([grazing_margin(orbit.hybrid) for orbit in ladder])
+    np.testing.assert_allclose(margins, 1e-6 * 2.0 ** np.arange(11), rtol=0.05)
+    for orbit in ladder:
+        state, _margin = system.impact_orbit(orbit.parameters)
+        np.testing.assert_allclose(orbit.state / system.state_scale, state / system.state_scale, rtol=0.0, atol=1e-12)
+    largest = np.array([np.max(np.abs(orbit.multipliers)) for orbit in ladder[:8]])  # up to 1.3e-4 from grazing
+    np.testing.assert_allclose(largest * margins[:8], largest[0] * margins[0], rtol=0.02)
