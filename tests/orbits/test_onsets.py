@@ -102,6 +102,8 @@ def test_onsets_are_the_linear_orbits_touch_and_name_what_happens(branches) -> N
         assert "discontinuity-induced fold" in upper.note and upper.continues
         near = [p for p in branch.special("neimark_sacker") if "induced by it" in p.note]
         assert len(near) == 1 and 0.0 < near[0].value - lower.value < 1e-5 * lower.value
+        assert near[0].induced_by == lower.value  # exact: the onset's own value, carried
+        assert all((p.induced_by is not None) == ("induced by it" in p.note) for p in branch.special_points)
         # the grazing orbit is the linear one touching the bumper
         closed = system.linear_orbit(lower.orbit.parameters)
         assert abs(closed[1]) < 1e-9 and np.max(np.abs(lower.orbit.state - closed[0]) / system.state_scale) < 1e-9

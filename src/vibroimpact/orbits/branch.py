@@ -288,6 +288,9 @@ class SpecialPoint:
         Grazing only: impact count of the orbit found beyond the point, if any.
     eigenvector : ndarray or None
         Period doubling: the eigenvector of the multiplier -1 (for branch switching).
+    induced_by : float or None
+        A fold, period doubling or Neimark-Sacker point found within 1e-3 of a contact onset's grazing on the way to
+        it: the onset's parameter value [its unit]. Its multipliers jump there, so it solves no smooth extended system.
     """
 
     kind: str
@@ -299,6 +302,7 @@ class SpecialPoint:
     continues: bool | None = None
     impacts_after: int | None = None
     eigenvector: NDArray[np.float64] | None = None
+    induced_by: float | None = None
 
 
 @dataclass(frozen=True, eq=False)

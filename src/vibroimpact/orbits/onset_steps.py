@@ -162,7 +162,7 @@ class OnsetSteps:
 
     def _rigid_ladder(self, side: Point, root: float) -> list[Point]:
         """The closed-form one-impact orbits born at a rigid stop's onset at ``root`` (:func:`~vibroimpact.orbits.
-        onsets.impacting_ladder`), as points at distances to grazing 1e-6 ... 1e-3 from it, each with its tangent
+        onsets.impacting_ladder`), as points at distances to grazing 1.6e-5 ... 1e-3 from it, each with its tangent
         pointing away from the onset; empty where the closed form does not apply."""
         ladder = impacting_ladder(self.system, side.p, self.index, root)
         points: list[Point] = []
@@ -202,7 +202,7 @@ class OnsetSteps:
             key, point = self.specials[k]
             if point.orbit.hybrid is not None and grazing_margin(point.orbit.hybrid) >= INDUCED_MARGIN:
                 continue  # found on the way to it, farther than where it induces
-            self.specials[k] = (key, dataclasses.replace(point, note=f"{point.note} (next to the contact onset at {found.value:.10g}: induced by it)"))
+            self.specials[k] = (key, dataclasses.replace(point, note=f"{point.note} (next to the contact onset at {found.value:.10g}: induced by it)", induced_by=found.value))
         self.specials.append((at, dataclasses.replace(found, note="; ".join(notes))))
 
     def _away(self, beyond: Point, at: Point) -> Point:

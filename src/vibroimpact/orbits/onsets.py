@@ -21,9 +21,11 @@ from vibroimpact.orbits.branch import ParametrisedMap
 __all__ = ["contact_free_onset", "impacting_ladder", "linear_clearance", "stability_change", "touches_ahead", "SCAN_POINTS", "LADDER"]
 
 #: The distances to grazing (approach speed over w L) of the closed-form impacting orbits that carry a rigid stop's
-#: branch to and from its onset: 1e-6 doubling to 1.02e-3, where arclength steps take over (the impacting orbit's
-#: multipliers grow like one over the impact speed next to grazing, and Newton's region shrinks with it).
-LADDER = tuple(1e-6 * 2.0**k for k in range(11))
+#: branch to and from its onset: 1.5625e-5 doubling to 1e-3, where arclength steps take over (the impacting orbit's
+#: multipliers grow like one over the impact speed next to grazing, and Newton's region shrinks with it). The first
+#: is 16 times the rigid engines' default sticking velocity (1e-6 of the velocity scale): slower impacts end in
+#: sticking there, and the engine's orbit is no longer the closed form's.
+LADDER = tuple(1.5625e-5 * 2.0**k for k in range(7))
 
 
 def impacting_ladder(system: ParametrisedMap, p: NDArray[np.float64], index: int, root: float, margins: tuple[float, ...] = LADDER) -> list[tuple[NDArray[np.float64], NDArray[np.float64], float]]:

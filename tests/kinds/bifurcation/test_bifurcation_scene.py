@@ -182,3 +182,44 @@ def test_the_general_form_reports_the_load_and_the_missing_restitution() -> None
     both = general([{"coordinate": "x2", "clearance": 0.003}])
     both["stop"] = {"clearance": 0.003}
     assert any(p.startswith("stop:") for p in problems(both))
+
+
+def test_bumpers_given_by_stiffness_are_the_frequency_form_on_each_stops_mass() -> None:
+    """``bumper: {stiffness: [N/m]}``: Omega_b = sqrt(K_b / m_eff) with the stop's effective mass, M2 = 0.1 kg on the
+    paper's stop, m1 m2 / (m1 + m2) on a relative pair of a diagonal M (1e-15 relative); the stiffnesses are kept."""
+    paper = parse_scene(document(bumper={"stiffness": [1e5, 0.1 * (2.0 * 3.141592653589793 * 250.0) ** 2]})).settings
+    assert paper.bumper_frequencies == pytest.approx(((1e5 / 0.1) ** 0.5 / (2.0 * 3.141592653589793), 250.0), rel=1e-15)
+    assert paper.bumper_stiffnesses == pytest.approx((1e5, 0.1 * (2.0 * 3.141592653589793 * 250.0) ** 2), rel=1e-15)
+    relative = parse_scene(general(RELATIVE_PAIR, bumper={"stiffness": [1e5]})).settings
+    mass = 1.0 * 0.1 / 1.1
+    assert relative.bumper_frequencies == pytest.approx(((1e5 / mass) ** 0.5 / (2.0 * 3.141592653589793),), rel=1e-15)
+    assert parse_scene(document(bumper={"frequency": [250.0]})).settings.bumper_stiffnesses == ()
+
+
+@pytest.mark.parametrize(
+    ("doc", "words"),
+    [
+        (document(bumper={"stiffness": [1e5], "frequency": [250.0]}), "give exactly one of frequency (Omega_b / 2 pi [Hz]) or stiffness (K_b [N/m])"),
+        (document(bumper={}), "give exactly one of frequency"),
+        (document(bumper={"stiffness": [-1.0]}), "bifurcation.bumper.stiffness"),
+        (general([{"coordinate": "x1", "side": "upper", "clearance": 0.003}, {"coordinate": "x2", "side": "upper", "clearance": 0.003}], bumper={"stiffness": [1e5]}),
+         "the stops push different effective masses (1, 0.1 kg)"),
+    ],
+)
+def test_a_wrong_bumper_stiffness_names_its_key(doc: dict[str, Any], words: str) -> None:
+    found = problems(doc)
+    assert any(p.startswith("bifurcation.bumper") and words in p for p in found), found
+
+
+def test_a_bumper_given_by_stiffness_is_named_by_it_on_the_page() -> None:
+    import math
+
+    import numpy as np
+    import xarray as xr
+
+    from vibroimpact.kinds.bifurcation.bumper import bumper_name
+
+    given = xr.Dataset(attrs={"bumper_frequencies_Hz": np.array([159.15494309189535, 250.0]), "bumper_stiffnesses_N_per_m": np.array([1e5, 246740.11002723395])})
+    assert bumper_name(given, 250.0) == "K_b = 2.467e+05 N/m (250 Hz)"
+    assert "K_b" not in bumper_name(given, math.inf)
+    assert bumper_name(xr.Dataset(attrs={"bumper_frequencies_Hz": np.array([250.0])}), 250.0) == "250 Hz"

@@ -25,6 +25,7 @@ onsets at tangency.
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -157,7 +158,8 @@ class OrbitSet:
         for orbit in branch.orbits:
             self.points.append(_record(system, orbit) | {"branch": label, "origin": ORIGINS.index(origin)})
         for point in branch.special_points:
-            self.add_special(_record(system, point.orbit) | {"branch": label, "kind": SPECIAL_POINT_KINDS.index(point.kind), "frequency": point.value, "note": point.note})
+            self.add_special(_record(system, point.orbit) | {"branch": label, "kind": SPECIAL_POINT_KINDS.index(point.kind), "frequency": point.value, "note": point.note,
+                                                           "induced_by": math.nan if point.induced_by is None else point.induced_by})
         self.notes.append(f"branch {label} ({origin}): {len(branch.orbits)} points, {branch.values.min():.4f}-{branch.values.max():.4f} Hz, ends: {branch.end}")
         return label
 
@@ -372,8 +374,8 @@ def find_branches(
     if period_doubling:
         for mapping, branch in list(maps):
             for point in branch.special("period_doubling"):
-                if point.orbit.period != 1:
-                    continue
+                if point.orbit.period != 1 or point.induced_by is not None:
+                    continue  # (a doubling induced by a contact onset has no smooth period-2 branch next to it)
 
                 def doubled(mapping: ImpactMap = mapping, point: SpecialPoint = point) -> None:
                     orbit = switch_period_doubling(mapping, point)

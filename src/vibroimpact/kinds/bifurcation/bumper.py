@@ -39,7 +39,7 @@ from vibroimpact.reporting.page import DrawnFigure, Table
 from vibroimpact.runs.failures import as_lines
 from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure
 
-__all__ = ["has_bumpers", "has_rigid", "diagram_models", "model_view", "rigid_view", "bumper_frequencies", "convergence_rows", "convergence_table", "bumper_answer", "absent_text", "bumper_figure", "MATCH_WINDOW", "SAME_POINT"]
+__all__ = ["has_bumpers", "has_rigid", "diagram_models", "model_view", "rigid_view", "bumper_frequencies", "bumper_name", "convergence_rows", "convergence_table", "bumper_answer", "absent_text", "bumper_figure", "MATCH_WINDOW", "SAME_POINT"]
 
 #: Largest distance [Hz] of the stiffest bumper's special point from the rigid stop's it is matched with.
 MATCH_WINDOW = 0.5
@@ -96,8 +96,19 @@ def model_view(dataset: xr.Dataset, bumper: float) -> xr.Dataset:
         index = [float(f) for f in view["bumper_frequency"].values].index(bumper)
         view = view.isel(bumper_frequency=index).drop_vars("bumper_frequency")
     rigid = math.isinf(bumper)
-    return view.assign_attrs(diagram_label="rigid stop" if rigid else f"bumper {fmt(bumper, 'g')} Hz", diagram_tag="_rigid" if rigid else f"_bumper{fmt(bumper, 'g')}Hz",
+    return view.assign_attrs(diagram_label="rigid stop" if rigid else f"bumper {bumper_name(dataset, bumper)}", diagram_tag="_rigid" if rigid else f"_bumper{fmt(bumper, 'g')}Hz",
                              brute_force_engine="compiled exact engine" if rigid else "the bumper's compiled closed-form engine")  # fmt: skip
+
+
+def bumper_name(dataset: xr.Dataset, bumper: float) -> str:
+    """A bumper in the scene's own units: ``250 Hz``, or ``K_b = 2.467e+05 N/m (250 Hz)`` where the scene gave its
+    stiffness (the attribute ``bumper_stiffnesses_N_per_m``, in the order of ``bumper_frequencies_Hz``)."""
+    frequency = f"{fmt(bumper, 'g')} Hz"
+    stiffnesses, frequencies = dataset.attrs.get("bumper_stiffnesses_N_per_m"), dataset.attrs.get("bumper_frequencies_Hz")
+    if stiffnesses is None or frequencies is None or math.isinf(bumper):
+        return frequency
+    match = [k for k, f in zip(np.atleast_1d(stiffnesses), np.atleast_1d(frequencies)) if abs(float(f) - bumper) <= 1e-12 * bumper]
+    return f"K_b = {float(match[0]):.4g} N/m ({frequency})" if match else frequency
 
 
 def _of(values: np.ndarray, bumper: float) -> np.ndarray:
@@ -240,7 +251,7 @@ def convergence_table(dataset: xr.Dataset) -> Table:
     """Per restitution and special point: the rigid stop's frequency, each bumper's and its difference, and the
     observed orders of convergence."""
     bumpers = bumper_frequencies(dataset)
-    heads = ["R", "special point", "rigid stop [Hz]"] + [f"{fmt(fb, 'g')} Hz bumper [Hz] (difference)" for fb in bumpers]
+    heads = ["R", "special point", "rigid stop [Hz]"] + [f"{bumper_name(dataset, fb)} bumper [Hz] (difference)" for fb in bumpers]
     heads += [f"order {fmt(a, 'g')} → {fmt(b, 'g')} Hz" for a, b in zip(bumpers[:-1], bumpers[1:])]
     body = []
     for r in dataset["restitution"].values:
@@ -288,7 +299,7 @@ def bumper_answer(dataset: xr.Dataset) -> str:
         shifts = [(abs(float(row["errors"][0])), row) for row in rows if math.isfinite(float(row["errors"][0])) and not row["same"]]
         if shifts:
             size, row = max(shifts, key=lambda item: item[0])
-            words.append(f"the {fmt(bumpers[0], 'g')} Hz bumper moves them by up to {fmt(size, '.3g')} Hz (the {_name(str(row['kind']))} at {fmt(float(row['rigid']), '.3f')} Hz)")
+            words.append(f"the {bumper_name(dataset, bumpers[0])} bumper moves them by up to {fmt(size, '.3g')} Hz (the {_name(str(row['kind']))} at {fmt(float(row['rigid']), '.3f')} Hz)")
         same = [row for row in rows if row["same"]]
         if same:
             words.append(f"the contact onsets at tangency at {', '.join(fmt(float(row['rigid']), '.3f') for row in same)} Hz, where the one-impact orbit's entry speed "
@@ -346,7 +357,7 @@ def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
                 run = np.append(piece, piece[-1] + 1) if piece.size and piece[-1] + 1 < f.size else piece
                 if run.size:
                     left.plot(f[run], amp[run], color=colours[fb], **(STABLE_STYLE if stable[piece[0]] else UNSTABLE_STYLE))
-        left.plot([], [], color=colours[fb], lw=2, label="rigid stop" if math.isinf(fb) else f"bumper {fmt(fb, 'g')} Hz")
+        left.plot([], [], color=colours[fb], lw=2, label="rigid stop" if math.isinf(fb) else f"bumper {bumper_name(dataset, fb)}")
     kinds = flags(dataset["special_point_kind"])
     sp_fb = dataset["special_point_bumper_frequency"].values
     for code, kind in enumerate(kinds):

@@ -378,6 +378,7 @@ def branch_arrays(found: OrbitSet, size: int) -> CaseResult:
         "sp_amplitudes": table(specials, "amplitudes", size), "sp_impulse": column(specials, "impulse"),
         "sp_floquet_modulus": column(specials, "floquet_modulus"), "sp_impacts": column(specials, "impacts", int),
         "sp_period": column(specials, "period", int), "sp_multipliers_real": sm.real, "sp_multipliers_imag": sm.imag,
+        "sp_induced_by": np.array([row.get("induced_by", np.nan) for row in specials], dtype=float),  # (NaN: a smooth point)
         "sp_note": np.array([row["note"] for row in specials], dtype=str), "sp_found_on": np.array([" ".join(map(str, row["found_on"])) for row in specials], dtype=str),
         "notes": np.array(found.notes, dtype=str), "absent": np.array(found.absent, dtype=str), **failure_arrays(found.attempts, found.failures),
     }  # fmt: skip
@@ -430,6 +431,8 @@ class ChartCase:
                 kind = SPECIAL_POINT_KINDS.index(point.kind)
                 if point.kind not in self.kinds or (point.kind == "grazing" and "velocity" in point.note):
                     continue  # the closed-form orbit's vanishing impact: the linear-response curve above
+                if point.induced_by is not None:
+                    continue  # induced by a contact onset (multipliers jump there): no smooth extended system
                 if any(k == kind and abs(f - point.value) < 1e-3 and abs(d - clearance) < 1e-6 for _c, k, f, d in rows):
                     continue  # on a curve already followed
                 attempts["curve"] = attempts.get("curve", 0) + 1

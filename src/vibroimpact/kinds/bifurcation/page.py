@@ -120,12 +120,15 @@ def _branch_classes(dataset: xr.Dataset) -> np.ndarray:
 def orbit_rows(dataset: xr.Dataset, restitution: float) -> list[dict[str, object]]:
     """Every class of periodic orbit continued at one restitution, in order of period and impacts: its name, branches,
     the bands [Hz] where it exists and where it is stable, and the frequencies [Hz] of its special points by kind (each
-    at the class of the branch it was found on)."""
+    at the class of the branch it was found on; not those a contact onset induces: the special points' table lists
+    them with their onset)."""
     at_r = np.isclose(dataset["branch_restitution"].values, restitution)
     classes = _branch_classes(dataset)
     kinds = _flags(dataset["special_point_kind"])
     branch_of = {int(b): tuple(c) for b, c in zip(dataset["branch"].values, classes)}
     sp_at_r = np.isclose(dataset["special_point_restitution"].values, restitution)
+    if "special_point_induced_by" in dataset:  # a point an onset induces is the onset's (its grazing note), not one more
+        sp_at_r &= ~np.isfinite(dataset["special_point_induced_by"].values)
     rows = []
     for key in sorted({tuple(c) for c in classes[at_r]}, key=lambda k: (k[1], k[0])):
         chosen = at_r & (classes == key).all(axis=1)

@@ -53,6 +53,7 @@ import numpy as np
 
 from vibroimpact.model.structure import require_in_range, require_positive
 from vibroimpact.scene.checker import Checker, SceneError
+from vibroimpact.model.contact import place_effective_mass
 from vibroimpact.model.layout import Layout, StopSpec
 from vibroimpact.scene.header import parse_names
 from vibroimpact.scene.layout_parse import parse_layout, static_drift
@@ -217,6 +218,9 @@ class BifurcationSettings:
     reference : str
         With bumpers, :data:`REFERENCES`: ``rigid`` adds the rigid stop's diagram as the convergence reference,
         ``none`` runs the bumpers alone; without bumpers ``none`` (the diagram is the rigid stop's).
+    bumper_stiffnesses : tuple of float
+        K_b of each bumper as the scene gave it [N m-1] (empty: given as frequencies), in the order of
+        ``bumper_frequencies``.
     """
 
     low: float
@@ -228,12 +232,15 @@ class BifurcationSettings:
     chart: ChartSettings | None = None
     bumper_frequencies: tuple[float, ...] = ()
     reference: str = "none"
+    bumper_stiffnesses: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         if not 0.0 < self.low < self.high:
             raise ValueError(f"frequency band ({self.low!r}, {self.high!r}): expected 0 < start < stop [Hz]")
         if self.reference not in REFERENCES:
             raise ValueError(f"reference = {self.reference!r} is not allowed: use one of {', '.join(REFERENCES)}")
+        if self.bumper_stiffnesses and len(self.bumper_stiffnesses) != len(self.bumper_frequencies):
+            raise ValueError(f"bumper_stiffnesses: expected {len(self.bumper_frequencies)} values (one per bumper frequency), got {len(self.bumper_stiffnesses)}")
         if self.reference != "none" and not self.bumper_frequencies:
             raise ValueError(f"reference = {self.reference!r}: a reference needs bumpers (without them the diagram is the rigid stop's)")
 
@@ -294,7 +301,11 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
     brute = _settings(c, "bifurcation.brute_force", spec.get("brute_force", {}), _BRUTE_KEYS, _brute_values)
     branches = _settings(c, "bifurcation.continuation", spec.get("continuation", {}), _BRANCH_KEYS, _branch_values)
     chart = _settings(c, "bifurcation.chart", spec["chart"], _CHART_KEYS, _chart_values) if "chart" in spec else None
-    bumpers = _bumpers(c, spec["bumper"]) if "bumper" in spec else ()
+    masses = None  # the mass each stop's bumper pushes [kg] (the paper's stop: M2)
+    if layout is not None and specs is not None:
+        masses = [item.effective_mass(layout.structure) for item in specs] if specs else [place_effective_mass((1, None, "upper"), layout.structure.mass_matrix)]
+    given = _bumpers(c, spec["bumper"], masses) if "bumper" in spec else ((), ())
+    bumpers, stiffnesses = given if given is not None else (None, ())
     reference = "none"
     if "reference" in spec:
         if spec["reference"] not in REFERENCES:
@@ -321,7 +332,7 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
         raise SceneError(c.problems, source)
     assert layout is not None and specs is not None and amplitude is not None and isinstance(name, str) and clearance is not None
     assert low is not None and high is not None and restitution is not None and brute is not None and branches is not None
-    settings = BifurcationSettings(low, high, tuple(float(r) for r in restitution), float(clearance), brute, branches, chart, tuple(bumpers or ()), reference)
+    settings = BifurcationSettings(low, high, tuple(float(r) for r in restitution), float(clearance), brute, branches, chart, tuple(bumpers or ()), reference, stiffnesses)
     return Scene(
         name=name,
         description=description,
@@ -354,7 +365,7 @@ def _stops(c: Checker, doc: dict, layout: Layout | None, swept_restitution: bool
     for k, stop in enumerate(specs):
         entry = doc["stops"][k]
         if "bumper" in entry:
-            c.fail(f"stops[{k}].bumper", "a bifurcation study's stops are rigid; bumpers beside them are given by bifurcation.bumper: {frequency: [Hz, ...]}")
+            c.fail(f"stops[{k}].bumper", "a bifurcation study's stops are rigid; bumpers beside them are given by bifurcation.bumper: {frequency: [Hz, ...]} or {stiffness: [N/m, ...]}")
             ok = False
         if stop.clearance is None:
             c.fail(f"stops[{k}].clearance", "required: Delta [m] in (0, inf), the same for every stop (the chart varies it)")
@@ -381,13 +392,28 @@ def _stops(c: Checker, doc: dict, layout: Layout | None, swept_restitution: bool
     return shared, specs[0].clearance, own
 
 
-def _bumpers(c: Checker, value: Any) -> tuple[float, ...] | None:
-    """``bifurcation.bumper``: {frequency: Omega_b / 2 pi [Hz], a list (or grid) of values > 0}."""
-    spec = c.mapping("bifurcation.bumper", value, {"frequency"}, {"frequency"})
-    if "frequency" not in spec:
+def _bumpers(c: Checker, value: Any, masses: list[float] | None) -> tuple[tuple[float, ...], tuple[float, ...]] | None:
+    """``bifurcation.bumper``: {frequency: Omega_b / 2 pi [Hz]} or {stiffness: K_b [N/m]}, a list (or grid) of values
+    > 0: the bumpers' frequencies [Hz] and the stiffnesses the scene gave (empty for the frequency form), converted
+    with the stops' effective mass ``masses`` [kg] (which must be one: one frequency per bumper for every stop)."""
+    spec = c.mapping("bifurcation.bumper", value, {"frequency", "stiffness"})
+    forms = [key for key in ("frequency", "stiffness") if key in spec]
+    if len(forms) != 1:
+        c.fail("bifurcation.bumper", f"give exactly one of frequency (Omega_b / 2 pi [Hz]) or stiffness (K_b [N/m]), got {forms or 'neither'}")
         return None
-    grid = c.grid("bifurcation.bumper.frequency", spec["frequency"], 0.0, math.inf, False)
-    return None if grid is None else tuple(float(f) for f in grid)
+    key = f"bifurcation.bumper.{forms[0]}"
+    grid = c.grid(key, spec[forms[0]], 0.0, math.inf, False)
+    if grid is None:
+        return None
+    if forms[0] == "frequency":
+        return tuple(float(f) for f in grid), ()
+    if not masses:
+        return None  # (the layout failed: said already)
+    if max(masses) - min(masses) > 1e-12 * max(masses):
+        c.fail(key, f"the stops push different effective masses ({', '.join(f'{m:.6g}' for m in masses)} kg): one K_b gives each its own Omega_b; give bumper.frequency instead")
+        return None
+    mass = masses[0]
+    return tuple(math.sqrt(float(k) / mass) / (2.0 * math.pi) for k in grid), tuple(float(k) for k in grid)
 
 
 def _settings(c: Checker, key: str, value: Any, allowed: set[str], values: Any) -> Any:

@@ -38,8 +38,9 @@ __all__ = ["StiffnessCase", "monotone_pieces", "curve_pieces", "on_piece", "FOLL
 #: The kinds of special point followed in the bumper's stiffness (a grazing point, the contact onset at tangency,
 #: does not depend on Omega_b).
 FOLLOWED = ("fold", "period_doubling", "neimark_sacker")
-#: How the continuation marks a special point located next to a contact onset and induced by it (its note): the
-#: multipliers jump across the unit circle at the onset, which does not depend on Omega_b, so the point solves no
+#: How the continuation's note marks a special point located next to a contact onset and induced by it (its
+#: ``induced_by``, the onset's value, says so to code): the multipliers jump across the unit circle at the onset,
+#: which does not depend on Omega_b, so the point solves no
 #: smooth extended system and has no curve in the stiffness (the shipped study's 4 kHz bumper: a period doubling
 #: 1.1e-4 Hz above the onset at 26.026487 Hz, "does not solve its extended system" when followed).
 INDUCED = "induced by it"
@@ -114,7 +115,7 @@ class StiffnessCase:
             system = BumperPeriodMap(mapping.problem, bounds=bounds)
             for point in branch.special_points:
                 kind = SPECIAL_POINT_KINDS.index(point.kind)
-                if point.kind not in FOLLOWED or INDUCED in point.note or _on_a_curve(rows, kind, point.value, float(system.parameters[-1])):
+                if point.kind not in FOLLOWED or point.induced_by is not None or _on_a_curve(rows, kind, point.value, float(system.parameters[-1])):
                     continue  # not followed (or induced by a contact onset); or on a curve already followed (both roots' branches, a fold pair's cusp)
                 attempts["stiffness_curve"] += 1
                 try:

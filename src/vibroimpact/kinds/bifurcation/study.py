@@ -284,7 +284,7 @@ def _branches(results: list[CaseResult], restitutions: tuple[float, ...], coordi
         m = result["sp_frequency"].size
         specials.setdefault("branch", []).append(result["sp_branch"])
         specials.setdefault("restitution", []).append(np.full(m, r))
-        for name in ("kind", "frequency", "amplitudes", "impulse", "floquet_modulus", "impacts", "period", "multipliers_real", "multipliers_imag", "note"):
+        for name in ("kind", "frequency", "amplitudes", "impulse", "floquet_modulus", "impacts", "period", "multipliers_real", "multipliers_imag", "note", "induced_by"):
             specials.setdefault(name, []).append(result[f"sp_{name}"])
         specials.setdefault("found_on", []).append(result["sp_found_on"])
     p = {k: np.concatenate(v) for k, v in points.items()}
@@ -317,6 +317,7 @@ def _branches(results: list[CaseResult], restitutions: tuple[float, ...], coordi
             "special_point_multiplier_real": (sp + ("multiplier",), s["multipliers_real"].reshape(-1, 2 * size), a["special_point_multiplier_real"]),
             "special_point_multiplier_imag": (sp + ("multiplier",), s["multipliers_imag"].reshape(-1, 2 * size), a["special_point_multiplier_imag"]),
             "special_point_note": (sp, s["note"].astype(str), a["special_point_note"]),
+            "special_point_induced_by": (sp, s["induced_by"], a["special_point_induced_by"]),
             "special_point_branches": (sp, s["found_on"].astype(str), a["special_point_branches"]),
         },
         coords={
@@ -448,6 +449,8 @@ def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult],
         if absent:
             attrs["bumper_starts_without_orbit"] = absent
         attrs["bumper_frequencies_Hz"] = np.array(settings.bumper_frequencies)
+        if settings.bumper_stiffnesses:  # the scene gave K_b [N/m]: its pages say so
+            attrs["bumper_stiffnesses_N_per_m"] = np.array(settings.bumper_stiffnesses)
         attrs["bifurcation_reference"] = settings.reference
         attrs["method_brute_force"] = (f"each diagram's own contact law: the bumpers' with their closed-form engine ({_engine(settings.bumper_frequencies[0])}), "
                                        + (f"the rigid stop's with the compiled exact engine ({_engine(None)}); " if settings.rigid else "")

@@ -34,6 +34,7 @@ BIFURCATION_ATTRIBUTES: dict[str, dict[str, str]] = {
     "special_point_multiplier_real": {"units": "1", "long_name": "real part of the Floquet multipliers at the special point"},
     "special_point_multiplier_imag": {"units": "1", "long_name": "imaginary part of the Floquet multipliers at the special point"},
     "special_point_note": {"long_name": "what happens at the special point"},
+    "special_point_induced_by": {"units": "Hz", "long_name": "frequency of the contact onset within 1e-3 of whose grazing the point was found, its multipliers' jump there (NaN: a smooth bifurcation)"},
     "special_point_branches": {"long_name": "labels of every branch the special point was found on, space-separated (the first: special_point_branch, whose orbit the other variables describe)"},
     "brute_x1": {"units": "m", "long_name": "brute force: X1 at each kept strobe t = k T (force q cos(w t))"},
     "brute_x1_amplitude": {"units": "m", "long_name": "brute force: fundamental-harmonic amplitude of X1 over each kept period"},
