@@ -38,7 +38,8 @@ def test_seeds_that_fail_are_counted_and_summarised() -> None:
     result = failure_arrays(found.attempts, found.failures) | {"notes": np.array(found.notes, dtype=str)}
     lines, details = failure_summary(tallies(result, "R = 0.2"))
     meaning = FAILURES["seed"].meaning
-    assert lines == [f"{FAILURES['seed'].what}, R = 0.2: 2 of 2 failed (2 with 'the map returned a non-finite state'); {meaning}"]
+    which = "which: brute-force seed at 25.000 Hz (period 1); brute-force seed at 25.500 Hz (period 2)"
+    assert lines == [f"{FAILURES['seed'].what}, R = 0.2: 2 of 2 failed (2 with 'the map returned a non-finite state'; {which}); {meaning}"]
     assert len(details) == 2 and all(d.startswith("R = 0.2: brute-force seed at 25") and "ShootingError" in d for d in details)
     said: list[str] = []
     _say_notes(said.append, "R = 0.2", result)  # the console: the notes without the raw failures
@@ -55,7 +56,8 @@ def test_brute_force_points_that_fail_are_counted() -> None:
     down = {"regime": np.array([1, 1, 1], dtype=np.int8), "error": np.array(["", "", ""])}
     tally = sweep_tally("sweep", "R = 0.8", [up, down], ["sweeping up", "sweeping down"], f)
     lines, details = failure_summary([tally])
-    assert lines == [f"{FAILURES['sweep'].what}, R = 0.8: 2 of 6 failed (2 with 'no progress: 70 events'); {FAILURES['sweep'].meaning}"]
+    which = "which: sweeping up at 20.500 Hz; sweeping up at 21.000 Hz"
+    assert lines == [f"{FAILURES['sweep'].what}, R = 0.8: 2 of 6 failed (2 with 'no progress: 70 events'; {which}); {FAILURES['sweep'].meaning}"]
     assert details == ["R = 0.8: sweeping up at 20.500 Hz failed: RuntimeError: no progress at t = 1.5 s: 70 events",
                        "R = 0.8: sweeping up at 21.000 Hz failed: RuntimeError: no progress at t = 2.25 s: 70 events"]  # fmt: skip
     assert failure_summary([sweep_tally("sweep", "R = 0.8", [down], ["sweeping down"], f)]) == ([], [])
@@ -94,3 +96,14 @@ def test_a_run_records_its_failures_in_its_dataset(small_bifurcation: xr.Dataset
     for detail in details:
         where, message = detail.split(": ", 1)
         assert message in log or "sweeping" in message, detail
+
+
+def test_a_failure_line_names_its_starts_and_how_far_newton_began() -> None:
+    """Each failed start is named in its line, with the scaled residual Newton's method began from where the message
+    gives it (a seed 6 % of the state scale off a periodic orbit says why it failed); past six, how many more."""
+    from vibroimpact.kinds.bifurcation.logs import Tally
+
+    details = tuple(f"brute-force seed at {20.0 + k:.3f} Hz (period 13) failed: ShootingError: the line search failed (scaled residual history: [0.0637, 0.0548])" for k in range(8))
+    lines, _ = failure_summary([Tally("seed", "R = 0.2", 32, details)])
+    assert "which: brute-force seed at 20.000 Hz (period 13), residual 0.0637 at the start; " in lines[0]
+    assert "brute-force seed at 25.000 Hz (period 13), residual 0.0637 at the start; and 2 more)" in lines[0]

@@ -183,16 +183,30 @@ def _reason(detail: str) -> str:
     return _PARTICULARS.sub("", message)
 
 
+#: The most starts a failure line names (the raw messages name every one).
+NAMED_STARTS = 6
+
+
+def _start(detail: str) -> str:
+    """Which start a raw message is of ("brute-force seed at 21.000 Hz (period 13)"), with the scaled residual
+    Newton's method started from where it gives one (how far the start was from an orbit)."""
+    subject = detail.split(" failed: ", 1)[0]
+    first = re.search(r"scaled residual history: \[([-+0-9.e]+)", detail)
+    return f"{subject}, residual {first.group(1)} at the start" if first else subject
+
+
 def failure_summary(counted: Sequence[Tally]) -> tuple[list[str], list[str]]:
     """The run's failures: one line per tally that failed, "<what failed>, <where>: <k> of <n> failed (<k1> with
-    '<reason 1>'; ...); <what it means for the results>", and every raw message, "<where>: <message>" (both empty
-    when nothing failed)."""
+    '<reason 1>'; ...; which: <start>, ...); <what it means for the results>", and every raw message, "<where>:
+    <message>" (both empty when nothing failed)."""
     lines, details = [], []
     for tally in counted:
         if not tally.details:
             continue
         kind = FAILURES[tally.kind]
         reasons = "; ".join(f"{count} with '{reason}'" for reason, count in Counter(_reason(d) for d in tally.details).most_common())
-        lines.append(f"{kind.what}, {tally.where}: {len(tally.details)} of {tally.total} failed ({reasons}); {kind.meaning}")
+        starts = [_start(d) for d in tally.details]
+        which = "; ".join(starts[:NAMED_STARTS]) + (f"; and {len(starts) - NAMED_STARTS} more" if len(starts) > NAMED_STARTS else "")
+        lines.append(f"{kind.what}, {tally.where}: {len(tally.details)} of {tally.total} failed ({reasons}; which: {which}); {kind.meaning}")
         details += [f"{tally.where}: {detail}" for detail in tally.details]
     return lines, details
