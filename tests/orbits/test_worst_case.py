@@ -50,3 +50,17 @@ def test_unstable_orbits_count_only_when_asked(traced) -> None:
     everything, stable = branch_maximum(system, branch, stable_only=False), branch_maximum(system, branch)
     assert everything.amplitude >= stable.amplitude
     assert everything.amplitude >= branch_measures(system, branch).amplitude(0).max() * (1.0 - 1e-12)
+
+
+def test_the_worst_case_over_the_band_names_its_motion() -> None:
+    """The paper's design over 15-45 Hz: the contact-free orbit where it clears the stop and every branch from the
+    closed form (the isolated 18.25-18.71 Hz branch, unstable, and the main one, traced once): the worst stable |X1|
+    is the one-impact orbit's 2.7526 mm at 25.16 Hz, the closed form's maximum to 1e-12."""
+    from vibroimpact.orbits.worst_case import worst_response
+
+    worst = worst_response(PROBLEM, (15.0, 45.0))
+    closed = minimize_scalar(lambda f: -float(np.abs(solve_impact_orbit(PROBLEM, frequency=np.array([f]), root="+").harmonics())[0, 0]),
+                             bounds=(25.0, 25.3), method="bounded", options={"xatol": 1e-12})  # fmt: skip
+    assert worst.amplitude == pytest.approx(-closed.fun, rel=1e-12)
+    assert worst.motion.startswith("1 impact per period") and worst.frequency == pytest.approx(25.1612, abs=1e-4)
+    assert len(worst.branches) == 2 and sum(top is None for _b, top in worst.branches) == 1

@@ -10,6 +10,7 @@ orbit shot from the sampled orbit's state: the maximum to the shooting's toleran
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -17,11 +18,15 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from vibroimpact.analysis.impact_orbit import solve_impact_orbit
+from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import Branch, PeriodicOrbit
-from vibroimpact.orbits.maps import branch_measures, orbit_measures
+from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
+from vibroimpact.orbits.maps import ImpactMap, branch_measures, closed_form_state, orbit_measures
 from vibroimpact.orbits.shooting import ShootingError, shoot
 
-__all__ = ["BranchMaximum", "branch_maximum", "STABLE_BOUNDARY"]
+__all__ = ["BranchMaximum", "branch_maximum", "WorstCase", "worst_response", "STABLE_BOUNDARY"]
 
 #: A special point's orbit with every |multiplier| below 1 + this borders a stable stretch (its critical multiplier
 #: is on the unit circle) [-].
@@ -116,3 +121,113 @@ def _interior(system: Any, branch: Branch, i: int, coordinate: int, tolerance: f
     if not math.isfinite(float(result.fun)) or float(result.x) not in found:
         return None
     return BranchMaximum(-float(result.fun), float(result.x), "interior", found[float(result.x)])
+
+
+@dataclass(frozen=True, eq=False)
+class WorstCase:
+    """The largest stable |X| of a problem over a band (:func:`worst_response`).
+
+    Attributes
+    ----------
+    amplitude : float
+        |X| [m].
+    frequency : float
+        Where [Hz].
+    motion : str
+        Which motion sets it ("the contact-free orbit", "one impact per period", ...) and where on its branch.
+    branches : tuple of (Branch, BranchMaximum or None)
+        Every branch continued for it, with its own maximum.
+    """
+
+    amplitude: float
+    frequency: float
+    motion: str
+    branches: tuple[tuple[Branch, BranchMaximum | None], ...]
+
+
+def worst_response(problem: Any, band: tuple[float, float], coordinate: int = 0, scan: int = 301) -> WorstCase:
+    """The largest stable |X| of ``coordinate`` over ``band`` [Hz], over the contact-free orbit (in closed form, where
+    it clears the stops) and every branch continued from a closed-form one-impact orbit (each root of eq. 16, the
+    middle of each run of ``scan`` frequencies where it exists and is admissible), each located exactly
+    (:func:`branch_maximum`). Period-doubled branches and non-periodic attractors are not searched here.
+
+    Raises
+    ------
+    ValueError
+        A problem the closed form does not apply to (several stops that are not a symmetric pair, bumpers).
+    """
+    low, high = (float(f) for f in band)
+    f = np.linspace(low, high, scan)
+    base = ImpactMap(problem)
+    index = base.parameter_names.index("frequency")
+
+    def linear(frequency: float) -> float:
+        p = base.parameters.copy()
+        p[index] = frequency
+        found = base.linear_orbit(p)
+        if found is None or found[1] < 0.0:
+            return math.nan
+        q = ImpactProblem(problem.system, problem.contact, dataclasses.replace(problem.harmonic, frequency=frequency))
+        return float(abs(linear_amplitudes(q).coordinates[coordinate]))
+
+    best = (-math.inf, math.nan, "")
+    values = np.array([linear(x) for x in f])
+    for i in np.flatnonzero(np.isfinite(values)):
+        left = values[i - 1] if i > 0 else -math.inf
+        right = values[i + 1] if i + 1 < values.size else -math.inf
+        if values[i] >= np.nan_to_num(left, nan=-math.inf) and values[i] >= np.nan_to_num(right, nan=-math.inf):
+            a, b = f[max(i - 1, 0)], f[min(i + 1, f.size - 1)]
+            found = minimize_scalar(lambda x: -np.nan_to_num(linear(x), nan=0.0), bounds=(a, b), method="bounded", options={"xatol": 1e-12 * b})
+            value, where = (-float(found.fun), float(found.x)) if -float(found.fun) >= values[i] else (float(values[i]), float(f[i]))
+            if value > best[0]:
+                best = (value, where, "the contact-free orbit")
+    branches: list[tuple[Branch, BranchMaximum | None]] = []
+    traced: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    for root in ("+", "-"):
+        orbit = solve_impact_orbit(problem, frequency=f, root=root)
+        ok = np.asarray(orbit.admissible(), dtype=bool).reshape(-1)
+        runs = np.split(np.arange(f.size), np.flatnonzero(np.diff(ok.astype(int))) + 1)
+        for run in runs:
+            if not ok[run[0]]:
+                continue
+            start = float(f[run[len(run) // 2]])
+            at = ImpactProblem(problem.system, problem.contact, dataclasses.replace(problem.harmonic, frequency=start))
+            system = ImpactMap(at)
+            single = solve_impact_orbit(at, root=root)
+            x_start = float(np.abs(single.harmonics()).reshape(-1)[coordinate])
+            if any(_passes(known, start, x_start) for known in traced):
+                continue  # a branch already traced passes through this start
+            try:
+                shot = shoot(system, closed_form_state(at, single), system.parameters)
+            except ShootingError:
+                continue
+            branch = continue_branch(system, shot, "frequency", ContinuationSettings(lower=low, upper=high))
+            measured = branch_measures(system, branch)
+            traced.append((branch.values, measured.amplitude(coordinate), branch.impacts))
+            top = branch_maximum(system, branch, coordinate)
+            branches.append((branch, top))
+            if top is not None and top.amplitude > best[0]:
+                best = (top.amplitude, top.value, f"{_motion(top)} ({top.where} of its branch)")
+    return WorstCase(best[0], best[1], best[2], tuple(branches))
+
+
+def _passes(known: tuple[np.ndarray, np.ndarray, np.ndarray], frequency: float, amplitude: float) -> bool:
+    """Does a traced branch (values [Hz], |X| [m], impacts) pass through the one-impact orbit at ``frequency`` with
+    |X| = ``amplitude``: a segment of one-impact points bracketing the frequency whose interpolated |X| is within
+    1e-3 of it (relative)?"""
+    values, amplitudes, impacts = known
+    for i in range(values.size - 1):
+        a, b = float(values[i]), float(values[i + 1])
+        if impacts[i] == impacts[i + 1] == 1 and min(a, b) <= frequency <= max(a, b) and a != b:
+            x = amplitudes[i] + (amplitudes[i + 1] - amplitudes[i]) * (frequency - a) / (b - a)
+            if abs(x - amplitude) <= 1e-3 * amplitude:
+                return True
+    return False
+
+
+def _motion(top: BranchMaximum) -> str:
+    impacts = top.orbit.hybrid.impacts if top.orbit.hybrid is not None else 0
+    period = top.orbit.period
+    if impacts == 0:
+        return "the contact-free orbit"
+    return f"{impacts} impact{'s' if impacts != 1 else ''} per {period} period{'s' if period != 1 else ''}" if period != 1 else f"{impacts} impact{'s' if impacts != 1 else ''} per period"
