@@ -1,0 +1,208 @@
+"""The largest stable response of a rigid-stop design over a band, in closed form: the design search's fast objective
+(issue 32).
+
+Two motions have closed forms on any layout with one stop or a symmetric two-sided pair: the contact-free steady
+state (stable, being linear and damped, where it clears every stop) and the period-1 impact orbit with one impact per
+period (two for the pair; eqs. 15-18, both roots of the impulse equation, each where it exists, stays off the stops
+between impacts and has every Floquet multiplier inside the unit circle). :func:`closed_form_worst` scans both on
+``scan`` frequencies, takes the largest stable |X| of each motion and refines it by zoomed scans between the scan
+points either side (each trial frequency solved in closed form and kept only where the motion is still stable and
+admissible): the maximum's frequency to ``tolerance`` of the frequency, not to a scan step.
+
+What a closed form cannot see: period-k orbits (k > 1), orbits with more impacts per period, and non-periodic
+attractors. The band's share where neither motion is stable is returned as :attr:`BandWorst.uncovered`: there the
+motion is one of those, and only continuation and brute force (:mod:`vibroimpact.orbits.worst_case`, the design
+kind's certification) know its size; :attr:`BandWorst.estimate` guesses it from the unstable orbits there, so that a
+search does not mistake a band it cannot see for a quiet one.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from vibroimpact.analysis.impact_orbit import solve_impact_orbit
+from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
+from vibroimpact.model.problem import ImpactProblem
+
+__all__ = ["BandWorst", "closed_form_worst", "closed_form_at", "MOTIONS", "SCAN"]
+
+#: Frequencies of the scan whose maxima are refined.
+SCAN = 241
+#: Frequencies of each zoomed scan of a maximum.
+ZOOM = 17
+#: The motions with a closed form, as :attr:`BandWorst.motion` names them (index: the CF flag value).
+MOTIONS = ("none", "contact-free", "impacting, period 1")
+
+
+@dataclass(frozen=True)
+class BandWorst:
+    """The largest stable |X| of one coordinate over a band (or at one frequency), over the closed-form motions.
+
+    Attributes
+    ----------
+    amplitude : float
+        |X| [m] (fundamental harmonic); 0 where no closed-form motion is stable anywhere.
+    frequency : float
+        Where [Hz] (NaN where none).
+    motion : str
+        One of :data:`MOTIONS`: which motion sets it.
+    impacts : int
+        Impacts per period of that motion (0 contact-free).
+    uncovered : float
+        Share of the scanned frequencies [-] where no closed-form motion is stable (there the motion is one the
+        closed forms do not know).
+    estimate : float
+        Where uncovered, a guess at the size of the motion there [m]: the largest |X| of the closed-form impact orbits
+        that exist there, stable or not (a non-periodic attractor winds around its unstable orbits), else of the
+        contact-free motion that does not fit; 0 where the band is covered.
+    estimate_frequency : float
+        Where the guess is largest [Hz] (NaN where covered).
+    """
+
+    amplitude: float
+    frequency: float
+    motion: str
+    impacts: int
+    uncovered: float
+    estimate: float = 0.0
+    estimate_frequency: float = math.nan
+
+    def __post_init__(self) -> None:
+        if self.motion not in MOTIONS:
+            raise ValueError(f"motion = {self.motion!r} is not one of {MOTIONS}")
+        if not 0.0 <= self.uncovered <= 1.0:
+            raise ValueError(f"uncovered = {self.uncovered!r} must be a share in [0, 1]")
+
+
+def _linear(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """|X| of the contact-free steady state where it clears every stop (NaN elsewhere), and everywhere."""
+    linear = linear_amplitudes(problem, omega=2.0 * np.pi * f)
+    x = np.abs(linear.coordinates[..., coordinate])
+    return np.where(linear.fits(problem.clearances()), x, np.nan), x
+
+
+def _impacting(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, root: str, largest_only: bool = False) -> tuple[NDArray[np.float64], int, NDArray[np.float64]]:
+    """|X| of the closed-form impact orbit (``root``) where it exists, is stable and admissible, NaN elsewhere; its
+    impacts per period; and |X| wherever it exists (any stability, admissible or not). Stability first (cheap),
+    admissibility (sampled over the period) only where stable; ``largest_only``: only until the largest admissible
+    one is known (the others NaN)."""
+    orbit = solve_impact_orbit(problem, frequency=f, root=root)
+    x = np.full(f.shape, np.nan)
+    exists = np.flatnonzero(np.asarray(orbit.exists, dtype=bool).reshape(-1))
+    if exists.size == 0:
+        return x, orbit.impacts_per_period, x.copy()
+    existing = np.full(f.shape, np.nan)
+    existing[exists] = np.abs(orbit.take(exists).harmonics()[..., coordinate]).reshape(-1)
+    modulus = np.max(np.abs(floquet_multipliers(orbit.take(exists))), axis=-1)
+    stable = exists[modulus < 1.0 - MARGINAL_MODULUS]
+    if stable.size == 0:
+        return x, orbit.impacts_per_period, existing
+    chosen = orbit.take(stable)
+    amplitude = np.abs(chosen.harmonics()[..., coordinate]).reshape(-1)
+    if largest_only:
+        for k in np.argsort(amplitude)[::-1]:
+            if bool(np.asarray(chosen.take([k]).admissible()).reshape(-1)[0]):
+                x[stable[k]] = amplitude[k]
+                break
+        return x, orbit.impacts_per_period, existing
+    ok = np.asarray(chosen.admissible(), dtype=bool).reshape(-1)
+    x[stable[ok]] = amplitude[ok]
+    return x, orbit.impacts_per_period, existing
+
+
+#: The closed-form motions: the contact-free one, and the impact orbit of each root of the impulse equation.
+_ROOTS = (None, "+", "-")
+
+
+def _curve(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, root: str | None, largest_only: bool = False) -> tuple[str, int, NDArray[np.float64], NDArray[np.float64]]:
+    """(motion, impacts, |X| where stable or NaN, |X| where it exists or NaN) of one closed-form motion (``root``
+    None: contact-free, which exists everywhere) at ``f`` [Hz] (``largest_only``: see :func:`_impacting`)."""
+    if root is None:
+        x, everywhere = _linear(problem, f, coordinate)
+        return MOTIONS[1], 0, x, everywhere
+    x, impacts, existing = _impacting(problem, f, coordinate, root, largest_only)
+    return MOTIONS[2], impacts, x, existing
+
+
+def _curves(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int) -> list[tuple[str | None, tuple[str, int, NDArray[np.float64], NDArray[np.float64]]]]:
+    """(root, :func:`_curve`) of every closed-form motion at frequencies ``f`` [Hz]."""
+    return [(root, _curve(problem, f, coordinate, root)) for root in _ROOTS if root is None or problem.stops]
+
+
+def closed_form_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: int = 0, scan: int = SCAN, tolerance: float = 1e-8) -> BandWorst:
+    """The largest stable |X| of ``coordinate`` over ``band`` [Hz] among the closed-form motions (module docstring).
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+        Rigid stops: one, or a symmetric two-sided pair (else the closed form's ``ValueError``).
+    band : (float, float)
+        [Hz], low < high.
+    coordinate : int
+        0: the paper's primary mass x1.
+    scan : int
+        Frequencies of the scan (>= 3).
+    tolerance : float
+        Of the refined frequency, relative [-].
+    """
+    low, high = (float(b) for b in band)
+    if not 0.0 < low < high or scan < 3:
+        raise ValueError(f"band = {band!r} must be 0 < low < high [Hz] and scan = {scan} >= 3")
+    f = np.linspace(low, high, scan)
+    curves = _curves(problem, f, coordinate)
+    covered = np.zeros(f.size, dtype=bool)
+    best = (0.0, math.nan, MOTIONS[0], 0)
+    for root, (motion, impacts, x, _) in curves:
+        covered |= np.isfinite(x)
+        if not np.any(np.isfinite(x)):
+            continue
+        i = int(np.nanargmax(x))
+        value, where = _refine(problem, f, i, float(x[i]), coordinate, root, tolerance)
+        if value > best[0]:
+            best = (value, where, motion, impacts)
+    estimate, estimate_frequency = 0.0, math.nan
+    if not covered.all():
+        impacting = [existing for root, (_, _, _, existing) in curves if root is not None]
+        linear = curves[0][1][3]
+        guess = np.fmax.reduce(impacting) if impacting else np.full(f.size, np.nan)
+        guess = np.where(np.isfinite(guess), guess, linear)[~covered]
+        k = int(np.argmax(guess))
+        estimate, estimate_frequency = float(guess[k]), float(f[~covered][k])
+    return BandWorst(best[0], best[1], best[2], best[3], float(np.count_nonzero(~covered)) / f.size, estimate, estimate_frequency)
+
+
+def _refine(problem: ImpactProblem, f: NDArray[np.float64], i: int, value: float, coordinate: int, root: str | None, tolerance: float) -> tuple[float, float]:
+    """The maximum of the motion ``root`` (:func:`_curve`) between the scan points either side of ``i``, where it
+    stays stable and admissible, never below the scanned ``value``: zoomed scans of :data:`ZOOM` points, each over
+    the two steps around the previous one's maximum, until a step is below ``tolerance`` of the frequency (one
+    vectorised closed form per zoom, where a bounded search would solve one frequency at a time)."""
+    best, where = value, float(f[i])
+    a, b = float(f[max(i - 1, 0)]), float(f[min(i + 1, f.size - 1)])
+    while (b - a) / (ZOOM - 1) > tolerance * b:
+        x = np.linspace(a, b, ZOOM)
+        y = _curve(problem, x, coordinate, root, largest_only=True)[2]
+        if not np.any(np.isfinite(y)):
+            break
+        k = int(np.nanargmax(y))
+        if y[k] > best:
+            best, where = float(y[k]), float(x[k])
+        a, b = float(x[max(k - 1, 0)]), float(x[min(k + 1, x.size - 1)])
+    return best, where
+
+
+def closed_form_at(problem: ImpactProblem, frequency: float, coordinate: int = 0) -> BandWorst:
+    """The largest stable |X| of ``coordinate`` at one ``frequency`` [Hz] among the closed-form motions that coexist
+    there (e.g. an absorber's operating point: the contact-free notch, or an impact orbit that destroys it)."""
+    f = np.array([float(frequency)])
+    best = (0.0, math.nan, MOTIONS[0], 0)
+    covered = False
+    for _, (motion, impacts, x, _) in _curves(problem, f, coordinate):
+        if math.isfinite(x[0]):
+            covered = True
+            if x[0] > best[0]:
+                best = (float(x[0]), float(frequency), motion, impacts)
+    return BandWorst(best[0], best[1], best[2], best[3], 0.0 if covered else 1.0)

@@ -1,0 +1,65 @@
+"""The closed-form worst case of a rigid-stop design over a band (issue 32): the design search's fast objective,
+against the linear optimum's band peak (stop out of reach), the closed form's own bounded search (the paper's design),
+and the motions that coexist at one frequency."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import minimize_scalar
+
+from vibroimpact.analysis.band_worst import MOTIONS, closed_form_at, closed_form_worst
+from vibroimpact.analysis.impact_orbit import solve_impact_orbit
+from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.analysis.linear_optimum import band_peak
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import PAPER_SYSTEM
+
+
+def paper(clearance: float, restitution: float) -> ImpactProblem:
+    return ImpactProblem(PAPER_SYSTEM, RigidStop(clearance, restitution), HarmonicForce(10.0, 25.0))
+
+
+def test_a_stop_out_of_reach_gives_the_linear_band_peak() -> None:
+    """Delta = 1 m: the contact-free motion everywhere, its peak equal to the linear band peak (located there to
+    1e-12 rad/s) to 1e-9 relative; nothing uncovered."""
+    found = closed_form_worst(paper(1.0, 0.5), (15.0, 45.0))
+    linear = band_peak(PAPER_SYSTEM, 10.0, (15.0, 45.0))
+    assert found.motion == MOTIONS[1] and found.impacts == 0 and found.uncovered == 0.0  # exact: a count of none
+    assert found.amplitude == pytest.approx(linear.amplitude, rel=1e-9)
+    assert found.frequency == pytest.approx(linear.frequency, rel=1e-6)
+
+
+def test_the_paper_design_is_set_by_its_one_impact_orbit() -> None:
+    """Delta = 3 mm, R = 0.2: 2.7526 mm at 25.161 Hz, the stable root's maximum by a bounded search on eqs. 15-18 to
+    1e-10 relative (the same number the continued branch gives, tests/orbits/test_worst_case.py)."""
+    problem = paper(0.003, 0.2)
+    found = closed_form_worst(problem, (15.0, 45.0))
+    closed = minimize_scalar(lambda f: -float(np.abs(solve_impact_orbit(problem, frequency=np.array([f]), root="+").harmonics())[0, 0]),
+                             bounds=(25.0, 25.3), method="bounded", options={"xatol": 1e-12})  # fmt: skip
+    assert found.motion == MOTIONS[2] and found.impacts == 1
+    assert found.amplitude == pytest.approx(-closed.fun, rel=1e-10)
+    assert found.frequency == pytest.approx(closed.x, abs=1e-4)
+    assert 0.0 < found.uncovered < 0.5 and 0.0 < found.estimate  # between the bands, no period-1 motion is stable
+
+
+def test_at_one_frequency_the_worst_coexisting_motion_is_taken() -> None:
+    """Delta = 2 mm, R = 0.6 at 20.85 Hz: the linear motion does not fit (its stop coordinate exceeds Delta), the
+    stable impact orbit is the answer, |X1| of one root of eq. 16 to 1e-12; with the stop out of reach, the notch's
+    own |X1|."""
+    problem = paper(0.002, 0.6)
+    at = closed_form_at(problem, 20.85)
+    linear = linear_amplitudes(problem, frequency=20.85)
+    assert not bool(linear.fits(problem.clearances()))
+    roots = [float(np.abs(solve_impact_orbit(problem, frequency=np.array([20.85]), root=r).harmonics())[0, 0]) for r in "+-"]
+    assert at.motion == MOTIONS[2] and min(abs(at.amplitude / x - 1.0) for x in roots if np.isfinite(x)) < 1e-12
+    free = closed_form_at(paper(1.0, 0.6), 20.85)
+    assert free.motion == MOTIONS[1]
+    assert free.amplitude == pytest.approx(abs(linear_amplitudes(paper(1.0, 0.6), frequency=20.85).coordinates[0]), rel=1e-12)
+
+
+def test_a_bad_band_is_refused() -> None:
+    with pytest.raises(ValueError, match="band"):
+        closed_form_worst(paper(0.003, 0.2), (45.0, 15.0))
