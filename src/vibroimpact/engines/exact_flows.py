@@ -186,7 +186,27 @@ def decompose(
     if n == 0:
         empty = np.zeros(0)
         return Flow(empty.astype(complex), np.zeros((0, 0), complex), np.zeros((0, 0), complex), empty.astype(complex), empty, np.zeros((0, 0)), np.zeros((0, 0)), empty, float(omega))
-    return with_harmonic(unforced_flow(a, constant, null_basis), a, harmonic, omega)
+    return with_harmonic(_remembered_unforced_flow(a, np.asarray(constant, dtype=float), null_basis), a, harmonic, omega)
+
+
+#: Most unforced flows :func:`decompose` remembers (per process): a continuation in frequency rebuilds the same
+#: structure's model at every step, and its eigen-decomposition is most of that cost.
+REMEMBERED_FLOWS = 64
+_FLOWS: dict[bytes, Flow] = {}
+
+
+def _remembered_unforced_flow(a: NDArray[np.float64], constant: NDArray[np.float64], null_basis: NDArray[np.float64] | None) -> Flow:
+    """:func:`unforced_flow`, remembered by the bytes of its inputs (the same bits in, the same flow out); the oldest
+    of :data:`REMEMBERED_FLOWS` forgotten first. Nothing reads a flow's arrays but to compute new ones."""
+    basis = None if null_basis is None else np.asarray(null_basis, dtype=float)
+    key = b"|".join((repr((a.shape, constant.shape, None if basis is None else basis.shape)).encode(), a.tobytes(), constant.tobytes(), b"-" if basis is None else basis.tobytes()))
+    flow = _FLOWS.get(key)
+    if flow is None:
+        flow = unforced_flow(a, constant, basis)
+        if len(_FLOWS) >= REMEMBERED_FLOWS:
+            del _FLOWS[next(iter(_FLOWS))]
+        _FLOWS[key] = flow
+    return flow
 
 
 def unforced_flow(matrix: NDArray[np.float64], constant: NDArray[np.float64], null_basis: NDArray[np.float64] | None = None) -> Flow:
