@@ -74,6 +74,7 @@ def _resolve(target: str) -> Any:
 
 #: Every kind of study, first match first (see the module's docstring).
 KINDS: tuple[Kind, ...] = (
+    Kind("design", "design", "vibroimpact.kinds.design.scene:parse_design_scene", "vibroimpact.kinds.design.study:DesignStudy", "vibroimpact.kinds.design.page:page_for"),
     Kind("concepts", "concepts", "vibroimpact.kinds.concepts.scene:parse_concepts_scene", "vibroimpact.kinds.concepts.study:ConceptsStudy", "vibroimpact.kinds.concepts.page:page_for"),
     Kind("validation", "validation", "vibroimpact.kinds.validation.scene:parse_validation_scene", "vibroimpact.kinds.validation.study:ValidationStudy", "vibroimpact.kinds.validation.page:page_for"),
     Kind("benchmark", "benchmark", "vibroimpact.kinds.benchmark.scene:parse_benchmark_scene", "vibroimpact.kinds.benchmark.study:BenchmarkStudy", "vibroimpact.kinds.benchmark.page:page_for"),

@@ -1,0 +1,1 @@
+"""The ``design`` kind: which absorber and stop to build (issue 32)."""

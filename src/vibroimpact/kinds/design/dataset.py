@@ -1,0 +1,194 @@
+"""The dataset of a design study: every evaluation, the mistuning samples, the certificates, and the designs the
+page compares (the recommended one, the scene's own, the optimum linear absorber) with their frequency responses.
+
+Dimensions: ``evaluation`` (every candidate, in the order evaluated), ``sample`` (the mistuning samples, 0 the
+nominal design), ``certificate`` (each problem certified by continuation) with ``point`` (its branches' points),
+``design`` (the compared designs, named by ``design_name``) and ``frequency`` [Hz] (their responses). Every
+coordinate variable is numeric; labels are auxiliary variables (CF 1.8).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from numpy.typing import NDArray
+
+from vibroimpact.analysis.band_worst import MOTIONS
+from vibroimpact.analysis.impact_orbit import solve_impact_orbit
+from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
+from vibroimpact.kinds.design.evaluate import MAX_BRANCH_POINTS
+from vibroimpact.kinds.design.scene import DesignSettings, safe_name
+from vibroimpact.kinds.design.search import STAGES
+from vibroimpact.kinds.design.study import Outcome
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import TwoDofSystem
+
+__all__ = ["design_dataset", "response_curves", "equal_peaks", "RESPONSE_POINTS", "DESIGNS", "RIDGE"]
+
+#: Frequencies of the compared designs' responses.
+RESPONSE_POINTS = 601
+#: The compared designs, in the order of the ``design`` dimension.
+DESIGNS = ("recommended", "scene", "linear_optimum")
+#: Two band maxima within this share of each other make an equal-peak ridge [-].
+RIDGE = 0.02
+
+
+def response_curves(problem: ImpactProblem, frequency: NDArray[np.float64], coordinate: int) -> dict[str, NDArray[np.float64]]:
+    """|X| [m] of the contact-free motion (everywhere), whether it fits; and of each root's period-1 impact orbit
+    where it exists, with its state (-1 none or not admissible, 0 unstable, 1 stable)."""
+    linear = linear_amplitudes(problem, omega=2.0 * np.pi * frequency)
+    out = {"linear": np.abs(linear.coordinates[..., coordinate]), "linear_fits": linear.fits(problem.clearances()).astype(np.int8)}
+    for root, name in (("+", "impact_plus"), ("-", "impact_minus")):
+        x, state = np.full(frequency.shape, np.nan), np.full(frequency.shape, -1, dtype=np.int8)
+        if problem.stops:
+            orbit = solve_impact_orbit(problem, frequency=frequency, root=root)
+            ok = np.flatnonzero(np.asarray(orbit.admissible(), dtype=bool).reshape(-1))
+            if ok.size:
+                taken = orbit.take(ok)
+                x[ok] = np.abs(taken.harmonics()[..., coordinate]).reshape(-1)
+                modulus = np.max(np.abs(floquet_multipliers(taken)), axis=-1)
+                state[ok] = np.where(modulus < 1.0 - MARGINAL_MODULUS, 1, 0)
+        out[name], out[f"{name}_stable"] = x, state
+    return out
+
+
+def equal_peaks(frequency: NDArray[np.float64], curves: dict[str, NDArray[np.float64]]) -> tuple[float, float, float]:
+    """(relative difference, f1, f2) of the two largest local maxima of the worst stable motion's |X| [Hz]; NaN
+    where it has fewer than two."""
+    stable = [np.where(curves["linear_fits"] == 1, curves["linear"], np.nan)]
+    stable += [np.where(curves[f"{n}_stable"] == 1, curves[n], np.nan) for n in ("impact_plus", "impact_minus")]
+    worst = np.fmax.reduce(stable)
+    filled = np.nan_to_num(worst, nan=-np.inf)
+    peaks = [i for i in range(filled.size) if np.isfinite(filled[i]) and filled[i] >= filled[max(i - 1, 0)] and filled[i] >= filled[min(i + 1, filled.size - 1)]]
+    if len(peaks) < 2:
+        return math.nan, math.nan, math.nan
+    top = sorted(peaks, key=lambda i: filled[i], reverse=True)[:2]
+    return float((filled[top[0]] - filled[top[1]]) / filled[top[0]]), float(frequency[top[0]]), float(frequency[top[1]])
+
+
+def _flag(values: Any, meanings: tuple[str, ...], long_name: str, dims: tuple[str, ...]) -> xr.Variable:
+    return xr.Variable(dims, np.asarray(values, dtype=np.int8), {"long_name": long_name, "flag_values": np.arange(len(meanings), dtype=np.int8),
+                                                                  "flag_meanings": " ".join(m.replace(" ", "_").replace(",", "") for m in meanings)})  # fmt: skip
+
+
+def design_dataset(scene: Any, outcome: Outcome) -> xr.Dataset:
+    """Assemble the dataset (module docstring)."""
+    settings: DesignSettings = outcome.settings
+    ev, space = outcome.evaluations, outcome.space
+    E, S = len(ev.scores), space.samples
+    designs = np.array(ev.designs)
+    data: dict[str, xr.Variable] = {}
+    for k, v in enumerate(settings.variables):
+        data[f"variable_{safe_name(v.name)}"] = xr.Variable("evaluation", designs[:, k], {"units": v.unit, "long_name": f"design variable {v.name}", "valid_min": v.low, "valid_max": v.high})
+    values = np.array([ev.values(r) for r in ev.results])
+    data["objective"] = xr.Variable("evaluation", [ev.objective(r) for r in ev.results], {"units": "m", "long_name": f"{settings.objective}: the {_quantile(settings.quantile)} over the samples of the largest stable |X| over the band (closed-form screen)"})
+    data["score"] = xr.Variable("evaluation", ev.scores, {"units": "m", "long_name": "the objective raised by the operating constraint's penalty (what the search minimised)"})
+    data["operating_amplitude"] = xr.Variable("evaluation", [ev.operating(r) for r in ev.results], {"units": "m", "long_name": "worst coexisting |X| at the operating frequency, same quantile"})
+    data["feasible"] = _flag([ev.feasible(r) for r in ev.results], ("violates", "holds"), "the operating constraint", ("evaluation",))
+    data["evaluation_stage"] = _flag(ev.stages, STAGES, "why the candidate was evaluated", ("evaluation",))
+    data["sample_value"] = xr.Variable(("evaluation", "sample"), values, {"units": "m", "long_name": "largest stable |X| over the band under each sample (or the guess where uncovered)"})
+    data["sample_frequency"] = xr.Variable(("evaluation", "sample"), np.array([r["frequency"] for r in ev.results]), {"units": "Hz", "long_name": "where the sample's worst case is"})
+    data["sample_motion"] = _flag(np.array([r["motion"] for r in ev.results]), MOTIONS, "the motion that sets the sample's worst case", ("evaluation", "sample"))
+    data["sample_uncovered"] = xr.Variable(("evaluation", "sample"), np.array([r["uncovered"] for r in ev.results]), {"units": "1", "long_name": "share of the band where no closed-form motion is stable"})
+    for k, m in enumerate(settings.mistuning):
+        offsets = np.array([row[k] for row in space.offsets])
+        data[f"mistuning_{safe_name(m.name)}"] = xr.Variable("sample", offsets, {"units": "1" if m.relative else ("m" if m.name == "clearance" else "1"),
+                                                                                  "long_name": f"{'relative' if m.relative else 'absolute'} offset of {m.name} in each sample (sample 0: the nominal design)"})  # fmt: skip
+    _certificates(data, outcome)
+    attrs = _designs(data, scene, outcome)
+    coords = {"evaluation": ("evaluation", np.arange(E, dtype=np.int32), {"units": "1", "long_name": "index of the candidate, in the order evaluated"}),
+              "sample": ("sample", np.arange(S, dtype=np.int32), {"units": "1", "long_name": "mistuning sample (0: the nominal design)"}),
+              "certificate": ("certificate", np.arange(len(outcome.certified), dtype=np.int32), {"units": "1", "long_name": "index of the certified problem"}),
+              "point": ("point", np.arange(MAX_BRANCH_POINTS, dtype=np.int32), {"units": "1", "long_name": "index of a continued orbit"}),
+              "design": ("design", np.arange(len(DESIGNS), dtype=np.int32), {"units": "1", "long_name": "index of the compared design (design_name)"})}  # fmt: skip
+    dataset = xr.Dataset(data, coords=coords)
+    dataset.attrs.update(attrs)
+    dataset.attrs.update({"study_kind": "design", "band_low_Hz": settings.band[0], "band_high_Hz": settings.band[1], "objective": settings.objective,
+                          "quantile": settings.quantile, "samples": settings.samples, "mistuning_seed": settings.seed, "search_method": settings.search.method,
+                          "variables": ", ".join(v.name for v in settings.variables), "operating_frequency_Hz": settings.operating[0] if settings.operating else math.nan,
+                          "operating_limit_m": settings.operating[1] if settings.operating else math.nan, "recommended_evaluation": outcome.recommended,
+                          "search_wall_time_s": outcome.wall_times.get("search", math.nan), "certification_wall_time_s": outcome.wall_times.get("certification", math.nan),
+                          "excitation_amplitude_N": scene.amplitude})  # fmt: skip
+    errors = sorted({str(e) for r in ev.results for e in np.asarray(r["error"]).reshape(-1) if str(e)})
+    if errors:
+        dataset.attrs["run_failures"] = [f"{sum(1 for r in ev.results for e in np.asarray(r['error']).reshape(-1) if str(e))} samples of candidates have no value (scored infinite): {errors[0]}"]
+    return dataset
+
+
+def _quantile(q: float) -> str:
+    return "worst" if q >= 1.0 else f"{q:g} quantile"
+
+
+def _certificates(data: dict[str, xr.Variable], outcome: Outcome) -> None:
+    rows = outcome.certified
+    dims = ("certificate",)
+    data["certificate_evaluation"] = xr.Variable(dims, np.array([r["evaluation"] for r in rows], dtype=np.int32), {"units": "1", "long_name": "the certified candidate (index of evaluation)"})
+    data["certificate_sample"] = xr.Variable(dims, np.array([r["sample"] for r in rows], dtype=np.int32), {"units": "1", "long_name": "the certified mistuning sample"})
+    for key, units, name in (("worst", "m", "largest stable |X| over the band by continuation of every branch from the closed-form orbits"), ("frequency", "Hz", "where"),
+                             ("screened", "m", "the closed-form screen's value of the same problem"), ("wall_time", "s", "cost of the certification")):  # fmt: skip
+        data[f"certificate_{key}"] = xr.Variable(dims, np.array([float(r[key]) for r in rows], dtype=float), {"units": units, "long_name": name})
+    data["certificate_motion"] = xr.Variable(dims, np.array([str(r["motion"]) for r in rows], dtype=str), {"long_name": "the motion that sets the certified worst case"})
+    data["certificate_error"] = xr.Variable(dims, np.array([str(r["error"]) for r in rows], dtype=str), {"long_name": "why a certification failed (empty: it did not)"})
+    for key, units, name in (("frequency", "Hz", "frequency of a continued orbit"), ("amplitude", "m", "|X| of a continued orbit"), ("stable", "1", "1 where the continued orbit is stable"),
+                             ("impacts", "1", "impacts per period of a continued orbit"), ("index", "1", "which branch of its certificate")):  # fmt: skip
+        block = np.array([r[f"branch_{key}"] for r in rows], dtype=float).reshape(len(rows), MAX_BRANCH_POINTS)
+        data[f"branch_{key}"] = xr.Variable(("certificate", "point"), block, {"units": units, "long_name": name})
+
+
+def _designs(data: dict[str, xr.Variable], scene: Any, outcome: Outcome) -> dict[str, object]:
+    """The compared designs' variables, objectives and responses; the answer's attributes."""
+    settings, ev, space = outcome.settings, outcome.evaluations, outcome.space
+    frequency = np.linspace(settings.band[0], settings.band[1], RESPONSE_POINTS)
+    problems: list[ImpactProblem | None] = [space.problem_at(ev.designs[outcome.recommended]) if outcome.recommended >= 0 else None, space.problem]
+    linear_problem = None
+    if outcome.linear is not None:
+        structure = outcome.linear.system
+        far = 1e3 * space.problem.length_scale()
+        out_of_reach = scene.layout.problem(scene.amplitude, settings.band[0], settings.restitution, far)  # the linear absorber has no stop
+        linear_problem = ImpactProblem(structure, out_of_reach.stops, out_of_reach.harmonic)
+    problems.append(linear_problem)
+    keys = ("linear", "linear_fits", "impact_plus", "impact_plus_stable", "impact_minus", "impact_minus_stable")
+    curves = {k: np.full((len(DESIGNS), frequency.size), np.nan) for k in keys}
+    for d, problem in enumerate(problems):
+        if problem is None:
+            continue
+        for k, v in response_curves(problem, frequency, settings.coordinate).items():
+            curves[k][d] = v
+    rows = ("design", "frequency")
+    data["design_name"] = xr.Variable("design", np.array(DESIGNS, dtype=str), {"long_name": "the compared design"})
+    data["response_frequency"] = xr.Variable("frequency", frequency, {"units": "Hz", "long_name": "excitation frequency of the compared designs' responses"})
+    data["response_linear"] = xr.Variable(rows, curves["linear"], {"units": "m", "long_name": "|X| of the contact-free motion (where it fits: response_linear_fits)"})
+    for name in ("linear_fits", "impact_plus_stable", "impact_minus_stable"):
+        meanings = ("hits_a_stop", "clears_the_stops") if name == "linear_fits" else ("unstable", "stable")
+        data[f"response_{name}"] = xr.Variable(rows, np.nan_to_num(curves[name], nan=-1).astype(np.int8), {"long_name": name.replace("_", " "), "_FillValue": np.int8(-1),
+                                                                                                           "flag_values": np.array([0, 1], dtype=np.int8), "flag_meanings": " ".join(meanings)})  # fmt: skip
+    for name in ("impact_plus", "impact_minus"):
+        data[f"response_{name}"] = xr.Variable(rows, curves[name], {"units": "m", "long_name": f"|X| of the admissible period-1 impact orbit, root {name[-5:]} of the impulse equation"})
+    values = np.full((len(DESIGNS), space.samples), np.nan)
+    if outcome.recommended >= 0:
+        values[0] = ev.values(ev.results[outcome.recommended])
+    values[1] = ev.values(ev.results[0])
+    values[2] = outcome.linear_values
+    operating = [ev.operating(ev.results[outcome.recommended]) if outcome.recommended >= 0 else math.nan, ev.operating(ev.results[0]), outcome.linear_operating]
+    data["design_operating_amplitude"] = xr.Variable("design", np.array(operating, dtype=float), {"units": "m", "long_name": "worst coexisting |X1| at the operating frequency over the samples (NaN: no constraint)"})
+    data["design_sample_value"] = xr.Variable(("design", "sample"), values, {"units": "m", "long_name": "largest stable |X| over the band of each compared design under each sample"})
+    for k, v in enumerate(settings.variables):
+        column = [ev.designs[outcome.recommended][k] if outcome.recommended >= 0 else math.nan, ev.designs[0][k], math.nan]
+        if outcome.linear is not None and v.name in ("k2", "b2"):
+            column[2] = getattr(outcome.linear.system, v.name)
+        data[f"design_{safe_name(v.name)}"] = xr.Variable("design", np.array(column, dtype=float), {"units": v.unit, "long_name": f"{v.name} of the compared design"})
+    ridge = equal_peaks(frequency, {k: curves[k][0] for k in keys}) if outcome.recommended >= 0 else (math.nan, math.nan, math.nan)
+    attrs: dict[str, object] = {"equal_peak_difference": ridge[0], "equal_peak_frequencies_Hz": np.array(ridge[1:], dtype=float)}
+    if outcome.linear is not None:
+        attrs.update({"linear_optimum_tuning": outcome.linear.tuning, "linear_optimum_damping_ratio": outcome.linear.damping_ratio,
+                      "linear_optimum_k2_N_per_m": outcome.linear.system.k2, "linear_optimum_b2_N_s_per_m": outcome.linear.system.b2,
+                      "linear_optimum_worst_m": outcome.linear.worst})  # fmt: skip
+    if outcome.recommended >= 0:
+        attrs["recommended_certified_score_m"] = outcome.corrected.get(outcome.recommended, math.nan)
+    paper = TwoDofSystem.of(space.problem.structure)
+    attrs["static_deflection_m"] = abs(scene.amplitude) / paper.k1 if paper is not None else math.nan
+    return attrs

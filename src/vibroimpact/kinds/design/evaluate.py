@@ -1,0 +1,230 @@
+"""One design's worst case, as runner cases (:mod:`vibroimpact.runs.runner`): the closed-form screen of a candidate
+under every mistuning sample (:class:`DesignCase`), and the certification of one problem by continuation
+(:class:`CertifyCase`).
+
+A design is a vector of the scene's variables; a mistuning sample a vector of offsets of the robust scalars
+(relative for a structural scalar, absolute for the clearance and restitution; sample 0 is the nominal design). Both
+set parameters of one :class:`~vibroimpact.orbits.maps.ImpactMap` of the scene's problem, whose
+:meth:`~vibroimpact.orbits.maps.ImpactMap.problem_at` builds the problem: the one path from a parameter vector to a
+problem that continuation uses too.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import NDArray
+
+from vibroimpact.analysis.band_worst import MOTIONS, closed_form_at, closed_form_worst
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.orbits.maps import ImpactMap, branch_measures
+from vibroimpact.orbits.worst_case import worst_response
+from vibroimpact.runs.runner import CaseResult, ProgressReport
+from vibroimpact.runs.store import case_key
+
+__all__ = ["DesignSpace", "DesignCase", "sample_chunks", "CHUNKS", "DESIGN_FIELDS", "CertifyCase", "CERTIFY_FIELDS", "STOP_PARAMETERS"]
+
+#: The map's parameters a design or a mistuning may set besides the layout scalars.
+STOP_PARAMETERS = ("clearance", "restitution")
+
+
+@dataclass(frozen=True, eq=False)
+class DesignSpace:
+    """The scene's problem and how designs and mistuning samples move it.
+
+    Attributes
+    ----------
+    problem : ImpactProblem
+        The scene's own design (rigid stops: one, or a symmetric pair).
+    variables : tuple of str
+        The design variables (``clearance``, ``restitution`` or layout scalars).
+    mistuned : tuple of str
+        The robust scalars, in the order of ``offsets``' columns.
+    relative : tuple of bool
+        Whether each robust scalar's offset is relative.
+    offsets : tuple of tuple of float
+        One row per sample, sample 0 the nominal design (all zeros).
+    band : (float, float)
+        [Hz].
+    coordinate : int
+        Of the objective.
+    operating : float
+        Frequency of the operating constraint [Hz]; NaN: none.
+    """
+
+    problem: ImpactProblem
+    variables: tuple[str, ...]
+    mistuned: tuple[str, ...]
+    relative: tuple[bool, ...]
+    offsets: tuple[tuple[float, ...], ...]
+    band: tuple[float, float]
+    coordinate: int = 0
+    operating: float = math.nan
+    scan: int = 241
+
+    def __post_init__(self) -> None:
+        if len(self.relative) != len(self.mistuned) or any(len(row) != len(self.mistuned) for row in self.offsets) or not self.offsets:
+            raise ValueError("offsets: one row per sample (the nominal first), one column per mistuned scalar")
+
+    @cached_property
+    def map(self) -> ImpactMap:
+        """The impact map whose parameters are the design's and the mistuning's scalars."""
+        layout = tuple(dict.fromkeys(n for n in (*self.variables, *self.mistuned) if n not in STOP_PARAMETERS))
+        return ImpactMap(self.problem, layout=layout)
+
+    @property
+    def samples(self) -> int:
+        """Rows of ``offsets`` (the nominal included)."""
+        return len(self.offsets)
+
+    def parameters(self, design: NDArray[np.float64] | tuple[float, ...], sample: int) -> NDArray[np.float64]:
+        """The map's parameter vector of ``design`` under mistuning sample ``sample`` (restitution kept in [0, 1],
+        clearance positive)."""
+        names = self.map.parameter_names
+        p = np.array(self.map.parameters, dtype=float)
+        for name, value in zip(self.variables, design):
+            p[names.index(name)] = float(value)
+        for name, relative, offset in zip(self.mistuned, self.relative, self.offsets[sample]):
+            i = names.index(name)
+            p[i] = p[i] * (1.0 + offset) if relative else p[i] + offset
+        r, d = names.index("restitution"), names.index("clearance")
+        p[r] = min(max(p[r], 0.0), 1.0)
+        p[d] = max(p[d], 1e-9 * self.map.problem.length_scale())
+        return p
+
+    def problem_at(self, design: NDArray[np.float64] | tuple[float, ...], sample: int = 0) -> ImpactProblem:
+        """The problem of ``design`` under sample ``sample`` (0: nominal)."""
+        return self.map.problem_at(self.parameters(design, sample))
+
+    def key_content(self) -> dict:
+        """What determines every result in this space (for case keys)."""
+        return {"problem": repr(self.problem), "variables": self.variables, "mistuned": self.mistuned, "relative": self.relative,
+                "offsets": self.offsets, "band": self.band, "coordinate": self.coordinate, "operating": self.operating, "scan": self.scan}  # fmt: skip
+
+
+#: Cases one candidate's samples are split into (at most).
+CHUNKS = 4
+
+
+def sample_chunks(samples: int) -> list[tuple[int, ...]]:
+    """The samples 0 ... ``samples`` - 1 in at most :data:`CHUNKS` consecutive runs of equal size (the last shorter)."""
+    size = -(-samples // CHUNKS)
+    return [tuple(range(first, min(first + size, samples))) for first in range(0, samples, size)]
+
+
+#: Fields of :class:`DesignCase`: per sample, the worst stable |X| [m] over the band, where [Hz], which motion (index of
+#: :data:`~vibroimpact.analysis.band_worst.MOTIONS`), the uncovered share and the guess there [m], the worst |X| at the
+#: operating frequency [m] (NaN: no constraint) and which motion; ``error``: why a sample has no value.
+DESIGN_FIELDS = ("worst", "frequency", "motion", "uncovered", "estimate", "operating", "operating_motion", "error")
+
+
+@dataclass(frozen=True, eq=False)
+class DesignCase:
+    """The closed-form worst case of one design under the mistuning samples ``samples`` (module docstring): a
+    candidate's samples are split over a few cases, so that workers share even one candidate."""
+
+    space: DesignSpace
+    design: tuple[float, ...]
+    samples: tuple[int, ...]
+    engine: str = "closed_form"
+    fields: tuple[str, ...] = DESIGN_FIELDS
+    progress_unit: str = "designs"
+
+    @property
+    def progress_total(self) -> float:
+        """Its samples' share of one design."""
+        return len(self.samples) / self.space.samples
+
+    def key(self) -> str:
+        """Hash of the space and the design."""
+        return case_key({"kind": "design", "space": self.space.key_content(), "design": list(self.design), "samples": list(self.samples)})
+
+    def run(self, report: ProgressReport | None = None) -> CaseResult:
+        """Arrays over ``samples`` (:data:`DESIGN_FIELDS`)."""
+        n = len(self.samples)
+        out = {k: np.full(n, np.nan) for k in ("worst", "frequency", "uncovered", "estimate", "operating")}
+        motion, operating_motion = np.zeros(n, dtype=np.int8), np.zeros(n, dtype=np.int8)
+        errors = [""] * n
+        for row, s in enumerate(self.samples):
+            try:
+                problem = self.space.problem_at(self.design, s)
+                found = closed_form_worst(problem, self.space.band, self.space.coordinate, self.space.scan)
+                if math.isfinite(self.space.operating):
+                    at = closed_form_at(problem, self.space.operating, self.space.coordinate)
+                    # no stable closed-form motion at the operating point: the guess from the orbits that exist there
+                    out["operating"][row] = at.amplitude if at.uncovered == 0.0 else closed_form_worst(problem, _around(self.space.operating), self.space.coordinate, 3).estimate  # exact: a share of none
+                    operating_motion[row] = MOTIONS.index(at.motion)
+            except ValueError as error:  # a structure the model refuses (a mass driven non-positive ...)
+                errors[row] = f"{type(error).__name__}: {str(error)[:160]}"
+                continue
+            out["worst"][row], out["frequency"][row], out["uncovered"][row], out["estimate"][row] = found.amplitude, found.frequency, found.uncovered, found.estimate
+            motion[row] = MOTIONS.index(found.motion)
+        if report is not None:
+            report(self.progress_total)
+        return out | {"motion": motion, "operating_motion": operating_motion, "error": np.array(errors, dtype=str)}
+
+
+def _around(frequency: float) -> tuple[float, float]:
+    """A band of 1e-6 relative around ``frequency`` [Hz] (a three-point scan of it)."""
+    return frequency * (1.0 - 1e-6), frequency * (1.0 + 1e-6)
+
+
+#: Fields of :class:`CertifyCase`: the continuation's worst |X| [m], where [Hz], its motion (text), and its cost [s];
+#: the continued branches' points (frequency [Hz], |X| [m], stable 0/1, impacts per period, branch index), NaN-padded.
+CERTIFY_FIELDS = ("worst", "frequency", "motion", "wall_time", "branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index", "error")
+#: Most branch points kept per certified problem.
+MAX_BRANCH_POINTS = 4000
+
+
+@dataclass(frozen=True, eq=False)
+class CertifyCase:
+    """The worst case of one problem by continuation (:func:`~vibroimpact.orbits.worst_case.worst_response`): every
+    branch continued from the closed-form orbits, its maxima located exactly."""
+
+    space: DesignSpace
+    design: tuple[float, ...]
+    sample: int = 0
+    engine: str = "continuation"
+    fields: tuple[str, ...] = CERTIFY_FIELDS
+    progress_unit: str = "designs"
+
+    @property
+    def progress_total(self) -> float:
+        """One problem."""
+        return 1.0
+
+    def key(self) -> str:
+        """Hash of the space, the design and the sample."""
+        return case_key({"kind": "design_certify", "space": self.space.key_content(), "design": list(self.design), "sample": self.sample})
+
+    def run(self, report: ProgressReport | None = None) -> CaseResult:
+        """The continuation's worst case and the branches it traced (:data:`CERTIFY_FIELDS`)."""
+        start = time.perf_counter()
+        points = {k: np.full(MAX_BRANCH_POINTS, np.nan) for k in ("branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index")}
+        problem = self.space.problem_at(self.design, self.sample)
+        try:
+            found = worst_response(problem, self.space.band, self.space.coordinate)
+        except (ValueError, RuntimeError) as error:
+            return {"worst": np.array(math.nan), "frequency": np.array(math.nan), "motion": np.array(""), "wall_time": np.array(time.perf_counter() - start),
+                    **points, "error": np.array(f"{type(error).__name__}: {str(error)[:200]}")}  # fmt: skip
+        wall = time.perf_counter() - start
+        k = 0
+        system = ImpactMap(problem)  # the frequency is each branch's own parameter
+        for index, (branch, _) in enumerate(found.branches):
+            count = min(len(branch.values), MAX_BRANCH_POINTS - k)
+            if count <= 0:
+                break
+            measured = branch_measures(system, branch)
+            points["branch_frequency"][k : k + count] = branch.values[:count]
+            points["branch_amplitude"][k : k + count] = measured.amplitude(self.space.coordinate)[:count]
+            points["branch_stable"][k : k + count] = np.asarray(branch.stable, dtype=float)[:count]
+            points["branch_impacts"][k : k + count] = np.asarray(branch.impacts, dtype=float)[:count]
+            points["branch_index"][k : k + count] = index
+            k += count
+        if report is not None:
+            report(1.0)
+        return {"worst": np.array(found.amplitude), "frequency": np.array(found.frequency), "motion": np.array(found.motion), "wall_time": np.array(wall), **points, "error": np.array("")}

@@ -1,0 +1,377 @@
+"""Design scenes: the header of every scene, the layout with its own design (the stops' clearance and restitution,
+the structure's values), and ``design``: which scalars to choose, within which bounds, to minimise what over which
+band, under which mistuning, and compared with what.
+
+The layout is written as in every scene (:mod:`vibroimpact.scene.layout_parse`): the paper's named form
+(``system: {m1 ... b2}``, ``stop: {clearance, restitution}``: one stop above the absorber x2) or the general one
+(``system: {mass, stiffness, damping, coordinates}``, ``stops: [...]``, each giving its clearance and restitution;
+every stop shares them: one stop, or a symmetric two-sided pair, the layouts with a closed-form impact orbit). The
+values the scene gives are *its design*: the page compares the optimum with it (the paper's scene: the paper's
+design). Example (``studies/design_vs_linear.yaml``, shortened)::
+
+    system: {m1: 1.0, m2: 0.1, k1: 25000, k2: 4300, b1: 0.8, b2: 0.08}
+    excitation: {amplitude: 10.0}
+    stop: {clearance: 0.003, restitution: 0.2}
+    design:
+      variables: {clearance: [0.5e-3, 8e-3], restitution: [0.0, 0.9], k2: [1000.0, 8000.0], b2: [0.0, 20.0]}
+      band: {start: 15.0, stop: 45.0}                   # [Hz]
+      objective: x1_amplitude                           # |X| of a coordinate: <name>_amplitude
+      constraints: {operating: {frequency: 33.0, x1_amplitude: 0.05e-3}}   # the notch must survive
+      robust: {k1: 0.05, samples: 32, seed: 1}          # +-5 % of k1, a seeded Latin hypercube
+      compare: linear_optimum                           # the H-infinity optimum linear absorber of the same mass
+      search: {method: differential_evolution, population: 8, generations: 25, seed: 1, polish: true}
+      certify: {candidates: 1}
+
+A variable is ``clearance`` [m], ``restitution`` [-] or any layout scalar of
+:mod:`vibroimpact.orbits.layout_parameters` (``k2``, ``b2``, ``m2``, ``spring[x1,x2]``, ``mass[x3]``, ...; its unit
+follows its matrix). A mistuning (``robust``) names the same scalars: a structural one by a relative spread (0.05:
++-5 %), ``clearance`` [m] and ``restitution`` [-] by an absolute one; ``samples`` points of a seeded Latin hypercube
+over the spreads, plus the nominal design, and the objective is their worst (``quantile: 1``) or a stated quantile.
+Every key is checked (unknown keys, wrong types and out-of-range values are reported together, each naming its key).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from typing import Any
+
+from vibroimpact.model.layout import Layout
+from vibroimpact.model.structure import require_in_range
+from vibroimpact.scene.checker import Checker, SceneError
+from vibroimpact.scene.header import parse_names
+from vibroimpact.scene.layout_parse import parse_layout
+from vibroimpact.scene.schema import Scene
+
+__all__ = ["DESIGN_TOP_KEYS", "STOP_VARIABLES", "METHODS", "COMPARISONS", "Variable", "Mistuning", "SearchSettings", "DesignSettings", "parse_design_scene", "safe_name"]
+
+#: Top-level keys of a design scene.
+DESIGN_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "design", "report", "cluster"}
+#: Design variables of the stops (absolute units; every other variable is a layout scalar).
+STOP_VARIABLES = {"clearance": "m", "restitution": "1"}
+#: Searches: a global search then a local polish, or every point of a grid over the variables (a map).
+METHODS = ("differential_evolution", "grid")
+#: What the optimum is compared with: the best linear absorber of the same mass (the paper's two masses), or nothing.
+COMPARISONS = ("linear_optimum", "none")
+_DESIGN_KEYS = {"variables", "band", "objective", "constraints", "robust", "compare", "search", "certify"}
+_SEARCH_KEYS = {"method", "population", "generations", "seed", "polish", "points"}
+_LAYOUT_FORMS = re.compile(r"^(m1|m2|k1|k2|b1|b2|(mass|stiffness|damping|spring|dashpot)\[\s*\w+\s*(,\s*\w+\s*)?\])$")
+#: Most evaluations of one scene's search (candidates x mistuning samples).
+MAX_EVALUATIONS = 2_000_000
+
+
+def safe_name(name: str) -> str:
+    """A variable's name as a netCDF-safe suffix: ``spring[x1,x2]`` -> ``spring_x1_x2``."""
+    return re.sub(r"\W+", "_", name).strip("_")
+
+
+@dataclass(frozen=True)
+class Variable:
+    """A design variable and its bounds.
+
+    Attributes
+    ----------
+    name : str
+        ``clearance``, ``restitution`` or a layout scalar (module docstring).
+    low, high : float
+        Bounds [unit], low < high.
+    unit : str
+        UDUNITS string (``m``, ``1``, ``N m-1``, ``N s m-1``, ``kg``).
+    """
+
+    name: str
+    low: float
+    high: float
+    unit: str
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.low) and math.isfinite(self.high) and self.low < self.high):
+            raise ValueError(f"variable {self.name!r}: bounds [{self.low!r}, {self.high!r}] must be finite with low < high")
+
+
+@dataclass(frozen=True)
+class Mistuning:
+    """How far one scalar may be from the drawing.
+
+    Attributes
+    ----------
+    name : str
+        As a :class:`Variable` names it.
+    spread : float
+        Half-width: relative [-] for a structural scalar (0.05: +-5 %), absolute [m] or [-] for ``clearance`` and
+        ``restitution``.
+    relative : bool
+        The spread is relative.
+    """
+
+    name: str
+    spread: float
+    relative: bool
+
+    def __post_init__(self) -> None:
+        if not 0.0 < require_in_range(f"robust.{self.name}", self.spread, 0.0, 0.5 if self.relative else math.inf):
+            raise ValueError(f"robust.{self.name} = {self.spread!r} is out of range: allowed (0, {0.5 if self.relative else math.inf:g}]")
+
+
+@dataclass(frozen=True)
+class SearchSettings:
+    """How candidates are chosen: ``method`` of :data:`METHODS`; for differential evolution ``population`` (members
+    per variable) and ``generations``, seeded, then a local polish; for a grid ``points`` per variable."""
+
+    method: str = "differential_evolution"
+    population: int = 8
+    generations: int = 25
+    seed: int = 1
+    polish: bool = True
+    points: int = 12
+
+    def __post_init__(self) -> None:
+        if self.method not in METHODS:
+            raise ValueError(f"method: {self.method!r} is not one of {METHODS}")
+        for key, value, low, high in (("population", self.population, 4, 100), ("generations", self.generations, 1, 1000), ("points", self.points, 2, 200), ("seed", self.seed, 0, 2**31 - 1)):
+            if not low <= value <= high:
+                raise ValueError(f"{key} = {value!r} is out of range: allowed [{low}, {high}]")
+
+
+@dataclass(frozen=True)
+class DesignSettings:
+    """What a design scene asks (module docstring).
+
+    Attributes
+    ----------
+    variables : tuple of Variable
+        What is chosen, and within which bounds.
+    band : (float, float)
+        [Hz].
+    coordinate : int
+        The coordinate whose |X| is the objective (0: x1).
+    objective : str
+        Its name, ``<coordinate>_amplitude``.
+    operating : (float, float) or None
+        (frequency [Hz], largest allowed |X| there [m]): the absorber's notch must survive, on the same worst-case
+        basis as the objective; None: no constraint.
+    mistuning : tuple of Mistuning
+        The robustness spreads (empty: the nominal design alone).
+    samples : int
+        Latin-hypercube samples of the mistuning (the nominal design is evaluated besides them).
+    seed : int
+        Of the Latin hypercube.
+    quantile : float
+        The objective over the samples: 1 their worst, less a quantile.
+    compare : str
+        One of :data:`COMPARISONS`.
+    search : SearchSettings
+    certified : int
+        Candidates (best screened first) whose worst case is certified by continuation and brute force.
+    clearance, restitution : float
+        The scene's own design of the stops: Delta [m], R [-].
+    """
+
+    variables: tuple[Variable, ...]
+    band: tuple[float, float]
+    coordinate: int
+    objective: str
+    operating: tuple[float, float] | None
+    mistuning: tuple[Mistuning, ...]
+    samples: int
+    seed: int
+    quantile: float
+    compare: str
+    search: SearchSettings
+    certified: int
+    clearance: float
+    restitution: float
+
+    def __post_init__(self) -> None:
+        if not self.variables:
+            raise ValueError("variables: give at least one design variable")
+        if not 0.0 < self.band[0] < self.band[1]:
+            raise ValueError(f"band = {self.band!r} must be 0 < start < stop [Hz]")
+        if not 0.0 < require_in_range("quantile", self.quantile, 0.0, 1.0):
+            raise ValueError(f"quantile = {self.quantile!r} is out of range: allowed (0, 1]")
+        if self.compare not in COMPARISONS:
+            raise ValueError(f"compare: {self.compare!r} is not one of {COMPARISONS}")
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The variables' names, in order."""
+        return tuple(v.name for v in self.variables)
+
+
+def parse_design_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
+    """Validate a design scene's document (a mapping with ``design``) and build the :class:`Scene`; raise
+    :class:`SceneError` listing all problems."""
+    c = Checker()
+    doc = c.mapping("", document, DESIGN_TOP_KEYS, {"name", "system", "excitation", "design"}, kind="design")
+    name, description, report = parse_names(c, doc)
+    layout, amplitude, coordinates = parse_layout(c, doc)
+    clearance, restitution = _stop_values(c, doc, layout)
+    spec = c.mapping("design", doc.get("design"), _DESIGN_KEYS, {"variables", "band"}) if "design" in doc else {}
+    variables = _variables(c, spec.get("variables"), layout) if "variables" in spec else ()
+    band = _band(c, spec["band"]) if "band" in spec else None
+    coordinate, objective = _objective(c, spec.get("objective", "x1_amplitude"), coordinates)
+    operating = _operating(c, spec.get("constraints", {}), coordinates, band)
+    mistuning, samples, seed, quantile = _robust(c, spec.get("robust", {}), layout)
+    compare = spec.get("compare", "none")
+    if compare not in COMPARISONS:
+        c.fail("design.compare", f"{compare!r} is not allowed: use one of {', '.join(COMPARISONS)}")
+    elif compare == "linear_optimum" and layout is not None and layout.paper_view() is None:
+        c.fail("design.compare", "linear_optimum is the optimum absorber of the paper's two masses (system: {m1 ... b2}); this structure is not one: use none")
+    search = _search(c, spec.get("search", {}))
+    certified = _certify(c, spec.get("certify", {}))
+    if search is not None and variables and samples is not None:
+        count = (search.points ** len(variables) if search.method == "grid" else search.population * len(variables) * (search.generations + 1) * 2) * (samples + 1)
+        if count > MAX_EVALUATIONS:
+            c.fail("design.search", f"{count:.3g} closed-form evaluations is too many: allowed at most {MAX_EVALUATIONS:.0e} (fewer points, generations or samples)")
+    if c.problems:
+        raise SceneError(c.problems, source)
+    assert layout is not None and amplitude is not None and isinstance(name, str) and band is not None and search is not None
+    assert clearance is not None and restitution is not None and samples is not None and seed is not None and quantile is not None and certified is not None
+    settings = DesignSettings(variables, band, coordinate, objective, operating, mistuning, samples, seed, quantile, str(compare), search, certified, clearance, restitution)
+    return Scene(name=name, description=description, layout=layout, amplitude=amplitude, kind="design", settings=settings, report=report, text=text)
+
+
+def _stop_values(c: Checker, doc: dict, layout: Layout | None) -> tuple[float | None, float | None]:
+    """The stops' shared clearance [m] and restitution [-]: the paper's ``stop`` gives them, or every entry of
+    ``stops`` gives the same."""
+    if "stop" not in doc and "stops" not in doc:
+        c.fail("stop", "required: the paper's stop {clearance: Delta [m], restitution: R} above the absorber x2, or 'stops' (one, or a symmetric pair)")
+        return None, None
+    if "stops" not in doc:
+        stop = c.mapping("stop", doc["stop"], {"clearance", "restitution"}, {"clearance", "restitution"})
+        clearance = c.number("stop.clearance", stop["clearance"], 0.0, math.inf, low_inclusive=False) if "clearance" in stop else None
+        restitution = c.number("stop.restitution", stop["restitution"], 0.0, 1.0) if "restitution" in stop else None
+        return clearance, restitution
+    if layout is None:
+        return None, None
+    values = [(spec.clearance, spec.restitution) for spec in layout.stops]
+    if any(v is None for pair in values for v in pair) or len(set(values)) != 1:
+        c.fail("stops", "every stop of a design scene gives the same clearance and restitution (the design's; the variables move them together)")
+        return None, None
+    return float(values[0][0]), float(values[0][1])  # type: ignore[arg-type]
+
+
+def _variables(c: Checker, value: Any, layout: Layout | None) -> tuple[Variable, ...]:
+    spec = value if isinstance(value, dict) and value else None
+    if spec is None:
+        c.fail("design.variables", f"expected a mapping of at least one name to [low, high], got {value!r}")
+        return ()
+    out = []
+    for key, bounds in spec.items():
+        name = str(key)
+        unit = STOP_VARIABLES.get(name) or _layout_unit(c, f"design.variables.{name}", name, layout)
+        if unit is None:
+            continue
+        if not (isinstance(bounds, list) and len(bounds) == 2):
+            c.fail(f"design.variables.{name}", f"expected [low, high], got {bounds!r}")
+            continue
+        high_limit = 1.0 if name == "restitution" else math.inf
+        low_value = c.number(f"design.variables.{name}[0]", bounds[0], 0.0, high_limit, low_inclusive=name == "restitution" or name.startswith(("b", "dashpot", "damping")))
+        high_value = c.number(f"design.variables.{name}[1]", bounds[1], 0.0, high_limit, low_inclusive=False)
+        if low_value is None or high_value is None:
+            continue
+        if not low_value < high_value:
+            c.fail(f"design.variables.{name}", f"low = {low_value:g} must be below high = {high_value:g}")
+            continue
+        out.append(Variable(name, low_value, high_value, unit))
+    if len(out) > 6:
+        c.fail("design.variables", f"{len(out)} variables: allowed at most 6 (a global search in more dimensions needs more evaluations than a study should)")
+    return tuple(out)
+
+
+def _layout_unit(c: Checker, key: str, name: str, layout: Layout | None) -> str | None:
+    """The unit of the layout scalar ``name`` (None, with a problem recorded, if the layout has none of that name)."""
+    if not _LAYOUT_FORMS.match(name.replace(" ", "")):
+        c.fail(key, f"unknown design variable {name!r}: allowed clearance, restitution, or a layout scalar (k2, b2, m2, ... on the paper's system; mass[a], spring[a,b], dashpot[a], stiffness[a,b], damping[a] on any)")
+        return None
+    if layout is None:
+        return None
+    from vibroimpact.model.problem import ImpactProblem  # model layer: reading a scene loads no solver
+    from vibroimpact.orbits.layout_parameters import layout_parameter
+
+    try:
+        problem = layout.problem(1.0, 1.0, 0.5, 1.0)
+        return layout_parameter(name, problem).unit if isinstance(problem, ImpactProblem) else None
+    except ValueError as error:
+        c.fail(key, str(error))
+        return None
+
+
+def _band(c: Checker, value: Any) -> tuple[float, float] | None:
+    band = c.mapping("design.band", value, {"start", "stop"}, {"start", "stop"})
+    low = c.number("design.band.start", band["start"], 0.0, math.inf, low_inclusive=False) if "start" in band else None
+    high = c.number("design.band.stop", band["stop"], 0.0, math.inf, low_inclusive=False) if "stop" in band else None
+    if low is None or high is None:
+        return None
+    if high <= low:
+        c.fail("design.band.stop", f"{high:g} must be greater than start = {low:g}")
+        return None
+    return low, high
+
+
+def _objective(c: Checker, value: Any, coordinates: tuple[str, ...] | None) -> tuple[int, str]:
+    names = coordinates or ("x1", "x2")
+    allowed = [f"{n}_amplitude" for n in names]
+    if value not in allowed:
+        c.fail("design.objective", f"{value!r} is not allowed: use one of {', '.join(allowed)} (|X| of a coordinate, the worst stable motion over the band)")
+        return 0, allowed[0]
+    return allowed.index(value), str(value)
+
+
+def _operating(c: Checker, value: Any, coordinates: tuple[str, ...] | None, band: tuple[float, float] | None) -> tuple[float, float] | None:
+    constraints = c.mapping("design.constraints", value, {"operating"})
+    if "operating" not in constraints:
+        return None
+    names = coordinates or ("x1", "x2")
+    keys = {"frequency", *(f"{n}_amplitude" for n in names)}
+    spec = c.mapping("design.constraints.operating", constraints["operating"], keys, {"frequency"})
+    amplitude_keys = [k for k in spec if k != "frequency"]
+    if len(amplitude_keys) != 1:
+        c.fail("design.constraints.operating", f"give the frequency [Hz] and one largest amplitude [m] ({', '.join(sorted(keys - {'frequency'}))})")
+        return None
+    frequency = c.number("design.constraints.operating.frequency", spec.get("frequency"), 0.0, math.inf, low_inclusive=False) if "frequency" in spec else None
+    limit = c.number(f"design.constraints.operating.{amplitude_keys[0]}", spec[amplitude_keys[0]], 0.0, math.inf, low_inclusive=False)
+    if amplitude_keys[0] != "x1_amplitude" and coordinates is not None and amplitude_keys[0] != f"{coordinates[0]}_amplitude":
+        c.fail(f"design.constraints.operating.{amplitude_keys[0]}", "the operating limit is on the objective's coordinate x1 (the primary): give x1_amplitude")
+        return None
+    return (frequency, limit) if frequency is not None and limit is not None else None
+
+
+def _robust(c: Checker, value: Any, layout: Layout | None) -> tuple[tuple[Mistuning, ...], int | None, int | None, float | None]:
+    if not isinstance(value, dict):
+        c.fail("design.robust", f"expected a mapping of spreads and samples, got {value!r}")
+        return (), None, None, None
+    spreads = [str(k) for k in value if str(k) not in ("samples", "seed", "quantile")]
+    if spreads and "samples" not in value:
+        c.fail("design.robust.samples", "required with a spread: how many Latin-hypercube samples (e.g. 32)")
+    samples = c.integer("design.robust.samples", value.get("samples", 0), 0, 4096)
+    seed = c.integer("design.robust.seed", value.get("seed", 1), 0, 2**31 - 1)
+    quantile = c.number("design.robust.quantile", value.get("quantile", 1.0), 0.0, 1.0, low_inclusive=False)
+    out = []
+    for name in spreads:
+        spread = value[name]
+        relative = name not in STOP_VARIABLES
+        if relative and _layout_unit(c, f"design.robust.{name}", name, layout) is None:
+            continue
+        limit = 0.5 if relative else (1.0 if name == "restitution" else math.inf)
+        number = c.number(f"design.robust.{name}", spread, 0.0, limit, low_inclusive=False, high_inclusive=not relative)
+        if number is not None:
+            out.append(Mistuning(name, number, relative))
+    if out and samples == 0:
+        c.fail("design.robust.samples", "0 samples of a mistuning: give at least 1 (a Latin hypercube over the spreads)")
+    return tuple(out), samples if out else 0, seed, quantile
+
+
+def _search(c: Checker, value: Any) -> SearchSettings | None:
+    spec = c.mapping("design.search", value, _SEARCH_KEYS)
+    try:
+        return SearchSettings(**spec)
+    except (TypeError, ValueError) as error:
+        c.fail_settings("design.search", error)
+        return None
+
+
+def _certify(c: Checker, value: Any) -> int | None:
+    spec = c.mapping("design.certify", value, {"candidates"})
+    return c.integer("design.certify.candidates", spec.get("candidates", 1), 0, 20)

@@ -1,0 +1,155 @@
+"""The design search: every candidate evaluated through the runner, kept in order, scored on its worst case.
+
+:class:`Evaluations` sends candidates to :meth:`vibroimpact.runs.runner.Runner.map` as
+:class:`~vibroimpact.kinds.design.evaluate.DesignCase` (so they spread over local cores or a dask cluster, and a
+rerun takes every finished one from the store), keeps each with the stage that asked for it, and scores it:
+
+* a sample's value is the larger of the worst stable closed-form motion and, where the band is not covered by one,
+  the guess at the motion there (:class:`~vibroimpact.analysis.band_worst.BandWorst`);
+* the design's objective is the ``quantile`` of its samples' values (1: the worst), likewise its operating |X|;
+* its score is the objective, raised by 10 times the relative excess of the operating |X| over its limit (a design
+  that destroys the notch is never the best feasible one), and infinite where a sample has no value.
+
+:func:`differential_evolution` is scipy's, vectorised: each generation's population is one batch of cases.
+:func:`nelder_mead_polish` then refines the best point with a bounded simplex search. :func:`grid_search` evaluates
+a full grid.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import optimize
+
+from vibroimpact.kinds.design.evaluate import DesignCase, DesignSpace, sample_chunks
+from vibroimpact.runs.runner import CaseResult, Runner
+
+__all__ = ["STAGES", "Evaluations", "differential_evolution", "nelder_mead_polish", "grid_search", "PENALTY", "POLISH_STEP", "POLISH_END"]
+
+#: Why a candidate was evaluated (CF flag values of ``evaluation_stage``).
+STAGES = ("global", "polish", "grid", "reference")
+#: Score raised by this times the relative excess of the operating |X| over its limit [-].
+PENALTY = 10.0
+#: The polish's first simplex and its last, shares of each variable's range [-].
+POLISH_STEP = 0.05
+POLISH_END = 1e-6
+
+
+@dataclass
+class Evaluations:
+    """Every candidate evaluated so far, in order, with its stage and scores (module docstring).
+
+    Attributes
+    ----------
+    space : DesignSpace
+    bounds : ndarray, shape (n, 2)
+        Each variable's [low, high].
+    runner : Runner
+    quantile : float
+        Of the samples' values (1: the worst).
+    limit : float
+        Largest operating |X| [m] (NaN: no constraint).
+    """
+
+    space: DesignSpace
+    bounds: NDArray[np.float64]
+    runner: Runner
+    quantile: float = 1.0
+    limit: float = math.nan
+    designs: list[NDArray[np.float64]] = field(default_factory=list)
+    stages: list[int] = field(default_factory=list)
+    results: list[CaseResult] = field(default_factory=list)
+    scores: list[float] = field(default_factory=list)
+
+    def evaluate(self, designs: NDArray[np.float64], stage: str) -> NDArray[np.float64]:
+        """The scores of ``designs`` (shape (m, n), in the variables' units), each kept."""
+        designs = np.atleast_2d(np.asarray(designs, dtype=float))
+        chunks = sample_chunks(self.space.samples)
+        parts = self.runner.map([DesignCase(self.space, tuple(float(v) for v in x), chunk) for x in designs for chunk in chunks])
+        results = [{k: np.concatenate([np.atleast_1d(p[k]) for p in parts[i * len(chunks) : (i + 1) * len(chunks)]]) for k in parts[0]} for i in range(len(designs))]
+        scores = np.array([self.score(result) for result in results])
+        for x, result, value in zip(designs, results, scores):
+            self.designs.append(x.copy())
+            self.stages.append(STAGES.index(stage))
+            self.results.append(result)
+            self.scores.append(float(value))
+        return scores
+
+    def values(self, result: CaseResult) -> NDArray[np.float64]:
+        """Each sample's value [m]: the worst closed-form motion, or the guess where the band is uncovered."""
+        return np.fmax(np.asarray(result["worst"], dtype=float), np.where(np.asarray(result["uncovered"]) > 0.0, result["estimate"], np.nan))
+
+    def objective(self, result: CaseResult) -> float:
+        """The samples' ``quantile`` [m] (NaN where a sample has no value)."""
+        values = self.values(result)
+        return float(np.quantile(values, self.quantile, method="higher")) if np.all(np.isfinite(values)) else math.nan
+
+    def operating(self, result: CaseResult) -> float:
+        """The operating |X| over the samples, the same quantile [m] (NaN: no constraint)."""
+        values = np.asarray(result["operating"], dtype=float)
+        return float(np.quantile(values, self.quantile, method="higher")) if math.isfinite(self.limit) and np.all(np.isfinite(values)) else math.nan
+
+    def score(self, result: CaseResult) -> float:
+        """The objective with the operating constraint's penalty; inf where a sample has no value."""
+        objective = self.objective(result)
+        if not math.isfinite(objective):
+            return math.inf
+        if not math.isfinite(self.limit):
+            return objective
+        operating = self.operating(result)
+        return objective * (1.0 + PENALTY * max(0.0, operating / self.limit - 1.0)) if math.isfinite(operating) else math.inf
+
+    def feasible(self, result: CaseResult) -> bool:
+        """The operating constraint holds (always, without one)."""
+        return not math.isfinite(self.limit) or self.operating(result) <= self.limit
+
+    def best(self) -> int:
+        """Index of the best evaluation (least score)."""
+        return int(np.argmin(self.scores))
+
+    def scaled(self, unit: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Points of the unit cube (shape (..., n)) in the variables' units."""
+        low, high = self.bounds[:, 0], self.bounds[:, 1]
+        return low + np.clip(unit, 0.0, 1.0) * (high - low)
+
+
+def differential_evolution(evaluations: Evaluations, population: int, generations: int, seed: int) -> None:
+    """scipy's differential evolution on the unit cube, each generation one batch (``population`` members per
+    variable, Latin-hypercube start, seeded: a rerun asks for the same candidates and the store answers)."""
+    n = evaluations.bounds.shape[0]
+
+    def batch(unit: NDArray[np.float64]) -> NDArray[np.float64]:
+        return evaluations.evaluate(evaluations.scaled(np.asarray(unit).T), "global")
+
+    optimize.differential_evolution(batch, [(0.0, 1.0)] * n, popsize=population, maxiter=generations, seed=seed, polish=False, vectorized=True,
+                                    updating="deferred", init="latinhypercube", tol=1e-6, atol=0.0)  # fmt: skip
+
+
+def nelder_mead_polish(evaluations: Evaluations, budget: int) -> None:
+    """Nelder-Mead from the best design so far, in the unit cube (bounded), its first simplex :data:`POLISH_STEP` of
+    each range wide, until the simplex is :data:`POLISH_END` of each range or ``budget`` evaluations are spent: a
+    local search that needs no gradient (the objective is a maximum of peaks, not smooth; on an equal-peak ridge a
+    search along the axes stalls where the simplex turns along the ridge). One candidate at a time: its samples are
+    what the workers share (:class:`~vibroimpact.kinds.design.evaluate.DesignCase` chunks)."""
+    span = evaluations.bounds[:, 1] - evaluations.bounds[:, 0]
+    centre = (evaluations.designs[evaluations.best()] - evaluations.bounds[:, 0]) / span
+    n = centre.size
+    simplex = np.vstack([centre, centre + POLISH_STEP * np.eye(n) * np.where(centre + POLISH_STEP <= 1.0, 1.0, -1.0)[:, None]])
+    scale = max(abs(evaluations.scores[evaluations.best()]), 1e-300)
+
+    def one(unit: NDArray[np.float64]) -> float:
+        return float(evaluations.evaluate(evaluations.scaled(np.asarray(unit)[None, :]), "polish")[0]) / scale
+
+    optimize.minimize(one, centre, method="Nelder-Mead", bounds=[(0.0, 1.0)] * n,
+                      options={"initial_simplex": np.clip(simplex, 0.0, 1.0), "xatol": POLISH_END, "fatol": 1e-10, "maxfev": budget})  # fmt: skip
+
+
+def grid_search(evaluations: Evaluations, points: int) -> None:
+    """Every point of a grid of ``points`` per variable, bounds included (one batch)."""
+    axes = [np.linspace(0.0, 1.0, points)] * evaluations.bounds.shape[0]
+    unit = np.array(list(itertools.product(*axes)))
+    evaluations.evaluate(evaluations.scaled(unit), "grid")

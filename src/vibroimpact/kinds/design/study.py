@@ -1,0 +1,192 @@
+"""The ``design`` kind of study: which absorber and stop to build.
+
+1. The mistuning samples: a seeded Latin hypercube over the robust spreads, plus the nominal design
+   (:func:`mistuning_offsets`).
+2. The search (:mod:`vibroimpact.kinds.design.search`): differential evolution and a Nelder-Mead polish, or a grid; each
+   candidate's closed-form worst case under every sample, through the runner (resumable, spread over workers).
+3. The comparisons: the scene's own design, and (``compare: linear_optimum``) the H-infinity optimum linear absorber of
+   the same mass under the same mistuning (:func:`vibroimpact.analysis.linear_optimum.optimal_linear_absorber`), its
+   band peaks exact.
+4. The certification (:class:`~vibroimpact.kinds.design.evaluate.CertifyCase`): the best candidates at the nominal
+   sample and at their worst one, and the scene's design at the nominal one, by continuation of every branch from the closed-form
+   orbits; a candidate whose certified worst case exceeds its screen is scored on the certified value, and the
+   recommendation is the best certified candidate.
+5. The dataset (:mod:`vibroimpact.kinds.design.dataset`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from numpy.typing import NDArray
+from scipy.stats import qmc
+
+from vibroimpact.analysis.linear_optimum import LinearAbsorberOptimum, band_peak, optimal_linear_absorber
+from vibroimpact.kinds.design.evaluate import CertifyCase, DesignSpace
+from vibroimpact.kinds.design.scene import DesignSettings
+from vibroimpact.kinds.design.search import Evaluations, nelder_mead_polish, differential_evolution, grid_search
+from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.runs.cluster import Progress
+from vibroimpact.runs.estimate import Costs, Estimate
+from vibroimpact.runs.runner import Runner
+
+__all__ = ["mistuning_offsets", "design_space", "Outcome", "run_design", "DesignStudy", "SECONDS_PER_SAMPLE", "SECONDS_PER_CERTIFICATE", "POLISH_BUDGET"]
+
+#: Polish evaluations per variable.
+POLISH_BUDGET = 40
+#: Costs of :meth:`DesignStudy.estimate` on the calibration machine: one closed-form worst case (one design, one
+#: sample) and one certification by continuation [s].
+SECONDS_PER_SAMPLE = 0.06
+SECONDS_PER_CERTIFICATE = 8.0
+
+
+def mistuning_offsets(settings: DesignSettings) -> NDArray[np.float64]:
+    """Offsets of the robust scalars, shape (1 + samples, M): the nominal design (zeros), then a seeded Latin
+    hypercube over [-spread, +spread] of each."""
+    spreads = np.array([m.spread for m in settings.mistuning], dtype=float)
+    if spreads.size == 0 or settings.samples == 0:
+        return np.zeros((1, spreads.size))
+    unit = qmc.LatinHypercube(d=spreads.size, seed=settings.seed).random(settings.samples)
+    return np.vstack([np.zeros(spreads.size), (2.0 * unit - 1.0) * spreads])
+
+
+def design_space(scene: Any) -> DesignSpace:
+    """The scene's problem (its own design) and how its variables and mistuning move it."""
+    settings: DesignSettings = scene.settings
+    problem = scene.layout.problem(scene.amplitude, settings.band[0], settings.restitution, settings.clearance)
+    offsets = mistuning_offsets(settings)
+    operating = settings.operating[0] if settings.operating is not None else math.nan
+    return DesignSpace(problem, settings.names, tuple(m.name for m in settings.mistuning), tuple(m.relative for m in settings.mistuning),
+                       tuple(tuple(float(v) for v in row) for row in offsets), settings.band, settings.coordinate, operating)  # fmt: skip
+
+
+class Outcome:
+    """What a design study found (the dataset's content): the evaluations, the certified candidates, the comparisons."""
+
+    def __init__(self, settings: DesignSettings, space: DesignSpace, evaluations: Evaluations) -> None:
+        self.settings = settings
+        self.space = space
+        self.evaluations = evaluations
+        self.scene_design = np.array([space.map.parameters[space.map.parameter_names.index(n)] for n in settings.names])
+        self.certified: list[dict[str, Any]] = []
+        self.linear: LinearAbsorberOptimum | None = None
+        self.linear_values = np.full(space.samples, np.nan)
+        self.linear_operating = math.nan
+        self.recommended = -1
+        self.corrected: dict[int, float] = {}
+        self.wall_times: dict[str, float] = {}
+
+
+def run_design(scene: Any, progress: Progress | None = None, runner: Runner | None = None) -> xr.Dataset:
+    """Search, compare and certify (module docstring); the dataset."""
+    from vibroimpact.kinds.design.dataset import design_dataset
+
+    settings: DesignSettings = scene.settings
+    say = progress if progress is not None else (lambda message: None)
+    runner = runner if runner is not None else Runner(progress=progress is not None)
+    space = design_space(scene)
+    bounds = np.array([[v.low, v.high] for v in settings.variables])
+    limit = settings.operating[1] if settings.operating is not None else math.nan
+    evaluations = Evaluations(space, bounds, runner, settings.quantile, limit)
+    outcome = Outcome(settings, space, evaluations)
+    start = time.perf_counter()
+    evaluations.evaluate(outcome.scene_design[None, :], "reference")
+    search = settings.search
+    if search.method == "grid":
+        say(f"design: a grid of {search.points}^{bounds.shape[0]} candidates, {space.samples} samples each")
+        grid_search(evaluations, search.points)
+    else:
+        say(f"design: differential evolution over {bounds.shape[0]} variables ({search.population * bounds.shape[0]} members, up to {search.generations} generations), {space.samples} samples each")
+        differential_evolution(evaluations, search.population, search.generations, search.seed)
+        if search.polish:
+            nelder_mead_polish(evaluations, POLISH_BUDGET * bounds.shape[0])
+    outcome.wall_times["search"] = time.perf_counter() - start
+    say(f"design: {len(evaluations.scores)} candidates evaluated in {outcome.wall_times['search']:.0f} s; best screened worst case {1e3 * evaluations.objective(evaluations.results[evaluations.best()]):.4g} mm")
+    if settings.compare == "linear_optimum":
+        _linear(outcome, scene.amplitude)
+    _certify(outcome, runner, say)
+    return design_dataset(scene, outcome)
+
+
+def _linear(outcome: Outcome, amplitude: float) -> None:
+    """The optimum linear absorber of the same mass under the same (structural) mistuning, and its band peak under
+    every sample."""
+    space = outcome.space
+    primaries = [TwoDofSystem.of(space.problem_at(outcome.scene_design, s).structure) for s in range(space.samples)]
+    if any(p is None for p in primaries):
+        return
+    outcome.linear = optimal_linear_absorber(primaries[0], amplitude, space.band, mistuned=tuple(primaries[1:]))  # type: ignore[arg-type]
+    k2, b2 = outcome.linear.system.k2, outcome.linear.system.b2
+    systems = [TwoDofSystem(p.m1, p.m2, p.k1, k2, p.b1, b2) for p in primaries]  # type: ignore[union-attr]
+    outcome.linear_values = np.array([band_peak(system, amplitude, space.band).amplitude for system in systems])
+    if math.isfinite(space.operating):  # the linear absorber's |X1| at the operating frequency, worst over the samples
+        outcome.linear_operating = max(abs(amplitude) * float(np.abs(system.receptances(2.0 * math.pi * space.operating).h11)) for system in systems)
+
+
+def _certify(outcome: Outcome, runner: Runner, say: Progress) -> None:
+    """Certify the best distinct candidates and the scene's design at their nominal and worst samples; the
+    recommendation is the best certified candidate (module docstring)."""
+    evaluations, settings = outcome.evaluations, outcome.settings
+    order = [int(i) for i in np.argsort(evaluations.scores) if math.isfinite(evaluations.scores[int(i)])]
+    chosen: list[int] = []
+    for i in order:
+        if len(chosen) >= settings.certified:
+            break
+        if all(not np.allclose(evaluations.designs[i], evaluations.designs[j], rtol=1e-6, atol=0.0) for j in chosen):
+            chosen.append(i)
+    reference = next(i for i, s in enumerate(evaluations.stages) if s == 3)  # the scene's own design, evaluated first
+    targets = chosen + ([reference] if reference not in chosen else [])
+    cases, owners = [], []
+    for i in targets:
+        values = evaluations.values(evaluations.results[i])
+        worst_sample = int(np.nanargmax(values)) if np.any(np.isfinite(values)) and i in chosen else 0  # the scene's design: nominal only
+        for sample in dict.fromkeys((0, worst_sample)):
+            cases.append(CertifyCase(outcome.space, tuple(float(v) for v in evaluations.designs[i]), sample))
+            owners.append((i, sample))
+    start = time.perf_counter()
+    results = runner.map(cases) if cases else []
+    outcome.wall_times["certification"] = time.perf_counter() - start
+    for (i, sample), result in zip(owners, results):
+        screened = float(evaluations.values(evaluations.results[i])[sample])
+        outcome.certified.append({"evaluation": i, "sample": sample, "screened": screened, **result})
+    corrected = {}
+    for i in targets:
+        certified = max((float(c["worst"]) for c in outcome.certified if c["evaluation"] == i and math.isfinite(float(c["worst"]))), default=math.nan)
+        objective = evaluations.objective(evaluations.results[i])
+        # a certified worst case above the screen's raises the objective, and the score with it (the penalty kept)
+        corrected[i] = evaluations.scores[i] * max(1.0, certified / objective) if math.isfinite(certified) and objective > 0.0 else evaluations.scores[i]
+    outcome.corrected = corrected
+    outcome.recommended = min(chosen, key=lambda i: corrected[i]) if chosen else (order[0] if order else -1)  # none certified: the best screened
+    if chosen:
+        say(f"design: certified {len(targets)} designs by continuation in {outcome.wall_times['certification']:.0f} s; recommended evaluation {outcome.recommended}")
+
+
+class DesignStudy:
+    """The ``design`` kind: :func:`run_design` on the scene."""
+
+    name = "design"
+
+    def run(self, scene: Any, progress: Progress | None, runner: Runner) -> xr.Dataset:
+        """The scene's dataset, with its name, text and provenance."""
+        from vibroimpact.runs.run import provenance
+
+        dataset = run_design(scene, progress, runner)
+        dataset.attrs.update({"title": f"vibroimpact design '{scene.name}'", "scene_name": scene.name, "scene": scene.text} | provenance())
+        return dataset
+
+    def estimate(self, scene: Any, jobs: int, costs: Costs) -> Estimate:
+        """Predicted wall time and memory on the calibration machine, from :data:`SECONDS_PER_SAMPLE` and
+        :data:`SECONDS_PER_CERTIFICATE`."""
+        settings: DesignSettings = scene.settings
+        n, samples = len(settings.variables), settings.samples + 1
+        search = settings.search
+        candidates = search.points**n if search.method == "grid" else search.population * n * (search.generations + 1) + (POLISH_BUDGET * n if search.polish else 0)
+        screen = candidates * samples * SECONDS_PER_SAMPLE
+        certify = (2 * settings.certified + 1) * SECONDS_PER_CERTIFICATE
+        wall = screen / max(jobs, 1) + certify / max(min(jobs, 2 * settings.certified + 1), 1) + 10.0
+        return Estimate(wall_time=wall, memory=400e6, parts={"search": screen, "certification": certify, "report": 10.0},
+                        points={"search": f"up to {candidates} candidates x {samples} samples"})  # fmt: skip

@@ -1,0 +1,91 @@
+"""Design scenes (issue 32): what the ``design`` section says, and every mistake refused before any work, each naming
+its key and the allowed range."""
+
+from __future__ import annotations
+
+import copy
+
+import pytest
+
+from vibroimpact.kinds.design.scene import DesignSettings
+from vibroimpact.scene.checker import SceneError
+from vibroimpact.scene.reader import parse_scene
+
+SCENE = {
+    "name": "d",
+    "system": {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0, "b1": 0.8, "b2": 0.08},
+    "excitation": {"amplitude": 10.0},
+    "stop": {"clearance": 0.003, "restitution": 0.2},
+    "design": {
+        "variables": {"clearance": [0.0005, 0.008], "restitution": [0.0, 0.9], "k2": [1000.0, 8000.0], "b2": [0.0, 20.0]},
+        "band": {"start": 15.0, "stop": 45.0},
+        "constraints": {"operating": {"frequency": 33.0, "x1_amplitude": 5e-5}},
+        "robust": {"k1": 0.05, "clearance": 0.0002, "samples": 32, "seed": 3},
+        "compare": "linear_optimum",
+    },
+}
+
+
+def scene_with(**design) -> dict:
+    document = copy.deepcopy(SCENE)
+    document["design"].update(design)
+    return document
+
+
+def test_a_design_scene_reads_its_section() -> None:
+    scene = parse_scene(copy.deepcopy(SCENE))
+    settings: DesignSettings = scene.settings
+    assert scene.kind == "design"
+    assert settings.names == ("clearance", "restitution", "k2", "b2")
+    assert [v.unit for v in settings.variables] == ["m", "1", "N m-1", "N s m-1"]
+    assert settings.operating == (33.0, 5e-5) and settings.samples == 32 and settings.seed == 3
+    assert [(m.name, m.relative) for m in settings.mistuning] == [("k1", True), ("clearance", False)]
+    assert settings.clearance == 0.003 and settings.restitution == 0.2  # exact: the scene's own numbers
+    assert settings.compare == "linear_optimum" and settings.search.method == "differential_evolution"
+
+
+@pytest.mark.parametrize(
+    ("design", "key", "words"),
+    [
+        ({"variables": {"k9": [1.0, 2.0]}}, "design.variables.k9", "unknown design variable"),
+        ({"variables": {"mass[x7]": [1.0, 2.0]}}, "design.variables.mass[x7]", "x7"),
+        ({"variables": {"clearance": [0.004, 0.002]}}, "design.variables.clearance", "below"),
+        ({"variables": {"restitution": [0.0, 1.5]}}, "design.variables.restitution[1]", "allowed"),
+        ({"band": {"start": 45.0, "stop": 15.0}}, "design.band.stop", "greater"),
+        ({"objective": "x3_amplitude"}, "design.objective", "x1_amplitude"),
+        ({"robust": {"k1": 0.05}}, "design.robust.samples", "required"),
+        ({"robust": {"k1": 0.9, "samples": 4}}, "design.robust.k1", "allowed"),
+        ({"compare": "den_hartog"}, "design.compare", "linear_optimum"),
+        ({"search": {"method": "annealing"}}, "design.search.method", "differential_evolution"),
+        ({"search": {"population": 1}}, "design.search.population", "allowed"),
+        ({"certify": {"candidates": -1}}, "design.certify.candidates", "allowed"),
+        ({"constraints": {"operating": {"frequency": 33.0}}}, "design.constraints.operating", "largest amplitude"),
+        ({"constraints": {"impact_force": 150.0}}, "design.constraints.impact_force", "unknown key"),
+    ],
+)
+def test_mistakes_are_refused_naming_their_key(design: dict, key: str, words: str) -> None:
+    with pytest.raises(SceneError) as caught:
+        parse_scene(scene_with(**design))
+    assert any(line.startswith(f"{key}:") and words in line for line in caught.value.problems), caught.value.problems
+
+
+def test_the_stop_must_give_the_scene_s_design() -> None:
+    document = copy.deepcopy(SCENE)
+    document["stop"] = {"clearance": 0.003}
+    with pytest.raises(SceneError) as caught:
+        parse_scene(document)
+    assert any(line.startswith("stop.restitution:") for line in caught.value.problems)
+
+
+def test_the_linear_optimum_needs_the_paper_s_two_masses() -> None:
+    document = copy.deepcopy(SCENE)
+    document["system"] = {"mass": [[1.0, 0.0], [0.0, 0.1]], "stiffness": [[29300, -4300], [-4300, 4300]], "damping": [[0.88, -0.08], [-0.08, 0.08]], "coordinates": ["a", "b"]}
+    document["excitation"] = {"amplitude": 10.0, "on": "a"}
+    document.pop("stop")
+    document["stops"] = [{"coordinate": "b", "side": "upper", "clearance": 0.003, "restitution": 0.2}]
+    document["design"]["variables"] = {"clearance": [0.001, 0.005]}
+    document["design"].pop("constraints")
+    document["design"]["robust"] = {}
+    with pytest.raises(SceneError) as caught:
+        parse_scene(document)
+    assert any(line.startswith("design.compare:") and "paper's two masses" in line for line in caught.value.problems), caught.value.problems
