@@ -229,7 +229,7 @@ class ImpactMap:
         try:
             problem = self.problem_at(p)
             roots = [solve_impact_orbit(problem, root=root) for root in ("+", "-")]
-        except (ValueError, TypeError):  # no problem at p, or no closed form for it
+        except ValueError:  # no problem at p, or no closed form for it (closed_form_layout says why)
             return None
         admissible = [orbit for orbit in roots if bool(np.all(orbit.admissible()))]
         if not admissible:
