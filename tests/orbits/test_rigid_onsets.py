@@ -12,7 +12,8 @@ import pytest
 from scipy.optimize import brentq
 
 from vibroimpact.engines.exact import ExactEngine
-from vibroimpact.model.contact import RigidStop
+from vibroimpact.analysis.impact_orbit import solve_impact_orbit
+from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import PAPER_SYSTEM
@@ -101,3 +102,25 @@ def test_the_branch_leaves_an_onset_on_the_closed_form_orbits_born_there(branche
         np.testing.assert_allclose(orbit.state / system.state_scale, state / system.state_scale, rtol=0.0, atol=1e-12)
     largest = np.array([np.max(np.abs(orbit.multipliers)) for orbit in ladder[:4]])  # up to 1.3e-4 from grazing
     np.testing.assert_allclose(largest * margins[:4], largest[0] * margins[0], rtol=0.02)
+
+
+def test_the_closed_form_orbit_is_none_where_none_applies() -> None:
+    """:meth:`ImpactMap.impact_orbit` is None, not an exception, where the closed form refuses the problem (it raises
+    ValueError saying why: a bumper, two stops that are not a symmetric pair), at a parameter vector that is no
+    problem (a negative frequency) and over two periods; on the paper's problem it is a state and a distance to
+    grazing."""
+    paper = ImpactProblem(PAPER_SYSTEM, RigidStop(DELTA, 0.2), HarmonicForce(Q, 25.0))
+    bumper = ImpactProblem(PAPER_SYSTEM, KelvinVoigtBumper(DELTA, 400.0, 0.1), HarmonicForce(Q, 25.0))
+    unpaired = ImpactProblem(PAPER_SYSTEM.structure, (Stop(RigidStop(DELTA, 0.2), 1), Stop(RigidStop(2e-3, 0.2), 0, side="lower")), HarmonicForce(Q, 25.0))
+    for problem, why in ((bumper, "need rigid stops"), (unpaired, "do not form a symmetric two-sided stop")):
+        with pytest.raises(ValueError, match=why):
+            solve_impact_orbit(problem)
+        system = ImpactMap(problem, stop=0)
+        assert system.impact_orbit(system.parameters) is None
+    system = ImpactMap(paper)
+    negative = system.parameters.copy()
+    negative[0] = -25.0
+    assert system.impact_orbit(negative) is None
+    assert system.with_periods(2).impact_orbit(system.parameters) is None
+    state, margin = system.impact_orbit(system.parameters)
+    assert state.shape == (4,) and np.all(np.isfinite(state)) and margin > 0.0

@@ -57,6 +57,7 @@ class _Walker(OnsetSteps):
         self.n = system.dimension
         self.specials: list[tuple[float, SpecialPoint]] = []
         self.lower = lower_period_maps(system)
+        self.clear_onset()
 
     def tolerance(self, point: Point) -> float:
         """Arclength bracket that gives the parameter to locate_tolerance relative."""

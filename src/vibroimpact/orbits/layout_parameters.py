@@ -65,8 +65,6 @@ class LayoutParameter:
         (a, b) coordinates; (a, a) for a diagonal entry; (a,) for a ground element; () for the bumpers.
     unit : str
         [kg], [N m-1] or [N s m-1].
-    field : str or None
-        The named system's field (m1 ... b2) it was given as, if it was.
     """
 
     name: str
@@ -74,7 +72,6 @@ class LayoutParameter:
     element: bool
     indices: tuple[int, ...]
     unit: str
-    field: str | None = None
 
     @property
     def structural(self) -> bool:
@@ -104,12 +101,11 @@ def layout_parameter(name: str, problem: ImpactProblem) -> LayoutParameter:
         if not all(isinstance(item.law, KelvinVoigtBumper) for item in problem.stops):
             raise ValueError(f"parameter {name!r}: the problem's stops are not Kelvin-Voigt bumpers")
         return LayoutParameter(name, "bumper", False, (), "N m-1")
-    field = None
     text = name
     if name in NAMED_SYSTEM:
         if TwoDofSystem.of(problem.structure) is None:
             raise ValueError(f"parameter {name!r} names a field of the paper's two-mass system; this structure is not one: use {_FORMS.split(', m1')[0]}")
-        field, text = name, NAMED_SYSTEM[name]
+        text = NAMED_SYSTEM[name]
     match = _GRAMMAR.match(text.replace(" ", ""))
     if match is None:
         raise ValueError(f"parameter {name!r} is not a layout scalar: allowed {_FORMS}")
@@ -122,7 +118,7 @@ def layout_parameter(name: str, problem: ImpactProblem) -> LayoutParameter:
     if not element and len(indices) == 1:
         indices = (indices[0], indices[0])
     matrix = _MATRIX[kind]
-    return LayoutParameter(name, matrix, element, indices, _UNITS[matrix], field)
+    return LayoutParameter(name, matrix, element, indices, _UNITS[matrix])
 
 
 def check_independent(parameters: Sequence[LayoutParameter]) -> None:

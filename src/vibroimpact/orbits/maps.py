@@ -45,7 +45,7 @@ from numpy.typing import ArrayLike, NDArray
 from typing import Any
 
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
-from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.analysis.linear import LinearAmplitudes, linear_amplitudes
 from vibroimpact.engines.registry import BUMPER, engine_for, make_engine
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
 from vibroimpact.model.problem import ImpactProblem
@@ -54,7 +54,7 @@ from vibroimpact.orbits.layout_parameters import LayoutParameter, check_independ
 from vibroimpact.orbits.sections import StrobeGap, moved_phase, moved_state, resection, strobe_gap
 from vibroimpact.orbits.shooting import closed_form_state, section_phase, with_impulse
 
-__all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "BranchMeasures", "branch_measures", "closed_form_state", "with_impulse", "section_phase", "resection", "PARAMETERS", "SECTION_PARAMETER", "stop_selection", "Resection"]
+__all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "BranchMeasures", "branch_measures", "closed_form_state", "with_impulse", "section_phase", "resection", "PARAMETERS", "SECTION_PARAMETER", "stop_selection", "Resection", "ContactFreeOrbit"]
 
 #: The parameters of an :class:`ImpactMap`, in order, with their units.
 PARAMETERS = {"frequency": "Hz", "restitution": "1", "clearance": "m", "amplitude": "N", "phase": "rad"}
@@ -193,11 +193,18 @@ class ImpactMap:
         return Resection(moved_state(problem, state, periods, self.engine, run, gap.shift), moved, gap)
 
     def linear_orbit(self, p: NDArray[np.float64]) -> tuple[NDArray[np.float64], float] | None:
+        """The contact-free steady state at parameters ``p``, in closed form: its state at the strobe and its least
+        relative clearance to a stop (:meth:`contact_free_orbit`, which also gives its amplitudes). None where ``p``
+        is no problem, or the structure has no static equilibrium under the load."""
+        found = self.contact_free_orbit(p)
+        return None if found is None else (found.state, found.clearance)
+
+    def contact_free_orbit(self, p: NDArray[np.float64]) -> "ContactFreeOrbit | None":
         """The contact-free steady state at parameters ``p``, in closed form (:func:`~vibroimpact.analysis.linear.
-        linear_amplitudes`): its state at the strobe, and its least relative clearance to a stop, min_k (Delta_k -
+        linear_amplitudes`): its state at the strobe, its least relative clearance to a stop, min_k (Delta_k -
         |n_k . X| - n_k . x0) / max(|Delta_k|, L / 1000) with L the length scale [-] (negative: it would cross that
-        stop; zero: it touches it, an onset; 1: it does not move towards any stop). None where ``p`` is no problem,
-        or the structure has no static equilibrium under the load."""
+        stop; zero: it touches it, an onset; 1: it does not move towards any stop), and its complex amplitudes. None
+        where ``p`` is no problem, or the structure has no static equilibrium under the load."""
         try:
             problem = self.problem_at(p)
         except ValueError:
@@ -209,7 +216,7 @@ class ImpactMap:
         state = np.concatenate([linear.static + x.real, (1j * problem.omega * x).real])
         reach = np.abs(linear.stops) + linear.stop_static
         clearances = problem.clearances()
-        return state, float(np.min((clearances - reach) / np.maximum(np.abs(clearances), 1e-3 * self.state_scale[0])))
+        return ContactFreeOrbit(state, float(np.min((clearances - reach) / np.maximum(np.abs(clearances), 1e-3 * self.state_scale[0]))), linear)
 
     def impact_orbit(self, p: NDArray[np.float64]) -> tuple[NDArray[np.float64], float] | None:
         """The closed-form one-impact orbit at parameters ``p`` with the least impulse of its admissible roots
@@ -222,7 +229,7 @@ class ImpactMap:
         try:
             problem = self.problem_at(p)
             roots = [solve_impact_orbit(problem, root=root) for root in ("+", "-")]
-        except (ValueError, TypeError):  # no problem at p, or no closed form for it
+        except ValueError:  # no problem at p, or no closed form for it (closed_form_layout says why)
             return None
         admissible = [orbit for orbit in roots if bool(np.all(orbit.admissible()))]
         if not admissible:
@@ -315,6 +322,25 @@ class Resection:
     state: NDArray[np.float64]
     parameters: NDArray[np.float64]
     gap: StrobeGap
+
+
+@dataclass(frozen=True, eq=False)
+class ContactFreeOrbit:
+    """The contact-free steady state of an :class:`ImpactMap` at a parameter vector (:meth:`ImpactMap.contact_free_orbit`).
+
+    Attributes
+    ----------
+    state : ndarray, shape (2N,)
+        Its state at the strobe (x [m], x' [m s-1]).
+    clearance : float
+        Its least relative clearance to a stop [-] (negative: it would cross that stop; zero: it touches it).
+    amplitudes : LinearAmplitudes
+        Its complex amplitudes (:func:`~vibroimpact.analysis.linear.linear_amplitudes` of the map's problem there) [m].
+    """
+
+    state: NDArray[np.float64]
+    clearance: float
+    amplitudes: LinearAmplitudes
 
 
 def _law(law: RigidStop | KelvinVoigtBumper, clearance: float, restitution: float) -> RigidStop | KelvinVoigtBumper:

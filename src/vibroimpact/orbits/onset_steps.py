@@ -66,6 +66,16 @@ class OnsetSteps:
     arc: Any
     specials: list[tuple[float, SpecialPoint]]
     tolerance: Any  # (point) -> the arclength bracket of a located point
+    touching: Point | None
+    arrival: list[Point]
+    reference: Point | None
+    departure: list[Point]
+
+    def clear_onset(self) -> None:
+        """Forget the last onset's points (the walker's constructor, and each grazing point): its own orbit
+        (``touching``), the last stretch arriving at it and the point 1e-3 from it (``arrival``, ``reference``), and
+        the closed-form orbits leaving it (``departure``, for :meth:`leave`)."""
+        self.touching, self.arrival, self.reference, self.departure = None, [], None, []
 
     def grazing(self, a: Point, sigma: float, arclength: float, hint: Point | None = None) -> object:
         """Locate a grazing point between a and sigma; return the point beyond it (None: the branch ends there)."""
@@ -73,7 +83,7 @@ class OnsetSteps:
         if not math.isfinite(value):
             return NOT_GRAZING  # a plain corrector failure, not a grazing
         onset = self.onset(side, beyond, value)
-        self.touching, self.arrival, self.reference, self.departure = None, [], None, []
+        self.clear_onset()
         if onset is not None:
             value, touching, free = onset
             grazing = touching if touching is not None else grazing
@@ -235,7 +245,7 @@ class OnsetSteps:
         parameter that leaves the point.
         """
         if start.out.hybrid is None or start.out.hybrid.onset_depth is None:
-            departure, self.departure = getattr(self, "departure", []), []
+            departure, self.departure = self.departure, []
             return departure  # rigid stops: the closed-form orbits found at the onset (:meth:`_rigid_ladder`)
         signature = signature_of(start) if signature is None else signature
         margin = grazing_margin(start.out.hybrid) if signature_of(start) == signature else 0.0

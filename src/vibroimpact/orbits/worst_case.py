@@ -10,7 +10,6 @@ orbit shot from the sampled orbit's state: the maximum to the shooting's toleran
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -19,8 +18,6 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
-from vibroimpact.analysis.linear import linear_amplitudes
-from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import Branch, PeriodicOrbit
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
 from vibroimpact.orbits.maps import ImpactMap, branch_measures, closed_form_state, orbit_measures
@@ -161,14 +158,16 @@ def worst_response(problem: Any, band: tuple[float, float], coordinate: int = 0,
     base = ImpactMap(problem)
     index = base.parameter_names.index("frequency")
 
-    def linear(frequency: float) -> float:
+    def at_frequency(frequency: float) -> np.ndarray:
         p = base.parameters.copy()
         p[index] = frequency
-        found = base.linear_orbit(p)
-        if found is None or found[1] < 0.0:
+        return p
+
+    def linear(frequency: float) -> float:
+        found = base.contact_free_orbit(at_frequency(frequency))
+        if found is None or found.clearance < 0.0:
             return math.nan
-        q = ImpactProblem(problem.system, problem.contact, dataclasses.replace(problem.harmonic, frequency=frequency))
-        return float(abs(linear_amplitudes(q).coordinates[coordinate]))
+        return float(abs(found.amplitudes.coordinates[coordinate]))
 
     best = (-math.inf, math.nan, "")
     values = np.array([linear(x) for x in f])
@@ -191,14 +190,14 @@ def worst_response(problem: Any, band: tuple[float, float], coordinate: int = 0,
             if not ok[run[0]]:
                 continue
             start = float(f[run[len(run) // 2]])
-            at = ImpactProblem(problem.system, problem.contact, dataclasses.replace(problem.harmonic, frequency=start))
-            system = ImpactMap(at)
-            single = solve_impact_orbit(at, root=root)
+            there = base.problem_at(at_frequency(start))
+            system = ImpactMap(there)
+            single = solve_impact_orbit(there, root=root)
             x_start = float(np.abs(single.harmonics()).reshape(-1)[coordinate])
             if any(_passes(known, start, x_start) for known in traced):
                 continue  # a branch already traced passes through this start
             try:
-                shot = shoot(system, closed_form_state(at, single), system.parameters)
+                shot = shoot(system, closed_form_state(there, single), system.parameters)
             except ShootingError:
                 continue
             branch = continue_branch(system, shot, "frequency", ContinuationSettings(lower=low, upper=high))

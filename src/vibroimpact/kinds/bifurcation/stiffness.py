@@ -3,7 +3,8 @@ one, by continuation instead of by distance.
 
 A :class:`StiffnessCase` finds the one-contact branches of the stiffest bumper of a study (``bifurcation.bumper``)
 and continues each of their folds, period doublings and Neimark-Sacker points (period 1; not those a contact onset
-induces, :data:`INDUCED`) in (frequency, T_b) on
+induces, their ``induced_by``: the multipliers jump across the unit circle at the onset, which does not depend on
+Omega_b, so such a point solves no smooth extended system and has no curve in the stiffness) in (frequency, T_b) on
 :class:`~vibroimpact.orbits.bumper_map.BumperPeriodMap`, T_b = 1 / (Omega_b / 2 pi) [s] the bumper period, over
 :data:`STIFFER` times the stiffest bumper's frequency down to the softest's divided by :data:`SOFTER`. A curve says
 where its special point is at every bumper in between (and whether it still exists: a fold curve that turns back in
@@ -33,17 +34,11 @@ from vibroimpact.orbits.continuation import ContinuationSettings, continue_speci
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.store import case_key
 
-__all__ = ["StiffnessCase", "monotone_pieces", "curve_pieces", "on_piece", "FOLLOWED", "INDUCED", "STIFFER", "SOFTER", "CURVE_SETTINGS", "STIFFNESS_FIELDS", "ON_CURVE"]
+__all__ = ["StiffnessCase", "monotone_pieces", "curve_pieces", "on_piece", "FOLLOWED", "STIFFER", "SOFTER", "CURVE_SETTINGS", "STIFFNESS_FIELDS", "ON_CURVE"]
 
 #: The kinds of special point followed in the bumper's stiffness (a grazing point, the contact onset at tangency,
 #: does not depend on Omega_b).
 FOLLOWED = ("fold", "period_doubling", "neimark_sacker")
-#: How the continuation's note marks a special point located next to a contact onset and induced by it (its
-#: ``induced_by``, the onset's value, says so to code): the multipliers jump across the unit circle at the onset,
-#: which does not depend on Omega_b, so the point solves no
-#: smooth extended system and has no curve in the stiffness (the shipped study's 4 kHz bumper: a period doubling
-#: 1.1e-4 Hz above the onset at 26.026487 Hz, "does not solve its extended system" when followed).
-INDUCED = "induced by it"
 #: The curves reach this many times the stiffest bumper's frequency (Richardson's extrapolation to the rigid stop
 #: takes the curve at its stiffest T_b and twice it) ...
 STIFFER = 16.0
