@@ -25,7 +25,7 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.motion import classify_motion, classify_strobes
 from vibroimpact.simulation.harmonics import linear_state, resting_state
 
-__all__ = ["MOTION_CLASSES", "MAX_KEPT_IMPACTS", "MAX_PERIOD", "REPEAT_TOLERANCE", "SWEEP_FIELDS", "at_frequency", "linear_start", "measure_motion", "stepped_sweep"]
+__all__ = ["MOTION_CLASSES", "MAX_KEPT_IMPACTS", "MAX_PERIOD", "REPEAT_TOLERANCE", "SWEEP_FIELDS", "at_frequency", "sweep_arrays", "linear_start", "measure_motion", "stepped_sweep"]
 
 #: What the motion at a brute-force point is (CF flags of ``brute_regime`` and ``chart_regime``, values 0...).
 MOTION_CLASSES = ("linear", "one_impact", "other_periodic", "quasi_periodic", "chaotic", "irregular")
@@ -80,12 +80,8 @@ def stepped_sweep(
     """
     f = np.array(frequencies)
     order = np.argsort(f) if direction == "up" else np.argsort(f)[::-1]
-    n, s, width = f.size, strobes, 2 * problem.size
-    out = {
-        "strobe": np.full((n, s), np.nan), "amplitude": np.full((n, s), np.nan), "velocity": np.full((n, MAX_KEPT_IMPACTS), np.nan),
-        "impacts": np.zeros(n), "regime": np.full(n, -1, dtype=np.int8), "period": np.zeros(n, dtype=np.int16), "lyapunov": np.full(n, np.nan),
-        "state": np.full((n, width), np.nan),
-    }  # fmt: skip
+    n, s = f.size, strobes
+    out = sweep_arrays(n, s, 2 * problem.size)
     state = None
     errors = [""] * n
     for done, k in enumerate(order):
@@ -99,6 +95,16 @@ def stepped_sweep(
         if report is not None:
             report(done + 1)
     return out | {"error": np.array(errors, dtype=str)}
+
+
+def sweep_arrays(n: int, strobes: int, width: int) -> dict[str, NDArray[Any]]:
+    """The arrays :func:`measure_motion` fills for ``n`` points of ``strobes`` periods and states of ``width`` (2N)
+    entries, unmeasured: NaN, no impacts, ``regime`` -1, ``period`` 0 (:data:`SWEEP_FIELDS` but ``error``)."""
+    return {
+        "strobe": np.full((n, strobes), np.nan), "amplitude": np.full((n, strobes), np.nan), "velocity": np.full((n, MAX_KEPT_IMPACTS), np.nan),
+        "impacts": np.zeros(n), "regime": np.full(n, -1, dtype=np.int8), "period": np.zeros(n, dtype=np.int16), "lyapunov": np.full(n, np.nan),
+        "state": np.full((n, width), np.nan),
+    }  # fmt: skip
 
 
 def linear_start(problem: ImpactProblem) -> NDArray[np.float64]:
