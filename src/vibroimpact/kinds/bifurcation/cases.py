@@ -2,13 +2,8 @@
 of one restitution, and the two-parameter chart's curves.
 
 * :class:`SweepCase`: a stepped sweep over frequencies (up or down) of the engine with exact Jacobians for the
-  problem's contact law (the compiled exact engine for rigid stops, the bumper's closed-form engine for Kelvin-Voigt
-  bumpers), the end state carried to the next frequency; at each frequency a transient is dropped, then the strobes of the first coordinate (X1 on the
-  paper's layout), its per-period fundamental and the impact velocities are kept and the motion is classified (:data:`MOTION_CLASSES`): linear, one impact per period,
-  another periodic motion, or, where the strobes do not repeat, quasi-periodic, chaotic or irregular from the exact
-  Jacobians (:func:`vibroimpact.orbits.motion.classify_motion`; from the strobes alone where a Jacobian is undefined,
-  :func:`~vibroimpact.orbits.motion.classify_strobes`). A strictly negative Lyapunov exponent means a periodic
-  orbit approached slowly: the motion is classified by the period that repeats best.
+  problem's contact law, the end state carried to the next frequency, each point's motion measured and classified
+  (:data:`MOTION_CLASSES`): :func:`vibroimpact.simulation.attractors.stepped_sweep`, as a runner case.
 * :class:`BranchCase`: :func:`vibroimpact.kinds.bifurcation.branches.find_branches` of one restitution.
 * :class:`ChartCase`: the special points of the chart's restitution followed in (frequency, clearance), from the
   branches of its own continuation (their labels and frequency ranges are returned too): folds, period
@@ -26,9 +21,7 @@ stops sharing one clearance and restitution, harmonic load) and moves it in freq
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Callable, Sequence
-from typing import Any
 from dataclasses import dataclass, asdict
 
 import numpy as np
@@ -45,11 +38,10 @@ from vibroimpact.orbits.branch import lower_period_maps, SPECIAL_POINT_KINDS, It
 from vibroimpact.orbits.continuation import continue_special_point, ContinuationSettings, continue_branch
 from vibroimpact.orbits.grazing_curve import trace_grazing
 from vibroimpact.orbits.maps import ImpactMap, orbit_measures, resection
-from vibroimpact.orbits.motion import classify_motion, classify_strobes
 from vibroimpact.orbits.shooting import ShootingError, shoot
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.store import case_key
-from vibroimpact.simulation.harmonics import linear_state, resting_state
+from vibroimpact.simulation.attractors import MAX_KEPT_IMPACTS, MOTION_CLASSES, SWEEP_FIELDS, stepped_sweep
 
 __all__ = ["Seed", "MAX_SEEDED_BRANCHES", "SEEDED_MAX_STEPS", "sweep_seeds", "seed_branches", "MOTION_CLASSES", "MAX_KEPT_IMPACTS", "SweepCase", "BranchCase", "ChartCase", "branch_arrays"]
 
@@ -196,22 +188,12 @@ def _seed_failure(seed: Seed, error: Exception) -> str:
     return f"brute-force seed at {seed.frequency:.3f} Hz (period {seed.period}) failed: {type(error).__name__}: {str(error)[:160]}"
 
 
-#: What the motion at a brute-force point is (CF flags of ``brute_regime`` and ``chart_regime``, values 0...).
-MOTION_CLASSES = ("linear", "one_impact", "other_periodic", "quasi_periodic", "chaotic", "irregular")
-#: Impact velocities kept per brute-force point (NaN-padded).
-MAX_KEPT_IMPACTS = 64
-#: Longest period looked for in the strobes [periods] (the strobes kept must cover it twice).
-MAX_PERIOD = 32
-#: Strobes repeat when they differ by less than this, relative to the motion's length (Delta + q |H12| on the paper's
-#: layout, :meth:`ImpactProblem.velocity_scale` / w in general; velocities: times w) [-].
-REPEAT_TOLERANCE = 1e-6
-
-
 @dataclass(frozen=True, eq=False)
 class SweepCase:
     """A stepped brute-force sweep of ``problem`` (its restitution and clearance; rigid stops or Kelvin-Voigt
     bumpers) in one direction over ``frequencies`` [Hz] with ``engine`` (a registry name with exact Jacobians for the
-    problem's contact law); ``strobe`` and ``amplitude`` are the first coordinate's."""
+    problem's contact law); ``strobe`` and ``amplitude`` are the first coordinate's
+    (:func:`vibroimpact.simulation.attractors.stepped_sweep`)."""
 
     problem: ImpactProblem
     direction: str
@@ -219,7 +201,7 @@ class SweepCase:
     transient: int
     strobes: int
     engine: str = engine_for(RIGID, "exact_jacobians")  # the registry's, by capability: exact Jacobians for the problem's contact law
-    fields: tuple[str, ...] = ("strobe", "amplitude", "velocity", "impacts", "regime", "period", "lyapunov", "state", "error")
+    fields: tuple[str, ...] = SWEEP_FIELDS
     progress_unit: str = "frequency points"
 
     @property
@@ -234,72 +216,7 @@ class SweepCase:
     def run(self, report: ProgressReport | None = None) -> CaseResult:
         """Arrays over the frequencies in increasing order (whatever the direction); ``error``: the raw message where
         the engine failed (``regime`` -1), else empty."""
-        engine = make_engine(self.engine)
-        f = np.array(self.frequencies)
-        order = np.argsort(f) if self.direction == "up" else np.argsort(f)[::-1]
-        n, s, width = f.size, self.strobes, 2 * self.problem.size
-        out = {
-            "strobe": np.full((n, s), np.nan), "amplitude": np.full((n, s), np.nan), "velocity": np.full((n, MAX_KEPT_IMPACTS), np.nan),
-            "impacts": np.zeros(n), "regime": np.full(n, -1, dtype=np.int8), "period": np.zeros(n, dtype=np.int16), "lyapunov": np.full(n, np.nan),
-            "state": np.full((n, width), np.nan),
-        }  # fmt: skip
-        state = None
-        errors = [""] * n
-        for done, k in enumerate(order):
-            problem = problem_at(self.problem, float(f[k]))
-            state = _linear_start(problem) if state is None else state
-            try:
-                state = _measure(engine, problem, state, self.transient, s, out, k)
-            except RuntimeError as error:  # the engine made no progress (endless chattering): start the next point at rest
-                state = resting_state(problem)
-                errors[k] = f"{type(error).__name__}: {str(error)[:160]}"
-            if report is not None:
-                report(done + 1)
-        return out | {"error": np.array(errors, dtype=str)}
-
-
-def _linear_start(problem: ImpactProblem) -> NDArray[np.float64]:
-    """The linear steady state at t = 0 if it fits inside every stop, else rest on the stops."""
-    linear = linear_state(problem)
-    return linear.state(problem.omega) if linear.fits(problem) else resting_state(problem)
-
-
-def _measure(engine: Any, problem: ImpactProblem, state: NDArray[np.float64], transient: int, strobes: int, out: dict, k: int) -> NDArray[np.float64]:
-    """Drop the transient, keep ``strobes`` periods at row ``k`` of ``out``; return the end state."""
-    if transient:
-        state = engine.integrate(problem, state, 0.0, transient).final_state
-    run = engine.integrate(problem, state, 0.0, strobes, moments=True, jacobians=True)
-    s = run.strobe_states
-    out["state"][k] = run.final_state
-    out["strobe"][k] = s[1:, 0]
-    out["amplitude"][k] = np.abs(run.moments[:, 0]) * 2.0 / problem.period
-    velocities = run.impact_velocities
-    out["velocity"][k, : min(velocities.size, MAX_KEPT_IMPACTS)] = velocities[-MAX_KEPT_IMPACTS:]
-    out["impacts"][k] = velocities.size / strobes
-    length = problem.length_scale()
-    scale = np.repeat([length, problem.omega * length], problem.size)
-    mismatch = [float(np.max(np.abs(s[p:] - s[:-p]) / scale)) if s.shape[0] > 2 * p else math.inf for p in range(1, MAX_PERIOD + 1)]
-    period = next((p for p, m in enumerate(mismatch, start=1) if m < REPEAT_TOLERANCE), 0)
-    if velocities.size == 0:
-        out["regime"][k], out["period"][k] = 0, 1
-        return run.final_state
-    if not period:
-        jacobians = run.strobe_jacobians
-        if np.all(np.isfinite(jacobians)):
-            evidence = classify_motion(jacobians, s[1:])
-        else:  # a degenerate event (e.g. a chatter sequence ending as a release begins) left a Jacobian undefined
-            evidence = classify_strobes(s[1:])  # the strobes alone decide the clear cases; no exponent
-        out["lyapunov"][k] = evidence.lyapunov_exponent
-        if evidence.lyapunov_exponent < -0.005:  # contracting: a periodic orbit approached slowly
-            period = int(np.argmin(mismatch)) + 1
-        else:
-            out["regime"][k] = MOTION_CLASSES.index(evidence.kind)
-            return run.final_state
-    out["period"][k] = period
-    tail = (strobes // period) * period
-    impacts = np.count_nonzero(run.impact_times >= run.strobe_times[strobes - tail])
-    out["regime"][k] = 1 if period == 1 and impacts == tail else 2
-    return run.final_state
+        return stepped_sweep(self.problem, self.direction, self.frequencies, self.transient, self.strobes, make_engine(self.engine), report)
 
 
 #: Fields of :func:`branch_arrays`.

@@ -67,12 +67,13 @@ from vibroimpact.scene.variables import COORDINATE_ATTRIBUTES, STABLE_ATTRIBUTES
 from vibroimpact.kinds.bifurcation.variables import BIFURCATION_ATTRIBUTES
 from vibroimpact.kinds.bifurcation.branches import MAX_ORBIT_IMPACTS, ORIGINS
 from vibroimpact.kinds.bifurcation.logs import Tally, chart_labels, continuation_log, failure_summary, numbered_across, relabel, sweep_tally, tallies
-from vibroimpact.kinds.bifurcation.cases import MAX_KEPT_IMPACTS, MAX_PERIOD, MOTION_CLASSES, BranchCase, ChartCase, SweepCase, Seed, sweep_seeds
+from vibroimpact.kinds.bifurcation.cases import BranchCase, ChartCase, SweepCase, Seed, sweep_seeds
 from vibroimpact.kinds.bifurcation.stiffness import SOFTER, STIFFER, StiffnessCase
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.run import provenance
 from vibroimpact.runs.runner import CaseResult, Runner
+from vibroimpact.simulation.attractors import MAX_KEPT_IMPACTS, MAX_PERIOD, MOTION_CLASSES
 
 __all__ = ["BifurcationStudy", "diagram_problem", "CONTINUATION_SECONDS", "CLOSED_FORM_SECONDS", "CHART_SECONDS", "STIFFNESS_SECONDS", "REPORT_FIGURES"]
 

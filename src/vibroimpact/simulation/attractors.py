@@ -1,0 +1,153 @@
+"""Attractors by brute force: stepped sweeps of an engine over frequencies, each point's motion measured and named.
+
+:func:`stepped_sweep` runs the engine with exact Jacobians for the problem's contact law (the compiled exact engine
+for rigid stops, the bumper's closed-form engine for Kelvin-Voigt bumpers) over frequencies in one direction, the end
+state carried to the next frequency; at each frequency (:func:`measure_motion`) a transient is dropped, then the
+strobes of the first coordinate (X1 on the paper's layout), its per-period fundamental and the impact velocities are
+kept and the motion is classified (:data:`MOTION_CLASSES`): linear, one impact per period, another periodic motion,
+or, where the strobes do not repeat, quasi-periodic, chaotic or irregular from the exact Jacobians
+(:func:`vibroimpact.orbits.motion.classify_motion`; from the strobes alone where a Jacobian is undefined,
+:func:`~vibroimpact.orbits.motion.classify_strobes`). A strictly negative Lyapunov exponent means a periodic orbit
+approached slowly: the motion is classified by the period that repeats best.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.orbits.motion import classify_motion, classify_strobes
+from vibroimpact.simulation.harmonics import linear_state, resting_state
+
+__all__ = ["MOTION_CLASSES", "MAX_KEPT_IMPACTS", "MAX_PERIOD", "REPEAT_TOLERANCE", "SWEEP_FIELDS", "at_frequency", "sweep_arrays", "linear_start", "measure_motion", "stepped_sweep"]
+
+#: What the motion at a brute-force point is (CF flags of ``brute_regime`` and ``chart_regime``, values 0...).
+MOTION_CLASSES = ("linear", "one_impact", "other_periodic", "quasi_periodic", "chaotic", "irregular")
+#: Impact velocities kept per brute-force point (NaN-padded).
+MAX_KEPT_IMPACTS = 64
+#: Longest period looked for in the strobes [periods] (the strobes kept must cover it twice).
+MAX_PERIOD = 32
+#: Strobes repeat when they differ by less than this, relative to the motion's length (Delta + q |H12| on the paper's
+#: layout, :meth:`ImpactProblem.velocity_scale` / w in general; velocities: times w) [-].
+REPEAT_TOLERANCE = 1e-6
+#: The arrays of :func:`stepped_sweep`, over the frequencies in increasing order.
+SWEEP_FIELDS = ("strobe", "amplitude", "velocity", "impacts", "regime", "period", "lyapunov", "state", "error")
+
+
+def at_frequency(problem: ImpactProblem, frequency: float) -> ImpactProblem:
+    """``problem`` at another excitation frequency [Hz]: the structure, stops and the load's distribution, phase and
+    static part kept (the bifurcation kind's ``problem_at`` without its clearance and phase)."""
+    excitation = dataclasses.replace(problem.harmonic, frequency=float(frequency))
+    return ImpactProblem(problem.system, problem.stops, excitation)
+
+
+def stepped_sweep(
+    problem: ImpactProblem, direction: str, frequencies: Sequence[float], transient: int, strobes: int, engine: Any,
+    report: Callable[[float], None] | None = None,
+) -> dict[str, NDArray[Any]]:  # fmt: skip
+    """A stepped brute-force sweep of ``problem`` in one direction, the end state carried from point to point.
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+        Structure, stops (rigid or Kelvin-Voigt bumpers) and harmonic load; its frequency is replaced by each point's.
+    direction : str
+        ``up`` (increasing frequency) or anything else (decreasing).
+    frequencies : sequence of float
+        The points [Hz], in any order.
+    transient, strobes : int
+        Periods dropped, then periods kept, at each point [-].
+    engine : object
+        A built engine with exact Jacobians for the problem's contact law (``integrate(..., moments=True,
+        jacobians=True)``).
+    report : callable, optional
+        Gets the number of points done after each.
+
+    Returns
+    -------
+    dict
+        :data:`SWEEP_FIELDS` over the frequencies in increasing order (whatever the direction): ``strobe`` (n, s) x1
+        at the strobes [m], ``amplitude`` (n, s) per-period |X1| [m], ``velocity`` (n, :data:`MAX_KEPT_IMPACTS`) the
+        last impact velocities [m s-1], ``impacts`` per period, ``regime`` (:data:`MOTION_CLASSES` index, -1 where
+        the engine failed), ``period`` (0: no repeat), ``lyapunov`` [1/period], ``state`` (n, 2N) the end state and
+        ``error`` the raw message where the engine failed (the next point then starts at rest), else empty.
+    """
+    f = np.array(frequencies)
+    order = np.argsort(f) if direction == "up" else np.argsort(f)[::-1]
+    n, s = f.size, strobes
+    out = sweep_arrays(n, s, 2 * problem.size)
+    state = None
+    errors = [""] * n
+    for done, k in enumerate(order):
+        moved = at_frequency(problem, float(f[k]))
+        state = linear_start(moved) if state is None else state
+        try:
+            state = measure_motion(engine, moved, state, transient, s, out, k)
+        except RuntimeError as error:  # the engine made no progress (endless chattering): start the next point at rest
+            state = resting_state(moved)
+            errors[k] = f"{type(error).__name__}: {str(error)[:160]}"
+        if report is not None:
+            report(done + 1)
+    return out | {"error": np.array(errors, dtype=str)}
+
+
+def sweep_arrays(n: int, strobes: int, width: int) -> dict[str, NDArray[Any]]:
+    """The arrays :func:`measure_motion` fills for ``n`` points of ``strobes`` periods and states of ``width`` (2N)
+    entries, unmeasured: NaN, no impacts, ``regime`` -1, ``period`` 0 (:data:`SWEEP_FIELDS` but ``error``)."""
+    return {
+        "strobe": np.full((n, strobes), np.nan), "amplitude": np.full((n, strobes), np.nan), "velocity": np.full((n, MAX_KEPT_IMPACTS), np.nan),
+        "impacts": np.zeros(n), "regime": np.full(n, -1, dtype=np.int8), "period": np.zeros(n, dtype=np.int16), "lyapunov": np.full(n, np.nan),
+        "state": np.full((n, width), np.nan),
+    }  # fmt: skip
+
+
+def linear_start(problem: ImpactProblem) -> NDArray[np.float64]:
+    """The linear steady state at t = 0 if it fits inside every stop, else rest on the stops [m, m s-1]."""
+    linear = linear_state(problem)
+    return linear.state(problem.omega) if linear.fits(problem) else resting_state(problem)
+
+
+def measure_motion(engine: Any, problem: ImpactProblem, state: NDArray[np.float64], transient: int, strobes: int, out: dict, k: int) -> NDArray[np.float64]:
+    """Drop ``transient`` periods from ``state``, keep ``strobes`` periods at row ``k`` of ``out`` (the arrays of
+    :func:`stepped_sweep`, ``error`` aside); return the end state [m, m s-1]."""
+    if transient:
+        state = engine.integrate(problem, state, 0.0, transient).final_state
+    run = engine.integrate(problem, state, 0.0, strobes, moments=True, jacobians=True)
+    s = run.strobe_states
+    out["state"][k] = run.final_state
+    out["strobe"][k] = s[1:, 0]
+    out["amplitude"][k] = np.abs(run.moments[:, 0]) * 2.0 / problem.period
+    velocities = run.impact_velocities
+    out["velocity"][k, : min(velocities.size, MAX_KEPT_IMPACTS)] = velocities[-MAX_KEPT_IMPACTS:]
+    out["impacts"][k] = velocities.size / strobes
+    length = problem.length_scale()
+    scale = np.repeat([length, problem.omega * length], problem.size)
+    mismatch = [float(np.max(np.abs(s[p:] - s[:-p]) / scale)) if s.shape[0] > 2 * p else math.inf for p in range(1, MAX_PERIOD + 1)]
+    period = next((p for p, m in enumerate(mismatch, start=1) if m < REPEAT_TOLERANCE), 0)
+    if velocities.size == 0:
+        out["regime"][k], out["period"][k] = 0, 1
+        return run.final_state
+    if not period:
+        jacobians = run.strobe_jacobians
+        if np.all(np.isfinite(jacobians)):
+            evidence = classify_motion(jacobians, s[1:])
+        else:  # a degenerate event (e.g. a chatter sequence ending as a release begins) left a Jacobian undefined
+            evidence = classify_strobes(s[1:])  # the strobes alone decide the clear cases; no exponent
+        out["lyapunov"][k] = evidence.lyapunov_exponent
+        if evidence.lyapunov_exponent < -0.005:  # contracting: a periodic orbit approached slowly
+            period = int(np.argmin(mismatch)) + 1
+        else:
+            out["regime"][k] = MOTION_CLASSES.index(evidence.kind)
+            return run.final_state
+    out["period"][k] = period
+    tail = (strobes // period) * period
+    impacts = np.count_nonzero(run.impact_times >= run.strobe_times[strobes - tail])
+    out["regime"][k] = 1 if period == 1 and impacts == tail else 2
+    return run.final_state
+
