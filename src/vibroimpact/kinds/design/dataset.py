@@ -20,7 +20,8 @@ from vibroimpact.analysis.band_worst import MOTIONS
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
-from vibroimpact.kinds.design.evaluate import MAX_BRANCH_POINTS
+from vibroimpact.kinds.design.evaluate import ATTRACTOR_POINTS, MAX_BRANCH_POINTS, SWEEP_ACCURACIES
+from vibroimpact.simulation.certified_worst import SOURCES
 from vibroimpact.kinds.design.scene import DesignSettings, safe_name
 from vibroimpact.kinds.design.search import STAGES
 from vibroimpact.kinds.design.study import Outcome
@@ -104,6 +105,8 @@ def design_dataset(scene: Any, outcome: Outcome) -> xr.Dataset:
               "sample": ("sample", np.arange(S, dtype=np.int32), {"units": "1", "long_name": "mistuning sample (0: the nominal design)"}),
               "certificate": ("certificate", np.arange(len(outcome.certified), dtype=np.int32), {"units": "1", "long_name": "index of the certified problem"}),
               "point": ("point", np.arange(MAX_BRANCH_POINTS, dtype=np.int32), {"units": "1", "long_name": "index of a continued orbit"}),
+              "attractor_point": ("attractor_point", np.arange(ATTRACTOR_POINTS, dtype=np.int32), {"units": "1", "long_name": "index of a brute-force frequency"}),
+              "accuracy": ("accuracy", np.arange(len(SWEEP_ACCURACIES), dtype=np.int32), {"units": "1", "long_name": "index of sweep_accuracy"}),
               "design": ("design", np.arange(len(DESIGNS), dtype=np.int32), {"units": "1", "long_name": "index of the compared design (design_name)"})}  # fmt: skip
     dataset = xr.Dataset(data, coords=coords)
     dataset.attrs.update(attrs)
@@ -126,17 +129,33 @@ def _quantile(q: float) -> str:
 def _certificates(data: dict[str, xr.Variable], outcome: Outcome) -> None:
     rows = outcome.certified
     dims = ("certificate",)
+
+    def column(key: str) -> NDArray[np.float64]:
+        return np.array([float(r[key]) for r in rows], dtype=float)
+
     data["certificate_evaluation"] = xr.Variable(dims, np.array([r["evaluation"] for r in rows], dtype=np.int32), {"units": "1", "long_name": "the certified candidate (index of evaluation)"})
     data["certificate_sample"] = xr.Variable(dims, np.array([r["sample"] for r in rows], dtype=np.int32), {"units": "1", "long_name": "the certified mistuning sample"})
-    for key, units, name in (("worst", "m", "largest stable |X| over the band by continuation of every branch from the closed-form orbits"), ("frequency", "Hz", "where"),
-                             ("screened", "m", "the closed-form screen's value of the same problem"), ("wall_time", "s", "cost of the certification")):  # fmt: skip
-        data[f"certificate_{key}"] = xr.Variable(dims, np.array([float(r[key]) for r in rows], dtype=float), {"units": units, "long_name": name})
+    for key, units, name in (("worst", "m", "certified largest stable |X1| over the band: the larger of continuation and brute force, located exactly where continued"),
+                             ("frequency", "Hz", "where the certified worst case is"), ("screened", "m", "the closed-form screen's value of the same problem"),
+                             ("continuation_worst", "m", "largest stable |X1| of the branches continued from the closed-form orbits"),
+                             ("continuation_time", "s", "wall time of the continuation"), ("brute_worst", "m", "largest |X1| of any attractor the brute force found (a grid sample)"),
+                             ("brute_frequency", "Hz", "where the brute force found it"), ("brute_time", "s", "wall time of the brute force (and of continuing from its orbit)")):  # fmt: skip
+        data[f"certificate_{key}"] = xr.Variable(dims, column(key), {"units": units, "long_name": name})
+    data["certificate_wall_time"] = xr.Variable(dims, column("continuation_time") + column("brute_time"), {"units": "s", "long_name": "wall time of the certification (continuation and brute force)"})
+    data["certificate_source"] = _flag([max(int(r["source"]), 0) for r in rows], SOURCES, "which method sets the certified worst case", dims)
     data["certificate_motion"] = xr.Variable(dims, np.array([str(r["motion"]) for r in rows], dtype=str), {"long_name": "the motion that sets the certified worst case"})
+    data["certificate_brute_motion"] = xr.Variable(dims, np.array([str(r["brute_motion"]) for r in rows], dtype=str), {"long_name": "the motion of the brute force's largest attractor"})
     data["certificate_error"] = xr.Variable(dims, np.array([str(r["error"]) for r in rows], dtype=str), {"long_name": "why a certification failed (empty: it did not)"})
-    for key, units, name in (("frequency", "Hz", "frequency of a continued orbit"), ("amplitude", "m", "|X| of a continued orbit"), ("stable", "1", "1 where the continued orbit is stable"),
+    data["sweep_accuracy"] = xr.Variable("accuracy", np.array(SWEEP_ACCURACIES), {"units": "1", "long_name": "relative accuracy of a band maximum"})
+    data["certificate_sweep_points"] = xr.Variable(("certificate", "accuracy"), np.array([r["sweep_points"] for r in rows], dtype=float).reshape(len(rows), len(SWEEP_ACCURACIES)),
+                                                   {"units": "1", "long_name": "frequencies a stepped sweep needs to reach the certified maximum to the accuracy (from the curvature of its branch there)"})  # fmt: skip
+    for key, units, name in (("frequency", "Hz", "frequency of a continued orbit"), ("amplitude", "m", "|X1| of a continued orbit"), ("stable", "1", "1 where the continued orbit is stable"),
                              ("impacts", "1", "impacts per period of a continued orbit"), ("index", "1", "which branch of its certificate")):  # fmt: skip
         block = np.array([r[f"branch_{key}"] for r in rows], dtype=float).reshape(len(rows), MAX_BRANCH_POINTS)
         data[f"branch_{key}"] = xr.Variable(("certificate", "point"), block, {"units": units, "long_name": name})
+    for key, units, name in (("frequency", "Hz", "frequency of the brute force"), ("amplitude", "m", "largest |X1| of the attractors the brute force found there (every run)")):
+        block = np.array([r[f"attractor_{key}"] for r in rows], dtype=float).reshape(len(rows), ATTRACTOR_POINTS)
+        data[f"attractor_{key}"] = xr.Variable(("certificate", "attractor_point"), block, {"units": units, "long_name": name})
 
 
 def _designs(data: dict[str, xr.Variable], scene: Any, outcome: Outcome) -> dict[str, object]:

@@ -12,7 +12,6 @@ problem that continuation uses too.
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -22,11 +21,11 @@ from numpy.typing import NDArray
 from vibroimpact.analysis.band_worst import MOTIONS, closed_form_at, closed_form_worst
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.maps import ImpactMap, branch_measures
-from vibroimpact.orbits.worst_case import worst_response
+from vibroimpact.simulation.certified_worst import SOURCES, certified_worst, sweep_points_for
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.store import case_key
 
-__all__ = ["DesignSpace", "DesignCase", "sample_chunks", "CHUNKS", "DESIGN_FIELDS", "CertifyCase", "CERTIFY_FIELDS", "STOP_PARAMETERS"]
+__all__ = ["DesignSpace", "DesignCase", "sample_chunks", "CHUNKS", "DESIGN_FIELDS", "CertifyCase", "CERTIFY_FIELDS", "STOP_PARAMETERS", "ATTRACTOR_POINTS", "SWEEP_ACCURACIES", "MAX_BRANCH_POINTS"]
 
 #: The map's parameters a design or a mistuning may set besides the layout scalars.
 STOP_PARAMETERS = ("clearance", "restitution")
@@ -111,9 +110,9 @@ CHUNKS = 4
 
 
 def sample_chunks(samples: int) -> list[tuple[int, ...]]:
-    """The samples 0 ... ``samples`` - 1 in at most :data:`CHUNKS` consecutive runs of equal size (the last shorter)."""
-    size = -(-samples // CHUNKS)
-    return [tuple(range(first, min(first + size, samples))) for first in range(0, samples, size)]
+    """The samples 0 ... ``samples`` - 1 in min(``samples``, :data:`CHUNKS`) consecutive runs whose sizes differ by
+    at most one (two workers share 9 samples as 5 and 4, not 6 and 3)."""
+    return [tuple(int(i) for i in part) for part in np.array_split(np.arange(samples), min(samples, CHUNKS))]
 
 
 #: Fields of :class:`DesignCase`: per sample, the worst stable |X| [m] over the band, where [Hz], which motion (index of
@@ -173,22 +172,30 @@ def _around(frequency: float) -> tuple[float, float]:
     return frequency * (1.0 - 1e-6), frequency * (1.0 + 1e-6)
 
 
-#: Fields of :class:`CertifyCase`: the continuation's worst |X| [m], where [Hz], its motion (text), and its cost [s];
-#: the continued branches' points (frequency [Hz], |X| [m], stable 0/1, impacts per period, branch index), NaN-padded.
-CERTIFY_FIELDS = ("worst", "frequency", "motion", "wall_time", "branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index", "error")
+#: Fields of :class:`CertifyCase`: the certified worst |X| [m], where [Hz], its motion (text) and source (index of
+#: :data:`~vibroimpact.simulation.certified_worst.SOURCES`); the continuation's and the brute force's own answers and
+#: wall times [s]; the frequencies a stepped sweep needs to reach the same maximum to 1e-4 and 1e-8 (relative); the
+#: continued branches' points (frequency [Hz], |X| [m], stable 0/1, impacts per period, branch index), NaN-padded; the
+#: brute force's largest |X| at each of its frequencies.
+CERTIFY_FIELDS = ("worst", "frequency", "motion", "source", "continuation_worst", "continuation_time", "brute_worst", "brute_frequency", "brute_motion", "brute_time",
+                  "sweep_points", "branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index", "attractor_frequency", "attractor_amplitude", "error")  # fmt: skip
 #: Most branch points kept per certified problem.
 MAX_BRANCH_POINTS = 4000
+#: Frequencies of the certification's brute force.
+ATTRACTOR_POINTS = 121
+#: The accuracies (relative) at which a stepped sweep's cost is compared with the certification's.
+SWEEP_ACCURACIES = (1e-4, 1e-8)
 
 
 @dataclass(frozen=True, eq=False)
 class CertifyCase:
-    """The worst case of one problem by continuation (:func:`~vibroimpact.orbits.worst_case.worst_response`): every
-    branch continued from the closed-form orbits, its maxima located exactly."""
+    """The worst case of one problem certified by continuation and brute force
+    (:func:`~vibroimpact.simulation.certified_worst.certified_worst`)."""
 
     space: DesignSpace
     design: tuple[float, ...]
     sample: int = 0
-    engine: str = "continuation"
+    engine: str = "certification"
     fields: tuple[str, ...] = CERTIFY_FIELDS
     progress_unit: str = "designs"
 
@@ -199,32 +206,46 @@ class CertifyCase:
 
     def key(self) -> str:
         """Hash of the space, the design and the sample."""
-        return case_key({"kind": "design_certify", "space": self.space.key_content(), "design": list(self.design), "sample": self.sample})
+        return case_key({"kind": "design_certify", "space": self.space.key_content(), "design": list(self.design), "sample": self.sample, "attractors": ATTRACTOR_POINTS})
 
     def run(self, report: ProgressReport | None = None) -> CaseResult:
-        """The continuation's worst case and the branches it traced (:data:`CERTIFY_FIELDS`)."""
-        start = time.perf_counter()
+        """The certified worst case, each method's, and the branches traced (:data:`CERTIFY_FIELDS`)."""
         points = {k: np.full(MAX_BRANCH_POINTS, np.nan) for k in ("branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index")}
+        attractors = {k: np.full(ATTRACTOR_POINTS, np.nan) for k in ("attractor_frequency", "attractor_amplitude")}
+        scalars: dict[str, object] = {k: math.nan for k in ("worst", "frequency", "continuation_worst", "continuation_time", "brute_worst", "brute_frequency", "brute_time")}
+        scalars |= {"motion": "", "brute_motion": "", "source": -1}
         problem = self.space.problem_at(self.design, self.sample)
         try:
-            found = worst_response(problem, self.space.band, self.space.coordinate)
+            found = certified_worst(problem, self.space.band, frequencies=ATTRACTOR_POINTS)
         except (ValueError, RuntimeError) as error:
-            return {"worst": np.array(math.nan), "frequency": np.array(math.nan), "motion": np.array(""), "wall_time": np.array(time.perf_counter() - start),
-                    **points, "error": np.array(f"{type(error).__name__}: {str(error)[:200]}")}  # fmt: skip
-        wall = time.perf_counter() - start
-        k = 0
+            return {**{k: np.array(v) for k, v in scalars.items()}, "sweep_points": np.full(len(SWEEP_ACCURACIES), np.nan), **points, **attractors,
+                    "error": np.array(f"{type(error).__name__}: {str(error)[:200]}")}  # fmt: skip
+        top = found.attractors.maximum
+        scalars |= {"worst": found.amplitude, "frequency": found.frequency, "motion": found.motion, "source": SOURCES.index(found.source),
+                    "continuation_worst": found.continuation.amplitude, "continuation_time": found.continuation_time,
+                    "brute_worst": top.amplitude, "brute_frequency": top.frequency, "brute_motion": top.motion, "brute_time": found.brute_force_time}  # fmt: skip
         system = ImpactMap(problem)  # the frequency is each branch's own parameter
-        for index, (branch, _) in enumerate(found.branches):
+        branches = [branch for branch, _ in found.continuation.branches] + list(found.extra)
+        k, setting = 0, None
+        for index, branch in enumerate(branches):
             count = min(len(branch.values), MAX_BRANCH_POINTS - k)
             if count <= 0:
                 break
-            measured = branch_measures(system, branch)
+            measured = branch_measures(system if branch.orbits[0].period == 1 else ImpactMap(problem, periods=branch.orbits[0].period), branch).amplitude(self.space.coordinate)
+            stable = np.asarray(branch.stable, dtype=float)
             points["branch_frequency"][k : k + count] = branch.values[:count]
-            points["branch_amplitude"][k : k + count] = measured.amplitude(self.space.coordinate)[:count]
-            points["branch_stable"][k : k + count] = np.asarray(branch.stable, dtype=float)[:count]
+            points["branch_amplitude"][k : k + count] = measured[:count]
+            points["branch_stable"][k : k + count] = stable[:count]
             points["branch_impacts"][k : k + count] = np.asarray(branch.impacts, dtype=float)[:count]
             points["branch_index"][k : k + count] = index
             k += count
+            near = np.abs(np.asarray(branch.values) - found.frequency) <= 1e-6 * found.frequency + 1e-12
+            if np.any(near & (np.abs(measured - found.amplitude) <= 1e-3 * found.amplitude)):
+                setting = (np.asarray(branch.values)[stable == 1], measured[stable == 1])
+        f = found.attractors.frequency
+        attractors["attractor_frequency"][: f.size] = f
+        attractors["attractor_amplitude"][: f.size] = np.nanmax(np.where(np.isfinite(found.attractors.amplitude), found.attractors.amplitude, -np.inf), axis=1)
+        sweep = np.array([sweep_points_for(setting[1], setting[0], a, self.space.band) if setting is not None else math.nan for a in SWEEP_ACCURACIES])
         if report is not None:
             report(1.0)
-        return {"worst": np.array(found.amplitude), "frequency": np.array(found.frequency), "motion": np.array(found.motion), "wall_time": np.array(wall), **points, "error": np.array("")}
+        return {**{k: np.array(v) for k, v in scalars.items()}, "sweep_points": sweep, **points, **attractors, "error": np.array("")}

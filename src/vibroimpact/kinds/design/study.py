@@ -8,9 +8,10 @@
    the same mass under the same mistuning (:func:`vibroimpact.analysis.linear_optimum.optimal_linear_absorber`), its
    band peaks exact.
 4. The certification (:class:`~vibroimpact.kinds.design.evaluate.CertifyCase`): the best candidates at the nominal
-   sample and at their worst one, and the scene's design at the nominal one, by continuation of every branch from the closed-form
-   orbits; a candidate whose certified worst case exceeds its screen is scored on the certified value, and the
-   recommendation is the best certified candidate.
+   sample and at their worst one, and the scene's design at the nominal one, by continuation of every branch from the
+   closed-form orbits and by brute force (every attractor; a larger periodic one continued and located exactly); a
+   candidate whose certified worst case exceeds its screen is scored on the certified value, and the recommendation
+   is the best certified candidate.
 5. The dataset (:mod:`vibroimpact.kinds.design.dataset`).
 """
 
