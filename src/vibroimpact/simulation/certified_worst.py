@@ -58,6 +58,8 @@ class CertifiedWorst:
         Branches continued from brute-force orbits (empty unless ``source`` says so).
     continuation_time, brute_force_time : float
         Wall times [s] (the brute force's including any continuation from its orbits).
+    attractor_time : float
+        Wall time of the brute-force runs alone [s] (every frequency, every run).
     """
 
     amplitude: float
@@ -69,6 +71,12 @@ class CertifiedWorst:
     extra: tuple[Branch, ...]
     continuation_time: float
     brute_force_time: float
+    attractor_time: float = math.nan
+
+    @property
+    def seconds_per_point(self) -> float:
+        """The brute force's wall time per frequency and run [s]: what one more point of a stepped sweep costs."""
+        return self.attractor_time / self.attractors.amplitude.size if self.attractors.amplitude.size else math.nan
 
     def __post_init__(self) -> None:
         if self.source not in SOURCES:
@@ -89,6 +97,7 @@ def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequenci
     continued = worst_response(problem, (low, high))
     middle = time.perf_counter()
     sweep = band_attractors(problem, (low, high), frequencies=frequencies, starts=starts, transient=transient, strobes=strobes)
+    swept = time.perf_counter()
     top = sweep.maximum
     best = (continued.amplitude, continued.frequency, continued.motion, SOURCES[0])
     extra: tuple[Branch, ...] = ()
@@ -100,7 +109,7 @@ def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequenci
                 best = (refined[0], refined[1], f"{top.motion} ({refined[2]} of its branch, continued from the brute force)", SOURCES[2])
                 extra = (refined[3],)
     end = time.perf_counter()
-    return CertifiedWorst(best[0], best[1], best[2], best[3], continued, sweep, extra, middle - start, end - middle)
+    return CertifiedWorst(best[0], best[1], best[2], best[3], continued, sweep, extra, middle - start, end - middle, swept - middle)
 
 
 def _continued(problem: ImpactProblem, band: tuple[float, float], frequency: float, state: np.ndarray, period: int) -> tuple[float, float, str, Branch] | None:

@@ -95,12 +95,12 @@ def warnings(dataset: xr.Dataset) -> list[str]:
     if recommended >= 0:
         uncovered = float(np.nanmax(d["sample_uncovered"].values[recommended]))
         if uncovered > 0.0:
-            out.append(f"On {fmt(100 * uncovered, '.2g')} % of the band no period-1 motion of the recommended design is stable: there its motion is of a kind the closed forms do not know (more impacts, a longer period, or not periodic); the screen guessed its size from the unstable orbits, and the certification below continued every branch it could start.")
+            out.append(f"On {fmt(100 * uncovered, '.2g')} % of the band no period-1 motion of the recommended design is stable: there its motion is of a kind the closed forms do not know (more impacts, a longer period, or not periodic); the screen guessed its size from the unstable orbits; the certification found the motions there by brute force.")
         rows = np.flatnonzero(d["certificate_evaluation"].values == recommended)
         for r in rows:
             worst, screened = float(d["certificate_worst"].values[r]), float(d["certificate_screened"].values[r])
             if math.isfinite(worst) and worst > screened * (1.0 + 1e-6):
-                out.append(f"Continuation found a larger stable motion than the screen under sample {int(d['certificate_sample'].values[r])}: {_mm(worst)} ({d['certificate_motion'].values[r]} at {fmt(d['certificate_frequency'].values[r], '.4g')} Hz) against {_mm(screened)}.")
+                out.append(f"The certification found a larger stable motion than the screen under sample {int(d['certificate_sample'].values[r])}: {_mm(worst)} ({d['certificate_motion'].values[r]} at {fmt(d['certificate_frequency'].values[r], '.4g')} Hz) against {_mm(screened)}.")
             error = str(d["certificate_error"].values[r])
             if error:
                 out.append(f"The certification of sample {int(d['certificate_sample'].values[r])} failed: {error}")
@@ -108,7 +108,10 @@ def warnings(dataset: xr.Dataset) -> list[str]:
     if math.isfinite(ridge) and ridge < 0.02:
         f1, f2 = (float(x) for x in np.atleast_1d(d.attrs["equal_peak_frequencies_Hz"]))
         out.append(f"The recommended design sits on an equal-peak ridge: its two largest band maxima ({fmt(f1, '.4g')} and {fmt(f2, '.4g')} Hz) differ by {fmt(100 * ridge, '.2g')} %; a small change of any variable raises one of them.")
-    out.append("Not searched: non-periodic attractors by brute force, and branches born at period doublings and grazings (the certification continues the branches from the closed-form orbits).")
+    if d.sizes.get("certificate", 0):
+        points = d.sizes.get("attractor_point", 0)
+        out.append(f"What the certification can miss: an attractor whose basin none of its runs entered (sweeps both ways and two more starts at each of {points} frequencies), or one that lives only between those frequencies; "
+                   "the search itself ranked candidates on closed forms (period-1 motions), which a design with a larger multi-impact or non-periodic motion can fool until it is certified.")
     for failure in d.attrs.get("run_failures", []) if isinstance(d.attrs.get("run_failures"), list) else []:
         out.append(str(failure))
     return out

@@ -149,6 +149,8 @@ def _certificates(data: dict[str, xr.Variable], outcome: Outcome) -> None:
     data["sweep_accuracy"] = xr.Variable("accuracy", np.array(SWEEP_ACCURACIES), {"units": "1", "long_name": "relative accuracy of a band maximum"})
     data["certificate_sweep_points"] = xr.Variable(("certificate", "accuracy"), np.array([r["sweep_points"] for r in rows], dtype=float).reshape(len(rows), len(SWEEP_ACCURACIES)),
                                                    {"units": "1", "long_name": "frequencies a stepped sweep needs to reach the certified maximum to the accuracy (from the curvature of its branch there)"})  # fmt: skip
+    data["certificate_sweep_time"] = xr.Variable(("certificate", "accuracy"), np.array([r["sweep_time"] for r in rows], dtype=float).reshape(len(rows), len(SWEEP_ACCURACIES)),
+                                                 {"units": "s", "long_name": "what that stepped sweep (one direction) costs at the brute force's measured wall time per point and run"})  # fmt: skip
     for key, units, name in (("frequency", "Hz", "frequency of a continued orbit"), ("amplitude", "m", "|X1| of a continued orbit"), ("stable", "1", "1 where the continued orbit is stable"),
                              ("impacts", "1", "impacts per period of a continued orbit"), ("index", "1", "which branch of its certificate")):  # fmt: skip
         block = np.array([r[f"branch_{key}"] for r in rows], dtype=float).reshape(len(rows), MAX_BRANCH_POINTS)

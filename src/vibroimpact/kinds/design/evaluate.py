@@ -174,11 +174,12 @@ def _around(frequency: float) -> tuple[float, float]:
 
 #: Fields of :class:`CertifyCase`: the certified worst |X| [m], where [Hz], its motion (text) and source (index of
 #: :data:`~vibroimpact.simulation.certified_worst.SOURCES`); the continuation's and the brute force's own answers and
-#: wall times [s]; the frequencies a stepped sweep needs to reach the same maximum to 1e-4 and 1e-8 (relative); the
+#: wall times [s]; the frequencies a stepped sweep needs to reach the same maximum to 1e-4 and 1e-8 (relative) and what
+#: it would cost [s] at the brute force's measured cost per point; the
 #: continued branches' points (frequency [Hz], |X| [m], stable 0/1, impacts per period, branch index), NaN-padded; the
 #: brute force's largest |X| at each of its frequencies.
 CERTIFY_FIELDS = ("worst", "frequency", "motion", "source", "continuation_worst", "continuation_time", "brute_worst", "brute_frequency", "brute_motion", "brute_time",
-                  "sweep_points", "branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index", "attractor_frequency", "attractor_amplitude", "error")  # fmt: skip
+                  "sweep_points", "sweep_time", "branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index", "attractor_frequency", "attractor_amplitude", "error")  # fmt: skip
 #: Most branch points kept per certified problem.
 MAX_BRANCH_POINTS = 4000
 #: Frequencies of the certification's brute force.
@@ -218,20 +219,21 @@ class CertifyCase:
         try:
             found = certified_worst(problem, self.space.band, frequencies=ATTRACTOR_POINTS)
         except (ValueError, RuntimeError) as error:
-            return {**{k: np.array(v) for k, v in scalars.items()}, "sweep_points": np.full(len(SWEEP_ACCURACIES), np.nan), **points, **attractors,
+            return {**{k: np.array(v) for k, v in scalars.items()}, "sweep_points": np.full(len(SWEEP_ACCURACIES), np.nan), "sweep_time": np.full(len(SWEEP_ACCURACIES), np.nan), **points, **attractors,
                     "error": np.array(f"{type(error).__name__}: {str(error)[:200]}")}  # fmt: skip
         top = found.attractors.maximum
         scalars |= {"worst": found.amplitude, "frequency": found.frequency, "motion": found.motion, "source": SOURCES.index(found.source),
                     "continuation_worst": found.continuation.amplitude, "continuation_time": found.continuation_time,
                     "brute_worst": top.amplitude, "brute_frequency": top.frequency, "brute_motion": top.motion, "brute_time": found.brute_force_time}  # fmt: skip
         system = ImpactMap(problem)  # the frequency is each branch's own parameter
-        branches = [branch for branch, _ in found.continuation.branches] + list(found.extra)
+        branches = [(branch, top) for branch, top in found.continuation.branches] + [(branch, None) for branch in found.extra]
         k, setting = 0, None
-        for index, branch in enumerate(branches):
+        for index, (branch, top) in enumerate(branches):
             count = min(len(branch.values), MAX_BRANCH_POINTS - k)
             if count <= 0:
                 break
-            measured = branch_measures(system if branch.orbits[0].period == 1 else ImpactMap(problem, periods=branch.orbits[0].period), branch).amplitude(self.space.coordinate)
+            period = branch.orbits[0].period
+            measured = branch_measures(system if period == 1 else ImpactMap(problem, periods=period), branch).amplitude(self.space.coordinate)
             stable = np.asarray(branch.stable, dtype=float)
             points["branch_frequency"][k : k + count] = branch.values[:count]
             points["branch_amplitude"][k : k + count] = measured[:count]
@@ -239,8 +241,8 @@ class CertifyCase:
             points["branch_impacts"][k : k + count] = np.asarray(branch.impacts, dtype=float)[:count]
             points["branch_index"][k : k + count] = index
             k += count
-            near = np.abs(np.asarray(branch.values) - found.frequency) <= 1e-6 * found.frequency + 1e-12
-            if np.any(near & (np.abs(measured - found.amplitude) <= 1e-3 * found.amplitude)):
+            sets_it = found.source == SOURCES[2] if top is None else (found.source == SOURCES[0] and top.amplitude == found.amplitude)  # exact: the same number passed on
+            if sets_it:  # the stable stretch of the branch whose maximum is the worst case
                 setting = (np.asarray(branch.values)[stable == 1], measured[stable == 1])
         f = found.attractors.frequency
         attractors["attractor_frequency"][: f.size] = f
@@ -248,4 +250,4 @@ class CertifyCase:
         sweep = np.array([sweep_points_for(setting[1], setting[0], a, self.space.band) if setting is not None else math.nan for a in SWEEP_ACCURACIES])
         if report is not None:
             report(1.0)
-        return {**{k: np.array(v) for k, v in scalars.items()}, "sweep_points": sweep, **points, **attractors, "error": np.array("")}
+        return {**{k: np.array(v) for k, v in scalars.items()}, "sweep_points": sweep, "sweep_time": sweep * found.seconds_per_point, **points, **attractors, "error": np.array("")}
