@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import Branch
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
@@ -87,14 +88,13 @@ def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequenci
     """The worst stable |X1| of ``problem`` over ``band`` [Hz] (module docstring); ``frequencies``, ``starts``,
     ``transient`` and ``strobes`` are the brute force's (:func:`~vibroimpact.simulation.band_attractors.band_attractors`).
 
-    Raises
-    ------
-    ValueError
-        A problem the closed forms do not apply to (the continuation starts from them).
+    A problem the closed forms do not apply to (a free mass, stops that are not one or a symmetric pair) has no
+    closed-form start to continue from: its worst case is the brute force's, continued where periodic.
     """
     low, high = (float(b) for b in band)
     start = time.perf_counter()
-    continued = worst_response(problem, (low, high))
+    # continuation starts from the closed forms; a layout without them (a free mass ...) is brute force's alone
+    continued = worst_response(problem, (low, high)) if closed_form_refusal(problem) is None else WorstCase(0.0, math.nan, "", ())
     middle = time.perf_counter()
     sweep = band_attractors(problem, (low, high), frequencies=frequencies, starts=starts, transient=transient, strobes=strobes)
     swept = time.perf_counter()
@@ -103,7 +103,7 @@ def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequenci
     extra: tuple[Branch, ...] = ()
     if math.isfinite(top.amplitude) and top.amplitude > continued.amplitude * (1.0 + 1e-6):
         best = (top.amplitude, top.frequency, f"{top.motion} (brute force, {top.run} run)", SOURCES[1])
-        if top.period >= 1 and top.impacts > 0.0:
+        if top.period >= 1 and top.impacts > 0.0 and top.regime in ("one_impact", "other_periodic"):
             refined = _continued(problem, (low, high), top.frequency, np.array(top.state), top.period)
             if refined is not None and refined[0] >= top.amplitude * (1.0 - 1e-3):  # the same orbit, located exactly
                 best = (refined[0], refined[1], f"{top.motion} ({refined[2]} of its branch, continued from the brute force)", SOURCES[2])

@@ -111,7 +111,8 @@ def warnings(dataset: xr.Dataset) -> list[str]:
     if d.sizes.get("certificate", 0):
         points = d.sizes.get("attractor_point", 0)
         out.append(f"What the certification can miss: an attractor whose basin none of its runs entered (sweeps both ways and two more starts at each of {points} frequencies), or one that lives only between those frequencies; "
-                   "the search itself ranked candidates on closed forms (period-1 motions), which a design with a larger multi-impact or non-periodic motion can fool until it is certified.")
+                   + ("the search itself ranked candidates on closed forms (period-1 motions), which a design with a larger multi-impact or non-periodic motion can fool until it is certified."
+                      if not np.any(d["sample_motion"].values == 3) else "the search itself ranked candidates by a coarse brute force (no closed form applies to this layout), whose grid and few starts a narrow or rarely reached motion escapes."))
     for failure in d.attrs.get("run_failures", []) if isinstance(d.attrs.get("run_failures"), list) else []:
         out.append(str(failure))
     return out

@@ -16,11 +16,11 @@ import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
-from vibroimpact.analysis.band_worst import MOTIONS
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
+from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
-from vibroimpact.kinds.design.evaluate import ATTRACTOR_POINTS, MAX_BRANCH_POINTS, SWEEP_ACCURACIES
+from vibroimpact.kinds.design.evaluate import ATTRACTOR_POINTS, MAX_BRANCH_POINTS, SCREEN_MOTIONS, SWEEP_ACCURACIES
 from vibroimpact.simulation.certified_worst import SOURCES
 from vibroimpact.kinds.design.scene import DesignSettings, safe_name
 from vibroimpact.kinds.design.search import STAGES
@@ -40,12 +40,13 @@ RIDGE = 0.02
 
 def response_curves(problem: ImpactProblem, frequency: NDArray[np.float64], coordinate: int) -> dict[str, NDArray[np.float64]]:
     """|X| [m] of the contact-free motion (everywhere), whether it fits; and of each root's period-1 impact orbit
-    where it exists, with its state (-1 none or not admissible, 0 unstable, 1 stable)."""
+    where it exists, with its state (-1 none or not admissible, 0 unstable, 1 stable; none on a layout without a
+    closed form)."""
     linear = linear_amplitudes(problem, omega=2.0 * np.pi * frequency)
     out = {"linear": np.abs(linear.coordinates[..., coordinate]), "linear_fits": linear.fits(problem.clearances()).astype(np.int8)}
     for root, name in (("+", "impact_plus"), ("-", "impact_minus")):
         x, state = np.full(frequency.shape, np.nan), np.full(frequency.shape, -1, dtype=np.int8)
-        if problem.stops:
+        if problem.stops and closed_form_refusal(problem) is None:
             orbit = solve_impact_orbit(problem, frequency=frequency, root=root)
             ok = np.flatnonzero(np.asarray(orbit.admissible(), dtype=bool).reshape(-1))
             if ok.size:
@@ -93,7 +94,7 @@ def design_dataset(scene: Any, outcome: Outcome) -> xr.Dataset:
     data["evaluation_stage"] = _flag(ev.stages, STAGES, "why the candidate was evaluated", ("evaluation",))
     data["sample_value"] = xr.Variable(("evaluation", "sample"), values, {"units": "m", "long_name": "largest stable |X| over the band under each sample (or the guess where uncovered)"})
     data["sample_frequency"] = xr.Variable(("evaluation", "sample"), np.array([r["frequency"] for r in ev.results]), {"units": "Hz", "long_name": "where the sample's worst case is"})
-    data["sample_motion"] = _flag(np.array([r["motion"] for r in ev.results]), MOTIONS, "the motion that sets the sample's worst case", ("evaluation", "sample"))
+    data["sample_motion"] = _flag(np.array([r["motion"] for r in ev.results]), SCREEN_MOTIONS, "the motion that sets the sample's worst case", ("evaluation", "sample"))
     data["sample_uncovered"] = xr.Variable(("evaluation", "sample"), np.array([r["uncovered"] for r in ev.results]), {"units": "1", "long_name": "share of the band where no closed-form motion is stable"})
     for k, m in enumerate(settings.mistuning):
         offsets = np.array([row[k] for row in space.offsets])
@@ -203,7 +204,8 @@ def _designs(data: dict[str, xr.Variable], scene: Any, outcome: Outcome) -> dict
         if outcome.linear is not None and v.name in ("k2", "b2"):
             column[2] = getattr(outcome.linear.system, v.name)
         data[f"design_{safe_name(v.name)}"] = xr.Variable("design", np.array(column, dtype=float), {"units": v.unit, "long_name": f"{v.name} of the compared design"})
-    ridge = equal_peaks(frequency, {k: curves[k][0] for k in keys}) if outcome.recommended >= 0 else (math.nan, math.nan, math.nan)
+    closed = outcome.recommended >= 0 and closed_form_refusal(space.problem) is None  # a ridge of the closed forms' curves only
+    ridge = equal_peaks(frequency, {k: curves[k][0] for k in keys}) if closed else (math.nan, math.nan, math.nan)
     attrs: dict[str, object] = {"equal_peak_difference": ridge[0], "equal_peak_frequencies_Hz": np.array(ridge[1:], dtype=float)}
     if outcome.linear is not None:
         attrs.update({"linear_optimum_tuning": outcome.linear.tuning, "linear_optimum_damping_ratio": outcome.linear.damping_ratio,

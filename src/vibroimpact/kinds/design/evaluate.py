@@ -19,14 +19,22 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.analysis.band_worst import MOTIONS, closed_form_at, closed_form_worst
+from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.simulation.band_attractors import band_attractors
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.maps import ImpactMap, branch_measures
 from vibroimpact.simulation.certified_worst import SOURCES, certified_worst, sweep_points_for
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.store import case_key
 
-__all__ = ["DesignSpace", "DesignCase", "sample_chunks", "CHUNKS", "DESIGN_FIELDS", "CertifyCase", "CERTIFY_FIELDS", "STOP_PARAMETERS", "ATTRACTOR_POINTS", "SWEEP_ACCURACIES", "MAX_BRANCH_POINTS"]
+__all__ = ["DesignSpace", "DesignCase", "sample_chunks", "CHUNKS", "DESIGN_FIELDS", "CertifyCase", "CERTIFY_FIELDS", "STOP_PARAMETERS", "ATTRACTOR_POINTS", "SWEEP_ACCURACIES", "MAX_BRANCH_POINTS", "SCREEN_MOTIONS", "BRUTE", "BRUTE_SCREEN"]
 
+#: The screen's motions: the closed forms' (:data:`~vibroimpact.analysis.band_worst.MOTIONS`), and brute force's on a
+#: layout without a closed form.
+BRUTE = "found by brute force"
+SCREEN_MOTIONS = (*MOTIONS, BRUTE)
+#: The screen's brute force where no closed form applies: frequencies, extra starts, transient and measured periods.
+BRUTE_SCREEN = (41, 1, 200, 64)
 #: The map's parameters a design or a mistuning may set besides the layout scalars.
 STOP_PARAMETERS = ("clearance", "restitution")
 
@@ -116,7 +124,7 @@ def sample_chunks(samples: int) -> list[tuple[int, ...]]:
 
 
 #: Fields of :class:`DesignCase`: per sample, the worst stable |X| [m] over the band, where [Hz], which motion (index of
-#: :data:`~vibroimpact.analysis.band_worst.MOTIONS`), the uncovered share and the guess there [m], the worst |X| at the
+#: :data:`SCREEN_MOTIONS`), the uncovered share and the guess there [m], the worst |X| at the
 #: operating frequency [m] (NaN: no constraint) and which motion; ``error``: why a sample has no value.
 DESIGN_FIELDS = ("worst", "frequency", "motion", "uncovered", "estimate", "operating", "operating_motion", "error")
 
@@ -151,20 +159,32 @@ class DesignCase:
         for row, s in enumerate(self.samples):
             try:
                 problem = self.space.problem_at(self.design, s)
-                found = closed_form_worst(problem, self.space.band, self.space.coordinate, self.space.scan)
+                if closed_form_refusal(problem) is None:
+                    found = closed_form_worst(problem, self.space.band, self.space.coordinate, self.space.scan)
+                    values = (found.amplitude, found.frequency, found.uncovered, found.estimate, SCREEN_MOTIONS.index(found.motion))
+                else:  # no closed form (a free mass, stops that are not one or a symmetric pair): brute force screens
+                    top = band_attractors(problem, self.space.band, *BRUTE_SCREEN).maximum
+                    values = (top.amplitude, top.frequency, 0.0, 0.0, SCREEN_MOTIONS.index(BRUTE))
                 if math.isfinite(self.space.operating):
-                    at = closed_form_at(problem, self.space.operating, self.space.coordinate)
-                    # no stable closed-form motion at the operating point: the guess from the orbits that exist there
-                    out["operating"][row] = at.amplitude if at.uncovered == 0.0 else closed_form_worst(problem, _around(self.space.operating), self.space.coordinate, 3).estimate  # exact: a share of none
-                    operating_motion[row] = MOTIONS.index(at.motion)
+                    out["operating"][row], operating_motion[row] = _operating(problem, self.space.operating, self.space.coordinate)
             except ValueError as error:  # a structure the model refuses (a mass driven non-positive ...)
                 errors[row] = f"{type(error).__name__}: {str(error)[:160]}"
                 continue
-            out["worst"][row], out["frequency"][row], out["uncovered"][row], out["estimate"][row] = found.amplitude, found.frequency, found.uncovered, found.estimate
-            motion[row] = MOTIONS.index(found.motion)
+            out["worst"][row], out["frequency"][row], out["uncovered"][row], out["estimate"][row], motion[row] = values
         if report is not None:
             report(self.progress_total)
         return out | {"motion": motion, "operating_motion": operating_motion, "error": np.array(errors, dtype=str)}
+
+
+def _operating(problem: ImpactProblem, frequency: float, coordinate: int) -> tuple[float, int]:
+    """The worst coexisting |X| at the operating ``frequency`` [Hz] and its motion (index of :data:`SCREEN_MOTIONS`):
+    the closed forms' (where none is stable there, the guess from the orbits that exist), else brute force's."""
+    if closed_form_refusal(problem) is not None:
+        return band_attractors(problem, _around(frequency), 2, *BRUTE_SCREEN[1:]).maximum.amplitude, SCREEN_MOTIONS.index(BRUTE)
+    at = closed_form_at(problem, frequency, coordinate)
+    if at.uncovered == 0.0:  # exact: a share of none
+        return at.amplitude, SCREEN_MOTIONS.index(at.motion)
+    return closed_form_worst(problem, _around(frequency), coordinate, 3).estimate, SCREEN_MOTIONS.index(at.motion)
 
 
 def _around(frequency: float) -> tuple[float, float]:
