@@ -1,5 +1,7 @@
 """What a design study answers, in words: the design to build and its worst case against the comparisons
-(:func:`answer_text`), and what the reader must know before building it (:func:`warnings`), read from the dataset."""
+(:func:`answer_text`), and what the reader must know before building it (:func:`warnings`), read from the dataset;
+and the facts the page's figures and tables share: the compared designs present, their worst cases, the search's
+path, the evaluations by stage, the mistuning's spreads."""
 
 from __future__ import annotations
 
@@ -9,11 +11,12 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 import yaml
+from numpy.typing import NDArray
 
 from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.reporting.style import fmt
 
-__all__ = ["answer_text", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst"]
+__all__ = ["answer_text", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
 
 _SYMBOLS = {"clearance": "Delta", "restitution": "R"}
 #: How the page names the compared designs (the dataset's ``design`` dimension, in order).
@@ -157,6 +160,30 @@ def design_worst(dataset: xr.Dataset, design: int) -> float:
     screened = float(np.nanmax(row)) if np.any(np.isfinite(row)) else math.nan
     certified = certified_worst(dataset, design)[0]
     return float(np.fmax(screened, certified))
+
+
+def present_designs(dataset: xr.Dataset) -> list[int]:
+    """The compared designs the dataset has a response of (the linear absorber only when compared)."""
+    return [k for k in range(dataset.sizes["design"]) if np.any(np.isfinite(dataset["response_linear"].values[k]))]
+
+
+def search_path(dataset: xr.Dataset) -> NDArray[np.int64]:
+    """Indices of the evaluations that lowered the best score so far, in evaluation order (the first one included):
+    the best design after each step of the search."""
+    best, path = math.inf, []
+    for i, score in enumerate(dataset["score"].values):
+        if score < best:
+            best = float(score)
+            path.append(i)
+    return np.array(path, dtype=np.int64)
+
+
+def stage_counts(dataset: xr.Dataset) -> dict[str, int]:
+    """How many candidates each stage of the search evaluated (``evaluation_stage``), by the stage's name."""
+    flags = dataset["evaluation_stage"]
+    meanings = str(flags.attrs.get("flag_meanings", "")).split()
+    counts = np.bincount(flags.values.astype(int), minlength=len(meanings))
+    return {name: int(counts[k]) for k, name in enumerate(meanings)}
 
 
 def answer_text(dataset: xr.Dataset) -> str:
