@@ -2,7 +2,7 @@
 (issue 32).
 
 Two motions have closed forms on any layout with one stop or a symmetric two-sided pair: the contact-free steady
-state (stable, being linear and damped, where it clears every stop) and the period-1 impact orbit with one impact per
+state (stable where it clears every stop, unless a free mass has no dashpot) and the period-1 impact orbit with one impact per
 period (two for the pair; eqs. 15-18, both roots of the impulse equation, each where it exists, stays off the stops
 between impacts and has every Floquet multiplier inside the unit circle). :func:`closed_form_worst` scans both on
 ``scan`` frequencies, takes the largest stable |X| of each motion (and every local maximum within 10 % of it) and
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
-from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.analysis.linear import contact_free_is_stable, linear_amplitudes
 from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.model.problem import ImpactProblem
 
@@ -85,10 +85,10 @@ class BandWorst:
 
 
 def _linear(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """|X| of the contact-free steady state where it clears every stop (NaN elsewhere), and everywhere."""
+    """|X| of the contact-free steady state where it clears every stop and is stable (NaN elsewhere), and everywhere."""
     linear = linear_amplitudes(problem, omega=2.0 * np.pi * f)
     x = np.abs(linear.coordinates[..., coordinate])
-    return np.where(linear.fits(problem.clearances()), x, np.nan), x
+    return np.where(linear.fits(problem.clearances()) & contact_free_is_stable(problem.structure), x, np.nan), x
 
 
 def _impacting(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, root: str, largest_only: bool = False) -> tuple[NDArray[np.float64], int, NDArray[np.float64]]:

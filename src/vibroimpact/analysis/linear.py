@@ -27,7 +27,21 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["base_coupling", "base_force", "peaks_near", "LinearResponse", "linear_response", "ResonancePeak", "resonance_peaks", "LinearAmplitudes", "linear_amplitudes", "linear_reach", "structure_amplitudes", "structure_peaks"]
+__all__ = ["contact_free_is_stable", "base_coupling", "base_force", "peaks_near", "LinearResponse", "linear_response", "ResonancePeak", "resonance_peaks", "LinearAmplitudes", "linear_amplitudes", "linear_reach", "structure_amplitudes", "structure_peaks"]
+
+
+def contact_free_is_stable(system: LinearStructure) -> bool:
+    """Whether the contact-free steady state is a stable motion: every rigid-body mode of K (a free mass) is resisted
+    by a dashpot. An undamped one (an impact damper's free mass in its cavity) only drifts at a constant speed when
+    disturbed, into a stop: its contact-free motion is no attractor, however well it fits."""
+    stiffness, damping = system.stiffness_matrix, system.damping_matrix
+    values, vectors = np.linalg.eigh(stiffness)
+    top = float(np.max(np.abs(values))) if values.size else 0.0
+    rigid = vectors[:, np.abs(values) <= 1e-12 * top] if top > 0.0 else np.eye(stiffness.shape[0])
+    if rigid.shape[1] == 0:
+        return True
+    inner = rigid.T @ damping @ rigid
+    return bool(np.min(np.linalg.eigvalsh(0.5 * (inner + inner.T))) > 1e-12 * max(float(np.max(np.abs(damping))), 1e-300))
 
 
 def base_coupling(system: LinearStructure) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

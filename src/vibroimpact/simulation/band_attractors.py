@@ -5,7 +5,8 @@ At equally spaced frequencies, the stepped sweeps of :mod:`vibroimpact.simulatio
 carrying its end state to the next frequency), and more runs start at each frequency from the contact-free linear
 state, rest on the stops and random states of the motion's size (:func:`attractor_starts`, seeded). Each run's motion
 is measured and classified by :func:`~vibroimpact.simulation.attractors.measure_motion`; a contact-free motion's
-|X1| is the closed form's (the only contact-free attractor is the linear steady state, where it clears the stops).
+|X1| is the closed form's (the only contact-free attractor is the linear steady state, where it clears the stops;
+none where a free mass has no dashpot: :func:`~vibroimpact.analysis.linear.contact_free_is_stable`).
 The largest is :class:`AttractorMaximum`: where, which run, which motion, and its peak |x1(t)|.
 
 It finds what continuation from the closed forms (:func:`vibroimpact.orbits.worst_case.worst_response`) does not
@@ -23,6 +24,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from vibroimpact.analysis.linear import contact_free_is_stable
 from vibroimpact.engines.registry import engine_for
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.simulation.attractors import MOTION_CLASSES, at_frequency, measure_motion, stepped_sweep, sweep_arrays
@@ -194,11 +196,12 @@ def band_attractors(
             except RuntimeError:  # the engine made no progress (endless chattering): no attractor from this start
                 rows[2 + j]["regime"][k] = -1
     amplitude = np.full((n, r), np.nan)
+    stable = contact_free_is_stable(problem.structure)
     measured = np.stack([np.where(row["regime"] >= 0, np.max(row["amplitude"], axis=1), np.nan) for row in rows], axis=1)
     for k in range(n):
         moved = at_frequency(problem, float(f[k]))
         linear = linear_state(moved)
-        free = abs(complex(linear.amplitudes[0])) if linear.fits(moved) else math.nan
+        free = abs(complex(linear.amplitudes[0])) if linear.fits(moved) and stable else math.nan  # an undamped free mass: no attractor
         for j, row in enumerate(rows):
             amplitude[k, j] = _attractor_amplitude(row, k, free)
     stack = {name: np.stack([row[name] for row in rows], axis=1) for name in ("regime", "period", "impacts", "lyapunov", "state")}

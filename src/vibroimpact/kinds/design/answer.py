@@ -1,50 +1,189 @@
 """What a design study answers, in words: the design to build and its worst case against the comparisons
-(:func:`answer_text`), and what the reader must know before building it (:func:`warnings`), read from the dataset."""
+(:func:`answer_text`), and what the reader must know before building it (:func:`warnings`), read from the dataset;
+and the facts the page's figures and tables share: the compared designs present, their worst cases, the search's
+path, the evaluations by stage, the mistuning's spreads."""
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
+import yaml
+from numpy.typing import NDArray
 
 from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.reporting.style import fmt
 
-__all__ = ["answer_text", "warnings", "variable_text", "mistuning_text"]
+__all__ = ["answer_text", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
 
 _SYMBOLS = {"clearance": "Delta", "restitution": "R"}
+#: How the page names the compared designs (the dataset's ``design`` dimension, in order).
+DESIGN_TITLES = ("recommended design", "the scene's design", "best linear absorber")
+_UNITS = {"1": "", "N m-1": "N/m", "N s m-1": "N s/m"}
 
 
 def _mm(value: float) -> str:
     return f"{fmt(1e3 * value, '.4g')} mm" if math.isfinite(value) else "not known"
 
 
+def unit_text(unit: str) -> str:
+    """A UDUNITS string as the page writes it: ``N m-1`` -> ``N/m``; empty for ``1``."""
+    return _UNITS.get(unit, unit)
+
+
+def variable_names(dataset: xr.Dataset) -> list[str]:
+    """The design variables, in the order of the scene (attribute ``variables``)."""
+    return [name for name in str(dataset.attrs.get("variables", "")).split(", ") if name]
+
+
 def variable_text(dataset: xr.Dataset, design: int) -> str:
-    """``Delta = 2.1 mm, R = 0.35, k2 = 4120 N/m`` of a compared design."""
+    """``Delta = 2.1 mm, R = 0.35, k2 = 4120 N/m`` of a compared design (its variables with a value)."""
     parts = []
-    for name in str(dataset.attrs.get("variables", "")).split(", "):
-        if not name:
+    for name in variable_names(dataset):
+        variable = dataset[f"design_{safe_name(name)}"]
+        value = float(variable.values[design])
+        if not math.isfinite(value):
             continue
-        value = float(dataset[f"design_{safe_name(name)}"].values[design])
         if name == "clearance":
             parts.append(f"Delta = {fmt(1e3 * value, '.4g')} mm")
         else:
-            unit = dataset[f"design_{safe_name(name)}"].attrs.get("units", "1")
-            parts.append(f"{_SYMBOLS.get(name, name)} = {fmt(value, '.4g')}{'' if unit == '1' else ' ' + unit.replace(' m-1', '/m').replace('N s/m', 'N s/m')}")
+            unit = unit_text(str(variable.attrs.get("units", "1")))
+            parts.append(f"{_SYMBOLS.get(name, name)} = {fmt(value, '.4g')}{' ' + unit if unit else ''}")
     return ", ".join(parts)
+
+
+def design_text(dataset: xr.Dataset, design: int) -> str:
+    """:func:`variable_text`, and for the linear absorber (no stop) its k2 and b2: ``no stop, k2 = 2061 N/m, b2 = 5.337 N s/m``."""
+    if DESIGN_TITLES[design] != "best linear absorber":
+        return variable_text(dataset, design)
+    k2, b2 = (float(dataset.attrs.get(key, math.nan)) for key in ("linear_optimum_k2_N_per_m", "linear_optimum_b2_N_s_per_m"))
+    absorber = f", k2 = {fmt(k2, '.4g')} N/m, b2 = {fmt(b2, '.4g')} N s/m" if math.isfinite(k2) and math.isfinite(b2) else ""
+    return f"no stop{absorber}"
+
+
+@dataclass(frozen=True)
+class Spread:
+    """How far one scalar was mistuned.
+
+    Attributes
+    ----------
+    name : str
+        The scalar (``k1``, ``clearance``, ...).
+    spread : float
+        Half-width of the samples' range: relative [-] or absolute [m] for the clearance, [-] for the restitution.
+    relative : bool
+        The spread is a share of the scalar.
+    stated : bool
+        Read from the stored scene's ``design.robust`` (False: the largest offset of the samples, a lower bound).
+    """
+
+    name: str
+    spread: float
+    relative: bool
+    stated: bool
+
+    def text(self) -> str:
+        """``+-5 % of k1``, ``+-0.2 mm of the clearance``, ``+-0.05 of the restitution`` (``offsets up to +-...``
+        when not stated)."""
+        lead = "+-" if self.stated else "offsets up to +-"
+        if self.relative:
+            return f"{lead}{fmt(100 * self.spread, '.2g')} % of {self.name}"
+        if self.name == "clearance":
+            return f"{lead}{fmt(1e3 * self.spread, '.2g')} mm of the clearance"
+        return f"{lead}{fmt(self.spread, '.2g')} of the {self.name}"
+
+
+def _stored_robust(scene_text: str) -> dict[str, object]:
+    """The stored scene's ``design.robust`` read as plain YAML, unchecked (as the page reads its description); empty
+    if it has none."""
+    try:
+        document = yaml.safe_load(scene_text)
+    except yaml.YAMLError:
+        return {}
+    design = document.get("design") if isinstance(document, dict) else None
+    robust = design.get("robust") if isinstance(design, dict) else None
+    return robust if isinstance(robust, dict) else {}
+
+
+def mistuning_spreads(dataset: xr.Dataset) -> list[Spread]:
+    """Each mistuned scalar's spread: as the stored scene states it (``design.robust``, read as plain YAML), else the
+    largest offset the samples drew (the dataset keeps the offsets, not the spreads)."""
+    robust = _stored_robust(str(dataset.attrs.get("scene", "")))
+    out = []
+    for name in dataset.data_vars:
+        if not str(name).startswith("mistuning_"):
+            continue
+        variable = dataset[name]
+        what = str(variable.attrs.get("long_name", "")).split(" offset of ")[-1].split(" in each")[0]
+        relative = str(variable.attrs.get("long_name", "")).startswith("relative")
+        stated = robust.get(what)
+        if isinstance(stated, (int, float)) and not isinstance(stated, bool) and math.isfinite(float(stated)):
+            out.append(Spread(what, float(stated), relative, True))
+        else:
+            out.append(Spread(what, float(np.max(np.abs(variable.values))), relative, False))
+    return out
 
 
 def mistuning_text(dataset: xr.Dataset) -> str:
     """``+-5 % of k1 and +-0.2 mm of the clearance (32 samples)``, or empty."""
-    parts = []
-    for name in dataset.data_vars:
-        if str(name).startswith("mistuning_"):
-            v = dataset[name]
-            spread = float(np.max(np.abs(v.values)))
-            what = str(v.attrs.get("long_name", "")).split(" offset of ")[-1].split(" in each")[0]
-            parts.append(f"+-{fmt(100 * spread, '.2g')} % of {what}" if v.attrs.get("units") == "1" and "relative" in v.attrs.get("long_name", "") else f"+-{fmt(1e3 * spread, '.2g')} mm of the {what}" if what == "clearance" else f"+-{fmt(spread, '.2g')} of {what}")
-    return f"{' and '.join(parts)} ({dataset.sizes['sample'] - 1} samples)" if parts else ""
+    spreads = mistuning_spreads(dataset)
+    if not spreads:
+        return ""
+    return f"{' and '.join(s.text() for s in spreads)} ({dataset.sizes['sample'] - 1} samples)"
+
+
+def design_evaluation(dataset: xr.Dataset, design: int) -> int:
+    """The evaluation a compared design is (the recommended one, the scene's: the first); -1 for the linear
+    absorber, which the search did not evaluate, or when nothing was recommended."""
+    return (int(dataset.attrs.get("recommended_evaluation", -1)), 0, -1)[design]
+
+
+def certified_worst(dataset: xr.Dataset, design: int) -> tuple[float, int]:
+    """The largest certified worst case [m] of a compared design over its certificates, and that certificate's
+    index; (NaN, -1) where none has a value."""
+    evaluation = design_evaluation(dataset, design)
+    rows = np.flatnonzero(dataset["certificate_evaluation"].values == evaluation) if evaluation >= 0 else np.zeros(0, dtype=int)
+    worst = dataset["certificate_worst"].values
+    rows = [int(r) for r in rows if math.isfinite(float(worst[r]))]
+    if not rows:
+        return math.nan, -1
+    row = max(rows, key=lambda r: float(worst[r]))
+    return float(worst[row]), row
+
+
+def design_worst(dataset: xr.Dataset, design: int) -> float:
+    """A compared design's worst case [m]: the largest of its samples' screened values and its certificates' (NaN
+    when it has none)."""
+    row = dataset["design_sample_value"].values[design]
+    screened = float(np.nanmax(row)) if np.any(np.isfinite(row)) else math.nan
+    certified = certified_worst(dataset, design)[0]
+    return float(np.fmax(screened, certified))
+
+
+def present_designs(dataset: xr.Dataset) -> list[int]:
+    """The compared designs the dataset has a response of (the linear absorber only when compared)."""
+    return [k for k in range(dataset.sizes["design"]) if np.any(np.isfinite(dataset["response_linear"].values[k]))]
+
+
+def search_path(dataset: xr.Dataset) -> NDArray[np.int64]:
+    """Indices of the evaluations that lowered the best score so far, in evaluation order (the first one included):
+    the best design after each step of the search."""
+    best, path = math.inf, []
+    for i, score in enumerate(dataset["score"].values):
+        if score < best:
+            best = float(score)
+            path.append(i)
+    return np.array(path, dtype=np.int64)
+
+
+def stage_counts(dataset: xr.Dataset) -> dict[str, int]:
+    """How many candidates each stage of the search evaluated (``evaluation_stage``), by the stage's name."""
+    flags = dataset["evaluation_stage"]
+    meanings = str(flags.attrs.get("flag_meanings", "")).split()
+    counts = np.bincount(flags.values.astype(int), minlength=len(meanings))
+    return {name: int(counts[k]) for k, name in enumerate(meanings)}
 
 
 def answer_text(dataset: xr.Dataset) -> str:
@@ -58,8 +197,7 @@ def answer_text(dataset: xr.Dataset) -> str:
     recommended = int(d.attrs.get("recommended_evaluation", -1))
     if recommended < 0:
         return f"No design could be recommended: no candidate had a finite worst case {over}."
-    certified = float(d.attrs.get("recommended_certified_score_m", math.nan))
-    head = f"Build {variable_text(d, 0)}: worst case |X1| = {_mm(max(worst[0], certified) if math.isfinite(certified) else worst[0])} {over}"
+    head = f"Build {variable_text(d, 0)}: worst case |X1| = {_mm(design_worst(d, 0))} {over}"
     limit = float(d.attrs.get("operating_limit_m", math.nan))
     operating = d["design_operating_amplitude"].values
     at = fmt(d.attrs.get("operating_frequency_Hz"), ".4g")
@@ -67,12 +205,15 @@ def answer_text(dataset: xr.Dataset) -> str:
     def notch(k: int) -> str:
         if not math.isfinite(limit) or not math.isfinite(float(operating[k])):
             return ""
-        return f", |X1| at {at} Hz {_mm(float(operating[k]))}" + ("" if operating[k] <= limit else f", above the allowed {_mm(limit)}")
+        if operating[k] > limit:
+            return f", {_mm(float(operating[k]))} at {at} Hz, above the allowed {_mm(limit)}"
+        return f", {_mm(float(operating[k]))} at {at} Hz" + (f", where {_mm(limit)} is allowed" if k == 0 else "")
 
     others = []
     if np.any(np.isfinite(values[2])):
         others.append(f"best linear absorber of the same mass: {_mm(worst[2])}{notch(2)}")
-    others.append(f"the scene's design ({variable_text(d, 1)}): {_mm(worst[1])}{notch(1)}")
+    scene = variable_text(d, 1)
+    others.append(f"the scene's design{', ' + scene if scene else ''}: {_mm(design_worst(d, 1))}{notch(1)}")
     return f"{head}{notch(0)} ({'; '.join(others)})."
 
 
@@ -93,10 +234,13 @@ def warnings(dataset: xr.Dataset) -> list[str]:
         if not operating <= limit:
             out.append(f"No candidate keeps the notch: at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz |X1| reaches {_mm(operating)} against the allowed {_mm(limit)}; the recommendation is the least bad.")
     if recommended >= 0:
-        uncovered = float(np.nanmax(d["sample_uncovered"].values[recommended]))
-        if uncovered > 0.0:
-            out.append(f"On {fmt(100 * uncovered, '.2g')} % of the band no period-1 motion of the recommended design is stable: there its motion is of a kind the closed forms do not know (more impacts, a longer period, or not periodic); the screen guessed its size from the unstable orbits; the certification found the motions there by brute force.")
         rows = np.flatnonzero(d["certificate_evaluation"].values == recommended)
+        uncovered = float(np.nanmax(d["sample_uncovered"].values[recommended]))
+        checked = "the certification found the motions there by brute force" if rows.size else "nothing checked it"
+        if uncovered > 0.0:
+            out.append(f"On {fmt(100 * uncovered, '.2g')} % of the band no period-1 motion of the recommended design is stable: there its motion is of a kind the closed forms do not know (more impacts, a longer period, or not periodic); the screen guessed its size from the unstable orbits, and {checked}.")
+        if not rows.size:
+            out.append("The recommended design was not certified (certify: candidates 0): its worst case is the screen's alone.")
         for r in rows:
             worst, screened = float(d["certificate_worst"].values[r]), float(d["certificate_screened"].values[r])
             if math.isfinite(worst) and worst > screened * (1.0 + 1e-6):

@@ -1,19 +1,170 @@
-"""The page of a design study: which absorber and stop to build, answered first, with what it was compared with and
-what was not checked; then the figures (:mod:`vibroimpact.kinds.design.figures`). Everything is read from the
-dataset."""
+"""The page of a design study: which absorber and stop to build, answered first, then what the reader must know
+before building it; the figures (:mod:`vibroimpact.kinds.design.figures`: the objective over the variables with the
+search's path, the compared designs' responses, their worst cases under mistuning); a table of the compared designs
+(:func:`designs_table`); and how it was computed (:func:`method_text`, :func:`certificates_table`). Everything is read
+from the dataset."""
 
 from __future__ import annotations
 
 import html
+import math
 from pathlib import Path
 
+import numpy as np
 import xarray as xr
 
-from vibroimpact.kinds.design.answer import answer_text, warnings
-from vibroimpact.kinds.design.figures import design_figures
-from vibroimpact.reporting.page import Section, saved
+from vibroimpact.kinds.design.answer import DESIGN_TITLES, answer_text, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, stage_counts, unit_text, variable_names, warnings
+from vibroimpact.kinds.design.figures import DESIGN_COLOURS, design_figures
+from vibroimpact.kinds.design.scene import safe_name
+from vibroimpact.reporting.page import Section, Table, saved
+from vibroimpact.reporting.style import fmt
 
-__all__ = ["DesignPage", "page_for"]
+__all__ = ["DesignPage", "page_for", "designs_table", "certificates_table", "method_text", "best_marks"]
+
+_WRAP = "style='white-space:normal'"
+
+
+def best_marks(values: list[float]) -> list[bool]:
+    """Which of ``values`` are the least (within 1e-9 relative); none when fewer than two are finite."""
+    finite = [v for v in values if math.isfinite(v)]
+    if len(finite) < 2:
+        return [False] * len(values)
+    least = min(finite)
+    return [math.isfinite(v) and v <= least + 1e-9 * abs(least) for v in values]
+
+
+def _mm(value: float) -> str:
+    return fmt(1e3 * value, ".4g") or "n/a"
+
+
+def _variable_cell(d: xr.Dataset, name: str, k: int) -> str:
+    value = float(d[f"design_{safe_name(name)}"].values[k])
+    if not math.isfinite(value):
+        return "no stop" if name in ("clearance", "restitution") else "n/a"
+    return fmt(1e3 * value, ".4g") if name == "clearance" else fmt(value, ".4g")
+
+
+def designs_table(dataset: xr.Dataset) -> str:
+    """The compared designs (rows) with their variables, worst case over the samples, nominal worst case, certified
+    worst case and the motion that sets it, and |X1| at the operating frequency; the least of each result column
+    marked ★ bold."""
+    d = dataset
+    rows = present_designs(d) or [1]
+    names = variable_names(d)
+    values = d["design_sample_value"].values
+    constrained = math.isfinite(float(d.attrs.get("operating_limit_m", math.nan)))
+    limit = float(d.attrs.get("operating_limit_m", math.nan))
+    columns: dict[str, list[float]] = {
+        "over": [float(np.nanmax(values[k])) if np.any(np.isfinite(values[k])) else math.nan for k in rows],
+        "nominal": [float(values[k, 0]) for k in rows],
+        "certified": [certified_worst(d, k)[0] for k in rows],
+    }
+    if constrained:
+        columns["operating"] = [float(d["design_operating_amplitude"].values[k]) for k in rows]
+    marks = {key: best_marks(column) for key, column in columns.items()}
+    heads = [f"<th {_WRAP}>{html.escape(n)}{' [mm]' if n == 'clearance' else ('' if not unit_text(str(d[f'variable_{safe_name(n)}'].attrs.get('units', '1'))) else ' [' + unit_text(str(d[f'variable_{safe_name(n)}'].attrs.get('units'))) + ']')}</th>" for n in names]
+    heads += [f"<th {_WRAP}>worst case over the {d.sizes['sample']} samples [mm]</th>", f"<th {_WRAP}>nominal worst case [mm]</th>", f"<th {_WRAP}>certified worst case [mm] and the motion that sets it</th>"]
+    if constrained:
+        heads.append(f"<th {_WRAP}>|X1| at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz [mm] (allowed {_mm(limit)})</th>")
+    lines = [f"<table><tr><th>design</th>{''.join(heads)}</tr>"]
+    for j, k in enumerate(rows):
+        evaluation = design_evaluation(d, k)
+        swatch = f"<span style='color:{DESIGN_COLOURS[k]}'>■</span> "
+        extra = f"<br><small>{html.escape(design_text(d, k))}</small>" if k == 2 else ""
+        cells = [f"<td {_WRAP}>{swatch}{html.escape(DESIGN_TITLES[k])}{extra}</td>"] + [f"<td>{_variable_cell(d, n, k)}</td>" for n in names]
+        over = _mm(columns["over"][j])
+        if evaluation >= 0 and np.any(np.isfinite(values[k])):
+            s = int(np.nanargmax(values[k]))
+            over += f"<br><small>sample {s}, {fmt(d['sample_frequency'].values[evaluation, s], '.4g')} Hz</small>"
+        worst, row = certified_worst(d, k)
+        if row >= 0:
+            certified = f"{_mm(worst)}<br><small>{html.escape(str(d['certificate_motion'].values[row]))}, sample {int(d['certificate_sample'].values[row])}, {fmt(d['certificate_frequency'].values[row], '.4g')} Hz</small>"
+        else:
+            certified = "exact (no stop: the band peak in closed form)" if k == 2 else "not certified"
+        texts = {"over": over, "nominal": _mm(columns["nominal"][j]), "certified": certified}
+        if constrained:
+            operating = columns["operating"][j]
+            texts["operating"] = _mm(operating) + (" <small>(above the limit)</small>" if operating > limit else "")
+        for key, text in texts.items():
+            cells.append(f"<td {_WRAP if key == 'certified' else ''}>{'<b>★ ' + text + '</b>' if marks[key][j] else text}</td>")
+        lines.append(f"<tr>{''.join(cells)}</tr>")
+    lines.append("</table>")
+    note = ("<p><small>★ bold: the least value of the column. Worst case: the largest stable |X1| over the band; over the samples: the largest "
+            "under any mistuning sample (sample 0 is the nominal design); certified: the largest found by continuing every branch from the "
+            "closed-form orbits (nominal sample and the worst one).</small></p>")  # fmt: skip
+    return "".join(lines) + note
+
+
+def _who(dataset: xr.Dataset, evaluation: int) -> str:
+    """How the page names an evaluated candidate."""
+    if evaluation == int(dataset.attrs.get("recommended_evaluation", -1)):
+        return "the recommended design"
+    return "the scene's design" if evaluation == 0 else f"candidate {evaluation}"
+
+
+def certificates_table(dataset: xr.Dataset) -> str:
+    """Each certification: the design and sample, the screen's and the continuation's worst case, where, the motion,
+    and its wall time; empty when nothing was certified."""
+    d = dataset
+    if d.sizes["certificate"] == 0:
+        return ""
+    lines = [f"<table><tr><th>design</th><th>sample</th><th {_WRAP}>screened worst case [mm]</th><th {_WRAP}>certified worst case [mm]</th><th>at [Hz]</th><th>motion</th><th>wall time [s]</th><th>error</th></tr>"]
+    for r in range(d.sizes["certificate"]):
+        who = _who(d, int(d["certificate_evaluation"].values[r]))
+        lines.append(f"<tr><td>{who}</td><td>{int(d['certificate_sample'].values[r])}</td><td>{_mm(d['certificate_screened'].values[r])}</td><td>{_mm(d['certificate_worst'].values[r])}</td>"
+                     f"<td>{fmt(d['certificate_frequency'].values[r], '.5g')}</td><td {_WRAP}>{html.escape(str(d['certificate_motion'].values[r]))}</td>"
+                     f"<td>{fmt(d['certificate_wall_time'].values[r], '.3g')}</td><td {_WRAP}>{html.escape(str(d['certificate_error'].values[r])) or 'none'}</td></tr>")  # fmt: skip
+    return "".join(lines) + "</table>"
+
+
+def method_text(dataset: xr.Dataset) -> str:
+    """How the page's numbers were computed (HTML paragraphs): the screen, the search and its evaluations by stage,
+    the mistuning, the certification, with their wall times."""
+    d = dataset
+    n, samples = d.sizes["evaluation"], d.sizes["sample"]
+    counts = stage_counts(d)
+    search_time, certify_time = float(d.attrs.get("search_wall_time_s", math.nan)), float(d.attrs.get("certification_wall_time_s", math.nan))
+    per = search_time / (n * samples) if n * samples else math.nan
+    method = str(d.attrs.get("search_method", "?"))
+    if method == "grid":
+        how = f"A grid over the variables ({counts.get('grid', 0)} candidates)"
+    else:
+        polish = f", then a bounded Nelder-Mead polish from the best one ({counts.get('polish', 0)} evaluations)" if counts.get("polish") else ", no polish"
+        how = f"Differential evolution (scipy, Latin-hypercube start, seeded; {counts.get('global', 0)} evaluations){polish}"
+    stages = ", ".join(f"{name} {count}" for name, count in counts.items() if count)
+    spreads = mistuning_spreads(d)
+    mistuned = (f"{samples - 1} samples of a seeded Latin hypercube (seed {d.attrs.get('mistuning_seed', '?')}) over {' and '.join(s.text() for s in spreads)}, plus the nominal design"
+                if spreads and samples > 1 else "the nominal design only (no mistuning)")  # fmt: skip
+    quantile = float(d.attrs.get("quantile", 1.0))
+    over = "the worst of them" if quantile >= 1.0 else f"their {fmt(quantile, '.3g')} quantile"
+    parts = [f"<p><b>The screen (closed forms).</b> Each candidate's worst case is, under each mistuning sample, the largest |X1| over "
+             f"{fmt(d.attrs['band_low_Hz'], '.4g')}-{fmt(d.attrs['band_high_Hz'], '.4g')} Hz of every stable closed-form motion: the contact-free motion where "
+             "it clears the stop and both roots of the period-1 impact orbit where admissible and stable, maxima refined in frequency; where no such "
+             "motion is stable, a guess at the motion's size from the orbits that exist. The objective is "
+             f"{over} over the samples: {mistuned}.</p>"]  # fmt: skip
+    limit = float(d.attrs.get("operating_limit_m", math.nan))
+    if math.isfinite(limit):
+        parts.append(f"<p><b>The operating constraint.</b> The worst coexisting |X1| at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz must stay at or below "
+                     f"{_mm(limit)} mm; the search minimised the objective raised by 10 times the relative excess of that |X1| over the limit (a penalty, "
+                     f"not a hard bound; {int(np.sum(d['feasible'].values == 1))} of {n} candidates keep it).</p>")  # fmt: skip
+    jobs = d.attrs.get("run_jobs")
+    workers = f" on {int(jobs)} worker{'s' if int(jobs) != 1 else ''}" if isinstance(jobs, (int, np.integer)) else ""
+    parts.append(f"<p><b>The search.</b> {how}. {n} candidates in all, by stage: {stages} (the reference is the scene's own design); {n * samples} "
+                 f"closed-form problems in {fmt(search_time, '.3g')} s of wall time{workers}, {fmt(1e3 * per, '.3g')} ms a problem.</p>")  # fmt: skip
+    certified = d.sizes["certificate"]
+    if certified:
+        total = float(np.nansum(d["certificate_wall_time"].values))
+        which: dict[str, list[str]] = {}
+        for r in range(certified):
+            which.setdefault(_who(d, int(d["certificate_evaluation"].values[r])), []).append(str(int(d["certificate_sample"].values[r])))
+        listed = "; ".join(f"{who} at sample{'s' if len(s) > 1 else ''} {' and '.join(s)}" for who, s in which.items())
+        parts.append(f"<p><b>The certification (continuation).</b> {certified} problem{'s' if certified > 1 else ''} ({listed}; sample 0 is the nominal design), "
+                     f"each continued in frequency along every branch started from its closed-form orbits: {fmt(certify_time, '.3g')} s of wall time, "
+                     f"{fmt(total, '.3g')} s summed over the problems. A certified worst case above the screen's raises the candidate's score; the "
+                     "recommendation is the best certified candidate.</p>")  # fmt: skip
+    else:
+        parts.append("<p><b>The certification (continuation).</b> Nothing was certified: the worst cases are the screen's.</p>")
+    return "".join(parts)
 
 
 class DesignPage:
@@ -25,15 +176,19 @@ class DesignPage:
     def summary(self) -> str:
         """What was computed, for the page's heading."""
         d = self.dataset
-        return (f"{d.sizes['evaluation']} candidate designs ({d.attrs.get('search_method', '?')} over {d.attrs.get('variables', '?')}), each under "
+        return (f"{d.sizes['evaluation']} candidate designs ({str(d.attrs.get('search_method', '?')).replace('_', ' ')} over {d.attrs.get('variables', '?')}), each under "
                 f"{d.sizes['sample']} mistuning samples (the nominal design included); {d.sizes['certificate']} problems certified by continuation")  # fmt: skip
 
     def sections(self, out: Path) -> list[Section]:
-        """The answer, the warnings, the figures."""
+        """The answer and the warnings, the figures, the compared designs, how it was computed."""
         d = self.dataset
         items = "".join(f"<li>{html.escape(w)}</li>" for w in warnings(d))
         first = Section("Which design to build", f"<p><b>{html.escape(answer_text(d))}</b></p>" + (f"<p>Before you build it:</p><ul>{items}</ul>" if items else ""))
-        return [first, Section("Figures", "", figures=saved(design_figures(d), out))]
+        figures = Section("Figures", "", figures=saved(design_figures(d), out))
+        table = Section("The compared designs", "", tables=[Table("Worst cases of the compared designs", designs_table(d))])
+        certificates = certificates_table(d)
+        method = Section("How this was computed", method_text(d), tables=[Table("The certificates", certificates)] if certificates else [])
+        return [first, figures, table, method]
 
 
 def page_for(dataset: xr.Dataset) -> DesignPage:

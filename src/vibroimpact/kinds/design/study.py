@@ -140,7 +140,7 @@ def _certify(outcome: Outcome, runner: Runner, say: Progress) -> None:
         if all(not np.allclose(evaluations.designs[i], evaluations.designs[j], rtol=1e-6, atol=0.0) for j in chosen):
             chosen.append(i)
     reference = next(i for i, s in enumerate(evaluations.stages) if s == 3)  # the scene's own design, evaluated first
-    targets = chosen + ([reference] if reference not in chosen else [])
+    targets = chosen + ([reference] if reference not in chosen and chosen else [])  # none certified: the scene's design neither
     cases, owners = [], []
     for i in targets:
         values = evaluations.values(evaluations.results[i])

@@ -1,0 +1,177 @@
+"""The design page (issue 32) from tiny studies run here: it answers first ("Build ..."), warns before any figure,
+writes every figure, marks the best of each column of its table, and draws a one-variable study with neither a linear
+comparison nor an operating constraint, and a study that recommended nothing.
+
+The scenes' own stop is 1 m away (never reached): the scene's design is always certified by continuation, and
+without impacts that takes milliseconds rather than the paper's 3 mm stop's tens of seconds."""
+
+from __future__ import annotations
+
+import copy
+import html
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from vibroimpact.kinds.design.answer import answer_text, mistuning_text, search_path, warnings
+from vibroimpact.kinds.design.figures import DESIGN_COLOURS, response_figure, robustness_figure, search_figure
+from vibroimpact.kinds.design.page import DesignPage, best_marks, designs_table
+from vibroimpact.kinds.design.study import DesignStudy
+from vibroimpact.reporting.page import write_report
+from vibroimpact.runs.runner import Runner
+from vibroimpact.scene.reader import parse_scene
+
+import matplotlib.pyplot as plt
+
+FIGURES = {"design_search", "design_response", "design_robustness"}
+
+TWO_VARIABLES = {
+    "name": "page_two",
+    "description": "two variables, a notch to keep, compared with the linear optimum",
+    "system": {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0, "b1": 0.8, "b2": 0.08},
+    "excitation": {"amplitude": 10.0},
+    "stop": {"clearance": 1.0, "restitution": 0.2},
+    "design": {
+        "variables": {"clearance": [0.002, 0.006], "restitution": [0.1, 0.8]},
+        "band": {"start": 15.0, "stop": 45.0},
+        "constraints": {"operating": {"frequency": 33.0, "x1_amplitude": 5e-5}},
+        "robust": {"clearance": 0.0002, "samples": 2, "seed": 1},
+        "compare": "linear_optimum",
+        "search": {"population": 4, "generations": 2, "seed": 1, "polish": False},
+        "certify": {"candidates": 0},
+    },
+}
+
+
+def _run(document: dict) -> xr.Dataset:
+    scene = parse_scene(copy.deepcopy(document), text=yaml.safe_dump(document, sort_keys=False))
+    return DesignStudy().run(scene, None, Runner(jobs=1, progress=False))
+
+
+@pytest.fixture(scope="module")
+def two() -> xr.Dataset:
+    return _run(TWO_VARIABLES)
+
+
+@pytest.fixture(scope="module")
+def one() -> xr.Dataset:
+    document = copy.deepcopy(TWO_VARIABLES)
+    document["name"] = "page_one"
+    design = document["design"]
+    design["variables"] = {"clearance": [0.002, 0.006]}
+    design["compare"] = "none"
+    del design["constraints"]
+    return _run(document)
+
+
+def _text(fragment: str) -> str:
+    return html.unescape(re.sub(r"<[^>]+>", "", fragment)).strip()
+
+
+def test_the_page_answers_first_and_warns_before_any_figure(two: xr.Dataset, tmp_path: Path) -> None:
+    sections = DesignPage(two).sections(tmp_path)
+    assert sections[0].title == "Which design to build" and not sections[0].figures
+    assert _text(sections[0].intro).startswith("Build Delta = ")
+    page = write_report(two, tmp_path).read_text(encoding="utf-8")
+    body = page[page.index("</nav>") :]
+    first_figure = body.index("<figure")
+    assert body.index("Build Delta = ") < body.index("Before you build it") < first_figure
+    for warning in warnings(two):
+        assert body.index(html.escape(warning)) < first_figure
+
+
+def test_every_figure_file_is_written_and_embedded(two: xr.Dataset, tmp_path: Path) -> None:
+    page = write_report(two, tmp_path).read_text(encoding="utf-8")
+    written = {path.stem for path in tmp_path.glob("*.png")}
+    assert written == FIGURES
+    assert all((tmp_path / f"{name}.png").stat().st_size > 10_000 for name in FIGURES)
+    assert page.count("<img ") == len(FIGURES)
+    assert all(f"({name}.png)" in page for name in FIGURES)
+
+
+def test_the_answer_names_the_spreads_the_scene_states_and_the_comparisons(two: xr.Dataset) -> None:
+    assert mistuning_text(two) == "+-0.2 mm of the clearance (2 samples)"  # as stated, not the samples' largest offset
+    text = answer_text(two)
+    assert "over 15-45 Hz and +-0.2 mm of the clearance (2 samples)" in text
+    assert "best linear absorber of the same mass: " in text and "the scene's design, Delta = 1000 mm, R = 0.2: " in text
+    assert "at 33 Hz" in text
+    assert any("was not certified" in w for w in warnings(two))  # certify: candidates 0
+
+
+def test_the_search_map_draws_the_contours_the_path_and_the_designs(two: xr.Dataset) -> None:
+    drawn = search_figure(two)
+    ax = drawn.figure.axes[0]
+    assert any(type(c).__name__ == "TriContourSet" for c in ax.collections)
+    path = search_path(two)
+    scores = two["score"].values
+    assert path[0] == 0 and np.all(np.diff(scores[path]) < 0.0)
+    assert scores[path[-1]] == np.min(scores)  # exact: the last improvement is the best score
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    trace = lines["the search's path: best design so far, in evaluation order"]
+    assert len(trace.get_xdata()) == len(path)
+    star = lines["recommended design"]
+    assert star.get_xdata()[0] == pytest.approx(1e3 * float(two["design_clearance"].values[0]), rel=1e-12)
+    assert star.get_ydata()[0] == pytest.approx(float(two["design_restitution"].values[0]), rel=1e-12)
+    assert "log-spaced" in drawn.caption and "exceeds" in drawn.caption
+    plt.close(drawn.figure)
+
+
+def test_the_responses_are_coloured_by_design_and_say_whose(two: xr.Dataset) -> None:
+    drawn = response_figure(two)
+    axes = drawn.figure.axes
+    assert len(axes) == 4  # the comparison, then the recommended, the scene's and the linear absorber
+    for ax, colour in zip(axes[1:], DESIGN_COLOURS):
+        assert any(line.get_color() == colour and np.any(np.isfinite(np.asarray(line.get_ydata(), dtype=float))) for line in ax.get_lines())
+    labels = [text.get_text() for text in drawn.figure.legends[0].get_texts()]
+    assert labels[0].startswith("recommended design: Delta = ") and labels[2].startswith("best linear absorber: no stop, k2 = ")
+    assert any(label.startswith("operating frequency 33 Hz") for label in labels)
+    plt.close(drawn.figure)
+
+
+def test_the_robustness_caption_says_how_many_samples_and_what_spreads(two: xr.Dataset) -> None:
+    drawn = robustness_figure(two)
+    assert "3 samples: the nominal design and 2 of a Latin hypercube (seed 1) over +-0.2 mm of the clearance" in drawn.caption
+    assert "best linear absorber" in drawn.caption  # no stop: the clearance's spread does not reach it
+    plt.close(drawn.figure)
+
+
+def test_the_table_marks_the_least_of_each_column(two: xr.Dataset) -> None:
+    assert best_marks([2.0, 1.0, math.nan]) == [False, True, False]
+    assert best_marks([1.0, math.nan, math.nan]) == [False, False, False]  # nothing to compare with
+    table = designs_table(two)
+    rows = table.split("<tr>")[2:]
+    worst = [float(np.nanmax(row)) for row in two["design_sample_value"].values]
+    best = int(np.argmin(worst))
+    assert "★" in rows[best].split("</td>")[3]  # design, clearance, restitution, then the worst case over the samples
+    assert all("★" not in row.split("</td>")[3] for k, row in enumerate(rows) if k != best)
+    assert "not certified" in rows[0] and "exact (no stop" in rows[2]
+
+
+def test_one_variable_without_comparison_or_constraint_draws(one: xr.Dataset, tmp_path: Path) -> None:
+    assert math.isnan(float(one.attrs["operating_limit_m"])) and np.all(np.isnan(one["design_sample_value"].values[2]))
+    text = answer_text(one)
+    assert text.startswith("Build Delta = ") and "linear" not in text and "allowed" not in text
+    page = write_report(one, tmp_path).read_text(encoding="utf-8")
+    assert {path.stem for path in tmp_path.glob("*.png")} == FIGURES
+    assert "allowed" not in designs_table(one)
+    drawn = search_figure(one)
+    assert len(drawn.figure.axes) == 1 and drawn.figure.axes[0].get_yscale() == "log"
+    plt.close(drawn.figure)
+    assert page.index("Before you build it") < page.index("<figure")
+
+
+def test_a_study_that_recommended_nothing_still_draws(two: xr.Dataset, tmp_path: Path) -> None:
+    """What the dataset holds when no candidate had a finite worst case: no recommended row."""
+    nothing = two.copy(deep=True)
+    nothing.attrs["recommended_evaluation"] = -1
+    for name in [n for n in nothing.data_vars if str(n).startswith(("design_", "response_")) and "design" in nothing[n].dims and str(n) != "design_name"]:
+        values = nothing[name].values
+        values[0] = -1 if values.dtype.kind == "i" else np.nan
+    assert answer_text(nothing).startswith("No design could be recommended")
+    write_report(nothing, tmp_path)
+    assert {path.stem for path in tmp_path.glob("*.png")} == FIGURES
