@@ -34,6 +34,8 @@ __all__ = ["STAGES", "Evaluations", "differential_evolution", "nelder_mead_polis
 STAGES = ("global", "polish", "grid", "reference")
 #: Score raised by this times the relative excess of the operating |X| over its limit [-].
 PENALTY = 10.0
+#: A single candidate with at most this many samples is evaluated in this process, not sent to the workers.
+IN_PROCESS_SAMPLES = 12
 #: The polish's first simplex and its last, shares of each variable's range [-].
 POLISH_STEP = 0.05
 POLISH_END = 1e-6
@@ -68,7 +70,9 @@ class Evaluations:
     def evaluate(self, designs: NDArray[np.float64], stage: str) -> NDArray[np.float64]:
         """The scores of ``designs`` (shape (m, n), in the variables' units), each kept."""
         designs = np.atleast_2d(np.asarray(designs, dtype=float))
-        chunks = sample_chunks(self.space.samples)
+        # one candidate with few samples (a polish step) runs here whole: a dask round trip costs more than its samples
+        few = designs.shape[0] == 1 and self.space.samples <= IN_PROCESS_SAMPLES
+        chunks = [tuple(range(self.space.samples))] if few else sample_chunks(self.space.samples)
         parts = self.runner.map([DesignCase(self.space, tuple(float(v) for v in x), chunk) for x in designs for chunk in chunks])
         results = [{k: np.concatenate([np.atleast_1d(p[k]) for p in parts[i * len(chunks) : (i + 1) * len(chunks)]]) for k in parts[0]} for i in range(len(designs))]
         scores = np.array([self.score(result) for result in results])
