@@ -117,7 +117,7 @@ def test_the_study_kind_attribute_decides_and_is_checked() -> None:
     ds.attrs = dict(ds.attrs, study_kind="benchmark")
     assert study_kind(ds) == "benchmark"
     ds.attrs["study_kind"] = "continuation"
-    with pytest.raises(ValueError, match="study_kind must be one of concepts, validation, benchmark, bifurcation, swept, stepped"):
+    with pytest.raises(ValueError, match="study_kind must be one of design, concepts, validation, benchmark, bifurcation, swept, stepped"):
         study_kind(ds)
     with pytest.raises(ValueError, match="kind must be one of"):
         StudyRecord(kind="other", name="x", description="", scene_text="", version="0")

@@ -128,6 +128,7 @@ KIND_CASES: dict[str, str] = {
     # three of the five validation cases (the other two, bouncing ball and grazing, write the same kinds of
     # variables as these and cost 3 s each): continued orbits on ``point``, a table of checks, an impact sequence
     **{f"golden:validation_{case}": "validation" for case in ("budd_dux", "relative_stop", "zeno")},
+    "golden:design_vs_linear": "design",  # every evaluation, samples, certificates with branches and attractors, compared designs
 }
 
 
