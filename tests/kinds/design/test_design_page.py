@@ -18,7 +18,7 @@ import pytest
 import xarray as xr
 import yaml
 
-from vibroimpact.kinds.design.answer import answer_text, mistuning_text, search_path, warnings
+from vibroimpact.kinds.design.answer import answer_text, linear_wins, mistuning_text, search_path, warnings
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, response_figure, robustness_figure, search_figure
 from vibroimpact.kinds.design.page import DesignPage, best_marks, designs_table
 from vibroimpact.kinds.design.study import DesignStudy
@@ -175,3 +175,22 @@ def test_a_study_that_recommended_nothing_still_draws(two: xr.Dataset, tmp_path:
     assert answer_text(nothing).startswith("No design could be recommended")
     write_report(nothing, tmp_path)
     assert {path.stem for path in tmp_path.glob("*.png")} == FIGURES
+
+
+def test_where_the_linear_absorber_beats_every_stop_the_answer_says_build_no_stop(two: xr.Dataset) -> None:
+    """The recommended design's worst case raised above the linear absorber's: without a notch to keep the answer
+    recommends no stop (and names the best design with one); with the notch, which the linear absorber misses, it
+    still recommends the stop, and the warning says what the stop costs over the band."""
+    worse = two.copy(deep=True)
+    linear = float(np.nanmax(worse["design_sample_value"].values[2]))
+    worse["design_sample_value"].values[0] = 1.5 * linear
+    assert not linear_wins(worse) and answer_text(worse).startswith("Build Delta = ")  # the linear absorber has no notch
+    assert any(w.startswith("Over the band the stop does not pay") and "but it has no notch" in w for w in warnings(worse))
+    worse.attrs["operating_limit_m"] = math.nan
+    assert linear_wins(worse)
+    text = answer_text(worse)
+    assert text.startswith("Build no stop: the best linear absorber of the same mass (no stop, k2 = ")
+    assert f"|X1| = {1e3 * linear:.4g} mm over 15-45 Hz" in text and "the best design with a stop found, Delta = " in text
+    assert f"{1e3 * 1.5 * linear:.4g} mm" in text
+    worse["design_sample_value"].values[0] = 0.5 * linear  # the stop wins again
+    assert not linear_wins(worse) and answer_text(worse).startswith("Build Delta = ")

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.reporting.style import fmt
 
-__all__ = ["answer_text", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
+__all__ = ["answer_text", "linear_wins", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
 
 _SYMBOLS = {"clearance": "Delta", "restitution": "R"}
 #: How the page names the compared designs (the dataset's ``design`` dimension, in order).
@@ -197,7 +197,6 @@ def answer_text(dataset: xr.Dataset) -> str:
     recommended = int(d.attrs.get("recommended_evaluation", -1))
     if recommended < 0:
         return f"No design could be recommended: no candidate had a finite worst case {over}."
-    head = f"Build {variable_text(d, 0)}: worst case |X1| = {_mm(design_worst(d, 0))} {over}"
     limit = float(d.attrs.get("operating_limit_m", math.nan))
     operating = d["design_operating_amplitude"].values
     at = fmt(d.attrs.get("operating_frequency_Hz"), ".4g")
@@ -209,12 +208,28 @@ def answer_text(dataset: xr.Dataset) -> str:
             return f", {_mm(float(operating[k]))} at {at} Hz, above the allowed {_mm(limit)}"
         return f", {_mm(float(operating[k]))} at {at} Hz" + (f", where {_mm(limit)} is allowed" if k == 0 else "")
 
-    others = []
-    if np.any(np.isfinite(values[2])):
-        others.append(f"best linear absorber of the same mass: {_mm(worst[2])}{notch(2)}")
     scene = variable_text(d, 1)
-    others.append(f"the scene's design{', ' + scene if scene else ''}: {_mm(design_worst(d, 1))}{notch(1)}")
-    return f"{head}{notch(0)} ({'; '.join(others)})."
+    scene_part = f"the scene's design{', ' + scene if scene else ''}: {_mm(design_worst(d, 1))}{notch(1)}"
+    if linear_wins(d):  # no design with a stop found beats the linear absorber: say so first
+        return (f"Build no stop: the best linear absorber of the same mass ({design_text(d, 2)}) has the smallest worst case, |X1| = {_mm(worst[2])} {over}{notch(2)} "
+                f"(the best design with a stop found, {variable_text(d, 0)}: {_mm(design_worst(d, 0))}{notch(0)}; {scene_part}).")  # fmt: skip
+    others = [f"best linear absorber of the same mass: {_mm(worst[2])}{notch(2)}"] if np.any(np.isfinite(values[2])) else []
+    others.append(scene_part)
+    return f"Build {variable_text(d, 0)}: worst case |X1| = {_mm(design_worst(d, 0))} {over}{notch(0)} ({'; '.join(others)})."
+
+
+def linear_wins(dataset: xr.Dataset) -> bool:
+    """Whether the best linear absorber of the same mass beats the recommended design with a stop: a smaller worst
+    case than the recommended design's (screened or certified, whichever is larger), and, with an operating
+    constraint, keeping it."""
+    d = dataset
+    row = d["design_sample_value"].values[2]
+    if int(d.attrs.get("recommended_evaluation", -1)) < 0 or not np.any(np.isfinite(row)):
+        return False
+    limit = float(d.attrs.get("operating_limit_m", math.nan))
+    notch = float(d["design_operating_amplitude"].values[2])
+    keeps = not math.isfinite(limit) or (math.isfinite(notch) and notch <= limit)
+    return keeps and float(np.nanmax(row)) < design_worst(d, 0)
 
 
 def warnings(dataset: xr.Dataset) -> list[str]:
@@ -224,11 +239,11 @@ def warnings(dataset: xr.Dataset) -> list[str]:
     recommended = int(d.attrs.get("recommended_evaluation", -1))
     values = d["design_sample_value"].values
     limit = float(d.attrs.get("operating_limit_m", math.nan))
-    if np.any(np.isfinite(values[2])) and recommended >= 0 and np.nanmax(values[0]) >= np.nanmax(values[2]):
+    if np.any(np.isfinite(values[2])) and recommended >= 0 and design_worst(d, 0) >= np.nanmax(values[2]):
         linear_notch = float(d["design_operating_amplitude"].values[2])
         keeps = math.isfinite(limit) and math.isfinite(linear_notch) and linear_notch > limit
         cost = f", but it has no notch: |X1| at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz is {_mm(linear_notch)}, above the allowed {_mm(limit)}" if keeps else ""
-        out.append(f"Over the band the stop does not pay: the best linear absorber of the same mass has the smaller worst case ({_mm(float(np.nanmax(values[2])))} against {_mm(float(np.nanmax(values[0])))}){cost}.")
+        out.append(f"Over the band the stop does not pay: the best linear absorber of the same mass has the smaller worst case ({_mm(float(np.nanmax(values[2])))} against {_mm(design_worst(d, 0))}){cost}.")
     if math.isfinite(limit) and recommended >= 0:
         operating = float(d["operating_amplitude"].values[recommended])
         if not operating <= limit:
