@@ -183,6 +183,8 @@ class OnsetSteps:
                 break
             if previous is not None:
                 secant = point.z - previous.z
+                if not np.linalg.norm(secant) > 0.0:  # the same orbit again (the ladder's margins collapsed): no way on
+                    continue
                 point = dataclasses.replace(point, tangent=self.arc.tangent(point.jacobian, secant / np.linalg.norm(secant)))
             points.append(point)
             previous = point
