@@ -124,3 +124,25 @@ def test_the_closed_form_orbit_is_none_where_none_applies() -> None:
     assert system.with_periods(2).impact_orbit(system.parameters) is None
     state, margin = system.impact_orbit(system.parameters)
     assert state.shape == (4,) and np.all(np.isfinite(state)) and margin > 0.0
+
+
+def test_the_ladder_is_empty_where_the_impulse_jumps_at_the_onset() -> None:
+    """The paper's system with Delta = 2.3596 mm, R = 0.1893 (design_paper's recommended design): at the onset near
+    33.08 Hz the orbit born there grows from grazing (each rung within 5 % of its margin), while at the one near
+    20.007 Hz the closed form's orbit on the far side is 0.105 from grazing however close to the root (the impulse
+    jumps there): no rung of its ladder is offered (two of them were one orbit, and the continuation's secant between
+    them was 0/0)."""
+    from vibroimpact.orbits.onsets import LADDER, contact_free_onset, impacting_ladder
+
+    problem = ImpactProblem(PAPER_SYSTEM, RigidStop(0.0023596441695948873, 0.1892973965404693), HarmonicForce(Q, 20.0))
+    system = ImpactMap(problem)
+    index = system.parameter_names.index("frequency")
+    rungs = {}
+    for near in (20.0069, 33.0785):
+        p = np.array(system.parameters, dtype=float)
+        p[index] = near
+        root, _ = contact_free_onset(system, p, index, near, 1e-3)
+        rungs[near] = impacting_ladder(system, p, index, root)
+    assert rungs[20.0069] == []
+    margins = np.array([margin for _, _, margin in rungs[33.0785]])
+    assert margins.size == len(LADDER) and np.allclose(margins, LADDER, rtol=0.05, atol=0.0)

@@ -36,7 +36,9 @@ def impacting_ladder(system: ParametrisedMap, p: NDArray[np.float64], index: int
 
     Next to the onset the orbit's impact speed grows linearly with the parameter's distance to it (the impulse is a
     simple root of eq. 16 at J = 0), so a probe at 1e-9 of the root's magnitude (or of 1) sets the offset of each margin,
-    refined by one secant step."""
+    refined by one secant step. The ladder ends at the first margin no orbit comes within a factor 2 of: where the
+    impulse does not grow from 0 at the root (it jumps to a finite orbit, e.g. one that exists on both sides), the
+    orbits found are not the ones born there."""
     closed = getattr(system, "impact_orbit", None)
     if closed is None or not margins:
         return []
@@ -64,8 +66,9 @@ def impacting_ladder(system: ParametrisedMap, p: NDArray[np.float64], index: int
             if abs(orbit[1] - target) <= 0.05 * target:
                 break
             offset *= target / orbit[1]
-        if orbit is not None and orbit[1] > 0.0:
-            ladder.append((orbit[0], q, orbit[1]))
+        if orbit is None or not 0.5 * target <= orbit[1] <= 2.0 * target:
+            break  # no orbit near this margin: the one found is not born at the onset (the impulse jumps there)
+        ladder.append((orbit[0], q, orbit[1]))
     return ladder
 
 
