@@ -163,7 +163,8 @@ class DesignSettings:
         One of :data:`COMPARISONS`.
     search : SearchSettings
     certified : int
-        Candidates (best screened first) whose worst case is certified by continuation and brute force.
+        At most this many distinct candidates (best screened first) have their worst case certified by continuation
+        and brute force, one at a time until no later candidate can beat the best certified one.
     clearance, restitution : float
         The scene's own design of the stops: Delta [m], R [-].
     """

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import itertools
 import math
+import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,7 +30,7 @@ from scipy import optimize
 from vibroimpact.kinds.design.evaluate import DesignCase, DesignSpace, sample_chunks
 from vibroimpact.runs.runner import CaseResult, Runner
 
-__all__ = ["STAGES", "Evaluations", "differential_evolution", "nelder_mead_polish", "grid_search", "PENALTY", "POLISH_STEP", "POLISH_END"]
+__all__ = ["STAGES", "IN_PROCESS_SAMPLES", "Evaluations", "differential_evolution", "nelder_mead_polish", "grid_search", "PENALTY", "POLISH_STEP", "POLISH_END"]
 
 #: Why a candidate was evaluated (CF flag values of ``evaluation_stage``).
 STAGES = ("global", "polish", "grid", "reference")
@@ -36,6 +38,8 @@ STAGES = ("global", "polish", "grid", "reference")
 PENALTY = 10.0
 #: A single candidate with at most this many samples is evaluated in this process, not sent to the workers.
 IN_PROCESS_SAMPLES = 12
+#: The polish reports how far it got every this many evaluations.
+POLISH_REPORT = 10
 #: The polish's first simplex and its last, shares of each variable's range [-].
 POLISH_STEP = 0.05
 POLISH_END = 1e-6
@@ -67,13 +71,19 @@ class Evaluations:
     results: list[CaseResult] = field(default_factory=list)
     scores: list[float] = field(default_factory=list)
 
-    def evaluate(self, designs: NDArray[np.float64], stage: str) -> NDArray[np.float64]:
-        """The scores of ``designs`` (shape (m, n), in the variables' units), each kept."""
+    def evaluate(self, designs: NDArray[np.float64], stage: str, quiet: bool = False) -> NDArray[np.float64]:
+        """The scores of ``designs`` (shape (m, n), in the variables' units), each kept; ``quiet``: without the
+        runner's progress bar (a polish step of a second or two; the polish says how it goes)."""
         designs = np.atleast_2d(np.asarray(designs, dtype=float))
         # one candidate with few samples (a polish step) runs here whole: a dask round trip costs more than its samples
         few = designs.shape[0] == 1 and self.space.samples <= IN_PROCESS_SAMPLES
         chunks = [tuple(range(self.space.samples))] if few else sample_chunks(self.space.samples)
-        parts = self.runner.map([DesignCase(self.space, tuple(float(v) for v in x), chunk) for x in designs for chunk in chunks])
+        shown = self.runner.progress
+        self.runner.progress = shown and not quiet
+        try:
+            parts = self.runner.map([DesignCase(self.space, tuple(float(v) for v in x), chunk) for x in designs for chunk in chunks])
+        finally:
+            self.runner.progress = shown
         results = [{k: np.concatenate([np.atleast_1d(p[k]) for p in parts[i * len(chunks) : (i + 1) * len(chunks)]]) for k in parts[0]} for i in range(len(designs))]
         scores = np.array([self.score(result) for result in results])
         for x, result, value in zip(designs, results, scores):
@@ -133,20 +143,28 @@ def differential_evolution(evaluations: Evaluations, population: int, generation
                                     updating="deferred", init="latinhypercube", tol=1e-6, atol=0.0)  # fmt: skip
 
 
-def nelder_mead_polish(evaluations: Evaluations, budget: int) -> None:
+def nelder_mead_polish(evaluations: Evaluations, budget: int, say: Callable[[str], None] | None = None) -> None:
     """Nelder-Mead from the best design so far, in the unit cube (bounded), its first simplex :data:`POLISH_STEP` of
     each range wide, until the simplex is :data:`POLISH_END` of each range or ``budget`` evaluations are spent: a
     local search that needs no gradient (the objective is a maximum of peaks, not smooth; on an equal-peak ridge a
     search along the axes stalls where the simplex turns along the ridge). One candidate at a time: its samples are
-    what the workers share (:class:`~vibroimpact.kinds.design.evaluate.DesignCase` chunks)."""
+    what the workers share (:class:`~vibroimpact.kinds.design.evaluate.DesignCase` chunks); ``say`` hears how far
+    it got every :data:`POLISH_REPORT` evaluations."""
     span = evaluations.bounds[:, 1] - evaluations.bounds[:, 0]
     centre = (evaluations.designs[evaluations.best()] - evaluations.bounds[:, 0]) / span
     n = centre.size
     simplex = np.vstack([centre, centre + POLISH_STEP * np.eye(n) * np.where(centre + POLISH_STEP <= 1.0, 1.0, -1.0)[:, None]])
     scale = max(abs(evaluations.scores[evaluations.best()]), 1e-300)
 
+    done, started = [0], time.perf_counter()
+
     def one(unit: NDArray[np.float64]) -> float:
-        return float(evaluations.evaluate(evaluations.scaled(np.asarray(unit)[None, :]), "polish")[0]) / scale
+        value = float(evaluations.evaluate(evaluations.scaled(np.asarray(unit)[None, :]), "polish", quiet=say is not None)[0]) / scale
+        done[0] += 1
+        if say is not None and (done[0] % POLISH_REPORT == 0 or done[0] == budget):
+            best = evaluations.scores[evaluations.best()]
+            say(f"design: polish {done[0]}/{budget} evaluations, {time.perf_counter() - started:.0f} s; best score {1e3 * best:.5g} mm")
+        return value
 
     optimize.minimize(one, centre, method="Nelder-Mead", bounds=[(0.0, 1.0)] * n,
                       options={"initial_simplex": np.clip(simplex, 0.0, 1.0), "xatol": POLISH_END, "fatol": 1e-10, "maxfev": budget})  # fmt: skip

@@ -1,0 +1,87 @@
+"""The certification's rounds (issue 32): candidates are certified one at a time, best screened first, skipping one
+next to a candidate already certified, until no later candidate can beat the best certified one (certification only
+raises a worst case) or ``certify.candidates`` are spent; the recommendation is the best certified candidate.
+
+The runner here answers each certification from a table: what is tested is which candidates are certified, in what
+batches, and what is recommended."""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+import pytest
+import yaml
+
+from vibroimpact.kinds.design.search import Evaluations
+from vibroimpact.kinds.design.study import DISTINCT, Outcome, _certify, design_space
+from vibroimpact.scene.reader import parse_scene
+
+SCENE = {
+    "name": "rounds",
+    "system": {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0, "b1": 0.8, "b2": 0.08},
+    "excitation": {"amplitude": 10.0},
+    "stop": {"clearance": 0.003, "restitution": 0.2},
+    "design": {"variables": {"clearance": [0.001, 0.005], "restitution": [0.0, 0.8]}, "band": {"start": 15.0, "stop": 45.0},
+               "certify": {"candidates": 3}},
+}  # fmt: skip
+
+
+class TableRunner:
+    """Answers a certification of (clearance, sample) from ``certified`` [m]; keeps each batch's cases."""
+
+    def __init__(self, certified: dict[float, float]) -> None:
+        self.certified = certified
+        self.batches: list[list[tuple[float, int]]] = []
+
+    def map(self, cases):
+        self.batches.append([(case.design[0], case.sample) for case in cases])
+        return [{"worst": self.certified[case.design[0]]} for case in cases]
+
+
+def _outcome(screened: dict[float, float], certified: dict[float, float], candidates: int = 3) -> tuple[Outcome, TableRunner]:
+    document = copy.deepcopy(SCENE)
+    document["design"]["certify"]["candidates"] = candidates
+    scene = parse_scene(document, text=yaml.safe_dump(document))
+    space = design_space(scene)
+    runner = TableRunner(certified)
+    evaluations = Evaluations(space, np.array([[0.001, 0.005], [0.0, 0.8]]), runner)  # type: ignore[arg-type]
+    for k, (clearance, value) in enumerate(screened.items()):
+        evaluations.designs.append(np.array([clearance, 0.2]))
+        evaluations.stages.append(3 if k == 0 else 0)  # the first is the scene's own design
+        evaluations.results.append({"worst": np.full(space.samples, value), "uncovered": np.zeros(space.samples), "estimate": np.zeros(space.samples)})
+        evaluations.scores.append(value)
+    return Outcome(scene.settings, space, evaluations), runner
+
+
+def test_a_candidate_the_certification_raises_gives_way_to_the_next_distinct_one() -> None:
+    # the scene's design (3 mm) screens worst; the best (2 mm) is certified far higher; its neighbour (2.1 mm, within
+    # DISTINCT of the range) is skipped; 4 mm holds its screen, and 4.5 mm, screened higher, cannot beat it
+    assert 0.1e-3 <= DISTINCT * 4e-3
+    screened = {3e-3: 3.0, 2e-3: 1.0, 2.1e-3: 1.01, 4e-3: 1.5, 4.5e-3: 1.6}
+    certified = {3e-3: 3.0, 2e-3: 2.0, 2.1e-3: 2.0, 4e-3: 1.5, 4.5e-3: 1.6}
+    outcome, runner = _outcome(screened, certified)
+    _certify(outcome, runner, lambda message: None)  # type: ignore[arg-type]
+    assert runner.batches == [[(2e-3, 0), (3e-3, 0)], [(4e-3, 0)]]  # the scene's design with the first, nominal only
+    assert outcome.recommended == 3
+    assert outcome.corrected[1] == pytest.approx(2.0, rel=1e-12) and outcome.corrected[3] == pytest.approx(1.5, rel=1e-12)
+
+
+def test_a_candidate_that_holds_its_screen_ends_the_rounds() -> None:
+    screened = {3e-3: 3.0, 2e-3: 1.0, 4e-3: 1.5}
+    outcome, runner = _outcome(screened, {3e-3: 3.0, 2e-3: 1.0, 4e-3: 1.5})
+    _certify(outcome, runner, lambda message: None)  # type: ignore[arg-type]
+    assert len(runner.batches) == 1 and outcome.recommended == 1
+
+
+def test_the_rounds_stop_at_the_budget_and_recommend_the_best_certified() -> None:
+    screened = {3e-3: 3.0, 2e-3: 1.0, 4e-3: 1.2, 1.2e-3: 1.3}
+    certified = {3e-3: 3.0, 2e-3: 2.0, 4e-3: 2.5, 1.2e-3: 1.4}
+    outcome, runner = _outcome(screened, certified, candidates=2)
+    _certify(outcome, runner, lambda message: None)  # type: ignore[arg-type]
+    assert [batch[0][0] for batch in runner.batches] == [2e-3, 4e-3]  # 1.2 mm, which would win, is past the budget
+    assert outcome.recommended == 1 and math.isclose(outcome.corrected[1], 2.0)
+    outcome, runner = _outcome(screened, certified, candidates=0)
+    _certify(outcome, runner, lambda message: None)  # type: ignore[arg-type]
+    assert runner.batches == [] and outcome.recommended == 1  # none certified: the best screened
