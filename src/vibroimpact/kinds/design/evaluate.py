@@ -12,6 +12,7 @@ problem that continuation uses too.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -194,11 +195,11 @@ def _around(frequency: float) -> tuple[float, float]:
 
 #: Fields of :class:`CertifyCase`: the certified worst |X| [m], where [Hz], its motion (text) and source (index of
 #: :data:`~vibroimpact.simulation.certified_worst.SOURCES`); the continuation's and the brute force's own answers and
-#: wall times [s]; the frequencies a stepped sweep needs to reach the same maximum to 1e-4 and 1e-8 (relative) and what
+#: wall times [s], and the closed-form screen's wall time on the same problem [s] (NaN: no closed form); the frequencies a stepped sweep needs to reach the same maximum to 1e-4 and 1e-8 (relative) and what
 #: it would cost [s] at the brute force's measured cost per point; the
 #: continued branches' points (frequency [Hz], |X| [m], stable 0/1, impacts per period, branch index), NaN-padded; the
 #: brute force's largest |X| at each of its frequencies.
-CERTIFY_FIELDS = ("worst", "frequency", "motion", "source", "continuation_worst", "continuation_time", "brute_worst", "brute_frequency", "brute_motion", "brute_time",
+CERTIFY_FIELDS = ("worst", "frequency", "motion", "source", "continuation_worst", "continuation_time", "brute_worst", "brute_frequency", "brute_motion", "brute_time", "screen_time",
                   "sweep_points", "sweep_time", "branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index", "attractor_frequency", "attractor_amplitude", "error")  # fmt: skip
 #: Most branch points kept per certified problem.
 MAX_BRANCH_POINTS = 4000
@@ -233,10 +234,14 @@ class CertifyCase:
         """The certified worst case, each method's, and the branches traced (:data:`CERTIFY_FIELDS`)."""
         points = {k: np.full(MAX_BRANCH_POINTS, np.nan) for k in ("branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index")}
         attractors = {k: np.full(ATTRACTOR_POINTS, np.nan) for k in ("attractor_frequency", "attractor_amplitude")}
-        scalars: dict[str, object] = {k: math.nan for k in ("worst", "frequency", "continuation_worst", "continuation_time", "brute_worst", "brute_frequency", "brute_time")}
+        scalars: dict[str, object] = {k: math.nan for k in ("worst", "frequency", "continuation_worst", "continuation_time", "brute_worst", "brute_frequency", "brute_time", "screen_time")}
         scalars |= {"motion": "", "brute_motion": "", "source": -1}
         problem = self.space.problem_at(self.design, self.sample)
         try:
+            if closed_form_refusal(problem) is None:  # what the search's objective costs on this problem, timed alone
+                start = time.perf_counter()
+                closed_form_worst(problem, self.space.band, self.space.coordinate, self.space.scan)
+                scalars["screen_time"] = time.perf_counter() - start
             found = certified_worst(problem, self.space.band, frequencies=ATTRACTOR_POINTS)
         except (ValueError, RuntimeError) as error:
             return {**{k: np.array(v) for k, v in scalars.items()}, "sweep_points": np.full(len(SWEEP_ACCURACIES), np.nan), "sweep_time": np.full(len(SWEEP_ACCURACIES), np.nan), **points, **attractors,
