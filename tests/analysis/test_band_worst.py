@@ -12,10 +12,13 @@ from vibroimpact.analysis.band_worst import MOTIONS, closed_form_at, closed_form
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.analysis.linear_optimum import band_peak
+from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import PAPER_SYSTEM
+
+from tests.analysis.impact_flow import ImpactFlow
 
 
 def paper(clearance: float, restitution: float) -> ImpactProblem:
@@ -63,3 +66,27 @@ def test_at_one_frequency_the_worst_coexisting_motion_is_taken() -> None:
 def test_a_bad_band_is_refused() -> None:
     with pytest.raises(ValueError, match="band"):
         closed_form_worst(paper(0.003, 0.2), (45.0, 15.0))
+
+
+def test_the_screen_s_impulse_is_an_impact_an_independent_integration_measures() -> None:
+    """The paper's design (Delta = 3 mm, R = 0.2): the screen's largest impulse of one impact over 15-45 Hz is the
+    largest over its scan frequencies of the stable, admissible one-impact orbits' impulses; started on that orbit,
+    DOP853 with exact impact events (tests/analysis/impact_flow.py, no closed form inside) measures the same impulse,
+    m_eff (1 + R) times the approach speed, at every impact of 3 periods (1e-8 relative); with the stop out of reach
+    there is no impact and the impulse is 0."""
+    problem = paper(0.003, 0.2)
+    found = closed_form_worst(problem, (15.0, 45.0))
+    f = np.linspace(15.0, 45.0, 241)
+    largest, where = 0.0, np.nan
+    for root in ("+", "-"):
+        orbit = solve_impact_orbit(problem, frequency=f, root=root)
+        for k in np.flatnonzero(orbit.exists):
+            one = orbit.take([k])
+            if np.max(np.abs(floquet_multipliers(one))) < 1.0 - MARGINAL_MODULUS and bool(one.admissible(samples=128)[0]) and float(one.impulse[0]) > largest:
+                largest, where = float(one.impulse[0]), float(f[k])
+    assert found.impulse == pytest.approx(largest, rel=1e-12) and largest > 0.0
+    at = ImpactProblem(PAPER_SYSTEM, RigidStop(0.003, 0.2), HarmonicForce(10.0, where))
+    orbit = next(o for o in (solve_impact_orbit(at, root=r) for r in ("+", "-")) if bool(o.exists) and float(o.impulse) == pytest.approx(largest, rel=1e-9))
+    _, impacts = ImpactFlow(at).run(orbit.state_at(np.array([0.0]))[0], 0.0, 3 * at.period)
+    assert len(impacts) == 3 and all(impact.impulse == pytest.approx(largest, rel=1e-8) for impact in impacts)
+    assert closed_form_worst(paper(1.0, 0.2), (15.0, 45.0)).impulse == 0.0  # exact: no impact, no impulse

@@ -67,6 +67,10 @@ class BandWorst:
         contact-free motion that does not fit; 0 where the band is covered.
     estimate_frequency : float
         Where the guess is largest [Hz] (NaN where covered).
+    impulse : float
+        The largest impulse of one impact [N s] among the stable, admissible closed-form impact orbits on the scan's
+        frequencies (not refined between them); 0 where no impacting motion is stable (the impact force's measure
+        for a rigid stop, whose force is a Dirac pulse).
     """
 
     amplitude: float
@@ -76,6 +80,7 @@ class BandWorst:
     uncovered: float
     estimate: float = 0.0
     estimate_frequency: float = math.nan
+    impulse: float = 0.0
 
     def __post_init__(self) -> None:
         if self.motion not in MOTIONS:
@@ -91,22 +96,23 @@ def _linear(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int) -> 
     return np.where(linear.fits(problem.clearances()) & contact_free_is_stable(problem.structure), x, np.nan), x
 
 
-def _impacting(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, root: str, largest_only: bool = False) -> tuple[NDArray[np.float64], int, NDArray[np.float64]]:
+def _impacting(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, root: str, largest_only: bool = False) -> tuple[NDArray[np.float64], int, NDArray[np.float64], NDArray[np.float64]]:
     """|X| of the closed-form impact orbit (``root``) where it exists, is stable and admissible, NaN elsewhere; its
-    impacts per period; and |X| wherever it exists (any stability, admissible or not). Stability first (cheap),
-    admissibility (sampled over the period) only where stable; ``largest_only``: only until the largest admissible
-    one is known (the others NaN)."""
+    impacts per period; |X| wherever it exists (any stability, admissible or not); and its impulse per impact [N s]
+    where stable and admissible (NaN elsewhere). Stability first (cheap), admissibility (sampled over the period) only
+    where stable; ``largest_only``: only until the largest admissible one is known (the others NaN)."""
     orbit = solve_impact_orbit(problem, frequency=f, root=root)
     x = np.full(f.shape, np.nan)
+    impulse = np.full(f.shape, np.nan)
     exists = np.flatnonzero(np.asarray(orbit.exists, dtype=bool).reshape(-1))
     if exists.size == 0:
-        return x, orbit.impacts_per_period, x.copy()
+        return x, orbit.impacts_per_period, x.copy(), impulse
     existing = np.full(f.shape, np.nan)
     existing[exists] = np.abs(orbit.take(exists).harmonics()[..., coordinate]).reshape(-1)
     modulus = np.max(np.abs(floquet_multipliers(orbit.take(exists))), axis=-1)
     stable = exists[modulus < 1.0 - MARGINAL_MODULUS]
     if stable.size == 0:
-        return x, orbit.impacts_per_period, existing
+        return x, orbit.impacts_per_period, existing, impulse
     chosen = orbit.take(stable)
     amplitude = np.abs(chosen.harmonics()[..., coordinate]).reshape(-1)
     if largest_only:
@@ -114,27 +120,29 @@ def _impacting(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, 
             if bool(np.asarray(chosen.take([k]).admissible()).reshape(-1)[0]):
                 x[stable[k]] = amplitude[k]
                 break
-        return x, orbit.impacts_per_period, existing
+        return x, orbit.impacts_per_period, existing, impulse
     ok = np.asarray(chosen.admissible(samples=SCAN_SAMPLES), dtype=bool).reshape(-1)
     x[stable[ok]] = amplitude[ok]
-    return x, orbit.impacts_per_period, existing
+    impulse[stable[ok]] = np.asarray(chosen.impulse, dtype=float).reshape(-1)[ok]
+    return x, orbit.impacts_per_period, existing, impulse
 
 
 #: The closed-form motions: the contact-free one, and the impact orbit of each root of the impulse equation.
 _ROOTS = (None, "+", "-")
 
 
-def _curve(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, root: str | None, largest_only: bool = False) -> tuple[str, int, NDArray[np.float64], NDArray[np.float64]]:
-    """(motion, impacts, |X| where stable or NaN, |X| where it exists or NaN) of one closed-form motion (``root``
-    None: contact-free, which exists everywhere) at ``f`` [Hz] (``largest_only``: see :func:`_impacting`)."""
+def _curve(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, root: str | None, largest_only: bool = False) -> tuple[str, int, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """(motion, impacts, |X| where stable or NaN, |X| where it exists or NaN, impulse per impact [N s] where stable
+    or NaN) of one closed-form motion (``root`` None: contact-free, which exists everywhere and has no impulse) at
+    ``f`` [Hz] (``largest_only``: see :func:`_impacting`)."""
     if root is None:
         x, everywhere = _linear(problem, f, coordinate)
-        return MOTIONS[1], 0, x, everywhere
-    x, impacts, existing = _impacting(problem, f, coordinate, root, largest_only)
-    return MOTIONS[2], impacts, x, existing
+        return MOTIONS[1], 0, x, everywhere, np.where(np.isfinite(x), 0.0, np.nan)
+    x, impacts, existing, impulse = _impacting(problem, f, coordinate, root, largest_only)
+    return MOTIONS[2], impacts, x, existing, impulse
 
 
-def _curves(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int) -> list[tuple[str | None, tuple[str, int, NDArray[np.float64], NDArray[np.float64]]]]:
+def _curves(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int) -> list[tuple[str | None, tuple[str, int, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]]]:
     """(root, :func:`_curve`) of every closed-form motion at frequencies ``f`` [Hz]."""
     return [(root, _curve(problem, f, coordinate, root)) for root in _ROOTS if root is None or problem.stops]
 
@@ -162,8 +170,11 @@ def closed_form_worst(problem: ImpactProblem, band: tuple[float, float], coordin
     curves = _curves(problem, f, coordinate)
     covered = np.zeros(f.size, dtype=bool)
     best = (0.0, math.nan, MOTIONS[0], 0)
-    for root, (motion, impacts, x, _) in curves:
+    impulse = 0.0
+    for root, (motion, impacts, x, _, impulses) in curves:
         covered |= np.isfinite(x)
+        if np.any(np.isfinite(impulses)):
+            impulse = max(impulse, float(np.nanmax(impulses)))
         if not np.any(np.isfinite(x)):
             continue
         for i in _maxima(x):
@@ -172,13 +183,13 @@ def closed_form_worst(problem: ImpactProblem, band: tuple[float, float], coordin
                 best = (value, where, motion, impacts)
     estimate, estimate_frequency = 0.0, math.nan
     if not covered.all():
-        impacting = [existing for root, (_, _, _, existing) in curves if root is not None]
+        impacting = [existing for root, (_, _, _, existing, _) in curves if root is not None]
         linear = curves[0][1][3]
         guess = np.fmax.reduce(impacting) if impacting else np.full(f.size, np.nan)
         guess = np.where(np.isfinite(guess), guess, linear)[~covered]
         k = int(np.argmax(guess))
         estimate, estimate_frequency = float(guess[k]), float(f[~covered][k])
-    return BandWorst(best[0], best[1], best[2], best[3], float(np.count_nonzero(~covered)) / f.size, estimate, estimate_frequency)
+    return BandWorst(best[0], best[1], best[2], best[3], float(np.count_nonzero(~covered)) / f.size, estimate, estimate_frequency, impulse)
 
 
 def _maxima(x: NDArray[np.float64]) -> list[int]:
@@ -215,7 +226,7 @@ def closed_form_at(problem: ImpactProblem, frequency: float, coordinate: int = 0
     f = np.array([float(frequency)])
     best = (0.0, math.nan, MOTIONS[0], 0)
     covered = False
-    for _, (motion, impacts, x, _) in _curves(problem, f, coordinate):
+    for _, (motion, impacts, x, _, _) in _curves(problem, f, coordinate):
         if math.isfinite(x[0]):
             covered = True
             if x[0] > best[0]:

@@ -21,6 +21,7 @@ import yaml
 from vibroimpact.kinds.design.answer import answer_text, linear_wins, mistuning_text, search_path, warnings
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, response_figure, robustness_figure, search_figure
 from vibroimpact.kinds.design.page import DesignPage, best_marks, designs_table
+from vibroimpact.kinds.design.tradeoff import front_text, tradeoff_figure
 from vibroimpact.kinds.design.study import DesignStudy
 from vibroimpact.reporting.page import write_report
 from vibroimpact.runs.runner import Runner
@@ -28,7 +29,7 @@ from vibroimpact.scene.reader import parse_scene
 
 import matplotlib.pyplot as plt
 
-FIGURES = {"design_search", "design_response", "design_robustness"}
+FIGURES = {"design_search", "design_response", "design_robustness", "design_tradeoff"}
 
 TWO_VARIABLES = {
     "name": "page_two",
@@ -194,3 +195,21 @@ def test_where_the_linear_absorber_beats_every_stop_the_answer_says_build_no_sto
     assert f"{1e3 * 1.5 * linear:.4g} mm" in text
     worse["design_sample_value"].values[0] = 0.5 * linear  # the stop wins again
     assert not linear_wins(worse) and answer_text(worse).startswith("Build Delta = ")
+
+
+def test_the_tradeoff_draws_the_front_and_the_designs(two: xr.Dataset) -> None:
+    """Every candidate with an impulse, the front's steps through exactly the flagged candidates, the recommended
+    design at its own impulse and worst case; the page's sentence spans the front."""
+    drawn = tradeoff_figure(two)
+    ax = drawn.figure.axes[0]
+    front = np.flatnonzero(two["pareto_front"].values == 1)
+    assert front.size >= 1
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    steps = next(line for label, line in lines.items() if label.startswith("the front: "))
+    assert sorted(np.asarray(steps.get_xdata(), dtype=float)) == sorted(two["impulse"].values[front])  # exact: the values drawn
+    star = lines["recommended design"]
+    r = int(two.attrs["recommended_evaluation"])
+    assert star.get_xdata()[0] == two["impulse"].values[r] and star.get_ydata()[0] == 1e3 * two["objective"].values[r]  # exact: the values drawn
+    assert np.all(two["sample_impulse"].values >= 0.0) and np.any(two["impulse"].values > 0.0)
+    assert front_text(two).startswith(f"The trade-off: {front.size} candidates form the front")
+    plt.close(drawn.figure)

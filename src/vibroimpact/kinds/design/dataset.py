@@ -23,7 +23,7 @@ from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.kinds.design.evaluate import ATTRACTOR_POINTS, MAX_BRANCH_POINTS, SCREEN_MOTIONS, SWEEP_ACCURACIES
 from vibroimpact.simulation.certified_worst import SOURCES
 from vibroimpact.kinds.design.scene import DesignSettings, safe_name
-from vibroimpact.kinds.design.search import STAGES
+from vibroimpact.kinds.design.search import STAGES, pareto_front
 from vibroimpact.kinds.design.study import Outcome
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
@@ -96,6 +96,12 @@ def design_dataset(scene: Any, outcome: Outcome) -> xr.Dataset:
     data["sample_frequency"] = xr.Variable(("evaluation", "sample"), np.array([r["frequency"] for r in ev.results]), {"units": "Hz", "long_name": "where the sample's worst case is"})
     data["sample_motion"] = _flag(np.array([r["motion"] for r in ev.results]), SCREEN_MOTIONS, "the motion that sets the sample's worst case", ("evaluation", "sample"))
     data["sample_uncovered"] = xr.Variable(("evaluation", "sample"), np.array([r["uncovered"] for r in ev.results]), {"units": "1", "long_name": "share of the band where no closed-form motion is stable"})
+    impulses = np.array([r["impulse"] for r in ev.results], dtype=float)
+    data["sample_impulse"] = xr.Variable(("evaluation", "sample"), impulses, {"units": "N s", "long_name": "largest impulse of one impact of the stable closed-form impact orbits on the scan (0: none impacts; NaN: screened by brute force)"})
+    worst_impulse = np.array([float(np.max(row)) if np.all(np.isfinite(row)) else math.nan for row in impulses])
+    data["impulse"] = xr.Variable("evaluation", worst_impulse, {"units": "N s", "long_name": "largest impulse of one impact over the samples"})
+    front = pareto_front(data["objective"].values, worst_impulse, [ev.feasible(r) for r in ev.results])
+    data["pareto_front"] = _flag(front, ("dominated", "on_the_front"), "no other feasible candidate has a smaller or equal objective and impulse, one smaller", ("evaluation",))
     for k, m in enumerate(settings.mistuning):
         offsets = np.array([row[k] for row in space.offsets])
         data[f"mistuning_{safe_name(m.name)}"] = xr.Variable("sample", offsets, {"units": "1" if m.relative else ("m" if m.name == "clearance" else "1"),

@@ -126,8 +126,9 @@ def sample_chunks(samples: int) -> list[tuple[int, ...]]:
 
 #: Fields of :class:`DesignCase`: per sample, the worst stable |X| [m] over the band, where [Hz], which motion (index of
 #: :data:`SCREEN_MOTIONS`), the uncovered share and the guess there [m], the worst |X| at the
-#: operating frequency [m] (NaN: no constraint) and which motion; ``error``: why a sample has no value.
-DESIGN_FIELDS = ("worst", "frequency", "motion", "uncovered", "estimate", "operating", "operating_motion", "error")
+#: operating frequency [m] (NaN: no constraint) and which motion; the largest impulse of one impact of a stable
+#: closed-form orbit on the scan [N s] (NaN: screened by brute force); ``error``: why a sample has no value.
+DESIGN_FIELDS = ("worst", "frequency", "motion", "uncovered", "estimate", "operating", "operating_motion", "impulse", "error")
 
 
 @dataclass(frozen=True, eq=False)
@@ -154,20 +155,22 @@ class DesignCase:
     def run(self, report: ProgressReport | None = None) -> CaseResult:
         """Arrays over ``samples`` (:data:`DESIGN_FIELDS`)."""
         n = len(self.samples)
-        out = {k: np.full(n, np.nan) for k in ("worst", "frequency", "uncovered", "estimate", "operating")}
+        out = {k: np.full(n, np.nan) for k in ("worst", "frequency", "uncovered", "estimate", "operating", "impulse")}
         motion, operating_motion = np.zeros(n, dtype=np.int8), np.zeros(n, dtype=np.int8)
         errors = [""] * n
         for row, s in enumerate(self.samples):
             try:
                 problem = self.space.problem_at(self.design, s)
-                if closed_form_refusal(problem) is None:
+                closed = closed_form_refusal(problem) is None
+                if closed:
                     found = closed_form_worst(problem, self.space.band, self.space.coordinate, self.space.scan)
                     values = (found.amplitude, found.frequency, found.uncovered, found.estimate, SCREEN_MOTIONS.index(found.motion))
+                    out["impulse"][row] = found.impulse
                 else:  # no closed form (a free mass, stops that are not one or a symmetric pair): brute force screens
                     top = band_attractors(problem, self.space.band, *BRUTE_SCREEN).maximum
                     values = (top.amplitude, top.frequency, 0.0, 0.0, SCREEN_MOTIONS.index(BRUTE))
                 if math.isfinite(self.space.operating):
-                    out["operating"][row], operating_motion[row] = _operating(problem, self.space.operating, self.space.coordinate)
+                    out["operating"][row], operating_motion[row] = _operating(problem, self.space.operating, self.space.coordinate, closed)
             except ValueError as error:  # a structure the model refuses (a mass driven non-positive ...)
                 errors[row] = f"{type(error).__name__}: {str(error)[:160]}"
                 continue
@@ -177,10 +180,11 @@ class DesignCase:
         return out | {"motion": motion, "operating_motion": operating_motion, "error": np.array(errors, dtype=str)}
 
 
-def _operating(problem: ImpactProblem, frequency: float, coordinate: int) -> tuple[float, int]:
+def _operating(problem: ImpactProblem, frequency: float, coordinate: int, closed: bool) -> tuple[float, int]:
     """The worst coexisting |X| at the operating ``frequency`` [Hz] and its motion (index of :data:`SCREEN_MOTIONS`):
-    the closed forms' (where none is stable there, the guess from the orbits that exist), else brute force's."""
-    if closed_form_refusal(problem) is not None:
+    the closed forms' (``closed``: they apply; where none is stable there, the guess from the orbits that exist), else
+    brute force's."""
+    if not closed:
         return band_attractors(problem, _around(frequency), 2, *BRUTE_SCREEN[1:]).maximum.amplitude, SCREEN_MOTIONS.index(BRUTE)
     at = closed_form_at(problem, frequency, coordinate)
     if at.uncovered == 0.0:  # exact: a share of none

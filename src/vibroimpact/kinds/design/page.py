@@ -16,6 +16,7 @@ import xarray as xr
 from vibroimpact.kinds.design.answer import DESIGN_TITLES, answer_text, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, stage_counts, unit_text, variable_names, warnings
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, design_figures
 from vibroimpact.kinds.design.scene import safe_name
+from vibroimpact.kinds.design.tradeoff import front_text, tradeoff_figure
 from vibroimpact.reporting.page import Section, Table, saved
 from vibroimpact.reporting.style import fmt
 
@@ -230,7 +231,11 @@ class DesignPage:
         d = self.dataset
         items = "".join(f"<li>{html.escape(w)}</li>" for w in warnings(d))
         first = Section("Which design to build", f"<p><b>{html.escape(answer_text(d))}</b></p>" + (f"<p>Before you build it:</p><ul>{items}</ul>" if items else ""))
-        figures = Section("Figures", "", figures=saved(design_figures(d), out))
+        drawn = design_figures(d)
+        trade = front_text(d) if "pareto_front" in d else ""
+        if trade:  # only where the screen knew impulses (closed forms), so the panel has data
+            drawn.append(tradeoff_figure(d))
+        figures = Section("Figures", f"<p>{html.escape(trade)}</p>" if trade else "", figures=saved(drawn, out))
         table = Section("The compared designs", "", tables=[Table("Worst cases of the compared designs", designs_table(d))])
         certificates = certificates_table(d)
         method = Section("How this was computed", method_text(d), tables=[Table("The certificates", certificates)] if certificates else [])

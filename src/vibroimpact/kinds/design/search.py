@@ -24,13 +24,13 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 from scipy import optimize
 
 from vibroimpact.kinds.design.evaluate import DesignCase, DesignSpace, sample_chunks
 from vibroimpact.runs.runner import CaseResult, Runner
 
-__all__ = ["STAGES", "IN_PROCESS_SAMPLES", "Evaluations", "differential_evolution", "nelder_mead_polish", "grid_search", "PENALTY", "POLISH_STEP", "POLISH_END"]
+__all__ = ["pareto_front", "STAGES", "IN_PROCESS_SAMPLES", "Evaluations", "differential_evolution", "nelder_mead_polish", "grid_search", "PENALTY", "POLISH_STEP", "POLISH_END"]
 
 #: Why a candidate was evaluated (CF flag values of ``evaluation_stage``).
 STAGES = ("global", "polish", "grid", "reference")
@@ -175,3 +175,25 @@ def grid_search(evaluations: Evaluations, points: int) -> None:
     axes = [np.linspace(0.0, 1.0, points)] * evaluations.bounds.shape[0]
     unit = np.array(list(itertools.product(*axes)))
     evaluations.evaluate(evaluations.scaled(unit), "grid")
+
+
+def pareto_front(objective: ArrayLike, impulse: ArrayLike, feasible: ArrayLike) -> NDArray[np.bool_]:
+    """Whether each candidate is on the front: feasible, both values finite, and no other such candidate at most as
+    large in both and smaller in one (equal pairs are all on it).
+
+    Parameters
+    ----------
+    objective, impulse : array_like, shape (E,)
+        The worst |X| [m] and the worst impulse of one impact [N s] of each candidate.
+    feasible : array_like of bool, shape (E,)
+        The operating constraint holds.
+    """
+    x, y = np.asarray(objective, dtype=float), np.asarray(impulse, dtype=float)
+    ok = np.asarray(feasible, dtype=bool) & np.isfinite(x) & np.isfinite(y)
+    front = np.zeros(x.size, dtype=bool)
+    index = np.flatnonzero(ok)
+    for i in index:
+        others = index[index != i]
+        dominated = (x[others] <= x[i]) & (y[others] <= y[i]) & ((x[others] < x[i]) | (y[others] < y[i]))
+        front[i] = not np.any(dominated)
+    return front

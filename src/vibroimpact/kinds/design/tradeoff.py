@@ -1,0 +1,76 @@
+"""The trade-off of a design study between the worst |X1| and the impact: the candidates no other beats on both.
+
+A rigid stop's contact force is a Dirac pulse; its measure is the impulse of one impact [N s], which the closed-form
+screen reads off every stable period-1 impact orbit it scans (``sample_impulse``). :func:`~vibroimpact.kinds.design.search.pareto_front` marks the
+feasible candidates that no other feasible candidate beats on both the objective and the worst impulse: the front of
+what the search visited (searches constrained on the impulse would push it further). :func:`tradeoff_figure` draws
+it, :func:`front_text` says it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from vibroimpact.kinds.design.answer import DESIGN_TITLES
+from vibroimpact.reporting.page import DrawnFigure
+from vibroimpact.reporting.style import Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure
+
+__all__ = ["tradeoff_figure", "front_text", "FRONT_COLOUR"]
+
+#: The front (Okabe-Ito vermillion); the recommended and the scene's designs keep their page colours.
+FRONT_COLOUR = "#D55E00"
+_DESIGN_COLOURS = ("#0072B2", "#E69F00")
+_DESIGN_MARKERS = ("*", "s")
+
+
+def tradeoff_figure(dataset: xr.Dataset) -> DrawnFigure:
+    """The worst |X1| against the worst impulse of one impact of every candidate, the front joined, the recommended
+    and the scene's designs marked."""
+    d = dataset
+    objective, impulse = 1e3 * d["objective"].values, d["impulse"].values
+    feasible, front = d["feasible"].values == 1, d["pareto_front"].values == 1
+    fig, axes = new_figure(1, panel_height=3.6, legend_rows=legend_rows(5, 2))
+    ax = axes[0]
+    shown = np.isfinite(objective) & np.isfinite(impulse)
+    ax.plot(impulse[shown & feasible], objective[shown & feasible], "o", ms=3, color="0.55", label="a candidate (keeps the operating constraint)")
+    if np.any(shown & ~feasible):
+        ax.plot(impulse[shown & ~feasible], objective[shown & ~feasible], "x", ms=4, color="0.55", label="a candidate that violates the operating constraint")
+    order = np.flatnonzero(front)[np.argsort(impulse[front])]
+    if order.size:
+        ax.step(impulse[order], objective[order], where="post", color=FRONT_COLOUR, lw=1.8, marker="o", ms=5, label=f"the front: {order.size} candidates no other beats on both")
+    for k, evaluation in enumerate((int(d.attrs.get("recommended_evaluation", -1)), 0)):
+        if evaluation >= 0 and shown[evaluation]:
+            ax.plot([impulse[evaluation]], [objective[evaluation]], _DESIGN_MARKERS[k], ms=13 if k == 0 else 9, color=_DESIGN_COLOURS[k], mec="k", mew=0.8, zorder=6, label=DESIGN_TITLES[k])
+    finish_axes(ax, "worst impulse of one impact over the band and the samples [N s]", "worst case |X1| [mm]", "Worst |X1| against the impact: the trade-off")
+    figure_legend(fig, axes, columns=2)
+    caption = Caption(f"Each of the search's {int(np.count_nonzero(shown))} candidates with both values (closed-form screen): its worst case |X1| over the band and the mistuning samples against "
+                      "the largest impulse of one impact of its stable period-1 impact orbits (scan frequencies, not refined; 0: no impacting motion is stable).")  # fmt: skip
+    caption.add("front", f"The vermillion steps join the front: the feasible candidates no other feasible candidate beats on both ({order.size}); it is the front of what the search evaluated, not of a search constrained on the impulse.")
+    if np.any(shown & ~feasible):
+        caption.add("infeasible", "Crosses violate the operating constraint and are left off the front.")
+    missing = int(np.count_nonzero(~shown))
+    if missing:
+        caption.add("missing", f"{missing} candidates have no impulse (screened by brute force, or no value) and are not drawn.")
+    return DrawnFigure(fig, "design_tradeoff", "Worst |X1| against the impact: the trade-off", caption.text())
+
+
+def front_text(dataset: xr.Dataset) -> str:
+    """One sentence on the front: its span in impulse and |X1|, and where the recommended design sits on it."""
+    d = dataset
+    front = d["pareto_front"].values == 1
+    if not np.any(front):
+        return ""
+    impulse, objective = d["impulse"].values[front], 1e3 * d["objective"].values[front]
+    recommended = int(d.attrs.get("recommended_evaluation", -1))
+    where = ""
+    if recommended >= 0 and math.isfinite(float(d["impulse"].values[recommended])):
+        on = bool(d["pareto_front"].values[recommended] == 1)
+        where = f"; the recommended design ({fmt(float(d['impulse'].values[recommended]), '.3g')} N s) is {'on it' if on else 'off it (by the screen, another candidate is no worse on both)'}"
+    if impulse.size == 1:
+        where = "; it is the recommended design" if recommended >= 0 and d["pareto_front"].values[recommended] == 1 else where
+        return f"The trade-off: one feasible candidate beats every other on both the worst |X1| and the impulse ({fmt(float(objective[0]), '.4g')} mm at {fmt(float(impulse[0]), '.3g')} N s){where}."
+    return (f"The trade-off: {int(np.count_nonzero(front))} candidates form the front, from {fmt(float(np.min(objective)), '.4g')} mm at "
+            f"{fmt(float(impulse[np.argmin(objective)]), '.3g')} N s to {fmt(float(objective[np.argmin(impulse)]), '.4g')} mm at {fmt(float(np.min(impulse)), '.3g')} N s{where}.")  # fmt: skip
