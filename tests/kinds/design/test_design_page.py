@@ -18,7 +18,7 @@ import pytest
 import xarray as xr
 import yaml
 
-from vibroimpact.kinds.design.answer import answer_text, linear_wins, mistuning_text, search_path, warnings
+from vibroimpact.kinds.design.answer import answer_text, design_titles, linear_wins, mistuning_text, search_path, warnings
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, response_figure, robustness_figure, search_figure
 from vibroimpact.kinds.design.page import DesignPage, best_marks, designs_table
 from vibroimpact.kinds.design.tradeoff import front_text, tradeoff_figure
@@ -193,6 +193,10 @@ def test_where_the_linear_absorber_beats_every_stop_the_answer_says_build_no_sto
     assert text.startswith("Build no stop: the best linear absorber of the same mass (no stop, k2 = ")
     assert f"|X1| = {1e3 * linear:.4g} mm over 15-45 Hz" in text and "the best design with a stop found, Delta = " in text
     assert f"{1e3 * 1.5 * linear:.4g} mm" in text
+    assert design_titles(worse)[0] == "best design with a stop" and design_titles(two)[0] == "recommended design"
+    labels = [t.get_text() for t in robustness_figure(worse).figure.legends[0].get_texts()]
+    assert labels[0].startswith("best design with a stop: worst ") and not any("recommended" in label for label in labels)
+    plt.close("all")
     worse["design_sample_value"].values[0] = 0.5 * linear  # the stop wins again
     assert not linear_wins(worse) and answer_text(worse).startswith("Build Delta = ")
 
@@ -212,4 +216,20 @@ def test_the_tradeoff_draws_the_front_and_the_designs(two: xr.Dataset) -> None:
     assert star.get_xdata()[0] == two["impulse"].values[r] and star.get_ydata()[0] == 1e3 * two["objective"].values[r]  # exact: the values drawn
     assert np.all(two["sample_impulse"].values >= 0.0) and np.any(two["impulse"].values > 0.0)
     assert front_text(two).startswith(f"The trade-off: {front.size} candidates form the front")
+    plt.close(drawn.figure)
+
+
+def test_the_robustness_figure_marks_a_certified_sample_above_the_screen() -> None:
+    """The golden design_paper dataset with the recommended design's worst certified sample raised to twice its
+    screened value: a vermillion star at that value, on that sample's step, and the caption names it."""
+    d = xr.open_dataset(Path(__file__).parents[2] / "golden" / "data" / "design_paper.nc").load()
+    r = int(d.attrs["recommended_evaluation"])
+    row = int(np.flatnonzero(d["certificate_evaluation"].values == r)[-1])
+    sample = int(d["certificate_sample"].values[row])
+    screened = float(d["design_sample_value"].values[0, sample])
+    d["certificate_worst"].values[row] = 2.0 * screened
+    drawn = robustness_figure(d)
+    stars = [line for line in drawn.figure.axes[0].get_lines() if line.get_marker() == "*"]
+    assert len(stars) == 1 and stars[0].get_xdata()[0] == pytest.approx(2e3 * screened, rel=1e-12)
+    assert f"sample {sample}: {2e3 * screened:.4g} mm" in drawn.caption and "certified up to" in drawn.figure.legends[0].get_texts()[0].get_text()
     plt.close(drawn.figure)

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.reporting.style import fmt
 
-__all__ = ["answer_text", "linear_wins", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
+__all__ = ["answer_text", "design_titles", "linear_wins", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
 
 _SYMBOLS = {"clearance": "Delta", "restitution": "R"}
 #: How the page names the compared designs (the dataset's ``design`` dimension, in order).
@@ -216,6 +216,12 @@ def answer_text(dataset: xr.Dataset) -> str:
     others = [f"best linear absorber of the same mass: {_mm(worst[2])}{notch(2)}"] if np.any(np.isfinite(values[2])) else []
     others.append(scene_part)
     return f"Build {variable_text(d, 0)}: worst case |X1| = {_mm(design_worst(d, 0))} {over}{notch(0)} ({'; '.join(others)})."
+
+
+def design_titles(dataset: xr.Dataset) -> tuple[str, str, str]:
+    """How the page names the compared designs: :data:`DESIGN_TITLES`, the first called "best design with a stop"
+    where the linear absorber is the one to build (:func:`linear_wins`)."""
+    return ("best design with a stop", *DESIGN_TITLES[1:]) if linear_wins(dataset) else DESIGN_TITLES  # type: ignore[return-value]
 
 
 def linear_wins(dataset: xr.Dataset) -> bool:

@@ -27,7 +27,7 @@ from matplotlib.ticker import FormatStrFormatter, LogFormatter
 from matplotlib.tri import Triangulation, TriAnalyzer
 from numpy.typing import NDArray
 
-from vibroimpact.kinds.design.answer import DESIGN_TITLES, design_evaluation, design_text, mistuning_spreads, present_designs, search_path, stage_counts, unit_text, variable_names
+from vibroimpact.kinds.design.answer import design_evaluation, design_titles, design_text, mistuning_spreads, present_designs, search_path, stage_counts, unit_text, variable_names
 from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.reporting.page import DrawnFigure
 from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure
@@ -169,7 +169,7 @@ def _path_and_designs(ax: Axes, d: xr.Dataset, pair: tuple[str, ...], box: tuple
         values = [float(d[f"design_{safe_name(n)}"].values[k]) for n in pair]
         if all(math.isfinite(v) for v in values):
             shown = [min(max(v, box[2 * j]), box[2 * j + 1]) * scales[j] for j, v in enumerate(values)]
-            ax.plot(*shown, marker=DESIGN_MARKERS[k], ms=16 if k == 0 else 10, color=DESIGN_COLOURS[k], mec="k", mew=0.9, ls="none", zorder=5, label=DESIGN_TITLES[k])
+            ax.plot(*shown, marker=DESIGN_MARKERS[k], ms=16 if k == 0 else 10, color=DESIGN_COLOURS[k], mec="k", mew=0.9, ls="none", zorder=5, label=design_titles(d)[k])
 
 
 def search_figure(dataset: xr.Dataset) -> DrawnFigure:
@@ -201,7 +201,7 @@ def search_figure(dataset: xr.Dataset) -> DrawnFigure:
         caption.add("fill", "The grey shading is interpolated linearly over triangles between the evaluated candidates (small dots), light where the worst case is small; where there are no candidates it is a guess.")
     caption.add("levels", f"The colour levels are log-spaced from the least worst case ({fmt(10 ** levels[0], '.3g')} mm) to the {OBJECTIVE_PERCENTILE:g}th percentile ({fmt(10 ** levels[-1], '.3g')} mm); worse candidates share the darkest grey.")
     caption.add("path", f"The vermillion line joins the best design so far (by the searched score) each time it improved: {len(search_path(d))} steps over {', '.join(f'{v} {k}' for k, v in counts.items() if v)} evaluations.")
-    caption.add("designs", "The blue star is the recommended design, the orange square the scene's own (drawn at the edge of the map when it lies outside the bounds).")
+    caption.add("designs", f"The blue star is the {design_titles(d)[0]}, the orange square the scene's own (drawn at the edge of the map when it lies outside the bounds).")
     if math.isfinite(float(d.attrs.get("operating_limit_m", math.nan))):
         caption.add("limit", f"Crosses mark candidates whose |X1| at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz exceeds the allowed {fmt(1e3 * d.attrs['operating_limit_m'], '.3g')} mm (the search penalised them)"
                     + ("." if projected else "; the hatched region bounded by the purple line is where that |X1|, interpolated between the candidates, exceeds it."))  # fmt: skip
@@ -238,13 +238,13 @@ def _search_line(d: xr.Dataset, name: str) -> DrawnFigure:
     for k in (1, 0):
         value, evaluation = float(d[f"design_{safe_name(name)}"].values[k]), design_evaluation(d, k)
         if math.isfinite(value) and evaluation >= 0:
-            ax.plot([min(max(value, low), high) * scale], [objective[evaluation]], marker=DESIGN_MARKERS[k], ms=16 if k == 0 else 10, color=DESIGN_COLOURS[k], mec="k", mew=0.9, ls="none", label=DESIGN_TITLES[k])
+            ax.plot([min(max(value, low), high) * scale], [objective[evaluation]], marker=DESIGN_MARKERS[k], ms=16 if k == 0 else 10, color=DESIGN_COLOURS[k], mec="k", mew=0.9, ls="none", label=design_titles(d)[k])
     ax.set_xlim(low * scale, high * scale)
     finish_axes(ax, label, "worst case |X1| [mm]", f"The search over {name}", log=True)
     _plain_log(ax)
     figure_legend(fig, axes, columns=3)
     caption = Caption(f"The worst case |X1| over the band and the mistuning samples (closed-form screen, mm, log scale) of each of the search's {d.sizes['evaluation']} candidates against {name}.")
-    caption.add("path", "The vermillion line joins the best design so far each time it improved; the blue star is the recommended design, the orange square the scene's own (at the edge when outside the bounds).")
+    caption.add("path", f"The vermillion line joins the best design so far each time it improved; the blue star is the {design_titles(d)[0]}, the orange square the scene's own (at the edge when outside the bounds).")
     return DrawnFigure(fig, "design_search", "The objective over the design variable, and the search's path", caption.text())
 
 
@@ -350,9 +350,9 @@ def response_figure(dataset: xr.Dataset) -> DrawnFigure:
         if values:
             ax.set_ylim(0.7 * min(values), 1.6 * max(values))
         ax.set_xlim(float(f[0]), float(f[-1]))
-        finish_axes(ax, _FREQUENCY, "|X1| [mm]", f"{DESIGN_TITLES[k][:1].upper()}{DESIGN_TITLES[k][1:]}: {design_text(d, k)}", log=True)
+        finish_axes(ax, _FREQUENCY, "|X1| [mm]", f"{design_titles(d)[k][:1].upper()}{design_titles(d)[k][1:]}: {design_text(d, k)}", log=True)
         _plain_log(ax)
-    entries = [Line2D([], [], color=DESIGN_COLOURS[k], lw=2.4, label=f"{DESIGN_TITLES[k]}: {design_text(d, k)}") for k in present]
+    entries = [Line2D([], [], color=DESIGN_COLOURS[k], lw=2.4, label=f"{design_titles(d)[k]}: {design_text(d, k)}") for k in present]
     entries += [Line2D([], [], **look, label=label) for kind, (look, label) in _LOOKS.items() if kind in kinds]
     caption = Caption("|X1| (fundamental amplitude of the primary mass, mm, log scale) of the compared designs without mistuning; colour: whose design.")
     if compare:
@@ -372,6 +372,18 @@ def response_figure(dataset: xr.Dataset) -> DrawnFigure:
 
 
 # ----------------------------------------------------------------------------------------- robustness
+def _certified_above(d: xr.Dataset, k: int, screened: NDArray[np.float64]) -> list[tuple[int, float]]:
+    """(sample, certified worst case [mm]) of compared design ``k``'s certificates whose value is above the screen's
+    (``screened`` [mm] per sample)."""
+    evaluation = design_evaluation(d, k)
+    out = []
+    for r in np.flatnonzero(d["certificate_evaluation"].values == evaluation) if evaluation >= 0 else ():
+        sample, certified = int(d["certificate_sample"].values[r]), 1e3 * float(d["certificate_worst"].values[r])
+        if math.isfinite(certified) and math.isfinite(float(screened[sample])) and certified > float(screened[sample]) * (1.0 + 1e-6):
+            out.append((sample, certified))
+    return out
+
+
 def robustness_figure(dataset: xr.Dataset) -> DrawnFigure:
     """The worst case of each compared design under every mistuning sample, as an empirical distribution, the
     nominal sample marked."""
@@ -380,27 +392,35 @@ def robustness_figure(dataset: xr.Dataset) -> DrawnFigure:
     samples = d.sizes["sample"]
     fig, axes = new_figure(1, panel_height=3.6, legend_rows=legend_rows(4, 2))
     ax = axes[0]
-    constant = []
+    constant, raised = [], []
     for k in range(values.shape[0]):
         row = np.sort(values[k][np.isfinite(values[k])])
         if not row.size:
             continue
         share = np.arange(row.size + 1) / row.size
+        above = _certified_above(d, k, values[k])
+        note = f" (screened; certified up to {fmt(max(c for _, c in above), '.3g')} mm)" if above else ""
         ax.step(np.r_[row[0], row], share, where="post", color=DESIGN_COLOURS[k], lw=2.0,
-                label=f"{DESIGN_TITLES[k]}: worst {fmt(row[-1], '.3g')} mm, median {fmt(float(np.median(row)), '.3g')} mm")  # fmt: skip
+                label=f"{design_titles(d)[k]}: worst {fmt(row[-1], '.3g')} mm, median {fmt(float(np.median(row)), '.3g')} mm{note}")  # fmt: skip
         nominal = float(values[k, 0])
         if math.isfinite(nominal):
             ax.plot([nominal], [np.searchsorted(row, nominal, side="right") / row.size], "o", ms=8, color=DESIGN_COLOURS[k], mec="k", mew=1.0, zorder=5)
+        for sample, certified in above:  # the screen missed this sample's worst motion: the certified one, joined to it
+            y = np.searchsorted(row, float(values[k, sample]), side="right") / row.size
+            ax.plot([float(values[k, sample]), certified], [y, y], color=CERTIFIED_COLOUR, lw=1.0, ls=":", zorder=4)
+            ax.plot([certified], [y], "*", ms=13, color=CERTIFIED_COLOUR, mec="k", mew=0.6, zorder=6)
+            raised.append((design_titles(d)[k], sample, certified))
         if row[-1] - row[0] <= 1e-9 * row[-1] and row.size > 1:
-            constant.append(DESIGN_TITLES[k])
+            constant.append(design_titles(d)[k])
     ax.set_ylim(-0.03, 1.05)
-    finite = values[np.isfinite(values) & (values > 0.0)]
+    finite = np.r_[values[np.isfinite(values) & (values > 0.0)], [c for _, _, c in raised]]
     if finite.size and np.max(finite) > 4.0 * np.min(finite):  # a design far worse than the others: a log axis keeps both legible
         ax.set_xscale("log")
         _plain_log(ax, "x")
     finish_axes(ax, "worst case |X1| over the band [mm]", "share of samples at or below", "Worst case under mistuning: empirical distribution over the samples")
     nominal = Line2D([], [], marker="o", ms=8, color="0.7", mec="k", mew=1.0, ls="none", label="the nominal design (sample 0)")
-    figure_legend(fig, axes, extra=[nominal], columns=2)
+    extra = [nominal] + ([Line2D([], [], marker="*", ms=13, color=CERTIFIED_COLOUR, mec="k", mew=0.6, ls=":", lw=1.0, label="certified worst case of a sample, where above the screen's")] if raised else [])
+    figure_legend(fig, axes, extra=extra, columns=2)
     spreads = mistuning_spreads(d)
     if samples > 1 and spreads:
         drawn = f"{samples} samples: the nominal design and {samples - 1} of a Latin hypercube (seed {d.attrs.get('mistuning_seed', '?')}) over {' and '.join(s.text() for s in spreads)}"
@@ -408,6 +428,10 @@ def robustness_figure(dataset: xr.Dataset) -> DrawnFigure:
         drawn = "one sample: no mistuning, the nominal design only"
     caption = Caption(f"Each compared design's largest stable |X1| over the band under each mistuning sample, as the share of samples at or below a value (a step per sample); {drawn}.")
     caption.add("nominal", "Dots mark the nominal design's value on each curve.")
+    if raised:
+        which = "; ".join(f"{title}, sample {sample}: {fmt(value, '.4g')} mm" for title, sample, value in raised)
+        screen = "a coarse brute force: few frequencies and starts" if np.any(d["sample_motion"].values == 3) else "the closed forms: period-1 motions"
+        caption.add("certified", f"The curves are the screen's values ({screen}). Vermillion stars mark where the certification (continuation and brute force) found a larger motion under a certified sample, joined to the screen's value ({which}): the distribution above the screen's values is not known for the other samples.")
     if constant:
         caption.add("constant", f"The same value under every sample for {' and '.join(t if t.startswith('the ') else 'the ' + t for t in constant)}: the mistuned scalars do not change it (a stop that is never reached, or none).")
     return DrawnFigure(fig, "design_robustness", "Worst case under mistuning", caption.text())

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from vibroimpact.kinds.design.answer import DESIGN_TITLES, answer_text, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, stage_counts, unit_text, variable_names, warnings
+from vibroimpact.kinds.design.answer import answer_text, design_titles, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, stage_counts, unit_text, variable_names, warnings
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, design_figures
 from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.kinds.design.tradeoff import front_text, tradeoff_figure
@@ -72,7 +72,7 @@ def designs_table(dataset: xr.Dataset) -> str:
         evaluation = design_evaluation(d, k)
         swatch = f"<span style='color:{DESIGN_COLOURS[k]}'>■</span> "
         extra = f"<br><small>{html.escape(design_text(d, k))}</small>" if k == 2 else ""
-        cells = [f"<td {_WRAP}>{swatch}{html.escape(DESIGN_TITLES[k])}{extra}</td>"] + [f"<td>{_variable_cell(d, n, k)}</td>" for n in names]
+        cells = [f"<td {_WRAP}>{swatch}{html.escape(design_titles(d)[k])}{extra}</td>"] + [f"<td>{_variable_cell(d, n, k)}</td>" for n in names]
         over = _mm(columns["over"][j])
         if evaluation >= 0 and np.any(np.isfinite(values[k])):
             s = int(np.nanargmax(values[k]))

@@ -14,7 +14,7 @@ import math
 import numpy as np
 import xarray as xr
 
-from vibroimpact.kinds.design.answer import DESIGN_TITLES
+from vibroimpact.kinds.design.answer import design_titles
 from vibroimpact.reporting.page import DrawnFigure
 from vibroimpact.reporting.style import Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure
 
@@ -43,7 +43,7 @@ def tradeoff_figure(dataset: xr.Dataset) -> DrawnFigure:
         ax.step(impulse[order], objective[order], where="post", color=FRONT_COLOUR, lw=1.8, marker="o", ms=5, label=f"the front: {order.size} candidates no other beats on both")
     for k, evaluation in enumerate((int(d.attrs.get("recommended_evaluation", -1)), 0)):
         if evaluation >= 0 and shown[evaluation]:
-            ax.plot([impulse[evaluation]], [objective[evaluation]], _DESIGN_MARKERS[k], ms=13 if k == 0 else 9, color=_DESIGN_COLOURS[k], mec="k", mew=0.8, zorder=6, label=DESIGN_TITLES[k])
+            ax.plot([impulse[evaluation]], [objective[evaluation]], _DESIGN_MARKERS[k], ms=13 if k == 0 else 9, color=_DESIGN_COLOURS[k], mec="k", mew=0.8, zorder=6, label=design_titles(d)[k])
     finish_axes(ax, "worst impulse of one impact over the band and the samples [N s]", "worst case |X1| [mm]", "Worst |X1| against the impact: the trade-off")
     figure_legend(fig, axes, columns=2)
     caption = Caption(f"Each of the search's {int(np.count_nonzero(shown))} candidates with both values (closed-form screen): its worst case |X1| over the band and the mistuning samples against "
@@ -68,9 +68,9 @@ def front_text(dataset: xr.Dataset) -> str:
     where = ""
     if recommended >= 0 and math.isfinite(float(d["impulse"].values[recommended])):
         on = bool(d["pareto_front"].values[recommended] == 1)
-        where = f"; the recommended design ({fmt(float(d['impulse'].values[recommended]), '.3g')} N s) is {'on it' if on else 'off it (by the screen, another candidate is no worse on both)'}"
+        where = f"; the {design_titles(d)[0]} ({fmt(float(d['impulse'].values[recommended]), '.3g')} N s) is {'on it' if on else 'off it (by the screen, another candidate is no worse on both)'}"
     if impulse.size == 1:
-        where = "; it is the recommended design" if recommended >= 0 and d["pareto_front"].values[recommended] == 1 else where
+        where = f"; it is the {design_titles(d)[0]}" if recommended >= 0 and d["pareto_front"].values[recommended] == 1 else where
         return f"The trade-off: one feasible candidate beats every other on both the worst |X1| and the impulse ({fmt(float(objective[0]), '.4g')} mm at {fmt(float(impulse[0]), '.3g')} N s){where}."
     return (f"The trade-off: {int(np.count_nonzero(front))} candidates form the front, from {fmt(float(np.min(objective)), '.4g')} mm at "
             f"{fmt(float(impulse[np.argmin(objective)]), '.3g')} N s to {fmt(float(objective[np.argmin(impulse)]), '.4g')} mm at {fmt(float(np.min(impulse)), '.3g')} N s{where}.")  # fmt: skip
