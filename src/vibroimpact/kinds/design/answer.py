@@ -259,9 +259,9 @@ def warnings(dataset: xr.Dataset) -> list[str]:
         uncovered = float(np.nanmax(d["sample_uncovered"].values[recommended]))
         checked = "the certification found the motions there by brute force" if rows.size else "nothing checked it"
         if uncovered > 0.0:
-            out.append(f"On {fmt(100 * uncovered, '.2g')} % of the band no period-1 motion of the recommended design is stable: there its motion is of a kind the closed forms do not know (more impacts, a longer period, or not periodic); the screen guessed its size from the unstable orbits, and {checked}.")
+            out.append(f"On {fmt(100 * uncovered, '.2g')} % of the band no period-1 motion of the {design_titles(d)[0]} is stable: there its motion is of a kind the closed forms do not know (more impacts, a longer period, or not periodic); the screen guessed its size from the unstable orbits, and {checked}.")
         if not rows.size:
-            out.append("The recommended design was not certified (certify: candidates 0): its worst case is the screen's alone.")
+            out.append(f"The {design_titles(d)[0]} was not certified (certify: candidates 0): its worst case is the screen's alone.")
         for r in rows:
             worst, screened = float(d["certificate_worst"].values[r]), float(d["certificate_screened"].values[r])
             if math.isfinite(worst) and worst > screened * (1.0 + 1e-6):
@@ -272,7 +272,7 @@ def warnings(dataset: xr.Dataset) -> list[str]:
     ridge = float(d.attrs.get("equal_peak_difference", math.nan))
     if math.isfinite(ridge) and ridge < 0.02:
         f1, f2 = (float(x) for x in np.atleast_1d(d.attrs["equal_peak_frequencies_Hz"]))
-        out.append(f"The recommended design sits on an equal-peak ridge: its two largest band maxima ({fmt(f1, '.4g')} and {fmt(f2, '.4g')} Hz) differ by {fmt(100 * ridge, '.2g')} %; a small change of any variable raises one of them.")
+        out.append(f"The {design_titles(d)[0]} sits on an equal-peak ridge: its two largest band maxima ({fmt(f1, '.4g')} and {fmt(f2, '.4g')} Hz) differ by {fmt(100 * ridge, '.2g')} %; a small change of any variable raises one of them.")
     if d.sizes.get("certificate", 0):
         points = d.sizes.get("attractor_point", 0)
         out.append(f"What the certification can miss: an attractor whose basin none of its runs entered (sweeps both ways and two more starts at each of {points} frequencies), or one that lives only between those frequencies; "

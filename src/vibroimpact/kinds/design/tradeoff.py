@@ -13,6 +13,8 @@ import math
 
 import numpy as np
 import xarray as xr
+from matplotlib.axes import Axes
+from numpy.typing import NDArray
 
 from vibroimpact.kinds.design.answer import design_titles
 from vibroimpact.reporting.page import DrawnFigure
@@ -45,16 +47,33 @@ def tradeoff_figure(dataset: xr.Dataset) -> DrawnFigure:
         if evaluation >= 0 and shown[evaluation]:
             ax.plot([impulse[evaluation]], [objective[evaluation]], _DESIGN_MARKERS[k], ms=13 if k == 0 else 9, color=_DESIGN_COLOURS[k], mec="k", mew=0.8, zorder=6, label=design_titles(d)[k])
     finish_axes(ax, "worst impulse of one impact over the band and the samples [N s]", "worst case |X1| [mm]", "Worst |X1| against the impact: the trade-off")
+    outside = _zoom(ax, impulse, objective, front | (np.arange(impulse.size) == 0), shown)
     figure_legend(fig, axes, columns=2)
     caption = Caption(f"Each of the search's {int(np.count_nonzero(shown))} candidates with both values (closed-form screen): its worst case |X1| over the band and the mistuning samples against "
                       "the largest impulse of one impact of its stable period-1 impact orbits (scan frequencies, not refined; 0: no impacting motion is stable).")  # fmt: skip
     caption.add("front", f"The vermillion steps join the front: the feasible candidates no other feasible candidate beats on both ({order.size}); it is the front of what the search evaluated, not of a search constrained on the impulse.")
     if np.any(shown & ~feasible):
         caption.add("infeasible", "Crosses violate the operating constraint and are left off the front.")
+    if outside:
+        caption.add("zoom", f"Drawn around the front and the scene's design: {outside} candidates with a larger impulse or |X1| lie beyond the axes.")
     missing = int(np.count_nonzero(~shown))
     if missing:
         caption.add("missing", f"{missing} candidates have no impulse (screened by brute force, or no value) and are not drawn.")
     return DrawnFigure(fig, "design_tradeoff", "Worst |X1| against the impact: the trade-off", caption.text())
+
+
+def _zoom(ax: Axes, impulse: NDArray[np.float64], objective: NDArray[np.float64], keep: NDArray[np.bool_], shown: NDArray[np.bool_]) -> int:
+    """Limit the axes to 1.5 times the impulse and 1.3 times the |X1| of the ``keep`` candidates (the front and the
+    scene's design), so that far worse candidates do not squeeze the front into a corner; how many lie beyond."""
+    kept = keep & shown
+    if not np.any(kept):
+        return 0
+    right = 1.5 * float(np.max(impulse[kept])) if float(np.max(impulse[kept])) > 0.0 else float(np.max(impulse[shown], initial=1.0))
+    top = 1.3 * float(np.max(objective[kept]))
+    bottom = 0.9 * float(np.min(objective[shown]))
+    ax.set_xlim(-0.02 * right, right)
+    ax.set_ylim(bottom, top)
+    return int(np.count_nonzero(shown & ((impulse > right) | (objective > top))))
 
 
 def front_text(dataset: xr.Dataset) -> str:
