@@ -183,7 +183,7 @@ class OnsetSteps:
                 break
             if previous is not None:
                 secant = point.z - previous.z
-                if not np.linalg.norm(secant) > 0.0:  # the same orbit again (the ladder's margins collapsed): no way on
+                if not np.linalg.norm(secant) > 1e-12 * max(np.linalg.norm(point.z), 1e-300):  # the same orbit again: no way on
                     continue
                 point = dataclasses.replace(point, tangent=self.arc.tangent(point.jacobian, secant / np.linalg.norm(secant)))
             points.append(point)

@@ -63,7 +63,7 @@ def test_a_candidate_the_certification_raises_gives_way_to_the_next_distinct_one
     certified = {3e-3: 3.0, 2e-3: 2.0, 2.1e-3: 2.0, 4e-3: 1.5, 4.5e-3: 1.6}
     outcome, runner = _outcome(screened, certified)
     _certify(outcome, runner, lambda message: None)  # type: ignore[arg-type]
-    assert runner.batches == [[(2e-3, 0), (3e-3, 0)], [(4e-3, 0)]]  # the scene's design with the first, nominal only
+    assert runner.batches == [[(2e-3, 0), (3e-3, 0)], [(4e-3, 0)]]  # exact: the designs passed on; the scene's design with the first, nominal only
     assert outcome.recommended == 3
     assert outcome.corrected[1] == pytest.approx(2.0, rel=1e-12) and outcome.corrected[3] == pytest.approx(1.5, rel=1e-12)
 
@@ -80,8 +80,19 @@ def test_the_rounds_stop_at_the_budget_and_recommend_the_best_certified() -> Non
     certified = {3e-3: 3.0, 2e-3: 2.0, 4e-3: 2.5, 1.2e-3: 1.4}
     outcome, runner = _outcome(screened, certified, candidates=2)
     _certify(outcome, runner, lambda message: None)  # type: ignore[arg-type]
-    assert [batch[0][0] for batch in runner.batches] == [2e-3, 4e-3]  # 1.2 mm, which would win, is past the budget
+    assert [batch[0][0] for batch in runner.batches] == [2e-3, 4e-3]  # exact: the designs passed on; 1.2 mm, which would win, is past the budget
     assert outcome.recommended == 1 and math.isclose(outcome.corrected[1], 2.0)
     outcome, runner = _outcome(screened, certified, candidates=0)
     _certify(outcome, runner, lambda message: None)  # type: ignore[arg-type]
     assert runner.batches == [] and outcome.recommended == 1  # none certified: the best screened
+
+
+def test_the_scene_s_design_is_not_certified_twice() -> None:
+    """The scene's design (3 mm), certified at its nominal sample with the first candidate, comes up again in the
+    screen's order: only what is left of it is certified (every sample equal here: nothing), no duplicate row."""
+    screened = {3e-3: 1.2, 2e-3: 1.0}
+    outcome, runner = _outcome(screened, {3e-3: 1.2, 2e-3: 2.0})
+    _certify(outcome, runner, lambda message: None)  # type: ignore[arg-type]
+    assert runner.batches == [[(2e-3, 0), (3e-3, 0)]]  # exact: the designs passed on
+    pairs = [(c["evaluation"], c["sample"]) for c in outcome.certified]
+    assert len(pairs) == len(set(pairs)) and outcome.recommended == 0

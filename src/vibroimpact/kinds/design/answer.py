@@ -253,7 +253,8 @@ def warnings(dataset: xr.Dataset) -> list[str]:
     if math.isfinite(limit) and recommended >= 0:
         operating = float(d["operating_amplitude"].values[recommended])
         if not operating <= limit:
-            out.append(f"No candidate keeps the notch: at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz |X1| reaches {_mm(operating)} against the allowed {_mm(limit)}; the recommendation is the least bad.")
+            tail = "; the best linear absorber does" if linear_wins(d) else "; the recommendation is the least bad"
+            out.append(f"No design with a stop keeps the notch: at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz |X1| reaches {_mm(operating)} against the allowed {_mm(limit)}{tail}.")
     if recommended >= 0:
         rows = np.flatnonzero(d["certificate_evaluation"].values == recommended)
         uncovered = float(np.nanmax(d["sample_uncovered"].values[recommended]))

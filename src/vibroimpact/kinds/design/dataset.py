@@ -97,9 +97,12 @@ def design_dataset(scene: Any, outcome: Outcome) -> xr.Dataset:
     data["sample_motion"] = _flag(np.array([r["motion"] for r in ev.results]), SCREEN_MOTIONS, "the motion that sets the sample's worst case", ("evaluation", "sample"))
     data["sample_uncovered"] = xr.Variable(("evaluation", "sample"), np.array([r["uncovered"] for r in ev.results]), {"units": "1", "long_name": "share of the band where no closed-form motion is stable"})
     impulses = np.array([r["impulse"] for r in ev.results], dtype=float)
-    data["sample_impulse"] = xr.Variable(("evaluation", "sample"), impulses, {"units": "N s", "long_name": "largest impulse of one impact of the stable closed-form impact orbits on the scan (0: none impacts; NaN: screened by brute force)"})
-    worst_impulse = np.array([float(np.max(row)) if np.all(np.isfinite(row)) else math.nan for row in impulses])
-    data["impulse"] = xr.Variable("evaluation", worst_impulse, {"units": "N s", "long_name": "largest impulse of one impact over the samples"})
+    data["sample_impulse"] = xr.Variable(("evaluation", "sample"), impulses, {"units": "N s", "long_name": "largest impulse of one impact of the stable closed-form impact orbits on the scan (0: none impacts; NaN: screened by brute force; a lower bound where the band is partly uncovered)"})
+    uncovered = np.array([r["uncovered"] for r in ev.results], dtype=float)
+    # where a sample's band is partly uncovered its impulse is a lower bound; an impulse of 0 there (no impact orbit
+    # stable anywhere) says nothing about the unknown motions: no value, off the front
+    worst_impulse = np.array([float(np.max(row)) if np.all(np.isfinite(row)) and not (np.max(row) <= 0.0 and np.any(gap > 0.0)) else math.nan for row, gap in zip(impulses, uncovered)])
+    data["impulse"] = xr.Variable("evaluation", worst_impulse, {"units": "N s", "long_name": "largest impulse of one impact over the samples (a lower bound where a sample's band is partly uncovered; NaN where it is 0 there)"})
     front = pareto_front(data["objective"].values, worst_impulse, [ev.feasible(r) for r in ev.results])
     data["pareto_front"] = _flag(front, ("dominated", "on_the_front"), "no other feasible candidate has a smaller or equal objective and impulse, one smaller", ("evaluation",))
     for k, m in enumerate(settings.mistuning):

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from vibroimpact.kinds.design.answer import answer_text, design_titles, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, stage_counts, unit_text, variable_names, warnings
+from vibroimpact.kinds.design.answer import answer_text, design_titles, linear_wins, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, stage_counts, unit_text, variable_names, warnings
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, design_figures
 from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.kinds.design.tradeoff import front_text, tradeoff_figure
@@ -99,7 +99,7 @@ def designs_table(dataset: xr.Dataset) -> str:
 def _who(dataset: xr.Dataset, evaluation: int) -> str:
     """How the page names an evaluated candidate."""
     if evaluation == int(dataset.attrs.get("recommended_evaluation", -1)):
-        return "the recommended design"
+        return f"the {design_titles(dataset)[0]}"
     return "the scene's design" if evaluation == 0 else f"candidate {evaluation}"
 
 
@@ -209,7 +209,7 @@ def cost_text(dataset: xr.Dataset) -> str:
                        f"({fmt(1e3 * screened, '.4g')} mm against the certified {fmt(1e3 * worst, '.4g')} mm): it knows only period-1 motions.")  # fmt: skip
     else:
         screen_part = ""
-    return (f"<p><b>What the exact worst case costs.</b> The continuation located the recommended design's maximum in {fmt(continuation, '.3g')} s (to its "
+    return (f"<p><b>What the exact worst case costs.</b> The continuation located the {design_titles(d)[0]}'s maximum in {fmt(continuation, '.3g')} s (to its "
             f"tolerance, ~1e-10). A stepped brute-force sweep (one direction, its measured cost per point) reaching the same maximum would need "
             f"{'; '.join(cells)}. {summary}{screen_part}</p>")  # fmt: skip
 
@@ -230,7 +230,7 @@ class DesignPage:
         """The answer and the warnings, the figures, the compared designs, how it was computed."""
         d = self.dataset
         items = "".join(f"<li>{html.escape(w)}</li>" for w in warnings(d))
-        first = Section("Which design to build", f"<p><b>{html.escape(answer_text(d))}</b></p>" + (f"<p>Before you build it:</p><ul>{items}</ul>" if items else ""))
+        first = Section("Which design to build", f"<p><b>{html.escape(answer_text(d))}</b></p>" + (f"<p>{'Before you build a stop' if linear_wins(d) else 'Before you build it'}:</p><ul>{items}</ul>" if items else ""))
         drawn = design_figures(d)
         trade = front_text(d) if "pareto_front" in d else ""
         if trade:  # only where the screen knew impulses (closed forms), so the panel has data

@@ -167,14 +167,17 @@ def _certify_round(outcome: Outcome, runner: Runner, targets: list[int], chosen:
     one's score is raised by the ratio of its certified worst case to its screened objective, where larger."""
     evaluations = outcome.evaluations
     cases, owners = [], []
+    done = {(c["evaluation"], c["sample"]) for c in outcome.certified}  # the scene's design, certified in the first round
     for i in targets:
         values = evaluations.values(evaluations.results[i])
         worst_sample = int(np.nanargmax(values)) if np.any(np.isfinite(values)) and i in chosen else 0  # the scene's design: nominal only
         for sample in dict.fromkeys((0, worst_sample)):
+            if (i, sample) in done:
+                continue
             cases.append(CertifyCase(outcome.space, tuple(float(v) for v in evaluations.designs[i]), sample))
             owners.append((i, sample))
     start = time.perf_counter()
-    results = runner.map(cases)
+    results = runner.map(cases) if cases else []
     outcome.wall_times["certification"] += time.perf_counter() - start
     for (i, sample), result in zip(owners, results):
         screened = float(evaluations.values(evaluations.results[i])[sample])

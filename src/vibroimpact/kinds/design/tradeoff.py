@@ -47,15 +47,16 @@ def tradeoff_figure(dataset: xr.Dataset) -> DrawnFigure:
         if evaluation >= 0 and shown[evaluation]:
             ax.plot([impulse[evaluation]], [objective[evaluation]], _DESIGN_MARKERS[k], ms=13 if k == 0 else 9, color=_DESIGN_COLOURS[k], mec="k", mew=0.8, zorder=6, label=design_titles(d)[k])
     finish_axes(ax, "worst impulse of one impact over the band and the samples [N s]", "worst case |X1| [mm]", "Worst |X1| against the impact: the trade-off")
-    outside = _zoom(ax, impulse, objective, front | (np.arange(impulse.size) == 0), shown)
+    outside = _zoom(ax, impulse, objective, front | np.isin(np.arange(impulse.size), [0, int(d.attrs.get("recommended_evaluation", -1))]), shown)
     figure_legend(fig, axes, columns=2)
     caption = Caption(f"Each of the search's {int(np.count_nonzero(shown))} candidates with both values (closed-form screen): its worst case |X1| over the band and the mistuning samples against "
-                      "the largest impulse of one impact of its stable period-1 impact orbits (scan frequencies, not refined; 0: no impacting motion is stable).")  # fmt: skip
+                      "the largest impulse of one impact of its stable period-1 impact orbits (scan frequencies, not refined; 0: only contact-free motions are stable). "
+                      "Where a candidate's band is partly uncovered (motions the closed forms do not know) its impulse is a lower bound, and is not drawn where it would read 0.")  # fmt: skip
     caption.add("front", f"The vermillion steps join the front: the feasible candidates no other feasible candidate beats on both ({order.size}); it is the front of what the search evaluated, not of a search constrained on the impulse.")
     if np.any(shown & ~feasible):
         caption.add("infeasible", "Crosses violate the operating constraint and are left off the front.")
     if outside:
-        caption.add("zoom", f"Drawn around the front and the scene's design: {outside} candidates with a larger impulse or |X1| lie beyond the axes.")
+        caption.add("zoom", f"Drawn around the front and the compared designs: {outside} candidates with a larger impulse or |X1| lie beyond the axes.")
     missing = int(np.count_nonzero(~shown))
     if missing:
         caption.add("missing", f"{missing} candidates have no impulse (screened by brute force, or no value) and are not drawn.")
@@ -63,12 +64,12 @@ def tradeoff_figure(dataset: xr.Dataset) -> DrawnFigure:
 
 
 def _zoom(ax: Axes, impulse: NDArray[np.float64], objective: NDArray[np.float64], keep: NDArray[np.bool_], shown: NDArray[np.bool_]) -> int:
-    """Limit the axes to 1.5 times the impulse and 1.3 times the |X1| of the ``keep`` candidates (the front and the
-    scene's design), so that far worse candidates do not squeeze the front into a corner; how many lie beyond."""
+    """Limit the axes to 1.5 times the impulse and 1.3 times the |X1| of the ``keep`` candidates (the front, the
+    recommended and the scene's designs), so that far worse candidates do not squeeze the front into a corner; how many lie beyond."""
     kept = keep & shown
     if not np.any(kept):
         return 0
-    right = 1.5 * float(np.max(impulse[kept])) if float(np.max(impulse[kept])) > 0.0 else float(np.max(impulse[shown], initial=1.0))
+    right = 1.5 * max(float(np.max(impulse[kept])), 0.1 * float(np.max(impulse[shown])), 1e-12)
     top = 1.3 * float(np.max(objective[kept]))
     bottom = 0.9 * float(np.min(objective[shown]))
     ax.set_xlim(-0.02 * right, right)
