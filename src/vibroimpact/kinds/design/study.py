@@ -183,16 +183,21 @@ def _certify_round(outcome: Outcome, runner: Runner, targets: list[int], chosen:
         screened = float(evaluations.values(evaluations.results[i])[sample])
         outcome.certified.append({"evaluation": i, "sample": sample, "screened": screened, **result})
     for i in targets:
-        certified = max((float(c["worst"]) for c in outcome.certified if c["evaluation"] == i and math.isfinite(float(c["worst"]))), default=math.nan)
+        certified = _certified_max(outcome, i)
         objective = evaluations.objective(evaluations.results[i])
         # a certified worst case above the screen's raises the objective, and the score with it (the penalty kept)
         outcome.corrected[i] = evaluations.scores[i] * max(1.0, certified / objective) if math.isfinite(certified) and objective > 0.0 else evaluations.scores[i]
 
 
+def _certified_max(outcome: Outcome, i: int) -> float:
+    """The largest certified worst case of candidate ``i`` over its certificates [m] (NaN: none has a value)."""
+    return max((float(c["worst"]) for c in outcome.certified if c["evaluation"] == i and math.isfinite(float(c["worst"]))), default=math.nan)
+
+
 def _worst_text(outcome: Outcome, i: int) -> str:
     """``screened 1.712 mm, certified 2.506 mm`` of candidate ``i`` (its largest certified worst case)."""
     screened = outcome.evaluations.objective(outcome.evaluations.results[i])
-    certified = max((float(c["worst"]) for c in outcome.certified if c["evaluation"] == i and math.isfinite(float(c["worst"]))), default=math.nan)
+    certified = _certified_max(outcome, i)
     return f"screened {1e3 * screened:.4g} mm, certified {1e3 * certified:.4g} mm"
 
 

@@ -17,15 +17,14 @@ from matplotlib.axes import Axes
 from numpy.typing import NDArray
 
 from vibroimpact.kinds.design.answer import design_titles
+from vibroimpact.kinds.design.figures import DESIGN_COLOURS, DESIGN_MARKERS, PATH_COLOUR
 from vibroimpact.reporting.page import DrawnFigure
 from vibroimpact.reporting.style import Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure
 
 __all__ = ["tradeoff_figure", "front_text", "FRONT_COLOUR"]
 
-#: The front (Okabe-Ito vermillion); the recommended and the scene's designs keep their page colours.
-FRONT_COLOUR = "#D55E00"
-_DESIGN_COLOURS = ("#0072B2", "#E69F00")
-_DESIGN_MARKERS = ("*", "s")
+#: The front (Okabe-Ito vermillion, the search path's colour); the compared designs keep their page colours.
+FRONT_COLOUR = PATH_COLOUR
 
 
 def tradeoff_figure(dataset: xr.Dataset) -> DrawnFigure:
@@ -45,7 +44,7 @@ def tradeoff_figure(dataset: xr.Dataset) -> DrawnFigure:
         ax.step(impulse[order], objective[order], where="post", color=FRONT_COLOUR, lw=1.8, marker="o", ms=5, label=f"the front: {order.size} candidates no other beats on both")
     for k, evaluation in enumerate((int(d.attrs.get("recommended_evaluation", -1)), 0)):
         if evaluation >= 0 and shown[evaluation]:
-            ax.plot([impulse[evaluation]], [objective[evaluation]], _DESIGN_MARKERS[k], ms=13 if k == 0 else 9, color=_DESIGN_COLOURS[k], mec="k", mew=0.8, zorder=6, label=design_titles(d)[k])
+            ax.plot([impulse[evaluation]], [objective[evaluation]], DESIGN_MARKERS[k], ms=13 if k == 0 else 9, color=DESIGN_COLOURS[k], mec="k", mew=0.8, zorder=6, label=design_titles(d)[k])
     finish_axes(ax, "worst impulse of one impact over the band and the samples [N s]", "worst case |X1| [mm]", "Worst |X1| against the impact: the trade-off")
     outside = _zoom(ax, impulse, objective, front | np.isin(np.arange(impulse.size), [0, int(d.attrs.get("recommended_evaluation", -1))]), shown)
     figure_legend(fig, axes, columns=2)
