@@ -122,6 +122,21 @@ def test_a_case_that_fails_its_checksum_is_computed_again(tmp_path: Path) -> Non
     store = StudyStore(tmp_path / "c.zarr", "f")
     store.save_case("exact-1", {"x": np.arange(1000.0), "y": np.ones(4)})
     assert store.load_case("exact-1", ("x", "y")) is not None and store.damaged_cases == 0
-    chunk = next(c for c in (tmp_path / "c.zarr" / "cases" / "exact-1" / "x").iterdir() if not c.name.startswith("."))
+    chunk = next(c for c in (tmp_path / "c.zarr" / "cases" / "exact-1").iterdir() if not c.name.startswith("."))  # its one chunk
     chunk.write_bytes(chunk.read_bytes()[:-8] + bytes(8))
     assert StudyStore(tmp_path / "c.zarr", "f").load_case("exact-1", ("x", "y")) is None
+
+
+def test_a_case_cut_off_or_without_its_chunk_is_computed_again(tmp_path: Path) -> None:
+    store = StudyStore(tmp_path / "c.zarr", "f")
+    for name in ("exact-1", "exact-2"):
+        store.save_case(name, {"x": np.arange(10.0), "note": np.array("a text")})
+    (tmp_path / "c.zarr" / "cases" / "exact-1" / "0").unlink()  # the packed fields lost: read as zeros
+    (tmp_path / "c.zarr" / "cases" / "exact-2" / ".zattrs").unlink()  # killed before its checksum was written
+    again = StudyStore(tmp_path / "c.zarr", "f")
+    assert again.case_count() == 1, "only the case with a checksum counts as finished"
+    assert again.load_case("exact-1", ("x",)) is None and again.damaged_cases == 1
+    assert again.load_case("exact-2", ("x",)) is None and again.damaged_cases == 1, "a case cut off is not damaged: it was never finished"
+    again.save_case("exact-1", {"x": np.arange(10.0), "note": np.array("a text")})
+    loaded = again.load_case("exact-1", ("x", "note"))
+    assert loaded is not None and np.array_equal(loaded["x"], np.arange(10.0)) and str(loaded["note"]) == "a text"
