@@ -30,14 +30,16 @@ from scipy import optimize
 from vibroimpact.kinds.design.evaluate import DesignCase, DesignSpace, sample_chunks
 from vibroimpact.runs.runner import CaseResult, Runner
 
-__all__ = ["pareto_front", "STAGES", "IN_PROCESS_SAMPLES", "Evaluations", "differential_evolution", "nelder_mead_polish", "grid_search", "PENALTY", "POLISH_STEP", "POLISH_END"]
+__all__ = ["pareto_front", "STAGES", "WHOLE_CANDIDATES", "Evaluations", "differential_evolution", "nelder_mead_polish", "grid_search", "PENALTY", "POLISH_STEP", "POLISH_END"]
 
 #: Why a candidate was evaluated (CF flag values of ``evaluation_stage``).
 STAGES = ("global", "polish", "grid", "reference")
 #: Score raised by this times the relative excess of the operating |X| over its limit [-].
 PENALTY = 10.0
-#: A single candidate with at most this many samples is evaluated in this process, not sent to the workers.
-IN_PROCESS_SAMPLES = 12
+#: A batch of at least this many candidates sends each whole to a worker (one case, all its samples); a smaller batch
+#: (a polish step, the scene's own design) splits each candidate's samples over a few cases, so that the workers share
+#: even one candidate. Depends on the batch alone: a rerun asks for the same cases whatever the workers.
+WHOLE_CANDIDATES = 8
 #: The polish reports how far it got every this many evaluations.
 POLISH_REPORT = 10
 #: The polish's first simplex and its last, shares of each variable's range [-].
@@ -75,9 +77,8 @@ class Evaluations:
         """The scores of ``designs`` (shape (m, n), in the variables' units), each kept; ``quiet``: without the
         runner's progress bar (a polish step of a second or two; the polish says how it goes)."""
         designs = np.atleast_2d(np.asarray(designs, dtype=float))
-        # one candidate with few samples (a polish step) runs here whole: a dask round trip costs more than its samples
-        few = designs.shape[0] == 1 and self.space.samples <= IN_PROCESS_SAMPLES
-        chunks = [tuple(range(self.space.samples))] if few else sample_chunks(self.space.samples)
+        whole = designs.shape[0] >= WHOLE_CANDIDATES
+        chunks = [tuple(range(self.space.samples))] if whole else sample_chunks(self.space.samples)
         shown = self.runner.progress
         self.runner.progress = shown and not quiet
         try:

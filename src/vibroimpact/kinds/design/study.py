@@ -28,9 +28,9 @@ from numpy.typing import NDArray
 from scipy.stats import qmc
 
 from vibroimpact.analysis.linear_optimum import LinearAbsorberOptimum, band_peak, optimal_linear_absorber
-from vibroimpact.kinds.design.evaluate import CertifyCase, DesignSpace
+from vibroimpact.kinds.design.evaluate import CHUNKS, CertifyCase, DesignSpace
 from vibroimpact.kinds.design.scene import DesignSettings
-from vibroimpact.kinds.design.search import IN_PROCESS_SAMPLES, Evaluations, nelder_mead_polish, differential_evolution, grid_search
+from vibroimpact.kinds.design.search import Evaluations, nelder_mead_polish, differential_evolution, grid_search
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import Costs, Estimate
@@ -222,9 +222,9 @@ class DesignStudy:
         search = settings.search
         candidates = search.points**n if search.method == "grid" else search.population * n * (search.generations + 1) + (POLISH_BUDGET if search.polish else 0)
         screen = candidates * samples * SECONDS_PER_SAMPLE
-        # a polish step's few samples run in this process, one candidate after the other: no worker shares them
-        serial = POLISH_BUDGET * samples * SECONDS_PER_SAMPLE if search.method != "grid" and search.polish and samples <= IN_PROCESS_SAMPLES else 0.0
         certify = (2 * settings.certified + 1) * SECONDS_PER_CERTIFICATE  # at most: the rounds may stop after the first
-        wall = (screen - serial) / max(jobs, 1) + serial + certify / max(min(jobs, 2), 1) + 10.0
+        # a polish step's samples are shared by at most CHUNKS workers (one candidate at a time)
+        polish = POLISH_BUDGET * samples * SECONDS_PER_SAMPLE if search.method != "grid" and search.polish else 0.0
+        wall = (screen - polish) / max(jobs, 1) + polish / max(min(jobs, CHUNKS, samples), 1) + certify / max(min(jobs, 2), 1) + 10.0
         return Estimate(wall_time=wall, memory=400e6, parts={"search": screen, "certification": certify, "report": 10.0},
                         points={"search": f"up to {candidates} candidates x {samples} samples"})  # fmt: skip
