@@ -96,3 +96,27 @@ def test_the_scene_s_design_is_not_certified_twice() -> None:
     assert runner.batches == [[(2e-3, 0), (3e-3, 0)]]  # exact: the designs passed on
     pairs = [(c["evaluation"], c["sample"]) for c in outcome.certified]
     assert len(pairs) == len(set(pairs)) and outcome.recommended == 0
+
+
+def test_with_a_quantile_a_certificate_raises_its_sample_not_the_whole_objective() -> None:
+    """quantile 0.5 over 5 samples (1.0 ... 1.4 mm screened, the median 1.2 mm): certified 1.35 mm at the nominal
+    sample and its worst one, the nominal's value rises to 1.35 and the worst keeps its 1.4 (certification never
+    lowers a value): the median is 1.3 mm, not the 1.35 that scaling the objective by the largest certificate gave."""
+    document = copy.deepcopy(SCENE)
+    document["design"]["robust"] = {"clearance": 0.0002, "samples": 4, "quantile": 0.5, "seed": 1}
+    document["design"]["certify"]["candidates"] = 1
+    scene = parse_scene(document, text=yaml.safe_dump(document))
+    space = design_space(scene)
+    runner = TableRunner({2e-3: 1.35, 3e-3: 1.5})
+    evaluations = Evaluations(space, np.array([[0.001, 0.005], [0.0, 0.8]]), runner, quantile=0.5)  # type: ignore[arg-type]
+    for k, (clearance, values) in enumerate({3e-3: [1.5] * 5, 2e-3: [1.0, 1.1, 1.2, 1.3, 1.4]}.items()):
+        evaluations.designs.append(np.array([clearance, 0.2]))
+        evaluations.stages.append(3 if k == 0 else 0)
+        result = {"worst": np.array(values), "uncovered": np.zeros(5), "estimate": np.zeros(5)}
+        evaluations.results.append(result)
+        evaluations.scores.append(evaluations.score(result))
+    assert evaluations.scores[1] == pytest.approx(1.2, rel=1e-12)
+    outcome = Outcome(scene.settings, space, evaluations)
+    _certify(outcome, runner, lambda message: None)  # type: ignore[arg-type]
+    assert runner.batches[0][:2] == [(2e-3, 0), (2e-3, 4)]  # exact: the designs and samples passed on
+    assert outcome.corrected[1] == pytest.approx(1.3, rel=1e-12) and outcome.recommended == 1

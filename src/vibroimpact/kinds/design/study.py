@@ -183,10 +183,23 @@ def _certify_round(outcome: Outcome, runner: Runner, targets: list[int], chosen:
         screened = float(evaluations.values(evaluations.results[i])[sample])
         outcome.certified.append({"evaluation": i, "sample": sample, "screened": screened, **result})
     for i in targets:
-        certified = _certified_max(outcome, i)
         objective = evaluations.objective(evaluations.results[i])
-        # a certified worst case above the screen's raises the objective, and the score with it (the penalty kept)
-        outcome.corrected[i] = evaluations.scores[i] * max(1.0, certified / objective) if math.isfinite(certified) and objective > 0.0 else evaluations.scores[i]
+        corrected = _corrected_objective(outcome, i)
+        # a certified worst case above the screen's raises its sample's value, the objective (the samples' quantile)
+        # and the score with it (the penalty kept)
+        outcome.corrected[i] = evaluations.scores[i] * (corrected / objective) if math.isfinite(corrected) and objective > 0.0 else evaluations.scores[i]
+
+
+def _corrected_objective(outcome: Outcome, i: int) -> float:
+    """Candidate ``i``'s objective [m] with each certified sample's value raised to its certified worst case where
+    larger: the same ``quantile`` of the samples (1: the worst), so that a certificate above a sample outside the
+    quantile's reach does not move it (NaN: a sample without a value)."""
+    evaluations = outcome.evaluations
+    values = np.array(evaluations.values(evaluations.results[i]), dtype=float)
+    for c in outcome.certified:
+        if c["evaluation"] == i and math.isfinite(float(c["worst"])):
+            values[int(c["sample"])] = max(values[int(c["sample"])], float(c["worst"]))
+    return float(np.quantile(values, evaluations.quantile, method="higher")) if np.all(np.isfinite(values)) else math.nan
 
 
 def _certified_max(outcome: Outcome, i: int) -> float:
