@@ -29,7 +29,7 @@ FRONT_COLOUR = PATH_COLOUR
 
 def tradeoff_figure(dataset: xr.Dataset) -> DrawnFigure:
     """The worst |X1| against the worst impulse of one impact of every candidate, the front joined, the recommended
-    and the scene's designs marked."""
+    and the scene's designs marked, and the best linear absorber of the same mass (no stop: no impact) at 0 N s."""
     d = dataset
     objective, impulse = 1e3 * d["objective"].values, d["impulse"].values
     feasible, front = d["feasible"].values == 1, d["pareto_front"].values == 1
@@ -45,12 +45,21 @@ def tradeoff_figure(dataset: xr.Dataset) -> DrawnFigure:
     for k, evaluation in enumerate((int(d.attrs.get("recommended_evaluation", -1)), 0)):
         if evaluation >= 0 and shown[evaluation]:
             ax.plot([impulse[evaluation]], [objective[evaluation]], DESIGN_MARKERS[k], ms=13 if k == 0 else 9, color=DESIGN_COLOURS[k], mec="k", mew=0.8, zorder=6, label=design_titles(d)[k])
+    linear = _linear_worst(d)
+    if math.isfinite(linear):
+        violation = _linear_violation(d)
+        ax.plot([0.0], [1e3 * linear], DESIGN_MARKERS[2], ms=10, color=DESIGN_COLOURS[2] if not violation else "none", mec=DESIGN_COLOURS[2] if violation else "k", mew=1.6 if violation else 0.8, zorder=6,
+                label=f"{design_titles(d)[2]} (no stop: no impact){'; violates the operating constraint' if violation else ''}")  # fmt: skip
     finish_axes(ax, "worst impulse of one impact over the band and the samples [N s]", "worst case |X1| [mm]", "Worst |X1| against the impact: the trade-off")
-    outside = _zoom(ax, impulse, objective, front | np.isin(np.arange(impulse.size), [0, int(d.attrs.get("recommended_evaluation", -1))]), shown)
+    outside = _zoom(ax, impulse, objective, front | np.isin(np.arange(impulse.size), [0, int(d.attrs.get("recommended_evaluation", -1))]), shown, 1e3 * linear)
     figure_legend(fig, axes, columns=2)
     caption = Caption(f"Each of the search's {int(np.count_nonzero(shown))} candidates with both values (closed-form screen): its worst case |X1| over the band and the mistuning samples against "
                       "the largest impulse of one impact of its stable period-1 impact orbits (scan frequencies, not refined; 0: only contact-free motions are stable). "
                       "Where a candidate's band is partly uncovered (motions the closed forms do not know) its impulse is a lower bound, and is not drawn where it would read 0.")  # fmt: skip
+    if math.isfinite(linear):
+        violation = _linear_violation(d)
+        caption.add("linear", f"The green diamond at 0 N s is the {design_titles(d)[2]} of the same mass under the same mistuning ({fmt(1e3 * linear, '.4g')} mm, exact band peaks): it has no stop, hence no impact"
+                    + (f"; hollow: it violates the operating constraint ({violation}), which a design with a stop keeps." if violation else "; a design with a stop pays for a smaller |X1| with its impacts."))  # fmt: skip
     caption.add("front", f"The vermillion steps join the front: the feasible candidates no other feasible candidate beats on both ({order.size}); it is the front of what the search evaluated, not of a search constrained on the impulse.")
     if np.any(shown & ~feasible):
         caption.add("infeasible", "Crosses violate the operating constraint and are left off the front.")
@@ -62,34 +71,65 @@ def tradeoff_figure(dataset: xr.Dataset) -> DrawnFigure:
     return DrawnFigure(fig, "design_tradeoff", "Worst |X1| against the impact: the trade-off", caption.text())
 
 
-def _zoom(ax: Axes, impulse: NDArray[np.float64], objective: NDArray[np.float64], keep: NDArray[np.bool_], shown: NDArray[np.bool_]) -> int:
+def _zoom(ax: Axes, impulse: NDArray[np.float64], objective: NDArray[np.float64], keep: NDArray[np.bool_], shown: NDArray[np.bool_], linear: float = math.nan) -> int:
     """Limit the axes to 1.5 times the impulse and 1.3 times the |X1| of the ``keep`` candidates (the front, the
-    recommended and the scene's designs), so that far worse candidates do not squeeze the front into a corner; how many lie beyond."""
+    recommended and the scene's designs) and of the ``linear`` absorber [mm] (NaN: none), so that far worse
+    candidates do not squeeze the front into a corner; how many lie beyond."""
     kept = keep & shown
     if not np.any(kept):
         return 0
     right = 1.5 * max(float(np.max(impulse[kept])), 0.1 * float(np.max(impulse[shown])), 1e-12)
-    top = 1.3 * float(np.max(objective[kept]))
-    bottom = 0.9 * float(np.min(objective[shown]))
+    top = 1.3 * float(np.nanmax([float(np.max(objective[kept])), linear]))
+    bottom = 0.9 * float(np.nanmin([float(np.min(objective[shown])), linear]))
     ax.set_xlim(-0.02 * right, right)
     ax.set_ylim(bottom, top)
     return int(np.count_nonzero(shown & ((impulse > right) | (objective > top))))
 
 
+def _linear_worst(dataset: xr.Dataset) -> float:
+    """The best linear absorber's worst case over the samples [m] (NaN: not compared)."""
+    row = dataset["design_sample_value"].values[2]
+    return float(np.nanmax(row)) if np.any(np.isfinite(row)) else math.nan
+
+
+def _linear_violation(dataset: xr.Dataset) -> str:
+    """Where the best linear absorber violates the operating constraint, how (``|X1| = 0.62 mm at 33 Hz, allowed
+    0.05 mm``); else empty."""
+    d = dataset
+    limit, notch = float(d.attrs.get("operating_limit_m", math.nan)), float(d["design_operating_amplitude"].values[2])
+    if not math.isfinite(limit) or not math.isfinite(notch) or notch <= limit:
+        return ""
+    return f"|X1| = {fmt(1e3 * notch, '.3g')} mm at {fmt(float(d.attrs['operating_frequency_Hz']), 'g')} Hz, allowed {fmt(1e3 * limit, '.3g')} mm"
+
+
 def front_text(dataset: xr.Dataset) -> str:
-    """One sentence on the front: its span in impulse and |X1|, and where the recommended design sits on it."""
+    """One sentence on the front: its span in impulse and |X1|, where the recommended design sits on it, and where
+    the best linear absorber (no impact) stands against it."""
     d = dataset
     front = d["pareto_front"].values == 1
     if not np.any(front):
         return ""
     impulse, objective = d["impulse"].values[front], 1e3 * d["objective"].values[front]
     recommended = int(d.attrs.get("recommended_evaluation", -1))
+    titles = design_titles(d)
     where = ""
     if recommended >= 0 and math.isfinite(float(d["impulse"].values[recommended])):
         on = bool(d["pareto_front"].values[recommended] == 1)
-        where = f"; the {design_titles(d)[0]} ({fmt(float(d['impulse'].values[recommended]), '.3g')} N s) is {'on it' if on else 'off it (by the screen, another candidate is no worse on both)'}"
+        if impulse.size == 1:
+            where = f"; it is the {titles[0]}" if on else f"; the {titles[0]} is off it"
+        else:
+            where = f"; the {titles[0]} ({fmt(float(d['impulse'].values[recommended]), '.3g')} N s) is {'on it' if on else 'off it (by the screen, another candidate is no worse on both)'}"
+    linear = _linear_worst(d)
+    if math.isfinite(linear):
+        above = int(np.count_nonzero(objective >= 1e3 * linear))
+        violation = _linear_violation(d)
+        if violation:
+            against = f"{'below' if above else 'above'} {'the whole front' if above in (0, objective.size) else f'{above} of the front candidates'}, but it violates the operating constraint ({violation})"
+        else:
+            against = ("below the whole front: no stop pays for its impacts" if above == objective.size else
+                       f"below {above} of the front's {objective.size} candidates" if above else "above the whole front (by the screen)")  # fmt: skip
+        where += f"; the {titles[2]} has no impact, at {fmt(1e3 * linear, '.4g')} mm, {against}"
     if impulse.size == 1:
-        where = f"; it is the {design_titles(d)[0]}" if recommended >= 0 and d["pareto_front"].values[recommended] == 1 else where
         return f"The trade-off: one feasible candidate beats every other on both the worst |X1| and the impulse ({fmt(float(objective[0]), '.4g')} mm at {fmt(float(impulse[0]), '.3g')} N s){where}."
     return (f"The trade-off: {int(np.count_nonzero(front))} candidates form the front, from {fmt(float(np.min(objective)), '.4g')} mm at "
             f"{fmt(float(impulse[np.argmin(objective)]), '.3g')} N s to {fmt(float(objective[np.argmin(impulse)]), '.4g')} mm at {fmt(float(np.min(impulse)), '.3g')} N s{where}.")  # fmt: skip
