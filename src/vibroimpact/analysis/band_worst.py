@@ -29,7 +29,7 @@ from vibroimpact.analysis.linear import contact_free_is_stable, linear_amplitude
 from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["BandWorst", "closed_form_worst", "closed_form_at", "MOTIONS", "SCAN"]
+__all__ = ["BandWorst", "closed_form_worst", "closed_form_at", "contact_free_curve", "existing_impact_curve", "MOTIONS", "SCAN"]
 
 #: Frequencies of the scan whose maxima are refined.
 SCAN = 241
@@ -89,8 +89,9 @@ class BandWorst:
             raise ValueError(f"uncovered = {self.uncovered!r} must be a share in [0, 1]")
 
 
-def _linear(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """|X| of the contact-free steady state where it clears every stop and is stable (NaN elsewhere), and everywhere."""
+def contact_free_curve(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """|X| [m] of ``coordinate``'s contact-free steady state at frequencies ``f`` [Hz] where it clears every stop and
+    is stable (NaN elsewhere), and everywhere (in closed form; any contact law: it never touches one)."""
     linear = linear_amplitudes(problem, omega=2.0 * np.pi * f)
     x = np.abs(linear.coordinates[..., coordinate])
     return np.where(linear.fits(problem.clearances()) & contact_free_is_stable(problem.structure), x, np.nan), x
@@ -127,6 +128,17 @@ def _impacting(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, 
     return x, orbit.impacts_per_period, existing, impulse
 
 
+def existing_impact_curve(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, root: str) -> NDArray[np.float64]:
+    """|X| [m] of the closed-form impact orbit of ``root`` at frequencies ``f`` [Hz] wherever it exists (any
+    stability, admissible or not; NaN elsewhere): what :attr:`BandWorst.estimate` guesses from."""
+    orbit = solve_impact_orbit(problem, frequency=f, root=root)
+    existing = np.full(f.shape, np.nan)
+    exists = np.flatnonzero(np.asarray(orbit.exists, dtype=bool).reshape(-1))
+    if exists.size:
+        existing[exists] = np.abs(orbit.take(exists).harmonics()[..., coordinate]).reshape(-1)
+    return existing
+
+
 #: The closed-form motions: the contact-free one, and the impact orbit of each root of the impulse equation.
 _ROOTS = (None, "+", "-")
 
@@ -136,7 +148,7 @@ def _curve(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, root
     or NaN) of one closed-form motion (``root`` None: contact-free, which exists everywhere and has no impulse) at
     ``f`` [Hz] (``largest_only``: see :func:`_impacting`)."""
     if root is None:
-        x, everywhere = _linear(problem, f, coordinate)
+        x, everywhere = contact_free_curve(problem, f, coordinate)
         return MOTIONS[1], 0, x, everywhere, np.where(np.isfinite(x), 0.0, np.nan)
     x, impacts, existing, impulse = _impacting(problem, f, coordinate, root, largest_only)
     return MOTIONS[2], impacts, x, existing, impulse

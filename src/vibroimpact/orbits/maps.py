@@ -171,6 +171,7 @@ class ImpactMap:
         if unknown:
             raise ValueError(f"bounds: unknown parameters {sorted(unknown)}; allowed {list(names)}")
         self._box = [(self.parameter_names.index(name), float(low), float(high)) for name, (low, high) in self.bounds.items()]
+        self._last: tuple[bytes, ImpactProblem] | None = None  # the last problem built: Newton's iterates share their p
 
     def resectioned(self, y: NDArray[np.float64], p: NDArray[np.float64], times: int = 1) -> "Resection | None":
         """The orbit through ``y`` (at parameters ``p``) seen through the strobe in the middle of the widest gap its
@@ -248,11 +249,15 @@ class ImpactMap:
 
     def problem_at(self, p: NDArray[np.float64]) -> ImpactProblem:
         """The problem with parameter vector ``p``: its layout scalars (``layout``) set last, on the problem of the
-        other parameters."""
+        other parameters (the last one built is kept: a shot's Newton iterates and its line search share ``p``)."""
+        key = np.asarray(p, dtype=float).tobytes()
+        if self._last is not None and self._last[0] == key:
+            return self._last[1]
         problem = self._problem_before_layout(p)
-        if not self.layout:
-            return problem
-        return with_layout(problem, self.layout, p[self._fixed :], self.stops)
+        if self.layout:
+            problem = with_layout(problem, self.layout, p[self._fixed :], self.stops)
+        self._last = (key, problem)
+        return problem
 
     def _problem_before_layout(self, p: NDArray[np.float64]) -> ImpactProblem:
         """The problem with the parameters before the layout scalars."""

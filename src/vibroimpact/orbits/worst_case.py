@@ -20,6 +20,7 @@ from scipy.optimize import minimize_scalar
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.orbits.branch import Branch, PeriodicOrbit
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
+from vibroimpact.orbits.bumper_screen import bumper_screen_refusal, rigid_twin
 from vibroimpact.orbits.maps import ImpactMap, branch_measures, closed_form_state, orbit_measures
 from vibroimpact.orbits.shooting import ShootingError, shoot
 
@@ -146,12 +147,15 @@ def worst_response(problem: Any, band: tuple[float, float], coordinate: int = 0,
     """The largest stable |X| of ``coordinate`` over ``band`` [Hz], over the contact-free orbit (in closed form, where
     it clears the stops) and every branch continued from a closed-form one-impact orbit (each root of eq. 16, the
     middle of each run of ``scan`` frequencies where it exists and is admissible), each located exactly
-    (:func:`branch_maximum`). Period-doubled branches and non-periodic attractors are not searched here.
+    (:func:`branch_maximum`). Kelvin-Voigt bumpers start from their rigid twin's closed-form orbit
+    (:func:`~vibroimpact.orbits.bumper_screen.rigid_twin`: the same stops, rigid), shot on the bumpers' own map.
+    Period-doubled branches and non-periodic attractors are not searched here.
 
     Raises
     ------
     ValueError
-        A problem the closed form does not apply to (several stops that are not a symmetric pair, bumpers).
+        A problem the closed form does not apply to (several stops that are not a symmetric pair, a free mass), nor
+        its rigid twin where its stops are bumpers.
     """
     low, high = (float(f) for f in band)
     f = np.linspace(low, high, scan)
@@ -182,8 +186,9 @@ def worst_response(problem: Any, band: tuple[float, float], coordinate: int = 0,
                 best = (value, where, "the contact-free orbit")
     branches: list[tuple[Branch, BranchMaximum | None]] = []
     traced: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    bumpers = bumper_screen_refusal(problem) is None  # bumpers whose rigid twin has the closed forms
     for root in ("+", "-"):
-        orbit = solve_impact_orbit(problem, frequency=f, root=root)
+        orbit = solve_impact_orbit(rigid_twin(problem) if bumpers else problem, frequency=f, root=root)
         ok = np.asarray(orbit.admissible(), dtype=bool).reshape(-1)
         runs = np.split(np.arange(f.size), np.flatnonzero(np.diff(ok.astype(int))) + 1)
         for run in runs:
@@ -192,14 +197,19 @@ def worst_response(problem: Any, band: tuple[float, float], coordinate: int = 0,
             start = float(f[run[len(run) // 2]])
             there = base.problem_at(at_frequency(start))
             system = ImpactMap(there)
-            single = solve_impact_orbit(there, root=root)
-            x_start = float(np.abs(single.harmonics()).reshape(-1)[coordinate])
-            if any(_passes(known, start, x_start) for known in traced):
-                continue  # a branch already traced passes through this start
+            closed = rigid_twin(there) if bumpers else there
+            single = solve_impact_orbit(closed, root=root)
+            if not bumpers:
+                x_start = float(np.abs(single.harmonics()).reshape(-1)[coordinate])
+                if any(_passes(known, start, x_start) for known in traced):
+                    continue  # a branch already traced passes through this start
             try:
-                shot = shoot(system, closed_form_state(there, single), system.parameters)
+                shot = shoot(system, closed_form_state(closed, single), system.parameters)
             except ShootingError:
                 continue
+            if bumpers:  # the bumper's own orbit: is it on a branch already traced?
+                if shot.impacts < 1 or any(_passes(known, start, float(orbit_measures(system, shot).amplitudes[coordinate])) for known in traced):
+                    continue
             branch = continue_branch(system, shot, "frequency", ContinuationSettings(lower=low, upper=high))
             measured = branch_measures(system, branch)
             traced.append((branch.values, measured.amplitude(coordinate), branch.impacts))

@@ -24,6 +24,7 @@ import numpy as np
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import Branch
+from vibroimpact.orbits.bumper_screen import bumper_screen_refusal
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
 from vibroimpact.orbits.maps import ImpactMap
 from vibroimpact.orbits.shooting import ShootingError, shoot
@@ -88,13 +89,16 @@ def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequenci
     """The worst stable |X1| of ``problem`` over ``band`` [Hz] (module docstring); ``frequencies``, ``starts``,
     ``transient`` and ``strobes`` are the brute force's (:func:`~vibroimpact.simulation.band_attractors.band_attractors`).
 
-    A problem the closed forms do not apply to (a free mass, stops that are not one or a symmetric pair) has no
-    closed-form start to continue from: its worst case is the brute force's, continued where periodic.
+    Bumpers continue from their rigid twin's closed-form orbits. A problem the closed forms do not apply to (a free
+    mass, stops that are not one or a symmetric pair) has no closed-form start to continue from: its worst case is the
+    brute force's, continued where periodic.
     """
     low, high = (float(b) for b in band)
     start = time.perf_counter()
-    # continuation starts from the closed forms; a layout without them (a free mass ...) is brute force's alone
-    continued = worst_response(problem, (low, high)) if closed_form_refusal(problem) is None else WorstCase(0.0, math.nan, "", ())
+    # continuation starts from the closed forms (bumpers: their rigid twin's); a layout without them (a free mass ...)
+    # is brute force's alone
+    starts = closed_form_refusal(problem) is None or bumper_screen_refusal(problem) is None
+    continued = worst_response(problem, (low, high)) if starts else WorstCase(0.0, math.nan, "", ())
     middle = time.perf_counter()
     sweep = band_attractors(problem, (low, high), frequencies=frequencies, starts=starts, transient=transient, strobes=strobes)
     swept = time.perf_counter()

@@ -18,7 +18,7 @@ from vibroimpact.reporting.style import fmt
 
 __all__ = ["answer_text", "design_titles", "linear_wins", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
 
-_SYMBOLS = {"clearance": "Delta", "restitution": "R"}
+_SYMBOLS = {"clearance": "Delta", "restitution": "R", "bumper_stiffness": "K_b"}
 #: How the page names the compared designs (the dataset's ``design`` dimension, in order).
 DESIGN_TITLES = ("recommended design", "the scene's design", "best linear absorber")
 _UNITS = {"1": "", "N m-1": "N/m", "N s m-1": "N s/m"}

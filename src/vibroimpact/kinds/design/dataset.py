@@ -18,9 +18,10 @@ from numpy.typing import NDArray
 
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.orbits.bumper_screen import bumper_curves, bumper_screen_refusal
 from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
-from vibroimpact.kinds.design.evaluate import ATTRACTOR_POINTS, MAX_BRANCH_POINTS, SCREEN_MOTIONS, SWEEP_ACCURACIES
+from vibroimpact.kinds.design.evaluate import ATTRACTOR_POINTS, MAX_BRANCH_POINTS, SCREEN_MOTIONS, SCREENS, SWEEP_ACCURACIES, screen_kind
 from vibroimpact.simulation.certified_worst import SOURCES
 from vibroimpact.kinds.design.scene import DesignSettings, safe_name
 from vibroimpact.kinds.design.search import STAGES, pareto_front
@@ -40,13 +41,18 @@ RIDGE = 0.02
 
 def response_curves(problem: ImpactProblem, frequency: NDArray[np.float64], coordinate: int) -> dict[str, NDArray[np.float64]]:
     """|X| [m] of the contact-free motion (everywhere), whether it fits; and of each root's period-1 impact orbit
-    where it exists, with its state (-1 none or not admissible, 0 unstable, 1 stable; none on a layout without a
-    closed form)."""
+    where it exists, with its state (-1 none or not admissible, 0 unstable, 1 stable; bumpers: the orbit grown from
+    the rigid twin's root, :func:`~vibroimpact.orbits.bumper_screen.bumper_curves`; none on a layout without a closed
+    form)."""
     linear = linear_amplitudes(problem, omega=2.0 * np.pi * frequency)
     out = {"linear": np.abs(linear.coordinates[..., coordinate]), "linear_fits": linear.fits(problem.clearances()).astype(np.int8)}
+    bumpers = bool(problem.stops) and bumper_screen_refusal(problem) is None
+    grown = bumper_curves(problem, frequency, coordinate) if bumpers else {}  # bumper orbits grown from the rigid twin's
     for root, name in (("+", "impact_plus"), ("-", "impact_minus")):
         x, state = np.full(frequency.shape, np.nan), np.full(frequency.shape, -1, dtype=np.int8)
-        if problem.stops and closed_form_refusal(problem) is None:
+        if bumpers:
+            x, state = grown[root]
+        elif problem.stops and closed_form_refusal(problem) is None:
             orbit = solve_impact_orbit(problem, frequency=frequency, root=root)
             ok = np.flatnonzero(np.asarray(orbit.admissible(), dtype=bool).reshape(-1))
             if ok.size:
@@ -126,7 +132,7 @@ def design_dataset(scene: Any, outcome: Outcome) -> xr.Dataset:
                           "quantile": settings.quantile, "samples": settings.samples, "mistuning_seed": settings.seed, "search_method": settings.search.method,
                           "variables": ", ".join(v.name for v in settings.variables), "operating_frequency_Hz": settings.operating[0] if settings.operating else math.nan,
                           "operating_limit_m": settings.operating[1] if settings.operating else math.nan, "recommended_evaluation": outcome.recommended,
-                          "excitation_amplitude_N": scene.amplitude})  # fmt: skip
+                          "excitation_amplitude_N": scene.amplitude, "screen": screen_kind(outcome.space.problem)})  # fmt: skip
     errors = sorted({str(e) for r in ev.results for e in np.asarray(r["error"]).reshape(-1) if str(e)})
     if errors:
         dataset.attrs["run_failures"] = [f"{sum(1 for r in ev.results for e in np.asarray(r['error']).reshape(-1) if str(e))} samples of candidates have no value (scored infinite): {errors[0]}"]
@@ -214,7 +220,7 @@ def _designs(data: dict[str, xr.Variable], scene: Any, outcome: Outcome) -> dict
         if outcome.linear is not None and v.name in ("k2", "b2"):
             column[2] = getattr(outcome.linear.system, v.name)
         data[f"design_{safe_name(v.name)}"] = xr.Variable("design", np.array(column, dtype=float), {"units": v.unit, "long_name": f"{v.name} of the compared design"})
-    closed = outcome.recommended >= 0 and closed_form_refusal(space.problem) is None  # a ridge of the closed forms' curves only
+    closed = outcome.recommended >= 0 and screen_kind(space.problem) != SCREENS[2]  # a ridge of the screen's curves only
     ridge = equal_peaks(frequency, {k: curves[k][0] for k in keys}) if closed else (math.nan, math.nan, math.nan)
     attrs: dict[str, object] = {"equal_peak_difference": ridge[0], "equal_peak_frequencies_Hz": np.array(ridge[1:], dtype=float)}
     if outcome.linear is not None:

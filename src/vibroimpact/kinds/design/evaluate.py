@@ -1,6 +1,6 @@
-"""One design's worst case, as runner cases (:mod:`vibroimpact.runs.runner`): the closed-form screen of a candidate
-under every mistuning sample (:class:`DesignCase`), and the certification of one problem by continuation
-(:class:`CertifyCase`).
+"""One design's worst case, as runner cases (:mod:`vibroimpact.runs.runner`): the screen of a candidate under every
+mistuning sample (:class:`DesignCase`: the closed forms, or bumper orbits grown from them, :func:`screen_kind`), and
+the certification of one problem by continuation (:class:`CertifyCase`).
 
 A design is a vector of the scene's variables; a mistuning sample a vector of offsets of the robust scalars
 (relative for a structural scalar, absolute for the clearance and restitution; sample 0 is the nominal design). Both
@@ -19,16 +19,18 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.analysis.band_worst import MOTIONS, closed_form_at, closed_form_worst
+from vibroimpact.analysis.band_worst import MOTIONS, BandWorst, closed_form_at, closed_form_worst
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.simulation.band_attractors import band_attractors
+from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.orbits.bumper_screen import bumper_at, bumper_screen_refusal, bumper_worst
 from vibroimpact.orbits.maps import ImpactMap, branch_measures
 from vibroimpact.simulation.certified_worst import SOURCES, certified_worst, sweep_points_for
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.store import case_key
 
-__all__ = ["DesignSpace", "DesignCase", "sample_chunks", "CHUNKS", "DESIGN_FIELDS", "CertifyCase", "CERTIFY_FIELDS", "STOP_PARAMETERS", "ATTRACTOR_POINTS", "SWEEP_ACCURACIES", "MAX_BRANCH_POINTS", "SCREEN_MOTIONS", "BRUTE", "BRUTE_SCREEN"]
+__all__ = ["DesignSpace", "DesignCase", "sample_chunks", "CHUNKS", "DESIGN_FIELDS", "CertifyCase", "CERTIFY_FIELDS", "STOP_PARAMETERS", "MIN_BUMPER_RESTITUTION", "SCREENS", "screen_kind", "screen_worst", "ATTRACTOR_POINTS", "SWEEP_ACCURACIES", "MAX_BRANCH_POINTS", "SCREEN_MOTIONS", "BRUTE", "BRUTE_SCREEN"]
 
 #: The screen's motions: the closed forms' (:data:`~vibroimpact.analysis.band_worst.MOTIONS`), and brute force's on a
 #: layout without a closed form.
@@ -38,6 +40,26 @@ SCREEN_MOTIONS = (*MOTIONS, BRUTE)
 BRUTE_SCREEN = (41, 1, 200, 64)
 #: The map's parameters a design or a mistuning may set besides the layout scalars.
 STOP_PARAMETERS = ("clearance", "restitution")
+#: A bumper's restitution is kept at or above this [-] (R = 0 needs an infinite loss factor).
+MIN_BUMPER_RESTITUTION = 1e-3
+#: How the screen sees a problem (:func:`screen_kind`): the rigid stops' closed forms, bumper orbits grown from their
+#: rigid twin's, or brute force (no closed form: a free mass, stops that are not one or a symmetric pair).
+SCREENS = ("closed_form", "bumper_orbits", "brute_force")
+
+
+def screen_kind(problem: ImpactProblem) -> str:
+    """Which of :data:`SCREENS` screens ``problem``."""
+    if closed_form_refusal(problem) is None:
+        return SCREENS[0]
+    return SCREENS[1] if bumper_screen_refusal(problem) is None else SCREENS[2]
+
+
+def screen_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: int, scan: int) -> BandWorst:
+    """The screen's worst case of ``problem`` over ``band`` [Hz]: the closed forms' (``scan`` frequencies) or the
+    bumper orbits' (:data:`~vibroimpact.orbits.bumper_screen.BUMPER_SCAN` frequencies, each a shot orbit)."""
+    if screen_kind(problem) == SCREENS[0]:
+        return closed_form_worst(problem, band, coordinate, scan)
+    return bumper_worst(problem, band, coordinate)
 
 
 @dataclass(frozen=True, eq=False)
@@ -84,6 +106,11 @@ class DesignSpace:
         layout = tuple(dict.fromkeys(n for n in (*self.variables, *self.mistuned) if n not in STOP_PARAMETERS))
         return ImpactMap(self.problem, layout=layout)
 
+    @cached_property
+    def bumpers(self) -> bool:
+        """The stops are Kelvin-Voigt bumpers (their loss factor the inverse of R)."""
+        return any(isinstance(stop.law, KelvinVoigtBumper) for stop in self.problem.stops)
+
     @property
     def samples(self) -> int:
         """Rows of ``offsets`` (the nominal included)."""
@@ -100,7 +127,7 @@ class DesignSpace:
             i = names.index(name)
             p[i] = p[i] * (1.0 + offset) if relative else p[i] + offset
         r, d = names.index("restitution"), names.index("clearance")
-        p[r] = min(max(p[r], 0.0), 1.0)
+        p[r] = min(max(p[r], MIN_BUMPER_RESTITUTION if self.bumpers else 0.0), 1.0)
         p[d] = max(p[d], 1e-9 * self.map.problem.length_scale())
         return p
 
@@ -161,16 +188,16 @@ class DesignCase:
         for row, s in enumerate(self.samples):
             try:
                 problem = self.space.problem_at(self.design, s)
-                closed = closed_form_refusal(problem) is None
-                if closed:
-                    found = closed_form_worst(problem, self.space.band, self.space.coordinate, self.space.scan)
+                kind = screen_kind(problem)
+                if kind != SCREENS[2]:
+                    found = screen_worst(problem, self.space.band, self.space.coordinate, self.space.scan)
                     values = (found.amplitude, found.frequency, found.uncovered, found.estimate, SCREEN_MOTIONS.index(found.motion))
                     out["impulse"][row] = found.impulse
                 else:  # no closed form (a free mass, stops that are not one or a symmetric pair): brute force screens
                     top = band_attractors(problem, self.space.band, *BRUTE_SCREEN).maximum
                     values = (top.amplitude, top.frequency, 0.0, 0.0, SCREEN_MOTIONS.index(BRUTE))
                 if math.isfinite(self.space.operating):
-                    out["operating"][row], operating_motion[row] = _operating(problem, self.space.operating, self.space.coordinate, closed)
+                    out["operating"][row], operating_motion[row] = _operating(problem, self.space.operating, self.space.coordinate, kind)
             except ValueError as error:  # a structure the model refuses (a mass driven non-positive ...)
                 errors[row] = f"{type(error).__name__}: {str(error)[:160]}"
                 continue
@@ -180,16 +207,17 @@ class DesignCase:
         return out | {"motion": motion, "operating_motion": operating_motion, "error": np.array(errors, dtype=str)}
 
 
-def _operating(problem: ImpactProblem, frequency: float, coordinate: int, closed: bool) -> tuple[float, int]:
+def _operating(problem: ImpactProblem, frequency: float, coordinate: int, kind: str) -> tuple[float, int]:
     """The worst coexisting |X| at the operating ``frequency`` [Hz] and its motion (index of :data:`SCREEN_MOTIONS`):
-    the closed forms' (``closed``: they apply; where none is stable there, the guess from the orbits that exist), else
-    brute force's."""
-    if not closed:
+    the screen's (``kind`` of :data:`SCREENS`; where none of its motions is stable there, the guess from the orbits
+    that exist), else brute force's."""
+    if kind == SCREENS[2]:
         return band_attractors(problem, _around(frequency), 2, *BRUTE_SCREEN[1:]).maximum.amplitude, SCREEN_MOTIONS.index(BRUTE)
-    at = closed_form_at(problem, frequency, coordinate)
+    at = closed_form_at(problem, frequency, coordinate) if kind == SCREENS[0] else bumper_at(problem, frequency, coordinate)
     if at.uncovered == 0.0:  # exact: a share of none
         return at.amplitude, SCREEN_MOTIONS.index(at.motion)
-    return closed_form_worst(problem, _around(frequency), coordinate, 3).estimate, SCREEN_MOTIONS.index(at.motion)
+    around = closed_form_worst(problem, _around(frequency), coordinate, 3) if kind == SCREENS[0] else bumper_worst(problem, _around(frequency), coordinate, 3)
+    return around.estimate, SCREEN_MOTIONS.index(at.motion)
 
 
 def _around(frequency: float) -> tuple[float, float]:
@@ -242,9 +270,9 @@ class CertifyCase:
         scalars |= {"motion": "", "brute_motion": "", "source": -1}
         problem = self.space.problem_at(self.design, self.sample)
         try:
-            if closed_form_refusal(problem) is None:  # what the search's objective costs on this problem, timed alone
+            if screen_kind(problem) != SCREENS[2]:  # what the search's objective costs on this problem, timed alone
                 start = time.perf_counter()
-                closed_form_worst(problem, self.space.band, self.space.coordinate, self.space.scan)
+                screen_worst(problem, self.space.band, self.space.coordinate, self.space.scan)
                 scalars["screen_time"] = time.perf_counter() - start
             found = certified_worst(problem, self.space.band, frequencies=ATTRACTOR_POINTS)
         except (ValueError, RuntimeError) as error:

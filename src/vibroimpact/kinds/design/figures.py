@@ -430,7 +430,8 @@ def robustness_figure(dataset: xr.Dataset) -> DrawnFigure:
     caption.add("nominal", "Dots mark the nominal design's value on each curve.")
     if raised:
         which = "; ".join(f"{title}, sample {sample}: {fmt(value, '.4g')} mm" for title, sample, value in raised)
-        screen = "a coarse brute force: few frequencies and starts" if np.any(d["sample_motion"].values == 3) else "the closed forms: period-1 motions"
+        screen = ("a coarse brute force: few frequencies and starts" if np.any(d["sample_motion"].values == 3) else
+                  "period-1 bumper orbits" if d.attrs.get("screen") == "bumper_orbits" else "the closed forms: period-1 motions")  # fmt: skip
         caption.add("certified", f"The curves are the screen's values ({screen}). Vermillion stars mark where the certification (continuation and brute force) found a larger motion under a certified sample, joined to the screen's value ({which}): the distribution above the screen's values is not known for the other samples.")
     if constant:
         caption.add("constant", f"The same value under every sample for {' and '.join(t if t.startswith('the ') else 'the ' + t for t in constant)}: the mistuned scalars do not change it (a stop that is never reached, or none).")

@@ -139,11 +139,18 @@ def method_text(dataset: xr.Dataset) -> str:
                 if spreads and samples > 1 else "the nominal design only (no mistuning)")  # fmt: skip
     quantile = float(d.attrs.get("quantile", 1.0))
     over = "the worst of them" if quantile >= 1.0 else f"their {fmt(quantile, '.3g')} quantile"
-    parts = [f"<p><b>The screen (closed forms).</b> Each candidate's worst case is, under each mistuning sample, the largest |X1| over "
-             f"{fmt(d.attrs['band_low_Hz'], '.4g')}-{fmt(d.attrs['band_high_Hz'], '.4g')} Hz of every stable closed-form motion: the contact-free motion where "
-             "it clears the stop and both roots of the period-1 impact orbit where admissible and stable, maxima refined in frequency; where no such "
-             "motion is stable, a guess at the motion's size from the orbits that exist. The objective is "
-             f"{over} over the samples: {mistuned}.</p>"]  # fmt: skip
+    if d.attrs.get("screen") == "bumper_orbits":
+        screen = ("<p><b>The screen (bumper orbits).</b> Each candidate's worst case is, under each mistuning sample, the largest |X1| over "
+                  f"{fmt(d.attrs['band_low_Hz'], '.4g')}-{fmt(d.attrs['band_high_Hz'], '.4g')} Hz of every stable motion it knows: the contact-free motion "
+                  "(closed form) where it clears the stop, and the period-1 bumper orbit of each root of the rigid twin's closed form (the same stop, rigid), "
+                  "shot on the bumper's exact map at each scan frequency from the orbit at the previous one, stability from its Floquet multipliers, "
+                  "maxima refined in frequency; where no such motion is stable, a guess at the motion's size from the orbits that exist.")  # fmt: skip
+    else:
+        screen = ("<p><b>The screen (closed forms).</b> Each candidate's worst case is, under each mistuning sample, the largest |X1| over "
+                  f"{fmt(d.attrs['band_low_Hz'], '.4g')}-{fmt(d.attrs['band_high_Hz'], '.4g')} Hz of every stable closed-form motion: the contact-free motion where "
+                  "it clears the stop and both roots of the period-1 impact orbit where admissible and stable, maxima refined in frequency; where no such "
+                  "motion is stable, a guess at the motion's size from the orbits that exist.")  # fmt: skip
+    parts = [f"{screen} The objective is {over} over the samples: {mistuned}.</p>"]
     limit = float(d.attrs.get("operating_limit_m", math.nan))
     if math.isfinite(limit):
         parts.append(f"<p><b>The operating constraint.</b> The worst coexisting |X1| at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz must stay at or below "
@@ -161,7 +168,7 @@ def method_text(dataset: xr.Dataset) -> str:
             which.setdefault(_who(d, int(d["certificate_evaluation"].values[r])), []).append(str(int(d["certificate_sample"].values[r])))
         listed = "; ".join(f"{who} at sample{'s' if len(s) > 1 else ''} {' and '.join(s)}" for who, s in which.items())
         parts.append(f"<p><b>The certification (continuation and brute force).</b> {certified} problem{'s' if certified > 1 else ''} ({listed}; sample 0 is the nominal design), "
-                     f"each continued in frequency along every branch started from its closed-form orbits, and swept by brute force (up and down, two more starts, "
+                     f"each continued in frequency along every branch started from its {'bumper orbits shot from the rigid twin' + chr(39) + 's' if d.attrs.get('screen') == 'bumper_orbits' else 'closed-form orbits'}, and swept by brute force (up and down, two more starts, "
                      f"{d.sizes.get('attractor_point', 0)} frequencies; a larger periodic attractor it finds is continued and its maximum located): {fmt(certify_time, '.3g')} s of wall time, "
                      f"{fmt(total, '.3g')} s summed over the problems. A certified worst case above the screen's raises the candidate's score; the "
                      "recommendation is the best certified candidate.</p>")  # fmt: skip
@@ -201,11 +208,13 @@ def cost_text(dataset: xr.Dataset) -> str:
         return ""
     summary = ("At the accuracy a grid usually gives, brute force is cheaper than the continuation, which wins where the maximum must be exact."
                if ratios[0] < 1.0 else "The continuation is the cheaper at every accuracy shown.")
+    bumpers = d.attrs.get("screen") == "bumper_orbits"
     if same:
-        screen_part = (f" The search's own objective, the closed-form screen (each period-1 branch's maxima refined to 1e-8 by zoomed closed-form scans), found the same "
-                       f"maximum in {fmt(screen, '.2g')} s: {' and '.join(screen_ratios)}.")  # fmt: skip
+        how = ("the bumper screen (each period-1 bumper orbit shot along the scan, its maxima refined by a bounded search)" if bumpers
+               else "the closed-form screen (each period-1 branch's maxima refined to 1e-8 by zoomed closed-form scans)")  # fmt: skip
+        screen_part = f" The search's own objective, {how}, found the same maximum in {fmt(screen, '.2g')} s: {' and '.join(screen_ratios)}."
     elif math.isfinite(screen):
-        screen_part = (f" The search's own objective, the closed-form screen, took {fmt(screen, '.2g')} s on this problem but did not find its worst case "
+        screen_part = (f" The search's own objective, the {'bumper' if bumpers else 'closed-form'} screen, took {fmt(screen, '.2g')} s on this problem but did not find its worst case "
                        f"({fmt(1e3 * screened, '.4g')} mm against the certified {fmt(1e3 * worst, '.4g')} mm): it knows only period-1 motions.")  # fmt: skip
     else:
         screen_part = ""

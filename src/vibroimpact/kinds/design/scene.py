@@ -37,19 +37,21 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-from vibroimpact.model.layout import Layout
+from vibroimpact.model.layout import PAPER_STOP, Layout
 from vibroimpact.model.structure import require_in_range
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.scene.header import parse_names
 from vibroimpact.scene.layout_parse import parse_layout
 from vibroimpact.scene.schema import Scene
 
-__all__ = ["DESIGN_TOP_KEYS", "STOP_VARIABLES", "METHODS", "COMPARISONS", "Variable", "Mistuning", "SearchSettings", "DesignSettings", "parse_design_scene", "safe_name"]
+__all__ = ["DESIGN_TOP_KEYS", "STOP_VARIABLES", "BUMPER_VARIABLE", "METHODS", "COMPARISONS", "Variable", "Mistuning", "SearchSettings", "DesignSettings", "parse_design_scene", "safe_name"]
 
 #: Top-level keys of a design scene.
 DESIGN_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "design", "report", "cluster"}
 #: Design variables of the stops (absolute units; every other variable is a layout scalar).
 STOP_VARIABLES = {"clearance": "m", "restitution": "1"}
+#: The bumpers' stiffness K_b [N m-1], a variable where the stops have bumpers (their loss factor follows R).
+BUMPER_VARIABLE = "bumper_stiffness"
 #: Searches: a global search then a local polish, or every point of a grid over the variables (a map).
 METHODS = ("differential_evolution", "grid")
 #: What the optimum is compared with: the best linear absorber of the same mass (the paper's two masses), or nothing.
@@ -167,6 +169,9 @@ class DesignSettings:
         and brute force, one at a time until no later candidate can beat the best certified one.
     clearance, restitution : float
         The scene's own design of the stops: Delta [m], R [-].
+    bumper_frequency : float or None
+        Omega_b / 2 pi [Hz] of the stops' Kelvin-Voigt bumpers (their loss factor the exact inverse of R); None: rigid
+        stops.
     """
 
     variables: tuple[Variable, ...]
@@ -183,6 +188,7 @@ class DesignSettings:
     certified: int
     clearance: float
     restitution: float
+    bumper_frequency: float | None = None
 
     def __post_init__(self) -> None:
         if not self.variables:
@@ -207,13 +213,13 @@ def parse_design_scene(document: dict, text: str = "", source: str = "scene") ->
     doc = c.mapping("", document, DESIGN_TOP_KEYS, {"name", "system", "excitation", "design"}, kind="design")
     name, description, report = parse_names(c, doc)
     layout, amplitude, coordinates = parse_layout(c, doc)
-    clearance, restitution = _stop_values(c, doc, layout)
+    clearance, restitution, bumper = _stop_values(c, doc, layout)
     spec = c.mapping("design", doc.get("design"), _DESIGN_KEYS, {"variables", "band"}) if "design" in doc else {}
-    variables = _variables(c, spec.get("variables"), layout) if "variables" in spec else ()
+    variables = _variables(c, spec.get("variables"), layout, bumper) if "variables" in spec else ()
     band = _band(c, spec["band"]) if "band" in spec else None
     coordinate, objective = _objective(c, spec.get("objective", "x1_amplitude"), coordinates)
     operating = _operating(c, spec.get("constraints", {}), coordinates, band)
-    mistuning, samples, seed, quantile = _robust(c, spec.get("robust", {}), layout)
+    mistuning, samples, seed, quantile = _robust(c, spec.get("robust", {}), layout, bumper)
     compare = spec.get("compare", "none")
     if compare not in COMPARISONS:
         c.fail("design.compare", f"{compare!r} is not allowed: use one of {', '.join(COMPARISONS)}")
@@ -229,31 +235,56 @@ def parse_design_scene(document: dict, text: str = "", source: str = "scene") ->
         raise SceneError(c.problems, source)
     assert layout is not None and amplitude is not None and isinstance(name, str) and band is not None and search is not None
     assert clearance is not None and restitution is not None and samples is not None and seed is not None and quantile is not None and certified is not None
-    settings = DesignSettings(variables, band, coordinate, objective, operating, mistuning, samples, seed, quantile, str(compare), search, certified, clearance, restitution)
+    settings = DesignSettings(variables, band, coordinate, objective, operating, mistuning, samples, seed, quantile, str(compare), search, certified, clearance, restitution, bumper)
     return Scene(name=name, description=description, layout=layout, amplitude=amplitude, kind="design", settings=settings, report=report, text=text)
 
 
-def _stop_values(c: Checker, doc: dict, layout: Layout | None) -> tuple[float | None, float | None]:
-    """The stops' shared clearance [m] and restitution [-]: the paper's ``stop`` gives them, or every entry of
-    ``stops`` gives the same."""
+def _stop_values(c: Checker, doc: dict, layout: Layout | None) -> tuple[float | None, float | None, float | None]:
+    """The stops' shared clearance [m], restitution [-] and bumper Omega_b / 2 pi [Hz] (None: rigid stops): the
+    paper's ``stop`` gives them, or every entry of ``stops`` gives the same. A bumper's loss factor is the exact
+    inverse of the restitution (a design variable moves both), so it gives its stiffness or frequency alone."""
     if "stop" not in doc and "stops" not in doc:
         c.fail("stop", "required: the paper's stop {clearance: Delta [m], restitution: R} above the absorber x2, or 'stops' (one, or a symmetric pair)")
-        return None, None
+        return None, None, None
     if "stops" not in doc:
-        stop = c.mapping("stop", doc["stop"], {"clearance", "restitution"}, {"clearance", "restitution"})
+        stop = c.mapping("stop", doc["stop"], {"clearance", "restitution", "bumper"}, {"clearance", "restitution"})
         clearance = c.number("stop.clearance", stop["clearance"], 0.0, math.inf, low_inclusive=False) if "clearance" in stop else None
         restitution = c.number("stop.restitution", stop["restitution"], 0.0, 1.0) if "restitution" in stop else None
-        return clearance, restitution
+        bumper = _bumper(c, "stop.bumper", stop["bumper"], layout) if "bumper" in stop else None
+        if bumper is not None and restitution is not None and restitution <= 0.0:
+            c.fail("stop.restitution", "0 with a bumper: a bumper's restitution must be above 0 (R = 0 needs an infinite loss factor): allowed (0, 1]")
+        return clearance, restitution, bumper
     if layout is None:
-        return None, None
+        return None, None, None
     values = [(spec.clearance, spec.restitution) for spec in layout.stops]
     if any(v is None for pair in values for v in pair) or len(set(values)) != 1:
         c.fail("stops", "every stop of a design scene gives the same clearance and restitution (the design's; the variables move them together)")
-        return None, None
-    return float(values[0][0]), float(values[0][1])  # type: ignore[arg-type]
+        return None, None, None
+    bumpers = {spec.bumper_frequency for spec in layout.stops}
+    if len(bumpers) != 1 or any(spec.bumper_loss_factor is not None and spec.bumper_stiffness is None for spec in layout.stops):
+        c.fail("stops", "every stop of a design scene is rigid, or every one has a bumper of the same frequency (or stiffness) without its own loss factor (the restitution gives it)")
+        return None, None, None
+    return float(values[0][0]), float(values[0][1]), bumpers.pop()  # type: ignore[arg-type]
 
 
-def _variables(c: Checker, value: Any, layout: Layout | None) -> tuple[Variable, ...]:
+def _bumper(c: Checker, key: str, value: Any, layout: Layout | None) -> float | None:
+    """The design's bumper Omega_b / 2 pi [Hz] from ``{frequency: Hz}`` or ``{stiffness: N/m}`` (the paper's stop,
+    effective mass m2)."""
+    if isinstance(value, dict) and set(value) & {"loss_factor", "damping"}:
+        c.fail(key, f"{', '.join(sorted(set(value) & {'loss_factor', 'damping'}))}: a design's bumper takes its loss from the restitution (a variable may move it): give frequency [Hz] or stiffness [N/m] alone")
+        return None
+    from vibroimpact.scene.bumper_parse import parse_bumper
+
+    mass = PAPER_STOP.effective_mass(layout.structure) if layout is not None else None
+    spec = parse_bumper(c, key, value, mass)
+    if spec is None:
+        return None
+    if spec.frequency is None:
+        c.fail(key, "give frequency [Hz] or stiffness [N/m]")
+    return spec.frequency
+
+
+def _variables(c: Checker, value: Any, layout: Layout | None, bumper: float | None) -> tuple[Variable, ...]:
     spec = value if isinstance(value, dict) and value else None
     if spec is None:
         c.fail("design.variables", f"expected a mapping of at least one name to [low, high], got {value!r}")
@@ -261,14 +292,14 @@ def _variables(c: Checker, value: Any, layout: Layout | None) -> tuple[Variable,
     out = []
     for key, bounds in spec.items():
         name = str(key)
-        unit = STOP_VARIABLES.get(name) or _layout_unit(c, f"design.variables.{name}", name, layout)
+        unit = STOP_VARIABLES.get(name) or _layout_unit(c, f"design.variables.{name}", name, layout, bumper)
         if unit is None:
             continue
         if not (isinstance(bounds, list) and len(bounds) == 2):
             c.fail(f"design.variables.{name}", f"expected [low, high], got {bounds!r}")
             continue
         high_limit = 1.0 if name == "restitution" else math.inf
-        low_value = c.number(f"design.variables.{name}[0]", bounds[0], 0.0, high_limit, low_inclusive=name == "restitution" or name.startswith(("b", "dashpot", "damping")))
+        low_value = c.number(f"design.variables.{name}[0]", bounds[0], 0.0, high_limit, low_inclusive=(name == "restitution" and bumper is None) or name.startswith(("b2", "b1", "dashpot", "damping")))
         high_value = c.number(f"design.variables.{name}[1]", bounds[1], 0.0, high_limit, low_inclusive=False)
         if low_value is None or high_value is None:
             continue
@@ -281,10 +312,16 @@ def _variables(c: Checker, value: Any, layout: Layout | None) -> tuple[Variable,
     return tuple(out)
 
 
-def _layout_unit(c: Checker, key: str, name: str, layout: Layout | None) -> str | None:
-    """The unit of the layout scalar ``name`` (None, with a problem recorded, if the layout has none of that name)."""
+def _layout_unit(c: Checker, key: str, name: str, layout: Layout | None, bumper: float | None = None) -> str | None:
+    """The unit of the layout scalar ``name`` (None, with a problem recorded, if the layout has none of that name);
+    ``bumper_stiffness`` [N m-1] where the stops have bumpers (``bumper``: their Omega_b / 2 pi [Hz])."""
+    if name == BUMPER_VARIABLE:
+        if bumper is None:
+            c.fail(key, f"{name}: the stops are rigid; give the stop a bumper (stop: {{clearance, restitution, bumper: {{stiffness: K_b [N/m]}}}}) to choose its stiffness")
+            return None
+        return "N m-1"
     if not _LAYOUT_FORMS.match(name.replace(" ", "")):
-        c.fail(key, f"unknown design variable {name!r}: allowed clearance, restitution, or a layout scalar (k2, b2, m2, ... on the paper's system; mass[a], spring[a,b], dashpot[a], stiffness[a,b], damping[a] on any)")
+        c.fail(key, f"unknown design variable {name!r}: allowed clearance, restitution, bumper_stiffness (a stop with a bumper), or a layout scalar (k2, b2, m2, ... on the paper's system; mass[a], spring[a,b], dashpot[a], stiffness[a,b], damping[a] on any)")
         return None
     if layout is None:
         return None
@@ -339,7 +376,7 @@ def _operating(c: Checker, value: Any, coordinates: tuple[str, ...] | None, band
     return (frequency, limit) if frequency is not None and limit is not None else None
 
 
-def _robust(c: Checker, value: Any, layout: Layout | None) -> tuple[tuple[Mistuning, ...], int | None, int | None, float | None]:
+def _robust(c: Checker, value: Any, layout: Layout | None, bumper: float | None = None) -> tuple[tuple[Mistuning, ...], int | None, int | None, float | None]:
     if not isinstance(value, dict):
         c.fail("design.robust", f"expected a mapping of spreads and samples, got {value!r}")
         return (), None, None, None
@@ -353,7 +390,7 @@ def _robust(c: Checker, value: Any, layout: Layout | None) -> tuple[tuple[Mistun
     for name in spreads:
         spread = value[name]
         relative = name not in STOP_VARIABLES
-        if relative and _layout_unit(c, f"design.robust.{name}", name, layout) is None:
+        if relative and _layout_unit(c, f"design.robust.{name}", name, layout, bumper) is None:
             continue
         limit = 0.5 if relative else (1.0 if name == "restitution" else math.inf)
         number = c.number(f"design.robust.{name}", spread, 0.0, limit, low_inclusive=False, high_inclusive=not relative)

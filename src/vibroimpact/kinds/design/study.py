@@ -59,7 +59,9 @@ def mistuning_offsets(settings: DesignSettings) -> NDArray[np.float64]:
 def design_space(scene: Any) -> DesignSpace:
     """The scene's problem (its own design) and how its variables and mistuning move it."""
     settings: DesignSettings = scene.settings
-    problem = scene.layout.problem(scene.amplitude, settings.band[0], settings.restitution, settings.clearance)
+    bumper = settings.bumper_frequency is not None  # Kelvin-Voigt bumpers, their loss factor the inverse of R
+    problem = scene.layout.problem(scene.amplitude, settings.band[0], settings.restitution, settings.clearance, bumper=bumper,
+                                   bumper_frequency=settings.bumper_frequency if bumper else math.nan)  # fmt: skip
     offsets = mistuning_offsets(settings)
     operating = settings.operating[0] if settings.operating is not None else math.nan
     return DesignSpace(problem, settings.names, tuple(m.name for m in settings.mistuning), tuple(m.relative for m in settings.mistuning),

@@ -53,9 +53,10 @@ def tradeoff_figure(dataset: xr.Dataset) -> DrawnFigure:
     finish_axes(ax, "worst impulse of one impact over the band and the samples [N s]", "worst case |X1| [mm]", "Worst |X1| against the impact: the trade-off")
     outside = _zoom(ax, impulse, objective, front | np.isin(np.arange(impulse.size), [0, int(d.attrs.get("recommended_evaluation", -1))]), shown, 1e3 * linear)
     figure_legend(fig, axes, columns=2)
-    caption = Caption(f"Each of the search's {int(np.count_nonzero(shown))} candidates with both values (closed-form screen): its worst case |X1| over the band and the mistuning samples against "
-                      "the largest impulse of one impact of its stable period-1 impact orbits (scan frequencies, not refined; 0: only contact-free motions are stable). "
-                      "Where a candidate's band is partly uncovered (motions the closed forms do not know) its impulse is a lower bound, and is not drawn where it would read 0.")  # fmt: skip
+    bumpers = d.attrs.get("screen") == "bumper_orbits"
+    caption = Caption(f"Each of the search's {int(np.count_nonzero(shown))} candidates with both values ({'bumper' if bumpers else 'closed-form'} screen): its worst case |X1| over the band and the mistuning samples against "
+                      f"the largest impulse of one {'contact (the integral of the bumper force over it)' if bumpers else 'impact'} of its stable period-1 impact orbits (scan frequencies, not refined; 0: only contact-free motions are stable). "
+                      "Where a candidate's band is partly uncovered (motions the screen does not know) its impulse is a lower bound, and is not drawn where it would read 0.")  # fmt: skip
     if math.isfinite(linear):
         violation = _linear_violation(d)
         caption.add("linear", f"The green diamond at 0 N s is the {design_titles(d)[2]} of the same mass under the same mistuning ({fmt(1e3 * linear, '.4g')} mm, exact band peaks): it has no stop, hence no impact"

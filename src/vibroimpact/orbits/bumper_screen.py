@@ -1,0 +1,238 @@
+"""The largest stable response of a design with Kelvin-Voigt bumpers over a band: the design search's fast objective
+where the stops are bumpers (issue 32), the compliant counterpart of :func:`~vibroimpact.analysis.band_worst.
+closed_form_worst`.
+
+A bumper has no closed-form orbit, but its rigid twin (the same stops, rigid, with the bumper's restitution) has, and
+the bumper's period-1 orbit tends to it as the bumper stiffens (:mod:`vibroimpact.orbits.bumper_map`). So each root
+of the rigid closed form is followed along the scan: at every frequency the bumper's stroboscopic map (exact flow,
+exact Jacobian) is shot from the orbit found at the previous frequency, else from the rigid twin's closed-form orbit
+there, and kept where it converges with a contact per period; its Floquet multipliers say whether it is stable, one
+exact integration over its period gives |X| (the fundamental harmonic) and the impulse of its contact. The contact-free
+motion is the linear closed form, as for a rigid stop. The largest stable |X| of each motion is refined between the
+scan points either side by a bounded scalar search, each trial shot from the nearest orbit found: the maximum's
+frequency to ``tolerance``, not to a scan step.
+
+What this cannot see is what the rigid screen cannot see: period-k and multi-contact orbits and non-periodic
+attractors, the band's share where no motion it knows is stable (:attr:`BandWorst.uncovered`), with the rigid screen's
+guess there (the rigid twin's closed-form orbits that exist, stable or not).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import minimize_scalar
+
+from vibroimpact.analysis.band_worst import MOTIONS, BandWorst, contact_free_curve, existing_impact_curve
+from vibroimpact.analysis.impact_orbit import solve_impact_orbit
+from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.orbits.branch import PeriodicOrbit
+from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures
+from vibroimpact.orbits.shooting import ShootingError, ShootingSettings, shoot
+
+__all__ = ["bumper_worst", "bumper_at", "bumper_curves", "rigid_twin", "bumper_screen_refusal", "BUMPER_SCAN"]
+
+#: Frequencies of the bumper screen's scan (each a shot orbit per root, where the rigid screen solves a closed form).
+BUMPER_SCAN = 61
+#: Newton's tolerance of the screen's shots (scaled residual) [-] and its iterations: from the previous frequency's
+#: orbit 4-6 converge; a shot that needs more is at an orbit's end (grazing, a fold), where the screen gives up.
+_SHOOTING = ShootingSettings(tolerance=1e-10, max_iterations=12)
+#: A shot orbit is stable when its largest Floquet multiplier is below 1 - this [-] (the closed forms' margin).
+_MARGIN = 1e-9
+
+
+def rigid_twin(problem: ImpactProblem) -> ImpactProblem:
+    """``problem`` with each Kelvin-Voigt bumper replaced by a rigid stop of the same clearance and restitution: the
+    limit of infinite bumper stiffness, whose closed-form orbits start the bumper's."""
+    stops = tuple(dataclasses.replace(stop, law=RigidStop(stop.law.clearance, stop.law.restitution)) if isinstance(stop.law, KelvinVoigtBumper) else stop for stop in problem.stops)
+    return ImpactProblem(problem.system, stops, problem.harmonic)
+
+
+def bumper_screen_refusal(problem: ImpactProblem) -> str | None:
+    """Why :func:`bumper_worst` does not apply to ``problem``, or None: its stops must all be bumpers, and their rigid
+    twin must have the closed forms (one stop, or a symmetric pair; no free mass)."""
+    if not problem.stops or not all(isinstance(stop.law, KelvinVoigtBumper) for stop in problem.stops):
+        return "the bumper screen needs every stop to be a Kelvin-Voigt bumper"
+    return closed_form_refusal(rigid_twin(problem))
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class _Point:
+    """One shot bumper orbit on the scan: |X| [m], impulse of its largest contact [N s], stable."""
+
+    orbit: PeriodicOrbit
+    amplitude: float
+    impulse: float
+    stable: bool
+
+
+def _measured(system: ImpactMap, orbit: PeriodicOrbit, coordinate: int) -> _Point | None:
+    """The orbit's |X| and impulse, or None where it has no contact (a contact-free orbit: the linear closed form's)."""
+    if orbit.impacts < 1:
+        return None
+    measures = orbit_measures(system, orbit)
+    impulse = float(np.max(np.abs(measures.impulses))) if measures.impulses.size else 0.0
+    return _Point(orbit, float(measures.amplitudes[coordinate]), impulse, orbit.floquet_modulus < 1.0 - _MARGIN)
+
+
+def _shot(system: ImpactMap, seeds: list[NDArray[np.float64]], p: NDArray[np.float64], coordinate: int) -> _Point | None:
+    """The first seed's orbit that converges with a contact per period, measured (None: none does)."""
+    for seed in seeds:
+        try:
+            orbit = shoot(system, seed, p, settings=_SHOOTING)
+        except (ShootingError, ValueError):
+            continue
+        point = _measured(system, orbit, coordinate)
+        if point is not None:
+            return point
+    return None
+
+
+def _rigid_seed(twin: ImpactMap, p: NDArray[np.float64], root: str) -> NDArray[np.float64] | None:
+    """The rigid twin's closed-form orbit state of ``root`` at parameters ``p`` (None where it does not exist)."""
+    problem = twin.problem_at(p)
+    try:
+        orbit = solve_impact_orbit(problem, root=root)
+    except ValueError:
+        return None
+    return closed_form_state(problem, orbit) if bool(np.all(orbit.exists)) else None
+
+
+def _track(system: ImpactMap, twin: ImpactMap, f: NDArray[np.float64], root: str, coordinate: int) -> list[_Point | None]:
+    """The bumper orbit of one root along the scan: each shot from the previous one found, else (or where that
+    fails) from the rigid twin's closed form, solved only then."""
+    p = np.array(system.parameters, dtype=float)
+    rigid = np.array(twin.parameters, dtype=float)
+    points: list[_Point | None] = []
+    previous: _Point | None = None
+    for frequency in f:
+        p[0] = rigid[0] = frequency
+        found = _shot(system, [previous.orbit.state], p.copy(), coordinate) if previous is not None else None
+        if found is None:
+            seed = _rigid_seed(twin, rigid, root)
+            found = _shot(system, [seed], p.copy(), coordinate) if seed is not None else None
+        previous = found
+        points.append(found)
+    return points
+
+
+def bumper_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: int = 0, scan: int = BUMPER_SCAN, tolerance: float = 1e-7) -> BandWorst:
+    """The largest stable |X| of ``coordinate`` over ``band`` [Hz] among the contact-free motion and the period-1
+    bumper orbits grown from the rigid twin's closed forms (module docstring).
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+        Kelvin-Voigt bumpers whose rigid twin has the closed forms (:func:`bumper_screen_refusal`).
+    band : (float, float)
+        [Hz], low < high.
+    coordinate : int
+        0: the paper's primary mass x1.
+    scan : int
+        Frequencies of the scan (>= 3).
+    tolerance : float
+        Of the refined frequency, relative [-].
+    """
+    low, high = (float(b) for b in band)
+    if not 0.0 < low < high or scan < 3:
+        raise ValueError(f"band = {band!r} must be 0 < low < high [Hz] and scan = {scan} >= 3")
+    reason = bumper_screen_refusal(problem)
+    if reason is not None:
+        raise ValueError(reason)
+    f = np.linspace(low, high, scan)
+    system, twin = ImpactMap(problem), ImpactMap(rigid_twin(problem))
+    free, free_everywhere = contact_free_curve(problem, f, coordinate)
+    covered = np.isfinite(free)
+    best = (0.0, math.nan, MOTIONS[0], 0)
+    if np.any(covered):
+        k = int(np.nanargmax(free))
+        best = (float(free[k]), float(f[k]), MOTIONS[1], 0)  # the contact-free maximum: the linear closed form's, refined below
+        best = max(best, (*_refine_free(problem, f, k, coordinate, tolerance), MOTIONS[1], 0), key=lambda b: b[0])
+    impulse = 0.0
+    for root in ("+", "-"):
+        track = _track(system, twin, f, root, coordinate)
+        x = np.array([pt.amplitude if pt is not None and pt.stable else np.nan for pt in track])
+        stable_impulses = [pt.impulse for pt in track if pt is not None and pt.stable]
+        impulse = max([impulse, *stable_impulses])
+        covered |= np.isfinite(x)
+        if not np.any(np.isfinite(x)):
+            continue
+        k = int(np.nanargmax(x))
+        value, where = _refine(system, f, track, k, coordinate, tolerance)
+        if value > best[0]:
+            best = (value, where, MOTIONS[2], int(track[k].orbit.impacts))  # type: ignore[union-attr]
+    estimate, estimate_frequency = 0.0, math.nan
+    if not covered.all():  # the rigid screen's guess there: the rigid twin's impact orbits that exist, else contact-free
+        guess = np.fmax.reduce([existing_impact_curve(twin.problem, f, coordinate, root) for root in ("+", "-")])
+        there = np.where(np.isfinite(guess), guess, free_everywhere)[~covered]
+        k = int(np.argmax(there))
+        estimate, estimate_frequency = float(there[k]), float(f[~covered][k])
+    return BandWorst(best[0], best[1], best[2], best[3], float(np.count_nonzero(~covered)) / f.size, estimate, estimate_frequency, impulse)
+
+
+def _refine_free(problem: ImpactProblem, f: NDArray[np.float64], k: int, coordinate: int, tolerance: float) -> tuple[float, float]:
+    """The contact-free maximum between the scan points either side of ``k`` where it still fits (bounded search)."""
+    a, b = float(f[max(k - 1, 0)]), float(f[min(k + 1, f.size - 1)])
+
+    def negative(frequency: float) -> float:
+        value = contact_free_curve(problem, np.array([frequency]), coordinate)[0][0]
+        return -float(value) if math.isfinite(value) else 0.0
+
+    found = minimize_scalar(negative, bounds=(a, b), method="bounded", options={"xatol": tolerance * b})
+    return -float(found.fun), float(found.x)
+
+
+def _refine(system: ImpactMap, f: NDArray[np.float64], track: list[_Point | None], k: int, coordinate: int, tolerance: float) -> tuple[float, float]:
+    """The largest stable |X| of the orbit ``track[k]`` between the scan points either side, each trial shot from the
+    nearest scanned orbit (never below the scanned value)."""
+    point = track[k]
+    assert point is not None
+    best = (point.amplitude, float(f[k]))
+    a, b = float(f[max(k - 1, 0)]), float(f[min(k + 1, f.size - 1)])
+    p = np.array(system.parameters, dtype=float)
+
+    def negative(frequency: float) -> float:
+        nearest = min((j for j in (k - 1, k, k + 1) if 0 <= j < f.size and track[j] is not None), key=lambda j: abs(f[j] - frequency))
+        p[0] = frequency
+        trial = _shot(system, [track[nearest].orbit.state], p.copy(), coordinate)  # type: ignore[union-attr]
+        return -trial.amplitude if trial is not None and trial.stable else 0.0
+
+    found = minimize_scalar(negative, bounds=(a, b), method="bounded", options={"xatol": tolerance * b})
+    if -float(found.fun) > best[0]:
+        best = (-float(found.fun), float(found.x))
+    return best
+
+
+def bumper_curves(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int = 0) -> dict[str, tuple[NDArray[np.float64], NDArray[np.int8]]]:
+    """Each root's bumper orbit along frequencies ``f`` [Hz] (ascending; grown as in :func:`bumper_worst`): |X| of
+    ``coordinate`` [m] where one was found (NaN elsewhere) and its state (1 stable, 0 unstable, -1 none)."""
+    system, twin = ImpactMap(problem), ImpactMap(rigid_twin(problem))
+    out = {}
+    for root in ("+", "-"):
+        track = _track(system, twin, np.asarray(f, dtype=float), root, coordinate)
+        x = np.array([pt.amplitude if pt is not None else np.nan for pt in track])
+        state = np.array([-1 if pt is None else int(pt.stable) for pt in track], dtype=np.int8)
+        out[root] = (x, state)
+    return out
+
+
+def bumper_at(problem: ImpactProblem, frequency: float, coordinate: int = 0) -> BandWorst:
+    """The largest stable |X| of ``coordinate`` at one ``frequency`` [Hz] among the contact-free motion and the
+    bumper orbits shot from each root of the rigid twin's closed form (an absorber's operating point)."""
+    f = np.array([float(frequency)])
+    system, twin = ImpactMap(problem), ImpactMap(rigid_twin(problem))
+    free = contact_free_curve(problem, f, coordinate)[0]
+    best = (float(free[0]), float(frequency), MOTIONS[1], 0) if math.isfinite(free[0]) else (0.0, math.nan, MOTIONS[0], 0)
+    covered = math.isfinite(free[0])
+    for root in ("+", "-"):
+        point = _track(system, twin, f, root, coordinate)[0]
+        if point is not None and point.stable:
+            covered = True
+            if point.amplitude > best[0]:
+                best = (point.amplitude, float(frequency), MOTIONS[2], int(point.orbit.impacts))
+    return BandWorst(best[0], best[1], best[2], best[3], 0.0 if covered else 1.0)
