@@ -97,8 +97,8 @@ def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequenci
     start = time.perf_counter()
     # continuation starts from the closed forms (bumpers: their rigid twin's); a layout without them (a free mass ...)
     # is brute force's alone
-    starts = closed_form_refusal(problem) is None or bumper_screen_refusal(problem) is None
-    continued = worst_response(problem, (low, high)) if starts else WorstCase(0.0, math.nan, "", ())
+    closed = closed_form_refusal(problem) is None or bumper_screen_refusal(problem) is None
+    continued = worst_response(problem, (low, high)) if closed else WorstCase(0.0, math.nan, "", ())
     middle = time.perf_counter()
     sweep = band_attractors(problem, (low, high), frequencies=frequencies, starts=starts, transient=transient, strobes=strobes)
     swept = time.perf_counter()

@@ -4,6 +4,7 @@ its key and the allowed range."""
 from __future__ import annotations
 
 import copy
+import math
 
 import pytest
 
@@ -89,3 +90,44 @@ def test_the_linear_optimum_needs_the_paper_s_two_masses() -> None:
     with pytest.raises(SceneError) as caught:
         parse_scene(document)
     assert any(line.startswith("design.compare:") and "paper's two masses" in line for line in caught.value.problems), caught.value.problems
+
+
+def bumper_scene(bumper: object, variables: dict | None = None, restitution: float = 0.2) -> dict:
+    """The scene on a Kelvin-Voigt bumper (``stop.bumper``), its variables ``variables`` (default: the three of
+    ``design_bumper``)."""
+    document = copy.deepcopy(SCENE)
+    document["stop"] = {"clearance": 0.003, "restitution": restitution, "bumper": bumper}
+    document["design"]["variables"] = variables or {"clearance": [0.0005, 0.008], "restitution": [0.05, 0.9], "bumper_stiffness": [4e4, 4e6]}
+    return document
+
+
+def test_a_bumper_design_reads_its_stiffness_in_either_form() -> None:
+    """A bumper given by frequency or by stiffness on m2 = 0.1 kg (K_b = m2 (2 pi 250)^2 = 246 740 N/m): the same
+    250 Hz; ``bumper_stiffness`` is a variable in N/m, and the scene's design problem has a bumper of that frequency
+    whose loss factor gives the restitution."""
+    from vibroimpact.kinds.design.study import design_space
+    from vibroimpact.model.contact import KelvinVoigtBumper
+
+    for bumper in ({"frequency": 250.0}, {"stiffness": 0.1 * (2.0 * math.pi * 250.0) ** 2}):
+        scene = parse_scene(bumper_scene(bumper))
+        settings: DesignSettings = scene.settings
+        assert settings.bumper_frequency == pytest.approx(250.0, rel=1e-12)
+        assert [v.unit for v in settings.variables] == ["m", "1", "N m-1"]
+        law = design_space(scene).problem.stops[0].law
+        assert isinstance(law, KelvinVoigtBumper) and law.frequency == pytest.approx(250.0, rel=1e-12) and law.restitution == pytest.approx(0.2, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("document", "key", "words"),
+    [
+        (bumper_scene({"frequency": 250.0}, {"restitution": [0.0, 0.9]}), "design.variables.restitution[0]", "allowed"),
+        (bumper_scene({"frequency": 250.0}, restitution=0.0), "stop.restitution", "infinite loss factor"),
+        (bumper_scene({"frequency": 250.0, "loss_factor": 0.3}), "stop.bumper", "takes its loss from the restitution"),
+        (scene_with(variables={"bumper_stiffness": [4e4, 4e6]}), "design.variables.bumper_stiffness", "the stops are rigid"),
+        (bumper_scene({"frequency": 250.0}, {"bumper_stiffness": [0.0, 4e6]}), "design.variables.bumper_stiffness[0]", "allowed"),
+    ],
+)
+def test_bumper_mistakes_are_refused_naming_their_key(document: dict, key: str, words: str) -> None:
+    with pytest.raises(SceneError) as caught:
+        parse_scene(document)
+    assert any(line.startswith(f"{key}:") and words in line for line in caught.value.problems), caught.value.problems

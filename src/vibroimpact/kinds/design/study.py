@@ -36,13 +36,15 @@ from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.runner import Runner
 
-__all__ = ["mistuning_offsets", "design_space", "Outcome", "run_design", "DesignStudy", "SECONDS_PER_SAMPLE", "SECONDS_PER_CERTIFICATE", "POLISH_BUDGET"]
+__all__ = ["mistuning_offsets", "design_space", "Outcome", "run_design", "DesignStudy", "SECONDS_PER_SAMPLE", "SECONDS_PER_BUMPER_SAMPLE", "SECONDS_PER_CERTIFICATE", "POLISH_BUDGET"]
 
 #: The polish's evaluations (Nelder-Mead's function evaluations).
 POLISH_BUDGET = 80
 #: Costs of :meth:`DesignStudy.estimate` on the calibration machine: one closed-form worst case (one design, one
-#: sample) and one certification by continuation [s].
+#: sample), one bumper screen's (shot orbits, :mod:`vibroimpact.orbits.bumper_screen`) and one certification by
+#: continuation [s].
 SECONDS_PER_SAMPLE = 0.06
+SECONDS_PER_BUMPER_SAMPLE = 0.2
 SECONDS_PER_CERTIFICATE = 8.0
 
 
@@ -236,10 +238,11 @@ class DesignStudy:
         n, samples = len(settings.variables), settings.samples + 1
         search = settings.search
         candidates = search.points**n if search.method == "grid" else search.population * n * (search.generations + 1) + (POLISH_BUDGET if search.polish else 0)
-        screen = candidates * samples * SECONDS_PER_SAMPLE
+        per_sample = SECONDS_PER_BUMPER_SAMPLE if settings.bumper_frequency is not None else SECONDS_PER_SAMPLE
+        screen = candidates * samples * per_sample
         certify = (2 * settings.certified + 1) * SECONDS_PER_CERTIFICATE  # at most: the rounds may stop after the first
         # a polish step's samples are shared by at most CHUNKS workers (one candidate at a time)
-        polish = POLISH_BUDGET * samples * SECONDS_PER_SAMPLE if search.method != "grid" and search.polish else 0.0
+        polish = POLISH_BUDGET * samples * per_sample if search.method != "grid" and search.polish else 0.0
         wall = (screen - polish) / max(jobs, 1) + polish / max(min(jobs, CHUNKS, samples), 1) + certify / max(min(jobs, 2), 1) + 10.0
         return Estimate(wall_time=wall, memory=400e6, parts={"search": screen, "certification": certify, "report": 10.0},
                         points={"search": f"up to {candidates} candidates x {samples} samples"})  # fmt: skip
