@@ -62,16 +62,19 @@ def test_the_screen_s_maximum_is_the_one_continuation_locates() -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("bumper", "restitution", "clearance"), [(120.0, 0.5, 2e-3), (1000.0, 0.05, 4e-3), (400.0, 0.8, 1e-3)])
-def test_the_screen_agrees_with_continuation_on_other_designs(bumper: float, restitution: float, clearance: float) -> None:
-    """Three more designs (soft and stiff bumpers, small and large R and clearance): the screen's worst case is no
-    larger than continuation's (the screen sees a subset of the branches), and equal where both are the same kind of
-    motion's maximum."""
+@pytest.mark.parametrize(("bumper", "restitution", "clearance", "same"), [(120.0, 0.5, 2e-3, True), (1000.0, 0.05, 4e-3, True), (400.0, 0.8, 1e-3, False)])
+def test_the_screen_agrees_with_continuation_on_other_designs(bumper: float, restitution: float, clearance: float, same: bool) -> None:
+    """Three more designs (soft and stiff bumpers, small and large R and clearance): on the first two both find the
+    same one-contact orbit's maximum (to 1e-9); on the third continuation finds a larger two-contact orbit (9.95 mm
+    against the screen's 7.38 mm): the screen sees period-1 one-contact orbits only, never more than continuation."""
     problem = bumper_problem(bumper, restitution, clearance)
     screened, continued = bumper_worst(problem, BAND), worst_response(problem, BAND)
     assert screened.amplitude <= continued.amplitude * (1.0 + 1e-9)
-    if screened.motion == "impacting, period 1" and continued.motion.startswith("1 impact per period"):
-        assert screened.amplitude == pytest.approx(continued.amplitude, rel=1e-7)
+    assert continued.motion.startswith("1 impact per period") is same
+    if same:
+        assert screened.amplitude == pytest.approx(continued.amplitude, rel=1e-9)
+    else:
+        assert screened.amplitude < 0.8 * continued.amplitude
 
 
 def test_a_stiffening_bumper_tends_to_the_rigid_stop_at_first_order() -> None:
@@ -87,7 +90,7 @@ def test_the_curves_and_the_operating_point_are_the_screen_s() -> None:
     """The response curves the page draws hold the screen's maximum (to the scan's resolution), and the operating
     point at 33 Hz (the absorber's notch) is the contact-free motion, as for the rigid stop."""
     problem = bumper_problem(250.0)
-    f = np.linspace(*BAND, 61)
+    f = np.linspace(*BAND, 97)  # not the screen's scan: its points fall between the screen's
     curves = bumper_curves(problem, f)
     stable = np.fmax.reduce([np.where(state == 1, x, np.nan) for x, state in curves.values()])
     assert np.nanmax(stable) <= bumper_worst(problem, BAND).amplitude * (1.0 + 1e-12)

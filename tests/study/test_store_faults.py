@@ -140,3 +140,19 @@ def test_a_case_cut_off_or_without_its_chunk_is_computed_again(tmp_path: Path) -
     again.save_case("exact-1", {"x": np.arange(10.0), "note": np.array("a text")})
     loaded = again.load_case("exact-1", ("x", "note"))
     assert loaded is not None and np.array_equal(loaded["x"], np.arange(10.0)) and str(loaded["note"]) == "a text"
+
+
+def test_cases_written_by_older_code_are_counted_when_discarded(tmp_path: Path) -> None:
+    """A store of the older layout (a group per case, marked complete) counts its cases in the discard message."""
+    import zarr
+
+    path = tmp_path / "old.zarr"
+    root = zarr.open_group(str(path), mode="a", zarr_format=2)
+    root.attrs.update({"fingerprint": "one", "code": "old", "scene_path": ""})
+    for name in ("exact-1", "exact-2"):
+        group = root.require_group(f"cases/{name}")
+        group.create_array("x", data=np.arange(3.0))
+        group.attrs["complete"] = True
+    lines: list[str] = []
+    StudyStore(path, "two", say=lines.append)
+    assert len(lines) == 1 and "0 finished blocks and 2 finished cases discarded" in lines[0]

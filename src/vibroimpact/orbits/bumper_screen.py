@@ -72,12 +72,21 @@ class _Point:
 
 
 def _measured(system: ImpactMap, orbit: PeriodicOrbit, coordinate: int) -> _Point | None:
-    """The orbit's |X| and impulse, or None where it has no contact (a contact-free orbit: the linear closed form's)."""
+    """The orbit's |X|, stability and (stable orbits) the impulse of its largest contact, or None where it has no
+    contact (a contact-free orbit: the linear closed form's)."""
     if orbit.impacts < 1:
         return None
     measures = orbit_measures(system, orbit)
-    impulse = float(np.max(np.abs(measures.impulses))) if measures.impulses.size else 0.0
-    return _Point(orbit, float(measures.amplitudes[coordinate]), impulse, orbit.floquet_modulus < 1.0 - _MARGIN)
+    stable = orbit.floquet_modulus < 1.0 - _MARGIN
+    return _Point(orbit, float(measures.amplitudes[coordinate]), _contact_impulse(system, orbit) if stable else math.nan, stable)
+
+
+def _contact_impulse(system: ImpactMap, orbit: PeriodicOrbit) -> float:
+    """The largest impulse of one whole contact of the orbit [N s] (the integral of the bumper's force over it): over
+    two of its periods, so that a contact under way at the strobe is also seen whole, not only its part after it."""
+    problem = system.problem_at(orbit.parameters)
+    trajectory = system.engine.integrate(problem, orbit.state, 0.0, 2 * orbit.period * system.periods)
+    return float(np.max(np.abs(trajectory.impulses))) if trajectory.impulses.size else 0.0
 
 
 def _shot(system: ImpactMap, seeds: list[NDArray[np.float64]], p: NDArray[np.float64], coordinate: int) -> _Point | None:

@@ -173,6 +173,12 @@ class ImpactMap:
         self._box = [(self.parameter_names.index(name), float(low), float(high)) for name, (low, high) in self.bounds.items()]
         self._last: tuple[bytes, ImpactProblem] | None = None  # the last problem built: Newton's iterates share their p
 
+    def __getstate__(self) -> dict[str, Any]:
+        """The map without its last problem (a cache: a pickled map sent to a worker carries none)."""
+        state = self.__dict__.copy()
+        state["_last"] = None
+        return state
+
     def resectioned(self, y: NDArray[np.float64], p: NDArray[np.float64], times: int = 1) -> "Resection | None":
         """The orbit through ``y`` (at parameters ``p``) seen through the strobe in the middle of the widest gap its
         contacts leave over ``times`` map iterations: its state there and ``p`` with the moved force phase [rad]
@@ -251,8 +257,9 @@ class ImpactMap:
         """The problem with parameter vector ``p``: its layout scalars (``layout``) set last, on the problem of the
         other parameters (the last one built is kept: a shot's Newton iterates and its line search share ``p``)."""
         key = np.asarray(p, dtype=float).tobytes()
-        if self._last is not None and self._last[0] == key:
-            return self._last[1]
+        last = self._last  # read once: another thread may replace it
+        if last is not None and last[0] == key:
+            return last[1]
         problem = self._problem_before_layout(p)
         if self.layout:
             problem = with_layout(problem, self.layout, p[self._fixed :], self.stops)

@@ -203,6 +203,12 @@ def _lock_owner(lock: Path) -> tuple[int, str, str] | None:
         return None
 
 
+def _count_cases(group: Any) -> int:
+    """Finished cases in the ``cases`` group: arrays with their checksum, and (written by older code) groups marked
+    complete."""
+    return sum(1 for _name, case in group.arrays() if case.attrs.get("checksum")) + sum(1 for _name, case in group.groups() if case.attrs.get("complete"))
+
+
 def _finished_work(path: Path) -> str:
     """'N finished blocks and M finished cases' of the store at ``path`` (what discarding it costs), read part by part
     so that a damaged root does not hide them."""
@@ -215,7 +221,7 @@ def _finished_work(path: Path) -> str:
             pass
         try:
             group = zarr.open_group(str(path / _CASES), mode="r", zarr_format=ZARR_FORMAT)
-            cases = sum(1 for _name, case in group.arrays() if case.attrs.get("checksum"))
+            cases = _count_cases(group)
         except Exception:  # noqa: BLE001 - none, or damaged
             pass
     return f"{blocks} finished blocks and {cases} finished cases"
@@ -287,8 +293,12 @@ class StudyStore:
         path = f"{_CASES}/{name}"
         if path not in self.root:
             return None
-        node = self.root[path]
-        checksum = node.attrs.get("checksum")
+        try:
+            node = self.root[path]
+            checksum = node.attrs.get("checksum")
+        except Exception:  # noqa: BLE001 - damaged metadata (a truncated .zarray or .zattrs): computed again
+            self.damaged_cases += 1
+            return None
         if not isinstance(node, zarr.Array) or not checksum:  # written by older code, or cut off before its checksum
             return None
         try:
@@ -320,7 +330,7 @@ class StudyStore:
         """Finished cases in the store."""
         if _CASES not in self.root:
             return 0
-        return sum(1 for _name, array in self.root[_CASES].arrays() if array.attrs.get("checksum"))
+        return _count_cases(self.root[_CASES])
 
     # -- grid blocks -------------------------------------------------------------------------------------------
 

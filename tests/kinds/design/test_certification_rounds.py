@@ -99,9 +99,11 @@ def test_the_scene_s_design_is_not_certified_twice() -> None:
 
 
 def test_with_a_quantile_a_certificate_raises_its_sample_not_the_whole_objective() -> None:
-    """quantile 0.5 over 5 samples (1.0 ... 1.4 mm screened, the median 1.2 mm): certified 1.35 mm at the nominal
-    sample and its worst one, the nominal's value rises to 1.35 and the worst keeps its 1.4 (certification never
-    lowers a value): the median is 1.3 mm, not the 1.35 that scaling the objective by the largest certificate gave."""
+    """quantile 0.5 over 5 samples (1.0 ... 1.4 mm screened, the median 1.2 mm at sample 2): the certified samples
+    are the nominal and the one that sets the median (not the worst, whose certificate could not move a median);
+    certified 1.35 mm, both rise to 1.35 and the median is 1.35 mm. Had the certificate been 1.25 mm, the median would
+    be 1.25: scaling the objective by the largest certificate over it gave the same here, but not in general (a
+    certificate of the worst sample alone would move the median not at all)."""
     document = copy.deepcopy(SCENE)
     document["design"]["robust"] = {"clearance": 0.0002, "samples": 4, "quantile": 0.5, "seed": 1}
     document["design"]["certify"]["candidates"] = 1
@@ -118,5 +120,9 @@ def test_with_a_quantile_a_certificate_raises_its_sample_not_the_whole_objective
     assert evaluations.scores[1] == pytest.approx(1.2, rel=1e-12)
     outcome = Outcome(scene.settings, space, evaluations)
     _certify(outcome, runner, lambda message: None)  # type: ignore[arg-type]
-    assert runner.batches[0][:2] == [(2e-3, 0), (2e-3, 4)]  # exact: the designs and samples passed on
-    assert outcome.corrected[1] == pytest.approx(1.3, rel=1e-12) and outcome.recommended == 1
+    assert runner.batches[0][:2] == [(2e-3, 0), (2e-3, 2)]  # exact: the designs and samples passed on
+    assert outcome.corrected[1] == pytest.approx(1.35, rel=1e-12) and outcome.recommended == 1
+    runner.certified[2e-3] = 1.25  # a smaller certificate: the nominal's 1.0 -> 1.25, the median's 1.2 -> 1.25
+    outcome = Outcome(scene.settings, space, evaluations)
+    _certify(outcome, runner, lambda message: None)  # type: ignore[arg-type]
+    assert outcome.corrected[1] == pytest.approx(1.25, rel=1e-12)

@@ -131,3 +131,31 @@ def test_bumper_mistakes_are_refused_naming_their_key(document: dict, key: str, 
     with pytest.raises(SceneError) as caught:
         parse_scene(document)
     assert any(line.startswith(f"{key}:") and words in line for line in caught.value.problems), caught.value.problems
+
+
+def test_the_bumper_stiffness_variable_sets_the_bumper_of_every_problem() -> None:
+    """A design's K_b = 1e6 N/m on m2 = 0.1 kg: every sample's problem has Omega_b / 2 pi = sqrt(K_b / m2) / 2 pi
+    (503.3 Hz), and its loss factor still gives the design's R."""
+    from vibroimpact.kinds.design.study import design_space
+
+    space = design_space(parse_scene(bumper_scene({"frequency": 250.0})))
+    for sample in range(space.samples):
+        law = space.problem_at((0.002, 0.4, 1e6), sample).stops[0].law
+        assert law.frequency == pytest.approx(math.sqrt(1e6 / 0.1) / (2.0 * math.pi), rel=1e-12)
+    assert space.problem_at((0.002, 0.4, 1e6), 0).stops[0].law.restitution == pytest.approx(0.4, rel=1e-9)
+
+
+def test_a_general_layout_s_bumpers_give_no_loss_of_their_own() -> None:
+    """``stops:`` with bumpers: a frequency alone is read; a damping (or loss factor) of its own is refused, and so
+    is R = 0."""
+    document = copy.deepcopy(SCENE)
+    del document["stop"]
+    document["design"]["variables"] = {"clearance": [0.0005, 0.008], "bumper_stiffness": [4e4, 4e6]}
+    stop = {"coordinate": "x2", "clearance": 0.003, "restitution": 0.2, "bumper": {"frequency": 250.0}}
+    document["stops"] = [stop]
+    assert parse_scene(copy.deepcopy(document)).settings.bumper_frequency == pytest.approx(250.0, rel=1e-12)
+    for bumper, restitution in (({"stiffness": 2.5e5, "damping": 10.0}, 0.2), ({"frequency": 250.0}, 0.0)):
+        document["stops"] = [stop | {"bumper": bumper, "restitution": restitution}]
+        with pytest.raises(SceneError) as caught:
+            parse_scene(copy.deepcopy(document))
+        assert any(line.startswith("stops:") for line in caught.value.problems), caught.value.problems

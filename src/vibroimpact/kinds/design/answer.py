@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.reporting.style import fmt
 
-__all__ = ["answer_text", "design_titles", "linear_wins", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
+__all__ = ["answer_text", "design_titles", "screen_words", "linear_wins", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
 
 _SYMBOLS = {"clearance": "Delta", "restitution": "R", "bumper_stiffness": "K_b"}
 #: How the page names the compared designs (the dataset's ``design`` dimension, in order).
@@ -218,6 +218,12 @@ def answer_text(dataset: xr.Dataset) -> str:
     return f"Build {variable_text(d, 0)}: worst case |X1| = {_mm(design_worst(d, 0))} {over}{notch(0)} ({'; '.join(others)})."
 
 
+def screen_words(dataset: xr.Dataset) -> str:
+    """How the page names the search's screen (attribute ``screen``): ``closed-form`` (rigid stops), ``bumper``
+    (period-1 bumper orbits shot from the rigid twin's closed forms) or ``brute-force``."""
+    return {"bumper_orbits": "bumper", "brute_force": "brute-force"}.get(str(dataset.attrs.get("screen", "")), "closed-form")
+
+
 def design_titles(dataset: xr.Dataset) -> tuple[str, str, str]:
     """How the page names the compared designs: :data:`DESIGN_TITLES`, the first called "best design with a stop"
     where the linear absorber is the one to build (:func:`linear_wins`)."""
@@ -260,7 +266,10 @@ def warnings(dataset: xr.Dataset) -> list[str]:
         uncovered = float(np.nanmax(d["sample_uncovered"].values[recommended]))
         checked = "the certification found the motions there by brute force" if rows.size else "nothing checked it"
         if uncovered > 0.0:
-            out.append(f"On {fmt(100 * uncovered, '.2g')} % of the band no period-1 motion of the {design_titles(d)[0]} is stable: there its motion is of a kind the closed forms do not know (more impacts, a longer period, or not periodic); the screen guessed its size from the unstable orbits, and {checked}.")
+            if d.attrs.get("screen") == "bumper_orbits":
+                out.append(f"On {fmt(100 * uncovered, '.2g')} % of the band the screen found no stable period-1 motion of the {design_titles(d)[0]} (none there, or a bumper orbit its shots did not reach): there its motion may be one the screen does not know (more contacts, a longer period, or not periodic); the screen guessed its size from the rigid twin's orbits, and {checked}.")
+            else:
+                out.append(f"On {fmt(100 * uncovered, '.2g')} % of the band no period-1 motion of the {design_titles(d)[0]} is stable: there its motion is of a kind the closed forms do not know (more impacts, a longer period, or not periodic); the screen guessed its size from the unstable orbits, and {checked}.")
         if not rows.size:
             out.append(f"The {design_titles(d)[0]} was not certified (certify: candidates 0): its worst case is the screen's alone.")
         for r in rows:
@@ -277,7 +286,9 @@ def warnings(dataset: xr.Dataset) -> list[str]:
     if d.sizes.get("certificate", 0):
         points = d.sizes.get("attractor_point", 0)
         out.append(f"What the certification can miss: an attractor whose basin none of its runs entered (sweeps both ways and two more starts at each of {points} frequencies), or one that lives only between those frequencies; "
-                   + ("the search itself ranked candidates on closed forms (period-1 motions), which a design with a larger multi-impact or non-periodic motion can fool until it is certified."
+                   + ("the search itself ranked candidates on period-1 bumper orbits shot from the rigid twin's closed forms, which a design with a larger multi-contact or non-periodic motion can fool until it is certified."
+                      if d.attrs.get("screen") == "bumper_orbits" else
+                      "the search itself ranked candidates on closed forms (period-1 motions), which a design with a larger multi-impact or non-periodic motion can fool until it is certified."
                       if not np.any(d["sample_motion"].values == 3) else "the search itself ranked candidates by a coarse brute force (no closed form applies to this layout), whose grid and few starts a narrow or rarely reached motion escapes."))
     for failure in d.attrs.get("run_failures", []) if isinstance(d.attrs.get("run_failures"), list) else []:
         out.append(str(failure))

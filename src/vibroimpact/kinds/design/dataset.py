@@ -220,7 +220,7 @@ def _designs(data: dict[str, xr.Variable], scene: Any, outcome: Outcome) -> dict
         if outcome.linear is not None and v.name in ("k2", "b2"):
             column[2] = getattr(outcome.linear.system, v.name)
         data[f"design_{safe_name(v.name)}"] = xr.Variable("design", np.array(column, dtype=float), {"units": v.unit, "long_name": f"{v.name} of the compared design"})
-    closed = outcome.recommended >= 0 and screen_kind(space.problem) != SCREENS[2]  # a ridge of the screen's curves only
+    closed = outcome.recommended >= 0 and screen_kind(space.problem) == SCREENS[0]  # a ridge of the closed forms' curves only (a bumper's have gaps where shots fail)
     ridge = equal_peaks(frequency, {k: curves[k][0] for k in keys}) if closed else (math.nan, math.nan, math.nan)
     attrs: dict[str, object] = {"equal_peak_difference": ridge[0], "equal_peak_frequencies_Hz": np.array(ridge[1:], dtype=float)}
     if outcome.linear is not None:

@@ -217,7 +217,7 @@ def _operating(problem: ImpactProblem, frequency: float, coordinate: int, kind: 
     if at.uncovered == 0.0:  # exact: a share of none
         return at.amplitude, SCREEN_MOTIONS.index(at.motion)
     around = closed_form_worst(problem, _around(frequency), coordinate, 3) if kind == SCREENS[0] else bumper_worst(problem, _around(frequency), coordinate, 3)
-    return around.estimate, SCREEN_MOTIONS.index(at.motion)
+    return max(around.amplitude, around.estimate), SCREEN_MOTIONS.index(at.motion)  # a stable motion found beside it counts too
 
 
 def _around(frequency: float) -> tuple[float, float]:

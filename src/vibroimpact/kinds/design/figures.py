@@ -27,7 +27,7 @@ from matplotlib.ticker import FormatStrFormatter, LogFormatter
 from matplotlib.tri import Triangulation, TriAnalyzer
 from numpy.typing import NDArray
 
-from vibroimpact.kinds.design.answer import design_evaluation, design_titles, design_text, mistuning_spreads, present_designs, search_path, stage_counts, unit_text, variable_names
+from vibroimpact.kinds.design.answer import design_evaluation, design_titles, design_text, mistuning_spreads, present_designs, screen_words, search_path, stage_counts, unit_text, variable_names
 from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.reporting.page import DrawnFigure
 from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure
@@ -194,7 +194,7 @@ def search_figure(dataset: xr.Dataset) -> DrawnFigure:
         bar.ax.set_yticklabels([fmt(10**t, ".3g") for t in levels[::2]])
         bar.set_label("worst case |X1| over the band and the samples [mm]")
     counts = stage_counts(d)
-    caption = Caption(f"The search's {d.sizes['evaluation']} candidates over {' and '.join(names[:3]) if projected else ' and '.join(names)}: each candidate's worst case |X1| over the band and the mistuning samples (closed-form screen), in mm.")
+    caption = Caption(f"The search's {d.sizes['evaluation']} candidates over {' and '.join(names[:3]) if projected else ' and '.join(names)}: each candidate's worst case |X1| over the band and the mistuning samples ({screen_words(d)} screen), in mm.")
     if projected:
         caption.add("projected", f"{len(names)} variables: each map is a projection, the other variables vary from point to point (a point's colour is its own worst case, the best drawn on top); the last panel is the worst case in evaluation order.")
     else:
@@ -243,7 +243,7 @@ def _search_line(d: xr.Dataset, name: str) -> DrawnFigure:
     finish_axes(ax, label, "worst case |X1| [mm]", f"The search over {name}", log=True)
     _plain_log(ax)
     figure_legend(fig, axes, columns=3)
-    caption = Caption(f"The worst case |X1| over the band and the mistuning samples (closed-form screen, mm, log scale) of each of the search's {d.sizes['evaluation']} candidates against {name}.")
+    caption = Caption(f"The worst case |X1| over the band and the mistuning samples ({screen_words(d)} screen, mm, log scale) of each of the search's {d.sizes['evaluation']} candidates against {name}.")
     caption.add("path", f"The vermillion line joins the best design so far each time it improved; the blue star is the {design_titles(d)[0]}, the orange square the scene's own (at the edge when outside the bounds).")
     return DrawnFigure(fig, "design_search", "The objective over the design variable, and the search's path", caption.text())
 
@@ -356,10 +356,11 @@ def response_figure(dataset: xr.Dataset) -> DrawnFigure:
     entries += [Line2D([], [], **look, label=label) for kind, (look, label) in _LOOKS.items() if kind in kinds]
     caption = Caption("|X1| (fundamental amplitude of the primary mass, mm, log scale) of the compared designs without mistuning; colour: whose design.")
     if compare:
-        caption.add("compare", "The first panel overlays each design's worst stable motion at each frequency (gaps: no closed-form period-1 motion is stable there); the others show every motion of one design.")
-    caption.add("lines", "Thin solid: the contact-free motion where it clears the stop; thick solid and dashed: the stable and unstable period-1 impact orbits (both roots of the impulse equation, where admissible); dotted grey: the contact-free motion where it would cross the stop, not a motion.")
+        caption.add("compare", f"The first panel overlays each design's worst stable motion at each frequency (gaps: no {screen_words(d)} period-1 motion is stable there); the others show every motion of one design.")
+    roots = "the bumper orbits grown from both roots of the rigid twin's impulse equation, where its shots converged" if screen_words(d) == "bumper" else "both roots of the impulse equation, where admissible"
+    caption.add("lines", f"Thin solid: the contact-free motion where it clears the stop; thick solid and dashed: the stable and unstable period-1 impact orbits ({roots}); dotted grey: the contact-free motion where it would cross the stop, not a motion.")
     if kinds & {"branch_stable", "branch_unstable"}:
-        caption.add("branches", "Dots: orbits of the branches continued from the closed-form ones (dark stable, light unstable).")
+        caption.add("branches", f"Dots: orbits of the branches continued from the {'bumper orbits shot from the rigid twin' + chr(39) + 's closed forms' if screen_words(d) == 'bumper' else 'closed-form ones'} (dark stable, light unstable).")
     if "certified" in kinds:
         caption.add("certified", "The vermillion star is the certified worst case over the band (continuation, no mistuning).")
     caption.add("worst", "The black ring is the worst case over the band without mistuning (the screen's value; the linear absorber's band peak).")

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from vibroimpact.kinds.design.answer import answer_text, design_titles, linear_wins, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, stage_counts, unit_text, variable_names, warnings
+from vibroimpact.kinds.design.answer import answer_text, design_titles, linear_wins, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, screen_words, stage_counts, unit_text, variable_names, warnings
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, design_figures
 from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.kinds.design.tradeoff import front_text, tradeoff_figure
@@ -92,7 +92,7 @@ def designs_table(dataset: xr.Dataset) -> str:
     lines.append("</table>")
     note = ("<p><small>★ bold: the least value of the column. Worst case: the largest stable |X1| over the band; over the samples: the largest "
             "under any mistuning sample (sample 0 is the nominal design); certified: the largest found by continuing every branch from the "
-            "closed-form orbits (nominal sample and the worst one).</small></p>")  # fmt: skip
+            f"{'bumper orbits shot from the rigid twin' + chr(39) + 's closed forms' if screen_words(d) == 'bumper' else 'closed-form orbits'} (nominal sample and the one that sets the objective).</small></p>")  # fmt: skip
     return "".join(lines) + note
 
 
@@ -159,7 +159,7 @@ def method_text(dataset: xr.Dataset) -> str:
     jobs = d.attrs.get("run_jobs")
     workers = f" on {int(jobs)} worker{'s' if int(jobs) != 1 else ''}" if isinstance(jobs, (int, np.integer)) else ""
     parts.append(f"<p><b>The search.</b> {how}. {n} candidates in all, by stage: {stages} (the reference is the scene's own design); {n * samples} "
-                 f"closed-form problems in {fmt(search_time, '.3g')} s of wall time{workers}, {fmt(1e3 * per, '.3g')} ms a problem.</p>")  # fmt: skip
+                 f"{screen_words(d)} problems in {fmt(search_time, '.3g')} s of wall time{workers}, {fmt(1e3 * per, '.3g')} ms a problem.</p>")  # fmt: skip
     certified = d.sizes["certificate"]
     if certified:
         total = float(np.nansum(d["certificate_wall_time"].values))

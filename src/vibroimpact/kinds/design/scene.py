@@ -261,10 +261,14 @@ def _stop_values(c: Checker, doc: dict, layout: Layout | None) -> tuple[float | 
         c.fail("stops", "every stop of a design scene gives the same clearance and restitution (the design's; the variables move them together)")
         return None, None, None
     bumpers = {spec.bumper_frequency for spec in layout.stops}
-    if len(bumpers) != 1 or any(spec.bumper_loss_factor is not None and spec.bumper_stiffness is None for spec in layout.stops):
-        c.fail("stops", "every stop of a design scene is rigid, or every one has a bumper of the same frequency (or stiffness) without its own loss factor (the restitution gives it)")
+    if len(bumpers) != 1 or any(spec.bumper_loss_factor is not None or spec.bumper_damping is not None for spec in layout.stops):
+        c.fail("stops", "every stop of a design scene is rigid, or every one has a bumper of the same frequency (or stiffness) without its own loss factor or damping (the restitution gives it)")
         return None, None, None
-    return float(values[0][0]), float(values[0][1]), bumpers.pop()  # type: ignore[arg-type]
+    bumper = bumpers.pop()
+    if bumper is not None and float(values[0][1]) <= 0.0:  # type: ignore[arg-type]
+        c.fail("stops", "restitution 0 with bumpers: a bumper's restitution must be above 0 (R = 0 needs an infinite loss factor): allowed (0, 1]")
+        return None, None, None
+    return float(values[0][0]), float(values[0][1]), bumper  # type: ignore[arg-type]
 
 
 def _bumper(c: Checker, key: str, value: Any, layout: Layout | None) -> float | None:

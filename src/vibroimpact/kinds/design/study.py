@@ -8,7 +8,7 @@
    the same mass under the same mistuning (:func:`vibroimpact.analysis.linear_optimum.optimal_linear_absorber`), its
    band peaks exact.
 4. The certification (:class:`~vibroimpact.kinds.design.evaluate.CertifyCase`, :func:`_certify`): the best
-   candidates, one at a time, at the nominal sample and at their worst one, and the scene's design at the nominal
+   candidates, one at a time, at the nominal sample and at the one that sets their objective (their worst), and the scene's design at the nominal
    one, by continuation of every branch from the closed-form orbits and by brute force (every attractor; a larger
    periodic one continued and located exactly); a candidate whose certified worst case exceeds its screen is scored
    on the certified value, the next distinct candidate is certified while it could still be better, and the
@@ -167,14 +167,16 @@ def _certify(outcome: Outcome, runner: Runner, say: Progress) -> None:
 
 
 def _certify_round(outcome: Outcome, runner: Runner, targets: list[int], chosen: list[int]) -> None:
-    """Certify ``targets`` (candidates in ``chosen``: nominal and worst sample; others: nominal) in one batch; each
-    one's score is raised by the ratio of its certified worst case to its screened objective, where larger."""
+    """Certify ``targets`` (candidates in ``chosen``: the nominal sample and the one that sets the objective, the
+    worst with quantile 1; others: nominal) in one batch; each one's score is raised by the ratio of its corrected
+    objective (:func:`_corrected_objective`) to its screened one, where larger."""
     evaluations = outcome.evaluations
     cases, owners = [], []
     done = {(c["evaluation"], c["sample"]) for c in outcome.certified}  # the scene's design, certified in the first round
     for i in targets:
         values = evaluations.values(evaluations.results[i])
-        worst_sample = int(np.nanargmax(values)) if np.any(np.isfinite(values)) and i in chosen else 0  # the scene's design: nominal only
+        # the sample that sets the objective (its quantile; the worst with quantile 1); the scene's design: nominal only
+        worst_sample = int(np.nanargmin(np.abs(values - evaluations.objective(evaluations.results[i])))) if np.all(np.isfinite(values)) and i in chosen else 0
         for sample in dict.fromkeys((0, worst_sample)):
             if (i, sample) in done:
                 continue
