@@ -29,7 +29,7 @@ from vibroimpact.analysis.linear import contact_free_is_stable, linear_amplitude
 from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["BandWorst", "closed_form_worst", "closed_form_at", "contact_free_curve", "existing_impact_curve", "MOTIONS", "SCAN"]
+__all__ = ["BandWorst", "closed_form_worst", "closed_form_at", "contact_free_curve", "existing_impact_curve", "scan_frequencies", "MOTIONS", "SCAN"]
 
 #: Frequencies of the scan whose maxima are refined.
 SCAN = 241
@@ -159,6 +159,15 @@ def _curves(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int) -> 
     return [(root, _curve(problem, f, coordinate, root)) for root in _ROOTS if root is None or problem.stops]
 
 
+def scan_frequencies(band: tuple[float, float], scan: int) -> NDArray[np.float64]:
+    """``scan`` evenly spaced frequencies over ``band`` [Hz], its ends included; ``ValueError`` unless 0 < low < high
+    and scan >= 3."""
+    low, high = (float(b) for b in band)
+    if not 0.0 < low < high or scan < 3:
+        raise ValueError(f"band = {band!r} must be 0 < low < high [Hz] and scan = {scan} >= 3")
+    return np.linspace(low, high, scan)
+
+
 def closed_form_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: int = 0, scan: int = SCAN, tolerance: float = 1e-8) -> BandWorst:
     """The largest stable |X| of ``coordinate`` over ``band`` [Hz] among the closed-form motions (module docstring).
 
@@ -175,10 +184,7 @@ def closed_form_worst(problem: ImpactProblem, band: tuple[float, float], coordin
     tolerance : float
         Of the refined frequency, relative [-].
     """
-    low, high = (float(b) for b in band)
-    if not 0.0 < low < high or scan < 3:
-        raise ValueError(f"band = {band!r} must be 0 < low < high [Hz] and scan = {scan} >= 3")
-    f = np.linspace(low, high, scan)
+    f = scan_frequencies(band, scan)
     curves = _curves(problem, f, coordinate)
     covered = np.zeros(f.size, dtype=bool)
     best = (0.0, math.nan, MOTIONS[0], 0)

@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import minimize_scalar
 
-from vibroimpact.analysis.band_worst import MOTIONS, BandWorst, contact_free_curve, existing_impact_curve
+from vibroimpact.analysis.band_worst import MOTIONS, BandWorst, contact_free_curve, existing_impact_curve, scan_frequencies
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
@@ -138,22 +138,13 @@ def bumper_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: 
     ----------
     problem : ImpactProblem
         Kelvin-Voigt bumpers whose rigid twin has the closed forms (:func:`bumper_screen_refusal`).
-    band : (float, float)
-        [Hz], low < high.
-    coordinate : int
-        0: the paper's primary mass x1.
-    scan : int
-        Frequencies of the scan (>= 3).
-    tolerance : float
-        Of the refined frequency, relative [-].
+    band, coordinate, scan, tolerance
+        As :func:`~vibroimpact.analysis.band_worst.closed_form_worst` (``scan``: shot orbits per root).
     """
-    low, high = (float(b) for b in band)
-    if not 0.0 < low < high or scan < 3:
-        raise ValueError(f"band = {band!r} must be 0 < low < high [Hz] and scan = {scan} >= 3")
+    f = scan_frequencies(band, scan)
     reason = bumper_screen_refusal(problem)
     if reason is not None:
         raise ValueError(reason)
-    f = np.linspace(low, high, scan)
     system, twin = ImpactMap(problem), ImpactMap(rigid_twin(problem))
     free, free_everywhere = contact_free_curve(problem, f, coordinate)
     covered = np.isfinite(free)
