@@ -29,18 +29,18 @@ from scipy.optimize import minimize_scalar
 from vibroimpact.analysis.band_worst import MOTIONS, BandWorst, contact_free_curve, existing_impact_curve, scan_frequencies
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.engines.compliant.period_shooting import PeriodOrbit
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.orbits.branch import PeriodicOrbit
-from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures
-from vibroimpact.orbits.shooting import ShootingError, ShootingSettings, shoot
+from vibroimpact.orbits.maps import ImpactMap
+from vibroimpact.orbits.shooting import ShootingSettings
 
 __all__ = ["bumper_worst", "bumper_at", "bumper_curves", "rigid_twin", "bumper_screen_refusal", "BUMPER_SCAN"]
 
 #: Frequencies of the bumper screen's scan (each a shot orbit per root, where the rigid screen solves a closed form).
 BUMPER_SCAN = 61
 #: Newton's tolerance of the screen's shots (scaled residual) [-] and its iterations: from the previous frequency's
-#: orbit 4-6 converge; a shot that needs more is at an orbit's end (grazing, a fold), where the screen gives up.
+#: orbit 3-6 converge; a shot that needs more is at an orbit's end (grazing, a fold), where the screen gives up.
 _SHOOTING = ShootingSettings(tolerance=1e-10, max_iterations=12)
 #: A shot orbit is stable when its largest Floquet multiplier is below 1 - this [-] (the closed forms' margin).
 _MARGIN = 1e-9
@@ -63,68 +63,75 @@ def bumper_screen_refusal(problem: ImpactProblem) -> str | None:
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class _Point:
-    """One shot bumper orbit on the scan: |X| [m], impulse of its largest contact [N s], stable."""
+    """One shot bumper orbit on the scan: its state at t = 0, contacts per period, |X| [m], impulse of its largest
+    contact [N s], stable."""
 
-    orbit: PeriodicOrbit
+    state: NDArray[np.float64]
+    contacts: int
     amplitude: float
     impulse: float
     stable: bool
 
 
-def _measured(system: ImpactMap, orbit: PeriodicOrbit, coordinate: int) -> _Point | None:
-    """The orbit's |X|, stability and (stable orbits) the impulse of its largest contact, or None where it has no
-    contact (a contact-free orbit: the linear closed form's)."""
-    if orbit.impacts < 1:
+def _measured(system: ImpactMap, problem: ImpactProblem, orbit: PeriodOrbit, coordinate: int) -> _Point | None:
+    """The orbit's |X| (the fundamental harmonic over its period, as :func:`~vibroimpact.orbits.maps.orbit_measures`
+    gives it), stability and (stable orbits) the largest impulse of one whole contact, or None where it has no contact
+    (a contact-free orbit: the linear closed form's). The impulse is taken over two periods, so that a contact under
+    way at the strobe is also seen whole, not only its part after it."""
+    if orbit.contacts < 1:
         return None
-    measures = orbit_measures(system, orbit)
     stable = orbit.floquet_modulus < 1.0 - _MARGIN
-    return _Point(orbit, float(measures.amplitudes[coordinate]), _contact_impulse(system, orbit) if stable else math.nan, stable)
-
-
-def _contact_impulse(system: ImpactMap, orbit: PeriodicOrbit) -> float:
-    """The largest impulse of one whole contact of the orbit [N s] (the integral of the bumper's force over it): over
-    two of its periods, so that a contact under way at the strobe is also seen whole, not only its part after it."""
-    problem = system.problem_at(orbit.parameters)
-    trajectory = system.engine.integrate(problem, orbit.state, 0.0, 2 * orbit.period * system.periods)
-    return float(np.max(np.abs(trajectory.impulses))) if trajectory.impulses.size else 0.0
+    trajectory = system.engine.integrate(problem, orbit.state, 0.0, 2 if stable else 1, moments=True)
+    amplitude = float(np.abs(trajectory.moments[0][coordinate])) * 2.0 / problem.period
+    impulse = (float(np.max(np.abs(trajectory.impulses))) if trajectory.impulses.size else 0.0) if stable else math.nan
+    return _Point(orbit.state, orbit.contacts, amplitude, impulse, stable)
 
 
 def _shot(system: ImpactMap, seeds: list[NDArray[np.float64]], p: NDArray[np.float64], coordinate: int) -> _Point | None:
-    """The first seed's orbit that converges with a contact per period, measured (None: none does)."""
+    """The first seed's orbit that converges with a contact per period, measured (None: none does): Newton on the
+    engine's compiled period (:meth:`~vibroimpact.engines.compliant.exact.CompliantExactEngine.shoot_period`)."""
+    problem = system.problem_at(p)
     for seed in seeds:
         try:
-            orbit = shoot(system, seed, p, settings=_SHOOTING)
-        except (ShootingError, ValueError):
+            orbit = system.engine.shoot_period(problem, seed, system.state_scale, _SHOOTING.tolerance, _SHOOTING.max_iterations, _SHOOTING.min_damping)
+        except ValueError:
             continue
-        point = _measured(system, orbit, coordinate)
+        point = _measured(system, problem, orbit, coordinate) if orbit is not None else None
         if point is not None:
             return point
     return None
 
 
-def _rigid_seed(twin: ImpactMap, p: NDArray[np.float64], root: str) -> NDArray[np.float64] | None:
-    """The rigid twin's closed-form orbit state of ``root`` at parameters ``p`` (None where it does not exist)."""
-    problem = twin.problem_at(p)
-    try:
-        orbit = solve_impact_orbit(problem, root=root)
-    except ValueError:
-        return None
-    return closed_form_state(problem, orbit) if bool(np.all(orbit.exists)) else None
+def _maps(problem: ImpactProblem) -> tuple[ImpactMap, ImpactMap]:
+    """The bumper problem's map and its rigid twin's; the bumper's engine must shoot periods itself."""
+    system = ImpactMap(problem)
+    if not system.engine.capabilities.period_shooting:
+        raise ValueError(f"the bumper screen needs an engine that shoots period-1 orbits itself; {system.engine.name!r} does not")
+    return system, ImpactMap(rigid_twin(problem))
+
+
+def _rigid_seeds(twin: ImpactMap, f: NDArray[np.float64], root: str) -> NDArray[np.float64]:
+    """The rigid twin's closed-form orbit state of ``root`` at each frequency ``f`` [Hz], shape (F, 2N) (NaN rows where
+    it does not exist): one vectorised solve for the whole scan."""
+    orbit = solve_impact_orbit(twin.problem, frequency=f, root=root)
+    states = np.asarray(orbit.state_at(np.zeros(np.shape(orbit.omega) + (1,))), dtype=float).reshape(f.size, -1)
+    exists = np.all(np.asarray(orbit.exists, dtype=bool).reshape(f.size, -1), axis=1)
+    return np.where(exists[:, None], states, np.nan)
 
 
 def _track(system: ImpactMap, twin: ImpactMap, f: NDArray[np.float64], root: str, coordinate: int) -> list[_Point | None]:
     """The bumper orbit of one root along the scan: each shot from the previous one found, else (or where that
-    fails) from the rigid twin's closed form, solved only then."""
+    fails) from the rigid twin's closed form (solved for the whole scan once one is needed)."""
     p = np.array(system.parameters, dtype=float)
-    rigid = np.array(twin.parameters, dtype=float)
     points: list[_Point | None] = []
     previous: _Point | None = None
-    for frequency in f:
-        p[0] = rigid[0] = frequency
-        found = _shot(system, [previous.orbit.state], p.copy(), coordinate) if previous is not None else None
+    seeds: NDArray[np.float64] | None = None
+    for i, frequency in enumerate(f):
+        p[0] = frequency
+        found = _shot(system, [previous.state], p.copy(), coordinate) if previous is not None else None
         if found is None:
-            seed = _rigid_seed(twin, rigid, root)
-            found = _shot(system, [seed], p.copy(), coordinate) if seed is not None else None
+            seeds = _rigid_seeds(twin, f, root) if seeds is None else seeds
+            found = _shot(system, [seeds[i]], p.copy(), coordinate) if np.all(np.isfinite(seeds[i])) else None
         previous = found
         points.append(found)
     return points
@@ -145,7 +152,7 @@ def bumper_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: 
     reason = bumper_screen_refusal(problem)
     if reason is not None:
         raise ValueError(reason)
-    system, twin = ImpactMap(problem), ImpactMap(rigid_twin(problem))
+    system, twin = _maps(problem)
     free, free_everywhere = contact_free_curve(problem, f, coordinate)
     covered = np.isfinite(free)
     best = (0.0, math.nan, MOTIONS[0], 0)
@@ -165,7 +172,7 @@ def bumper_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: 
         k = int(np.nanargmax(x))
         value, where = _refine(system, f, track, k, coordinate, tolerance)
         if value > best[0]:
-            best = (value, where, MOTIONS[2], int(track[k].orbit.impacts))  # type: ignore[union-attr]
+            best = (value, where, MOTIONS[2], track[k].contacts)  # type: ignore[union-attr]
     estimate, estimate_frequency = 0.0, math.nan
     if not covered.all():  # the rigid screen's guess there: the rigid twin's impact orbits that exist, else contact-free
         guess = np.fmax.reduce([existing_impact_curve(twin.problem, f, coordinate, root) for root in ("+", "-")])
@@ -199,7 +206,7 @@ def _refine(system: ImpactMap, f: NDArray[np.float64], track: list[_Point | None
     def negative(frequency: float) -> float:
         nearest = min((j for j in (k - 1, k, k + 1) if 0 <= j < f.size and track[j] is not None), key=lambda j: abs(f[j] - frequency))
         p[0] = frequency
-        trial = _shot(system, [track[nearest].orbit.state], p.copy(), coordinate)  # type: ignore[union-attr]
+        trial = _shot(system, [track[nearest].state], p.copy(), coordinate)  # type: ignore[union-attr]
         return -trial.amplitude if trial is not None and trial.stable else 0.0
 
     found = minimize_scalar(negative, bounds=(a, b), method="bounded", options={"xatol": tolerance * b})
@@ -211,7 +218,7 @@ def _refine(system: ImpactMap, f: NDArray[np.float64], track: list[_Point | None
 def bumper_curves(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int = 0) -> dict[str, tuple[NDArray[np.float64], NDArray[np.int8]]]:
     """Each root's bumper orbit along frequencies ``f`` [Hz] (ascending; grown as in :func:`bumper_worst`): |X| of
     ``coordinate`` [m] where one was found (NaN elsewhere) and its state (1 stable, 0 unstable, -1 none)."""
-    system, twin = ImpactMap(problem), ImpactMap(rigid_twin(problem))
+    system, twin = _maps(problem)
     out = {}
     for root in ("+", "-"):
         track = _track(system, twin, np.asarray(f, dtype=float), root, coordinate)
@@ -225,7 +232,7 @@ def bumper_at(problem: ImpactProblem, frequency: float, coordinate: int = 0) -> 
     """The largest stable |X| of ``coordinate`` at one ``frequency`` [Hz] among the contact-free motion and the
     bumper orbits shot from each root of the rigid twin's closed form (an absorber's operating point)."""
     f = np.array([float(frequency)])
-    system, twin = ImpactMap(problem), ImpactMap(rigid_twin(problem))
+    system, twin = _maps(problem)
     free = contact_free_curve(problem, f, coordinate)[0]
     best = (float(free[0]), float(frequency), MOTIONS[1], 0) if math.isfinite(free[0]) else (0.0, math.nan, MOTIONS[0], 0)
     covered = math.isfinite(free[0])
@@ -234,5 +241,5 @@ def bumper_at(problem: ImpactProblem, frequency: float, coordinate: int = 0) -> 
         if point is not None and point.stable:
             covered = True
             if point.amplitude > best[0]:
-                best = (point.amplitude, float(frequency), MOTIONS[2], int(point.orbit.impacts))
+                best = (point.amplitude, float(frequency), MOTIONS[2], point.contacts)
     return BandWorst(best[0], best[1], best[2], best[3], 0.0 if covered else 1.0)

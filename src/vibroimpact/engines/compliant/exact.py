@@ -36,6 +36,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines.base import MODE_FREE, Trajectory, check_run
 from vibroimpact.engines.compliant import exact_loop
+from vibroimpact.engines.compliant.period_shooting import PeriodOrbit, shoot_period
 from vibroimpact.engines.compliant.model import MODE_CONTACT
 from vibroimpact.engines.exact import StrobeMap, chained_jacobian, stack_flows
 from vibroimpact.engines.exact_flows import Flow, mechanical_null_basis, unforced_flow, with_harmonic
@@ -65,7 +66,17 @@ def bumper_flows(problem: ImpactProblem) -> tuple[tuple[Flow, ...], NDArray[np.f
         (flows, stiffness [N m-1], damping [N s m-1], effective masses [kg]): ``flows[mask]`` is the flow of y = (x, x')
         with the bumpers of the stops in the bit mask pushing (``flows[0]`` the free flight).
     """
-    modes, k_b, b_b, masses = contact_modes(dataclasses.replace(problem, excitation=dataclasses.replace(problem.harmonic, frequency=1.0)))
+    return _flows(problem, _at_one_hertz(problem))
+
+
+def _at_one_hertz(problem: ImpactProblem) -> ImpactProblem:
+    """``problem`` forced at 1 Hz: the key of what does not depend on the forcing frequency."""
+    return dataclasses.replace(problem, excitation=dataclasses.replace(problem.harmonic, frequency=1.0))
+
+
+def _flows(problem: ImpactProblem, unit: ImpactProblem) -> tuple[tuple[Flow, ...], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`bumper_flows`, ``unit`` the problem at 1 Hz."""
+    modes, k_b, b_b, masses = contact_modes(unit)
     size = problem.size
     harmonic, _static = problem.load()
     b = np.concatenate([np.zeros(size, dtype=complex), np.linalg.solve(problem.structure.mass_matrix.astype(complex), harmonic)])
@@ -133,17 +144,15 @@ class _Setup:
     sampling: tuple
 
 
-@lru_cache(maxsize=512)
-def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
-    """Once per problem (a continuation calls the map of one problem thousands of times)."""
-    count, size = len(problem.stops), problem.size
-    if count > MAX_BUMPERS:
-        raise ValueError(f"contact: {count} bumpers; the engine 'compliant_exact' prepares every contact mode (2^K flows) and takes at most {MAX_BUMPERS}")
-    flows, k_b, b_b, masses = bumper_flows(problem)
+@lru_cache(maxsize=256)
+def _contact_geometry(unit: ImpactProblem) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """What the compiled loop watches, whatever the forcing frequency (``unit``: the problem at 1 Hz): per stop, the
+    observables d, -d, F, -F as weights over y and offsets, the weights of n_k . x' and the onset's saltation matrix."""
+    _modes, k_b, b_b, _masses = contact_modes(unit)
+    count, size = len(unit.stops), unit.size
     n = 2 * size
-    normals, clearances = problem.normals(), problem.clearances()
+    normals, clearances = unit.normals(), unit.clearances()
     zero = np.zeros(size)
-    # per stop, the observables d, -d, F, -F as weights over y and offsets
     obsw = np.zeros((4 * count, n))
     obso = np.zeros(4 * count)
     velw = np.zeros((count, n))
@@ -155,9 +164,22 @@ def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
         obso[4 * k : 4 * k + 4] = -clearances[k], clearances[k], -k_b[k] * clearances[k], k_b[k] * clearances[k]
         velw[k] = np.concatenate([zero, normals[k]])
         # onset at d = 0: the field jumps by -(0, M^-1 n) B d', d' = n . x' the crossing speed
-        salts[k, size:, :size] -= b_b[k] * np.outer(np.linalg.solve(problem.structure.mass_matrix, normals[k]), normals[k])
-    length = problem.length_scale()
+        salts[k, size:, :size] -= b_b[k] * np.outer(np.linalg.solve(unit.structure.mass_matrix, normals[k]), normals[k])
+    return obsw, obso, velw, salts
+
+
+@lru_cache(maxsize=512)
+def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
+    """Once per problem (a continuation calls the map of one problem thousands of times); what does not depend on the
+    forcing frequency once per problem at any frequency (a scan in frequency sets up a new problem at every step)."""
+    count = len(problem.stops)
+    if count > MAX_BUMPERS:
+        raise ValueError(f"contact: {count} bumpers; the engine 'compliant_exact' prepares every contact mode (2^K flows) and takes at most {MAX_BUMPERS}")
+    unit = _at_one_hertz(problem)
+    flows, k_b, b_b, _masses = _flows(problem, unit)
+    obsw, obso, velw, salts = _contact_geometry(unit)
     velocity = problem.velocity_scale()
+    length = velocity / problem.omega  # problem.length_scale(), without computing the velocity again
     force_tolerances = 1e-15 * (k_b * length + b_b * velocity)
     nodes, weights = gauss_legendre(16)
     arguments = BumperLoopArguments(
@@ -232,6 +254,13 @@ class CompliantExactEngine:
             surface_onsets=onsets[:, 3] > 0.5,
             onset_curvatures=onsets[:, 4].copy(),
         )
+
+    def shoot_period(self, problem: ImpactProblem, guess: NDArray[np.float64], scale: NDArray[np.float64], tolerance: float, max_iterations: int, min_damping: float = 1.0 / 1024.0) -> PeriodOrbit | None:
+        """The period-1 orbit near ``guess`` (x, x') at t = 0 [m, m s-1] by damped Newton on the compiled period, its
+        residual scaled by ``scale`` [m, m s-1] and converged to ``tolerance`` [-] (None: no convergence in
+        ``max_iterations``); :func:`~vibroimpact.engines.compliant.period_shooting.shoot_period`."""
+        check_run(self.name, problem, KelvinVoigtBumper, 1)
+        return shoot_period(_setup(problem, self.settings).arguments, guess, scale, tolerance, max_iterations, min_damping)
 
     def sample(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, times: NDArray[np.float64]) -> tuple[Trajectory, NDArray[np.float64]]:
         """Integrate ``periods`` periods from ``state`` at ``t_start`` [s] and give the states (x, x') at ``times`` [s]
