@@ -313,3 +313,20 @@ def test_a_new_frequency_keeps_the_contact_modes_and_gives_the_same_flows() -> N
         for name in ("eigenvalues", "vectors", "inverse", "harmonic", "constant", "projector", "nilpotent", "drift"):
             assert np.array_equal(getattr(a, name), getattr(b, name)), name  # exact: the same computation
         assert a.omega == b.omega == second.omega  # exact: copied input
+
+
+def test_a_new_frequency_s_loop_arguments_equal_those_made_with_nothing_kept() -> None:
+    """The engine keeps what does not depend on the frequency (the modes' stack, the contact geometry, the load) and
+    makes only the harmonic parts at a new one (a bumper screen and a continuation set up a problem at every step):
+    every argument of the compiled loop equals, to the last bit, the one made with every cache cleared."""
+    from vibroimpact.engines.compliant.exact import forget_problems, loop_arguments
+
+    law = KelvinVoigtBumper(PAPER_CLEARANCE, 613.0, loss_factor_from_restitution(0.41))
+    first, second = (ImpactProblem(PAPER_SYSTEM, law, HarmonicForce(PAPER_AMPLITUDE, f)) for f in (27.0, 27.3))
+    loop_arguments(first)
+    kept = loop_arguments(second)
+    forget_problems()
+    fresh = loop_arguments(second)
+    assert fresh is not kept
+    for name, a, b in zip(fresh._fields, kept, fresh):
+        assert np.asarray(a).dtype == np.asarray(b).dtype and np.array_equal(a, b), name  # exact: the same computation

@@ -37,7 +37,7 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["ExactEngine", "StrobeMap", "chained_jacobian", "loop_setup", "stack_flows"]
+__all__ = ["ExactEngine", "StrobeMap", "chained_jacobian", "loop_setup", "restacked", "stack_flows"]
 
 
 def chained_jacobian(factors: NDArray[np.float64], size: int) -> NDArray[np.float64]:
@@ -106,34 +106,50 @@ def stack_flows(flows: tuple[Flow, ...], omega: float) -> StackedFlows:
     """The flows as the compiled loops' stacked arrays (see :mod:`~vibroimpact.engines.exact_core`), by the loops'
     parameter names: flow f is entry f of each array (the exact engine's free and held flights; the bumper engine's
     contact modes); ``omega`` [rad s-1]."""
+    return restacked(_frequency_free_stack(flows), flows, [flow.harmonic for flow in flows], omega)
+
+
+def _frequency_free_stack(flows: tuple[Flow, ...]) -> StackedFlows:
+    """What :func:`stack_flows` stacks whatever the forcing frequency (its harmonic parts left empty)."""
     count, n = len(flows), flows[0].harmonic.size
     widest = max(flow.eigenvalues.size for flow in flows)
     lams = np.zeros((count, widest), dtype=complex)
     hlams = np.zeros((count, widest), dtype=complex)
     vecs = np.zeros((count, n, widest), dtype=complex)
     invs = np.zeros((count, widest, n), dtype=complex)
-    rates = np.zeros((count, widest + 2), dtype=complex)
-    rinv = np.zeros((count, widest + 3, widest + 2), dtype=complex)
     counts, hcounts = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)
     for f, flow in enumerate(flows):
         m = flow.eigenvalues.size
         half = _half(flow.eigenvalues)
         counts[f], hcounts[f] = m, half.size
         lams[f, :m], hlams[f, : half.size], vecs[f, :, :m], invs[f, :m, :] = flow.eigenvalues, half, flow.vectors, flow.inverse
-        r, inverse = exact_moments.moment_rates(np.ascontiguousarray(flow.eigenvalues), omega)
-        rates[f, : m + 2], rinv[f, : m + 3, : m + 2] = r, inverse
-    hrms = np.array([flow.harmonic for flow in flows], dtype=complex).reshape(count, n)
     csts = np.array([flow.constant for flow in flows], dtype=float).reshape(count, n)
     zpros = np.array([flow.projector for flow in flows], dtype=float).reshape(count, n, n)
     znils = np.array([flow.nilpotent for flow in flows], dtype=float).reshape(count, n, n)
     zdrvs = np.array([flow.drift for flow in flows], dtype=float).reshape(count, n)
     zdrv2s = np.array([flow.drift2 for flow in flows], dtype=float).reshape(count, n)
     polys = np.array([flow.polynomial for flow in flows], dtype=np.bool_)
-    fastests = np.array([omega + (float(np.max(np.abs(flow.eigenvalues))) if flow.eigenvalues.size else 0.0) for flow in flows])
+    empty = np.zeros(0)
     return StackedFlows(
-        lams=lams, counts=counts, vecs=vecs, invs=invs, hrms=hrms, csts=csts, zpros=zpros, znils=znils, zdrvs=zdrvs, zdrv2s=zdrv2s,
-        polys=polys, hlams=hlams, hcounts=hcounts, rates_all=rates, rinv_all=rinv, fastests=fastests,
+        lams=lams, counts=counts, vecs=vecs, invs=invs, hrms=empty.astype(complex), csts=csts, zpros=zpros, znils=znils, zdrvs=zdrvs, zdrv2s=zdrv2s,
+        polys=polys, hlams=hlams, hcounts=hcounts, rates_all=empty.astype(complex), rinv_all=empty.astype(complex), fastests=empty,
     )  # fmt: skip
+
+
+def restacked(stacked: StackedFlows, flows: tuple[Flow, ...], harmonics: list[NDArray[np.complex128]], omega: float) -> StackedFlows:
+    """``stacked`` (the ``flows``' stack at any frequency) at ``omega`` [rad s-1], their harmonic responses
+    ``harmonics``: bit for bit :func:`stack_flows` of the flows with those responses (a scan in frequency keeps the
+    rest of a stack, :func:`_frequency_free_stack`, and makes only this)."""
+    count, widest = stacked.lams.shape
+    rates = np.zeros((count, widest + 2), dtype=complex)
+    rinv = np.zeros((count, widest + 3, widest + 2), dtype=complex)
+    for f, flow in enumerate(flows):
+        m = flow.eigenvalues.size
+        r, inverse = exact_moments.moment_rates(np.ascontiguousarray(flow.eigenvalues), omega)
+        rates[f, : m + 2], rinv[f, : m + 3, : m + 2] = r, inverse
+    hrms = np.array(harmonics, dtype=complex).reshape(count, -1)
+    fastests = np.array([omega + (float(np.max(np.abs(flow.eigenvalues))) if flow.eigenvalues.size else 0.0) for flow in flows])
+    return stacked._replace(hrms=hrms, rates_all=rates, rinv_all=rinv, fastests=fastests)
 
 
 @dataclass(frozen=True, eq=False)

@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import resonance_refusal
 
-__all__ = ["Flow", "decompose", "unforced_flow", "with_harmonic", "mechanical_null_basis", "ExactModel", "build_model"]
+__all__ = ["Flow", "decompose", "unforced_flow", "harmonic_response", "mechanical_null_basis", "ExactModel", "build_model"]
 
 #: Relative size below which an eigenvalue of K (or of the damping on its null space) counts as zero.
 _ZERO = 1e-12
@@ -254,8 +254,13 @@ def unforced_flow(matrix: NDArray[np.float64], constant: NDArray[np.float64], nu
 def with_harmonic(flow: Flow, matrix: NDArray[np.float64], harmonic: NDArray[np.complex128], omega: float) -> Flow:
     """An :func:`unforced_flow` of ``matrix`` (A [s-1]) with the harmonic load b (``harmonic``) at w = ``omega``
     [rad s-1]: :func:`decompose`'s flow, bit for bit."""
-    a = np.asarray(matrix, dtype=float)
-    return dataclasses.replace(flow, harmonic=_harmonic_response(a, np.asarray(harmonic, dtype=complex), flow.eigenvalues, omega), omega=float(omega))
+    return dataclasses.replace(flow, harmonic=harmonic_response(flow, matrix, harmonic, omega), omega=float(omega))
+
+
+def harmonic_response(flow: Flow, matrix: NDArray[np.float64], harmonic: NDArray[np.complex128], omega: float) -> NDArray[np.complex128]:
+    """The harmonic particular solution of :func:`with_harmonic`'s flow, alone (a scan in frequency needs no other
+    part of the flow anew)."""
+    return _harmonic_response(np.asarray(matrix, dtype=float), np.asarray(harmonic, dtype=complex), flow.eigenvalues, omega)
 
 
 def _harmonic_response(a: NDArray[np.float64], b: NDArray[np.complex128], lam: NDArray[np.complex128], omega: float) -> NDArray[np.complex128]:

@@ -38,16 +38,16 @@ from vibroimpact.engines.base import MODE_FREE, Trajectory, check_run
 from vibroimpact.engines.compliant import exact_loop
 from vibroimpact.engines.compliant.period_shooting import PeriodOrbit, shoot_period
 from vibroimpact.engines.compliant.model import MODE_CONTACT
-from vibroimpact.engines.exact import StrobeMap, chained_jacobian, stack_flows
-from vibroimpact.engines.exact_flows import Flow, mechanical_null_basis, unforced_flow, with_harmonic
-from vibroimpact.engines.kernel_arguments import BumperLoopArguments, leading_arguments
+from vibroimpact.engines.exact import StrobeMap, chained_jacobian, restacked, stack_flows
+from vibroimpact.engines.exact_flows import Flow, harmonic_response, mechanical_null_basis, unforced_flow
+from vibroimpact.engines.kernel_arguments import BumperLoopArguments, StackedFlows, leading_arguments
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.engines.registry import ENGINES, Capabilities
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["CompliantExactEngine", "bumper_flows", "contact_modes", "loop_is_cached", "prepare_compiled_loop"]
+__all__ = ["CompliantExactEngine", "bumper_flows", "contact_modes", "loop_arguments", "forget_problems", "loop_is_cached", "prepare_compiled_loop"]
 
 #: Most bumpers of one problem: the engine prepares every contact mode, 2^K flows.
 MAX_BUMPERS = 8
@@ -77,14 +77,35 @@ def _at_one_hertz(problem: ImpactProblem) -> ImpactProblem:
 def _flows(problem: ImpactProblem, unit: ImpactProblem) -> tuple[tuple[Flow, ...], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """:func:`bumper_flows`, ``unit`` the problem at 1 Hz."""
     modes, k_b, b_b, masses = contact_modes(unit)
-    size = problem.size
-    harmonic, _static = problem.load()
-    b = np.concatenate([np.zeros(size, dtype=complex), np.linalg.solve(problem.structure.mass_matrix.astype(complex), harmonic)])
-    flows = []
+    flows = tuple(dataclasses.replace(flow, harmonic=harmonic, omega=float(problem.omega)) for (_a, flow), harmonic in zip(modes, _harmonics(problem, unit, modes)))
+    return flows, k_b, b_b, masses
+
+
+def _harmonics(problem: ImpactProblem, unit: ImpactProblem, modes: tuple) -> list[NDArray[np.complex128]]:
+    """Each contact mode's harmonic particular solution at ``problem``'s frequency (``unit``: the problem at 1 Hz,
+    ``modes`` its :func:`contact_modes`)."""
+    b = _harmonic_load(unit)
+    out = []
     for mask, (a, unforced) in enumerate(modes):
         with _in_contact(mask, len(problem.stops)):
-            flows.append(with_harmonic(unforced, a, b, problem.omega))
-    return tuple(flows), k_b, b_b, masses
+            out.append(harmonic_response(unforced, a, b, problem.omega))
+    return out
+
+
+@lru_cache(maxsize=256)
+def _harmonic_load(unit: ImpactProblem) -> NDArray[np.complex128]:
+    """The harmonic load of the state equation, (0, M^-1 F) [N kg-1], whatever the forcing frequency."""
+    harmonic, _static = unit.load()
+    return np.concatenate([np.zeros(unit.size, dtype=complex), np.linalg.solve(unit.structure.mass_matrix.astype(complex), harmonic)])
+
+
+@lru_cache(maxsize=256)
+def _unforced_stack(unit: ImpactProblem) -> tuple[tuple[Flow, ...], StackedFlows]:
+    """The contact modes' flows and their stack at any frequency (:func:`~vibroimpact.engines.exact.restacked` makes
+    the rest)."""
+    modes, *_ = contact_modes(unit)
+    flows = tuple(flow for _a, flow in modes)
+    return flows, stack_flows(flows, 1.0)
 
 
 @lru_cache(maxsize=256)
@@ -176,18 +197,33 @@ def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
     if count > MAX_BUMPERS:
         raise ValueError(f"contact: {count} bumpers; the engine 'compliant_exact' prepares every contact mode (2^K flows) and takes at most {MAX_BUMPERS}")
     unit = _at_one_hertz(problem)
-    flows, k_b, b_b, _masses = _flows(problem, unit)
+    modes, k_b, b_b, _masses = contact_modes(unit)
+    flows, unforced = _unforced_stack(unit)
+    stacked = restacked(unforced, flows, _harmonics(problem, unit, modes), problem.omega)
     obsw, obso, velw, salts = _contact_geometry(unit)
     velocity = problem.velocity_scale()
     length = velocity / problem.omega  # problem.length_scale(), without computing the velocity again
     force_tolerances = 1e-15 * (k_b * length + b_b * velocity)
     nodes, weights = gauss_legendre(16)
     arguments = BumperLoopArguments(
-        **stack_flows(flows, problem.omega)._asdict(), omega=problem.omega, period=problem.period, obsw=obsw, obso=obso, velw=velw, salts=salts,
+        **stacked._asdict(), omega=problem.omega, period=problem.period, obsw=obsw, obso=obso, velw=velw, salts=salts,
         zero_har=np.zeros(4 * count, dtype=complex), gap_tolerance=1e-15 * length, force_tolerances=force_tolerances,
         max_events=10 * settings.max_impacts_per_period, gl_nodes=nodes, gl_weights=weights,
     )  # fmt: skip
     return _Setup(arguments, leading_arguments(exact_loop.sample_pieces, arguments))
+
+
+def loop_arguments(problem: ImpactProblem, settings: EngineSettings = EngineSettings()) -> BumperLoopArguments:
+    """The compiled loop's leading arguments for ``problem`` (kept per problem, and what does not depend on its
+    forcing frequency per problem at any frequency)."""
+    return _setup(problem, settings).arguments
+
+
+def forget_problems() -> None:
+    """Drop everything kept per problem (the loop's arguments, the contact modes and their stack, the contact geometry,
+    the load): the memory back, and the next problem set up from nothing."""
+    for cached in (_setup, contact_modes, _unforced_stack, _contact_geometry, _harmonic_load):
+        cached.cache_clear()
 
 
 class CompliantExactEngine:
