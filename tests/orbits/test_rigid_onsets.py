@@ -127,7 +127,7 @@ def test_the_closed_form_orbit_is_none_where_none_applies() -> None:
 
 
 def test_the_ladder_is_empty_where_the_impulse_jumps_at_the_onset() -> None:
-    """The paper's system with Delta = 2.3596 mm, R = 0.1893 (design_paper's recommended design): at the onset near
+    """The paper's system with Delta = 2.3596 mm, R = 0.1893 (design_rigid_stop's recommended design): at the onset near
     33.08 Hz the orbit born there grows from grazing (each rung within 5 % of its margin), while at the one near
     20.007 Hz the closed form's orbit on the far side is 0.105 from grazing however close to the root (the impulse
     jumps there): no rung of its ladder is offered (two of them were one orbit, and the continuation's secant between

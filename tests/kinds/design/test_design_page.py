@@ -225,9 +225,9 @@ def test_the_tradeoff_draws_the_front_and_the_designs(two: xr.Dataset) -> None:
 
 
 def test_the_robustness_figure_marks_a_certified_sample_above_the_screen() -> None:
-    """The golden design_paper dataset with the recommended design's worst certified sample raised to twice its
+    """The golden design_rigid_stop dataset with the recommended design's worst certified sample raised to twice its
     screened value: a vermillion star at that value, on that sample's step, and the caption names it."""
-    d = xr.open_dataset(Path(__file__).parents[2] / "golden" / "data" / "design_paper.nc").load()
+    d = xr.open_dataset(Path(__file__).parents[2] / "golden" / "data" / "design_rigid_stop.nc").load()
     r = int(d.attrs["recommended_evaluation"])
     row = int(np.flatnonzero(d["certificate_evaluation"].values == r)[-1])
     sample = int(d["certificate_sample"].values[row])

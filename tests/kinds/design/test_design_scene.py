@@ -94,7 +94,7 @@ def test_the_linear_optimum_needs_the_paper_s_two_masses() -> None:
 
 def bumper_scene(bumper: object, variables: dict | None = None, restitution: float = 0.2) -> dict:
     """The scene on a Kelvin-Voigt bumper (``stop.bumper``), its variables ``variables`` (default: the three of
-    ``design_bumper``)."""
+    ``design_paper``)."""
     document = copy.deepcopy(SCENE)
     document["stop"] = {"clearance": 0.003, "restitution": restitution, "bumper": bumper}
     document["design"]["variables"] = variables or {"clearance": [0.0005, 0.008], "restitution": [0.05, 0.9], "bumper_stiffness": [4e4, 4e6]}
