@@ -54,10 +54,11 @@ def screen_kind(problem: ImpactProblem) -> str:
     return SCREENS[1] if bumper_screen_refusal(problem) is None else SCREENS[2]
 
 
-def screen_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: int, scan: int) -> BandWorst:
+def screen_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: int, scan: int, kind: str | None = None) -> BandWorst:
     """The screen's worst case of ``problem`` over ``band`` [Hz]: the closed forms' (``scan`` frequencies) or the
-    bumper orbits' (:data:`~vibroimpact.orbits.bumper_screen.BUMPER_SCAN` frequencies, each a shot orbit)."""
-    if screen_kind(problem) == SCREENS[0]:
+    bumper orbits' (:data:`~vibroimpact.orbits.bumper_screen.BUMPER_SCAN` frequencies, each a shot orbit); ``kind``:
+    its :func:`screen_kind` where the caller has it."""
+    if (kind if kind is not None else screen_kind(problem)) == SCREENS[0]:
         return closed_form_worst(problem, band, coordinate, scan)
     return bumper_worst(problem, band, coordinate)
 
@@ -190,7 +191,7 @@ class DesignCase:
                 problem = self.space.problem_at(self.design, s)
                 kind = screen_kind(problem)
                 if kind != SCREENS[2]:
-                    found = screen_worst(problem, self.space.band, self.space.coordinate, self.space.scan)
+                    found = screen_worst(problem, self.space.band, self.space.coordinate, self.space.scan, kind)
                     values = (found.amplitude, found.frequency, found.uncovered, found.estimate, SCREEN_MOTIONS.index(found.motion))
                     out["impulse"][row] = found.impulse
                 else:  # no closed form (a free mass, stops that are not one or a symmetric pair): brute force screens

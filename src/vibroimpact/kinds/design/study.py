@@ -6,7 +6,7 @@
    candidate's closed-form worst case under every sample, through the runner (resumable, spread over workers).
 3. The comparisons: the scene's own design, and (``compare: linear_optimum``) the H-infinity optimum linear absorber of
    the same mass under the same mistuning (:func:`vibroimpact.analysis.linear_optimum.optimal_linear_absorber`), its
-   band peaks exact.
+   band peaks exact: in this process, while the workers certify.
 4. The certification (:class:`~vibroimpact.kinds.design.evaluate.CertifyCase`, :func:`_certify`): the best
    candidates, one at a time, at the nominal sample and at the one that sets their objective (their worst), and the scene's design at the nominal
    one, by continuation of every branch from the closed-form orbits and by brute force (every attractor; a larger
@@ -19,6 +19,7 @@
 from __future__ import annotations
 
 import math
+import threading
 import time
 from typing import Any
 
@@ -44,7 +45,7 @@ POLISH_BUDGET = 80
 #: sample), one bumper screen's (shot orbits, :mod:`vibroimpact.orbits.bumper_screen`) and one certification by
 #: continuation [s].
 SECONDS_PER_SAMPLE = 0.06
-SECONDS_PER_BUMPER_SAMPLE = 0.2
+SECONDS_PER_BUMPER_SAMPLE = 0.15
 SECONDS_PER_CERTIFICATE = 8.0
 
 
@@ -112,9 +113,25 @@ def run_design(scene: Any, progress: Progress | None = None, runner: Runner | No
             nelder_mead_polish(evaluations, POLISH_BUDGET, say if progress is not None else None)
     outcome.wall_times["search"] = time.perf_counter() - start
     say(f"design: {len(evaluations.scores)} candidates evaluated in {outcome.wall_times['search']:.0f} s; best screened worst case {1e3 * evaluations.objective(evaluations.results[evaluations.best()]):.4g} mm")
-    if settings.compare == "linear_optimum":
-        _linear(outcome, scene.amplitude)
-    _certify(outcome, runner, say)
+    # the linear optimum in this process while the workers certify (a certification round often leaves one idle)
+    failed: list[BaseException] = []
+
+    def compare() -> None:
+        try:
+            _linear(outcome, scene.amplitude)
+        except BaseException as error:  # said by the main thread, after the certification
+            failed.append(error)
+
+    linear = threading.Thread(target=compare, name="linear optimum") if settings.compare == "linear_optimum" else None
+    if linear is not None:
+        linear.start()
+    try:
+        _certify(outcome, runner, say)
+    finally:
+        if linear is not None:
+            linear.join()
+    if failed:
+        raise failed[0]
     return design_dataset(scene, outcome)
 
 
