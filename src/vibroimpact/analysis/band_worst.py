@@ -29,7 +29,7 @@ from vibroimpact.analysis.linear import contact_free_is_stable, linear_amplitude
 from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["BandWorst", "closed_form_worst", "closed_form_at", "contact_free_curve", "existing_impact_curve", "scan_frequencies", "MOTIONS", "SCAN"]
+__all__ = ["BandWorst", "closed_form_worst", "closed_form_at", "contact_free_curve", "existing_impact_curve", "scan_frequencies", "MOTIONS", "SCAN", "refine_maximum"]
 
 #: Frequencies of the scan whose maxima are refined.
 SCAN = 241
@@ -196,7 +196,7 @@ def closed_form_worst(problem: ImpactProblem, band: tuple[float, float], coordin
         if not np.any(np.isfinite(x)):
             continue
         for i in _maxima(x):
-            value, where = _refine(problem, f, i, float(x[i]), coordinate, root, tolerance)
+            value, where = refine_maximum(problem, f, i, float(x[i]), coordinate, root, tolerance)
             if value > best[0]:
                 best = (value, where, motion, impacts)
     estimate, estimate_frequency = 0.0, math.nan
@@ -219,7 +219,7 @@ def _maxima(x: NDArray[np.float64]) -> list[int]:
     return sorted(found, key=lambda i: -y[i])
 
 
-def _refine(problem: ImpactProblem, f: NDArray[np.float64], i: int, value: float, coordinate: int, root: str | None, tolerance: float) -> tuple[float, float]:
+def refine_maximum(problem: ImpactProblem, f: NDArray[np.float64], i: int, value: float, coordinate: int, root: str | None, tolerance: float) -> tuple[float, float]:
     """The maximum of the motion ``root`` (:func:`_curve`) between the scan points either side of ``i``, where it
     stays stable and admissible, never below the scanned ``value``: zoomed scans of :data:`ZOOM` points, each over
     the two steps around the previous one's maximum, until a step is below ``tolerance`` of the frequency (one

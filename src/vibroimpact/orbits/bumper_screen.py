@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import minimize_scalar
 
-from vibroimpact.analysis.band_worst import MOTIONS, BandWorst, contact_free_curve, existing_impact_curve, scan_frequencies
+from vibroimpact.analysis.band_worst import MOTIONS, BandWorst, contact_free_curve, existing_impact_curve, refine_maximum, scan_frequencies
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.engines.compliant.period_shooting import PeriodOrbit
@@ -159,7 +159,7 @@ def bumper_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: 
     if np.any(covered):
         k = int(np.nanargmax(free))
         best = (float(free[k]), float(f[k]), MOTIONS[1], 0)  # the contact-free maximum: the linear closed form's, refined below
-        best = max(best, (*_refine_free(problem, f, k, coordinate, tolerance), MOTIONS[1], 0), key=lambda b: b[0])
+        best = max(best, (*refine_maximum(problem, f, k, float(free[k]), coordinate, None, tolerance), MOTIONS[1], 0), key=lambda b: b[0])
     impulse = 0.0
     for root in ("+", "-"):
         track = _track(system, twin, f, root, coordinate)
@@ -180,18 +180,6 @@ def bumper_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: 
         k = int(np.argmax(there))
         estimate, estimate_frequency = float(there[k]), float(f[~covered][k])
     return BandWorst(best[0], best[1], best[2], best[3], float(np.count_nonzero(~covered)) / f.size, estimate, estimate_frequency, impulse)
-
-
-def _refine_free(problem: ImpactProblem, f: NDArray[np.float64], k: int, coordinate: int, tolerance: float) -> tuple[float, float]:
-    """The contact-free maximum between the scan points either side of ``k`` where it still fits (bounded search)."""
-    a, b = float(f[max(k - 1, 0)]), float(f[min(k + 1, f.size - 1)])
-
-    def negative(frequency: float) -> float:
-        value = contact_free_curve(problem, np.array([frequency]), coordinate)[0][0]
-        return -float(value) if math.isfinite(value) else 0.0
-
-    found = minimize_scalar(negative, bounds=(a, b), method="bounded", options={"xatol": tolerance * b})
-    return -float(found.fun), float(found.x)
 
 
 def _refine(system: ImpactMap, f: NDArray[np.float64], track: list[_Point | None], k: int, coordinate: int, tolerance: float) -> tuple[float, float]:
