@@ -238,3 +238,20 @@ def test_the_robustness_figure_marks_a_certified_sample_above_the_screen() -> No
     assert len(stars) == 1 and stars[0].get_xdata()[0] == pytest.approx(2e3 * screened, rel=1e-12)
     assert f"sample {sample}: {2e3 * screened:.4g} mm" in drawn.caption and "certified up to" in drawn.figure.legends[0].get_texts()[0].get_text()
     plt.close(drawn.figure)
+
+
+def test_a_branch_cut_at_the_step_limit_is_warned_with_where_and_how_large_it_was() -> None:
+    """The golden design_paper dataset (a bumper) with the first branch of the recommended design's first certificate
+    marked as stopped at the continuation's step limit: the warnings say so, with that branch's frequency span and
+    largest |X1|, and nothing is said while no branch is cut."""
+    d = xr.open_dataset(Path(__file__).parents[2] / "golden" / "data" / "design_paper.nc").load()
+    r = int(d.attrs["recommended_evaluation"])
+    row = int(np.flatnonzero(d["certificate_evaluation"].values == r)[0])
+    assert not any("step limit" in w for w in warnings(d))
+    branch = d["branch_index"].values[row] == 0.0  # exact: an index
+    assert np.count_nonzero(branch) > 2
+    d["branch_cut"].values[row] = np.where(branch, 1.0, 0.0)
+    said = [w for w in warnings(d) if "step limit" in w]
+    f, x = d["branch_frequency"].values[row][branch], d["branch_amplitude"].values[row][branch]
+    assert len(said) == 1 and "followed 1 branch only as far as the continuation's step limit (2000 steps)" in said[0]
+    assert f"between {np.min(f):.4g} and {np.max(f):.4g} Hz, |X1| up to {1e3 * np.max(x):.4g} mm on it" in said[0]

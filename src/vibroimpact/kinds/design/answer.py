@@ -14,6 +14,7 @@ import yaml
 from numpy.typing import NDArray
 
 from vibroimpact.kinds.design.scene import safe_name
+from vibroimpact.orbits.continuation_settings import ContinuationSettings
 from vibroimpact.reporting.style import fmt
 
 __all__ = ["answer_text", "design_titles", "screen_words", "linear_wins", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
@@ -276,6 +277,9 @@ def warnings(dataset: xr.Dataset) -> list[str]:
             worst, screened = float(d["certificate_worst"].values[r]), float(d["certificate_screened"].values[r])
             if math.isfinite(worst) and worst > screened * (1.0 + 1e-6):
                 out.append(f"The certification found a larger stable motion than the screen under sample {int(d['certificate_sample'].values[r])}: {_mm(worst)} ({d['certificate_motion'].values[r]} at {fmt(d['certificate_frequency'].values[r], '.4g')} Hz) against {_mm(screened)}.")
+            cut = _cut_branches(d, int(r))
+            if cut:
+                out.append(cut)
             error = str(d["certificate_error"].values[r])
             if error:
                 out.append(f"The certification of sample {int(d['certificate_sample'].values[r])} failed: {error}")
@@ -293,3 +297,19 @@ def warnings(dataset: xr.Dataset) -> list[str]:
     for failure in d.attrs.get("run_failures", []) if isinstance(d.attrs.get("run_failures"), list) else []:
         out.append(str(failure))
     return out
+
+
+def _cut_branches(d: xr.Dataset, row: int) -> str:
+    """What certificate ``row`` says of its branches that stopped at the continuation's step limit ("": none)."""
+    if "branch_cut" not in d:
+        return ""
+    cut = d["branch_cut"].values[row] == 1.0  # exact: a 0/1 flag
+    if not np.any(cut):
+        return ""
+    frequency, amplitude, stable = (d[name].values[row][cut] for name in ("branch_frequency", "branch_amplitude", "branch_stable"))
+    count = np.unique(d["branch_index"].values[row][cut]).size
+    steady = amplitude[stable == 1.0]  # exact: a 0/1 flag
+    stable_text = f", stable up to {_mm(float(np.max(steady)))}" if steady.size else ", none of it stable"
+    return (f"The certification of sample {int(d['certificate_sample'].values[row])} followed {count} branch{'es' if count > 1 else ''} only as far as the continuation's "
+            f"step limit ({ContinuationSettings().max_steps} steps): between {fmt(float(np.min(frequency)), '.4g')} and {fmt(float(np.max(frequency)), '.4g')} Hz, |X1| up to "
+            f"{_mm(float(np.max(amplitude)))} on {'them' if count > 1 else 'it'}{stable_text}; past that point {'they are' if count > 1 else 'it is'} not known, and only the brute force looked there.")

@@ -170,7 +170,8 @@ def _certificates(data: dict[str, xr.Variable], outcome: Outcome) -> None:
     data["certificate_sweep_time"] = xr.Variable(("certificate", "accuracy"), np.array([r["sweep_time"] for r in rows], dtype=float).reshape(len(rows), len(SWEEP_ACCURACIES)),
                                                  {"units": "s", "long_name": "what that stepped sweep (one direction) costs at the brute force's measured wall time per point and run"})  # fmt: skip
     for key, units, name in (("frequency", "Hz", "frequency of a continued orbit"), ("amplitude", "m", "|X1| of a continued orbit"), ("stable", "1", "1 where the continued orbit is stable"),
-                             ("impacts", "1", "impacts per period of a continued orbit"), ("index", "1", "which branch of its certificate")):  # fmt: skip
+                             ("impacts", "1", "impacts per period of a continued orbit"), ("index", "1", "which branch of its certificate"),
+                             ("cut", "1", "1 where the continued orbit's branch stopped at the continuation's step limit (followed no further)")):  # fmt: skip
         block = np.array([r[f"branch_{key}"] for r in rows], dtype=float).reshape(len(rows), MAX_BRANCH_POINTS)
         data[f"branch_{key}"] = xr.Variable(("certificate", "point"), block, {"units": units, "long_name": name})
     for key, units, name in (("frequency", "Hz", "frequency of the brute force"), ("amplitude", "m", "largest |X1| of the attractors the brute force found there (every run)")):

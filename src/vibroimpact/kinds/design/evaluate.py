@@ -230,10 +230,11 @@ def _around(frequency: float) -> tuple[float, float]:
 #: :data:`~vibroimpact.simulation.certified_worst.SOURCES`); the continuation's and the brute force's own answers and
 #: wall times [s], and the closed-form screen's wall time on the same problem [s] (NaN: no closed form); the frequencies a stepped sweep needs to reach the same maximum to 1e-4 and 1e-8 (relative) and what
 #: it would cost [s] at the brute force's measured cost per point; the
-#: continued branches' points (frequency [Hz], |X| [m], stable 0/1, impacts per period, branch index), NaN-padded; the
+#: continued branches' points (frequency [Hz], |X| [m], stable 0/1, impacts per period, branch index, 1 where its branch
+#: stopped at the continuation's step limit), NaN-padded; the
 #: brute force's largest |X| at each of its frequencies.
 CERTIFY_FIELDS = ("worst", "frequency", "motion", "source", "continuation_worst", "continuation_time", "brute_worst", "brute_frequency", "brute_motion", "brute_time", "screen_time",
-                  "sweep_points", "sweep_time", "branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index", "attractor_frequency", "attractor_amplitude", "error")  # fmt: skip
+                  "sweep_points", "sweep_time", "branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index", "branch_cut", "attractor_frequency", "attractor_amplitude", "error")  # fmt: skip
 #: Most branch points kept per certified problem.
 MAX_BRANCH_POINTS = 4000
 #: Frequencies of the certification's brute force.
@@ -265,7 +266,7 @@ class CertifyCase:
 
     def run(self, report: ProgressReport | None = None) -> CaseResult:
         """The certified worst case, each method's, and the branches traced (:data:`CERTIFY_FIELDS`)."""
-        points = {k: np.full(MAX_BRANCH_POINTS, np.nan) for k in ("branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index")}
+        points = {k: np.full(MAX_BRANCH_POINTS, np.nan) for k in ("branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index", "branch_cut")}
         attractors = {k: np.full(ATTRACTOR_POINTS, np.nan) for k in ("attractor_frequency", "attractor_amplitude")}
         scalars: dict[str, object] = {k: math.nan for k in ("worst", "frequency", "continuation_worst", "continuation_time", "brute_worst", "brute_frequency", "brute_time", "screen_time")}
         scalars |= {"motion": "", "brute_motion": "", "source": -1}
@@ -298,6 +299,7 @@ class CertifyCase:
             points["branch_stable"][k : k + count] = stable[:count]
             points["branch_impacts"][k : k + count] = np.asarray(branch.impacts, dtype=float)[:count]
             points["branch_index"][k : k + count] = index
+            points["branch_cut"][k : k + count] = float("max_steps" in branch.end)  # followed only as far as the step limit
             k += count
             sets_it = found.source == SOURCES[2] if top is None else (found.source == SOURCES[0] and top.amplitude == found.amplitude)  # exact: the same number passed on
             if sets_it:  # the stable stretch of the branch whose maximum is the worst case
