@@ -330,3 +330,19 @@ def test_a_new_frequency_s_loop_arguments_equal_those_made_with_nothing_kept() -
     assert fresh is not kept
     for name, a, b in zip(fresh._fields, kept, fresh):
         assert np.asarray(a).dtype == np.asarray(b).dtype and np.array_equal(a, b), name  # exact: the same computation
+
+
+@pytest.mark.parametrize("base_motion", [False, True])
+def test_the_loop_s_harmonic_response_is_the_free_flight_s_at_the_problem_s_own_frequency(base_motion: bool) -> None:
+    """What is kept across frequencies must not include the load: a base motion's inertial load grows with w^2. The
+    free flight's harmonic particular solution in the loop's arguments, after a setup at another frequency, is
+    (jw I - A)^-1 b of the problem's own first-order form (an independent path) to 1e-12."""
+    from vibroimpact.engines.compliant.exact import loop_arguments
+
+    law = KelvinVoigtBumper(PAPER_CLEARANCE, 437.0, loss_factor_from_restitution(0.52))
+    amplitude = 1e-4 if base_motion else PAPER_AMPLITUDE  # [m] of the base, or [N]
+    first, second = (ImpactProblem(PAPER_SYSTEM, law, HarmonicForce(amplitude, f, base_motion=base_motion)) for f in (21.0, 33.0))
+    loop_arguments(first)
+    a, b, _b0 = second.first_order()
+    expected = np.linalg.solve(1j * second.omega * np.eye(a.shape[0]) - a, b)
+    assert np.max(np.abs(loop_arguments(second).hrms[0] - expected)) <= 1e-12 * np.max(np.abs(expected))

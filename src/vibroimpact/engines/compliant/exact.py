@@ -77,26 +77,21 @@ def _at_one_hertz(problem: ImpactProblem) -> ImpactProblem:
 def _flows(problem: ImpactProblem, unit: ImpactProblem) -> tuple[tuple[Flow, ...], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """:func:`bumper_flows`, ``unit`` the problem at 1 Hz."""
     modes, k_b, b_b, masses = contact_modes(unit)
-    flows = tuple(dataclasses.replace(flow, harmonic=harmonic, omega=float(problem.omega)) for (_a, flow), harmonic in zip(modes, _harmonics(problem, unit, modes)))
+    flows = tuple(dataclasses.replace(flow, harmonic=harmonic, omega=float(problem.omega)) for (_a, flow), harmonic in zip(modes, _harmonics(problem, modes)))
     return flows, k_b, b_b, masses
 
 
-def _harmonics(problem: ImpactProblem, unit: ImpactProblem, modes: tuple) -> list[NDArray[np.complex128]]:
-    """Each contact mode's harmonic particular solution at ``problem``'s frequency (``unit``: the problem at 1 Hz,
-    ``modes`` its :func:`contact_modes`)."""
-    b = _harmonic_load(unit)
+def _harmonics(problem: ImpactProblem, modes: tuple) -> list[NDArray[np.complex128]]:
+    """Each contact mode's harmonic particular solution at ``problem``'s frequency (``modes``: its
+    :func:`contact_modes`); its load is the problem's own, which may depend on the frequency (a base
+    motion's inertial load grows with w^2)."""
+    harmonic, _static = problem.load()
+    b = np.concatenate([np.zeros(problem.size, dtype=complex), np.linalg.solve(problem.structure.mass_matrix.astype(complex), harmonic)])
     out = []
     for mask, (a, unforced) in enumerate(modes):
         with _in_contact(mask, len(problem.stops)):
             out.append(harmonic_response(unforced, a, b, problem.omega))
     return out
-
-
-@lru_cache(maxsize=256)
-def _harmonic_load(unit: ImpactProblem) -> NDArray[np.complex128]:
-    """The harmonic load of the state equation, (0, M^-1 F) [N kg-1], whatever the forcing frequency."""
-    harmonic, _static = unit.load()
-    return np.concatenate([np.zeros(unit.size, dtype=complex), np.linalg.solve(unit.structure.mass_matrix.astype(complex), harmonic)])
 
 
 @lru_cache(maxsize=256)
@@ -199,7 +194,7 @@ def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
     unit = _at_one_hertz(problem)
     modes, k_b, b_b, _masses = contact_modes(unit)
     flows, unforced = _unforced_stack(unit)
-    stacked = restacked(unforced, flows, _harmonics(problem, unit, modes), problem.omega)
+    stacked = restacked(unforced, flows, _harmonics(problem, modes), problem.omega)
     obsw, obso, velw, salts = _contact_geometry(unit)
     velocity = problem.velocity_scale()
     length = velocity / problem.omega  # problem.length_scale(), without computing the velocity again
@@ -220,9 +215,9 @@ def loop_arguments(problem: ImpactProblem, settings: EngineSettings = EngineSett
 
 
 def forget_problems() -> None:
-    """Drop everything kept per problem (the loop's arguments, the contact modes and their stack, the contact geometry,
-    the load): the memory back, and the next problem set up from nothing."""
-    for cached in (_setup, contact_modes, _unforced_stack, _contact_geometry, _harmonic_load):
+    """Drop everything kept per problem (the loop's arguments, the contact modes and their stack, the contact
+    geometry): the memory back, and the next problem set up from nothing."""
+    for cached in (_setup, contact_modes, _unforced_stack, _contact_geometry):
         cached.cache_clear()
 
 
