@@ -59,7 +59,7 @@ def test_unwritable_out_is_refused_before_any_work(tmp_path: Path, monkeypatch: 
     def never(*args: object, **kwargs: object) -> None:
         raise AssertionError("work started although --out cannot be written")
 
-    monkeypatch.setattr(cli, "run_study", never)
+    monkeypatch.setattr(study, "run_study", never)  # the CLI imports it when a run starts
     assert cli.main([str(write_yaml(tmp_path / "tiny.yaml", base_scene())), "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert f"--out {out} cannot be written" in err and "Traceback" not in err
@@ -316,3 +316,37 @@ def test_sweep_cost_options_make_its_settings() -> None:
     assert settings.methods == ("DOP853",) and settings.reference_rtol is None
     assert settings.sweep.start_frequency > settings.sweep.stop_frequency  # down: 45 -> 15 Hz
     assert settings.engine_settings.rtol == pytest.approx(1e-7) and settings.budget == pytest.approx(5.0)
+
+
+#: What a study's run needs and the CLI's help, listing and scene refusals must not load (each costs 0.1-0.5 s of
+#: import; together they made ``run-study --help`` take 1.1 s on the quiet machine, 13-21 s under load).
+HEAVY_MODULES = ("xarray", "pandas", "zarr", "dask", "distributed", "matplotlib", "numba", "sksundae", "scipy.optimize", "scipy.integrate")
+
+
+def _loaded_after(code: str) -> set[str]:
+    """Which of :data:`HEAVY_MODULES` a fresh interpreter has loaded after running ``code``."""
+    probe = code + f"\nimport sys\nprint(','.join(m for m in {HEAVY_MODULES!r} if m in sys.modules))\n"
+    found = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True, timeout=120)
+    return {name for name in found.stdout.strip().split(",") if name}
+
+
+def test_help_the_listing_and_a_refused_scene_load_none_of_the_run_s_modules() -> None:
+    """The CLI's parser and help, the shipped studies' listing and a refused scene need none of
+    :data:`HEAVY_MODULES`: they answer in a fraction of a second (0.25-0.35 s on the quiet machine, was 1.1-1.2 s)."""
+    code = (
+        "from vibroimpact import cli\n"
+        "from vibroimpact.scene import SceneError, parse_scene, shipped_studies\n"
+        "cli.build_parser().format_help(); cli.study_listing(shipped_studies())\n"
+        "try:\n"
+        "    parse_scene({'name': 'x', 'system': {'m1': -1.0}})\n"
+        "except SceneError:\n"
+        "    pass\n"
+    )
+    assert _loaded_after(code) == set()
+
+
+@pytest.mark.parametrize("scene", ["restitution", "design_paper", "bifurcation_bumper", "absorber_concepts"])
+def test_reading_a_shipped_scene_loads_none_of_the_run_s_modules(scene: str) -> None:
+    """Reading and checking a shipped scene loads nothing a run needs but scipy's solvers (the check converts a
+    restitution into a bumper's loss factor by a root search)."""
+    assert _loaded_after(f"from vibroimpact.scene import load_scene, shipped_studies_dir\nload_scene(shipped_studies_dir() / '{scene}.yaml')") <= {"scipy.optimize"}

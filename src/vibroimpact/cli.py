@@ -18,15 +18,15 @@ import threading
 import tempfile
 import time
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
 from vibroimpact.scene import Scene, SceneError, find_scene, load_scene, shipped_studies
 from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, ClusterLost, Terminated, choose_scheduler, leave_quietly, unreachable
-from vibroimpact.runs.failures import console_line, run_failures
-from vibroimpact.runs.run import read_dataset, write_dataset, run_study
-from vibroimpact.runs.store import OutputBusy, StoreOfAnotherScene, StudyStore, claim_output, store_fingerprint
+
+if TYPE_CHECKING:  # the run's modules (xarray, zarr, dask) load only once a study runs: help, --list and a refused
+    from vibroimpact.runs.store import StudyStore  # scene answer without them
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILURE = 1
@@ -129,6 +129,8 @@ def main(argv: list[str] | None = None) -> int:
     if problem is not None:
         print(f"run-study: error: --out {out_dir} cannot be written: {problem}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    from vibroimpact.runs.store import OutputBusy, StoreOfAnotherScene, StudyStore, claim_output, store_fingerprint
+
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminate)  # SIGTERM ends the run as Ctrl-C does
     try:
@@ -250,6 +252,7 @@ def _report(path: Path, out_dir: Path, jobs: int) -> Path | str:
     from vibroimpact.reporting.page import write_report  # matplotlib is imported only when a report is made
 
     from vibroimpact.runs.cluster import ProgressBar
+    from vibroimpact.runs.run import read_dataset
 
     dataset = read_dataset(path)  # the file's groups joined: the dataset the run gave
     bar = ProgressBar([1.0], [], "page", enabled=True, verb="report", status="drawing the figures")  # its heartbeat
@@ -274,6 +277,9 @@ def unwritable(out_dir: Path) -> str | None:
 
 
 def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, store: StudyStore, scheduler: str | None) -> int:
+    from vibroimpact.runs.failures import console_line, run_failures
+    from vibroimpact.runs.run import run_study, write_dataset
+
     started = time.perf_counter()
     try:
         dataset = run_study(scene, jobs=args.jobs, store=store, scheduler=scheduler, load=False)

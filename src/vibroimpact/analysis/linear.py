@@ -18,7 +18,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import minimize_scalar
 
 from vibroimpact.analysis.layout import harmonic_load_of
 from vibroimpact.model.excitation import HarmonicForce, angular_frequency, check_closed_form_inputs
@@ -275,6 +274,8 @@ def peaks_near(frequencies: ArrayLike, magnitude: Callable[[ArrayLike], NDArray[
         grid = omega_n * np.linspace(1.0 - span, 1.0 + span, 4001)
         k = int(np.argmax(magnitude(grid)))
         lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+        from scipy.optimize import minimize_scalar  # here, not at import: reading a scene must not load scipy's solvers
+
         best = minimize_scalar(lambda w: -float(magnitude(w)), bounds=(lo, hi), method="bounded", options={"xatol": 1e-10 * omega_n})
         peaks.append(ResonancePeak(mode=mode, frequency=float(best.x) / (2.0 * np.pi), value=float(-best.fun)))
     return peaks

@@ -29,7 +29,6 @@ from typing import TYPE_CHECKING, Union
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import brentq
 
 from vibroimpact.model.units import length_text
 from vibroimpact.model.structure import require_finite, require_in_range, require_non_negative, require_positive
@@ -269,6 +268,8 @@ def loss_factor_from_restitution(restitution: float) -> float:
         high *= 2.0
         if high > 1e12:
             raise ValueError(f"restitution = {r!r} is below what a bumper of loss factor up to 1e12 reaches")
+    from scipy.optimize import brentq  # here, not at import: reading a scene must not load scipy's solvers
+
     return float(brentq(lambda xi: restitution_from_loss_factor(xi) - r, 0.0, high, xtol=1e-15, rtol=1e-15))
 
 

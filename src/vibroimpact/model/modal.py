@@ -17,7 +17,6 @@ from functools import lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import least_squares
 
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
@@ -202,6 +201,8 @@ def fit_modal_parameters(system: TwoDofSystem, omega_grid: tuple[float, ...] | N
     start = np.concatenate([np.abs(np.real(exact.form_factor)), np.clip(exact.loss_factor, 1e-9, 0.98)])
     lower = np.array([0.0, 0.0, 1e-12, 1e-12])
     upper = np.array([np.inf, np.inf, 0.99, 0.99])
+    from scipy.optimize import least_squares  # here, not at import: reading a scene must not load scipy's solvers
+
     fit = least_squares(residual, start, bounds=(lower, upper), x_scale=np.abs(start) + 1e-300, xtol=1e-14, ftol=1e-14, gtol=1e-14)
     if not fit.success:
         raise RuntimeError(f"the modal curve fit did not converge: {fit.message}")

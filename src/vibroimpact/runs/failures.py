@@ -13,8 +13,12 @@ of study:
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import xarray as xr
+
+if TYPE_CHECKING:  # only named in signatures: the CLI's help and refusals must not load xarray
+    import xarray as xr
 
 __all__ = ["FAILED_FLAG", "run_failures", "failure_details", "console_line", "as_lines"]
 
