@@ -277,6 +277,7 @@ def unwritable(out_dir: Path) -> str | None:
 
 
 def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, store: StudyStore, scheduler: str | None) -> int:
+    from vibroimpact.kinds.stepped.operating import unreached_text
     from vibroimpact.runs.failures import console_line, run_failures
     from vibroimpact.runs.run import run_study, write_dataset
 
@@ -290,6 +291,9 @@ def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, store: StudyStor
         dataset.attrs["run_peak_memory_bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
         path = write_dataset(dataset, out_dir / f"{scene.name}.nc")  # streamed from the store, chunk by chunk
         print(f"wrote {path}")
+        unreached = unreached_text(dataset)  # a clearance typed in mm runs silently else: say it before the report
+        if unreached:
+            print(f"warning: {unreached}", file=sys.stderr)
         failures = run_failures(dataset)  # read before the store (which a lazy dataset reads) goes
         report: Path | str | None = None
         if scene.report and not args.no_report:

@@ -19,14 +19,32 @@ from vibroimpact.model.modal import exact_modal_parameters, fit_modal_parameters
 from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
 from vibroimpact.reporting.coincide import coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
-from vibroimpact.reporting.record import GeneralSetting, StudySetting
+from vibroimpact.reporting.record import GeneralSetting, StudySetting, named_layout
 from vibroimpact.reporting.style import DISPLACEMENT_SCALE, DISPLACEMENT_UNITS, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour
 
-__all__ = ["SolutionsPage", "linear_section", "linear_figure", "modal_table", "structure_figure", "layout_tables", "stop_constraint", "LINEAR_FIGURE_POINTS"]
+__all__ = ["paper_study", "SolutionsPage", "linear_section", "linear_figure", "modal_table", "structure_figure", "layout_tables", "stop_constraint", "LINEAR_FIGURE_POINTS"]
 
 #: Frequencies of the linear system's figures (0.0075 Hz over 15-45 Hz: the resonances are about 0.1 Hz wide).
 LINEAR_FIGURE_POINTS = 4001
 _FREQUENCY = "frequency [Hz]"
+
+
+def paper_study(dataset: xr.Dataset) -> bool:
+    """Is ``dataset``'s study the paper's own: its layout (:meth:`~vibroimpact.model.layout.Layout.paper_view`) on
+    its system of eq. 24 (:data:`~vibroimpact.model.system.PAPER_SYSTEM`)? Only then do captions cite the paper's
+    figures and equations; any other system gets neutral ones."""
+    return named_layout(dataset) == PAPER_SYSTEM
+
+
+def _titles(paper: bool) -> dict[str, str]:
+    """The linear figures' panel titles and fit labels: citing the paper's figures and equations, or neutral."""
+    if paper:
+        return {"responses": "Linear responses (paper fig. 2)", "force": "Linear force on the base (paper fig. 3)", "fit": "Accuracy of the curve fit (paper fig. 4)",
+                "exact": "|H22| exact (eq. 4)", "fitted": "|H22| of eq. 10, the paper's fitted modes", "against": "against the paper's curve fit (circles)",
+                "no_fit": "(the paper's fit needs two underdamped modes)"}  # fmt: skip
+    return {"responses": "Linear responses", "force": "Linear force on the base", "fit": "Accuracy of the two-mode curve fit", "exact": "|H22| exact",
+            "fitted": "|H22| of the two-mode curve fit", "against": "against the two-mode curve fit with the undamped natural frequencies held (circles)",
+            "no_fit": "(the two-mode curve fit needs two underdamped modes)"}  # fmt: skip
 
 
 class SolutionsPage:
@@ -50,13 +68,16 @@ class SolutionsPage:
         return f"solutions: {', '.join(self.setting.solutions)}"
 
 
-def linear_section(setting: StudySetting, out: Path) -> Section:
-    """The section the swept-sine and bumper pages open with: the linear system and the modal parameters of H22."""
-    return Section("Linear system", figures=saved([linear_figure(setting)], out), tables=[modal_table(setting.system)])
+def linear_section(setting: StudySetting, out: Path, paper: bool = True) -> Section:
+    """The section the swept-sine and bumper pages open with: the linear system and the modal parameters of H22
+    (captions citing the paper where ``paper``, :func:`paper_study`)."""
+    return Section("Linear system", figures=saved([linear_figure(setting, paper)], out), tables=[modal_table(setting.system)])
 
 
-def linear_figure(setting: StudySetting) -> DrawnFigure:
-    """Linear responses, force on the base and the curve fit of H22 (paper figures 2-4)."""
+def linear_figure(setting: StudySetting, paper: bool = True) -> DrawnFigure:
+    """Linear responses, force on the base and the curve fit of H22 (paper figures 2-4; their captions cite the
+    paper only where ``paper``)."""
+    titles = _titles(paper)
     system = setting.system
     # the closed form is cheap: a fine grid over the study's range (its own grid may be a handful of points)
     f = np.union1d(setting.frequency, np.linspace(setting.frequency.min(), setting.frequency.max(), LINEAR_FIGURE_POINTS))
@@ -69,21 +90,21 @@ def linear_figure(setting: StudySetting) -> DrawnFigure:
     ax.semilogy(f, DISPLACEMENT_SCALE * np.abs(response.x2), label="|X2| absorber", color="C1", lw=1.4, gid="linear")
     for delta in setting.clearance:
         ax.axhline(DISPLACEMENT_SCALE * delta, color="k", lw=0.9, ls="--")
-    finish_axes(ax, _FREQUENCY, f"amplitude [{DISPLACEMENT_UNITS}]", "Linear responses (paper fig. 2)")
+    finish_axes(ax, _FREQUENCY, f"amplitude [{DISPLACEMENT_UNITS}]", titles["responses"])
     ax = axes[1]
     ax.semilogy(f, np.abs(response.force), color="C2", lw=1.4, gid="linear")
-    finish_axes(ax, _FREQUENCY, "|F| on the base [N]", "Linear force on the base (paper fig. 3)")
+    finish_axes(ax, _FREQUENCY, "|F| on the base [N]", titles["force"])
     ax = axes[2]
-    ax.semilogy(f, np.abs(system.receptances(w).h22), label="|H22| exact (eq. 4)", color="k", lw=1.4)
+    ax.semilogy(f, np.abs(system.receptances(w).h22), label=titles["exact"], color="k", lw=1.4)
     if fit is not None:
         step = max(1, f.size // 120)
-        ax.semilogy(f[::step], np.abs(fit.receptance(w[::step])), "o", color="C3", mfc="none", ms=4.5, label="|H22| of eq. 10, the paper's fitted modes")
-    finish_axes(ax, _FREQUENCY, "|H22| [m/N]", "Accuracy of the curve fit (paper fig. 4)")
+        ax.semilogy(f[::step], np.abs(fit.receptance(w[::step])), "o", color="C3", mfc="none", ms=4.5, label=titles["fitted"])
+    finish_axes(ax, _FREQUENCY, "|H22| [m/N]", titles["fit"])
     figure_legend(fig, axes, [Line2D([], [], color="k", lw=0.9, ls="--", label="clearance Delta")])
     natural = ", ".join(fmt(x / (2 * np.pi), ".3f") for x in system.natural_angular_frequencies())
     caption = (
         f"Linear system (Delta -> infinity): |X1| and |X2| (dashed: the clearance), the force on the base, and |H22| exact "
-        f"{'against the paper' + chr(39) + 's curve fit (circles)' if fit is not None else '(the paper' + chr(39) + 's fit needs two underdamped modes)'}. "
+        f"{titles['against'] if fit is not None else titles['no_fit']}. "
         f"Natural frequencies {natural} Hz, anti-resonance {fmt(system.antiresonance_angular_frequency() / (2 * np.pi), '.3f')} Hz."
     )
     return DrawnFigure(fig, "linear", "Linear responses, force on the base, fit of H22", caption)
@@ -103,14 +124,16 @@ def modal_table(system: TwoDofSystem) -> Table:
         )
     note = "The paper prints A = 2.75, 7.25 and xi = 0.0022, 0.0023 for its system (eq. 24)." if system == PAPER_SYSTEM else ""
     if fit is None:
-        note += " The system has fewer than two underdamped modes: the paper's fit does not apply."
+        note += " The system has fewer than two underdamped modes: the two-mode curve fit does not apply."
     return Table("Modal parameters of H22", "<table>" + "".join(rows) + f"</table><p>{note}</p>")
 
 
-def structure_figure(setting: GeneralSetting, frequency: np.ndarray) -> DrawnFigure:
+def structure_figure(setting: GeneralSetting, frequency: np.ndarray, paper: bool = False) -> DrawnFigure:
     """The linear system: |X| of every coordinate, |n_k . X| of every stop's coordinate (dashed) against the gap the
     static deflection leaves it, Delta_k - n_k . x_static (dotted, the stop's colour), the force on the base, and,
-    where the structure has the named view, |H22| exact against the paper's curve fit (paper figures 2-4)."""
+    where the structure has the named view, |H22| exact against the two-mode curve fit (paper figures 2-4; their
+    captions cite the paper only where ``paper``, :func:`paper_study`)."""
+    titles = _titles(paper)
     f = np.union1d(frequency, np.linspace(frequency.min(), frequency.max(), LINEAR_FIGURE_POINTS))
     w = 2.0 * np.pi * f
     x = setting.linear(w)
@@ -130,13 +153,13 @@ def structure_figure(setting: GeneralSetting, frequency: np.ndarray) -> DrawnFig
     finish_axes(axes[1], _FREQUENCY, f"amplitude [{DISPLACEMENT_UNITS}]", "Each stop's coordinate, linear system")
     coincide = coincidence_phrase([*reveal_coincident(axes[0], coordinates), *reveal_coincident(axes[1], stops), *reveal_coincident(axes[1], lines)])
     axes[2].semilogy(f, np.abs(base_force(setting.structure, w, x)), color="C2", lw=1.4, label="|F| on the base", gid="linear:force")
-    finish_axes(axes[2], _FREQUENCY, "|F| on the base [N]", "Linear force on the base (paper fig. 3)")
+    finish_axes(axes[2], _FREQUENCY, "|F| on the base [N]", titles["force"])
     if named is not None:
-        axes[3].semilogy(f, np.abs(named.receptances(w).h22), label="|H22| exact (eq. 4)", color="k", lw=1.4)
+        axes[3].semilogy(f, np.abs(named.receptances(w).h22), label=titles["exact"], color="k", lw=1.4)
         if fit is not None:
             step = max(1, f.size // 120)
-            axes[3].semilogy(f[::step], np.abs(fit.receptance(w[::step])), "o", color="C3", mfc="none", ms=4.5, label="|H22| of eq. 10, the paper's fitted modes")
-        finish_axes(axes[3], _FREQUENCY, "|H22| [m/N]", "Accuracy of the curve fit (paper fig. 4)")
+            axes[3].semilogy(f[::step], np.abs(fit.receptance(w[::step])), "o", color="C3", mfc="none", ms=4.5, label=titles["fitted"])
+        finish_axes(axes[3], _FREQUENCY, "|H22| [m/N]", titles["fit"])
     figure_legend(fig, axes)
     natural = ", ".join(fmt(v / (2 * np.pi), ".3f") for v in (named.natural_angular_frequencies() if named is not None else setting.structure.natural_angular_frequencies()))
     caption = (
@@ -145,7 +168,7 @@ def structure_figure(setting: GeneralSetting, frequency: np.ndarray) -> DrawnFig
         f"same colour, {_gap_words(setting, static, gaps)} The force on the base, 1^T (K + j w C) X."
     )
     if named is not None:
-        fitted = "against the paper's curve fit (circles)" if fit is not None else "(the paper's fit needs two underdamped modes)"
+        fitted = titles["against"] if fit is not None else titles["no_fit"]
         caption += f" |H22| exact {fitted}. Natural frequencies {natural} Hz, anti-resonance {fmt(named.antiresonance_angular_frequency() / (2 * np.pi), '.3f')} Hz."
     else:
         caption += f" Natural frequencies {natural} Hz."

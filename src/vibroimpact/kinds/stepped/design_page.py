@@ -18,11 +18,12 @@ import xarray as xr
 from vibroimpact.kinds.stepped.design_figures import BAND_TITLES, peak_maps_figure, regime_map_figure, response_figure
 from vibroimpact.kinds.stepped.design_metrics import BAND_NAMES, DESIGN_REGIME_LABELS, DesignRegime
 from vibroimpact.kinds.stepped.design_ranking import TIER_TEXT, Candidate, DesignMap, design_map
+from vibroimpact.kinds.stepped.operating import OperatingRow, WORSE_RATIO, operating_point, unreached_text, warnings_html
 from vibroimpact.reporting.page import Section, Table, saved
 from vibroimpact.reporting.style import fmt, solution_ref
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 
-__all__ = ["DesignMapPage", "recommendation_text", "candidates_table", "frequency_ranges", "TOP_CANDIDATES"]
+__all__ = ["DesignMapPage", "operating_html", "recommendation_text", "candidates_table", "frequency_ranges", "TOP_CANDIDATES"]
 
 #: Rows of the candidates' table.
 TOP_CANDIDATES = 5
@@ -137,6 +138,41 @@ def _clearance_text(dm: DesignMap, best: Candidate) -> str:
     return "".join(text)
 
 
+def _is(row: OperatingRow, design: Candidate) -> bool:
+    """Is ``row`` the design's (same R and Delta, as the rows write them)?"""
+    return set(row.where.split(", ")) == {f"R = {fmt(design.restitution, 'g')}", f"Delta = {fmt(1e3 * design.clearance, 'g')} mm"}
+
+
+def operating_html(dataset: xr.Dataset, dm: DesignMap) -> tuple[str, str]:
+    """The page's first lines, before the recommendation: a warning where no design reaches the stop, or where the
+    recommended design makes |X1| at the operating point (the anti-resonance) worse than without a stop; and the
+    paragraph beside the recommendation: |X1| there without a stop, with the recommended design, and how many designs
+    make it worse (HTML, each empty where there is nothing to say; :mod:`vibroimpact.kinds.stepped.operating`)."""
+    warnings = [unreached_text(dataset)]
+    point = operating_point(dataset)
+    if point is None:
+        return warnings_html([w for w in warnings if w]), ""
+    rows = [r for r in point.rows if r.solution == dm.solution]
+    if not rows:
+        return warnings_html([w for w in warnings if w]), f"<p>At the absorber's operating point, its anti-resonance {fmt(point.frequency, '.5g')} Hz, {solution_ref(dm.solution)} has no value: it lies off its grid.</p>"
+    first = rows[0]
+    chosen = [r for r in rows if dm.recommendation is not None and _is(r, dm.recommendation.design)]
+    worse = sorted((r for r in rows if r.ratio > WORSE_RATIO), key=lambda r: -r.ratio)
+    ratio = lambda r: fmt(r.ratio, ".3g", "×{}")  # noqa: E731
+    if chosen and chosen[0].ratio > WORSE_RATIO:
+        warnings.append(f"The recommended design makes the absorber worse at its operating point: at {fmt(first.frequency, '.4g')} Hz (anti-resonance {fmt(point.frequency, '.5g')} Hz) "
+                        f"|X1| is {_mm(first.linear)} without a stop against {_mm(chosen[0].stopped)} with it, {ratio(chosen[0])}.")  # fmt: skip
+    text = [f"At the absorber's operating point, its anti-resonance {fmt(point.frequency, '.5g')} Hz (sqrt(k2/m2) / 2 pi), |X1| without a stop is {_mm(first.linear)} "
+            f"at the grid's nearest frequency {fmt(first.frequency, '.4g')} Hz"]  # fmt: skip
+    if chosen:
+        text.append(f"; with the recommended design {_mm(chosen[0].stopped)} ({ratio(chosen[0])})" if math.isfinite(chosen[0].stopped) else "; the recommended design has no realisable value there")
+    if worse:
+        text.append(f"; {len(worse)} of the {len(rows)} designs make it worse (up to {_mm(worse[0].stopped)}, {ratio(worse[0])}, at {html.escape(worse[0].where)}): a clearance below the absorber's free motion there strikes the stop at the notch")
+    else:
+        text.append(f"; no design of the {len(rows)} makes it worse")
+    return warnings_html([w for w in warnings if w]), f"<p>{''.join(text)}.</p>"
+
+
 def candidates_table(dm: DesignMap) -> str:
     """The best :data:`TOP_CANDIDATES` eligible designs (the recommended one marked) and the absorber without a stop."""
     wrap = "style='white-space:normal'"
@@ -227,7 +263,8 @@ class DesignMapPage:
         """The answer with its table and definitions, then the maps and the recommended design's response."""
         dm = self.map
         peaks, regimes, *response = saved([peak_maps_figure(dm), regime_map_figure(dm), response_figure(self.dataset, dm)], out)
-        answer = Section("Which restitution and clearance", recommendation_text(dm), tables=[Table("Best candidate designs", candidates_table(dm) + _definitions(dm))])
+        first, operating = operating_html(self.dataset, dm)
+        answer = Section("Which restitution and clearance", first + recommendation_text(dm) + operating, tables=[Table("Best candidate designs", candidates_table(dm) + _definitions(dm))])
         return [
             answer,
             Section("Peak |X1| per band over the designs", figures=[peaks]),

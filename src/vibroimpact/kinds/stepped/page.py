@@ -29,9 +29,10 @@ from vibroimpact.engines.registry import BUMPER, RIGID
 from vibroimpact.kinds.stepped.answers import answer_text, band_peaks, contact_text, convergence_rows, convergence_text, peak_rows, peaks_text, reduction_text
 from vibroimpact.kinds.stepped.crosscheck import cross_check_section, cross_check_text, cross_checks
 from vibroimpact.kinds.stepped.figures import peaks_table, response_panels_figure, where_text
+from vibroimpact.kinds.stepped.operating import operating_point, operating_text, warning_lines, warnings_html
 from vibroimpact.kinds.stepped.responses import clearance_text, series_by_restitution, regime_figure, response_figure, simulation_figure, stability_figure
 from vibroimpact.kinds.stepped.tables import agreement_table, reduction_intro, reduction_tables
-from vibroimpact.grids.sections import SolutionsPage, layout_tables, linear_section, modal_table, structure_figure
+from vibroimpact.grids.sections import SolutionsPage, layout_tables, linear_section, modal_table, paper_study, structure_figure
 from vibroimpact.orbits.motion import MotionThresholds
 from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved, StudyPage
@@ -63,12 +64,13 @@ def _variant(label: str, solution: str) -> str:
 
 
 def peak_figure(dataset: xr.Dataset, setting: StudySetting, parameter: str, name: str) -> DrawnFigure:
-    """Peak |X1| of each resonance band against ``parameter`` (``restitution`` or ``clearance``): figures 25-26."""
+    """Peak |X1| of each resonance band against ``parameter`` (``restitution`` or ``clearance``): figures 25-26 (the
+    caption cites them for the paper's own study only, :func:`~vibroimpact.grids.sections.paper_study`)."""
     rows = peak_rows(dataset, setting, parameter)
     scale, unit = (1e3, "mm") if parameter == "clearance" else (1.0, "-")
     labels = list(dict.fromkeys(r[0] for r in rows))
     fig, axes = new_figure(2, panel_height=3.9, legend_rows=legend_rows(len(labels) + 2, 3))
-    caption = Caption(f"Largest {QUANTITIES['x1_amplitude'].label} in each resonance band against the {parameter} (paper figures 25-26); one colour per solution.")
+    caption = Caption(f"Largest {QUANTITIES['x1_amplitude'].label} in each resonance band against the {parameter}{' (paper figures 25-26)' if paper_study(dataset) else ''}; one colour per solution.")
     engines = SimulationMarkers()
     for band, ax in enumerate(axes):
         for label in labels:
@@ -157,10 +159,11 @@ class BumperStiffnessPage(SolutionsPage):
         bumpers = contact_solutions([str(s) for s in self.dataset["solution"].values], BUMPER)
         answer = convergence_text(self.dataset, self.setting, reference, bumpers[0]) if reference is not None and bumpers and self.setting.simulation_frequency.size else ""
         checks = cross_checks(self.dataset)
-        intro = "".join(f"<p>{html.escape(text)}</p>" for text in [answer] + [cross_check_text(c) for c in checks] if text)
+        operating = operating_text(operating_point(self.dataset))
+        intro = warnings_html(warning_lines(self.dataset)) + "".join(f"<p>{html.escape(text)}</p>" for text in [answer] + [cross_check_text(c) for c in checks] + [operating] if text)
         convergence = Section("Compliant bumper against the rigid stop", intro=intro, figures=saved([figure], out), tables=stiffness_tables(self.dataset, self.setting))
         check = cross_check_section(checks)
-        return [convergence, *([check] if check is not None else []), linear_section(self.setting, out)]
+        return [convergence, *([check] if check is not None else []), linear_section(self.setting, out, paper_study(self.dataset))]
 
 
 def _stiffness_reference(dataset: xr.Dataset) -> str | None:
@@ -322,7 +325,9 @@ class FrequencyResponsePage:
         answers = [peaks_text(dataset, setting, p) for p in peaks if setting is not None] + [contact_text(dataset)] + [cross_check_text(c) for c in checks] + [answer_text(dataset, layout)]
         if setting is not None and any(s != "linear" for s in dataset["solution"].values):
             answers.append(reduction_text(dataset, layout))
-        sections = [Section("Largest responses", intro="".join(f"<p>{html.escape(a)}</p>" for a in answers if a), tables=[peaks_table(dataset, layout)])]
+        answers.append(operating_text(operating_point(dataset, layout)))  # beside the reduction factors
+        first = warnings_html(warning_lines(dataset, layout))  # before any praise
+        sections = [Section("Largest responses", intro=first + "".join(f"<p>{html.escape(a)}</p>" for a in answers if a), tables=[peaks_table(dataset, layout)])]
         if (check := cross_check_section(checks)) is not None:
             sections.append(check)
         for parameter in peaks:
@@ -330,10 +335,10 @@ class FrequencyResponsePage:
             figure = peak_figure(dataset, setting, parameter, f"peaks_vs_{parameter}")
             sections.append(Section(f"Resonance peaks against the {parameter}", figures=saved([figure], out), tables=peak_tables(dataset, setting, parameter)))
         if setting is not None and any(s != "linear" for s in dataset["solution"].values):
-            sections.append(Section("Reduction factors", intro=reduction_intro(), tables=reduction_tables(dataset, layout, named_layout(dataset) is not None)))
+            sections.append(Section("Reduction factors", intro=reduction_intro(), tables=reduction_tables(dataset, layout, paper_study(dataset))))
         intro = f"<p>Stops: {html.escape('; '.join(layout.stops))}. Load: {html.escape(layout.load_text())}.</p>"
         tables = ([modal_table(layout.named)] if layout.named is not None else []) + layout_tables(layout)
-        sections.append(Section("Linear system", intro=intro, figures=saved([structure_figure(layout, dataset["frequency"].values)], out), tables=tables))
+        sections.append(Section("Linear system", intro=intro, figures=saved([structure_figure(layout, dataset["frequency"].values, paper_study(dataset))], out), tables=tables))
         if setting is not None and "stop" not in dataset.dims:
             sections += _paper_response_sections(dataset, out)
         else:

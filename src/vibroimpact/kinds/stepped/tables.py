@@ -200,8 +200,8 @@ def reduction_intro() -> str:
 
 def reduction_tables(dataset: xr.Dataset, setting: GeneralSetting, paper_layout: bool) -> list[Table]:
     """One table per quantity: reduction factors of every solution but ``linear`` at each (clearance, R) of a study
-    whose structure has the named view; the paper's own values beside them where the study has its layout
-    (``paper_layout``) and its example's numbers."""
+    whose structure has the named view; the paper's own values beside them, in a column of their own, where the study
+    is the paper's (``paper_layout``, :func:`~vibroimpact.grids.sections.paper_study`) and has its example's numbers."""
     assert setting.named is not None
     on_subset = subset_solutions(dataset)  # a few points make no resonance peak: their own section compares them
     solutions = [str(s) for s in dataset["solution"].values if s != "linear" and s not in on_subset]
@@ -211,11 +211,7 @@ def reduction_tables(dataset: xr.Dataset, setting: GeneralSetting, paper_layout:
         if quantity not in dataset or not solutions:
             continue
         units, scale = QUANTITIES[quantity].page_units, QUANTITIES[quantity].scale
-        header = _header(
-            f"linear peak 1 / 2 [{units}]", f"largest realisable in band 1 / 2 [{units}]", "reduction factor 1", "reduction factor 2", "computed points 1 / 2",
-            "undefined points 1 / 2", "unstable points 1 / 2", "paper",
-        )
-        body = []
+        cells: list[tuple[str, tuple[float, float] | None]] = []
         for solution in solutions:
             part = computed_part(dataset, solution)
             f = part["frequency"].values
@@ -224,12 +220,16 @@ def reduction_tables(dataset: xr.Dataset, setting: GeneralSetting, paper_layout:
                 paper = paper_reduction_factors(setting.named, setting.amplitude, quantity, row.restitution, row.clearance) if paper_layout else None
                 factors = "".join(f"<td>{fmt(factor, '.1f')}{' &dagger;' if coarse else ''}</td>" for factor, coarse in zip(row.factor, row.coarse))
                 unstable = "n/a" if row.unstable is None else f"{row.unstable[0]} / {row.unstable[1]}"
-                body.append(
+                cells.append((
                     f"<tr><td>{solution}</td><td>{fmt(row.clearance * 1e3, 'g')}</td><td>{fmt(row.restitution, 'g')}</td>"
                     f"<td>{fmt(scale * row.linear_peak[0], '#.4g')} / {fmt(scale * row.linear_peak[1], '#.4g')}</td><td>{fmt(scale * row.largest[0], '#.4g')} / {fmt(scale * row.largest[1], '#.4g')}</td>"
-                    f"{factors}<td>{computed}</td><td>{row.undefined[0]} / {row.undefined[1]}</td><td>{unstable}</td>"
-                    f"<td>{'' if paper is None else fmt(paper[0], 'g') + ' / ' + fmt(paper[1], 'g')}</td></tr>"
-                )
+                    f"{factors}<td>{computed}</td><td>{row.undefined[0]} / {row.undefined[1]}</td><td>{unstable}</td>", paper))  # fmt: skip
+        quoted = any(paper is not None for _, paper in cells)  # the paper's column only where it quotes a value
+        header = _header(
+            f"linear peak 1 / 2 [{units}]", f"largest realisable in band 1 / 2 [{units}]", "reduction factor 1", "reduction factor 2", "computed points 1 / 2",
+            "undefined points 1 / 2", "unstable points 1 / 2", *(["paper"] if quoted else []),
+        )
+        body = [row + (f"<td>{'' if paper is None else fmt(paper[0], 'g') + ' / ' + fmt(paper[1], 'g')}</td>" if quoted else "") + "</tr>" for row, paper in cells]
         tables.append(Table(f"Reduction factors: {QUANTITIES[quantity].label}", f"<table>{header}{''.join(body)}</table>"))
     return tables
 

@@ -24,7 +24,7 @@ from matplotlib.lines import Line2D
 
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.grids.regime_map import regime_map
-from vibroimpact.grids.sections import SolutionsPage, layout_tables, linear_section, structure_figure
+from vibroimpact.grids.sections import paper_study, SolutionsPage, layout_tables, linear_section, structure_figure
 from vibroimpact.reporting.record import GeneralSetting, bumper_text, general_setting, is_general, study_setting, SWEPT_SOLUTION
 from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
@@ -245,7 +245,7 @@ class SweptSinePage(SolutionsPage):
         run = swept_sine_run(self.dataset)
         part, intro = _first_point(self.dataset)
         sweeps = Section("Swept sine against the steady states", intro=intro, figures=saved(sweep_figures(part, run), out), tables=sweep_tables(part, run, self.setting.split_frequency))
-        return [Section("Contacts and the steady states", intro=sweep_answer(part, run, self.setting.split_frequency) + intro), linear_section(self.setting, out), sweeps]
+        return [Section("Contacts and the steady states", intro=sweep_answer(part, run, self.setting.split_frequency) + intro), linear_section(self.setting, out, paper_study(self.dataset)), sweeps]
 
 
 class GeneralSweptPage:
