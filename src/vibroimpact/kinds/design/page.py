@@ -15,6 +15,7 @@ import xarray as xr
 
 from vibroimpact.kinds.design.answer import answer_text, design_titles, linear_wins, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, screen_words, stage_counts, unit_text, variable_names, warnings
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, design_figures
+from vibroimpact.kinds.design.operating import design_operating, operating_sentence, operating_warnings
 from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.kinds.design.tradeoff import front_text, tradeoff_figure
 from vibroimpact.reporting.page import Section, Table, saved
@@ -239,7 +240,9 @@ class DesignPage:
         """The answer and the warnings, the figures, the compared designs, how it was computed."""
         d = self.dataset
         items = "".join(f"<li>{html.escape(w)}</li>" for w in warnings(d))
-        first = Section("Which design to build", f"<p><b>{html.escape(answer_text(d))}</b></p>" + (f"<p>{'Before you build a stop' if linear_wins(d) else 'Before you build it'}:</p><ul>{items}</ul>" if items else ""))
+        point = design_operating(d)
+        before = "".join(f"<p><b>Warning.</b> {html.escape(line)}</p>" for line in operating_warnings(point))  # before the recommendation's praise
+        first = Section("Which design to build", before + f"<p><b>{html.escape(answer_text(d))}</b></p>" + operating_sentence(point) + (f"<p>{'Before you build a stop' if linear_wins(d) else 'Before you build it'}:</p><ul>{items}</ul>" if items else ""))
         drawn = design_figures(d)
         trade = front_text(d) if "pareto_front" in d else ""
         if trade:  # only where the screen knew impulses (closed forms), so the panel has data

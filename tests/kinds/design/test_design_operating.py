@@ -1,0 +1,58 @@
+"""The design page states the recommended design at the absorber's operating point against the same absorber
+without its stop, and warns first where the stop makes it worse or the absorber's free motion there does not fit."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from vibroimpact.analysis.linear import linear_response
+from vibroimpact.kinds.design.operating import design_operating, operating_warnings
+from vibroimpact.kinds.design.page import DesignPage
+from vibroimpact.model.system import PAPER_SYSTEM
+from vibroimpact.reporting.style import fmt
+
+from tests.golden.golden import DATA
+from tests.reporting.test_report_pages import quick_save
+
+
+@pytest.fixture(scope="module")
+def dataset() -> xr.Dataset:
+    with xr.open_dataset(DATA / "design_rigid_stop.nc") as data:
+        return data.load()
+
+
+def test_the_declared_operating_point_against_the_same_absorber_without_its_stop(dataset: xr.Dataset) -> None:
+    """33 Hz is declared: with the stop, the search's worst coexisting |X1| there; without, |q H11| of the paper's
+    absorber (the design varies only the stop); the recommended clearance holds the free motion |q H12|."""
+    point = design_operating(dataset)
+    assert point is not None and point.declared and point.frequency == pytest.approx(33.0, rel=1e-12)
+    linear = linear_response(PAPER_SYSTEM, 33.0, 10.0)
+    assert point.linear == pytest.approx(float(np.abs(linear.x1)), rel=1e-12)
+    assert point.free == pytest.approx(float(np.abs(linear.x2)), rel=1e-12)
+    assert point.stopped == pytest.approx(float(dataset["design_operating_amplitude"].values[0]), rel=1e-12)
+    assert operating_warnings(point) == []
+
+
+def test_a_stop_that_destroys_the_notch_is_said_before_the_recommendation(dataset: xr.Dataset, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A recommended 1 mm stop whose |X1| at 33 Hz is 100 times the linear absorber's: the page's first lines say so
+    with the two numbers and the factor, and that the 2.32 mm free motion does not fit in 1 mm."""
+    worse = dataset.copy(deep=True)
+    worse["design_operating_amplitude"].values[0] *= 100.0
+    worse["design_clearance"].values[0] = 0.001
+    point = design_operating(worse)
+    assert point is not None and point.ratio == pytest.approx(100.0, rel=1e-9)
+    monkeypatch.setattr("vibroimpact.reporting.page.save_figure", quick_save)
+    for name in ("design_figures", "method_text", "certificates_table"):  # the golden file keeps no wall times: only the answer is read here
+        monkeypatch.setattr(f"vibroimpact.kinds.design.page.{name}", lambda _d, empty=([] if name == "design_figures" else ""): empty)
+    intro = DesignPage(worse).sections(tmp_path)[0].intro
+    first, second = intro.split("</p>")[:2]
+    assert first.startswith("<p><b>Warning.</b> The recommended stop makes the absorber worse at its operating point")
+    assert f"{fmt(1e3 * point.linear, '.4g')} mm without the stop" in first and f"{fmt(1e3 * point.stopped, '.4g')} mm with it, ×100" in first
+    assert "does not fit in the recommended gap" in second and "against a clearance of 1 mm" in second
+    assert intro.index("Build ") > intro.index("Warning.")
+    assert math.isfinite(point.free) and point.free > 0.002
