@@ -56,3 +56,10 @@ def test_a_stop_that_destroys_the_notch_is_said_before_the_recommendation(datase
     assert "does not fit in the recommended gap" in second and "against a clearance of 1 mm" in second
     assert intro.index("Build ") > intro.index("Warning.")
     assert math.isfinite(point.free) and point.free > 0.002
+
+
+def test_the_design_and_stepped_pages_judge_worse_alike() -> None:
+    from vibroimpact.kinds.design import operating as design
+    from vibroimpact.kinds.stepped import operating as stepped
+
+    assert (design.WORSE_RATIO, design.NEAREST) == (stepped.WORSE_RATIO, stepped.NEAREST)  # exact: the same constants
