@@ -28,13 +28,14 @@ def pytest_sessionstart(session: pytest.Session) -> None:
     import sys
 
     if os.environ.get("PYTEST_XDIST_WORKER") is None:
-        from vibroimpact.engines.compliant.exact import loop_is_cached, prepare_compiled_loop
-        from vibroimpact.runs.run import prepare_compiled_core
+        from vibroimpact.engines.registry import engine_spec
+        from vibroimpact.runs.run import prepare_engines
 
-        child = None if loop_is_cached() else subprocess.Popen([sys.executable, "-c", "from vibroimpact.engines.compliant.exact import prepare_compiled_loop; prepare_compiled_loop()"])
-        prepare_compiled_core(None)
+        bumper = engine_spec("compliant_exact")
+        child = None if bumper.kernels_cached() else subprocess.Popen([sys.executable, "-c", "from vibroimpact.runs.run import prepare_engines; prepare_engines(['compliant_exact'])"])
+        prepare_engines(["exact"])
         if child is not None and child.wait() != 0:
-            prepare_compiled_loop()  # compiling here says why it failed
+            bumper.prepare_kernels()  # compiling here says why it failed
 
 
 @pytest.fixture

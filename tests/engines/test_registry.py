@@ -120,3 +120,16 @@ def test_every_stepped_solution_has_a_presentation_row() -> None:
     assert set(SOLUTIONS) == set(SOLUTION_LOOKS)
     assert all(SOLUTION_LOOKS[name].marker is not None for name in ENGINE_SOLUTIONS)
     assert set(ENGINE_SOLUTIONS) == {name for name, spec in ENGINES.items() if spec.capabilities.stepped_solution}
+
+
+def test_a_compiled_engine_prepares_its_kernels() -> None:
+    """The engines with numba kernels (the rigid stop's and the bumper's closed-form engines) say so (capability
+    ``compiled``) and find them in numba's cache (the test session compiled them first: preparing them again compiles
+    nothing, 0 s). A cold cache compiles each once, before the workers: tests/test_first_run.py (slow tier)."""
+    from vibroimpact.engines.registry import ENGINES, engine_for
+
+    compiled = [name for name, spec in ENGINES.items() if spec.capabilities.compiled]
+    assert sorted(compiled) == sorted({engine_for(RIGID, "exact_jacobians"), engine_for(BUMPER, "exact_jacobians")})
+    for name in compiled:
+        assert ENGINES[name].kernels_cached(), name
+        assert ENGINES[name].prepare_kernels() == 0.0, name  # exact: cached, nothing compiled

@@ -117,3 +117,39 @@ def test_a_slower_machine_gets_a_longer_prediction() -> None:
     assert all(slower.parts[name] == pytest.approx(2.5 * seconds) for name, seconds in calibration.parts.items())
     assert slower.memory == calibration.memory and "2.50 x" in slower.text()
     assert SPEED_FACTOR_RANGE[0] <= speed_factor() <= SPEED_FACTOR_RANGE[1]
+
+
+def test_a_clamped_probe_says_it_was_clamped(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A probe outside the believable range is clamped, and the estimate says so with the measured factor; a probe
+    inside it is printed as measured."""
+    from vibroimpact.runs import estimate
+
+    scene = parse_scene(small_scene())
+    shipped = estimate.default_costs().speed_probe_seconds
+    low, high = SPEED_FACTOR_RANGE
+    monkeypatch.setattr(estimate, "_probe_time", lambda: 37.0 * shipped)
+    slow = estimate_scene(scene, jobs=1)
+    assert slow.speed_factor == pytest.approx(high) and slow.measured_speed_factor == pytest.approx(37.0)
+    assert "37.00 x" in slow.text() and "outside the believable range" in slow.text() and f"clamped to {high:.2f} x and may be short" in slow.text()
+    monkeypatch.setattr(estimate, "_probe_time", lambda: 0.01 * shipped)
+    fast = estimate_scene(scene, jobs=1)
+    assert fast.speed_factor == pytest.approx(low) and f"clamped to {low:.2f} x and may be long" in fast.text()
+    monkeypatch.setattr(estimate, "_probe_time", lambda: 3.0 * shipped)
+    measured = estimate_scene(scene, jobs=1)
+    assert measured.measured_speed_factor is None and "a probe took 3.00 x" in measured.text() and "outside" not in measured.text()
+
+
+def test_the_estimate_needs_no_compiled_core(tmp_path: Path) -> None:
+    """``--estimate`` on a fresh install answers without compiling the exact engine's core (30-60 s): in a process with
+    an empty numba cache, the probe and the estimate of the main job leave no compiled exact core in the cache."""
+    import os
+    import subprocess
+    import sys
+
+    cache = tmp_path / "numba"
+    code = "from vibroimpact.cli import main; raise SystemExit(main(['restitution', '--estimate']))"
+    done = subprocess.run([sys.executable, "-c", code], env=os.environ | {"NUMBA_CACHE_DIR": str(cache)}, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert "predicted wall time" in done.stdout
+    compiled = sorted(path.name for path in cache.rglob("*.nbi"))
+    assert not [name for name in compiled if name.startswith(("exact_core.", "exact_loop."))], compiled

@@ -314,3 +314,31 @@ class ExactEngine:
 def _stats(counters: NDArray[np.int64], impacts: int) -> dict[str, int]:
     steps, events, sticks, releases, touches = (int(c) for c in counters)
     return {"impacts": impacts, "sticks": sticks, "releases": releases, "steps": steps, "events": events, "touches": touches}
+
+
+def kernels_cached() -> bool:
+    """Whether numba's on-disk cache holds the engine's compiled core (a check of its index; False where unsure)."""
+    try:
+        return bool(exact_core.run_periods._cache._cache_file._load_index())  # numba's index of cached overloads
+    except (AttributeError, OSError, EOFError, ValueError):  # another numba's layout: compile (or load) to be sure
+        return False
+
+
+def prepare_kernels() -> float:
+    """Compile the engine's core in this process, every overload a study runs (or load it from numba's on-disk cache);
+    return the seconds spent compiling [s] (0 where cached).
+
+    numba compiles the core on first use and caches it on disk (``@njit(cache=True)``); a cold cache costs ~30-50 s
+    of compiling. Done once before parallel workers start, they load the cached code instead of each compiling it.
+    """
+    import time
+
+    from vibroimpact.model.contact import Stop
+    from vibroimpact.model.excitation import HarmonicForce
+    from vibroimpact.model.system import PAPER_SYSTEM
+
+    cached = kernels_cached()
+    start = time.perf_counter()
+    problem = ImpactProblem(PAPER_SYSTEM, (Stop(RigidStop(3e-3, 0.2), coordinate=1),), HarmonicForce(10.0, 25.0))
+    ExactEngine().integrate(problem, np.zeros(4), 0.0, 2, moments=True)
+    return 0.0 if cached else time.perf_counter() - start

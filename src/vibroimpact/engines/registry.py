@@ -48,6 +48,10 @@ class Capabilities:
         ``shoot_period(problem, guess, scale, tolerance, max_iterations)`` finds a period-1 orbit by damped Newton on
         its compiled period, without the general map's Python around each evaluation (a
         :class:`~vibroimpact.engines.compliant.period_shooting.PeriodOrbit`, or None).
+    compiled : bool
+        Its kernels are compiled by numba on first use (tens of seconds) and kept in numba's on-disk cache: its module's
+        ``kernels_cached()`` says whether the cache holds them and ``prepare_kernels()`` compiles them in the calling
+        process (or loads them from the cache), returning the seconds spent compiling (:meth:`EngineSpec.prepare_kernels`).
     """
 
     contact: str
@@ -57,6 +61,7 @@ class Capabilities:
     stepped_solution: bool = False
     sweeps: bool = False
     period_shooting: bool = False
+    compiled: bool = False
 
     def __post_init__(self) -> None:
         if self.contact not in (RIGID, BUMPER):
@@ -108,6 +113,24 @@ class EngineSpec:
         """:data:`RIGID` or :data:`BUMPER`: the contact law of the problems it integrates."""
         return self.capabilities.contact
 
+    def kernels_cached(self) -> bool:
+        """Whether numba's on-disk cache holds the engine's compiled kernels (True for an engine with none to compile)."""
+        if not self.capabilities.compiled:
+            return True
+        cached: bool = self._module().kernels_cached()
+        return cached
+
+    def prepare_kernels(self) -> float:
+        """Compile the engine's kernels in this process, or load them from numba's on-disk cache; return the seconds
+        spent compiling [s] (0 where they were cached, or the engine has none)."""
+        if not self.capabilities.compiled:
+            return 0.0
+        seconds: float = self._module().prepare_kernels()
+        return seconds
+
+    def _module(self) -> Any:
+        return importlib.import_module(self.target.partition(":")[0])
+
 
 #: A rigid-stop engine that integrates to a tolerance; the bumper's.
 INTEGRATOR, BUMPER_INTEGRATOR = Capabilities(RIGID), Capabilities(BUMPER, sweeps=True)
@@ -122,7 +145,7 @@ def _solve_ivp(method: str) -> EngineSpec:
 #: name -> engine. ``momentary`` uses the method of its settings; the suffixed names fix it.
 ENGINES: Mapping[str, EngineSpec] = MappingProxyType(
     {
-        "exact": EngineSpec("vibroimpact.engines.exact:ExactEngine", Capabilities(RIGID, exact_jacobians=True, exact_flow=True, tolerance_free=True, stepped_solution=True), "piecewise-exact closed-form flow with guaranteed contact search, compiled: the reference"),
+        "exact": EngineSpec("vibroimpact.engines.exact:ExactEngine", Capabilities(RIGID, exact_jacobians=True, exact_flow=True, tolerance_free=True, stepped_solution=True, compiled=True), "piecewise-exact closed-form flow with guaranteed contact search, compiled: the reference"),
         "exact_python": EngineSpec("vibroimpact.engines.exact_python:PythonExactEngine", EXACT_FLOW, "the exact engine's algorithm in pure Python: its cross-check and speed baseline"),
         "momentary": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", Capabilities(RIGID, stepped_solution=True), "SUNDIALS CVODE with contact events and a grazing guard (method from the settings)"),
         "momentary_adams": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", INTEGRATOR, "SUNDIALS CVODE, Adams, with contact events and a grazing guard", settings_method="adams"),
@@ -136,7 +159,7 @@ ENGINES: Mapping[str, EngineSpec] = MappingProxyType(
         "compliant_ida": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", BUMPER_INTEGRATOR, "the engine compliant, under the name benchmark scenes use"),
         "compliant_cvode_adams": EngineSpec("vibroimpact.engines.compliant.ida:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (Adams)", settings_method="adams"),
         "compliant_cvode_bdf": EngineSpec("vibroimpact.engines.compliant.ida:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (BDF)", settings_method="bdf"),
-        "compliant_exact": EngineSpec("vibroimpact.engines.compliant.exact:CompliantExactEngine", Capabilities(BUMPER, exact_jacobians=True, exact_flow=True, tolerance_free=True, stepped_solution=True, period_shooting=True), "Kelvin-Voigt bumper in closed form per contact mode with guaranteed switch search, compiled: the bumper's reference"),
+        "compliant_exact": EngineSpec("vibroimpact.engines.compliant.exact:CompliantExactEngine", Capabilities(BUMPER, exact_jacobians=True, exact_flow=True, tolerance_free=True, stepped_solution=True, period_shooting=True, compiled=True), "Kelvin-Voigt bumper in closed form per contact mode with guaranteed switch search, compiled: the bumper's reference"),
     }
 )
 

@@ -13,9 +13,11 @@ study); each kind of study (:data:`vibroimpact.scene.kinds.KINDS`) sums its own 
 * swept sines: seconds per simulated second of the compliant engine at its tolerance;
 * benchmarks: every method at every tolerance, as the benchmark runs them;
 * the work is spread over ``jobs`` processes; the report adds a fixed cost per figure;
-* everything is scaled by this machine's speed against the calibration machine's: a probe of about 0.25 s (the same
-  short ``exact`` and ``momentary`` runs, timed at calibration too) measures it, so a slower or busier machine gets a
-  longer prediction.
+* everything is scaled by this machine's speed against the calibration machine's: a probe of about 0.1 s (the same
+  short runs of the pure-Python exact flow and of ``momentary``, timed at calibration too) measures it, so a slower or
+  busier machine gets a longer prediction. The probe needs no compiled core (a fresh install answers in seconds, not
+  after the core's 30-60 s of compiling); a probe outside :data:`SPEED_FACTOR_RANGE` is clamped, and the estimate
+  says so.
 
 Memory: the dataset (every variable over the full grid, the running estimates of sweeps), the samples a sweep holds
 while it runs, and the measured footprint of one worker process. It is an estimate: the report of
@@ -44,7 +46,7 @@ from vibroimpact.runs.store import atomic_path
 from vibroimpact.scene.kinds import kind_named
 from vibroimpact.scene.schema import Scene
 
-__all__ = ["COSTS_FILE", "Costs", "Estimate", "default_costs", "cost_engine", "cluster_startup", "os_cpus", "cluster_cores", "CLUSTER_STARTUP", "TASK_SECONDS", "WRITE_SECONDS_PER_VARIABLE", "estimate_scene", "engine_scale", "speed_probe", "speed_factor", "calibrate", "write_costs", "SPEED_FACTOR_RANGE"]
+__all__ = ["COSTS_FILE", "Costs", "Estimate", "default_costs", "cost_engine", "cluster_startup", "os_cpus", "cluster_cores", "CLUSTER_STARTUP", "TASK_SECONDS", "WRITE_SECONDS_PER_VARIABLE", "estimate_scene", "engine_scale", "speed_probe", "speed_factor", "measured_speed_factor", "clamped_speed", "calibrate", "write_costs", "SPEED_FACTOR_RANGE"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -203,7 +205,11 @@ class Estimate:
     points : dict
         Time-domain points (or sweeps) per solution, and how many are predicted to integrate.
     speed_factor : float
-        This machine's time for the speed probe over the calibration machine's [-] (> 1: slower).
+        This machine's time for the speed probe over the calibration machine's [-] (> 1: slower), as the prediction
+        uses it (within :data:`SPEED_FACTOR_RANGE`).
+    measured_speed_factor : float or None
+        The probe's own ratio where it fell outside :data:`SPEED_FACTOR_RANGE` and ``speed_factor`` is its clamp [-];
+        None where the probe was used as measured (or the factor was given).
     """
 
     wall_time: float
@@ -211,6 +217,7 @@ class Estimate:
     parts: dict[str, float] = field(default_factory=dict)
     points: dict[str, str] = field(default_factory=dict)
     speed_factor: float = 1.0
+    measured_speed_factor: float | None = None
 
     def text(self) -> str:
         """The estimate as printed by ``run-study --estimate``."""
@@ -218,10 +225,14 @@ class Estimate:
         for name, seconds in self.parts.items():
             detail = f" ({self.points[name]})" if name in self.points else ""
             lines.append(f"  {name}: {_duration(seconds)} of work{detail}")
-        lines.append(
-            f"(costs measured by the accuracy_cost study, scaled by this machine's speed: a probe took {self.speed_factor:.2f} x "
-            "the calibration machine's time; an estimate, typically within a factor of 2)"
-        )
+        if self.measured_speed_factor is None:
+            speed = f"a probe took {self.speed_factor:.2f} x the calibration machine's time"
+        else:
+            short = "short" if self.measured_speed_factor > self.speed_factor else "long"
+            speed = (f"a probe took {self.measured_speed_factor:.2f} x the calibration machine's time, outside the believable range "
+                     f"{SPEED_FACTOR_RANGE[0]:g}-{SPEED_FACTOR_RANGE[1]:g} x (a glitch, or a machine under heavy load): the prediction "
+                     f"is clamped to {self.speed_factor:.2f} x and may be {short}")
+        lines.append(f"(costs measured by the accuracy_cost study, scaled by this machine's speed: {speed}; an estimate, typically within a factor of 2)")
         return "\n".join(lines)
 
 
@@ -259,8 +270,10 @@ SPEED_FACTOR_RANGE = (0.2, 10.0)
 
 
 def speed_probe(repeats: int = 3) -> float:
-    """Wall time of a fixed short workload, the best of ``repeats`` [s]: 100 periods of ``exact`` and 100 of
-    ``momentary`` (CVODE Adams, rtol 1e-8) at 25 Hz from rest, the kind of work the simulations spend their time on."""
+    """Wall time of a fixed short workload, the best of ``repeats`` [s]: 100 periods of ``exact_python`` (the exact
+    flow in Python and numpy) and 100 of ``momentary`` (CVODE Adams, rtol 1e-8, compiled callbacks) at 25 Hz from rest,
+    the kind of work the simulations spend their time on. It needs no compiled exact core: on a fresh install it
+    answers after the callbacks' few seconds of compiling, not the core's 30-60 s."""
     import time
 
     from vibroimpact.engines.registry import make_engine
@@ -271,7 +284,7 @@ def speed_probe(repeats: int = 3) -> float:
     from vibroimpact.model.system import PAPER_SYSTEM
 
     problem = ImpactProblem(PAPER_SYSTEM, RigidStop(3e-3, 0.2), HarmonicForce(10.0, 25.0))
-    engines = (make_engine("exact"), make_engine("momentary", EngineSettings(*STEPPED_TOLERANCES)))
+    engines = (make_engine("exact_python"), make_engine("momentary", EngineSettings(*STEPPED_TOLERANCES)))
     best = math.inf
     for _ in range(repeats):
         started = time.perf_counter()
@@ -290,9 +303,19 @@ def _probe_time() -> float:
 def speed_factor(costs: Costs | None = None) -> float:
     """This machine's probe time over the calibration machine's (``costs``, by default the package's) [-], within
     :data:`SPEED_FACTOR_RANGE`."""
+    return clamped_speed(measured_speed_factor(costs))
+
+
+def measured_speed_factor(costs: Costs | None = None) -> float:
+    """This machine's probe time over the calibration machine's (``costs``, by default the package's) [-], unclamped."""
     costs = default_costs() if costs is None else costs
+    return _probe_time() / costs.speed_probe_seconds
+
+
+def clamped_speed(factor: float) -> float:
+    """``factor`` [-] within :data:`SPEED_FACTOR_RANGE`."""
     low, high = SPEED_FACTOR_RANGE
-    return min(max(_probe_time() / costs.speed_probe_seconds, low), high)
+    return min(max(factor, low), high)
 
 
 def estimate_scene(scene: Scene, jobs: int = 1, speed: float | None = None, costs: Costs | None = None) -> Estimate:
@@ -302,7 +325,8 @@ def estimate_scene(scene: Scene, jobs: int = 1, speed: float | None = None, cost
     measured with :func:`speed_factor`. ``costs`` are the calibrated costs, by default the package's."""
     jobs = max(1, jobs)
     costs = default_costs() if costs is None else costs
-    speed = speed_factor(costs) if speed is None else speed
+    measured = measured_speed_factor(costs) if speed is None else None
+    speed = clamped_speed(measured) if measured is not None else speed
     unscaled = kind_named(scene.kind).make_study().estimate(scene, jobs, costs)
     return Estimate(
         wall_time=unscaled.wall_time * speed,
@@ -310,6 +334,7 @@ def estimate_scene(scene: Scene, jobs: int = 1, speed: float | None = None, cost
         parts={name: seconds * speed for name, seconds in unscaled.parts.items()},
         points=unscaled.points,
         speed_factor=speed,
+        measured_speed_factor=measured if measured is not None and measured != speed else None,  # exact: clamped or not
     )
 
 

@@ -26,13 +26,14 @@ from __future__ import annotations
 import sys
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any, Mapping, Protocol
+from typing import Any, Mapping, Protocol, Sequence
 
 import numpy as np
 import pandas as pd
 import xarray as xr
 
 from vibroimpact import __version__
+from vibroimpact.engines.registry import engine_spec
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.runner import Runner
 from vibroimpact.runs.estimate import Costs, Estimate
@@ -40,7 +41,7 @@ from vibroimpact.runs.store import StudyStore, atomic_path, source_hash
 from vibroimpact.scene.kinds import kind_named
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, Scene
 
-__all__ = ["StudyKind", "study_kind", "run_study", "prepare_compiled_core", "atomic_path", "write_dataset", "read_dataset", "split_groups", "join_groups", "absent_value", "SIMULATED_GROUP", "netcdf_attribute", "provenance"]
+__all__ = ["StudyKind", "study_kind", "run_study", "prepare_engines", "atomic_path", "write_dataset", "read_dataset", "split_groups", "join_groups", "absent_value", "SIMULATED_GROUP", "netcdf_attribute", "provenance"]
 
 class StudyKind(Protocol):
     """What a kind of study does with a scene (each kind's ``study.py``, registered in :data:`vibroimpact.scene.kinds.KINDS`)."""
@@ -59,6 +60,11 @@ class StudyKind(Protocol):
         """The predicted wall time and memory of running the scene with ``jobs`` processes, on the calibration machine."""
         ...
 
+    def engines(self, scene: Scene) -> tuple[str, ...]:
+        """The registered engines the study runs on the scene (those with compiled kernels are compiled, or loaded, before
+        any work starts: :func:`prepare_engines`)."""
+        ...
+
 
 def study_kind(scene: Scene) -> StudyKind:
     """The study of ``scene``'s kind (its module is imported now)."""
@@ -66,41 +72,34 @@ def study_kind(scene: Scene) -> StudyKind:
     return study
 
 
-def prepare_compiled_core(progress: Progress | None = None) -> float:
-    """Compile the exact engine's core in this process, once per machine, before any worker starts; return the
-    seconds it took (0 where numba's on-disk cache already holds it).
+def prepare_engines(engines: Sequence[str], progress: Progress | None = None) -> float:
+    """Compile the kernels of the registered ``engines`` in this process, once per machine, before any worker starts;
+    return the seconds it took (0 where numba's on-disk cache already holds them, or no engine has kernels).
 
-    numba compiles the core on first use and caches it on disk (``@njit(cache=True)``); a cold cache costs ~30-50 s
-    of compiling. Done here, the workers of a local cluster load the cached code (~1 s each) instead of each compiling
-    it again at once, and the user is told why the first run waits, in one line, before it does.
+    numba compiles an engine's kernels on first use and caches them on disk (``@njit(cache=True)``); a cold cache
+    costs ~30-60 s of compiling per engine. Done here, the workers of a local cluster load the cached code (~0.1 s
+    each, before their first task: :class:`~vibroimpact.runs.runner.Runner`) instead of each compiling it again at
+    once inside its first point's wall time, and the user is told why the first run waits, in one line, before it does.
+    Cached kernels are loaded here too, for the work this process runs itself.
+    An engine is asked whether it has kernels (its capability ``compiled``), never named here.
     """
-    from vibroimpact.engines import exact_core
-
-    try:
-        cached = bool(exact_core.run_periods._cache._cache_file._load_index())  # numba's index of cached overloads
-    except (AttributeError, OSError, EOFError, ValueError):  # another numba's layout: assume it must compile
-        cached = False
-    if cached:
-        return 0.0
     import time
 
-    import numpy as np
-
-    from vibroimpact.engines.registry import make_engine
-    from vibroimpact.model.contact import RigidStop, Stop
-    from vibroimpact.model.excitation import HarmonicForce
-    from vibroimpact.model.problem import ImpactProblem
-    from vibroimpact.model.system import PAPER_SYSTEM
-
-    if progress is not None:
-        progress("compiling the exact engine's core (first run on this machine only, ~30-60 s; later runs load it from numba's cache)")
-    start = time.perf_counter()
-    problem = ImpactProblem(PAPER_SYSTEM, (Stop(RigidStop(3e-3, 0.2), coordinate=1),), HarmonicForce(10.0, 25.0))
-    make_engine("exact").integrate(problem, np.zeros(4), 0.0, 2, moments=True)  # every overload a study runs
-    elapsed = time.perf_counter() - start
-    if progress is not None:
-        progress(f"compiled the exact engine's core in {elapsed:.0f} s")
-    return elapsed
+    total = 0.0
+    for name in dict.fromkeys(engines):
+        spec = engine_spec(name)
+        if spec.kernels_cached():
+            spec.prepare_kernels()  # loaded here too (~0.1 s): work run in this process times none of it
+            continue
+        if progress is not None:
+            progress(f"compiling the {name} engine's kernels (first run on this machine only, ~30-60 s; later runs load them from numba's cache)")
+        start = time.perf_counter()
+        spec.prepare_kernels()
+        elapsed = time.perf_counter() - start
+        total += elapsed
+        if progress is not None:
+            progress(f"compiled the {name} engine's kernels in {elapsed:.0f} s")
+    return total
 
 
 def _stderr_progress(message: str) -> None:
@@ -141,8 +140,9 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
         When the dask scheduler goes away.
     """
     kind = study_kind(scene)
-    prepare_compiled_core(progress)
-    with Runner(jobs, scheduler, store, progress is not None) as runner:
+    engines = kind.engines(scene)
+    prepare_engines(engines, progress)
+    with Runner(jobs, scheduler, store, progress is not None, engines=engines) as runner:
         dataset = kind.run(scene, progress, runner)
     dataset.attrs["study_kind"] = kind.name
     if runner.worker_peak_memory:

@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact import __version__
+from vibroimpact.engines.registry import engine_spec
 from vibroimpact.runs.cluster import ClusterLost, Connection, connect, leave_quietly, ProgressBar, ProgressReport, Throttled
 from vibroimpact.runs.store import source_hash, StudyStore
 
@@ -83,9 +84,13 @@ class Runner:
     report : callable or None
         Receives the work done so far by this runner, summed over its cases (a runner inside a worker task passes its
         progress on to the task's own report).
+    engines : sequence of str
+        Registered engines the work runs: each dask worker loads their compiled kernels (:class:`~vibroimpact.runs.kernel_loader.KernelLoader`) before
+        its first task, so no task's own timing includes loading (or compiling) them.
     """
 
-    def __init__(self, jobs: int = 1, scheduler: str | None = None, store: StudyStore | None = None, progress: bool = True, report: ProgressReport | None = None) -> None:
+    def __init__(self, jobs: int = 1, scheduler: str | None = None, store: StudyStore | None = None, progress: bool = True, report: ProgressReport | None = None, engines: Sequence[str] = ()) -> None:
+        self.engines = tuple(engines)
         self.jobs = jobs
         self.scheduler = scheduler
         self.store = store
@@ -106,6 +111,11 @@ class Runner:
         """The dask connection, started on first use."""
         if self._connection is None:
             self._connection = connect(self.jobs, self.scheduler)
+            if any(engine_spec(name).capabilities.compiled for name in self.engines):
+                from vibroimpact.runs.kernel_loader import KernelLoader
+
+                # every worker, and any that joins later, loads the kernels before it takes a task
+                self._connection.client.register_plugin(KernelLoader(self.engines), name="vibroimpact-kernels")  # type: ignore[attr-defined]
         return self._connection
 
     @property

@@ -47,7 +47,7 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["CompliantExactEngine", "bumper_flows", "contact_modes", "loop_arguments", "forget_problems", "loop_is_cached", "prepare_compiled_loop"]
+__all__ = ["CompliantExactEngine", "bumper_flows", "contact_modes", "loop_arguments", "forget_problems"]
 
 #: Most bumpers of one problem: the engine prepares every contact mode, 2^K flows.
 MAX_BUMPERS = 8
@@ -344,7 +344,7 @@ def _trajectory(problem: ImpactProblem, t_start: float, periods: int, out: tuple
     )
 
 
-def loop_is_cached() -> bool:
+def kernels_cached() -> bool:
     """Whether numba's on-disk cache holds the engine's loop (a check of its index; False where unsure)."""
     try:
         return bool(exact_loop.run_bumper_periods._cache._cache_file._load_index())  # numba's index of cached overloads
@@ -352,21 +352,20 @@ def loop_is_cached() -> bool:
         return False
 
 
-def prepare_compiled_loop() -> float:
-    """Compile the engine's loop in this process unless numba's on-disk cache holds it (a check of its index); return
-    the seconds it took (0 where cached). Run once before parallel workers start, they load it instead of each
-    compiling it at once (~25 s of CPU each on a loaded 2-core machine)."""
-    if loop_is_cached():
-        return 0.0
+def prepare_kernels() -> float:
+    """Compile the engine's loop in this process, every overload a study runs (or load it from numba's on-disk cache);
+    return the seconds spent compiling [s] (0 where cached). Run once before parallel workers start, they load it
+    instead of each compiling it at once (~25 s of CPU each on a loaded 2-core machine)."""
     import time
 
     from vibroimpact.model.contact import Stop
     from vibroimpact.model.excitation import HarmonicForce
     from vibroimpact.model.structure import LinearStructure
 
+    cached = kernels_cached()
     start = time.perf_counter()
     problem = ImpactProblem(LinearStructure(mass=[[1.0]], stiffness=[[1e4]]), (Stop(KelvinVoigtBumper(1e-3, 100.0, 0.3), coordinate=0),), HarmonicForce(100.0, 10.0))
     engine = CompliantExactEngine()
     engine.integrate(problem, np.zeros(2), 0.0, 2, moments=True, jacobians=True)
     engine.sample(problem, np.zeros(2), 0.0, 1, np.array([0.05]))
-    return time.perf_counter() - start
+    return 0.0 if cached else time.perf_counter() - start

@@ -429,6 +429,13 @@ class BenchmarkStudy:
 
     name = "benchmark"
 
+    @staticmethod
+    def engines(scene: Any) -> tuple[str, ...]:
+        """The benchmarked methods, the references and the model ladder's engines."""
+        settings: BenchmarkSettings = scene.settings.settings
+        ladder = ("exact", "momentary", "compliant") if settings.ladder is not None else ()
+        return tuple(dict.fromkeys((*settings.methods, *REFERENCES.values(), *ladder)))
+
     def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """Every method at every tolerance on every case, in this process (timings are compared with each other:
         ``runner`` is not used)."""

@@ -111,6 +111,11 @@ class BifurcationStudy:
 
     name = "bifurcation"
 
+    @staticmethod
+    def engines(scene: Scene) -> tuple[str, ...]:
+        """The continuation's and brute force's engine of each diagram (exact Jacobians for its contact law)."""
+        return tuple(dict.fromkeys(_engine(fb) for _r, fb in _diagrams(scene)))
+
     def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """The study's dataset (module docstring); ``progress`` gets a line per stage and per branch set."""
         settings = scene.settings

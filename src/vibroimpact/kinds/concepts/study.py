@@ -37,6 +37,7 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.runner import Runner
+from vibroimpact.engines.registry import BUMPER, RIGID, engine_for
 
 __all__ = ["ClosedForms", "closed_forms", "MARGINAL_MODULUS", "concepts_dataset", "ConceptsStudy", "run_concepts", "CHUNK"]
 
@@ -318,6 +319,16 @@ class ConceptsStudy:
     """The ``concepts`` kind: :func:`run_concepts` on the scene's :class:`ConceptsSettings`."""
 
     name = "concepts"
+
+    @staticmethod
+    def engines(scene: Any) -> tuple[str, ...]:
+        """The rigid stop's exact engine (simulations and branches); with bumpers, the bumper's closed-form engine
+        (branches) and the integrator the simulations cross-check it with."""
+        settings: ConceptsSettings = scene.settings
+        rigid = engine_for(RIGID, "exact_jacobians")
+        if not math.isfinite(settings.bumper_frequency):
+            return (rigid,)
+        return (rigid, engine_for(BUMPER, "exact_jacobians"), "compliant")
 
     def run(self, scene: Any, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """The scene's dataset, with its name, text and provenance."""

@@ -36,6 +36,7 @@ from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.runner import Runner
+from vibroimpact.engines.registry import BUMPER, RIGID, engine_for
 
 __all__ = ["mistuning_offsets", "design_space", "Outcome", "run_design", "DesignStudy", "SECONDS_PER_SAMPLE", "SECONDS_PER_BUMPER_SAMPLE", "SECONDS_PER_CERTIFICATE", "POLISH_BUDGET"]
 
@@ -241,6 +242,13 @@ class DesignStudy:
     """The ``design`` kind: :func:`run_design` on the scene."""
 
     name = "design"
+
+    @staticmethod
+    def engines(scene: Any) -> tuple[str, ...]:
+        """The engine with exact Jacobians for the stops' contact law (the screen's shooting and the certification's
+        continuation and brute force)."""
+        settings: DesignSettings = scene.settings
+        return (engine_for(RIGID if settings.bumper_frequency is None else BUMPER, "exact_jacobians"),)
 
     def run(self, scene: Any, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """The scene's dataset, with its name, text and provenance."""

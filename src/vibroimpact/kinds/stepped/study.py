@@ -115,6 +115,11 @@ class SteppedStudy:
 
     name = "stepped"
 
+    @staticmethod
+    def engines(scene: Scene) -> tuple[str, ...]:
+        """The engines among the scene's solutions (the closed forms need none)."""
+        return tuple(name for name in scene.settings.solutions if name in ENGINE_SOLUTIONS)
+
     def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """Every solution of ``scene`` over its grid (see :func:`vibroimpact.runs.run.run_study`), solved block by
         block (:mod:`vibroimpact.kinds.stepped.blocks`) by :func:`~vibroimpact.kinds.stepped.study.general_block`, whichever

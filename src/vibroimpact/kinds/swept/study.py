@@ -189,6 +189,11 @@ class SweptStudy:
 
     name = "swept"
 
+    @staticmethod
+    def engines(scene: Scene) -> tuple[str, ...]:
+        """The engines among the scene's solutions (a swept sine runs the compliant one)."""
+        return tuple(name for name in scene.settings.solutions if name in ENGINE_SOLUTIONS)
+
     def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """Every solution of ``scene`` over its grid (see :func:`vibroimpact.runs.run.run_study`)."""
         grid = StudyGrid.of(scene)

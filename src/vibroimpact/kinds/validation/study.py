@@ -297,6 +297,11 @@ class ValidationStudy:
 
     name = "validation"
 
+    @staticmethod
+    def engines(scene: Any) -> tuple[str, ...]:
+        """The case's engines (the Zeno case lists them; the others run the exact engine)."""
+        return tuple(getattr(scene.settings.case, "engines", ("exact",)))
+
     def run(self, scene, progress: Callable[[str], None] | None, runner: Runner) -> xr.Dataset:
         """The scene's dataset (module docstring); one process (each case takes seconds)."""
         return run_validation(scene.settings, scene.name, scene.text, progress)
