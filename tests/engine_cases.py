@@ -11,7 +11,7 @@ from vibroimpact.engines.exact import ExactEngine
 
 from vibroimpact.engines.base import Trajectory
 from vibroimpact.engines.linear_flow import gauss_legendre
-from vibroimpact.analysis.linear import linear_response
+from vibroimpact.analysis.linear import paper_linear_response
 from vibroimpact.analysis.impact_orbit import ImpactOrbit
 from vibroimpact.analysis.pgf import solve_one_impact
 from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
@@ -45,7 +45,7 @@ def orbit_force(system: TwoDofSystem, orbit: ImpactOrbit) -> np.ndarray:
 
 def linear_state(problem: ImpactProblem, t: float = 0.0) -> np.ndarray:
     """The linear steady state (no stop) at time t under q cos(w t + phase)."""
-    response = linear_response(named(problem), omega=problem.omega, amplitude=problem.amplitude)
+    response = paper_linear_response(named(problem), omega=problem.omega, amplitude=problem.amplitude)
     rotation = np.exp(1j * (problem.omega * t + problem.phase))
     x = np.array([response.x1, response.x2]) * rotation
     return np.concatenate([x.real, (1j * problem.omega * x).real])

@@ -43,11 +43,18 @@ def test_25_means_25_hz_in_the_closed_forms() -> None:
 
 
 def test_25_means_25_hz_in_the_linear_response() -> None:
+    """The paper's system is a view of its problem: the same amplitudes, reported at 25 Hz beside 50 pi rad/s."""
+    from vibroimpact.analysis.linear import paper_linear_response
+
     paper = linear_response(PAPER_SYSTEM, 25.0, 10.0)
     general = linear_amplitudes(PROBLEM, 25.0)
-    np.testing.assert_allclose(paper.x1, general.coordinates[..., 0], rtol=1e-12)
-    np.testing.assert_allclose(paper.x2, general.coordinates[..., 1], rtol=1e-12)
-    np.testing.assert_allclose(linear_amplitudes(PROBLEM).coordinates, general.coordinates, rtol=1e-15)  # the problem's own 25 Hz
+    receptances = paper_linear_response(PAPER_SYSTEM, 25.0, 10.0)  # eqs. 4-5
+    np.testing.assert_allclose(receptances.x1, general.coordinate("x1"), rtol=1e-12)
+    np.testing.assert_allclose(receptances.x2, general.coordinate("x2"), rtol=1e-12)
+    np.testing.assert_allclose(receptances.force, general.force, rtol=1e-12)
+    np.testing.assert_allclose(paper.amplitudes, general.amplitudes, rtol=1e-15)
+    np.testing.assert_allclose(linear_response(PROBLEM).amplitudes, general.amplitudes, rtol=1e-15)  # the problem's own 25 Hz
+    assert paper.coordinates == ("x1", "x2") and float(paper.frequency) == pytest.approx(25.0, rel=1e-15)
 
 
 def test_natural_frequencies_are_hz_and_angular_ones_say_so() -> None:

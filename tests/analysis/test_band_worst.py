@@ -60,7 +60,7 @@ def test_at_one_frequency_the_worst_coexisting_motion_is_taken() -> None:
     assert at.motion == MOTIONS[2] and min(abs(at.amplitude / x - 1.0) for x in roots if np.isfinite(x)) < 1e-12
     free = closed_form_at(paper(1.0, 0.6), 20.85)
     assert free.motion == MOTIONS[1]
-    assert free.amplitude == pytest.approx(abs(linear_amplitudes(paper(1.0, 0.6), frequency=20.85).coordinates[0]), rel=1e-12)
+    assert free.amplitude == pytest.approx(abs(linear_amplitudes(paper(1.0, 0.6), frequency=20.85).amplitudes[0]), rel=1e-12)
 
 
 def test_a_bad_band_is_refused() -> None:

@@ -13,7 +13,7 @@ import pytest
 from vibroimpact.analysis.greens import periodic_green
 from vibroimpact.analysis.impact_orbit import ImpactOrbit, impulse_roots, solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
-from vibroimpact.analysis.linear import linear_amplitudes, linear_response
+from vibroimpact.analysis.linear import linear_amplitudes, paper_linear_response
 from vibroimpact.analysis.pgf import solve_one_impact
 from vibroimpact.analysis.stability import floquet_multipliers, monodromy
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
@@ -148,15 +148,15 @@ def test_paper_layout_as_structure_equals_named_form() -> None:
 
 
 def test_linear_amplitudes_of_paper_layout_and_relative_coordinate() -> None:
-    """linear_amplitudes equals linear_response (q H11, q H12) on the paper's layout; a relative stop's amplitude is
+    """linear_amplitudes equals paper_linear_response (q H11, q H12) on the paper's layout; a relative stop's amplitude is
     x2 - x1 = q (H12 - H11), to round-off."""
     w = 2.0 * np.pi * FREQUENCIES
-    paper = linear_response(PAPER_SYSTEM, omega=w, amplitude=10.0)
+    paper = paper_linear_response(PAPER_SYSTEM, omega=w, amplitude=10.0)
     general = linear_amplitudes(paper_problem(), omega=w)
     np.testing.assert_allclose(general.coordinate("x1"), paper.x1, rtol=1e-13)
-    np.testing.assert_allclose(general.stops[..., 0], paper.x2, rtol=1e-13)
+    np.testing.assert_allclose(general.stop_amplitudes[..., 0], paper.x2, rtol=1e-13)
     relative = linear_amplitudes(relative_problem(25.0, phase=0.0), omega=w)
-    np.testing.assert_allclose(relative.stops[..., 0], paper.x2 - paper.x1, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(relative.stop_amplitudes[..., 0], paper.x2 - paper.x1, rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(relative.relative("x2", "x1"), paper.x2 - paper.x1, rtol=1e-12, atol=1e-15)
 
 

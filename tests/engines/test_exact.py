@@ -14,7 +14,7 @@ from vibroimpact.engines.base import MODE_STUCK
 from vibroimpact.engines.exact import ExactEngine
 
 from vibroimpact.engines.settings import EngineSettings
-from vibroimpact.analysis.linear import linear_response
+from vibroimpact.analysis.linear import paper_linear_response
 from vibroimpact.model.system import TwoDofSystem
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
@@ -57,7 +57,7 @@ def test_far_clearance_is_the_linear_solution() -> None:
 def test_grazing_contact_is_never_missed(margin: float, system: TwoDofSystem) -> None:
     """The linear orbit's maximum X2 lies 0.5 nm beyond (or short of) the stop: one impact (or none) per period."""
     frequency = 30.0
-    amplitude_x2 = PAPER_AMPLITUDE * abs(linear_response(system, omega=2 * np.pi * frequency, amplitude=1.0).x2)
+    amplitude_x2 = PAPER_AMPLITUDE * abs(paper_linear_response(system, omega=2 * np.pi * frequency, amplitude=1.0).x2)
     problem = ImpactProblem(system, RigidStop(amplitude_x2 + margin, 0.9), HarmonicForce(PAPER_AMPLITUDE, frequency))
     trajectory = ENGINE.integrate(problem, linear_state(problem), 0.0, 3)
     if margin < 0:

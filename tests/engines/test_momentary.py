@@ -17,7 +17,7 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.event_loop import Model
 from vibroimpact.engines.momentary import COMPILED_EVENTS, COMPILED_JACOBIAN, COMPILED_RHS, MomentaryEngine, compiled_parameters
 from vibroimpact.engines.sundae import evaluate_compiled
-from vibroimpact.analysis.linear import linear_response
+from vibroimpact.analysis.linear import paper_linear_response
 from vibroimpact.model.system import TwoDofSystem
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
@@ -60,7 +60,7 @@ def test_error_follows_the_tolerance(system: TwoDofSystem) -> None:
 
 def _grazing_problems(system: TwoDofSystem, margin: float) -> list[ImpactProblem]:
     frequency = 30.0
-    amplitude_x2 = PAPER_AMPLITUDE * abs(linear_response(system, omega=2 * np.pi * frequency, amplitude=1.0).x2)
+    amplitude_x2 = PAPER_AMPLITUDE * abs(paper_linear_response(system, omega=2 * np.pi * frequency, amplitude=1.0).x2)
     return [ImpactProblem(system, RigidStop(amplitude_x2 + margin, 0.9), HarmonicForce(PAPER_AMPLITUDE, frequency, phase=phase)) for phase in np.linspace(0, 2 * np.pi, 24, endpoint=False)]
 
 

@@ -42,7 +42,7 @@ from vibroimpact.engines.base import Engine
 from vibroimpact.engines.registry import RIGID as RIGID_LAW
 from vibroimpact.engines.registry import engine_spec, make_engine
 from vibroimpact.engines.settings import EngineSettings
-from vibroimpact.analysis.linear import linear_response
+from vibroimpact.analysis.linear import paper_linear_response
 from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
 
 from tests.conftest import PAPER_AMPLITUDE, PAPER_CLEARANCE
@@ -243,7 +243,7 @@ def _pgf(frequency: float, restitution: float, clearance: float = PAPER_CLEARANC
 
 def _grazing(margin: float, phase: float) -> ImpactProblem:
     """30 Hz, R = 0.9: the linear orbit's largest X2 is ``margin`` short of the stop (negative: beyond it)."""
-    amplitude_x2 = PAPER_AMPLITUDE * abs(linear_response(PAPER_SYSTEM, omega=2 * math.pi * 30.0, amplitude=1.0).x2)
+    amplitude_x2 = PAPER_AMPLITUDE * abs(paper_linear_response(PAPER_SYSTEM, omega=2 * math.pi * 30.0, amplitude=1.0).x2)
     return ImpactProblem(PAPER_SYSTEM, RigidStop(amplitude_x2 + margin, 0.9), HarmonicForce(PAPER_AMPLITUDE, 30.0, phase=phase))
 
 

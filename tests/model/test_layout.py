@@ -120,18 +120,18 @@ def test_the_linear_reach_is_a_problem_s_linear_amplitudes_bit_for_bit(layout: L
         assert reach.shape == (len(layout.stops),)
         for restitution, clearance in ((0.5, 1.0), (0.05, 2e-4)):
             linear = linear_amplitudes(layout.problem(amplitude, frequency, restitution, clearance))
-            np.testing.assert_array_equal(reach, np.abs(linear.stops) + linear.stop_static)  # exact: the one arithmetic, on the same structure and load
+            np.testing.assert_array_equal(reach, np.abs(linear.stop_amplitudes) + linear.stop_static)  # exact: the one arithmetic, on the same structure and load
 
 
 def test_the_linear_reach_of_the_paper_s_stop_is_q_h12() -> None:
     """On the paper's layout the reach is the absorber's linear amplitude q |H12| (no static load); on a relative pair
     both sides see the same |X2 - X1|; a static load adds n . K^-1 F0, signed by the stop's side."""
-    from vibroimpact.analysis.linear import linear_reach, linear_response
+    from vibroimpact.analysis.linear import linear_reach, paper_linear_response
 
     frequencies = (12.0, 25.0, 33.0)
     for f in frequencies:
         reach = linear_reach(Layout(PAPER_SYSTEM), 10.0, f)
-        response = linear_response(PAPER_SYSTEM, f, 10.0)
+        response = paper_linear_response(PAPER_SYSTEM, f, 10.0)
         np.testing.assert_allclose(reach, [abs(response.x2)], rtol=1e-12)
         pair = linear_reach(REACH_LAYOUTS[1][1], 10.0, f)
         np.testing.assert_allclose(pair, [abs(response.x2 - response.x1)] * 2, rtol=1e-12)

@@ -80,12 +80,31 @@ def test_the_normal_and_effective_mass_of_each_kind_of_stop() -> None:
     assert Stop(law, 0, side="lower").describe(("x1", "x2")) == "x1 >= -3 mm"
 
 
+def test_a_stop_takes_its_coordinates_by_name_as_scenes_do() -> None:
+    """``Stop(law, "x2")`` is the scene's ``coordinate: x2`` (index 1, not 2), on the structure's own names too; the
+    problem holds the indices, so a named stop's problem equals the indexed one."""
+    law = RigidStop(3e-3, 0.2)
+    force = HarmonicForce(10.0, 25.0)
+    named = ImpactProblem(PAPER, (Stop(law, "x2"), Stop(law, "x2", other="x1", side="lower")), force)
+    indexed = ImpactProblem(PAPER, (Stop(law, 1), Stop(law, 1, other=0, side="lower")), force)
+    assert named == indexed and [stop.place for stop in named.stops] == [(1, None, "upper"), (1, 0, "lower")]
+    chain = LinearStructure(np.diag([1.0, 0.5, 0.1]), [[3.0, -1.0, 0.0], [-1.0, 2.0, -1.0], [0.0, -1.0, 1.0]], coordinates=("base", "mid", "tip"))
+    tip = ImpactProblem(chain, (Stop(law, "tip", other="base"),), HarmonicForce(1.0, 1.0))
+    np.testing.assert_array_equal(tip.normals(), [[-1.0, 0.0, 1.0]])
+    assert Stop(law, "tip", other="base").describe(("base", "mid", "tip")) == "tip - base <= 3 mm"
+    assert Stop.bumper(np.diag([1.0, 0.1]), 1e-3, 4e4, loss_factor=0.2, coordinate="x2") == Stop.bumper(np.diag([1.0, 0.1]), 1e-3, 4e4, loss_factor=0.2, coordinate=1)
+
+
 @pytest.mark.parametrize(
     ("build", "message"),
     [
         (lambda: Stop(RigidStop(0.0, 0.5), 0, side="left"), "stop side = 'left' is not allowed"),
         (lambda: Stop(RigidStop(0.0, 0.5), 1, other=1), "the two coordinates must differ"),
-        (lambda: Stop(RigidStop(0.0, 0.5), -1), "expected an index >= 0"),
+        (lambda: Stop(RigidStop(0.0, 0.5), -1), "expected a coordinate's name .* or a 0-based index >= 0"),
+        (lambda: Stop(RigidStop(0.0, 0.5), "x2", other="x2"), "the two coordinates must differ"),
+        (lambda: ImpactProblem(PAPER, (Stop(RigidStop(0.0, 0.5), "absorber"),), HarmonicForce(1.0, 1.0)), r"stop coordinate = 'absorber' is not a coordinate of the system: allowed \['x1', 'x2'\]"),
+        (lambda: ImpactProblem(PAPER, (Stop(RigidStop(0.0, 0.5), "x2", other="x3"),), HarmonicForce(1.0, 1.0)), "second coordinate = 'x3' is not a coordinate"),
+        (lambda: Stop(RigidStop(0.0, 0.5), "x2").normal(2), "a name is known only against a structure"),
         (lambda: ImpactProblem(LinearStructure([[1.0]], [[1.0]]), (Stop(RigidStop(0.0, 0.5), 1),), HarmonicForce(1.0, 1.0)), "coordinate index 1 is out of range"),
         (lambda: ImpactProblem(PAPER, (Stop(RigidStop(0.0, 0.5), 1),), HarmonicForce(1.0, 1.0, static=(1.0,))), "excitation.static: expected 2 values"),
         (lambda: HarmonicForce(1.0, 1.0, weights=(1.0,), base_motion=True), "give no 'on' weights"),

@@ -104,7 +104,7 @@ def test_closest_approach_of_a_free_flight_is_the_linear_orbits_distance_to_the_
     linear = linear_state(free)
     assert linear.fits(free)
     out = ImpactMap(free).evaluate(linear.state(free.omega), ImpactMap(free).parameters)
-    x2 = abs(linear_amplitudes(free, omega=free.omega).coordinates[1])
+    x2 = abs(linear_amplitudes(free, omega=free.omega).amplitudes[1])
     assert out.hybrid.impacts == 0 and math.isinf(out.hybrid.min_impact_velocity)
     assert out.hybrid.closest_approach == pytest.approx(x2 - PAPER_CLEARANCE, rel=1e-9)
     assert out.hybrid.closest_approach < 0.0
@@ -112,7 +112,7 @@ def test_closest_approach_of_a_free_flight_is_the_linear_orbits_distance_to_the_
 
 def _touch() -> float:
     """Where the linear orbit touches the surface, q |H12| = Delta, below the resonance [Hz]."""
-    return brentq(lambda f: abs(linear_amplitudes(problem(f, None), omega=2.0 * np.pi * f).coordinates[1]) - PAPER_CLEARANCE, 19.0, 21.0, xtol=1e-13)
+    return brentq(lambda f: abs(linear_amplitudes(problem(f, None), omega=2.0 * np.pi * f).amplitudes[1]) - PAPER_CLEARANCE, 19.0, 21.0, xtol=1e-13)
 
 
 def test_the_continued_branch_passes_through_steady_states_and_ends_at_contact_onset_at_tangency() -> None:

@@ -93,7 +93,7 @@ def test_an_accepted_absorber_locked_by_its_dashpot_gives_the_locked_answer() ->
     document = copy.deepcopy(base_scene())
     document["system"]["b2"] = 1e5 * math.sqrt(4300.0 * 0.1)
     frequency = np.array([20.0, 25.0, 30.0])
-    x1 = np.abs(linear_amplitudes(first_problem(parse_scene(document)), frequency).coordinates[:, 0])
+    x1 = np.abs(linear_amplitudes(first_problem(parse_scene(document)), frequency).amplitudes[:, 0])
     w = 2.0 * np.pi * frequency
     locked = 10.0 / np.abs(25000.0 - w**2 * 1.1 + 1j * w * 0.8)
     np.testing.assert_allclose(x1, locked, rtol=1e-4)

@@ -12,7 +12,7 @@ from vibroimpact.engines.exact import ExactEngine
 
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.engines.momentary import MomentaryEngine
-from vibroimpact.analysis.linear import linear_response
+from vibroimpact.analysis.linear import paper_linear_response
 from vibroimpact.analysis.pgf import solve_one_impact
 from vibroimpact.simulation.steady import steady_state
 from vibroimpact.simulation.settings import SteadySettings
@@ -59,13 +59,13 @@ def test_linear_point_is_answered_without_integrating(system: TwoDofSystem) -> N
     problem = ImpactProblem(system, RigidStop(PAPER_CLEARANCE, 0.2), HarmonicForce(PAPER_AMPLITUDE, 30.0))
     result = steady_state(ExactEngine(), problem, "linear")
     assert not result.integrated and result.periods_used == 0
-    assert abs(result.measures.x1) == pytest.approx(abs(linear_response(system, omega=problem.omega, amplitude=PAPER_AMPLITUDE).x1), rel=1e-15)
+    assert abs(result.measures.x1) == pytest.approx(abs(paper_linear_response(system, omega=problem.omega, amplitude=PAPER_AMPLITUDE).x1), rel=1e-15)
 
 
 def test_measured_linear_motion_has_exact_harmonics_and_rms(system: TwoDofSystem) -> None:
     """Integrating the linear steady state (no contact) measures its amplitude and RMS = amplitude / sqrt 2 exactly."""
     problem = ImpactProblem(system, RigidStop(1.0, 0.2), HarmonicForce(PAPER_AMPLITUDE, 30.0))
-    response = linear_response(system, omega=problem.omega, amplitude=PAPER_AMPLITUDE)
+    response = paper_linear_response(system, omega=problem.omega, amplitude=PAPER_AMPLITUDE)
     state = np.array([response.x1.real, response.x2.real, (1j * problem.omega * response.x1).real, (1j * problem.omega * response.x2).real])
     result = steady_state(ExactEngine(), problem, (0.0, state), SteadySettings(tolerance=1e-10))
     m = result.measures

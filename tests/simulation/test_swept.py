@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vibroimpact.analysis.linear import linear_response
+from vibroimpact.analysis.linear import paper_linear_response
 from vibroimpact.engines.registry import make_engine
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import KelvinVoigtBumper
@@ -65,7 +65,7 @@ def test_estimates_of_a_slow_sweep_without_contact_are_the_linear_steady_state()
     assert set(names) | {f"running_{q}" for q in names} | {"time", "instantaneous_frequency"} == set(out)
     assert all(out[q].shape == (1, 3) for q in SWEEP_STOP_QUANTITIES)  # one stop
     assert np.isnan(out["x1_amplitude"][[0, 2]]).all() and np.isfinite(out["x1_amplitude"][1])
-    linear = linear_response(PAPER_SYSTEM, omega=np.array([2.0 * np.pi * 15.5]), amplitude=10.0)
+    linear = paper_linear_response(PAPER_SYSTEM, omega=np.array([2.0 * np.pi * 15.5]), amplitude=10.0)
     assert out["x1_amplitude"][1] == pytest.approx(abs(linear.x1[0]), rel=1e-2)
     assert out["x2_amplitude"][1] == pytest.approx(abs(linear.x2[0]), rel=1e-2)
     assert out["impacts_per_period"][1] == 0.0 and out["peak_contact_force"][0, 1] == 0.0  # exact: no contact counted

@@ -93,7 +93,7 @@ def contact_free_curve(problem: ImpactProblem, f: NDArray[np.float64], coordinat
     """|X| [m] of ``coordinate``'s contact-free steady state at frequencies ``f`` [Hz] where it clears every stop and
     is stable (NaN elsewhere), and everywhere (in closed form; any contact law: it never touches one)."""
     linear = linear_amplitudes(problem, omega=2.0 * np.pi * f)
-    x = np.abs(linear.coordinates[..., coordinate])
+    x = np.abs(linear.amplitudes[..., coordinate])
     return np.where(linear.fits(problem.clearances()) & contact_free_is_stable(problem.structure), x, np.nan), x
 
 

@@ -1,5 +1,6 @@
 """Closed-form impact orbits of any linear structure: one impact per period on one rigid stop, or the symmetric
-two impacts per period on a two-sided stop (derivation of the latter in :func:`vibroimpact.analysis.two_sided.solve_two_impacts`).
+two impacts per period on a two-sided stop (derivation of the latter in :func:`vibroimpact.analysis.two_sided.solve_two_impacts`, public as
+:func:`vibroimpact.solve_two_impacts`).
 
 The structure ``M x'' + C x' + K x = Re(F e^{jwt}) + F0 - n lambda(t)`` has its stop's coordinate u = n . x (n the
 stop's normal: e_i, -e_i, +-(e_i - e_j)) and gap Delta - u. With time measured from an (upper) impact, u(0) = Delta,
@@ -26,6 +27,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -34,11 +36,13 @@ from vibroimpact.analysis.greens import GREEN_CONDITION_LIMIT, green_condition, 
 from vibroimpact.analysis.layout import ClosedFormLayout, closed_form_layout, harmonic_load
 from vibroimpact.analysis.linear import base_force as suspension_force
 from vibroimpact.analysis.paper_fit import PaperFit
-from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
+from vibroimpact.model.contact import RigidStop
+from vibroimpact.model.excitation import HarmonicForce, angular_frequency, check_closed_form_inputs
 from vibroimpact.model.modal import ModalResponse, impulse_modes
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["ImpactOrbit", "solve_impact_orbit", "impulse_roots", "ROOTS"]
+__all__ = ["ImpactOrbit", "solve_impact_orbit", "problem_view", "impulse_roots", "ROOTS"]
 
 #: The two roots of the impulse equation: '+' (the paper's, the one that is stable where either is) and '-'.
 ROOTS = ("+", "-")
@@ -113,6 +117,26 @@ class ImpactOrbit:
     condition: NDArray[np.float64]
 
     # --------------------------------------------------------------- scalars
+    @property
+    def frequency(self) -> NDArray[np.float64]:
+        """f = w / (2 pi) [Hz], the excitation frequency of every point (:attr:`omega` is w [rad s-1])."""
+        return self.omega / (2.0 * np.pi)
+
+    @cached_property
+    def multipliers(self) -> NDArray[np.complex128]:
+        """Floquet multipliers [-] of every orbit, shape S + (2N,), sorted by decreasing modulus; NaN where no orbit
+        exists (:func:`~vibroimpact.analysis.stability.floquet_multipliers`; computed once, on first use)."""
+        from vibroimpact.analysis.stability import floquet_multipliers  # stability builds on this module
+
+        return floquet_multipliers(self)
+
+    @property
+    def stable(self) -> NDArray[np.bool_]:
+        """True where the orbit exists and every Floquet multiplier lies inside the unit circle, |mu| < 1, shape S
+        (admissibility is :meth:`admissible`; an orbit that penetrates a stop is no motion, whatever its multipliers)."""
+        moduli = np.abs(self.multipliers)
+        return self.exists & np.all(np.isfinite(moduli), axis=-1) & np.all(np.nan_to_num(moduli, nan=np.inf) < 1.0, axis=-1)
+
     @property
     def conditioned(self) -> NDArray[np.bool_]:
         """Where the closed form is evaluated: condition <= GREEN_CONDITION_LIMIT (False where the sums are
@@ -355,8 +379,28 @@ def _impulse_and_phase(w: NDArray, delta: NDArray, r: NDArray, m_eff: float, a: 
     return np.where(exists, impulse, np.nan), phase, exists
 
 
+def problem_view(system: "TwoDofSystem | ImpactProblem", frequency: ArrayLike | None, clearance: ArrayLike | None, restitution: ArrayLike | None,
+                 amplitude: ArrayLike | None, omega: ArrayLike | None = None, call: str = "solve_impact_orbit") -> ImpactProblem:  # fmt: skip
+    """The problem a closed form solves: ``system`` itself if it is an :class:`ImpactProblem`; the paper's named
+    :class:`TwoDofSystem` is a view of the paper's layout (one rigid upper stop on x2, the force on x1), whose values
+    (frequency or omega, clearance, restitution, amplitude) must then all be given: they replace its placeholders.
+
+    Raises
+    ------
+    TypeError
+        A :class:`TwoDofSystem` without all four values, or a ``system`` of another kind.
+    """
+    if isinstance(system, ImpactProblem):
+        return system
+    if not isinstance(system, TwoDofSystem):
+        raise TypeError(f"{call}: system = {system!r} is not an ImpactProblem or the paper's TwoDofSystem")
+    if (frequency is None and omega is None) or clearance is None or restitution is None or amplitude is None:
+        raise TypeError(f"{call}(system, frequency, clearance, restitution, amplitude): the paper's system needs all five (a problem carries its own)")
+    return ImpactProblem(system, RigidStop(0.0, 0.0), HarmonicForce(1.0, 1.0))  # placeholders: the values given replace them
+
+
 def solve_impact_orbit(
-    problem: ImpactProblem,
+    problem: "ImpactProblem | TwoDofSystem",
     frequency: ArrayLike | None = None,
     clearance: ArrayLike | None = None,
     restitution: ArrayLike | None = None,
@@ -370,9 +414,10 @@ def solve_impact_orbit(
 
     Parameters
     ----------
-    problem : ImpactProblem
+    problem : ImpactProblem or TwoDofSystem
         Structure, rigid stop(s) and harmonic force (:func:`.layout.closed_form_layout` says whether a closed form
-        applies: ``ValueError`` with the reason otherwise).
+        applies: ``ValueError`` with the reason otherwise); the paper's :class:`TwoDofSystem` is a view of its layout
+        (:func:`problem_view`: give frequency, clearance, restitution and amplitude).
     frequency : array_like, optional
         f [Hz], > 0; default the problem's.
     clearance : array_like, optional
@@ -388,7 +433,14 @@ def solve_impact_orbit(
     green : PaperFit, optional
         The paper's fitted chi22 and constant chi22'(0-) instead of the exact ones (``pgf_paper``; its layout only,
         :mod:`~vibroimpact.analysis.paper_fit`).
+
+    Returns
+    -------
+    ImpactOrbit
+        Impulse, phase, existence, ``frequency`` [Hz] beside ``omega`` [rad s-1], ``stable`` and ``multipliers``
+        (Floquet), :meth:`~ImpactOrbit.harmonics`, :meth:`~ImpactOrbit.admissible`, the motion.
     """
+    problem = problem_view(problem, frequency, clearance, restitution, amplitude, omega)
     layout = closed_form_layout(problem)
     check_closed_form_inputs(clearance, restitution, amplitude)
     w, delta, r, q = (np.asarray(x, dtype=float) for x in np.broadcast_arrays(

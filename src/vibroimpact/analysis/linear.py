@@ -1,7 +1,8 @@
 """Steady-state response of the linear system (no stop, Delta -> infinity) and its resonance peaks.
 
-:func:`linear_response` and :func:`resonance_peaks` are the paper's named two-mass system (X1, X2, suspension force).
-:func:`linear_amplitudes` is any structure under its problem's load: the complex amplitude of every coordinate,
+:func:`paper_linear_response` and :func:`resonance_peaks` are the paper's named two-mass system by its receptances
+(X1, X2, suspension force). :func:`linear_response` (also named :func:`linear_amplitudes`) is any problem under its
+load (the paper's system a view of its problem): the complex amplitude of every coordinate,
 H(jw) F(w), and of every stop's coordinate n_k . H F (a relative coordinate x_i - x_j for a relative stop, signed
 by the stop's side), plus the static deflection K^-1 F0 where K is invertible (:func:`structure_amplitudes` the same
 from the structure, load and stop directions alone; :func:`linear_reach` each stop's |n_k . X| + n_k . x0 of a
@@ -20,13 +21,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.analysis.layout import harmonic_load_of
+from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce, angular_frequency, check_closed_form_inputs
 from vibroimpact.model.layout import Layout
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["contact_free_is_stable", "base_coupling", "base_force", "peaks_near", "LinearResponse", "linear_response", "ResonancePeak", "resonance_peaks", "LinearAmplitudes", "linear_amplitudes", "linear_reach", "structure_amplitudes", "structure_peaks"]
+__all__ = ["contact_free_is_stable", "base_coupling", "base_force", "peaks_near", "LinearResponse", "paper_linear_response", "linear_response", "ResonancePeak", "resonance_peaks", "LinearAmplitudes", "linear_amplitudes", "linear_reach", "structure_amplitudes", "structure_peaks"]
 
 
 def contact_free_is_stable(system: LinearStructure) -> bool:
@@ -75,7 +77,8 @@ def base_force(system: LinearStructure, omega: ArrayLike, x: ArrayLike, through:
 
 @dataclass(frozen=True, eq=False)
 class LinearResponse:
-    """Complex amplitudes of the linear steady state under the force q cos(w t).
+    """Complex amplitudes of the paper's linear steady state under the force q cos(w t), by eqs. 4-5
+    (:func:`paper_linear_response`; the public form of any problem is :class:`LinearAmplitudes`).
 
     Attributes
     ----------
@@ -90,11 +93,12 @@ class LinearResponse:
     force: NDArray[np.complex128]
 
 
-def linear_response(system: TwoDofSystem, frequency: ArrayLike | None = None, amplitude: float | None = None, *, omega: ArrayLike | None = None) -> LinearResponse:
-    """Linear steady-state amplitudes of the paper's system at ``frequency`` [Hz] (or angular frequencies ``omega``
-    [rad s-1], keyword only) for force amplitude q [N] (``amplitude``, finite)."""
+def paper_linear_response(system: TwoDofSystem, frequency: ArrayLike | None = None, amplitude: float | None = None, *, omega: ArrayLike | None = None) -> LinearResponse:
+    """Linear steady-state amplitudes of the paper's system by its receptances (eqs. 4-5) at ``frequency`` [Hz] (or
+    angular frequencies ``omega`` [rad s-1], keyword only) for force amplitude q [N] (``amplitude``, finite): the
+    arithmetic of the paper's studies (:func:`linear_response` is the public form, of any problem)."""
     if amplitude is None:
-        raise TypeError("linear_response(system, frequency, amplitude): the force amplitude q [N] is needed")
+        raise TypeError("paper_linear_response(system, frequency, amplitude): the force amplitude q [N] is needed")
     check_closed_form_inputs(None, None, amplitude)
     w = np.asarray(angular_frequency(frequency, omega), dtype=float)
     h = system.receptances(w)
@@ -139,69 +143,105 @@ def resonance_peaks(system: TwoDofSystem, amplitude: float, quantity: str = "x1"
         raise ValueError(f"quantity must be 'x1', 'x2' or 'force', got {quantity!r}")
 
     def magnitude(w: ArrayLike) -> NDArray[np.float64]:
-        return np.abs(getattr(linear_response(system, omega=w, amplitude=amplitude), quantity))
+        return np.abs(getattr(paper_linear_response(system, omega=w, amplitude=amplitude), quantity))
 
     return peaks_near(system.natural_angular_frequencies(), magnitude, span)
 
 
 @dataclass(frozen=True, eq=False)
 class LinearAmplitudes:
-    """The linear steady state of a structure under its problem's load, without stops.
+    """The linear steady state of a structure under its problem's load, without stops: what
+    :func:`linear_response` returns.
 
     Attributes
     ----------
     omega : ndarray
-        Angular frequencies w [rad s-1], shape S.
-    coordinates : ndarray of complex, shape S + (N,)
-        H(jw) F(w): complex amplitude of each coordinate in the problem's time [m].
-    stops : ndarray of complex, shape S + (K,)
+        Angular frequencies w [rad s-1], shape S (:attr:`frequency` f [Hz]).
+    amplitudes : ndarray of complex, shape S + (N,)
+        H(jw) F(w): complex amplitude of each coordinate in the problem's time [m], columns in the order of
+        ``coordinates`` (:meth:`coordinate` by name).
+    stop_amplitudes : ndarray of complex, shape S + (K,)
         n_k . H F: complex amplitude of each stop's coordinate (the quantity its gap Delta_k - n_k . x subtracts) [m].
     static : ndarray, shape (N,)
         K^-1 F0, the static deflection [m] (NaN where K is singular and a static load is given; zeros without one).
     stop_static : ndarray, shape (K,)
         n_k . K^-1 F0 [m].
-    names : tuple of str
-        The coordinates' names.
+    coordinates : tuple of str
+        The coordinates' names (as :attr:`TimeHistory.coordinates <vibroimpact.simulation.history.TimeHistory.coordinates>`).
+    structure : LinearStructure
+        The structure (its K and C give :attr:`force`).
     """
 
     omega: NDArray[np.float64]
-    coordinates: NDArray[np.complex128]
-    stops: NDArray[np.complex128]
+    amplitudes: NDArray[np.complex128]
+    stop_amplitudes: NDArray[np.complex128]
     static: NDArray[np.float64]
     stop_static: NDArray[np.float64]
-    names: tuple[str, ...]
+    coordinates: tuple[str, ...]
+    structure: LinearStructure
+
+    @property
+    def frequency(self) -> NDArray[np.float64]:
+        """f = w / (2 pi) [Hz]."""
+        return self.omega / (2.0 * np.pi)
+
+    @property
+    def force(self) -> NDArray[np.complex128]:
+        """Fundamental of the force on the base through the springs and dashpots, 1^T (K + j w C) X [N], shape S
+        ((K1 + j w B1) X1 on the paper's system; :func:`base_force`)."""
+        return base_force(self.structure, self.omega, self.amplitudes)
 
     def coordinate(self, name: str) -> NDArray[np.complex128]:
-        """The complex amplitude of the coordinate called ``name`` [m]."""
-        if name not in self.names:
-            raise ValueError(f"coordinate = {name!r} is not a coordinate of the system: allowed {list(self.names)}")
-        return self.coordinates[..., self.names.index(name)]
+        """The complex amplitude of the coordinate called ``name`` [m], shape S."""
+        if name not in self.coordinates:
+            raise ValueError(f"coordinate = {name!r} is not a coordinate of the system: allowed {list(self.coordinates)}")
+        return self.amplitudes[..., self.coordinates.index(name)]
 
     def relative(self, first: str, second: str) -> NDArray[np.complex128]:
         """The complex amplitude of x_first - x_second [m]."""
         return self.coordinate(first) - self.coordinate(second)
 
     def fits(self, clearances: ArrayLike) -> NDArray[np.bool_]:
-        """True where every stop's linear coordinate stays inside its clearance: |n_k H F| + n_k K^-1 F0 <= Delta_k."""
-        return np.all(np.abs(self.stops) + self.stop_static <= np.asarray(clearances, dtype=float), axis=-1)
+        """True where every stop's linear coordinate stays inside its clearance: |n_k H F| + n_k K^-1 F0 <= Delta_k
+        (``clearances`` Delta_k [m])."""
+        return np.all(np.abs(self.stop_amplitudes) + self.stop_static <= np.asarray(clearances, dtype=float), axis=-1)
 
 
-def linear_amplitudes(problem: ImpactProblem, frequency: ArrayLike | None = None, amplitude: ArrayLike | None = None, *, omega: ArrayLike | None = None) -> LinearAmplitudes:
+def linear_response(system: ImpactProblem | TwoDofSystem, frequency: ArrayLike | None = None, amplitude: ArrayLike | None = None, *,
+                    omega: ArrayLike | None = None) -> LinearAmplitudes:  # fmt: skip
     """The complex amplitudes of every coordinate and every stop's coordinate over ``frequency`` (module docstring).
 
     Parameters
     ----------
-    problem : ImpactProblem
+    system : ImpactProblem or TwoDofSystem
         Structure, stops and a harmonic load (force on any coordinates, or base motion: then the coordinates are
-        relative to the base).
+        relative to the base); the paper's named system is a view of its problem (the force on x1, the stop on x2),
+        which needs ``frequency`` and ``amplitude``.
     frequency : array_like, optional
         f [Hz], > 0; default the problem's.
     amplitude : array_like, optional
         q [N] (base motion: Y [m]); default the problem's.
     omega : array_like, optional
         w [rad s-1] instead of ``frequency`` (keyword only).
+
+    Returns
+    -------
+    LinearAmplitudes
+        ``amplitudes`` per coordinate [m] (``coordinate(name)``), ``frequency`` [Hz] beside ``omega`` [rad s-1],
+        the base ``force`` [N], ``fits(clearances)``.
     """
-    return structure_amplitudes(problem.structure, problem.harmonic, problem.normals(), frequency, amplitude, omega=omega)
+    if not isinstance(system, ImpactProblem):
+        if not isinstance(system, TwoDofSystem):
+            raise TypeError(f"linear_response: system = {system!r} is not an ImpactProblem or the paper's TwoDofSystem")
+        if (frequency is None and omega is None) or amplitude is None:
+            raise TypeError("linear_response(system, frequency, amplitude): the paper's system needs the frequency [Hz] and the force amplitude q [N]")
+        check_closed_form_inputs(None, None, amplitude)
+        system = ImpactProblem(system, RigidStop(0.0, 0.0), HarmonicForce(1.0, 1.0))  # its layout; the values given replace the placeholders
+    return structure_amplitudes(system.structure, system.harmonic, system.normals(), frequency, amplitude, omega=omega)
+
+
+#: The same function: the name of the studies' code.
+linear_amplitudes = linear_response
 
 
 def structure_amplitudes(
@@ -233,7 +273,7 @@ def structure_amplitudes(
         static = np.full(structure.size, np.nan)
     else:
         static = np.linalg.solve(structure.stiffness_matrix, static_load)
-    return LinearAmplitudes(w, x, x @ normals.T, static, normals @ static, tuple(structure.coordinates))
+    return LinearAmplitudes(w, x, x @ normals.T, static, normals @ static, tuple(structure.coordinates), structure)
 
 
 def linear_reach(layout: Layout, amplitude: float, frequency: float) -> NDArray[np.float64]:
@@ -243,7 +283,7 @@ def linear_reach(layout: Layout, amplitude: float, frequency: float) -> NDArray[
     values: the layout's geometry and load answer it, the numbers those of :func:`linear_amplitudes` of any problem
     of the layout at that point."""
     linear = structure_amplitudes(layout.problem_structure, layout.load.force(amplitude, frequency), layout.normals())
-    return np.abs(linear.stops) + linear.stop_static
+    return np.abs(linear.stop_amplitudes) + linear.stop_static
 
 
 def structure_peaks(problem: ImpactProblem, output: ArrayLike, span: float = 0.05) -> list[ResonancePeak]:
@@ -261,7 +301,7 @@ def structure_peaks(problem: ImpactProblem, output: ArrayLike, span: float = 0.0
     weights = np.asarray(output, dtype=float)
 
     def magnitude(w: ArrayLike) -> NDArray[np.float64]:
-        return np.abs(linear_amplitudes(problem, omega=np.asarray(w, dtype=float)).coordinates @ weights)
+        return np.abs(linear_amplitudes(problem, omega=np.asarray(w, dtype=float)).amplitudes @ weights)
 
     return peaks_near([wn for wn in problem.structure.natural_angular_frequencies() if wn > 0.0], magnitude, span)
 

@@ -28,11 +28,9 @@ from enum import Enum
 
 from numpy.typing import ArrayLike
 
-from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
+from vibroimpact.analysis.impact_orbit import ImpactOrbit, problem_view, solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_layout
 from vibroimpact.analysis.paper_fit import PaperFit
-from vibroimpact.model.contact import RigidStop
-from vibroimpact.model.excitation import HarmonicForce, check_closed_form_inputs
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
 
@@ -87,12 +85,13 @@ def solve_one_impact(
     needed). ``solve_one_impact(problem, frequency=None, clearance=None, restitution=None, amplitude=None)`` with an
     :class:`ImpactProblem` of any structure with one rigid stop (absolute or relative, upper or lower) takes the
     problem's own values where none are given; ``ValueError`` saying why where it does not apply (several stops, a
-    bumper, a rigid-body mode; a symmetric two-sided stop is :func:`vibroimpact.analysis.two_sided.solve_two_impacts`).
+    bumper, a rigid-body mode; a symmetric two-sided stop is :func:`vibroimpact.solve_two_impacts`). The paper's
+    system is a view of its problem (:func:`~vibroimpact.analysis.impact_orbit.problem_view`), not another solver.
 
     Parameters
     ----------
-    system : TwoDofSystem or ImpactProblem
-        The linear system (paper's layout), or the whole problem.
+    system : ImpactProblem or TwoDofSystem
+        The whole problem, or the paper's named system (its layout; then all five values are needed).
     frequency : array_like
         Excitation frequency f [Hz], > 0 (``ValueError`` otherwise).
     clearance : array_like
@@ -110,18 +109,13 @@ def solve_one_impact(
     Returns
     -------
     ImpactOrbit
-        Impulse, phase, existence, motion, harmonics (x1 is coordinate 0, x2 coordinate 1 on the paper's layout).
+        The one orbit type of every closed form: impulse, phase, existence, ``frequency`` [Hz] and ``omega``
+        [rad s-1], ``stable`` and ``multipliers`` (Floquet), ``harmonics()`` (x1 is column 0, x2 column 1 on the
+        paper's layout), ``admissible()``, the motion.
     """
     variant = PgfVariant(variant)
-    if isinstance(system, ImpactProblem):
-        problem = system
-        if closed_form_layout(problem).two_sided:
-            raise ValueError("contact: the stops form a symmetric two-sided stop, whose closed form has two impacts per period: use analysis.two_sided.solve_two_impacts")
-    else:
-        if (frequency is None and omega is None) or clearance is None or restitution is None or amplitude is None:
-            raise TypeError("solve_one_impact(system, frequency, clearance, restitution, amplitude): the paper's form needs all five")
-        check_closed_form_inputs(clearance, restitution, amplitude)
-        # the paper's layout; its stop and force are placeholders: the values given replace them
-        problem = ImpactProblem(system, RigidStop(0.0, 0.0), HarmonicForce(1.0, 1.0))
+    problem = problem_view(system, frequency, clearance, restitution, amplitude, omega, "solve_one_impact")
+    if closed_form_layout(problem).two_sided:
+        raise ValueError("contact: the stops form a symmetric two-sided stop, whose closed form has two impacts per period: use vibroimpact.solve_two_impacts(problem)")
     green = PaperFit.of(problem) if variant is PgfVariant.PAPER else None
     return solve_impact_orbit(problem, frequency, clearance, restitution, amplitude, omega=omega, green=green)

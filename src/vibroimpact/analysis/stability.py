@@ -112,9 +112,9 @@ def floquet_multipliers(solution: ImpactOrbit) -> NDArray[np.complex128]:
 
 
 def is_stable(solution: ImpactOrbit) -> NDArray[np.bool_]:
-    """True where the one-impact orbit exists and all Floquet multipliers satisfy |mu| < 1."""
-    moduli = np.abs(floquet_multipliers(solution))
-    return solution.exists & np.all(np.isfinite(moduli), axis=-1) & np.all(np.nan_to_num(moduli, nan=np.inf) < 1.0, axis=-1)
+    """True where the orbit exists and all Floquet multipliers satisfy |mu| < 1: :attr:`ImpactOrbit.stable
+    <vibroimpact.analysis.impact_orbit.ImpactOrbit.stable>`."""
+    return solution.stable
 
 
 # --------------------------------------------------------------------------------------------------------------------

@@ -5,15 +5,16 @@ from __future__ import annotations
 
 from numpy.typing import ArrayLike
 
-from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
+from vibroimpact.analysis.impact_orbit import ImpactOrbit, problem_view, solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_layout
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import TwoDofSystem
 
 __all__ = ["solve_two_impacts"]
 
 
 def solve_two_impacts(
-    problem: ImpactProblem,
+    problem: ImpactProblem | TwoDofSystem,
     frequency: ArrayLike | None = None,
     clearance: ArrayLike | None = None,
     restitution: ArrayLike | None = None,
@@ -26,8 +27,9 @@ def solve_two_impacts(
 
     Parameters
     ----------
-    problem : ImpactProblem
-        Structure without rigid-body modes, two rigid stops forming a symmetric pair, harmonic force.
+    problem : ImpactProblem or TwoDofSystem
+        Structure without rigid-body modes, two rigid stops forming a symmetric pair, harmonic force (the paper's
+        system is a view of its one-stop layout: refused with the reason, as any one-stop problem).
     frequency : array_like, optional
         f [Hz], > 0; default the problem's.
     clearance : array_like, optional
@@ -44,7 +46,13 @@ def solve_two_impacts(
     Raises
     ------
     ValueError
-        Naming why the layout has no such orbit (one stop: use :func:`vibroimpact.analysis.pgf.solve_one_impact`).
+        Naming why the layout has no such orbit (one stop: use :func:`vibroimpact.solve_one_impact`).
+
+    Returns
+    -------
+    ImpactOrbit
+        The one orbit type of every closed form (``two_sided`` True): ``frequency`` [Hz], ``omega`` [rad s-1],
+        ``stable``, ``multipliers``, ``harmonics()``, ``admissible()``.
 
     Notes
     -----
@@ -97,7 +105,8 @@ def solve_two_impacts(
     and is a fixed point of an independent integration (scipy, events on both gaps); the monodromy equals the
     finite-difference Jacobian of that integration; a stable orbit attracts a perturbed start.
     """
+    problem = problem_view(problem, frequency, clearance, restitution, amplitude, omega, "solve_two_impacts")
     layout = closed_form_layout(problem)
     if not layout.two_sided:
-        raise ValueError("contact: one stop has no two-sided symmetric orbit; its closed form is analysis.pgf.solve_one_impact(problem)")
+        raise ValueError("contact: one stop has no two-sided symmetric orbit; its closed form is vibroimpact.solve_one_impact(problem)")
     return solve_impact_orbit(problem, frequency, clearance, restitution, amplitude, root, omega=omega)

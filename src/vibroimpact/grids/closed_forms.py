@@ -59,7 +59,7 @@ def general_linear_values(scene: Scene, omega: np.ndarray, shape: tuple[int, ...
     stop; the scene's quantities broadcast to ``shape`` (per-stop ones to (K, *shape))."""
     problem = first_problem(scene)
     linear = linear_amplitudes(problem, omega=omega)
-    x = linear.coordinates  # omega.shape + (N,)
+    x = linear.amplitudes  # omega.shape + (N,)
     count = len(scene.layout.stops)
     clearances = stop_clearances(scene)[None, :, None, None, None, :]  # (1, nc, 1, 1, 1, K)
     fits = linear.fits(clearances)  # (1, nc, 1, 1, F)
@@ -147,12 +147,12 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
         flag = np.where(np.abs(modulus - 1.0) <= MARGINAL_MODULUS, STABLE_MARGINAL, modulus < 1.0)
         return np.where(impact & np.isfinite(modulus), flag, -1).astype(np.int8)
 
-    linear_rms = np.sqrt(linear.static**2 + 0.5 * np.abs(linear.coordinates) ** 2)
+    linear_rms = np.sqrt(linear.static**2 + 0.5 * np.abs(linear.amplitudes) ** 2)
     peaks = functools.cache(lambda: _peak_estimates(scene, orbit, count))
     makers: dict[str, Callable[[], np.ndarray]] = {
         "regime": lambda: regime,
-        "force_amplitude": lambda: choose(np.abs(orbit_base_force(False)), np.abs(base_force(scene.layout.structure, w, linear.coordinates))),
-        "suspension_force_amplitude": lambda: choose(np.abs(orbit_base_force(True)), np.abs(base_force(scene.layout.structure, w, linear.coordinates))),
+        "force_amplitude": lambda: choose(np.abs(orbit_base_force(False)), np.abs(base_force(scene.layout.structure, w, linear.amplitudes))),
+        "suspension_force_amplitude": lambda: choose(np.abs(orbit_base_force(True)), np.abs(base_force(scene.layout.structure, w, linear.amplitudes))),
         "impulse": lambda: np.where(impact, per_stop(orbit.impulse), np.where(free, 0.0, np.nan)),
         "phase": lambda: np.where(impact, orbit.phase, np.nan),
         "floquet_modulus": lambda: modulus,
@@ -167,7 +167,7 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
         **{name: (lambda: np.full(w.shape, np.nan)) for name in MOTION_QUANTITIES},
     }
     for i, name in enumerate(scene.coordinates):
-        makers[coordinate_quantity("x1_amplitude", name)] = lambda i=i: choose(np.abs(harmonics()[..., i]), np.abs(linear.coordinates[..., i]))
+        makers[coordinate_quantity("x1_amplitude", name)] = lambda i=i: choose(np.abs(harmonics()[..., i]), np.abs(linear.amplitudes[..., i]))
         makers[coordinate_quantity("x1_rms", name)] = lambda i=i: choose(rms()[..., i], linear_rms[..., i])
         makers[coordinate_quantity("one_impact_x1_amplitude", name)] = lambda i=i: np.where(orbit.exists, np.abs(harmonics()[..., i]), np.nan)
     return broadcast_quantities(scene, {q: makers[q]() for q in scene.settings.quantities}, shape)

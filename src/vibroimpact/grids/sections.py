@@ -14,7 +14,7 @@ import numpy as np
 import xarray as xr
 from matplotlib.lines import Line2D
 
-from vibroimpact.analysis.linear import base_force, linear_response
+from vibroimpact.analysis.linear import base_force, paper_linear_response
 from vibroimpact.model.modal import exact_modal_parameters, fit_modal_parameters, underdamped_mode_count
 from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
 from vibroimpact.reporting.coincide import coincidence_phrase, reveal_coincident
@@ -82,7 +82,7 @@ def linear_figure(setting: StudySetting, paper: bool = True) -> DrawnFigure:
     # the closed form is cheap: a fine grid over the study's range (its own grid may be a handful of points)
     f = np.union1d(setting.frequency, np.linspace(setting.frequency.min(), setting.frequency.max(), LINEAR_FIGURE_POINTS))
     w = 2.0 * np.pi * f
-    response = linear_response(system, omega=w, amplitude=setting.amplitude)
+    response = paper_linear_response(system, omega=w, amplitude=setting.amplitude)
     fit = fit_modal_parameters(system) if underdamped_mode_count(system) == 2 else None
     fig, axes = new_figure(3, panel_height=3.6, legend_rows=2)
     ax = axes[0]

@@ -41,6 +41,8 @@ __all__ = [
     "RIGID",
     "BUMPER",
     "Stop",
+    "CoordinateRef",
+    "default_coordinates",
     "SIDES",
     "check_room",
     "describe_place",
@@ -134,7 +136,8 @@ class RigidStop:
 
 @dataclass(frozen=True)
 class KelvinVoigtBumper:
-    """Visco-elastic bumper (eq. 25): clearance Delta [m], apparent natural frequency Omega_b [rad s-1] and loss factor xi_b [-].
+    """Visco-elastic bumper (eq. 25): clearance Delta [m], apparent natural frequency Omega_b / 2 pi [Hz] (:attr:`omega`
+    is Omega_b [rad s-1]) and loss factor xi_b [-].
 
     Parameters
     ----------
@@ -254,9 +257,20 @@ def restitution_from_loss_factor(xi: float) -> float:
 
 
 def loss_factor_from_restitution(restitution: float) -> float:
-    """The loss factor xi_b that gives restitution ``restitution`` (inverse of :func:`restitution_from_loss_factor`).
+    """The loss factor xi_b [-] of the Kelvin-Voigt bumper whose one collision restitutes R (the inverse of
+    :func:`restitution_from_loss_factor`, to 1e-15): the bumper that stands for a rigid stop of restitution R.
 
     R(xi) decreases from 1 (xi = 0) through exp(-2) (xi = 1) towards 0 for an ever more damped bumper.
+
+    Parameters
+    ----------
+    restitution : float
+        R [-], 0 < R <= 1 (R = 0 needs an infinitely damped bumper: ``ValueError``).
+
+    Returns
+    -------
+    float
+        xi_b [-], >= 0 (0 for R = 1).
     """
     r = require_in_range("restitution", restitution, 0.0, 1.0)
     if r == 1.0:
@@ -305,6 +319,31 @@ ContactLaw = Union[RigidStop, KelvinVoigtBumper]
 SIDES = ("upper", "lower")
 
 
+#: A coordinate as a :class:`Stop` takes it: its name (``"x2"``), or its 0-based index (an int).
+CoordinateRef = Union[str, int]
+
+
+def default_coordinates(size: int) -> tuple[str, ...]:
+    """``x1, x2, ...``: the names of a structure's coordinates where it gives none (a bare mass matrix)."""
+    return tuple(f"x{i + 1}" for i in range(size))
+
+
+def _check_reference(key: str, value: object) -> None:
+    if isinstance(value, str):
+        if not value.isidentifier():
+            raise ValueError(f"{key} = {value!r}: expected a coordinate's name (letters, digits and _, as 'x2') or a 0-based index >= 0")
+    elif isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise ValueError(f"{key} = {value!r}: expected a coordinate's name (as 'x2') or a 0-based index >= 0")
+
+
+def _resolve(key: str, value: CoordinateRef, names: tuple[str, ...]) -> int:
+    if isinstance(value, str):
+        if value not in names:
+            raise ValueError(f"{key} = {value!r} is not a coordinate of the system: allowed {list(names)}")
+        return names.index(value)
+    return value
+
+
 @dataclass(frozen=True)
 class Stop:
     """One stop of the structure.
@@ -313,31 +352,52 @@ class Stop:
     ----------
     law : RigidStop or KelvinVoigtBumper
         Contact law; it carries the clearance Delta [m] (any finite number; negative preloads).
-    coordinate : int
-        Index of the stopped coordinate (0-based), >= 0.
-    other : int or None
-        For a relative stop, the index of the second coordinate: the gap is on x[coordinate] - x[other].
+    coordinate : str or int
+        The stopped coordinate by name, as in scenes (``"x2"``: the structure's ``coordinates``, ``x1, x2, ...``
+        unless it names them), or by its 0-based index where an int is given (``1`` is x2). A problem resolves a
+        name against its structure (:meth:`resolve`; ``ValueError`` naming the allowed names).
+    other : str, int or None
+        For a relative stop, the second coordinate (name, or 0-based index): the gap is on x[coordinate] - x[other].
     side : {"upper", "lower"}
         ``upper``: x <= Delta; ``lower``: x >= -Delta.
     """
 
     law: ContactLaw
-    coordinate: int = 1
-    other: int | None = None
+    coordinate: CoordinateRef = "x2"
+    other: CoordinateRef | None = None
     side: str = "upper"
 
     def __post_init__(self) -> None:
         if not isinstance(self.law, (RigidStop, KelvinVoigtBumper)):
             raise TypeError(f"stop law = {self.law!r} is not allowed: expected a RigidStop or a KelvinVoigtBumper")
-        if isinstance(self.coordinate, bool) or not isinstance(self.coordinate, int) or self.coordinate < 0:
-            raise ValueError(f"stop coordinate = {self.coordinate!r}: expected an index >= 0")
+        _check_reference("stop coordinate", self.coordinate)
         if self.other is not None:
-            if isinstance(self.other, bool) or not isinstance(self.other, int) or self.other < 0:
-                raise ValueError(f"stop between: second coordinate = {self.other!r}: expected an index >= 0")
-            if self.other == self.coordinate:
-                raise ValueError(f"stop between: the two coordinates must differ, got {self.coordinate} twice")
+            _check_reference("stop between: second coordinate", self.other)
+            if self.other == self.coordinate:  # exact: names or indices
+                raise ValueError(f"stop between: the two coordinates must differ, got {self.coordinate!r} twice")
         if self.side not in SIDES:
             raise ValueError(f"stop side = {self.side!r} is not allowed: allowed {list(SIDES)}")
+
+    @property
+    def named(self) -> bool:
+        """Is a coordinate given by name (not yet resolved to an index against a structure)?"""
+        return isinstance(self.coordinate, str) or isinstance(self.other, str)
+
+    def resolve(self, names: Sequence[str]) -> Stop:
+        """The same stop with its coordinates as 0-based indices among ``names`` (the structure's coordinates);
+        ``ValueError`` naming the allowed names for a name that is not one of them, or where the two coincide."""
+        if not self.named:
+            return self
+        names = tuple(names)
+        coordinate = _resolve("stop coordinate", self.coordinate, names)
+        other = None if self.other is None else _resolve("stop between: second coordinate", self.other, names)
+        return Stop(self.law, coordinate, other, self.side)
+
+    def _indexed(self) -> Stop:
+        if self.named:
+            raise ValueError(f"stop coordinate = {self.coordinate!r}{'' if self.other is None else f', other = {self.other!r}'}: a name is known only "
+                             "against a structure; ImpactProblem resolves it, or Stop.resolve(structure.coordinates)")  # fmt: skip
+        return self
 
     @property
     def clearance(self) -> float:
@@ -360,15 +420,16 @@ class Stop:
         return isinstance(self.law, RigidStop)
 
     def check_size(self, size: int, key: str = "stops") -> None:
-        """``ValueError`` naming ``key`` if a coordinate index is not below ``size``."""
-        for index in (self.coordinate, self.other):
+        """``ValueError`` naming ``key`` if a coordinate index is not below ``size`` (or a name is not resolved)."""
+        for index in (self._indexed().coordinate, self.other):
             if index is not None and index >= size:
                 raise ValueError(f"{key}: coordinate index {index} is out of range for a system of {size} coordinates: allowed [0, {size - 1}]")
 
     @property
     def place(self) -> tuple[int, int | None, str]:
-        """(coordinate, other, side): where the stop acts, without its law."""
-        return (self.coordinate, self.other, self.side)
+        """(coordinate, other, side) as 0-based indices: where the stop acts, without its law."""
+        stop = self._indexed()
+        return (stop.coordinate, stop.other, stop.side)  # type: ignore[return-value]
 
     def normal(self, size: int) -> NDArray[np.float64]:
         """n [-], shape (size,): the gap is Delta - n . x."""
@@ -387,20 +448,24 @@ class Stop:
     @classmethod
     def bumper(
         cls, mass_matrix: NDArray[np.float64], clearance: float, stiffness: float, damping: float | None = None, loss_factor: float | None = None,
-        coordinate: int = 1, other: int | None = None, side: str = "upper",
+        coordinate: CoordinateRef = "x2", other: CoordinateRef | None = None, side: str = "upper", coordinates: Sequence[str] | None = None,
     ) -> Stop:  # fmt: skip
         """A stop with a Kelvin-Voigt bumper given in physical units on the structure of mass matrix M [kg]: stiffness
         K [N m-1] and damping B [N s m-1] (or loss factor xi_b [-]), converted with the stop's own effective mass
-        (:meth:`KelvinVoigtBumper.from_stiffness`); ``coordinate``, ``other`` and ``side`` as for the class."""
-        place = cls(RigidStop(clearance, 1.0), coordinate, other, side)  # validates where it acts
+        (:meth:`KelvinVoigtBumper.from_stiffness`); ``coordinate``, ``other`` and ``side`` as for the class, names
+        among ``coordinates`` (default ``x1, x2, ...``)."""
+        names = default_coordinates(mass_matrix.shape[0]) if coordinates is None else tuple(coordinates)
+        place = cls(RigidStop(clearance, 1.0), coordinate, other, side).resolve(names)  # validates where it acts
         place.check_size(mass_matrix.shape[0])
+        coordinate, other = place.coordinate, place.other
         law = KelvinVoigtBumper.from_stiffness(clearance, stiffness, place.effective_mass(mass_matrix), damping, loss_factor)
         return cls(law, coordinate, other, side)
 
     def describe(self, names: tuple[str, ...]) -> str:
-        """E.g. ``x2 <= 3 mm`` or ``x2 - x1 >= -3 mm``: the constraint in words."""
-        self.check_size(len(names))
-        return describe_place(self.place, self.clearance, names)
+        """E.g. ``x2 <= 3 mm`` or ``x2 - x1 >= -3 mm``: the constraint in words, on coordinates called ``names``."""
+        stop = self.resolve(names)
+        stop.check_size(len(names))
+        return describe_place(stop.place, self.clearance, names)
 
 
 def place_normal(place: tuple[int, int | None, str], size: int) -> NDArray[np.float64]:

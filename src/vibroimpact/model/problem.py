@@ -50,7 +50,8 @@ class ImpactProblem:
         structure (its matrices, coordinates x1, x2).
     contact : RigidStop, KelvinVoigtBumper or tuple of Stop
         A single contact law means the paper's stop: an upper stop of the absorber (coordinate 2) against the base.
-        A tuple of :class:`Stop` gives any layout (any number, absolute or relative, upper or lower).
+        A tuple of :class:`Stop` gives any layout (any number, absolute or relative, upper or lower); a stop's
+        coordinates given by name (``Stop(law, "x2")``) are resolved against the structure's names here.
     excitation : HarmonicForce or SweptSine
         q cos(w t + phase) distributed over the coordinates (plus a constant force), or the linear swept sine.
     """
@@ -71,6 +72,9 @@ class ImpactProblem:
             for stop in self.contact:
                 if not isinstance(stop, Stop):
                     raise TypeError(f"contact: {stop!r} is not a Stop")
+            if any(stop.named for stop in self.contact):  # coordinates by name, as in scenes: indices from here on
+                object.__setattr__(self, "contact", tuple(stop.resolve(self.system.coordinates) for stop in self.contact))
+            for stop in self.contact:
                 stop.check_size(self.system.size)
             check_room([stop.place for stop in self.contact], [stop.clearance for stop in self.contact], self.system.coordinates)
         elif self.system.size < 2:

@@ -41,8 +41,8 @@ class ContinuationSettings:
         (False, the default: through contact onsets, on to the contact-free orbit and back).
     clear : float
         Without ``stop_at_grazing``: a contact-free stretch ends the branch (``end = 'clear'``) once its clearance
-        to every stop exceeds this fraction of the stop's clearance and grows (the linear orbit then moves less than
-        half the gap): it is known in closed form, and it would go on to zero or infinite frequency [-].
+        to every stop exceeds this fraction [-] of the stop's clearance and grows (the linear orbit then moves less
+        than half the gap): it is known in closed form, and it would go on to zero or infinite frequency.
     grazing_margin : float
         A failed step from a point whose grazing margin is below this is searched for a grazing point [-].
     """

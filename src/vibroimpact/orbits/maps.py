@@ -219,9 +219,9 @@ class ImpactMap:
         linear = linear_amplitudes(problem)
         if not np.all(np.isfinite(linear.static)):
             return None
-        x = linear.coordinates
+        x = linear.amplitudes
         state = np.concatenate([linear.static + x.real, (1j * problem.omega * x).real])
-        reach = np.abs(linear.stops) + linear.stop_static
+        reach = np.abs(linear.stop_amplitudes) + linear.stop_static
         clearances = problem.clearances()
         return ContactFreeOrbit(state, float(np.min((clearances - reach) / np.maximum(np.abs(clearances), 1e-3 * self.state_scale[0]))), linear)
 
@@ -414,7 +414,21 @@ class OrbitMeasures:
 
 
 def orbit_measures(system: ImpactMap, orbit: PeriodicOrbit) -> OrbitMeasures:
-    """Impulses and harmonic amplitudes of ``orbit``, from one exact integration over its period."""
+    """Impulses and harmonic amplitudes of ``orbit``, from one exact integration over its period.
+
+    Parameters
+    ----------
+    system : ImpactMap
+        The stroboscopic map the orbit was found on (:func:`~vibroimpact.orbits.shooting.shoot`,
+        :func:`~vibroimpact.orbits.continuation.continue_branch`).
+    orbit : PeriodicOrbit
+        The orbit (its strobe state and parameters).
+
+    Returns
+    -------
+    OrbitMeasures
+        Each impact's velocity [m s-1] and impulse [N s], and each coordinate's fundamental amplitude [m].
+    """
     problem = system.problem_at(orbit.parameters)
     periods = orbit.period * system.periods
     trajectory = system.engine.integrate(problem, orbit.state, 0.0, periods, moments=True)
@@ -460,7 +474,21 @@ class BranchMeasures:
 
 def branch_measures(system: ImpactMap, branch: Branch) -> BranchMeasures:
     """:func:`orbit_measures` of every orbit of ``branch`` (continued on ``system``), as arrays along it: one exact
-    integration per point, each at the orbit's own strobe."""
+    integration per point, each at the orbit's own strobe.
+
+    Parameters
+    ----------
+    system : ImpactMap
+        The map the branch was continued on.
+    branch : Branch
+        The branch (:func:`~vibroimpact.orbits.continuation.continue_branch`).
+
+    Returns
+    -------
+    BranchMeasures
+        Per point: the continued parameter's value, each coordinate's fundamental amplitude [m]
+        (``amplitude(coordinate)``), the impacts per period, the largest impulse [N s] and the stability.
+    """
     measures = [orbit_measures(system, orbit) for orbit in branch.orbits]
     return BranchMeasures(
         branch.parameter,

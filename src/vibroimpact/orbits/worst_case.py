@@ -171,7 +171,7 @@ def worst_response(problem: Any, band: tuple[float, float], coordinate: int = 0,
         found = base.contact_free_orbit(at_frequency(frequency))
         if found is None or found.clearance < 0.0:
             return math.nan
-        return float(abs(found.amplitudes.coordinates[coordinate]))
+        return float(abs(found.amplitudes.amplitudes[coordinate]))
 
     best = (-math.inf, math.nan, "")
     values = np.array([linear(x) for x in f])

@@ -226,7 +226,7 @@ def test_a_clearance_below_the_linear_reach_is_a_problem_s_linear_amplitude_minu
     assert scene.settings is not None
     problem = scene.settings.cases[0].problem
     linear = linear_amplitudes(problem)
-    reach = np.abs(linear.stops) + linear.stop_static
+    reach = np.abs(linear.stop_amplitudes) + linear.stop_static
     np.testing.assert_array_equal([stop.clearance for stop in problem.stops], reach - 1e-4)  # exact: the same arithmetic, at the case's own frequency
     assert problem.stops[0].clearance == problem.stops[1].clearance  # exact: n_lower = -n_upper, |.| and a zero static load
     relative = np.abs(linear.relative("absorber", "floor2"))

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from vibroimpact.analysis.linear import linear_response, resonance_peaks
+from vibroimpact.analysis.linear import paper_linear_response, resonance_peaks
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.reporting.record import GeneralSetting
 from vibroimpact.kinds.stepped.tables import paper_reduction_factors, reduction_factors
@@ -33,8 +33,8 @@ def dataset(values: np.ndarray, stable: np.ndarray | None = None) -> xr.Dataset:
 def test_factor_is_linear_peak_over_largest_realisable_value() -> None:
     values = np.full(FREQUENCY.size, 1e-4)
     row = reduction_factors(dataset(values, np.ones(FREQUENCY.size)), SETTING, "x1_amplitude", "pgf")[0]
-    linear = np.abs(linear_response(SYSTEM, omega=2 * np.pi * FREQUENCY, amplitude=AMPLITUDE).x1)
-    fits = np.abs(linear_response(SYSTEM, omega=2 * np.pi * FREQUENCY, amplitude=AMPLITUDE).x2) <= 0.003
+    linear = np.abs(paper_linear_response(SYSTEM, omega=2 * np.pi * FREQUENCY, amplitude=AMPLITUDE).x1)
+    fits = np.abs(paper_linear_response(SYSTEM, omega=2 * np.pi * FREQUENCY, amplitude=AMPLITUDE).x2) <= 0.003
     split = FREQUENCY < SYSTEM.antiresonance_angular_frequency() / (2 * np.pi)
     for band, mask in enumerate([split, ~split]):
         expected = max(1e-4, linear[mask & fits].max())

@@ -180,7 +180,7 @@ class OrbitSet:
         label = self.count
         self.count += 1
         multipliers = _linear_multipliers(problem, frequency)
-        amplitudes = np.abs(linear_amplitudes(problem, omega=2.0 * np.pi * np.asarray(frequency)).coordinates)
+        amplitudes = np.abs(linear_amplitudes(problem, omega=2.0 * np.pi * np.asarray(frequency)).amplitudes)
         for k, f in enumerate(frequency):
             modulus = float(np.max(np.abs(multipliers[k])))
             self.points.append({
@@ -268,7 +268,7 @@ def linear_segments(problem: ImpactProblem, low: float, high: float, step: float
 
     def gap(f: float) -> float:
         linear = linear_amplitudes(problem, omega=2.0 * np.pi * f)
-        return float(np.min(clearances - linear.stop_static - np.abs(linear.stops)))
+        return float(np.min(clearances - linear.stop_static - np.abs(linear.stop_amplitudes)))
 
     fits = np.array([gap(f) >= 0.0 for f in frequency])
     segments = []

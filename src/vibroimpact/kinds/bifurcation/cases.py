@@ -397,7 +397,7 @@ def _grazing_curves(problem: ImpactProblem, low: float, high: float, low_c: floa
     (every stop sharing the clearance Delta)."""
     f = np.arange(low, high + 0.5 * step, step)
     linear = linear_amplitudes(problem, omega=2.0 * np.pi * f)
-    d = np.max(np.abs(linear.stops) + linear.stop_static, axis=-1)
+    d = np.max(np.abs(linear.stop_amplitudes) + linear.stop_static, axis=-1)
     inside = (d >= low_c) & (d <= high_c)
     runs = np.split(np.flatnonzero(inside), np.flatnonzero(np.diff(np.flatnonzero(inside)) > 1) + 1)
     return [(f[r], d[r]) for r in runs if r.size > 1]

@@ -86,7 +86,7 @@ def closed_forms(concept: Concept, amplitude: float, frequency: NDArray[np.float
     w = 2.0 * np.pi * f
     problem = ImpactProblem(concept.system, concept.stops, HarmonicForce(amplitude, float(f[0])))  # without a stop too
     linear = linear_amplitudes(problem, omega=w)
-    x = linear.coordinates
+    x = linear.amplitudes
     base = base_force(problem.structure, w, x)
     fits = linear.fits(problem.clearances())  # always true without a stop
     nan = np.full(f.shape, np.nan)

@@ -45,7 +45,7 @@ def response_curves(problem: ImpactProblem, frequency: NDArray[np.float64], coor
     the rigid twin's root, :func:`~vibroimpact.orbits.bumper_screen.bumper_curves`; none on a layout without a closed
     form)."""
     linear = linear_amplitudes(problem, omega=2.0 * np.pi * frequency)
-    out = {"linear": np.abs(linear.coordinates[..., coordinate]), "linear_fits": linear.fits(problem.clearances()).astype(np.int8)}
+    out = {"linear": np.abs(linear.amplitudes[..., coordinate]), "linear_fits": linear.fits(problem.clearances()).astype(np.int8)}
     bumpers = bool(problem.stops) and bumper_screen_refusal(problem) is None
     grown = bumper_curves(problem, frequency, coordinate) if bumpers else {}  # bumper orbits grown from the rigid twin's
     for root, name in (("+", "impact_plus"), ("-", "impact_minus")):

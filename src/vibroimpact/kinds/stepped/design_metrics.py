@@ -40,7 +40,7 @@ import numpy as np
 import xarray as xr
 from scipy.optimize import minimize_scalar
 
-from vibroimpact.analysis.linear import linear_response
+from vibroimpact.analysis.linear import paper_linear_response
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.reporting.record import named_view
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
@@ -338,7 +338,7 @@ def no_stop_amplitude(dataset: xr.Dataset, frequency: np.ndarray, quantity: str 
     system = named_view(dataset)
     if system is None or "excitation_amplitude_N" not in dataset.attrs:
         return None
-    response = linear_response(system, omega=2.0 * np.pi * np.asarray(frequency, dtype=float), amplitude=float(dataset.attrs["excitation_amplitude_N"]))
+    response = paper_linear_response(system, omega=2.0 * np.pi * np.asarray(frequency, dtype=float), amplitude=float(dataset.attrs["excitation_amplitude_N"]))
     return np.abs(getattr(response, quantity))
 
 
