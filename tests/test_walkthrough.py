@@ -93,6 +93,7 @@ def test_the_notebook_imports_only_public_names() -> None:
     assert len(readme_python_blocks()) >= 3
 
 
+@pytest.mark.slow  # 36 s: the README's sections again, in a fresh interpreter (the default tier runs each apart)
 @pytest.mark.timeout(900)
 def test_the_readme_and_a_general_layout_run_as_a_notebook(tmp_path: Path) -> None:
     env = {**os.environ, "MPLBACKEND": "Agg"}
