@@ -52,10 +52,8 @@ def small_bifurcation(tmp_path_factory: pytest.TempPathFactory) -> "xr.Dataset":
     import fcntl
     import os
 
-    import xarray as xr
-
     from tests.kinds.bifurcation.test_bifurcation import SMALL
-    from vibroimpact.runs.run import run_study, write_dataset
+    from vibroimpact.runs.run import read_dataset, run_study, write_dataset
     from vibroimpact.scene import parse_scene
 
     # the run's folder: shared by the xdist workers (their base folders' parent); without xdist the base folder itself,
@@ -67,4 +65,4 @@ def small_bifurcation(tmp_path_factory: pytest.TempPathFactory) -> "xr.Dataset":
         fcntl.flock(lock, fcntl.LOCK_EX)
         if not path.exists():
             write_dataset(run_study(parse_scene(SMALL), progress=None), path)
-    return xr.load_dataset(path)
+    return read_dataset(path)  # the file's labels back on their dimensions

@@ -25,6 +25,7 @@ from vibroimpact.model.contact import RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
+from vibroimpact.runs.run import read_dataset
 from vibroimpact.simulation.steady import SteadySettings, steady_state
 
 from tests.scene.test_scene import base_scene, write_yaml
@@ -85,7 +86,7 @@ def _dataset(tmp_path: Path) -> xr.Dataset:
     document["solutions"] = ["pgf"]
     out = tmp_path / "out"
     assert cli.main([str(write_yaml(tmp_path / "undamped.yaml", document)), "--out", str(out), "--jobs", "1", "--no-report"]) == 0
-    return xr.load_dataset(out / "tiny.nc").sel(solution="pgf").squeeze()
+    return read_dataset(out / "tiny.nc").sel(solution="pgf").squeeze()
 
 
 def test_a_study_flags_the_ill_conditioned_points_and_reports_only_self_consistent_stable_orbits(tmp_path: Path) -> None:

@@ -18,6 +18,7 @@ import xarray as xr
 
 from vibroimpact import cli
 from vibroimpact.analysis.stability import Regime
+from vibroimpact.runs.labels import decode_labels
 from vibroimpact.simulation import steady
 from vibroimpact.simulation.history import engine_of
 from vibroimpact.simulation.steady import AMPLITUDE_LIMIT, amplitude_scale, check_amplitude, steady_state
@@ -45,8 +46,8 @@ def test_a_study_near_the_undamped_resonance_flags_every_solution_and_reports_th
     document["simulation"] = {"start": "linear"}
     out = tmp_path / "out"
     assert cli.main([str(write_yaml(tmp_path / "undamped.yaml", document)), "--out", str(out), "--jobs", "1", "--no-report"]) == 0
-    closed = xr.load_dataset(out / "tiny.nc").sel(solution="pgf").squeeze()
-    simulated = xr.load_dataset(out / "tiny.nc", group="simulated").squeeze()
+    closed = decode_labels(xr.load_dataset(out / "tiny.nc")).sel(solution="pgf").squeeze()
+    simulated = decode_labels(xr.load_dataset(out / "tiny.nc", group="simulated")).squeeze()  # on the simulated frequencies
     assert closed["regime"].values.tolist() == [Regime.ONE_IMPACT, Regime.FAILED, Regime.FAILED]
     for name in ("momentary", "exact"):
         run = simulated.sel(solution=name)

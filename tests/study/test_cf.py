@@ -1,10 +1,16 @@
 """Datasets are CF-1.8 clean: the IOOS compliance checker finds no error and no warning in what ``run-study`` writes,
-for every kind of study; and the numbers a dataset records as attributes stay numbers when it is read back."""
+for every kind of study and every netCDF group, none of its checks raises, and it exits 0 (what a pipeline gating on
+``compliance-checker --test=cf:1.8`` sees); and the numbers a dataset records as attributes stay numbers when it is
+read back."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import re
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -17,10 +23,10 @@ from compliance_checker.runner import CheckSuite, ComplianceChecker
 
 from vibroimpact.scene import load_scene, parse_scene
 from vibroimpact.scene.kinds import KIND_NAMES
-from vibroimpact.runs.run import netcdf_attribute, write_dataset
+from vibroimpact.runs.run import netcdf_attribute, read_dataset, write_dataset
 from vibroimpact.runs.run import run_study
 
-from tests.golden.golden import SCENES
+from tests.golden.golden import DATA, SCENES
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
 from tests.kinds.swept.test_swept_study import sweep_document
 
@@ -60,10 +66,19 @@ def flattened(path: Path, group: str, target: Path) -> Path:
     return target
 
 
+#: What the checker prints to stderr before each check that raised (its exceptions: the check was not made).
+EXCEPTION_LINE = re.compile(r"^cf:1\.8\.\w+: ")
+
+
 def checked(path: Path, report: Path) -> list[str]:
-    """Every error and warning of ``compliance-checker --test=cf:1.8`` on the file at ``path``, one line each."""
+    """Every error and warning of ``compliance-checker --test=cf:1.8`` on the file at ``path``, one line each; every
+    check that raised instead of checking (the checker prints it to stderr and exits 2 after "All tests passed!");
+    and the checker's exit status where it is not 0 (2 where a check raised, 1 where a check failed), as the command
+    line computes it from what :meth:`ComplianceChecker.run_checker` returns."""
     CheckSuite.load_all_available_checkers()
-    ComplianceChecker.run_checker(str(path), ["cf:1.8"], 0, "normal", output_filename=str(report), output_format="json")
+    stderr = io.StringIO()
+    with contextlib.redirect_stderr(stderr):
+        passed, raised = ComplianceChecker.run_checker(str(path), ["cf:1.8"], 0, "normal", output_filename=str(report), output_format="json")
     result = json.loads(report.read_text())["cf:1.8"]
     findings = []
     for priority in ERRORS_AND_WARNINGS:
@@ -71,12 +86,43 @@ def checked(path: Path, report: Path) -> list[str]:
             scored, possible = check["value"]
             if scored < possible:
                 findings.append(f"{check['name']}: {'; '.join(check['msgs'])}")
+    findings += [f"raised: {line}" for line in stderr.getvalue().splitlines() if EXCEPTION_LINE.match(line)]
+    status = 2 if raised else 0 if passed else 1  # the command line's exit status
+    if status:
+        findings.append(f"exit status {status}")
     return findings
 
 
 def write(document: dict[str, Any], folder: Path) -> Path:
     scene = parse_scene(document, text=yaml.safe_dump(document))
-    return write_dataset(run_study(scene, progress=None), folder / f"{scene.name}.nc")
+    dataset = run_study(scene, progress=None)
+    return read_back_as_written(dataset, write_dataset(dataset, folder / f"{scene.name}.nc"))
+
+
+def read_back_as_written(dataset: xr.Dataset, path: Path) -> Path:
+    """``path``, after checking that :func:`read_dataset` reads it back as ``dataset``: labels on their dimensions,
+    values, attributes (the writer's ``history`` aside; a one-element sequence is one value in netCDF) and types
+    (text is text, fixed-width or not)."""
+    back = read_dataset(path)
+    assert back.attrs.pop("history")
+    expected = dataset.copy()
+    expected.attrs = {key: as_netcdf_reads(value) for key, value in dataset.attrs.items() if key != "history"}
+    xr.testing.assert_identical(back, expected)
+    assert types(back) == types(dataset)
+    return path
+
+
+def as_netcdf_reads(value: object) -> object:
+    """An attribute's value as netCDF gives it back: a one-element sequence is its element."""
+    if isinstance(value, (list, tuple, np.ndarray)) and np.size(value) == 1:
+        return np.asarray(value).ravel()[0]
+    return value
+
+
+def types(dataset: xr.Dataset) -> dict[str, str]:
+    """Each variable's type; ``text`` for strings (numpy's fixed-width or Python objects: a file read back gives the
+    former)."""
+    return {str(name): "text" if variable.dtype.kind in "OU" else str(variable.dtype) for name, variable in dataset.variables.items()}
 
 
 #: A string attribute that reads as a number or as numpy's text of an array ('[23.02212513 36.07439742]').
@@ -133,14 +179,15 @@ KIND_CASES: dict[str, str] = {
 
 
 def write_case(case: str, request: pytest.FixtureRequest, folder: Path) -> Path:
-    """The dataset of ``case`` (:data:`KIND_CASES`) as ``run-study`` writes it."""
+    """The dataset of ``case`` (:data:`KIND_CASES`) as ``run-study`` writes it (and :func:`read_dataset` reads it back)."""
     if case == "bifurcation":
         dataset = request.getfixturevalue("small_bifurcation")  # run once per test run, read back from its file
-        return write_dataset(dataset, folder / "bifurcation.nc")
+        return read_back_as_written(dataset, write_dataset(dataset, folder / "bifurcation.nc"))
     if case == "concepts":
         return write(CONCEPTS_DOCUMENT, folder)
     name = case.removeprefix("golden:")
-    return write_dataset(run_study(load_scene(SCENES / f"{name}.yaml"), progress=None), folder / f"{name}.nc")
+    dataset = run_study(load_scene(SCENES / f"{name}.yaml"), progress=None)
+    return read_back_as_written(dataset, write_dataset(dataset, folder / f"{name}.nc"))
 
 
 @pytest.mark.timeout(120)
@@ -196,6 +243,34 @@ def test_every_kind_is_cf_clean(case: str, request: pytest.FixtureRequest, tmp_p
         assert dataset.attrs["study_kind"] == KIND_CASES[case]
     assert cf_findings(path, tmp_path / "cf.json") == []
     assert numbers_as_text(path) == []
+
+
+@pytest.mark.timeout(120)
+def test_the_command_line_checker_exits_0_on_every_golden_dataset_and_group(tmp_path: Path) -> None:
+    """``compliance-checker --test=cf:1.8`` as a pipeline runs it, on every blessed golden dataset (every shipped
+    study, shrunk) and each of their groups (flattened): exit status 0, and no check that raised (which it reports on
+    stderr, after the line naming the files)."""
+    files = sorted(DATA.glob("*.nc"))
+    for path in list(files):
+        with netCDF4.Dataset(path) as source:
+            groups = list(source.groups)
+        files += [flattened(path, group, tmp_path / f"{path.stem}_{group}.nc") for group in groups]
+    assert len(files) > len(list(DATA.glob("*.nc")))  # some groups among them
+    checker = Path(sys.executable).with_name("compliance-checker")
+    done = subprocess.run([str(checker), "--test=cf:1.8", *map(str, files)], capture_output=True, text=True, timeout=110)
+    raised = [line for line in done.stderr.splitlines() if EXCEPTION_LINE.match(line) or "exceptions occurred" in line]
+    assert (done.returncode, raised) == (0, [])
+    assert done.stdout.count("All tests passed!") == len(files)
+
+
+def test_the_check_finds_a_check_that_raised(tmp_path: Path) -> None:
+    """The check is not blind to what the scores do not show: a string coordinate variable (labels along a dimension)
+    makes the checker's monotonicity check raise, which it reports apart, exiting 2 after "All tests passed!"."""
+    dataset = xr.Dataset({"x": ("solution", [1.0, 2.0], {"units": "m", "long_name": "x"})}, coords={"solution": ("solution", ["exact", "pgf"], {"long_name": "solution method"})}, attrs={"Conventions": "CF-1.8", "title": "t", "history": "written"})
+    dataset.to_netcdf(tmp_path / "labels.nc")
+    findings = checked(tmp_path / "labels.nc", tmp_path / "cf.json")
+    assert findings[-1] == "exit status 2"
+    assert any(finding.startswith("raised: cf:1.8.check_coordinate_variables_strict_monotonicity") for finding in findings)
 
 
 def test_the_cases_cover_every_kind() -> None:

@@ -31,15 +31,18 @@ def drawn(data: xr.DataArray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def test_the_naive_plot_of_a_simulated_solution_draws_its_curve(relative_stop: xr.Dataset, tmp_path: Path) -> None:
-    """In the group, ``x1_amplitude.sel(solution=engine).plot()`` draws a finite value at every simulated frequency;
-    the same plot of the one in-memory dataset draws isolated points between NaNs (the trap)."""
+    """In the group, with its labels as index, ``x1_amplitude.sel(solution_label=engine).plot()`` draws a finite value
+    at every simulated frequency; the same plot of the one in-memory dataset draws isolated points between NaNs (the
+    trap). In the file ``solution`` is an index dimension and its labels are ``solution_label`` (CF 1.8 6.1.1)."""
     path = write_dataset(relative_stop, tmp_path / "relative_stop.nc")
     simulation = np.atleast_1d(relative_stop.attrs["simulation_frequency_Hz"])
-    with xr.open_dataset(path, group=SIMULATED_GROUP) as simulated, xr.open_dataset(path) as root:
-        assert list(simulated["solution"].values) == ["momentary", "exact"] and list(root["solution"].values) == ["linear", "pgf"]
+    with xr.open_dataset(path, group=SIMULATED_GROUP) as opened, xr.open_dataset(path) as root:
+        assert "solution" not in opened.variables and "solution" not in root.variables
+        simulated = opened.set_xindex("solution_label")  # the README's recipe
+        assert list(simulated["solution_label"].values) == ["momentary", "exact"] and list(root["solution_label"].values) == ["linear", "pgf"]
         assert root.attrs["simulated_solutions_group"] == SIMULATED_GROUP and SIMULATED_GROUP in root.attrs["comment"]
         for engine in ("momentary", "exact"):
-            x, y = drawn(simulated["x1_amplitude"].sel(solution=engine))
+            x, y = drawn(simulated["x1_amplitude"].sel(solution_label=engine))
             np.testing.assert_array_equal(x, simulation)
             assert np.isfinite(y).all() and (y > 0.0).all(), engine
         assert root["frequency"].size == relative_stop["frequency"].size > 10 * simulation.size

@@ -42,6 +42,7 @@ import xarray as xr
 
 from vibroimpact.engines.registry import ENGINES, engine_spec
 from vibroimpact.model.layout import Layout
+from vibroimpact.runs.labels import decode_labels
 from vibroimpact.runs.store import atomic_path
 from vibroimpact.scene.kinds import kind_named
 from vibroimpact.scene.schema import Scene
@@ -352,7 +353,8 @@ def calibrate(accuracy: Path, base: Costs | None = None) -> Costs:
     ValueError
         If it is not a dataset of the ``accuracy_cost`` study (a stepped ``one_impact`` case and a ``swept`` case).
     """
-    with xr.open_dataset(accuracy) as data:
+    with xr.open_dataset(accuracy) as opened:
+        data = decode_labels(opened)  # the cases, engines and references by name (:mod:`vibroimpact.runs.labels`)
         missing = [name for name in ("case", "engine", "wall_time", "reference_wall_time") if name not in data.variables]
         if missing:
             raise ValueError(f"{accuracy} is not an accuracy_cost dataset: no {', '.join(missing)}")

@@ -18,7 +18,10 @@ and ``lyapunov_*`` are only in ``simulated``, ``stable`` and ``phase`` only in t
 simulations are: attribute ``simulated_solutions_group`` and its ``comment``. Read both with ``xarray.open_groups``
 (``xarray.open_datatree`` refuses a child whose ``frequency`` differs from its parent's); :func:`read_dataset` joins
 them into the one dataset :func:`run_study` returns (every solution on every frequency, NaN or ``not_applicable``
-where it was not computed), :func:`split_groups` splits that one.
+where it was not computed), :func:`split_groups` splits that one. In the file every dimension labelled by strings
+(``solution``, ``sweep``, ``case``, ``engine``, ...) or by numbers out of order (a bumper bifurcation's
+``bumper_frequency``) is an index dimension and its labels are the auxiliary coordinate ``<dimension>_label`` (CF 1.8
+section 6.1.1, :mod:`vibroimpact.runs.labels`); :func:`read_dataset` puts them back on their dimensions.
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ from vibroimpact.engines.registry import engine_spec
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.runner import Runner
 from vibroimpact.runs.estimate import Costs, Estimate
+from vibroimpact.runs.labels import decode_labels, encode_labels
 from vibroimpact.runs.store import StudyStore, atomic_path, source_hash
 from vibroimpact.scene.kinds import kind_named
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, Scene
@@ -257,11 +261,13 @@ def split_groups(dataset: xr.Dataset) -> dict[str, xr.Dataset]:
     holds no value over one group's solutions (all NaN, or all ``not_applicable``: ``converged`` or ``lyapunov_*`` for
     the closed forms, ``stable`` or ``phase`` for the engines) is left out of that group; one with no value in either
     goes with the simulations. The root's attributes say where the simulations are (``simulated_solutions_group`` and
-    a sentence in ``comment``). :func:`join_groups` gives ``dataset`` back.
+    a sentence in ``comment``). In each group the labelled dimensions (strings, or numbers out of order) are index
+    dimensions, their labels in ``<dimension>_label`` (:func:`vibroimpact.runs.labels.encode_labels`).
+    :func:`join_groups` gives ``dataset`` back.
     """
     simulated, on_axis = _simulated(dataset)
     if not simulated:
-        return {"/": dataset}
+        return {"/": encode_labels(dataset)}
     closed = [str(name) for name in dataset["solution"].values if name not in simulated]
     per_solution = [name for name, variable in dataset.data_vars.items() if "solution" in variable.dims]
     root = dataset.sel(solution=closed)
@@ -275,18 +281,21 @@ def split_groups(dataset: xr.Dataset) -> dict[str, xr.Dataset]:
     root.attrs = {**dataset.attrs, "simulated_solutions_group": SIMULATED_GROUP, "comment": f"{comment} {SIMULATED_COMMENT}".strip()}
     group = group[in_group]
     group.attrs = {"comment": "The simulated solutions of the root group's study, at the frequencies they were simulated at (the root's simulation_frequency_Hz)."}
-    return {"/": root, f"/{SIMULATED_GROUP}": group}
+    return {"/": encode_labels(root), f"/{SIMULATED_GROUP}": encode_labels(group)}
 
 
 def join_groups(groups: Mapping[str, xr.Dataset]) -> xr.Dataset:
     """The one dataset of :func:`split_groups`'s groups (or of ``xarray.open_groups`` on a file :func:`write_dataset`
     wrote): every solution on the root's frequency axis, the simulated ones ``not_applicable`` or NaN at the
     frequencies they were not simulated at, a variable left out of a group ``not_applicable`` or NaN for its
-    solutions. The root's solutions come first."""
-    root = groups["/"]
+    solutions. The root's solutions come first; the labels of the groups' dimensions are their coordinates again
+    (:func:`vibroimpact.runs.labels.decode_labels`), and a flag variable a file masked (xarray reads an integer
+    variable with a ``_FillValue`` as floats, NaN at the fill value) is integers again."""
+    root = _unmasked(decode_labels(groups["/"]))
     group = groups.get(f"/{SIMULATED_GROUP}")
     if group is None:
         return root
+    group = _unmasked(decode_labels(group))
     parts = [part for part in (root, group) if "solution" in part.dims]
     solutions = np.concatenate([part["solution"].values for part in parts])
     order, frequency = pd.Index(solutions), root.indexes["frequency"]
@@ -307,6 +316,18 @@ def join_groups(groups: Mapping[str, xr.Dataset]) -> xr.Dataset:
     comment = str(attrs.pop("comment", "")).removesuffix(SIMULATED_COMMENT).strip()
     joined.attrs = {**attrs, **({"comment": comment} if comment else {})}
     return joined
+
+
+def _unmasked(dataset: xr.Dataset) -> xr.Dataset:
+    """``dataset`` with every integer variable that xarray read as floats (masked at its ``_FillValue``) back to its
+    stored integers, the fill value where it read NaN and ``_FillValue`` among its attributes, as it was written."""
+    masked = {}
+    for name, variable in dataset.data_vars.items():
+        stored, fill = variable.encoding.get("dtype"), variable.encoding.get("_FillValue")
+        if stored is not None and np.dtype(stored).kind in "iu" and variable.dtype.kind == "f" and fill is not None:
+            values = np.where(np.isnan(variable.values), fill, variable.values).astype(stored)
+            masked[name] = xr.Variable(variable.dims, values, {**variable.attrs, "_FillValue": np.asarray(fill, dtype=stored)[()]})
+    return dataset.assign(masked) if masked else dataset
 
 
 def read_dataset(path: str | Path) -> xr.Dataset:

@@ -16,6 +16,7 @@ from vibroimpact.model.contact import Stop
 from vibroimpact import cli
 from vibroimpact.kinds.benchmark.study import _compare, equal_error_speedup, run_benchmark
 from vibroimpact.kinds.benchmark.scene import BenchmarkCase, BenchmarkSettings
+from vibroimpact.runs.run import read_dataset
 from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.engines.base import Trajectory
 from vibroimpact.model.system import TwoDofSystem
@@ -90,7 +91,7 @@ def test_benchmark_scene_end_to_end(tmp_path: Path) -> None:
     path = tmp_path / "tiny.yaml"
     path.write_text(yaml.safe_dump(scene))
     assert cli.main([str(path), "--out", str(tmp_path / "o")]) == 0
-    data = xr.open_dataset(tmp_path / "o" / "tiny_cost.nc")
+    data = read_dataset(tmp_path / "o" / "tiny_cost.nc")
     assert int(data["reference_impacts"].sel(case="graze", reference="exact")) >= 3
     assert int(data["impacts"].sel(case="graze", engine="solve_ivp_DOP853", rtol=1e-6)) < int(data["impacts"].sel(case="graze", engine="momentary_adams", rtol=1e-6))
     assert (tmp_path / "o" / "report.html").is_file() and (tmp_path / "o" / "work_precision.png").is_file()

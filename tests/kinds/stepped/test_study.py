@@ -11,7 +11,8 @@ import yaml
 
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.scene import load_scene, parse_scene
-from vibroimpact.runs.run import write_dataset
+from vibroimpact.runs.labels import decode_labels
+from vibroimpact.runs.run import read_dataset, write_dataset
 from vibroimpact.runs.run import run_study
 
 DATA = Path(__file__).parents[2] / "data"
@@ -29,11 +30,11 @@ def golden_run() -> xr.Dataset:
 
 
 def test_matches_golden_netcdf(golden_run: xr.Dataset, tmp_path: Path) -> None:
-    """Regression: the same scene gives the stored dataset (after a write/read round trip)."""
-    path = write_dataset(golden_run, tmp_path / "run.nc")
-    with xr.open_dataset(path) as fresh, xr.open_dataset(DATA / "golden_small.nc") as golden:
-        xr.testing.assert_allclose(fresh.load(), golden.load(), rtol=1e-9, atol=1e-15)
-        xr.testing.assert_equal(fresh["regime"], golden["regime"])
+    """Regression: the same scene gives the stored dataset (after a write/read round trip). The stored file predates
+    the labels' move to ``solution_label`` (a string coordinate variable ``solution``): read_dataset reads both."""
+    fresh, golden = read_dataset(write_dataset(golden_run, tmp_path / "run.nc")), read_dataset(DATA / "golden_small.nc")
+    xr.testing.assert_allclose(fresh, golden, rtol=1e-9, atol=1e-15)
+    xr.testing.assert_equal(fresh["regime"], golden["regime"])
 
 
 def test_output_contract(golden_run: xr.Dataset) -> None:
@@ -128,7 +129,8 @@ def test_simulated_solutions_join_the_dataset(tmp_path: Path) -> None:
     assert cli.main([str(path), "--out", str(tmp_path / "o"), "--jobs", "1"]) == 0
     assert not (tmp_path / "o" / ".cache").exists()
     path = tmp_path / "o" / "golden_small.nc"
-    with xr.open_dataset(path) as ds, xr.open_dataset(path, group="simulated") as simulated:  # the engines on their own grid
+    with xr.open_dataset(path) as root, xr.open_dataset(path, group="simulated") as group:  # the engines on their own grid
+        ds, simulated = decode_labels(root), decode_labels(group)  # the labels back on ``solution``
         assert 25.1 in ds["frequency"].values and 30.0 in ds["frequency"].values and list(ds["solution"].values) == ["pgf"]
         np.testing.assert_array_equal(simulated["frequency"].values, [24.5, 25.1, 30.0])
         for engine in ("exact", "momentary"):

@@ -12,7 +12,7 @@ import yaml
 
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.scene import parse_scene
-from vibroimpact.runs.run import write_dataset
+from vibroimpact.runs.run import read_dataset, write_dataset
 from vibroimpact.runs.run import run_study
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
@@ -66,9 +66,7 @@ def test_contract(sweep_run: xr.Dataset, tmp_path: Path) -> None:
     assert np.all(ds["swept_regime"].sel(frequency=25.0).values == Regime.SWEPT_CONTACT)
     assert ds["swept_regime"].attrs["flag_meanings"] == ds["regime"].attrs["flag_meanings"]
     assert np.all(ds["sweep_contacts"].values > 0.95 * 8 * 25.0)
-    write_dataset(ds, tmp_path / "sweep.nc")
-    with xr.open_dataset(tmp_path / "sweep.nc") as back:
-        loaded = back.load()
+    loaded = read_dataset(write_dataset(ds, tmp_path / "sweep.nc"))
     assert "vibroimpact" in loaded.attrs.pop("history")  # CF: the file says what wrote it
     xr.testing.assert_identical(loaded, ds)
 
