@@ -276,8 +276,12 @@ def unwritable(out_dir: Path) -> str | None:
     return None
 
 
+def _as_lines(value: object) -> list[str]:
+    """A dataset attribute of lines (one string, or a list of them) as a list."""
+    return [value] if isinstance(value, str) else [str(line) for line in value]  # type: ignore[attr-defined]
+
+
 def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, store: StudyStore, scheduler: str | None) -> int:
-    from vibroimpact.kinds.stepped.operating import unreached_text
     from vibroimpact.runs.failures import console_line, run_failures
     from vibroimpact.runs.run import run_study, write_dataset
 
@@ -291,9 +295,8 @@ def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, store: StudyStor
         dataset.attrs["run_peak_memory_bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
         path = write_dataset(dataset, out_dir / f"{scene.name}.nc")  # streamed from the store, chunk by chunk
         print(f"wrote {path}")
-        unreached = unreached_text(dataset)  # a clearance typed in mm runs silently else: say it before the report
-        if unreached:
-            print(f"warning: {unreached}", file=sys.stderr)
+        for warning in _as_lines(dataset.attrs.get("run_warnings", ())):  # e.g. a stop never reached (a clearance typed in mm)
+            print(f"warning: {warning}", file=sys.stderr)
         failures = run_failures(dataset)  # read before the store (which a lazy dataset reads) goes
         report: Path | str | None = None
         if scene.report and not args.no_report:

@@ -32,8 +32,8 @@ def test_the_declared_operating_point_against_the_same_absorber_without_its_stop
     point = design_operating(dataset)
     assert point is not None and point.declared and point.frequency == pytest.approx(33.0, rel=1e-12)
     linear = linear_response(PAPER_SYSTEM, 33.0, 10.0)
-    assert point.linear == pytest.approx(float(np.abs(linear.x1)), rel=1e-12)
-    assert point.free == pytest.approx(float(np.abs(linear.x2)), rel=1e-12)
+    assert point.linear == pytest.approx(float(np.abs(linear.coordinate("x1"))), rel=1e-12)
+    assert point.free == pytest.approx(float(np.abs(linear.coordinate("x2"))), rel=1e-12)
     assert point.stopped == pytest.approx(float(dataset["design_operating_amplitude"].values[0]), rel=1e-12)
     assert operating_warnings(point) == []
 

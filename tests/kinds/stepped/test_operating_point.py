@@ -66,7 +66,7 @@ def test_the_operating_point_is_the_anti_resonance_and_its_values_are_the_closed
     assert row.solution == "pgf"
     assert abs(row.frequency - ANTIRESONANCE) <= 0.025 + 1e-9  # the nearest point of a 0.05 Hz grid
     system = TwoDofSystem(**SYSTEM)
-    linear = float(np.abs(linear_response(system, row.frequency, 50.0).x1))
+    linear = float(np.abs(linear_response(system, row.frequency, 50.0).coordinate("x1")))
     assert row.linear == pytest.approx(linear, rel=1e-9)
     there = dataset.sel(frequency=row.frequency)
     assert row.linear == pytest.approx(float(there["x1_amplitude"].sel(solution="linear")), rel=1e-9)
@@ -115,7 +115,7 @@ def test_a_clearance_typed_in_mm_is_said_on_the_console_and_the_page(tmp_path: P
     assert cli.main([str(path), "--out", str(tmp_path / "out"), "--jobs", "1"]) == 0
     err = capsys.readouterr().err
     dataset = xr.open_dataset(tmp_path / "out" / "user_mm.nc")
-    largest = float(np.max(np.abs(linear_response(TwoDofSystem(**SYSTEM), dataset["frequency"].values, 50.0).x2)))
+    largest = float(np.max(np.abs(linear_response(TwoDofSystem(**SYSTEM), dataset["frequency"].values, 50.0).coordinate("x2"))))
     line = f"the largest |x2| on the grid is {fmt(largest * 1e3, '.3g')} mm against a 2000 mm clearance; did you mean 2 mm (0.002 m)?"
     warnings = [w for w in err.splitlines() if w.startswith("warning: The stop is never reached")]
     assert len(warnings) == 1 and warnings[0].endswith(line), err

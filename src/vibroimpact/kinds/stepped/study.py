@@ -25,6 +25,7 @@ from vibroimpact.runs.runner import Runner
 from vibroimpact.model.layout import stop_descriptions
 from vibroimpact.reporting.solutions import solution_method
 from vibroimpact.scene.schema import Scene, GRID_DIMS, STOP_QUANTITIES, ENGINE_SOLUTIONS
+from vibroimpact.kinds.stepped.operating import unreached_text
 from vibroimpact.simulation.settings import SWEEP_STARTS
 
 __all__ = ["general_orbit_outlook", "UNKNOWN_WANDERING", "general_block", "general_coordinates", "SteppedStudy", "expected_periods", "SETTLING_PERIODS", "SHOOTING_PERIODS", "ESTIMATE_POINTS"]
@@ -131,7 +132,11 @@ class SteppedStudy:
         raw = run_grid(scene, runner, general_block, {"solution": len(solutions), "stop": len(scene.layout.stops)})
         dataset = describe_stops(raw.assign_coords(coords))
         say(f"{', '.join(solutions)}: done")
-        return finish_dataset(dataset, scene, coords, self.simulation_attributes(scene))
+        finished = finish_dataset(dataset, scene, coords, self.simulation_attributes(scene))
+        unreached = unreached_text(finished)  # a clearance typed in mm runs silently else: run-study says it in one line
+        if unreached:
+            finished.attrs["run_warnings"] = [unreached]
+        return finished
 
     @staticmethod
     def simulation_attributes(scene: Scene) -> dict[str, object]:
