@@ -25,7 +25,7 @@ def _legend_texts(fig: plt.Figure) -> list[str]:
 
 
 def _shared(ax: plt.Axes) -> list:
-    return [line for line in ax.get_lines() if line.get_gid() == "shared"]
+    return [line for line in ax.get_lines() if str(line.get_gid()).startswith("shared:")]
 
 
 def _beneath(ax: plt.Axes) -> list:

@@ -16,7 +16,8 @@ constant value, the curves are left out and the constant is drawn once (:data:`~
 labelled with whose it is ("R = 0.2 ... 0.9 (all 8): exactly 0 (no impacts)": the figure's legend shows it, whatever
 entries the page gives it), and the caption says so (:class:`Shared`).
 
-The bands carry the gid ``beneath:<gid of the curve>``, a shared constant ``shared`` (tests find them by it).
+The bands carry the gid ``beneath:<gid of the curve>``, a shared constant ``shared:<gids of its curves, joined by +>``
+(tests find them by it).
 """
 
 from __future__ import annotations
@@ -133,7 +134,8 @@ def _share_constants(ax: Axes, drawn: list[tuple[str, Sequence[Line2D], tuple[np
         runs = tuple((float(x[a]), float(x[b])) for a, b in _runs(shared))
         entry = Shared(tuple(drawn[same_grid[row]][0] for row in members), level, runs, len(drawn), x_span, meaning)
         zorder = min((line.get_zorder() for _, lines, _ in drawn for line in lines), default=2.0) - 0.5
-        ax.plot(x, np.where(shared, level, np.nan), zorder=zorder, label=entry.label, gid="shared", **SHARED_STYLE)  # type: ignore[arg-type]
+        gids = dict.fromkeys(str(line.get_gid()) for row in members for line in drawn[same_grid[row]][1] if line.get_gid())
+        ax.plot(x, np.where(shared, level, np.nan), zorder=zorder, label=entry.label, gid="shared:" + "+".join(gids), **SHARED_STYLE)  # type: ignore[arg-type]
         found.append(entry)
     return found
 

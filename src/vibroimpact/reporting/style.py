@@ -319,7 +319,7 @@ def figure_legend(fig: MatplotlibFigure, axes: Sequence[Axes], extra: Iterable[L
     """One legend for the whole figure, below the panels (outside every axes, so it covers no data).
 
     Entries are the labelled artists of ``axes`` (each label once, in drawing order) followed by ``extra``, and the
-    constants shared by several series of any panel, drawn once (gid ``shared``,
+    constants shared by several series of any panel, drawn once (gid ``shared:...``,
     :func:`~vibroimpact.reporting.coincide.reveal_coincident`): their label says whose they are.
     """
     entries: dict[str, object] = {}
@@ -330,7 +330,7 @@ def figure_legend(fig: MatplotlibFigure, axes: Sequence[Axes], extra: Iterable[L
         entries.setdefault(handle.get_label(), handle)
     for ax in fig.axes:
         for line in ax.get_lines():
-            if line.get_gid() == "shared":
+            if str(line.get_gid()).startswith("shared:"):
                 entries.setdefault(str(line.get_label()), line)
     if entries:
         fig.legend(list(entries.values()), list(entries.keys()), loc="outside lower center", ncols=min(columns, len(entries)), fontsize=MIN_FONT_SIZE + 1)
