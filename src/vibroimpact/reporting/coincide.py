@@ -186,7 +186,7 @@ def _band(ax: Axes, line: Line2D, x: np.ndarray, mask: np.ndarray, beneath: np.n
                 solid_capstyle="butt", dash_capstyle="butt", zorder=zorder, label="_nolegend_", gid=f"beneath:{line.get_gid()}", transform=line.get_transform())  # fmt: skip
 
 
-def reveal_coincident(ax: Axes, curves: Sequence[tuple[str, Sequence[Line2D]]], tolerance: float = TOLERANCE, min_stretch: float = MIN_STRETCH, zero: str = "") -> list[Coincidence | Shared]:
+def reveal_coincident(ax: Axes, curves: Sequence[tuple[str, Sequence[Line2D]]], tolerance: float = TOLERANCE, min_stretch: float = MIN_STRETCH, zero: str = "", share: bool = True) -> list[Coincidence | Shared]:
     """Draw a constant shared by several curves of ``ax`` once, labelled, and every other curve lying under a
     coinciding one as a band around it; return what is shared and which coincide where.
 
@@ -201,6 +201,9 @@ def reveal_coincident(ax: Axes, curves: Sequence[tuple[str, Sequence[Line2D]]], 
         :data:`TOLERANCE` and :data:`MIN_STRETCH`.
     zero : str
         What a shared 0 means, for its label ("no impacts").
+    share : bool
+        Draw a constant shared by several curves once (False: reference lines meant to be constant, such as each
+        stop's clearance, stay as drawn).
 
     Returns
     -------
@@ -209,7 +212,7 @@ def reveal_coincident(ax: Axes, curves: Sequence[tuple[str, Sequence[Line2D]]], 
     """
     x_span = float(abs(np.subtract(*ax.get_xlim()))) or 1.0
     values = [(name, lines, _values(lines)) for name, lines in curves]
-    shared = _share_constants(ax, [(name, lines, xy) for name, lines, xy in values if xy is not None], x_span, min_stretch, zero)
+    shared = _share_constants(ax, [(name, lines, xy) for name, lines, xy in values if xy is not None], x_span, min_stretch, zero) if share else []
     values = [(name, lines, _values(lines)) for name, lines in curves] if shared else values
     drawn = [(name, lines, xy) for name, lines, xy in values if xy is not None]
     log = ax.get_yscale() == "log"
