@@ -64,7 +64,9 @@ def test_a_curve_under_an_identical_one_shows_as_a_band_and_the_caption_says_so(
 
     from tests.reporting.test_report_support import steady_dataset
     from vibroimpact.kinds.stepped.responses import response_figure
+    from vibroimpact.reporting.style import ordered_colours
 
+    first, second = ordered_colours(2)
     ds = steady_dataset(engines=(), restitution=(0.2, 0.6), step=0.5)
     same = ds["x1_amplitude"].copy()
     same.loc[{"restitution": 0.2}] = same.sel(restitution=0.6).values
@@ -73,10 +75,10 @@ def test_a_curve_under_an_identical_one_shows_as_a_band_and_the_caption_says_so(
     try:
         assert "R = 0.2 lies under R = 0.6" in drawn.caption
         ax = next(a for a in drawn.figure.axes if a.get_title().startswith("'pgf'"))
-        top = [line for line in ax.get_lines() if line.get_gid() == "pgf" and to_hex(line.get_color()) == to_hex("C1") and len(line.get_xdata()) > 1]
+        top = [line for line in ax.get_lines() if line.get_gid() == "pgf" and to_hex(line.get_color()) == second and len(line.get_xdata()) > 1]
         bands = _beneath(ax, "pgf")
         assert top and bands
-        assert all(to_hex(band.get_color()) == to_hex("C0") for band in bands)  # R = 0.2's colour
+        assert all(to_hex(band.get_color()) == first for band in bands)  # R = 0.2's colour
         assert min(band.get_linewidth() for band in bands) >= max(line.get_linewidth() for line in top) + 2.0  # >= 1 pt each side
         assert max(band.get_zorder() for band in bands) < min(line.get_zorder() for line in top)
         values = 1e3 * same.sel(solution="pgf", restitution=0.2).values

@@ -288,10 +288,12 @@ def visible(line: Line2D) -> np.ndarray:
 
 
 def shown_points(ax: Axes, gid: str) -> set[tuple[float, float]]:
-    """(x, y) of every visible data point drawn in ``ax`` by artists with ``gid``."""
+    """(x, y) of every visible data point drawn in ``ax`` by artists with ``gid``, or by the line of a constant it
+    shares with other curves, drawn once for them all (gid ``shared:<gid>+<gid>...``)."""
     points: set[tuple[float, float]] = set()
     for line in ax.get_lines():
-        if line.get_gid() == gid:
+        name = str(line.get_gid())
+        if name == gid or (name.startswith("shared:") and gid in name[len("shared:") :].split("+")):
             mask = visible(line)
             x = np.asarray(line.get_xdata(), dtype=float)[mask]
             y = np.asarray(line.get_ydata(), dtype=float)[mask]

@@ -151,7 +151,7 @@ def structure_figure(setting: GeneralSetting, frequency: np.ndarray, paper: bool
         if np.isfinite(gaps[k]) and gaps[k] > 0.0:  # drawn on the frequencies, as the curves it is compared with
             lines.append((f"the gap of stop {k}", axes[1].plot(f, np.full(f.shape, DISPLACEMENT_SCALE * gaps[k]), color=series_colour(k), lw=1.1, ls=":", label=f"stop {k}: gap {fmt(gaps[k] * 1e3, '.4g')} mm", gid=f"gap:stop{k}")))
     finish_axes(axes[1], _FREQUENCY, f"amplitude [{DISPLACEMENT_UNITS}]", "Each stop's coordinate, linear system")
-    coincide = coincidence_phrase([*reveal_coincident(axes[0], coordinates), *reveal_coincident(axes[1], stops), *reveal_coincident(axes[1], lines)])
+    coincide = coincidence_phrase([*reveal_coincident(axes[0], coordinates), *reveal_coincident(axes[1], stops), *reveal_coincident(axes[1], lines, share=False)])
     axes[2].semilogy(f, np.abs(base_force(setting.structure, w, x)), color="C2", lw=1.4, label="|F| on the base", gid="linear:force")
     finish_axes(axes[2], _FREQUENCY, "|F| on the base [N]", titles["force"])
     if named is not None:

@@ -18,6 +18,7 @@ import matplotlib
 matplotlib.use("Agg")  # reports are drawn without a display
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.axes import Axes  # noqa: E402
+from matplotlib.colors import to_hex  # noqa: E402
 from matplotlib.figure import Figure as MatplotlibFigure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
@@ -62,6 +63,14 @@ __all__ = [
     "new_figure",
     "regime_label",
     "series_colour",
+    "OKABE_ITO",
+    "ORDERED_COLORMAP",
+    "ORDERED_SPAN",
+    "ORDERED_WIDTHS",
+    "ordered_colours",
+    "ordered_widths",
+    "SHARED_STYLE",
+    "ZERO_MEANINGS",
     "solution_ref",
 ]
 
@@ -175,13 +184,50 @@ STABLE_STYLE = {"ls": "-", "lw": 1.4}
 UNSTABLE_STYLE = {"ls": (0, (5, 2.5)), "lw": 1.4}
 #: The linear system (no stop).
 LINEAR_STYLE = {"ls": ":", "lw": 1.3, "color": "k"}
+#: What a value of 0 of a quantity says, for the label of a 0 shared by several series (drawn once).
+ZERO_MEANINGS = {"impulse": "no impacts", "impacts_per_period": "no impacts", "peak_acceleration": "no contact", "peak_contact_force": "no contact"}
+#: A constant curve shared by several series (exactly 0 where none of them impacts), drawn once: dark grey, solid.
+SHARED_STYLE = {"ls": "-", "lw": 2.0, "color": "#555555"}
 #: Raw one-impact solution wherever eqs. 15-16 have a root, unchecked: thin and faint, behind everything.
 RAW_STYLE = {"ls": "-", "lw": 0.7, "alpha": 0.35, "zorder": 1}
 
 
 def series_colour(index: int) -> str:
-    """Colour of the ``index``-th series of a figure (matplotlib's default cycle, ten colours)."""
+    """Colour of the ``index``-th series of a figure whose series have no order (methods, coordinates: matplotlib's
+    default cycle, ten colours); an ordered parameter's series take :func:`ordered_colours`."""
     return f"C{index % 10}"
+
+
+#: Okabe-Ito's colours, told apart with any colour vision: the one qualitative palette of the pages (orbit classes and
+#: special points of the bifurcation pages; the sweep directions are its vermillion and sky blue).
+OKABE_ITO = ("#0072B2", "#E69F00", "#009E73", "#CC79A7", "#56B4E9", "#D55E00", "#F0E442", "#000000")
+#: The one sequential palette of an ordered parameter's series on every page (restitution R, clearance Delta, bumper
+#: frequency Omega_b, excitation frequency): viridis from its dark end to :data:`ORDERED_SPAN`'s top, short of the pale
+#: yellow that vanishes on white. Nine values stay at least 8 CIELAB units apart pairwise, with normal vision and under
+#: simulated protanopia, deuteranopia and tritanopia; matplotlib's default cycle had red beside green and brown beside
+#: olive.
+ORDERED_COLORMAP = "viridis"
+#: The stretch of :data:`ORDERED_COLORMAP` the series share, [0, 1] of the colour map.
+ORDERED_SPAN = (0.0, 0.9)
+#: Line widths of an ordered parameter's series [pt]: the first widest, the last thinnest, so that where curves
+#: coincide each earlier one shows around the later ones (no series is hidden under the last drawn).
+ORDERED_WIDTHS = (2.8, 1.4)
+
+
+def ordered_colours(count: int) -> list[str]:
+    """The colours of ``count`` series of an ordered parameter, in its order (:data:`ORDERED_COLORMAP`)."""
+    cmap = matplotlib.colormaps[ORDERED_COLORMAP]
+    low, high = ORDERED_SPAN
+    return [to_hex(cmap(low + (high - low) * k / max(count - 1, 1))) for k in range(count)]
+
+
+def ordered_widths(count: int, single: float = 1.4) -> list[float]:
+    """Line widths [pt] of ``count`` series of an ordered parameter (:data:`ORDERED_WIDTHS`, the first widest);
+    ``single`` for one series."""
+    if count <= 1:
+        return [single] * count
+    wide, thin = ORDERED_WIDTHS
+    return [wide + (thin - wide) * k / (count - 1) for k in range(count)]
 
 
 def solution_ref(solution: str) -> str:
@@ -191,7 +237,7 @@ def solution_ref(solution: str) -> str:
 
 #: Sweep directions, one palette for every page: vermillion up, sky blue down (Okabe-Ito: told apart with any colour
 #: vision, unlike red and green).
-SWEEP_COLOURS = {"up": "#D55E00", "down": "#56B4E9"}
+SWEEP_COLOURS = {"up": OKABE_ITO[5], "down": OKABE_ITO[4]}
 
 
 def fmt(value: SupportsFloat | None, spec: str = ".3g", pattern: str = "{}") -> str:
@@ -272,7 +318,9 @@ def new_figure(
 def figure_legend(fig: MatplotlibFigure, axes: Sequence[Axes], extra: Iterable[Line2D] = (), columns: int = 4) -> None:
     """One legend for the whole figure, below the panels (outside every axes, so it covers no data).
 
-    Entries are the labelled artists of ``axes`` (each label once, in drawing order) followed by ``extra``.
+    Entries are the labelled artists of ``axes`` (each label once, in drawing order) followed by ``extra``, and the
+    constants shared by several series of any panel, drawn once (gid ``shared:...``,
+    :func:`~vibroimpact.reporting.coincide.reveal_coincident`): their label says whose they are.
     """
     entries: dict[str, object] = {}
     for ax in axes:
@@ -280,6 +328,10 @@ def figure_legend(fig: MatplotlibFigure, axes: Sequence[Axes], extra: Iterable[L
             entries.setdefault(label, handle)
     for handle in extra:
         entries.setdefault(handle.get_label(), handle)
+    for ax in fig.axes:
+        for line in ax.get_lines():
+            if str(line.get_gid()).startswith("shared:"):
+                entries.setdefault(str(line.get_label()), line)
     if entries:
         fig.legend(list(entries.values()), list(entries.keys()), loc="outside lower center", ncols=min(columns, len(entries)), fontsize=MIN_FONT_SIZE + 1)
 

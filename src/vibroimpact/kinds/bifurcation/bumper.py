@@ -32,12 +32,12 @@ import numpy as np
 import xarray as xr
 
 from vibroimpact.kinds.bifurcation.bumper_start import STIFF_START
-from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, ORBIT_PALETTE, SPECIAL_MARKERS, first_coordinate, flags, length_of
+from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, SPECIAL_MARKERS, first_coordinate, flags, length_of
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
 from vibroimpact.kinds.bifurcation.stiffness import ON_CURVE, SOFTER, STIFFER, curve_pieces, on_piece
 from vibroimpact.reporting.page import DrawnFigure, Table
 from vibroimpact.runs.failures import as_lines
-from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure
+from vibroimpact.reporting.style import MIN_FONT_SIZE, OKABE_ITO, STABLE_STYLE, UNSTABLE_STYLE, finish_axes, fmt, new_figure, ordered_colours
 
 __all__ = ["has_bumpers", "has_rigid", "diagram_models", "model_view", "rigid_view", "bumper_frequencies", "bumper_name", "convergence_rows", "convergence_table", "bumper_answer", "absent_text", "bumper_figure", "MATCH_WINDOW", "SAME_POINT"]
 
@@ -57,10 +57,11 @@ SAME_POINT = 1e-9
 RICHARDSON = 0.1
 #: A curve that stops short of the softest bumper by more than this share of its period "ends" there [-].
 REACH = 0.01
-#: Colour of the rigid stop's branches; the bumpers take :data:`ORBIT_PALETTE` in order of frequency.
+#: Colour of the rigid stop's branches; the bumpers take the ordered palette (:func:`ordered_colours`) in order of
+#: frequency.
 RIGID_COLOUR = "k"
 #: Line colours of the convergence panel, one per special point (Okabe-Ito's and grey; black is the rigid stop's).
-CONVERGENCE_COLOURS = ("#0072B2", "#E69F00", "#009E73", "#CC79A7", "#56B4E9", "#D55E00", "#999999", "#F0E442")
+CONVERGENCE_COLOURS = (*OKABE_ITO[:6], "#999999", OKABE_ITO[6])
 #: Origins of the branches started from the closed form (flags of ``branch_origin``).
 _CLOSED = ("one_impact", "two_impacts")
 
@@ -334,6 +335,11 @@ def absent_text(dataset: xr.Dataset) -> str:
             f"stiffness from a bumper {fmt(STIFF_START, 'g')} times stiffer, vanishes before it reaches the scene's bumper; {len(lines)} start{'s' if len(lines) != 1 else ''}):</p><ul>{items}</ul>")
 
 
+def _bumper_colours(count: int) -> str:
+    """The bumpers' colours in words (the ordered palette, softest first)."""
+    return "dark purple" if count == 1 else "dark purple for the softest to yellow-green for the stiffest" if count > 2 else "dark purple, then yellow-green"
+
+
 def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
     """Left: the closed-form branches of the rigid stop and of every bumper, the first coordinate's amplitude against
     frequency; right: each special point's distance from the rigid stop's against 1 / Omega_b (log-log, a slope-1
@@ -342,8 +348,8 @@ def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
     label = coordinate_label(name)
     bumpers = bumper_frequencies(dataset)
     unit, scale = length_of(dataset)
-    colours = {math.inf: RIGID_COLOUR} | {fb: ORBIT_PALETTE[i % len(ORBIT_PALETTE)] for i, fb in enumerate(bumpers)}
-    fig, (left, right) = new_figure(2, panel_height=4.6, columns=2, legend_rows=legend_rows(len(bumpers) + 16, 4))
+    colours = {math.inf: RIGID_COLOUR} | dict(zip(bumpers, ordered_colours(len(bumpers))))
+    fig, (left, right) = new_figure(2, panel_height=6.0, columns=2)  # the legends under the panels included
     origins = flags(dataset["branch_origin"])
     codes = [origins.index(k) for k in _CLOSED if k in origins]
     fb_points = dataset["branch_bumper_frequency"].values
@@ -357,7 +363,7 @@ def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
                 run = np.append(piece, piece[-1] + 1) if piece.size and piece[-1] + 1 < f.size else piece
                 if run.size:
                     left.plot(f[run], amp[run], color=colours[fb], **(STABLE_STYLE if stable[piece[0]] else UNSTABLE_STYLE))
-        left.plot([], [], color=colours[fb], lw=2, label="rigid stop" if math.isinf(fb) else f"bumper {bumper_name(dataset, fb)}")
+        left.plot([], [], color=colours[fb], lw=2, label="rigid stop, one-impact branch" if math.isinf(fb) else f"bumper {bumper_name(dataset, fb)}, one-contact branch")
     kinds = flags(dataset["special_point_kind"])
     sp_fb = dataset["special_point_bumper_frequency"].values
     for code, kind in enumerate(kinds):
@@ -392,13 +398,17 @@ def bumper_figure(dataset: xr.Dataset) -> DrawnFigure:
         right.minorticks_off()
     finish_axes(left, "excitation frequency [Hz]", f"|{label}| fundamental [{unit}]", f"{label} amplitude: one-impact branches, rigid stop and bumpers")
     finish_axes(right, "1 / (Omega_b / 2 pi) [1/Hz]", "|special point's frequency − rigid stop's| [Hz]", "convergence to the rigid stop's special points")
-    figure_legend(fig, [left, right], columns=4)
+    # two legends, one under each panel: the left's colours are the contact models (bumpers in the ordered palette),
+    # the right's the special points (Okabe-Ito), and neither legend mixes the two
+    for ax, title in ((left, "branch colour: contact model; open marker: its special point"), (right, "colour: special point (kind, rigid stop's frequency)")):
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncols=2, fontsize=MIN_FONT_SIZE + 1, title=title, title_fontsize=MIN_FONT_SIZE + 1)
     caption = (
         f"Left: the branches started from the closed form (one impact per period) of the rigid stop (black) and of Kelvin-Voigt bumpers of "
-        f"{', '.join(fmt(fb, 'g') for fb in bumpers)} Hz ({', '.join(['blue', 'orange', 'green', 'pink'][: len(bumpers)])}), each with the loss factor whose "
+        f"{', '.join(fmt(fb, 'g') for fb in bumpers)} Hz ({_bumper_colours(len(bumpers))}), each with the loss factor whose "
         f"collision restitution is R, Delta = {fmt(float(dataset['clearance']) * scale, 'g')} {unit}: the {label} fundamental, solid where stable, dashed where "
         "unstable; open markers in the branch's colour: its special points. Right: the distance of each special point of the bumpers' branches from the "
-        "rigid stop's against 1 / (Omega_b / 2 pi) [1/Hz], log-log, one colour per special point (legend: its kind and the rigid stop's frequency), "
+        "rigid stop's against 1 / (Omega_b / 2 pi) [1/Hz], log-log, one colour per special point (its own legend, under the panel: its kind and the rigid stop's frequency), "
         "markers at the bumpers of the study, lines: the special point followed in the bumper's stiffness (its curve from the stiffest bumper, "
         "where the table's matching comes from; markers joined by straight lines where no curve was followed); the dotted black line has slope 1 "
         "(first-order convergence). The contact onsets at tangency, the same points for every bumper, and points found at one bumper only are not drawn there."

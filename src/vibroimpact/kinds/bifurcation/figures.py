@@ -21,7 +21,7 @@ from matplotlib.patches import Patch
 from vibroimpact.reporting.page import DrawnFigure
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.model.units import length_unit
-from vibroimpact.reporting.style import REGIME_COLOURS, STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure, SWEEP_COLOURS
+from vibroimpact.reporting.style import OKABE_ITO, REGIME_COLOURS, STABLE_STYLE, UNSTABLE_STYLE, figure_legend, finish_axes, fmt, legend_rows, new_figure, SWEEP_COLOURS
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
 
 __all__ = ["KIND_NAMES", "bifurcation_figures", "diagram_figure", "multiplier_figure", "chart_figure", "orbit_class", "branch_class", "orbit_looks", "orbit_label", "first_coordinate", "flags", "length_of"]
@@ -32,7 +32,7 @@ KIND_NAMES = {"fold": "fold", "period_doubling": "period doubling", "neimark_sac
 SPECIAL_MARKERS = {"fold": "o", "period_doubling": "s", "neimark_sacker": "D", "grazing": "^"}
 #: Line colours of the orbit classes: Okabe-Ito's, told apart with any colour vision; not the sweeps' vermillion and
 #: sky blue (:data:`SWEEP_COLOURS`, the brute-force dots), not black (the linear orbit), not yellow (too faint as a line).
-ORBIT_PALETTE = ("#0072B2", "#E69F00", "#009E73", "#CC79A7")
+ORBIT_PALETTE = OKABE_ITO[:4]
 #: Markers on the lines of the classes beyond the palette: class k (in order of period and impacts) takes colour
 #: k mod 4 and marker k // 4; filled and small, unlike the special points' open black markers.
 ORBIT_MARKERS = ("", "o", "s", "v", "P", "X", "*", "h")
@@ -46,7 +46,7 @@ MOTION_REGIMES = {
 }  # fmt: skip
 #: Colour of the chart's curves of each kind of special point (Okabe-Ito and black, grazing dashed; drawn with a white
 #: edge, to show over any regime).
-CURVE_COLOURS = {"fold": "k", "period_doubling": "#E69F00", "neimark_sacker": "#CC79A7", "grazing": "k"}
+CURVE_COLOURS = {"fold": "k", "period_doubling": OKABE_ITO[1], "neimark_sacker": OKABE_ITO[3], "grazing": "k"}
 _FREQUENCY = "excitation frequency [Hz]"
 #: Top of the multiplier figure's axis [-].
 MODULUS_TOP = 20.0
@@ -171,7 +171,7 @@ def diagram_figure(dataset: xr.Dataset, restitution: float, index: int) -> Drawn
     finish_axes(top, "", f"|{label}| fundamental [{unit}]", f"{where}: {label} amplitude")
     finish_axes(bottom, _FREQUENCY, "impact velocity [m/s]", f"{where}: impact velocities")
     dots = [Line2D([], [], ls="", marker="o", ms=5, color=SWEEP_COLOURS.get(str(d), "C7"), label=f"brute force, sweep {d}") for d in dataset["sweep"].values]
-    extra = [*dots, Line2D([], [], color="k", **STABLE_STYLE, label="stable"), Line2D([], [], color="k", **UNSTABLE_STYLE, label="unstable")]
+    extra = [*dots, Line2D([], [], color="k", **STABLE_STYLE, label="stable periodic orbit of the continuation (solid)"), Line2D([], [], color="k", **UNSTABLE_STYLE, label="unstable periodic orbit of the continuation (dashed)")]
     figure_legend(fig, [top, bottom], [*_class_legend(looks, classes), *extra], columns=4)
     caption = (
         f"Bifurcation diagram at R = {fmt(restitution, 'g')}{_model(dataset)}, Delta = {fmt(float(dataset['clearance']) * scale, 'g')} {unit}. Dots: brute-force "

@@ -18,7 +18,7 @@ from matplotlib.axes import Axes
 from matplotlib.lines import Line2D
 from matplotlib.ticker import FormatStrFormatter, LogFormatter
 
-from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
+from vibroimpact.reporting.coincide import Coincidence, Shared, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, render_page, rendering, saved, write_page
 from vibroimpact.reporting.record import stored_description
 from vibroimpact.reporting.style import LINEAR_STYLE, STABLE_STYLE, UNSTABLE_STYLE, Caption, figure_legend, fmt, new_figure, finish_axes, legend_rows
@@ -187,7 +187,7 @@ def impact_figure(dataset: xr.Dataset) -> DrawnFigure | None:
               ("simulated_impulse_per_period", "impulse per period [N s]", "rigid stops: impulse", False),
               ("simulated_impacts_per_period", "impacts per period", "rigid stops: impacts", False))  # fmt: skip
     fig, axes = new_figure(len(panels), panel_height=3.2, legend_rows=legend_rows(len(rows), 2))
-    found: list[Coincidence] = []
+    found: list[Coincidence | Shared] = []
     for ax, (variable, ylabel, title, log) in zip(axes, panels):
         _band(ax, dataset, static=False)
         curves: list[tuple[str, list[Line2D]]] = []
@@ -199,7 +199,7 @@ def impact_figure(dataset: xr.Dataset) -> DrawnFigure | None:
         ax.set_xlim(float(fs[0]), float(fs[-1]))
         if log:
             _plain_ticks(ax)
-        found += reveal_coincident(ax, curves)
+        found += reveal_coincident(ax, curves, zero="no impacts" if variable.startswith("simulated_") else "")
     figure_legend(fig, axes, columns=2)
     bumper = fmt(dataset.attrs.get("bumper_frequency_Hz"), ".4g")
     caption = (

@@ -30,15 +30,15 @@ from vibroimpact.kinds.stepped.answers import answer_text, band_peaks, contact_t
 from vibroimpact.kinds.stepped.crosscheck import cross_check_section, cross_check_text, cross_checks
 from vibroimpact.kinds.stepped.figures import peaks_table, response_panels_figure, where_text
 from vibroimpact.kinds.stepped.operating import operating_point, operating_text, warning_lines, warnings_html
-from vibroimpact.kinds.stepped.responses import clearance_text, series_by_restitution, regime_figure, response_figure, simulation_figure, stability_figure
+from vibroimpact.kinds.stepped.responses import clearance_text, series_by_restitution, regime_figure, response_figure, simulation_figure, stability_figure, subset_counts
 from vibroimpact.kinds.stepped.tables import agreement_table, reduction_intro, reduction_tables
 from vibroimpact.grids.sections import SolutionsPage, layout_tables, linear_section, modal_table, paper_study, structure_figure
 from vibroimpact.orbits.motion import MotionThresholds
-from vibroimpact.reporting.coincide import Coincidence, coincidence_phrase, reveal_coincident
+from vibroimpact.reporting.coincide import Coincidence, Shared, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved, StudyPage
 from vibroimpact.reporting.record import StudySetting, GeneralSetting, general_setting, named_layout, study_setting
-from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_points, periodic_points, stability_keys, unstable_points
-from vibroimpact.reporting.style import DISPLACEMENT_SCALE, QUANTITIES, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, series_colour, solution_ref, ENGINE_MARKERS, REGIME_COLOURS
+from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, closed_forms_whose, draw_curve, draw_points, marker_scales, periodic_points, stability_keys, unstable_points
+from vibroimpact.reporting.style import DISPLACEMENT_SCALE, QUANTITIES, SOLUTION_COLOURS, SOLUTION_DESCRIPTIONS, Caption, axis_label, figure_legend, finish_axes, fmt, legend_rows, new_figure, ordered_colours, ordered_widths, solution_ref, ENGINE_MARKERS, REGIME_COLOURS, ZERO_MEANINGS
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, contact_solutions
 
 __all__ = ["page_for", "BumperStiffnessPage", "peak_figure", "peak_tables", "peak_acceleration_figure", "stiffness_figure", "stiffness_tables", "band_peaks", "lyapunov_figure", "FrequencyResponsePage", "RESPONSE_QUANTITIES", "SIMULATION_QUANTITIES", "unswept_restitution", "answer_text"]
@@ -116,34 +116,35 @@ def peak_acceleration_figure(part: xr.Dataset, name: str) -> DrawnFigure | None:
     f = part["frequency"].values
     lines = series_by_restitution(part)
     present = [str(s) for s in part["solution"].values]
-    fig, axes = new_figure(len(quantities), panel_height=3.9, legend_rows=legend_rows(len(lines) + 4))
+    fig, axes = new_figure(len(quantities), panel_height=3.9, legend_rows=legend_rows(len(lines) + 5, 3))
     caption = Caption(
         f"{' and '.join(QUANTITIES[q].label for q in quantities)} per steady state against frequency, {clearance_text(part)}, one colour per restitution ratio."
     )
     any_unstable = False
-    engines = SimulationMarkers()
-    found: list[Coincidence] = []
+    engines = SimulationMarkers(subset_counts(part))
+    colours, widths, scales = ordered_colours(len(lines)), ordered_widths(len(lines)), marker_scales(len(lines))
+    found: list[Coincidence | Shared] = []
     for ax, quantity in zip(axes, quantities):
         curves: list[tuple[str, list[Line2D]]] = []
         for i, (text, line) in enumerate(lines):
             if "pgf" in present:
                 before = len(ax.lines)
-                drawn, unstable = draw_curve(ax, f, QUANTITIES[quantity].scale * line[quantity].sel(solution="pgf").values, colour=series_colour(i), label=None, gid="pgf", unstable=unstable_points(line, "pgf"), zorder=OVER_MARKERS_ZORDER)
+                drawn, unstable = draw_curve(ax, f, QUANTITIES[quantity].scale * line[quantity].sel(solution="pgf").values, colour=colours[i], label=None, gid="pgf", unstable=unstable_points(line, "pgf"), zorder=OVER_MARKERS_ZORDER, width=widths[i])
                 curves.append((text, list(ax.lines[before:])))
                 any_unstable |= unstable
                 if drawn:
                     caption.add("pgf", f"Lines: the estimate from {solution_ref('pgf')}, Gamma(xi_b) Omega_b J / (1 + R) for the force (section 6.3 with the corrected factor Gamma; the deceleration less the absorber spring's pull): the rigid-stop impulse J gives the entry speed, the one-collision solution of the bumper gives the peak.")
             for bumper in contact_solutions(present, BUMPER):
-                engines.add(bumper, draw_points(ax, f, QUANTITIES[quantity].scale * line[quantity].sel(solution=bumper).values, periodic=periodic_points(line, bumper), solution=bumper, colour=series_colour(i), label=None))
+                engines.add(bumper, draw_points(ax, f, QUANTITIES[quantity].scale * line[quantity].sel(solution=bumper).values, periodic=periodic_points(line, bumper), solution=bumper, colour=colours[i], label=None, scale=scales[i]))
         finish_axes(ax, "frequency [Hz]", axis_label(quantity), QUANTITIES[quantity].label)
-        found += reveal_coincident(ax, curves)
+        found += reveal_coincident(ax, curves, zero=ZERO_MEANINGS.get(quantity, ""))
     if any_unstable:
         caption.add("unstable", "Dashed: the estimate on a one-impact orbit that exists but is unstable.")
     if engines:
         caption.add("bumper", engines.phrase(irregular="irregular motion, the largest over the measured window", each="one marker per simulated point"))
     caption.add("coincide", coincidence_phrase(found))
-    keys: list[Line2D | Patch] = [Patch(color=series_colour(i), label=text) for i, (text, _) in enumerate(lines)]
-    figure_legend(fig, [], keys + (stability_keys() if any_unstable else []) + engines.keys())
+    keys: list[Line2D | Patch] = [Patch(color=colours[i], label=text) for i, (text, _) in enumerate(lines)]
+    figure_legend(fig, [], keys + (stability_keys(f"under the estimate from {solution_ref('pgf')}") if any_unstable else []) + engines.keys(), columns=3)
     return DrawnFigure(fig, name, f"Peak contact deceleration and force, {clearance_text(part)}", caption.text())
 
 
@@ -184,22 +185,25 @@ def stiffness_figure(dataset: xr.Dataset, setting: StudySetting, name: str) -> D
     panels = 2 if "wall_time" in dataset else 1
     fig, axes = new_figure(panels, panel_height=4.0, legend_rows=legend_rows(f.size + 2, 6))
     ax = axes[0]
+    colours, widths = ordered_colours(f.size), ordered_widths(f.size)
+    curves: list[tuple[str, list[Line2D]]] = []
     for k, frequency in enumerate(f):
         point = dataset.sel(frequency=frequency)
         sim = point["x1_amplitude"].sel(solution=compliant).values
         ref = point["x1_amplitude"].sel(solution=reference).values
-        ax.loglog(bumper, np.abs(sim - ref) / ref, "o-", color=series_colour(k), ms=4, label=f"{fmt(frequency, 'g')} Hz", gid=compliant)
+        curves.append((f"{fmt(frequency, 'g')} Hz", ax.loglog(bumper, np.abs(sim - ref) / ref, "o-", color=colours[k], lw=widths[k], ms=2.0 + 1.5 * widths[k], label=f"{fmt(frequency, 'g')} Hz", gid=compliant)))
     ax.loglog(bumper, 0.1 * bumper[0] / bumper, "k--", lw=0.9, label="slope -1")
     finish_axes(ax, "bumper frequency Omega_b / 2 pi [Hz]", f"relative difference of {QUANTITIES['x1_amplitude'].label} [1]", "Convergence to the rigid stop")
     caption = Caption(
         f"Left: relative difference of the steady-state {QUANTITIES['x1_amplitude'].label} of {solution_ref(compliant)}, {SOLUTION_DESCRIPTIONS[compliant]} (restitution-matched "
         f"loss factor) from the rigid-stop simulation {solution_ref(reference)} as the bumper stiffens, one colour per excitation frequency; the dashed line has slope -1."
     )
+    coincide = coincidence_phrase(reveal_coincident(ax, curves), unit="Hz of Omega_b / 2 pi", spec=".4g")
     if panels == 2:
         ax = axes[1]
         if len(bumpers) == 1:
             for k, frequency in enumerate(f):
-                ax.loglog(bumper, dataset["wall_time"].sel(solution=compliant, frequency=frequency).values, "o-", color=series_colour(k), ms=4, label=f"{fmt(frequency, 'g')} Hz", gid=compliant)
+                ax.loglog(bumper, dataset["wall_time"].sel(solution=compliant, frequency=frequency).values, "o-", color=colours[k], ms=4, label=f"{fmt(frequency, 'g')} Hz", gid=compliant)
             cost = f"Right: the wall time of each steady state of {solution_ref(compliant)} (transient plus measurement, one process)"
         else:
             for engine in bumpers:
@@ -208,12 +212,14 @@ def stiffness_figure(dataset: xr.Dataset, setting: StudySetting, name: str) -> D
                     median = np.array([np.nanmedian(w) if np.isfinite(w).any() else np.nan for w in walls])
                 marker = ENGINE_MARKERS.get(engine, ("o", 4.0))[0]
                 run = np.isfinite(median)  # an engine on a subset of the bumpers: its line joins those it ran
-                ax.loglog(bumper[run], median[run], f"{marker}-", color=SOLUTION_COLOURS[engine], ms=6, lw=1.6, label=f"{solution_ref(engine)} (median)", gid=engine)
+                subset = f", {int(run.sum())} of {bumper.size} bumpers" if run.sum() < bumper.size else ""
+                ax.loglog(bumper[run], median[run], f"{marker}-", color=SOLUTION_COLOURS[engine], ms=6, lw=1.6, label=f"{solution_ref(engine)} (median{subset})", gid=engine)
             cost = ("Right: the median wall time of a steady state over the simulated frequencies (transient plus measurement, one process) of " + " and of ".join(f"{solution_ref(e)}, {SOLUTION_DESCRIPTIONS[e]}" for e in bumpers) + ", in the same run")
         rigid = float(np.nanmedian(dataset["wall_time"].sel(solution=reference).values))
         ax.axhline(rigid, color="k", ls=":", lw=1.2, label=f"{reference} (median)", gid=reference)
         finish_axes(ax, "bumper frequency Omega_b / 2 pi [Hz]", "wall time per steady state [s]", "Cost of the compliant model")
         caption.add("cost", f"{cost}; dotted: the median of {solution_ref(reference)}.")
+    caption.add("coincide", coincide)
     for ax in axes:
         # ticks at the bumpers computed: read off directly, and no crowded minor-tick labels on a short log axis
         ax.set_xticks(bumper, [fmt(b, "g") for b in bumper])

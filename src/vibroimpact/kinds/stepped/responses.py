@@ -16,9 +16,10 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from vibroimpact.grids.regime_map import regime_map
+from vibroimpact.kinds.stepped.crosscheck import subset_solutions
 from vibroimpact.reporting.coincide import coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure
-from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, draw_curve, draw_linear, draw_points, periodic_points, stability_keys, unstable_points
+from vibroimpact.reporting.series import OVER_MARKERS_ZORDER, SimulationMarkers, closed_forms_whose, draw_curve, marker_scales, draw_linear, draw_points, periodic_points, stability_keys, subset_points, unstable_points
 from vibroimpact.reporting.style import (
     LINEAR_STYLE,
     QUANTITIES,
@@ -26,6 +27,7 @@ from vibroimpact.reporting.style import (
     SOLUTION_COLOURS,
     SOLUTION_DESCRIPTIONS,
     SOLUTION_TITLES,
+    ZERO_MEANINGS,
     Caption,
     axis_label,
     figure_legend,
@@ -33,12 +35,13 @@ from vibroimpact.reporting.style import (
     fmt,
     legend_rows,
     new_figure,
-    series_colour,
+    ordered_colours,
+    ordered_widths,
     solution_ref,
 )
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS
 
-__all__ = ["response_figure", "regime_figure", "stability_figure", "simulation_figure", "series_by_restitution", "clearance_text"]
+__all__ = ["response_figure", "regime_figure", "stability_figure", "simulation_figure", "series_by_restitution", "clearance_text", "subset_counts", "subset_title"]
 
 #: Fewer grid points than this: closed-form curves also get a marker per value.
 COARSE_GRID_POINTS = 30
@@ -63,6 +66,17 @@ def series_by_restitution(part: xr.Dataset) -> list[tuple[str, xr.Dataset]]:
     return [(f"R = {fmt(part['restitution'], 'g')}", part)]
 
 
+def subset_counts(part: xr.Dataset) -> dict[str, int]:
+    """The solutions of ``part`` run on a subset of the simulation grid -> how many points each computed."""
+    return {solution: subset_points(part, solution) for solution in subset_solutions(part)}
+
+
+def subset_title(title: str, solution: str, counts: dict[str, int]) -> str:
+    """A panel's title, with "subset: n points" where ``solution`` ran on a subset (it looks like a full panel)."""
+    n = counts.get(solution)
+    return title if n is None else f"{title} (subset: {n} point{'s' if n != 1 else ''})"
+
+
 def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure | None:
     """One panel per solution with values of ``quantity``: closed forms as curves, simulations as markers, one colour
     per restitution ratio, the linear system dotted (paper figures 5-8). None if nothing has a finite value."""
@@ -81,8 +95,10 @@ def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure |
         f"{q.label} ({q.meaning}) against frequency, {clearance_text(part)}, one colour per restitution ratio; one panel "
         f"per solution: {'; '.join(f'{solution_ref(s)}, {SOLUTION_DESCRIPTIONS.get(s, s)}' for s in panels)}."
     )
-    fig, axes = new_figure(len(panels), panel_height=3.7, sharey=True, legend_rows=legend_rows(len(lines) + 6))
-    engines = SimulationMarkers()
+    fig, axes = new_figure(len(panels), panel_height=3.7, sharey=True, legend_rows=legend_rows(len(lines) + 7, 3))
+    counts = subset_counts(part)
+    engines = SimulationMarkers(counts)
+    colours, widths, scales = ordered_colours(len(lines)), ordered_widths(len(lines)), marker_scales(len(lines))
     any_unstable = gaps = raw = False
     curves: list[list[tuple[str, list[Line2D]]]] = []
     for ax, solution in zip(axes, panels):
@@ -93,19 +109,19 @@ def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure |
         for i, (text, line) in enumerate(lines if solution != "linear" else []):
             values = q.scale * line[quantity].sel(solution=solution).values
             if solution in ENGINE_SOLUTIONS:
-                engines.add(solution, draw_points(ax, f, values, periodic=periodic_points(line, solution), solution=solution, colour=series_colour(i), label=None))
+                engines.add(solution, draw_points(ax, f, values, periodic=periodic_points(line, solution), solution=solution, colour=colours[i], label=None, scale=scales[i]))
                 continue
             before = len(ax.lines)
-            _, unstable = draw_curve(ax, f, values, colour=series_colour(i), label=None, gid=solution, unstable=unstable_points(line, solution), coarse=coarse)
+            _, unstable = draw_curve(ax, f, values, colour=colours[i], label=None, gid=solution, unstable=unstable_points(line, solution), coarse=coarse, width=widths[i])
             curves[-1].append((text, list(ax.lines[before:])))
             any_unstable |= unstable
             gaps |= bool(np.isnan(values).any())
             if raw_name in line and solution != "linear":
                 raw_values = q.scale * line[raw_name].sel(solution=solution).values
                 if np.isfinite(raw_values).any():
-                    ax.plot(f, raw_values, color=series_colour(i), label="_nolegend_", gid=f"raw:{solution}", **RAW_STYLE)
+                    ax.plot(f, raw_values, color=colours[i], label="_nolegend_", gid=f"raw:{solution}", **RAW_STYLE)
                     raw = True
-        finish_axes(ax, _FREQUENCY, axis_label(quantity), f"{solution_ref(solution)}: {SOLUTION_TITLES.get(solution, solution)}", log=q.log)
+        finish_axes(ax, _FREQUENCY, axis_label(quantity), subset_title(f"{solution_ref(solution)}: {SOLUTION_TITLES.get(solution, solution)}", solution, counts), log=q.log)
     if any_unstable:
         caption.add("unstable", "Curves: solid where the one-impact orbit is stable (or the motion linear), dashed where it exists but is unstable (Floquet): the real motion there is another one.")
     if gaps:
@@ -118,13 +134,13 @@ def response_figure(part: xr.Dataset, quantity: str, name: str) -> DrawnFigure |
     top = float(np.max(finite[np.isfinite(finite)], initial=0.0))
     if top > 0.0:
         axes[0].set_ylim(top=3.0 * top if q.log else 1.1 * top)
-    coincide = coincidence_phrase(found for ax, drawn in zip(axes, curves) for found in reveal_coincident(ax, drawn))
-    keys = [Patch(color=series_colour(i), label=text) for i, (text, _) in enumerate(lines)]
+    coincide = coincidence_phrase(found for ax, drawn in zip(axes, curves) for found in reveal_coincident(ax, drawn, zero=ZERO_MEANINGS.get(quantity, "")))
+    keys = [Patch(color=colours[i], label=text) for i, (text, _) in enumerate(lines)]
     if with_linear:
         keys.append(Line2D([], [], label="LIN (linear system)", **LINEAR_STYLE))
-    keys += stability_keys() if any_unstable else []
+    keys += stability_keys(closed_forms_whose(s for s in panels if s not in ENGINE_SOLUTIONS and s != "linear")) if any_unstable else []
     keys += [Line2D([], [], color="k", label="raw one-impact solution", **RAW_STYLE)] if raw else []
-    figure_legend(fig, [], keys + engines.keys())
+    figure_legend(fig, [], keys + engines.keys(), columns=3)
     caption.add("coincide", coincide)
     missing = [s for s in candidates if s not in panels]
     tail = f"No finite values, not drawn: {', '.join(solution_ref(s) for s in missing)}." if missing else ""
@@ -156,9 +172,10 @@ def stability_figure(part: xr.Dataset, name: str) -> DrawnFigure:
     fig, axes = new_figure(1, panel_height=3.8, legend_rows=legend_rows(len(lines) + 1, 6))
     ax = axes[0]
     curves: list[tuple[str, list[Line2D]]] = []
+    colours, widths = ordered_colours(len(lines)), ordered_widths(len(lines))
     for i, (text, line) in enumerate(lines):
         before = len(ax.lines)
-        draw_curve(ax, f, line["floquet_modulus"].sel(solution="pgf").values, colour=series_colour(i), label=text, gid="pgf", coarse=f.size < COARSE_GRID_POINTS)
+        draw_curve(ax, f, line["floquet_modulus"].sel(solution="pgf").values, colour=colours[i], label=text, gid="pgf", coarse=f.size < COARSE_GRID_POINTS, width=widths[i])
         curves.append((text, list(ax.lines[before:])))
     ax.axhline(1.0, color="k", lw=1.0, label="stability limit 1")
     finish_axes(ax, _FREQUENCY, axis_label("floquet_modulus"), f"{solution_ref('pgf')}: stability of the one-impact orbit, {clearance_text(part)}", log=True)
@@ -185,8 +202,8 @@ def simulation_figure(part: xr.Dataset, quantity: str, engines: list[str], name:
     coarse = f.size < COARSE_GRID_POINTS
     panels = "one panel per restitution ratio" if len(lines) > 1 else lines[0][0]
     caption = Caption(f"{q.label} ({q.meaning}) against frequency, {clearance_text(part)}: {panels}.")
-    fig, axes = new_figure(len(lines), panel_height=3.5, legend_rows=legend_rows(2 + 2 * len(drawn) + 2))
-    markers = SimulationMarkers()
+    fig, axes = new_figure(len(lines), panel_height=3.5, legend_rows=legend_rows(2 + 2 * len(drawn) + 2, 3))
+    markers = SimulationMarkers(subset_counts(part))
     any_unstable = gaps = False
     for ax, (text, line) in zip(axes, lines):
         if "linear" in present and quantity != "impulse":
@@ -200,12 +217,12 @@ def simulation_figure(part: xr.Dataset, quantity: str, engines: list[str], name:
             caption.add("closed", f"{solution_ref(closed)} (blue line): the {SOLUTION_DESCRIPTIONS[closed]}.")
         for engine in drawn:
             values = q.scale * line[quantity].sel(solution=engine).values
-            markers.add(engine, draw_points(ax, f, values, periodic=periodic_points(line, engine), solution=engine, colour=SOLUTION_COLOURS[engine], label=solution_ref(engine)))
+            markers.add(engine, draw_points(ax, f, values, periodic=periodic_points(line, engine), solution=engine, colour=SOLUTION_COLOURS[engine], label=markers.name(engine)))
         finish_axes(ax, _FREQUENCY, axis_label(quantity), text, log=q.log)
     if any_unstable:
         caption.add("unstable", f"{solution_ref(closed)} dashed: the one-impact orbit exists but is unstable (Floquet).")
     if gaps:
         caption.add("gaps", f"Gaps in {solution_ref(closed)}: no admissible one-impact regime while the linear motion would cross the stop.")
     caption.add("engines", markers.phrase())
-    figure_legend(fig, axes, stability_keys() if any_unstable else [])
+    figure_legend(fig, axes, stability_keys(closed_forms_whose([closed] if closed else [])) if any_unstable else [], columns=3)
     return DrawnFigure(fig, name, f"Simulations against the closed form: {q.label}, {clearance_text(part)}", caption.text())
