@@ -272,8 +272,11 @@ def split_groups(dataset: xr.Dataset) -> dict[str, xr.Dataset]:
     per_solution = [name for name, variable in dataset.data_vars.items() if "solution" in variable.dims]
     root = dataset.sel(solution=closed)
     group = dataset.sel(solution=simulated).isel(frequency=np.flatnonzero(on_axis))
-    in_root = [name for name in per_solution if closed and bool(_present(root[name]).any())]
-    in_group = [name for name in per_solution if name not in in_root or bool(_present(group[name]).any())]
+    # whether each variable holds a value in each group: one computation over a lazy dataset (which reads the store
+    # once), not one per variable
+    holds = xr.Dataset({(part, name): _present(source[name]).any() for part, source in (("root", root), ("group", group)) for name in per_solution}).compute()
+    in_root = [name for name in per_solution if closed and bool(holds[("root", name)])]
+    in_group = [name for name in per_solution if name not in in_root or bool(holds[("group", name)])]
     root = root.drop_vars([name for name in per_solution if name not in in_root])
     if not closed:
         root = root.drop_dims("solution")
