@@ -182,7 +182,7 @@ def cross_check_section(checks: list[CrossCheck]) -> Section | None:
     names = "; ".join(f"{solution_ref(c.checked)} against {solution_ref(c.reference)}" for c in checks)
     intro = (
         f"<p>Point by point ({html.escape(names)}): the regime each engine found, |X1| and its relative difference where both are periodic, "
-        "and each steady state's wall time in this run (transient plus measurement, one process; the first point a worker computes also loads the compiled engine). "
+        "and each steady state's wall time in this run (transient plus measurement, one process; no compile or load of a compiled engine: each worker loads them before its first point). "
         "The page's first section sums them up.</p>"
     )
     return Section("The same contact by two engines", intro=intro, tables=tables)
