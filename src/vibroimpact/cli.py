@@ -293,13 +293,18 @@ def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, store: StudyStor
         dataset.attrs["run_jobs"] = args.jobs
         dataset.attrs["run_scheduler"] = scheduler or ("local dask cluster" if args.jobs > 1 else "this process")
         dataset.attrs["run_peak_memory_bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-        path = write_dataset(dataset, out_dir / f"{scene.name}.nc")  # streamed from the store, chunk by chunk
+        reported = bool(scene.report) and not args.no_report
+        # streamed from the store chunk by chunk; a dataset the report reads whole anyway is read from it once (a
+        # copy, freed after the write: restitution's 26 MB, 1.4 s against 4.6 s streamed)
+        written = dataset.compute() if reported and dataset.nbytes <= REPORT_MEMORY_LIMIT else dataset
+        path = write_dataset(written, out_dir / f"{scene.name}.nc")
         print(f"wrote {path}")
         for warning in _as_lines(dataset.attrs.get("run_warnings", ())):  # e.g. a stop never reached (a clearance typed in mm)
             print(f"warning: {warning}", file=sys.stderr)
-        failures = run_failures(dataset)  # read before the store (which a lazy dataset reads) goes
+        failures = run_failures(written)  # read before the store (which a lazy dataset reads) goes
+        del written
         report: Path | str | None = None
-        if scene.report and not args.no_report:
+        if reported:
             report = _report(path, out_dir, args.jobs)
             print(f"wrote {report}" if isinstance(report, Path) else report)
         if failures:

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable, Protocol
 
-from vibroimpact.reporting.style import DPI  # first: selects the Agg backend before pyplot is imported
+from vibroimpact.reporting.style import DPI, REPORT_RC, thin_minor_log_ticks  # first: selects the Agg backend before pyplot is imported
 
 import matplotlib.pyplot as plt  # noqa: E402
 import xarray as xr  # noqa: E402
@@ -117,6 +117,7 @@ def save_figure(drawn: DrawnFigure, out_dir: Path) -> Figure:
 def _png(figure: MatplotlibFigure) -> bytes:
     """The figure rendered to PNG bytes, then closed."""
     buffer = io.BytesIO()
+    thin_minor_log_ticks(figure)
     figure.savefig(buffer, format="png", dpi=DPI, bbox_inches="tight", pad_inches=0.08)
     plt.close(figure)
     return buffer.getvalue()
@@ -263,7 +264,7 @@ def write_report(dataset: xr.Dataset, out_dir: str | Path, jobs: int = 1) -> Pat
     out.mkdir(parents=True, exist_ok=True)
     record = study_record(dataset)
     page = page_for(dataset)
-    with rendering(jobs):
+    with rendering(jobs), plt.rc_context(REPORT_RC):
         sections = page.sections(out)
     if not getattr(page, "states_failures", False):  # a page that places them itself (bifurcation: before its tables)
         sections = with_failures(sections, run_failures(dataset), failure_details(dataset))
