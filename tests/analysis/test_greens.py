@@ -70,3 +70,24 @@ def test_paper_constant_velocity_is_wrong_near_resonance(system: TwoDofSystem) -
     assert rate(30.0) == pytest.approx(constant, rel=0.05)
     assert abs(rate(23.02) - constant) > 10 * abs(constant)
     assert abs(rate(36.07) - constant) > 10 * abs(constant)
+
+
+@pytest.mark.parametrize("antiperiodic", [False, True])
+@pytest.mark.parametrize("derivative", [0, 1, 2])
+def test_paired_sum_equals_the_full_sum(system: TwoDofSystem, derivative: int, antiperiodic: bool) -> None:
+    """Conjugate terms summed once (``paired``, the admissibility search's fast path) give the full sum to round-off,
+    for pairs of complex poles, for a real pole added (an overdamped term), and (every term taken) for poles that do not
+    pair."""
+    from vibroimpact.model.modal import PoleResidueModel
+
+    model = exact_pole_residue(system)
+    omega = 2 * np.pi * np.linspace(15.0, 45.0, 31)[:, None]
+    t = (np.pi / omega if antiperiodic else 2 * np.pi / omega) * np.linspace(0.0, 1.0, 33)[None, :]
+    with_real = PoleResidueModel(np.append(model.poles, -300.0 + 0j), np.append(model.residues, 0.02 + 0j))
+    unpaired = PoleResidueModel(model.poles[:3], model.residues[:3])  # one pole lost its partner: no real sum any more
+    for case in (model, with_real, unpaired):
+        full = periodic_green(case, omega, t, derivative, antiperiodic)
+        paired = periodic_green(case, omega, t, derivative, antiperiodic, paired=True)
+        np.testing.assert_allclose(paired, full, rtol=0, atol=1e-13 * np.max(np.abs(full)))
+    # and the fast path is another sum (rounded otherwise), not the default one by another name
+    assert np.any(periodic_green(model, omega, t, derivative, antiperiodic, paired=True) != periodic_green(model, omega, t, derivative, antiperiodic))  # exact: differs in rounding

@@ -79,7 +79,7 @@ def _weights(poles: NDArray[np.complex128], t: NDArray[np.float64], period: NDAr
     return poles**derivative * np.exp(poles * t) / (1.0 - np.exp(poles * period))
 
 
-def periodic_green(model: PoleResidueModel, omega: ArrayLike, t: ArrayLike, derivative: int = 0, antiperiodic: bool = False) -> NDArray[np.float64]:
+def periodic_green(model: PoleResidueModel, omega: ArrayLike, t: ArrayLike, derivative: int = 0, antiperiodic: bool = False, paired: bool = False) -> NDArray[np.float64]:
     """Periodic Green function chi(t) (or its time derivative) for excitation angular frequency ``omega``.
 
     Parameters
@@ -95,6 +95,10 @@ def periodic_green(model: PoleResidueModel, omega: ArrayLike, t: ArrayLike, deri
         Order of the time derivative, >= 0.
     antiperiodic : bool
         The antiperiodic function psi (impulses of alternating sign every T/2), for 0 <= t <= T/2.
+    paired : bool
+        Sum each pair of complex-conjugate terms once (its real part doubled), with the coefficients computed once per
+        frequency: ~1.7x faster on a long time axis, equal to ~1e-16 relative but not bit for bit (the admissibility
+        search, whose samples only locate a maximum, uses it; every value a study reports takes the default).
 
     Returns
     -------
@@ -104,11 +108,33 @@ def periodic_green(model: PoleResidueModel, omega: ArrayLike, t: ArrayLike, deri
     w = np.asarray(omega, dtype=float)[..., None]
     tt = np.asarray(t, dtype=float)[..., None]
     period = 2.0 * np.pi / w
+    if paired:
+        p, residues, weight = _real_sum_terms(model)
+        # the coefficients once per frequency, then one exponential per time and pole (the time axis is the long one)
+        coefficient = residues * p**derivative / (1.0 + np.exp(p * 0.5 * period) if antiperiodic else 1.0 - np.exp(p * period))
+        return np.sum(weight * (coefficient * np.exp(p * tt)).real, axis=-1)
     p = model.poles
     if not antiperiodic:  # the paper's path, unchanged
         terms = model.residues * p**derivative * np.exp(p * tt) / (1.0 - np.exp(p * period))
         return np.sum(terms, axis=-1).real
     return np.sum(model.residues * _weights(p, tt, period, derivative, True), axis=-1).real
+
+
+def _real_sum_terms(model: PoleResidueModel) -> tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.float64]]:
+    """Poles, residues and weights whose weighted real parts sum to the model's real sums: a pair of complex-conjugate
+    poles (and residues) once, its real part doubled, a real pole once; every term once (weight 1) if the poles do not
+    pair. The periodic sums of a real structure then cost half the exponentials."""
+    p, r = model.poles, model.residues
+    upper, real = p.imag > 0.0, p.imag == 0.0  # exact: a real pole is one whose imaginary part is zero
+    lower = np.flatnonzero(p.imag < 0.0)
+    if lower.size != np.count_nonzero(upper):
+        return p, r, np.ones(p.shape)
+    partner = [lower[np.argmin(np.abs(p[lower] - np.conj(pole)))] for pole in p[upper]]
+    scale = np.max(np.abs(p)) if p.size else 1.0
+    if len(set(partner)) != len(partner) or np.any(np.abs(p[partner] - np.conj(p[upper])) > 1e-14 * scale) or np.any(np.abs(r[partner] - np.conj(r[upper])) > 1e-14 * np.max(np.abs(r))):
+        return p, r, np.ones(p.shape)
+    keep = upper | real
+    return p[keep], r[keep], np.where(real[keep], 1.0, 2.0)
 
 
 def green_vector(modes: ModalResponse, omega: ArrayLike, t: ArrayLike, derivative: int = 0, antiperiodic: bool = False) -> NDArray[np.float64]:

@@ -217,8 +217,9 @@ class ImpactOrbit:
         green = green_vector(self.modes, w, local, derivative, self.two_sided)
         return linear - sign * self.impulse[..., None, None] * green
 
-    def coordinate(self, t: ArrayLike, derivative: int = 0) -> NDArray[np.float64]:
-        """u(t) = n . x(t) of the (upper) stop (or a derivative), shape S + (m,)."""
+    def coordinate(self, t: ArrayLike, derivative: int = 0, paired: bool = False) -> NDArray[np.float64]:
+        """u(t) = n . x(t) of the (upper) stop (or a derivative), shape S + (m,); ``paired``: conjugate terms summed
+        once (:func:`~vibroimpact.analysis.greens.periodic_green`: faster, equal to round-off, not bit for bit)."""
         tt = np.asarray(t, dtype=float)
         w = self.omega[..., None]
         angle = w * tt + self.phase[..., None] + derivative * np.pi / 2.0
@@ -230,7 +231,7 @@ class ImpactOrbit:
             half = self.window[..., None]
             later = tt > half
             local, sign = np.where(later, tt - half, tt), np.where(later, -1.0, 1.0)
-        return linear - sign * self.impulse[..., None] * periodic_green(self.modes.output(self.normal), w, local, derivative, self.two_sided)
+        return linear - sign * self.impulse[..., None] * periodic_green(self.modes.output(self.normal), w, local, derivative, self.two_sided, paired)
 
     def state(self, t: ArrayLike) -> NDArray[np.float64]:
         """(x, x') at times ``t`` from the impact, shape S + (m, 2N)."""
@@ -329,7 +330,7 @@ class ImpactOrbit:
     def _max_overshoot(self, fractions: NDArray[np.float64]) -> NDArray[np.float64]:
         window = self.window[..., None]
         t = fractions * window
-        u = self.coordinate(t)
+        u = self.coordinate(t, paired=True)  # the samples only locate the maximum, which the Newton steps refine
         delta = self.clearance[..., None]
         excess = u - delta
         if self.two_sided:
@@ -342,7 +343,7 @@ class ImpactOrbit:
         # refine u's maximum, or (two-sided, where the lower stop is nearer) its minimum
         side = np.sign(np.take_along_axis(u, k[..., None], axis=-1)) if self.two_sided else np.ones(k.shape + (1,))
         for _ in range(8):
-            slope, curvature = side * self.coordinate(tk, 1), side * self.coordinate(tk, 2)
+            slope, curvature = side * self.coordinate(tk, 1, paired=True), side * self.coordinate(tk, 2, paired=True)
             with np.errstate(divide="ignore", invalid="ignore"):
                 step = np.where(curvature < 0.0, -slope / curvature, 0.0)
             tk = np.clip(tk + np.nan_to_num(step), lo, hi)

@@ -25,7 +25,6 @@ from vibroimpact.runs.runner import Runner
 from vibroimpact.model.layout import stop_descriptions
 from vibroimpact.reporting.solutions import solution_method
 from vibroimpact.scene.schema import Scene, GRID_DIMS, STOP_QUANTITIES, ENGINE_SOLUTIONS
-from vibroimpact.kinds.stepped.operating import unreached_text
 from vibroimpact.simulation.settings import SWEEP_STARTS
 
 __all__ = ["general_orbit_outlook", "UNKNOWN_WANDERING", "general_block", "general_coordinates", "SteppedStudy", "expected_periods", "SETTLING_PERIODS", "SHOOTING_PERIODS", "ESTIMATE_POINTS"]
@@ -133,6 +132,8 @@ class SteppedStudy:
         dataset = describe_stops(raw.assign_coords(coords))
         say(f"{', '.join(solutions)}: done")
         finished = finish_dataset(dataset, scene, coords, self.simulation_attributes(scene))
+        from vibroimpact.kinds.stepped.operating import unreached_text  # a page's module (matplotlib): not on the workers
+
         unreached = unreached_text(finished)  # a clearance typed in mm runs silently else: run-study says it in one line
         if unreached:
             finished.attrs["run_warnings"] = [unreached]
