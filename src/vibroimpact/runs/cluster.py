@@ -20,7 +20,7 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["SCHEDULER_VARIABLE", "ClusterLost", "SyncCancelRace", "Connection", "choose_scheduler", "connect", "Terminated", "unreachable", "dask_setup", "Progress", "ProgressReport", "Throttled", "ProgressBar", "REPORT_INTERVAL", "HEARTBEAT"]
+__all__ = ["WORKER_LIBRARIES", "import_libraries", "SCHEDULER_VARIABLE", "ClusterLost", "SyncCancelRace", "Connection", "choose_scheduler", "connect", "Terminated", "unreachable", "dask_setup", "Progress", "ProgressReport", "Throttled", "ProgressBar", "REPORT_INTERVAL", "HEARTBEAT"]
 
 #: The environment variable naming a running scheduler (``tcp://host:8786``).
 SCHEDULER_VARIABLE = "VIBROIMPACT_SCHEDULER"
@@ -35,6 +35,11 @@ WORKER_ENVIRONMENT = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_
 #: for a dashboard the study does not show; 36 blocks of the design map on 2 workers: 6.6 s with it, 6.1 s without,
 #: the mean of 3 interleaved runs each).
 WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ": WORKER_ENVIRONMENT, "distributed.worker.profile.enabled": False}
+#: The libraries a study's code imports on a worker, imported as the workers start (:func:`import_libraries`), while
+#: the study's process imports its own code; none holds a compiled kernel of the package's (those load only after the
+#: study's process has compiled them: :class:`~vibroimpact.runs.kernel_loader.KernelLoader`). restitution.yaml: the
+#: first task began ~2.6 s after the cluster was up, of which ~1.2 s imported these.
+WORKER_LIBRARIES = ("numpy", "scipy.integrate", "scipy.optimize", "scipy.linalg", "xarray", "zarr", "numba", "dask.array")
 #: How long connecting to a named scheduler may take before the study gives up [s].
 CONNECT_TIMEOUT = 30.0
 
@@ -250,6 +255,15 @@ def _cluster_blocking_ctrl_c() -> object:
         return LocalCluster(n_workers=0, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL, preload=[__name__])
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
+
+
+async def import_libraries() -> None:
+    """Import :data:`WORKER_LIBRARIES` (run on each worker as it starts: ``Client.run``, which runs only a coroutine
+    without waiting for it)."""
+    import importlib
+
+    for name in WORKER_LIBRARIES:
+        importlib.import_module(name)
 
 
 def dask_setup(worker: object) -> None:

@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 
 from vibroimpact import __version__
 from vibroimpact.engines.registry import engine_spec
-from vibroimpact.runs.cluster import ClusterLost, Connection, connect, leave_quietly, ProgressBar, ProgressReport, Throttled
+from vibroimpact.runs.cluster import ClusterLost, Connection, connect, import_libraries, leave_quietly, ProgressBar, ProgressReport, Throttled
 from vibroimpact.runs.store import source_hash, StudyStore
 
 __all__ = ["Case", "CaseResult", "ProgressReport", "Runner", "TaskFunction", "OtherCode", "WorkerDied", "MAX_CASES_PER_TASK"]
@@ -108,15 +108,32 @@ class Runner:
 
     @property
     def connection(self) -> Connection:
-        """The dask connection, started on first use."""
+        """The dask connection, started on first use (or by :meth:`start`)."""
         if self._connection is None:
             self._connection = connect(self.jobs, self.scheduler)
-            if any(engine_spec(name).capabilities.compiled for name in self.engines):
-                from vibroimpact.runs.kernel_loader import KernelLoader
-
-                # every worker, and any that joins later, loads the kernels before it takes a task
-                self._connection.client.register_plugin(KernelLoader(self.engines), name="vibroimpact-kernels")  # type: ignore[attr-defined]
+            self._load_kernels()
         return self._connection
+
+    def start(self) -> None:
+        """Start the dask connection now, if work goes to dask workers: the workers start and import their libraries
+        (:data:`~vibroimpact.runs.cluster.WORKER_LIBRARIES`) while this process goes on (importing the study's code);
+        the engines' kernels load on the workers once :meth:`use_engines` names them."""
+        if self.distributed and self._connection is None:
+            self.connection.client.run(import_libraries, wait=False)  # type: ignore[attr-defined]
+
+    def use_engines(self, engines: Sequence[str]) -> None:
+        """The registered engines the work runs, their kernels compiled in this process by now
+        (:func:`vibroimpact.runs.run.prepare_engines`): each worker loads them before its next task."""
+        self.engines = tuple(engines)
+        if self._connection is not None:
+            self._load_kernels()
+
+    def _load_kernels(self) -> None:
+        if self._connection is not None and any(engine_spec(name).capabilities.compiled for name in self.engines):
+            from vibroimpact.runs.kernel_loader import KernelLoader
+
+            # every worker, and any that joins later, loads the kernels before it takes a task
+            self._connection.client.register_plugin(KernelLoader(self.engines), name="vibroimpact-kernels")  # type: ignore[attr-defined]
 
     @property
     def workers(self) -> int:

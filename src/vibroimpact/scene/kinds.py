@@ -40,6 +40,10 @@ class Kind:
         ``"module:class"`` of the kind's study: ``run(scene, progress, runner)`` and ``estimate(scene, jobs, costs)``.
     page : str
         ``"module:function"`` that chooses the report page of a dataset of this kind, ``function(dataset) -> page``.
+    shares_work : bool
+        Whether the kind's run shares its work among a runner's dask workers (then a local cluster starts before the
+        kind's code is imported, its workers starting meanwhile); False: it runs in the study's process (timings a
+        starting cluster would disturb).
     """
 
     name: str
@@ -47,6 +51,7 @@ class Kind:
     scene: str
     study: str
     page: str
+    shares_work: bool = True
 
     def __post_init__(self) -> None:
         for field in ("scene", "study", "page"):
@@ -76,8 +81,8 @@ def _resolve(target: str) -> Any:
 KINDS: tuple[Kind, ...] = (
     Kind("design", "design", "vibroimpact.kinds.design.scene:parse_design_scene", "vibroimpact.kinds.design.study:DesignStudy", "vibroimpact.kinds.design.page:page_for"),
     Kind("concepts", "concepts", "vibroimpact.kinds.concepts.scene:parse_concepts_scene", "vibroimpact.kinds.concepts.study:ConceptsStudy", "vibroimpact.kinds.concepts.page:page_for"),
-    Kind("validation", "validation", "vibroimpact.kinds.validation.scene:parse_validation_scene", "vibroimpact.kinds.validation.study:ValidationStudy", "vibroimpact.kinds.validation.page:page_for"),
-    Kind("benchmark", "benchmark", "vibroimpact.kinds.benchmark.scene:parse_benchmark_scene", "vibroimpact.kinds.benchmark.study:BenchmarkStudy", "vibroimpact.kinds.benchmark.page:page_for"),
+    Kind("validation", "validation", "vibroimpact.kinds.validation.scene:parse_validation_scene", "vibroimpact.kinds.validation.study:ValidationStudy", "vibroimpact.kinds.validation.page:page_for", shares_work=False),
+    Kind("benchmark", "benchmark", "vibroimpact.kinds.benchmark.scene:parse_benchmark_scene", "vibroimpact.kinds.benchmark.study:BenchmarkStudy", "vibroimpact.kinds.benchmark.page:page_for", shares_work=False),
     Kind("bifurcation", "bifurcation", "vibroimpact.kinds.bifurcation.scene:parse_bifurcation_scene", "vibroimpact.kinds.bifurcation.study:BifurcationStudy", "vibroimpact.kinds.bifurcation.page:page_for"),
     Kind("swept", "swept_sine", "vibroimpact.kinds.swept.scene:parse_swept_scene", "vibroimpact.kinds.swept.study:SweptStudy", "vibroimpact.kinds.swept.page:page_for"),
     Kind("stepped", None, "vibroimpact.kinds.stepped.scene:parse_stepped_scene", "vibroimpact.kinds.stepped.study:SteppedStudy", "vibroimpact.kinds.stepped.page:page_for"),
