@@ -19,10 +19,11 @@ def _libraries_loaded() -> bool:
     return all(name in sys.modules for name in WORKER_LIBRARIES)
 
 
-def test_started_workers_import_their_libraries_before_any_task() -> None:
-    with Runner(jobs=2, progress=False) as runner:
+def test_started_workers_import_their_libraries_before_any_task(capsys: pytest.CaptureFixture[str]) -> None:
+    with Runner(jobs=2, progress=True) as runner:
         runner.start()
         assert runner._connection is not None  # started now, not at the first task
+        assert capsys.readouterr().err == "starting 2 worker processes\n"  # the start's wait is said before it
         client = runner.connection.client
         deadline = time.monotonic() + 60.0
         loaded = client.run(_libraries_loaded)  # type: ignore[attr-defined]
