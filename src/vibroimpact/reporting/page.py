@@ -40,8 +40,9 @@ from vibroimpact.scene.kinds import kind_named  # noqa: E402
 
 __all__ = ["DrawnFigure", "Figure", "Table", "Section", "StudyPage", "save_figure", "saved", "rendering", "render_page", "write_page", "write_report", "with_failures", "page_for"]
 
-#: The processes that render figures to PNG while :func:`rendering` is active (None: this process).
-_RENDERERS: ContextVar[Executor | None] = ContextVar("renderers", default=None)
+#: The processes that render figures while :func:`rendering` is active, and the figures handed to them (their PNG
+#: paths and pending bytes); None: this process renders.
+_RENDERERS: ContextVar[tuple[Executor, list[tuple[Path, "Future[bytes]"]]] | None] = ContextVar("renderers", default=None)
 
 
 @dataclass(frozen=True)
@@ -129,34 +130,48 @@ def _png_of_pickle(data: bytes) -> bytes:
 
 
 def _write(drawn: DrawnFigure, png: bytes, out_dir: Path) -> Figure:
-    path = Path(out_dir) / f"{drawn.name}.png"
+    path = _png_path(drawn, out_dir)
+    _write_png(path, png)
+    return Figure(path, drawn.title, drawn.caption)
+
+
+def _png_path(drawn: DrawnFigure, out_dir: Path) -> Path:
+    return Path(out_dir) / f"{drawn.name}.png"
+
+
+def _write_png(path: Path, png: bytes) -> None:
     with atomic_path(path) as temporary:
         temporary.write_bytes(png)
-    return Figure(path, drawn.title, drawn.caption)
 
 
 @contextmanager
 def rendering(jobs: int) -> Iterator[None]:
-    """Inside, :func:`saved` renders figures to PNG in ``jobs`` processes (rendering is most of a report's time:
-    ~0.6 s per figure of a 30 000-point study); ``jobs`` <= 1 renders here."""
+    """Inside, :func:`saved` hands figures to ``jobs`` processes that render them to PNG (rendering is most of a
+    report's time: ~0.5 s per figure of a 30 000-point study) and returns at once, so the page draws its next figures
+    meanwhile; the files are written as the context ends (before the page is). ``jobs`` <= 1 renders here."""
     if jobs <= 1:
         yield
         return
+    pending: list[tuple[Path, Future[bytes]]] = []
     with ProcessPoolExecutor(max_workers=jobs) as pool:
-        token = _RENDERERS.set(pool)
+        token = _RENDERERS.set((pool, pending))
         try:
             yield
         finally:
             _RENDERERS.reset(token)
+        for path, png in pending:
+            _write_png(path, png.result())
 
 
 def saved(drawn: Iterable[DrawnFigure | None], out: Path) -> list[Figure]:
-    """Write each drawn figure (skipping None): as soon as it comes, so that few are open at once, or, inside
-    :func:`rendering`, handed pickled to the rendering processes (a figure that cannot be pickled is rendered here)."""
-    pool = _RENDERERS.get()
-    if pool is None:
+    """Each drawn figure's record (skipping None): written as soon as it comes, so that few are open at once, or,
+    inside :func:`rendering`, handed pickled to the rendering processes and written when the context ends (a figure
+    that cannot be pickled is written here and now)."""
+    renderers = _RENDERERS.get()
+    if renderers is None:
         return [save_figure(figure, out) for figure in drawn if figure is not None]
-    pending: list[tuple[DrawnFigure, Future[bytes] | bytes]] = []
+    pool, pending = renderers
+    figures = []
     for figure in drawn:
         if figure is None:
             continue
@@ -164,11 +179,13 @@ def saved(drawn: Iterable[DrawnFigure | None], out: Path) -> list[Figure]:
             data = pickle.dumps(figure.figure)
         except Exception:  # noqa: BLE001 - any figure that does not pickle (a lambda formatter; pandas caches filled
             # while being pickled: "dictionary changed size during iteration", seen on clearance_peaks) is drawn here
-            pending.append((figure, _png(figure.figure)))
+            figures.append(save_figure(figure, out))
             continue
         plt.close(figure.figure)
-        pending.append((figure, pool.submit(_png_of_pickle, data)))
-    return [_write(figure, png if isinstance(png, bytes) else png.result(), out) for figure, png in pending]
+        path = _png_path(figure, out)
+        pending.append((path, pool.submit(_png_of_pickle, data)))
+        figures.append(Figure(path, figure.title, figure.caption))
+    return figures
 
 
 _STYLE = (
