@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 
 from vibroimpact.scene import Scene, SceneError, find_scene, load_scene, shipped_studies
-from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, ClusterLost, Terminated, choose_scheduler, leave_quietly, unreachable
+from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, ClusterLost, Terminated, choose_scheduler, dashboard_address, leave_quietly, unreachable
 
 if TYPE_CHECKING:  # the run's modules (xarray, zarr, dask) load only once a study runs: help, --list and a refused
     from vibroimpact.runs.store import StudyStore  # scene answer without them
@@ -121,6 +121,12 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     if args.estimate:
         return _estimate(scene, args.jobs, args.costs, args.workers)
+    if scheduler is None and args.jobs > 1:
+        try:
+            dashboard_address()  # the local cluster's dashboard: loopback unless $VIBROIMPACT_DASHBOARD says where
+        except ValueError as error:
+            print(f"run-study: error: {error}", file=sys.stderr)
+            return EXIT_BAD_INPUT
     if scheduler is not None and (why := unreachable(scheduler)) is not None:
         print(f"run-study: error: cannot reach the dask scheduler at {scheduler} (--scheduler, ${SCHEDULER_VARIABLE} or the scene's cluster.scheduler): {why}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -20,10 +20,16 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["WORKER_LIBRARIES", "import_libraries", "SCHEDULER_VARIABLE", "ClusterLost", "SyncCancelRace", "Connection", "choose_scheduler", "connect", "Terminated", "unreachable", "dask_setup", "Progress", "ProgressReport", "Throttled", "ProgressBar", "REPORT_INTERVAL", "HEARTBEAT"]
+__all__ = ["WORKER_LIBRARIES", "import_libraries", "DASHBOARD_VARIABLE", "DEFAULT_DASHBOARD", "dashboard_address", "SCHEDULER_VARIABLE", "ClusterLost", "SyncCancelRace", "Connection", "choose_scheduler", "connect", "Terminated", "unreachable", "dask_setup", "Progress", "ProgressReport", "Throttled", "ProgressBar", "REPORT_INTERVAL", "HEARTBEAT"]
 
 #: The environment variable naming a running scheduler (``tcp://host:8786``).
 SCHEDULER_VARIABLE = "VIBROIMPACT_SCHEDULER"
+#: The environment variable giving the local cluster's dask dashboard address (``HOST:PORT``; port 0: any free one).
+DASHBOARD_VARIABLE = "VIBROIMPACT_DASHBOARD"
+#: Where the local cluster's dashboard listens unless :data:`DASHBOARD_VARIABLE` says otherwise: loopback only (it
+#: shows worker addresses, local paths, memory and call stacks), on any free port. The scheduler and the workers listen
+#: on loopback too (dask's default for a local cluster).
+DEFAULT_DASHBOARD = "127.0.0.1:0"
 #: Environment of a local cluster's worker processes, set before they start: dask's default but for its
 #: MALLOC_TRIM_THRESHOLD_ (glibc returning freed memory above 64 KiB to the system at once, 4 % more time for the
 #: exact engine's many small arrays, measured in one process), and one malloc arena (a worker computes in a thread).
@@ -46,6 +52,23 @@ CONNECT_TIMEOUT = 30.0
 
 class ClusterLost(RuntimeError):
     """The dask scheduler went away (or could not be reached) while a study ran."""
+
+
+def dashboard_address() -> str:
+    """The local cluster's dashboard address: ``$VIBROIMPACT_DASHBOARD`` or :data:`DEFAULT_DASHBOARD`.
+
+    Raises
+    ------
+    ValueError
+        When the variable is not ``HOST:PORT`` with a port in [0, 65535] (an empty host: every interface, said so).
+    """
+    value = os.environ.get(DASHBOARD_VARIABLE, "").strip()
+    if not value:
+        return DEFAULT_DASHBOARD
+    host, colon, port = value.rpartition(":")
+    if not colon or not port.isdigit() or not 0 <= int(port) <= 65535 or len(value) > 300:
+        raise ValueError(f"${DASHBOARD_VARIABLE} = {value[:80]!r}: allowed HOST:PORT with a port in [0, 65535] (e.g. 127.0.0.1:8787; ':8787' listens on every interface)")
+    return value
 
 
 def choose_scheduler(option: str | None, scene_scheduler: str | None) -> str | None:
@@ -249,10 +272,11 @@ def _cluster_blocking_ctrl_c() -> object:
 
     from distributed import LocalCluster
 
+    dashboard = dashboard_address()  # checked before anything starts
     resource_tracker.ensure_running()
     blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
-        return LocalCluster(n_workers=0, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL, preload=[__name__])
+        return LocalCluster(n_workers=0, threads_per_worker=1, processes=True, dashboard_address=dashboard, silence_logs=logging.CRITICAL, preload=[__name__])
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
 
