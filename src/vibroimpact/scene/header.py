@@ -13,17 +13,19 @@ from typing import Any
 from vibroimpact.scene.checker import Checker
 from vibroimpact.scene.schema import MAX_SWEEP_SAMPLES
 
-__all__ = ["NAME", "parse_names", "parse_cluster", "check_sweep_run"]
+__all__ = ["NAME", "MAX_NAME_LENGTH", "parse_names", "parse_cluster", "check_sweep_run"]
 
-#: A scene's or a case's name: safe as a file name.
-NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+#: A scene's or a case's name: safe as a file name, at most :data:`MAX_NAME_LENGTH` characters (the run writes
+#: ``.<name>.zarr.removed-<pid>`` and the like, within the 255 bytes a file name may take).
+MAX_NAME_LENGTH = 100
+NAME = re.compile(rf"^[A-Za-z0-9][A-Za-z0-9_.-]{{0,{MAX_NAME_LENGTH - 1}}}$")
 
 
 def parse_names(c: Checker, doc: dict, pages: tuple[str, ...] = ()) -> tuple[Any, str, bool | str]:
     """Name, description and the report switch of any scene (or one of ``pages``, the report pages it may name)."""
     name = doc.get("name")
     if "name" in doc and not (isinstance(name, str) and NAME.match(name)):
-        c.fail("name", f"expected a file-name-safe string (letters, digits, '_', '-', '.'), got {name!r}")
+        c.fail("name", f"expected a file-name-safe string of at most {MAX_NAME_LENGTH} characters (letters, digits, '_', '-', '.'), got {name!r}")
     description = doc.get("description", "")
     if not isinstance(description, str):
         c.fail("description", f"expected a string, got {type(description).__name__}")

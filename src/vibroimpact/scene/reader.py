@@ -62,6 +62,9 @@ _UniqueKeyLoader.add_implicit_resolver(
 #: Most nodes a scene may hold once its aliases are expanded (the largest shipped scene holds a few hundred): aliases
 #: that multiply (`a: [*b, *b, ...]` nested, "billion laughs") are refused before anything reads the values.
 MAX_EXPANDED_NODES = 100_000
+#: Most characters a scene's values may hold once its aliases are expanded (the largest shipped scene is ~6 kB): a
+#: long string repeated by aliases (a "bytes bomb": 90 000 aliases of 200 kB) is refused before anything reads it.
+MAX_EXPANDED_CHARACTERS = 1_000_000
 
 
 def read_yaml(text: str) -> Any:
@@ -81,6 +84,8 @@ def read_yaml(text: str) -> Any:
         size = _expanded_size(node, {}, 0)
         if size > MAX_EXPANDED_NODES:
             raise yaml.YAMLError(f"its aliases expand to more than {MAX_EXPANDED_NODES} values (a scene needs a few hundred); refused before reading them")
+        if _expanded_characters(node, {}) > MAX_EXPANDED_CHARACTERS:
+            raise yaml.YAMLError(f"its values hold more than {MAX_EXPANDED_CHARACTERS} characters once its aliases are expanded (a scene holds a few thousand); refused before reading them")
         try:
             return loader.construct_document(node)
         except ValueError as error:  # Python's limit on the digits of an integer (4300), as PyYAML lets it through
@@ -107,6 +112,25 @@ def _expanded_size(node: yaml.Node, sizes: dict[int, int], depth: int) -> int:
         for key, value in node.value:
             total += _expanded_size(key, sizes, depth + 1) + _expanded_size(value, sizes, depth + 1)
             if total > MAX_EXPANDED_NODES:
+                break
+    sizes[id(node)] = total
+    return total
+
+
+def _expanded_characters(node: yaml.Node, sizes: dict[int, int]) -> int:
+    """Characters of the scalars under ``node`` with every alias expanded (after :func:`_expanded_size` bounded the
+    nodes and their depth), counted up to just past :data:`MAX_EXPANDED_CHARACTERS`."""
+    known = sizes.get(id(node))
+    if known is not None:
+        return known
+    total = 0
+    if isinstance(node, yaml.ScalarNode):
+        total = len(node.value)
+    else:
+        children = node.value if isinstance(node, yaml.SequenceNode) else [part for pair in node.value for part in pair]
+        for child in children:
+            total += _expanded_characters(child, sizes)
+            if total > MAX_EXPANDED_CHARACTERS:
                 break
     sizes[id(node)] = total
     return total
