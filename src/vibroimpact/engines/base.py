@@ -15,7 +15,7 @@ from vibroimpact.engines.registry import Capabilities
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import Contact, ImpactProblem
 
-__all__ = ["Trajectory", "TrajectoryBuilder", "SweepRecord", "Engine", "SweepingEngine", "check_run", "MODE_FREE", "MODE_STUCK"]
+__all__ = ["Trajectory", "TrajectoryBuilder", "SweepRecord", "Engine", "SweepingEngine", "check_run", "start_state", "MODE_FREE", "MODE_STUCK"]
 
 #: Segment modes of a trajectory.
 MODE_FREE, MODE_STUCK = 0, 1
@@ -316,3 +316,23 @@ def check_run(engine: str, problem: ImpactProblem, contact: type[Contact], perio
     for k, stop in enumerate(problem.stops):
         if not isinstance(stop.law, contact):
             raise TypeError(f"engine {engine!r} solves a {contact.__name__}, not stop {k}'s contact = {stop.law!r}")
+
+
+def start_state(problem: ImpactProblem, state: NDArray[np.float64], t_start: float) -> NDArray[np.float64]:
+    """``state`` (x, x') as a writable C-ordered copy, after checking it and ``t_start`` [s] as every run does first: 2 N
+    finite values and a finite time (a NaN or an infinity would make an event loop search for ever).
+
+    Raises
+    ------
+    ValueError
+        Naming ``state`` or ``t_start`` and what is wrong with it.
+    """
+    values = np.array(state, dtype=float, order="C")  # a writable copy: one compiled overload (a read-only array would compile another)
+    if values.shape != (2 * problem.size,):
+        raise ValueError(f"state: expected {2 * problem.size} values (x and x' of {problem.size} coordinates), got shape {values.shape}")
+    if not np.all(np.isfinite(values)):
+        bad = int(np.flatnonzero(~np.isfinite(values))[0])
+        raise ValueError(f"state: expected finite values [m, m s-1], got {values[bad]!r} at index {bad}")
+    if not math.isfinite(float(t_start)):
+        raise ValueError(f"t_start = {float(t_start)!r} s: expected a finite time")
+    return values

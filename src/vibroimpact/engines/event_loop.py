@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.engines.registry import INTEGRATOR, Capabilities
-from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory, TrajectoryBuilder
+from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory, TrajectoryBuilder, start_state
 from vibroimpact.engines.flow_layout import flow_layout
 from vibroimpact.engines.rigid_kernels import RigidContact, APEX, STUCK, events_kernel, holding_kernel, jacobian_kernel, pack_parameters, quadrature_count, rhs_kernel
 from vibroimpact.engines.settings import EngineSettings
@@ -258,10 +258,8 @@ class EventLoopEngine(ABC):
     def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, outputs: Outputs | None) -> Trajectory:
         """:meth:`integrate`, recording the states at the times of ``outputs`` if given."""
         law = RigidContact(self.name, problem, self.settings, periods)
-        state = np.asarray(state, dtype=float)
+        state = start_state(problem, state, t_start)  # finite, 2 N values
         n = problem.size
-        if state.shape != (2 * n,):
-            raise ValueError(f"state: expected {2 * n} values (x and x' of {n} coordinates), got shape {state.shape}")
         law.check_start(state)
         model = Model(problem, moments)
         layout = model.layout

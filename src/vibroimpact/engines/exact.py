@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines.registry import ENGINES, Capabilities
 from vibroimpact.engines import exact_core, exact_moments
-from vibroimpact.engines.base import MODE_STUCK, Trajectory, check_run
+from vibroimpact.engines.base import MODE_STUCK, Trajectory, check_run, start_state
 from vibroimpact.engines.exact_flows import Flow, ExactModel, build_model
 from vibroimpact.engines.exact_python import PythonExactEngine
 from vibroimpact.engines.kernel_arguments import LoopArguments, StackedFlows, leading_arguments
@@ -203,9 +203,7 @@ class ExactEngine:
     def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, jacobians: bool, approach: bool) -> tuple:
         check_run(self.name, problem, RigidStop, periods)
         setup = loop_setup(problem, self.settings)
-        state = np.array(state, dtype=float, order="C")  # a writable copy: one compiled overload (a read-only array would compile another, ~10 s)
-        if state.shape != (2 * problem.size,):
-            raise ValueError(f"state: expected {2 * problem.size} values (x and x' of {problem.size} coordinates), got shape {state.shape}")
+        state = start_state(problem, state, t_start)  # finite, 2 N values, a writable copy (one compiled overload)
         setup.law.check_start(state)
         out = exact_core.run_periods(*setup.arguments, state, float(t_start), int(periods), moments, jacobians, approach)
         if out[0] == exact_core.STATUS_NO_PROGRESS:

@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.engines.registry import ENGINES, Capabilities
-from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory, TrajectoryBuilder
+from vibroimpact.engines.base import MODE_FREE, MODE_STUCK, Trajectory, TrajectoryBuilder, start_state
 from vibroimpact.engines.exact_flows import ExactModel, build_model
 from vibroimpact.engines.linear_flow import HarmonicLinearFlow, Observable, Piece, escape_step, first_crossing, gauss_legendre
 from vibroimpact.engines.rigid_kernels import RigidContact
@@ -44,7 +44,7 @@ class PythonExactEngine:
     def integrate(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False) -> Trajectory:
         """Integrate ``periods`` whole periods from ``state`` (x, x') at ``t_start`` [s]."""
         run = _Run(RigidContact(self.name, problem, self.settings, periods), problem, TrajectoryBuilder(problem, moments))
-        return run.go(np.asarray(state, dtype=float), float(t_start), int(periods))
+        return run.go(start_state(problem, state, t_start), float(t_start), int(periods))
 
     def sample(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, times: NDArray[np.float64]) -> tuple[Trajectory, NDArray[np.float64]]:
         """Integrate ``periods`` periods from ``state`` at ``t_start`` [s] and give the states at ``times`` [s] (inside

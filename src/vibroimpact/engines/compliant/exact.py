@@ -34,7 +34,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.engines.base import MODE_FREE, Trajectory, check_run
+from vibroimpact.engines.base import MODE_FREE, Trajectory, check_run, start_state
 from vibroimpact.engines.compliant import exact_loop
 from vibroimpact.engines.compliant.period_shooting import PeriodOrbit, shoot_period
 from vibroimpact.engines.compliant.model import MODE_CONTACT
@@ -235,9 +235,7 @@ class CompliantExactEngine:
         check_run(self.name, problem, KelvinVoigtBumper, periods)
         problem.harmonic  # TypeError naming the excitation if it is not harmonic (a sweep has no closed form)
         setup = _setup(problem, self.settings)
-        state = np.array(state, dtype=float, order="C")  # a writable copy: one compiled overload
-        if state.shape != (2 * problem.size,):
-            raise ValueError(f"state: expected {2 * problem.size} values (x and x' of {problem.size} coordinates), got shape {state.shape}")
+        state = start_state(problem, state, t_start)  # finite, 2 N values, a writable copy (one compiled overload)
         out = exact_loop.run_bumper_periods(*setup.arguments, state, float(t_start), int(periods), bool(moments), bool(jacobians), bool(approach))
         if out[0] == exact_loop.STATUS_NO_PROGRESS:
             raise RuntimeError(f"no progress at t = {out[1]!r} s: more than {10 * self.settings.max_impacts_per_period} contact switches in one period")
