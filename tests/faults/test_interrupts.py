@@ -51,6 +51,28 @@ def test_ctrl_c_while_the_workers_start_stops_the_run_in_one_line(tmp_path: Path
 
 @pytest.mark.faults
 @pytest.mark.timeout(480)
+def test_sigterm_while_the_workers_start_is_said_as_sigterm(tmp_path: Path) -> None:
+    """A batch system's SIGTERM (to the study's process alone) while its workers start: every line it prints says
+    SIGTERM, none "interrupted" (issue 34: it was said as a Ctrl-C)."""
+    run = start_run_study([str(_slow_scene(tmp_path)), "--out", "out", "--jobs", "2"], tmp_path)
+    lines: list[str] = []
+    reader = _reader(run.stderr, lines)
+    _wait_for(run, lines, "starting 2 worker processes", time.monotonic() + 120.0)
+    assert run.poll() is None, "".join(lines)
+    time.sleep(0.3)  # the cluster takes ~1 s to start on a quiet machine
+    run.send_signal(signal.SIGTERM)
+    run.wait(timeout=120)
+    reader.join(timeout=10)
+    run.stdout.close()  # type: ignore[union-attr]
+    run.stderr.close()  # type: ignore[union-attr]
+    err = "".join(lines)
+    assert run.returncode == 143, err
+    assert "interrupted" not in err and "Traceback" not in err, err
+    assert err.rstrip().splitlines()[-1] == "terminated (SIGTERM): nothing had finished yet; run the same command to start again", err
+
+
+@pytest.mark.faults
+@pytest.mark.timeout(480)
 def test_sigterm_ends_the_run_like_ctrl_c_with_its_blocks_kept(tmp_path: Path) -> None:
     run = start_run_study([str(_slow_scene(tmp_path)), "--out", "out", "--jobs", "2"], tmp_path)
     store = tmp_path / "out" / "interrupted.zarr"

@@ -219,8 +219,9 @@ def _start_local_cluster(jobs: int) -> Connection:
 
     def record(signum: int, _frame: object) -> None:
         leave_quietly()
-        if not interrupted:
-            print("\ninterrupted: stopping the workers as they start", file=sys.stderr, flush=True)
+        if not interrupted:  # SIGTERM (a batch system, `timeout`) is said as itself, not as a Ctrl-C
+            what = "terminated (SIGTERM)" if signum == signal.SIGTERM else "interrupted"
+            print(f"\n{what}: stopping the workers as they start", file=sys.stderr, flush=True)
         interrupted.append(signum)
 
     def stop_if_interrupted(cluster: object | None, client: object | None) -> None:
