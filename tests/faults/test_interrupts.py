@@ -123,3 +123,22 @@ def test_a_server_that_is_not_a_dask_scheduler_is_refused_within_seconds() -> No
     finally:
         server.shutdown()
     assert unreachable("foo://bar") == "unknown address scheme 'foo': dask knows inproc, tcp, tls, ucx, ws, wss (e.g. tcp://host:8786)"
+
+
+@pytest.mark.faults
+@pytest.mark.timeout(300)
+@pytest.mark.parametrize("delay", [0.05, 0.15, 0.3])
+def test_ctrl_c_while_the_command_imports_is_one_line(tmp_path: Path, delay: float) -> None:
+    """Ctrl-C in the first fraction of a second, while ``run-study`` imports its command line (no handler of the
+    study's yet): exit 130 and one line, no KeyboardInterrupt traceback (issue 34: 3 of 5 such runs printed one)."""
+    import subprocess
+    import sys
+
+    run = subprocess.Popen([sys.executable, "-m", "vibroimpact.entry", str(_slow_scene(tmp_path)), "--out", "out", "--jobs", "2"], cwd=tmp_path,
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)  # fmt: skip
+    time.sleep(delay)
+    os.killpg(run.pid, signal.SIGINT)
+    _out, err = run.communicate(timeout=120)
+    assert run.returncode == 130, err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+    assert err.rstrip().splitlines()[-1] in ("interrupted: nothing had started yet", "interrupted: nothing had finished yet; run the same command to start again"), err
