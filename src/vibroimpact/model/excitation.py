@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from vibroimpact.model.structure import require_non_negative, require_positive
+from vibroimpact.model.structure import require_finite, require_non_negative, require_positive
 
 __all__ = ["HarmonicForce", "SweptSine", "load_weights", "static_load", "angular_frequency", "check_closed_form_inputs"]
 
@@ -81,8 +81,9 @@ class HarmonicForce:
     base_motion: bool = False
 
     def __post_init__(self) -> None:
-        require_non_negative("amplitude", self.amplitude)
-        require_positive("frequency", self.frequency)
+        object.__setattr__(self, "amplitude", require_non_negative("amplitude", self.amplitude))
+        object.__setattr__(self, "frequency", require_positive("frequency", self.frequency))  # a float, whatever number type came
+        object.__setattr__(self, "phase", require_finite("phase", self.phase))
         object.__setattr__(self, "weights", _vector("excitation.on", self.weights))
         object.__setattr__(self, "static", _vector("excitation.static", self.static))
         if self.base_motion and self.weights is not None:

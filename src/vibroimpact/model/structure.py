@@ -15,6 +15,7 @@ excitation is a base motion, see :mod:`~vibroimpact.model.excitation`).
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -353,7 +354,8 @@ class LinearStructure:
 # --------------------------------------------------------------------------------------------------------------------
 
 def _number(name: str, value: object) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
+    # any real number, numpy's included (np.int64, np.float32); not a bool
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise ValueError(f"{name}: expected a number, got {value!r} ({type(value).__name__})")
     number = float(value)
     if not math.isfinite(number):

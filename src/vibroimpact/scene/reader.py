@@ -169,6 +169,7 @@ def load_scene(path: str | Path) -> Scene:
         for mark in (getattr(error, "context_mark", None), getattr(error, "problem_mark", None)):
             if mark is not None:
                 mark.name = str(path)  # PyYAML names a parsed string "<unicode string>"
+                mark.buffer = None  # line and column, never the line itself: the path may name a file that is not a scene
         raise SceneError([f"not valid YAML: {error}"], str(path)) from None
     return parse_scene(document, text=text, source=str(path))
 
