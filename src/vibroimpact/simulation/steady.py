@@ -17,6 +17,8 @@ closed forms refuse too), and a result whose amplitude exceeds :data:`AMPLITUDE_
 
 from __future__ import annotations
 
+from collections import deque
+
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
@@ -112,11 +114,17 @@ class SteadyResult:
         periods = max(self.multiplicity, 1) if periods is None else periods
         require_in_range("periods", periods, 1, 1e6)
         require_in_range("samples_per_period", samples_per_period, 1, 1e7)
+        if int(periods) * int(samples_per_period) > MAX_HISTORY_SAMPLES:  # checked before anything is allocated
+            raise ValueError(f"periods x samples_per_period = {int(periods)} x {int(samples_per_period)} = {int(periods) * int(samples_per_period):.3g} samples is out of range: allowed [1, {MAX_HISTORY_SAMPLES:.0e}] (the history holds every sample)")
         step = self.problem.period / samples_per_period
         times = self.end_time + step * np.arange(int(periods) * int(samples_per_period) + 1)
         if not self.integrated:
             return linear_history(self.problem, times)
         return time_history(self.engine, self.problem, self.end_state, self.end_time, times)  # type: ignore[arg-type]
+
+
+#: Most samples :meth:`SteadyResult.history` gives (2 N states each: 320 MB for N = 2), checked before it allocates them.
+MAX_HISTORY_SAMPLES = 10_000_000
 
 
 def start_state(problem: ImpactProblem, mode: str, orbit_stop: RigidStop | tuple[Stop, ...] | None = None) -> tuple[float, NDArray[np.float64]]:
@@ -323,7 +331,9 @@ def march(
     scale = motion_scale(problem) if scale is None else scale
     limit = settings.max_periods if max_periods is None else int(max_periods)
     first = settings.chunk_periods if first_chunk is None else first_chunk
-    strobes = [y]
+    # only the last strobes are read: a ring of them keeps memory independent of max_periods (a list of every strobe
+    # held ~190 MB per 10^6 periods)
+    strobes: deque[NDArray[np.float64]] = deque([y], maxlen=3 * settings.max_multiplicity + 1)
     used = multiplicity = 0
     while used < limit:
         chunk = min(first if used == 0 else settings.chunk_periods, limit - used)
@@ -331,7 +341,7 @@ def march(
         used += chunk
         strobes.extend(trajectory.strobe_states[1:])
         t, y = float(trajectory.strobe_times[-1]), trajectory.final_state
-        multiplicity = strobes_repeat(np.array(strobes[-3 * settings.max_multiplicity - 1 :]), scale, settings)
+        multiplicity = strobes_repeat(np.array(strobes), scale, settings)
         if multiplicity:
             break
     return t, y, multiplicity, used
