@@ -143,6 +143,8 @@ def main(argv: list[str] | None = None) -> int:
         with claim_output(out_dir):
             for stale in out_dir.glob(".*.tmp"):  # a write cut off by a kill (runs.store.atomic_path): never a result
                 stale.unlink(missing_ok=True)
+            for doomed in out_dir.glob(".*.zarr.removed-*"):  # a finished store whose removal was cut off
+                shutil.rmtree(doomed, ignore_errors=True)
             # finished blocks and cases: a rerun of the same scene skips them
             store = StudyStore(out_dir / f"{scene.name}.zarr", store_fingerprint(scene.text), scene_path, _say)
             try:

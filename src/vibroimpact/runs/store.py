@@ -258,7 +258,9 @@ class StudyStore:
         source = str(Path(scene_path).resolve()) if scene_path is not None else ""
         if path is not None and path.exists():
             self._discard_unless_ours(path, source)
-        self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT)
+        # the run reads every array's own metadata, as the export does: a kept store's consolidated copy
+        # (:meth:`keep`) could vouch for an array whose own files are lost or edited
+        self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
         if "fingerprint" not in self.root.attrs:
             self.root.attrs.update({"fingerprint": fingerprint, "code": code_fingerprint(), "scene_path": source})
         self._grid_ready = _BLOCK_DONE in self.root or _GRID_VARIABLES in self.root.attrs
@@ -267,7 +269,7 @@ class StudyStore:
     def _discard_unless_ours(self, path: Path, source: str) -> None:
         """Empty the folder ``path`` unless it holds this scene's store; say why and how much was discarded."""
         try:
-            attrs: dict[str, Any] | None = dict(zarr.open_group(str(path), mode="r", zarr_format=ZARR_FORMAT).attrs)
+            attrs: dict[str, Any] | None = dict(zarr.open_group(str(path), mode="r", zarr_format=ZARR_FORMAT, use_consolidated=False).attrs)
         except Exception:  # noqa: BLE001 - unreadable or damaged root metadata (a JSON error, a missing file)
             attrs = None
         if attrs is not None and attrs.get("fingerprint") == self.fingerprint:
@@ -342,15 +344,17 @@ class StudyStore:
     def begin_grid(self, template: xr.Dataset, block_count: int, plan: tuple[tuple[int, ...], tuple[int, ...]]) -> None:
         """Create the grid's variables from ``template`` (lazy arrays with the grid's dimensions and chunks; nothing
         is computed) and ``block_done``; ``plan`` (the grid's shape and a block's) is kept for a resumed run."""
-        encoding = {name: {"_FillValue": None} for name, variable in template.data_vars.items() if variable.dtype.kind in "iub"}
-        # the dataset's attributes become the group's: the fingerprint goes with them
-        template = template.assign_attrs(dict(self.root.attrs) | {"grid_shape": list(plan[0]), "block_shape": list(plan[1]), _GRID_VARIABLES: sorted(map(str, template.data_vars))})
-        template.to_zarr(self.store, mode="a", compute=False, zarr_format=ZARR_FORMAT, encoding=encoding, consolidated=False)
-        self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT)
+        # the bookkeeping first, the grid's variables and their list last: a kill in between leaves a store whose
+        # grid a rerun drops (no variables listed, or flags without variables), never variables without flags
         checksum = self.root.create_array(_BLOCK_CHECKSUM, shape=(block_count, 32), chunks=(1, 32), dtype="uint8", fill_value=0, overwrite=True)
         checksum.attrs["_ARRAY_DIMENSIONS"] = ["block", "sha256_byte"]
         done = self.root.create_array(_BLOCK_DONE, shape=(block_count,), chunks=(1,), dtype="uint8", fill_value=0, overwrite=True)
         done.attrs["_ARRAY_DIMENSIONS"] = ["block"]
+        encoding = {name: {"_FillValue": None} for name, variable in template.data_vars.items() if variable.dtype.kind in "iub"}
+        # the dataset's attributes become the group's: the fingerprint goes with them
+        template = template.assign_attrs(dict(self.root.attrs) | {"grid_shape": list(plan[0]), "block_shape": list(plan[1]), _GRID_VARIABLES: sorted(map(str, template.data_vars))})
+        template.to_zarr(self.store, mode="a", compute=False, zarr_format=ZARR_FORMAT, encoding=encoding, consolidated=False)
+        self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
         self._arrays.clear()
         self._grid_ready = True
 
@@ -431,7 +435,7 @@ class StudyStore:
                     shutil.rmtree(self.path / name, ignore_errors=True)
                 elif name in self.root:
                     del self.root[name]
-            self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT)
+            self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
         self.root.attrs.pop(_GRID_VARIABLES, None)
         self._arrays.clear()
         self._grid_ready = False
@@ -444,8 +448,15 @@ class StudyStore:
         return self._arrays[name]
 
     def block_count(self) -> int:
-        """Finished blocks in the store."""
-        return int(self.finished_blocks().sum()) if self._grid_ready else 0
+        """Finished blocks in the store (0 where its flags cannot be read: :meth:`verify_blocks` then drops the grid)."""
+        if not self._grid_ready:
+            return 0
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # zarr warns of an array whose metadata is lost
+                return int(self.finished_blocks().sum())
+        except Exception:  # noqa: BLE001 - lost or damaged flags (a kill while the grid was being created)
+            return 0
 
     def grid_dataset(self) -> xr.Dataset:
         """The grid's variables, lazily (dask arrays over the store's chunks), without ``block_done``."""
@@ -472,7 +483,7 @@ class StudyStore:
                     coords[dim] = values.astype(str) if values.dtype == object else values
         if coords:
             xr.Dataset(coords=coords, attrs=dict(self.root.attrs)).to_zarr(self.store, mode="a", zarr_format=ZARR_FORMAT, consolidated=False)  # keeps the group's attributes
-            self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT)
+            self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
         attrs = dict(dataset.attrs)
         self.root.attrs.update({key: value.tolist() if isinstance(value, np.ndarray) else value.item() if isinstance(value, np.generic) else value for key, value in attrs.items()})
         zarr.consolidate_metadata(self.store, zarr_format=ZARR_FORMAT)
