@@ -7,8 +7,11 @@ from __future__ import annotations
 import http.server
 import os
 import signal
+import subprocess
+import sys
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -29,22 +32,29 @@ def _reader(stream: object, lines: list[str]) -> threading.Thread:
     return thread
 
 
-@pytest.mark.faults
-@pytest.mark.timeout(300)
-def test_ctrl_c_while_the_workers_start_stops_the_run_in_one_line(tmp_path: Path) -> None:
-    run = start_run_study([str(_slow_scene(tmp_path)), "--out", "out", "--jobs", "2"], tmp_path)
+def _signal_while_the_workers_start(folder: Path, after: float, send: Callable[[subprocess.Popen[str]], None]) -> tuple[int, str]:
+    """Start a run with 2 workers, ``send`` it a signal ``after`` seconds after it says the workers are starting;
+    return its exit status and stderr."""
+    run = start_run_study([str(_slow_scene(folder)), "--out", "out", "--jobs", "2"], folder)
     lines: list[str] = []
     reader = _reader(run.stderr, lines)
     _wait_for(run, lines, "starting 2 worker processes", time.monotonic() + 120.0)
     assert run.poll() is None, "".join(lines)
-    time.sleep(0.5)  # the workers are being spawned and import the package
-    os.killpg(run.pid, signal.SIGINT)
+    time.sleep(after)
+    send(run)
     run.wait(timeout=120)
     reader.join(timeout=10)
     run.stdout.close()  # type: ignore[union-attr]
     run.stderr.close()  # type: ignore[union-attr]
-    err = "".join(lines)
-    assert run.returncode == 130, err
+    return run.returncode, "".join(lines)
+
+
+@pytest.mark.faults
+@pytest.mark.timeout(300)
+def test_ctrl_c_while_the_workers_start_stops_the_run_in_one_line(tmp_path: Path) -> None:
+    # 0.5 s: the workers are being spawned and import the package
+    returncode, err = _signal_while_the_workers_start(tmp_path, 0.5, lambda run: os.killpg(run.pid, signal.SIGINT))
+    assert returncode == 130, err
     assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
     assert err.rstrip().splitlines()[-1] == "interrupted: nothing had finished yet; run the same command to start again", err
 
@@ -54,19 +64,9 @@ def test_ctrl_c_while_the_workers_start_stops_the_run_in_one_line(tmp_path: Path
 def test_sigterm_while_the_workers_start_is_said_as_sigterm(tmp_path: Path) -> None:
     """A batch system's SIGTERM (to the study's process alone) while its workers start: every line it prints says
     SIGTERM, none "interrupted" (issue 34: it was said as a Ctrl-C)."""
-    run = start_run_study([str(_slow_scene(tmp_path)), "--out", "out", "--jobs", "2"], tmp_path)
-    lines: list[str] = []
-    reader = _reader(run.stderr, lines)
-    _wait_for(run, lines, "starting 2 worker processes", time.monotonic() + 120.0)
-    assert run.poll() is None, "".join(lines)
-    time.sleep(0.3)  # the cluster takes ~1 s to start on a quiet machine
-    run.send_signal(signal.SIGTERM)
-    run.wait(timeout=120)
-    reader.join(timeout=10)
-    run.stdout.close()  # type: ignore[union-attr]
-    run.stderr.close()  # type: ignore[union-attr]
-    err = "".join(lines)
-    assert run.returncode == 143, err
+    # 0.3 s: the cluster takes ~1 s to start on a quiet machine
+    returncode, err = _signal_while_the_workers_start(tmp_path, 0.3, lambda run: run.send_signal(signal.SIGTERM))
+    assert returncode == 143, err
     assert "interrupted" not in err and "Traceback" not in err, err
     assert err.rstrip().splitlines()[-1] == "terminated (SIGTERM): nothing had finished yet; run the same command to start again", err
 
@@ -131,9 +131,6 @@ def test_a_server_that_is_not_a_dask_scheduler_is_refused_within_seconds() -> No
 def test_ctrl_c_while_the_command_imports_is_one_line(tmp_path: Path, delay: float) -> None:
     """Ctrl-C in the first fraction of a second, while ``run-study`` imports its command line (no handler of the
     study's yet): exit 130 and one line, no KeyboardInterrupt traceback (issue 34: 3 of 5 such runs printed one)."""
-    import subprocess
-    import sys
-
     run = subprocess.Popen([sys.executable, "-m", "vibroimpact.entry", str(_slow_scene(tmp_path)), "--out", "out", "--jobs", "2"], cwd=tmp_path,
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)  # fmt: skip
     time.sleep(delay)
