@@ -21,11 +21,13 @@ def study_environment(scheduler: str | None = None) -> dict[str, str]:
     return environment | ({SCHEDULER_VARIABLE: scheduler} if scheduler is not None else {})
 
 
-def start_run_study(arguments: list[str], folder: Path, scheduler_variable: str | None = None) -> subprocess.Popen[str]:
+def start_run_study(arguments: list[str], folder: Path, scheduler_variable: str | None = None, module: str = "vibroimpact.cli") -> subprocess.Popen[str]:
     """``run-study ARGUMENTS`` in ``folder`` (``VIBROIMPACT_SCHEDULER``: ``scheduler_variable``), in its own process
-    group as a terminal's foreground job (SIGINT handled as in an interactive shell), stdout and stderr piped."""
+    group as a terminal's foreground job (SIGINT handled as in an interactive shell, even where the tests' own process
+    ignores it, as pytest-xdist's workers do), stdout and stderr piped; ``module``: the one run as ``python -m``
+    (``vibroimpact.entry``: the ``run-study`` command's own entry point)."""
     return subprocess.Popen(
-        [sys.executable, "-m", "vibroimpact.cli", *arguments],
+        [sys.executable, "-m", module, *arguments],
         cwd=folder,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,

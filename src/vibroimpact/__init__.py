@@ -27,13 +27,6 @@ if os.environ.get("VIBROIMPACT_WORKER") == "1":  # a local cluster's worker, spa
         _signal.signal(_signal.SIGINT, _signal.SIG_IGN)
 
 import importlib
-from importlib.metadata import PackageNotFoundError, version
-from typing import Any
-
-try:
-    __version__ = version("vibroimpact")
-except PackageNotFoundError:  # running from a source tree without installation
-    __version__ = "0+unknown"
 
 #: Public name -> the module that defines it (README, "Architecture").
 _PUBLIC = {
@@ -97,8 +90,18 @@ _PUBLIC = {
 __all__ = ["__version__", *_PUBLIC]
 
 
-def __getattr__(name: str) -> Any:
-    """Load a public name's module on first use (PEP 562)."""
+def __getattr__(name: str) -> object:
+    """Load a public name's module on first use (PEP 562); the version too (``import vibroimpact``, run-study's first
+    step, stays instant)."""
+    if name == "__version__":
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            found = version("vibroimpact")
+        except PackageNotFoundError:  # running from a source tree without installation
+            found = "0+unknown"
+        globals()["__version__"] = found
+        return found
     if name not in _PUBLIC:
         raise AttributeError(f"module 'vibroimpact' has no attribute {name!r}")
     value = getattr(importlib.import_module(_PUBLIC[name]), name)
