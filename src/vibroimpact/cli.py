@@ -322,7 +322,12 @@ def _run(scene: Scene, args: argparse.Namespace, out_dir: Path, store: StudyStor
             store.keep(dataset)
             print(f"kept {store.path}")
         else:
-            store.remove()
+            try:
+                store.remove()
+            except KeyboardInterrupt as interrupt:  # the results are written: only the store's removal was cut off
+                what = "terminated (SIGTERM)" if isinstance(interrupt, Terminated) else "interrupted"
+                print(f"\n{what} while removing {store.path}: the results are written; what is left of it goes with the next run", file=sys.stderr)
+                return EXIT_TERMINATED if isinstance(interrupt, Terminated) else EXIT_INTERRUPTED
     except ClusterLost:
         raise  # main says what was kept
     except (OSError, ValueError, ArithmeticError, np.linalg.LinAlgError, RuntimeError) as error:

@@ -51,8 +51,9 @@ from numpy.typing import NDArray
 from zarr.core.sync import sync  # zarr's own event loop, the one its synchronous API runs on
 
 from vibroimpact import __version__
+from vibroimpact.runs.store_record import read_record, record_digest, restore, set_aside, check_members_readable
 
-__all__ = ["atomic_path", "source_hash", "case_key", "StudyStore", "OutputBusy", "claim_output", "store_fingerprint", "code_fingerprint", "values_digest", "StoreOfAnotherScene", "NOT_IN_FINGERPRINT", "ZARR_FORMAT"]
+__all__ = ["atomic_path", "source_hash", "case_key", "StudyStore", "OutputBusy", "claim_output", "store_fingerprint", "code_fingerprint", "values_digest", "StoreOfAnotherScene", "StoreUnusable", "NOT_IN_FINGERPRINT", "ZARR_FORMAT"]
 
 
 @contextmanager
@@ -108,6 +109,11 @@ _BLOCK_DONE = "block_done"
 _BLOCK_CHECKSUM = "block_checksum"
 #: The grid's variables, recorded when the grid begins (a variable whose metadata is lost is missed by name).
 _GRID_VARIABLES = "grid_variables"
+#: The copy of the grid's metadata files and its digest (:mod:`vibroimpact.runs.store_record`), written last.
+_GRID_RECORD = "grid_record"
+_GRID_RECORD_DIGEST = "grid_record_sha256"
+#: The root's attributes that lay the grid out, kept in the record.
+_GRID_PLAN = ("grid_shape", "block_shape", _GRID_VARIABLES)
 
 
 def values_digest(arrays: list[tuple[str, NDArray[np.generic]]]) -> bytes:
@@ -151,6 +157,11 @@ def store_fingerprint(scene_text: str) -> str:
 def code_fingerprint() -> str:
     """The package version and its source (:func:`source_hash`): results of other code are not reused."""
     return hashlib.sha256(f"{__version__}\0{source_hash()}".encode()).hexdigest()[:24]
+
+
+class StoreUnusable(RuntimeError):
+    """The store cannot be read for a reason no rebuilding mends (an unreadable array beside the grid's): the caller
+    sets it aside (:meth:`StudyStore.start_afresh`) and computes again."""
 
 
 class StoreOfAnotherScene(RuntimeError):
@@ -256,6 +267,7 @@ class StudyStore:
         self.damaged_cases = 0
         self.store: Any = str(path) if path is not None else zarr.storage.MemoryStore()
         source = str(Path(scene_path).resolve()) if scene_path is not None else ""
+        self.scene_path = source
         if path is not None and path.exists():
             self._discard_unless_ours(path, source)
         # the run reads every array's own metadata, as the export does: a kept store's consolidated copy
@@ -263,8 +275,19 @@ class StudyStore:
         self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
         if "fingerprint" not in self.root.attrs:
             self.root.attrs.update({"fingerprint": fingerprint, "code": code_fingerprint(), "scene_path": source})
-        self._grid_ready = _BLOCK_DONE in self.root or _GRID_VARIABLES in self.root.attrs
+        self._grid_ready = _BLOCK_DONE in self.root or any(key in self.root.attrs for key in (_GRID_VARIABLES, _GRID_RECORD))
         self._arrays: dict[str, Any] = {}
+
+    def start_afresh(self, why: str) -> None:
+        """Set the store aside (renamed, never deleted; one line says where and why) and begin an empty one."""
+        if self.path is None:
+            raise StoreUnusable(why)  # a store in memory is never damaged: this is a bug, said as it is
+        aside = set_aside(self.path)
+        self.say(f"{self.path}: cannot be read ({why}): set aside as {aside.name}, computed again")
+        self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
+        self.root.attrs.update({"fingerprint": self.fingerprint, "code": code_fingerprint(), "scene_path": self.scene_path})
+        self._arrays.clear()
+        self._grid_ready = False
 
     def _discard_unless_ours(self, path: Path, source: str) -> None:
         """Empty the folder ``path`` unless it holds this scene's store; say why and how much was discarded."""
@@ -278,15 +301,14 @@ class StudyStore:
             raise StoreOfAnotherScene(
                 f"{path} holds the finished work of another scene ({attrs['scene_path']}); it is kept: remove it, or "
                 "run this scene with another --out (or another name)")
-        if attrs is None:
-            why = "its attributes are unreadable (damaged)"
-        elif attrs.get("code") != code_fingerprint():
-            why = "the package's code changed since it was written"
-        else:
-            why = "the scene's values changed since it was written"
-        self.say(f"{path}: {why}: {_finished_work(path)} discarded, computed again")
+        if attrs is None or "fingerprint" not in attrs:  # damaged: kept for whoever wants to look, never deleted
+            work = _finished_work(path)
+            aside = set_aside(path)
+            self.say(f"{path}: its attributes are {'unreadable' if attrs is None else 'lost'} (damaged): set aside as {aside.name} ({work}), computed again")
+            return
+        why = "the package's code changed" if attrs.get("code") != code_fingerprint() else "the scene's values changed"
+        self.say(f"{path}: {why} since it was written: {_finished_work(path)} discarded, computed again")
         shutil.rmtree(path)
-
 
     # -- cases -------------------------------------------------------------------------------------------------
 
@@ -355,8 +377,39 @@ class StudyStore:
         template = template.assign_attrs(dict(self.root.attrs) | {"grid_shape": list(plan[0]), "block_shape": list(plan[1]), _GRID_VARIABLES: sorted(map(str, template.data_vars))})
         template.to_zarr(self.store, mode="a", compute=False, zarr_format=ZARR_FORMAT, encoding=encoding, consolidated=False)
         self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
+        if self.path is not None:  # the record of the metadata last: a grid without it was cut off while created
+            record = read_record(self.path, [*template.data_vars, _BLOCK_DONE, _BLOCK_CHECKSUM], {key: self.root.attrs[key] for key in _GRID_PLAN})
+            self.root.attrs.update({_GRID_RECORD: record, _GRID_RECORD_DIGEST: record_digest(record)})
         self._arrays.clear()
         self._grid_ready = True
+
+    def check_grid(self) -> int:
+        """Compare the grid's metadata (every array's ``.zarray`` and ``.zattrs``, the grid's plan) with the record
+        written when the grid began and write back what differs, saying which arrays were rebuilt; a grid without a
+        whole record (cut off while being created, or its record damaged) is dropped. Return the finished blocks
+        dropped (0: the grid's metadata is as it was written, or rebuilt).
+
+        Call it before :meth:`grid_plan` and :meth:`verify_blocks`: they read the metadata it restores.
+        """
+        if not self._grid_ready or self.path is None:
+            return 0
+        try:
+            attrs = dict(self.root.attrs)
+            record = attrs[_GRID_RECORD]
+            whole = isinstance(record, dict) and attrs[_GRID_RECORD_DIGEST] == record_digest(record)
+        except Exception:  # noqa: BLE001 - no record (cut off before it), or unreadable attributes
+            whole = False
+        if not whole:
+            return self._drop_grid()
+        rebuilt = restore(self.path, record)
+        if any(attrs.get(key) != value for key, value in record["plan"].items()):
+            self.root.attrs.update(record["plan"])
+            rebuilt.append("the grid's plan")
+        if rebuilt:
+            self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
+            self._arrays.clear()
+            self.say(f"{self.path}: metadata lost or changed since it was written, rebuilt from the store's record: {', '.join(rebuilt)}")
+        return 0
 
     def grid_plan(self) -> tuple[tuple[int, ...], tuple[int, ...]] | None:
         """The grid's shape and a block's, as the run that began the store planned them (None: not recorded)."""
@@ -436,7 +489,8 @@ class StudyStore:
                 elif name in self.root:
                     del self.root[name]
             self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
-        self.root.attrs.pop(_GRID_VARIABLES, None)
+        for key in (_GRID_VARIABLES, _GRID_RECORD, _GRID_RECORD_DIGEST):
+            self.root.attrs.pop(key, None)
         self._arrays.clear()
         self._grid_ready = False
         return max(count, 1)
@@ -460,7 +514,14 @@ class StudyStore:
 
     def grid_dataset(self) -> xr.Dataset:
         """The grid's variables, lazily (dask arrays over the store's chunks), without ``block_done``."""
-        dataset = xr.open_zarr(self.store, consolidated=False, zarr_format=ZARR_FORMAT).drop_vars([_BLOCK_DONE, _BLOCK_CHECKSUM])
+        names = {str(name) for name in self.root.attrs.get(_GRID_VARIABLES, [])}  # type: ignore[union-attr]
+        try:
+            if self.path is not None:  # zarr opens every array beside ours at once, and one that fails leaves the rest pending
+                check_members_readable(self.path)
+            others = [name for name in self.root.array_keys() if name not in names]  # bookkeeping, kept coordinates, anything foreign: never exported
+            dataset = xr.open_zarr(self.store, consolidated=False, zarr_format=ZARR_FORMAT, drop_variables=others)
+        except Exception as error:  # noqa: BLE001 - whatever an unreadable array raises (a JSON error, a missing file)
+            raise StoreUnusable(f"{type(error).__name__}: {error}") from error
         dataset.attrs.clear()  # the fingerprint, and a kept store's attributes of its last run: the study sets its own
         for variable in dataset.variables.values():
             for key in _TYPED_ATTRIBUTES:

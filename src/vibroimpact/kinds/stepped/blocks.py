@@ -154,10 +154,13 @@ def run_grid(scene: Scene, runner: Runner, solve: BlockSolver, extra_sizes: dict
 
     ``extra_sizes``: sizes of dimensions other than the grid's (``solution``, ``stop``), which every block has whole.
     """
-    from vibroimpact.runs.store import StudyStore, store_fingerprint
+    from vibroimpact.runs.store import StoreUnusable, StudyStore, store_fingerprint
 
     store = runner.store if runner.store is not None else StudyStore(None, store_fingerprint(scene.text))
     plan = plan_blocks(scene, runner.workers if runner.distributed else 1)
+    dropped = store.check_grid()  # the metadata as it was written (rebuilt where it differs), before anything reads it
+    if dropped:
+        store.say(f"the grid's record of its metadata is lost or damaged: {dropped} finished blocks are computed again")
     if store.grid_ready:
         kept = store.grid_plan()
         if kept is not None and kept[0] == plan.full:
@@ -171,19 +174,26 @@ def run_grid(scene: Scene, runner: Runner, solve: BlockSolver, extra_sizes: dict
         store.write_block(index, plan.region(index), {name: (dims, values) for name, (dims, values, _attrs) in variables.items()})
 
     totals = [block_work(scene, plan, index) for index in range(plan.count)]
-    # every finished block proves its values against its checksum: on resume, and again before they are exported
-    for check in ("resumed", "exported"):
-        finished_before = store.block_count()
-        damaged = store.verify_blocks(plan.region)
-        if damaged:
-            store.say(f"{damaged} damaged blocks of {max(finished_before, damaged)} finished ({check}) are computed again")
-        skip = np.flatnonzero(store.finished_blocks()).tolist() if store.grid_ready else []
-        if check == "exported" and len(skip) == plan.count:
-            break
-        runner.run_tasks(_solve_block, (scene, plan, solve), list(range(plan.count)), totals, "points", finished, skip=skip, verb="simulating" if _simulates(scene) else "solving")
-    if store.block_count() != plan.count:  # cannot happen: a block that failed twice in one run raises on the way
-        raise RuntimeError(f"the store holds {store.block_count()} of the grid's {plan.count} blocks after the run")
-    return store.grid_dataset()
+    for attempt in (1, 2):
+        # every finished block proves its values against its checksum: on resume, and again before they are exported
+        for check in ("resumed", "exported"):
+            finished_before = store.block_count()
+            damaged = store.verify_blocks(plan.region)
+            if damaged:
+                store.say(f"{damaged} damaged blocks of {max(finished_before, damaged)} finished ({check}) are computed again")
+            skip = np.flatnonzero(store.finished_blocks()).tolist() if store.grid_ready else []
+            if check == "exported" and len(skip) == plan.count:
+                break
+            runner.run_tasks(_solve_block, (scene, plan, solve), list(range(plan.count)), totals, "points", finished, skip=skip, verb="simulating" if _simulates(scene) else "solving")
+        if store.block_count() != plan.count:  # cannot happen: a block that failed twice in one run raises on the way
+            raise RuntimeError(f"the store holds {store.block_count()} of the grid's {plan.count} blocks after the run")
+        try:
+            return store.grid_dataset()
+        except StoreUnusable as error:
+            if attempt == 2:
+                raise RuntimeError(f"{store.path}: a store begun afresh cannot be read: {error}") from error
+            store.start_afresh(str(error))  # an unreadable array beside the grid's: nothing can be trusted
+    raise AssertionError("unreachable")
 
 
 def _template(variables: dict[str, tuple[tuple[str, ...], np.ndarray, dict[str, object]]], sizes: dict[str, int], chunks: dict[str, int]) -> xr.Dataset:
