@@ -75,7 +75,7 @@ def test_keep_zarr_keeps_the_store_beside_the_netcdf_file(tmp_path: Path) -> Non
 
 
 def test_a_second_run_on_the_same_output_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from vibroimpact.runs.store import claim_output
+    from vibroimpact.runs.output_files import claim_output
 
     out = tmp_path / "out"
     out.mkdir()

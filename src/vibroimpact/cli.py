@@ -135,13 +135,14 @@ def main(argv: list[str] | None = None) -> int:
     if problem is not None:
         print(f"run-study: error: --out {out_dir} cannot be written: {problem}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    from vibroimpact.runs.store import OutputBusy, StoreOfAnotherScene, StudyStore, claim_output, store_fingerprint
+    from vibroimpact.runs.output_files import OutputBusy, claim_output
+    from vibroimpact.runs.store import StoreOfAnotherScene, StudyStore, store_fingerprint
 
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminate)  # SIGTERM ends the run as Ctrl-C does
     try:
         with claim_output(out_dir):
-            for stale in out_dir.glob(".*.tmp"):  # a write cut off by a kill (runs.store.atomic_path): never a result
+            for stale in out_dir.glob(".*.tmp"):  # a write cut off by a kill (runs.output_files.atomic_path): never a result
                 stale.unlink(missing_ok=True)
             for doomed in out_dir.glob(".*.zarr.removed-*"):  # a finished store whose removal was cut off
                 shutil.rmtree(doomed, ignore_errors=True)

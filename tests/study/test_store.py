@@ -22,7 +22,8 @@ from vibroimpact.kinds.stepped.blocks import BlockPlan, block_scene, plan_blocks
 from vibroimpact.runs.run import run_study
 from vibroimpact.runs.runner import Runner
 from vibroimpact.kinds.stepped.study import general_block
-from vibroimpact.runs.store import OutputBusy, StudyStore, claim_output, store_fingerprint
+from vibroimpact.runs.output_files import OutputBusy, claim_output
+from vibroimpact.runs.store import StudyStore, store_fingerprint
 
 from tests.study.test_estimate import small_scene
 

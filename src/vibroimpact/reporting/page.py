@@ -35,7 +35,7 @@ from matplotlib.figure import Figure as MatplotlibFigure  # noqa: E402
 
 from vibroimpact.reporting.record import study_kind, study_record  # noqa: E402
 from vibroimpact.runs.failures import failure_details, run_failures  # noqa: E402
-from vibroimpact.runs.store import atomic_path  # noqa: E402
+from vibroimpact.runs.output_files import atomic_path  # noqa: E402
 from vibroimpact.scene.kinds import kind_named  # noqa: E402
 
 __all__ = ["DrawnFigure", "Figure", "Table", "Section", "StudyPage", "save_figure", "saved", "rendering", "render_page", "write_page", "write_report", "with_failures", "page_for"]

@@ -43,7 +43,7 @@ import xarray as xr
 from vibroimpact.engines.registry import ENGINES, engine_spec
 from vibroimpact.model.layout import Layout
 from vibroimpact.runs.labels import decode_labels
-from vibroimpact.runs.store import atomic_path
+from vibroimpact.runs.output_files import atomic_path
 from vibroimpact.scene.kinds import kind_named
 from vibroimpact.scene.schema import Scene
 

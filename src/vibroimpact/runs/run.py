@@ -41,7 +41,8 @@ from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.runner import Runner
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.labels import decode_labels, encode_labels
-from vibroimpact.runs.store import StudyStore, atomic_path, source_hash
+from vibroimpact.runs.output_files import atomic_path
+from vibroimpact.runs.store import StudyStore, source_hash
 from vibroimpact.scene.kinds import kind_named
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, Scene
 
@@ -158,7 +159,7 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
 
 
 # --------------------------------------------------------------------------------------------------------------------
-# Writing datasets: atomic files (runs.store.atomic_path: a reader never sees half a file, a failed write leaves the
+# Writing datasets: atomic files (runs.output_files.atomic_path: a reader never sees half a file, a failed write leaves the
 # previous one intact), netCDF with compression and CF-clean coordinates, and the provenance every dataset carries.
 # --------------------------------------------------------------------------------------------------------------------
 

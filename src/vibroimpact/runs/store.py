@@ -22,25 +22,19 @@ lost metadata) is computed again and the run says how many in one line. No fill 
 point belongs to a block, and the export waits until every block has proved itself.
 
 Only the process that runs the study writes the store (workers return their results to it), so a cluster needs no
-shared file system. :func:`claim_output` keeps a second study off the same output.
+shared file system. :func:`vibroimpact.runs.output_files.claim_output` keeps a second study off the same output.
 """
 
 from __future__ import annotations
 
 import asyncio
-import fcntl
 import functools
 import hashlib
 import io
 import json
 import os
 import shutil
-import socket
-import tempfile
-import time
 import warnings
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Callable
 
@@ -53,26 +47,7 @@ from zarr.core.sync import sync  # zarr's own event loop, the one its synchronou
 from vibroimpact import __version__
 from vibroimpact.runs.store_record import read_record, record_digest, restore, set_aside, check_members_readable
 
-__all__ = ["atomic_path", "source_hash", "case_key", "StudyStore", "OutputBusy", "claim_output", "store_fingerprint", "code_fingerprint", "values_digest", "StoreOfAnotherScene", "StoreUnusable", "NOT_IN_FINGERPRINT", "ZARR_FORMAT"]
-
-
-@contextmanager
-def atomic_path(path: Path, suffix: str = ".tmp") -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; on success it replaces ``path`` (mode 0644), on failure it is removed.
-
-    ``suffix`` is the temporary file's ending (``.npz`` for ``numpy.savez``, which would otherwise add one).
-    """
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
-    os.close(handle)
-    temporary = Path(name)
-    try:
-        yield temporary
-        os.chmod(temporary, 0o644)
-        os.replace(temporary, path)
-    except BaseException:
-        temporary.unlink(missing_ok=True)
-        raise
+__all__ = ["source_hash", "case_key", "StudyStore", "store_fingerprint", "code_fingerprint", "values_digest", "StoreOfAnotherScene", "StoreUnusable", "NOT_IN_FINGERPRINT", "ZARR_FORMAT"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -132,10 +107,6 @@ def values_digest(arrays: list[tuple[str, NDArray[np.generic]]]) -> bytes:
 _TYPED_ATTRIBUTES = ("flag_values", "flag_masks", "valid_min", "valid_max", "valid_range")
 
 
-class OutputBusy(RuntimeError):
-    """Another study is writing the same output folder."""
-
-
 #: Top-level scene keys that change no number: a store survives their edits (where the work runs, the page's words).
 NOT_IN_FINGERPRINT = ("cluster", "description", "report")
 
@@ -166,52 +137,6 @@ class StoreUnusable(RuntimeError):
 
 class StoreOfAnotherScene(RuntimeError):
     """The output folder's store holds the finished work of another scene file (a name clash): it is not deleted."""
-
-
-@contextmanager
-def claim_output(out_dir: Path) -> Iterator[Path]:
-    """Hold an exclusive lock on ``out_dir/.run-study.lock`` while a study writes there.
-
-    The lock is the operating system's (``flock``): it goes with the process, so a run that was killed leaves nothing
-    to clean up, and two runs can never both hold it. The file says who holds it.
-
-    Raises
-    ------
-    OutputBusy
-        When another process holds it (its process id, host and start time are named).
-    """
-    lock = out_dir / ".run-study.lock"
-    while True:
-        handle = os.open(lock, os.O_CREAT | os.O_RDWR, 0o644)
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            os.close(handle)
-            owner = _lock_owner(lock)
-            who = f"process {owner[0]} on {owner[1]}, since {owner[2]}" if owner else "another process"
-            raise OutputBusy(f"{out_dir} is being written by another run-study ({who}); wait for it to finish or choose another --out") from None
-        try:
-            same = os.fstat(handle).st_ino == os.stat(lock).st_ino
-        except FileNotFoundError:
-            same = False
-        if same:
-            break
-        os.close(handle)  # the file was removed by its last holder between our open and our lock: take the new one
-    os.ftruncate(handle, 0)
-    os.write(handle, f"{os.getpid()} {socket.gethostname()} {time.strftime('%Y-%m-%dT%H:%M:%S')}\n".encode())
-    try:
-        yield lock
-    finally:
-        lock.unlink(missing_ok=True)  # while still locked: a waiting run then locks a removed file, sees it, retries
-        os.close(handle)
-
-
-def _lock_owner(lock: Path) -> tuple[int, str, str] | None:
-    try:
-        pid, host, since = lock.read_text().split()
-        return int(pid), host, since
-    except (OSError, ValueError):
-        return None
 
 
 def _count_cases(group: Any) -> int:
