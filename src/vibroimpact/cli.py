@@ -8,6 +8,7 @@ A first argument that names a subcommand runs it (a scene file of that name is s
 from __future__ import annotations
 
 import argparse
+import errno
 import os
 import resource
 import re
@@ -276,6 +277,16 @@ def unwritable(out_dir: Path) -> str | None:
     """Why files cannot be written into ``out_dir`` (created if missing), or ``None`` if they can."""
     if out_dir.exists() and not out_dir.is_dir():
         return "it exists and is not a folder"
+    for folder in (out_dir, *out_dir.parents):
+        if folder.is_symlink() and not folder.exists():  # mkdir would say "File exists"
+            try:
+                target = f"to {os.readlink(folder)}, which does not exist"
+                folder.resolve(strict=True)
+            except RuntimeError:
+                target = "in a loop of symbolic links"
+            except OSError as error:
+                target = "in a loop of symbolic links" if error.errno == errno.ELOOP else target
+            return f"{folder} is a symbolic link {target}"
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile(dir=out_dir, prefix=".write-test-"):
