@@ -10,12 +10,18 @@ import shutil
 from pathlib import Path
 from typing import Any, Callable
 
+import numpy as np
 import pytest
 import xarray as xr
 import zarr
 
+from tests.kinds.stepped.test_cases import _case
 from tests.test_cli_runner import _scene_file
 from vibroimpact import cli
+from vibroimpact.kinds.stepped.cases import FIELDS
+from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.runs.runner import Runner
+from vibroimpact.runs.store import StudyStore
 from vibroimpact.runs import store as store_module
 
 
@@ -191,3 +197,33 @@ def test_an_interrupt_while_the_store_is_removed_is_one_line(tmp_path: Path, mon
     monkeypatch.undo()
     assert cli.main([str(scene), "--out", str(out), "--jobs", "1", "--no-report"]) == 0
     assert not list(out.glob(".tiny.zarr.removed-*"))
+
+
+#: Damage to a store's finished cases: the group's own metadata, one case's metadata, the group replaced by a file.
+_CASE_DAMAGE: dict[str, Callable[[Path], None]] = {
+    "cases .zgroup lost": lambda store: (store / "cases/.zgroup").unlink(),
+    "cases .zgroup truncated": lambda store: (store / "cases/.zgroup").write_text("{"),
+    "a case's .zarray truncated": lambda store: next(store.glob("cases/*/.zarray")).write_text("{"),
+    "a case's .zattrs truncated": lambda store: next(store.glob("cases/*/.zattrs")).write_text("{"),
+    "cases a file": lambda store: (shutil.rmtree(store / "cases"), (store / "cases").write_text("x")),
+}
+
+
+@pytest.mark.faults
+@pytest.mark.timeout(300)
+@pytest.mark.parametrize("damage", sorted(_CASE_DAMAGE))
+def test_damaged_cases_are_computed_again_never_a_traceback(system: TwoDofSystem, tmp_path: Path, damage: str) -> None:
+    """A truncated .zgroup or .zattrs of the finished cases raised a JSONDecodeError on every rerun; now the group's
+    metadata is rebuilt, a case whose own is damaged is computed again, and the results are those of the first run."""
+    cases = [_case(system, "pgf", frequencies=(25.0,)), _case(system, "linear", frequencies=(30.0, 31.0))]
+    path = tmp_path / "study.zarr"
+    first = Runner(store=StudyStore(path, "fingerprint"), progress=False).map(cases)
+    _CASE_DAMAGE[damage](path)
+    said: list[str] = []
+    again = Runner(store=StudyStore(path, "fingerprint", say=said.append), progress=False).map(cases)
+    for before, after in zip(first, again):
+        for name in FIELDS:
+            if name != "wall_time":
+                np.testing.assert_array_equal(after[name], before[name])
+    assert StudyStore(path, "fingerprint").case_count() == 2
+    assert damage.startswith("a case's") or said, damage  # the group's damage is said in one line

@@ -202,6 +202,7 @@ class StudyStore:
             self.root.attrs.update({"fingerprint": fingerprint, "code": code_fingerprint(), "scene_path": source})
         self._grid_ready = _BLOCK_DONE in self.root or any(key in self.root.attrs for key in (_GRID_VARIABLES, _GRID_RECORD))
         self._arrays: dict[str, Any] = {}
+        self._cases_group: Any = None
 
     def start_afresh(self, why: str) -> None:
         """Set the store aside (renamed, never deleted; one line says where and why) and begin an empty one."""
@@ -212,6 +213,7 @@ class StudyStore:
         self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
         self.root.attrs.update({"fingerprint": self.fingerprint, "code": code_fingerprint(), "scene_path": self.scene_path})
         self._arrays.clear()
+        self._cases_group = None
         self._grid_ready = False
 
     def _discard_unless_ours(self, path: Path, source: str) -> None:
@@ -239,11 +241,11 @@ class StudyStore:
 
     def load_case(self, name: str, fields: tuple[str, ...]) -> dict[str, NDArray[np.generic]] | None:
         """The stored result of the case called ``name``, or None if it is not (completely) stored."""
-        path = f"{_CASES}/{name}"
-        if path not in self.root:
-            return None
         try:
-            node = self.root[path]
+            cases = self._cases()
+            if name not in cases:
+                return None
+            node = cases[name]
             checksum = node.attrs.get("checksum")
         except Exception:  # noqa: BLE001 - damaged metadata (a truncated .zarray or .zattrs): computed again
             self.damaged_cases += 1
@@ -271,15 +273,50 @@ class StudyStore:
         buffer = io.BytesIO()
         np.savez(buffer, **written)
         packed = np.frombuffer(buffer.getvalue(), dtype=np.uint8)
-        array = self.root.require_group(_CASES).create_array(name, shape=packed.shape, dtype=np.uint8, chunks=packed.shape, overwrite=True)
+        cases = self._cases()
+        try:
+            array = cases.create_array(name, shape=packed.shape, dtype=np.uint8, chunks=packed.shape, overwrite=True)
+        except Exception:  # noqa: BLE001 - the case's old metadata is unreadable (truncated): its folder goes whole
+            if self.path is None:
+                raise
+            shutil.rmtree(self.path / _CASES / name, ignore_errors=True)
+            array = cases.create_array(name, shape=packed.shape, dtype=np.uint8, chunks=packed.shape, overwrite=True)
         array[...] = packed
         array.attrs["checksum"] = values_digest(sorted(written.items())).hex()  # last: a case cut off before it is not stored
 
     def case_count(self) -> int:
         """Finished cases in the store."""
-        if _CASES not in self.root:
-            return 0
-        return _count_cases(self.root[_CASES])
+        if self.path is None:
+            return _count_cases(self._cases())
+        count = 0  # read file by file: a case whose metadata is damaged is not finished, and hides no other
+        for attributes in sorted((self.path / _CASES).glob("*/.zattrs")):
+            try:
+                count += bool(json.loads(attributes.read_text()).get("checksum"))
+            except (OSError, ValueError, AttributeError):
+                pass
+        return count
+
+    def _cases(self) -> Any:
+        """The group of finished cases; on disk, its own metadata (nothing but the format) rewritten where it is lost
+        or unreadable, and a file where its folder should be set aside with the whole store."""
+        if self._cases_group is not None:
+            return self._cases_group
+        if self.path is not None:
+            folder = self.path / _CASES
+            if folder.exists() and not folder.is_dir():
+                self.start_afresh(f"{folder.name} is not a folder")
+            elif folder.is_dir():
+                try:
+                    readable = json.loads((folder / ".zgroup").read_text()).get("zarr_format") == ZARR_FORMAT
+                    json.loads((folder / ".zattrs").read_text()) if (folder / ".zattrs").exists() else None
+                except (OSError, ValueError, AttributeError):
+                    readable = False
+                if not readable:
+                    (folder / ".zattrs").unlink(missing_ok=True)
+                    (folder / ".zgroup").write_text(json.dumps({"zarr_format": ZARR_FORMAT}))
+                    self.say(f"{folder}: its metadata was lost or unreadable: rebuilt")
+        self._cases_group = self.root.require_group(_CASES)
+        return self._cases_group
 
     # -- grid blocks -------------------------------------------------------------------------------------------
 
@@ -406,7 +443,11 @@ class StudyStore:
             count = int(np.prod([-(-n // b) for n, b in zip(*plan)])) if plan is not None else 0
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # zarr warns of the array whose metadata is lost: it goes anyway
-            names = {str(name) for name in self.root.attrs.get(_GRID_VARIABLES, [])} | set(self.root.array_keys())  # type: ignore[union-attr]
+            names = {str(name) for name in self.root.attrs.get(_GRID_VARIABLES, [])}  # type: ignore[union-attr]
+            try:
+                names |= set(self.root.array_keys())  # those of a grid cut off before its list was written
+            except Exception:  # noqa: BLE001 - an array whose metadata is unreadable: the folders tell
+                names |= {member.parent.name for member in self.path.glob("*/.zarray")} if self.path is not None else set()
             names -= {_CASES}
             for name in names:
                 if self.path is not None:  # on disk: the folder whole, an array whose metadata is lost has chunk files
