@@ -68,15 +68,17 @@ def green_condition(poles: ArrayLike, omega: ArrayLike, antiperiodic: bool = Fal
         return np.ones(w.shape)
     period = 2.0 * np.pi / w[..., None]
     with np.errstate(divide="ignore", over="ignore"):
-        denominator = 1.0 + np.exp(p * 0.5 * period) if antiperiodic else 1.0 - np.exp(p * period)
-        return np.max(1.0 / np.abs(denominator), axis=-1)
+        return np.max(1.0 / np.abs(_denominator(p, period, antiperiodic)), axis=-1)
+
+
+def _denominator(poles: NDArray[np.complex128], period: NDArray[np.float64], antiperiodic: bool) -> NDArray[np.complex128]:
+    """The periodic sum's 1 - exp(p T) (antiperiodic: 1 + exp(p T / 2)) [-], ``period`` T [s]."""
+    return 1.0 + np.exp(poles * 0.5 * period) if antiperiodic else 1.0 - np.exp(poles * period)
 
 
 def _weights(poles: NDArray[np.complex128], t: NDArray[np.float64], period: NDArray[np.float64], derivative: int, antiperiodic: bool) -> NDArray[np.complex128]:
     """p^d exp(p t) / (1 -+ exp(p T')) with T' = T (periodic) or T/2 (antiperiodic)."""
-    if antiperiodic:
-        return poles**derivative * np.exp(poles * t) / (1.0 + np.exp(poles * 0.5 * period))
-    return poles**derivative * np.exp(poles * t) / (1.0 - np.exp(poles * period))
+    return poles**derivative * np.exp(poles * t) / _denominator(poles, period, antiperiodic)
 
 
 def periodic_green(model: PoleResidueModel, omega: ArrayLike, t: ArrayLike, derivative: int = 0, antiperiodic: bool = False, paired: bool = False) -> NDArray[np.float64]:
@@ -111,11 +113,11 @@ def periodic_green(model: PoleResidueModel, omega: ArrayLike, t: ArrayLike, deri
     if paired:
         p, residues, weight = _real_sum_terms(model)
         # the coefficients once per frequency, then one exponential per time and pole (the time axis is the long one)
-        coefficient = residues * p**derivative / (1.0 + np.exp(p * 0.5 * period) if antiperiodic else 1.0 - np.exp(p * period))
+        coefficient = residues * p**derivative / _denominator(p, period, antiperiodic)
         return np.sum(weight * (coefficient * np.exp(p * tt)).real, axis=-1)
     p = model.poles
     if not antiperiodic:  # the paper's path, unchanged
-        terms = model.residues * p**derivative * np.exp(p * tt) / (1.0 - np.exp(p * period))
+        terms = model.residues * p**derivative * np.exp(p * tt) / _denominator(p, period, False)
         return np.sum(terms, axis=-1).real
     return np.sum(model.residues * _weights(p, tt, period, derivative, True), axis=-1).real
 
