@@ -85,13 +85,14 @@ class Runner:
     report : callable or None
         Receives the work done so far by this runner, summed over its cases (a runner inside a worker task passes its
         progress on to the task's own report).
-    engines : sequence of str
-        Registered engines the work runs: each dask worker loads their compiled kernels (:class:`~vibroimpact.runs.kernel_loader.KernelLoader`) before
-        its first task, so no task's own timing includes loading (or compiling) them.
+
+    The registered engines the work runs are named by :meth:`use_engines`, once their kernels are compiled: each dask
+    worker loads them (:class:`~vibroimpact.runs.kernel_loader.KernelLoader`) before its first task, so no task's own
+    timing includes loading (or compiling) them.
     """
 
-    def __init__(self, jobs: int = 1, scheduler: str | None = None, store: StudyStore | None = None, progress: bool = True, report: ProgressReport | None = None, engines: Sequence[str] = ()) -> None:
-        self.engines = tuple(engines)
+    def __init__(self, jobs: int = 1, scheduler: str | None = None, store: StudyStore | None = None, progress: bool = True, report: ProgressReport | None = None) -> None:
+        self.engines: tuple[str, ...] = ()
         self.jobs = jobs
         self.scheduler = scheduler
         self.store = store
@@ -121,8 +122,12 @@ class Runner:
         the engines' kernels load on the workers once :meth:`use_engines` names them."""
         if self.distributed and self._connection is None:
             if self.progress:  # the start takes ~1 s, 5-16 s under load: said before it begins
-                print(f"starting {self.jobs} worker processes" if self.scheduler is None else f"connecting to the dask scheduler at {self.scheduler}", file=sys.stderr, flush=True)
+                print(self._starting(), file=sys.stderr, flush=True)
             self.connection.client.run(import_libraries, wait=False)  # type: ignore[attr-defined]
+
+    def _starting(self) -> str:
+        """What the start of the dask connection does, in words (said before it begins, and by the bar meanwhile)."""
+        return f"starting {self.jobs} worker processes" if self.scheduler is None else f"connecting to the dask scheduler at {self.scheduler}"
 
     def use_engines(self, engines: Sequence[str]) -> None:
         """The registered engines the work runs, their kernels compiled in this process by now
@@ -256,7 +261,7 @@ class Runner:
         order = [index for index in range(len(items)) if index not in skipped]
         starting = ""  # the bar's heartbeat says why nothing moves while the cluster starts (5-16 s)
         if self.distributed and self._connection is None:
-            starting = f"starting {self.jobs} worker processes" if self.scheduler is None else f"connecting to the dask scheduler at {self.scheduler}"
+            starting = self._starting()
         bar = ProgressBar(list(totals), list(skipped), unit, self.progress, verb, done_before, status=starting)
         try:
             if not self.distributed:
