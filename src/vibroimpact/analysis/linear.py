@@ -25,7 +25,7 @@ from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce, angular_frequency, check_closed_form_inputs
 from vibroimpact.model.layout import Layout
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.structure import LinearStructure
+from vibroimpact.model.structure import CONDITION_LIMIT, LinearStructure, harmonic_condition
 from vibroimpact.model.system import TwoDofSystem
 
 __all__ = ["contact_free_is_stable", "base_coupling", "base_force", "peaks_near", "LinearResponse", "paper_linear_response", "linear_response", "ResonancePeak", "resonance_peaks", "LinearAmplitudes", "linear_amplitudes", "linear_reach", "structure_amplitudes", "structure_peaks"]
@@ -159,9 +159,10 @@ class LinearAmplitudes:
         Angular frequencies w [rad s-1], shape S (:attr:`frequency` f [Hz]).
     amplitudes : ndarray of complex, shape S + (N,)
         H(jw) F(w): complex amplitude of each coordinate in the problem's time [m], columns in the order of
-        ``coordinates`` (:meth:`coordinate` by name).
+        ``coordinates`` (:meth:`coordinate` by name); NaN where the response is ill-conditioned (:attr:`conditioned`).
     stop_amplitudes : ndarray of complex, shape S + (K,)
-        n_k . H F: complex amplitude of each stop's coordinate (the quantity its gap Delta_k - n_k . x subtracts) [m].
+        n_k . H F: complex amplitude of each stop's coordinate (the quantity its gap Delta_k - n_k . x subtracts) [m];
+        NaN where :attr:`amplitudes` is.
     static : ndarray, shape (N,)
         K^-1 F0, the static deflection [m] (NaN where K is singular and a static load is given; zeros without one).
     stop_static : ndarray, shape (K,)
@@ -170,6 +171,13 @@ class LinearAmplitudes:
         The coordinates' names (as :attr:`TimeHistory.coordinates <vibroimpact.simulation.history.TimeHistory.coordinates>`).
     structure : LinearStructure
         The structure (its K and C give :attr:`force`).
+    condition : ndarray, shape S
+        kappa of the harmonic response [-] (:func:`~vibroimpact.model.structure.harmonic_condition`, ~1 / (2 pi
+        relative detuning) near an undamped natural frequency): beyond
+        :data:`~vibroimpact.model.structure.CONDITION_LIMIT` (within ~1.6e-5 relative of an undamped natural
+        frequency, or at a resonance damped zeta < 1.6e-5) the response is not evaluated, as the other closed forms'
+        (:attr:`ImpactOrbit.conditioned <vibroimpact.analysis.impact_orbit.ImpactOrbit.conditioned>`) and the steady
+        states' band: :attr:`amplitudes` NaN there (before: 1.4e12 m at an undamped resonance).
     """
 
     omega: NDArray[np.float64]
@@ -179,6 +187,13 @@ class LinearAmplitudes:
     stop_static: NDArray[np.float64]
     coordinates: tuple[str, ...]
     structure: LinearStructure
+    condition: NDArray[np.float64]
+
+    @property
+    def conditioned(self) -> NDArray[np.bool_]:
+        """Where the response is evaluated: condition <= CONDITION_LIMIT, shape S (False near an undamped natural
+        frequency, where the amplitudes are NaN: unknown, not absent)."""
+        return self.condition <= CONDITION_LIMIT
 
     @property
     def frequency(self) -> NDArray[np.float64]:
@@ -228,7 +243,8 @@ def linear_response(system: ImpactProblem | TwoDofSystem, frequency: ArrayLike |
     -------
     LinearAmplitudes
         ``amplitudes`` per coordinate [m] (``coordinate(name)``), ``frequency`` [Hz] beside ``omega`` [rad s-1],
-        the base ``force`` [N], ``fits(clearances)``.
+        the base ``force`` [N], ``fits(clearances)``; NaN (and ``fits`` False) where ``conditioned`` is False, within
+        ~1.6e-5 (relative) of an undamped natural frequency, where the response is ill-conditioned.
     """
     if not isinstance(system, ImpactProblem):
         if not isinstance(system, TwoDofSystem):
@@ -265,6 +281,10 @@ def structure_amplitudes(
     w = np.asarray(angular_frequency(frequency, omega, excitation.omega), dtype=float)
     load = harmonic_load_of(structure, excitation, w, amplitude)
     x = np.einsum("...ij,...j->...i", structure.receptance_matrix(w), load)
+    condition = harmonic_condition(np.linalg.eigvals(structure.state_matrix), w)
+    refused = np.broadcast_to(condition > CONDITION_LIMIT, x.shape[:-1])
+    if np.any(refused):
+        x = np.where(refused[..., None], np.nan, x)  # the closed forms' and the engines' band: no number
     normals = np.asarray(normals, dtype=float)
     static_load = excitation.static_vector(structure.size)
     if not np.any(static_load):
@@ -273,7 +293,7 @@ def structure_amplitudes(
         static = np.full(structure.size, np.nan)
     else:
         static = np.linalg.solve(structure.stiffness_matrix, static_load)
-    return LinearAmplitudes(w, x, x @ normals.T, static, normals @ static, tuple(structure.coordinates), structure)
+    return LinearAmplitudes(w, x, x @ normals.T, static, normals @ static, tuple(structure.coordinates), structure, condition)
 
 
 def linear_reach(layout: Layout, amplitude: float, frequency: float) -> NDArray[np.float64]:

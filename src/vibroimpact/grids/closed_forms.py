@@ -56,7 +56,10 @@ def _per_coordinate(scene: Scene, template: str, values: np.ndarray) -> dict[str
 
 def general_linear_values(scene: Scene, omega: np.ndarray, shape: tuple[int, ...]) -> dict[str, np.ndarray]:
     """The linear steady state (no stop) at ``omega`` [rad s-1] (axes of the full grid), flagged where it crosses a
-    stop; the scene's quantities broadcast to ``shape`` (per-stop ones to (K, *shape))."""
+    stop; the scene's quantities broadcast to ``shape`` (per-stop ones to (K, *shape)). Where the harmonic response
+    is ill-conditioned (near an undamped natural frequency, :attr:`LinearAmplitudes.conditioned
+    <vibroimpact.analysis.linear.LinearAmplitudes.conditioned>`) the regime is ``failed`` and every value NaN, as
+    the other closed forms'."""
     problem = first_problem(scene)
     linear = linear_amplitudes(problem, omega=omega)
     x = linear.amplitudes  # omega.shape + (N,)
@@ -66,20 +69,22 @@ def general_linear_values(scene: Scene, omega: np.ndarray, shape: tuple[int, ...
     force = base_force(scene.layout.structure, omega, x)
     rms = np.sqrt(linear.static**2 + 0.5 * np.abs(x) ** 2)
     zero_or_nan = np.where(fits, 0.0, np.nan)
+    zero = np.where(linear.conditioned, 0.0, np.nan)  # NaN where refused (ill-conditioned)
+    regime = np.where(fits, Regime.LINEAR, Regime.LINEAR_EXCEEDS_CLEARANCE)
     values = {
         **_per_coordinate(scene, "x1_amplitude", np.abs(x)),
         **_per_coordinate(scene, "x1_rms", rms),
         **_per_coordinate(scene, "one_impact_x1_amplitude", np.full(x.shape, np.nan)),
         "force_amplitude": np.abs(force),
         "suspension_force_amplitude": np.abs(force),
-        "impulse": np.zeros((count, *shape)),
+        "impulse": np.broadcast_to(zero, (count, *shape)),
         "phase": np.full(shape, np.nan),
-        "regime": np.where(fits, Regime.LINEAR, Regime.LINEAR_EXCEEDS_CLEARANCE).astype(np.int8),
+        "regime": np.where(linear.conditioned, regime, Regime.FAILED).astype(np.int8),
         "stable": np.full(shape, -1, dtype=np.int8),
         "floquet_modulus": np.full(shape, np.nan),
         "one_impact_force_amplitude": np.full(shape, np.nan),
         "one_impact_impulse": np.full((count, *shape), np.nan),
-        "impacts_per_period": np.zeros(shape),
+        "impacts_per_period": np.broadcast_to(zero, shape),
         "converged": np.full(shape, -1, dtype=np.int8),
         "peak_acceleration": np.broadcast_to(zero_or_nan, (count, *np.shape(zero_or_nan))),
         "peak_contact_force": np.broadcast_to(zero_or_nan, (count, *np.shape(zero_or_nan))),
@@ -126,6 +131,7 @@ def general_pgf_values(scene: Scene, omega: np.ndarray, delta: np.ndarray, r: np
     unstable = modulus > 1.0 + MARGINAL_MODULUS
     regime[(regime == Regime.ONE_IMPACT_COEXISTING_LINEAR) & unstable] = Regime.LINEAR_WITH_UNSTABLE_ONE_IMPACT
     regime[~np.broadcast_to(orbit.conditioned, regime.shape)] = Regime.FAILED  # ill-conditioned sums: values NaN
+    regime[~np.broadcast_to(linear.conditioned, regime.shape) & ~np.isin(regime, _IMPACT_REGIMES)] = Regime.FAILED  # nor the linear motion known
     impact = np.isin(regime, _IMPACT_REGIMES)
     free = np.isin(regime, _LINEAR_REGIMES)
     count = len(scene.layout.stops)
