@@ -48,6 +48,9 @@ WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ": WORKER_ENVIRONMENT, "dis
 WORKER_LIBRARIES = ("numpy", "scipy.integrate", "scipy.optimize", "scipy.linalg", "xarray", "zarr", "numba", "dask.array")
 #: How long connecting to a named scheduler may take before the study gives up [s].
 CONNECT_TIMEOUT = 30.0
+#: How long a named scheduler without workers is given for one to join before the study, not begun, gives up [s]
+#: (:func:`unreachable`; without the check: ``TimeoutError: No valid workers found`` after 30-46 s, an empty store left).
+WORKER_WAIT = 20.0
 
 
 class ClusterLost(RuntimeError):
@@ -110,11 +113,14 @@ class Connection:
                 self.cluster.close(timeout=10)  # type: ignore[attr-defined]
 
 
-def unreachable(scheduler: str, timeout: float = 10.0) -> str | None:
-    """Why the dask scheduler at ``scheduler`` cannot be reached (within ``timeout`` [s]), or None if it can.
+def unreachable(scheduler: str, timeout: float = 10.0, worker_wait: float | None = None) -> str | None:
+    """Why the dask scheduler at ``scheduler`` cannot run a study (not reached within ``timeout`` [s], or no worker
+    within ``worker_wait`` [s], default :data:`WORKER_WAIT`), or None if it can.
 
     The handshake has a deadline of its own: a server that accepts the connection but is not a dask scheduler (its
-    dashboard's port, a web server) would otherwise keep the client waiting for an answer that never comes.
+    dashboard's port, a web server) would otherwise keep the client waiting for an answer that never comes. A
+    scheduler that answers but has no worker is given ``worker_wait`` for one to join (workers of a batch system may
+    start after it); then it is refused too, before the study makes its store.
     """
     from distributed import Client
     from distributed.comm.registry import backends
@@ -122,7 +128,10 @@ def unreachable(scheduler: str, timeout: float = 10.0) -> str | None:
     scheme = scheduler.split("://", 1)[0] if "://" in scheduler else "tcp"
     if scheme not in backends:  # refused before a client exists (a client that never connected warns as it goes)
         return f"unknown address scheme {scheme!r}: dask knows {', '.join(sorted(backends))} (e.g. tcp://host:8786)"
+    wait = WORKER_WAIT if worker_wait is None else worker_wait
+    no_workers = f"it has no workers: none joined within {wait:g} s (start some with 'dask worker {scheduler}', or give --jobs N without a scheduler to run on this machine)"
     outcome: list[str | None] = []
+    reached: list[bool] = []
 
     def handshake() -> None:
         logging.getLogger("distributed").setLevel(logging.CRITICAL)  # the one line below says what went wrong
@@ -131,14 +140,23 @@ def unreachable(scheduler: str, timeout: float = 10.0) -> str | None:
         except Exception as error:  # noqa: BLE001 - any failure of the handshake is an answer: not reachable
             outcome.append(f"{type(error).__name__}: {error}" if str(error) else type(error).__name__)
             return
-        client.close()
-        outcome.append(None)
+        reached.append(True)
+        try:
+            client.wait_for_workers(1, timeout=wait)
+        except TimeoutError:
+            outcome.append(no_workers)
+        except Exception as error:  # noqa: BLE001 - the scheduler went away while asked: not usable
+            outcome.append(f"{type(error).__name__}: {error}" if str(error) else type(error).__name__)
+        else:
+            outcome.append(None)
+        finally:
+            client.close()
 
     thread = threading.Thread(target=handshake, name="vibroimpact-scheduler-check", daemon=True)
     thread.start()
-    thread.join(timeout + 2.0)
+    thread.join(timeout + wait + 2.0)
     if not outcome:  # the thread is left behind: the study stops here (exit 2)
-        return f"no dask scheduler answered within {timeout:.0f} s (a server that is not a dask scheduler, such as the dashboard's port?)"
+        return no_workers if reached else f"no dask scheduler answered within {timeout:.0f} s (a server that is not a dask scheduler, such as the dashboard's port?)"
     return outcome[0]
 
 

@@ -275,6 +275,9 @@ class Runner:
 
     def _run_distributed(self, function: TaskFunction, shared: Any, items: Sequence[Any], order: list[int], bar: ProgressBar, finished: Callable[[int, Any], None]) -> None:
         connection = self.connection
+        if connection.worker_count() == 0:  # a named scheduler without workers: a broadcast would wait dask's own timeout
+            bar.set_status(f"waiting for a worker to join the dask scheduler (at most {NO_WORKER_TIMEOUT:.0f} s)")
+            _wait_for_a_worker(connection)
         bar.set_status("waiting for the workers' first results")
         client: Any = connection.client
         token = uuid.uuid4().hex[:12]
@@ -352,6 +355,16 @@ class WorkerDied(RuntimeError):
 ALLOWED_FAILURES = 3
 #: How long a cluster may have no worker at all before the study gives up [s].
 NO_WORKER_TIMEOUT = 120.0
+
+
+def _wait_for_a_worker(connection: Connection) -> None:
+    """Return once the cluster has a worker; raise :class:`ClusterLost` when none joins within
+    :data:`NO_WORKER_TIMEOUT` (before: ``TimeoutError: No valid workers found`` from the broadcast of the shared data,
+    after dask's own timeout, 30-46 s)."""
+    try:
+        connection.client.wait_for_workers(1, timeout=NO_WORKER_TIMEOUT)  # type: ignore[attr-defined]
+    except TimeoutError:
+        raise ClusterLost(f"the dask scheduler at {connection.address} has no workers: none joined within {NO_WORKER_TIMEOUT:g} s") from None
 
 
 def _check_workers(connection: Connection, alone_since: list[float]) -> None:
