@@ -1,9 +1,11 @@
 """Smaller misuse cases of issue 34, item 8: a dask scheduler without workers is refused in one line within a bounded
-wait, leaving no store (before: ``TimeoutError: No valid workers found`` after 30-46 s, exit 1, an empty store
-left)."""
+wait, leaving no store (before: ``TimeoutError: No valid workers found`` after 30-46 s, exit 1, an empty store left);
+a chattering IDA run says its failure in one line, not in SUNDIALS' ~2 800 lines of ``[IDASolve, Error: -22]``."""
 
 from __future__ import annotations
 
+import sys
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -11,6 +13,13 @@ import numpy as np
 import pytest
 
 from vibroimpact import cli
+from vibroimpact.engines.compliant import ida
+from vibroimpact.engines.registry import make_engine
+from vibroimpact.engines.sundae import solver_messages
+from vibroimpact.model.contact import KelvinVoigtBumper, loss_factor_from_restitution
+from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.runs import cluster, runner
 from vibroimpact.runs.cluster import ClusterLost
 from vibroimpact.runs.runner import Runner
@@ -59,3 +68,39 @@ def test_a_runner_on_a_scheduler_without_workers_gives_up_naming_it(idle_schedul
 def _twice(shared: np.ndarray, item: float, _report: object) -> np.ndarray:
     return shared * item * 2.0
 
+
+def _chattering() -> ImpactProblem:
+    """The paper's system at 10 Hz on a 100 kHz bumper at zero clearance, R = 0.01: IDA meets ~30 close roots in 30
+    periods (an event function at round-off zero at a recorded root, IDA_ILL_INPUT), each handled by a restart."""
+    return ImpactProblem(PAPER_SYSTEM, KelvinVoigtBumper(0.0, 100_000.0, loss_factor_from_restitution(0.01)), HarmonicForce(10.0, 10.0))
+
+
+@pytest.mark.timeout(120)
+def test_a_chattering_ida_run_prints_nothing_of_sundials(capfd: pytest.CaptureFixture[str]) -> None:
+    run = make_engine("compliant").integrate(_chattering(), np.zeros(4), 0.0, 30)
+    out, err = capfd.readouterr()
+    assert run.strobe_times.size == 31 and run.stats["contacts"] > 30
+    assert "IDASolve" not in out + err and not out.strip(), (out + err)[:2000]
+
+
+@pytest.mark.timeout(120)
+def test_a_failing_ida_run_says_sundials_reason_in_its_one_line(monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setattr(ida, "_MAX_SWITCHES_IN_PLACE", -1)  # the first close root counts as stuck
+    with pytest.raises(RuntimeError) as failure:
+        make_engine("compliant").integrate(_chattering(), np.zeros(4), 0.0, 30)
+    message = str(failure.value)
+    assert message.startswith("IDA stops at close roots over and over at t = ") and "\n" not in message, message
+    assert "(SUNDIALS: [IDASolve, Error: -22] Root found at and very near t = " in message, message
+    out, err = capfd.readouterr()
+    assert "IDASolve" not in out + err, (out + err)[:2000]
+
+
+def test_solver_messages_keep_only_the_calling_thread_s_output(capsys: pytest.CaptureFixture[str]) -> None:
+    stdout = sys.stdout
+    with solver_messages() as said:
+        print("[IDASolve, Error: -22] kept")
+        other = threading.Thread(target=print, args=("another thread's line",))
+        other.start()
+        other.join()
+    assert said == ["[IDASolve, Error: -22] kept"] and sys.stdout is stdout
+    assert capsys.readouterr().out == "another thread's line\n"

@@ -13,8 +13,13 @@ from __future__ import annotations
 
 import ctypes as C
 import glob
+import io
 import os
+import sys
+import threading
 import weakref
+from collections.abc import Iterator
+from contextlib import contextmanager
 from functools import lru_cache
 from typing import Any
 
@@ -23,7 +28,7 @@ from numba import types
 from numba.extending import intrinsic
 from numpy.typing import NDArray
 
-__all__ = ["clear_event_records", "CompiledCvode", "compiled_cvode_problem", "content_data", "as_doubles", "evaluate_compiled"]
+__all__ = ["clear_event_records", "solver_messages", "CompiledCvode", "compiled_cvode_problem", "content_data", "as_doubles", "evaluate_compiled"]
 
 _ADAMS, _BDF, _NORMAL = 1, 2, 1
 #: CVODE's return flags for a stop at ``tstop`` and at a root.
@@ -48,6 +53,64 @@ def clear_event_records(events: Any) -> None:
     counts = getattr(events, "_i_cnt", None)
     if counts is not None:
         counts[:] = 0
+
+
+class _ThreadsOwnOutput(io.TextIOBase):
+    """``sys.stdout`` while solver calls run (:func:`solver_messages`): what a thread inside such a call writes goes to
+    that call's buffer, what any other thread writes goes on to the stream it replaced."""
+
+    def __init__(self, stream: Any) -> None:
+        self.stream = stream
+        self.buffers = threading.local()
+
+    def write(self, text: str) -> int:
+        buffer = getattr(self.buffers, "current", None)
+        if buffer is None and self.stream is None:  # no stdout at all (print then writes nothing)
+            return len(text)
+        return (buffer if buffer is not None else self.stream).write(text)
+
+    def flush(self) -> None:
+        if getattr(self.buffers, "current", None) is None and self.stream is not None:
+            self.stream.flush()
+
+    def __getattr__(self, name: str) -> Any:  # encoding, isatty, fileno, ...: the stream's
+        return getattr(self.stream, name)
+
+
+_OUTPUT_LOCK = threading.Lock()
+_output: list[Any] = [None, 0]  # the installed _ThreadsOwnOutput and how many calls use it
+
+
+@contextmanager
+def solver_messages() -> Iterator[list[str]]:
+    """Keep what scikit-sundae prints during a solver call, and yield it as a list of lines (filled on exit).
+
+    scikit-sundae 1.2.0 replaces SUNDIALS' error handler by one that prints every error to ``sys.stdout``
+    (``[IDASolve, Error: -22] Root found at and very near t = ...``), a handled return included: a chattering
+    compliant run printed ~2 800 such lines. The caller says a failure in its own one line, with the last of these
+    when it helps. Other threads' output is not touched (``sys.stdout`` is shared: a proxy sends only the calling
+    thread's writes to the buffer, and is removed when the last call using it ends).
+    """
+    buffer = io.StringIO()
+    lines: list[str] = []
+    with _OUTPUT_LOCK:
+        if _output[1] == 0:
+            _output[0] = _ThreadsOwnOutput(sys.stdout)
+            sys.stdout = _output[0]
+        _output[1] += 1
+        proxy = _output[0]
+    proxy.buffers.current = buffer
+    try:
+        yield lines
+    finally:
+        proxy.buffers.current = None
+        with _OUTPUT_LOCK:
+            _output[1] -= 1
+            if _output[1] == 0:
+                if sys.stdout is proxy:  # else replaced meanwhile (a test's capture): left as it is
+                    sys.stdout = proxy.stream
+                _output[0] = None
+        lines.extend(line.strip() for line in buffer.getvalue().splitlines() if line.strip())
 
 
 @intrinsic

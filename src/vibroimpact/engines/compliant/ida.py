@@ -43,7 +43,7 @@ from vibroimpact.engines.compliant.model import MODE_CONTACT, BumperModel, absol
 from vibroimpact.engines.event_loop import moment_row
 from vibroimpact.engines.registry import BUMPER_INTEGRATOR, Capabilities
 from vibroimpact.engines.settings import EngineSettings
-from vibroimpact.engines.sundae import clear_event_records
+from vibroimpact.engines.sundae import clear_event_records, solver_messages
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import require_positive
@@ -220,6 +220,11 @@ class CompliantEngine:
         return IDA(model.residual(contact), **options), events
 
 
+def _last(said: list[str]) -> str:
+    """The last of SUNDIALS' messages in a solver call, for the failure's one line (``''`` if it said nothing)."""
+    return f" (SUNDIALS: {said[-1]})" if said else ""
+
+
 def base_force(problem: ImpactProblem, states: NDArray[np.float64], contact: NDArray[np.float64]) -> NDArray[np.float64]:
     """Force on the base [N] from samples of (x, x') (rows) and of each stop's contact force (rows of K): the springs
     and dashpots to the ground, 1^T (K x + C x'), plus each stop's force on the base, (1^T n_k) lambda_k (+lambda_k
@@ -289,10 +294,11 @@ class _Run:
                 tspan = np.array([self.t, 0.5 * (self.t + outputs[i]), outputs[i]])
             solver, events = self.solver(self.contact)
             self.counts["solver_calls"] += 1
-            result = self.engine.solve(solver, tspan, self.y, self.model.derivative(self.t, self.y, self.contact))
+            with solver_messages() as said:  # SUNDIALS' own words on each error, handled ones too: not printed
+                result = self.engine.solve(solver, tspan, self.y, self.model.derivative(self.t, self.y, self.contact))
             close_roots = self._close_roots(result)
             if result.status < 0 and not close_roots:
-                raise RuntimeError(f"IDA failed at t = {float(result.t[-1])!r} s: {result.message}")
+                raise RuntimeError(f"IDA failed at t = {float(result.t[-1])!r} s: {result.message}{_last(said)}")
             times, states = result.t[1:], result.y[1:]
             stopped = result.status == _STATUS_ROOT  # on a terminal event: the last row is the root
             # on close roots the last row is the recorded root where the solver stopped: the run goes on from there
@@ -309,7 +315,7 @@ class _Run:
             if close_roots:
                 in_place = in_place + 1 if end_t == last_switch else 0
                 if in_place > _MAX_SWITCHES_IN_PLACE:
-                    raise RuntimeError(f"IDA stops at close roots over and over at t = {end_t!r} s: {result.message}")
+                    raise RuntimeError(f"IDA stops at close roots over and over at t = {end_t!r} s: {result.message}{_last(said)}")
                 last_switch = end_t
             self.t, self.y = end_t, np.array(end_y)
             if stopped:
