@@ -40,6 +40,7 @@ if TYPE_CHECKING:
 __all__ = [
     "RIGID",
     "BUMPER",
+    "MAX_LOSS_FACTOR",
     "Stop",
     "CoordinateRef",
     "default_coordinates",
@@ -134,6 +135,10 @@ class RigidStop:
         return Impact(velocity, after, sticks, mass * (velocity - after))
 
 
+#: The most damped bumper accepted, as xi_b [-] (its restitution 2.5e-7): the scenes' limit too.
+MAX_LOSS_FACTOR = 1e3
+
+
 @dataclass(frozen=True)
 class KelvinVoigtBumper:
     """Visco-elastic bumper (eq. 25): clearance Delta [m], apparent natural frequency Omega_b / 2 pi [Hz] (:attr:`omega`
@@ -146,7 +151,7 @@ class KelvinVoigtBumper:
     frequency : float
         Apparent natural frequency Omega_b / 2 pi [Hz], > 0.
     loss_factor : float
-        xi_b [-], >= 0 (overdamped bumpers, xi_b >= 1, are allowed).
+        xi_b [-], in [0, :data:`MAX_LOSS_FACTOR`] (overdamped bumpers, xi_b >= 1, are allowed).
     """
 
     clearance: float = field(metadata={"units": "m"})
@@ -156,7 +161,11 @@ class KelvinVoigtBumper:
     def __post_init__(self) -> None:
         require_finite("clearance", self.clearance)
         require_positive("frequency", self.frequency)
-        require_non_negative("loss_factor", self.loss_factor)
+        if not require_non_negative("loss_factor", self.loss_factor) <= MAX_LOSS_FACTOR:
+            raise ValueError(
+                f"loss_factor = {self.loss_factor!r} is out of range: allowed [0, {MAX_LOSS_FACTOR:g}] (beyond it a bumper's slow "
+                f"decay rate Omega_b / (2 xi_b) is lost to round-off beside its fast one, 2 xi_b Omega_b; its restitution is already "
+                f"{restitution_from_loss_factor(MAX_LOSS_FACTOR):.2g} at {MAX_LOSS_FACTOR:g})")
 
     @classmethod
     def from_stiffness(
@@ -239,6 +248,8 @@ def release_time(xi: float) -> float:
     if xi == 1.0:
         return 2.0
     s = math.sqrt(xi * xi - 1.0)
+    if xi > 1e4:  # s / xi rounds to 1 (atanh: a domain error from 7e7 on); atanh(s / xi) = log(xi + s) since xi^2 - s^2 = 1
+        return 2.0 * math.log(xi + s) / s
     return 2.0 * math.atanh(s / xi) / s
 
 
@@ -280,8 +291,10 @@ def loss_factor_from_restitution(restitution: float) -> float:
     high = 1.0
     while restitution_from_loss_factor(high) > r:
         high *= 2.0
-        if high > 1e12:
-            raise ValueError(f"restitution = {r!r} is below what a bumper of loss factor up to 1e12 reaches")
+        if high > MAX_LOSS_FACTOR:
+            if restitution_from_loss_factor(MAX_LOSS_FACTOR) > r:
+                raise ValueError(f"restitution = {r!r} is below what a bumper of loss factor up to {MAX_LOSS_FACTOR:g} reaches: allowed [{restitution_from_loss_factor(MAX_LOSS_FACTOR):.3g}, 1]")
+            high = MAX_LOSS_FACTOR
     from scipy.optimize import brentq  # here, not at import: reading a scene must not load scipy's solvers
 
     return float(brentq(lambda xi: restitution_from_loss_factor(xi) - r, 0.0, high, xtol=1e-15, rtol=1e-15))

@@ -18,7 +18,7 @@ import dataclasses
 import math
 from typing import Any, NamedTuple
 
-from vibroimpact.model.contact import KelvinVoigtBumper
+from vibroimpact.model.contact import MAX_LOSS_FACTOR, KelvinVoigtBumper
 from vibroimpact.model.layout import Layout, StopSpec
 from vibroimpact.scene.checker import Checker
 from vibroimpact.scene.schema import MAX_BUMPER_FREQUENCY as _MAX_FREQUENCY
@@ -29,8 +29,8 @@ __all__ = ["BUMPER_KEYS", "PHYSICAL_KEYS", "MAX_BUMPER_LOSS_FACTOR", "BumperSpec
 BUMPER_KEYS = {"frequency", "loss_factor", "stiffness", "damping"}
 #: Keys of a bumper in physical units only.
 PHYSICAL_KEYS = {"stiffness", "damping"}
-#: Most damped bumper accepted, as xi_b [-].
-MAX_BUMPER_LOSS_FACTOR = 1e3
+#: Most damped bumper accepted, as xi_b [-]: the model's own limit.
+MAX_BUMPER_LOSS_FACTOR = MAX_LOSS_FACTOR
 
 
 class BumperSpec(NamedTuple):

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import lru_cache
@@ -90,7 +90,7 @@ def _harmonics(problem: ImpactProblem, modes: tuple) -> list[NDArray[np.complex1
     b = np.concatenate([np.zeros(problem.size, dtype=complex), np.linalg.solve(problem.structure.mass_matrix.astype(complex), harmonic)])
     out = []
     for mask, (a, unforced) in enumerate(modes):
-        with _in_contact(mask, len(problem.stops)):
+        with _in_contact(mask, [stop.law for stop in problem.stops]):  # type: ignore[misc]
             out.append(harmonic_response(unforced, a, b, problem.omega))
     return out
 
@@ -133,7 +133,7 @@ def contact_modes(problem: ImpactProblem) -> tuple[tuple[tuple[NDArray[np.float6
             _check_resolved(k_mode, mask, normals, rigid, laws, k_b)
         a = np.block([[np.zeros((size, size)), np.eye(size)], [-np.linalg.solve(mass, k_mode), -np.linalg.solve(mass, c_mode)]])
         b0 = np.concatenate([np.zeros(size), np.linalg.solve(mass, load)])
-        with _in_contact(mask, count):
+        with _in_contact(mask, laws):
             modes.append((a, unforced_flow(a, b0, mechanical_null_basis(mass, k_mode, c_mode))))
     return tuple(modes), k_b, b_b, masses
 
@@ -188,18 +188,19 @@ def _check_resolved(
 
 
 @contextmanager
-def _in_contact(mask: int, count: int) -> Iterator[None]:
-    """A mode's refusal (``ValueError``) said as the contact's: in contact with the stops of ``mask``, the free flight's
-    as it is."""
+def _in_contact(mask: int, laws: Sequence[KelvinVoigtBumper]) -> Iterator[None]:
+    """A mode's refusal (``ValueError``) said as the contact's, naming each pushing stop's loss factor; the free
+    flight's as it is."""
     try:
         yield
     except ValueError as error:
         if not mask:
             raise
-        pushing = ", ".join(str(k) for k in range(count) if (mask >> k) & 1)
+        pushing = [k for k in range(len(laws)) if (mask >> k) & 1]
+        losses = ", ".join(f"stop {k}: loss_factor = {laws[k].loss_factor:g}" for k in pushing)
         raise ValueError(
-            f"contact: in contact with stop(s) {pushing}: {error} (a critically damped bumper, loss factor 1, on a body nothing else "
-            "holds has a repeated eigenvalue): use a loss factor off 1, or the integrating engine 'compliant'"
+            f"contact: in contact with stop(s) {', '.join(map(str, pushing))} ({losses}): {error} (a critically damped bumper, "
+            "loss factor 1, on a body nothing else holds has a repeated eigenvalue): use a loss factor off 1, or the integrating engine 'compliant'"
         ) from error
 
 
