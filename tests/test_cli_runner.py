@@ -53,7 +53,7 @@ def test_an_unreachable_scheduler_is_refused_before_any_work(tmp_path: Path, mon
         port = probe.getsockname()[1]
     out = tmp_path / "out"
     assert cli.main([str(_scene_file(tmp_path)), "--scheduler", f"tcp://127.0.0.1:{port}", "--out", str(out)]) == cli.EXIT_BAD_INPUT
-    assert f"run-study: error: cannot reach the dask scheduler at tcp://127.0.0.1:{port}" in capsys.readouterr().err
+    assert f"run-study: error: cannot use the dask scheduler at tcp://127.0.0.1:{port}" in capsys.readouterr().err
     assert not out.exists()
 
 

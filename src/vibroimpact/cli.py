@@ -129,7 +129,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"run-study: error: {error}", file=sys.stderr)
             return EXIT_BAD_INPUT
     if scheduler is not None and (why := unreachable(scheduler)) is not None:
-        print(f"run-study: error: cannot reach the dask scheduler at {scheduler} (--scheduler, ${SCHEDULER_VARIABLE} or the scene's cluster.scheduler): {why}", file=sys.stderr)
+        print(f"run-study: error: cannot use the dask scheduler at {scheduler} (--scheduler, ${SCHEDULER_VARIABLE} or the scene's cluster.scheduler): {why}", file=sys.stderr)
         return EXIT_BAD_INPUT
     out_dir = args.out if args.out is not None else Path("results") / scene.name
     problem = unwritable(out_dir)
@@ -159,6 +159,8 @@ def main(argv: list[str] | None = None) -> int:
             except ClusterLost as error:
                 leave_quietly()
                 print(f"\nrun-study: {error}: {_kept(store)}", file=sys.stderr)
+                if not store.block_count() and not store.case_count():
+                    store.remove()  # nothing finished: no empty store left behind
                 return EXIT_FAILURE
     except (OutputBusy, StoreOfAnotherScene) as error:
         print(f"run-study: error: {error}", file=sys.stderr)

@@ -50,7 +50,7 @@ def test_a_scheduler_without_workers_is_refused_in_one_line_and_leaves_no_store(
     err = capsys.readouterr().err
     assert code == cli.EXIT_BAD_INPUT, err
     lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"run-study: error: cannot reach the dask scheduler at {idle_scheduler}"), err
+    assert len(lines) == 1 and lines[0].startswith(f"run-study: error: cannot use the dask scheduler at {idle_scheduler}"), err
     assert f"it has no workers: none joined within 1 s (start some with 'dask worker {idle_scheduler}'" in lines[0], err
     assert not out.exists()
 
@@ -104,3 +104,17 @@ def test_solver_messages_keep_only_the_calling_thread_s_output(capsys: pytest.Ca
         other.join()
     assert said == ["[IDASolve, Error: -22] kept"] and sys.stdout is stdout
     assert capsys.readouterr().out == "another thread's line\n"
+
+
+@pytest.mark.timeout(180)
+def test_workers_gone_after_the_check_leave_one_line_and_no_empty_store(tmp_path: Path, idle_scheduler: str, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """The scheduler's workers gone between the command's check and the work: one line naming the scheduler, exit 1,
+    and no store of nothing left behind."""
+    monkeypatch.setattr(cli, "unreachable", lambda _address: None)  # the check passed: the workers left since
+    monkeypatch.setattr(runner, "NO_WORKER_TIMEOUT", 1.0)
+    out = tmp_path / "out"
+    code = cli.main([str(_scene_file(tmp_path)), "--scheduler", idle_scheduler, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == cli.EXIT_FAILURE, err
+    assert err.strip().splitlines()[-1] == f"run-study: the dask scheduler at {idle_scheduler} has no workers: none joined within 1 s: nothing had finished yet; run the same command to start again", err
+    assert "Traceback" not in err and not (out / "tiny.zarr").exists()
