@@ -94,6 +94,20 @@ def _run_kept(scene: Path, out: Path) -> int:
     return cli.main([str(scene), "--out", str(out), "--jobs", "1", "--keep-zarr", "--no-report"])
 
 
+def _damage_and_rerun(folder: Path, damage: Callable[[Path], object], capsys: pytest.CaptureFixture[str]) -> tuple[xr.Dataset, xr.Dataset, str]:
+    """Run the tiny scene keeping its store, ``damage(store)``, run it again: both datasets and the rerun's stderr
+    (which must hold no traceback)."""
+    scene, out = _scene_file(folder), folder / "out"
+    assert _run_kept(scene, out) == 0
+    first = xr.load_dataset(out / "tiny.nc")
+    damage(out / "tiny.zarr")
+    capsys.readouterr()
+    assert _run_kept(scene, out) == 0
+    err = capsys.readouterr().err
+    assert "Traceback" not in err, err
+    return first, xr.load_dataset(out / "tiny.nc"), err
+
+
 def _assert_same_results(again: xr.Dataset, first: xr.Dataset) -> None:
     """Every variable and coordinate identical (values, dtype, attributes); the dataset's attributes but the run's own."""
     assert set(again.variables) == set(first.variables)
@@ -109,30 +123,18 @@ def test_damaged_metadata_of_a_kept_store_is_rebuilt_never_exported(tmp_path: Pa
     """Issue 34, item 1: with an edited dtype the rerun exported garbage, with an edited attribute the edit, with a
     lost .zarray no variable, exit 0 each time; a truncated .zarray, edited chunks or block_shape failed every rerun.
     Now every metadata file is compared with the record written when the grid began, and rebuilt from it."""
-    scene, out = _scene_file(tmp_path), tmp_path / "out"
-    assert _run_kept(scene, out) == 0
-    first = xr.load_dataset(out / "tiny.nc")
-    _METADATA_DAMAGE[damage](out / "tiny.zarr")
-    capsys.readouterr()
-    assert _run_kept(scene, out) == 0
-    err = capsys.readouterr().err
-    assert "Traceback" not in err and "rebuilt from the store's record" in err, err
-    _assert_same_results(xr.load_dataset(out / "tiny.nc"), first)
+    first, again, err = _damage_and_rerun(tmp_path, _METADATA_DAMAGE[damage], capsys)
+    assert "rebuilt from the store's record" in err, err
+    _assert_same_results(again, first)
 
 
 @pytest.mark.faults
 @pytest.mark.timeout(300)
 def test_a_grid_without_its_record_is_computed_again(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """A kill after the grid's arrays were created but before its record was written (the record goes last)."""
-    scene, out = _scene_file(tmp_path), tmp_path / "out"
-    assert _run_kept(scene, out) == 0
-    first = xr.load_dataset(out / "tiny.nc")
-    _edit_json(out / "tiny.zarr/.zattrs", lambda m: m.pop("grid_record"))
-    capsys.readouterr()
-    assert _run_kept(scene, out) == 0
-    err = capsys.readouterr().err
-    assert "Traceback" not in err and "finished blocks are computed again" in err, err
-    _assert_same_results(xr.load_dataset(out / "tiny.nc"), first)
+    first, again, err = _damage_and_rerun(tmp_path, lambda store: _edit_json(store / ".zattrs", lambda m: m.pop("grid_record")), capsys)
+    assert "finished blocks are computed again" in err, err
+    _assert_same_results(again, first)
 
 
 @pytest.mark.faults
@@ -141,23 +143,20 @@ def test_a_grid_without_its_record_is_computed_again(tmp_path: Path, capsys: pyt
 def test_an_array_foreign_to_the_grid_is_never_exported(tmp_path: Path, readable: bool, capsys: pytest.CaptureFixture[str]) -> None:
     """An array put into a kept store's root reached the .nc; an unreadable one failed every rerun. A readable one is
     left where it is and not exported; a store with an unreadable one is set aside (renamed) and computed again."""
-    scene, out = _scene_file(tmp_path), tmp_path / "out"
-    assert _run_kept(scene, out) == 0
-    first = xr.load_dataset(out / "tiny.nc")
-    intruder = out / "tiny.zarr" / "intruder"
-    if readable:
-        array = zarr.open_group(str(out / "tiny.zarr"), mode="a", zarr_format=2, use_consolidated=False).create_array("intruder", shape=(3,), dtype="f8")
-        array[...] = 7.0
-        array.attrs["_ARRAY_DIMENSIONS"] = ["intruder_dim"]
-    else:
-        intruder.mkdir()
-        (intruder / ".zarray").write_text("{not json")
-    capsys.readouterr()
-    assert _run_kept(scene, out) == 0
-    err = capsys.readouterr().err
-    assert "Traceback" not in err, err
-    _assert_same_results(xr.load_dataset(out / "tiny.nc"), first)
-    assert intruder.exists() == readable
+
+    def intrude(store: Path) -> None:
+        if readable:
+            array = zarr.open_group(str(store), mode="a", zarr_format=2, use_consolidated=False).create_array("intruder", shape=(3,), dtype="f8")
+            array[...] = 7.0
+            array.attrs["_ARRAY_DIMENSIONS"] = ["intruder_dim"]
+        else:
+            (store / "intruder").mkdir()
+            (store / "intruder" / ".zarray").write_text("{not json")
+
+    first, again, err = _damage_and_rerun(tmp_path, intrude, capsys)
+    _assert_same_results(again, first)
+    out = tmp_path / "out"
+    assert (out / "tiny.zarr" / "intruder").exists() == readable
     set_aside = list(out.glob("tiny.zarr.damaged-*"))
     assert len(set_aside) == (0 if readable else 1) and all((path / "intruder").is_dir() for path in set_aside), err
     assert readable or f"set aside as {set_aside[0].name}" in err
@@ -167,16 +166,10 @@ def test_an_array_foreign_to_the_grid_is_never_exported(tmp_path: Path, readable
 @pytest.mark.timeout(300)
 def test_a_store_without_its_attributes_is_set_aside_and_said_so(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """A deleted root .zattrs was called "the package's code changed" and the store deleted; it is set aside, named."""
-    scene, out = _scene_file(tmp_path), tmp_path / "out"
-    assert _run_kept(scene, out) == 0
-    first = xr.load_dataset(out / "tiny.nc")
-    (out / "tiny.zarr/.zattrs").unlink()
-    capsys.readouterr()
-    assert _run_kept(scene, out) == 0
-    err = capsys.readouterr().err
+    first, again, err = _damage_and_rerun(tmp_path, lambda store: (store / ".zattrs").unlink(), capsys)
     assert "attributes are lost (damaged): set aside as tiny.zarr.damaged-" in err and "code changed" not in err, err
-    assert len(list(out.glob("tiny.zarr.damaged-*/x1_amplitude"))) == 1
-    _assert_same_results(xr.load_dataset(out / "tiny.nc"), first)
+    assert len(list((tmp_path / "out").glob("tiny.zarr.damaged-*/x1_amplitude"))) == 1
+    _assert_same_results(again, first)
 
 
 @pytest.mark.faults
