@@ -12,6 +12,7 @@ import subprocess
 import sys
 import time
 from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -94,7 +95,7 @@ class DaskCluster:
         """Start the scheduler on loopback ``port`` (0: a free one); its address, read from its scheduler file."""
         scheduler_file = self.folder / "scheduler.json"
         scheduler_file.unlink(missing_ok=True)
-        self.scheduler = self._spawn(["scheduler", "--host", "127.0.0.1", "--port", str(port), "--dashboard-address", ":0", "--scheduler-file", str(scheduler_file)], "scheduler.log")
+        self.scheduler = self._spawn(["scheduler", "--host", "127.0.0.1", "--port", str(port), "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(scheduler_file)], "scheduler.log")
         deadline = time.monotonic() + START_TIMEOUT
         while True:
             try:
@@ -109,7 +110,7 @@ class DaskCluster:
     def add_workers(self, count: int) -> None:
         """Start ``count`` workers and wait until the scheduler knows all of this cluster's live workers."""
         for _ in range(count):
-            arguments = ["worker", self.address, "--nworkers", "1", "--nthreads", "1", "--host", "127.0.0.1", "--dashboard-address", ":0", "--no-nanny"]
+            arguments = ["worker", self.address, "--nworkers", "1", "--nthreads", "1", "--host", "127.0.0.1", "--dashboard-address", "127.0.0.1:0", "--no-nanny"]
             self.workers.append(self._spawn(arguments, f"worker-{len(self.workers)}.log"))
         self.wait_for_workers(sum(1 for worker in self.workers if worker.poll() is None))
 
@@ -136,15 +137,23 @@ class DaskCluster:
         self.kill_scheduler()
 
 
-@pytest.fixture
-def dask_cluster(tmp_path: Path) -> Iterator[DaskCluster]:
-    """A scheduler and two single-threaded workers, running and registered; killed at the end of the test."""
-    folder = tmp_path / "dask"
+@contextmanager
+def running_cluster(folder: Path, workers: int) -> Iterator[DaskCluster]:
+    """A scheduler on loopback and ``workers`` single-threaded workers (0: none), running and registered, their files
+    in ``folder``; killed on leaving."""
     folder.mkdir()
     cluster = DaskCluster(folder)
     try:
         cluster.start_scheduler()
-        cluster.add_workers(2)
+        if workers:
+            cluster.add_workers(workers)
         yield cluster
     finally:
         cluster.close()
+
+
+@pytest.fixture
+def dask_cluster(tmp_path: Path) -> Iterator[DaskCluster]:
+    """A scheduler and two single-threaded workers, running and registered; killed at the end of the test."""
+    with running_cluster(tmp_path / "dask", 2) as cluster:
+        yield cluster

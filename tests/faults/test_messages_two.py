@@ -24,7 +24,7 @@ from vibroimpact.runs import cluster, runner
 from vibroimpact.runs.cluster import ClusterLost
 from vibroimpact.runs.runner import Runner
 
-from tests.cluster.conftest import DaskCluster
+from tests.cluster.conftest import running_cluster
 from tests.test_cli_runner import _scene_file
 
 pytestmark = pytest.mark.faults
@@ -33,13 +33,8 @@ pytestmark = pytest.mark.faults
 @pytest.fixture
 def idle_scheduler(tmp_path: Path) -> Iterator[str]:
     """The address of a ``dask scheduler`` on loopback with no worker; killed at the end of the test."""
-    folder = tmp_path / "dask"
-    folder.mkdir()
-    scheduler = DaskCluster(folder)
-    try:
-        yield scheduler.start_scheduler()
-    finally:
-        scheduler.close()
+    with running_cluster(tmp_path / "dask", 0) as cluster:
+        yield cluster.address
 
 
 @pytest.mark.timeout(180)
