@@ -64,7 +64,7 @@ USES = _uses()
 def test_the_scan_sees_the_known_uses() -> None:
     """Uses through each form the scan reads: a from-import, a module's attribute, a registry target."""
     assert "vibroimpact.engines.compliant.exact_loop" in USES["vibroimpact.engines.exact_pieces"]["piece_state"]
-    assert "vibroimpact.engines.exact" in USES["vibroimpact.engines.exact_core"]["run_periods"]
+    assert "vibroimpact.engines.exact" in USES["vibroimpact.engines.exact_core"]["run_periods_until"]
     assert "registry (compliant_exact)" in USES["vibroimpact.engines.compliant.exact"]["CompliantExactEngine"]
 
 

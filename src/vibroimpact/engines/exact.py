@@ -30,6 +30,7 @@ from vibroimpact.engines import exact_core, exact_moments
 from vibroimpact.engines.base import MODE_STUCK, Trajectory, check_run, start_state
 from vibroimpact.engines.exact_flows import Flow, ExactModel, build_model
 from vibroimpact.engines.exact_python import PythonExactEngine
+from vibroimpact.engines.interruptible import call_interruptibly
 from vibroimpact.engines.kernel_arguments import LoopArguments, StackedFlows, leading_arguments
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.engines.rigid_kernels import RigidContact
@@ -205,7 +206,9 @@ class ExactEngine:
         setup = loop_setup(problem, self.settings)
         state = start_state(problem, state, t_start)  # finite, 2 N values, a writable copy (one compiled overload)
         setup.law.check_start(state)
-        out = exact_core.run_periods(*setup.arguments, state, float(t_start), int(periods), moments, jacobians, approach)
+        out = call_interruptibly(
+            lambda cancel: exact_core.run_periods_until(*setup.arguments, state, float(t_start), int(periods), moments, jacobians, approach, cancel), int(periods)
+        )  # a long run in a helper thread: Ctrl-C stops it at once
         if out[0] == exact_core.STATUS_NO_PROGRESS:
             raise RuntimeError(f"no progress at t = {out[1]!r} s: more than {10 * setup.law.max_impacts} events in one period")
         if out[0] == exact_core.STATUS_TWO_STICKS:
@@ -317,7 +320,7 @@ def _stats(counters: NDArray[np.int64], impacts: int) -> dict[str, int]:
 def kernels_cached() -> bool:
     """Whether numba's on-disk cache holds the engine's compiled core (a check of its index; False where unsure)."""
     try:
-        return bool(exact_core.run_periods._cache._cache_file._load_index())  # numba's index of cached overloads
+        return bool(exact_core.run_periods_until._cache._cache_file._load_index())  # numba's index of cached overloads
     except (AttributeError, OSError, EOFError, ValueError):  # another numba's layout: compile (or load) to be sure
         return False
 

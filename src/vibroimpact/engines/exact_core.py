@@ -45,9 +45,9 @@ from vibroimpact.engines.exact_pieces import NONE, ZERO, halve_pairs, modal_coor
 from vibroimpact.engines.exact_roots import closest_approach, escape_step, first_crossing, observable_value, round_off_band
 from vibroimpact.engines.numba_cache import stamp_with_callees
 
-__all__ = ["run_periods", "sample_states", "STATUS_OK", "STATUS_NO_PROGRESS", "STATUS_TWO_STICKS", "transition_matrix", "left_multiply", "grow_rows"]
+__all__ = ["run_periods", "run_periods_until", "sample_states", "STATUS_OK", "STATUS_NO_PROGRESS", "STATUS_TWO_STICKS", "transition_matrix", "left_multiply", "grow_rows"]
 
-STATUS_OK, STATUS_NO_PROGRESS, STATUS_TWO_STICKS = 0, 1, 2
+STATUS_OK, STATUS_NO_PROGRESS, STATUS_TWO_STICKS, STATUS_INTERRUPTED = 0, 1, 2, 3
 
 
 # ------------------------------------------------------------------------------------ Jacobians, stops, bookkeeping
@@ -217,7 +217,31 @@ def run_periods(
     impulse, stop, segments (s, 3): start, mode, stop, segment_states (s, n), moments (periods, 2 N + K),
     counters [steps, events, sticks, releases, touches], approach [value, time, stop]); status
     :data:`STATUS_TWO_STICKS` stops the run where the structure would stick on two stops at once (t_fail, and
-    approach[2] the other stop, counters[4] the first).
+    approach[2] the other stop, counters[4] the first). :func:`run_periods_until` with no one to stop it.
+    """
+    return run_periods_until(
+        lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
+        a_matrix, load, static, omega, period,
+        gapw, velw, kickw, clearances, restitutions, masses, simple, signs,
+        hold_w, hold_off, hold_har, force_tolerances, bounce, stick, touch,
+        sticking_velocity, max_impacts, tolerance, resolution_velocity, gl_nodes, gl_weights,
+        y_start, t_start, periods, want_moments, want_jacobians, want_approach, np.zeros(1, dtype=np.int64),
+    )  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def run_periods_until(
+    lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
+    a_matrix, load, static, omega, period,
+    gapw, velw, kickw, clearances, restitutions, masses, simple, signs,
+    hold_w, hold_off, hold_har, force_tolerances, bounce, stick, touch,
+    sticking_velocity, max_impacts, tolerance, resolution_velocity, gl_nodes, gl_weights,
+    y_start, t_start, periods, want_moments, want_jacobians, want_approach, cancel,
+):  # fmt: skip
+    """:func:`run_periods` that another thread can stop: it returns :data:`STATUS_INTERRUPTED` (t where it stopped)
+    at its next step once ``cancel[0]`` (int64 array of one entry) is nonzero. It releases the GIL (``nogil``), so
+    the main thread can wait for it in Python and take a Ctrl-C meanwhile (:mod:`~vibroimpact.engines.interruptible`);
+    reading the flag changes no number.
     """
     n = y_start.size
     size = n // 2
@@ -283,6 +307,8 @@ def run_periods(
     hm = 0
     poly = False
     while k <= periods:
+        if cancel[0] != 0:  # asked to stop (a Ctrl-C in the waiting thread): what is done so far, flagged
+            return STATUS_INTERRUPTED, t, strobes[:k], jacobians[: k - 1], impacts[:n_impacts], segments[:n_segments], segment_states[:n_segments], moments, counters, approach
         boundary = origin + k * period
         if fresh:
             t_piece = t
