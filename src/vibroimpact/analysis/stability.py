@@ -156,7 +156,7 @@ class Regime(IntEnum):
     #: state: ``impacts_per_period`` says how many contacts per cycle.
     SWEPT_CONTACT = 10
     #: The solution could not be computed at this point; values are NaN. Time-domain solutions: the integrator failed
-    #: (the error went to stderr). Closed forms (``pgf``, ``pgf_paper``): the Green function sums are ill-conditioned,
+    #: (the error went to stderr). Closed forms (``linear``, ``pgf``, ``pgf_paper``): the sums are ill-conditioned,
     #: near an undamped or nearly undamped natural frequency (:data:`vibroimpact.analysis.greens.GREEN_CONDITION_LIMIT`):
     #: the closed form is not valid there, and whether an orbit exists is unknown.
     FAILED = 11
