@@ -104,3 +104,25 @@ def test_the_slow_structure_s_bumpers_are_the_paper_s_at_100_times_their_frequen
     assert slow.converged and paper.converged
     assert abs(slow.measures.x1) == pytest.approx(abs(paper.measures.x1), rel=1e-8)
     assert math.isclose(abs(slow.measures.x1), rigid_x1, rel_tol=1e-6)
+
+
+def _bumper_scene(system: dict[str, float], bumper_frequency: float, amplitude: float = PAPER_AMPLITUDE) -> dict[str, object]:
+    return {
+        "name": "stiff", "system": system, "excitation": {"amplitude": amplitude}, "stop": {"clearance": PAPER_CLEARANCE, "restitution": RESTITUTION},
+        "sweep": {"bumper_frequency": [100.0, bumper_frequency], "frequency": [FORCING / 100.0]}, "solutions": ["exact", "compliant_exact"],
+        "report": False,
+    }
+
+
+def test_a_scene_with_a_bumper_too_stiff_for_its_structure_is_refused_before_any_work() -> None:
+    """The scenes' cap (1e6 Hz) cannot know the structure: the slow system is refused above 2.7e5 Hz by the model's
+    own judgement (model/bumper_limit.py), naming the key and the range, before any point is computed (it failed every
+    point in contact at run time); the paper's system takes 1e6 Hz."""
+    from vibroimpact.scene.checker import SceneError
+    from vibroimpact.scene.reader import parse_scene
+
+    slow = {"m1": 1.0, "m2": 0.1, "k1": 2.5, "k2": 0.43, "b1": 0.008, "b2": 0.0008}
+    with pytest.raises(SceneError, match=r"sweep\.bumper_frequency: compliant_exact: stop 0: bumper frequency = 1e\+06 Hz is too stiff for this structure: allowed \(0, 2\.7e\+05\] Hz here .*RigidStop\(clearance=0\.003, restitution=0\.2\)"):
+        parse_scene(_bumper_scene(slow, 1e6, PAPER_AMPLITUDE * 1e-4))
+    parse_scene(_bumper_scene(slow, 2.7e5, PAPER_AMPLITUDE * 1e-4))
+    parse_scene(_bumper_scene(dict(PAPER_SYSTEM.__dict__), 1e6))

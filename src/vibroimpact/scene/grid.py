@@ -19,7 +19,9 @@ from typing import Any
 import numpy as np
 
 from vibroimpact.analysis.pgf import AdmissibilitySettings
-from vibroimpact.engines.registry import BUMPER
+from vibroimpact.engines.registry import BUMPER, engine_spec
+from vibroimpact.model.bumper_limit import bumper_refusal
+from vibroimpact.model.layout import Layout
 from vibroimpact.model.contact import loss_factor_from_restitution, restitution_from_loss_factor
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.modal import underdamped_mode_count
@@ -219,6 +221,10 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     if layout is not None and (specs is not None or "stops" not in doc):
         layout = layout.with_stops(specs) if specs is not None else layout
         check_layout_solutions(c, solutions, layout, "swept_sine" in doc, grids.get("restitution"), grids.get("clearance"))
+        exact_bumpers = [name for name in bumper_solutions if engine_spec(name).capabilities.exact_flow]
+        if exact_bumpers and not c.problems:
+            where = "sweep.bumper_frequency" if "bumper_frequency" in sweep else "bumper.frequency" if "bumper" in doc else "stops"
+            _check_bumper_stiffness(c, where, exact_bumpers, layout, grids)
 
     sizes = [g.size for g in grids.values() if g is not None]
     if len(sizes) >= 3 and math.prod(sizes) > MAX_STUDY_POINTS:
@@ -278,6 +284,24 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
         name=name, description=description, layout=layout, amplitude=amplitude, kind="stepped" if swept_sine is None else "swept", settings=grid,
         report=report, text=text, cluster_scheduler=scheduler,
     )
+
+
+def _check_bumper_stiffness(c: Checker, where: str, names: list[str], layout: Layout, grids: dict[str, np.ndarray | None]) -> None:
+    """Record at ``where`` a bumper too stiff for the structure for the exact-flow bumper solutions ``names``
+    (:func:`~vibroimpact.model.bumper_limit.bumper_refusal`), judged at the grid's stiffest bumper: the engines would
+    refuse every point in contact."""
+    frequencies, losses = grids.get("bumper_frequency"), grids.get("bumper_loss_factor")
+    restitution, clearance = grids.get("restitution"), grids.get("clearance")
+    try:
+        problem = layout.problem(
+            1.0, 1.0, float(np.max(restitution)) if restitution is not None else math.nan, float(clearance[0]) if clearance is not None else math.nan,
+            bumper=True, bumper_frequency=float(np.max(frequencies)) if frequencies is not None else math.nan,
+            loss_factor=float(losses[0]) if losses is not None else math.nan,
+        )  # fmt: skip
+    except ValueError:
+        return  # a stop without its values: said where they are checked
+    if (refusal := bumper_refusal(problem)) is not None:
+        c.fail(where, f"{'/'.join(names)}: {refusal}")
 
 
 def _parse_swept_sine(c: Checker, value: Any, engines: list[str], grid: np.ndarray | None) -> SweptSineSettings | None:
