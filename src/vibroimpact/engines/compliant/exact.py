@@ -41,6 +41,7 @@ from vibroimpact.engines.compliant.period_shooting import PeriodOrbit, shoot_per
 from vibroimpact.engines.compliant.model import MODE_CONTACT
 from vibroimpact.engines.exact import StrobeMap, chained_jacobian, restacked, stack_flows
 from vibroimpact.engines.exact_flows import Flow, harmonic_response, mechanical_null_basis, unforced_flow
+from vibroimpact.engines.interruptible import call_interruptibly
 from vibroimpact.engines.kernel_arguments import BumperLoopArguments, StackedFlows, leading_arguments
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.engines.registry import ENGINES, Capabilities
@@ -290,7 +291,9 @@ class CompliantExactEngine:
         problem.harmonic  # TypeError naming the excitation if it is not harmonic (a sweep has no closed form)
         setup = _setup(problem, self.settings)
         state = start_state(problem, state, t_start)  # finite, 2 N values, a writable copy (one compiled overload)
-        out = exact_loop.run_bumper_periods(*setup.arguments, state, float(t_start), int(periods), bool(moments), bool(jacobians), bool(approach))
+        out = call_interruptibly(
+            lambda cancel: exact_loop.run_bumper_periods_until(*setup.arguments, state, float(t_start), int(periods), bool(moments), bool(jacobians), bool(approach), cancel), int(periods)
+        )  # a long run in a helper thread: Ctrl-C stops it at once
         if out[0] == exact_loop.STATUS_NO_PROGRESS:
             raise RuntimeError(f"no progress at t = {out[1]!r} s: more than {10 * self.settings.max_impacts_per_period} contact switches in one period")
         return out
@@ -397,9 +400,10 @@ def _trajectory(problem: ImpactProblem, t_start: float, periods: int, out: tuple
 
 
 def kernels_cached() -> bool:
-    """Whether numba's on-disk cache holds the engine's loop (a check of its index; False where unsure)."""
+    """Whether numba's on-disk cache holds the engine's loop, and the one that period shooting calls (a check of their
+    indexes; False where unsure)."""
     try:
-        return bool(exact_loop.run_bumper_periods._cache._cache_file._load_index())  # numba's index of cached overloads
+        return all(bool(kernel._cache._cache_file._load_index()) for kernel in (exact_loop.run_bumper_periods_until, exact_loop.run_bumper_periods))  # numba's index of cached overloads
     except (AttributeError, OSError, EOFError, ValueError):  # another numba's layout: compile (or load) to be sure
         return False
 
@@ -420,4 +424,5 @@ def prepare_kernels() -> float:
     engine = CompliantExactEngine()
     engine.integrate(problem, np.zeros(2), 0.0, 2, moments=True, jacobians=True)
     engine.sample(problem, np.zeros(2), 0.0, 1, np.array([0.05]))
+    engine.shoot_period(problem, np.zeros(2), np.ones(2), 1e-10, 0)  # its period (run_bumper_periods: ~3 s more)
     return 0.0 if cached else time.perf_counter() - start

@@ -47,9 +47,9 @@ from vibroimpact.engines.exact_pieces import halve_pairs, modal_coordinates, obs
 from vibroimpact.engines.exact_roots import closest_approach, escape_step, first_crossing, observable_derivatives, observable_value, round_off_band
 from vibroimpact.engines.numba_cache import stamp_with_callees
 
-__all__ = ["run_bumper_periods", "sample_pieces", "STATUS_NO_PROGRESS"]
+__all__ = ["run_bumper_periods", "run_bumper_periods_until", "sample_pieces", "STATUS_NO_PROGRESS"]
 
-STATUS_OK, STATUS_NO_PROGRESS = 0, 1
+STATUS_OK, STATUS_NO_PROGRESS, STATUS_INTERRUPTED = 0, 1, 2
 #: Phases of a stop (module docstring).
 BELOW, BEYOND, CONTACT = 0, 1, 2
 #: Most extrema of one observable :func:`_largest` visits in one call (at most a period): a contact's force has one or
@@ -214,7 +214,25 @@ def run_bumper_periods(
     largest interior local maximum of a penetration d_k while stop k is ``BELOW`` (the closest approach of a free
     flight to the bumper's surface, the exact engine's :func:`~vibroimpact.engines.exact_roots.closest_approach`;
     -inf without one, or unless ``want_approach``)); status :data:`STATUS_NO_PROGRESS` stops the run at t after
-    ``max_events`` in one period.
+    ``max_events`` in one period. :func:`run_bumper_periods_until` with no one to stop it.
+    """
+    return run_bumper_periods_until(
+        lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
+        omega, period, obsw, obso, velw, salts, zero_har, gap_tolerance, force_tolerances, max_events, gl_nodes, gl_weights,
+        y_start, t_start, periods, want_moments, want_jacobians, want_approach, np.zeros(1, dtype=np.int64),
+    )  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def run_bumper_periods_until(
+    lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
+    omega, period, obsw, obso, velw, salts, zero_har, gap_tolerance, force_tolerances, max_events, gl_nodes, gl_weights,
+    y_start, t_start, periods, want_moments, want_jacobians, want_approach, cancel,
+):  # fmt: skip
+    """:func:`run_bumper_periods` that another thread can stop: it returns :data:`STATUS_INTERRUPTED` (t where it
+    stopped) at its next step once ``cancel[0]`` (int64 array of one entry) is nonzero. It releases the GIL
+    (``nogil``), so the main thread can wait for it in Python and take a Ctrl-C meanwhile
+    (:mod:`~vibroimpact.engines.interruptible`); reading the flag changes no number.
     """
     n = y_start.size
     size = n // 2
@@ -286,6 +304,8 @@ def run_bumper_periods(
     poly = False
     last_mask = -1
     while k <= periods:
+        if cancel[0] != 0:  # asked to stop (a Ctrl-C in the waiting thread): what is done so far, flagged
+            return STATUS_INTERRUPTED, t, strobes, jacobians, contacts[:n_contacts], segments[:n_segments], segment_states[:n_segments], moments, counters, onsets[:n_onsets], approach
         boundary = origin + k * period
         if fresh:
             t_piece = t
