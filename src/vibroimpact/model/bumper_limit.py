@@ -47,10 +47,8 @@ def bumper_refusal(problem: ImpactProblem) -> str | None:
     stiffness = structure.stiffness_matrix
     normals = problem.normals()
     count = normals.shape[0]
-    kicks = np.linalg.solve(structure.mass_matrix, normals.T).T.reshape(count, problem.size)
-    masses = 1.0 / np.einsum("ki,ki->k", normals, kicks)
     laws = [stop.law for stop in problem.stops]
-    k_b = np.array([law.stiffness(m) for law, m in zip(laws, masses)])  # type: ignore[union-attr]
+    k_b = np.array([law.stiffness(stop.effective_mass(structure.mass_matrix)) for law, stop in zip(laws, problem.stops)])  # type: ignore[union-attr]
     rigid = rigid_modes(stiffness)
     for mask in range(1, 1 << count):
         pushing = [k for k in range(count) if (mask >> k) & 1]

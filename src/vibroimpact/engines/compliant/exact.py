@@ -26,7 +26,6 @@ moments' contact-force channels are the integrals of F_k e^{-jwt}.
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -46,6 +45,7 @@ from vibroimpact.engines.kernel_arguments import BumperLoopArguments, StackedFlo
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.engines.registry import ENGINES, Capabilities
 from vibroimpact.engines.settings import EngineSettings
+from vibroimpact.model.bumper_limit import bumper_refusal
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 
@@ -120,7 +120,8 @@ def contact_modes(problem: ImpactProblem) -> tuple[tuple[tuple[NDArray[np.float6
     k_b = np.array([law.stiffness(m) for law, m in zip(laws, masses)])
     b_b = np.array([law.damping(m) for law, m in zip(laws, masses)])
     _harmonic, static = problem.load()
-    rigid = _rigid_modes(stiffness)
+    if (refusal := bumper_refusal(problem)) is not None:  # converged and wrong beyond it
+        raise ValueError(f"the engine 'compliant_exact': {refusal}, with the engine 'exact'")
     modes = []
     for mask in range(1 << count):
         k_mode, c_mode, load = stiffness.copy(), damping.copy(), static.copy()
@@ -130,62 +131,11 @@ def contact_modes(problem: ImpactProblem) -> tuple[tuple[tuple[NDArray[np.float6
                 k_mode += k_b[k] * outer
                 c_mode += b_b[k] * outer
                 load += k_b[k] * clearances[k] * normals[k]
-        if mask:
-            _check_resolved(k_mode, mask, normals, rigid, laws, k_b)
         a = np.block([[np.zeros((size, size)), np.eye(size)], [-np.linalg.solve(mass, k_mode), -np.linalg.solve(mass, c_mode)]])
         b0 = np.concatenate([np.zeros(size), np.linalg.solve(mass, load)])
         with _in_contact(mask, laws):
             modes.append((a, unforced_flow(a, b0, mechanical_null_basis(mass, k_mode, c_mode))))
     return tuple(modes), k_b, b_b, masses
-
-
-#: The softest stiffness of a contact mode (its smallest eigenvalue of K + sum K_k n_k n_k^T that is not a rigid-body
-#: mode) as a fraction of its stiffest, below which the engine refuses the bumper [-]. The modes' flows judge an
-#: eigenvalue under 1e-12 of the largest a rigid-body mode (:func:`~vibroimpact.engines.exact_flows.mechanical_null_basis`):
-#: past it a bumper loses the structure's own mode in contact, and the answer is converged and wrong (the paper's system
-#: at 24 Hz, R = 0.2: |X1| 1.877 mm from 9e7 Hz on, the rigid stop's 2.567 mm; right to 5e-9 up to 8e7 Hz). 1e-11
-#: keeps a factor 10 (3.2 in the bumper's frequency) from that edge: 2.7e7 Hz on the paper's system.
-STIFFNESS_SPREAD = 1e-11
-
-
-def _rigid_modes(stiffness: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The structure's rigid-body modes (columns, orthonormal), judged at its own stiffness scale as the flows judge
-    them (an eigenvalue of K under 1e-12 of the largest)."""
-    mu, q = np.linalg.eigh(stiffness)
-    top = float(np.max(np.abs(mu))) if mu.size else 0.0
-    return q[:, mu <= 1e-12 * top] if top > 0.0 else np.eye(stiffness.shape[0])
-
-
-def _check_resolved(
-    k_mode: NDArray[np.float64], mask: int, normals: NDArray[np.float64], rigid: NDArray[np.float64], laws: list[KelvinVoigtBumper], k_b: NDArray[np.float64],
-) -> None:  # fmt: skip
-    """``ValueError`` unless the contact mode ``mask`` keeps every flexible mode of the structure at least
-    :data:`STIFFNESS_SPREAD` of its stiffest: a bumper so stiff that double precision cannot hold the structure's
-    own stiffness beside it (``rigid``: the structure's rigid-body modes; those the pushing bumpers do not stop stay
-    rigid in contact)."""
-    pushing = [k for k in range(len(laws)) if (mask >> k) & 1]
-    stopped = normals[pushing] @ rigid
-    expected = rigid.shape[1] - (int(np.linalg.matrix_rank(stopped)) if stopped.size else 0)
-    mu = np.sort(np.linalg.eigvalsh(k_mode))
-    if expected >= mu.size:
-        return
-    top = float(np.max(np.abs(mu)))
-    softest = float(mu[expected])
-    if softest > STIFFNESS_SPREAD * top:
-        return
-    k = max(pushing, key=lambda j: k_b[j])
-    law = laws[k]
-    limit = law.frequency * math.sqrt(max(softest, 0.0) / (STIFFNESS_SPREAD * top))  # K_k dominates K: softest ~ fixed, top ~ f^2
-    if limit > 0.0:
-        unit = 10.0 ** (math.floor(math.log10(limit)) - 1)
-        limit = math.floor(limit / unit) * unit  # two digits, rounded down: the bound said is one that holds
-    raise ValueError(
-        f"stop {k}: bumper frequency = {law.frequency:.6g} Hz (K = {k_b[k]:.3g} N/m) is too stiff for the engine 'compliant_exact' on this "
-        f"structure: in contact its softest mode ({softest:.3g} N/m) is {softest / top:.2g} of its stiffest, and below {STIFFNESS_SPREAD:g} "
-        f"double precision cannot hold the structure's own stiffness beside the bumper's (the answer converges, and is wrong); allowed: "
-        f"frequency in (0, {limit:.2g}] Hz here. A stiffer bumper is the rigid stop to its contact time (the difference falls as 1/frequency): "
-        f"use RigidStop(clearance={law.clearance!r}, restitution={law.restitution:.6g}), the restitution of this bumper's loss factor, with the engine 'exact'"
-    )
 
 
 @contextmanager
