@@ -73,7 +73,7 @@ def _missing_metadata(path: Path) -> None:
 
 
 @pytest.mark.faults  # a real store damaged on disk, run again (1-2 s each): with the other injected faults
-@pytest.mark.parametrize(("damage", "blocks_again"), [(_missing_chunk, 1), (_truncated_chunk, 1), (_swapped_chunks, 2), (_missing_metadata, 18)])
+@pytest.mark.parametrize(("damage", "blocks_again"), [(_missing_chunk, 1), (_truncated_chunk, 1), (_swapped_chunks, 2)])
 def test_a_damaged_store_ends_in_the_undisturbed_dataset(undisturbed: tuple[object, xr.Dataset, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch, damage: object, blocks_again: int) -> None:
     dataset, lines, solved = _rerun(undisturbed, tmp_path, damage, monkeypatch)
     xr.testing.assert_identical(dataset, undisturbed[1])
@@ -82,11 +82,24 @@ def test_a_damaged_store_ends_in_the_undisturbed_dataset(undisturbed: tuple[obje
 
 
 @pytest.mark.faults  # a real store damaged on disk, run again (1-2 s each): with the other injected faults
-def test_a_damaged_root_attribute_file_discards_the_store_in_one_line(undisturbed: tuple[object, xr.Dataset, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_lost_metadata_is_rebuilt_and_no_block_computed_again(undisturbed: tuple[object, xr.Dataset, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A lost ``.zarray`` is written back from the record the store kept when its grid began (issue 34): the 18
+    finished blocks then prove their values and none is computed again (before the record: all 18 were)."""
+    dataset, lines, solved = _rerun(undisturbed, tmp_path, _missing_metadata, monkeypatch)
+    xr.testing.assert_identical(dataset, undisturbed[1])
+    assert solved == 0
+    assert len(lines) == 1 and lines[0].endswith("metadata lost or changed since it was written, rebuilt from the store's record: regime"), lines
+
+
+@pytest.mark.faults  # a real store damaged on disk, run again (1-2 s each): with the other injected faults
+def test_a_damaged_root_attribute_file_sets_the_store_aside_in_one_line(undisturbed: tuple[object, xr.Dataset, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Unreadable root attributes: the store is set aside (renamed, kept for whoever wants to look; issue 34) and
+    computed again."""
     dataset, lines, solved = _rerun(undisturbed, tmp_path, lambda path: (path / ".zattrs").write_text("{ not json"), monkeypatch)
     xr.testing.assert_identical(dataset, undisturbed[1])
     assert solved == 18
-    assert len(lines) == 1 and "its attributes are unreadable (damaged): 18 finished blocks and 0 finished cases discarded" in lines[0]
+    assert len(lines) == 1 and "its attributes are unreadable (damaged): set aside as grid.zarr.damaged-" in lines[0] and "(18 finished blocks and 0 finished cases), computed again" in lines[0], lines
+    assert len(list(tmp_path.glob("grid.zarr.damaged-*/regime"))) == 1
 
 
 @pytest.mark.faults  # a real store damaged on disk, run again (1-2 s each): with the other injected faults
