@@ -154,10 +154,11 @@ def unreachable(scheduler: str, timeout: float = 10.0, worker_wait: float | None
 
     thread = threading.Thread(target=handshake, name="vibroimpact-scheduler-check", daemon=True)
     thread.start()
-    thread.join(timeout + wait + 2.0)
-    if not outcome:  # the thread is left behind: the study stops here (exit 2)
-        return no_workers if reached else f"no dask scheduler answered within {timeout:.0f} s (a server that is not a dask scheduler, such as the dashboard's port?)"
-    return outcome[0]
+    thread.join(timeout + 2.0)  # the handshake's own deadline first: a server that never answers is not waited on for workers
+    if not outcome and not reached:  # the thread is left behind: the study stops here (exit 2)
+        return f"no dask scheduler answered within {timeout:.0f} s (a server that is not a dask scheduler, such as the dashboard's port?)"
+    thread.join(wait + 2.0)
+    return outcome[0] if outcome else no_workers
 
 
 class SyncCancelRace(logging.Filter):
