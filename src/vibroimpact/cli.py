@@ -159,8 +159,8 @@ def main(argv: list[str] | None = None) -> int:
             except ClusterLost as error:
                 leave_quietly()
                 print(f"\nrun-study: {error}: {_kept(store)}", file=sys.stderr)
-                if not store.block_count() and not store.case_count():
-                    store.remove()  # nothing finished: no empty store left behind
+                if store.fresh and not store.block_count() and not store.case_count():
+                    store.remove()  # begun by this run and nothing finished: no empty store left behind
                 return EXIT_FAILURE
     except (OutputBusy, StoreOfAnotherScene) as error:
         print(f"run-study: error: {error}", file=sys.stderr)

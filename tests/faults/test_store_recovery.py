@@ -220,3 +220,13 @@ def test_damaged_cases_are_computed_again_never_a_traceback(system: TwoDofSystem
                 np.testing.assert_array_equal(after[name], before[name])
     assert StudyStore(path, "fingerprint").case_count() == 2
     assert damage.startswith("a case's") or said, damage  # the group's damage is said in one line
+
+
+@pytest.mark.faults
+def test_only_a_store_this_run_began_counts_as_fresh(tmp_path: Path) -> None:
+    """A run whose cluster is lost removes a store of nothing finished only if it began it: an earlier run's store
+    whose flags cannot be read (so that it seems to hold nothing) is never removed unasked."""
+    path = tmp_path / "study.zarr"
+    assert StudyStore(path, "fingerprint").fresh
+    assert not StudyStore(path, "fingerprint").fresh
+    assert StudyStore(path, "another scene").fresh  # the other fingerprint's store was discarded: this one is new

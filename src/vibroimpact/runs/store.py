@@ -194,7 +194,11 @@ class StudyStore:
         source = str(Path(scene_path).resolve()) if scene_path is not None else ""
         self.scene_path = source
         if path is not None and path.exists():
+            for partial in (*path.glob("*.partial"), *path.glob("*/*.partial")):  # zarr's half-written files of a kill: never data
+                partial.unlink(missing_ok=True)
             self._discard_unless_ours(path, source)
+        #: Whether this run began the store (nothing of an earlier run in it): only such a store may be removed unasked.
+        self.fresh = path is None or not path.exists()
         # the run reads every array's own metadata, as the export does: a kept store's consolidated copy
         # (:meth:`keep`) could vouch for an array whose own files are lost or edited
         self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
@@ -235,7 +239,7 @@ class StudyStore:
             return
         why = "the package's code changed" if attrs.get("code") != code_fingerprint() else "the scene's values changed"
         self.say(f"{path}: {why} since it was written: {_finished_work(path)} discarded, computed again")
-        shutil.rmtree(path)
+        self.remove()  # renamed first: a removal cut off half-way leaves no store that looks damaged
 
     # -- cases -------------------------------------------------------------------------------------------------
 
@@ -348,13 +352,23 @@ class StudyStore:
     def check_grid(self) -> int:
         """Compare the grid's metadata (every array's ``.zarray`` and ``.zattrs``, the grid's plan) with the record
         written when the grid began and write back what differs, saying which arrays were rebuilt; a grid without a
-        whole record (cut off while being created, or its record damaged) is dropped. Return the finished blocks
-        dropped (0: the grid's metadata is as it was written, or rebuilt).
+        whole record (cut off while being created, or its record damaged) is dropped; a store with an unreadable array
+        beside the grid's is set aside (:meth:`start_afresh`). Return the finished blocks dropped (0: the grid's
+        metadata is as it was written, or rebuilt).
 
         Call it before :meth:`grid_plan` and :meth:`verify_blocks`: they read the metadata it restores.
         """
-        if not self._grid_ready or self.path is None:
+        if self.path is None:
             return 0
+        dropped = self._check_grid_record() if self._grid_ready else 0
+        try:  # an unreadable array beside the grid's fails every read of the store: known before any work
+            check_members_readable(self.path, skip=(_CASES,))
+        except ValueError as error:
+            self.start_afresh(str(error))
+        return dropped
+
+    def _check_grid_record(self) -> int:
+        """:meth:`check_grid` for the grid's own arrays and plan; return the finished blocks dropped."""
         try:
             attrs = dict(self.root.attrs)
             record = attrs[_GRID_RECORD]
@@ -459,7 +473,7 @@ class StudyStore:
             self.root.attrs.pop(key, None)
         self._arrays.clear()
         self._grid_ready = False
-        return max(count, 1)
+        return count
 
     def _array(self, name: str) -> Any:
         """The store's array ``name``, opened once."""
@@ -483,7 +497,7 @@ class StudyStore:
         names = {str(name) for name in self.root.attrs.get(_GRID_VARIABLES, [])}  # type: ignore[union-attr]
         try:
             if self.path is not None:  # zarr opens every array beside ours at once, and one that fails leaves the rest pending
-                check_members_readable(self.path)
+                check_members_readable(self.path, skip=(_CASES,))
             others = [name for name in self.root.array_keys() if name not in names]  # bookkeeping, kept coordinates, anything foreign: never exported
             dataset = xr.open_zarr(self.store, consolidated=False, zarr_format=ZARR_FORMAT, drop_variables=others)
         except Exception as error:  # noqa: BLE001 - whatever an unreadable array raises (a JSON error, a missing file)
