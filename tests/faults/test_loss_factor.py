@@ -48,3 +48,25 @@ def test_a_restitution_no_bumper_reaches_is_named() -> None:
     with pytest.raises(ValueError, match=r"restitution = 1e-09 is below what a bumper of loss factor up to 1000 reaches: allowed \[2.5e-07, 1\]"):
         loss_factor_from_restitution(1e-9)
     assert math.isclose(restitution_from_loss_factor(loss_factor_from_restitution(0.2)), 0.2, rel_tol=1e-12)
+
+
+@pytest.mark.faults
+@pytest.mark.parametrize("stops", [False, True])
+def test_a_restitution_no_bumper_reaches_is_refused_by_the_scene(stops: bool) -> None:
+    """R = 1e-8 with a bumper solution passed the scene's check (only R = 0 was refused) and failed at run time, after
+    every block, on every rerun; now the scene names the key and the floor 2.5e-7, before any work."""
+    from vibroimpact.scene.checker import SceneError
+    from vibroimpact.scene.reader import parse_scene
+
+    document = {
+        "name": "floor", "system": {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0, "b1": 0.8, "b2": 0.08}, "excitation": {"amplitude": 10.0},
+        "stop": {"clearance": 0.003}, "bumper": {"frequency": 250.0}, "sweep": {"restitution": [1e-8, 0.5], "frequency": [24.0]}, "solutions": ["compliant_exact"],
+    }
+    key = "stop.restitution"
+    if stops:
+        document.pop("stop")
+        document["stops"] = [{"coordinate": "x2", "clearance": 0.003, "restitution": 1e-8}]
+        document["sweep"] = {"frequency": [24.0]}
+        key = r"stops\[0\].restitution"
+    with pytest.raises(SceneError, match=rf"{key}: R = 1e-08 needs a bumper more damped than loss factor 1000 for the compliant solution: give .*bumper.loss_factor.*R >= 2.5e-07"):
+        parse_scene(document)

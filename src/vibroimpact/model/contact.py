@@ -41,6 +41,7 @@ __all__ = [
     "RIGID",
     "BUMPER",
     "MAX_LOSS_FACTOR",
+    "MIN_BUMPER_RESTITUTION",
     "Stop",
     "CoordinateRef",
     "default_coordinates",
@@ -267,6 +268,11 @@ def restitution_from_loss_factor(xi: float) -> float:
     return math.exp(-xi * release_time(xi))
 
 
+#: The least restitution a bumper gives, R(:data:`MAX_LOSS_FACTOR`) = 2.5e-7 [-]: a rigid stop's R below it has no
+#: bumper to stand for it.
+MIN_BUMPER_RESTITUTION = restitution_from_loss_factor(MAX_LOSS_FACTOR)
+
+
 def loss_factor_from_restitution(restitution: float) -> float:
     """The loss factor xi_b [-] of the Kelvin-Voigt bumper whose one collision restitutes R (the inverse of
     :func:`restitution_from_loss_factor`, to 1e-15): the bumper that stands for a rigid stop of restitution R.
@@ -292,8 +298,8 @@ def loss_factor_from_restitution(restitution: float) -> float:
     while restitution_from_loss_factor(high) > r:
         high *= 2.0
         if high > MAX_LOSS_FACTOR:
-            if restitution_from_loss_factor(MAX_LOSS_FACTOR) > r:
-                raise ValueError(f"restitution = {r!r} is below what a bumper of loss factor up to {MAX_LOSS_FACTOR:g} reaches: allowed [{restitution_from_loss_factor(MAX_LOSS_FACTOR):.3g}, 1]")
+            if MIN_BUMPER_RESTITUTION > r:
+                raise ValueError(f"restitution = {r!r} is below what a bumper of loss factor up to {MAX_LOSS_FACTOR:g} reaches: allowed [{MIN_BUMPER_RESTITUTION:.3g}, 1]")
             high = MAX_LOSS_FACTOR
     from scipy.optimize import brentq  # here, not at import: reading a scene must not load scipy's solvers
 

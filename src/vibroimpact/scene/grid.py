@@ -22,7 +22,7 @@ from vibroimpact.analysis.pgf import AdmissibilitySettings
 from vibroimpact.engines.registry import BUMPER, engine_spec
 from vibroimpact.model.bumper_limit import bumper_refusal
 from vibroimpact.model.layout import Layout
-from vibroimpact.model.contact import loss_factor_from_restitution, restitution_from_loss_factor
+from vibroimpact.model.contact import MAX_LOSS_FACTOR, MIN_BUMPER_RESTITUTION, loss_factor_from_restitution, restitution_from_loss_factor
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.modal import underdamped_mode_count
 from vibroimpact.scene.bumper_parse import BUMPER_KEYS, PHYSICAL_KEYS, scene_bumper
@@ -216,8 +216,9 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
             c.fail("bumper", "required by the compliant solution and swept-sine tests: {frequency: Omega_b / 2 pi [Hz], loss_factor: xi_b (optional)}")
         elif "bumper" in doc and "bumper_frequency" not in sweep and "frequency" not in fixed["bumper"] and not physical:
             c.fail("bumper.frequency", "required unless swept (sweep.bumper_frequency): Omega_b / 2 pi [Hz] in (0, inf), or bumper.stiffness [N/m] in (0, inf)")
-        if bumper_solutions and "bumper_loss_factor" not in grids and (r := grids.get("restitution")) is not None and np.any(r == 0.0):
-            c.fail("stop.restitution", "R = 0 needs an infinitely damped bumper for the compliant solution: give bumper.loss_factor, or sweep R > 0")
+        if bumper_solutions and "bumper_loss_factor" not in grids and (r := grids.get("restitution")) is not None and np.any(r < MIN_BUMPER_RESTITUTION):
+            least = "R = 0 needs an infinitely damped bumper" if np.any(r == 0.0) else f"R = {float(np.min(r)):g} needs a bumper more damped than loss factor {MAX_LOSS_FACTOR:g}"
+            c.fail("stop.restitution", f"{least} for the compliant solution: give bumper.loss_factor, or sweep R >= {MIN_BUMPER_RESTITUTION:.2g}")
     if layout is not None and (specs is not None or "stops" not in doc):
         layout = layout.with_stops(specs) if specs is not None else layout
         check_layout_solutions(c, solutions, layout, "swept_sine" in doc, grids.get("restitution"), grids.get("clearance"))

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from vibroimpact.model.contact import restitution_from_loss_factor
+from vibroimpact.model.contact import MAX_LOSS_FACTOR, MIN_BUMPER_RESTITUTION, restitution_from_loss_factor
 from vibroimpact.model.layout import StopSpec
 from vibroimpact.scene.checker import Checker, interval
 
@@ -112,5 +112,6 @@ def _check_zero_restitution(c: Checker, specs: list[dict[str, Any]], grids: dict
         if spec["bumper_loss_factor"] is not None:
             continue
         values = [spec["restitution"]] if spec["restitution"] is not None else ([] if r_grid is None else list(r_grid))
-        if any(v == 0.0 for v in values):
-            c.fail(f"stops[{k}].restitution", f"R = 0 needs an infinitely damped bumper for the compliant solution: give the stop's bumper.loss_factor in {interval(0.0, 1e3)}, or R > 0")
+        if any(v < MIN_BUMPER_RESTITUTION for v in values):
+            least = "R = 0 needs an infinitely damped bumper" if any(v == 0.0 for v in values) else f"R = {min(values):g} needs a bumper more damped than loss factor {MAX_LOSS_FACTOR:g}"
+            c.fail(f"stops[{k}].restitution", f"{least} for the compliant solution: give the stop's bumper.loss_factor in {interval(0.0, MAX_LOSS_FACTOR)}, or R >= {MIN_BUMPER_RESTITUTION:.2g}")
