@@ -10,15 +10,17 @@ from __future__ import annotations
 import os
 import sys
 
-__all__ = ["main", "EXIT_INTERRUPTED"]
+__all__ = ["main", "EXIT_INTERRUPTED", "EXIT_TERMINATED"]
 
-#: Exit status of an interrupted run (128 + SIGINT), as :mod:`vibroimpact.cli` gives it.
+#: Exit status of an interrupted run (128 + SIGINT), and of a terminated one (128 + SIGTERM), as :mod:`vibroimpact.cli`
+#: gives them.
 EXIT_INTERRUPTED = 130
+EXIT_TERMINATED = 143
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``run-study``: :func:`vibroimpact.cli.main`, with a Ctrl-C before the study takes it over said in one line
-    (the process then ends at once with status :data:`EXIT_INTERRUPTED`)."""
+    """``run-study``: :func:`vibroimpact.cli.main`, with a Ctrl-C while it imports said in one line (the process then
+    ends at once with status :data:`EXIT_INTERRUPTED`), and one outside the run's own handler too."""
     try:
         from vibroimpact.cli import main as run_study
     except BaseException as error:  # a Ctrl-C inside a class body's __set_name__ comes as a RuntimeError it caused
@@ -27,9 +29,12 @@ def main(argv: list[str] | None = None) -> int:
         raise
     try:
         return run_study(argv)
-    except KeyboardInterrupt:
-        _say_interrupted()
-        raise  # not reached
+    except KeyboardInterrupt as interrupt:  # outside the run's own handler (reading the scene, opening the store)
+        from vibroimpact.runs.cluster import Terminated  # loaded with the command line
+
+        terminated = isinstance(interrupt, Terminated)
+        print(f"\n{'terminated (SIGTERM)' if terminated else 'interrupted'}: run the same command to go on (finished work in the output's store is kept)", file=sys.stderr, flush=True)
+        return EXIT_TERMINATED if terminated else EXIT_INTERRUPTED
 
 
 def _interrupted(error: BaseException | None) -> bool:

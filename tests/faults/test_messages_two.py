@@ -113,3 +113,18 @@ def test_workers_gone_after_the_check_leave_one_line_and_no_empty_store(tmp_path
     assert code == cli.EXIT_FAILURE, err
     assert err.strip().splitlines()[-1] == f"run-study: the dask scheduler at {idle_scheduler} has no workers: none joined within 1 s: nothing had finished yet; run the same command to start again", err
     assert "Traceback" not in err and not (out / "tiny.zarr").exists()
+
+
+def test_standard_output_while_a_solver_runs_is_still_the_terminal_s() -> None:
+    """While an IDA call captures its thread's output, ``sys.stdout`` answers as the stream it replaced: its file
+    descriptor, encoding, whether it is a terminal (io.TextIOBase's own answers were None, False and an error)."""
+    stream = sys.stdout
+    with solver_messages():
+        assert sys.stdout is not stream
+        assert sys.stdout.encoding == stream.encoding and sys.stdout.isatty() == stream.isatty() and sys.stdout.writable()
+        try:
+            expected: int | None = stream.fileno()
+        except (OSError, ValueError):
+            expected = None
+        if expected is not None:
+            assert sys.stdout.fileno() == expected

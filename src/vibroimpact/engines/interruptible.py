@@ -49,13 +49,14 @@ def call_interruptibly(run: Callable[[NDArray[np.int64]], T], periods: int) -> T
             outcome["error"] = error
 
     worker = threading.Thread(target=work, name="vibroimpact-compiled-loop", daemon=True)
-    worker.start()
     try:
+        worker.start()  # a Ctrl-C inside start() too: the loop may have begun
         while worker.is_alive():
             worker.join(_POLL)
     except BaseException:
         cancel[0] = 1
-        worker.join()  # within one step of the loop
+        if worker.ident is not None:
+            worker.join()  # within one step of the loop
         raise
     if "error" in outcome:
         raise outcome["error"]  # type: ignore[misc]

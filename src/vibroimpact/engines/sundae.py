@@ -73,7 +73,27 @@ class _ThreadsOwnOutput(io.TextIOBase):
         if getattr(self.buffers, "current", None) is None and self.stream is not None:
             self.stream.flush()
 
-    def __getattr__(self, name: str) -> Any:  # encoding, isatty, fileno, ...: the stream's
+    # what TextIOBase answers for itself (no encoding, not a terminal, no file descriptor) is the stream's
+    def isatty(self) -> bool:
+        return bool(self.stream is not None and self.stream.isatty())
+
+    def fileno(self) -> int:
+        if self.stream is None:
+            raise io.UnsupportedOperation("fileno")
+        return int(self.stream.fileno())
+
+    def writable(self) -> bool:
+        return True
+
+    @property
+    def encoding(self) -> Any:  # type: ignore[override]
+        return getattr(self.stream, "encoding", None)
+
+    @property
+    def errors(self) -> Any:  # type: ignore[override]
+        return getattr(self.stream, "errors", None)
+
+    def __getattr__(self, name: str) -> Any:  # anything else: the stream's
         return getattr(self.stream, name)
 
 
