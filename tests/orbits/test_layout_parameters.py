@@ -18,7 +18,7 @@ from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
 from vibroimpact.orbits.bumper_map import BumperPeriodMap
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch, continue_special_point
-from vibroimpact.orbits.layout_parameters import layout_parameter
+from vibroimpact.model.parameters import layout_parameter
 from vibroimpact.orbits.maps import ImpactMap, closed_form_state
 from vibroimpact.orbits.shooting import shoot
 

@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.model.contact import BUMPER, KelvinVoigtBumper, RigidStop
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.orbits.layout_parameters import BUMPER_STIFFNESS
+from vibroimpact.model.parameters import BUMPER_STIFFNESS
 from vibroimpact.orbits.maps import PARAMETERS, ImpactMap
 
 __all__ = ["BumperPeriodMap", "BUMPER_PERIOD"]

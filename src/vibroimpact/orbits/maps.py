@@ -50,14 +50,15 @@ from vibroimpact.engines.registry import BUMPER, engine_for, make_engine
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import Branch, HybridInfo, MapEvaluation, PeriodicOrbit
-from vibroimpact.orbits.layout_parameters import LayoutParameter, check_independent, layout_parameter, with_layout
+from vibroimpact.model.parameters import PARAMETERS as PARAMETER_TABLE
+from vibroimpact.model.parameters import LayoutParameter, check_independent, layout_parameter, with_layout
 from vibroimpact.orbits.sections import StrobeGap, moved_phase, moved_state, resection, strobe_gap
 from vibroimpact.orbits.shooting import closed_form_state, section_phase, with_impulse
 
 __all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "BranchMeasures", "branch_measures", "closed_form_state", "with_impulse", "section_phase", "resection", "PARAMETERS", "SECTION_PARAMETER", "stop_selection", "Resection", "ContactFreeOrbit"]
 
 #: The parameters of an :class:`ImpactMap`, in order, with their units.
-PARAMETERS = {"frequency": "Hz", "restitution": "1", "clearance": "m", "amplitude": "N", "phase": "rad"}
+PARAMETERS = {name: PARAMETER_TABLE[name].unit for name in ("frequency", "restitution", "clearance", "amplitude", "phase")}
 #: The parameter that places the strobe: the force's phase at t = 0 (a section of the orbit, not a physical property).
 SECTION_PARAMETER = "phase"
 
@@ -110,7 +111,7 @@ class ImpactMap:
         frequency, 0.1, 15 % of its length scale, 10 % of its amplitude, 1 rad; on the paper's 25 Hz, 10 N problem
         1 Hz, 0.1, 1.1 mm, 1 N), so that a 0.1 Hz structure and a 30 Hz one take the same steps in their own units.
     layout : sequence of str, optional
-        Layout scalars appended to the parameters (:mod:`~vibroimpact.orbits.layout_parameters`: ``"k2"``,
+        Layout scalars appended to the parameters (:mod:`~vibroimpact.model.parameters`: ``"k2"``,
         ``"mass[x2]"``, ``"spring[x1,x2]"``, ``"bumper_stiffness"`` ...), so that any of them can be continued or be
         the second parameter of a special point's curve; their scale is 10 % of their value.
 

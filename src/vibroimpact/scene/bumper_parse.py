@@ -21,7 +21,7 @@ from typing import Any, NamedTuple
 from vibroimpact.model.contact import MAX_LOSS_FACTOR, KelvinVoigtBumper
 from vibroimpact.model.layout import Layout, StopSpec
 from vibroimpact.scene.checker import Checker
-from vibroimpact.scene.schema import MAX_BUMPER_FREQUENCY as _MAX_FREQUENCY
+from vibroimpact.model.parameters import MAX_BUMPER_FREQUENCY as _MAX_FREQUENCY
 
 __all__ = ["BUMPER_KEYS", "PHYSICAL_KEYS", "MAX_BUMPER_LOSS_FACTOR", "BumperSpec", "parse_bumper", "read_bumper", "convert_bumper", "bumper_form_problem", "scene_bumper"]
 

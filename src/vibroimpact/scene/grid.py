@@ -188,7 +188,8 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     derived_restitution = "bumper_loss_factor" in sweep
     bumper_solutions = [name for name in solutions if ENGINE_CONTACT.get(name) == BUMPER]
     grids: dict[str, np.ndarray | None] = {}
-    for key, (_units, low, high, low_inclusive) in SWEEPABLE.items():
+    for key, row in SWEEPABLE.items():
+        low, high, low_inclusive = row.low, row.high, row.low_inclusive
         section, field_name = _FIXED_PLACE.get(key, ("", ""))
         place = f"{section}.{field_name}"
         given_fixed = field_name in fixed.get(section, {})

@@ -14,6 +14,7 @@ from typing import Generic, Sequence, TypeVar
 
 from vibroimpact.engines.registry import RIGID, engine_for, engine_names, engine_spec, stepped_solutions
 from vibroimpact.model.layout import Layout
+from vibroimpact.model.parameters import PARAMETERS
 from vibroimpact.scene.kinds import KIND_NAMES
 from vibroimpact.scene.variables import MOTION_QUANTITIES, QUANTITIES, STOP_QUANTITIES, quantities_for
 from vibroimpact.simulation.settings import START_MODES, SWEEP_STARTS
@@ -64,14 +65,8 @@ BENCHMARK_METHODS = tuple(name for name in engine_names() if name != BENCHMARK_R
 SWEEP_DIRECTIONS = ("up", "down")
 #: How a simulation starts at each frequency.
 SIMULATION_STARTS = START_MODES + SWEEP_STARTS
-#: Parameters that can be swept, with their units and allowed ranges (low, high, low inclusive).
-SWEEPABLE = {
-    "frequency": ("Hz", 0.0, math.inf, False),
-    "restitution": ("1", 0.0, 1.0, True),
-    "clearance": ("m", -math.inf, math.inf, False),
-    "bumper_frequency": ("Hz", 0.0, 1e6, False),
-    "bumper_loss_factor": ("1", 0.0, 1e3, True),
-}
+#: Parameters a stepped or swept scene can sweep: rows of the parameter table (units and allowed ranges).
+SWEEPABLE = {name: PARAMETERS[name] for name in ("frequency", "restitution", "clearance", "bumper_frequency", "bumper_loss_factor")}
 #: Dimension order of a study's grid (unswept ones are squeezed out of the dataset).
 GRID_DIMS = ("restitution", "clearance", "bumper_frequency", "sweep", "frequency")
 #: Most points of one grid.
@@ -80,8 +75,6 @@ MAX_GRID_POINTS = 1_000_000
 MAX_STUDY_POINTS = 10_000_000
 #: Most output samples of one swept-sine run (7 floats each, plus the estimators' temporaries: ~1 GB).
 MAX_SWEEP_SAMPLES = 10_000_000
-#: Stiffest bumper accepted [Hz] (tested to 100 kHz; contact then lasts microseconds).
-MAX_BUMPER_FREQUENCY = 1e6
 #: Most periods of one benchmark run.
 MAX_BENCHMARK_PERIODS = 1_000_000
 

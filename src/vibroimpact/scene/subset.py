@@ -61,8 +61,8 @@ def parse_subset(c: Checker, value: Any, engines: list[str], axes: Mapping[str, 
             if axis == "frequency" and start in SWEEP_STARTS:
                 c.fail(place, f"a stepped sweep (start: {start}) follows every simulated frequency in one chain: a subset of them is another sweep; keep every frequency, or subset another axis")
                 continue
-            _units, low, high, low_inclusive = SWEEPABLE[axis]
-            given = c.grid(place, values, low, high, low_inclusive)
+            row = SWEEPABLE[axis]
+            given = c.grid(place, values, row.low, row.high, row.low_inclusive)
             if given is None:
                 continue
             snapped = _snap(c, place, given, grid, axis)

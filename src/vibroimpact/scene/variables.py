@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from vibroimpact.analysis.stability import regime_attributes
+from vibroimpact.model.parameters import PARAMETERS
 
 __all__ = ["VARIABLE_ATTRIBUTES", "CONVERGED_ATTRIBUTES", "STABLE_MARGINAL", "STABLE_ATTRIBUTES", "COORDINATE_ATTRIBUTES", "flag_attributes", "quantity_attributes", "QUANTITIES", "MOTION_QUANTITIES", "STOP_QUANTITIES", "quantities_for"]
 
@@ -56,12 +57,9 @@ STABLE_ATTRIBUTES = {
     "flag_meanings": "not_applicable unstable stable marginal",
 }
 COORDINATE_ATTRIBUTES: dict[str, dict[str, str]] = {
-    "frequency": {"units": "Hz", "long_name": "excitation frequency"},
-    "restitution": {"units": "1", "long_name": "restitution ratio R"},
-    "clearance": {"units": "m", "long_name": "clearance Delta between absorber and stop"},
+    **{name: {"units": PARAMETERS[name].unit, "long_name": PARAMETERS[name].long_name} for name in ("frequency", "restitution", "clearance")},
     "solution": {"long_name": "solution method"},
-    "bumper_frequency": {"units": "Hz", "long_name": "apparent natural frequency Omega_b / 2 pi of the compliant bumper"},
-    "bumper_loss_factor": {"units": "1", "long_name": "loss factor xi_b of the compliant bumper"},
+    **{name: {"units": PARAMETERS[name].unit, "long_name": PARAMETERS[name].long_name} for name in ("bumper_frequency", "bumper_loss_factor")},
     "sweep": {"long_name": "direction of the swept-sine test"},
 }
 

@@ -35,13 +35,13 @@ from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.layout import Layout, LoadSpec, StopSpec, build_stops
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.contact import Stop
+from vibroimpact.model.parameters import MAX_BUMPER_FREQUENCY
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.scene.header import NAME, check_sweep_run, parse_names
 from vibroimpact.scene.layout_parse import parse_layout
 from vibroimpact.scene.schema import (
     BENCHMARK_METHODS,
     MAX_BENCHMARK_PERIODS,
-    MAX_BUMPER_FREQUENCY,
     Scene,
 )
 from vibroimpact.simulation.settings import START_MODES

@@ -30,7 +30,7 @@ from vibroimpact.simulation.certified_worst import SOURCES, certified_worst, swe
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.store import case_key
 
-__all__ = ["DesignSpace", "DesignCase", "sample_chunks", "CHUNKS", "DESIGN_FIELDS", "CertifyCase", "CERTIFY_FIELDS", "STOP_PARAMETERS", "MIN_BUMPER_RESTITUTION", "SCREENS", "screen_kind", "screen_worst", "ATTRACTOR_POINTS", "SWEEP_ACCURACIES", "MAX_BRANCH_POINTS", "SCREEN_MOTIONS", "BRUTE", "BRUTE_SCREEN"]
+__all__ = ["DesignSpace", "DesignCase", "sample_chunks", "CHUNKS", "DESIGN_FIELDS", "CertifyCase", "CERTIFY_FIELDS", "MIN_BUMPER_RESTITUTION", "SCREENS", "screen_kind", "screen_worst", "ATTRACTOR_POINTS", "SWEEP_ACCURACIES", "MAX_BRANCH_POINTS", "SCREEN_MOTIONS", "BRUTE", "BRUTE_SCREEN"]
 
 #: The screen's motions: the closed forms' (:data:`~vibroimpact.analysis.band_worst.MOTIONS`), and brute force's on a
 #: layout without a closed form.
@@ -38,8 +38,6 @@ BRUTE = "found by brute force"
 SCREEN_MOTIONS = (*MOTIONS, BRUTE)
 #: The screen's brute force where no closed form applies: frequencies, extra starts, transient and measured periods.
 BRUTE_SCREEN = (41, 1, 200, 64)
-#: The map's parameters a design or a mistuning may set besides the layout scalars.
-STOP_PARAMETERS = ("clearance", "restitution")
 #: A bumper's restitution is kept at or above this [-] (R = 0 needs an infinite loss factor).
 MIN_BUMPER_RESTITUTION = 1e-3
 #: How the screen sees a problem (:func:`screen_kind`): the rigid stops' closed forms, bumper orbits grown from their
@@ -104,7 +102,7 @@ class DesignSpace:
     @cached_property
     def map(self) -> ImpactMap:
         """The impact map whose parameters are the design's and the mistuning's scalars."""
-        layout = tuple(dict.fromkeys(n for n in (*self.variables, *self.mistuned) if n not in STOP_PARAMETERS))
+        layout = tuple(dict.fromkeys(n for n in (*self.variables, *self.mistuned) if n not in ImpactMap.parameter_names))
         return ImpactMap(self.problem, layout=layout)
 
     @cached_property

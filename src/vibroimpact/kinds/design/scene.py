@@ -22,22 +22,26 @@ design). Example (``studies/design_vs_linear.yaml``, shortened)::
       search: {method: differential_evolution, population: 8, generations: 25, seed: 1, polish: true}
       certify: {candidates: 1}
 
-A variable is ``clearance`` [m], ``restitution`` [-] or any layout scalar of
-:mod:`vibroimpact.orbits.layout_parameters` (``k2``, ``b2``, ``m2``, ``spring[x1,x2]``, ``mass[x3]``, ...; its unit
-follows its matrix). A mistuning (``robust``) names the same scalars: a structural one by a relative spread (0.05:
-+-5 %), ``clearance`` [m] and ``restitution`` [-] by an absolute one; ``samples`` points of a seeded Latin hypercube
+A variable is ``clearance`` [m], ``restitution`` [-], ``bumper_stiffness`` [N m-1] (stops with bumpers) or any layout
+scalar (``k2``, ``b2``, ``m2``, ``spring[x1,x2]``, ``mass[x3]``, ...): a row of the parameter table
+(:mod:`vibroimpact.model.parameters`), which gives its unit, its allowed bounds (a design narrows only the clearance,
+to (0, inf), and a bumper's restitution, to (0, 1]) and how a mistuning spreads it. A mistuning (``robust``) names the
+same scalars: a structural one by a relative spread (0.05: +-5 %), ``clearance`` [m] and ``restitution`` [-] by an
+absolute one; ``samples`` points of a seeded Latin hypercube
 over the spreads, plus the nominal design, and the objective is their worst (``quantile: 1``) or a stated quantile.
 Every key is checked (unknown keys, wrong types and out-of-range values are reported together, each naming its key).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from dataclasses import dataclass
 from typing import Any
 
 from vibroimpact.model.layout import PAPER_STOP, Layout
+from vibroimpact.model.parameters import BUMPER_STIFFNESS, LAYOUT_FORMS, MAX_RELATIVE_SPREAD, PARAMETERS, Parameter, parameter
 from vibroimpact.model.structure import require_in_range
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.scene.header import parse_names
@@ -48,17 +52,16 @@ __all__ = ["DESIGN_TOP_KEYS", "STOP_VARIABLES", "BUMPER_VARIABLE", "METHODS", "C
 
 #: Top-level keys of a design scene.
 DESIGN_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "design", "report", "cluster"}
-#: Design variables of the stops (absolute units; every other variable is a layout scalar).
-STOP_VARIABLES = {"clearance": "m", "restitution": "1"}
+#: Design variables of the stops (every other variable is the bumpers' stiffness or a layout scalar).
+STOP_VARIABLES = ("clearance", "restitution")
 #: The bumpers' stiffness K_b [N m-1], a variable where the stops have bumpers (their loss factor follows R).
-BUMPER_VARIABLE = "bumper_stiffness"
+BUMPER_VARIABLE = BUMPER_STIFFNESS
 #: Searches: a global search then a local polish, or every point of a grid over the variables (a map).
 METHODS = ("differential_evolution", "grid")
 #: What the optimum is compared with: the best linear absorber of the same mass (the paper's two masses), or nothing.
 COMPARISONS = ("linear_optimum", "none")
 _DESIGN_KEYS = {"variables", "band", "objective", "constraints", "robust", "compare", "search", "certify"}
 _SEARCH_KEYS = {"method", "population", "generations", "seed", "polish", "points"}
-_LAYOUT_FORMS = re.compile(r"^(m1|m2|k1|k2|b1|b2|(mass|stiffness|damping|spring|dashpot)\[\s*\w+\s*(,\s*\w+\s*)?\])$")
 #: Most evaluations of one scene's search (candidates x mistuning samples).
 MAX_EVALUATIONS = 2_000_000
 
@@ -112,8 +115,9 @@ class Mistuning:
     relative: bool
 
     def __post_init__(self) -> None:
-        if not 0.0 < require_in_range(f"robust.{self.name}", self.spread, 0.0, 0.5 if self.relative else math.inf):
-            raise ValueError(f"robust.{self.name} = {self.spread!r} is out of range: allowed (0, {0.5 if self.relative else math.inf:g}]")
+        limit = MAX_RELATIVE_SPREAD if self.relative else math.inf
+        if not 0.0 < require_in_range(f"robust.{self.name}", self.spread, 0.0, limit):
+            raise ValueError(f"robust.{self.name} = {self.spread!r} is out of range: allowed (0, {limit:g}]")
 
 
 @dataclass(frozen=True)
@@ -296,45 +300,50 @@ def _variables(c: Checker, value: Any, layout: Layout | None, bumper: float | No
     out = []
     for key, bounds in spec.items():
         name = str(key)
-        unit = STOP_VARIABLES.get(name) or _layout_unit(c, f"design.variables.{name}", name, layout, bumper)
-        if unit is None:
+        row = _design_row(c, f"design.variables.{name}", name, layout, bumper)
+        if row is None:
             continue
         if not (isinstance(bounds, list) and len(bounds) == 2):
             c.fail(f"design.variables.{name}", f"expected [low, high], got {bounds!r}")
             continue
-        high_limit = 1.0 if name == "restitution" else math.inf
-        low_value = c.number(f"design.variables.{name}[0]", bounds[0], 0.0, high_limit, low_inclusive=(name == "restitution" and bumper is None) or name.startswith(("b2", "b1", "dashpot", "damping")))
-        high_value = c.number(f"design.variables.{name}[1]", bounds[1], 0.0, high_limit, low_inclusive=False)
+        low_value = c.number(f"design.variables.{name}[0]", bounds[0], row.low, row.high, row.low_inclusive, row.high_inclusive)
+        high_value = c.number(f"design.variables.{name}[1]", bounds[1], row.low, row.high, low_inclusive=False, high_inclusive=row.high_inclusive)
         if low_value is None or high_value is None:
             continue
         if not low_value < high_value:
             c.fail(f"design.variables.{name}", f"low = {low_value:g} must be below high = {high_value:g}")
             continue
-        out.append(Variable(name, low_value, high_value, unit))
+        out.append(Variable(name, low_value, high_value, row.unit))
     if len(out) > 6:
         c.fail("design.variables", f"{len(out)} variables: allowed at most 6 (a global search in more dimensions needs more evaluations than a study should)")
     return tuple(out)
 
 
-def _layout_unit(c: Checker, key: str, name: str, layout: Layout | None, bumper: float | None = None) -> str | None:
-    """The unit of the layout scalar ``name`` (None, with a problem recorded, if the layout has none of that name);
-    ``bumper_stiffness`` [N m-1] where the stops have bumpers (``bumper``: their Omega_b / 2 pi [Hz])."""
+def _design_row(c: Checker, key: str, name: str, layout: Layout | None, bumper: float | None = None) -> Parameter | None:
+    """The parameter table's row of the design scalar ``name`` (None, with a problem recorded, if a design cannot
+    choose it): ``clearance`` narrowed to (0, inf) (the closed forms' stops are apart from the structure), ``restitution``
+    to (0, 1] on bumpers (R = 0 needs an infinite loss factor), ``bumper_stiffness`` where the stops have bumpers
+    (``bumper``: their Omega_b / 2 pi [Hz]), or a layout scalar the structure has."""
+    if name in STOP_VARIABLES:
+        row = PARAMETERS[name]
+        if name == "clearance":
+            return dataclasses.replace(row, low=0.0, low_inclusive=False)
+        return row if bumper is None else dataclasses.replace(row, low_inclusive=False)
     if name == BUMPER_VARIABLE:
         if bumper is None:
             c.fail(key, f"{name}: the stops are rigid; give the stop a bumper (stop: {{clearance, restitution, bumper: {{stiffness: K_b [N/m]}}}}) to choose its stiffness")
             return None
-        return "N m-1"
-    if not _LAYOUT_FORMS.match(name.replace(" ", "")):
+        return PARAMETERS[name]
+    if not LAYOUT_FORMS.match(name.replace(" ", "")):
         c.fail(key, f"unknown design variable {name!r}: allowed clearance, restitution, bumper_stiffness (a stop with a bumper), or a layout scalar (k2, b2, m2, ... on the paper's system; mass[a], spring[a,b], dashpot[a], stiffness[a,b], damping[a] on any)")
         return None
     if layout is None:
         return None
     from vibroimpact.model.problem import ImpactProblem  # model layer: reading a scene loads no solver
-    from vibroimpact.orbits.layout_parameters import layout_parameter
 
     try:
         problem = layout.problem(1.0, 1.0, 0.5, 1.0)
-        return layout_parameter(name, problem).unit if isinstance(problem, ImpactProblem) else None
+        return parameter(name, problem) if isinstance(problem, ImpactProblem) else None
     except ValueError as error:
         c.fail(key, str(error))
         return None
@@ -392,14 +401,12 @@ def _robust(c: Checker, value: Any, layout: Layout | None, bumper: float | None 
     quantile = c.number("design.robust.quantile", value.get("quantile", 1.0), 0.0, 1.0, low_inclusive=False)
     out = []
     for name in spreads:
-        spread = value[name]
-        relative = name not in STOP_VARIABLES
-        if relative and _layout_unit(c, f"design.robust.{name}", name, layout, bumper) is None:
+        row = _design_row(c, f"design.robust.{name}", name, layout, bumper)
+        if row is None:
             continue
-        limit = 0.5 if relative else (1.0 if name == "restitution" else math.inf)
-        number = c.number(f"design.robust.{name}", spread, 0.0, limit, low_inclusive=False, high_inclusive=not relative)
+        number = c.number(f"design.robust.{name}", value[name], 0.0, row.spread_limit, low_inclusive=False, high_inclusive=not row.relative_spread)
         if number is not None:
-            out.append(Mistuning(name, number, relative))
+            out.append(Mistuning(name, number, row.relative_spread))
     if out and samples == 0:
         c.fail("design.robust.samples", "0 samples of a mistuning: give at least 1 (a Latin hypercube over the spreads)")
     return tuple(out), samples if out else 0, seed, quantile

@@ -1,7 +1,24 @@
-"""Layout scalars as parameters of an :class:`~vibroimpact.orbits.maps.ImpactMap`: any entry of the structure's
-matrices, a spring or dashpot of it, the named system's m1 ... b2, and the bumpers' stiffness.
+"""The parameter table: every scalar a study may vary, declared once (name, unit, long name, allowed range, how a
+mistuning spreads it), and any layout scalar as a value one can read from and set on a problem.
 
-A name says which scalar (coordinates by name, e.g. ``x1``, or by index, e.g. ``0``)::
+Scene sweeps (:data:`vibroimpact.scene.schema.SWEEPABLE`), the datasets' coordinates, the impact map's parameters
+(:data:`vibroimpact.orbits.maps.PARAMETERS`), design variables and mistuning read :data:`PARAMETERS` and
+:func:`parameter`; a new kind of scalar is one row here. The named scalars::
+
+    frequency           f of the harmonic force                              [Hz]     (0, inf)
+    amplitude           its amplitude q                                      [N]      (-inf, inf)
+    phase               its phase                                            [rad]    (-inf, inf)
+    restitution         the stops' restitution R                             [1]      [0, 1]
+    clearance           the stops' clearance Delta                           [m]      (-inf, inf)
+    bumper_frequency    a bumper's Omega_b / 2 pi                            [Hz]     (0, 1e6]
+    bumper_loss_factor  a bumper's xi_b                                      [1]      [0, 1e3]
+    bumper_stiffness    K_b = m_k Omega_b^2 of the selected stops' bumpers   [N m-1]  (0, inf)
+
+and every layout scalar of the structure's matrices, by the grammar below (its unit follows its matrix, its range
+(0, inf), a dashpot's [0, inf)). A mistuning spreads a structural scalar (and a bumper's stiffness or frequency)
+relatively, at most +-50 %, and the stops' clearance and restitution absolutely.
+
+A layout scalar's name says which scalar (coordinates by name, e.g. ``x1``, or by index, e.g. ``0``)::
 
     mass[a]  mass[a,b]           M[a, a], M[a, b] = M[b, a]                       [kg]
     stiffness[a]  stiffness[a,b]  K[a, a], K[a, b] = K[b, a]                       [N m-1]
@@ -32,20 +49,126 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.model.contact import KelvinVoigtBumper
+from vibroimpact.model.contact import MAX_LOSS_FACTOR, KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["LayoutParameter", "layout_parameter", "with_layout", "check_independent", "BUMPER_STIFFNESS", "NAMED_SYSTEM"]
+__all__ = ["Parameter", "PARAMETERS", "parameter", "MAX_RELATIVE_SPREAD", "MAX_BUMPER_FREQUENCY", "LayoutParameter", "layout_parameter",
+           "with_layout", "check_independent", "BUMPER_STIFFNESS", "NAMED_SYSTEM", "LAYOUT_FORMS"]
 
 #: The bumpers' stiffness K_b [N m-1].
 BUMPER_STIFFNESS = "bumper_stiffness"
+#: Largest relative mistuning of a scalar (0.5: +-50 %) [-].
+MAX_RELATIVE_SPREAD = 0.5
+#: Stiffest bumper a scene may ask for [Hz] (tested to 100 kHz; contact then lasts microseconds). A structure may
+#: refuse a softer one: :func:`vibroimpact.model.bumper_limit.bumper_refusal`.
+MAX_BUMPER_FREQUENCY = 1e6
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One scalar a study may vary: a row of the parameter table (module docstring).
+
+    Attributes
+    ----------
+    name : str
+        Its name in scenes, datasets and maps.
+    unit : str
+        UDUNITS string.
+    long_name : str
+        What it is, for datasets and pages.
+    low, high : float
+        Its allowed range [unit].
+    low_inclusive, high_inclusive : bool
+        Whether ``low`` and ``high`` are allowed.
+    relative_spread : bool
+        A mistuning spreads it relatively (a fraction of its value, at most :data:`MAX_RELATIVE_SPREAD`), else by an
+        absolute offset [unit] (at most the width of its range).
+    """
+
+    name: str
+    unit: str
+    long_name: str
+    low: float
+    high: float
+    low_inclusive: bool = False
+    high_inclusive: bool = True
+    relative_spread: bool = True
+
+    def __post_init__(self) -> None:
+        if not self.low < self.high:
+            raise ValueError(f"parameter {self.name!r}: its range [{self.low!r}, {self.high!r}] must have low < high")
+
+    @property
+    def spread_limit(self) -> float:
+        """The largest mistuning spread: relative [-] or absolute [unit]."""
+        return MAX_RELATIVE_SPREAD if self.relative_spread else self.high - self.low
+
+    def allows(self, value: float) -> bool:
+        """``value`` is in the parameter's range."""
+        above = value >= self.low if self.low_inclusive else value > self.low
+        below = value <= self.high if self.high_inclusive else value < self.high
+        return bool(above and below)
+
+    def clip(self, value: float) -> float:
+        """``value`` brought into the closed range [low, high]."""
+        return min(max(value, self.low), self.high)
+
+
+_MATRIX_NAMES = {"mass": "mass", "stiffness": "stiffness", "damping": "damping", "spring": "stiffness", "dashpot": "damping"}
+#: The named scalars (module docstring); a layout scalar's row is made by :func:`parameter`.
+PARAMETERS: dict[str, Parameter] = {
+    item.name: item
+    for item in (
+        Parameter("frequency", "Hz", "excitation frequency", 0.0, math.inf, high_inclusive=False),
+        Parameter("amplitude", "N", "amplitude of the harmonic force", -math.inf, math.inf, high_inclusive=False),
+        Parameter("phase", "rad", "phase of the harmonic force", -math.inf, math.inf, high_inclusive=False, relative_spread=False),
+        Parameter("restitution", "1", "restitution ratio R", 0.0, 1.0, low_inclusive=True, relative_spread=False),
+        Parameter("clearance", "m", "clearance Delta between absorber and stop", -math.inf, math.inf, high_inclusive=False, relative_spread=False),
+        Parameter("bumper_frequency", "Hz", "apparent natural frequency Omega_b / 2 pi of the compliant bumper", 0.0, MAX_BUMPER_FREQUENCY),
+        Parameter("bumper_loss_factor", "1", "loss factor xi_b of the compliant bumper", 0.0, MAX_LOSS_FACTOR, low_inclusive=True),
+        Parameter(BUMPER_STIFFNESS, "N m-1", "stiffness K_b = m_k Omega_b^2 of the compliant bumpers", 0.0, math.inf, high_inclusive=False),
+    )
+}
+
+
+def parameter(name: str, problem: ImpactProblem | None = None) -> Parameter:
+    """The table's row of ``name``: a named scalar, or a layout scalar by the grammar (module docstring).
+
+    Parameters
+    ----------
+    name : str
+        A name of :data:`PARAMETERS` or a layout scalar (``k2``, ``spring[x1,x2]``, ``mass[x3]`` ...).
+    problem : ImpactProblem, optional
+        Resolves a layout scalar's coordinates (and checks that the structure has them); without it only the form of
+        the name is checked.
+
+    Raises
+    ------
+    ValueError
+        A name that is neither, naming the allowed forms; a layout scalar the problem's structure does not have.
+    """
+    if name in PARAMETERS:
+        return PARAMETERS[name]
+    text = NAMED_SYSTEM.get(name, name).replace(" ", "")
+    match = _GRAMMAR.match(text)
+    if match is None:
+        raise ValueError(f"unknown parameter {name!r}: allowed {', '.join(PARAMETERS)}, or a layout scalar ({_FORMS})")
+    if problem is not None:
+        layout_parameter(name, problem)
+    kind, first, second = match.groups()
+    matrix = _MATRIX_NAMES[kind]
+    off_diagonal = kind in ("mass", "stiffness", "damping") and second is not None and second != first
+    damping = matrix == "damping"
+    low = -math.inf if off_diagonal else 0.0
+    return Parameter(name, _UNITS[matrix], f"layout scalar {name}" + (f" = {text}" if name != text else ""), low, math.inf, low_inclusive=damping and not off_diagonal, high_inclusive=False)
 #: The paper's named parameters, as elements of the general grammar (their units follow).
 NAMED_SYSTEM = {"m1": "mass[x1]", "m2": "mass[x2]", "k1": "spring[x1]", "k2": "spring[x1,x2]", "b1": "dashpot[x1]", "b2": "dashpot[x1,x2]"}
-_MATRIX = {"mass": "mass", "stiffness": "stiffness", "damping": "damping", "spring": "stiffness", "dashpot": "damping"}
 _UNITS = {"mass": "kg", "stiffness": "N m-1", "damping": "N s m-1"}
 _GRAMMAR = re.compile(r"^(mass|stiffness|damping|spring|dashpot)\[\s*(\w+)\s*(?:,\s*(\w+)\s*)?\]$")
+#: A layout scalar's name, as a scene writes it (spaces allowed): the grammar's forms and the named system's.
+LAYOUT_FORMS = re.compile(r"^(m1|m2|k1|k2|b1|b2|(mass|stiffness|damping|spring|dashpot)\[\s*\w+\s*(,\s*\w+\s*)?\])$")
 _FORMS = "mass[a], mass[a,b], stiffness[a(,b)], damping[a(,b)], spring[a(,b)], dashpot[a(,b)], m1 ... b2 (the named system), bumper_stiffness"
 
 
@@ -117,7 +240,7 @@ def layout_parameter(name: str, problem: ImpactProblem) -> LayoutParameter:
         raise ValueError(f"parameter {name!r}: an element joins two different coordinates (or one and the ground: {kind}[{first}])")
     if not element and len(indices) == 1:
         indices = (indices[0], indices[0])
-    matrix = _MATRIX[kind]
+    matrix = _MATRIX_NAMES[kind]
     return LayoutParameter(name, matrix, element, indices, _UNITS[matrix])
 
 
