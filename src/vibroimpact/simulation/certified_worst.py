@@ -85,8 +85,10 @@ class CertifiedWorst:
             raise ValueError(f"source = {self.source!r} is not one of {SOURCES}")
 
 
-def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequencies: int = 121, starts: int = 2, transient: int = 200, strobes: int = 64) -> CertifiedWorst:
-    """The worst stable |X1| of ``problem`` over ``band`` [Hz] (module docstring); ``frequencies``, ``starts``,
+def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequencies: int = 121, starts: int = 2, transient: int = 200, strobes: int = 64,
+                    coordinate: int = 0) -> CertifiedWorst:  # fmt: skip
+    """The worst stable |X| of ``coordinate`` (0: x1) of ``problem`` over ``band`` [Hz] (module docstring): continuation,
+    brute force and the brute force's orbit continued all measure that coordinate; ``frequencies``, ``starts``,
     ``transient`` and ``strobes`` are the brute force's (:func:`~vibroimpact.simulation.band_attractors.band_attractors`).
 
     Bumpers continue from their rigid twin's closed-form orbits. A problem the closed forms do not apply to (a free
@@ -98,9 +100,9 @@ def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequenci
     # continuation starts from the closed forms (bumpers: their rigid twin's); a layout without them (a free mass ...)
     # is brute force's alone
     closed = closed_form_refusal(problem) is None or bumper_screen_refusal(problem) is None
-    continued = worst_response(problem, (low, high)) if closed else WorstCase(0.0, math.nan, "", ())
+    continued = worst_response(problem, (low, high), coordinate) if closed else WorstCase(0.0, math.nan, "", ())
     middle = time.perf_counter()
-    sweep = band_attractors(problem, (low, high), frequencies=frequencies, starts=starts, transient=transient, strobes=strobes)
+    sweep = band_attractors(problem, (low, high), frequencies=frequencies, starts=starts, transient=transient, strobes=strobes, coordinate=coordinate)
     swept = time.perf_counter()
     top = sweep.maximum
     best = (continued.amplitude, continued.frequency, continued.motion, SOURCES[0])
@@ -108,7 +110,7 @@ def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequenci
     if math.isfinite(top.amplitude) and top.amplitude > continued.amplitude * (1.0 + 1e-6):
         best = (top.amplitude, top.frequency, f"{top.motion} (brute force, {top.run} run)", SOURCES[1])
         if top.period >= 1 and top.impacts > 0.0 and top.regime in ("one_impact", "other_periodic"):
-            refined = _continued(problem, (low, high), top.frequency, np.array(top.state), top.period)
+            refined = _continued(problem, (low, high), top.frequency, np.array(top.state), top.period, coordinate)
             if refined is not None and refined[0] >= top.amplitude * (1.0 - 1e-3):  # the same orbit, located exactly
                 best = (refined[0], refined[1], f"{top.motion} ({refined[2]} of its branch, continued from the brute force)", SOURCES[2])
                 extra = (refined[3],)
@@ -116,16 +118,16 @@ def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequenci
     return CertifiedWorst(best[0], best[1], best[2], best[3], continued, sweep, extra, middle - start, end - middle, swept - middle)
 
 
-def _continued(problem: ImpactProblem, band: tuple[float, float], frequency: float, state: np.ndarray, period: int) -> tuple[float, float, str, Branch] | None:
-    """(|X1| [m], where [Hz], which place, branch) of the stable maximum of the branch through the period-``period``
-    orbit near ``state`` at ``frequency``; None where shooting or continuation fails."""
+def _continued(problem: ImpactProblem, band: tuple[float, float], frequency: float, state: np.ndarray, period: int, coordinate: int = 0) -> tuple[float, float, str, Branch] | None:
+    """(|X| of ``coordinate`` [m], where [Hz], which place, branch) of the stable maximum of the branch through the
+    period-``period`` orbit near ``state`` at ``frequency``; None where shooting or continuation fails."""
     system = ImpactMap(at_frequency(problem, frequency), periods=period)
     try:
         orbit = shoot(system, state, system.parameters)
         branch = continue_branch(system, orbit, "frequency", ContinuationSettings(lower=band[0], upper=band[1]))
     except (ShootingError, ValueError, RuntimeError):
         return None
-    top = branch_maximum(system, branch)
+    top = branch_maximum(system, branch, coordinate)
     return (top.amplitude, top.value, top.where, branch) if top is not None else None
 
 

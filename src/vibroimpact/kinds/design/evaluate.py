@@ -193,7 +193,7 @@ class DesignCase:
                     values = (found.amplitude, found.frequency, found.uncovered, found.estimate, SCREEN_MOTIONS.index(found.motion))
                     out["impulse"][row] = found.impulse
                 else:  # no closed form (a free mass, stops that are not one or a symmetric pair): brute force screens
-                    top = band_attractors(problem, self.space.band, *BRUTE_SCREEN).maximum
+                    top = band_attractors(problem, self.space.band, *BRUTE_SCREEN, coordinate=self.space.coordinate).maximum
                     values = (top.amplitude, top.frequency, 0.0, 0.0, SCREEN_MOTIONS.index(BRUTE))
                 if math.isfinite(self.space.operating):
                     out["operating"][row], operating_motion[row] = _operating(problem, self.space.operating, self.space.coordinate, kind)
@@ -211,7 +211,7 @@ def _operating(problem: ImpactProblem, frequency: float, coordinate: int, kind: 
     the screen's (``kind`` of :data:`SCREENS`; where none of its motions is stable there, the guess from the orbits
     that exist), else brute force's."""
     if kind == SCREENS[2]:
-        return band_attractors(problem, _around(frequency), 2, *BRUTE_SCREEN[1:]).maximum.amplitude, SCREEN_MOTIONS.index(BRUTE)
+        return band_attractors(problem, _around(frequency), 2, *BRUTE_SCREEN[1:], coordinate=coordinate).maximum.amplitude, SCREEN_MOTIONS.index(BRUTE)
     at = closed_form_at(problem, frequency, coordinate) if kind == SCREENS[0] else bumper_at(problem, frequency, coordinate)
     if at.uncovered == 0.0:  # exact: a share of none
         return at.amplitude, SCREEN_MOTIONS.index(at.motion)
@@ -274,7 +274,7 @@ class CertifyCase:
                 start = time.perf_counter()
                 screen_worst(problem, self.space.band, self.space.coordinate, self.space.scan)
                 scalars["screen_time"] = time.perf_counter() - start
-            found = certified_worst(problem, self.space.band, frequencies=ATTRACTOR_POINTS)
+            found = certified_worst(problem, self.space.band, frequencies=ATTRACTOR_POINTS, coordinate=self.space.coordinate)
         except (ValueError, RuntimeError) as error:
             return {**{k: np.array(v) for k, v in scalars.items()}, "sweep_points": np.full(len(SWEEP_ACCURACIES), np.nan), "sweep_time": np.full(len(SWEEP_ACCURACIES), np.nan), **points, **attractors,
                     "error": np.array(f"{type(error).__name__}: {str(error)[:200]}")}  # fmt: skip
