@@ -15,7 +15,7 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "vibroimpact"
 #: Lowest first: a module may import from its own layer and those before it (README, "Architecture").
-LAYERS = ("model", "analysis", "engines", "orbits", "simulation", "scene", "runs", "reporting", "grids", "kinds", "cli")
+LAYERS = ("model", "analysis", "engines", "orbits", "simulation", "measures", "scene", "runs", "reporting", "grids", "kinds", "cli")
 #: Third-party libraries a layer must not import (lower layers are physics and numerics only); the layers from ``runs``
 #: up (``runs``, ``reporting``, ``grids``, ``kinds``, ``cli``) write datasets and draw, and may import any.
 FORBIDDEN_LIBRARIES = {
@@ -24,6 +24,7 @@ FORBIDDEN_LIBRARIES = {
     "engines": ("yaml", "xarray", "matplotlib", "netCDF4"),
     "orbits": ("yaml", "xarray", "matplotlib", "netCDF4", "sksundae"),
     "simulation": ("yaml", "xarray", "matplotlib", "netCDF4"),
+    "measures": ("yaml", "xarray", "matplotlib", "netCDF4"),
     "scene": ("xarray", "matplotlib", "netCDF4", "sksundae", "scipy.integrate"),
 }
 #: A kind's scene section is read with the scene layer (reading a scene loads no solver): these kind modules are held
