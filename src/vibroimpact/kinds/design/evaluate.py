@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from vibroimpact.analysis.band_worst import MOTIONS, BandWorst, closed_form_at, closed_form_worst
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.simulation.band_attractors import band_attractors
-from vibroimpact.model.contact import KelvinVoigtBumper
+from vibroimpact.model.contact import MIN_BUMPER_RESTITUTION, KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.bumper_screen import bumper_at, bumper_screen_refusal, bumper_worst
 from vibroimpact.orbits.maps import ImpactMap, branch_measures
@@ -30,7 +30,7 @@ from vibroimpact.simulation.certified_worst import SOURCES, certified_worst, swe
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.store import case_key
 
-__all__ = ["DesignSpace", "DesignCase", "sample_chunks", "CHUNKS", "DESIGN_FIELDS", "CertifyCase", "CERTIFY_FIELDS", "MIN_BUMPER_RESTITUTION", "SCREENS", "screen_kind", "screen_worst", "ATTRACTOR_POINTS", "SWEEP_ACCURACIES", "MAX_BRANCH_POINTS", "SCREEN_MOTIONS", "BRUTE", "BRUTE_SCREEN"]
+__all__ = ["DesignSpace", "DesignCase", "sample_chunks", "CHUNKS", "DESIGN_FIELDS", "CertifyCase", "CERTIFY_FIELDS", "SCREENS", "screen_kind", "screen_worst", "ATTRACTOR_POINTS", "SWEEP_ACCURACIES", "MAX_BRANCH_POINTS", "SCREEN_MOTIONS", "BRUTE", "BRUTE_SCREEN"]
 
 #: The screen's motions: the closed forms' (:data:`~vibroimpact.analysis.band_worst.MOTIONS`), and brute force's on a
 #: layout without a closed form.
@@ -38,8 +38,6 @@ BRUTE = "found by brute force"
 SCREEN_MOTIONS = (*MOTIONS, BRUTE)
 #: The screen's brute force where no closed form applies: frequencies, extra starts, transient and measured periods.
 BRUTE_SCREEN = (41, 1, 200, 64)
-#: A bumper's restitution is kept at or above this [-] (R = 0 needs an infinite loss factor).
-MIN_BUMPER_RESTITUTION = 1e-3
 #: How the screen sees a problem (:func:`screen_kind`): the rigid stops' closed forms, bumper orbits grown from their
 #: rigid twin's, or brute force (no closed form: a free mass, stops that are not one or a symmetric pair).
 SCREENS = ("closed_form", "bumper_orbits", "brute_force")
