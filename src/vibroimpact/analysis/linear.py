@@ -25,7 +25,7 @@ from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce, angular_frequency, check_closed_form_inputs
 from vibroimpact.model.layout import Layout
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.structure import CONDITION_LIMIT, LinearStructure, harmonic_condition
+from vibroimpact.model.structure import CONDITION_LIMIT, LinearStructure, harmonic_condition, stiffness_modes
 from vibroimpact.model.system import TwoDofSystem
 
 __all__ = ["contact_free_is_stable", "base_coupling", "base_force", "peaks_near", "LinearResponse", "paper_linear_response", "linear_response", "ResonancePeak", "resonance_peaks", "LinearAmplitudes", "linear_amplitudes", "linear_reach", "structure_amplitudes", "structure_peaks"]
@@ -36,9 +36,7 @@ def contact_free_is_stable(system: LinearStructure) -> bool:
     by a dashpot. An undamped one (an impact damper's free mass in its cavity) only drifts at a constant speed when
     disturbed, into a stop: its contact-free motion is no attractor, however well it fits."""
     stiffness, damping = system.stiffness_matrix, system.damping_matrix
-    values, vectors = np.linalg.eigh(stiffness)
-    top = float(np.max(np.abs(values))) if values.size else 0.0
-    rigid = vectors[:, np.abs(values) <= 1e-12 * top] if top > 0.0 else np.eye(stiffness.shape[0])
+    rigid = stiffness_modes(stiffness, 1e-12).rigid
     if rigid.shape[1] == 0:
         return True
     inner = rigid.T @ damping @ rigid

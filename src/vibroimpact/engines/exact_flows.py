@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.structure import resonance_refusal
+from vibroimpact.model.structure import resonance_refusal, stiffness_modes
 
 __all__ = ["Flow", "decompose", "unforced_flow", "harmonic_response", "mechanical_null_basis", "ExactModel", "build_model"]
 
@@ -137,17 +137,16 @@ def mechanical_null_basis(
     size = mass.shape[0]
     if size == 0:
         return np.zeros((0, 0))
-    mu, q = np.linalg.eigh(stiffness)
-    top = max(float(np.max(np.abs(mu))) if mu.size else 0.0, float(stiffness_scale))
-    rigid = q[:, mu <= _ZERO * top] if top > 0.0 else np.eye(size)
+    modes = stiffness_modes(stiffness, _ZERO, floor=stiffness_scale)
+    rigid = modes.rigid
     if rigid.shape[1] == 0:
         return np.zeros((2 * size, 0))
     inner = rigid.T @ damping @ rigid
     nu, w = np.linalg.eigh(0.5 * (inner + inner.T))
     damping_scale = max(float(np.max(np.abs(damping))) if damping.size else 0.0, float(damping_scale))
     free = rigid @ w[:, np.abs(nu) <= _ZERO * max(damping_scale, 1e-300)] if damping_scale > 0.0 else rigid
-    flexible = q[:, mu > _ZERO * top] if top > 0.0 else np.zeros((size, 0))
-    pseudo = flexible @ np.diag(1.0 / mu[mu > _ZERO * top]) @ flexible.T if top > 0.0 else np.zeros((size, size))
+    flexible = modes.flexible
+    pseudo = flexible @ np.diag(1.0 / modes.flexible_values) @ flexible.T if modes.scale > 0.0 else np.zeros((size, size))
     columns = [np.concatenate([rigid, np.zeros_like(rigid)])]
     if free.shape[1]:
         columns.append(np.concatenate([-pseudo @ damping @ free, free]))

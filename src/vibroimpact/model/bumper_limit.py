@@ -17,25 +17,18 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
+
+from vibroimpact.model.structure import stiffness_modes
 
 if TYPE_CHECKING:
     from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["STIFFNESS_SPREAD", "RIGID_MODE_RATIO", "rigid_modes", "bumper_refusal"]
+__all__ = ["STIFFNESS_SPREAD", "RIGID_MODE_RATIO", "bumper_refusal"]
 
 #: A contact mode's softest flexible stiffness as a fraction of its stiffest, below which a bumper is refused [-].
 STIFFNESS_SPREAD = 1e-11
 #: A stiffness eigenvalue under this fraction of the largest is a rigid-body mode [-] (as the exact flows judge).
 RIGID_MODE_RATIO = 1e-12
-
-
-def rigid_modes(stiffness: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The rigid-body modes of a stiffness matrix K [N m-1] (orthonormal columns): eigenvectors whose eigenvalue is
-    under :data:`RIGID_MODE_RATIO` of the largest."""
-    mu, q = np.linalg.eigh(stiffness)
-    top = float(np.max(np.abs(mu))) if mu.size else 0.0
-    return q[:, mu <= RIGID_MODE_RATIO * top] if top > 0.0 else np.eye(stiffness.shape[0])
 
 
 def bumper_refusal(problem: ImpactProblem) -> str | None:
@@ -49,7 +42,7 @@ def bumper_refusal(problem: ImpactProblem) -> str | None:
     count = normals.shape[0]
     laws = [stop.law for stop in problem.stops]
     k_b = np.array([law.stiffness(stop.effective_mass(structure.mass_matrix)) for law, stop in zip(laws, problem.stops)])  # type: ignore[union-attr]
-    rigid = rigid_modes(stiffness)
+    rigid = stiffness_modes(stiffness, RIGID_MODE_RATIO).rigid
     for mask in range(1, 1 << count):
         pushing = [k for k in range(count) if (mask >> k) & 1]
         k_mode = stiffness + sum(k_b[k] * np.outer(normals[k], normals[k]) for k in pushing)

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 __all__ = ["LinearStructure", "as_matrix_rows", "require_finite", "require_positive", "require_non_negative", "require_in_range",
            "MASS_RATIO", "STIFFNESS_RATIO", "DAMPING_RATIO", "RIGID_BODY_THRESHOLD", "require_ratio", "CONDITION_LIMIT", "harmonic_condition",
-           "resonance_refusal"]
+           "resonance_refusal", "StiffnessModes", "stiffness_modes"]
 
 #: Relative tolerance of the symmetry and definiteness checks.
 _TOLERANCE = 1e-12
@@ -55,6 +55,76 @@ _ROUND_OFF = 1e-13
 #: ~1 / (2 pi zeta) at a resonance of damping ratio zeta (refused where zeta < 1.6e-5). The shipped scenes stay below
 #: 146 (zeta >= 0.0022).
 CONDITION_LIMIT = 1e4
+
+
+@dataclass(frozen=True, eq=False)
+class StiffnessModes:
+    """A stiffness matrix K split by the rigid-mode rule (:func:`stiffness_modes`): its eigenvalues, ascending, and
+    orthonormal eigenvectors, the stiffness they are judged against, and which are rigid-body modes.
+
+    Attributes
+    ----------
+    values : ndarray, shape (N,)
+        Eigenvalues of K [N m-1], ascending.
+    vectors : ndarray, shape (N, N)
+        Their eigenvectors (orthonormal columns); the identity where K is zero.
+    scale : float
+        The stiffness [N m-1] the eigenvalues are judged against (0: K is zero, every mode rigid).
+    is_rigid : ndarray of bool, shape (N,)
+        Which eigenvalues are rigid-body modes.
+    """
+
+    values: NDArray[np.float64]
+    vectors: NDArray[np.float64]
+    scale: float
+    is_rigid: NDArray[np.bool_]
+
+    @property
+    def rigid(self) -> NDArray[np.float64]:
+        """The rigid-body modes (orthonormal columns, shape (N, r)): a basis of K's null space."""
+        return self.vectors[:, self.is_rigid]
+
+    @property
+    def flexible(self) -> NDArray[np.float64]:
+        """The flexible modes (orthonormal columns, shape (N, N - r))."""
+        return self.vectors[:, ~self.is_rigid]
+
+    @property
+    def flexible_values(self) -> NDArray[np.float64]:
+        """The flexible modes' eigenvalues [N m-1], ascending."""
+        return self.values[~self.is_rigid]
+
+    @property
+    def count(self) -> int:
+        """r, the number of rigid-body modes."""
+        return int(np.count_nonzero(self.is_rigid))
+
+
+def stiffness_modes(stiffness: ArrayLike, threshold: float, floor: float = 0.0, scale: float | None = None) -> StiffnessModes:
+    """The rigid-body and flexible modes of a stiffness matrix K [N m-1]: an eigenvalue at most ``threshold`` of the
+    stiffness scale is a rigid-body mode (a free mass).
+
+    Parameters
+    ----------
+    stiffness : array_like, shape (N, N)
+        K [N m-1], symmetric.
+    threshold : float
+        The fraction of the scale at or below which an eigenvalue is rigid [-].
+    floor : float, optional
+        The least stiffness scale [N m-1]: the scale is the largest of K's |eigenvalues| and this (a reduced, held
+        structure passes the full structure's, since its K may be round-off alone).
+    scale : float, optional
+        The stiffness scale [N m-1] itself, in place of the above (K's largest entry, as two callers judge).
+    """
+    matrix = np.asarray(stiffness, dtype=float)
+    values, vectors = np.linalg.eigh(matrix)
+    if scale is None:
+        top = max(float(np.max(np.abs(values))) if values.size else 0.0, float(floor))
+    else:
+        top = float(scale)
+    if top > 0.0:
+        return StiffnessModes(values, vectors, top, values <= threshold * top)
+    return StiffnessModes(values, np.eye(matrix.shape[0]), 0.0, np.ones(values.size, dtype=bool))
 
 
 def harmonic_condition(poles: ArrayLike, omega: ArrayLike) -> NDArray[np.float64]:
@@ -182,8 +252,8 @@ def _check_symmetric_definite(name: str, matrix: NDArray[np.float64], positive: 
 def _check_dynamic_range(mass: NDArray[np.float64], stiffness: NDArray[np.float64], damping: NDArray[np.float64]) -> None:
     """``ValueError`` where K has an eigenvalue that is neither a spring nor a free mass to working precision, or C
     overdamps the structure beyond what double precision resolves (:data:`DAMPING_RATIO`)."""
-    k_values = np.linalg.eigvalsh(stiffness)
-    k_max = float(k_values[-1])
+    modes = stiffness_modes(stiffness, RIGID_BODY_THRESHOLD)
+    k_values, k_max = modes.values, modes.scale
     if k_max <= 0.0:
         return  # free masses only: no spring to compare with
     soft = k_values[(k_values > _ROUND_OFF * k_max) & (k_values <= RIGID_BODY_THRESHOLD * k_max)]
@@ -324,10 +394,7 @@ class LinearStructure:
     def rigid_body_modes(self) -> int:
         """Number of rigid-body modes: the dimension of the null space of K (free masses, floating structures)."""
         stiffness = self.stiffness_matrix
-        scale = float(np.max(np.abs(stiffness))) if np.any(stiffness) else 0.0
-        if scale == 0.0:
-            return self.size
-        return int(np.sum(np.linalg.eigvalsh(stiffness) <= RIGID_BODY_THRESHOLD * scale))
+        return stiffness_modes(stiffness, RIGID_BODY_THRESHOLD, scale=float(np.max(np.abs(stiffness)))).count
 
     def natural_angular_frequencies(self) -> NDArray[np.float64]:
         """Undamped natural angular frequencies, ascending [rad s-1] (0 for each rigid-body mode)."""

@@ -30,7 +30,7 @@ import numpy as np
 
 from vibroimpact.analysis.layout import layout_refusal
 from vibroimpact.model.contact import SIDES, place_effective_mass
-from vibroimpact.model.structure import LinearStructure
+from vibroimpact.model.structure import LinearStructure, stiffness_modes
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.bumper_parse import BumperSpec, parse_bumper
 from vibroimpact.scene.checker import Checker
@@ -357,9 +357,7 @@ def static_drift(layout: Layout) -> bool:
     if load.static is None or not any(load.static) or not structure.rigid_body_modes():
         return False
     stiffness = structure.stiffness_matrix
-    values, vectors = np.linalg.eigh(stiffness)
-    scale = float(np.max(np.abs(stiffness))) if np.any(stiffness) else 0.0
-    free = vectors[:, values <= 1e-10 * scale] if scale > 0.0 else vectors
+    free = stiffness_modes(stiffness, 1e-10, scale=float(np.max(np.abs(stiffness)))).rigid
     static = np.asarray(load.static)
     return bool(np.max(np.abs(free.T @ static)) > 1e-12 * float(np.max(np.abs(static))))
 
