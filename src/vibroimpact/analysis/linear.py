@@ -36,7 +36,7 @@ def contact_free_is_stable(system: LinearStructure) -> bool:
     by a dashpot. An undamped one (an impact damper's free mass in its cavity) only drifts at a constant speed when
     disturbed, into a stop: its contact-free motion is no attractor, however well it fits."""
     stiffness, damping = system.stiffness_matrix, system.damping_matrix
-    rigid = stiffness_modes(stiffness, 1e-12).rigid
+    rigid = stiffness_modes(stiffness).rigid
     if rigid.shape[1] == 0:
         return True
     inner = rigid.T @ damping @ rigid

@@ -35,7 +35,8 @@ from vibroimpact.model.structure import resonance_refusal, stiffness_modes
 
 __all__ = ["Flow", "decompose", "unforced_flow", "harmonic_response", "mechanical_null_basis", "ExactModel", "build_model"]
 
-#: Relative size below which an eigenvalue of K (or of the damping on its null space) counts as zero.
+#: Relative size below which an eigenvalue of the damping on K's rigid-body modes counts as zero (a rigid mode no
+#: dashpot resists); K's own rigid modes are the model's one rule (:func:`~vibroimpact.model.structure.stiffness_modes`).
 _ZERO = 1e-12
 #: Largest condition number of the modal basis [V | Z] (a defective nonzero eigenvalue has none).
 _CONDITION = 1e12
@@ -130,6 +131,7 @@ def mechanical_null_basis(
     rigid r) adds a Jordan chain of length 2, (x_u, u) with K x_u = -C u (then A (x_u, u) = (u, 0)). Longer chains
     cannot occur (M is definite), so A_z^2 = 0.
 
+    K's rigid modes are the model's one rule (:func:`~vibroimpact.model.structure.stiffness_modes`).
     ``stiffness_scale`` and ``damping_scale`` [N m-1, N s m-1] are the scales below which an eigenvalue is round-off
     zero, at least the matrices' own: a reduced (held) structure passes the full structure's, since its K may be
     round-off alone (a free-free pair held together by a relative stop: T^T K T ~ 1e-29 of nothing).
@@ -137,7 +139,7 @@ def mechanical_null_basis(
     size = mass.shape[0]
     if size == 0:
         return np.zeros((0, 0))
-    modes = stiffness_modes(stiffness, _ZERO, floor=stiffness_scale)
+    modes = stiffness_modes(stiffness, floor=stiffness_scale)
     rigid = modes.rigid
     if rigid.shape[1] == 0:
         return np.zeros((2 * size, 0))

@@ -1,8 +1,9 @@
 """How stiff a Kelvin-Voigt bumper a structure holds beside its own stiffness in double precision.
 
 In contact a bumper adds K_k n_k n_k^T to the structure's stiffness matrix. An exact flow tells a rigid-body mode from
-a flexible one by its stiffness eigenvalue (under 1e-12 of the largest: rigid,
-:func:`~vibroimpact.engines.exact_flows.mechanical_null_basis`); once K_k is about 1e12 times the structure's softest
+a flexible one by the one rule (its stiffness eigenvalue at most
+:data:`~vibroimpact.model.structure.RIGID_MODE_RATIO` = 1e-12 of the largest: rigid,
+:func:`~vibroimpact.model.structure.stiffness_modes`); once K_k is about 1e12 times the structure's softest
 flexible stiffness, that mode is taken for a rigid one and the answer converges, wrong (the paper's system at 24 Hz,
 R = 0.2: |X1| 1.877 mm from 9e7 Hz on, against the rigid stop's 2.567 mm; right to 5e-9 up to 8e7 Hz). Each contact
 mode's softest flexible stiffness must therefore be at least :data:`STIFFNESS_SPREAD` of its stiffest (10x from that
@@ -23,12 +24,12 @@ from vibroimpact.model.structure import stiffness_modes
 if TYPE_CHECKING:
     from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["STIFFNESS_SPREAD", "RIGID_MODE_RATIO", "bumper_refusal"]
+__all__ = ["STIFFNESS_SPREAD", "bumper_refusal"]
 
-#: A contact mode's softest flexible stiffness as a fraction of its stiffest, below which a bumper is refused [-].
+#: A contact mode's softest flexible stiffness as a fraction of its stiffest, below which a bumper is refused [-]:
+#: strictly inside the rigid-mode rule (10x above :data:`~vibroimpact.model.structure.RIGID_MODE_RATIO`), so that no
+#: accepted contact mode has a flexible mode the flows take for a rigid one.
 STIFFNESS_SPREAD = 1e-11
-#: A stiffness eigenvalue under this fraction of the largest is a rigid-body mode [-] (as the exact flows judge).
-RIGID_MODE_RATIO = 1e-12
 
 
 def bumper_refusal(problem: ImpactProblem) -> str | None:
@@ -42,7 +43,7 @@ def bumper_refusal(problem: ImpactProblem) -> str | None:
     count = normals.shape[0]
     laws = [stop.law for stop in problem.stops]
     k_b = np.array([law.stiffness(stop.effective_mass(structure.mass_matrix)) for law, stop in zip(laws, problem.stops)])  # type: ignore[union-attr]
-    rigid = stiffness_modes(stiffness, RIGID_MODE_RATIO).rigid
+    rigid = stiffness_modes(stiffness).rigid
     for mask in range(1, 1 << count):
         pushing = [k for k in range(count) if (mask >> k) & 1]
         k_mode = stiffness + sum(k_b[k] * np.outer(normals[k], normals[k]) for k in pushing)

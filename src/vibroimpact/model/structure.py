@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = ["LinearStructure", "as_matrix_rows", "require_finite", "require_positive", "require_non_negative", "require_in_range",
-           "MASS_RATIO", "STIFFNESS_RATIO", "DAMPING_RATIO", "RIGID_BODY_THRESHOLD", "require_ratio", "CONDITION_LIMIT", "harmonic_condition",
+           "MASS_RATIO", "STIFFNESS_RATIO", "DAMPING_RATIO", "RIGID_MODE_RATIO", "SOFTEST_SPRING", "require_ratio", "CONDITION_LIMIT", "harmonic_condition",
            "resonance_refusal", "StiffnessModes", "stiffness_modes"]
 
 #: Relative tolerance of the symmetry and definiteness checks.
@@ -32,17 +32,40 @@ _TOLERANCE = 1e-12
 #: mix the two in sums like K / M1 + K / M2: beyond ~1e12 double precision (eps 2.2e-16) keeps fewer than 4 digits of
 #: the smaller term, and beyond 1e16 none (m2 = 1e300 gave x1 = 0 where it is 7.4e-4 m).
 MASS_RATIO = 1e12
-#: A stiffness eigenvalue at most this fraction of the largest is a rigid-body mode (a free mass) [-]:
-#: :meth:`LinearStructure.rigid_body_modes`.
-RIGID_BODY_THRESHOLD = 1e-10
-#: Largest ratio of two springs of the named system, k1 / k2 or k2 / k1 [-]: K's eigenvalue ratio is then at most
-#: ~4e9, so that no spring reads as a free mass (:data:`RIGID_BODY_THRESHOLD`); k2 = 1e300 made the absorber's
-#: spring swallow the suspension's (all-NaN linear responses).
+#: The one rule of a rigid-body mode (a free mass) [-]: an eigenvalue of a stiffness matrix at most this fraction of
+#: its largest |eigenvalue| is one (:func:`stiffness_modes`, which every such judgement asks: the structure's
+#: rigid-body modes, the closed forms' refusal, the exact flows' null space, a bumper's contact modes, the contact-free
+#: stability, a static drift). Measured:
+#:
+#: * an exact zero comes out of ``eigh`` within 4.8e-16 of the largest (20,000 floating chains of 2-8 masses, springs
+#:   spread over 1e9, alone and in contact with a relative bumper up to 1e11 times their stiffest spring): 2000x below;
+#: * above it the exact flows compute a flexible mode right: the paper's system at 24 Hz, R = 0.2, against a bumper of
+#:   8e7 Hz (its contact mode's softest stiffness 1.16e-12 of its stiffest) gives |X1| = the rigid stop's (2.567 mm)
+#:   plus its 26.4 Hz / f term (26.49); at 9e7 Hz (9.2e-13) the mode is judged rigid and |X1| is 1.877 mm, 27 % low.
+#:   With the rule at 1e-10 the same went wrong from 9e6 Hz (9.2e-11): a larger value only takes flexible modes for
+#:   rigid sooner, and a bumper refusal 10x inside it would refuse, from 2.7e6 Hz, bumpers computed right;
+#: * the golden suite's 139,512 judgements (every shipped scene) saw rigid eigenvalues of exactly 0 and flexible ones of
+#:   at least 1.8e-6 of the largest: any value between moves no shipped number.
+#:
+#: What lies near it is refused before any work, the refusal edges strictly inside it: a contact mode whose softest
+#: flexible stiffness is under :data:`~vibroimpact.model.bumper_limit.STIFFNESS_SPREAD` (1e-11, 10x above) of its
+#: stiffest, and a scene's structure with an eigenvalue between :data:`_ROUND_OFF` (1e-13, 10x below) and
+#: :data:`SOFTEST_SPRING` (1e-10, 100x above) of its largest (:meth:`LinearStructure.check_dynamic_range`).
+RIGID_MODE_RATIO = 1e-12
+#: The softest spring a scene's structure may have [-]: a nonzero eigenvalue of K under this fraction of the largest
+#: is refused (:meth:`LinearStructure.check_dynamic_range`: "reads as a free mass"), 100x above
+#: :data:`RIGID_MODE_RATIO`, so that no accepted spring is near the rule.
+SOFTEST_SPRING = 1e-10
+#: Largest ratio of two springs of the named system, k1 / k2 or k2 / k1 [-]: K's eigenvalue ratio is then at least
+#: 2.5e-10 (k2 / k1 = 1e9; 1e-9 at k2 / k1 = 1e-9), above :data:`SOFTEST_SPRING`, so that no spring reads as a free
+#: mass; k2 = 1e300 made the absorber's spring swallow the suspension's (all-NaN linear responses).
 STIFFNESS_RATIO = 1e9
 #: Largest b^2 / (k m) of a dashpot against its spring and mass [-] (4 zeta^2: the ratio of the fast to the slow pole
 #: of an overdamped mode): beyond ~1e12 the slow pole is round-off next to the fast one.
 DAMPING_RATIO = 1e12
-#: Eigenvalues of K below this fraction of the largest are zero to round-off (a free mass written as matrices) [-].
+#: Eigenvalues of K at most this fraction of the largest are zero to round-off (a free mass written as matrices) [-]:
+#: 10x under :data:`RIGID_MODE_RATIO`, 200x over the round-off measured there; a scene's eigenvalue above it must be
+#: a spring (above :data:`SOFTEST_SPRING`).
 _ROUND_OFF = 1e-13
 
 
@@ -100,30 +123,27 @@ class StiffnessModes:
         return int(np.count_nonzero(self.is_rigid))
 
 
-def stiffness_modes(stiffness: ArrayLike, threshold: float, floor: float = 0.0, scale: float | None = None) -> StiffnessModes:
-    """The rigid-body and flexible modes of a stiffness matrix K [N m-1]: an eigenvalue at most ``threshold`` of the
-    stiffness scale is a rigid-body mode (a free mass).
+def stiffness_modes(stiffness: ArrayLike, floor: float = 0.0) -> StiffnessModes:
+    """The rigid-body and flexible modes of a stiffness matrix K [N m-1], by the one rule: an eigenvalue at most
+    :data:`RIGID_MODE_RATIO` of the stiffness scale (K's largest |eigenvalue|) is a rigid-body mode (a free mass).
+
+    The null space of K is that of the generalized problem K v = w^2 M v too (M is definite), so the rule needs no
+    masses: every caller judges K's own eigenvalues.
 
     Parameters
     ----------
     stiffness : array_like, shape (N, N)
         K [N m-1], symmetric.
-    threshold : float
-        The fraction of the scale at or below which an eigenvalue is rigid [-].
     floor : float, optional
-        The least stiffness scale [N m-1]: the scale is the largest of K's |eigenvalues| and this (a reduced, held
-        structure passes the full structure's, since its K may be round-off alone).
-    scale : float, optional
-        The stiffness scale [N m-1] itself, in place of the above (K's largest entry, as two callers judge).
+        The least stiffness scale [N m-1]: the scale is the largest of K's |eigenvalues| and this. A reduced (held)
+        structure passes the full structure's, since its own K may be round-off alone (a free-free pair held together
+        by a relative stop: T^T K T ~ 1e-29 of nothing).
     """
     matrix = np.asarray(stiffness, dtype=float)
     values, vectors = np.linalg.eigh(matrix)
-    if scale is None:
-        top = max(float(np.max(np.abs(values))) if values.size else 0.0, float(floor))
-    else:
-        top = float(scale)
+    top = max(float(np.max(np.abs(values))) if values.size else 0.0, float(floor))
     if top > 0.0:
-        return StiffnessModes(values, vectors, top, values <= threshold * top)
+        return StiffnessModes(values, vectors, top, values <= RIGID_MODE_RATIO * top)
     return StiffnessModes(values, np.eye(matrix.shape[0]), 0.0, np.ones(values.size, dtype=bool))
 
 
@@ -252,13 +272,14 @@ def _check_symmetric_definite(name: str, matrix: NDArray[np.float64], positive: 
 def _check_dynamic_range(mass: NDArray[np.float64], stiffness: NDArray[np.float64], damping: NDArray[np.float64]) -> None:
     """``ValueError`` where K has an eigenvalue that is neither a spring nor a free mass to working precision, or C
     overdamps the structure beyond what double precision resolves (:data:`DAMPING_RATIO`)."""
-    modes = stiffness_modes(stiffness, RIGID_BODY_THRESHOLD)
+    modes = stiffness_modes(stiffness)
     k_values, k_max = modes.values, modes.scale
     if k_max <= 0.0:
         return  # free masses only: no spring to compare with
-    soft = k_values[(k_values > _ROUND_OFF * k_max) & (k_values <= RIGID_BODY_THRESHOLD * k_max)]
+    # every eigenvalue 10x below the rigid-mode rule (zero to round-off) or 100x above it (a spring): none near it
+    soft = k_values[(k_values > _ROUND_OFF * k_max) & (k_values <= SOFTEST_SPRING * k_max)]
     if soft.size:
-        require_ratio("system.stiffness", "largest / smallest nonzero eigenvalue", k_max / float(soft[0]), 1.0 / RIGID_BODY_THRESHOLD, 1.0,
+        require_ratio("system.stiffness", "largest / smallest nonzero eigenvalue", k_max / float(soft[0]), 1.0 / SOFTEST_SPRING, 1.0,
                       "a spring this soft next to the stiffest reads as a free mass (make it 0, or stiffer)")
     c_max = max(float(np.linalg.eigvalsh(damping)[-1]), 0.0)
     m_max = float(np.linalg.eigvalsh(mass)[-1])
@@ -320,9 +341,9 @@ class LinearStructure:
 
     def check_dynamic_range(self) -> None:
         """``ValueError`` where K has an eigenvalue that is neither a spring nor a free mass to working precision
-        (between 1e-13 and :data:`RIGID_BODY_THRESHOLD` of the largest), or C overdamps the structure beyond
-        :data:`DAMPING_RATIO` (its largest eigenvalue squared over K's times M's). M's ratio is checked on
-        construction. The scene checker calls it (a scene is refused before any work); the Python API leaves such
+        (between 1e-13 and :data:`SOFTEST_SPRING` of the largest, around the rigid-mode rule :data:`RIGID_MODE_RATIO`),
+        or C overdamps the structure beyond :data:`DAMPING_RATIO` (its largest eigenvalue squared over K's times M's).
+        M's ratio is checked on construction. The scene checker calls it (a scene is refused before any work); the Python API leaves such
         structures to its caller."""
         _check_dynamic_range(self.mass_matrix, self.stiffness_matrix, self.damping_matrix)
 
@@ -392,9 +413,9 @@ class LinearStructure:
 
     # ---------------------------------------------------------------- modes
     def rigid_body_modes(self) -> int:
-        """Number of rigid-body modes: the dimension of the null space of K (free masses, floating structures)."""
-        stiffness = self.stiffness_matrix
-        return stiffness_modes(stiffness, RIGID_BODY_THRESHOLD, scale=float(np.max(np.abs(stiffness)))).count
+        """Number of rigid-body modes: the dimension of the null space of K (free masses, floating structures), by the
+        one rule (:func:`stiffness_modes`)."""
+        return stiffness_modes(self.stiffness_matrix).count
 
     def natural_angular_frequencies(self) -> NDArray[np.float64]:
         """Undamped natural angular frequencies, ascending [rad s-1] (0 for each rigid-body mode)."""

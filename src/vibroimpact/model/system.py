@@ -178,8 +178,10 @@ class TwoDofSystem:
         return self.structure.receptance(omega, output, load)
 
     def rigid_body_modes(self) -> int:
-        """0: both springs are positive."""
-        return 0
+        """Number of rigid-body modes of its stiffness matrix, by the one rule
+        (:meth:`LinearStructure.rigid_body_modes`): 0 unless a spring is under ~1e-12 of the other (k2 = 1e-12 k1, a
+        free absorber of the Python API; a scene keeps k2 / k1 within 1e-9 ... 1e9)."""
+        return self.structure.rigid_body_modes()
 
     # --------------------------------------------------------------- polynomials
     def characteristic_polynomial(self) -> NDArray[np.float64]:

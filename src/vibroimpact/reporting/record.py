@@ -312,10 +312,9 @@ class GeneralSetting:
         """x_static = K^-1 F0 [m] under the constant force (zeros without one); None where K is singular."""
         if not np.any(self.static):
             return np.zeros(self.structure.size)
-        stiffness = self.structure.stiffness_matrix
-        if self.structure.rigid_body_modes() or np.linalg.cond(stiffness) > 1e12:
+        if self.structure.rigid_body_modes():  # the one rule: the same as cond(K) >= 1e12
             return None
-        return np.linalg.solve(stiffness, self.static)
+        return np.linalg.solve(self.structure.stiffness_matrix, self.static)
 
     def load(self, w: np.ndarray) -> np.ndarray:
         """Harmonic load per coordinate at each w [rad s-1] [N], shape w.shape + (N,)."""
