@@ -32,6 +32,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from vibroimpact.analysis.floquet import floquet_multipliers
 from vibroimpact.analysis.greens import GREEN_CONDITION_LIMIT, green_condition, green_vector, periodic_green
 from vibroimpact.analysis.layout import ClosedFormLayout, closed_form_layout, harmonic_load
 from vibroimpact.analysis.linear import base_force as suspension_force
@@ -125,9 +126,7 @@ class ImpactOrbit:
     @cached_property
     def multipliers(self) -> NDArray[np.complex128]:
         """Floquet multipliers [-] of every orbit, shape S + (2N,), sorted by decreasing modulus; NaN where no orbit
-        exists (:func:`~vibroimpact.analysis.stability.floquet_multipliers`; computed once, on first use)."""
-        from vibroimpact.analysis.stability import floquet_multipliers  # stability builds on this module
-
+        exists (:func:`~vibroimpact.analysis.floquet.floquet_multipliers`; computed once, on first use)."""
         return floquet_multipliers(self)
 
     @property

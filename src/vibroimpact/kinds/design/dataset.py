@@ -25,7 +25,7 @@ from vibroimpact.kinds.design.evaluate import ATTRACTOR_POINTS, MAX_BRANCH_POINT
 from vibroimpact.simulation.certified_worst import SOURCES
 from vibroimpact.kinds.design.scene import DesignSettings, safe_name
 from vibroimpact.kinds.design.search import STAGES, pareto_front
-from vibroimpact.kinds.design.study import Outcome
+from vibroimpact.kinds.design.outcome import Outcome
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
 

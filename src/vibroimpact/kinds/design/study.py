@@ -28,8 +28,10 @@ import xarray as xr
 from numpy.typing import NDArray
 from scipy.stats import qmc
 
-from vibroimpact.analysis.linear_optimum import LinearAbsorberOptimum, band_peak, optimal_linear_absorber
+from vibroimpact.analysis.linear_optimum import band_peak, optimal_linear_absorber
+from vibroimpact.kinds.design.dataset import design_dataset
 from vibroimpact.kinds.design.evaluate import CHUNKS, CertifyCase, DesignSpace
+from vibroimpact.kinds.design.outcome import Outcome
 from vibroimpact.kinds.design.scene import DesignSettings
 from vibroimpact.kinds.design.search import Evaluations, nelder_mead_polish, differential_evolution, grid_search
 from vibroimpact.model.system import TwoDofSystem
@@ -72,27 +74,8 @@ def design_space(scene: Any) -> DesignSpace:
                        tuple(tuple(float(v) for v in row) for row in offsets), settings.band, settings.coordinate, operating)  # fmt: skip
 
 
-class Outcome:
-    """What a design study found (the dataset's content): the evaluations, the certified candidates, the comparisons."""
-
-    def __init__(self, settings: DesignSettings, space: DesignSpace, evaluations: Evaluations) -> None:
-        self.settings = settings
-        self.space = space
-        self.evaluations = evaluations
-        self.scene_design = np.array([space.map.parameters[space.map.parameter_names.index(n)] for n in settings.names])
-        self.certified: list[dict[str, Any]] = []
-        self.linear: LinearAbsorberOptimum | None = None
-        self.linear_values = np.full(space.samples, np.nan)
-        self.linear_operating = math.nan
-        self.recommended = -1
-        self.corrected: dict[int, float] = {}
-        self.wall_times: dict[str, float] = {}
-
-
 def run_design(scene: Any, progress: Progress | None = None, runner: Runner | None = None) -> xr.Dataset:
     """Search, compare and certify (module docstring); the dataset."""
-    from vibroimpact.kinds.design.dataset import design_dataset
-
     settings: DesignSettings = scene.settings
     say = progress if progress is not None else (lambda message: None)
     runner = runner if runner is not None else Runner(progress=progress is not None)
