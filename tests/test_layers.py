@@ -1,7 +1,8 @@
-"""The package's layers import downward only, and the lower layers know nothing of YAML, xarray or plotting.
+"""The package's layers import downward only, the lower layers know nothing of YAML, xarray or plotting, and no
+module imports itself through others (no import cycle).
 
-Read from the source (every ``import`` statement, including those inside functions), so a new upward import fails
-here however rarely it runs.
+Read from the source (every ``import`` statement, including those inside functions), so a new upward import or
+cycle fails here however rarely it runs.
 """
 
 from __future__ import annotations
@@ -193,3 +194,93 @@ def test_modules_loaded_by_name_exist_and_keep_the_layers() -> None:
 
     for name in vibroimpact.__all__:
         assert getattr(vibroimpact, name) is not None, name
+
+
+# ----------------------------------------------------------------------------------------------- no import cycles
+def type_checking_lines(path: Path) -> set[int]:
+    """The lines under ``if TYPE_CHECKING:`` (or ``typing.TYPE_CHECKING``) in ``path``: an import there never runs,
+    only a type checker reads it (an annotation under ``from __future__ import annotations`` is a string), so it makes
+    no import cycle; the layer checks above read it all the same."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    lines: set[int] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and ast.unparse(node.test) in ("TYPE_CHECKING", "typing.TYPE_CHECKING"):
+            lines |= {inner.lineno for statement in node.body for inner in ast.walk(statement) if hasattr(inner, "lineno")}
+    return lines
+
+
+def import_graph(paths: dict[str, Path]) -> dict[str, set[str]]:
+    """Module -> the modules among ``paths`` (module name -> source file) it imports when it runs: at module level or
+    inside a function, not under ``if TYPE_CHECKING:``. ``from pkg import name`` imports the module ``pkg.name`` where
+    that is a module, else ``pkg`` (a name defined or re-exported by ``pkg/__init__.py``).
+
+    Importing ``pkg.mod`` runs ``pkg/__init__.py`` first; that implicit edge is left out: Python has put the package in
+    ``sys.modules`` by then, so a package whose ``__init__`` re-exports its own submodules (``vibroimpact.scene``) is no
+    cycle with them. An explicit ``from pkg import name`` of such a re-export is an edge to ``pkg`` like any other.
+    """
+    graph: dict[str, set[str]] = {}
+    for module, path in paths.items():
+        skipped = type_checking_lines(path)
+        statements: dict[int, set[str]] = {}
+        for line, target in imports(path):
+            if line not in skipped:
+                statements.setdefault(line, set()).add(target)
+        edges: set[str] = set()
+        for targets in statements.values():
+            for target in targets:
+                if target in paths:
+                    if not any(other in paths and other.startswith(target + ".") for other in targets):
+                        edges.add(target)  # not merely the ``pkg`` of ``from pkg import module``
+                elif target.rpartition(".")[0] in paths:
+                    edges.add(target.rpartition(".")[0])  # ``from pkg import name``: a name of pkg's own
+        graph[module] = edges - {module}
+    return graph
+
+
+def find_cycle(graph: dict[str, set[str]]) -> list[str]:
+    """A cycle of ``graph`` as its nodes in import order, the first one repeated at the end (``[]``: none)."""
+    done: set[str] = set()
+    path: list[str] = []
+
+    def visit(node: str) -> list[str]:
+        path.append(node)
+        for after in sorted(graph.get(node, ())):
+            if after in path:
+                return path[path.index(after) :] + [after]
+            if after not in done and (cycle := visit(after)):
+                return cycle
+        path.pop()
+        done.add(node)
+        return []
+
+    for node in sorted(graph):
+        if node not in done and (cycle := visit(node)):
+            return cycle
+    return []
+
+
+def test_no_import_cycles() -> None:
+    """No module imports itself through others, however rarely the import runs (inside a function too): what two
+    modules share lives in a module below both."""
+    cycle = find_cycle(import_graph({module_name(path): path for path in SOURCES}))
+    assert not cycle, "import cycle: " + " -> ".join(cycle)
+
+
+def test_the_cycle_check_sees_a_cycle(tmp_path: Path) -> None:
+    """The cycle check is not blind: a cycle closed by an import inside a function is found, with its modules in
+    order; ``from pkg import module`` is an edge to the module, not to the package; an import under
+    ``if TYPE_CHECKING:`` is none."""
+    sources = {
+        "pkg": "",
+        "pkg.a": "from pkg.b import helper\n",
+        "pkg.b": "def helper():\n    from pkg import c\n",
+        "pkg.c": "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from pkg.d import D\nimport pkg.a\n",
+        "pkg.d": "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from pkg.a import A\nfrom pkg import VALUE\n",
+    }
+    paths = {name: tmp_path / f"{name}.py" for name in sources}
+    for name, text in sources.items():
+        paths[name].write_text(text)
+    graph = import_graph(paths)
+    assert graph == {"pkg": set(), "pkg.a": {"pkg.b"}, "pkg.b": {"pkg.c"}, "pkg.c": {"pkg.a"}, "pkg.d": {"pkg"}}
+    assert find_cycle(graph) == ["pkg.a", "pkg.b", "pkg.c", "pkg.a"]
+    assert find_cycle(graph | {"pkg.c": set()}) == [] and find_cycle({"x": {"y"}, "y": {"x"}}) == ["x", "y", "x"]
