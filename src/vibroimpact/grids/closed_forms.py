@@ -22,7 +22,7 @@ from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
 from vibroimpact.analysis.linear import base_force, linear_amplitudes
 from vibroimpact.analysis.paper_fit import PaperFit
 from vibroimpact.analysis.stability import Regime, classify, MARGINAL_MODULUS, floquet_multipliers
-from vibroimpact.model.contact import peak_acceleration_factor
+from vibroimpact.model.collision import peak_acceleration_factor
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.scene.schema import MOTION_QUANTITIES, STOP_QUANTITIES, Scene
 from vibroimpact.scene.variables import STABLE_MARGINAL

@@ -21,9 +21,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from vibroimpact.model.units import LENGTH_UNITS, length_text
-from vibroimpact.model.contact import (
-    KelvinVoigtBumper, RigidStop, Stop, check_room, loss_factor_from_restitution, place_effective_mass, place_normal, restitution_from_loss_factor,
-)  # fmt: skip
+from vibroimpact.model.collision import loss_factor_from_restitution, restitution_from_loss_factor
+from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop, check_room, place_effective_mass, place_normal
 from vibroimpact.model.excitation import HarmonicForce, SweptSine
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure

@@ -18,7 +18,8 @@ import dataclasses
 import math
 from typing import Any, NamedTuple
 
-from vibroimpact.model.contact import MAX_LOSS_FACTOR, KelvinVoigtBumper
+from vibroimpact.model.collision import MAX_LOSS_FACTOR
+from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.layout import Layout, StopSpec
 from vibroimpact.scene.checker import Checker
 from vibroimpact.model.parameters import MAX_BUMPER_FREQUENCY as _MAX_FREQUENCY

@@ -22,7 +22,7 @@ from vibroimpact.analysis.pgf import AdmissibilitySettings
 from vibroimpact.engines.registry import BUMPER, engine_spec
 from vibroimpact.model.bumper_limit import bumper_refusal
 from vibroimpact.model.layout import Layout
-from vibroimpact.model.contact import MAX_LOSS_FACTOR, MIN_BUMPER_RESTITUTION, loss_factor_from_restitution, restitution_from_loss_factor
+from vibroimpact.model.collision import MAX_LOSS_FACTOR, MIN_BUMPER_RESTITUTION, loss_factor_from_restitution, restitution_from_loss_factor
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.modal import underdamped_mode_count
 from vibroimpact.scene.bumper_parse import BUMPER_KEYS, PHYSICAL_KEYS, scene_bumper

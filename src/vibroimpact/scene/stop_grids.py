@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from vibroimpact.model.contact import MAX_LOSS_FACTOR, MIN_BUMPER_RESTITUTION, restitution_from_loss_factor
+from vibroimpact.model.collision import MAX_LOSS_FACTOR, MIN_BUMPER_RESTITUTION, restitution_from_loss_factor
 from vibroimpact.model.layout import StopSpec
 from vibroimpact.scene.checker import Checker, interval
 

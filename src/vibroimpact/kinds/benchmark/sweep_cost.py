@@ -29,7 +29,8 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from vibroimpact.model.contact import KelvinVoigtBumper, loss_factor_from_restitution
+from vibroimpact.model.collision import loss_factor_from_restitution
+from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.engines.base import SweepRecord
 from vibroimpact.engines.registry import make_engine

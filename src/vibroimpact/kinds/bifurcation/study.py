@@ -57,7 +57,7 @@ import numpy as np
 import xarray as xr
 
 from vibroimpact.engines.registry import BUMPER, RIGID, engine_for
-from vibroimpact.model.contact import loss_factor_from_restitution
+from vibroimpact.model.collision import loss_factor_from_restitution
 from vibroimpact.model.units import length_text
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS

@@ -36,7 +36,8 @@ from vibroimpact.scene.header import NAME, parse_names
 from vibroimpact.scene.layout_parse import parse_layout
 from vibroimpact.scene.simulation import parse_simulation
 from vibroimpact.model.absorber import den_hartog_absorber
-from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution, Stop
+from vibroimpact.model.collision import loss_factor_from_restitution
+from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import TwoDofSystem
