@@ -165,7 +165,7 @@ def test_installed_package_finds_its_studies(tmp_path: Path) -> None:
 
 def test_a_code_change_invalidates_the_resume_cache(monkeypatch: pytest.MonkeyPatch) -> None:
     """The cache key hashes the package's source: other code, other key (the version number alone would not do)."""
-    from vibroimpact.runs import store as fingerprint
+    from vibroimpact.runs import fingerprints as fingerprint
     from vibroimpact.engines.settings import EngineSettings
     from vibroimpact.model.contact import RigidStop
     from vibroimpact.kinds.stepped.cases import SimulationCase

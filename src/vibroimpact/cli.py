@@ -137,7 +137,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"run-study: error: --out {out_dir} cannot be written: {problem}", file=sys.stderr)
         return EXIT_BAD_INPUT
     from vibroimpact.runs.output_files import OutputBusy, claim_output
-    from vibroimpact.runs.store import StoreOfAnotherScene, StudyStore, store_fingerprint
+    from vibroimpact.runs.fingerprints import store_fingerprint
+    from vibroimpact.runs.store import StoreOfAnotherScene, StudyStore
 
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminate)  # SIGTERM ends the run as Ctrl-C does

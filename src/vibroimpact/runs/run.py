@@ -42,7 +42,8 @@ from vibroimpact.runs.runner import Runner
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.labels import decode_labels, encode_labels
 from vibroimpact.runs.output_files import atomic_path
-from vibroimpact.runs.store import StudyStore, source_hash
+from vibroimpact.runs.fingerprints import source_hash
+from vibroimpact.runs.store import StudyStore
 from vibroimpact.scene.kinds import kind_named
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, Scene
 

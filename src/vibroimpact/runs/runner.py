@@ -32,7 +32,8 @@ from numpy.typing import NDArray
 from vibroimpact import __version__
 from vibroimpact.engines.registry import engine_spec
 from vibroimpact.runs.cluster import ClusterLost, Connection, connect, import_libraries, leave_quietly, ProgressBar, ProgressReport, Throttled
-from vibroimpact.runs.store import source_hash, StudyStore
+from vibroimpact.runs.fingerprints import source_hash
+from vibroimpact.runs.store import StudyStore
 
 __all__ = ["Case", "CaseResult", "ProgressReport", "Runner", "TaskFunction", "OtherCode", "WorkerDied", "MAX_CASES_PER_TASK"]
 

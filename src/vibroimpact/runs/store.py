@@ -28,8 +28,6 @@ shared file system. :func:`vibroimpact.runs.output_files.claim_output` keeps a s
 from __future__ import annotations
 
 import asyncio
-import functools
-import hashlib
 import io
 import json
 import os
@@ -44,38 +42,11 @@ import zarr
 from numpy.typing import NDArray
 from zarr.core.sync import sync  # zarr's own event loop, the one its synchronous API runs on
 
-from vibroimpact import __version__
+from vibroimpact.runs.fingerprints import NOT_IN_FINGERPRINT, case_key, code_fingerprint, source_hash, store_fingerprint, values_digest
 from vibroimpact.runs.store_record import read_record, record_digest, restore, set_aside, check_members_readable
 
 __all__ = ["source_hash", "case_key", "StudyStore", "store_fingerprint", "code_fingerprint", "values_digest", "StoreOfAnotherScene", "StoreUnusable", "NOT_IN_FINGERPRINT", "ZARR_FORMAT"]
 
-
-# --------------------------------------------------------------------------------------------------------------------
-# A fingerprint of the code that computes: cache keys and datasets name the exact source they came from.
-# --------------------------------------------------------------------------------------------------------------------
-
-_PACKAGE = Path(__file__).resolve().parents[1]  # the vibroimpact package
-
-
-@functools.cache
-def source_hash() -> str:
-    """SHA-256 (hex) over the package's Python source files, their paths and contents, in a stable order.
-
-    Any edit of the code changes it, whatever the version number says, so results cached by older code are not reused.
-    """
-    digest = hashlib.sha256()
-    for path in sorted(_PACKAGE.rglob("*.py")):
-        digest.update(path.relative_to(_PACKAGE).as_posix().encode())
-        digest.update(b"\0")
-        digest.update(path.read_bytes())
-        digest.update(b"\0")
-    return digest.hexdigest()
-
-
-def case_key(content: dict[str, Any]) -> str:
-    """A stable 24-hex-digit key of ``content`` (JSON-serialisable), the package version and its source hash."""
-    text = json.dumps({"version": __version__, "source": source_hash(), "case": content}, sort_keys=True, default=str)
-    return hashlib.sha256(text.encode()).hexdigest()[:24]
 
 ZARR_FORMAT = 2
 _CASES = "cases"
@@ -91,43 +62,8 @@ _GRID_RECORD_DIGEST = "grid_record_sha256"
 _GRID_PLAN = ("grid_shape", "block_shape", _GRID_VARIABLES)
 
 
-def values_digest(arrays: list[tuple[str, NDArray[np.generic]]]) -> bytes:
-    """SHA-256 of named arrays: each name, dtype, shape and C-order bytes, in the given order.
-
-    A block's or a case's values read back from the store must give the digest they were written with: a lost chunk
-    (read as the fill value), a truncated or swapped one, all change it.
-    """
-    digest = hashlib.sha256()
-    for name, values in arrays:
-        array = np.ascontiguousarray(values)
-        digest.update(f"{name}\0{array.dtype.str}\0{array.shape}\0".encode())
-        digest.update(array.tobytes())
-    return digest.digest()
 #: Attributes whose values must keep the variable's own type (CF: flag_values of an int8 flag are int8).
 _TYPED_ATTRIBUTES = ("flag_values", "flag_masks", "valid_min", "valid_max", "valid_range")
-
-
-#: Top-level scene keys that change no number: a store survives their edits (where the work runs, the page's words).
-NOT_IN_FINGERPRINT = ("cluster", "description", "report")
-
-
-def store_fingerprint(scene_text: str) -> str:
-    """What a store's results depend on: the scene's values (not its comments, nor the keys of
-    :data:`NOT_IN_FINGERPRINT`), the package version and the package's source (:func:`code_fingerprint`)."""
-    import yaml
-
-    try:
-        document = yaml.safe_load(scene_text)
-    except yaml.YAMLError:
-        document = None
-    if isinstance(document, dict):
-        scene_text = yaml.safe_dump({key: value for key, value in document.items() if key not in NOT_IN_FINGERPRINT}, sort_keys=True)
-    return hashlib.sha256(f"{code_fingerprint()}\0{scene_text}".encode()).hexdigest()[:24]
-
-
-def code_fingerprint() -> str:
-    """The package version and its source (:func:`source_hash`): results of other code are not reused."""
-    return hashlib.sha256(f"{__version__}\0{source_hash()}".encode()).hexdigest()[:24]
 
 
 class StoreUnusable(RuntimeError):

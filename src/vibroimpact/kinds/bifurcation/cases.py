@@ -40,7 +40,7 @@ from vibroimpact.orbits.grazing_curve import trace_grazing
 from vibroimpact.orbits.maps import ImpactMap, orbit_measures, resection
 from vibroimpact.orbits.shooting import ShootingError, shoot
 from vibroimpact.runs.runner import CaseResult, ProgressReport
-from vibroimpact.runs.store import case_key
+from vibroimpact.runs.fingerprints import case_key
 from vibroimpact.simulation.attractors import MAX_KEPT_IMPACTS, MOTION_CLASSES, SWEEP_FIELDS, stepped_sweep
 
 __all__ = ["Seed", "MAX_SEEDED_BRANCHES", "SEEDED_MAX_STEPS", "sweep_seeds", "seed_branches", "MOTION_CLASSES", "MAX_KEPT_IMPACTS", "SweepCase", "BranchCase", "ChartCase", "branch_arrays"]

@@ -32,7 +32,7 @@ from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, SpecialPoint
 from vibroimpact.orbits.bumper_map import BUMPER_PERIOD, BumperPeriodMap
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_special_point
 from vibroimpact.runs.runner import CaseResult, ProgressReport
-from vibroimpact.runs.store import case_key
+from vibroimpact.runs.fingerprints import case_key
 
 __all__ = ["StiffnessCase", "monotone_pieces", "curve_pieces", "on_piece", "FOLLOWED", "STIFFER", "SOFTER", "CURVE_SETTINGS", "STIFFNESS_FIELDS", "ON_CURVE"]
 

@@ -26,7 +26,7 @@ from vibroimpact.orbits.continuation import ContinuationSettings, continue_branc
 from vibroimpact.orbits.maps import ImpactMap, resection
 from vibroimpact.orbits.shooting import shoot
 from vibroimpact.runs.runner import CaseResult, ProgressReport
-from vibroimpact.runs.store import case_key
+from vibroimpact.runs.fingerprints import case_key
 from vibroimpact.simulation.harmonics import HarmonicMeasures, measure
 from vibroimpact.simulation.settings import SteadySettings
 from vibroimpact.simulation.steady import march as march_to_repeat

@@ -28,7 +28,7 @@ from vibroimpact.kinds.concepts.scene import Concept
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.runs.runner import CaseResult, ProgressReport
-from vibroimpact.runs.store import case_key
+from vibroimpact.runs.fingerprints import case_key
 from vibroimpact.simulation.settings import SteadySettings
 
 __all__ = ["Replay", "replay_base_force", "SAMPLES_PER_PERIOD", "ConceptCase", "CASE_FIELDS", "COMPLEX_FIELDS"]

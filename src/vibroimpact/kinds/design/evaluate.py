@@ -28,7 +28,7 @@ from vibroimpact.orbits.bumper_screen import bumper_at, bumper_screen_refusal, b
 from vibroimpact.orbits.maps import ImpactMap, branch_measures
 from vibroimpact.simulation.certified_worst import SOURCES, certified_worst, sweep_points_for
 from vibroimpact.runs.runner import CaseResult, ProgressReport
-from vibroimpact.runs.store import case_key
+from vibroimpact.runs.fingerprints import case_key
 
 __all__ = ["DesignSpace", "DesignCase", "sample_chunks", "CHUNKS", "DESIGN_FIELDS", "CertifyCase", "CERTIFY_FIELDS", "SCREENS", "screen_kind", "screen_worst", "ATTRACTOR_POINTS", "SWEEP_ACCURACIES", "MAX_BRANCH_POINTS", "SCREEN_MOTIONS", "BRUTE", "BRUTE_SCREEN"]
 

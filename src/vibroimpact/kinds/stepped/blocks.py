@@ -154,7 +154,8 @@ def run_grid(scene: Scene, runner: Runner, solve: BlockSolver, extra_sizes: dict
 
     ``extra_sizes``: sizes of dimensions other than the grid's (``solution``, ``stop``), which every block has whole.
     """
-    from vibroimpact.runs.store import StoreUnusable, StudyStore, store_fingerprint
+    from vibroimpact.runs.fingerprints import store_fingerprint
+    from vibroimpact.runs.store import StoreUnusable, StudyStore
 
     store = runner.store if runner.store is not None else StudyStore(None, store_fingerprint(scene.text))
     plan = plan_blocks(scene, runner.workers if runner.distributed else 1)

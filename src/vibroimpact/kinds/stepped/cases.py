@@ -29,7 +29,7 @@ from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.runs.runner import CaseResult, ProgressReport, Runner
-from vibroimpact.runs.store import case_key
+from vibroimpact.runs.fingerprints import case_key
 from vibroimpact.model.layout import LoadSpec, build_stops
 from vibroimpact.scene.schema import Scene
 from vibroimpact.simulation.steady import linear_fits, pgf_guesses, steady_state

@@ -34,7 +34,7 @@ from vibroimpact.model.structure import LinearStructure
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import Costs, Estimate, engine_scale
 from vibroimpact.runs.runner import ProgressReport, Runner
-from vibroimpact.runs.store import case_key
+from vibroimpact.runs.fingerprints import case_key
 from vibroimpact.model.layout import LoadSpec, build_stops, stop_descriptions
 from vibroimpact.scene.grid import SweptSineSettings
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, GRID_DIMS, MOTION_QUANTITIES, STOP_QUANTITIES, Scene
