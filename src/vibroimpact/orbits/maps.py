@@ -50,15 +50,14 @@ from vibroimpact.engines.registry import BUMPER, engine_for, make_engine
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import Branch, HybridInfo, MapEvaluation, PeriodicOrbit
-from vibroimpact.model.parameters import PARAMETERS as PARAMETER_TABLE
-from vibroimpact.model.parameters import LayoutParameter, check_independent, layout_parameter, with_layout
+from vibroimpact.model.parameters import LayoutParameter, check_independent, layout_parameter, parameter, with_layout
 from vibroimpact.orbits.sections import StrobeGap, moved_phase, moved_state, resection, strobe_gap
 from vibroimpact.orbits.shooting import closed_form_state, section_phase, with_impulse
 
 __all__ = ["ImpactMap", "OrbitMeasures", "orbit_measures", "BranchMeasures", "branch_measures", "closed_form_state", "with_impulse", "section_phase", "resection", "PARAMETERS", "SECTION_PARAMETER", "stop_selection", "Resection", "ContactFreeOrbit"]
 
 #: The parameters of an :class:`ImpactMap`, in order, with their units.
-PARAMETERS = {name: PARAMETER_TABLE[name].unit for name in ("frequency", "restitution", "clearance", "amplitude", "phase")}
+PARAMETERS = {name: parameter(name).unit for name in ("frequency", "restitution", "clearance", "amplitude", "phase")}
 #: The parameter that places the strobe: the force's phase at t = 0 (a section of the orbit, not a physical property).
 SECTION_PARAMETER = "phase"
 
