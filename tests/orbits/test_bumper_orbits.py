@@ -25,7 +25,8 @@ from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
-from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures, section_phase
+from vibroimpact.orbits.maps import ImpactMap, closed_form_state, section_phase
+from vibroimpact.orbits.orbit_measures import orbit_measures
 from vibroimpact.orbits.shooting import shoot
 from vibroimpact.simulation.harmonics import linear_state
 from vibroimpact.simulation.settings import SteadySettings

@@ -35,7 +35,8 @@ from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.orbits.bifurcations import switch_period_doubling
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
 from vibroimpact.orbits.lyapunov import _inside, state_scales
-from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures, section_phase
+from vibroimpact.orbits.maps import ImpactMap, closed_form_state, section_phase
+from vibroimpact.orbits.orbit_measures import orbit_measures
 from vibroimpact.orbits.shooting import shoot
 
 

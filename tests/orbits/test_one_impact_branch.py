@@ -25,7 +25,8 @@ from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.orbits.bifurcations import switch_period_doubling
 from vibroimpact.orbits.branch import Iterated
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
-from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures, section_phase, with_impulse
+from vibroimpact.orbits.maps import ImpactMap, closed_form_state, section_phase, with_impulse
+from vibroimpact.orbits.orbit_measures import orbit_measures
 from vibroimpact.orbits.shooting import shoot
 
 pytestmark = pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")

@@ -14,7 +14,8 @@ from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.orbits.continuation import continue_branch
-from vibroimpact.orbits.maps import ImpactMap, branch_measures, closed_form_state
+from vibroimpact.orbits.maps import ImpactMap, closed_form_state
+from vibroimpact.orbits.orbit_measures import branch_measures
 from vibroimpact.orbits.shooting import shoot
 from vibroimpact.orbits.worst_case import branch_maximum
 

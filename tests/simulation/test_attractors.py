@@ -155,7 +155,8 @@ def test_brute_force_finds_a_larger_two_impact_orbit_than_the_worst_case_searche
     at 25.8 Hz (its branch's exact maximum: 9.4162 mm at 25.7766 Hz, an interior maximum just below its fold at
     25.9326 Hz). The grid's orbit is a stable fixed point of the exact map: shot from the sweep's end state, it is
     the same orbit (|X1| to 1e-6) with every multiplier inside the unit circle."""
-    from vibroimpact.orbits.maps import ImpactMap, orbit_measures
+    from vibroimpact.orbits.maps import ImpactMap
+    from vibroimpact.orbits.orbit_measures import orbit_measures
     from vibroimpact.orbits.shooting import shoot
     from vibroimpact.orbits.worst_case import worst_response
     from vibroimpact.simulation.attractors import at_frequency

@@ -42,7 +42,8 @@ def test_a_two_impact_orbit_found_by_brute_force_is_continued_and_located() -> N
     branch = found.extra[0]
     import numpy as np
 
-    from vibroimpact.orbits.maps import ImpactMap, branch_measures
+    from vibroimpact.orbits.maps import ImpactMap
+    from vibroimpact.orbits.orbit_measures import branch_measures
 
     x = branch_measures(ImpactMap(paper(0.003, 0.8)), branch).amplitude(0)
     stable = np.asarray(branch.stable, dtype=bool)

@@ -37,7 +37,7 @@ def closed_form(frequency: float) -> np.ndarray:
 def test_brute_force_measures_the_coordinate_it_is_given(coordinate: int) -> None:
     """Every run's measured |X| is the closed form's |X| of that coordinate (to 1e-7: the runs drop 100 periods of
     transient), and the maximum's sampled peak is of that coordinate's x(t), not x1's."""
-    sweep = band_attractors(PROBLEM, BAND, frequencies=7, starts=1, transient=100, coordinate=coordinate)
+    sweep = band_attractors(PROBLEM, BAND, frequencies=7, starts=1, transient=100, measure=coordinate)
     assert np.all(sweep.regime == MOTION_CLASSES.index("one_impact"))
     expected = np.array([closed_form(float(f))[coordinate] for f in sweep.frequency])
     np.testing.assert_allclose(sweep.amplitude, np.repeat(expected[:, None], len(sweep.runs), axis=1), rtol=1e-7)
@@ -51,8 +51,8 @@ def test_brute_force_measures_the_coordinate_it_is_given(coordinate: int) -> Non
 def test_certification_measures_the_coordinate_it_is_given() -> None:
     """Continuation, brute force and their maximum all judge |X2|: the certified worst case is the closed form's |X2|
     maximum (to the continuation's tolerance), and differs from the |X1| answer by the ratio of the two."""
-    x2 = certified_worst(PROBLEM, BAND, frequencies=7, starts=1, transient=100, coordinate=1)
-    x1 = certified_worst(PROBLEM, BAND, frequencies=7, starts=1, transient=100, coordinate=0)
+    x2 = certified_worst(PROBLEM, BAND, frequencies=7, starts=1, transient=100, measure=1)
+    x1 = certified_worst(PROBLEM, BAND, frequencies=7, starts=1, transient=100, measure=0)
     assert x2.amplitude == pytest.approx(closed_form(x2.frequency)[1], rel=1e-6)
     assert x1.amplitude == pytest.approx(closed_form(x1.frequency)[0], rel=1e-6)
     scan = np.linspace(*BAND, 301)

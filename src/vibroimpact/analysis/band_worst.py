@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.linear import contact_free_is_stable, linear_amplitudes
+from vibroimpact.analysis.measures import Measure, as_measure
 from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.model.problem import ImpactProblem
 
@@ -46,7 +47,8 @@ MOTIONS = ("none", "contact-free", "impacting, period 1")
 
 @dataclass(frozen=True)
 class BandWorst:
-    """The largest stable |X| of one coordinate over a band (or at one frequency), over the closed-form motions.
+    """The largest stable value of a measure (|X| of one coordinate, or the force to the base) over a band (or at one
+    frequency), over the closed-form motions; ``amplitude`` holds it, in the measure's unit.
 
     Attributes
     ----------
@@ -89,33 +91,36 @@ class BandWorst:
             raise ValueError(f"uncovered = {self.uncovered!r} must be a share in [0, 1]")
 
 
-def contact_free_curve(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """|X| [m] of ``coordinate``'s contact-free steady state at frequencies ``f`` [Hz] where it clears every stop and
-    is stable (NaN elsewhere), and everywhere (in closed form; any contact law: it never touches one)."""
-    linear = linear_amplitudes(problem, omega=2.0 * np.pi * f)
-    x = np.abs(linear.amplitudes[..., coordinate])
+def contact_free_curve(problem: ImpactProblem, f: NDArray[np.float64], measure: int | Measure) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The ``measure`` (a coordinate index: its |X| [m]) of the contact-free steady state at frequencies ``f`` [Hz]
+    where it clears every stop and is stable (NaN elsewhere), and everywhere (in closed form; any contact law: it
+    never touches one)."""
+    omega = 2.0 * np.pi * f
+    linear = linear_amplitudes(problem, omega=omega)
+    x = as_measure(measure, problem).of_harmonics(problem, omega, linear.amplitudes)
     return np.where(linear.fits(problem.clearances()) & contact_free_is_stable(problem.structure), x, np.nan), x
 
 
-def _impacting(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, root: str, largest_only: bool = False) -> tuple[NDArray[np.float64], int, NDArray[np.float64], NDArray[np.float64]]:
+def _impacting(problem: ImpactProblem, f: NDArray[np.float64], measure: int | Measure, root: str, largest_only: bool = False) -> tuple[NDArray[np.float64], int, NDArray[np.float64], NDArray[np.float64]]:
     """|X| of the closed-form impact orbit (``root``) where it exists, is stable and admissible, NaN elsewhere; its
     impacts per period; |X| wherever it exists (any stability, admissible or not); and its impulse per impact [N s]
     where stable and admissible (NaN elsewhere). Stability first (cheap), admissibility (sampled over the period) only
     where stable; ``largest_only``: only until the largest admissible one is known (the others NaN)."""
     orbit = solve_impact_orbit(problem, frequency=f, root=root)
+    measure = as_measure(measure, problem)
     x = np.full(f.shape, np.nan)
     impulse = np.full(f.shape, np.nan)
     exists = np.flatnonzero(np.asarray(orbit.exists, dtype=bool).reshape(-1))
     if exists.size == 0:
         return x, orbit.impacts_per_period, x.copy(), impulse
     existing = np.full(f.shape, np.nan)
-    existing[exists] = np.abs(orbit.take(exists).harmonics()[..., coordinate]).reshape(-1)
+    existing[exists] = measure.of_orbit(orbit.take(exists)).reshape(-1)
     modulus = np.max(np.abs(floquet_multipliers(orbit.take(exists))), axis=-1)
     stable = exists[modulus < 1.0 - MARGINAL_MODULUS]
     if stable.size == 0:
         return x, orbit.impacts_per_period, existing, impulse
     chosen = orbit.take(stable)
-    amplitude = np.abs(chosen.harmonics()[..., coordinate]).reshape(-1)
+    amplitude = measure.of_orbit(chosen).reshape(-1)
     if largest_only:
         for k in np.argsort(amplitude)[::-1]:
             if bool(np.asarray(chosen.take([k]).admissible()).reshape(-1)[0]):
@@ -128,14 +133,14 @@ def _impacting(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, 
     return x, orbit.impacts_per_period, existing, impulse
 
 
-def existing_impact_curve(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, root: str) -> NDArray[np.float64]:
-    """|X| [m] of the closed-form impact orbit of ``root`` at frequencies ``f`` [Hz] wherever it exists (any
+def existing_impact_curve(problem: ImpactProblem, f: NDArray[np.float64], measure: int | Measure, root: str) -> NDArray[np.float64]:
+    """The ``measure`` (a coordinate index: its |X| [m]) of the closed-form impact orbit of ``root`` at frequencies ``f`` [Hz] wherever it exists (any
     stability, admissible or not; NaN elsewhere): what :attr:`BandWorst.estimate` guesses from."""
     orbit = solve_impact_orbit(problem, frequency=f, root=root)
     existing = np.full(f.shape, np.nan)
     exists = np.flatnonzero(np.asarray(orbit.exists, dtype=bool).reshape(-1))
     if exists.size:
-        existing[exists] = np.abs(orbit.take(exists).harmonics()[..., coordinate]).reshape(-1)
+        existing[exists] = as_measure(measure, problem).of_orbit(orbit.take(exists)).reshape(-1)
     return existing
 
 
@@ -143,20 +148,20 @@ def existing_impact_curve(problem: ImpactProblem, f: NDArray[np.float64], coordi
 _ROOTS = (None, "+", "-")
 
 
-def _curve(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int, root: str | None, largest_only: bool = False) -> tuple[str, int, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+def _curve(problem: ImpactProblem, f: NDArray[np.float64], measure: int | Measure, root: str | None, largest_only: bool = False) -> tuple[str, int, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """(motion, impacts, |X| where stable or NaN, |X| where it exists or NaN, impulse per impact [N s] where stable
     or NaN) of one closed-form motion (``root`` None: contact-free, which exists everywhere and has no impulse) at
     ``f`` [Hz] (``largest_only``: see :func:`_impacting`)."""
     if root is None:
-        x, everywhere = contact_free_curve(problem, f, coordinate)
+        x, everywhere = contact_free_curve(problem, f, measure)
         return MOTIONS[1], 0, x, everywhere, np.where(np.isfinite(x), 0.0, np.nan)
-    x, impacts, existing, impulse = _impacting(problem, f, coordinate, root, largest_only)
+    x, impacts, existing, impulse = _impacting(problem, f, measure, root, largest_only)
     return MOTIONS[2], impacts, x, existing, impulse
 
 
-def _curves(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int) -> list[tuple[str | None, tuple[str, int, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]]]:
+def _curves(problem: ImpactProblem, f: NDArray[np.float64], measure: int | Measure) -> list[tuple[str | None, tuple[str, int, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]]]:
     """(root, :func:`_curve`) of every closed-form motion at frequencies ``f`` [Hz]."""
-    return [(root, _curve(problem, f, coordinate, root)) for root in _ROOTS if root is None or problem.stops]
+    return [(root, _curve(problem, f, measure, root)) for root in _ROOTS if root is None or problem.stops]
 
 
 def scan_frequencies(band: tuple[float, float], scan: int) -> NDArray[np.float64]:
@@ -168,8 +173,8 @@ def scan_frequencies(band: tuple[float, float], scan: int) -> NDArray[np.float64
     return np.linspace(low, high, scan)
 
 
-def closed_form_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: int = 0, scan: int = SCAN, tolerance: float = 1e-8) -> BandWorst:
-    """The largest stable |X| of ``coordinate`` over ``band`` [Hz] among the closed-form motions (module docstring).
+def closed_form_worst(problem: ImpactProblem, band: tuple[float, float], measure: int | Measure = 0, scan: int = SCAN, tolerance: float = 1e-8) -> BandWorst:
+    """The largest stable ``measure`` over ``band`` [Hz] among the closed-form motions (module docstring).
 
     Parameters
     ----------
@@ -177,15 +182,16 @@ def closed_form_worst(problem: ImpactProblem, band: tuple[float, float], coordin
         Rigid stops: one, or a symmetric two-sided pair (else the closed form's ``ValueError``).
     band : (float, float)
         [Hz], low < high.
-    coordinate : int
-        0: the paper's primary mass x1.
+    measure : int or Measure
+        A row of :mod:`vibroimpact.analysis.measures`, or a coordinate index for its |X| (0: the paper's primary mass x1).
     scan : int
         Frequencies of the scan (>= 3).
     tolerance : float
         Of the refined frequency, relative [-].
     """
     f = scan_frequencies(band, scan)
-    curves = _curves(problem, f, coordinate)
+    measure = as_measure(measure, problem)
+    curves = _curves(problem, f, measure)
     covered = np.zeros(f.size, dtype=bool)
     best = (0.0, math.nan, MOTIONS[0], 0)
     impulse = 0.0
@@ -196,7 +202,7 @@ def closed_form_worst(problem: ImpactProblem, band: tuple[float, float], coordin
         if not np.any(np.isfinite(x)):
             continue
         for i in _maxima(x):
-            value, where = refine_maximum(problem, f, i, float(x[i]), coordinate, root, tolerance)
+            value, where = refine_maximum(problem, f, i, float(x[i]), measure, root, tolerance)
             if value > best[0]:
                 best = (value, where, motion, impacts)
     estimate, estimate_frequency = 0.0, math.nan
@@ -219,7 +225,7 @@ def _maxima(x: NDArray[np.float64]) -> list[int]:
     return sorted(found, key=lambda i: -y[i])
 
 
-def refine_maximum(problem: ImpactProblem, f: NDArray[np.float64], i: int, value: float, coordinate: int, root: str | None, tolerance: float) -> tuple[float, float]:
+def refine_maximum(problem: ImpactProblem, f: NDArray[np.float64], i: int, value: float, measure: int | Measure, root: str | None, tolerance: float) -> tuple[float, float]:
     """The maximum of the motion ``root`` (:func:`_curve`) between the scan points either side of ``i``, where it
     stays stable and admissible, never below the scanned ``value``: zoomed scans of :data:`ZOOM` points, each over
     the two steps around the previous one's maximum, until a step is below ``tolerance`` of the frequency (one
@@ -228,7 +234,7 @@ def refine_maximum(problem: ImpactProblem, f: NDArray[np.float64], i: int, value
     a, b = float(f[max(i - 1, 0)]), float(f[min(i + 1, f.size - 1)])
     while (b - a) / (ZOOM - 1) > tolerance * b:
         x = np.linspace(a, b, ZOOM)
-        y = _curve(problem, x, coordinate, root, largest_only=True)[2]
+        y = _curve(problem, x, measure, root, largest_only=True)[2]
         if not np.any(np.isfinite(y)):
             break
         k = int(np.nanargmax(y))
@@ -238,13 +244,13 @@ def refine_maximum(problem: ImpactProblem, f: NDArray[np.float64], i: int, value
     return best, where
 
 
-def closed_form_at(problem: ImpactProblem, frequency: float, coordinate: int = 0) -> BandWorst:
-    """The largest stable |X| of ``coordinate`` at one ``frequency`` [Hz] among the closed-form motions that coexist
+def closed_form_at(problem: ImpactProblem, frequency: float, measure: int | Measure = 0) -> BandWorst:
+    """The largest stable ``measure`` at one ``frequency`` [Hz] among the closed-form motions that coexist
     there (e.g. an absorber's operating point: the contact-free notch, or an impact orbit that destroys it)."""
     f = np.array([float(frequency)])
     best = (0.0, math.nan, MOTIONS[0], 0)
     covered = False
-    for _, (motion, impacts, x, _, _) in _curves(problem, f, coordinate):
+    for _, (motion, impacts, x, _, _) in _curves(problem, f, measure):
         if math.isfinite(x[0]):
             covered = True
             if x[0] > best[0]:

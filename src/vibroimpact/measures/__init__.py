@@ -1,2 +1,3 @@
-"""What is judged over a band: the measure table (:mod:`~vibroimpact.measures.table`) and the one worst-case entry
-point over every method that finds a band maximum (:mod:`~vibroimpact.measures.worst_case`)."""
+"""What is judged over a band: the one worst-case entry point over every method that finds a band maximum of a
+measure (:mod:`~vibroimpact.measures.worst_case`; the measure table itself is :mod:`vibroimpact.analysis.measures`,
+below the closed forms that read it)."""

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from vibroimpact.analysis.band_worst import closed_form_worst
-from vibroimpact.measures.table import Measure, measure as measure_row
+from vibroimpact.analysis.measures import Measure, measure as measure_row
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.bumper_screen import bumper_worst
 from vibroimpact.orbits.worst_case import worst_response
@@ -64,28 +64,28 @@ class BandMaximum:
 
 
 def _closed_form(problem: ImpactProblem, band: tuple[float, float], row: Measure, **options: Any) -> BandMaximum:
-    found = closed_form_worst(problem, band, row.coordinate, **options)
+    found = closed_form_worst(problem, band, row, **options)
     return BandMaximum(found.amplitude, found.frequency, found.motion, row, "closed_form", found)
 
 
 def _bumper_orbits(problem: ImpactProblem, band: tuple[float, float], row: Measure, **options: Any) -> BandMaximum:
-    found = bumper_worst(problem, band, row.coordinate, **options)
+    found = bumper_worst(problem, band, row, **options)
     return BandMaximum(found.amplitude, found.frequency, found.motion, row, "bumper_orbits", found)
 
 
 def _continuation(problem: ImpactProblem, band: tuple[float, float], row: Measure, **options: Any) -> BandMaximum:
-    found = worst_response(problem, band, row.coordinate, **options)
+    found = worst_response(problem, band, row, **options)
     return BandMaximum(found.amplitude, found.frequency, found.motion, row, "continuation", found)
 
 
 def _brute_force(problem: ImpactProblem, band: tuple[float, float], row: Measure, **options: Any) -> BandMaximum:
-    found = band_attractors(problem, band, coordinate=row.coordinate, **options)
+    found = band_attractors(problem, band, measure=row, **options)
     top = found.maximum
     return BandMaximum(top.amplitude, top.frequency, top.motion, row, "brute_force", found)
 
 
 def _certified(problem: ImpactProblem, band: tuple[float, float], row: Measure, **options: Any) -> BandMaximum:
-    found = certified_worst(problem, band, coordinate=row.coordinate, **options)
+    found = certified_worst(problem, band, measure=row, **options)
     return BandMaximum(found.amplitude, found.frequency, found.motion, row, "certified", found)
 
 
@@ -109,7 +109,7 @@ def worst_case(problem: ImpactProblem, band: tuple[float, float], measure: str |
     band : (float, float)
         (low, high) [Hz].
     measure : str or Measure
-        A row of the measure table (:func:`vibroimpact.measures.table.measure`), by name on the problem's coordinates.
+        A row of the measure table (:func:`vibroimpact.analysis.measures.measure`), by name on the problem's coordinates.
     method : str
         A key of :data:`METHODS` (module docstring).
     **options
@@ -124,6 +124,7 @@ def worst_case(problem: ImpactProblem, band: tuple[float, float], measure: str |
     if method not in METHODS:
         raise ValueError(f"method = {method!r}: allowed {', '.join(METHODS)}")
     row = measure if isinstance(measure, Measure) else measure_row(measure, problem.structure.coordinates)
-    if row.coordinate >= problem.size:
-        raise ValueError(f"measure {row.name!r}: coordinate {row.coordinate} is not one of the problem's {problem.size}")
+    reason = row.refusal(problem)
+    if reason is not None:
+        raise ValueError(reason)
     return METHODS[method](problem, band, row, **options)

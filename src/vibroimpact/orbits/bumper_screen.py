@@ -29,6 +29,7 @@ from scipy.optimize import minimize_scalar
 from vibroimpact.analysis.band_worst import MOTIONS, BandWorst, contact_free_curve, existing_impact_curve, refine_maximum, scan_frequencies
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.analysis.measures import Measure, as_measure
 from vibroimpact.engines.compliant.period_shooting import PeriodOrbit
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
 from vibroimpact.model.problem import ImpactProblem
@@ -73,8 +74,8 @@ class _Point:
     stable: bool
 
 
-def _measured(system: ImpactMap, problem: ImpactProblem, orbit: PeriodOrbit, coordinate: int) -> _Point | None:
-    """The orbit's |X| (the fundamental harmonic over its period, as :func:`~vibroimpact.orbits.maps.orbit_measures`
+def _measured(system: ImpactMap, problem: ImpactProblem, orbit: PeriodOrbit, measure: int | Measure) -> _Point | None:
+    """The orbit's ``measure`` (of the fundamental harmonics over its period, as :func:`~vibroimpact.orbits.orbit_measures.orbit_measures`
     gives it), stability and (stable orbits) the largest impulse of one whole contact, or None where it has no contact
     (a contact-free orbit: the linear closed form's). The impulse is taken over two periods, so that a contact under
     way at the strobe is also seen whole, not only its part after it."""
@@ -82,12 +83,14 @@ def _measured(system: ImpactMap, problem: ImpactProblem, orbit: PeriodOrbit, coo
         return None
     stable = orbit.floquet_modulus < 1.0 - _MARGIN
     trajectory = system.engine.integrate(problem, orbit.state, 0.0, 2 if stable else 1, moments=True)
-    amplitude = float(np.abs(trajectory.moments[0][coordinate])) * 2.0 / problem.period
+    n, k = problem.size, len(problem.stops)
+    moments = trajectory.moments[0]
+    amplitude = float(as_measure(measure, problem).of_harmonics(problem, problem.omega, moments[:n], moments[n : n + k])) * 2.0 / problem.period
     impulse = (float(np.max(np.abs(trajectory.impulses))) if trajectory.impulses.size else 0.0) if stable else math.nan
     return _Point(orbit.state, orbit.contacts, amplitude, impulse, stable)
 
 
-def _shot(system: ImpactMap, seeds: list[NDArray[np.float64]], p: NDArray[np.float64], coordinate: int) -> _Point | None:
+def _shot(system: ImpactMap, seeds: list[NDArray[np.float64]], p: NDArray[np.float64], measure: Measure) -> _Point | None:
     """The first seed's orbit that converges with a contact per period, measured (None: none does): Newton on the
     engine's compiled period (:meth:`~vibroimpact.engines.compliant.exact.CompliantExactEngine.shoot_period`)."""
     problem = system.problem_at(p)
@@ -96,7 +99,7 @@ def _shot(system: ImpactMap, seeds: list[NDArray[np.float64]], p: NDArray[np.flo
             orbit = system.engine.shoot_period(problem, seed, system.state_scale, _SHOOTING.tolerance, _SHOOTING.max_iterations, _SHOOTING.min_damping)
         except ValueError:
             continue
-        point = _measured(system, problem, orbit, coordinate) if orbit is not None else None
+        point = _measured(system, problem, orbit, measure) if orbit is not None else None
         if point is not None:
             return point
     return None
@@ -119,7 +122,7 @@ def _rigid_seeds(twin: ImpactMap, f: NDArray[np.float64], root: str) -> NDArray[
     return np.where(exists[:, None], states, np.nan)
 
 
-def _track(system: ImpactMap, twin: ImpactMap, f: NDArray[np.float64], root: str, coordinate: int) -> list[_Point | None]:
+def _track(system: ImpactMap, twin: ImpactMap, f: NDArray[np.float64], root: str, measure: Measure) -> list[_Point | None]:
     """The bumper orbit of one root along the scan: each shot from the previous one found, else (or where that
     fails) from the rigid twin's closed form (solved for the whole scan once one is needed)."""
     p = np.array(system.parameters, dtype=float)
@@ -128,24 +131,24 @@ def _track(system: ImpactMap, twin: ImpactMap, f: NDArray[np.float64], root: str
     seeds: NDArray[np.float64] | None = None
     for i, frequency in enumerate(f):
         p[0] = frequency
-        found = _shot(system, [previous.state], p.copy(), coordinate) if previous is not None else None
+        found = _shot(system, [previous.state], p.copy(), measure) if previous is not None else None
         if found is None:
             seeds = _rigid_seeds(twin, f, root) if seeds is None else seeds
-            found = _shot(system, [seeds[i]], p.copy(), coordinate) if np.all(np.isfinite(seeds[i])) else None
+            found = _shot(system, [seeds[i]], p.copy(), measure) if np.all(np.isfinite(seeds[i])) else None
         previous = found
         points.append(found)
     return points
 
 
-def bumper_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: int = 0, scan: int = BUMPER_SCAN, tolerance: float = 1e-7) -> BandWorst:
-    """The largest stable |X| of ``coordinate`` over ``band`` [Hz] among the contact-free motion and the period-1
+def bumper_worst(problem: ImpactProblem, band: tuple[float, float], measure: int | Measure = 0, scan: int = BUMPER_SCAN, tolerance: float = 1e-7) -> BandWorst:
+    """The largest stable ``measure`` over ``band`` [Hz] among the contact-free motion and the period-1
     bumper orbits grown from the rigid twin's closed forms (module docstring).
 
     Parameters
     ----------
     problem : ImpactProblem
         Kelvin-Voigt bumpers whose rigid twin has the closed forms (:func:`bumper_screen_refusal`).
-    band, coordinate, scan, tolerance
+    band, measure, scan, tolerance
         As :func:`~vibroimpact.analysis.band_worst.closed_form_worst` (``scan``: shot orbits per root).
     """
     f = scan_frequencies(band, scan)
@@ -153,16 +156,17 @@ def bumper_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: 
     if reason is not None:
         raise ValueError(reason)
     system, twin = _maps(problem)
-    free, free_everywhere = contact_free_curve(problem, f, coordinate)
+    measure = as_measure(measure, problem)
+    free, free_everywhere = contact_free_curve(problem, f, measure)
     covered = np.isfinite(free)
     best = (0.0, math.nan, MOTIONS[0], 0)
     if np.any(covered):
         k = int(np.nanargmax(free))
         best = (float(free[k]), float(f[k]), MOTIONS[1], 0)  # the contact-free maximum: the linear closed form's, refined below
-        best = max(best, (*refine_maximum(problem, f, k, float(free[k]), coordinate, None, tolerance), MOTIONS[1], 0), key=lambda b: b[0])
+        best = max(best, (*refine_maximum(problem, f, k, float(free[k]), measure, None, tolerance), MOTIONS[1], 0), key=lambda b: b[0])
     impulse = 0.0
     for root in ("+", "-"):
-        track = _track(system, twin, f, root, coordinate)
+        track = _track(system, twin, f, root, measure)
         x = np.array([pt.amplitude if pt is not None and pt.stable else np.nan for pt in track])
         stable_impulses = [pt.impulse for pt in track if pt is not None and pt.stable]
         impulse = max([impulse, *stable_impulses])
@@ -170,19 +174,19 @@ def bumper_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: 
         if not np.any(np.isfinite(x)):
             continue
         k = int(np.nanargmax(x))
-        value, where = _refine(system, f, track, k, coordinate, tolerance)
+        value, where = _refine(system, f, track, k, measure, tolerance)
         if value > best[0]:
             best = (value, where, MOTIONS[2], track[k].contacts)  # type: ignore[union-attr]
     estimate, estimate_frequency = 0.0, math.nan
     if not covered.all():  # the rigid screen's guess there: the rigid twin's impact orbits that exist, else contact-free
-        guess = np.fmax.reduce([existing_impact_curve(twin.problem, f, coordinate, root) for root in ("+", "-")])
+        guess = np.fmax.reduce([existing_impact_curve(twin.problem, f, measure, root) for root in ("+", "-")])
         there = np.where(np.isfinite(guess), guess, free_everywhere)[~covered]
         k = int(np.argmax(there))
         estimate, estimate_frequency = float(there[k]), float(f[~covered][k])
     return BandWorst(best[0], best[1], best[2], best[3], float(np.count_nonzero(~covered)) / f.size, estimate, estimate_frequency, impulse)
 
 
-def _refine(system: ImpactMap, f: NDArray[np.float64], track: list[_Point | None], k: int, coordinate: int, tolerance: float) -> tuple[float, float]:
+def _refine(system: ImpactMap, f: NDArray[np.float64], track: list[_Point | None], k: int, measure: Measure, tolerance: float) -> tuple[float, float]:
     """The largest stable |X| of the orbit ``track[k]`` between the scan points either side, each trial shot from the
     nearest scanned orbit (never below the scanned value)."""
     point = track[k]
@@ -194,7 +198,7 @@ def _refine(system: ImpactMap, f: NDArray[np.float64], track: list[_Point | None
     def negative(frequency: float) -> float:
         nearest = min((j for j in (k - 1, k, k + 1) if 0 <= j < f.size and track[j] is not None), key=lambda j: abs(f[j] - frequency))
         p[0] = frequency
-        trial = _shot(system, [track[nearest].state], p.copy(), coordinate)  # type: ignore[union-attr]
+        trial = _shot(system, [track[nearest].state], p.copy(), measure)  # type: ignore[union-attr]
         return -trial.amplitude if trial is not None and trial.stable else 0.0
 
     found = minimize_scalar(negative, bounds=(a, b), method="bounded", options={"xatol": tolerance * b})
@@ -203,29 +207,31 @@ def _refine(system: ImpactMap, f: NDArray[np.float64], track: list[_Point | None
     return best
 
 
-def bumper_curves(problem: ImpactProblem, f: NDArray[np.float64], coordinate: int = 0) -> dict[str, tuple[NDArray[np.float64], NDArray[np.int8]]]:
-    """Each root's bumper orbit along frequencies ``f`` [Hz] (ascending; grown as in :func:`bumper_worst`): |X| of
-    ``coordinate`` [m] where one was found (NaN elsewhere) and its state (1 stable, 0 unstable, -1 none)."""
+def bumper_curves(problem: ImpactProblem, f: NDArray[np.float64], measure: int | Measure = 0) -> dict[str, tuple[NDArray[np.float64], NDArray[np.int8]]]:
+    """Each root's bumper orbit along frequencies ``f`` [Hz] (ascending; grown as in :func:`bumper_worst`): the
+    ``measure`` where one was found (NaN elsewhere) and its state (1 stable, 0 unstable, -1 none)."""
     system, twin = _maps(problem)
+    measure = as_measure(measure, problem)
     out = {}
     for root in ("+", "-"):
-        track = _track(system, twin, np.asarray(f, dtype=float), root, coordinate)
+        track = _track(system, twin, np.asarray(f, dtype=float), root, measure)
         x = np.array([pt.amplitude if pt is not None else np.nan for pt in track])
         state = np.array([-1 if pt is None else int(pt.stable) for pt in track], dtype=np.int8)
         out[root] = (x, state)
     return out
 
 
-def bumper_at(problem: ImpactProblem, frequency: float, coordinate: int = 0) -> BandWorst:
-    """The largest stable |X| of ``coordinate`` at one ``frequency`` [Hz] among the contact-free motion and the
+def bumper_at(problem: ImpactProblem, frequency: float, measure: int | Measure = 0) -> BandWorst:
+    """The largest stable ``measure`` at one ``frequency`` [Hz] among the contact-free motion and the
     bumper orbits shot from each root of the rigid twin's closed form (an absorber's operating point)."""
     f = np.array([float(frequency)])
     system, twin = _maps(problem)
-    free = contact_free_curve(problem, f, coordinate)[0]
+    measure = as_measure(measure, problem)
+    free = contact_free_curve(problem, f, measure)[0]
     best = (float(free[0]), float(frequency), MOTIONS[1], 0) if math.isfinite(free[0]) else (0.0, math.nan, MOTIONS[0], 0)
     covered = math.isfinite(free[0])
     for root in ("+", "-"):
-        point = _track(system, twin, f, root, coordinate)[0]
+        point = _track(system, twin, f, root, measure)[0]
         if point is not None and point.stable:
             covered = True
             if point.amplitude > best[0]:

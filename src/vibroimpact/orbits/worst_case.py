@@ -18,10 +18,12 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
+from vibroimpact.analysis.measures import Measure, as_measure
 from vibroimpact.orbits.branch import Branch, PeriodicOrbit
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
 from vibroimpact.orbits.bumper_screen import bumper_screen_refusal, rigid_twin
-from vibroimpact.orbits.maps import ImpactMap, branch_measures, closed_form_state, orbit_measures
+from vibroimpact.orbits.maps import ImpactMap, closed_form_state
+from vibroimpact.orbits.orbit_measures import branch_measures, orbit_measures
 from vibroimpact.orbits.shooting import ShootingError, shoot
 
 __all__ = ["BranchMaximum", "branch_maximum", "WorstCase", "worst_response", "STABLE_BOUNDARY"]
@@ -54,8 +56,8 @@ class BranchMaximum:
     orbit: PeriodicOrbit
 
 
-def branch_maximum(system: Any, branch: Branch, coordinate: int = 0, stable_only: bool = True, tolerance: float = 1e-10) -> BranchMaximum | None:
-    """The largest |X| of ``coordinate`` over ``branch`` (its stable stretches only, by default).
+def branch_maximum(system: Any, branch: Branch, measure: int | Measure = 0, stable_only: bool = True, tolerance: float = 1e-10) -> BranchMaximum | None:
+    """The largest ``measure`` over ``branch`` (its stable stretches only, by default).
 
     Parameters
     ----------
@@ -63,8 +65,8 @@ def branch_maximum(system: Any, branch: Branch, coordinate: int = 0, stable_only
         The map the branch was continued on.
     branch : Branch
         From :func:`~vibroimpact.orbits.continuation.continue_branch`.
-    coordinate : int
-        0: the paper's primary mass.
+    measure : int or Measure
+        A row of :mod:`vibroimpact.analysis.measures`, or a coordinate index for its |X| (0: the paper's primary mass).
     stable_only : bool
         Only stable orbits (the motions that can be observed), and the special points that bound them.
     tolerance : float
@@ -75,27 +77,27 @@ def branch_maximum(system: Any, branch: Branch, coordinate: int = 0, stable_only
     BranchMaximum or None
         None where no orbit of the branch is stable (``stable_only``).
     """
-    measures = branch_measures(system, branch)
-    amplitude = measures.amplitude(coordinate)
+    measure = as_measure(measure, system.problem)
+    amplitude = measure.of_shot(branch_measures(system, branch))
     stable = np.asarray(branch.stable, dtype=bool) if stable_only else np.ones(amplitude.size, dtype=bool)
     candidates: list[BranchMaximum] = []
     for point in branch.special_points:
         if stable_only and float(np.max(np.abs(point.orbit.multipliers))) > 1.0 + STABLE_BOUNDARY:
             continue
-        value = float(orbit_measures(system, point.orbit).amplitudes[coordinate])
+        value = float(measure.of_shot(orbit_measures(system, point.orbit)))
         candidates.append(BranchMaximum(value, point.value, point.kind, point.orbit))
     for end in (0, amplitude.size - 1):
         if amplitude.size and stable[end]:
             candidates.append(BranchMaximum(float(amplitude[end]), float(branch.values[end]), "end", branch.orbits[end]))
     for i in range(1, amplitude.size - 1):
         if stable[i - 1 : i + 2].all() and amplitude[i] >= amplitude[i - 1] and amplitude[i] >= amplitude[i + 1]:
-            refined = _interior(system, branch, i, coordinate, tolerance)
+            refined = _interior(system, branch, i, measure, tolerance)
             candidates.append(refined if refined is not None else BranchMaximum(float(amplitude[i]), float(branch.values[i]), "interior", branch.orbits[i]))
     return max(candidates, key=lambda c: c.amplitude) if candidates else None
 
 
-def _interior(system: Any, branch: Branch, i: int, coordinate: int, tolerance: float) -> BranchMaximum | None:
-    """The maximum of |X| between points i - 1 and i + 1 of ``branch``, by a bounded search in its parameter with
+def _interior(system: Any, branch: Branch, i: int, measure: Measure, tolerance: float) -> BranchMaximum | None:
+    """The maximum of ``measure`` between points i - 1 and i + 1 of ``branch``, by a bounded search in its parameter with
     each orbit shot from point i's state (None where the parameter is not monotone there or a shot fails)."""
     values = branch.values
     low, high = sorted((float(values[i - 1]), float(values[i + 1])))
@@ -113,7 +115,7 @@ def _interior(system: Any, branch: Branch, i: int, coordinate: int, tolerance: f
         except ShootingError:
             return math.nan
         found[p] = orbit
-        return -float(orbit_measures(system, orbit).amplitudes[coordinate])
+        return -float(measure.of_shot(orbit_measures(system, orbit)))
 
     result = minimize_scalar(negative, bounds=(low, high), method="bounded", options={"xatol": tolerance * max(abs(low), abs(high), 1e-300)})
     if not math.isfinite(float(result.fun)) or float(result.x) not in found:
@@ -143,8 +145,8 @@ class WorstCase:
     branches: tuple[tuple[Branch, BranchMaximum | None], ...]
 
 
-def worst_response(problem: Any, band: tuple[float, float], coordinate: int = 0, scan: int = 301) -> WorstCase:
-    """The largest stable |X| of ``coordinate`` over ``band`` [Hz], over the contact-free orbit (in closed form, where
+def worst_response(problem: Any, band: tuple[float, float], measure: int | Measure = 0, scan: int = 301) -> WorstCase:
+    """The largest stable ``measure`` (a coordinate index: its |X|) over ``band`` [Hz], over the contact-free orbit (in closed form, where
     it clears the stops) and every branch continued from a closed-form one-impact orbit (each root of eq. 16, the
     middle of each run of ``scan`` frequencies where it exists and is admissible), each located exactly
     (:func:`branch_maximum`). Kelvin-Voigt bumpers start from their rigid twin's closed-form orbit
@@ -160,6 +162,7 @@ def worst_response(problem: Any, band: tuple[float, float], coordinate: int = 0,
     low, high = (float(f) for f in band)
     f = np.linspace(low, high, scan)
     base = ImpactMap(problem)
+    measure = as_measure(measure, problem)
     index = base.parameter_names.index("frequency")
 
     def at_frequency(frequency: float) -> np.ndarray:
@@ -171,7 +174,7 @@ def worst_response(problem: Any, band: tuple[float, float], coordinate: int = 0,
         found = base.contact_free_orbit(at_frequency(frequency))
         if found is None or found.clearance < 0.0:
             return math.nan
-        return float(abs(found.amplitudes.amplitudes[coordinate]))
+        return float(measure.of_harmonics(base.problem_at(at_frequency(frequency)), 2.0 * math.pi * frequency, found.amplitudes.amplitudes))
 
     best = (-math.inf, math.nan, "")
     values = np.array([linear(x) for x in f])
@@ -200,7 +203,7 @@ def worst_response(problem: Any, band: tuple[float, float], coordinate: int = 0,
             closed = rigid_twin(there) if bumpers else there
             single = solve_impact_orbit(closed, root=root)
             if not bumpers:
-                x_start = float(np.abs(single.harmonics()).reshape(-1)[coordinate])
+                x_start = float(measure.of_orbit(single).reshape(-1)[0])
                 if any(_passes(known, start, x_start) for known in traced):
                     continue  # a branch already traced passes through this start
             try:
@@ -208,12 +211,12 @@ def worst_response(problem: Any, band: tuple[float, float], coordinate: int = 0,
             except ShootingError:
                 continue
             if bumpers:  # the bumper's own orbit: is it on a branch already traced?
-                if shot.impacts < 1 or any(_passes(known, start, float(orbit_measures(system, shot).amplitudes[coordinate])) for known in traced):
+                if shot.impacts < 1 or any(_passes(known, start, float(measure.of_shot(orbit_measures(system, shot)))) for known in traced):
                     continue
             branch = continue_branch(system, shot, "frequency", ContinuationSettings(lower=low, upper=high))
             measured = branch_measures(system, branch)
-            traced.append((branch.values, measured.amplitude(coordinate), branch.impacts))
-            top = branch_maximum(system, branch, coordinate)
+            traced.append((branch.values, measure.of_shot(measured), branch.impacts))
+            top = branch_maximum(system, branch, measure)
             branches.append((branch, top))
             if top is not None and top.amplitude > best[0]:
                 best = (top.amplitude, top.value, f"{_motion(top)} ({top.where} of its branch)")

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from vibroimpact.analysis.measures import Measure, as_measure
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.motion import classify_motion, classify_strobes
 from vibroimpact.simulation.harmonics import linear_state, resting_state
@@ -49,7 +50,7 @@ def at_frequency(problem: ImpactProblem, frequency: float) -> ImpactProblem:
 
 def stepped_sweep(
     problem: ImpactProblem, direction: str, frequencies: Sequence[float], transient: int, strobes: int, engine: Any,
-    report: Callable[[float], None] | None = None, coordinate: int = 0,
+    report: Callable[[float], None] | None = None, measure: int | Measure = 0,
 ) -> dict[str, NDArray[Any]]:  # fmt: skip
     """A stepped brute-force sweep of ``problem`` in one direction, the end state carried from point to point.
 
@@ -68,14 +69,15 @@ def stepped_sweep(
         jacobians=True)``).
     report : callable, optional
         Gets the number of points done after each.
-    coordinate : int
-        Whose per-period |X| is ``amplitude`` (0: x1).
+    measure : int or Measure
+        What ``amplitude`` holds per period: a row of :mod:`vibroimpact.analysis.measures`, or a coordinate index for
+        its |X| (0: x1).
 
     Returns
     -------
     dict
         :data:`SWEEP_FIELDS` over the frequencies in increasing order (whatever the direction): ``strobe`` (n, s) x1
-        at the strobes [m], ``amplitude`` (n, s) per-period |X| of ``coordinate`` [m], ``velocity`` (n, :data:`MAX_KEPT_IMPACTS`) the
+        at the strobes [m], ``amplitude`` (n, s) per-period ``measure`` [its unit], ``velocity`` (n, :data:`MAX_KEPT_IMPACTS`) the
         last impact velocities [m s-1], ``impacts`` per period, ``regime`` (:data:`MOTION_CLASSES` index, -1 where
         the engine failed), ``period`` (0: no repeat), ``lyapunov`` [1/period], ``state`` (n, 2N) the end state and
         ``error`` the raw message where the engine failed (the next point then starts at rest), else empty.
@@ -90,7 +92,7 @@ def stepped_sweep(
         moved = at_frequency(problem, float(f[k]))
         state = linear_start(moved) if state is None else state
         try:
-            state = measure_motion(engine, moved, state, transient, s, out, k, coordinate)
+            state = measure_motion(engine, moved, state, transient, s, out, k, measure)
         except RuntimeError as error:  # the engine made no progress (endless chattering): start the next point at rest
             state = resting_state(moved)
             errors[k] = f"{type(error).__name__}: {str(error)[:160]}"
@@ -115,9 +117,9 @@ def linear_start(problem: ImpactProblem) -> NDArray[np.float64]:
     return linear.state(problem.omega) if linear.fits(problem) else resting_state(problem)
 
 
-def measure_motion(engine: Any, problem: ImpactProblem, state: NDArray[np.float64], transient: int, strobes: int, out: dict, k: int, coordinate: int = 0) -> NDArray[np.float64]:
+def measure_motion(engine: Any, problem: ImpactProblem, state: NDArray[np.float64], transient: int, strobes: int, out: dict, k: int, measure: int | Measure = 0) -> NDArray[np.float64]:
     """Drop ``transient`` periods from ``state``, keep ``strobes`` periods at row ``k`` of ``out`` (the arrays of
-    :func:`stepped_sweep`, ``error`` aside; ``amplitude`` the per-period |X| of ``coordinate``); return the end state
+    :func:`stepped_sweep`, ``error`` aside; ``amplitude`` the per-period ``measure``); return the end state
     [m, m s-1]."""
     if transient:
         state = engine.integrate(problem, state, 0.0, transient).final_state
@@ -125,7 +127,8 @@ def measure_motion(engine: Any, problem: ImpactProblem, state: NDArray[np.float6
     s = run.strobe_states
     out["state"][k] = run.final_state
     out["strobe"][k] = s[1:, 0]
-    out["amplitude"][k] = np.abs(run.moments[:, coordinate]) * 2.0 / problem.period
+    n, m = problem.size, len(problem.stops)
+    out["amplitude"][k] = as_measure(measure, problem).of_harmonics(problem, problem.omega, run.moments[:, :n], run.moments[:, n : n + m]) * 2.0 / problem.period
     velocities = run.impact_velocities
     out["velocity"][k, : min(velocities.size, MAX_KEPT_IMPACTS)] = velocities[-MAX_KEPT_IMPACTS:]
     out["impacts"][k] = velocities.size / strobes

@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.analysis.linear import contact_free_is_stable
+from vibroimpact.analysis.measures import Measure, as_measure
 from vibroimpact.engines.registry import engine_for
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.simulation.attractors import MOTION_CLASSES, at_frequency, measure_motion, stepped_sweep, sweep_arrays
@@ -139,7 +140,7 @@ class AttractorSweep:
 
 def band_attractors(
     problem: ImpactProblem, band: tuple[float, float], frequencies: int = 301, starts: int = 4, transient: int = 300, strobes: int = 64,
-    engine: Any = None, seed: int = 0, coordinate: int = 0,
+    engine: Any = None, seed: int = 0, measure: int | Measure = 0,
 ) -> AttractorSweep:  # fmt: skip
     """Every attractor brute force finds over ``band``, and the largest |X1| among them: the true worst case a design
     is judged by, non-periodic motions included.
@@ -176,25 +177,27 @@ def band_attractors(
         stops, the bumper's closed-form engine for Kelvin-Voigt bumpers).
     seed : int
         Of the random starts.
-    coordinate : int
-        Whose |X| is measured and maximised (0: x1; the name |X1| above stands for it).
+    measure : int or Measure
+        What is measured and maximised: a row of :mod:`vibroimpact.analysis.measures`, or a coordinate index for its
+        |X| (0: x1; the name |X1| above stands for it).
     """
     low, high = (float(f) for f in band)
     if not 0.0 < low < high or frequencies < 2 or starts < 0 or transient < 0 or strobes < 16:
         raise ValueError(f"band = {band!r}, frequencies = {frequencies!r}, starts = {starts!r}, transient = {transient!r}, strobes = {strobes!r}: "
                          "expected 0 < low < high [Hz], at least 2 frequencies and 16 strobes, no negative starts or transient")  # fmt: skip
+    measure = as_measure(measure, problem)
     engine = engine_of(engine_for(problem.contact_law, "exact_jacobians") if engine is None else engine)
     f = np.linspace(low, high, frequencies)
     runs = ("up", "down") + attractor_labels(starts)
     n, r, s = f.size, len(runs), strobes
-    rows = [stepped_sweep(problem, direction, f, transient, s, engine, coordinate=coordinate) for direction in ("up", "down")]
+    rows = [stepped_sweep(problem, direction, f, transient, s, engine, measure=measure) for direction in ("up", "down")]
     rows += [sweep_arrays(n, s, 2 * problem.size) for _ in range(starts)]
     rng = np.random.default_rng(seed)
     for k in range(n):
         moved = at_frequency(problem, float(f[k]))
         for j, (_label, start) in enumerate(attractor_starts(moved, starts, rng)):
             try:
-                measure_motion(engine, moved, start, transient, s, rows[2 + j], k, coordinate)
+                measure_motion(engine, moved, start, transient, s, rows[2 + j], k, measure)
             except RuntimeError:  # the engine made no progress (endless chattering): no attractor from this start
                 rows[2 + j]["regime"][k] = -1
     amplitude = np.full((n, r), np.nan)
@@ -203,11 +206,11 @@ def band_attractors(
     for k in range(n):
         moved = at_frequency(problem, float(f[k]))
         linear = linear_state(moved)
-        free = abs(complex(linear.amplitudes[coordinate])) if linear.fits(moved) and stable else math.nan  # an undamped free mass: no attractor
+        free = measure.of_state(moved, linear.amplitudes) if linear.fits(moved) and stable else math.nan  # an undamped free mass: no attractor
         for j, row in enumerate(rows):
             amplitude[k, j] = _attractor_amplitude(row, k, free)
     stack = {name: np.stack([row[name] for row in rows], axis=1) for name in ("regime", "period", "impacts", "lyapunov", "state")}
-    maximum = _maximum(problem, engine, f, runs, amplitude, stack, s, coordinate)
+    maximum = _maximum(problem, engine, f, runs, amplitude, stack, s, measure)
     return AttractorSweep(f, runs, amplitude, measured, stack["regime"], stack["period"], stack["impacts"], stack["lyapunov"], stack["state"], maximum)
 
 
@@ -265,9 +268,10 @@ def _attractor_amplitude(row: dict[str, NDArray[Any]], k: int, free: float) -> f
 
 def _maximum(
     problem: ImpactProblem, engine: Any, f: NDArray[np.float64], runs: tuple[str, ...], amplitude: NDArray[np.float64], stack: dict[str, NDArray[Any]], strobes: int,
-    coordinate: int = 0,
+    measure: Measure,
 ) -> AttractorMaximum:  # fmt: skip
-    """The largest entry of ``amplitude``, its motion, and its peak |x(t)| of ``coordinate`` from a sampled run."""
+    """The largest entry of ``amplitude``, its motion, and the peak |x(t)| of the measure's coordinate from a sampled
+    run (NaN for a measure of no coordinate)."""
     if not np.any(np.isfinite(amplitude)):
         return AttractorMaximum(math.nan, math.nan, "none", "none", 0, math.nan, "", ())
     k, j = np.unravel_index(int(np.nanargmax(amplitude)), amplitude.shape)
@@ -282,7 +286,7 @@ def _maximum(
     state = stack["state"][k, j]
     moved = at_frequency(problem, float(f[k]))
     peak = math.nan
-    if hasattr(engine, "sample"):
+    if hasattr(engine, "sample") and measure.coordinate is not None:
         times = np.linspace(0.0, strobes * moved.period, strobes * PEAK_SAMPLES + 1)
-        peak = float(np.max(np.abs(engine.sample(moved, state, 0.0, strobes, times)[1][:, coordinate])))
+        peak = float(np.max(np.abs(engine.sample(moved, state, 0.0, strobes, times)[1][:, measure.coordinate])))
     return AttractorMaximum(float(amplitude[k, j]), float(f[k]), motion, regime, period, impacts, runs[j], tuple(float(x) for x in state), peak)

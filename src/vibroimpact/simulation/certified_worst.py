@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.analysis.measures import Measure
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.branch import Branch
 from vibroimpact.orbits.bumper_screen import bumper_screen_refusal
@@ -86,9 +87,9 @@ class CertifiedWorst:
 
 
 def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequencies: int = 121, starts: int = 2, transient: int = 200, strobes: int = 64,
-                    coordinate: int = 0) -> CertifiedWorst:  # fmt: skip
-    """The worst stable |X| of ``coordinate`` (0: x1) of ``problem`` over ``band`` [Hz] (module docstring): continuation,
-    brute force and the brute force's orbit continued all measure that coordinate; ``frequencies``, ``starts``,
+                    measure: int | Measure = 0) -> CertifiedWorst:  # fmt: skip
+    """The worst stable ``measure`` (a coordinate index: its |X|; 0: x1) of ``problem`` over ``band`` [Hz] (module
+    docstring): continuation, brute force and the brute force's orbit continued all judge that measure; ``frequencies``, ``starts``,
     ``transient`` and ``strobes`` are the brute force's (:func:`~vibroimpact.simulation.band_attractors.band_attractors`).
 
     Bumpers continue from their rigid twin's closed-form orbits. A problem the closed forms do not apply to (a free
@@ -100,9 +101,9 @@ def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequenci
     # continuation starts from the closed forms (bumpers: their rigid twin's); a layout without them (a free mass ...)
     # is brute force's alone
     closed = closed_form_refusal(problem) is None or bumper_screen_refusal(problem) is None
-    continued = worst_response(problem, (low, high), coordinate) if closed else WorstCase(0.0, math.nan, "", ())
+    continued = worst_response(problem, (low, high), measure) if closed else WorstCase(0.0, math.nan, "", ())
     middle = time.perf_counter()
-    sweep = band_attractors(problem, (low, high), frequencies=frequencies, starts=starts, transient=transient, strobes=strobes, coordinate=coordinate)
+    sweep = band_attractors(problem, (low, high), frequencies=frequencies, starts=starts, transient=transient, strobes=strobes, measure=measure)
     swept = time.perf_counter()
     top = sweep.maximum
     best = (continued.amplitude, continued.frequency, continued.motion, SOURCES[0])
@@ -110,7 +111,7 @@ def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequenci
     if math.isfinite(top.amplitude) and top.amplitude > continued.amplitude * (1.0 + 1e-6):
         best = (top.amplitude, top.frequency, f"{top.motion} (brute force, {top.run} run)", SOURCES[1])
         if top.period >= 1 and top.impacts > 0.0 and top.regime in ("one_impact", "other_periodic"):
-            refined = _continued(problem, (low, high), top.frequency, np.array(top.state), top.period, coordinate)
+            refined = _continued(problem, (low, high), top.frequency, np.array(top.state), top.period, measure)
             if refined is not None and refined[0] >= top.amplitude * (1.0 - 1e-3):  # the same orbit, located exactly
                 best = (refined[0], refined[1], f"{top.motion} ({refined[2]} of its branch, continued from the brute force)", SOURCES[2])
                 extra = (refined[3],)
@@ -118,8 +119,8 @@ def certified_worst(problem: ImpactProblem, band: tuple[float, float], frequenci
     return CertifiedWorst(best[0], best[1], best[2], best[3], continued, sweep, extra, middle - start, end - middle, swept - middle)
 
 
-def _continued(problem: ImpactProblem, band: tuple[float, float], frequency: float, state: np.ndarray, period: int, coordinate: int = 0) -> tuple[float, float, str, Branch] | None:
-    """(|X| of ``coordinate`` [m], where [Hz], which place, branch) of the stable maximum of the branch through the
+def _continued(problem: ImpactProblem, band: tuple[float, float], frequency: float, state: np.ndarray, period: int, measure: int | Measure = 0) -> tuple[float, float, str, Branch] | None:
+    """(``measure``, where [Hz], which place, branch) of the stable maximum of the branch through the
     period-``period`` orbit near ``state`` at ``frequency``; None where shooting or continuation fails."""
     system = ImpactMap(at_frequency(problem, frequency), periods=period)
     try:
@@ -127,7 +128,7 @@ def _continued(problem: ImpactProblem, band: tuple[float, float], frequency: flo
         branch = continue_branch(system, orbit, "frequency", ContinuationSettings(lower=band[0], upper=band[1]))
     except (ShootingError, ValueError, RuntimeError):
         return None
-    top = branch_maximum(system, branch, coordinate)
+    top = branch_maximum(system, branch, measure)
     return (top.amplitude, top.value, top.where, branch) if top is not None else None
 
 

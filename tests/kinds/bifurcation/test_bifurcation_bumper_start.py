@@ -12,7 +12,8 @@ from vibroimpact.kinds.bifurcation.bumper_start import BumperStart, bumper_start
 from vibroimpact.kinds.bifurcation.cases import MOTION_CLASSES, SweepCase
 from vibroimpact.kinds.bifurcation.study import diagram_problem
 from vibroimpact.engines.registry import BUMPER, engine_for
-from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures, section_phase
+from vibroimpact.orbits.maps import ImpactMap, closed_form_state, section_phase
+from vibroimpact.orbits.orbit_measures import orbit_measures
 from vibroimpact.orbits.shooting import shoot
 from vibroimpact.scene import find_scene, load_scene
 

@@ -41,7 +41,8 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.bifurcations import switch_period_doubling
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Branch, Iterated, PeriodicOrbit, SpecialPoint
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
-from vibroimpact.orbits.maps import ImpactMap, closed_form_state, orbit_measures, section_phase
+from vibroimpact.orbits.maps import ImpactMap, closed_form_state, section_phase
+from vibroimpact.orbits.orbit_measures import orbit_measures
 from vibroimpact.orbits.shooting import shoot
 
 __all__ = ["rigid_twin", "ORIGINS", "MAX_ORBIT_IMPACTS", "SAME_POINT_FREQUENCY", "SAME_POINT_ORBIT", "same_special_point", "map_bounds", "problem_at", "stop_values", "OrbitSet", "find_branches", "closed_form_orbits", "linear_segments", "band_step"]

@@ -37,7 +37,8 @@ from vibroimpact.model.units import length_unit
 from vibroimpact.orbits.branch import lower_period_maps, SPECIAL_POINT_KINDS, Iterated
 from vibroimpact.orbits.continuation import continue_special_point, ContinuationSettings, continue_branch
 from vibroimpact.orbits.grazing_curve import trace_grazing
-from vibroimpact.orbits.maps import ImpactMap, orbit_measures, resection
+from vibroimpact.orbits.maps import ImpactMap, resection
+from vibroimpact.orbits.orbit_measures import orbit_measures
 from vibroimpact.orbits.shooting import ShootingError, shoot
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.fingerprints import case_key

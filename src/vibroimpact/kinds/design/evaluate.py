@@ -25,7 +25,8 @@ from vibroimpact.simulation.band_attractors import band_attractors
 from vibroimpact.model.contact import MIN_BUMPER_RESTITUTION, KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.bumper_screen import bumper_at, bumper_screen_refusal, bumper_worst
-from vibroimpact.orbits.maps import ImpactMap, branch_measures
+from vibroimpact.orbits.maps import ImpactMap
+from vibroimpact.orbits.orbit_measures import branch_measures
 from vibroimpact.simulation.certified_worst import SOURCES, certified_worst, sweep_points_for
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.fingerprints import case_key
@@ -191,7 +192,7 @@ class DesignCase:
                     values = (found.amplitude, found.frequency, found.uncovered, found.estimate, SCREEN_MOTIONS.index(found.motion))
                     out["impulse"][row] = found.impulse
                 else:  # no closed form (a free mass, stops that are not one or a symmetric pair): brute force screens
-                    top = band_attractors(problem, self.space.band, *BRUTE_SCREEN, coordinate=self.space.coordinate).maximum
+                    top = band_attractors(problem, self.space.band, *BRUTE_SCREEN, measure=self.space.coordinate).maximum
                     values = (top.amplitude, top.frequency, 0.0, 0.0, SCREEN_MOTIONS.index(BRUTE))
                 if math.isfinite(self.space.operating):
                     out["operating"][row], operating_motion[row] = _operating(problem, self.space.operating, self.space.coordinate, kind)
@@ -209,7 +210,7 @@ def _operating(problem: ImpactProblem, frequency: float, coordinate: int, kind: 
     the screen's (``kind`` of :data:`SCREENS`; where none of its motions is stable there, the guess from the orbits
     that exist), else brute force's."""
     if kind == SCREENS[2]:
-        return band_attractors(problem, _around(frequency), 2, *BRUTE_SCREEN[1:], coordinate=coordinate).maximum.amplitude, SCREEN_MOTIONS.index(BRUTE)
+        return band_attractors(problem, _around(frequency), 2, *BRUTE_SCREEN[1:], measure=coordinate).maximum.amplitude, SCREEN_MOTIONS.index(BRUTE)
     at = closed_form_at(problem, frequency, coordinate) if kind == SCREENS[0] else bumper_at(problem, frequency, coordinate)
     if at.uncovered == 0.0:  # exact: a share of none
         return at.amplitude, SCREEN_MOTIONS.index(at.motion)
@@ -272,7 +273,7 @@ class CertifyCase:
                 start = time.perf_counter()
                 screen_worst(problem, self.space.band, self.space.coordinate, self.space.scan)
                 scalars["screen_time"] = time.perf_counter() - start
-            found = certified_worst(problem, self.space.band, frequencies=ATTRACTOR_POINTS, coordinate=self.space.coordinate)
+            found = certified_worst(problem, self.space.band, frequencies=ATTRACTOR_POINTS, measure=self.space.coordinate)
         except (ValueError, RuntimeError) as error:
             return {**{k: np.array(v) for k, v in scalars.items()}, "sweep_points": np.full(len(SWEEP_ACCURACIES), np.nan), "sweep_time": np.full(len(SWEEP_ACCURACIES), np.nan), **points, **attractors,
                     "error": np.array(f"{type(error).__name__}: {str(error)[:200]}")}  # fmt: skip
