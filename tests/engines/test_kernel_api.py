@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[2]
 KERNEL_MODULES = tuple(
     f"vibroimpact.engines.{name}"
     for name in (
-        "exact", "exact_core", "exact_pieces", "exact_roots", "exact_moments", "exact_flows", "rigid_kernels",
+        "exact", "exact_core", "exact_matrices", "exact_pieces", "exact_roots", "exact_moments", "exact_flows", "rigid_kernels",
         "flow_layout", "linear_flow", "kernel_arguments", "compliant.exact_loop", "compliant.exact",
     )
 )  # fmt: skip

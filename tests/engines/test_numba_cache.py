@@ -19,7 +19,7 @@ from pathlib import Path
 import pytest
 
 from vibroimpact import engines
-from vibroimpact.engines import exact_core, exact_moments, exact_pieces, exact_roots, rigid_kernels, sundae
+from vibroimpact.engines import exact_core, exact_matrices, exact_moments, exact_pieces, exact_roots, rigid_kernels, sundae
 from vibroimpact.engines.compliant import exact_loop, model
 from vibroimpact.engines.numba_cache import compiled_functions, kernel_modules
 
@@ -33,8 +33,8 @@ def _sources(*modules: object) -> str:
 
 
 def test_each_loop_finds_every_file_whose_kernels_it_compiles() -> None:
-    assert kernel_modules(vars(exact_loop)) == [exact_core, exact_moments, exact_pieces, exact_roots]  # exact_core's through transition_matrix, and on
-    assert kernel_modules(vars(exact_core)) == [exact_moments, exact_pieces, exact_roots]
+    assert kernel_modules(vars(exact_loop)) == [exact_matrices, exact_moments, exact_pieces, exact_roots]  # the matrix helpers exact_core shares
+    assert kernel_modules(vars(exact_core)) == [exact_matrices, exact_moments, exact_pieces, exact_roots]
     assert kernel_modules(vars(exact_moments)) == [exact_pieces]
     assert kernel_modules(vars(exact_roots)) == [exact_pieces]  # its root search holds exact_pieces.ZERO, a constant
     assert kernel_modules(vars(rigid_kernels)) == [sundae]  # its kernels read sundae's intrinsics
@@ -42,7 +42,7 @@ def test_each_loop_finds_every_file_whose_kernels_it_compiles() -> None:
 
 
 def test_every_compiled_function_carries_its_callees_sources_in_its_stamp() -> None:
-    readers = ((exact_loop, (exact_core, exact_moments, exact_pieces, exact_roots)), (exact_core, (exact_moments, exact_pieces, exact_roots)), (exact_moments, (exact_pieces,)), (exact_roots, (exact_pieces,)))
+    readers = ((exact_loop, (exact_matrices, exact_moments, exact_pieces, exact_roots)), (exact_core, (exact_matrices, exact_moments, exact_pieces, exact_roots)), (exact_moments, (exact_pieces,)), (exact_roots, (exact_pieces,)))
     for module, callees in readers:
         functions = compiled_functions(vars(module))
         assert len(functions) >= 5, module.__name__

@@ -1,8 +1,9 @@
 """The compiled core of the ``exact`` engine: its whole event loop in one numba function, with the exact Jacobian.
 
 Its kernels live beside it, shared with the ``compliant_exact`` loop: a piece of flow
-(:mod:`~vibroimpact.engines.exact_pieces`), the guaranteed root search (:mod:`~vibroimpact.engines.exact_roots`) and
-the closed-form moments (:mod:`~vibroimpact.engines.exact_moments`). numba's on-disk cache is keyed by the source file
+(:mod:`~vibroimpact.engines.exact_pieces`), the guaranteed root search (:mod:`~vibroimpact.engines.exact_roots`), the
+closed-form moments (:mod:`~vibroimpact.engines.exact_moments`) and the transition matrices and array helpers
+(:mod:`~vibroimpact.engines.exact_matrices`). numba's on-disk cache is keyed by the source file
 of each cached function only, so an edit of a kernel would not recompile its callers (numba PR #8396, unmerged; a
 kernel module beside this one once served stale machine code): every compiled function here is stamped with their
 sources (:mod:`~vibroimpact.engines.numba_cache`).
@@ -40,51 +41,18 @@ import math
 import numpy as np
 from numba import njit
 
+from vibroimpact.engines.exact_matrices import grow_rows, left_multiply, transition_matrix
 from vibroimpact.engines.exact_moments import add_moments, add_moments_gl
 from vibroimpact.engines.exact_pieces import NONE, ZERO, halve_pairs, modal_coordinates, observable, piece_state, polynomial_part
 from vibroimpact.engines.exact_roots import closest_approach, escape_step, first_crossing, observable_value, round_off_band
 from vibroimpact.engines.numba_cache import stamp_with_callees
 
-__all__ = ["run_periods", "run_periods_until", "sample_states", "STATUS_OK", "STATUS_NO_PROGRESS", "STATUS_TWO_STICKS", "transition_matrix", "left_multiply", "grow_rows"]
+__all__ = ["run_periods", "run_periods_until", "sample_states", "STATUS_OK", "STATUS_NO_PROGRESS", "STATUS_TWO_STICKS"]
 
 STATUS_OK, STATUS_NO_PROGRESS, STATUS_TWO_STICKS, STATUS_INTERRUPTED = 0, 1, 2, 3
 
 
 # ------------------------------------------------------------------------------------ Jacobians, stops, bookkeeping
-@njit(cache=True, error_model="numpy")
-def transition_matrix(lams, vecs, invs, f, m, dt, poly, zpros, znils, out):
-    """exp(A dt) of flow f: Re(V diag(e^{lam dt}) V^+) (+ P_z + A_z dt), into ``out`` (n x n)."""
-    n = out.shape[0]
-    for r in range(n):
-        for c in range(n):
-            out[r, c] = 0.0
-    for i in range(m):
-        g = np.exp(lams[f, i] * dt)
-        for r in range(n):
-            left = vecs[f, r, i] * g
-            for c in range(n):
-                out[r, c] += (left * invs[f, i, c]).real
-    if poly:
-        for r in range(n):
-            for c in range(n):
-                out[r, c] += zpros[f, r, c] + znils[f, r, c] * dt
-
-
-@njit(cache=True, error_model="numpy")
-def left_multiply(factor, jac, work):
-    """jac <- factor @ jac (n x n), through ``work``."""
-    n = jac.shape[0]
-    for r in range(n):
-        for c in range(n):
-            acc = 0.0
-            for m in range(n):
-                acc += factor[r, m] * jac[m, c]
-            work[r, c] = acc
-    for r in range(n):
-        for c in range(n):
-            jac[r, c] = work[r, c]
-
-
 @njit(cache=True, error_model="numpy")
 def _field(a_matrix, load, static, omega, t, y, held, velw, kickw, masses, simple, out):
     """The vector field at (t, y): free (``held`` < 0), or held on stop ``held`` (its holding force subtracted)."""
@@ -131,13 +99,6 @@ def _saltation(jumps, stop, a_matrix, load, static, omega, t, before, after, vel
         for c in range(n):
             if gapw[stop, c] != 0.0:
                 out[r, c] += difference * gapw[stop, c]
-
-
-@njit(cache=True, error_model="numpy")
-def grow_rows(array, rows):
-    bigger = np.empty((max(2 * array.shape[0], rows),) + array.shape[1:], dtype=array.dtype)
-    bigger[: array.shape[0]] = array
-    return bigger
 
 
 @njit(cache=True, error_model="numpy")

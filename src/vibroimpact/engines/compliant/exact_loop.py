@@ -1,7 +1,7 @@
 """The compiled core of the ``compliant_exact`` engine: the Kelvin-Voigt bumper's event loop in closed form, on the
 ``exact`` engine's machinery (the flows' pieces and observables, :mod:`~vibroimpact.engines.exact_pieces`; the
 guaranteed first-root search, :mod:`~vibroimpact.engines.exact_roots`; transition matrices,
-:mod:`~vibroimpact.engines.exact_core`; closed-form moments, :mod:`~vibroimpact.engines.exact_moments`), with the
+:mod:`~vibroimpact.engines.exact_matrices`; closed-form moments, :mod:`~vibroimpact.engines.exact_moments`), with the
 bumper's contact law in place of the impact map.
 
 Flows are stacked as :func:`~vibroimpact.engines.exact.stack_flows` stacks them, one per *contact mode*: flow f is the
@@ -41,7 +41,7 @@ import math
 import numpy as np
 from numba import njit
 
-from vibroimpact.engines.exact_core import grow_rows, left_multiply, transition_matrix
+from vibroimpact.engines.exact_matrices import grow_rows, left_multiply, transition_matrix
 from vibroimpact.engines.exact_moments import add_moments_gl, coordinate_amplitudes, moment_integrals, piece_factors, weighted_amplitudes
 from vibroimpact.engines.exact_pieces import halve_pairs, modal_coordinates, observable, piece_state, polynomial_part
 from vibroimpact.engines.exact_roots import closest_approach, escape_step, first_crossing, observable_derivatives, observable_value, round_off_band
