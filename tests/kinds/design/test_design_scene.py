@@ -45,6 +45,26 @@ def test_a_design_scene_reads_its_section() -> None:
     assert settings.compare == "linear_optimum" and settings.search.method == "differential_evolution"
 
 
+def test_the_objective_and_the_constraint_are_rows_of_the_measure_table() -> None:
+    """The objective may be |X| of any coordinate or the force to the base, and the operating constraint limits its
+    own measure (|X1| by default, the primary's notch), whatever the objective."""
+    force = parse_scene(scene_with(objective="force_amplitude", constraints={"operating": {"frequency": 33.0, "x1_amplitude": 5e-5}})).settings
+    assert (force.measure.name, force.measure.unit, force.measure.coordinate, force.objective) == ("force_amplitude", "N", None, "force_amplitude")
+    assert force.constraint is not None and (force.constraint.name, force.constraint.coordinate) == ("x1_amplitude", 0)
+    absorber = parse_scene(scene_with(objective="x2_amplitude", constraints={"operating": {"frequency": 33.0, "force_amplitude": 2.0}})).settings
+    assert (absorber.measure.coordinate, absorber.measure.unit) == (1, "m")
+    assert absorber.constraint is not None and (absorber.constraint.name, absorber.constraint.unit) == ("force_amplitude", "N")
+    assert absorber.operating == (33.0, 2.0)  # exact: the scene's own numbers
+
+
+def test_the_base_force_of_a_base_motion_is_refused() -> None:
+    document = scene_with(objective="force_amplitude")
+    document["excitation"] = {"amplitude": 1e-3, "base_motion": True}
+    with pytest.raises(SceneError) as caught:
+        parse_scene(document)
+    assert any(line.startswith("design.objective:") and "base-motion" in line for line in caught.value.problems), caught.value.problems
+
+
 @pytest.mark.parametrize(
     ("design", "key", "words"),
     [
@@ -53,7 +73,7 @@ def test_a_design_scene_reads_its_section() -> None:
         ({"variables": {"clearance": [0.004, 0.002]}}, "design.variables.clearance", "below"),
         ({"variables": {"restitution": [0.0, 1.5]}}, "design.variables.restitution[1]", "allowed"),
         ({"band": {"start": 45.0, "stop": 15.0}}, "design.band.stop", "greater"),
-        ({"objective": "x3_amplitude"}, "design.objective", "x1_amplitude"),
+        ({"objective": "x3_amplitude"}, "design.objective", "x1_amplitude, x2_amplitude, force_amplitude"),
         ({"robust": {"k1": 0.05}}, "design.robust.samples", "required"),
         ({"robust": {"k1": 0.9, "samples": 4}}, "design.robust.k1", "allowed"),
         ({"compare": "den_hartog"}, "design.compare", "linear_optimum"),

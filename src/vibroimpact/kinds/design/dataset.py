@@ -20,6 +20,7 @@ from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.orbits.bumper_screen import bumper_curves, bumper_screen_refusal
 from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.analysis.measures import Measure, as_measure
 from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.kinds.design.evaluate import ATTRACTOR_POINTS, MAX_BRANCH_POINTS, SCREEN_MOTIONS, SCREENS, SWEEP_ACCURACIES, screen_kind
 from vibroimpact.simulation.certified_worst import SOURCES
@@ -39,15 +40,17 @@ DESIGNS = ("recommended", "scene", "linear_optimum")
 RIDGE = 0.02
 
 
-def response_curves(problem: ImpactProblem, frequency: NDArray[np.float64], coordinate: int) -> dict[str, NDArray[np.float64]]:
-    """|X| [m] of the contact-free motion (everywhere), whether it fits; and of each root's period-1 impact orbit
+def response_curves(problem: ImpactProblem, frequency: NDArray[np.float64], measure: Measure | int) -> dict[str, NDArray[np.float64]]:
+    """The ``measure`` (a coordinate index: its |X| [m]) of the contact-free motion (everywhere), whether it fits; and of each root's period-1 impact orbit
     where it exists, with its state (-1 none or not admissible, 0 unstable, 1 stable; bumpers: the orbit grown from
     the rigid twin's root, :func:`~vibroimpact.orbits.bumper_screen.bumper_curves`; none on a layout without a closed
     form)."""
-    linear = linear_amplitudes(problem, omega=2.0 * np.pi * frequency)
-    out = {"linear": np.abs(linear.amplitudes[..., coordinate]), "linear_fits": linear.fits(problem.clearances()).astype(np.int8)}
+    omega = 2.0 * np.pi * frequency
+    measure = as_measure(measure, problem)
+    linear = linear_amplitudes(problem, omega=omega)
+    out = {"linear": measure.of_harmonics(problem, omega, linear.amplitudes), "linear_fits": linear.fits(problem.clearances()).astype(np.int8)}
     bumpers = bool(problem.stops) and bumper_screen_refusal(problem) is None
-    grown = bumper_curves(problem, frequency, coordinate) if bumpers else {}  # bumper orbits grown from the rigid twin's
+    grown = bumper_curves(problem, frequency, measure) if bumpers else {}  # bumper orbits grown from the rigid twin's
     for root, name in (("+", "impact_plus"), ("-", "impact_minus")):
         x, state = np.full(frequency.shape, np.nan), np.full(frequency.shape, -1, dtype=np.int8)
         if bumpers:
@@ -57,7 +60,7 @@ def response_curves(problem: ImpactProblem, frequency: NDArray[np.float64], coor
             ok = np.flatnonzero(np.asarray(orbit.admissible(), dtype=bool).reshape(-1))
             if ok.size:
                 taken = orbit.take(ok)
-                x[ok] = np.abs(taken.harmonics()[..., coordinate]).reshape(-1)
+                x[ok] = measure.of_orbit(taken).reshape(-1)
                 modulus = np.max(np.abs(floquet_multipliers(taken)), axis=-1)
                 state[ok] = np.where(modulus < 1.0 - MARGINAL_MODULUS, 1, 0)
         out[name], out[f"{name}_stable"] = x, state
@@ -87,18 +90,20 @@ def design_dataset(scene: Any, outcome: Outcome) -> xr.Dataset:
     """Assemble the dataset (module docstring)."""
     settings: DesignSettings = outcome.settings
     ev, space = outcome.evaluations, outcome.space
+    unit, _, generic = measure_words(settings.measure)
+    limit_unit, limit_symbol, _ = measure_words(settings.constraint)
     E, S = len(ev.scores), space.samples
     designs = np.array(ev.designs)
     data: dict[str, xr.Variable] = {}
     for k, v in enumerate(settings.variables):
         data[f"variable_{safe_name(v.name)}"] = xr.Variable("evaluation", designs[:, k], {"units": v.unit, "long_name": f"design variable {v.name}", "valid_min": v.low, "valid_max": v.high})
     values = np.array([ev.values(r) for r in ev.results])
-    data["objective"] = xr.Variable("evaluation", [ev.objective(r) for r in ev.results], {"units": "m", "long_name": f"{settings.objective}: the {_quantile(settings.quantile)} over the samples of the largest stable |X| over the band (closed-form screen)"})
-    data["score"] = xr.Variable("evaluation", ev.scores, {"units": "m", "long_name": "the objective raised by the operating constraint's penalty (what the search minimised)"})
-    data["operating_amplitude"] = xr.Variable("evaluation", [ev.operating(r) for r in ev.results], {"units": "m", "long_name": "worst coexisting |X| at the operating frequency, same quantile"})
+    data["objective"] = xr.Variable("evaluation", [ev.objective(r) for r in ev.results], {"units": unit, "long_name": f"{settings.objective}: the {_quantile(settings.quantile)} over the samples of the largest stable {generic} over the band (closed-form screen)"})
+    data["score"] = xr.Variable("evaluation", ev.scores, {"units": unit, "long_name": "the objective raised by the operating constraint's penalty (what the search minimised)"})
+    data["operating_amplitude"] = xr.Variable("evaluation", [ev.operating(r) for r in ev.results], {"units": limit_unit, "long_name": f"worst coexisting {'|X|' if limit_symbol == '|X1|' else limit_symbol} at the operating frequency, same quantile"})
     data["feasible"] = _flag([ev.feasible(r) for r in ev.results], ("violates", "holds"), "the operating constraint", ("evaluation",))
     data["evaluation_stage"] = _flag(ev.stages, STAGES, "why the candidate was evaluated", ("evaluation",))
-    data["sample_value"] = xr.Variable(("evaluation", "sample"), values, {"units": "m", "long_name": "largest stable |X| over the band under each sample (or the guess where uncovered)"})
+    data["sample_value"] = xr.Variable(("evaluation", "sample"), values, {"units": unit, "long_name": f"largest stable {generic} over the band under each sample (or the guess where uncovered)"})
     data["sample_frequency"] = xr.Variable(("evaluation", "sample"), np.array([r["frequency"] for r in ev.results]), {"units": "Hz", "long_name": "where the sample's worst case is"})
     data["sample_motion"] = _flag(np.array([r["motion"] for r in ev.results]), SCREEN_MOTIONS, "the motion that sets the sample's worst case", ("evaluation", "sample"))
     data["sample_uncovered"] = xr.Variable(("evaluation", "sample"), np.array([r["uncovered"] for r in ev.results]), {"units": "1", "long_name": "share of the band where no closed-form motion is stable"})
@@ -139,6 +144,14 @@ def design_dataset(scene: Any, outcome: Outcome) -> xr.Dataset:
     return dataset
 
 
+def measure_words(measure: Measure | None) -> tuple[str, str, str]:
+    """(unit, symbol, the generic symbol of a band's worst case) of a measure for the dataset's attributes: (m, |X1|,
+    |X|) of a displacement, (N, |F|, |F|) of the base force; None: the primary's |X1| (the notch)."""
+    if measure is None:
+        return "m", "|X1|", "|X|"
+    return measure.unit, measure.symbol, "|X|" if measure.coordinate is not None else measure.symbol
+
+
 def _quantile(q: float) -> str:
     return "worst" if q >= 1.0 else f"{q:g} quantile"
 
@@ -146,16 +159,17 @@ def _quantile(q: float) -> str:
 def _certificates(data: dict[str, xr.Variable], outcome: Outcome) -> None:
     rows = outcome.certified
     dims = ("certificate",)
+    unit, symbol, _ = measure_words(outcome.settings.measure)
 
     def column(key: str) -> NDArray[np.float64]:
         return np.array([float(r[key]) for r in rows], dtype=float)
 
     data["certificate_evaluation"] = xr.Variable(dims, np.array([r["evaluation"] for r in rows], dtype=np.int32), {"units": "1", "long_name": "the certified candidate (index of evaluation)"})
     data["certificate_sample"] = xr.Variable(dims, np.array([r["sample"] for r in rows], dtype=np.int32), {"units": "1", "long_name": "the certified mistuning sample"})
-    for key, units, name in (("worst", "m", "certified largest stable |X1| over the band: the larger of continuation and brute force, located exactly where continued"),
-                             ("frequency", "Hz", "where the certified worst case is"), ("screened", "m", "the closed-form screen's value of the same problem"),
-                             ("continuation_worst", "m", "largest stable |X1| of the branches continued from the closed-form orbits"),
-                             ("continuation_time", "s", "wall time of the continuation"), ("brute_worst", "m", "largest |X1| of any attractor the brute force found (a grid sample)"),
+    for key, units, name in (("worst", unit, f"certified largest stable {symbol} over the band: the larger of continuation and brute force, located exactly where continued"),
+                             ("frequency", "Hz", "where the certified worst case is"), ("screened", unit, "the closed-form screen's value of the same problem"),
+                             ("continuation_worst", unit, f"largest stable {symbol} of the branches continued from the closed-form orbits"),
+                             ("continuation_time", "s", "wall time of the continuation"), ("brute_worst", unit, f"largest {symbol} of any attractor the brute force found (a grid sample)"),
                              ("brute_frequency", "Hz", "where the brute force found it"), ("brute_time", "s", "wall time of the brute force (and of continuing from its orbit)"),
                              ("screen_time", "s", "wall time of the closed-form screen of the same problem (the search's objective)")):  # fmt: skip
         data[f"certificate_{key}"] = xr.Variable(dims, column(key), {"units": units, "long_name": name})
@@ -169,12 +183,12 @@ def _certificates(data: dict[str, xr.Variable], outcome: Outcome) -> None:
                                                    {"units": "1", "long_name": "frequencies a stepped sweep needs to reach the certified maximum to the accuracy (from the curvature of its branch there)"})  # fmt: skip
     data["certificate_sweep_time"] = xr.Variable(("certificate", "accuracy"), np.array([r["sweep_time"] for r in rows], dtype=float).reshape(len(rows), len(SWEEP_ACCURACIES)),
                                                  {"units": "s", "long_name": "what that stepped sweep (one direction) costs at the brute force's measured wall time per point and run"})  # fmt: skip
-    for key, units, name in (("frequency", "Hz", "frequency of a continued orbit"), ("amplitude", "m", "|X1| of a continued orbit"), ("stable", "1", "1 where the continued orbit is stable"),
+    for key, units, name in (("frequency", "Hz", "frequency of a continued orbit"), ("amplitude", unit, f"{symbol} of a continued orbit"), ("stable", "1", "1 where the continued orbit is stable"),
                              ("impacts", "1", "impacts per period of a continued orbit"), ("index", "1", "which branch of its certificate"),
                              ("cut", "1", "1 where the continued orbit's branch stopped at the continuation's step limit (followed no further)")):  # fmt: skip
         block = np.array([r[f"branch_{key}"] for r in rows], dtype=float).reshape(len(rows), MAX_BRANCH_POINTS)
         data[f"branch_{key}"] = xr.Variable(("certificate", "point"), block, {"units": units, "long_name": name})
-    for key, units, name in (("frequency", "Hz", "frequency of the brute force"), ("amplitude", "m", "largest |X1| of the attractors the brute force found there (every run)")):
+    for key, units, name in (("frequency", "Hz", "frequency of the brute force"), ("amplitude", unit, f"largest {symbol} of the attractors the brute force found there (every run)")):
         block = np.array([r[f"attractor_{key}"] for r in rows], dtype=float).reshape(len(rows), ATTRACTOR_POINTS)
         data[f"attractor_{key}"] = xr.Variable(("certificate", "attractor_point"), block, {"units": units, "long_name": name})
 
@@ -182,6 +196,8 @@ def _certificates(data: dict[str, xr.Variable], outcome: Outcome) -> None:
 def _designs(data: dict[str, xr.Variable], scene: Any, outcome: Outcome) -> dict[str, object]:
     """The compared designs' variables, objectives and responses; the answer's attributes."""
     settings, ev, space = outcome.settings, outcome.evaluations, outcome.space
+    unit, _, generic = measure_words(settings.measure)
+    limit_unit, limit_symbol, _ = measure_words(settings.constraint)
     frequency = np.linspace(settings.band[0], settings.band[1], RESPONSE_POINTS)
     problems: list[ImpactProblem | None] = [space.problem_at(ev.designs[outcome.recommended]) if outcome.recommended >= 0 else None, space.problem]
     linear_problem = None
@@ -196,26 +212,26 @@ def _designs(data: dict[str, xr.Variable], scene: Any, outcome: Outcome) -> dict
     for d, problem in enumerate(problems):
         if problem is None:
             continue
-        for k, v in response_curves(problem, frequency, settings.coordinate).items():
+        for k, v in response_curves(problem, frequency, settings.measure).items():
             curves[k][d] = v
     rows = ("design", "frequency")
     data["design_name"] = xr.Variable("design", np.array(DESIGNS, dtype=str), {"long_name": "the compared design"})
     data["response_frequency"] = xr.Variable("frequency", frequency, {"units": "Hz", "long_name": "excitation frequency of the compared designs' responses"})
-    data["response_linear"] = xr.Variable(rows, curves["linear"], {"units": "m", "long_name": "|X| of the contact-free motion (where it fits: response_linear_fits)"})
+    data["response_linear"] = xr.Variable(rows, curves["linear"], {"units": unit, "long_name": f"{generic} of the contact-free motion (where it fits: response_linear_fits)"})
     for name in ("linear_fits", "impact_plus_stable", "impact_minus_stable"):
         meanings = ("hits_a_stop", "clears_the_stops") if name == "linear_fits" else ("unstable", "stable")
         data[f"response_{name}"] = xr.Variable(rows, np.nan_to_num(curves[name], nan=-1).astype(np.int8), {"long_name": name.replace("_", " "), "_FillValue": np.int8(-1),
                                                                                                            "flag_values": np.array([0, 1], dtype=np.int8), "flag_meanings": " ".join(meanings)})  # fmt: skip
     for name in ("impact_plus", "impact_minus"):
-        data[f"response_{name}"] = xr.Variable(rows, curves[name], {"units": "m", "long_name": f"|X| of the admissible period-1 impact orbit, root {name[-5:]} of the impulse equation"})
+        data[f"response_{name}"] = xr.Variable(rows, curves[name], {"units": unit, "long_name": f"{generic} of the admissible period-1 impact orbit, root {name[-5:]} of the impulse equation"})
     values = np.full((len(DESIGNS), space.samples), np.nan)
     if outcome.recommended >= 0:
         values[0] = ev.values(ev.results[outcome.recommended])
     values[1] = ev.values(ev.results[0])
     values[2] = outcome.linear_values
     operating = [ev.operating(ev.results[outcome.recommended]) if outcome.recommended >= 0 else math.nan, ev.operating(ev.results[0]), outcome.linear_operating]
-    data["design_operating_amplitude"] = xr.Variable("design", np.array(operating, dtype=float), {"units": "m", "long_name": "worst coexisting |X1| at the operating frequency over the samples (NaN: no constraint)"})
-    data["design_sample_value"] = xr.Variable(("design", "sample"), values, {"units": "m", "long_name": "largest stable |X| over the band of each compared design under each sample"})
+    data["design_operating_amplitude"] = xr.Variable("design", np.array(operating, dtype=float), {"units": limit_unit, "long_name": f"worst coexisting {limit_symbol} at the operating frequency over the samples (NaN: no constraint)"})
+    data["design_sample_value"] = xr.Variable(("design", "sample"), values, {"units": unit, "long_name": f"largest stable {generic} over the band of each compared design under each sample"})
     for k, v in enumerate(settings.variables):
         column = [ev.designs[outcome.recommended][k] if outcome.recommended >= 0 else math.nan, ev.designs[0][k], math.nan]
         if outcome.linear is not None and v.name in ("k2", "b2"):

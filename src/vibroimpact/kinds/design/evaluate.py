@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.analysis.band_worst import MOTIONS, BandWorst, closed_form_at, closed_form_worst
 from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.analysis.measures import Measure, as_measure
 from vibroimpact.simulation.band_attractors import band_attractors
 from vibroimpact.model.contact import MIN_BUMPER_RESTITUTION, KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
@@ -51,13 +52,13 @@ def screen_kind(problem: ImpactProblem) -> str:
     return SCREENS[1] if bumper_screen_refusal(problem) is None else SCREENS[2]
 
 
-def screen_worst(problem: ImpactProblem, band: tuple[float, float], coordinate: int, scan: int, kind: str | None = None) -> BandWorst:
+def screen_worst(problem: ImpactProblem, band: tuple[float, float], measure: Measure | int, scan: int, kind: str | None = None) -> BandWorst:
     """The screen's worst case of ``problem`` over ``band`` [Hz]: the closed forms' (``scan`` frequencies) or the
     bumper orbits' (:data:`~vibroimpact.orbits.bumper_screen.BUMPER_SCAN` frequencies, each a shot orbit); ``kind``:
     its :func:`screen_kind` where the caller has it."""
     if (kind if kind is not None else screen_kind(problem)) == SCREENS[0]:
-        return closed_form_worst(problem, band, coordinate, scan)
-    return bumper_worst(problem, band, coordinate)
+        return closed_form_worst(problem, band, measure, scan)
+    return bumper_worst(problem, band, measure)
 
 
 @dataclass(frozen=True, eq=False)
@@ -78,10 +79,15 @@ class DesignSpace:
         One row per sample, sample 0 the nominal design (all zeros).
     band : (float, float)
         [Hz].
-    coordinate : int
-        Of the objective.
+    objective : Measure
+        What the objective judges (a row of :mod:`vibroimpact.analysis.measures`; a coordinate index is read as its
+        |X|).
     operating : float
         Frequency of the operating constraint [Hz]; NaN: none.
+    scan : int
+        Frequencies of the closed-form screen's scan.
+    constraint : Measure
+        What the operating constraint judges there (a coordinate index is read as its |X|; default x1's).
     """
 
     problem: ImpactProblem
@@ -90,11 +96,14 @@ class DesignSpace:
     relative: tuple[bool, ...]
     offsets: tuple[tuple[float, ...], ...]
     band: tuple[float, float]
-    coordinate: int = 0
+    objective: Measure | int = 0
     operating: float = math.nan
     scan: int = 241
+    constraint: Measure | int = 0
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "objective", as_measure(self.objective, self.problem))
+        object.__setattr__(self, "constraint", as_measure(self.constraint, self.problem))
         if len(self.relative) != len(self.mistuned) or any(len(row) != len(self.mistuned) for row in self.offsets) or not self.offsets:
             raise ValueError("offsets: one row per sample (the nominal first), one column per mistuned scalar")
 
@@ -136,7 +145,8 @@ class DesignSpace:
     def key_content(self) -> dict:
         """What determines every result in this space (for case keys)."""
         return {"problem": repr(self.problem), "variables": self.variables, "mistuned": self.mistuned, "relative": self.relative,
-                "offsets": self.offsets, "band": self.band, "coordinate": self.coordinate, "operating": self.operating, "scan": self.scan}  # fmt: skip
+                "offsets": self.offsets, "band": self.band, "objective": self.objective.name, "operating": self.operating, "scan": self.scan,
+                "constraint": self.constraint.name}  # fmt: skip
 
 
 #: Cases one candidate's samples are split into (at most).
@@ -188,14 +198,14 @@ class DesignCase:
                 problem = self.space.problem_at(self.design, s)
                 kind = screen_kind(problem)
                 if kind != SCREENS[2]:
-                    found = screen_worst(problem, self.space.band, self.space.coordinate, self.space.scan, kind)
+                    found = screen_worst(problem, self.space.band, self.space.objective, self.space.scan, kind)
                     values = (found.amplitude, found.frequency, found.uncovered, found.estimate, SCREEN_MOTIONS.index(found.motion))
                     out["impulse"][row] = found.impulse
                 else:  # no closed form (a free mass, stops that are not one or a symmetric pair): brute force screens
-                    top = band_attractors(problem, self.space.band, *BRUTE_SCREEN, measure=self.space.coordinate).maximum
+                    top = band_attractors(problem, self.space.band, *BRUTE_SCREEN, measure=self.space.objective).maximum
                     values = (top.amplitude, top.frequency, 0.0, 0.0, SCREEN_MOTIONS.index(BRUTE))
                 if math.isfinite(self.space.operating):
-                    out["operating"][row], operating_motion[row] = _operating(problem, self.space.operating, self.space.coordinate, kind)
+                    out["operating"][row], operating_motion[row] = _operating(problem, self.space.operating, self.space.constraint, kind)
             except ValueError as error:  # a structure the model refuses (a mass driven non-positive ...)
                 errors[row] = f"{type(error).__name__}: {str(error)[:160]}"
                 continue
@@ -205,16 +215,16 @@ class DesignCase:
         return out | {"motion": motion, "operating_motion": operating_motion, "error": np.array(errors, dtype=str)}
 
 
-def _operating(problem: ImpactProblem, frequency: float, coordinate: int, kind: str) -> tuple[float, int]:
-    """The worst coexisting |X| at the operating ``frequency`` [Hz] and its motion (index of :data:`SCREEN_MOTIONS`):
+def _operating(problem: ImpactProblem, frequency: float, measure: Measure, kind: str) -> tuple[float, int]:
+    """The worst coexisting ``measure`` at the operating ``frequency`` [Hz] and its motion (index of :data:`SCREEN_MOTIONS`):
     the screen's (``kind`` of :data:`SCREENS`; where none of its motions is stable there, the guess from the orbits
     that exist), else brute force's."""
     if kind == SCREENS[2]:
-        return band_attractors(problem, _around(frequency), 2, *BRUTE_SCREEN[1:], measure=coordinate).maximum.amplitude, SCREEN_MOTIONS.index(BRUTE)
-    at = closed_form_at(problem, frequency, coordinate) if kind == SCREENS[0] else bumper_at(problem, frequency, coordinate)
+        return band_attractors(problem, _around(frequency), 2, *BRUTE_SCREEN[1:], measure=measure).maximum.amplitude, SCREEN_MOTIONS.index(BRUTE)
+    at = closed_form_at(problem, frequency, measure) if kind == SCREENS[0] else bumper_at(problem, frequency, measure)
     if at.uncovered == 0.0:  # exact: a share of none
         return at.amplitude, SCREEN_MOTIONS.index(at.motion)
-    around = closed_form_worst(problem, _around(frequency), coordinate, 3) if kind == SCREENS[0] else bumper_worst(problem, _around(frequency), coordinate, 3)
+    around = closed_form_worst(problem, _around(frequency), measure, 3) if kind == SCREENS[0] else bumper_worst(problem, _around(frequency), measure, 3)
     return max(around.amplitude, around.estimate), SCREEN_MOTIONS.index(at.motion)  # a stable motion found beside it counts too
 
 
@@ -271,9 +281,9 @@ class CertifyCase:
         try:
             if screen_kind(problem) != SCREENS[2]:  # what the search's objective costs on this problem, timed alone
                 start = time.perf_counter()
-                screen_worst(problem, self.space.band, self.space.coordinate, self.space.scan)
+                screen_worst(problem, self.space.band, self.space.objective, self.space.scan)
                 scalars["screen_time"] = time.perf_counter() - start
-            found = certified_worst(problem, self.space.band, frequencies=ATTRACTOR_POINTS, measure=self.space.coordinate)
+            found = certified_worst(problem, self.space.band, frequencies=ATTRACTOR_POINTS, measure=self.space.objective)
         except (ValueError, RuntimeError) as error:
             return {**{k: np.array(v) for k, v in scalars.items()}, "sweep_points": np.full(len(SWEEP_ACCURACIES), np.nan), "sweep_time": np.full(len(SWEEP_ACCURACIES), np.nan), **points, **attractors,
                     "error": np.array(f"{type(error).__name__}: {str(error)[:200]}")}  # fmt: skip
@@ -289,7 +299,7 @@ class CertifyCase:
             if count <= 0:
                 break
             period = branch.orbits[0].period
-            measured = branch_measures(system if period == 1 else ImpactMap(problem, periods=period), branch).amplitude(self.space.coordinate)
+            measured = self.space.objective.of_shot(branch_measures(system if period == 1 else ImpactMap(problem, periods=period), branch))
             stable = np.asarray(branch.stable, dtype=float)
             points["branch_frequency"][k : k + count] = branch.values[:count]
             points["branch_amplitude"][k : k + count] = measured[:count]

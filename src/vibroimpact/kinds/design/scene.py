@@ -15,7 +15,7 @@ design). Example (``studies/design_vs_linear.yaml``, shortened)::
     design:
       variables: {clearance: [0.5e-3, 8e-3], restitution: [0.0, 0.9], k2: [1000.0, 8000.0], b2: [0.0, 20.0]}
       band: {start: 15.0, stop: 45.0}                   # [Hz]
-      objective: x1_amplitude                           # |X| of a coordinate: <name>_amplitude
+      objective: x1_amplitude                           # |X| of a coordinate (<name>_amplitude) or force_amplitude
       constraints: {operating: {frequency: 33.0, x1_amplitude: 0.05e-3}}   # the notch must survive
       robust: {k1: 0.05, samples: 32, seed: 1}          # +-5 % of k1, a seeded Latin hypercube
       compare: linear_optimum                           # the H-infinity optimum linear absorber of the same mass
@@ -40,6 +40,7 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
+from vibroimpact.analysis.measures import Measure, measure, measure_names
 from vibroimpact.model.layout import PAPER_STOP, Layout
 from vibroimpact.model.parameters import BUMPER_STIFFNESS, LAYOUT_FORMS, MAX_RELATIVE_SPREAD, PARAMETERS, Parameter, parameter
 from vibroimpact.model.structure import require_in_range
@@ -150,13 +151,14 @@ class DesignSettings:
         What is chosen, and within which bounds.
     band : (float, float)
         [Hz].
-    coordinate : int
-        The coordinate whose |X| is the objective (0: x1).
+    measure : Measure
+        What the objective judges: a row of the measure table (:mod:`vibroimpact.analysis.measures`), |X| of a
+        coordinate or the force to the base.
     objective : str
-        Its name, ``<coordinate>_amplitude``.
+        Its name, ``<coordinate>_amplitude`` or ``force_amplitude``.
     operating : (float, float) or None
-        (frequency [Hz], largest allowed |X| there [m]): the absorber's notch must survive, on the same worst-case
-        basis as the objective; None: no constraint.
+        (frequency [Hz], largest allowed value of ``constraint`` there [its unit]): the absorber's notch must survive,
+        on the same worst-case basis as the objective; None: no constraint.
     mistuning : tuple of Mistuning
         The robustness spreads (empty: the nominal design alone).
     samples : int
@@ -176,11 +178,13 @@ class DesignSettings:
     bumper_frequency : float or None
         Omega_b / 2 pi [Hz] of the stops' Kelvin-Voigt bumpers (their loss factor the exact inverse of R); None: rigid
         stops.
+    constraint : Measure or None
+        What the operating constraint judges (None: |X1|, the primary's notch).
     """
 
     variables: tuple[Variable, ...]
     band: tuple[float, float]
-    coordinate: int
+    measure: Measure
     objective: str
     operating: tuple[float, float] | None
     mistuning: tuple[Mistuning, ...]
@@ -193,6 +197,7 @@ class DesignSettings:
     clearance: float
     restitution: float
     bumper_frequency: float | None = None
+    constraint: Measure | None = None
 
     def __post_init__(self) -> None:
         if not self.variables:
@@ -221,8 +226,9 @@ def parse_design_scene(document: dict, text: str = "", source: str = "scene") ->
     spec = c.mapping("design", doc.get("design"), _DESIGN_KEYS, {"variables", "band"}) if "design" in doc else {}
     variables = _variables(c, spec.get("variables"), layout, bumper) if "variables" in spec else ()
     band = _band(c, spec["band"]) if "band" in spec else None
-    coordinate, objective = _objective(c, spec.get("objective", "x1_amplitude"), coordinates)
-    operating = _operating(c, spec.get("constraints", {}), coordinates, band)
+    objective_measure = _objective(c, spec.get("objective", "x1_amplitude"), coordinates)
+    operating, constraint = _operating(c, spec.get("constraints", {}), coordinates, band)
+    _check_measures(c, layout, (("design.objective", objective_measure), ("design.constraints.operating", constraint)))
     mistuning, samples, seed, quantile = _robust(c, spec.get("robust", {}), layout, bumper)
     compare = spec.get("compare", "none")
     if compare not in COMPARISONS:
@@ -239,7 +245,8 @@ def parse_design_scene(document: dict, text: str = "", source: str = "scene") ->
         raise SceneError(c.problems, source)
     assert layout is not None and amplitude is not None and isinstance(name, str) and band is not None and search is not None
     assert clearance is not None and restitution is not None and samples is not None and seed is not None and quantile is not None and certified is not None
-    settings = DesignSettings(variables, band, coordinate, objective, operating, mistuning, samples, seed, quantile, str(compare), search, certified, clearance, restitution, bumper)
+    settings = DesignSettings(variables, band, objective_measure, objective_measure.name, operating, mistuning, samples, seed, quantile, str(compare), search, certified, clearance,
+                              restitution, bumper, constraint)  # fmt: skip
     return Scene(name=name, description=description, layout=layout, amplitude=amplitude, kind="design", settings=settings, report=report, text=text)
 
 
@@ -361,32 +368,45 @@ def _band(c: Checker, value: Any) -> tuple[float, float] | None:
     return low, high
 
 
-def _objective(c: Checker, value: Any, coordinates: tuple[str, ...] | None) -> tuple[int, str]:
+def _objective(c: Checker, value: Any, coordinates: tuple[str, ...] | None) -> Measure:
     names = coordinates or ("x1", "x2")
-    allowed = [f"{n}_amplitude" for n in names]
+    allowed = measure_names(names)
     if value not in allowed:
-        c.fail("design.objective", f"{value!r} is not allowed: use one of {', '.join(allowed)} (|X| of a coordinate, the worst stable motion over the band)")
-        return 0, allowed[0]
-    return allowed.index(value), str(value)
+        c.fail("design.objective", f"{value!r} is not allowed: use one of {', '.join(allowed)} (|X| of a coordinate or the force to the base, the worst stable motion's over the band)")
+        return measure(allowed[0], names)
+    return measure(str(value), names)
 
 
-def _operating(c: Checker, value: Any, coordinates: tuple[str, ...] | None, band: tuple[float, float] | None) -> tuple[float, float] | None:
+def _operating(c: Checker, value: Any, coordinates: tuple[str, ...] | None, band: tuple[float, float] | None) -> tuple[tuple[float, float] | None, Measure | None]:
+    """(frequency [Hz], largest allowed value [its unit]) of the operating constraint and the measure it limits (any
+    row of the measure table: |X1| keeps the primary's notch)."""
     constraints = c.mapping("design.constraints", value, {"operating"})
     if "operating" not in constraints:
-        return None
+        return None, None
     names = coordinates or ("x1", "x2")
-    keys = {"frequency", *(f"{n}_amplitude" for n in names)}
+    keys = {"frequency", *measure_names(names)}
     spec = c.mapping("design.constraints.operating", constraints["operating"], keys, {"frequency"})
-    amplitude_keys = [k for k in spec if k != "frequency"]
-    if len(amplitude_keys) != 1:
-        c.fail("design.constraints.operating", f"give the frequency [Hz] and one largest amplitude [m] ({', '.join(sorted(keys - {'frequency'}))})")
-        return None
+    limit_keys = [k for k in spec if k != "frequency"]
+    if len(limit_keys) != 1:
+        c.fail("design.constraints.operating", f"give the frequency [Hz] and one largest amplitude [m] or force [N] ({', '.join(sorted(keys - {'frequency'}))})")
+        return None, None
     frequency = c.number("design.constraints.operating.frequency", spec.get("frequency"), 0.0, math.inf, low_inclusive=False) if "frequency" in spec else None
-    limit = c.number(f"design.constraints.operating.{amplitude_keys[0]}", spec[amplitude_keys[0]], 0.0, math.inf, low_inclusive=False)
-    if amplitude_keys[0] != "x1_amplitude" and coordinates is not None and amplitude_keys[0] != f"{coordinates[0]}_amplitude":
-        c.fail(f"design.constraints.operating.{amplitude_keys[0]}", "the operating limit is on the objective's coordinate x1 (the primary): give x1_amplitude")
-        return None
-    return (frequency, limit) if frequency is not None and limit is not None else None
+    limit = c.number(f"design.constraints.operating.{limit_keys[0]}", spec[limit_keys[0]], 0.0, math.inf, low_inclusive=False)
+    limited = measure(limit_keys[0], names)
+    return ((frequency, limit) if frequency is not None and limit is not None else None), limited
+
+
+def _check_measures(c: Checker, layout: Layout | None, rows: tuple[tuple[str, Measure | None], ...]) -> None:
+    """Each measure can be read on the layout's problem (the force to the base is refused under a base motion)."""
+    if layout is None:
+        return
+    from vibroimpact.model.problem import ImpactProblem  # model layer: reading a scene loads no solver
+
+    problem = layout.problem(1.0, 1.0, 0.5, 1.0)
+    for key, row in rows:
+        reason = row.refusal(problem) if row is not None and isinstance(problem, ImpactProblem) else None
+        if reason is not None:
+            c.fail(key, reason)
 
 
 def _robust(c: Checker, value: Any, layout: Layout | None, bumper: float | None = None) -> tuple[tuple[Mistuning, ...], int | None, int | None, float | None]:

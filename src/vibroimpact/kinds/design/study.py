@@ -71,7 +71,8 @@ def design_space(scene: Any) -> DesignSpace:
     offsets = mistuning_offsets(settings)
     operating = settings.operating[0] if settings.operating is not None else math.nan
     return DesignSpace(problem, settings.names, tuple(m.name for m in settings.mistuning), tuple(m.relative for m in settings.mistuning),
-                       tuple(tuple(float(v) for v in row) for row in offsets), settings.band, settings.coordinate, operating)  # fmt: skip
+                       tuple(tuple(float(v) for v in row) for row in offsets), settings.band, settings.measure, operating,
+                       constraint=settings.constraint if settings.constraint is not None else 0)  # fmt: skip
 
 
 def run_design(scene: Any, progress: Progress | None = None, runner: Runner | None = None) -> xr.Dataset:
