@@ -138,6 +138,11 @@ def design_dataset(scene: Any, outcome: Outcome) -> xr.Dataset:
                           "variables": ", ".join(v.name for v in settings.variables), "operating_frequency_Hz": settings.operating[0] if settings.operating else math.nan,
                           "operating_limit_m": settings.operating[1] if settings.operating else math.nan, "recommended_evaluation": outcome.recommended,
                           "excitation_amplitude_N": scene.amplitude, "screen": screen_kind(outcome.space.problem)})  # fmt: skip
+    limited = settings.constraint
+    if limited is not None and limited.name != "x1_amplitude":  # the notch of the primary is the default: no attribute
+        dataset.attrs["operating_measure"] = limited.name
+        if limited.unit != "m":  # the limit's attribute names its unit
+            dataset.attrs[f"operating_limit_{limited.unit}"] = dataset.attrs.pop("operating_limit_m")
     errors = sorted({str(e) for r in ev.results for e in np.asarray(r["error"]).reshape(-1) if str(e)})
     if errors:
         dataset.attrs["run_failures"] = [f"{sum(1 for r in ev.results for e in np.asarray(r['error']).reshape(-1) if str(e))} samples of candidates have no value (scored infinite): {errors[0]}"]
