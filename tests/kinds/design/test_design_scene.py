@@ -45,6 +45,25 @@ def test_a_design_scene_reads_its_section() -> None:
     assert settings.compare == "linear_optimum" and settings.search.method == "differential_evolution"
 
 
+def test_any_row_of_the_parameter_table_is_a_design_variable() -> None:
+    """A layout scalar the grammar names needs no code of the design kind: its unit and range are the parameter
+    table's. A coupling entry of the stiffness matrix is negative (-k2 here), so its bounds may be; the design space
+    sets it on the problem as the continuation's map does."""
+    from vibroimpact.kinds.design.study import design_space
+    from vibroimpact.model.parameters import layout_parameter
+
+    scene = parse_scene(scene_with(variables={"stiffness[x1,x2]": [-5000.0, -3000.0], "mass[x2]": [0.05, 0.2]}, robust={}, compare="none"))
+    settings: DesignSettings = scene.settings
+    assert [(v.name, v.unit, v.low) for v in settings.variables] == [("stiffness[x1,x2]", "N m-1", -5000.0), ("mass[x2]", "kg", 0.05)]
+    space = design_space(scene)
+    problem = space.problem_at((-4000.0, 0.12))
+    assert layout_parameter("stiffness[x1,x2]", problem).value(problem, (0,)) == pytest.approx(-4000.0, rel=1e-15)
+    assert problem.structure.mass_matrix[1, 1] == pytest.approx(0.12, rel=1e-15)
+    with pytest.raises(SceneError) as caught:  # a mass keeps its positive range
+        parse_scene(scene_with(variables={"mass[x2]": [-0.1, 0.2]}))
+    assert any(line.startswith("design.variables.mass[x2][0]:") and "(0, inf)" in line for line in caught.value.problems), caught.value.problems
+
+
 def test_the_objective_and_the_constraint_are_rows_of_the_measure_table() -> None:
     """The objective may be |X| of any coordinate or the force to the base, and the operating constraint limits its
     own measure (|X1| by default, the primary's notch), whatever the objective."""

@@ -31,17 +31,14 @@ import xarray as xr
 
 from vibroimpact.kinds.stepped.crosscheck import subset_solutions
 from vibroimpact.kinds.stepped.tables import computed_part
+from vibroimpact.measures.figures_of_merit import NEAREST, WORSE_RATIO
 from vibroimpact.reporting.record import GeneralSetting, general_setting, study_kind
 from vibroimpact.reporting.style import DISPLACEMENT_SCALE, fmt
 
 __all__ = ["warnings_html", "OperatingRow", "OperatingPoint", "operating_point", "operating_text", "warning_lines", "unreached_text", "WORSE_RATIO", "NEAREST", "MM_HINT_CLEARANCE"]
 
-#: A stop makes the operating point worse where its |X1| exceeds the linear absorber's by more than this factor [-].
-WORSE_RATIO = 1.01
 #: A clearance at least this large [m] that no motion reaches was probably typed in mm: the warning asks.
 MM_HINT_CLEARANCE = 0.05
-#: The grid frequency stands for the operating frequency only within this share of it [-] (the notch is narrow).
-NEAREST = 0.01
 #: At most this many rows are listed one by one; more are summarised (range and count).
 _LISTED = 6
 
