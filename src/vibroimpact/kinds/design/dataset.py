@@ -248,7 +248,7 @@ def _designs(data: dict[str, xr.Variable], scene: Any, outcome: Outcome) -> dict
     if outcome.linear is not None:
         attrs.update({"linear_optimum_tuning": outcome.linear.tuning, "linear_optimum_damping_ratio": outcome.linear.damping_ratio,
                       "linear_optimum_k2_N_per_m": outcome.linear.system.k2, "linear_optimum_b2_N_s_per_m": outcome.linear.system.b2,
-                      "linear_optimum_worst_m": outcome.linear.worst})  # fmt: skip
+                      f"linear_optimum_worst_{settings.measure.unit}": outcome.linear.worst})  # fmt: skip
     if outcome.recommended >= 0:
         attrs["recommended_certified_score_m"] = outcome.corrected.get(outcome.recommended, math.nan)
     paper = TwoDofSystem.of(space.problem.structure)

@@ -235,6 +235,9 @@ def parse_design_scene(document: dict, text: str = "", source: str = "scene") ->
         c.fail("design.compare", f"{compare!r} is not allowed: use one of {', '.join(COMPARISONS)}")
     elif compare == "linear_optimum" and layout is not None and layout.paper_view() is None:
         c.fail("design.compare", "linear_optimum is the optimum absorber of the paper's two masses (system: {m1 ... b2}); this structure is not one: use none")
+    elif compare == "linear_optimum" and objective_measure.coordinate not in (None, 0):
+        c.fail("design.compare", f"linear_optimum minimises the objective's {objective_measure.name} over linear absorbers of the same mass, and it has no minimum: "
+                                 "the absorber's own motion falls without end as its spring and dashpot are loosened (a detached absorber moves least): use none")
     search = _search(c, spec.get("search", {}))
     certified = _certify(c, spec.get("certify", {}))
     if search is not None and variables and samples is not None:

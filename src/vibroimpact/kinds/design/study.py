@@ -28,7 +28,7 @@ import xarray as xr
 from numpy.typing import NDArray
 from scipy.stats import qmc
 
-from vibroimpact.analysis.linear_optimum import band_peak, optimal_linear_absorber
+from vibroimpact.analysis.linear_optimum import band_peak, linear_measure, optimal_linear_absorber
 from vibroimpact.kinds.design.dataset import design_dataset
 from vibroimpact.kinds.design.evaluate import CHUNKS, CertifyCase, DesignSpace
 from vibroimpact.kinds.design.outcome import Outcome
@@ -127,12 +127,12 @@ def _linear(outcome: Outcome, amplitude: float) -> None:
     primaries = [TwoDofSystem.of(space.problem_at(outcome.scene_design, s).structure) for s in range(space.samples)]
     if any(p is None for p in primaries):
         return
-    outcome.linear = optimal_linear_absorber(primaries[0], amplitude, space.band, mistuned=tuple(primaries[1:]))  # type: ignore[arg-type]
+    outcome.linear = optimal_linear_absorber(primaries[0], amplitude, space.band, mistuned=tuple(primaries[1:]), measure=space.objective)  # type: ignore[arg-type]
     k2, b2 = outcome.linear.system.k2, outcome.linear.system.b2
     systems = [TwoDofSystem(p.m1, p.m2, p.k1, k2, p.b1, b2) for p in primaries]  # type: ignore[union-attr]
-    outcome.linear_values = np.array([band_peak(system, amplitude, space.band).amplitude for system in systems])
-    if math.isfinite(space.operating):  # the linear absorber's |X1| at the operating frequency, worst over the samples
-        outcome.linear_operating = max(abs(amplitude) * float(np.abs(system.receptances(2.0 * math.pi * space.operating).h11)) for system in systems)
+    outcome.linear_values = np.array([band_peak(system, amplitude, space.band, measure=space.objective).amplitude for system in systems])
+    if math.isfinite(space.operating):  # the linear absorber's value of the constraint's measure there, worst over the samples
+        outcome.linear_operating = max(float(linear_measure(system, amplitude, 2.0 * math.pi * space.operating, space.constraint)) for system in systems)
 
 
 #: Candidates nearer than this share of each variable's range (in every variable) to one already certified are not
