@@ -13,6 +13,7 @@ import xarray as xr
 import yaml
 from numpy.typing import NDArray
 
+from vibroimpact.kinds.design.quantity import constraint_quantity, objective_quantity, operating_limit
 from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.orbits.continuation_settings import ContinuationSettings
 from vibroimpact.reporting.style import fmt
@@ -23,10 +24,6 @@ _SYMBOLS = {"clearance": "Delta", "restitution": "R", "bumper_stiffness": "K_b"}
 #: How the page names the compared designs (the dataset's ``design`` dimension, in order).
 DESIGN_TITLES = ("recommended design", "the scene's design", "best linear absorber")
 _UNITS = {"1": "", "N m-1": "N/m", "N s m-1": "N s/m"}
-
-
-def _mm(value: float) -> str:
-    return f"{fmt(1e3 * value, '.4g')} mm" if math.isfinite(value) else "not known"
 
 
 def unit_text(unit: str) -> str:
@@ -142,7 +139,7 @@ def design_evaluation(dataset: xr.Dataset, design: int) -> int:
 
 
 def certified_worst(dataset: xr.Dataset, design: int) -> tuple[float, int]:
-    """The largest certified worst case [m] of a compared design over its certificates, and that certificate's
+    """The largest certified worst case [the objective's unit: m or N] of a compared design over its certificates, and that certificate's
     index; (NaN, -1) where none has a value."""
     evaluation = design_evaluation(dataset, design)
     rows = np.flatnonzero(dataset["certificate_evaluation"].values == evaluation) if evaluation >= 0 else np.zeros(0, dtype=int)
@@ -155,7 +152,7 @@ def certified_worst(dataset: xr.Dataset, design: int) -> tuple[float, int]:
 
 
 def design_worst(dataset: xr.Dataset, design: int) -> float:
-    """A compared design's worst case [m]: the largest of its samples' screened values and its certificates' (NaN
+    """A compared design's worst case [the objective's unit]: the largest of its samples' screened values and its certificates' (NaN
     when it has none)."""
     row = dataset["design_sample_value"].values[design]
     screened = float(np.nanmax(row)) if np.any(np.isfinite(row)) else math.nan
@@ -198,25 +195,26 @@ def answer_text(dataset: xr.Dataset) -> str:
     recommended = int(d.attrs.get("recommended_evaluation", -1))
     if recommended < 0:
         return f"No design could be recommended: no candidate had a finite worst case {over}."
-    limit = float(d.attrs.get("operating_limit_m", math.nan))
+    q, c, limit = objective_quantity(d), constraint_quantity(d), operating_limit(d)
     operating = d["design_operating_amplitude"].values
     at = fmt(d.attrs.get("operating_frequency_Hz"), ".4g")
+    of = "" if c.name == q.name else f"{c.symbol} = "  # the constraint's measure named where it is not the objective's
 
     def notch(k: int) -> str:
         if not math.isfinite(limit) or not math.isfinite(float(operating[k])):
             return ""
         if operating[k] > limit:
-            return f", {_mm(float(operating[k]))} at {at} Hz, above the allowed {_mm(limit)}"
-        return f", {_mm(float(operating[k]))} at {at} Hz" + (f", where {_mm(limit)} is allowed" if k == 0 else "")
+            return f", {of}{c.text(float(operating[k]))} at {at} Hz, above the allowed {c.text(limit)}"
+        return f", {of}{c.text(float(operating[k]))} at {at} Hz" + (f", where {c.text(limit)} is allowed" if k == 0 else "")
 
     scene = variable_text(d, 1)
-    scene_part = f"the scene's design{', ' + scene if scene else ''}: {_mm(design_worst(d, 1))}{notch(1)}"
+    scene_part = f"the scene's design{', ' + scene if scene else ''}: {q.text(design_worst(d, 1))}{notch(1)}"
     if linear_wins(d):  # no design with a stop found beats the linear absorber: say so first
-        return (f"Build no stop: the best linear absorber of the same mass ({design_text(d, 2)}) has the smallest worst case, |X1| = {_mm(worst[2])} {over}{notch(2)} "
-                f"(the best design with a stop found, {variable_text(d, 0)}: {_mm(design_worst(d, 0))}{notch(0)}; {scene_part}).")  # fmt: skip
-    others = [f"best linear absorber of the same mass: {_mm(worst[2])}{notch(2)}"] if np.any(np.isfinite(values[2])) else []
+        return (f"Build no stop: the best linear absorber of the same mass ({design_text(d, 2)}) has the smallest worst case, {q.symbol} = {q.text(worst[2])} {over}{notch(2)} "
+                f"(the best design with a stop found, {variable_text(d, 0)}: {q.text(design_worst(d, 0))}{notch(0)}; {scene_part}).")  # fmt: skip
+    others = [f"best linear absorber of the same mass: {q.text(worst[2])}{notch(2)}"] if np.any(np.isfinite(values[2])) else []
     others.append(scene_part)
-    return f"Build {variable_text(d, 0)}: worst case |X1| = {_mm(design_worst(d, 0))} {over}{notch(0)} ({'; '.join(others)})."
+    return f"Build {variable_text(d, 0)}: worst case {q.symbol} = {q.text(design_worst(d, 0))} {over}{notch(0)} ({'; '.join(others)})."
 
 
 def screen_words(dataset: xr.Dataset) -> str:
@@ -239,7 +237,7 @@ def linear_wins(dataset: xr.Dataset) -> bool:
     row = d["design_sample_value"].values[2]
     if int(d.attrs.get("recommended_evaluation", -1)) < 0 or not np.any(np.isfinite(row)):
         return False
-    limit = float(d.attrs.get("operating_limit_m", math.nan))
+    limit = operating_limit(d)
     notch = float(d["design_operating_amplitude"].values[2])
     keeps = not math.isfinite(limit) or (math.isfinite(notch) and notch <= limit)
     return keeps and float(np.nanmax(row)) < design_worst(d, 0)
@@ -251,17 +249,17 @@ def warnings(dataset: xr.Dataset) -> list[str]:
     out: list[str] = []
     recommended = int(d.attrs.get("recommended_evaluation", -1))
     values = d["design_sample_value"].values
-    limit = float(d.attrs.get("operating_limit_m", math.nan))
+    q, c, limit = objective_quantity(d), constraint_quantity(d), operating_limit(d)
     if np.any(np.isfinite(values[2])) and recommended >= 0 and design_worst(d, 0) >= np.nanmax(values[2]):
         linear_notch = float(d["design_operating_amplitude"].values[2])
         keeps = math.isfinite(limit) and math.isfinite(linear_notch) and linear_notch > limit
-        cost = f", but it has no notch: |X1| at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz is {_mm(linear_notch)}, above the allowed {_mm(limit)}" if keeps else ""
-        out.append(f"Over the band the stop does not pay: the best linear absorber of the same mass has the smaller worst case ({_mm(float(np.nanmax(values[2])))} against {_mm(design_worst(d, 0))}){cost}.")
+        cost = f", but it has no notch: {c.symbol} at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz is {c.text(linear_notch)}, above the allowed {c.text(limit)}" if keeps else ""
+        out.append(f"Over the band the stop does not pay: the best linear absorber of the same mass has the smaller worst case ({q.text(float(np.nanmax(values[2])))} against {q.text(design_worst(d, 0))}){cost}.")
     if math.isfinite(limit) and recommended >= 0:
         operating = float(d["operating_amplitude"].values[recommended])
         if not operating <= limit:
             tail = "; the best linear absorber does" if linear_wins(d) else "; the recommendation is the least bad"
-            out.append(f"No design with a stop keeps the notch: at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz |X1| reaches {_mm(operating)} against the allowed {_mm(limit)}{tail}.")
+            out.append(f"No design with a stop keeps the notch: at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz {c.symbol} reaches {c.text(operating)} against the allowed {c.text(limit)}{tail}.")
     if recommended >= 0:
         rows = np.flatnonzero(d["certificate_evaluation"].values == recommended)
         uncovered = float(np.nanmax(d["sample_uncovered"].values[recommended]))
@@ -276,7 +274,7 @@ def warnings(dataset: xr.Dataset) -> list[str]:
         for r in rows:
             worst, screened = float(d["certificate_worst"].values[r]), float(d["certificate_screened"].values[r])
             if math.isfinite(worst) and worst > screened * (1.0 + 1e-6):
-                out.append(f"The certification found a larger stable motion than the screen under sample {int(d['certificate_sample'].values[r])}: {_mm(worst)} ({d['certificate_motion'].values[r]} at {fmt(d['certificate_frequency'].values[r], '.4g')} Hz) against {_mm(screened)}.")
+                out.append(f"The certification found a larger stable motion than the screen under sample {int(d['certificate_sample'].values[r])}: {q.text(worst)} ({d['certificate_motion'].values[r]} at {fmt(d['certificate_frequency'].values[r], '.4g')} Hz) against {q.text(screened)}.")
             cut = _cut_branches(d, int(r))
             if cut:
                 out.append(cut)
@@ -309,7 +307,8 @@ def _cut_branches(d: xr.Dataset, row: int) -> str:
     frequency, amplitude, stable = (d[name].values[row][cut] for name in ("branch_frequency", "branch_amplitude", "branch_stable"))
     count = np.unique(d["branch_index"].values[row][cut]).size
     steady = amplitude[stable == 1.0]  # exact: a 0/1 flag
-    stable_text = f", stable up to {_mm(float(np.max(steady)))}" if steady.size else ", none of it stable"
+    q = objective_quantity(d)  # the branches' amplitude is the objective's measure
+    stable_text = f", stable up to {q.text(float(np.max(steady)))}" if steady.size else ", none of it stable"
     return (f"The certification of sample {int(d['certificate_sample'].values[row])} followed {count} branch{'es' if count > 1 else ''} only as far as the continuation's "
-            f"step limit ({ContinuationSettings().max_steps} steps): between {fmt(float(np.min(frequency)), '.4g')} and {fmt(float(np.max(frequency)), '.4g')} Hz, |X1| up to "
-            f"{_mm(float(np.max(amplitude)))} on {'them' if count > 1 else 'it'}{stable_text}; past that point {'they are' if count > 1 else 'it is'} not known, and only the brute force looked there.")
+            f"step limit ({ContinuationSettings().max_steps} steps): between {fmt(float(np.min(frequency)), '.4g')} and {fmt(float(np.max(frequency)), '.4g')} Hz, {q.symbol} up to "
+            f"{q.text(float(np.max(amplitude)))} on {'them' if count > 1 else 'it'}{stable_text}; past that point {'they are' if count > 1 else 'it is'} not known, and only the brute force looked there.")

@@ -1,9 +1,12 @@
-"""What a design page says of the absorber's operating point before it recommends a stop: |X1| of the recommended
+"""What a design page says of the absorber's operating point before it recommends a stop: a measure of the recommended
 design there with its stop against the same absorber without it, and whether the absorber's free motion there fits
 in the recommended clearance (a warning first where the stop makes it worse, or it does not fit).
 
+The measure (:mod:`vibroimpact.kinds.design.quantity`) is the operating constraint's where the frequency is declared
+(|X1| by default: the primary's notch), else the objective's (the responses' measure); |X1| on the paper's scenes.
+
 The operating point is the scene's declared operating frequency (``design.constraints.operating.frequency``), else the
-recommended absorber's anti-resonance sqrt(k2/m2) / 2 pi. With the stop: the worst coexisting |X1| there over the
+recommended absorber's anti-resonance sqrt(k2/m2) / 2 pi. With the stop: the worst coexisting measure there over the
 samples where the frequency is declared (the search's own value), else the worst stable motion of the recommended
 design's responses at the nearest frequency of their grid (within 1 %). Without: the linear closed form of the same
 absorber (its k2 and b2, the scene's or the design's), nominal. Read from the dataset and its stored scene (its
@@ -20,12 +23,14 @@ import numpy as np
 import xarray as xr
 import yaml
 
+from vibroimpact.analysis.linear import base_force
+from vibroimpact.kinds.design.quantity import Quantity, constraint_quantity, objective_quantity, quantity
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.reporting.style import fmt
 
 __all__ = ["DesignOperating", "design_operating", "operating_sentence", "operating_warnings", "WORSE_RATIO", "NEAREST"]
 
-#: The stop makes the operating point worse where |X1| exceeds the linear absorber's by more than this factor [-] (as
+#: The stop makes the operating point worse where the measure exceeds the linear absorber's by more than this factor [-] (as
 #: on the stepped pages, :data:`vibroimpact.kinds.stepped.operating.WORSE_RATIO`; kinds do not import each other).
 WORSE_RATIO = 1.01
 #: A response grid's frequency stands for the operating frequency only within this share of it [-].
@@ -43,13 +48,15 @@ class DesignOperating:
     declared : bool
         The scene declared it (else: the recommended absorber's anti-resonance).
     stopped : float
-        |X1| with the stop there [m] (NaN: not computed there).
+        The measure with the stop there [m or N] (NaN: not computed there).
     linear : float
-        |X1| of the same absorber without the stop there [m].
+        The measure of the same absorber without the stop there [m or N].
     free : float
         |X2| of the same absorber without the stop there [m], its free motion.
     clearance : float
         The recommended clearance [m] (NaN: no stop).
+    measure : Quantity
+        What ``stopped`` and ``linear`` measure (default |X1|).
     """
 
     frequency: float
@@ -58,6 +65,7 @@ class DesignOperating:
     linear: float
     free: float
     clearance: float
+    measure: Quantity = quantity("x1_amplitude")
 
     def __post_init__(self) -> None:
         if not self.frequency > 0.0:
@@ -88,7 +96,8 @@ def _system(dataset: xr.Dataset) -> TwoDofSystem | None:
 
 
 def _responses(dataset: xr.Dataset, frequency: float) -> float:
-    """The recommended design's worst stable |X1| at the response grid's frequency nearest ``frequency`` [m] (NaN
+    """The recommended design's worst stable motion (the objective's measure) at the response grid's frequency
+    nearest ``frequency`` [m or N] (NaN
     where none lies within :data:`NEAREST` of it, or no motion is stable there)."""
     f = np.asarray(dataset["response_frequency"].values, dtype=float) if "response_frequency" in dataset else np.zeros(0)
     if not f.size:
@@ -113,13 +122,21 @@ def design_operating(dataset: xr.Dataset) -> DesignOperating | None:
     declared = math.isfinite(float(d.attrs.get("operating_frequency_Hz", math.nan)))
     frequency = float(d.attrs["operating_frequency_Hz"]) if declared else system.antiresonance_frequency()
     stopped = float(d["design_operating_amplitude"].values[0]) if declared else _responses(d, frequency)
+    measure = constraint_quantity(d) if declared else objective_quantity(d)
     amplitude = float(d.attrs.get("excitation_amplitude_N", math.nan))
-    h = system.receptances(np.array([2.0 * math.pi * frequency]))
+    omega = 2.0 * math.pi * frequency
+    h = system.receptances(np.array([omega]))
+    x = np.array([amplitude * h.h11[0], amplitude * h.h12[0]])  # the linear absorber's fundamentals [m]
+    if measure.displacement:
+        linear = float(abs(x[system.coordinates.index(measure.name.removesuffix("_amplitude"))]))
+    else:  # the force to the base, by the one base-force formula (no stop: no contact force)
+        linear = float(abs(base_force(system.structure, omega, x)))
     clearance = float(d["design_clearance"].values[0]) if "design_clearance" in d else math.nan
-    return DesignOperating(frequency, declared, stopped, float(abs(amplitude * h.h11[0])), float(abs(amplitude * h.h12[0])), clearance)
+    return DesignOperating(frequency, declared, stopped, linear, float(abs(x[1])), clearance, measure)
 
 
 def _mm(value: float) -> str:
+    """The absorber's free motion and its clearance (displacements, whatever the measures): ``2.32 mm``."""
     return f"{fmt(1e3 * value, '.4g')} mm" if math.isfinite(value) else "not known"
 
 
@@ -128,14 +145,14 @@ def _where(point: DesignOperating) -> str:
 
 
 def operating_warnings(point: DesignOperating | None) -> list[str]:
-    """The page's first lines where the recommended stop makes |X1| at the operating point worse than the same
+    """The page's first lines where the recommended stop makes the measure at the operating point worse than the same
     absorber without it, or the absorber's free motion there does not fit in the recommended clearance."""
     if point is None:
         return []
-    lines = []
+    lines, q = [], point.measure
     if point.ratio > WORSE_RATIO:
-        lines.append(f"The recommended stop makes the absorber worse at its operating point ({_where(point)}): |X1| is {_mm(point.linear)} without the stop against "
-                     f"{_mm(point.stopped)} with it, ×{fmt(point.ratio, '.3g')}.")  # fmt: skip
+        lines.append(f"The recommended stop makes the absorber worse at its operating point ({_where(point)}): {q.symbol} is {q.text(point.linear)} without the stop against "
+                     f"{q.text(point.stopped)} with it, ×{fmt(point.ratio, '.3g')}.")  # fmt: skip
     if point.free > point.clearance:
         lines.append(f"The absorber's free motion at its operating point does not fit in the recommended gap: without the stop, at {fmt(point.frequency, '.5g')} Hz, "
                      f"|X2| = {_mm(point.free)} against a clearance of {_mm(point.clearance)}: the stop is struck at the frequency the absorber works at.")  # fmt: skip
@@ -143,12 +160,13 @@ def operating_warnings(point: DesignOperating | None) -> list[str]:
 
 
 def operating_sentence(point: DesignOperating | None) -> str:
-    """|X1| of the recommended design at the operating point with its stop and without, in one HTML paragraph."""
+    """The measure of the recommended design at the operating point with its stop and without, in one HTML paragraph."""
     if point is None:
         return ""
+    q = point.measure
     if not math.isfinite(point.stopped):
-        return (f"<p>At the absorber's operating point ({html.escape(_where(point))}) |X1| of the same absorber without the stop is {_mm(point.linear)}; "
+        return (f"<p>At the absorber's operating point ({html.escape(_where(point))}) {q.symbol} of the same absorber without the stop is {q.text(point.linear)}; "
                 "with the stop it was not computed there (the band's responses do not reach it).</p>")  # fmt: skip
     worst = " (the worst coexisting motion over the samples)" if point.declared else " (its worst stable motion on the responses' grid)"
-    return (f"<p>At the absorber's operating point ({html.escape(_where(point))}) the recommended design's |X1| is {_mm(point.stopped)} with its stop{worst} against "
-            f"{_mm(point.linear)} for the same absorber without the stop: ×{fmt(point.ratio, '.3g')}.</p>")  # fmt: skip
+    return (f"<p>At the absorber's operating point ({html.escape(_where(point))}) the recommended design's {q.symbol} is {q.text(point.stopped)} with its stop{worst} against "
+            f"{q.text(point.linear)} for the same absorber without the stop: ×{fmt(point.ratio, '.3g')}.</p>")  # fmt: skip

@@ -16,6 +16,7 @@ import xarray as xr
 from vibroimpact.kinds.design.answer import answer_text, design_titles, linear_wins, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, screen_words, stage_counts, unit_text, variable_names, warnings
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, design_figures
 from vibroimpact.kinds.design.operating import design_operating, operating_sentence, operating_warnings
+from vibroimpact.kinds.design.quantity import constraint_quantity, objective_quantity, operating_limit
 from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.kinds.design.tradeoff import front_text, tradeoff_figure
 from vibroimpact.reporting.page import Section, Table, saved
@@ -35,10 +36,6 @@ def best_marks(values: list[float]) -> list[bool]:
     return [math.isfinite(v) and v <= least + 1e-9 * abs(least) for v in values]
 
 
-def _mm(value: float) -> str:
-    return fmt(1e3 * value, ".4g") or "n/a"
-
-
 def _variable_cell(d: xr.Dataset, name: str, k: int) -> str:
     value = float(d[f"design_{safe_name(name)}"].values[k])
     if not math.isfinite(value):
@@ -48,14 +45,15 @@ def _variable_cell(d: xr.Dataset, name: str, k: int) -> str:
 
 def designs_table(dataset: xr.Dataset) -> str:
     """The compared designs (rows) with their variables, worst case over the samples, nominal worst case, certified
-    worst case and the motion that sets it, and |X1| at the operating frequency; the least of each result column
+    worst case and the motion that sets it (the objective's measure), and the constraint's measure at the operating
+    frequency; the least of each result column
     marked ★ bold."""
     d = dataset
     rows = present_designs(d) or [1]
     names = variable_names(d)
     values = d["design_sample_value"].values
-    constrained = math.isfinite(float(d.attrs.get("operating_limit_m", math.nan)))
-    limit = float(d.attrs.get("operating_limit_m", math.nan))
+    q, c, limit = objective_quantity(d), constraint_quantity(d), operating_limit(d)
+    constrained = math.isfinite(limit)
     columns: dict[str, list[float]] = {
         "over": [float(np.nanmax(values[k])) if np.any(np.isfinite(values[k])) else math.nan for k in rows],
         "nominal": [float(values[k, 0]) for k in rows],
@@ -65,33 +63,34 @@ def designs_table(dataset: xr.Dataset) -> str:
         columns["operating"] = [float(d["design_operating_amplitude"].values[k]) for k in rows]
     marks = {key: best_marks(column) for key, column in columns.items()}
     heads = [f"<th {_WRAP}>{html.escape(n)}{' [mm]' if n == 'clearance' else ('' if not unit_text(str(d[f'variable_{safe_name(n)}'].attrs.get('units', '1'))) else ' [' + unit_text(str(d[f'variable_{safe_name(n)}'].attrs.get('units'))) + ']')}</th>" for n in names]
-    heads += [f"<th {_WRAP}>worst case over the {d.sizes['sample']} samples [mm]</th>", f"<th {_WRAP}>nominal worst case [mm]</th>", f"<th {_WRAP}>certified worst case [mm] and the motion that sets it</th>"]
+    worst = "worst case" if q.name == "x1_amplitude" else f"worst case {q.symbol}"  # the paper's |X1| as the note says it
+    heads += [f"<th {_WRAP}>{worst} over the {d.sizes['sample']} samples [{q.unit}]</th>", f"<th {_WRAP}>nominal {worst} [{q.unit}]</th>", f"<th {_WRAP}>certified {worst} [{q.unit}] and the motion that sets it</th>"]
     if constrained:
-        heads.append(f"<th {_WRAP}>|X1| at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz [mm] (allowed {_mm(limit)})</th>")
+        heads.append(f"<th {_WRAP}>{c.symbol} at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz [{c.unit}] (allowed {c.number(limit)})</th>")
     lines = [f"<table><tr><th>design</th>{''.join(heads)}</tr>"]
     for j, k in enumerate(rows):
         evaluation = design_evaluation(d, k)
         swatch = f"<span style='color:{DESIGN_COLOURS[k]}'>■</span> "
         extra = f"<br><small>{html.escape(design_text(d, k))}</small>" if k == 2 else ""
         cells = [f"<td {_WRAP}>{swatch}{html.escape(design_titles(d)[k])}{extra}</td>"] + [f"<td>{_variable_cell(d, n, k)}</td>" for n in names]
-        over = _mm(columns["over"][j])
+        over = q.number(columns["over"][j])
         if evaluation >= 0 and np.any(np.isfinite(values[k])):
             s = int(np.nanargmax(values[k]))
             over += f"<br><small>sample {s}, {fmt(d['sample_frequency'].values[evaluation, s], '.4g')} Hz</small>"
-        worst, row = certified_worst(d, k)
+        value, row = certified_worst(d, k)
         if row >= 0:
-            certified = f"{_mm(worst)}<br><small>{html.escape(str(d['certificate_motion'].values[row]))}, sample {int(d['certificate_sample'].values[row])}, {fmt(d['certificate_frequency'].values[row], '.4g')} Hz</small>"
+            certified = f"{q.number(value)}<br><small>{html.escape(str(d['certificate_motion'].values[row]))}, sample {int(d['certificate_sample'].values[row])}, {fmt(d['certificate_frequency'].values[row], '.4g')} Hz</small>"
         else:
             certified = "exact (no stop: the band peak in closed form)" if k == 2 else "not certified"
-        texts = {"over": over, "nominal": _mm(columns["nominal"][j]), "certified": certified}
+        texts = {"over": over, "nominal": q.number(columns["nominal"][j]), "certified": certified}
         if constrained:
             operating = columns["operating"][j]
-            texts["operating"] = _mm(operating) + (" <small>(above the limit)</small>" if operating > limit else "")
+            texts["operating"] = c.number(operating) + (" <small>(above the limit)</small>" if operating > limit else "")
         for key, text in texts.items():
             cells.append(f"<td {_WRAP if key == 'certified' else ''}>{'<b>★ ' + text + '</b>' if marks[key][j] else text}</td>")
         lines.append(f"<tr>{''.join(cells)}</tr>")
     lines.append("</table>")
-    note = ("<p><small>★ bold: the least value of the column. Worst case: the largest stable |X1| over the band; over the samples: the largest "
+    note = (f"<p><small>★ bold: the least value of the column. Worst case: the largest stable {q.symbol} over the band; over the samples: the largest "
             "under any mistuning sample (sample 0 is the nominal design); certified: the largest found by continuing every branch from the "
             f"{'bumper orbits shot from the rigid twin' + chr(39) + 's closed forms' if screen_words(d) == 'bumper' else 'closed-form orbits'} (nominal sample and the one that sets the objective).</small></p>")  # fmt: skip
     return "".join(lines) + note
@@ -110,10 +109,12 @@ def certificates_table(dataset: xr.Dataset) -> str:
     d = dataset
     if d.sizes["certificate"] == 0:
         return ""
-    lines = [f"<table><tr><th>design</th><th>sample</th><th {_WRAP}>screened worst case [mm]</th><th {_WRAP}>certified worst case [mm]</th><th>at [Hz]</th><th>motion</th><th>wall time [s]</th><th>error</th></tr>"]
+    q = objective_quantity(d)
+    worst = "worst case" if q.name == "x1_amplitude" else f"worst case {q.symbol}"
+    lines = [f"<table><tr><th>design</th><th>sample</th><th {_WRAP}>screened {worst} [{q.unit}]</th><th {_WRAP}>certified {worst} [{q.unit}]</th><th>at [Hz]</th><th>motion</th><th>wall time [s]</th><th>error</th></tr>"]
     for r in range(d.sizes["certificate"]):
         who = _who(d, int(d["certificate_evaluation"].values[r]))
-        lines.append(f"<tr><td>{who}</td><td>{int(d['certificate_sample'].values[r])}</td><td>{_mm(d['certificate_screened'].values[r])}</td><td>{_mm(d['certificate_worst'].values[r])}</td>"
+        lines.append(f"<tr><td>{who}</td><td>{int(d['certificate_sample'].values[r])}</td><td>{q.number(d['certificate_screened'].values[r])}</td><td>{q.number(d['certificate_worst'].values[r])}</td>"
                      f"<td>{fmt(d['certificate_frequency'].values[r], '.5g')}</td><td {_WRAP}>{html.escape(str(d['certificate_motion'].values[r]))}</td>"
                      f"<td>{fmt(d['certificate_wall_time'].values[r], '.3g')}</td><td {_WRAP}>{html.escape(str(d['certificate_error'].values[r])) or 'none'}</td></tr>")  # fmt: skip
     return "".join(lines) + "</table>"
@@ -140,22 +141,22 @@ def method_text(dataset: xr.Dataset) -> str:
                 if spreads and samples > 1 else "the nominal design only (no mistuning)")  # fmt: skip
     quantile = float(d.attrs.get("quantile", 1.0))
     over = "the worst of them" if quantile >= 1.0 else f"their {fmt(quantile, '.3g')} quantile"
+    q, c, limit = objective_quantity(d), constraint_quantity(d), operating_limit(d)
     if d.attrs.get("screen") == "bumper_orbits":
-        screen = ("<p><b>The screen (bumper orbits).</b> Each candidate's worst case is, under each mistuning sample, the largest |X1| over "
+        screen = (f"<p><b>The screen (bumper orbits).</b> Each candidate's worst case is, under each mistuning sample, the largest {q.symbol} over "
                   f"{fmt(d.attrs['band_low_Hz'], '.4g')}-{fmt(d.attrs['band_high_Hz'], '.4g')} Hz of every stable motion it knows: the contact-free motion "
                   "(closed form) where it clears the stop, and the period-1 bumper orbit of each root of the rigid twin's closed form (the same stop, rigid), "
                   "shot on the bumper's exact map at each scan frequency from the orbit at the previous one, stability from its Floquet multipliers, "
                   "maxima refined in frequency; where no such motion is stable, a guess at the motion's size from the orbits that exist.")  # fmt: skip
     else:
-        screen = ("<p><b>The screen (closed forms).</b> Each candidate's worst case is, under each mistuning sample, the largest |X1| over "
+        screen = (f"<p><b>The screen (closed forms).</b> Each candidate's worst case is, under each mistuning sample, the largest {q.symbol} over "
                   f"{fmt(d.attrs['band_low_Hz'], '.4g')}-{fmt(d.attrs['band_high_Hz'], '.4g')} Hz of every stable closed-form motion: the contact-free motion where "
                   "it clears the stop and both roots of the period-1 impact orbit where admissible and stable, maxima refined in frequency; where no such "
                   "motion is stable, a guess at the motion's size from the orbits that exist.")  # fmt: skip
     parts = [f"{screen} The objective is {over} over the samples: {mistuned}.</p>"]
-    limit = float(d.attrs.get("operating_limit_m", math.nan))
     if math.isfinite(limit):
-        parts.append(f"<p><b>The operating constraint.</b> The worst coexisting |X1| at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz must stay at or below "
-                     f"{_mm(limit)} mm; the search minimised the objective raised by 10 times the relative excess of that |X1| over the limit (a penalty, "
+        parts.append(f"<p><b>The operating constraint.</b> The worst coexisting {c.symbol} at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz must stay at or below "
+                     f"{c.text(limit)}; the search minimised the objective raised by 10 times the relative excess of that {c.symbol} over the limit (a penalty, "
                      f"not a hard bound; {int(np.sum(d['feasible'].values == 1))} of {n} candidates keep it).</p>")  # fmt: skip
     jobs = d.attrs.get("run_jobs")
     workers = f" on {int(jobs)} worker{'s' if int(jobs) != 1 else ''}" if isinstance(jobs, (int, np.integer)) else ""
@@ -192,6 +193,7 @@ def cost_text(dataset: xr.Dataset) -> str:
     continuation = float(d["certificate_continuation_time"].values[r])
     screen = float(d["certificate_screen_time"].values[r]) if "certificate_screen_time" in d else math.nan
     worst, screened = float(d["certificate_worst"].values[r]), float(d["certificate_screened"].values[r])
+    q = objective_quantity(d)
     same = math.isfinite(screen) and screen > 0.0 and abs(screened - worst) <= 1e-6 * worst  # the screen found the certified maximum
     cells, ratios, screen_ratios = [], [], []
     for a in range(d.sizes["accuracy"]):
@@ -216,7 +218,7 @@ def cost_text(dataset: xr.Dataset) -> str:
         screen_part = f" The search's own objective, {how}, found the same maximum in {fmt(screen, '.2g')} s: {' and '.join(screen_ratios)}."
     elif math.isfinite(screen):
         screen_part = (f" The search's own objective, the {'bumper' if bumpers else 'closed-form'} screen, took {fmt(screen, '.2g')} s on this problem but did not find its worst case "
-                       f"({fmt(1e3 * screened, '.4g')} mm against the certified {fmt(1e3 * worst, '.4g')} mm): it knows only period-1 motions.")  # fmt: skip
+                       f"({q.text(screened)} against the certified {q.text(worst)}): it knows only period-1 motions.")  # fmt: skip
     else:
         screen_part = ""
     return (f"<p><b>What the exact worst case costs.</b> The continuation located the {design_titles(d)[0]}'s maximum in {fmt(continuation, '.3g')} s (to its "
