@@ -25,16 +25,12 @@ import yaml
 
 from vibroimpact.analysis.linear import base_force
 from vibroimpact.kinds.design.quantity import Quantity, constraint_quantity, objective_quantity, quantity
+from vibroimpact.measures.figures_of_merit import NEAREST, WORSE_RATIO
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.reporting.style import fmt
 
 __all__ = ["DesignOperating", "design_operating", "operating_sentence", "operating_warnings", "WORSE_RATIO", "NEAREST"]
 
-#: The stop makes the operating point worse where the measure exceeds the linear absorber's by more than this factor [-] (as
-#: on the stepped pages, :data:`vibroimpact.kinds.stepped.operating.WORSE_RATIO`; kinds do not import each other).
-WORSE_RATIO = 1.01
-#: A response grid's frequency stands for the operating frequency only within this share of it [-].
-NEAREST = 0.01
 
 
 @dataclass(frozen=True)

@@ -30,6 +30,7 @@ from scipy.stats import qmc
 
 from vibroimpact.analysis.linear_optimum import band_peak, linear_measure, optimal_linear_absorber
 from vibroimpact.kinds.design.dataset import design_dataset
+from vibroimpact.kinds.design.quantity import quantity
 from vibroimpact.kinds.design.evaluate import CHUNKS, CertifyCase, DesignSpace
 from vibroimpact.kinds.design.outcome import Outcome
 from vibroimpact.kinds.design.scene import DesignSettings
@@ -97,7 +98,7 @@ def run_design(scene: Any, progress: Progress | None = None, runner: Runner | No
         if search.polish:
             nelder_mead_polish(evaluations, POLISH_BUDGET, say if progress is not None else None)
     outcome.wall_times["search"] = time.perf_counter() - start
-    say(f"design: {len(evaluations.scores)} candidates evaluated in {outcome.wall_times['search']:.0f} s; best screened worst case {1e3 * evaluations.objective(evaluations.results[evaluations.best()]):.4g} mm")
+    say(f"design: {len(evaluations.scores)} candidates evaluated in {outcome.wall_times['search']:.0f} s; best screened worst case {_amount(settings.objective, evaluations.objective(evaluations.results[evaluations.best()]))}")
     # the linear optimum in this process while the workers certify (a certification round often leaves one idle)
     failed: list[BaseException] = []
 
@@ -219,7 +220,13 @@ def _worst_text(outcome: Outcome, i: int) -> str:
     """``screened 1.712 mm, certified 2.506 mm`` of candidate ``i`` (its largest certified worst case)."""
     screened = outcome.evaluations.objective(outcome.evaluations.results[i])
     certified = _certified_max(outcome, i)
-    return f"screened {1e3 * screened:.4g} mm, certified {1e3 * certified:.4g} mm"
+    return f"screened {_amount(outcome.settings.objective, screened)}, certified {_amount(outcome.settings.objective, certified)}"
+
+
+def _amount(objective: str, value: float) -> str:
+    """``value`` of the measure ``objective`` [SI] in the page's unit for the console (``2.506 mm``, ``73.02 N``)."""
+    shown = quantity(objective)
+    return f"{shown.scale * value:.4g} {shown.unit}"
 
 
 class DesignStudy:
