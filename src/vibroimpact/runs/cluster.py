@@ -191,11 +191,11 @@ def connect(jobs: int, scheduler: str | None) -> Connection:
     ClusterLost
         When the named scheduler cannot be reached within :data:`CONNECT_TIMEOUT`.
     """
+    if scheduler is None:
+        return _start_local_cluster(jobs)
     from distributed import Client
 
     _drop_sync_cancel_race()
-    if scheduler is None:
-        return _start_local_cluster(jobs)
     # a running cluster's comings and goings (a worker lost, a connection closed) are the scheduler's to log; the
     # study's process says what matters to it in one line
     logging.getLogger("distributed").setLevel(logging.WARNING)
@@ -231,9 +231,6 @@ def _start_local_cluster(jobs: int) -> Connection:
     the start (the scheduler; the workers importing dask and numba, 5-16 s under load) records a Ctrl-C, says so at
     once, stops waiting, closes the cluster and raises it.
     """
-    import dask.config
-    from distributed import Client
-
     interrupted: list[int] = []
 
     def record(signum: int, _frame: object) -> None:
@@ -252,9 +249,16 @@ def _start_local_cluster(jobs: int) -> Connection:
         raise Terminated() if interrupted[0] == signal.SIGTERM else KeyboardInterrupt()
 
     main = threading.current_thread() is threading.main_thread()
+    # recorded from here on, before the first import of dask and distributed: an exception raised by a handler inside
+    # those imports (seconds under load) could be swallowed by a library, and a SIGTERM was (the faults tier, once)
     previous = {signum: signal.signal(signum, record) for signum in (signal.SIGINT, signal.SIGTERM)} if main else {}
     cluster = client = None
     try:
+        import dask.config
+        from distributed import Client
+
+        _drop_sync_cancel_race()
+        stop_if_interrupted(None, None)
         with dask.config.set(WORKER_CONFIG):  # the nannies hand it to the worker processes as they are made
             cluster = _cluster_blocking_ctrl_c()
             client = Client(cluster, set_as_default=False)
