@@ -49,6 +49,11 @@ def test_the_table_names_each_coordinate() -> None:
     assert measure_names(("x1", "x2", "x3")) == ("x1_amplitude", "x2_amplitude", "x3_amplitude", "force_amplitude")
     row = measure("x3_amplitude", ("x1", "x2", "x3"))
     assert (row.coordinate, row.unit) == (2, "m")
+    # one symbol rule for datasets and pages: by the coordinate's name, not its position
+    assert (row.symbol, measure("force_amplitude").symbol, measure("top_amplitude", ("base", "top")).symbol) == ("|X3|", "|F|", "|top|")
+    from vibroimpact.kinds.design.quantity import quantity
+
+    assert all(quantity(m.name).symbol == m.symbol for m in (row, measure("force_amplitude"), measure("top_amplitude", ("base", "top"))))
     with pytest.raises(ValueError, match="unknown measure 'x3_amplitude': allowed x1_amplitude, x2_amplitude, force_amplitude"):
         measure("x3_amplitude")
     with pytest.raises(ValueError, match="coordinate"):

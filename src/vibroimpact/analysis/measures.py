@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from vibroimpact.analysis.linear import base_force
 from vibroimpact.model.excitation import HarmonicForce
 
-__all__ = ["Measure", "measure", "measure_names", "as_measure", "AMPLITUDE", "BASE_FORCE"]
+__all__ = ["Measure", "measure", "measure_names", "as_measure", "symbol_of", "AMPLITUDE", "BASE_FORCE"]
 
 #: The form of a displacement-amplitude measure's name.
 AMPLITUDE = re.compile(r"^(?P<coordinate>\w+)_amplitude$")
@@ -65,8 +65,8 @@ class Measure:
 
     @property
     def symbol(self) -> str:
-        """How a page writes it: ``|X1|``, ``|F|``."""
-        return f"|X{self.coordinate + 1}|" if self.coordinate is not None else "|F|"
+        """How datasets and pages write it (:func:`symbol_of`): ``|X1|``, ``|F|``."""
+        return symbol_of(self.name)
 
     def refusal(self, problem: Any) -> str | None:
         """Why this measure cannot be read on ``problem`` (None: it can): a coordinate the structure lacks; the base
@@ -109,6 +109,24 @@ class Measure:
         if self.coordinate is not None:
             return np.abs(orbit.harmonics()[..., self.coordinate])
         return np.abs(orbit.base_force())
+
+
+def symbol_of(name: str) -> str:
+    """How datasets and pages write the measure ``name``: ``|F|`` for the force to the base, ``|X2|`` for
+    ``x2_amplitude``, ``|<name>|`` for a general coordinate's (``|floor1|``).
+
+    Raises
+    ------
+    ValueError
+        A name that is neither ``force_amplitude`` nor ``<coordinate>_amplitude``.
+    """
+    if name == BASE_FORCE:
+        return "|F|"
+    match = AMPLITUDE.match(name)
+    if match is None:
+        raise ValueError(f"unknown measure {name!r}: allowed <coordinate>_amplitude or {BASE_FORCE}")
+    digits = re.fullmatch(r"x(\d+)", match["coordinate"])
+    return f"|X{digits[1]}|" if digits else f"|{match['coordinate']}|"
 
 
 def measure_names(coordinates: Sequence[str]) -> tuple[str, ...]:

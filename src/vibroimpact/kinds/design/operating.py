@@ -23,7 +23,7 @@ import numpy as np
 import xarray as xr
 import yaml
 
-from vibroimpact.analysis.linear import base_force
+from vibroimpact.analysis.linear_optimum import linear_measure
 from vibroimpact.kinds.design.quantity import Quantity, constraint_quantity, objective_quantity, quantity
 from vibroimpact.measures.figures_of_merit import NEAREST, WORSE_RATIO
 from vibroimpact.model.system import TwoDofSystem
@@ -121,14 +121,10 @@ def design_operating(dataset: xr.Dataset) -> DesignOperating | None:
     measure = constraint_quantity(d) if declared else objective_quantity(d)
     amplitude = float(d.attrs.get("excitation_amplitude_N", math.nan))
     omega = 2.0 * math.pi * frequency
-    h = system.receptances(np.array([omega]))
-    x = np.array([amplitude * h.h11[0], amplitude * h.h12[0]])  # the linear absorber's fundamentals [m]
-    if measure.displacement:
-        linear = float(abs(x[system.coordinates.index(measure.name.removesuffix("_amplitude"))]))
-    else:  # the force to the base, by the one base-force formula (no stop: no contact force)
-        linear = float(abs(base_force(system.structure, omega, x)))
+    linear = float(linear_measure(system, amplitude, omega, measure.name))  # the same absorber without its stop
+    free = float(abs(amplitude * system.receptances(np.array([omega])).h12[0]))  # its absorber's motion there [m]
     clearance = float(d["design_clearance"].values[0]) if "design_clearance" in d else math.nan
-    return DesignOperating(frequency, declared, stopped, linear, float(abs(x[1])), clearance, measure)
+    return DesignOperating(frequency, declared, stopped, linear, free, clearance, measure)
 
 
 def _mm(value: float) -> str:

@@ -6,12 +6,11 @@ its display unit (a displacement [m] in mm, a force [N] in N), and the constrain
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 
 import xarray as xr
 
-from vibroimpact.analysis.measures import AMPLITUDE, BASE_FORCE
+from vibroimpact.analysis.measures import BASE_FORCE, symbol_of
 from vibroimpact.reporting.style import fmt
 
 __all__ = ["Quantity", "quantity", "objective_quantity", "constraint_quantity", "operating_limit", "DEFAULT_CONSTRAINT"]
@@ -75,15 +74,12 @@ def quantity(name: str) -> Quantity:
     ValueError
         A name that is neither ``force_amplitude`` nor ``<coordinate>_amplitude``.
     """
+    symbol = symbol_of(name)  # the one rule of datasets and pages; refuses an unknown name
     if name == BASE_FORCE:
-        return Quantity(name, "|F|", "N", 1.0, "fundamental amplitude of the force transmitted to the base")
-    match = AMPLITUDE.match(name)
-    if match is None:
-        raise ValueError(f"unknown measure {name!r}: allowed <coordinate>_amplitude or {BASE_FORCE}")
-    coordinate = match["coordinate"]
-    digits = re.fullmatch(r"x(\d+)", coordinate)
+        return Quantity(name, symbol, "N", 1.0, "fundamental amplitude of the force transmitted to the base")
+    coordinate = name.removesuffix("_amplitude")
     what = "the primary mass" if coordinate == "x1" else f"the displacement {coordinate}"
-    return Quantity(name, f"|X{digits[1]}|" if digits else f"|{coordinate}|", "mm", 1e3, f"fundamental amplitude of {what}")
+    return Quantity(name, symbol, "mm", 1e3, f"fundamental amplitude of {what}")
 
 
 def objective_quantity(dataset: xr.Dataset) -> Quantity:
