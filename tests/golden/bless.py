@@ -6,16 +6,23 @@ the whole suite).
 
 from __future__ import annotations
 
+import os
 import sys
-import tempfile
-from pathlib import Path
 
-from tests.golden.golden import DATA, compute, identical, read_back, scene_names, written
-from vibroimpact.runs.run import write_dataset
+from tests.golden.arithmetic import PINS, pinned
+
+if __name__ == "__main__" and not pinned():  # before numpy is loaded: this process again, in the pinned arithmetic
+    os.execve(sys.executable, [sys.executable, "-m", "tests.golden.bless", *sys.argv[1:]], {**os.environ, **PINS})
+
+import tempfile  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+from tests.golden.golden import DATA, compute, identical, read_back, scene_names, written  # noqa: E402
+from vibroimpact.runs.run import write_dataset  # noqa: E402
 
 
 def bless(name: str) -> None:
-    """Write ``name``'s golden files; a dataset identical to the blessed one, types included, is left as it is (its
+    """Write ``name``'s golden files (in the pinned arithmetic, :mod:`tests.golden.arithmetic`); a dataset identical to the blessed one, types included, is left as it is (its
     file would differ only by the ``history`` stamp)."""
     with tempfile.TemporaryDirectory() as folder:
         dataset, text = compute(name, Path(folder))

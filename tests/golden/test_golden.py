@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 import xarray as xr
 
+from tests.golden.arithmetic import pinned, unpinned_message
 from tests.golden.golden import DATA, SCENES, compute, dtypes, scene_names, stored, written
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -19,6 +20,7 @@ ROOT = Path(__file__).resolve().parents[2]
 @pytest.mark.timeout(900)
 @pytest.mark.parametrize("name", scene_names())
 def test_scene_gives_its_golden_dataset_and_page(name: str, tmp_path: Path) -> None:
+    assert pinned(), unpinned_message()
     dataset, text = compute(name, tmp_path)
     blessed, blessed_text = stored(name)
     now = written(dataset, tmp_path)
@@ -44,3 +46,13 @@ def test_page_text_keeps_headings_captions_and_cells_but_not_the_scene() -> None
 
     text = page_text("<h1>T</h1><p>a  <b>b</b></p><pre>scene: x</pre><figure><figcaption>cap <span>(f.png)</span></figcaption></figure><table><tr><th>h</th><td>1.5</td></tr></table>")
     assert text == "h1: T\np: a b\nfigcaption: cap (f.png)\nth: h\ntd: 1.5\n"
+
+
+def test_ci_runs_the_golden_suite_in_the_pinned_arithmetic() -> None:
+    """``.ci/run`` sets every pin of :data:`tests.golden.arithmetic.PINS` on its golden line (a drifted pin would make
+    CI compare in another arithmetic than the files were blessed in)."""
+    from tests.golden.arithmetic import PINS
+
+    line = next(line for line in (ROOT / ".ci" / "run").read_text().splitlines() if "-m golden" in line and not line.lstrip().startswith("#"))
+    for key, value in PINS.items():
+        assert f'{key}="{value}"' in line or f"{key}={value}" in line, (key, line)
