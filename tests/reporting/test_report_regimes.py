@@ -57,15 +57,6 @@ def test_regime_colours_stay_distinct_for_colour_blind_readers() -> None:
             assert difference > CVD_DISTINCT, f"{deficiency}: {a.name} {colour_a} and {b.name} {colour_b} differ by {difference:.1f}"
 
 
-def test_the_design_map_colours_its_classes_from_the_one_regime_palette() -> None:
-    from vibroimpact.kinds.stepped.design_figures import REGIME_MAP_COLOURS
-    from vibroimpact.kinds.stepped.design_metrics import DesignRegime
-
-    assert set(REGIME_MAP_COLOURS) == set(DesignRegime)
-    assert set(REGIME_MAP_COLOURS.values()) <= set(REGIME_COLOURS.values())
-    assert len(set(REGIME_MAP_COLOURS.values())) == len(REGIME_MAP_COLOURS)
-
-
 def _every_flag() -> xr.Dataset:
     """One solution whose regime runs through every flag along frequency at the first restitution ratio (the second
     is linear throughout, so that every column is drawn, ``not_computed`` included)."""

@@ -163,7 +163,7 @@ MISTAKES = [
     ("duplicate-stop", lambda d: d["stops"][1].update(side="upper"), ["stops[1]:", "same coordinates and side"]),
     ("stop-and-stops", lambda d: d.update(stop={"clearance": 0.003}), ["stop:", "not both"]),
     ("pgf-paper", lambda d: d.update(solutions=["pgf_paper"]), ["solutions:", "pgf_paper", "use pgf"]),
-    ("design-map-relative", lambda d: d.update(report="design_map"), ["report: the design_map page is for stepped studies of the paper's layout"]),
+    ("design-map-moved", lambda d: d.update(report="design_map"), ["report: the design map is the design kind's grid search", "method: grid"]),
     ("pgf-unequal-pair", lambda d: d["stops"][1].update(clearance=0.002), ["solutions: pgf does not apply", "symmetric"]),
     ("swept-base-motion", lambda d: d.update(swept_sine={"start": 20.0, "stop": 26.0, "rate": 0.5}, solutions=["compliant"], bumper={"frequency": 250.0}, excitation={"amplitude": 0.001, "base_motion": True}), ["excitation.base_motion:", "swept base motion is not supported"]),
     ("compliant-no-bumper", lambda d: d.update(solutions=["compliant"]), ["stops[0].bumper.frequency: required unless swept"]),

@@ -163,8 +163,6 @@ def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[st
     for key, value in asdict(scene.settings.admissibility).items():
         attrs[f"admissibility_{key}"] = value
     attrs.update(simulation_attributes)
-    if isinstance(scene.report, str):
-        attrs["report_page"] = scene.report  # the page the scene asks for (reporting.page.page_for)
     if fit is not None:
         attrs["pgf_paper_form_factors_per_kg"] = np.real(fit.form_factor)
         attrs["pgf_paper_loss_factors"] = fit.loss_factor

@@ -8,7 +8,7 @@ the HTML with a table of contents linking every section, figure and table. Each 
 :func:`write_report` writes a dataset's report: PNG figures and a self-contained ``report.html`` (figures embedded as
 base64) into a folder, everything read from the dataset itself (:mod:`vibroimpact.reporting.record`), never from a
 re-validated scene; :func:`page_for` asks the dataset's kind (:data:`vibroimpact.scene.kinds.KINDS`) for its page
-(each kind's ``page.py``: concepts, validation, benchmark, bifurcation, swept; stepped: the design map, the bumper
+(each kind's ``page.py``: concepts, validation, benchmark, bifurcation, swept, design; stepped: the bumper
 stiffness page and one frequency-response page for every other layout, whose sections follow what the dataset holds).
 """
 

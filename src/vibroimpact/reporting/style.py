@@ -21,7 +21,7 @@ from matplotlib.axes import Axes  # noqa: E402
 from matplotlib.colors import to_hex  # noqa: E402
 from matplotlib.figure import Figure as MatplotlibFigure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.ticker import LogLocator  # noqa: E402
+from matplotlib.ticker import FormatStrFormatter, LogFormatter, LogLocator  # noqa: E402
 
 from vibroimpact.analysis.stability import Regime  # noqa: E402
 # every solution's row (colour, title, words), kept without matplotlib for the studies; re-exported for the pages
@@ -36,6 +36,8 @@ from vibroimpact.reporting.solutions import (  # noqa: E402
 )
 
 __all__ = [
+    "PlainLogFormatter",
+    "plain_log",
     "DISPLACEMENT_SCALE",
     "DISPLACEMENT_UNITS",
     "DPI",
@@ -149,7 +151,7 @@ def axis_label(quantity: str) -> str:
 
 
 # ----------------------------------------------------------------------------------------------- regimes
-#: The one regime palette of every page (regime maps, the design map's classes, markers coloured by regime), safe for
+#: The one regime palette of every page (regime maps, markers coloured by regime), safe for
 #: colour-blind readers: no two flags are told apart by red against green alone (every pair stays at least 10 CIELAB
 #: units apart under simulated protanopia, deuteranopia and tritanopia; Okabe-Ito and Paul Tol colours). Pale yellows
 #: and sand for the linear motion, blues for the one-impact orbit (indigo where it is unstable), vermillion and rose
@@ -370,3 +372,18 @@ def finish_axes(ax: Axes, xlabel: str, ylabel: str, title: str, log: bool = Fals
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=MIN_FONT_SIZE + 2)
     ax.grid(True, which="both", alpha=0.3)
+
+
+class PlainLogFormatter(LogFormatter):
+    """matplotlib's choice of which log-axis ticks to label, written as plain numbers: 0.2, 3."""
+
+    def _num_to_string(self, x: float, vmin: float, vmax: float) -> str:
+        return f"{x:g}"
+
+
+def plain_log(ax: Axes, which: str = "y") -> None:
+    """Plain numbers on a log axis (0.5, 1, 2 rather than 5 x 10^-1); a few minor ticks labelled when the axis spans
+    about a decade or less (matplotlib's thinning)."""
+    axis = ax.yaxis if which == "y" else ax.xaxis
+    axis.set_major_formatter(FormatStrFormatter("%g"))
+    axis.set_minor_formatter(PlainLogFormatter(labelOnlyBase=False, minor_thresholds=(1.0, 0.5)))

@@ -49,8 +49,6 @@ __all__ = ["GridSettings", "SweptSineSettings", "TOP_KEYS", "parse_grid_scene"]
 
 #: Top-level keys of a grid scene.
 TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bumper", "sweep", "swept_sine", "solutions", "quantities", "settings", "simulation", "report", "cluster"}
-#: Report pages a grid scene may ask for by name (``report: design_map``) instead of its kind's page.
-REPORT_PAGES = ("design_map",)
 #: Simulation keys that only stepped steady states use.
 _STEADY_ONLY_KEYS = {"frequency", "start", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods", "subset"}
 #: Where an unswept parameter is given instead (``frequency`` is always swept).
@@ -162,7 +160,10 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     all problems."""
     c = Checker()
     doc = c.mapping("", document, TOP_KEYS, {"name", "system", "excitation", "sweep", "solutions"}, kind="swept" if "swept_sine" in document else "stepped")
-    name, description, report = parse_names(c, doc, REPORT_PAGES)
+    if doc.get("report") == "design_map":  # the stepped kind's design-map page is the design kind's grid search now
+        c.fail("report", "the design map is the design kind's grid search: a scene with a 'design' section and 'search: {method: grid, points: N}' (studies/design_map.yaml)")
+        doc = {**doc, "report": True}
+    name, description, report = parse_names(c, doc)
     layout, amplitude, coordinates = parse_layout(c, doc)
 
     sweep = c.mapping("sweep", doc.get("sweep", {}), {*SWEEPABLE, "stop"}, {"frequency"}) if "sweep" in doc else {}
@@ -176,8 +177,6 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
     scheduler = parse_cluster(c, doc)
     specs = layout.stops if layout is not None and "stops" in doc else None
-    if isinstance(report, str) and ("swept_sine" in doc or layout is not None and layout.paper_view() is None):
-        c.fail("report", f"the {report} page is for stepped studies of the paper's layout (a two-mass chain x1, x2 as {{m1 ... b2}}; one upper stop on x2; force on x1), however written")
     targets = None
     if "stop" in sweep:
         if "stops" not in doc:

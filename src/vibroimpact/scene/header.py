@@ -21,8 +21,8 @@ MAX_NAME_LENGTH = 100
 NAME = re.compile(rf"^[A-Za-z0-9][A-Za-z0-9_.-]{{0,{MAX_NAME_LENGTH - 1}}}$")
 
 
-def parse_names(c: Checker, doc: dict, pages: tuple[str, ...] = ()) -> tuple[Any, str, bool | str]:
-    """Name, description and the report switch of any scene (or one of ``pages``, the report pages it may name)."""
+def parse_names(c: Checker, doc: dict) -> tuple[Any, str, bool]:
+    """Name, description and the report switch of any scene."""
     name = doc.get("name")
     if "name" in doc and not (isinstance(name, str) and NAME.match(name)):
         c.fail("name", f"expected a file-name-safe string of at most {MAX_NAME_LENGTH} characters (letters, digits, '_', '-', '.'), got {name!r}")
@@ -30,8 +30,8 @@ def parse_names(c: Checker, doc: dict, pages: tuple[str, ...] = ()) -> tuple[Any
     if not isinstance(description, str):
         c.fail("description", f"expected a string, got {type(description).__name__}")
     report = doc.get("report", True)
-    if not isinstance(report, bool) and report not in pages:
-        c.fail("report", f"expected true or false{' or a page name (' + ', '.join(pages) + ')' if pages else ''}, got {report!r}")
+    if not isinstance(report, bool):
+        c.fail("report", f"expected true or false, got {report!r}")
         report = True
     return name, description, report
 

@@ -100,8 +100,8 @@ class Scene(Generic[SettingsT]):
     settings : object
         The kind's own frozen settings, built by its parser (``GridSettings`` for stepped and swept scenes,
         ``BenchmarkScene``, ``BifurcationSettings``, ``ValidationSettings``, ``ConceptsSettings``).
-    report : bool or str
-        Whether ``run-study`` writes the comparison report; a string names the page (``design_map``).
+    report : bool
+        Whether ``run-study`` writes the comparison report.
     text : str
         The YAML source, stored in the output's attributes.
     cluster_scheduler : str or None
@@ -114,7 +114,7 @@ class Scene(Generic[SettingsT]):
     amplitude: float
     kind: str
     settings: SettingsT
-    report: bool | str = True
+    report: bool = True
     text: str = ""
     cluster_scheduler: str | None = None
 

@@ -126,13 +126,13 @@ def test_the_sections_follow_what_the_dataset_holds(changes: dict[str, Any], ext
     assert any(title.startswith("Frequency responses") for title in titles) is not panels
 
 
-def test_the_paper_layout_as_matrices_may_ask_for_the_design_map_and_pgf_paper() -> None:
-    """What the named form may ask for, the matrix form of the same layout may too (the design map, the paper's
-    route); the same masses with another stop may not (tests/scene/test_scene_layout.py)."""
-    document = matrix_scene() | {"solutions": ["linear", "pgf", "pgf_paper"], "report": "design_map"}
+def test_the_paper_layout_as_matrices_may_ask_for_pgf_paper() -> None:
+    """What the named form may ask for, the matrix form of the same layout may too (the paper's route); the same
+    masses with another stop may not (tests/scene/test_scene_layout.py)."""
+    document = matrix_scene() | {"solutions": ["linear", "pgf", "pgf_paper"]}
     document.pop("simulation")
     document["stops"][0].pop("clearance")
     document["stops"][0].pop("restitution")
     document["sweep"] = {"restitution": [0.2, 0.8], "clearance": [0.002, 0.003], "frequency": [20.0, 25.0]}
     scene = parse_scene(document)
-    assert scene.report == "design_map" and scene.settings.solutions == ("linear", "pgf", "pgf_paper")
+    assert scene.settings.solutions == ("linear", "pgf", "pgf_paper")

@@ -16,12 +16,11 @@ import numpy as np
 import xarray as xr
 from matplotlib.axes import Axes
 from matplotlib.lines import Line2D
-from matplotlib.ticker import FormatStrFormatter, LogFormatter
 
 from vibroimpact.reporting.coincide import Coincidence, Shared, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, render_page, rendering, saved, write_page
 from vibroimpact.reporting.record import stored_description
-from vibroimpact.reporting.style import LINEAR_STYLE, STABLE_STYLE, UNSTABLE_STYLE, Caption, figure_legend, fmt, new_figure, finish_axes, legend_rows
+from vibroimpact.reporting.style import LINEAR_STYLE, STABLE_STYLE, UNSTABLE_STYLE, Caption, figure_legend, fmt, new_figure, finish_axes, legend_rows, plain_log
 
 __all__ = ["page_for", "concept_colour", "response_figure", "overview_figure", "impact_figure", "Column", "COLUMNS", "best_rows", "verdict", "verdicts", "concepts_table", "ConceptsPage", "write_concepts_report", "DEFINITIONS"]
 
@@ -63,20 +62,6 @@ def _isolated(y: np.ndarray) -> np.ndarray:
     return finite & ~before & ~after
 
 
-class PlainLogFormatter(LogFormatter):
-    """matplotlib's log-axis labels (its choice of which minor ticks to label) written as plain numbers: 0.2, 3."""
-
-    def _num_to_string(self, x: float, vmin: float, vmax: float) -> str:
-        return f"{x:g}"
-
-
-def _plain_ticks(ax: Axes) -> None:
-    """Plain numbers on a log axis (0.5, 1, 2 rather than 5 x 10^-1); a few minor ticks labelled when the axis spans
-    about a decade or less (matplotlib's thinning)."""
-    ax.yaxis.set_major_formatter(FormatStrFormatter("%g"))
-    ax.yaxis.set_minor_formatter(PlainLogFormatter(labelOnlyBase=False, minor_thresholds=(1.0, 0.5)))
-
-
 def _split(x: np.ndarray, y: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """x, y with NaN where ``mask`` is False (a broken line)."""
     return x, np.where(mask, y, np.nan)
@@ -113,7 +98,7 @@ def response_figure(dataset: xr.Dataset) -> DrawnFigure:
         _simulated(ax, dataset, i, fs, colour, caption)
         ax.set_xlim(float(f[0]), float(f[-1]))
         finish_axes(ax, FREQUENCY, "|X1| [mm]", str(dataset["label"].values[i]), log=True)
-        _plain_ticks(ax)
+        plain_log(ax)
     caption.add("band", f"The shaded stretch is the anti-resonance band ({fmt(dataset.attrs['band_low_Hz'], '.2f')}-{fmt(dataset.attrs['band_high_Hz'], '.2f')} Hz), where the lightly damped absorber without a stop keeps |X1| below the static deflection q/k1 = {fmt(1e3 * dataset.attrs['static_deflection_m'], '.2g')} mm (dotted grey line).")
     caption.add("worst", "The wide pale band is the worst stable motion found at each frequency, from which the table's peak and notch are taken.")
     figure_legend(fig, axes, columns=4)
@@ -162,7 +147,7 @@ def overview_figure(dataset: xr.Dataset) -> DrawnFigure:
     finish_axes(axes[1], FREQUENCY, "worst stable base force, fundamental [N]", "force on the base", log=True)
     for ax in axes:
         ax.set_xlim(float(f[0]), float(f[-1]))
-        _plain_ticks(ax)
+        plain_log(ax)
     coincide = coincidence_phrase(found for ax, drawn in zip(axes, curves) for found in reveal_coincident(ax, drawn))
     figure_legend(fig, axes, columns=2)
     caption = (
@@ -198,7 +183,7 @@ def impact_figure(dataset: xr.Dataset) -> DrawnFigure | None:
         finish_axes(ax, FREQUENCY, ylabel, title, log=log)
         ax.set_xlim(float(fs[0]), float(fs[-1]))
         if log:
-            _plain_ticks(ax)
+            plain_log(ax)
         found += reveal_coincident(ax, curves, zero="no impacts" if variable.startswith("simulated_") else "")
     figure_legend(fig, axes, columns=2)
     bumper = fmt(dataset.attrs.get("bumper_frequency_Hz"), ".4g")

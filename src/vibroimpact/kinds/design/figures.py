@@ -1,9 +1,6 @@
 """Figures of a design study, everything read from the dataset.
 
-* :func:`search_figure`: the objective over two design variables (filled contours interpolated from the evaluated
-  candidates on log-spaced levels up to a high percentile), the candidates, the search's path (the best design so
-  far, in evaluation order), the recommended and the scene's designs; with more than two variables one panel per
-  pair of the first three (projections: the other variables vary); with one, the objective against it.
+* :func:`search_figure` (:mod:`vibroimpact.kinds.design.search_map`): the objective over the design variables.
 * :func:`response_figure`: the compared designs' worst stable motion side by side, then each design with every
   coexisting motion (contact-free, both roots of the period-1 impact orbit, the continued branches), its worst case
   and the operating constraint.
@@ -24,35 +21,19 @@ import math
 import numpy as np
 import xarray as xr
 from matplotlib.axes import Axes
-from matplotlib.colors import ListedColormap
 from matplotlib.lines import Line2D
-from matplotlib.ticker import FormatStrFormatter, LogFormatter
-from matplotlib.tri import Triangulation, TriAnalyzer
 from numpy.typing import NDArray
 
-from vibroimpact.kinds.design.answer import design_evaluation, design_titles, design_text, mistuning_spreads, present_designs, screen_words, search_path, stage_counts, unit_text, variable_names
+from vibroimpact.kinds.design.answer import design_evaluation, design_titles, design_text, mistuning_spreads, present_designs, screen_words
 from vibroimpact.kinds.design.quantity import constraint_quantity, objective_quantity, operating_limit
-from vibroimpact.kinds.design.scene import safe_name
+from vibroimpact.kinds.design.palette import CERTIFIED_COLOUR, DESIGN_COLOURS, DESIGN_MARKERS, LIMIT_COLOUR, OBJECTIVE_PERCENTILE, PATH_COLOUR
+from vibroimpact.kinds.design.search_map import search_figure
 from vibroimpact.reporting.page import DrawnFigure
-from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure
-
-import matplotlib.pyplot as plt  # after style: the Agg backend is selected
+from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, plain_log
 
 __all__ = ["design_figures", "search_figure", "response_figure", "robustness_figure", "worst_stable",
-           "PlainLogFormatter", "DESIGN_COLOURS", "DESIGN_MARKERS", "PATH_COLOUR", "CERTIFIED_COLOUR", "LIMIT_COLOUR", "OBJECTIVE_PERCENTILE"]  # fmt: skip
+           "DESIGN_COLOURS", "DESIGN_MARKERS", "PATH_COLOUR", "CERTIFIED_COLOUR", "LIMIT_COLOUR", "OBJECTIVE_PERCENTILE"]  # fmt: skip
 
-#: The compared designs' colours (recommended, the scene's, the linear optimum): Okabe-Ito blue, orange, green.
-DESIGN_COLOURS = ("#0072B2", "#E69F00", "#009E73")
-#: The compared designs' markers on the search's map.
-DESIGN_MARKERS = ("*", "s", "D")
-#: The search's path (Okabe-Ito vermillion).
-PATH_COLOUR = "#D55E00"
-#: The certified worst case, the feasibility boundary (Okabe-Ito vermillion, reddish purple).
-CERTIFIED_COLOUR, LIMIT_COLOUR = "#D55E00", "#CC79A7"
-#: The objective's colour scale ends at this percentile of the candidates' values (worse ones share its top colour).
-OBJECTIVE_PERCENTILE = 90.0
-#: The objective's colours: light where it is small (good), never darker than mid-grey (the dots stay visible).
-OBJECTIVE_MAP = ListedColormap(plt.get_cmap("Greys")(np.linspace(0.03, 0.7, 256)), name="design_objective")
 _FREQUENCY = "excitation frequency [Hz]"
 _OPERATING = {"color": "0.3", "lw": 1.0, "ls": (0, (6, 2, 1, 2))}
 
@@ -71,205 +52,6 @@ def worst_stable(dataset: xr.Dataset, design: int) -> NDArray[np.float64]:
     return np.fmax.reduce(curves)
 
 
-# ------------------------------------------------------------------------------------------------- the search
-def _axis(dataset: xr.Dataset, name: str) -> tuple[float, str]:
-    """(factor to the page's units, axis label) of a design variable."""
-    if name == "clearance":
-        return 1e3, "clearance Delta [mm]"
-    if name == "restitution":
-        return 1.0, "restitution R [-]"
-    unit = unit_text(str(dataset[f"variable_{safe_name(name)}"].attrs.get("units", "1")))
-    return 1.0, f"{name} [{unit or '-'}]"
-
-
-def _limits(dataset: xr.Dataset, name: str) -> tuple[float, float]:
-    """A variable's bounds, 3 % wider each side [its units]."""
-    attrs = dataset[f"variable_{safe_name(name)}"].attrs
-    low, high = float(attrs["valid_min"]), float(attrs["valid_max"])
-    return low - 0.03 * (high - low), high + 0.03 * (high - low)
-
-
-def _levels(objective: NDArray[np.float64]) -> NDArray[np.float64]:
-    """log10 levels [log10 of the page's unit] from the least objective to :data:`OBJECTIVE_PERCENTILE` of them."""
-    finite = objective[np.isfinite(objective) & (objective > 0.0)]
-    low = float(np.min(finite))
-    high = max(float(np.percentile(finite, OBJECTIVE_PERCENTILE)), 1.05 * low)
-    return np.linspace(math.log10(low) - 1e-9, math.log10(high), 13)
-
-
-def _triangulation(u: NDArray[np.float64], v: NDArray[np.float64], x: NDArray[np.float64], y: NDArray[np.float64]) -> Triangulation | None:
-    """Delaunay triangles of the points (u, v) of the unit square (the bounds), on (x, y); flat border triangles
-    masked; None where the points span no triangle."""
-    try:
-        unit = Triangulation(u, v)
-    except (RuntimeError, ValueError):
-        return None
-    if unit.triangles.size == 0:
-        return None
-    mask = TriAnalyzer(unit).get_flat_tri_mask(0.02)
-    if np.all(mask):
-        return None
-    out = Triangulation(x, y, unit.triangles)
-    out.set_mask(mask)
-    return out
-
-
-def _map_panel(ax: Axes, d: xr.Dataset, pair: tuple[str, str], levels: NDArray[np.float64], projected: bool) -> object:
-    """One panel of the search's map over ``pair``; the colour mapping drawn (for the colour bar)."""
-    (sx, xlabel), (sy, ylabel) = _axis(d, pair[0]), _axis(d, pair[1])
-    x, y = (d[f"variable_{safe_name(n)}"].values for n in pair)
-    objective = objective_quantity(d).value(d["objective"].values)
-    finite = np.isfinite(objective) & (objective > 0.0)
-    feasible = d["feasible"].values == 1
-    constrained = math.isfinite(operating_limit(d))
-    (x0, x1), (y0, y1) = _limits(d, pair[0]), _limits(d, pair[1])
-    mappable = None
-    inside = (x >= x0) & (x <= x1) & (y >= y0) & (y <= y1)  # the scene's design may lie outside the bounds
-    if not projected:
-        order = np.flatnonzero(finite & inside)[np.argsort(objective[finite & inside], kind="stable")]
-        u, v = (x[order] - x0) / (x1 - x0), (y[order] - y0) / (y1 - y0)
-        _, first = np.unique(np.round(np.c_[u, v], 9), axis=0, return_index=True)  # coincident candidates: the best one
-        keep = order[np.sort(first)]
-        tri = _triangulation((x[keep] - x0) / (x1 - x0), (y[keep] - y0) / (y1 - y0), x[keep] * sx, y[keep] * sy)
-        if tri is not None:
-            mappable = ax.tricontourf(tri, np.log10(objective[keep]), levels=levels, cmap=OBJECTIVE_MAP, extend="max", zorder=0)
-            if constrained:
-                _feasibility_line(ax, d, tri, keep)
-        ax.plot(x[feasible & inside] * sx, y[feasible & inside] * sy, ".", color="0.1", ms=3.0, ls="none", label="evaluated candidate" + (", holds the operating limit" if constrained else ""))
-        if constrained and np.any(~feasible & inside):
-            ax.plot(x[~feasible & inside] * sx, y[~feasible & inside] * sy, "x", color="0.1", ms=3.5, mew=0.7, ls="none", label="evaluated candidate, violates the operating limit")
-    if mappable is None:  # projections, or too few candidates to triangulate: the candidates coloured, the best on top
-        order = np.flatnonzero(finite & inside)[np.argsort(-objective[finite & inside], kind="stable")]
-        for subset, marker, what in ((order[feasible[order]], "o", ""), (order[~feasible[order]], "X", ", violates the operating limit")):
-            if subset.size:
-                mappable = ax.scatter(x[subset] * sx, y[subset] * sy, c=np.log10(objective[subset]), cmap=OBJECTIVE_MAP, vmin=levels[0], vmax=levels[-1],
-                                      marker=marker, s=16, edgecolors="0.2", linewidths=0.4, zorder=2, label=f"evaluated candidate{what} (colour: worst case)")  # fmt: skip
-    _path_and_designs(ax, d, pair, (x0, x1, y0, y1))
-    ax.set_xlim(x0 * sx, x1 * sx)
-    ax.set_ylim(y0 * sy, y1 * sy)
-    finish_axes(ax, xlabel, ylabel, f"Worst case over {pair[0]} and {pair[1]}" + (" (projection)" if projected else ""))
-    ax.grid(False)
-    return mappable
-
-
-def _feasibility_line(ax: Axes, d: xr.Dataset, tri: Triangulation, keep: NDArray[np.int64]) -> None:
-    """Where the interpolated operating constraint's measure crosses its limit (when it does)."""
-    ratio = d["operating_amplitude"].values[keep] / operating_limit(d)
-    if not np.all(np.isfinite(ratio)) or not np.min(ratio) < 1.0 < np.max(ratio):
-        return
-    with plt.rc_context({"hatch.color": LIMIT_COLOUR, "hatch.linewidth": 0.7}):
-        ax.tricontourf(tri, ratio, levels=[1.0, float(np.max(ratio)) * 1.01], colors="none", hatches=["////"], zorder=1)
-    ax.tricontour(tri, ratio, levels=[1.0], colors=LIMIT_COLOUR, linewidths=1.8, zorder=3)
-    ax.fill([], [], facecolor="none", edgecolor=LIMIT_COLOUR, hatch="////", lw=1.8, label=f"{constraint_quantity(d).symbol} at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz above its limit (interpolated)")
-
-
-def _path_and_designs(ax: Axes, d: xr.Dataset, pair: tuple[str, ...], box: tuple[float, float, float, float]) -> None:
-    """The search's path and the compared designs on a panel (values outside the bounds drawn at their edge)."""
-    scales = [_axis(d, n)[0] for n in pair]
-    columns = [np.clip(d[f"variable_{safe_name(n)}"].values, box[2 * k], box[2 * k + 1]) * scales[k] for k, n in enumerate(pair)]
-    path = search_path(d)
-    ax.plot(columns[0][path], columns[1][path], "-o", color=PATH_COLOUR, lw=1.3, ms=3.5, mec="white", mew=0.5, zorder=4, label="the search's path: best design so far, in evaluation order")
-    for k in (2, 1, 0):
-        values = [float(d[f"design_{safe_name(n)}"].values[k]) for n in pair]
-        if all(math.isfinite(v) for v in values):
-            shown = [min(max(v, box[2 * j]), box[2 * j + 1]) * scales[j] for j, v in enumerate(values)]
-            ax.plot(*shown, marker=DESIGN_MARKERS[k], ms=16 if k == 0 else 10, color=DESIGN_COLOURS[k], mec="k", mew=0.9, ls="none", zorder=5, label=design_titles(d)[k])
-
-
-def search_figure(dataset: xr.Dataset) -> DrawnFigure:
-    """The objective over the design variables: a map over two, one panel per pair of the first three (projections),
-    or the objective against the one (module docstring)."""
-    d = dataset
-    names = variable_names(d)
-    if len(names) == 1:
-        return _search_line(d, names[0])
-    pairs = [(names[0], names[1])] if len(names) == 2 else [(names[i], names[j]) for i, j in ((0, 1), (0, 2), (1, 2))]
-    projected = len(names) > 2
-    q, c, limit = objective_quantity(d), constraint_quantity(d), operating_limit(d)
-    objective = q.value(d["objective"].values)
-    inside = np.all([(d[f"variable_{safe_name(n)}"].values >= _limits(d, n)[0]) & (d[f"variable_{safe_name(n)}"].values <= _limits(d, n)[1]) for n in names], axis=0)
-    levels = _levels(np.where(inside, objective, np.nan))
-    fig, axes = new_figure(len(pairs) + projected, panel_height=4.6 if not projected else 3.8, legend_rows=legend_rows(7, 3))
-    mappables = [_map_panel(ax, d, pair, levels, projected) for ax, pair in zip(axes, pairs)]
-    if projected:
-        _progress_panel(axes[-1], d)
-    mappable = next((m for m in mappables if m is not None), None)
-    if mappable is not None:
-        bar = fig.colorbar(mappable, ax=axes[: len(pairs)], extend="max", ticks=levels[::2], shrink=0.9)
-        bar.ax.set_yticklabels([fmt(10**t, ".3g") for t in levels[::2]])
-        bar.set_label(f"worst case {q.symbol} over the band and the samples [{q.unit}]")
-    counts = stage_counts(d)
-    caption = Caption(f"The search's {d.sizes['evaluation']} candidates over {' and '.join(names[:3]) if projected else ' and '.join(names)}: each candidate's worst case {q.symbol} over the band and the mistuning samples ({screen_words(d)} screen), in {q.unit}.")
-    if projected:
-        caption.add("projected", f"{len(names)} variables: each map is a projection, the other variables vary from point to point (a point's colour is its own worst case, the best drawn on top); the last panel is the worst case in evaluation order.")
-    else:
-        caption.add("fill", "The grey shading is interpolated linearly over triangles between the evaluated candidates (small dots), light where the worst case is small; where there are no candidates it is a guess.")
-    caption.add("levels", f"The colour levels are log-spaced from the least worst case ({fmt(10 ** levels[0], '.3g')} {q.unit}) to the {OBJECTIVE_PERCENTILE:g}th percentile ({fmt(10 ** levels[-1], '.3g')} {q.unit}); worse candidates share the darkest grey.")
-    caption.add("path", f"The vermillion line joins the best design so far (by the searched score) each time it improved: {len(search_path(d))} steps over {', '.join(f'{v} {k}' for k, v in counts.items() if v)} evaluations.")
-    caption.add("designs", f"The blue star is the {design_titles(d)[0]}, the orange square the scene's own (drawn at the edge of the map when it lies outside the bounds).")
-    if math.isfinite(limit):
-        caption.add("limit", f"Crosses mark candidates whose {c.symbol} at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz exceeds the allowed {fmt(c.value(limit), '.3g')} {c.unit} (the search penalised them)"
-                    + ("." if projected else f"; the hatched region bounded by the purple line is where that {c.symbol}, interpolated between the candidates, exceeds it."))  # fmt: skip
-    figure_legend(fig, axes, columns=3)
-    return DrawnFigure(fig, "design_search", "The objective over the design variables, and the search's path", caption.text())
-
-
-def _progress_panel(ax: Axes, d: xr.Dataset) -> None:
-    """Each candidate's worst case in evaluation order, and the best score so far."""
-    q = objective_quantity(d)
-    objective, score = q.value(d["objective"].values), q.value(d["score"].values)
-    index = np.arange(objective.size)
-    ax.plot(index, objective, ".", color="0.35", ms=4, ls="none")
-    ax.step(index, np.minimum.accumulate(np.where(np.isfinite(score), score, np.inf)), where="post", color=PATH_COLOUR, lw=1.5)
-    recommended = int(d.attrs.get("recommended_evaluation", -1))
-    if recommended >= 0:
-        ax.plot([recommended], [objective[recommended]], marker=DESIGN_MARKERS[0], ms=16, color=DESIGN_COLOURS[0], mec="k", mew=0.9, ls="none")
-    finish_axes(ax, "evaluation (in the order evaluated)", f"worst case {q.label}", "Worst case in evaluation order (line: best score so far)", log=True)
-    _plain_log(ax)
-
-
-def _search_line(d: xr.Dataset, name: str) -> DrawnFigure:
-    """The objective against the one design variable."""
-    scale, label = _axis(d, name)
-    q = objective_quantity(d)
-    x, objective = d[f"variable_{safe_name(name)}"].values, q.value(d["objective"].values)
-    low, high = _limits(d, name)
-    fig, axes = new_figure(1, panel_height=3.8, legend_rows=legend_rows(5, 3))
-    ax = axes[0]
-    feasible = d["feasible"].values == 1
-    ax.plot(x[feasible] * scale, objective[feasible], ".", color="0.2", ms=5, ls="none", label="evaluated candidate")
-    if np.any(~feasible):
-        ax.plot(x[~feasible] * scale, objective[~feasible], "x", color="0.2", ms=5, ls="none", label="evaluated candidate, violates the operating limit")
-    path = search_path(d)
-    ax.plot(np.clip(x[path], low, high) * scale, objective[path], "-o", color=PATH_COLOUR, lw=1.3, ms=4, mec="white", mew=0.5, label="the search's path: best design so far")
-    for k in (1, 0):
-        value, evaluation = float(d[f"design_{safe_name(name)}"].values[k]), design_evaluation(d, k)
-        if math.isfinite(value) and evaluation >= 0:
-            ax.plot([min(max(value, low), high) * scale], [objective[evaluation]], marker=DESIGN_MARKERS[k], ms=16 if k == 0 else 10, color=DESIGN_COLOURS[k], mec="k", mew=0.9, ls="none", label=design_titles(d)[k])
-    ax.set_xlim(low * scale, high * scale)
-    finish_axes(ax, label, f"worst case {q.label}", f"The search over {name}", log=True)
-    _plain_log(ax)
-    figure_legend(fig, axes, columns=3)
-    caption = Caption(f"The worst case {q.symbol} over the band and the mistuning samples ({screen_words(d)} screen, {q.unit}, log scale) of each of the search's {d.sizes['evaluation']} candidates against {name}.")
-    caption.add("path", f"The vermillion line joins the best design so far each time it improved; the blue star is the {design_titles(d)[0]}, the orange square the scene's own (at the edge when outside the bounds).")
-    return DrawnFigure(fig, "design_search", "The objective over the design variable, and the search's path", caption.text())
-
-
-class PlainLogFormatter(LogFormatter):
-    """matplotlib's choice of which log-axis ticks to label, written as plain numbers: 0.2, 3."""
-
-    def _num_to_string(self, x: float, vmin: float, vmax: float) -> str:
-        return f"{x:g}"
-
-
-def _plain_log(ax: Axes, which: str = "y") -> None:
-    """Plain numbers on a log axis (0.5, 2), minor ticks labelled when it spans about a decade or less."""
-    axis = ax.yaxis if which == "y" else ax.xaxis
-    axis.set_major_formatter(FormatStrFormatter("%g"))
-    axis.set_minor_formatter(PlainLogFormatter(labelOnlyBase=False, minor_thresholds=(1.0, 0.5)))
-
-
-# ------------------------------------------------------------------------------------------ the responses
 def _worst_point(d: xr.Dataset, k: int) -> tuple[float, float]:
     """(frequency [Hz], the objective's measure [m or N]) of a compared design's nominal worst case: the screen's, or the linear peak's."""
     value = float(d["design_sample_value"].values[k, 0])
@@ -351,7 +133,7 @@ def response_figure(dataset: xr.Dataset) -> DrawnFigure:
         _operating(ax, d)
         ax.set_xlim(float(f[0]), float(f[-1]))
         finish_axes(ax, _FREQUENCY, q.label, "Worst stable motion of each design (no mistuning)", log=True)
-        _plain_log(ax)
+        plain_log(ax)
     kinds = {"worst"}
     for ax, k in zip(axes[int(compare) :], present):
         values, drawn = _design_panel(ax, d, k)
@@ -361,7 +143,7 @@ def response_figure(dataset: xr.Dataset) -> DrawnFigure:
             ax.set_ylim(0.7 * min(values), 1.6 * max(values))
         ax.set_xlim(float(f[0]), float(f[-1]))
         finish_axes(ax, _FREQUENCY, q.label, f"{design_titles(d)[k][:1].upper()}{design_titles(d)[k][1:]}: {design_text(d, k)}", log=True)
-        _plain_log(ax)
+        plain_log(ax)
     entries = [Line2D([], [], color=DESIGN_COLOURS[k], lw=2.4, label=f"{design_titles(d)[k]}: {design_text(d, k)}") for k in present]
     entries += [Line2D([], [], **look, label=label) for kind, (look, label) in _LOOKS.items() if kind in kinds]
     caption = Caption(f"{q.symbol} ({q.description}, {q.unit}, log scale) of the compared designs without mistuning; colour: whose design.")
@@ -433,7 +215,7 @@ def robustness_figure(dataset: xr.Dataset) -> DrawnFigure:
     finite = np.r_[values[np.isfinite(values) & (values > 0.0)], [c for _, _, c in raised]]
     if finite.size and np.max(finite) > 4.0 * np.min(finite):  # a design far worse than the others: a log axis keeps both legible
         ax.set_xscale("log")
-        _plain_log(ax, "x")
+        plain_log(ax, "x")
     finish_axes(ax, f"worst case {q.symbol} over the band [{q.unit}]", "share of samples at or below", "Worst case under mistuning: empirical distribution over the samples")
     nominal = Line2D([], [], marker="o", ms=8, color="0.7", mec="k", mew=1.0, ls="none", label="the nominal design (sample 0)")
     extra = [nominal] + ([Line2D([], [], marker="*", ms=13, color=CERTIFIED_COLOUR, mec="k", mew=0.6, ls=":", lw=1.0, label="certified worst case of a sample, where above the screen's")] if raised else [])

@@ -459,13 +459,8 @@ def unswept_restitution(drawn: DrawnFigure | None, part: xr.Dataset) -> DrawnFig
 
 
 def page_for(dataset: xr.Dataset) -> StudyPage:
-    """The page of a stepped dataset: the design map where the scene asked for it (attribute ``report_page`` =
-    ``design_map``), the bumper's convergence to the rigid stop for the paper's layout with a swept bumper frequency,
-    the frequency-response page otherwise."""
-    from vibroimpact.kinds.stepped.design_page import DesignMapPage  # noqa: PLC0415 - only design maps draw it
-
-    if dataset.attrs.get("report_page") == "design_map":
-        return DesignMapPage(dataset)
+    """The page of a stepped dataset: the bumper's convergence to the rigid stop for the paper's layout with a swept
+    bumper frequency, the frequency-response page otherwise."""
     if "bumper_frequency" in dataset.dims and named_layout(dataset) is not None:
         return BumperStiffnessPage(dataset, study_setting(dataset))
     return FrequencyResponsePage(dataset)

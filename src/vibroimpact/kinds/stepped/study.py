@@ -191,14 +191,8 @@ class SteppedStudy:
         )  # fmt: skip
 
 
-#: Figures of the design-map page (three band maps, the regime map, the response at the recommended design).
-DESIGN_MAP_FIGURES = 5
-
-
 def report_figures(scene: Scene) -> int:
     """Figures of the study's report page."""
-    if scene.report == "design_map":
-        return DESIGN_MAP_FIGURES
     per_clearance = 12 if any(s in ENGINE_SOLUTIONS for s in scene.settings.solutions) else 7
     return 1 + per_clearance * scene.settings.clearance.size + (2 if len(scene.settings.swept) > 1 else 0)
 
