@@ -8,7 +8,7 @@ For every concept of the scene (:mod:`vibroimpact.kinds.concepts.scene`):
    each stop's Kelvin-Voigt twin through ``compliant`` for the peak impact acceleration and contact force;
 3. branches continued in frequency from the simulated periodic motions and the closed-form orbit
    (:mod:`~vibroimpact.kinds.concepts.branches`): stable and unstable stretches;
-4. the worst stable response and the figures of merit (:mod:`~vibroimpact.kinds.concepts.metrics`).
+4. the worst stable response and the figures of merit (:mod:`~vibroimpact.measures.figures_of_merit`).
 
 Steps 2 and 3 run in ``jobs`` processes through :meth:`vibroimpact.runs.runner.Runner.map` (resumable cache).
 Output contract: dimensions ``concept`` (names), ``frequency`` [Hz] (fine grid), ``simulation_frequency`` [Hz] and
@@ -30,7 +30,7 @@ from vibroimpact.analysis.linear import base_force, linear_amplitudes
 from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.kinds.concepts.branches import BranchCase, branch_seeds
 from vibroimpact.kinds.concepts.cases import CASE_FIELDS, ConceptCase
-from vibroimpact.kinds.concepts.metrics import anti_resonance_band, band_metrics, envelope, stretches
+from vibroimpact.measures.figures_of_merit import anti_resonance_band, band_metrics, envelope, stretches
 from vibroimpact.kinds.concepts.scene import Concept, ConceptsSettings
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem

@@ -17,7 +17,7 @@ from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.checker import SceneError
 from vibroimpact.kinds.concepts.scene import parse_concepts
 from vibroimpact.model.absorber import den_hartog_absorber
-from vibroimpact.kinds.concepts.metrics import anti_resonance_band, band_metrics, envelope, stretches
+from vibroimpact.measures.figures_of_merit import anti_resonance_band, band_metrics, envelope, stretches
 from vibroimpact.analysis.linear import base_force
 from vibroimpact.simulation.harmonics import base_weights
 from vibroimpact.kinds.concepts.branches import check_stops
