@@ -284,3 +284,34 @@ def test_the_cycle_check_sees_a_cycle(tmp_path: Path) -> None:
     assert graph == {"pkg": set(), "pkg.a": {"pkg.b"}, "pkg.b": {"pkg.c"}, "pkg.c": {"pkg.a"}, "pkg.d": {"pkg"}}
     assert find_cycle(graph) == ["pkg.a", "pkg.b", "pkg.c", "pkg.a"]
     assert find_cycle(graph | {"pkg.c": set()}) == [] and find_cycle({"x": {"y"}, "y": {"x"}}) == ["x", "y", "x"]
+
+
+
+#: The modules outside ``model/`` that may name the paper's named system (``TwoDofSystem``, a view of the paper's
+#: layout): the public re-export, the scene's ``system:`` key, the page's named parameters, and the paper's formulas
+#: and tables. Everything else works on the one model (``Layout``, ``LinearStructure``, ``ImpactProblem``) and reaches
+#: the view through it (``problem_of``, ``named_view``, ``named_system``).
+NAMED_SYSTEM_VIEWS = 6
+
+
+def modules_naming(name: str, package: Path) -> list[str]:
+    """The modules of ``package`` outside its ``model/`` whose text names ``name`` (in code, an annotation or a
+    docstring), as paths relative to ``package``."""
+    paths = (path.relative_to(package) for path in sorted(package.rglob("*.py")))
+    return [str(path) for path in paths if path.parts[0] != "model" and name in (package / path).read_text(encoding="utf-8")]
+
+
+def test_the_named_system_is_named_by_views_only() -> None:
+    """At most :data:`NAMED_SYSTEM_VIEWS` modules outside ``model/`` name ``TwoDofSystem``."""
+    naming = modules_naming("TwoDofSystem", PACKAGE)
+    assert len(naming) <= NAMED_SYSTEM_VIEWS, f"{len(naming)} modules outside model/ name TwoDofSystem (allowed {NAMED_SYSTEM_VIEWS}): {naming}"
+
+
+def test_the_named_system_count_sees_a_new_name(tmp_path: Path) -> None:
+    """The count is not blind: a docstring naming the view counts, in a subfolder too; a module under ``model/``
+    and one that does not name it do not."""
+    files = {"model/system.py": "class TwoDofSystem: ...\n", "analysis/x.py": '"""A TwoDofSystem."""\n', "kinds/k/y.py": "from a import TwoDofSystem\n", "z.py": "x = 1\n"}
+    for relative, text in files.items():
+        (tmp_path / relative).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / relative).write_text(text)
+    assert modules_naming("TwoDofSystem", tmp_path) == ["analysis/x.py", "kinds/k/y.py"]

@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from vibroimpact.analysis.linear import paper_linear_response, resonance_peaks
+from vibroimpact.analysis.linear import paper_linear_response
+from vibroimpact.analysis.linear_optimum import resonance_peaks
 from vibroimpact.model.system import TwoDofSystem
 
 from tests.conftest import PAPER_AMPLITUDE

@@ -37,13 +37,11 @@ from vibroimpact.analysis.greens import GREEN_CONDITION_LIMIT, green_condition, 
 from vibroimpact.analysis.layout import ClosedFormLayout, closed_form_layout, harmonic_load
 from vibroimpact.analysis.linear import base_force as suspension_force
 from vibroimpact.analysis.paper_fit import PaperFit
-from vibroimpact.model.contact import RigidStop
-from vibroimpact.model.excitation import HarmonicForce, angular_frequency, check_closed_form_inputs
+from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
 from vibroimpact.model.modal import ModalResponse, impulse_modes
-from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.model.problem import ImpactProblem, ProblemLike, problem_of
 
-__all__ = ["ImpactOrbit", "solve_impact_orbit", "problem_view", "impulse_roots", "ROOTS"]
+__all__ = ["ImpactOrbit", "solve_impact_orbit", "impulse_roots", "ROOTS"]
 
 #: The two roots of the impulse equation: '+' (the paper's, the one that is stable where either is) and '-'.
 ROOTS = ("+", "-")
@@ -379,28 +377,8 @@ def _impulse_and_phase(w: NDArray, delta: NDArray, r: NDArray, m_eff: float, a: 
     return np.where(exists, impulse, np.nan), phase, exists
 
 
-def problem_view(system: "TwoDofSystem | ImpactProblem", frequency: ArrayLike | None, clearance: ArrayLike | None, restitution: ArrayLike | None,
-                 amplitude: ArrayLike | None, omega: ArrayLike | None = None, call: str = "solve_impact_orbit") -> ImpactProblem:  # fmt: skip
-    """The problem a closed form solves: ``system`` itself if it is an :class:`ImpactProblem`; the paper's named
-    :class:`TwoDofSystem` is a view of the paper's layout (one rigid upper stop on x2, the force on x1), whose values
-    (frequency or omega, clearance, restitution, amplitude) must then all be given: they replace its placeholders.
-
-    Raises
-    ------
-    TypeError
-        A :class:`TwoDofSystem` without all four values, or a ``system`` of another kind.
-    """
-    if isinstance(system, ImpactProblem):
-        return system
-    if not isinstance(system, TwoDofSystem):
-        raise TypeError(f"{call}: system = {system!r} is not an ImpactProblem or the paper's TwoDofSystem")
-    if (frequency is None and omega is None) or clearance is None or restitution is None or amplitude is None:
-        raise TypeError(f"{call}(system, frequency, clearance, restitution, amplitude): the paper's system needs all five (a problem carries its own)")
-    return ImpactProblem(system, RigidStop(0.0, 0.0), HarmonicForce(1.0, 1.0))  # placeholders: the values given replace them
-
-
 def solve_impact_orbit(
-    problem: "ImpactProblem | TwoDofSystem",
+    problem: ProblemLike,
     frequency: ArrayLike | None = None,
     clearance: ArrayLike | None = None,
     restitution: ArrayLike | None = None,
@@ -414,10 +392,10 @@ def solve_impact_orbit(
 
     Parameters
     ----------
-    problem : ImpactProblem or TwoDofSystem
+    problem : ImpactProblem or the paper's named system
         Structure, rigid stop(s) and harmonic force (:func:`.layout.closed_form_layout` says whether a closed form
-        applies: ``ValueError`` with the reason otherwise); the paper's :class:`TwoDofSystem` is a view of its layout
-        (:func:`problem_view`: give frequency, clearance, restitution and amplitude).
+        applies: ``ValueError`` with the reason otherwise); the paper's named system is a view of its layout
+        (:func:`~vibroimpact.model.problem.problem_of`: give frequency, clearance, restitution and amplitude).
     frequency : array_like, optional
         f [Hz], > 0; default the problem's.
     clearance : array_like, optional
@@ -440,7 +418,7 @@ def solve_impact_orbit(
         Impulse, phase, existence, ``frequency`` [Hz] beside ``omega`` [rad s-1], ``stable`` and ``multipliers``
         (Floquet), :meth:`~ImpactOrbit.harmonics`, :meth:`~ImpactOrbit.admissible`, the motion.
     """
-    problem = problem_view(problem, frequency, clearance, restitution, amplitude, omega)
+    problem = problem_of(problem, "solve_impact_orbit", frequency=frequency if omega is None else omega, clearance=clearance, restitution=restitution, amplitude=amplitude)
     layout = closed_form_layout(problem)
     check_closed_form_inputs(clearance, restitution, amplitude)
     w, delta, r, q = (np.asarray(x, dtype=float) for x in np.broadcast_arrays(

@@ -1,7 +1,8 @@
 """Steady-state response of the linear system (no stop, Delta -> infinity) and its resonance peaks.
 
-:func:`paper_linear_response` and :func:`resonance_peaks` are the paper's named two-mass system by its receptances
-(X1, X2, suspension force). :func:`linear_response` (also named :func:`linear_amplitudes`) is any problem under its
+:func:`paper_linear_response` is the paper's named two-mass system by its receptances (X1, X2, suspension force;
+defined with the paper's other formulas in :mod:`vibroimpact.model.system`; its resonance peaks are
+:func:`vibroimpact.analysis.linear_optimum.resonance_peaks`). :func:`linear_response` (also named :func:`linear_amplitudes`) is any problem under its
 load (the paper's system a view of its problem): the complex amplitude of every coordinate,
 H(jw) F(w), and of every stop's coordinate n_k . H F (a relative coordinate x_i - x_j for a relative stop, signed
 by the stop's side), plus the static deflection K^-1 F0 where K is invertible (:func:`structure_amplitudes` the same
@@ -21,14 +22,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.analysis.layout import harmonic_load_of
-from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.excitation import HarmonicForce, angular_frequency, check_closed_form_inputs
 from vibroimpact.model.layout import Layout
-from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.problem import ImpactProblem, ProblemLike, problem_of
 from vibroimpact.model.structure import CONDITION_LIMIT, LinearStructure, harmonic_condition, stiffness_modes
-from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.model.system import LinearResponse, paper_linear_response
 
-__all__ = ["contact_free_is_stable", "base_coupling", "base_force", "peaks_near", "LinearResponse", "paper_linear_response", "linear_response", "ResonancePeak", "resonance_peaks", "LinearAmplitudes", "linear_amplitudes", "linear_reach", "structure_amplitudes", "structure_peaks"]
+__all__ = ["contact_free_is_stable", "base_coupling", "base_force", "peaks_near", "LinearResponse", "paper_linear_response", "linear_response", "ResonancePeak", "LinearAmplitudes", "linear_amplitudes", "linear_reach", "structure_amplitudes", "structure_peaks"]
 
 
 def contact_free_is_stable(system: LinearStructure) -> bool:
@@ -73,37 +73,6 @@ def base_force(system: LinearStructure, omega: ArrayLike, x: ArrayLike, through:
     return force
 
 
-@dataclass(frozen=True, eq=False)
-class LinearResponse:
-    """Complex amplitudes of the paper's linear steady state under the force q cos(w t), by eqs. 4-5
-    (:func:`paper_linear_response`; the public form of any problem is :class:`LinearAmplitudes`).
-
-    Attributes
-    ----------
-    x1, x2 : ndarray of complex
-        Displacement amplitudes of the primary mass and the absorber [m].
-    force : ndarray of complex
-        Force transmitted to the base through the suspension, (K1 + j w B1) X1 [N].
-    """
-
-    x1: NDArray[np.complex128]
-    x2: NDArray[np.complex128]
-    force: NDArray[np.complex128]
-
-
-def paper_linear_response(system: TwoDofSystem, frequency: ArrayLike | None = None, amplitude: float | None = None, *, omega: ArrayLike | None = None) -> LinearResponse:
-    """Linear steady-state amplitudes of the paper's system by its receptances (eqs. 4-5) at ``frequency`` [Hz] (or
-    angular frequencies ``omega`` [rad s-1], keyword only) for force amplitude q [N] (``amplitude``, finite): the
-    arithmetic of the paper's studies (:func:`linear_response` is the public form, of any problem)."""
-    if amplitude is None:
-        raise TypeError("paper_linear_response(system, frequency, amplitude): the force amplitude q [N] is needed")
-    check_closed_form_inputs(None, None, amplitude)
-    w = np.asarray(angular_frequency(frequency, omega), dtype=float)
-    h = system.receptances(w)
-    x1 = amplitude * h.h11
-    return LinearResponse(x1=x1, x2=amplitude * h.h12, force=(system.k1 + 1j * w * system.b1) * x1)
-
-
 @dataclass(frozen=True)
 class ResonancePeak:
     """Maximum of a linear amplitude near one natural frequency.
@@ -121,29 +90,6 @@ class ResonancePeak:
     mode: int
     frequency: float
     value: float
-
-
-def resonance_peaks(system: TwoDofSystem, amplitude: float, quantity: str = "x1", span: float = 0.05) -> list[ResonancePeak]:
-    """Maxima of a linear amplitude near each natural frequency, by analytic maximisation (not from a grid).
-
-    Parameters
-    ----------
-    system : TwoDofSystem
-        The linear system.
-    amplitude : float
-        Force amplitude q [N].
-    quantity : {'x1', 'x2', 'force'}
-        Which amplitude.
-    span : float
-        Relative half-width of the search window around each undamped natural frequency [-].
-    """
-    if quantity not in ("x1", "x2", "force"):
-        raise ValueError(f"quantity must be 'x1', 'x2' or 'force', got {quantity!r}")
-
-    def magnitude(w: ArrayLike) -> NDArray[np.float64]:
-        return np.abs(getattr(paper_linear_response(system, omega=w, amplitude=amplitude), quantity))
-
-    return peaks_near(system.natural_angular_frequencies(), magnitude, span)
 
 
 @dataclass(frozen=True, eq=False)
@@ -220,13 +166,13 @@ class LinearAmplitudes:
         return np.all(np.abs(self.stop_amplitudes) + self.stop_static <= np.asarray(clearances, dtype=float), axis=-1)
 
 
-def linear_response(system: ImpactProblem | TwoDofSystem, frequency: ArrayLike | None = None, amplitude: ArrayLike | None = None, *,
+def linear_response(system: ProblemLike, frequency: ArrayLike | None = None, amplitude: ArrayLike | None = None, *,
                     omega: ArrayLike | None = None) -> LinearAmplitudes:  # fmt: skip
     """The complex amplitudes of every coordinate and every stop's coordinate over ``frequency`` (module docstring).
 
     Parameters
     ----------
-    system : ImpactProblem or TwoDofSystem
+    system : ImpactProblem or the paper's named system
         Structure, stops and a harmonic load (force on any coordinates, or base motion: then the coordinates are
         relative to the base); the paper's named system is a view of its problem (the force on x1, the stop on x2),
         which needs ``frequency`` and ``amplitude``.
@@ -244,14 +190,10 @@ def linear_response(system: ImpactProblem | TwoDofSystem, frequency: ArrayLike |
         the base ``force`` [N], ``fits(clearances)``; NaN (and ``fits`` False) where ``conditioned`` is False, within
         ~1.6e-5 (relative) of an undamped natural frequency, where the response is ill-conditioned.
     """
-    if not isinstance(system, ImpactProblem):
-        if not isinstance(system, TwoDofSystem):
-            raise TypeError(f"linear_response: system = {system!r} is not an ImpactProblem or the paper's TwoDofSystem")
-        if (frequency is None and omega is None) or amplitude is None:
-            raise TypeError("linear_response(system, frequency, amplitude): the paper's system needs the frequency [Hz] and the force amplitude q [N]")
+    problem = problem_of(system, "linear_response", frequency=frequency if omega is None else omega, amplitude=amplitude)
+    if problem is not system:  # the paper's named system: its layout, with the values given
         check_closed_form_inputs(None, None, amplitude)
-        system = ImpactProblem(system, RigidStop(0.0, 0.0), HarmonicForce(1.0, 1.0))  # its layout; the values given replace the placeholders
-    return structure_amplitudes(system.structure, system.harmonic, system.normals(), frequency, amplitude, omega=omega)
+    return structure_amplitudes(problem.structure, problem.harmonic, problem.normals(), frequency, amplitude, omega=omega)
 
 
 #: The same function: the name of the studies' code.

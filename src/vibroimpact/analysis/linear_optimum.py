@@ -31,11 +31,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import minimize, minimize_scalar
 
+from vibroimpact.analysis.linear import ResonancePeak, paper_linear_response, peaks_near
 from vibroimpact.analysis.measures import Measure, measure as measure_named
 from vibroimpact.model.structure import STIFFNESS_RATIO, require_non_negative, require_positive
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["nishihara_asami", "band_peak", "BandPeak", "linear_measure", "as_linear_measure", "LinearAbsorberOptimum", "NoLinearOptimum", "optimal_linear_absorber", "SCAN_POINTS", "X1_AMPLITUDE"]
+__all__ = ["nishihara_asami", "band_peak", "BandPeak", "linear_measure", "resonance_peaks", "as_linear_measure", "LinearAbsorberOptimum", "NoLinearOptimum", "optimal_linear_absorber", "SCAN_POINTS", "X1_AMPLITUDE"]
 
 #: The default measure: the primary mass's |X1| (the H-infinity optimum's).
 X1_AMPLITUDE = measure_named("x1_amplitude")
@@ -108,6 +109,30 @@ def linear_measure(system: TwoDofSystem, amplitude: float, omega: float | np.nda
         return q * np.abs(h.h12)
     x = np.stack([q * h.h11, q * h.h12], axis=-1)  # X1, X2 [m]
     return chosen.of_harmonics(system, w, x)
+
+
+def resonance_peaks(system: TwoDofSystem, amplitude: float, quantity: str = "x1", span: float = 0.05) -> list[ResonancePeak]:
+    """Maxima of a linear amplitude of the paper's system near each natural frequency, by analytic maximisation (not
+    from a grid; :func:`~vibroimpact.analysis.linear.structure_peaks` is the same for any problem).
+
+    Parameters
+    ----------
+    system : TwoDofSystem
+        The linear system.
+    amplitude : float
+        Force amplitude q [N].
+    quantity : {'x1', 'x2', 'force'}
+        Which amplitude (:func:`~vibroimpact.model.system.paper_linear_response`).
+    span : float
+        Relative half-width of the search window around each undamped natural frequency [-].
+    """
+    if quantity not in ("x1", "x2", "force"):
+        raise ValueError(f"quantity must be 'x1', 'x2' or 'force', got {quantity!r}")
+
+    def magnitude(w: np.ndarray) -> np.ndarray:
+        return np.abs(getattr(paper_linear_response(system, omega=w, amplitude=amplitude), quantity))
+
+    return peaks_near(system.natural_angular_frequencies(), magnitude, span)
 
 
 def band_peak(system: TwoDofSystem, amplitude: float, band: tuple[float, float], measure: Measure | str = X1_AMPLITUDE) -> BandPeak:

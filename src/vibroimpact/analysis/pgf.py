@@ -28,11 +28,10 @@ from enum import Enum
 
 from numpy.typing import ArrayLike
 
-from vibroimpact.analysis.impact_orbit import ImpactOrbit, problem_view, solve_impact_orbit
+from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_layout
 from vibroimpact.analysis.paper_fit import PaperFit
-from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.model.problem import ProblemLike, problem_of
 
 __all__ = ["PgfVariant", "solve_one_impact", "AdmissibilitySettings"]
 
@@ -68,7 +67,7 @@ class AdmissibilitySettings:
 
 
 def solve_one_impact(
-    system: TwoDofSystem | ImpactProblem,
+    system: ProblemLike,
     frequency: ArrayLike | None = None,
     clearance: ArrayLike | None = None,
     restitution: ArrayLike | None = None,
@@ -81,16 +80,16 @@ def solve_one_impact(
     :func:`~vibroimpact.analysis.impact_orbit.solve_impact_orbit` for one rigid stop.
 
     Two forms, one result. ``solve_one_impact(system, frequency, clearance, restitution, amplitude, variant)`` with the
-    paper's :class:`TwoDofSystem` is the paper's layout (one upper stop on x2, the force on x1; all five values
+    paper's named system (m1 ... b2) is the paper's layout (one upper stop on x2, the force on x1; all five values
     needed). ``solve_one_impact(problem, frequency=None, clearance=None, restitution=None, amplitude=None)`` with an
     :class:`ImpactProblem` of any structure with one rigid stop (absolute or relative, upper or lower) takes the
     problem's own values where none are given; ``ValueError`` saying why where it does not apply (several stops, a
     bumper, a rigid-body mode; a symmetric two-sided stop is :func:`vibroimpact.solve_two_impacts`). The paper's
-    system is a view of its problem (:func:`~vibroimpact.analysis.impact_orbit.problem_view`), not another solver.
+    system is a view of its problem (:func:`~vibroimpact.model.problem.problem_of`), not another solver.
 
     Parameters
     ----------
-    system : ImpactProblem or TwoDofSystem
+    system : ImpactProblem or the paper's named system
         The whole problem, or the paper's named system (its layout; then all five values are needed).
     frequency : array_like
         Excitation frequency f [Hz], > 0 (``ValueError`` otherwise).
@@ -114,7 +113,7 @@ def solve_one_impact(
         paper's layout), ``admissible()``, the motion.
     """
     variant = PgfVariant(variant)
-    problem = problem_view(system, frequency, clearance, restitution, amplitude, omega, "solve_one_impact")
+    problem = problem_of(system, "solve_one_impact", frequency=frequency if omega is None else omega, clearance=clearance, restitution=restitution, amplitude=amplitude)
     if closed_form_layout(problem).two_sided:
         raise ValueError("contact: the stops form a symmetric two-sided stop, whose closed form has two impacts per period: use vibroimpact.solve_two_impacts(problem)")
     green = PaperFit.of(problem) if variant is PgfVariant.PAPER else None

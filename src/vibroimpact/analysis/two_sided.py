@@ -5,16 +5,15 @@ from __future__ import annotations
 
 from numpy.typing import ArrayLike
 
-from vibroimpact.analysis.impact_orbit import ImpactOrbit, problem_view, solve_impact_orbit
+from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_layout
-from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.model.problem import ProblemLike, problem_of
 
 __all__ = ["solve_two_impacts"]
 
 
 def solve_two_impacts(
-    problem: ImpactProblem | TwoDofSystem,
+    problem: ProblemLike,
     frequency: ArrayLike | None = None,
     clearance: ArrayLike | None = None,
     restitution: ArrayLike | None = None,
@@ -27,7 +26,7 @@ def solve_two_impacts(
 
     Parameters
     ----------
-    problem : ImpactProblem or TwoDofSystem
+    problem : ImpactProblem or the paper's named system
         Structure without rigid-body modes, two rigid stops forming a symmetric pair, harmonic force (the paper's
         system is a view of its one-stop layout: refused with the reason, as any one-stop problem).
     frequency : array_like, optional
@@ -105,7 +104,7 @@ def solve_two_impacts(
     and is a fixed point of an independent integration (scipy, events on both gaps); the monodromy equals the
     finite-difference Jacobian of that integration; a stable orbit attracts a perturbed start.
     """
-    problem = problem_view(problem, frequency, clearance, restitution, amplitude, omega, "solve_two_impacts")
+    problem = problem_of(problem, "solve_two_impacts", frequency=frequency if omega is None else omega, clearance=clearance, restitution=restitution, amplitude=amplitude)
     layout = closed_form_layout(problem)
     if not layout.two_sided:
         raise ValueError("contact: one stop has no two-sided symmetric orbit; its closed form is vibroimpact.solve_one_impact(problem)")

@@ -16,7 +16,9 @@ from matplotlib.lines import Line2D
 
 from vibroimpact.analysis.linear import base_force, paper_linear_response
 from vibroimpact.model.modal import exact_modal_parameters, fit_modal_parameters, underdamped_mode_count
-from vibroimpact.model.system import PAPER_SYSTEM, TwoDofSystem
+from vibroimpact.model.layout import Layout
+from vibroimpact.model.problem import System
+from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.reporting.coincide import coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, saved
 from vibroimpact.reporting.record import GeneralSetting, StudySetting, named_layout
@@ -110,8 +112,12 @@ def linear_figure(setting: StudySetting, paper: bool = True) -> DrawnFigure:
     return DrawnFigure(fig, "linear", "Linear responses, force on the base, fit of H22", caption)
 
 
-def modal_table(system: TwoDofSystem) -> Table:
-    """Exact and fitted modal parameters of H22 of ``system``."""
+def modal_table(structure: System) -> Table:
+    """Exact and fitted modal parameters of H22 of ``structure``, the paper's two-mass chain (its named system, or
+    matrices that have that view; ``ValueError`` otherwise)."""
+    system = Layout(structure).named_view()
+    if system is None:
+        raise ValueError("modal_table: the modal parameters of H22 are the paper's two-mass chain's (x1 primary, x2 absorber)")
     exact = exact_modal_parameters(system)
     fit = fit_modal_parameters(system) if exact.omega.size == 2 else None
     rows = ["<tr><th>mode</th><th>Omega/2pi [Hz]</th><th>xi exact</th><th>xi fitted</th><th>A exact (complex) [1/kg]</th><th>A fitted [1/kg]</th></tr>"]

@@ -26,12 +26,9 @@ from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop, check_
 from vibroimpact.model.excitation import HarmonicForce, SweptSine
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
-from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.model.system import NAMED_KEYS, TwoDofSystem
 
 __all__ = ["Layout", "LoadSpec", "StopSpec", "PAPER_STOP", "build_stops", "describe_stop", "stop_descriptions", "bumper_units", "NAMED_KEYS"]
-
-#: The named system's parameters, as the attributes ``system_<key>`` record them.
-NAMED_KEYS = ("m1", "m2", "k1", "k2", "b1", "b2")
 
 
 @dataclass(frozen=True)

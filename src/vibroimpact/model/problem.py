@@ -19,12 +19,15 @@ from vibroimpact.model.excitation import HarmonicForce, SweptSine, load_weights,
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 
-__all__ = ["Contact", "Excitation", "ImpactProblem"]
+__all__ = ["Contact", "Excitation", "System", "ImpactProblem", "ProblemLike", "problem_of"]
 
 #: The contact laws a problem may have.
 Contact = Union[RigidStop, KelvinVoigtBumper]
 #: The excitations a problem may have.
 Excitation = Union[HarmonicForce, SweptSine]
+#: The structures a problem may have: any N-dof structure, or the paper's named system (m1 ... b2, taken as its
+#: structure; :mod:`~vibroimpact.model.system`, a view of the paper's layout).
+System = Union[LinearStructure, TwoDofSystem]
 
 _Kind = TypeVar("_Kind")
 
@@ -94,6 +97,11 @@ class ImpactProblem:
     def size(self) -> int:
         """N, the number of degrees of freedom (the state has 2 N entries: displacements, then velocities)."""
         return self.system.size
+
+    def named_view(self) -> TwoDofSystem | None:
+        """The structure's named view (m1 ... b2, :meth:`TwoDofSystem.of`) whatever the stops and load; None where the
+        structure is not the paper's two-mass chain."""
+        return TwoDofSystem.of(self.system)
 
     @property
     def stops(self) -> tuple[Stop, ...]:
@@ -194,7 +202,7 @@ class ImpactProblem:
 
     def holding_force(self, x1: float | NDArray[np.float64], v1: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
         """Force the rigid stop must exert to hold the absorber at rest on it [N] (see :meth:`RigidStop.holding_force`)."""
-        named = TwoDofSystem.of(self.system)
+        named = self.named_view()
         if named is None:
             raise TypeError("holding_force: the absorber's holding force needs the paper's two-mass chain; ask contact_holding(stop, state, t)")
         return self.rigid_stop.holding_force(named, x1, v1)
@@ -252,3 +260,37 @@ class ImpactProblem:
         """A displacement typical of the motion [m], for relative thresholds: Delta + q |H12| on the paper's layout, in
         general the largest |Delta_k| + |n_k . H F| over the stops (:meth:`velocity_scale` / w)."""
         return self.velocity_scale() / self.omega
+
+
+#: What the closed forms and the linear response accept: a problem, or the paper's named system, a view of the
+#: paper's layout whose values the caller gives (:func:`problem_of`).
+ProblemLike = Union[ImpactProblem, TwoDofSystem]
+
+
+def problem_of(system: ProblemLike, call: str, **values: object) -> ImpactProblem:
+    """The problem ``system`` is: itself if it is an :class:`ImpactProblem`; the paper's named system is a view of the
+    paper's layout (one rigid upper stop on x2, the force on x1) whose placeholders the caller's ``values`` replace
+    (f or w, Delta, R, q: each must then be given, not None).
+
+    Parameters
+    ----------
+    system : ImpactProblem or TwoDofSystem
+        The problem, or the paper's named system.
+    call : str
+        The calling function's name, for the messages.
+    **values
+        The values the caller replaces the problem's with, by name (None: not given).
+
+    Raises
+    ------
+    TypeError
+        A ``system`` of another kind, or the named system with a value not given.
+    """
+    if isinstance(system, ImpactProblem):
+        return system
+    if not isinstance(system, TwoDofSystem):
+        raise TypeError(f"{call}: system = {system!r} is not an ImpactProblem or the paper's TwoDofSystem")
+    missing = [name for name, value in values.items() if value is None]
+    if missing:
+        raise TypeError(f"{call}(system, {', '.join(values)}): the paper's system needs {', '.join(missing)} (a problem carries its own)")
+    return ImpactProblem(system, RigidStop(0.0, 0.0), HarmonicForce(1.0, 1.0))  # placeholders: the values given replace them

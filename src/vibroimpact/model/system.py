@@ -12,15 +12,17 @@ Equations of motion (seed paper eq. 1, without the contact force)::
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
 from vibroimpact.model.structure import DAMPING_RATIO, MASS_RATIO, STIFFNESS_RATIO, LinearStructure, require_non_negative, require_positive, require_ratio
 
-__all__ = ["TwoDofSystem", "Receptances", "PAPER_SYSTEM"]
+__all__ = ["TwoDofSystem", "Receptances", "PAPER_SYSTEM", "NAMED_KEYS", "named_system", "LinearResponse", "paper_linear_response"]
 
 
 @dataclass(frozen=True)
@@ -126,6 +128,11 @@ class TwoDofSystem:
         if not (chain and k1 > 0.0 and k2 > 0.0 and b1 >= 0.0 and b2 >= 0.0):
             return None
         return cls(m1=float(m[0, 0]), m2=float(m[1, 1]), k1=k1, k2=k2, b1=b1, b2=b2)
+
+    def with_absorber(self, stiffness: float, damping: float) -> "TwoDofSystem":
+        """The same primary (m1, k1, b1) and absorber mass m2 with the absorber's stiffness k2 = ``stiffness``
+        [N m-1] and damping b2 = ``damping`` [N s m-1] (each checked as the constructor checks it)."""
+        return TwoDofSystem(self.m1, self.m2, self.k1, stiffness, self.b1, damping)
 
     # ------------------------------------------------------------------ matrices
     @property
@@ -265,7 +272,55 @@ class TwoDofSystem:
 
     def as_dict(self) -> dict[str, float]:
         """Plain dictionary of the parameters (SI units), for dataset attributes."""
-        return {name: float(getattr(self, name)) for name in ("m1", "m2", "k1", "k2", "b1", "b2")}
+        return {name: float(getattr(self, name)) for name in NAMED_KEYS}
+
+
+#: The named system's parameters, in the order of its fields.
+NAMED_KEYS = ("m1", "m2", "k1", "k2", "b1", "b2")
+
+
+def named_system(values: Mapping[str, float]) -> TwoDofSystem:
+    """The paper's named system of ``values`` (m1, m2, k1, k2 and optionally b1, b2 [SI]), as a scene's ``system``,
+    a dataset's ``system_<key>`` attributes or a validation case write them: the view's one constructor from its
+    parameters (``TypeError`` for another key, ``ValueError`` for a value out of range).
+
+    Its :attr:`~TwoDofSystem.structure` is the one model's structure of these values; where a structure exists,
+    :meth:`TwoDofSystem.of` (or :meth:`Layout.named_view <vibroimpact.model.layout.Layout.named_view>`) is its view.
+    """
+    return TwoDofSystem(**{key: float(value) for key, value in values.items()})
+
+
+@dataclass(frozen=True, eq=False)
+class LinearResponse:
+    """Complex amplitudes of the paper's linear steady state under the force q cos(w t), by eqs. 4-5
+    (:func:`paper_linear_response`; the public form of any problem is
+    :class:`~vibroimpact.analysis.linear.LinearAmplitudes`).
+
+    Attributes
+    ----------
+    x1, x2 : ndarray of complex
+        Displacement amplitudes of the primary mass and the absorber [m].
+    force : ndarray of complex
+        Force transmitted to the base through the suspension, (K1 + j w B1) X1 [N].
+    """
+
+    x1: NDArray[np.complex128]
+    x2: NDArray[np.complex128]
+    force: NDArray[np.complex128]
+
+
+def paper_linear_response(system: TwoDofSystem, frequency: ArrayLike | None = None, amplitude: float | None = None, *, omega: ArrayLike | None = None) -> LinearResponse:
+    """Linear steady-state amplitudes of the paper's system by its receptances (eqs. 4-5) at ``frequency`` [Hz] (or
+    angular frequencies ``omega`` [rad s-1], keyword only) for force amplitude q [N] (``amplitude``, finite): the
+    arithmetic of the paper's studies (:func:`~vibroimpact.analysis.linear.linear_response` is the public form, of
+    any problem)."""
+    if amplitude is None:
+        raise TypeError("paper_linear_response(system, frequency, amplitude): the force amplitude q [N] is needed")
+    check_closed_form_inputs(None, None, amplitude)
+    w = np.asarray(angular_frequency(frequency, omega), dtype=float)
+    h = system.receptances(w)
+    x1 = amplitude * h.h11
+    return LinearResponse(x1=x1, x2=amplitude * h.h12, force=(system.k1 + 1j * w * system.b1) * x1)
 
 
 #: The paper's numerical example (eq. 24).

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from vibroimpact.analysis.linear import paper_linear_response, resonance_peaks
+from vibroimpact.analysis.linear import paper_linear_response
+from vibroimpact.analysis.linear_optimum import resonance_peaks
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.reporting.record import GeneralSetting
 from vibroimpact.kinds.stepped.tables import paper_reduction_factors, reduction_factors

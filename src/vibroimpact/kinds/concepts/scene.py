@@ -39,8 +39,7 @@ from vibroimpact.model.absorber import den_hartog_absorber
 from vibroimpact.model.collision import loss_factor_from_restitution
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
-from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.model.problem import ImpactProblem, System
 from vibroimpact.scene.layout_parse import parse_stops
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.simulation.settings import SteadySettings
@@ -63,8 +62,9 @@ class Concept:
         Short, file-name-safe name (the dataset's ``concept`` coordinate).
     label : str
         What the report calls it.
-    system : TwoDofSystem
-        m1, k1, b1 and m2 of the scene, with this concept's k2 and b2.
+    system : LinearStructure or the paper's named system
+        The paper's named system (m1 ... b2 of the scene's layout, :meth:`~vibroimpact.model.layout.Layout.paper_view`)
+        with this concept's k2 and b2.
     stops : tuple of Stop
         Rigid stops (none: the linear absorber).
     absorber : str
@@ -73,7 +73,7 @@ class Concept:
 
     name: str
     label: str
-    system: TwoDofSystem
+    system: System
     stops: tuple[Stop, ...] = ()
     absorber: str = ""
 
@@ -109,8 +109,8 @@ class ConceptsSettings:
 
     Attributes
     ----------
-    system : TwoDofSystem
-        The scene's system: the reference of the anti-resonance band and the base of every concept.
+    system : LinearStructure or the paper's named system
+        The scene's named system (its layout's paper view): the reference of the anti-resonance band and the base of every concept.
     amplitude : float
         q [N] on the primary mass.
     concepts : tuple of Concept
@@ -129,7 +129,7 @@ class ConceptsSettings:
         Most points per continued branch and direction; 0: no continuation.
     """
 
-    system: TwoDofSystem
+    system: System
     amplitude: float
     concepts: tuple[Concept, ...]
     frequency: np.ndarray
@@ -221,7 +221,7 @@ def _simulation(c: Checker, value: Any, frequency: np.ndarray | None) -> tuple[n
     return settings.frequency, settings.engine, settings.steady
 
 
-def _concepts(c: Checker, value: Any, system: TwoDofSystem) -> tuple[Concept, ...]:
+def _concepts(c: Checker, value: Any, system: System) -> tuple[Concept, ...]:
     if not isinstance(value, list) or not value:
         c.fail("concepts", f"expected a non-empty list of concepts ({{name, label, absorber, stops}}), got {value!r}")
         return ()
@@ -250,7 +250,7 @@ def _concepts(c: Checker, value: Any, system: TwoDofSystem) -> tuple[Concept, ..
     return tuple(concepts)
 
 
-def _absorber(c: Checker, key: str, value: Any, system: TwoDofSystem) -> tuple[TwoDofSystem, str] | None:
+def _absorber(c: Checker, key: str, value: Any, system: System) -> tuple[System, str] | None:
     spec = c.mapping(key, value, {"stiffness", "damping"})
     optimum = den_hartog_absorber(system.m1, system.k1, system.m2)
     chosen = {"stiffness": system.k2, "damping": system.b2}
@@ -271,7 +271,7 @@ def _absorber(c: Checker, key: str, value: Any, system: TwoDofSystem) -> tuple[T
             if number is None:
                 return None
             chosen[part], words[part] = number, f"{'k2' if part == 'stiffness' else 'b2'} = {number:g} {unit}"
-    built = TwoDofSystem(system.m1, system.m2, system.k1, chosen["stiffness"], system.b1, chosen["damping"])
+    built = system.with_absorber(chosen["stiffness"], chosen["damping"])
     try:
         built.check_ratios()
     except ValueError as error:  # a ratio beyond double precision (model/system.py)

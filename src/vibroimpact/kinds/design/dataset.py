@@ -28,7 +28,6 @@ from vibroimpact.kinds.design.scene import DesignSettings, safe_name
 from vibroimpact.kinds.design.search import STAGES, pareto_front
 from vibroimpact.kinds.design.outcome import Outcome
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.system import TwoDofSystem
 
 __all__ = ["design_dataset", "response_curves", "equal_peaks", "RESPONSE_POINTS", "DESIGNS", "RIDGE"]
 
@@ -251,6 +250,6 @@ def _designs(data: dict[str, xr.Variable], scene: Any, outcome: Outcome) -> dict
                       f"linear_optimum_worst_{settings.measure.unit}": outcome.linear.worst})  # fmt: skip
     if outcome.recommended >= 0:
         attrs["recommended_certified_score_m"] = outcome.corrected.get(outcome.recommended, math.nan)
-    paper = TwoDofSystem.of(space.problem.structure)
+    paper = space.problem.named_view()
     attrs["static_deflection_m"] = abs(scene.amplitude) / paper.k1 if paper is not None else math.nan
     return attrs

@@ -26,7 +26,8 @@ import yaml
 from vibroimpact.analysis.linear_optimum import linear_measure
 from vibroimpact.kinds.design.quantity import Quantity, constraint_quantity, objective_quantity, quantity
 from vibroimpact.measures.figures_of_merit import NEAREST, WORSE_RATIO
-from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.model.problem import System
+from vibroimpact.model.system import named_system
 from vibroimpact.reporting.style import fmt
 
 __all__ = ["DesignOperating", "design_operating", "operating_sentence", "operating_warnings", "WORSE_RATIO", "NEAREST"]
@@ -73,7 +74,7 @@ class DesignOperating:
         return self.stopped / self.linear if self.linear > 0.0 else math.nan
 
 
-def _system(dataset: xr.Dataset) -> TwoDofSystem | None:
+def _system(dataset: xr.Dataset) -> System | None:
     """The recommended design's two-mass system: the stored scene's m1 ... b2 with the design's k2 and b2 where they
     are design variables; None where the scene gives no named system."""
     try:
@@ -88,7 +89,7 @@ def _system(dataset: xr.Dataset) -> TwoDofSystem | None:
     for k in ("k2", "b2"):
         if f"design_{k}" in dataset and math.isfinite(float(dataset[f"design_{k}"].values[0])):
             values[k] = float(dataset[f"design_{k}"].values[0])
-    return TwoDofSystem(**values) if values["k2"] > 0.0 else None
+    return named_system(values) if values["k2"] > 0.0 else None
 
 
 def _responses(dataset: xr.Dataset, frequency: float) -> float:

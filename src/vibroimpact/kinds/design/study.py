@@ -35,7 +35,6 @@ from vibroimpact.kinds.design.evaluate import CHUNKS, CertifyCase, DesignSpace
 from vibroimpact.kinds.design.outcome import Outcome
 from vibroimpact.kinds.design.scene import DesignSettings
 from vibroimpact.kinds.design.search import Evaluations, nelder_mead_polish, differential_evolution, grid_search
-from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.runner import Runner
@@ -125,12 +124,12 @@ def _linear(outcome: Outcome, amplitude: float) -> None:
     """The optimum linear absorber of the same mass under the same (structural) mistuning, and its band peak under
     every sample."""
     space = outcome.space
-    primaries = [TwoDofSystem.of(space.problem_at(outcome.scene_design, s).structure) for s in range(space.samples)]
+    primaries = [space.problem_at(outcome.scene_design, s).named_view() for s in range(space.samples)]
     if any(p is None for p in primaries):
         return
     outcome.linear = optimal_linear_absorber(primaries[0], amplitude, space.band, mistuned=tuple(primaries[1:]), measure=space.objective)  # type: ignore[arg-type]
     k2, b2 = outcome.linear.system.k2, outcome.linear.system.b2
-    systems = [TwoDofSystem(p.m1, p.m2, p.k1, k2, p.b1, b2) for p in primaries]  # type: ignore[union-attr]
+    systems = [p.with_absorber(k2, b2) for p in primaries]  # type: ignore[union-attr]
     outcome.linear_values = np.array([band_peak(system, amplitude, space.band, measure=space.objective).amplitude for system in systems])
     if math.isfinite(space.operating):  # the linear absorber's value of the constraint's measure there, worst over the samples
         outcome.linear_operating = max(float(linear_measure(system, amplitude, 2.0 * math.pi * space.operating, space.constraint)) for system in systems)

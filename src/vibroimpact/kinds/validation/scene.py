@@ -38,7 +38,7 @@ from vibroimpact.model.contact import RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
-from vibroimpact.model.system import TwoDofSystem
+from vibroimpact.model.system import NAMED_KEYS, named_system
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.scene.schema import Scene
 
@@ -61,8 +61,7 @@ def case_structure(case: ValidationCase) -> LinearStructure:
         return LinearStructure([[case.mass]], [[0.0]], [[0.0]], ("z",))
     if isinstance(case, GrazingCase):
         return LinearStructure([[case.mass]], [[case.stiffness]], [[case.damping]], ("x",))
-    named = TwoDofSystem(case.m1, case.m2, case.k1, case.k2, case.b1, case.b2)
-    return named.structure
+    return named_system({key: getattr(case, key) for key in NAMED_KEYS}).structure  # the paper's masses (relative stop)
 
 
 def case_layout(case: ValidationCase) -> Layout:
@@ -227,7 +226,7 @@ def read_validation_scene(document: Any, text: str = "", source: str = "scene") 
         case = settings.case
         try:
             if isinstance(case, RelativeStopCase):
-                TwoDofSystem(case.m1, case.m2, case.k1, case.k2, case.b1, case.b2).check_ratios()
+                named_system({key: getattr(case, key) for key in NAMED_KEYS}).check_ratios()
             else:
                 case_structure(case).check_dynamic_range()
         except ValueError as error:  # a ratio beyond double precision (model/structure.py, model/system.py)
