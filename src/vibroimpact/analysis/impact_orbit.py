@@ -41,7 +41,7 @@ from vibroimpact.model.excitation import angular_frequency, check_closed_form_in
 from vibroimpact.model.modal import ModalResponse, impulse_modes
 from vibroimpact.model.problem import ImpactProblem, ProblemLike, problem_of
 
-__all__ = ["ImpactOrbit", "solve_impact_orbit", "impulse_roots", "ROOTS"]
+__all__ = ["ImpactOrbit", "solve_impact_orbit", "closed_form_problem", "impulse_roots", "ROOTS"]
 
 #: The two roots of the impulse equation: '+' (the paper's, the one that is stable where either is) and '-'.
 ROOTS = ("+", "-")
@@ -377,6 +377,33 @@ def _impulse_and_phase(w: NDArray, delta: NDArray, r: NDArray, m_eff: float, a: 
     return np.where(exists, impulse, np.nan), phase, exists
 
 
+#: Why a closed form refuses a layout of the other form (by :attr:`ClosedFormLayout.two_sided`), naming its solver.
+_OTHER_FORM = {
+    False: "contact: one stop has no two-sided symmetric orbit; its closed form is vibroimpact.solve_one_impact(problem)",
+    True: "contact: the stops form a symmetric two-sided stop, whose closed form has two impacts per period: use vibroimpact.solve_two_impacts(problem)",
+}
+
+
+def closed_form_problem(system: ProblemLike, call: str, frequency: ArrayLike | None, clearance: ArrayLike | None, restitution: ArrayLike | None,
+                        amplitude: ArrayLike | None, omega: ArrayLike | None = None, two_sided: bool | None = None) -> tuple[ImpactProblem, ClosedFormLayout]:  # fmt: skip
+    """The problem a closed form solves (:func:`~vibroimpact.model.problem.problem_of`: the paper's named system needs
+    every value) and its layout (:func:`.layout.closed_form_layout`), for :func:`solve_impact_orbit` and the solvers of
+    one form, ``solve_one_impact`` (``two_sided`` False) and ``solve_two_impacts`` (True).
+
+    Raises
+    ------
+    TypeError
+        As :func:`~vibroimpact.model.problem.problem_of`, naming ``call``.
+    ValueError
+        The layout has no closed form (the reason), or is not of the form ``two_sided`` asks (naming the other solver).
+    """
+    problem = problem_of(system, call, frequency=frequency if omega is None else omega, clearance=clearance, restitution=restitution, amplitude=amplitude)
+    layout = closed_form_layout(problem)
+    if two_sided is not None and layout.two_sided != two_sided:
+        raise ValueError(_OTHER_FORM[layout.two_sided])
+    return problem, layout
+
+
 def solve_impact_orbit(
     problem: ProblemLike,
     frequency: ArrayLike | None = None,
@@ -418,8 +445,7 @@ def solve_impact_orbit(
         Impulse, phase, existence, ``frequency`` [Hz] beside ``omega`` [rad s-1], ``stable`` and ``multipliers``
         (Floquet), :meth:`~ImpactOrbit.harmonics`, :meth:`~ImpactOrbit.admissible`, the motion.
     """
-    problem = problem_of(problem, "solve_impact_orbit", frequency=frequency if omega is None else omega, clearance=clearance, restitution=restitution, amplitude=amplitude)
-    layout = closed_form_layout(problem)
+    problem, layout = closed_form_problem(problem, "solve_impact_orbit", frequency, clearance, restitution, amplitude, omega)
     check_closed_form_inputs(clearance, restitution, amplitude)
     w, delta, r, q = (np.asarray(x, dtype=float) for x in np.broadcast_arrays(
         angular_frequency(frequency, omega, problem.omega), layout.clearance if clearance is None else clearance,

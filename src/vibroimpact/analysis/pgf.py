@@ -28,10 +28,9 @@ from enum import Enum
 
 from numpy.typing import ArrayLike
 
-from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
-from vibroimpact.analysis.layout import closed_form_layout
+from vibroimpact.analysis.impact_orbit import ImpactOrbit, closed_form_problem, solve_impact_orbit
 from vibroimpact.analysis.paper_fit import PaperFit
-from vibroimpact.model.problem import ProblemLike, problem_of
+from vibroimpact.model.problem import ProblemLike
 
 __all__ = ["PgfVariant", "solve_one_impact", "AdmissibilitySettings"]
 
@@ -113,8 +112,6 @@ def solve_one_impact(
         paper's layout), ``admissible()``, the motion.
     """
     variant = PgfVariant(variant)
-    problem = problem_of(system, "solve_one_impact", frequency=frequency if omega is None else omega, clearance=clearance, restitution=restitution, amplitude=amplitude)
-    if closed_form_layout(problem).two_sided:
-        raise ValueError("contact: the stops form a symmetric two-sided stop, whose closed form has two impacts per period: use vibroimpact.solve_two_impacts(problem)")
+    problem, _ = closed_form_problem(system, "solve_one_impact", frequency, clearance, restitution, amplitude, omega, two_sided=False)
     green = PaperFit.of(problem) if variant is PgfVariant.PAPER else None
     return solve_impact_orbit(problem, frequency, clearance, restitution, amplitude, omega=omega, green=green)

@@ -5,9 +5,8 @@ from __future__ import annotations
 
 from numpy.typing import ArrayLike
 
-from vibroimpact.analysis.impact_orbit import ImpactOrbit, solve_impact_orbit
-from vibroimpact.analysis.layout import closed_form_layout
-from vibroimpact.model.problem import ProblemLike, problem_of
+from vibroimpact.analysis.impact_orbit import ImpactOrbit, closed_form_problem, solve_impact_orbit
+from vibroimpact.model.problem import ProblemLike
 
 __all__ = ["solve_two_impacts"]
 
@@ -104,8 +103,5 @@ def solve_two_impacts(
     and is a fixed point of an independent integration (scipy, events on both gaps); the monodromy equals the
     finite-difference Jacobian of that integration; a stable orbit attracts a perturbed start.
     """
-    problem = problem_of(problem, "solve_two_impacts", frequency=frequency if omega is None else omega, clearance=clearance, restitution=restitution, amplitude=amplitude)
-    layout = closed_form_layout(problem)
-    if not layout.two_sided:
-        raise ValueError("contact: one stop has no two-sided symmetric orbit; its closed form is vibroimpact.solve_one_impact(problem)")
+    problem, _ = closed_form_problem(problem, "solve_two_impacts", frequency, clearance, restitution, amplitude, omega, two_sided=True)
     return solve_impact_orbit(problem, frequency, clearance, restitution, amplitude, root, omega=omega)
