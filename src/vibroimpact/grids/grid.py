@@ -19,7 +19,6 @@ from vibroimpact.scene.schema import ENGINE_SOLUTIONS, STOP_QUANTITIES, Scene
 from vibroimpact.scene.variables import COORDINATE_ATTRIBUTES, quantity_attributes
 from vibroimpact.grids.closed_forms import general_linear_values, general_pgf_values
 from vibroimpact.runs.cluster import Progress
-from vibroimpact.runs.run import provenance
 from vibroimpact.reporting.solutions import closed_form_methods, solution_method
 
 __all__ = ["StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset", "no_one_impact_orbit", "general_quantity_attributes", "describe_stops"]
@@ -148,10 +147,6 @@ def _metadata(scene: Scene, simulation_attributes: dict[str, object]) -> dict[st
     fit = fit_modal_parameters(named) if named is not None and "pgf_paper" in scene.settings.solutions else None
     natural = named.natural_angular_frequencies() if named is not None else structure.natural_angular_frequencies()
     attrs: dict[str, object] = {
-        "title": f"vibroimpact study '{scene.name}'",
-        "scene_name": scene.name,
-        "scene": scene.text,
-        **provenance(),
         "excitation_amplitude_N": scene.amplitude,
         "natural_frequencies_Hz": np.array(natural) / (2.0 * np.pi),
     }

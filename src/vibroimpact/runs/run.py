@@ -7,7 +7,8 @@ Output contract (read by other tools; keep these names): dimensions ``solution``
 [rad] and ``regime`` (CF flags). Unswept stop parameters are scalar coordinates. Swept-sine scenes add dimension
 ``sweep``: the swept runs' estimates are ``swept_<quantity>`` (sweep, frequency) and their running estimates
 ``running_<quantity>`` (sweep, elapsed_time); the steady-state solutions are not repeated along ``sweep``. Benchmark
-scenes have dimensions (case, engine, rtol). Every dataset names its kind in the attribute ``study_kind``.
+scenes have dimensions (case, engine, rtol). Every dataset begins with the same header (``title``, ``scene_name``,
+``scene``, the provenance: :func:`dataset_header`) and names its kind in the attribute ``study_kind``.
 
 In the file (:func:`write_dataset`) each solution lives on the frequencies it was computed at: the root group holds
 the solutions computed on every frequency (the closed forms), and a study that simulates puts its simulated solutions
@@ -47,7 +48,7 @@ from vibroimpact.runs.store import StudyStore
 from vibroimpact.scene.kinds import kind_named
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, Scene
 
-__all__ = ["StudyKind", "study_kind", "run_study", "prepare_engines", "atomic_path", "write_dataset", "read_dataset", "split_groups", "join_groups", "absent_value", "SIMULATED_GROUP", "netcdf_attribute", "provenance"]
+__all__ = ["StudyKind", "study_kind", "run_study", "prepare_engines", "atomic_path", "write_dataset", "read_dataset", "split_groups", "join_groups", "absent_value", "SIMULATED_GROUP", "netcdf_attribute", "provenance", "dataset_header", "HEADER_ATTRIBUTES"]
 
 class StudyKind(Protocol):
     """What a kind of study does with a scene (each kind's ``study.py``, registered in :data:`vibroimpact.scene.kinds.KINDS`)."""
@@ -58,7 +59,7 @@ class StudyKind(Protocol):
         ...
 
     def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
-        """The scene's dataset; ``progress`` receives a line per finished step (None: silence); its work runs in
+        """The scene's dataset, without the header :func:`run_study` writes (:func:`dataset_header`); ``progress`` receives a line per finished step (None: silence); its work runs in
         ``runner`` (this process, a local dask cluster or a running one), which keeps finished work in its store."""
         ...
 
@@ -153,7 +154,7 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
         prepare_engines(engines, progress)
         runner.use_engines(engines)
         dataset = kind.run(scene, progress, runner)
-    dataset.attrs["study_kind"] = kind.name
+    dataset.attrs = dataset_header(scene, dataset.attrs) | {"study_kind": kind.name}
     if runner.worker_peak_memory:
         dataset.attrs["run_peak_memory_worker_bytes"] = runner.worker_peak_memory  # the largest dask worker
     return dataset.load() if load else dataset
@@ -163,6 +164,27 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
 # Writing datasets: atomic files (runs.output_files.atomic_path: a reader never sees half a file, a failed write leaves the
 # previous one intact), netCDF with compression and CF-clean coordinates, and the provenance every dataset carries.
 # --------------------------------------------------------------------------------------------------------------------
+
+#: The attributes :func:`dataset_header` writes first in every dataset (and a kind's run never writes).
+HEADER_ATTRIBUTES = ("title", "scene_name", "scene", "vibroimpact_version", "vibroimpact_source_sha256", "Conventions")
+
+
+def dataset_header(scene: Scene, attrs: Mapping[str, Any]) -> dict[str, Any]:
+    """``attrs`` (what a kind's run says of its dataset) after the header every dataset carries, in this order: the
+    ``title`` its kind's row gives (:meth:`vibroimpact.scene.kinds.Kind.title_of`), ``scene_name``, the scene's text
+    (``scene``) and :func:`provenance`. :func:`run_study` adds ``study_kind`` last.
+
+    Raises
+    ------
+    ValueError
+        Where ``attrs`` holds a header attribute (:data:`HEADER_ATTRIBUTES`: only this function writes them).
+    """
+    written = sorted(set(attrs) & {*HEADER_ATTRIBUTES, "study_kind"})
+    if written:
+        raise ValueError(f"the {scene.kind} kind's run wrote {', '.join(written)}: run_study writes the header of every dataset")
+    header: dict[str, Any] = {"title": kind_named(scene.kind).title_of(scene), "scene_name": scene.name, "scene": scene.text, **provenance()}
+    return header | dict(attrs)
+
 
 def provenance() -> dict[str, str]:
     """What every dataset says about how it was made: the package version, its source and the conventions followed."""

@@ -44,6 +44,9 @@ class Kind:
         Whether the kind's run shares its work among a runner's dask workers (then a local cluster starts before the
         kind's code is imported, its workers starting meanwhile); False: it runs in the study's process (timings a
         starting cluster would disturb).
+    title : str
+        What the kind's datasets say they are (attribute ``title``, after ``vibroimpact``): a ``str.format`` template
+        of the scene's ``name`` and ``settings`` (:meth:`title_of`).
     """
 
     name: str
@@ -52,12 +55,18 @@ class Kind:
     study: str
     page: str
     shares_work: bool = True
+    title: str = "study '{name}'"
 
     def __post_init__(self) -> None:
         for field in ("scene", "study", "page"):
             module, _, attribute = getattr(self, field).partition(":")
             if not module.startswith("vibroimpact.kinds.") or not attribute.isidentifier():
                 raise ValueError(f"kind {self.name!r}: {field} must be 'vibroimpact.kinds.<module>:<name>', got {getattr(self, field)!r}")
+
+    def title_of(self, scene: Any) -> str:
+        """The ``title`` of ``scene``'s dataset: ``vibroimpact`` and the kind's :attr:`title` of the scene's name and
+        settings (``vibroimpact design 'paper'``, ``vibroimpact validation 'zeno': zeno``)."""
+        return f"vibroimpact {self.title.format(name=scene.name, settings=scene.settings)}"
 
     def parse_scene(self, document: dict, text: str, source: str) -> Any:
         """Check ``document`` as a scene of this kind (the kind's scene parser, imported now)."""
@@ -79,11 +88,11 @@ def _resolve(target: str) -> Any:
 
 #: Every kind of study, first match first (see the module's docstring).
 KINDS: tuple[Kind, ...] = (
-    Kind("design", "design", "vibroimpact.kinds.design.scene:parse_design_scene", "vibroimpact.kinds.design.study:DesignStudy", "vibroimpact.kinds.design.page:page_for"),
-    Kind("concepts", "concepts", "vibroimpact.kinds.concepts.scene:parse_concepts_scene", "vibroimpact.kinds.concepts.study:ConceptsStudy", "vibroimpact.kinds.concepts.page:page_for"),
-    Kind("validation", "validation", "vibroimpact.kinds.validation.scene:parse_validation_scene", "vibroimpact.kinds.validation.study:ValidationStudy", "vibroimpact.kinds.validation.page:page_for", shares_work=False),
-    Kind("benchmark", "benchmark", "vibroimpact.kinds.benchmark.scene:parse_benchmark_scene", "vibroimpact.kinds.benchmark.study:BenchmarkStudy", "vibroimpact.kinds.benchmark.page:page_for", shares_work=False),
-    Kind("bifurcation", "bifurcation", "vibroimpact.kinds.bifurcation.scene:parse_bifurcation_scene", "vibroimpact.kinds.bifurcation.study:BifurcationStudy", "vibroimpact.kinds.bifurcation.page:page_for"),
+    Kind("design", "design", "vibroimpact.kinds.design.scene:parse_design_scene", "vibroimpact.kinds.design.study:DesignStudy", "vibroimpact.kinds.design.page:page_for", title="design '{name}'"),
+    Kind("concepts", "concepts", "vibroimpact.kinds.concepts.scene:parse_concepts_scene", "vibroimpact.kinds.concepts.study:ConceptsStudy", "vibroimpact.kinds.concepts.page:page_for", title="absorber concepts '{name}'"),
+    Kind("validation", "validation", "vibroimpact.kinds.validation.scene:parse_validation_scene", "vibroimpact.kinds.validation.study:ValidationStudy", "vibroimpact.kinds.validation.page:page_for", shares_work=False, title="validation '{name}': {settings.name}"),
+    Kind("benchmark", "benchmark", "vibroimpact.kinds.benchmark.scene:parse_benchmark_scene", "vibroimpact.kinds.benchmark.study:BenchmarkStudy", "vibroimpact.kinds.benchmark.page:page_for", shares_work=False, title="benchmark '{name}'"),
+    Kind("bifurcation", "bifurcation", "vibroimpact.kinds.bifurcation.scene:parse_bifurcation_scene", "vibroimpact.kinds.bifurcation.study:BifurcationStudy", "vibroimpact.kinds.bifurcation.page:page_for", title="bifurcation study '{name}'"),
     Kind("swept", "swept_sine", "vibroimpact.kinds.swept.scene:parse_swept_scene", "vibroimpact.kinds.swept.study:SweptStudy", "vibroimpact.kinds.swept.page:page_for"),
     Kind("stepped", None, "vibroimpact.kinds.stepped.scene:parse_stepped_scene", "vibroimpact.kinds.stepped.study:SteppedStudy", "vibroimpact.kinds.stepped.page:page_for"),
 )  # fmt: skip

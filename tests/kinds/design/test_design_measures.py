@@ -14,8 +14,8 @@ import xarray as xr
 import yaml
 
 from vibroimpact.engines.exact import ExactEngine
-from vibroimpact.kinds.design.study import DesignStudy, design_space
-from vibroimpact.runs.runner import Runner
+from vibroimpact.kinds.design.study import design_space
+from vibroimpact.runs.run import run_study
 from vibroimpact.scene.checker import SceneError
 from vibroimpact.scene.reader import parse_scene
 from vibroimpact.simulation.attractors import at_frequency
@@ -43,7 +43,7 @@ def run(objective: str, **design: object) -> tuple[xr.Dataset, object]:
     document = copy.deepcopy(SCENE)
     document["design"] |= {"objective": objective, **design}
     scene = parse_scene(document, text=yaml.safe_dump(document, sort_keys=False))
-    return DesignStudy().run(scene, None, Runner(jobs=1, progress=False)), scene
+    return run_study(scene, progress=None), scene
 
 
 def independent_maximum(problem: object, objective: str, band: tuple[float, float]) -> tuple[float, float]:

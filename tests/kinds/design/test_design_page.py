@@ -22,9 +22,8 @@ from vibroimpact.kinds.design.answer import answer_text, design_titles, linear_w
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, response_figure, robustness_figure, search_figure
 from vibroimpact.kinds.design.page import DesignPage, best_marks, designs_table
 from vibroimpact.kinds.design.tradeoff import front_text, tradeoff_figure
-from vibroimpact.kinds.design.study import DesignStudy
+from vibroimpact.runs.run import run_study
 from vibroimpact.reporting.page import write_report
-from vibroimpact.runs.runner import Runner
 from vibroimpact.scene.reader import parse_scene
 
 import matplotlib.pyplot as plt
@@ -51,7 +50,7 @@ TWO_VARIABLES = {
 
 def _run(document: dict) -> xr.Dataset:
     scene = parse_scene(copy.deepcopy(document), text=yaml.safe_dump(document, sort_keys=False))
-    return DesignStudy().run(scene, None, Runner(jobs=1, progress=False))
+    return run_study(scene, progress=None)
 
 
 @pytest.fixture(scope="module")

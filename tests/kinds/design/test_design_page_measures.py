@@ -24,12 +24,11 @@ from vibroimpact.kinds.design.figures import response_figure, robustness_figure,
 from vibroimpact.kinds.design.operating import design_operating, operating_sentence, operating_warnings
 from vibroimpact.kinds.design.page import certificates_table, designs_table, method_text
 from vibroimpact.kinds.design.quantity import Quantity, constraint_quantity, objective_quantity, operating_limit, quantity
-from vibroimpact.kinds.design.study import DesignStudy
+from vibroimpact.runs.run import run_study
 from vibroimpact.kinds.design.tradeoff import front_text, tradeoff_figure
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.reporting.page import write_report
 from vibroimpact.reporting.style import fmt
-from vibroimpact.runs.runner import Runner
 from vibroimpact.scene.reader import parse_scene
 
 from tests.golden.golden import page_text
@@ -48,7 +47,7 @@ def _run(name: str, objective: str, limit: dict[str, float], compare: str = "lin
     document["design"]["compare"] = compare
     document["design"]["constraints"] = {"operating": {"frequency": AT, **limit}}
     scene = parse_scene(copy.deepcopy(document), text=yaml.safe_dump(document, sort_keys=False))
-    return DesignStudy().run(scene, None, Runner(jobs=1, progress=False))
+    return run_study(scene, progress=None)
 
 
 @pytest.fixture(scope="module")

@@ -10,9 +10,8 @@ import pytest
 from vibroimpact.kinds.validation.page import ValidationPage, write_validation_report
 from vibroimpact.scene.reader import read_yaml
 from vibroimpact.scene.kinds import KIND_NAMES as STUDY_KINDS
-from vibroimpact.kinds.validation.scene import read_validation_scene
-from vibroimpact.runs.run import write_dataset
-from vibroimpact.kinds.validation.study import run_validation
+from vibroimpact.kinds.validation.scene import parse_validation_scene
+from vibroimpact.runs.run import run_study, write_dataset
 from vibroimpact.kinds.validation.formulas import PASSED_MEANINGS
 
 from tests.study.test_cf import cf_findings
@@ -24,8 +23,8 @@ REGISTERED = "validation" in STUDY_KINDS
 
 def _zeno(tmp_path: Path):
     text = (STUDIES / "zeno.yaml").read_text(encoding="utf-8")
-    scene = read_validation_scene(read_yaml(text), text)
-    return scene, run_validation(scene.settings, scene.name, scene.text)
+    scene = parse_validation_scene(read_yaml(text), text)
+    return scene, run_study(scene, progress=None)
 
 
 def test_dataset_table_and_page(tmp_path: Path) -> None:

@@ -24,7 +24,6 @@ from vibroimpact.engines.settings import REFERENCE_RTOL, EngineSettings
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.estimate import Costs, Estimate, engine_scale
-from vibroimpact.runs.run import provenance
 from vibroimpact.runs.runner import Runner
 from vibroimpact.kinds.benchmark.scene import BenchmarkCase, BenchmarkSettings, LadderSettings
 from vibroimpact.scene.schema import Scene
@@ -441,7 +440,6 @@ class BenchmarkStudy:
         ``runner`` is not used)."""
         assert scene.settings is not None
         dataset = run_benchmark(list(scene.settings.cases), scene.settings.settings, progress=progress is not None)
-        dataset.attrs.update({"title": f"vibroimpact benchmark '{scene.name}'", "scene_name": scene.name, "scene": scene.text} | provenance())
         if scene.layout.paper_view() is None:  # the paper's layout needs no record: its page draws the paper's names
             dataset.attrs.update(scene.layout.attributes(*_shared_values(scene.settings.cases, scene.layout.stops)) | closed_form_methods() | {"excitation_amplitude_N": scene.amplitude})
         return dataset

@@ -71,7 +71,6 @@ from vibroimpact.kinds.bifurcation.cases import BranchCase, ChartCase, SweepCase
 from vibroimpact.kinds.bifurcation.stiffness import SOFTER, STIFFER, StiffnessCase
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.cluster import Progress
-from vibroimpact.runs.run import provenance
 from vibroimpact.runs.runner import CaseResult, Runner
 from vibroimpact.simulation.attractors import MAX_KEPT_IMPACTS, MAX_PERIOD, MOTION_CLASSES
 
@@ -436,10 +435,6 @@ def _metadata(scene: Scene, results: list[CaseResult], sweeps: list[CaseResult],
     settings = scene.settings
     assert settings is not None
     attrs: dict[str, object] = {
-        "title": f"vibroimpact bifurcation study '{scene.name}'",
-        "scene_name": scene.name,
-        "scene": scene.text,
-        **provenance(),
         **_layout_attributes(scene),
         "frequency_band_Hz": np.array([settings.low, settings.high]),
         "brute_force_transient_periods": settings.brute_force.transient_periods,

@@ -236,8 +236,7 @@ def concepts_dataset(settings: ConceptsSettings, closed: dict[str, ClosedForms],
               "point": ("point", np.arange(points, dtype=np.int32), {"units": "1", "long_name": "index of the point along each concept's continued branch"})}  # fmt: skip
     dataset = xr.Dataset({k: xr.Variable(*v) for k, v in data.items()}, coords=coords)
     dataset.attrs.update({"band_low_Hz": low, "band_high_Hz": high, "anti_resonance_Hz": anti, "static_deflection_m": static,
-                          "excitation_amplitude_N": settings.amplitude, "bumper_frequency_Hz": settings.bumper_frequency,
-                          "study_kind": "concepts"})  # fmt: skip
+                          "excitation_amplitude_N": settings.amplitude, "bumper_frequency_Hz": settings.bumper_frequency})  # fmt: skip
     if failures:
         dataset.attrs["run_failures"] = failures  # said on the page and in the console (vibroimpact.runs.failures)
     return dataset
@@ -331,12 +330,8 @@ class ConceptsStudy:
         return (rigid, engine_for(BUMPER, "exact_jacobians"), "compliant")
 
     def run(self, scene: Any, progress: Progress | None, runner: Runner) -> xr.Dataset:
-        """The scene's dataset, with its name, text and provenance."""
-        from vibroimpact.runs.run import provenance
-
-        dataset = run_concepts(scene.settings, progress, runner)
-        dataset.attrs.update({"title": f"vibroimpact absorber concepts '{scene.name}'", "scene_name": scene.name, "scene": scene.text} | provenance())
-        return dataset
+        """The scene's dataset (its header is :func:`~vibroimpact.runs.run.run_study`'s)."""
+        return run_concepts(scene.settings, progress, runner)
 
     def estimate(self, scene: Any, jobs: int, costs: Costs) -> Estimate:
         """Predicted wall time and memory on the calibration machine, from this kind's own measured costs per point

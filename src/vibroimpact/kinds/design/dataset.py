@@ -132,7 +132,7 @@ def design_dataset(scene: Any, outcome: Outcome) -> xr.Dataset:
         data[f"{part}_wall_time"] = xr.Variable((), outcome.wall_times.get(part, math.nan), {"units": "s", "long_name": f"wall time of the {part}"})
     dataset = xr.Dataset(data, coords=coords)
     dataset.attrs.update(attrs)
-    dataset.attrs.update({"study_kind": "design", "band_low_Hz": settings.band[0], "band_high_Hz": settings.band[1], "objective": settings.objective,
+    dataset.attrs.update({"band_low_Hz": settings.band[0], "band_high_Hz": settings.band[1], "objective": settings.objective,
                           "quantile": settings.quantile, "samples": settings.samples, "mistuning_seed": settings.seed, "search_method": settings.search.method,
                           "variables": ", ".join(v.name for v in settings.variables), "operating_frequency_Hz": settings.operating[0] if settings.operating else math.nan,
                           "operating_limit_m": settings.operating[1] if settings.operating else math.nan, "recommended_evaluation": outcome.recommended,

@@ -241,12 +241,8 @@ class DesignStudy:
         return (engine_for(RIGID if settings.bumper_frequency is None else BUMPER, "exact_jacobians"),)
 
     def run(self, scene: Any, progress: Progress | None, runner: Runner) -> xr.Dataset:
-        """The scene's dataset, with its name, text and provenance."""
-        from vibroimpact.runs.run import provenance
-
-        dataset = run_design(scene, progress, runner)
-        dataset.attrs.update({"title": f"vibroimpact design '{scene.name}'", "scene_name": scene.name, "scene": scene.text} | provenance())
-        return dataset
+        """The scene's dataset (its header is :func:`~vibroimpact.runs.run.run_study`'s)."""
+        return run_design(scene, progress, runner)
 
     def estimate(self, scene: Any, jobs: int, costs: Costs) -> Estimate:
         """Predicted wall time and memory on the calibration machine, from :data:`SECONDS_PER_SAMPLE` and

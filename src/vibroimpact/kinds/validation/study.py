@@ -26,7 +26,6 @@ from vibroimpact.kinds.validation.scene import relative_stop_problem, zeno_probl
 from vibroimpact.kinds.validation.settings import RelativeStopCase, ZenoCase, ValidationSettings
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.runs.estimate import Costs, Estimate
-from vibroimpact.runs.run import provenance
 from vibroimpact.runs.runner import Runner
 
 __all__ = ["run_zeno", "run_relative_stop", "FreeFlight", "free_flight", "INTEGRATOR_ALLOWANCE", "ROUND_OFF_EVENTS", "ValidationStudy", "run_validation", "RUNNERS", "CASE_SECONDS"]
@@ -275,17 +274,12 @@ CASE_SECONDS = MappingProxyType({"budd_dux": 1.5, "bouncing_ball": 4.0, "zeno": 
 REPORT_FIGURES = 1
 
 
-def run_validation(settings: ValidationSettings, name: str, text: str = "", progress: Callable[[str], None] | None = None) -> xr.Dataset:
-    """Run a validation case and gather its dataset (module docstring)."""
+def run_validation(settings: ValidationSettings, progress: Callable[[str], None] | None = None) -> xr.Dataset:
+    """Run a validation case and gather its dataset (module docstring; its header is
+    :func:`~vibroimpact.runs.run.run_study`'s)."""
     say = progress if progress is not None else (lambda message: None)
     outcome = RUNNERS[settings.name](settings.case, say)
-    attrs = {
-        "title": f"vibroimpact validation '{name}': {settings.name}",
-        "scene_name": name,
-        "scene": text,
-        "validation_source": settings.source,
-        "study_kind": "validation",
-    } | provenance()
+    attrs = {"validation_source": settings.source}
     passed = sum(c.passed for c in outcome.checks)
     checks = sum(not c.informative for c in outcome.checks)
     say(f"{settings.name}: {passed} of {checks} checks passed")
@@ -304,7 +298,7 @@ class ValidationStudy:
 
     def run(self, scene, progress: Callable[[str], None] | None, runner: Runner) -> xr.Dataset:
         """The scene's dataset (module docstring); one process (each case takes seconds)."""
-        return run_validation(scene.settings, scene.name, scene.text, progress)
+        return run_validation(scene.settings, progress)
 
     def estimate(self, scene, jobs: int, costs: Costs) -> Estimate:
         """The case's measured time plus the report, on the calibration machine."""
