@@ -21,7 +21,7 @@ from vibroimpact.grids.closed_forms import general_linear_values, general_pgf_va
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.reporting.solutions import closed_form_methods, solution_method
 
-__all__ = ["StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset", "no_one_impact_orbit", "general_quantity_attributes", "describe_stops"]
+__all__ = ["StudyGrid", "solve_each", "grid_coordinates", "steady_variable", "finish_dataset", "no_one_impact_orbit", "general_quantity_attributes", "describe_stops", "grid_engines"]
 
 #: The values of one solution, quantity -> array over (part of) the full grid.
 Values = dict[str, np.ndarray]
@@ -115,6 +115,12 @@ def steady_variable(quantity: str, scene: Scene, grid: StudyGrid, per_solution: 
 
     steady = [full(name, values) for name, values in zip(scene.settings.solutions, per_solution) if name in solutions]
     return np.stack(steady) if steady else None
+
+
+def grid_engines(scene: Scene) -> tuple[str, ...]:
+    """The engines among a grid scene's solutions (the closed forms need none): the stepped and swept kinds'
+    ``engines``."""
+    return tuple(name for name in scene.settings.solutions if name in ENGINE_SOLUTIONS)
 
 
 def finish_dataset(dataset: xr.Dataset, scene: Scene, coords: dict[str, object], simulation_attributes: dict[str, object], keep: tuple[str, ...] = ()) -> xr.Dataset:

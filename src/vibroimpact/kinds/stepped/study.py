@@ -16,7 +16,7 @@ from vibroimpact.engines.registry import BUMPER, engine_spec
 from vibroimpact.kinds.stepped.cases import general_simulated_values
 from vibroimpact.grids.closed_forms import stop_clearances
 from vibroimpact.grids.estimate import EnginePart, closed_form_scale, grid_estimate
-from vibroimpact.grids.grid import StudyGrid, describe_stops, finish_dataset, general_quantity_attributes, grid_coordinates, solve_each
+from vibroimpact.grids.grid import StudyGrid, describe_stops, finish_dataset, general_quantity_attributes, grid_coordinates, grid_engines, solve_each
 from vibroimpact.kinds.stepped.blocks import plan_blocks, run_grid
 from vibroimpact.scene.subset import subset_axes, subset_share, subset_text
 from vibroimpact.runs.cluster import Progress
@@ -114,11 +114,7 @@ class SteppedStudy:
     """Steady states over (restitution, clearance, bumper, frequency): dimension ``solution`` for every solution."""
 
     name = "stepped"
-
-    @staticmethod
-    def engines(scene: Scene) -> tuple[str, ...]:
-        """The engines among the scene's solutions (the closed forms need none)."""
-        return tuple(name for name in scene.settings.solutions if name in ENGINE_SOLUTIONS)
+    engines = staticmethod(grid_engines)
 
     def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """Every solution of ``scene`` over its grid (see :func:`vibroimpact.runs.run.run_study`), solved block by

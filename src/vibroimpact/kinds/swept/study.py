@@ -26,7 +26,7 @@ from vibroimpact.engines.registry import make_engine
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.grids.closed_forms import general_linear_values, general_pgf_values
 from vibroimpact.grids.estimate import EnginePart, closed_form_scale, grid_estimate
-from vibroimpact.grids.grid import StudyGrid, describe_stops, finish_dataset, general_quantity_attributes, grid_coordinates
+from vibroimpact.grids.grid import StudyGrid, describe_stops, finish_dataset, general_quantity_attributes, grid_coordinates, grid_engines
 from vibroimpact.model.contact import Stop
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem
@@ -188,11 +188,7 @@ class SweptStudy:
     """Swept-sine tests of the compliant model beside the steady-state closed forms; dimension ``sweep``."""
 
     name = "swept"
-
-    @staticmethod
-    def engines(scene: Scene) -> tuple[str, ...]:
-        """The engines among the scene's solutions (a swept sine runs the compliant one)."""
-        return tuple(name for name in scene.settings.solutions if name in ENGINE_SOLUTIONS)
+    engines = staticmethod(grid_engines)  # a swept sine runs the compliant engine
 
     def run(self, scene: Scene, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """Every solution of ``scene`` over its grid (see :func:`vibroimpact.runs.run.run_study`)."""
