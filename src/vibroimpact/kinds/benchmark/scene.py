@@ -37,7 +37,7 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.contact import Stop
 from vibroimpact.model.parameters import MAX_BUMPER_FREQUENCY
 from vibroimpact.scene.checker import Checker, SceneError
-from vibroimpact.scene.header import NAME, check_sweep_run, parse_names
+from vibroimpact.scene.header import NAME, check_sweep_run, open_scene
 from vibroimpact.scene.layout_parse import parse_layout
 from vibroimpact.scene.schema import (
     BENCHMARK_METHODS,
@@ -204,9 +204,7 @@ class _Layout:
 def parse_benchmark_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
     """Validate a benchmark scene's document (a mapping with ``benchmark``) and build the :class:`Scene`; raise
     :class:`SceneError` listing all problems."""
-    c = Checker()
-    doc = c.mapping("", document, BENCHMARK_TOP_KEYS, {"name", "system", "excitation", "benchmark"}, kind="benchmark")
-    name, description, report = parse_names(c, doc)
+    c, doc, name, description, report = open_scene(document, BENCHMARK_TOP_KEYS, {"name", "system", "excitation", "benchmark"}, "benchmark")
     parsed, amplitude, _ = parse_layout(c, doc)
     layout = _Layout(parsed, amplitude) if parsed is not None and amplitude is not None else None
     spec = c.mapping("benchmark", doc["benchmark"], _BENCHMARK_KEYS, {"duration", "methods", "tolerances", "cases"}) if "benchmark" in doc else {}

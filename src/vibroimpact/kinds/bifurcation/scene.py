@@ -55,7 +55,7 @@ from vibroimpact.model.structure import require_in_range, require_positive
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.model.contact import place_effective_mass
 from vibroimpact.model.layout import Layout, StopSpec
-from vibroimpact.scene.header import parse_names
+from vibroimpact.scene.header import open_scene
 from vibroimpact.scene.layout_parse import parse_layout, static_drift
 from vibroimpact.scene.schema import SWEEP_DIRECTIONS, Scene
 
@@ -279,9 +279,7 @@ _CHART_KEYS = {"restitution", "clearance", "kinds", "max_steps", "frequency_step
 def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
     """Validate a bifurcation scene's document (a mapping with ``bifurcation``) and build the :class:`Scene`; raise
     :class:`SceneError` listing all problems."""
-    c = Checker()
-    doc = c.mapping("", document, BIFURCATION_TOP_KEYS, {"name", "system", "excitation", "bifurcation"}, kind="bifurcation")
-    name, description, report = parse_names(c, doc)
+    c, doc, name, description, report = open_scene(document, BIFURCATION_TOP_KEYS, {"name", "system", "excitation", "bifurcation"}, "bifurcation")
     layout, amplitude, _ = parse_layout(c, doc)
     if layout is not None and static_drift(layout):
         c.fail("excitation.static", "the static force pushes the structure along a rigid-body mode: it has no steady state to follow")

@@ -32,7 +32,7 @@ import numpy as np
 
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.layout import Layout
-from vibroimpact.scene.header import NAME, parse_names
+from vibroimpact.scene.header import NAME, open_scene
 from vibroimpact.scene.layout_parse import parse_layout
 from vibroimpact.scene.simulation import parse_simulation
 from vibroimpact.model.absorber import den_hartog_absorber
@@ -163,9 +163,7 @@ MAX_SIMULATION_POINTS = 2000
 def parse_concepts(document: Any, source: str = "scene") -> tuple[str, str, bool, ConceptsSettings]:
     """Check a concepts scene's document and return (name, description, report, settings); :class:`SceneError`
     listing every problem otherwise."""
-    c = Checker()
-    doc = c.mapping("", document, CONCEPTS_TOP_KEYS, {"name", "system", "excitation", "frequency", "concepts"}, kind="concepts")
-    name, description, report = parse_names(c, doc)
+    c, doc, name, description, report = open_scene(document, CONCEPTS_TOP_KEYS, {"name", "system", "excitation", "frequency", "concepts"}, "concepts")
     layout, amplitude, _ = parse_layout(c, doc)
     system = layout.paper_view() if layout is not None else None  # the absorber concepts are variants of the paper's layout
     if layout is not None and system is None:

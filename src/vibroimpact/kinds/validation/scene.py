@@ -24,7 +24,7 @@ from typing import Any
 
 
 from vibroimpact.model.layout import Layout, LoadSpec, StopSpec
-from vibroimpact.scene.header import parse_names
+from vibroimpact.scene.header import open_scene
 from vibroimpact.kinds.validation.settings import BouncingBallCase, BuddDuxCase, GrazingCase, RelativeStopCase, ValidationCase, ZenoCase
 from vibroimpact.kinds.validation.settings import (
     CASE_PARAMETERS,
@@ -218,9 +218,7 @@ def _consistent(c: Checker, case: str, values: dict[str, Any]) -> bool:
 def read_validation_scene(document: Any, text: str = "", source: str = "scene") -> ValidationScene:
     """Check a validation scene's document (a mapping with ``validation``); raise :class:`SceneError` listing all
     problems."""
-    c = Checker()
-    doc = c.mapping("", document, VALIDATION_TOP_KEYS, {"name", "validation"}, kind="validation")
-    name, description, report = parse_names(c, doc)
+    c, doc, name, description, report = open_scene(document, VALIDATION_TOP_KEYS, {"name", "validation"}, "validation")
     settings = validation_settings(c, doc["validation"]) if "validation" in doc else None
     if settings is not None and not c.problems:
         case = settings.case
