@@ -70,9 +70,10 @@ def test_the_attributes_read_back_as_the_same_layout() -> None:
     assert view is not None and view.k1 == 0.1  # exact: the recorded parameter, not K[0, 0] - K2
 
 
-@pytest.mark.parametrize(("name", "paper"), [("bifurcation", True), ("bifurcation_relative_stop", False), ("restitution", True), ("relative_stop", False)])
+@pytest.mark.parametrize(("name", "paper"), [("bifurcation", True), ("bifurcation_relative_stop", False), ("restitution", True), ("relative_stop", False), ("design_paper", True), ("validation_relative_stop", False)])
 def test_every_golden_dataset_records_its_layout(name: str, paper: bool) -> None:
-    """The bifurcation kind writes its layout with the one writer too: a page reads any kind's layout back."""
+    """The bifurcation, design and validation kinds write their layout with the one writer too: a page reads any
+    kind's layout back (a concepts dataset records the concepts' shared structure and load, and no stop)."""
     with xr.open_dataset(DATA / f"{name}.nc") as dataset:
         layout = Layout.from_attributes(dataset.attrs)
     assert (layout.paper_view() is not None) is paper

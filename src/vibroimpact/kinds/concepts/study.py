@@ -330,8 +330,14 @@ class ConceptsStudy:
         return (rigid, engine_for(BUMPER, "exact_jacobians"), "compliant")
 
     def run(self, scene: Any, progress: Progress | None, runner: Runner) -> xr.Dataset:
-        """The scene's dataset (its header is :func:`~vibroimpact.runs.run.run_study`'s)."""
-        return run_concepts(scene.settings, progress, runner)
+        """The scene's dataset (its header is :func:`~vibroimpact.runs.run.run_study`'s), with the structure and load
+        every concept shares (:meth:`~vibroimpact.model.layout.Layout.attributes`: ``system_*``, ``excitation_*``).
+        The ``stop_*`` attributes are left out: each concept has its own stops (variable ``stops``) and absorber
+        (``absorber_stiffness``, ``absorber_damping``), the scene none of its own."""
+        dataset = run_concepts(scene.settings, progress, runner)
+        shared = scene.layout.attributes(np.array([]), np.array([]))
+        dataset.attrs.update({key: value for key, value in shared.items() if not key.startswith("stop_")})
+        return dataset
 
     def estimate(self, scene: Any, jobs: int, costs: Costs) -> Estimate:
         """Predicted wall time and memory on the calibration machine, from this kind's own measured costs per point

@@ -241,8 +241,13 @@ class DesignStudy:
         return (engine_for(RIGID if settings.bumper_frequency is None else BUMPER, "exact_jacobians"),)
 
     def run(self, scene: Any, progress: Progress | None, runner: Runner) -> xr.Dataset:
-        """The scene's dataset (its header is :func:`~vibroimpact.runs.run.run_study`'s)."""
-        return run_design(scene, progress, runner)
+        """The scene's dataset (its header is :func:`~vibroimpact.runs.run.run_study`'s), with the layout it designs
+        (:meth:`~vibroimpact.model.layout.Layout.attributes`, its stops at the scene's own clearance and restitution)."""
+        settings: DesignSettings = scene.settings
+        dataset = run_design(scene, progress, runner)
+        bumper = None if settings.bumper_frequency is None else np.array([settings.bumper_frequency])
+        dataset.attrs.update(scene.layout.attributes(np.array([settings.restitution]), np.array([settings.clearance]), bumper))
+        return dataset
 
     def estimate(self, scene: Any, jobs: int, costs: Costs) -> Estimate:
         """Predicted wall time and memory on the calibration machine, from :data:`SECONDS_PER_SAMPLE` and

@@ -297,8 +297,15 @@ class ValidationStudy:
         return tuple(getattr(scene.settings.case, "engines", ("exact",)))
 
     def run(self, scene, progress: Callable[[str], None] | None, runner: Runner) -> xr.Dataset:
-        """The scene's dataset (module docstring); one process (each case takes seconds)."""
-        return run_validation(scene.settings, progress)
+        """The scene's dataset (module docstring); one process (each case takes seconds). Every case has a layout
+        (:func:`~vibroimpact.kinds.validation.scene.case_layout`), recorded as every kind records its own
+        (:meth:`~vibroimpact.model.layout.Layout.attributes`): its stop at the case's restitution and clearance (the
+        Budd-Dux case's continued range of clearances: swept; the bouncing ball's and Zeno's table: 0)."""
+        dataset = run_validation(scene.settings, progress)
+        case = scene.settings.case
+        clearance = np.atleast_1d(np.asarray(getattr(case, "clearance", 0.0), dtype=float))
+        dataset.attrs.update(scene.layout.attributes(np.array([case.restitution]), clearance))
+        return dataset
 
     def estimate(self, scene, jobs: int, costs: Costs) -> Estimate:
         """The case's measured time plus the report, on the calibration machine."""
