@@ -44,10 +44,11 @@ class Capabilities:
     sweeps : bool
         Also a sweeping engine: ``sweep(problem, sample_rate, state, progress)`` runs a swept sine (a closed-form
         engine cannot: a chirp has no closed-form particular solution).
-    period_shooting : bool
-        ``shoot_period(problem, guess, scale, tolerance, max_iterations)`` finds a period-1 orbit by damped Newton on
-        its compiled period, without the general map's Python around each evaluation (a
-        :class:`~vibroimpact.engines.compliant.period_shooting.PeriodOrbit`, or None).
+    compiled_period : bool
+        ``compiled_period(problem)`` gives its stroboscopic map over one period from t = 0 as its compiled loop alone
+        computes it, without the general map's Python around each evaluation (a
+        :class:`~vibroimpact.engines.compliant.exact.CompiledPeriod`, shot as
+        :class:`~vibroimpact.orbits.bumper_map.CompiledPeriodMap`).
     compiled : bool
         Its kernels are compiled by numba on first use (tens of seconds) and kept in numba's on-disk cache: its module's
         ``kernels_cached()`` says whether the cache holds them and ``prepare_kernels()`` compiles them in the calling
@@ -60,7 +61,7 @@ class Capabilities:
     tolerance_free: bool = False
     stepped_solution: bool = False
     sweeps: bool = False
-    period_shooting: bool = False
+    compiled_period: bool = False
     compiled: bool = False
 
     def __post_init__(self) -> None:
@@ -159,7 +160,7 @@ ENGINES: Mapping[str, EngineSpec] = MappingProxyType(
         "compliant_ida": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", BUMPER_INTEGRATOR, "the engine compliant, under the name benchmark scenes use"),
         "compliant_cvode_adams": EngineSpec("vibroimpact.engines.compliant.ida:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (Adams)", settings_method="adams"),
         "compliant_cvode_bdf": EngineSpec("vibroimpact.engines.compliant.ida:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (BDF)", settings_method="bdf"),
-        "compliant_exact": EngineSpec("vibroimpact.engines.compliant.exact:CompliantExactEngine", Capabilities(BUMPER, exact_jacobians=True, exact_flow=True, tolerance_free=True, stepped_solution=True, period_shooting=True, compiled=True), "Kelvin-Voigt bumper in closed form per contact mode with guaranteed switch search, compiled: the bumper's reference"),
+        "compliant_exact": EngineSpec("vibroimpact.engines.compliant.exact:CompliantExactEngine", Capabilities(BUMPER, exact_jacobians=True, exact_flow=True, tolerance_free=True, stepped_solution=True, compiled_period=True, compiled=True), "Kelvin-Voigt bumper in closed form per contact mode with guaranteed switch search, compiled: the bumper's reference"),
     }
 )
 

@@ -10,6 +10,11 @@ reaching a cusp), without matching points of separate branches by distance.
 
 Changing T_b keeps the bumper's restitution R, hence its loss factor (R depends on the loss factor alone, corrected
 eq. 26): K_b and B_b = 2 M2 xi_b Omega_b scale together.
+
+:class:`CompiledPeriodMap` is the same :class:`~vibroimpact.orbits.maps.ImpactMap` of bumpers over one period with
+each evaluation the engine's compiled period alone (its image and exact Jacobian bit for bit, its contacts, nothing
+that continuation watches besides): the map :func:`~vibroimpact.orbits.shooting.shoot` is given where it shoots many
+orbits (the bumper screen, :mod:`~vibroimpact.orbits.bumper_screen`).
 """
 
 from __future__ import annotations
@@ -25,9 +30,10 @@ from numpy.typing import ArrayLike, NDArray
 from vibroimpact.model.contact import BUMPER, KelvinVoigtBumper, RigidStop
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.parameters import BUMPER_STIFFNESS
+from vibroimpact.orbits.branch import HybridInfo, MapEvaluation
 from vibroimpact.orbits.maps import PARAMETERS, ImpactMap
 
-__all__ = ["BumperPeriodMap", "BUMPER_PERIOD"]
+__all__ = ["BumperPeriodMap", "CompiledPeriodMap", "BUMPER_PERIOD"]
 
 #: The added parameter's name; its units are seconds.
 BUMPER_PERIOD = "bumper_period"
@@ -87,3 +93,46 @@ class BumperPeriodMap(ImpactMap):
             dataclasses.replace(item, law=dataclasses.replace(item.law, frequency=1.0 / period)) if k in self.stops else item for k, item in enumerate(problem.stops)
         )
         return ImpactProblem(problem.system, stops, problem.excitation)
+
+
+class CompiledPeriodMap(ImpactMap):
+    """:class:`~vibroimpact.orbits.maps.ImpactMap` of a problem with Kelvin-Voigt bumpers over one period, each
+    evaluation its engine's compiled period (:meth:`~vibroimpact.engines.compliant.exact.CompliantExactEngine.
+    compiled_period`, made once per parameter vector): the same image and exact Jacobian, and of the hybrid
+    information the contacts per period only (no closest approach nor onset speeds: NaN), for
+    :func:`~vibroimpact.orbits.shooting.shoot`, not for continuation. Parameters as ImpactMap's (``periods`` 1).
+
+    Raises
+    ------
+    ValueError
+        ``periods`` other than 1, or an engine without a compiled period (``capabilities.compiled_period``).
+    """
+
+    def __init__(self, problem: ImpactProblem, periods: int = 1, engine: Any = None, bounds: dict[str, tuple[float, float]] | None = None,
+                 stop: int | str | None = None, parameter_scale: ArrayLike | None = None, layout: Sequence[str] = ()) -> None:  # fmt: skip
+        super().__init__(problem, periods, engine, bounds, stop, parameter_scale, layout)
+        if self.periods != 1:
+            raise ValueError(f"periods = {periods!r}: a compiled period map is over one period")
+        if not self.engine.capabilities.compiled_period:
+            raise ValueError(f"a compiled period map needs an engine that gives its compiled period; {self.engine.name!r} does not")
+        self._period: tuple[ImpactProblem, Any] | None = None  # the last parameter vector's problem and its period
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The map without its caches."""
+        return super().__getstate__() | {"_period": None}
+
+    def evaluate(self, y: NDArray[np.float64], p: NDArray[np.float64]) -> MapEvaluation:
+        """The state one period after ``y`` at t = 0, its exact Jacobian and the contacts; no image (NaN) where
+        :meth:`ImpactMap.evaluate` has none."""
+        problem = self.image_problem(y, p)
+        image = None
+        if problem is not None:
+            last = self._period  # read once: another thread may replace it
+            if last is None or last[0] is not problem:
+                last = self._period = (problem, self.engine.compiled_period(problem))
+            image = last[1](y)
+        n = self.dimension
+        if image is None:
+            return MapEvaluation(np.full(n, np.nan), np.full((n, n), np.nan), None, None)
+        length = self.state_scale[0]
+        return MapEvaluation(image.state, image.jacobian, None, HybridInfo(image.contacts, math.nan, math.nan, 0, length, problem.omega * length))  # type: ignore[union-attr]

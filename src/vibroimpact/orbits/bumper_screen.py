@@ -30,11 +30,12 @@ from vibroimpact.analysis.band_worst import MOTIONS, BandWorst, contact_free_cur
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.analysis.measures import Measure, as_measure
-from vibroimpact.engines.compliant.period_shooting import PeriodOrbit
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.orbits.branch import PeriodicOrbit
+from vibroimpact.orbits.bumper_map import CompiledPeriodMap
 from vibroimpact.orbits.maps import ImpactMap
-from vibroimpact.orbits.shooting import ShootingSettings
+from vibroimpact.orbits.shooting import ShootingError, ShootingSettings, shoot
 
 __all__ = ["bumper_worst", "bumper_at", "bumper_curves", "rigid_twin", "bumper_screen_refusal", "BUMPER_SCAN"]
 
@@ -74,12 +75,12 @@ class _Point:
     stable: bool
 
 
-def _measured(system: ImpactMap, problem: ImpactProblem, orbit: PeriodOrbit, measure: int | Measure) -> _Point | None:
+def _measured(system: ImpactMap, problem: ImpactProblem, orbit: PeriodicOrbit, measure: int | Measure) -> _Point | None:
     """The orbit's ``measure`` (of the fundamental harmonics over its period, as :func:`~vibroimpact.orbits.orbit_measures.orbit_measures`
     gives it), stability and (stable orbits) the largest impulse of one whole contact, or None where it has no contact
     (a contact-free orbit: the linear closed form's). The impulse is taken over two periods, so that a contact under
     way at the strobe is also seen whole, not only its part after it."""
-    if orbit.contacts < 1:
+    if orbit.impacts < 1:
         return None
     stable = orbit.floquet_modulus < 1.0 - _MARGIN
     trajectory = system.engine.integrate(problem, orbit.state, 0.0, 2 if stable else 1, moments=True)
@@ -87,30 +88,27 @@ def _measured(system: ImpactMap, problem: ImpactProblem, orbit: PeriodOrbit, mea
     moments = trajectory.moments[0]
     amplitude = float(as_measure(measure, problem).of_harmonics(problem, problem.omega, moments[:n], moments[n : n + k])) * 2.0 / problem.period
     impulse = (float(np.max(np.abs(trajectory.impulses))) if trajectory.impulses.size else 0.0) if stable else math.nan
-    return _Point(orbit.state, orbit.contacts, amplitude, impulse, stable)
+    return _Point(orbit.state, orbit.impacts, amplitude, impulse, stable)
 
 
-def _shot(system: ImpactMap, seeds: list[NDArray[np.float64]], p: NDArray[np.float64], measure: Measure) -> _Point | None:
+def _shot(system: CompiledPeriodMap, seeds: list[NDArray[np.float64]], p: NDArray[np.float64], measure: Measure) -> _Point | None:
     """The first seed's orbit that converges with a contact per period, measured (None: none does): Newton on the
-    engine's compiled period (:meth:`~vibroimpact.engines.compliant.exact.CompliantExactEngine.shoot_period`)."""
+    engine's compiled period (:class:`~vibroimpact.orbits.bumper_map.CompiledPeriodMap`)."""
     problem = system.problem_at(p)
     for seed in seeds:
         try:
-            orbit = system.engine.shoot_period(problem, seed, system.state_scale, _SHOOTING.tolerance, _SHOOTING.max_iterations, _SHOOTING.min_damping)
-        except ValueError:
+            orbit = shoot(system, seed, p, settings=_SHOOTING)
+        except (ShootingError, ValueError):  # no orbit from this seed; a problem the engine refuses
             continue
-        point = _measured(system, problem, orbit, measure) if orbit is not None else None
+        point = _measured(system, problem, orbit, measure)
         if point is not None:
             return point
     return None
 
 
-def _maps(problem: ImpactProblem) -> tuple[ImpactMap, ImpactMap]:
-    """The bumper problem's map and its rigid twin's; the bumper's engine must shoot periods itself."""
-    system = ImpactMap(problem)
-    if not system.engine.capabilities.period_shooting:
-        raise ValueError(f"the bumper screen needs an engine that shoots period-1 orbits itself; {system.engine.name!r} does not")
-    return system, ImpactMap(rigid_twin(problem))
+def _maps(problem: ImpactProblem) -> tuple[CompiledPeriodMap, ImpactMap]:
+    """The bumper problem's map (its engine's compiled period) and its rigid twin's."""
+    return CompiledPeriodMap(problem), ImpactMap(rigid_twin(problem))
 
 
 def _rigid_seeds(twin: ImpactMap, f: NDArray[np.float64], root: str) -> NDArray[np.float64]:
@@ -122,7 +120,7 @@ def _rigid_seeds(twin: ImpactMap, f: NDArray[np.float64], root: str) -> NDArray[
     return np.where(exists[:, None], states, np.nan)
 
 
-def _track(system: ImpactMap, twin: ImpactMap, f: NDArray[np.float64], root: str, measure: Measure) -> list[_Point | None]:
+def _track(system: CompiledPeriodMap, twin: ImpactMap, f: NDArray[np.float64], root: str, measure: Measure) -> list[_Point | None]:
     """The bumper orbit of one root along the scan: each shot from the previous one found, else (or where that
     fails) from the rigid twin's closed form (solved for the whole scan once one is needed)."""
     p = np.array(system.parameters, dtype=float)
@@ -186,7 +184,7 @@ def bumper_worst(problem: ImpactProblem, band: tuple[float, float], measure: int
     return BandWorst(best[0], best[1], best[2], best[3], float(np.count_nonzero(~covered)) / f.size, estimate, estimate_frequency, impulse)
 
 
-def _refine(system: ImpactMap, f: NDArray[np.float64], track: list[_Point | None], k: int, measure: Measure, tolerance: float) -> tuple[float, float]:
+def _refine(system: CompiledPeriodMap, f: NDArray[np.float64], track: list[_Point | None], k: int, measure: Measure, tolerance: float) -> tuple[float, float]:
     """The largest stable |X| of the orbit ``track[k]`` between the scan points either side, each trial shot from the
     nearest scanned orbit (never below the scanned value)."""
     point = track[k]

@@ -274,6 +274,17 @@ class ImpactMap:
         stops = tuple(dataclasses.replace(item, law=_law(item.law, clearance, restitution)) if k in self.stops else item for k, item in enumerate(base.stops))
         return ImpactProblem(base.system, stops, excitation)
 
+    def image_problem(self, y: NDArray[np.float64], p: NDArray[np.float64]) -> ImpactProblem | None:
+        """The problem at ``p`` where ``y`` has an image (:meth:`evaluate`), else None: a non-finite state, parameters
+        outside ``bounds`` or their ranges, or a state inside a stop."""
+        if not (np.isfinite(y).all() and all(low <= p[i] <= high for i, low, high in self._box)):
+            return None
+        try:
+            problem = self.problem_at(p)
+        except ValueError:  # a Newton iterate outside the parameters' ranges (negative frequency, R > 1, ...)
+            return None
+        return problem if self.contact == BUMPER or _outside_stops(problem, y) else None
+
     def evaluate(self, y: NDArray[np.float64], p: NDArray[np.float64]) -> MapEvaluation:
         """The state k periods after ``y`` at t = 0, its Jacobian and the hybrid information.
 
@@ -281,14 +292,9 @@ class ImpactMap:
         negative frequency, R > 1), parameters outside ``bounds`` and a flight on which the engine makes no progress
         (endless chattering) have no image: NaN, which Newton's method and the corrector treat as a failed step.
         """
-        problem = None
-        if all(low <= p[i] <= high for i, low, high in self._box) and np.all(np.isfinite(y)):
-            try:
-                problem = self.problem_at(p)
-            except ValueError:  # a Newton iterate outside the parameters' ranges (negative frequency, R > 1, ...)
-                problem = None
+        problem = self.image_problem(y, p)
         strobe = None
-        if problem is not None and _outside_stops(problem, y):
+        if problem is not None:
             try:
                 strobe = self.engine.strobe_map(problem, np.asarray(y, dtype=float), 0.0, self.periods)
             except RuntimeError:  # the engine made no progress (endless chattering)
@@ -374,8 +380,6 @@ def _typical(problem: ImpactProblem, item: LayoutParameter) -> float:
 
 
 def _outside_stops(problem: ImpactProblem, y: NDArray[np.float64]) -> bool:
-    """Every gap Delta_k - n_k . x >= 0 (on the paper's layout: X2 <= Delta); any state of a bumper problem (a
-    bumper may be compressed)."""
-    if problem.contact_law == BUMPER:
-        return True
+    """Every gap Delta_k - n_k . x >= 0 (on the paper's layout: X2 <= Delta): rigid stops (any state of a bumper
+    problem has an image: a bumper may be compressed)."""
     return bool(np.all(problem.clearances() - problem.normals() @ np.asarray(y[: problem.size], dtype=float) >= 0.0))

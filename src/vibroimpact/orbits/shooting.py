@@ -122,7 +122,9 @@ def shoot(system: ParametrisedMap, guess: ArrayLike, parameters: ArrayLike, peri
     Parameters
     ----------
     system : ParametrisedMap
-        The map P (e.g. the stroboscopic map of an impacting system over one excitation period).
+        The map P (e.g. the stroboscopic map of an impacting system over one excitation period,
+        :class:`~vibroimpact.orbits.maps.ImpactMap`, or a bumper engine's compiled period,
+        :class:`~vibroimpact.orbits.bumper_map.CompiledPeriodMap`).
     guess : array_like, shape (n,)
         Starting state (e.g. the closed-form one-impact orbit, or the previous point of a sweep).
     parameters : array_like, shape (m,)
@@ -151,7 +153,7 @@ def shoot(system: ParametrisedMap, guess: ArrayLike, parameters: ArrayLike, peri
     out = mapping.evaluate(y, p)
     r = scaled_residual(out, y, scale)
     history = [float(np.max(np.abs(r)))]
-    for _ in range(settings.max_iterations):
+    for iteration in range(settings.max_iterations + 1):  # every iterate checked, the last one too
         if not np.all(np.isfinite(r)):
             raise ShootingError("the map returned a non-finite state", tuple(history))
         if not np.all(np.isfinite(out.jacobian)):  # e.g. an impact at zero speed: its saltation matrix is singular
@@ -165,6 +167,8 @@ def shoot(system: ParametrisedMap, guess: ArrayLike, parameters: ArrayLike, peri
                     tuple(history),
                 )
             return make_orbit(mapping, y, p, out, tuple(history))
+        if iteration == settings.max_iterations:
+            break
         step = _solve(out.jacobian - identity, -(out.image - y))
         norm = float(np.linalg.norm(r))
         damping = 1.0
@@ -179,8 +183,6 @@ def shoot(system: ParametrisedMap, guess: ArrayLike, parameters: ArrayLike, peri
                 raise ShootingError(f"the line search failed: no step down to {settings.min_damping:g} of Newton's decreases the residual", tuple(history))
         y, out, r = trial, trial_out, trial_r
         history.append(float(np.max(np.abs(r))))
-    if history[-1] <= settings.tolerance:
-        return make_orbit(mapping, y, p, out, tuple(history))
     raise ShootingError(f"no convergence in {settings.max_iterations} Newton iterations", tuple(history))
 
 

@@ -16,8 +16,11 @@ from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import PAPER_SYSTEM
+from vibroimpact.orbits.branch import PeriodicOrbit
+from vibroimpact.orbits.bumper_map import CompiledPeriodMap
 from vibroimpact.orbits.bumper_screen import _measured, rigid_twin
 from vibroimpact.orbits.maps import ImpactMap, closed_form_state
+from vibroimpact.orbits.shooting import ShootingSettings, shoot
 
 FREQUENCY = 25.0  # [Hz]
 
@@ -28,21 +31,27 @@ def bumper_problem(phase: float) -> ImpactProblem:
     return ImpactProblem(PAPER_SYSTEM, law, HarmonicForce(10.0, FREQUENCY, phase=phase))
 
 
+def _shot(problem: ImpactProblem, guess: np.ndarray) -> PeriodicOrbit:
+    """The period-1 orbit near ``guess``, shot on the engine's compiled period."""
+    system = CompiledPeriodMap(problem)
+    return shoot(system, guess, system.parameters, settings=ShootingSettings(tolerance=1e-12, max_iterations=30))
+
+
 def test_a_contact_under_way_at_the_strobe_is_counted_whole() -> None:
     """The same orbit seen from a strobe in the middle of its contact (the force's phase moved by w times the
     contact's middle): the screen's measure of it gives the whole contact's impulse, as from a strobe in free flight
     (to 1e-9), where one period from that strobe sees only the contact's two parts (each smaller), and the same |X1|."""
     problem = bumper_problem(0.0)
     engine = CompliantExactEngine()
-    orbit = engine.shoot_period(problem, closed_form_state(rigid_twin(problem)), ImpactMap(problem).state_scale, 1e-12, 30)
-    assert orbit is not None and orbit.contacts == 1 and orbit.floquet_modulus < 1.0
+    orbit = _shot(problem, closed_form_state(rigid_twin(problem)))
+    assert orbit.impacts == 1 and orbit.floquet_modulus < 1.0
     whole = engine.integrate(problem, orbit.state, 0.0, 1)
     start, end = whole.segments[whole.segments[:, 2] == MODE_CONTACT][0, :2]
     middle = 0.5 * (float(start) + float(end))  # [s]
     shifted = bumper_problem(2.0 * math.pi * FREQUENCY * middle)
     _trajectory, sampled = engine.sample(problem, orbit.state, 0.0, 1, np.array([middle]))
-    moved = engine.shoot_period(shifted, np.asarray(sampled[0], dtype=float), ImpactMap(shifted).state_scale, 1e-12, 30)
-    assert moved is not None and moved.floquet_modulus < 1.0
+    moved = _shot(shifted, np.asarray(sampled[0], dtype=float))
+    assert moved.floquet_modulus < 1.0
     reference, straddled = _measured(ImpactMap(problem), problem, orbit, 0), _measured(ImpactMap(shifted), shifted, moved, 0)
     assert reference is not None and straddled is not None
     assert reference.impulse == pytest.approx(float(np.max(np.abs(whole.impulses))), rel=1e-12)

@@ -30,13 +30,13 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.engines.base import MODE_FREE, Trajectory, check_run, start_state
 from vibroimpact.engines.compliant import exact_loop
-from vibroimpact.engines.compliant.period_shooting import PeriodOrbit, shoot_period
 from vibroimpact.engines.compliant.model import MODE_CONTACT
 from vibroimpact.engines.exact import StrobeMap, chained_jacobian, restacked, stack_flows
 from vibroimpact.engines.exact_flows import Flow, harmonic_response, mechanical_null_basis, unforced_flow
@@ -291,12 +291,12 @@ class CompliantExactEngine:
             onset_curvatures=onsets[:, 4].copy(),
         )
 
-    def shoot_period(self, problem: ImpactProblem, guess: NDArray[np.float64], scale: NDArray[np.float64], tolerance: float, max_iterations: int, min_damping: float = 1.0 / 1024.0) -> PeriodOrbit | None:
-        """The period-1 orbit near ``guess`` (x, x') at t = 0 [m, m s-1] by damped Newton on the compiled period, its
-        residual scaled by ``scale`` [m, m s-1] and converged to ``tolerance`` [-] (None: no convergence in
-        ``max_iterations``); :func:`~vibroimpact.engines.compliant.period_shooting.shoot_period`."""
+    def compiled_period(self, problem: ImpactProblem) -> "CompiledPeriod":
+        """``problem``'s stroboscopic map over one period from t = 0 as the compiled loop alone computes it
+        (:class:`CompiledPeriod`): the map :class:`~vibroimpact.orbits.bumper_map.CompiledPeriodMap` gives
+        :func:`~vibroimpact.orbits.shooting.shoot`."""
         check_run(self.name, problem, KelvinVoigtBumper, 1)
-        return shoot_period(_setup(problem, self.settings).arguments, guess, scale, tolerance, max_iterations, min_damping)
+        return CompiledPeriod(_setup(problem, self.settings).arguments)
 
     def sample(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, times: NDArray[np.float64]) -> tuple[Trajectory, NDArray[np.float64]]:
         """Integrate ``periods`` periods from ``state`` at ``t_start`` [s] and give the states (x, x') at ``times`` [s]
@@ -318,6 +318,39 @@ class CompliantExactEngine:
 def _stats(counters: NDArray[np.int64], impacts: int) -> dict[str, int]:
     steps, events, onsets, touches, releases = (int(c) for c in counters)
     return {"impacts": impacts, "contacts": onsets, "releases": releases, "touches": touches, "steps": steps, "events": events}
+
+
+class PeriodImage(NamedTuple):
+    """One period of :class:`CompiledPeriod`."""
+
+    state: NDArray[np.float64]  # (x, x') at its end [m, m s-1]
+    jacobian: NDArray[np.float64]  # the exact Jacobian of the period's stroboscopic map
+    contacts: int  # contact onsets in it
+
+
+#: The compiled period's cancel flag: never set (a period is short; the loop reads it and changes no number).
+_NEVER = np.zeros(1, dtype=np.int64)
+
+
+@dataclass(frozen=True, eq=False)
+class CompiledPeriod:
+    """One problem's stroboscopic map over one period from t = 0, its exact Jacobian and its contacts, as the compiled
+    loop computes them with nothing around it (no checks, no thread, no records, no closest approach): the map the
+    bumper screen shoots some 150 orbits of per design, where through :meth:`CompliantExactEngine.strobe_map` three
+    quarters of each evaluation's time was Python around the compiled period. The loop's own overload (the engine's
+    runs'): nothing more to compile."""
+
+    arguments: BumperLoopArguments
+
+    def __call__(self, state: NDArray[np.float64]) -> PeriodImage | None:
+        """The period from ``state`` (x, x') at t = 0 [m, m s-1]; None for a non-finite state, or a period on which the
+        loop makes no progress (more contact switches than its budget)."""
+        if not np.isfinite(state).all():
+            return None
+        out = exact_loop.run_bumper_periods_until(*self.arguments, np.array(state, dtype=float), 0.0, 1, False, True, False, _NEVER)
+        if out[0] == exact_loop.STATUS_NO_PROGRESS:
+            return None
+        return PeriodImage(out[2][1], out[3][0], int(out[9].shape[0]))
 
 
 def _trajectory(problem: ImpactProblem, t_start: float, periods: int, out: tuple, moments: bool, jacobians: bool) -> Trajectory:
@@ -350,10 +383,10 @@ def _trajectory(problem: ImpactProblem, t_start: float, periods: int, out: tuple
 
 
 def kernels_cached() -> bool:
-    """Whether numba's on-disk cache holds the engine's loop, and the one that period shooting calls (a check of their
-    indexes; False where unsure)."""
+    """Whether numba's on-disk cache holds the engine's loop (its runs' and :class:`CompiledPeriod`'s; a check of its
+    index; False where unsure)."""
     try:
-        return all(bool(kernel._cache._cache_file._load_index()) for kernel in (exact_loop.run_bumper_periods_until, exact_loop.run_bumper_periods))  # numba's index of cached overloads
+        return bool(exact_loop.run_bumper_periods_until._cache._cache_file._load_index())  # numba's index of cached overloads
     except (AttributeError, OSError, EOFError, ValueError):  # another numba's layout: compile (or load) to be sure
         return False
 
@@ -374,5 +407,4 @@ def prepare_kernels() -> float:
     engine = CompliantExactEngine()
     engine.integrate(problem, np.zeros(2), 0.0, 2, moments=True, jacobians=True)
     engine.sample(problem, np.zeros(2), 0.0, 1, np.array([0.05]))
-    engine.shoot_period(problem, np.zeros(2), np.ones(2), 1e-10, 0)  # its period (run_bumper_periods: ~3 s more)
     return 0.0 if cached else time.perf_counter() - start
