@@ -25,9 +25,9 @@ def _parameters(kernel: object) -> tuple[str, ...]:
     return tuple(inspect.signature(kernel.py_func).parameters)  # type: ignore[attr-defined]
 
 
-@pytest.mark.parametrize(("fields", "kernel"), [(LoopArguments, exact_core.run_periods), (BumperLoopArguments, exact_loop.run_bumper_periods)], ids=["exact", "bumper"])
+@pytest.mark.parametrize(("fields", "kernel"), [(LoopArguments, exact_core.run_periods_until), (BumperLoopArguments, exact_loop.run_bumper_periods_until)], ids=["exact", "bumper"])
 def test_the_fields_are_the_loops_leading_parameters_in_order(fields: type, kernel: object) -> None:
-    assert fields._fields + RUN_PARAMETERS == _parameters(kernel)  # type: ignore[attr-defined]
+    assert fields._fields + RUN_PARAMETERS + ("cancel",) == _parameters(kernel)  # type: ignore[attr-defined]
     assert fields._fields[: len(StackedFlows._fields)] == StackedFlows._fields  # the stacked flows lead both loops
 
 
@@ -54,3 +54,27 @@ def test_the_sampling_kernel_gets_the_loops_arrays_by_name() -> None:
     assert names == (*StackedFlows._fields[:11], "omega", "gapw", "clearances", "simple", "signs")
     assert all(value is getattr(setup.arguments, name) for name, value in zip(names, setup.sampling))
     assert isinstance(setup.arguments, LoopArguments) and setup.arguments.gapw.shape == (1, 4)
+
+
+def test_each_loop_s_result_has_a_name_for_each_entry() -> None:
+    """A run of each loop gives exactly its named output's entries, each the array its name says (what callers read
+    by name, no caller by position)."""
+    import numpy as np
+
+    from vibroimpact.engines.compliant.exact import loop_arguments
+    from vibroimpact.engines.kernel_arguments import BumperLoopOutput, LoopOutput
+    from vibroimpact.model.contact import KelvinVoigtBumper
+
+    never = np.zeros(1, dtype=np.int64)
+    rigid = ImpactProblem(PAPER_SYSTEM, RigidStop(PAPER_CLEARANCE, 0.6), HarmonicForce(PAPER_AMPLITUDE, 25.0))
+    out = LoopOutput._make(exact_core.run_periods_until(*loop_setup(rigid, EngineSettings()).arguments, np.zeros(4), 0.0, 3, True, True, True, never))
+    assert out.status == exact_core.STATUS_OK and out.strobes.shape == (4, 4) and out.jacobians.shape == (3, 4, 4) and out.moments.shape == (3, 5)
+    assert out.impacts.shape[1] == 4 and out.segments.shape[1] == 3 and out.segment_states.shape[1] == 4 and out.counters.size == 5 and out.approach.size == 3
+    assert exact_core.run_periods(*loop_setup(rigid, EngineSettings()).arguments, np.zeros(4), 0.0, 3, True, True, True).strobes.tobytes() == out.strobes.tobytes()
+    bumper = ImpactProblem(PAPER_SYSTEM, KelvinVoigtBumper(PAPER_CLEARANCE, 250.0, 0.3), HarmonicForce(PAPER_AMPLITUDE, 25.0))
+    raw = exact_loop.run_bumper_periods_until(*loop_arguments(bumper), np.zeros(4), 0.0, 3, True, True, True, never)
+    out = BumperLoopOutput._make(raw)
+    assert BumperLoopOutput._fields[:-2] == LoopOutput._fields[:-1] and BumperLoopOutput._fields[-2:] == ("onsets", "approach")
+    assert out.status == exact_loop.STATUS_NO_PROGRESS - 1 and out.strobes.shape == (4, 4) and out.jacobians.shape == (3, 4, 4) and out.moments.shape == (3, 5)
+    assert out.impacts.shape[1] == 6 and out.segments.shape[1] == 2 and out.counters.size == 5 and out.onsets.shape[1] == 5 and out.approach.size == 3
+    assert out.impacts.shape[0] >= 1 and out.onsets.shape[0] >= 1  # the absorber reaches its bumper within three periods

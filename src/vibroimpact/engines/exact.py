@@ -31,7 +31,7 @@ from vibroimpact.engines.base import MODE_STUCK, Trajectory, check_run, start_st
 from vibroimpact.engines.exact_flows import Flow, ExactModel, build_model
 from vibroimpact.engines.exact_python import PythonExactEngine
 from vibroimpact.engines.interruptible import call_interruptibly
-from vibroimpact.engines.kernel_arguments import LoopArguments, StackedFlows, leading_arguments
+from vibroimpact.engines.kernel_arguments import LoopArguments, LoopOutput, StackedFlows, leading_arguments
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.engines.rigid_kernels import RigidContact
 from vibroimpact.engines.settings import EngineSettings
@@ -201,21 +201,21 @@ class ExactEngine:
     def __init__(self, settings: EngineSettings = EngineSettings()) -> None:
         self.settings = settings
 
-    def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, jacobians: bool, approach: bool) -> tuple:
+    def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, jacobians: bool, approach: bool) -> LoopOutput:
         check_run(self.name, problem, RigidStop, periods)
         setup = loop_setup(problem, self.settings)
         state = start_state(problem, state, t_start)  # finite, 2 N values, a writable copy (one compiled overload)
         setup.law.check_start(state)
-        out = call_interruptibly(
+        out = LoopOutput._make(call_interruptibly(
             lambda cancel: exact_core.run_periods_until(*setup.arguments, state, float(t_start), int(periods), moments, jacobians, approach, cancel), int(periods)
-        )  # a long run in a helper thread: Ctrl-C stops it at once
-        if out[0] == exact_core.STATUS_NO_PROGRESS:
-            raise RuntimeError(f"no progress at t = {out[1]!r} s: more than {10 * setup.law.max_impacts} events in one period")
-        if out[0] == exact_core.STATUS_TWO_STICKS:
-            first, second = (int(x) for x in (out[8][4], out[9][2]))
+        ))  # a long run in a helper thread: Ctrl-C stops it at once
+        if out.status == exact_core.STATUS_NO_PROGRESS:
+            raise RuntimeError(f"no progress at t = {out.t!r} s: more than {10 * setup.law.max_impacts} events in one period")
+        if out.status == exact_core.STATUS_TWO_STICKS:
+            first, second = int(out.counters[4]), int(out.approach[2])
             names = setup.law.names
             raise NotImplementedError(
-                f"at t = {out[1]!r} s the structure would stick on two stops at once (stop {first}: "
+                f"at t = {out.t!r} s the structure would stick on two stops at once (stop {first}: "
                 f"{problem.stops[first].describe(names)}, stop {second}: {problem.stops[second].describe(names)}); "
                 "the exact engine holds one stop at a time"
             )
@@ -228,9 +228,8 @@ class ExactEngine:
 
         With ``jacobians``, ``strobe_jacobians[k]`` is the exact Jacobian of period k's stroboscopic map.
         """
-        _status, _t, strobes, jac, impacts, segments, segment_states, period_moments, counters, _approach = self._run(
-            problem, state, t_start, periods, moments, jacobians, False
-        )
+        out = self._run(problem, state, t_start, periods, moments, jacobians, False)
+        strobes, jac, impacts, segments, segment_states, period_moments, counters = out.strobes, out.jacobians, out.impacts, out.segments, out.segment_states, out.moments, out.counters
         n, width = 2 * problem.size, 2 * problem.size + len(problem.stops)
         times = float(t_start) + np.arange(periods + 1) * problem.period  # the loop's boundaries, bit for bit
         starts = segments[:, 0]
@@ -255,10 +254,11 @@ class ExactEngine:
     def strobe_map(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float = 0.0, periods: int = 1) -> StrobeMap:
         """The stroboscopic map over ``periods`` periods from ``state`` at ``t_start`` [s], with its exact Jacobian
         and what a continuation watches (impact speeds, closest approach of the gaps)."""
-        _status, _t, strobes, jac, impacts, _segments, _states, _moments, counters, approach = self._run(problem, state, t_start, periods, False, True, True)
-        product = chained_jacobian(jac, 2 * problem.size)
+        out = self._run(problem, state, t_start, periods, False, True, True)
+        impacts, counters, approach = out.impacts, out.counters, out.approach
+        product = chained_jacobian(out.jacobians, 2 * problem.size)
         return StrobeMap(
-            state=strobes[-1].copy(),
+            state=out.strobes[-1].copy(),
             jacobian=product,
             impact_times=impacts[:, 0].copy(),
             impact_velocities=impacts[:, 1].copy(),

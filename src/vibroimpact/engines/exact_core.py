@@ -45,6 +45,7 @@ from vibroimpact.engines.exact_matrices import grow_rows, left_multiply, transit
 from vibroimpact.engines.exact_moments import add_moments, add_moments_gl
 from vibroimpact.engines.exact_pieces import NONE, ZERO, halve_pairs, modal_coordinates, observable, piece_state, polynomial_part
 from vibroimpact.engines.exact_roots import closest_approach, escape_step, first_crossing, observable_value, round_off_band
+from vibroimpact.engines.kernel_arguments import LoopOutput
 from vibroimpact.engines.numba_cache import stamp_with_callees
 
 __all__ = ["run_periods", "run_periods_until", "sample_states", "STATUS_OK", "STATUS_NO_PROGRESS", "STATUS_TWO_STICKS"]
@@ -163,31 +164,18 @@ def _holds(stop, lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv
 
 
 # ------------------------------------------------------------------------------------------------------- the loop
-@njit(cache=True, error_model="numpy")
-def run_periods(
-    lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
-    a_matrix, load, static, omega, period,
-    gapw, velw, kickw, clearances, restitutions, masses, simple, signs,
-    hold_w, hold_off, hold_har, force_tolerances, bounce, stick, touch,
-    sticking_velocity, max_impacts, tolerance, resolution_velocity, gl_nodes, gl_weights,
-    y_start, t_start, periods, want_moments, want_jacobians, want_approach,
-):  # fmt: skip
+def run_periods(*arguments: object) -> LoopOutput:
     """Integrate ``periods`` periods from (t_start, y_start); see :class:`vibroimpact.engines.exact.ExactEngine`.
 
-    Returns (status, t_fail, strobes (periods + 1, n), jacobians (periods, n, n), impacts (m, 4): time, speed,
-    impulse, stop, segments (s, 3): start, mode, stop, segment_states (s, n), moments (periods, 2 N + K),
-    counters [steps, events, sticks, releases, touches], approach [value, time, stop]); status
-    :data:`STATUS_TWO_STICKS` stops the run where the structure would stick on two stops at once (t_fail, and
-    approach[2] the other stop, counters[4] the first). :func:`run_periods_until` with no one to stop it.
+    The arguments are :func:`run_periods_until`'s without ``cancel`` (no one stops this run); returns its
+    :class:`~vibroimpact.engines.kernel_arguments.LoopOutput`: ``status``, ``t`` (where it stopped), ``strobes``
+    (periods + 1, n), ``jacobians`` (periods, n, n), ``impacts`` (m, 4): time, speed, impulse, stop, ``segments``
+    (s, 3): start, mode, stop, ``segment_states`` (s, n), ``moments`` (periods, 2 N + K), ``counters`` [steps, events,
+    sticks, releases, touches], ``approach`` [value, time, stop]; status :data:`STATUS_TWO_STICKS` stops the run where
+    the structure would stick on two stops at once (at ``t``; ``approach[2]`` the other stop, ``counters[4]`` the
+    first).
     """
-    return run_periods_until(
-        lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
-        a_matrix, load, static, omega, period,
-        gapw, velw, kickw, clearances, restitutions, masses, simple, signs,
-        hold_w, hold_off, hold_har, force_tolerances, bounce, stick, touch,
-        sticking_velocity, max_impacts, tolerance, resolution_velocity, gl_nodes, gl_weights,
-        y_start, t_start, periods, want_moments, want_jacobians, want_approach, np.zeros(1, dtype=np.int64),
-    )  # fmt: skip
+    return LoopOutput._make(run_periods_until(*arguments, np.zeros(1, dtype=np.int64)))
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -199,10 +187,10 @@ def run_periods_until(
     sticking_velocity, max_impacts, tolerance, resolution_velocity, gl_nodes, gl_weights,
     y_start, t_start, periods, want_moments, want_jacobians, want_approach, cancel,
 ):  # fmt: skip
-    """:func:`run_periods` that another thread can stop: it returns :data:`STATUS_INTERRUPTED` (t where it stopped)
-    at its next step once ``cancel[0]`` (int64 array of one entry) is nonzero. It releases the GIL (``nogil``), so
-    the main thread can wait for it in Python and take a Ctrl-C meanwhile (:mod:`~vibroimpact.engines.interruptible`);
-    reading the flag changes no number.
+    """:func:`run_periods` (its result a plain tuple) that another thread can stop: it returns
+    :data:`STATUS_INTERRUPTED` (t where it stopped) at its next step once ``cancel[0]`` (int64 array of one entry) is
+    nonzero. It releases the GIL (``nogil``), so the main thread can wait for it in Python and take a Ctrl-C meanwhile
+    (:mod:`~vibroimpact.engines.interruptible`); reading the flag changes no number.
     """
     n = y_start.size
     size = n // 2

@@ -41,7 +41,7 @@ from vibroimpact.engines.compliant.model import MODE_CONTACT
 from vibroimpact.engines.exact import StrobeMap, chained_jacobian, restacked, stack_flows
 from vibroimpact.engines.exact_flows import Flow, harmonic_response, mechanical_null_basis, unforced_flow
 from vibroimpact.engines.interruptible import call_interruptibly
-from vibroimpact.engines.kernel_arguments import BumperLoopArguments, StackedFlows, leading_arguments
+from vibroimpact.engines.kernel_arguments import BumperLoopArguments, BumperLoopOutput, StackedFlows, leading_arguments
 from vibroimpact.engines.linear_flow import gauss_legendre
 from vibroimpact.engines.registry import ENGINES, Capabilities
 from vibroimpact.engines.settings import EngineSettings
@@ -236,16 +236,16 @@ class CompliantExactEngine:
     def __init__(self, settings: EngineSettings = EngineSettings()) -> None:
         self.settings = settings
 
-    def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, jacobians: bool, approach: bool = False) -> tuple:
+    def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, jacobians: bool, approach: bool = False) -> BumperLoopOutput:
         check_run(self.name, problem, KelvinVoigtBumper, periods)
         problem.harmonic  # TypeError naming the excitation if it is not harmonic (a sweep has no closed form)
         setup = _setup(problem, self.settings)
         state = start_state(problem, state, t_start)  # finite, 2 N values, a writable copy (one compiled overload)
-        out = call_interruptibly(
+        out = BumperLoopOutput._make(call_interruptibly(
             lambda cancel: exact_loop.run_bumper_periods_until(*setup.arguments, state, float(t_start), int(periods), bool(moments), bool(jacobians), bool(approach), cancel), int(periods)
-        )  # a long run in a helper thread: Ctrl-C stops it at once
-        if out[0] == exact_loop.STATUS_NO_PROGRESS:
-            raise RuntimeError(f"no progress at t = {out[1]!r} s: more than {10 * self.settings.max_impacts_per_period} contact switches in one period")
+        ))  # a long run in a helper thread: Ctrl-C stops it at once
+        if out.status == exact_loop.STATUS_NO_PROGRESS:
+            raise RuntimeError(f"no progress at t = {out.t!r} s: more than {10 * self.settings.max_impacts_per_period} contact switches in one period")
         return out
 
     def integrate(
@@ -273,10 +273,10 @@ class CompliantExactEngine:
         to 0) is where either reaches 0.
         """
         out = self._run(problem, state, t_start, periods, False, True, True)
-        _status, _t, strobes, jac, contacts, _segments, _states, _moments, counters, onsets, approach = out
-        product = chained_jacobian(jac, 2 * problem.size)
+        counters, onsets, approach = out.counters, out.onsets, out.approach
+        product = chained_jacobian(out.jacobians, 2 * problem.size)
         return StrobeMap(
-            state=strobes[-1].copy(),
+            state=out.strobes[-1].copy(),
             jacobian=product,
             impact_times=onsets[:, 0].copy(),
             impact_velocities=onsets[:, 1].copy(),
@@ -284,7 +284,7 @@ class CompliantExactEngine:
             releases=int(counters[4]),
             closest_approach=float(approach[0]),
             closest_approach_time=float(approach[1]),
-            stats=_stats(counters, contacts.shape[0]),
+            stats=_stats(counters, out.impacts.shape[0]),
             impact_stops=onsets[:, 2].astype(np.int64),
             closest_approach_stop=int(approach[2]),
             surface_onsets=onsets[:, 3] > 0.5,
@@ -307,7 +307,7 @@ class CompliantExactEngine:
         if times.size and (np.any(np.diff(times) < 0.0) or times[0] < t_start or times[-1] > t_end):
             raise ValueError(f"times: expected increasing times inside the run [{t_start!r}, {t_end!r}] s, got [{times.min()!r}, {times.max()!r}] s")
         out = self._run(problem, state, t_start, periods, False, False)
-        segments, states = out[5], out[6]
+        segments, states = out.segments, out.segment_states
         starts = np.ascontiguousarray(segments[:, 0])
         pieces = np.clip(np.searchsorted(starts, times, side="right") - 1, 0, max(starts.size - 1, 0)).astype(np.int64)
         flows = segments[:, 1].astype(np.int64)
@@ -347,15 +347,15 @@ class CompiledPeriod:
         loop makes no progress (more contact switches than its budget)."""
         if not np.isfinite(state).all():
             return None
-        out = exact_loop.run_bumper_periods_until(*self.arguments, np.array(state, dtype=float), 0.0, 1, False, True, False, _NEVER)
-        if out[0] == exact_loop.STATUS_NO_PROGRESS:
+        out = BumperLoopOutput._make(exact_loop.run_bumper_periods_until(*self.arguments, np.array(state, dtype=float), 0.0, 1, False, True, False, _NEVER))
+        if out.status == exact_loop.STATUS_NO_PROGRESS:
             return None
-        return PeriodImage(out[2][1], out[3][0], int(out[9].shape[0]))
+        return PeriodImage(out.strobes[1], out.jacobians[0], int(out.onsets.shape[0]))
 
 
-def _trajectory(problem: ImpactProblem, t_start: float, periods: int, out: tuple, moments: bool, jacobians: bool) -> Trajectory:
+def _trajectory(problem: ImpactProblem, t_start: float, periods: int, out: BumperLoopOutput, moments: bool, jacobians: bool) -> Trajectory:
     """The compiled loop's output as a :class:`Trajectory`."""
-    _status, _t, strobes, jac, contacts, segments, segment_states, period_moments, counters = out[:9]
+    strobes, jac, contacts, segments, segment_states, period_moments, counters = out.strobes, out.jacobians, out.impacts, out.segments, out.segment_states, out.moments, out.counters
     n, width = 2 * problem.size, 2 * problem.size + len(problem.stops)
     times = t_start + np.arange(periods + 1) * problem.period  # the loop's boundaries, bit for bit
     starts = segments[:, 0]

@@ -47,7 +47,7 @@ from vibroimpact.engines.exact_pieces import halve_pairs, modal_coordinates, obs
 from vibroimpact.engines.exact_roots import closest_approach, escape_step, first_crossing, observable_derivatives, observable_value, round_off_band
 from vibroimpact.engines.numba_cache import stamp_with_callees
 
-__all__ = ["run_bumper_periods", "run_bumper_periods_until", "sample_pieces", "STATUS_NO_PROGRESS"]
+__all__ = ["run_bumper_periods_until", "sample_pieces", "STATUS_NO_PROGRESS"]
 
 STATUS_OK, STATUS_NO_PROGRESS, STATUS_INTERRUPTED = 0, 1, 2
 #: Phases of a stop (module docstring).
@@ -197,15 +197,16 @@ def _peaks(mask, obsw, obso, velw, lams, vecs, hrms, csts, f, m, hlams, hm, moda
 
 
 # ------------------------------------------------------------------------------------------------------- the loop
-@njit(cache=True, error_model="numpy")
-def run_bumper_periods(
+@njit(cache=True, error_model="numpy", nogil=True)
+def run_bumper_periods_until(
     lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
     omega, period, obsw, obso, velw, salts, zero_har, gap_tolerance, force_tolerances, max_events, gl_nodes, gl_weights,
-    y_start, t_start, periods, want_moments, want_jacobians, want_approach,
+    y_start, t_start, periods, want_moments, want_jacobians, want_approach, cancel,
 ):  # fmt: skip
     """Integrate ``periods`` periods from (t_start, y_start); see :class:`~vibroimpact.engines.compliant.exact.CompliantExactEngine`.
 
-    Returns (status, t, strobes (periods + 1, n), jacobians (periods, n, n), contacts (c, 6): onset time, entry
+    Returns (by name, :class:`~vibroimpact.engines.kernel_arguments.BumperLoopOutput`) (status, t, strobes
+    (periods + 1, n), jacobians (periods, n, n), impacts (c, 6): onset time, entry
     speed n . x', impulse, largest force, largest deceleration, stop, of each completed contact; segments (s, 2):
     start, contact mode, with segment_states (s, n); moments (periods, 2 N + K); counters [steps, events, onsets,
     touches, releases]; onsets (o, 5): time, entry speed n . x', stop, 1 for an onset at the surface (d = 0, from
@@ -214,25 +215,12 @@ def run_bumper_periods(
     largest interior local maximum of a penetration d_k while stop k is ``BELOW`` (the closest approach of a free
     flight to the bumper's surface, the exact engine's :func:`~vibroimpact.engines.exact_roots.closest_approach`;
     -inf without one, or unless ``want_approach``)); status :data:`STATUS_NO_PROGRESS` stops the run at t after
-    ``max_events`` in one period. :func:`run_bumper_periods_until` with no one to stop it.
-    """
-    return run_bumper_periods_until(
-        lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
-        omega, period, obsw, obso, velw, salts, zero_har, gap_tolerance, force_tolerances, max_events, gl_nodes, gl_weights,
-        y_start, t_start, periods, want_moments, want_jacobians, want_approach, np.zeros(1, dtype=np.int64),
-    )  # fmt: skip
+    ``max_events`` in one period.
 
-
-@njit(cache=True, error_model="numpy", nogil=True)
-def run_bumper_periods_until(
-    lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
-    omega, period, obsw, obso, velw, salts, zero_har, gap_tolerance, force_tolerances, max_events, gl_nodes, gl_weights,
-    y_start, t_start, periods, want_moments, want_jacobians, want_approach, cancel,
-):  # fmt: skip
-    """:func:`run_bumper_periods` that another thread can stop: it returns :data:`STATUS_INTERRUPTED` (t where it
-    stopped) at its next step once ``cancel[0]`` (int64 array of one entry) is nonzero. It releases the GIL
-    (``nogil``), so the main thread can wait for it in Python and take a Ctrl-C meanwhile
-    (:mod:`~vibroimpact.engines.interruptible`); reading the flag changes no number.
+    Another thread can stop it: it returns :data:`STATUS_INTERRUPTED` (t where it stopped) at its next step once
+    ``cancel[0]`` (int64 array of one entry) is nonzero. It releases the GIL (``nogil``), so the main thread can wait
+    for it in Python and take a Ctrl-C meanwhile (:mod:`~vibroimpact.engines.interruptible`); reading the flag changes
+    no number.
     """
     n = y_start.size
     size = n // 2

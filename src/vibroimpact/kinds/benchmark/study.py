@@ -178,7 +178,7 @@ def exact_kernel(case: BenchmarkCase, moments: bool = True) -> Callable[[], int]
     state = np.ascontiguousarray(y0, dtype=float)
 
     def kernel() -> int:
-        status = exact_core.run_periods(*arguments, state, float(t0), int(case.periods), moments, False, False)[0]
+        status = exact_core.run_periods(*arguments, state, float(t0), int(case.periods), moments, False, False).status
         if status != exact_core.STATUS_OK:
             raise RuntimeError(f"benchmark case {case.name}: the exact kernel made no progress")
         return int(status)
