@@ -41,9 +41,9 @@ import math
 import numpy as np
 from numba import njit
 
-from vibroimpact.engines.exact_matrices import grow_rows, left_multiply, transition_matrix
+from vibroimpact.engines.exact_matrices import end_period, grow_rows, left_multiply, transition_matrix
 from vibroimpact.engines.exact_moments import add_moments, add_moments_gl
-from vibroimpact.engines.exact_pieces import NONE, ZERO, halve_pairs, modal_coordinates, observable, piece_state, polynomial_part
+from vibroimpact.engines.exact_pieces import NONE, YES, ZERO, halve_pairs, modal_coordinates, observable, piece_state, polynomial_part
 from vibroimpact.engines.exact_roots import closest_approach, escape_step, first_crossing, observable_value, round_off_band
 from vibroimpact.engines.kernel_arguments import LoopOutput
 from vibroimpact.engines.numba_cache import stamp_with_callees
@@ -249,6 +249,8 @@ def run_periods_until(
     salt = np.empty((n, n))
     before = np.empty(n)
     ybuf = np.empty(n)
+    force_rows = np.arange(stops)  # the holding force of stop j: row j of hold_w, hold_off, hold_har
+    held_impulses = np.zeros(stops)  # (the Gauss-Legendre moments integrate it too; a rigid stop's impulses are its impacts')
     ynew = np.empty(n)
     t_piece = t
     f = 0  # the piece's flow: 0 free, 1 + k held on stop k
@@ -299,7 +301,8 @@ def run_periods_until(
         if t_end > t:
             if want_moments:
                 if poly:
-                    add_moments_gl(moments, k - 1, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, fastests[f], gl_nodes, gl_weights, hold_w, hold_off, hold_har, size, stops, z0, q1, q2, ybuf)
+                    held = (1 << stuck) if stuck >= 0 else 0
+                    add_moments_gl(moments, k - 1, YES, held, force_rows, YES, held_impulses, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, fastests[f], gl_nodes, gl_weights, hold_w, hold_off, hold_har, size, stops, z0, q1, q2, ybuf)
                 else:
                     add_moments(moments, k - 1, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, rates_all, rinv_all, buffers, hold_w, hold_off, hold_har, size, stops)
             if want_approach:
@@ -320,13 +323,7 @@ def run_periods_until(
             for j in range(stops):
                 leave[j] = t_end - events_at[j] <= 1e-9 * period
                 impacts_period[j] = 0
-            for r in range(n):
-                strobes[k, r] = y[r]
-            if want_jacobians:
-                for r in range(n):
-                    for c in range(n):
-                        jacobians[k - 1, r, c] = jac[r, c]
-                        jac[r, c] = 1.0 if r == c else 0.0
+            end_period(k, y, strobes, want_jacobians, jac, jacobians)
             k += 1
             events_period = 0
             continue

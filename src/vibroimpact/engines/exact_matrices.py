@@ -1,6 +1,6 @@
 """The small array kernels both compiled loops share (the ``exact`` engine's :mod:`~vibroimpact.engines.exact_core` and
 the ``compliant_exact`` loop): a flow's state-transition matrix, the in-place left product that chains a period's
-Jacobian, and an output array grown by rows.
+Jacobian, a period's end recorded (its strobe and Jacobian), and an output array grown by rows.
 
 Flows are stacked as :mod:`~vibroimpact.engines.exact_core` describes (``lams``, ``vecs``, ``invs``; ``zpros``,
 ``znils`` where ``polys[f]``). The compiled functions of a module that calls these are stamped with this file's source
@@ -14,7 +14,7 @@ from numba import njit
 
 from vibroimpact.engines.numba_cache import stamp_with_callees
 
-__all__ = ["transition_matrix", "left_multiply", "grow_rows"]
+__all__ = ["transition_matrix", "left_multiply", "end_period", "grow_rows"]
 
 
 @njit(cache=True, error_model="numpy")
@@ -49,6 +49,20 @@ def left_multiply(factor, jac, work):
     for r in range(n):
         for c in range(n):
             jac[r, c] = work[r, c]
+
+
+@njit(cache=True, error_model="numpy")
+def end_period(k, y, strobes, want_jacobians, jac, jacobians):
+    """The end of period k: the state ``y`` as ``strobes[k]`` and, if wanted, the period's Jacobian ``jac`` as
+    ``jacobians[k - 1]``, ``jac`` then the identity again (the next period's product starts)."""
+    n = y.size
+    for r in range(n):
+        strobes[k, r] = y[r]
+    if want_jacobians:
+        for r in range(n):
+            for c in range(n):
+                jacobians[k - 1, r, c] = jac[r, c]
+                jac[r, c] = 1.0 if r == c else 0.0
 
 
 @njit(cache=True, error_model="numpy")

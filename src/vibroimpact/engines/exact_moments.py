@@ -141,10 +141,14 @@ def add_moments(out, row, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_p
 
 
 @njit(cache=True, error_model="numpy")
-def add_moments_gl(out, row, stuck, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, ta, tb, fastest, nodes, weights, hold_w, hold_off, hold_har, size, stops, z0, q1, q2, y):
-    """As :func:`add_moments` for a flow with rigid-body (polynomial) terms, by Gauss-Legendre quadrature on chunks
-    of at most 2 / (|lambda|max + w) [s]: exact for the polynomial parts (degree <= 4 in the squares), to round-off
-    for the exponentials."""
+def add_moments_gl(out, row, want_moments, forces, force_rows, subtract, impulses, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, ta, tb, fastest, nodes, weights, force_w, force_off, force_har, size, stops, z0, q1, q2, y):
+    """Over [ta, tb] of a piece of a flow with rigid-body (polynomial) terms, by Gauss-Legendre quadrature on chunks
+    of at most 2 / (|lambda|max + w) [s] (exact for the polynomial parts, degree <= 4 in the squares; to round-off for
+    the exponentials), both loops' integrals in one pass over the nodes: if ``want_moments``, each coordinate's
+    Fourier and square integrals into ``out[row]`` (:func:`add_moments`' closed-form ones); for each stop j in the bit
+    mask ``forces``, its force F = force_off[i] + Re(force_har[i] e^{jwt}) + force_w[i] . y (row i = force_rows[j]):
+    its integral into ``impulses[j]`` and, if ``want_moments``, its Fourier integral into ``out[row, size + j]``
+    (subtracted where ``subtract``: the exact engine's rows are minus its holding force)."""
     chunks = max(1, int(math.ceil(fastest * (tb - ta) / 2.0)))
     for c in range(chunks):
         a = ta + (tb - ta) * c / chunks
@@ -154,14 +158,23 @@ def add_moments_gl(out, row, stuck, lams, vecs, hrms, csts, f, m, modal, omega, 
             w = (b - a) * weights[q]
             piece_state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t, y, YES, z0, q1, q2)
             phasor = complex(math.cos(omega * t), -math.sin(omega * t))
-            for i in range(size):
-                out[row, i] += w * y[i] * phasor
-                out[row, size + stops + i] += w * y[i] * y[i]
-            if stuck >= 0:
-                force = hold_off[stuck] + (hold_har[stuck] * complex(math.cos(omega * t), math.sin(omega * t))).real
+            if want_moments:
+                for i in range(size):
+                    out[row, i] += w * y[i] * phasor
+                    out[row, size + stops + i] += w * y[i] * y[i]
+            for j in range(stops):
+                if not (forces >> j) & 1:
+                    continue
+                i = force_rows[j]
+                force = force_off[i] + (force_har[i] * complex(math.cos(omega * t), math.sin(omega * t))).real
                 for r in range(y.size):
-                    force += hold_w[stuck, r] * y[r]
-                out[row, size + stuck] -= w * force * phasor
+                    force += force_w[i, r] * y[r]
+                impulses[j] += w * force
+                if want_moments:
+                    if subtract:
+                        out[row, size + j] -= w * force * phasor
+                    else:
+                        out[row, size + j] += w * force * phasor
 
 
 stamp_with_callees(globals())

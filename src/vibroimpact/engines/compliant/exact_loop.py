@@ -41,7 +41,7 @@ import math
 import numpy as np
 from numba import njit
 
-from vibroimpact.engines.exact_matrices import grow_rows, left_multiply, transition_matrix
+from vibroimpact.engines.exact_matrices import end_period, grow_rows, left_multiply, transition_matrix
 from vibroimpact.engines.exact_moments import add_moments_gl, coordinate_amplitudes, moment_integrals, piece_factors, weighted_amplitudes
 from vibroimpact.engines.exact_pieces import halve_pairs, modal_coordinates, observable, piece_state, polynomial_part
 from vibroimpact.engines.exact_roots import closest_approach, escape_step, first_crossing, observable_derivatives, observable_value, round_off_band
@@ -153,33 +153,6 @@ def _piece_integrals(moments, row, want_moments, mask, impulses, lams, vecs, hrm
 
 
 @njit(cache=True, error_model="numpy")
-def _piece_integrals_gl(moments, row, want_moments, mask, impulses, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, ta, tb, fastest, nodes, weights, obsw, obso, zero_har, size, stops, z0, q1, q2, y):
-    """As :func:`_piece_integrals` on a flow with rigid-body (polynomial) terms, by Gauss-Legendre quadrature (the
-    exact engine's chunks)."""
-    if want_moments:
-        add_moments_gl(moments, row, _NONE, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, ta, tb, fastest, nodes, weights, obsw, obso, zero_har, size, stops, z0, q1, q2, y)
-    if mask == 0:
-        return
-    chunks = max(1, int(math.ceil(fastest * (tb - ta) / 2.0)))
-    for c in range(chunks):
-        a = ta + (tb - ta) * c / chunks
-        b = ta + (tb - ta) * (c + 1) / chunks
-        for q in range(nodes.size):
-            t = a + (b - a) * nodes[q]
-            w = (b - a) * weights[q]
-            piece_state(lams, vecs, hrms, csts, f, m, omega, t_piece, modal, t, y, _YES, z0, q1, q2)
-            phasor = complex(math.cos(omega * t), -math.sin(omega * t))
-            for j in range(stops):
-                if (mask >> j) & 1:
-                    force = obso[4 * j + 2]
-                    for r in range(y.size):
-                        force += obsw[4 * j + 2, r] * y[r]
-                    impulses[j] += w * force
-                    if want_moments:
-                        moments[row, size + j] += w * force * phasor
-
-
-@njit(cache=True, error_model="numpy")
 def _peaks(mask, obsw, obso, velw, lams, vecs, hrms, csts, f, m, hlams, hm, modal, amp, poly, z0, q1, q2, scratch, work, omega, t_piece, ta, tb, peak_force, peak_deceleration):
     """Raise each stop in contact's largest force F and largest deceleration -n . x'' to their largest on [ta, tb]."""
     jw = complex(0.0, omega)
@@ -256,6 +229,7 @@ def run_bumper_periods_until(
     phi = np.empty((n, n))
     product = np.empty((n, n))
     ybuf = np.empty(n)
+    force_rows = 4 * np.arange(stops) + 2  # the force F_k: row 4 k + 2 of obsw, obso (zero_har: no harmonic part)
     ynew = np.empty(n)
     phase = np.zeros(stops, dtype=np.int64)
     onset_time, onset_speed = np.zeros(stops), np.zeros(stops)
@@ -338,7 +312,7 @@ def run_bumper_periods_until(
                 left_multiply(phi, jac, product)
             if mask != 0 or want_moments:
                 if poly:
-                    _piece_integrals_gl(moments, k - 1, want_moments, mask, impulses, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, fastests[f], gl_nodes, gl_weights, obsw, obso, zero_har, size, stops, z0, q1, q2, ybuf)
+                    add_moments_gl(moments, k - 1, want_moments, mask, force_rows, _NO, impulses, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, fastests[f], gl_nodes, gl_weights, obsw, obso, zero_har, size, stops, z0, q1, q2, ybuf)
                 else:
                     _piece_integrals(moments, k - 1, want_moments, mask, impulses, lams, vecs, hrms, csts, f, m, modal, omega, t_piece, t, t_end, rates_all, rinv_all, buffers, obsw, obso, size, stops)
             if want_approach:
@@ -352,13 +326,7 @@ def run_bumper_periods_until(
             y[r] = ynew[r]
         t = t_end
         if event < 0:
-            for r in range(n):
-                strobes[k, r] = y[r]
-            if want_jacobians:
-                for r in range(n):
-                    for c in range(n):
-                        jacobians[k - 1, r, c] = jac[r, c]
-                        jac[r, c] = 1.0 if r == c else 0.0
+            end_period(k, y, strobes, want_jacobians, jac, jacobians)
             k += 1
             events_period = 0
             continue
