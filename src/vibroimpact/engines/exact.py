@@ -38,7 +38,7 @@ from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import RigidStop
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["ExactEngine", "StrobeMap", "chained_jacobian", "loop_setup", "restacked", "stack_flows"]
+__all__ = ["ExactEngine", "StrobeMap", "loop_setup", "loop_strobe_map", "loop_trajectory", "restacked", "stack_flows"]
 
 
 def chained_jacobian(factors: NDArray[np.float64], size: int) -> NDArray[np.float64]:
@@ -153,6 +153,43 @@ def restacked(stacked: StackedFlows, flows: tuple[Flow, ...], harmonics: list[ND
     return stacked._replace(hrms=hrms, rates_all=rates, rinv_all=rinv, fastests=fastests)
 
 
+def loop_strobe_map(out: LoopOutput, size: int, events: NDArray[np.float64], sticks: int, releases: int, stats: dict[str, int], **more: NDArray) -> StrobeMap:
+    """A compiled loop's run with its Jacobians and closest approach (``out``: a
+    :class:`~vibroimpact.engines.kernel_arguments.LoopOutput` or a ``BumperLoopOutput``) as the :class:`StrobeMap` of
+    its periods, N = ``size``: ``events`` (time, speed, stop) the map's impacts, and the ``more`` fields of an
+    engine's own."""
+    approach = out.approach
+    return StrobeMap(
+        state=out.strobes[-1].copy(), jacobian=chained_jacobian(out.jacobians, 2 * size), impact_times=events[:, 0].copy(), impact_velocities=events[:, 1].copy(),
+        sticks=sticks, releases=releases, closest_approach=float(approach[0]), closest_approach_time=float(approach[1]), stats=stats,
+        impact_stops=events[:, 2].astype(np.int64), closest_approach_stop=int(approach[2]), **more,
+    )  # fmt: skip
+
+
+def loop_trajectory(
+    problem: ImpactProblem, t_start: float, periods: int, out: LoopOutput, moments: bool, jacobians: bool, modes: NDArray, segment_stops: NDArray[np.int64], stats: dict[str, int], **more: NDArray
+) -> Trajectory:
+    """A compiled loop's run from ``t_start`` [s] (``out``: a :class:`~vibroimpact.engines.kernel_arguments.LoopOutput`
+    or a ``BumperLoopOutput``) as a :class:`Trajectory`: its strobes at the loop's period boundaries, each segment
+    running to the next one's start (empty ones dropped) with its mode and stop (``modes``, ``segment_stops``, one per
+    segment), its impacts (time, speed and impulse its first columns, the stop its last), ``stats``, the moments and
+    Jacobians if asked for, and the ``more`` fields of an engine's own."""
+    n, width = 2 * problem.size, 2 * problem.size + len(problem.stops)
+    times = float(t_start) + np.arange(periods + 1) * problem.period  # the loop's boundaries, bit for bit
+    starts = out.segments[:, 0]
+    ends = np.append(starts[1:], times[-1]) if starts.size else starts
+    keep = ends > starts
+    impacts = out.impacts
+    return Trajectory(
+        problem=problem, strobe_times=times, strobe_states=out.strobes,
+        impact_times=impacts[:, 0].copy(), impact_velocities=impacts[:, 1].copy(), impulses=impacts[:, 2].copy(),
+        segments=np.column_stack([starts, ends, modes])[keep], segment_states=out.segment_states[keep],
+        moments=out.moments if moments else np.zeros((0, width), dtype=complex), stats=stats,
+        strobe_jacobians=out.jacobians if jacobians else np.zeros((0, n, n)),
+        impact_stops=impacts[:, -1].astype(np.int64), segment_stops=segment_stops[keep], **more,
+    )  # fmt: skip
+
+
 @dataclass(frozen=True, eq=False)
 class _Setup:
     """What the compiled loop needs of one problem: its flows and thresholds, as the loop's leading arguments."""
@@ -229,47 +266,15 @@ class ExactEngine:
         With ``jacobians``, ``strobe_jacobians[k]`` is the exact Jacobian of period k's stroboscopic map.
         """
         out = self._run(problem, state, t_start, periods, moments, jacobians, False)
-        strobes, jac, impacts, segments, segment_states, period_moments, counters = out.strobes, out.jacobians, out.impacts, out.segments, out.segment_states, out.moments, out.counters
-        n, width = 2 * problem.size, 2 * problem.size + len(problem.stops)
-        times = float(t_start) + np.arange(periods + 1) * problem.period  # the loop's boundaries, bit for bit
-        starts = segments[:, 0]
-        ends = np.append(starts[1:], times[-1]) if starts.size else starts
-        keep = ends > starts
-        return Trajectory(
-            problem=problem,
-            strobe_times=times,
-            strobe_states=strobes,
-            impact_times=impacts[:, 0].copy(),
-            impact_velocities=impacts[:, 1].copy(),
-            impulses=impacts[:, 2].copy(),
-            segments=np.column_stack([starts, ends, segments[:, 1]])[keep],
-            segment_states=segment_states[keep],
-            moments=period_moments if moments else np.zeros((0, width), dtype=complex),
-            stats=_stats(counters, impacts.shape[0]),
-            strobe_jacobians=jac if jacobians else np.zeros((0, n, n)),
-            impact_stops=impacts[:, 3].astype(np.int64),
-            segment_stops=segments[keep, 2].astype(np.int64),
-        )
+        segments = out.segments
+        return loop_trajectory(problem, t_start, periods, out, moments, jacobians, segments[:, 1], segments[:, 2].astype(np.int64), _stats(out.counters, out.impacts.shape[0]))
 
     def strobe_map(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float = 0.0, periods: int = 1) -> StrobeMap:
         """The stroboscopic map over ``periods`` periods from ``state`` at ``t_start`` [s], with its exact Jacobian
         and what a continuation watches (impact speeds, closest approach of the gaps)."""
         out = self._run(problem, state, t_start, periods, False, True, True)
-        impacts, counters, approach = out.impacts, out.counters, out.approach
-        product = chained_jacobian(out.jacobians, 2 * problem.size)
-        return StrobeMap(
-            state=out.strobes[-1].copy(),
-            jacobian=product,
-            impact_times=impacts[:, 0].copy(),
-            impact_velocities=impacts[:, 1].copy(),
-            sticks=int(counters[2]),
-            releases=int(counters[3]),
-            closest_approach=float(approach[0]),
-            closest_approach_time=float(approach[1]),
-            stats=_stats(counters, impacts.shape[0]),
-            impact_stops=impacts[:, 3].astype(np.int64),
-            closest_approach_stop=int(approach[2]),
-        )
+        impacts, counters = out.impacts, out.counters
+        return loop_strobe_map(out, problem.size, impacts[:, [0, 1, 3]], int(counters[2]), int(counters[3]), _stats(counters, impacts.shape[0]))
 
     def dense(self, trajectory: Trajectory, times: NDArray[np.float64], side: str = "right") -> NDArray[np.float64]:
         """States at arbitrary ``times`` inside a trajectory, shape (n, 2 N), exact (from its segments).

@@ -9,8 +9,9 @@ order:
 
 * :class:`StackedFlows`: what :func:`~vibroimpact.engines.exact.stack_flows` returns, the leading parameters of both
   loops (flow f is entry f of each array, see :mod:`~vibroimpact.engines.exact_core`);
-* :class:`LoopArguments`: :func:`~vibroimpact.engines.exact_core.run_periods` before :data:`RUN_PARAMETERS`;
-* :class:`BumperLoopArguments`: :func:`~vibroimpact.engines.compliant.exact_loop.run_bumper_periods` before them;
+* :class:`LoopArguments`: :func:`~vibroimpact.engines.exact_core.run_periods_until` before :data:`RUN_PARAMETERS`
+  (the stacked flows' fields, then its own);
+* :class:`BumperLoopArguments`: :func:`~vibroimpact.engines.compliant.exact_loop.run_bumper_periods_until` before them;
 * :func:`leading_arguments`: a kernel's leading arguments taken from such a tuple by its parameter names
   (:func:`~vibroimpact.engines.exact_core.sample_states`, :func:`~vibroimpact.engines.compliant.exact_loop.sample_pieces`).
 
@@ -56,85 +57,39 @@ class StackedFlows(NamedTuple):
     fastests: NDArray[np.float64]  # omega + the largest |lambda| per flow [rad s-1]
 
 
-class LoopArguments(NamedTuple):
-    """The leading arguments of :func:`~vibroimpact.engines.exact_core.run_periods` (see
-    :class:`~vibroimpact.engines.exact_flows.ExactModel` for the stops' arrays)."""
-
-    lams: NDArray[np.complex128]
-    counts: NDArray[np.int64]
-    vecs: NDArray[np.complex128]
-    invs: NDArray[np.complex128]
-    hrms: NDArray[np.complex128]
-    csts: NDArray[np.float64]
-    zpros: NDArray[np.float64]
-    znils: NDArray[np.float64]
-    zdrvs: NDArray[np.float64]
-    zdrv2s: NDArray[np.float64]
-    polys: NDArray[np.bool_]
-    hlams: NDArray[np.complex128]
-    hcounts: NDArray[np.int64]
-    rates_all: NDArray[np.complex128]
-    rinv_all: NDArray[np.complex128]
-    fastests: NDArray[np.float64]
-    a_matrix: NDArray[np.float64]  # A of the free flight [s-1, s-2]
-    load: NDArray[np.complex128]  # its harmonic load b
-    static: NDArray[np.float64]  # its constant load b0
-    omega: float  # [rad s-1]
-    period: float  # [s]
-    gapw: NDArray[np.float64]  # (n_k, 0) per stop: the gap's weights over y
-    velw: NDArray[np.float64]  # (0, n_k): the gap velocity's
-    kickw: NDArray[np.float64]  # (0, M^-1 n_k): an impulse's direction [kg-1]
-    clearances: NDArray[np.float64]  # [m]
-    restitutions: NDArray[np.float64]  # [-]
-    masses: NDArray[np.float64]  # effective masses [kg]
-    simple: NDArray[np.int64]  # the coordinate a stop moves alone (-1: none)
-    signs: NDArray[np.float64]  # its sign in n_k
-    hold_w: NDArray[np.float64]  # minus the holding force's weights over y [N m-1, N s m-1]
-    hold_off: NDArray[np.float64]  # its offsets [N]
-    hold_har: NDArray[np.complex128]  # its harmonic parts [N]
-    force_tolerances: NDArray[np.float64]  # [N]
-    bounce: NDArray[np.float64]  # the impact maps, (K, n, n)
-    stick: NDArray[np.float64]
-    touch: NDArray[np.float64]
-    sticking_velocity: float  # [m s-1]
-    max_impacts: int  # per period
-    tolerance: float  # on a gap [m]
-    resolution_velocity: float  # [m s-1]
-    gl_nodes: NDArray[np.float64]  # Gauss-Legendre nodes on [-1, 1]
-    gl_weights: NDArray[np.float64]
+def _after_flows(name: str, doc: str, fields: list[tuple[str, Any]]) -> Any:
+    """A named tuple of :class:`StackedFlows`' fields followed by ``fields`` (a loop's own leading parameters)."""
+    made = NamedTuple(name, [*StackedFlows.__annotations__.items(), *fields])  # type: ignore[misc]
+    made.__doc__ = doc
+    return made
 
 
-class BumperLoopArguments(NamedTuple):
-    """The leading arguments of :func:`~vibroimpact.engines.compliant.exact_loop.run_bumper_periods`."""
+LoopArguments = _after_flows("LoopArguments", """The leading arguments of :func:`~vibroimpact.engines.exact_core.run_periods_until`: the stacked flows,
+    then the free flight's A [s-1, s-2], harmonic load b and constant load b0, omega [rad s-1], the period [s]; per stop
+    the gap's weights over y (n_k, 0), its velocity's (0, n_k), an impulse's direction (0, M^-1 n_k) [kg-1], the
+    clearance [m], restitution, effective mass [kg], the coordinate it moves alone (-1: none) and its sign in n_k;
+    minus the holding force's weights [N m-1, N s m-1], offsets and harmonic parts [N], its force tolerances [N], the
+    impact maps (K, n, n) of a bounce, a stick and a touch; the sticking velocity [m s-1], impacts per period before
+    sticking, the gap tolerance [m], the velocity resolution [m s-1] and the Gauss-Legendre nodes and weights on [-1, 1]
+    (:class:`~vibroimpact.engines.exact_flows.ExactModel` for the stops' arrays).""", [
+    ("a_matrix", NDArray[np.float64]), ("load", NDArray[np.complex128]), ("static", NDArray[np.float64]), ("omega", float), ("period", float),
+    ("gapw", NDArray[np.float64]), ("velw", NDArray[np.float64]), ("kickw", NDArray[np.float64]), ("clearances", NDArray[np.float64]),
+    ("restitutions", NDArray[np.float64]), ("masses", NDArray[np.float64]), ("simple", NDArray[np.int64]), ("signs", NDArray[np.float64]),
+    ("hold_w", NDArray[np.float64]), ("hold_off", NDArray[np.float64]), ("hold_har", NDArray[np.complex128]), ("force_tolerances", NDArray[np.float64]),
+    ("bounce", NDArray[np.float64]), ("stick", NDArray[np.float64]), ("touch", NDArray[np.float64]),
+    ("sticking_velocity", float), ("max_impacts", int), ("tolerance", float), ("resolution_velocity", float),
+    ("gl_nodes", NDArray[np.float64]), ("gl_weights", NDArray[np.float64]),
+])  # fmt: skip
 
-    lams: NDArray[np.complex128]
-    counts: NDArray[np.int64]
-    vecs: NDArray[np.complex128]
-    invs: NDArray[np.complex128]
-    hrms: NDArray[np.complex128]
-    csts: NDArray[np.float64]
-    zpros: NDArray[np.float64]
-    znils: NDArray[np.float64]
-    zdrvs: NDArray[np.float64]
-    zdrv2s: NDArray[np.float64]
-    polys: NDArray[np.bool_]
-    hlams: NDArray[np.complex128]
-    hcounts: NDArray[np.int64]
-    rates_all: NDArray[np.complex128]
-    rinv_all: NDArray[np.complex128]
-    fastests: NDArray[np.float64]
-    omega: float  # [rad s-1]
-    period: float  # [s]
-    obsw: NDArray[np.float64]  # weights of d_k, -d_k, F_k, -F_k over y, (4 K, n)
-    obso: NDArray[np.float64]  # their offsets [m, N]
-    velw: NDArray[np.float64]  # (0, n_k) per stop
-    salts: NDArray[np.float64]  # saltation matrix of an onset at d = 0, (K, n, n)
-    zero_har: NDArray[np.complex128]  # zeros, (4 K,)
-    gap_tolerance: float  # [m]
-    force_tolerances: NDArray[np.float64]  # [N]
-    max_events: int  # per period
-    gl_nodes: NDArray[np.float64]
-    gl_weights: NDArray[np.float64]
+BumperLoopArguments = _after_flows("BumperLoopArguments", """The leading arguments of :func:`~vibroimpact.engines.compliant.exact_loop.run_bumper_periods_until`:
+    the stacked flows (one per contact mode), then omega [rad s-1], the period [s]; the weights of d_k, -d_k, F_k, -F_k
+    over y (4 K, n) and their offsets [m, N], per stop (0, n_k) and the saltation matrix of an onset at d = 0 (K, n, n);
+    zeros (4 K,) as the observables' harmonic parts; the gap tolerance [m], the force tolerances [N], the contact
+    switches per period before giving up, and the Gauss-Legendre nodes and weights.""", [
+    ("omega", float), ("period", float), ("obsw", NDArray[np.float64]), ("obso", NDArray[np.float64]), ("velw", NDArray[np.float64]),
+    ("salts", NDArray[np.float64]), ("zero_har", NDArray[np.complex128]), ("gap_tolerance", float), ("force_tolerances", NDArray[np.float64]),
+    ("max_events", int), ("gl_nodes", NDArray[np.float64]), ("gl_weights", NDArray[np.float64]),
+])  # fmt: skip
 
 
 class LoopOutput(NamedTuple):

@@ -31,7 +31,7 @@ from vibroimpact.engines.sundae import as_doubles, content_data
 from vibroimpact.model.contact import Impact, RigidStop
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["pack_parameters", "quadrature_count", "rhs_kernel", "jacobian_kernel", "events_kernel", "holding_kernel", "STUCK", "APEX", "COMPILED_RHS", "COMPILED_JACOBIAN", "COMPILED_EVENTS", "RigidContact"]
+__all__ = ["pack_parameters", "pack_blocks", "quadrature_count", "rhs_kernel", "jacobian_kernel", "events_kernel", "holding_kernel", "STUCK", "APEX", "COMPILED_RHS", "COMPILED_JACOBIAN", "COMPILED_EVENTS", "RigidContact"]
 
 # header of the parameter array: mode, flags, sizes and the offsets of the blocks after it
 STUCK, APEX, SIZE, _N, STOPS, _OMEGA, _TRIG, _A, _C, _BR, _BI, _G, _G0, _NORMAL, _H, _H0, _HBR, _HBI, _TINV, _XOFF, LENGTH = range(21)
@@ -73,11 +73,17 @@ def pack_parameters(layout: FlowLayout, states: int, apex: bool = True) -> NDArr
     header[STUCK], header[APEX], header[SIZE], header[_N], header[STOPS], header[_OMEGA] = -1.0, float(apex), states, n, k, layout.omega
     # which of cos(wt), sin(wt) the flight's forcing needs (the moments need both): none, cos, or both
     header[_TRIG] = 2.0 if np.any(blocks[3] != 0.0) else 1.0 if np.any(blocks[2] != 0.0) else 0.0
-    start = HEADER
-    for index, block in zip(range(_A, LENGTH), blocks):
+    return pack_blocks(header, _A, LENGTH, blocks)
+
+
+def pack_blocks(header: NDArray[np.float64], first: int, length: int, blocks: list[NDArray]) -> NDArray[np.float64]:
+    """``header`` followed by ``blocks``, flat, as the compiled kernels read a parameter array: entries ``first`` to
+    ``length - 1`` of the header get the blocks' offsets in it, entry ``length`` its total size."""
+    start = header.size
+    for index, block in zip(range(first, length), blocks):
         header[index] = start
         start += block.size
-    header[LENGTH] = start
+    header[length] = start
     return np.concatenate([header, *blocks]).astype(np.float64)
 
 

@@ -38,7 +38,7 @@ from numpy.typing import NDArray
 from vibroimpact.engines.base import MODE_FREE, Trajectory, check_run, start_state
 from vibroimpact.engines.compliant import exact_loop
 from vibroimpact.engines.compliant.model import MODE_CONTACT
-from vibroimpact.engines.exact import StrobeMap, chained_jacobian, restacked, stack_flows
+from vibroimpact.engines.exact import StrobeMap, loop_strobe_map, loop_trajectory, restacked, stack_flows
 from vibroimpact.engines.exact_flows import Flow, harmonic_response, mechanical_null_basis, unforced_flow
 from vibroimpact.engines.interruptible import call_interruptibly
 from vibroimpact.engines.kernel_arguments import BumperLoopArguments, BumperLoopOutput, StackedFlows, leading_arguments
@@ -273,23 +273,8 @@ class CompliantExactEngine:
         to 0) is where either reaches 0.
         """
         out = self._run(problem, state, t_start, periods, False, True, True)
-        counters, onsets, approach = out.counters, out.onsets, out.approach
-        product = chained_jacobian(out.jacobians, 2 * problem.size)
-        return StrobeMap(
-            state=out.strobes[-1].copy(),
-            jacobian=product,
-            impact_times=onsets[:, 0].copy(),
-            impact_velocities=onsets[:, 1].copy(),
-            sticks=0,
-            releases=int(counters[4]),
-            closest_approach=float(approach[0]),
-            closest_approach_time=float(approach[1]),
-            stats=_stats(counters, out.impacts.shape[0]),
-            impact_stops=onsets[:, 2].astype(np.int64),
-            closest_approach_stop=int(approach[2]),
-            surface_onsets=onsets[:, 3] > 0.5,
-            onset_curvatures=onsets[:, 4].copy(),
-        )
+        counters, onsets = out.counters, out.onsets
+        return loop_strobe_map(out, problem.size, onsets[:, :3], 0, int(counters[4]), _stats(counters, out.impacts.shape[0]), surface_onsets=onsets[:, 3] > 0.5, onset_curvatures=onsets[:, 4].copy())
 
     def compiled_period(self, problem: ImpactProblem) -> "CompiledPeriod":
         """``problem``'s stroboscopic map over one period from t = 0 as the compiled loop alone computes it
@@ -354,31 +339,14 @@ class CompiledPeriod:
 
 
 def _trajectory(problem: ImpactProblem, t_start: float, periods: int, out: BumperLoopOutput, moments: bool, jacobians: bool) -> Trajectory:
-    """The compiled loop's output as a :class:`Trajectory`."""
-    strobes, jac, contacts, segments, segment_states, period_moments, counters = out.strobes, out.jacobians, out.impacts, out.segments, out.segment_states, out.moments, out.counters
-    n, width = 2 * problem.size, 2 * problem.size + len(problem.stops)
-    times = t_start + np.arange(periods + 1) * problem.period  # the loop's boundaries, bit for bit
-    starts = segments[:, 0]
-    ends = np.append(starts[1:], times[-1]) if starts.size else starts
-    keep = ends > starts
-    masks = segments[:, 1].astype(np.int64)
+    """The compiled loop's output as a :class:`Trajectory` (:func:`~vibroimpact.engines.exact.loop_trajectory`): a
+    segment in contact is with its lowest stop in contact; each contact's largest force and deceleration."""
+    masks = out.segments[:, 1].astype(np.int64)
     lowest = np.array([(int(mask) & -int(mask)).bit_length() - 1 for mask in masks], dtype=np.int64)
-    return Trajectory(
-        problem=problem,
-        strobe_times=times,
-        strobe_states=strobes,
-        impact_times=contacts[:, 0].copy(),
-        impact_velocities=contacts[:, 1].copy(),
-        impulses=contacts[:, 2].copy(),
-        segments=np.column_stack([starts, ends, np.where(masks > 0, MODE_CONTACT, MODE_FREE)])[keep],
-        segment_states=segment_states[keep],
-        moments=period_moments if moments else np.zeros((0, width), dtype=complex),
-        contact_peaks=contacts[:, 3:5].copy(),
-        stats=_stats(counters, contacts.shape[0]),
-        strobe_jacobians=jac if jacobians else np.zeros((0, n, n)),
-        impact_stops=contacts[:, 5].astype(np.int64),
-        segment_stops=lowest[keep],
-        contact_peak_stops=contacts[:, 5].astype(np.int64),
+    contacts = out.impacts
+    return loop_trajectory(
+        problem, t_start, periods, out, moments, jacobians, np.where(masks > 0, MODE_CONTACT, MODE_FREE), lowest, _stats(out.counters, contacts.shape[0]),
+        contact_peaks=contacts[:, 3:5].copy(), contact_peak_stops=contacts[:, 5].astype(np.int64),
     )
 
 

@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines.flow_layout import flow_layout
 from vibroimpact.engines.numba_cache import stamp_with_callees
-from vibroimpact.engines.rigid_kernels import quadrature_count
+from vibroimpact.engines.rigid_kernels import pack_blocks, quadrature_count
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.problem import ImpactProblem
@@ -66,12 +66,7 @@ def pack_mode(n: int, k: int, size: int, mask: int, quadratures: int, swept: boo
     blocks = [a.ravel(), c, b.real.copy(), b.imag.copy(), force_rows.ravel(), force_constants, normals.ravel(), t.ravel(), t_inverse.ravel(), offset]
     header = np.zeros(_HEADER)
     header[:_A] = n, k, size, mask, quadratures, float(swept), omega, w0, half_alpha
-    start = _HEADER
-    for index, block in zip(range(_A, _LENGTH), blocks):
-        header[index] = start
-        start += block.size
-    header[_LENGTH] = start
-    return np.concatenate([header, *blocks]).astype(np.float64)
+    return pack_blocks(header, _A, _LENGTH, blocks)
 
 
 @njit(cache=True)
