@@ -45,7 +45,7 @@ from vibroimpact.model.layout import PAPER_STOP, Layout
 from vibroimpact.model.parameters import BUMPER_STIFFNESS, LAYOUT_FORMS, MAX_RELATIVE_SPREAD, PARAMETERS, Parameter, parameter
 from vibroimpact.model.structure import require_in_range
 from vibroimpact.scene.checker import Checker, SceneError
-from vibroimpact.scene.header import parse_names
+from vibroimpact.scene.header import open_scene
 from vibroimpact.scene.layout_parse import parse_layout
 from vibroimpact.scene.schema import Scene
 
@@ -218,9 +218,7 @@ class DesignSettings:
 def parse_design_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
     """Validate a design scene's document (a mapping with ``design``) and build the :class:`Scene`; raise
     :class:`SceneError` listing all problems."""
-    c = Checker()
-    doc = c.mapping("", document, DESIGN_TOP_KEYS, {"name", "system", "excitation", "design"}, kind="design")
-    name, description, report = parse_names(c, doc)
+    c, doc, name, description, report = open_scene(document, DESIGN_TOP_KEYS, {"name", "system", "excitation", "design"}, "design")
     layout, amplitude, coordinates = parse_layout(c, doc)
     clearance, restitution, bumper = _stop_values(c, doc, layout)
     spec = c.mapping("design", doc.get("design"), _DESIGN_KEYS, {"variables", "band"}) if "design" in doc else {}
