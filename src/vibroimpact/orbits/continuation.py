@@ -45,6 +45,10 @@ __all__ = ["ContinuationSettings", "continue_branch", "SpecialCurve", "continue_
 #: A failed step moves the strobe when the nearest contact is closer to it than this fraction of the distance the moved
 #: strobe would have (half the widest gap between contacts).
 RESECTION_RATIO = 0.5
+#: A step across which the number of Floquet multipliers outside the unit circle changes while no test function changes
+#: sign (two crossings inside it cancel in the tests: a torus pair leaving the circle next to another pair's product
+#: crossing 1) is halved, at most this many times, until a test changes sign in a part.
+MAX_DETECTION_SPLITS = 10
 
 
 class _Walker(OnsetSteps):
@@ -90,6 +94,20 @@ class _Walker(OnsetSteps):
         if found is not None:
             self.specials.append((arclength + float(a.tangent @ (best.z - a.z)), found))
 
+    def _between(self, a: Point, b: Point) -> Point | None:
+        """A point of the branch between a and b in the continued parameter, with their impacts: an ordinary step from
+        a along its own tangent (the branch's, oriented towards b), a half, a quarter or an eighth of the way; None
+        where none is found."""
+        n = self.n
+        chord = b.z - a.z
+        tangent = self.arc.tangent(a.jacobian, chord / float(np.linalg.norm(chord)))
+        way = float(tangent @ chord)
+        for fraction in (0.5, 0.25, 0.125):
+            middle = self.arc.correct(a.z + fraction * way * tangent, tangent, self.settings.tolerance, 12)
+            if middle is not None and signature_of(middle) == signature_of(a) and min(a.z[n], b.z[n]) < middle.z[n] < max(a.z[n], b.z[n]):
+                return middle
+        return None
+
     def _collapsed(self, point: Point) -> bool:
         """Is this fixed point of P^K also one of P^d for a proper divisor d of K: the branch meets the lower-period
         orbit it was born from (a period doubling, or a k-tupling where a multiplier is a k-th root of unity)?"""
@@ -99,12 +117,25 @@ class _Walker(OnsetSteps):
                 return True
         return False
 
-    def detect(self, a: Point, values_a: dict[str, float], b: Point, values_b: dict[str, float], sigma: float, arclength: float) -> None:
-        """Locate every test function that changes sign between a and b (sigma along a's tangent)."""
-        self.parent = None
-        for kind, before in values_a.items():
-            if np.sign(before) * np.sign(values_b[kind]) < 0:
-                self.special(kind, a, sigma, arclength)
+    def detect(self, a: Point, values_a: dict[str, float], b: Point, values_b: dict[str, float], sigma: float, arclength: float, splits: int = 0) -> None:
+        """Locate every test function that changes sign between a and b (sigma along a's tangent). Where none does but
+        the number of multipliers outside the unit circle changed (the same impacts at both ends: two crossings inside
+        the step cancel in the tests), the step is halved in the parameter and each half searched
+        (:data:`MAX_DETECTION_SPLITS`)."""
+        if splits == 0:
+            self.parent = None
+        changed = [kind for kind, before in values_a.items() if np.sign(before) * np.sign(values_b[kind]) < 0]
+        unstable_a, unstable_b = _unstable(a), _unstable(b)
+        if not changed and unstable_a != unstable_b and splits < MAX_DETECTION_SPLITS and min(unstable_a, unstable_b) >= 0 and _same_contacts(a, b):
+            middle = self._between(a, b)
+            if middle is not None:
+                values_middle = self.tests(middle)
+                first = float(a.tangent @ (middle.z - a.z))
+                self.detect(a, values_a, middle, values_middle, first, arclength, splits + 1)
+                self.detect(middle, values_middle, b, values_b, float(middle.tangent @ (b.z - middle.z)), arclength + first, splits + 1)
+                return
+        for kind in changed:
+            self.special(kind, a, sigma, arclength)
 
     def _grazing_distance(self, a: Point) -> float:
         """Arclength to the grazing point extrapolated from the margin's slope (inf when it is not approaching)."""
@@ -341,3 +372,17 @@ def continue_branch(system: ParametrisedMap, orbit: PeriodicOrbit, parameter: st
     points = list(reversed(down)) + up[1:]
     specials = [s for _, s in reversed(down_specials)] + [s for _, s in up_specials]
     return Branch(parameter, tuple(p.orbit(system) for p in points), tuple(specials), f"{down_end}, {up_end}")
+
+
+def _unstable(point: Point) -> int:
+    """How many of the point's Floquet multipliers lie outside the unit circle (-1: the map has no Jacobian there)."""
+    jacobian = point.out.jacobian
+    if not np.all(np.isfinite(jacobian)):
+        return -1
+    return int(np.sum(np.abs(np.linalg.eigvals(jacobian)) > 1.0))
+
+
+def _same_contacts(a: Point, b: Point) -> bool:
+    """Whether a and b have the same impacts and sticks (the multipliers then move smoothly between them)."""
+    return a.out.hybrid is None or b.out.hybrid is None or a.out.hybrid.signature == b.out.hybrid.signature
+
