@@ -47,7 +47,7 @@ __all__ = ["ContinuationSettings", "continue_branch", "SpecialCurve", "continue_
 RESECTION_RATIO = 0.5
 #: A step across which the number of Floquet multipliers outside the unit circle changes while no test function changes
 #: sign (two crossings inside it cancel in the tests: a torus pair leaving the circle next to another pair's product
-#: crossing 1) is halved, at most this many times, until a test changes sign in a part.
+#: crossing 1) is split in two at a point of the branch between its ends, at most this many times over.
 MAX_DETECTION_SPLITS = 10
 
 
@@ -120,14 +120,14 @@ class _Walker(OnsetSteps):
     def detect(self, a: Point, values_a: dict[str, float], b: Point, values_b: dict[str, float], sigma: float, arclength: float, splits: int = 0) -> None:
         """Locate every test function that changes sign between a and b (sigma along a's tangent). Where none does but
         the number of multipliers outside the unit circle changed (the same impacts at both ends: two crossings inside
-        the step cancel in the tests), the step is halved in the parameter and each half searched
-        (:data:`MAX_DETECTION_SPLITS`)."""
+        the step cancel in the tests), the step is split at a point of the branch between its ends (:meth:`_between`) and
+        each part searched (:data:`MAX_DETECTION_SPLITS`)."""
         if splits == 0:
             self.parent = None
         changed = [kind for kind, before in values_a.items() if np.sign(before) * np.sign(values_b[kind]) < 0]
-        unstable_a, unstable_b = _unstable(a), _unstable(b)
-        if not changed and unstable_a != unstable_b and splits < MAX_DETECTION_SPLITS and min(unstable_a, unstable_b) >= 0 and _same_contacts(a, b):
-            middle = self._between(a, b)
+        if not changed and splits < MAX_DETECTION_SPLITS and signature_of(a) == signature_of(b):  # (multipliers only then)
+            outside = (_unstable(a), _unstable(b))
+            middle = self._between(a, b) if outside[0] != outside[1] and min(outside) >= 0 else None
             if middle is not None:
                 values_middle = self.tests(middle)
                 first = float(a.tangent @ (middle.z - a.z))
@@ -380,9 +380,4 @@ def _unstable(point: Point) -> int:
     if not np.all(np.isfinite(jacobian)):
         return -1
     return int(np.sum(np.abs(np.linalg.eigvals(jacobian)) > 1.0))
-
-
-def _same_contacts(a: Point, b: Point) -> bool:
-    """Whether a and b have the same impacts and sticks (the multipliers then move smoothly between them)."""
-    return a.out.hybrid is None or b.out.hybrid is None or a.out.hybrid.signature == b.out.hybrid.signature
 
