@@ -24,7 +24,11 @@ from vibroimpact.reporting.style import Caption, figure_legend, finish_axes, fmt
 
 import matplotlib.pyplot as plt  # after style: the Agg backend is selected
 
+#: A grid search's map (:func:`grid_cells`): the values of the two variables and the evaluation in each cell (y, x).
+GridCells = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]
+
 __all__ = ["search_figure", "grid_cells"]
+
 
 def _axis(dataset: xr.Dataset, name: str) -> tuple[float, str]:
     """(factor to the page's units, axis label) of a design variable."""
@@ -68,8 +72,9 @@ def _triangulation(u: NDArray[np.float64], v: NDArray[np.float64], x: NDArray[np
     return out
 
 
-def _map_panel(ax: Axes, d: xr.Dataset, pair: tuple[str, str], levels: NDArray[np.float64], projected: bool) -> object:
-    """One panel of the search's map over ``pair``; the colour mapping drawn (for the colour bar)."""
+def _map_panel(ax: Axes, d: xr.Dataset, pair: tuple[str, str], levels: NDArray[np.float64], projected: bool, cells: GridCells | None) -> object:
+    """One panel of the search's map over ``pair`` (``cells``: the grid search's map of them, :func:`grid_cells`); the
+    colour mapping drawn (for the colour bar)."""
     (sx, xlabel), (sy, ylabel) = _axis(d, pair[0]), _axis(d, pair[1])
     x, y = (d[f"variable_{safe_name(n)}"].values for n in pair)
     objective = objective_quantity(d).value(d["objective"].values)
@@ -79,7 +84,6 @@ def _map_panel(ax: Axes, d: xr.Dataset, pair: tuple[str, str], levels: NDArray[n
     (x0, x1), (y0, y1) = _limits(d, pair[0]), _limits(d, pair[1])
     mappable = None
     inside = (x >= x0) & (x <= x1) & (y >= y0) & (y <= y1)  # the scene's design may lie outside the bounds
-    cells = None if projected else grid_cells(d, pair)
     if cells is not None:
         mappable = _cell_map(ax, d, cells, (sx, sy), levels)
     elif not projected:
@@ -120,12 +124,13 @@ def _feasibility_line(ax: Axes, d: xr.Dataset, tri: Triangulation, keep: NDArray
     ax.fill([], [], facecolor="none", edgecolor=LIMIT_COLOUR, hatch="////", lw=1.8, label=f"{constraint_quantity(d).symbol} at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz above its limit (interpolated)")
 
 
-def grid_cells(d: xr.Dataset, pair: tuple[str, str]) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]] | None:
+def grid_cells(d: xr.Dataset, pair: tuple[str, str]) -> GridCells | None:
     """The grid search's candidates over ``pair`` as a map: (x values, y values, evaluation index of each cell, shape
     (y, x)); None unless the dataset's grid stage evaluated every cell of a full grid over these two variables."""
-    if len(variable_names(d)) != 2 or stage_counts(d).get("grid", 0) == 0:
+    counts = stage_counts(d)
+    if len(variable_names(d)) != 2 or counts.get("grid", 0) == 0:
         return None
-    grid = np.flatnonzero(d["evaluation_stage"].values == list(stage_counts(d)).index("grid"))
+    grid = np.flatnonzero(d["evaluation_stage"].values == list(counts).index("grid"))
     x, y = (d[f"variable_{safe_name(n)}"].values[grid] for n in pair)
     xs, ys = np.unique(x), np.unique(y)
     if xs.size < 2 or ys.size < 2 or xs.size * ys.size != grid.size:
@@ -141,7 +146,7 @@ def _edges(centres: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.concatenate([[centres[0] - (middle[0] - centres[0])], middle, [centres[-1] + (centres[-1] - middle[-1])]])
 
 
-def _cell_map(ax: Axes, d: xr.Dataset, cells: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]], scales: tuple[float, float], levels: NDArray[np.float64]) -> object:
+def _cell_map(ax: Axes, d: xr.Dataset, cells: GridCells, scales: tuple[float, float], levels: NDArray[np.float64]) -> object:
     """A grid search drawn as the map it is: one cell per candidate, its own worst case (no interpolation); the cells
     that break the operating limit hatched and outlined."""
     xs, ys, index = cells
@@ -149,12 +154,13 @@ def _cell_map(ax: Axes, d: xr.Dataset, cells: tuple[NDArray[np.float64], NDArray
     norm = BoundaryNorm(levels, OBJECTIVE_MAP.N, extend="max")
     with np.errstate(divide="ignore", invalid="ignore"):
         shown = np.where(np.isfinite(objective) & (objective > 0.0), np.log10(objective), np.nan)
-    mappable = ax.pcolormesh(_edges(xs) * scales[0], _edges(ys) * scales[1], np.ma.masked_invalid(shown), cmap=OBJECTIVE_MAP, norm=norm, zorder=0)
+    x_edges, y_edges = _edges(xs) * scales[0], _edges(ys) * scales[1]
+    mappable = ax.pcolormesh(x_edges, y_edges, np.ma.masked_invalid(shown), cmap=OBJECTIVE_MAP, norm=norm, zorder=0)
     if math.isfinite(operating_limit(d)):
         broken = d["feasible"].values[index] != 1
         if np.any(broken):
             with plt.rc_context({"hatch.color": LIMIT_COLOUR, "hatch.linewidth": 0.7}):
-                ax.pcolor(_edges(xs) * scales[0], _edges(ys) * scales[1], np.ma.masked_where(~broken, np.ones(broken.shape)), hatch="////", facecolor="none",
+                ax.pcolor(x_edges, y_edges, np.ma.masked_where(~broken, np.ones(broken.shape)), hatch="////", facecolor="none",
                           edgecolor=LIMIT_COLOUR, linewidth=0.0, zorder=1)  # fmt: skip
             ax.contour(xs * scales[0], ys * scales[1], broken.astype(float), levels=[0.5], colors=LIMIT_COLOUR, linewidths=1.8, zorder=3)
             ax.fill([], [], facecolor="none", edgecolor=LIMIT_COLOUR, hatch="////", lw=1.8, label=f"{constraint_quantity(d).symbol} at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz above its limit (the candidate's own value)")
@@ -192,7 +198,8 @@ def search_figure(dataset: xr.Dataset) -> DrawnFigure:
     inside = np.all([(d[f"variable_{safe_name(n)}"].values >= _limits(d, n)[0]) & (d[f"variable_{safe_name(n)}"].values <= _limits(d, n)[1]) for n in names], axis=0)
     levels = _levels(np.where(inside, objective, np.nan))
     fig, axes = new_figure(len(pairs) + projected, panel_height=4.6 if not projected else 3.8, legend_rows=legend_rows(7, 3))
-    mappables = [_map_panel(ax, d, pair, levels, projected) for ax, pair in zip(axes, pairs)]
+    cells = None if projected else grid_cells(d, pairs[0])
+    mappables = [_map_panel(ax, d, pair, levels, projected, cells) for ax, pair in zip(axes, pairs)]
     if projected:
         _progress_panel(axes[-1], d)
     mappable = next((m for m in mappables if m is not None), None)
@@ -200,7 +207,6 @@ def search_figure(dataset: xr.Dataset) -> DrawnFigure:
         bar = fig.colorbar(mappable, ax=axes[: len(pairs)], extend="max", ticks=levels[::2], shrink=0.9)
         bar.ax.set_yticklabels([fmt(10**t, ".3g") for t in levels[::2]])
         bar.set_label(f"worst case {q.symbol} over the band and the samples [{q.unit}]")
-    cells = None if projected else grid_cells(d, pairs[0])
     if cells is not None:
         caption = _grid_caption(d, cells, levels)
     else:
@@ -222,7 +228,7 @@ def search_figure(dataset: xr.Dataset) -> DrawnFigure:
     return DrawnFigure(fig, "design_search", "The objective over the design variables, and the search's path", caption.text())
 
 
-def _grid_caption(d: xr.Dataset, cells: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]], levels: NDArray[np.float64]) -> Caption:
+def _grid_caption(d: xr.Dataset, cells: GridCells, levels: NDArray[np.float64]) -> Caption:
     """What the grid's map draws."""
     xs, ys, index = cells
     q, c, limit = objective_quantity(d), constraint_quantity(d), operating_limit(d)
