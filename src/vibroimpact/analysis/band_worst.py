@@ -5,7 +5,9 @@ Two motions have closed forms on any layout with one stop or a symmetric two-sid
 state (stable where it clears every stop, unless a free mass has no dashpot) and the period-1 impact orbit with one impact per
 period (two for the pair; eqs. 15-18, both roots of the impulse equation, each where it exists, stays off the stops
 between impacts and has every Floquet multiplier inside the unit circle). :func:`closed_form_worst` scans both on
-``scan`` frequencies, takes the largest stable |X| of each motion (and every local maximum within 10 % of it) and
+``scan`` evenly spaced frequencies, with more where the structure can resonate (its free and locked modes, the
+contact region: :func:`~vibroimpact.analysis.scan_grid.scan_frequencies`, so that the answer does not depend on the
+band's width), takes the largest stable |X| of each motion (and every local maximum within 10 % of it) and
 refines each by zoomed scans between the scan
 points either side (each trial frequency solved in closed form and kept only where the motion is still stable and
 admissible): the maximum's frequency to ``tolerance`` of the frequency, not to a scan step.
@@ -27,10 +29,11 @@ from numpy.typing import NDArray
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.linear import contact_free_is_stable, linear_amplitudes
 from vibroimpact.analysis.measures import Measure, as_measure
+from vibroimpact.analysis.scan_grid import scan_frequencies, scan_widths
 from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
 from vibroimpact.model.problem import ImpactProblem
 
-__all__ = ["BandWorst", "closed_form_worst", "closed_form_at", "contact_free_curve", "existing_impact_curve", "scan_frequencies", "MOTIONS", "SCAN", "refine_maximum"]
+__all__ = ["BandWorst", "closed_form_worst", "closed_form_at", "contact_free_curve", "existing_impact_curve", "scan_frequencies", "uncovered_share", "MOTIONS", "SCAN", "refine_maximum"]
 
 #: Frequencies of the scan whose maxima are refined.
 SCAN = 241
@@ -61,8 +64,9 @@ class BandWorst:
     impacts : int
         Impacts per period of that motion (0 contact-free).
     uncovered : float
-        Share of the scanned frequencies [-] where no closed-form motion is stable (there the motion is one the
-        closed forms do not know).
+        Share of the band's width [-] where no closed-form motion is stable (there the motion is one the closed forms
+        do not know): each scan frequency weighted by the width it stands for (:func:`uncovered_share`), since the
+        scan is finer where the structure can resonate.
     estimate : float
         Where uncovered, a guess at the size of the motion there [m]: the largest |X| of the closed-form impact orbits
         that exist there, stable or not (a non-periodic attractor winds around its unstable orbits), else of the
@@ -164,15 +168,6 @@ def _curves(problem: ImpactProblem, f: NDArray[np.float64], measure: int | Measu
     return [(root, _curve(problem, f, measure, root)) for root in _ROOTS if root is None or problem.stops]
 
 
-def scan_frequencies(band: tuple[float, float], scan: int) -> NDArray[np.float64]:
-    """``scan`` evenly spaced frequencies over ``band`` [Hz], its ends included; ``ValueError`` unless 0 < low < high
-    and scan >= 3."""
-    low, high = (float(b) for b in band)
-    if not 0.0 < low < high or scan < 3:
-        raise ValueError(f"band = {band!r} must be 0 < low < high [Hz] and scan = {scan} >= 3")
-    return np.linspace(low, high, scan)
-
-
 def closed_form_worst(problem: ImpactProblem, band: tuple[float, float], measure: int | Measure = 0, scan: int = SCAN, tolerance: float = 1e-8) -> BandWorst:
     """The largest stable ``measure`` over ``band`` [Hz] among the closed-form motions (module docstring).
 
@@ -185,11 +180,12 @@ def closed_form_worst(problem: ImpactProblem, band: tuple[float, float], measure
     measure : int or Measure
         A row of :mod:`vibroimpact.analysis.measures`, or a coordinate index for its |X| (0: the paper's primary mass x1).
     scan : int
-        Frequencies of the scan (>= 3).
+        Evenly spaced frequencies of the scan (>= 3); more are added where they are coarser than
+        :data:`~vibroimpact.analysis.scan_grid.RESONANCE_SPACING` of the frequency around the structure's resonances.
     tolerance : float
         Of the refined frequency, relative [-].
     """
-    f = scan_frequencies(band, scan)
+    f = scan_frequencies(band, scan, problem)
     measure = as_measure(measure, problem)
     curves = _curves(problem, f, measure)
     covered = np.zeros(f.size, dtype=bool)
@@ -213,7 +209,15 @@ def closed_form_worst(problem: ImpactProblem, band: tuple[float, float], measure
         guess = np.where(np.isfinite(guess), guess, linear)[~covered]
         k = int(np.argmax(guess))
         estimate, estimate_frequency = float(guess[k]), float(f[~covered][k])
-    return BandWorst(best[0], best[1], best[2], best[3], float(np.count_nonzero(~covered)) / f.size, estimate, estimate_frequency, impulse)
+    return BandWorst(best[0], best[1], best[2], best[3], uncovered_share(f, covered), estimate, estimate_frequency, impulse)
+
+
+def uncovered_share(f: NDArray[np.float64], covered: NDArray[np.bool_]) -> float:
+    """The share [-] of the band's width where no motion is ``covered`` on the scan ``f`` [Hz]: each point weighted by
+    the width it stands for (:func:`~vibroimpact.analysis.scan_grid.scan_widths`; an evenly spaced scan: the share of
+    its points)."""
+    widths = scan_widths(f)
+    return min(1.0, float(np.sum(widths[~covered]) / np.sum(widths)))
 
 
 def _maxima(x: NDArray[np.float64]) -> list[int]:
