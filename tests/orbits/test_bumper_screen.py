@@ -12,13 +12,14 @@ import numpy as np
 import pytest
 
 from vibroimpact.analysis.band_worst import closed_form_worst
+from vibroimpact.analysis.scan_grid import scan_frequencies
 from vibroimpact.engines.registry import make_engine
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import PAPER_SYSTEM
-from vibroimpact.orbits.bumper_screen import bumper_at, bumper_curves, bumper_screen_refusal, bumper_worst, rigid_twin
+from vibroimpact.orbits.bumper_screen import BUMPER_SCAN, BUMPER_SPACING, bumper_at, bumper_curves, bumper_screen_refusal, bumper_worst, rigid_twin
 from vibroimpact.orbits.worst_case import worst_response
 from vibroimpact.simulation.settings import SteadySettings
 from vibroimpact.simulation.steady import steady_state
@@ -97,3 +98,16 @@ def test_the_curves_and_the_operating_point_are_the_screen_s() -> None:
     assert np.nanmax(stable) == pytest.approx(bumper_worst(problem, BAND).amplitude, rel=1e-3)
     notch = bumper_at(problem, 33.0)
     assert notch.motion == "contact-free" and notch.amplitude < 2e-5
+
+
+def test_the_screen_finds_the_bumper_s_resonance_over_a_wide_band() -> None:
+    """250 Hz bumper, R = 0.2: over 15-4500 Hz the screen's 61 evenly spaced shots step 75 Hz, over the whole
+    resonance; the points added around the structure's free, locked and bumper-engaged modes find the same 3.0085 mm
+    of one contact per period near 24.93 Hz as over 15-45 Hz (to 1e-6 relative), where the scan is the evenly spaced
+    one."""
+    problem = bumper_problem(250.0)
+    narrow, wide = bumper_worst(problem, BAND), bumper_worst(problem, (15.0, 4500.0))
+    assert narrow.amplitude == pytest.approx(3.0085e-3, rel=1e-4)
+    assert wide.motion == "impacting, period 1" and wide.amplitude == pytest.approx(narrow.amplitude, rel=1e-6)
+    assert wide.frequency == pytest.approx(narrow.frequency, rel=1e-5)
+    np.testing.assert_array_equal(scan_frequencies(BAND, BUMPER_SCAN, problem, spacing=BUMPER_SPACING), np.linspace(*BAND, BUMPER_SCAN))
