@@ -125,9 +125,9 @@ def scan_frequencies(band: tuple[float, float], scan: int, problem: ImpactProble
     if not 0.0 < low < high or scan < 3:
         raise ValueError(f"band = {band!r} must be 0 < low < high [Hz] and scan = {scan} >= 3")
     even = np.linspace(low, high, scan)
-    if problem is None:
-        return even
     coarse_below = (high - low) / (scan - 1) / spacing  # the even grid's step is within ``spacing`` of f above this
+    if problem is None or coarse_below <= low:  # fine enough everywhere: no modes nor onsets to look for
+        return even
     spans = [(a, min(b, coarse_below)) for a, b in _spans(problem, (low, high), spacing) if a < coarse_below]
     logs = [math.log(b / a) for a, b in spans if b > a]
     if not logs:
