@@ -32,7 +32,7 @@ from vibroimpact.simulation.attractors import MOTION_CLASSES, at_frequency, meas
 from vibroimpact.simulation.harmonics import gaps, linear_state, resting_state
 from vibroimpact.simulation.history import engine_of
 
-__all__ = ["PEAK_SAMPLES", "INSIDE", "AttractorMaximum", "AttractorSweep", "band_attractors", "attractor_labels", "attractor_starts"]
+__all__ = ["PEAK_SAMPLES", "INSIDE", "pulled_inside", "AttractorMaximum", "AttractorSweep", "band_attractors", "attractor_labels", "attractor_starts"]
 
 #: Samples per excitation period of the run that measures the peak |x1(t)| of the largest attractor [-] (a harmonic
 #: motion's peak is then low by at most 1 - cos(pi / 256) = 7.5e-5, relative).
@@ -236,11 +236,11 @@ def attractor_starts(problem: ImpactProblem, starts: int, rng: np.random.Generat
         else:
             spread = length * rng.uniform(0.5, 2.0)
             state = rest + np.concatenate([spread * rng.uniform(-1.0, 1.0, size), problem.omega * spread * rng.uniform(-1.0, 1.0, size)])
-        found.append((label, _inside(problem, rest, state)))
+        found.append((label, pulled_inside(problem, rest, state)))
     return found
 
 
-def _inside(problem: ImpactProblem, rest: NDArray[np.float64], state: NDArray[np.float64]) -> NDArray[np.float64]:
+def pulled_inside(problem: ImpactProblem, rest: NDArray[np.float64], state: NDArray[np.float64]) -> NDArray[np.float64]:
     """``state``, or the point of the line from ``rest`` to it :data:`INSIDE` of the way to the first stop it touches."""
     towards = problem.normals() @ (state - rest)[: problem.size]  # n_k . (x - x_rest): how much closer to each stop
     room = gaps(problem, rest)

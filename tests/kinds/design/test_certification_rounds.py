@@ -50,7 +50,7 @@ def _outcome(screened: dict[float, float], certified: dict[float, float], candid
     for k, (clearance, value) in enumerate(screened.items()):
         evaluations.designs.append(np.array([clearance, 0.2]))
         evaluations.stages.append(3 if k == 0 else 0)  # the first is the scene's own design
-        evaluations.results.append({"worst": np.full(space.samples, value), "uncovered": np.zeros(space.samples), "estimate": np.zeros(space.samples)})
+        evaluations.results.append({"worst": np.full(space.samples, value), "uncovered": np.zeros(space.samples), "estimate": np.zeros(space.samples), "operating": np.full(space.samples, np.nan)})
         evaluations.scores.append(value)
     return Outcome(scene.settings, space, evaluations), runner
 
@@ -99,7 +99,8 @@ def test_the_scene_s_design_is_not_certified_twice() -> None:
 
 
 def test_with_a_quantile_a_certificate_raises_its_sample_not_the_whole_objective() -> None:
-    """quantile 0.5 over 5 samples (1.0 ... 1.4 mm screened, the median 1.2 mm at sample 2): the certified samples
+    """quantile 0.5 over the nominal and 4 random samples (1.0 ... 1.4 mm screened, the median 1.2 mm at sample 4;
+    samples 1 and 2 are the box's corners, 1.6 and 1.7 mm, outside a quantile's statistics): the certified samples
     are the nominal and the one that sets the median (not the worst, whose certificate could not move a median);
     certified 1.35 mm, both rise to 1.35 and the median is 1.35 mm. Had the certificate been 1.25 mm, the median would
     be 1.25: scaling the objective by the largest certificate over it gave the same here, but not in general (a
@@ -111,16 +112,18 @@ def test_with_a_quantile_a_certificate_raises_its_sample_not_the_whole_objective
     space = design_space(scene)
     runner = TableRunner({2e-3: 1.35, 3e-3: 1.5})
     evaluations = Evaluations(space, np.array([[0.001, 0.005], [0.0, 0.8]]), runner, quantile=0.5)  # type: ignore[arg-type]
-    for k, (clearance, values) in enumerate({3e-3: [1.5] * 5, 2e-3: [1.0, 1.1, 1.2, 1.3, 1.4]}.items()):
+    assert space.samples == 7 and evaluations.corners == 0  # the corners are samples; Evaluations is told below
+    evaluations.corners = 2
+    for k, (clearance, values) in enumerate({3e-3: [1.5] * 7, 2e-3: [1.0, 1.6, 1.7, 1.1, 1.2, 1.3, 1.4]}.items()):
         evaluations.designs.append(np.array([clearance, 0.2]))
         evaluations.stages.append(3 if k == 0 else 0)
-        result = {"worst": np.array(values), "uncovered": np.zeros(5), "estimate": np.zeros(5)}
+        result = {"worst": np.array(values), "uncovered": np.zeros(7), "estimate": np.zeros(7), "operating": np.full(7, np.nan)}
         evaluations.results.append(result)
         evaluations.scores.append(evaluations.score(result))
     assert evaluations.scores[1] == pytest.approx(1.2, rel=1e-12)
     outcome = Outcome(scene.settings, space, evaluations)
     _certify(outcome, runner, lambda message: None)  # type: ignore[arg-type]
-    assert runner.batches[0][:2] == [(2e-3, 0), (2e-3, 2)]  # exact: the designs and samples passed on
+    assert runner.batches[0][:2] == [(2e-3, 0), (2e-3, 4)]  # exact: the designs and samples passed on
     assert outcome.corrected[1] == pytest.approx(1.35, rel=1e-12) and outcome.recommended == 1
     runner.certified[2e-3] = 1.25  # a smaller certificate: the nominal's 1.0 -> 1.25, the median's 1.2 -> 1.25
     outcome = Outcome(scene.settings, space, evaluations)

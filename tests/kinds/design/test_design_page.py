@@ -95,9 +95,10 @@ def test_every_figure_file_is_written_and_embedded(two: xr.Dataset, tmp_path: Pa
 
 
 def test_the_answer_names_the_spreads_the_scene_states_and_the_comparisons(two: xr.Dataset) -> None:
-    assert mistuning_text(two) == "+-0.2 mm of the clearance (2 samples)"  # as stated, not the samples' largest offset
+    # as stated, not the samples' largest offset; the box's corners and its worst point are samples too
+    assert mistuning_text(two) == "+-0.2 mm of the clearance (the box's 2 corners, its worst point and 2 random samples)"
     text = answer_text(two)
-    assert "over 15-45 Hz and +-0.2 mm of the clearance (2 samples)" in text
+    assert "over 15-45 Hz and +-0.2 mm of the clearance (the box's 2 corners, its worst point and 2 random samples)" in text
     assert "best linear absorber of the same mass: " in text and "the scene's design, Delta = 1000 mm, R = 0.2: " in text
     assert "at 33 Hz" in text
     assert any("was not certified" in w for w in warnings(two))  # certify: candidates 0
@@ -135,7 +136,7 @@ def test_the_responses_are_coloured_by_design_and_say_whose(two: xr.Dataset) -> 
 
 def test_the_robustness_caption_says_how_many_samples_and_what_spreads(two: xr.Dataset) -> None:
     drawn = robustness_figure(two)
-    assert "3 samples: the nominal design and 2 of a Latin hypercube (seed 1) over +-0.2 mm of the clearance" in drawn.caption
+    assert "5 samples: the nominal design, the 2 corners of the tolerance box and 2 of a Latin hypercube (seed 1) over +-0.2 mm of the clearance" in drawn.caption
     assert "best linear absorber" in drawn.caption  # no stop: the clearance's spread does not reach it
     plt.close(drawn.figure)
 
@@ -184,6 +185,7 @@ def test_where_the_linear_absorber_beats_every_stop_the_answer_says_build_no_sto
     worse = two.copy(deep=True)
     linear = float(np.nanmax(worse["design_sample_value"].values[2]))
     worse["design_sample_value"].values[0] = 1.5 * linear
+    worse.attrs["box_worst_screened"] = 1.5 * linear  # the box's worst point with them
     assert not linear_wins(worse) and answer_text(worse).startswith("Build Delta = ")  # the linear absorber has no notch
     assert any(w.startswith("Over the band the stop does not pay") and "but it has no notch" in w for w in warnings(worse))
     worse.attrs["operating_limit_m"] = math.nan
@@ -197,6 +199,7 @@ def test_where_the_linear_absorber_beats_every_stop_the_answer_says_build_no_sto
     assert labels[0].startswith("best design with a stop: worst ") and not any("recommended" in label for label in labels)
     plt.close("all")
     worse["design_sample_value"].values[0] = 0.5 * linear  # the stop wins again
+    worse.attrs["box_worst_screened"] = 0.5 * linear
     assert not linear_wins(worse) and answer_text(worse).startswith("Build Delta = ")
 
 

@@ -18,7 +18,7 @@ from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.orbits.continuation_settings import ContinuationSettings
 from vibroimpact.reporting.style import fmt
 
-__all__ = ["answer_text", "design_titles", "screen_words", "linear_wins", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
+__all__ = ["answer_text", "sample_counts", "samples_text", "operating_motion", "at_bounds", "never_strikes", "ties", "TIE", "design_titles", "screen_words", "linear_wins", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
 
 _SYMBOLS = {"clearance": "Delta", "restitution": "R", "bumper_stiffness": "K_b"}
 #: How the page names the compared designs (the dataset's ``design`` dimension, in order).
@@ -124,12 +124,31 @@ def mistuning_spreads(dataset: xr.Dataset) -> list[Spread]:
     return out
 
 
+def sample_counts(dataset: xr.Dataset) -> tuple[int, int]:
+    """(corners of the tolerance box, random samples) among the mistuning samples (``sample_kind``; a dataset
+    without it: every sample but the nominal is random)."""
+    if "sample_kind" not in dataset:
+        return 0, dataset.sizes["sample"] - 1
+    kinds = dataset["sample_kind"].values
+    return int(np.count_nonzero(kinds == 1)), int(np.count_nonzero(kinds == 2))
+
+
+def samples_text(dataset: xr.Dataset) -> str:
+    """``the box's 4 corners, its worst point and 6 random samples``; ``32 samples`` without corners."""
+    corners, random = sample_counts(dataset)
+    if not corners:
+        return f"{random} samples"
+    box = ", its worst point" if "box_worst_screened" in dataset.attrs else ""
+    return f"the box's {corners} corners{box} and {random} random samples"
+
+
 def mistuning_text(dataset: xr.Dataset) -> str:
-    """``+-5 % of k1 and +-0.2 mm of the clearance (32 samples)``, or empty."""
+    """``+-5 % of k1 and +-0.2 mm of the clearance (the box's 4 corners, its worst point and 6 random samples)``, or
+    empty."""
     spreads = mistuning_spreads(dataset)
     if not spreads:
         return ""
-    return f"{' and '.join(s.text() for s in spreads)} ({dataset.sizes['sample'] - 1} samples)"
+    return f"{' and '.join(s.text() for s in spreads)} ({samples_text(dataset)})"
 
 
 def design_evaluation(dataset: xr.Dataset, design: int) -> int:
@@ -152,12 +171,14 @@ def certified_worst(dataset: xr.Dataset, design: int) -> tuple[float, int]:
 
 
 def design_worst(dataset: xr.Dataset, design: int) -> float:
-    """A compared design's worst case [the objective's unit]: the largest of its samples' screened values and its certificates' (NaN
-    when it has none)."""
+    """A compared design's worst case [the objective's unit]: the largest of its samples' screened values, its
+    certificates' and (the recommended design) the screen's value at the tolerance box's worst point (NaN when it has
+    none)."""
     row = dataset["design_sample_value"].values[design]
     screened = float(np.nanmax(row)) if np.any(np.isfinite(row)) else math.nan
     certified = certified_worst(dataset, design)[0]
-    return float(np.fmax(screened, certified))
+    box = float(dataset.attrs.get("box_worst_screened", math.nan)) if design == 0 else math.nan
+    return float(np.fmax(np.fmax(screened, certified), box))
 
 
 def present_designs(dataset: xr.Dataset) -> list[int]:
@@ -184,8 +205,78 @@ def stage_counts(dataset: xr.Dataset) -> dict[str, int]:
     return {name: int(counts[k]) for k, name in enumerate(meanings)}
 
 
+#: Two worst cases within this share of each other tie [-]: the certificate's own tolerance is far finer (continuation
+#: 1e-7, the brute force's shots 1e-6), but mistuned designs differ in their last digits.
+TIE = 1e-3
+
+
+def ties(first: float, second: float) -> bool:
+    """Whether two worst cases tie (:data:`TIE`)."""
+    return math.isfinite(first) and math.isfinite(second) and abs(first - second) <= TIE * max(abs(first), abs(second))
+
+
+def operating_motion(dataset: xr.Dataset, design: int) -> str:
+    """Which motion sets a compared design's stated operating value and who reached it: ``a period-4 motion, 1 impact
+    per 4 periods, reached from rest and from 63 of 63 other starts`` (its certificate's), else the screen's (its
+    period and impacts, and how many of its runs reached it); "" where nothing says."""
+    d = dataset
+    value = float(d["design_operating_amplitude"].values[design])
+    evaluation = design_evaluation(d, design)
+    if evaluation < 0 or not math.isfinite(value):
+        return ""
+    if "certificate_operating_worst" in d:
+        rows = [int(r) for r in np.flatnonzero(d["certificate_evaluation"].values == evaluation) if math.isfinite(float(d["certificate_operating_worst"].values[r]))]
+        top = max(rows, key=lambda r: float(d["certificate_operating_worst"].values[r]), default=None)
+        if top is not None and float(d["certificate_operating_worst"].values[top]) >= value * (1.0 - 1e-9):
+            return f"{d['certificate_operating_motion'].values[top]}, {d['certificate_operating_reached'].values[top]}"
+    if "sample_operating" not in d:
+        return ""
+    row = d["sample_operating"].values[evaluation]
+    if not np.any(np.isfinite(row)):
+        return ""
+    k = int(np.nanargmax(row))
+    period, impacts, starts = (float(d[f"sample_operating_{key}"].values[evaluation, k]) for key in ("period", "impacts", "starts"))
+    if not math.isfinite(period):
+        return ""
+    count = int(round(impacts)) if math.isfinite(impacts) else 0
+    motion = "the contact-free motion" if count == 0 and period == 1 else (f"a period-{int(period)} motion, {count} impact{'s' if count != 1 else ''} per {'period' if period == 1 else f'{int(period)} periods'}" if period else "a non-periodic motion")
+    return motion + (f", reached by {int(starts)} of the screen's runs" if starts > 0 else "")
+
+
+def at_bounds(dataset: xr.Dataset, design: int = 0) -> str:
+    """`` (R = 0 is the lower bound of its range)`` for the compared design's variables that sit on a bound of their
+    range (within 1e-9 of the range), "" where none does."""
+    parts = []
+    for name in variable_names(dataset):
+        key = f"variable_{safe_name(name)}"
+        if key not in dataset or f"design_{safe_name(name)}" not in dataset:
+            continue
+        low, high = (float(dataset[key].attrs.get(k, math.nan)) for k in ("valid_min", "valid_max"))
+        value = float(dataset[f"design_{safe_name(name)}"].values[design])
+        if not (math.isfinite(low) and math.isfinite(high) and math.isfinite(value)):
+            continue
+        for bound, word in ((low, "lower"), (high, "upper")):
+            if abs(value - bound) <= 1e-9 * (high - low):
+                shown = f"Delta = {fmt(1e3 * value, '.4g')} mm" if name == "clearance" else f"{_SYMBOLS.get(name, name)} = {fmt(value, '.4g')}"
+                parts.append(f"{shown} is the {word} bound of its range")
+    return f" ({'; '.join(parts)})" if parts else ""
+
+
+def never_strikes(dataset: xr.Dataset, design: int = 0) -> bool:
+    """Whether no stable motion any certificate of the compared design found in the band strikes its stop (every
+    certificate says so, at least one exists): the design is a linear absorber with an idle stop."""
+    if "certificate_impacting" not in dataset:
+        return False
+    evaluation = design_evaluation(dataset, design)
+    rows = np.flatnonzero(dataset["certificate_evaluation"].values == evaluation) if evaluation >= 0 else np.zeros(0, dtype=int)
+    flags = dataset["certificate_impacting"].values[rows]
+    return bool(rows.size) and bool(np.all(flags == 0.0))  # exact: 0/1 flags
+
+
 def answer_text(dataset: xr.Dataset) -> str:
-    """The page's first sentence (module docstring)."""
+    """The page's first sentence (module docstring): what to build, its worst case and operating value with the
+    motions that set them; "No design in these bounds holds ..." where none keeps the operating limit; "Build no stop"
+    where the linear absorber is better or the recommended stop is never struck; ties named."""
     d = dataset
     low, high = fmt(d.attrs["band_low_Hz"], ".4g"), fmt(d.attrs["band_high_Hz"], ".4g")
     values = d["design_sample_value"].values
@@ -203,18 +294,33 @@ def answer_text(dataset: xr.Dataset) -> str:
     def notch(k: int) -> str:
         if not math.isfinite(limit) or not math.isfinite(float(operating[k])):
             return ""
+        motion = operating_motion(d, k)
+        which = f" ({motion})" if motion else ""
         if operating[k] > limit:
-            return f", {of}{c.text(float(operating[k]))} at {at} Hz, above the allowed {c.text(limit)}"
-        return f", {of}{c.text(float(operating[k]))} at {at} Hz" + (f", where {c.text(limit)} is allowed" if k == 0 else "")
+            return f", {of}{c.text(float(operating[k]))} at {at} Hz{which}, above the allowed {c.text(limit)}"
+        return f", {of}{c.text(float(operating[k]))} at {at} Hz{which}" + (f", where {c.text(limit)} is allowed" if k == 0 else "")
 
     scene = variable_text(d, 1)
     scene_part = f"the scene's design{', ' + scene if scene else ''}: {q.text(design_worst(d, 1))}{notch(1)}"
+    best = design_worst(d, 0)
+    if math.isfinite(limit) and not float(operating[0]) <= limit:
+        linear = f"; the best linear absorber of the same mass: {q.text(worst[2])}{notch(2)}" if np.any(np.isfinite(values[2])) else ""
+        return (f"No design in these bounds holds the operating limit ({c.symbol} at most {c.text(limit)} at {at} Hz): the least violation is {variable_text(d, 0)}{at_bounds(d)}, "
+                f"worst case {q.symbol} = {q.text(best)} {over}{notch(0)} ({scene_part}{linear}).")  # fmt: skip
     if linear_wins(d):  # no design with a stop found beats the linear absorber: say so first
-        return (f"Build no stop: the best linear absorber of the same mass ({design_text(d, 2)}) has the smallest worst case, {q.symbol} = {q.text(worst[2])} {over}{notch(2)} "
-                f"(the best design with a stop found, {variable_text(d, 0)}: {q.text(design_worst(d, 0))}{notch(0)}; {scene_part}).")  # fmt: skip
-    others = [f"best linear absorber of the same mass: {q.text(worst[2])}{notch(2)}"] if np.any(np.isfinite(values[2])) else []
+        tie = ties(worst[2], best)
+        verb = "ties with the best design with a stop found" if tie else "has the smallest worst case"
+        return (f"Build no stop: the best linear absorber of the same mass ({design_text(d, 2)}) {verb}, {q.symbol} = {q.text(worst[2])} {over}{notch(2)} "
+                f"(the best design with a stop found, {variable_text(d, 0)}: {q.text(best)}{notch(0)}; {scene_part}).")  # fmt: skip
+    if never_strikes(d):
+        return (f"Build no stop: no motion found in the band strikes the recommended stop ({variable_text(d, 0)}{at_bounds(d)}), so it is a linear absorber with an idle stop; "
+                f"worst case {q.symbol} = {q.text(best)} {over}{notch(0)} ({scene_part}).")  # fmt: skip
+    others = []
+    if np.any(np.isfinite(values[2])):
+        tie = " (a tie)" if ties(worst[2], best) else ""
+        others.append(f"best linear absorber of the same mass: {q.text(worst[2])}{notch(2)}{tie}")
     others.append(scene_part)
-    return f"Build {variable_text(d, 0)}: worst case {q.symbol} = {q.text(design_worst(d, 0))} {over}{notch(0)} ({'; '.join(others)})."
+    return f"Build {variable_text(d, 0)}{at_bounds(d)}: worst case {q.symbol} = {q.text(best)} {over}{notch(0)} ({'; '.join(others)})."
 
 
 def screen_words(dataset: xr.Dataset) -> str:
@@ -240,7 +346,8 @@ def linear_wins(dataset: xr.Dataset) -> bool:
     limit = operating_limit(d)
     notch = float(d["design_operating_amplitude"].values[2])
     keeps = not math.isfinite(limit) or (math.isfinite(notch) and notch <= limit)
-    return keeps and float(np.nanmax(row)) < design_worst(d, 0)
+    linear = float(np.nanmax(row))
+    return keeps and (linear < design_worst(d, 0) or ties(linear, design_worst(d, 0)))
 
 
 def warnings(dataset: xr.Dataset) -> list[str]:

@@ -22,7 +22,7 @@ from vibroimpact.orbits.bumper_screen import bumper_curves, bumper_screen_refusa
 from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.analysis.measures import Measure, as_measure
 from vibroimpact.analysis.stability import MARGINAL_MODULUS, floquet_multipliers
-from vibroimpact.kinds.design.evaluate import ATTRACTOR_POINTS, MAX_BRANCH_POINTS, SCREEN_MOTIONS, SCREENS, SWEEP_ACCURACIES, screen_kind
+from vibroimpact.kinds.design.evaluate import ATTRACTOR_POINTS, MAX_BRANCH_POINTS, OPERATING_STARTS, SCREEN_MOTIONS, SCREENS, SWEEP_ACCURACIES, screen_kind
 from vibroimpact.simulation.certified_worst import SOURCES
 from vibroimpact.kinds.design.scene import DesignSettings, safe_name
 from vibroimpact.kinds.design.search import STAGES, pareto_front
@@ -115,6 +115,13 @@ def design_dataset(scene: Any, outcome: Outcome) -> xr.Dataset:
     data["impulse"] = xr.Variable("evaluation", worst_impulse, {"units": "N s", "long_name": "largest impulse of one impact over the samples (a lower bound where a sample's band is partly uncovered; NaN where it is 0 there)"})
     front = pareto_front(data["objective"].values, worst_impulse, [ev.feasible(r) for r in ev.results])
     data["pareto_front"] = _flag(front, ("dominated", "on_the_front"), "no other feasible candidate has a smaller or equal objective and impulse, one smaller", ("evaluation",))
+    for key, units, name in (("operating_period", "1", "period of the motion that sets the sample's operating value [excitation periods]"),
+                             ("operating_impacts", "1", "its impacts per period"), ("operating_starts", "1", f"how many of the screen's {OPERATING_STARTS} runs at the operating frequency reached it (0: a closed form's motion no run reached)")):  # fmt: skip
+        data[f"sample_{key}"] = xr.Variable(("evaluation", "sample"), np.array([r[key] for r in ev.results], dtype=float), {"units": units, "long_name": name})
+    data["sample_operating"] = xr.Variable(("evaluation", "sample"), np.array([r["operating"] for r in ev.results], dtype=float),
+                                           {"units": limit_unit, "long_name": f"largest {limit_symbol} at the operating frequency under each sample over every motion the screen found there"})  # fmt: skip
+    corners = ev.corners if S > 1 else 0
+    data["sample_kind"] = _flag([0] + [1] * corners + [2] * (S - 1 - corners), SAMPLE_KINDS, "what the sample is: the nominal design, a corner of the tolerance box, or a Latin-hypercube sample", ("sample",))
     for k, m in enumerate(settings.mistuning):
         offsets = np.array([row[k] for row in space.offsets])
         data[f"mistuning_{safe_name(m.name)}"] = xr.Variable("sample", offsets, {"units": "1" if m.relative else ("m" if m.name == "clearance" else "1"),
@@ -128,7 +135,7 @@ def design_dataset(scene: Any, outcome: Outcome) -> xr.Dataset:
               "attractor_point": ("attractor_point", np.arange(ATTRACTOR_POINTS, dtype=np.int32), {"units": "1", "long_name": "index of a brute-force frequency"}),
               "accuracy": ("accuracy", np.arange(len(SWEEP_ACCURACIES), dtype=np.int32), {"units": "1", "long_name": "index of sweep_accuracy"}),
               "design": ("design", np.arange(len(DESIGNS), dtype=np.int32), {"units": "1", "long_name": "index of the compared design (design_name)"})}  # fmt: skip
-    for part in ("search", "certification"):  # timings are variables: the golden suite and the page's fixed timings know them by long name
+    for part in ("search", "certification", "box"):  # timings are variables: the golden suite and the page's fixed timings know them by long name
         data[f"{part}_wall_time"] = xr.Variable((), outcome.wall_times.get(part, math.nan), {"units": "s", "long_name": f"wall time of the {part}"})
     dataset = xr.Dataset(data, coords=coords)
     dataset.attrs.update(attrs)
@@ -160,6 +167,10 @@ def _quantile(q: float) -> str:
     return "worst" if q >= 1.0 else f"{q:g} quantile"
 
 
+#: What a mistuning sample is (``sample_kind``).
+SAMPLE_KINDS = ("nominal", "corner", "random")
+
+
 def _certificates(data: dict[str, xr.Variable], outcome: Outcome) -> None:
     rows = outcome.certified
     dims = ("certificate",)
@@ -182,6 +193,18 @@ def _certificates(data: dict[str, xr.Variable], outcome: Outcome) -> None:
     data["certificate_motion"] = xr.Variable(dims, np.array([str(r["motion"]) for r in rows], dtype=str), {"long_name": "the motion that sets the certified worst case"})
     data["certificate_brute_motion"] = xr.Variable(dims, np.array([str(r["brute_motion"]) for r in rows], dtype=str), {"long_name": "the motion of the brute force's largest attractor"})
     data["certificate_error"] = xr.Variable(dims, np.array([str(r["error"]) for r in rows], dtype=str), {"long_name": "why a certification failed (empty: it did not)"})
+    data["certificate_impacting"] = xr.Variable(dims, column("impacting"), {"units": "1", "long_name": "1 where a stable motion found in the band (a continued branch or a brute-force attractor) strikes a stop"})
+    limit_unit, limit_symbol, _ = measure_words(outcome.settings.constraint)
+    for key, units, name in (("operating_worst", limit_unit, f"largest {limit_symbol} at the operating frequency over every motion found there (closed forms, seeded runs with their periodic orbits shot, the brute force's attractors)"),
+                             ("screened_operating", limit_unit, f"the screen's {limit_symbol} at the operating frequency for the same problem"),
+                             ("operating_period", "1", "period of the motion that sets it [excitation periods]"), ("operating_impacts", "1", "its impacts per period"),
+                             ("operating_runs", "1", "seeded runs at the operating frequency"), ("operating_time", "s", "wall time of the operating point's runs and shots")):  # fmt: skip
+        data[f"certificate_{key}"] = xr.Variable(dims, column(key), {"units": units, "long_name": name})
+    data["certificate_operating_motion"] = xr.Variable(dims, np.array([str(r["operating_motion"]) for r in rows], dtype=str), {"long_name": "the motion that sets the certified operating value"})
+    data["certificate_operating_reached"] = xr.Variable(dims, np.array([str(r["operating_reached"]) for r in rows], dtype=str), {"long_name": "which runs reached it"})
+    offsets = np.array([outcome.box["offset"] if r["sample"] < 0 and outcome.box else outcome.space.offsets[max(int(r["sample"]), 0)] for r in rows], dtype=float).reshape(len(rows), len(outcome.space.mistuned))
+    for k, name in enumerate(outcome.space.mistuned):
+        data[f"certificate_offset_{safe_name(name)}"] = xr.Variable(dims, offsets[:, k], {"units": "1" if outcome.space.relative[k] else ("m" if name == "clearance" else "1"), "long_name": f"offset of {name} of the certified problem (sample -1: the tolerance box's worst point)"})
     data["sweep_accuracy"] = xr.Variable("accuracy", np.array(SWEEP_ACCURACIES), {"units": "1", "long_name": "relative accuracy of a band maximum"})
     data["certificate_sweep_points"] = xr.Variable(("certificate", "accuracy"), np.array([r["sweep_points"] for r in rows], dtype=float).reshape(len(rows), len(SWEEP_ACCURACIES)),
                                                    {"units": "1", "long_name": "frequencies a stepped sweep needs to reach the certified maximum to the accuracy (from the curvature of its branch there)"})  # fmt: skip
@@ -233,8 +256,9 @@ def _designs(data: dict[str, xr.Variable], scene: Any, outcome: Outcome) -> dict
         values[0] = ev.values(ev.results[outcome.recommended])
     values[1] = ev.values(ev.results[0])
     values[2] = outcome.linear_values
-    operating = [ev.operating(ev.results[outcome.recommended]) if outcome.recommended >= 0 else math.nan, ev.operating(ev.results[0]), outcome.linear_operating]
-    data["design_operating_amplitude"] = xr.Variable("design", np.array(operating, dtype=float), {"units": limit_unit, "long_name": f"worst coexisting {limit_symbol} at the operating frequency over the samples (NaN: no constraint)"})
+    # each stated operating value: the screen's over the samples, raised by every certificate of that design
+    operating = [max(ev.operating(ev.results[i]), outcome.corrected_operating.get(i, -math.inf)) if i >= 0 else math.nan for i in (outcome.recommended, 0)] + [outcome.linear_operating]
+    data["design_operating_amplitude"] = xr.Variable("design", np.array(operating, dtype=float), {"units": limit_unit, "long_name": f"worst coexisting {limit_symbol} at the operating frequency over the samples and every motion found there, certificates included (NaN: no constraint)"})
     data["design_sample_value"] = xr.Variable(("design", "sample"), values, {"units": unit, "long_name": f"largest stable {generic} over the band of each compared design under each sample"})
     for k, v in enumerate(settings.variables):
         column = [ev.designs[outcome.recommended][k] if outcome.recommended >= 0 else math.nan, ev.designs[0][k], math.nan]
@@ -250,6 +274,10 @@ def _designs(data: dict[str, xr.Variable], scene: Any, outcome: Outcome) -> dict
                       f"linear_optimum_worst_{settings.measure.unit}": outcome.linear.worst})  # fmt: skip
     if outcome.recommended >= 0:
         attrs["recommended_certified_score_m"] = outcome.corrected.get(outcome.recommended, math.nan)
+        attrs["recommended_contradicted"] = np.array(outcome.contradicted, dtype=np.int32)  # candidates whose certificate broke the constraint their screen kept
+    if outcome.box:
+        attrs.update({"box_worst_screened": float(outcome.box["screened"]), "box_worst_sample": int(outcome.box["sample"]), "box_evaluations": int(outcome.box["evaluations"]),
+                      "box_worst_offsets": np.array(outcome.box["offset"], dtype=float)})  # fmt: skip
     paper = space.problem.named_view()
     attrs["static_deflection_m"] = abs(scene.amplitude) / paper.k1 if paper is not None else math.nan
     return attrs

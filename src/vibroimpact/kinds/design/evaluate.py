@@ -22,7 +22,9 @@ from numpy.typing import NDArray
 from vibroimpact.analysis.band_worst import MOTIONS, BandWorst, closed_form_at, closed_form_worst
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.analysis.measures import Measure, as_measure
-from vibroimpact.simulation.band_attractors import band_attractors
+from vibroimpact.simulation.attractors import MOTION_CLASSES
+from vibroimpact.simulation.band_attractors import AttractorSweep, band_attractors
+from vibroimpact.simulation.point_motions import SAME_SIZE, point_motions
 from vibroimpact.model.contact import MIN_BUMPER_RESTITUTION, KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.bumper_screen import bumper_at, bumper_screen_refusal, bumper_worst
@@ -32,7 +34,7 @@ from vibroimpact.simulation.certified_worst import SOURCES, certified_worst, swe
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.fingerprints import case_key
 
-__all__ = ["DesignSpace", "DesignCase", "sample_chunks", "CHUNKS", "DESIGN_FIELDS", "CertifyCase", "CERTIFY_FIELDS", "SCREENS", "screen_kind", "screen_worst", "ATTRACTOR_POINTS", "SWEEP_ACCURACIES", "MAX_BRANCH_POINTS", "SCREEN_MOTIONS", "BRUTE", "BRUTE_SCREEN"]
+__all__ = ["DesignSpace", "DesignCase", "sample_chunks", "CHUNKS", "DESIGN_FIELDS", "CertifyCase", "CERTIFY_FIELDS", "SCREENS", "screen_kind", "screen_worst", "ATTRACTOR_POINTS", "SWEEP_ACCURACIES", "MAX_BRANCH_POINTS", "certified_operating", "OPERATING_STARTS", "CERTIFY_OPERATING_STARTS", "SCREEN_MOTIONS", "BRUTE", "BRUTE_SCREEN"]
 
 #: The screen's motions: the closed forms' (:data:`~vibroimpact.analysis.band_worst.MOTIONS`), and brute force's on a
 #: layout without a closed form.
@@ -123,24 +125,24 @@ class DesignSpace:
         """Rows of ``offsets`` (the nominal included)."""
         return len(self.offsets)
 
-    def parameters(self, design: NDArray[np.float64] | tuple[float, ...], sample: int) -> NDArray[np.float64]:
-        """The map's parameter vector of ``design`` under mistuning sample ``sample`` (restitution kept in [0, 1],
-        clearance positive)."""
+    def parameters(self, design: NDArray[np.float64] | tuple[float, ...], sample: int, offset: tuple[float, ...] | None = None) -> NDArray[np.float64]:
+        """The map's parameter vector of ``design`` under mistuning sample ``sample``, or under the robust scalars'
+        offsets ``offset`` where given (restitution kept in [0, 1], clearance positive)."""
         names = self.map.parameter_names
         p = np.array(self.map.parameters, dtype=float)
         for name, value in zip(self.variables, design):
             p[names.index(name)] = float(value)
-        for name, relative, offset in zip(self.mistuned, self.relative, self.offsets[sample]):
+        for name, relative, moved in zip(self.mistuned, self.relative, self.offsets[sample] if offset is None else offset):
             i = names.index(name)
-            p[i] = p[i] * (1.0 + offset) if relative else p[i] + offset
+            p[i] = p[i] * (1.0 + moved) if relative else p[i] + moved
         r, d = names.index("restitution"), names.index("clearance")
         p[r] = min(max(p[r], MIN_BUMPER_RESTITUTION if self.bumpers else 0.0), 1.0)
         p[d] = max(p[d], 1e-9 * self.map.problem.length_scale())
         return p
 
-    def problem_at(self, design: NDArray[np.float64] | tuple[float, ...], sample: int = 0) -> ImpactProblem:
-        """The problem of ``design`` under sample ``sample`` (0: nominal)."""
-        return self.map.problem_at(self.parameters(design, sample))
+    def problem_at(self, design: NDArray[np.float64] | tuple[float, ...], sample: int = 0, offset: tuple[float, ...] | None = None) -> ImpactProblem:
+        """The problem of ``design`` under sample ``sample`` (0: nominal), or under the offsets ``offset``."""
+        return self.map.problem_at(self.parameters(design, sample, offset))
 
     def key_content(self) -> dict:
         """What determines every result in this space (for case keys)."""
@@ -161,9 +163,15 @@ def sample_chunks(samples: int) -> list[tuple[int, ...]]:
 
 #: Fields of :class:`DesignCase`: per sample, the worst stable |X| [m] over the band, where [Hz], which motion (index of
 #: :data:`SCREEN_MOTIONS`), the uncovered share and the guess there [m], the worst |X| at the
-#: operating frequency [m] (NaN: no constraint) and which motion; the largest impulse of one impact of a stable
+#: operating frequency [m] (NaN: no constraint) over every motion found there, which motion, its period, impacts per
+#: period and how many of the :data:`OPERATING_STARTS` runs reached it; the largest impulse of one impact of a stable
 #: closed-form orbit on the scan [N s] (NaN: screened by brute force); ``error``: why a sample has no value.
-DESIGN_FIELDS = ("worst", "frequency", "motion", "uncovered", "estimate", "operating", "operating_motion", "impulse", "error")
+DESIGN_FIELDS = ("worst", "frequency", "motion", "uncovered", "estimate", "operating", "operating_motion", "operating_period", "operating_impacts", "operating_starts", "impulse", "error")
+#: The screen's runs at the operating frequency (rest and the linear state among them), their periods dropped and
+#: measured, and their seed: every motion they settle on is judged (:func:`_operating`).
+OPERATING_STARTS = 8
+OPERATING_RUN = (200, 64)
+OPERATING_SEED = 1
 
 
 @dataclass(frozen=True, eq=False)
@@ -185,12 +193,13 @@ class DesignCase:
 
     def key(self) -> str:
         """Hash of the space and the design."""
-        return case_key({"kind": "design", "space": self.space.key_content(), "design": list(self.design), "samples": list(self.samples)})
+        return case_key({"kind": "design", "space": self.space.key_content(), "design": list(self.design), "samples": list(self.samples),
+                         "operating": [OPERATING_STARTS, *OPERATING_RUN, OPERATING_SEED]})  # fmt: skip
 
     def run(self, report: ProgressReport | None = None) -> CaseResult:
         """Arrays over ``samples`` (:data:`DESIGN_FIELDS`)."""
         n = len(self.samples)
-        out = {k: np.full(n, np.nan) for k in ("worst", "frequency", "uncovered", "estimate", "operating", "impulse")}
+        out = {k: np.full(n, np.nan) for k in ("worst", "frequency", "uncovered", "estimate", "operating", "operating_period", "operating_impacts", "operating_starts", "impulse")}
         motion, operating_motion = np.zeros(n, dtype=np.int8), np.zeros(n, dtype=np.int8)
         errors = [""] * n
         for row, s in enumerate(self.samples):
@@ -205,7 +214,8 @@ class DesignCase:
                     top = band_attractors(problem, self.space.band, *BRUTE_SCREEN, measure=self.space.objective).maximum
                     values = (top.amplitude, top.frequency, 0.0, 0.0, SCREEN_MOTIONS.index(BRUTE))
                 if math.isfinite(self.space.operating):
-                    out["operating"][row], operating_motion[row] = _operating(problem, self.space.operating, self.space.constraint, kind)
+                    out["operating"][row], operating_motion[row], *rest = _operating(problem, self.space.operating, self.space.constraint, kind)
+                    out["operating_period"][row], out["operating_impacts"][row], out["operating_starts"][row] = rest
             except ValueError as error:  # a structure the model refuses (a mass driven non-positive ...)
                 errors[row] = f"{type(error).__name__}: {str(error)[:160]}"
                 continue
@@ -215,22 +225,22 @@ class DesignCase:
         return out | {"motion": motion, "operating_motion": operating_motion, "error": np.array(errors, dtype=str)}
 
 
-def _operating(problem: ImpactProblem, frequency: float, measure: Measure, kind: str) -> tuple[float, int]:
-    """The worst coexisting ``measure`` at the operating ``frequency`` [Hz] and its motion (index of :data:`SCREEN_MOTIONS`):
-    the screen's (``kind`` of :data:`SCREENS`; where none of its motions is stable there, the guess from the orbits
-    that exist), else brute force's."""
-    if kind == SCREENS[2]:
-        return band_attractors(problem, _around(frequency), 2, *BRUTE_SCREEN[1:], measure=measure).maximum.amplitude, SCREEN_MOTIONS.index(BRUTE)
-    at = closed_form_at(problem, frequency, measure) if kind == SCREENS[0] else bumper_at(problem, frequency, measure)
-    if at.uncovered == 0.0:  # exact: a share of none
-        return at.amplitude, SCREEN_MOTIONS.index(at.motion)
-    around = closed_form_worst(problem, _around(frequency), measure, 3) if kind == SCREENS[0] else bumper_worst(problem, _around(frequency), measure, 3)
-    return max(around.amplitude, around.estimate), SCREEN_MOTIONS.index(at.motion)  # a stable motion found beside it counts too
-
-
-def _around(frequency: float) -> tuple[float, float]:
-    """A band of 1e-6 relative around ``frequency`` [Hz] (a three-point scan of it)."""
-    return frequency * (1.0 - 1e-6), frequency * (1.0 + 1e-6)
+def _operating(problem: ImpactProblem, frequency: float, measure: Measure, kind: str) -> tuple[float, int, int, int, int]:
+    """The worst coexisting ``measure`` at the operating ``frequency`` [Hz] over every motion found there: the stable
+    closed-form ones (``kind`` of :data:`SCREENS`) and every motion :data:`OPERATING_STARTS` seeded runs settle on
+    (:func:`~vibroimpact.simulation.point_motions.point_motions`: rest and the linear state among them); with the
+    motion that sets it (index of :data:`SCREEN_MOTIONS`, :data:`BRUTE` for a sampled one), its period, impacts per
+    period and the runs that reached it (0: a closed form's, not reached by the runs)."""
+    closed = (0.0, MOTIONS[0], 0)
+    if kind != SCREENS[2]:
+        at = closed_form_at(problem, frequency, measure) if kind == SCREENS[0] else bumper_at(problem, frequency, measure)
+        closed = (at.amplitude, at.motion, at.impacts)
+    sampled = point_motions(problem, frequency, measure, OPERATING_STARTS, *OPERATING_RUN, seed=OPERATING_SEED)
+    top = sampled.largest
+    if top is not None and top.value > closed[0] * (1.0 + SAME_SIZE):
+        return top.value, SCREEN_MOTIONS.index(BRUTE), top.period, top.impacts, top.starts
+    reached = sum(m.starts for m in sampled.motions if abs(m.value - closed[0]) <= SAME_SIZE * closed[0])
+    return closed[0], SCREEN_MOTIONS.index(closed[1]), 1, closed[2], reached
 
 
 #: Fields of :class:`CertifyCase`: the certified worst |X| [m], where [Hz], its motion (text) and source (index of
@@ -239,9 +249,18 @@ def _around(frequency: float) -> tuple[float, float]:
 #: it would cost [s] at the brute force's measured cost per point; the
 #: continued branches' points (frequency [Hz], |X| [m], stable 0/1, impacts per period, branch index, 1 where its branch
 #: stopped at the continuation's step limit), NaN-padded; the
-#: brute force's largest |X| at each of its frequencies.
+#: brute force's largest |X| at each of its frequencies; ``impacting``: 1 where any stable motion found in the band
+#: (a branch or an attractor) strikes a stop; the operating point's worst value over every motion found there (closed
+#: forms, :data:`CERTIFY_OPERATING_STARTS` runs with their periodic orbits shot, the brute force's attractors at that
+#: frequency), the motion (text), who reached it (text), its period, impacts per period, the runs, and the wall time [s].
 CERTIFY_FIELDS = ("worst", "frequency", "motion", "source", "continuation_worst", "continuation_time", "brute_worst", "brute_frequency", "brute_motion", "brute_time", "screen_time",
-                  "sweep_points", "sweep_time", "branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index", "branch_cut", "attractor_frequency", "attractor_amplitude", "error")  # fmt: skip
+                  "sweep_points", "sweep_time", "branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index", "branch_cut", "attractor_frequency", "attractor_amplitude",
+                  "impacting", "operating_worst", "operating_motion", "operating_reached", "operating_period", "operating_impacts", "operating_runs", "operating_time", "error")  # fmt: skip
+#: The certification's runs at the operating frequency (rest and the linear state among them), their periods dropped
+#: and measured, and their seed (another than the screen's): every periodic motion they settle on is shot.
+CERTIFY_OPERATING_STARTS = 64
+CERTIFY_OPERATING_RUN = (400, 64)
+CERTIFY_OPERATING_SEED = 2
 #: Most branch points kept per certified problem.
 MAX_BRANCH_POINTS = 4000
 #: Frequencies of the certification's brute force.
@@ -253,11 +272,14 @@ SWEEP_ACCURACIES = (1e-4, 1e-8)
 @dataclass(frozen=True, eq=False)
 class CertifyCase:
     """The worst case of one problem certified by continuation and brute force
-    (:func:`~vibroimpact.simulation.certified_worst.certified_worst`)."""
+    (:func:`~vibroimpact.simulation.certified_worst.certified_worst`), and its operating point over every motion found
+    there (:func:`certified_operating`); ``offset``: the robust scalars' offsets where the problem is not one of the
+    space's samples (a point of the tolerance box, ``sample`` -1)."""
 
     space: DesignSpace
     design: tuple[float, ...]
     sample: int = 0
+    offset: tuple[float, ...] | None = None
     engine: str = "certification"
     fields: tuple[str, ...] = CERTIFY_FIELDS
     progress_unit: str = "designs"
@@ -268,16 +290,18 @@ class CertifyCase:
         return 1.0
 
     def key(self) -> str:
-        """Hash of the space, the design and the sample."""
-        return case_key({"kind": "design_certify", "space": self.space.key_content(), "design": list(self.design), "sample": self.sample, "attractors": ATTRACTOR_POINTS})
+        """Hash of the space, the design, the sample (or its offsets) and the certification's coverage."""
+        return case_key({"kind": "design_certify", "space": self.space.key_content(), "design": list(self.design), "sample": self.sample, "attractors": ATTRACTOR_POINTS,
+                         "offset": list(self.offset) if self.offset is not None else None, "operating": [CERTIFY_OPERATING_STARTS, *CERTIFY_OPERATING_RUN, CERTIFY_OPERATING_SEED]})  # fmt: skip
 
     def run(self, report: ProgressReport | None = None) -> CaseResult:
         """The certified worst case, each method's, and the branches traced (:data:`CERTIFY_FIELDS`)."""
         points = {k: np.full(MAX_BRANCH_POINTS, np.nan) for k in ("branch_frequency", "branch_amplitude", "branch_stable", "branch_impacts", "branch_index", "branch_cut")}
         attractors = {k: np.full(ATTRACTOR_POINTS, np.nan) for k in ("attractor_frequency", "attractor_amplitude")}
         scalars: dict[str, object] = {k: math.nan for k in ("worst", "frequency", "continuation_worst", "continuation_time", "brute_worst", "brute_frequency", "brute_time", "screen_time")}
-        scalars |= {"motion": "", "brute_motion": "", "source": -1}
-        problem = self.space.problem_at(self.design, self.sample)
+        scalars |= {"motion": "", "brute_motion": "", "source": -1, "impacting": math.nan}
+        scalars |= {k: math.nan for k in ("operating_worst", "operating_period", "operating_impacts", "operating_runs", "operating_time")} | {"operating_motion": "", "operating_reached": ""}
+        problem = self.space.problem_at(self.design, self.sample, self.offset)
         try:
             if screen_kind(problem) != SCREENS[2]:  # what the search's objective costs on this problem, timed alone
                 start = time.perf_counter()
@@ -313,8 +337,46 @@ class CertifyCase:
                 setting = (np.asarray(branch.values)[stable == 1], measured[stable == 1])
         f = found.attractors.frequency
         attractors["attractor_frequency"][: f.size] = f
-        attractors["attractor_amplitude"][: f.size] = np.nanmax(np.where(np.isfinite(found.attractors.amplitude), found.attractors.amplitude, -np.inf), axis=1)
+        attractors["attractor_amplitude"][: f.size] = found.attractors.largest()
+        branch_strikes = np.any((points["branch_stable"] == 1.0) & (points["branch_impacts"] > 0.0))  # exact: 0/1 flags and counts
+        scalars["impacting"] = float(branch_strikes or bool(np.any(np.isfinite(found.attractors.amplitude) & (found.attractors.impacts > 0.0))))
+        if math.isfinite(self.space.operating):
+            start = time.perf_counter()
+            scalars |= certified_operating(problem, self.space, found.attractors)
+            scalars["operating_time"] = time.perf_counter() - start
         sweep = np.array([sweep_points_for(setting[1], setting[0], a, self.space.band) if setting is not None else math.nan for a in SWEEP_ACCURACIES])
         if report is not None:
             report(1.0)
         return {**{k: np.array(v) for k, v in scalars.items()}, "sweep_points": sweep, "sweep_time": sweep * found.seconds_per_point, **points, **attractors, "error": np.array("")}
+
+
+def certified_operating(problem: ImpactProblem, space: DesignSpace, attractors: AttractorSweep | None = None) -> dict[str, object]:
+    """``problem``'s worst value of the constraint's measure at the operating frequency over every motion found there:
+    the stable closed-form ones, every motion :data:`CERTIFY_OPERATING_STARTS` runs settle on (rest and the linear
+    state among them, every periodic one shot: its orbit exact), and the brute force's attractors where its grid
+    holds that frequency and it judged the same measure; the fields ``operating_*`` of :data:`CERTIFY_FIELDS`."""
+    frequency, measure = space.operating, space.constraint
+    kind = screen_kind(problem)
+    candidates: list[tuple[float, str, str, int, int]] = []  # (value, motion, who reached it, period, impacts per period)
+    if kind != SCREENS[2]:
+        at = closed_form_at(problem, frequency, measure) if kind == SCREENS[0] else bumper_at(problem, frequency, measure)
+        if at.motion != MOTIONS[0]:
+            name = "the contact-free motion" if at.motion == MOTIONS[1] else f"a period-1 motion, {at.impacts} impact{'s' if at.impacts != 1 else ''} per period"
+            candidates.append((at.amplitude, name, "a closed form" if kind == SCREENS[0] else "a bumper orbit shot from the closed form", 1, at.impacts))
+    sampled = point_motions(problem, frequency, measure, CERTIFY_OPERATING_STARTS, *CERTIFY_OPERATING_RUN, seed=CERTIFY_OPERATING_SEED, shoot_orbits=True)
+    candidates += [(m.value, m.text() + ("" if m.exact or not m.period or m.regime == "linear" else " (its last periods: shooting failed)"), sampled.share_text(m), m.period, m.impacts) for m in sampled.motions]
+    if attractors is not None and space.objective.name == measure.name:
+        near = np.flatnonzero(np.abs(attractors.frequency - frequency) <= 1e-9 * frequency)
+        for k in near:
+            for j, value in enumerate(attractors.amplitude[k]):
+                if math.isfinite(value):
+                    period, impacts = int(attractors.period[k, j]), float(attractors.impacts[k, j])
+                    candidates.append((float(value), f"an attractor of the band's brute force ({MOTION_CLASSES[int(attractors.regime[k, j])].replace('_', ' ')}, period {period})",
+                                       f"its {attractors.runs[j]} run", period, int(round(impacts * max(period, 1)))))  # fmt: skip
+    if not candidates:
+        return {"operating_runs": float(sampled.runs)}
+    value, motion, reached, period, impacts = max(candidates, key=lambda c: c[0])
+    same = [m for m in sampled.motions if abs(m.value - value) <= SAME_SIZE * value]
+    if same:  # the runs reached the motion that sets it (a closed form's too): say who
+        reached = sampled.share_text(same[0])
+    return {"operating_worst": value, "operating_motion": motion, "operating_reached": reached, "operating_period": float(period), "operating_impacts": float(impacts), "operating_runs": float(sampled.runs)}

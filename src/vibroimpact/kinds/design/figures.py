@@ -24,7 +24,7 @@ from matplotlib.axes import Axes
 from matplotlib.lines import Line2D
 from numpy.typing import NDArray
 
-from vibroimpact.kinds.design.answer import design_evaluation, design_titles, design_text, mistuning_spreads, present_designs, screen_words
+from vibroimpact.kinds.design.answer import design_evaluation, design_titles, design_text, mistuning_spreads, present_designs, sample_counts, screen_words
 from vibroimpact.kinds.design.quantity import constraint_quantity, objective_quantity, operating_limit
 from vibroimpact.kinds.design.palette import CERTIFIED_COLOUR, DESIGN_COLOURS, DESIGN_MARKERS, LIMIT_COLOUR, OBJECTIVE_PERCENTILE, PATH_COLOUR
 from vibroimpact.kinds.design.search_map import search_figure
@@ -222,7 +222,9 @@ def robustness_figure(dataset: xr.Dataset) -> DrawnFigure:
     figure_legend(fig, axes, extra=extra, columns=2)
     spreads = mistuning_spreads(d)
     if samples > 1 and spreads:
-        drawn = f"{samples} samples: the nominal design and {samples - 1} of a Latin hypercube (seed {d.attrs.get('mistuning_seed', '?')}) over {' and '.join(s.text() for s in spreads)}"
+        corners, random = sample_counts(d)
+        box = f", the {corners} corners of the tolerance box" if corners else ""
+        drawn = f"{samples} samples: the nominal design{box} and {random} of a Latin hypercube (seed {d.attrs.get('mistuning_seed', '?')}) over {' and '.join(s.text() for s in spreads)}"
     else:
         drawn = "one sample: no mistuning, the nominal design only"
     caption = Caption(f"Each compared design's largest stable {q.symbol} over the band under each mistuning sample, as the share of samples at or below a value (a step per sample); {drawn}.")

@@ -24,6 +24,7 @@ import xarray as xr
 import yaml
 
 from vibroimpact.analysis.linear_optimum import linear_measure
+from vibroimpact.kinds.design.answer import operating_motion
 from vibroimpact.kinds.design.quantity import Quantity, constraint_quantity, objective_quantity, quantity
 from vibroimpact.measures.figures_of_merit import NEAREST, WORSE_RATIO
 from vibroimpact.model.problem import System
@@ -54,6 +55,8 @@ class DesignOperating:
         The recommended clearance [m] (NaN: no stop).
     measure : Quantity
         What ``stopped`` and ``linear`` measure (default |X1|).
+    motion : str
+        The motion that sets ``stopped`` and who reached it ("": not known).
     """
 
     frequency: float
@@ -63,6 +66,7 @@ class DesignOperating:
     free: float
     clearance: float
     measure: Quantity = quantity("x1_amplitude")
+    motion: str = ""
 
     def __post_init__(self) -> None:
         if not self.frequency > 0.0:
@@ -125,7 +129,7 @@ def design_operating(dataset: xr.Dataset) -> DesignOperating | None:
     linear = float(linear_measure(system, amplitude, omega, measure.name))  # the same absorber without its stop
     free = float(abs(amplitude * system.receptances(np.array([omega])).h12[0]))  # its absorber's motion there [m]
     clearance = float(d["design_clearance"].values[0]) if "design_clearance" in d else math.nan
-    return DesignOperating(frequency, declared, stopped, linear, free, clearance, measure)
+    return DesignOperating(frequency, declared, stopped, linear, free, clearance, measure, operating_motion(d, 0) if declared else "")
 
 
 def _mm(value: float) -> str:
@@ -160,6 +164,6 @@ def operating_sentence(point: DesignOperating | None) -> str:
     if not math.isfinite(point.stopped):
         return (f"<p>At the absorber's operating point ({html.escape(_where(point))}) {q.symbol} of the same absorber without the stop is {q.text(point.linear)}; "
                 "with the stop it was not computed there (the band's responses do not reach it).</p>")  # fmt: skip
-    worst = " (the worst coexisting motion over the samples)" if point.declared else " (its worst stable motion on the responses' grid)"
+    worst = (f" (the largest over every motion found there under every sample: {html.escape(point.motion)})" if point.motion else " (the largest over every motion found there under every sample)") if point.declared else " (its worst stable motion on the responses' grid)"
     return (f"<p>At the absorber's operating point ({html.escape(_where(point))}) the recommended design's {q.symbol} is {q.text(point.stopped)} with its stop{worst} against "
             f"{q.text(point.linear)} for the same absorber without the stop: ×{fmt(point.ratio, '.3g')}.</p>")  # fmt: skip

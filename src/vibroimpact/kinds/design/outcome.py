@@ -31,4 +31,7 @@ class Outcome:
         self.linear_operating = math.nan
         self.recommended = -1
         self.corrected: dict[int, float] = {}
+        self.corrected_operating: dict[int, float] = {}
+        self.contradicted: list[int] = []
+        self.box: dict[str, Any] = {}
         self.wall_times: dict[str, float] = {}

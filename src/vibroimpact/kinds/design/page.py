@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from vibroimpact.kinds.design.answer import answer_text, design_titles, linear_wins, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, screen_words, stage_counts, unit_text, variable_names, warnings
+from vibroimpact.kinds.design.answer import answer_text, design_titles, linear_wins, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, sample_counts, screen_words, stage_counts, unit_text, variable_names, warnings
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, design_figures
 from vibroimpact.kinds.design.operating import design_operating, operating_sentence, operating_warnings
 from vibroimpact.kinds.design.quantity import constraint_quantity, objective_quantity, operating_limit
@@ -137,7 +137,10 @@ def method_text(dataset: xr.Dataset) -> str:
         how = f"Differential evolution (scipy, Latin-hypercube start, seeded; {counts.get('global', 0)} evaluations){polish}"
     stages = ", ".join(f"{name} {count}" for name, count in counts.items() if count)
     spreads = mistuning_spreads(d)
-    mistuned = (f"{samples - 1} samples of a seeded Latin hypercube (seed {d.attrs.get('mistuning_seed', '?')}) over {' and '.join(s.text() for s in spreads)}, plus the nominal design"
+    corners, random = sample_counts(d)
+    box = f", the {corners} corners of that box" if corners else ""
+    box += f" and its worst point, sought by a bounded Nelder-Mead maximisation of the screen from the worst sample ({int(d.attrs['box_evaluations'])} evaluations)" if "box_worst_screened" in d.attrs else ""
+    mistuned = (f"{random} samples of a seeded Latin hypercube (seed {d.attrs.get('mistuning_seed', '?')}) over {' and '.join(s.text() for s in spreads)}, plus the nominal design{box}"
                 if spreads and samples > 1 else "the nominal design only (no mistuning)")  # fmt: skip
     quantile = float(d.attrs.get("quantile", 1.0))
     over = "the worst of them" if quantile >= 1.0 else f"their {fmt(quantile, '.3g')} quantile"

@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import optimize
 
 from vibroimpact.kinds.design.evaluate import DesignCase, DesignSpace, sample_chunks
+from vibroimpact.kinds.design.quantity import quantity
 from vibroimpact.runs.runner import CaseResult, Runner
 
 __all__ = ["pareto_front", "STAGES", "WHOLE_CANDIDATES", "Evaluations", "differential_evolution", "nelder_mead_polish", "grid_search", "PENALTY", "POLISH_STEP", "POLISH_END"]
@@ -61,6 +62,9 @@ class Evaluations:
         Of the samples' values (1: the worst).
     limit : float
         Largest operating |X| [m] (NaN: no constraint).
+    corners : int
+        Samples 1 ... ``corners`` are the tolerance box's corners: in the worst case (quantile 1), not in a quantile's
+        statistics.
     """
 
     space: DesignSpace
@@ -68,6 +72,7 @@ class Evaluations:
     runner: Runner
     quantile: float = 1.0
     limit: float = math.nan
+    corners: int = 0
     designs: list[NDArray[np.float64]] = field(default_factory=list)
     stages: list[int] = field(default_factory=list)
     results: list[CaseResult] = field(default_factory=list)
@@ -98,29 +103,49 @@ class Evaluations:
         """Each sample's value [m]: the worst closed-form motion, or the guess where the band is uncovered."""
         return np.fmax(np.asarray(result["worst"], dtype=float), np.where(np.asarray(result["uncovered"]) > 0.0, result["estimate"], np.nan))
 
+    def over_samples(self, values: NDArray[np.float64]) -> float:
+        """The ``quantile`` of per-sample ``values`` (1: the largest over every sample, the box's corners included;
+        below 1: over the nominal design and the random samples alone); NaN where one has no value."""
+        values = np.asarray(values, dtype=float)
+        if not np.all(np.isfinite(values)):
+            return math.nan
+        if self.quantile >= 1.0:
+            return float(np.max(values))
+        statistics = np.delete(values, np.arange(1, 1 + self.corners)) if values.size > 1 + self.corners else values
+        return float(np.quantile(statistics, self.quantile, method="higher"))
+
     def objective(self, result: CaseResult) -> float:
-        """The samples' ``quantile`` [m] (NaN where a sample has no value)."""
-        values = self.values(result)
-        return float(np.quantile(values, self.quantile, method="higher")) if np.all(np.isfinite(values)) else math.nan
+        """The samples' ``quantile`` [m] (:meth:`over_samples`; NaN where a sample has no value)."""
+        return self.over_samples(self.values(result))
 
     def operating(self, result: CaseResult) -> float:
-        """The operating |X| over the samples, the same quantile [m] (NaN: no constraint)."""
-        values = np.asarray(result["operating"], dtype=float)
-        return float(np.quantile(values, self.quantile, method="higher")) if math.isfinite(self.limit) and np.all(np.isfinite(values)) else math.nan
+        """The operating value over the samples, the same rule [m] (NaN: no constraint)."""
+        return self.over_samples(result["operating"]) if math.isfinite(self.limit) else math.nan
 
-    def score(self, result: CaseResult) -> float:
-        """The objective with the operating constraint's penalty; inf where a sample has no value."""
-        objective = self.objective(result)
+    def penalised(self, objective: float, operating: float) -> float:
+        """The score of an ``objective`` with its ``operating`` value: the objective raised by :data:`PENALTY` times
+        the relative excess over the limit; inf where either has no value."""
         if not math.isfinite(objective):
             return math.inf
         if not math.isfinite(self.limit):
             return objective
-        operating = self.operating(result)
         return objective * (1.0 + PENALTY * max(0.0, operating / self.limit - 1.0)) if math.isfinite(operating) else math.inf
+
+    def score(self, result: CaseResult) -> float:
+        """The objective with the operating constraint's penalty; inf where a sample has no value."""
+        return self.penalised(self.objective(result), self.operating(result))
 
     def feasible(self, result: CaseResult) -> bool:
         """The operating constraint holds (always, without one)."""
         return not math.isfinite(self.limit) or self.operating(result) <= self.limit
+
+    def best_text(self) -> str:
+        """How the best candidate so far stands, for the console: ``best worst case 3.036 mm, the constraint kept``;
+        a penalised score is never written as a length."""
+        result = self.results[self.best()]
+        shown = quantity(self.space.objective.name)
+        kept = "" if not math.isfinite(self.limit) else (", the constraint kept" if self.feasible(result) else f", the constraint broken ({quantity(self.space.constraint.name).text(self.operating(result))} against {quantity(self.space.constraint.name).text(self.limit)})")
+        return f"best worst case {shown.text(self.objective(result))}{kept}"
 
     def best(self) -> int:
         """Index of the best evaluation (least score)."""
@@ -163,8 +188,7 @@ def nelder_mead_polish(evaluations: Evaluations, budget: int, say: Callable[[str
         value = float(evaluations.evaluate(evaluations.scaled(np.asarray(unit)[None, :]), "polish", quiet=say is not None)[0]) / scale
         done[0] += 1
         if say is not None and (done[0] % POLISH_REPORT == 0 or done[0] == budget):
-            best = evaluations.scores[evaluations.best()]
-            say(f"design: polish {done[0]}/{budget} evaluations, {time.perf_counter() - started:.0f} s; best score {1e3 * best:.5g} mm")
+            say(f"design: polish {done[0]}/{budget} evaluations, {time.perf_counter() - started:.0f} s; {evaluations.best_text()}")
         return value
 
     optimize.minimize(one, centre, method="Nelder-Mead", bounds=[(0.0, 1.0)] * n,

@@ -18,6 +18,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 import threading
 import time
@@ -26,12 +27,13 @@ from typing import Any
 import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
+from scipy import optimize
 from scipy.stats import qmc
 
 from vibroimpact.analysis.linear_optimum import band_peak, linear_measure, optimal_linear_absorber
 from vibroimpact.kinds.design.dataset import design_dataset
 from vibroimpact.kinds.design.quantity import quantity
-from vibroimpact.kinds.design.evaluate import CHUNKS, CertifyCase, DesignSpace
+from vibroimpact.kinds.design.evaluate import CHUNKS, SCREENS, CertifyCase, DesignSpace, screen_kind, screen_worst
 from vibroimpact.kinds.design.outcome import Outcome
 from vibroimpact.kinds.design.scene import DesignSettings
 from vibroimpact.kinds.design.search import Evaluations, nelder_mead_polish, differential_evolution, grid_search
@@ -52,14 +54,28 @@ SECONDS_PER_BUMPER_SAMPLE = 0.15
 SECONDS_PER_CERTIFICATE = 8.0
 
 
+#: The tolerance box's corners are samples where there are at most this many (2^M for M robust scalars); beyond, the
+#: box's worst case is the local maximisation's (:func:`_box_worst`) [-].
+MAX_CORNERS = 16
+
+
+def box_corners(settings: DesignSettings) -> int:
+    """How many corners of the tolerance box are samples: 2^M for M robust scalars, 0 where that exceeds
+    :data:`MAX_CORNERS` or nothing is mistuned."""
+    count = 2 ** len(settings.mistuning)
+    return count if settings.mistuning and count <= MAX_CORNERS else 0
+
+
 def mistuning_offsets(settings: DesignSettings) -> NDArray[np.float64]:
-    """Offsets of the robust scalars, shape (1 + samples, M): the nominal design (zeros), then a seeded Latin
-    hypercube over [-spread, +spread] of each."""
+    """Offsets of the robust scalars, shape (1 + corners + samples, M): the nominal design (zeros), the corners of
+    the box [-spread, +spread] of each (:func:`box_corners`), then a seeded Latin hypercube over the box (the samples:
+    statistics of the spread; the corners and the local maximisation bound it)."""
     spreads = np.array([m.spread for m in settings.mistuning], dtype=float)
     if spreads.size == 0 or settings.samples == 0:
         return np.zeros((1, spreads.size))
+    corners = np.array(list(itertools.product((-1.0, 1.0), repeat=spreads.size))) * spreads if box_corners(settings) else np.zeros((0, spreads.size))
     unit = qmc.LatinHypercube(d=spreads.size, seed=settings.seed).random(settings.samples)
-    return np.vstack([np.zeros(spreads.size), (2.0 * unit - 1.0) * spreads])
+    return np.vstack([np.zeros(spreads.size), corners, (2.0 * unit - 1.0) * spreads])
 
 
 def design_space(scene: Any) -> DesignSpace:
@@ -83,7 +99,7 @@ def run_design(scene: Any, progress: Progress | None = None, runner: Runner | No
     space = design_space(scene)
     bounds = np.array([[v.low, v.high] for v in settings.variables])
     limit = settings.operating[1] if settings.operating is not None else math.nan
-    evaluations = Evaluations(space, bounds, runner, settings.quantile, limit)
+    evaluations = Evaluations(space, bounds, runner, settings.quantile, limit, box_corners(settings) if space.samples > 1 else 0)
     outcome = Outcome(settings, space, evaluations)
     start = time.perf_counter()
     evaluations.evaluate(outcome.scene_design[None, :], "reference")
@@ -140,12 +156,20 @@ def _linear(outcome: Outcome, amplitude: float) -> None:
 DISTINCT = 0.05
 
 
+#: Candidates certified beyond ``certify.candidates`` while certificates contradict the screen (a candidate the screen
+#: called feasible whose certificate breaks the constraint): the search's evidence returned to it, bounded.
+MAX_CONTRADICTED = 4
+
+
 def _certify(outcome: Outcome, runner: Runner, say: Progress) -> None:
     """Certify candidates one at a time, best screened first, each at its nominal and its worst sample (the first
     round also the scene's design, nominal), up to ``certify.candidates`` distinct ones: certification only raises a
     worst case, so once the best certified score is no larger than the next candidate's screened one, no later
-    candidate can beat it and the rounds stop. The recommendation is the best certified candidate (none certified:
-    the best screened)."""
+    candidate can beat it and the rounds stop. A certificate that contradicts its screen (the screen kept the operating
+    constraint, the certificate breaks it) returns to the search: that candidate is scored on its certificate, its
+    neighbours (within :data:`DISTINCT`) are passed over, and one more candidate is certified, up to
+    :data:`MAX_CONTRADICTED` more. The recommendation is the best certified candidate (none certified: the best
+    screened); its worst case is then sought over the whole tolerance box (:func:`_box_worst`)."""
     evaluations, settings = outcome.evaluations, outcome.settings
     order = [int(i) for i in np.argsort(evaluations.scores, kind="stable") if math.isfinite(evaluations.scores[int(i)])]
     span = evaluations.bounds[:, 1] - evaluations.bounds[:, 0]
@@ -153,7 +177,7 @@ def _certify(outcome: Outcome, runner: Runner, say: Progress) -> None:
     chosen: list[int] = []
     outcome.wall_times["certification"] = 0.0
     for i in order:
-        if len(chosen) >= settings.certified:
+        if len(chosen) >= settings.certified + len(outcome.contradicted) or len(outcome.contradicted) > MAX_CONTRADICTED:
             break
         if chosen and min(outcome.corrected[j] for j in chosen) <= evaluations.scores[i]:
             break  # no candidate screened this high can be certified lower
@@ -162,24 +186,48 @@ def _certify(outcome: Outcome, runner: Runner, say: Progress) -> None:
         targets = [i] + ([reference] if not chosen and reference != i else [])  # none certified: the scene's design neither
         chosen.append(i)
         _certify_round(outcome, runner, targets, chosen)
+        if evaluations.feasible(evaluations.results[i]) and not _holds(outcome, i):
+            outcome.contradicted.append(i)
+            say(f"design: the certificate of candidate {len(chosen)} (evaluation {i}) breaks the constraint its screen kept: {_operating_text(outcome, i)}; certifying the next candidate")
         say(f"design: certified candidate {len(chosen)} (evaluation {i}): {_worst_text(outcome, i)}")
     outcome.recommended = min(chosen, key=lambda i: outcome.corrected[i]) if chosen else (order[0] if order else -1)
     if chosen:
-        say(f"design: certified {len(chosen)} candidates by continuation and brute force in {outcome.wall_times['certification']:.0f} s; recommended evaluation {outcome.recommended}")
+        say(f"design: certified {len(chosen)} candidates by continuation, brute force and the operating point's runs in {outcome.wall_times['certification']:.0f} s; recommended evaluation {outcome.recommended}")
+    _box_worst(outcome, runner, say)
+
+
+def _holds(outcome: Outcome, i: int) -> bool:
+    """Candidate ``i``'s certified operating value keeps the limit (always, without a constraint)."""
+    limit = outcome.evaluations.limit
+    return not math.isfinite(limit) or outcome.corrected_operating.get(i, math.inf) <= limit
+
+
+def _operating_text(outcome: Outcome, i: int) -> str:
+    """``0.776 mm at 33 Hz (a period-4 motion, 1 impact per 4 periods, reached from rest and from 63 of 63 other
+    starts)`` of candidate ``i``'s largest certified operating value."""
+    rows = [c for c in outcome.certified if c["evaluation"] == i and math.isfinite(float(c.get("operating_worst", math.nan)))]
+    if not rows:
+        return "not certified there"
+    top = max(rows, key=lambda c: float(c["operating_worst"]))
+    shown = quantity(outcome.settings.constraint.name) if outcome.settings.constraint is not None else quantity(outcome.settings.objective)
+    return f"{shown.text(float(top['operating_worst']))} at {outcome.space.operating:.4g} Hz ({top['operating_motion']}, {top['operating_reached']})"
 
 
 def _certify_round(outcome: Outcome, runner: Runner, targets: list[int], chosen: list[int]) -> None:
     """Certify ``targets`` (candidates in ``chosen``: the nominal sample and the one that sets the objective, the
-    worst with quantile 1; others: nominal) in one batch; each one's score is raised by the ratio of its corrected
-    objective (:func:`_corrected_objective`) to its screened one, where larger."""
+    worst with quantile 1; others: nominal) in one batch; each one's score becomes the penalised score of its corrected
+    objective and operating value (:func:`_corrected`)."""
     evaluations = outcome.evaluations
     cases, owners = [], []
     done = {(c["evaluation"], c["sample"]) for c in outcome.certified}  # the scene's design, certified in the first round
     for i in targets:
         values = evaluations.values(evaluations.results[i])
-        # the sample that sets the objective (its quantile; the worst with quantile 1); the scene's design: nominal only
+        # the sample that sets the objective (its quantile; the worst with quantile 1) and the one that sets the
+        # operating value; the scene's design: nominal only
         worst_sample = int(np.nanargmin(np.abs(values - evaluations.objective(evaluations.results[i])))) if np.all(np.isfinite(values)) and i in chosen else 0
-        for sample in dict.fromkeys((0, worst_sample)):
+        operating = np.asarray(evaluations.results[i]["operating"], dtype=float)
+        operating_sample = int(np.nanargmax(operating)) if i in chosen and np.any(np.isfinite(operating)) else 0
+        for sample in dict.fromkeys((0, worst_sample, operating_sample)):
             if (i, sample) in done:
                 continue
             cases.append(CertifyCase(outcome.space, tuple(float(v) for v in evaluations.designs[i]), sample))
@@ -189,25 +237,91 @@ def _certify_round(outcome: Outcome, runner: Runner, targets: list[int], chosen:
     outcome.wall_times["certification"] += time.perf_counter() - start
     for (i, sample), result in zip(owners, results):
         screened = float(evaluations.values(evaluations.results[i])[sample])
-        outcome.certified.append({"evaluation": i, "sample": sample, "screened": screened, **result})
+        outcome.certified.append({"evaluation": i, "sample": sample, "screened": screened, "screened_operating": float(np.asarray(evaluations.results[i]["operating"])[sample]), **result})
     for i in targets:
-        objective = evaluations.objective(evaluations.results[i])
-        corrected = _corrected_objective(outcome, i)
-        # a certified worst case above the screen's raises its sample's value, the objective (the samples' quantile)
-        # and the score with it (the penalty kept)
-        outcome.corrected[i] = evaluations.scores[i] * (corrected / objective) if math.isfinite(corrected) and objective > 0.0 else evaluations.scores[i]
+        _corrected(outcome, i)
 
 
-def _corrected_objective(outcome: Outcome, i: int) -> float:
-    """Candidate ``i``'s objective [m] with each certified sample's value raised to its certified worst case where
-    larger: the same ``quantile`` of the samples (1: the worst), so that a certificate above a sample outside the
-    quantile's reach does not move it (NaN: a sample without a value)."""
+def _corrected(outcome: Outcome, i: int) -> None:
+    """Candidate ``i``'s objective and operating value with each certified sample's raised to its certificate where
+    larger (the same rule over the samples), and its score from them: ``outcome.corrected`` and
+    ``outcome.corrected_operating``."""
     evaluations = outcome.evaluations
     values = np.array(evaluations.values(evaluations.results[i]), dtype=float)
+    operating = np.array(evaluations.results[i]["operating"], dtype=float)
+    box = []
     for c in outcome.certified:
-        if c["evaluation"] == i and math.isfinite(float(c["worst"])):
-            values[int(c["sample"])] = max(values[int(c["sample"])], float(c["worst"]))
-    return float(np.quantile(values, evaluations.quantile, method="higher")) if np.all(np.isfinite(values)) else math.nan
+        if c["evaluation"] != i:
+            continue
+        worst, at = float(c["worst"]), float(c.get("operating_worst", math.nan))
+        if int(c["sample"]) < 0:  # a point of the box that is no sample
+            box.append((worst, at))
+            continue
+        if math.isfinite(worst):
+            values[int(c["sample"])] = max(values[int(c["sample"])], worst)
+        if math.isfinite(at):
+            operating[int(c["sample"])] = max(operating[int(c["sample"])], at)
+    objective, operating_value = evaluations.over_samples(values), evaluations.operating({"operating": operating})
+    if evaluations.quantile >= 1.0:  # the worst case is over the whole box
+        objective = max([objective] + [w for w, _ in box if math.isfinite(w)])
+        operating_value = max([operating_value] + [a for _, a in box if math.isfinite(a)])
+    outcome.corrected[i] = evaluations.penalised(objective, operating_value)
+    outcome.corrected_operating[i] = operating_value
+
+
+#: The local maximisation over the tolerance box: its evaluations, and how near the box's worst point must come to a
+#: certified one's value for no new certificate to be needed [-].
+BOX_BUDGET = 40
+BOX_SAME = 1e-6
+
+
+def _box_worst(outcome: Outcome, runner: Runner, say: Progress) -> None:
+    """The recommended design's worst case over the whole tolerance box: a bounded Nelder-Mead maximisation of the
+    screen's band worst case over the robust scalars' offsets, started from the worst sample (corners included), and
+    where it finds more than every sample, that point certified too (its certificate counts in the worst case).
+    ``outcome.box``: the box's worst offsets, the screened value there, and the evaluations spent."""
+    space, i = outcome.space, outcome.recommended
+    evaluations = outcome.evaluations
+    if i < 0 or not space.mistuned or space.samples < 2 or evaluations.quantile < 1.0:
+        return
+    spreads = np.array([max(abs(row[k]) for row in space.offsets) for k in range(len(space.mistuned))])
+    values = evaluations.values(evaluations.results[i])
+    if not np.all(np.isfinite(values)) or not np.all(spreads > 0.0):
+        return
+    design = tuple(float(v) for v in evaluations.designs[i])
+    kind = screen_kind(space.problem_at(design, 0))
+    if kind == SCREENS[2]:
+        return  # a brute-force screen: too coarse to climb; the corners stand
+    start = time.perf_counter()
+    count = [0]
+
+    def negative(unit: NDArray[np.float64]) -> float:
+        count[0] += 1
+        offset = tuple(float(v) for v in np.clip(unit, -1.0, 1.0) * spreads)
+        try:
+            return -screen_worst(space.problem_at(design, 0, offset), space.band, space.objective, space.scan, kind).amplitude
+        except ValueError:
+            return 0.0
+
+    worst = int(np.argmax(values))
+    begin = np.array(space.offsets[worst]) / spreads
+    found = optimize.minimize(negative, begin, method="Nelder-Mead", bounds=[(-1.0, 1.0)] * spreads.size,
+                              options={"initial_simplex": _inward_simplex(begin), "maxfev": BOX_BUDGET, "xatol": 1e-4, "fatol": 1e-12})  # fmt: skip
+    top = float(-found.fun) if found.fun < -float(values[worst]) else float(values[worst])
+    offset = tuple(float(v) for v in np.clip(found.x, -1.0, 1.0) * spreads) if found.fun < -float(values[worst]) else tuple(float(v) for v in space.offsets[worst])
+    outcome.box = {"offset": offset, "screened": top, "evaluations": count[0], "sample": worst if top == float(values[worst]) else -1}
+    if top > float(np.max(values)) * (1.0 + BOX_SAME) and outcome.settings.certified > 0:
+        say(f"design: the tolerance box's worst point is no sample ({_amount(outcome.settings.objective, top)} screened against {_amount(outcome.settings.objective, float(np.max(values)))}); certifying it")
+        result = runner.map([CertifyCase(space, design, -1, offset)])[0]
+        outcome.certified.append({"evaluation": i, "sample": -1, "screened": top, "screened_operating": math.nan, **result})
+        _corrected(outcome, i)
+    outcome.wall_times["box"] = time.perf_counter() - start
+
+
+def _inward_simplex(begin: NDArray[np.float64]) -> NDArray[np.float64]:
+    """A first simplex at ``begin`` (a point of [-1, 1]^M), its edges a quarter of the box, pointing inward."""
+    step = 0.25 * np.where(begin > 0.0, -1.0, 1.0)
+    return np.vstack([begin, begin + np.diag(step)])
 
 
 def _certified_max(outcome: Outcome, i: int) -> float:
