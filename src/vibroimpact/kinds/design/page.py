@@ -15,6 +15,7 @@ import xarray as xr
 
 from vibroimpact.kinds.design.answer import answer_text, design_titles, linear_wins, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, sample_counts, screen_words, stage_counts, unit_text, variable_names, warnings
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, design_figures
+from vibroimpact.kinds.design.consistency import contradictions
 from vibroimpact.kinds.design.operating import design_operating, operating_sentence, operating_warnings
 from vibroimpact.kinds.design.quantity import constraint_quantity, objective_quantity, operating_limit
 from vibroimpact.kinds.design.scene import safe_name
@@ -247,7 +248,13 @@ class DesignPage:
         items = "".join(f"<li>{html.escape(w)}</li>" for w in warnings(d))
         point = design_operating(d)
         before = "".join(f"<p><b>Warning.</b> {html.escape(line)}</p>" for line in operating_warnings(point))  # before the recommendation's praise
-        first = Section("Which design to build", before + f"<p><b>{html.escape(answer_text(d))}</b></p>" + operating_sentence(point) + (f"<p>{'Before you build a stop' if linear_wins(d) else 'Before you build it'}:</p><ul>{items}</ul>" if items else ""))
+        refused = contradictions(d)
+        if refused:  # a certificate that a stored motion exceeds is never printed as one
+            answer = (f"<p><b>No answer: what this study stored contradicts the recommendation's stated numbers, so they are not stated.</b> {html.escape('; '.join(refused[:4]))}"
+                      f"{f' (and {len(refused) - 4} more)' if len(refused) > 4 else ''}.</p>")  # fmt: skip
+        else:
+            answer = f"<p><b>{html.escape(answer_text(d))}</b></p>" + operating_sentence(point)
+        first = Section("Which design to build", before + answer + (f"<p>{'Before you build a stop' if linear_wins(d) else 'Before you build it'}:</p><ul>{items}</ul>" if items else ""))
         drawn = design_figures(d)
         trade = front_text(d) if "pareto_front" in d else ""
         if trade:  # only where the screen knew impulses (closed forms), so the panel has data
