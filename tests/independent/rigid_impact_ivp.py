@@ -114,6 +114,8 @@ class Settled:
     impacts_per_period : (n,) int.
     impacts : every ImpactRecord in the measured periods.
     transient_impacts : the transient's ImpactRecords (for the impact-law test).
+    transient_strobe_states : (transient + 1, 4) the strobes of the transient, from t = 0 (its last row is
+        strobe_states[0]).
     releases : (time) of every release from sticking in the measured periods.
     sticking_time : total time spent stuck in the measured periods [s].
     period : T [s].
@@ -129,6 +131,7 @@ class Settled:
     releases: list[float] = field(default_factory=list)
     sticking_time: float = 0.0
     period: float = math.nan
+    transient_strobe_states: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 4)))
 
     @property
     def end_state(self) -> NDArray[np.float64]:
@@ -220,6 +223,12 @@ class _Model:
             return np.array([x1, self.p.clearance, v1, 0.0])
         return np.array([x1, x1 + self.p.clearance, v1, v1])
 
+    def project(self, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        """y with the stopped coordinate put exactly on the stop."""
+        out = y.copy()
+        out[1] = self.p.clearance if self.p.layout == ABSOLUTE else y[0] + self.p.clearance
+        return out
+
     def bounce(self, y: NDArray[np.float64], sticks: bool) -> tuple[NDArray[np.float64], float]:
         """State after the impact and the impulse on the absorber [N s]."""
         p = self.p
@@ -271,8 +280,14 @@ class _Runner:
 
         model = self.model
 
+        # the event fires at a penetration of 1e-13 clearance (1e-17 m for 0.1 mm): far above the round-off of a
+        # state put on the stop (a few ulps of x2), so a restart there (after a plastic impact, a touch or a
+        # release, gap'' <= 0) cannot find a spurious root at its own start and loop without advancing
+        offset = 1e-13 * max(abs(p.clearance), 1e-6)
+        self.gap_offset = offset
+
         def gap_event(t: float, y: NDArray[np.float64]) -> float:
-            return model.gap(y)
+            return model.gap(y) - offset
 
         gap_event.terminal, gap_event.direction = True, 1.0  # type: ignore[attr-defined]
 
@@ -292,6 +307,7 @@ class _Runner:
         stuck_time = 0.0
         moment = 0.0j
         piece = model.period / 16.0
+        stalled = 0
         while True:
             if t >= t_end - 1e-14 * model.period:
                 break
@@ -320,9 +336,16 @@ class _Runner:
                 moment += _harmonic_piece(sol.sol, t, t_next, model.omega, piece, 0)
             y = sol.y[:, -1].copy()
             t = t_next
+            if t_next - t <= 1e-12 * model.period:
+                stalled += 1
+                if stalled > 1000:
+                    raise RuntimeError(f"no progress at t = {t!r} (state {y!r}): 1000 events in a row at the same time")
+            else:
+                stalled = 0
             if sol.status == 1:  # impact
                 v = model.approach(y)
-                if v <= 0.0:  # a touch: nothing to do
+                if v <= 0.0:  # a touch: put back on the stop, nothing else
+                    y = model.project(y)
                     continue
                 chattering = v <= self.sticking_velocity or model.p.R == 0.0 or len(impacts) >= self.max_impacts
                 sticks = chattering and model.holding_force(t, y) > 0.0
@@ -358,9 +381,12 @@ def settle(params: Params | Mapping, frequency_hz: float, start_state, transient
     period = runner.model.period
     state = np.array(start_state, dtype=float).reshape(4)
     transient_impacts: list[ImpactRecord] = []
+    transient_strobes = np.zeros((transient_periods + 1, 4))
+    transient_strobes[0] = state
     for k in range(transient_periods):
         state, _, impacts, _, _ = runner.one_period(k * period, state, harmonics_in_transient)
         transient_impacts.extend(impacts)
+        transient_strobes[k + 1] = state
     n = measured_periods
     strobes = np.zeros((n + 1, 4))
     strobes[0] = state
@@ -379,7 +405,8 @@ def settle(params: Params | Mapping, frequency_hz: float, start_state, transient
         all_releases.extend(releases)
         stuck_total += stuck
     times = (transient_periods + np.arange(n + 1)) * period
-    return Settled(np.abs(coefficients), coefficients, times, strobes, counts, all_impacts, transient_impacts, all_releases, stuck_total, period)
+    return Settled(np.abs(coefficients), coefficients, times, strobes, counts, all_impacts, transient_impacts, all_releases, stuck_total, period,
+                   transient_strobes)
 
 
 def detect_period(strobe_states: NDArray[np.float64], max_period: int = 32, rtol: float = 1e-6) -> int:
