@@ -179,7 +179,8 @@ def _random_starts(count: int, seed: int) -> list[np.ndarray]:
 @pytest.mark.slow
 def test_random_starts_reach_the_period_4_motion() -> None:
     """20 seeded starts (positions within +-clearance, velocities within +-omega clearance): each settles on the
-    period-4 motion or on the contact-free state (~1 min on one core)."""
+    period-4 motion or on the contact-free state; measured: all 20 on the period-4 motion (in its four phases:
+    the impact in period 1, 2, 3 or 4 of the cycle), none on the linear state (~75 s on one core)."""
     period4 = 0
     for start in _random_starts(20, 1):
         run = settle(DESIGN, FREQUENCY, start, TRANSIENT, 8)
@@ -188,4 +189,4 @@ def test_random_starts_reach_the_period_4_motion() -> None:
             period4 += 1
         else:
             assert run.impacts_per_period.sum() == 0
-    assert period4 >= 1
+    assert period4 == 20
