@@ -84,3 +84,22 @@ def test_texts() -> None:
     found = PointMotions(33.0, 64, (irregular,), 400, 64)
     assert found.share_text(irregular) == "reached from 1 of 64 starts, not from rest"
     assert math.isclose(found.value, 1e-3)
+
+
+def test_an_untouched_free_mass_counts_with_the_primary_s_own_motion() -> None:
+    """The impact damper's free mass (k2 = b2 = 0) in a 150 mm cavity at 24 Hz never reaches a wall from rest: no
+    attractor in the strict sense (any push makes it drift), but a motion that lasts while nothing disturbs it. Its
+    |X1| is the primary's alone, F / |k1 - m1 w^2 + j w b1| (the free mass exerts nothing), never a NaN that a
+    search would skip."""
+    space = design_space(load_scene("studies/impact_damper.yaml"))
+    problem = space.problem_at((0.15, 0.5), 0)
+    omega = 2.0 * math.pi * 24.0
+    alone = 10.0 / abs(25000.0 - omega**2 + 1j * omega * 0.31623)
+    found = point_motions(problem, 24.0, starts=2, transient=100, strobes=32)
+    rest = next(m for m in found.motions if m.from_rest)
+    assert rest.regime == "linear" and rest.value == pytest.approx(alone, rel=1e-6)
+    from vibroimpact.simulation.band_attractors import band_attractors
+
+    sweep = band_attractors(problem, (23.9, 24.1), frequencies=2, starts=2, transient=100, strobes=32)
+    assert np.all(np.isfinite(sweep.amplitude[:, 3]))  # the run from rest
+    assert sweep.amplitude[0, 3] == pytest.approx(10.0 / abs(25000.0 - (2 * math.pi * 23.9) ** 2 + 1j * 2 * math.pi * 23.9 * 0.31623), rel=1e-6)

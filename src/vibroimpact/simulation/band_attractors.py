@@ -6,7 +6,8 @@ carrying its end state to the next frequency), and more runs start at each frequ
 state, rest on the stops and random states of the motion's size (:func:`attractor_starts`, seeded). Each run's motion
 is measured and classified by :func:`~vibroimpact.simulation.attractors.measure_motion`; a contact-free motion's
 |X1| is the closed form's (the only contact-free attractor is the linear steady state, where it clears the stops;
-none where a free mass has no dashpot: :func:`~vibroimpact.analysis.linear.contact_free_is_stable`).
+an undamped free mass's too, where it fits: no attractor, :func:`~vibroimpact.analysis.linear.contact_free_is_stable`, but
+a motion that lasts while nothing disturbs it, and a run from rest stays on it).
 The largest is :class:`AttractorMaximum`: where, which run, which motion, and its peak |x1(t)|.
 
 It finds what continuation from the closed forms (:func:`vibroimpact.orbits.worst_case.worst_response`) does not
@@ -24,7 +25,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.analysis.linear import contact_free_is_stable
 from vibroimpact.analysis.measures import Measure, as_measure
 from vibroimpact.engines.registry import engine_for
 from vibroimpact.model.problem import ImpactProblem
@@ -201,12 +201,13 @@ def band_attractors(
             except RuntimeError:  # the engine made no progress (endless chattering): no attractor from this start
                 rows[2 + j]["regime"][k] = -1
     amplitude = np.full((n, r), np.nan)
-    stable = contact_free_is_stable(problem.structure)
     measured = np.stack([np.where(row["regime"] >= 0, np.max(row["amplitude"], axis=1), np.nan) for row in rows], axis=1)
     for k in range(n):
         moved = at_frequency(problem, float(f[k]))
         linear = linear_state(moved)
-        free = measure.of_state(moved, linear.amplitudes) if linear.fits(moved) and stable else math.nan  # an undamped free mass: no attractor
+        # an undamped free mass's contact-free motion is no attractor (a push makes it drift), but it lasts while
+        # nothing disturbs it: a run that never touched a stop counts with it, where it fits
+        free = measure.of_state(moved, linear.amplitudes) if linear.fits(moved) else math.nan
         for j, row in enumerate(rows):
             amplitude[k, j] = _attractor_amplitude(row, k, free)
     stack = {name: np.stack([row[name] for row in rows], axis=1) for name in ("regime", "period", "impacts", "lyapunov", "state")}
@@ -253,7 +254,8 @@ def pulled_inside(problem: ImpactProblem, rest: NDArray[np.float64], state: NDAr
 
 def _attractor_amplitude(row: dict[str, NDArray[Any]], k: int, free: float) -> float:
     """|X1| of the attractor of point ``k`` of a run [m]: the closed form's ``free`` for a contact-free motion (NaN:
-    the linear state crosses a stop, a transient), the last period's for a periodic orbit still being approached (a
+    the linear state crosses a stop, a transient; an undamped free mass that never touched its stops counts with it:
+    its motion lasts while nothing disturbs it), the last period's for a periodic orbit still being approached (a
     negative exponent), else the largest per-period |X1| over the measured periods."""
     regime = int(row["regime"][k])
     if regime < 0:

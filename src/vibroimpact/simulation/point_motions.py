@@ -30,7 +30,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from vibroimpact.analysis.linear import contact_free_is_stable
 from vibroimpact.analysis.measures import Measure, as_measure
 from vibroimpact.engines.registry import engine_for
 from vibroimpact.model.problem import ImpactProblem
@@ -196,7 +195,7 @@ def point_motions(
         except RuntimeError:  # no progress (endless chattering): no attractor from this start
             rows["regime"][k] = -1
     linear = linear_state(moved)
-    free = measure.of_state(moved, linear.amplitudes) if linear.fits(moved) and contact_free_is_stable(moved.structure) else math.nan
+    free = measure.of_state(moved, linear.amplitudes) if linear.fits(moved) else math.nan  # an undamped free mass's too (:func:`_run`)
     found: list[dict[str, Any]] = []
     for k, (label, _start) in enumerate(begun):
         run = _run(rows, k, strobes, free)
@@ -218,7 +217,9 @@ def point_motions(
 
 def _run(rows: dict[str, NDArray[Any]], k: int, strobes: int, free: float) -> dict[str, Any] | None:
     """Run ``k``'s motion: its grouping key (kind, period, impacts), value, convergence and end state; None where the
-    engine failed or a contact-free run is no attractor (its linear state crosses a stop)."""
+    engine failed or a contact-free run is no attractor (its linear state crosses a stop). A contact-free run counts
+    with the closed form ``free``, an undamped free mass's too: no attractor (a push makes it drift, see
+    :func:`~vibroimpact.analysis.linear.contact_free_is_stable`), but a motion that lasts while nothing disturbs it."""
     regime = int(rows["regime"][k])
     if regime < 0:
         return None

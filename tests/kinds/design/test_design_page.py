@@ -257,3 +257,21 @@ def test_a_branch_cut_at_the_step_limit_is_warned_with_where_and_how_large_it_wa
     f, x = d["branch_frequency"].values[row][branch], d["branch_amplitude"].values[row][branch]
     assert len(said) == 1 and "followed 1 branch only as far as the continuation's step limit (2000 steps)" in said[0]
     assert f"between {np.min(f):.4g} and {np.max(f):.4g} Hz, |X1| up to {1e3 * np.max(x):.4g} mm on it" in said[0]
+
+
+def test_a_limit_the_absorber_alone_breaks_is_said_before_the_search_and_answered_no_design() -> None:
+    """A notch limit of 1 um at 33 Hz, where the paper's absorber alone gives 8.97 um (|q H11|, closed form): the
+    dataset keeps that closed form, no candidate keeps the limit, and the answer begins "No design in these bounds
+    holds" with both numbers, never "Build"; the least violation is named."""
+    document = copy.deepcopy(TWO_VARIABLES)
+    document["name"] = "page_infeasible"
+    document["design"]["constraints"] = {"operating": {"frequency": 33.0, "x1_amplitude": 1e-6}}
+    document["design"]["robust"] = {"clearance": 0.0002, "samples": 1, "seed": 1}
+    document["design"]["compare"] = "none"
+    d = _run(document)
+    alone = float(d.attrs["operating_absorber_alone"])
+    assert alone == pytest.approx(8.973115761e-6, rel=1e-8)
+    assert not np.any(d["feasible"].values == 1)
+    text = answer_text(d)
+    assert text.startswith("No design in these bounds holds the operating limit (|X1| at most 0.001 mm at 33 Hz; without a stop the absorber already has 0.008973 mm there")
+    assert "the least violation is Delta = " in text and "Build" not in text

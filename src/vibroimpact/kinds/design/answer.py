@@ -18,7 +18,7 @@ from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.orbits.continuation_settings import ContinuationSettings
 from vibroimpact.reporting.style import fmt
 
-__all__ = ["answer_text", "sample_counts", "samples_text", "operating_motion", "at_bounds", "never_strikes", "ties", "TIE", "design_titles", "screen_words", "linear_wins", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
+__all__ = ["answer_text", "worst_motion", "offset_text", "sample_counts", "samples_text", "operating_motion", "at_bounds", "never_strikes", "ties", "TIE", "design_titles", "screen_words", "linear_wins", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
 
 _SYMBOLS = {"clearance": "Delta", "restitution": "R", "bumper_stiffness": "K_b"}
 #: How the page names the compared designs (the dataset's ``design`` dimension, in order).
@@ -93,6 +93,16 @@ class Spread:
         return f"{lead}{fmt(self.spread, '.2g')} of the {self.name}"
 
 
+def offset_text(name: str, offset: float, relative: bool) -> str:
+    """One robust scalar's offset: ``+5 % of k1``, ``-0.2 mm of the clearance``, ``+0.05 of the restitution``."""
+    sign = "+" if offset >= 0.0 else "-"
+    if relative:
+        return f"{sign}{fmt(100 * abs(offset), '.2g')} % of {name}"
+    if name == "clearance":
+        return f"{sign}{fmt(1e3 * abs(offset), '.2g')} mm of the clearance"
+    return f"{sign}{fmt(abs(offset), '.2g')} of the {name}"
+
+
 def _stored_robust(scene_text: str) -> dict[str, object]:
     """The stored scene's ``design.robust`` read as plain YAML, unchecked (as the page reads its description); empty
     if it has none."""
@@ -137,9 +147,9 @@ def samples_text(dataset: xr.Dataset) -> str:
     """``the box's 4 corners, its worst point and 6 random samples``; ``32 samples`` without corners."""
     corners, random = sample_counts(dataset)
     if not corners:
-        return f"{random} samples"
+        return f"{random} sample{'s' if random != 1 else ''}"
     box = ", its worst point" if "box_worst_screened" in dataset.attrs else ""
-    return f"the box's {corners} corners{box} and {random} random samples"
+    return f"the box's {corners} corners{box} and {random} random sample{'s' if random != 1 else ''}"
 
 
 def mistuning_text(dataset: xr.Dataset) -> str:
@@ -273,6 +283,57 @@ def never_strikes(dataset: xr.Dataset, design: int = 0) -> bool:
     return bool(rows.size) and bool(np.all(flags == 0.0))  # exact: 0/1 flags
 
 
+def _where_in_box(d: xr.Dataset, sample: int, certificate: int | None = None) -> str:
+    """`` at the box's corner +0.2 mm of the clearance, -0.05 of the restitution`` (a corner), `` under sample 5 (...)``,
+    `` at the box's worst point (...)`` (sample -1); "" for the nominal design or without mistuning."""
+    if sample == 0:
+        return " at the nominal design"
+    names = [str(v).removeprefix("mistuning_") for v in d.data_vars if str(v).startswith("mistuning_")]
+    parts = []
+    for name in names:
+        variable = d[f"mistuning_{name}"]
+        relative = str(variable.attrs.get("long_name", "")).startswith("relative")
+        if certificate is not None and f"certificate_offset_{name}" in d:
+            value = float(d[f"certificate_offset_{name}"].values[certificate])
+        elif sample >= 0:
+            value = float(variable.values[sample])
+        else:
+            continue
+        what = str(variable.attrs.get("long_name", "")).split(" offset of ")[-1].split(" in each")[0]
+        parts.append(offset_text(what, value, relative))
+    if not parts:
+        return ""
+    kind = int(d["sample_kind"].values[sample]) if "sample_kind" in d and sample >= 0 else -1
+    where = "the box's worst point" if sample < 0 else ("the box's corner" if kind == 1 else f"sample {sample}")
+    return f" at {where}, {', '.join(parts)}"
+
+
+def worst_motion(dataset: xr.Dataset, design: int = 0) -> str:
+    """What sets a compared design's stated worst case, where and under which offsets: ``set at 24.34 Hz by the
+    motion with 1 impact per period (interior of its branch) at the box's corner, +0.2 mm of the clearance, -0.05 of
+    the restitution`` (its certificate's, else its screen's); "" where nothing says."""
+    d = dataset
+    evaluation = design_evaluation(d, design)
+    worst = design_worst(d, design)
+    if evaluation < 0 or not math.isfinite(worst):
+        return ""
+    value, row = certified_worst(d, design)
+    if row >= 0 and value >= worst * (1.0 - 1e-9):
+        motion = str(d["certificate_motion"].values[row])
+        named = f"the motion with {motion}" if motion[:1].isdigit() else motion
+        return f"set at {fmt(float(d['certificate_frequency'].values[row]), '.5g')} Hz by {named}{_where_in_box(d, int(d['certificate_sample'].values[row]), row)}"
+    values = d["sample_value"].values[evaluation]
+    if not np.any(np.isfinite(values)):
+        return ""
+    sample = int(np.nanargmax(values))
+    if float(values[sample]) < worst * (1.0 - 1e-9):  # the box's worst point, screened only
+        return "set at the box's worst point (screened)"
+    meanings = str(d["sample_motion"].attrs.get("flag_meanings", "")).split()
+    code = int(d["sample_motion"].values[evaluation, sample])
+    motion = meanings[code].replace("_", " ") if 0 <= code < len(meanings) else "a motion"
+    return f"set at {fmt(float(d['sample_frequency'].values[evaluation, sample]), '.5g')} Hz by the screen's {motion} motion{_where_in_box(d, sample)}"
+
+
 def answer_text(dataset: xr.Dataset) -> str:
     """The page's first sentence (module docstring): what to build, its worst case and operating value with the
     motions that set them; "No design in these bounds holds ..." where none keeps the operating limit; "Build no stop"
@@ -304,8 +365,10 @@ def answer_text(dataset: xr.Dataset) -> str:
     scene_part = f"the scene's design{', ' + scene if scene else ''}: {q.text(design_worst(d, 1))}{notch(1)}"
     best = design_worst(d, 0)
     if math.isfinite(limit) and not float(operating[0]) <= limit:
+        alone = float(d.attrs.get("operating_absorber_alone", math.nan))
+        why = f"; without a stop the absorber already has {c.text(alone)} there, and no stop in these bounds lowers it enough" if math.isfinite(alone) and alone > limit else ""
         linear = f"; the best linear absorber of the same mass: {q.text(worst[2])}{notch(2)}" if np.any(np.isfinite(values[2])) else ""
-        return (f"No design in these bounds holds the operating limit ({c.symbol} at most {c.text(limit)} at {at} Hz): the least violation is {variable_text(d, 0)}{at_bounds(d)}, "
+        return (f"No design in these bounds holds the operating limit ({c.symbol} at most {c.text(limit)} at {at} Hz{why}): the least violation is {variable_text(d, 0)}{at_bounds(d)}, "
                 f"worst case {q.symbol} = {q.text(best)} {over}{notch(0)} ({scene_part}{linear}).")  # fmt: skip
     if linear_wins(d):  # no design with a stop found beats the linear absorber: say so first
         tie = ties(worst[2], best)
@@ -320,7 +383,11 @@ def answer_text(dataset: xr.Dataset) -> str:
         tie = " (a tie)" if ties(worst[2], best) else ""
         others.append(f"best linear absorber of the same mass: {q.text(worst[2])}{notch(2)}{tie}")
     others.append(scene_part)
-    return f"Build {variable_text(d, 0)}{at_bounds(d)}: worst case {q.symbol} = {q.text(best)} {over}{notch(0)} ({'; '.join(others)})."
+    motion = worst_motion(d, 0)
+    setting = f", {motion}" if motion else ""
+    kept = notch(0)
+    kept = "; " + kept.removeprefix(", ") if setting and kept else kept
+    return f"Build {variable_text(d, 0)}{at_bounds(d)}: worst case {q.symbol} = {q.text(best)} {over}{setting}{kept} ({'; '.join(others)})."
 
 
 def screen_words(dataset: xr.Dataset) -> str:

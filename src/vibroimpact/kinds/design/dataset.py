@@ -275,6 +275,7 @@ def _designs(data: dict[str, xr.Variable], scene: Any, outcome: Outcome) -> dict
     if outcome.recommended >= 0:
         attrs["recommended_certified_score_m"] = outcome.corrected.get(outcome.recommended, math.nan)
         attrs["recommended_contradicted"] = np.array(outcome.contradicted, dtype=np.int32)  # candidates whose certificate broke the constraint their screen kept
+    attrs["operating_absorber_alone"] = outcome.alone  # the scene's absorber without its stop at the operating frequency (NaN: the structure is a design variable)
     if outcome.box:
         attrs.update({"box_worst_screened": float(outcome.box["screened"]), "box_worst_sample": int(outcome.box["sample"]), "box_evaluations": int(outcome.box["evaluations"]),
                       "box_worst_offsets": np.array(outcome.box["offset"], dtype=float)})  # fmt: skip

@@ -29,6 +29,7 @@ class Outcome:
         self.linear: LinearAbsorberOptimum | None = None
         self.linear_values = np.full(space.samples, np.nan)
         self.linear_operating = math.nan
+        self.alone = math.nan
         self.recommended = -1
         self.corrected: dict[int, float] = {}
         self.corrected_operating: dict[int, float] = {}

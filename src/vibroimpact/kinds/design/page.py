@@ -16,6 +16,7 @@ import xarray as xr
 from vibroimpact.kinds.design.answer import answer_text, design_titles, linear_wins, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, sample_counts, screen_words, stage_counts, unit_text, variable_names, warnings
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, design_figures
 from vibroimpact.kinds.design.consistency import contradictions
+from vibroimpact.kinds.design.evaluate import CERTIFY_OPERATING_RUN, CERTIFY_OPERATING_STARTS, OPERATING_RUN, OPERATING_STARTS
 from vibroimpact.kinds.design.operating import design_operating, operating_sentence, operating_warnings
 from vibroimpact.kinds.design.quantity import constraint_quantity, objective_quantity, operating_limit
 from vibroimpact.kinds.design.scene import safe_name
@@ -159,9 +160,16 @@ def method_text(dataset: xr.Dataset) -> str:
                   "motion is stable, a guess at the motion's size from the orbits that exist.")  # fmt: skip
     parts = [f"{screen} The objective is {over} over the samples: {mistuned}.</p>"]
     if math.isfinite(limit):
-        parts.append(f"<p><b>The operating constraint.</b> The worst coexisting {c.symbol} at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz must stay at or below "
-                     f"{c.text(limit)}; the search minimised the objective raised by 10 times the relative excess of that {c.symbol} over the limit (a penalty, "
-                     f"not a hard bound; {int(np.sum(d['feasible'].values == 1))} of {n} candidates keep it).</p>")  # fmt: skip
+        contradicted = np.atleast_1d(d.attrs.get("recommended_contradicted", np.zeros(0, dtype=int)))
+        returned = (f" {contradicted.size} candidate{'s' if contradicted.size != 1 else ''} the screen called feasible broke the limit when certified; each was scored on its certificate, "
+                    "its neighbours passed over, and the next distinct candidate certified.") if contradicted.size else ""  # fmt: skip
+        parts.append(f"<p><b>The operating constraint.</b> {c.symbol} at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz must stay at or below {c.text(limit)} on every motion "
+                     f"found there, under every sample: the screen takes the largest of the stable closed-form motions and of every motion {OPERATING_STARTS} seeded runs settle on "
+                     f"(the contact-free linear state, rest, and random states from 5 % to twice the motion's length; {OPERATING_RUN[0]} periods dropped, {OPERATING_RUN[1]} measured); "
+                     f"the certification runs {CERTIFY_OPERATING_STARTS} more ({CERTIFY_OPERATING_RUN[0]} periods dropped, {CERTIFY_OPERATING_RUN[1]} measured), shoots every periodic motion "
+                     "they reach (its orbit exact, its value the largest one-period fundamental over its period) and adds the brute force's attractors there. The search "
+                     f"minimised the objective raised by 10 times the relative excess over the limit (a penalty, not a hard bound; {int(np.sum(d['feasible'].values == 1))} of {n} "
+                     f"candidates keep it on the screen).{returned}</p>")  # fmt: skip
     jobs = d.attrs.get("run_jobs")
     workers = f" on {int(jobs)} worker{'s' if int(jobs) != 1 else ''}" if isinstance(jobs, (int, np.integer)) else ""
     parts.append(f"<p><b>The search.</b> {how}. {n} candidates in all, by stage: {stages} (the reference is the scene's own design); {n * samples} "

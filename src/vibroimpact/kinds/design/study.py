@@ -1,19 +1,28 @@
 """The ``design`` kind of study: which absorber and stop to build.
 
-1. The mistuning samples: a seeded Latin hypercube over the robust spreads, plus the nominal design
-   (:func:`mistuning_offsets`).
-2. The search (:mod:`vibroimpact.kinds.design.search`): differential evolution and a Nelder-Mead polish, or a grid; each
-   candidate's closed-form worst case under every sample, through the runner (resumable, spread over workers).
+Every number the answer states is a maximum over every motion the study reached, at every point it names, over the
+whole tolerance box (issue 48):
+
+1. The mistuning samples: the nominal design, the corners of the tolerance box (:func:`box_corners`) and a seeded
+   Latin hypercube over it (:func:`mistuning_offsets`).
+2. The search (:mod:`vibroimpact.kinds.design.search`): differential evolution and a Nelder-Mead polish, or a grid;
+   each candidate's worst case under every sample (the closed forms, or bumper orbits grown from them) and its value
+   at the operating frequency over every motion the screen finds there (the closed forms and seeded runs from rest,
+   the linear state and random states: :mod:`vibroimpact.simulation.point_motions`), through the runner.
 3. The comparisons: the scene's own design, and (``compare: linear_optimum``) the H-infinity optimum linear absorber of
    the same mass under the same mistuning (:func:`vibroimpact.analysis.linear_optimum.optimal_linear_absorber`), its
-   band peaks exact: in this process, while the workers certify.
+   band peaks exact: in this process, while the workers certify. A limit the absorber alone already breaks at the
+   operating frequency is said before the search (:func:`_absorber_alone`).
 4. The certification (:class:`~vibroimpact.kinds.design.evaluate.CertifyCase`, :func:`_certify`): the best
-   candidates, one at a time, at the nominal sample and at the one that sets their objective (their worst), and the scene's design at the nominal
-   one, by continuation of every branch from the closed-form orbits and by brute force (every attractor; a larger
-   periodic one continued and located exactly); a candidate whose certified worst case exceeds its screen is scored
-   on the certified value, the next distinct candidate is certified while it could still be better, and the
-   recommendation is the best certified candidate.
-5. The dataset (:mod:`vibroimpact.kinds.design.dataset`).
+   candidates, one at a time, at the nominal sample, the one that sets their objective and the one that sets their
+   operating value, and the scene's design at the nominal one: continuation of every branch, brute force over the
+   band, and at the operating frequency 64 more runs with every periodic motion shot. A certified value above the
+   screen's raises the candidate's score; a certificate that breaks the constraint the screen kept sends the search on
+   to the next distinct candidate; the recommendation is the best certified candidate. Its worst case is then sought
+   over the whole box (:func:`_box_worst`: a bounded maximisation from the worst sample, certified where it exceeds
+   every sample).
+5. The dataset (:mod:`vibroimpact.kinds.design.dataset`); the page refuses an answer anything stored contradicts
+   (:mod:`vibroimpact.kinds.design.consistency`).
 """
 
 from __future__ import annotations
@@ -101,6 +110,11 @@ def run_design(scene: Any, progress: Progress | None = None, runner: Runner | No
     limit = settings.operating[1] if settings.operating is not None else math.nan
     evaluations = Evaluations(space, bounds, runner, settings.quantile, limit, box_corners(settings) if space.samples > 1 else 0)
     outcome = Outcome(settings, space, evaluations)
+    outcome.alone = _absorber_alone(scene, space)
+    if math.isfinite(outcome.alone) and outcome.alone > limit:  # said before any search: a stop must lower what the absorber alone gives
+        shown = quantity(space.constraint.name)
+        say(f"design: without a stop the scene's absorber already has {shown.symbol} = {shown.text(outcome.alone)} at {space.operating:.4g} Hz, above the allowed {shown.text(limit)}: "
+            "only a stop that lowers it there can keep the limit")  # fmt: skip
     start = time.perf_counter()
     evaluations.evaluate(outcome.scene_design[None, :], "reference")
     search = settings.search
@@ -134,6 +148,18 @@ def run_design(scene: Any, progress: Progress | None = None, runner: Runner | No
     if failed:
         raise failed[0]
     return design_dataset(scene, outcome)
+
+
+def _absorber_alone(scene: Any, space: DesignSpace) -> float:
+    """The constraint's value at the operating frequency of the scene's absorber without its stop, where no design
+    variable changes the structure (NaN otherwise, or without a constraint): the closed form that shows a limit
+    infeasible before any search."""
+    if not math.isfinite(space.operating) or any(name not in ("clearance", "restitution", "bumper_stiffness") for name in space.variables):
+        return math.nan
+    system = space.problem.named_view()
+    if system is None:
+        return math.nan
+    return float(linear_measure(system, scene.amplitude, 2.0 * math.pi * space.operating, space.constraint))
 
 
 def _linear(outcome: Outcome, amplitude: float) -> None:
