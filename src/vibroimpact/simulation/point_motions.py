@@ -261,10 +261,15 @@ def _shot(problem: ImpactProblem, engine: Any, found: dict[str, Any], measure: M
         return _motion(found)
     if not orbit.stable:
         return _motion(found)
-    run = engine.integrate(problem, orbit.state, 0.0, found["period"], moments=True)
+    try:
+        run = engine.integrate(problem, orbit.state, 0.0, found["period"], moments=True)
+    except RuntimeError:  # the engine made no progress from the shot state: keep the runs' value
+        return _motion(found)
     n, m = problem.size, len(problem.stops)
     per_period = measure.of_harmonics(problem, problem.omega, run.moments[:, :n], run.moments[:, n : n + m]) * 2.0 / problem.period
     value = float(np.max(per_period))
     if abs(value - found["value"]) > 1e-3 * max(value, found["value"]):  # another orbit than the runs' (they had settled)
         return _motion(found)
-    return _motion(found, value, True, tuple(float(x) for x in orbit.state))
+    # the orbit's value, exact; never below what the runs showed (their last periods are at most the shooting
+    # tolerance away)
+    return _motion(found, max(value, found["value"]), True, tuple(float(x) for x in orbit.state))

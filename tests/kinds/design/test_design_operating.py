@@ -54,7 +54,7 @@ def test_a_stop_that_destroys_the_notch_is_said_before_the_recommendation(datase
     assert first.startswith("<p><b>Warning.</b> The recommended stop makes the absorber worse at its operating point")
     assert f"{fmt(1e3 * point.linear, '.4g')} mm without the stop" in first and f"{fmt(1e3 * point.stopped, '.4g')} mm with it, ×100" in first
     assert "does not fit in the recommended gap" in second and "against a clearance of 1 mm" in second
-    assert intro.index("No design in these bounds holds the operating limit") > intro.index("Warning.")  # 100 x 0.009 mm breaks the 0.05 mm limit
+    assert intro.index("No design found in these bounds keeps the operating limit") > intro.index("Warning.")  # 100 x 0.009 mm breaks the 0.05 mm limit
     assert math.isfinite(point.free) and point.free > 0.002
 
 

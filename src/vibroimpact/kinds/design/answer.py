@@ -93,6 +93,11 @@ class Spread:
         return f"{lead}{fmt(self.spread, '.2g')} of the {self.name}"
 
 
+def sample_name(sample: int) -> str:
+    """How the page names a certified sample: ``sample 3``, or ``the tolerance box's worst point`` (-1)."""
+    return "the tolerance box's worst point" if sample < 0 else f"sample {sample}"
+
+
 def offset_text(name: str, offset: float, relative: bool) -> str:
     """One robust scalar's offset: ``+5 % of k1``, ``-0.2 mm of the clearance``, ``+0.05 of the restitution``."""
     sign = "+" if offset >= 0.0 else "-"
@@ -275,12 +280,20 @@ def at_bounds(dataset: xr.Dataset, design: int = 0) -> str:
 def never_strikes(dataset: xr.Dataset, design: int = 0) -> bool:
     """Whether no stable motion any certificate of the compared design found in the band strikes its stop (every
     certificate says so, at least one exists): the design is a linear absorber with an idle stop."""
-    if "certificate_impacting" not in dataset:
+    d = dataset
+    if "certificate_impacting" not in d:
         return False
-    evaluation = design_evaluation(dataset, design)
-    rows = np.flatnonzero(dataset["certificate_evaluation"].values == evaluation) if evaluation >= 0 else np.zeros(0, dtype=int)
-    flags = dataset["certificate_impacting"].values[rows]
-    return bool(rows.size) and bool(np.all(flags == 0.0))  # exact: 0/1 flags
+    evaluation = design_evaluation(d, design)
+    rows = np.flatnonzero(d["certificate_evaluation"].values == evaluation) if evaluation >= 0 else np.zeros(0, dtype=int)
+    if not rows.size or not np.all(d["certificate_impacting"].values[rows] == 0.0):  # exact: 0/1 flags
+        return False
+    if "certificate_operating_impacts" in d and np.any(d["certificate_operating_impacts"].values[rows] > 0.0):
+        return False  # a motion at the operating point strikes it
+    screened = [np.asarray(d[name].values[evaluation], dtype=float) for name in ("sample_operating_impacts",) if name in d]
+    if any(np.any(v > 0.0) for v in screened):
+        return False
+    impulses = np.asarray(d["sample_impulse"].values[evaluation], dtype=float) if "sample_impulse" in d else np.zeros(0)
+    return not np.any(impulses > 0.0)  # no stable impact orbit on any sample's scan (NaN: screened by brute force, whose runs the certificates judge)
 
 
 def _where_in_box(d: xr.Dataset, sample: int, certificate: int | None = None) -> str:
@@ -368,7 +381,7 @@ def answer_text(dataset: xr.Dataset) -> str:
         alone = float(d.attrs.get("operating_absorber_alone", math.nan))
         why = f"; without a stop the absorber already has {c.text(alone)} there, and no stop in these bounds lowers it enough" if math.isfinite(alone) and alone > limit else ""
         linear = f"; the best linear absorber of the same mass: {q.text(worst[2])}{notch(2)}" if np.any(np.isfinite(values[2])) else ""
-        return (f"No design in these bounds holds the operating limit ({c.symbol} at most {c.text(limit)} at {at} Hz{why}): the least violation is {variable_text(d, 0)}{at_bounds(d)}, "
+        return (f"No design found in these bounds keeps the operating limit ({c.symbol} at most {c.text(limit)} at {at} Hz{why}): the best found (the least penalised score) is {variable_text(d, 0)}{at_bounds(d)}, "
                 f"worst case {q.symbol} = {q.text(best)} {over}{notch(0)} ({scene_part}{linear}).")  # fmt: skip
     if linear_wins(d):  # no design with a stop found beats the linear absorber: say so first
         tie = ties(worst[2], best)
@@ -448,13 +461,13 @@ def warnings(dataset: xr.Dataset) -> list[str]:
         for r in rows:
             worst, screened = float(d["certificate_worst"].values[r]), float(d["certificate_screened"].values[r])
             if math.isfinite(worst) and worst > screened * (1.0 + 1e-6):
-                out.append(f"The certification found a larger stable motion than the screen under sample {int(d['certificate_sample'].values[r])}: {q.text(worst)} ({d['certificate_motion'].values[r]} at {fmt(d['certificate_frequency'].values[r], '.4g')} Hz) against {q.text(screened)}.")
+                out.append(f"The certification found a larger stable motion than the screen under {sample_name(int(d['certificate_sample'].values[r]))}: {q.text(worst)} ({d['certificate_motion'].values[r]} at {fmt(d['certificate_frequency'].values[r], '.4g')} Hz) against {q.text(screened)}.")
             cut = _cut_branches(d, int(r))
             if cut:
                 out.append(cut)
             error = str(d["certificate_error"].values[r])
             if error:
-                out.append(f"The certification of sample {int(d['certificate_sample'].values[r])} failed: {error}")
+                out.append(f"The certification of {sample_name(int(d['certificate_sample'].values[r]))} failed: {error}")
     ridge = float(d.attrs.get("equal_peak_difference", math.nan))
     if math.isfinite(ridge) and ridge < 0.02:
         f1, f2 = (float(x) for x in np.atleast_1d(d.attrs["equal_peak_frequencies_Hz"]))
@@ -483,6 +496,6 @@ def _cut_branches(d: xr.Dataset, row: int) -> str:
     steady = amplitude[stable == 1.0]  # exact: a 0/1 flag
     q = objective_quantity(d)  # the branches' amplitude is the objective's measure
     stable_text = f", stable up to {q.text(float(np.max(steady)))}" if steady.size else ", none of it stable"
-    return (f"The certification of sample {int(d['certificate_sample'].values[row])} followed {count} branch{'es' if count > 1 else ''} only as far as the continuation's "
+    return (f"The certification of {sample_name(int(d['certificate_sample'].values[row]))} followed {count} branch{'es' if count > 1 else ''} only as far as the continuation's "
             f"step limit ({ContinuationSettings().max_steps} steps): between {fmt(float(np.min(frequency)), '.4g')} and {fmt(float(np.max(frequency)), '.4g')} Hz, {q.symbol} up to "
             f"{q.text(float(np.max(amplitude)))} on {'them' if count > 1 else 'it'}{stable_text}; past that point {'they are' if count > 1 else 'it is'} not known, and only the brute force looked there.")

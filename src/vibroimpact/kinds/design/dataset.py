@@ -257,7 +257,11 @@ def _designs(data: dict[str, xr.Variable], scene: Any, outcome: Outcome) -> dict
     values[1] = ev.values(ev.results[0])
     values[2] = outcome.linear_values
     # each stated operating value: the screen's over the samples, raised by every certificate of that design
-    operating = [max(ev.operating(ev.results[i]), outcome.corrected_operating.get(i, -math.inf)) if i >= 0 else math.nan for i in (outcome.recommended, 0)] + [outcome.linear_operating]
+    # the largest over every sample (corners included, whatever the quantile) and every certificate: a stated number
+    operating = [float(np.fmax(np.nanmax(np.asarray(ev.results[i]["operating"], dtype=float), initial=-np.inf), outcome.corrected_operating.get(i, -math.inf)))
+                 if i >= 0 and math.isfinite(ev.limit) else math.nan for i in (outcome.recommended, 0)] + [outcome.linear_operating]  # fmt: skip
+    certified_at = [max((float(c.get("operating_worst", math.nan)) for c in outcome.certified if c["evaluation"] == i and math.isfinite(float(c.get("operating_worst", math.nan)))), default=-math.inf) for i in (outcome.recommended, 0)]
+    operating[:2] = [max(v, c) if math.isfinite(v) or math.isfinite(c) else math.nan for v, c in zip(operating[:2], certified_at)]
     data["design_operating_amplitude"] = xr.Variable("design", np.array(operating, dtype=float), {"units": limit_unit, "long_name": f"worst coexisting {limit_symbol} at the operating frequency over the samples and every motion found there, certificates included (NaN: no constraint)"})
     data["design_sample_value"] = xr.Variable(("design", "sample"), values, {"units": unit, "long_name": f"largest stable {generic} over the band of each compared design under each sample"})
     for k, v in enumerate(settings.variables):

@@ -231,16 +231,19 @@ def _operating(problem: ImpactProblem, frequency: float, measure: Measure, kind:
     (:func:`~vibroimpact.simulation.point_motions.point_motions`: rest and the linear state among them); with the
     motion that sets it (index of :data:`SCREEN_MOTIONS`, :data:`BRUTE` for a sampled one), its period, impacts per
     period and the runs that reached it (0: a closed form's, not reached by the runs)."""
-    closed = (0.0, MOTIONS[0], 0)
+    closed = (math.nan, MOTIONS[0], 0)  # no stable closed-form motion there: nothing known from the closed forms
     if kind != SCREENS[2]:
         at = closed_form_at(problem, frequency, measure) if kind == SCREENS[0] else bumper_at(problem, frequency, measure)
-        closed = (at.amplitude, at.motion, at.impacts)
+        if at.motion != MOTIONS[0]:
+            closed = (at.amplitude, at.motion, at.impacts)
     sampled = point_motions(problem, frequency, measure, OPERATING_STARTS, *OPERATING_RUN, seed=OPERATING_SEED)
     top = sampled.largest
-    if top is not None and top.value > closed[0] * (1.0 + SAME_SIZE):
-        return top.value, SCREEN_MOTIONS.index(BRUTE), top.period, top.impacts, top.starts
+    if top is None and not math.isfinite(closed[0]):
+        return math.nan, SCREEN_MOTIONS.index(MOTIONS[0]), 0, 0, 0  # no motion found at all: no value (the candidate is scored infinite), never 0
+    if top is not None and not top.value <= closed[0] * (1.0 + SAME_SIZE):
+        return max(top.value, closed[0]) if math.isfinite(closed[0]) else top.value, SCREEN_MOTIONS.index(BRUTE), top.period, top.impacts, top.starts
     reached = sum(m.starts for m in sampled.motions if abs(m.value - closed[0]) <= SAME_SIZE * closed[0])
-    return closed[0], SCREEN_MOTIONS.index(closed[1]), 1, closed[2], reached
+    return max(closed[0], top.value if top is not None else -math.inf), SCREEN_MOTIONS.index(closed[1]), 1, closed[2], reached
 
 
 #: Fields of :class:`CertifyCase`: the certified worst |X| [m], where [Hz], its motion (text) and source (index of
@@ -342,7 +345,10 @@ class CertifyCase:
         scalars["impacting"] = float(branch_strikes or bool(np.any(np.isfinite(found.attractors.amplitude) & (found.attractors.impacts > 0.0))))
         if math.isfinite(self.space.operating):
             start = time.perf_counter()
-            scalars |= certified_operating(problem, self.space, found.attractors)
+            try:
+                scalars |= certified_operating(problem, self.space, found.attractors)
+            except (ValueError, RuntimeError) as error:  # no value: the candidate cannot be said to keep the constraint
+                scalars["operating_motion"] = f"not judged: {type(error).__name__}: {str(error)[:160]}"
             scalars["operating_time"] = time.perf_counter() - start
         sweep = np.array([sweep_points_for(setting[1], setting[0], a, self.space.band) if setting is not None else math.nan for a in SWEEP_ACCURACIES])
         if report is not None:

@@ -177,7 +177,7 @@ def _certified_above(d: xr.Dataset, k: int, screened: NDArray[np.float64]) -> li
     out = []
     for r in np.flatnonzero(d["certificate_evaluation"].values == evaluation) if evaluation >= 0 else ():
         sample, certified = int(d["certificate_sample"].values[r]), objective_quantity(d).value(float(d["certificate_worst"].values[r]))
-        if math.isfinite(certified) and math.isfinite(float(screened[sample])) and certified > float(screened[sample]) * (1.0 + 1e-6):
+        if sample >= 0 and math.isfinite(certified) and math.isfinite(float(screened[sample])) and certified > float(screened[sample]) * (1.0 + 1e-6):  # the box's worst point is no sample
             out.append((sample, certified))
     return out
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from vibroimpact.kinds.design.answer import answer_text, design_titles, linear_wins, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, sample_counts, screen_words, stage_counts, unit_text, variable_names, warnings
+from vibroimpact.kinds.design.answer import sample_name, answer_text, design_titles, linear_wins, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, sample_counts, screen_words, stage_counts, unit_text, variable_names, warnings
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, design_figures
 from vibroimpact.kinds.design.consistency import contradictions
 from vibroimpact.kinds.design.evaluate import CERTIFY_OPERATING_RUN, CERTIFY_OPERATING_STARTS, OPERATING_RUN, OPERATING_STARTS
@@ -81,7 +81,7 @@ def designs_table(dataset: xr.Dataset) -> str:
             over += f"<br><small>sample {s}, {fmt(d['sample_frequency'].values[evaluation, s], '.4g')} Hz</small>"
         value, row = certified_worst(d, k)
         if row >= 0:
-            certified = f"{q.number(value)}<br><small>{html.escape(str(d['certificate_motion'].values[row]))}, sample {int(d['certificate_sample'].values[row])}, {fmt(d['certificate_frequency'].values[row], '.4g')} Hz</small>"
+            certified = f"{q.number(value)}<br><small>{html.escape(str(d['certificate_motion'].values[row]))}, {sample_name(int(d['certificate_sample'].values[row]))}, {fmt(d['certificate_frequency'].values[row], '.4g')} Hz</small>"
         else:
             certified = "exact (no stop: the band peak in closed form)" if k == 2 else "not certified"
         texts = {"over": over, "nominal": q.number(columns["nominal"][j]), "certified": certified}
@@ -116,7 +116,7 @@ def certificates_table(dataset: xr.Dataset) -> str:
     lines = [f"<table><tr><th>design</th><th>sample</th><th {_WRAP}>screened {worst} [{q.unit}]</th><th {_WRAP}>certified {worst} [{q.unit}]</th><th>at [Hz]</th><th>motion</th><th>wall time [s]</th><th>error</th></tr>"]
     for r in range(d.sizes["certificate"]):
         who = _who(d, int(d["certificate_evaluation"].values[r]))
-        lines.append(f"<tr><td>{who}</td><td>{int(d['certificate_sample'].values[r])}</td><td>{q.number(d['certificate_screened'].values[r])}</td><td>{q.number(d['certificate_worst'].values[r])}</td>"
+        lines.append(f"<tr><td>{who}</td><td>{sample_name(int(d['certificate_sample'].values[r])).removeprefix('sample ')}</td><td>{q.number(d['certificate_screened'].values[r])}</td><td>{q.number(d['certificate_worst'].values[r])}</td>"
                      f"<td>{fmt(d['certificate_frequency'].values[r], '.5g')}</td><td {_WRAP}>{html.escape(str(d['certificate_motion'].values[r]))}</td>"
                      f"<td>{fmt(d['certificate_wall_time'].values[r], '.3g')}</td><td {_WRAP}>{html.escape(str(d['certificate_error'].values[r])) or 'none'}</td></tr>")  # fmt: skip
     return "".join(lines) + "</table>"
@@ -179,7 +179,7 @@ def method_text(dataset: xr.Dataset) -> str:
         total = float(np.nansum(d["certificate_wall_time"].values))
         which: dict[str, list[str]] = {}
         for r in range(certified):
-            which.setdefault(_who(d, int(d["certificate_evaluation"].values[r])), []).append(str(int(d["certificate_sample"].values[r])))
+            which.setdefault(_who(d, int(d["certificate_evaluation"].values[r])), []).append(str(int(d["certificate_sample"].values[r])) if int(d["certificate_sample"].values[r]) >= 0 else "the box's worst point")
         listed = "; ".join(f"{who} at sample{'s' if len(s) > 1 else ''} {' and '.join(s)}" for who, s in which.items())
         parts.append(f"<p><b>The certification (continuation and brute force).</b> {certified} problem{'s' if certified > 1 else ''} ({listed}; sample 0 is the nominal design), "
                      f"each continued in frequency along every branch started from its {'bumper orbits shot from the rigid twin' + chr(39) + 's' if d.attrs.get('screen') == 'bumper_orbits' else 'closed-form orbits'}, and swept by brute force (up and down, two more starts, "

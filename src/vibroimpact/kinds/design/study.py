@@ -61,6 +61,8 @@ POLISH_BUDGET = 80
 SECONDS_PER_SAMPLE = 0.06
 SECONDS_PER_BUMPER_SAMPLE = 0.15
 SECONDS_PER_CERTIFICATE = 8.0
+#: The screen's runs at the operating frequency, per sample [s] (8 runs of 264 periods, quiet machine).
+SECONDS_PER_OPERATING = 0.015
 
 
 #: The tolerance box's corners are samples where there are at most this many (2^M for M robust scalars); beyond, the
@@ -212,7 +214,7 @@ def _certify(outcome: Outcome, runner: Runner, say: Progress) -> None:
         targets = [i] + ([reference] if not chosen and reference != i else [])  # none certified: the scene's design neither
         chosen.append(i)
         _certify_round(outcome, runner, targets, chosen)
-        if evaluations.feasible(evaluations.results[i]) and not _holds(outcome, i):
+        if not _holds(outcome, i) and (evaluations.feasible(evaluations.results[i]) or not math.isfinite(outcome.corrected[i])):
             outcome.contradicted.append(i)
             say(f"design: the certificate of candidate {len(chosen)} (evaluation {i}) breaks the constraint its screen kept: {_operating_text(outcome, i)}; certifying the next candidate")
         say(f"design: certified candidate {len(chosen)} (evaluation {i}): {_worst_text(outcome, i)}")
@@ -223,7 +225,10 @@ def _certify(outcome: Outcome, runner: Runner, say: Progress) -> None:
 
 
 def _holds(outcome: Outcome, i: int) -> bool:
-    """Candidate ``i``'s certified operating value keeps the limit (always, without a constraint)."""
+    """Candidate ``i``'s certificates all succeeded and its certified operating value keeps the limit (always,
+    without a constraint)."""
+    if any(str(c.get("error", "")) for c in outcome.certified if c["evaluation"] == i):
+        return False  # a failed certificate certifies nothing
     limit = outcome.evaluations.limit
     return not math.isfinite(limit) or outcome.corrected_operating.get(i, math.inf) <= limit
 
@@ -291,7 +296,8 @@ def _corrected(outcome: Outcome, i: int) -> None:
     if evaluations.quantile >= 1.0:  # the worst case is over the whole box
         objective = max([objective] + [w for w, _ in box if math.isfinite(w)])
         operating_value = max([operating_value] + [a for _, a in box if math.isfinite(a)])
-    outcome.corrected[i] = evaluations.penalised(objective, operating_value)
+    failed = any(str(c.get("error", "")) for c in outcome.certified if c["evaluation"] == i)
+    outcome.corrected[i] = math.inf if failed else evaluations.penalised(objective, operating_value)  # a failed certificate: never recommended on the screen's word
     outcome.corrected_operating[i] = operating_value
 
 
@@ -310,7 +316,7 @@ def _box_worst(outcome: Outcome, runner: Runner, say: Progress) -> None:
     evaluations = outcome.evaluations
     if i < 0 or not space.mistuned or space.samples < 2 or evaluations.quantile < 1.0:
         return
-    spreads = np.array([max(abs(row[k]) for row in space.offsets) for k in range(len(space.mistuned))])
+    spreads = np.array([m.spread for m in outcome.settings.mistuning], dtype=float)  # the box itself, corners or not
     values = evaluations.values(evaluations.results[i])
     if not np.all(np.isfinite(values)) or not np.all(spreads > 0.0):
         return
@@ -325,9 +331,10 @@ def _box_worst(outcome: Outcome, runner: Runner, say: Progress) -> None:
         count[0] += 1
         offset = tuple(float(v) for v in np.clip(unit, -1.0, 1.0) * spreads)
         try:
-            return -screen_worst(space.problem_at(design, 0, offset), space.band, space.objective, space.scan, kind).amplitude
+            found = screen_worst(space.problem_at(design, 0, offset), space.band, space.objective, space.scan, kind)
         except ValueError:
             return 0.0
+        return -max(found.amplitude, found.estimate if found.uncovered > 0.0 else 0.0)  # the samples' rule (Evaluations.values)
 
     worst = int(np.argmax(values))
     begin = np.array(space.offsets[worst]) / spreads
@@ -341,6 +348,11 @@ def _box_worst(outcome: Outcome, runner: Runner, say: Progress) -> None:
         result = runner.map([CertifyCase(space, design, -1, offset)])[0]
         outcome.certified.append({"evaluation": i, "sample": -1, "screened": top, "screened_operating": math.nan, **result})
         _corrected(outcome, i)
+        certified = sorted({int(c["evaluation"]) for c in outcome.certified if int(c["evaluation"]) in outcome.corrected})
+        best = min(certified, key=lambda j: outcome.corrected[j])
+        if best != i:  # the box's worst point lost it the recommendation: the best certified candidate instead
+            say(f"design: the box's worst point raised evaluation {i} above evaluation {best}; recommending {best}")
+            outcome.recommended = best
     outcome.wall_times["box"] = time.perf_counter() - start
 
 
@@ -393,12 +405,13 @@ class DesignStudy:
         """Predicted wall time and memory on the calibration machine, from :data:`SECONDS_PER_SAMPLE` and
         :data:`SECONDS_PER_CERTIFICATE`."""
         settings: DesignSettings = scene.settings
-        n, samples = len(settings.variables), settings.samples + 1
+        n, samples = len(settings.variables), settings.samples + 1 + box_corners(settings)
         search = settings.search
         candidates = search.points**n if search.method == "grid" else search.population * n * (search.generations + 1) + (POLISH_BUDGET if search.polish else 0)
-        per_sample = SECONDS_PER_BUMPER_SAMPLE if settings.bumper_frequency is not None else SECONDS_PER_SAMPLE
+        per_sample = (SECONDS_PER_BUMPER_SAMPLE if settings.bumper_frequency is not None else SECONDS_PER_SAMPLE) + (SECONDS_PER_OPERATING if settings.operating is not None else 0.0)
         screen = candidates * samples * per_sample
-        certify = (2 * settings.certified + 1) * SECONDS_PER_CERTIFICATE  # at most: the rounds may stop after the first
+        # at most: three certificates per candidate and the box's worst point (the rounds may stop after the first)
+        certify = (3 * settings.certified + 2) * SECONDS_PER_CERTIFICATE + BOX_BUDGET * per_sample
         # a polish step's samples are shared by at most CHUNKS workers (one candidate at a time)
         polish = POLISH_BUDGET * samples * per_sample if search.method != "grid" and search.polish else 0.0
         wall = (screen - polish) / max(jobs, 1) + polish / max(min(jobs, CHUNKS, samples), 1) + certify / max(min(jobs, 2), 1) + 10.0
