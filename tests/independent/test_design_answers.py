@@ -4,7 +4,7 @@ tolerance box's worst point. Read from the golden design datasets of rigid stops
 values and certificates); a bumper design is the bumper engine's (not this integrator's) and is not read here.
 
 What is held: no motion the integrator settles on (its strobes repeating, after up to 3000 periods) exceeds a stated
-number beyond its own accuracy (1e-6 relative). Slow tier: the integrator takes about 5 ms a period."""
+number beyond its own accuracy and the residue of a slow transient (1e-4 relative). Slow tier: the integrator takes about 5 ms a period."""
 
 from __future__ import annotations
 
@@ -18,9 +18,12 @@ import yaml
 from tests.golden.golden import DATA
 from tests.independent.rigid_impact_ivp import Params, detect_period, linear_steady_state, settle
 
-#: The integrator's agreement with the package's engines (test_rigid_impact_ivp: 1e-12 on periodic motions; a
-#: motion still settling after the transient is larger than its attractor, never smaller) [-].
-ACCURACY = 1e-6
+#: How far a settled run may lie above a stated number [-]: the integrator agrees with the package's engines to 1e-12
+#: on periodic motions (test_rigid_impact_ivp), but the lightly damped absorber's transient decays as exp(-zeta w t)
+#: (zeta2 = 0.0019: a time constant of 84 periods at 33 Hz), so a run whose strobes repeat to 1e-6 can still lie
+#: 1e-5 to 1e-4 above the motion it approaches (measured: 2.4e-5 after 316-3000 periods). The defects this guards
+#: against are 10-100x (a notch of 0.05 mm stated where a period-4 motion reaches 0.776 mm).
+ACCURACY = 1e-4
 
 
 def _params(d: xr.Dataset, offsets: dict[str, float]) -> Params:
@@ -123,3 +126,13 @@ def test_the_stated_worst_case_holds_at_the_box_s_worst_point(name: str) -> None
     for start in _starts(p, frequency, 2, seed=11):
         found.append(_settled(p, frequency, start))
     assert max(found) <= stated * (1.0 + ACCURACY), f"{name}: the integrator settles on {max(found)} m above the stated {stated} m"
+
+
+@pytest.mark.slow
+def test_the_check_refuses_the_old_answer_s_notch() -> None:
+    """The check can fail: the old shipped answer (Delta = 2.3596 mm, R = 0.1893) stated 0.05 mm at 33 Hz; from rest
+    the integrator settles on its period-4 motion, 0.776 mm, far above it."""
+    p = Params(1.0, 0.1, 25000.0, 4300.0, 0.8, 0.08, F=10.0, clearance=2.3596e-3, R=0.1893)
+    found = _settled(p, 33.0, np.zeros(4))
+    assert found == pytest.approx(0.77606741e-3, rel=1e-6)
+    assert not found <= 5e-5 * (1.0 + ACCURACY)
