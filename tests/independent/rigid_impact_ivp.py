@@ -355,7 +355,7 @@ class _Runner:
                 if v <= 0.0:  # a touch: put back on the stop, nothing else
                     y = model.project(y)
                     continue
-                chattering = v <= self.sticking_velocity or model.p.R == 0.0 or len(impacts) >= self.max_impacts
+                chattering = v <= self.sticking_velocity or model.p.R == 0.0 or len(impacts) >= self.max_impacts  # exact: R = 0 is a parsed input (a plastic stop)
                 sticks = chattering and model.holding_force(t, y) > 0.0
                 after, impulse = model.bounce(y, sticks)
                 impacts.append(ImpactRecord(t, y.copy(), after.copy(), v, sticks, impulse, model.gap(y)))
