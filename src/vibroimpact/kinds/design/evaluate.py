@@ -24,7 +24,7 @@ from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.analysis.measures import Measure, as_measure
 from vibroimpact.simulation.attractors import MOTION_CLASSES
 from vibroimpact.simulation.band_attractors import AttractorSweep, band_attractors
-from vibroimpact.simulation.point_motions import SAME_SIZE, point_motions
+from vibroimpact.simulation.point_motions import SAME_SIZE, PointMotion, point_motions
 from vibroimpact.model.contact import MIN_BUMPER_RESTITUTION, KelvinVoigtBumper
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.bumper_screen import bumper_at, bumper_screen_refusal, bumper_worst
@@ -232,10 +232,9 @@ def _operating(problem: ImpactProblem, frequency: float, measure: Measure, kind:
     motion that sets it (index of :data:`SCREEN_MOTIONS`, :data:`BRUTE` for a sampled one), its period, impacts per
     period and the runs that reached it (0: a closed form's, not reached by the runs)."""
     closed = (math.nan, MOTIONS[0], 0)  # no stable closed-form motion there: nothing known from the closed forms
-    if kind != SCREENS[2]:
-        at = closed_form_at(problem, frequency, measure) if kind == SCREENS[0] else bumper_at(problem, frequency, measure)
-        if at.motion != MOTIONS[0]:
-            closed = (at.amplitude, at.motion, at.impacts)
+    at = _screen_at(problem, frequency, measure, kind)
+    if at is not None:
+        closed = (at.amplitude, at.motion, at.impacts)
     sampled = point_motions(problem, frequency, measure, OPERATING_STARTS, *OPERATING_RUN, seed=OPERATING_SEED)
     top = sampled.largest
     if top is None and not math.isfinite(closed[0]):
@@ -356,6 +355,15 @@ class CertifyCase:
         return {**{k: np.array(v) for k, v in scalars.items()}, "sweep_points": sweep, "sweep_time": sweep * found.seconds_per_point, **points, **attractors, "error": np.array("")}
 
 
+def _screen_at(problem: ImpactProblem, frequency: float, measure: Measure, kind: str) -> BandWorst | None:
+    """The screen's largest stable motion at one ``frequency`` [Hz] (``kind`` of :data:`SCREENS`: the closed forms or
+    the bumper orbits shot from them); None where none of its motions is stable there or it has none (brute force)."""
+    if kind == SCREENS[2]:
+        return None
+    at = closed_form_at(problem, frequency, measure) if kind == SCREENS[0] else bumper_at(problem, frequency, measure)
+    return at if at.motion != MOTIONS[0] else None
+
+
 def certified_operating(problem: ImpactProblem, space: DesignSpace, attractors: AttractorSweep | None = None) -> dict[str, object]:
     """``problem``'s worst value of the constraint's measure at the operating frequency over every motion found there:
     the stable closed-form ones, every motion :data:`CERTIFY_OPERATING_STARTS` runs settle on (rest and the linear
@@ -364,11 +372,10 @@ def certified_operating(problem: ImpactProblem, space: DesignSpace, attractors: 
     frequency, measure = space.operating, space.constraint
     kind = screen_kind(problem)
     candidates: list[tuple[float, str, str, int, int]] = []  # (value, motion, who reached it, period, impacts per period)
-    if kind != SCREENS[2]:
-        at = closed_form_at(problem, frequency, measure) if kind == SCREENS[0] else bumper_at(problem, frequency, measure)
-        if at.motion != MOTIONS[0]:
-            name = "the contact-free motion" if at.motion == MOTIONS[1] else f"a period-1 motion, {at.impacts} impact{'s' if at.impacts != 1 else ''} per period"
-            candidates.append((at.amplitude, name, "a closed form" if kind == SCREENS[0] else "a bumper orbit shot from the closed form", 1, at.impacts))
+    at = _screen_at(problem, frequency, measure, kind)
+    if at is not None:
+        name = PointMotion(at.amplitude, "linear" if at.motion == MOTIONS[1] else "one_impact", 1, at.impacts, 0, False, False).text()
+        candidates.append((at.amplitude, name, "a closed form" if kind == SCREENS[0] else "a bumper orbit shot from the closed form", 1, at.impacts))
     sampled = point_motions(problem, frequency, measure, CERTIFY_OPERATING_STARTS, *CERTIFY_OPERATING_RUN, seed=CERTIFY_OPERATING_SEED, shoot_orbits=True)
     candidates += [(m.value, m.text() + ("" if m.exact or not m.period or m.regime == "linear" else " (its last periods: shooting failed)"), sampled.share_text(m), m.period, m.impacts) for m in sampled.motions]
     if attractors is not None and space.objective.name == measure.name:
