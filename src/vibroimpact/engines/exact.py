@@ -19,6 +19,7 @@ and release), for shooting, continuation and Lyapunov exponents (:mod:`vibroimpa
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
 
@@ -26,8 +27,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.engines.registry import ENGINES, Capabilities
-from vibroimpact.engines import exact_core, exact_moments
+from vibroimpact.engines import batch_kernels, exact_core, exact_moments
 from vibroimpact.engines.base import MODE_STUCK, Trajectory, check_run, start_state
+from vibroimpact.engines.batch import BatchRuns, run_batch
 from vibroimpact.engines.exact_flows import Flow, ExactModel, build_model
 from vibroimpact.engines.exact_python import PythonExactEngine
 from vibroimpact.engines.interruptible import call_interruptibly
@@ -228,6 +230,12 @@ def loop_setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
     return _Setup(law, model, arguments, leading_arguments(exact_core.sample_states, arguments))
 
 
+def _checked_setup(name: str, problem: ImpactProblem, settings: EngineSettings, periods: int) -> _Setup:
+    """:func:`loop_setup` after the checks of every run (:func:`~vibroimpact.engines.base.check_run`)."""
+    check_run(name, problem, RigidStop, periods)
+    return loop_setup(problem, settings)
+
+
 class ExactEngine:
     """Exact piecewise-linear reference engine, compiled (see module docstring)."""
 
@@ -257,6 +265,29 @@ class ExactEngine:
                 "the exact engine holds one stop at a time"
             )
         return out
+
+    def run_many(
+        self, problems: Sequence[ImpactProblem], case_of: NDArray[np.int64], starts: NDArray[np.float64], transient: int, strobes: int,
+        scales: NDArray[np.float64], max_period: int,
+    ) -> BatchRuns:  # fmt: skip
+        """Many runs in one compiled call (:mod:`~vibroimpact.engines.batch_kernels`): run i is ``problems[case_of[i]]``
+        from ``starts[i]`` at t = 0, ``transient`` periods dropped, ``strobes`` measured with moments and Jacobians,
+        bit for bit :meth:`integrate`'s two runs; ``scales`` (cases, 2 N) the strobes' repeat test's [m, m s-1] up to
+        ``max_period``. A run with no progress keeps its status; one that would stick on two stops at once raises
+        :meth:`integrate`'s ``NotImplementedError``."""
+        setups = [_checked_setup(self.name, problem, self.settings, max(transient, strobes)) for problem in problems]
+        case_of = np.asarray(case_of, dtype=np.int64)
+        begun = np.array([start_state(problems[c], state, 0.0) for c, state in zip(case_of, starts)], dtype=float).reshape(case_of.size, -1)
+        for c, state in zip(case_of, begun):
+            setups[c].law.check_start(state)
+        runs = run_batch(batch_kernels.run_rigid_batch, [setup.arguments for setup in setups], case_of, begun, transient, strobes, scales, max_period)
+        stuck = np.flatnonzero(runs.status == exact_core.STATUS_TWO_STICKS)
+        if stuck.size:
+            i = int(stuck[0])  # its single runs raise their message, naming both stops
+            problem = problems[case_of[i]]
+            end = self._run(problem, begun[i], 0.0, transient, False, False, False).strobes[-1] if transient else begun[i]
+            self._run(problem, end, 0.0, strobes, True, True, False)
+        return runs
 
     def integrate(
         self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False, jacobians: bool = False

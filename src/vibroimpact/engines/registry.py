@@ -49,6 +49,9 @@ class Capabilities:
         computes it, without the general map's Python around each evaluation (a
         :class:`~vibroimpact.engines.compliant.exact.CompiledPeriod`, shot as
         :class:`~vibroimpact.orbits.bumper_map.CompiledPeriodMap`).
+    batched : bool
+        ``run_many(problems, case_of, starts, transient, strobes, scales, max_period)`` runs many starts of problems of
+        one layout in one compiled call, bit for bit its single runs (:mod:`~vibroimpact.engines.batch`).
     compiled : bool
         Its kernels are compiled by numba on first use (tens of seconds) and kept in numba's on-disk cache: its module's
         ``kernels_cached()`` says whether the cache holds them and ``prepare_kernels()`` compiles them in the calling
@@ -62,6 +65,7 @@ class Capabilities:
     stepped_solution: bool = False
     sweeps: bool = False
     compiled_period: bool = False
+    batched: bool = False
     compiled: bool = False
 
     def __post_init__(self) -> None:
@@ -146,7 +150,7 @@ def _solve_ivp(method: str) -> EngineSpec:
 #: name -> engine. ``momentary`` uses the method of its settings; the suffixed names fix it.
 ENGINES: Mapping[str, EngineSpec] = MappingProxyType(
     {
-        "exact": EngineSpec("vibroimpact.engines.exact:ExactEngine", Capabilities(RIGID, exact_jacobians=True, exact_flow=True, tolerance_free=True, stepped_solution=True, compiled=True), "piecewise-exact closed-form flow with guaranteed contact search, compiled: the reference"),
+        "exact": EngineSpec("vibroimpact.engines.exact:ExactEngine", Capabilities(RIGID, exact_jacobians=True, exact_flow=True, tolerance_free=True, stepped_solution=True, batched=True, compiled=True), "piecewise-exact closed-form flow with guaranteed contact search, compiled: the reference"),
         "exact_python": EngineSpec("vibroimpact.engines.exact_python:PythonExactEngine", EXACT_FLOW, "the exact engine's algorithm in pure Python: its cross-check and speed baseline"),
         "momentary": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", Capabilities(RIGID, stepped_solution=True), "SUNDIALS CVODE with contact events and a grazing guard (method from the settings)"),
         "momentary_adams": EngineSpec("vibroimpact.engines.momentary:MomentaryEngine", INTEGRATOR, "SUNDIALS CVODE, Adams, with contact events and a grazing guard", settings_method="adams"),
@@ -160,7 +164,7 @@ ENGINES: Mapping[str, EngineSpec] = MappingProxyType(
         "compliant_ida": EngineSpec("vibroimpact.engines.compliant.ida:CompliantEngine", BUMPER_INTEGRATOR, "the engine compliant, under the name benchmark scenes use"),
         "compliant_cvode_adams": EngineSpec("vibroimpact.engines.compliant.ida:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (Adams)", settings_method="adams"),
         "compliant_cvode_bdf": EngineSpec("vibroimpact.engines.compliant.ida:CompliantCvodeEngine", BUMPER_INTEGRATOR, "Kelvin-Voigt bumper through SUNDIALS CVODE (BDF)", settings_method="bdf"),
-        "compliant_exact": EngineSpec("vibroimpact.engines.compliant.exact:CompliantExactEngine", Capabilities(BUMPER, exact_jacobians=True, exact_flow=True, tolerance_free=True, stepped_solution=True, compiled_period=True, compiled=True), "Kelvin-Voigt bumper in closed form per contact mode with guaranteed switch search, compiled: the bumper's reference"),
+        "compliant_exact": EngineSpec("vibroimpact.engines.compliant.exact:CompliantExactEngine", Capabilities(BUMPER, exact_jacobians=True, exact_flow=True, tolerance_free=True, stepped_solution=True, compiled_period=True, batched=True, compiled=True), "Kelvin-Voigt bumper in closed form per contact mode with guaranteed switch search, compiled: the bumper's reference"),
     }
 )
 

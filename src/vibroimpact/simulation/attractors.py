@@ -26,7 +26,7 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.motion import classify_motion, classify_strobes
 from vibroimpact.simulation.harmonics import linear_state, resting_state
 
-__all__ = ["MOTION_CLASSES", "MAX_KEPT_IMPACTS", "MAX_PERIOD", "REPEAT_TOLERANCE", "SWEEP_FIELDS", "at_frequency", "sweep_arrays", "linear_start", "measure_motion", "stepped_sweep"]
+__all__ = ["MOTION_CLASSES", "MAX_KEPT_IMPACTS", "MAX_PERIOD", "REPEAT_TOLERANCE", "SWEEP_FIELDS", "at_frequency", "sweep_arrays", "linear_start", "measure_motion", "measure_motions", "repeat_scale", "stepped_sweep"]
 
 #: What the motion at a brute-force point is (CF flags of ``brute_regime`` and ``chart_regime``, values 0...).
 MOTION_CLASSES = ("linear", "one_impact", "other_periodic", "quasi_periodic", "chaotic", "irregular")
@@ -125,24 +125,80 @@ def measure_motion(engine: Any, problem: ImpactProblem, state: NDArray[np.float6
         state = engine.integrate(problem, state, 0.0, transient).final_state
     run = engine.integrate(problem, state, 0.0, strobes, moments=True, jacobians=True)
     s = run.strobe_states
-    out["state"][k] = run.final_state
+    scale = repeat_scale(problem)
+    mismatch = [float(np.max(np.abs(s[p:] - s[:-p]) / scale)) if s.shape[0] > 2 * p else math.inf for p in range(1, MAX_PERIOD + 1)]
+    velocities = run.impact_velocities
+    _keep_motion(
+        problem, out, k, s, run.moments, velocities[-MAX_KEPT_IMPACTS:], velocities.size, np.array(mismatch), lambda: run.strobe_jacobians,
+        lambda first: int(np.count_nonzero(run.impact_times >= run.strobe_times[first])), as_measure(measure, problem),
+    )  # fmt: skip
+    return run.final_state
+
+
+def repeat_scale(problem: ImpactProblem) -> NDArray[np.float64]:
+    """The scales of the strobes' repeat test [m, m s-1]: the motion's length for positions, times w for velocities."""
+    length = problem.length_scale()
+    return np.repeat([length, problem.omega * length], problem.size)
+
+
+def measure_motions(
+    engine: Any, problems: Sequence[ImpactProblem], case_of: Sequence[int], starts: Sequence[NDArray[np.float64]], transient: int, strobes: int,
+    measure: int | Measure = 0,
+) -> dict[str, NDArray[Any]]:  # fmt: skip
+    """:func:`measure_motion` of many runs: run i from ``starts[i]`` on ``problems[case_of[i]]``; row i of the arrays
+    returned (:func:`sweep_arrays`), ``regime`` -1 where the engine made no progress.
+
+    An engine that can (capability ``batched``) runs them all in one compiled call
+    (:mod:`~vibroimpact.engines.batch`), bit for bit the single runs; any other runs them one by one.
+    """
+    runs = len(starts)
+    width = 2 * problems[0].size if problems else 0
+    out = sweep_arrays(runs, strobes, width)
+    if runs == 0:
+        return out
+    if not getattr(engine.capabilities, "batched", False):
+        for i, (c, start) in enumerate(zip(case_of, starts)):
+            try:
+                measure_motion(engine, problems[c], start, transient, strobes, out, i, measure)
+            except RuntimeError:  # no progress (endless chattering): no attractor from this start
+                out["regime"][i] = -1
+        return out
+    scales = np.array([repeat_scale(problem) for problem in problems])
+    batch = engine.run_many(problems, np.asarray(case_of, dtype=np.int64), np.array(starts, dtype=float), transient, strobes, scales, MAX_PERIOD)
+    measures = [as_measure(measure, problem) for problem in problems]
+    for i, c in enumerate(case_of):
+        if batch.status[i] != 0:  # no progress (endless chattering): no attractor from this start
+            continue
+        count = int(batch.impacts[i])
+        _keep_motion(
+            problems[c], out, i, batch.strobes[i], batch.moments[i], batch.velocities[i, : min(count, MAX_KEPT_IMPACTS)], count, batch.mismatch[i],
+            lambda i=i: batch.jacobians[i], lambda first, i=i: int(batch.after[i, first]), measures[c],
+        )  # fmt: skip
+    return out
+
+
+def _keep_motion(
+    problem: ImpactProblem, out: dict, k: int, s: NDArray[np.float64], moments: NDArray[np.complex128], velocities: NDArray[np.float64], count: int,
+    mismatch: NDArray[np.float64], jacobians: Callable[[], NDArray[np.float64]], impacts_from: Callable[[int], int], measure: Measure,
+) -> None:  # fmt: skip
+    """Row ``k`` of ``out`` from a measured run: its strobes ``s`` and per-period ``moments``, its last impact speeds
+    and their ``count``, the repeat test per period (``mismatch``), its Jacobians (asked only where the strobes do not
+    repeat) and the impacts at or after strobe j (``impacts_from(j)``)."""
+    strobes = s.shape[0] - 1
+    out["state"][k] = s[-1]
     out["strobe"][k] = s[1:, 0]
     n, m = problem.size, len(problem.stops)
-    out["amplitude"][k] = as_measure(measure, problem).of_harmonics(problem, problem.omega, run.moments[:, :n], run.moments[:, n : n + m]) * 2.0 / problem.period
-    velocities = run.impact_velocities
-    out["velocity"][k, : min(velocities.size, MAX_KEPT_IMPACTS)] = velocities[-MAX_KEPT_IMPACTS:]
-    out["impacts"][k] = velocities.size / strobes
-    length = problem.length_scale()
-    scale = np.repeat([length, problem.omega * length], problem.size)
-    mismatch = [float(np.max(np.abs(s[p:] - s[:-p]) / scale)) if s.shape[0] > 2 * p else math.inf for p in range(1, MAX_PERIOD + 1)]
-    period = next((p for p, m in enumerate(mismatch, start=1) if m < REPEAT_TOLERANCE), 0)
-    if velocities.size == 0:
+    out["amplitude"][k] = measure.of_harmonics(problem, problem.omega, moments[:, :n], moments[:, n : n + m]) * 2.0 / problem.period
+    out["velocity"][k, : velocities.size] = velocities
+    out["impacts"][k] = count / strobes
+    period = next((p for p, value in enumerate(mismatch, start=1) if value < REPEAT_TOLERANCE), 0)
+    if count == 0:
         out["regime"][k], out["period"][k] = 0, 1
-        return run.final_state
+        return
     if not period:
-        jacobians = run.strobe_jacobians
-        if np.all(np.isfinite(jacobians)):
-            evidence = classify_motion(jacobians, s[1:])
+        matrices = jacobians()
+        if np.all(np.isfinite(matrices)):
+            evidence = classify_motion(matrices, s[1:])
         else:  # a degenerate event (e.g. a chatter sequence ending as a release begins) left a Jacobian undefined
             evidence = classify_strobes(s[1:])  # the strobes alone decide the clear cases; no exponent
         out["lyapunov"][k] = evidence.lyapunov_exponent
@@ -150,10 +206,7 @@ def measure_motion(engine: Any, problem: ImpactProblem, state: NDArray[np.float6
             period = int(np.argmin(mismatch)) + 1
         else:
             out["regime"][k] = MOTION_CLASSES.index(evidence.kind)
-            return run.final_state
+            return
     out["period"][k] = period
     tail = (strobes // period) * period
-    impacts = np.count_nonzero(run.impact_times >= run.strobe_times[strobes - tail])
-    out["regime"][k] = 1 if period == 1 and impacts == tail else 2
-    return run.final_state
-
+    out["regime"][k] = 1 if period == 1 and impacts_from(strobes - tail) == tail else 2

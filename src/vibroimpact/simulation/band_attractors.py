@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from vibroimpact.analysis.measures import Measure, as_measure
 from vibroimpact.engines.registry import engine_for
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.simulation.attractors import MOTION_CLASSES, at_frequency, measure_motion, stepped_sweep, sweep_arrays
+from vibroimpact.simulation.attractors import MOTION_CLASSES, at_frequency, measure_motions, stepped_sweep, sweep_arrays
 from vibroimpact.simulation.harmonics import gaps, linear_state, resting_state
 from vibroimpact.simulation.history import engine_of
 
@@ -193,13 +193,13 @@ def band_attractors(
     rows = [stepped_sweep(problem, direction, f, transient, s, engine, measure=measure) for direction in ("up", "down")]
     rows += [sweep_arrays(n, s, 2 * problem.size) for _ in range(starts)]
     rng = np.random.default_rng(seed)
-    for k in range(n):
-        moved = at_frequency(problem, float(f[k]))
-        for j, (_label, start) in enumerate(attractor_starts(moved, starts, rng)):
-            try:
-                measure_motion(engine, moved, start, transient, s, rows[2 + j], k, measure)
-            except RuntimeError:  # the engine made no progress (endless chattering): no attractor from this start
-                rows[2 + j]["regime"][k] = -1
+    moved_all = [at_frequency(problem, float(f[k])) for k in range(n)]
+    begun = [(k, j, start) for k in range(n) for j, (_label, start) in enumerate(attractor_starts(moved_all[k], starts, rng))]
+    # every start at every frequency in one call (one compiled call for an engine that batches); regime -1: no progress
+    measured_starts = measure_motions(engine, moved_all, [k for k, _j, _start in begun], [start for _k, _j, start in begun], transient, s, measure)
+    for i, (k, j, _start) in enumerate(begun):
+        for name, values in measured_starts.items():
+            rows[2 + j][name][k] = values[i]
     amplitude = np.full((n, r), np.nan)
     measured = np.stack([np.where(row["regime"] >= 0, np.max(row["amplitude"], axis=1), np.nan) for row in rows], axis=1)
     for k in range(n):

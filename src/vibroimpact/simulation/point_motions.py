@@ -10,7 +10,7 @@ Runs start from the contact-free linear state, from rest, and from seeded random
 log-uniformly from 5 % to twice the motion's length (the clearance plus the absorber's linear stroke,
 :meth:`~vibroimpact.model.problem.ImpactProblem.length_scale`), so that both small motions about the notch and large
 impacting ones are entered. Each run drops ``transient`` periods and measures ``strobes``
-(:func:`~vibroimpact.simulation.attractors.measure_motion`). The runs are grouped into distinct motions (kind,
+(:func:`~vibroimpact.simulation.attractors.measure_motions`: one compiled call for an engine that batches). The runs are grouped into distinct motions (kind,
 period k, impacts per k periods, and size); a periodic motion with impacts is then shot (``shoot_orbits``): its
 orbit solved by Newton's method from the run's end state and measured over its k periods exactly, not over the last
 sampled periods. A motion's value is its largest one-period ``measure`` over its k periods (the largest per-period
@@ -35,7 +35,7 @@ from vibroimpact.engines.registry import engine_for
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.maps import ImpactMap
 from vibroimpact.orbits.shooting import ShootingError, shoot
-from vibroimpact.simulation.attractors import MOTION_CLASSES, at_frequency, measure_motion, sweep_arrays
+from vibroimpact.simulation.attractors import MOTION_CLASSES, at_frequency, measure_motions
 from vibroimpact.simulation.band_attractors import pulled_inside
 from vibroimpact.simulation.harmonics import linear_state, resting_state
 from vibroimpact.simulation.history import engine_of
@@ -188,12 +188,7 @@ def point_motions(
     engine = engine_of(engine_for(problem.contact_law, "exact_jacobians") if engine is None else engine)
     moved = at_frequency(problem, float(frequency))
     begun = point_starts(moved, starts, seed)
-    rows = sweep_arrays(len(begun), strobes, 2 * moved.size)
-    for k, (_label, start) in enumerate(begun):
-        try:
-            measure_motion(engine, moved, start, transient, strobes, rows, k, measure)
-        except RuntimeError:  # no progress (endless chattering): no attractor from this start
-            rows["regime"][k] = -1
+    rows = measure_motions(engine, [moved], [0] * len(begun), [start for _label, start in begun], transient, strobes, measure)  # regime -1: no progress
     linear = linear_state(moved)
     free = measure.of_state(moved, linear.amplitudes) if linear.fits(moved) else math.nan  # an undamped free mass's too (:func:`_run`)
     found: list[dict[str, Any]] = []

@@ -1,0 +1,56 @@
+"""Many runs of one bumper layout in one compiled call: the ``compliant_exact`` engine's batch loop
+(:mod:`~vibroimpact.engines.batch_kernels` says what a batch runs and keeps; every number is the single run's, bit for
+bit)."""
+
+from __future__ import annotations
+
+from numba import njit
+
+from vibroimpact.engines.batch_kernels import batch_outputs, keep_run
+from vibroimpact.engines.compliant.exact_loop import run_bumper_periods_until
+from vibroimpact.engines.numba_cache import stamp_with_callees
+
+__all__ = ["run_bumper_batch"]
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def run_bumper_batch(
+    lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
+    omega, period, obsw, obso, velw, salts, zero_har, gap_tolerance, force_tolerances, max_events, gl_nodes, gl_weights,
+    case_of, starts, transient, strobes, scales, max_period, cancel,
+):  # fmt: skip
+    """Run i: case ``case_of[i]`` (its entry of every stacked leading argument of
+    :func:`~vibroimpact.engines.compliant.exact_loop.run_bumper_periods_until`) from ``starts[i]`` at t = 0,
+    ``transient`` periods, then ``strobes`` periods with moments and Jacobians from the end state at t = 0 (as
+    :func:`~vibroimpact.engines.batch_kernels.run_rigid_batch`)."""
+    runs, n = starts.shape
+    width = n + velw.shape[1]
+    status, stopped, kept, jacobians, moments, impacts, velocities, after, mismatch = batch_outputs(runs, strobes, n, width, max_period)
+    for i in range(runs):
+        if cancel[0] != 0:
+            break
+        c = case_of[i]
+        y = starts[i].copy()
+        if transient > 0:
+            first = run_bumper_periods_until(
+                lams[c], counts[c], vecs[c], invs[c], hrms[c], csts[c], zpros[c], znils[c], zdrvs[c], zdrv2s[c], polys[c], hlams[c], hcounts[c], rates_all[c], rinv_all[c], fastests[c],
+                omega[c], period[c], obsw[c], obso[c], velw[c], salts[c], zero_har[c], gap_tolerance[c], force_tolerances[c], max_events[c], gl_nodes[c], gl_weights[c],
+                y, 0.0, transient, False, False, False, cancel,
+            )  # fmt: skip
+            if first[0] != 0:
+                status[i], stopped[i] = first[0], first[1]
+                continue
+            y = first[2][-1].copy()
+        out = run_bumper_periods_until(
+            lams[c], counts[c], vecs[c], invs[c], hrms[c], csts[c], zpros[c], znils[c], zdrvs[c], zdrv2s[c], polys[c], hlams[c], hcounts[c], rates_all[c], rinv_all[c], fastests[c],
+            omega[c], period[c], obsw[c], obso[c], velw[c], salts[c], zero_har[c], gap_tolerance[c], force_tolerances[c], max_events[c], gl_nodes[c], gl_weights[c],
+            y, 0.0, strobes, True, True, False, cancel,
+        )  # fmt: skip
+        if out[0] != 0:
+            status[i], stopped[i] = out[0], out[1]
+            continue
+        keep_run(i, out[2], out[3], out[4], out[7], period[c], scales[c], kept, jacobians, moments, impacts, velocities, after, mismatch)
+    return status, stopped, kept, jacobians, moments, impacts, velocities, after, mismatch
+
+
+stamp_with_callees(globals())
