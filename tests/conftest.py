@@ -18,7 +18,7 @@ PAPER_CLEARANCE = 3e-3
 
 
 def pytest_sessionstart(session: pytest.Session) -> None:
-    """Compile the exact engine's numba core and the exact bumper's loop once, in the controlling process, before the
+    """Compile the exact engine's numba core and the exact bumper's loop, with their batch entries, once, in the controlling process, before the
     xdist workers start: with a cold cache (a fresh clone) every worker would otherwise compile them at once (~30 s
     and ~30 s of CPU each); they load them from numba's on-disk cache instead. The two compile side by side, the loop
     in a child process (on a quiet 2-core machine ~30 s of wall time instead of ~40 s one after the other). Nothing
@@ -32,10 +32,10 @@ def pytest_sessionstart(session: pytest.Session) -> None:
         from vibroimpact.runs.run import prepare_engines
 
         bumper = engine_spec("compliant_exact")
-        child = None if bumper.kernels_cached() else subprocess.Popen([sys.executable, "-c", "from vibroimpact.runs.run import prepare_engines; prepare_engines(['compliant_exact'])"])
-        prepare_engines(["exact"])
+        child = None if bumper.kernels_cached(True) else subprocess.Popen([sys.executable, "-c", "from vibroimpact.runs.run import prepare_engines; prepare_engines(['compliant_exact'], batched=['compliant_exact'])"])
+        prepare_engines(["exact"], batched=["exact"])
         if child is not None and child.wait() != 0:
-            bumper.prepare_kernels()  # compiling here says why it failed
+            bumper.prepare_kernels(True)  # compiling here says why it failed
 
 
 @pytest.fixture

@@ -119,3 +119,17 @@ def test_an_engine_that_cannot_batch_runs_one_by_one() -> None:
 def test_no_runs() -> None:
     out = measure_motions(make_engine("exact"), [RIGID], [], [], 10, 16)
     assert out["regime"].shape == (0,)
+
+
+def test_only_a_study_that_runs_many_starts_compiles_the_batch_entry() -> None:
+    from vibroimpact.runs.run import batched_engines, study_kind
+    from vibroimpact.scene.reader import load_scene
+
+    design = load_scene("studies/design_rigid_stop.yaml")
+    assert batched_engines(study_kind(design), design) == ("exact",)
+    stepped = load_scene("studies/restitution.yaml")
+    assert batched_engines(study_kind(stepped), stepped) == ()
+    # an engine without a batch entry has nothing more to compile for it
+    from vibroimpact.engines.registry import engine_spec
+
+    assert engine_spec("momentary").prepare_kernels(batched=True) == 0.0 and engine_spec("momentary").kernels_cached(batched=True)

@@ -353,20 +353,24 @@ def _stats(counters: NDArray[np.int64], impacts: int) -> dict[str, int]:
     return {"impacts": impacts, "sticks": sticks, "releases": releases, "steps": steps, "events": events, "touches": touches}
 
 
-def kernels_cached() -> bool:
-    """Whether numba's on-disk cache holds the engine's compiled core (a check of its index; False where unsure)."""
+def kernels_cached(batched: bool = False) -> bool:
+    """Whether numba's on-disk cache holds the engine's compiled core (with ``batched``, its batch entry too; a check
+    of their indexes; False where unsure)."""
+    kernels = (exact_core.run_periods_until, batch_kernels.run_rigid_batch) if batched else (exact_core.run_periods_until,)
     try:
-        return bool(exact_core.run_periods_until._cache._cache_file._load_index())  # numba's index of cached overloads
+        return all(bool(kernel._cache._cache_file._load_index()) for kernel in kernels)  # numba's index of cached overloads
     except (AttributeError, OSError, EOFError, ValueError):  # another numba's layout: compile (or load) to be sure
         return False
 
 
-def prepare_kernels() -> float:
-    """Compile the engine's core in this process, every overload a study runs (or load it from numba's on-disk cache);
-    return the seconds spent compiling [s] (0 where cached).
+def prepare_kernels(batched: bool = False) -> float:
+    """Compile the engine's core in this process, every overload a study runs (or load it from numba's on-disk cache),
+    and with ``batched`` its batch entry (:meth:`ExactEngine.run_many`); return the seconds spent compiling [s] (0
+    where cached).
 
-    numba compiles the core on first use and caches it on disk (``@njit(cache=True)``); a cold cache costs ~30-50 s
-    of compiling. Done once before parallel workers start, they load the cached code instead of each compiling it.
+    numba compiles the core on first use and caches it on disk (``@njit(cache=True)``); a cold cache costs ~30 s of
+    compiling, the batch entry ~25 s more (numba compiles the core again inside it). Done once before parallel
+    workers start, they load the cached code instead of each compiling it.
     """
     import time
 
@@ -374,8 +378,11 @@ def prepare_kernels() -> float:
     from vibroimpact.model.excitation import HarmonicForce
     from vibroimpact.model.system import PAPER_SYSTEM
 
-    cached = kernels_cached()
+    cached = kernels_cached(batched)
     start = time.perf_counter()
     problem = ImpactProblem(PAPER_SYSTEM, (Stop(RigidStop(3e-3, 0.2), coordinate=1),), HarmonicForce(10.0, 25.0))
-    ExactEngine().integrate(problem, np.zeros(4), 0.0, 2, moments=True)
+    engine = ExactEngine()
+    engine.integrate(problem, np.zeros(4), 0.0, 2, moments=True)
+    if batched:
+        engine.run_many([problem], np.zeros(1, dtype=np.int64), np.zeros((1, 4)), 1, 2, np.ones((1, 4)), 1)
     return 0.0 if cached else time.perf_counter() - start

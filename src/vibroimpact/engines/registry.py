@@ -54,7 +54,7 @@ class Capabilities:
         one layout in one compiled call, bit for bit its single runs (:mod:`~vibroimpact.engines.batch`).
     compiled : bool
         Its kernels are compiled by numba on first use (tens of seconds) and kept in numba's on-disk cache: its module's
-        ``kernels_cached()`` says whether the cache holds them and ``prepare_kernels()`` compiles them in the calling
+        ``kernels_cached(batched)`` says whether the cache holds them and ``prepare_kernels(batched)`` compiles them in the calling
         process (or loads them from the cache), returning the seconds spent compiling (:meth:`EngineSpec.prepare_kernels`).
     """
 
@@ -118,19 +118,21 @@ class EngineSpec:
         """:data:`RIGID` or :data:`BUMPER`: the contact law of the problems it integrates."""
         return self.capabilities.contact
 
-    def kernels_cached(self) -> bool:
-        """Whether numba's on-disk cache holds the engine's compiled kernels (True for an engine with none to compile)."""
+    def kernels_cached(self, batched: bool = False) -> bool:
+        """Whether numba's on-disk cache holds the engine's compiled kernels, with ``batched`` its batch entry's too
+        (True for an engine with none to compile)."""
         if not self.capabilities.compiled:
             return True
-        cached: bool = self._module().kernels_cached()
+        cached: bool = self._module().kernels_cached(batched and self.capabilities.batched)
         return cached
 
-    def prepare_kernels(self) -> float:
-        """Compile the engine's kernels in this process, or load them from numba's on-disk cache; return the seconds
+    def prepare_kernels(self, batched: bool = False) -> float:
+        """Compile the engine's kernels in this process, or load them from numba's on-disk cache, with ``batched`` its
+        batch entry too (where it has one; a study that runs many starts at once asks for it); return the seconds
         spent compiling [s] (0 where they were cached, or the engine has none)."""
         if not self.capabilities.compiled:
             return 0.0
-        seconds: float = self._module().prepare_kernels()
+        seconds: float = self._module().prepare_kernels(batched and self.capabilities.batched)
         return seconds
 
     def _module(self) -> Any:

@@ -21,13 +21,16 @@ class KernelLoader(WorkerPlugin):  # type: ignore[misc]
     ----------
     engines : sequence of str
         Registered engine names; those without compiled kernels are skipped.
+    batched : sequence of str
+        Those whose batch entry the study runs too.
     """
 
     idempotent = True
 
-    def __init__(self, engines: Sequence[str]) -> None:
+    def __init__(self, engines: Sequence[str], batched: Sequence[str] = ()) -> None:
         self.engines = tuple(engines)
+        self.batched = tuple(batched)
 
     def setup(self, worker: object) -> None:
         for name in self.engines:
-            engine_spec(name).prepare_kernels()
+            engine_spec(name).prepare_kernels(name in self.batched)

@@ -48,7 +48,7 @@ from vibroimpact.runs.store import StudyStore
 from vibroimpact.scene.kinds import kind_named
 from vibroimpact.scene.schema import ENGINE_SOLUTIONS, Scene
 
-__all__ = ["StudyKind", "study_kind", "run_study", "prepare_engines", "atomic_path", "write_dataset", "read_dataset", "split_groups", "join_groups", "absent_value", "SIMULATED_GROUP", "netcdf_attribute", "provenance", "dataset_header", "HEADER_ATTRIBUTES"]
+__all__ = ["StudyKind", "study_kind", "batched_engines", "run_study", "prepare_engines", "atomic_path", "write_dataset", "read_dataset", "split_groups", "join_groups", "absent_value", "SIMULATED_GROUP", "netcdf_attribute", "provenance", "dataset_header", "HEADER_ATTRIBUTES"]
 
 class StudyKind(Protocol):
     """What a kind of study does with a scene (each kind's ``study.py``, registered in :data:`vibroimpact.scene.kinds.KINDS`)."""
@@ -73,13 +73,20 @@ class StudyKind(Protocol):
         ...
 
 
+def batched_engines(kind: StudyKind, scene: Scene) -> tuple[str, ...]:
+    """Those of the study's engines whose batch entry it runs (many starts in one compiled call: its
+    ``batched_engines(scene)``, where the kind has one; none otherwise): only these compile it (~20-25 s each)."""
+    named = getattr(kind, "batched_engines", None)
+    return tuple(named(scene)) if named is not None else ()
+
+
 def study_kind(scene: Scene) -> StudyKind:
     """The study of ``scene``'s kind (its module is imported now)."""
     study: StudyKind = kind_named(scene.kind).make_study()
     return study
 
 
-def prepare_engines(engines: Sequence[str], progress: Progress | None = None) -> float:
+def prepare_engines(engines: Sequence[str], progress: Progress | None = None, batched: Sequence[str] = ()) -> float:
     """Compile the kernels of the registered ``engines`` in this process, once per machine, before any worker starts;
     return the seconds it took (0 where numba's on-disk cache already holds them, or no engine has kernels).
 
@@ -87,7 +94,8 @@ def prepare_engines(engines: Sequence[str], progress: Progress | None = None) ->
     costs ~30-60 s of compiling per engine. Done here, the workers of a local cluster load the cached code (~0.1 s
     each, before their first task: :class:`~vibroimpact.runs.runner.Runner`) instead of each compiling it again at
     once inside its first point's wall time, and the user is told why the first run waits, in one line, before it does.
-    Cached kernels are loaded here too, for the work this process runs itself.
+    Cached kernels are loaded here too, for the work this process runs itself. The engines named in ``batched`` have
+    their batch entry compiled too; the others not (a scene compiles only what it runs).
     An engine is asked whether it has kernels (its capability ``compiled``), never named here.
     """
     import time
@@ -95,13 +103,14 @@ def prepare_engines(engines: Sequence[str], progress: Progress | None = None) ->
     total = 0.0
     for name in dict.fromkeys(engines):
         spec = engine_spec(name)
-        if spec.kernels_cached():
-            spec.prepare_kernels()  # loaded here too (~0.1 s): work run in this process times none of it
+        batch = name in batched
+        if spec.kernels_cached(batch):
+            spec.prepare_kernels(batch)  # loaded here too (~0.1 s): work run in this process times none of it
             continue
         if progress is not None:
             progress(f"compiling the {name} engine's kernels (first run on this machine only, ~30-60 s; later runs load them from numba's cache)")
         start = time.perf_counter()
-        spec.prepare_kernels()
+        spec.prepare_kernels(batch)
         elapsed = time.perf_counter() - start
         total += elapsed
         if progress is not None:
@@ -150,9 +159,9 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
         if kind_named(scene.kind).shares_work:
             runner.start()  # a local cluster's workers start while this process imports the kind's code (~1 s sooner)
         kind = study_kind(scene)
-        engines = kind.engines(scene)
-        prepare_engines(engines, progress)
-        runner.use_engines(engines)
+        engines, batched = kind.engines(scene), batched_engines(kind, scene)
+        prepare_engines(engines, progress, batched)
+        runner.use_engines(engines, batched)
         dataset = kind.run(scene, progress, runner)
     dataset.attrs = dataset_header(scene, dataset.attrs) | {"study_kind": kind.name}
     if runner.worker_peak_memory:

@@ -94,6 +94,7 @@ class Runner:
 
     def __init__(self, jobs: int = 1, scheduler: str | None = None, store: StudyStore | None = None, progress: bool = True, report: ProgressReport | None = None) -> None:
         self.engines: tuple[str, ...] = ()
+        self.batched: tuple[str, ...] = ()
         self.jobs = jobs
         self.scheduler = scheduler
         self.store = store
@@ -130,10 +131,12 @@ class Runner:
         """What the start of the dask connection does, in words (said before it begins, and by the bar meanwhile)."""
         return f"starting {self.jobs} worker processes" if self.scheduler is None else f"connecting to the dask scheduler at {self.scheduler}"
 
-    def use_engines(self, engines: Sequence[str]) -> None:
-        """The registered engines the work runs, their kernels compiled in this process by now
-        (:func:`vibroimpact.runs.run.prepare_engines`): each worker loads them before its next task."""
+    def use_engines(self, engines: Sequence[str], batched: Sequence[str] = ()) -> None:
+        """The registered engines the work runs (those in ``batched`` with their batch entry), their kernels compiled
+        in this process by now (:func:`vibroimpact.runs.run.prepare_engines`): each worker loads them before its next
+        task."""
         self.engines = tuple(engines)
+        self.batched = tuple(batched)
         if self._connection is not None:
             self._load_kernels()
 
@@ -142,7 +145,7 @@ class Runner:
             from vibroimpact.runs.kernel_loader import KernelLoader
 
             # every worker, and any that joins later, loads the kernels before it takes a task
-            self._connection.client.register_plugin(KernelLoader(self.engines), name="vibroimpact-kernels")  # type: ignore[attr-defined]
+            self._connection.client.register_plugin(KernelLoader(self.engines, self.batched), name="vibroimpact-kernels")  # type: ignore[attr-defined]
 
     @property
     def workers(self) -> int:

@@ -366,29 +366,33 @@ def _trajectory(problem: ImpactProblem, t_start: float, periods: int, out: Bumpe
     )
 
 
-def kernels_cached() -> bool:
-    """Whether numba's on-disk cache holds the engine's loop (its runs' and :class:`CompiledPeriod`'s; a check of its
-    index; False where unsure)."""
+def kernels_cached(batched: bool = False) -> bool:
+    """Whether numba's on-disk cache holds the engine's loop (its runs' and :class:`CompiledPeriod`'s; with
+    ``batched``, its batch entry too; a check of their indexes; False where unsure)."""
+    kernels = (exact_loop.run_bumper_periods_until, batch_loop.run_bumper_batch) if batched else (exact_loop.run_bumper_periods_until,)
     try:
-        return bool(exact_loop.run_bumper_periods_until._cache._cache_file._load_index())  # numba's index of cached overloads
+        return all(bool(kernel._cache._cache_file._load_index()) for kernel in kernels)  # numba's index of cached overloads
     except (AttributeError, OSError, EOFError, ValueError):  # another numba's layout: compile (or load) to be sure
         return False
 
 
-def prepare_kernels() -> float:
-    """Compile the engine's loop in this process, every overload a study runs (or load it from numba's on-disk cache);
-    return the seconds spent compiling [s] (0 where cached). Run once before parallel workers start, they load it
-    instead of each compiling it at once (~25 s of CPU each on a loaded 2-core machine)."""
+def prepare_kernels(batched: bool = False) -> float:
+    """Compile the engine's loop in this process, every overload a study runs (or load it from numba's on-disk cache),
+    and with ``batched`` its batch entry (:meth:`CompliantExactEngine.run_many`); return the seconds spent compiling
+    [s] (0 where cached). Run once before parallel workers start, they load it instead of each compiling it at once
+    (~25 s of CPU each on a loaded 2-core machine, the batch entry ~20 s more)."""
     import time
 
     from vibroimpact.model.contact import Stop
     from vibroimpact.model.excitation import HarmonicForce
     from vibroimpact.model.structure import LinearStructure
 
-    cached = kernels_cached()
+    cached = kernels_cached(batched)
     start = time.perf_counter()
     problem = ImpactProblem(LinearStructure(mass=[[1.0]], stiffness=[[1e4]]), (Stop(KelvinVoigtBumper(1e-3, 100.0, 0.3), coordinate=0),), HarmonicForce(100.0, 10.0))
     engine = CompliantExactEngine()
     engine.integrate(problem, np.zeros(2), 0.0, 2, moments=True, jacobians=True)
     engine.sample(problem, np.zeros(2), 0.0, 1, np.array([0.05]))
+    if batched:
+        engine.run_many([problem], np.zeros(1, dtype=np.int64), np.zeros((1, 2)), 1, 2, np.ones((1, 2)), 1)
     return 0.0 if cached else time.perf_counter() - start

@@ -392,6 +392,10 @@ class DesignStudy:
         settings: DesignSettings = scene.settings
         return (engine_for(RIGID if settings.bumper_frequency is None else BUMPER, "exact_jacobians"),)
 
+    def batched_engines(self, scene: Any) -> tuple[str, ...]:
+        """The same engine: its runs at the operating frequency and its brute force go many starts to one compiled call."""
+        return self.engines(scene)
+
     def run(self, scene: Any, progress: Progress | None, runner: Runner) -> xr.Dataset:
         """The scene's dataset (its header is :func:`~vibroimpact.runs.run.run_study`'s), with the layout it designs
         (:meth:`~vibroimpact.model.layout.Layout.attributes`, its stops at the scene's own clearance and restitution)."""
