@@ -83,6 +83,7 @@ def test_product_of_multipliers(system: TwoDofSystem, restitution: float) -> Non
     np.testing.assert_allclose(np.prod(floquet_multipliers(o), axis=-1).real, expected, rtol=1e-8, atol=1e-14)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("frequency", "stable"), [(25.0, True), (40.0, True), (38.0, False), (18.7, False)])
 def test_simulation_leaves_unstable_orbits_and_returns_to_stable_ones(system: TwoDofSystem, frequency: float, stable: bool) -> None:
     """A 1e-6 perturbation of the orbit decays where the multipliers say stable and grows where they say unstable."""

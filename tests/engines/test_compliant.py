@@ -164,6 +164,7 @@ def _paper_sweep_record(settings: EngineSettings, start: float, stop: float, sam
     return sweep, CompliantEngine(settings).sweep(ImpactProblem(PAPER_SYSTEM, bumper, sweep), sample_rate)
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(60)
 def test_sweep_settings_agree_with_a_tight_run() -> None:
     """The paper's sweep settings (rtol 1e-6, atol 1e-10 m) against rtol 1e-9 over a contact-rich 10 s (24 -> 25 Hz,
@@ -185,6 +186,7 @@ def test_sweep_settings_agree_with_a_tight_run() -> None:
     np.testing.assert_allclose(record.contact_fourier[:, 0], tight.contact_fourier[:, 0], atol=1e-4 * np.abs(tight.contact_fourier[:, 0]).max())
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(60)
 def test_sweep_record_contacts_stats_and_force_quadrature() -> None:
     """Per contact: onset, peak force and deceleration (one row each, positive); counters; samples of the bumper

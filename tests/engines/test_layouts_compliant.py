@@ -26,6 +26,7 @@ from tests.engines.test_layouts_momentary import assert_close_to_scale, chain_pr
 TIGHT = EngineSettings(rtol=1e-10, atol=1e-14)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("engine", ["compliant", "compliant_cvode_adams"])
 def test_the_paper_layout_written_generally_equals_the_named_form(engine: str) -> None:
     """Matrices and a tuple of one bumper Stop give the named form's run: strobes, moments, contacts to 1e-10."""

@@ -26,6 +26,7 @@ from tests.engine_cases import energy_budget, linear_state
 TIGHT = EngineSettings(rtol=1e-10, atol=1e-14)
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(60)
 @pytest.mark.parametrize("compiled", [True, False])
 @pytest.mark.parametrize("method", ["adams", "bdf"])

@@ -53,6 +53,7 @@ def test_the_screen_s_worst_case_is_the_steady_state_ida_marches_to() -> None:
     assert ida.converged and abs(ida.measures.x1) == pytest.approx(found.amplitude, rel=1e-7)
 
 
+@pytest.mark.slow
 def test_the_screen_s_maximum_is_the_one_continuation_locates() -> None:
     """The same bumper: continuation of every branch grown from the rigid twin's closed forms locates the band's
     maximum at the screen's value and frequency (both refine the same stable stretch's interior maximum)."""

@@ -42,6 +42,7 @@ def test_the_linear_orbit_grazes_where_q_h12_equals_the_clearance() -> None:
     assert curve.measure == "tangency" and all(o.impacts == 0 for o in curve.orbits)
 
 
+@pytest.mark.slow
 def test_the_one_impact_orbits_own_tangency_is_followed() -> None:
     """R = 0.2, 3 mm: the one-impact branch of the narrow band near 18.5 Hz ends where a free flight touches the stop
     (the extended system of the two-parameter continuation has no Jacobian there); along the traced curve the orbit

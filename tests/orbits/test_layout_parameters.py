@@ -106,6 +106,7 @@ def test_a_mass_of_a_chain_continued_against_the_closed_form() -> None:
         np.testing.assert_allclose(point.state / system.state_scale, closed_form_state(at) / system.state_scale, rtol=0.0, atol=1e-10)
 
 
+@pytest.mark.slow
 def test_a_fold_followed_in_frequency_and_k2_is_the_fold_of_each_branch() -> None:
     """The first band's fold (26.7027 Hz at K2 = 4300 N/m) followed in (frequency, K2) over 4000-4600 N/m: at a
     K2 on the curve, the frequency branch of that system has its fold at the curve's frequency (1e-9 Hz)."""

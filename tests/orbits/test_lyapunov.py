@@ -161,6 +161,7 @@ def problem_25hz() -> tuple[ImpactProblem, np.ndarray, float, object]:
     return pgf_start(25.0, 0.2)
 
 
+@pytest.mark.slow
 def test_two_trajectories_on_the_henon_map(problem_25hz: tuple) -> None:
     problem = problem_25hz[0]
     scale = state_scales(problem)

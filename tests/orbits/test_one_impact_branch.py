@@ -29,7 +29,7 @@ from vibroimpact.orbits.maps import ImpactMap, closed_form_state, section_phase,
 from vibroimpact.orbits.orbit_measures import orbit_measures
 from vibroimpact.orbits.shooting import shoot
 
-pytestmark = pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")
+pytestmark = [pytest.mark.slow, pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")]
 
 DELTA, Q, R = 3e-3, 10.0, 0.2
 BANDS = {"low": ((19.0, 29.0), 24.0), "high": ((33.0, 45.0), 37.0)}

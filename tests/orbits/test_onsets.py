@@ -28,7 +28,7 @@ from vibroimpact.orbits.continuation import continue_branch
 from vibroimpact.orbits.maps import ImpactMap
 from vibroimpact.orbits.shooting import shoot
 
-pytestmark = pytest.mark.skipif(not hasattr(CompliantExactEngine, "strobe_map"), reason="needs the compiled compliant core")
+pytestmark = [pytest.mark.slow, pytest.mark.skipif(not hasattr(CompliantExactEngine, "strobe_map"), reason="needs the compiled compliant core")]
 
 CLEARANCE, BUMPER, FORCE = 1.0, 100.0, 0.1  # [m], [N/m], [N]
 BAND = (0.08, 0.13)  # [Hz] on the 0.1 Hz system

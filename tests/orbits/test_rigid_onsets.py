@@ -22,7 +22,7 @@ from vibroimpact.orbits.continuation import continue_branch
 from vibroimpact.orbits.maps import ImpactMap, closed_form_state
 from vibroimpact.orbits.shooting import shoot
 
-pytestmark = pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")
+pytestmark = [pytest.mark.slow, pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")]
 
 DELTA, Q = 3e-3, 10.0
 

@@ -19,7 +19,7 @@ from vibroimpact.orbits.orbit_measures import branch_measures
 from vibroimpact.orbits.shooting import shoot
 from vibroimpact.orbits.worst_case import branch_maximum
 
-pytestmark = pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")
+pytestmark = [pytest.mark.slow, pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")]
 
 PROBLEM = ImpactProblem(PAPER_SYSTEM, RigidStop(0.003, 0.2), HarmonicForce(10.0, 25.0))
 

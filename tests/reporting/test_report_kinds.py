@@ -156,6 +156,7 @@ def test_the_setting_is_what_the_dataset_stores() -> None:
     np.testing.assert_array_equal(study_setting(stored).simulation_frequency, [20.0, 30.0])
 
 
+@pytest.mark.slow
 def test_one_restitution_draws_each_quantity_once(tmp_path: Path) -> None:
     """With one R, a quantity's panels per solution would each hold one series of what the simulation figure
     overlays: it is drawn once, there (a study sweeping the clearance had 32 figures of 82 twice). Another closed form

@@ -11,6 +11,7 @@ from vibroimpact.reporting.style import MIN_FONT_SIZE
 from tests.reporting.test_report_support import FIGURE_KINDS, PAGE_CONTENT_WIDTH, build, layout_problems, png_width
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", FIGURE_KINDS)
 def test_figure_reads_well_at_page_width(kind: str) -> None:
     for drawn in build(kind):

@@ -410,6 +410,7 @@ def test_cli_non_utf8_file_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_cli_runs_a_tiny_scene_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """A valid scene: exit 0, the dataset and the report are written, no temporary file is left."""
     path = write_yaml(tmp_path / "tiny.yaml", base_scene())
@@ -430,6 +431,7 @@ def test_cli_runs_a_tiny_scene_end_to_end(tmp_path: Path, capsys: pytest.Capture
     np.testing.assert_allclose(dataset["frequency"].values, np.arange(20.0, 26.0 + 0.25, 0.5))
 
 
+@pytest.mark.slow
 def test_cli_no_report_writes_only_the_dataset(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """``report: false`` in the scene: only ``<name>.nc`` is written."""
     document = scene_with(lambda d: d.update(report=False, solutions=["linear"], sweep={"frequency": [20.0, 21.0]}))

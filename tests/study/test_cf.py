@@ -206,6 +206,7 @@ def test_stepped_study_with_every_kind_of_solution_is_cf_clean(tmp_path: Path) -
     assert cf_findings(path, tmp_path / "cf.json") == []
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(120)
 def test_swept_sine_study_is_cf_clean(tmp_path: Path) -> None:
     """Running estimates over the sweep's elapsed time, string coordinates, per-run statistics."""
@@ -234,6 +235,7 @@ def test_benchmark_study_is_cf_clean(tmp_path: Path) -> None:
     assert cf_findings(path, tmp_path / "cf.json") == []
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(120)
 @pytest.mark.parametrize("case", list(KIND_CASES))
 def test_every_kind_is_cf_clean(case: str, request: pytest.FixtureRequest, tmp_path: Path) -> None:
@@ -245,6 +247,7 @@ def test_every_kind_is_cf_clean(case: str, request: pytest.FixtureRequest, tmp_p
     assert numbers_as_text(path) == []
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(120)
 def test_the_command_line_checker_exits_0_on_every_golden_dataset_and_group(tmp_path: Path) -> None:
     """``compliance-checker --test=cf:1.8`` as a pipeline runs it, on every blessed golden dataset (every shipped

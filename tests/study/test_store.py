@@ -119,6 +119,7 @@ def _interrupt_after(blocks_solved: int, scene: object, path: Path, monkeypatch:
     monkeypatch.setattr(blocks, "_solve_block", real)
 
 
+@pytest.mark.slow
 def test_a_half_written_store_resumes_with_the_missing_blocks_only(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Interrupted after some blocks (a block whose flag is not set counts as not written): the rerun solves the
     others only and the result equals an uninterrupted run."""
@@ -189,6 +190,7 @@ def test_the_block_plan_follows_the_work() -> None:
     assert plan_blocks(chain, 8).block[-1] == simulated.settings.all_frequencies.size
 
 
+@pytest.mark.slow
 def test_a_resumed_study_keeps_its_blocks_whatever_its_workers(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """The block plan depends on the workers; a study resumed with other workers (another plan) reuses the plan
     stored with its blocks, so its values land where they belong."""

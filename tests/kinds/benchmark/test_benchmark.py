@@ -124,6 +124,7 @@ def test_compliant_cvode_is_an_independent_integrator_of_the_same_model(system: 
     assert not math.isnan(a.final_state[0])
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(120)
 def test_accuracy_benchmark_with_compliant_and_swept_cases(system: TwoDofSystem) -> None:
     """Compliant methods are measured against the bumper's closed form (compliant_exact) on a stepped case and against

@@ -19,6 +19,8 @@ from vibroimpact.runs.run import run_study
 from tests.golden.golden import is_timing
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
 
+pytestmark = pytest.mark.slow  # a whole study per module: the slow tier (issue 49, measured)
+
 PAPER_MATRICES = {"mass": [[1.0, 0.0], [0.0, 0.1]], "stiffness": [[29300.0, -4300.0], [-4300.0, 4300.0]], "damping": [[0.88, -0.08], [-0.08, 0.08]], "coordinates": ["x1", "x2"]}
 #: studies/base_motion_frame.yaml's structure, base motion and two-sided stop on the absorber.
 FRAME = {

@@ -11,6 +11,8 @@ from vibroimpact.kinds.bifurcation.study import diagram_problem
 from vibroimpact.kinds.bifurcation.branches import closed_form_orbits
 from vibroimpact.runs.run import run_study
 
+pytestmark = pytest.mark.slow  # a whole study per module: the slow tier (issue 49, measured)
+
 SMALL = {
     "name": "bif_small",
     "system": {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0, "b1": 0.8, "b2": 0.08},

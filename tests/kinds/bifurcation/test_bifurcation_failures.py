@@ -63,6 +63,7 @@ def test_brute_force_points_that_fail_are_counted() -> None:
     assert failure_summary([sweep_tally("sweep", "R = 0.8", [down], ["sweeping down"], f)]) == ([], [])
 
 
+@pytest.mark.slow
 def test_the_page_says_what_failed_after_its_answer_and_the_raw_messages_at_its_end(small_bifurcation: xr.Dataset, tmp_path: Path) -> None:
     """The summary comes right after the answer, before any figure; nothing raw comes before the collapsed logs at
     the end, and the raw messages are collapsed there; a run where nothing failed says nothing of failures."""
@@ -84,6 +85,7 @@ def test_the_page_says_what_failed_after_its_answer_and_the_raw_messages_at_its_
     assert "What failed" not in write_report(clean, tmp_path / "clean").read_text(encoding="utf-8")
 
 
+@pytest.mark.slow
 def test_a_run_records_its_failures_in_its_dataset(small_bifurcation: xr.Dataset) -> None:
     """The small study's run: every "k of n failed" of ``run_failures`` adds up to its raw messages, each of which is
     also a line of the continuation log (at its place among the branches)."""

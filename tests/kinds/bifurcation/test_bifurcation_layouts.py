@@ -20,6 +20,8 @@ from vibroimpact.kinds.bifurcation.study import diagram_problem
 from vibroimpact.kinds.bifurcation.branches import ORIGINS, closed_form_orbits
 from vibroimpact.runs.run import run_study
 
+pytestmark = pytest.mark.slow  # a whole study per module: the slow tier (issue 49, measured)
+
 #: The paper's system as matrices (k1 + k2 = 29300, b1 + b2 = 0.88), force on x1: the named form's structure.
 MATRICES = {"mass": [[1.0, 0.0], [0.0, 0.1]], "stiffness": [[29300.0, -4300.0], [-4300.0, 4300.0]], "damping": [[0.88, -0.08], [-0.08, 0.08]], "coordinates": ["x1", "x2"]}
 #: The golden bifurcation scene shrunk to the one-impact branch of R = 0.2 over 20-27 Hz, which holds a grazing point

@@ -11,6 +11,8 @@ import xarray as xr
 from vibroimpact.kinds.bifurcation.page import BifurcationPage
 from vibroimpact.reporting.page import page_for, write_report
 
+pytestmark = pytest.mark.slow  # a whole study per module: the slow tier (issue 49, measured)
+
 
 @pytest.fixture
 def dataset(small_bifurcation: xr.Dataset) -> xr.Dataset:

@@ -17,6 +17,8 @@ from vibroimpact.kinds.concepts.study import ConceptsStudy, run_concepts
 
 from tests.engine_cases import orbit_force
 
+pytestmark = pytest.mark.slow  # a whole study per module: the slow tier (issue 49, measured)
+
 DOCUMENT = {
     "name": "tiny_concepts",
     "system": {"m1": 1.0, "m2": 0.1, "k1": 25000.0, "k2": 4300.0, "b1": 0.8, "b2": 0.08},

@@ -21,7 +21,7 @@ from vibroimpact.scene.reader import parse_scene
 from vibroimpact.simulation.attractors import at_frequency
 from vibroimpact.simulation.steady import steady_state
 
-pytestmark = pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")
+pytestmark = [pytest.mark.slow, pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")]
 
 #: The paper's absorber on a rigid stop over 24-27 Hz (the one-impact orbit's band), one variable, certified.
 SCENE = {

@@ -28,6 +28,8 @@ from vibroimpact.scene.reader import parse_scene
 
 import matplotlib.pyplot as plt
 
+pytestmark = pytest.mark.slow  # a whole study per module: the slow tier (issue 49, measured)
+
 FIGURES = {"design_search", "design_response", "design_robustness", "design_tradeoff"}
 
 TWO_VARIABLES = {

@@ -36,6 +36,8 @@ from tests.kinds.design.test_design_page import TWO_VARIABLES
 
 import matplotlib.pyplot as plt
 
+pytestmark = pytest.mark.slow  # a whole study per module: the slow tier (issue 49, measured)
+
 #: The studies' operating frequency [Hz] and their limits: |X1| [m], |F| [N].
 AT, X1_LIMIT, FORCE_LIMIT = 33.0, 5e-5, 2.0
 

@@ -12,6 +12,8 @@ from vibroimpact.kinds.design.study import run_design
 from vibroimpact.runs.runner import Runner
 from vibroimpact.scene.reader import parse_scene
 
+pytestmark = pytest.mark.slow  # a whole study per module: the slow tier (issue 49, measured)
+
 M1, K1, M2, Q = 1.0, 25000.0, 0.05, 10.0
 
 

@@ -56,6 +56,7 @@ def test_store_resumes_without_recomputing(system: TwoDofSystem, tmp_path: Path,
                 np.testing.assert_array_equal(a[name], b[name])
 
 
+@pytest.mark.slow
 def test_dask_workers_give_the_same_results(system: TwoDofSystem) -> None:
     cases = [_case(system, "pgf", frequencies=(25.0, 26.0)), _case(system, "pgf", engine="momentary", frequencies=(25.0,))]
     serial = Runner(jobs=1, progress=False).map(cases)

@@ -106,6 +106,7 @@ def test_a_user_system_gets_neutral_captions_and_no_paper_column(dataset: xr.Dat
     assert not any("paper fig" in line for line in page)
 
 
+@pytest.mark.slow
 def test_a_clearance_typed_in_mm_is_said_on_the_console_and_the_page(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """clearance: 2 (meant in mm, read in m) is never reached: one console line and the page's first line say so,
     with the largest |x2| of the grid (the linear one: nothing strikes) against 2000 mm, and ask whether 2 mm was meant."""

@@ -112,6 +112,7 @@ def test_failed_write_keeps_previous_file(golden_run: xr.Dataset, tmp_path: Path
     assert sorted(p.name for p in tmp_path.iterdir()) == ["x.nc"]
 
 
+@pytest.mark.slow
 def test_simulated_solutions_join_the_dataset(tmp_path: Path) -> None:
     """Engines on their own coarse grid (the file's group ``simulated``); on stable one-impact points they equal pgf;
     CLI in this process (--jobs 1; the local dask cluster's results are the same: test_cases.py)."""

@@ -15,6 +15,8 @@ from vibroimpact.runs.run import run_study
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
 
+pytestmark = pytest.mark.slow  # a whole study per module: the slow tier (issue 49, measured)
+
 
 def bumper_scene(**changes: Any) -> dict[str, Any]:
     document: dict[str, Any] = {

@@ -111,6 +111,7 @@ def test_relative_stops_sweep_names_each_coordinate_and_stop(relative_run: xr.Da
     assert float(ds["sweep_failed"].sel(sweep="up")) == 0.0 and float(ds["sweep_contacts"].sel(sweep="up")) > 20  # exact: a flag stored as float
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(120)
 def test_relative_stops_sweep_follows_the_stepped_compliant_steady_state(relative_run: xr.Dataset) -> None:
     """At 22.4 and 22.6 Hz, reached at 0.1 Hz/s, the running estimates over 8 cycles are those of the compliant
@@ -157,6 +158,7 @@ def test_a_stop_without_a_bumper_is_refused_for_a_sweep() -> None:
     assert any(p.startswith("stops[0].bumper.frequency: required") for p in caught.value.problems), caught.value.problems
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(120)
 def test_relative_stops_sweep_page_draws_every_coordinate_and_stop(relative_run: xr.Dataset, tmp_path: Path) -> None:
     """The general page: structure and stops with their linear responses, then one panel per coordinate, the force,

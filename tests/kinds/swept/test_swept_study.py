@@ -17,6 +17,8 @@ from vibroimpact.runs.run import run_study
 
 from tests.scene.test_scene import PAPER_SYSTEM_SPEC
 
+pytestmark = pytest.mark.slow  # a whole study per module: the slow tier (issue 49, measured)
+
 
 def sweep_document(**changes: Any) -> dict[str, Any]:
     """24 -> 26 Hz at 0.25 Hz/s (8 s) through stable one-impact orbits, R = 0.2, a stiff 4 kHz bumper."""

@@ -81,6 +81,7 @@ def test_bouncing_ball_brute_force_doubles_where_the_branch_does() -> None:
             assert spread > 1e-3, g
 
 
+@pytest.mark.slow
 def test_grazing_boundary() -> None:
     """The forced oscillator m x'' + c x' + k x = A cos(w t) with a stop at d starts to impact at
     A = d sqrt((k - m w^2)^2 + (c w)^2) (the linear amplitude reaches the stop; e.g. Nordmark, J. Sound Vib. 145
