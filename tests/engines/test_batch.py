@@ -133,3 +133,27 @@ def test_only_a_study_that_runs_many_starts_compiles_the_batch_entry() -> None:
     from vibroimpact.engines.registry import engine_spec
 
     assert engine_spec("momentary").prepare_kernels(batched=True) == 0.0 and engine_spec("momentary").kernels_cached(batched=True)  # exact: no compile, 0.0 returned as such
+
+
+@pytest.mark.parametrize(("name", "problem"), [("exact", RIGID), ("compliant_exact", BUMPER)])
+def test_a_chained_batch_is_the_stepped_sweep_bit_for_bit(name: str, problem: ImpactProblem) -> None:
+    # each point from the previous one's end state: stepped_sweep's single runs, in one compiled call
+    from vibroimpact.simulation.attractors import linear_start, stepped_sweep
+
+    engine = make_engine(name)
+    frequencies = np.linspace(30.0, 36.0, 7)
+    swept = stepped_sweep(problem, "down", frequencies, 80, 32, engine)
+    problems = [at_frequency(problem, f) for f in frequencies[::-1]]
+    starts = [linear_start(problems[0])] + [np.zeros(4)] * 6  # the fallbacks: never used (no run fails)
+    chained = measure_motions(engine, problems, list(range(7)), starts, 80, 32, chain_from=[-1, 0, 1, 2, 3, 4, 5])
+    for field, values in chained.items():
+        assert np.array_equal(values[::-1], swept[field], equal_nan=values.dtype.kind == "f"), field
+    assert np.all(chained["regime"] >= 0)
+    one_by_one = measure_motions(_OneByOne(), problems, list(range(7)), starts, 80, 32, chain_from=[-1, 0, 1, 2, 3, 4, 5]) if name == "exact" else chained
+    for field, values in chained.items():
+        assert np.array_equal(values, one_by_one[field], equal_nan=values.dtype.kind == "f"), field
+
+
+def test_a_chain_runs_forward_only() -> None:
+    with pytest.raises(ValueError, match="chain_from"):
+        make_engine("exact").run_many([RIGID], np.zeros(2, dtype=np.int64), np.zeros((2, 4)), 1, 16, np.ones((1, 4)), 4, np.array([1, -1]))

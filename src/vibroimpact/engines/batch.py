@@ -44,7 +44,7 @@ def _stacked(cases: Sequence[Any]) -> tuple:
 
 def run_batch(
     kernel: Callable[..., tuple], arguments: Sequence[Any], case_of: NDArray[np.int64], starts: NDArray[np.float64], transient: int, strobes: int,
-    scales: NDArray[np.float64], max_period: int,
+    scales: NDArray[np.float64], max_period: int, chain_from: NDArray[np.int64] | None = None,
 ) -> BatchRuns:  # fmt: skip
     """Run every start through ``kernel`` (a batch loop), the cases grouped by the shapes of their leading arguments.
 
@@ -64,13 +64,21 @@ def run_batch(
         The repeat test's scales per case [m, m s-1].
     max_period : int
         Longest period of the repeat test [periods].
+    chain_from : ndarray of int, shape (runs,), optional
+        Run i starts from run ``chain_from[i]``'s end state (an earlier run; ``starts[i]`` where that one failed),
+        or from ``starts[i]`` where it is -1 (default: every run from its start). Chained runs share one group.
     """
     case_of = np.asarray(case_of, dtype=np.int64)
     starts = np.ascontiguousarray(starts, dtype=float)
     scales = np.ascontiguousarray(scales, dtype=float)
+    chain_from = np.full(case_of.size, -1, dtype=np.int64) if chain_from is None else np.asarray(chain_from, dtype=np.int64)
+    if np.any(chain_from >= np.arange(case_of.size)):
+        raise ValueError("chain_from: a run starts from an earlier run's end (chain_from[i] < i) or from its start (-1)")
     groups: dict[tuple, list[int]] = {}
     for c, case in enumerate(arguments):
         groups.setdefault(_signature(case), []).append(c)
+    if len(groups) > 1 and np.any(chain_from >= 0):
+        raise ValueError("chained runs need cases whose leading arguments have one shape (one compiled call)")
     parts = []
     for members in groups.values():
         local = np.full(len(arguments), -1, dtype=np.int64)
@@ -79,7 +87,7 @@ def run_batch(
         stacked = _stacked([arguments[c] for c in members])
         total = rows.size * (transient + strobes)
         out = call_interruptibly(
-            lambda cancel: kernel(*stacked, local[case_of[rows]], starts[rows], int(transient), int(strobes), scales[members], int(max_period), cancel), total
+            lambda cancel: kernel(*stacked, local[case_of[rows]], starts[rows], chain_from[rows], int(transient), int(strobes), scales[members], int(max_period), cancel), total
         )  # fmt: skip
         parts.append((rows, out))
     if len(parts) == 1 and parts[0][0].size == case_of.size:

@@ -90,11 +90,12 @@ def run_rigid_batch(
     gapw, velw, kickw, clearances, restitutions, masses, simple, signs,
     hold_w, hold_off, hold_har, force_tolerances, bounce, stick, touch,
     sticking_velocity, max_impacts, tolerance, resolution_velocity, gl_nodes, gl_weights,
-    case_of, starts, transient, strobes, scales, max_period, cancel,
+    case_of, starts, chain_from, transient, strobes, scales, max_period, cancel,
 ):  # fmt: skip
     """Run i: case ``case_of[i]`` (its entry of every stacked leading argument of
-    :func:`~vibroimpact.engines.exact_core.run_periods_until`) from ``starts[i]`` at t = 0, ``transient`` periods,
-    then ``strobes`` periods with moments and Jacobians from the end state at t = 0; ``scales`` (cases, n) the repeat
+    :func:`~vibroimpact.engines.exact_core.run_periods_until`) from ``starts[i]`` at t = 0 (where ``chain_from[i]``
+    = j >= 0, from run j's end state, unless run j failed: a stepped sweep; j < i), ``transient`` periods, then
+    ``strobes`` periods with moments and Jacobians from the end state at t = 0; ``scales`` (cases, n) the repeat
     test's scales, ``max_period`` its longest period. Returns :func:`batch_outputs`' arrays; stops at the next step
     once ``cancel[0]`` is nonzero."""
     runs, n = starts.shape
@@ -104,7 +105,8 @@ def run_rigid_batch(
         if cancel[0] != 0:
             break
         c = case_of[i]
-        y = starts[i].copy()
+        j = chain_from[i]
+        y = kept[j, strobes].copy() if j >= 0 and status[j] == 0 else starts[i].copy()  # a sweep: the end of run j
         if transient > 0:
             first = run_periods_until(
                 lams[c], counts[c], vecs[c], invs[c], hrms[c], csts[c], zpros[c], znils[c], zdrvs[c], zdrv2s[c], polys[c], hlams[c], hcounts[c], rates_all[c], rinv_all[c], fastests[c],

@@ -268,25 +268,27 @@ class ExactEngine:
 
     def run_many(
         self, problems: Sequence[ImpactProblem], case_of: NDArray[np.int64], starts: NDArray[np.float64], transient: int, strobes: int,
-        scales: NDArray[np.float64], max_period: int,
+        scales: NDArray[np.float64], max_period: int, chain_from: NDArray[np.int64] | None = None,
     ) -> BatchRuns:  # fmt: skip
         """Many runs in one compiled call (:mod:`~vibroimpact.engines.batch_kernels`): run i is ``problems[case_of[i]]``
         from ``starts[i]`` at t = 0, ``transient`` periods dropped, ``strobes`` measured with moments and Jacobians,
         bit for bit :meth:`integrate`'s two runs; ``scales`` (cases, 2 N) the strobes' repeat test's [m, m s-1] up to
-        ``max_period``. A run with no progress keeps its status; one that would stick on two stops at once raises
+        ``max_period``; ``chain_from``: runs that start where an earlier one ended (a stepped sweep,
+        :func:`~vibroimpact.engines.batch.run_batch`). A run with no progress keeps its status; one that would stick on two stops at once raises
         :meth:`integrate`'s ``NotImplementedError``."""
         setups = [_checked_setup(self.name, problem, self.settings, max(transient, strobes)) for problem in problems]
         case_of = np.asarray(case_of, dtype=np.int64)
         begun = np.array([start_state(problems[c], state, 0.0) for c, state in zip(case_of, starts)], dtype=float).reshape(case_of.size, -1)
         for c, state in zip(case_of, begun):
             setups[c].law.check_start(state)
-        runs = run_batch(batch_kernels.run_rigid_batch, [setup.arguments for setup in setups], case_of, begun, transient, strobes, scales, max_period)
+        runs = run_batch(batch_kernels.run_rigid_batch, [setup.arguments for setup in setups], case_of, begun, transient, strobes, scales, max_period, chain_from)
         stuck = np.flatnonzero(runs.status == exact_core.STATUS_TWO_STICKS)
         if stuck.size:
             i = int(stuck[0])  # its single runs raise their message, naming both stops
             problem = problems[case_of[i]]
             end = self._run(problem, begun[i], 0.0, transient, False, False, False).strobes[-1] if transient else begun[i]
             self._run(problem, end, 0.0, strobes, True, True, False)
+            raise NotImplementedError(f"run {i} would stick on two stops at once (from a sweep's previous state); the exact engine holds one stop at a time")
         return runs
 
     def integrate(

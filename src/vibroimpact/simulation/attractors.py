@@ -143,10 +143,12 @@ def repeat_scale(problem: ImpactProblem) -> NDArray[np.float64]:
 
 def measure_motions(
     engine: Any, problems: Sequence[ImpactProblem], case_of: Sequence[int], starts: Sequence[NDArray[np.float64]], transient: int, strobes: int,
-    measure: int | Measure = 0,
+    measure: int | Measure = 0, chain_from: Sequence[int] | None = None,
 ) -> dict[str, NDArray[Any]]:  # fmt: skip
     """:func:`measure_motion` of many runs: run i from ``starts[i]`` on ``problems[case_of[i]]``; row i of the arrays
-    returned (:func:`sweep_arrays`), ``regime`` -1 where the engine made no progress.
+    returned (:func:`sweep_arrays`), ``regime`` -1 where the engine made no progress. Where ``chain_from[i]`` = j >= 0
+    (j < i), run i starts from run j's end state instead, unless run j failed (a stepped sweep, as
+    :func:`stepped_sweep` carries its state; ``starts[i]`` is then where it starts).
 
     An engine that can (capability ``batched``) runs them all in one compiled call
     (:mod:`~vibroimpact.engines.batch`), bit for bit the single runs; any other runs them one by one.
@@ -156,15 +158,18 @@ def measure_motions(
     out = sweep_arrays(runs, strobes, width)
     if runs == 0:
         return out
+    chain = [-1] * runs if chain_from is None else [int(j) for j in chain_from]
     if not getattr(engine.capabilities, "batched", False):
+        ends: list[NDArray[np.float64] | None] = [None] * runs
         for i, (c, start) in enumerate(zip(case_of, starts)):
+            begin = ends[chain[i]] if chain[i] >= 0 and ends[chain[i]] is not None else start
             try:
-                measure_motion(engine, problems[c], start, transient, strobes, out, i, measure)
+                ends[i] = measure_motion(engine, problems[c], begin, transient, strobes, out, i, measure)
             except RuntimeError:  # no progress (endless chattering): no attractor from this start
                 out["regime"][i] = -1
         return out
     scales = np.array([repeat_scale(problem) for problem in problems])
-    batch = engine.run_many(problems, np.asarray(case_of, dtype=np.int64), np.array(starts, dtype=float), transient, strobes, scales, MAX_PERIOD)
+    batch = engine.run_many(problems, np.asarray(case_of, dtype=np.int64), np.array(starts, dtype=float), transient, strobes, scales, MAX_PERIOD, np.array(chain, dtype=np.int64))
     measures = [as_measure(measure, problem) for problem in problems]
     for i, c in enumerate(case_of):
         if batch.status[i] != 0:  # no progress (endless chattering): no attractor from this start

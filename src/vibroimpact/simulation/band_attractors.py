@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from vibroimpact.analysis.measures import Measure, as_measure
 from vibroimpact.engines.registry import engine_for
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.simulation.attractors import MOTION_CLASSES, at_frequency, measure_motions, stepped_sweep, sweep_arrays
+from vibroimpact.simulation.attractors import MOTION_CLASSES, at_frequency, linear_start, measure_motions, sweep_arrays
 from vibroimpact.simulation.harmonics import gaps, linear_state, resting_state
 from vibroimpact.simulation.history import engine_of
 
@@ -190,16 +190,21 @@ def band_attractors(
     f = np.linspace(low, high, frequencies)
     runs = ("up", "down") + attractor_labels(starts)
     n, r, s = f.size, len(runs), strobes
-    rows = [stepped_sweep(problem, direction, f, transient, s, engine, measure=measure) for direction in ("up", "down")]
-    rows += [sweep_arrays(n, s, 2 * problem.size) for _ in range(starts)]
+    rows = [sweep_arrays(n, s, 2 * problem.size) for _ in range(2 + starts)]
     rng = np.random.default_rng(seed)
     moved_all = [at_frequency(problem, float(f[k])) for k in range(n)]
-    begun = [(k, j, start) for k in range(n) for j, (_label, start) in enumerate(attractor_starts(moved_all[k], starts, rng))]
-    # every start at every frequency in one call (one compiled call for an engine that batches); regime -1: no progress
-    measured_starts = measure_motions(engine, moved_all, [k for k, _j, _start in begun], [start for _k, _j, start in begun], transient, s, measure)
-    for i, (k, j, _start) in enumerate(begun):
-        for name, values in measured_starts.items():
-            rows[2 + j][name][k] = values[i]
+    # the sweeps (each point from the previous one's end, from rest after a failure: stepped_sweep's rule), then every
+    # start at every frequency: one call (one compiled call for an engine that batches); regime -1: no progress
+    begun: list[tuple[int, int, NDArray[np.float64], int]] = []
+    for j, order in enumerate((range(n), range(n - 1, -1, -1))):
+        for step, k in enumerate(order):
+            previous = len(begun) - 1 if step else -1
+            begun.append((k, j, linear_start(moved_all[k]) if not step else resting_state(moved_all[begun[previous][0]]), previous))
+    begun += [(k, 2 + j, start, -1) for k in range(n) for j, (_label, start) in enumerate(attractor_starts(moved_all[k], starts, rng))]
+    measured = measure_motions(engine, moved_all, [k for k, *_ in begun], [start for _k, _j, start, _c in begun], transient, s, measure, [c for *_, c in begun])
+    for i, (k, j, _start, _chain) in enumerate(begun):
+        for name, values in measured.items():
+            rows[j][name][k] = values[i]
     amplitude = np.full((n, r), np.nan)
     measured = np.stack([np.where(row["regime"] >= 0, np.max(row["amplitude"], axis=1), np.nan) for row in rows], axis=1)
     for k in range(n):

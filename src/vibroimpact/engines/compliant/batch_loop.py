@@ -17,7 +17,7 @@ __all__ = ["run_bumper_batch"]
 def run_bumper_batch(
     lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
     omega, period, obsw, obso, velw, salts, zero_har, gap_tolerance, force_tolerances, max_events, gl_nodes, gl_weights,
-    case_of, starts, transient, strobes, scales, max_period, cancel,
+    case_of, starts, chain_from, transient, strobes, scales, max_period, cancel,
 ):  # fmt: skip
     """Run i: case ``case_of[i]`` (its entry of every stacked leading argument of
     :func:`~vibroimpact.engines.compliant.exact_loop.run_bumper_periods_until`) from ``starts[i]`` at t = 0,
@@ -30,7 +30,8 @@ def run_bumper_batch(
         if cancel[0] != 0:
             break
         c = case_of[i]
-        y = starts[i].copy()
+        j = chain_from[i]
+        y = kept[j, strobes].copy() if j >= 0 and status[j] == 0 else starts[i].copy()  # a sweep: the end of run j
         if transient > 0:
             first = run_bumper_periods_until(
                 lams[c], counts[c], vecs[c], invs[c], hrms[c], csts[c], zpros[c], znils[c], zdrvs[c], zdrv2s[c], polys[c], hlams[c], hcounts[c], rates_all[c], rinv_all[c], fastests[c],

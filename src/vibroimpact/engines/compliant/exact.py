@@ -251,7 +251,7 @@ class CompliantExactEngine:
 
     def run_many(
         self, problems: Sequence[ImpactProblem], case_of: NDArray[np.int64], starts: NDArray[np.float64], transient: int, strobes: int,
-        scales: NDArray[np.float64], max_period: int,
+        scales: NDArray[np.float64], max_period: int, chain_from: NDArray[np.int64] | None = None,
     ) -> BatchRuns:  # fmt: skip
         """Many runs in one compiled call, bit for bit :meth:`integrate`'s (as
         :meth:`~vibroimpact.engines.exact.ExactEngine.run_many`); a run with no progress keeps its status."""
@@ -262,7 +262,7 @@ class CompliantExactEngine:
             arguments.append(_setup(problem, self.settings).arguments)
         case_of = np.asarray(case_of, dtype=np.int64)
         begun = np.array([start_state(problems[c], state, 0.0) for c, state in zip(case_of, starts)], dtype=float).reshape(case_of.size, -1)
-        return run_batch(batch_loop.run_bumper_batch, arguments, case_of, begun, transient, strobes, scales, max_period)
+        return run_batch(batch_loop.run_bumper_batch, arguments, case_of, begun, transient, strobes, scales, max_period, chain_from)
 
     def integrate(
         self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool = False, jacobians: bool = False
