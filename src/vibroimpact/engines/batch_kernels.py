@@ -25,7 +25,7 @@ from numba import njit
 from vibroimpact.engines.exact_core import run_periods_until
 from vibroimpact.engines.numba_cache import stamp_with_callees
 
-__all__ = ["KEPT_VELOCITIES", "batch_outputs", "keep_run", "run_rigid_batch"]
+__all__ = ["KEPT_VELOCITIES", "batch_outputs", "keep_run", "run_start", "end_phase", "run_rigid_batch"]
 
 #: Impact speeds kept per run, the last ones (NaN-padded) [-].
 KEPT_VELOCITIES = 64
@@ -83,6 +83,26 @@ def keep_run(i, strobes_run, jacobians_run, impacts_run, moments_run, period, sc
         mismatch[i, p - 1] = math.nan if undefined else largest
 
 
+@njit(cache=True, error_model="numpy")
+def run_start(i, starts, chain_from, status, kept):
+    """Where run i starts: where run ``chain_from[i]`` ended, if it is a run (a stepped sweep) and it did not fail;
+    else ``starts[i]`` (a copy)."""
+    j = chain_from[i]
+    return kept[j, kept.shape[1] - 1].copy() if j >= 0 and status[j] == 0 else starts[i].copy()
+
+
+@njit(cache=True, error_model="numpy")
+def end_phase(i, phase, out, period, scale, status, stopped, kept, jacobians, moments, impacts, velocities, after, mismatch):
+    """After phase ``phase`` of run i (0: the transient, 1: the measured run; ``out`` the loop's output): its failure
+    recorded (status, time; False: the run ends here), or the measured run kept (:func:`keep_run`)."""
+    if out[0] != 0:
+        status[i], stopped[i] = out[0], out[1]
+        return False
+    if phase == 1:
+        keep_run(i, out[2], out[3], out[4], out[7], period, scale, kept, jacobians, moments, impacts, velocities, after, mismatch)
+    return True
+
+
 @njit(cache=True, error_model="numpy", nogil=True)
 def run_rigid_batch(
     lams, counts, vecs, invs, hrms, csts, zpros, znils, zdrvs, zdrv2s, polys, hlams, hcounts, rates_all, rinv_all, fastests,
@@ -102,34 +122,24 @@ def run_rigid_batch(
     width = n + clearances.shape[1]
     status, stopped, kept, jacobians, moments, impacts, velocities, after, mismatch = batch_outputs(runs, strobes, n, width, max_period)
     for i in range(runs):
-        if cancel[0] != 0:
-            break
         c = case_of[i]
-        j = chain_from[i]
-        y = kept[j, strobes].copy() if j >= 0 and status[j] == 0 else starts[i].copy()  # a sweep: the end of run j
-        if transient > 0:
-            first = run_periods_until(
+        y = run_start(i, starts, chain_from, status, kept)
+        for phase in range(2):  # the transient (nothing recorded), then the measured run
+            periods = transient if phase == 0 else strobes
+            if periods == 0:
+                continue
+            out = run_periods_until(
                 lams[c], counts[c], vecs[c], invs[c], hrms[c], csts[c], zpros[c], znils[c], zdrvs[c], zdrv2s[c], polys[c], hlams[c], hcounts[c], rates_all[c], rinv_all[c], fastests[c],
                 a_matrix[c], load[c], static[c], omega[c], period[c], gapw[c], velw[c], kickw[c], clearances[c], restitutions[c], masses[c], simple[c], signs[c],
                 hold_w[c], hold_off[c], hold_har[c], force_tolerances[c], bounce[c], stick[c], touch[c],
                 sticking_velocity[c], max_impacts[c], tolerance[c], resolution_velocity[c], gl_nodes[c], gl_weights[c],
-                y, 0.0, transient, False, False, False, cancel,
+                y, 0.0, periods, phase == 1, phase == 1, False, cancel,
             )  # fmt: skip
-            if first[0] != 0:
-                status[i], stopped[i] = first[0], first[1]
-                continue
-            y = first[2][-1].copy()
-        out = run_periods_until(
-            lams[c], counts[c], vecs[c], invs[c], hrms[c], csts[c], zpros[c], znils[c], zdrvs[c], zdrv2s[c], polys[c], hlams[c], hcounts[c], rates_all[c], rinv_all[c], fastests[c],
-            a_matrix[c], load[c], static[c], omega[c], period[c], gapw[c], velw[c], kickw[c], clearances[c], restitutions[c], masses[c], simple[c], signs[c],
-            hold_w[c], hold_off[c], hold_har[c], force_tolerances[c], bounce[c], stick[c], touch[c],
-            sticking_velocity[c], max_impacts[c], tolerance[c], resolution_velocity[c], gl_nodes[c], gl_weights[c],
-            y, 0.0, strobes, True, True, False, cancel,
-        )  # fmt: skip
-        if out[0] != 0:
-            status[i], stopped[i] = out[0], out[1]
-            continue
-        keep_run(i, out[2], out[3], out[4], out[7], period[c], scales[c], kept, jacobians, moments, impacts, velocities, after, mismatch)
+            if not end_phase(i, phase, out, period[c], scales[c], status, stopped, kept, jacobians, moments, impacts, velocities, after, mismatch):
+                break
+            y = out[2][-1].copy()
+        if cancel[0] != 0:
+            break
     return status, stopped, kept, jacobians, moments, impacts, velocities, after, mismatch
 
 

@@ -4,7 +4,9 @@ design is judged by, non-periodic motions included (:func:`band_attractors`).
 At equally spaced frequencies, the stepped sweeps of :mod:`vibroimpact.simulation.attractors` run up and down (each
 carrying its end state to the next frequency), and more runs start at each frequency from the contact-free linear
 state, rest on the stops and random states of the motion's size (:func:`attractor_starts`, seeded). Each run's motion
-is measured and classified by :func:`~vibroimpact.simulation.attractors.measure_motion`; a contact-free motion's
+is measured and classified as :func:`~vibroimpact.simulation.attractors.measure_motion` does, every run (sweeps
+included) in one call of :func:`~vibroimpact.simulation.attractors.measure_motions` (one compiled call for an engine
+that batches, bit for bit the single runs); a contact-free motion's
 |X1| is the closed form's (the only contact-free attractor is the linear steady state, where it clears the stops;
 an undamped free mass's too, where it fits: no attractor, :func:`~vibroimpact.analysis.linear.contact_free_is_stable`, but
 a motion that lasts while nothing disturbs it, and a run from rest stays on it).
@@ -145,8 +147,8 @@ def band_attractors(
     """Every attractor brute force finds over ``band``, and the largest |X1| among them: the true worst case a design
     is judged by, non-periodic motions included.
 
-    At ``frequencies`` equally spaced points of the band, sweeps up and down (:func:`~vibroimpact.simulation.attractors.stepped_sweep`, each carrying its
-    end state to the next point) and ``starts`` more runs per point (:func:`attractor_starts`: the contact-free linear
+    At ``frequencies`` equally spaced points of the band, sweeps up and down (as :func:`~vibroimpact.simulation.attractors.stepped_sweep`, each carrying its
+    end state to the next point, in the same call as the starts) and ``starts`` more runs per point (:func:`attractor_starts`: the contact-free linear
     state, rest on the stops, then random states of the motion's size, seeded); each drops ``transient`` periods and
     measures ``strobes`` (:func:`~vibroimpact.simulation.attractors.measure_motion`). Every run's motion is stable by construction: it is what the flow
     settled on.

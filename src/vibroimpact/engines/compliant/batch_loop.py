@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from vibroimpact.engines.batch_kernels import batch_outputs, keep_run
+from vibroimpact.engines.batch_kernels import batch_outputs, end_phase, run_start
 from vibroimpact.engines.compliant.exact_loop import run_bumper_periods_until
 from vibroimpact.engines.numba_cache import stamp_with_callees
 
@@ -27,30 +27,22 @@ def run_bumper_batch(
     width = n + velw.shape[1]
     status, stopped, kept, jacobians, moments, impacts, velocities, after, mismatch = batch_outputs(runs, strobes, n, width, max_period)
     for i in range(runs):
-        if cancel[0] != 0:
-            break
         c = case_of[i]
-        j = chain_from[i]
-        y = kept[j, strobes].copy() if j >= 0 and status[j] == 0 else starts[i].copy()  # a sweep: the end of run j
-        if transient > 0:
-            first = run_bumper_periods_until(
+        y = run_start(i, starts, chain_from, status, kept)
+        for phase in range(2):  # the transient (nothing recorded), then the measured run
+            periods = transient if phase == 0 else strobes
+            if periods == 0:
+                continue
+            out = run_bumper_periods_until(
                 lams[c], counts[c], vecs[c], invs[c], hrms[c], csts[c], zpros[c], znils[c], zdrvs[c], zdrv2s[c], polys[c], hlams[c], hcounts[c], rates_all[c], rinv_all[c], fastests[c],
                 omega[c], period[c], obsw[c], obso[c], velw[c], salts[c], zero_har[c], gap_tolerance[c], force_tolerances[c], max_events[c], gl_nodes[c], gl_weights[c],
-                y, 0.0, transient, False, False, False, cancel,
+                y, 0.0, periods, phase == 1, phase == 1, False, cancel,
             )  # fmt: skip
-            if first[0] != 0:
-                status[i], stopped[i] = first[0], first[1]
-                continue
-            y = first[2][-1].copy()
-        out = run_bumper_periods_until(
-            lams[c], counts[c], vecs[c], invs[c], hrms[c], csts[c], zpros[c], znils[c], zdrvs[c], zdrv2s[c], polys[c], hlams[c], hcounts[c], rates_all[c], rinv_all[c], fastests[c],
-            omega[c], period[c], obsw[c], obso[c], velw[c], salts[c], zero_har[c], gap_tolerance[c], force_tolerances[c], max_events[c], gl_nodes[c], gl_weights[c],
-            y, 0.0, strobes, True, True, False, cancel,
-        )  # fmt: skip
-        if out[0] != 0:
-            status[i], stopped[i] = out[0], out[1]
-            continue
-        keep_run(i, out[2], out[3], out[4], out[7], period[c], scales[c], kept, jacobians, moments, impacts, velocities, after, mismatch)
+            if not end_phase(i, phase, out, period[c], scales[c], status, stopped, kept, jacobians, moments, impacts, velocities, after, mismatch):
+                break
+            y = out[2][-1].copy()
+        if cancel[0] != 0:
+            break
     return status, stopped, kept, jacobians, moments, impacts, velocities, after, mismatch
 
 
