@@ -247,8 +247,7 @@ class ExactEngine:
         self.settings = settings
 
     def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, jacobians: bool, approach: bool) -> LoopOutput:
-        check_run(self.name, problem, RigidStop, periods)
-        setup = loop_setup(problem, self.settings)
+        setup = _checked_setup(self.name, problem, self.settings, periods)
         state = start_state(problem, state, t_start)  # finite, 2 N values, a writable copy (one compiled overload)
         setup.law.check_start(state)
         out = LoopOutput._make(call_interruptibly(

@@ -26,7 +26,7 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.motion import classify_motion, classify_strobes
 from vibroimpact.simulation.harmonics import linear_state, resting_state
 
-__all__ = ["MOTION_CLASSES", "MAX_KEPT_IMPACTS", "MAX_PERIOD", "REPEAT_TOLERANCE", "SWEEP_FIELDS", "at_frequency", "sweep_arrays", "linear_start", "measure_motion", "measure_motions", "repeat_scale", "stepped_sweep"]
+__all__ = ["MOTION_CLASSES", "MAX_KEPT_IMPACTS", "MAX_PERIOD", "REPEAT_TOLERANCE", "SWEEP_FIELDS", "at_frequency", "sweep_arrays", "linear_start", "measure_motion", "measure_motions", "repeat_scale", "stepped_sweep", "sweep_chain"]
 
 #: What the motion at a brute-force point is (CF flags of ``brute_regime`` and ``chart_regime``, values 0...).
 MOTION_CLASSES = ("linear", "one_impact", "other_periodic", "quasi_periodic", "chaotic", "irregular")
@@ -99,6 +99,14 @@ def stepped_sweep(
         if report is not None:
             report(done + 1)
     return out | {"error": np.array(errors, dtype=str)}
+
+
+def sweep_chain(problems: Sequence[ImpactProblem], first: int = 0) -> tuple[list[NDArray[np.float64]], list[int]]:
+    """:func:`stepped_sweep`'s rule as starts and links for :func:`measure_motions`: through ``problems`` in their
+    order, the first point from :func:`linear_start`, each next one from the previous point's end state (a link to
+    that run, which is run ``first + i`` in the call), or from rest where that point failed."""
+    starts = [linear_start(problems[0])] + [resting_state(problem) for problem in problems[:-1]]
+    return starts, [-1] + [first + i for i in range(len(problems) - 1)]
 
 
 def sweep_arrays(n: int, strobes: int, width: int) -> dict[str, NDArray[Any]]:

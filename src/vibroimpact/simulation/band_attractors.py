@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 from vibroimpact.analysis.measures import Measure, as_measure
 from vibroimpact.engines.registry import engine_for
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.simulation.attractors import MOTION_CLASSES, at_frequency, linear_start, measure_motions, sweep_arrays
+from vibroimpact.simulation.attractors import MOTION_CLASSES, at_frequency, measure_motions, sweep_arrays, sweep_chain
 from vibroimpact.simulation.harmonics import gaps, linear_state, resting_state
 from vibroimpact.simulation.history import engine_of
 
@@ -198,19 +198,17 @@ def band_attractors(
     # the sweeps (each point from the previous one's end, from rest after a failure: stepped_sweep's rule), then every
     # start at every frequency: one call (one compiled call for an engine that batches); regime -1: no progress
     begun: list[tuple[int, int, NDArray[np.float64], int]] = []
-    for j, order in enumerate((range(n), range(n - 1, -1, -1))):
-        for step, k in enumerate(order):
-            previous = len(begun) - 1 if step else -1
-            begun.append((k, j, linear_start(moved_all[k]) if not step else resting_state(moved_all[begun[previous][0]]), previous))
+    for j, order in enumerate((list(range(n)), list(range(n - 1, -1, -1)))):
+        sweep_starts, links = sweep_chain([moved_all[k] for k in order], len(begun))
+        begun += [(k, j, start, link) for k, start, link in zip(order, sweep_starts, links)]
     begun += [(k, 2 + j, start, -1) for k in range(n) for j, (_label, start) in enumerate(attractor_starts(moved_all[k], starts, rng))]
-    measured = measure_motions(engine, moved_all, [k for k, *_ in begun], [start for _k, _j, start, _c in begun], transient, s, measure, [c for *_, c in begun])
-    for i, (k, j, _start, _chain) in enumerate(begun):
-        for name, values in measured.items():
+    found = measure_motions(engine, moved_all, [k for k, *_ in begun], [start for _k, _j, start, _c in begun], transient, s, measure, [c for *_, c in begun])
+    for i, (k, j, _start, _link) in enumerate(begun):
+        for name, values in found.items():
             rows[j][name][k] = values[i]
     amplitude = np.full((n, r), np.nan)
     measured = np.stack([np.where(row["regime"] >= 0, np.max(row["amplitude"], axis=1), np.nan) for row in rows], axis=1)
-    for k in range(n):
-        moved = at_frequency(problem, float(f[k]))
+    for k, moved in enumerate(moved_all):
         linear = linear_state(moved)
         # an undamped free mass's contact-free motion is no attractor (a push makes it drift), but it lasts while
         # nothing disturbs it: a run that never touched a stop counts with it, where it fits

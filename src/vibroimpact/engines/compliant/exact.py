@@ -214,6 +214,14 @@ def _setup(problem: ImpactProblem, settings: EngineSettings) -> _Setup:
     return _Setup(arguments, leading_arguments(exact_loop.sample_pieces, arguments))
 
 
+def _checked_setup(name: str, problem: ImpactProblem, settings: EngineSettings, periods: int) -> _Setup:
+    """:func:`_setup` after the checks of every run: :func:`~vibroimpact.engines.base.check_run`, and a harmonic
+    excitation (``TypeError`` naming it otherwise: a sweep has no closed form)."""
+    check_run(name, problem, KelvinVoigtBumper, periods)
+    problem.harmonic
+    return _setup(problem, settings)
+
+
 def loop_arguments(problem: ImpactProblem, settings: EngineSettings = EngineSettings()) -> BumperLoopArguments:
     """The compiled loop's leading arguments for ``problem`` (kept per problem, and what does not depend on its
     forcing frequency per problem at any frequency)."""
@@ -238,9 +246,7 @@ class CompliantExactEngine:
         self.settings = settings
 
     def _run(self, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, periods: int, moments: bool, jacobians: bool, approach: bool = False) -> BumperLoopOutput:
-        check_run(self.name, problem, KelvinVoigtBumper, periods)
-        problem.harmonic  # TypeError naming the excitation if it is not harmonic (a sweep has no closed form)
-        setup = _setup(problem, self.settings)
+        setup = _checked_setup(self.name, problem, self.settings, periods)
         state = start_state(problem, state, t_start)  # finite, 2 N values, a writable copy (one compiled overload)
         out = BumperLoopOutput._make(call_interruptibly(
             lambda cancel: exact_loop.run_bumper_periods_until(*setup.arguments, state, float(t_start), int(periods), bool(moments), bool(jacobians), bool(approach), cancel), int(periods)
@@ -255,11 +261,7 @@ class CompliantExactEngine:
     ) -> BatchRuns:  # fmt: skip
         """Many runs in one compiled call, bit for bit :meth:`integrate`'s (as
         :meth:`~vibroimpact.engines.exact.ExactEngine.run_many`); a run with no progress keeps its status."""
-        arguments = []
-        for problem in problems:
-            check_run(self.name, problem, KelvinVoigtBumper, max(transient, strobes))
-            problem.harmonic  # TypeError naming the excitation if it is not harmonic
-            arguments.append(_setup(problem, self.settings).arguments)
+        arguments = [_checked_setup(self.name, problem, self.settings, max(transient, strobes)).arguments for problem in problems]
         case_of = np.asarray(case_of, dtype=np.int64)
         begun = np.array([start_state(problems[c], state, 0.0) for c, state in zip(case_of, starts)], dtype=float).reshape(case_of.size, -1)
         return run_batch(batch_loop.run_bumper_batch, arguments, case_of, begun, transient, strobes, scales, max_period, chain_from)
