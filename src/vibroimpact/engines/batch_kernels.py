@@ -51,10 +51,17 @@ def batch_outputs(runs, strobes, n, width, max_period):
 def keep_run(i, strobes_run, jacobians_run, impacts_run, moments_run, period, scale, kept, jacobians, moments, impacts, velocities, after, mismatch):
     """Keep row ``i`` of a batch from a measured run (its strobes, Jacobians, impacts (m, >= 2): time, speed, ...,
     and moments); ``period`` [s] and ``scale`` (n,) of its case."""
-    count = strobes_run.shape[0]
-    kept[i] = strobes_run
-    jacobians[i] = jacobians_run
-    moments[i] = moments_run
+    count, n = strobes_run.shape
+    for j in range(count):  # element by element: an array-to-slice copy compiles numba's shape-error text (~4 s)
+        for r in range(n):
+            kept[i, j, r] = strobes_run[j, r]
+    for j in range(jacobians_run.shape[0]):
+        for r in range(n):
+            for c in range(n):
+                jacobians[i, j, r, c] = jacobians_run[j, r, c]
+    for j in range(moments_run.shape[0]):
+        for r in range(moments_run.shape[1]):
+            moments[i, j, r] = moments_run[j, r]
     m = impacts_run.shape[0]
     impacts[i] = m
     first = max(0, m - KEPT_VELOCITIES)
@@ -67,7 +74,6 @@ def keep_run(i, strobes_run, jacobians_run, impacts_run, moments_run, period, sc
             if impacts_run[r, 0] >= boundary:
                 total += 1
         after[i, j] = total
-    n = strobes_run.shape[1]
     for p in range(1, mismatch.shape[1] + 1):
         if count <= 2 * p:
             continue
@@ -128,12 +134,13 @@ def run_rigid_batch(
             periods = transient if phase == 0 else strobes
             if periods == 0:
                 continue
+            approach = phase > 1  # False, as a bool typed at run time: the single run's overload of the core (a literal False compiled it again, ~9 s)
             out = run_periods_until(
                 lams[c], counts[c], vecs[c], invs[c], hrms[c], csts[c], zpros[c], znils[c], zdrvs[c], zdrv2s[c], polys[c], hlams[c], hcounts[c], rates_all[c], rinv_all[c], fastests[c],
                 a_matrix[c], load[c], static[c], omega[c], period[c], gapw[c], velw[c], kickw[c], clearances[c], restitutions[c], masses[c], simple[c], signs[c],
                 hold_w[c], hold_off[c], hold_har[c], force_tolerances[c], bounce[c], stick[c], touch[c],
                 sticking_velocity[c], max_impacts[c], tolerance[c], resolution_velocity[c], gl_nodes[c], gl_weights[c],
-                y, 0.0, periods, phase == 1, phase == 1, False, cancel,
+                y, 0.0, periods, phase == 1, phase == 1, approach, cancel,
             )  # fmt: skip
             if not end_phase(i, phase, out, period[c], scales[c], status, stopped, kept, jacobians, moments, impacts, velocities, after, mismatch):
                 break

@@ -68,7 +68,11 @@ def end_period(k, y, strobes, want_jacobians, jac, jacobians):
 @njit(cache=True, error_model="numpy")
 def grow_rows(array, rows):
     bigger = np.empty((max(2 * array.shape[0], rows),) + array.shape[1:], dtype=array.dtype)
-    bigger[: array.shape[0]] = array
+    # the old rows lead a new C-ordered array, so a flat copy fills them; element by element, since an array-to-slice
+    # copy compiles numba's shape-error text (~1.5 s of a cold compile)
+    old, flat = np.ascontiguousarray(array).reshape(-1), bigger.reshape(-1)
+    for i in range(old.size):
+        flat[i] = old[i]
     return bigger
 
 

@@ -38,7 +38,8 @@ def moment_rates(lam, omega):
     vanishes: that integral is then taken by its series). Called once per flow when the engine prepares a problem."""
     m = lam.size + 2
     rates = np.empty(m, dtype=np.complex128)
-    rates[: lam.size] = lam
+    for k in range(lam.size):  # element by element: an array-to-slice copy compiles numba's shape-error text (~2 s)
+        rates[k] = lam[k]
     rates[lam.size], rates[lam.size + 1] = complex(0.0, omega), complex(0.0, -omega)
     inverse = np.zeros((m + 1, m), dtype=np.complex128)  # rows 0..m-1: 1 / (r_k + r_l); row m: 1 / (r_k - jw)
     for k in range(m):

@@ -75,7 +75,7 @@ class StudyKind(Protocol):
 
 def batched_engines(kind: StudyKind, scene: Scene) -> tuple[str, ...]:
     """Those of the study's engines whose batch entry it runs (many starts in one compiled call: its
-    ``batched_engines(scene)``, where the kind has one; none otherwise): only these compile it (~20-25 s each)."""
+    ``batched_engines(scene)``, where the kind has one; none otherwise): only these compile it (~6-10 s each)."""
     named = getattr(kind, "batched_engines", None)
     return tuple(named(scene)) if named is not None else ()
 

@@ -33,10 +33,11 @@ def run_bumper_batch(
             periods = transient if phase == 0 else strobes
             if periods == 0:
                 continue
+            approach = phase > 1  # False, as a bool typed at run time: the single run's overload of the core (a literal False compiled it again, ~9 s)
             out = run_bumper_periods_until(
                 lams[c], counts[c], vecs[c], invs[c], hrms[c], csts[c], zpros[c], znils[c], zdrvs[c], zdrv2s[c], polys[c], hlams[c], hcounts[c], rates_all[c], rinv_all[c], fastests[c],
                 omega[c], period[c], obsw[c], obso[c], velw[c], salts[c], zero_har[c], gap_tolerance[c], force_tolerances[c], max_events[c], gl_nodes[c], gl_weights[c],
-                y, 0.0, periods, phase == 1, phase == 1, False, cancel,
+                y, 0.0, periods, phase == 1, phase == 1, approach, cancel,
             )  # fmt: skip
             if not end_phase(i, phase, out, period[c], scales[c], status, stopped, kept, jacobians, moments, impacts, velocities, after, mismatch):
                 break
