@@ -9,6 +9,7 @@ with another stop (another coordinate, a second side) changes the contact and th
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import TypeVar, Union
 
 import numpy as np
@@ -249,7 +250,12 @@ class ImpactProblem:
 
     def velocity_scale(self) -> float:
         """A velocity typical of the harmonic motion [m s-1], for relative thresholds: w (Delta + q |H12|) on the
-        paper's layout, and in general w times the largest |Delta_k| + |n_k . H F| over the stops."""
+        paper's layout, and in general w times the largest |Delta_k| + |n_k . H F| over the stops (computed once per
+        problem: a frozen value's)."""
+        return self._velocity_scale
+
+    @cached_property
+    def _velocity_scale(self) -> float:
         _, static = self.load()
         minv_static = np.linalg.solve(self.structure.mass_matrix, static)
         # a static load's length: how far it moves a stop's coordinate in 1/w [s] (gravity on a free mass)

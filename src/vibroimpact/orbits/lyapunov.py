@@ -154,7 +154,7 @@ def lyapunov_from_jacobians(jacobians: ArrayLike, transient: int | None = None, 
     growth = np.empty(n)
     for k in range(n):
         v = jac[k] @ v
-        norm = float(np.linalg.norm(v))
+        norm = math.sqrt(float(v.dot(v)))  # np.linalg.norm's own arithmetic for a real vector, without its checks
         if norm == 0.0:  # exact: an annihilated tangent vector stays zero
             growth[k:] = -math.inf
             break
