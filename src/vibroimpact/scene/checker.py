@@ -7,6 +7,7 @@ allowed range) and returns the value or None, so that a parser reports every pro
 
 from __future__ import annotations
 
+import difflib
 import math
 from typing import Any
 
@@ -15,7 +16,7 @@ import numpy as np
 from vibroimpact.scene.kinds import KINDS
 from vibroimpact.scene.schema import MAX_GRID_POINTS
 
-__all__ = ["SceneError", "Checker", "interval"]
+__all__ = ["SceneError", "Checker", "interval", "did_you_mean"]
 
 
 class SceneError(ValueError):
@@ -34,6 +35,12 @@ def interval(low: float, high: float, low_inclusive: bool = True, high_inclusive
     opening = "[" if low_inclusive and math.isfinite(low) else "("
     closing = "]" if high_inclusive and math.isfinite(high) else ")"
     return f"{opening}{low:g}, {high:g}{closing}"
+
+
+def did_you_mean(given: str, allowed: list[str] | tuple[str, ...] | set[str]) -> str:
+    """``"; did you mean 'x'?"`` for the allowed name closest to ``given`` (difflib's ratio at least 0.6), else ``""``."""
+    close = difflib.get_close_matches(given, sorted(allowed), n=1)
+    return f"; did you mean {close[0]!r}?" if close else ""
 
 
 class Checker:
@@ -63,11 +70,11 @@ class Checker:
             return {}
         for unknown in sorted(set(map(str, value)) - allowed):
             if kind is None:
-                self.fail(f"{key}.{unknown}" if key else unknown, f"unknown key (allowed: {', '.join(sorted(allowed))})")
+                self.fail(f"{key}.{unknown}" if key else unknown, f"unknown key (allowed: {', '.join(sorted(allowed))}){did_you_mean(unknown, allowed)}")
                 continue
             owner = next((row.name for row in KINDS if row.section == unknown), None)
             whose = f"; it is the section of a {owner} scene" if owner is not None and owner != kind else ""
-            self.fail(f"{key}.{unknown}" if key else unknown, f"unknown key: a {kind} scene does not use it{whose} (allowed: {', '.join(sorted(allowed))})")
+            self.fail(f"{key}.{unknown}" if key else unknown, f"unknown key: a {kind} scene does not use it{whose} (allowed: {', '.join(sorted(allowed))}){did_you_mean(unknown, allowed)}")
         for missing in sorted(required - set(value)):
             self.fail(f"{key}.{missing}" if key else missing, "required key is missing")
         return value

@@ -45,6 +45,7 @@ from vibroimpact.model.layout import PAPER_STOP, Layout
 from vibroimpact.model.parameters import BUMPER_STIFFNESS, LAYOUT_FORMS, MAX_RELATIVE_SPREAD, PARAMETERS, Parameter, parameter
 from vibroimpact.model.structure import require_in_range
 from vibroimpact.scene.checker import Checker, SceneError
+from vibroimpact.scene.declared import Key, Section
 from vibroimpact.scene.header import open_scene
 from vibroimpact.scene.layout_parse import parse_layout
 from vibroimpact.scene.schema import Scene
@@ -62,7 +63,20 @@ METHODS = ("differential_evolution", "grid")
 #: What the optimum is compared with: the best linear absorber of the same mass (the paper's two masses), or nothing.
 COMPARISONS = ("linear_optimum", "none")
 _DESIGN_KEYS = {"variables", "band", "objective", "constraints", "robust", "compare", "search", "certify"}
-_SEARCH_KEYS = {"method", "population", "generations", "seed", "polish", "points"}
+_EVOLUTION = ("method", "differential_evolution")
+#: ``design.search``, declared (:mod:`vibroimpact.scene.declared`): the keys of one method are refused with the other.
+SEARCH = Section("design.search", (
+    Key("method", str, "how candidates are chosen: a global search then a local polish, or every point of a grid", "differential_evolution", choices=METHODS),
+    Key("population", int, "members of each generation per design variable", 8, 4, 100, read_when=_EVOLUTION),
+    Key("generations", int, "generations at most", 25, 1, 1000, read_when=_EVOLUTION),
+    Key("seed", int, "the search's random seed", 1, 0, 2**31 - 1, read_when=_EVOLUTION),
+    Key("polish", bool, "a Nelder-Mead polish of the best candidate after the search", True, read_when=_EVOLUTION),
+    Key("points", int, "grid points per design variable", 12, 2, 200, read_when=("method", "grid")),
+), "how candidates are chosen")  # fmt: skip
+#: ``design.certify``, declared.
+CERTIFY = Section("design.certify", (
+    Key("candidates", int, "the best candidates certified by continuation, brute force and the tolerance box's corners", 1, 0, 20),
+), "which candidates are certified")  # fmt: skip
 #: Most evaluations of one scene's search (candidates x mistuning samples).
 MAX_EVALUATIONS = 2_000_000
 
@@ -126,19 +140,19 @@ class SearchSettings:
     """How candidates are chosen: ``method`` of :data:`METHODS`; for differential evolution ``population`` (members
     per variable) and ``generations``, seeded, then a local polish; for a grid ``points`` per variable."""
 
-    method: str = "differential_evolution"
-    population: int = 8
-    generations: int = 25
-    seed: int = 1
-    polish: bool = True
-    points: int = 12
+    method: str = SEARCH.key("method").default
+    population: int = SEARCH.key("population").default
+    generations: int = SEARCH.key("generations").default
+    seed: int = SEARCH.key("seed").default
+    polish: bool = SEARCH.key("polish").default
+    points: int = SEARCH.key("points").default
 
     def __post_init__(self) -> None:
-        if self.method not in METHODS:
-            raise ValueError(f"method: {self.method!r} is not one of {METHODS}")
-        for key, value, low, high in (("population", self.population, 4, 100), ("generations", self.generations, 1, 1000), ("points", self.points, 2, 200), ("seed", self.seed, 0, 2**31 - 1)):
-            if not low <= value <= high:
-                raise ValueError(f"{key} = {value!r} is out of range: allowed [{low}, {high}]")
+        c = Checker()  # the scene's own checks (:data:`SEARCH`): a string is no boolean, 4.5 no population
+        for key in SEARCH.keys:
+            key.check(c, key.name, getattr(self, key.name))
+        if c.problems:
+            raise ValueError("; ".join(c.problems))
 
 
 @dataclass(frozen=True)
@@ -434,14 +448,10 @@ def _robust(c: Checker, value: Any, layout: Layout | None, bumper: float | None 
 
 
 def _search(c: Checker, value: Any) -> SearchSettings | None:
-    spec = c.mapping("design.search", value, _SEARCH_KEYS)
-    try:
-        return SearchSettings(**spec)
-    except (TypeError, ValueError) as error:
-        c.fail_settings("design.search", error)
-        return None
+    values = SEARCH.read(c, value)
+    return SearchSettings(**values) if values is not None else None
 
 
 def _certify(c: Checker, value: Any) -> int | None:
-    spec = c.mapping("design.certify", value, {"candidates"})
-    return c.integer("design.certify.candidates", spec.get("candidates", 1), 0, 20)
+    values = CERTIFY.read(c, value)
+    return values["candidates"] if values is not None else None

@@ -1,0 +1,200 @@
+"""Scene keys declared once: each key's type, range, unit, default and one line of documentation, from which the
+check, its messages, "did you mean" and the grammar reference all come.
+
+A :class:`Section` is a mapping of a scene (``design.search``, ``design.certify``) whose keys are :class:`Key` rows.
+Its :meth:`Section.read` checks a parsed YAML value against them and returns every key's value, the defaults
+filled in: a YAML boolean is a boolean and an integer an integer (no string is silently truthy, ``4.5`` is no
+population), a value out of range is refused with the range, an unknown key with the closest declared one, and a key
+that only another key's choice reads (``population`` with ``method: grid``) is refused rather than ignored. What it
+returns is exactly the section's keys, so a settings dataclass built from it (``Settings(**values)``) reads every
+declared key by construction (tests/scene/test_declared.py walks each section into its settings).
+
+YAML 1.2 booleans only: the scene reader gives ``no``, ``off`` and ``'false'`` as strings, which a boolean key refuses.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from vibroimpact.scene.checker import Checker, did_you_mean, interval
+
+__all__ = ["Key", "Section", "REQUIRED"]
+
+
+class _Required:
+    """The default of a key that has none: the scene must give it."""
+
+    def __repr__(self) -> str:
+        return "REQUIRED"
+
+
+#: The default of a key the scene must give.
+REQUIRED: Any = _Required()
+
+#: The YAML type each Python type of a key is written as, in messages and in the reference.
+_TYPE_NAMES = {bool: "boolean (true or false)", int: "integer", float: "number", str: "name"}
+_ARTICLES = {bool: "a", int: "an", float: "a", str: "a"}
+
+
+@dataclass(frozen=True)
+class Key:
+    """One key of a scene section.
+
+    Attributes
+    ----------
+    name : str
+        As written in the scene.
+    type : type
+        ``bool``, ``int``, ``float`` or ``str``; an integer is accepted where a number is asked, never the reverse,
+        and a boolean is no number.
+    doc : str
+        One line: what the key sets.
+    default : object
+        Its value where the scene does not give it; :data:`REQUIRED`: the scene must.
+    low, high : float
+        The allowed range, both ends included (numbers only; +-inf: unbounded).
+    unit : str
+        Its unit in brackets' words (``"Hz"``, ``"m"``; ``""`` for a pure number or a name).
+    choices : tuple of str
+        The allowed names (``str`` keys only; empty: any name).
+    read_when : tuple of (str, str), optional
+        (another key, its value): this key is read only where the other has that value; given otherwise it is refused.
+    """
+
+    name: str
+    type: type
+    doc: str
+    default: Any = REQUIRED
+    low: float = -math.inf
+    high: float = math.inf
+    unit: str = ""
+    choices: tuple[str, ...] = ()
+    read_when: tuple[str, str] | None = None
+
+    def __post_init__(self) -> None:
+        if self.type not in _TYPE_NAMES:
+            raise TypeError(f"Key {self.name!r}: type {self.type!r} is not one of bool, int, float, str")
+        if self.choices and self.type is not str:
+            raise TypeError(f"Key {self.name!r}: choices are names, for a str key only")
+        if self.default is not REQUIRED and self.check(Checker(), self.name, self.default) is None:
+            raise ValueError(f"Key {self.name!r}: its default {self.default!r} fails its own check")
+
+    def allowed(self) -> str:
+        """What the key accepts, in words: its type, then its range or its choices."""
+        if self.choices:
+            return f"one of {', '.join(self.choices)}"
+        kind = _TYPE_NAMES[self.type]
+        if self.type is int and math.isfinite(self.low) and math.isfinite(self.high):
+            return f"{kind} in [{int(self.low)}, {int(self.high)}]"
+        if self.type in (int, float) and (math.isfinite(self.low) or math.isfinite(self.high)):
+            return f"{kind} in {interval(self.low, self.high)}" + (f" [{self.unit}]" if self.unit else "")
+        return kind + (f" [{self.unit}]" if self.unit else "")
+
+    def check(self, c: Checker, where: str, value: Any) -> Any:
+        """``value`` if the key accepts it (an integer given for a number as a float), else None with the problem
+        recorded in ``c`` under ``where``."""
+        wrong = f"expected {_ARTICLES[self.type]} {_TYPE_NAMES[self.type]}, got {value!r} ({type(value).__name__})"
+        if self.type is bool:
+            if not isinstance(value, bool):
+                c.fail(where, wrong + ("; YAML 1.2 booleans are true and false" if isinstance(value, str) else ""))
+                return None
+            return value
+        if self.type is str:
+            if not isinstance(value, str):
+                c.fail(where, wrong)
+                return None
+            if self.choices and value not in self.choices:
+                c.fail(where, f"{value!r} is not allowed: allowed {', '.join(self.choices)}{did_you_mean(value, self.choices)}")
+                return None
+            return value
+        accepted = (int,) if self.type is int else (int, float)
+        if isinstance(value, bool) or not isinstance(value, accepted):
+            c.fail(where, wrong)
+            return None
+        number = self.type(value)
+        if not (math.isfinite(number) and self.low <= number <= self.high):
+            c.fail(where, f"{value!r} is out of range: allowed {self.allowed()}")
+            return None
+        return number
+
+
+@dataclass(frozen=True)
+class Section:
+    """A mapping of a scene whose keys are declared (:class:`Key`), checked and read by :meth:`read`.
+
+    Attributes
+    ----------
+    path : str
+        Where it is in a scene, dotted (``design.search``).
+    keys : tuple of Key
+        Its keys, in the order the reference lists them.
+    doc : str
+        One line: what the section sets.
+    """
+
+    path: str
+    keys: tuple[Key, ...]
+    doc: str
+
+    def __post_init__(self) -> None:
+        names = [key.name for key in self.keys]
+        if len(set(names)) != len(names):
+            raise ValueError(f"section {self.path}: a key is declared twice in {names}")
+        for key in self.keys:
+            if key.read_when is not None:
+                other = self.key(key.read_when[0])
+                if key.read_when[1] not in other.choices:
+                    raise ValueError(f"section {self.path}: {key.name} is read when {key.read_when[0]} is {key.read_when[1]!r}, not one of its choices")
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The declared keys' names."""
+        return tuple(key.name for key in self.keys)
+
+    def key(self, name: str) -> Key:
+        """The declared key ``name``."""
+        for key in self.keys:
+            if key.name == name:
+                return key
+        raise KeyError(f"section {self.path} declares no key {name!r} (its keys: {', '.join(self.names)})")
+
+    def read(self, c: Checker, value: Any) -> dict[str, Any] | None:
+        """Every declared key's value from the parsed ``value`` (None or a mapping), defaults filled in; None, with
+        every problem recorded in ``c`` (each naming its key), where anything is wrong."""
+        if value is None:
+            value = {}
+        if not isinstance(value, dict):
+            c.fail(self.path, f"expected a mapping with keys {', '.join(self.names)}, got {value!r} ({type(value).__name__})")
+            return None
+        before = len(c.problems)
+        for given in value:
+            if str(given) not in self.names:
+                c.fail(f"{self.path}.{given}", f"unknown key (allowed: {', '.join(self.names)}){did_you_mean(str(given), self.names)}")
+        read: dict[str, Any] = {}
+        for key in self.keys:
+            where = f"{self.path}.{key.name}"
+            if key.name in value:
+                read[key.name] = key.check(c, where, value[key.name])
+            elif key.default is REQUIRED:
+                c.fail(where, f"required key is missing ({key.doc}; {key.allowed()})")
+            else:
+                read[key.name] = key.default
+        for key in self.keys:
+            if key.read_when is None or key.name not in value:
+                continue
+            other, wanted = key.read_when
+            chosen = read.get(other)
+            if chosen is not None and chosen != wanted:
+                c.fail(f"{self.path}.{key.name}", f"not read with {other}: {chosen} (only with {other}: {wanted}); remove it or choose {other}: {wanted}")
+        return read if len(c.problems) == before else None
+
+    def reference(self) -> list[str]:
+        """The section's rows of the grammar reference: ``| key | allowed | default | what it sets |`` (markdown)."""
+        rows = []
+        for key in self.keys:
+            default = "required" if key.default is REQUIRED else repr(key.default).lower() if isinstance(key.default, bool) else str(key.default)
+            when = f" (read with {key.read_when[0]}: {key.read_when[1]})" if key.read_when else ""
+            rows.append(f"| `{self.path}.{key.name}` | {key.allowed()} | {default} | {key.doc}{when} |")
+        return rows

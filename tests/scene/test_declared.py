@@ -1,0 +1,164 @@
+"""Declared scene keys (issue 50, :mod:`vibroimpact.scene.declared`): every declared key walked into the settings
+the kind reads, every wrong type generated from the declaration and refused in one run naming each key (exit 2,
+nothing written), a key one method never reads refused with the other, "did you mean" for a misspelt key, and the
+Python settings refusing what the scene refuses."""
+
+from __future__ import annotations
+
+import copy
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+from vibroimpact.kinds.design.scene import CERTIFY, SEARCH, SearchSettings
+from vibroimpact.scene.checker import Checker, SceneError
+from vibroimpact.scene.declared import REQUIRED, Key, Section
+from vibroimpact.scene.reader import parse_scene, read_yaml
+
+from tests.kinds.design.test_design_scene import SCENE
+
+#: Each declared section of the design kind, and where its parsed values land in the scene's settings.
+WHERE = {SEARCH.path: lambda settings, name: getattr(settings.search, name), CERTIFY.path: lambda settings, name: settings.certified}
+
+
+def _scene(section: str, values: dict[str, Any]) -> dict:
+    document = copy.deepcopy(SCENE)
+    document["design"][section.rpartition(".")[2]] = values
+    return document
+
+
+def _other_value(key: Key) -> Any:
+    """A valid value of ``key`` other than its default."""
+    if key.type is bool:
+        return not key.default
+    if key.type is str:
+        return next(choice for choice in key.choices if choice != key.default)
+    return key.default + 1 if key.default + 1 <= key.high else key.default - 1
+
+
+def _wrong_values(key: Key) -> list[Any]:
+    """Values of the wrong type for ``key``: a string for anything else, a float for an integer, a number for a name or
+    a boolean, the YAML 1.1 spellings of a boolean."""
+    if key.type is bool:
+        return ["no", "false", 0, 1]
+    if key.type is int:
+        return [float(key.default) + 0.5, str(key.default), True]
+    if key.type is float:
+        return [str(key.default), True]
+    return [3, True]
+
+
+def _method_of(section: Section, key: Key) -> dict[str, Any]:
+    """The other keys ``key`` needs to be read (its ``read_when``)."""
+    return {key.read_when[0]: key.read_when[1]} if key.read_when else {}
+
+
+@pytest.mark.parametrize("section", [SEARCH, CERTIFY], ids=lambda s: s.path)
+def test_every_declared_key_reaches_the_settings(section: Section) -> None:
+    for key in section.keys:
+        value = _other_value(key)
+        given = _method_of(section, key) | {key.name: value}
+        settings = parse_scene(_scene(section.path, given)).settings
+        assert WHERE[section.path](settings, key.name) == value, (key.name, value)
+
+
+def test_search_settings_have_exactly_the_declared_keys() -> None:
+    fields = set(SearchSettings.__dataclass_fields__)
+    assert fields == set(SEARCH.names)
+    assert all(getattr(SearchSettings(), key.name) == key.default for key in SEARCH.keys)
+
+
+@pytest.mark.parametrize("section", [SEARCH, CERTIFY], ids=lambda s: s.path)
+def test_each_wrong_type_is_refused_naming_its_key(section: Section) -> None:
+    for key in section.keys:
+        for wrong in _wrong_values(key):
+            given = _method_of(section, key) | {key.name: wrong}
+            with pytest.raises(SceneError) as caught:
+                parse_scene(_scene(section.path, given))
+            assert any(line.startswith(f"{section.path}.{key.name}: expected") for line in caught.value.problems), (key.name, wrong, caught.value.problems)
+
+
+def test_a_scene_with_every_key_wrong_is_refused_at_once_with_exit_2_and_nothing_written(tmp_path: Path) -> None:
+    document = copy.deepcopy(SCENE)
+    document["design"]["search"] = {key.name: _wrong_values(key)[0] for key in SEARCH.keys}
+    document["design"]["certify"] = {key.name: _wrong_values(key)[0] for key in CERTIFY.keys}
+    path = tmp_path / "wrong.yaml"
+    path.write_text(yaml.safe_dump(document), encoding="utf-8")
+    out = tmp_path / "out"
+    done = subprocess.run([sys.executable, "-m", "vibroimpact.cli", str(path), "--out", str(out)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2, done.stderr
+    for section in (SEARCH, CERTIFY):
+        for key in section.keys:
+            assert f"{section.path}.{key.name}: expected" in done.stderr, (key.name, done.stderr)
+    assert not out.exists() or not any(out.iterdir())
+
+
+@pytest.mark.parametrize("spelt", ["no", "off", "false", "False", "yes", "on", "true"])
+def test_a_boolean_is_a_yaml_1_2_boolean(spelt: str) -> None:
+    text = yaml.safe_dump(_scene(SEARCH.path, {})).replace("search: {}", f"search: {{polish: {spelt}}}")
+    assert f"polish: {spelt}" in text
+    if spelt in ("true", "false", "False"):  # YAML 1.2's booleans
+        assert parse_scene(read_yaml(text)).settings.search.polish is (spelt.lower() == "true")
+        return
+    with pytest.raises(SceneError) as caught:
+        parse_scene(read_yaml(text))
+    assert any(line.startswith("design.search.polish: expected a boolean") for line in caught.value.problems), caught.value.problems
+
+
+@pytest.mark.parametrize(("given", "refused"), [({"method": "grid", "population": 8, "generations": 3}, ["population", "generations"]), ({"method": "grid", "polish": False}, ["polish"]), ({"points": 10}, ["points"])])
+def test_a_key_the_chosen_method_never_reads_is_refused(given: dict, refused: list[str]) -> None:
+    with pytest.raises(SceneError) as caught:
+        parse_scene(_scene(SEARCH.path, given))
+    for name in refused:
+        assert any(line.startswith(f"design.search.{name}: not read with method") for line in caught.value.problems), caught.value.problems
+
+
+def test_a_misspelt_key_or_name_gets_the_closest_declared_one() -> None:
+    with pytest.raises(SceneError) as caught:
+        parse_scene(_scene(SEARCH.path, {"polsh": True, "method": "grdi"}))
+    problems = caught.value.problems
+    assert any(line.startswith("design.search.polsh: unknown key") and "did you mean 'polish'?" in line for line in problems), problems
+    assert any(line.startswith("design.search.method:") and "did you mean 'grid'?" in line for line in problems), problems
+    document = copy.deepcopy(SCENE)
+    document["stop"] = {"clearence": 0.003, "restitution": 0.2}  # a hand-checked section says it too
+    with pytest.raises(SceneError) as caught:
+        parse_scene(document)
+    assert any(line.startswith("stop.clearence:") and "did you mean 'clearance'?" in line for line in caught.value.problems), caught.value.problems
+
+
+@pytest.mark.parametrize(("values", "words"), [({"polish": "no"}, "polish: expected a boolean"), ({"population": 4.5}, "population: expected an integer"), ({"points": 1}, "points: 1 is out of range"), ({"method": "annealing"}, "method: 'annealing' is not allowed")])
+def test_the_python_settings_refuse_what_the_scene_refuses(values: dict, words: str) -> None:
+    with pytest.raises(ValueError, match=words):
+        SearchSettings(**values)
+
+
+def test_a_declaration_is_checked_when_it_is_made() -> None:
+    with pytest.raises(ValueError, match="fails its own check"):
+        Key("population", int, "members", 2, 4, 100)
+    with pytest.raises(TypeError, match="for a str key only"):
+        Key("points", int, "points", 12, choices=("a",))
+    with pytest.raises(ValueError, match="declared twice"):
+        Section("s", (Key("a", int, "a", 1), Key("a", int, "a", 2)), "twice")
+    with pytest.raises(ValueError, match="not one of its choices"):
+        Section("s", (Key("method", str, "m", "x", choices=("x", "y")), Key("n", int, "n", 1, read_when=("method", "z"))), "bad")
+
+
+def test_a_required_key_is_named_with_what_it_takes_and_a_section_must_be_a_mapping() -> None:
+    section = Section("demo", (Key("count", int, "how many", REQUIRED, 1, 9), Key("name", str, "what", "a")), "a demo")
+    c = Checker()
+    assert section.read(c, {"name": "b"}) is None
+    assert c.problems == ["demo.count: required key is missing (how many; integer in [1, 9])"]
+    c = Checker()
+    assert section.read(c, {"count": 3}) == {"count": 3, "name": "a"}
+    assert section.read(c, [1, 2]) is None and c.problems[-1].startswith("demo: expected a mapping with keys count, name")
+
+
+def test_the_reference_lists_each_key_with_its_range_default_and_meaning() -> None:
+    rows = SEARCH.reference()
+    assert len(rows) == len(SEARCH.keys)
+    assert "| `design.search.population` | integer in [4, 100] | 8 | members of each generation per design variable (read with method: differential_evolution) |" in rows
+    assert any(row.startswith("| `design.search.polish` | boolean (true or false) | true |") for row in rows)
