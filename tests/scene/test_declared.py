@@ -162,3 +162,21 @@ def test_the_reference_lists_each_key_with_its_range_default_and_meaning() -> No
     assert len(rows) == len(SEARCH.keys)
     assert "| `design.search.population` | integer in [4, 100] | 8 | members of each generation per design variable (read with method: differential_evolution) |" in rows
     assert any(row.startswith("| `design.search.polish` | boolean (true or false) | true |") for row in rows)
+
+
+#: A shipped scene of each kind.
+KIND_SCENES = {"stepped": "restitution.yaml", "swept": "bumper_sweep.yaml", "design": "design_rigid_stop.yaml", "benchmark": "engine_cost.yaml",
+               "bifurcation": "bifurcation.yaml", "concepts": "absorber_concepts.yaml", "validation": "validation/zeno.yaml"}  # fmt: skip
+
+
+@pytest.mark.parametrize("kind", sorted(KIND_SCENES))
+def test_every_kind_reads_the_shared_header_s_cluster(kind: str) -> None:
+    document = read_yaml((Path(__file__).resolve().parents[2] / "studies" / KIND_SCENES[kind]).read_text(encoding="utf-8"))
+    assert parse_scene(copy.deepcopy(document)).kind == kind
+    document["cluster"] = {"scheduler": "tcp://127.0.0.1:8786"}
+    assert parse_scene(copy.deepcopy(document)).cluster_scheduler == "tcp://127.0.0.1:8786"  # honoured: the CLI runs there
+    for wrong, words in ((42, "expected a mapping"), ({"schedular": "tcp://h:1"}, "did you mean 'scheduler'?"), ({"scheduler": "nowhere"}, "expected a scheduler address")):
+        document["cluster"] = wrong
+        with pytest.raises(SceneError) as caught:
+            parse_scene(copy.deepcopy(document))
+        assert any(line.startswith("cluster") and words in line for line in caught.value.problems), (kind, wrong, caught.value.problems)

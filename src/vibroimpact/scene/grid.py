@@ -27,7 +27,7 @@ from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.modal import underdamped_mode_count
 from vibroimpact.scene.bumper_parse import BUMPER_KEYS, PHYSICAL_KEYS, scene_bumper
 from vibroimpact.scene.checker import Checker, SceneError, interval
-from vibroimpact.scene.header import check_sweep_run, open_scene, parse_cluster
+from vibroimpact.scene.header import check_sweep_run, open_scene
 from vibroimpact.scene.layout_parse import check_layout_solutions, parse_layout, parse_sweep_stops
 from vibroimpact.scene.stop_grids import stop_grids
 from vibroimpact.scene.schema import (
@@ -159,7 +159,7 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     """Validate a grid scene's document (a mapping) and build the :class:`Scene`; raise :class:`SceneError` listing
     all problems."""
     moved = isinstance(document, dict) and document.get("report") == "design_map"  # the stepped kind's old design-map page
-    c, doc, name, description, report = open_scene({**document, "report": True} if moved else document, TOP_KEYS, {"name", "system", "excitation", "sweep", "solutions"},
+    c, doc, name, description, report, scheduler = open_scene({**document, "report": True} if moved else document, TOP_KEYS, {"name", "system", "excitation", "sweep", "solutions"},
                                                    "swept" if isinstance(document, dict) and "swept_sine" in document else "stepped")  # fmt: skip
     if moved:
         c.fail("report", "the design map is the design kind's grid search: a scene with a 'design' section and 'search: {method: grid, points: N}' (studies/design_map.yaml)")
@@ -174,7 +174,6 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     if physical:
         fixed["bumper"], layout = scene_bumper(c, doc["bumper"], sweep, layout, "stops" in doc)
     solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
-    scheduler = parse_cluster(c, doc)
     specs = layout.stops if layout is not None and "stops" in doc else None
     targets = None
     if "stop" in sweep:

@@ -13,7 +13,10 @@ from typing import Any
 from vibroimpact.scene.checker import Checker
 from vibroimpact.scene.schema import MAX_SWEEP_SAMPLES
 
-__all__ = ["NAME", "MAX_NAME_LENGTH", "open_scene", "parse_names", "parse_cluster", "check_sweep_run"]
+__all__ = ["NAME", "MAX_NAME_LENGTH", "HEADER_KEYS", "open_scene", "parse_names", "parse_cluster", "check_sweep_run"]
+
+#: The keys every scene may give, whatever its kind, read once by :func:`open_scene` and honoured by every kind.
+HEADER_KEYS = frozenset({"name", "description", "report", "cluster"})
 
 #: A scene's or a case's name: safe as a file name, at most :data:`MAX_NAME_LENGTH` characters (the run writes
 #: ``.<name>.zarr.removed-<pid>`` and the like, within the 255 bytes a file name may take).
@@ -21,18 +24,19 @@ MAX_NAME_LENGTH = 100
 NAME = re.compile(rf"^[A-Za-z0-9][A-Za-z0-9_.-]{{0,{MAX_NAME_LENGTH - 1}}}$")
 
 
-def open_scene(document: Any, top_keys: set[str], required: set[str], kind: str) -> tuple[Checker, dict, Any, str, bool]:
+def open_scene(document: Any, top_keys: set[str], required: set[str], kind: str) -> tuple[Checker, dict, Any, str, bool, str | None]:
     """How a kind's scene parser begins: a new :class:`Checker`, ``document`` checked as a mapping of the kind's
-    ``top_keys`` with the ``required`` ones (a key of another kind named as such), and its :func:`parse_names`.
+    ``top_keys`` and the :data:`HEADER_KEYS` with the ``required`` ones (a key of another kind named as such), its
+    :func:`parse_names` and its :func:`parse_cluster`: the header every kind reads the same way.
 
     Returns
     -------
     tuple
-        (checker, the document as a mapping, name, description, report).
+        (checker, the document as a mapping, name, description, report, the cluster's scheduler or None).
     """
     c = Checker()
-    doc = c.mapping("", document, top_keys, required, kind=kind)
-    return (c, doc, *parse_names(c, doc))
+    doc = c.mapping("", document, set(top_keys) | HEADER_KEYS, required, kind=kind)
+    return (c, doc, *parse_names(c, doc), parse_cluster(c, doc))
 
 
 def parse_names(c: Checker, doc: dict) -> tuple[Any, str, bool]:

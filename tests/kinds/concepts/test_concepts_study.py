@@ -38,7 +38,7 @@ SYSTEM = TwoDofSystem(1.0, 0.1, 25000.0, 4300.0, 0.8, 0.08)
 
 @pytest.fixture(scope="module")
 def dataset() -> xr.Dataset:
-    _name, _description, _report, settings = parse_concepts(copy.deepcopy(DOCUMENT))
+    _name, _description, _report, settings, _scheduler = parse_concepts(copy.deepcopy(DOCUMENT))
     return run_concepts(settings, progress=None)
 
 

@@ -204,7 +204,7 @@ class _Layout:
 def parse_benchmark_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
     """Validate a benchmark scene's document (a mapping with ``benchmark``) and build the :class:`Scene`; raise
     :class:`SceneError` listing all problems."""
-    c, doc, name, description, report = open_scene(document, BENCHMARK_TOP_KEYS, {"name", "system", "excitation", "benchmark"}, "benchmark")
+    c, doc, name, description, report, scheduler = open_scene(document, BENCHMARK_TOP_KEYS, {"name", "system", "excitation", "benchmark"}, "benchmark")
     parsed, amplitude, _ = parse_layout(c, doc)
     layout = _Layout(parsed, amplitude) if parsed is not None and amplitude is not None else None
     spec = c.mapping("benchmark", doc["benchmark"], _BENCHMARK_KEYS, {"duration", "methods", "tolerances", "cases"}) if "benchmark" in doc else {}
@@ -243,6 +243,7 @@ def parse_benchmark_scene(document: dict, text: str = "", source: str = "scene")
         settings=BenchmarkScene(tuple(cases), settings),
         report=report,
         text=text,
+        cluster_scheduler=scheduler,
     )
 
 

@@ -279,7 +279,7 @@ _CHART_KEYS = {"restitution", "clearance", "kinds", "max_steps", "frequency_step
 def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
     """Validate a bifurcation scene's document (a mapping with ``bifurcation``) and build the :class:`Scene`; raise
     :class:`SceneError` listing all problems."""
-    c, doc, name, description, report = open_scene(document, BIFURCATION_TOP_KEYS, {"name", "system", "excitation", "bifurcation"}, "bifurcation")
+    c, doc, name, description, report, scheduler = open_scene(document, BIFURCATION_TOP_KEYS, {"name", "system", "excitation", "bifurcation"}, "bifurcation")
     layout, amplitude, _ = parse_layout(c, doc)
     if layout is not None and static_drift(layout):
         c.fail("excitation.static", "the static force pushes the structure along a rigid-body mode: it has no steady state to follow")
@@ -340,6 +340,7 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
         settings=settings,
         report=report,
         text=text,
+        cluster_scheduler=scheduler,
     )
 
 

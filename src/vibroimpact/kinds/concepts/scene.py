@@ -160,10 +160,10 @@ MAX_CONCEPTS = 12
 MAX_SIMULATION_POINTS = 2000
 
 
-def parse_concepts(document: Any, source: str = "scene") -> tuple[str, str, bool, ConceptsSettings]:
-    """Check a concepts scene's document and return (name, description, report, settings); :class:`SceneError`
-    listing every problem otherwise."""
-    c, doc, name, description, report = open_scene(document, CONCEPTS_TOP_KEYS, {"name", "system", "excitation", "frequency", "concepts"}, "concepts")
+def parse_concepts(document: Any, source: str = "scene") -> tuple[str, str, bool, ConceptsSettings, str | None]:
+    """Check a concepts scene's document and return (name, description, report, settings, the cluster's scheduler);
+    :class:`SceneError` listing every problem otherwise."""
+    c, doc, name, description, report, scheduler = open_scene(document, CONCEPTS_TOP_KEYS, {"name", "system", "excitation", "frequency", "concepts"}, "concepts")
     layout, amplitude, _ = parse_layout(c, doc)
     system = layout.paper_view() if layout is not None else None  # the absorber concepts are variants of the paper's layout
     if layout is not None and system is None:
@@ -190,7 +190,7 @@ def parse_concepts(document: Any, source: str = "scene") -> tuple[str, str, bool
     assert isinstance(name, str) and system is not None and amplitude is not None and frequency is not None and simulation is not None
     sim_frequency, engine, steady = simulation
     settings = ConceptsSettings(system, amplitude, concepts, frequency, sim_frequency, engine, steady, bumper_frequency, steps)
-    return name, description, report, settings
+    return name, description, report, settings, scheduler
 
 
 def parse_concepts_scene(document: Any, text: str = "", source: str = "scene") -> Any:
@@ -198,9 +198,10 @@ def parse_concepts_scene(document: Any, text: str = "", source: str = "scene") -
     :class:`ConceptsSettings`; :attr:`Scene.kind` is then ``concepts``)."""
     from vibroimpact.scene.schema import Scene
 
-    name, description, report, settings = parse_concepts(document, source)
+    name, description, report, settings, scheduler = parse_concepts(document, source)
     return Scene(
         name=name, description=description, layout=Layout(settings.system), amplitude=settings.amplitude, kind="concepts", settings=settings, report=report, text=text,
+        cluster_scheduler=scheduler,
     )  # fmt: skip
 
 

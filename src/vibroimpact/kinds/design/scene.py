@@ -232,7 +232,7 @@ class DesignSettings:
 def parse_design_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
     """Validate a design scene's document (a mapping with ``design``) and build the :class:`Scene`; raise
     :class:`SceneError` listing all problems."""
-    c, doc, name, description, report = open_scene(document, DESIGN_TOP_KEYS, {"name", "system", "excitation", "design"}, "design")
+    c, doc, name, description, report, scheduler = open_scene(document, DESIGN_TOP_KEYS, {"name", "system", "excitation", "design"}, "design")
     layout, amplitude, coordinates = parse_layout(c, doc)
     clearance, restitution, bumper = _stop_values(c, doc, layout)
     spec = c.mapping("design", doc.get("design"), _DESIGN_KEYS, {"variables", "band"}) if "design" in doc else {}
@@ -262,7 +262,8 @@ def parse_design_scene(document: dict, text: str = "", source: str = "scene") ->
     assert clearance is not None and restitution is not None and samples is not None and seed is not None and quantile is not None and certified is not None
     settings = DesignSettings(variables, band, objective_measure, objective_measure.name, operating, mistuning, samples, seed, quantile, str(compare), search, certified, clearance,
                               restitution, bumper, constraint)  # fmt: skip
-    return Scene(name=name, description=description, layout=layout, amplitude=amplitude, kind="design", settings=settings, report=report, text=text)
+    return Scene(name=name, description=description, layout=layout, amplitude=amplitude, kind="design", settings=settings, report=report, text=text,
+                 cluster_scheduler=scheduler)
 
 
 def _stop_values(c: Checker, doc: dict, layout: Layout | None) -> tuple[float | None, float | None, float | None]:

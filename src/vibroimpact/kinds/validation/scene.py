@@ -134,6 +134,8 @@ class ValidationScene:
         Whether ``run-study`` writes the report.
     text : str
         The YAML source.
+    cluster_scheduler : str or None
+        The scene's ``cluster: {scheduler: ADDRESS}`` (None: a local cluster).
     """
 
     name: str
@@ -141,6 +143,7 @@ class ValidationScene:
     settings: ValidationSettings
     report: bool = True
     text: str = ""
+    cluster_scheduler: str | None = None
 
 
 def validation_settings(c: Checker, value: Any) -> ValidationSettings | None:
@@ -218,7 +221,7 @@ def _consistent(c: Checker, case: str, values: dict[str, Any]) -> bool:
 def read_validation_scene(document: Any, text: str = "", source: str = "scene") -> ValidationScene:
     """Check a validation scene's document (a mapping with ``validation``); raise :class:`SceneError` listing all
     problems."""
-    c, doc, name, description, report = open_scene(document, VALIDATION_TOP_KEYS, {"name", "validation"}, "validation")
+    c, doc, name, description, report, scheduler = open_scene(document, VALIDATION_TOP_KEYS, {"name", "validation"}, "validation")
     settings = validation_settings(c, doc["validation"]) if "validation" in doc else None
     if settings is not None and not c.problems:
         case = settings.case
@@ -232,7 +235,7 @@ def read_validation_scene(document: Any, text: str = "", source: str = "scene") 
     if c.problems:
         raise SceneError(c.problems, source)
     assert isinstance(name, str) and settings is not None
-    return ValidationScene(name, description, settings, report, text)
+    return ValidationScene(name, description, settings, report, text, scheduler)
 
 
 def parse_validation_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
@@ -249,4 +252,5 @@ def parse_validation_scene(document: Any, text: str = "", source: str = "scene")
         settings=checked.settings,
         report=checked.report,
         text=text,
+        cluster_scheduler=checked.cluster_scheduler,
     )
