@@ -57,6 +57,26 @@ def test_an_unreachable_scheduler_is_refused_before_any_work(tmp_path: Path, mon
     assert not out.exists()
 
 
+@pytest.mark.parametrize("jobs", ["0", "1000", str(cluster.local_worker_limit() + 1)])
+def test_a_worker_count_beyond_the_machine_is_refused_before_any_work(tmp_path: Path, capsys: pytest.CaptureFixture[str], jobs: str) -> None:
+    """``--jobs 1000`` on a 2-core machine once started 1000 workers and ran out of memory after 341 s: refused at
+    once (exit 2, nothing written), naming the option and the range this machine allows."""
+    out = tmp_path / "out"
+    assert cli.main([str(_scene_file(tmp_path)), "--jobs", jobs, "--out", str(out)]) == cli.EXIT_BAD_INPUT
+    said = capsys.readouterr().err
+    assert f"--jobs = {jobs} is out of range: allowed an integer in [1, {cluster.local_worker_limit()}] on this machine" in said, said
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("jobs", [0, 1000, 1.5, True])
+def test_the_python_runner_refuses_the_same_worker_counts(jobs: object) -> None:
+    from vibroimpact.runs.runner import Runner
+
+    with pytest.raises(ValueError, match=r"jobs = .* is out of range: allowed an integer in \[1, "):
+        Runner(jobs=jobs, progress=False)  # type: ignore[arg-type]
+    assert Runner(jobs=cluster.local_worker_limit(), progress=False).jobs == cluster.local_worker_limit()  # starts nothing yet
+
+
 def test_keep_zarr_keeps_the_store_beside_the_netcdf_file(tmp_path: Path) -> None:
     scene = _scene_file(tmp_path)
     assert cli.main([str(scene), "--out", str(tmp_path / "kept"), "--jobs", "1", "--keep-zarr"]) == 0

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 
 from vibroimpact.scene import Scene, SceneError, find_scene, load_scene, shipped_studies
-from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, ClusterLost, Terminated, choose_scheduler, dashboard_address, leave_quietly, unreachable
+from vibroimpact.runs.cluster import SCHEDULER_VARIABLE, ClusterLost, Terminated, check_jobs, choose_scheduler, dashboard_address, leave_quietly, unreachable
 
 if TYPE_CHECKING:  # the run's modules (xarray, zarr, dask) load only once a study runs: help, --list and a refused
     from vibroimpact.runs.store import StudyStore  # scene answer without them
@@ -110,8 +110,10 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     local = args.jobs is not None  # an explicit --jobs runs here, unless --scheduler is given too
     args.jobs = args.jobs if args.jobs is not None else os.cpu_count() or 1
-    if args.jobs < 1:
-        print(f"run-study: error: --jobs {args.jobs} is out of range: allowed [1, inf)", file=sys.stderr)
+    try:
+        check_jobs(args.jobs, "--jobs")
+    except ValueError as error:
+        print(f"run-study: error: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
     scheduler = args.scheduler if local else choose_scheduler(args.scheduler, scene.cluster_scheduler)
     if args.workers is not None and not args.estimate:

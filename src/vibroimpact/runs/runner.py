@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 
 from vibroimpact import __version__
 from vibroimpact.engines.registry import engine_spec
-from vibroimpact.runs.cluster import ClusterLost, Connection, connect, import_libraries, leave_quietly, ProgressBar, ProgressReport, Throttled
+from vibroimpact.runs.cluster import ClusterLost, Connection, check_jobs, connect, import_libraries, leave_quietly, ProgressBar, ProgressReport, Throttled
 from vibroimpact.runs.fingerprints import source_hash
 from vibroimpact.runs.store import StudyStore
 
@@ -95,7 +95,7 @@ class Runner:
     def __init__(self, jobs: int = 1, scheduler: str | None = None, store: StudyStore | None = None, progress: bool = True, report: ProgressReport | None = None) -> None:
         self.engines: tuple[str, ...] = ()
         self.batched: tuple[str, ...] = ()
-        self.jobs = jobs
+        self.jobs = check_jobs(jobs) if scheduler is None else jobs  # refused before anything starts
         self.scheduler = scheduler
         self.store = store
         self.progress = progress and report is None
