@@ -344,7 +344,10 @@ def continue_branch(system: ParametrisedMap, orbit: PeriodicOrbit, parameter: st
         The points in arclength order with the located special points. ``end`` says why the continuation stopped;
         both ways, it is ``"<first end>, <last end>"``.
     """
-    index = list(system.parameter_names).index(parameter)
+    names = list(system.parameter_names)
+    if parameter not in names:  # a layout scalar is continued once the map carries it (ImpactMap(layout=[...]))
+        raise ValueError(f"parameter = {parameter!r} is not one of the map's parameters: allowed {', '.join(names)} (a layout scalar such as 'k2' or 'mass[x2]' once the map is built with layout=[...])")
+    index = names.index(parameter)
     if direction not in (1, -1, 0):
         raise ValueError(f"direction = {direction!r}: allowed 1, -1, 0")
     walker = _Walker(system, orbit, index, settings)

@@ -144,8 +144,8 @@ class ImpactMap:
         problem.harmonic  # noqa: B018 - raises TypeError naming the part unless a harmonic force
         self.stops = stop_selection(problem, stop)
         self.stop = stop
-        if int(periods) < 1:
-            raise ValueError(f"periods = {periods!r} is out of range: allowed [1, inf)")
+        if isinstance(periods, bool) or not isinstance(periods, (int, np.integer)) or periods < 1:  # 1.7 is no count of periods
+            raise ValueError(f"periods = {periods!r} is out of range: allowed an integer in [1, inf)")
         self.problem, self.periods = problem, int(periods)
         self.contact = problem.contact_law
         self.engine = engine if engine is not None else make_engine(engine_for(self.contact, "exact_jacobians"))

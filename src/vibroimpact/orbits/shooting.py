@@ -145,10 +145,15 @@ def shoot(system: ParametrisedMap, guess: ArrayLike, parameters: ArrayLike, peri
         No convergence (with the residual history), a non-finite map value, or a sticking orbit when
         ``settings.allow_sticking`` is False.
     """
-    mapping: ParametrisedMap = Iterated(system, period) if period != 1 else system
-    scale = np.asarray(mapping.state_scale, dtype=float)
+    if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period < 1:
+        raise ValueError(f"period = {period!r} is out of range: allowed an integer in [1, inf) (excitation periods)")
     p = np.array(parameters, dtype=float)
     y = np.array(guess, dtype=float)
+    for name, values, size in (("guess", y, getattr(system, "dimension", y.size)), ("parameters", p, len(getattr(system, "parameter_names", p)))):
+        if values.shape != (size,) or not np.all(np.isfinite(values)):  # refused here, not as a map that failed
+            raise ValueError(f"{name}: expected {size} finite values, got {values.tolist()!r}")
+    mapping: ParametrisedMap = Iterated(system, period) if period != 1 else system
+    scale = np.asarray(mapping.state_scale, dtype=float)
     identity = np.eye(y.size)
     out = mapping.evaluate(y, p)
     r = scaled_residual(out, y, scale)
