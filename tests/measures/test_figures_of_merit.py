@@ -115,7 +115,7 @@ DOCUMENT = {
 
 
 def test_a_concepts_scene() -> None:
-    name, _description, report, settings = parse_concepts(DOCUMENT)
+    name, _description, report, settings, _scheduler = parse_concepts(DOCUMENT)
     optimum = den_hartog_absorber(1.0, 25000.0, 0.1)
     dh, paper_k2, stop, rel = settings.concepts
     assert name == "tiny" and report and settings.simulation_frequency.tolist() == [25.0, 34.0] and math.isnan(settings.bumper_frequency)
@@ -156,7 +156,7 @@ def test_the_shipped_scene() -> None:
     from vibroimpact.scene.reader import read_yaml
 
     document = read_yaml((shipped_studies_dir() / "absorber_concepts.yaml").read_text(encoding="utf-8"))
-    name, _description, _report, settings = parse_concepts(document)
+    name, _description, _report, settings, _scheduler = parse_concepts(document)
     optimum = den_hartog_absorber(1.0, 25000.0, 0.1)
     concepts = {c.name: c for c in settings.concepts}
     assert name == "absorber_concepts" and settings.bumper_frequency == 250.0 and settings.amplitude == 10.0  # exact: parsed inputs

@@ -15,7 +15,7 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.system import PAPER_SYSTEM
 from vibroimpact.orbits.continuation import continue_branch
 from vibroimpact.orbits.maps import ImpactMap
-from vibroimpact.orbits.shooting import shoot
+from vibroimpact.orbits.shooting import ShootingError, shoot
 
 PROBLEM = ImpactProblem(PAPER_SYSTEM, RigidStop(3e-3, 0.2), HarmonicForce(10.0, 25.0))
 
@@ -33,13 +33,14 @@ def test_a_continued_parameter_is_one_the_map_has() -> None:
         continue_branch(system, None, "mass[5,5]")  # type: ignore[arg-type]
 
 
-@pytest.mark.parametrize(("guess", "parameters", "period", "words"), [
-    ([math.nan, 0.0, 0.0, 0.0], None, 1, r"guess: expected 4 finite values, got \[nan, 0.0, 0.0, 0.0\]"),
-    ([0.0, 0.0, 0.0], None, 1, "guess: expected 4 finite values"),
-    ([0.0, 0.0, 0.0, 0.0], [math.inf, 0.2, 3e-3, 10.0, 0.0], 1, "parameters: expected 5 finite values"),
-    ([0.0, 0.0, 0.0, 0.0], None, 1.5, r"period = 1.5 is out of range"),
+@pytest.mark.parametrize(("guess", "parameters", "period", "error", "words"), [
+    ([math.nan, 0.0, 0.0, 0.0], None, 1, ShootingError, "the guess is not finite"),  # a failed seed: counted as a failed shot
+    ([0.0, 0.0, 0.0, 0.0], [math.inf, 0.2, 3e-3, 10.0, 0.0], 1, ShootingError, "the parameters is not finite"),
+    ([0.0, 0.0, 0.0], None, 1, ValueError, r"guess: expected 4 values, got \[0.0, 0.0, 0.0\]"),
+    ([0.0, 0.0, 0.0, 0.0], [25.0, 0.2], 1, ValueError, "parameters: expected 5 values"),
+    ([0.0, 0.0, 0.0, 0.0], None, 1.5, ValueError, r"period = 1.5 is out of range"),
 ])  # fmt: skip
-def test_shooting_names_the_input_it_cannot_start_from(guess: list[float], parameters: list[float] | None, period: object, words: str) -> None:
+def test_shooting_names_the_input_it_cannot_start_from(guess: list[float], parameters: list[float] | None, period: object, error: type, words: str) -> None:
     system = ImpactMap(PROBLEM)
-    with pytest.raises(ValueError, match=words):
+    with pytest.raises(error, match=words):
         shoot(system, guess, system.parameters if parameters is None else parameters, period)  # type: ignore[arg-type]

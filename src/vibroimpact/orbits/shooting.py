@@ -150,8 +150,10 @@ def shoot(system: ParametrisedMap, guess: ArrayLike, parameters: ArrayLike, peri
     p = np.array(parameters, dtype=float)
     y = np.array(guess, dtype=float)
     for name, values, size in (("guess", y, getattr(system, "dimension", y.size)), ("parameters", p, len(getattr(system, "parameter_names", p)))):
-        if values.shape != (size,) or not np.all(np.isfinite(values)):  # refused here, not as a map that failed
-            raise ValueError(f"{name}: expected {size} finite values, got {values.tolist()!r}")
+        if values.shape != (size,):
+            raise ValueError(f"{name}: expected {size} values, got {values.tolist()!r}")
+        if not np.all(np.isfinite(values)):  # said of the input, not as a map that failed; a failed seed's state is one
+            raise ShootingError(f"the {name} is not finite: no orbit can be shot from it")
     mapping: ParametrisedMap = Iterated(system, period) if period != 1 else system
     scale = np.asarray(mapping.state_scale, dtype=float)
     identity = np.eye(y.size)

@@ -28,7 +28,7 @@ PROBLEM = ImpactProblem(PAPER_SYSTEM.structure, (Stop(RigidStop(3e-3, 0.2), coor
 
 @pytest.mark.skipif(not hasattr(ExactEngine, "strobe_map"), reason="needs the compiled exact core (ExactEngine.strobe_map)")
 def test_seeds_that_fail_are_counted_and_summarised() -> None:
-    """Two seeds whose state is not finite: shooting from them fails with the map's non-finite state, the run goes on,
+    """Two seeds whose state is not finite: shooting from them fails, saying so of the guess, the run goes on,
     and the summary says 2 of 2 failed, why, and what that means; the raw messages are kept, one per seed."""
     nan = (float("nan"),) * 4
     found = OrbitSet()
@@ -39,7 +39,7 @@ def test_seeds_that_fail_are_counted_and_summarised() -> None:
     lines, details = failure_summary(tallies(result, "R = 0.2"))
     meaning = FAILURES["seed"].meaning
     which = "which: brute-force seed at 25.000 Hz (period 1); brute-force seed at 25.500 Hz (period 2)"
-    assert lines == [f"{FAILURES['seed'].what}, R = 0.2: 2 of 2 failed (2 with 'the map returned a non-finite state'; {which}); {meaning}"]
+    assert lines == [f"{FAILURES['seed'].what}, R = 0.2: 2 of 2 failed (2 with 'the guess is not finite: no orbit can be shot from it'; {which}); {meaning}"]
     assert len(details) == 2 and all(d.startswith("R = 0.2: brute-force seed at 25") and "ShootingError" in d for d in details)
     said: list[str] = []
     _say_notes(said.append, "R = 0.2", result)  # the console: the notes without the raw failures
