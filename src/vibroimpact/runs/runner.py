@@ -104,6 +104,9 @@ class Runner:
         self._connection: Connection | None = None
         #: The largest resident memory of one worker process [bytes], read when the connection closes (0: none ran).
         self.worker_peak_memory = 0
+        #: What the store gave back instead of computing it: unit (cases, blocks) -> [reused, of all asked].
+        self.reuse: dict[str, list[int]] = {}
+        self._saved: set[str] = set()  # the cases this runner stored itself
 
     @property
     def distributed(self) -> bool:
@@ -153,6 +156,18 @@ class Runner:
         if self.scheduler is None:
             return self.jobs
         return self.connection.workers
+
+    def note_reused(self, unit: str, reused: int, total: int) -> None:
+        """Count ``reused`` of ``total`` pieces of work (``unit``: cases, blocks) that the store gave back."""
+        counts = self.reuse.setdefault(unit, [0, 0])
+        counts[0] += reused
+        counts[1] += total
+
+    def reuse_line(self) -> str:
+        """One line saying what the store gave back (``resumed: 270 of 271 cases reused from ...``); "" where nothing."""
+        parts = [f"{reused} of {total} {unit}" for unit, (reused, total) in self.reuse.items() if reused]
+        where = f" from {self.store.path}" if self.store is not None and self.store.path is not None else ""
+        return f"resumed: {' and '.join(parts)} reused{where}" if parts else ""
 
     def close(self, failed: bool = False) -> None:
         """Close the dask connection (a local cluster's workers stop); after a success, first read the workers' peak
@@ -208,11 +223,14 @@ class Runner:
             if self.store.damaged_cases > damaged_before:
                 self.store.say(f"{self.store.damaged_cases - damaged_before} damaged cases of {len(cases)} are computed again")
         pending = [index for index, result in enumerate(results) if result is None]
+        # reused: given back by the store, not saved earlier in this run (a case asked twice in one run is no resume)
+        self.note_reused("cases", sum(1 for i, result in enumerate(results) if result is not None and names[i] not in self._saved), len(cases))
 
         def keep(index: int, result: CaseResult) -> None:
             results[index] = result
             if self.store is not None:
                 self.store.save_case(names[index], result)
+                self._saved.add(names[index])
 
         units = list(dict.fromkeys(case.progress_unit for case in cases))  # each unit once, in order
         unit = " + ".join(units) if units else "points"  # mixed cases (sweeps beside a chart) count each in its own unit

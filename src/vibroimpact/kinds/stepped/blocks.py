@@ -183,6 +183,8 @@ def run_grid(scene: Scene, runner: Runner, solve: BlockSolver, extra_sizes: dict
             if damaged:
                 store.say(f"{damaged} damaged blocks of {max(finished_before, damaged)} finished ({check}) are computed again")
             skip = np.flatnonzero(store.finished_blocks()).tolist() if store.grid_ready else []
+            if check == "resumed" and attempt == 1:
+                runner.note_reused("blocks", len(skip), plan.count)
             if check == "exported" and len(skip) == plan.count:
                 break
             runner.run_tasks(_solve_block, (scene, plan, solve), list(range(plan.count)), totals, "points", finished, skip=skip, verb="simulating" if _simulates(scene) else "solving")
