@@ -146,3 +146,30 @@ def test_workers_is_for_the_estimate(tmp_path: Path, capsys: pytest.CaptureFixtu
     assert "--workers is for --estimate" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
 
+
+
+def test_a_rerun_of_a_finished_run_keeps_its_dataset_or_says_why_not(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A finished run's dataset is this scene's (the same values, the same code): a rerun keeps it as it is and says
+    so (a new description changes no number); with a value changed it says why it computes again."""
+    out = tmp_path / "out"
+    scene = _scene_file(tmp_path)
+    assert cli.main([str(scene), "--out", str(out), "--jobs", "1", "--no-report"]) == 0
+    dataset = out / "tiny.nc"
+    made = dataset.stat().st_mtime_ns
+    capsys.readouterr()
+    scene = _scene_file(tmp_path, description="the same values, other words")
+    assert cli.main([str(scene), "--out", str(out), "--jobs", "1", "--no-report"]) == 0
+    said = capsys.readouterr()
+    assert f"{dataset}: this scene's finished run (the same values, the same code): kept as it is; remove it to compute again" in said.err
+    assert dataset.stat().st_mtime_ns == made and "wrote" not in said.out
+    scene = _scene_file(tmp_path, excitation={"amplitude": 12.0})
+    assert cli.main([str(scene), "--out", str(out), "--jobs", "1", "--no-report"]) == 0
+    said = capsys.readouterr()
+    assert f"{dataset}: the scene's values changed since it was made: computed again, and replaced when done" in said.err
+    assert dataset.stat().st_mtime_ns != made and f"wrote {dataset}" in said.out
+    import netCDF4
+
+    with netCDF4.Dataset(dataset, "a") as handle:  # as if an older vibroimpact had made it
+        handle.setncattr("vibroimpact_source_sha256", "0" * 64)
+    assert cli.main([str(scene), "--out", str(out), "--jobs", "1", "--no-report"]) == 0
+    assert f"{dataset}: other code made it (another vibroimpact version or source): computed again" in capsys.readouterr().err

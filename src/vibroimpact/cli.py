@@ -138,7 +138,7 @@ def main(argv: list[str] | None = None) -> int:
     if problem is not None:
         print(f"run-study: error: --out {out_dir} cannot be written: {problem}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    from vibroimpact.runs.output_files import OutputBusy, claim_output
+    from vibroimpact.runs.output_files import OutputBusy, claim_output, finished_run
     from vibroimpact.runs.fingerprints import store_fingerprint
     from vibroimpact.runs.store import StoreOfAnotherScene, StudyStore
 
@@ -150,6 +150,16 @@ def main(argv: list[str] | None = None) -> int:
                 stale.unlink(missing_ok=True)
             for doomed in out_dir.glob(".*.zarr.removed-*"):  # a finished store whose removal was cut off
                 shutil.rmtree(doomed, ignore_errors=True)
+            dataset_path = out_dir / f"{scene.name}.nc"
+            finished, why_not = finished_run(dataset_path, scene.text)
+            if finished and not (out_dir / f"{scene.name}.zarr").exists():  # a store (a kept or cut-off run) resumes
+                print(f"{dataset_path}: this scene's finished run (the same values, the same code): kept as it is; remove it to compute again", file=sys.stderr)
+                if bool(scene.report) and not args.no_report and not (out_dir / "report.html").exists():
+                    report = _report(dataset_path, out_dir, args.jobs)
+                    print(f"wrote {report}" if isinstance(report, Path) else report)
+                return 0
+            if why_not:
+                print(f"{dataset_path}: {why_not}: computed again, and replaced when done", file=sys.stderr)
             # finished blocks and cases: a rerun of the same scene skips them
             store = StudyStore(out_dir / f"{scene.name}.zarr", store_fingerprint(scene.text), scene_path, _say)
             try:

@@ -1,5 +1,5 @@
-"""The output folder's files: written atomically (:func:`atomic_path`), and claimed by one study at a time
-(:func:`claim_output`)."""
+"""The output folder's files: written atomically (:func:`atomic_path`), claimed by one study at a time
+(:func:`claim_output`), and a finished run's dataset recognised by a rerun (:func:`finished_run`)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,37 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["atomic_path", "OutputBusy", "claim_output"]
+__all__ = ["atomic_path", "OutputBusy", "claim_output", "finished_run"]
+
+
+def finished_run(path: Path, scene_text: str) -> tuple[bool, str]:
+    """Whether the dataset at ``path`` is a finished run of the scene ``scene_text`` by this code (the same values,
+    not counting comments, description, report or cluster, and the same package source), and why not where it is not.
+
+    Returns
+    -------
+    (bool, str)
+        (True, "") where it is; (False, the reason in words) where it is not; (False, "") where there is no dataset.
+    """
+    if not path.exists():
+        return False, ""
+    from vibroimpact import __version__
+    from vibroimpact.runs.fingerprints import source_hash, store_fingerprint
+
+    try:
+        import netCDF4
+
+        with netCDF4.Dataset(path) as handle:
+            attrs = {name: handle.getncattr(name) for name in ("scene", "vibroimpact_version", "vibroimpact_source_sha256") if name in handle.ncattrs()}
+    except OSError as error:
+        return False, f"it cannot be read ({error})"
+    if "scene" not in attrs:
+        return False, "it records no scene"
+    if attrs.get("vibroimpact_version") != __version__ or attrs.get("vibroimpact_source_sha256") != source_hash():
+        return False, "other code made it (another vibroimpact version or source)"
+    if store_fingerprint(str(attrs["scene"])) != store_fingerprint(scene_text):
+        return False, "the scene's values changed since it was made"
+    return True, ""
 
 
 @contextmanager
