@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["LinearStructure", "as_matrix_rows", "require_finite", "require_positive", "require_non_negative", "require_in_range",
+__all__ = ["LinearStructure", "as_matrix_rows", "require_finite", "require_positive", "require_non_negative", "require_count", "require_in_range",
            "MASS_RATIO", "STIFFNESS_RATIO", "DAMPING_RATIO", "RIGID_MODE_RATIO", "SOFTEST_SPRING", "require_ratio", "CONDITION_LIMIT", "harmonic_condition",
            "resonance_refusal", "StiffnessModes", "stiffness_modes"]
 
@@ -470,6 +470,15 @@ def require_non_negative(name: str, value: object) -> float:
     if number < 0.0:
         raise ValueError(f"{name} = {value!r} is out of range: allowed [0, inf)")
     return number
+
+
+def require_count(name: str, value: object, low: int = 1, high: float = math.inf, why: str = "") -> int:
+    """Return ``value`` as int if it is a whole count (an int or a numpy integer, not a bool) with low <= value <=
+    high, else raise ``ValueError`` naming ``name`` (``why``: said after the range, e.g. what bounds it)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not low <= value <= high:
+        upper = "inf)" if math.isinf(high) else f"{int(high)}]"
+        raise ValueError(f"{name} = {value!r} is out of range: allowed an integer in [{low}, {upper}{why}")
+    return int(value)
 
 
 def require_in_range(name: str, value: object, low: float, high: float) -> float:

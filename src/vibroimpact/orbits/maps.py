@@ -49,6 +49,7 @@ from vibroimpact.analysis.linear import LinearAmplitudes, linear_amplitudes
 from vibroimpact.engines.registry import BUMPER, engine_for, make_engine
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
 from vibroimpact.model.problem import ImpactProblem
+from vibroimpact.model.structure import require_count
 from vibroimpact.orbits.branch import Branch, HybridInfo, MapEvaluation, PeriodicOrbit
 from vibroimpact.model.parameters import LayoutParameter, check_independent, layout_parameter, parameter, with_layout
 from vibroimpact.orbits.sections import StrobeGap, moved_phase, moved_state, resection, strobe_gap
@@ -144,9 +145,7 @@ class ImpactMap:
         problem.harmonic  # noqa: B018 - raises TypeError naming the part unless a harmonic force
         self.stops = stop_selection(problem, stop)
         self.stop = stop
-        if isinstance(periods, bool) or not isinstance(periods, (int, np.integer)) or periods < 1:  # 1.7 is no count of periods
-            raise ValueError(f"periods = {periods!r} is out of range: allowed an integer in [1, inf)")
-        self.problem, self.periods = problem, int(periods)
+        self.problem, self.periods = problem, require_count("periods", periods)  # 1.7 is no count of periods
         self.contact = problem.contact_law
         self.engine = engine if engine is not None else make_engine(engine_for(self.contact, "exact_jacobians"))
         chosen = problem.stops[self.stops[0]]

@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 from vibroimpact.analysis.impact_orbit import ROOTS, ImpactOrbit, solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.model.problem import ImpactProblem
-from vibroimpact.model.structure import require_in_range, require_positive
+from vibroimpact.model.structure import require_count, require_in_range, require_positive
 from vibroimpact.orbits.branch import Iterated, MapEvaluation, ParametrisedMap, PeriodicOrbit
 
 __all__ = ["ShootingSettings", "ShootingError", "shoot", "make_orbit", "parameter_derivative", "scaled_residual", "closed_form_state", "with_impulse", "section_phase"]
@@ -145,8 +145,7 @@ def shoot(system: ParametrisedMap, guess: ArrayLike, parameters: ArrayLike, peri
         No convergence (with the residual history), a non-finite map value, or a sticking orbit when
         ``settings.allow_sticking`` is False.
     """
-    if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period < 1:
-        raise ValueError(f"period = {period!r} is out of range: allowed an integer in [1, inf) (excitation periods)")
+    require_count("period", period, why=" (excitation periods)")
     p = np.array(parameters, dtype=float)
     y = np.array(guess, dtype=float)
     for name, values, size in (("guess", y, getattr(system, "dimension", y.size)), ("parameters", p, len(getattr(system, "parameter_names", p)))):

@@ -20,6 +20,8 @@ from typing import Callable
 
 import numpy as np
 
+from vibroimpact.model.structure import require_count
+
 __all__ = ["WORKERS_PER_CORE", "local_worker_limit", "check_jobs", "WORKER_LIBRARIES", "import_libraries", "DASHBOARD_VARIABLE", "DEFAULT_DASHBOARD", "dashboard_address", "SCHEDULER_VARIABLE", "ClusterLost", "SyncCancelRace", "Connection", "choose_scheduler", "connect", "Terminated", "unreachable", "dask_setup", "Progress", "ProgressReport", "Throttled", "ProgressBar", "REPORT_INTERVAL", "HEARTBEAT"]
 
 #: The environment variable naming a running scheduler (``tcp://host:8786``).
@@ -41,10 +43,6 @@ WORKER_ENVIRONMENT = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_
 #: for a dashboard the study does not show; 36 blocks of the design map on 2 workers: 6.6 s with it, 6.1 s without,
 #: the mean of 3 interleaved runs each).
 WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ": WORKER_ENVIRONMENT, "distributed.worker.profile.enabled": False}
-#: The libraries a study's code imports on a worker, imported as the workers start (:func:`import_libraries`), while
-#: the study's process imports its own code; none holds a compiled kernel of the package's (those load only after the
-#: study's process has compiled them: :class:`~vibroimpact.runs.kernel_loader.KernelLoader`). restitution.yaml: the
-#: first task began ~2.6 s after the cluster was up, of which ~1.2 s imported these.
 #: Most local worker processes per core: each runs one thread, so more only wait for a core while each holds its
 #: ~0.3 GB of libraries (``--jobs 1000`` on 2 cores once ran the machine out of memory after 341 s).
 WORKERS_PER_CORE = 4
@@ -58,11 +56,13 @@ def local_worker_limit() -> int:
 def check_jobs(jobs: object, key: str = "jobs") -> int:
     """``jobs`` as a count of local worker processes, or ValueError naming ``key`` and the range this machine allows."""
     limit = local_worker_limit()
-    if isinstance(jobs, bool) or not isinstance(jobs, int) or not 1 <= jobs <= limit:
-        raise ValueError(f"{key} = {jobs!r} is out of range: allowed an integer in [1, {limit}] on this machine ({os.cpu_count() or 1} cores, at most {WORKERS_PER_CORE} worker processes a core)")
-    return jobs
+    return require_count(key, jobs, 1, limit, f" on this machine ({os.cpu_count() or 1} cores, at most {WORKERS_PER_CORE} worker processes a core)")
 
 
+#: The libraries a study's code imports on a worker, imported as the workers start (:func:`import_libraries`), while
+#: the study's process imports its own code; none holds a compiled kernel of the package's (those load only after the
+#: study's process has compiled them: :class:`~vibroimpact.runs.kernel_loader.KernelLoader`). restitution.yaml: the
+#: first task began ~2.6 s after the cluster was up, of which ~1.2 s imported these.
 WORKER_LIBRARIES = ("numpy", "scipy.integrate", "scipy.optimize", "scipy.linalg", "xarray", "zarr", "numba", "dask.array")
 #: How long connecting to a named scheduler may take before the study gives up [s].
 CONNECT_TIMEOUT = 30.0

@@ -163,8 +163,9 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
         prepare_engines(engines, progress, batched)
         runner.use_engines(engines, batched)
         dataset = kind.run(scene, progress, runner)
-        if runner.reuse_line() and progress is not None:
-            progress(runner.reuse_line())  # the same line in every kind: what a resumed run took from its store
+        reused = runner.reuse_line()
+        if reused and progress is not None:
+            progress(reused)  # the same line in every kind: what a resumed run took from its store
     dataset.attrs = dataset_header(scene, dataset.attrs) | {"study_kind": kind.name}
     if runner.worker_peak_memory:
         dataset.attrs["run_peak_memory_worker_bytes"] = runner.worker_peak_memory  # the largest dask worker

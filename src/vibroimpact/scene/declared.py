@@ -109,15 +109,9 @@ class Key:
                 c.fail(where, f"{value!r} is not allowed: allowed {', '.join(self.choices)}{did_you_mean(value, self.choices)}")
                 return None
             return value
-        accepted = (int,) if self.type is int else (int, float)
-        if isinstance(value, bool) or not isinstance(value, accepted):
-            c.fail(where, wrong)
-            return None
-        number = self.type(value)
-        if not (math.isfinite(number) and self.low <= number <= self.high):
-            c.fail(where, f"{value!r} is out of range: allowed {self.allowed()}")
-            return None
-        return number
+        if self.type is int:
+            return c.integer(where, value, self.low, self.high)  # type: ignore[arg-type]
+        return c.number(where, value, self.low, self.high)
 
 
 @dataclass(frozen=True)
