@@ -165,7 +165,7 @@ def test_a_rerun_of_a_finished_run_keeps_its_dataset_or_says_why_not(tmp_path: P
     scene = _scene_file(tmp_path, excitation={"amplitude": 12.0})
     assert cli.main([str(scene), "--out", str(out), "--jobs", "1", "--no-report"]) == 0
     said = capsys.readouterr()
-    assert f"{dataset}: the scene's values changed since it was made: computed again, and replaced when done" in said.err
+    assert f"{dataset}: the scene's values changed since it was made (excitation.amplitude): computed again, and replaced when done" in said.err
     assert dataset.stat().st_mtime_ns != made and f"wrote {dataset}" in said.out
     import netCDF4
 

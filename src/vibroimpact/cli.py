@@ -139,7 +139,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"run-study: error: --out {out_dir} cannot be written: {problem}", file=sys.stderr)
         return EXIT_BAD_INPUT
     from vibroimpact.runs.output_files import OutputBusy, claim_output, finished_run
-    from vibroimpact.runs.fingerprints import store_fingerprint
+    from vibroimpact.runs.fingerprints import fingerprinted_values, store_fingerprint
     from vibroimpact.runs.store import StoreOfAnotherScene, StudyStore
 
     if threading.current_thread() is threading.main_thread():
@@ -161,7 +161,7 @@ def main(argv: list[str] | None = None) -> int:
             if why_not:
                 print(f"{dataset_path}: {why_not}: computed again, and replaced when done", file=sys.stderr)
             # finished blocks and cases: a rerun of the same scene skips them
-            store = StudyStore(out_dir / f"{scene.name}.zarr", store_fingerprint(scene.text), scene_path, _say)
+            store = StudyStore(out_dir / f"{scene.name}.zarr", store_fingerprint(scene.text), scene_path, _say, fingerprinted_values(scene.text))
             try:
                 return _run(scene, args, out_dir, store, scheduler)
             except KeyboardInterrupt as interrupt:

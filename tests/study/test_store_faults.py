@@ -5,6 +5,7 @@ Finished work is discarded only for a change of values or code, said in one line
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -129,6 +130,37 @@ def test_changed_values_discard_in_one_line_and_another_scenes_store_is_kept(tmp
     lines: list[str] = []
     assert StudyStore(path, "two", scene_path=first, say=lines.append).case_count() == 0
     assert lines == [f"{path}: the scene's values changed since it was written: 0 finished blocks and 1 finished cases discarded, computed again"]
+
+
+def test_changed_values_are_named_and_an_edited_fingerprint_is_told_apart(tmp_path: Path) -> None:
+    """A store records the values its fingerprint is made of: a rerun of changed values names the keys that changed,
+    and a fingerprint edited in the store is said as what it is, the store set aside, not deleted (before:
+    "the scene's values changed", and the store deleted)."""
+    from vibroimpact.runs.fingerprints import fingerprinted_values, store_fingerprint
+
+    first = "name: s\nsystem: {m1: 1.0, k1: 25000}\nexcitation: {amplitude: 10.0}\ndesign: {band: {start: 15, stop: 45}}\n"
+    second = first.replace("amplitude: 10.0", "amplitude: 12.0").replace("stop: 45", "stop: 40")
+    path = tmp_path / "s.zarr"
+
+    def open_store(text: str, lines: list[str]) -> StudyStore:
+        return StudyStore(path, store_fingerprint(text), tmp_path / "s.yaml", lines.append, fingerprinted_values(text))
+
+    open_store(first, []).save_case("exact-1", {"x": np.arange(3.0)})
+    lines: list[str] = []
+    assert open_store(second, lines).case_count() == 0
+    assert lines == [f"{path}: the scene's values changed (design.band.stop, excitation.amplitude) since it was written: 0 finished blocks and 1 "
+                     "finished cases discarded, computed again"]
+    open_store(first, []).save_case("exact-1", {"x": np.arange(3.0)})
+    attributes = json.loads((path / ".zattrs").read_text())
+    attributes["fingerprint"] = "0" * 24
+    (path / ".zattrs").write_text(json.dumps(attributes))
+    lines = []
+    assert open_store(first, lines).case_count() == 0
+    assert len(lines) == 1 and lines[0].startswith(f"{path}: its fingerprint is not that of the scene values and code it recorded (edited or "
+                                                   "damaged): set aside as s.zarr.damaged-"), lines
+    assert lines[0].endswith("(0 finished blocks and 1 finished cases), computed again"), lines
+    aside = list(tmp_path.glob("s.zarr.damaged-*"))
+    assert len(aside) == 1 and (aside[0] / "cases" / "exact-1").is_dir(), "the edited store is kept, never deleted"
 
 
 def test_a_case_that_fails_its_checksum_is_computed_again(tmp_path: Path) -> None:

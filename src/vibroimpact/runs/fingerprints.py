@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from vibroimpact import __version__
 
-__all__ = ["source_hash", "case_key", "store_fingerprint", "code_fingerprint", "values_digest", "NOT_IN_FINGERPRINT"]
+__all__ = ["source_hash", "case_key", "store_fingerprint", "fingerprinted_values", "fingerprint_of", "changed_keys", "code_fingerprint", "values_digest", "NOT_IN_FINGERPRINT"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -66,9 +66,10 @@ def values_digest(arrays: list[tuple[str, NDArray[np.generic]]]) -> bytes:
 NOT_IN_FINGERPRINT = ("cluster", "description", "report")
 
 
-def store_fingerprint(scene_text: str) -> str:
-    """What a store's results depend on: the scene's values (not its comments, nor the keys of
-    :data:`NOT_IN_FINGERPRINT`), the package version and the package's source (:func:`code_fingerprint`)."""
+def fingerprinted_values(scene_text: str) -> str:
+    """The part of a scene a store's results depend on, as text: its values without comments nor the keys of
+    :data:`NOT_IN_FINGERPRINT`, keys sorted (the text itself where it is no YAML mapping). A store records it beside
+    its fingerprint, so that a rerun can tell a changed scene (and which keys changed) from an edited fingerprint."""
     import yaml
 
     try:
@@ -76,8 +77,41 @@ def store_fingerprint(scene_text: str) -> str:
     except yaml.YAMLError:
         document = None
     if isinstance(document, dict):
-        scene_text = yaml.safe_dump({key: value for key, value in document.items() if key not in NOT_IN_FINGERPRINT}, sort_keys=True)
-    return hashlib.sha256(f"{code_fingerprint()}\0{scene_text}".encode()).hexdigest()[:24]
+        return yaml.safe_dump({key: value for key, value in document.items() if key not in NOT_IN_FINGERPRINT}, sort_keys=True)
+    return scene_text
+
+
+def fingerprint_of(code: str, values: str) -> str:
+    """The fingerprint of the values text ``values`` (:func:`fingerprinted_values`) computed by the code ``code``
+    (:func:`code_fingerprint`): 24 hex digits."""
+    return hashlib.sha256(f"{code}\0{values}".encode()).hexdigest()[:24]
+
+
+def store_fingerprint(scene_text: str) -> str:
+    """What a store's results depend on: the scene's values (not its comments, nor the keys of
+    :data:`NOT_IN_FINGERPRINT`), the package version and the package's source (:func:`code_fingerprint`)."""
+    return fingerprint_of(code_fingerprint(), fingerprinted_values(scene_text))
+
+
+def changed_keys(before: str, after: str, most: int = 4) -> str:
+    """The keys whose values differ between two values texts (:func:`fingerprinted_values`), dotted
+    (``design.band.stop``), at most ``most`` named and the rest counted; ``""`` where none can be named."""
+    import yaml
+
+    def flat(document: Any, prefix: str = "") -> dict[str, Any]:
+        if isinstance(document, dict) and document:
+            return {path: value for key, item in document.items() for path, value in flat(item, f"{prefix}{key}.").items()}
+        return {prefix.rstrip("."): document}
+
+    try:
+        old, new = flat(yaml.safe_load(before)), flat(yaml.safe_load(after))
+    except yaml.YAMLError:
+        return ""
+    differ = sorted(key for key in old.keys() | new.keys() if key and (key not in old or key not in new or old[key] != new[key]))
+    if not differ:
+        return ""
+    named = ", ".join(differ[:most])
+    return named + (f" and {len(differ) - most} more" if len(differ) > most else "")
 
 
 def code_fingerprint() -> str:

@@ -27,7 +27,7 @@ def finished_run(path: Path, scene_text: str) -> tuple[bool, str]:
     if not path.exists():
         return False, ""
     from vibroimpact import __version__
-    from vibroimpact.runs.fingerprints import source_hash, store_fingerprint
+    from vibroimpact.runs.fingerprints import changed_keys, fingerprinted_values, source_hash, store_fingerprint
 
     try:
         import netCDF4
@@ -41,7 +41,8 @@ def finished_run(path: Path, scene_text: str) -> tuple[bool, str]:
     if attrs.get("vibroimpact_version") != __version__ or attrs.get("vibroimpact_source_sha256") != source_hash():
         return False, "other code made it (another vibroimpact version or source)"
     if store_fingerprint(str(attrs["scene"])) != store_fingerprint(scene_text):
-        return False, "the scene's values changed since it was made"
+        keys = changed_keys(fingerprinted_values(str(attrs["scene"])), fingerprinted_values(scene_text))
+        return False, f"the scene's values changed since it was made{f' ({keys})' if keys else ''}"
     return True, ""
 
 

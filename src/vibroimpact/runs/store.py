@@ -12,9 +12,11 @@ the fixed-width strings that some results hold):
 * the group ``cases``: one array per finished case (``<engine>-<key>``), its result fields packed in one ``.npz``
   byte stream (no pickle; one write per case, not one per field: a design study's cases are stored 12x faster), its
   attribute ``checksum`` the digest of the values;
-* the attributes ``fingerprint`` (the scene's values, the package version and its source), ``code`` and
-  ``scene_path``: a store of changed values or other code is started afresh rather than mixed, saying why and how
-  much it discards; a store begun by another scene file is refused, never deleted.
+* the attributes ``fingerprint`` (the scene's values, the package version and its source), ``code``,
+  ``scene_values`` (the values text the fingerprint is made of) and ``scene_path``: a store of changed values (the
+  keys named) or other code is started afresh rather than mixed, saying why and how much it discards; a store whose
+  fingerprint is not that of its own recorded values and code was edited or damaged, and is set aside (never
+  deleted); a store begun by another scene file is refused, never deleted.
 
 A store proves what it serves: every finished block is checked against its checksum when a run resumes and again
 before its values are exported, and every case when it is read; one that fails (a lost, truncated or swapped chunk,
@@ -42,7 +44,7 @@ import zarr
 from numpy.typing import NDArray
 from zarr.core.sync import sync  # zarr's own event loop, the one its synchronous API runs on
 
-from vibroimpact.runs.fingerprints import NOT_IN_FINGERPRINT, case_key, code_fingerprint, source_hash, store_fingerprint, values_digest
+from vibroimpact.runs.fingerprints import NOT_IN_FINGERPRINT, case_key, changed_keys, code_fingerprint, fingerprint_of, source_hash, store_fingerprint, values_digest
 from vibroimpact.runs.store_record import read_record, record_digest, restore, set_aside, check_members_readable
 
 __all__ = ["source_hash", "case_key", "StudyStore", "store_fingerprint", "code_fingerprint", "values_digest", "StoreOfAnotherScene", "StoreUnusable", "NOT_IN_FINGERPRINT", "ZARR_FORMAT"]
@@ -113,6 +115,10 @@ class StudyStore:
         The scene file the work comes from (recorded; a store begun by another scene file is refused, not emptied).
     say : callable or None
         Receives one line whenever finished work is discarded (a changed scene or code, damaged blocks or cases).
+    values : str
+        :func:`~vibroimpact.runs.fingerprints.fingerprinted_values` of the scene, recorded beside the fingerprint: a
+        rerun of changed values names the keys that changed, and a fingerprint that is not its own values' is told
+        apart as edited or damaged. ``""``: not recorded (the reasons are then said without the keys).
 
     Raises
     ------
@@ -120,9 +126,10 @@ class StudyStore:
         When ``path`` holds the store of another scene file (same name, other file): nothing is deleted.
     """
 
-    def __init__(self, path: Path | None, fingerprint: str, scene_path: Path | None = None, say: Callable[[str], None] | None = None) -> None:
+    def __init__(self, path: Path | None, fingerprint: str, scene_path: Path | None = None, say: Callable[[str], None] | None = None, values: str = "") -> None:
         self.path = path
         self.fingerprint = fingerprint
+        self.values = values
         self.say = say or (lambda _line: None)
         #: Cases read back whose values failed their checksum (computed again).
         self.damaged_cases = 0
@@ -139,7 +146,7 @@ class StudyStore:
         # (:meth:`keep`) could vouch for an array whose own files are lost or edited
         self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
         if "fingerprint" not in self.root.attrs:
-            self.root.attrs.update({"fingerprint": fingerprint, "code": code_fingerprint(), "scene_path": source})
+            self.root.attrs.update(self._identity())
         self._grid_ready = _BLOCK_DONE in self.root or any(key in self.root.attrs for key in (_GRID_VARIABLES, _GRID_RECORD))
         self._arrays: dict[str, Any] = {}
         self._cases_group: Any = None
@@ -151,7 +158,7 @@ class StudyStore:
         aside = set_aside(self.path)
         self.say(f"{self.path}: cannot be read ({why}): set aside as {aside.name}, computed again")
         self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
-        self.root.attrs.update({"fingerprint": self.fingerprint, "code": code_fingerprint(), "scene_path": self.scene_path})
+        self.root.attrs.update(self._identity())
         self._arrays.clear()
         self._cases_group = None
         self._grid_ready = False
@@ -168,14 +175,30 @@ class StudyStore:
             raise StoreOfAnotherScene(
                 f"{path} holds the finished work of another scene ({attrs['scene_path']}); it is kept: remove it, or "
                 "run this scene with another --out (or another name)")
-        if attrs is None or "fingerprint" not in attrs:  # damaged: kept for whoever wants to look, never deleted
+        recorded = attrs.get("scene_values") if attrs is not None else None
+        damage = None
+        if attrs is None or "fingerprint" not in attrs:
+            damage = f"its attributes are {'unreadable' if attrs is None else 'lost'} (damaged)"
+        elif isinstance(recorded, str) and fingerprint_of(str(attrs.get("code")), recorded) != attrs["fingerprint"]:
+            damage = "its fingerprint is not that of the scene values and code it recorded (edited or damaged)"
+        if damage is not None:  # kept for whoever wants to look, never deleted
             work = _finished_work(path)
             aside = set_aside(path)
-            self.say(f"{path}: its attributes are {'unreadable' if attrs is None else 'lost'} (damaged): set aside as {aside.name} ({work}), computed again")
+            self.say(f"{path}: {damage}: set aside as {aside.name} ({work}), computed again")
             return
-        why = "the package's code changed" if attrs.get("code") != code_fingerprint() else "the scene's values changed"
+        if attrs.get("code") != code_fingerprint():
+            why = "the package's code changed"
+        else:
+            keys = changed_keys(recorded, self.values) if isinstance(recorded, str) and self.values else ""
+            why = f"the scene's values changed ({keys})" if keys else "the scene's values changed"
         self.say(f"{path}: {why} since it was written: {_finished_work(path)} discarded, computed again")
         self.remove()  # renamed first: a removal cut off half-way leaves no store that looks damaged
+
+    def _identity(self) -> dict[str, str]:
+        """The root attributes that say whose store it is: the fingerprint, the code, the values (if known) and the
+        scene file."""
+        identity = {"fingerprint": self.fingerprint, "code": code_fingerprint(), "scene_path": self.scene_path}
+        return identity | ({"scene_values": self.values} if self.values else {})
 
     # -- cases -------------------------------------------------------------------------------------------------
 
