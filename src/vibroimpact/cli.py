@@ -60,6 +60,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--workers", type=int, default=None, metavar="N", help="with --estimate: predict the wall time on N workers of a dask cluster (default: --jobs on this machine's cores)")
     parser.add_argument("--costs", type=Path, default=None, help="cost file of --estimate (default: the package's calibrated costs, see run-study calibrate)")
     parser.add_argument("--list", action="store_true", help="list the shipped studies with their descriptions, and run nothing")
+    parser.add_argument("--keys", action="store_true", help="print every declared scene key (what it accepts, its default, what it sets) as markdown tables, and run nothing")
     return parser
 
 
@@ -98,9 +99,15 @@ def main(argv: list[str] | None = None) -> int:
     if args.list:
         print(study_listing(shipped_studies(), shutil.get_terminal_size((120, 24)).columns))
         return 0
+    if args.keys:
+        from vibroimpact.scene.declared import reference_table
+        from vibroimpact.scene.kinds import KINDS
+
+        print(reference_table([section for kind in KINDS for section in kind.sections()]))
+        return 0
     if args.scene is None:
         parser.print_usage(sys.stderr)
-        print("run-study: error: a scene is required (or --list)", file=sys.stderr)
+        print("run-study: error: a scene is required (or --list, or --keys)", file=sys.stderr)
         return EXIT_BAD_INPUT
     try:
         scene_path = find_scene(args.scene)

@@ -14,21 +14,43 @@ from typing import Any
 import pytest
 import yaml
 
+from vibroimpact.kinds.bifurcation.scene import BRUTE_FORCE, CHART, CONTINUATION, BranchSettings, BruteForceSettings, ChartSettings
 from vibroimpact.kinds.design.scene import CERTIFY, SEARCH, SearchSettings
 from vibroimpact.scene.checker import Checker, SceneError
-from vibroimpact.scene.declared import REQUIRED, Key, Section
+from vibroimpact.scene.declared import REQUIRED, Band, Key, Names, Section
+from vibroimpact.scene.kinds import KINDS
 from vibroimpact.scene.reader import parse_scene, read_yaml
 
 from tests.kinds.design.test_design_scene import SCENE
 
-#: Each declared section of the design kind, and where its parsed values land in the scene's settings.
-WHERE = {SEARCH.path: lambda settings, name: getattr(settings.search, name), CERTIFY.path: lambda settings, name: settings.certified}
+STUDIES = Path(__file__).resolve().parents[2] / "studies"
 
 
-def _scene(section: str, values: dict[str, Any]) -> dict:
+def _design(section: str, values: dict[str, Any]) -> dict:
     document = copy.deepcopy(SCENE)
     document["design"][section.rpartition(".")[2]] = values
     return document
+
+
+def _bifurcation(section: str, values: dict[str, Any]) -> dict:
+    document = read_yaml((STUDIES / "bifurcation.yaml").read_text(encoding="utf-8"))
+    document["bifurcation"][section.rpartition(".")[2]] = values
+    return document
+
+
+#: Each declared section: a scene of its kind with the section's values, and where each value lands in the settings.
+PLACES = {
+    SEARCH.path: (_design, lambda settings, name: getattr(settings.search, name)),
+    CERTIFY.path: (_design, lambda settings, name: settings.certified),
+    BRUTE_FORCE.path: (_bifurcation, lambda settings, name: getattr(settings.brute_force, name)),
+    CONTINUATION.path: (_bifurcation, lambda settings, name: getattr(settings.branches, name)),
+    CHART.path: (_bifurcation, lambda settings, name: getattr(settings.chart, name)),
+}
+SECTIONS = [section for kind in KINDS for section in kind.sections()]
+
+
+def _scene(section: str, values: dict[str, Any]) -> dict:
+    return PLACES[section][0](section, values)
 
 
 def _other_value(key: Key) -> Any:
@@ -37,18 +59,28 @@ def _other_value(key: Key) -> Any:
         return not key.default
     if key.type is str:
         return next(choice for choice in key.choices if choice != key.default)
+    if key.type is Names:
+        return key.default[:-1] if len(key.default) > 1 else tuple(choice for choice in key.choices if choice not in key.default)[:1]
+    if key.type is Band:
+        return (key.default[0], (key.default[0] + key.default[1]) / 2.0)
+    if key.type is float:
+        return (key.default + key.high) / 2.0 if key.high < 10.0 else key.default * 1.5
     return key.default + 1 if key.default + 1 <= key.high else key.default - 1
 
 
 def _wrong_values(key: Key) -> list[Any]:
     """Values of the wrong type for ``key``: a string for anything else, a float for an integer, a number for a name or
-    a boolean, the YAML 1.1 spellings of a boolean."""
+    a boolean, the YAML 1.1 spellings of a boolean, a bare name for a list of names, a list for a band."""
     if key.type is bool:
         return ["no", "false", 0, 1]
     if key.type is int:
         return [float(key.default) + 0.5, str(key.default), True]
     if key.type is float:
         return [str(key.default), True]
+    if key.type is Names:
+        return [key.choices[0], True]
+    if key.type is Band:
+        return [list(key.default), 3]
     return [3, True]
 
 
@@ -57,13 +89,17 @@ def _method_of(section: Section, key: Key) -> dict[str, Any]:
     return {key.read_when[0]: key.read_when[1]} if key.read_when else {}
 
 
-@pytest.mark.parametrize("section", [SEARCH, CERTIFY], ids=lambda s: s.path)
+def test_every_declared_section_of_every_kind_is_walked_here() -> None:
+    assert sorted(section.path for section in SECTIONS) == sorted(PLACES)
+
+
+@pytest.mark.parametrize("section", SECTIONS, ids=lambda s: s.path)
 def test_every_declared_key_reaches_the_settings(section: Section) -> None:
     for key in section.keys:
         value = _other_value(key)
-        given = _method_of(section, key) | {key.name: value}
+        given = _method_of(section, key) | {key.name: key.as_written(value)}
         settings = parse_scene(_scene(section.path, given)).settings
-        assert WHERE[section.path](settings, key.name) == value, (key.name, value)
+        assert PLACES[section.path][1](settings, key.name) == value, (key.name, value)
 
 
 def test_search_settings_have_exactly_the_declared_keys() -> None:
@@ -72,7 +108,7 @@ def test_search_settings_have_exactly_the_declared_keys() -> None:
     assert all(getattr(SearchSettings(), key.name) == key.default for key in SEARCH.keys)
 
 
-@pytest.mark.parametrize("section", [SEARCH, CERTIFY], ids=lambda s: s.path)
+@pytest.mark.parametrize("section", SECTIONS, ids=lambda s: s.path)
 def test_each_wrong_type_is_refused_naming_its_key(section: Section) -> None:
     for key in section.keys:
         for wrong in _wrong_values(key):
@@ -82,16 +118,18 @@ def test_each_wrong_type_is_refused_naming_its_key(section: Section) -> None:
             assert any(line.startswith(f"{section.path}.{key.name}: expected") for line in caught.value.problems), (key.name, wrong, caught.value.problems)
 
 
-def test_a_scene_with_every_key_wrong_is_refused_at_once_with_exit_2_and_nothing_written(tmp_path: Path) -> None:
-    document = copy.deepcopy(SCENE)
-    document["design"]["search"] = {key.name: _wrong_values(key)[0] for key in SEARCH.keys}
-    document["design"]["certify"] = {key.name: _wrong_values(key)[0] for key in CERTIFY.keys}
+@pytest.mark.parametrize("kind", sorted({section.path.partition(".")[0] for section in SECTIONS}))
+def test_a_scene_with_every_key_wrong_is_refused_at_once_with_exit_2_and_nothing_written(tmp_path: Path, kind: str) -> None:
+    sections = [section for section in SECTIONS if section.path.startswith(f"{kind}.")]
+    document = _scene(sections[0].path, {})
+    for section in sections:
+        document[kind][section.path.rpartition(".")[2]] = {key.name: _wrong_values(key)[0] for key in section.keys}
     path = tmp_path / "wrong.yaml"
     path.write_text(yaml.safe_dump(document), encoding="utf-8")
     out = tmp_path / "out"
     done = subprocess.run([sys.executable, "-m", "vibroimpact.cli", str(path), "--out", str(out)], capture_output=True, text=True, timeout=120)
     assert done.returncode == 2, done.stderr
-    for section in (SEARCH, CERTIFY):
+    for section in sections:
         for key in section.keys:
             assert f"{section.path}.{key.name}: expected" in done.stderr, (key.name, done.stderr)
     assert not out.exists() or not any(out.iterdir())
@@ -139,7 +177,7 @@ def test_the_python_settings_refuse_what_the_scene_refuses(values: dict, words: 
 def test_a_declaration_is_checked_when_it_is_made() -> None:
     with pytest.raises(ValueError, match="fails its own check"):
         Key("population", int, "members", 2, 4, 100)
-    with pytest.raises(TypeError, match="for a str key only"):
+    with pytest.raises(TypeError, match="for a str or Names key only"):
         Key("points", int, "points", 12, choices=("a",))
     with pytest.raises(ValueError, match="declared twice"):
         Section("s", (Key("a", int, "a", 1), Key("a", int, "a", 2)), "twice")
@@ -180,3 +218,33 @@ def test_every_kind_reads_the_shared_header_s_cluster(kind: str) -> None:
         with pytest.raises(SceneError) as caught:
             parse_scene(copy.deepcopy(document))
         assert any(line.startswith("cluster") and words in line for line in caught.value.problems), (kind, wrong, caught.value.problems)
+
+
+@pytest.mark.parametrize(("make", "words"), [
+    (lambda: BranchSettings(linear="yes"), "linear: expected a boolean"),  # before: any string was accepted as true
+    (lambda: BruteForceSettings(directions=("up", "up")), r"directions\[1\]: 'up' is listed twice"),
+    (lambda: BruteForceSettings(step=0.0), r"step: 0.0 is out of range: allowed \(0, inf\)"),
+    (lambda: ChartSettings(clearance=(5e-3, 1e-3)), "clearance.stop: 0.001 must be greater than start = 0.005"),
+    (lambda: ChartSettings(kinds=("fold", "cusp")), r"kinds\[1\]: unknown name 'cusp'"),
+])  # fmt: skip
+def test_the_bifurcation_settings_refuse_what_the_scene_refuses(make: Any, words: str) -> None:
+    with pytest.raises(ValueError, match=words):
+        make()
+
+
+def test_names_and_bands_read_as_tuples_and_are_written_back_as_a_scene_writes_them() -> None:
+    assert BRUTE_FORCE.read(Checker(), {"directions": ["down"]})["directions"] == ("down",)  # type: ignore[index]
+    assert CHART.read(Checker(), {"clearance": {"start": 0.002, "stop": 0.004}})["clearance"] == (0.002, 0.004)  # type: ignore[index]
+    assert CHART.key("clearance").allowed() == "band {start, stop} in (0, 1] [m]"
+    rows = CHART.reference() + BRUTE_FORCE.reference()
+    assert "| `bifurcation.chart.clearance` | band {start, stop} in (0, 1] [m] | {start: 0.001, stop: 0.006} | clearance range of the chart |" in rows
+    assert "| `bifurcation.brute_force.directions` | list of names from up, down | [up, down] | which ways the frequency is stepped, the end state carried to the next |" in rows
+
+
+def test_run_study_keys_prints_every_declared_key_of_every_kind_and_runs_nothing(tmp_path: Path) -> None:
+    done = subprocess.run([sys.executable, "-m", "vibroimpact.cli", "--keys"], capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    rows = [line for line in done.stdout.splitlines() if line.startswith("| `")]
+    assert rows == [row for section in SECTIONS for row in section.reference()]
+    assert {section.path for section in SECTIONS} <= {line.split("`")[1] for line in done.stdout.splitlines() if line.startswith("### ")}
+    assert not any(tmp_path.iterdir())

@@ -20,7 +20,7 @@ from typing import Any
 
 from vibroimpact.scene.checker import Checker, did_you_mean, interval
 
-__all__ = ["Key", "Section", "REQUIRED"]
+__all__ = ["Key", "Section", "REQUIRED", "Names", "Band", "reference_table"]
 
 
 class _Required:
@@ -33,9 +33,18 @@ class _Required:
 #: The default of a key the scene must give.
 REQUIRED: Any = _Required()
 
+class Names:
+    """The type of a key whose value is a non-empty list of names from its choices, none repeated (read as a tuple)."""
+
+
+class Band:
+    """The type of a key whose value is a band ``{start, stop}``, both in the key's range, start below stop (read as
+    the tuple ``(start, stop)``)."""
+
+
 #: The YAML type each Python type of a key is written as, in messages and in the reference.
-_TYPE_NAMES = {bool: "boolean (true or false)", int: "integer", float: "number", str: "name"}
-_ARTICLES = {bool: "a", int: "an", float: "a", str: "a"}
+_TYPE_NAMES = {bool: "boolean (true or false)", int: "integer", float: "number", str: "name", Names: "list of names", Band: "band {start, stop}"}
+_ARTICLES = {bool: "a", int: "an", float: "a", str: "a", Names: "a", Band: "a"}
 
 
 @dataclass(frozen=True)
@@ -47,20 +56,22 @@ class Key:
     name : str
         As written in the scene.
     type : type
-        ``bool``, ``int``, ``float`` or ``str``; an integer is accepted where a number is asked, never the reverse,
-        and a boolean is no number.
+        ``bool``, ``int``, ``float``, ``str``, :class:`Names` or :class:`Band`; an integer is accepted where a number
+        is asked, never the reverse, and a boolean is no number.
     doc : str
         One line: what the key sets.
     default : object
         Its value where the scene does not give it; :data:`REQUIRED`: the scene must.
     low, high : float
-        The allowed range, both ends included (numbers only; +-inf: unbounded).
+        The allowed range, both ends included unless ``open_low`` (numbers and bands; +-inf: unbounded, open).
     unit : str
         Its unit in brackets' words (``"Hz"``, ``"m"``; ``""`` for a pure number or a name).
     choices : tuple of str
-        The allowed names (``str`` keys only; empty: any name).
+        The allowed names (``str`` and :class:`Names` keys only; empty: any name).
     read_when : tuple of (str, str), optional
         (another key, its value): this key is read only where the other has that value; given otherwise it is refused.
+    open_low : bool
+        Whether ``low`` itself is refused (a step, a frequency: above 0).
     """
 
     name: str
@@ -72,25 +83,39 @@ class Key:
     unit: str = ""
     choices: tuple[str, ...] = ()
     read_when: tuple[str, str] | None = None
+    open_low: bool = False
 
     def __post_init__(self) -> None:
         if self.type not in _TYPE_NAMES:
-            raise TypeError(f"Key {self.name!r}: type {self.type!r} is not one of bool, int, float, str")
-        if self.choices and self.type is not str:
-            raise TypeError(f"Key {self.name!r}: choices are names, for a str key only")
-        if self.default is not REQUIRED and self.check(Checker(), self.name, self.default) is None:
+            raise TypeError(f"Key {self.name!r}: type {self.type!r} is not one of bool, int, float, str, Names, Band")
+        if self.choices and self.type not in (str, Names):
+            raise TypeError(f"Key {self.name!r}: choices are names, for a str or Names key only")
+        if self.type is Names and not self.choices:
+            raise TypeError(f"Key {self.name!r}: a Names key lists its choices")
+        if self.default is not REQUIRED and self.check(Checker(), self.name, self.as_written(self.default)) is None:
             raise ValueError(f"Key {self.name!r}: its default {self.default!r} fails its own check")
 
     def allowed(self) -> str:
         """What the key accepts, in words: its type, then its range or its choices."""
+        if self.type is Names:
+            return f"list of names from {', '.join(self.choices)}"
         if self.choices:
             return f"one of {', '.join(self.choices)}"
         kind = _TYPE_NAMES[self.type]
         if self.type is int and math.isfinite(self.low) and math.isfinite(self.high):
             return f"{kind} in [{int(self.low)}, {int(self.high)}]"
-        if self.type in (int, float) and (math.isfinite(self.low) or math.isfinite(self.high)):
-            return f"{kind} in {interval(self.low, self.high)}" + (f" [{self.unit}]" if self.unit else "")
+        if self.type in (int, float, Band) and (math.isfinite(self.low) or math.isfinite(self.high)):
+            return f"{kind} in {interval(self.low, self.high, not self.open_low)}" + (f" [{self.unit}]" if self.unit else "")
         return kind + (f" [{self.unit}]" if self.unit else "")
+
+    def as_written(self, value: Any) -> Any:
+        """``value`` of the key as a scene writes it: a band's ``(start, stop)`` as ``{start, stop}``, names as a
+        list; anything else as it is."""
+        if self.type is Band and isinstance(value, tuple) and len(value) == 2:
+            return {"start": value[0], "stop": value[1]}
+        if self.type is Names and isinstance(value, tuple):
+            return list(value)
+        return value
 
     def check(self, c: Checker, where: str, value: Any) -> Any:
         """``value`` if the key accepts it (an integer given for a number as a float), else None with the problem
@@ -111,7 +136,22 @@ class Key:
             return value
         if self.type is int:
             return c.integer(where, value, self.low, self.high)  # type: ignore[arg-type]
-        return c.number(where, value, self.low, self.high)
+        if self.type is Names:
+            chosen = c.choices(where, value, self.choices)
+            return chosen if chosen and len(chosen) == len(value) else None
+        if self.type is Band:
+            band = c.mapping(where, value, {"start", "stop"}, {"start", "stop"})
+            if set(map(str, band)) != {"start", "stop"}:
+                return None
+            start = c.number(f"{where}.start", band["start"], self.low, self.high, not self.open_low)
+            stop = c.number(f"{where}.stop", band["stop"], self.low, self.high, not self.open_low)
+            if start is None or stop is None:
+                return None
+            if stop <= start:
+                c.fail(f"{where}.stop", f"{stop:g} must be greater than start = {start:g}")
+                return None
+            return (start, stop)
+        return c.number(where, value, self.low, self.high, not self.open_low)
 
 
 @dataclass(frozen=True)
@@ -184,11 +224,41 @@ class Section:
                 c.fail(f"{self.path}.{key.name}", f"not read with {other}: {chosen} (only with {other}: {wanted}); remove it or choose {other}: {wanted}")
         return read if len(c.problems) == before else None
 
+    def validate(self, settings: Any) -> None:
+        """Check the attributes of a settings dataclass built from Python (each declared key's attribute, written as
+        a scene writes it) by the scene's own checks; raise ValueError naming every problem, as the scene does."""
+        c = Checker()
+        for key in self.keys:
+            key.check(c, key.name, key.as_written(getattr(settings, key.name)))
+        if c.problems:
+            raise ValueError("; ".join(c.problems))
+
     def reference(self) -> list[str]:
         """The section's rows of the grammar reference: ``| key | allowed | default | what it sets |`` (markdown)."""
         rows = []
         for key in self.keys:
-            default = "required" if key.default is REQUIRED else repr(key.default).lower() if isinstance(key.default, bool) else str(key.default)
+            default = "required" if key.default is REQUIRED else _written(key.as_written(key.default))
             when = f" (read with {key.read_when[0]}: {key.read_when[1]})" if key.read_when else ""
             rows.append(f"| `{self.path}.{key.name}` | {key.allowed()} | {default} | {key.doc}{when} |")
         return rows
+
+
+def _written(value: Any) -> str:
+    """A default as YAML writes it (``true``, ``[up, down]``, ``{start: 0.001, stop: 0.006}``)."""
+    if isinstance(value, bool):
+        return str(value).lower()
+    if isinstance(value, list):
+        return "[" + ", ".join(_written(item) for item in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{name}: {_written(item)}" for name, item in value.items()) + "}"
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def reference_table(sections: tuple[Section, ...] | list[Section]) -> str:
+    """The grammar reference of ``sections`` (markdown): per section its one line, then a row per key with what it
+    accepts, its default and what it sets (``run-study --keys``)."""
+    lines: list[str] = []
+    for section in sections:
+        lines += [f"### `{section.path}`: {section.doc}", "", "| key | allowed | default | what it sets |", "|---|---|---|---|"]
+        lines += [*section.reference(), ""]
+    return "\n".join(lines)

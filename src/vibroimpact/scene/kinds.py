@@ -72,6 +72,12 @@ class Kind:
         """Check ``document`` as a scene of this kind (the kind's scene parser, imported now)."""
         return _resolve(self.scene)(document, text, source)
 
+    def sections(self) -> tuple[Any, ...]:
+        """The kind's declared scene sections (:class:`~vibroimpact.scene.declared.Section`: the ``SECTIONS`` of its
+        scene module; imports the scene parser only)."""
+        module, _, _ = self.scene.partition(":")
+        return tuple(getattr(importlib.import_module(module), "SECTIONS", ()))
+
     def make_study(self) -> Any:
         """The kind's study object (imports its run)."""
         return _resolve(self.study)()

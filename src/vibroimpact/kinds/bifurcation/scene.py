@@ -47,19 +47,19 @@ import dataclasses
 import math
 import re
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
-from vibroimpact.model.structure import require_in_range, require_positive
 from vibroimpact.scene.checker import Checker, SceneError
+from vibroimpact.scene.declared import Band, Key, Names, Section
 from vibroimpact.model.contact import place_effective_mass
 from vibroimpact.model.layout import Layout, StopSpec
 from vibroimpact.scene.header import open_scene
 from vibroimpact.scene.layout_parse import parse_layout, static_drift
 from vibroimpact.scene.schema import SWEEP_DIRECTIONS, Scene
 
-__all__ = ["BIFURCATION_TOP_KEYS", "CHART_KINDS", "REFERENCES", "BruteForceSettings", "BranchSettings", "ChartSettings", "BifurcationSettings", "coordinate_label", "parse_bifurcation_scene"]
+__all__ = ["BIFURCATION_TOP_KEYS", "CHART_KINDS", "REFERENCES", "BRUTE_FORCE", "CONTINUATION", "CHART", "SECTIONS", "BruteForceSettings", "BranchSettings", "ChartSettings", "BifurcationSettings", "coordinate_label", "parse_bifurcation_scene"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -75,6 +75,7 @@ CHART_KINDS = ("fold", "period_doubling", "neimark_sacker", "grazing")
 REFERENCES = ("rigid", "none")
 #: Most brute-force periods of one scene (frequencies x restitutions x directions x periods per point).
 MAX_BRUTE_PERIODS = 50_000_000
+_Settings = TypeVar("_Settings")
 
 
 def coordinate_label(name: str) -> str:
@@ -83,36 +84,56 @@ def coordinate_label(name: str) -> str:
     return name.upper() if re.fullmatch(r"[a-z][0-9]+", name) else name
 
 
+#: ``bifurcation.brute_force``, declared (:mod:`vibroimpact.scene.declared`).
+BRUTE_FORCE = Section("bifurcation.brute_force", (
+    Key("step", float, "frequency step of the stepped sweeps", 0.05, 0.0, math.inf, "Hz", open_low=True),
+    Key("transient_periods", int, "periods integrated and dropped at each frequency", 300, 0, 1_000_000),
+    Key("strobes", int, "strobes (whole periods) kept at each frequency", 64, 1, 100_000),
+    Key("directions", Names, "which ways the frequency is stepped, the end state carried to the next", ("up", "down"), choices=SWEEP_DIRECTIONS),
+), "stepped sweeps of the time simulation (exact)")  # fmt: skip
+#: ``bifurcation.continuation``, declared.
+CONTINUATION = Section("bifurcation.continuation", (
+    Key("one_impact", bool, "the closed-form impact orbit's branches, from both roots of eq. 16", True),
+    Key("period_doubling", bool, "period-2 branches switched at every period doubling", True),
+    Key("grazing", bool, "branches born at grazing points with another impact count", True),
+    Key("linear", bool, "the impactless orbit wherever it fits inside every stop", True),
+    Key("brute_force", bool, "branches seeded from the brute force's periodic strobes", True),
+    Key("max_steps", int, "continuation steps per direction of a branch, at most", 2000, 1, 100_000),
+    Key("max_step", float, "largest arclength step, in the continuation's scaled variables", 0.1, 1e-4, 1.0),
+), "which branches are continued in frequency, and how far")  # fmt: skip
+#: ``bifurcation.chart``, declared.
+CHART = Section("bifurcation.chart", (
+    Key("restitution", float, "R of the chart", 0.2, 0.0, 1.0),
+    Key("clearance", Band, "clearance range of the chart", (1e-3, 6e-3), 0.0, 1.0, "m", open_low=True),
+    Key("kinds", Names, "special points followed in (frequency, clearance)", CHART_KINDS, choices=CHART_KINDS),
+    Key("max_steps", int, "continuation steps per direction of a curve, at most", 300, 1, 100_000),
+    Key("frequency_step", float, "frequency step of the regime map's brute-force sweeps", 0.25, 0.0, math.inf, "Hz", open_low=True),
+    Key("clearance_num", int, "clearances of the regime map, evenly spaced over the range", 12, 2, 1000),
+    Key("transient_periods", int, "periods dropped at each point of the regime map", 300, 0, 1_000_000),
+    Key("strobes", int, "periods kept for the classification at each point of the regime map", 128, 64, 100_000),
+), "the two-parameter chart (frequency x clearance at one restitution)")  # fmt: skip
+#: The sections of a bifurcation scene that are declared (``run-study --keys bifurcation`` lists them).
+SECTIONS = (BRUTE_FORCE, CONTINUATION, CHART)
+
+
 @dataclass(frozen=True)
 class BruteForceSettings:
-    """Stepped sweeps of the time simulation (``exact``), the end state carried to the next frequency.
+    """Stepped sweeps of the time simulation (``exact``), the end state carried to the next frequency: the keys of
+    :data:`BRUTE_FORCE` (``step`` [Hz], ``transient_periods``, ``strobes``, ``directions``: ``up`` and/or ``down``),
+    checked by the scene's own checks."""
 
-    Attributes
-    ----------
-    step : float
-        Frequency step [Hz].
-    transient_periods : int
-        Periods integrated and dropped at each frequency.
-    strobes : int
-        Strobes (whole periods) kept at each frequency.
-    directions : tuple of str
-        ``up`` and/or ``down``.
-    """
-
-    step: float = 0.05
-    transient_periods: int = 300
-    strobes: int = 64
-    directions: tuple[str, ...] = ("up", "down")  # scene.schema.SWEEP_DIRECTIONS (the parser checks against it)
+    step: float = BRUTE_FORCE.key("step").default
+    transient_periods: int = BRUTE_FORCE.key("transient_periods").default
+    strobes: int = BRUTE_FORCE.key("strobes").default
+    directions: tuple[str, ...] = BRUTE_FORCE.key("directions").default
 
     def __post_init__(self) -> None:
-        require_positive("step", self.step)
-        require_in_range("transient_periods", self.transient_periods, 0, 1_000_000)
-        require_in_range("strobes", self.strobes, 1, 100_000)
+        BRUTE_FORCE.validate(self)
 
 
 @dataclass(frozen=True)
 class BranchSettings:
-    """Which branches are continued in frequency, and how far.
+    """Which branches are continued in frequency, and how far: the keys of :data:`CONTINUATION`.
 
     Attributes
     ----------
@@ -135,22 +156,21 @@ class BranchSettings:
         Largest arclength step, in the continuation's scaled variables [-].
     """
 
-    one_impact: bool = True
-    period_doubling: bool = True
-    grazing: bool = True
-    linear: bool = True
-    brute_force: bool = True
-    max_steps: int = 2000
-    max_step: float = 0.1
+    one_impact: bool = CONTINUATION.key("one_impact").default
+    period_doubling: bool = CONTINUATION.key("period_doubling").default
+    grazing: bool = CONTINUATION.key("grazing").default
+    linear: bool = CONTINUATION.key("linear").default
+    brute_force: bool = CONTINUATION.key("brute_force").default
+    max_steps: int = CONTINUATION.key("max_steps").default
+    max_step: float = CONTINUATION.key("max_step").default
 
     def __post_init__(self) -> None:
-        require_in_range("max_steps", self.max_steps, 1, 100_000)
-        require_in_range("max_step", self.max_step, 1e-4, 1.0)
+        CONTINUATION.validate(self)
 
 
 @dataclass(frozen=True)
 class ChartSettings:
-    """The two-parameter chart (frequency x clearance at one restitution).
+    """The two-parameter chart (frequency x clearance at one restitution): the keys of :data:`CHART`.
 
     Attributes
     ----------
@@ -170,24 +190,17 @@ class ChartSettings:
         Periods dropped, and kept for the classification, at each point of the regime map.
     """
 
-    restitution: float = 0.2
-    clearance: tuple[float, float] = (1e-3, 6e-3)
-    kinds: tuple[str, ...] = CHART_KINDS
-    max_steps: int = 300
-    frequency_step: float = 0.25
-    clearance_num: int = 12
-    transient_periods: int = 300
-    strobes: int = 128
+    restitution: float = CHART.key("restitution").default
+    clearance: tuple[float, float] = CHART.key("clearance").default
+    kinds: tuple[str, ...] = CHART.key("kinds").default
+    max_steps: int = CHART.key("max_steps").default
+    frequency_step: float = CHART.key("frequency_step").default
+    clearance_num: int = CHART.key("clearance_num").default
+    transient_periods: int = CHART.key("transient_periods").default
+    strobes: int = CHART.key("strobes").default
 
     def __post_init__(self) -> None:
-        require_in_range("restitution", self.restitution, 0.0, 1.0)
-        if not 0.0 < self.clearance[0] < self.clearance[1]:
-            raise ValueError(f"clearance = {self.clearance!r}: expected 0 < start < stop [m]")
-        require_in_range("max_steps", self.max_steps, 1, 100_000)
-        require_positive("frequency_step", self.frequency_step)
-        require_in_range("clearance_num", self.clearance_num, 2, 1000)
-        require_in_range("transient_periods", self.transient_periods, 0, 1_000_000)
-        require_in_range("strobes", self.strobes, 64, 100_000)
+        CHART.validate(self)
 
     @property
     def clearances(self) -> np.ndarray:
@@ -271,9 +284,6 @@ class BifurcationSettings:
 
 #: Keys of the ``bifurcation`` section and of its parts.
 _KEYS = {"frequency", "restitution", "brute_force", "continuation", "chart", "bumper", "reference"}
-_BRUTE_KEYS = {"step", "transient_periods", "strobes", "directions"}
-_BRANCH_KEYS = {"one_impact", "period_doubling", "grazing", "linear", "brute_force", "max_steps", "max_step"}
-_CHART_KEYS = {"restitution", "clearance", "kinds", "max_steps", "frequency_step", "clearance_num", "transient_periods", "strobes"}
 
 
 def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
@@ -296,9 +306,9 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
             c.fail("bifurcation.frequency.stop", f"{high:g} must be greater than start = {low:g}")
             high = None
     restitution = c.grid("bifurcation.restitution", spec["restitution"], 0.0, 1.0, True) if "restitution" in spec else own_restitution
-    brute = _settings(c, "bifurcation.brute_force", spec.get("brute_force", {}), _BRUTE_KEYS, _brute_values)
-    branches = _settings(c, "bifurcation.continuation", spec.get("continuation", {}), _BRANCH_KEYS, _branch_values)
-    chart = _settings(c, "bifurcation.chart", spec["chart"], _CHART_KEYS, _chart_values) if "chart" in spec else None
+    brute = _settings(c, BRUTE_FORCE, spec.get("brute_force"), BruteForceSettings)
+    branches = _settings(c, CONTINUATION, spec.get("continuation"), BranchSettings)
+    chart = _settings(c, CHART, spec["chart"], ChartSettings) if "chart" in spec else None
     masses = None  # the mass each stop's bumper pushes [kg] (the paper's stop: M2)
     if layout is not None and specs is not None:
         masses = [item.effective_mass(layout.structure) for item in specs] if specs else [place_effective_mass((1, None, "upper"), layout.structure.mass_matrix)]
@@ -415,68 +425,8 @@ def _bumpers(c: Checker, value: Any, masses: list[float] | None) -> tuple[tuple[
     return tuple(math.sqrt(float(k) / mass) / (2.0 * math.pi) for k in grid), tuple(float(k) for k in grid)
 
 
-def _settings(c: Checker, key: str, value: Any, allowed: set[str], values: Any) -> Any:
-    """A settings dataclass from the mapping ``value`` under ``key``: ``values(c, key, spec)`` checks each entry and
-    returns (class, keyword arguments) or None; a failure of the class's own validation names the key."""
-    spec = c.mapping(key, value, allowed)
-    if set(map(str, spec)) - allowed:
-        return None
-    built = values(c, key, spec)
-    if built is None:
-        return None
-    kind, kwargs = built
-    try:
-        return kind(**kwargs)
-    except (ValueError, TypeError) as error:
-        c.fail(f"{key}.{str(error).split(' ')[0]}", str(error))
-        return None
-
-
-def _brute_values(c: Checker, key: str, spec: dict) -> tuple[type, dict] | None:
-    kwargs: dict[str, Any] = {}
-    if "step" in spec:
-        kwargs["step"] = c.number(f"{key}.step", spec["step"], 0.0, math.inf, low_inclusive=False)
-    if "transient_periods" in spec:
-        kwargs["transient_periods"] = c.integer(f"{key}.transient_periods", spec["transient_periods"], 0, 1_000_000)
-    if "strobes" in spec:
-        kwargs["strobes"] = c.integer(f"{key}.strobes", spec["strobes"], 1, 100_000)
-    if "directions" in spec:
-        kwargs["directions"] = c.choices(f"{key}.directions", spec["directions"], SWEEP_DIRECTIONS) or None
-    return None if None in kwargs.values() else (BruteForceSettings, kwargs)
-
-
-def _branch_values(c: Checker, key: str, spec: dict) -> tuple[type, dict] | None:
-    kwargs: dict[str, Any] = {}
-    for flag in ("one_impact", "period_doubling", "grazing", "linear", "brute_force"):
-        if flag in spec:
-            if not isinstance(spec[flag], bool):
-                c.fail(f"{key}.{flag}", f"expected true or false, got {spec[flag]!r}")
-                kwargs[flag] = None
-            else:
-                kwargs[flag] = spec[flag]
-    if "max_steps" in spec:
-        kwargs["max_steps"] = c.integer(f"{key}.max_steps", spec["max_steps"], 1, 100_000)
-    if "max_step" in spec:
-        kwargs["max_step"] = c.number(f"{key}.max_step", spec["max_step"], 1e-4, 1.0)
-    return None if None in kwargs.values() else (BranchSettings, kwargs)
-
-
-def _chart_values(c: Checker, key: str, spec: dict) -> tuple[type, dict] | None:
-    kwargs: dict[str, Any] = {}
-    if "restitution" in spec:
-        kwargs["restitution"] = c.number(f"{key}.restitution", spec["restitution"], 0.0, 1.0)
-    if "clearance" in spec:
-        band = c.mapping(f"{key}.clearance", spec["clearance"], {"start", "stop"}, {"start", "stop"})
-        start = c.number(f"{key}.clearance.start", band["start"], 0.0, 1.0, low_inclusive=False) if "start" in band else None
-        stop = c.number(f"{key}.clearance.stop", band["stop"], 0.0, 1.0, low_inclusive=False) if "stop" in band else None
-        if start is not None and stop is not None and stop <= start:
-            c.fail(f"{key}.clearance.stop", f"{stop:g} must be greater than start = {start:g}")
-        kwargs["clearance"] = (start, stop) if start is not None and stop is not None and stop > start else None
-    if "kinds" in spec:
-        kwargs["kinds"] = c.choices(f"{key}.kinds", spec["kinds"], CHART_KINDS) or None
-    for name, low, high in (("max_steps", 1, 100_000), ("clearance_num", 2, 1000), ("transient_periods", 0, 1_000_000), ("strobes", 64, 100_000)):
-        if name in spec:
-            kwargs[name] = c.integer(f"{key}.{name}", spec[name], low, high)
-    if "frequency_step" in spec:
-        kwargs["frequency_step"] = c.number(f"{key}.frequency_step", spec["frequency_step"], 0.0, math.inf, low_inclusive=False)
-    return None if None in kwargs.values() else (ChartSettings, kwargs)
+def _settings(c: Checker, section: Section, value: Any, kind: type[_Settings]) -> _Settings | None:
+    """The settings dataclass ``kind`` of a declared ``section`` read from ``value`` (every key, defaults filled in);
+    None with the problems recorded."""
+    values = section.read(c, value)
+    return kind(**values) if values is not None else None

@@ -50,7 +50,7 @@ from vibroimpact.scene.header import open_scene
 from vibroimpact.scene.layout_parse import parse_layout
 from vibroimpact.scene.schema import Scene
 
-__all__ = ["DESIGN_TOP_KEYS", "STOP_VARIABLES", "BUMPER_VARIABLE", "METHODS", "COMPARISONS", "Variable", "Mistuning", "SearchSettings", "DesignSettings", "parse_design_scene", "safe_name"]
+__all__ = ["DESIGN_TOP_KEYS", "SEARCH", "CERTIFY", "SECTIONS", "STOP_VARIABLES", "BUMPER_VARIABLE", "METHODS", "COMPARISONS", "Variable", "Mistuning", "SearchSettings", "DesignSettings", "parse_design_scene", "safe_name"]
 
 #: Top-level keys of a design scene.
 DESIGN_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "design", "report", "cluster"}
@@ -77,6 +77,8 @@ SEARCH = Section("design.search", (
 CERTIFY = Section("design.certify", (
     Key("candidates", int, "the best candidates certified by continuation, brute force and the tolerance box's corners", 1, 0, 20),
 ), "which candidates are certified")  # fmt: skip
+#: The sections of a design scene that are declared (``run-study --keys design`` lists them).
+SECTIONS = (SEARCH, CERTIFY)
 #: Most evaluations of one scene's search (candidates x mistuning samples).
 MAX_EVALUATIONS = 2_000_000
 
@@ -148,11 +150,7 @@ class SearchSettings:
     points: int = SEARCH.key("points").default
 
     def __post_init__(self) -> None:
-        c = Checker()  # the scene's own checks (:data:`SEARCH`): a string is no boolean, 4.5 no population
-        for key in SEARCH.keys:
-            key.check(c, key.name, getattr(self, key.name))
-        if c.problems:
-            raise ValueError("; ".join(c.problems))
+        SEARCH.validate(self)  # the scene's own checks: a string is no boolean, 4.5 no population
 
 
 @dataclass(frozen=True)
