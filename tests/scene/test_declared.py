@@ -15,6 +15,7 @@ import pytest
 import yaml
 
 from vibroimpact.kinds.bifurcation.scene import BRUTE_FORCE, CHART, CONTINUATION, BranchSettings, BruteForceSettings, ChartSettings
+from vibroimpact.kinds.concepts.scene import CONTINUATION as CONCEPTS_CONTINUATION
 from vibroimpact.kinds.design.scene import CERTIFY, SEARCH, SearchSettings
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.scene.declared import REQUIRED, Band, Key, Names, Section
@@ -26,31 +27,36 @@ from tests.kinds.design.test_design_scene import SCENE
 STUDIES = Path(__file__).resolve().parents[2] / "studies"
 
 
-def _design(section: str, values: dict[str, Any]) -> dict:
-    document = copy.deepcopy(SCENE)
-    document["design"][section.rpartition(".")[2]] = values
+def _shipped(name: str) -> dict:
+    return read_yaml((STUDIES / name).read_text(encoding="utf-8"))
+
+
+def _put(document: dict, path: str, values: dict[str, Any]) -> dict:
+    """``document`` with the section at the dotted ``path`` set to ``values``."""
+    *parents, leaf = path.split(".")
+    place = document
+    for parent in parents:
+        place = place[parent]
+    place[leaf] = values
     return document
 
 
-def _bifurcation(section: str, values: dict[str, Any]) -> dict:
-    document = read_yaml((STUDIES / "bifurcation.yaml").read_text(encoding="utf-8"))
-    document["bifurcation"][section.rpartition(".")[2]] = values
-    return document
-
-
-#: Each declared section: a scene of its kind with the section's values, and where each value lands in the settings.
+#: Each declared section: a scene of its kind, and where each of its values lands in the kind's settings.
 PLACES = {
-    SEARCH.path: (_design, lambda settings, name: getattr(settings.search, name)),
-    CERTIFY.path: (_design, lambda settings, name: settings.certified),
-    BRUTE_FORCE.path: (_bifurcation, lambda settings, name: getattr(settings.brute_force, name)),
-    CONTINUATION.path: (_bifurcation, lambda settings, name: getattr(settings.branches, name)),
-    CHART.path: (_bifurcation, lambda settings, name: getattr(settings.chart, name)),
-}
+    SEARCH.path: (lambda: copy.deepcopy(SCENE), lambda settings, name: getattr(settings.search, name)),
+    CERTIFY.path: (lambda: copy.deepcopy(SCENE), lambda settings, name: settings.certified),
+    BRUTE_FORCE.path: (lambda: _shipped("bifurcation.yaml"), lambda settings, name: getattr(settings.brute_force, name)),
+    CONTINUATION.path: (lambda: _shipped("bifurcation.yaml"), lambda settings, name: getattr(settings.branches, name)),
+    CHART.path: (lambda: _shipped("bifurcation.yaml"), lambda settings, name: getattr(settings.chart, name)),
+    CONCEPTS_CONTINUATION.path: (lambda: _shipped("absorber_concepts.yaml"),
+                                 lambda settings, name: settings.continuation_steps if name == "max_steps" else settings.continuation_steps > 0),
+}  # fmt: skip
 SECTIONS = [section for kind in KINDS for section in kind.sections()]
+KIND_OF = {section.path: kind.name for kind in KINDS for section in kind.sections()}
 
 
 def _scene(section: str, values: dict[str, Any]) -> dict:
-    return PLACES[section][0](section, values)
+    return _put(PLACES[section][0](), section, values)
 
 
 def _other_value(key: Key) -> Any:
@@ -118,12 +124,12 @@ def test_each_wrong_type_is_refused_naming_its_key(section: Section) -> None:
             assert any(line.startswith(f"{section.path}.{key.name}: expected") for line in caught.value.problems), (key.name, wrong, caught.value.problems)
 
 
-@pytest.mark.parametrize("kind", sorted({section.path.partition(".")[0] for section in SECTIONS}))
+@pytest.mark.parametrize("kind", sorted(set(KIND_OF.values())))
 def test_a_scene_with_every_key_wrong_is_refused_at_once_with_exit_2_and_nothing_written(tmp_path: Path, kind: str) -> None:
-    sections = [section for section in SECTIONS if section.path.startswith(f"{kind}.")]
-    document = _scene(sections[0].path, {})
+    sections = [section for section in SECTIONS if KIND_OF[section.path] == kind]
+    document = PLACES[sections[0].path][0]()
     for section in sections:
-        document[kind][section.path.rpartition(".")[2]] = {key.name: _wrong_values(key)[0] for key in section.keys}
+        _put(document, section.path, {key.name: _wrong_values(key)[0] for key in section.keys})
     path = tmp_path / "wrong.yaml"
     path.write_text(yaml.safe_dump(document), encoding="utf-8")
     out = tmp_path / "out"

@@ -41,10 +41,11 @@ from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem, System
 from vibroimpact.scene.layout_parse import parse_stops
+from vibroimpact.scene.declared import Key, Section
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.simulation.settings import SteadySettings
 
-__all__ = ["Concept", "ConceptsSettings", "bumper_twin", "CONCEPTS_TOP_KEYS", "parse_concepts", "parse_concepts_scene", "MAX_CONCEPTS"]
+__all__ = ["CONTINUATION", "SECTIONS", "Concept", "ConceptsSettings", "bumper_twin", "CONCEPTS_TOP_KEYS", "parse_concepts", "parse_concepts_scene", "MAX_CONCEPTS"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -103,6 +104,15 @@ def bumper_twin(law: Any, bumper_frequency: float) -> KelvinVoigtBumper:
     return KelvinVoigtBumper(law.clearance, bumper_frequency, loss_factor_from_restitution(law.restitution))
 
 
+#: ``continuation``, declared (:mod:`vibroimpact.scene.declared`).
+CONTINUATION = Section("continuation", (
+    Key("enabled", bool, "continue each concept's branches from its closed-form and simulated orbits", True),
+    Key("max_steps", int, "points per continued branch and direction, at most (0: none)", 400, 0, 100_000),
+), "the concepts' continued branches")  # fmt: skip
+#: The sections of a concepts scene that are declared (``run-study --keys`` lists them).
+SECTIONS = (CONTINUATION,)
+
+
 @dataclass(frozen=True, eq=False)
 class ConceptsSettings:
     """Everything a concepts study computes from.
@@ -137,7 +147,7 @@ class ConceptsSettings:
     engine: EngineSettings = field(default_factory=EngineSettings)
     steady: SteadySettings = field(default_factory=SteadySettings)
     bumper_frequency: float = math.nan
-    continuation_steps: int = 400
+    continuation_steps: int = CONTINUATION.key("max_steps").default
 
     @property
     def static_deflection(self) -> float:
@@ -153,7 +163,6 @@ _UNUSED_SIMULATION_KEYS = {
     "lyapunov_periods": "a concepts scene does not classify non-periodic motion (its steady states march, then measure "
     "irregular_measure_periods); stepped scenes do",
 }
-_CONTINUATION_KEYS = {"max_steps", "enabled"}
 #: Most concepts of one scene (a table row and a panel each).
 MAX_CONCEPTS = 12
 #: Most time-domain frequencies per concept.
@@ -175,15 +184,8 @@ def parse_concepts(document: Any, source: str = "scene") -> tuple[str, str, bool
         bumper = c.mapping("bumper", doc["bumper"], {"frequency"}, {"frequency"})
         if "frequency" in bumper:
             bumper_frequency = c.number("bumper.frequency", bumper["frequency"], 0.0, 1e6, low_inclusive=False) or math.nan
-    steps = 400
-    if "continuation" in doc:
-        spec = c.mapping("continuation", doc["continuation"], _CONTINUATION_KEYS)
-        if "max_steps" in spec:
-            steps = c.integer("continuation.max_steps", spec["max_steps"], 0, 100_000) or 0
-        if spec.get("enabled", True) is False:
-            steps = 0
-        elif "enabled" in spec and spec["enabled"] is not True:
-            c.fail("continuation.enabled", f"expected true or false, got {spec['enabled']!r}")
+    continuation = CONTINUATION.read(c, doc.get("continuation")) or {}
+    steps = continuation.get("max_steps", 0) if continuation.get("enabled") else 0
     concepts = _concepts(c, doc["concepts"], system) if "concepts" in doc and system is not None else ()
     if c.problems:
         raise SceneError(c.problems, source)
