@@ -101,9 +101,9 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.keys:
         from vibroimpact.scene.declared import reference_table
-        from vibroimpact.scene.kinds import KINDS
+        from vibroimpact.scene.kinds import declared_sections
 
-        print(reference_table([section for kind in KINDS for section in kind.sections()]))
+        print(reference_table(declared_sections()))
         return 0
     if args.scene is None:
         parser.print_usage(sys.stderr)

@@ -19,7 +19,8 @@ from vibroimpact.kinds.concepts.scene import CONTINUATION as CONCEPTS_CONTINUATI
 from vibroimpact.kinds.design.scene import CERTIFY, SEARCH, SearchSettings
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.scene.declared import REQUIRED, Band, Key, Names, Section
-from vibroimpact.scene.kinds import KINDS
+from vibroimpact.scene.grid import ADMISSIBILITY, SWEPT_SINE
+from vibroimpact.scene.kinds import KINDS, declared_sections
 from vibroimpact.scene.reader import parse_scene, read_yaml
 
 from tests.kinds.design.test_design_scene import SCENE
@@ -36,11 +37,13 @@ def _put(document: dict, path: str, values: dict[str, Any]) -> dict:
     *parents, leaf = path.split(".")
     place = document
     for parent in parents:
-        place = place[parent]
+        place = place.setdefault(parent, {})
     place[leaf] = values
     return document
 
 
+#: The swept-sine settings' names of its scene keys where they differ.
+SWEPT_FIELDS = {"start": "start_frequency", "stop": "stop_frequency"}
 #: Each declared section: a scene of its kind, and where each of its values lands in the kind's settings.
 PLACES = {
     SEARCH.path: (lambda: copy.deepcopy(SCENE), lambda settings, name: getattr(settings.search, name)),
@@ -50,17 +53,29 @@ PLACES = {
     CHART.path: (lambda: _shipped("bifurcation.yaml"), lambda settings, name: getattr(settings.chart, name)),
     CONCEPTS_CONTINUATION.path: (lambda: _shipped("absorber_concepts.yaml"),
                                  lambda settings, name: settings.continuation_steps if name == "max_steps" else settings.continuation_steps > 0),
+    SWEPT_SINE.path: (lambda: _shipped("bumper_sweep.yaml"), lambda settings, name: getattr(settings.swept_sine, SWEPT_FIELDS.get(name, name))),
+    ADMISSIBILITY.path: (lambda: _shipped("restitution.yaml"), lambda settings, name: getattr(settings.admissibility, name)),
 }  # fmt: skip
-SECTIONS = [section for kind in KINDS for section in kind.sections()]
-KIND_OF = {section.path: kind.name for kind in KINDS for section in kind.sections()}
+SECTIONS = list(declared_sections())
+KIND_OF = {section.path: kind.name for kind in reversed(KINDS) for section in kind.sections()}  # a shared section: the first kind's
 
 
 def _scene(section: str, values: dict[str, Any]) -> dict:
     return _put(PLACES[section][0](), section, values)
 
 
-def _other_value(key: Key) -> Any:
-    """A valid value of ``key`` other than its default."""
+def _required(section: Section) -> dict[str, Any]:
+    """The values the section's shipped scene gives its required keys."""
+    place = PLACES[section.path][0]()
+    for part in section.path.split("."):
+        place = place.get(part, {})
+    return {key.name: place[key.name] for key in section.keys if key.default is REQUIRED}
+
+
+def _other_value(key: Key, given: Any = None) -> Any:
+    """A valid value of ``key`` other than its default (a required key's: other than ``given``, its scene's)."""
+    if key.default is REQUIRED:
+        return given * 1.01
     if key.type is bool:
         return not key.default
     if key.type is str:
@@ -82,7 +97,7 @@ def _wrong_values(key: Key) -> list[Any]:
     if key.type is int:
         return [float(key.default) + 0.5, str(key.default), True]
     if key.type is float:
-        return [str(key.default), True]
+        return [f"~{key.default}", True]  # a string PyYAML writes bare ('1e-09') would read back as a YAML 1.2 number
     if key.type is Names:
         return [key.choices[0], True]
     if key.type is Band:
@@ -101,9 +116,10 @@ def test_every_declared_section_of_every_kind_is_walked_here() -> None:
 
 @pytest.mark.parametrize("section", SECTIONS, ids=lambda s: s.path)
 def test_every_declared_key_reaches_the_settings(section: Section) -> None:
+    required = _required(section)
     for key in section.keys:
-        value = _other_value(key)
-        given = _method_of(section, key) | {key.name: key.as_written(value)}
+        value = _other_value(key, required.get(key.name))
+        given = required | _method_of(section, key) | {key.name: key.as_written(value)}
         settings = parse_scene(_scene(section.path, given)).settings
         assert PLACES[section.path][1](settings, key.name) == value, (key.name, value)
 
@@ -116,9 +132,10 @@ def test_search_settings_have_exactly_the_declared_keys() -> None:
 
 @pytest.mark.parametrize("section", SECTIONS, ids=lambda s: s.path)
 def test_each_wrong_type_is_refused_naming_its_key(section: Section) -> None:
+    required = _required(section)
     for key in section.keys:
         for wrong in _wrong_values(key):
-            given = _method_of(section, key) | {key.name: wrong}
+            given = required | _method_of(section, key) | {key.name: wrong}
             with pytest.raises(SceneError) as caught:
                 parse_scene(_scene(section.path, given))
             assert any(line.startswith(f"{section.path}.{key.name}: expected") for line in caught.value.problems), (key.name, wrong, caught.value.problems)

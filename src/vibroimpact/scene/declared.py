@@ -194,9 +194,11 @@ class Section:
                 return key
         raise KeyError(f"section {self.path} declares no key {name!r} (its keys: {', '.join(self.names)})")
 
-    def read(self, c: Checker, value: Any) -> dict[str, Any] | None:
+    def read(self, c: Checker, value: Any, partial: bool = False) -> dict[str, Any] | None:
         """Every declared key's value from the parsed ``value`` (None or a mapping), defaults filled in; None, with
-        every problem recorded in ``c`` (each naming its key), where anything is wrong."""
+        every problem recorded in ``c`` (each naming its key), where anything is wrong. ``partial``: where keys are
+        wrong, the others' values all the same (a wrong or missing key's None), so that checks across keys can still
+        say their problems at once; None only where ``value`` is no mapping."""
         if value is None:
             value = {}
         if not isinstance(value, dict):
@@ -213,6 +215,7 @@ class Section:
                 read[key.name] = key.check(c, where, value[key.name])
             elif key.default is REQUIRED:
                 c.fail(where, f"required key is missing ({key.doc}; {key.allowed()})")
+                read[key.name] = None
             else:
                 read[key.name] = key.default
         for key in self.keys:
@@ -222,7 +225,7 @@ class Section:
             chosen = read.get(other)
             if chosen is not None and chosen != wanted:
                 c.fail(f"{self.path}.{key.name}", f"not read with {other}: {chosen} (only with {other}: {wanted}); remove it or choose {other}: {wanted}")
-        return read if len(c.problems) == before else None
+        return read if partial or len(c.problems) == before else None
 
     def validate(self, settings: Any) -> None:
         """Check the attributes of a settings dataclass built from Python (each declared key's attribute, written as

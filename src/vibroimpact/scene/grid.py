@@ -27,6 +27,7 @@ from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.modal import underdamped_mode_count
 from vibroimpact.scene.bumper_parse import BUMPER_KEYS, PHYSICAL_KEYS, scene_bumper
 from vibroimpact.scene.checker import Checker, SceneError, interval
+from vibroimpact.scene.declared import REQUIRED, Key, Names, Section
 from vibroimpact.scene.header import check_sweep_run, open_scene
 from vibroimpact.scene.layout_parse import check_layout_solutions, parse_layout, parse_sweep_stops
 from vibroimpact.scene.stop_grids import stop_grids
@@ -45,7 +46,7 @@ from vibroimpact.scene.schema import (
 )
 from vibroimpact.scene.simulation import SimulationSettings, parse_simulation
 
-__all__ = ["GridSettings", "SweptSineSettings", "TOP_KEYS", "parse_grid_scene"]
+__all__ = ["GridSettings", "SweptSineSettings", "SWEPT_SINE", "ADMISSIBILITY", "TOP_KEYS", "parse_grid_scene"]
 
 #: Top-level keys of a grid scene.
 TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bumper", "sweep", "swept_sine", "solutions", "quantities", "settings", "simulation", "report", "cluster"}
@@ -53,6 +54,23 @@ TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bum
 _STEADY_ONLY_KEYS = {"frequency", "start", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods", "subset"}
 #: Where an unswept parameter is given instead (``frequency`` is always swept).
 _FIXED_PLACE = {"restitution": ("stop", "restitution"), "clearance": ("stop", "clearance"), "bumper_frequency": ("bumper", "frequency"), "bumper_loss_factor": ("bumper", "loss_factor")}
+
+
+#: ``swept_sine``, declared (:mod:`vibroimpact.scene.declared`); :class:`SweptSineSettings` in this order.
+SWEPT_SINE = Section("swept_sine", (
+    Key("start", float, "the sweep's lower end", REQUIRED, 0.0, math.inf, "Hz", open_low=True),
+    Key("stop", float, "the sweep's upper end (a sweep down runs from it to start)", REQUIRED, 0.0, math.inf, "Hz", open_low=True),
+    Key("rate", float, "|alpha|, how fast the frequency moves", REQUIRED, 0.0, math.inf, "Hz s-1", open_low=True),
+    Key("directions", Names, "which ways it sweeps", SWEEP_DIRECTIONS, choices=SWEEP_DIRECTIONS),
+    Key("sample_rate", float, "output samples per second of the simulated signals", 1000.0, 0.0, 1e7, "Hz", open_low=True),
+    Key("window_cycles", int, "cycles of the excitation in the running estimators' window", 8, 1, 10_000),
+    Key("initial_state", str, "linear: each run starts on the linear steady state (where it fits), rest: at rest", "linear", choices=("linear", "rest")),
+), "a swept-sine test (the paper's Simulink run) instead of stepped steady states")  # fmt: skip
+#: ``settings.admissibility``, declared: how the closed form's X2(t) <= Delta is checked.
+ADMISSIBILITY = Section("settings.admissibility", (
+    Key("samples_per_period", int, "uniform samples of X2(t) per period before the largest is refined", AdmissibilitySettings.samples_per_period, 16, 1_000_000),
+    Key("relative_tolerance", float, "how far X2(t) may exceed Delta, a fraction of (Delta + q |H12|)", AdmissibilitySettings.relative_tolerance, 0.0, 1e-2),
+), "the closed forms' admissibility check")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -241,15 +259,8 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     admissibility = AdmissibilitySettings()
     if "settings" in doc:
         settings = c.mapping("settings", doc["settings"], {"admissibility"})
-        if "admissibility" in settings:
-            adm = c.mapping("settings.admissibility", settings["admissibility"], {"samples_per_period", "relative_tolerance"})
-            kwargs: dict[str, Any] = {}
-            if "samples_per_period" in adm:
-                kwargs["samples_per_period"] = c.integer("settings.admissibility.samples_per_period", adm["samples_per_period"], 16, 1_000_000)
-            if "relative_tolerance" in adm:
-                kwargs["relative_tolerance"] = c.number("settings.admissibility.relative_tolerance", adm["relative_tolerance"], 0.0, 1e-2)
-            if None not in kwargs.values():
-                admissibility = AdmissibilitySettings(**kwargs)
+        if "admissibility" in settings and (values := ADMISSIBILITY.read(c, settings["admissibility"])) is not None:
+            admissibility = AdmissibilitySettings(**values)
 
     simulation = None
     engines = [name for name in solutions if name in ENGINE_SOLUTIONS]
@@ -306,18 +317,12 @@ def _check_bumper_stiffness(c: Checker, where: str, names: list[str], layout: La
 def _parse_swept_sine(c: Checker, value: Any, engines: list[str], grid: np.ndarray | None) -> SweptSineSettings | None:
     """``swept_sine: {start, stop, rate, directions, sample_rate, window_cycles, initial_state}`` (frequencies [Hz],
     rate [Hz s-1]); every problem is reported."""
-    spec = c.mapping("swept_sine", value, {"start", "stop", "rate", "directions", "sample_rate", "window_cycles", "initial_state"}, {"start", "stop", "rate"})
     if engines != ["compliant"]:
         c.fail("solutions", f"a swept-sine test runs the compliant solution only (and needs it): got {engines or 'none'}")
-    start = c.number("swept_sine.start", spec["start"], 0.0, math.inf, low_inclusive=False) if "start" in spec else None
-    stop = c.number("swept_sine.stop", spec["stop"], 0.0, math.inf, low_inclusive=False) if "stop" in spec else None
-    rate = c.number("swept_sine.rate", spec["rate"], 0.0, math.inf, low_inclusive=False) if "rate" in spec else None
-    directions = c.choices("swept_sine.directions", spec["directions"], SWEEP_DIRECTIONS) if "directions" in spec else SWEEP_DIRECTIONS
-    sample_rate = c.number("swept_sine.sample_rate", spec.get("sample_rate", 1000.0), 0.0, 1e7, low_inclusive=False)
-    cycles = c.integer("swept_sine.window_cycles", spec.get("window_cycles", 8), 1, 10_000)
-    initial = spec.get("initial_state", "linear")
-    if initial not in ("linear", "rest"):
-        c.fail("swept_sine.initial_state", f"{initial!r} is not allowed: use linear or rest")
+    spec = SWEPT_SINE.read(c, value, partial=True)  # the checks across keys below still say their problems
+    if spec is None:
+        return None
+    start, stop, rate, directions, sample_rate, cycles, initial = (spec[key] for key in SWEPT_SINE.names)
     if start is None or stop is None:
         return None
     if stop <= start:
@@ -326,6 +331,6 @@ def _parse_swept_sine(c: Checker, value: Any, engines: list[str], grid: np.ndarr
     rate, sample_rate = check_sweep_run(c, "swept_sine", start, stop, rate, sample_rate, cycles, " or swept_sine.window_cycles")
     if grid is not None and not np.any((grid >= start) & (grid <= stop)):
         c.fail("sweep.frequency", f"no frequency of the grid lies in the swept band [{start:g}, {stop:g}] Hz, where the running estimates are reported")
-    if rate is None or sample_rate is None or cycles is None or not directions or initial not in ("linear", "rest"):
+    if rate is None or sample_rate is None or cycles is None or directions is None or initial is None:
         return None
     return SweptSineSettings(start, stop, rate, directions, sample_rate, cycles, initial)
