@@ -18,9 +18,10 @@ from vibroimpact.kinds.bifurcation.scene import BRUTE_FORCE, CHART, CONTINUATION
 from vibroimpact.kinds.concepts.scene import CONTINUATION as CONCEPTS_CONTINUATION
 from vibroimpact.kinds.design.scene import CERTIFY, SEARCH, SearchSettings
 from vibroimpact.scene.checker import Checker, SceneError
-from vibroimpact.scene.declared import REQUIRED, Band, Key, Names, Section
+from vibroimpact.scene.declared import DERIVED, REQUIRED, Band, Grid, Key, Names, Section, Table
 from vibroimpact.scene.grid import ADMISSIBILITY, SWEPT_SINE
 from vibroimpact.scene.kinds import KINDS, declared_sections
+from vibroimpact.scene.simulation import SIMULATION
 from vibroimpact.scene.reader import parse_scene, read_yaml
 
 from tests.kinds.design.test_design_scene import SCENE
@@ -55,7 +56,21 @@ PLACES = {
                                  lambda settings, name: settings.continuation_steps if name == "max_steps" else settings.continuation_steps > 0),
     SWEPT_SINE.path: (lambda: _shipped("bumper_sweep.yaml"), lambda settings, name: getattr(settings.swept_sine, SWEPT_FIELDS.get(name, name))),
     ADMISSIBILITY.path: (lambda: _shipped("restitution.yaml"), lambda settings, name: getattr(settings.admissibility, name)),
+    SIMULATION.path: (lambda: _shipped("restitution.yaml"), lambda settings, name: _simulation_value(settings.simulation, name)),
 }  # fmt: skip
+#: A valid value, for the walk, of each key whose default the kind derives.
+DERIVED_VALUES = {"simulation.frequency": [20.0, 30.0], "simulation.rtol": 1e-6, "simulation.atol": 1e-9, "simulation.subset": {"momentary": {"frequency": [25.0]}}}
+
+
+def _simulation_value(simulation: Any, name: str) -> Any:
+    """Where the ``simulation`` section's key ``name`` lands in the scene's simulation settings (arrays as lists)."""
+    if name == "frequency":
+        return simulation.frequency.tolist()
+    if name == "subset":
+        return {solution: {axis: values.tolist() for axis, values in axes.items()} for solution, axes in simulation.subset.items()}
+    if name in ("start",):
+        return simulation.start
+    return getattr(simulation.engine if name in ("method", "rtol", "atol", "max_step") else simulation.steady, name)
 SECTIONS = list(declared_sections())
 KIND_OF = {section.path: kind.name for kind in reversed(KINDS) for section in kind.sections()}  # a shared section: the first kind's
 
@@ -72,10 +87,12 @@ def _required(section: Section) -> dict[str, Any]:
     return {key.name: place[key.name] for key in section.keys if key.default is REQUIRED}
 
 
-def _other_value(key: Key, given: Any = None) -> Any:
+def _other_value(key: Key, given: Any = None, section_path: str = "") -> Any:
     """A valid value of ``key`` other than its default (a required key's: other than ``given``, its scene's)."""
     if key.default is REQUIRED:
         return given * 1.01
+    if key.default is DERIVED:
+        return DERIVED_VALUES[f"{section_path}.{key.name}"]
     if key.type is bool:
         return not key.default
     if key.type is str:
@@ -102,6 +119,10 @@ def _wrong_values(key: Key) -> list[Any]:
         return [key.choices[0], True]
     if key.type is Band:
         return [list(key.default), 3]
+    if key.type is Grid:
+        return ["20 Hz", True]
+    if key.type is Table:
+        return [[1, 2], "momentary"]
     return [3, True]
 
 
@@ -118,7 +139,7 @@ def test_every_declared_section_of_every_kind_is_walked_here() -> None:
 def test_every_declared_key_reaches_the_settings(section: Section) -> None:
     required = _required(section)
     for key in section.keys:
-        value = _other_value(key, required.get(key.name))
+        value = _other_value(key, required.get(key.name), section.path)
         given = required | _method_of(section, key) | {key.name: key.as_written(value)}
         settings = parse_scene(_scene(section.path, given)).settings
         assert PLACES[section.path][1](settings, key.name) == value, (key.name, value)

@@ -578,10 +578,10 @@ def test_simulation_grid_is_merged_into_the_frequency_axis() -> None:
 @pytest.mark.parametrize(
     ("simulation", "fragment"),
     [
-        ({"start": "middle"}, "simulation.start: 'middle' is not allowed: use one of linear, pgf, rest, shooting, sweep_up, sweep_down"),
-        ({"rtol": 5.0}, "simulation.rtol: rtol = 5.0 is out of range: allowed [1e-15, 0.1]"),
-        ({"method": "rk4"}, "simulation.method: method = 'rk4' is not allowed"),
-        ({"max_periods": 0}, "simulation.max_periods: max_periods = 0 is out of range"),
+        ({"start": "middle"}, "simulation.start: 'middle' is not allowed: allowed linear, pgf, rest, shooting, sweep_up, sweep_down"),
+        ({"rtol": 5.0}, "simulation.rtol: 5.0 is out of range: allowed [1e-15, 0.1]"),
+        ({"method": "rk4"}, "simulation.method: 'rk4' is not allowed: allowed adams, bdf"),
+        ({"max_periods": 0}, "simulation.max_periods: 0 is out of range: allowed [1, 100000000]"),
         ({"frequency": [-1.0]}, "simulation.frequency[0]: -1.0 is out of range"),
         ({"colour": 1}, "simulation.colour: unknown key"),
     ],

@@ -44,7 +44,7 @@ def test_subset_keeps_the_named_values_snapped_onto_their_grids() -> None:
         ({"compliant": {"restitution": [0.3]}}, {}, "simulation.subset.compliant.restitution: 0.3 not on the grid of sweep.restitution: allowed one of 0.2, 0.6 [-]"),
         ({"compliant": {"phase": [1.0]}}, {}, "simulation.subset.compliant.phase: unknown key"),
         ({"compliant": {}}, {}, "simulation.subset.compliant: empty: name at least one axis of frequency, restitution"),
-        ([22.0], {}, "simulation.subset: expected a mapping {solution: {axis: values}}"),
+        ([22.0], {}, "simulation.subset: expected a mapping, got [22.0] (list): {solution: {axis: [values]}}"),
         ({"compliant": {"frequency": [22.0]}}, {"start": "sweep_up"}, "simulation.subset.compliant.frequency: a stepped sweep (start: sweep_up) follows every simulated frequency"),
     ],
 )

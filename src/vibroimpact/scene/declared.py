@@ -20,7 +20,7 @@ from typing import Any
 
 from vibroimpact.scene.checker import Checker, did_you_mean, interval
 
-__all__ = ["Key", "Section", "REQUIRED", "Names", "Band", "reference_table"]
+__all__ = ["Key", "Section", "REQUIRED", "DERIVED", "Names", "Band", "Grid", "Table", "reference_table"]
 
 
 class _Required:
@@ -33,6 +33,17 @@ class _Required:
 #: The default of a key the scene must give.
 REQUIRED: Any = _Required()
 
+
+class _Derived:
+    """The default of a key whose value, where the scene does not give it, follows from other keys (its doc says how)."""
+
+    def __repr__(self) -> str:
+        return "DERIVED"
+
+
+#: The default of a key whose value the kind derives where the scene does not give it (read as None).
+DERIVED: Any = _Derived()
+
 class Names:
     """The type of a key whose value is a non-empty list of names from its choices, none repeated (read as a tuple)."""
 
@@ -42,9 +53,19 @@ class Band:
     the tuple ``(start, stop)``)."""
 
 
+class Grid:
+    """The type of a key whose value is a grid: a list of values or ``{start, stop, step | num}`` in the key's range
+    (read as the sorted values, an array)."""
+
+
+class Table:
+    """The type of a key whose value is a mapping its own parser checks entry by entry (its doc names the form)."""
+
+
 #: The YAML type each Python type of a key is written as, in messages and in the reference.
-_TYPE_NAMES = {bool: "boolean (true or false)", int: "integer", float: "number", str: "name", Names: "list of names", Band: "band {start, stop}"}
-_ARTICLES = {bool: "a", int: "an", float: "a", str: "a", Names: "a", Band: "a"}
+_TYPE_NAMES = {bool: "boolean (true or false)", int: "integer", float: "number", str: "name", Names: "list of names", Band: "band {start, stop}",
+               Grid: "grid: [values] or {start, stop, step | num}", Table: "mapping"}
+_ARTICLES = {bool: "a", int: "an", float: "a", str: "a", Names: "a", Band: "a", Grid: "a", Table: "a"}
 
 
 @dataclass(frozen=True)
@@ -87,12 +108,12 @@ class Key:
 
     def __post_init__(self) -> None:
         if self.type not in _TYPE_NAMES:
-            raise TypeError(f"Key {self.name!r}: type {self.type!r} is not one of bool, int, float, str, Names, Band")
+            raise TypeError(f"Key {self.name!r}: type {self.type!r} is not one of bool, int, float, str, Names, Band, Grid, Table")
         if self.choices and self.type not in (str, Names):
             raise TypeError(f"Key {self.name!r}: choices are names, for a str or Names key only")
         if self.type is Names and not self.choices:
             raise TypeError(f"Key {self.name!r}: a Names key lists its choices")
-        if self.default is not REQUIRED and self.check(Checker(), self.name, self.as_written(self.default)) is None:
+        if self.default is not REQUIRED and self.default is not DERIVED and self.check(Checker(), self.name, self.as_written(self.default)) is None:
             raise ValueError(f"Key {self.name!r}: its default {self.default!r} fails its own check")
 
     def allowed(self) -> str:
@@ -104,7 +125,7 @@ class Key:
         kind = _TYPE_NAMES[self.type]
         if self.type is int and math.isfinite(self.low) and math.isfinite(self.high):
             return f"{kind} in [{int(self.low)}, {int(self.high)}]"
-        if self.type in (int, float, Band) and (math.isfinite(self.low) or math.isfinite(self.high)):
+        if self.type in (int, float, Band, Grid) and (math.isfinite(self.low) or math.isfinite(self.high)):
             return f"{kind} in {interval(self.low, self.high, not self.open_low)}" + (f" [{self.unit}]" if self.unit else "")
         return kind + (f" [{self.unit}]" if self.unit else "")
 
@@ -115,6 +136,8 @@ class Key:
             return {"start": value[0], "stop": value[1]}
         if self.type is Names and isinstance(value, tuple):
             return list(value)
+        if self.type is Grid and hasattr(value, "tolist"):
+            return value.tolist()
         return value
 
     def check(self, c: Checker, where: str, value: Any) -> Any:
@@ -151,6 +174,13 @@ class Key:
                 c.fail(f"{where}.stop", f"{stop:g} must be greater than start = {start:g}")
                 return None
             return (start, stop)
+        if self.type is Grid:
+            return c.grid(where, value, self.low, self.high, not self.open_low)
+        if self.type is Table:
+            if not isinstance(value, dict):
+                c.fail(where, f"{wrong}: {self.doc}")
+                return None
+            return value
         return c.number(where, value, self.low, self.high, not self.open_low)
 
 
@@ -216,6 +246,8 @@ class Section:
             elif key.default is REQUIRED:
                 c.fail(where, f"required key is missing ({key.doc}; {key.allowed()})")
                 read[key.name] = None
+            elif key.default is DERIVED:
+                read[key.name] = None
             else:
                 read[key.name] = key.default
         for key in self.keys:
@@ -240,7 +272,7 @@ class Section:
         """The section's rows of the grammar reference: ``| key | allowed | default | what it sets |`` (markdown)."""
         rows = []
         for key in self.keys:
-            default = "required" if key.default is REQUIRED else _written(key.as_written(key.default))
+            default = "required" if key.default is REQUIRED else "derived" if key.default is DERIVED else _written(key.as_written(key.default))
             when = f" (read with {key.read_when[0]}: {key.read_when[1]})" if key.read_when else ""
             rows.append(f"| `{self.path}.{key.name}` | {key.allowed()} | {default} | {key.doc}{when} |")
         return rows
