@@ -305,7 +305,7 @@ class Runner:
         token = uuid.uuid4().hex[:12]
         topic = f"vibroimpact-progress-{token}"
         client.subscribe_topic(topic, lambda event: bar.partial(*event[1]))
-        shared_data = client.scatter(shared, broadcast=True, hash=False) if shared is not None else None
+        shared_data = _broadcast(connection, shared, bar) if shared is not None else None
         source = source_hash()  # a worker running other code refuses the task rather than mixing its results in
         queue = iter(order)
         running: dict[Any, int] = {}
@@ -377,6 +377,11 @@ class WorkerDied(RuntimeError):
 ALLOWED_FAILURES = 3
 #: How long a cluster may have no worker at all before the study gives up [s].
 NO_WORKER_TIMEOUT = 120.0
+#: How long one broadcast of the shared data waits for a worker to send it to [s] (dask's own wait otherwise: the
+#: client's timeout, 30 s); none there by then: :func:`_wait_for_a_worker`, then the broadcast again.
+BROADCAST_TIMEOUT = 5.0
+#: How many broadcasts of the shared data are tried before the study gives up (each lost to workers that left).
+BROADCAST_TRIES = 3
 
 
 def _wait_for_a_worker(connection: Connection) -> None:
@@ -387,6 +392,33 @@ def _wait_for_a_worker(connection: Connection) -> None:
         connection.client.wait_for_workers(1, timeout=NO_WORKER_TIMEOUT)  # type: ignore[attr-defined]
     except TimeoutError:
         raise ClusterLost(f"the dask scheduler at {connection.address} has no workers: none joined within {NO_WORKER_TIMEOUT:g} s") from None
+
+
+def _broadcast(connection: Connection, shared: Any, bar: ProgressBar) -> Any:
+    """``shared`` on every worker (the future of ``client.scatter(broadcast=True)``), sent again when the workers left
+    while it was sent: the count of workers before it is no promise that one is still there. A broadcast that finds
+    no worker within :data:`BROADCAST_TIMEOUT` (``TimeoutError``), or whose worker leaves as the data goes to it
+    (``OSError``: the connection closed; ``ValueError``: no worker left to copy it to), waits for a worker to join
+    (:func:`_wait_for_a_worker`) and is tried again, :data:`BROADCAST_TRIES` times in all (before: exit 1 with dask's
+    ``TimeoutError: No valid workers found`` in one line).
+
+    Raises
+    ------
+    ClusterLost
+        When the scheduler is lost, no worker joins within :data:`NO_WORKER_TIMEOUT`, or every try lost its workers.
+    """
+    client: Any = connection.client
+    failure = ""
+    for _ in range(BROADCAST_TRIES):
+        try:
+            return client.scatter(shared, broadcast=True, hash=False, timeout=BROADCAST_TIMEOUT)
+        except (TimeoutError, OSError, ValueError) as error:
+            _check(client, connection.address)  # the scheduler itself gone: said as such, at once
+            failure = f"{type(error).__name__}: {error}" if str(error) else type(error).__name__
+        bar.set_status(f"waiting for a worker to join the dask scheduler (at most {NO_WORKER_TIMEOUT:.0f} s)")
+        _wait_for_a_worker(connection)
+        bar.set_status("waiting for the workers' first results")
+    raise ClusterLost(f"the dask scheduler at {connection.address} has no workers: they left during each of {BROADCAST_TRIES} broadcasts of the study's shared data ({failure})")
 
 
 def _check_workers(connection: Connection, alone_since: list[float]) -> None:

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -269,6 +270,8 @@ def linear_segments(problem: ImpactProblem, low: float, high: float, step: float
 
     def gap(f: float) -> float:
         linear = linear_amplitudes(problem, omega=2.0 * np.pi * f)
+        if not np.all(linear.conditioned):  # an undamped resonance's band: NaN amplitudes, the orbit unbounded
+            return -np.inf
         return float(np.min(clearances - linear.stop_static - np.abs(linear.stop_amplitudes)))
 
     fits = np.array([gap(f) >= 0.0 for f in frequency])
@@ -278,11 +281,30 @@ def linear_segments(problem: ImpactProblem, low: float, high: float, step: float
             continue
         inner = list(frequency[run])
         if run[0] > 0:
-            inner.insert(0, brentq(gap, frequency[run[0] - 1], frequency[run[0]], xtol=1e-12))
+            inner.insert(0, _grazing_end(gap, frequency[run[0]], frequency[run[0] - 1]))
         if run[-1] < frequency.size - 1:
-            inner.append(brentq(gap, frequency[run[-1]], frequency[run[-1] + 1], xtol=1e-12))
+            inner.append(_grazing_end(gap, frequency[run[-1]], frequency[run[-1] + 1]))
         segments.append(np.array(inner))
     return segments
+
+
+def _grazing_end(gap: Callable[[float], float], inside: float, outside: float) -> float:
+    """Where the linear orbit's least ``gap`` [m] to a stop reaches 0 between ``inside`` (it fits: gap >= 0) and
+    ``outside`` (it does not) [Hz]: brentq to 1e-12 Hz. An ``outside`` in the band of an undamped resonance (gap -inf:
+    the response is unbounded and not evaluated there, within ~1.6e-5 relative of the natural frequency) is first
+    stepped off towards ``inside`` by bisection until the gap is finite (before: brentq's ValueError 'The function
+    value at x=... is NaN'); a graze inside that band ends the segment at its edge (the last frequency that fits)."""
+    end = gap(outside)
+    while not np.isfinite(end):
+        if abs(outside - inside) <= 1e-12:
+            return inside  # the graze lies within the band where the response is not evaluated: its edge
+        middle = 0.5 * (inside + outside)
+        value = gap(middle)
+        if np.isfinite(value) and value >= 0.0:
+            inside = middle
+        else:
+            outside, end = middle, value
+    return float(brentq(gap, min(inside, outside), max(inside, outside), xtol=1e-12))  # low to high, as before
 
 
 def find_branches(
