@@ -89,3 +89,20 @@ def test_the_grazing_curves_split_at_the_resonance(detuning: float) -> None:
     curves = _grazing_curves(_problem(), centre - 0.05, centre + 0.05, 0.0, 1e3, step=F1 * 1e-6)
     assert len(curves) == 2 and all(np.all(np.isfinite(d)) for _f, d in curves)
     assert curves[0][0][-1] < F1 - 0.9 * BAND and curves[1][0][0] > F1 + 0.9 * BAND
+
+
+def test_a_benchmark_case_below_an_unbounded_linear_amplitude_is_refused_naming_the_frequency() -> None:
+    """``clearance_below_linear`` measures from the linear amplitude, unbounded (NaN, refused) at an undamped natural
+    frequency: the case is refused naming its frequency and why (before: the stop's clearance became NaN and the stop
+    refused it, 'clearance: expected a finite number, got nan', naming neither the frequency nor the cause)."""
+    from pathlib import Path
+
+    from vibroimpact.scene import SceneError, parse_scene
+    from vibroimpact.scene.reader import read_yaml
+
+    document = read_yaml((Path(__file__).resolve().parents[2] / "studies" / "engine_cost.yaml").read_text(encoding="utf-8"))
+    document["system"].update(b1=0.0, b2=0.0)
+    document["benchmark"]["cases"] = [{"name": "graze", "frequency": F1, "restitution": 0.9, "clearance_below_linear": 5e-10, "start": "linear"}]
+    with pytest.raises(SceneError) as caught:
+        parse_scene(document)
+    assert any(p.startswith("benchmark.cases[0].frequency: 23.0221 Hz: the linear amplitude is unbounded there") for p in caught.value.problems), caught.value.problems

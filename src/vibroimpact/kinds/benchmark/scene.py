@@ -347,6 +347,10 @@ def _case_stops(c: Checker, key: str, layout: _Layout, frequency: float, restitu
             chosen = []
             for k, spec in enumerate(specs):
                 if spec.clearance is None:
+                    if not math.isfinite(reach[k]):  # the linear response's refused band at an undamped resonance
+                        c.fail(f"{key}.frequency", f"{frequency:g} Hz: the linear amplitude is unbounded there (an undamped natural frequency), so "
+                               "clearance_below_linear has nothing to measure from: give clearance [m] or another frequency")
+                        return None
                     if reach[k] - below < 0.0:
                         of = f" of stop {k}" if len(specs) > 1 else ""
                         c.fail(f"{key}.clearance_below_linear", f"{below:g} m exceeds the linear amplitude{of} {reach[k]:g} m")
