@@ -20,7 +20,7 @@ from typing import Any
 
 from vibroimpact.scene.checker import Checker, did_you_mean, interval
 
-__all__ = ["Key", "Section", "REQUIRED", "DERIVED", "Names", "Band", "Grid", "Table", "reference_table"]
+__all__ = ["Key", "Section", "REQUIRED", "DERIVED", "Names", "Band", "Grid", "Table", "Rows", "reference_table"]
 
 
 class _Required:
@@ -62,10 +62,15 @@ class Table:
     """The type of a key whose value is a mapping its own parser checks entry by entry (its doc names the form)."""
 
 
+class Rows:
+    """The type of a key whose value is a non-empty list of mappings its own parser checks row by row (its doc names
+    a row's keys)."""
+
+
 #: The YAML type each Python type of a key is written as, in messages and in the reference.
 _TYPE_NAMES = {bool: "boolean (true or false)", int: "integer", float: "number", str: "name", Names: "list of names", Band: "band {start, stop}",
-               Grid: "grid: [values] or {start, stop, step | num}", Table: "mapping"}
-_ARTICLES = {bool: "a", int: "an", float: "a", str: "a", Names: "a", Band: "a", Grid: "a", Table: "a"}
+               Grid: "grid: [values] or {start, stop, step | num}", Table: "mapping", Rows: "non-empty list of mappings"}
+_ARTICLES = {bool: "a", int: "an", float: "a", str: "a", Names: "a", Band: "a", Grid: "a", Table: "a", Rows: "a"}
 
 
 @dataclass(frozen=True)
@@ -108,7 +113,7 @@ class Key:
 
     def __post_init__(self) -> None:
         if self.type not in _TYPE_NAMES:
-            raise TypeError(f"Key {self.name!r}: type {self.type!r} is not one of bool, int, float, str, Names, Band, Grid, Table")
+            raise TypeError(f"Key {self.name!r}: type {self.type!r} is not one of bool, int, float, str, Names, Band, Grid, Table, Rows")
         if self.choices and self.type not in (str, Names):
             raise TypeError(f"Key {self.name!r}: choices are names, for a str or Names key only")
         if self.type is Names and not self.choices:
@@ -176,6 +181,11 @@ class Key:
             return (start, stop)
         if self.type is Grid:
             return c.grid(where, value, self.low, self.high, not self.open_low)
+        if self.type is Rows:
+            if not isinstance(value, list) or not value:
+                c.fail(where, f"{wrong}: {self.doc}")
+                return None
+            return value
         if self.type is Table:
             if not isinstance(value, dict):
                 c.fail(where, f"{wrong}: {self.doc}")

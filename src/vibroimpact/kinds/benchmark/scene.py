@@ -37,6 +37,7 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.contact import Stop
 from vibroimpact.model.parameters import MAX_BUMPER_FREQUENCY
 from vibroimpact.scene.checker import Checker, SceneError
+from vibroimpact.scene.declared import DERIVED, REQUIRED, Grid, Key, Names, Rows, Section, Table
 from vibroimpact.scene.header import NAME, check_sweep_run, open_scene
 from vibroimpact.scene.layout_parse import parse_layout
 from vibroimpact.scene.schema import (
@@ -50,7 +51,28 @@ __all__ = ["BenchmarkScene", "BenchmarkCase", "BenchmarkSettings", "LadderSettin
 
 #: Top-level keys of a benchmark scene.
 BENCHMARK_TOP_KEYS = {"name", "description", "system", "excitation", "stops", "benchmark", "report"}
-_BENCHMARK_KEYS = {"duration", "methods", "tolerances", "atol_ratio", "repeats", "max_seconds", "cases", "ladder"}
+#: ``benchmark``, declared (:mod:`vibroimpact.scene.declared`): a case's keys and the ladder's are checked by their own.
+BENCHMARK = Section("benchmark", (
+    Key("duration", float, "time simulated per run", REQUIRED, 0.0, 1e5, "s", open_low=True),
+    Key("methods", Names, "the methods timed", REQUIRED, choices=BENCHMARK_METHODS),
+    Key("tolerances", Grid, "relative tolerances of the integrators (atol = rtol x atol_ratio)", REQUIRED, 1e-15, 1e-1),
+    Key("atol_ratio", float, "absolute tolerance per unit of relative tolerance", ATOL_RATIO, 1e-12, 1.0, "m"),
+    Key("repeats", int, "runs per point (their median wall time)", 3, 1, 100),
+    Key("max_seconds", float, "a method's tighter tolerances are skipped once one of its runs took longer", 60.0, 0.0, 1e5, "s", open_low=True),
+    Key("cases", Rows, "{name, frequency, restitution, clearance | clearance_below_linear, start[, bumper_frequency] | swept_sine} each", REQUIRED),
+    Key("ladder", Table, "{frequency, bumper_frequencies[, restitution, clearance, rtol, repeats]}: one point through every model", DERIVED),
+), "what to time, against the exact references")  # fmt: skip
+#: ``benchmark.ladder``, declared: restitution and clearance go to the stops that give none (required where one does).
+LADDER = Section("benchmark.ladder", (
+    Key("frequency", float, "the excitation frequency of the ladder's point", REQUIRED, 0.0, math.inf, "Hz", open_low=True),
+    Key("restitution", float, "R of the stops that give none (derived: the stops' own)", DERIVED, 0.0, 1.0, open_low=True),
+    Key("clearance", float, "Delta of the stops that give none (derived: the stops' own)", DERIVED, 0.0, math.inf, "m"),
+    Key("bumper_frequencies", Grid, "Omega_b / 2 pi of the compliant models", REQUIRED, 0.0, MAX_BUMPER_FREQUENCY, "Hz", open_low=True),
+    Key("rtol", float, "tolerance of the integrators (atol = rtol x atol_ratio)", STEPPED_TOLERANCES[0], 1e-14, 1e-2),
+    Key("repeats", int, "runs per model (their median wall time)", 3, 1, 100),
+), "one frequency point through every model, from the closed form to ever stiffer bumpers")  # fmt: skip
+#: The sections of a benchmark scene that are declared (``run-study --keys`` lists them).
+SECTIONS = (BENCHMARK, LADDER)
 _BENCHMARK_CASE_KEYS = {"name", "frequency", "restitution", "clearance", "clearance_below_linear", "start", "bumper_frequency", "swept_sine"}
 
 
@@ -83,8 +105,8 @@ class LadderSettings:
     restitution: float
     clearance: float
     bumper_frequencies: tuple[float, ...]
-    rtol: float = STEPPED_TOLERANCES[0]
-    repeats: int = 3
+    rtol: float = LADDER.key("rtol").default
+    repeats: int = LADDER.key("repeats").default
     problem: ImpactProblem | None = None
     compliant: tuple[tuple[Stop, ...], ...] = ()
 
@@ -159,9 +181,9 @@ class BenchmarkSettings:
 
     methods: tuple[str, ...]
     tolerances: tuple[float, ...]
-    atol_ratio: float = ATOL_RATIO
-    repeats: int = 3
-    max_seconds: float = 60.0
+    atol_ratio: float = BENCHMARK.key("atol_ratio").default
+    repeats: int = BENCHMARK.key("repeats").default
+    max_seconds: float = BENCHMARK.key("max_seconds").default
     ladder: LadderSettings | None = None
 
 
@@ -207,24 +229,13 @@ def parse_benchmark_scene(document: dict, text: str = "", source: str = "scene")
     c, doc, name, description, report, scheduler = open_scene(document, BENCHMARK_TOP_KEYS, {"name", "system", "excitation", "benchmark"}, "benchmark")
     parsed, amplitude, _ = parse_layout(c, doc)
     layout = _Layout(parsed, amplitude) if parsed is not None and amplitude is not None else None
-    spec = c.mapping("benchmark", doc["benchmark"], _BENCHMARK_KEYS, {"duration", "methods", "tolerances", "cases"}) if "benchmark" in doc else {}
-    duration = c.number("benchmark.duration", spec.get("duration"), 0.0, 1e5, low_inclusive=False) if "duration" in spec else None
-    methods = c.choices("benchmark.methods", spec.get("methods"), BENCHMARK_METHODS) if "methods" in spec else ()
-    tolerances = c.grid("benchmark.tolerances", spec.get("tolerances"), 1e-15, 1e-1, True) if "tolerances" in spec else None
-    options: dict[str, Any] = {}
-    if "atol_ratio" in spec:
-        options["atol_ratio"] = c.number("benchmark.atol_ratio", spec["atol_ratio"], 1e-12, 1.0)
-    if "repeats" in spec:
-        options["repeats"] = c.integer("benchmark.repeats", spec["repeats"], 1, 100)
-    if "max_seconds" in spec:
-        options["max_seconds"] = c.number("benchmark.max_seconds", spec["max_seconds"], 0.0, 1e5, low_inclusive=False)
-    if "ladder" in spec:
+    spec = (BENCHMARK.read(c, doc["benchmark"], partial=True) if "benchmark" in doc else None) or {}
+    duration, methods, tolerances = spec.get("duration"), spec.get("methods") or (), spec.get("tolerances")
+    options: dict[str, Any] = {key: spec[key] for key in ("atol_ratio", "repeats", "max_seconds") if spec.get(key) is not None}
+    if spec.get("ladder") is not None:
         options["ladder"] = _parse_ladder(c, spec["ladder"], layout)
     cases = []
-    raw_cases = spec.get("cases", [])
-    if not isinstance(raw_cases, list) or not raw_cases:
-        c.fail("benchmark.cases", "expected a non-empty list of cases {name, frequency, restitution, clearance | clearance_below_linear, start[, bumper_frequency] | swept_sine}")
-        raw_cases = []
+    raw_cases = spec.get("cases") or []
     case_names: list[str] = []
     for i, raw in enumerate(raw_cases):
         case = _parse_case(c, f"benchmark.cases[{i}]", raw, case_names, layout, duration)
@@ -380,18 +391,19 @@ def _parse_ladder(c: Checker, value: Any, layout: _Layout | None) -> LadderSetti
     """``ladder: {frequency, restitution, clearance, bumper_frequencies, rtol, repeats}``; restitution and clearance
     go to the stops that give none (required where one does)."""
     needed = {field for field in ("restitution", "clearance") if layout is None or layout.takes(field)}
-    spec = c.mapping("benchmark.ladder", value, {"frequency", "restitution", "clearance", "bumper_frequencies", "rtol", "repeats"}, {"frequency", "bumper_frequencies"} | needed)
-    frequency = c.number("benchmark.ladder.frequency", spec["frequency"], 0.0, math.inf, low_inclusive=False) if "frequency" in spec else None
-    restitution = c.number("benchmark.ladder.restitution", spec["restitution"], 0.0, 1.0, low_inclusive=False) if "restitution" in spec else math.nan
-    clearance = c.number("benchmark.ladder.clearance", spec["clearance"], 0.0, math.inf) if "clearance" in spec else math.nan
-    bumpers = c.grid("benchmark.ladder.bumper_frequencies", spec["bumper_frequencies"], 0.0, MAX_BUMPER_FREQUENCY, False) if "bumper_frequencies" in spec else None
-    rtol = c.number("benchmark.ladder.rtol", spec.get("rtol", STEPPED_TOLERANCES[0]), 1e-14, 1e-2)
-    repeats = c.integer("benchmark.ladder.repeats", spec.get("repeats", 3), 1, 100)
+    spec = LADDER.read(c, value, partial=True)
+    if spec is None:
+        return None
+    for field in sorted(needed - set(value)):
+        c.fail(f"benchmark.ladder.{field}", f"required key is missing: a stop gives no {field} ({LADDER.key(field).allowed()})")
+    frequency, bumpers, rtol, repeats = spec["frequency"], spec["bumper_frequencies"], spec["rtol"], spec["repeats"]
+    restitution = spec["restitution"] if "restitution" in value else math.nan
+    clearance = spec["clearance"] if "clearance" in value else math.nan
     if layout is not None:
         for field in ("restitution", "clearance"):
-            if field in spec and field not in needed:
+            if field in value and field not in needed:
                 c.fail(f"benchmark.ladder.{field}", f"every stop of 'stops' gives its own {field}: remove it")
-    if any(v is None for v in (frequency, restitution, clearance, bumpers, rtol, repeats, layout)) or not needed <= set(spec):
+    if any(v is None for v in (frequency, restitution, clearance, bumpers, rtol, repeats, layout)) or not needed <= set(value):
         return None
     assert frequency is not None and restitution is not None and clearance is not None and bumpers is not None and rtol is not None and repeats is not None and layout is not None
     try:
