@@ -22,6 +22,7 @@ from vibroimpact.kinds.design.scene import CERTIFY, SEARCH, SearchSettings
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.scene.declared import DERIVED, REQUIRED, Band, Grid, Key, Names, Rows, Section, Table
 from vibroimpact.scene.grid import ADMISSIBILITY, SWEPT_SINE
+from vibroimpact.scene.header import CLUSTER, HEADER
 from vibroimpact.scene.kinds import KINDS, declared_sections
 from vibroimpact.scene.simulation import SIMULATION
 from vibroimpact.scene.reader import parse_scene, read_yaml
@@ -37,6 +38,9 @@ def _shipped(name: str) -> dict:
 
 def _put(document: dict, path: str, values: dict[str, Any]) -> dict:
     """``document`` with the section at the dotted ``path`` set to ``values``."""
+    if not path:  # the top level: the shared header
+        document.update(values)
+        return document
     *parents, leaf = path.split(".")
     place = document
     for parent in parents:
@@ -49,26 +53,33 @@ def _put(document: dict, path: str, values: dict[str, Any]) -> dict:
 SWEPT_FIELDS = {"start": "start_frequency", "stop": "stop_frequency"}
 #: Each declared section: a scene of its kind, and where each of its values lands in the kind's settings.
 PLACES = {
-    SEARCH.path: (lambda: copy.deepcopy(SCENE), lambda settings, name: getattr(settings.search, name)),
-    CERTIFY.path: (lambda: copy.deepcopy(SCENE), lambda settings, name: settings.certified),
-    BRUTE_FORCE.path: (lambda: _shipped("bifurcation.yaml"), lambda settings, name: getattr(settings.brute_force, name)),
-    CONTINUATION.path: (lambda: _shipped("bifurcation.yaml"), lambda settings, name: getattr(settings.branches, name)),
-    CHART.path: (lambda: _shipped("bifurcation.yaml"), lambda settings, name: getattr(settings.chart, name)),
+    HEADER.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: _header_value(scene, name)),
+    CLUSTER.path: (lambda: copy.deepcopy(SCENE) | {"cluster": {"scheduler": "tcp://head:8786"}}, lambda scene, name: scene.cluster_scheduler),
+    SEARCH.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: getattr(scene.settings.search, name)),
+    CERTIFY.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: scene.settings.certified),
+    BRUTE_FORCE.path: (lambda: _shipped("bifurcation.yaml"), lambda scene, name: getattr(scene.settings.brute_force, name)),
+    CONTINUATION.path: (lambda: _shipped("bifurcation.yaml"), lambda scene, name: getattr(scene.settings.branches, name)),
+    CHART.path: (lambda: _shipped("bifurcation.yaml"), lambda scene, name: getattr(scene.settings.chart, name)),
     CONCEPTS_CONTINUATION.path: (lambda: _shipped("absorber_concepts.yaml"),
-                                 lambda settings, name: settings.continuation_steps if name == "max_steps" else settings.continuation_steps > 0),
-    SWEPT_SINE.path: (lambda: _shipped("bumper_sweep.yaml"), lambda settings, name: getattr(settings.swept_sine, SWEPT_FIELDS.get(name, name))),
-    ADMISSIBILITY.path: (lambda: _shipped("restitution.yaml"), lambda settings, name: getattr(settings.admissibility, name)),
-    SIMULATION.path: (lambda: _shipped("restitution.yaml"), lambda settings, name: _simulation_value(settings.simulation, name)),
-    BENCHMARK.path: (lambda: _shipped("engine_cost.yaml"), lambda scene, name: _benchmark_value(scene, name)),
-    LADDER.path: (lambda: _put(_shipped("engine_cost.yaml"), "benchmark.ladder", dict(LADDER_POINT)), lambda scene, name: getattr(scene.settings.ladder, name)),
+                                 lambda scene, name: scene.settings.continuation_steps if name == "max_steps" else scene.settings.continuation_steps > 0),
+    SWEPT_SINE.path: (lambda: _shipped("bumper_sweep.yaml"), lambda scene, name: getattr(scene.settings.swept_sine, SWEPT_FIELDS.get(name, name))),
+    ADMISSIBILITY.path: (lambda: _shipped("restitution.yaml"), lambda scene, name: getattr(scene.settings.admissibility, name)),
+    SIMULATION.path: (lambda: _shipped("restitution.yaml"), lambda scene, name: _simulation_value(scene.settings.simulation, name)),
+    BENCHMARK.path: (lambda: _shipped("engine_cost.yaml"), lambda scene, name: _benchmark_value(scene.settings, name)),
+    LADDER.path: (lambda: _put(_shipped("engine_cost.yaml"), "benchmark.ladder", dict(LADDER_POINT)), lambda scene, name: getattr(scene.settings.settings.ladder, name)),
 }  # fmt: skip
 #: A ladder on the paper's stop, which gives neither restitution nor clearance (both then needed).
 LADDER_POINT = {"frequency": 25.0, "restitution": 0.2, "clearance": 0.003, "bumper_frequencies": [1000.0, 5000.0]}
 #: Keys the kind derives but the walk's scene needs given (the paper's stop takes them from the ladder).
 NEEDED = {"benchmark.ladder.restitution", "benchmark.ladder.clearance"}
 #: A valid value, for the walk, of each key whose default the kind derives.
-DERIVED_VALUES = {"simulation.frequency": [20.0, 30.0], "simulation.rtol": 1e-6, "simulation.atol": 1e-9, "simulation.subset": {"momentary": {"frequency": [25.0]}},
+DERIVED_VALUES = {"cluster": {"scheduler": "tcp://head:8786"}, "simulation.frequency": [20.0, 30.0], "simulation.rtol": 1e-6, "simulation.atol": 1e-9, "simulation.subset": {"momentary": {"frequency": [25.0]}},
                   "benchmark.ladder": LADDER_POINT, "benchmark.ladder.restitution": 0.5, "benchmark.ladder.clearance": 0.002}
+
+
+def _header_value(scene: Any, name: str) -> Any:
+    """Where the shared header's key ``name`` lands in a scene."""
+    return {"scheduler": scene.cluster_scheduler} if name == "cluster" else getattr(scene, name)
 
 
 def _benchmark_value(scene: Any, name: str) -> Any:
@@ -111,6 +122,7 @@ def _simulation_value(simulation: Any, name: str) -> Any:
     return getattr(simulation.engine if name in ("method", "rtol", "atol", "max_step") else simulation.steady, name)
 SECTIONS = list(declared_sections())
 KIND_OF = {section.path: kind.name for kind in reversed(KINDS) for section in kind.sections()}  # a shared section: the first kind's
+KIND_OF |= {HEADER.path: "design", CLUSTER.path: "design"}  # every kind's: walked in a design scene
 
 
 def _scene(section: str, values: dict[str, Any]) -> dict:
@@ -120,21 +132,21 @@ def _scene(section: str, values: dict[str, Any]) -> dict:
 def _required(section: Section) -> dict[str, Any]:
     """The values the section's shipped scene gives its required keys."""
     place = PLACES[section.path][0]()
-    for part in section.path.split("."):
+    for part in section.path.split(".") if section.path else ():
         place = place.get(part, {})
-    return {key.name: place[key.name] for key in section.keys if key.default is REQUIRED or f"{section.path}.{key.name}" in NEEDED}
+    return {key.name: place[key.name] for key in section.keys if key.default is REQUIRED or section.where(key.name) in NEEDED}
 
 
 def _other_value(key: Key, given: Any = None, section_path: str = "") -> Any:
     """A valid value of ``key`` other than its default (a required key's: other than ``given``, its scene's)."""
     if key.default is REQUIRED:
-        return given[:1] if isinstance(given, list) else given * 1.01
+        return given[:1] if isinstance(given, list) else given + "2" if isinstance(given, str) else given * 1.01
     if key.default is DERIVED:
-        return DERIVED_VALUES[f"{section_path}.{key.name}"]
+        return DERIVED_VALUES[f"{section_path}.{key.name}" if section_path else key.name]
     if key.type is bool:
         return not key.default
     if key.type is str:
-        return next(choice for choice in key.choices if choice != key.default)
+        return next(choice for choice in key.choices if choice != key.default) if key.choices else f"{key.default}other"
     if key.type is Names:
         return key.default[:-1] if len(key.default) > 1 else tuple(choice for choice in key.choices if choice not in key.default)[:1]
     if key.type is Band:
@@ -181,8 +193,8 @@ def test_every_declared_key_reaches_the_settings(section: Section) -> None:
     for key in section.keys:
         value = _other_value(key, required.get(key.name), section.path)
         given = required | _method_of(section, key) | {key.name: key.as_written(value)}
-        settings = parse_scene(_scene(section.path, given)).settings
-        assert _same(PLACES[section.path][1](settings, key.name), value), (key.name, value)
+        scene = parse_scene(_scene(section.path, given))
+        assert _same(PLACES[section.path][1](scene, key.name), value), (key.name, value)
 
 
 def test_search_settings_have_exactly_the_declared_keys() -> None:
@@ -199,7 +211,7 @@ def test_each_wrong_type_is_refused_naming_its_key(section: Section) -> None:
             given = required | _method_of(section, key) | {key.name: wrong}
             with pytest.raises(SceneError) as caught:
                 parse_scene(_scene(section.path, given))
-            assert any(line.startswith(f"{section.path}.{key.name}: expected") for line in caught.value.problems), (key.name, wrong, caught.value.problems)
+            assert any(line.startswith(f"{section.where(key.name)}: expected") for line in caught.value.problems), (key.name, wrong, caught.value.problems)
 
 
 @pytest.mark.parametrize("kind", sorted(set(KIND_OF.values())))
@@ -207,7 +219,7 @@ def test_a_scene_with_every_key_wrong_is_refused_at_once_with_exit_2_and_nothing
     sections = [section for section in SECTIONS if KIND_OF[section.path] == kind]
     document = PLACES[sections[0].path][0]()
     for section in sections:
-        _put(document, section.path, {key.name: _wrong_values(key)[0] for key in section.keys if f"{section.path}.{key.name}" not in PLACES})
+        _put(document, section.path, {key.name: _wrong_values(key)[0] for key in section.keys if section.where(key.name) not in PLACES})
     path = tmp_path / "wrong.yaml"
     path.write_text(yaml.safe_dump(document), encoding="utf-8")
     out = tmp_path / "out"
@@ -215,8 +227,8 @@ def test_a_scene_with_every_key_wrong_is_refused_at_once_with_exit_2_and_nothing
     assert done.returncode == 2, done.stderr
     for section in sections:
         for key in section.keys:
-            if f"{section.path}.{key.name}" not in PLACES:  # a declared section of its own: its keys are wrong instead
-                assert f"{section.path}.{key.name}: expected" in done.stderr, (key.name, done.stderr)
+            if section.where(key.name) not in PLACES:  # a declared section of its own: its keys are wrong instead
+                assert f"{section.where(key.name)}: expected" in done.stderr, (key.name, done.stderr)
     assert not out.exists() or not any(out.iterdir())
 
 

@@ -226,10 +226,10 @@ MISTAKES = [
     ("solutions-not-list", _top("solutions", "linear"), ["solutions: expected a non-empty list of names", "'linear'"]),
     ("unknown-quantity", _top("quantities", ["x2_amplitude", "velocity"]), ["quantities[1]: unknown name 'velocity'", "allowed: x1_amplitude", "floquet_modulus"]),
     ("quantity-twice", _top("quantities", ["impulse", "impulse"]), ["quantities[1]: 'impulse' is listed twice"]),
-    ("report-not-bool", _top("report", "yes"), ["report: expected true or false, got 'yes'"]),
-    ("report-int", _top("report", 1), ["report: expected true or false, got 1"]),
+    ("report-not-bool", _top("report", "yes"), ["report: expected a boolean (true or false), got 'yes' (str); YAML 1.2 booleans are true and false"]),
+    ("report-int", _top("report", 1), ["report: expected a boolean (true or false), got 1 (int)"]),
     ("bad-name", _top("name", "my scene/1"), ["name: expected a file-name-safe string", "'my scene/1'"]),
-    ("description-not-string", _top("description", 3), ["description: expected a string, got int"]),
+    ("description-not-string", _top("description", 3), ["description: expected a string, got 3 (int)"]),
     ("unknown-settings-key", _top("settings", {"tolerance": 1e-9}), ["settings.tolerance: unknown key", "allowed: admissibility"]),
     ("samples-too-few", _top("settings", {"admissibility": {"samples_per_period": 8}}), ["settings.admissibility.samples_per_period: 8 is out of range: allowed [16, 1000000]"]),
     ("tolerance-too-large", _top("settings", {"admissibility": {"relative_tolerance": 0.1}}), ["settings.admissibility.relative_tolerance: 0.1 is out of range: allowed [0, 0.01]"]),
@@ -631,6 +631,6 @@ def test_benchmark_scene_checks_the_common_header() -> None:
         parse_scene(doc)
     assert caught.value.problems == [
         "system: required key is missing",
-        "description: expected a string, got int",
-        "report: expected true or false, got 'yes'",
+        "description: expected a string, got 3 (int)",
+        "report: expected a boolean (true or false), got 'yes' (str); YAML 1.2 booleans are true and false",
     ]

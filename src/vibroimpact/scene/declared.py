@@ -68,7 +68,7 @@ class Rows:
 
 
 #: The YAML type each Python type of a key is written as, in messages and in the reference.
-_TYPE_NAMES = {bool: "boolean (true or false)", int: "integer", float: "number", str: "name", Names: "list of names", Band: "band {start, stop}",
+_TYPE_NAMES = {bool: "boolean (true or false)", int: "integer", float: "number", str: "string", Names: "list of names", Band: "band {start, stop}",
                Grid: "grid: [values] or {start, stop, step | num}", Table: "mapping", Rows: "non-empty list of mappings"}
 _ARTICLES = {bool: "a", int: "an", float: "a", str: "a", Names: "a", Band: "a", Grid: "a", Table: "a", Rows: "a"}
 
@@ -201,7 +201,7 @@ class Section:
     Attributes
     ----------
     path : str
-        Where it is in a scene, dotted (``design.search``).
+        Where it is in a scene, dotted (``design.search``); ``""``: the scene's top level (the shared header).
     keys : tuple of Key
         Its keys, in the order the reference lists them.
     doc : str
@@ -221,6 +221,10 @@ class Section:
                 other = self.key(key.read_when[0])
                 if key.read_when[1] not in other.choices:
                     raise ValueError(f"section {self.path}: {key.name} is read when {key.read_when[0]} is {key.read_when[1]!r}, not one of its choices")
+
+    def where(self, name: str) -> str:
+        """The dotted place of the key ``name`` in a scene (the top level's keys: their names alone)."""
+        return f"{self.path}.{name}" if self.path else name
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -247,10 +251,10 @@ class Section:
         before = len(c.problems)
         for given in value:
             if str(given) not in self.names:
-                c.fail(f"{self.path}.{given}", f"unknown key (allowed: {', '.join(self.names)}){did_you_mean(str(given), self.names)}")
+                c.fail(self.where(str(given)), f"unknown key (allowed: {', '.join(self.names)}){did_you_mean(str(given), self.names)}")
         read: dict[str, Any] = {}
         for key in self.keys:
-            where = f"{self.path}.{key.name}"
+            where = self.where(key.name)
             if key.name in value:
                 read[key.name] = key.check(c, where, value[key.name])
             elif key.default is REQUIRED:
@@ -266,7 +270,7 @@ class Section:
             other, wanted = key.read_when
             chosen = read.get(other)
             if chosen is not None and chosen != wanted:
-                c.fail(f"{self.path}.{key.name}", f"not read with {other}: {chosen} (only with {other}: {wanted}); remove it or choose {other}: {wanted}")
+                c.fail(self.where(key.name), f"not read with {other}: {chosen} (only with {other}: {wanted}); remove it or choose {other}: {wanted}")
         return read if partial or len(c.problems) == before else None
 
     def validate(self, settings: Any) -> None:
@@ -284,7 +288,7 @@ class Section:
         for key in self.keys:
             default = "required" if key.default is REQUIRED else "derived" if key.default is DERIVED else _written(key.as_written(key.default))
             when = f" (read with {key.read_when[0]}: {key.read_when[1]})" if key.read_when else ""
-            rows.append(f"| `{self.path}.{key.name}` | {key.allowed()} | {default} | {key.doc}{when} |")
+            rows.append(f"| `{self.where(key.name)}` | {key.allowed()} | {default} | {key.doc}{when} |")
         return rows
 
 

@@ -11,17 +11,30 @@ import re
 from typing import Any
 
 from vibroimpact.scene.checker import Checker
+from vibroimpact.scene.declared import DERIVED, REQUIRED, Key, Section, Table
 from vibroimpact.scene.schema import MAX_SWEEP_SAMPLES
 
-__all__ = ["NAME", "MAX_NAME_LENGTH", "HEADER_KEYS", "open_scene", "parse_names", "parse_cluster", "check_sweep_run"]
-
-#: The keys every scene may give, whatever its kind, read once by :func:`open_scene` and honoured by every kind.
-HEADER_KEYS = frozenset({"name", "description", "report", "cluster"})
+__all__ = ["NAME", "MAX_NAME_LENGTH", "HEADER", "CLUSTER", "HEADER_KEYS", "open_scene", "parse_names", "parse_cluster", "check_sweep_run"]
 
 #: A scene's or a case's name: safe as a file name, at most :data:`MAX_NAME_LENGTH` characters (the run writes
 #: ``.<name>.zarr.removed-<pid>`` and the like, within the 255 bytes a file name may take).
 MAX_NAME_LENGTH = 100
 NAME = re.compile(rf"^[A-Za-z0-9][A-Za-z0-9_.-]{{0,{MAX_NAME_LENGTH - 1}}}$")
+
+#: The shared header, declared (:mod:`vibroimpact.scene.declared`): the keys every scene may give, whatever its kind,
+#: read once by :func:`open_scene` and honoured by every kind.
+HEADER = Section("", (
+    Key("name", str, f"the study's name: its output folder and files (letters, digits, '_', '-', '.'; at most {MAX_NAME_LENGTH})", REQUIRED),
+    Key("description", str, "one line the page and the dataset carry (no number depends on it)", ""),
+    Key("report", bool, "whether run-study writes the HTML page beside the dataset", True),
+    Key("cluster", Table, "{scheduler: tcp://host:8786}: a running dask scheduler to run on (default: a local cluster)", DERIVED),
+), "what every scene has, whatever its kind")  # fmt: skip
+#: ``cluster``, declared.
+CLUSTER = Section("cluster", (
+    Key("scheduler", str, "the address of a running dask scheduler, e.g. tcp://head-node:8786", REQUIRED),
+), "where the study runs")  # fmt: skip
+#: The keys every scene may give, whatever its kind.
+HEADER_KEYS = frozenset(HEADER.names)
 
 
 def open_scene(document: Any, top_keys: set[str], required: set[str], kind: str) -> tuple[Checker, dict, Any, str, bool, str | None]:
@@ -40,27 +53,24 @@ def open_scene(document: Any, top_keys: set[str], required: set[str], kind: str)
 
 
 def parse_names(c: Checker, doc: dict) -> tuple[Any, str, bool]:
-    """Name, description and the report switch of any scene."""
-    name = doc.get("name")
-    if "name" in doc and not (isinstance(name, str) and NAME.match(name)):
+    """Name, description and the report switch of any scene (:data:`HEADER`; a missing name is the kind's to say)."""
+    values = HEADER.read(c, {key: doc[key] for key in ("name", "description", "report") if key in doc}, partial=True) or {}
+    name = values.get("name") if "name" in doc else doc.get("name")
+    if isinstance(name, str) and not NAME.match(name):
         c.fail("name", f"expected a file-name-safe string of at most {MAX_NAME_LENGTH} characters (letters, digits, '_', '-', '.'), got {name!r}")
-    description = doc.get("description", "")
-    if not isinstance(description, str):
-        c.fail("description", f"expected a string, got {type(description).__name__}")
-    report = doc.get("report", True)
-    if not isinstance(report, bool):
-        c.fail("report", f"expected true or false, got {report!r}")
-        report = True
-    return name, description, report
+    description = values.get("description")
+    report = values.get("report")
+    return name, description if description is not None else "", report if report is not None else True
 
 
 def parse_cluster(c: Checker, doc: dict) -> str | None:
-    """The scene's ``cluster: {scheduler: ADDRESS}``: a running dask scheduler to run on (None: a local cluster)."""
+    """The scene's ``cluster: {scheduler: ADDRESS}`` (:data:`CLUSTER`): a running dask scheduler to run on (None: a
+    local cluster)."""
     if "cluster" not in doc:
         return None
-    section = c.mapping("cluster", doc["cluster"], {"scheduler"}, {"scheduler"})
-    address = section.get("scheduler")
-    if address is not None and not (isinstance(address, str) and "://" in address or isinstance(address, str) and ":" in address):
+    values = CLUSTER.read(c, doc["cluster"])
+    address = values["scheduler"] if values is not None else None
+    if address is not None and ":" not in address:
         c.fail("cluster.scheduler", f"expected a scheduler address such as tcp://host:8786, got {address!r}")
         return None
     return address

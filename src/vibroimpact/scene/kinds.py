@@ -122,9 +122,11 @@ def kind_named(name: str) -> Kind:
 
 
 def declared_sections() -> tuple[Any, ...]:
-    """Every kind's declared sections (:meth:`Kind.sections`), each once (a section two kinds share, in the first's
-    place); imports the kinds' scene parsers only."""
-    seen: dict[str, Any] = {}
+    """The shared header's declared sections, then every kind's (:meth:`Kind.sections`), each once (a section two kinds
+    share, in the first's place); imports the kinds' scene parsers only."""
+    from vibroimpact.scene.header import CLUSTER, HEADER
+
+    seen: dict[str, Any] = {HEADER.path: HEADER, CLUSTER.path: CLUSTER}
     for kind in KINDS:
         for section in kind.sections():
             seen.setdefault(section.path, section)
