@@ -89,6 +89,15 @@ def _first_clause(text: str) -> str:
     return text.rstrip(".")
 
 
+def _print_listing(text: str) -> int:
+    """Print a listing to stdout and return 0; a reader that stops early (``| head``) ends it quietly."""
+    try:
+        print(text, flush=True)
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # Python's own flush at exit must not fail too
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the process exit code (2 for a bad scene or arguments, 130 when interrupted)."""
     argv = sys.argv[1:] if argv is None else list(argv)
@@ -97,14 +106,12 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.list:
-        print(study_listing(shipped_studies(), shutil.get_terminal_size((120, 24)).columns))
-        return 0
+        return _print_listing(study_listing(shipped_studies(), shutil.get_terminal_size((120, 24)).columns))
     if args.keys:
         from vibroimpact.scene.declared import reference_table
         from vibroimpact.scene.kinds import declared_sections
 
-        print(reference_table(declared_sections()))
-        return 0
+        return _print_listing(reference_table(declared_sections()))
     if args.scene is None:
         parser.print_usage(sys.stderr)
         print("run-study: error: a scene is required (or --list, or --keys)", file=sys.stderr)

@@ -343,5 +343,20 @@ def test_run_study_keys_prints_every_declared_key_of_every_kind_and_runs_nothing
     assert done.returncode == 0, done.stderr
     rows = [line for line in done.stdout.splitlines() if line.startswith("| `")]
     assert rows == [row for section in SECTIONS for row in section.reference()]
-    assert {section.path for section in SECTIONS} <= {line.split("`")[1] for line in done.stdout.splitlines() if line.startswith("### ")}
+    titles = [line for line in done.stdout.splitlines() if line.startswith("### ")]
+    assert titles[0].startswith("### the top level: ") and {section.path for section in SECTIONS[1:]} == {line.split("`")[1] for line in titles[1:]}
     assert not any(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("option", ["--keys", "--list"])
+def test_a_listing_read_only_in_part_ends_quietly(option: str) -> None:
+    """``run-study --keys | head -1``: the reader closes the pipe after one line; run-study ends with 0 and no
+    BrokenPipeError traceback (before: exit 1 and a traceback)."""
+    run = subprocess.Popen([sys.executable, "-m", "vibroimpact.cli", option], stdout=subprocess.PIPE, stderr=subprocess.PIPE, bufsize=0)
+    assert run.stdout is not None and run.stderr is not None
+    assert run.stdout.read(1)
+    run.stdout.close()
+    error = run.stderr.read().decode()
+    run.stderr.close()
+    assert run.wait(timeout=120) == 0, error
+    assert "Traceback" not in error and "BrokenPipeError" not in error, error

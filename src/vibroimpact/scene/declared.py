@@ -300,6 +300,8 @@ def _written(value: Any) -> str:
         return "[" + ", ".join(_written(item) for item in value) + "]"
     if isinstance(value, dict):
         return "{" + ", ".join(f"{name}: {_written(item)}" for name, item in value.items()) + "}"
+    if value == "":
+        return '""'
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 
@@ -308,6 +310,7 @@ def reference_table(sections: tuple[Section, ...] | list[Section]) -> str:
     accepts, its default and what it sets (``run-study --keys``)."""
     lines: list[str] = []
     for section in sections:
-        lines += [f"### `{section.path}`: {section.doc}", "", "| key | allowed | default | what it sets |", "|---|---|---|---|"]
+        title = f"`{section.path}`" if section.path else "the top level"
+        lines += [f"### {title}: {section.doc}", "", "| key | allowed | default | what it sets |", "|---|---|---|---|"]
         lines += [*section.reference(), ""]
     return "\n".join(lines)
