@@ -25,10 +25,10 @@ certification with the linear optimum still computing in the study's process is 
 Damage to a kept store (:data:`_DAMAGE`): each kind of file a design run's store holds, a case's chunk (a flipped bit),
 its checksum (``.zattrs``), its ``.zarray``, the root's consolidated ``.zmetadata`` (edited, removed) and a whole case
 removed. The run reads every case's own files (never the consolidated copy) and proves its values by their checksum:
-a damaged chunk, checksum or ``.zarray`` is said (``1 damaged cases of 2 are computed again``); a lost case is only
-counted (``resumed: 321 of 322 cases reused``), and so is one whose checksum file is lost (taken for a case cut off
-before its checksum), and the consolidated metadata is rewritten without a word (each marked ``TODO(issue 50)`` where
-a line should name it).
+a damaged chunk, checksum or ``.zarray`` is said (``1 damaged case of 2 ... is computed again``), a case whose checksum
+file is lost too (``stored without its checksum``), and a lost, edited or unreadable consolidated ``.zmetadata`` (rewritten
+when the store is kept); a whole case removed is only counted (``resumed: 321 of 322 cases reused``): no record of the
+store lists its cases, and a case gone is one never computed.
 
 Bit for bit: every variable's bytes, dtype, dimensions and attributes and every attribute of the file
 (:func:`_digests`), read from the netCDF file with the netCDF library's masking and scaling off, but for what times or
@@ -376,21 +376,19 @@ def _other_checksum(document: dict[str, Any]) -> None:
 _DAMAGE: dict[str, tuple[Callable[[Path], None], str | None]] = {
     # a certificate's packed result: the chunk fails its checksum, the certificate is computed again
     "a bit flipped in a certificate's chunk": (
-        lambda store: _flip_a_bit(_a_case(store, "certification") / "0"), "1 damaged cases of 2 are computed again"),
-    "a candidate's checksum edited": (lambda store: _edit_json(_a_case(store, "closed_form") / ".zattrs", _other_checksum), "1 damaged cases of "),
+        lambda store: _flip_a_bit(_a_case(store, "certification") / "0"),
+        "1 damaged case of 2 (values failing their checksum, or unreadable metadata) is computed again"),
+    "a candidate's checksum edited": (lambda store: _edit_json(_a_case(store, "closed_form") / ".zattrs", _other_checksum), "1 damaged case of "),
     "a candidate's .zarray edited (dtype)": (
-        lambda store: _edit_json(_a_case(store, "closed_form") / ".zarray", lambda m: m.update(dtype="<u2")), "1 damaged cases of "),
-    # TODO(issue 50): a line naming the case whose checksum (.zattrs) is lost (it is taken for a case cut off before its
-    # checksum was written, computed again and counted only in 'resumed: 321 of 322 cases reused')
-    "a candidate's .zattrs (checksum) removed": (lambda store: (_a_case(store, "closed_form") / ".zattrs").unlink(), None),
+        lambda store: _edit_json(_a_case(store, "closed_form") / ".zarray", lambda m: m.update(dtype="<u2")), "1 damaged case of "),
+    "a candidate's .zattrs (checksum) removed": (lambda store: (_a_case(store, "closed_form") / ".zattrs").unlink(),
+                                                 "stored without its checksum (cut off before it was written, or it was lost) is computed again"),
     # the root's consolidated metadata (written for readers of a kept store; the run reads every array's own files)
-    # TODO(issue 50): a line naming the store's .zmetadata as damaged and rewritten (the rerun rewrites it silently)
     ".zmetadata edited": (lambda store: _edit_json(store / ".zmetadata", lambda m: m["metadata"].update({"cases/.zgroup": {"zarr_format": 3}})),
-                          None),
-    # TODO(issue 50): a line naming the store's .zmetadata as lost and rewritten (the rerun rewrites it silently)
-    ".zmetadata removed": (lambda store: (store / ".zmetadata").unlink(), None),
-    # TODO(issue 50): a line naming the finished case that is gone from the kept store (said only as 'resumed: N-1 of
-    # N cases reused', as if it had never been computed)
+                          "/.zmetadata: the store's consolidated metadata differs from the arrays' own metadata (cases/.zgroup)"),
+    ".zmetadata removed": (lambda store: (store / ".zmetadata").unlink(), "/.zmetadata: the store's consolidated metadata is lost"),
+    # a finished case gone whole is a case never computed: no record of the store lists its cases, so it is said only as
+    # 'resumed: N-1 of N cases reused'
     "a certificate removed": (lambda store: shutil.rmtree(_a_case(store, "certification")), None),
 }
 
@@ -409,7 +407,7 @@ def test_a_damaged_kept_design_store_is_rerun_bit_for_bit(tmp_path: Path, undist
     if said is not None:
         assert said in err, err
     resumed = next(line for line in err.splitlines() if line.startswith("resumed: "))
-    recomputed = said is not None or "removed" in damage and ".zmetadata" not in damage  # one case computed again
+    recomputed = ".zmetadata" not in damage  # one case computed again, but for the consolidated copy
     assert resumed == f"resumed: {cases - recomputed} of {cases} cases reused from {store}", err
     _assert_identical(out / f"{NAME}.nc", undisturbed.digests, err)
     kept = {case.name for case in (store / "cases").iterdir() if case.is_dir()}

@@ -201,3 +201,31 @@ def test_cases_written_by_older_code_are_counted_when_discarded(tmp_path: Path) 
     lines: list[str] = []
     StudyStore(path, "two", say=lines.append)
     assert len(lines) == 1 and "0 finished blocks and 2 finished cases discarded" in lines[0]
+
+
+def test_a_kept_store_s_consolidated_metadata_lost_or_edited_is_said_and_a_case_without_checksum_too(tmp_path: Path) -> None:
+    """A kept store's ``.zmetadata`` (a copy of the arrays' own metadata, for readers) lost or edited is said when a run
+    opens it, once (the next run, cut off before keeping it, is not taken for damage); a case whose checksum file is
+    lost is said as computed again (before: both silent)."""
+    path = tmp_path / "k.zarr"
+    store = StudyStore(path, "f")
+    store.save_case("exact-1", {"x": np.arange(3.0)})
+    store.keep(xr.Dataset(attrs={"title": "kept"}))
+    (path / ".zmetadata").unlink()
+    lines: list[str] = []
+    StudyStore(path, "f", say=lines.append)
+    assert lines == [f"{path / '.zmetadata'}: the store's consolidated metadata is lost: the run reads every array's own, and writes it again when it keeps the store"]
+    lines.clear()
+    StudyStore(path, "f", say=lines.append)
+    assert lines == [], "said once: a run that did not keep the store left no copy to check"
+    store = StudyStore(path, "f")
+    store.keep(xr.Dataset(attrs={"title": "kept"}))
+    consolidated = json.loads((path / ".zmetadata").read_text())
+    consolidated["metadata"]["cases/.zgroup"] = {"zarr_format": 3}
+    (path / ".zmetadata").write_text(json.dumps(consolidated))
+    (path / "cases" / "exact-1" / ".zattrs").unlink()
+    lines.clear()
+    store = StudyStore(path, "f", say=lines.append)
+    assert lines == [f"{path / '.zmetadata'}: the store's consolidated metadata differs from the arrays' own metadata (cases/.zgroup, cases/exact-1/.zattrs): "
+                     "the run reads every array's own, and writes it again when it keeps the store"]
+    assert store.load_case("exact-1", ("x",)) is None and store.unsealed_cases == 1 and store.damaged_cases == 0

@@ -218,10 +218,15 @@ class Runner:
         names = [f"{case.engine}-{case.key()}" for case in cases] if self.store is not None else []
         results: list[CaseResult | None] = [None] * len(cases)
         if self.store is not None:
-            damaged_before = self.store.damaged_cases
+            damaged_before, unsealed_before = self.store.damaged_cases, self.store.unsealed_cases
             results = [self.store.load_case(name, case.fields) for name, case in zip(names, cases)]
-            if self.store.damaged_cases > damaged_before:
-                self.store.say(f"{self.store.damaged_cases - damaged_before} damaged cases of {len(cases)} are computed again")
+            damaged, unsealed = self.store.damaged_cases - damaged_before, self.store.unsealed_cases - unsealed_before
+            if damaged:
+                self.store.say(f"{damaged} damaged case{'s' if damaged > 1 else ''} of {len(cases)} (values failing their checksum, or unreadable metadata) "
+                               f"{'are' if damaged > 1 else 'is'} computed again")
+            if unsealed:
+                self.store.say(f"{unsealed} case{'s' if unsealed > 1 else ''} of {len(cases)} stored without {'their' if unsealed > 1 else 'its'} checksum "
+                               f"(cut off before it was written, or it was lost) {'are' if unsealed > 1 else 'is'} computed again")
         pending = [index for index, result in enumerate(results) if result is None]
         # reused: given back by the store, not saved earlier in this run (a case asked twice in one run is no resume)
         self.note_reused("cases", sum(1 for i, result in enumerate(results) if result is not None and names[i] not in self._saved), len(cases))

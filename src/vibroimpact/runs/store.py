@@ -60,6 +60,8 @@ _GRID_VARIABLES = "grid_variables"
 #: The copy of the grid's metadata files and its digest (:mod:`vibroimpact.runs.store_record`), written last.
 _GRID_RECORD = "grid_record"
 _GRID_RECORD_DIGEST = "grid_record_sha256"
+#: The root's attribute set when a store is kept whole with its consolidated metadata (:meth:`StudyStore.keep`).
+_KEPT = "kept_with_consolidated_metadata"
 #: The root's attributes that lay the grid out, kept in the record.
 _GRID_PLAN = ("grid_shape", "block_shape", _GRID_VARIABLES)
 
@@ -133,6 +135,8 @@ class StudyStore:
         self.say = say or (lambda _line: None)
         #: Cases read back whose values failed their checksum (computed again).
         self.damaged_cases = 0
+        #: Cases found without their checksum: cut off before it was written, or it was lost (computed again).
+        self.unsealed_cases = 0
         self.store: Any = str(path) if path is not None else zarr.storage.MemoryStore()
         source = str(Path(scene_path).resolve()) if scene_path is not None else ""
         self.scene_path = source
@@ -148,6 +152,8 @@ class StudyStore:
         if "fingerprint" not in self.root.attrs:
             self.root.attrs.update(self._identity())
         self._grid_ready = _BLOCK_DONE in self.root or any(key in self.root.attrs for key in (_GRID_VARIABLES, _GRID_RECORD))
+        if path is not None and self.root.attrs.get(_KEPT):
+            self._check_consolidated(path)
         self._arrays: dict[str, Any] = {}
         self._cases_group: Any = None
 
@@ -214,6 +220,7 @@ class StudyStore:
             self.damaged_cases += 1
             return None
         if not isinstance(node, zarr.Array) or not checksum:  # written by older code, or cut off before its checksum
+            self.unsealed_cases += 1
             return None
         try:
             with np.load(io.BytesIO(np.asarray(node[...], dtype=np.uint8).tobytes()), allow_pickle=False) as packed:
@@ -486,7 +493,29 @@ class StudyStore:
             self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
         attrs = dict(dataset.attrs)
         self.root.attrs.update({key: value.tolist() if isinstance(value, np.ndarray) else value.item() if isinstance(value, np.generic) else value for key, value in attrs.items()})
+        self.root.attrs[_KEPT] = True  # its consolidated metadata is checked when a run opens it again
         zarr.consolidate_metadata(self.store, zarr_format=ZARR_FORMAT)
+
+    def _check_consolidated(self, path: Path) -> None:
+        """Say whether a kept store's consolidated metadata (``.zmetadata``, a copy of every array's own files for
+        readers; a run reads the files themselves) is lost, unreadable or differs from the files; either way it is
+        written again when the run keeps the store, and nothing else depends on it. The store is then no longer
+        marked as kept, so that a run cut off before it is kept again is not taken for damage."""
+        consolidated = path / ".zmetadata"
+        damage = None
+        try:
+            recorded = json.loads(consolidated.read_text())["metadata"]
+            files = {member.relative_to(path).as_posix() for member in path.rglob(".z*") if member.name in (".zarray", ".zattrs", ".zgroup")}
+            differ = sorted(key for key in files | set(recorded) if key not in recorded or key not in files or json.loads((path / key).read_text()) != recorded[key])
+            if differ:
+                damage = f"differs from the arrays' own metadata ({', '.join(differ[:3])}{' ...' if len(differ) > 3 else ''})"
+        except FileNotFoundError:
+            damage = "is lost"
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            damage = "is unreadable"
+        if damage is not None:
+            self.say(f"{consolidated}: the store's consolidated metadata {damage}: the run reads every array's own, and writes it again when it keeps the store")
+        self.root.attrs[_KEPT] = False
 
     def remove(self) -> None:
         """Delete the store (after its results are exported): renamed first, so that a removal cut off half-way
