@@ -45,7 +45,7 @@ from numpy.typing import NDArray
 from zarr.core.sync import sync  # zarr's own event loop, the one its synchronous API runs on
 
 from vibroimpact.runs.fingerprints import NOT_IN_FINGERPRINT, case_key, changed_keys, code_fingerprint, fingerprint_of, source_hash, store_fingerprint, values_digest
-from vibroimpact.runs.store_record import read_record, record_digest, restore, set_aside, check_members_readable
+from vibroimpact.runs.store_record import consolidated_damage, read_record, record_digest, restore, set_aside, check_members_readable
 
 __all__ = ["source_hash", "case_key", "StudyStore", "store_fingerprint", "code_fingerprint", "values_digest", "StoreOfAnotherScene", "StoreUnusable", "NOT_IN_FINGERPRINT", "ZARR_FORMAT"]
 
@@ -497,24 +497,12 @@ class StudyStore:
         zarr.consolidate_metadata(self.store, zarr_format=ZARR_FORMAT)
 
     def _check_consolidated(self, path: Path) -> None:
-        """Say whether a kept store's consolidated metadata (``.zmetadata``, a copy of every array's own files for
-        readers; a run reads the files themselves) is lost, unreadable or differs from the files; either way it is
-        written again when the run keeps the store, and nothing else depends on it. The store is then no longer
-        marked as kept, so that a run cut off before it is kept again is not taken for damage."""
-        consolidated = path / ".zmetadata"
-        damage = None
-        try:
-            recorded = json.loads(consolidated.read_text())["metadata"]
-            files = {member.relative_to(path).as_posix() for member in path.rglob(".z*") if member.name in (".zarray", ".zattrs", ".zgroup")}
-            differ = sorted(key for key in files | set(recorded) if key not in recorded or key not in files or json.loads((path / key).read_text()) != recorded[key])
-            if differ:
-                damage = f"differs from the arrays' own metadata ({', '.join(differ[:3])}{' ...' if len(differ) > 3 else ''})"
-        except FileNotFoundError:
-            damage = "is lost"
-        except (OSError, ValueError, KeyError, TypeError, AttributeError):
-            damage = "is unreadable"
+        """Say whether a kept store's consolidated metadata is damaged (:func:`consolidated_damage`; written again
+        when the run keeps the store); the store is then no longer marked as kept, so that a run cut off before it
+        keeps it again is not taken for damage."""
+        damage = consolidated_damage(path)
         if damage is not None:
-            self.say(f"{consolidated}: the store's consolidated metadata {damage}: the run reads every array's own, and writes it again when it keeps the store")
+            self.say(f"{path / '.zmetadata'}: the store's consolidated metadata {damage}: the run reads every array's own, and writes it again when it keeps the store")
         self.root.attrs[_KEPT] = False
 
     def remove(self) -> None:

@@ -9,7 +9,8 @@ the record and writes back what differs (:func:`restore`): an edited dtype, a lo
 are rebuilt, never exported; the values are then checked against their checksums as before.
 
 A store that a rerun cannot use at all (its root attributes lost or unreadable, an unreadable array beside the grid's)
-is set aside (:func:`set_aside`: renamed, never deleted) and the work is done again.
+is set aside (:func:`set_aside`: renamed, never deleted) and the work is done again. A kept store's consolidated
+metadata, a copy for readers, is checked against the files (:func:`consolidated_damage`) and written again.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-__all__ = ["METADATA_FILES", "read_record", "record_digest", "restore", "set_aside", "check_members_readable"]
+__all__ = ["METADATA_FILES", "read_record", "record_digest", "restore", "set_aside", "check_members_readable", "consolidated_damage"]
 
 #: An array's metadata files in zarr format 2.
 METADATA_FILES = (".zarray", ".zattrs")
@@ -107,3 +108,20 @@ def check_members_readable(path: Path, skip: tuple[str, ...] = ()) -> None:
                     json.loads(text)
             except (OSError, ValueError) as error:
                 raise ValueError(f"{member.name}/{file} is unreadable: {error}") from None
+
+
+def consolidated_damage(path: Path) -> str | None:
+    """What is wrong with the consolidated metadata (``.zmetadata``) of the kept store at ``path``, a copy of every
+    array's own ``.zarray``, ``.zattrs`` and ``.zgroup`` for readers (a run reads the files themselves): ``"is lost"``,
+    ``"is unreadable"``, ``"differs from the arrays' own metadata (KEYS)"``, or None where it is whole."""
+    try:
+        recorded = json.loads((path / ".zmetadata").read_text())["metadata"]
+        files = {member.relative_to(path).as_posix() for member in path.rglob(".z*") if member.name in (".zarray", ".zattrs", ".zgroup")}
+        differ = sorted(key for key in files | set(recorded) if key not in recorded or key not in files or json.loads((path / key).read_text()) != recorded[key])
+    except FileNotFoundError:
+        return "is lost"
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return "is unreadable"
+    if differ:
+        return f"differs from the arrays' own metadata ({', '.join(differ[:3])}{' ...' if len(differ) > 3 else ''})"
+    return None
