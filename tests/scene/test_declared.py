@@ -22,8 +22,8 @@ from vibroimpact.kinds.design.scene import CERTIFY, SEARCH, SearchSettings
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.scene.declared import DERIVED, REQUIRED, Band, Grid, Key, Names, Rows, Section, Table
 from vibroimpact.scene.grid import ADMISSIBILITY, SWEPT_SINE
-from vibroimpact.scene.header import CLUSTER, HEADER
-from vibroimpact.scene.kinds import KINDS, declared_sections
+from vibroimpact.scene.header import CLUSTER, HEADER, declared_sections
+from vibroimpact.scene.kinds import KINDS
 from vibroimpact.scene.simulation import SIMULATION
 from vibroimpact.scene.reader import parse_scene, read_yaml
 
