@@ -109,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
         return _print_listing(study_listing(shipped_studies(), shutil.get_terminal_size((120, 24)).columns))
     if args.keys:
         from vibroimpact.scene.declared import reference_table
-        from vibroimpact.scene.kinds import declared_sections
+        from vibroimpact.scene.header import declared_sections
 
         return _print_listing(reference_table(declared_sections()))
     if args.scene is None:

@@ -11,10 +11,11 @@ import re
 from typing import Any
 
 from vibroimpact.scene.checker import Checker
+from vibroimpact.scene.kinds import KINDS
 from vibroimpact.scene.declared import DERIVED, REQUIRED, Key, Section, Table
 from vibroimpact.scene.schema import MAX_SWEEP_SAMPLES
 
-__all__ = ["NAME", "MAX_NAME_LENGTH", "HEADER", "CLUSTER", "HEADER_KEYS", "open_scene", "parse_names", "parse_cluster", "check_sweep_run"]
+__all__ = ["NAME", "MAX_NAME_LENGTH", "HEADER", "CLUSTER", "HEADER_KEYS", "declared_sections", "open_scene", "parse_names", "parse_cluster", "check_sweep_run"]
 
 #: A scene's or a case's name: safe as a file name, at most :data:`MAX_NAME_LENGTH` characters (the run writes
 #: ``.<name>.zarr.removed-<pid>`` and the like, within the 255 bytes a file name may take).
@@ -35,6 +36,16 @@ CLUSTER = Section("cluster", (
 ), "where the study runs")  # fmt: skip
 #: The keys every scene may give, whatever its kind.
 HEADER_KEYS = frozenset(HEADER.names)
+
+
+def declared_sections() -> tuple[Section, ...]:
+    """The shared header's declared sections, then every kind's (:meth:`~vibroimpact.scene.kinds.Kind.sections`),
+    each once (a section two kinds share, in the first's place); imports the kinds' scene parsers only."""
+    seen: dict[str, Section] = {HEADER.path: HEADER, CLUSTER.path: CLUSTER}
+    for kind in KINDS:
+        for section in kind.sections():
+            seen.setdefault(section.path, section)
+    return tuple(seen.values())
 
 
 def open_scene(document: Any, top_keys: set[str], required: set[str], kind: str) -> tuple[Checker, dict, Any, str, bool, str | None]:

@@ -18,7 +18,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["Kind", "KINDS", "KIND_NAMES", "kind_of_document", "kind_named", "declared_sections"]
+__all__ = ["Kind", "KINDS", "KIND_NAMES", "kind_of_document", "kind_named"]
 
 
 @dataclass(frozen=True)
@@ -119,15 +119,3 @@ def kind_named(name: str) -> Kind:
         return _BY_NAME[name]
     except KeyError:
         raise KeyError(f"no kind of study called {name!r}; the kinds are {', '.join(KIND_NAMES)}") from None
-
-
-def declared_sections() -> tuple[Any, ...]:
-    """The shared header's declared sections, then every kind's (:meth:`Kind.sections`), each once (a section two kinds
-    share, in the first's place); imports the kinds' scene parsers only."""
-    from vibroimpact.scene.header import CLUSTER, HEADER
-
-    seen: dict[str, Any] = {HEADER.path: HEADER, CLUSTER.path: CLUSTER}
-    for kind in KINDS:
-        for section in kind.sections():
-            seen.setdefault(section.path, section)
-    return tuple(seen.values())
