@@ -18,7 +18,7 @@ import yaml
 from vibroimpact.kinds.benchmark.scene import BENCHMARK, LADDER
 from vibroimpact.kinds.bifurcation.scene import BRUTE_FORCE, CHART, CONTINUATION, BranchSettings, BruteForceSettings, ChartSettings
 from vibroimpact.kinds.concepts.scene import CONTINUATION as CONCEPTS_CONTINUATION
-from vibroimpact.kinds.design.scene import CERTIFY, SEARCH, SearchSettings
+from vibroimpact.kinds.design.scene import CERTIFY, CONSTRAINTS, DESIGN, OPERATING, ROBUST, SEARCH, SearchSettings
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.scene.declared import DERIVED, REQUIRED, Band, Grid, Key, Names, Rows, Section, Table
 from vibroimpact.scene.grid import ADMISSIBILITY, SWEPT_SINE
@@ -55,6 +55,10 @@ SWEPT_FIELDS = {"start": "start_frequency", "stop": "stop_frequency"}
 PLACES = {
     HEADER.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: _header_value(scene, name)),
     CLUSTER.path: (lambda: copy.deepcopy(SCENE) | {"cluster": {"scheduler": "tcp://head:8786"}}, lambda scene, name: scene.cluster_scheduler),
+    DESIGN.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: _design_value(scene.settings, name)),
+    CONSTRAINTS.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: scene.settings.operating),
+    OPERATING.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: scene.settings.operating[0]),
+    ROBUST.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: getattr(scene.settings, name)),
     SEARCH.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: getattr(scene.settings.search, name)),
     CERTIFY.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: scene.settings.certified),
     BRUTE_FORCE.path: (lambda: _shipped("bifurcation.yaml"), lambda scene, name: getattr(scene.settings.brute_force, name)),
@@ -71,10 +75,19 @@ PLACES = {
 #: A ladder on the paper's stop, which gives neither restitution nor clearance (both then needed).
 LADDER_POINT = {"frequency": 25.0, "restitution": 0.2, "clearance": 0.003, "bumper_frequencies": [1000.0, 5000.0]}
 #: Keys the kind derives but the walk's scene needs given (the paper's stop takes them from the ladder).
-NEEDED = {"benchmark.ladder.restitution", "benchmark.ladder.clearance"}
+NEEDED = {"benchmark.ladder.restitution", "benchmark.ladder.clearance", "design.robust.samples"}  # the last: with a spread
+#: A valid value, for the walk, of a key whose other values the declaration cannot tell (a name the layout makes).
+OTHER_VALUES = {"design.objective": "force_amplitude"}
 #: A valid value, for the walk, of each key whose default the kind derives.
 DERIVED_VALUES = {"cluster": {"scheduler": "tcp://head:8786"}, "simulation.frequency": [20.0, 30.0], "simulation.rtol": 1e-6, "simulation.atol": 1e-9, "simulation.subset": {"momentary": {"frequency": [25.0]}},
                   "benchmark.ladder": LADDER_POINT, "benchmark.ladder.restitution": 0.5, "benchmark.ladder.clearance": 0.002}
+
+
+def _design_value(settings: Any, name: str) -> Any:
+    """Where the ``design`` section's key ``name`` lands in the design settings (the variables as the scene writes them)."""
+    if name == "variables":
+        return {variable.name: [variable.low, variable.high] for variable in settings.variables}
+    return getattr(settings, name)
 
 
 def _header_value(scene: Any, name: str) -> Any:
@@ -134,11 +147,18 @@ def _required(section: Section) -> dict[str, Any]:
     place = PLACES[section.path][0]()
     for part in section.path.split(".") if section.path else ():
         place = place.get(part, {})
-    return {key.name: place[key.name] for key in section.keys if key.default is REQUIRED or section.where(key.name) in NEEDED}
+    given = {key.name: place[key.name] for key in section.keys if key.default is REQUIRED or section.where(key.name) in NEEDED}
+    return given | ({name: value for name, value in place.items() if name not in section.names} if section.others else {})  # a spread, a limit
 
 
 def _other_value(key: Key, given: Any = None, section_path: str = "") -> Any:
     """A valid value of ``key`` other than its default (a required key's: other than ``given``, its scene's)."""
+    if f"{section_path}.{key.name}" in OTHER_VALUES:
+        return OTHER_VALUES[f"{section_path}.{key.name}"]
+    if key.default is REQUIRED and key.type is Band:
+        return (given["start"], (given["start"] + given["stop"]) / 2.0)
+    if key.default is REQUIRED and isinstance(given, dict):
+        return dict(list(given.items())[:1])
     if key.default is REQUIRED:
         return given[:1] if isinstance(given, list) else given + "2" if isinstance(given, str) else given * 1.01
     if key.default is DERIVED:
@@ -168,7 +188,7 @@ def _wrong_values(key: Key) -> list[Any]:
     if key.type is Names:
         return [key.choices[0], True]
     if key.type is Band:
-        return [list(key.default), 3]
+        return [[1.0, 2.0], 3]
     if key.type is Grid:
         return ["20 Hz", True]
     if key.type is Table:
@@ -191,6 +211,8 @@ def test_every_declared_section_of_every_kind_is_walked_here() -> None:
 def test_every_declared_key_reaches_the_settings(section: Section) -> None:
     required = _required(section)
     for key in section.keys:
+        if section.where(key.name) in PLACES:
+            continue  # a declared section of its own, walked as such
         value = _other_value(key, required.get(key.name), section.path)
         given = required | _method_of(section, key) | {key.name: key.as_written(value)}
         scene = parse_scene(_scene(section.path, given))

@@ -206,11 +206,15 @@ class Section:
         Its keys, in the order the reference lists them.
     doc : str
         One line: what the section sets.
+    others : str
+        One line on the keys the kind names beyond the declared ones (a spread per scalar, a limit per measure), which
+        its own parser checks; ``""``: none, every other key is refused here.
     """
 
     path: str
     keys: tuple[Key, ...]
     doc: str
+    others: str = ""
 
     def __post_init__(self) -> None:
         names = [key.name for key in self.keys]
@@ -250,7 +254,7 @@ class Section:
             return None
         before = len(c.problems)
         for given in value:
-            if str(given) not in self.names:
+            if str(given) not in self.names and not self.others:
                 c.fail(self.where(str(given)), f"unknown key (allowed: {', '.join(self.names)}){did_you_mean(str(given), self.names)}")
         read: dict[str, Any] = {}
         for key in self.keys:
@@ -289,6 +293,8 @@ class Section:
             default = "required" if key.default is REQUIRED else "derived" if key.default is DERIVED else _written(key.as_written(key.default))
             when = f" (read with {key.read_when[0]}: {key.read_when[1]})" if key.read_when else ""
             rows.append(f"| `{self.where(key.name)}` | {key.allowed()} | {default} | {key.doc}{when} |")
+        if self.others:
+            rows.append(f"| `{self.where('<name>')}` | number | - | {self.others} |")
         return rows
 
 

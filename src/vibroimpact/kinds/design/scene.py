@@ -44,13 +44,13 @@ from vibroimpact.analysis.measures import Measure, measure, measure_names
 from vibroimpact.model.layout import PAPER_STOP, Layout
 from vibroimpact.model.parameters import BUMPER_STIFFNESS, LAYOUT_FORMS, MAX_RELATIVE_SPREAD, PARAMETERS, Parameter, parameter
 from vibroimpact.model.structure import require_in_range
-from vibroimpact.scene.checker import Checker, SceneError
-from vibroimpact.scene.declared import Key, Section
+from vibroimpact.scene.checker import Checker, SceneError, did_you_mean
+from vibroimpact.scene.declared import DERIVED, REQUIRED, Band, Key, Section, Table
 from vibroimpact.scene.header import open_scene
 from vibroimpact.scene.layout_parse import parse_layout
 from vibroimpact.scene.schema import Scene
 
-__all__ = ["DESIGN_TOP_KEYS", "SEARCH", "CERTIFY", "SECTIONS", "STOP_VARIABLES", "BUMPER_VARIABLE", "METHODS", "COMPARISONS", "Variable", "Mistuning", "SearchSettings", "DesignSettings", "parse_design_scene", "safe_name"]
+__all__ = ["DESIGN_TOP_KEYS", "DESIGN", "ROBUST", "CONSTRAINTS", "OPERATING", "SEARCH", "CERTIFY", "SECTIONS", "STOP_VARIABLES", "BUMPER_VARIABLE", "METHODS", "COMPARISONS", "Variable", "Mistuning", "SearchSettings", "DesignSettings", "parse_design_scene", "safe_name"]
 
 #: Top-level keys of a design scene.
 DESIGN_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "design", "report", "cluster"}
@@ -62,7 +62,35 @@ BUMPER_VARIABLE = BUMPER_STIFFNESS
 METHODS = ("differential_evolution", "grid")
 #: What the optimum is compared with: the best linear absorber of the same mass (the paper's two masses), or nothing.
 COMPARISONS = ("linear_optimum", "none")
-_DESIGN_KEYS = {"variables", "band", "objective", "constraints", "robust", "compare", "search", "certify"}
+#: ``design``, declared (:mod:`vibroimpact.scene.declared`); its mappings are declared sections of their own or
+#: checked by their own parsers (the variables, whose names are the layout's).
+DESIGN = Section("design", (
+    Key("variables", Table, "{scalar: [low, high]}: what the search chooses (clearance, restitution, bumper_stiffness or a layout scalar; at most 6)",
+        REQUIRED),
+    Key("band", Band, "the band whose worst stable motion is judged", REQUIRED, 0.0, math.inf, "Hz", open_low=True),
+    Key("objective", str, "what is minimised, the worst stable motion's over the band: <coordinate>_amplitude [m] or force_amplitude [N]", "x1_amplitude"),
+    Key("constraints", Table, "{operating: {frequency, <measure>: largest value}} (design.constraints)", DERIVED),
+    Key("robust", Table, "{<scalar>: spread, samples, seed, quantile}: the mistuning (design.robust)", DERIVED),
+    Key("compare", str, "what the optimum is compared with: the best linear absorber of the same mass, or nothing", "none", choices=COMPARISONS),
+    Key("search", Table, "how candidates are chosen (design.search)", DERIVED),
+    Key("certify", Table, "which candidates are certified (design.certify)", DERIVED),
+), "which scalars to choose, within which bounds, to minimise what over which band")  # fmt: skip
+#: ``design.robust``, declared: the spreads are the scalars' own keys.
+ROBUST = Section("design.robust", (
+    Key("samples", int, "Latin-hypercube samples of the mistuning (required with a spread)", 0, 0, 4096),
+    Key("seed", int, "the Latin hypercube's seed", 1, 0, 2**31 - 1),
+    Key("quantile", float, "the objective over the samples: 1 their worst, less a quantile", 1.0, 0.0, 1.0, open_low=True),
+), "the mistuning the objective is judged over",
+    others="a spread per scalar: relative for a structural one (0.05: +-5 %), absolute for clearance [m] and restitution [-]")  # fmt: skip
+#: ``design.constraints``, declared.
+CONSTRAINTS = Section("design.constraints", (
+    Key("operating", Table, "{frequency, <measure>: largest value}: the notch that must survive (design.constraints.operating)", DERIVED),
+), "what every design must keep")  # fmt: skip
+#: ``design.constraints.operating``, declared: the limit is the measure's own key.
+OPERATING = Section("design.constraints.operating", (
+    Key("frequency", float, "the operating frequency", REQUIRED, 0.0, math.inf, "Hz", open_low=True),
+), "the operating point's limit, judged as the objective is (its worst case over the mistuning)",
+    others="one largest value of a measure, > 0: <coordinate>_amplitude [m] or force_amplitude [N]")  # fmt: skip
 _EVOLUTION = ("method", "differential_evolution")
 #: ``design.search``, declared (:mod:`vibroimpact.scene.declared`): the keys of one method are refused with the other.
 SEARCH = Section("design.search", (
@@ -77,8 +105,8 @@ SEARCH = Section("design.search", (
 CERTIFY = Section("design.certify", (
     Key("candidates", int, "the best candidates certified by continuation, brute force and the tolerance box's corners", 1, 0, 20),
 ), "which candidates are certified")  # fmt: skip
-#: The sections of a design scene that are declared (``run-study --keys design`` lists them).
-SECTIONS = (SEARCH, CERTIFY)
+#: The sections of a design scene that are declared (``run-study --keys`` lists them).
+SECTIONS = (DESIGN, CONSTRAINTS, OPERATING, ROBUST, SEARCH, CERTIFY)
 #: Most evaluations of one scene's search (candidates x mistuning samples).
 MAX_EVALUATIONS = 2_000_000
 
@@ -233,23 +261,21 @@ def parse_design_scene(document: dict, text: str = "", source: str = "scene") ->
     c, doc, name, description, report, scheduler = open_scene(document, DESIGN_TOP_KEYS, {"name", "system", "excitation", "design"}, "design")
     layout, amplitude, coordinates = parse_layout(c, doc)
     clearance, restitution, bumper = _stop_values(c, doc, layout)
-    spec = c.mapping("design", doc.get("design"), _DESIGN_KEYS, {"variables", "band"}) if "design" in doc else {}
-    variables = _variables(c, spec.get("variables"), layout, bumper) if "variables" in spec else ()
-    band = _band(c, spec["band"]) if "band" in spec else None
-    objective_measure = _objective(c, spec.get("objective", "x1_amplitude"), coordinates)
-    operating, constraint = _operating(c, spec.get("constraints", {}), coordinates, band)
+    spec = (DESIGN.read(c, doc["design"], partial=True) if "design" in doc else None) or {}
+    variables = _variables(c, spec["variables"], layout, bumper) if spec.get("variables") is not None else ()
+    band = spec.get("band")
+    objective_measure = _objective(c, spec.get("objective") or DESIGN.key("objective").default, coordinates)
+    operating, constraint = _operating(c, spec.get("constraints") or {}, coordinates, band)
     _check_measures(c, layout, (("design.objective", objective_measure), ("design.constraints.operating", constraint)))
-    mistuning, samples, seed, quantile = _robust(c, spec.get("robust", {}), layout, bumper)
-    compare = spec.get("compare", "none")
-    if compare not in COMPARISONS:
-        c.fail("design.compare", f"{compare!r} is not allowed: use one of {', '.join(COMPARISONS)}")
-    elif compare == "linear_optimum" and layout is not None and layout.paper_view() is None:
+    mistuning, samples, seed, quantile = _robust(c, spec.get("robust") or {}, layout, bumper)
+    compare = spec.get("compare") or DESIGN.key("compare").default
+    if compare == "linear_optimum" and layout is not None and layout.paper_view() is None:
         c.fail("design.compare", "linear_optimum is the optimum absorber of the paper's two masses (system: {m1 ... b2}); this structure is not one: use none")
     elif compare == "linear_optimum" and objective_measure.coordinate not in (None, 0):
         c.fail("design.compare", f"linear_optimum minimises the objective's {objective_measure.name} over linear absorbers of the same mass, and it has no minimum: "
                                  "the absorber's own motion falls without end as its spring and dashpot are loosened (a detached absorber moves least): use none")
-    search = _search(c, spec.get("search", {}))
-    certified = _certify(c, spec.get("certify", {}))
+    search = _search(c, spec.get("search"))
+    certified = _certify(c, spec.get("certify"))
     if search is not None and variables and samples is not None:
         count = (search.points ** len(variables) if search.method == "grid" else search.population * len(variables) * (search.generations + 1) * 2) * (samples + 1)
         if count > MAX_EVALUATIONS:
@@ -370,18 +396,6 @@ def _design_row(c: Checker, key: str, name: str, layout: Layout | None, bumper: 
         return None
 
 
-def _band(c: Checker, value: Any) -> tuple[float, float] | None:
-    band = c.mapping("design.band", value, {"start", "stop"}, {"start", "stop"})
-    low = c.number("design.band.start", band["start"], 0.0, math.inf, low_inclusive=False) if "start" in band else None
-    high = c.number("design.band.stop", band["stop"], 0.0, math.inf, low_inclusive=False) if "stop" in band else None
-    if low is None or high is None:
-        return None
-    if high <= low:
-        c.fail("design.band.stop", f"{high:g} must be greater than start = {low:g}")
-        return None
-    return low, high
-
-
 def _objective(c: Checker, value: Any, coordinates: tuple[str, ...] | None) -> Measure:
     names = coordinates or ("x1", "x2")
     allowed = measure_names(names)
@@ -394,17 +408,21 @@ def _objective(c: Checker, value: Any, coordinates: tuple[str, ...] | None) -> M
 def _operating(c: Checker, value: Any, coordinates: tuple[str, ...] | None, band: tuple[float, float] | None) -> tuple[tuple[float, float] | None, Measure | None]:
     """(frequency [Hz], largest allowed value [its unit]) of the operating constraint and the measure it limits (any
     row of the measure table: |X1| keeps the primary's notch)."""
-    constraints = c.mapping("design.constraints", value, {"operating"})
-    if "operating" not in constraints:
+    constraints = CONSTRAINTS.read(c, value)
+    if constraints is None or constraints["operating"] is None:
         return None, None
     names = coordinates or ("x1", "x2")
-    keys = {"frequency", *measure_names(names)}
-    spec = c.mapping("design.constraints.operating", constraints["operating"], keys, {"frequency"})
-    limit_keys = [k for k in spec if k != "frequency"]
+    limits = measure_names(names)
+    spec = constraints["operating"]
+    read = OPERATING.read(c, spec, partial=True)
+    limit_keys = [str(k) for k in spec if str(k) not in OPERATING.names]
+    for unknown in (k for k in limit_keys if k not in limits):
+        c.fail(f"design.constraints.operating.{unknown}", f"unknown key (allowed: frequency, {', '.join(limits)}){did_you_mean(unknown, ('frequency', *limits))}")
+    limit_keys = [k for k in limit_keys if k in limits]
     if len(limit_keys) != 1:
-        c.fail("design.constraints.operating", f"give the frequency [Hz] and one largest amplitude [m] or force [N] ({', '.join(sorted(keys - {'frequency'}))})")
+        c.fail("design.constraints.operating", f"give the frequency [Hz] and one largest amplitude [m] or force [N] ({', '.join(limits)})")
         return None, None
-    frequency = c.number("design.constraints.operating.frequency", spec.get("frequency"), 0.0, math.inf, low_inclusive=False) if "frequency" in spec else None
+    frequency = read["frequency"] if read is not None else None
     limit = c.number(f"design.constraints.operating.{limit_keys[0]}", spec[limit_keys[0]], 0.0, math.inf, low_inclusive=False)
     limited = measure(limit_keys[0], names)
     return ((frequency, limit) if frequency is not None and limit is not None else None), limited
@@ -424,15 +442,13 @@ def _check_measures(c: Checker, layout: Layout | None, rows: tuple[tuple[str, Me
 
 
 def _robust(c: Checker, value: Any, layout: Layout | None, bumper: float | None = None) -> tuple[tuple[Mistuning, ...], int | None, int | None, float | None]:
-    if not isinstance(value, dict):
-        c.fail("design.robust", f"expected a mapping of spreads and samples, got {value!r}")
+    read = ROBUST.read(c, value, partial=True)
+    if read is None:
         return (), None, None, None
-    spreads = [str(k) for k in value if str(k) not in ("samples", "seed", "quantile")]
+    spreads = [str(k) for k in value if str(k) not in ROBUST.names]
     if spreads and "samples" not in value:
         c.fail("design.robust.samples", "required with a spread: how many Latin-hypercube samples (e.g. 32)")
-    samples = c.integer("design.robust.samples", value.get("samples", 0), 0, 4096)
-    seed = c.integer("design.robust.seed", value.get("seed", 1), 0, 2**31 - 1)
-    quantile = c.number("design.robust.quantile", value.get("quantile", 1.0), 0.0, 1.0, low_inclusive=False)
+    samples, seed, quantile = read["samples"], read["seed"], read["quantile"]
     out = []
     for name in spreads:
         row = _design_row(c, f"design.robust.{name}", name, layout, bumper)
