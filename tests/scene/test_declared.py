@@ -16,7 +16,7 @@ import pytest
 import yaml
 
 from vibroimpact.kinds.benchmark.scene import BENCHMARK, LADDER
-from vibroimpact.kinds.bifurcation.scene import BRUTE_FORCE, CHART, CONTINUATION, BranchSettings, BruteForceSettings, ChartSettings
+from vibroimpact.kinds.bifurcation.scene import BIFURCATION, BRUTE_FORCE, CHART, CONTINUATION, BranchSettings, BruteForceSettings, ChartSettings
 from vibroimpact.kinds.concepts.scene import CONTINUATION as CONCEPTS_CONTINUATION
 from vibroimpact.kinds.design.scene import CERTIFY, CONSTRAINTS, DESIGN, OPERATING, ROBUST, SEARCH, SearchSettings
 from vibroimpact.scene.checker import Checker, SceneError
@@ -61,6 +61,7 @@ PLACES = {
     ROBUST.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: getattr(scene.settings, name)),
     SEARCH.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: getattr(scene.settings.search, name)),
     CERTIFY.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: scene.settings.certified),
+    BIFURCATION.path: (lambda: _shipped("bifurcation.yaml"), lambda scene, name: _bifurcation_value(scene.settings, name)),
     BRUTE_FORCE.path: (lambda: _shipped("bifurcation.yaml"), lambda scene, name: getattr(scene.settings.brute_force, name)),
     CONTINUATION.path: (lambda: _shipped("bifurcation.yaml"), lambda scene, name: getattr(scene.settings.branches, name)),
     CHART.path: (lambda: _shipped("bifurcation.yaml"), lambda scene, name: getattr(scene.settings.chart, name)),
@@ -75,11 +76,14 @@ PLACES = {
 #: A ladder on the paper's stop, which gives neither restitution nor clearance (both then needed).
 LADDER_POINT = {"frequency": 25.0, "restitution": 0.2, "clearance": 0.003, "bumper_frequencies": [1000.0, 5000.0]}
 #: Keys the kind derives but the walk's scene needs given (the paper's stop takes them from the ladder).
-NEEDED = {"benchmark.ladder.restitution", "benchmark.ladder.clearance", "design.robust.samples"}  # the last: with a spread
+NEEDED = {"benchmark.ladder.restitution", "benchmark.ladder.clearance", "design.robust.samples", "bifurcation.restitution"}  # with a spread; the paper's stop
 #: A valid value, for the walk, of a key whose other values the declaration cannot tell (a name the layout makes).
 OTHER_VALUES = {"design.objective": "force_amplitude"}
+#: Keys the walk gives beside a key that is read only with them (a reference needs bumpers).
+CONTEXT = {"bifurcation.reference": {"bumper": {"frequency": [100.0]}}}
 #: A valid value, for the walk, of each key whose default the kind derives.
-DERIVED_VALUES = {"cluster": {"scheduler": "tcp://head:8786"}, "simulation.frequency": [20.0, 30.0], "simulation.rtol": 1e-6, "simulation.atol": 1e-9, "simulation.subset": {"momentary": {"frequency": [25.0]}},
+DERIVED_VALUES = {"cluster": {"scheduler": "tcp://head:8786"}, "bifurcation.restitution": [0.5], "bifurcation.bumper": {"frequency": [100.0]},
+                  "bifurcation.brute_force": {}, "bifurcation.continuation": {}, "bifurcation.chart": {}, "simulation.frequency": [20.0, 30.0], "simulation.rtol": 1e-6, "simulation.atol": 1e-9, "simulation.subset": {"momentary": {"frequency": [25.0]}},
                   "benchmark.ladder": LADDER_POINT, "benchmark.ladder.restitution": 0.5, "benchmark.ladder.clearance": 0.002}
 
 
@@ -87,6 +91,15 @@ def _design_value(settings: Any, name: str) -> Any:
     """Where the ``design`` section's key ``name`` lands in the design settings (the variables as the scene writes them)."""
     if name == "variables":
         return {variable.name: [variable.low, variable.high] for variable in settings.variables}
+    return getattr(settings, name)
+
+
+def _bifurcation_value(settings: Any, name: str) -> Any:
+    """Where the ``bifurcation`` section's key ``name`` lands in the bifurcation settings."""
+    if name == "frequency":
+        return (settings.low, settings.high)
+    if name == "bumper":
+        return {"frequency": list(settings.bumper_frequencies)}
     return getattr(settings, name)
 
 
@@ -214,7 +227,7 @@ def test_every_declared_key_reaches_the_settings(section: Section) -> None:
         if section.where(key.name) in PLACES:
             continue  # a declared section of its own, walked as such
         value = _other_value(key, required.get(key.name), section.path)
-        given = required | _method_of(section, key) | {key.name: key.as_written(value)}
+        given = required | _method_of(section, key) | CONTEXT.get(section.where(key.name), {}) | {key.name: key.as_written(value)}
         scene = parse_scene(_scene(section.path, given))
         assert _same(PLACES[section.path][1](scene, key.name), value), (key.name, value)
 

@@ -62,8 +62,8 @@ def test_a_bumper_scene_runs_its_bumpers_alone_unless_it_asks_for_the_rigid_refe
 @pytest.mark.parametrize(
     ("change", "words"),
     [
-        ({"bumper": {"frequency": [1000.0]}, "reference": "rigid stop"}, "'rigid stop' is not allowed: use one of rigid, none"),
-        ({"bumper": {"frequency": [1000.0]}, "reference": True}, "True is not allowed: use one of rigid, none"),
+        ({"bumper": {"frequency": [1000.0]}, "reference": "rigid stop"}, "'rigid stop' is not allowed: allowed rigid, none; did you mean 'rigid'?"),
+        ({"bumper": {"frequency": [1000.0]}, "reference": True}, "expected a string, got True (bool)"),
         ({"reference": "rigid"}, "a reference needs bifurcation.bumper"),
     ],
 )

@@ -52,14 +52,14 @@ from typing import Any, TypeVar
 import numpy as np
 
 from vibroimpact.scene.checker import Checker, SceneError
-from vibroimpact.scene.declared import Band, Key, Names, Section
+from vibroimpact.scene.declared import DERIVED, REQUIRED, Band, Grid, Key, Names, Section, Table
 from vibroimpact.model.contact import place_effective_mass
 from vibroimpact.model.layout import Layout, StopSpec
 from vibroimpact.scene.header import open_scene
 from vibroimpact.scene.layout_parse import parse_layout, static_drift
 from vibroimpact.scene.schema import SWEEP_DIRECTIONS, Scene
 
-__all__ = ["BIFURCATION_TOP_KEYS", "CHART_KINDS", "REFERENCES", "BRUTE_FORCE", "CONTINUATION", "CHART", "SECTIONS", "BruteForceSettings", "BranchSettings", "ChartSettings", "BifurcationSettings", "coordinate_label", "parse_bifurcation_scene"]
+__all__ = ["BIFURCATION_TOP_KEYS", "CHART_KINDS", "REFERENCES", "BIFURCATION", "BRUTE_FORCE", "CONTINUATION", "CHART", "SECTIONS", "BruteForceSettings", "BranchSettings", "ChartSettings", "BifurcationSettings", "coordinate_label", "parse_bifurcation_scene"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -112,8 +112,18 @@ CHART = Section("bifurcation.chart", (
     Key("transient_periods", int, "periods dropped at each point of the regime map", 300, 0, 1_000_000),
     Key("strobes", int, "periods kept for the classification at each point of the regime map", 128, 64, 100_000),
 ), "the two-parameter chart (frequency x clearance at one restitution)")  # fmt: skip
-#: The sections of a bifurcation scene that are declared (``run-study --keys bifurcation`` lists them).
-SECTIONS = (BRUTE_FORCE, CONTINUATION, CHART)
+#: ``bifurcation``, declared; its mappings are declared sections of their own, or (the bumpers) checked by their parser.
+BIFURCATION = Section("bifurcation", (
+    Key("frequency", Band, "the band the diagrams span", REQUIRED, 0.0, math.inf, "Hz", open_low=True),
+    Key("restitution", Grid, "R of each diagram, the same for every stop (derived: the stops' own)", DERIVED, 0.0, 1.0),
+    Key("brute_force", Table, "stepped sweeps of the time simulation (bifurcation.brute_force)", DERIVED),
+    Key("continuation", Table, "which branches are continued (bifurcation.continuation)", DERIVED),
+    Key("chart", Table, "the two-parameter chart, frequency x clearance (bifurcation.chart); rigid stops only", DERIVED),
+    Key("bumper", Table, "{frequency: [Hz, ...]} or {stiffness: [N/m, ...]}: Kelvin-Voigt bumpers' diagrams (default: the rigid stop's)", DERIVED),
+    Key("reference", str, "rigid: the rigid stop's diagram beside the bumpers', as their reference", "none", choices=REFERENCES),
+), "the diagrams: which band, which restitutions, which contact models")  # fmt: skip
+#: The sections of a bifurcation scene that are declared (``run-study --keys`` lists them).
+SECTIONS = (BIFURCATION, BRUTE_FORCE, CONTINUATION, CHART)
 
 
 @dataclass(frozen=True)
@@ -282,8 +292,6 @@ class BifurcationSettings:
         count = math.floor((self.high - self.low) / self.chart.frequency_step * (1.0 + 1e-12)) + 1
         return np.round(self.low + self.chart.frequency_step * np.arange(count), 10)
 
-#: Keys of the ``bifurcation`` section and of its parts.
-_KEYS = {"frequency", "restitution", "brute_force", "continuation", "chart", "bumper", "reference"}
 
 
 def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene") -> Scene:
@@ -294,35 +302,26 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
     if layout is not None and static_drift(layout):
         c.fail("excitation.static", "the static force pushes the structure along a rigid-body mode: it has no steady state to follow")
     stops_give_restitution = isinstance(doc.get("stops"), list) and bool(doc["stops"]) and all(isinstance(e, dict) and "restitution" in e for e in doc["stops"])
-    required = {"frequency"} if stops_give_restitution else {"frequency", "restitution"}
-    spec = c.mapping("bifurcation", doc.get("bifurcation"), _KEYS, required) if "bifurcation" in doc else {}
-    specs, clearance, own_restitution = _stops(c, doc, layout, "restitution" in spec)
-    low = high = None
-    if "frequency" in spec:
-        band = c.mapping("bifurcation.frequency", spec["frequency"], {"start", "stop"}, {"start", "stop"})
-        low = c.number("bifurcation.frequency.start", band["start"], 0.0, math.inf, low_inclusive=False) if "start" in band else None
-        high = c.number("bifurcation.frequency.stop", band["stop"], 0.0, math.inf, low_inclusive=False) if "stop" in band else None
-        if low is not None and high is not None and high <= low:
-            c.fail("bifurcation.frequency.stop", f"{high:g} must be greater than start = {low:g}")
-            high = None
-    restitution = c.grid("bifurcation.restitution", spec["restitution"], 0.0, 1.0, True) if "restitution" in spec else own_restitution
+    given = doc.get("bifurcation") if isinstance(doc.get("bifurcation"), dict) else {}
+    spec = (BIFURCATION.read(c, doc["bifurcation"], partial=True) if "bifurcation" in doc else None) or {}
+    if "bifurcation" in doc and not stops_give_restitution and "restitution" not in given:
+        c.fail("bifurcation.restitution", f"required key is missing: the stops give none ({BIFURCATION.key('restitution').allowed()})")
+    specs, clearance, own_restitution = _stops(c, doc, layout, "restitution" in given)
+    low, high = spec.get("frequency") or (None, None)
+    restitution = spec.get("restitution") if "restitution" in given else own_restitution
     brute = _settings(c, BRUTE_FORCE, spec.get("brute_force"), BruteForceSettings)
     branches = _settings(c, CONTINUATION, spec.get("continuation"), BranchSettings)
-    chart = _settings(c, CHART, spec["chart"], ChartSettings) if "chart" in spec else None
+    chart = _settings(c, CHART, spec["chart"], ChartSettings) if spec.get("chart") is not None else None
     masses = None  # the mass each stop's bumper pushes [kg] (the paper's stop: M2)
     if layout is not None and specs is not None:
         masses = [item.effective_mass(layout.structure) for item in specs] if specs else [place_effective_mass((1, None, "upper"), layout.structure.mass_matrix)]
-    given = _bumpers(c, spec["bumper"], masses) if "bumper" in spec else ((), ())
-    bumpers, stiffnesses = given if given is not None else (None, ())
-    reference = "none"
-    if "reference" in spec:
-        if spec["reference"] not in REFERENCES:
-            c.fail("bifurcation.reference", f"{spec['reference']!r} is not allowed: use one of {', '.join(REFERENCES)} (rigid: the rigid stop's diagram beside the bumpers', as their reference)")
-        elif "bumper" not in spec and spec["reference"] != "none":
-            c.fail("bifurcation.reference", "a reference needs bifurcation.bumper: without bumpers the diagram is the rigid stop's")
-        else:
-            reference = str(spec["reference"])
-    if bumpers and "chart" in spec:
+    read_bumpers = _bumpers(c, spec["bumper"], masses) if spec.get("bumper") is not None else ((), ())
+    bumpers, stiffnesses = read_bumpers if read_bumpers is not None else (None, ())
+    reference = spec.get("reference") or "none"
+    if reference != "none" and "bumper" not in given:
+        c.fail("bifurcation.reference", "a reference needs bifurcation.bumper: without bumpers the diagram is the rigid stop's")
+        reference = "none"
+    if bumpers and "chart" in given:
         c.fail("bifurcation.chart", "a chart follows the rigid stop's special points only: remove it, or bifurcation.bumper")
     if bumpers and restitution is not None and np.any(restitution <= 0.0):
         c.fail("bifurcation.restitution", "R = 0 needs an infinitely damped bumper: allowed (0, 1] with bifurcation.bumper")
