@@ -198,3 +198,16 @@ def test_a_general_layout_s_bumpers_give_no_loss_of_their_own() -> None:
         with pytest.raises(SceneError) as caught:
             parse_scene(copy.deepcopy(document))
         assert any(line.startswith("stops:") for line in caught.value.problems), caught.value.problems
+
+
+def test_an_x2_objective_with_the_limit_on_x1_judges_the_limit_on_x1() -> None:
+    """Issue 50: ``objective: x2_amplitude`` with the operating limit written on ``x1_amplitude`` evaluated the limit
+    on x2 (2.323 mm against a 0.05 mm limit, every |X2| labelled |X1|). The design space the study searches judges the
+    objective on x2 and the limit on x1, each its own row of the measure table."""
+    from vibroimpact.kinds.design.study import design_space
+
+    scene = parse_scene(scene_with(objective="x2_amplitude", compare="none"))  # the limit: x1_amplitude 5e-5 m at 33 Hz
+    space = design_space(scene)
+    assert not isinstance(space.objective, int) and (space.objective.name, space.objective.coordinate) == ("x2_amplitude", 1)
+    assert not isinstance(space.constraint, int) and (space.constraint.name, space.constraint.coordinate, space.constraint.unit) == ("x1_amplitude", 0, "m")
+    assert scene.settings.operating == (33.0, 5e-5)  # exact: the scene's own numbers
