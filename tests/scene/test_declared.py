@@ -20,9 +20,11 @@ from vibroimpact.kinds.bifurcation.scene import BIFURCATION, BRUTE_FORCE, CHART,
 from vibroimpact.kinds.concepts.scene import CONTINUATION as CONCEPTS_CONTINUATION
 from vibroimpact.kinds.design.scene import CERTIFY, CONSTRAINTS, DESIGN, OPERATING, ROBUST, SEARCH, SearchSettings
 from vibroimpact.scene.checker import Checker, SceneError
-from vibroimpact.scene.declared import DERIVED, REQUIRED, Band, Grid, Key, Names, Rows, Section, Table
+from vibroimpact.scene.declared import DERIVED, REQUIRED, Band, Free, Grid, Key, Names, Rows, Section, Table
 from vibroimpact.scene.grid import ADMISSIBILITY, SWEPT_SINE
+from vibroimpact.scene.bumper_parse import BUMPER
 from vibroimpact.scene.header import CLUSTER, HEADER, declared_sections
+from vibroimpact.scene.layout_parse import EXCITATION, MATRIX_SYSTEM, NAMED_SYSTEM, STOP_ROW
 from vibroimpact.scene.kinds import KINDS
 from vibroimpact.scene.simulation import SIMULATION
 from vibroimpact.scene.reader import parse_scene, read_yaml
@@ -36,10 +38,29 @@ def _shipped(name: str) -> dict:
     return read_yaml((STUDIES / name).read_text(encoding="utf-8"))
 
 
+def _id(section: Section) -> str:
+    """A declared section's entry in :data:`PLACES`: its path, and its form where the path has more than one."""
+    return f"{section.path}#{section.form}" if section.form else section.path
+
+
+def _where(section: Section, name: str) -> str:
+    """Where a problem of the key ``name`` is said: a stop row's in the walk's first stop."""
+    return section.where(name).replace("stops[k]", "stops[0]")
+
+
+def _analytic(name: str) -> dict:
+    """A shipped stepped scene with its closed forms alone (no simulation, no paper-only route), renamed."""
+    document = {key: value for key, value in _shipped(name).items() if key != "simulation"}
+    return document | {"name": f"{document['name']}_analytic", "solutions": ["linear", "pgf"]}
+
+
 def _put(document: dict, path: str, values: dict[str, Any]) -> dict:
-    """``document`` with the section at the dotted ``path`` set to ``values``."""
+    """``document`` with the section at the dotted ``path`` set to ``values`` (``stops[k]``: the first stop)."""
     if not path:  # the top level: the shared header
         document.update(values)
+        return document
+    if path == STOP_ROW.path:
+        document["stops"][0] = values
         return document
     *parents, leaf = path.split(".")
     place = document
@@ -54,6 +75,11 @@ SWEPT_FIELDS = {"start": "start_frequency", "stop": "stop_frequency"}
 #: Each declared section: a scene of its kind, and where each of its values lands in the kind's settings.
 PLACES = {
     HEADER.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: _header_value(scene, name)),
+    _id(NAMED_SYSTEM): (lambda: _shipped("restitution.yaml"), lambda scene, name: getattr(scene.layout.paper_view(), name)),
+    _id(MATRIX_SYSTEM): (lambda: _shipped("relative_stop.yaml"), None),  # every key a matrix or names: the structure's own checks
+    EXCITATION.path: (lambda: _analytic("restitution.yaml"), lambda scene, name: scene.amplitude if name == "amplitude" else scene.layout.load.base_motion),
+    STOP_ROW.path: (lambda: _shipped("relative_stop.yaml") | {"stops": [{"between": ["x2", "x1"], "clearance": 0.003, "restitution": 0.2}]}, None),
+    BUMPER.path: (lambda: _shipped("bumper_sweep.yaml"), None),
     CLUSTER.path: (lambda: copy.deepcopy(SCENE) | {"cluster": {"scheduler": "tcp://head:8786"}}, lambda scene, name: scene.cluster_scheduler),
     DESIGN.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: _design_value(scene.settings, name)),
     CONSTRAINTS.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: scene.settings.operating),
@@ -76,13 +102,15 @@ PLACES = {
 #: A ladder on the paper's stop, which gives neither restitution nor clearance (both then needed).
 LADDER_POINT = {"frequency": 25.0, "restitution": 0.2, "clearance": 0.003, "bumper_frequencies": [1000.0, 5000.0]}
 #: Keys the kind derives but the walk's scene needs given (the paper's stop takes them from the ladder).
-NEEDED = {"benchmark.ladder.restitution", "benchmark.ladder.clearance", "design.robust.samples", "bifurcation.restitution"}  # with a spread; the paper's stop
+NEEDED = {"benchmark.ladder.restitution", "benchmark.ladder.clearance", "design.robust.samples", "bifurcation.restitution", "stops[k].between",
+          "stops[k].clearance", "stops[k].restitution"}  # with a spread; the paper's stop
 #: A valid value, for the walk, of a key whose other values the declaration cannot tell (a name the layout makes).
 OTHER_VALUES = {"design.objective": "force_amplitude"}
 #: Keys the walk gives beside a key that is read only with them (a reference needs bumpers).
-CONTEXT = {"bifurcation.reference": {"bumper": {"frequency": [100.0]}}}
+CONTEXT = {"bifurcation.reference": {"bumper": {"frequency": [100.0]}}, "bumper.loss_factor": {"frequency": 250.0}, "bumper.damping": {"stiffness": 2.5e5}}
 #: A valid value, for the walk, of each key whose default the kind derives.
-DERIVED_VALUES = {"cluster": {"scheduler": "tcp://head:8786"}, "bifurcation.restitution": [0.5], "bifurcation.bumper": {"frequency": [100.0]},
+DERIVED_VALUES = {"cluster": {"scheduler": "tcp://head:8786"}, "bumper.frequency": 300.0, "bumper.loss_factor": 0.1, "bumper.stiffness": 2.5e5,
+                  "bumper.damping": 10.0, "stops[k].bumper": {"frequency": 300.0}, "bifurcation.restitution": [0.5], "bifurcation.bumper": {"frequency": [100.0]},
                   "bifurcation.brute_force": {}, "bifurcation.continuation": {}, "bifurcation.chart": {}, "simulation.frequency": [20.0, 30.0], "simulation.rtol": 1e-6, "simulation.atol": 1e-9, "simulation.subset": {"momentary": {"frequency": [25.0]}},
                   "benchmark.ladder": LADDER_POINT, "benchmark.ladder.restitution": 0.5, "benchmark.ladder.clearance": 0.002}
 
@@ -120,17 +148,18 @@ def _benchmark_value(scene: Any, name: str) -> Any:
     return getattr(scene.settings, name)
 
 
-def _same(found: Any, value: Any) -> bool:
-    """Whether a settings' value is the scene's: sequences and arrays as lists, sorted where the settings sort them,
-    rows by their names."""
+def _same(found: Any, value: Any, key: Key) -> bool:
+    """Whether a settings' value is the scene's: sequences and arrays as lists (a grid's sorted, as the settings sort
+    it; names in their order), rows by their names, numbers to 1e-12."""
     def plain(item: Any) -> Any:
         if isinstance(item, dict):
-            return {key: plain(entry) for key, entry in item.items()}
+            return {name: plain(entry) for name, entry in item.items()}
         if isinstance(item, (list, tuple)) or hasattr(item, "tolist"):
-            return sorted(plain(entry) for entry in (item.tolist() if hasattr(item, "tolist") else item)) if not any(isinstance(e, dict) for e in item) else [plain(e) for e in item]
+            items = [plain(entry) for entry in (item.tolist() if hasattr(item, "tolist") else item)]
+            return sorted(items) if key.type is Grid else items
         return item
 
-    if isinstance(value, list) and value and all(isinstance(row, dict) for row in value):
+    if key.type is Rows:
         value = [row["name"] for row in value]
     if isinstance(value, float) and not isinstance(found, bool) and isinstance(found, (int, float)):
         return math.isclose(found, value, rel_tol=1e-12)
@@ -147,19 +176,20 @@ def _simulation_value(simulation: Any, name: str) -> Any:
         return simulation.start
     return getattr(simulation.engine if name in ("method", "rtol", "atol", "max_step") else simulation.steady, name)
 SECTIONS = list(declared_sections())
-KIND_OF = {section.path: kind.name for kind in reversed(KINDS) for section in kind.sections()}  # a shared section: the first kind's
-KIND_OF |= {HEADER.path: "design", CLUSTER.path: "design"}  # every kind's: walked in a design scene
 
 
-def _scene(section: str, values: dict[str, Any]) -> dict:
-    return _put(PLACES[section][0](), section, values)
+def _scene(section: Section | str, values: dict[str, Any]) -> dict:
+    section = section if isinstance(section, Section) else next(s for s in SECTIONS if _id(s) == section)
+    return _put(PLACES[_id(section)][0](), section.path, values)
 
 
 def _required(section: Section) -> dict[str, Any]:
     """The values the section's shipped scene gives its required keys."""
-    place = PLACES[section.path][0]()
-    for part in section.path.split(".") if section.path else ():
+    place = PLACES[_id(section)][0]()
+    for part in section.path.split(".") if section.path and section is not STOP_ROW else ():
         place = place.get(part, {})
+    if section is STOP_ROW:
+        place = place["stops"][0]
     given = {key.name: place[key.name] for key in section.keys if key.default is REQUIRED or section.where(key.name) in NEEDED}
     return given | ({name: value for name, value in place.items() if name not in section.names} if section.others else {})  # a spread, a limit
 
@@ -172,7 +202,7 @@ def _other_value(key: Key, given: Any = None, section_path: str = "") -> Any:
         return (given["start"], (given["start"] + given["stop"]) / 2.0)
     if key.default is REQUIRED and isinstance(given, dict):
         return dict(list(given.items())[:1])
-    if key.default is REQUIRED:
+    if key.default is REQUIRED or key.default is DERIVED and given is not None:
         return given[:1] if isinstance(given, list) else given + "2" if isinstance(given, str) else given * 1.01
     if key.default is DERIVED:
         return DERIVED_VALUES[f"{section_path}.{key.name}" if section_path else key.name]
@@ -185,7 +215,8 @@ def _other_value(key: Key, given: Any = None, section_path: str = "") -> Any:
     if key.type is Band:
         return (key.default[0], (key.default[0] + key.default[1]) / 2.0)
     if key.type is float:
-        return (key.default + key.high) / 2.0 if key.high < 10.0 else key.default * 1.5
+        other = (key.default + key.high) / 2.0 if key.high < 10.0 else key.default * 1.5
+        return other if other != key.default else (key.default + key.low) / 2.0 if math.isfinite(key.low) and key.low != key.default else 1.0  # exact: a walk value
     return key.default + 1 if key.default + 1 <= key.high else key.default - 1
 
 
@@ -208,6 +239,8 @@ def _wrong_values(key: Key) -> list[Any]:
         return [[1, 2], "momentary"]
     if key.type is Rows:
         return ["one_impact", 3]
+    if key.type is Free:
+        return []  # many forms: no value is wrong by its type alone
     return [3, True]
 
 
@@ -217,19 +250,20 @@ def _method_of(section: Section, key: Key) -> dict[str, Any]:
 
 
 def test_every_declared_section_of_every_kind_is_walked_here() -> None:
-    assert sorted(section.path for section in SECTIONS) == sorted(PLACES)
+    assert sorted(_id(section) for section in SECTIONS) == sorted(PLACES)
 
 
 @pytest.mark.parametrize("section", SECTIONS, ids=lambda s: s.path)
 def test_every_declared_key_reaches_the_settings(section: Section) -> None:
-    required = _required(section)
+    required, where = _required(section), PLACES[_id(section)][1]
     for key in section.keys:
-        if section.where(key.name) in PLACES:
-            continue  # a declared section of its own, walked as such
+        if section.where(key.name) in PLACES or key.type is Free:
+            continue  # a declared section of its own, walked as such; a value of many forms, its parser's
         value = _other_value(key, required.get(key.name), section.path)
+        assert key.as_written(value) != key.as_written(required.get(key.name, key.default)), (key.name, "walked with the value it has anyway")
         given = required | _method_of(section, key) | CONTEXT.get(section.where(key.name), {}) | {key.name: key.as_written(value)}
-        scene = parse_scene(_scene(section.path, given))
-        assert _same(PLACES[section.path][1](scene, key.name), value), (key.name, value)
+        scene = parse_scene(_scene(section, given))  # accepted (where None: what it sets is the model's to show)
+        assert where is None or _same(where(scene, key.name), value, key), (key.name, value)
 
 
 def test_search_settings_have_exactly_the_declared_keys() -> None:
@@ -245,16 +279,20 @@ def test_each_wrong_type_is_refused_naming_its_key(section: Section) -> None:
         for wrong in _wrong_values(key):
             given = required | _method_of(section, key) | {key.name: wrong}
             with pytest.raises(SceneError) as caught:
-                parse_scene(_scene(section.path, given))
-            assert any(line.startswith(f"{section.where(key.name)}: expected") for line in caught.value.problems), (key.name, wrong, caught.value.problems)
+                parse_scene(_scene(section, given))
+            assert any(line.startswith(f"{_where(section, key.name)}: expected") for line in caught.value.problems), (key.name, wrong, caught.value.problems)
 
 
-@pytest.mark.parametrize("kind", sorted(set(KIND_OF.values())))
-def test_a_scene_with_every_key_wrong_is_refused_at_once_with_exit_2_and_nothing_written(tmp_path: Path, kind: str) -> None:
-    sections = [section for section in SECTIONS if KIND_OF[section.path] == kind]
-    document = PLACES[sections[0].path][0]()
+#: The declared sections grouped by the scene they are walked in (its name).
+SCENES_OF = {name: [section for section in SECTIONS if PLACES[_id(section)][0]()["name"] == name] for name in sorted({PLACES[key][0]()["name"] for key in PLACES})}
+
+
+@pytest.mark.parametrize("scene", sorted(SCENES_OF))
+def test_a_scene_with_every_key_wrong_is_refused_at_once_with_exit_2_and_nothing_written(tmp_path: Path, scene: str) -> None:
+    sections = [section for section in SCENES_OF[scene] if any(_wrong_values(key) for key in section.keys)]
+    document = PLACES[_id(sections[0])][0]()
     for section in sections:
-        _put(document, section.path, {key.name: _wrong_values(key)[0] for key in section.keys if section.where(key.name) not in PLACES})
+        _put(document, section.path, {key.name: _wrong_values(key)[0] for key in section.keys if section.where(key.name) not in PLACES and _wrong_values(key)})
     path = tmp_path / "wrong.yaml"
     path.write_text(yaml.safe_dump(document), encoding="utf-8")
     out = tmp_path / "out"
@@ -262,8 +300,8 @@ def test_a_scene_with_every_key_wrong_is_refused_at_once_with_exit_2_and_nothing
     assert done.returncode == 2, done.stderr
     for section in sections:
         for key in section.keys:
-            if section.where(key.name) not in PLACES:  # a declared section of its own: its keys are wrong instead
-                assert f"{section.where(key.name)}: expected" in done.stderr, (key.name, done.stderr)
+            if section.where(key.name) not in PLACES and _wrong_values(key):  # a section of its own: its keys are wrong instead
+                assert f"{_where(section, key.name)}: expected" in done.stderr, (key.name, done.stderr)
     assert not out.exists() or not any(out.iterdir())
 
 

@@ -134,7 +134,7 @@ def test_a_physical_bumper_is_not_also_swept(change: Any, expected: str) -> None
         ({"frequency": 250.0, "damping": 3.0}, "stops[0].bumper: give the bumper either as frequency [Hz]"),
         ({"stiffness": 1e5, "damping": 3.0, "loss_factor": 0.2}, "stops[0].bumper: give damping [N s/m] or loss_factor [-], not both"),
         ({"stiffness": 1e13}, "stops[0].bumper.stiffness: 1e+13 N/m is out of range: allowed (0, 3.589e+12] N/m on this stop (effective mass 0.0909091 kg"),
-        ({"stiffness": 1e5, "mass": 1.0}, "stops[0].bumper.mass: unknown key (allowed: damping, frequency, loss_factor, stiffness)"),
+        ({"stiffness": 1e5, "mass": 1.0}, "stops[0].bumper.mass: unknown key (allowed: frequency, loss_factor, stiffness, damping)"),
     ],
 )
 def test_stop_bumper_mistakes(bumper: dict[str, Any], expected: str) -> None:

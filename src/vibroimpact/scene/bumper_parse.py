@@ -22,12 +22,21 @@ from vibroimpact.model.collision import MAX_LOSS_FACTOR
 from vibroimpact.model.contact import KelvinVoigtBumper
 from vibroimpact.model.layout import Layout, StopSpec
 from vibroimpact.scene.checker import Checker
+from vibroimpact.scene.declared import DERIVED, Key, Section
 from vibroimpact.model.parameters import MAX_BUMPER_FREQUENCY as _MAX_FREQUENCY
 
-__all__ = ["BUMPER_KEYS", "PHYSICAL_KEYS", "MAX_BUMPER_LOSS_FACTOR", "BumperSpec", "parse_bumper", "read_bumper", "convert_bumper", "bumper_form_problem", "scene_bumper"]
+__all__ = ["BUMPER", "BUMPER_KEYS", "PHYSICAL_KEYS", "MAX_BUMPER_LOSS_FACTOR", "BumperSpec", "parse_bumper", "read_bumper", "convert_bumper", "bumper_form_problem", "scene_bumper"]
 
+#: A Kelvin-Voigt bumper, declared (:mod:`vibroimpact.scene.declared`): frequency with loss_factor, or stiffness with
+#: damping or loss_factor (converted with its stop's effective mass); read at ``bumper``, ``stop.bumper``, ``stops[k].bumper``.
+BUMPER = Section("bumper", (
+    Key("frequency", float, "Omega_b / 2 pi on the stop's effective mass", DERIVED, 0.0, _MAX_FREQUENCY, "Hz", open_low=True),
+    Key("loss_factor", float, "xi_b, the bumper's loss (derived: from the restitution, or from damping)", DERIVED, 0.0, MAX_LOSS_FACTOR),
+    Key("stiffness", float, "K_b, instead of frequency", DERIVED, 0.0, math.inf, "N m-1", open_low=True),
+    Key("damping", float, "B_b, with stiffness, instead of loss_factor", DERIVED, 0.0, math.inf, "N s m-1"),
+), "a Kelvin-Voigt bumper on a stop (the compliant contact model)")  # fmt: skip
 #: Keys of a bumper, in either form.
-BUMPER_KEYS = {"frequency", "loss_factor", "stiffness", "damping"}
+BUMPER_KEYS = set(BUMPER.names)
 #: Keys of a bumper in physical units only.
 PHYSICAL_KEYS = {"stiffness", "damping"}
 #: Most damped bumper accepted, as xi_b [-]: the model's own limit.
@@ -78,21 +87,16 @@ def parse_bumper(c: Checker, key: str, value: Any, effective_mass: float | None)
 
 def read_bumper(c: Checker, key: str, value: Any) -> BumperSpec | None:
     """The bumper at ``key`` as given, each value checked against its own range, the forms not mixed; not converted."""
-    spec = c.mapping(key, value, BUMPER_KEYS)
-    if not isinstance(value, dict):
+    read = BUMPER.at(key).read(c, value, partial=True)
+    if read is None:
         return None
-    problem = bumper_form_problem(set(spec))
+    problem = bumper_form_problem(set(map(str, value)) & BUMPER_KEYS)
     if problem is not None:
         c.fail(key, problem)
         return None
-    values: dict[str, float | None] = {}
-    ranges = {"frequency": (0.0, _MAX_FREQUENCY, False), "loss_factor": (0.0, MAX_BUMPER_LOSS_FACTOR, True), "stiffness": (0.0, math.inf, False), "damping": (0.0, math.inf, True)}
-    for name, (low, high, low_inclusive) in ranges.items():
-        if name in spec:
-            values[name] = c.number(f"{key}.{name}", spec[name], low, high, low_inclusive=low_inclusive)
-    if any(number is None for number in values.values()):
+    if any(read[name] is None for name in value if name in BUMPER_KEYS) or set(map(str, value)) - BUMPER_KEYS:
         return None
-    return BumperSpec(values.get("frequency"), values.get("loss_factor"), values.get("stiffness"), values.get("damping"))
+    return BumperSpec(read["frequency"], read["loss_factor"], read["stiffness"], read["damping"])
 
 
 def convert_bumper(c: Checker, key: str, spec: BumperSpec, effective_mass: float | None, where: str = "this stop") -> BumperSpec | None:

@@ -14,13 +14,14 @@ YAML 1.2 booleans only: the scene reader gives ``no``, ``off`` and ``'false'`` a
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
 
 from vibroimpact.scene.checker import Checker, did_you_mean, interval
 
-__all__ = ["Key", "Section", "REQUIRED", "DERIVED", "Names", "Band", "Grid", "Table", "Rows", "reference_table"]
+__all__ = ["Key", "Section", "REQUIRED", "DERIVED", "Names", "Band", "Grid", "Table", "Rows", "Free", "reference_table"]
 
 
 class _Required:
@@ -67,10 +68,15 @@ class Rows:
     a row's keys)."""
 
 
+class Free:
+    """The type of a key whose value takes more than one form (a coordinate's name or a list of weights, a matrix):
+    its own parser checks it, and its doc names the forms."""
+
+
 #: The YAML type each Python type of a key is written as, in messages and in the reference.
 _TYPE_NAMES = {bool: "boolean (true or false)", int: "integer", float: "number", str: "string", Names: "list of names", Band: "band {start, stop}",
-               Grid: "grid: [values] or {start, stop, step | num}", Table: "mapping", Rows: "non-empty list of mappings"}
-_ARTICLES = {bool: "a", int: "an", float: "a", str: "a", Names: "a", Band: "a", Grid: "a", Table: "a", Rows: "a"}
+               Grid: "grid: [values] or {start, stop, step | num}", Table: "mapping", Rows: "non-empty list of mappings", Free: "as its meaning says"}
+_ARTICLES = {bool: "a", int: "an", float: "a", str: "a", Names: "a", Band: "a", Grid: "a", Table: "a", Rows: "a", Free: "a"}
 
 
 @dataclass(frozen=True)
@@ -113,7 +119,7 @@ class Key:
 
     def __post_init__(self) -> None:
         if self.type not in _TYPE_NAMES:
-            raise TypeError(f"Key {self.name!r}: type {self.type!r} is not one of bool, int, float, str, Names, Band, Grid, Table, Rows")
+            raise TypeError(f"Key {self.name!r}: type {self.type!r} is not one of bool, int, float, str, Names, Band, Grid, Table, Rows, Free")
         if self.choices and self.type not in (str, Names):
             raise TypeError(f"Key {self.name!r}: choices are names, for a str or Names key only")
         if self.type is Names and not self.choices:
@@ -181,6 +187,8 @@ class Key:
             return (start, stop)
         if self.type is Grid:
             return c.grid(where, value, self.low, self.high, not self.open_low)
+        if self.type is Free:
+            return value
         if self.type is Rows:
             if not isinstance(value, list) or not value:
                 c.fail(where, f"{wrong}: {self.doc}")
@@ -209,12 +217,16 @@ class Section:
     others : str
         One line on the keys the kind names beyond the declared ones (a spread per scalar, a limit per measure), which
         its own parser checks; ``""``: none, every other key is refused here.
+    form : str
+        Which form of the mapping at ``path`` it declares, where there are more than one (the named system, its
+        matrices); ``""``: the only one.
     """
 
     path: str
     keys: tuple[Key, ...]
     doc: str
     others: str = ""
+    form: str = ""
 
     def __post_init__(self) -> None:
         names = [key.name for key in self.keys]
@@ -225,6 +237,10 @@ class Section:
                 other = self.key(key.read_when[0])
                 if key.read_when[1] not in other.choices:
                     raise ValueError(f"section {self.path}: {key.name} is read when {key.read_when[0]} is {key.read_when[1]!r}, not one of its choices")
+
+    def at(self, path: str) -> "Section":
+        """The same section read at another place of a scene (a bumper at ``stops[2].bumper``): its messages name it."""
+        return dataclasses.replace(self, path=path)
 
     def where(self, name: str) -> str:
         """The dotted place of the key ``name`` in a scene (the top level's keys: their names alone)."""
@@ -316,7 +332,7 @@ def reference_table(sections: tuple[Section, ...] | list[Section]) -> str:
     accepts, its default and what it sets (``run-study --keys``)."""
     lines: list[str] = []
     for section in sections:
-        title = f"`{section.path}`" if section.path else "the top level"
+        title = (f"`{section.path}`" if section.path else "the top level") + (f" ({section.form})" if section.form else "")
         lines += [f"### {title}: {section.doc}", "", "| key | allowed | default | what it sets |", "|---|---|---|---|"]
         lines += [*section.reference(), ""]
     return "\n".join(lines)

@@ -39,12 +39,14 @@ HEADER_KEYS = frozenset(HEADER.names)
 
 
 def declared_sections() -> tuple[Section, ...]:
-    """The shared header's declared sections, then every kind's (:meth:`~vibroimpact.scene.kinds.Kind.sections`),
+    """The shared header's and the layout's declared sections, then every kind's (:meth:`~vibroimpact.scene.kinds.Kind.sections`),
     each once (a section two kinds share, in the first's place); imports the kinds' scene parsers only."""
-    seen: dict[str, Section] = {HEADER.path: HEADER, CLUSTER.path: CLUSTER}
+    from vibroimpact.scene.layout_parse import LAYOUT_SECTIONS
+
+    seen: dict[tuple[str, str], Section] = {(section.path, section.form): section for section in (HEADER, CLUSTER, *LAYOUT_SECTIONS)}
     for kind in KINDS:
         for section in kind.sections():
-            seen.setdefault(section.path, section)
+            seen.setdefault((section.path, section.form), section)
     return tuple(seen.values())
 
 

@@ -32,20 +32,55 @@ from vibroimpact.analysis.layout import layout_refusal
 from vibroimpact.model.contact import SIDES, place_effective_mass
 from vibroimpact.model.structure import LinearStructure, stiffness_modes
 from vibroimpact.model.system import TwoDofSystem
-from vibroimpact.scene.bumper_parse import BumperSpec, parse_bumper
+from vibroimpact.scene.bumper_parse import BUMPER, BumperSpec, parse_bumper
 from vibroimpact.scene.checker import Checker
+from vibroimpact.scene.declared import DERIVED, REQUIRED, Free, Key, Section, Table
 from vibroimpact.model.layout import PAPER_STOP, Layout, LoadSpec, StopSpec, build_stops
 
-__all__ = ["NAMED_SYSTEM_KEYS", "MATRIX_SYSTEM_KEYS", "EXCITATION_KEYS", "STOP_KEYS", "LayoutSection", "parse_layout", "parse_structure", "parse_load", "parse_stops", "parse_sweep_stops", "parse_stop_layout", "document_names", "check_layout_solutions", "pgf_refusal", "static_drift"]
+__all__ = ["NAMED_SYSTEM", "MATRIX_SYSTEM", "EXCITATION", "STOP_ROW", "LAYOUT_SECTIONS", "NAMED_SYSTEM_KEYS", "MATRIX_SYSTEM_KEYS", "EXCITATION_KEYS", "STOP_KEYS", "LayoutSection", "parse_layout", "parse_structure", "parse_load", "parse_stops", "parse_sweep_stops", "parse_stop_layout", "document_names", "check_layout_solutions", "pgf_refusal", "static_drift"]
 
+#: ``system`` in the paper's named form, declared (:mod:`vibroimpact.scene.declared`).
+NAMED_SYSTEM = Section("system", (
+    Key("m1", float, "the primary mass", REQUIRED, 0.0, math.inf, "kg", open_low=True),
+    Key("m2", float, "the absorber's mass", REQUIRED, 0.0, math.inf, "kg", open_low=True),
+    Key("k1", float, "the primary's suspension", REQUIRED, 0.0, math.inf, "N m-1", open_low=True),
+    Key("k2", float, "the absorber's spring", REQUIRED, 0.0, math.inf, "N m-1", open_low=True),
+    Key("b1", float, "the primary's damping", 0.0, 0.0, math.inf, "N s m-1"),
+    Key("b2", float, "the absorber's damping", 0.0, 0.0, math.inf, "N s m-1"),
+), "the paper's two masses: a primary on its suspension, an absorber on the primary", form="the paper's named form")  # fmt: skip
+#: ``system`` by its matrices, declared: their shapes and values are the structure's own checks.
+MATRIX_SYSTEM = Section("system", (
+    Key("mass", Free, "M: a list of N rows of N numbers", REQUIRED, unit="kg"),
+    Key("stiffness", Free, "K: a list of N rows of N numbers", REQUIRED, unit="N m-1"),
+    Key("damping", Free, "B: a list of N rows of N numbers (derived: none)", DERIVED, unit="N s m-1"),
+    Key("coordinates", Free, "a name per row: [x1, x2, ...] (derived: x1 ... xN)", DERIVED),
+), "any linear structure of N degrees of freedom", form="matrices")  # fmt: skip
+#: ``excitation``, declared.
+EXCITATION = Section("excitation", (
+    Key("amplitude", float, "q, the harmonic force's amplitude (a base motion: the base's displacement, m)", REQUIRED, 0.0, math.inf, "N", open_low=True),
+    Key("on", Free, "where the force acts: a coordinate's name, or a weight per coordinate (derived: the first coordinate)", DERIVED),
+    Key("static", Free, "a constant force per coordinate [N] (derived: none)", DERIVED),
+    Key("base_motion", bool, "the base moves by amplitude [m] and loads every coordinate through its mass", False),
+), "the load: q cos(w t) on a coordinate, weighted, or a base motion")  # fmt: skip
+#: One entry of ``stops``, declared: where it acts and the values it gives (the others come from the sweep).
+STOP_ROW = Section("stops[k]", (
+    Key("coordinate", Free, "the coordinate's name, for a stop against the base (or between)", DERIVED),
+    Key("between", Free, "[a, b]: two coordinates' names, for a stop on the gap a - b (or coordinate)", DERIVED),
+    Key("side", str, "upper: x <= Delta, lower: x >= -Delta", "upper", choices=tuple(SIDES)),
+    Key("clearance", float, "Delta (negative: a preload; derived: the scene's or the sweep's)", DERIVED, unit="m"),
+    Key("restitution", float, "R (derived: the scene's or the sweep's)", DERIVED, 0.0, 1.0),
+    Key("bumper", Table, "a Kelvin-Voigt bumper on this stop (bumper)", DERIVED),
+), "one stop of any layout: where it acts, and its own values")  # fmt: skip
+#: The layout's declared sections (``run-study --keys`` lists them after the header's).
+LAYOUT_SECTIONS = (NAMED_SYSTEM, MATRIX_SYSTEM, EXCITATION, STOP_ROW, BUMPER)
 #: Keys of the paper's named system.
-NAMED_SYSTEM_KEYS = ("m1", "m2", "k1", "k2", "b1", "b2")
+NAMED_SYSTEM_KEYS = NAMED_SYSTEM.names
 #: Keys of a system given by matrices.
-MATRIX_SYSTEM_KEYS = ("mass", "stiffness", "damping", "coordinates")
+MATRIX_SYSTEM_KEYS = MATRIX_SYSTEM.names
 #: Keys of the excitation section.
-EXCITATION_KEYS = {"amplitude", "on", "static", "base_motion"}
+EXCITATION_KEYS = set(EXCITATION.names)
 #: Keys of one entry of ``stops``.
-STOP_KEYS = {"coordinate", "between", "side", "clearance", "restitution", "bumper"}
+STOP_KEYS = set(STOP_ROW.names)
 #: Most stops of one scene.
 MAX_STOPS = 16
 #: Most coordinates of a structure written in a scene.
@@ -89,14 +124,11 @@ def parse_structure(c: Checker, value: Any) -> TwoDofSystem | LinearStructure | 
 
 
 def _named_system(c: Checker, value: Any) -> TwoDofSystem | None:
-    spec = c.mapping("system", value, set(NAMED_SYSTEM_KEYS), {"m1", "m2", "k1", "k2"})
-    numbers: dict[str, float] = {}
-    for key in NAMED_SYSTEM_KEYS:
-        if key in spec:
-            number = c.number(f"system.{key}", spec[key], 0.0, math.inf, low_inclusive=key.startswith("b"))
-            if number is not None:
-                numbers[key] = number
-    if not {"m1", "m2", "k1", "k2"} <= set(numbers) or len(numbers) < len(spec.keys() & set(NAMED_SYSTEM_KEYS)):
+    read = NAMED_SYSTEM.read(c, value, partial=True)
+    if read is None:
+        return None
+    numbers = {key: read[key] for key in NAMED_SYSTEM_KEYS if key in value and read[key] is not None}  # as given: the defaults are the model's
+    if not {"m1", "m2", "k1", "k2"} <= set(numbers) or len(numbers) < len(value.keys() & set(NAMED_SYSTEM_KEYS)):
         return None
     system = TwoDofSystem(**numbers)
     try:
@@ -112,7 +144,8 @@ def _matrix_structure(c: Checker, value: dict) -> LinearStructure | None:
     if named:
         c.fail("system", f"give either the named form (m1, m2, k1, k2, b1, b2) or matrices (mass, stiffness, damping, coordinates), not both: remove {', '.join(named)}")
         return None
-    spec = c.mapping("system", value, set(MATRIX_SYSTEM_KEYS), {"mass", "stiffness"})
+    MATRIX_SYSTEM.read(c, value, partial=True)
+    spec = {key: value[key] for key in MATRIX_SYSTEM_KEYS if key in value}
     if not {"mass", "stiffness"} <= set(spec):
         return None
     ok = True
@@ -163,14 +196,14 @@ def _record(c: Checker, default_key: str, error: ValueError) -> None:
 def parse_load(c: Checker, value: Any, names: tuple[str, ...] | None) -> tuple[float | None, LoadSpec | None]:
     """``excitation: {amplitude, on, static, base_motion}`` -> (amplitude, load); the load is None for the paper's
     force on the primary mass (only ``amplitude`` given). ``names``: the structure's coordinates (None: unknown)."""
-    spec = c.mapping("excitation", value, EXCITATION_KEYS, {"amplitude"})
-    amplitude = c.number("excitation.amplitude", spec["amplitude"], 0.0, math.inf, low_inclusive=False) if "amplitude" in spec else None
+    read = EXCITATION.read(c, value, partial=True)
+    if read is None:
+        return None, None
+    spec = {key: value[key] for key in EXCITATION_KEYS if key in value}
+    amplitude = read["amplitude"]
     if not set(spec) & (EXCITATION_KEYS - {"amplitude"}):
         return amplitude, None
-    base_motion = spec.get("base_motion", False)
-    if not isinstance(base_motion, bool):
-        c.fail("excitation.base_motion", f"expected true or false, got {base_motion!r}")
-        base_motion = False
+    base_motion = bool(read["base_motion"])  # a wrong one (None) is said already
     if base_motion and "on" in spec:
         c.fail("excitation.on", "a base motion loads every coordinate through its mass: remove 'on' (amplitude is the base displacement [m])")
     weights = None
@@ -229,17 +262,15 @@ def parse_stops(c: Checker, value: Any, names: tuple[str, ...] | None, key: str 
 
 
 def _stop(c: Checker, key: str, entry: Any, names: tuple[str, ...] | None, mass: np.ndarray | None) -> StopSpec | None:
-    spec = c.mapping(key, entry, STOP_KEYS)
-    if not isinstance(entry, dict):
+    read = STOP_ROW.at(key).read(c, entry, partial=True)
+    if read is None:
         return None
+    spec = {name: entry[name] for name in STOP_KEYS if name in entry}
     where = [k for k in ("coordinate", "between") if k in spec]
     if len(where) != 1:
         c.fail(key, "give exactly one of 'coordinate: NAME' (a stop against the base) or 'between: [NAME, NAME]' (a relative stop)")
         return None
-    side = spec.get("side", "upper")
-    if side not in SIDES:
-        c.fail(f"{key}.side", f"{side!r} is not allowed: use upper (x <= Delta) or lower (x >= -Delta)")
-        side = None
+    side = read["side"]
     coordinate = other = None
     if names is not None:
         if "coordinate" in spec:
@@ -254,10 +285,11 @@ def _stop(c: Checker, key: str, entry: Any, names: tuple[str, ...] | None, mass:
                 if coordinate is not None and coordinate == other:
                     c.fail(f"{key}.between", f"the two coordinates must differ, got {pair[0]!r} twice")
                     coordinate = None
-    clearance = c.number(f"{key}.clearance", spec["clearance"], -math.inf, math.inf, False, False) if "clearance" in spec else None
-    restitution = c.number(f"{key}.restitution", spec["restitution"], 0.0, 1.0) if "restitution" in spec else None
+    clearance, restitution = read["clearance"], read["restitution"]
     bumper = BumperSpec()
     if "bumper" in spec:
+        if read["bumper"] is None:
+            return None  # not a mapping: said
         placed = mass is not None and side is not None and coordinate is not None and ("between" not in spec or other is not None)
         effective_mass = place_effective_mass((coordinate, other, side), mass) if placed else None  # type: ignore[arg-type]
         parsed = parse_bumper(c, f"{key}.bumper", spec["bumper"], effective_mass)
