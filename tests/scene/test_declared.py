@@ -25,7 +25,6 @@ from vibroimpact.scene.grid import ADMISSIBILITY, SWEPT_SINE
 from vibroimpact.scene.bumper_parse import BUMPER
 from vibroimpact.scene.header import CLUSTER, HEADER, declared_sections
 from vibroimpact.scene.layout_parse import EXCITATION, MATRIX_SYSTEM, NAMED_SYSTEM, STOP_ROW
-from vibroimpact.scene.kinds import KINDS
 from vibroimpact.scene.simulation import SIMULATION
 from vibroimpact.scene.reader import parse_scene, read_yaml
 
@@ -433,3 +432,35 @@ def test_a_listing_read_only_in_part_ends_quietly(option: str) -> None:
     run.stderr.close()
     assert run.wait(timeout=120) == 0, error
     assert "Traceback" not in error and "BrokenPipeError" not in error, error
+
+
+def test_review_mends_a_null_section_a_missing_name_a_misspelt_spread_and_a_section_that_is_no_mapping() -> None:
+    """A section given as null is refused, not read as its defaults; a missing name is said once; a misspelt key of a
+    section that takes other keys of its kind's (design.robust's spreads) gets did-you-mean instead of 'unknown design
+    variable'; 'bifurcation: 5' is said as no mapping, without a restitution said missing beside it."""
+    concepts = _shipped("absorber_concepts.yaml") | {"continuation": None}
+    with pytest.raises(SceneError) as caught:
+        parse_scene(concepts)
+    assert any(line.startswith("continuation: expected a mapping") for line in caught.value.problems), caught.value.problems
+    stepped = _shipped("restitution.yaml") | {"settings": {"admissibility": None}}
+    with pytest.raises(SceneError) as caught:
+        parse_scene(stepped)
+    assert any(line.startswith("settings.admissibility: expected a mapping") for line in caught.value.problems), caught.value.problems
+    nameless = copy.deepcopy(SCENE)
+    del nameless["name"]
+    with pytest.raises(SceneError) as caught:
+        parse_scene(nameless)
+    assert [line for line in caught.value.problems if line.startswith("name:")] == ["name: required key is missing"], caught.value.problems
+    robust = copy.deepcopy(SCENE)
+    robust["design"]["robust"] = {"k1": 0.05, "sample": 8, "quantil": 0.9}
+    with pytest.raises(SceneError) as caught:
+        parse_scene(robust)
+    problems = caught.value.problems
+    assert any(line.startswith("design.robust.sample: unknown key") and "did you mean 'samples'?" in line for line in problems), problems
+    assert any(line.startswith("design.robust.quantil: unknown key") and "did you mean 'quantile'?" in line for line in problems), problems
+    assert not any("unknown design variable" in line for line in problems), problems
+    bifurcation = _shipped("bifurcation.yaml") | {"bifurcation": 5}
+    with pytest.raises(SceneError) as caught:
+        parse_scene(bifurcation)
+    assert [line for line in caught.value.problems if line.startswith("bifurcation")] == [caught.value.problems[0]], caught.value.problems
+    assert caught.value.problems[0].startswith("bifurcation: expected a mapping"), caught.value.problems

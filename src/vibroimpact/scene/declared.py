@@ -242,6 +242,11 @@ class Section:
         """The same section read at another place of a scene (a bumper at ``stops[2].bumper``): its messages name it."""
         return dataclasses.replace(self, path=path)
 
+    def misspelt(self, name: str) -> bool:
+        """Whether ``name``, not declared, is close to a declared key (``sample`` for ``samples``): refused as a
+        misspelling even where the section takes other keys of its kind's (:attr:`others`)."""
+        return name not in self.names and bool(did_you_mean(name, self.names))
+
     def where(self, name: str) -> str:
         """The dotted place of the key ``name`` in a scene (the top level's keys: their names alone)."""
         return f"{self.path}.{name}" if self.path else name
@@ -262,15 +267,14 @@ class Section:
         """Every declared key's value from the parsed ``value`` (None or a mapping), defaults filled in; None, with
         every problem recorded in ``c`` (each naming its key), where anything is wrong. ``partial``: where keys are
         wrong, the others' values all the same (a wrong or missing key's None), so that checks across keys can still
-        say their problems at once; None only where ``value`` is no mapping."""
-        if value is None:
-            value = {}
+        say their problems at once; None only where ``value`` is no mapping. A section the scene does not give is read
+        from ``{}`` (its defaults); one it gives as ``null`` is refused as no mapping."""
         if not isinstance(value, dict):
             c.fail(self.path, f"expected a mapping with keys {', '.join(self.names)}, got {value!r} ({type(value).__name__})")
             return None
         before = len(c.problems)
         for given in value:
-            if str(given) not in self.names and not self.others:
+            if str(given) not in self.names and (not self.others or self.misspelt(str(given))):
                 c.fail(self.where(str(given)), f"unknown key (allowed: {', '.join(self.names)}){did_you_mean(str(given), self.names)}")
         read: dict[str, Any] = {}
         for key in self.keys:

@@ -46,7 +46,8 @@ def declared_sections() -> tuple[Section, ...]:
     seen: dict[tuple[str, str], Section] = {(section.path, section.form): section for section in (HEADER, CLUSTER, *LAYOUT_SECTIONS)}
     for kind in KINDS:
         for section in kind.sections():
-            seen.setdefault((section.path, section.form), section)
+            if seen.setdefault((section.path, section.form), section) is not section:
+                raise ValueError(f"kind {kind.name!r} declares a section {section.path!r} ({section.form or 'its only form'}) that another declares otherwise")
     return tuple(seen.values())
 
 
@@ -67,9 +68,9 @@ def open_scene(document: Any, top_keys: set[str], required: set[str], kind: str)
 
 def parse_names(c: Checker, doc: dict) -> tuple[Any, str, bool]:
     """Name, description and the report switch of any scene (:data:`HEADER`; a missing name is the kind's to say)."""
-    values = HEADER.read(c, {key: doc[key] for key in ("name", "description", "report") if key in doc}, partial=True) or {}
-    name = values.get("name") if "name" in doc else doc.get("name")
-    if isinstance(name, str) and not NAME.match(name):
+    values = HEADER.read(c, {key: doc[key] for key in ("description", "report") if key in doc} | {"name": "_"}, partial=True) or {}
+    name = doc.get("name")  # required by each kind's own keys, said once there
+    if "name" in doc and HEADER.key("name").check(c, "name", name) is not None and not NAME.match(name):
         c.fail("name", f"expected a file-name-safe string of at most {MAX_NAME_LENGTH} characters (letters, digits, '_', '-', '.'), got {name!r}")
     description = values.get("description")
     report = values.get("report")

@@ -304,13 +304,13 @@ def parse_bifurcation_scene(document: dict, text: str = "", source: str = "scene
     stops_give_restitution = isinstance(doc.get("stops"), list) and bool(doc["stops"]) and all(isinstance(e, dict) and "restitution" in e for e in doc["stops"])
     given = doc.get("bifurcation") if isinstance(doc.get("bifurcation"), dict) else {}
     spec = (BIFURCATION.read(c, doc["bifurcation"], partial=True) if "bifurcation" in doc else None) or {}
-    if "bifurcation" in doc and not stops_give_restitution and "restitution" not in given:
+    if isinstance(doc.get("bifurcation"), dict) and not stops_give_restitution and "restitution" not in given:
         c.fail("bifurcation.restitution", f"required key is missing: the stops give none ({BIFURCATION.key('restitution').allowed()})")
     specs, clearance, own_restitution = _stops(c, doc, layout, "restitution" in given)
     low, high = spec.get("frequency") or (None, None)
     restitution = spec.get("restitution") if "restitution" in given else own_restitution
-    brute = _settings(c, BRUTE_FORCE, spec.get("brute_force"), BruteForceSettings)
-    branches = _settings(c, CONTINUATION, spec.get("continuation"), BranchSettings)
+    brute = _settings(c, BRUTE_FORCE, spec.get("brute_force") or {}, BruteForceSettings)  # None: not given, or said already
+    branches = _settings(c, CONTINUATION, spec.get("continuation") or {}, BranchSettings)
     chart = _settings(c, CHART, spec["chart"], ChartSettings) if spec.get("chart") is not None else None
     masses = None  # the mass each stop's bumper pushes [kg] (the paper's stop: M2)
     if layout is not None and specs is not None:

@@ -184,7 +184,7 @@ def parse_concepts(document: Any, source: str = "scene") -> tuple[str, str, bool
         bumper = c.mapping("bumper", doc["bumper"], {"frequency"}, {"frequency"})
         if "frequency" in bumper:
             bumper_frequency = c.number("bumper.frequency", bumper["frequency"], 0.0, 1e6, low_inclusive=False) or math.nan
-    continuation = CONTINUATION.read(c, doc.get("continuation")) or {}
+    continuation = CONTINUATION.read(c, doc.get("continuation", {})) or {}
     steps = continuation.get("max_steps", 0) if continuation.get("enabled") else 0
     concepts = _concepts(c, doc["concepts"], system) if "concepts" in doc and system is not None else ()
     if c.problems:

@@ -415,7 +415,7 @@ def _operating(c: Checker, value: Any, coordinates: tuple[str, ...] | None, band
     limits = measure_names(names)
     spec = constraints["operating"]
     read = OPERATING.read(c, spec, partial=True)
-    limit_keys = [str(k) for k in spec if str(k) not in OPERATING.names]
+    limit_keys = [str(k) for k in spec if str(k) not in OPERATING.names and not OPERATING.misspelt(str(k))]
     for unknown in (k for k in limit_keys if k not in limits):
         c.fail(f"design.constraints.operating.{unknown}", f"unknown key (allowed: frequency, {', '.join(limits)}){did_you_mean(unknown, ('frequency', *limits))}")
     limit_keys = [k for k in limit_keys if k in limits]
@@ -445,7 +445,7 @@ def _robust(c: Checker, value: Any, layout: Layout | None, bumper: float | None 
     read = ROBUST.read(c, value, partial=True)
     if read is None:
         return (), None, None, None
-    spreads = [str(k) for k in value if str(k) not in ROBUST.names]
+    spreads = [str(k) for k in value if str(k) not in ROBUST.names and not ROBUST.misspelt(str(k))]  # a misspelling is said by the read
     if spreads and "samples" not in value:
         c.fail("design.robust.samples", "required with a spread: how many Latin-hypercube samples (e.g. 32)")
     samples, seed, quantile = read["samples"], read["seed"], read["quantile"]
@@ -463,10 +463,10 @@ def _robust(c: Checker, value: Any, layout: Layout | None, bumper: float | None 
 
 
 def _search(c: Checker, value: Any) -> SearchSettings | None:
-    values = SEARCH.read(c, value)
+    values = SEARCH.read(c, value if value is not None else {})  # None: not given, or said already
     return SearchSettings(**values) if values is not None else None
 
 
 def _certify(c: Checker, value: Any) -> int | None:
-    values = CERTIFY.read(c, value)
+    values = CERTIFY.read(c, value if value is not None else {})
     return values["candidates"] if values is not None else None
