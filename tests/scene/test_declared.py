@@ -464,3 +464,29 @@ def test_review_mends_a_null_section_a_missing_name_a_misspelt_spread_and_a_sect
         parse_scene(bifurcation)
     assert [line for line in caught.value.problems if line.startswith("bifurcation")] == [caught.value.problems[0]], caught.value.problems
     assert caught.value.problems[0].startswith("bifurcation: expected a mapping"), caught.value.problems
+
+
+def _beyond(key: Key) -> list[Any]:
+    """Values just outside a numeric key's declared range (its open low end itself), none for an unbounded side."""
+    outside: list[Any] = []
+    if math.isfinite(key.low):
+        outside.append(key.low if key.open_low else (key.low - 1 if key.type is int else key.low - max(abs(key.low), 1.0) * 1e-6))
+    if math.isfinite(key.high):
+        outside.append(key.high + 1 if key.type is int else key.high + max(abs(key.high), 1.0) * 1e-6)
+    return outside
+
+
+@pytest.mark.parametrize("section", SECTIONS, ids=_id)
+def test_a_value_just_outside_each_declared_range_is_refused_naming_its_key_and_the_range(section: Section) -> None:
+    """The declared range is the one the scene enforces: at each finite end, the nearest value outside (the open low
+    end itself) is refused naming the key and the allowed range as the reference prints it."""
+    required = _required(section)
+    for key in section.keys:
+        if key.type not in (int, float):
+            continue
+        for outside in _beyond(key):
+            given = required | _method_of(section, key) | CONTEXT.get(section.where(key.name), {}) | {key.name: outside}
+            with pytest.raises(SceneError) as caught:
+                parse_scene(_scene(section, given))
+            said = f"{_where(section, key.name)}: {outside!r} is out of range: allowed "
+            assert any(line.startswith(said) for line in caught.value.problems), (key.name, outside, caught.value.problems)

@@ -88,14 +88,16 @@ class Key:
     name : str
         As written in the scene.
     type : type
-        ``bool``, ``int``, ``float``, ``str``, :class:`Names` or :class:`Band`; an integer is accepted where a number
-        is asked, never the reverse, and a boolean is no number.
+        ``bool``, ``int``, ``float``, ``str``, :class:`Names`, :class:`Band`, :class:`Grid`, :class:`Table`,
+        :class:`Rows` or :class:`Free`; an integer is accepted where a number is asked, never the reverse (``1e5``
+        is a number in YAML 1.2, no count), and a boolean is no number.
     doc : str
         One line: what the key sets.
     default : object
-        Its value where the scene does not give it; :data:`REQUIRED`: the scene must.
+        Its value where the scene does not give it; :data:`REQUIRED`: the scene must; :data:`DERIVED`: the kind
+        derives it from other keys, or (a mapping) the section is then absent and its own defaults hold.
     low, high : float
-        The allowed range, both ends included unless ``open_low`` (numbers and bands; +-inf: unbounded, open).
+        The allowed range, both ends included unless ``open_low`` (numbers, bands and grids; +-inf: unbounded, open).
     unit : str
         Its unit in brackets' words (``"Hz"``, ``"m"``; ``""`` for a pure number or a name).
     choices : tuple of str
@@ -124,6 +126,8 @@ class Key:
             raise TypeError(f"Key {self.name!r}: choices are names, for a str or Names key only")
         if self.type is Names and not self.choices:
             raise TypeError(f"Key {self.name!r}: a Names key lists its choices")
+        if self.open_low and self.type not in (float, Band, Grid):
+            raise TypeError(f"Key {self.name!r}: an open low end is for numbers, bands and grids (a count's range is whole numbers)")
         if self.default is not REQUIRED and self.default is not DERIVED and self.check(Checker(), self.name, self.as_written(self.default)) is None:
             raise ValueError(f"Key {self.name!r}: its default {self.default!r} fails its own check")
 

@@ -97,10 +97,10 @@ class SweptSineSettings:
     start_frequency: float
     stop_frequency: float
     rate: float
-    directions: tuple[str, ...] = SWEEP_DIRECTIONS
-    sample_rate: float = 1000.0
-    window_cycles: int = 8
-    initial_state: str = "linear"
+    directions: tuple[str, ...] = SWEPT_SINE.key("directions").default
+    sample_rate: float = SWEPT_SINE.key("sample_rate").default
+    window_cycles: int = SWEPT_SINE.key("window_cycles").default
+    initial_state: str = SWEPT_SINE.key("initial_state").default
 
     def sweep(self, amplitude: float, direction: str) -> SweptSine:
         """The excitation of one direction."""
