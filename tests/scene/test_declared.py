@@ -18,6 +18,7 @@ import yaml
 from vibroimpact.kinds.benchmark.scene import BENCHMARK, LADDER
 from vibroimpact.kinds.bifurcation.scene import BIFURCATION, BRUTE_FORCE, CHART, CONTINUATION, BranchSettings, BruteForceSettings, ChartSettings
 from vibroimpact.kinds.concepts.scene import CONTINUATION as CONCEPTS_CONTINUATION
+from vibroimpact.kinds.validation.settings import CASE_SECTIONS
 from vibroimpact.kinds.design.scene import CERTIFY, CONSTRAINTS, DESIGN, OPERATING, ROBUST, SEARCH, SearchSettings
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.scene.declared import DERIVED, REQUIRED, Band, Free, Grid, Key, Names, Rows, Section, Table
@@ -79,6 +80,7 @@ PLACES = {
     EXCITATION.path: (lambda: _analytic("restitution.yaml"), lambda scene, name: scene.amplitude if name == "amplitude" else scene.layout.load.base_motion),
     STOP_ROW.path: (lambda: _shipped("relative_stop.yaml") | {"stops": [{"between": ["x2", "x1"], "clearance": 0.003, "restitution": 0.2}]}, None),
     BUMPER.path: (lambda: _shipped("bumper_sweep.yaml"), None),
+    **{_id(section): (lambda name=name: _shipped(f"validation/{name}.yaml"), lambda scene, key: getattr(scene.settings.case, key)) for name, section in CASE_SECTIONS.items()},
     CLUSTER.path: (lambda: copy.deepcopy(SCENE) | {"cluster": {"scheduler": "tcp://head:8786"}}, lambda scene, name: scene.cluster_scheduler),
     DESIGN.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: _design_value(scene.settings, name)),
     CONSTRAINTS.path: (lambda: copy.deepcopy(SCENE), lambda scene, name: scene.settings.operating),
@@ -103,8 +105,10 @@ LADDER_POINT = {"frequency": 25.0, "restitution": 0.2, "clearance": 0.003, "bump
 #: Keys the kind derives but the walk's scene needs given (the paper's stop takes them from the ladder).
 NEEDED = {"benchmark.ladder.restitution", "benchmark.ladder.clearance", "design.robust.samples", "bifurcation.restitution", "stops[k].between",
           "stops[k].clearance", "stops[k].restitution"}  # with a spread; the paper's stop
+#: Keys that choose which form of their section is read (walked as each form).
+FORM_KEYS = {"validation.case"}
 #: A valid value, for the walk, of a key whose other values the declaration cannot tell (a name the layout makes).
-OTHER_VALUES = {"design.objective": "force_amplitude"}
+OTHER_VALUES = {"design.objective": "force_amplitude", "validation.forcing_frequency": 2.75}  # the last: |1 / (1 - w^2)| stays above sigma's 0.14
 #: Keys the walk gives beside a key that is read only with them (a reference needs bumpers).
 CONTEXT = {"bifurcation.reference": {"bumper": {"frequency": [100.0]}}, "bumper.loss_factor": {"frequency": 250.0}, "bumper.damping": {"stiffness": 2.5e5}}
 #: A valid value, for the walk, of each key whose default the kind derives.
@@ -256,8 +260,8 @@ def test_every_declared_section_of_every_kind_is_walked_here() -> None:
 def test_every_declared_key_reaches_the_settings(section: Section) -> None:
     required, where = _required(section), PLACES[_id(section)][1]
     for key in section.keys:
-        if section.where(key.name) in PLACES or key.type is Free:
-            continue  # a declared section of its own, walked as such; a value of many forms, its parser's
+        if section.where(key.name) in PLACES or key.type is Free or section.where(key.name) in FORM_KEYS:
+            continue  # a declared section of its own, walked as such; a value of many forms, its parser's; the form itself
         value = _other_value(key, required.get(key.name), section.path)
         assert key.as_written(value) != key.as_written(required.get(key.name, key.default)), (key.name, "walked with the value it has anyway")
         given = required | _method_of(section, key) | CONTEXT.get(section.where(key.name), {}) | {key.name: key.as_written(value)}
@@ -291,7 +295,9 @@ def test_a_scene_with_every_key_wrong_is_refused_at_once_with_exit_2_and_nothing
     sections = [section for section in SCENES_OF[scene] if any(_wrong_values(key) for key in section.keys)]
     document = PLACES[_id(sections[0])][0]()
     for section in sections:
-        _put(document, section.path, {key.name: _wrong_values(key)[0] for key in section.keys if section.where(key.name) not in PLACES and _wrong_values(key)})
+        kept = {name: value for name, value in _required(section).items() if section.where(name) in FORM_KEYS}  # which form is read
+        _put(document, section.path, kept | {key.name: _wrong_values(key)[0] for key in section.keys if section.where(key.name) not in PLACES.keys() | FORM_KEYS
+                                             and _wrong_values(key)})
     path = tmp_path / "wrong.yaml"
     path.write_text(yaml.safe_dump(document), encoding="utf-8")
     out = tmp_path / "out"
@@ -299,7 +305,7 @@ def test_a_scene_with_every_key_wrong_is_refused_at_once_with_exit_2_and_nothing
     assert done.returncode == 2, done.stderr
     for section in sections:
         for key in section.keys:
-            if section.where(key.name) not in PLACES and _wrong_values(key):  # a section of its own: its keys are wrong instead
+            if section.where(key.name) not in PLACES.keys() | FORM_KEYS and _wrong_values(key):  # a section of its own: its keys are wrong instead
                 assert f"{_where(section, key.name)}: expected" in done.stderr, (key.name, done.stderr)
     assert not out.exists() or not any(out.iterdir())
 
@@ -467,12 +473,12 @@ def test_review_mends_a_null_section_a_missing_name_a_misspelt_spread_and_a_sect
 
 
 def _beyond(key: Key) -> list[Any]:
-    """Values just outside a numeric key's declared range (its open low end itself), none for an unbounded side."""
+    """Values just outside a numeric key's declared range (an open end itself), none for an unbounded side."""
     outside: list[Any] = []
     if math.isfinite(key.low):
         outside.append(key.low if key.open_low else (key.low - 1 if key.type is int else key.low - max(abs(key.low), 1.0) * 1e-6))
     if math.isfinite(key.high):
-        outside.append(key.high + 1 if key.type is int else key.high + max(abs(key.high), 1.0) * 1e-6)
+        outside.append(key.high if key.open_high else key.high + 1 if key.type is int else key.high + max(abs(key.high), 1.0) * 1e-6)
     return outside
 
 

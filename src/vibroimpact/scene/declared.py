@@ -104,8 +104,8 @@ class Key:
         The allowed names (``str`` and :class:`Names` keys only; empty: any name).
     read_when : tuple of (str, str), optional
         (another key, its value): this key is read only where the other has that value; given otherwise it is refused.
-    open_low : bool
-        Whether ``low`` itself is refused (a step, a frequency: above 0).
+    open_low, open_high : bool
+        Whether ``low`` (a step, a frequency: above 0) or ``high`` (a restitution below 1) itself is refused.
     """
 
     name: str
@@ -118,6 +118,7 @@ class Key:
     choices: tuple[str, ...] = ()
     read_when: tuple[str, str] | None = None
     open_low: bool = False
+    open_high: bool = False
 
     def __post_init__(self) -> None:
         if self.type not in _TYPE_NAMES:
@@ -126,8 +127,8 @@ class Key:
             raise TypeError(f"Key {self.name!r}: choices are names, for a str or Names key only")
         if self.type is Names and not self.choices:
             raise TypeError(f"Key {self.name!r}: a Names key lists its choices")
-        if self.open_low and self.type not in (float, Band, Grid):
-            raise TypeError(f"Key {self.name!r}: an open low end is for numbers, bands and grids (a count's range is whole numbers)")
+        if (self.open_low or self.open_high) and self.type not in (float, Band, Grid):
+            raise TypeError(f"Key {self.name!r}: an open end is for numbers, bands and grids (a count's range is whole numbers)")
         if self.default is not REQUIRED and self.default is not DERIVED and self.check(Checker(), self.name, self.as_written(self.default)) is None:
             raise ValueError(f"Key {self.name!r}: its default {self.default!r} fails its own check")
 
@@ -141,7 +142,7 @@ class Key:
         if self.type is int and math.isfinite(self.low) and math.isfinite(self.high):
             return f"{kind} in [{int(self.low)}, {int(self.high)}]"
         if self.type in (int, float, Band, Grid) and (math.isfinite(self.low) or math.isfinite(self.high)):
-            return f"{kind} in {interval(self.low, self.high, not self.open_low)}" + (f" [{self.unit}]" if self.unit else "")
+            return f"{kind} in {interval(self.low, self.high, not self.open_low, not self.open_high)}" + (f" [{self.unit}]" if self.unit else "")
         return kind + (f" [{self.unit}]" if self.unit else "")
 
     def as_written(self, value: Any) -> Any:
@@ -181,8 +182,8 @@ class Key:
             band = c.mapping(where, value, {"start", "stop"}, {"start", "stop"})
             if set(map(str, band)) != {"start", "stop"}:
                 return None
-            start = c.number(f"{where}.start", band["start"], self.low, self.high, not self.open_low)
-            stop = c.number(f"{where}.stop", band["stop"], self.low, self.high, not self.open_low)
+            start = c.number(f"{where}.start", band["start"], self.low, self.high, not self.open_low, not self.open_high)
+            stop = c.number(f"{where}.stop", band["stop"], self.low, self.high, not self.open_low, not self.open_high)
             if start is None or stop is None:
                 return None
             if stop <= start:
@@ -190,7 +191,7 @@ class Key:
                 return None
             return (start, stop)
         if self.type is Grid:
-            return c.grid(where, value, self.low, self.high, not self.open_low)
+            return c.grid(where, value, self.low, self.high, not self.open_low)  # a grid's top is closed
         if self.type is Free:
             return value
         if self.type is Rows:
@@ -203,7 +204,7 @@ class Key:
                 c.fail(where, f"{wrong}: {self.doc}")
                 return None
             return value
-        return c.number(where, value, self.low, self.high, not self.open_low)
+        return c.number(where, value, self.low, self.high, not self.open_low, not self.open_high)
 
 
 @dataclass(frozen=True)

@@ -10,14 +10,14 @@ Example (``studies/validation/budd_dux.yaml``)::
       restitution: 0.8
       clearance: {start: -0.5, stop: 0.14}
 
-The keys of each case, their units and ranges are :data:`vibroimpact.kinds.validation.settings.CASE_PARAMETERS`.
+The keys of each case, their units and ranges are :data:`vibroimpact.kinds.validation.settings.CASE_PARAMETERS`, declared as
+one form of the ``validation`` section per case (:data:`~vibroimpact.kinds.validation.settings.CASE_SECTIONS`).
 Every unknown key, wrong type and out-of-range value is reported together, each naming its key.
 """
 
 from __future__ import annotations
 
 import cmath
-import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -27,11 +27,11 @@ from vibroimpact.model.layout import Layout, LoadSpec, StopSpec
 from vibroimpact.scene.header import open_scene
 from vibroimpact.kinds.validation.settings import BouncingBallCase, BuddDuxCase, GrazingCase, RelativeStopCase, ValidationCase, ZenoCase
 from vibroimpact.kinds.validation.settings import (
-    CASE_PARAMETERS,
     VALIDATION_CASES,
     VALIDATION_TOP_KEYS,
-    ZENO_ENGINES,
-    Parameter,
+    CASE_KEY,
+    CASE_SECTIONS,
+    SECTIONS,
     ValidationSettings,
 )
 from vibroimpact.model.contact import RigidStop, Stop
@@ -42,7 +42,7 @@ from vibroimpact.model.system import NAMED_KEYS, named_system
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.scene.schema import Scene
 
-__all__ = ["BALL_TIME_SHIFT", "case_structure", "budd_dux_problem", "ball_problem", "ball_amplitude", "zeno_problem", "grazing_problem", "grazing_phase", "relative_stop_problem", "ValidationScene", "read_validation_scene", "parse_validation_scene", "validation_settings"]
+__all__ = ["BALL_TIME_SHIFT", "case_structure", "budd_dux_problem", "ball_problem", "ball_amplitude", "zeno_problem", "grazing_problem", "grazing_phase", "relative_stop_problem", "ValidationScene", "read_validation_scene", "parse_validation_scene", "validation_settings", "SECTIONS"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -153,50 +153,17 @@ def validation_settings(c: Checker, value: Any) -> ValidationSettings | None:
         return None
     case_name = value.get("case")
     if case_name not in VALIDATION_CASES:
-        c.fail("validation.case", f"{case_name!r} is not allowed: use one of {', '.join(VALIDATION_CASES)}" if "case" in value else "required key is missing")
+        CASE_KEY.check(c, "validation.case", case_name) if "case" in value else c.fail("validation.case", f"required key is missing ({CASE_KEY.allowed()})")
         return None
-    parameters = CASE_PARAMETERS[case_name]
-    spec = c.mapping("validation", value, {"case", *parameters})
+    values = CASE_SECTIONS[case_name].read(c, value)
+    if values is None:
+        return None
+    values.pop("case")
     cls = VALIDATION_CASES[case_name]
-    defaults = {f.name: f.default for f in dataclasses.fields(cls)}
-    kwargs: dict[str, Any] = {}
-    ok = True
-    for key, parameter in parameters.items():
-        if key not in spec:
-            continue
-        checked = _value(c, f"validation.{key}", spec[key], parameter)
-        if checked is None:
-            ok = False
-        else:
-            kwargs[key] = checked
-    if not ok or set(map(str, spec)) - {"case", *parameters}:
-        return None
-    values = defaults | kwargs
+    kwargs = {key: item for key, item in values.items() if key in value}  # as given: the defaults are the case's own
     if not _consistent(c, case_name, values):
         return None
     return ValidationSettings(cls(**kwargs))
-
-
-def _value(c: Checker, key: str, value: Any, parameter: Parameter) -> Any:
-    """One parameter's checked value (None: a problem was recorded)."""
-    bounds = (parameter.low, parameter.high, parameter.low_inclusive, parameter.high_inclusive)
-    if parameter.kind == "number":
-        return c.number(key, value, *bounds)
-    if parameter.kind == "integer":
-        return c.integer(key, value, int(parameter.low), int(parameter.high))
-    if parameter.kind == "engines":
-        chosen = c.choices(key, value, ZENO_ENGINES)
-        return chosen if chosen and len(chosen) == len(value) else None
-    spec = c.mapping(key, value, {"start", "stop"}, {"start", "stop"})
-    if set(map(str, spec)) != {"start", "stop"}:
-        return None
-    low, high = c.number(f"{key}.start", spec["start"], *bounds), c.number(f"{key}.stop", spec["stop"], *bounds)
-    if low is None or high is None:
-        return None
-    if not high > low:
-        c.fail(f"{key}.stop", f"{high:g} must be greater than start = {low:g}")
-        return None
-    return (low, high)
 
 
 def _consistent(c: Checker, case: str, values: dict[str, Any]) -> bool:

@@ -9,11 +9,17 @@ name these types.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Union
+from typing import Any, Union
+
+from vibroimpact.scene.declared import REQUIRED, Band, Key, Names, Section
 
 __all__ = [
+    "CASE_KEY",
+    "CASE_SECTIONS",
+    "SECTIONS",
     "VALIDATION_CASES",
     "VALIDATION_TOP_KEYS",
     "CASE_SOURCES",
@@ -52,6 +58,18 @@ class Parameter:
     high_inclusive: bool = True
     kind: str = "number"
     help: str = ""
+
+
+def _key(name: str, parameter: Parameter, default: Any) -> Key:
+    """A case's parameter as a declared scene key (:mod:`vibroimpact.scene.declared`), its default the case's."""
+    kinds = {"number": float, "integer": int, "range": Band, "engines": Names}
+    unit = "" if parameter.units == "1" else parameter.units
+    if parameter.kind == "engines":
+        return Key(name, Names, parameter.help, default, choices=ZENO_ENGINES)
+    if parameter.kind == "integer":
+        return Key(name, int, parameter.help, default, parameter.low, parameter.high, unit)
+    return Key(name, kinds[parameter.kind], parameter.help, default, parameter.low, parameter.high, unit,
+               open_low=not parameter.low_inclusive and math.isfinite(parameter.low), open_high=not parameter.high_inclusive and math.isfinite(parameter.high))
 
 
 def _tolerance() -> Parameter:
@@ -316,3 +334,16 @@ class ValidationSettings:
     def source(self) -> str:
         """The publication whose closed form the case reproduces."""
         return CASE_SOURCES[self.case.name]
+
+
+#: ``validation.case``, declared: which published closed form.
+CASE_KEY = Key("case", str, "the published closed form reproduced", REQUIRED, choices=tuple(VALIDATION_CASES))
+#: ``validation`` of each case, declared (one form per case): the case's parameters, their defaults the case's own.
+CASE_SECTIONS = {
+    name: Section("validation", (CASE_KEY, *(_key(key, parameter, {f.name: f.default for f in dataclasses.fields(VALIDATION_CASES[name])}[key])
+                                           for key, parameter in CASE_PARAMETERS[name].items())),
+                  f"the {name} case: {CASE_SOURCES[name]}", form=f"case: {name}")
+    for name in CASE_PARAMETERS
+}  # fmt: skip
+#: The sections of a validation scene that are declared (``run-study --keys`` lists them).
+SECTIONS = tuple(CASE_SECTIONS.values())
