@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 import yaml
 
-from vibroimpact.kinds.benchmark.scene import BENCHMARK, LADDER
+from vibroimpact.kinds.benchmark.scene import BENCHMARK, CASE_ROW, CASE_SWEEP, LADDER
 from vibroimpact.kinds.bifurcation.scene import BIFURCATION, BRUTE_FORCE, CHART, CONTINUATION, BranchSettings, BruteForceSettings, ChartSettings
 from vibroimpact.kinds.concepts.scene import CONTINUATION as CONCEPTS_CONTINUATION
 from vibroimpact.kinds.validation.settings import CASE_SECTIONS
@@ -43,9 +43,14 @@ def _id(section: Section) -> str:
     return f"{section.path}#{section.form}" if section.form else section.path
 
 
+def _own_section(section: Section, key: Key) -> bool:
+    """Whether ``key`` of ``section`` is a declared section of its own (a mapping, or a list of rows), walked as such."""
+    return section.where(key.name) in PLACES or f"{section.where(key.name)}[k]" in PLACES
+
+
 def _where(section: Section, name: str) -> str:
     """Where a problem of the key ``name`` is said: a stop row's in the walk's first stop."""
-    return section.where(name).replace("stops[k]", "stops[0]")
+    return section.where(name).replace("stops[k]", "stops[0]").replace("cases[k]", "cases[0]")
 
 
 def _analytic(name: str) -> dict:
@@ -61,6 +66,12 @@ def _put(document: dict, path: str, values: dict[str, Any]) -> dict:
         return document
     if path == STOP_ROW.path:
         document["stops"][0] = values
+        return document
+    if path == CASE_ROW.path:
+        document["benchmark"]["cases"] = [values]
+        return document
+    if path == CASE_SWEEP.path:
+        document["benchmark"]["cases"][0]["swept_sine"] = values
         return document
     *parents, leaf = path.split(".")
     place = document
@@ -98,21 +109,27 @@ PLACES = {
     ADMISSIBILITY.path: (lambda: _shipped("restitution.yaml"), lambda scene, name: getattr(scene.settings.admissibility, name)),
     SIMULATION.path: (lambda: _shipped("restitution.yaml"), lambda scene, name: _simulation_value(scene.settings.simulation, name)),
     BENCHMARK.path: (lambda: _shipped("engine_cost.yaml"), lambda scene, name: _benchmark_value(scene.settings, name)),
+    CASE_ROW.path: (lambda: _shipped("engine_cost.yaml"), None),
+    CASE_SWEEP.path: (lambda: _put(_shipped("engine_cost.yaml"), CASE_ROW.path, dict(SWEPT_CASE)), None),
     LADDER.path: (lambda: _put(_shipped("engine_cost.yaml"), "benchmark.ladder", dict(LADDER_POINT)), lambda scene, name: getattr(scene.settings.settings.ladder, name)),
 }  # fmt: skip
+#: A swept benchmark case (the walk's base for its sweep).
+SWEPT_CASE = {"name": "swept", "restitution": 0.2, "clearance": 0.003, "bumper_frequency": 1000.0, "swept_sine": {"start": 20.0, "stop": 30.0, "rate": 10.0}}
 #: A ladder on the paper's stop, which gives neither restitution nor clearance (both then needed).
 LADDER_POINT = {"frequency": 25.0, "restitution": 0.2, "clearance": 0.003, "bumper_frequencies": [1000.0, 5000.0]}
 #: Keys the kind derives but the walk's scene needs given (the paper's stop takes them from the ladder).
-NEEDED = {"benchmark.ladder.restitution", "benchmark.ladder.clearance", "design.robust.samples", "bifurcation.restitution", "stops[k].between",
+NEEDED = {"benchmark.cases[k].start", "benchmark.cases[k].frequency", "benchmark.cases[k].restitution", "benchmark.cases[k].clearance", "benchmark.ladder.restitution", "benchmark.ladder.clearance", "design.robust.samples", "bifurcation.restitution", "stops[k].between",
           "stops[k].clearance", "stops[k].restitution"}  # with a spread; the paper's stop
 #: Keys that choose which form of their section is read (walked as each form).
 FORM_KEYS = {"validation.case"}
 #: A valid value, for the walk, of a key whose other values the declaration cannot tell (a name the layout makes).
 OTHER_VALUES = {"design.objective": "force_amplitude", "validation.forcing_frequency": 2.75}  # the last: |1 / (1 - w^2)| stays above sigma's 0.14
 #: Keys the walk gives beside a key that is read only with them (a reference needs bumpers).
-CONTEXT = {"bifurcation.reference": {"bumper": {"frequency": [100.0]}}, "bumper.loss_factor": {"frequency": 250.0}, "bumper.damping": {"stiffness": 2.5e5}}
+CONTEXT = {"benchmark.cases[k].clearance_below_linear": {"clearance": None}, "benchmark.cases[k].swept_sine": {"frequency": None, "start": None},
+           "bifurcation.reference": {"bumper": {"frequency": [100.0]}}, "bumper.loss_factor": {"frequency": 250.0}, "bumper.damping": {"stiffness": 2.5e5}}
 #: A valid value, for the walk, of each key whose default the kind derives.
-DERIVED_VALUES = {"cluster": {"scheduler": "tcp://head:8786"}, "bumper.frequency": 300.0, "bumper.loss_factor": 0.1, "bumper.stiffness": 2.5e5,
+DERIVED_VALUES = {"benchmark.cases[k].clearance_below_linear": 1e-5, "benchmark.cases[k].bumper_frequency": 500.0,
+                  "benchmark.cases[k].swept_sine": {"start": 20.0, "stop": 30.0, "rate": 10.0}, "cluster": {"scheduler": "tcp://head:8786"}, "bumper.frequency": 300.0, "bumper.loss_factor": 0.1, "bumper.stiffness": 2.5e5,
                   "bumper.damping": 10.0, "stops[k].bumper": {"frequency": 300.0}, "bifurcation.restitution": [0.5], "bifurcation.bumper": {"frequency": [100.0]},
                   "bifurcation.brute_force": {}, "bifurcation.continuation": {}, "bifurcation.chart": {}, "simulation.frequency": [20.0, 30.0], "simulation.rtol": 1e-6, "simulation.atol": 1e-9, "simulation.subset": {"momentary": {"frequency": [25.0]}},
                   "benchmark.ladder": LADDER_POINT, "benchmark.ladder.restitution": 0.5, "benchmark.ladder.clearance": 0.002}
@@ -189,10 +206,13 @@ def _scene(section: Section | str, values: dict[str, Any]) -> dict:
 def _required(section: Section) -> dict[str, Any]:
     """The values the section's shipped scene gives its required keys."""
     place = PLACES[_id(section)][0]()
-    for part in section.path.split(".") if section.path and section is not STOP_ROW else ():
+    for part in section.path.split(".") if section.path and section not in (STOP_ROW, CASE_ROW, CASE_SWEEP) else ():
         place = place.get(part, {})
     if section is STOP_ROW:
         place = place["stops"][0]
+    if section in (CASE_ROW, CASE_SWEEP):
+        place = place["benchmark"]["cases"][0]
+        place = place["swept_sine"] if section is CASE_SWEEP else place
     given = {key.name: place[key.name] for key in section.keys if key.default is REQUIRED or section.where(key.name) in NEEDED}
     return given | ({name: value for name, value in place.items() if name not in section.names} if section.others else {})  # a spread, a limit
 
@@ -205,6 +225,8 @@ def _other_value(key: Key, given: Any = None, section_path: str = "") -> Any:
         return (given["start"], (given["start"] + given["stop"]) / 2.0)
     if key.default is REQUIRED and isinstance(given, dict):
         return dict(list(given.items())[:1])
+    if key.type is str and key.choices and given is not None:
+        return next(choice for choice in key.choices if choice != given)
     if key.default is REQUIRED or key.default is DERIVED and given is not None:
         return given[:1] if isinstance(given, list) else given + "2" if isinstance(given, str) else given * 1.01
     if key.default is DERIVED:
@@ -260,11 +282,12 @@ def test_every_declared_section_of_every_kind_is_walked_here() -> None:
 def test_every_declared_key_reaches_the_settings(section: Section) -> None:
     required, where = _required(section), PLACES[_id(section)][1]
     for key in section.keys:
-        if section.where(key.name) in PLACES or key.type is Free or section.where(key.name) in FORM_KEYS:
+        if _own_section(section, key) or key.type is Free or section.where(key.name) in FORM_KEYS:
             continue  # a declared section of its own, walked as such; a value of many forms, its parser's; the form itself
         value = _other_value(key, required.get(key.name), section.path)
         assert key.as_written(value) != key.as_written(required.get(key.name, key.default)), (key.name, "walked with the value it has anyway")
         given = required | _method_of(section, key) | CONTEXT.get(section.where(key.name), {}) | {key.name: key.as_written(value)}
+        given = {name: item for name, item in given.items() if item is not None}  # a context's None: a key the walked one replaces
         scene = parse_scene(_scene(section, given))  # accepted (where None: what it sets is the model's to show)
         assert where is None or _same(where(scene, key.name), value, key), (key.name, value)
 
@@ -296,7 +319,7 @@ def test_a_scene_with_every_key_wrong_is_refused_at_once_with_exit_2_and_nothing
     document = PLACES[_id(sections[0])][0]()
     for section in sections:
         kept = {name: value for name, value in _required(section).items() if section.where(name) in FORM_KEYS}  # which form is read
-        _put(document, section.path, kept | {key.name: _wrong_values(key)[0] for key in section.keys if section.where(key.name) not in PLACES.keys() | FORM_KEYS
+        _put(document, section.path, kept | {key.name: _wrong_values(key)[0] for key in section.keys if not _own_section(section, key) and section.where(key.name) not in FORM_KEYS
                                              and _wrong_values(key)})
     path = tmp_path / "wrong.yaml"
     path.write_text(yaml.safe_dump(document), encoding="utf-8")
@@ -305,7 +328,7 @@ def test_a_scene_with_every_key_wrong_is_refused_at_once_with_exit_2_and_nothing
     assert done.returncode == 2, done.stderr
     for section in sections:
         for key in section.keys:
-            if section.where(key.name) not in PLACES.keys() | FORM_KEYS and _wrong_values(key):  # a section of its own: its keys are wrong instead
+            if not _own_section(section, key) and section.where(key.name) not in FORM_KEYS and _wrong_values(key):  # a section of its own: its keys are wrong instead
                 assert f"{_where(section, key.name)}: expected" in done.stderr, (key.name, done.stderr)
     assert not out.exists() or not any(out.iterdir())
 

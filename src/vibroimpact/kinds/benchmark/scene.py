@@ -71,9 +71,28 @@ LADDER = Section("benchmark.ladder", (
     Key("rtol", float, "tolerance of the integrators (atol = rtol x atol_ratio)", STEPPED_TOLERANCES[0], 1e-14, 1e-2),
     Key("repeats", int, "runs per model (their median wall time)", 3, 1, 100),
 ), "one frequency point through every model, from the closed form to ever stiffer bumpers")  # fmt: skip
+#: One entry of ``benchmark.cases``, declared: a stepped case (frequency, start) or a swept one (swept_sine); the
+#: values the stops give themselves are not the case's.
+CASE_ROW = Section("benchmark.cases[k]", (
+    Key("name", str, "the case's name in the dataset (letters, digits, '_', '-', '.'; unique)", REQUIRED),
+    Key("frequency", float, "the excitation frequency (a stepped case)", DERIVED, 0.0, math.inf, "Hz", open_low=True),
+    Key("restitution", float, "R of the stops that give none", DERIVED, 0.0, 1.0),
+    Key("clearance", float, "Delta of the stops that give none (or clearance_below_linear)", DERIVED, 0.0, math.inf, "m"),
+    Key("clearance_below_linear", float, "Delta that far inside the linear amplitude at the frequency (or clearance)", DERIVED, -1.0, 1.0, "m"),
+    Key("start", str, "where each run starts (required for a stepped case; a swept case starts at rest)", DERIVED, choices=tuple(START_MODES)),
+    Key("bumper_frequency", float, "Omega_b / 2 pi of the compliant methods' bumpers (derived: none, no compliant method)", DERIVED, 0.0, MAX_BUMPER_FREQUENCY,
+        "Hz", open_low=True),
+    Key("swept_sine", Table, "{start, stop, rate[, sample_rate]}: a swept case instead (benchmark.cases[k].swept_sine)", DERIVED),
+), "one benchmark run: the problem, where it starts and how long it lasts")  # fmt: skip
+#: A swept case's sweep, declared.
+CASE_SWEEP = Section("benchmark.cases[k].swept_sine", (
+    Key("start", float, "the frequency the sweep starts at", REQUIRED, 0.0, math.inf, "Hz", open_low=True),
+    Key("stop", float, "the frequency it ends at (below start: a sweep down)", REQUIRED, 0.0, math.inf, "Hz", open_low=True),
+    Key("rate", float, "|alpha|, how fast the frequency moves", REQUIRED, 0.0, math.inf, "Hz s-1", open_low=True),
+    Key("sample_rate", float, "output samples per second", 2000.0, 0.0, 1e7, "Hz", open_low=True),
+), "a swept case's sweep, driven by q sin(theta(t))")  # fmt: skip
 #: The sections of a benchmark scene that are declared (``run-study --keys`` lists them).
-SECTIONS = (BENCHMARK, LADDER)
-_BENCHMARK_CASE_KEYS = {"name", "frequency", "restitution", "clearance", "clearance_below_linear", "start", "bumper_frequency", "swept_sine"}
+SECTIONS = (BENCHMARK, LADDER, CASE_ROW, CASE_SWEEP)
 
 
 @dataclass(frozen=True)
@@ -269,27 +288,26 @@ def _own_or_case(c: Checker, key: str, case: dict[str, Any], layout: _Layout, fi
 
 def _parse_case(c: Checker, key: str, raw: Any, names: list[str], layout: _Layout | None, duration: float | None) -> BenchmarkCase | None:
     """One entry of ``benchmark.cases``, checked; None where it is unusable (every problem recorded)."""
-    case = c.mapping(key, raw, _BENCHMARK_CASE_KEYS, {"name"})
-    if "name" in case:
-        if not (isinstance(case["name"], str) and NAME.match(case["name"])):
+    read = CASE_ROW.at(key).read(c, raw, partial=True)
+    if read is None:
+        return None
+    case = {name: raw[name] for name in CASE_ROW.names if name in raw}
+    if "name" in case and read["name"] is not None:
+        if not NAME.match(case["name"]):
             c.fail(f"{key}.name", f"expected a name of letters, digits, '_', '-', '.', got {case['name']!r}")
         elif case["name"] in names:
             c.fail(f"{key}.name", f"{case['name']!r} is used by another case: names must be unique")
         names.append(str(case["name"]))
     swept = case.get("swept_sine")
-    if "swept_sine" in case and not isinstance(swept, dict):
-        c.fail(f"{key}.swept_sine", f"expected a mapping {{start, stop, rate, sample_rate}}, got {swept!r}")
-        return None
+    if "swept_sine" in case and read["swept_sine"] is None:
+        return None  # no mapping: said
     needs = {"restitution": True, "clearance": True, "bumper_frequency": swept is not None}
     if layout is not None:
         needs = {field: _own_or_case(c, key, case, layout, field, words) for field, words in (("restitution", "restitution"), ("clearance", "clearance"), ("bumper_frequency", "bumper frequency"))}
     f_start = f_stop = rate = sample_rate = None
     if swept is not None:
-        spec_s = c.mapping(f"{key}.swept_sine", swept, {"start", "stop", "rate", "sample_rate"}, {"start", "stop", "rate"})
-        f_start = c.number(f"{key}.swept_sine.start", spec_s.get("start"), 0.0, math.inf, low_inclusive=False) if "start" in spec_s else None
-        f_stop = c.number(f"{key}.swept_sine.stop", spec_s.get("stop"), 0.0, math.inf, low_inclusive=False) if "stop" in spec_s else None
-        rate = c.number(f"{key}.swept_sine.rate", spec_s.get("rate"), 0.0, math.inf, low_inclusive=False) if "rate" in spec_s else None
-        sample_rate = c.number(f"{key}.swept_sine.sample_rate", spec_s.get("sample_rate", 2000.0), 0.0, 1e7, low_inclusive=False)
+        sweep = CASE_SWEEP.at(f"{key}.swept_sine").read(c, swept, partial=True) or {}
+        f_start, f_stop, rate, sample_rate = (sweep.get(name) for name in ("start", "stop", "rate", "sample_rate"))
         if "frequency" in case or "start" in case:
             c.fail(key, "a swept_sine case sets its own frequencies and starts at rest: remove frequency and start")
         if "bumper_frequency" not in case and needs["bumper_frequency"]:
@@ -308,21 +326,19 @@ def _parse_case(c: Checker, key: str, raw: Any, names: list[str], layout: _Layou
             c.fail(f"{key}.frequency", "required key is missing")
         if "start" not in case:
             c.fail(f"{key}.start", "required key is missing")
-        frequency = c.number(f"{key}.frequency", case.get("frequency"), 0.0, math.inf, low_inclusive=False) if "frequency" in case else None
+        frequency = read["frequency"]
     if needs["restitution"] and "restitution" not in case:
         c.fail(f"{key}.restitution", "required key is missing")
-    restitution = c.number(f"{key}.restitution", case.get("restitution"), 0.0, 1.0) if "restitution" in case else math.nan
-    bumper = c.number(f"{key}.bumper_frequency", case["bumper_frequency"], 0.0, MAX_BUMPER_FREQUENCY, low_inclusive=False) if "bumper_frequency" in case else math.nan
+    restitution = read["restitution"] if "restitution" in case else math.nan
+    bumper = read["bumper_frequency"] if "bumper_frequency" in case else math.nan
     if bumper is not None and math.isfinite(bumper) and restitution == 0.0:
         c.fail(f"{key}.restitution", "R = 0 needs an infinitely damped bumper: use R > 0 with bumper_frequency")
     if needs["clearance"] and ("clearance" in case) == ("clearance_below_linear" in case):
         c.fail(key, "give exactly one of 'clearance' [m] or 'clearance_below_linear' [m]")
         return None
-    start = case.get("start", "rest")
-    if start not in START_MODES:
-        c.fail(f"{key}.start", f"{start!r} is not allowed: use rest, linear or pgf")
-    clearance = c.number(f"{key}.clearance", case["clearance"], 0.0, math.inf) if "clearance" in case else math.nan
-    below = c.number(f"{key}.clearance_below_linear", case["clearance_below_linear"], -1.0, 1.0) if "clearance_below_linear" in case else math.nan
+    start = read["start"] if "start" in case else "rest"  # None: said; a stepped case without it is said above
+    clearance = read["clearance"] if "clearance" in case else math.nan
+    below = read["clearance_below_linear"] if "clearance_below_linear" in case else math.nan
     if None in (frequency, restitution, layout, duration, bumper, clearance, below) or start not in START_MODES:
         return None
     assert frequency is not None and restitution is not None and layout is not None and duration is not None and bumper is not None and clearance is not None and below is not None
