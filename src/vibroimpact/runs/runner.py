@@ -303,8 +303,7 @@ class Runner:
     def _run_distributed(self, function: TaskFunction, shared: Any, items: Sequence[Any], order: list[int], bar: ProgressBar, finished: Callable[[int, Any], None]) -> None:
         connection = self.connection
         if connection.worker_count() == 0:  # a named scheduler without workers: a broadcast would wait dask's own timeout
-            bar.set_status(f"waiting for a worker to join the dask scheduler (at most {NO_WORKER_TIMEOUT:.0f} s)")
-            _wait_for_a_worker(connection)
+            _await_a_worker(connection, bar)
         bar.set_status("waiting for the workers' first results")
         client: Any = connection.client
         token = uuid.uuid4().hex[:12]
@@ -399,6 +398,12 @@ def _wait_for_a_worker(connection: Connection) -> None:
         raise ClusterLost(f"the dask scheduler at {connection.address} has no workers: none joined within {NO_WORKER_TIMEOUT:g} s") from None
 
 
+def _await_a_worker(connection: Connection, bar: ProgressBar) -> None:
+    """:func:`_wait_for_a_worker`, said meanwhile on the bar's status line."""
+    bar.set_status(f"waiting for a worker to join the dask scheduler (at most {NO_WORKER_TIMEOUT:.0f} s)")
+    _wait_for_a_worker(connection)
+
+
 def _broadcast(connection: Connection, shared: Any, bar: ProgressBar) -> Any:
     """``shared`` on every worker (the future of ``client.scatter(broadcast=True)``), sent again when the workers left
     while it was sent: the count of workers before it is no promise that one is still there. A broadcast that finds
@@ -420,8 +425,7 @@ def _broadcast(connection: Connection, shared: Any, bar: ProgressBar) -> Any:
         except (TimeoutError, OSError, ValueError) as error:
             _check(client, connection.address)  # the scheduler itself gone: said as such, at once
             failure = f"{type(error).__name__}: {error}" if str(error) else type(error).__name__
-        bar.set_status(f"waiting for a worker to join the dask scheduler (at most {NO_WORKER_TIMEOUT:.0f} s)")
-        _wait_for_a_worker(connection)
+        _await_a_worker(connection, bar)
         bar.set_status("waiting for the workers' first results")
     raise ClusterLost(f"the dask scheduler at {connection.address} has no workers: they left during each of {BROADCAST_TRIES} broadcasts of the study's shared data ({failure})")
 

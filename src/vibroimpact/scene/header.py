@@ -68,13 +68,14 @@ def open_scene(document: Any, top_keys: set[str], required: set[str], kind: str)
 
 def parse_names(c: Checker, doc: dict) -> tuple[Any, str, bool]:
     """Name, description and the report switch of any scene (:data:`HEADER`; a missing name is the kind's to say)."""
-    values = HEADER.read(c, {key: doc[key] for key in ("description", "report") if key in doc} | {"name": "_"}, partial=True) or {}
+    def given(key: str) -> Any:  # its declared check where the scene gives it, else (or where wrong) its default
+        checked = HEADER.key(key).check(c, key, doc[key]) if key in doc else None
+        return checked if checked is not None else HEADER.key(key).default
+
     name = doc.get("name")  # required by each kind's own keys, said once there
     if "name" in doc and HEADER.key("name").check(c, "name", name) is not None and not NAME.match(name):
         c.fail("name", f"expected a file-name-safe string of at most {MAX_NAME_LENGTH} characters (letters, digits, '_', '-', '.'), got {name!r}")
-    description = values.get("description")
-    report = values.get("report")
-    return name, description if description is not None else "", report if report is not None else True
+    return name, given("description"), given("report")
 
 
 def parse_cluster(c: Checker, doc: dict) -> str | None:

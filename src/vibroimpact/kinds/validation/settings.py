@@ -339,11 +339,13 @@ class ValidationSettings:
 #: ``validation.case``, declared: which published closed form.
 CASE_KEY = Key("case", str, "the published closed form reproduced", REQUIRED, choices=tuple(VALIDATION_CASES))
 #: ``validation`` of each case, declared (one form per case): the case's parameters, their defaults the case's own.
-CASE_SECTIONS = {
-    name: Section("validation", (CASE_KEY, *(_key(key, parameter, {f.name: f.default for f in dataclasses.fields(VALIDATION_CASES[name])}[key])
-                                           for key, parameter in CASE_PARAMETERS[name].items())),
-                  f"the {name} case: {CASE_SOURCES[name]}", form=f"case: {name}")
-    for name in CASE_PARAMETERS
-}  # fmt: skip
+def _case_section(name: str) -> Section:
+    """The ``validation`` section of the case ``name``: its parameters, each default the case dataclass's own."""
+    defaults = {field.name: field.default for field in dataclasses.fields(VALIDATION_CASES[name])}
+    keys = (_key(key, parameter, defaults[key]) for key, parameter in CASE_PARAMETERS[name].items())
+    return Section("validation", (CASE_KEY, *keys), f"the {name} case: {CASE_SOURCES[name]}", form=f"case: {name}")
+
+
+CASE_SECTIONS = {name: _case_section(name) for name in CASE_PARAMETERS}
 #: The sections of a validation scene that are declared (``run-study --keys`` lists them).
 SECTIONS = tuple(CASE_SECTIONS.values())
