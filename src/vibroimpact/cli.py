@@ -205,7 +205,10 @@ def _say(line: str) -> None:
 
 def _kept(store: StudyStore) -> str:
     """What an interrupted run keeps and how to go on, in words (``12 finished blocks and 3 finished cases kept in
-    ...; run the same command to resume``)."""
+    ...; run the same command to resume``), once the store's I/O that the interrupt cut off has ended."""
+    from vibroimpact.runs.store_record import settle_io
+
+    settle_io()
     blocks, cases = store.block_count(), store.case_count()
     if not blocks and not cases:
         return "nothing had finished yet; run the same command to start again"
