@@ -22,7 +22,7 @@ from vibroimpact.kinds.validation.settings import CASE_SECTIONS
 from vibroimpact.kinds.design.scene import CERTIFY, CONSTRAINTS, DESIGN, OPERATING, ROBUST, SEARCH, SearchSettings
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.scene.declared import DERIVED, REQUIRED, Band, Free, Grid, Key, Names, Rows, Section, Table
-from vibroimpact.scene.grid import ADMISSIBILITY, SWEPT_SINE
+from vibroimpact.scene.grid import ADMISSIBILITY, GRID_SETTINGS, GRID_STOP, GRID_TOP, SWEEP, SWEPT_SINE
 from vibroimpact.scene.bumper_parse import BUMPER
 from vibroimpact.scene.header import CLUSTER, HEADER, declared_sections
 from vibroimpact.scene.layout_parse import EXCITATION, MATRIX_SYSTEM, NAMED_SYSTEM, STOP_ROW
@@ -45,12 +45,19 @@ def _id(section: Section) -> str:
 
 def _own_section(section: Section, key: Key) -> bool:
     """Whether ``key`` of ``section`` is a declared section of its own (a mapping, or a list of rows), walked as such."""
-    return section.where(key.name) in PLACES or f"{section.where(key.name)}[k]" in PLACES
+    paths = {place.partition("#")[0] for place in PLACES}  # a section of several forms: any of them
+    return section.where(key.name) in paths or f"{section.where(key.name)}[k]" in paths
 
 
 def _where(section: Section, name: str) -> str:
     """Where a problem of the key ``name`` is said: a stop row's in the walk's first stop."""
     return section.where(name).replace("stops[k]", "stops[0]").replace("cases[k]", "cases[0]")
+
+
+def _swept_scene(stop: dict | None = None, sweep: dict | None = None) -> dict:
+    """The paper's closed forms over a frequency grid, the stop's values fixed in ``stop`` or swept in ``sweep``."""
+    document = {key: value for key, value in _analytic("restitution.yaml").items() if key != "stop"}
+    return document | {"sweep": (sweep or {}) | {"frequency": {"start": 20.0, "stop": 30.0, "step": 0.5}}} | ({"stop": stop} if stop else {})
 
 
 def _analytic(name: str) -> dict:
@@ -108,6 +115,10 @@ PLACES = {
     SWEPT_SINE.path: (lambda: _shipped("bumper_sweep.yaml"), lambda scene, name: getattr(scene.settings.swept_sine, SWEPT_FIELDS.get(name, name))),
     ADMISSIBILITY.path: (lambda: _shipped("restitution.yaml"), lambda scene, name: getattr(scene.settings.admissibility, name)),
     SIMULATION.path: (lambda: _shipped("restitution.yaml"), lambda scene, name: _simulation_value(scene.settings.simulation, name)),
+    _id(GRID_TOP): (lambda: _analytic("restitution.yaml"), lambda scene, name: getattr(scene.settings, name)),
+    SWEEP.path: (lambda: _swept_scene(sweep={"restitution": [0.0, 0.5], "clearance": [0.002, 0.003]}), lambda scene, name: getattr(scene.settings, name)),
+    _id(GRID_STOP): (lambda: _swept_scene(stop={"clearance": 0.003, "restitution": 0.2}), lambda scene, name: float(getattr(scene.settings, name)[0])),
+    GRID_SETTINGS.path: (lambda: _shipped("restitution.yaml"), None),
     BENCHMARK.path: (lambda: _shipped("engine_cost.yaml"), lambda scene, name: _benchmark_value(scene.settings, name)),
     CASE_ROW.path: (lambda: _shipped("engine_cost.yaml"), None),
     CASE_SWEEP.path: (lambda: _put(_shipped("engine_cost.yaml"), CASE_ROW.path, dict(SWEPT_CASE)), None),
@@ -118,17 +129,17 @@ SWEPT_CASE = {"name": "swept", "restitution": 0.2, "clearance": 0.003, "bumper_f
 #: A ladder on the paper's stop, which gives neither restitution nor clearance (both then needed).
 LADDER_POINT = {"frequency": 25.0, "restitution": 0.2, "clearance": 0.003, "bumper_frequencies": [1000.0, 5000.0]}
 #: Keys the kind derives but the walk's scene needs given (the paper's stop takes them from the ladder).
-NEEDED = {"benchmark.cases[k].start", "benchmark.cases[k].frequency", "benchmark.cases[k].restitution", "benchmark.cases[k].clearance", "benchmark.ladder.restitution", "benchmark.ladder.clearance", "design.robust.samples", "bifurcation.restitution", "stops[k].between",
+NEEDED = {"sweep.restitution", "sweep.clearance", "stop.clearance", "stop.restitution", "benchmark.cases[k].start", "benchmark.cases[k].frequency", "benchmark.cases[k].restitution", "benchmark.cases[k].clearance", "benchmark.ladder.restitution", "benchmark.ladder.clearance", "design.robust.samples", "bifurcation.restitution", "stops[k].between",
           "stops[k].clearance", "stops[k].restitution"}  # with a spread; the paper's stop
 #: Keys that choose which form of their section is read (walked as each form).
 FORM_KEYS = {"validation.case"}
 #: A valid value, for the walk, of a key whose other values the declaration cannot tell (a name the layout makes).
-OTHER_VALUES = {"design.objective": "force_amplitude", "validation.forcing_frequency": 2.75}  # the last: |1 / (1 - w^2)| stays above sigma's 0.14
+OTHER_VALUES = {"sweep.frequency": [20.0, 25.0], "design.objective": "force_amplitude", "validation.forcing_frequency": 2.75}  # the last: |1 / (1 - w^2)| stays above sigma's 0.14
 #: Keys the walk gives beside a key that is read only with them (a reference needs bumpers).
-CONTEXT = {"benchmark.cases[k].clearance_below_linear": {"clearance": None}, "benchmark.cases[k].swept_sine": {"frequency": None, "start": None},
+CONTEXT = {"sweep.bumper_loss_factor": {"restitution": None}, "benchmark.cases[k].clearance_below_linear": {"clearance": None}, "benchmark.cases[k].swept_sine": {"frequency": None, "start": None},
            "bifurcation.reference": {"bumper": {"frequency": [100.0]}}, "bumper.loss_factor": {"frequency": 250.0}, "bumper.damping": {"stiffness": 2.5e5}}
 #: A valid value, for the walk, of each key whose default the kind derives.
-DERIVED_VALUES = {"benchmark.cases[k].clearance_below_linear": 1e-5, "benchmark.cases[k].bumper_frequency": 500.0,
+DERIVED_VALUES = {"sweep.bumper_frequency": [100.0, 200.0], "sweep.bumper_loss_factor": [0.1, 0.2], "benchmark.cases[k].clearance_below_linear": 1e-5, "benchmark.cases[k].bumper_frequency": 500.0,
                   "benchmark.cases[k].swept_sine": {"start": 20.0, "stop": 30.0, "rate": 10.0}, "cluster": {"scheduler": "tcp://head:8786"}, "bumper.frequency": 300.0, "bumper.loss_factor": 0.1, "bumper.stiffness": 2.5e5,
                   "bumper.damping": 10.0, "stops[k].bumper": {"frequency": 300.0}, "bifurcation.restitution": [0.5], "bifurcation.bumper": {"frequency": [100.0]},
                   "bifurcation.brute_force": {}, "bifurcation.continuation": {}, "bifurcation.chart": {}, "simulation.frequency": [20.0, 30.0], "simulation.rtol": 1e-6, "simulation.atol": 1e-9, "simulation.subset": {"momentary": {"frequency": [25.0]}},
@@ -454,7 +465,10 @@ def test_run_study_keys_prints_every_declared_key_of_every_kind_and_runs_nothing
     rows = [line for line in done.stdout.splitlines() if line.startswith("| `")]
     assert rows == [row for section in SECTIONS for row in section.reference()]
     titles = [line for line in done.stdout.splitlines() if line.startswith("### ")]
-    assert titles[0].startswith("### the top level: ") and {section.path for section in SECTIONS[1:]} == {line.split("`")[1] for line in titles[1:]}
+    top = [line for line in titles if line.startswith("### the top level")]
+    assert titles[0].startswith("### the top level: ") and len(top) == sum(not section.path for section in SECTIONS)  # the header, then each kind's own
+    assert "### the top level (stepped and swept): " in "\n".join(top)
+    assert {section.path for section in SECTIONS if section.path} == {line.split("`")[1] for line in titles if line not in top}
     assert not any(tmp_path.iterdir())
 
 

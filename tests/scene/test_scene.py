@@ -175,7 +175,7 @@ MISTAKES = [
     ("unknown-system-key", _set("system", "m3", 1.0), ["system.m3: unknown key", "allowed: m1, m2, k1, k2, b1, b2"]),
     ("unknown-excitation-key", _set("excitation", "phase", 0.0), ["excitation.phase: unknown key", "allowed: amplitude"]),
     ("unknown-stop-key", _set("stop", "stiffness", 1.0), ["stop.stiffness: unknown key", "allowed: clearance, restitution"]),
-    ("unknown-sweep-key", _set("sweep", "amplitude", [1.0]), ["sweep.amplitude: unknown key", "allowed: bumper_frequency, bumper_loss_factor, clearance, frequency, restitution"]),
+    ("unknown-sweep-key", _set("sweep", "amplitude", [1.0]), ["sweep.amplitude: unknown key", "allowed: frequency, restitution, clearance, bumper_frequency, bumper_loss_factor, stop"]),
     ("string-mass", _set("system", "m1", "heavy"), ["system.m1: expected a number", "'heavy'", "(str)"]),
     ("bool-stiffness", _set("system", "k1", True), ["system.k1: expected a number", "True", "(bool)"]),
     ("list-amplitude", _set("excitation", "amplitude", [1.0, 2.0]), ["excitation.amplitude: expected a number", "(list)"]),

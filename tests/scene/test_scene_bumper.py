@@ -56,7 +56,7 @@ def test_swept_loss_factor_sets_the_restitution() -> None:
         (lambda d: d.update(bumper={"frequency": -1.0}), "bumper.frequency: -1.0 is out of range: allowed (0, 1e+06]"),
         (lambda d: d.update(bumper={"frequency": 250.0, "loss_factor": -0.1}), "bumper.loss_factor: -0.1 is out of range: allowed [0, 1000]"),
         (lambda d: d.update(bumper={"frequency": 250.0, "damping": 1.0}), "bumper: give the bumper either as frequency [Hz] (with loss_factor [-]) or as stiffness [N/m]"),
-        (lambda d: d.update(bumper={"frequency": 250.0, "mass": 1.0}), "bumper.mass: unknown key (allowed: damping, frequency, loss_factor, stiffness)"),
+        (lambda d: d.update(bumper={"frequency": 250.0, "mass": 1.0}), "bumper.mass: unknown key (allowed: frequency, loss_factor, stiffness, damping)"),
         (lambda d: d["sweep"].update(bumper_frequency=[100.0, 200.0]), "bumper.frequency: also swept in sweep.bumper_frequency"),
         (lambda d: d["sweep"].update(bumper_loss_factor=[0.5, 1.0]), "sweep.bumper_loss_factor: sweeping the bumper's loss factor sets the restitution"),
         (lambda d: d["stop"].update(restitution=0.0), "stop.restitution: R = 0 needs an infinitely damped bumper"),

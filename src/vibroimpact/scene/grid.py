@@ -25,9 +25,9 @@ from vibroimpact.model.layout import Layout
 from vibroimpact.model.collision import MAX_LOSS_FACTOR, MIN_BUMPER_RESTITUTION, loss_factor_from_restitution, restitution_from_loss_factor
 from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.modal import underdamped_mode_count
-from vibroimpact.scene.bumper_parse import BUMPER_KEYS, PHYSICAL_KEYS, scene_bumper
+from vibroimpact.scene.bumper_parse import BUMPER as BUMPER_SECTION, PHYSICAL_KEYS, scene_bumper
 from vibroimpact.scene.checker import Checker, SceneError, interval
-from vibroimpact.scene.declared import REQUIRED, Key, Names, Section
+from vibroimpact.scene.declared import DERIVED, REQUIRED, Free, Grid, Key, Names, Section, Table
 from vibroimpact.scene.header import check_sweep_run, open_scene
 from vibroimpact.scene.layout_parse import check_layout_solutions, parse_layout, parse_sweep_stops
 from vibroimpact.scene.stop_grids import stop_grids
@@ -46,10 +46,46 @@ from vibroimpact.scene.schema import (
 )
 from vibroimpact.scene.simulation import SimulationSettings, parse_simulation
 
-__all__ = ["GridSettings", "SweptSineSettings", "SWEPT_SINE", "ADMISSIBILITY", "TOP_KEYS", "parse_grid_scene"]
+__all__ = ["GridSettings", "SweptSineSettings", "GRID_TOP", "SWEEP", "GRID_STOP", "GRID_SETTINGS", "SWEPT_SINE", "ADMISSIBILITY", "TOP_KEYS", "parse_grid_scene"]
 
+
+
+def _swept(name: str, default: Any = DERIVED) -> Key:
+    """The declared grid of the parameter table's row ``name`` (its range, its unit)."""
+    row = SWEEPABLE[name]
+    return Key(name, Grid, f"the {row.long_name} values swept", default, row.low, row.high, "" if row.unit == "1" else row.unit, open_low=not row.low_inclusive)
+
+
+def _fixed(name: str) -> Key:
+    """The declared one value of the parameter table's row ``name``, where it is not swept."""
+    row = SWEEPABLE[name]
+    return Key(name, float, f"the {row.long_name}, unless swept (sweep.{name})", DERIVED, row.low, row.high, "" if row.unit == "1" else row.unit,
+               open_low=not row.low_inclusive, open_high=not row.high_inclusive)  # fmt: skip
+
+
+#: A grid scene's own top-level keys, declared (:mod:`vibroimpact.scene.declared`); the header's and the layout's
+#: (system, excitation, stops, bumper) are declared with them.
+GRID_TOP = Section("", (
+    Key("sweep", Table, "the grids swept: frequency, and any of restitution, clearance, bumper_frequency, bumper_loss_factor (sweep)", REQUIRED),
+    Key("solutions", Names, "what is computed at every point: closed forms (linear, pgf, pgf_paper) and engines", REQUIRED, choices=SOLUTIONS),
+    Key("quantities", Free, "a list of output names from the layout's (x1_amplitude ... for the paper's coordinates; default: every one)", DERIVED),
+    Key("stop", Table, "{clearance, restitution}: the paper's stop above the absorber x2 (or 'stops': any layout)", DERIVED),
+    Key("settings", Table, "{admissibility: ...}: the closed forms' settings (settings.admissibility)", DERIVED),
+    Key("simulation", Table, "the time-domain solutions' settings (simulation)", DERIVED),
+    Key("swept_sine", Table, "a swept-sine test instead of stepped steady states (swept_sine)", DERIVED),
+), "a stepped or swept scene's own keys", form="stepped and swept")  # fmt: skip
+#: ``sweep``, declared: the grids, and which stops they move.
+SWEEP = Section("sweep", (
+    *(_swept(name, REQUIRED if name == "frequency" else DERIVED) for name in SWEEPABLE),
+    Key("stop", Free, "which stops the swept restitution, clearance and bumper apply to: an index of 'stops' or a list of them (default: every stop)", DERIVED),
+), "the grids the study runs over (every combination)")  # fmt: skip
+#: The paper's ``stop`` of a grid scene, declared.
+GRID_STOP = Section("stop", (_fixed("clearance"), _fixed("restitution")), "the paper's stop above the absorber x2", form="stepped and swept")
+#: ``settings``, declared.
+GRID_SETTINGS = Section("settings", (Key("admissibility", Table, "how the closed form's X2(t) <= Delta is checked (settings.admissibility)", DERIVED),),
+                        "the closed forms' settings")  # fmt: skip
 #: Top-level keys of a grid scene.
-TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "bumper", "sweep", "swept_sine", "solutions", "quantities", "settings", "simulation", "report", "cluster"}
+TOP_KEYS = {*GRID_TOP.names, "system", "excitation", "stops", "bumper"}
 #: Simulation keys that only stepped steady states use.
 _STEADY_ONLY_KEYS = {"frequency", "start", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods", "lyapunov_periods", "subset"}
 #: Where an unswept parameter is given instead (``frequency`` is always swept).
@@ -177,21 +213,19 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     """Validate a grid scene's document (a mapping) and build the :class:`Scene`; raise :class:`SceneError` listing
     all problems."""
     moved = isinstance(document, dict) and document.get("report") == "design_map"  # the stepped kind's old design-map page
-    c, doc, name, description, report, scheduler = open_scene({**document, "report": True} if moved else document, TOP_KEYS, {"name", "system", "excitation", "sweep", "solutions"},
+    c, doc, name, description, report, scheduler = open_scene({**document, "report": True} if moved else document, TOP_KEYS, {"name", "system", "excitation"},
                                                    "swept" if isinstance(document, dict) and "swept_sine" in document else "stepped")  # fmt: skip
+    own = GRID_TOP.read(c, {key: doc[key] for key in GRID_TOP.names if key in doc}, partial=True) or {}  # sweep and solutions required
     if moved:
         c.fail("report", "the design map is the design kind's grid search: a scene with a 'design' section and 'search: {method: grid, points: N}' (studies/design_map.yaml)")
     layout, amplitude, coordinates = parse_layout(c, doc)
 
-    sweep = c.mapping("sweep", doc.get("sweep", {}), {*SWEEPABLE, "stop"}, {"frequency"}) if "sweep" in doc else {}
+    sweep = _given(c, SWEEP, own.get("sweep"))  # each grid checked by its declaration (None where wrong), sweep.stop as given
     physical = isinstance(doc.get("bumper"), dict) and bool(doc["bumper"].keys() & PHYSICAL_KEYS)  # K_b [N/m], B_b [N s/m]
-    fixed = {
-        "stop": c.mapping("stop", doc["stop"], {"clearance", "restitution"}) if "stop" in doc else {},
-        "bumper": c.mapping("bumper", doc["bumper"], BUMPER_KEYS) if "bumper" in doc and not physical else {},
-    }
+    fixed = {"stop": _given(c, GRID_STOP, own.get("stop")), "bumper": _given(c, BUMPER_SECTION, doc.get("bumper")) if "bumper" in doc and not physical else {}}
     if physical:
         fixed["bumper"], layout = scene_bumper(c, doc["bumper"], sweep, layout, "stops" in doc)
-    solutions = c.choices("solutions", doc["solutions"], SOLUTIONS) if "solutions" in doc else ()
+    solutions = own.get("solutions") or ()
     specs = layout.stops if layout is not None and "stops" in doc else None
     targets = None
     if "stop" in sweep:
@@ -211,9 +245,9 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
         if key in sweep:
             if given_fixed:
                 c.fail(place, f"also swept in sweep.{key}: give it in one place only")
-            grids[key] = c.grid(f"sweep.{key}", sweep[key], low, high, low_inclusive)
+            grids[key] = sweep[key]
         elif given_fixed:
-            value = c.number(place, fixed[section][field_name], low, high, low_inclusive)
+            value = fixed[section][field_name] if section == "stop" or not physical else c.number(place, fixed[section][field_name], low, high, low_inclusive)
             grids[key] = None if value is None else np.array([value])
         elif key == "restitution" and derived_restitution:
             continue  # R(xi_b) of the swept loss factors
@@ -252,14 +286,13 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
     if len(set(allowed)) != len(allowed):
         clashing = sorted({q for q in allowed if allowed.count(q) > 1})
         c.fail("system.coordinates", f"names that make output names clash ({', '.join(clashing)}): rename them (e.g. not 'force')")
-    quantities = c.choices("quantities", doc["quantities"], allowed) if "quantities" in doc else allowed
+    quantities = c.choices("quantities", own["quantities"], allowed) if own.get("quantities") is not None else allowed
     if "regime" not in quantities:
         quantities = (*quantities, "regime")
 
     admissibility = AdmissibilitySettings()
-    if "settings" in doc:
-        settings = c.mapping("settings", doc["settings"], {"admissibility"})
-        if "admissibility" in settings and (values := ADMISSIBILITY.read(c, settings["admissibility"])) is not None:
+    if (settings := own.get("settings")) is not None and (values := GRID_SETTINGS.read(c, settings)) is not None and values["admissibility"] is not None:
+        if (values := ADMISSIBILITY.read(c, values["admissibility"])) is not None:
             admissibility = AdmissibilitySettings(**values)
 
     simulation = None
@@ -294,6 +327,16 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
         name=name, description=description, layout=layout, amplitude=amplitude, kind="stepped" if swept_sine is None else "swept", settings=grid,
         report=report, text=text, cluster_scheduler=scheduler,
     )
+
+
+def _given(c: Checker, section: Section, value: Any) -> dict[str, Any]:
+    """The keys of ``section`` the scene gives in ``value`` (None: the section is absent), each checked by its
+    declaration (None where wrong: it is still given, for the checks of where a value may be given); unknown keys
+    are refused with the closest declared one."""
+    if value is None:
+        return {}
+    read = section.read(c, value, partial=True)
+    return {key: read[key] for key in section.names if key in value} if read is not None else {}
 
 
 def _check_bumper_stiffness(c: Checker, where: str, names: list[str], layout: Layout, grids: dict[str, np.ndarray | None]) -> None:

@@ -5,14 +5,14 @@ from __future__ import annotations
 
 from typing import Any
 
-from vibroimpact.scene.grid import ADMISSIBILITY, parse_grid_scene
+from vibroimpact.scene.grid import ADMISSIBILITY, GRID_SETTINGS, GRID_STOP, GRID_TOP, SWEEP, parse_grid_scene
 from vibroimpact.scene.simulation import SIMULATION
 from vibroimpact.scene.schema import Scene
 
 __all__ = ["parse_stepped_scene", "SECTIONS"]
 
 #: The sections of a stepped scene that are declared (``run-study --keys`` lists them).
-SECTIONS = (SIMULATION, ADMISSIBILITY)
+SECTIONS = (GRID_TOP, SWEEP, GRID_STOP, SIMULATION, GRID_SETTINGS, ADMISSIBILITY)
 
 
 def parse_stepped_scene(document: Any, text: str = "", source: str = "scene") -> Scene:

@@ -6,14 +6,14 @@ from __future__ import annotations
 
 from typing import Any
 
-from vibroimpact.scene.grid import ADMISSIBILITY, SWEPT_SINE, parse_grid_scene
+from vibroimpact.scene.grid import ADMISSIBILITY, GRID_SETTINGS, GRID_STOP, GRID_TOP, SWEEP, SWEPT_SINE, parse_grid_scene
 from vibroimpact.scene.simulation import SIMULATION
 from vibroimpact.scene.schema import Scene
 
 __all__ = ["parse_swept_scene", "SECTIONS"]
 
 #: The sections of a swept scene that are declared (``run-study --keys`` lists them).
-SECTIONS = (SWEPT_SINE, SIMULATION, ADMISSIBILITY)
+SECTIONS = (GRID_TOP, SWEEP, GRID_STOP, SWEPT_SINE, SIMULATION, GRID_SETTINGS, ADMISSIBILITY)
 
 
 def parse_swept_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
