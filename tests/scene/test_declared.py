@@ -16,10 +16,10 @@ import pytest
 import yaml
 
 from vibroimpact.kinds.benchmark.scene import BENCHMARK, CASE_ROW, CASE_SWEEP, LADDER
-from vibroimpact.kinds.bifurcation.scene import BIFURCATION, BRUTE_FORCE, CHART, CONTINUATION, BranchSettings, BruteForceSettings, ChartSettings
-from vibroimpact.kinds.concepts.scene import CONTINUATION as CONCEPTS_CONTINUATION
+from vibroimpact.kinds.bifurcation.scene import BIFURCATION_STOP, BIFURCATION, BRUTE_FORCE, CHART, CONTINUATION, BranchSettings, BruteForceSettings, ChartSettings
+from vibroimpact.kinds.concepts.scene import CONCEPT_ABSORBER, CONCEPT_ROW, CONCEPTS_BUMPER, CONCEPTS_TOP, CONTINUATION as CONCEPTS_CONTINUATION
 from vibroimpact.kinds.validation.settings import CASE_SECTIONS
-from vibroimpact.kinds.design.scene import CERTIFY, CONSTRAINTS, DESIGN, OPERATING, ROBUST, SEARCH, SearchSettings
+from vibroimpact.kinds.design.scene import DESIGN_STOP, CERTIFY, CONSTRAINTS, DESIGN, OPERATING, ROBUST, SEARCH, SearchSettings
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.scene.declared import DERIVED, REQUIRED, Band, Free, Grid, Key, Names, Rows, Section, Table
 from vibroimpact.scene.grid import ADMISSIBILITY, GRID_SETTINGS, GRID_STOP, GRID_TOP, SWEEP, SWEPT_SINE
@@ -51,7 +51,7 @@ def _own_section(section: Section, key: Key) -> bool:
 
 def _where(section: Section, name: str) -> str:
     """Where a problem of the key ``name`` is said: a stop row's in the walk's first stop."""
-    return section.where(name).replace("stops[k]", "stops[0]").replace("cases[k]", "cases[0]")
+    return section.where(name).replace("[k]", "[0]")
 
 
 def _swept_scene(stop: dict | None = None, sweep: dict | None = None) -> dict:
@@ -71,20 +71,17 @@ def _put(document: dict, path: str, values: dict[str, Any]) -> dict:
     if not path:  # the top level: the shared header
         document.update(values)
         return document
-    if path == STOP_ROW.path:
-        document["stops"][0] = values
-        return document
-    if path == CASE_ROW.path:
+    if path == CASE_ROW.path:  # the only case: the others' names and starts are not the walk's
         document["benchmark"]["cases"] = [values]
-        return document
-    if path == CASE_SWEEP.path:
-        document["benchmark"]["cases"][0]["swept_sine"] = values
         return document
     *parents, leaf = path.split(".")
     place = document
-    for parent in parents:
-        place = place.setdefault(parent, {})
-    place[leaf] = values
+    for parent in parents:  # a list of rows (concepts[k]): its first row
+        place = place[parent[:-3]][0] if parent.endswith("[k]") else place.setdefault(parent, {})
+    if leaf.endswith("[k]"):
+        place[leaf[:-3]][0] = values
+    else:
+        place[leaf] = values
     return document
 
 
@@ -115,6 +112,12 @@ PLACES = {
     SWEPT_SINE.path: (lambda: _shipped("bumper_sweep.yaml"), lambda scene, name: getattr(scene.settings.swept_sine, SWEPT_FIELDS.get(name, name))),
     ADMISSIBILITY.path: (lambda: _shipped("restitution.yaml"), lambda scene, name: getattr(scene.settings.admissibility, name)),
     SIMULATION.path: (lambda: _shipped("restitution.yaml"), lambda scene, name: _simulation_value(scene.settings.simulation, name)),
+    _id(DESIGN_STOP): (lambda: _put(copy.deepcopy(SCENE), "design.variables", {"clearance": [0.5e-3, 8e-3], "restitution": [0.05, 0.9]}), lambda scene, name: {"frequency": scene.settings.bumper_frequency} if name == "bumper" else getattr(scene.settings, name)),
+    _id(BIFURCATION_STOP): (lambda: _shipped("bifurcation.yaml"), lambda scene, name: scene.settings.clearance),
+    _id(CONCEPTS_TOP): (lambda: _shipped("absorber_concepts.yaml"), lambda scene, name: getattr(scene.settings, name) if name == "frequency" else [concept.name for concept in scene.settings.concepts]),
+    _id(CONCEPTS_BUMPER): (lambda: _shipped("absorber_concepts.yaml"), lambda scene, name: scene.settings.bumper_frequency),
+    CONCEPT_ROW.path: (lambda: _shipped("absorber_concepts.yaml"), lambda scene, name: _concept_value(scene.settings.concepts[0], name)),
+    CONCEPT_ABSORBER.path: (lambda: _shipped("absorber_concepts.yaml"), None),  # each key a number or den_hartog: its parser's
     _id(GRID_TOP): (lambda: _analytic("restitution.yaml"), lambda scene, name: getattr(scene.settings, name)),
     SWEEP.path: (lambda: _swept_scene(sweep={"restitution": [0.0, 0.5], "clearance": [0.002, 0.003]}), lambda scene, name: getattr(scene.settings, name)),
     _id(GRID_STOP): (lambda: _swept_scene(stop={"clearance": 0.003, "restitution": 0.2}), lambda scene, name: float(getattr(scene.settings, name)[0])),
@@ -134,16 +137,24 @@ NEEDED = {"sweep.restitution", "sweep.clearance", "stop.clearance", "stop.restit
 #: Keys that choose which form of their section is read (walked as each form).
 FORM_KEYS = {"validation.case"}
 #: A valid value, for the walk, of a key whose other values the declaration cannot tell (a name the layout makes).
-OTHER_VALUES = {"sweep.frequency": [20.0, 25.0], "design.objective": "force_amplitude", "validation.forcing_frequency": 2.75}  # the last: |1 / (1 - w^2)| stays above sigma's 0.14
+OTHER_VALUES = {"frequency": [20.0, 30.0], "sweep.frequency": [20.0, 25.0], "design.objective": "force_amplitude", "validation.forcing_frequency": 2.75}  # the last: |1 / (1 - w^2)| stays above sigma's 0.14
 #: Keys the walk gives beside a key that is read only with them (a reference needs bumpers).
 CONTEXT = {"sweep.bumper_loss_factor": {"restitution": None}, "benchmark.cases[k].clearance_below_linear": {"clearance": None}, "benchmark.cases[k].swept_sine": {"frequency": None, "start": None},
            "bifurcation.reference": {"bumper": {"frequency": [100.0]}}, "bumper.loss_factor": {"frequency": 250.0}, "bumper.damping": {"stiffness": 2.5e5}}
 #: A valid value, for the walk, of each key whose default the kind derives.
-DERIVED_VALUES = {"sweep.bumper_frequency": [100.0, 200.0], "sweep.bumper_loss_factor": [0.1, 0.2], "benchmark.cases[k].clearance_below_linear": 1e-5, "benchmark.cases[k].bumper_frequency": 500.0,
+DERIVED_VALUES = {"concepts[k].stops": [{"coordinate": "x2", "side": "upper", "clearance": 0.003, "restitution": 0.2}], "stop.bumper": {"frequency": 300.0}, "concepts[k].label": "another label", "sweep.bumper_frequency": [100.0, 200.0], "sweep.bumper_loss_factor": [0.1, 0.2], "benchmark.cases[k].clearance_below_linear": 1e-5, "benchmark.cases[k].bumper_frequency": 500.0,
                   "benchmark.cases[k].swept_sine": {"start": 20.0, "stop": 30.0, "rate": 10.0}, "cluster": {"scheduler": "tcp://head:8786"}, "bumper.frequency": 300.0, "bumper.loss_factor": 0.1, "bumper.stiffness": 2.5e5,
                   "bumper.damping": 10.0, "stops[k].bumper": {"frequency": 300.0}, "bifurcation.restitution": [0.5], "bifurcation.bumper": {"frequency": [100.0]},
                   "bifurcation.brute_force": {}, "bifurcation.continuation": {}, "bifurcation.chart": {}, "simulation.frequency": [20.0, 30.0], "simulation.rtol": 1e-6, "simulation.atol": 1e-9, "simulation.subset": {"momentary": {"frequency": [25.0]}},
                   "benchmark.ladder": LADDER_POINT, "benchmark.ladder.restitution": 0.5, "benchmark.ladder.clearance": 0.002}
+
+
+def _concept_value(concept: Any, name: str) -> Any:
+    """Where a concept row's key ``name`` lands in its :class:`~vibroimpact.kinds.concepts.scene.Concept` (stops as
+    the scene writes them)."""
+    if name == "stops":
+        return [{"coordinate": concept.system.coordinates[stop.coordinate], "side": stop.side, "clearance": stop.law.clearance, "restitution": stop.law.restitution} for stop in concept.stops]
+    return getattr(concept, name)
 
 
 def _design_value(settings: Any, name: str) -> Any:
@@ -191,7 +202,7 @@ def _same(found: Any, value: Any, key: Key) -> bool:
         return item
 
     if key.type is Rows:
-        value = [row["name"] for row in value]
+        value = [row["name"] if "name" in row else row for row in value]
     if isinstance(value, float) and not isinstance(found, bool) and isinstance(found, (int, float)):
         return math.isclose(found, value, rel_tol=1e-12)
     return plain(found) == plain(value)
@@ -217,21 +228,16 @@ def _scene(section: Section | str, values: dict[str, Any]) -> dict:
 def _required(section: Section) -> dict[str, Any]:
     """The values the section's shipped scene gives its required keys."""
     place = PLACES[_id(section)][0]()
-    for part in section.path.split(".") if section.path and section not in (STOP_ROW, CASE_ROW, CASE_SWEEP) else ():
-        place = place.get(part, {})
-    if section is STOP_ROW:
-        place = place["stops"][0]
-    if section in (CASE_ROW, CASE_SWEEP):
-        place = place["benchmark"]["cases"][0]
-        place = place["swept_sine"] if section is CASE_SWEEP else place
+    for part in section.path.split(".") if section.path else ():  # a list of rows (stops[k]): its first row
+        place = place[part[:-3]][0] if part.endswith("[k]") else place.get(part, {})
     given = {key.name: place[key.name] for key in section.keys if key.default is REQUIRED or section.where(key.name) in NEEDED}
     return given | ({name: value for name, value in place.items() if name not in section.names} if section.others else {})  # a spread, a limit
 
 
 def _other_value(key: Key, given: Any = None, section_path: str = "") -> Any:
     """A valid value of ``key`` other than its default (a required key's: other than ``given``, its scene's)."""
-    if f"{section_path}.{key.name}" in OTHER_VALUES:
-        return OTHER_VALUES[f"{section_path}.{key.name}"]
+    if (where := f"{section_path}.{key.name}" if section_path else key.name) in OTHER_VALUES:
+        return OTHER_VALUES[where]
     if key.default is REQUIRED and key.type is Band:
         return (given["start"], (given["start"] + given["stop"]) / 2.0)
     if key.default is REQUIRED and isinstance(given, dict):

@@ -59,7 +59,7 @@ from vibroimpact.scene.header import open_scene
 from vibroimpact.scene.layout_parse import parse_layout, static_drift
 from vibroimpact.scene.schema import SWEEP_DIRECTIONS, Scene
 
-__all__ = ["BIFURCATION_TOP_KEYS", "CHART_KINDS", "REFERENCES", "BIFURCATION", "BRUTE_FORCE", "CONTINUATION", "CHART", "SECTIONS", "BruteForceSettings", "BranchSettings", "ChartSettings", "BifurcationSettings", "coordinate_label", "parse_bifurcation_scene"]
+__all__ = ["BIFURCATION_TOP_KEYS", "CHART_KINDS", "REFERENCES", "BIFURCATION", "BRUTE_FORCE", "CONTINUATION", "CHART", "BIFURCATION_STOP", "SECTIONS", "BruteForceSettings", "BranchSettings", "ChartSettings", "BifurcationSettings", "coordinate_label", "parse_bifurcation_scene"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -122,8 +122,12 @@ BIFURCATION = Section("bifurcation", (
     Key("bumper", Table, "{frequency: [Hz, ...]} or {stiffness: [N/m, ...]}: Kelvin-Voigt bumpers' diagrams (default: the rigid stop's)", DERIVED),
     Key("reference", str, "rigid: the rigid stop's diagram beside the bumpers', as their reference", "none", choices=REFERENCES),
 ), "the diagrams: which band, which restitutions, which contact models")  # fmt: skip
+#: The paper's ``stop`` of a bifurcation scene, declared (R is the diagrams', bifurcation.restitution).
+BIFURCATION_STOP = Section("stop", (
+    Key("clearance", float, "Delta, the stop's gap above the absorber x2", REQUIRED, 0.0, math.inf, "m", open_low=True),
+), "the paper's stop above the absorber x2 (or 'stops': any layout)", form="bifurcation")  # fmt: skip
 #: The sections of a bifurcation scene that are declared (``run-study --keys`` lists them).
-SECTIONS = (BIFURCATION, BRUTE_FORCE, CONTINUATION, CHART)
+SECTIONS = (BIFURCATION_STOP, BIFURCATION, BRUTE_FORCE, CONTINUATION, CHART)
 
 
 @dataclass(frozen=True)
@@ -364,9 +368,8 @@ def _stops(c: Checker, doc: dict, layout: Layout | None, swept_restitution: bool
         return None, None, None
     specs = layout.stops if layout is not None else None
     if "stops" not in doc:
-        stop = c.mapping("stop", doc["stop"], {"clearance"}, {"clearance"})
-        clearance = c.number("stop.clearance", stop["clearance"], 0.0, math.inf, low_inclusive=False) if "clearance" in stop else None
-        return (), clearance, None
+        stop = BIFURCATION_STOP.read(c, doc["stop"], partial=True)
+        return ((), stop["clearance"], None) if stop is not None else (None, None, None)
     if specs is None:
         return None, None, None
     ok = True

@@ -41,11 +41,11 @@ from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem, System
 from vibroimpact.scene.layout_parse import parse_stops
-from vibroimpact.scene.declared import Key, Section
+from vibroimpact.scene.declared import DERIVED, REQUIRED, Free, Grid, Key, Rows, Section, Table
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.simulation.settings import SteadySettings
 
-__all__ = ["CONTINUATION", "SECTIONS", "Concept", "ConceptsSettings", "bumper_twin", "CONCEPTS_TOP_KEYS", "parse_concepts", "parse_concepts_scene", "MAX_CONCEPTS"]
+__all__ = ["CONTINUATION", "CONCEPTS_TOP", "CONCEPTS_BUMPER", "CONCEPT_ROW", "CONCEPT_ABSORBER", "SECTIONS", "Concept", "ConceptsSettings", "bumper_twin", "CONCEPTS_TOP_KEYS", "parse_concepts", "parse_concepts_scene", "MAX_CONCEPTS"]
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -109,8 +109,32 @@ CONTINUATION = Section("continuation", (
     Key("enabled", bool, "continue each concept's branches from its closed-form and simulated orbits", True),
     Key("max_steps", int, "points per continued branch and direction, at most (0: none)", 400, 0, 100_000),
 ), "the concepts' continued branches")  # fmt: skip
+#: A concepts scene's own top-level keys, declared (the header's and the layout's are declared with them).
+CONCEPTS_TOP = Section("", (
+    Key("frequency", Grid, "the closed forms' frequencies", REQUIRED, 0.0, math.inf, "Hz", open_low=True),
+    Key("concepts", Rows, "the concepts compared, {name, label, absorber, stops} each (concepts[k]); at most 12", REQUIRED),
+    Key("simulation", Table, "the time-domain steady states' settings (simulation; default: every 61st frequency)", DERIVED),
+    Key("bumper", Table, "{frequency: Hz}: each rigid stop's Kelvin-Voigt twin, its loss factor from R (default: none)", DERIVED),
+    Key("continuation", Table, "the concepts' continued branches (continuation)", DERIVED),
+), "a concepts scene's own keys", form="concepts")  # fmt: skip
+#: ``bumper`` of a concepts scene, declared.
+CONCEPTS_BUMPER = Section("bumper", (
+    Key("frequency", float, "Omega_b / 2 pi of each rigid stop's Kelvin-Voigt twin (same clearance, loss factor from R)", REQUIRED, 0.0, 1e6, "Hz", open_low=True),
+), "the bumper twins of the concepts' rigid stops", form="concepts")  # fmt: skip
+#: A row of ``concepts``, declared.
+CONCEPT_ROW = Section("concepts[k]", (
+    Key("name", str, "the concept's name, file-name safe (the dataset's concept coordinate)", REQUIRED),
+    Key("label", str, "what the page calls it (default: its name)", DERIVED),
+    Key("absorber", Table, "{stiffness, damping}: k2 and b2 replaced (concepts[k].absorber; default: the scene's)", DERIVED),
+    Key("stops", Rows, "rigid stops in the shared stops grammar, each with clearance > 0 and restitution > 0 (default: none, the linear absorber)", DERIVED),
+), "one absorber concept")  # fmt: skip
+#: ``concepts[k].absorber``, declared.
+CONCEPT_ABSORBER = Section("concepts[k].absorber", (
+    Key("stiffness", Free, "k2: a number > 0 [N m-1], or den_hartog (Den Hartog's tuning)", DERIVED),
+    Key("damping", Free, "b2: a number >= 0 [N s m-1], or den_hartog (Den Hartog's optimum damping)", DERIVED),
+), "the concept's absorber spring and damper")  # fmt: skip
 #: The sections of a concepts scene that are declared (``run-study --keys`` lists them).
-SECTIONS = (CONTINUATION,)
+SECTIONS = (CONCEPTS_TOP, CONCEPTS_BUMPER, CONTINUATION, CONCEPT_ROW, CONCEPT_ABSORBER)
 
 
 @dataclass(frozen=True, eq=False)
@@ -155,8 +179,7 @@ class ConceptsSettings:
         return self.amplitude / self.system.k1
 
 #: Top-level keys of a concepts scene.
-CONCEPTS_TOP_KEYS = {"name", "description", "system", "excitation", "frequency", "simulation", "bumper", "continuation", "concepts", "report"}
-_CONCEPT_KEYS = {"name", "label", "absorber", "stops"}
+CONCEPTS_TOP_KEYS = {*CONCEPTS_TOP.names, "system", "excitation"}
 _SIMULATION_KEYS = frozenset({"frequency", "rtol", "atol", "tolerance", "max_periods", "measure_periods", "irregular_measure_periods"})
 #: Simulation keys of other kinds that a concepts scene does not use: refused with the reason, never ignored.
 _UNUSED_SIMULATION_KEYS = {
@@ -172,21 +195,19 @@ MAX_SIMULATION_POINTS = 2000
 def parse_concepts(document: Any, source: str = "scene") -> tuple[str, str, bool, ConceptsSettings, str | None]:
     """Check a concepts scene's document and return (name, description, report, settings, the cluster's scheduler);
     :class:`SceneError` listing every problem otherwise."""
-    c, doc, name, description, report, scheduler = open_scene(document, CONCEPTS_TOP_KEYS, {"name", "system", "excitation", "frequency", "concepts"}, "concepts")
+    c, doc, name, description, report, scheduler = open_scene(document, CONCEPTS_TOP_KEYS, {"name", "system", "excitation"}, "concepts")
     layout, amplitude, _ = parse_layout(c, doc)
     system = layout.paper_view() if layout is not None else None  # the absorber concepts are variants of the paper's layout
     if layout is not None and system is None:
         c.fail("system", "a concepts scene needs the paper's layout: the two-mass chain (a primary mass on its suspension, an absorber on the primary) as {m1, m2, k1, k2, b1, b2} or its matrices with coordinates [x1, x2], the force on x1")
-    frequency = c.grid("frequency", doc["frequency"], 0.0, math.inf, False) if "frequency" in doc else None
+    own = CONCEPTS_TOP.read(c, {key: doc[key] for key in CONCEPTS_TOP.names if key in doc}, partial=True) or {}  # frequency, concepts required
+    frequency = own.get("frequency")
     simulation = _simulation(c, doc.get("simulation", {}), frequency)
-    bumper_frequency = math.nan
-    if "bumper" in doc:
-        bumper = c.mapping("bumper", doc["bumper"], {"frequency"}, {"frequency"})
-        if "frequency" in bumper:
-            bumper_frequency = c.number("bumper.frequency", bumper["frequency"], 0.0, 1e6, low_inclusive=False) or math.nan
+    bumper = CONCEPTS_BUMPER.read(c, doc["bumper"]) if "bumper" in doc else None
+    bumper_frequency = bumper["frequency"] if bumper is not None else math.nan
     continuation = CONTINUATION.read(c, doc.get("continuation", {})) or {}
     steps = continuation.get("max_steps", 0) if continuation.get("enabled") else 0
-    concepts = _concepts(c, doc["concepts"], system) if "concepts" in doc and system is not None else ()
+    concepts = _concepts(c, own["concepts"], system) if own.get("concepts") is not None and system is not None else ()
     if c.problems:
         raise SceneError(c.problems, source)
     assert isinstance(name, str) and system is not None and amplitude is not None and frequency is not None and simulation is not None
@@ -223,36 +244,35 @@ def _simulation(c: Checker, value: Any, frequency: np.ndarray | None) -> tuple[n
 
 
 def _concepts(c: Checker, value: Any, system: System) -> tuple[Concept, ...]:
-    if not isinstance(value, list) or not value:
-        c.fail("concepts", f"expected a non-empty list of concepts ({{name, label, absorber, stops}}), got {value!r}")
-        return ()
     if len(value) > MAX_CONCEPTS:
         c.fail("concepts", f"{len(value)} concepts is too many: allowed at most {MAX_CONCEPTS}")
         return ()
     concepts: list[Concept] = []
     for i, entry in enumerate(value):
         key = f"concepts[{i}]"
-        spec = c.mapping(key, entry, _CONCEPT_KEYS, {"name"})
-        name = spec.get("name")
-        if "name" in spec and not (isinstance(name, str) and NAME.match(name)):
+        spec = CONCEPT_ROW.at(key).read(c, entry)
+        if spec is None:
+            continue
+        name = spec["name"]
+        if not NAME.match(name):
             c.fail(f"{key}.name", f"expected a file-name-safe string (letters, digits, '_', '-', '.'), got {name!r}")
             continue
         if name in [concept.name for concept in concepts]:
             c.fail(f"{key}.name", f"{name!r} is used twice: names must be unique")
             continue
-        label = spec.get("label", name)
-        if not isinstance(label, str):
-            c.fail(f"{key}.label", f"expected a string, got {label!r}")
-            continue
-        built = _absorber(c, f"{key}.absorber", spec.get("absorber", {}), system)
-        stops = _stops(c, f"{key}.stops", spec["stops"], system.coordinates) if "stops" in spec else ()
+        label = spec["label"] if spec["label"] is not None else name
+        built = _absorber(c, f"{key}.absorber", spec["absorber"] if spec["absorber"] is not None else {}, system)
+        stops = _stops(c, f"{key}.stops", spec["stops"], system.coordinates) if spec["stops"] is not None else ()
         if built is not None and stops is not None and isinstance(name, str):
             concepts.append(Concept(name, label, built[0], stops, built[1]))
     return tuple(concepts)
 
 
 def _absorber(c: Checker, key: str, value: Any, system: System) -> tuple[System, str] | None:
-    spec = c.mapping(key, value, {"stiffness", "damping"})
+    spec = CONCEPT_ABSORBER.at(key).read(c, value)
+    if spec is None:
+        return None
+    spec = {part: item for part, item in spec.items() if item is not None}
     optimum = den_hartog_absorber(system.m1, system.k1, system.m2)
     chosen = {"stiffness": system.k2, "damping": system.b2}
     words = {"stiffness": f"k2 = {system.k2:g} N/m", "damping": f"b2 = {system.b2:g} N s/m"}

@@ -50,7 +50,7 @@ from vibroimpact.scene.header import open_scene
 from vibroimpact.scene.layout_parse import parse_layout
 from vibroimpact.scene.schema import Scene
 
-__all__ = ["DESIGN_TOP_KEYS", "DESIGN", "ROBUST", "CONSTRAINTS", "OPERATING", "SEARCH", "CERTIFY", "SECTIONS", "STOP_VARIABLES", "BUMPER_VARIABLE", "METHODS", "COMPARISONS", "Variable", "Mistuning", "SearchSettings", "DesignSettings", "parse_design_scene", "safe_name"]
+__all__ = ["DESIGN_TOP_KEYS", "DESIGN_STOP", "DESIGN", "ROBUST", "CONSTRAINTS", "OPERATING", "SEARCH", "CERTIFY", "SECTIONS", "STOP_VARIABLES", "BUMPER_VARIABLE", "METHODS", "COMPARISONS", "Variable", "Mistuning", "SearchSettings", "DesignSettings", "parse_design_scene", "safe_name"]
 
 #: Top-level keys of a design scene.
 DESIGN_TOP_KEYS = {"name", "description", "system", "excitation", "stop", "stops", "design", "report", "cluster"}
@@ -105,8 +105,14 @@ SEARCH = Section("design.search", (
 CERTIFY = Section("design.certify", (
     Key("candidates", int, "the best candidates certified by continuation, brute force and the tolerance box's corners", 1, 0, 20),
 ), "which candidates are certified")  # fmt: skip
+#: The paper's ``stop`` of a design scene, declared: the design's starting values (a variable moves them).
+DESIGN_STOP = Section("stop", (
+    Key("clearance", float, "Delta, the stop's gap above the absorber x2", REQUIRED, 0.0, math.inf, "m", open_low=True),
+    Key("restitution", float, "R of each impact (above 0 with a bumper)", REQUIRED, 0.0, 1.0),
+    Key("bumper", Table, "{frequency: Hz} or {stiffness: N/m}: a Kelvin-Voigt bumper whose loss factor follows R (default: a rigid stop)", DERIVED),
+), "the paper's stop above the absorber x2 (or 'stops': one, or a symmetric pair)", form="design")  # fmt: skip
 #: The sections of a design scene that are declared (``run-study --keys`` lists them).
-SECTIONS = (DESIGN, CONSTRAINTS, OPERATING, ROBUST, SEARCH, CERTIFY)
+SECTIONS = (DESIGN_STOP, DESIGN, CONSTRAINTS, OPERATING, ROBUST, SEARCH, CERTIFY)
 #: Most evaluations of one scene's search (candidates x mistuning samples).
 MAX_EVALUATIONS = 2_000_000
 
@@ -298,10 +304,11 @@ def _stop_values(c: Checker, doc: dict, layout: Layout | None) -> tuple[float | 
         c.fail("stop", "required: the paper's stop {clearance: Delta [m], restitution: R} above the absorber x2, or 'stops' (one, or a symmetric pair)")
         return None, None, None
     if "stops" not in doc:
-        stop = c.mapping("stop", doc["stop"], {"clearance", "restitution", "bumper"}, {"clearance", "restitution"})
-        clearance = c.number("stop.clearance", stop["clearance"], 0.0, math.inf, low_inclusive=False) if "clearance" in stop else None
-        restitution = c.number("stop.restitution", stop["restitution"], 0.0, 1.0) if "restitution" in stop else None
-        bumper = _bumper(c, "stop.bumper", stop["bumper"], layout) if "bumper" in stop else None
+        stop = DESIGN_STOP.read(c, doc["stop"], partial=True)
+        if stop is None:
+            return None, None, None
+        clearance, restitution = stop["clearance"], stop["restitution"]
+        bumper = _bumper(c, "stop.bumper", stop["bumper"], layout) if stop["bumper"] is not None else None
         if bumper is not None and restitution is not None and restitution <= 0.0:
             c.fail("stop.restitution", "0 with a bumper: a bumper's restitution must be above 0 (R = 0 needs an infinite loss factor): allowed (0, 1]")
         return clearance, restitution, bumper
