@@ -21,7 +21,7 @@ from vibroimpact.kinds.concepts.scene import CONCEPT_ABSORBER, CONCEPT_ROW, CONC
 from vibroimpact.kinds.validation.settings import CASE_SECTIONS
 from vibroimpact.kinds.design.scene import DESIGN_STOP, CERTIFY, CONSTRAINTS, DESIGN, OPERATING, ROBUST, SEARCH, SearchSettings
 from vibroimpact.scene.checker import Checker, SceneError
-from vibroimpact.scene.declared import DERIVED, REQUIRED, Band, Free, Grid, Key, Names, Rows, Section, Table
+from vibroimpact.scene.declared import DERIVED, OPTIONAL, REQUIRED, Band, Free, Grid, Key, Names, Rows, Section, Table
 from vibroimpact.scene.grid import ADMISSIBILITY, GRID_SETTINGS, GRID_STOP, GRID_TOP, SWEEP, SWEPT_SINE
 from vibroimpact.scene.bumper_parse import BUMPER
 from vibroimpact.scene.header import CLUSTER, HEADER, declared_sections
@@ -244,9 +244,9 @@ def _other_value(key: Key, given: Any = None, section_path: str = "") -> Any:
         return dict(list(given.items())[:1])
     if key.type is str and key.choices and given is not None:
         return next(choice for choice in key.choices if choice != given)
-    if key.default is REQUIRED or key.default is DERIVED and given is not None:
+    if key.default is REQUIRED or (key.default is DERIVED or key.default is OPTIONAL) and given is not None:
         return given[:1] if isinstance(given, list) else given + "2" if isinstance(given, str) else given * 1.01
-    if key.default is DERIVED:
+    if key.default is DERIVED or key.default is OPTIONAL:
         return DERIVED_VALUES[f"{section_path}.{key.name}" if section_path else key.name]
     if key.type is bool:
         return not key.default
@@ -407,6 +407,10 @@ def test_a_declaration_is_checked_when_it_is_made() -> None:
         Section("s", (Key("a", int, "a", 1), Key("a", int, "a", 2)), "twice")
     with pytest.raises(ValueError, match="not one of its choices"):
         Section("s", (Key("method", str, "m", "x", choices=("x", "y")), Key("n", int, "n", 1, read_when=("method", "z"))), "bad")
+    with pytest.raises(TypeError, match="is OPTIONAL"):  # a mapping left out is no value derived from others
+        Key("robust", Table, "the mistuning", DERIVED)
+    with pytest.raises(TypeError, match="is DERIVED"):
+        Key("rtol", float, "the tolerance", OPTIONAL)
 
 
 def test_a_required_key_is_named_with_what_it_takes_and_a_section_must_be_a_mapping() -> None:
@@ -424,6 +428,9 @@ def test_the_reference_lists_each_key_with_its_range_default_and_meaning() -> No
     assert len(rows) == len(SEARCH.keys)
     assert "| `design.search.population` | integer in [4, 100] | 8 | members of each generation per design variable (read with method: differential_evolution) |" in rows
     assert any(row.startswith("| `design.search.polish` | boolean (true or false) | true |") for row in rows)
+    design = DESIGN.reference()  # a section left out is optional; a value the kind works out is derived
+    assert any(row.startswith("| `design.robust` | mapping | optional |") for row in design)
+    assert any(row.startswith("| `simulation.rtol` | number in [1e-15, 0.1] | derived |") for row in SIMULATION.reference())
 
 
 #: A shipped scene of each kind.

@@ -21,7 +21,7 @@ from typing import Any
 
 from vibroimpact.scene.checker import Checker, did_you_mean, interval
 
-__all__ = ["Key", "Section", "REQUIRED", "DERIVED", "Names", "Band", "Grid", "Table", "Rows", "Free", "reference_table"]
+__all__ = ["Key", "Section", "REQUIRED", "DERIVED", "OPTIONAL", "Names", "Band", "Grid", "Table", "Rows", "Free", "reference_table"]
 
 
 class _Required:
@@ -44,6 +44,18 @@ class _Derived:
 
 #: The default of a key whose value the kind derives where the scene does not give it (read as None).
 DERIVED: Any = _Derived()
+
+
+class _Optional:
+    """The default of a mapping or a list the scene may leave out: its own keys' defaults then hold, or the study goes
+    without it (a bumper, a cluster, a concept's stops)."""
+
+    def __repr__(self) -> str:
+        return "OPTIONAL"
+
+
+#: The default of a mapping or a list the scene may leave out (read as None; its doc says what holds without it).
+OPTIONAL: Any = _Optional()
 
 class Names:
     """The type of a key whose value is a non-empty list of names from its choices, none repeated (read as a tuple)."""
@@ -95,7 +107,8 @@ class Key:
         One line: what the key sets.
     default : object
         Its value where the scene does not give it; :data:`REQUIRED`: the scene must; :data:`DERIVED`: the kind
-        derives it from other keys, or (a mapping) the section is then absent and its own defaults hold.
+        derives it from other keys; :data:`OPTIONAL` (a mapping or a list): absent, its own keys' defaults hold or
+        the study goes without it.
     low, high : float
         The allowed range, both ends included unless ``open_low`` (numbers, bands and grids; +-inf: unbounded, open).
     unit : str
@@ -129,7 +142,11 @@ class Key:
             raise TypeError(f"Key {self.name!r}: a Names key lists its choices")
         if (self.open_low or self.open_high) and self.type not in (float, Band, Grid):
             raise TypeError(f"Key {self.name!r}: an open end is for numbers, bands and grids (a count's range is whole numbers)")
-        if self.default is not REQUIRED and self.default is not DERIVED and self.check(Checker(), self.name, self.as_written(self.default)) is None:
+        if self.default is OPTIONAL and self.type not in (Table, Rows, Free):
+            raise TypeError(f"Key {self.name!r}: OPTIONAL is the default of a mapping or a list; a value the kind derives is DERIVED")
+        if self.default is DERIVED and self.type in (Table, Rows):
+            raise TypeError(f"Key {self.name!r}: a mapping or a list the scene may leave out is OPTIONAL")
+        if not any(self.default is marker for marker in (REQUIRED, DERIVED, OPTIONAL)) and self.check(Checker(), self.name, self.as_written(self.default)) is None:
             raise ValueError(f"Key {self.name!r}: its default {self.default!r} fails its own check")
 
     def allowed(self) -> str:
@@ -289,7 +306,7 @@ class Section:
             elif key.default is REQUIRED:
                 c.fail(where, f"required key is missing ({key.doc}; {key.allowed()})")
                 read[key.name] = None
-            elif key.default is DERIVED:
+            elif key.default is DERIVED or key.default is OPTIONAL:
                 read[key.name] = None
             else:
                 read[key.name] = key.default
@@ -315,7 +332,7 @@ class Section:
         """The section's rows of the grammar reference: ``| key | allowed | default | what it sets |`` (markdown)."""
         rows = []
         for key in self.keys:
-            default = "required" if key.default is REQUIRED else "derived" if key.default is DERIVED else _written(key.as_written(key.default))
+            default = {id(REQUIRED): "required", id(DERIVED): "derived", id(OPTIONAL): "optional"}.get(id(key.default)) or _written(key.as_written(key.default))
             when = f" (read with {key.read_when[0]}: {key.read_when[1]})" if key.read_when else ""
             rows.append(f"| `{self.where(key.name)}` | {key.allowed()} | {default} | {key.doc}{when} |")
         if self.others:

@@ -27,7 +27,7 @@ from vibroimpact.model.excitation import SweptSine
 from vibroimpact.model.modal import underdamped_mode_count
 from vibroimpact.scene.bumper_parse import BUMPER as BUMPER_SECTION, PHYSICAL_KEYS, scene_bumper
 from vibroimpact.scene.checker import Checker, SceneError, interval
-from vibroimpact.scene.declared import DERIVED, REQUIRED, Free, Grid, Key, Names, Section, Table
+from vibroimpact.scene.declared import DERIVED, OPTIONAL, REQUIRED, Free, Grid, Key, Names, Section, Table
 from vibroimpact.scene.header import check_sweep_run, open_scene
 from vibroimpact.scene.layout_parse import check_layout_solutions, parse_layout, parse_sweep_stops
 from vibroimpact.scene.stop_grids import stop_grids
@@ -68,21 +68,21 @@ def _fixed(name: str) -> Key:
 GRID_TOP = Section("", (
     Key("sweep", Table, "the grids swept: frequency, and any of restitution, clearance, bumper_frequency, bumper_loss_factor (sweep)", REQUIRED),
     Key("solutions", Names, "what is computed at every point: closed forms (linear, pgf, pgf_paper) and engines", REQUIRED, choices=SOLUTIONS),
-    Key("quantities", Free, "a list of output names from the layout's (x1_amplitude ... for the paper's coordinates; default: every one)", DERIVED),
-    Key("stop", Table, "{clearance, restitution}: the paper's stop above the absorber x2 (or 'stops': any layout)", DERIVED),
-    Key("settings", Table, "{admissibility: ...}: the closed forms' settings (settings.admissibility)", DERIVED),
-    Key("simulation", Table, "the time-domain solutions' settings (simulation)", DERIVED),
-    Key("swept_sine", Table, "a swept-sine test instead of stepped steady states (swept_sine)", DERIVED),
+    Key("quantities", Free, "a list of output names from the layout's (x1_amplitude ... for the paper's coordinates; default: every one)", OPTIONAL),
+    Key("stop", Table, "{clearance, restitution}: the paper's stop above the absorber x2 (or 'stops': any layout)", OPTIONAL),
+    Key("settings", Table, "{admissibility: ...}: the closed forms' settings (settings.admissibility)", OPTIONAL),
+    Key("simulation", Table, "the time-domain solutions' settings (simulation)", OPTIONAL),
+    Key("swept_sine", Table, "a swept-sine test instead of stepped steady states (swept_sine)", OPTIONAL),
 ), "a stepped or swept scene's own keys", form="stepped and swept")  # fmt: skip
 #: ``sweep``, declared: the grids, and which stops they move.
 SWEEP = Section("sweep", (
     *(_swept(name, REQUIRED if name == "frequency" else DERIVED) for name in SWEEPABLE),
-    Key("stop", Free, "which stops the swept restitution, clearance and bumper apply to: an index of 'stops' or a list of them (default: every stop)", DERIVED),
+    Key("stop", Free, "which stops the swept restitution, clearance and bumper apply to: an index of 'stops' or a list of them (default: every stop)", OPTIONAL),
 ), "the grids the study runs over (every combination)")  # fmt: skip
 #: The paper's ``stop`` of a grid scene, declared.
 GRID_STOP = Section("stop", (_fixed("clearance"), _fixed("restitution")), "the paper's stop above the absorber x2", form="stepped and swept")
 #: ``settings``, declared.
-GRID_SETTINGS = Section("settings", (Key("admissibility", Table, "how the closed form's X2(t) <= Delta is checked (settings.admissibility)", DERIVED),),
+GRID_SETTINGS = Section("settings", (Key("admissibility", Table, "how the closed form's X2(t) <= Delta is checked (settings.admissibility)", OPTIONAL),),
                         "the closed forms' settings")  # fmt: skip
 #: Top-level keys of a grid scene.
 TOP_KEYS = {*GRID_TOP.names, "system", "excitation", "stops", "bumper"}

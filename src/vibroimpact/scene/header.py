@@ -12,7 +12,7 @@ from typing import Any
 
 from vibroimpact.scene.checker import Checker
 from vibroimpact.scene.kinds import KINDS
-from vibroimpact.scene.declared import DERIVED, REQUIRED, Key, Section, Table
+from vibroimpact.scene.declared import OPTIONAL, REQUIRED, Key, Section, Table
 from vibroimpact.scene.schema import MAX_SWEEP_SAMPLES
 
 __all__ = ["NAME", "MAX_NAME_LENGTH", "HEADER", "CLUSTER", "HEADER_KEYS", "declared_sections", "open_scene", "parse_names", "parse_cluster", "check_sweep_run"]
@@ -28,7 +28,7 @@ HEADER = Section("", (
     Key("name", str, f"the study's name: its output folder and files (letters, digits, '_', '-', '.'; at most {MAX_NAME_LENGTH})", REQUIRED),
     Key("description", str, "one line the page and the dataset carry (no number depends on it)", ""),
     Key("report", bool, "whether run-study writes the HTML page beside the dataset", True),
-    Key("cluster", Table, "{scheduler: tcp://host:8786}: a running dask scheduler to run on (default: a local cluster)", DERIVED),
+    Key("cluster", Table, "{scheduler: tcp://host:8786}: a running dask scheduler to run on (default: a local cluster)", OPTIONAL),
 ), "what every scene has, whatever its kind")  # fmt: skip
 #: ``cluster``, declared.
 CLUSTER = Section("cluster", (

@@ -34,7 +34,7 @@ from vibroimpact.model.structure import LinearStructure, stiffness_modes
 from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.scene.bumper_parse import BUMPER, BumperSpec, parse_bumper
 from vibroimpact.scene.checker import Checker
-from vibroimpact.scene.declared import DERIVED, REQUIRED, Free, Key, Section, Table
+from vibroimpact.scene.declared import DERIVED, OPTIONAL, REQUIRED, Free, Key, Section, Table
 from vibroimpact.model.layout import PAPER_STOP, Layout, LoadSpec, StopSpec, build_stops
 
 __all__ = ["NAMED_SYSTEM", "MATRIX_SYSTEM", "EXCITATION", "STOP_ROW", "LAYOUT_SECTIONS", "NAMED_SYSTEM_KEYS", "MATRIX_SYSTEM_KEYS", "EXCITATION_KEYS", "STOP_KEYS", "LayoutSection", "parse_layout", "parse_structure", "parse_load", "parse_stops", "parse_sweep_stops", "parse_stop_layout", "document_names", "check_layout_solutions", "pgf_refusal", "static_drift"]
@@ -52,24 +52,24 @@ NAMED_SYSTEM = Section("system", (
 MATRIX_SYSTEM = Section("system", (
     Key("mass", Free, "M: a list of N rows of N numbers", REQUIRED, unit="kg"),
     Key("stiffness", Free, "K: a list of N rows of N numbers", REQUIRED, unit="N m-1"),
-    Key("damping", Free, "B: a list of N rows of N numbers (derived: none)", DERIVED, unit="N s m-1"),
-    Key("coordinates", Free, "a name per row: [x1, x2, ...] (derived: x1 ... xN)", DERIVED),
+    Key("damping", Free, "B: a list of N rows of N numbers (derived: none)", OPTIONAL, unit="N s m-1"),
+    Key("coordinates", Free, "a name per row: [x1, x2, ...] (derived: x1 ... xN)", OPTIONAL),
 ), "any linear structure of N degrees of freedom", form="matrices")  # fmt: skip
 #: ``excitation``, declared.
 EXCITATION = Section("excitation", (
     Key("amplitude", float, "q, the harmonic force's amplitude (a base motion: the base's displacement, m)", REQUIRED, 0.0, math.inf, "N", open_low=True),
-    Key("on", Free, "where the force acts: a coordinate's name, or a weight per coordinate (derived: the first coordinate)", DERIVED),
-    Key("static", Free, "a constant force per coordinate [N] (derived: none)", DERIVED),
+    Key("on", Free, "where the force acts: a coordinate's name, or a weight per coordinate (derived: the first coordinate)", OPTIONAL),
+    Key("static", Free, "a constant force per coordinate [N] (derived: none)", OPTIONAL),
     Key("base_motion", bool, "the base moves by amplitude [m] and loads every coordinate through its mass", False),
 ), "the load: q cos(w t) on a coordinate, weighted, or a base motion")  # fmt: skip
 #: One entry of ``stops``, declared: where it acts and the values it gives (the others come from the sweep).
 STOP_ROW = Section("stops[k]", (
-    Key("coordinate", Free, "the coordinate's name, for a stop against the base (or between)", DERIVED),
-    Key("between", Free, "[a, b]: two coordinates' names, for a stop on the gap a - b (or coordinate)", DERIVED),
+    Key("coordinate", Free, "the coordinate's name, for a stop against the base (or between)", OPTIONAL),
+    Key("between", Free, "[a, b]: two coordinates' names, for a stop on the gap a - b (or coordinate)", OPTIONAL),
     Key("side", str, "upper: x <= Delta, lower: x >= -Delta", "upper", choices=tuple(SIDES)),
     Key("clearance", float, "Delta (negative: a preload; derived: the scene's or the sweep's)", DERIVED, unit="m"),
     Key("restitution", float, "R (derived: the scene's or the sweep's)", DERIVED, 0.0, 1.0),
-    Key("bumper", Table, "a Kelvin-Voigt bumper on this stop (bumper)", DERIVED),
+    Key("bumper", Table, "a Kelvin-Voigt bumper on this stop (bumper)", OPTIONAL),
 ), "one stop of any layout: where it acts, and its own values")  # fmt: skip
 #: The layout's declared sections (``run-study --keys`` lists them after the header's).
 LAYOUT_SECTIONS = (NAMED_SYSTEM, MATRIX_SYSTEM, EXCITATION, STOP_ROW, BUMPER)

@@ -15,7 +15,7 @@ import numpy as np
 
 from vibroimpact.engines.settings import STEPPED_TOLERANCES, SWEPT_TOLERANCES, EngineSettings
 from vibroimpact.scene.checker import Checker
-from vibroimpact.scene.declared import DERIVED, Grid, Key, Section, Table
+from vibroimpact.scene.declared import DERIVED, OPTIONAL, Grid, Key, Section, Table
 from vibroimpact.scene.schema import SIMULATION_STARTS
 from vibroimpact.scene.subset import Subset, parse_subset
 from vibroimpact.simulation.settings import SteadySettings
@@ -38,7 +38,7 @@ SIMULATION = Section("simulation", (
     Key("measure_periods", int, "periods measured on a periodic steady state", _STEADY.measure_periods, 1, 1_000_000),
     Key("irregular_measure_periods", int, "periods measured on a motion that does not repeat", _STEADY.irregular_measure_periods, 1, 1_000_000),
     Key("lyapunov_periods", int, "periods of the Lyapunov run (0: none)", _STEADY.lyapunov_periods, 0, 10_000_000),
-    Key("subset", Table, "{solution: {axis: [values]}}: a solution on part of the grid only", DERIVED),
+    Key("subset", Table, "{solution: {axis: [values]}}: a solution on part of the grid only", OPTIONAL),
 ), "how the time-domain solutions are run")  # fmt: skip
 #: Every key of a ``simulation`` section (a kind reads some of them).
 SIMULATION_KEYS = frozenset(SIMULATION.names)

@@ -37,7 +37,7 @@ from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.contact import Stop
 from vibroimpact.model.parameters import MAX_BUMPER_FREQUENCY
 from vibroimpact.scene.checker import Checker, SceneError
-from vibroimpact.scene.declared import DERIVED, REQUIRED, Grid, Key, Names, Rows, Section, Table
+from vibroimpact.scene.declared import DERIVED, OPTIONAL, REQUIRED, Grid, Key, Names, Rows, Section, Table
 from vibroimpact.scene.header import NAME, check_sweep_run, open_scene
 from vibroimpact.scene.layout_parse import parse_layout
 from vibroimpact.scene.schema import (
@@ -60,7 +60,7 @@ BENCHMARK = Section("benchmark", (
     Key("repeats", int, "runs per point (their median wall time)", 3, 1, 100),
     Key("max_seconds", float, "a method's tighter tolerances are skipped once one of its runs took longer", 60.0, 0.0, 1e5, "s", open_low=True),
     Key("cases", Rows, "{name, frequency, restitution, clearance | clearance_below_linear, start[, bumper_frequency] | swept_sine} each", REQUIRED),
-    Key("ladder", Table, "{frequency, bumper_frequencies[, restitution, clearance, rtol, repeats]}: one point through every model", DERIVED),
+    Key("ladder", Table, "{frequency, bumper_frequencies[, restitution, clearance, rtol, repeats]}: one point through every model", OPTIONAL),
 ), "what to time, against the exact references")  # fmt: skip
 #: ``benchmark.ladder``, declared: restitution and clearance go to the stops that give none (required where one does).
 LADDER = Section("benchmark.ladder", (
@@ -82,7 +82,7 @@ CASE_ROW = Section("benchmark.cases[k]", (
     Key("start", str, "where each run starts (required for a stepped case; a swept case starts at rest)", DERIVED, choices=tuple(START_MODES)),
     Key("bumper_frequency", float, "Omega_b / 2 pi of the compliant methods' bumpers (derived: none, no compliant method)", DERIVED, 0.0, MAX_BUMPER_FREQUENCY,
         "Hz", open_low=True),
-    Key("swept_sine", Table, "{start, stop, rate[, sample_rate]}: a swept case instead (benchmark.cases[k].swept_sine)", DERIVED),
+    Key("swept_sine", Table, "{start, stop, rate[, sample_rate]}: a swept case instead (benchmark.cases[k].swept_sine)", OPTIONAL),
 ), "one benchmark run: the problem, where it starts and how long it lasts")  # fmt: skip
 #: A swept case's sweep, declared.
 CASE_SWEEP = Section("benchmark.cases[k].swept_sine", (

@@ -52,7 +52,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from vibroimpact.scene.checker import Checker, SceneError
-from vibroimpact.scene.declared import DERIVED, REQUIRED, Band, Grid, Key, Names, Section, Table
+from vibroimpact.scene.declared import DERIVED, OPTIONAL, REQUIRED, Band, Grid, Key, Names, Section, Table
 from vibroimpact.model.contact import place_effective_mass
 from vibroimpact.model.layout import Layout, StopSpec
 from vibroimpact.scene.header import open_scene
@@ -116,10 +116,10 @@ CHART = Section("bifurcation.chart", (
 BIFURCATION = Section("bifurcation", (
     Key("frequency", Band, "the band the diagrams span", REQUIRED, 0.0, math.inf, "Hz", open_low=True),
     Key("restitution", Grid, "R of each diagram, the same for every stop (derived: the stops' own)", DERIVED, 0.0, 1.0),
-    Key("brute_force", Table, "stepped sweeps of the time simulation (bifurcation.brute_force)", DERIVED),
-    Key("continuation", Table, "which branches are continued (bifurcation.continuation)", DERIVED),
-    Key("chart", Table, "the two-parameter chart, frequency x clearance (bifurcation.chart); rigid stops only", DERIVED),
-    Key("bumper", Table, "{frequency: [Hz, ...]} or {stiffness: [N/m, ...]}: Kelvin-Voigt bumpers' diagrams (default: the rigid stop's)", DERIVED),
+    Key("brute_force", Table, "stepped sweeps of the time simulation (bifurcation.brute_force)", OPTIONAL),
+    Key("continuation", Table, "which branches are continued (bifurcation.continuation)", OPTIONAL),
+    Key("chart", Table, "the two-parameter chart, frequency x clearance (bifurcation.chart); rigid stops only", OPTIONAL),
+    Key("bumper", Table, "{frequency: [Hz, ...]} or {stiffness: [N/m, ...]}: Kelvin-Voigt bumpers' diagrams (default: the rigid stop's)", OPTIONAL),
     Key("reference", str, "rigid: the rigid stop's diagram beside the bumpers', as their reference", "none", choices=REFERENCES),
 ), "the diagrams: which band, which restitutions, which contact models")  # fmt: skip
 #: The paper's ``stop`` of a bifurcation scene, declared (R is the diagrams', bifurcation.restitution).

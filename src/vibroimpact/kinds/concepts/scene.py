@@ -41,7 +41,7 @@ from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
 from vibroimpact.model.problem import ImpactProblem, System
 from vibroimpact.scene.layout_parse import parse_stops
-from vibroimpact.scene.declared import DERIVED, REQUIRED, Free, Grid, Key, Rows, Section, Table
+from vibroimpact.scene.declared import DERIVED, OPTIONAL, REQUIRED, Free, Grid, Key, Rows, Section, Table
 from vibroimpact.scene.checker import Checker, SceneError
 from vibroimpact.simulation.settings import SteadySettings
 
@@ -113,9 +113,9 @@ CONTINUATION = Section("continuation", (
 CONCEPTS_TOP = Section("", (
     Key("frequency", Grid, "the closed forms' frequencies", REQUIRED, 0.0, math.inf, "Hz", open_low=True),
     Key("concepts", Rows, "the concepts compared, {name, label, absorber, stops} each (concepts[k]); at most 12", REQUIRED),
-    Key("simulation", Table, "the time-domain steady states' settings (simulation; default: every 61st frequency)", DERIVED),
-    Key("bumper", Table, "{frequency: Hz}: each rigid stop's Kelvin-Voigt twin, its loss factor from R (default: none)", DERIVED),
-    Key("continuation", Table, "the concepts' continued branches (continuation)", DERIVED),
+    Key("simulation", Table, "the time-domain steady states' settings (simulation; default: every 61st frequency)", OPTIONAL),
+    Key("bumper", Table, "{frequency: Hz}: each rigid stop's Kelvin-Voigt twin, its loss factor from R (default: none)", OPTIONAL),
+    Key("continuation", Table, "the concepts' continued branches (continuation)", OPTIONAL),
 ), "a concepts scene's own keys", form="concepts")  # fmt: skip
 #: ``bumper`` of a concepts scene, declared.
 CONCEPTS_BUMPER = Section("bumper", (
@@ -125,13 +125,13 @@ CONCEPTS_BUMPER = Section("bumper", (
 CONCEPT_ROW = Section("concepts[k]", (
     Key("name", str, "the concept's name, file-name safe (the dataset's concept coordinate)", REQUIRED),
     Key("label", str, "what the page calls it (default: its name)", DERIVED),
-    Key("absorber", Table, "{stiffness, damping}: k2 and b2 replaced (concepts[k].absorber; default: the scene's)", DERIVED),
-    Key("stops", Rows, "rigid stops in the shared stops grammar, each with clearance > 0 and restitution > 0 (default: none, the linear absorber)", DERIVED),
+    Key("absorber", Table, "{stiffness, damping}: k2 and b2 replaced (concepts[k].absorber; default: the scene's)", OPTIONAL),
+    Key("stops", Rows, "rigid stops in the shared stops grammar, each with clearance > 0 and restitution > 0 (default: none, the linear absorber)", OPTIONAL),
 ), "one absorber concept")  # fmt: skip
 #: ``concepts[k].absorber``, declared.
 CONCEPT_ABSORBER = Section("concepts[k].absorber", (
-    Key("stiffness", Free, "k2: a number > 0 [N m-1], or den_hartog (Den Hartog's tuning)", DERIVED),
-    Key("damping", Free, "b2: a number >= 0 [N s m-1], or den_hartog (Den Hartog's optimum damping)", DERIVED),
+    Key("stiffness", Free, "k2: a number > 0 [N m-1], or den_hartog (Den Hartog's tuning)", OPTIONAL),
+    Key("damping", Free, "b2: a number >= 0 [N s m-1], or den_hartog (Den Hartog's optimum damping)", OPTIONAL),
 ), "the concept's absorber spring and damper")  # fmt: skip
 #: The sections of a concepts scene that are declared (``run-study --keys`` lists them).
 SECTIONS = (CONCEPTS_TOP, CONCEPTS_BUMPER, CONTINUATION, CONCEPT_ROW, CONCEPT_ABSORBER)

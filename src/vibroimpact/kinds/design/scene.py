@@ -45,7 +45,7 @@ from vibroimpact.model.layout import PAPER_STOP, Layout
 from vibroimpact.model.parameters import BUMPER_STIFFNESS, LAYOUT_FORMS, MAX_RELATIVE_SPREAD, PARAMETERS, Parameter, parameter
 from vibroimpact.model.structure import require_in_range
 from vibroimpact.scene.checker import Checker, SceneError, did_you_mean
-from vibroimpact.scene.declared import DERIVED, REQUIRED, Band, Key, Section, Table
+from vibroimpact.scene.declared import OPTIONAL, REQUIRED, Band, Key, Section, Table
 from vibroimpact.scene.header import open_scene
 from vibroimpact.scene.layout_parse import parse_layout
 from vibroimpact.scene.schema import Scene
@@ -69,11 +69,11 @@ DESIGN = Section("design", (
         REQUIRED),
     Key("band", Band, "the band whose worst stable motion is judged", REQUIRED, 0.0, math.inf, "Hz", open_low=True),
     Key("objective", str, "what is minimised, the worst stable motion's over the band: <coordinate>_amplitude [m] or force_amplitude [N]", "x1_amplitude"),
-    Key("constraints", Table, "{operating: {frequency, <measure>: largest value}} (design.constraints)", DERIVED),
-    Key("robust", Table, "{<scalar>: spread, samples, seed, quantile}: the mistuning (design.robust)", DERIVED),
+    Key("constraints", Table, "{operating: {frequency, <measure>: largest value}} (design.constraints)", OPTIONAL),
+    Key("robust", Table, "{<scalar>: spread, samples, seed, quantile}: the mistuning (design.robust)", OPTIONAL),
     Key("compare", str, "what the optimum is compared with: the best linear absorber of the same mass, or nothing", "none", choices=COMPARISONS),
-    Key("search", Table, "how candidates are chosen (design.search)", DERIVED),
-    Key("certify", Table, "which candidates are certified (design.certify)", DERIVED),
+    Key("search", Table, "how candidates are chosen (design.search)", OPTIONAL),
+    Key("certify", Table, "which candidates are certified (design.certify)", OPTIONAL),
 ), "which scalars to choose, within which bounds, to minimise what over which band")  # fmt: skip
 #: ``design.robust``, declared: the spreads are the scalars' own keys.
 ROBUST = Section("design.robust", (
@@ -84,7 +84,7 @@ ROBUST = Section("design.robust", (
     others="a spread per scalar: relative for a structural one (0.05: +-5 %), absolute for clearance [m] and restitution [-]")  # fmt: skip
 #: ``design.constraints``, declared.
 CONSTRAINTS = Section("design.constraints", (
-    Key("operating", Table, "{frequency, <measure>: largest value}: the notch that must survive (design.constraints.operating)", DERIVED),
+    Key("operating", Table, "{frequency, <measure>: largest value}: the notch that must survive (design.constraints.operating)", OPTIONAL),
 ), "what every design must keep")  # fmt: skip
 #: ``design.constraints.operating``, declared: the limit is the measure's own key.
 OPERATING = Section("design.constraints.operating", (
@@ -109,7 +109,7 @@ CERTIFY = Section("design.certify", (
 DESIGN_STOP = Section("stop", (
     Key("clearance", float, "Delta, the stop's gap above the absorber x2", REQUIRED, 0.0, math.inf, "m", open_low=True),
     Key("restitution", float, "R of each impact (above 0 with a bumper)", REQUIRED, 0.0, 1.0),
-    Key("bumper", Table, "{frequency: Hz} or {stiffness: N/m}: a Kelvin-Voigt bumper whose loss factor follows R (default: a rigid stop)", DERIVED),
+    Key("bumper", Table, "{frequency: Hz} or {stiffness: N/m}: a Kelvin-Voigt bumper whose loss factor follows R (default: a rigid stop)", OPTIONAL),
 ), "the paper's stop above the absorber x2 (or 'stops': one, or a symmetric pair)", form="design")  # fmt: skip
 #: The sections of a design scene that are declared (``run-study --keys`` lists them).
 SECTIONS = (DESIGN_STOP, DESIGN, CONSTRAINTS, OPERATING, ROBUST, SEARCH, CERTIFY)
