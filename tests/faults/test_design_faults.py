@@ -27,8 +27,8 @@ its checksum (``.zattrs``), its ``.zarray``, the root's consolidated ``.zmetadat
 removed. The run reads every case's own files (never the consolidated copy) and proves its values by their checksum:
 a damaged chunk, checksum or ``.zarray`` is said (``1 damaged case of 2 ... is computed again``), a case whose checksum
 file is lost too (``stored without its checksum``), and a lost, edited or unreadable consolidated ``.zmetadata`` (rewritten
-when the store is kept); a whole case removed is only counted (``resumed: 321 of 322 cases reused``): no record of the
-store lists its cases, and a case gone is one never computed.
+when the store is kept); a whole case removed is said as gone (``1 case of 2 that the store had finished is gone from
+it``), told from one never computed by the store's list of the cases it finished.
 
 Bit for bit: every variable's bytes, dtype, dimensions and attributes and every attribute of the file
 (:func:`_digests`), read from the netCDF file with the netCDF library's masking and scaling off, but for what times or
@@ -387,9 +387,8 @@ _DAMAGE: dict[str, tuple[Callable[[Path], None], str | None]] = {
     ".zmetadata edited": (lambda store: _edit_json(store / ".zmetadata", lambda m: m["metadata"].update({"cases/.zgroup": {"zarr_format": 3}})),
                           "/.zmetadata: the store's consolidated metadata differs from the arrays' own metadata (cases/.zgroup)"),
     ".zmetadata removed": (lambda store: (store / ".zmetadata").unlink(), "/.zmetadata: the store's consolidated metadata is lost"),
-    # a finished case gone whole is a case never computed: no record of the store lists its cases, so it is said only as
-    # 'resumed: N-1 of N cases reused'
-    "a certificate removed": (lambda store: shutil.rmtree(_a_case(store, "certification")), None),
+    # a finished case gone whole: the store's list of the cases it finished tells it from one never computed
+    "a certificate removed": (lambda store: shutil.rmtree(_a_case(store, "certification")), "1 case of 2 that the store had finished is gone from it (removed): computed again"),
 }
 
 

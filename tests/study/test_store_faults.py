@@ -14,6 +14,7 @@ import pytest
 import xarray as xr
 import yaml
 
+from vibroimpact.model.system import TwoDofSystem
 from vibroimpact.runs.run import run_study
 from vibroimpact.runs.store import StoreOfAnotherScene, StudyStore, store_fingerprint
 
@@ -185,6 +186,39 @@ def test_a_case_cut_off_or_without_its_chunk_is_computed_again(tmp_path: Path) -
     again.save_case("exact-1", {"x": np.arange(10.0), "note": np.array("a text")})
     loaded = again.load_case("exact-1", ("x", "note"))
     assert loaded is not None and np.array_equal(loaded["x"], np.arange(10.0)) and str(loaded["note"]) == "a text"
+
+
+def test_a_finished_case_gone_from_the_store_is_told_from_one_never_computed(tmp_path: Path) -> None:
+    path = tmp_path / "c.zarr"
+    store = StudyStore(path, "f")
+    for name in ("exact-1", "exact-2"):
+        store.save_case(name, {"x": np.arange(3.0)})
+    shutil.rmtree(path / "cases" / "exact-1")  # a whole finished case removed
+    again = StudyStore(path, "f")
+    assert again.load_case("exact-1", ("x",)) is None and again.lost_cases == 1
+    assert again.load_case("exact-3", ("x",)) is None and again.lost_cases == 1, "never computed: not lost"
+    assert again.load_case("exact-2", ("x",)) is not None and again.damaged_cases == again.unsealed_cases == 0
+    (tmp_path / ".c.zarr.finished").write_text("exact-2\nexac")  # a line cut off by a kill names no case
+    assert StudyStore(path, "f").load_case("exact-1", ("x",)) is None
+    fresh = StudyStore(tmp_path / "other.zarr", "f")
+    assert fresh.load_case("exact-1", ("x",)) is None and fresh.lost_cases == 0
+
+
+def test_a_runner_says_in_one_line_how_many_finished_cases_were_gone(system: TwoDofSystem, tmp_path: Path) -> None:
+    from tests.kinds.stepped.test_cases import _case
+    from vibroimpact.runs.runner import Runner
+
+    cases = [_case(system, "pgf", frequencies=(25.0,)), _case(system, "linear", frequencies=(30.0, 31.0))]
+    path = tmp_path / "study.zarr"
+    Runner(store=StudyStore(path, "f"), progress=False).map(cases)
+    for case in (path / "cases").iterdir():
+        if case.is_dir():
+            shutil.rmtree(case)
+    said: list[str] = []
+    again = Runner(store=StudyStore(path, "f", say=said.append), progress=False)
+    again.map(cases)
+    assert said == ["2 cases of 2 that the store had finished are gone from it (removed): computed again"]
+    assert again.reuse_line() == ""
 
 
 def test_cases_written_by_older_code_are_counted_when_discarded(tmp_path: Path) -> None:

@@ -218,15 +218,17 @@ class Runner:
         names = [f"{case.engine}-{case.key()}" for case in cases] if self.store is not None else []
         results: list[CaseResult | None] = [None] * len(cases)
         if self.store is not None:
-            damaged_before, unsealed_before = self.store.damaged_cases, self.store.unsealed_cases
+            before = (self.store.damaged_cases, self.store.unsealed_cases, self.store.lost_cases)
             results = [self.store.load_case(name, case.fields) for name, case in zip(names, cases)]
-            damaged, unsealed = self.store.damaged_cases - damaged_before, self.store.unsealed_cases - unsealed_before
+            damaged, unsealed, lost = (now - then for now, then in zip((self.store.damaged_cases, self.store.unsealed_cases, self.store.lost_cases), before))
             if damaged:
                 self.store.say(f"{damaged} damaged case{'s' if damaged > 1 else ''} of {len(cases)} (values failing their checksum, or unreadable metadata) "
                                f"{'are' if damaged > 1 else 'is'} computed again")
             if unsealed:
                 self.store.say(f"{unsealed} case{'s' if unsealed > 1 else ''} of {len(cases)} stored without {'their' if unsealed > 1 else 'its'} checksum "
                                f"(cut off before it was written, or it was lost) {'are' if unsealed > 1 else 'is'} computed again")
+            if lost:
+                self.store.say(f"{lost} case{'s' if lost > 1 else ''} of {len(cases)} that the store had finished {'are' if lost > 1 else 'is'} gone from it (removed): computed again")
         pending = [index for index, result in enumerate(results) if result is None]
         # reused: given back by the store, not saved earlier in this run (a case asked twice in one run is no resume)
         self.note_reused("cases", sum(1 for i, result in enumerate(results) if result is not None and names[i] not in self._saved), len(cases))

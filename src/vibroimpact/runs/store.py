@@ -45,7 +45,7 @@ from numpy.typing import NDArray
 from zarr.core.sync import sync  # zarr's own event loop, the one its synchronous API runs on
 
 from vibroimpact.runs.fingerprints import NOT_IN_FINGERPRINT, case_key, changed_keys, code_fingerprint, fingerprint_of, source_hash, store_fingerprint, values_digest
-from vibroimpact.runs.store_record import consolidated_damage, read_record, record_digest, restore, set_aside, check_members_readable
+from vibroimpact.runs.store_record import add_to_ledger, consolidated_damage, count_cases, finished_work, forget_ledger, ledger_names, read_record, record_digest, restore, set_aside, check_members_readable
 
 __all__ = ["source_hash", "case_key", "StudyStore", "store_fingerprint", "code_fingerprint", "values_digest", "StoreOfAnotherScene", "StoreUnusable", "NOT_IN_FINGERPRINT", "ZARR_FORMAT"]
 
@@ -77,30 +77,6 @@ class StoreUnusable(RuntimeError):
 
 class StoreOfAnotherScene(RuntimeError):
     """The output folder's store holds the finished work of another scene file (a name clash): it is not deleted."""
-
-
-def _count_cases(group: Any) -> int:
-    """Finished cases in the ``cases`` group: arrays with their checksum, and (written by older code) groups marked
-    complete."""
-    return sum(1 for _name, case in group.arrays() if case.attrs.get("checksum")) + sum(1 for _name, case in group.groups() if case.attrs.get("complete"))
-
-
-def _finished_work(path: Path) -> str:
-    """'N finished blocks and M finished cases' of the store at ``path`` (what discarding it costs), read part by part
-    so that a damaged root does not hide them."""
-    blocks = cases = 0
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # zarr warns of what it cannot recognise: counted as nothing
-        try:
-            blocks = int(np.asarray(zarr.open_array(str(path / _BLOCK_DONE), mode="r", zarr_format=ZARR_FORMAT)[...]).astype(bool).sum())
-        except Exception:  # noqa: BLE001 - none, or damaged
-            pass
-        try:
-            group = zarr.open_group(str(path / _CASES), mode="r", zarr_format=ZARR_FORMAT)
-            cases = _count_cases(group)
-        except Exception:  # noqa: BLE001 - none, or damaged
-            pass
-    return f"{blocks} finished blocks and {cases} finished cases"
 
 
 class StudyStore:
@@ -137,6 +113,8 @@ class StudyStore:
         self.damaged_cases = 0
         #: Cases found without their checksum: cut off before it was written, or it was lost (computed again).
         self.unsealed_cases = 0
+        #: Cases the store had finished (:data:`~vibroimpact.runs.store_record.LEDGER`) that are gone from it.
+        self.lost_cases = 0
         self.store: Any = str(path) if path is not None else zarr.storage.MemoryStore()
         source = str(Path(scene_path).resolve()) if scene_path is not None else ""
         self.scene_path = source
@@ -146,6 +124,9 @@ class StudyStore:
             self._discard_unless_ours(path, source)
         #: Whether this run began the store (nothing of an earlier run in it): only such a store may be removed unasked.
         self.fresh = path is None or not path.exists()
+        if path is not None and self.fresh:
+            forget_ledger(path)  # of a store removed by hand
+        self._ledger = ledger_names(path) if path is not None else set()
         # the run reads every array's own metadata, as the export does: a kept store's consolidated copy
         # (:meth:`keep`) could vouch for an array whose own files are lost or edited
         self.root = zarr.open_group(self.store, mode="a", zarr_format=ZARR_FORMAT, use_consolidated=False)
@@ -168,6 +149,8 @@ class StudyStore:
         self._arrays.clear()
         self._cases_group = None
         self._grid_ready = False
+        forget_ledger(self.path)
+        self._ledger = set()
 
     def _discard_unless_ours(self, path: Path, source: str) -> None:
         """Empty the folder ``path`` unless it holds this scene's store; say why and how much was discarded."""
@@ -188,7 +171,7 @@ class StudyStore:
         elif isinstance(recorded, str) and fingerprint_of(str(attrs.get("code")), recorded) != attrs["fingerprint"]:
             damage = "its fingerprint is not that of the scene values and code it recorded (edited or damaged)"
         if damage is not None:  # kept for whoever wants to look, never deleted
-            work = _finished_work(path)
+            work = finished_work(path, _BLOCK_DONE, _CASES, ZARR_FORMAT)
             aside = set_aside(path)
             self.say(f"{path}: {damage}: set aside as {aside.name} ({work}), computed again")
             return
@@ -197,7 +180,7 @@ class StudyStore:
         else:
             keys = changed_keys(recorded, self.values) if isinstance(recorded, str) and self.values else ""
             why = f"the scene's values changed ({keys})" if keys else "the scene's values changed"
-        self.say(f"{path}: {why} since it was written: {_finished_work(path)} discarded, computed again")
+        self.say(f"{path}: {why} since it was written: {finished_work(path, _BLOCK_DONE, _CASES, ZARR_FORMAT)} discarded, computed again")
         self.remove()  # renamed first: a removal cut off half-way leaves no store that looks damaged
 
     def _identity(self) -> dict[str, str]:
@@ -213,6 +196,7 @@ class StudyStore:
         try:
             cases = self._cases()
             if name not in cases:
+                self.lost_cases += name in self._ledger  # finished once, gone since; else never computed
                 return None
             node = cases[name]
             checksum = node.attrs.get("checksum")
@@ -252,12 +236,14 @@ class StudyStore:
             shutil.rmtree(self.path / _CASES / name, ignore_errors=True)
             array = cases.create_array(name, shape=packed.shape, dtype=np.uint8, chunks=packed.shape, overwrite=True)
         array[...] = packed
-        array.attrs["checksum"] = values_digest(sorted(written.items())).hex()  # last: a case cut off before it is not stored
+        array.attrs["checksum"] = values_digest(sorted(written.items())).hex()  # a case cut off before it is not stored
+        if self.path is not None:
+            add_to_ledger(self.path, name)
 
     def case_count(self) -> int:
         """Finished cases in the store."""
         if self.path is None:
-            return _count_cases(self._cases())
+            return count_cases(self._cases())
         count = 0  # read file by file: a case whose metadata is damaged is not finished, and hides no other
         for attributes in sorted((self.path / _CASES).glob("*/.zattrs")):
             try:
@@ -511,4 +497,5 @@ class StudyStore:
         if self.path is not None and self.path.exists():
             doomed = self.path.with_name(f".{self.path.name}.removed-{os.getpid()}")
             os.replace(self.path, doomed)
+            forget_ledger(self.path)
             shutil.rmtree(doomed, ignore_errors=True)

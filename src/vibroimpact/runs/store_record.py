@@ -25,11 +25,19 @@ import hashlib
 import json
 import os
 import time
+import warnings
 from pathlib import Path
 from typing import Any
 
-__all__ = ["METADATA_FILES", "read_record", "record_digest", "restore", "set_aside", "check_members_readable", "consolidated_damage", "settle_io"]
+import numpy as np
+import zarr
 
+__all__ = ["METADATA_FILES", "read_record", "record_digest", "restore", "set_aside", "check_members_readable", "consolidated_damage", "settle_io", "LEDGER", "ledger_path", "ledger_names", "add_to_ledger", "forget_ledger", "count_cases", "finished_work"]
+
+#: The store's list of the cases it finished, one name a line, appended as each is sealed (``.<name>.zarr.finished``
+#: beside the store: zarr warns of any file in its hierarchy that is none of its own): a case gone from the store (its
+#: folder removed or lost) is then told from one never computed. It goes when its store goes or starts afresh.
+LEDGER = ".finished"
 #: An array's metadata files in zarr format 2.
 METADATA_FILES = (".zarray", ".zattrs")
 
@@ -147,3 +155,53 @@ def settle_io(timeout: float = 10.0) -> bool:
         return not pending
 
     return bool(sync(others_ended()))
+
+
+def ledger_path(path: Path) -> Path:
+    """Where the list of the cases the store at ``path`` finished is kept (:data:`LEDGER`)."""
+    return path.with_name(f".{path.name}{LEDGER}")
+
+
+def ledger_names(path: Path) -> set[str]:
+    """The names of the cases the store at ``path`` finished (empty where it has no list). A line cut off by a kill
+    names no case."""
+    try:
+        return set(ledger_path(path).read_text(encoding="utf-8").splitlines())
+    except (OSError, UnicodeDecodeError):
+        return set()
+
+
+def add_to_ledger(path: Path, name: str) -> None:
+    """Record beside the store at ``path`` that the case ``name`` is finished (after its checksum is written)."""
+    with open(ledger_path(path), "a", encoding="utf-8") as ledger:
+        ledger.write(name + "\n")
+
+
+def forget_ledger(path: Path) -> None:
+    """Remove the list of finished cases of the store at ``path`` (the store is gone, or starts afresh)."""
+    ledger_path(path).unlink(missing_ok=True)
+
+
+def count_cases(group: Any) -> int:
+    """Finished cases in the ``cases`` group: arrays with their checksum, and (written by older code) groups marked
+    complete."""
+    return sum(1 for _name, case in group.arrays() if case.attrs.get("checksum")) + sum(1 for _name, case in group.groups() if case.attrs.get("complete"))
+
+
+def finished_work(path: Path, block_done: str, cases_group: str, zarr_format: int) -> str:
+    """'N finished blocks and M finished cases' of the store at ``path`` (what discarding it costs), read part by part
+    so that a damaged root does not hide them: its flags of finished blocks (the array ``block_done``) and its
+    ``cases_group``."""
+    blocks = cases = 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # zarr warns of what it cannot recognise: counted as nothing
+        try:
+            blocks = int(np.asarray(zarr.open_array(str(path / block_done), mode="r", zarr_format=zarr_format)[...]).astype(bool).sum())
+        except Exception:  # noqa: BLE001 - none, or damaged
+            pass
+        try:
+            group = zarr.open_group(str(path / cases_group), mode="r", zarr_format=zarr_format)
+            cases = count_cases(group)
+        except Exception:  # noqa: BLE001 - none, or damaged
+            pass
+    return f"{blocks} finished blocks and {cases} finished cases"
