@@ -106,3 +106,41 @@ def test_a_benchmark_case_below_an_unbounded_linear_amplitude_is_refused_naming_
     with pytest.raises(SceneError) as caught:
         parse_scene(document)
     assert any(p.startswith("benchmark.cases[0].frequency: 23.0221 Hz: the linear amplitude is unbounded there") for p in caught.value.problems), caught.value.problems
+
+
+class _ClosedFormOnly:
+    """A map whose contact-free orbit's clearance [-] is ``clearance(frequency)`` (None: no orbit there)."""
+
+    def __init__(self, clearance: object) -> None:
+        self.clearance = clearance
+
+    def linear_orbit(self, q: np.ndarray) -> tuple[np.ndarray, float] | None:
+        value = self.clearance(float(q[0]))  # type: ignore[operator]
+        return None if value is None else (np.zeros(4), value)
+
+
+def test_a_pole_the_clearance_changes_sign_across_is_no_onset() -> None:
+    """A clearance that jumps from +inf to -inf (1 / (20 - f)) changes sign with no zero: brentq converges on the
+    pole, which is no grazing (before: returned as the onset at 20 Hz)."""
+    from vibroimpact.orbits.onsets import contact_free_onset
+
+    p = np.array([19.99])
+    pole = _ClosedFormOnly(lambda f: 1.0 / (20.0 - f) if f != 20.0 else math.inf)  # exact: the pole itself
+    assert contact_free_onset(pole, p, 0, 19.99, 0.1) is None  # type: ignore[arg-type]
+    root, q = contact_free_onset(_ClosedFormOnly(lambda f: 20.0 - f), p, 0, 19.99, 0.1)  # type: ignore[arg-type, misc]
+    assert root == pytest.approx(20.0, rel=1e-14) and q[0] == root
+
+
+def test_a_peak_beside_a_gap_of_the_worst_case_curve_is_no_peak() -> None:
+    """The worst stable motion's local maxima (design.dataset.equal_peaks): a point beside a stretch where no stable
+    motion is known is no maximum, the curve may rise into the gap (before: 2.8 at index 1 beside the gap counted, and
+    the two 'equal peaks' were 3.0 and 2.8)."""
+    from vibroimpact.kinds.design.dataset import equal_peaks
+
+    linear = np.array([1.0, 2.8, np.nan, np.nan, 2.5, 3.0, 2.0, 1.0, 2.6, 1.0])
+    curves = {"linear": linear, "linear_fits": np.ones(10), **{f"impact_{s}{suffix}": np.full(10, np.nan) for s in ("plus", "minus") for suffix in ("", "_stable")}}
+    frequency = np.arange(10.0)
+    difference, first, second = equal_peaks(frequency, curves)
+    assert (first, second) == (5.0, 8.0) and difference == pytest.approx((3.0 - 2.6) / 3.0, rel=1e-15)
+    curves["linear"] = np.array([1.0, 2.8, np.nan, np.nan, 3.0, 2.0, 1.0, 0.5, 0.4, 0.2])  # the one maximum beside the gap
+    assert all(math.isnan(value) for value in equal_peaks(frequency, curves))

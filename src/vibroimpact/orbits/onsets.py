@@ -106,18 +106,21 @@ def contact_free_onset(system: ParametrisedMap, p: NDArray[np.float64], index: i
         root = estimate
     else:
         width = max(reach * 1e-6, abs(estimate) * 1e-14)
-        root = math.nan
+        root, ends = math.nan, math.nan
         while width <= reach:
             for end in (estimate - width, estimate + width):
                 there = linear_clearance(system, p, index, end)
                 if math.isfinite(there) and there * at <= 0.0:
                     low, high = sorted((estimate, end))
                     root = brentq(lambda v: linear_clearance(system, p, index, v), low, high, xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=200)
+                    ends = max(abs(at), abs(there))
                     break
             if math.isfinite(root):
                 break
             width *= 2.0
         if not math.isfinite(root):
+            return None
+        if not abs(linear_clearance(system, p, index, root)) <= ends:  # a pole (or a gap) the sign changed across, no zero
             return None
     q = np.array(p, dtype=float)
     q[index] = root

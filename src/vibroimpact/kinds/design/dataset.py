@@ -68,12 +68,14 @@ def response_curves(problem: ImpactProblem, frequency: NDArray[np.float64], meas
 
 def equal_peaks(frequency: NDArray[np.float64], curves: dict[str, NDArray[np.float64]]) -> tuple[float, float, float]:
     """(relative difference, f1, f2) of the two largest local maxima of the worst stable motion's |X| [Hz]; NaN
-    where it has fewer than two."""
+    where it has fewer than two. A point beside a gap (no stable motion known there) is no maximum: the curve may rise
+    into the gap."""
     stable = [np.where(curves["linear_fits"] == 1, curves["linear"], np.nan)]
     stable += [np.where(curves[f"{n}_stable"] == 1, curves[n], np.nan) for n in ("impact_plus", "impact_minus")]
     worst = np.fmax.reduce(stable)
-    filled = np.nan_to_num(worst, nan=-np.inf)
-    peaks = [i for i in range(filled.size) if np.isfinite(filled[i]) and filled[i] >= filled[max(i - 1, 0)] and filled[i] >= filled[min(i + 1, filled.size - 1)]]
+    filled = np.where(np.isfinite(worst), worst, np.nan)
+    last = filled.size - 1
+    peaks = [i for i in range(filled.size) if np.isfinite(filled[i]) and all(np.isfinite(filled[j]) and filled[i] >= filled[j] for j in (max(i - 1, 0), min(i + 1, last)))]
     if len(peaks) < 2:
         return math.nan, math.nan, math.nan
     top = sorted(peaks, key=lambda i: filled[i], reverse=True)[:2]
