@@ -21,6 +21,7 @@ from typing import Callable
 import numpy as np
 
 from vibroimpact.model.structure import require_count
+from vibroimpact.runs.spawn_main import workers_without_main
 
 __all__ = ["WORKERS_PER_CORE", "local_worker_limit", "check_jobs", "WORKER_LIBRARIES", "import_libraries", "DASHBOARD_VARIABLE", "DEFAULT_DASHBOARD", "dashboard_address", "SCHEDULER_VARIABLE", "ClusterLost", "SyncCancelRace", "Connection", "choose_scheduler", "connect", "Terminated", "unreachable", "dask_setup", "Progress", "ProgressReport", "Throttled", "ProgressBar", "REPORT_INTERVAL", "HEARTBEAT"]
 
@@ -277,15 +278,15 @@ def _start_local_cluster(jobs: int) -> Connection:
 
         _drop_sync_cancel_race()
         stop_if_interrupted(None, None)
-        with dask.config.set(WORKER_CONFIG):  # the nannies hand it to the worker processes as they are made
+        with dask.config.set(WORKER_CONFIG), workers_without_main():  # a user's script is not run again by each worker
             cluster = _cluster_blocking_ctrl_c()
             client = Client(cluster, set_as_default=False)
             stop_if_interrupted(cluster, client)
             cluster.scale(jobs)
-        while len(client.scheduler_info(n_workers=-1).get("workers", {})) < jobs and not interrupted:
-            if cluster.status.name in ("failed", "closed"):
-                raise RuntimeError(f"the local cluster's workers failed to start ({cluster.status.name})")
-            time.sleep(0.1)
+            while len(client.scheduler_info(n_workers=-1).get("workers", {})) < jobs and not interrupted:
+                if cluster.status.name in ("failed", "closed"):
+                    raise RuntimeError(f"the local cluster's workers failed to start ({cluster.status.name})")
+                time.sleep(0.1)
         stop_if_interrupted(cluster, client)
     except Exception:
         if interrupted:  # a worker hit by the interrupt before it could ignore it: the interrupt is what happened

@@ -40,6 +40,7 @@ from vibroimpact import __version__
 from vibroimpact.engines.registry import engine_spec
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.runner import Runner
+from vibroimpact.runs.spawn_main import refuse_in_a_spawned_import
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.labels import decode_labels, encode_labels
 from vibroimpact.runs.output_files import atomic_path
@@ -154,7 +155,16 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
         On Ctrl-C, after the work in progress is cancelled (finished work stays in ``store``).
     vibroimpact.runs.cluster.ClusterLost
         When the dask scheduler goes away.
+    RuntimeError
+        When called by a worker process running the caller's script again (an unguarded call: it says what to write).
+
+    Notes
+    -----
+    A script may call it at its top level with ``jobs > 1``: the workers do not run the script again as they start
+    (:mod:`vibroimpact.runs.spawn_main`). A worker dask restarts later does; guard the call with
+    ``if __name__ == "__main__":`` for that.
     """
+    refuse_in_a_spawned_import("run_study")
     with Runner(jobs, scheduler, store, progress is not None) as runner:
         if kind_named(scene.kind).shares_work:
             runner.start()  # a local cluster's workers start while this process imports the kind's code (~1 s sooner)
