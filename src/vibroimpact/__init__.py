@@ -6,8 +6,11 @@ time-domain engines, and studies that put them side by side (seed paper: the abs
 base). The names users import are available here and load their layer on first use, so ``import vibroimpact``
 stays light::
 
-    from vibroimpact import load_scene, run_study, write_dataset
-    dataset = run_study(load_scene("studies/restitution.yaml"), jobs=2)
+    from vibroimpact import design_answer, load_scene, run_study
+
+    if __name__ == "__main__":  # a script that starts worker processes (jobs > 1) runs its study once, here
+        dataset = run_study(load_scene("design_rigid_stop"), jobs=2)
+        print(design_answer(dataset).headline)
 """
 
 from __future__ import annotations
@@ -89,6 +92,8 @@ _PUBLIC = {
     "split_groups": "vibroimpact.runs.run",
     "join_groups": "vibroimpact.runs.run",
     "write_report": "vibroimpact.reporting.page",
+    "design_answer": "vibroimpact.kinds.design.result",
+    "DesignAnswer": "vibroimpact.kinds.design.result",
 }
 
 __all__ = ["__version__", *_PUBLIC]

@@ -27,7 +27,7 @@ from vibroimpact.scene.checker import SceneError
 from vibroimpact.scene.kinds import KINDS, kind_of_document
 from vibroimpact.scene.schema import Scene
 
-__all__ = ["read_yaml", "parse_scene", "load_scene", "find_scene", "shipped_studies_dir", "shipped_studies"]
+__all__ = ["read_yaml", "parse_scene", "load_scene", "scene_text", "find_scene", "shipped_studies_dir", "shipped_studies"]
 
 class _UniqueKeyLoader(yaml.SafeLoader):
     """``yaml.SafeLoader`` that refuses a key repeated in one mapping (PyYAML silently keeps the last one) and reads
@@ -138,6 +138,7 @@ def _expanded_characters(node: yaml.Node, sizes: dict[int, int]) -> int:
 
 def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
     """Validate a parsed YAML document and build the :class:`Scene`; raise :class:`SceneError` listing all problems.
+    Without ``text`` (a scene made in Python), the scene keeps the document written as YAML (:func:`scene_text`).
 
     The document is a scene of the first kind (:data:`vibroimpact.scene.kinds.KINDS`) whose section it has
     (``concepts``, ``validation``, ``benchmark``, ``bifurcation``, ``swept_sine``); any other is a stepped scene over
@@ -148,10 +149,28 @@ def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
         sections = ", ".join(kind.section for kind in KINDS if kind.section)
         raise SceneError([f"scene: expected a mapping of a scene's sections (name, system, excitation, ...; a kind's own: {sections}), got {what}"], source)
     kind = kind_of_document(document)
-    scene: Scene = kind.parse_scene(document, text, source)
+    scene: Scene = kind.parse_scene(document, text or scene_text(document), source)
     if scene.kind != kind.name:  # a parser that names another kind than its row: a broken table, not a user error
         raise RuntimeError(f"the scene parser of kind {kind.name!r} ({kind.scene}) made a scene of kind {scene.kind!r}")
     return scene
+
+
+def scene_text(document: dict) -> str:
+    """The YAML text of a scene given as a mapping (from Python, not a file): what the dataset and the page keep of
+    it (its description, its stated spreads, the scene shown at the page's foot), as a file's text is kept. numpy
+    numbers and arrays are written as the plain numbers and lists they hold."""
+
+    def plain(value: Any) -> Any:
+        if isinstance(value, dict):
+            return {str(key): plain(item) for key, item in value.items()}
+        if isinstance(value, (list, tuple)):
+            return [plain(item) for item in value]
+        return value.tolist() if hasattr(value, "tolist") else value
+
+    try:
+        return yaml.safe_dump(plain(document), sort_keys=False, allow_unicode=True)
+    except yaml.YAMLError:  # a value YAML cannot write (an object): the scene's own checks say what is wrong with it
+        return ""
 
 
 def load_scene(path: str | Path) -> Scene:
