@@ -205,8 +205,9 @@ class Runner:
 
     # -- cases -------------------------------------------------------------------------------------------------
 
-    def map(self, cases: Sequence[Case]) -> list[CaseResult]:
-        """The results of ``cases`` in their order: taken from the store where finished before, else run (and stored).
+    def map(self, cases: Sequence[Case], verb: str = "simulating") -> list[CaseResult]:
+        """The results of ``cases`` in their order: taken from the store where finished before, else run (and stored);
+        ``verb`` leads the progress bar (``design: generation 2 of at most 25``).
 
         Raises
         ------
@@ -242,7 +243,7 @@ class Runner:
         units = list(dict.fromkeys(case.progress_unit for case in cases))  # each unit once, in order
         unit = " + ".join(units) if units else "points"  # mixed cases (sweeps beside a chart) count each in its own unit
         if not self.distributed or (len(pending) <= 1 and self.scheduler is None):
-            self._run_here(cases, pending, [i for i in range(len(cases)) if results[i] is not None], unit, keep)
+            self._run_here(cases, pending, [i for i in range(len(cases)) if results[i] is not None], unit, keep, verb)
         else:
             per_task = max(1, min(MAX_CASES_PER_TASK, len(pending) // (TASKS_PER_WORKER * self.workers)))
             batches = [pending[first : first + per_task] for first in range(0, len(pending), per_task)]
@@ -254,14 +255,14 @@ class Runner:
 
             items = [[cases[i] for i in batch] for batch in batches]
             done_before = sum(cases[i].progress_total for i in range(len(cases)) if results[i] is not None)
-            self.run_tasks(_run_cases, None, items, totals, unit, finished, done_before=done_before)
+            self.run_tasks(_run_cases, None, items, totals, unit, finished, verb=verb, done_before=done_before)
         finished_results = [result for result in results if result is not None]
         if len(finished_results) != len(cases):  # cannot happen: every case either came from the store or was run
             raise RuntimeError(f"{len(cases) - len(finished_results)} simulation cases have no result")
         return finished_results
 
-    def _run_here(self, cases: Sequence[Case], pending: list[int], finished: list[int], unit: str, keep: Callable[[int, CaseResult], None]) -> None:
-        bar = ProgressBar([case.progress_total for case in cases], finished, unit, self.progress)
+    def _run_here(self, cases: Sequence[Case], pending: list[int], finished: list[int], unit: str, keep: Callable[[int, CaseResult], None], verb: str = "simulating") -> None:
+        bar = ProgressBar([case.progress_total for case in cases], finished, unit, self.progress, verb)
         try:
             for index in pending:
                 offset = self._offset

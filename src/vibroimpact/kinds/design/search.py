@@ -78,16 +78,17 @@ class Evaluations:
     results: list[CaseResult] = field(default_factory=list)
     scores: list[float] = field(default_factory=list)
 
-    def evaluate(self, designs: NDArray[np.float64], stage: str, quiet: bool = False) -> NDArray[np.float64]:
+    def evaluate(self, designs: NDArray[np.float64], stage: str, quiet: bool = False, verb: str = "simulating") -> NDArray[np.float64]:
         """The scores of ``designs`` (shape (m, n), in the variables' units), each kept; ``quiet``: without the
-        runner's progress bar (a polish step of a second or two; the polish says how it goes)."""
+        runner's progress bar (a polish step of a second or two; the polish says how it goes); ``verb`` leads the bar
+        (which generation it is)."""
         designs = np.atleast_2d(np.asarray(designs, dtype=float))
         whole = designs.shape[0] >= WHOLE_CANDIDATES
         chunks = [tuple(range(self.space.samples))] if whole else sample_chunks(self.space.samples)
         shown = self.runner.progress
         self.runner.progress = shown and not quiet
         try:
-            parts = self.runner.map([DesignCase(self.space, tuple(float(v) for v in x), chunk) for x in designs for chunk in chunks])
+            parts = self.runner.map([DesignCase(self.space, tuple(float(v) for v in x), chunk) for x in designs for chunk in chunks], verb)
         finally:
             self.runner.progress = shown
         results = [{k: np.concatenate([np.atleast_1d(p[k]) for p in parts[i * len(chunks) : (i + 1) * len(chunks)]]) for k in parts[0]} for i in range(len(designs))]
@@ -161,9 +162,12 @@ def differential_evolution(evaluations: Evaluations, population: int, generation
     """scipy's differential evolution on the unit cube, each generation one batch (``population`` members per
     variable, Latin-hypercube start, seeded: a rerun asks for the same candidates and the store answers)."""
     n = evaluations.bounds.shape[0]
+    done = [0]
 
     def batch(unit: NDArray[np.float64]) -> NDArray[np.float64]:
-        return evaluations.evaluate(evaluations.scaled(np.asarray(unit).T), "global")
+        which = "the first population" if done[0] == 0 else f"generation {done[0]} of at most {generations}"
+        done[0] += 1
+        return evaluations.evaluate(evaluations.scaled(np.asarray(unit).T), "global", verb=f"design: {which}")
 
     optimize.differential_evolution(batch, [(0.0, 1.0)] * n, popsize=population, maxiter=generations, seed=seed, polish=False, vectorized=True,
                                     updating="deferred", init="latinhypercube", tol=1e-6, atol=0.0)  # fmt: skip
@@ -199,7 +203,7 @@ def grid_search(evaluations: Evaluations, points: int) -> None:
     """Every point of a grid of ``points`` per variable, bounds included (one batch)."""
     axes = [np.linspace(0.0, 1.0, points)] * evaluations.bounds.shape[0]
     unit = np.array(list(itertools.product(*axes)))
-    evaluations.evaluate(evaluations.scaled(unit), "grid")
+    evaluations.evaluate(evaluations.scaled(unit), "grid", verb=f"design: a grid of {len(unit)} points")
 
 
 def pareto_front(objective: ArrayLike, impulse: ArrayLike, feasible: ArrayLike) -> NDArray[np.bool_]:

@@ -118,7 +118,7 @@ def run_design(scene: Any, progress: Progress | None = None, runner: Runner | No
         say(f"design: without a stop the scene's absorber already has {shown.symbol} = {shown.text(outcome.alone)} at {space.operating:.4g} Hz, above the allowed {shown.text(limit)}: "
             "only a stop that lowers it there can keep the limit")  # fmt: skip
     start = time.perf_counter()
-    evaluations.evaluate(outcome.scene_design[None, :], "reference")
+    evaluations.evaluate(outcome.scene_design[None, :], "reference", verb="design: the scene's own design")
     search = settings.search
     if search.method == "grid":
         say(f"design: a grid of {search.points}^{bounds.shape[0]} candidates, {space.samples} samples each")
