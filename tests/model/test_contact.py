@@ -217,7 +217,7 @@ def test_stop_bumper_converts_with_the_stops_own_effective_mass() -> None:
     np.testing.assert_allclose(between.effective_mass(mass), 0.2, rtol=1e-15)
     np.testing.assert_allclose([between.law.stiffness(0.2), between.law.damping(0.2)], [4e4, 8.0], rtol=CONVERSION_RTOL)
     np.testing.assert_allclose(place_effective_mass((1, None, "upper"), mass), 0.25, rtol=1e-15)
-    with pytest.raises(ValueError, match=re.escape("coordinate index 2 is out of range for a system of 2 coordinates: allowed [0, 1]")):
+    with pytest.raises(ValueError, match=re.escape("coordinate index 2 is out of range for a system of 2 coordinates: allowed [0, 1] (an int is a 0-based index: 0 is x1, 1 is x2; or give the name, 'x2')")):
         Stop.bumper(mass, 0.002, 4e4, damping=8.0, coordinate=2)
 
 

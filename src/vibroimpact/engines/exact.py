@@ -369,8 +369,9 @@ def prepare_kernels(batched: bool = False) -> float:
     and with ``batched`` its batch entry (:meth:`ExactEngine.run_many`); return the seconds spent compiling [s] (0
     where cached).
 
-    numba compiles the core on first use and caches it on disk (``@njit(cache=True)``); a cold cache costs ~25 s of
-    compiling, the batch entry ~10 s more (it calls the core's own overload). Done once before parallel
+    numba compiles the core on first use and caches it on disk (``@njit(cache=True)``); a cold cache costs
+    :data:`~vibroimpact.engines.registry.FIRST_COMPILE_TIME` of compiling, the batch entry ~10-15 s more (it calls the
+    core's own overload). Done once before parallel
     workers start, they load the cached code instead of each compiling it.
     """
     import time

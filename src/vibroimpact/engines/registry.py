@@ -11,6 +11,7 @@ its name. Adding an engine is one module plus one line here::
 from __future__ import annotations
 
 import importlib
+import sys
 from dataclasses import dataclass, field, fields
 from types import MappingProxyType
 from typing import Any, Mapping
@@ -18,7 +19,7 @@ from typing import Any, Mapping
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import BUMPER, RIGID
 
-__all__ = ["RIGID", "BUMPER", "Capabilities", "CAPABILITIES", "EngineSpec", "ENGINES", "engine_names", "stepped_solutions", "engine_spec", "make_engine", "engine_for"]
+__all__ = ["RIGID", "BUMPER", "Capabilities", "CAPABILITIES", "EngineSpec", "ENGINES", "engine_names", "stepped_solutions", "engine_spec", "make_engine", "engine_for", "FIRST_COMPILE_TIME", "compile_notice"]
 
 # RIGID and BUMPER, the contact laws an engine can solve (the momentary-impact stop and the Kelvin-Voigt bumper), are
 # the model's names (vibroimpact.model.contact), re-exported here beside the capabilities that use them.
@@ -189,9 +190,26 @@ def engine_spec(name: str) -> EngineSpec:
         raise ValueError(f"engine {name!r} is unknown: use one of {', '.join(ENGINES)}") from None
 
 
+#: What the first use of a compiled engine costs on a machine, numba compiling its kernels into its on-disk cache
+#: (measured: ``exact`` 25-46 s on a quiet 2-core machine, 57 s and its batch entry 15 s more at load 3); later runs
+#: load them in ~0.1 s. The one figure the package states (the README, the run's line, this notice).
+FIRST_COMPILE_TIME = "~30-60 s"
+_ANNOUNCED: set[str] = set()
+
+
+def compile_notice(name: str) -> str:
+    """The line said before an engine's kernels are compiled (the first use on a machine)."""
+    return f"compiling the {name} engine's kernels (first use on this machine only, {FIRST_COMPILE_TIME}; later runs load them from numba's cache)"
+
+
 def make_engine(name: str, settings: EngineSettings = EngineSettings()) -> Any:
-    """The engine registered under ``name``, built with ``settings``."""
-    return engine_spec(name).build(settings)
+    """The engine registered under ``name``, built with ``settings``. The first one built of an engine whose kernels
+    are not compiled yet says so on a terminal (:func:`compile_notice`): its first use waits for numba."""
+    spec = engine_spec(name)
+    if spec.capabilities.compiled and name not in _ANNOUNCED and sys.stderr is not None and sys.stderr.isatty() and not spec.kernels_cached():
+        _ANNOUNCED.add(name)
+        print(compile_notice(name), file=sys.stderr, flush=True)
+    return spec.build(settings)
 
 
 def engine_for(contact: str, capability: str) -> str:

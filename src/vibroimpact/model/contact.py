@@ -331,7 +331,8 @@ class Stop:
         """``ValueError`` naming ``key`` if a coordinate index is not below ``size`` (or a name is not resolved)."""
         for index in (self._indexed().coordinate, self.other):
             if index is not None and index >= size:
-                raise ValueError(f"{key}: coordinate index {index} is out of range for a system of {size} coordinates: allowed [0, {size - 1}]")
+                raise ValueError(f"{key}: coordinate index {index} is out of range for a system of {size} coordinates: allowed [0, {size - 1}] "
+                                 f"(an int is a 0-based index: 0 is x1, {size - 1} is x{size}; or give the name, 'x{size}')")
 
     @property
     def place(self) -> tuple[int, int | None, str]:

@@ -21,7 +21,7 @@ from matplotlib.axes import Axes  # noqa: E402
 from matplotlib.colors import to_hex  # noqa: E402
 from matplotlib.figure import Figure as MatplotlibFigure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.ticker import FormatStrFormatter, LogFormatter, LogLocator  # noqa: E402
+from matplotlib.ticker import FormatStrFormatter, FuncFormatter, LogFormatter, LogLocator, ScalarFormatter  # noqa: E402
 
 from vibroimpact.analysis.stability import Regime  # noqa: E402
 # every solution's row (colour, title, words), kept without matplotlib for the studies; re-exported for the pages
@@ -62,6 +62,8 @@ __all__ = [
     "Quantity",
     "REPORT_RC",
     "thin_minor_log_ticks",
+    "readable_axes",
+    "readable_scale",
     "axis_label",
     "figure_legend",
     "fmt",
@@ -285,6 +287,27 @@ REPORT_RC = {"axes.titley": 1.0}
 MINOR_LOG_TICKS = (2.0, 5.0)
 
 
+def readable_scale(low: float, high: float) -> str:
+    """``log`` for values spanning a decade or more (all above 0), else ``linear``: a log axis over less than a decade
+    carries one or two labels (a panel of 2.3-5 mm was labelled "10" alone)."""
+    return "log" if low > 0.0 and math.isfinite(high / low) and high / low >= 10.0 else "linear"
+
+
+def _plain_number(value: float, _position: object = None) -> str:
+    """A tick label as a plain number, six significant digits at most (2.5e+06, 0.003, 24.5): no offset or
+    multiplier written apart at the axis' end, where it overprinted the panel's title ("1e6")."""
+    return f"{value:.6g}"
+
+
+def readable_axes(figure: MatplotlibFigure) -> None:
+    """Every linear axis of ``figure`` (a colorbar's too) labelled with plain numbers (:func:`_plain_number`), never
+    matplotlib's offset or ``1e6`` multiplier; applied as figures are rendered, so that every page has it."""
+    for ax in figure.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            if axis.get_scale() == "linear" and type(axis.get_major_formatter()) is ScalarFormatter:
+                axis.set_major_formatter(FuncFormatter(_plain_number))
+
+
 def thin_minor_log_ticks(figure: MatplotlibFigure) -> None:
     """Every log axis of ``figure`` with minor ticks at :data:`MINOR_LOG_TICKS` only (applied as figures are
     rendered, so every page has it, whichever way its panels were made logarithmic)."""
@@ -382,8 +405,13 @@ class PlainLogFormatter(LogFormatter):
 
 
 def plain_log(ax: Axes, which: str = "y") -> None:
-    """Plain numbers on a log axis (0.5, 1, 2 rather than 5 x 10^-1); a few minor ticks labelled when the axis spans
-    about a decade or less (matplotlib's thinning)."""
+    """Plain numbers on a log axis (0.5, 1, 2 rather than 5 x 10^-1). Over two decades or less (its limits as set
+    now) every minor tick is labelled too, at 2 and 5 in each decade (:data:`MINOR_LOG_TICKS`, set as the figure is
+    rendered): 0.2, 0.5, 1, 2, 5 rather than the one or two labels matplotlib's thinning leaves; wider, its thinning."""
     axis = ax.yaxis if which == "y" else ax.xaxis
     axis.set_major_formatter(FormatStrFormatter("%g"))
-    axis.set_minor_formatter(PlainLogFormatter(labelOnlyBase=False, minor_thresholds=(1.0, 0.5)))
+    low, high = sorted(ax.get_ylim() if which == "y" else ax.get_xlim())
+    if low > 0.0 and high / low <= 100.0:
+        axis.set_minor_formatter(FormatStrFormatter("%g"))
+    else:
+        axis.set_minor_formatter(PlainLogFormatter(labelOnlyBase=False, minor_thresholds=(1.0, 0.5)))

@@ -37,7 +37,7 @@ import pandas as pd
 import xarray as xr
 
 from vibroimpact import __version__
-from vibroimpact.engines.registry import engine_spec
+from vibroimpact.engines.registry import compile_notice, engine_spec
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.runner import Runner
 from vibroimpact.runs.spawn_main import refuse_in_a_spawned_import
@@ -92,7 +92,7 @@ def prepare_engines(engines: Sequence[str], progress: Progress | None = None, ba
     return the seconds it took (0 where numba's on-disk cache already holds them, or no engine has kernels).
 
     numba compiles an engine's kernels on first use and caches them on disk (``@njit(cache=True)``); a cold cache
-    costs ~30-60 s of compiling per engine. Done here, the workers of a local cluster load the cached code (~0.1 s
+    costs :data:`~vibroimpact.engines.registry.FIRST_COMPILE_TIME` of compiling per engine. Done here, the workers of a local cluster load the cached code (~0.1 s
     each, before their first task: :class:`~vibroimpact.runs.runner.Runner`) instead of each compiling it again at
     once inside its first point's wall time, and the user is told why the first run waits, in one line, before it does.
     Cached kernels are loaded here too, for the work this process runs itself. The engines named in ``batched`` have
@@ -109,7 +109,7 @@ def prepare_engines(engines: Sequence[str], progress: Progress | None = None, ba
             spec.prepare_kernels(batch)  # loaded here too (~0.1 s): work run in this process times none of it
             continue
         if progress is not None:
-            progress(f"compiling the {name} engine's kernels (first run on this machine only, ~30-60 s; later runs load them from numba's cache)")
+            progress(compile_notice(name))
         start = time.perf_counter()
         spec.prepare_kernels(batch)
         elapsed = time.perf_counter() - start

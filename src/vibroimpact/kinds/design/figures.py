@@ -29,7 +29,7 @@ from vibroimpact.kinds.design.quantity import constraint_quantity, objective_qua
 from vibroimpact.kinds.design.palette import CERTIFIED_COLOUR, DESIGN_COLOURS, DESIGN_MARKERS, LIMIT_COLOUR, OBJECTIVE_PERCENTILE, PATH_COLOUR
 from vibroimpact.kinds.design.search_map import search_figure
 from vibroimpact.reporting.page import DrawnFigure
-from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, plain_log
+from vibroimpact.reporting.style import STABLE_STYLE, UNSTABLE_STYLE, Caption, figure_legend, finish_axes, fmt, legend_rows, new_figure, plain_log, readable_scale
 
 __all__ = ["design_figures", "search_figure", "response_figure", "robustness_figure", "worst_stable",
            "DESIGN_COLOURS", "DESIGN_MARKERS", "PATH_COLOUR", "CERTIFIED_COLOUR", "LIMIT_COLOUR", "OBJECTIVE_PERCENTILE"]  # fmt: skip
@@ -125,28 +125,42 @@ def response_figure(dataset: xr.Dataset) -> DrawnFigure:
     compare = len(present) > 1
     q, c, limit = objective_quantity(d), constraint_quantity(d), operating_limit(d)
     fig, axes = new_figure(len(present) + compare, panel_height=3.3, legend_rows=legend_rows(len(present) + len(_LOOKS) + 1, 3))
+    first_scale = ""
     if compare:
         ax = axes[0]
+        worst = [q.value(worst_stable(d, k)) for k in present]
+        finite = np.concatenate([w[np.isfinite(w) & (w > 0.0)] for w in worst])
+        first_scale = readable_scale(float(np.min(finite)), float(np.max(finite))) if finite.size else "log"
         for k in sorted(present, reverse=True):  # the recommended design on top, drawn narrower than the others
-            ax.plot(f, q.value(worst_stable(d, k)), color=DESIGN_COLOURS[k], lw=1.8 if k == 0 else 3.2, zorder=3 - k)
+            ax.plot(f, worst[present.index(k)], color=DESIGN_COLOURS[k], lw=1.8 if k == 0 else 3.2, zorder=3 - k)
             ax.plot(*(np.array(_worst_point(d, k)) * (1.0, q.scale)), marker="o", ms=12, mfc="none", mec="k", mew=1.4, ls="none", zorder=6)
         _operating(ax, d)
         ax.set_xlim(float(f[0]), float(f[-1]))
-        finish_axes(ax, _FREQUENCY, q.label, "Worst stable motion of each design (no mistuning)", log=True)
-        plain_log(ax)
+        finish_axes(ax, _FREQUENCY, q.label, "Worst stable motion of each design (no mistuning)", log=first_scale == "log")
+        if first_scale == "log":
+            plain_log(ax)
     kinds = {"worst"}
-    for ax, k in zip(axes[int(compare) :], present):
+    shown: list[float] = []
+    design_axes = list(zip(axes[int(compare) :], present))
+    for ax, k in design_axes:
         values, drawn = _design_panel(ax, d, k)
         kinds |= drawn
+        shown += list(values)
         _operating(ax, d)
-        if values:
-            ax.set_ylim(0.7 * min(values), 1.6 * max(values))
         ax.set_xlim(float(f[0]), float(f[-1]))
-        finish_axes(ax, _FREQUENCY, q.label, f"{design_titles(d)[k][:1].upper()}{design_titles(d)[k][1:]}: {design_text(d, k)}", log=True)
-        plain_log(ax)
+    # one y range for the designs' own panels, so that they compare by eye; log only over a decade or more
+    low, high = (0.7 * min(shown), 1.6 * max(shown)) if shown else (math.nan, math.nan)
+    scale = readable_scale(low, high) if shown else "log"
+    for ax, k in design_axes:
+        if shown:
+            ax.set_ylim(low, high)
+        finish_axes(ax, _FREQUENCY, q.label, f"{design_titles(d)[k][:1].upper()}{design_titles(d)[k][1:]}: {design_text(d, k)}", log=scale == "log")
+        if scale == "log":
+            plain_log(ax)
     entries = [Line2D([], [], color=DESIGN_COLOURS[k], lw=2.4, label=f"{design_titles(d)[k]}: {design_text(d, k)}") for k in present]
     entries += [Line2D([], [], **look, label=label) for kind, (look, label) in _LOOKS.items() if kind in kinds]
-    caption = Caption(f"{q.symbol} ({q.description}, {q.unit}, log scale) of the compared designs without mistuning; colour: whose design.")
+    scaled = f"{scale} scale" if first_scale in ("", scale) else f"the first panel on a {first_scale} scale, the others on a {scale} scale"
+    caption = Caption(f"{q.symbol} ({q.description}, {q.unit}, {scaled}) of the compared designs without mistuning, the designs' own panels on one y range; colour: whose design.")
     if compare:
         caption.add("compare", f"The first panel overlays each design's worst stable motion at each frequency (gaps: no {screen_words(d)} period-1 motion is stable there); the others show every motion of one design.")
     roots = "the bumper orbits grown from both roots of the rigid twin's impulse equation, where its shots converged" if screen_words(d) == "bumper" else "both roots of the impulse equation, where admissible"
