@@ -13,6 +13,7 @@ import xarray as xr
 import yaml
 from numpy.typing import NDArray
 
+from vibroimpact.kinds.design.cautions import SYMBOLS as _SYMBOLS, at_bounds, cautions, variable_names
 from vibroimpact.kinds.design.quantity import constraint_quantity, objective_quantity, operating_limit
 from vibroimpact.kinds.design.scene import safe_name
 from vibroimpact.orbits.continuation_settings import ContinuationSettings
@@ -20,7 +21,6 @@ from vibroimpact.reporting.style import fmt
 
 __all__ = ["answer_text", "worst_motion", "offset_text", "sample_counts", "samples_text", "operating_motion", "at_bounds", "never_strikes", "ties", "TIE", "design_titles", "screen_words", "linear_wins", "warnings", "variable_names", "variable_text", "design_text", "unit_text", "Spread", "mistuning_spreads", "mistuning_text", "DESIGN_TITLES", "design_evaluation", "certified_worst", "design_worst", "present_designs", "search_path", "stage_counts"]
 
-_SYMBOLS = {"clearance": "Delta", "restitution": "R", "bumper_stiffness": "K_b"}
 #: How the page names the compared designs (the dataset's ``design`` dimension, in order).
 DESIGN_TITLES = ("recommended design", "the scene's design", "best linear absorber")
 _UNITS = {"1": "", "N m-1": "N/m", "N s m-1": "N s/m"}
@@ -29,11 +29,6 @@ _UNITS = {"1": "", "N m-1": "N/m", "N s m-1": "N s/m"}
 def unit_text(unit: str) -> str:
     """A UDUNITS string as the page writes it: ``N m-1`` -> ``N/m``; empty for ``1``."""
     return _UNITS.get(unit, unit)
-
-
-def variable_names(dataset: xr.Dataset) -> list[str]:
-    """The design variables, in the order of the scene (attribute ``variables``)."""
-    return [name for name in str(dataset.attrs.get("variables", "")).split(", ") if name]
 
 
 def variable_text(dataset: xr.Dataset, design: int) -> str:
@@ -258,25 +253,6 @@ def operating_motion(dataset: xr.Dataset, design: int) -> str:
     return motion + (f", reached by {int(starts)} of the screen's runs" if starts > 0 else "")
 
 
-def at_bounds(dataset: xr.Dataset, design: int = 0) -> str:
-    """`` (R = 0 is the lower bound of its range)`` for the compared design's variables that sit on a bound of their
-    range (within 1e-9 of the range), "" where none does."""
-    parts = []
-    for name in variable_names(dataset):
-        key = f"variable_{safe_name(name)}"
-        if key not in dataset or f"design_{safe_name(name)}" not in dataset:
-            continue
-        low, high = (float(dataset[key].attrs.get(k, math.nan)) for k in ("valid_min", "valid_max"))
-        value = float(dataset[f"design_{safe_name(name)}"].values[design])
-        if not (math.isfinite(low) and math.isfinite(high) and math.isfinite(value)):
-            continue
-        for bound, word in ((low, "lower"), (high, "upper")):
-            if abs(value - bound) <= 1e-9 * (high - low):
-                shown = f"Delta = {fmt(1e3 * value, '.4g')} mm" if name == "clearance" else f"{_SYMBOLS.get(name, name)} = {fmt(value, '.4g')}"
-                parts.append(f"{shown} is the {word} bound of its range")
-    return f" ({'; '.join(parts)})" if parts else ""
-
-
 def never_strikes(dataset: xr.Dataset, design: int = 0) -> bool:
     """Whether no stable motion any certificate of the compared design found in the band strikes its stop (every
     certificate says so, at least one exists): the design is a linear absorber with an idle stop."""
@@ -481,6 +457,7 @@ def warnings(dataset: xr.Dataset) -> list[str]:
                       if not np.any(d["sample_motion"].values == 3) else "the search itself ranked candidates by a coarse brute force (no closed form applies to this layout), whose grid and few starts a narrow or rarely reached motion escapes."))
     for failure in d.attrs.get("run_failures", []) if isinstance(d.attrs.get("run_failures"), list) else []:
         out.append(str(failure))
+    out += cautions(d)  # a variable on its bound, a mistuning cut off, an impacting motion near the operating frequency
     return out
 
 

@@ -1,0 +1,53 @@
+"""The cautions a designer needs on the design page (issue 51), from the golden design_rigid_stop dataset moved to
+each case: a variable on its bound, a restitution mistuning cut off at 0, and an impacting motion that coexists
+within 5 % of the operating frequency above the allowed value; none on the dataset as it is."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from vibroimpact import design_answer
+from vibroimpact.kinds.design.answer import warnings
+from vibroimpact.kinds.design.cautions import cautions
+from vibroimpact.runs.run import read_dataset
+
+GOLDEN = Path(__file__).resolve().parents[2] / "golden" / "data"
+
+
+@pytest.fixture
+def dataset() -> xr.Dataset:
+    return read_dataset(GOLDEN / "design_rigid_stop.nc").load()
+
+
+def test_the_golden_design_needs_no_caution(dataset: xr.Dataset) -> None:
+    assert cautions(dataset) == []
+
+
+def test_a_design_on_the_bound_of_its_range_is_said(dataset: xr.Dataset) -> None:
+    dataset["design_restitution"].values[0] = dataset["variable_restitution"].attrs["valid_min"]  # R = 0
+    said = cautions(dataset)
+    assert any(line.startswith("The recommended design sits on a bound of the range searched (R = 0 is the lower bound of its range)") for line in said), said
+    assert all(line in warnings(dataset) for line in said) and all(line in design_answer(dataset).warnings for line in said)
+
+
+def test_a_mistuning_cut_off_at_zero_restitution_is_said(dataset: xr.Dataset) -> None:
+    dataset["design_restitution"].values[0] = 0.02  # the +-0.05 of the scene reaches -0.03
+    said = [line for line in cautions(dataset) if "mistuning is cut off" in line]
+    assert said == ["The restitution's mistuning is cut off at 0, its lowest physical value, for the recommended design (R = 0.02): the tolerance box is one-sided there: its samples stop at 0, short of the offset the scene states."]
+
+
+def test_an_impacting_motion_near_the_operating_frequency_is_said(dataset: xr.Dataset) -> None:
+    f = dataset["response_frequency"].values
+    stable = np.asarray(dataset["response_impact_plus_stable"].values[0]) == 1
+    impacting = np.where(stable, dataset["response_impact_plus"].values[0], np.nan)
+    where = int(np.nanargmax(impacting))
+    dataset.attrs["operating_frequency_Hz"] = float(f[where]) * 1.02  # 2 % above the impacting motion's peak
+    said = [line for line in cautions(dataset) if "a stable impacting motion" in line]
+    assert len(said) == 1 and "% below the operating frequency, a stable impacting motion of the recommended design reaches" in said[0], said
+    assert "against the allowed 0.05 mm" in said[0]
+    dataset.attrs["operating_frequency_Hz"] = float(f[where]) * 1.2  # 20 % away: not near
+    assert not any("a stable impacting motion" in line for line in cautions(dataset))
