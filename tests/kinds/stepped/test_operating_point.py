@@ -140,3 +140,18 @@ def test_the_paper_s_notch_is_kept_by_its_stop() -> None:
     assert point is not None and point.frequency == pytest.approx(math.sqrt(4300.0 / 0.1) / (2.0 * math.pi), rel=1e-12)
     assert point.free == () and point.rows[0].ratio == pytest.approx(1.0, abs=1e-9)
     assert warning_lines(data) == []
+
+
+def test_the_operating_sentence_over_many_points_reads_as_one_sentence() -> None:
+    """Many solutions and swept points: the least and the most, each with its own frequency where it is not the
+    first row's (before: 'from exact 0.00897 mm (x1) at R = 0, 33 Hz, where the linear absorber's is 0.00897 mm to
+    pgf 0.00898 mm ...', a clause inside a range)."""
+    from vibroimpact.kinds.stepped.operating import OperatingPoint, OperatingRow, operating_text
+
+    linear = 8.97e-6
+    rows = [OperatingRow("pgf", f"R = {r:g}", 33.003, linear, linear * (1.0 + r / 100.0)) for r in (0.2, 0.4, 0.6, 0.8)]
+    rows += [OperatingRow("exact", f"R = {r:g}", 33.0, linear, linear * (1.0 - r / 1000.0)) for r in (0.0, 0.2, 0.4)]
+    text = operating_text(OperatingPoint(33.003, "x1", tuple(rows), (), (23.0, 36.1)))
+    assert "where the linear absorber's is" not in text and " to " not in text
+    assert ("with the stop, over 7 solutions and swept points, the least is exact 0.00897 mm (×1) at R = 0.4 and 33 Hz (the linear absorber there: "
+            "0.00897 mm) and the most pgf 0.00904 mm (×1.01) at R = 0.8; 0 of them are worse than the linear absorber") in text, text

@@ -195,12 +195,14 @@ def operating_point(dataset: xr.Dataset, layout: GeneralSetting | None = None) -
 
 
 def _row_text(row: OperatingRow, frequency: float | None) -> str:
-    """``pgf 4.81 mm (x240) at R = 0.5``; the row's own frequency where it differs from ``frequency``."""
+    """``pgf 4.81 mm (x240) at R = 0.5``; with the row's own frequency where it differs from ``frequency``:
+    ``exact 0.00897 mm (x1) at R = 0 and 33 Hz (the linear absorber there: 0.00897 mm)``."""
     value = f"{_mm(row.stopped)} ({fmt(row.ratio, '.3g', '×{}')})" if math.isfinite(row.stopped) else "no realisable value (no stable orbit known there)"
     where = [row.where] if row.where else []
-    if frequency is None or abs(row.frequency - frequency) > 1e-9:
-        where.append(f"{fmt(row.frequency, '.4g')} Hz, where the linear absorber's is {_mm(row.linear)}")
-    return f"{row.solution} {value}" + (f" at {', '.join(where)}" if where else "")
+    own = frequency is None or abs(row.frequency - frequency) > 1e-9
+    if own:
+        where.append(f"{fmt(row.frequency, '.4g')} Hz")
+    return f"{row.solution} {value}" + (f" at {' and '.join(where)}" if where else "") + (f" (the linear absorber there: {_mm(row.linear)})" if own else "")
 
 
 def operating_text(point: OperatingPoint | None) -> str:
@@ -218,7 +220,7 @@ def operating_text(point: OperatingPoint | None) -> str:
         return f"{lead}: " + "; ".join(_row_text(r, first.frequency) for r in point.rows) + " (the factor: with the stop / without)."
     worse = point.worse()
     low, high = min(finite, key=lambda r: r.stopped), max(finite, key=lambda r: r.stopped)
-    return (f"{lead}, from {_row_text(low, first.frequency)} to {_row_text(high, first.frequency)} over {len(point.rows)} solutions and swept points; "
+    return (f"{lead}, over {len(point.rows)} solutions and swept points, the least is {_row_text(low, first.frequency)} and the most {_row_text(high, first.frequency)}; "
             f"{len(worse)} of them {'is' if len(worse) == 1 else 'are'} worse than the linear absorber (factor above {fmt(WORSE_RATIO, 'g')}).")  # fmt: skip
 
 
