@@ -51,3 +51,25 @@ def test_an_impacting_motion_near_the_operating_frequency_is_said(dataset: xr.Da
     assert "against the allowed 0.05 mm" in said[0]
     dataset.attrs["operating_frequency_Hz"] = float(f[where]) * 1.2  # 20 % away: not near
     assert not any("a stable impacting motion" in line for line in cautions(dataset))
+
+
+def test_a_linear_absorber_level_with_the_stop_design_does_as_well_not_better(dataset: xr.Dataset) -> None:
+    """'2.974 mm against 2.974 mm' called the linear absorber 'the smaller': a tie is said as one."""
+    from vibroimpact.kinds.design.answer import design_worst
+
+    dataset["design_sample_value"].values[2] = design_worst(dataset, 0)
+    said = [line for line in warnings(dataset) if line.startswith("Over the band the stop does not pay")]
+    assert len(said) == 1 and "does as well" in said[0] and "smaller" not in said[0], said
+
+
+def test_a_design_whose_stop_is_never_struck_is_named_so_where_its_star_is_drawn(dataset: xr.Dataset) -> None:
+    from vibroimpact.kinds.design.answer import design_titles, never_strikes
+
+    recommended = int(dataset.attrs["recommended_evaluation"])
+    rows = dataset["certificate_evaluation"].values == recommended
+    dataset["certificate_impacting"].values[rows] = 0.0
+    if "certificate_operating_impacts" in dataset:
+        dataset["certificate_operating_impacts"].values[rows] = 0.0
+    dataset["sample_operating_impacts"].values[recommended] = 0.0
+    dataset["sample_impulse"].values[recommended] = 0.0
+    assert never_strikes(dataset) and design_titles(dataset)[0] == "recommended design (its stop never struck)"

@@ -387,8 +387,13 @@ def screen_words(dataset: xr.Dataset) -> str:
 
 def design_titles(dataset: xr.Dataset) -> tuple[str, str, str]:
     """How the page names the compared designs: :data:`DESIGN_TITLES`, the first called "best design with a stop"
-    where the linear absorber is the one to build (:func:`linear_wins`)."""
-    return ("best design with a stop", *DESIGN_TITLES[1:]) if linear_wins(dataset) else DESIGN_TITLES  # type: ignore[return-value]
+    where the linear absorber is the one to build (:func:`linear_wins`), and "recommended design (its stop never
+    struck)" where the answer is to build it without its stop (:func:`never_strikes`): its star marks the absorber."""
+    if linear_wins(dataset):
+        return ("best design with a stop", *DESIGN_TITLES[1:])  # type: ignore[return-value]
+    if never_strikes(dataset):
+        return ("recommended design (its stop never struck)", *DESIGN_TITLES[1:])  # type: ignore[return-value]
+    return DESIGN_TITLES  # type: ignore[return-value]
 
 
 def linear_wins(dataset: xr.Dataset) -> bool:
@@ -417,7 +422,11 @@ def warnings(dataset: xr.Dataset) -> list[str]:
         linear_notch = float(d["design_operating_amplitude"].values[2])
         keeps = math.isfinite(limit) and math.isfinite(linear_notch) and linear_notch > limit
         cost = f", but it has no notch: {c.symbol} at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz is {c.text(linear_notch)}, above the allowed {c.text(limit)}" if keeps else ""
-        out.append(f"Over the band the stop does not pay: the best linear absorber of the same mass has the smaller worst case ({q.text(float(np.nanmax(values[2])))} against {q.text(design_worst(d, 0))}){cost}.")
+        best_linear = float(np.nanmax(values[2]))
+        if ties(best_linear, design_worst(d, 0)):
+            out.append(f"Over the band the stop does not pay: the best linear absorber of the same mass does as well ({q.text(best_linear)}, level with the best design with a stop){cost}.")
+        else:
+            out.append(f"Over the band the stop does not pay: the best linear absorber of the same mass has the smaller worst case ({q.text(best_linear)} against {q.text(design_worst(d, 0))}){cost}.")
     if math.isfinite(limit) and recommended >= 0:
         operating = float(d["operating_amplitude"].values[recommended])
         if not operating <= limit:

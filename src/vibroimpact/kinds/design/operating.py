@@ -156,8 +156,9 @@ def operating_warnings(point: DesignOperating | None) -> list[str]:
     return lines
 
 
-def operating_sentence(point: DesignOperating | None) -> str:
-    """The measure of the recommended design at the operating point with its stop and without, in one HTML paragraph."""
+def operating_sentence(point: DesignOperating | None, idle: bool = False) -> str:
+    """The measure of the recommended design at the operating point with its stop and without, in one HTML paragraph;
+    ``idle``: its stop is never struck (the answer is to build it without), said so rather than "with its stop"."""
     if point is None:
         return ""
     q = point.measure
@@ -165,5 +166,8 @@ def operating_sentence(point: DesignOperating | None) -> str:
         return (f"<p>At the absorber's operating point ({html.escape(_where(point))}) {q.symbol} of the same absorber without the stop is {q.text(point.linear)}; "
                 "with the stop it was not computed there (the band's responses do not reach it).</p>")  # fmt: skip
     worst = (f" (the largest over every motion found there under every sample: {html.escape(point.motion)})" if point.motion else " (the largest over every motion found there under every sample)") if point.declared else " (its worst stable motion on the responses' grid)"
+    if idle:
+        return (f"<p>At the absorber's operating point ({html.escape(_where(point))}) the recommended absorber's {q.symbol} is {q.text(point.stopped)}{worst}; its stop is never "
+                f"struck, and without it the same absorber has {q.text(point.linear)} there.</p>")  # fmt: skip
     return (f"<p>At the absorber's operating point ({html.escape(_where(point))}) the recommended design's {q.symbol} is {q.text(point.stopped)} with its stop{worst} against "
             f"{q.text(point.linear)} for the same absorber without the stop: ×{fmt(point.ratio, '.3g')}.</p>")  # fmt: skip

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from vibroimpact.kinds.design.answer import sample_name, answer_text, design_titles, linear_wins, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, sample_counts, screen_words, stage_counts, unit_text, variable_names, warnings
+from vibroimpact.kinds.design.answer import never_strikes, sample_name, answer_text, design_titles, linear_wins, certified_worst, design_evaluation, design_text, mistuning_spreads, present_designs, sample_counts, screen_words, stage_counts, unit_text, variable_names, warnings
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, design_figures
 from vibroimpact.kinds.design.consistency import contradictions
 from vibroimpact.kinds.design.evaluate import CERTIFY_OPERATING_RUN, CERTIFY_OPERATING_STARTS, OPERATING_RUN, OPERATING_STARTS
@@ -261,7 +261,7 @@ class DesignPage:
             answer = (f"<p><b>No answer: what this study stored contradicts the recommendation's stated numbers, so they are not stated.</b> {html.escape('; '.join(refused[:4]))}"
                       f"{f' (and {len(refused) - 4} more)' if len(refused) > 4 else ''}.</p>")  # fmt: skip
         else:
-            answer = f"<p><b>{html.escape(answer_text(d))}</b></p>" + operating_sentence(point)
+            answer = f"<p><b>{html.escape(answer_text(d))}</b></p>" + operating_sentence(point, never_strikes(d))
         first = Section("Which design to build", before + answer + (f"<p>{'Before you build a stop' if linear_wins(d) else 'Before you build it'}:</p><ul>{items}</ul>" if items else ""))
         drawn = design_figures(d)
         trade = front_text(d) if "pareto_front" in d else ""

@@ -17,7 +17,7 @@ import xarray as xr
 from matplotlib.axes import Axes
 from numpy.typing import NDArray
 
-from vibroimpact.kinds.design.answer import design_titles
+from vibroimpact.kinds.design.answer import design_titles, ties
 from vibroimpact.kinds.design.figures import DESIGN_COLOURS, DESIGN_MARKERS, PATH_COLOUR
 from vibroimpact.kinds.design.quantity import constraint_quantity, objective_quantity, operating_limit
 from vibroimpact.reporting.page import DrawnFigure
@@ -62,10 +62,11 @@ def tradeoff_figure(dataset: xr.Dataset) -> DrawnFigure:
                       "Where a candidate's band is partly uncovered (motions the screen does not know) its impulse is a lower bound, and is not drawn where it would read 0.")  # fmt: skip
     if math.isfinite(linear):
         violation = _linear_violation(d)
-        below = bool(np.any(front)) and q.value(linear) < float(np.min(objective[front]))
+        least = float(np.min(objective[front])) if np.any(front) else math.nan
+        below = math.isfinite(least) and (q.value(linear) < least or ties(q.value(linear), least))  # level with the front's least: no better for a stop either
         caption.add("linear", f"The green diamond at 0 N s is the {design_titles(d)[2]} of the same mass under the same mistuning ({fmt(q.value(linear), '.4g')} {q.unit}, exact band peaks): it has no stop, hence no impact"
                     + (f"; hollow: it violates the operating constraint ({violation})." if violation else
-                       "; below the whole front, it is smaller on both." if below else f"; a design with a stop below it pays for its smaller {q.symbol} with impacts."))  # fmt: skip
+                       "; level with or below the whole front, it is no larger on both." if below else f"; a design with a stop below it pays for its smaller {q.symbol} with impacts."))  # fmt: skip
     caption.add("front", f"The vermillion steps join the front: the feasible candidates no other feasible candidate beats on both ({order.size}); it is the front of what the search evaluated, not of a search constrained on the impulse.")
     if np.any(shown & ~feasible):
         caption.add("infeasible", "Crosses violate the operating constraint and are left off the front.")
@@ -129,12 +130,15 @@ def front_text(dataset: xr.Dataset) -> str:
             where = f"; the {titles[0]} ({fmt(float(d['impulse'].values[recommended]), '.3g')} N s) is {'on it' if on else 'off it (by the screen, another candidate is no worse on both)'}"
     linear = _linear_worst(d)
     if math.isfinite(linear):
-        above = int(np.count_nonzero(objective >= q.value(linear)))
+        level = np.array([ties(float(value), q.value(linear)) for value in objective], dtype=bool)  # equal is no 'below'
+        above = int(np.count_nonzero((objective >= q.value(linear)) & ~level))
         violation = _linear_violation(d)
         if violation:
             against = f"{'below' if above else 'above'} {'the whole front' if above in (0, objective.size) else f'{above} of the front candidates'}, but it violates the operating constraint ({violation})"
         else:
+            tied = int(np.count_nonzero(level))
             against = ("below the whole front: no stop pays for its impacts" if above == objective.size else
+                       f"level with the front's least {q.symbol} and below the rest: no stop pays for its impacts" if tied and above + tied == objective.size else
                        f"below {above} of the front's {objective.size} candidates" if above else "above the whole front (by the screen)")  # fmt: skip
         where += f"; the {titles[2]} has no impact, at {fmt(q.value(linear), '.4g')} {q.unit}, {against}"
     if impulse.size == 1:
