@@ -126,3 +126,23 @@ def test_the_two_sided_relative_stop_draws_both_stops_coordinates() -> None:
         assert _beneath(drawn.figure.axes[1], "linear:stop0") and not _beneath(drawn.figure.axes[1], "linear:stop1")
     finally:
         plt.close(drawn.figure)
+
+
+def test_nine_coinciding_curves_stack_no_more_than_three_bands() -> None:
+    """Nine restitution ratios on one curve made the lowest band 8 steps wide (0.45-1.0 mm around 0.67 mm on a log
+    axis, read as scatter); the bands stop at MAX_BANDS steps, and the caption still names every coincidence."""
+    from vibroimpact.reporting.coincide import BAND_STEP, MAX_BANDS, coincidence_phrase, reveal_coincident
+
+    figure, ax = plt.subplots()
+    x = np.linspace(15.0, 45.0, 200)
+    curves = []
+    for k in range(9):
+        (line,) = ax.plot(x, 0.67 + 0.0 * x, lw=1.4, gid=f"R{k}")
+        curves.append((f"R = {k / 10:g}", [line]))
+    found = reveal_coincident(ax, curves, share=False)
+    try:
+        widths = [line.get_linewidth() for line in ax.get_lines() if str(line.get_gid()).startswith("beneath:")]
+        assert widths and max(widths) <= 1.4 + BAND_STEP * MAX_BANDS + 1e-9
+        assert len(found) == 8 and "R = 0" in coincidence_phrase(found)
+    finally:
+        plt.close(figure)

@@ -7,7 +7,8 @@ A figure draws its curves as usual, then hands each panel's curves to :func:`rev
 curve's marker size where it has markers (a marker hides a curve a line's width away), over a stretch at
 least :data:`MIN_STRETCH` of the axis wide (a crossing is not a coincidence). Each curve beneath n coinciding ones is
 drawn again there, in its own colour and line style (solid, dashed or dotted as it is), n x :data:`BAND_STEP` wider
-than the widest of them and behind them: every coinciding curve shows as a band around the next. Stable (solid) and
+than the widest of them and behind them (n at most :data:`MAX_BANDS`: deeper ones share the widest band, and the
+caption names them): every coinciding curve shows as a band around the next. Stable (solid) and
 unstable (dashed) stay told apart, as the pages draw them. :func:`coincidence_phrase` is the caption's sentence.
 
 A constant shared by several curves (exactly 0 where none of several restitution ratios impacts) is not a
@@ -32,7 +33,7 @@ from matplotlib.lines import Line2D
 
 from vibroimpact.reporting.style import SHARED_STYLE, fmt
 
-__all__ = ["Coincidence", "Shared", "reveal_coincident", "coincidence_phrase", "series_names", "TOLERANCE", "MIN_STRETCH", "BAND_STEP", "SAME"]
+__all__ = ["Coincidence", "Shared", "reveal_coincident", "coincidence_phrase", "series_names", "TOLERANCE", "MIN_STRETCH", "BAND_STEP", "MAX_BANDS", "SAME"]
 
 #: Largest distance of two coinciding curves, as a fraction of the panel's height (log axes: of its decades); about a
 #: line's width on a panel of the pages.
@@ -43,6 +44,9 @@ MIN_STRETCH = 0.03
 SAME = 1e-9
 #: Width each curve beneath adds to the band around the curves above it [pt] (1 pt, 1.5 px, on each side).
 BAND_STEP = 2.0
+#: Most bands stacked around a curve: deeper curves share the widest band (nine coinciding restitution ratios made a
+#: band of 8 steps, 0.45-1.0 mm around one value of 0.67 mm on a log axis, read as scatter); the caption names them all.
+MAX_BANDS = 3
 
 
 @dataclass(frozen=True)
@@ -249,6 +253,7 @@ def reveal_coincident(ax: Axes, curves: Sequence[tuple[str, Sequence[Line2D]]], 
     widest = max((line.get_linewidth() for _, lines, _ in drawn for line in lines), default=1.0)
     bottom = min((line.get_zorder() for _, lines, _ in drawn for line in lines), default=2.0)
     for (_, lines, (x, _)), d in zip(drawn, depth):
+        d = np.minimum(d, MAX_BANDS)
         for level in range(1, int(d.max(initial=0)) + 1):
             for line in lines:
                 _band(ax, line, x, d == level, d > 0, widest + BAND_STEP * level, bottom - 0.01 * level)
