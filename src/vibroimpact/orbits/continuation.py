@@ -34,6 +34,7 @@ import numpy as np
 from vibroimpact.orbits.arclength import ArclengthSystem, Point
 from vibroimpact.orbits.bifurcations import classify, grazing_margin, locate
 from vibroimpact.orbits.bifurcations import neimark_sacker_test, period_doubling_test
+from vibroimpact.orbits.call_progress import CallProgress
 from vibroimpact.orbits.branch import Branch, ParametrisedMap, PeriodicOrbit, SpecialPoint, lower_period_maps
 from vibroimpact.orbits.continuation_settings import ContinuationSettings
 from vibroimpact.orbits.onset_steps import NOT_GRAZING, OnsetSteps, signature_of
@@ -57,6 +58,7 @@ class _Walker(OnsetSteps):
     def __init__(self, system: ParametrisedMap, orbit: PeriodicOrbit, index: int, settings: ContinuationSettings) -> None:
         self.system, self.index, self.settings = system, index, settings
         self.name = system.parameter_names[index]
+        self.progress = CallProgress(f"continuing in {self.name}")  # on a terminal, a call of seconds says how far it got
         self.arc = self.first_arc = ArclengthSystem(system, orbit.parameters, (index,))
         self.n = system.dimension
         self.specials: list[tuple[float, SpecialPoint]] = []
@@ -212,6 +214,7 @@ class _Walker(OnsetSteps):
         values_a = self.tests(a)
         turn = math.cos(s.max_turn)
         for _ in range(s.max_steps):
+            self.progress.update(f"{len(points)} points, {self.name} = {float(a.p[self.index]):.6g}")
             b = self.arc.correct(a.z + h * a.tangent, a.tangent, s.tolerance, s.max_corrector_iterations)
             if b is not None and b.tangent @ a.tangent < turn and h > s.min_step:
                 b = None  # the tangent turned too much: a smaller step
@@ -359,12 +362,15 @@ def continue_branch(system: ParametrisedMap, orbit: PeriodicOrbit, parameter: st
         return Point(start.z, start.y, start.p, start.out, start.residual, start.jacobian, t, 0, orbit.residual_history)
 
     runs = []
-    for sign in ((1.0, -1.0) if direction == 0 else (float(direction),)):
-        walker.specials = []
-        points, end = walker.run(oriented(sign))
-        runs.append((points, end, sorted(walker.specials, key=lambda item: item[0])))
-        if end == "closed":
-            break
+    try:
+        for sign in ((1.0, -1.0) if direction == 0 else (float(direction),)):
+            walker.specials = []
+            points, end = walker.run(oriented(sign))
+            runs.append((points, end, sorted(walker.specials, key=lambda item: item[0])))
+            if end == "closed":
+                break
+    finally:
+        walker.progress.close(f"{sum(len(run[0]) for run in runs)} points")
     if direction != 0:
         points, end, specials = runs[0]
         return Branch(parameter, tuple(p.orbit(system) for p in points), tuple(s for _, s in specials), end)

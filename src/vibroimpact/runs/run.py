@@ -41,6 +41,7 @@ from vibroimpact.engines.registry import compile_notice, engine_spec
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.runner import Runner
 from vibroimpact.runs.spawn_main import refuse_in_a_spawned_import
+from vibroimpact.orbits.call_progress import quiet_calls
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.labels import decode_labels, encode_labels
 from vibroimpact.runs.output_files import atomic_path
@@ -165,7 +166,7 @@ def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: 
     ``if __name__ == "__main__":`` for that.
     """
     refuse_in_a_spawned_import("run_study")
-    with Runner(jobs, scheduler, store, progress is not None) as runner:
+    with quiet_calls(), Runner(jobs, scheduler, store, progress is not None) as runner:  # the study's bar, not each call's line
         if kind_named(scene.kind).shares_work:
             runner.start()  # a local cluster's workers start while this process imports the kind's code (~1 s sooner)
         kind = study_kind(scene)
