@@ -73,3 +73,21 @@ def test_a_design_whose_stop_is_never_struck_is_named_so_where_its_star_is_drawn
     dataset["sample_operating_impacts"].values[recommended] = 0.0
     dataset["sample_impulse"].values[recommended] = 0.0
     assert never_strikes(dataset) and design_titles(dataset)[0] == "recommended design (its stop never struck)"
+
+
+def test_the_search_map_caption_speaks_of_a_hatched_region_only_where_one_is_drawn(dataset: xr.Dataset) -> None:
+    """An infeasible limit (no candidate keeps it) drew no hatching while the caption described 'the hatched region'."""
+    import matplotlib.pyplot as plt
+
+    from vibroimpact.kinds.design.search_map import HATCHED, search_figure
+
+    def hatched(drawn: object) -> bool:
+        return any(c.get_gid() == HATCHED for ax in drawn.figure.axes for c in ax.collections)  # type: ignore[attr-defined]
+
+    drawn = search_figure(dataset)
+    assert hatched(drawn) and "the hatched region bounded by the purple line" in drawn.caption
+    plt.close(drawn.figure)
+    dataset["operating_amplitude"].values[:] = 1.0  # 1 m at the operating point: no candidate keeps 0.05 mm
+    drawn = search_figure(dataset)
+    assert not hatched(drawn) and "hatched region" not in drawn.caption and "no candidate keeps it, so no region is hatched" in drawn.caption
+    plt.close(drawn.figure)

@@ -113,13 +113,23 @@ def _map_panel(ax: Axes, d: xr.Dataset, pair: tuple[str, str], levels: NDArray[n
     return mappable
 
 
+#: The gid of the region where the interpolated constraint breaks its limit (hatched).
+HATCHED = "limit:hatched"
+
+
+def _hatched(figure: object) -> bool:
+    """Whether a panel of ``figure`` hatches the region where the constraint breaks its limit."""
+    return any(collection.get_gid() == HATCHED for ax in figure.axes for collection in ax.collections)  # type: ignore[attr-defined]
+
+
 def _feasibility_line(ax: Axes, d: xr.Dataset, tri: Triangulation, keep: NDArray[np.int64]) -> None:
     """Where the interpolated operating constraint's measure crosses its limit (when it does)."""
     ratio = d["operating_amplitude"].values[keep] / operating_limit(d)
     if not np.all(np.isfinite(ratio)) or not np.min(ratio) < 1.0 < np.max(ratio):
         return
     with plt.rc_context({"hatch.color": LIMIT_COLOUR, "hatch.linewidth": 0.7}):
-        ax.tricontourf(tri, ratio, levels=[1.0, float(np.max(ratio)) * 1.01], colors="none", hatches=["////"], zorder=1)
+        hatched = ax.tricontourf(tri, ratio, levels=[1.0, float(np.max(ratio)) * 1.01], colors="none", hatches=["////"], zorder=1)
+    hatched.set_gid(HATCHED)  # the caption speaks of the hatched region only where it is drawn
     ax.tricontour(tri, ratio, levels=[1.0], colors=LIMIT_COLOUR, linewidths=1.8, zorder=3)
     ax.fill([], [], facecolor="none", edgecolor=LIMIT_COLOUR, hatch="////", lw=1.8, label=f"{constraint_quantity(d).symbol} at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz above its limit (interpolated)")
 
@@ -221,7 +231,8 @@ def search_figure(dataset: xr.Dataset) -> DrawnFigure:
         caption.add("designs", f"The blue star is the {design_titles(d)[0]}, the orange square the scene's own (drawn at the edge of the map when it lies outside the bounds).")
         if math.isfinite(limit):
             caption.add("limit", f"Crosses mark candidates whose {c.symbol} at {fmt(d.attrs['operating_frequency_Hz'], '.4g')} Hz exceeds the allowed {fmt(c.value(limit), '.3g')} {c.unit} (the search penalised them)"
-                        + ("." if projected else f"; the hatched region bounded by the purple line is where that {c.symbol}, interpolated between the candidates, exceeds it."))  # fmt: skip
+                        + (f"; the hatched region bounded by the purple line is where that {c.symbol}, interpolated between the candidates, exceeds it." if _hatched(fig) else
+                           "; no candidate keeps it, so no region is hatched." if not np.any(d["operating_amplitude"].values <= limit) else "."))  # fmt: skip
     figure_legend(fig, axes, columns=3)
     if cells is not None:
         return DrawnFigure(fig, "design_search", "The map of the grid: the objective of every candidate", caption.text())
