@@ -63,10 +63,11 @@ def tradeoff_figure(dataset: xr.Dataset) -> DrawnFigure:
     if math.isfinite(linear):
         violation = _linear_violation(d)
         least = float(np.min(objective[front])) if np.any(front) else math.nan
-        below = math.isfinite(least) and (q.value(linear) < least or ties(q.value(linear), least))  # level with the front's least: no better for a stop either
+        level = math.isfinite(least) and ties(q.value(linear), least)  # level with the front's least: no better for a stop either
+        below = math.isfinite(least) and q.value(linear) < least and not level
         caption.add("linear", f"The green diamond at 0 N s is the {design_titles(d)[2]} of the same mass under the same mistuning ({fmt(q.value(linear), '.4g')} {q.unit}, exact band peaks): it has no stop, hence no impact"
                     + (f"; hollow: it violates the operating constraint ({violation})." if violation else
-                       "; level with or below the whole front, it is no larger on both." if below else f"; a design with a stop below it pays for its smaller {q.symbol} with impacts."))  # fmt: skip
+                       "; below the whole front, it is smaller on both." if below else "; level with the front's least, it is no larger on both." if level else f"; a design with a stop below it pays for its smaller {q.symbol} with impacts."))  # fmt: skip
     caption.add("front", f"The vermillion steps join the front: the feasible candidates no other feasible candidate beats on both ({order.size}); it is the front of what the search evaluated, not of a search constrained on the impulse.")
     if np.any(shown & ~feasible):
         caption.add("infeasible", "Crosses violate the operating constraint and are left off the front.")
