@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from vibroimpact.model.structure import require_in_range, require_non_negative
+from vibroimpact.model.keywords import suggest_keywords
 
 __all__ = ["EngineSettings", "STEPPED_TOLERANCES", "SWEPT_TOLERANCES", "SWEEP_SETTINGS", "SWEEP_REFERENCE_RTOL", "REFERENCE_RTOL", "ATOL_RATIO"]
 
@@ -24,6 +25,7 @@ ATOL_RATIO = 1e-4
 REFERENCE_RTOL = 1e-13
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class EngineSettings:
     """Numerical settings of a time-domain engine.

@@ -8,10 +8,12 @@ from dataclasses import dataclass
 
 from vibroimpact.model.structure import require_in_range, require_positive
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS
+from vibroimpact.model.keywords import suggest_keywords
 
 __all__ = ["ContinuationSettings"]
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class ContinuationSettings:
     """How a branch is followed.

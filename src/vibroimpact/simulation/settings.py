@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from vibroimpact.model.structure import require_in_range
+from vibroimpact.model.keywords import suggest_keywords
 
 __all__ = ["SteadySettings", "START_MODES", "SWEEP_STARTS"]
 
@@ -15,6 +16,7 @@ START_MODES = ("linear", "pgf", "rest", "shooting")
 SWEEP_STARTS = ("sweep_up", "sweep_down")
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class SteadySettings:
     """How a steady state is sought.
