@@ -268,11 +268,54 @@ def warning_lines(dataset: xr.Dataset, layout: GeneralSetting | None = None) -> 
         count = f" Worse at {len(worse)} of the {len(point.rows)} solutions and swept points." if len(point.rows) > 1 else ""
         lines.append(f"The stop makes the absorber worse at its operating point: at {fmt(row.frequency, '.4g')} Hz (anti-resonance {fmt(point.frequency, '.5g')} Hz) |{c}| is "
                      f"{_mm(row.linear)} with the linear absorber against {_mm(row.stopped)} with the stop{where}, ×{fmt(row.ratio, '.3g')}{_notch_peak(dataset, point, row)}.{count}")  # fmt: skip
+    nearby = _nearby_impacts(dataset, point, layout, {row.solution for row in worse})
+    if nearby:
+        lines.append(nearby)
     if point.free:
         parts = [f"|{coordinate}| = {_mm(motion)} against a gap of {_mm(gap, '.6g')}" for coordinate, motion, gap in point.free]
         lines.append(f"The absorber's free motion at its operating point does not fit in the gap: without the stop, at {fmt(point.frequency, '.4g')} Hz, " + "; ".join(parts)
                      + ". The stop is struck at the frequency the absorber is tuned to.")  # fmt: skip
     return lines
+
+
+#: How close to the operating point a coexisting impacting motion is said [-, of the frequency]: a machine's speed
+#: drifts by a few per cent with its load and supply (the design kind's cautions use the same).
+NEAR_OPERATING = 0.05
+
+
+def _nearby_impacts(dataset: xr.Dataset, point: OperatingPoint, layout: GeneralSetting, said: set[str]) -> str:
+    """The largest stable motion with the stop within :data:`NEAR_OPERATING` of the operating point that exceeds the
+    linear absorber's there by the factor :data:`WORSE_RATIO`, of a solution not already said worse at the point
+    itself, in one sentence; "" where none."""
+    quantity = f"{point.coordinate}_amplitude"
+    found: tuple[float, float, float, str, str] | None = None
+    for solution in sorted({row.solution for row in point.rows} - said):
+        part = computed_part(dataset, solution)
+        f = np.asarray(part["frequency"].values, dtype=float)
+        near = np.flatnonzero(np.abs(f - point.frequency) <= NEAR_OPERATING * point.frequency)
+        if not near.size:
+            continue
+        data = part[quantity].sel(solution=solution).isel(frequency=near)
+        if "stable" in part and "stable" in dataset.data_vars:
+            data = data.where(part["stable"].sel(solution=solution).isel(frequency=near) != 0)
+        dims = _swept(data)
+        values = data.transpose(*dims, "frequency", ...).values
+        values = values.reshape(values.shape[: len(dims) + 1] + (-1,)).max(axis=-1) if values.ndim > len(dims) + 1 else values
+        linear = np.asarray(layout.linear_value(quantity, 2.0 * np.pi * f[near]), dtype=float)
+        ratio = np.where(np.isfinite(values), values / linear, np.nan)
+        if not np.any(ratio > WORSE_RATIO):
+            continue
+        index = np.unravel_index(int(np.nanargmax(ratio)), ratio.shape)
+        if found is None or float(ratio[index]) > found[0]:
+            found = (float(ratio[index]), float(f[near][index[-1]]), float(values[index]), solution, _where(data, dims, tuple(int(i) for i in index[:-1])))
+    if found is None:
+        return ""
+    _ratio, at, value, solution, where = found
+    share = 100.0 * (at - point.frequency) / point.frequency
+    linear_there = float(layout.linear_value(quantity, np.array([2.0 * np.pi * at]))[0])
+    return (f"At {fmt(at, '.4g')} Hz, {fmt(abs(share), '.2g')} % {'below' if share < 0 else 'above'} the absorber's operating point ({fmt(point.frequency, '.5g')} Hz), "
+            f"{solution} has a stable motion with the stop of |{point.coordinate.upper()}| = {_mm(value)}{' at ' + where if where else ''} beside the linear absorber's "
+            f"{_mm(linear_there)}: a drift of the operating speed by that much can land on it.")  # fmt: skip
 
 
 def unreached_text(dataset: xr.Dataset, layout: GeneralSetting | None = None) -> str:
