@@ -555,3 +555,15 @@ def test_a_value_just_outside_each_declared_range_is_refused_naming_its_key_and_
                 parse_scene(_scene(section, given))
             said = f"{_where(section, key.name)}: {outside!r} is out of range: allowed "
             assert any(line.startswith(said) for line in caught.value.problems), (key.name, outside, caught.value.problems)
+
+
+@pytest.mark.parametrize("shipped, key", [("restitution.yaml", "simulation"), ("bumper_sweep.yaml", "swept_sine"), ("absorber_concepts.yaml", "bumper"),
+                                          ("absorber_concepts.yaml", "simulation"), ("absorber_concepts.yaml", "continuation")])
+def test_a_section_that_is_no_mapping_is_said_once(shipped: str, key: str) -> None:
+    """The kind's top level checks a section's type, and the section itself is then not read again: 'bumper: 5' was
+    said twice ('expected a mapping, got 5' by each reader)."""
+    document = _shipped(shipped) | {key: 5}
+    with pytest.raises(SceneError) as raised:
+        parse_scene(document)
+    said = [problem for problem in raised.value.problems if problem.startswith(f"{key}:")]
+    assert len(said) == 1 and "expected a mapping" in said[0], said

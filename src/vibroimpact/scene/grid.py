@@ -297,16 +297,17 @@ def parse_grid_scene(document: dict, text: str = "", source: str = "scene") -> S
 
     simulation = None
     engines = [name for name in solutions if name in ENGINE_SOLUTIONS]
-    swept_sine = _parse_swept_sine(c, doc["swept_sine"], engines, grids.get("frequency")) if "swept_sine" in doc else None
-    if "simulation" in doc:
+    # the sections as the top level read them: one that is no mapping was said there, once, and is not read again
+    swept_sine = _parse_swept_sine(c, own["swept_sine"], engines, grids.get("frequency")) if own.get("swept_sine") is not None else None
+    if (given := own.get("simulation")) is not None:
         if not engines:
             c.fail("simulation", f"given, but no time-domain solution ({', '.join(ENGINE_SOLUTIONS)}) is asked for")
         elif (main_grid := grids.get("frequency")) is not None:
             if "swept_sine" in doc:
-                for key in sorted(set(doc["simulation"]) & _STEADY_ONLY_KEYS if isinstance(doc["simulation"], dict) else ()):
+                for key in sorted(set(given) & _STEADY_ONLY_KEYS):
                     c.fail(f"simulation.{key}", "not used by a swept-sine test (it sets stepped steady states): remove it")
             swept_axes = {key: grid for key, grid in grids.items() if key in sweep and key != "frequency"}
-            simulation = parse_simulation(c, doc["simulation"], main_grid, swept="swept_sine" in doc, engines=engines, axes=swept_axes)
+            simulation = parse_simulation(c, given, main_grid, swept="swept_sine" in doc, engines=engines, axes=swept_axes)
     elif engines and (main_grid := grids.get("frequency")) is not None:
         simulation = parse_simulation(c, {}, main_grid, swept="swept_sine" in doc)
 

@@ -202,10 +202,11 @@ def parse_concepts(document: Any, source: str = "scene") -> tuple[str, str, bool
         c.fail("system", "a concepts scene needs the paper's layout: the two-mass chain (a primary mass on its suspension, an absorber on the primary) as {m1, m2, k1, k2, b1, b2} or its matrices with coordinates [x1, x2], the force on x1")
     own = CONCEPTS_TOP.read(c, {key: doc[key] for key in CONCEPTS_TOP.names if key in doc}, partial=True) or {}  # frequency, concepts required
     frequency = own.get("frequency")
-    simulation = _simulation(c, doc.get("simulation", {}), frequency)
-    bumper = CONCEPTS_BUMPER.read(c, doc["bumper"]) if "bumper" in doc else None
+    # the sections as the top level read them: one that is no mapping was said there, once, and is not read again
+    simulation = _simulation(c, own.get("simulation") or {}, frequency)
+    bumper = CONCEPTS_BUMPER.read(c, own["bumper"]) if own.get("bumper") is not None else None
     bumper_frequency = bumper["frequency"] if bumper is not None else math.nan
-    continuation = CONTINUATION.read(c, doc.get("continuation", {})) or {}
+    continuation = CONTINUATION.read(c, own.get("continuation") or {}) or {}
     steps = continuation.get("max_steps", 0) if continuation.get("enabled") else 0
     concepts = _concepts(c, own["concepts"], system) if own.get("concepts") is not None and system is not None else ()
     if c.problems:
@@ -263,7 +264,7 @@ def _concepts(c: Checker, value: Any, system: System) -> tuple[Concept, ...]:
         label = spec["label"] if spec["label"] is not None else name
         built = _absorber(c, f"{key}.absorber", spec["absorber"] if spec["absorber"] is not None else {}, system)
         stops = _stops(c, f"{key}.stops", spec["stops"], system.coordinates) if spec["stops"] is not None else ()
-        if built is not None and stops is not None and isinstance(name, str):
+        if built is not None and stops is not None:
             concepts.append(Concept(name, label, built[0], stops, built[1]))
     return tuple(concepts)
 
