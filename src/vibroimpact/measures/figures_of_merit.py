@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["WORSE_RATIO", "NEAREST", "Envelope", "anti_resonance_band", "envelope", "stretches", "BandMetrics", "band_metrics"]
+__all__ = ["WORSE_RATIO", "NEAREST", "NEAR_OPERATING", "Envelope", "anti_resonance_band", "envelope", "stretches", "BandMetrics", "band_metrics"]
 
 #: A stop makes the operating point worse where its value exceeds the linear absorber's by more than this factor [-]
 #: (1 % above: beyond the round-off of a computed ratio, well below any change an engineer would accept).
@@ -34,6 +34,9 @@ WORSE_RATIO = 1.01
 #: A computed grid frequency stands for the operating frequency only within this share of it [-] (the notch is narrow:
 #: its width is of the order of the absorber's damping ratio times its frequency).
 NEAREST = 0.01
+#: A stable motion with the stop this close to the operating frequency [-, of it] is warned of where it exceeds what is
+#: allowed there: a machine's speed drifts by a few per cent with its load and supply (stepped and design pages).
+NEAR_OPERATING = 0.05
 
 
 def anti_resonance_band(frequency: NDArray[np.float64], x1: NDArray[np.float64], static: float) -> tuple[float, float, float]:

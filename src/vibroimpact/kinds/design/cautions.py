@@ -14,16 +14,14 @@ import xarray as xr
 
 from vibroimpact.kinds.design.quantity import constraint_quantity, objective_quantity, operating_limit
 from vibroimpact.kinds.design.scene import safe_name
+from vibroimpact.measures.figures_of_merit import NEAR_OPERATING
 from vibroimpact.model.collision import MIN_BUMPER_RESTITUTION
 from vibroimpact.reporting.style import fmt
 
-__all__ = ["SYMBOLS", "NEAR_OPERATING", "variable_names", "at_bounds", "cautions"]
+__all__ = ["SYMBOLS", "variable_names", "at_bounds", "cautions"]
 
 #: How the page writes the design variables that have a symbol.
 SYMBOLS = {"clearance": "Delta", "restitution": "R", "bumper_stiffness": "K_b"}
-#: How close to the operating frequency a coexisting impacting motion is said [-, of the frequency]: a machine's
-#: speed drifts by a few per cent with its load and supply.
-NEAR_OPERATING = 0.05
 
 
 def variable_names(dataset: xr.Dataset) -> list[str]:
@@ -82,7 +80,7 @@ def _clipped(dataset: xr.Dataset) -> list[str]:
 
 
 def _nearby_impacts(dataset: xr.Dataset) -> str:
-    """A stable impacting motion of the recommended design within :data:`NEAR_OPERATING` of the operating
+    """A stable impacting motion of the recommended design within :data:`~vibroimpact.measures.figures_of_merit.NEAR_OPERATING` of the operating
     frequency, above the allowed value (the constraint's measure is the responses'), in one sentence; "" where none."""
     limit, at = operating_limit(dataset), float(dataset.attrs.get("operating_frequency_Hz", math.nan))
     q, c = objective_quantity(dataset), constraint_quantity(dataset)

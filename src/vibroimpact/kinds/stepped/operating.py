@@ -31,7 +31,7 @@ import xarray as xr
 
 from vibroimpact.kinds.stepped.crosscheck import subset_solutions
 from vibroimpact.kinds.stepped.tables import computed_part
-from vibroimpact.measures.figures_of_merit import NEAREST, WORSE_RATIO
+from vibroimpact.measures.figures_of_merit import NEAR_OPERATING, NEAREST, WORSE_RATIO
 from vibroimpact.reporting.record import GeneralSetting, general_setting, study_kind
 from vibroimpact.reporting.style import DISPLACEMENT_SCALE, fmt
 
@@ -278,13 +278,8 @@ def warning_lines(dataset: xr.Dataset, layout: GeneralSetting | None = None) -> 
     return lines
 
 
-#: How close to the operating point a coexisting impacting motion is said [-, of the frequency]: a machine's speed
-#: drifts by a few per cent with its load and supply (the design kind's cautions use the same).
-NEAR_OPERATING = 0.05
-
-
 def _nearby_impacts(dataset: xr.Dataset, point: OperatingPoint, layout: GeneralSetting, said: set[str]) -> str:
-    """The largest stable motion with the stop within :data:`NEAR_OPERATING` of the operating point that exceeds the
+    """The largest stable motion with the stop within :data:`~vibroimpact.measures.figures_of_merit.NEAR_OPERATING` of the operating point that exceeds the
     linear absorber's there by the factor :data:`WORSE_RATIO`, of a solution not already said worse at the point
     itself, in one sentence; "" where none."""
     quantity = f"{point.coordinate}_amplitude"
