@@ -30,6 +30,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from vibroimpact.model.keywords import suggest_keywords
+
+
 if TYPE_CHECKING:  # annotations only: impact_orbit imports this module (ImpactOrbit.multipliers)
     from vibroimpact.analysis.impact_orbit import ImpactOrbit
 
@@ -92,6 +95,7 @@ def half_period_jacobian(orbit: ImpactOrbit) -> NDArray[np.float64]:
     return -saltation(orbit) @ _flow(orbit.layout.structure.state_matrix, orbit.period / 2.0)
 
 
+@suggest_keywords
 def floquet_multipliers(solution: ImpactOrbit) -> NDArray[np.complex128]:
     """Floquet multipliers of each impact orbit, shape S + (2N,), sorted by decreasing modulus; NaN where no orbit
     exists.

@@ -38,6 +38,7 @@ from vibroimpact.analysis.layout import ClosedFormLayout, closed_form_layout, ha
 from vibroimpact.analysis.linear import base_force as suspension_force
 from vibroimpact.analysis.paper_fit import PaperFit
 from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.modal import ModalResponse, impulse_modes
 from vibroimpact.model.problem import ImpactProblem, ProblemLike, problem_of
 
@@ -64,6 +65,7 @@ def impulse_roots(a: NDArray, b: NDArray, discriminant: NDArray, constant: NDArr
     return np.where(discriminant >= 0.0, impulse, np.nan)
 
 
+@suggest_keywords
 @dataclass(frozen=True, eq=False)
 class ImpactOrbit:
     """Closed-form impact orbits at a set of points (arrays share one broadcast shape S).
@@ -404,6 +406,7 @@ def closed_form_problem(system: ProblemLike, call: str, frequency: ArrayLike | N
     return problem, layout
 
 
+@suggest_keywords
 def solve_impact_orbit(
     problem: ProblemLike,
     frequency: ArrayLike | None = None,

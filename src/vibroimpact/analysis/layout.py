@@ -29,6 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.model.contact import place_normal
 from vibroimpact.model.excitation import HarmonicForce, load_weights
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.layout import Layout
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
@@ -165,6 +166,7 @@ def closed_form_layout(problem: ImpactProblem) -> ClosedFormLayout:
     return ClosedFormLayout(kind, structure, n, chosen, first.effective_mass(structure.mass_matrix), first.clearance, first.law.restitution)
 
 
+@suggest_keywords
 def closed_form_refusal(problem: ImpactProblem) -> str | None:
     """Why no closed form applies to ``problem`` (the message of :func:`closed_form_layout`), or None."""
     try:

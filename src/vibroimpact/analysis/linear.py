@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.analysis.layout import harmonic_load_of
 from vibroimpact.model.excitation import HarmonicForce, angular_frequency, check_closed_form_inputs
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.layout import Layout
 from vibroimpact.model.problem import ImpactProblem, ProblemLike, problem_of
 from vibroimpact.model.structure import CONDITION_LIMIT, LinearStructure, harmonic_condition, stiffness_modes
@@ -92,6 +93,7 @@ class ResonancePeak:
     value: float
 
 
+@suggest_keywords
 @dataclass(frozen=True, eq=False)
 class LinearAmplitudes:
     """The linear steady state of a structure under its problem's load, without stops: what
@@ -166,6 +168,7 @@ class LinearAmplitudes:
         return np.all(np.abs(self.stop_amplitudes) + self.stop_static <= np.asarray(clearances, dtype=float), axis=-1)
 
 
+@suggest_keywords
 def linear_response(system: ProblemLike, frequency: ArrayLike | None = None, amplitude: ArrayLike | None = None, *,
                     omega: ArrayLike | None = None) -> LinearAmplitudes:  # fmt: skip
     """The complex amplitudes of every coordinate and every stop's coordinate over ``frequency`` (module docstring).

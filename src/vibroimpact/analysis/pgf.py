@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike
 
 from vibroimpact.analysis.impact_orbit import ImpactOrbit, closed_form_problem, solve_impact_orbit
 from vibroimpact.analysis.paper_fit import PaperFit
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.problem import ProblemLike
 
 __all__ = ["PgfVariant", "solve_one_impact", "AdmissibilitySettings"]
@@ -65,6 +66,7 @@ class AdmissibilitySettings:
     chunk_points: int = 2048
 
 
+@suggest_keywords
 def solve_one_impact(
     system: ProblemLike,
     frequency: ArrayLike | None = None,

@@ -6,11 +6,13 @@ from __future__ import annotations
 from numpy.typing import ArrayLike
 
 from vibroimpact.analysis.impact_orbit import ImpactOrbit, closed_form_problem, solve_impact_orbit
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.problem import ProblemLike
 
 __all__ = ["solve_two_impacts"]
 
 
+@suggest_keywords
 def solve_two_impacts(
     problem: ProblemLike,
     frequency: ArrayLike | None = None,

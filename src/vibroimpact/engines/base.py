@@ -13,6 +13,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines.registry import Capabilities
 from vibroimpact.model.excitation import SweptSine
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.problem import Contact, ImpactProblem
 
 __all__ = ["Trajectory", "TrajectoryBuilder", "SweepRecord", "Engine", "SweepingEngine", "check_run", "start_state", "MODE_FREE", "MODE_STUCK"]
@@ -21,6 +22,7 @@ __all__ = ["Trajectory", "TrajectoryBuilder", "SweepRecord", "Engine", "Sweeping
 MODE_FREE, MODE_STUCK = 0, 1
 
 
+@suggest_keywords
 @dataclass(frozen=True, eq=False)
 class Trajectory:
     """Immutable record of an integration over whole periods from ``t_start``.

@@ -18,6 +18,7 @@ from typing import Any, Mapping
 
 from vibroimpact.engines.settings import EngineSettings
 from vibroimpact.model.contact import BUMPER, RIGID
+from vibroimpact.model.keywords import suggest_keywords
 
 __all__ = ["RIGID", "BUMPER", "Capabilities", "CAPABILITIES", "EngineSpec", "ENGINES", "engine_names", "stepped_solutions", "engine_spec", "make_engine", "engine_for", "FIRST_COMPILE_TIME", "compile_notice"]
 
@@ -25,6 +26,7 @@ __all__ = ["RIGID", "BUMPER", "Capabilities", "CAPABILITIES", "EngineSpec", "ENG
 # the model's names (vibroimpact.model.contact), re-exported here beside the capabilities that use them.
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class Capabilities:
     """What an engine can do, as the code that runs it asks.
@@ -202,6 +204,7 @@ def compile_notice(name: str) -> str:
     return f"compiling the {name} engine's kernels (first use on this machine only, {FIRST_COMPILE_TIME}; later runs load them from numba's cache)"
 
 
+@suggest_keywords
 def make_engine(name: str, settings: EngineSettings = EngineSettings()) -> Any:
     """The engine registered under ``name``, built with ``settings``. The first one built of an engine whose kernels
     are not compiled yet says so on a terminal (:func:`compile_notice`): its first use waits for numba."""

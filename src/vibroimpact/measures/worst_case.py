@@ -25,6 +25,7 @@ from typing import Any
 
 from vibroimpact.analysis.band_worst import closed_form_worst
 from vibroimpact.analysis.measures import Measure, measure as measure_row
+from vibroimpact.model.keywords import checked_options, suggest_keywords
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.orbits.bumper_screen import bumper_worst
 from vibroimpact.orbits.worst_case import worst_response
@@ -34,6 +35,7 @@ from vibroimpact.simulation.certified_worst import certified_worst
 __all__ = ["BandMaximum", "METHODS", "worst_case"]
 
 
+@suggest_keywords
 @dataclass(frozen=True, eq=False)
 class BandMaximum:
     """The largest stable value of a measure over a band, and what found it.
@@ -98,7 +100,17 @@ METHODS: dict[str, Callable[..., BandMaximum]] = {
     "certified": _certified,
 }
 
+#: Method name -> the function its ``**options`` go to (each checked against its keywords before any work).
+OPTION_TAKERS: dict[str, Callable[..., Any]] = {
+    "closed_form": closed_form_worst,
+    "bumper_orbits": bumper_worst,
+    "continuation": worst_response,
+    "brute_force": band_attractors,
+    "certified": certified_worst,
+}
 
+
+@suggest_keywords
 def worst_case(problem: ImpactProblem, band: tuple[float, float], measure: str | Measure = "x1_amplitude", method: str = "certified", **options: Any) -> BandMaximum:
     """The largest stable value of ``measure`` of ``problem`` over ``band`` [Hz], found by ``method``.
 
@@ -120,9 +132,12 @@ def worst_case(problem: ImpactProblem, band: tuple[float, float], measure: str |
     ValueError
         An unknown method or measure (naming the allowed ones), or what the method refuses (a layout without closed
         forms for ``closed_form``, rigid stops for ``bumper_orbits`` ...).
+    TypeError
+        An option the method does not take (naming the ones it takes and the closest).
     """
     if method not in METHODS:
         raise ValueError(f"method = {method!r}: allowed {', '.join(METHODS)}")
+    checked_options(f"worst_case(method={method!r})", options, OPTION_TAKERS[method])
     row = measure if isinstance(measure, Measure) else measure_row(measure, problem.structure.coordinates)
     reason = row.refusal(problem)
     if reason is not None:

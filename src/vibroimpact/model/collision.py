@@ -26,6 +26,7 @@ from __future__ import annotations
 import cmath
 import math
 
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.structure import require_in_range, require_non_negative
 
 __all__ = [
@@ -65,6 +66,7 @@ def release_time(xi: float) -> float:
     return 2.0 * math.atanh(s / xi) / s
 
 
+@suggest_keywords
 def restitution_from_loss_factor(xi: float) -> float:
     """R(xi_b) of one Kelvin-Voigt collision that releases when the force would turn negative [-].
 
@@ -84,6 +86,7 @@ def restitution_from_loss_factor(xi: float) -> float:
 MIN_BUMPER_RESTITUTION = restitution_from_loss_factor(MAX_LOSS_FACTOR)
 
 
+@suggest_keywords
 def loss_factor_from_restitution(restitution: float) -> float:
     """The loss factor xi_b [-] of the Kelvin-Voigt bumper whose one collision restitutes R (the inverse of
     :func:`restitution_from_loss_factor`, to 1e-15): the bumper that stands for a rigid stop of restitution R.

@@ -19,6 +19,7 @@ from vibroimpact.model.collision import (
     MAX_LOSS_FACTOR, MIN_BUMPER_RESTITUTION, loss_factor_from_restitution, paper_restitution, peak_acceleration_factor, release_time,
     restitution_from_loss_factor,
 )  # fmt: skip
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.units import length_text
 from vibroimpact.model.structure import require_finite, require_in_range, require_non_negative, require_positive
 
@@ -78,6 +79,7 @@ class Impact:
     impulse: float
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class RigidStop:
     """Momentary-impact stop: clearance Delta [m] (negative: a preloading stop) and restitution ratio R [-] in [0, 1].
@@ -125,6 +127,7 @@ class RigidStop:
         return Impact(velocity, after, sticks, mass * (velocity - after))
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class KelvinVoigtBumper:
     """Visco-elastic bumper (eq. 25): clearance Delta [m], apparent natural frequency Omega_b / 2 pi [Hz] (:attr:`omega`
@@ -252,6 +255,7 @@ def _resolve(key: str, value: CoordinateRef, names: tuple[str, ...]) -> int:
     return value
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class Stop:
     """One stop of the structure.

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.structure import require_finite, require_non_negative, require_positive
 
 __all__ = ["HarmonicForce", "SweptSine", "load_weights", "static_load", "angular_frequency", "check_closed_form_inputs"]
@@ -51,6 +52,7 @@ def static_load(static: tuple[float, ...] | None, size: int, key: str = "excitat
     return np.array(static, dtype=float)
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class HarmonicForce:
     """A harmonic load q cos(2 pi f t + phase), distributed over the coordinates, plus an optional constant force.
@@ -116,6 +118,7 @@ class HarmonicForce:
         return self.amplitude * np.cos(self.omega * np.asarray(t, dtype=float) + self.phase)
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class SweptSine:
     """Linear swept sine q sin(theta(t)), instantaneous frequency f0 + alpha t from t = 0 to ``duration``.

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.units import LENGTH_UNITS, length_text
 from vibroimpact.model.collision import loss_factor_from_restitution, restitution_from_loss_factor
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, Stop, check_room, place_effective_mass, place_normal
@@ -228,6 +229,7 @@ def _described_clearance(words: str, side: str) -> float:
     return value if side == "upper" else -value
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class Layout:
     """A structure, its load and its stops, without the values a study sweeps.

@@ -50,6 +50,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.model.contact import MAX_LOSS_FACTOR, KelvinVoigtBumper
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
@@ -66,6 +67,7 @@ MAX_RELATIVE_SPREAD = 0.5
 MAX_BUMPER_FREQUENCY = 1e6
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class Parameter:
     """One scalar a study may vary: a row of the parameter table (module docstring).
@@ -133,6 +135,7 @@ PARAMETERS: dict[str, Parameter] = {
 }
 
 
+@suggest_keywords
 def parameter(name: str, problem: ImpactProblem | None = None) -> Parameter:
     """The table's row of ``name``: a named scalar, or a layout scalar by the grammar (module docstring).
 

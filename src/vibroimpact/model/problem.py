@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.model.contact import BUMPER, RIGID, KelvinVoigtBumper, RigidStop, Stop, check_room
 from vibroimpact.model.excitation import HarmonicForce, SweptSine, load_weights, static_load
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.structure import LinearStructure
 from vibroimpact.model.system import TwoDofSystem
 
@@ -43,6 +44,7 @@ def _part_of_kind(name: str, value: object, kind: type[_Kind], why: str) -> _Kin
 _PARTS = {"system": (TwoDofSystem, LinearStructure), "contact": (RigidStop, KelvinVoigtBumper, tuple), "excitation": (HarmonicForce, SweptSine)}
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class ImpactProblem:
     """A linear structure with stops and a harmonic (or swept) load.

@@ -21,6 +21,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from vibroimpact.model.keywords import suggest_keywords
+
+
 __all__ = ["LinearStructure", "as_matrix_rows", "require_finite", "require_positive", "require_non_negative", "require_count", "require_in_range",
            "MASS_RATIO", "STIFFNESS_RATIO", "DAMPING_RATIO", "RIGID_MODE_RATIO", "SOFTEST_SPRING", "require_ratio", "CONDITION_LIMIT", "harmonic_condition",
            "resonance_refusal", "StiffnessModes", "stiffness_modes"]
@@ -288,6 +291,7 @@ def _check_dynamic_range(mass: NDArray[np.float64], stiffness: NDArray[np.float6
                   "a mode that overdamped has a slow pole lost to round-off next to its fast one")
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class LinearStructure:
     """Masses, springs and dashpots of a linear structure of N degrees of freedom.

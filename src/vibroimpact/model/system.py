@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.model.excitation import angular_frequency, check_closed_form_inputs
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.structure import DAMPING_RATIO, MASS_RATIO, STIFFNESS_RATIO, LinearStructure, require_non_negative, require_positive, require_ratio
 
 __all__ = ["TwoDofSystem", "Receptances", "PAPER_SYSTEM", "NAMED_KEYS", "named_system", "LinearResponse", "paper_linear_response"]
@@ -45,6 +46,7 @@ class Receptances:
     h22: NDArray[np.complex128]
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class TwoDofSystem:
     """Masses, springs and dashpots of the vibration protection system (paper fig. 1).

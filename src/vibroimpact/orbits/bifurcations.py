@@ -27,6 +27,7 @@ from itertools import combinations
 import numpy as np
 from numpy.typing import NDArray
 
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.orbits.arclength import ArclengthSystem, Point
 from vibroimpact.orbits.branch import HybridInfo, Iterated, MapEvaluation, ParametrisedMap, PeriodicOrbit, SpecialPoint
 
@@ -310,6 +311,7 @@ def classify(kind: str, orbit: PeriodicOrbit, parameter: str, test_value: float)
     raise ValueError(f"kind = {kind!r}: classify handles fold, period_doubling and neimark_sacker")
 
 
+@suggest_keywords
 def switch_period_doubling(system: ParametrisedMap, point: SpecialPoint, amplitude: float = 1e-3, tolerance: float = 1e-11) -> PeriodicOrbit:
     """The period-2k orbit born at a period doubling, from the guess y* +- eps v (v: the -1 eigenvector).
 

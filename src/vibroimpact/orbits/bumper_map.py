@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.model.contact import BUMPER, KelvinVoigtBumper, RigidStop
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.parameters import BUMPER_STIFFNESS
 from vibroimpact.orbits.branch import HybridInfo, MapEvaluation
@@ -39,6 +40,7 @@ __all__ = ["BumperPeriodMap", "CompiledPeriodMap", "BUMPER_PERIOD"]
 BUMPER_PERIOD = "bumper_period"
 
 
+@suggest_keywords
 class BumperPeriodMap(ImpactMap):
     """:class:`~vibroimpact.orbits.maps.ImpactMap` of a problem whose selected stops are Kelvin-Voigt bumpers, with
     their period T_b = 2 pi / Omega_b = 1 / (Omega_b / 2 pi) [s] as the last parameter.

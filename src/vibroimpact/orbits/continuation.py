@@ -31,6 +31,7 @@ import math
 
 import numpy as np
 
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.orbits.arclength import ArclengthSystem, Point
 from vibroimpact.orbits.bifurcations import classify, grazing_margin, locate
 from vibroimpact.orbits.bifurcations import neimark_sacker_test, period_doubling_test
@@ -324,6 +325,7 @@ class _Walker(OnsetSteps):
 
 
 
+@suggest_keywords
 def continue_branch(system: ParametrisedMap, orbit: PeriodicOrbit, parameter: str, settings: ContinuationSettings = ContinuationSettings(), direction: int = 0) -> Branch:
     """Follow the branch of periodic orbits through ``orbit`` as ``parameter`` varies.
 

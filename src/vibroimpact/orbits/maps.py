@@ -48,6 +48,7 @@ from vibroimpact.analysis.impact_orbit import solve_impact_orbit
 from vibroimpact.analysis.linear import LinearAmplitudes, linear_amplitudes
 from vibroimpact.engines.registry import BUMPER, engine_for, make_engine
 from vibroimpact.model.contact import KelvinVoigtBumper, RigidStop, loss_factor_from_restitution
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import require_count
 from vibroimpact.orbits.branch import Branch, HybridInfo, MapEvaluation, PeriodicOrbit
@@ -87,6 +88,7 @@ def stop_selection(problem: ImpactProblem, stop: int | str | None) -> tuple[int,
     return (stop,)
 
 
+@suggest_keywords
 class ImpactMap:
     """Stroboscopic map over ``periods`` excitation periods of a problem with rigid stops or Kelvin-Voigt bumpers under
     a harmonic force.

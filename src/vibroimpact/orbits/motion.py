@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.analysis.stability import Regime
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.structure import require_in_range, require_positive
 from vibroimpact.orbits.lyapunov import LyapunovEstimate, lyapunov_from_jacobians
 
@@ -318,6 +319,7 @@ class MotionEvidence:
         return {"quasi_periodic": Regime.QUASI_PERIODIC, "chaotic": Regime.CHAOTIC}.get(self.kind, Regime.IRREGULAR)
 
 
+@suggest_keywords
 def classify_motion(jacobians: ArrayLike, strobes: ArrayLike, thresholds: MotionThresholds = MotionThresholds(), transient: int | None = None) -> MotionEvidence:
     """Classify a non-periodic motion from its exact per-period Jacobians and its strobes.
 

@@ -12,12 +12,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.analysis.linear import base_force
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.orbits.branch import Branch, PeriodicOrbit
 from vibroimpact.orbits.maps import ImpactMap
 
 __all__ = ["OrbitMeasures", "orbit_measures", "BranchMeasures", "branch_measures"]
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class OrbitMeasures:
     """What a periodic orbit of an :class:`ImpactMap` means physically.
@@ -55,6 +57,7 @@ class OrbitMeasures:
         return float(self.amplitudes[1]) if self.amplitudes.size > 1 else math.nan
 
 
+@suggest_keywords
 def orbit_measures(system: ImpactMap, orbit: PeriodicOrbit) -> OrbitMeasures:
     """Impulses and harmonic amplitudes of ``orbit``, from one exact integration over its period.
 
@@ -84,6 +87,7 @@ def orbit_measures(system: ImpactMap, orbit: PeriodicOrbit) -> OrbitMeasures:
     return OrbitMeasures(trajectory.impact_velocities.copy(), trajectory.impulses.copy(), amplitudes, stops, force)
 
 
+@suggest_keywords
 @dataclass(frozen=True, eq=False)
 class BranchMeasures:
     """What a branch's orbits mean physically, point by point (:func:`branch_measures`).
@@ -119,6 +123,7 @@ class BranchMeasures:
         return self.amplitudes[:, coordinate]
 
 
+@suggest_keywords
 def branch_measures(system: ImpactMap, branch: Branch) -> BranchMeasures:
     """:func:`orbit_measures` of every orbit of ``branch`` (continued on ``system``), as arrays along it: one exact
     integration per point, each at the orbit's own strobe.

@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from vibroimpact.analysis.impact_orbit import ROOTS, ImpactOrbit, solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.structure import require_count, require_in_range, require_positive
 from vibroimpact.orbits.branch import Iterated, MapEvaluation, ParametrisedMap, PeriodicOrbit
@@ -116,6 +117,7 @@ def _solve(matrix: NDArray[np.float64], rhs: NDArray[np.float64]) -> NDArray[np.
         return np.linalg.lstsq(matrix, rhs, rcond=None)[0]
 
 
+@suggest_keywords
 def shoot(system: ParametrisedMap, guess: ArrayLike, parameters: ArrayLike, period: int = 1, settings: ShootingSettings = ShootingSettings()) -> PeriodicOrbit:
     """A period-``period`` orbit of ``system`` near ``guess``: a zero of ``P^k(y) - y`` by damped Newton.
 
@@ -197,6 +199,7 @@ def shoot(system: ParametrisedMap, guess: ArrayLike, parameters: ArrayLike, peri
 # phase clear of the impacts.
 # --------------------------------------------------------------------------------------------------------------------
 
+@suggest_keywords
 def closed_form_state(problem: ImpactProblem, orbit: ImpactOrbit | None = None, root: str = "+") -> NDArray[np.float64]:
     """The state (x, x') at t = 0 of ``problem``'s time on its closed-form impact orbit (any structure), shape (2N,).
 

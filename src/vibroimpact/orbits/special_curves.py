@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.orbits.arclength import ArclengthSystem, Point, TestFunction
 from vibroimpact.orbits.bifurcations import grazing_margin, locate, neimark_sacker_test, period_doubling_test
 from vibroimpact.orbits.branch import MapEvaluation, ParametrisedMap, PeriodicOrbit, SpecialPoint
@@ -79,6 +80,7 @@ def defining_function(kind: str, reference: tuple[int, int] | None = None) -> Te
     return table[kind]
 
 
+@suggest_keywords
 def continue_special_point(
     system: ParametrisedMap,
     point: SpecialPoint,

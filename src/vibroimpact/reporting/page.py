@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable, Protocol
 
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.reporting.style import DPI, REPORT_RC, readable_axes, thin_minor_log_ticks  # first: selects the Agg backend before pyplot is imported
 
 import matplotlib.pyplot as plt  # noqa: E402
@@ -275,6 +276,7 @@ def write_page(path: Path, text: str) -> Path:
 # The report of a dataset: its kind's page, written. 
 # --------------------------------------------------------------------------------------------------------------------
 
+@suggest_keywords
 def write_report(dataset: xr.Dataset, out_dir: str | Path, jobs: int = 1) -> Path:
     """Write the PNG figures and ``report.html`` for ``dataset`` into ``out_dir``, rendering the figures in ``jobs``
     processes; return the HTML path."""

@@ -38,6 +38,7 @@ import xarray as xr
 
 from vibroimpact import __version__
 from vibroimpact.engines.registry import compile_notice, engine_spec
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.runs.cluster import Progress
 from vibroimpact.runs.runner import Runner
 from vibroimpact.runs.spawn_main import refuse_in_a_spawned_import
@@ -124,6 +125,7 @@ def _stderr_progress(message: str) -> None:
     print(message, file=sys.stderr, flush=True)
 
 
+@suggest_keywords
 def run_study(scene: Scene, progress: Progress | None = _stderr_progress, jobs: int = 1, store: StudyStore | None = None, scheduler: str | None = None, load: bool = True) -> xr.Dataset:
     """Compute every solution of ``scene`` over its grid.
 
@@ -300,6 +302,7 @@ def _simulated(dataset: xr.Dataset) -> tuple[list[str], np.ndarray]:
     return simulated, mask
 
 
+@suggest_keywords
 def split_groups(dataset: xr.Dataset) -> dict[str, xr.Dataset]:
     """``dataset`` as :func:`write_dataset` stores it: netCDF group path -> dataset (what ``xarray.open_groups`` reads).
 
@@ -337,6 +340,7 @@ def split_groups(dataset: xr.Dataset) -> dict[str, xr.Dataset]:
     return {"/": encode_labels(root), f"/{SIMULATED_GROUP}": encode_labels(group)}
 
 
+@suggest_keywords
 def join_groups(groups: Mapping[str, xr.Dataset]) -> xr.Dataset:
     """The one dataset of :func:`split_groups`'s groups (or of ``xarray.open_groups`` on a file :func:`write_dataset`
     wrote): every solution on the root's frequency axis, the simulated ones ``not_applicable`` or NaN at the
@@ -383,6 +387,7 @@ def _unmasked(dataset: xr.Dataset) -> xr.Dataset:
     return dataset.assign(masked) if masked else dataset
 
 
+@suggest_keywords
 def read_dataset(path: str | Path) -> xr.Dataset:
     """The dataset :func:`write_dataset` wrote at ``path``, loaded, its groups joined (:func:`join_groups`): the one
     dataset :func:`run_study` returned, which the report pages draw from."""
@@ -406,6 +411,7 @@ def _netcdf_encoding(dataset: xr.Dataset) -> tuple[xr.Dataset, dict[str, dict[st
     return dataset, encoding
 
 
+@suggest_keywords
 def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
     """Write ``dataset`` to netCDF atomically: a temporary file in the same folder, then a rename.
 

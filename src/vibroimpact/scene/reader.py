@@ -23,6 +23,7 @@ from typing import Any
 
 import yaml
 
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.scene.checker import SceneError
 from vibroimpact.scene.kinds import KINDS, kind_of_document
 from vibroimpact.scene.schema import Scene
@@ -136,6 +137,7 @@ def _expanded_characters(node: yaml.Node, sizes: dict[int, int]) -> int:
     return total
 
 
+@suggest_keywords
 def parse_scene(document: Any, text: str = "", source: str = "scene") -> Scene:
     """Validate a parsed YAML document and build the :class:`Scene`; raise :class:`SceneError` listing all problems.
     Without ``text`` (a scene made in Python), the scene keeps the document written as YAML (:func:`scene_text`).
@@ -173,6 +175,7 @@ def scene_text(document: dict) -> str:
         return ""
 
 
+@suggest_keywords
 def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene, found as ``run-study`` finds it (:func:`find_scene`: a path, ``studies/<name>`` here,
     or a shipped scene such as ``restitution`` or ``validation/zeno``); raise :class:`SceneError` (or ``OSError`` if
@@ -197,6 +200,7 @@ def load_scene(path: str | Path) -> Scene:
 # Where scenes are: a scene named on the command line, and the scenes shipped with the package.
 # --------------------------------------------------------------------------------------------------------------------
 
+@suggest_keywords
 def find_scene(name: str | Path) -> Path:
     """Locate a scene: the path as given, else ``studies/<name>`` in the working directory, else the shipped one.
 

@@ -13,6 +13,7 @@ from typing import Generic, Sequence, TypeVar
 
 
 from vibroimpact.engines.registry import RIGID, engine_for, engine_names, engine_spec, stepped_solutions
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.layout import Layout
 from vibroimpact.model.parameters import PARAMETERS
 from vibroimpact.scene.kinds import KIND_NAMES
@@ -79,6 +80,7 @@ MAX_SWEEP_SAMPLES = 10_000_000
 MAX_BENCHMARK_PERIODS = 1_000_000
 
 
+@suggest_keywords
 @dataclass(frozen=True, eq=False)
 class Scene(Generic[SettingsT]):
     """A validated scene: a header shared by every kind, and its kind's own settings.

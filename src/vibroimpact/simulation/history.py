@@ -23,12 +23,14 @@ from numpy.typing import NDArray
 
 from vibroimpact.engines.base import Engine
 from vibroimpact.engines.registry import make_engine
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.simulation.harmonics import linear_state
 
 __all__ = ["TimeHistory", "time_history", "linear_history", "engine_of"]
 
 
+@suggest_keywords
 @dataclass(frozen=True, eq=False)
 class TimeHistory:
     """A motion sampled at given times, and the contacts inside the sampled span.
@@ -110,6 +112,7 @@ def _periods(problem: ImpactProblem, t_start: float, t_last: float) -> int:
     return periods
 
 
+@suggest_keywords
 def time_history(engine: Engine | str, problem: ImpactProblem, state: NDArray[np.float64], t_start: float, times: NDArray[np.float64]) -> TimeHistory:
     """The motion from ``state`` at ``t_start``, sampled at ``times``.
 

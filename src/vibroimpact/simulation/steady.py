@@ -29,6 +29,7 @@ from numpy.typing import NDArray
 from vibroimpact.engines.base import Engine
 from vibroimpact.model.contact import RIGID, RigidStop, Stop
 from vibroimpact.model.excitation import HarmonicForce
+from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.simulation.harmonics import HarmonicMeasures, measure, gaps, linear_state, resting_state, suspension_force
 from vibroimpact.analysis.impact_orbit import solve_impact_orbit
@@ -228,6 +229,7 @@ def check_amplitude(problem: ImpactProblem, result: "SteadyResult") -> None:
         )
 
 
+@suggest_keywords
 def steady_state(
     engine: Engine | str,
     problem: ImpactProblem,

@@ -66,3 +66,17 @@ def test_the_design_and_stepped_pages_judge_worse_alike() -> None:
 
     for kind in (design, stepped):  # one declaration, read by both kinds: not copies held equal
         assert kind.WORSE_RATIO is figures_of_merit.WORSE_RATIO and kind.NEAREST is figures_of_merit.NEAREST
+
+
+def test_a_design_above_the_operating_limit_is_never_called_recommended(dataset: xr.Dataset) -> None:
+    """Issue 51: with no design keeping the notch, the search map's and the trade-off's star marked a design 'the
+    recommended design' that the answer calls only the best found (the least penalised score). The title, read by
+    every legend, table and figure title, now says what the answer says."""
+    from vibroimpact.kinds.design.answer import answer_text, design_titles
+    from vibroimpact.kinds.design.quantity import operating_limit
+
+    assert design_titles(dataset)[0] == "recommended design"  # the golden design keeps its 0.05 mm limit
+    worse = dataset.copy(deep=True)
+    worse["design_operating_amplitude"].values[0] = 2.0 * operating_limit(dataset)
+    assert design_titles(worse)[0] == "best found (above the operating limit)"
+    assert answer_text(worse).startswith("No design found in these bounds keeps the operating limit") and "the best found" in answer_text(worse)

@@ -388,7 +388,12 @@ def screen_words(dataset: xr.Dataset) -> str:
 def design_titles(dataset: xr.Dataset) -> tuple[str, str, str]:
     """How the page names the compared designs: :data:`DESIGN_TITLES`, the first called "best design with a stop"
     where the linear absorber is the one to build (:func:`linear_wins`), and "recommended design (its stop never
-    struck)" where the answer is to build it without its stop (:func:`never_strikes`): its star marks the absorber."""
+    struck)" where the answer is to build it without its stop (:func:`never_strikes`): its star marks the absorber;
+    "best found (above the operating limit)" where no design in the bounds keeps the operating limit (the answer's
+    first words), so that no marker calls a design that breaks the limit a recommendation."""
+    limit = operating_limit(dataset)
+    if math.isfinite(limit) and int(dataset.attrs.get("recommended_evaluation", -1)) >= 0 and not float(dataset["design_operating_amplitude"].values[0]) <= limit:
+        return ("best found (above the operating limit)", *DESIGN_TITLES[1:])  # type: ignore[return-value]
     if linear_wins(dataset):
         return ("best design with a stop", *DESIGN_TITLES[1:])  # type: ignore[return-value]
     if never_strikes(dataset):

@@ -23,6 +23,7 @@ import xarray as xr
 
 from vibroimpact.kinds.design.answer import DESIGN_TITLES, answer_text, certified_worst, design_text, design_worst, present_designs, sample_name, variable_names, warnings
 from vibroimpact.kinds.design.scene import safe_name
+from vibroimpact.model.keywords import suggest_keywords
 
 __all__ = ["ComparedDesign", "Certificate", "DesignAnswer", "design_answer"]
 
@@ -88,6 +89,7 @@ class Certificate:
     error: str
 
 
+@suggest_keywords
 @dataclass(frozen=True)
 class DesignAnswer:
     """What a design study answers (:func:`design_answer`).
@@ -142,6 +144,7 @@ def _number(value: float) -> str:
     return "-" if not math.isfinite(value) else f"{value:.4g}"
 
 
+@suggest_keywords
 def design_answer(dataset: xr.Dataset) -> DesignAnswer:
     """The answer of a design study's dataset (from :func:`~vibroimpact.runs.run.run_study` or read back by
     :func:`~vibroimpact.runs.run.read_dataset`): the same sentence, numbers and warnings the page shows; ValueError
