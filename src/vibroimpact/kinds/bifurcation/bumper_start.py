@@ -1,11 +1,14 @@
-"""The start of a bumper's one-contact branch: the rigid stop's orbit continued to the scene's bumper through the
-bumper period.
+"""One start of a bumper's one-contact branch: the rigid stop's orbit continued to the scene's bumper through the
+bumper period. (The other, needing no rigid stop, is the contact-free orbit's onset:
+:mod:`vibroimpact.orbits.onset_start`.)
 
 A Kelvin-Voigt bumper has no closed-form orbit of its own; its one-contact orbit at a frequency f0 is the rigid
 stop's (the limit T_b -> 0 of the bumper period T_b = 1 / (Omega_b / 2 pi)) continued in T_b. :func:`bumper_start`
 shoots the rigid orbit on a bumper :data:`STIFF_START` times stiffer than the scene's (the orbits converge at first
 order in T_b: the rigid orbit is 1 / :data:`STIFF_START` as far from that bumper's as from the scene's), then follows
-it in T_b on :class:`~vibroimpact.orbits.bumper_map.BumperPeriodMap` up to the scene's bumper. Shooting the rigid
+it in T_b on :class:`~vibroimpact.orbits.bumper_map.BumperPeriodMap` up to the scene's bumper, in stages of a
+factor :data:`STAGE` in T_b, each measuring arclength in its own first T_b (steps in log T_b: a bumper 64 times
+softer than the start is 3 stages). Shooting the rigid
 orbit on the scene's bumper directly fails where the two are far apart (the shipped ``bifurcation_bumper``: 8 of its
 20 starts, the line search or 40 Newton iterations stalling on a residual of 1e-3 to 5e-2).
 
@@ -27,12 +30,16 @@ from vibroimpact.orbits.continuation import ContinuationSettings, continue_branc
 from vibroimpact.orbits.maps import ImpactMap
 from vibroimpact.orbits.shooting import shoot
 
-__all__ = ["STIFF_START", "START_STEPS", "BumperStart", "bumper_start"]
+__all__ = ["STIFF_START", "START_STEPS", "STAGE", "BumperStart", "bumper_start"]
 
 #: The rigid orbit is first shot on a bumper this many times stiffer (in Omega_b) than the scene's [-].
 STIFF_START = 64.0
-#: Most continuation steps in T_b from that bumper to the scene's (measured: 5-50 on the shipped study).
+#: Most continuation steps in T_b per stage (measured: 5-50 on the shipped study).
 START_STEPS = 300
+#: T_b grows by at most this factor per stage, each stage measuring arclength in its first T_b: steps in log T_b, as
+#: many per octave of the bumper's stiffness wherever they are (one scale for all of them took 300 steps to soften a
+#: 100 Hz bumper to 10 Hz and stalled there on NLvib's chain, whose bumper is 1.59 Hz) [-].
+STAGE = 4.0
 #: The continuation reached the scene's bumper when its largest T_b is within this of it, relative [-] (its last
 #: point lies on the bound).
 REACHED = 1e-9
@@ -90,23 +97,28 @@ def bumper_start(mapping: ImpactMap, rigid: PeriodicOrbit) -> BumperStart:
         raise ValueError("mapping: every stop must be a Kelvin-Voigt bumper")
     target = 1.0 / next(iter(laws)).frequency  # type: ignore[union-attr]
     stiff = target / STIFF_START
-    bounds = {**mapping.bounds, BUMPER_PERIOD: (0.5 * stiff, target)}
-    system = BumperPeriodMap(mapping.problem, bounds=bounds)
+    system = BumperPeriodMap(mapping.problem, bounds={**mapping.bounds, BUMPER_PERIOD: (0.5 * stiff, target)})
     parameters = system.parameters.copy()
     parameters[-1] = stiff
-    first = shoot(system, rigid.state, parameters)
-    settings = ContinuationSettings(lower=0.5 * stiff, upper=target, max_steps=START_STEPS, stop_at_grazing=True)
-    branch = continue_branch(system, first, BUMPER_PERIOD, settings, direction=1)
-    periods = branch.values
-    softest = 1.0 / float(periods.max())
-    if periods.max() >= target * (1.0 - REACHED):
-        last = branch.orbits[int(periods.argmax())]
-        return BumperStart(shoot(mapping, last.state, mapping.parameters), "", softest)
-    turns = [point for point in branch.special_points if point.kind in ("fold", "grazing")]
-    if turns and turns[0].kind == "fold":
-        why = f"followed in the bumper's stiffness it turns back at Omega_b / 2 pi = {1.0 / turns[0].value:.4g} Hz (a fold in T_b: it exists only with stiffer bumpers)"
-    elif turns:
-        why = f"followed in the bumper's stiffness it loses its contact at Omega_b / 2 pi = {1.0 / turns[0].value:.4g} Hz (an onset at tangency)"
-    else:  # neither an answer nor the orbit: the continuation gave up
-        raise RuntimeError(f"the continuation in the bumper's stiffness reached only Omega_b / 2 pi = {softest:.4g} Hz of {1.0 / target:g} Hz (it ended: {branch.end})")
-    return BumperStart(None, why, softest)
+    orbit = shoot(system, rigid.state, parameters)
+    reached = stiff
+    while reached < target * (1.0 - REACHED):  # one stage per factor STAGE in T_b: steps in log T_b
+        upper = min(STAGE * reached, target)
+        scale = (*BumperPeriodMap.natural_scale(mapping.problem)[:-1], reached)  # a unit of arclength: this stage's T_b
+        stage = BumperPeriodMap(mapping.problem, bounds={**mapping.bounds, BUMPER_PERIOD: (0.5 * reached, upper)}, parameter_scale=scale)
+        settings = ContinuationSettings(lower=0.5 * reached, upper=upper, max_steps=START_STEPS, stop_at_grazing=True)
+        branch = continue_branch(stage, orbit, BUMPER_PERIOD, settings, direction=1)
+        periods = branch.values
+        if periods.max() >= upper * (1.0 - REACHED):
+            orbit, reached = branch.orbits[int(periods.argmax())], upper
+            continue
+        softest = 1.0 / float(periods.max())
+        turns = [point for point in branch.special_points if point.kind in ("fold", "grazing")]
+        if turns and turns[0].kind == "fold":
+            why = f"followed in the bumper's stiffness it turns back at Omega_b / 2 pi = {1.0 / turns[0].value:.4g} Hz (a fold in T_b: it exists only with stiffer bumpers)"
+        elif turns:
+            why = f"followed in the bumper's stiffness it loses its contact at Omega_b / 2 pi = {1.0 / turns[0].value:.4g} Hz (an onset at tangency)"
+        else:  # neither an answer nor the orbit: the continuation gave up
+            raise RuntimeError(f"the continuation in the bumper's stiffness reached only Omega_b / 2 pi = {softest:.4g} Hz of {1.0 / target:g} Hz (it ended: {branch.end})")
+        return BumperStart(None, why, softest)
+    return BumperStart(shoot(mapping, orbit.state, mapping.parameters), "", 1.0 / target)
