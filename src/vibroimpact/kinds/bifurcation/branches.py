@@ -43,6 +43,7 @@ from vibroimpact.orbits.bifurcations import switch_period_doubling
 from vibroimpact.orbits.branch import SPECIAL_POINT_KINDS, Branch, Iterated, PeriodicOrbit, SpecialPoint
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
 from vibroimpact.orbits.maps import ImpactMap, closed_form_state, section_phase
+from vibroimpact.orbits.onset_start import contact_orbit_at_onset
 from vibroimpact.orbits.orbit_measures import orbit_measures
 from vibroimpact.orbits.shooting import shoot
 
@@ -347,10 +348,30 @@ def find_branches(
             found.failed(kind, f"{what} failed: {type(error).__name__}: {str(error)[:200]}")
 
     maps: list[tuple[ImpactMap, Branch]] = []
+    segments = linear_segments(problem, low, high)
     if linear:
-        for segment in linear_segments(problem, low, high):
+        for segment in segments:
             found.add_linear(problem, segment)
     bumper = problem.contact_law == BUMPER
+    if bumper and grazing:  # a bumper's contact branch is born smoothly where the contact-free orbit touches it
+        for onset, outside in _onsets(segments, low, high):
+
+            def from_onset(onset: float = onset, outside: float = outside) -> None:
+                if any(point["kind"] == SPECIAL_POINT_KINDS.index("grazing") and abs(point["frequency"] - onset) <= SAME_POINT_FREQUENCY * onset for point in found.specials):
+                    return  # a branch from another onset already ended here
+                mapping = ImpactMap(problem_at(problem, onset), bounds=bounds)
+                first = contact_orbit_at_onset(mapping, onset, outside)
+                if first is None:
+                    found.notes.append(f"no orbit with a contact found next to the contact onset at {onset:.6g} Hz")
+                    return
+                if found.known(first.parameter("frequency"), 1, first.impacts, float(orbit_measures(mapping, first).impulses.sum())):
+                    return  # a branch from another onset already passed through it
+                branch = continue_branch(mapping, first, "frequency", settings)
+                label = found.add_branch(mapping, branch, "grazing")
+                maps.append((mapping, branch))
+                say(f"contact branch {label} from the contact onset at {onset:.6g} Hz: {len(branch.orbits)} points, {len(branch.special_points)} special points")
+
+            attempt("grazing", f"contact branch from the onset at {onset:.6g} Hz", from_onset)
     reference = rigid_twin(problem) if bumper else problem  # whose closed form starts the branches
     refusal = closed_form_refusal(reference) if one_impact else None
     if refusal is not None:
@@ -432,6 +453,20 @@ def find_branches(
                 attempt("grazing", f"branch born at {point.value:.4f} Hz", beyond)
     found.maps = maps
     return found
+
+
+def _onsets(segments: list[NDArray[np.float64]], low: float, high: float) -> list[tuple[float, float]]:
+    """(frequency [Hz], side) of each end of the contact-free orbit's ``segments`` that is a contact onset rather than
+    an end of the band [low, high]: side -1 for a segment's first point (beyond it, below, the orbit crosses a stop),
+    +1 for its last."""
+    edge = 1e-9 * (high - low)
+    out = []
+    for segment in segments:
+        if segment[0] > low + edge:
+            out.append((float(segment[0]), -1.0))
+        if segment[-1] < high - edge:
+            out.append((float(segment[-1]), 1.0))
+    return out
 
 
 def _segment(mask: NDArray[np.bool_], k: int) -> tuple[int, int]:
