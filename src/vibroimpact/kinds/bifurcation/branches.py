@@ -353,25 +353,6 @@ def find_branches(
         for segment in segments:
             found.add_linear(problem, segment)
     bumper = problem.contact_law == BUMPER
-    if bumper and grazing:  # a bumper's contact branch is born smoothly where the contact-free orbit touches it
-        for onset, outside in _onsets(segments, low, high):
-
-            def from_onset(onset: float = onset, outside: float = outside) -> None:
-                if any(point["kind"] == SPECIAL_POINT_KINDS.index("grazing") and abs(point["frequency"] - onset) <= SAME_POINT_FREQUENCY * onset for point in found.specials):
-                    return  # a branch from another onset already ended here
-                mapping = ImpactMap(problem_at(problem, onset), bounds=bounds)
-                first = contact_orbit_at_onset(mapping, onset, outside)
-                if first is None:
-                    found.notes.append(f"no orbit with a contact found next to the contact onset at {onset:.6g} Hz")
-                    return
-                if found.known(first.parameter("frequency"), 1, first.impacts, float(orbit_measures(mapping, first).impulses.sum())):
-                    return  # a branch from another onset already passed through it
-                branch = continue_branch(mapping, first, "frequency", settings)
-                label = found.add_branch(mapping, branch, "grazing")
-                maps.append((mapping, branch))
-                say(f"contact branch {label} from the contact onset at {onset:.6g} Hz: {len(branch.orbits)} points, {len(branch.special_points)} special points")
-
-            attempt("grazing", f"contact branch from the onset at {onset:.6g} Hz", from_onset)
     reference = rigid_twin(problem) if bumper else problem  # whose closed form starts the branches
     refusal = closed_form_refusal(reference) if one_impact else None
     if refusal is not None:
@@ -415,6 +396,26 @@ def find_branches(
                     say(f"{kind.replace('_', '-')} branch {label} from {f0:.2f} Hz: {len(branch.orbits)} points, {len(branch.special_points)} special points")
 
                 attempt("closed_form", f"{kind.replace('_', '-')} branch from {f0:.2f} Hz", start)
+    if bumper and grazing:  # a bumper's contact branch is born smoothly where the contact-free orbit touches it (where
+        # no branch from the rigid twin's closed form reached that onset already)
+        for onset, outside in _onsets(segments, low, high):
+
+            def from_onset(onset: float = onset, outside: float = outside) -> None:
+                if any(point["kind"] == SPECIAL_POINT_KINDS.index("grazing") and abs(point["frequency"] - onset) <= SAME_POINT_FREQUENCY * onset for point in found.specials):
+                    return  # a branch from another onset already ended here
+                mapping = ImpactMap(problem_at(problem, onset), bounds=bounds)
+                first = contact_orbit_at_onset(mapping, onset, outside)
+                if first is None:
+                    found.notes.append(f"no orbit with a contact found next to the contact onset at {onset:.6g} Hz")
+                    return
+                if found.known(first.parameter("frequency"), 1, first.impacts, float(orbit_measures(mapping, first).impulses.sum())):
+                    return  # a branch from another onset already passed through it
+                branch = continue_branch(mapping, first, "frequency", settings)
+                label = found.add_branch(mapping, branch, "grazing")
+                maps.append((mapping, branch))
+                say(f"contact branch {label} from the contact onset at {onset:.6g} Hz: {len(branch.orbits)} points, {len(branch.special_points)} special points")
+
+            attempt("grazing", f"contact branch from the onset at {onset:.6g} Hz", from_onset)
     if period_doubling:
         for mapping, branch in list(maps):
             for point in branch.special("period_doubling"):
