@@ -154,3 +154,30 @@ def test_the_rigid_stops_orbit_softened_in_log_steps_reaches_the_bumper() -> Non
         assert np.max(np.abs(period_map(begun.orbit.state, f0, 100.0) - begun.orbit.state)) <= 1e-6 * GAP
         reached.append(begun.orbit.state)
     assert np.max(np.abs(reached[0] - reached[1])) > 1e-3  # two orbits, not one found twice
+
+
+def test_a_bumpers_brute_force_orbits_are_continued(tmp_path) -> None:
+    """``continuation: {brute_force: true}`` continues the bumper's own brute-force attractors (before: only a rigid
+    stop's were seeded; a bumper diagram dropped them): between the chain's Neimark-Sacker points the sweeps lock onto
+    orbits of several periods that no branch from an onset or the closed form reaches, each continued on the
+    bumper's map with its contacts, none failing."""
+    from vibroimpact.runs.run import run_study
+    from vibroimpact.scene.reader import parse_scene
+
+    scene = parse_scene({
+        "name": "chain_seeds", "description": "NLvib's chain, a bumper's seeds",
+        "system": {"mass": MASS.tolist(), "stiffness": STIFFNESS.tolist(), "damping": DAMPING.tolist(), "coordinates": ["x1", "x2"]},
+        "excitation": {"amplitude": FORCE, "on": "x2"},
+        "stops": [{"coordinate": "x1", "side": "upper", "clearance": GAP}],
+        "bifurcation": {"frequency": {"start": 0.093, "stop": 0.0955}, "restitution": [1.0], "bumper": {"stiffness": [100.0]},
+                        "brute_force": {"step": 0.0005, "transient_periods": 200, "strobes": 64, "directions": ["up", "down"]},
+                        "continuation": {"brute_force": True, "one_impact": False, "period_doubling": False}},
+    })  # fmt: skip
+    data = run_study(scene, progress=None)
+    seeded = data["branch_origin"].values == list(data["branch_origin"].attrs["flag_meanings"].split()).index("brute_force")
+    assert seeded.any() and np.all(data["impacts_per_period"].values[seeded] > 0)
+    assert np.any(data["period_multiplicity"].values[seeded] > 1)
+    import re
+
+    tally = re.search(r"brute-force seeds: (\d+), (\d+) new branches, .*, (\d+) not converged", str(data.attrs["continuation_notes"]))
+    assert tally is not None and int(tally.group(2)) > 0 and tally.group(3) == "0"

@@ -28,7 +28,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from vibroimpact.analysis.linear import linear_amplitudes
-from vibroimpact.engines.exact import ExactEngine
 from vibroimpact.engines.registry import RIGID, engine_for, make_engine
 from vibroimpact.kinds.bifurcation.logs import FAILURE_FIELDS, failure_arrays
 from vibroimpact.kinds.bifurcation.branches import OrbitSet, map_bounds, problem_at, stop_values, MAX_ORBIT_IMPACTS, find_branches
@@ -121,7 +120,7 @@ def seed_branches(
     found : OrbitSet
         The branches known so far; the new ones are added.
     problem : ImpactProblem
-        Structure, rigid stops (the sweep's restitution and clearance) and harmonic load, as the sweep ran it.
+        Structure, stops (rigid or bumpers: the sweep's restitution and clearance) and harmonic load, as the sweep ran it.
     low, high : float
         The band [Hz].
     seeds : sequence of Seed
@@ -133,7 +132,7 @@ def seed_branches(
     progress : callable, optional
         Gets a line per branch.
     """
-    engine = ExactEngine()
+    engine = make_engine(engine_for(problem.contact_law, "exact_jacobians"))  # the sweep's: rigid stops or bumpers
     restitution = stop_values(problem)[1]
     bounds = map_bounds(low, high)
     settings = dataclasses.replace(settings, max_steps=min(settings.max_steps, SEEDED_MAX_STEPS))

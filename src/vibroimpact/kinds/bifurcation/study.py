@@ -136,15 +136,14 @@ class BifurcationStudy:
             + (f"; the chart's curves (R = {chart.restitution:g})" if chart else ""))  # fmt: skip
         first = runner.map(charted + sweeps + maps)
         chart_result, swept = (first[0], first[1:]) if chart else (None, first)
-        plain = tuple((k, False if k == "brute_force" else v) for k, v in options)  # seeds from the rigid stop's brute force only
         continuation = []
         for i, (r, fb) in enumerate(diagrams):
             seeds: list[Seed] = []
-            if settings.branches.brute_force and fb is None:
+            if settings.branches.brute_force:  # every diagram's own sweeps, the bumpers' too
                 for j, _direction in enumerate(brute.directions):
                     result = swept[i * len(brute.directions) + j]
                     seeds += sweep_seeds(settings.frequency, result["period"], result["impacts"], result["state"], j)
-            continuation.append(BranchCase(diagram_problem(scene, r, bumper_frequency=fb), settings.low, settings.high, options if fb is None else plain, tuple(seeds)))
+            continuation.append(BranchCase(diagram_problem(scene, r, bumper_frequency=fb), settings.low, settings.high, options, tuple(seeds)))
         stiffness = _stiffness_cases(scene, options) if settings.bumper_frequencies and settings.rigid else []
         say(f"continuing the branches of {', '.join(_label(r, fb) for r, fb in diagrams)}" + (", and following the stiffest bumper's special points in its stiffness" if stiffness else ""))
         mapped = runner.map(stiffness + continuation)  # the longest cases first
