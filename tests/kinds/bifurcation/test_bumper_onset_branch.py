@@ -181,3 +181,19 @@ def test_a_bumpers_brute_force_orbits_are_continued(tmp_path) -> None:
 
     tally = re.search(r"brute-force seeds: (\d+), (\d+) new branches, .*, (\d+) not converged", str(data.attrs["continuation_notes"]))
     assert tally is not None and int(tally.group(2)) > 0 and tally.group(3) == "0"
+
+
+def test_a_soft_bumper_on_the_paper_layout_answers_every_start() -> None:
+    """The paper's layout with a 100 Hz bumper (R = 0.2): the rigid branch over 18.25-18.71 Hz has no counterpart for
+    bumpers softer than its fold in T_b; its starts at 18.27 and 18.70 Hz did not converge on a 6.4 kHz bumper ('no
+    convergence in 40 Newton iterations', 'the line search failed'). Shot on a stiffer one, each is an answer: a fold
+    in T_b (over 18-19 Hz: at 4.72 kHz, 15.1 kHz and 937 Hz), none a failure."""
+    from vibroimpact import PAPER_SYSTEM
+    from vibroimpact.model.collision import loss_factor_from_restitution
+
+    problem = ImpactProblem(PAPER_SYSTEM, KelvinVoigtBumper(0.003, 100.0, loss_factor_from_restitution(0.2)), HarmonicForce(10.0, 25.0))
+    found = find_branches(problem, 18.0, 19.0, period_doubling=False, grazing=False)
+    assert found.failures == [] and found.attempts.get("closed_form", 0) >= 2
+    turns = [float(line.split("turns back at Omega_b / 2 pi = ")[1].split(" Hz")[0]) for line in found.absent if "turns back" in line]
+    assert len(turns) == found.attempts["closed_form"]  # every start answered: a fold in T_b above the scene's bumper
+    assert min(turns) > 100.0 and max(turns) > 1e4  # the 18.70 Hz start turns back at 15.1 kHz

@@ -28,12 +28,16 @@ from vibroimpact.orbits.branch import PeriodicOrbit
 from vibroimpact.orbits.bumper_map import BUMPER_PERIOD, BumperPeriodMap
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
 from vibroimpact.orbits.maps import ImpactMap
-from vibroimpact.orbits.shooting import shoot
+from vibroimpact.orbits.shooting import ShootingError, shoot
 
-__all__ = ["STIFF_START", "START_STEPS", "STAGE", "BumperStart", "bumper_start"]
+__all__ = ["STIFF_START", "STIFFER", "STIFF_TRIES", "START_STEPS", "STAGE", "BumperStart", "bumper_start"]
 
 #: The rigid orbit is first shot on a bumper this many times stiffer (in Omega_b) than the scene's [-].
 STIFF_START = 64.0
+#: Where the rigid orbit does not converge on that bumper, it is shot on one this many times stiffer again [-] ...
+STIFFER = 8.0
+#: ... at most this many bumpers in all [-].
+STIFF_TRIES = 4
 #: Most continuation steps in T_b per stage (measured: 5-50 on the shipped study).
 START_STEPS = 300
 #: T_b grows by at most this factor per stage, each stage measuring arclength in its first T_b: steps in log T_b, as
@@ -96,12 +100,7 @@ def bumper_start(mapping: ImpactMap, rigid: PeriodicOrbit) -> BumperStart:
     if not all(isinstance(law, KelvinVoigtBumper) for law in laws):
         raise ValueError("mapping: every stop must be a Kelvin-Voigt bumper")
     target = 1.0 / next(iter(laws)).frequency  # type: ignore[union-attr]
-    stiff = target / STIFF_START
-    system = BumperPeriodMap(mapping.problem, bounds={**mapping.bounds, BUMPER_PERIOD: (0.5 * stiff, target)})
-    parameters = system.parameters.copy()
-    parameters[-1] = stiff
-    orbit = shoot(system, rigid.state, parameters)
-    reached = stiff
+    orbit, reached = _stiff_orbit(mapping, rigid, target)
     while reached < target * (1.0 - REACHED):  # one stage per factor STAGE in T_b: steps in log T_b
         upper = min(STAGE * reached, target)
         scale = (*BumperPeriodMap.natural_scale(mapping.problem)[:-1], reached)  # a unit of arclength: this stage's T_b
@@ -122,3 +121,23 @@ def bumper_start(mapping: ImpactMap, rigid: PeriodicOrbit) -> BumperStart:
             raise RuntimeError(f"the continuation in the bumper's stiffness reached only Omega_b / 2 pi = {softest:.4g} Hz of {1.0 / target:g} Hz (it ended: {branch.end})")
         return BumperStart(None, why, softest)
     return BumperStart(shoot(mapping, orbit.state, mapping.parameters), "", 1.0 / target)
+
+
+def _stiff_orbit(mapping: ImpactMap, rigid: PeriodicOrbit, target: float) -> tuple[PeriodicOrbit, float]:
+    """The rigid orbit shot on a bumper :data:`STIFF_START` times stiffer than the scene's (in Omega_b), or, where
+    Newton does not converge there, :data:`STIFFER` times stiffer again, up to :data:`STIFF_TRIES` times: the orbit and
+    its T_b [s]. (Next to a fold in T_b the bumper's orbit moves fast as the bumper softens: on the paper's layout the
+    rigid branch at 18.27 and 18.70 Hz, whose bumper orbits turn back near 840 Hz, did not converge on a 6.4 kHz bumper.)
+    Raises the last ShootingError where none converged."""
+    failure: ShootingError | None = None
+    for k in range(STIFF_TRIES):
+        stiff = target / (STIFF_START * STIFFER**k)
+        system = BumperPeriodMap(mapping.problem, bounds={**mapping.bounds, BUMPER_PERIOD: (0.5 * stiff, target)})
+        parameters = system.parameters.copy()
+        parameters[-1] = stiff
+        try:
+            return shoot(system, rigid.state, parameters), stiff
+        except ShootingError as error:
+            failure = error
+    assert failure is not None
+    raise failure
