@@ -131,7 +131,8 @@ class OrbitSet:
     the continued branches with their maps (``maps``: (ImpactMap, Branch) pairs). A special point is kept once
     (:func:`same_special_point`), with the labels of every branch it was found on (``found_on``). What failed is
     counted (``attempts`` and ``failures`` by kind of work: :meth:`attempted`, :meth:`failed`); ``absent`` says, a
-    line each, which closed-form starts a bumper has no orbit for (:class:`~vibroimpact.kinds.bifurcation.bumper_start.BumperStart`)."""
+    line each, which closed-form starts a bumper has no orbit for (:class:`~vibroimpact.kinds.bifurcation.bumper_start.BumperStart`);
+    ``settled`` what each brute-force seed that settles slowly reached (:mod:`~vibroimpact.kinds.bifurcation.slow_seeds`)."""
 
     points: list[dict] = field(default_factory=list)
     specials: list[dict] = field(default_factory=list)
@@ -141,6 +142,7 @@ class OrbitSet:
     attempts: dict[str, int] = field(default_factory=dict)
     failures: list[tuple[str, str]] = field(default_factory=list)
     absent: list[str] = field(default_factory=list)
+    settled: list = field(default_factory=list)
     _index: tuple | None = None
 
     def attempted(self, what: str) -> None:

@@ -21,6 +21,7 @@ stops sharing one clearance and restitution, harmonic load) and moves it in freq
 from __future__ import annotations
 
 import dataclasses
+from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, asdict
 
@@ -30,6 +31,7 @@ from numpy.typing import NDArray
 from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.engines.registry import RIGID, engine_for, make_engine
 from vibroimpact.kinds.bifurcation.logs import FAILURE_FIELDS, failure_arrays
+from vibroimpact.kinds.bifurcation.slow_seeds import SLOW_SEED_FIELDS, SeedOutcome, continue_seed_orbit, settle_seed, slow_seed_arrays
 from vibroimpact.kinds.bifurcation.branches import OrbitSet, map_bounds, problem_at, stop_values, MAX_ORBIT_IMPACTS, find_branches
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.units import length_unit
@@ -41,6 +43,7 @@ from vibroimpact.orbits.orbit_measures import orbit_measures
 from vibroimpact.orbits.shooting import ShootingError, shoot
 from vibroimpact.runs.runner import CaseResult, ProgressReport
 from vibroimpact.runs.fingerprints import case_key
+from vibroimpact.simulation.settling import SettledMotion
 from vibroimpact.simulation.attractors import MAX_KEPT_IMPACTS, MOTION_CLASSES, SWEEP_FIELDS, stepped_sweep
 
 __all__ = ["Seed", "MAX_SEEDED_BRANCHES", "SEEDED_MAX_STEPS", "sweep_seeds", "seed_branches", "MOTION_CLASSES", "MAX_KEPT_IMPACTS", "SweepCase", "BranchCase", "ChartCase", "branch_arrays"]
@@ -137,6 +140,7 @@ def seed_branches(
     bounds = map_bounds(low, high)
     settings = dataclasses.replace(settings, max_steps=min(settings.max_steps, SEEDED_MAX_STEPS))
     added, skipped, failed, unstable = 0, 0, 0, 0
+    slow: list[tuple[Seed, ShootingError]] = []
     for seed in seeds:
         if added >= max_branches:
             found.notes.append(f"brute-force seeds: stopped after {max_branches} new branches ({len(seeds)} seeds)")
@@ -153,8 +157,11 @@ def seed_branches(
                     orbit = shoot(sweep_map, orbit.state, sweep_map.parameters)
                     break
         except ShootingError as error:
-            found.failed("seed", _seed_failure(seed, error))
-            failed += 1
+            if np.all(np.isfinite(seed.state)):
+                slow.append((seed, error))  # a motion still settling: run on, after the other seeds (slow_seeds)
+            else:
+                found.failed("seed", _seed_failure(seed, error))
+                failed += 1
             continue
         if not orbit.stable:  # not the attractor the sweep settled on (its strobes only nearly repeated)
             unstable += 1
@@ -179,8 +186,47 @@ def seed_branches(
         found.notes[-1] += f"; seeded at {seed.frequency:.3f} Hz, period {period}, {measures.impulses.size} impacts, max |mu| = {orbit.floquet_modulus:.4g} there"
         if progress is not None:
             progress(f"R = {restitution:g}: branch {label} from the brute force at {seed.frequency:.3f} Hz (period {period}): {len(branch.orbits)} points")
-    found.notes.append(f"brute-force seeds: {len(seeds)}, {added} new branches, {skipped} on known branches, {unstable} unstable (no attractor), {failed} not converged")
+    count = found.count
+    settled = _settle_slow_seeds(found, problem, slow, bounds, settings, engine, max_branches - added)
+    failed += sum(outcome.outcome == "failed" for outcome in settled)
+    added += found.count - count
+    kinds = Counter(outcome.outcome for outcome in settled if outcome.outcome != "failed")
+    what = ", ".join(f"{count} {SETTLED_WORDS[kind]}" for kind, count in kinds.items())
+    found.notes.append(f"brute-force seeds: {len(seeds)}, {added} new branches, {skipped} on known branches, {unstable} unstable (no attractor), "
+                       f"{len(slow)} settling slowly{' (' + what + ')' if what else ''}, {failed} failed")  # fmt: skip
     return added
+
+
+#: How the seeds' summary note counts each outcome of a slowly settling seed.
+SETTLED_WORDS = {"periodic": "periodic", "quasi_periodic": "on a torus", "chaotic": "chaotic", "undecided": "undecided"}
+
+
+def _settle_slow_seeds(
+    found: OrbitSet, problem: ImpactProblem, slow: Sequence[tuple[Seed, ShootingError]], bounds: dict[str, tuple[float, float]], settings: ContinuationSettings, engine: ExactEngine,
+    room: int,
+) -> list[SeedOutcome]:  # fmt: skip
+    """Run on the motion of every seed shooting did not converge from, say what it reached in ``found.notes`` and
+    ``found.settled`` (an engine's failure as a failure), and continue the periodic orbits found, at most ``room``
+    new branches (:mod:`~vibroimpact.kinds.bifurcation.slow_seeds`)."""
+    outcomes = []
+    for seed, error in slow:
+        at = problem_at(problem, seed.frequency)
+        history = getattr(error, "residual_history", ())
+        residual = f"residual {history[0]:.3g} at the start" if history else str(error)[:120]
+
+        def orbit_of(motion: SettledMotion, at: ImpactProblem = at) -> tuple[int, str]:
+            return continue_seed_orbit(found, at, motion, bounds, settings, engine, room > 0)
+
+        before = found.count
+        outcome = settle_seed(found, at, seed.frequency, seed.period, np.array(seed.state), residual, orbit_of, engine)
+        room -= found.count - before
+        if outcome.outcome == "failed":
+            found.failed("seed", outcome.text)
+        else:
+            found.notes.append(outcome.text)
+        found.settled.append(outcome)
+        outcomes.append(outcome)
+    return outcomes
 
 
 def _seed_failure(seed: Seed, error: Exception) -> str:
@@ -224,7 +270,7 @@ BRANCH_FIELDS = (
     "branch", "origin", "frequency", "amplitudes", "impulse", "floquet_modulus", "stable", "impacts", "period",
     "multipliers_real", "multipliers_imag", "velocities",
     "sp_branch", "sp_kind", "sp_frequency", "sp_amplitudes", "sp_impulse", "sp_floquet_modulus", "sp_impacts", "sp_period",
-    "sp_multipliers_real", "sp_multipliers_imag", "sp_note", "sp_found_on", "notes", "absent", *FAILURE_FIELDS,
+    "sp_multipliers_real", "sp_multipliers_imag", "sp_note", "sp_found_on", "notes", "absent", *FAILURE_FIELDS, *SLOW_SEED_FIELDS,
 )  # fmt: skip
 
 
@@ -298,6 +344,7 @@ def branch_arrays(found: OrbitSet, size: int) -> CaseResult:
         "sp_induced_by": np.array([row.get("induced_by", np.nan) for row in specials], dtype=float),  # (NaN: a smooth point)
         "sp_note": np.array([row["note"] for row in specials], dtype=str), "sp_found_on": np.array([" ".join(map(str, row["found_on"])) for row in specials], dtype=str),
         "notes": np.array(found.notes, dtype=str), "absent": np.array(found.absent, dtype=str), **failure_arrays(found.attempts, found.failures),
+        **slow_seed_arrays(found.settled),
     }  # fmt: skip
 
 

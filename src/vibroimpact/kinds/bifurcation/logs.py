@@ -53,13 +53,17 @@ def branch_offsets(results: list[CaseResult]) -> list[int]:
 
 def numbered(result: CaseResult, offset: int) -> CaseResult:
     """A copy of a branch case's arrays with every branch label moved by ``offset``: the points' and special points'
-    labels, the branches each special point was found on, and the labels in the notes."""
+    labels, the branches each special point was found on, the labels in the notes, and those of the slowly settling
+    seeds' orbits (``ss_branch``, -1 kept, and in ``ss_text``)."""
     labels = {k: str(k + offset) for k in range(int(result["branch"].max()) + 1 if result["branch"].size else 0)}
     moved = dict(result)
     moved["branch"] = result["branch"] + offset
     moved["sp_branch"] = result["sp_branch"] + offset
     moved["sp_found_on"] = np.array([" ".join(labels.get(int(b), b) for b in found.split()) for found in result["sp_found_on"]], dtype=str)
     moved["notes"] = np.array([relabel(str(note), labels) for note in result["notes"]], dtype=str)
+    if "ss_branch" in result:  # the seeds that settle slowly: the branches their orbits were continued as
+        moved["ss_branch"] = np.where(result["ss_branch"] >= 0, result["ss_branch"] + offset, -1)
+        moved["ss_text"] = np.array([relabel(str(text), labels) for text in result["ss_text"]], dtype=str)
     return moved
 
 
@@ -116,7 +120,7 @@ FAILURES: dict[str, FailureKind] = {
                                    "those branches and their special points are missing from the diagrams and the tables; the branches found are unaffected"),
     "grazing": FailureKind("continuing the branches born at grazing points",
                            "those branches and their special points are missing from the diagrams and the tables; the branches found are unaffected"),
-    "seed": FailureKind("shooting from brute-force seeds (points where a sweep's strobes repeat)",
+    "seed": FailureKind("shooting from brute-force seeds (points where a sweep's strobes repeat) and running on those that settle slowly",
                         "an orbit the sweeps settle on only there may lack its continued branch (its brute-force dots are still drawn); the branches found are unaffected"),
     "sweep": FailureKind("brute-force frequencies (the engine made no progress, e.g. endless chattering)",
                          "those frequencies have no dots in the diagrams (regime 'failed'); the sweep went on from rest, the other frequencies are unaffected"),

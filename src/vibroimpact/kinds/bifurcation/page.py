@@ -22,6 +22,7 @@ from vibroimpact.runs.failures import as_lines
 from vibroimpact.kinds.bifurcation.bumper import absent_text, bumper_answer, bumper_figure, convergence_table, diagram_models, has_bumpers, has_rigid, model_view
 from vibroimpact.kinds.bifurcation.figures import KIND_NAMES, bifurcation_figures, branch_class, first_coordinate, flags as _flags, length_of, orbit_class, orbit_label as _orbit_label
 from vibroimpact.kinds.bifurcation.scene import coordinate_label
+from vibroimpact.kinds.bifurcation.seed_report import slow_seed_text
 
 __all__ = ["page_for", "BifurcationPage", "bifurcation_figures", "special_point_table", "orbit_class", "first_coordinate", "headline", "answer_text", "failure_text", "failure_details"]
 
@@ -307,7 +308,8 @@ class BifurcationPage:
             figures = saved(bifurcation_figures(view), out)
             chart = [f for f in figures if f.path.stem == "chart"]
             tables = "".join(orbit_table(view, float(r)) for r in view["restitution"].values)
-            answer = answer_text(view) + ("" if self.bumpers else failure_text(view)) + tables  # what failed right after the answer
+            seeded = slow_seed_text(view) if not self.bumpers or math.isinf(diagram_models(self.full)[n]) else ""  # the rigid stop's brute force only
+            answer = answer_text(view) + ("" if self.bumpers else failure_text(view)) + seeded + tables  # what failed right after the answer
             title = "Bifurcation diagrams" + (f": {view.attrs['diagram_label']}" + (", the reference" if math.isinf(diagram_models(self.full)[n]) else "") if self.bumpers else "")
             sections.append(Section(title, answer, [f for f in figures if f not in chart], [special_point_table(view)]))
             if chart:

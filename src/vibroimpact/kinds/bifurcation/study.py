@@ -25,6 +25,8 @@ Output (``bifurcation.nc``; attributes from :data:`vibroimpact.kinds.bifurcation
 * with bumpers, ``bumper_starts_without_orbit`` (absent otherwise): the closed-form starts a bumper has no orbit for,
   a line each, "R = <R>, bumper <Hz> Hz: the rigid stop's ... orbit at <f> Hz ... has no counterpart with this bumper:
   <where its continuation in the bumper's stiffness turns back>" (an answer, not a failure);
+* the brute-force seeds that settle slowly (shooting from them did not converge), when any did: dimension
+  ``slow_seed`` with what the motion from each reached (:mod:`vibroimpact.kinds.bifurcation.seed_report`);
 * what failed, when anything did (attributes, absent otherwise): ``run_failures``, one line per kind of work and
   restitution, "<what failed>: <k> of <n> failed (<reasons>); <what it means for the results>", and
   ``run_failure_details``, every raw message (:mod:`vibroimpact.kinds.bifurcation.logs`); the console gets one line.
@@ -68,6 +70,7 @@ from vibroimpact.kinds.bifurcation.variables import BIFURCATION_ATTRIBUTES
 from vibroimpact.kinds.bifurcation.branches import MAX_ORBIT_IMPACTS, ORIGINS
 from vibroimpact.kinds.bifurcation.logs import Tally, chart_labels, continuation_log, failure_summary, numbered_across, relabel, sweep_tally, tallies
 from vibroimpact.kinds.bifurcation.cases import BranchCase, ChartCase, SweepCase, Seed, sweep_seeds
+from vibroimpact.kinds.bifurcation.seed_report import slow_seed_dataset
 from vibroimpact.kinds.bifurcation.stiffness import SOFTER, STIFFER, StiffnessCase
 from vibroimpact.runs.estimate import Costs, Estimate
 from vibroimpact.runs.cluster import Progress
@@ -161,7 +164,7 @@ class BifurcationStudy:
         sets = len(diagrams)
         data = _branches(results[:sets], tuple(r for r, _fb in diagrams), scene.coordinates, scene.layout.load.base_motion,
                          tuple(fb for _r, fb in diagrams) if settings.bumper_frequencies else ())  # fmt: skip
-        data = data.merge(_brute(swept[: len(sweeps)], scene, brute.directions, brute.strobes))
+        data = data.merge(_brute(swept[: len(sweeps)], scene, brute.directions, brute.strobes)).merge(slow_seed_dataset(results[:sets], tuple(r for r, _fb in diagrams)))
         if curves:
             data = data.merge(_stiffness(curves, settings.restitution))
         if chart is not None:
