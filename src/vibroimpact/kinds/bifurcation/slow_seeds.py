@@ -206,7 +206,7 @@ def settle_seed(
     ran = f"{head}; run on for {motion.periods} periods"
     if motion.kind == "periodic":
         label, what = continue_orbit(motion)
-        longer = f", longer than the sweeps' {MAX_PERIOD}" if motion.period > MAX_PERIOD else " (after more periods than the sweep's)"
+        longer = f", longer than the {MAX_PERIOD} the sweeps look for" if motion.period > MAX_PERIOD else ", repeating once run longer"
         return SeedOutcome(frequency, sweep_period, "periodic", orbit_period=motion.period, branch=label, **common,
                            text=f"{ran}: a periodic orbit of period {motion.period}{longer}: {motion.reason}; {what}")  # fmt: skip
     if motion.kind == "chaotic":
