@@ -212,7 +212,7 @@ def _settle_slow_seeds(
     for seed, error in slow:
         at = problem_at(problem, seed.frequency)
         history = getattr(error, "residual_history", ())
-        residual = f"residual {history[0]:.3g} at the start" if history else str(error)[:120]
+        residual = (f"residual {history[0]:.3g} at the start" if np.isfinite(history[0]) else "the map has no value at its strobe") if history else str(error)[:120]
 
         def orbit_of(motion: SettledMotion, at: ImpactProblem = at) -> tuple[int, str]:
             return continue_seed_orbit(found, at, motion, bounds, settings, engine, room > 0)
