@@ -179,7 +179,7 @@ def test_a_bumpers_brute_force_orbits_are_continued(tmp_path) -> None:
     assert np.any(data["period_multiplicity"].values[seeded] > 1)
     import re
 
-    tally = re.search(r"brute-force seeds: (\d+), (\d+) new branches, .*, (\d+) not converged", str(data.attrs["continuation_notes"]))
+    tally = re.search(r"brute-force seeds: (\d+), (\d+) new branches, .*, (\d+) failed", str(data.attrs["continuation_notes"]))
     assert tally is not None and int(tally.group(2)) > 0 and tally.group(3) == "0"
 
 

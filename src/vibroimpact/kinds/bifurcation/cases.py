@@ -23,6 +23,7 @@ from __future__ import annotations
 import dataclasses
 from collections import Counter
 from collections.abc import Callable, Sequence
+from typing import Any
 from dataclasses import dataclass, asdict
 
 import numpy as np
@@ -202,7 +203,7 @@ SETTLED_WORDS = {"periodic": "periodic", "quasi_periodic": "on a torus", "chaoti
 
 
 def _settle_slow_seeds(
-    found: OrbitSet, problem: ImpactProblem, slow: Sequence[tuple[Seed, ShootingError]], bounds: dict[str, tuple[float, float]], settings: ContinuationSettings, engine: ExactEngine,
+    found: OrbitSet, problem: ImpactProblem, slow: Sequence[tuple[Seed, ShootingError]], bounds: dict[str, tuple[float, float]], settings: ContinuationSettings, engine: Any,
     room: int,
 ) -> list[SeedOutcome]:  # fmt: skip
     """Run on the motion of every seed shooting did not converge from, say what it reached in ``found.notes`` and
