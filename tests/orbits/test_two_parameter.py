@@ -41,3 +41,22 @@ def test_neimark_sacker_curve_of_the_delayed_logistic_map() -> None:
     assert ss.min() == pytest.approx(0.2) and ss.max() == pytest.approx(3.0)
     assert np.max(np.abs(r - 2.0)) < 1e-10
     assert all(np.abs(o.multipliers) == pytest.approx([1.0, 1.0], abs=1e-8) for o in curve.orbits)
+
+
+def test_a_neimark_sacker_point_beside_a_strongly_unstable_multiplier_is_followed() -> None:
+    """The paper's second band (R = 0.2, 3 mm): its Neimark-Sacker point at 37.574128 Hz has a real multiplier of 35
+    beside the critical pair. The curve's old defining function, det(J(2) - I), carries that multiplier's factors and
+    its round-off kept Newton off the curve ('does not solve its extended system'); on the pair's own |mu|^2 - 1 the
+    curve in (frequency, clearance) runs to both clearance bounds, with a pair on the unit circle at every point."""
+    from vibroimpact import PAPER_SYSTEM, HarmonicForce, ImpactMap, ImpactProblem, RigidStop, closed_form_state
+
+    problem = ImpactProblem(PAPER_SYSTEM, RigidStop(0.003, 0.2), HarmonicForce(10.0, 25.0))
+    system = ImpactMap(problem)
+    branch = continue_branch(system, shoot(system, closed_form_state(problem), system.parameters), "frequency")
+    point = min(branch.special("neimark_sacker"), key=lambda p: abs(p.value - 37.574128))
+    assert point.value == pytest.approx(37.574128, abs=1e-6) and point.orbit.floquet_modulus > 30.0
+    curve = continue_special_point(system, point, "clearance", bounds={"clearance": (0.0025, 0.0035)})
+    assert curve.end == "bound, bound" and len(curve.orbits) > 10
+    for orbit in curve.orbits:
+        pair = orbit.multipliers[np.abs(orbit.multipliers.imag) > 1e-6]
+        assert pair.size == 2 and np.max(np.abs(np.abs(pair) - 1.0)) <= 1e-8
