@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Iterable, Protocol
 
 from vibroimpact.model.keywords import suggest_keywords
-from vibroimpact.reporting.style import DPI, REPORT_RC, readable_axes, thin_minor_log_ticks  # first: selects the Agg backend before pyplot is imported
+from vibroimpact.reporting.style import DPI, REPORT_RC, linear_under_a_decade, readable_axes, thin_minor_log_ticks  # first: selects the Agg backend before pyplot is imported
 
 import matplotlib.pyplot as plt  # noqa: E402
 import xarray as xr  # noqa: E402
@@ -119,6 +119,7 @@ def save_figure(drawn: DrawnFigure, out_dir: Path) -> Figure:
 def _png(figure: MatplotlibFigure) -> bytes:
     """The figure rendered to PNG bytes, then closed."""
     buffer = io.BytesIO()
+    linear_under_a_decade(figure)
     thin_minor_log_ticks(figure)
     readable_axes(figure)
     figure.savefig(buffer, format="png", dpi=DPI, bbox_inches="tight", pad_inches=0.08)

@@ -21,7 +21,7 @@ from matplotlib.axes import Axes  # noqa: E402
 from matplotlib.colors import to_hex  # noqa: E402
 from matplotlib.figure import Figure as MatplotlibFigure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.ticker import FormatStrFormatter, FuncFormatter, LogFormatter, LogLocator, ScalarFormatter  # noqa: E402
+from matplotlib.ticker import FormatStrFormatter, FuncFormatter, LogFormatter, LogFormatterSciNotation, LogLocator, ScalarFormatter  # noqa: E402
 
 from vibroimpact.analysis.stability import Regime  # noqa: E402
 # every solution's row (colour, title, words), kept without matplotlib for the studies; re-exported for the pages
@@ -64,6 +64,9 @@ __all__ = [
     "thin_minor_log_ticks",
     "readable_axes",
     "readable_scale",
+    "drawn_scale",
+    "linear_under_a_decade",
+    "scale_phrase",
     "axis_label",
     "figure_legend",
     "fmt",
@@ -293,6 +296,46 @@ def readable_scale(low: float, high: float) -> str:
     return "log" if low > 0.0 and math.isfinite(high / low) and high / low >= 10.0 else "linear"
 
 
+def drawn_scale(ax: Axes, which: str = "y") -> str:
+    """The scale the ``which`` axis of ``ax`` is drawn on (:func:`linear_under_a_decade`): ``log`` where it is
+    logarithmic and its view limits as they are now span a decade or more (:func:`readable_scale`), else ``linear``."""
+    axis = ax.yaxis if which == "y" else ax.xaxis
+    if axis.get_scale() != "log":
+        return "linear"
+    low, high = sorted(ax.get_ylim() if which == "y" else ax.get_xlim())
+    return readable_scale(low, high)
+
+
+def linear_under_a_decade(figure: MatplotlibFigure) -> None:
+    """Every log axis of ``figure`` whose view spans less than a decade drawn linear instead (:func:`drawn_scale`): a
+    log axis over 700-2000 m/s² or 2.3-3 mm reads as a linear one with crowded, uneven labels (``3 x 10^0``).
+    Applied as figures are rendered, so that every page has it; a caption names the scale with :func:`scale_phrase`.
+    A colorbar's axis keeps its scale (its norm sets it)."""
+    for ax in figure.axes:
+        if hasattr(ax, "_colorbar"):
+            continue
+        for which in ("x", "y"):
+            axis = ax.yaxis if which == "y" else ax.xaxis
+            if axis.get_scale() == "log" and drawn_scale(ax, which) == "linear":
+                limits = ax.get_ylim() if which == "y" else ax.get_xlim()
+                automatic = ax.get_autoscaley_on() if which == "y" else ax.get_autoscalex_on()
+                (ax.set_yscale if which == "y" else ax.set_xscale)("linear")  # autoscaled again where it was
+                if not automatic:  # limits the figure set stay
+                    (ax.set_ylim if which == "y" else ax.set_xlim)(*limits)
+
+
+def scale_phrase(axes: Sequence[Axes], which: str = "y") -> str:
+    """How a caption names the scales of ``axes`` as drawn (:func:`drawn_scale`): ``log scale`` or ``linear scale``
+    where they agree, else ``log scale, except panels 1, 2: linear, as they span less than a decade``, panels
+    counted in ``axes``' order."""
+    scales = [drawn_scale(ax, which) for ax in axes]
+    if len(set(scales)) <= 1:
+        return f"{scales[0] if scales else 'linear'} scale"
+    linear = [str(k + 1) for k, scale in enumerate(scales) if scale == "linear"]
+    many = len(linear) > 1
+    return f"log scale, except panel{'s' if many else ''} {', '.join(linear)}: linear, as {'they span' if many else 'it spans'} less than a decade"
+
+
 def _plain_number(value: float, _position: object = None) -> str:
     """A tick label as a plain number, six significant digits at most (2.5e+06, 0.003, 24.5): no offset or
     multiplier written apart at the axis' end, where it overprinted the panel's title ("1e6")."""
@@ -301,11 +344,15 @@ def _plain_number(value: float, _position: object = None) -> str:
 
 def readable_axes(figure: MatplotlibFigure) -> None:
     """Every linear axis of ``figure`` (a colorbar's too) labelled with plain numbers (:func:`_plain_number`), never
-    matplotlib's offset or ``1e6`` multiplier; applied as figures are rendered, so that every page has it."""
+    matplotlib's offset or ``1e6`` multiplier; every log axis still labelled by matplotlib's default (``10^0``,
+    ``10^1`` alone over 0.5-50) labelled as :func:`plain_log` does (0.5, 1, 2, 5, 10, 20, 50). Applied as figures
+    are rendered, so that every page has it."""
     for ax in figure.axes:
-        for axis in (ax.xaxis, ax.yaxis):
+        for which, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
             if axis.get_scale() == "linear" and type(axis.get_major_formatter()) is ScalarFormatter:
                 axis.set_major_formatter(FuncFormatter(_plain_number))
+            elif axis.get_scale() == "log" and type(axis.get_major_formatter()) is LogFormatterSciNotation and not hasattr(ax, "_colorbar"):
+                plain_log(ax, which)
 
 
 def thin_minor_log_ticks(figure: MatplotlibFigure) -> None:

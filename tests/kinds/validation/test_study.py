@@ -39,7 +39,7 @@ def test_dataset_table_and_page(tmp_path: Path) -> None:
     page = write_validation_report(dataset, tmp_path / "report")
     text = page.read_text(encoding="utf-8")
     assert text.count("<tr>") == dataset.sizes["check"] + 1
-    assert "validation_zeno.png" in text and "every check passed" in text
+    assert "validation_zeno.png" in text and "<p><b>Every check passed</b>. Source: " in text  # the answer before the source
     assert ValidationPage(dataset).summary() == f"validation case zeno: {dataset.sizes['check']} of {dataset.sizes['check']} checks passed"
 
 

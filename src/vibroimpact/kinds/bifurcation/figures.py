@@ -243,7 +243,8 @@ def chart_figure(dataset: xr.Dataset) -> DrawnFigure:
         ax.set_xlim(float(dataset["map_frequency"].min()), float(dataset["map_frequency"].max()))
         finish_axes(ax, _FREQUENCY, f"clearance Delta [{unit}]" if ax is axes[0] else "", f"brute force sweeping {direction}")
     drawn = set(np.unique(dataset["chart_regime"].values).tolist())
-    patches = [Patch(facecolor=colours[k], edgecolor="0.5", label=meaning.replace("_", " ")) for k, meaning in enumerate(meanings) if meaning != "failed" or k - 1 in drawn]
+    # a legend entry for each class some cell shows, no other (flag k - 1 is the k-th meaning)
+    patches = [Patch(facecolor=colours[k], edgecolor="0.5", label=meaning.replace("_", " ")) for k, meaning in enumerate(meanings) if k - 1 in drawn]
     figure_legend(fig, axes, patches, columns=5)
     r = dataset.attrs.get("chart_restitution", float("nan"))
     caption = (

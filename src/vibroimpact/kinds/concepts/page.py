@@ -20,7 +20,7 @@ from matplotlib.lines import Line2D
 from vibroimpact.reporting.coincide import Coincidence, Shared, coincidence_phrase, reveal_coincident
 from vibroimpact.reporting.page import DrawnFigure, Section, Table, render_page, rendering, saved, write_page
 from vibroimpact.reporting.record import stored_description
-from vibroimpact.reporting.style import LINEAR_STYLE, STABLE_STYLE, UNSTABLE_STYLE, Caption, figure_legend, fmt, new_figure, finish_axes, legend_rows, plain_log
+from vibroimpact.reporting.style import LINEAR_STYLE, STABLE_STYLE, UNSTABLE_STYLE, Caption, figure_legend, fmt, new_figure, finish_axes, legend_rows, plain_log, scale_phrase
 
 __all__ = ["page_for", "concept_colour", "response_figure", "overview_figure", "impact_figure", "Column", "COLUMNS", "best_rows", "verdict", "verdicts", "concepts_table", "ConceptsPage", "write_concepts_report", "DEFINITIONS"]
 
@@ -74,7 +74,7 @@ def response_figure(dataset: xr.Dataset) -> DrawnFigure:
     names = [str(n) for n in dataset["concept"].values]
     f = dataset["frequency"].values
     fs = dataset["simulation_frequency"].values
-    caption = Caption("|X1| (fundamental amplitude of the primary mass) against frequency, one panel per concept, in mm on a log scale.")
+    caption = Caption("|X1| (fundamental amplitude of the primary mass) against frequency, one panel per concept, in mm on a {scale}.")
     fig, axes = new_figure(len(names), panel_height=3.3, legend_rows=legend_rows(7))
     for i, (ax, name) in enumerate(zip(axes, names)):
         colour = concept_colour(i)
@@ -102,6 +102,7 @@ def response_figure(dataset: xr.Dataset) -> DrawnFigure:
     caption.add("band", f"The shaded stretch is the anti-resonance band ({fmt(dataset.attrs['band_low_Hz'], '.2f')}-{fmt(dataset.attrs['band_high_Hz'], '.2f')} Hz), where the lightly damped absorber without a stop keeps |X1| below the static deflection q/k1 = {fmt(1e3 * dataset.attrs['static_deflection_m'], '.2g')} mm (dotted grey line).")
     caption.add("worst", "The wide pale band is the worst stable motion found at each frequency, from which the table's peak and notch are taken.")
     figure_legend(fig, axes, columns=4)
+    caption.lead = caption.lead.format(scale=scale_phrase(axes))
     return DrawnFigure(fig, "concepts_x1", "|X1| of each concept: stable and unstable orbits", caption.text())
 
 
@@ -151,8 +152,8 @@ def overview_figure(dataset: xr.Dataset) -> DrawnFigure:
     coincide = coincidence_phrase(found for ax, drawn in zip(axes, curves) for found in reveal_coincident(ax, drawn))
     figure_legend(fig, axes, columns=2)
     caption = (
-        "Left: the worst stable |X1| found at each frequency, every concept in its colour (log scale; where no stable periodic orbit is "
-        "known only the simulated steady states are drawn, as dots). Right: the fundamental of the force on the base of that motion, through the suspension "
+        f"Left: the worst stable |X1| found at each frequency, every concept in its colour ({scale_phrase(axes[:1])}; where no stable periodic orbit is "
+        f"known only the simulated steady states are drawn, as dots). Right: the fundamental of the force on the base of that motion, through the suspension "
         "(k1 x1 + b1 x1') and the absolute stops (a relative stop's force stays between the masses). Shaded: the anti-resonance band; "
         "dotted grey: q/k1." + (f" {coincide}" if coincide else "")
     )
@@ -190,7 +191,7 @@ def impact_figure(dataset: xr.Dataset) -> DrawnFigure | None:
     caption = (
         f"First three panels: steady states of each rigid stop's Kelvin-Voigt twin (Omega_b/2pi = {bumper} Hz, loss factor giving the stop's R) "
         "through the compliant engine: the largest deceleration in contact, the largest bumper force, and the largest force on the base "
-        "(k1 x1 + b1 x1' plus the absolute stops' force, from a dense replay of the steady state), against frequency (log scales; the first two "
+        f"(k1 x1 + b1 x1' plus the absolute stops' force, from a dense replay of the steady state), against frequency ({scale_phrase(axes[:3])}; the first two "
         "have no point where nothing touches). Last two: the exact engine's rigid stops, total impulse and impacts per excitation period (chattering shows "
         "as many impacts). Shaded: the anti-resonance band."
     )

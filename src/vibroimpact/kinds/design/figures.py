@@ -62,11 +62,18 @@ def _worst_point(d: xr.Dataset, k: int) -> tuple[float, float]:
     return (float(d["response_frequency"].values[int(np.nanargmax(curve))]), value) if np.any(np.isfinite(curve)) else (math.nan, math.nan)
 
 
+def _operating_drawn(d: xr.Dataset) -> bool:
+    """Whether the scene sets an operating limit at a frequency inside the responses' band (the panels' x range): the
+    line and bar of :func:`_operating` are drawn, and the legend and caption name them, only then."""
+    at, f = float(d.attrs.get("operating_frequency_Hz", math.nan)), d["response_frequency"].values
+    return math.isfinite(at) and math.isfinite(operating_limit(d)) and float(f[0]) <= at <= float(f[-1])
+
+
 def _operating(ax: Axes, d: xr.Dataset) -> None:
     """The operating frequency (vertical line) and the allowed value there (a bar, where the constraint limits the
-    objective's measure: the axes' own), when the scene sets a limit."""
+    objective's measure: the axes' own), when the scene sets a limit at a frequency the panels show."""
     at, limit, c = float(d.attrs.get("operating_frequency_Hz", math.nan)), operating_limit(d), constraint_quantity(d)
-    if math.isfinite(at) and math.isfinite(limit):
+    if _operating_drawn(d):
         ax.axvline(at, **_OPERATING, zorder=1)
         if c.name == objective_quantity(d).name:
             ax.plot([at], [c.value(limit)], marker="_", ms=22, mew=2.5, color="k", ls="none", zorder=6)
@@ -173,7 +180,9 @@ def response_figure(dataset: xr.Dataset) -> DrawnFigure:
     if math.isfinite(limit):
         at = fmt(d.attrs["operating_frequency_Hz"], ".4g")
         allowed = f"{fmt(c.value(limit), '.3g')} {c.unit}"
-        if c.name == q.name:
+        if not _operating_drawn(d):  # outside the band the panels show: not drawn, and said so
+            caption.add("operating", f"The operating frequency, {at} Hz, lies outside the band drawn ({fmt(f[0], 'g')}-{fmt(f[-1], 'g')} Hz): its allowed {c.symbol} ({allowed}) is not drawn.")
+        elif c.name == q.name:
             entries.append(Line2D([], [], **_OPERATING, marker="_", ms=14, mew=2.5, mec="k", label=f"operating frequency {at} Hz and the allowed {c.symbol} there"))
             caption.add("operating", f"The dash-dotted line is the operating frequency, {at} Hz, and the black bar on it the allowed {c.symbol} there ({allowed}).")
         else:  # the constraint limits another measure than these axes show: its limit is not drawn on them

@@ -260,7 +260,8 @@ def lyapunov_figure(part: xr.Dataset, engines: list[str], name: str) -> DrawnFig
     band = MotionThresholds()
     lines = series_by_restitution(part)
     f = part["frequency"].values
-    fig, axes = new_figure(len(lines), panel_height=3.0, legend_rows=legend_rows(len(_KINDS) + len(drawn) + 1))
+    fig, axes = new_figure(len(lines), panel_height=3.0, sharey=True, legend_rows=legend_rows(len(_KINDS) + len(drawn) + 1))  # the R panels compare: one y range
+    decided: set[Regime] = set()
     for ax, (text, line) in zip(axes, lines):
         ax.axhspan(-band.zero_band, band.zero_band, color="#dddddd", zorder=0)
         ax.axhline(0.0, color="k", lw=0.8)
@@ -272,10 +273,11 @@ def lyapunov_figure(part: xr.Dataset, engines: list[str], name: str) -> DrawnFig
             for kind in _KINDS:
                 chosen = np.isfinite(exponent) & (regime == int(kind))
                 if chosen.any():
+                    decided.add(kind)
                     ax.errorbar(f[chosen], exponent[chosen], yerr=error[chosen], fmt=marker, ms=size, color=REGIME_COLOURS[kind], mec="k", mew=0.5, ecolor="0.4", elinewidth=0.8, ls="none", gid=engine)
         finish_axes(ax, "frequency [Hz]", axis_label("lyapunov_exponent"), text)
         ax.set_xlim(f[0], f[-1])  # the study's band, as in the other figures
-    keys = [_key("o", REGIME_COLOURS[kind], kind.name.lower()) for kind in _KINDS]
+    keys = [_key("o", REGIME_COLOURS[kind], kind.name.lower()) for kind in _KINDS if kind in decided]  # the colours drawn, no other
     keys += [_key(ENGINE_MARKERS.get(e, ("s", 5.0))[0], "white", solution_ref(e)) for e in drawn]
     figure_legend(fig, axes, keys)
     caption = Caption(

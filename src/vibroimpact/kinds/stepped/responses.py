@@ -15,6 +15,7 @@ import xarray as xr
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from vibroimpact.analysis.stability import Regime
 from vibroimpact.grids.regime_map import regime_map
 from vibroimpact.kinds.stepped.crosscheck import subset_solutions
 from vibroimpact.reporting.coincide import coincidence_phrase, reveal_coincident
@@ -156,13 +157,19 @@ def regime_figure(part: xr.Dataset, name: str) -> DrawnFigure:
     """Regime flag of every point: one panel per solution, one row per restitution ratio, one colour per flag; the
     closed-form one-impact orbits that are unstable (``stable`` = 0) hatched over their colour."""
     lines = series_by_restitution(part)
-    panels = []
+    panels, shown, idle = [], [], []
     for s in part["solution"].values:
         flags = np.array([line["regime"].sel(solution=s).values for _, line in lines], dtype=int)
+        if np.all(flags == int(Regime.NOT_COMPUTED)):  # a solution run on a subset elsewhere: an empty panel says nothing
+            idle.append(solution_ref(str(s)))
+            continue
         unstable = np.array([line["stable"].sel(solution=s).values == 0 for _, line in lines]) if "stable" in part else None
         panels.append((f"{solution_ref(str(s))}: regime, {clearance_text(part)}", [text for text, _ in lines], flags, unstable))
-    solutions = ", ".join(solution_ref(str(s)) for s in part["solution"].values)
-    return regime_map(panels, part["frequency"].values, name, f"Regime map, {clearance_text(part)}", f"Regime of each point of {solutions}")
+        shown.append(solution_ref(str(s)))
+    drawn = regime_map(panels, part["frequency"].values, name, f"Regime map, {clearance_text(part)}", f"Regime of each point of {', '.join(shown)}")
+    if not idle:
+        return drawn
+    return DrawnFigure(drawn.figure, drawn.name, drawn.title, f"{drawn.caption} No panel for {', '.join(idle)}: {'it' if len(idle) == 1 else 'they'} computed no point at {clearance_text(part)}.")
 
 
 def stability_figure(part: xr.Dataset, name: str) -> DrawnFigure:
@@ -202,7 +209,7 @@ def simulation_figure(part: xr.Dataset, quantity: str, engines: list[str], name:
     coarse = f.size < COARSE_GRID_POINTS
     panels = "one panel per restitution ratio" if len(lines) > 1 else lines[0][0]
     caption = Caption(f"{q.label} ({q.meaning}) against frequency, {clearance_text(part)}: {panels}.")
-    fig, axes = new_figure(len(lines), panel_height=3.5, legend_rows=legend_rows(2 + 2 * len(drawn) + 2, 3))
+    fig, axes = new_figure(len(lines), panel_height=3.5, sharey=True, legend_rows=legend_rows(2 + 2 * len(drawn) + 2, 3))  # the R panels compare: one y range
     markers = SimulationMarkers(subset_counts(part))
     any_unstable = gaps = False
     for ax, (text, line) in zip(axes, lines):

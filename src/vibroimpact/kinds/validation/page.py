@@ -116,7 +116,7 @@ def _zeno(ds: xr.Dataset) -> DrawnFigure:
     figure_legend(fig, [ax, err], columns=3)
     caption = (f"A ball dropped from rest on a fixed table comes to rest at the Zeno time {t_zeno:.6g} s. Right: how far each rigid-stop engine's sticking "
                f"time is from it, against its tolerance; the dotted line is the bound the sticking velocity sets (2 e v_s / (g (1 - e)) = "
-               f"{float(ds.attrs['deficit_high_s']):.2e} s).")  # fmt: skip
+               f"{float(ds.attrs['deficit_high_s']):.2e} s, drawn as {float(ds.attrs['deficit_high_s']) / t_zeno:.2e} of the Zeno time).")  # fmt: skip
     return DrawnFigure(fig, "validation_zeno", "The Zeno time, engine by engine", caption)
 
 
@@ -212,10 +212,10 @@ class ValidationPage:
         """The table (with the source and notes) and the case's figure."""
         attrs = self.dataset.attrs
         passed, total = self.counts()
-        verdict = "every check passed" if passed == total else f"{total - passed} of {total} checks FAILED"
+        verdict = "Every check passed" if passed == total else f"{total - passed} of {total} checks FAILED"
         notes = [line for line in str(attrs.get("validation_notes", "")).split("\n") if line]
         intro = (
-            f"<p>Source: {html.escape(str(attrs.get('validation_source', '')))}. <b>{html.escape(verdict)}</b>.</p>"
+            f"<p><b>{html.escape(verdict)}</b>. Source: {html.escape(str(attrs.get('validation_source', '')))}.</p>"  # the answer first
             + "".join(f"<p>{html.escape(note)}</p>" for note in notes)
         )
         figures = saved([validation_figure(self.dataset)], out)
