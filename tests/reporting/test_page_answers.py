@@ -97,4 +97,4 @@ def test_the_bumper_studies_open_with_ida_against_the_closed_form_bumper(name: s
     assert check.reference == "compliant_exact" and check.periodic >= 2
     assert check.largest["x1_amplitude"] < 1e-5 and check.largest["x2_amplitude"] < 1e-5
     text = first_section(name)
-    assert cross_check_text(check) in text and "A steady state of 'compliant_exact' costs 1/" in text, text
+    assert cross_check_text(check) in text and "A steady state of 'compliant_exact' costs " in text, text

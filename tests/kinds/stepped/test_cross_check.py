@@ -49,3 +49,21 @@ def test_the_sentence_and_table_state_agreement_cost_and_every_point() -> None:
 
 def test_no_cross_check_without_a_subset() -> None:
     assert cross_checks(steady_dataset()) == []
+
+
+def test_the_subset_is_said_in_the_page_units() -> None:
+    """The dataset keeps its subset in SI ('clearance 0.002 m'); the page writes every clearance in mm, as 'Delta = 2 mm'
+    a few words later (the golden clearance_peaks page said 'clearance 0.002 m')."""
+    data = subset_dataset()
+    data.attrs["simulation_subset_compliant"] = "frequency 24, 26, 36 Hz; clearance 0.002, 0.0025 m"
+    (check,) = cross_checks(data)
+    assert check.subset == "frequency 24, 26, 36 Hz; clearance 2, 2.5 mm"
+    assert "run on frequency 24, 26, 36 Hz; clearance 2, 2.5 mm, against" in cross_check_text(check) and " m," not in cross_check_text(check)
+
+
+def test_a_dearer_reference_is_said_as_a_multiple_not_one_over_a_fraction() -> None:
+    """The golden clearance_peaks page said 'costs 1/0.467 of one of 'compliant''."""
+    from vibroimpact.kinds.stepped.crosscheck import cost_words
+
+    said = [cost_words(ratio) for ratio in (100.0, 0.467, 1.0004)]
+    assert said == ["costs 1/100 of", "costs 2.14 times", "costs as much as"]

@@ -160,8 +160,8 @@ def bumper_answer(dataset: xr.Dataset) -> str:
             elif np.isfinite(dataset["wall_time"].sel(case=case, engine=method).values).any():
                 reached.append(f"{html.escape(method)} at no rtol measured")
         text = f"{_bumper_label(dataset, case)}: {', '.join(reached) or 'no integrator measured'}; {html.escape(REFERENCES['bumper'])}, without tolerance, {fmt(1e6 * closed, '.3g')} us per period"
-        if math.isfinite(cheapest):
-            text += f", {_times(cheapest / closed)} cheaper than the cheapest of them"
+        if math.isfinite(cheapest):  # a factor below 1 is no saving: said the other way round
+            text += f", {_times(cheapest / closed)} cheaper than the cheapest of them" if cheapest >= closed else f", {_times(closed / cheapest)} the cost of the cheapest of them"
         parts.append(text)
     return (
         f"<p>The bumper, against its closed form ({html.escape(REFERENCES['bumper'])}): the loosest rtol within {fmt(target, 'g')} (relative) of "

@@ -6,6 +6,7 @@ path, the evaluations by stage, the mistuning's spreads."""
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -297,6 +298,19 @@ def _where_in_box(d: xr.Dataset, sample: int, certificate: int | None = None) ->
     return f" at {where}, {', '.join(parts)}"
 
 
+def motion_noun(motion: str) -> str:
+    """A certificate's motion (``certificate_motion``) as the noun that follows "set at 25 Hz by": ``the motion with 1
+    impact per period (...)``, ``the contact-free motion (brute force, up run)``, ``the period-2 motion with 3 impacts
+    (...)``, ``an irregular motion, 0.2 impacts per period (...)``."""
+    period = re.match(r"period (\d+), (.*)", motion)
+    if motion[:1].isdigit() or period:
+        return f"the period-{period[1]} motion with {period[2]}" if period else f"the motion with {motion}"
+    kind = motion.split(",")[0].split(" (")[0]
+    if kind in ("contact-free", "irregular", "chaotic", "quasi-periodic"):
+        return f"{'the' if kind == 'contact-free' else 'an' if kind[0] in 'aeiou' else 'a'} {kind} motion{motion[len(kind) :]}"
+    return motion
+
+
 def worst_motion(dataset: xr.Dataset, design: int = 0) -> str:
     """What sets a compared design's stated worst case, where and under which offsets: ``set at 24.34 Hz by the
     motion with 1 impact per period (interior of its branch) at the box's corner, +0.2 mm of the clearance, -0.05 of
@@ -308,8 +322,7 @@ def worst_motion(dataset: xr.Dataset, design: int = 0) -> str:
         return ""
     value, row = certified_worst(d, design)
     if row >= 0 and value >= worst * (1.0 - 1e-9):
-        motion = str(d["certificate_motion"].values[row])
-        named = f"the motion with {motion}" if motion[:1].isdigit() else motion
+        named = motion_noun(str(d["certificate_motion"].values[row]))
         return f"set at {fmt(float(d['certificate_frequency'].values[row]), '.5g')} Hz by {named}{_where_in_box(d, int(d['certificate_sample'].values[row]), row)}"
     values = d["sample_value"].values[evaluation]
     if not np.any(np.isfinite(values)):
@@ -451,7 +464,7 @@ def warnings(dataset: xr.Dataset) -> list[str]:
         for r in rows:
             worst, screened = float(d["certificate_worst"].values[r]), float(d["certificate_screened"].values[r])
             if math.isfinite(worst) and worst > screened * (1.0 + 1e-6):
-                out.append(f"The certification found a larger stable motion than the screen under {sample_name(int(d['certificate_sample'].values[r]))}: {q.text(worst)} ({d['certificate_motion'].values[r]} at {fmt(d['certificate_frequency'].values[r], '.4g')} Hz) against {q.text(screened)}.")
+                out.append(f"The certification found a larger stable motion than the screen under {sample_name(int(d['certificate_sample'].values[r]))}: {q.text(worst)}, {motion_noun(str(d['certificate_motion'].values[r]))} at {fmt(d['certificate_frequency'].values[r], '.4g')} Hz, against {q.text(screened)}.")
             cut = _cut_branches(d, int(r))
             if cut:
                 out.append(cut)

@@ -19,7 +19,7 @@ import xarray as xr
 from vibroimpact.analysis.stability import Regime
 from vibroimpact.engines.registry import BUMPER, RIGID
 from vibroimpact.reporting.page import Section, Table
-from vibroimpact.reporting.style import DISPLACEMENT_SCALE, QUANTITIES, SOLUTION_DESCRIPTIONS, fmt, solution_ref
+from vibroimpact.reporting.style import DISPLACEMENT_SCALE, PAGE_UNITS, QUANTITIES, SOLUTION_DESCRIPTIONS, fmt, solution_ref
 from vibroimpact.scene.schema import contact_solutions
 
 __all__ = ["subset_solutions", "CrossCheck", "cross_checks", "cross_check_text", "cross_check_section", "COMPARED"]
@@ -31,9 +31,28 @@ _NOT_INTEGRATED = (Regime.LINEAR, Regime.NOT_COMPUTED, Regime.FAILED)
 
 
 def subset_solutions(dataset: xr.Dataset) -> dict[str, str]:
-    """Solutions the study ran on a subset of its simulation grid -> that subset in words (dataset attributes)."""
+    """Solutions the study ran on a subset of its simulation grid -> that subset in words, in the page's units
+    (the dataset's attributes, :func:`page_unit_words`)."""
     prefix = "simulation_subset_"
-    return {key[len(prefix) :]: str(value) for key, value in dataset.attrs.items() if key.startswith(prefix) and key[len(prefix) :] in dataset["solution"].values}
+    return {key[len(prefix) :]: page_unit_words(str(value)) for key, value in dataset.attrs.items() if key.startswith(prefix) and key[len(prefix) :] in dataset["solution"].values}
+
+
+def page_unit_words(text: str) -> str:
+    """A subset in words as the dataset stores it, in SI (``frequency 26, 30 Hz; clearance 0.002 m``,
+    :func:`vibroimpact.scene.subset.subset_text`), in the page's units (:data:`PAGE_UNITS`: ``clearance 2 mm``),
+    as every other clearance on the page."""
+    parts = []
+    for part in text.split("; "):
+        head, _, unit = part.rpartition(" ")
+        axis, _, values = head.partition(" ")
+        if unit in PAGE_UNITS and values:
+            page_unit, factor = PAGE_UNITS[unit]
+            try:
+                part = f"{axis} {', '.join(fmt(float(v) * factor, 'g') for v in values.split(', '))} {page_unit}"
+            except ValueError:  # not a list of numbers: kept as it is
+                pass
+        parts.append(part)
+    return "; ".join(parts)
 
 
 @dataclass(frozen=True)
@@ -161,10 +180,19 @@ def cross_check_text(check: CrossCheck) -> str:
     text += "."
     if math.isfinite(check.cost_ratio):
         text += (
-            f" A steady state of {solution_ref(check.reference)} costs 1/{fmt(check.cost_ratio, '.3g')} of one of {solution_ref(check.checked)} "
+            f" A steady state of {solution_ref(check.reference)} {cost_words(check.cost_ratio)} one of {solution_ref(check.checked)} "
             f"(median ratio of their wall times at the points both integrated, in this run: {fmt(check.walls[0] * 1e3, '.4g')} ms against {fmt(check.walls[1] * 1e3, '.3g')} ms)."
         )
     return text
+
+
+def cost_words(ratio: float) -> str:
+    """How a steady state of the reference compares in cost with one of the checked solution, ``ratio`` = checked /
+    reference: ``costs 1/2.11 of`` (the reference cheaper), ``costs 2.14 times`` (dearer; not ``1/0.467``), ``costs
+    as much as``."""
+    if fmt(ratio, ".3g") == "1":  # exact: the ratio as written
+        return "costs as much as"
+    return f"costs 1/{fmt(ratio, '.3g')} of" if ratio > 1.0 else f"costs {fmt(1.0 / ratio, '.3g')} times"
 
 
 def cross_check_section(checks: list[CrossCheck]) -> Section | None:
