@@ -91,3 +91,20 @@ def test_the_search_map_caption_speaks_of_a_hatched_region_only_where_one_is_dra
     drawn = search_figure(dataset)
     assert not hatched(drawn) and "hatched region" not in drawn.caption and "no candidate keeps it, so no region is hatched" in drawn.caption
     plt.close(drawn.figure)
+
+
+def test_the_search_figure_names_its_variables_in_words_not_scene_keys() -> None:
+    """Issue 51 (review of every page): design_paper's search map titled a panel 'Worst case over clearance and
+    bumper_stiffness' and labelled an axis 'bumper_stiffness [N/m]'. Every title, axis label and the caption now say
+    'bumper stiffness K_b' (and 'clearance Delta', 'restitution R')."""
+    import matplotlib.pyplot as plt
+
+    from tests.golden.golden import DATA
+    from vibroimpact.kinds.design.search_map import search_figure
+
+    with xr.open_dataset(DATA / "design_paper.nc") as data:
+        drawn = search_figure(data.load())
+    texts = [drawn.caption] + [t for ax in drawn.figure.axes for t in (ax.get_title(), ax.get_xlabel(), ax.get_ylabel())]
+    plt.close(drawn.figure)
+    assert "bumper_stiffness" in str(data.attrs["variables"])
+    assert not any("bumper_stiffness" in t for t in texts) and any("bumper stiffness K_b" in t for t in texts)

@@ -15,6 +15,7 @@ from matplotlib.colors import BoundaryNorm
 from matplotlib.tri import Triangulation, TriAnalyzer
 from numpy.typing import NDArray
 
+from vibroimpact.kinds.design.cautions import SYMBOLS
 from vibroimpact.kinds.design.answer import design_evaluation, design_titles, screen_words, search_path, stage_counts, unit_text, variable_names
 from vibroimpact.kinds.design.palette import DESIGN_COLOURS, DESIGN_MARKERS, LIMIT_COLOUR, OBJECTIVE_MAP, OBJECTIVE_PERCENTILE, PATH_COLOUR
 from vibroimpact.kinds.design.quantity import constraint_quantity, objective_quantity, operating_limit
@@ -37,7 +38,15 @@ def _axis(dataset: xr.Dataset, name: str) -> tuple[float, str]:
     if name == "restitution":
         return 1.0, "restitution R [-]"
     unit = unit_text(str(dataset[f"variable_{safe_name(name)}"].attrs.get("units", "1")))
-    return 1.0, f"{name} [{unit or '-'}]"
+    return 1.0, f"{variable_words(name)} [{unit or '-'}]"
+
+
+def variable_words(name: str) -> str:
+    """A design variable as a page names it: its words and its symbol (``bumper stiffness K_b``, ``clearance Delta``),
+    not the scene's key (``bumper_stiffness``); a layout scalar without a symbol keeps its key (``k2``, ``mass[x3]``)."""
+    words = name.replace("_", " ")
+    symbol = SYMBOLS.get(name)
+    return f"{words} {symbol}" if symbol else words
 
 
 def _limits(dataset: xr.Dataset, name: str) -> tuple[float, float]:
@@ -108,7 +117,7 @@ def _map_panel(ax: Axes, d: xr.Dataset, pair: tuple[str, str], levels: NDArray[n
     _path_and_designs(ax, d, pair, (x0, x1, y0, y1), path=cells is None)
     ax.set_xlim(x0 * sx, x1 * sx)
     ax.set_ylim(y0 * sy, y1 * sy)
-    finish_axes(ax, xlabel, ylabel, f"Worst case over {pair[0]} and {pair[1]}" + (" (projection)" if projected else ""))
+    finish_axes(ax, xlabel, ylabel, f"Worst case over {variable_words(pair[0])} and {variable_words(pair[1])}" + (" (projection)" if projected else ""))
     ax.grid(False)
     return mappable
 
@@ -221,7 +230,7 @@ def search_figure(dataset: xr.Dataset) -> DrawnFigure:
         caption = _grid_caption(d, cells, levels)
     else:
         counts = stage_counts(d)
-        caption = Caption(f"The search's {d.sizes['evaluation']} candidates over {' and '.join(names[:3]) if projected else ' and '.join(names)}: each candidate's worst case {q.symbol} over the band and the mistuning samples ({screen_words(d)} screen), in {q.unit}.")
+        caption = Caption(f"The search's {d.sizes['evaluation']} candidates over {' and '.join(map(variable_words, names[:3] if projected else names))}: each candidate's worst case {q.symbol} over the band and the mistuning samples ({screen_words(d)} screen), in {q.unit}.")
         if projected:
             caption.add("projected", f"{len(names)} variables: each map is a projection, the other variables vary from point to point (a point's colour is its own worst case, the best drawn on top); the last panel is the worst case in evaluation order.")
         else:
@@ -288,10 +297,10 @@ def _search_line(d: xr.Dataset, name: str) -> DrawnFigure:
         if math.isfinite(value) and evaluation >= 0:
             ax.plot([min(max(value, low), high) * scale], [objective[evaluation]], marker=DESIGN_MARKERS[k], ms=16 if k == 0 else 10, color=DESIGN_COLOURS[k], mec="k", mew=0.9, ls="none", label=design_titles(d)[k])
     ax.set_xlim(low * scale, high * scale)
-    finish_axes(ax, label, f"worst case {q.label}", f"The search over {name}", log=True)
+    finish_axes(ax, label, f"worst case {q.label}", f"The search over {variable_words(name)}", log=True)
     plain_log(ax)
     figure_legend(fig, axes, columns=3)
-    caption = Caption(f"The worst case {q.symbol} over the band and the mistuning samples ({screen_words(d)} screen, {q.unit}, log scale) of each of the search's {d.sizes['evaluation']} candidates against {name}.")
+    caption = Caption(f"The worst case {q.symbol} over the band and the mistuning samples ({screen_words(d)} screen, {q.unit}, log scale) of each of the search's {d.sizes['evaluation']} candidates against {variable_words(name)}.")
     caption.add("path", f"The vermillion line joins the best design so far each time it improved; the blue star is the {design_titles(d)[0]}, the orange square the scene's own (at the edge when outside the bounds).")
     return DrawnFigure(fig, "design_search", "The objective over the design variable, and the search's path", caption.text())
 
