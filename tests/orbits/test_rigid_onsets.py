@@ -82,7 +82,7 @@ def test_onsets_are_the_closed_form_tangencies(branches) -> None:
         assert min(abs(point.value - root) for root in roots) <= 1e-12 * point.value
         assert point.continues
     notes = {round(point.value, 3): point.note for point in grazing}
-    assert "a free flight touches the stop; the branch continues with 1 impacts per period" in notes[33.972]
+    assert "a free flight touches the stop; the branch continues with 1 impact per period" in notes[33.972]
     assert "the branch turns back here: a nonsmooth fold" in notes[26.026]
     assert "a real multiplier through +1" in notes[37.499] and "a real multiplier through +1" in notes[20.618]
 

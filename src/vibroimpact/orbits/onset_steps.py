@@ -112,7 +112,7 @@ class OnsetSteps:
             after = beyond.out.hybrid
             if after.impacts == before.impacts:
                 what = f"{what} (the sticking phases change, {before.sticks} -> {after.sticks})"
-            note = f"{what}; the branch continues with {after.impacts} impacts per period"
+            note = f"{what}; the branch continues with {after.impacts} impact{'' if after.impacts == 1 else 's'} per period"
         else:
             note = f"{what}; no periodic orbit beyond: the branch ends"
         at = grazing if grazing is not None else side
