@@ -8,7 +8,9 @@ shoots the rigid orbit on a bumper :data:`STIFF_START` times stiffer than the sc
 order in T_b: the rigid orbit is 1 / :data:`STIFF_START` as far from that bumper's as from the scene's), then follows
 it in T_b on :class:`~vibroimpact.orbits.bumper_map.BumperPeriodMap` up to the scene's bumper, in stages of a
 factor :data:`STAGE` in T_b, each measuring arclength in its own first T_b (steps in log T_b: a bumper 64 times
-softer than the start is 3 stages). Shooting the rigid
+softer than the start is 3 stages); a stage that neither arrives nor meets a fold or an onset is taken again to the
+scene's bumper with one 1 ms unit (next to the rigid limit, a 256 kHz bumper's T_b of 4 us as the unit stalled on the
+paper's 18.27 Hz orbit). Shooting the rigid
 orbit on the scene's bumper directly fails where the two are far apart (the shipped ``bifurcation_bumper``: 8 of its
 20 starts, the line search or 40 Newton iterations stalling on a residual of 1e-3 to 5e-2).
 
@@ -24,7 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from vibroimpact.model.contact import KelvinVoigtBumper
-from vibroimpact.orbits.branch import PeriodicOrbit
+from vibroimpact.orbits.branch import Branch, PeriodicOrbit, SpecialPoint
 from vibroimpact.orbits.bumper_map import BUMPER_PERIOD, BumperPeriodMap
 from vibroimpact.orbits.continuation import ContinuationSettings, continue_branch
 from vibroimpact.orbits.maps import ImpactMap
@@ -103,24 +105,39 @@ def bumper_start(mapping: ImpactMap, rigid: PeriodicOrbit) -> BumperStart:
     orbit, reached = _stiff_orbit(mapping, rigid, target)
     while reached < target * (1.0 - REACHED):  # one stage per factor STAGE in T_b: steps in log T_b
         upper = min(STAGE * reached, target)
-        scale = (*BumperPeriodMap.natural_scale(mapping.problem)[:-1], reached)  # a unit of arclength: this stage's T_b
-        stage = BumperPeriodMap(mapping.problem, bounds={**mapping.bounds, BUMPER_PERIOD: (0.5 * reached, upper)}, parameter_scale=scale)
-        settings = ContinuationSettings(lower=0.5 * reached, upper=upper, max_steps=START_STEPS, stop_at_grazing=True)
-        branch = continue_branch(stage, orbit, BUMPER_PERIOD, settings, direction=1)
+        branch = _soften(mapping, orbit, reached, upper, reached)  # a unit of arclength: this stage's T_b
+        turned = _turns(branch)
+        if branch.values.max() < upper * (1.0 - REACHED) and not turned:  # neither there nor an answer: one scale to the end
+            upper = target
+            branch = _soften(mapping, orbit, reached, target, None)
+            turned = _turns(branch)
         periods = branch.values
         if periods.max() >= upper * (1.0 - REACHED):
             orbit, reached = branch.orbits[int(periods.argmax())], upper
             continue
         softest = 1.0 / float(periods.max())
-        turns = [point for point in branch.special_points if point.kind in ("fold", "grazing")]
-        if turns and turns[0].kind == "fold":
-            why = f"followed in the bumper's stiffness it turns back at Omega_b / 2 pi = {1.0 / turns[0].value:.4g} Hz (a fold in T_b: it exists only with stiffer bumpers)"
-        elif turns:
-            why = f"followed in the bumper's stiffness it loses its contact at Omega_b / 2 pi = {1.0 / turns[0].value:.4g} Hz (an onset at tangency)"
+        if turned and turned[0].kind == "fold":
+            why = f"followed in the bumper's stiffness it turns back at Omega_b / 2 pi = {1.0 / turned[0].value:.4g} Hz (a fold in T_b: it exists only with stiffer bumpers)"
+        elif turned:
+            why = f"followed in the bumper's stiffness it loses its contact at Omega_b / 2 pi = {1.0 / turned[0].value:.4g} Hz (an onset at tangency)"
         else:  # neither an answer nor the orbit: the continuation gave up
             raise RuntimeError(f"the continuation in the bumper's stiffness reached only Omega_b / 2 pi = {softest:.4g} Hz of {1.0 / target:g} Hz (it ended: {branch.end})")
         return BumperStart(None, why, softest)
     return BumperStart(shoot(mapping, orbit.state, mapping.parameters), "", 1.0 / target)
+
+
+def _soften(mapping: ImpactMap, orbit: PeriodicOrbit, start: float, upper: float, unit: float | None) -> Branch:
+    """``orbit`` (T_b = ``start`` [s]) continued in T_b up to ``upper`` [s], a unit of arclength in T_b of ``unit``
+    [s] (None: :meth:`BumperPeriodMap.natural_scale`'s 1 ms)."""
+    scale = None if unit is None else (*BumperPeriodMap.natural_scale(mapping.problem)[:-1], unit)
+    system = BumperPeriodMap(mapping.problem, bounds={**mapping.bounds, BUMPER_PERIOD: (0.5 * start, upper)}, parameter_scale=scale)
+    settings = ContinuationSettings(lower=0.5 * start, upper=upper, max_steps=START_STEPS, stop_at_grazing=True)
+    return continue_branch(system, orbit, BUMPER_PERIOD, settings, direction=1)
+
+
+def _turns(branch: Branch) -> list[SpecialPoint]:
+    """The folds and onsets (grazing) on ``branch``: where the softening orbit turns back or loses its contact."""
+    return [point for point in branch.special_points if point.kind in ("fold", "grazing")]
 
 
 def _stiff_orbit(mapping: ImpactMap, rigid: PeriodicOrbit, target: float) -> tuple[PeriodicOrbit, float]:
