@@ -4,6 +4,8 @@ within 5 % of the operating frequency above the allowed value; none on the datas
 
 from __future__ import annotations
 
+import math
+
 from pathlib import Path
 
 import numpy as np
@@ -108,3 +110,46 @@ def test_the_search_figure_names_its_variables_in_words_not_scene_keys() -> None
     plt.close(drawn.figure)
     assert "bumper_stiffness" in str(data.attrs["variables"])
     assert not any("bumper_stiffness" in t for t in texts) and any("bumper stiffness K_b" in t for t in texts)
+
+
+@pytest.mark.parametrize("name", ["design_paper", "design_vs_linear"])
+def test_the_progress_panel_draws_no_penalised_score(name: str) -> None:
+    """Review of every page: the 'best score so far' line of design_search.png began at a penalised score (~700 mm
+    beside worst cases of a few mm), which is no worst case. The line is now the best worst case so far among the
+    candidates that keep the operating limit: never above a worst case the panel plots, absent before the first."""
+    import matplotlib.pyplot as plt
+
+    from tests.golden.golden import DATA
+    from vibroimpact.kinds.design.palette import PATH_COLOUR
+    from vibroimpact.kinds.design.quantity import objective_quantity, operating_limit
+    from vibroimpact.kinds.design.search_map import search_figure
+
+    with xr.open_dataset(DATA / f"{name}.nc") as data:
+        d = data.load()
+    drawn = search_figure(d)
+    panel = next(ax for ax in drawn.figure.axes if ax.get_title().startswith("Worst case in evaluation order"))
+    lines = [line for line in panel.lines if line.get_color() == PATH_COLOUR and line.get_drawstyle().startswith("steps")]
+    title = panel.get_title()
+    plt.close(drawn.figure)
+    keeps = d["feasible"].values == 1
+    limited = math.isfinite(operating_limit(d))
+    assert lines and ("best so far that keeps the operating limit" in title) == limited
+    best = np.asarray(lines[0].get_ydata(), dtype=float)
+    objective = objective_quantity(d).value(d["objective"].values)
+    assert np.nanmax(best) <= np.max(objective[keeps]) * (1 + 1e-12)
+    assert np.all(np.isnan(best[: int(np.argmax(keeps))]))  # nothing before the first candidate that keeps it
+
+
+def test_the_worst_case_markers_are_drawn_whole_at_a_band_edge() -> None:
+    """Review of every page: design_response.png's worst-case ring at the band's 22 Hz edge was half clipped by the
+    axes. The rings and the certified stars are drawn unclipped (the band ends where the axis does)."""
+    import matplotlib.pyplot as plt
+
+    from tests.golden.golden import DATA
+    from vibroimpact.kinds.design.figures import response_figure
+
+    with xr.open_dataset(DATA / "design_rigid_stop.nc") as data:
+        drawn = response_figure(data.load())
+    marks = [line for ax in drawn.figure.axes for line in ax.lines if line.get_marker() in ("o", "*") and line.get_linestyle() == "None" and line.get_markersize() >= 12]
+    plt.close(drawn.figure)
+    assert marks and not any(line.get_clip_on() for line in marks)

@@ -104,10 +104,10 @@ def _design_panel(ax: Axes, d: xr.Dataset, k: int) -> tuple[list[float], set[str
         drawn.append(q.value(ba[np.isfinite(ba)]))
         worst, where = float(d["certificate_worst"].values[r]), float(d["certificate_frequency"].values[r])
         if math.isfinite(worst):
-            ax.plot([where], [q.value(worst)], marker="*", ms=14, color=CERTIFIED_COLOUR, mec="k", mew=0.6, ls="none", zorder=7)
+            ax.plot([where], [q.value(worst)], marker="*", ms=14, color=CERTIFIED_COLOUR, mec="k", mew=0.6, ls="none", zorder=7, clip_on=False)  # whole at a band edge
             kinds.add("certified")
     where, value = _worst_point(d, k)
-    ax.plot([where], [q.value(value)], marker="o", ms=12, mfc="none", mec="k", mew=1.4, ls="none", zorder=6)
+    ax.plot([where], [q.value(value)], marker="o", ms=12, mfc="none", mec="k", mew=1.4, ls="none", zorder=6, clip_on=False)  # whole at a band edge
     return [float(v) for part in drawn for v in np.asarray(part).ravel() if np.isfinite(v) and v > 0.0], kinds
 
 
@@ -140,7 +140,7 @@ def response_figure(dataset: xr.Dataset) -> DrawnFigure:
         first_scale = readable_scale(float(np.min(finite)), float(np.max(finite))) if finite.size else "log"
         for k in sorted(present, reverse=True):  # the recommended design on top, drawn narrower than the others
             ax.plot(f, worst[present.index(k)], color=DESIGN_COLOURS[k], lw=1.8 if k == 0 else 3.2, zorder=3 - k)
-            ax.plot(*(np.array(_worst_point(d, k)) * (1.0, q.scale)), marker="o", ms=12, mfc="none", mec="k", mew=1.4, ls="none", zorder=6)
+            ax.plot(*(np.array(_worst_point(d, k)) * (1.0, q.scale)), marker="o", ms=12, mfc="none", mec="k", mew=1.4, ls="none", zorder=6, clip_on=False)
         _operating(ax, d)
         ax.set_xlim(float(f[0]), float(f[-1]))
         finish_axes(ax, _FREQUENCY, q.label, "Worst stable motion of each design (no mistuning)", log=first_scale == "log")

@@ -265,16 +265,21 @@ def _grid_caption(d: xr.Dataset, cells: GridCells, levels: NDArray[np.float64]) 
 
 
 def _progress_panel(ax: Axes, d: xr.Dataset) -> None:
-    """Each candidate's worst case in evaluation order, and the best score so far."""
+    """Each candidate's worst case in evaluation order, and the best so far among those that keep the operating limit
+    (all, without one): a penalised score is no worst case, and drawn it stretched the axis to hundreds of mm."""
     q = objective_quantity(d)
     objective, score = q.value(d["objective"].values), q.value(d["score"].values)
     index = np.arange(objective.size)
     ax.plot(index, objective, ".", color="0.35", ms=4, ls="none")
-    ax.step(index, np.minimum.accumulate(np.where(np.isfinite(score), score, np.inf)), where="post", color=PATH_COLOUR, lw=1.5)
+    keeps = np.isfinite(score) & (d["feasible"].values == 1)
+    best = np.minimum.accumulate(np.where(keeps, score, np.inf))
+    if np.any(keeps):
+        ax.step(index, np.where(np.isfinite(best), best, np.nan), where="post", color=PATH_COLOUR, lw=1.5)
+    line = ("line: best so far" + (" that keeps the operating limit" if math.isfinite(operating_limit(d)) else "")) if np.any(keeps) else "no candidate keeps the operating limit"
     recommended = int(d.attrs.get("recommended_evaluation", -1))
     if recommended >= 0:
         ax.plot([recommended], [objective[recommended]], marker=DESIGN_MARKERS[0], ms=16, color=DESIGN_COLOURS[0], mec="k", mew=0.9, ls="none")
-    finish_axes(ax, "evaluation (in the order evaluated)", f"worst case {q.label}", "Worst case in evaluation order (line: best score so far)", log=True)
+    finish_axes(ax, "evaluation (in the order evaluated)", f"worst case {q.label}", f"Worst case in evaluation order ({line})", log=True)
     plain_log(ax)
 
 
