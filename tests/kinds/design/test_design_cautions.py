@@ -133,7 +133,7 @@ def test_the_progress_panel_draws_no_penalised_score(name: str) -> None:
     plt.close(drawn.figure)
     keeps = d["feasible"].values == 1
     limited = math.isfinite(operating_limit(d))
-    assert lines and ("best so far that keeps the operating limit" in title) == limited
+    assert lines and ("best so far keeping the limit" in title) == limited
     best = np.asarray(lines[0].get_ydata(), dtype=float)
     objective = objective_quantity(d).value(d["objective"].values)
     assert np.nanmax(best) <= np.max(objective[keeps]) * (1 + 1e-12)

@@ -232,7 +232,7 @@ def search_figure(dataset: xr.Dataset) -> DrawnFigure:
         counts = stage_counts(d)
         caption = Caption(f"The search's {d.sizes['evaluation']} candidates over {' and '.join(map(variable_words, names[:3] if projected else names))}: each candidate's worst case {q.symbol} over the band and the mistuning samples ({screen_words(d)} screen), in {q.unit}.")
         if projected:
-            caption.add("projected", f"{len(names)} variables: each map is a projection, the other variables vary from point to point (a point's colour is its own worst case, the best drawn on top); the last panel is the worst case in evaluation order.")
+            caption.add("projected", f"{len(names)} variables: each map is a projection, the other variables vary from point to point (a point's colour is its own worst case, the best drawn on top); the last panel is the worst case in evaluation order" + ("; there crosses break the operating limit and the line is the best so far of the others." if math.isfinite(limit) else ", the line the best so far."))
         else:
             caption.add("fill", "The grey shading is interpolated linearly over triangles between the evaluated candidates (small dots), light where the worst case is small; where there are no candidates it is a guess.")
         caption.add("levels", f"The colour levels are log-spaced from the least worst case ({fmt(10 ** levels[0], '.3g')} {q.unit}) to the {OBJECTIVE_PERCENTILE:g}th percentile ({fmt(10 ** levels[-1], '.3g')} {q.unit}); worse candidates share the darkest grey.")
@@ -270,12 +270,13 @@ def _progress_panel(ax: Axes, d: xr.Dataset) -> None:
     q = objective_quantity(d)
     objective, score = q.value(d["objective"].values), q.value(d["score"].values)
     index = np.arange(objective.size)
-    ax.plot(index, objective, ".", color="0.35", ms=4, ls="none")
     keeps = np.isfinite(score) & (d["feasible"].values == 1)
+    ax.plot(index[keeps], objective[keeps], ".", color="0.35", ms=4, ls="none")
+    ax.plot(index[~keeps], objective[~keeps], "x", color="0.35", ms=4, mew=0.8, ls="none")  # breaks the limit: no best
     best = np.minimum.accumulate(np.where(keeps, score, np.inf))
     if np.any(keeps):
         ax.step(index, np.where(np.isfinite(best), best, np.nan), where="post", color=PATH_COLOUR, lw=1.5)
-    line = ("line: best so far" + (" that keeps the operating limit" if math.isfinite(operating_limit(d)) else "")) if np.any(keeps) else "no candidate keeps the operating limit"
+    line = ("line: best so far" + (" keeping the limit" if math.isfinite(operating_limit(d)) else "")) if np.any(keeps) else "none keeps the limit"
     recommended = int(d.attrs.get("recommended_evaluation", -1))
     if recommended >= 0:
         ax.plot([recommended], [objective[recommended]], marker=DESIGN_MARKERS[0], ms=16, color=DESIGN_COLOURS[0], mec="k", mew=0.9, ls="none")
