@@ -32,10 +32,11 @@ def test_no_two_special_points_of_the_golden_scene_coincide() -> None:
         assert all(labels[0] == str(p["branch"]) for labels, p in zip(found_on, points))
     # the golden scene's grazing points at 26.03 Hz (one-impact branch 3 and the branch born at 27.05 Hz, 7), at
     # 27.05 Hz (the period-two branch 6, where branch 7 is born) and at 33.97 Hz (one-impact branch 4 and the period-7
-    # branch 8): each once, with both branches
+    # branch 8), and where the seeded branches' grazing points give birth (34.47, 38.49, 38.99 Hz: seeded 10, 9, 11 and
+    # born 14, 13, 15; 34.32 Hz: born 14 and the branch born from it, 16): each once, with both branches
     dataset = xr.load_dataset(DATA / "bifurcation.nc")
     twice = {round(float(f), 2): str(b) for f, b in zip(dataset["special_point_frequency"].values, dataset["special_point_branches"].values) if " " in str(b)}
-    assert twice == {26.03: "3 7", 27.05: "6 7", 33.97: "4 8"}
+    assert twice == {26.03: "3 7", 27.05: "6 7", 33.97: "4 8", 34.32: "14 16", 34.47: "10 14", 38.49: "9 13", 38.99: "11 15"}
 
 
 def test_every_distinct_special_point_is_kept_once() -> None:

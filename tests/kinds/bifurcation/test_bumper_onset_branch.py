@@ -200,3 +200,29 @@ def test_a_soft_or_stiff_bumper_on_the_paper_layout_answers_every_start(bumper: 
     turns = [float(line.split("turns back at Omega_b / 2 pi = ")[1].split(" Hz")[0]) for line in found.absent if "turns back" in line]
     assert all(t > bumper for t in turns) and any(t == pytest.approx(1.508e4, rel=1e-3) for t in turns)  # 18.70 Hz: 15.1 kHz
     assert len(found.absent) + len(found.maps) >= found.attempts["closed_form"]  # every start an orbit or an answer
+
+
+def test_a_branch_goes_on_where_a_free_flight_of_a_seeded_orbit_touches_the_stop() -> None:
+    """Issue 52: a rigid stop's branch through an onset to another contact count. On the golden diagram (the paper's
+    layout, R = 0.2) the branch seeded from the brute force at 38.5 Hz (period 10) meets a grazing point at 38.488 Hz
+    where a free flight touches the stop and an orbit with 6 impacts continues; before, the grazing points of
+    seeded branches were never visited and that branch ended there. Now a branch born there (origin 'grazing') passes
+    through the same grazing point, on the other side of it."""
+    import xarray as xr
+
+    from tests.golden.golden import DATA
+
+    with xr.open_dataset(DATA / "bifurcation.nc") as data:
+        d = data.load()
+    kinds = d["special_point_kind"].values
+    notes = [str(n) for n in d["special_point_note"].values]
+    flights = [k for k in np.flatnonzero(kinds == SPECIAL_POINT_KINDS.index("grazing")) if notes[k].startswith("a free flight touches the stop; the branch continues with")]
+    assert flights
+    grazing_origin = d["branch_origin"].attrs["flag_meanings"].split().index("grazing")
+    born = set(np.unique(d["branch"].values[d["branch_origin"].values == grazing_origin]).tolist())
+    continued = [k for k in flights if born & {int(b) for b in str(d["special_point_branches"].values[k]).split()}]
+    assert continued, "no branch born at a free flight's grazing point"
+    k = continued[0]
+    on = {int(b) for b in str(d["special_point_branches"].values[k]).split()}
+    counts = {float(d["impacts_per_period"].values[np.flatnonzero(d["branch"].values == b)].max()) for b in on}
+    assert len(on) >= 2 and len(counts) >= 2  # the same point on two branches with different contact counts

@@ -36,6 +36,7 @@ from scipy.optimize import brentq
 from vibroimpact.analysis.impact_orbit import ROOTS, ImpactOrbit, solve_impact_orbit
 from vibroimpact.analysis.layout import closed_form_refusal
 from vibroimpact.analysis.linear import linear_amplitudes
+from vibroimpact.kinds.bifurcation.born import MAX_GRAZING_BRANCHES, grow_at_grazing
 from vibroimpact.kinds.bifurcation.bumper_start import bumper_start
 from vibroimpact.model.contact import BUMPER, RigidStop
 from vibroimpact.model.problem import ImpactProblem
@@ -47,7 +48,7 @@ from vibroimpact.orbits.onset_start import contact_orbit_at_onset
 from vibroimpact.orbits.orbit_measures import orbit_measures
 from vibroimpact.orbits.shooting import shoot
 
-__all__ = ["rigid_twin", "ORIGINS", "MAX_ORBIT_IMPACTS", "SAME_POINT_FREQUENCY", "SAME_POINT_ORBIT", "same_special_point", "map_bounds", "problem_at", "stop_values", "OrbitSet", "find_branches", "closed_form_orbits", "linear_segments", "band_step"]
+__all__ = ["rigid_twin", "MAX_GRAZING_BRANCHES", "ORIGINS", "MAX_ORBIT_IMPACTS", "SAME_POINT_FREQUENCY", "SAME_POINT_ORBIT", "same_special_point", "map_bounds", "problem_at", "stop_values", "OrbitSet", "find_branches", "closed_form_orbits", "linear_segments", "band_step"]
 
 #: How a branch was found (CF flags of ``branch_origin``): the closed forms' kinds (one impact per period, the
 #: symmetric two impacts of a two-sided stop) are :data:`vibroimpact.analysis.layout.KINDS`.
@@ -69,8 +70,6 @@ def band_step(low: float, high: float, step: float) -> float:
     return min(step, (high - low) / MIN_POINTS)
 #: Largest relative impulse difference of an orbit from a branch it is taken to lie on [-].
 SAME_ORBIT = 0.02
-#: Most branches born at grazing points per restitution (each may have its own grazing points).
-MAX_GRAZING_BRANCHES = 8
 #: |max |mu| - 1| up to which an orbit is marginal (``stable`` = 2) [-].
 MARGINAL = 1e-9
 #: Two special points of one kind are one point when their frequencies differ by at most this, relative [-]. The
@@ -433,27 +432,7 @@ def find_branches(
 
                 attempt("period_doubling", f"period-2 branch at {point.value:.3f} Hz", doubled)
     if grazing:
-        born = 0
-        for mapping, branch in maps:  # grows while it runs: a born branch's own grazing points are visited too
-            for point in branch.special("grazing"):
-                if not point.continues or not point.impacts_after or point.impacts_after in set(branch.impacts.tolist()) or born >= MAX_GRAZING_BRANCHES:
-                    continue
-
-                def beyond(mapping: ImpactMap = mapping, point: SpecialPoint = point) -> None:
-                    orbit = _orbit_beyond(mapping, point)
-                    if orbit is None:
-                        found.notes.append(f"no orbit with {point.impacts_after} impacts found next to the grazing point at {point.value:.4f} Hz")
-                        return
-                    measures = orbit_measures(mapping, orbit)
-                    if found.known(orbit.parameter("frequency"), orbit.period, orbit.impacts, float(measures.impulses.sum()) / orbit.period):
-                        return
-                    child = continue_branch(Iterated(mapping, orbit.period) if orbit.period > 1 else mapping, orbit, "frequency", settings)
-                    label = found.add_branch(mapping, child, "grazing")
-                    maps.append((mapping, child))
-                    say(f"branch {label} born at the grazing point at {point.value:.3f} Hz: {len(child.orbits)} points")
-
-                born += 1
-                attempt("grazing", f"branch born at {point.value:.4f} Hz", beyond)
+        grow_at_grazing(found, maps, settings, say=say)
     found.maps = maps
     return found
 
@@ -480,21 +459,3 @@ def _segment(mask: NDArray[np.bool_], k: int) -> tuple[int, int]:
     while last < mask.size - 1 and mask[last + 1]:
         last += 1
     return first, last
-
-
-def _orbit_beyond(mapping: ImpactMap, point: SpecialPoint) -> PeriodicOrbit | None:
-    """The orbit with ``point.impacts_after`` impacts next to a grazing point: shooting from the grazing orbit on
-    either side of it, ever farther."""
-    orbit = point.orbit
-    index = orbit.parameter_names.index("frequency")
-    for offset in (1e-4, 1e-3, 1e-2, 5e-2):
-        for sign in (1.0, -1.0):
-            p = orbit.parameters.copy()
-            p[index] = point.value + sign * offset
-            try:
-                found = shoot(mapping, orbit.state, p, orbit.period)
-            except Exception:  # noqa: BLE001 - no orbit there: try the next guess
-                continue
-            if found.impacts == point.impacts_after:
-                return found
-    return None

@@ -33,6 +33,7 @@ from vibroimpact.analysis.linear import linear_amplitudes
 from vibroimpact.engines.registry import RIGID, engine_for, make_engine
 from vibroimpact.kinds.bifurcation.logs import FAILURE_FIELDS, failure_arrays
 from vibroimpact.kinds.bifurcation.slow_seeds import SLOW_SEED_FIELDS, SeedOutcome, continue_seed_orbit, settle_seed, slow_seed_arrays
+from vibroimpact.kinds.bifurcation.born import grow_at_grazing
 from vibroimpact.kinds.bifurcation.branches import OrbitSet, map_bounds, problem_at, stop_values, MAX_ORBIT_IMPACTS, find_branches
 from vibroimpact.model.problem import ImpactProblem
 from vibroimpact.model.units import length_unit
@@ -310,7 +311,10 @@ class BranchCase:
         found = find_branches(self.problem, self.low, self.high, **options)
         if brute_force and self.seeds:
             settings = ContinuationSettings(lower=self.low, upper=self.high, max_steps=int(options.get("max_steps", 2000)), max_step=float(options.get("max_step", 0.1)), stop_at_grazing=True)
+            first = len(found.maps)
             seed_branches(found, self.problem, self.low, self.high, self.seeds, settings)
+            if bool(options.get("grazing", True)):  # the seeded branches' grazing points, as the others' (branches.find_branches)
+                grow_at_grazing(found, found.maps, settings, first)
         return branch_arrays(found, self.problem.size)
 
 
