@@ -44,8 +44,8 @@ def suggest_keywords(target: T) -> T:
     function: Any = target.__init__ if isinstance(target, type) else target  # type: ignore[misc]
     if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in inspect.signature(function).parameters.values()):
         return target
-    names = frozenset(keyword_names(target))  # type: ignore[arg-type]
     ordered = keyword_names(target)  # type: ignore[arg-type]
+    names = frozenset(ordered)
     owner = getattr(target, "__name__", repr(target))
 
     @functools.wraps(function)

@@ -33,6 +33,7 @@ from vibroimpact.orbits.branch import HybridInfo, Iterated, MapEvaluation, Param
 
 __all__ = [
     "second_compound",
+    "critical_pair",
     "fold_test",
     "period_doubling_test",
     "neimark_sacker_test",
@@ -289,14 +290,20 @@ def _closest(multipliers: NDArray[np.complex128], target: complex) -> complex:
     return complex(multipliers[np.argmin(np.abs(multipliers - target))])
 
 
+def critical_pair(multipliers: NDArray[np.complex128]) -> complex | None:
+    """The complex multiplier nearest the unit circle (None: every multiplier is real): the one a Neimark-Sacker
+    point puts on it."""
+    pair = multipliers[np.abs(multipliers.imag) > 1e-9 * np.maximum(np.abs(multipliers), 1e-300)]
+    return None if pair.size == 0 else complex(pair[np.argmin(np.abs(np.abs(pair) - 1.0))])
+
+
 def classify(kind: str, orbit: PeriodicOrbit, parameter: str, test_value: float) -> SpecialPoint | None:
     """The special point of ``kind`` at ``orbit``, or None when its multipliers deny it (a neutral saddle)."""
     mu = orbit.multipliers
     if kind == "neimark_sacker":
-        pair = mu[np.abs(mu.imag) > 1e-9 * np.maximum(np.abs(mu), 1e-300)]
-        if pair.size == 0 or np.min(np.abs(np.abs(pair) - 1.0)) > 1e-5:
+        critical = critical_pair(mu)
+        if critical is None or abs(abs(critical) - 1.0) > 1e-5:
             return None
-        critical = pair[np.argmin(np.abs(np.abs(pair) - 1.0))]
         note = f"complex pair crosses the unit circle at angle {abs(np.angle(critical)):.6g} rad"
         return SpecialPoint(kind, orbit, parameter, orbit.parameter(parameter), test_value, note)
     if kind == "period_doubling":

@@ -26,7 +26,7 @@ import numpy as np
 
 from vibroimpact.orbits.branch import PeriodicOrbit
 from vibroimpact.orbits.maps import ImpactMap
-from vibroimpact.orbits.shooting import ShootingError, shoot
+from vibroimpact.orbits.shooting import shoot
 
 __all__ = ["OFFSETS", "contact_orbit_at_onset"]
 
@@ -67,7 +67,7 @@ def contact_orbit_at_onset(mapping: ImpactMap, onset: float, outside: float, off
                 continue
             try:
                 orbit = shoot(mapping, linear[0], p)
-            except (ShootingError, RuntimeError, ValueError):
+            except (RuntimeError, ValueError):  # ShootingError among them: no orbit from this guess
                 continue
             if orbit.impacts > 0:
                 return orbit

@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 
 from vibroimpact.model.keywords import suggest_keywords
 from vibroimpact.orbits.arclength import ArclengthSystem, Point, TestFunction
-from vibroimpact.orbits.bifurcations import grazing_margin, locate, period_doubling_test
+from vibroimpact.orbits.bifurcations import critical_pair, grazing_margin, locate, period_doubling_test
 from vibroimpact.orbits.branch import MapEvaluation, ParametrisedMap, PeriodicOrbit, SpecialPoint
 from vibroimpact.orbits.continuation_settings import ContinuationSettings
 
@@ -88,12 +88,8 @@ def _critical_pair_test(out: MapEvaluation) -> float:
     reaching the curve's tolerance ("does not solve its extended system"); this one is O(1) wherever the pair is."""
     if not np.all(np.isfinite(out.jacobian)):
         return math.nan
-    mu = np.linalg.eigvals(out.jacobian)
-    pairs = mu[mu.imag > 1e-9 * np.maximum(np.abs(mu), 1.0)]
-    if pairs.size == 0:
-        return math.nan
-    nearest = pairs[int(np.argmin(np.abs(np.abs(pairs) - 1.0)))]
-    return float(abs(nearest) ** 2 - 1.0)
+    critical = critical_pair(np.linalg.eigvals(out.jacobian))
+    return math.nan if critical is None else float(abs(critical) ** 2 - 1.0)
 
 
 @suggest_keywords
